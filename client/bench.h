@@ -1,0 +1,22 @@
+// `lightfarm bench`: path tracing throughput against Embree's raw ray rate on one scene.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "absl/status/status.h"
+
+namespace lf {
+
+struct BenchOptions {
+    std::string scene_path;
+    uint64_t spp = 16;
+    int threads = 2;
+    int resolution = 256;
+    int max_depth = -1;
+    uint64_t raw_rays = 4'000'000;
+};
+
+absl::Status RunBench(const BenchOptions& options);
+
+}  // namespace lf

@@ -1,0 +1,27 @@
+// Pinhole camera exactly as docs/scene-format.md defines it.
+#pragma once
+
+#include "lf/core/ray.h"
+#include "lf/core/scene.h"
+
+namespace lf {
+
+class Camera {
+public:
+    // `origin` is subtracted from world positions: kernels render in a frame centred on the
+    // scene so float precision is spent where the geometry is (see EmbreeScene).
+    Camera(const CameraSpec& spec, const Vec3d& origin);
+
+    // Ray through film point (px + u, py + v); px counts from the left, py from the top.
+    Ray GenerateRay(int px, int py, float u, float v) const;
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+private:
+    Vec3 position_, forward_, right_, up_;
+    float tan_half_fov_ = 0, aspect_ = 1;
+    int width_ = 0, height_ = 0;
+};
+
+}  // namespace lf

@@ -1,0 +1,71 @@
+// Sample accumulation. Sums are exact fixed point (quantum 2^-50) in 128-bit integers, so adding tiles, passes or threads in any order gives the same bits, and 10^6
+// samples in one pixel lose nothing to rounding.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "lf/core/rgb.h"
+
+namespace lf {
+
+class ExactSum {
+public:
+    void Add(float x);
+    ExactSum& operator+=(const ExactSum& o) {
+        fixed_ += o.fixed_;
+        return *this;
+    }
+    double Value() const;
+    bool operator==(const ExactSum&) const = default;
+
+private:
+    __int128 fixed_ = 0;
+};
+
+// Samples of one pixel split into two halves by sample index parity: the halves are two
+// independent estimates whose difference measures the error of their mean.
+struct PixelSums {
+    ExactSum sum[2][3];
+    uint32_t count[2] = {0, 0};
+
+    void Add(uint64_t sample_index, const Rgb& value);
+    PixelSums& operator+=(const PixelSums& o);
+    uint32_t Count() const { return count[0] + count[1]; }
+    Rgb Mean() const;
+    Rgb HalfMean(int half) const;
+};
+
+struct PixelRect {
+    int x0 = 0, y0 = 0, width = 0, height = 0;
+    int64_t Area() const { return int64_t(width) * height; }
+    bool operator==(const PixelRect&) const = default;
+};
+
+struct RenderStats {
+    uint64_t samples = 0;
+    uint64_t rays = 0;           // every ray cast, camera and shadow rays included
+    uint64_t invalid_samples = 0;  // NaN or infinite samples, never written
+    RenderStats& operator+=(const RenderStats& o) {
+        samples += o.samples;
+        rays += o.rays;
+        invalid_samples += o.invalid_samples;
+        return *this;
+    }
+};
+
+// The accumulated samples of one rectangle of the image.
+struct TileSums {
+    PixelRect rect;
+    std::vector<PixelSums> pixels;  // row-major within rect
+    RenderStats stats;
+
+    explicit TileSums(const PixelRect& r) : rect(r), pixels(size_t(r.Area())) {}
+    PixelSums& at(int x, int y) { return pixels[size_t(y - rect.y0) * rect.width + (x - rect.x0)]; }
+    const PixelSums& at(int x, int y) const {
+        return pixels[size_t(y - rect.y0) * rect.width + (x - rect.x0)];
+    }
+    TileSums& operator+=(const TileSums& o);  // same rect
+};
+
+}  // namespace lf

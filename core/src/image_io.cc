@@ -1,0 +1,114 @@
+#include "lf/core/image_io.h"
+
+#include <png.h>
+
+#include <ImfAttribute.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStandardAttributes.h>
+#include <ImfStringAttribute.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfIntAttribute.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <vector>
+
+namespace lf {
+
+// OpenEXR reports errors by exception; this adapter turns them into status values.
+
+absl::Status WriteExr(const std::string& path, const Image& image, const ExrAttributes& attributes) {
+    try {
+        Imf::Header header(image.width(), image.height());
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const auto& [name, value] : attributes) {
+            if (const auto* s = std::get_if<std::string>(&value)) {
+                header.insert(name, Imf::StringAttribute(*s));
+            } else if (const auto* i = std::get_if<int>(&value)) {
+                header.insert(name, Imf::IntAttribute(*i));
+            } else {
+                header.insert(name, Imf::DoubleAttribute(std::get<double>(value)));
+            }
+        }
+        Imf::FrameBuffer frame;
+        for (const auto& [name, data] : image.channels()) {
+            header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+            frame.insert(name, Imf::Slice(Imf::FLOAT, (char*)data.data(), sizeof(float),
+                                          sizeof(float) * size_t(image.width())));
+        }
+        Imf::OutputFile file(path.c_str(), header);
+        file.setFrameBuffer(frame);
+        file.writePixels(image.height());
+    } catch (const std::exception& e) {
+        return absl::UnavailableError(path + ": cannot write EXR: " + e.what());
+    }
+    return absl::OkStatus();
+}
+
+absl::StatusOr<ExrFile> ReadExr(const std::string& path) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imath::Box2i dw = file.header().dataWindow();
+        const int width = dw.max.x - dw.min.x + 1, height = dw.max.y - dw.min.y + 1;
+        ExrFile out{Image(width, height), {}};
+        Imf::FrameBuffer frame;
+        for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+            std::vector<float>& data = out.image.Channel(it.name());
+            char* base = (char*)(data.data()) - (size_t(dw.min.x) + size_t(dw.min.y) * width) * sizeof(float);
+            frame.insert(it.name(), Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(width)));
+        }
+        file.setFrameBuffer(frame);
+        file.readPixels(dw.min.y, dw.max.y);
+        for (auto it = file.header().begin(); it != file.header().end(); ++it) {
+            if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) {
+                out.attributes[it.name()] = s->value();
+            } else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&it.attribute())) {
+                out.attributes[it.name()] = i->value();
+            } else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute())) {
+                out.attributes[it.name()] = d->value();
+            }
+        }
+        return out;
+    } catch (const std::exception& e) {
+        return absl::InvalidArgumentError(path + ": cannot read EXR: " + e.what());
+    }
+}
+
+namespace {
+uint8_t EncodeSrgb(float linear) {
+    const float v = std::clamp(std::isfinite(linear) ? linear : 0.0f, 0.0f, 1.0f);
+    const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    return uint8_t(std::lround(s * 255.0f));
+}
+}  // namespace
+
+absl::Status WritePng(const std::string& path, const Image& image, float exposure) {
+    const float scale = std::exp2(exposure);
+    std::vector<uint8_t> rgb(size_t(image.width()) * image.height() * 3);
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const Rgb c = image.Pixel(x, y) * scale;
+            uint8_t* out = &rgb[(size_t(y) * image.width() + x) * 3];
+            for (int k = 0; k < 3; ++k) out[k] = EncodeSrgb(c[k]);
+        }
+    }
+    png_image png{};
+    png.version = PNG_IMAGE_VERSION;
+    png.width = png_uint_32(image.width());
+    png.height = png_uint_32(image.height());
+    png.format = PNG_FORMAT_RGB;
+    if (!png_image_write_to_file(&png, path.c_str(), 0, rgb.data(), 0, nullptr)) {
+        std::string message = png.message;
+        png_image_free(&png);
+        return absl::UnavailableError(path + ": cannot write PNG: " + message);
+    }
+    return absl::OkStatus();
+}
+
+}  // namespace lf

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Installs lightfarm's build and test dependencies from Debian 12's packages.
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config
+  libembree-dev libopenexr-dev libtbb-dev libspdlog-dev nlohmann-json3-dev libcli11-dev
+  libpng-dev libtinyobjloader-dev
+  libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
+  libsqlite3-dev libgtest-dev libgmock-dev libbenchmark-dev
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+echo "install-deps: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,39 @@
+// BSDFs of the four material types, evaluated and sampled in a local shading frame whose +z is
+// the front face's normal. Reflection happens on both faces (lambert, mirror, glossy): a pair
+// of directions on the back side is treated as its mirror image on the front. For dielectrics
+// +z is the outside. Values are f(wo, wi) without the cosine; Pdf is per solid angle.
+#pragma once
+
+#include <optional>
+
+#include "lf/core/rgb.h"
+#include "lf/core/scene.h"
+#include "lf/core/vec.h"
+
+namespace lf {
+
+struct BsdfSample {
+    Rgb f;          // BSDF value for (wo, wi); for delta lobes the value that, times |cos|/pdf,
+                    // gives the throughput weight
+    Vec3 wi;
+    float pdf = 0;  // solid angle density; for delta lobes the discrete probability of the lobe
+    bool delta = false;
+};
+
+class Bsdf {
+public:
+    explicit Bsdf(const Material& material);
+
+    Rgb Eval(const Vec3& wo, const Vec3& wi) const;
+    float Pdf(const Vec3& wo, const Vec3& wi) const;
+    // uc picks a lobe (Fresnel reflect vs refract), u the direction.
+    std::optional<BsdfSample> Sample(const Vec3& wo, float uc, const Vec2& u) const;
+
+    // True when every lobe is a Dirac delta: light sampling is useless there.
+    bool IsDelta() const;
+
+private:
+    const Material* material_;
+};
+
+}  // namespace lf

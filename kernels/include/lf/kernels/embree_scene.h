@@ -1,0 +1,74 @@
+// The scene converted once into Embree geometry. Geometry lives in "render space": world
+// positions minus origin() (the centre of the scene's bounds), converted to float only after
+// that subtraction, so a scene 10^5 units from the world origin keeps full float precision.
+// Hit points carry pbrt-v4 style floating-point error bounds; rays leaving a surface start
+// beyond them (SpawnRay), so there is no self-intersection at any scale.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/ray.h"
+#include "lf/core/scene.h"
+
+namespace lf {
+
+struct SurfaceHit {
+    float t = 0;
+    Vec3 p;        // render space
+    Vec3 p_error;  // absolute error bound of p per axis
+    Vec3 n;        // unit geometric normal of the front face
+    int material = 0;
+    int mesh = -1;      // index in Scene::meshes, or -1 for a sphere
+    int sphere = -1;    // index in Scene::spheres, or -1 for a triangle
+    int primitive = 0;  // triangle index within the mesh
+    float b1 = 0, b2 = 0;  // barycentrics of vertices 1 and 2 of the triangle
+};
+
+// A point on a surface with its error bound and normal: where rays start and end.
+struct SurfacePoint {
+    Vec3 p, p_error, n;
+};
+
+// A ray origin just outside p's error box on the side of w.
+Vec3 OffsetRayOrigin(const SurfacePoint& sp, const Vec3& w);
+Ray SpawnRay(const SurfacePoint& from, const Vec3& direction);
+// A ray from `from` that stops just short of `to`: t in (0, 1 - epsilon) over d = to' - from'.
+Ray SpawnRayTo(const SurfacePoint& from, const SurfacePoint& to);
+
+class EmbreeScene {
+public:
+    static absl::StatusOr<std::unique_ptr<EmbreeScene>> Build(const Scene& scene);
+    ~EmbreeScene();
+    EmbreeScene(const EmbreeScene&) = delete;
+    EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+    std::optional<SurfaceHit> Intersect(const Ray& ray) const;
+    bool Occluded(const Ray& ray) const;
+
+    const Scene& scene() const { return scene_; }
+    const Vec3d& origin() const { return origin_; }
+
+    // Render-space geometry, for light sampling and meshing.
+    const std::vector<Vec3>& positions(int mesh) const { return positions_[size_t(mesh)]; }
+    Vec3 SphereCenter(int sphere) const { return sphere_centers_[size_t(sphere)]; }
+    // Vertices of triangle `primitive` of `mesh` in render space.
+    void Triangle(int mesh, int primitive, Vec3* p0, Vec3* p1, Vec3* p2) const;
+    SurfacePoint TrianglePoint(int mesh, int primitive, float b1, float b2) const;
+    SurfacePoint SpherePoint(int sphere, const Vec3& direction_from_center) const;
+
+private:
+    EmbreeScene(const Scene& scene, const Vec3d& origin);
+
+    const Scene& scene_;
+    Vec3d origin_;
+    struct Handles;
+    std::unique_ptr<Handles> handles_;
+    std::vector<std::vector<Vec3>> positions_;
+    std::vector<Vec3> sphere_centers_;
+    unsigned sphere_geometry_ = ~0u;
+};
+
+}  // namespace lf

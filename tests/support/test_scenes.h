@@ -1,0 +1,69 @@
+// Scenes built in code for kernel tests, and statistics helpers for their tolerances.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "lf/core/image.h"
+#include "lf/core/scene.h"
+
+namespace lf::testing {
+
+// A closed axis-aligned box, all six faces facing inward, every face of material 0.
+inline void AddInwardBox(Scene& scene, const Vec3d& center, double half, int material) {
+    const double h = half;
+    auto quad = [&](Vec3d a, Vec3d b, Vec3d c, Vec3d d) {
+        TriangleMesh m;
+        m.material = material;
+        m.is_quad = true;
+        m.positions = {center + a, center + b, center + c, center + d};
+        m.triangles = {{0, 1, 2}, {0, 2, 3}};
+        scene.meshes.push_back(m);
+    };
+    // Winding chosen so (v1-v0)x(v2-v0) points into the box.
+    quad({-h, -h, -h}, {h, -h, -h}, {h, -h, h}, {-h, -h, h});   // floor, normal +y
+    quad({-h, h, -h}, {-h, h, h}, {h, h, h}, {h, h, -h});       // ceiling, normal -y
+    quad({-h, -h, -h}, {-h, -h, h}, {-h, h, h}, {-h, h, -h});   // x = -h, normal +x
+    quad({h, -h, -h}, {h, h, -h}, {h, h, h}, {h, -h, h});       // x = +h, normal -x
+    quad({-h, -h, -h}, {-h, h, -h}, {h, h, -h}, {h, -h, -h});   // z = -h, normal +z
+    quad({-h, -h, h}, {h, -h, h}, {h, h, h}, {-h, h, h});       // z = +h, normal -z
+}
+
+// A furnace: a closed box of emission le and lambert reflectance rho, camera inside.
+inline Scene MakeFurnace(double half, const Vec3d& center, float rho, float le, int resolution) {
+    Scene scene;
+    Material m;
+    m.name = "furnace";
+    m.reflectance = Rgb(rho);
+    m.emission = Rgb(le);
+    scene.materials.push_back(m);
+    AddInwardBox(scene, center, half, 0);
+    scene.camera.position = center + Vec3d(0.1, -0.2, 0.05) * half;
+    scene.camera.look_at = center + Vec3d(1, 0.3, 0.7) * half;
+    scene.camera.up = {0, 1, 0};
+    scene.camera.fov_y_deg = 90;
+    scene.camera.width = scene.camera.height = resolution;
+    return scene;
+}
+
+struct MeanAndError {
+    double mean = 0;
+    double standard_error = 0;
+};
+
+// Mean of a channel over the image, and its standard error from the spread of the pixels
+// (each pixel an independent estimate with the same expectation).
+inline MeanAndError ChannelMean(const Image& image, const std::string& channel) {
+    const std::vector<float>& v = *image.FindChannel(channel);
+    double sum = 0, sum2 = 0;
+    for (float x : v) {
+        sum += x;
+        sum2 += double(x) * x;
+    }
+    const double n = double(v.size());
+    const double mean = sum / n;
+    const double var = std::max(0.0, (sum2 - n * mean * mean) / (n - 1));
+    return {mean, std::sqrt(var / n)};
+}
+
+}  // namespace lf::testing

@@ -1,0 +1,145 @@
+// The path tracer against analytic answers: furnaces at several albedos and scales, and a
+// point light over a Lambertian plane.
+#include "lf/kernels/path_tracer.h"
+
+#include <gtest/gtest.h>
+
+#include <numbers>
+
+#include "lf/core/camera.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/tile_renderer.h"
+#include "test_scenes.h"
+
+namespace lf {
+namespace {
+
+// 5 standard errors: a correct renderer fails with probability below 1e-6 per check.
+constexpr double kSigmas = 5.0;
+
+RenderOutput Render(const Scene& scene, uint64_t spp, int max_depth = -1, uint64_t seed = 1) {
+    auto es = EmbreeScene::Build(scene);
+    EXPECT_TRUE(es.ok()) << es.status();
+    const Camera camera(scene.camera, (*es)->origin());
+    const PathTracer tracer(**es, max_depth);
+    RenderSettings settings;
+    settings.spp = spp;
+    settings.seed = seed;
+    settings.tile = 8;
+    return RenderImage(camera, tracer, settings);
+}
+
+struct FurnaceCase {
+    float rho;
+    double half;
+    double offset;
+};
+
+class Furnace : public ::testing::TestWithParam<FurnaceCase> {};
+
+// A closed box emitting Le with albedo rho everywhere: L = Le / (1 - rho) at every point,
+// the Neumann series summed to infinite depth (roulette only).
+TEST_P(Furnace, RadianceIsEmissionOverOneMinusAlbedo) {
+    const FurnaceCase c = GetParam();
+    const float le = 0.5f;
+    const Scene scene = testing::MakeFurnace(c.half, Vec3d(c.offset, c.offset, c.offset), c.rho,
+                                             le, 16);
+    const RenderOutput out = Render(scene, 64);
+    const double expected = le / (1.0 - c.rho);
+    EXPECT_EQ(out.stats.invalid_samples, 0u);
+    for (const char* channel : {"R", "G", "B"}) {
+        const testing::MeanAndError m = testing::ChannelMean(out.image, channel);
+        if (c.rho == 0) {
+            EXPECT_NEAR(m.mean, expected, 1e-6 * expected) << channel;
+            continue;
+        }
+        // The check has power only if the noise is small next to a plausible bug (a lost bounce).
+        EXPECT_LT(m.standard_error, 0.01 * expected) << channel;
+        EXPECT_NEAR(m.mean, expected, kSigmas * m.standard_error) << channel;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Albedos, Furnace,
+    ::testing::Values(FurnaceCase{0.0f, 1.0, 0.0}, FurnaceCase{0.5f, 1.0, 0.0},
+                      FurnaceCase{0.9f, 1.0, 0.0},
+                      // Scale extremes and far from the origin: leaks or self-intersection
+                      // would lose energy and show here.
+                      FurnaceCase{0.9f, 1e-4, 0.0}, FurnaceCase{0.9f, 1e5, 0.0},
+                      FurnaceCase{0.9f, 1.0, 1e5}, FurnaceCase{0.5f, 1e3, 1e5}),
+    [](const auto& info) {
+        return "rho" + std::to_string(int(info.param.rho * 100)) + "_case" +
+               std::to_string(info.index);
+    });
+
+TEST(Furnace, MaxDepthTruncatesTheNeumannSeries) {
+    // With at most N bounces, L = Le (1 + rho + ... + rho^N).
+    const float rho = 0.5f, le = 1.0f;
+    const Scene scene = testing::MakeFurnace(1.0, Vec3d(), rho, le, 16);
+    for (int depth : {0, 1, 3}) {
+        const RenderOutput out = Render(scene, 64, depth);
+        const double expected = le * (1 - std::pow(rho, depth + 1)) / (1 - rho);
+        const testing::MeanAndError m = testing::ChannelMean(out.image, "G");
+        EXPECT_NEAR(m.mean, expected, kSigmas * m.standard_error + 1e-6) << "depth " << depth;
+    }
+}
+
+// A point light of intensity I at height h over a Lambertian plane of albedo rho:
+// L(x) = rho/pi * I cos(theta) / r^2 with cos(theta) = h / r.
+TEST(PointLight, LambertianPlaneMatchesInverseSquareLaw) {
+    Scene scene;
+    Material plane;
+    plane.reflectance = Rgb(0.5f, 0.25f, 0.75f);
+    scene.materials.push_back(plane);
+    TriangleMesh m;
+    const double s = 50;
+    m.positions = {{-s, 0, -s}, {-s, 0, s}, {s, 0, s}, {s, 0, -s}};  // normal +y
+    m.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(m);
+    const Vec3d light(0.3, 1.0, -0.2);
+    const Rgb intensity(10.0f, 5.0f, 2.0f);
+    scene.point_lights.push_back({light, intensity});
+    scene.camera.position = {0, 3, 0};
+    scene.camera.look_at = {0, 0, 0};
+    scene.camera.up = {0, 0, 1};
+    scene.camera.fov_y_deg = 60;
+    scene.camera.width = scene.camera.height = 16;
+
+    const uint64_t spp = 64;
+    const RenderOutput out = Render(scene, spp, -1);
+    auto es = EmbreeScene::Build(scene);
+    const Camera camera(scene.camera, Vec3d());
+    // The expected pixel value is the mean of L over the pixel's footprint; integrate it on a
+    // fine grid, and take the spread over the footprint as the per-sample standard deviation.
+    constexpr int kGrid = 24;
+    for (int py = 0; py < 16; ++py) {
+        for (int px = 0; px < 16; ++px) {
+            double sum = 0, sum2 = 0;
+            for (int j = 0; j < kGrid; ++j) {
+                for (int i = 0; i < kGrid; ++i) {
+                    const Ray r = camera.GenerateRay(px, py, (i + 0.5f) / kGrid, (j + 0.5f) / kGrid);
+                    const double t = -double(r.o.y) / r.d.y;
+                    const Vec3d x(r.o.x + t * r.d.x, 0, r.o.z + t * r.d.z);
+                    const double dist2 = LengthSquared(light - x);
+                    const double cos_theta = light.y / std::sqrt(dist2);
+                    const double L = cos_theta / dist2 / std::numbers::pi;  // per unit rho*I
+                    sum += L;
+                    sum2 += L * L;
+                }
+            }
+            const double n = kGrid * kGrid;
+            const double mean = sum / n;
+            const double sd = std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+            const Rgb got = out.image.Pixel(px, py);
+            for (int c = 0; c < 3; ++c) {
+                const double k = double(plane.reflectance[c]) * intensity[c];
+                // Midpoint-rule error is far below the sampling error; 1e-5 covers float rounding.
+                const double tol = kSigmas * k * sd / std::sqrt(double(spp)) + 1e-5 * k * mean;
+                EXPECT_NEAR(got[c], k * mean, tol) << "pixel " << px << "," << py << " ch " << c;
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace lf
