@@ -2,6 +2,11 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
@@ -30,7 +35,27 @@ ExrAttributes DescribeRender(const std::string& scene_hash, const std::string& m
     };
 }
 
+namespace {
+
+// Fails before any rendering, so an hour of work is not lost to a typo in the output path.
+absl::Status CheckWritable(const std::string& path) {
+    if (path.empty()) return absl::OkStatus();
+    const bool existed = std::filesystem::exists(path);
+    std::ofstream probe(path, std::ios::app);
+    if (!probe) {
+        return absl::PermissionDeniedError(path + ": cannot write here: " + std::strerror(errno));
+    }
+    probe.close();
+    if (!existed) std::filesystem::remove(path);
+    return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options) {
+    for (const std::string* path : {&options.exr_path, &options.png_path}) {
+        if (absl::Status s = CheckWritable(*path); !s.ok()) return s;
+    }
     auto log = spdlog::get("render");
     if (!log) log = spdlog::default_logger()->clone("render");
 

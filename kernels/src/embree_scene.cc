@@ -20,6 +20,10 @@ struct EmbreeScene::Handles {
 
 namespace {
 
+// Strictly positive: an origin exactly on a surface (zero error bound, e.g. at coordinate 0 on
+// an axis-aligned plane) must not hit that surface at t = 0.
+constexpr float kTNear = std::numeric_limits<float>::min();
+
 void OnEmbreeError(void*, RTCError code, const char* message) {
     spdlog::error("embree: error {}: {}", int(code), message ? message : "");
 }
@@ -161,7 +165,7 @@ std::optional<SurfaceHit> EmbreeScene::Intersect(const Ray& ray) const {
     rh.ray.dir_x = ray.d.x;
     rh.ray.dir_y = ray.d.y;
     rh.ray.dir_z = ray.d.z;
-    rh.ray.tnear = 0.0f;
+    rh.ray.tnear = kTNear;
     rh.ray.tfar = ray.t_max;
     rh.ray.mask = ~0u;
     rh.ray.flags = 0;
@@ -203,7 +207,7 @@ bool EmbreeScene::Occluded(const Ray& ray) const {
     r.dir_x = ray.d.x;
     r.dir_y = ray.d.y;
     r.dir_z = ray.d.z;
-    r.tnear = 0.0f;
+    r.tnear = kTNear;
     r.tfar = ray.t_max;
     r.mask = ~0u;
     r.flags = 0;

@@ -16,11 +16,11 @@ inline void AddInwardBox(Scene& scene, const Vec3d& center, double half, int mat
         TriangleMesh m;
         m.material = material;
         m.is_quad = true;
-        m.positions = {center + a, center + b, center + c, center + d};
+        m.positions = {center + a, center + d, center + c, center + b};
         m.triangles = {{0, 1, 2}, {0, 2, 3}};
         scene.meshes.push_back(m);
     };
-    // Winding chosen so (v1-v0)x(v2-v0) points into the box.
+    // The corners below run outward-facing; listing them reversed makes the normals point in.
     quad({-h, -h, -h}, {h, -h, -h}, {h, -h, h}, {-h, -h, h});   // floor, normal +y
     quad({-h, h, -h}, {-h, h, h}, {h, h, h}, {h, h, -h});       // ceiling, normal -y
     quad({-h, -h, -h}, {-h, -h, h}, {-h, h, h}, {-h, h, -h});   // x = -h, normal +x
