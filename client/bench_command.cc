@@ -1,0 +1,29 @@
+#include "bench.h"
+#include "command.h"
+
+namespace lf {
+
+Command AddBenchCommand(CLI::App& app) {
+    auto options = std::make_shared<BenchOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "bench",
+        "Measure path samples/s and rays/s on a scene, and Embree's raw closest-hit rate for\n"
+        "incoherent rays in the same scene (the hardware limit for comparison).");
+    cmd->add_option("scene", options->scene_path, "scene file (JSON)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--spp", options->spp, "samples per pixel")->capture_default_str();
+    cmd->add_option("--threads", options->threads, "threads")->capture_default_str();
+    cmd->add_option("--resolution", options->resolution, "square image side (0 = scene's)")
+        ->capture_default_str();
+    cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
+        ->capture_default_str();
+    cmd->add_option("--rays", options->raw_rays, "rays for the raw Embree measurement")
+        ->capture_default_str();
+    return {cmd, [options] {
+                const absl::Status status = RunBench(*options);
+                return status.ok() ? 0 : ReportError(status);
+            }};
+}
+
+}  // namespace lf

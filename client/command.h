@@ -1,0 +1,24 @@
+// A subcommand of `lightfarm`: its CLI11 parser and what runs when the user picks it.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+
+namespace lf {
+
+struct Command {
+    CLI::App* parser;
+    std::function<int()> run;  // the process exit status
+};
+
+// Prints "lightfarm: error: <message>" and returns 1.
+int ReportError(const absl::Status& status);
+
+Command AddRenderCommand(CLI::App& app);
+Command AddBenchCommand(CLI::App& app);
+
+}  // namespace lf

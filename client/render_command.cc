@@ -1,0 +1,62 @@
+#include <cstdio>
+
+#include "command.h"
+#include "local_render.h"
+
+namespace lf {
+
+int ReportError(const absl::Status& status) {
+    std::fprintf(stderr, "lightfarm: error: %s\n", std::string(status.message()).c_str());
+    return 1;
+}
+
+Command AddRenderCommand(CLI::App& app) {
+    auto options = std::make_shared<LocalRenderOptions>();
+    auto no_progress = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand(
+        "render",
+        "Render a scene in this process (path tracing) to an OpenEXR image.\n"
+        "The EXR holds float32 R,G,B (mean radiance per pixel, W m^-2 sr^-1, box filter), the\n"
+        "two half-sample estimates A.R,A.G,A.B and B.R,B.G,B.B (even and odd samples; their\n"
+        "difference estimates the error) and spp, with header attributes lightfarm.* saying\n"
+        "how the image was made. Same seed and settings give the same bits for any --tile and\n"
+        "--threads.");
+    cmd->add_option("scene", options->scene_path, "scene file (JSON)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", options->exr_path, "output OpenEXR file")->required();
+    cmd->add_option("--png", options->png_path, "also write an sRGB PNG preview (clamped)");
+    cmd->add_option("--spp", options->render.spp, "samples per pixel")
+        ->capture_default_str()
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 24));
+    cmd->add_option("--seed", options->render.seed, "random seed")->capture_default_str();
+    cmd->add_option("--max-depth", options->max_depth,
+                    "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
+        ->capture_default_str()
+        ->check(CLI::Range(-1, 1 << 20));
+    cmd->add_option("--threads", options->render.threads, "worker threads; 0 = all cores")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1024));
+    cmd->add_option("--tile", options->render.tile, "tile side in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 65536));
+    cmd->add_flag("--no-progress", *no_progress, "no progress bar");
+
+    return {cmd, [options, no_progress] {
+                options->progress = !*no_progress;
+                absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
+                if (!summary.ok()) return ReportError(summary.status());
+                const double s = summary->seconds;
+                std::printf(
+                    "job %s: %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
+                    "%llu NaN/Inf samples -> %s\n",
+                    summary->job_id.c_str(), summary->width, summary->height,
+                    (unsigned long long)summary->stats.samples, s,
+                    summary->stats.samples / s * 1e-6, summary->stats.rays / s * 1e-6,
+                    (unsigned long long)summary->stats.invalid_samples,
+                    options->exr_path.c_str());
+                return 0;
+            }};
+}
+
+}  // namespace lf
