@@ -14,12 +14,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct RunResult {
     int status;
     std::string output;  // stdout and stderr
 };
 
-Run Lightfarm(const std::string& args) {
+RunResult Lightfarm(const std::string& args) {
     const std::string cmd = std::string(LF_BIN_DIR) + "/lightfarm " + args + " 2>&1";
     FILE* pipe = popen(cmd.c_str(), "r");
     std::string out;
@@ -45,7 +45,7 @@ protected:
 
 TEST_F(Cli, RenderWritesExrWithMetadataAndPng) {
     const std::string exr = (dir_ / "c.exr").string(), png = (dir_ / "c.png").string();
-    const Run r = Lightfarm("render " + std::string(LF_TEST_SCENES) +
+    const RunResult r = Lightfarm("render " + std::string(LF_TEST_SCENES) +
                             "/cornell_box.json -o " + exr + " --png " + png +
                             " --spp 2 --seed 3 --threads 2 --tile 16 --no-progress");
     ASSERT_EQ(r.status, 0) << r.output;
@@ -68,7 +68,7 @@ TEST_F(Cli, RenderWritesExrWithMetadataAndPng) {
 
 TEST_F(Cli, HelpExplainsEveryCommand) {
     for (const char* cmd : {"--help", "render --help", "bench --help"}) {
-        const Run r = Lightfarm(cmd);
+        const RunResult r = Lightfarm(cmd);
         EXPECT_EQ(r.status, 0) << cmd;
         EXPECT_NE(r.output.find("Usage"), std::string::npos) << cmd << r.output;
     }
@@ -76,7 +76,7 @@ TEST_F(Cli, HelpExplainsEveryCommand) {
 
 TEST_F(Cli, MalformedSceneNamesTheFileAndLine) {
     const std::string scene = Write("bad.json", "{\n  \"camera\": {\n    \"position\": [0, 0,\n");
-    const Run r = Lightfarm("render " + scene + " -o " + (dir_ / "x.exr").string());
+    const RunResult r = Lightfarm("render " + scene + " -o " + (dir_ / "x.exr").string());
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.output.find("bad.json"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
@@ -88,7 +88,7 @@ TEST_F(Cli, AbsurdOptionsAreRefused) {
     EXPECT_NE(Lightfarm(base + " --spp 0").status, 0);
     EXPECT_NE(Lightfarm(base + " --tile 0").status, 0);
     EXPECT_NE(Lightfarm(base + " --max-depth -5").status, 0);
-    const Run unwritable = Lightfarm(base.substr(0, base.find(" -o ")) +
+    const RunResult unwritable = Lightfarm(base.substr(0, base.find(" -o ")) +
                                      " -o /nonexistent/dir/x.exr --spp 1 --no-progress");
     EXPECT_NE(unwritable.status, 0);
     EXPECT_NE(unwritable.output.find("/nonexistent/dir/x.exr"), std::string::npos)
