@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/file_util.h"
 
 namespace lf {
 namespace {
@@ -35,28 +36,15 @@ struct MeshError {
 
 std::string LineSuffix(size_t line) { return line > 0 ? absl::StrCat(":", line) : ""; }
 
-std::vector<std::string_view> SplitFields(std::string_view line) {
-    std::vector<std::string_view> fields;
+std::vector<std::string> SplitFields(std::string_view line) {
+    std::vector<std::string> fields;
     size_t pos = 0;
     while ((pos = line.find_first_not_of(" \t\r", pos)) != std::string_view::npos) {
         const size_t end = std::min(line.find_first_of(" \t\r", pos), line.size());
-        fields.push_back(line.substr(pos, end - pos));
+        fields.emplace_back(line.substr(pos, end - pos));
         pos = end;
     }
     return fields;
-}
-
-absl::StatusOr<std::string> ReadFile(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        const std::string message = absl::StrCat(path, ": cannot open: ", std::strerror(errno));
-        if (!std::filesystem::exists(path)) return absl::NotFoundError(message);
-        return absl::InvalidArgumentError(message);
-    }
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    if (in.bad()) return absl::InvalidArgumentError(absl::StrCat(path, ": read error"));
-    return std::move(bytes).str();
 }
 
 // ---- Wavefront OBJ ---------------------------------------------------------------------------
@@ -69,7 +57,7 @@ size_t FindObjLine(std::string_view text, std::string_view keyword, Visit visit)
     while (pos < text.size()) {
         // Line ends as tinyobjloader counts them: \n, \r\n or a lone \r.
         const size_t end = std::min(text.find_first_of("\r\n", pos), text.size());
-        const std::vector<std::string_view> fields = SplitFields(text.substr(pos, end - pos));
+        const std::vector<std::string> fields = SplitFields(text.substr(pos, end - pos));
         ++line;
         pos = end + (text.substr(end, 2) == "\r\n" ? 2 : 1);
         if (!fields.empty() && fields[0] == keyword && visit(fields.size() - 1)) return line;
@@ -86,8 +74,10 @@ TriangleMesh ParseObj(const std::string& text) {
     if (!reader.ParseFromString(text, "", config)) {
         const std::string& error = reader.Error();
         const size_t at = error.rfind("line ");
-        const size_t line = at == std::string::npos ? 0 : std::strtoul(error.c_str() + at + 5, nullptr, 10);
-        Fail(LineSuffix(line), std::string(error.substr(0, error.find_last_not_of("\n.) ") + 1)));
+        const size_t line =
+            at == std::string::npos ? 0 : std::strtoul(error.c_str() + at + 5, nullptr, 10);
+        Fail(LineSuffix(line),
+             "tinyobjloader: " + error.substr(0, error.find_last_not_of("\n ") + 1));
     }
     if (reader.Warning().find("Degenerated face") != std::string::npos) {
         // tinyobjloader silently drops faces with fewer than three corners.
@@ -144,12 +134,14 @@ enum class PlyFormat { kAscii, kLittleEndian, kBigEndian };
 
 std::optional<PlyType> ParsePlyType(std::string_view name) {
     static constexpr std::pair<std::string_view, PlyType> kNames[] = {
-        {"char", PlyType::kInt8},     {"int8", PlyType::kInt8},       {"uchar", PlyType::kUint8},
-        {"uint8", PlyType::kUint8},   {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
-        {"ushort", PlyType::kUint16}, {"uint16", PlyType::kUint16},   {"int", PlyType::kInt32},
-        {"int32", PlyType::kInt32},   {"uint", PlyType::kUint32},     {"uint32", PlyType::kUint32},
-        {"float", PlyType::kFloat32}, {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
-        {"float64", PlyType::kFloat64}};
+        {"char", PlyType::kInt8},      {"int8", PlyType::kInt8},
+        {"uchar", PlyType::kUint8},    {"uint8", PlyType::kUint8},
+        {"short", PlyType::kInt16},    {"int16", PlyType::kInt16},
+        {"ushort", PlyType::kUint16},  {"uint16", PlyType::kUint16},
+        {"int", PlyType::kInt32},      {"int32", PlyType::kInt32},
+        {"uint", PlyType::kUint32},    {"uint32", PlyType::kUint32},
+        {"float", PlyType::kFloat32},  {"float32", PlyType::kFloat32},
+        {"double", PlyType::kFloat64}, {"float64", PlyType::kFloat64}};
     for (const auto& [n, type] : kNames) {
         if (n == name) return type;
     }
@@ -173,7 +165,7 @@ struct PlyElement {
 // Reads the body value by value. Errors name the element and record being read, and the line
 // for ASCII files.
 class PlyBodyReader {
-public:
+  public:
     PlyBodyReader(std::string_view body, PlyFormat format, size_t first_line)
         : body_(body), format_(format), line_(first_line) {}
 
@@ -189,29 +181,33 @@ public:
 
     double Read(PlyType type) {
         const double value = format_ == PlyFormat::kAscii ? ReadAscii() : ReadBinary(type);
-        if (!std::isfinite(value)) Fail("value is not finite");
         if (IsInteger(type) && value != std::floor(value)) {
             Fail(absl::StrCat("expected an integer, got ", value));
         }
         return value;
     }
 
-private:
+  private:
     double ReadAscii() {
-        while (pos_ < body_.size() && std::isspace(static_cast<unsigned char>(body_[pos_]))) {
-            if (body_[pos_++] == '\n') ++line_;
+        size_t pos = pos_, line = line_;
+        while (pos < body_.size() && std::isspace(static_cast<unsigned char>(body_[pos]))) {
+            if (body_[pos++] == '\n') ++line;
         }
-        if (pos_ == body_.size()) Fail("unexpected end of file");
+        // Reported at the last value's line, where the missing ones belong.
+        if (pos == body_.size()) Fail("unexpected end of file");
+        pos_ = pos;
+        line_ = line;
         const char* begin = body_.data() + pos_;
         const char* end = begin;
-        while (end < body_.data() + body_.size() && !std::isspace(static_cast<unsigned char>(*end))) {
+        while (end < body_.data() + body_.size() &&
+               !std::isspace(static_cast<unsigned char>(*end))) {
             ++end;
         }
         pos_ = size_t(end - body_.data());
         double value = 0;
         const auto [stop, error] = std::from_chars(begin, end, value);
         if (error != std::errc() || stop != end) {
-            Fail(absl::StrCat("expected a number, got \"", std::string_view(begin, end - begin), "\""));
+            Fail(absl::StrCat("expected a number, got \"", std::string(begin, end), "\""));
         }
         return value;
     }
@@ -223,18 +219,27 @@ private:
         unsigned char bytes[8];
         std::memcpy(bytes, body_.data() + pos_, size);
         pos_ += size;
-        const PlyFormat native =
-            std::endian::native == std::endian::little ? PlyFormat::kLittleEndian : PlyFormat::kBigEndian;
+        const PlyFormat native = std::endian::native == std::endian::little
+                                     ? PlyFormat::kLittleEndian
+                                     : PlyFormat::kBigEndian;
         if (format_ != native) std::reverse(bytes, bytes + size);
         switch (type) {
-            case PlyType::kInt8: return As<int8_t>(bytes);
-            case PlyType::kUint8: return As<uint8_t>(bytes);
-            case PlyType::kInt16: return As<int16_t>(bytes);
-            case PlyType::kUint16: return As<uint16_t>(bytes);
-            case PlyType::kInt32: return As<int32_t>(bytes);
-            case PlyType::kUint32: return As<uint32_t>(bytes);
-            case PlyType::kFloat32: return As<float>(bytes);
-            case PlyType::kFloat64: return As<double>(bytes);
+            case PlyType::kInt8:
+                return As<int8_t>(bytes);
+            case PlyType::kUint8:
+                return As<uint8_t>(bytes);
+            case PlyType::kInt16:
+                return As<int16_t>(bytes);
+            case PlyType::kUint16:
+                return As<uint16_t>(bytes);
+            case PlyType::kInt32:
+                return As<int32_t>(bytes);
+            case PlyType::kUint32:
+                return As<uint32_t>(bytes);
+            case PlyType::kFloat32:
+                return As<float>(bytes);
+            case PlyType::kFloat64:
+                return As<double>(bytes);
         }
         return 0;
     }
@@ -265,7 +270,7 @@ TriangleMesh ParsePly(std::string_view bytes) {
         return text;
     };
     const std::optional<std::string_view> magic = next_line();
-    if (!magic || SplitFields(*magic) != std::vector<std::string_view>{"ply"}) {
+    if (!magic || SplitFields(*magic) != std::vector<std::string>{"ply"}) {
         Fail(":1", "not a PLY file (it must start with a line `ply`)");
     }
 
@@ -275,7 +280,7 @@ TriangleMesh ParsePly(std::string_view bytes) {
     while (!header_ended) {
         const std::optional<std::string_view> text = next_line();
         if (!text) Fail("", "the header has no end_header line");
-        const std::vector<std::string_view> f = SplitFields(*text);
+        const std::vector<std::string> f = SplitFields(*text);
         const std::string where = LineSuffix(line);
         if (f.empty() || f[0] == "comment" || f[0] == "obj_info") continue;
         if (f[0] == "end_header") {
@@ -291,8 +296,9 @@ TriangleMesh ParsePly(std::string_view bytes) {
                 Fail(where, absl::StrCat("unknown format \"", f[1], "\""));
             }
         } else if (f[0] == "element" && f.size() == 3) {
-            PlyElement element{std::string(f[1])};
-            const auto [stop, error] = std::from_chars(f[2].data(), f[2].data() + f[2].size(), element.count);
+            PlyElement element{f[1], 0, {}};
+            const auto [stop, error] =
+                std::from_chars(f[2].data(), f[2].data() + f[2].size(), element.count);
             if (error != std::errc() || stop != f[2].data() + f[2].size()) {
                 Fail(where, absl::StrCat("bad element count \"", f[2], "\""));
             }
@@ -307,12 +313,13 @@ TriangleMesh ParsePly(std::string_view bytes) {
             if (list) {
                 property.count_type = ParsePlyType(f[2]);
                 if (!property.count_type || !IsInteger(*property.count_type)) {
-                    Fail(where, absl::StrCat("list length type \"", f[2], "\" is not an integer type"));
+                    Fail(where,
+                         absl::StrCat("list length type \"", f[2], "\" is not an integer type"));
                 }
             }
             elements.back().properties.push_back(std::move(property));
         } else {
-            Fail(where, absl::StrCat("unexpected header line \"", *text, "\""));
+            Fail(where, absl::StrCat("unexpected header line \"", std::string(*text), "\""));
         }
     }
     if (!format) Fail("", "the header has no format line");
@@ -326,6 +333,9 @@ TriangleMesh ParsePly(std::string_view bytes) {
         }
         return -1;
     };
+    auto find_corners = [&](const PlyElement& e) {
+        return std::max(find(e, "vertex_indices", true), find(e, "vertex_index", true));
+    };
     uint64_t vertex_count = 0;
     bool has_vertices = false, has_faces = false;
     for (const PlyElement& e : elements) {
@@ -333,14 +343,20 @@ TriangleMesh ParsePly(std::string_view bytes) {
             has_vertices = true;
             vertex_count = e.count;
             for (const char* axis : {"x", "y", "z"}) {
-                if (find(e, axis, false) < 0) Fail("", absl::StrCat("vertex element has no property ", axis));
+                if (find(e, axis, false) < 0) {
+                    Fail("", absl::StrCat("vertex element has no property ", axis));
+                }
             }
             if (vertex_count > std::numeric_limits<uint32_t>::max()) Fail("", "too many vertices");
         } else if (e.name == "face") {
             has_faces = true;
-            const int list = std::max(find(e, "vertex_indices", true), find(e, "vertex_index", true));
-            if (list < 0) Fail("", "face element has no list property vertex_indices or vertex_index");
-            if (!IsInteger(e.properties[list].type)) Fail("", "face vertex indices are not integers");
+            const int list = find_corners(e);
+            if (list < 0) {
+                Fail("", "face element has no list property vertex_indices or vertex_index");
+            }
+            if (!IsInteger(e.properties[list].type)) {
+                Fail("", "face vertex indices are not integers");
+            }
         }
     }
     if (!has_vertices) Fail("", "no vertex element");
@@ -353,8 +369,7 @@ TriangleMesh ParsePly(std::string_view bytes) {
         if (e.properties.empty()) continue;
         const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
         const int axes[3] = {find(e, "x", false), find(e, "y", false), find(e, "z", false)};
-        const int corner_list =
-            is_face ? std::max(find(e, "vertex_indices", true), find(e, "vertex_index", true)) : -1;
+        const int corner_list = is_face ? find_corners(e) : -1;
         // A count larger than the file can hold must not turn into a huge allocation.
         if (is_vertex) mesh.positions.reserve(std::min<uint64_t>(e.count, bytes.size()));
         for (uint64_t r = 0; r < e.count; ++r) {
@@ -372,20 +387,24 @@ TriangleMesh ParsePly(std::string_view bytes) {
                 }
                 const double n = reader.Read(*property.count_type);
                 if (n < 0) reader.Fail("negative list length");
-                for (double i = 0; i < n; ++i) {
+                for (uint64_t i = 0; i < uint64_t(n); ++i) {
                     const double value = reader.Read(property.type);
                     if (k != corner_list) continue;
                     if (value < 0 || value >= double(vertex_count)) {
-                        reader.Fail(absl::StrCat("vertex index ", value, " out of range (", vertex_count,
-                                                 " vertices)"));
+                        reader.Fail(absl::StrCat("vertex index ", value, " out of range (",
+                                                 vertex_count, " vertices)"));
                     }
                     corners.push_back(uint32_t(value));
                 }
             }
-            if (is_vertex) mesh.positions.push_back(p);
+            if (is_vertex) {
+                if (!IsFinite(p)) reader.Fail("coordinate is not finite");
+                mesh.positions.push_back(p);
+            }
             if (!is_face) continue;
             if (corners.size() < 3) {
-                reader.Fail(absl::StrCat("has ", corners.size(), " vertex indices; need at least 3"));
+                reader.Fail(
+                    absl::StrCat("has ", corners.size(), " vertex indices; need at least 3"));
             }
             for (size_t c = 1; c + 1 < corners.size(); ++c) {
                 mesh.triangles.push_back({corners[0], corners[c], corners[c + 1]});
@@ -402,8 +421,8 @@ absl::StatusOr<TriangleMesh> LoadMesh(const std::string& path) {
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
     if (extension != ".obj" && extension != ".ply") {
-        return absl::InvalidArgumentError(
-            absl::StrCat(path, ": unknown mesh format \"", extension, "\" (expected .obj or .ply)"));
+        return absl::InvalidArgumentError(absl::StrCat(path, ": unknown mesh format \"", extension,
+                                                       "\" (expected .obj or .ply)"));
     }
     absl::StatusOr<std::string> bytes = ReadFile(path);
     if (!bytes.ok()) return bytes.status();

@@ -1,0 +1,607 @@
+#include "lf/core/scene_loader.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <string_view>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "lf/core/file_util.h"
+#include "lf/core/mesh_io.h"
+
+namespace lf {
+namespace {
+
+// Keeps the materials object in file order, which is the order of Scene::materials.
+using Json = nlohmann::ordered_json;
+
+// Beyond this a coordinate is a unit mistake or garbage, and the float kernels would have no
+// precision left for the geometry's detail.
+constexpr double kMaxCoordinate = 1e15;
+constexpr int kMaxResolution = 65536;
+constexpr int64_t kMaxPixels = int64_t(1) << 28;
+// Twice a triangle's area below this fraction of its longest edge squared is within double
+// rounding of zero: the triangle has no reliable normal and no area to sample.
+constexpr double kDegenerateRatio = 1e-12;
+constexpr float kMaxFloat = std::numeric_limits<float>::max();
+
+// Validation runs many levels deep; an error unwinds to ParseScene as this exception, which adds
+// the source name, so every check stays one line.
+struct LoadError {
+    absl::Status status;
+};
+
+std::shared_ptr<spdlog::logger> SceneLogger() {
+    static std::mutex mutex;
+    std::lock_guard lock(mutex);
+    std::shared_ptr<spdlog::logger> logger = spdlog::get("scene");
+    if (!logger) {
+        logger = spdlog::default_logger()->clone("scene");
+        spdlog::register_logger(logger);
+    }
+    return logger;
+}
+
+// FNV-1a, 128-bit (Fowler, Noll, Vo): not cryptographic, but content_hash only has to tell
+// changed inputs apart, and this needs no library.
+class Fnv1a128 {
+  public:
+    void Update(std::string_view bytes) {
+        constexpr unsigned __int128 kPrime = (unsigned __int128)1 << 88 | 0x13b;
+        for (const char c : bytes) {
+            state_ ^= static_cast<unsigned char>(c);
+            state_ *= kPrime;
+        }
+    }
+    std::string Hex() const {
+        static constexpr char kDigits[] = "0123456789abcdef";
+        std::string hex(32, '0');
+        for (int i = 0; i < 32; ++i) hex[31 - i] = kDigits[int(state_ >> (4 * i)) & 15];
+        return hex;
+    }
+
+  private:
+    unsigned __int128 state_ = (unsigned __int128)0x6c62272e07bb0142 << 64 | 0x62b821756295c58d;
+};
+
+// nlohmann reports a number too large for a double without its position; as a SAX parser this
+// sees the byte offset of every error, so each one can name a line and column.
+class LocatingDomParser : public nlohmann::detail::json_sax_dom_parser<Json> {
+  public:
+    explicit LocatingDomParser(Json& result) : json_sax_dom_parser(result, false) {}
+
+    bool parse_error(std::size_t byte, const std::string&, const nlohmann::detail::exception& e) {
+        error_byte = byte;
+        error = e.what();
+        return false;
+    }
+
+    std::size_t error_byte = 0;
+    std::string error;
+};
+
+absl::Status ParseJson(const std::string& text, const std::string& source, Json& root) {
+    LocatingDomParser parser(root);
+    if (Json::sax_parse(text, &parser)) return absl::OkStatus();
+    // The offset counts the characters read, so the offending one is just before it.
+    const size_t at = std::min(text.size(), parser.error_byte > 0 ? parser.error_byte - 1 : 0);
+    const size_t line = 1 + std::count(text.begin(), text.begin() + at, '\n');
+    const size_t newline = at == 0 ? std::string::npos : text.rfind('\n', at - 1);
+    const size_t column = at + 1 - (newline == std::string::npos ? 0 : newline + 1);
+    // Drop nlohmann's "[json.exception.parse_error.101] parse error at line 2, column 9: ".
+    std::string message = parser.error.substr(parser.error.find(']') + 2);
+    if (message.starts_with("parse error")) message = message.substr(message.find(": ") + 2);
+    return absl::InvalidArgumentError(
+        absl::StrCat(source, ":", line, ":", column, ": JSON syntax error: ", message));
+}
+
+std::string Describe(const Json& json) {
+    if (json.is_string()) return absl::StrCat("string \"", json.get<std::string>(), "\"");
+    if (json.is_number()) return absl::StrCat("number ", json.get<double>());
+    return json.type_name();
+}
+
+// A JSON value with its path from the root (`shapes[2].vertices[1]`), for messages.
+class Node {
+  public:
+    Node(const Json& json, std::string path, std::vector<std::string>* warnings)
+        : json_(json), path_(std::move(path)), warnings_(warnings) {}
+
+    const Json& json() const { return json_; }
+    const std::string& path() const { return path_; }
+
+    [[noreturn]] void Fail(const std::string& message) const {
+        throw LoadError{absl::InvalidArgumentError(
+            path_.empty() ? std::string(message) : absl::StrCat(path_, ": ", message))};
+    }
+
+    void RequireObject() const {
+        if (!json_.is_object()) Fail(absl::StrCat("expected an object, got ", Describe(json_)));
+    }
+
+    // Unknown keys are most likely typos, but they do not make the scene unusable.
+    void WarnUnknownKeys(std::initializer_list<std::string_view> known) const {
+        for (const auto& [key, value] : json_.items()) {
+            if (std::find(known.begin(), known.end(), key) == known.end()) {
+                warnings_->push_back(absl::StrCat(Child(key), ": unknown key, ignored"));
+            }
+        }
+    }
+
+    void ExpectObject(std::initializer_list<std::string_view> known) const {
+        RequireObject();
+        WarnUnknownKeys(known);
+    }
+
+    bool Has(const std::string& key) const { return json_.contains(key); }
+
+    std::optional<Node> Find(const std::string& key) const {
+        if (!json_.contains(key)) return std::nullopt;
+        return Node(json_.at(key), Child(key), warnings_);
+    }
+
+    Node Get(const std::string& key) const {
+        if (!json_.contains(key)) Fail(absl::StrCat("missing required key \"", key, "\""));
+        return Node(json_.at(key), Child(key), warnings_);
+    }
+
+    // The elements of an array; `count`, when given, is required.
+    std::vector<Node> Elements(std::optional<size_t> count = std::nullopt) const {
+        if (!json_.is_array()) Fail(absl::StrCat("expected an array, got ", Describe(json_)));
+        if (count && json_.size() != *count) {
+            Fail(absl::StrCat("expected ", *count, " elements, got ", json_.size()));
+        }
+        std::vector<Node> elements;
+        for (size_t i = 0; i < json_.size(); ++i) {
+            elements.emplace_back(json_[i], absl::StrCat(path_, "[", i, "]"), warnings_);
+        }
+        return elements;
+    }
+
+    std::string String() const {
+        if (!json_.is_string()) Fail(absl::StrCat("expected a string, got ", Describe(json_)));
+        return json_.get<std::string>();
+    }
+
+    double Number() const {
+        if (!json_.is_number()) Fail(absl::StrCat("expected a number, got ", Describe(json_)));
+        const double value = json_.get<double>();
+        if (!std::isfinite(value)) Fail("not a finite number");
+        return value;
+    }
+
+    double NumberIn(double lo, double hi, const std::string& range) const {
+        const double value = Number();
+        if (!(value >= lo && value <= hi)) Fail(absl::StrCat("must be ", range, ", got ", value));
+        return value;
+    }
+
+    // A number in (0, kMaxFloat]: the kernels keep material parameters in float.
+    float PositiveFloat() const {
+        const double value = Number();
+        if (!(value > 0 && value <= kMaxFloat)) {
+            Fail(absl::StrCat("must be a positive float, got ", value));
+        }
+        return float(value);
+    }
+
+    int Integer(int lo, int hi) const {
+        const double value = NumberIn(lo, hi, absl::StrCat("an integer in [", lo, ", ", hi, "]"));
+        if (value != std::floor(value)) Fail(absl::StrCat("must be an integer, got ", value));
+        return int(value);
+    }
+
+    double Coordinate() const { return NumberIn(-kMaxCoordinate, kMaxCoordinate, "within ±1e15"); }
+
+    // [x, y, z], each a Coordinate().
+    Vec3d Vector() const {
+        const std::vector<Node> e = Elements(3);
+        return {e[0].Coordinate(), e[1].Coordinate(), e[2].Coordinate()};
+    }
+
+    // [r, g, b], each in [0, max].
+    Rgb Color(float max) const {
+        const std::vector<Node> e = Elements(3);
+        const std::string range = max == 1 ? "in [0, 1]" : "≥ 0 and below 3.4e38 (float range)";
+        return {float(e[0].NumberIn(0, max, range)), float(e[1].NumberIn(0, max, range)),
+                float(e[2].NumberIn(0, max, range))};
+    }
+
+  private:
+    std::string Child(const std::string& key) const {
+        return path_.empty() ? std::string(key) : absl::StrCat(path_, ".", key);
+    }
+
+    const Json& json_;
+    std::string path_;
+    std::vector<std::string>* warnings_;
+};
+
+// x -> M x + t, with M the 3x3 part of `m` and t its last column.
+struct Affine {
+    std::array<std::array<double, 4>, 3> m{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
+
+    Vec3d Apply(const Vec3d& p) const {
+        Vec3d out;
+        for (int r = 0; r < 3; ++r) {
+            out[r] = m[r][0] * p.x + m[r][1] * p.y + m[r][2] * p.z + m[r][3];
+        }
+        return out;
+    }
+    // This transform followed by `next`.
+    Affine Then(const Affine& next) const {
+        Affine out;
+        for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 4; ++c) {
+                out.m[r][c] = next.m[r][0] * m[0][c] + next.m[r][1] * m[1][c] +
+                              next.m[r][2] * m[2][c] + (c == 3 ? next.m[r][3] : 0);
+            }
+        }
+        return out;
+    }
+    Vec3d Row(int r) const { return {m[r][0], m[r][1], m[r][2]}; }
+    double Determinant() const { return Dot(Row(0), Cross(Row(1), Row(2))); }
+};
+
+Affine ParseTransform(const Node& n) {
+    n.ExpectObject({"scale", "rotate", "translate", "matrix"});
+    Affine transform;
+    if (const std::optional<Node> matrix = n.Find("matrix")) {
+        if (n.Has("scale") || n.Has("rotate") || n.Has("translate")) {
+            n.Fail("give either matrix or scale/rotate/translate, not both");
+        }
+        const std::vector<Node> e = matrix->Elements(16);
+        for (int i = 0; i < 12; ++i) transform.m[i / 4][i % 4] = e[i].Coordinate();
+        for (int i = 12; i < 16; ++i) {
+            if (e[i].Number() != (i == 15 ? 1 : 0)) {
+                matrix->Fail("the last row must be [0, 0, 0, 1] (affine transforms only)");
+            }
+        }
+    }
+    if (const std::optional<Node> scale = n.Find("scale")) {
+        const Vec3d s =
+            scale->json().is_number() ? Vec3d(1, 1, 1) * scale->Coordinate() : scale->Vector();
+        for (int a = 0; a < 3; ++a) transform.m[a][a] = s[a];
+    }
+    if (const std::optional<Node> rotate = n.Find("rotate")) {
+        rotate->ExpectObject({"axis", "angle_deg"});
+        const Node axis_node = rotate->Get("axis");
+        const Vec3d axis = axis_node.Vector();
+        if (LengthSquared(axis) == 0) axis_node.Fail("must not be zero");
+        const Vec3d a = Normalize(axis);
+        const double angle = rotate->Get("angle_deg").Number() * std::numbers::pi / 180;
+        const double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
+        Affine rotation;  // Rodrigues: counter-clockwise looking down the axis at the origin
+        rotation.m = {{{t * a.x * a.x + c, t * a.x * a.y - s * a.z, t * a.x * a.z + s * a.y, 0},
+                       {t * a.x * a.y + s * a.z, t * a.y * a.y + c, t * a.y * a.z - s * a.x, 0},
+                       {t * a.x * a.z - s * a.y, t * a.y * a.z + s * a.x, t * a.z * a.z + c, 0}}};
+        transform = transform.Then(rotation);
+    }
+    if (const std::optional<Node> translate = n.Find("translate")) {
+        const Vec3d t = translate->Vector();
+        for (int a = 0; a < 3; ++a) transform.m[a][3] += t[a];
+    }
+    const double scale =
+        Length(transform.Row(0)) * Length(transform.Row(1)) * Length(transform.Row(2));
+    if (!(std::abs(transform.Determinant()) > kDegenerateRatio * scale)) {
+        n.Fail("singular: it flattens the mesh");
+    }
+    return transform;
+}
+
+// Drops triangles with repeated vertices or (near) zero area; returns how many.
+int DropDegenerate(TriangleMesh& mesh) {
+    const size_t before = mesh.triangles.size();
+    std::erase_if(mesh.triangles, [&](const std::array<uint32_t, 3>& t) {
+        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return true;
+        const Vec3d& a = mesh.positions[t[0]];
+        const Vec3d e0 = mesh.positions[t[1]] - a, e1 = mesh.positions[t[2]] - a, e2 = e1 - e0;
+        const double longest = std::max({LengthSquared(e0), LengthSquared(e1), LengthSquared(e2)});
+        return !(Length(Cross(e0, e1)) > kDegenerateRatio * longest);
+    });
+    return int(before - mesh.triangles.size());
+}
+
+class SceneParser {
+  public:
+    explicit SceneParser(std::string base_dir) : base_dir_(std::move(base_dir)) {}
+
+    Scene Parse(const Json& json, const std::string& text) {
+        hash_.Update(text);
+        const Node root(json, "", &warnings_);
+        root.ExpectObject({"version", "camera", "materials", "shapes", "lights"});
+        if (const std::optional<Node> version = root.Find("version")) {
+            if (version->Number() != 1) version->Fail("unsupported; this build reads version 1");
+        }
+        Scene scene;
+        scene.camera = ParseCamera(root.Get("camera"));
+
+        const Node materials = root.Get("materials");
+        materials.RequireObject();
+        for (const auto& [name, value] : materials.json().items()) {
+            material_index_[name] = int(scene.materials.size());
+            scene.materials.push_back(
+                ParseMaterial(name, Node(value, absl::StrCat("materials.", name), &warnings_)));
+        }
+
+        const std::vector<Node> shapes = root.Get("shapes").Elements();
+        if (shapes.empty()) root.Get("shapes").Fail("no shapes; a scene needs at least one");
+        for (const Node& shape : shapes) ParseShape(shape, scene);
+
+        if (const std::optional<Node> lights = root.Find("lights")) {
+            for (const Node& light : lights->Elements()) {
+                scene.point_lights.push_back(ParseLight(light));
+            }
+        }
+
+        bool lit = !scene.point_lights.empty();
+        for (const TriangleMesh& mesh : scene.meshes) {
+            lit |= scene.materials[mesh.material].IsEmissive();
+        }
+        for (const Sphere& sphere : scene.spheres) {
+            lit |= scene.materials[sphere.material].IsEmissive();
+        }
+        if (!lit) {
+            warnings_.push_back("no emissive shape and no point light: the image will be black");
+        }
+
+        scene.dropped_degenerate = dropped_degenerate_;
+        scene.content_hash = hash_.Hex();
+        return scene;
+    }
+
+    const std::vector<std::string>& warnings() const { return warnings_; }
+
+  private:
+    CameraSpec ParseCamera(const Node& n) {
+        n.ExpectObject({"position", "look_at", "up", "fov_y_deg", "resolution"});
+        CameraSpec camera;
+        camera.position = n.Get("position").Vector();
+        const Node look_at = n.Get("look_at");
+        camera.look_at = look_at.Vector();
+        const Vec3d view = camera.look_at - camera.position;
+        if (LengthSquared(view) == 0) look_at.Fail("equals camera.position");
+        if (const std::optional<Node> up = n.Find("up")) {
+            camera.up = up->Vector();
+            if (LengthSquared(camera.up) == 0 ||
+                Length(Cross(Normalize(view), Normalize(camera.up))) < 1e-6) {
+                up->Fail("is zero or parallel to the view direction");
+            }
+        } else if (Length(Cross(Normalize(view), camera.up)) < 1e-6) {
+            n.Fail("the default up [0, 1, 0] is parallel to the view direction; give `up`");
+        }
+        const Node fov = n.Get("fov_y_deg");
+        camera.fov_y_deg = fov.Number();
+        if (!(camera.fov_y_deg > 0 && camera.fov_y_deg < 180)) {
+            fov.Fail(absl::StrCat("must be in (0, 180) degrees, got ", camera.fov_y_deg));
+        }
+        const Node resolution = n.Get("resolution");
+        const std::vector<Node> size = resolution.Elements(2);
+        camera.width = size[0].Integer(1, kMaxResolution);
+        camera.height = size[1].Integer(1, kMaxResolution);
+        if (int64_t(camera.width) * camera.height > kMaxPixels) {
+            resolution.Fail(
+                absl::StrCat(camera.width, " x ", camera.height, " is more than 2^28 pixels"));
+        }
+        return camera;
+    }
+
+    Material ParseMaterial(const std::string& name, const Node& n) {
+        n.RequireObject();
+        Material m;
+        m.name = name;
+        const Node type = n.Get("type");
+        const std::string type_name = type.String();
+        if (type_name == "lambert" || type_name == "mirror") {
+            n.WarnUnknownKeys({"type", "reflectance", "emission"});
+            m.type = type_name == "lambert" ? Material::Type::kLambert : Material::Type::kMirror;
+            m.reflectance = n.Get("reflectance").Color(1);
+        } else if (type_name == "glossy") {
+            n.WarnUnknownKeys(
+                {"type", "distribution", "roughness", "reflectance", "eta", "k", "emission"});
+            m.type = Material::Type::kGlossy;
+            if (const std::optional<Node> distribution = n.Find("distribution")) {
+                const std::string d = distribution->String();
+                if (d != "ggx" && d != "beckmann") {
+                    distribution->Fail(
+                        absl::StrCat("unknown distribution \"", d, "\"; expected ggx or beckmann"));
+                }
+                m.distribution =
+                    d == "ggx" ? Material::Distribution::kGgx : Material::Distribution::kBeckmann;
+            }
+            m.roughness = n.Get("roughness").PositiveFloat();
+            if (n.Has("eta") || n.Has("k")) {
+                if (n.Has("reflectance")) n.Fail("give either reflectance or eta and k, not both");
+                m.conductor = true;
+                const Node eta = n.Get("eta");
+                m.eta = eta.Color(kMaxFloat);
+                for (const Node& e : eta.Elements()) {
+                    if (e.Number() == 0) e.Fail("must be > 0");
+                }
+                m.k = n.Get("k").Color(kMaxFloat);
+            } else {
+                m.reflectance = n.Get("reflectance").Color(1);
+            }
+        } else if (type_name == "dielectric") {
+            n.WarnUnknownKeys({"type", "ior", "emission"});
+            m.type = Material::Type::kDielectric;
+            m.ior = n.Get("ior").PositiveFloat();
+        } else {
+            type.Fail(absl::StrCat("unknown material type \"", type_name,
+                                   "\"; expected lambert, mirror, glossy or dielectric"));
+        }
+        if (const std::optional<Node> emission = n.Find("emission")) {
+            m.emission = emission->Color(kMaxFloat);
+        }
+        return m;
+    }
+
+    void ParseShape(const Node& n, Scene& scene) {
+        n.RequireObject();
+        const Node type = n.Get("type");
+        const std::string type_name = type.String();
+        const Node material = n.Get("material");
+        const auto found = material_index_.find(material.String());
+        if (found == material_index_.end()) {
+            material.Fail(absl::StrCat("unknown material \"", material.String(), "\""));
+        }
+        const std::string name = n.Has("name") ? n.Get("name").String() : n.path();
+
+        if (type_name == "sphere") {
+            n.WarnUnknownKeys({"type", "material", "name", "center", "radius"});
+            Sphere sphere{name, found->second, n.Get("center").Vector(), 0};
+            const Node radius = n.Get("radius");
+            sphere.radius = radius.Number();
+            if (!(sphere.radius > 0 && sphere.radius <= kMaxCoordinate)) {
+                radius.Fail(absl::StrCat("must be in (0, 1e15], got ", sphere.radius));
+            }
+            scene.spheres.push_back(sphere);
+            return;
+        }
+
+        TriangleMesh mesh;
+        if (type_name == "quad" || type_name == "triangle") {
+            n.WarnUnknownKeys({"type", "material", "name", "vertices"});
+            const bool quad = type_name == "quad";
+            for (const Node& v : n.Get("vertices").Elements(quad ? 4 : 3)) {
+                mesh.positions.push_back(v.Vector());
+            }
+            mesh.triangles.push_back({0, 1, 2});
+            if (quad) mesh.triangles.push_back({0, 2, 3});
+            mesh.is_quad = quad;
+        } else if (type_name == "mesh") {
+            n.WarnUnknownKeys({"type", "material", "name", "file", "transform"});
+            mesh = LoadMeshShape(n);
+        } else {
+            type.Fail(absl::StrCat("unknown shape type \"", type_name,
+                                   "\"; expected quad, triangle, mesh or sphere"));
+        }
+        mesh.name = name;
+        mesh.material = found->second;
+
+        const int dropped = DropDegenerate(mesh);
+        if (mesh.triangles.empty()) {
+            n.Fail("every triangle is degenerate (zero area or repeated vertices)");
+        }
+        // Radiosity grids an is_quad mesh between its four corners, which no longer holds once
+        // a triangle is gone.
+        if (dropped > 0) mesh.is_quad = false;
+        dropped_degenerate_ += dropped;
+        scene.meshes.push_back(std::move(mesh));
+    }
+
+    TriangleMesh LoadMeshShape(const Node& n) {
+        const Node file = n.Get("file");
+        std::filesystem::path path(file.String());
+        if (path.empty()) file.Fail("empty file name");
+        if (path.is_relative()) path = std::filesystem::path(base_dir_) / path;
+        const std::string resolved = path.lexically_normal().string();
+
+        auto cached = mesh_cache_.find(resolved);
+        if (cached == mesh_cache_.end()) {
+            absl::StatusOr<TriangleMesh> loaded = LoadMesh(resolved);
+            if (!loaded.ok()) {
+                throw LoadError{
+                    absl::Status(loaded.status().code(),
+                                 absl::StrCat(file.path(), ": ", loaded.status().message()))};
+            }
+            absl::StatusOr<std::string> bytes = ReadFile(resolved);
+            if (!bytes.ok()) {
+                throw LoadError{
+                    absl::Status(bytes.status().code(),
+                                 absl::StrCat(file.path(), ": ", bytes.status().message()))};
+            }
+            hash_.Update(*bytes);
+            cached = mesh_cache_.emplace(resolved, *std::move(loaded)).first;
+        }
+        TriangleMesh mesh = cached->second;
+
+        if (const std::optional<Node> transform_node = n.Find("transform")) {
+            const Affine transform = ParseTransform(*transform_node);
+            for (Vec3d& p : mesh.positions) p = transform.Apply(p);
+            // A mirroring transform would turn front faces into back faces; keep them in front.
+            if (transform.Determinant() < 0) {
+                for (std::array<uint32_t, 3>& t : mesh.triangles) std::swap(t[1], t[2]);
+            }
+        }
+        for (const Vec3d& p : mesh.positions) {
+            if (MaxComponent(Abs(p)) > kMaxCoordinate) {
+                n.Fail(absl::StrCat("a vertex of ", resolved, " lies beyond ±1e15",
+                                    n.Has("transform") ? " after the transform" : "", ": (", p.x,
+                                    ", ", p.y, ", ", p.z, ")"));
+            }
+        }
+        return mesh;
+    }
+
+    PointLight ParseLight(const Node& n) {
+        n.RequireObject();
+        const Node type = n.Get("type");
+        if (type.String() != "point") {
+            type.Fail(absl::StrCat("unknown light type \"", type.String(), "\"; expected point"));
+        }
+        n.WarnUnknownKeys({"type", "position", "intensity", "power"});
+        PointLight light{n.Get("position").Vector(), Rgb()};
+        if (n.Has("intensity") == n.Has("power")) {
+            n.Fail("give exactly one of intensity (W/sr) or power (W)");
+        }
+        light.intensity = n.Has("intensity")
+                              ? n.Get("intensity").Color(kMaxFloat)
+                              : n.Get("power").Color(kMaxFloat) / float(4 * std::numbers::pi);
+        return light;
+    }
+
+    std::string base_dir_;
+    std::vector<std::string> warnings_;
+    std::map<std::string, int> material_index_;
+    std::map<std::string, TriangleMesh> mesh_cache_;
+    Fnv1a128 hash_;
+    int dropped_degenerate_ = 0;
+};
+
+}  // namespace
+
+absl::StatusOr<Scene> LoadScene(const std::string& path) {
+    absl::StatusOr<std::string> text = ReadFile(path);
+    if (!text.ok()) return text.status();
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    return ParseScene(*text, path, parent.empty() ? "." : parent.string());
+}
+
+absl::StatusOr<Scene> ParseScene(const std::string& json_text, const std::string& source,
+                                 const std::string& base_dir) {
+    Json root;
+    if (absl::Status status = ParseJson(json_text, source, root); !status.ok()) return status;
+    SceneParser parser(base_dir);
+    absl::StatusOr<Scene> scene;
+    try {
+        scene = parser.Parse(root, json_text);
+        scene->source = source;
+    } catch (const LoadError& e) {
+        scene = absl::Status(e.status.code(), absl::StrCat(source, ": ", e.status.message()));
+    }
+    // Also on failure: an unknown key is often the misspelling behind a missing one.
+    const std::shared_ptr<spdlog::logger> logger = SceneLogger();
+    for (const std::string& warning : parser.warnings()) logger->warn("{}: {}", source, warning);
+    if (scene.ok() && scene->dropped_degenerate > 0) {
+        logger->warn("{}: dropped {} degenerate triangles (zero area or repeated vertices)", source,
+                     scene->dropped_degenerate);
+    }
+    return scene;
+}
+
+}  // namespace lf
