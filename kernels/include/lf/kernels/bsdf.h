@@ -9,6 +9,7 @@
 #include "lf/core/rgb.h"
 #include "lf/core/scene.h"
 #include "lf/core/vec.h"
+#include "lf/kernels/microfacet.h"
 
 namespace lf {
 
@@ -33,7 +34,17 @@ public:
     bool IsDelta() const;
 
 private:
-    const Material* material_;
+    // The glossy lobe for wo and wi both in the upper hemisphere.
+    Rgb GlossyEval(const Vec3& wo, const Vec3& wi) const;
+    float GlossyPdf(const Vec3& wo, const Vec3& wi) const;
+
+    // Copies rather than a Material pointer: a Bsdf built from a temporary stays valid, and the
+    // name string is never touched.
+    Material::Type type_;
+    bool conductor_;
+    Rgb reflectance_, eta_, k_;
+    float ior_;
+    MicrofacetDistribution distribution_;
 };
 
 }  // namespace lf
