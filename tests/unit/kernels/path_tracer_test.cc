@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "lf/core/camera.h"
+#include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/tile_renderer.h"
 #include "test_scenes.h"
@@ -137,6 +138,60 @@ TEST(PointLight, LambertianPlaneMatchesInverseSquareLaw) {
                 const double tol = kSigmas * k * sd / std::sqrt(double(spp)) + 1e-5 * k * mean;
                 EXPECT_NEAR(got[c], k * mean, tol) << "pixel " << px << "," << py << " ch " << c;
             }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace lf
+
+namespace lf {
+namespace {
+
+// Per 8x8 block: mean radiance and the variance of that mean, from the half-sample buffers
+// (E[(A - B)^2] / 4 is the variance of the pixel mean (A + B) / 2).
+std::vector<std::pair<double, double>> BlockMeans(const Image& image, int channel) {
+    const char* names[3] = {"R", "G", "B"};
+    const std::vector<float>& m = *image.FindChannel(names[channel]);
+    const std::vector<float>& a = *image.FindChannel(std::string("A.") + names[channel]);
+    const std::vector<float>& b = *image.FindChannel(std::string("B.") + names[channel]);
+    std::vector<std::pair<double, double>> blocks;
+    for (int by = 0; by < image.height(); by += 8) {
+        for (int bx = 0; bx < image.width(); bx += 8) {
+            double sum = 0, var = 0;
+            for (int y = by; y < by + 8; ++y) {
+                for (int x = bx; x < bx + 8; ++x) {
+                    const size_t i = size_t(y) * image.width() + x;
+                    sum += m[i];
+                    var += (double(a[i]) - b[i]) * (double(a[i]) - b[i]) / 4;
+                }
+            }
+            blocks.push_back({sum / 64, var / (64.0 * 64.0)});
+        }
+    }
+    return blocks;
+}
+
+// The Cornell box moved 10^5 units from the origin renders the same image up to noise.
+TEST(FarFromOrigin, TranslatedCornellBoxMatches) {
+    absl::StatusOr<Scene> near = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
+    ASSERT_TRUE(near.ok()) << near.status();
+    near->camera.width = near->camera.height = 32;
+    Scene far = *near;
+    const Vec3d shift(1e5, -1e5, 1e5);
+    for (TriangleMesh& mesh : far.meshes) {
+        for (Vec3d& p : mesh.positions) p += shift;
+    }
+    far.camera.position += shift;
+    far.camera.look_at += shift;
+    const RenderOutput a = Render(*near, 64), b = Render(far, 64);
+    EXPECT_EQ(b.stats.invalid_samples, 0u);
+    for (int c = 0; c < 3; ++c) {
+        const auto blocks_a = BlockMeans(a.image, c), blocks_b = BlockMeans(b.image, c);
+        for (size_t i = 0; i < blocks_a.size(); ++i) {
+            const double sigma = std::sqrt(blocks_a[i].second + blocks_b[i].second);
+            EXPECT_NEAR(blocks_a[i].first, blocks_b[i].first, kSigmas * sigma + 1e-6)
+                << "block " << i << " channel " << c;
         }
     }
 }
