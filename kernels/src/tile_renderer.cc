@@ -29,8 +29,8 @@ TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, co
                 pixel.Add(s, L);
             }
         }
+        tile.stats.samples += uint64_t(rect.width) * (sample_end - sample_begin);
     }
-    tile.stats.samples += uint64_t(rect.Area()) * (sample_end - sample_begin);
     return tile;
 }
 
