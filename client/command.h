@@ -21,4 +21,12 @@ int ReportError(const absl::Status& status);
 Command AddRenderCommand(CLI::App& app);
 Command AddBenchCommand(CLI::App& app);
 
+// The farm (farm_commands.cc): jobs on a lightfarm-server.
+Command AddSubmitCommand(CLI::App& app);
+Command AddListCommand(CLI::App& app);
+Command AddStatusCommand(CLI::App& app);
+Command AddWatchCommand(CLI::App& app);
+Command AddFetchCommand(CLI::App& app);
+Command AddCancelCommand(CLI::App& app);
+
 }  // namespace lf

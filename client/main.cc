@@ -20,6 +20,12 @@ int main(int argc, char** argv) {
     const std::vector<lf::Command> commands = {
         lf::AddRenderCommand(app),
         lf::AddBenchCommand(app),
+        lf::AddSubmitCommand(app),
+        lf::AddListCommand(app),
+        lf::AddStatusCommand(app),
+        lf::AddWatchCommand(app),
+        lf::AddFetchCommand(app),
+        lf::AddCancelCommand(app),
     };
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::from_str(log_level));

@@ -19,6 +19,14 @@ public:
     double Value() const;
     bool operator==(const ExactSum&) const = default;
 
+    // The fixed-point integer itself, for encodings that must carry the sum exactly.
+    static ExactSum FromFixed(__int128 fixed) {
+        ExactSum s;
+        s.fixed_ = fixed;
+        return s;
+    }
+    __int128 fixed() const { return fixed_; }
+
 private:
     __int128 fixed_ = 0;
 };

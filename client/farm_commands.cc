@@ -1,0 +1,432 @@
+// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch and cancel, each a
+// call to lightfarm-server's JobService. All protobuf handling of the client is in this file.
+#include <grpcpp/grpcpp.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
+#include "command.h"
+#include "lightfarm/v1/job_service.grpc.pb.h"
+#include "progress_bar.h"
+#include "proto/grpc_status.h"
+#include "server/digest.h"
+#include "server/plan.h"
+#include "server/scene_files.h"
+
+namespace lf {
+
+namespace fs = std::filesystem;
+namespace pb = lightfarm::v1;
+
+namespace {
+
+constexpr size_t kChunkBytes = 1 << 20;
+
+struct FarmFlags {
+    std::string server = "127.0.0.1:7070";
+};
+
+void AddServerOption(CLI::App* cmd, FarmFlags& flags) {
+    cmd->add_option("--server", flags.server, "HOST:PORT of lightfarm-server")
+        ->envname("LIGHTFARM_SERVER")
+        ->capture_default_str();
+}
+
+std::unique_ptr<pb::JobService::Stub> Connect(const FarmFlags& flags) {
+    return pb::JobService::NewStub(
+        grpc::CreateChannel(flags.server, grpc::InsecureChannelCredentials()));
+}
+
+// The server's own words, with where it was asked when it could not be reached.
+absl::Status CallStatus(const grpc::Status& s, const FarmFlags& flags) {
+    if (s.error_code() == grpc::StatusCode::UNAVAILABLE) {
+        return absl::UnavailableError(
+            absl::StrCat("server ", flags.server, " not reachable: ", s.error_message()));
+    }
+    return FromGrpcStatus(s);
+}
+
+std::string StateName(pb::Job::State s) { return absl::AsciiStrToLower(pb::Job::State_Name(s)); }
+
+bool IsFinal(pb::Job::State s) {
+    return s == pb::Job::SUCCEEDED || s == pb::Job::FAILED || s == pb::Job::CANCELLED;
+}
+
+absl::StatusOr<std::string> ReadFile(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return absl::NotFoundError(path.string() + ": cannot be read");
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+// Every string in the scene JSON that names a file beside it: the files the server and workers
+// need. Finding them by looking, not by schema, keeps this right as the format grows.
+void CollectFileNames(const nlohmann::json& node, const fs::path& dir,
+                      std::map<std::string, fs::path>& found) {
+    if (node.is_string()) {
+        const std::string name = node.get<std::string>();
+        std::error_code ec;
+        if (!name.empty() && fs::is_regular_file(dir / name, ec)) found[name] = dir / name;
+    } else if (node.is_structured()) {
+        for (const auto& child : node) CollectFileNames(child, dir, found);
+    }
+}
+
+struct LocalFile {
+    pb::SceneFile ref;
+    fs::path path;
+};
+
+absl::Status Upload(pb::JobService::Stub& stub, const LocalFile& file, const std::string& content,
+                    const FarmFlags& flags) {
+    const auto context = ContextWithDeadline(absl::Minutes(10));
+    pb::UploadBlobResponse response;
+    std::unique_ptr<grpc::ClientWriter<pb::UploadBlobRequest>> writer =
+        stub.UploadBlob(context.get(), &response);
+    pb::UploadBlobRequest chunk;
+    chunk.set_hash(file.ref.hash());
+    chunk.set_size(file.ref.size());
+    size_t offset = 0;
+    do {
+        const size_t n = std::min(kChunkBytes, content.size() - offset);
+        chunk.set_data(content.data() + offset, n);
+        offset += n;
+        if (!writer->Write(chunk)) break;
+        chunk.clear_hash();
+        chunk.clear_size();
+    } while (offset < content.size());
+    writer->WritesDone();
+    if (absl::Status s = CallStatus(writer->Finish(), flags); !s.ok()) {
+        return absl::Status(s.code(), absl::StrCat(file.ref.path(), ": upload: ", s.message()));
+    }
+    return absl::OkStatus();
+}
+
+struct SubmitOptions {
+    FarmFlags farm;
+    std::string scene_path;
+    std::string name;
+    uint64_t spp = 16;
+    uint64_t seed = 0;
+    int max_depth = -1;
+    int tile = 32;
+    int passes = 1;
+    int priority = 0;
+};
+
+absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
+    const fs::path scene_path(o.scene_path);
+    absl::StatusOr<std::string> scene_text = ReadFile(scene_path);
+    if (!scene_text.ok()) return scene_text.status();
+    std::map<std::string, fs::path> names;
+    // A file that is not JSON goes up alone: the server's loader says what is wrong with it.
+    const nlohmann::json json = nlohmann::json::parse(*scene_text, nullptr, false);
+    if (!json.is_discarded()) CollectFileNames(json, scene_path.parent_path(), names);
+
+    std::vector<LocalFile> files;
+    std::map<std::string, std::string> contents;  // by hash
+    auto add = [&](const std::string& name, const fs::path& path,
+                   std::string content) -> absl::Status {
+        if (absl::Status s = CheckScenePath(name); !s.ok()) {
+            return absl::InvalidArgumentError(absl::StrCat(o.scene_path, ": ", s.message()));
+        }
+        LocalFile f{{}, path};
+        f.ref.set_path(name);
+        f.ref.set_hash(Sha256Hex(content));
+        f.ref.set_size(content.size());
+        contents[f.ref.hash()] = std::move(content);
+        files.push_back(std::move(f));
+        return absl::OkStatus();
+    };
+    if (absl::Status s = add(scene_path.filename().string(), scene_path, *scene_text); !s.ok()) {
+        return s;
+    }
+    for (const auto& [name, path] : names) {
+        if (fs::equivalent(path, scene_path)) continue;
+        absl::StatusOr<std::string> content = ReadFile(path);
+        if (!content.ok()) return content.status();
+        if (absl::Status s = add(name, path, std::move(*content)); !s.ok()) return s;
+    }
+
+    std::unique_ptr<pb::JobService::Stub> stub = Connect(o.farm);
+    pb::MissingBlobsRequest missing_req;
+    for (const auto& [hash, content] : contents) missing_req.add_hashes(hash);
+    pb::MissingBlobsResponse missing;
+    if (absl::Status s = CallStatus(
+            stub->MissingBlobs(ContextWithDeadline(absl::Seconds(10)).get(), missing_req, &missing),
+            o.farm);
+        !s.ok()) {
+        return s;
+    }
+    for (const std::string& hash : missing.hashes()) {
+        for (const LocalFile& f : files) {
+            if (f.ref.hash() != hash) continue;
+            if (absl::Status s = Upload(*stub, f, contents[hash], o.farm); !s.ok()) return s;
+            break;
+        }
+    }
+
+    pb::SubmitJobRequest req;
+    *req.mutable_scene() = files[0].ref;
+    for (size_t i = 1; i < files.size(); ++i) *req.add_files() = files[i].ref;
+    req.set_name(o.name.empty() ? scene_path.filename().string() : o.name);
+    req.set_priority(o.priority);
+    pb::RenderParams* params = req.mutable_params();
+    params->set_spp(o.spp);
+    params->set_seed(o.seed);
+    params->set_max_depth(o.max_depth);
+    params->set_tile(o.tile);
+    params->set_passes(o.passes);
+    pb::SubmitJobResponse resp;
+    // The server loads the scene to check it, which takes a while for large meshes.
+    if (absl::Status s = CallStatus(
+            stub->SubmitJob(ContextWithDeadline(absl::Minutes(2)).get(), req, &resp), o.farm);
+        !s.ok()) {
+        return s;
+    }
+    return resp.job_id();
+}
+
+std::string Progress(const pb::Job& job) {
+    return absl::StrCat(job.tasks_done(), "/", job.tasks_total());
+}
+
+void PrintJob(const pb::Job& job) {
+    const int64_t now = absl::ToUnixMillis(absl::Now());
+    auto seconds = [](int64_t from, int64_t to) { return double(to - from) / 1000.0; };
+    std::printf("job %s: %s\n", job.id().c_str(), StateName(job.state()).c_str());
+    std::printf("  name      %s\n", job.name().c_str());
+    std::printf("  image     %dx%d, %llu spp, seed %llu, max depth %d, tile %d, %d passes\n",
+                job.width(), job.height(), (unsigned long long)job.params().spp(),
+                (unsigned long long)job.params().seed(), job.params().max_depth(),
+                job.params().tile(), job.params().passes());
+    std::printf("  priority  %d\n", job.priority());
+    std::printf("  tasks     %s done, %d running, %d retried\n", Progress(job).c_str(),
+                job.tasks_running(), job.retries());
+    std::printf("  samples   %llu (%llu rays, %llu NaN/Inf)\n", (unsigned long long)job.samples(),
+                (unsigned long long)job.rays(), (unsigned long long)job.invalid_samples());
+    if (job.started_unix_ms() > 0) {
+        const int64_t end = job.finished_unix_ms() > 0 ? job.finished_unix_ms() : now;
+        std::printf("  time      %.1f s queued, %.1f s rendering\n",
+                    seconds(job.submitted_unix_ms(), job.started_unix_ms()),
+                    seconds(job.started_unix_ms(), end));
+    } else {
+        std::printf("  time      %.1f s queued\n", seconds(job.submitted_unix_ms(), now));
+    }
+    if (!job.error().empty()) std::printf("  error     %s\n", job.error().c_str());
+}
+
+absl::StatusOr<pb::Job> GetJob(const FarmFlags& flags, const std::string& id) {
+    pb::GetJobRequest req;
+    req.set_job_id(id);
+    pb::Job job;
+    absl::Status s = CallStatus(
+        Connect(flags)->GetJob(ContextWithDeadline(absl::Seconds(10)).get(), req, &job), flags);
+    if (!s.ok()) return s;
+    return job;
+}
+
+// Follows the job until it ends. Each call has a deadline; the watch goes on across them and
+// across a short server outage.
+absl::StatusOr<pb::Job> Watch(const FarmFlags& flags, const std::string& id, ProgressBar& bar) {
+    std::unique_ptr<pb::JobService::Stub> stub = Connect(flags);
+    pb::WatchJobRequest req;
+    req.set_job_id(id);
+    pb::Job job;
+    int outages = 0;
+    while (true) {
+        const auto context = ContextWithDeadline(absl::Minutes(1));
+        std::unique_ptr<grpc::ClientReader<pb::Job>> reader = stub->WatchJob(context.get(), req);
+        while (reader->Read(&job)) {
+            outages = 0;
+            bar.Update(size_t(job.tasks_done()), size_t(std::max(1, job.tasks_total())));
+            if (IsFinal(job.state())) return job;
+        }
+        const grpc::Status s = reader->Finish();
+        if (s.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED) continue;
+        if (s.error_code() == grpc::StatusCode::UNAVAILABLE && ++outages <= 10) {
+            absl::SleepFor(absl::Seconds(1));
+            continue;
+        }
+        if (!s.ok()) return CallStatus(s, flags);
+        if (IsFinal(job.state())) return job;
+    }
+}
+
+absl::Status Fetch(const FarmFlags& flags, const std::string& id, const std::string& out,
+                   bool preview) {
+    pb::FetchResultRequest req;
+    req.set_job_id(id);
+    req.set_preview(preview);
+    const auto context = ContextWithDeadline(absl::Minutes(30));
+    std::unique_ptr<grpc::ClientReader<pb::Chunk>> reader =
+        Connect(flags)->FetchResult(context.get(), req);
+    // Written beside the target and renamed, so a failed fetch leaves no half file.
+    const std::string temp = out + ".part";
+    std::ofstream file(temp, std::ios::binary);
+    if (!file) return absl::PermissionDeniedError(out + ": cannot write here");
+    pb::Chunk chunk;
+    while (reader->Read(&chunk)) {
+        file.write(chunk.data().data(), std::streamsize(chunk.data().size()));
+    }
+    file.close();
+    std::error_code ec;
+    if (absl::Status s = CallStatus(reader->Finish(), flags); !s.ok() || !file) {
+        fs::remove(temp, ec);
+        return s.ok() ? absl::InternalError(out + ": write failed") : s;
+    }
+    fs::rename(temp, out, ec);
+    if (ec) return absl::InternalError(out + ": " + ec.message());
+    return absl::OkStatus();
+}
+
+}  // namespace
+
+Command AddSubmitCommand(CLI::App& app) {
+    auto o = std::make_shared<SubmitOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "submit",
+        "Send a scene to a lightfarm-server as a job and print its id (the last line).\n"
+        "The scene file and every file it names beside it (meshes) are uploaded; files the\n"
+        "server already has are not sent again. Same settings give the same bits as\n"
+        "`lightfarm render`, whatever the tile size, passes or workers.");
+    cmd->add_option("scene", o->scene_path, "scene file (JSON)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    AddServerOption(cmd, o->farm);
+    cmd->add_option("--spp", o->spp, "samples per pixel")
+        ->capture_default_str()
+        ->check(CLI::Range(uint64_t(1), kMaxSpp));
+    cmd->add_option("--seed", o->seed, "random seed")->capture_default_str();
+    cmd->add_option("--max-depth", o->max_depth,
+                    "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
+        ->capture_default_str()
+        ->check(CLI::Range(-1, 1 << 20));
+    cmd->add_option("--tile", o->tile, "tile side in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxFarmTile));
+    cmd->add_option("--passes", o->passes,
+                    "sample passes per tile; each pass of each tile is one task")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1 << 20));
+    cmd->add_option("--priority", o->priority, "higher runs first; equal: oldest first")
+        ->capture_default_str();
+    cmd->add_option("--name", o->name, "job name (default: the scene file's name)");
+    return {cmd, [o] {
+                absl::StatusOr<std::string> id = Submit(*o);
+                if (!id.ok()) return ReportError(id.status());
+                std::printf("%s\n", id->c_str());
+                return 0;
+            }};
+}
+
+Command AddListCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    CLI::App* cmd = app.add_subcommand("list", "List the server's jobs, newest first.");
+    AddServerOption(cmd, *flags);
+    return {
+        cmd, [flags] {
+            pb::ListJobsResponse resp;
+            absl::Status s = CallStatus(
+                Connect(*flags)->ListJobs(ContextWithDeadline(absl::Seconds(10)).get(), {}, &resp),
+                *flags);
+            if (!s.ok()) return ReportError(s);
+            std::printf("%-16s %-10s %8s %11s %9s  %s\n", "JOB", "STATE", "PRIORITY", "TASKS",
+                        "SPP", "NAME");
+            for (const pb::Job& job : resp.jobs()) {
+                std::printf("%-16s %-10s %8d %11s %9llu  %s\n", job.id().c_str(),
+                            StateName(job.state()).c_str(), job.priority(), Progress(job).c_str(),
+                            (unsigned long long)job.params().spp(), job.name().c_str());
+            }
+            return 0;
+        }};
+}
+
+Command AddStatusCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand("status", "Show one job: state, progress, error.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id] {
+                absl::StatusOr<pb::Job> job = GetJob(*flags, *id);
+                if (!job.ok()) return ReportError(job.status());
+                PrintJob(*job);
+                return 0;
+            }};
+}
+
+Command AddWatchCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "watch",
+        "Follow a job until it ends (progress bar on a terminal). Exit status 0 only when it\n"
+        "succeeded.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id] {
+                ProgressBar bar(*id);
+                absl::StatusOr<pb::Job> job = Watch(*flags, *id, bar);
+                bar.Finish();
+                if (!job.ok()) return ReportError(job.status());
+                std::printf("job %s %s (%s tasks, %d retried)%s%s\n", job->id().c_str(),
+                            StateName(job->state()).c_str(), Progress(*job).c_str(), job->retries(),
+                            job->error().empty() ? "" : ": ", job->error().c_str());
+                return job->state() == pb::Job::SUCCEEDED ? 0 : 1;
+            }};
+}
+
+Command AddFetchCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto out = std::make_shared<std::string>();
+    auto preview = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand(
+        "fetch",
+        "Download a job's OpenEXR result (the same channels and header as `lightfarm render`).");
+    cmd->add_option("job", *id, "job id")->required();
+    cmd->add_option("-o,--output", *out, "output OpenEXR file")->required();
+    cmd->add_flag("--preview", *preview,
+                  "a running job's tiles merged so far (unfinished tiles have fewer samples)");
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id, out, preview] {
+                if (absl::Status s = Fetch(*flags, *id, *out, *preview); !s.ok()) {
+                    return ReportError(s);
+                }
+                std::printf("job %s -> %s\n", id->c_str(), out->c_str());
+                return 0;
+            }};
+}
+
+Command AddCancelCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "cancel", "Cancel a queued or running job; workers drop its tasks within a second.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    return {
+        cmd, [flags, id] {
+            pb::CancelJobRequest req;
+            req.set_job_id(*id);
+            pb::Job job;
+            absl::Status s = CallStatus(
+                Connect(*flags)->CancelJob(ContextWithDeadline(absl::Seconds(10)).get(), req, &job),
+                *flags);
+            if (!s.ok()) return ReportError(s);
+            std::printf("job %s %s\n", job.id().c_str(), StateName(job.state()).c_str());
+            return 0;
+        }};
+}
+
+}  // namespace lf

@@ -1,0 +1,299 @@
+#include "lf/core/patch_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <compare>
+#include <limits>
+#include <map>
+
+#include "absl/strings/str_cat.h"
+
+namespace lf {
+
+namespace {
+
+// Far beyond what an O(n^2) radiosity solve can handle; stops a typo from exhausting memory.
+constexpr int64_t kMaxPatches = int64_t(1) << 26;
+
+int64_t PatchCount(const std::vector<double>& longest_edges, double size) {
+    int64_t count = 0;
+    for (double edge : longest_edges) {
+        const double k = std::max(1.0, std::ceil(edge / size));
+        if (k * k > double(kMaxPatches)) return kMaxPatches + 1;
+        count += int64_t(k) * int64_t(k);
+        if (count > kMaxPatches) return kMaxPatches + 1;
+    }
+    return count;
+}
+
+// The largest patch size is one patch per triangle; halving finds a size that is too fine,
+// then bisection the coarsest size whose count still fits under the target.
+double PatchSizeForCount(const std::vector<double>& longest_edges, int64_t target) {
+    double hi = *std::max_element(longest_edges.begin(), longest_edges.end());
+    if (PatchCount(longest_edges, hi) >= target) return hi;
+    double lo = hi;
+    while (PatchCount(longest_edges, lo) <= target) lo *= 0.5;
+    for (int iteration = 0; iteration < 64; ++iteration) {
+        const double mid = std::sqrt(lo * hi);
+        if (mid <= lo || mid >= hi) break;
+        (PatchCount(longest_edges, mid) <= target ? hi : lo) = mid;
+    }
+    return hi;
+}
+
+double LongestEdge(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    return std::sqrt(std::max({LengthSquared(b - a), LengthSquared(c - b), LengthSquared(a - c)}));
+}
+
+// Vertices on a scene triangle's corners and edges are shared with the neighbours that use the
+// same subdivision along that edge: keyed by the scene vertex ids, never by position.
+struct VertexKey {
+    uint32_t a, b;        // corner: (id, id); edge: (smaller id, larger id)
+    int32_t k, position;  // edge: subdivision and position counted from `a`
+    auto operator<=>(const VertexKey&) const = default;
+};
+
+class SideRule {
+  public:
+    explicit SideRule(const Scene& scene) : scene_(scene) {
+        const auto [lo, hi] = scene.Bounds();
+        epsilon_ = std::max(1e-6 * Length(hi - lo), std::numeric_limits<double>::min());
+        for (const TriangleMesh& mesh : scene.meshes) {
+            Vec3d mlo = mesh.positions.front(), mhi = mlo;
+            for (const Vec3d& p : mesh.positions) {
+                mlo = Min(mlo, p);
+                mhi = Max(mhi, p);
+            }
+            mesh_bounds_.push_back({mlo, mhi});
+        }
+    }
+
+    // True if a point light or a vertex of the scene lies strictly in front of the plane
+    // through p with normal n: only then can light arrive there.
+    bool SomethingInFront(const Vec3d& p, const Vec3d& n) const {
+        for (const PointLight& light : scene_.point_lights) {
+            if (Dot(light.position - p, n) > epsilon_) return true;
+        }
+        for (size_t m = 0; m < scene_.meshes.size(); ++m) {
+            const auto& [lo, hi] = mesh_bounds_[m];
+            const Vec3d farthest(n.x > 0 ? hi.x : lo.x, n.y > 0 ? hi.y : lo.y,
+                                 n.z > 0 ? hi.z : lo.z);
+            if (Dot(farthest - p, n) <= epsilon_) continue;
+            for (const Vec3d& q : scene_.meshes[m].positions) {
+                if (Dot(q - p, n) > epsilon_) return true;
+            }
+        }
+        return false;
+    }
+
+  private:
+    const Scene& scene_;
+    double epsilon_ = 0;
+    std::vector<std::pair<Vec3d, Vec3d>> mesh_bounds_;
+};
+
+}  // namespace
+
+std::vector<GridTriangle> SubdivisionCells(int k) {
+    std::vector<GridTriangle> cells;
+    cells.reserve(size_t(k) * size_t(k));
+    for (int j = 0; j < k; ++j) {
+        for (int i = 0; i + j < k; ++i) {
+            cells.push_back({{{i, j}, {i + 1, j}, {i, j + 1}}});
+            if (i + j + 1 < k) cells.push_back({{{i + 1, j}, {i + 1, j + 1}, {i, j + 1}}});
+        }
+    }
+    return cells;
+}
+
+absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOptions& options) {
+    if (!scene.spheres.empty()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("radiosity: sphere '", scene.spheres.front().name,
+                         "' cannot be meshed; radiosity supports triangle meshes and quads only"));
+    }
+    for (const TriangleMesh& mesh : scene.meshes) {
+        const Material& material = scene.materials[size_t(mesh.material)];
+        if (material.type != Material::Type::kLambert) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                "radiosity: mesh '", mesh.name, "' uses ", MaterialTypeName(material.type),
+                " material '", material.name, "'; radiosity handles lambert materials only"));
+        }
+    }
+    if (!(options.patch_size >= 0) || (options.patch_size == 0 && options.patches <= 0)) {
+        return absl::InvalidArgumentError(
+            "radiosity: give a positive patch size or a positive patch count");
+    }
+
+    PatchMesh pm;
+    std::vector<double> longest_edges;
+    for (const TriangleMesh& mesh : scene.meshes) {
+        pm.mesh_first_triangle_.push_back(int64_t(longest_edges.size()));
+        double quad_edge = 0;
+        for (const auto& t : mesh.triangles) {
+            const double edge =
+                LongestEdge(mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]);
+            longest_edges.push_back(edge);
+            quad_edge = std::max(quad_edge, edge);
+        }
+        // Both halves of a quad share the diagonal: one subdivision keeps its vertices shared.
+        if (mesh.is_quad) {
+            std::fill(longest_edges.end() - int64_t(mesh.triangles.size()), longest_edges.end(),
+                      quad_edge);
+        }
+    }
+    if (longest_edges.empty()) return absl::InvalidArgumentError("radiosity: no triangles");
+
+    pm.patch_size_ = options.patch_size > 0 ? options.patch_size
+                                            : PatchSizeForCount(longest_edges, options.patches);
+    if (const int64_t n = PatchCount(longest_edges, pm.patch_size_); n > kMaxPatches) {
+        return absl::InvalidArgumentError(absl::StrCat("radiosity: patch size ", pm.patch_size_,
+                                                       " gives more than ", kMaxPatches,
+                                                       " patches"));
+    }
+
+    // Subdivision: grid vertex (i, j) of a triangle with subdivision k is the point with
+    // barycentrics b1 = i/k, b2 = j/k.
+    pm.triangles_.resize(longest_edges.size());
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        const TriangleMesh& mesh = scene.meshes[m];
+        std::map<VertexKey, uint32_t> shared;
+        auto shared_vertex = [&](const VertexKey& key, const Vec3d& p) {
+            const auto [it, inserted] = shared.try_emplace(key, uint32_t(pm.vertices_.size()));
+            if (inserted) pm.vertices_.push_back(p);
+            return it->second;
+        };
+        auto edge_vertex = [&](uint32_t a, uint32_t b, int k, int position) {
+            if (a > b) {
+                std::swap(a, b);
+                position = k - position;
+            }
+            const Vec3d& pa = mesh.positions[a];
+            return shared_vertex({a, b, k, position},
+                                 pa + (mesh.positions[b] - pa) * (double(position) / k));
+        };
+        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+            const auto& tri = mesh.triangles[t];
+            const Vec3d &p0 = mesh.positions[tri[0]], &p1 = mesh.positions[tri[1]],
+                        &p2 = mesh.positions[tri[2]];
+            const size_t index = size_t(pm.mesh_first_triangle_[m]) + t;
+            Triangle& info = pm.triangles_[index];
+            const int k = int(std::max(1.0, std::ceil(longest_edges[index] / pm.patch_size_)));
+            info.k = k;
+            info.first_patch = int64_t(pm.patches_.size());
+            info.normal = Normalize(Cross(p1 - p0, p2 - p0));
+            const double area = 0.5 * Length(Cross(p1 - p0, p2 - p0)) / (double(k) * k);
+
+            // Row j of the grid holds k + 1 - j vertices.
+            std::vector<uint32_t> grid;
+            grid.reserve(size_t(k + 1) * (k + 2) / 2);
+            for (int j = 0; j <= k; ++j) {
+                for (int i = 0; i + j <= k; ++i) {
+                    uint32_t id;
+                    if (i == 0 && j == 0) {
+                        id = shared_vertex({tri[0], tri[0], 0, 0}, p0);
+                    } else if (i == k) {
+                        id = shared_vertex({tri[1], tri[1], 0, 0}, p1);
+                    } else if (j == k) {
+                        id = shared_vertex({tri[2], tri[2], 0, 0}, p2);
+                    } else if (j == 0) {
+                        id = edge_vertex(tri[0], tri[1], k, i);
+                    } else if (i == 0) {
+                        id = edge_vertex(tri[0], tri[2], k, j);
+                    } else if (i + j == k) {
+                        id = edge_vertex(tri[1], tri[2], k, j);
+                    } else {
+                        id = uint32_t(pm.vertices_.size());
+                        const double b1 = double(i) / k, b2 = double(j) / k;
+                        pm.vertices_.push_back(p0 * (1 - b1 - b2) + p1 * b1 + p2 * b2);
+                    }
+                    grid.push_back(id);
+                }
+            }
+            auto at = [&](int i, int j) { return grid[size_t(j * (k + 1) - j * (j - 1) / 2 + i)]; };
+            for (const GridTriangle& cell : SubdivisionCells(k)) {
+                Patch patch;
+                patch.mesh = int32_t(m);
+                patch.primitive = int32_t(t);
+                for (size_t c = 0; c < 3; ++c) patch.vertices[c] = at(cell[c][0], cell[c][1]);
+                patch.area = area;
+                patch.cell = cell;
+                pm.patches_.push_back(patch);
+            }
+        }
+    }
+
+    const SideRule rule(scene);
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        const TriangleMesh& mesh = scene.meshes[m];
+        const Material& material = scene.materials[size_t(mesh.material)];
+        for (int back = 0; back < 2; ++back) {
+            for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+                const Triangle& info = pm.triangles_[size_t(pm.mesh_first_triangle_[m]) + t];
+                const Vec3d n = back ? -info.normal : info.normal;
+                const bool needed =
+                    (!back && material.IsEmissive()) ||
+                    (!material.reflectance.IsBlack() &&
+                     rule.SomethingInFront(mesh.positions[mesh.triangles[t][0]], n));
+                if (!needed) continue;
+                const int64_t end = info.first_patch + int64_t(info.k) * info.k;
+                for (int64_t p = info.first_patch; p < end; ++p) {
+                    pm.patches_[size_t(p)].sides[size_t(back)] = int32_t(pm.sides_.size());
+                    pm.sides_.push_back({int32_t(p), back == 1});
+                }
+            }
+        }
+    }
+    return pm;
+}
+
+const Vec3d& PatchMesh::Normal(int64_t patch) const {
+    const Patch& p = patches_[size_t(patch)];
+    return triangle(p.mesh, p.primitive).normal;
+}
+
+Vec3d PatchMesh::SideNormal(int32_t side) const {
+    const Side& s = sides_[size_t(side)];
+    const Vec3d& n = Normal(s.patch);
+    return s.back ? -n : n;
+}
+
+Vec3d PatchMesh::Centroid(int64_t patch) const {
+    const Patch& p = patches_[size_t(patch)];
+    return (vertices_[p.vertices[0]] + vertices_[p.vertices[1]] + vertices_[p.vertices[2]]) / 3.0;
+}
+
+PatchPoint PatchMesh::Locate(int mesh, int primitive, double b1, double b2) const {
+    const Triangle& info = triangle(mesh, primitive);
+    const int k = info.k;
+    const double x = std::clamp(b1, 0.0, 1.0) * k, y = std::clamp(b2, 0.0, 1.0) * k;
+    const int j = std::clamp(int(y), 0, k - 1);
+    // Rounding can put a point on the long edge just past it: it belongs to the last cell.
+    const int i = std::clamp(int(x), 0, k - 1 - j);
+    const double fx = x - i, fy = y - j;
+    const bool upward = fx + fy <= 1 || i + j == k - 1;
+    // Row j starts after 2kj - j^2 patches; upward and downward cells alternate along it.
+    const int64_t local = int64_t(2 * k - j) * j + 2 * i + (upward ? 0 : 1);
+    PatchPoint point;
+    point.patch = info.first_patch + local;
+    point.w = upward ? std::array<double, 3>{1 - fx - fy, fx, fy}
+                     : std::array<double, 3>{1 - fy, fx + fy - 1, 1 - fx};
+    double sum = 0;
+    for (double& w : point.w) sum += (w = std::max(w, 0.0));
+    for (double& w : point.w) w /= sum;
+    return point;
+}
+
+std::array<double, 2> PatchMesh::TriangleBarycentrics(int64_t patch,
+                                                      const std::array<double, 3>& w) const {
+    const Patch& p = patches_[size_t(patch)];
+    const double k = triangle(p.mesh, p.primitive).k;
+    double b1 = 0, b2 = 0;
+    for (size_t c = 0; c < 3; ++c) {
+        b1 += w[c] * p.cell[c][0];
+        b2 += w[c] * p.cell[c][1];
+    }
+    return {b1 / k, b2 / k};
+}
+
+}  // namespace lf

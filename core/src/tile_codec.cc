@@ -1,0 +1,114 @@
+#include "lf/core/tile_codec.h"
+
+#include <cstring>
+
+#include "absl/strings/str_cat.h"
+
+namespace lf {
+
+namespace {
+
+constexpr char kMagic[4] = {'L', 'F', 'T', 'S'};
+constexpr uint32_t kVersion = 1;
+constexpr size_t kHeaderBytes = 4 + 4 + 4 * 4 + 3 * 8;
+constexpr size_t kPixelBytes = 6 * 16 + 2 * 4;
+// 2^28 pixels is a 16k x 16k tile: far beyond any plan, small enough that size arithmetic
+// cannot overflow and a corrupt header cannot make us allocate terabytes.
+constexpr int64_t kMaxPixels = int64_t(1) << 28;
+
+void PutU64(std::string& out, uint64_t v) {
+    for (int i = 0; i < 8; ++i) out.push_back(char(uint8_t(v >> (8 * i))));
+}
+void PutU32(std::string& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(char(uint8_t(v >> (8 * i))));
+}
+
+class Reader {
+public:
+    explicit Reader(std::string_view bytes) : p_(bytes.data()) {}
+    uint64_t U64() { return uint64_t(U32()) | (uint64_t(U32()) << 32); }
+    uint32_t U32() {
+        uint32_t v = 0;
+        for (int i = 0; i < 4; ++i) v |= uint32_t(uint8_t(p_[i])) << (8 * i);
+        p_ += 4;
+        return v;
+    }
+    int32_t I32() { return int32_t(U32()); }
+
+private:
+    const char* p_;
+};
+
+}  // namespace
+
+size_t EncodedTileSumsSize(int64_t pixels) { return kHeaderBytes + size_t(pixels) * kPixelBytes; }
+
+std::string EncodeTileSums(const TileSums& tile) {
+    std::string out;
+    out.reserve(EncodedTileSumsSize(tile.rect.Area()));
+    out.append(kMagic, 4);
+    PutU32(out, kVersion);
+    for (int v : {tile.rect.x0, tile.rect.y0, tile.rect.width, tile.rect.height}) {
+        PutU32(out, uint32_t(v));
+    }
+    for (uint64_t v : {tile.stats.samples, tile.stats.rays, tile.stats.invalid_samples}) {
+        PutU64(out, v);
+    }
+    for (const PixelSums& p : tile.pixels) {
+        for (int h = 0; h < 2; ++h) {
+            for (int c = 0; c < 3; ++c) {
+                const auto v = static_cast<unsigned __int128>(p.sum[h][c].fixed());
+                PutU64(out, uint64_t(v));
+                PutU64(out, uint64_t(v >> 64));
+            }
+        }
+        PutU32(out, p.count[0]);
+        PutU32(out, p.count[1]);
+    }
+    return out;
+}
+
+absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
+    if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, 4) != 0) {
+        return absl::InvalidArgumentError(absl::StrCat("tile sums: not an encoded tile (",
+                                                       bytes.size(), " bytes, no LFTS header)"));
+    }
+    Reader in(bytes.substr(4));
+    if (const uint32_t version = in.U32(); version != kVersion) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("tile sums: version ", version, " is not the supported ", kVersion));
+    }
+    PixelRect rect;
+    rect.x0 = in.I32();
+    rect.y0 = in.I32();
+    rect.width = in.I32();
+    rect.height = in.I32();
+    if (rect.x0 < 0 || rect.y0 < 0 || rect.width <= 0 || rect.height <= 0 ||
+        rect.Area() > kMaxPixels) {
+        return absl::InvalidArgumentError(absl::StrCat("tile sums: bad rectangle ", rect.x0, ",",
+                                                       rect.y0, " ", rect.width, "x", rect.height));
+    }
+    if (bytes.size() != EncodedTileSumsSize(rect.Area())) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("tile sums: ", bytes.size(), " bytes for a ", rect.width, "x", rect.height,
+                         " tile, which takes ", EncodedTileSumsSize(rect.Area())));
+    }
+    TileSums tile(rect);
+    tile.stats.samples = in.U64();
+    tile.stats.rays = in.U64();
+    tile.stats.invalid_samples = in.U64();
+    for (PixelSums& p : tile.pixels) {
+        for (int h = 0; h < 2; ++h) {
+            for (int c = 0; c < 3; ++c) {
+                const uint64_t lo = in.U64(), hi = in.U64();
+                const auto v = (static_cast<unsigned __int128>(hi) << 64) | lo;
+                p.sum[h][c] = ExactSum::FromFixed(static_cast<__int128>(v));
+            }
+        }
+        p.count[0] = in.U32();
+        p.count[1] = in.U32();
+    }
+    return tile;
+}
+
+}  // namespace lf

@@ -1,0 +1,78 @@
+// Radiosity, the finite-element method for diffuse scenes (docs/radiosity.md): mesh the scene
+// into patches, compute form factors with Embree visibility, solve B = E + ρ F B, and render
+// the solution through the tile renderer like any other RadianceEstimator. A solution can be
+// saved and loaded again for another camera, and exported as a coloured PLY mesh.
+//
+//   auto renderer = PrepareRadiosity(embree_scene, options);  // meshing, form factors, solve
+//   RenderImage(camera, **renderer, settings);                 // any camera, any spp
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/patch_mesh.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/radiance.h"
+#include "lf/kernels/radiosity_display.h"
+#include "lf/kernels/radiosity_solver.h"
+
+namespace lf {
+
+struct RadiosityOptions {
+    double patch_size = 0;   // longest patch edge in scene units; 0: from `patches`
+    int64_t patches = 4000;  // target patch count
+    RadiositySolver solver = RadiositySolver::kGaussSeidel;
+    double tolerance = 1e-4;  // relative residual
+    int max_iterations = 10000;
+    RadiosityShading display = RadiosityShading::kSmooth;
+    std::string save_solution;  // paths; empty: none
+    std::string load_solution;  // reuse a saved solution: no form factors, no solve
+    std::string export_ply;
+    int threads = 0;  // 0: all cores
+};
+
+struct RadiosityReport {
+    int64_t patches = 0;
+    int64_t sides = 0;  // unknowns
+    double patch_size = 0;
+    bool loaded = false;  // from a saved solution
+    int iterations = 0;   // as in SolveResult (for a loaded solution, those of its solve)
+    double sweeps = 0;
+    double residual = 0;
+    double mesh_seconds = 0, form_factor_seconds = 0, solve_seconds = 0;
+    size_t form_factor_bytes = 0;
+    int64_t nonzero_form_factors = 0;
+    int64_t visibility_rays = 0;
+};
+
+class RadiosityRenderer : public RadianceEstimator {
+public:
+    RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh, std::vector<Rgb> radiosity,
+                      RadiosityShading shading, const RadiosityReport& report);
+
+    Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override {
+        return display_->Li(ray, sampler, stats);
+    }
+
+    const RadiosityReport& report() const { return report_; }
+    const PatchMesh& mesh() const { return *mesh_; }
+    std::span<const Rgb> radiosity() const { return radiosity_; }  // per side, W m^-2
+
+private:
+    std::unique_ptr<const PatchMesh> mesh_;  // stable address for the display
+    std::vector<Rgb> radiosity_;
+    std::unique_ptr<RadiosityDisplay> display_;
+    RadiosityReport report_;
+};
+
+// Fails with InvalidArgument for scenes radiosity cannot represent (spheres, non-lambert
+// materials, reflectance >= 1 with emission), for a solution that does not match the scene,
+// and with ResourceExhausted if the solver does not converge within the iteration limit.
+absl::StatusOr<std::unique_ptr<RadiosityRenderer>> PrepareRadiosity(
+    const EmbreeScene& scene, const RadiosityOptions& options);
+
+}  // namespace lf

@@ -1,0 +1,58 @@
+// Showing a radiosity solution: a RadianceEstimator for the tile renderer, so the image is the
+// same kind of EXR the path tracer writes, and a PLY export of the coloured patch mesh.
+//
+// A camera ray returns B/π of the patch side it hits (Lambertian radiance; B includes the
+// emission, so emitters need nothing extra). Flat shading uses the patch's value; smooth
+// shading interpolates corner values, each the area-weighted mean B of the sides that share
+// the vertex, face the same way and lie within 30° of each other (creases stay sharp).
+#pragma once
+
+#include <array>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/patch_mesh.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/radiance.h"
+
+namespace lf {
+
+enum class RadiosityShading { kFlat, kSmooth };
+
+// "flat", "smooth".
+absl::StatusOr<RadiosityShading> ParseRadiosityShading(std::string_view name);
+const char* RadiosityShadingName(RadiosityShading shading);
+
+// Radiosity at the three corners of every side, in the patch's corner order.
+std::vector<std::array<Rgb, 3>> SmoothCorners(const PatchMesh& mesh,
+                                              std::span<const Rgb> radiosity);
+
+class RadiosityDisplay : public RadianceEstimator {
+public:
+    // `mesh` must outlive the display; `radiosity` has one value per side.
+    RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& mesh, std::vector<Rgb> radiosity,
+                     RadiosityShading shading);
+
+    Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
+
+    // Radiance leaving one side of the point (b1, b2) of a scene triangle. Sides without an
+    // unknown have radiosity 0.
+    Rgb Radiance(int mesh, int primitive, double b1, double b2, bool back) const;
+
+private:
+    const EmbreeScene& scene_;
+    const PatchMesh& mesh_;
+    std::vector<Rgb> radiosity_;
+    std::vector<std::array<Rgb, 3>> corners_;  // smooth shading only
+};
+
+// ASCII PLY of every side with an unknown (back sides wound the other way), world positions,
+// vertex colours the smooth radiance B/π sRGB-encoded and clamped to [0, 1]. A vertex is
+// written once per distinct colour, so a side of a flat surface shares all its vertices.
+absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,
+                               std::span<const Rgb> radiosity);
+
+}  // namespace lf

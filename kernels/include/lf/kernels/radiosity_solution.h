@@ -1,0 +1,36 @@
+// A solved radiosity, saved so other cameras can render it without solving again. The file
+// names the scene by content hash and the meshing by its patch size, so a solution is never
+// applied to a scene or mesh it was not computed for.
+//
+// Binary, little-endian: "LFRADSOL", u32 version (1), u32 length + bytes of the scene hash,
+// f64 patch size, i64 patch count, i64 side count, i32 iterations, f64 residual, then three
+// f32 (R, G, B radiosity, W m^-2) per side in PatchMesh::sides() order.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/patch_mesh.h"
+#include "lf/core/rgb.h"
+
+namespace lf {
+
+struct RadiositySolution {
+    std::string scene_hash;
+    double patch_size = 0;
+    int64_t patches = 0;
+    int iterations = 0;
+    double residual = 0;
+    std::vector<Rgb> radiosity;  // per side
+};
+
+absl::Status SaveRadiositySolution(const std::string& path, const RadiositySolution& solution);
+absl::StatusOr<RadiositySolution> LoadRadiositySolution(const std::string& path);
+
+// Fails, naming `path`, unless the solution was computed for this scene and this meshing.
+absl::Status CheckRadiositySolution(const RadiositySolution& solution, const std::string& path,
+                                    const std::string& scene_hash, const PatchMesh& mesh);
+
+}  // namespace lf

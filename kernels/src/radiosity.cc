@@ -1,0 +1,161 @@
+#include "lf/kernels/radiosity.h"
+
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <numbers>
+
+#include "absl/strings/str_format.h"
+#include "lf/kernels/form_factors.h"
+#include "lf/kernels/radiosity_solution.h"
+#include "radiosity_log.h"
+
+namespace lf {
+
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The solver refuses this too, by side index; here the user learns which material it is.
+absl::Status CheckReflectance(const Scene& scene) {
+    bool emits = false;
+    for (const PointLight& light : scene.point_lights) emits |= !light.intensity.IsBlack();
+    for (const TriangleMesh& mesh : scene.meshes) {
+        emits |= scene.materials[size_t(mesh.material)].IsEmissive();
+    }
+    if (!emits) return absl::OkStatus();
+    for (const TriangleMesh& mesh : scene.meshes) {
+        const Material& m = scene.materials[size_t(mesh.material)];
+        if (m.reflectance.MaxComponent() >= 1) {
+            return absl::InvalidArgumentError(absl::StrFormat(
+                "radiosity: material '%s' has reflectance (%g, %g, %g); with emission in the "
+                "scene a reflectance of 1 or more has no finite solution",
+                m.name, m.reflectance.r, m.reflectance.g, m.reflectance.b));
+        }
+    }
+    return absl::OkStatus();
+}
+
+// E: exitance π L_e on emitters' front sides plus the point lights' direct light reflected.
+RadiositySystem MakeSystem(const EmbreeScene& scene, const PatchMesh& mesh,
+                           const FormFactors& form_factors) {
+    const std::vector<Rgb> irradiance = PointLightIrradiance(scene, mesh);
+    RadiositySystem system;
+    system.form_factors = &form_factors;
+    for (size_t s = 0; s < mesh.sides().size(); ++s) {
+        const PatchMesh::Side& side = mesh.sides()[s];
+        const PatchMesh::Patch& patch = mesh.patches()[size_t(side.patch)];
+        const Material& m =
+            scene.scene().materials[size_t(scene.scene().meshes[size_t(patch.mesh)].material)];
+        Rgb e = m.reflectance * irradiance[s];
+        if (!side.back) e += m.emission * float(std::numbers::pi);
+        system.emission.push_back(e);
+        system.reflectance.push_back(m.reflectance);
+        system.area.push_back(patch.area);
+    }
+    return system;
+}
+
+absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& scene,
+                                                           const RadiosityOptions& options) {
+    const Scene& s = scene.scene();
+    if (absl::Status status = CheckReflectance(s); !status.ok()) return status;
+    RadiosityReport report;
+    PatchMeshOptions mesh_options{options.patch_size, options.patches};
+    RadiositySolution loaded;
+    if (!options.load_solution.empty()) {
+        absl::StatusOr<RadiositySolution> solution = LoadRadiositySolution(options.load_solution);
+        if (!solution.ok()) return solution.status();
+        loaded = std::move(*solution);
+        mesh_options = {loaded.patch_size, 0};
+    }
+
+    auto start = std::chrono::steady_clock::now();
+    absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(s, mesh_options);
+    if (!mesh.ok()) return mesh.status();
+    report.mesh_seconds = SecondsSince(start);
+    report.patches = int64_t(mesh->patches().size());
+    report.sides = int64_t(mesh->sides().size());
+    report.patch_size = mesh->patch_size();
+    RadiosityLog()->info("{} patches of size {:.3g}, {} unknowns", report.patches,
+                         report.patch_size, report.sides);
+
+    std::vector<Rgb> radiosity;
+    if (!options.load_solution.empty()) {
+        if (absl::Status status =
+                CheckRadiositySolution(loaded, options.load_solution, s.content_hash, *mesh);
+            !status.ok()) {
+            return status;
+        }
+        report.loaded = true;
+        report.iterations = loaded.iterations;
+        report.residual = loaded.residual;
+        radiosity = std::move(loaded.radiosity);
+        RadiosityLog()->info("loaded the solution from {}", options.load_solution);
+    } else {
+        start = std::chrono::steady_clock::now();
+        const FormFactors form_factors = ComputeFormFactors(scene, *mesh);
+        report.form_factor_seconds = SecondsSince(start);
+        report.form_factor_bytes = form_factors.bytes();
+        report.nonzero_form_factors = form_factors.nonzeros();
+        report.visibility_rays = form_factors.rays();
+        RadiosityLog()->info("form factors in {:.2f} s: {} non-zero, {:.1f} MiB, {} rays",
+                             report.form_factor_seconds, report.nonzero_form_factors,
+                             double(report.form_factor_bytes) / (1 << 20), report.visibility_rays);
+
+        start = std::chrono::steady_clock::now();
+        const RadiositySystem system = MakeSystem(scene, *mesh, form_factors);
+        absl::StatusOr<SolveResult> solved =
+            SolveRadiosity(system, {options.solver, options.tolerance, options.max_iterations});
+        if (!solved.ok()) return solved.status();
+        report.solve_seconds = SecondsSince(start);
+        report.iterations = solved->iterations;
+        report.sweeps = solved->sweeps;
+        report.residual = solved->residual;
+        radiosity = std::move(solved->radiosity);
+        RadiosityLog()->info(
+            "{}: {} iterations ({:.1f} sweeps), relative residual {:.2g}, "
+            "{:.2f} s",
+            RadiositySolverName(options.solver), report.iterations, report.sweeps, report.residual,
+            report.solve_seconds);
+    }
+
+    if (!options.save_solution.empty()) {
+        const RadiositySolution solution{s.content_hash,    mesh->patch_size(), report.patches,
+                                         report.iterations, report.residual,    radiosity};
+        if (absl::Status status = SaveRadiositySolution(options.save_solution, solution);
+            !status.ok()) {
+            return status;
+        }
+    }
+    if (!options.export_ply.empty()) {
+        if (absl::Status status = WriteRadiosityPly(options.export_ply, *mesh, radiosity);
+            !status.ok()) {
+            return status;
+        }
+    }
+    return std::make_unique<RadiosityRenderer>(scene, std::move(*mesh), std::move(radiosity),
+                                               options.display, report);
+}
+
+}  // namespace
+
+RadiosityRenderer::RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh,
+                                     std::vector<Rgb> radiosity, RadiosityShading shading,
+                                     const RadiosityReport& report)
+    : mesh_(std::make_unique<const PatchMesh>(std::move(mesh))),
+      radiosity_(std::move(radiosity)),
+      display_(std::make_unique<RadiosityDisplay>(scene, *mesh_, radiosity_, shading)),
+      report_(report) {}
+
+absl::StatusOr<std::unique_ptr<RadiosityRenderer>> PrepareRadiosity(
+    const EmbreeScene& scene, const RadiosityOptions& options) {
+    tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+    absl::StatusOr<std::unique_ptr<RadiosityRenderer>> result;
+    arena.execute([&] { result = Prepare(scene, options); });
+    return result;
+}
+
+}  // namespace lf

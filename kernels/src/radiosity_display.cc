@@ -1,0 +1,149 @@
+#include "lf/kernels/radiosity_display.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+#include <tuple>
+
+#include "absl/strings/str_cat.h"
+
+namespace lf {
+
+namespace {
+
+constexpr float kInvPi = float(1 / std::numbers::pi);
+
+// Sides meeting at a vertex at more than this angle are a crease, not one smooth surface.
+const double kCreaseCosine = std::cos(30 * std::numbers::pi / 180);
+
+uint8_t EncodeSrgb(float linear) {
+    const float v = std::clamp(std::isfinite(linear) ? linear : 0.0f, 0.0f, 1.0f);
+    const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    return uint8_t(std::lround(s * 255.0f));
+}
+
+}  // namespace
+
+absl::StatusOr<RadiosityShading> ParseRadiosityShading(std::string_view name) {
+    for (RadiosityShading s : {RadiosityShading::kFlat, RadiosityShading::kSmooth}) {
+        if (name == RadiosityShadingName(s)) return s;
+    }
+    return absl::InvalidArgumentError(absl::StrCat("unknown radiosity display '", std::string(name),
+                                                   "' (expected flat or smooth)"));
+}
+
+const char* RadiosityShadingName(RadiosityShading shading) {
+    return shading == RadiosityShading::kFlat ? "flat" : "smooth";
+}
+
+std::vector<std::array<Rgb, 3>> SmoothCorners(const PatchMesh& mesh,
+                                              std::span<const Rgb> radiosity) {
+    const auto& sides = mesh.sides();
+    const auto& patches = mesh.patches();
+    // Sides around each vertex, as offsets into one array.
+    std::vector<int32_t> start(mesh.vertices().size() + 1, 0), around(sides.size() * 3);
+    for (const PatchMesh::Side& s : sides) {
+        for (uint32_t v : patches[size_t(s.patch)].vertices) ++start[v + 1];
+    }
+    for (size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
+    std::vector<int32_t> fill(start.begin(), start.end() - 1);
+    for (int32_t s = 0; s < int32_t(sides.size()); ++s) {
+        for (uint32_t v : patches[size_t(sides[size_t(s)].patch)].vertices) {
+            around[size_t(fill[v]++)] = s;
+        }
+    }
+
+    std::vector<std::array<Rgb, 3>> corners(sides.size());
+    for (int32_t s = 0; s < int32_t(sides.size()); ++s) {
+        const Vec3d n = mesh.SideNormal(s);
+        const auto& vertices = patches[size_t(sides[size_t(s)].patch)].vertices;
+        for (size_t c = 0; c < 3; ++c) {
+            double sum[3] = {0, 0, 0}, area = 0;
+            for (int32_t k = start[vertices[c]]; k < start[vertices[c] + 1]; ++k) {
+                const int32_t other = around[size_t(k)];
+                if (sides[size_t(other)].back != sides[size_t(s)].back ||
+                    Dot(mesh.SideNormal(other), n) < kCreaseCosine) {
+                    continue;
+                }
+                const double a = patches[size_t(sides[size_t(other)].patch)].area;
+                area += a;
+                for (int ch = 0; ch < 3; ++ch) sum[ch] += a * radiosity[size_t(other)][ch];
+            }
+            corners[size_t(s)][c] =
+                Rgb(float(sum[0] / area), float(sum[1] / area), float(sum[2] / area));
+        }
+    }
+    return corners;
+}
+
+RadiosityDisplay::RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& mesh,
+                                   std::vector<Rgb> radiosity, RadiosityShading shading)
+    : scene_(scene), mesh_(mesh), radiosity_(std::move(radiosity)) {
+    if (shading == RadiosityShading::kSmooth) corners_ = SmoothCorners(mesh_, radiosity_);
+}
+
+Rgb RadiosityDisplay::Li(const Ray& ray, Sampler&, RenderStats& stats) const {
+    ++stats.rays;
+    const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
+    if (!hit || hit->mesh < 0) return Rgb(0);
+    return Radiance(hit->mesh, hit->primitive, hit->b1, hit->b2, Dot(ray.d, hit->n) > 0);
+}
+
+Rgb RadiosityDisplay::Radiance(int mesh, int primitive, double b1, double b2, bool back) const {
+    const PatchPoint point = mesh_.Locate(mesh, primitive, b1, b2);
+    const int32_t side = mesh_.patches()[size_t(point.patch)].sides[back ? 1 : 0];
+    if (side < 0) return Rgb(0);
+    if (corners_.empty()) return radiosity_[size_t(side)] * kInvPi;
+    const auto& c = corners_[size_t(side)];
+    return (c[0] * float(point.w[0]) + c[1] * float(point.w[1]) + c[2] * float(point.w[2])) *
+           kInvPi;
+}
+
+absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,
+                               std::span<const Rgb> radiosity) {
+    const std::vector<std::array<Rgb, 3>> corners = SmoothCorners(mesh, radiosity);
+    using Colour = std::array<uint8_t, 3>;
+    std::map<std::tuple<uint32_t, bool, Colour>, uint32_t> index;
+    std::vector<std::pair<uint32_t, Colour>> vertices;
+    std::vector<std::array<uint32_t, 3>> faces;
+    for (size_t s = 0; s < mesh.sides().size(); ++s) {
+        const PatchMesh::Side& side = mesh.sides()[s];
+        const auto& patch_vertices = mesh.patches()[size_t(side.patch)].vertices;
+        std::array<uint32_t, 3> face;
+        for (size_t c = 0; c < 3; ++c) {
+            const Rgb radiance = corners[s][c] * kInvPi;
+            const Colour colour{EncodeSrgb(radiance.r), EncodeSrgb(radiance.g),
+                                EncodeSrgb(radiance.b)};
+            const auto key = std::tuple(patch_vertices[c], side.back, colour);
+            const auto [it, inserted] = index.try_emplace(key, uint32_t(vertices.size()));
+            if (inserted) vertices.push_back({patch_vertices[c], colour});
+            face[c] = it->second;
+        }
+        if (side.back) std::swap(face[1], face[2]);
+        faces.push_back(face);
+    }
+
+    FILE* file = std::fopen(path.c_str(), "w");
+    if (!file) return absl::NotFoundError(absl::StrCat(path, ": cannot write PLY"));
+    std::fprintf(file,
+                 "ply\nformat ascii 1.0\ncomment lightfarm radiosity: vertex colours are B/pi, "
+                 "sRGB\nelement vertex %zu\nproperty float x\nproperty float y\nproperty float "
+                 "z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face "
+                 "%zu\nproperty list uchar int vertex_indices\nend_header\n",
+                 vertices.size(), faces.size());
+    for (const auto& [v, colour] : vertices) {
+        const Vec3d& p = mesh.vertices()[v];
+        std::fprintf(file, "%.9g %.9g %.9g %d %d %d\n", p.x, p.y, p.z, colour[0], colour[1],
+                     colour[2]);
+    }
+    for (const auto& f : faces) std::fprintf(file, "3 %u %u %u\n", f[0], f[1], f[2]);
+    const bool failed = std::ferror(file) != 0;
+    if (std::fclose(file) != 0 || failed) {
+        return absl::DataLossError(absl::StrCat(path, ": error writing PLY"));
+    }
+    return absl::OkStatus();
+}
+
+}  // namespace lf

@@ -1,0 +1,113 @@
+#include "lf/kernels/radiosity_solution.h"
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+
+namespace lf {
+
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the solution file is little-endian");
+
+constexpr char kMagic[8] = {'L', 'F', 'R', 'A', 'D', 'S', 'O', 'L'};
+constexpr uint32_t kVersion = 1;
+// A scene hash is a hex digest; anything longer is a corrupt length field.
+constexpr uint32_t kMaxHashLength = 1024;
+
+template <typename T>
+void Put(std::ofstream& out, const T& value) {
+    out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+template <typename T>
+bool Get(std::ifstream& in, T& value) {
+    return bool(in.read(reinterpret_cast<char*>(&value), sizeof(T)));
+}
+
+}  // namespace
+
+absl::Status SaveRadiositySolution(const std::string& path, const RadiositySolution& solution) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) return absl::NotFoundError(absl::StrCat(path, ": cannot write radiosity solution"));
+    out.write(kMagic, sizeof kMagic);
+    Put(out, kVersion);
+    Put(out, uint32_t(solution.scene_hash.size()));
+    out.write(solution.scene_hash.data(), std::streamsize(solution.scene_hash.size()));
+    Put(out, solution.patch_size);
+    Put(out, solution.patches);
+    Put(out, int64_t(solution.radiosity.size()));
+    Put(out, int32_t(solution.iterations));
+    Put(out, solution.residual);
+    static_assert(sizeof(Rgb) == 3 * sizeof(float));
+    out.write(reinterpret_cast<const char*>(solution.radiosity.data()),
+              std::streamsize(solution.radiosity.size() * sizeof(Rgb)));
+    out.close();
+    if (!out) return absl::DataLossError(absl::StrCat(path, ": error writing radiosity solution"));
+    return absl::OkStatus();
+}
+
+absl::StatusOr<RadiositySolution> LoadRadiositySolution(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open radiosity solution"));
+    auto corrupt = [&path](const std::string& what) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(path, ": not a lightfarm radiosity solution (", what, ")"));
+    };
+    char magic[sizeof kMagic];
+    uint32_t version = 0, hash_length = 0;
+    if (!in.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0) {
+        return corrupt("bad magic");
+    }
+    if (!Get(in, version) || version != kVersion) {
+        return corrupt(absl::StrCat("version ", version, ", expected ", kVersion));
+    }
+    if (!Get(in, hash_length) || hash_length > kMaxHashLength) return corrupt("bad scene hash");
+    RadiositySolution solution;
+    solution.scene_hash.resize(hash_length);
+    int64_t sides = 0;
+    int32_t iterations = 0;
+    if (!in.read(solution.scene_hash.data(), hash_length) || !Get(in, solution.patch_size) ||
+        !Get(in, solution.patches) || !Get(in, sides) || !Get(in, iterations) ||
+        !Get(in, solution.residual) || sides < 0 || solution.patches < 0) {
+        return corrupt("truncated header");
+    }
+    solution.iterations = iterations;
+    // The side count must match the bytes that follow before anything is allocated.
+    const std::streamoff header_end = in.tellg();
+    in.seekg(0, std::ios::end);
+    const std::streamoff payload = in.tellg() - header_end;
+    if (payload != std::streamoff(sides) * std::streamoff(sizeof(Rgb))) {
+        return corrupt(absl::StrCat(payload, " bytes of radiosity for ", sides, " sides"));
+    }
+    in.seekg(header_end);
+    solution.radiosity.resize(size_t(sides));
+    if (!in.read(reinterpret_cast<char*>(solution.radiosity.data()), payload)) {
+        return corrupt("truncated radiosity");
+    }
+    return solution;
+}
+
+absl::Status CheckRadiositySolution(const RadiositySolution& solution, const std::string& path,
+                                    const std::string& scene_hash, const PatchMesh& mesh) {
+    if (solution.scene_hash != scene_hash) {
+        return absl::FailedPreconditionError(absl::StrFormat(
+            "%s: solution was computed for scene %s but this scene is %s; solve again", path,
+            solution.scene_hash.empty() ? "(no hash)" : solution.scene_hash,
+            scene_hash.empty() ? "(no hash)" : scene_hash));
+    }
+    if (solution.patches != int64_t(mesh.patches().size()) ||
+        solution.radiosity.size() != mesh.sides().size()) {
+        return absl::FailedPreconditionError(absl::StrFormat(
+            "%s: solution has %d patches and %d sides but meshing the scene at patch size %g "
+            "gives %d and %d; solve again",
+            path, solution.patches, solution.radiosity.size(), solution.patch_size,
+            mesh.patches().size(), mesh.sides().size()));
+    }
+    return absl::OkStatus();
+}
+
+}  // namespace lf

@@ -1,0 +1,84 @@
+#include "server/blob_store.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+
+namespace lf {
+
+namespace fs = std::filesystem;
+
+absl::StatusOr<std::unique_ptr<BlobStore>> BlobStore::Open(const std::string& dir) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) return absl::InternalError(dir + ": " + ec.message());
+    return std::unique_ptr<BlobStore>(new BlobStore(dir));
+}
+
+bool BlobStore::Has(const std::string& hash) const {
+    return IsSha256Hex(hash) && fs::exists(PathOf(hash));
+}
+
+std::string BlobStore::PathOf(const std::string& hash) const { return dir_ + "/" + hash; }
+
+absl::StatusOr<std::unique_ptr<BlobStore::Upload>> BlobStore::StartUpload(const std::string& hash,
+                                                                          uint64_t size) {
+    if (!IsSha256Hex(hash)) {
+        return absl::InvalidArgumentError("blob hash '" + hash + "' is not a SHA-256 hex digest");
+    }
+    static std::atomic<uint64_t> counter{0};
+    const std::string temp = absl::StrCat(dir_, "/.upload-", hash, "-", ::getpid(), "-", ++counter);
+    std::unique_ptr<Upload> upload(new Upload(hash, size, PathOf(hash), temp));
+    if (!upload->out_) return absl::InternalError(temp + ": cannot create");
+    return upload;
+}
+
+BlobStore::Upload::Upload(std::string hash, uint64_t size, std::string final_path,
+                          std::string temp_path)
+    : hash_(std::move(hash)),
+      size_(size),
+      final_path_(std::move(final_path)),
+      temp_path_(std::move(temp_path)),
+      out_(temp_path_, std::ios::binary) {}
+
+BlobStore::Upload::~Upload() {
+    if (finished_) return;
+    out_.close();
+    std::error_code ignored;
+    fs::remove(temp_path_, ignored);
+}
+
+absl::Status BlobStore::Upload::Append(std::string_view data) {
+    received_ += data.size();
+    if (received_ > size_) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("blob ", hash_, ": more than the announced ", size_, " bytes"));
+    }
+    digest_.Update(data);
+    out_.write(data.data(), std::streamsize(data.size()));
+    if (!out_) return absl::InternalError(temp_path_ + ": write failed");
+    return absl::OkStatus();
+}
+
+absl::Status BlobStore::Upload::Finish() {
+    if (received_ != size_) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("blob ", hash_, ": ", received_, " bytes arrived of ", size_));
+    }
+    if (const std::string got = digest_.HexDigest(); got != hash_) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("blob ", hash_, ": the content hashes to ", got));
+    }
+    out_.close();
+    if (!out_) return absl::InternalError(temp_path_ + ": write failed");
+    std::error_code ec;
+    fs::rename(temp_path_, final_path_, ec);
+    if (ec) return absl::InternalError(final_path_ + ": " + ec.message());
+    finished_ = true;
+    return absl::OkStatus();
+}
+
+}  // namespace lf

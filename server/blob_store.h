@@ -1,0 +1,49 @@
+// Content-addressed files in one folder, named by their SHA-256. An upload lands in a temporary
+// file and becomes visible only once its size and hash check out, so a blob that exists is
+// always whole.
+#pragma once
+
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "absl/status/statusor.h"
+#include "server/digest.h"
+
+namespace lf {
+
+class BlobStore {
+public:
+    // Creates `dir` when missing.
+    static absl::StatusOr<std::unique_ptr<BlobStore>> Open(const std::string& dir);
+
+    bool Has(const std::string& hash) const;
+    std::string PathOf(const std::string& hash) const;
+
+    class Upload {
+    public:
+        ~Upload();  // removes the temporary file unless Finish succeeded
+        absl::Status Append(std::string_view data);
+        absl::Status Finish();
+
+    private:
+        friend class BlobStore;
+        Upload(std::string hash, uint64_t size, std::string final_path, std::string temp_path);
+        std::string hash_;
+        uint64_t size_, received_ = 0;
+        std::string final_path_, temp_path_;
+        std::ofstream out_;
+        Sha256 digest_;
+        bool finished_ = false;
+    };
+    // InvalidArgument for a malformed hash.
+    absl::StatusOr<std::unique_ptr<Upload>> StartUpload(const std::string& hash, uint64_t size);
+
+private:
+    explicit BlobStore(std::string dir) : dir_(std::move(dir)) {}
+    std::string dir_;
+};
+
+}  // namespace lf

@@ -1,0 +1,137 @@
+#include "server/farm.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+
+#include "absl/strings/str_cat.h"
+#include "lf/core/image_io.h"
+#include "lf/core/tile_codec.h"
+#include "server/logging.h"
+#include "server/render_metadata.h"
+
+namespace lf {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("farm"); }
+
+// A name no other writer in this process uses at the same time.
+std::string UniqueSuffix() {
+    static std::atomic<uint64_t> counter{0};
+    return absl::StrCat(::getpid(), "-", ++counter);
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
+    std::error_code ec;
+    for (const char* sub : {"results", "previews", "scratch"}) {
+        fs::create_directories(fs::path(options.data_dir) / sub, ec);
+        if (ec) return absl::InternalError(options.data_dir + "/" + sub + ": " + ec.message());
+    }
+    absl::StatusOr<std::unique_ptr<BlobStore>> blobs = BlobStore::Open(options.data_dir + "/blobs");
+    if (!blobs.ok()) return blobs.status();
+    return std::unique_ptr<Farm>(new Farm(options, std::move(*blobs)));
+}
+
+Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs)
+    : options_(options), blobs_(std::move(blobs)), scheduler_(options.scheduler, store_) {}
+
+absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
+    std::vector<const BlobRef*> refs = {&spec.scene};
+    for (const BlobRef& f : spec.files) refs.push_back(&f);
+    for (const BlobRef* ref : refs) {
+        if (absl::Status s = CheckScenePath(ref->path); !s.ok()) return s;
+        if (!blobs_->Has(ref->hash)) {
+            return absl::FailedPreconditionError(
+                absl::StrCat(ref->path, ": blob ", ref->hash, " was not uploaded"));
+        }
+    }
+    if (spec.plan.tile > kMaxFarmTile) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("tile ", spec.plan.tile, " is above ", kMaxFarmTile,
+                         ", the largest whose result fits one message"));
+    }
+    if (spec.max_depth < -1) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("max depth ", spec.max_depth, " is below -1 (unlimited)"));
+    }
+    const std::string scratch = options_.data_dir + "/scratch/submit-" + UniqueSuffix();
+    absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
+        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); },
+        scratch);
+    if (!scene.ok()) {
+        Log()->warn("submission of {} refused: {}", spec.scene.path,
+                    std::string(scene.status().message()));
+        return absl::InvalidArgumentError(scene.status().message());
+    }
+    spec.plan.width = scene->camera.width;
+    spec.plan.height = scene->camera.height;
+    spec.scene_hash = scene->content_hash;
+    return scheduler_.Submit(spec);
+}
+
+absl::Status Farm::Complete(const std::string& lease_id, const std::string& worker,
+                            std::string_view tile_sums) {
+    absl::StatusOr<TileSums> sums = DecodeTileSums(tile_sums);
+    if (!sums.ok()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("lease ", lease_id, " from ", worker, ": ", sums.status().message()));
+    }
+    absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, *sums);
+    if (!done.ok()) return done.status();
+    if (done->job_rendered) FinishJob(done->job_id);
+    return absl::OkStatus();
+}
+
+void Farm::FinishJob(const std::string& job_id) {
+    absl::StatusOr<std::pair<JobRecord, Image>> snapshot = scheduler_.Snapshot(job_id);
+    if (!snapshot.ok()) return;  // cancelled meanwhile
+    const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
+    const absl::Status written = WriteImage(snapshot->first, snapshot->second, path);
+    scheduler_.Finish(job_id, written.ok() ? absl::StatusOr<std::string>(path)
+                                           : absl::StatusOr<std::string>(written));
+}
+
+absl::Status Farm::WriteImage(const JobRecord& job, const Image& image, const std::string& path) {
+    RenderMetadata metadata;
+    metadata.scene_hash = job.spec.scene_hash;
+    metadata.method = "path";
+    metadata.spp = job.spec.plan.spp;
+    metadata.seed = job.spec.seed;
+    metadata.max_depth = job.spec.max_depth;
+    metadata.seconds = job.started == absl::InfinitePast()
+                           ? 0.0
+                           : absl::ToDoubleSeconds(absl::Now() - job.started);
+    metadata.stats = job.stats;
+    // Renamed into place so a reader never sees half a file.
+    const std::string temp = path + ".tmp-" + UniqueSuffix();
+    if (absl::Status s = WriteExr(temp, image, DescribeRender(metadata)); !s.ok()) return s;
+    std::error_code ec;
+    fs::rename(temp, path, ec);
+    if (ec) return absl::InternalError(path + ": " + ec.message());
+    return absl::OkStatus();
+}
+
+absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool preview) {
+    absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+    if (!job.ok()) return job.status();
+    if (job->state == JobState::kSucceeded) return job->result_path;
+    if (!preview || IsFinal(job->state)) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "job ", job_id, " is ", JobStateName(job->state), " (", job->tasks_done, "/",
+            job->tasks_total, " tasks done): no result",
+            IsFinal(job->state) ? "" : " yet; --preview fetches what is merged so far"));
+    }
+    absl::StatusOr<std::pair<JobRecord, Image>> snapshot = scheduler_.Snapshot(job_id);
+    if (!snapshot.ok()) return snapshot.status();
+    const std::string path = options_.data_dir + "/previews/" + job_id + ".exr";
+    if (absl::Status s = WriteImage(snapshot->first, snapshot->second, path); !s.ok()) return s;
+    return path;
+}
+
+}  // namespace lf

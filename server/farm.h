@@ -1,0 +1,55 @@
+// The server's logic behind its gRPC services, in plain C++ types: taking a job in (checking its
+// blobs and its scene), taking results in (decoding and merging them, writing the EXR when the
+// last one arrives), and finding result files. Everything else is the scheduler's and the blob
+// store's, which the services use directly.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "absl/status/statusor.h"
+#include "server/blob_store.h"
+#include "server/job_store.h"
+#include "server/scheduler.h"
+
+namespace lf {
+
+struct FarmOptions {
+    std::string data_dir;  // blobs/, results/, previews/, scratch/ go here
+    SchedulerOptions scheduler;
+    absl::Duration heartbeat_interval = absl::Milliseconds(300);
+};
+
+class Farm {
+public:
+    static absl::StatusOr<std::unique_ptr<Farm>> Open(const FarmOptions& options);
+
+    // Checks the paths and blobs and that the scene loads (InvalidArgument with the loader's
+    // message when it does not), fills in the image size and scene hash, and queues the job.
+    absl::StatusOr<std::string> Submit(JobSpec spec);
+
+    // Decodes and merges a task's result; writes the job's EXR when it was the last one.
+    absl::Status Complete(const std::string& lease_id, const std::string& worker,
+                          std::string_view tile_sums);
+
+    // The EXR of a succeeded job; with `preview`, also of a running one (what is merged so far).
+    absl::StatusOr<std::string> ResultFile(const std::string& job_id, bool preview);
+
+    Scheduler& scheduler() { return scheduler_; }
+    BlobStore& blobs() { return *blobs_; }
+    const FarmOptions& options() const { return options_; }
+
+private:
+    Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs);
+    // Writes the merged image with the render's header attributes, atomically.
+    absl::Status WriteImage(const JobRecord& job, const Image& image, const std::string& path);
+    void FinishJob(const std::string& job_id);
+
+    const FarmOptions options_;
+    std::unique_ptr<BlobStore> blobs_;
+    InMemoryJobStore store_;
+    Scheduler scheduler_;
+};
+
+}  // namespace lf

@@ -1,0 +1,56 @@
+// The gRPC services of lightfarm-server: thin adapters that convert between protobuf messages
+// and the plain types of Farm and Scheduler. All protobuf conversion of the server is here.
+#pragma once
+
+#include "lightfarm/v1/job_service.grpc.pb.h"
+#include "lightfarm/v1/worker_service.grpc.pb.h"
+#include "server/farm.h"
+
+namespace lf {
+
+class JobServiceImpl final : public lightfarm::v1::JobService::Service {
+public:
+    explicit JobServiceImpl(Farm& farm) : farm_(farm) {}
+
+    grpc::Status MissingBlobs(grpc::ServerContext*, const lightfarm::v1::MissingBlobsRequest*,
+                              lightfarm::v1::MissingBlobsResponse*) override;
+    grpc::Status UploadBlob(grpc::ServerContext*,
+                            grpc::ServerReader<lightfarm::v1::UploadBlobRequest>*,
+                            lightfarm::v1::UploadBlobResponse*) override;
+    grpc::Status SubmitJob(grpc::ServerContext*, const lightfarm::v1::SubmitJobRequest*,
+                           lightfarm::v1::SubmitJobResponse*) override;
+    grpc::Status GetJob(grpc::ServerContext*, const lightfarm::v1::GetJobRequest*,
+                        lightfarm::v1::Job*) override;
+    grpc::Status ListJobs(grpc::ServerContext*, const lightfarm::v1::ListJobsRequest*,
+                          lightfarm::v1::ListJobsResponse*) override;
+    grpc::Status WatchJob(grpc::ServerContext*, const lightfarm::v1::WatchJobRequest*,
+                          grpc::ServerWriter<lightfarm::v1::Job>*) override;
+    grpc::Status CancelJob(grpc::ServerContext*, const lightfarm::v1::CancelJobRequest*,
+                           lightfarm::v1::Job*) override;
+    grpc::Status FetchResult(grpc::ServerContext*, const lightfarm::v1::FetchResultRequest*,
+                             grpc::ServerWriter<lightfarm::v1::Chunk>*) override;
+
+private:
+    Farm& farm_;
+};
+
+class WorkerServiceImpl final : public lightfarm::v1::WorkerService::Service {
+public:
+    explicit WorkerServiceImpl(Farm& farm) : farm_(farm) {}
+
+    grpc::Status LeaseTask(grpc::ServerContext*, const lightfarm::v1::LeaseTaskRequest*,
+                           lightfarm::v1::LeaseTaskResponse*) override;
+    grpc::Status Heartbeat(grpc::ServerContext*, const lightfarm::v1::HeartbeatRequest*,
+                           lightfarm::v1::HeartbeatResponse*) override;
+    grpc::Status CompleteTask(grpc::ServerContext*, const lightfarm::v1::CompleteTaskRequest*,
+                              lightfarm::v1::CompleteTaskResponse*) override;
+    grpc::Status FailTask(grpc::ServerContext*, const lightfarm::v1::FailTaskRequest*,
+                          lightfarm::v1::FailTaskResponse*) override;
+    grpc::Status FetchBlob(grpc::ServerContext*, const lightfarm::v1::FetchBlobRequest*,
+                           grpc::ServerWriter<lightfarm::v1::Chunk>*) override;
+
+private:
+    Farm& farm_;
+};
+
+}  // namespace lf

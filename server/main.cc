@@ -1,0 +1,95 @@
+// lightfarm-server: the farm's coordinator. Holds jobs, hands tasks to workers, merges their
+// results and serves the images. See docs/farm.md.
+#include <grpcpp/grpcpp.h>
+#include <signal.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <condition_variable>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "server/farm.h"
+#include "server/grpc_service.h"
+
+int main(int argc, char** argv) {
+    // Signals are taken by sigwait below; blocked before any thread starts so none gets them.
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+    CLI::App app{"lightfarm-server: the render farm's coordinator (see docs/farm.md)."};
+    std::string listen = "127.0.0.1:7070";
+    lf::FarmOptions options;
+    double lease_seconds = 10;
+    std::string log_level = "info";
+    app.add_option("--listen", listen, "HOST:PORT to serve on; port 0 picks a free one")
+        ->capture_default_str();
+    app.add_option("--data-dir", options.data_dir, "folder for blobs and results")->required();
+    app.add_option("--lease-seconds", lease_seconds,
+                   "a task goes back to the queue when its worker is silent this long")
+        ->capture_default_str()
+        ->check(CLI::Range(0.2, 3600.0));
+    app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+        ->capture_default_str();
+    CLI11_PARSE(app, argc, argv);
+
+    spdlog::set_default_logger(spdlog::stderr_color_mt("server"));
+    spdlog::set_level(spdlog::level::from_str(log_level));
+    options.scheduler.lease = absl::Seconds(lease_seconds);
+    // Often enough that a cancel reaches workers within about a second, and several times per
+    // lease so one slow answer does not lose it.
+    options.heartbeat_interval = std::min(absl::Milliseconds(300), options.scheduler.lease / 4);
+
+    absl::StatusOr<std::unique_ptr<lf::Farm>> farm = lf::Farm::Open(options);
+    if (!farm.ok()) {
+        std::fprintf(stderr, "lightfarm-server: error: %s\n",
+                     std::string(farm.status().message()).c_str());
+        return 1;
+    }
+    lf::JobServiceImpl job_service(**farm);
+    lf::WorkerServiceImpl worker_service(**farm);
+    grpc::ServerBuilder builder;
+    int port = 0;
+    builder.AddListeningPort(listen, grpc::InsecureServerCredentials(), &port);
+    builder.RegisterService(&job_service);
+    builder.RegisterService(&worker_service);
+    std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+    if (!server || port == 0) {
+        std::fprintf(stderr, "lightfarm-server: error: cannot listen on %s\n", listen.c_str());
+        return 1;
+    }
+    const std::string host = listen.substr(0, listen.rfind(':'));
+    std::printf("listening on %s:%d\n", host.c_str(), port);
+    std::fflush(stdout);
+    spdlog::info("listening on {}:{}, data in {}, leases of {} s", host, port, options.data_dir,
+                 lease_seconds);
+
+    // The timeout checker: expired leases go back to the queue within a tenth of a second.
+    std::mutex mutex;
+    std::condition_variable stop_cv;
+    bool stop = false;
+    std::thread checker([&] {
+        std::unique_lock<std::mutex> lock(mutex);
+        while (!stop_cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return stop; })) {
+            (*farm)->scheduler().ExpireLeases();
+        }
+    });
+
+    int signal = 0;
+    sigwait(&signals, &signal);
+    spdlog::info("signal {}: shutting down", signal);
+    (*farm)->scheduler().Shutdown();
+    server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+    {
+        std::lock_guard<std::mutex> lock(mutex);
+        stop = true;
+    }
+    stop_cv.notify_all();
+    checker.join();
+    return 0;
+}

@@ -1,0 +1,38 @@
+// Planning a path-traced render into tasks: tiles x sample passes. A task's result depends on
+// nothing but its rectangle and sample range (see lf::RenderTile), so tasks may run anywhere, in
+// any order, and their sums merge into the same bits as one local render.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/film.h"
+
+namespace lf {
+
+// The largest tile side on the farm (checked at submission, not by PlanRender): an encoded
+// 192x192 tile is 3.8 MB, under gRPC's 4 MiB message limit.
+inline constexpr int kMaxFarmTile = 192;
+// As `lightfarm render --spp`: exact sums stay far from overflow below this.
+inline constexpr uint64_t kMaxSpp = uint64_t(1) << 24;
+
+struct RenderPlanSettings {
+    int width = 0, height = 0;
+    uint64_t spp = 16;
+    int tile = 32;
+    int passes = 1;  // sample passes per tile, 1..spp
+};
+
+struct RenderTask {
+    int index = 0;  // position in the plan
+    PixelRect rect;
+    uint64_t sample_begin = 0, sample_end = 0;
+};
+
+// Tile by tile in lf::PlanTiles order (row by row), each tile's passes consecutive, so the tiles
+// being merged at any moment are few. Pass p covers samples [spp*p/passes, spp*(p+1)/passes).
+// InvalidArgument for sizes out of range (spp above kMaxSpp included).
+absl::StatusOr<std::vector<RenderTask>> PlanRender(const RenderPlanSettings& settings);
+
+}  // namespace lf

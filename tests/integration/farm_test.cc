@@ -1,0 +1,399 @@
+// The farm end to end on loopback: the real lightfarm-server, lightfarm-worker and lightfarm
+// binaries, ports chosen by the OS. Farm renders must equal `lightfarm render` bit for bit,
+// whatever the workers, tiles, passes, or a worker killed halfway. Every wait is bounded and
+// every child is killed in TearDown.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "lf/core/image_io.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+
+// A child process whose stderr goes to a log file and whose stdout is read through a pipe.
+class Child {
+public:
+    Child(const std::vector<std::string>& argv, const std::string& log) {
+        int out[2];
+        if (pipe(out) != 0) return;
+        pid_ = fork();
+        if (pid_ == 0) {
+            dup2(out[1], STDOUT_FILENO);
+            const int err = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            dup2(err, STDERR_FILENO);
+            close(out[0]);
+            std::vector<char*> args;
+            for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+            args.push_back(nullptr);
+            execv(args[0], args.data());
+            _exit(127);
+        }
+        close(out[1]);
+        stdout_ = out[0];
+    }
+    ~Child() {
+        Signal(SIGKILL);
+        Wait(milliseconds(5000));
+        if (stdout_ >= 0) close(stdout_);
+    }
+    Child(const Child&) = delete;
+    Child& operator=(const Child&) = delete;
+
+    pid_t pid() const { return pid_; }
+    void Signal(int sig) {
+        if (pid_ > 0 && !exit_status_) kill(pid_, sig);
+    }
+    // The first line of stdout, or "" after `timeout`.
+    std::string ReadLine(milliseconds timeout) {
+        const auto deadline = Clock::now() + timeout;
+        std::string line;
+        while (Clock::now() < deadline) {
+            pollfd p{stdout_, POLLIN, 0};
+            const int left =
+                int(std::chrono::duration_cast<milliseconds>(deadline - Clock::now()).count());
+            if (poll(&p, 1, std::max(left, 1)) <= 0) continue;
+            char c;
+            if (read(stdout_, &c, 1) != 1) break;
+            if (c == '\n') return line;
+            line.push_back(c);
+        }
+        return "";
+    }
+    // The exit status, or nullopt when the child is still running after `timeout`.
+    std::optional<int> Wait(milliseconds timeout) {
+        const auto deadline = Clock::now() + timeout;
+        while (pid_ > 0 && !exit_status_) {
+            int status = 0;
+            if (waitpid(pid_, &status, WNOHANG) == pid_) {
+                exit_status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+            } else if (Clock::now() > deadline) {
+                break;
+            } else {
+                std::this_thread::sleep_for(milliseconds(10));
+            }
+        }
+        return exit_status_;
+    }
+
+private:
+    pid_t pid_ = -1;
+    int stdout_ = -1;
+    std::optional<int> exit_status_;
+};
+
+struct CliRun {
+    int status;
+    std::string out, err;
+    std::string LastLine() const {
+        std::string s = out;
+        while (!s.empty() && s.back() == '\n') s.pop_back();
+        return s.substr(s.rfind('\n') == std::string::npos ? 0 : s.rfind('\n') + 1);
+    }
+};
+
+std::string ReadText(const fs::path& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+class Farm : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               ("lf_farm_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+        scene_ = WriteScene("cornell64.json", 64);
+    }
+
+    void TearDown() override {
+        if (HasFailure()) {
+            for (const auto& e : fs::directory_iterator(dir_)) {
+                if (e.path().extension() == ".log") {
+                    std::printf("---- %s\n%s", e.path().filename().c_str(),
+                                ReadText(e.path()).c_str());
+                }
+            }
+        }
+        children_.clear();  // kills them
+        fs::remove_all(dir_);
+    }
+
+    // The Cornell box at `resolution` squared.
+    std::string WriteScene(const std::string& name, int resolution) {
+        nlohmann::json scene =
+            nlohmann::json::parse(ReadText(fs::path(LF_TEST_SCENES) / "cornell_box.json"));
+        scene["camera"]["resolution"] = {resolution, resolution};
+        std::ofstream(dir_ / name) << scene.dump(1);
+        return (dir_ / name).string();
+    }
+
+    void StartServer(double lease_seconds = 10, const std::string& listen = "127.0.0.1:0") {
+        server_ =
+            Spawn({std::string(LF_BIN_DIR) + "/lightfarm-server", "--listen", listen, "--data-dir",
+                   (dir_ / "data").string(), "--lease-seconds", std::to_string(lease_seconds)},
+                  "server.log");
+        const std::string line = server_->ReadLine(milliseconds(10000));
+        ASSERT_EQ(line.rfind("listening on ", 0), 0u) << "server said: " << line;
+        address_ = line.substr(std::strlen("listening on "));
+    }
+
+    Child* StartWorker(const std::string& name, int threads = 1) {
+        return Spawn(
+            {std::string(LF_BIN_DIR) + "/lightfarm-worker", "--server", address_, "--threads",
+             std::to_string(threads), "--cache-dir", (dir_ / ("cache-" + name)).string()},
+            name + ".log");
+    }
+
+    Child* Spawn(const std::vector<std::string>& argv, const std::string& log) {
+        children_.push_back(std::make_unique<Child>(argv, (dir_ / log).string()));
+        return children_.back().get();
+    }
+
+    // `lightfarm ARGS`, bounded by `timeout` seconds.
+    CliRun Lightfarm(const std::string& args, int timeout = 60) {
+        const fs::path err = dir_ / "cli.err";
+        const std::string cmd = "timeout " + std::to_string(timeout) + " " +
+                                std::string(LF_BIN_DIR) + "/lightfarm " + args + " 2>" +
+                                err.string();
+        FILE* pipe = popen(cmd.c_str(), "r");
+        std::string out;
+        char buf[4096];
+        while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+        const int status = pclose(pipe);
+        return {WEXITSTATUS(status), out, ReadText(err)};
+    }
+    CliRun Farmctl(const std::string& args, int timeout = 60) {
+        return Lightfarm(args + " --server " + address_, timeout);
+    }
+
+    std::string Submit(const std::string& scene, const std::string& settings) {
+        const CliRun r = Farmctl("submit " + scene + " " + settings);
+        EXPECT_EQ(r.status, 0) << r.out << r.err;
+        return r.LastLine();
+    }
+
+    // Polls `status` until `pattern` shows up, for at most `timeout`.
+    bool WaitForStatus(const std::string& job, const std::string& pattern, milliseconds timeout) {
+        const auto deadline = Clock::now() + timeout;
+        while (Clock::now() < deadline) {
+            if (Farmctl("status " + job).out.find(pattern) != std::string::npos) return true;
+            std::this_thread::sleep_for(milliseconds(20));
+        }
+        return false;
+    }
+
+    // Watches the job to its end, fetches it, and compares every sample channel with a local
+    // render of the same scene and settings.
+    void ExpectSameAsLocal(const std::string& job, const std::string& scene, uint64_t spp,
+                           uint64_t seed) {
+        const CliRun watch = Farmctl("watch " + job);
+        ASSERT_EQ(watch.status, 0) << watch.out << watch.err;
+        const std::string farm = (dir_ / (job + ".exr")).string();
+        const CliRun fetch = Farmctl("fetch " + job + " -o " + farm);
+        ASSERT_EQ(fetch.status, 0) << fetch.out << fetch.err;
+
+        const std::string local =
+            (dir_ / ("local-" + std::to_string(spp) + "-" + std::to_string(seed) + ".exr"))
+                .string();
+        if (!fs::exists(local)) {
+            const CliRun r =
+                Lightfarm("render " + scene + " -o " + local + " --spp " + std::to_string(spp) +
+                          " --seed " + std::to_string(seed) + " --threads 2 --no-progress");
+            ASSERT_EQ(r.status, 0) << r.out << r.err;
+        }
+        absl::StatusOr<ExrFile> a = ReadExr(farm), b = ReadExr(local);
+        ASSERT_TRUE(a.ok()) << a.status();
+        ASSERT_TRUE(b.ok()) << b.status();
+        for (const char* ch : {"R", "G", "B", "A.R", "A.G", "A.B", "B.R", "B.G", "B.B", "spp"}) {
+            const std::vector<float>* x = a->image.FindChannel(ch);
+            const std::vector<float>* y = b->image.FindChannel(ch);
+            ASSERT_TRUE(x && y) << ch;
+            ASSERT_EQ(x->size(), y->size()) << ch;
+            EXPECT_EQ(0, std::memcmp(x->data(), y->data(), x->size() * sizeof(float)))
+                << "channel " << ch << " differs from the local render";
+        }
+        for (const char* key : {"lightfarm.sceneHash", "lightfarm.method", "lightfarm.spp",
+                                "lightfarm.seed", "lightfarm.maxDepth", "lightfarm.rays",
+                                "lightfarm.invalidSamples", "lightfarm.version"}) {
+            ASSERT_TRUE(a->attributes.count(key)) << key;
+            EXPECT_EQ(a->attributes.at(key), b->attributes.at(key)) << key;
+        }
+        EXPECT_TRUE(a->attributes.count("lightfarm.seconds"));
+    }
+
+    fs::path dir_;
+    std::string scene_;
+    std::string address_;
+    Child* server_ = nullptr;
+    std::vector<std::unique_ptr<Child>> children_;
+};
+
+TEST_F(Farm, HelpExplainsEveryFarmCommand) {
+    for (const char* cmd : {"submit", "list", "status", "watch", "fetch", "cancel"}) {
+        const CliRun r = Lightfarm(std::string(cmd) + " --help");
+        EXPECT_EQ(r.status, 0) << cmd;
+        EXPECT_NE(r.out.find("--server"), std::string::npos) << cmd << r.out;
+    }
+    for (auto [binary, option] : {std::pair{"lightfarm-server", "--data-dir"},
+                                  std::pair{"lightfarm-worker", "--cache-dir"}}) {
+        const std::string cmd = std::string(LF_BIN_DIR) + "/" + binary + " --help";
+        FILE* pipe = popen(cmd.c_str(), "r");
+        std::string out;
+        char buf[4096];
+        while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+        EXPECT_EQ(WEXITSTATUS(pclose(pipe)), 0) << binary;
+        EXPECT_NE(out.find(option), std::string::npos) << out;
+    }
+}
+
+TEST_F(Farm, SameBitsAsLocalRenderForAnyWorkersAndTiles) {
+    StartServer();
+    StartWorker("w1");
+    for (int workers : {1, 2}) {
+        if (workers == 2) StartWorker("w2");
+        for (const char* tile : {"16", "24"}) {
+            const std::string job =
+                Submit(scene_, std::string("--spp 8 --seed 5 --passes 2 --tile ") + tile);
+            ExpectSameAsLocal(job, scene_, 8, 5);
+        }
+    }
+}
+
+TEST_F(Farm, KilledWorkerDoesNotChangeTheImage) {
+    StartServer(/*lease_seconds=*/1);
+    Child* doomed = StartWorker("doomed");
+    StartWorker("survivor");
+    const std::string job = Submit(scene_, "--spp 512 --seed 9 --tile 16 --passes 8");
+    ASSERT_TRUE(WaitForStatus(job, "running", milliseconds(20000)));
+    std::this_thread::sleep_for(milliseconds(150));  // mid-task
+    doomed->Signal(SIGKILL);
+    ExpectSameAsLocal(job, scene_, 512, 9);
+    const std::string status = Farmctl("status " + job).out;
+    EXPECT_EQ(status.find(" 0 retried"), std::string::npos) << "no task was retried:\n" << status;
+}
+
+TEST_F(Farm, CancelStopsTheWorkWithinASecond) {
+    StartServer();
+    StartWorker("w1");
+    // One task that would take minutes.
+    const std::string job = Submit(scene_, "--spp 65536 --tile 64");
+    ASSERT_TRUE(WaitForStatus(job, "1 running", milliseconds(20000)));
+    const std::string preview = (dir_ / "preview.exr").string();
+    const CliRun not_yet = Farmctl("fetch " + job + " -o " + preview);
+    EXPECT_NE(not_yet.status, 0);
+    EXPECT_NE(not_yet.err.find("no result yet"), std::string::npos) << not_yet.err;
+    const CliRun fetch_preview = Farmctl("fetch --preview " + job + " -o " + preview);
+    ASSERT_EQ(fetch_preview.status, 0) << fetch_preview.err;
+    absl::StatusOr<ExrFile> partial = ReadExr(preview);
+    ASSERT_TRUE(partial.ok()) << partial.status();
+    EXPECT_EQ(partial->image.width(), 64);
+    EXPECT_EQ((*partial->image.FindChannel("spp"))[0], 0.0f);  // nothing merged yet
+
+    const CliRun cancel = Farmctl("cancel " + job);
+    ASSERT_EQ(cancel.status, 0) << cancel.out << cancel.err;
+    EXPECT_NE(cancel.out.find("cancelled"), std::string::npos) << cancel.out;
+
+    // The worker is free again at once: a small job right after finishes in a second or two.
+    const auto start = Clock::now();
+    const std::string next = Submit(scene_, "--spp 4 --tile 32");
+    const CliRun watch = Farmctl("watch " + next, 20);
+    EXPECT_EQ(watch.status, 0) << watch.out << watch.err;
+    EXPECT_LT(Clock::now() - start, milliseconds(5000));
+    EXPECT_NE(ReadText(dir_ / "w1.log").find("dropped"), std::string::npos);
+
+    const CliRun watch_cancelled = Farmctl("watch " + job);
+    EXPECT_EQ(watch_cancelled.status, 1);
+    EXPECT_NE(watch_cancelled.out.find("cancelled"), std::string::npos) << watch_cancelled.out;
+    EXPECT_NE(Farmctl("cancel " + job).status, 0);  // already ended
+}
+
+TEST_F(Farm, HigherPriorityJobOvertakesAnEarlierOne) {
+    StartServer();
+    StartWorker("w1");
+    const std::string big = WriteScene("cornell128.json", 128);
+    const std::string low = Submit(big, "--spp 256 --tile 16 --passes 2 --priority 0");
+    ASSERT_TRUE(WaitForStatus(low, "running", milliseconds(20000)));
+    const std::string high = Submit(scene_, "--spp 8 --tile 16 --priority 10");
+    const CliRun watch = Farmctl("watch " + high);
+    ASSERT_EQ(watch.status, 0) << watch.out << watch.err;
+    const std::string low_status = Farmctl("status " + low).out;
+    EXPECT_NE(low_status.find(": running"), std::string::npos) << low_status;
+    const CliRun list = Farmctl("list");
+    EXPECT_NE(list.out.find(high), std::string::npos) << list.out;
+    EXPECT_LT(list.out.find(high), list.out.find(low)) << "newest first:\n" << list.out;
+    Farmctl("cancel " + low);
+}
+
+TEST_F(Farm, MalformedSceneIsRefusedAndTheServerStaysUp) {
+    StartServer();
+    StartWorker("w1");
+    std::ofstream(dir_ / "bad.json") << "{\n  \"camera\": {\n    \"position\": [0, 0,\n";
+    const CliRun bad = Farmctl("submit " + (dir_ / "bad.json").string());
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.err.find("bad.json"), std::string::npos) << bad.err;
+    EXPECT_EQ(bad.err.find("not reachable"), std::string::npos) << bad.err;
+
+    nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
+    scene["shapes"][0]["material"] = "no_such_material";
+    std::ofstream(dir_ / "wrong.json") << scene.dump(1);
+    const CliRun wrong = Farmctl("submit " + (dir_ / "wrong.json").string());
+    EXPECT_NE(wrong.status, 0);
+    EXPECT_NE(wrong.err.find("no_such_material"), std::string::npos) << wrong.err;
+
+    const std::string job = Submit(scene_, "--spp 2");
+    EXPECT_EQ(Farmctl("watch " + job).status, 0);
+    EXPECT_NE(Farmctl("status job-doesnotexist").err.find("job-doesnotexist"), std::string::npos);
+}
+
+TEST_F(Farm, TerminatedWorkerHandsItsTaskBack) {
+    StartServer();
+    Child* worker = StartWorker("w1");
+    const std::string job = Submit(scene_, "--spp 65536 --tile 64");
+    ASSERT_TRUE(WaitForStatus(job, "1 running", milliseconds(20000)));
+    worker->Signal(SIGTERM);
+    EXPECT_EQ(worker->Wait(milliseconds(3000)), std::optional<int>(0));
+    const std::string status = Farmctl("status " + job).out;
+    EXPECT_NE(status.find("0 running, 1 retried"), std::string::npos) << status;
+    EXPECT_EQ(status.find("error"), std::string::npos) << status;
+    EXPECT_NE(ReadText(dir_ / "w1.log").find("handed back"), std::string::npos);
+    Farmctl("cancel " + job);
+}
+
+TEST_F(Farm, WorkersComeBackAfterTheServerRestarts) {
+    StartServer();
+    StartWorker("w1");
+    EXPECT_EQ(Farmctl("watch " + Submit(scene_, "--spp 2")).status, 0);
+    server_->Signal(SIGTERM);
+    ASSERT_EQ(server_->Wait(milliseconds(5000)), std::optional<int>(0));
+    const std::string address = address_;
+    StartServer(10, address);  // the same port
+    ASSERT_EQ(address_, address);
+    const CliRun watch = Farmctl("watch " + Submit(scene_, "--spp 2"), 20);
+    EXPECT_EQ(watch.status, 0) << watch.out << watch.err;
+}
+
+}  // namespace
+}  // namespace lf

@@ -1,0 +1,154 @@
+// Radiosity against the path tracer on the Cornell box at 64 x 64. Both renderers estimate the
+// same pixel integrals from the same film positions (same seed and sample count), so they may
+// differ only by the path tracer's noise and radiosity's discretisation, and the latter must
+// shrink as the mesh refines.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "lf/core/camera.h"
+#include "lf/core/scene_loader.h"
+#include "lf/kernels/path_tracer.h"
+#include "lf/kernels/radiosity.h"
+#include "lf/kernels/tile_renderer.h"
+
+namespace lf {
+namespace {
+
+constexpr int kResolution = 64;
+constexpr int kBlock = 8;
+constexpr uint64_t kSpp = 512;
+constexpr uint64_t kSeed = 7;
+// A correct pair of renderers fails a 5-sigma check with probability below 1e-6 per region.
+constexpr double kSigmas = 5;
+
+// Per region and channel: the mean over the region's pixels and its standard error from the
+// pixels' half-sample estimates, Var(pixel mean) ≈ (A - B)^2 / 4.
+struct RegionMeans {
+    std::vector<double> mean, error;  // [region * 3 + channel]
+};
+
+RegionMeans Means(const Image& image, const std::vector<int>& region, int regions) {
+    RegionMeans r;
+    r.mean.assign(size_t(regions) * 3, 0);
+    r.error.assign(r.mean.size(), 0);
+    std::vector<double> count(size_t(regions), 0);
+    for (int g : region) {
+        if (g >= 0) count[size_t(g)] += 1;
+    }
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c) {
+        const std::vector<float>& v = *image.FindChannel(names[c]);
+        const std::vector<float>& a = *image.FindChannel(std::string("A.") + names[c]);
+        const std::vector<float>& b = *image.FindChannel(std::string("B.") + names[c]);
+        for (size_t p = 0; p < region.size(); ++p) {
+            if (region[p] < 0) continue;
+            const double n = count[size_t(region[p])];
+            const size_t k = size_t(region[p]) * 3 + size_t(c);
+            r.mean[k] += v[p] / n;
+            r.error[k] += (double(a[p]) - b[p]) * (double(a[p]) - b[p]) / 4 / (n * n);
+        }
+    }
+    for (double& e : r.error) e = std::sqrt(e);
+    return r;
+}
+
+// 8 x 8-pixel blocks.
+std::vector<int> Blocks() {
+    std::vector<int> region(kResolution * kResolution);
+    for (int y = 0; y < kResolution; ++y) {
+        for (int x = 0; x < kResolution; ++x) {
+            region[size_t(y) * kResolution + x] =
+                (y / kBlock) * (kResolution / kBlock) + x / kBlock;
+        }
+    }
+    return region;
+}
+
+// Walls and box faces: the pixels whose centre and corners all see one scene mesh.
+std::vector<int> Surfaces(const EmbreeScene& scene, const Camera& camera) {
+    std::vector<int> region(kResolution * kResolution, -1);
+    for (int y = 0; y < kResolution; ++y) {
+        for (int x = 0; x < kResolution; ++x) {
+            int mesh = -2;
+            for (float u : {0.0f, 0.5f, 0.999f}) {
+                for (float v : {0.0f, 0.5f, 0.999f}) {
+                    const auto hit = scene.Intersect(camera.GenerateRay(x, y, u, v));
+                    const int m = hit ? hit->mesh : -1;
+                    mesh = mesh == -2 || mesh == m ? m : -1;
+                }
+            }
+            region[size_t(y) * kResolution + x] = mesh;
+        }
+    }
+    return region;
+}
+
+TEST(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
+    auto scene = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    scene->camera.width = scene->camera.height = kResolution;
+    auto es = EmbreeScene::Build(*scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    const EmbreeScene& embree = **es;
+    const Camera camera(scene->camera, embree.origin());
+    RenderSettings settings;
+    settings.spp = kSpp;
+    settings.seed = kSeed;
+    const Image path = RenderImage(camera, PathTracer(embree, -1), settings).image;
+
+    const std::vector<int> blocks = Blocks(), surfaces = Surfaces(embree, camera);
+    const int block_count = (kResolution / kBlock) * (kResolution / kBlock);
+    const int surface_count = int(scene->meshes.size());
+    const RegionMeans path_blocks = Means(path, blocks, block_count);
+    const RegionMeans path_surfaces = Means(path, surfaces, surface_count);
+
+    const int64_t patch_counts[] = {250, 1000, 4000};
+    std::vector<RegionMeans> radiosity_blocks, radiosity_surfaces;
+    std::vector<double> debiased;
+    std::printf("%8s %10s %10s %10s   (block means; path-traced mean %.4f)\n", "patches",
+                "rms diff", "noise", "debiased", [&] {
+                    double s = 0;
+                    for (double m : path_blocks.mean) s += m;
+                    return s / double(path_blocks.mean.size());
+                }());
+    for (int64_t n : patch_counts) {
+        RadiosityOptions options;
+        options.patches = n;
+        auto renderer = PrepareRadiosity(embree, options);
+        ASSERT_TRUE(renderer.ok()) << renderer.status();
+        const Image image = RenderImage(camera, **renderer, settings).image;
+        radiosity_blocks.push_back(Means(image, blocks, block_count));
+        radiosity_surfaces.push_back(Means(image, surfaces, surface_count));
+        // The mean squared difference is discretisation^2 + noise^2: subtracting the noise
+        // leaves radiosity's own error.
+        double diff2 = 0, noise2 = 0;
+        for (size_t k = 0; k < path_blocks.mean.size(); ++k) {
+            const double d = radiosity_blocks.back().mean[k] - path_blocks.mean[k];
+            diff2 += d * d;
+            noise2 += path_blocks.error[k] * path_blocks.error[k];
+        }
+        const double m = double(path_blocks.mean.size());
+        debiased.push_back(std::sqrt(std::max(0.0, diff2 - noise2) / m));
+        std::printf("%8ld %10.5f %10.5f %10.5f\n", n, std::sqrt(diff2 / m), std::sqrt(noise2 / m),
+                    debiased.back());
+    }
+    // The finer the mesh, the closer.
+    EXPECT_GT(debiased[0], debiased[1]);
+    EXPECT_GT(debiased[1], debiased[2]);
+
+    // Surface by surface at 1000 patches (5 cm, half the light's width: from here the mesh
+    // resolves the scene's features). Radiosity does not follow shadow and light boundaries, so
+    // its error is O(h) there: e(h) ≈ 2 (R(h/2) - R(h)) (Richardson), and 4000 patches halve h.
+    const RegionMeans& r = radiosity_surfaces[1];
+    for (size_t k = 0; k < path_surfaces.mean.size(); ++k) {
+        const double discretisation = 2 * std::abs(radiosity_surfaces[2].mean[k] - r.mean[k]);
+        EXPECT_NEAR(r.mean[k], path_surfaces.mean[k],
+                    kSigmas * path_surfaces.error[k] + discretisation)
+            << scene->meshes[k / 3].name << " channel " << k % 3;
+    }
+}
+
+}  // namespace
+}  // namespace lf

@@ -1,0 +1,310 @@
+// Form factors against closed forms: the contour integral alone, whole surfaces assembled from
+// patches (parallel and perpendicular unit squares), reciprocity and energy conservation.
+#include "lf/kernels/form_factors.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "lf/core/scene_loader.h"
+#include "test_scenes.h"
+
+namespace lf {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// A unit-reflectance-free lambert quad (v0, v1, v2, v3), front face (v1-v0)x(v2-v0).
+void AddQuad(Scene& scene, Vec3d v0, Vec3d v1, Vec3d v2, Vec3d v3) {
+    TriangleMesh m;
+    m.name = "quad" + std::to_string(scene.meshes.size());
+    m.is_quad = true;
+    m.positions = {v0, v1, v2, v3};
+    m.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(m);
+}
+
+Scene TwoQuads(bool perpendicular) {
+    Scene scene;
+    Material m;
+    m.reflectance = Rgb(0.5f);
+    scene.materials.push_back(m);
+    AddQuad(scene, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});  // z = 0, normal +z
+    if (perpendicular) {
+        AddQuad(scene, {0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1});  // x = 0, normal +x
+    } else {
+        AddQuad(scene, {0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1});  // z = 1, normal -z
+    }
+    return scene;
+}
+
+struct Meshed {
+    Scene scene;
+    std::unique_ptr<EmbreeScene> embree;
+    PatchMesh mesh;
+    FormFactors ff;
+};
+
+std::unique_ptr<Meshed> Compute(Scene scene, const PatchMeshOptions& options) {
+    auto m = std::make_unique<Meshed>();
+    m->scene = std::move(scene);
+    auto es = EmbreeScene::Build(m->scene);
+    EXPECT_TRUE(es.ok()) << es.status();
+    m->embree = std::move(*es);
+    auto mesh = PatchMesh::Build(m->scene, options);
+    EXPECT_TRUE(mesh.ok()) << mesh.status();
+    m->mesh = std::move(*mesh);
+    m->ff = ComputeFormFactors(*m->embree, m->mesh);
+    return m;
+}
+
+PatchMeshOptions Size(double patch_size) { return {patch_size, 0}; }
+PatchMeshOptions Count(int64_t patches) { return {0, patches}; }
+
+// F from scene mesh a to scene mesh b: the area-weighted mean over a's front sides of the
+// summed form factors to b's front sides.
+double SurfaceFormFactor(const Meshed& m, int a, int b) {
+    double num = 0, area = 0;
+    const auto& patches = m.mesh.patches();
+    for (const auto& pa : patches) {
+        if (pa.mesh != a || pa.sides[0] < 0) continue;
+        area += pa.area;
+        for (const auto& pb : patches) {
+            if (pb.mesh == b && pb.sides[0] >= 0)
+                num += pa.area * m.ff.At(pa.sides[0], pb.sides[0]);
+        }
+    }
+    return num / area;
+}
+
+// Parallel unit squares at unit distance (Siegel & Howell, Thermal Radiation Heat Transfer).
+double ParallelSquares() {
+    const double x = 1, y = 1;  // sides over distance
+    const double a = 1 + x * x, b = 1 + y * y;
+    return 2 / (kPi * x * y) *
+           (std::log(std::sqrt(a * b / (1 + x * x + y * y))) +
+            x * std::sqrt(b) * std::atan(x / std::sqrt(b)) +
+            y * std::sqrt(a) * std::atan(y / std::sqrt(a)) - x * std::atan(x) - y * std::atan(y));
+}
+
+// Perpendicular unit squares sharing an edge (Siegel & Howell, W = H = 1).
+double PerpendicularSquares() {
+    const double h = 1, w = 1;
+    const double h2 = h * h, w2 = w * w, s = h2 + w2;
+    const double log_term = 0.25 * std::log((1 + w2) * (1 + h2) / (1 + s) *
+                                            std::pow(w2 * (1 + s) / ((1 + w2) * s), w2) *
+                                            std::pow(h2 * (1 + s) / ((1 + h2) * s), h2));
+    return 1 / (kPi * w) *
+           (w * std::atan(1 / w) + h * std::atan(1 / h) -
+            std::sqrt(s) * std::atan(1 / std::sqrt(s)) + log_term);
+}
+
+TEST(ClosedForms, ReferenceValues) {
+    EXPECT_NEAR(ParallelSquares(), 0.19982, 5e-6);
+    EXPECT_NEAR(PerpendicularSquares(), 0.20004, 5e-6);
+}
+
+// The contour integral alone: a regular polygon inscribed in a disc sees less of it, one
+// circumscribed more, so the disc's R^2/(R^2+H^2) is bracketed with no tolerance to choose.
+TEST(ContourIntegral, BracketsTheCoaxialDisc) {
+    for (const auto& [radius, height] : {std::pair{1.0, 1.0}, {0.3, 2.0}, {5.0, 0.1}}) {
+        const double disc = radius * radius / (radius * radius + height * height);
+        for (int sides : {6, 32, 512}) {
+            std::vector<Vec3d> inner, outer;
+            const double r_out = radius / std::cos(kPi / sides);
+            for (int k = 0; k < sides; ++k) {
+                const double phi = 2 * kPi * k / sides;
+                inner.push_back({radius * std::cos(phi), radius * std::sin(phi), height});
+                outer.push_back({r_out * std::cos(phi), r_out * std::sin(phi), height});
+            }
+            const Vec3d x(0, 0, 0), n(0, 0, 1);
+            const double f_in = PointToPolygonFormFactor(x, n, inner);
+            const double f_out = PointToPolygonFormFactor(x, n, outer);
+            EXPECT_LE(f_in, disc) << sides;
+            EXPECT_GE(f_out, disc) << sides;
+            if (sides == 512) {
+                EXPECT_LT(f_out - f_in, 1e-4 * disc);
+            }
+        }
+    }
+}
+
+TEST(ContourIntegral, RectangleCornerAndOrientation) {
+    // A point under the corner of a parallel a x b rectangle at unit height (Howell's catalogue).
+    const double a = 2, b = 0.5;
+    const double expected = 1 / (2 * kPi) *
+                            (a / std::sqrt(1 + a * a) * std::atan(b / std::sqrt(1 + a * a)) +
+                             b / std::sqrt(1 + b * b) * std::atan(a / std::sqrt(1 + b * b)));
+    std::vector<Vec3d> rect = {{0, 0, 1}, {a, 0, 1}, {a, b, 1}, {0, b, 1}};
+    EXPECT_NEAR(PointToPolygonFormFactor({0, 0, 0}, {0, 0, 1}, rect), expected, 1e-14);
+    std::reverse(rect.begin(), rect.end());  // winding does not matter
+    EXPECT_NEAR(PointToPolygonFormFactor({0, 0, 0}, {0, 0, 1}, rect), expected, 1e-14);
+}
+
+// Bounds on the relative error of one entry, by separation (the distance from the receiver's
+// centroid to the source's bounding sphere, in receiver radii), as stated in form_factors.h and
+// checked against a refined reference in QuadratureErrorIsWithinTheStatedBound.
+constexpr double kSeparatedError = 5e-4;  // separation >= 1
+constexpr double kTouchingError = 5e-3;
+
+struct PatchSphere {
+    Vec3d c;
+    double r = 0;
+};
+
+PatchSphere SphereOf(const PatchMesh& mesh, int64_t patch) {
+    PatchSphere s{mesh.Centroid(patch), 0};
+    for (uint32_t v : mesh.patches()[size_t(patch)].vertices) {
+        s.r = std::max(s.r, Length(mesh.vertices()[v] - s.c));
+    }
+    return s;
+}
+
+double EntryBound(const PatchMesh& mesh, int32_t receiver, int32_t source) {
+    const PatchSphere r = SphereOf(mesh, mesh.sides()[size_t(receiver)].patch);
+    const PatchSphere s = SphereOf(mesh, mesh.sides()[size_t(source)].patch);
+    return (Length(r.c - s.c) - s.r) / r.r >= 1 ? kSeparatedError : kTouchingError;
+}
+
+// The bound of a whole-surface form factor: the entries' bounds averaged with their weights.
+double SurfaceBound(const Meshed& m, int a, int b) {
+    double num = 0, den = 0;
+    for (const auto& pa : m.mesh.patches()) {
+        if (pa.mesh != a || pa.sides[0] < 0) continue;
+        for (const auto& pb : m.mesh.patches()) {
+            if (pb.mesh != b || pb.sides[0] < 0) continue;
+            const double w = pa.area * m.ff.At(pa.sides[0], pb.sides[0]);
+            num += w * EntryBound(m.mesh, pa.sides[0], pb.sides[0]);
+            den += w;
+        }
+    }
+    return num / den;
+}
+
+TEST(FormFactors, UnitSquaresMatchTheirClosedForms) {
+    for (double size : {1.5, 0.5, 0.1}) {  // 1, 4 and 225 patches per triangle
+        for (bool perpendicular : {false, true}) {
+            auto m = Compute(TwoQuads(perpendicular), Size(size));
+            const double exact = perpendicular ? PerpendicularSquares() : ParallelSquares();
+            for (auto [a, b] : {std::pair{0, 1}, {1, 0}}) {  // equal areas: F_ab = F_ba
+                const double f = SurfaceFormFactor(*m, a, b);
+                EXPECT_NEAR(f, exact, SurfaceBound(*m, a, b) * exact)
+                    << (perpendicular ? "perpendicular" : "parallel") << " size " << size;
+                if (a == 0) {
+                    std::printf("%-13s patch size %.2f: F = %.7f, error %+.1e\n",
+                                perpendicular ? "perpendicular" : "parallel", size, f, f - exact);
+                }
+            }
+        }
+    }
+}
+
+// Two single-triangle patches against a reference from the same method on a 16 x 16
+// subdivision of both, whose entries are 16 times better separated.
+Scene TwoTriangles(Vec3d offset, bool perpendicular) {
+    Scene scene;
+    Material m;
+    m.reflectance = Rgb(0.5f);
+    scene.materials.push_back(m);
+    TriangleMesh a;
+    a.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // z = 0, normal +z
+    a.triangles = {{0, 1, 2}};
+    scene.meshes.push_back(a);
+    TriangleMesh b = a;
+    b.positions = perpendicular ? std::vector<Vec3d>{{0, 0, 0}, {0, 1, 0}, {0, 0, 1}}   // normal +x
+                                : std::vector<Vec3d>{{0, 0, 0}, {0, 1, 0}, {1, 0, 0}};  // -z
+    for (Vec3d& p : b.positions) p += offset;
+    scene.meshes.push_back(b);
+    return scene;
+}
+
+TEST(FormFactors, QuadratureErrorIsWithinTheStatedBound) {
+    std::printf("%-13s %5s %10s %12s %10s %10s\n", "case", "gap", "separation", "F", "error",
+                "reverse");
+    for (bool perpendicular : {false, true}) {
+        for (double d : {0.0, 0.05, 0.5, 2.0, 8.0}) {
+            const Vec3d offset = perpendicular ? Vec3d(-d, 0, 0) : Vec3d(0.3, 0.2, d + 0.02);
+            auto coarse = Compute(TwoTriangles(offset, perpendicular), Size(10));
+            auto fine = Compute(TwoTriangles(offset, perpendicular), Size(std::sqrt(2.0) / 15.9));
+            const double separation = [&] {
+                const PatchSphere a = SphereOf(coarse->mesh, 0), b = SphereOf(coarse->mesh, 1);
+                return (Length(a.c - b.c) - b.r) / a.r;
+            }();
+            const double bound = separation >= 1 ? kSeparatedError : kTouchingError;
+            double errors[2];
+            for (int dir = 0; dir < 2; ++dir) {
+                const double f = SurfaceFormFactor(*coarse, dir, 1 - dir);
+                const double ref = SurfaceFormFactor(*fine, dir, 1 - dir);
+                errors[dir] = (f - ref) / ref;
+                EXPECT_LE(std::abs(errors[dir]), bound) << perpendicular << " gap " << d;
+            }
+            std::printf("%-13s %5.2f %10.2f %12.5e %+10.1e %+10.1e\n",
+                        perpendicular ? "perpendicular" : "parallel", d, separation,
+                        SurfaceFormFactor(*coarse, 0, 1), errors[0], errors[1]);
+        }
+    }
+}
+
+// Each direction is integrated on its own receiver, with the same visibility, so
+// A_i F_ij = A_j F_ji up to the two entries' quadrature errors. Pairs where the plane of one
+// patch cuts the other are left out: there the integrand jumps to zero inside the receiver.
+TEST(FormFactors, ReciprocityHoldsWithinTheQuadratureError) {
+    auto scene = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    auto m = Compute(std::move(*scene), Count(500));
+    const PatchMesh& mesh = m->mesh;
+    auto straddles = [&](int32_t i, int32_t j) {
+        const PatchSphere pj = SphereOf(mesh, mesh.sides()[size_t(j)].patch);
+        const Vec3d nj = mesh.SideNormal(j);
+        for (uint32_t v : mesh.patches()[size_t(mesh.sides()[size_t(i)].patch)].vertices) {
+            if (Dot(nj, mesh.vertices()[v] - pj.c) < -1e-9) return true;
+        }
+        return false;
+    };
+    double worst = 0, straddling_mismatch = 0, straddling_transfer = 0;
+    int64_t pairs = 0;
+    for (int32_t i = 0; i < m->ff.size(); ++i) {
+        const double ai = mesh.patches()[size_t(mesh.sides()[size_t(i)].patch)].area;
+        for (int32_t j = i + 1; j < m->ff.size(); ++j) {
+            const double aj = mesh.patches()[size_t(mesh.sides()[size_t(j)].patch)].area;
+            const double gij = ai * m->ff.At(i, j), gji = aj * m->ff.At(j, i);
+            if (gij == 0 && gji == 0) continue;
+            if (straddles(i, j) || straddles(j, i)) {
+                straddling_mismatch += std::abs(gij - gji);
+                straddling_transfer += std::max(gij, gji);
+                continue;
+            }
+            const double bound = EntryBound(mesh, i, j) + EntryBound(mesh, j, i) + 0x1p-23;
+            ASSERT_LE(std::abs(gij - gji), bound * std::max(gij, gji)) << i << ", " << j;
+            worst = std::max(worst, std::abs(gij - gji) / std::max(gij, gji));
+            ++pairs;
+        }
+    }
+    std::printf(
+        "%ld pairs: worst relative mismatch %.1e; straddling pairs: %.1e of their "
+        "transfer\n",
+        pairs, worst, straddling_mismatch / straddling_transfer);
+}
+
+// The hemisphere of every receiver point is partitioned by the box, so rows differ from 1 only
+// by the quadrature errors left after they nearly cancel: at most the entries' bounds.
+TEST(FormFactors, ClosedBoxRowsSumToOne) {
+    for (int64_t patches : {12, 300, 1200}) {
+        auto m = Compute(testing::MakeFurnace(1.0, Vec3d(5, 0, 0), 0.5f, 1.0f, 8), Count(patches));
+        double worst = 0;
+        for (int32_t i = 0; i < m->ff.size(); ++i) {
+            double bound = 0;
+            for (int32_t j = 0; j < m->ff.size(); ++j) {
+                bound += m->ff.At(i, j) * EntryBound(m->mesh, i, j);
+            }
+            const double deviation = std::abs(m->ff.RowSum(i) - 1);
+            EXPECT_LE(deviation, bound) << i;
+            worst = std::max(worst, deviation);
+        }
+        std::printf("%zu patches: rows within %.1e of 1\n", m->mesh.patches().size(), worst);
+    }
+}
+
+}  // namespace
+}  // namespace lf

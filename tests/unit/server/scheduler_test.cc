@@ -1,0 +1,237 @@
+// The task state machine with a fake clock: priority then age, leases that heartbeats keep
+// alive and that expire otherwise, retries on other workers, three strikes, cancel, and
+// results that arrive late or twice.
+#include "server/scheduler.h"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+namespace lf {
+namespace {
+
+class SchedulerTest : public ::testing::Test {
+protected:
+    SchedulerTest() : scheduler_(Options(), store_, [this] { return now_; }) {}
+
+    static SchedulerOptions Options() {
+        SchedulerOptions o;
+        o.lease = absl::Seconds(10);
+        o.max_failures = 3;
+        return o;
+    }
+
+    // A 16x16 image in 8x8 tiles, 4 spp in 2 passes: 8 tasks.
+    std::string Submit(int priority, int tile = 8) {
+        JobSpec spec;
+        spec.name = "test";
+        spec.plan = {16, 16, 4, tile, 2};
+        spec.priority = priority;
+        absl::StatusOr<std::string> id = scheduler_.Submit(spec);
+        EXPECT_TRUE(id.ok()) << id.status();
+        now_ += absl::Milliseconds(1);
+        return *id;
+    }
+
+    static TileSums Result(const Lease& lease) {
+        TileSums sums(lease.task.rect);
+        for (PixelSums& p : sums.pixels) {
+            for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
+                p.Add(s, Rgb(0.5f));
+            }
+        }
+        return sums;
+    }
+
+    JobRecord Job(const std::string& id) { return *scheduler_.Get(id); }
+
+    absl::Time now_ = absl::FromUnixSeconds(1'000'000);
+    InMemoryJobStore store_;
+    Scheduler scheduler_;
+};
+
+TEST_F(SchedulerTest, HigherPriorityFirstThenOlderFirst) {
+    const std::string low = Submit(0), high_old = Submit(5), high_new = Submit(5);
+    EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, high_old);
+    for (int i = 0; i < 7; ++i) EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, high_old);
+    EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, high_new);
+    const std::string urgent = Submit(9);
+    EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, urgent);
+    EXPECT_EQ(Job(low).state, JobState::kQueued);
+    EXPECT_EQ(Job(high_old).state, JobState::kRunning);
+    EXPECT_EQ(Job(high_old).tasks_running, 8);
+}
+
+TEST_F(SchedulerTest, AllResultsInAnyOrderSucceedTheJob) {
+    const std::string id = Submit(0);
+    std::vector<Lease> leases;
+    while (std::optional<Lease> l = scheduler_.LeaseTask("w")) leases.push_back(*l);
+    ASSERT_EQ(leases.size(), 8u);
+    for (size_t i = leases.size(); i-- > 0;) {
+        absl::StatusOr<Scheduler::Completion> done =
+            scheduler_.Complete(leases[i].id, "w", Result(leases[i]));
+        ASSERT_TRUE(done.ok()) << done.status();
+        EXPECT_EQ(done->job_id, id);
+        EXPECT_EQ(done->job_rendered, i == 0);
+    }
+    EXPECT_EQ(Job(id).tasks_done, 8);
+    EXPECT_EQ(Job(id).stats.samples, 0u);  // the fake results carry no stats
+    auto snapshot = scheduler_.Snapshot(id);
+    ASSERT_TRUE(snapshot.ok());
+    EXPECT_EQ((*snapshot->second.FindChannel("spp"))[0], 4.0f);
+    scheduler_.Finish(id, std::string("/results/x.exr"));
+    EXPECT_EQ(Job(id).state, JobState::kSucceeded);
+    EXPECT_EQ(Job(id).result_path, "/results/x.exr");
+    EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
+}
+
+TEST_F(SchedulerTest, HeartbeatsKeepALeaseAndSilenceLosesIt) {
+    const std::string id = Submit(0);
+    const Lease lease = *scheduler_.LeaseTask("a");
+    for (int i = 0; i < 5; ++i) {
+        now_ += absl::Seconds(8);
+        EXPECT_TRUE(scheduler_.Heartbeat(lease.id, "a"));
+        EXPECT_EQ(scheduler_.ExpireLeases(), 0);
+    }
+    now_ += absl::Seconds(10);
+    EXPECT_EQ(scheduler_.ExpireLeases(), 1);
+    EXPECT_FALSE(scheduler_.Heartbeat(lease.id, "a"));  // the worker is told to stop
+    EXPECT_EQ(Job(id).retries, 1);
+    EXPECT_EQ(Job(id).tasks_running, 0);
+}
+
+TEST_F(SchedulerTest, RetriedTaskGoesToAnotherWorkerWhenThereIsOne) {
+    Submit(0);
+    const Lease lease = *scheduler_.LeaseTask("a");
+    scheduler_.LeaseTask("b");  // b is alive
+    ASSERT_TRUE(scheduler_.Fail(lease.id, "a", "out of memory", FailureKind::kTaskError).ok());
+    const Lease next_for_a = *scheduler_.LeaseTask("a");
+    EXPECT_NE(next_for_a.task.index, lease.task.index);
+    const Lease next_for_b = *scheduler_.LeaseTask("b");
+    EXPECT_EQ(next_for_b.task.index, lease.task.index);
+}
+
+TEST_F(SchedulerTest, LoneWorkerRetriesItsOwnFailure) {
+    Submit(0, 16);  // one tile, two passes
+    const Lease first = *scheduler_.LeaseTask("a");
+    ASSERT_TRUE(scheduler_.Fail(first.id, "a", "flaky", FailureKind::kTaskError).ok());
+    EXPECT_EQ(scheduler_.LeaseTask("a")->task.index, 0);
+}
+
+TEST_F(SchedulerTest, ThirdFailureFailsTheJobWithTheReason) {
+    const std::string id = Submit(0, 16);
+    for (int attempt = 1; attempt <= 3; ++attempt) {
+        std::optional<Lease> lease = scheduler_.LeaseTask("w");
+        ASSERT_TRUE(lease.has_value());
+        ASSERT_EQ(lease->task.index, 0);
+        ASSERT_TRUE(
+            scheduler_.Fail(lease->id, "w", "mesh.obj: no such file", FailureKind::kTaskError)
+                .ok());
+        EXPECT_EQ(Job(id).state, attempt < 3 ? JobState::kRunning : JobState::kFailed);
+    }
+    EXPECT_NE(Job(id).error.find("mesh.obj: no such file"), std::string::npos) << Job(id).error;
+    EXPECT_NE(Job(id).error.find("3 times"), std::string::npos) << Job(id).error;
+    EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
+}
+
+TEST_F(SchedulerTest, ExpiriesCountAsFailuresButShutdownsDoNot) {
+    const std::string id = Submit(0, 16);
+    for (int i = 0; i < 10; ++i) {
+        const Lease lease = *scheduler_.LeaseTask("w");
+        ASSERT_TRUE(
+            scheduler_.Fail(lease.id, "w", "worker shutting down", FailureKind::kWorkerShutdown)
+                .ok());
+    }
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+    for (int i = 0; i < 3; ++i) {
+        ASSERT_TRUE(scheduler_.LeaseTask("w").has_value());
+        now_ += absl::Seconds(11);
+        scheduler_.ExpireLeases();
+    }
+    EXPECT_EQ(Job(id).state, JobState::kFailed);
+    EXPECT_NE(Job(id).error.find("lease expired"), std::string::npos) << Job(id).error;
+}
+
+TEST_F(SchedulerTest, LateResultOfAnExpiredLeaseIsMergedOnce) {
+    const std::string id = Submit(0, 16);
+    const Lease slow = *scheduler_.LeaseTask("slow");
+    now_ += absl::Seconds(11);
+    scheduler_.ExpireLeases();
+    const Lease retry = *scheduler_.LeaseTask("fast");
+    ASSERT_EQ(retry.task.index, slow.task.index);
+    ASSERT_TRUE(scheduler_.Complete(slow.id, "slow", Result(slow)).ok());
+    EXPECT_FALSE(scheduler_.Heartbeat(retry.id, "fast"));  // nothing left to do for it
+    absl::StatusOr<Scheduler::Completion> again =
+        scheduler_.Complete(retry.id, "fast", Result(retry));
+    ASSERT_TRUE(again.ok());
+    EXPECT_FALSE(again->job_rendered);
+    EXPECT_EQ(Job(id).tasks_done, 1);
+    EXPECT_EQ(Job(id).tasks_running, 0);
+}
+
+TEST_F(SchedulerTest, WrongResultIsRefused) {
+    Submit(0);
+    const Lease lease = *scheduler_.LeaseTask("w");
+    TileSums wrong(PixelRect{0, 0, 3, 3});
+    EXPECT_EQ(scheduler_.Complete(lease.id, "w", wrong).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(scheduler_.Complete("job-nope/0/1", "w", wrong).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+}
+
+TEST_F(SchedulerTest, CancelStopsLeasesAndIsFinal) {
+    const std::string id = Submit(0);
+    const Lease lease = *scheduler_.LeaseTask("w");
+    absl::StatusOr<JobRecord> cancelled = scheduler_.Cancel(id);
+    ASSERT_TRUE(cancelled.ok());
+    EXPECT_EQ(cancelled->state, JobState::kCancelled);
+    EXPECT_EQ(cancelled->tasks_running, 0);
+    EXPECT_FALSE(scheduler_.Heartbeat(lease.id, "w"));
+    EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
+    EXPECT_EQ(scheduler_.Complete(lease.id, "w", Result(lease)).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(scheduler_.Cancel(id).status().code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(scheduler_.Cancel("job-unknown").status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST_F(SchedulerTest, WaitForChangeWakesOnAnyChange) {
+    const uint64_t v = scheduler_.WaitForChange(0, absl::InfinitePast());
+    EXPECT_EQ(scheduler_.WaitForChange(v, absl::Now() + absl::Milliseconds(10)), v);
+    Submit(0);
+    EXPECT_GT(scheduler_.WaitForChange(v, absl::Now() + absl::Seconds(10)), v);
+}
+
+TEST_F(SchedulerTest, IdleWorkerWaitsForWorkAndGetsItAtOnce) {
+    EXPECT_FALSE(scheduler_.LeaseTask("w", absl::Now() + absl::Milliseconds(20)).has_value());
+    std::thread submitter([this] {
+        absl::SleepFor(absl::Milliseconds(50));
+        Submit(0);
+    });
+    const absl::Time start = absl::Now();
+    const std::optional<Lease> lease = scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
+    submitter.join();
+    EXPECT_TRUE(lease.has_value());
+    EXPECT_LT(absl::Now() - start, absl::Seconds(5));
+}
+
+TEST_F(SchedulerTest, ShutdownEndsTheWait) {
+    std::thread stopper([this] {
+        absl::SleepFor(absl::Milliseconds(50));
+        scheduler_.Shutdown();
+    });
+    const absl::Time start = absl::Now();
+    EXPECT_FALSE(scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20)).has_value());
+    stopper.join();
+    EXPECT_LT(absl::Now() - start, absl::Seconds(5));
+}
+
+TEST_F(SchedulerTest, ListIsNewestFirst) {
+    const std::string a = Submit(0), b = Submit(0);
+    const std::vector<JobRecord> jobs = scheduler_.List();
+    ASSERT_EQ(jobs.size(), 2u);
+    EXPECT_EQ(jobs[0].id, b);
+    EXPECT_EQ(jobs[1].id, a);
+}
+
+}  // namespace
+}  // namespace lf

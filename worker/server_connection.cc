@@ -1,0 +1,126 @@
+#include "worker/server_connection.h"
+
+#include <grpcpp/grpcpp.h>
+
+#include <fstream>
+
+#include "lightfarm/v1/worker_service.grpc.pb.h"
+#include "proto/grpc_status.h"
+
+namespace lf {
+
+namespace pb = lightfarm::v1;
+
+namespace {
+
+BlobRef FromProto(const pb::SceneFile& f) { return {f.path(), f.hash(), f.size()}; }
+
+TaskAssignment FromProto(const pb::Task& t) {
+    TaskAssignment task;
+    task.lease_id = t.lease_id();
+    task.job_id = t.job_id();
+    task.task_index = t.task_index();
+    task.scene = FromProto(t.scene());
+    for (const pb::SceneFile& f : t.files()) task.files.push_back(FromProto(f));
+    task.seed = t.params().seed();
+    task.max_depth = t.params().max_depth();
+    task.rect = {t.x0(), t.y0(), t.width(), t.height()};
+    task.sample_begin = t.sample_begin();
+    task.sample_end = t.sample_end();
+    if (t.heartbeat_interval_ms() > 0) {
+        task.heartbeat_interval = absl::Milliseconds(t.heartbeat_interval_ms());
+    }
+    return task;
+}
+
+}  // namespace
+
+struct ServerConnection::Stub {
+    std::unique_ptr<pb::WorkerService::Stub> stub;
+};
+
+ServerConnection::ServerConnection(const std::string& address, std::string worker_id)
+    : worker_id_(std::move(worker_id)), stub_(std::make_unique<Stub>()) {
+    grpc::ChannelArguments args;
+    // gRPC's default reconnect backoff grows to two minutes; a restarted server should get its
+    // workers back at once.
+    args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
+    args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
+    args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
+    stub_->stub = pb::WorkerService::NewStub(
+        grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args));
+}
+
+ServerConnection::~ServerConnection() = default;
+
+absl::StatusOr<std::optional<TaskAssignment>> ServerConnection::Lease(absl::Duration wait) {
+    pb::LeaseTaskRequest req;
+    req.set_worker_id(worker_id_);
+    req.set_wait_ms(int(absl::ToInt64Milliseconds(wait)));
+    pb::LeaseTaskResponse resp;
+    // Waiting for the connection (rather than failing at once while the channel is in
+    // backoff) is what makes the channel reconnect as soon as a restarted server listens.
+    const auto context = ContextWithDeadline(wait + absl::Seconds(1));
+    context->set_wait_for_ready(true);
+    const grpc::Status s = stub_->stub->LeaseTask(context.get(), req, &resp);
+    if (!s.ok()) return FromGrpcStatus(s);
+    if (!resp.has_task()) return std::nullopt;
+    return FromProto(resp.task());
+}
+
+absl::StatusOr<bool> ServerConnection::Heartbeat(const std::string& lease_id) {
+    pb::HeartbeatRequest req;
+    req.set_lease_id(lease_id);
+    req.set_worker_id(worker_id_);
+    pb::HeartbeatResponse resp;
+    const grpc::Status s =
+        stub_->stub->Heartbeat(ContextWithDeadline(absl::Seconds(2)).get(), req, &resp);
+    if (!s.ok()) return FromGrpcStatus(s);
+    return !resp.cancelled();
+}
+
+absl::Status ServerConnection::Complete(const std::string& lease_id, const std::string& tile_sums,
+                                        double seconds) {
+    pb::CompleteTaskRequest req;
+    req.set_lease_id(lease_id);
+    req.set_worker_id(worker_id_);
+    req.set_tile_sums(tile_sums);
+    req.set_seconds(seconds);
+    pb::CompleteTaskResponse resp;
+    // Rides out a server restart: the result stays valid after its lease.
+    const auto context = ContextWithDeadline(absl::Seconds(30));
+    context->set_wait_for_ready(true);
+    return FromGrpcStatus(stub_->stub->CompleteTask(context.get(), req, &resp));
+}
+
+absl::Status ServerConnection::Fail(const std::string& lease_id, const std::string& reason,
+                                    bool shutdown) {
+    pb::FailTaskRequest req;
+    req.set_lease_id(lease_id);
+    req.set_worker_id(worker_id_);
+    req.set_reason(reason);
+    req.set_kind(shutdown ? pb::FailTaskRequest::WORKER_SHUTDOWN : pb::FailTaskRequest::TASK_ERROR);
+    pb::FailTaskResponse resp;
+    return FromGrpcStatus(
+        stub_->stub->FailTask(ContextWithDeadline(absl::Seconds(5)).get(), req, &resp));
+}
+
+absl::Status ServerConnection::FetchBlob(const std::string& hash, const std::string& path) {
+    pb::FetchBlobRequest req;
+    req.set_hash(hash);
+    // Generous: a large mesh over a slow link.
+    const auto context = ContextWithDeadline(absl::Minutes(10));
+    std::unique_ptr<grpc::ClientReader<pb::Chunk>> reader =
+        stub_->stub->FetchBlob(context.get(), req);
+    std::ofstream out(path, std::ios::binary);
+    pb::Chunk chunk;
+    while (reader->Read(&chunk))
+        out.write(chunk.data().data(), std::streamsize(chunk.data().size()));
+    const grpc::Status s = reader->Finish();
+    if (!s.ok()) return FromGrpcStatus(s);
+    out.close();
+    if (!out) return absl::InternalError(path + ": write failed");
+    return absl::OkStatus();
+}
+
+}  // namespace lf

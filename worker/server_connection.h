@@ -1,0 +1,54 @@
+// The worker's side of the wire: calls to the server's WorkerService with a deadline each, in
+// plain types. All protobuf conversion of the worker is here.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "lf/core/film.h"
+#include "server/scene_files.h"
+
+namespace lf {
+
+struct TaskAssignment {
+    std::string lease_id;
+    std::string job_id;
+    int task_index = 0;
+    BlobRef scene;
+    std::vector<BlobRef> files;
+    uint64_t seed = 0;
+    int max_depth = -1;
+    PixelRect rect;
+    uint64_t sample_begin = 0, sample_end = 0;
+    absl::Duration heartbeat_interval = absl::Milliseconds(300);
+};
+
+class ServerConnection {
+public:
+    // Connects lazily; after the server restarts, calls work again within about a second.
+    ServerConnection(const std::string& address, std::string worker_id);
+    ~ServerConnection();
+
+    const std::string& worker_id() const { return worker_id_; }
+
+    // Waits up to `wait` for work; nullopt: none.
+    absl::StatusOr<std::optional<TaskAssignment>> Lease(absl::Duration wait);
+    // False: stop the task (its job was cancelled or the lease is gone).
+    absl::StatusOr<bool> Heartbeat(const std::string& lease_id);
+    absl::Status Complete(const std::string& lease_id, const std::string& tile_sums,
+                          double seconds);
+    // `shutdown`: the worker is stopping, which does not count against the task.
+    absl::Status Fail(const std::string& lease_id, const std::string& reason, bool shutdown);
+    // Writes blob `hash` to `path`.
+    absl::Status FetchBlob(const std::string& hash, const std::string& path);
+
+private:
+    std::string worker_id_;
+    struct Stub;  // keeps gRPC headers out of the worker's other files
+    std::unique_ptr<Stub> stub_;
+};
+
+}  // namespace lf

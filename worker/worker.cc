@@ -1,0 +1,192 @@
+#include "worker/worker.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <map>
+#include <thread>
+
+#include "lf/core/tile_codec.h"
+#include "lf/kernels/tile_renderer.h"
+#include "server/logging.h"
+
+namespace lf {
+
+namespace {
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("worker"); }
+
+}  // namespace
+
+Worker::Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache)
+    : options_(std::move(options)), server_(server), cache_(cache), arena_(options_.threads) {}
+
+void Worker::Stop() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+    if (current_cancel_) current_cancel_->store(true);
+    wake_.notify_all();
+}
+
+void Worker::WaitIdle(absl::Duration d) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait_for(lock, absl::ToChronoNanoseconds(d), [&] { return stopping(); });
+}
+
+void Worker::Run() {
+    absl::Duration idle = options_.min_idle;
+    bool reachable = true;
+    while (!stopping()) {
+        absl::StatusOr<std::optional<TaskAssignment>> task = server_.Lease(options_.lease_wait);
+        if (task.ok() != reachable) {
+            reachable = task.ok();
+            if (reachable) {
+                Log()->info("worker={} server reachable again", server_.worker_id());
+            } else {
+                Log()->warn("worker={} server unreachable, retrying: {}", server_.worker_id(),
+                            std::string(task.status().message()));
+            }
+        }
+        if (!task.ok()) {
+            WaitIdle(idle);
+            idle = std::min(idle * 2, options_.max_idle);
+            continue;
+        }
+        idle = options_.min_idle;
+        if (!*task) continue;  // the server already waited
+        Execute(**task);
+    }
+    Log()->info("worker={} stopped", server_.worker_id());
+}
+
+void Worker::Execute(const TaskAssignment& task) {
+    std::atomic<bool> cancel{false};
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        current_cancel_ = &cancel;
+        if (stopping()) cancel = true;
+    }
+    // Heartbeats from their own thread, so a long tile keeps its lease and hears of a cancel.
+    std::mutex hb_mutex;
+    std::condition_variable hb_wake;
+    bool task_over = false;
+    std::atomic<bool> dropped{false};
+    std::thread heartbeat([&] {
+        std::unique_lock<std::mutex> lock(hb_mutex);
+        while (!hb_wake.wait_for(lock, absl::ToChronoNanoseconds(task.heartbeat_interval),
+                                 [&] { return task_over; })) {
+            lock.unlock();
+            const absl::StatusOr<bool> keep = server_.Heartbeat(task.lease_id);
+            lock.lock();
+            if (keep.ok() && !*keep) {
+                dropped = true;
+                cancel = true;
+            }
+        }
+    });
+
+    const absl::Time start = absl::Now();
+    absl::Status status = PrepareScene(task);
+    std::optional<TileSums> sums;
+    if (status.ok()) sums = Render(task, cancel);
+    {
+        std::lock_guard<std::mutex> lock(hb_mutex);
+        task_over = true;
+    }
+    hb_wake.notify_all();
+    heartbeat.join();
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        current_cancel_ = nullptr;
+    }
+
+    const std::string ids = "job=" + task.job_id + " task=" + std::to_string(task.task_index);
+    // A result that was finished before a stop was asked for is still worth sending.
+    if (dropped) {
+        Log()->info("{} dropped: the job was cancelled or the lease lost", ids);
+    } else if (status.ok() && !cancel) {
+        SendResult(task, *sums, absl::ToDoubleSeconds(absl::Now() - start));
+    } else if (stopping()) {
+        Log()->info("{} handed back: worker shutting down", ids);
+        (void)server_.Fail(task.lease_id, "worker shutting down", true);
+    } else {
+        Log()->error("{} failed: {}", ids, std::string(status.message()));
+        (void)server_.Fail(task.lease_id, std::string(status.message()), false);
+    }
+}
+
+absl::Status Worker::PrepareScene(const TaskAssignment& task) {
+    if (loaded_.job_id == task.job_id) return absl::OkStatus();
+    loaded_ = {};
+    auto fetch = [&](const std::string& hash, const std::string& path) {
+        return server_.FetchBlob(hash, path);
+    };
+    std::vector<const BlobRef*> refs = {&task.scene};
+    for (const BlobRef& ref : task.files) refs.push_back(&ref);
+    std::map<std::string, std::string> files;  // hash -> cached file
+    for (const BlobRef* ref : refs) {
+        absl::StatusOr<std::string> path = cache_.Get(ref->hash, fetch);
+        if (!path.ok()) return path.status();
+        files[ref->hash] = *path;
+    }
+    absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
+        task.scene, task.files, [&](const std::string& hash) { return files[hash]; },
+        options_.scratch_dir + "/" + task.job_id);
+    cache_.Trim();
+    if (!scene.ok()) return scene.status();
+    LoadedScene loaded;
+    loaded.scene = std::make_unique<Scene>(std::move(*scene));
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*loaded.scene);
+    if (!embree.ok()) return embree.status();
+    loaded.embree = std::move(*embree);
+    loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
+    loaded.tracer = std::make_unique<PathTracer>(*loaded.embree, task.max_depth);
+    loaded.job_id = task.job_id;
+    loaded_ = std::move(loaded);
+    Log()->info("job={} task={} scene {} loaded", task.job_id, task.task_index, task.scene.path);
+    return absl::OkStatus();
+}
+
+TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& cancel) {
+    // Pieces of one row and a few tens of thousands of samples: small enough that a cancel
+    // stops the work within a fraction of a second (RenderTile checks between rows), and exact
+    // sums make any split of the tile give the same bits.
+    constexpr uint64_t kSamplesPerPiece = 1 << 16;
+    const PixelRect& rect = task.rect;
+    const uint64_t step = std::max<uint64_t>(1, kSamplesPerPiece / uint64_t(rect.width));
+    TileSums tile(rect);
+    std::mutex stats_mutex;
+    arena_.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<int>(rect.y0, rect.y0 + rect.height, 1),
+            [&](const tbb::blocked_range<int>& rows) {
+                for (int y = rows.begin(); y != rows.end(); ++y) {
+                    const PixelRect row_rect{rect.x0, y, rect.width, 1};
+                    TileSums row(row_rect);
+                    for (uint64_t s = task.sample_begin; s < task.sample_end && !cancel;
+                         s += step) {
+                        row += RenderTile(*loaded_.camera, *loaded_.tracer, row_rect, task.seed, s,
+                                          std::min(s + step, task.sample_end), &cancel);
+                    }
+                    std::copy(row.pixels.begin(), row.pixels.end(), &tile.at(rect.x0, y));
+                    std::lock_guard<std::mutex> lock(stats_mutex);
+                    tile.stats += row.stats;
+                }
+            });
+    });
+    return tile;
+}
+
+void Worker::SendResult(const TaskAssignment& task, const TileSums& sums, double seconds) {
+    const absl::Status sent = server_.Complete(task.lease_id, EncodeTileSums(sums), seconds);
+    if (sent.ok()) {
+        Log()->debug("job={} task={} done in {:.2f} s ({} samples)", task.job_id, task.task_index,
+                     seconds, sums.stats.samples);
+    } else {
+        Log()->warn("job={} task={} result not taken: {}", task.job_id, task.task_index,
+                    std::string(sent.message()));
+    }
+}
+
+}  // namespace lf

@@ -1,0 +1,70 @@
+// A stateless farm worker: leases a task, renders its tile and sample range, hands back the
+// exact sums, and again. The only state kept between tasks is a cache: scene blobs on disk and
+// the last job's built scene in memory.
+#pragma once
+
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "absl/status/status.h"
+#include "lf/core/camera.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/path_tracer.h"
+#include "worker/blob_cache.h"
+#include "worker/server_connection.h"
+
+namespace lf {
+
+struct WorkerOptions {
+    int threads = 1;
+    std::string scratch_dir;  // where scenes are laid out while they load
+    // An idle worker long-polls the server for this long per call...
+    absl::Duration lease_wait = absl::Seconds(1);
+    // ...and backs off from this to that while the server cannot be reached.
+    absl::Duration min_idle = absl::Milliseconds(50), max_idle = absl::Seconds(1);
+};
+
+class Worker {
+public:
+    Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache);
+
+    // Leases and renders tasks until Stop.
+    void Run();
+    // Thread-safe: stops the current task, hands it back, and makes Run return.
+    void Stop();
+
+private:
+    struct LoadedScene {
+        std::string job_id;
+        std::unique_ptr<Scene> scene;  // EmbreeScene keeps a reference
+        std::unique_ptr<EmbreeScene> embree;
+        std::unique_ptr<Camera> camera;
+        std::unique_ptr<PathTracer> tracer;
+    };
+
+    void Execute(const TaskAssignment& task);
+    // The job's scene, built once for consecutive tasks of the same job.
+    absl::Status PrepareScene(const TaskAssignment& task);
+    TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
+    void SendResult(const TaskAssignment& task, const TileSums& sums, double seconds);
+    bool stopping() const { return stopping_.load(); }
+    void WaitIdle(absl::Duration d);
+
+    const WorkerOptions options_;
+    ServerConnection& server_;
+    BlobCache& cache_;
+    LoadedScene loaded_;
+    tbb::task_arena arena_;
+
+    std::atomic<bool> stopping_{false};
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::atomic<bool>* current_cancel_ = nullptr;  // guarded by mutex_
+};
+
+}  // namespace lf
