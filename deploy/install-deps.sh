@@ -6,7 +6,7 @@ packages=(
   libembree-dev libopenexr-dev libtbb-dev libspdlog-dev nlohmann-json3-dev libcli11-dev
   libpng-dev libtinyobjloader-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
-  libsqlite3-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libssl-dev libsqlite3-dev libgtest-dev libgmock-dev libbenchmark-dev
 )
 missing=()
 for p in "${packages[@]}"; do
