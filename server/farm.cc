@@ -10,6 +10,7 @@
 #include "lf/core/tile_codec.h"
 #include "server/logging.h"
 #include "server/render_metadata.h"
+#include "server/sqlite_job_store.h"
 
 namespace lf {
 
@@ -35,11 +36,22 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
     }
     absl::StatusOr<std::unique_ptr<BlobStore>> blobs = BlobStore::Open(options.data_dir + "/blobs");
     if (!blobs.ok()) return blobs.status();
-    return std::unique_ptr<Farm>(new Farm(options, std::move(*blobs)));
+    absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
+        SqliteJobStore::Open(options.data_dir + "/jobs.db");
+    if (!store.ok()) return store.status();
+    std::unique_ptr<Farm> farm(new Farm(options, std::move(*blobs), std::move(*store)));
+    absl::StatusOr<std::vector<std::string>> rendered = farm->scheduler_.Recover();
+    if (!rendered.ok()) return rendered.status();
+    for (const std::string& job_id : *rendered) farm->FinishJob(job_id);
+    return farm;
 }
 
-Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs)
-    : options_(options), blobs_(std::move(blobs)), scheduler_(options.scheduler, store_) {}
+Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
+           std::unique_ptr<JobStore> store)
+    : options_(options),
+      blobs_(std::move(blobs)),
+      store_(std::move(store)),
+      scheduler_(options.scheduler, *store_) {}
 
 absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     std::vector<const BlobRef*> refs = {&spec.scene};

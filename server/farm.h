@@ -16,13 +16,15 @@
 namespace lf {
 
 struct FarmOptions {
-    std::string data_dir;  // blobs/, results/, previews/, scratch/ go here
+    std::string data_dir;  // jobs.db, blobs/, results/, previews/, scratch/ go here
     SchedulerOptions scheduler;
     absl::Duration heartbeat_interval = absl::Milliseconds(300);
 };
 
 class Farm {
 public:
+    // Opens the data folder and takes up the jobs it holds that have not ended (see
+    // Scheduler::Recover), writing the results of those that were fully rendered.
     static absl::StatusOr<std::unique_ptr<Farm>> Open(const FarmOptions& options);
 
     // Checks the paths and blobs and that the scene loads (InvalidArgument with the loader's
@@ -41,14 +43,15 @@ public:
     const FarmOptions& options() const { return options_; }
 
 private:
-    Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs);
+    Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
+         std::unique_ptr<JobStore> store);
     // Writes the merged image with the render's header attributes, atomically.
     absl::Status WriteImage(const JobRecord& job, const Image& image, const std::string& path);
     void FinishJob(const std::string& job_id);
 
     const FarmOptions options_;
     std::unique_ptr<BlobStore> blobs_;
-    InMemoryJobStore store_;
+    std::unique_ptr<JobStore> store_;
     Scheduler scheduler_;
 };
 

@@ -71,6 +71,7 @@ void ToProto(const JobRecord& job, pb::Job* out) {
     out->set_started_unix_ms(UnixMillis(job.started));
     out->set_finished_unix_ms(UnixMillis(job.finished));
     out->set_retries(job.retries);
+    out->set_tasks_leased(job.tasks_leased);
 }
 
 JobSpec FromProto(const pb::SubmitJobRequest& r) {

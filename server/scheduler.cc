@@ -5,6 +5,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "lf/core/tile_codec.h"
 #include "server/logging.h"
 
 namespace lf {
@@ -13,19 +14,21 @@ namespace {
 
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("scheduler"); }
 
-std::string NewJobId() {
+std::string RandomHex(int digits) {
     static std::mt19937_64 rng{std::random_device{}()};
     static const char kHex[] = "0123456789abcdef";
-    std::string id = "job-";
+    std::string hex;
     uint64_t bits = rng();
-    for (int i = 0; i < 10; ++i, bits >>= 4) id.push_back(kHex[bits & 15]);
-    return id;
+    for (int i = 0; i < digits; ++i, bits >>= 4) hex.push_back(kHex[bits & 15]);
+    return hex;
 }
+
+std::string NewJobId() { return "job-" + RandomHex(10); }
 
 }  // namespace
 
 Scheduler::Scheduler(SchedulerOptions options, JobStore& store, Clock clock)
-    : options_(options), store_(store), clock_(std::move(clock)) {}
+    : options_(options), store_(store), clock_(std::move(clock)), boot_(RandomHex(6)) {}
 
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(spec.plan);
@@ -44,11 +47,54 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     job->record.spec = spec;
     job->record.submitted = clock_();
     job->record.tasks_total = int(plan->size());
-    Save(*job);
+    if (absl::Status s = Save(*job); !s.ok()) return s;
     Log()->info("job={} queued: {} tasks, {}x{}, {} spp, priority {}", id, plan->size(),
                 spec.plan.width, spec.plan.height, spec.plan.spp, spec.priority);
     active_[id] = std::move(job);
     return id;
+}
+
+absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::string> rendered;
+    for (JobRecord& record : store_.List()) {
+        next_seq_ = std::max(next_seq_, record.seq + 1);
+        if (IsFinal(record.state) || active_.count(record.id)) continue;
+        absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(record.spec.plan);
+        if (!plan.ok()) return plan.status();
+        absl::StatusOr<std::map<int, std::string>> results = store_.TaskResults(record.id);
+        if (!results.ok()) return results.status();
+        const int width = record.spec.plan.width, height = record.spec.plan.height;
+        auto job = std::make_unique<Job>(Job{std::move(record),
+                                             *plan,
+                                             std::vector<Task>(plan->size()),
+                                             {},
+                                             RenderMerger(width, height, *plan)});
+        for (const auto& [t, bytes] : *results) {
+            absl::StatusOr<TileSums> sums = DecodeTileSums(bytes);
+            // The store wrote what merged before, so this cannot fail unless the file was
+            // damaged; the task is then simply rendered again.
+            if (!sums.ok() || !job->merger.Add(t, *sums).ok()) {
+                Log()->warn("job={} task={}: the recorded result is unusable, rendering it again",
+                            job->record.id, t);
+                continue;
+            }
+            job->tasks[size_t(t)].state = TaskState::kDone;
+        }
+        for (int t = 0; t < int(plan->size()); ++t) {
+            if (job->tasks[size_t(t)].state != TaskState::kDone) job->queued.insert(t);
+        }
+        job->record.tasks_done = int(job->merger.tasks_done());
+        job->record.stats = job->merger.stats();
+        job->record.tasks_running = 0;
+        Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before",
+                    job->record.id, job->record.tasks_done, job->record.tasks_total,
+                    job->record.tasks_leased);
+        if (job->merger.Complete()) rendered.push_back(job->record.id);
+        Save(*job).IgnoreError();
+        active_[job->record.id] = std::move(job);
+    }
+    return rendered;
 }
 
 bool Scheduler::OtherWorkersAlive(const std::string& worker, absl::Time now) const {
@@ -95,15 +141,16 @@ std::optional<Lease> Scheduler::TryLease(const std::string& worker) {
     best->queued.erase(best_task);
     task.state = TaskState::kLeased;
     ++task.attempts;
+    ++best->record.tasks_leased;
     task.worker = worker;
-    task.lease_id = absl::StrCat(best->record.id, "/", best_task, "/", task.attempts);
+    task.lease_id = absl::StrCat(best->record.id, "/", best_task, "/", boot_, "-", task.attempts);
     timeouts_.Set(task.lease_id, now + options_.lease);
     if (best->record.state == JobState::kQueued) {
         best->record.state = JobState::kRunning;
         best->record.started = now;
     }
     ++best->record.tasks_running;
-    Save(*best);
+    Save(*best).IgnoreError();
     Log()->debug("job={} task={} leased to {} (attempt {})", best->record.id, best_task, worker,
                  task.attempts);
     return Lease{task.lease_id, best->record.id, best->plan[size_t(best_task)], best->record.spec};
@@ -162,7 +209,16 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     task.state = TaskState::kDone;
     job.record.tasks_done = int(job.merger.tasks_done());
     job.record.stats = job.merger.stats();
-    Save(job);
+    if (absl::Status s = store_.PutTaskDone(job.record, ref->task, EncodeTileSums(sums));
+        !s.ok()) {
+        // The merge cannot be taken back, and a job whose results are not all recorded would not
+        // survive a restart: it fails here, and the worker hears why.
+        const std::string job_id = job.record.id;
+        FailJob(job, absl::StrCat("recording the result of task ", ref->task, ": ", s.message()));
+        return absl::UnavailableError(absl::StrCat("job=", job_id, ": ", s.message()));
+    }
+    ++version_;
+    changed_.notify_all();
     Log()->debug("job={} task={} done by {} ({}/{})", job.record.id, ref->task, worker,
                  job.record.tasks_done, job.record.tasks_total);
     return Completion{job.record.id, job.merger.Complete()};
@@ -195,7 +251,7 @@ void Scheduler::Requeue(Job& job, int t, const std::string& reason, bool counted
     }
     job.queued.insert(t);
     ++job.record.retries;
-    Save(job);
+    Save(job).IgnoreError();
 }
 
 void Scheduler::FailJob(Job& job, const std::string& error) {
@@ -211,7 +267,7 @@ void Scheduler::EndJob(Job& job) {
     for (const Task& task : job.tasks) {
         if (task.state == TaskState::kLeased) timeouts_.Remove(task.lease_id);
     }
-    Save(job);
+    Save(job).IgnoreError();
     active_.erase(job.record.id);  // destroys `job`
 }
 
@@ -270,12 +326,12 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
     EndJob(job);
 }
 
-void Scheduler::Save(Job& job) {
-    if (absl::Status s = store_.Put(job.record); !s.ok()) {
-        Log()->error("job={} not saved: {}", job.record.id, std::string(s.message()));
-    }
+absl::Status Scheduler::Save(Job& job) {
+    absl::Status s = store_.Put(job.record);
+    if (!s.ok()) Log()->error("job={} not saved: {}", job.record.id, std::string(s.message()));
     ++version_;
     changed_.notify_all();
+    return s;
 }
 
 uint64_t Scheduler::WaitForChange(uint64_t version, absl::Time deadline) {

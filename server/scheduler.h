@@ -48,8 +48,15 @@ public:
     Scheduler(
         SchedulerOptions options, JobStore& store, Clock clock = [] { return absl::Now(); });
 
-    // Plans and queues the job; `spec` must be validated. Returns the job id.
+    // Plans and queues the job; `spec` must be validated. Returns the job id once the job is in
+    // the store (an error, and nothing queued, when the store cannot take it).
     absl::StatusOr<std::string> Submit(const JobSpec& spec);
+
+    // Takes up the jobs the store holds that have not ended, as a server restarting does: their
+    // recorded task results are merged again and every other task is queued (leases do not
+    // outlive the server; their workers' late results are still taken). Returns the jobs that
+    // are fully rendered, whose result the caller writes and Finishes.
+    absl::StatusOr<std::vector<std::string>> Recover();
 
     // The first queued task of the highest-priority, oldest job, preferring tasks that have not
     // failed on this worker. Waits until `wait_until` for one to be queued (a long poll: an
@@ -60,8 +67,9 @@ public:
     // Extends the lease. False means stop: the job was cancelled or the lease is gone.
     bool Heartbeat(const std::string& lease_id, const std::string& worker);
 
-    // Merges a task's result. The result is accepted even from an expired lease as long as the
-    // task is not done (it is the same bits whoever renders it); a duplicate is ignored.
+    // Merges a task's result and records it in the store before returning. The result is
+    // accepted even from an expired lease as long as the task is not done (it is the same bits
+    // whoever renders it); a duplicate is ignored.
     // `job_rendered` says the job is now fully rendered: the caller writes the result and calls
     // Finish.
     struct Completion {
@@ -125,7 +133,7 @@ private:
     void Requeue(Job& job, int task, const std::string& reason, bool counted);
     void FailJob(Job& job, const std::string& error);
     void EndJob(Job& job);  // drops the live state of a job in a final state
-    void Save(Job& job);    // writes the record and wakes watchers
+    absl::Status Save(Job& job);  // writes the record (the error is logged) and wakes watchers
     bool OtherWorkersAlive(const std::string& worker, absl::Time now) const;
 
     const SchedulerOptions options_;
@@ -137,6 +145,9 @@ private:
     uint64_t version_ = 0;
     bool shutdown_ = false;
     uint64_t next_seq_ = 1;
+    // In lease ids, so that a lease of an earlier run of the server is never taken for a current
+    // one: attempts are counted from zero again after a restart.
+    const std::string boot_;
     std::map<std::string, std::unique_ptr<Job>> active_;
     LeaseTimeouts timeouts_;
     std::map<std::string, absl::Time> workers_seen_;

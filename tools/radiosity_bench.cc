@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
     }
 
     std::printf("%8s %7s %8s %8s %8s %10s %9s %9s %6s %7s %9s %9s %8s\n", "patches", "sides",
-                "ff s", "ff cpu", "solve s", "nonzeros", "ff MiB", "peak MiB", "iters", "sweeps",
+                "ff s", "cpu s", "solve s", "nonzeros", "ff MiB", "peak MiB", "iters", "sweeps",
                 "residual", "rays", "vs path");
     for (int64_t n : patch_counts) {
         ResetPeakRss();

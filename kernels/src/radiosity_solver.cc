@@ -55,8 +55,8 @@ absl::Status Validate(const RadiositySystem& system) {
 absl::Status NotConverged(int sweeps, double residual, double tolerance) {
     return absl::ResourceExhaustedError(absl::StrFormat(
         "radiosity: not converged after %d sweeps (relative residual %.3g > tolerance %.3g); "
-        "reflectance near 1 needs about ln(tolerance) / ln(reflectance) sweeps: raise the "
-        "iteration limit or the tolerance",
+        "reflectance near 1 needs about ln(tolerance / (1 - reflectance)) / ln(reflectance) "
+        "sweeps: raise the iteration limit or the tolerance",
         sweeps, residual, tolerance));
 }
 

@@ -42,41 +42,59 @@ std::string TempPath(const std::string& name) {
         .string();
 }
 
-// Every pixel of a furnace shows L_e / (1 - ρ). A pixel is a convex combination of side
-// values (smooth shading interpolates), and a side's error is bounded by the power-norm error
-// ||e|| <= r ||B|| / (1 - ρ) spread over that side alone: |e_i| <= r ||B|| / ((1 - ρ) A_i).
-TEST(Radiosity, FurnaceRendersEmissionOverOneMinusRho) {
+// A furnace: every pixel is a convex combination of side values (flat shading picks one side,
+// smooth interpolates area-weighted means), so it lies within their range; and their mean is
+// within (r + ρε) / (1 - ρ(1 + ε)) of L_e / (1 - ρ), where r is the solver's residual and
+// ε = 5e-3 the largest stated error of a form factor, which bounds every row's deviation from 1.
+class RadiosityFurnace : public ::testing::TestWithParam<std::pair<double, double>> {};
+
+TEST_P(RadiosityFurnace, RendersEmissionOverOneMinusRho) {
+    const auto [half, offset] = GetParam();
     const float rho = 0.7f, le = 0.5f;
-    const Scene scene = testing::MakeFurnace(1.0, Vec3d(10, 0, -3), rho, le, 16);
+    const double epsilon = 5e-3;
+    const Scene scene =
+        testing::MakeFurnace(half, Vec3d(offset, 0.3 * offset, -offset), rho, le, 16);
     for (RadiosityShading shading : {RadiosityShading::kFlat, RadiosityShading::kSmooth}) {
         RadiosityOptions options;
         options.patches = 300;
         options.display = shading;
-        options.tolerance = 1e-7;
         Prepared p = Prepare(scene, options);
         ASSERT_TRUE(p.renderer.ok()) << p.renderer.status();
         const RadiosityRenderer& r = **p.renderer;
-        double power = 0, min_area = 1e300;
+        double lo = 1e300, hi = 0, power = 0, area = 0;
         for (int32_t s = 0; s < int32_t(r.radiosity().size()); ++s) {
             const double a = r.mesh().patches()[size_t(r.mesh().sides()[size_t(s)].patch)].area;
-            power += a * r.radiosity()[size_t(s)].r;
-            min_area = std::min(min_area, a);
+            const double radiance = r.radiosity()[size_t(s)].r / kPi;
+            lo = std::min(lo, radiance);
+            hi = std::max(hi, radiance);
+            power += a * radiance;
+            area += a;
         }
         const double expected = le / (1 - rho);
-        const double bound = r.report().residual * power / ((1 - rho) * min_area) / kPi;
+        const double bound = (r.report().residual + rho * epsilon) / (1 - rho * (1 + epsilon));
+        EXPECT_NEAR(power / area, expected, bound * expected);
         const Camera camera(scene.camera, p.embree->origin());
         RenderSettings settings;
         settings.spp = 2;
         const Image image = RenderImage(camera, r, settings).image;
         for (const char* channel : {"R", "G", "B"}) {
-            for (float v : *image.FindChannel(channel)) ASSERT_NEAR(v, expected, bound);
+            for (float v : *image.FindChannel(channel)) {
+                ASSERT_GE(v, lo * (1 - 1e-6));
+                ASSERT_LE(v, hi * (1 + 1e-6));
+            }
         }
     }
 }
 
+// Scale extremes and far from the origin: a leak or a false occlusion would show here.
+INSTANTIATE_TEST_SUITE_P(Scales, RadiosityFurnace,
+                         ::testing::Values(std::pair{1.0, 0.0}, std::pair{1e-4, 0.0},
+                                           std::pair{1e5, 0.0}, std::pair{1.0, 1e5}));
+
 // A point light at height h over a lambert floor: B = ρ I h / r^3, averaged over each patch.
-// The reference averages with 4096 midpoint samples per patch (error ~1e-7 here); the solver
-// uses the form factors' quadrature, whose error at these separations is below 1e-4.
+// The reference averages 4096 midpoint samples per patch (error ~(1/64)^2 of the patch's
+// variation); the solver uses the form factors' quadrature, whose stated error for separated
+// pairs is 5e-4 (form_factors.h).
 TEST(Radiosity, PointLightMatchesTheInverseSquareLaw) {
     Scene scene;
     Material floor;
@@ -118,7 +136,7 @@ TEST(Radiosity, PointLightMatchesTheInverseSquareLaw) {
         }
         const Rgb expected = floor.reflectance * intensity * float(sum / count);
         const Rgb& got = r.radiosity()[size_t(&side - r.mesh().sides().data())];
-        for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(got[ch], expected[ch], 1e-4 * expected[ch]);
+        for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(got[ch], expected[ch], 5e-4 * expected[ch]);
     }
 }
 

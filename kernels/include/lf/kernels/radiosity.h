@@ -30,7 +30,8 @@ struct RadiosityOptions {
     int max_iterations = 10000;
     RadiosityShading display = RadiosityShading::kSmooth;
     std::string save_solution;  // paths; empty: none
-    std::string load_solution;  // reuse a saved solution: no form factors, no solve
+    std::string load_solution;  // reuse a saved solution, meshed as it was (patch_size and
+                                // patches are ignored): no form factors, no solve
     std::string export_ply;
     int threads = 0;  // 0: all cores
 };

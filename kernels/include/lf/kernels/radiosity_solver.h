@@ -4,7 +4,8 @@
 // residual ||E + ρ F B - B|| / ||B|| of the returned B is below the tolerance, in the norm
 // ||x|| = Σ_i A_i (|x_r| + |x_g| + |x_b|): power, so the residual is the fraction of the radiant
 // power not yet accounted for. Each sweep shrinks the error by about max ρ (times the largest
-// row sum, 1 in a closed scene), so a solve takes about ln(tolerance) / ln(ρ) sweeps.
+// row sum, 1 in a closed scene), so a solve takes about ln(tolerance / (1 - ρ)) / ln(ρ) sweeps,
+// and B is within about tolerance / (1 - ρ) of the solution.
 //
 // Jacobi and Gauss-Seidel are sequences of one pure step, GatherGroup: the new B of one group
 // of sides from a solution so far. A Jacobi sweep applies it to every group against the same
