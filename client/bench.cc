@@ -13,7 +13,7 @@
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
-#include "lf/kernels/tile_renderer.h"
+#include "local_executor.h"
 
 namespace lf {
 
@@ -65,7 +65,9 @@ absl::Status RunBench(const BenchOptions& options) {
     RenderSettings settings;
     settings.spp = options.spp;
     settings.threads = options.threads;
-    const RenderOutput out = RenderImage(camera, tracer, settings);
+    absl::StatusOr<RenderOutput> rendered = RenderImage(camera, tracer, settings);
+    if (!rendered.ok()) return rendered.status();
+    const RenderOutput& out = *rendered;
     const double raw = RawRaysPerSecond(**embree, options.raw_rays, options.threads);
 
     const double sps = double(out.stats.samples) / out.seconds;

@@ -1,39 +1,21 @@
 #include "local_render.h"
 
-#include <spdlog/spdlog.h>
-
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
+#include "absl/strings/str_cat.h"
 #include "lf/core/camera.h"
+#include "lf/core/image_io.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
-#include "lf/version.h"
 #include "progress_bar.h"
+#include "server/logging.h"
+#include "server/render_metadata.h"
 
 namespace lf {
-
-ExrAttributes DescribeRender(const std::string& scene_hash, const std::string& method,
-                             const RenderSettings& settings, int max_depth,
-                             const RenderOutput& output) {
-    return {
-        {"lightfarm.version", std::string(kVersion)},
-        {"lightfarm.sceneHash", scene_hash},
-        {"lightfarm.method", method},
-        {"lightfarm.spp", int(settings.spp)},
-        {"lightfarm.seed", std::to_string(settings.seed)},
-        {"lightfarm.maxDepth", max_depth},
-        {"lightfarm.seconds", output.seconds},
-        {"lightfarm.invalidSamples", std::to_string(output.stats.invalid_samples)},
-        {"lightfarm.rays", std::to_string(output.stats.rays)},
-        {"lightfarm.channels",
-         std::string("R,G,B: mean radiance W m^-2 sr^-1 (box filter); A.*, B.*: means of the "
-                     "even and odd samples; spp: samples per pixel")},
-    };
-}
 
 namespace {
 
@@ -50,45 +32,113 @@ absl::Status CheckWritable(const std::string& path) {
     return absl::OkStatus();
 }
 
+// `auto`: radiosity models exactly the scenes it can (all Lambertian, no spheres) and is
+// view-independent; everything else needs the path tracer.
+absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
+                                         std::string* why) {
+    if (requested == "path" || requested == "radiosity") {
+        *why = "requested";
+        return requested;
+    }
+    if (requested != "auto") {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--method ", requested, ": expected path, radiosity or auto"));
+    }
+    for (const Material& m : scene.materials) {
+        if (m.type != Material::Type::kLambert) {
+            *why = absl::StrCat("material \"", m.name, "\" is ", MaterialTypeName(m.type),
+                                ", which radiosity cannot model");
+            return std::string("path");
+        }
+    }
+    if (!scene.spheres.empty()) {
+        *why = "the scene has spheres, which radiosity does not mesh";
+        return std::string("path");
+    }
+    *why = "every material is Lambertian";
+    return std::string("radiosity");
+}
+
+void AddRadiosityAttributes(const RadiosityReport& r, const RadiosityOptions& o,
+                            ExrAttributes* attributes) {
+    (*attributes)["lightfarm.radiosity.patches"] = std::to_string(r.patches);
+    (*attributes)["lightfarm.radiosity.unknowns"] = std::to_string(r.sides);
+    (*attributes)["lightfarm.radiosity.patchSize"] = r.patch_size;
+    (*attributes)["lightfarm.radiosity.solver"] = std::string(RadiositySolverName(o.solver));
+    (*attributes)["lightfarm.radiosity.iterations"] = r.iterations;
+    (*attributes)["lightfarm.radiosity.residual"] = r.residual;
+    (*attributes)["lightfarm.radiosity.tolerance"] = o.tolerance;
+    (*attributes)["lightfarm.radiosity.display"] = std::string(RadiosityShadingName(o.display));
+    (*attributes)["lightfarm.radiosity.loaded"] = std::string(r.loaded ? "yes" : "no");
+    (*attributes)["lightfarm.radiosity.formFactorSeconds"] = r.form_factor_seconds;
+    (*attributes)["lightfarm.radiosity.solveSeconds"] = r.solve_seconds;
+}
+
 }  // namespace
 
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options) {
     for (const std::string* path : {&options.exr_path, &options.png_path}) {
         if (absl::Status s = CheckWritable(*path); !s.ok()) return s;
     }
-    auto log = spdlog::get("render");
-    if (!log) log = spdlog::default_logger()->clone("render");
+    auto log = NamedLogger("render");
 
     absl::StatusOr<Scene> scene = LoadScene(options.scene_path);
     if (!scene.ok()) return scene.status();
     const std::string job_id = "local-" + scene->content_hash.substr(0, 8);
+    std::string why;
+    absl::StatusOr<std::string> method = ChooseMethod(*scene, options.method, &why);
+    if (!method.ok()) return method.status();
+    log->info("job={} method {} ({})", job_id, *method, why);
 
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
     const Camera camera(scene->camera, (*embree)->origin());
-    const PathTracer tracer(**embree, options.max_depth);
+
+    std::unique_ptr<RadianceEstimator> estimator;
+    const RadiosityRenderer* radiosity = nullptr;
+    if (*method == "radiosity") {
+        RadiosityOptions ro = options.radiosity;
+        ro.threads = options.render.threads;
+        absl::StatusOr<std::unique_ptr<RadiosityRenderer>> r = PrepareRadiosity(**embree, ro);
+        if (!r.ok()) return r.status();
+        radiosity = r->get();
+        estimator = std::move(*r);
+        const RadiosityReport& rep = radiosity->report();
+        log->info(
+            "job={} radiosity: {} patches, {} unknowns, {} iterations, residual {:.2e}, form "
+            "factors {:.2f} s ({} MiB), solve {:.2f} s",
+            job_id, rep.patches, rep.sides, rep.iterations, rep.residual,
+            rep.form_factor_seconds, rep.form_factor_bytes >> 20, rep.solve_seconds);
+    } else {
+        estimator = std::make_unique<PathTracer>(**embree, options.max_depth);
+    }
     log->info("job={} rendering {} ({}x{}, {} spp, seed {}, max depth {}, tile {})", job_id,
               options.scene_path, camera.width(), camera.height(), options.render.spp,
-              options.render.seed, options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
+              options.render.seed,
+              options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
               options.render.tile);
-
     ProgressBar bar("render");
-    const RenderOutput out = RenderImage(camera, tracer, options.render, [&](size_t done, size_t n) {
-        if (options.progress) bar.Update(done, n);
-    });
+    absl::StatusOr<RenderOutput> out =
+        RenderImage(camera, *estimator, options.render, [&](size_t done, size_t n) {
+            if (options.progress) bar.Update(done, n);
+        });
     if (options.progress) bar.Finish();
-    if (out.stats.invalid_samples > 0) {
+    if (!out.ok()) return out.status();
+    if (out->stats.invalid_samples > 0) {
         log->warn("job={} {} NaN or infinite samples were discarded (counted as zero)", job_id,
-                  out.stats.invalid_samples);
+                  out->stats.invalid_samples);
     }
 
-    const ExrAttributes attributes =
-        DescribeRender(scene->content_hash, "path", options.render, options.max_depth, out);
-    if (absl::Status s = WriteExr(options.exr_path, out.image, attributes); !s.ok()) return s;
+    ExrAttributes attributes =
+        DescribeRender({scene->content_hash, *method, options.render.spp, options.render.seed,
+                        options.max_depth, out->seconds, out->stats});
+    if (radiosity) AddRadiosityAttributes(radiosity->report(), options.radiosity, &attributes);
+    if (absl::Status s = WriteExr(options.exr_path, out->image, attributes); !s.ok()) return s;
     if (!options.png_path.empty()) {
-        if (absl::Status s = WritePng(options.png_path, out.image); !s.ok()) return s;
+        if (absl::Status s = WritePng(options.png_path, out->image); !s.ok()) return s;
     }
-    return LocalRenderSummary{job_id, out.stats, out.seconds, camera.width(), camera.height()};
+    return LocalRenderSummary{job_id, *method, out->stats, out->seconds, camera.width(),
+                              camera.height()};
 }
 
 }  // namespace lf

@@ -13,9 +13,12 @@ int ReportError(const absl::Status& status) {
 Command AddRenderCommand(CLI::App& app) {
     auto options = std::make_shared<LocalRenderOptions>();
     auto no_progress = std::make_shared<bool>(false);
+    auto solver = std::make_shared<std::string>("gauss-seidel");
+    auto display = std::make_shared<std::string>("smooth");
     CLI::App* cmd = app.add_subcommand(
         "render",
-        "Render a scene in this process (path tracing) to an OpenEXR image.\n"
+        "Render a scene in this process to an OpenEXR image, by path tracing or radiosity,\n"
+        "through the same planner and merger as the farm.\n"
         "The EXR holds float32 R,G,B (mean radiance per pixel, W m^-2 sr^-1, box filter), the\n"
         "two half-sample estimates A.R,A.G,A.B and B.R,B.G,B.B (even and odd samples; their\n"
         "difference estimates the error) and spp, with header attributes lightfarm.* saying\n"
@@ -40,17 +43,70 @@ Command AddRenderCommand(CLI::App& app) {
     cmd->add_option("--tile", options->render.tile, "tile side in pixels")
         ->capture_default_str()
         ->check(CLI::Range(1, 65536));
+    cmd->add_option("--passes", options->render.passes,
+                    "sample passes per tile, as a farm job would split them (same bits)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1 << 24));
     cmd->add_flag("--no-progress", *no_progress, "no progress bar");
+    cmd->add_option("--method", options->method,
+                    "path (path tracing, any material), radiosity (finite elements, Lambertian "
+                    "quads and triangles only, view-independent) or auto (radiosity when every "
+                    "material is Lambertian and there are no spheres; the log says why)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"path", "radiosity", "auto"}));
 
-    return {cmd, [options, no_progress] {
+    const std::string r = "Radiosity";
+    cmd->add_option("--patch-size", options->radiosity.patch_size,
+                    "longest patch edge in scene units (overrides --patches)")
+        ->group(r)
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--patches", options->radiosity.patches, "target number of patches")
+        ->group(r)
+        ->capture_default_str()
+        ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
+    cmd->add_option("--solver", *solver, "jacobi, gauss-seidel or shooting")
+        ->group(r)
+        ->capture_default_str()
+        ->check(CLI::IsMember({"jacobi", "gauss-seidel", "shooting"}));
+    cmd->add_option("--tolerance", options->radiosity.tolerance,
+                    "stop when the relative residual (area-weighted L1) is below this")
+        ->group(r)
+        ->capture_default_str()
+        ->check(CLI::Range(1e-12, 1.0));
+    cmd->add_option("--max-iterations", options->radiosity.max_iterations,
+                    "fail if not converged after this many iterations")
+        ->group(r)
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--radiosity-display", *display,
+                    "flat (one value per patch) or smooth (interpolated at vertices)")
+        ->group(r)
+        ->capture_default_str()
+        ->check(CLI::IsMember({"flat", "smooth"}));
+    cmd->add_option("--save-solution", options->radiosity.save_solution,
+                    "write the solved radiosity, to render other cameras without solving")
+        ->group(r);
+    cmd->add_option("--load-solution", options->radiosity.load_solution,
+                    "reuse a saved solution (must match the scene and mesh)")
+        ->group(r)
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--export-ply", options->radiosity.export_ply,
+                    "write the solution as a PLY mesh with per-vertex sRGB colours")
+        ->group(r);
+
+    return {cmd, [options, no_progress, solver, display] {
                 options->progress = !*no_progress;
+                // Both names were checked by CLI11 against the same lists.
+                options->radiosity.solver = ParseRadiositySolver(*solver).value();
+                options->radiosity.display = ParseRadiosityShading(*display).value();
                 absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
                 if (!summary.ok()) return ReportError(summary.status());
                 const double s = summary->seconds;
                 std::printf(
-                    "job %s: %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
+                    "job %s: %s, %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
                     "%llu NaN/Inf samples -> %s\n",
-                    summary->job_id.c_str(), summary->width, summary->height,
+                    summary->job_id.c_str(), summary->method.c_str(), summary->width,
+                    summary->height,
                     (unsigned long long)summary->stats.samples, s,
                     summary->stats.samples / s * 1e-6, summary->stats.rays / s * 1e-6,
                     (unsigned long long)summary->stats.invalid_samples,

@@ -28,7 +28,7 @@ public:
     const RenderStats& stats() const { return stats_; }
 
     // R,G,B, A.*, B.* and spp of everything merged so far; once Complete(), the final image,
-    // bit for bit what lf::RenderImage makes of the same settings.
+    // bit for bit what local mode (client/local_executor.h) makes of the same settings.
     Image Snapshot() const;
 
 private:

@@ -30,7 +30,7 @@ struct RenderTask {
     uint64_t sample_begin = 0, sample_end = 0;
 };
 
-// Tile by tile in lf::PlanTiles order (row by row), each tile's passes consecutive, so the tiles
+// Tile by tile, row by row, each tile's passes consecutive, so the tiles
 // being merged at any moment are few. Pass p covers samples [spp*p/passes, spp*(p+1)/passes).
 // InvalidArgument for sizes out of range (spp above kMaxSpp included).
 absl::StatusOr<std::vector<RenderTask>> PlanRender(const RenderPlanSettings& settings);

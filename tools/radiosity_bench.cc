@@ -17,6 +17,7 @@
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/tile_renderer.h"
+#include "local_executor.h"
 
 namespace {
 
@@ -92,7 +93,7 @@ int main(int argc, char** argv) {
     settings.threads = threads;
     lf::Image reference;
     if (reference_spp > 0) {
-        reference = lf::RenderImage(camera, lf::PathTracer(**embree, -1), settings).image;
+        reference = lf::RenderImage(camera, lf::PathTracer(**embree, -1), settings).value().image;
         std::printf("path-traced reference: %d x %d at %lu spp, noise (A-B)/2 relative rms %.4f\n",
                     resolution, resolution, reference_spp,
                     RelativeRms(reference, reference, "A.", "B.") / 2);
@@ -119,7 +120,7 @@ int main(int argc, char** argv) {
         double difference = NAN;
         if (reference_spp > 0) {
             difference =
-                RelativeRms(lf::RenderImage(camera, **renderer, settings).image, reference);
+                RelativeRms(lf::RenderImage(camera, **renderer, settings).value().image, reference);
         }
         std::printf("%8ld %7ld %8.2f %8.2f %8.2f %10ld %9.1f %9.1f %6d %7.1f %9.2e %9ld %8.4f\n",
                     r.patches, r.sides, r.form_factor_seconds, cpu, r.solve_seconds,

@@ -97,3 +97,50 @@ TEST_F(Cli, AbsurdOptionsAreRefused) {
 
 }  // namespace
 }  // namespace lf
+
+namespace lf {
+namespace {
+
+TEST_F(Cli, AutoPicksRadiosityForLambertianScenesAndSaysWhy) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::string exr = (dir_ / "r.exr").string(), solution = (dir_ / "r.sol").string();
+    const RunResult r = Lightfarm("render " + scene + " -o " + exr +
+                                  " --method auto --patches 300 --spp 1 --no-progress "
+                                  "--save-solution " + solution + " --export-ply " +
+                                  (dir_ / "r.ply").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("method radiosity (every material is Lambertian)"), std::string::npos)
+        << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.method")), "radiosity");
+    EXPECT_LT(std::get<double>(file->attributes.at("lightfarm.radiosity.residual")), 1e-4);
+    EXPECT_TRUE(fs::exists(dir_ / "r.ply"));
+
+    // The saved solution renders the same image without solving again.
+    const std::string again = (dir_ / "again.exr").string();
+    const RunResult loaded = Lightfarm("render " + scene + " -o " + again +
+                                       " --method radiosity --patches 300 --spp 1 --no-progress "
+                                       "--load-solution " + solution);
+    ASSERT_EQ(loaded.status, 0) << loaded.output;
+    absl::StatusOr<ExrFile> second = ReadExr(again);
+    ASSERT_TRUE(second.ok());
+    EXPECT_EQ(std::get<std::string>(second->attributes.at("lightfarm.radiosity.loaded")), "yes");
+    EXPECT_EQ(*second->image.FindChannel("R"), *file->image.FindChannel("R"));
+}
+
+TEST_F(Cli, RadiosityRefusesWhatItCannotModel) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/materials.json";
+    const RunResult r = Lightfarm("render " + scene + " -o " + (dir_ / "m.exr").string() +
+                                  " --method radiosity --spp 1 --no-progress");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("radiosity"), std::string::npos) << r.output;
+    const RunResult automatic = Lightfarm("render " + scene + " -o " + (dir_ / "m.exr").string() +
+                                          " --method auto --spp 1 --no-progress");
+    EXPECT_EQ(automatic.status, 0) << automatic.output;
+    EXPECT_NE(automatic.output.find("method path (material"), std::string::npos)
+        << automatic.output;
+}
+
+}  // namespace
+}  // namespace lf

@@ -12,6 +12,7 @@
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/tile_renderer.h"
+#include "local_executor.h"
 
 namespace lf {
 namespace {
@@ -96,7 +97,7 @@ TEST(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
     RenderSettings settings;
     settings.spp = kSpp;
     settings.seed = kSeed;
-    const Image path = RenderImage(camera, PathTracer(embree, -1), settings).image;
+    const Image path = RenderImage(camera, PathTracer(embree, -1), settings).value().image;
 
     const std::vector<int> blocks = Blocks(), surfaces = Surfaces(embree, camera);
     const int block_count = (kResolution / kBlock) * (kResolution / kBlock);
@@ -118,7 +119,7 @@ TEST(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
         options.patches = n;
         auto renderer = PrepareRadiosity(embree, options);
         ASSERT_TRUE(renderer.ok()) << renderer.status();
-        const Image image = RenderImage(camera, **renderer, settings).image;
+        const Image image = RenderImage(camera, **renderer, settings).value().image;
         radiosity_blocks.push_back(Means(image, blocks, block_count));
         radiosity_surfaces.push_back(Means(image, surfaces, surface_count));
         // The mean squared difference is discretisation^2 + noise^2: subtracting the noise

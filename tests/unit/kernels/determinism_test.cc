@@ -2,10 +2,13 @@
 // must not change a single bit.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/tile_renderer.h"
+#include "local_executor.h"
 #include "test_scenes.h"
 
 namespace lf {
@@ -31,13 +34,14 @@ protected:
         tracer_ = std::make_unique<PathTracer>(*embree_, -1);
     }
 
-    Image Render(int tile, int threads) const {
+    Image Render(int tile, int threads, int passes) const {
         RenderSettings s;
         s.spp = 6;
         s.seed = 42;
         s.tile = tile;
         s.threads = threads;
-        return RenderImage(*camera_, *tracer_, s).image;
+        s.passes = passes;
+        return RenderImage(*camera_, *tracer_, s).value().image;
     }
 
     Scene scene_;
@@ -46,10 +50,11 @@ protected:
     std::unique_ptr<PathTracer> tracer_;
 };
 
-TEST_F(Determinism, SameBitsForAnyTileSizeAndThreadCount) {
-    const Image reference = Render(24, 1);
-    for (auto [tile, threads] : {std::pair{1, 2}, {5, 2}, {7, 1}, {16, 2}, {64, 2}}) {
-        const Image other = Render(tile, threads);
+TEST_F(Determinism, SameBitsForAnyTileSizePassesAndThreadCount) {
+    const Image reference = Render(24, 1, 1);
+    for (auto [tile, threads, passes] : {std::tuple{1, 2, 1}, {5, 2, 3}, {7, 1, 2}, {16, 2, 6},
+                                         {64, 2, 4}}) {
+        const Image other = Render(tile, threads, passes);
         for (const auto& [name, data] : reference.channels()) {
             EXPECT_EQ(data, *other.FindChannel(name)) << name << " tile " << tile;
         }
@@ -74,9 +79,9 @@ TEST_F(Determinism, DifferentSeedsGiveDifferentNoise) {
     RenderSettings s;
     s.spp = 2;
     s.seed = 1;
-    const Image a = RenderImage(*camera_, *tracer_, s).image;
+    const Image a = RenderImage(*camera_, *tracer_, s).value().image;
     s.seed = 2;
-    const Image b = RenderImage(*camera_, *tracer_, s).image;
+    const Image b = RenderImage(*camera_, *tracer_, s).value().image;
     EXPECT_NE(*a.FindChannel("R"), *b.FindChannel("R"));
 }
 

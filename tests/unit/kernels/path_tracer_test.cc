@@ -10,6 +10,7 @@
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/tile_renderer.h"
+#include "local_executor.h"
 #include "test_scenes.h"
 
 namespace lf {
@@ -27,7 +28,7 @@ RenderOutput Render(const Scene& scene, uint64_t spp, int max_depth = -1, uint64
     settings.spp = spp;
     settings.seed = seed;
     settings.tile = 8;
-    return RenderImage(camera, tracer, settings);
+    return RenderImage(camera, tracer, settings).value();
 }
 
 struct FurnaceCase {

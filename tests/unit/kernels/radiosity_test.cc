@@ -13,6 +13,7 @@
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/tile_renderer.h"
+#include "local_executor.h"
 #include "test_scenes.h"
 
 namespace lf {
@@ -76,7 +77,7 @@ TEST_P(RadiosityFurnace, RendersEmissionOverOneMinusRho) {
         const Camera camera(scene.camera, p.embree->origin());
         RenderSettings settings;
         settings.spp = 2;
-        const Image image = RenderImage(camera, r, settings).image;
+        const Image image = RenderImage(camera, r, settings).value().image;
         for (const char* channel : {"R", "G", "B"}) {
             for (float v : *image.FindChannel(channel)) {
                 ASSERT_GE(v, lo * (1 - 1e-6));
@@ -172,8 +173,8 @@ TEST(Radiosity, SavedSolutionRendersAnotherCameraWithoutSolving) {
     const Camera camera(other, solved.embree->origin());
     RenderSettings settings;
     settings.spp = 1;
-    EXPECT_EQ(*RenderImage(camera, a, settings).image.FindChannel("R"),
-              *RenderImage(camera, b, settings).image.FindChannel("R"));
+    EXPECT_EQ(*RenderImage(camera, a, settings).value().image.FindChannel("R"),
+              *RenderImage(camera, b, settings).value().image.FindChannel("R"));
 
     // Another scene content: refused, naming both hashes.
     Scene changed = scene;

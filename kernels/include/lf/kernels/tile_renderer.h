@@ -1,14 +1,12 @@
-// Rendering rectangles of the image: the unit of work of local mode and of farm tasks.
+// Rendering a rectangle of the image over a range of samples: the unit of work of farm tasks
+// and of local mode (client/local_executor.h).
 #pragma once
 
 #include <atomic>
 #include <cstdint>
-#include <functional>
-#include <vector>
 
 #include "lf/core/camera.h"
 #include "lf/core/film.h"
-#include "lf/core/image.h"
 #include "lf/kernels/radiance.h"
 
 namespace lf {
@@ -19,28 +17,5 @@ namespace lf {
 TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, const PixelRect& rect,
                     uint64_t seed, uint64_t sample_begin, uint64_t sample_end,
                     const std::atomic<bool>* cancel = nullptr);
-
-// Square tiles of side `tile` covering the image, row by row.
-std::vector<PixelRect> PlanTiles(int width, int height, int tile);
-
-struct RenderSettings {
-    uint64_t spp = 16;
-    uint64_t seed = 0;
-    int threads = 0;  // 0: all cores
-    int tile = 32;
-};
-
-struct RenderOutput {
-    Image image;
-    RenderStats stats;
-    double seconds = 0;
-};
-
-// Called from worker threads with (tiles done, tiles in all); must be thread-safe.
-using ProgressFn = std::function<void(size_t, size_t)>;
-
-// Renders every tile in parallel (TBB) into R,G,B, A.*, B.* and spp channels.
-RenderOutput RenderImage(const Camera& camera, const RadianceEstimator& estimator,
-                         const RenderSettings& settings, const ProgressFn& progress = {});
 
 }  // namespace lf

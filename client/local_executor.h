@@ -1,0 +1,38 @@
+// The in-process executor of local mode: the farm's planner (server/plan.h) cuts the render into
+// tasks, TBB threads run them with lf::RenderTile as a worker would, and the farm's merger
+// (server/merge.h) assembles the image. So `lightfarm render` and a farm render of the same job
+// are the same code and the same bits.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "absl/status/statusor.h"
+#include "lf/core/camera.h"
+#include "lf/core/image.h"
+#include "lf/kernels/radiance.h"
+
+namespace lf {
+
+struct RenderSettings {
+    uint64_t spp = 16;
+    uint64_t seed = 0;
+    int threads = 0;  // 0: all cores
+    int tile = 32;
+    int passes = 1;   // sample passes per tile, as on the farm
+};
+
+struct RenderOutput {
+    Image image;  // R,G,B, A.*, B.*, spp
+    RenderStats stats;
+    double seconds = 0;
+};
+
+// Called from worker threads with (tasks done, tasks in all); must be thread-safe.
+using ProgressFn = std::function<void(size_t, size_t)>;
+
+absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEstimator& estimator,
+                                         const RenderSettings& settings,
+                                         const ProgressFn& progress = {});
+
+}  // namespace lf
