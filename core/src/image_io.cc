@@ -80,13 +80,11 @@ absl::StatusOr<ExrFile> ReadExr(const std::string& path) {
     }
 }
 
-namespace {
-uint8_t EncodeSrgb(float linear) {
+uint8_t EncodeSrgb8(float linear) {
     const float v = std::clamp(std::isfinite(linear) ? linear : 0.0f, 0.0f, 1.0f);
     const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
     return uint8_t(std::lround(s * 255.0f));
 }
-}  // namespace
 
 absl::Status WritePng(const std::string& path, const Image& image, float exposure) {
     const float scale = std::exp2(exposure);
@@ -95,7 +93,7 @@ absl::Status WritePng(const std::string& path, const Image& image, float exposur
         for (int x = 0; x < image.width(); ++x) {
             const Rgb c = image.Pixel(x, y) * scale;
             uint8_t* out = &rgb[(size_t(y) * image.width() + x) * 3];
-            for (int k = 0; k < 3; ++k) out[k] = EncodeSrgb(c[k]);
+            for (int k = 0; k < 3; ++k) out[k] = EncodeSrgb8(c[k]);
         }
     }
     png_image png{};

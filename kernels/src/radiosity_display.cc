@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/image_io.h"
 
 namespace lf {
 
@@ -17,12 +18,6 @@ constexpr float kInvPi = float(1 / std::numbers::pi);
 
 // Sides meeting at a vertex at more than this angle are a crease, not one smooth surface.
 const double kCreaseCosine = std::cos(30 * std::numbers::pi / 180);
-
-uint8_t EncodeSrgb(float linear) {
-    const float v = std::clamp(std::isfinite(linear) ? linear : 0.0f, 0.0f, 1.0f);
-    const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-    return uint8_t(std::lround(s * 255.0f));
-}
 
 }  // namespace
 
@@ -114,8 +109,8 @@ absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,
         std::array<uint32_t, 3> face;
         for (size_t c = 0; c < 3; ++c) {
             const Rgb radiance = corners[s][c] * kInvPi;
-            const Colour colour{EncodeSrgb(radiance.r), EncodeSrgb(radiance.g),
-                                EncodeSrgb(radiance.b)};
+            const Colour colour{EncodeSrgb8(radiance.r), EncodeSrgb8(radiance.g),
+                                EncodeSrgb8(radiance.b)};
             const auto key = std::tuple(patch_vertices[c], side.back, colour);
             const auto [it, inserted] = index.try_emplace(key, uint32_t(vertices.size()));
             if (inserted) vertices.push_back({patch_vertices[c], colour});

@@ -2,6 +2,7 @@
 // the image was made; PNG is an sRGB preview of R,G,B, clamped.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <variant>
@@ -22,6 +23,9 @@ struct ExrFile {
 
 absl::Status WriteExr(const std::string& path, const Image& image, const ExrAttributes& attributes);
 absl::StatusOr<ExrFile> ReadExr(const std::string& path);
+
+// Linear [0, 1] to the sRGB transfer curve in 8 bits; clamped, NaN as 0.
+uint8_t EncodeSrgb8(float linear);
 
 // Linear to sRGB-encoded 8 bit, after scaling by 2^exposure.
 absl::Status WritePng(const std::string& path, const Image& image, float exposure = 0.0f);
