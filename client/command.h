@@ -20,6 +20,8 @@ int ReportError(const absl::Status& status);
 
 Command AddRenderCommand(CLI::App& app);
 Command AddBenchCommand(CLI::App& app);
+Command AddConvergeCommand(CLI::App& app);
+Command AddPlanCommand(CLI::App& app);
 
 // The farm (farm_commands.cc): jobs on a lightfarm-server.
 Command AddSubmitCommand(CLI::App& app);

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/camera.h"
+#include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
@@ -32,8 +33,34 @@ absl::Status CheckWritable(const std::string& path) {
     return absl::OkStatus();
 }
 
-// `auto`: radiosity models exactly the scenes it can (all Lambertian, no spheres) and is
-// view-independent; everything else needs the path tracer.
+void AddRadiosityAttributes(const RadiosityReport& r, const RadiosityOptions& o,
+                            ExrAttributes* attributes) {
+    (*attributes)["lightfarm.radiosity.patches"] = std::to_string(r.patches);
+    (*attributes)["lightfarm.radiosity.unknowns"] = std::to_string(r.sides);
+    (*attributes)["lightfarm.radiosity.patchSize"] = r.patch_size;
+    (*attributes)["lightfarm.radiosity.solver"] = std::string(RadiositySolverName(o.solver));
+    (*attributes)["lightfarm.radiosity.iterations"] = r.iterations;
+    (*attributes)["lightfarm.radiosity.residual"] = r.residual;
+    (*attributes)["lightfarm.radiosity.tolerance"] = o.tolerance;
+    (*attributes)["lightfarm.radiosity.display"] = std::string(RadiosityShadingName(o.display));
+    (*attributes)["lightfarm.radiosity.loaded"] = std::string(r.loaded ? "yes" : "no");
+    (*attributes)["lightfarm.radiosity.formFactorSeconds"] = r.form_factor_seconds;
+    (*attributes)["lightfarm.radiosity.solveSeconds"] = r.solve_seconds;
+}
+
+void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveReport& report,
+                           ExrAttributes* attributes) {
+    (*attributes)["lightfarm.targetError"] = settings.target_error;
+    (*attributes)["lightfarm.timeLimit"] = settings.time_limit;
+    (*attributes)["lightfarm.adaptive.worstTileError"] = report.worst_tile_error;
+    (*attributes)["lightfarm.adaptive.tilesAboveTarget"] = report.tiles_above_target;
+    (*attributes)["lightfarm.adaptive.timedOut"] = std::string(report.timed_out ? "yes" : "no");
+    (*attributes)["lightfarm.adaptive.minSpp"] = int(report.min_spp);
+    (*attributes)["lightfarm.adaptive.maxSpp"] = int(report.max_spp);
+}
+
+}  // namespace
+
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
                                          std::string* why) {
     if (requested == "path" || requested == "radiosity") {
@@ -58,23 +85,6 @@ absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& 
     *why = "every material is Lambertian";
     return std::string("radiosity");
 }
-
-void AddRadiosityAttributes(const RadiosityReport& r, const RadiosityOptions& o,
-                            ExrAttributes* attributes) {
-    (*attributes)["lightfarm.radiosity.patches"] = std::to_string(r.patches);
-    (*attributes)["lightfarm.radiosity.unknowns"] = std::to_string(r.sides);
-    (*attributes)["lightfarm.radiosity.patchSize"] = r.patch_size;
-    (*attributes)["lightfarm.radiosity.solver"] = std::string(RadiositySolverName(o.solver));
-    (*attributes)["lightfarm.radiosity.iterations"] = r.iterations;
-    (*attributes)["lightfarm.radiosity.residual"] = r.residual;
-    (*attributes)["lightfarm.radiosity.tolerance"] = o.tolerance;
-    (*attributes)["lightfarm.radiosity.display"] = std::string(RadiosityShadingName(o.display));
-    (*attributes)["lightfarm.radiosity.loaded"] = std::string(r.loaded ? "yes" : "no");
-    (*attributes)["lightfarm.radiosity.formFactorSeconds"] = r.form_factor_seconds;
-    (*attributes)["lightfarm.radiosity.solveSeconds"] = r.solve_seconds;
-}
-
-}  // namespace
 
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options) {
     for (const std::string* path : {&options.exr_path, &options.png_path}) {
@@ -117,11 +127,21 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
               options.render.seed,
               options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
               options.render.tile);
+    const bool adaptive = options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
+    if (adaptive) {
+        log->info("job={} adaptive: first pass {} spp, target error {}, time limit {} s, at "
+                  "most {} spp",
+                  job_id, options.render.spp, options.adaptive.target_error,
+                  options.adaptive.time_limit, options.adaptive.max_spp);
+    }
     ProgressBar bar("render");
+    const ProgressFn progress = [&](size_t done, size_t n) {
+        if (options.progress) bar.Update(done, n);
+    };
     absl::StatusOr<RenderOutput> out =
-        RenderImage(camera, *estimator, options.render, [&](size_t done, size_t n) {
-            if (options.progress) bar.Update(done, n);
-        });
+        adaptive ? RenderImageAdaptive(camera, *estimator, options.render, options.adaptive,
+                                       progress)
+                 : RenderImage(camera, *estimator, options.render, progress);
     if (options.progress) bar.Finish();
     if (!out.ok()) return out.status();
     if (out->stats.invalid_samples > 0) {
@@ -129,16 +149,45 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
                   out->stats.invalid_samples);
     }
 
+    if (out->stats.truncated_paths > 0) {
+        log->warn("job={} {} paths reached the depth cap of {} bounces and were cut (a "
+                  "reflectance of 1 keeps Russian roulette from ending them)",
+                  job_id, out->stats.truncated_paths, kMaxPathDepth);
+    }
+
+    LocalRenderSummary summary;
+    summary.job_id = job_id;
+    summary.method = *method;
+    summary.stats = out->stats;
+    summary.seconds = out->seconds;
+    summary.width = camera.width();
+    summary.height = camera.height();
+    summary.adaptive = adaptive;
+    summary.adaptive_report = out->adaptive;
+    const uint64_t spp = adaptive ? out->adaptive.max_spp : options.render.spp;
     ExrAttributes attributes =
-        DescribeRender({scene->content_hash, *method, options.render.spp, options.render.seed,
+        DescribeRender({scene->content_hash, *method, spp, options.render.seed,
                         options.max_depth, out->seconds, out->stats});
+    if (adaptive || options.render.spp >= 2) {
+        absl::StatusOr<double> estimated = EstimatedRelativeError(out->image);
+        if (!estimated.ok()) return estimated.status();
+        summary.estimated_error = *estimated;
+        summary.high_variance = *estimated > kHighVarianceError;
+        attributes["lightfarm.estimatedError"] = *estimated;
+        attributes["lightfarm.highVariance"] = std::string(summary.high_variance ? "yes" : "no");
+        if (summary.high_variance) {
+            log->warn("job={} high variance: estimated relative error {:.3f} (above {})", job_id,
+                      *estimated, kHighVarianceError);
+        }
+    }
+    attributes["lightfarm.truncatedPaths"] = std::to_string(out->stats.truncated_paths);
+    if (adaptive) AddAdaptiveAttributes(options.adaptive, out->adaptive, &attributes);
     if (radiosity) AddRadiosityAttributes(radiosity->report(), options.radiosity, &attributes);
     if (absl::Status s = WriteExr(options.exr_path, out->image, attributes); !s.ok()) return s;
     if (!options.png_path.empty()) {
         if (absl::Status s = WritePng(options.png_path, out->image); !s.ok()) return s;
     }
-    return LocalRenderSummary{job_id, *method, out->stats, out->seconds, camera.width(),
-                              camera.height()};
+    return summary;
 }
 
 }  // namespace lf

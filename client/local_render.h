@@ -5,6 +5,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "lf/core/scene.h"
 #include "lf/kernels/radiosity.h"
 #include "local_executor.h"
 
@@ -16,6 +17,7 @@ struct LocalRenderOptions {
     std::string png_path;  // empty: no preview
     std::string method = "path";  // path | radiosity | auto
     RenderSettings render;
+    AdaptiveSettings adaptive;  // used when a target error or a time limit is set
     int max_depth = -1;
     RadiosityOptions radiosity;
     bool progress = true;
@@ -27,8 +29,22 @@ struct LocalRenderSummary {
     RenderStats stats;
     double seconds = 0;
     int width = 0, height = 0;
+    double estimated_error = -1;  // relative, from A/B; -1 below 2 samples per pixel
+    bool high_variance = false;
+    bool adaptive = false;
+    AdaptiveReport adaptive_report;
 };
 
+// An image whose own relative error estimate is above this is reported as high variance: at
+// 10 % the noise is plainly visible and its mean is not to be trusted for measurements.
+inline constexpr double kHighVarianceError = 0.1;
+
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options);
+
+// The method for `requested` (path, radiosity or auto) and, in *why, the reason. `auto`:
+// radiosity models exactly the scenes it can (all Lambertian, no spheres) and is
+// view-independent; everything else needs the path tracer.
+absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
+                                         std::string* why);
 
 }  // namespace lf

@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
     const std::vector<lf::Command> commands = {
         lf::AddRenderCommand(app),
         lf::AddBenchCommand(app),
+        lf::AddConvergeCommand(app),
+        lf::AddPlanCommand(app),
         lf::AddSubmitCommand(app),
         lf::AddListCommand(app),
         lf::AddStatusCommand(app),

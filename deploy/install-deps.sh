@@ -7,6 +7,7 @@ packages=(
   libpng-dev libtinyobjloader-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   libssl-dev libsqlite3-dev libgtest-dev libgmock-dev libbenchmark-dev
+  gnuplot-nox
 )
 missing=()
 for p in "${packages[@]}"; do

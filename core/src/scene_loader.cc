@@ -38,6 +38,10 @@ constexpr int64_t kMaxPixels = int64_t(1) << 28;
 // rounding of zero: the triangle has no reliable normal and no area to sample.
 constexpr double kDegenerateRatio = 1e-12;
 constexpr float kMaxFloat = std::numeric_limits<float>::max();
+// Emitted radiance (W m^-2 sr^-1) and point-light intensity (W/sr): 500 times the sun's
+// radiance. Far above it, a light's power overflows float in the light sampler and samples
+// reach the film's clamp (1e15, film.cc), both silently wrong.
+constexpr float kMaxRadiance = 1e10f;
 
 // Validation runs many levels deep; an error unwinds to ParseScene as this exception, which adds
 // the source name, so every check stays one line.
@@ -216,7 +220,9 @@ class Node {
     // [r, g, b], each in [0, max].
     Rgb Color(float max) const {
         const std::vector<Node> e = Elements(3);
-        const std::string range = max == 1 ? "in [0, 1]" : "≥ 0 and below 3.4e38 (float range)";
+        const std::string range = max == 1           ? "in [0, 1]"
+                                  : max == kMaxFloat ? "≥ 0 and below 3.4e38 (float range)"
+                                                     : absl::StrCat("≥ 0 and at most ", max);
         return {float(e[0].NumberIn(0, max, range)), float(e[1].NumberIn(0, max, range)),
                 float(e[2].NumberIn(0, max, range))};
     }
@@ -445,7 +451,7 @@ class SceneParser {
                                    "\"; expected lambert, mirror, glossy or dielectric"));
         }
         if (const std::optional<Node> emission = n.Find("emission")) {
-            m.emission = emission->Color(kMaxFloat);
+            m.emission = emission->Color(kMaxRadiance);
         }
         return m;
     }
@@ -560,8 +566,9 @@ class SceneParser {
             n.Fail("give exactly one of intensity (W/sr) or power (W)");
         }
         light.intensity = n.Has("intensity")
-                              ? n.Get("intensity").Color(kMaxFloat)
-                              : n.Get("power").Color(kMaxFloat) / float(4 * std::numbers::pi);
+                              ? n.Get("intensity").Color(kMaxRadiance)
+                              : n.Get("power").Color(float(4 * std::numbers::pi) * kMaxRadiance) /
+                                    float(4 * std::numbers::pi);
         return light;
     }
 

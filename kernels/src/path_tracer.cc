@@ -49,6 +49,10 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
             }
         }
         if (depth == max_depth_) break;
+        if (depth == kMaxPathDepth) {
+            ++stats.truncated_paths;
+            break;
+        }
 
         const Frame frame = Frame::FromNormal(hit->n);
         const Vec3 wo = frame.ToLocal(-ray.d);

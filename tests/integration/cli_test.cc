@@ -2,10 +2,12 @@
 // made, and bad input fails with a message naming what and where.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "lf/core/image_io.h"
 
@@ -63,11 +65,16 @@ TEST_F(Cli, RenderWritesExrWithMetadataAndPng) {
         EXPECT_TRUE(file->attributes.count(key)) << key;
     }
     EXPECT_EQ(std::get<int>(file->attributes.at("lightfarm.spp")), 2);
+    // Two samples leave the light's edges far from converged: flagged, in the log and header.
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.highVariance")), "yes");
+    EXPECT_GT(std::get<double>(file->attributes.at("lightfarm.estimatedError")), 0.1);
+    EXPECT_NE(r.output.find("high variance"), std::string::npos) << r.output;
     EXPECT_TRUE(fs::exists(png));
 }
 
 TEST_F(Cli, HelpExplainsEveryCommand) {
-    for (const char* cmd : {"--help", "render --help", "bench --help"}) {
+    for (const char* cmd :
+         {"--help", "render --help", "bench --help", "converge --help", "plan --help"}) {
         const RunResult r = Lightfarm(cmd);
         EXPECT_EQ(r.status, 0) << cmd;
         EXPECT_NE(r.output.find("Usage"), std::string::npos) << cmd << r.output;
@@ -140,6 +147,80 @@ TEST_F(Cli, RadiosityRefusesWhatItCannotModel) {
     EXPECT_EQ(automatic.status, 0) << automatic.output;
     EXPECT_NE(automatic.output.find("method path (material"), std::string::npos)
         << automatic.output;
+}
+
+TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
+    const fs::path out = dir_ / "conv";
+    const RunResult r = Lightfarm("converge " + std::string(LF_TEST_SCENES) +
+                                  "/cornell_box.json --out " + out.string() +
+                                  " --resolution 16 --max-spp 4 --reference-spp 16 "
+                                  "--min-patches 100 --max-patches 200 --threads 2");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("no reference given: own path-traced reference, 16 spp"),
+              std::string::npos)
+        << r.output;
+    std::ifstream csv(out / "convergence.csv");
+    std::string line;
+    ASSERT_TRUE(std::getline(csv, line));
+    EXPECT_EQ(line, "method,budget,seconds,rmse,relmse,smape");
+    std::vector<std::string> rows;
+    while (std::getline(csv, line)) rows.push_back(line);
+    // spp 1, 2, 4 and patch targets 100, 200.
+    ASSERT_EQ(rows.size(), 5u);
+    EXPECT_EQ(rows[0].rfind("path,1,", 0), 0u) << rows[0];
+    EXPECT_EQ(rows[3].rfind("radiosity,", 0), 0u) << rows[3];
+    for (const std::string& row : rows) {
+        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 5) << row;
+        EXPECT_EQ(row.find("nan"), std::string::npos) << row;
+    }
+    EXPECT_GT(fs::file_size(out / "convergence.png"), 1000u);
+
+    // Radiosity's refusal comes before any rendering.
+    const RunResult refused = Lightfarm("converge " + std::string(LF_TEST_SCENES) +
+                                        "/materials.json --out " + out.string() +
+                                        " --method both");
+    EXPECT_NE(refused.status, 0);
+    EXPECT_NE(refused.output.find("radiosity cannot model this scene: material"),
+              std::string::npos)
+        << refused.output;
+}
+
+TEST_F(Cli, TargetErrorRecordsTheEstimateInTheHeader) {
+    const std::string exr = (dir_ / "t.exr").string();
+    const RunResult r = Lightfarm("render " + std::string(LF_TEST_SCENES) +
+                                  "/cornell_box.json -o " + exr +
+                                  " --spp 4 --target-error 0.3 --time-limit 60 --threads 2 "
+                                  "--no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("estimated relative error"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("0 of 64 tiles above the target"), std::string::npos) << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    EXPECT_EQ(std::get<double>(file->attributes.at("lightfarm.targetError")), 0.3);
+    EXPECT_LE(std::get<double>(file->attributes.at("lightfarm.adaptive.worstTileError")), 0.3);
+    EXPECT_GT(std::get<double>(file->attributes.at("lightfarm.estimatedError")), 0);
+    const std::vector<float>& spp = *file->image.FindChannel("spp");
+    EXPECT_GE(*std::min_element(spp.begin(), spp.end()), 4);
+    EXPECT_EQ(*std::max_element(spp.begin(), spp.end()),
+              std::get<int>(file->attributes.at("lightfarm.spp")));
+}
+
+TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
+    const RunResult r = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
+                                  "/cornell_box.json --pilot-spp 2 --target-error 0.5 --threads 2");
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* text :
+         {"light: lambert, reflectance (0, 0, 0), emits (17, 12, 4)", "2 emissive triangles",
+          "method (--method auto): radiosity, because every material is Lambertian",
+          "path depth: unlimited", "3936 patches", "cost of render --target-error 0.5"}) {
+        EXPECT_NE(r.output.find(text), std::string::npos) << text << "\n" << r.output;
+    }
+    const RunResult glossy = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
+                                       "/materials.json --pilot-spp 2 --threads 2");
+    ASSERT_EQ(glossy.status, 0) << glossy.output;
+    EXPECT_NE(glossy.output.find("method (--method auto): path, because material"),
+              std::string::npos)
+        << glossy.output;
 }
 
 }  // namespace

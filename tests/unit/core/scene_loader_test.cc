@@ -363,6 +363,10 @@ TEST_F(SceneLoaderTest, MaterialErrorsNameThePath) {
     ExpectError(
         with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [-1, 0, 0]})"),
         "scene.json: materials.m.emission[0]: must be ≥ 0");
+    // Absurdly bright: the light sampler's power would overflow and the film would clamp.
+    ExpectError(
+        with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [1, 3e38, 0]})"),
+        "scene.json: materials.m.emission[1]: must be ≥ 0 and at most 1e+10, got 3e+38");
     ExpectError(with_material(R"({"type": "glossy", "roughness": 0, "reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m.roughness: must be a positive float, got 0");
     ExpectError(with_material(R"({"type": "glossy", "roughness": 0.1, "distribution": "phong", )"

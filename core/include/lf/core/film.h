@@ -54,10 +54,14 @@ struct RenderStats {
     uint64_t samples = 0;
     uint64_t rays = 0;           // every ray cast, camera and shadow rays included
     uint64_t invalid_samples = 0;  // NaN or infinite samples, never written
+    // Paths cut at the path tracer's hard depth cap (reflectance 1 keeps roulette from ending
+    // them). Local mode only: the farm's tile encoding does not carry it.
+    uint64_t truncated_paths = 0;
     RenderStats& operator+=(const RenderStats& o) {
         samples += o.samples;
         rays += o.rays;
         invalid_samples += o.invalid_samples;
+        truncated_paths += o.truncated_paths;
         return *this;
     }
 };

@@ -9,9 +9,16 @@
 
 namespace lf {
 
+// The most bounces of an "unlimited" path. Roulette ends paths long before this unless a
+// reflectance of 1 keeps their throughput at 1; then the cap bounds the work and the cut paths
+// are counted in RenderStats::truncated_paths. At albedo 0.999 a path outlives it with
+// probability e^-65.
+inline constexpr int kMaxPathDepth = 1 << 16;
+
 class PathTracer : public RadianceEstimator {
 public:
-    // max_depth: the most bounces a path may take; negative means unlimited (roulette only).
+    // max_depth: the most bounces a path may take; negative means unlimited (roulette, and
+    // kMaxPathDepth).
     PathTracer(const EmbreeScene& scene, int max_depth);
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;

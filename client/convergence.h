@@ -1,0 +1,51 @@
+// `lightfarm converge`: the trade between time and accuracy, measured. Renders a ladder of
+// budgets per method (samples per pixel for the path tracer, patch counts for radiosity),
+// compares each image with a reference and writes convergence.csv and a log-log plot of relative
+// RMSE against time with the fitted slope per method (docs/convergence.md).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/image_error.h"
+
+namespace lf {
+
+struct ConvergenceOptions {
+    std::string scene_path;
+    std::string out_dir;
+    std::string reference_path;   // empty: render our own path-traced reference
+    std::string method = "both";  // path | radiosity | both
+    int resolution = 0;           // image width, height keeps the aspect; 0: the scene's
+    uint64_t max_spp = 256;       // path ladder 1, 2, 4, ... up to this
+    uint64_t reference_spp = 4096;
+    int64_t min_patches = 250;  // radiosity ladder, doubling
+    int64_t max_patches = 4000;
+    double radiosity_tolerance = 1e-4;
+    uint64_t radiosity_spp = 64;  // camera rays per pixel through the solution (its footprint)
+    uint64_t seed = 0;
+    int threads = 0;
+    int max_depth = -1;
+};
+
+struct ConvergenceRow {
+    std::string method;
+    int64_t budget = 0;  // spp or patches
+    double seconds = 0;
+    ImageError error;
+};
+
+struct ConvergenceResult {
+    std::vector<ConvergenceRow> rows;
+    std::map<std::string, double> slopes;  // of sqrt(relmse) against seconds, per method
+    std::string reference;                 // what the reference was, for the user
+    double reference_rmse = 0;             // the reference's own error estimate (A/B), 0 if unknown
+    std::string csv_path, png_path;
+};
+
+absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& options);
+
+}  // namespace lf

@@ -1,0 +1,183 @@
+// `lightfarm plan`: what a render of a scene will model and what it will cost, before it runs.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "absl/strings/str_format.h"
+#include "command.h"
+#include "lf/core/camera.h"
+#include "lf/core/image_error.h"
+#include "lf/core/patch_mesh.h"
+#include "lf/core/scene_loader.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/path_tracer.h"
+#include "local_executor.h"
+#include "local_render.h"
+#include "server/plan.h"
+
+namespace lf {
+
+namespace {
+
+struct PlanOptions {
+    std::string scene_path;
+    double target_error = 0.01;
+    uint64_t pilot_spp = 8;
+    int64_t patches = 4000;
+    int max_depth = -1;
+    int threads = 0;
+};
+
+std::string Color(const Rgb& c) { return absl::StrFormat("(%.3g, %.3g, %.3g)", c.r, c.g, c.b); }
+
+double TriangleArea(const TriangleMesh& mesh, const std::array<uint32_t, 3>& t) {
+    const Vec3d a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
+    return 0.5 * Length(Cross(b - a, c - a));
+}
+
+absl::Status RunPlan(const PlanOptions& options) {
+    absl::StatusOr<Scene> scene = LoadScene(options.scene_path);
+    if (!scene.ok()) return scene.status();
+    std::printf("scene %s: %dx%d, %zu meshes, %zu spheres, %zu point lights\n",
+                options.scene_path.c_str(), scene->camera.width, scene->camera.height,
+                scene->meshes.size(), scene->spheres.size(), scene->point_lights.size());
+
+    std::set<int> used;
+    for (const TriangleMesh& m : scene->meshes) used.insert(m.material);
+    for (const Sphere& s : scene->spheres) used.insert(s.material);
+    std::printf("materials in use:\n");
+    float max_reflectance = 0;
+    bool dielectric = false;
+    for (int i : used) {
+        const Material& m = scene->materials[size_t(i)];
+        std::printf("  %s: %s, reflectance %s", m.name.c_str(), MaterialTypeName(m.type),
+                    Color(m.reflectance).c_str());
+        if (m.IsEmissive()) std::printf(", emits %s W m^-2 sr^-1", Color(m.emission).c_str());
+        std::printf("\n");
+        if (m.type == Material::Type::kDielectric) {
+            dielectric = true;
+        } else {
+            max_reflectance = std::max(max_reflectance, m.reflectance.MaxComponent());
+        }
+    }
+
+    int emissive_triangles = 0, emissive_spheres = 0;
+    double emitting_area = 0;
+    for (const TriangleMesh& m : scene->meshes) {
+        if (!scene->materials[size_t(m.material)].IsEmissive()) continue;
+        for (const auto& t : m.triangles) {
+            ++emissive_triangles;
+            emitting_area += TriangleArea(m, t);
+        }
+    }
+    for (const Sphere& s : scene->spheres) {
+        if (scene->materials[size_t(s.material)].IsEmissive()) ++emissive_spheres;
+    }
+    std::printf("lights: %d emissive triangles (%.4g m^2), %d emissive spheres, %zu point lights\n",
+                emissive_triangles, emitting_area, emissive_spheres, scene->point_lights.size());
+
+    std::string why;
+    absl::StatusOr<std::string> method = ChooseMethod(*scene, "auto", &why);
+    if (!method.ok()) return method.status();
+    std::printf("method (--method auto): %s, because %s\n", method->c_str(), why.c_str());
+
+    // A closed room of albedo rho keeps a path alive for 1/(1 - rho) bounces on average under
+    // the roulette; an open scene ends paths sooner.
+    std::printf(
+        "path depth: %s; Russian roulette from the second bounce (survival min(1, max "
+        "throughput channel)); largest reflectance %.3g, so paths average at most about "
+        "%.1f bounces in a closed room of it\n",
+        options.max_depth < 0 ? "unlimited"
+                              : absl::StrFormat("at most %d bounces", options.max_depth).c_str(),
+        max_reflectance, max_reflectance < 1 ? 1 / (1 - double(max_reflectance)) : INFINITY);
+    if (dielectric) {
+        std::printf(
+            "  dielectrics pass on nearly all light, so paths inside glass last until "
+            "they leave it\n");
+    }
+
+    if (*method == "radiosity") {
+        absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(*scene, {0, options.patches});
+        if (!mesh.ok()) return mesh.status();
+        const double n = double(mesh->patches().size());
+        std::printf(
+            "radiosity: target %lld patches -> %zu patches of size %.3g; form factors "
+            "grow as patches^2 (%.3g pairs at most, docs/radiosity.md)\n",
+            (long long)options.patches, mesh->patches().size(), mesh->patch_size(), n * n);
+    } else {
+        std::printf("radiosity: not used\n");
+    }
+
+    // A pilot pass of every tile at the full resolution, as the first pass of
+    // `render --target-error`: each tile's own estimate predicts the samples it needs, as error
+    // falls with 1/sqrt(spp), and the pilot's speed the time.
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
+    if (!embree.ok()) return embree.status();
+    const Camera camera(scene->camera, (*embree)->origin());
+    const PathTracer tracer(**embree, options.max_depth);
+    RenderSettings settings;
+    settings.spp = options.pilot_spp;
+    settings.threads = options.threads;
+    const AdaptiveSettings pilot_only{.target_error = options.target_error,
+                                      .max_spp = options.pilot_spp};
+    absl::StatusOr<RenderOutput> pilot = RenderImageAdaptive(camera, tracer, settings, pilot_only);
+    if (!pilot.ok()) return pilot.status();
+    double pixel_samples = 0, worst = 0;
+    for (const AdaptiveReport::Tile& tile : pilot->adaptive.per_tile) {
+        const double ratio = tile.error / options.target_error;
+        const double spp =
+            std::clamp(double(tile.spp) * ratio * ratio, double(tile.spp), double(kMaxSpp));
+        pixel_samples += spp * double(tile.rect.Area());
+        worst = std::max(worst, spp);
+    }
+    const double pixels = double(camera.width()) * camera.height();
+    const double seconds_per_sample = pilot->seconds / double(pilot->stats.samples);
+    std::printf(
+        "pilot (path tracing): %llu spp in %.2f s, estimated relative error %.4f over "
+        "the image, worst tile %.4f\n",
+        (unsigned long long)pilot->adaptive.max_spp, pilot->seconds,
+        pilot->adaptive.estimated_error, pilot->adaptive.worst_tile_error);
+    std::printf(
+        "cost of render --target-error %.4g: about %.0f spp on average (%.0f in the "
+        "hardest tile), %.1f s at this speed\n",
+        options.target_error, pixel_samples / pixels, worst, pixel_samples * seconds_per_sample);
+    return absl::OkStatus();
+}
+
+}  // namespace
+
+Command AddPlanCommand(CLI::App& app) {
+    auto options = std::make_shared<PlanOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "plan",
+        "Say what a render of the scene will model and why: materials and lights in use, the\n"
+        "method --method auto picks, the path depth policy, the radiosity patch count, and the\n"
+        "samples and time a target error needs (from a short pilot render's own error\n"
+        "estimate and speed).");
+    cmd->add_option("scene", options->scene_path, "scene file (JSON)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--target-error", options->target_error,
+                    "relative error to estimate the cost for")
+        ->capture_default_str()
+        ->check(CLI::Range(1e-6, 1.0));
+    cmd->add_option("--pilot-spp", options->pilot_spp, "samples per pixel of the pilot render")
+        ->capture_default_str()
+        ->check(CLI::Range(uint64_t(2), uint64_t(1) << 16));
+    cmd->add_option("--patches", options->patches, "radiosity patch target")
+        ->capture_default_str()
+        ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
+    cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
+        ->capture_default_str()
+        ->check(CLI::Range(-1, 1 << 20));
+    cmd->add_option("--threads", options->threads, "threads of the pilot; 0 = all cores")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1024));
+    return {cmd, [options] {
+                const absl::Status status = RunPlan(*options);
+                return status.ok() ? 0 : ReportError(status);
+            }};
+}
+
+}  // namespace lf

@@ -1,0 +1,48 @@
+// Errors of an image against a reference, and the error an image estimates for itself from its
+// two half-sample buffers (docs/convergence.md defines each metric).
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/image.h"
+
+namespace lf {
+
+// Keeps the relative metrics finite where the reference is black; 0.01 is the usual choice
+// (Rousselle et al.) and is small against the Cornell box's mean radiance of 0.12.
+inline constexpr double kRelativeErrorEpsilon = 0.01;
+
+struct ImageError {
+    double rmse = 0;    // sqrt(mean (x - r)^2)
+    double relmse = 0;  // mean (x - r)^2 / (r^2 + eps)
+    double smape = 0;   // mean |x - r| / (|x| + |r| + eps)
+};
+
+// Over every pixel and the R, G, B channels. InvalidArgument when the sizes differ or a
+// channel is missing.
+absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& reference);
+
+// The image's own estimate of its mean squared error: the mean over pixels and channels of
+// ((A - B) / 2)^2, unbiased for the variance of R,G,B when A and B hold equally many samples.
+// InvalidArgument without the A.* and B.* channels.
+absl::StatusOr<double> EstimatedMse(const Image& image);
+
+// Floor of the denominator of relative error estimates, in radiance units (W m^-2 sr^-1): a
+// black region is done at once instead of chasing 0/0.
+inline constexpr double kRelativeErrorFloor = 1e-3;
+
+// The relative error a tile estimates for itself, as Dammertz et al. 2009 do per block:
+// sqrt(mean over pixels and channels of ((A - B) / 2)^2) / (mean radiance + floor). 1 when a
+// pixel has fewer than 2 samples (no estimate yet).
+double EstimatedRelativeError(const TileSums& tile);
+
+// The same over a whole image, from its R,G,B and A.*, B.* channels.
+absl::StatusOr<double> EstimatedRelativeError(const Image& image);
+
+// Least-squares slope of log(y) against log(x); the points must be positive, at least two,
+// with distinct x (InvalidArgument otherwise).
+absl::StatusOr<double> LogLogSlope(const std::vector<std::pair<double, double>>& points);
+
+}  // namespace lf
