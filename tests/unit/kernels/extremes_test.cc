@@ -16,6 +16,7 @@
 #include "lf/kernels/path_tracer.h"
 #include "local_executor.h"
 #include "local_render.h"
+#include "render_path.h"
 #include "test_scenes.h"
 
 namespace lf {
@@ -24,21 +25,10 @@ namespace {
 // 5 standard errors: a correct renderer fails with probability below 1e-6 per check.
 constexpr double kSigmas = 5.0;
 
-struct Rendered {
-    RenderOutput out;
-    std::unique_ptr<EmbreeScene> embree;
-};
+using Rendered = testing::PathRender;
 
 Rendered Render(const Scene& scene, uint64_t spp, int max_depth = -1) {
-    auto es = EmbreeScene::Build(scene);
-    EXPECT_TRUE(es.ok()) << es.status();
-    const Camera camera(scene.camera, (*es)->origin());
-    const PathTracer tracer(**es, max_depth);
-    RenderSettings settings;
-    settings.spp = spp;
-    settings.seed = 5;
-    settings.tile = 8;
-    return {RenderImage(camera, tracer, settings).value(), std::move(*es)};
+    return testing::RenderPath(scene, spp, max_depth, 5);
 }
 
 TriangleMesh Quad(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d, int material) {

@@ -11,6 +11,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/tile_renderer.h"
 #include "local_executor.h"
+#include "render_path.h"
 #include "test_scenes.h"
 
 namespace lf {
@@ -20,15 +21,7 @@ namespace {
 constexpr double kSigmas = 5.0;
 
 RenderOutput Render(const Scene& scene, uint64_t spp, int max_depth = -1, uint64_t seed = 1) {
-    auto es = EmbreeScene::Build(scene);
-    EXPECT_TRUE(es.ok()) << es.status();
-    const Camera camera(scene.camera, (*es)->origin());
-    const PathTracer tracer(**es, max_depth);
-    RenderSettings settings;
-    settings.spp = spp;
-    settings.seed = seed;
-    settings.tile = 8;
-    return RenderImage(camera, tracer, settings).value();
+    return testing::RenderPath(scene, spp, max_depth, seed).out;
 }
 
 struct FurnaceCase {

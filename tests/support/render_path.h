@@ -1,0 +1,33 @@
+// Path tracing a scene built in a test through local mode's executor.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "lf/core/camera.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/path_tracer.h"
+#include "local_executor.h"
+
+namespace lf::testing {
+
+struct PathRender {
+    RenderOutput out;
+    std::unique_ptr<EmbreeScene> embree;  // for tests that cast rays of their own
+};
+
+inline PathRender RenderPath(const Scene& scene, uint64_t spp, int max_depth = -1,
+                             uint64_t seed = 1) {
+    auto es = EmbreeScene::Build(scene);
+    EXPECT_TRUE(es.ok()) << es.status();
+    const Camera camera(scene.camera, (*es)->origin());
+    const PathTracer tracer(**es, max_depth);
+    RenderSettings settings;
+    settings.spp = spp;
+    settings.seed = seed;
+    settings.tile = 8;
+    return {RenderImage(camera, tracer, settings).value(), std::move(*es)};
+}
+
+}  // namespace lf::testing
