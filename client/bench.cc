@@ -36,7 +36,8 @@ double RawRaysPerSecond(const EmbreeScene& scene, uint64_t count, int threads) {
                                   const Vec2 a = s.Get2D(), b = s.Get2D();
                                   const Vec3 o(lo.x + a.x * extent.x, lo.y + a.y * extent.y,
                                                lo.z + b.x * extent.z);
-                                  const float z = 1 - 2 * b.y, phi = 2 * std::numbers::pi_v<float> * s.Get1D();
+                                  const float z = 1 - 2 * b.y,
+                                              phi = 2 * std::numbers::pi_v<float> * s.Get1D();
                                   const float rr = std::sqrt(std::max(0.0f, 1 - z * z));
                                   const Ray ray{o, Vec3(rr * std::cos(phi), rr * std::sin(phi), z)};
                                   local_hits += scene.Intersect(ray).has_value();

@@ -13,13 +13,13 @@
 #include "absl/strings/str_format.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_io.h"
+#include "lf/core/log.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "local_executor.h"
 #include "local_render.h"
-#include "server/logging.h"
 
 extern char** environ;
 

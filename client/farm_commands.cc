@@ -1,6 +1,7 @@
 // The farm subcommands of `lightfarm`: submit, list, status, watch, fetch and cancel, each a
 // call to lightfarm-server's JobService. All protobuf handling of the client is in this file.
 #include <grpcpp/grpcpp.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -186,14 +187,20 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     params->set_max_depth(o.max_depth);
     params->set_tile(o.tile);
     params->set_passes(o.passes);
+    // A retry after a lost answer (the server restarting, say) gets the job of the first attempt.
+    req.set_request_id(Sha256Hex(
+        absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string())));
     pb::SubmitJobResponse resp;
-    // The server loads the scene to check it, which takes a while for large meshes.
-    if (absl::Status s = CallStatus(
-            stub->SubmitJob(ContextWithDeadline(absl::Minutes(2)).get(), req, &resp), o.farm);
-        !s.ok()) {
-        return s;
+    for (int attempt = 1;; ++attempt) {
+        // The server loads the scene to check it, which takes a while for large meshes.
+        const grpc::Status s =
+            stub->SubmitJob(ContextWithDeadline(absl::Minutes(2)).get(), req, &resp);
+        if (s.ok()) return resp.job_id();
+        if (s.error_code() != grpc::StatusCode::UNAVAILABLE || attempt == 5) {
+            return CallStatus(s, o.farm);
+        }
+        absl::SleepFor(absl::Seconds(1));
     }
-    return resp.job_id();
 }
 
 std::string Progress(const pb::Job& job) {
@@ -210,8 +217,8 @@ void PrintJob(const pb::Job& job) {
                 (unsigned long long)job.params().seed(), job.params().max_depth(),
                 job.params().tile(), job.params().passes());
     std::printf("  priority  %d\n", job.priority());
-    std::printf("  tasks     %s done, %d running, %d retried\n", Progress(job).c_str(),
-                job.tasks_running(), job.retries());
+    std::printf("  tasks     %s done, %d running, %d retried, %d leased\n", Progress(job).c_str(),
+                job.tasks_running(), job.retries(), job.tasks_leased());
     std::printf("  samples   %llu (%llu rays, %llu NaN/Inf)\n", (unsigned long long)job.samples(),
                 (unsigned long long)job.rays(), (unsigned long long)job.invalid_samples());
     if (job.started_unix_ms() > 0) {

@@ -19,8 +19,8 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
                                          const RenderSettings& settings,
                                          const ProgressFn& progress) {
     const auto start = std::chrono::steady_clock::now();
-    absl::StatusOr<std::vector<RenderTask>> tasks = PlanRender(
-        {camera.width(), camera.height(), settings.spp, settings.tile, settings.passes});
+    absl::StatusOr<std::vector<RenderTask>> tasks =
+        PlanRender({camera.width(), camera.height(), settings.spp, settings.tile, settings.passes});
     if (!tasks.ok()) return tasks.status();
     RenderMerger merger(camera.width(), camera.height(), *tasks);
     std::mutex mutex;
@@ -128,8 +128,8 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
                     for (size_t k = range.begin(); k != range.end(); ++k) {
                         Tile& tile = tiles[active[k]];
                         const uint64_t n = tile.sums.pixels[0].Count();
-                        tile.sums += RenderTile(camera, estimator, tile.sums.rect, settings.seed,
-                                                n, tile.next);
+                        tile.sums += RenderTile(camera, estimator, tile.sums.rect, settings.seed, n,
+                                                tile.next);
                         tile.error = EstimatedRelativeError(tile.sums);
                         const bool reached =
                             adaptive.target_error > 0 && tile.error <= adaptive.target_error;

@@ -20,7 +20,7 @@ struct RenderSettings {
     uint64_t seed = 0;
     int threads = 0;  // 0: all cores
     int tile = 32;
-    int passes = 1;   // sample passes per tile, as on the farm
+    int passes = 1;  // sample passes per tile, as on the farm
 };
 
 // Adaptive sampling (local mode): each tile gets passes of samples until its estimated relative

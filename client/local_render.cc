@@ -9,11 +9,11 @@
 #include "lf/core/camera.h"
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
+#include "lf/core/log.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "progress_bar.h"
-#include "server/logging.h"
 #include "server/render_metadata.h"
 
 namespace lf {
@@ -117,8 +117,8 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         log->info(
             "job={} radiosity: {} patches, {} unknowns, {} iterations, residual {:.2e}, form "
             "factors {:.2f} s ({} MiB), solve {:.2f} s",
-            job_id, rep.patches, rep.sides, rep.iterations, rep.residual,
-            rep.form_factor_seconds, rep.form_factor_bytes >> 20, rep.solve_seconds);
+            job_id, rep.patches, rep.sides, rep.iterations, rep.residual, rep.form_factor_seconds,
+            rep.form_factor_bytes >> 20, rep.solve_seconds);
     } else {
         estimator = std::make_unique<PathTracer>(**embree, options.max_depth);
     }
@@ -129,19 +129,20 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
               options.render.tile);
     const bool adaptive = options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
     if (adaptive) {
-        log->info("job={} adaptive: first pass {} spp, target error {}, time limit {} s, at "
-                  "most {} spp",
-                  job_id, options.render.spp, options.adaptive.target_error,
-                  options.adaptive.time_limit, options.adaptive.max_spp);
+        log->info(
+            "job={} adaptive: first pass {} spp, target error {}, time limit {} s, at "
+            "most {} spp",
+            job_id, options.render.spp, options.adaptive.target_error, options.adaptive.time_limit,
+            options.adaptive.max_spp);
     }
     ProgressBar bar("render");
     const ProgressFn progress = [&](size_t done, size_t n) {
         if (options.progress) bar.Update(done, n);
     };
     absl::StatusOr<RenderOutput> out =
-        adaptive ? RenderImageAdaptive(camera, *estimator, options.render, options.adaptive,
-                                       progress)
-                 : RenderImage(camera, *estimator, options.render, progress);
+        adaptive
+            ? RenderImageAdaptive(camera, *estimator, options.render, options.adaptive, progress)
+            : RenderImage(camera, *estimator, options.render, progress);
     if (options.progress) bar.Finish();
     if (!out.ok()) return out.status();
     if (out->stats.invalid_samples > 0) {
@@ -150,9 +151,10 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     }
 
     if (out->stats.truncated_paths > 0) {
-        log->warn("job={} {} paths reached the depth cap of {} bounces and were cut (a "
-                  "reflectance of 1 keeps Russian roulette from ending them)",
-                  job_id, out->stats.truncated_paths, kMaxPathDepth);
+        log->warn(
+            "job={} {} paths reached the depth cap of {} bounces and were cut (a "
+            "reflectance of 1 keeps Russian roulette from ending them)",
+            job_id, out->stats.truncated_paths, kMaxPathDepth);
     }
 
     LocalRenderSummary summary;
@@ -166,8 +168,8 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     summary.adaptive_report = out->adaptive;
     const uint64_t spp = adaptive ? out->adaptive.max_spp : options.render.spp;
     ExrAttributes attributes =
-        DescribeRender({scene->content_hash, *method, spp, options.render.seed,
-                        options.max_depth, out->seconds, out->stats});
+        DescribeRender({scene->content_hash, *method, spp, options.render.seed, options.max_depth,
+                        out->seconds, out->stats});
     if (adaptive || options.render.spp >= 2) {
         absl::StatusOr<double> estimated = EstimatedRelativeError(out->image);
         if (!estimated.ok()) return estimated.status();

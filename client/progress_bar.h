@@ -8,12 +8,12 @@
 namespace lf {
 
 class ProgressBar {
-public:
+  public:
     explicit ProgressBar(std::string label);
     void Update(size_t done, size_t total);  // thread-safe
     void Finish();
 
-private:
+  private:
     std::string label_;
     bool enabled_;
     std::mutex mutex_;

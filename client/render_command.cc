@@ -122,11 +122,9 @@ Command AddRenderCommand(CLI::App& app) {
                     "job %s: %s, %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
                     "%llu NaN/Inf samples -> %s\n",
                     summary->job_id.c_str(), summary->method.c_str(), summary->width,
-                    summary->height,
-                    (unsigned long long)summary->stats.samples, s,
+                    summary->height, (unsigned long long)summary->stats.samples, s,
                     summary->stats.samples / s * 1e-6, summary->stats.rays / s * 1e-6,
-                    (unsigned long long)summary->stats.invalid_samples,
-                    options->exr_path.c_str());
+                    (unsigned long long)summary->stats.invalid_samples, options->exr_path.c_str());
                 if (summary->estimated_error >= 0) {
                     std::printf("estimated relative error %.4f%s\n", summary->estimated_error,
                                 summary->high_variance ? " (high variance)" : "");

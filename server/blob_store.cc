@@ -1,8 +1,11 @@
 #include "server/blob_store.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
@@ -10,6 +13,29 @@
 namespace lf {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+absl::Status Sync(const std::string& path, int flags) {
+    const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+    if (fd < 0 || ::fsync(fd) != 0) {
+        const absl::Status s = absl::InternalError(path + ": " + std::strerror(errno));
+        if (fd >= 0) ::close(fd);
+        return s;
+    }
+    ::close(fd);
+    return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status RenameDurably(const std::string& temp, const std::string& path) {
+    if (absl::Status s = Sync(temp, O_RDONLY); !s.ok()) return s;
+    std::error_code ec;
+    fs::rename(temp, path, ec);
+    if (ec) return absl::InternalError(path + ": " + ec.message());
+    return Sync(fs::path(path).parent_path().string(), O_RDONLY | O_DIRECTORY);
+}
 
 absl::StatusOr<std::unique_ptr<BlobStore>> BlobStore::Open(const std::string& dir) {
     std::error_code ec;
@@ -59,7 +85,7 @@ absl::Status BlobStore::Upload::Append(std::string_view data) {
     }
     digest_.Update(data);
     out_.write(data.data(), std::streamsize(data.size()));
-    if (!out_) return absl::InternalError(temp_path_ + ": write failed");
+    if (!out_) return absl::InternalError(temp_path_ + ": " + std::strerror(errno));
     return absl::OkStatus();
 }
 
@@ -73,10 +99,9 @@ absl::Status BlobStore::Upload::Finish() {
             absl::StrCat("blob ", hash_, ": the content hashes to ", got));
     }
     out_.close();
-    if (!out_) return absl::InternalError(temp_path_ + ": write failed");
-    std::error_code ec;
-    fs::rename(temp_path_, final_path_, ec);
-    if (ec) return absl::InternalError(final_path_ + ": " + ec.message());
+    if (!out_) return absl::InternalError(temp_path_ + ": " + std::strerror(errno));
+    // Durable before any job that names it is recorded.
+    if (absl::Status s = RenameDurably(temp_path_, final_path_); !s.ok()) return s;
     finished_ = true;
     return absl::OkStatus();
 }

@@ -14,8 +14,12 @@
 
 namespace lf {
 
+// Puts `temp` in place as `path` durably: syncs its content, renames it, and syncs the folder,
+// so that after a crash `path` is either absent or whole.
+absl::Status RenameDurably(const std::string& temp, const std::string& path);
+
 class BlobStore {
-public:
+  public:
     // Creates `dir` when missing.
     static absl::StatusOr<std::unique_ptr<BlobStore>> Open(const std::string& dir);
 
@@ -23,12 +27,12 @@ public:
     std::string PathOf(const std::string& hash) const;
 
     class Upload {
-    public:
+      public:
         ~Upload();  // removes the temporary file unless Finish succeeded
         absl::Status Append(std::string_view data);
         absl::Status Finish();
 
-    private:
+      private:
         friend class BlobStore;
         Upload(std::string hash, uint64_t size, std::string final_path, std::string temp_path);
         std::string hash_;
@@ -41,7 +45,7 @@ public:
     // InvalidArgument for a malformed hash.
     absl::StatusOr<std::unique_ptr<Upload>> StartUpload(const std::string& hash, uint64_t size);
 
-private:
+  private:
     explicit BlobStore(std::string dir) : dir_(std::move(dir)) {}
     std::string dir_;
 };

@@ -9,7 +9,7 @@ namespace lf {
 
 // Incremental, for content that arrives in chunks.
 class Sha256 {
-public:
+  public:
     Sha256();
     ~Sha256();
     Sha256(const Sha256&) = delete;
@@ -18,7 +18,7 @@ public:
     void Update(std::string_view data);
     std::string HexDigest();  // lowercase hex; ends the hash
 
-private:
+  private:
     struct State;
     std::unique_ptr<State> state_;
 };

@@ -7,8 +7,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_io.h"
+#include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
-#include "server/logging.h"
 #include "server/render_metadata.h"
 #include "server/sqlite_job_store.h"
 
@@ -53,9 +53,30 @@ Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
       store_(std::move(store)),
       scheduler_(options.scheduler, *store_) {}
 
+absl::Status Farm::CheckSceneSize(uint64_t bytes) const {
+    if (bytes <= options_.limits.max_scene_bytes) return absl::OkStatus();
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the scene and its files are ", bytes, " bytes, above this server's limit of ",
+                     options_.limits.max_scene_bytes, " (lightfarm-server --max-scene-mb)"));
+}
+
+absl::StatusOr<std::unique_ptr<BlobStore::Upload>> Farm::StartUpload(const std::string& hash,
+                                                                     uint64_t size) {
+    if (absl::Status s = CheckSceneSize(size); !s.ok()) return s;
+    return blobs_->StartUpload(hash, size);
+}
+
 absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     std::vector<const BlobRef*> refs = {&spec.scene};
     for (const BlobRef& f : spec.files) refs.push_back(&f);
+    uint64_t scene_bytes = 0;
+    for (const BlobRef* ref : refs) scene_bytes += ref->size;
+    if (absl::Status s = CheckSceneSize(scene_bytes); !s.ok()) return s;
+    if (spec.plan.spp > options_.limits.max_spp) {
+        return absl::ResourceExhaustedError(
+            absl::StrCat(spec.plan.spp, " samples per pixel is above this server's limit of ",
+                         options_.limits.max_spp, " (lightfarm-server --max-spp)"));
+    }
     for (const BlobRef* ref : refs) {
         if (absl::Status s = CheckScenePath(ref->path); !s.ok()) return s;
         if (!blobs_->Has(ref->hash)) {
@@ -81,6 +102,14 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
                     std::string(scene.status().message()));
         return absl::InvalidArgumentError(scene.status().message());
     }
+    const int side = options_.limits.max_resolution;
+    if (scene->camera.width > side || scene->camera.height > side) {
+        return absl::ResourceExhaustedError(absl::StrCat("resolution ", scene->camera.width, "x",
+                                                         scene->camera.height,
+                                                         " is above this server's limit of ", side,
+                                                         " pixels per side "
+                                                         "(lightfarm-server --max-resolution)"));
+    }
     spec.plan.width = scene->camera.width;
     spec.plan.height = scene->camera.height;
     spec.scene_hash = scene->content_hash;
@@ -91,8 +120,10 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
                             std::string_view tile_sums) {
     absl::StatusOr<TileSums> sums = DecodeTileSums(tile_sums);
     if (!sums.ok()) {
+        const std::string reason = absl::StrCat("undecodable result: ", sums.status().message());
+        scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
         return absl::InvalidArgumentError(
-            absl::StrCat("lease ", lease_id, " from ", worker, ": ", sums.status().message()));
+            absl::StrCat("lease ", lease_id, " from ", worker, ": ", reason));
     }
     absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, *sums);
     if (!done.ok()) return done.status();
@@ -120,13 +151,11 @@ absl::Status Farm::WriteImage(const JobRecord& job, const Image& image, const st
                            ? 0.0
                            : absl::ToDoubleSeconds(absl::Now() - job.started);
     metadata.stats = job.stats;
-    // Renamed into place so a reader never sees half a file.
+    // Renamed into place so a reader never sees half a file, and durable before the job is
+    // recorded as succeeded.
     const std::string temp = path + ".tmp-" + UniqueSuffix();
     if (absl::Status s = WriteExr(temp, image, DescribeRender(metadata)); !s.ok()) return s;
-    std::error_code ec;
-    fs::rename(temp, path, ec);
-    if (ec) return absl::InternalError(path + ": " + ec.message());
-    return absl::OkStatus();
+    return RenameDurably(temp, path);
 }
 
 absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool preview) {

@@ -15,21 +15,34 @@
 
 namespace lf {
 
+// What one job may ask for; a submission beyond these is refused before anything is planned.
+struct JobLimits {
+    uint64_t max_scene_bytes = uint64_t(1) << 30;  // the scene JSON and its files together
+    int max_resolution = 16384;                    // pixels per side
+    uint64_t max_spp = uint64_t(1) << 20;
+};
+
 struct FarmOptions {
     std::string data_dir;  // jobs.db, blobs/, results/, previews/, scratch/ go here
     SchedulerOptions scheduler;
+    JobLimits limits;
     absl::Duration heartbeat_interval = absl::Milliseconds(300);
 };
 
 class Farm {
-public:
+  public:
     // Opens the data folder and takes up the jobs it holds that have not ended (see
     // Scheduler::Recover), writing the results of those that were fully rendered.
     static absl::StatusOr<std::unique_ptr<Farm>> Open(const FarmOptions& options);
 
-    // Checks the paths and blobs and that the scene loads (InvalidArgument with the loader's
-    // message when it does not), fills in the image size and scene hash, and queues the job.
+    // Checks the limits, the paths and blobs and that the scene loads (InvalidArgument with the
+    // loader's message when it does not), fills in the image size and scene hash, and queues the
+    // job. ResourceExhausted, naming the limit, for a job above the limits.
     absl::StatusOr<std::string> Submit(JobSpec spec);
+
+    // A blob upload, refused when the blob alone is above the scene size limit.
+    absl::StatusOr<std::unique_ptr<BlobStore::Upload>> StartUpload(const std::string& hash,
+                                                                   uint64_t size);
 
     // Decodes and merges a task's result; writes the job's EXR when it was the last one.
     absl::Status Complete(const std::string& lease_id, const std::string& worker,
@@ -42,9 +55,10 @@ public:
     BlobStore& blobs() { return *blobs_; }
     const FarmOptions& options() const { return options_; }
 
-private:
+  private:
     Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
          std::unique_ptr<JobStore> store);
+    absl::Status CheckSceneSize(uint64_t bytes) const;
     // Writes the merged image with the render's header attributes, atomically.
     absl::Status WriteImage(const JobRecord& job, const Image& image, const std::string& path);
     void FinishJob(const std::string& job_id);

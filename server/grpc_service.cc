@@ -4,8 +4,8 @@
 #include <fstream>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/log.h"
 #include "proto/grpc_status.h"
-#include "server/logging.h"
 
 namespace lf {
 
@@ -77,6 +77,7 @@ void ToProto(const JobRecord& job, pb::Job* out) {
 JobSpec FromProto(const pb::SubmitJobRequest& r) {
     JobSpec spec;
     spec.name = r.name().empty() ? r.scene().path() : r.name();
+    spec.request_id = r.request_id();
     spec.scene = FromProto(r.scene());
     for (const pb::SceneFile& f : r.files()) spec.files.push_back(FromProto(f));
     spec.plan.spp = r.params().spp();
@@ -141,7 +142,7 @@ grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext*,
         return ToGrpcStatus(absl::InvalidArgumentError("UploadBlob: empty stream"));
     }
     absl::StatusOr<std::unique_ptr<BlobStore::Upload>> upload =
-        farm_.blobs().StartUpload(chunk.hash(), chunk.size());
+        farm_.StartUpload(chunk.hash(), chunk.size());
     if (!upload.ok()) return ToGrpcStatus(upload.status());
     do {
         if (absl::Status s = (*upload)->Append(chunk.data()); !s.ok()) return ToGrpcStatus(s);

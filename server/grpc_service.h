@@ -9,7 +9,7 @@
 namespace lf {
 
 class JobServiceImpl final : public lightfarm::v1::JobService::Service {
-public:
+  public:
     explicit JobServiceImpl(Farm& farm) : farm_(farm) {}
 
     grpc::Status MissingBlobs(grpc::ServerContext*, const lightfarm::v1::MissingBlobsRequest*,
@@ -30,12 +30,12 @@ public:
     grpc::Status FetchResult(grpc::ServerContext*, const lightfarm::v1::FetchResultRequest*,
                              grpc::ServerWriter<lightfarm::v1::Chunk>*) override;
 
-private:
+  private:
     Farm& farm_;
 };
 
 class WorkerServiceImpl final : public lightfarm::v1::WorkerService::Service {
-public:
+  public:
     explicit WorkerServiceImpl(Farm& farm) : farm_(farm) {}
 
     grpc::Status LeaseTask(grpc::ServerContext*, const lightfarm::v1::LeaseTaskRequest*,
@@ -49,7 +49,7 @@ public:
     grpc::Status FetchBlob(grpc::ServerContext*, const lightfarm::v1::FetchBlobRequest*,
                            grpc::ServerWriter<lightfarm::v1::Chunk>*) override;
 
-private:
+  private:
     Farm& farm_;
 };
 

@@ -20,10 +20,10 @@ const char* JobStateName(JobState state) {
     return "unknown";
 }
 
-absl::Status InMemoryJobStore::Put(const JobRecord& job) {
+uint64_t InMemoryJobStore::QueuePut(const JobRecord& job) {
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_[job.id] = job;
-    return absl::OkStatus();
+    return 0;
 }
 
 absl::StatusOr<JobRecord> InMemoryJobStore::Get(const std::string& id) const {
@@ -31,6 +31,14 @@ absl::StatusOr<JobRecord> InMemoryJobStore::Get(const std::string& id) const {
     auto it = jobs_.find(id);
     if (it == jobs_.end()) return absl::NotFoundError("no job " + id);
     return it->second;
+}
+
+std::optional<std::string> InMemoryJobStore::FindRequest(const std::string& request_id) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [id, job] : jobs_) {
+        if (job.spec.request_id == request_id) return id;
+    }
+    return std::nullopt;
 }
 
 std::vector<JobRecord> InMemoryJobStore::List() const {

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -28,6 +28,7 @@ struct JobSpec {
     int max_depth = -1;
     int priority = 0;        // higher first
     std::string scene_hash;  // the loader's content hash, for the EXR header
+    std::string request_id;  // the client's, for idempotent retries; "" for none
 };
 
 enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled };
@@ -48,32 +49,45 @@ struct JobRecord {
 };
 
 class JobStore {
-public:
+  public:
     virtual ~JobStore() = default;
-    virtual absl::Status Put(const JobRecord& job) = 0;  // insert or replace, by id
-    // Put, together with the encoded TileSums of task `task` of the job, in one write. A record
-    // in a final state drops the job's task results.
-    virtual absl::Status PutTaskDone(const JobRecord& job, int task, std::string_view result) = 0;
+    // Writes are queued and become durable in the order they were queued; a store may commit
+    // many at once (group commit), so that callers can wait for durability without holding
+    // their locks. Each returns a ticket for WaitDurable.
+    virtual uint64_t QueuePut(const JobRecord& job) = 0;  // insert or replace, by id
+    // The job's record together with the encoded TileSums of its task `task`, in one write. A
+    // record in a final state drops the job's task results.
+    virtual uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) = 0;
+    // Blocks until the write of `ticket`, and every one before it, is durable; or its error.
+    virtual absl::Status WaitDurable(uint64_t ticket) = 0;
+    absl::Status Put(const JobRecord& job) { return WaitDurable(QueuePut(job)); }
+
+    // Reads see durable writes only.
     virtual absl::StatusOr<JobRecord> Get(const std::string& id) const = 0;  // NotFound
     virtual std::vector<JobRecord> List() const = 0;                         // newest first
-    // The results PutTaskDone recorded for a job that has not ended, by task index.
+    // The job submitted with this client request id, if any.
+    virtual std::optional<std::string> FindRequest(const std::string& request_id) const = 0;
+    // The results QueueTaskDone recorded for a job that has not ended, by task index.
     virtual absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const = 0;
 };
 
-// Nothing outlives the process, so there is nothing to recover: task results are not kept.
+// Nothing outlives the process, so there is nothing to recover: task results are not kept, and
+// every write is "durable" at once.
 class InMemoryJobStore : public JobStore {
-public:
-    absl::Status Put(const JobRecord& job) override;
-    absl::Status PutTaskDone(const JobRecord& job, int task, std::string_view result) override {
-        return Put(job);
+  public:
+    uint64_t QueuePut(const JobRecord& job) override;
+    uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) override {
+        return QueuePut(job);
     }
+    absl::Status WaitDurable(uint64_t ticket) override { return absl::OkStatus(); }
+    absl::StatusOr<JobRecord> Get(const std::string& id) const override;
+    std::vector<JobRecord> List() const override;
+    std::optional<std::string> FindRequest(const std::string& request_id) const override;
     absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const override {
         return std::map<int, std::string>{};
     }
-    absl::StatusOr<JobRecord> Get(const std::string& id) const override;
-    std::vector<JobRecord> List() const override;
 
-private:
+  private:
     mutable std::mutex mutex_;
     std::map<std::string, JobRecord> jobs_;
 };

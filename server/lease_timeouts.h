@@ -11,14 +11,14 @@
 namespace lf {
 
 class LeaseTimeouts {
-public:
+  public:
     void Set(const std::string& lease_id, absl::Time deadline);  // adds or moves
     void Remove(const std::string& lease_id);
     // Removes and returns the leases whose deadline is at or before `now`, earliest first.
     std::vector<std::string> TakeExpired(absl::Time now);
     size_t size() const { return by_id_.size(); }
 
-private:
+  private:
     std::multimap<absl::Time, std::string> by_deadline_;
     std::map<std::string, std::multimap<absl::Time, std::string>::iterator> by_id_;
 };

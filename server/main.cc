@@ -34,6 +34,23 @@ int main(int argc, char** argv) {
                    "a task goes back to the queue when its worker is silent this long")
         ->capture_default_str()
         ->check(CLI::Range(0.2, 3600.0));
+    double speculate_seconds = absl::ToDoubleSeconds(options.scheduler.speculate_after);
+    app.add_option("--speculate-seconds", speculate_seconds,
+                   "near a job's end, a task running this long (and twice the job's mean) is "
+                   "leased again to an idle worker")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    uint64_t max_scene_mb = options.limits.max_scene_bytes >> 20;
+    app.add_option("--max-scene-mb", max_scene_mb, "largest scene, files included, per job")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    app.add_option("--max-resolution", options.limits.max_resolution,
+                   "largest image width and height per job")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    app.add_option("--max-spp", options.limits.max_spp, "most samples per pixel per job")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
@@ -41,6 +58,8 @@ int main(int argc, char** argv) {
     spdlog::set_default_logger(spdlog::stderr_color_mt("server"));
     spdlog::set_level(spdlog::level::from_str(log_level));
     options.scheduler.lease = absl::Seconds(lease_seconds);
+    options.scheduler.speculate_after = absl::Seconds(speculate_seconds);
+    options.limits.max_scene_bytes = max_scene_mb << 20;
     // Often enough that a cancel reaches workers within about a second, and several times per
     // lease so one slow answer does not lose it.
     options.heartbeat_interval = std::min(absl::Milliseconds(300), options.scheduler.lease / 4);

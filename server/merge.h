@@ -14,7 +14,7 @@
 namespace lf {
 
 class RenderMerger {
-public:
+  public:
     RenderMerger(int width, int height, std::vector<RenderTask> tasks);
 
     // Adds the result of task `task_index`. InvalidArgument when `sums` is not that task's
@@ -31,7 +31,7 @@ public:
     // bit for bit what local mode (client/local_executor.h) makes of the same settings.
     Image Snapshot() const;
 
-private:
+  private:
     struct OpenTile {
         TileSums sums;
         int passes_left;

@@ -5,8 +5,8 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
-#include "server/logging.h"
 
 namespace lf {
 
@@ -33,25 +33,72 @@ Scheduler::Scheduler(SchedulerOptions options, JobStore& store, Clock clock)
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(spec.plan);
     if (!plan.ok()) return plan.status();
-    std::lock_guard<std::mutex> lock(mutex_);
-    std::string id = NewJobId();
-    while (active_.count(id) || store_.Get(id).ok()) id = NewJobId();
     auto job = std::make_unique<Job>(Job{{},
                                          *plan,
                                          std::vector<Task>(plan->size()),
                                          {},
                                          RenderMerger(spec.plan.width, spec.plan.height, *plan)});
     for (int i = 0; i < int(plan->size()); ++i) job->queued.insert(i);
-    job->record.id = id;
-    job->record.seq = next_seq_++;
     job->record.spec = spec;
     job->record.submitted = clock_();
     job->record.tasks_total = int(plan->size());
-    if (absl::Status s = Save(*job); !s.ok()) return s;
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (std::optional<std::pair<std::string, uint64_t>> earlier = FindRequest(spec.request_id)) {
+        lock.unlock();
+        if (absl::Status s = store_.WaitDurable(earlier->second); !s.ok()) return s;
+        Log()->info("job={} submitted again (request {})", earlier->first, spec.request_id);
+        return earlier->first;
+    }
+    std::string id = NewJobId();
+    while (active_.count(id) || store_.Get(id).ok()) id = NewJobId();
+    job->record.id = id;
+    job->record.seq = next_seq_++;
+    const uint64_t ticket = Save(*job);
+    job->submit_ticket = ticket;
+    active_[id] = std::move(job);
+    lock.unlock();
+    // Acknowledged only once durable; waiting outside the lock lets submissions and results
+    // share one sync.
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
+        Log()->error("job={} refused: {}", id, std::string(s.message()));
+        lock.lock();
+        active_.erase(id);
+        return s;
+    }
     Log()->info("job={} queued: {} tasks, {}x{}, {} spp, priority {}", id, plan->size(),
                 spec.plan.width, spec.plan.height, spec.plan.spp, spec.priority);
-    active_[id] = std::move(job);
     return id;
+}
+
+std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequest(
+    const std::string& request_id) const {
+    if (request_id.empty()) return std::nullopt;
+    for (const auto& [id, job] : active_) {
+        if (job->record.spec.request_id == request_id) return std::pair{id, job->submit_ticket};
+    }
+    if (std::optional<std::string> id = store_.FindRequest(request_id)) {
+        return std::pair{*id, uint64_t(0)};
+    }
+    return std::nullopt;
+}
+
+absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (auto it = active_.find(job_id); it != active_.end()) return it->second->record;
+        if (auto it = unrecorded_.find(job_id); it != unrecorded_.end()) return it->second;
+    }
+    return store_.Get(job_id);
+}
+
+std::vector<JobRecord> Scheduler::List() const {
+    std::vector<JobRecord> jobs = store_.List();
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (JobRecord& job : jobs) {
+        if (auto it = active_.find(job.id); it != active_.end()) job = it->second->record;
+        if (auto it = unrecorded_.find(job.id); it != unrecorded_.end()) job = it->second;
+    }
+    return jobs;
 }
 
 absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
@@ -91,7 +138,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
                     job->record.id, job->record.tasks_done, job->record.tasks_total,
                     job->record.tasks_leased);
         if (job->merger.Complete()) rendered.push_back(job->record.id);
-        Save(*job).IgnoreError();
+        Save(*job);
         active_[job->record.id] = std::move(job);
     }
     return rendered;
@@ -136,40 +183,87 @@ std::optional<Lease> Scheduler::TryLease(const std::string& worker) {
             break;
         }
     }
-    if (!best) return std::nullopt;
-    Task& task = best->tasks[size_t(best_task)];
-    best->queued.erase(best_task);
-    task.state = TaskState::kLeased;
-    ++task.attempts;
-    ++best->record.tasks_leased;
-    task.worker = worker;
-    task.lease_id = absl::StrCat(best->record.id, "/", best_task, "/", boot_, "-", task.attempts);
-    timeouts_.Set(task.lease_id, now + options_.lease);
-    if (best->record.state == JobState::kQueued) {
-        best->record.state = JobState::kRunning;
-        best->record.started = now;
+    if (best) return Grant(*best, best_task, worker, now);
+    for (auto& [id, job] : active_) {
+        if (const int t = StragglerFor(*job, worker, now); t >= 0) {
+            Log()->info("job={} task={} running for {}: leased again to {}", id, t,
+                        absl::FormatDuration(now - job->tasks[size_t(t)].leased_at), worker);
+            return Grant(*job, t, worker, now);
+        }
     }
-    ++best->record.tasks_running;
-    Save(*best).IgnoreError();
-    Log()->debug("job={} task={} leased to {} (attempt {})", best->record.id, best_task, worker,
+    return std::nullopt;
+}
+
+int Scheduler::StragglerFor(const Job& job, const std::string& worker, absl::Time now) const {
+    if (!job.queued.empty()) return -1;
+    absl::Duration limit = options_.speculate_after;
+    if (job.tasks_timed > 0) limit = std::max(limit, 2 * job.task_time_total / job.tasks_timed);
+    int oldest = -1;
+    for (int t = 0; t < int(job.tasks.size()); ++t) {
+        const Task& task = job.tasks[size_t(t)];
+        if (task.state != TaskState::kLeased || task.live.size() != 1 ||
+            task.failed_on.count(worker) ||
+            task.holders[size_t(*task.live.begin() - 1)] == worker ||
+            now - task.leased_at < limit) {
+            continue;
+        }
+        if (oldest < 0 || task.leased_at < job.tasks[size_t(oldest)].leased_at) oldest = t;
+    }
+    return oldest;
+}
+
+std::string Scheduler::LeaseId(const Job& job, int task, int attempt) const {
+    return absl::StrCat(job.record.id, "/", task, "/", boot_, "-", attempt);
+}
+
+Lease Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time now) {
+    Task& task = job.tasks[size_t(t)];
+    if (task.state == TaskState::kQueued) {
+        job.queued.erase(t);
+        task.state = TaskState::kLeased;
+        task.leased_at = now;
+        ++job.record.tasks_running;
+    }
+    ++task.attempts;
+    task.holders.push_back(worker);
+    task.live.insert(task.attempts);
+    ++job.record.tasks_leased;
+    const std::string lease_id = LeaseId(job, t, task.attempts);
+    timeouts_.Set(lease_id, now + options_.lease);
+    if (job.record.state == JobState::kQueued) {
+        job.record.state = JobState::kRunning;
+        job.record.started = now;
+    }
+    Save(job);
+    Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, worker,
                  task.attempts);
-    return Lease{task.lease_id, best->record.id, best->plan[size_t(best_task)], best->record.spec};
+    return Lease{lease_id, job.record.id, job.plan[size_t(t)], job.record.spec};
 }
 
 std::optional<Scheduler::LeaseRef> Scheduler::Resolve(const std::string& lease_id) {
     const std::vector<std::string> parts = absl::StrSplit(lease_id, '/');
-    int task = 0;
+    int task = 0, attempt = 0;
     if (parts.size() != 3 || !absl::SimpleAtoi(parts[1], &task)) return std::nullopt;
-    auto it = active_.find(parts[0]);
-    if (it == active_.end() || task < 0 || size_t(task) >= it->second->tasks.size()) {
+    const std::string prefix = boot_ + "-";
+    if (parts[2].rfind(prefix, 0) != 0 ||
+        !absl::SimpleAtoi(parts[2].substr(prefix.size()), &attempt)) {
         return std::nullopt;
     }
-    return LeaseRef{it->second.get(), task};
+    auto it = active_.find(parts[0]);
+    if (it == active_.end() || task < 0 || size_t(task) >= it->second->tasks.size() ||
+        attempt < 1 || attempt > it->second->tasks[size_t(task)].attempts) {
+        return std::nullopt;
+    }
+    return LeaseRef{it->second.get(), task, attempt};
 }
 
-bool Scheduler::IsCurrent(const LeaseRef& ref, const std::string& lease_id) const {
+bool Scheduler::HeldBy(const LeaseRef& ref, const std::string& worker) {
+    return ref.job->tasks[size_t(ref.task)].holders[size_t(ref.attempt - 1)] == worker;
+}
+
+bool Scheduler::IsCurrent(const LeaseRef& ref) {
     const Task& task = ref.job->tasks[size_t(ref.task)];
-    return task.state == TaskState::kLeased && task.lease_id == lease_id;
+    return task.state == TaskState::kLeased && task.live.count(ref.attempt);
 }
 
 bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker) {
@@ -177,7 +271,7 @@ bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker
     const absl::Time now = clock_();
     workers_seen_[worker] = now;
     const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !IsCurrent(*ref, lease_id)) return false;
+    if (!ref || !HeldBy(*ref, worker) || !IsCurrent(*ref)) return false;
     timeouts_.Set(lease_id, now + options_.lease);
     return true;
 }
@@ -185,73 +279,94 @@ bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker
 absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lease_id,
                                                           const std::string& worker,
                                                           const TileSums& sums) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    workers_seen_[worker] = clock_();
+    std::unique_lock<std::mutex> lock(mutex_);
+    const absl::Time now = clock_();
+    workers_seen_[worker] = now;
     const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref) {
-        return absl::FailedPreconditionError(
-            absl::StrCat("lease ", lease_id, ": its job is no longer running"));
+    if (!ref || !HeldBy(*ref, worker)) {
+        Log()->warn("result for lease {} from {} refused: not a lease it holds", lease_id, worker);
+        return absl::FailedPreconditionError(absl::StrCat(
+            "lease ", lease_id, " is not one of worker ", worker, " in a running job"));
     }
     Job& job = *ref->job;
     Task& task = job.tasks[size_t(ref->task)];
     if (task.state == TaskState::kDone) return Completion{job.record.id, false};
     if (absl::Status s = job.merger.Add(ref->task, sums); !s.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("job=", job.record.id, " task=", ref->task,
-                                                       " from ", worker, ": ", s.message()));
+        const std::string error = absl::StrCat("job=", job.record.id, " task=", ref->task, " from ",
+                                               worker, ": ", s.message());
+        if (IsCurrent(*ref)) {
+            timeouts_.Remove(lease_id);
+            Requeue(*ref, absl::StrCat("result refused: ", s.message()), true);
+        }
+        return absl::InvalidArgumentError(error);
     }
     if (task.state == TaskState::kLeased) {
-        // Whoever holds the lease now (maybe a retry elsewhere) learns at its next heartbeat.
-        timeouts_.Remove(task.lease_id);
+        // Whoever else holds a lease of it (a retry or a speculative copy) learns at its next
+        // heartbeat.
+        for (int attempt : task.live) timeouts_.Remove(LeaseId(job, ref->task, attempt));
+        task.live.clear();
         --job.record.tasks_running;
+        job.task_time_total += now - task.leased_at;
+        ++job.tasks_timed;
     } else {
         job.queued.erase(ref->task);
     }
     task.state = TaskState::kDone;
     job.record.tasks_done = int(job.merger.tasks_done());
     job.record.stats = job.merger.stats();
-    if (absl::Status s = store_.PutTaskDone(job.record, ref->task, EncodeTileSums(sums));
-        !s.ok()) {
-        // The merge cannot be taken back, and a job whose results are not all recorded would not
-        // survive a restart: it fails here, and the worker hears why.
-        const std::string job_id = job.record.id;
-        FailJob(job, absl::StrCat("recording the result of task ", ref->task, ": ", s.message()));
-        return absl::UnavailableError(absl::StrCat("job=", job_id, ": ", s.message()));
-    }
+    const uint64_t ticket = store_.QueueTaskDone(job.record, ref->task, EncodeTileSums(sums));
     ++version_;
     changed_.notify_all();
     Log()->debug("job={} task={} done by {} ({}/{})", job.record.id, ref->task, worker,
                  job.record.tasks_done, job.record.tasks_total);
-    return Completion{job.record.id, job.merger.Complete()};
+    const Completion completion{job.record.id, job.merger.Complete()};
+    lock.unlock();
+    // The worker hears "done" only once the result is durable.
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
+        // The merge cannot be taken back, and a job whose results are not all recorded would not
+        // survive a restart: it fails here, and the worker hears why.
+        lock.lock();
+        if (auto it = active_.find(completion.job_id); it != active_.end()) {
+            FailJob(*it->second,
+                    absl::StrCat("recording the result of task ", ref->task, ": ", s.message()));
+        }
+        return absl::Status(s.code(), absl::StrCat("job=", completion.job_id, ": ", s.message()));
+    }
+    return completion;
 }
 
 absl::Status Scheduler::Fail(const std::string& lease_id, const std::string& worker,
                              const std::string& reason, FailureKind kind) {
     std::lock_guard<std::mutex> lock(mutex_);
     const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !IsCurrent(*ref, lease_id)) return absl::OkStatus();
+    if (!ref || !HeldBy(*ref, worker) || !IsCurrent(*ref)) return absl::OkStatus();
     timeouts_.Remove(lease_id);
-    Requeue(*ref->job, ref->task, absl::StrCat(reason, " (worker ", worker, ")"),
-            kind == FailureKind::kTaskError);
+    Requeue(*ref, absl::StrCat(reason, " (worker ", worker, ")"), kind == FailureKind::kTaskError);
     return absl::OkStatus();
 }
 
-void Scheduler::Requeue(Job& job, int t, const std::string& reason, bool counted) {
+void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool counted) {
+    Job& job = *ref.job;
+    const int t = ref.task;
     Task& task = job.tasks[size_t(t)];
-    task.state = TaskState::kQueued;
-    --job.record.tasks_running;
+    task.live.erase(ref.attempt);
     if (counted) {
         ++task.failures;
-        task.failed_on.insert(task.worker);
+        task.failed_on.insert(task.holders[size_t(ref.attempt - 1)]);
     }
-    Log()->warn("job={} task={} attempt {} failed: {}{}", job.record.id, t, task.attempts, reason,
+    Log()->warn("job={} task={} attempt {} failed: {}{}", job.record.id, t, ref.attempt, reason,
                 counted ? "" : " (not counted)");
     if (task.failures >= options_.max_failures) {
         FailJob(job, absl::StrCat("task ", t, " failed ", task.failures, " times; last: ", reason));
         return;
     }
-    job.queued.insert(t);
-    ++job.record.retries;
-    Save(job).IgnoreError();
+    if (task.live.empty()) {  // otherwise another lease of it is still rendering
+        task.state = TaskState::kQueued;
+        --job.record.tasks_running;
+        job.queued.insert(t);
+        ++job.record.retries;
+    }
+    Save(job);
 }
 
 void Scheduler::FailJob(Job& job, const std::string& error) {
@@ -264,10 +379,16 @@ void Scheduler::FailJob(Job& job, const std::string& error) {
 void Scheduler::EndJob(Job& job) {
     job.record.finished = clock_();
     job.record.tasks_running = 0;
-    for (const Task& task : job.tasks) {
-        if (task.state == TaskState::kLeased) timeouts_.Remove(task.lease_id);
+    for (int t = 0; t < int(job.tasks.size()); ++t) {
+        for (int attempt : job.tasks[size_t(t)].live) timeouts_.Remove(LeaseId(job, t, attempt));
     }
-    Save(job).IgnoreError();
+    if (absl::Status s = store_.WaitDurable(Save(job)); !s.ok()) {
+        Log()->error("job={} ended ({}) but not recorded: {}", job.record.id,
+                     JobStateName(job.record.state), std::string(s.message()));
+        // Readers and watchers still learn how it ended; the store, which says it runs, has it
+        // run again after a restart.
+        unrecorded_[job.record.id] = job.record;
+    }
     active_.erase(job.record.id);  // destroys `job`
 }
 
@@ -291,9 +412,10 @@ int Scheduler::ExpireLeases() {
     const std::vector<std::string> expired = timeouts_.TakeExpired(clock_());
     for (const std::string& lease_id : expired) {
         const std::optional<LeaseRef> ref = Resolve(lease_id);
-        if (!ref || !IsCurrent(*ref, lease_id)) continue;
-        const std::string& worker = ref->job->tasks[size_t(ref->task)].worker;
-        Requeue(*ref->job, ref->task,
+        if (!ref || !IsCurrent(*ref)) continue;
+        const std::string& worker =
+            ref->job->tasks[size_t(ref->task)].holders[size_t(ref->attempt - 1)];
+        Requeue(*ref,
                 absl::StrCat("lease expired: worker ", worker, " sent no heartbeat for ",
                              absl::FormatDuration(options_.lease)),
                 true);
@@ -326,12 +448,11 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
     EndJob(job);
 }
 
-absl::Status Scheduler::Save(Job& job) {
-    absl::Status s = store_.Put(job.record);
-    if (!s.ok()) Log()->error("job={} not saved: {}", job.record.id, std::string(s.message()));
+uint64_t Scheduler::Save(Job& job) {
+    const uint64_t ticket = store_.QueuePut(job.record);
     ++version_;
     changed_.notify_all();
-    return s;
+    return ticket;
 }
 
 uint64_t Scheduler::WaitForChange(uint64_t version, absl::Time deadline) {

@@ -28,6 +28,10 @@ namespace lf {
 struct SchedulerOptions {
     absl::Duration lease = absl::Seconds(10);  // a lease lasts this long past the last heartbeat
     int max_failures = 3;                      // counted failures of one task that fail its job
+    // Near the end of a job (no task of it queued), an idle worker gets a second lease of a task
+    // running longer than this and longer than twice the job's mean task time; the first result
+    // wins (both are the same bits), so one slow worker does not hold the job.
+    absl::Duration speculate_after = absl::Seconds(1);
 };
 
 struct Lease {
@@ -43,13 +47,14 @@ enum class FailureKind {
 };
 
 class Scheduler {
-public:
+  public:
     using Clock = std::function<absl::Time()>;
     Scheduler(
         SchedulerOptions options, JobStore& store, Clock clock = [] { return absl::Now(); });
 
     // Plans and queues the job; `spec` must be validated. Returns the job id once the job is in
-    // the store (an error, and nothing queued, when the store cannot take it).
+    // the store (an error, and nothing queued, when the store cannot take it). A request id
+    // seen before returns that submission's job.
     absl::StatusOr<std::string> Submit(const JobSpec& spec);
 
     // Takes up the jobs the store holds that have not ended, as a server restarting does: their
@@ -59,8 +64,9 @@ public:
     absl::StatusOr<std::vector<std::string>> Recover();
 
     // The first queued task of the highest-priority, oldest job, preferring tasks that have not
-    // failed on this worker. Waits until `wait_until` for one to be queued (a long poll: an
-    // idle worker starts on a new job at once); nullopt when there is nothing to do.
+    // failed on this worker; when none is queued, a straggler's task (see speculate_after). Waits
+    // until `wait_until` for one to be queued (a long poll: an idle worker starts on a new job at
+    // once); nullopt when there is nothing to do.
     std::optional<Lease> LeaseTask(const std::string& worker,
                                    absl::Time wait_until = absl::InfinitePast());
 
@@ -69,7 +75,9 @@ public:
 
     // Merges a task's result and records it in the store before returning. The result is
     // accepted even from an expired lease as long as the task is not done (it is the same bits
-    // whoever renders it); a duplicate is ignored.
+    // whoever renders it); a duplicate is ignored. Refused: a lease this server never handed to
+    // `worker` (FailedPrecondition), and a result of the wrong rectangle or sample count
+    // (InvalidArgument; a current lease's task is then queued again as a counted failure).
     // `job_rendered` says the job is now fully rendered: the caller writes the result and calls
     // Finish.
     struct Completion {
@@ -95,21 +103,24 @@ public:
     // Ends a fully rendered job: succeeded with the result file, or failed with the error.
     void Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path);
 
-    absl::StatusOr<JobRecord> Get(const std::string& job_id) const { return store_.Get(job_id); }
-    std::vector<JobRecord> List() const { return store_.List(); }
+    // Running jobs as they are now, ended ones from the store.
+    absl::StatusOr<JobRecord> Get(const std::string& job_id) const;
+    std::vector<JobRecord> List() const;
 
     // Blocks until some job changed after `version` was current, or `deadline`, or Shutdown.
     // Returns the version now.
     uint64_t WaitForChange(uint64_t version, absl::Time deadline);
     void Shutdown();  // wakes every WaitForChange for good
 
-private:
+  private:
     enum class TaskState { kQueued, kLeased, kDone };
     struct Task {
         TaskState state = TaskState::kQueued;
-        int attempts = 0;  // leases handed out
-        int failures = 0;  // counted failures
-        std::string lease_id, worker;
+        int attempts = 0;                  // leases handed out
+        int failures = 0;                  // counted failures
+        std::vector<std::string> holders;  // the worker of each lease, by attempt - 1
+        std::set<int> live;    // attempts whose lease is current: two when one is speculative
+        absl::Time leased_at;  // when it last left the queue
         std::set<std::string> failed_on;
     };
     struct Job {
@@ -118,22 +129,37 @@ private:
         std::vector<Task> tasks;
         std::set<int> queued;
         RenderMerger merger;
+        uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
+        absl::Duration task_time_total = absl::ZeroDuration();  // lease to result, tasks done here
+        int tasks_timed = 0;
     };
     struct LeaseRef {
         Job* job;
         int task;
+        int attempt;
     };
 
+    // The job of an earlier submission with this request id, and the store ticket to wait for.
+    std::optional<std::pair<std::string, uint64_t>> FindRequest(
+        const std::string& request_id) const;
     std::optional<Lease> TryLease(const std::string& worker);
-    // Where a lease id points, whether or not the lease is still current.
+    // A second lease of a task running too long in the job, or -1 (see speculate_after).
+    int StragglerFor(const Job& job, const std::string& worker, absl::Time now) const;
+    Lease Grant(Job& job, int task, const std::string& worker, absl::Time now);
+    std::string LeaseId(const Job& job, int task, int attempt) const;
+    // Where a lease id of this server points, whether or not the lease is still current; nullopt
+    // for ids it never handed out (forged, or from before a restart).
     std::optional<LeaseRef> Resolve(const std::string& lease_id);
-    bool IsCurrent(const LeaseRef& ref, const std::string& lease_id) const;
-    // Puts a leased task back in the queue, counting a failure unless `counted` is false; fails
-    // the job at max_failures.
-    void Requeue(Job& job, int task, const std::string& reason, bool counted);
+    static bool HeldBy(const LeaseRef& ref, const std::string& worker);
+    static bool IsCurrent(const LeaseRef& ref);
+    // Ends the lease; when no other lease of the task is live, puts the task back in the queue.
+    // Counts a failure unless `counted` is false; fails the job at max_failures.
+    void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
     void FailJob(Job& job, const std::string& error);
-    void EndJob(Job& job);  // drops the live state of a job in a final state
-    absl::Status Save(Job& job);  // writes the record (the error is logged) and wakes watchers
+    // Drops the live state of a job in a final state, once its record is durable (so a reader
+    // never finds the ended job in neither place).
+    void EndJob(Job& job);
+    uint64_t Save(Job& job);  // queues the record's write and wakes watchers; a store ticket
     bool OtherWorkersAlive(const std::string& worker, absl::Time now) const;
 
     const SchedulerOptions options_;
@@ -149,6 +175,7 @@ private:
     // one: attempts are counted from zero again after a restart.
     const std::string boot_;
     std::map<std::string, std::unique_ptr<Job>> active_;
+    std::map<std::string, JobRecord> unrecorded_;  // ended while the store could not write
     LeaseTimeouts timeouts_;
     std::map<std::string, absl::Time> workers_seen_;
 };

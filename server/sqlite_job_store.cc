@@ -2,10 +2,13 @@
 
 #include <sqlite3.h>
 
-#include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "lf/core/log.h"
 
 namespace lf {
 
@@ -48,7 +51,8 @@ std::string RecordToJson(const JobRecord& r) {
           {"seed", s.seed},
           {"max_depth", s.max_depth},
           {"priority", s.priority},
-          {"scene_hash", s.scene_hash}}},
+          {"scene_hash", s.scene_hash},
+          {"request_id", s.request_id}}},
         {"state", int(r.state)},
         {"error", r.error},
         {"submitted", TimeToJson(r.submitted)},
@@ -86,6 +90,7 @@ absl::StatusOr<JobRecord> RecordFromJson(std::string_view text) {
         r.spec.max_depth = s.at("max_depth").get<int>();
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();
+        r.spec.request_id = s.value("request_id", "");
         r.state = JobState(j.at("state").get<int>());
         r.error = j.at("error").get<std::string>();
         r.submitted = TimeFromJson(j.at("submitted"));
@@ -102,14 +107,24 @@ absl::StatusOr<JobRecord> RecordFromJson(std::string_view text) {
         r.result_path = j.at("result_path").get<std::string>();
         return r;
     } catch (const json::exception& e) {
-        return absl::DataLossError(absl::StrCat("a job record in the store is unreadable: ",
-                                                e.what()));
+        return absl::DataLossError(
+            absl::StrCat("a job record in the store is unreadable: ", e.what()));
     }
+}
+
+// The connection's last error. A full disk says so in its code, so that the client's message
+// is plain; anything else is the server's problem.
+absl::Status StoreError(sqlite3* db) {
+    const std::string message = absl::StrCat("job store: ", sqlite3_errmsg(db));
+    if ((sqlite3_extended_errcode(db) & 0xff) == SQLITE_FULL) {
+        return absl::ResourceExhaustedError(message);
+    }
+    return absl::InternalError(message);
 }
 
 // A prepared statement, finalized on scope exit.
 class Statement {
-public:
+  public:
     Statement(sqlite3* db, const char* sql) : db_(db) {
         rc_ = sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr);
     }
@@ -143,7 +158,7 @@ public:
     }
     absl::Status status() const {
         if (rc_ == SQLITE_OK || rc_ == SQLITE_ROW) return absl::OkStatus();
-        return absl::UnavailableError(absl::StrCat("job store: ", sqlite3_errmsg(db_)));
+        return StoreError(db_);
     }
     std::string_view Column(int i) const {
         const void* data = sqlite3_column_blob(stmt_, i);
@@ -151,18 +166,15 @@ public:
     }
     int64_t ColumnInt(int i) const { return sqlite3_column_int64(stmt_, i); }
 
-private:
+  private:
     sqlite3* db_;
     sqlite3_stmt* stmt_ = nullptr;
     int rc_;
 };
 
 absl::Status Exec(sqlite3* db, const char* sql) {
-    char* error = nullptr;
-    if (sqlite3_exec(db, sql, nullptr, nullptr, &error) == SQLITE_OK) return absl::OkStatus();
-    absl::Status s = absl::UnavailableError(absl::StrCat("job store: ", error ? error : "?"));
-    sqlite3_free(error);
-    return s;
+    if (sqlite3_exec(db, sql, nullptr, nullptr, nullptr) == SQLITE_OK) return absl::OkStatus();
+    return StoreError(db);
 }
 
 }  // namespace
@@ -180,59 +192,120 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
     // synchronous=FULL: a commit is on disk when it returns, so what was acknowledged survives
     // a crash of the process or of the machine. The busy timeout only matters for a second
     // process (the sqlite3 shell) reading at the same time.
-    if (absl::Status s = Exec(db,
-                              "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
-                              "PRAGMA busy_timeout=5000;"
-                              "CREATE TABLE IF NOT EXISTS jobs (id TEXT PRIMARY KEY,"
-                              "  seq INTEGER NOT NULL, final INTEGER NOT NULL, record TEXT NOT NULL);"
-                              "CREATE TABLE IF NOT EXISTS task_results (job TEXT NOT NULL,"
-                              "  task INTEGER NOT NULL, sums BLOB NOT NULL,"
-                              "  PRIMARY KEY (job, task));");
+    if (absl::Status s =
+            Exec(db,
+                 "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
+                 "PRAGMA busy_timeout=5000;"
+                 "CREATE TABLE IF NOT EXISTS jobs (id TEXT PRIMARY KEY,"
+                 "  seq INTEGER NOT NULL, final INTEGER NOT NULL, record TEXT NOT NULL);"
+                 "CREATE TABLE IF NOT EXISTS task_results (job TEXT NOT NULL,"
+                 "  task INTEGER NOT NULL, sums BLOB NOT NULL,"
+                 "  PRIMARY KEY (job, task));"
+                 "CREATE INDEX IF NOT EXISTS jobs_by_request ON jobs ("
+                 "  json_extract(record, '$.spec.request_id'));");
         !s.ok()) {
-        return absl::UnavailableError(absl::StrCat(path, ": ", s.message()));
+        return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
     }
     return store;
 }
 
-SqliteJobStore::~SqliteJobStore() { sqlite3_close(db_); }
+SqliteJobStore::SqliteJobStore(sqlite3* db) : db_(db), writer_([this] { WriterLoop(); }) {}
 
-absl::Status SqliteJobStore::Transaction(const std::function<absl::Status()>& body) {
+SqliteJobStore::~SqliteJobStore() {
+    {
+        std::lock_guard<std::mutex> lock(queue_mutex_);
+        stop_ = true;
+    }
+    queued_cv_.notify_all();
+    writer_.join();
+    sqlite3_close(db_);
+}
+
+uint64_t SqliteJobStore::QueuePut(const JobRecord& job) {
+    return Queue({job.id, job.seq, IsFinal(job.state), RecordToJson(job)});
+}
+
+uint64_t SqliteJobStore::QueueTaskDone(const JobRecord& job, int task, std::string result) {
+    return Queue({job.id, job.seq, IsFinal(job.state), RecordToJson(job), task, std::move(result)});
+}
+
+uint64_t SqliteJobStore::Queue(Write write) {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queue_.push_back(std::move(write));
+    queued_cv_.notify_one();
+    return ++last_ticket_;
+}
+
+absl::Status SqliteJobStore::WaitDurable(uint64_t ticket) {
+    std::unique_lock<std::mutex> lock(queue_mutex_);
+    durable_cv_.wait(lock, [&] { return durable_ >= ticket; });
+    for (const auto& [first, last, error] : failed_) {
+        if (first <= ticket && ticket <= last) return error;
+    }
+    return absl::OkStatus();
+}
+
+void SqliteJobStore::WriterLoop() {
+    std::unique_lock<std::mutex> lock(queue_mutex_);
+    while (true) {
+        queued_cv_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+        if (queue_.empty()) return;  // stopping, and everything is committed
+        std::deque<Write> batch;
+        batch.swap(queue_);
+        const uint64_t last = last_ticket_, first = last - batch.size() + 1;
+        lock.unlock();
+        const absl::Status status = Commit(batch);
+        if (!status.ok()) {
+            // Writes nobody waits for (leases) are lost here but for this line; the next write
+            // of their job carries the state again.
+            std::set<std::string> jobs;
+            for (const Write& w : batch) jobs.insert(w.job_id);
+            NamedLogger("store")->error("job={} commit of {} writes failed: {}",
+                                        absl::StrJoin(jobs, ","), batch.size(),
+                                        std::string(status.message()));
+        }
+        lock.lock();
+        if (!status.ok()) failed_.emplace_back(first, last, status);
+        durable_ = last;
+        durable_cv_.notify_all();
+    }
+}
+
+absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
+    // Only the newest record of a job in the batch is written: the earlier ones would be
+    // replaced within the same transaction anyway.
+    std::map<std::string_view, size_t> newest;
+    for (size_t i = 0; i < batch.size(); ++i) newest[batch[i].job_id] = i;
+    std::lock_guard<std::mutex> lock(db_mutex_);
     if (absl::Status s = Exec(db_, "BEGIN IMMEDIATE"); !s.ok()) return s;
-    absl::Status s = body();
-    if (s.ok()) s = Exec(db_, "COMMIT");
-    if (!s.ok()) Exec(db_, "ROLLBACK").IgnoreError();
-    return s;
-}
-
-absl::Status SqliteJobStore::PutLocked(const JobRecord& job) {
-    Statement put(db_,
-                  "INSERT OR REPLACE INTO jobs (id, seq, final, record) VALUES (?1, ?2, ?3, ?4)");
-    put.Bind(1, job.id).Bind(2, int64_t(job.seq)).Bind(3, int64_t(IsFinal(job.state)));
-    put.Bind(4, RecordToJson(job)).Step();
-    if (!put.status().ok() || !IsFinal(job.state)) return put.status();
-    Statement drop(db_, "DELETE FROM task_results WHERE job = ?1");
-    drop.Bind(1, job.id).Step();
-    return drop.status();
-}
-
-absl::Status SqliteJobStore::Put(const JobRecord& job) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return Transaction([&] { return PutLocked(job); });
-}
-
-absl::Status SqliteJobStore::PutTaskDone(const JobRecord& job, int task, std::string_view result) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return Transaction([&] {
-        Statement put(db_,
-                      "INSERT OR REPLACE INTO task_results (job, task, sums) VALUES (?1, ?2, ?3)");
-        put.Bind(1, job.id).Bind(2, int64_t(task)).BindBlob(3, result).Step();
-        if (!put.status().ok()) return put.status();
-        return PutLocked(job);
-    });
+    absl::Status status;
+    for (size_t i = 0; i < batch.size() && status.ok(); ++i) {
+        const Write& w = batch[i];
+        if (w.task >= 0) {
+            Statement put(
+                db_, "INSERT OR REPLACE INTO task_results (job, task, sums) VALUES (?1, ?2, ?3)");
+            put.Bind(1, w.job_id).Bind(2, int64_t(w.task)).BindBlob(3, w.result).Step();
+            status = put.status();
+        }
+        if (!status.ok() || newest[w.job_id] != i) continue;
+        Statement put(
+            db_, "INSERT OR REPLACE INTO jobs (id, seq, final, record) VALUES (?1, ?2, ?3, ?4)");
+        put.Bind(1, w.job_id).Bind(2, int64_t(w.seq)).Bind(3, int64_t(w.final));
+        put.Bind(4, w.record).Step();
+        status = put.status();
+        if (status.ok() && w.final) {
+            Statement drop(db_, "DELETE FROM task_results WHERE job = ?1");
+            drop.Bind(1, w.job_id).Step();
+            status = drop.status();
+        }
+    }
+    if (status.ok()) status = Exec(db_, "COMMIT");
+    if (!status.ok()) Exec(db_, "ROLLBACK").IgnoreError();
+    return status;
 }
 
 absl::StatusOr<JobRecord> SqliteJobStore::Get(const std::string& id) const {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(db_mutex_);
     Statement get(db_, "SELECT record FROM jobs WHERE id = ?1");
     if (get.Bind(1, id).Step()) return RecordFromJson(get.Column(0));
     if (!get.status().ok()) return get.status();
@@ -240,7 +313,7 @@ absl::StatusOr<JobRecord> SqliteJobStore::Get(const std::string& id) const {
 }
 
 std::vector<JobRecord> SqliteJobStore::List() const {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(db_mutex_);
     std::vector<JobRecord> jobs;
     Statement list(db_, "SELECT record FROM jobs ORDER BY seq DESC");
     while (list.Step()) {
@@ -252,9 +325,16 @@ std::vector<JobRecord> SqliteJobStore::List() const {
     return jobs;
 }
 
+std::optional<std::string> SqliteJobStore::FindRequest(const std::string& request_id) const {
+    std::lock_guard<std::mutex> lock(db_mutex_);
+    Statement find(db_, "SELECT id FROM jobs WHERE json_extract(record, '$.spec.request_id') = ?1");
+    if (find.Bind(1, request_id).Step()) return std::string(find.Column(0));
+    return std::nullopt;
+}
+
 absl::StatusOr<std::map<int, std::string>> SqliteJobStore::TaskResults(
     const std::string& id) const {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(db_mutex_);
     std::map<int, std::string> results;
     Statement get(db_, "SELECT task, sums FROM task_results WHERE job = ?1");
     get.Bind(1, id);

@@ -1,11 +1,17 @@
 // Jobs and the results of their finished tasks in SQLite, so that a server killed at any point
-// and started again on the same data folder loses nothing it acknowledged: every write is one
-// transaction committed with WAL and synchronous=FULL before the caller answers anyone.
+// and started again on the same data folder loses nothing it acknowledged: WAL and
+// synchronous=FULL, and callers acknowledge only after WaitDurable. One writer thread commits
+// the queued writes in batches (group commit): one transaction and one sync for all the writes
+// that queued while the previous batch was being synced.
 #pragma once
 
+#include <condition_variable>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
+#include <tuple>
 
 #include "server/job_store.h"
 
@@ -14,25 +20,44 @@ struct sqlite3;
 namespace lf {
 
 class SqliteJobStore : public JobStore {
-public:
+  public:
     // Opens or creates the database at `path`.
     static absl::StatusOr<std::unique_ptr<SqliteJobStore>> Open(const std::string& path);
-    ~SqliteJobStore() override;
+    ~SqliteJobStore() override;  // commits what is queued
 
-    absl::Status Put(const JobRecord& job) override;
-    absl::Status PutTaskDone(const JobRecord& job, int task, std::string_view result) override;
+    uint64_t QueuePut(const JobRecord& job) override;
+    uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) override;
+    absl::Status WaitDurable(uint64_t ticket) override;
     absl::StatusOr<JobRecord> Get(const std::string& id) const override;
     std::vector<JobRecord> List() const override;
+    std::optional<std::string> FindRequest(const std::string& request_id) const override;
     absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const override;
 
-private:
-    explicit SqliteJobStore(sqlite3* db) : db_(db) {}
-    // Runs `body` between BEGIN IMMEDIATE and COMMIT, rolling back when it fails.
-    absl::Status Transaction(const std::function<absl::Status()>& body);
-    absl::Status PutLocked(const JobRecord& job);
+  private:
+    struct Write {
+        std::string job_id;
+        uint64_t seq;
+        bool final;
+        std::string record;  // JSON
+        int task = -1;       // with a task result when >= 0
+        std::string result = {};
+    };
 
-    mutable std::mutex mutex_;
+    explicit SqliteJobStore(sqlite3* db);
+    uint64_t Queue(Write write);
+    void WriterLoop();
+    absl::Status Commit(const std::deque<Write>& batch);  // one transaction
+
+    mutable std::mutex db_mutex_;  // the connection: the writer's transaction or a read
     sqlite3* db_;
+
+    std::mutex queue_mutex_;
+    std::condition_variable queued_cv_, durable_cv_;
+    std::deque<Write> queue_;
+    uint64_t last_ticket_ = 0, durable_ = 0;  // tickets issued; committed (or failed) through
+    std::vector<std::tuple<uint64_t, uint64_t, absl::Status>> failed_;  // (first, last, error)
+    bool stop_ = false;
+    std::thread writer_;
 };
 
 }  // namespace lf

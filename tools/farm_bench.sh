@@ -51,7 +51,8 @@ done
 best_local=0 best_farm=0 ratios=()
 for round in $(seq "$rounds"); do
   t0="$(now)"
-  "$bin/lightfarm" render "$scene" -o "$work/local.exr" --spp "$spp" --threads 2 --tile "$tile" \
+  "$bin/lightfarm" render "$scene" -o "$work/local.exr" --method path --spp "$spp" --threads 2 \
+    --tile "$tile" \
     --no-progress >/dev/null
   t1="$(now)"
   job="$("$bin/lightfarm" submit "$scene" --server "$address" --spp "$spp" --tile "$tile" \

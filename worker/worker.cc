@@ -7,9 +7,9 @@
 #include <map>
 #include <thread>
 
+#include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
 #include "lf/kernels/tile_renderer.h"
-#include "server/logging.h"
 
 namespace lf {
 

@@ -1,17 +1,16 @@
 #include "lf/core/image_io.h"
 
-#include <png.h>
-
 #include <ImfAttribute.h>
 #include <ImfChannelList.h>
+#include <ImfDoubleAttribute.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
 #include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
-#include <ImfDoubleAttribute.h>
-#include <ImfIntAttribute.h>
+#include <png.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,7 +22,8 @@ namespace lf {
 
 // OpenEXR reports errors by exception; this adapter turns them into status values.
 
-absl::Status WriteExr(const std::string& path, const Image& image, const ExrAttributes& attributes) {
+absl::Status WriteExr(const std::string& path, const Image& image,
+                      const ExrAttributes& attributes) {
     try {
         Imf::Header header(image.width(), image.height());
         header.compression() = Imf::ZIP_COMPRESSION;
@@ -58,10 +58,13 @@ absl::StatusOr<ExrFile> ReadExr(const std::string& path) {
         const int width = dw.max.x - dw.min.x + 1, height = dw.max.y - dw.min.y + 1;
         ExrFile out{Image(width, height), {}};
         Imf::FrameBuffer frame;
-        for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+        for (auto it = file.header().channels().begin(); it != file.header().channels().end();
+             ++it) {
             std::vector<float>& data = out.image.Channel(it.name());
-            char* base = (char*)(data.data()) - (size_t(dw.min.x) + size_t(dw.min.y) * width) * sizeof(float);
-            frame.insert(it.name(), Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(width)));
+            char* base = (char*)(data.data()) -
+                         (size_t(dw.min.x) + size_t(dw.min.y) * width) * sizeof(float);
+            frame.insert(it.name(), Imf::Slice(Imf::FLOAT, base, sizeof(float),
+                                               sizeof(float) * size_t(width)));
         }
         file.setFrameBuffer(frame);
         file.readPixels(dw.min.y, dw.max.y);

@@ -54,7 +54,7 @@ struct VertexKey {
 };
 
 class SideRule {
-public:
+  public:
     explicit SideRule(const Scene& scene) : scene_(scene) {
         const auto [lo, hi] = scene.Bounds();
         epsilon_ = std::max(1e-6 * Length(hi - lo), std::numeric_limits<double>::min());
@@ -86,7 +86,7 @@ public:
         return false;
     }
 
-private:
+  private:
     const Scene& scene_;
     double epsilon_ = 0;
     std::vector<std::pair<Vec3d, Vec3d>> mesh_bounds_;

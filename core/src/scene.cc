@@ -6,10 +6,14 @@ namespace lf {
 
 const char* MaterialTypeName(Material::Type type) {
     switch (type) {
-        case Material::Type::kLambert: return "lambert";
-        case Material::Type::kMirror: return "mirror";
-        case Material::Type::kGlossy: return "glossy";
-        case Material::Type::kDielectric: return "dielectric";
+        case Material::Type::kLambert:
+            return "lambert";
+        case Material::Type::kMirror:
+            return "mirror";
+        case Material::Type::kGlossy:
+            return "glossy";
+        case Material::Type::kDielectric:
+            return "dielectric";
     }
     return "unknown";
 }

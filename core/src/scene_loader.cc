@@ -21,6 +21,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/file_util.h"
+#include "lf/core/log.h"
 #include "lf/core/mesh_io.h"
 
 namespace lf {
@@ -48,17 +49,6 @@ constexpr float kMaxRadiance = 1e10f;
 struct LoadError {
     absl::Status status;
 };
-
-std::shared_ptr<spdlog::logger> SceneLogger() {
-    static std::mutex mutex;
-    std::lock_guard lock(mutex);
-    std::shared_ptr<spdlog::logger> logger = spdlog::get("scene");
-    if (!logger) {
-        logger = spdlog::default_logger()->clone("scene");
-        spdlog::register_logger(logger);
-    }
-    return logger;
-}
 
 // FNV-1a, 128-bit (Fowler, Noll, Vo): not cryptographic, but content_hash only has to tell
 // changed inputs apart, and this needs no library.
@@ -602,7 +592,7 @@ absl::StatusOr<Scene> ParseScene(const std::string& json_text, const std::string
         scene = absl::Status(e.status.code(), absl::StrCat(source, ": ", e.status.message()));
     }
     // Also on failure: an unknown key is often the misspelling behind a missing one.
-    const std::shared_ptr<spdlog::logger> logger = SceneLogger();
+    const std::shared_ptr<spdlog::logger> logger = NamedLogger("scene");
     for (const std::string& warning : parser.warnings()) logger->warn("{}: {}", source, warning);
     if (scene.ok() && scene->dropped_degenerate > 0) {
         logger->warn("{}: dropped {} degenerate triangles (zero area or repeated vertices)", source,

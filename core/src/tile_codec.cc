@@ -24,7 +24,7 @@ void PutU32(std::string& out, uint32_t v) {
 }
 
 class Reader {
-public:
+  public:
     explicit Reader(std::string_view bytes) : p_(bytes.data()) {}
     uint64_t U64() { return uint64_t(U32()) | (uint64_t(U32()) << 32); }
     uint32_t U32() {
@@ -35,7 +35,7 @@ public:
     }
     int32_t I32() { return int32_t(U32()); }
 
-private:
+  private:
     const char* p_;
 };
 

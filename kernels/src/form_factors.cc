@@ -9,7 +9,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "radiosity_log.h"
+#include "lf/core/log.h"
 
 namespace lf {
 
@@ -225,7 +225,7 @@ struct PairFormFactors {
 };
 
 class PairEvaluator {
-public:
+  public:
     PairEvaluator(const EmbreeScene& scene, const PatchMesh& mesh)
         : scene_(scene), mesh_(mesh), sides_(SideGeometries(scene, mesh)) {
         const auto [lo, hi] = scene.scene().Bounds();
@@ -265,7 +265,7 @@ public:
         return f;
     }
 
-private:
+  private:
     const EmbreeScene& scene_;
     const PatchMesh& mesh_;
     std::vector<SideGeometry> sides_;
@@ -347,7 +347,7 @@ FormFactorBlock ShrinkBlock(int32_t row_group, int32_t col_group, const PatchGro
 
 // Logs at most every few seconds, from whichever worker passes the deadline first.
 class ProgressLog {
-public:
+  public:
     explicit ProgressLog(int64_t total) : total_(total), start_(Clock::now()) {}
 
     void Add(int64_t work) {
@@ -355,11 +355,12 @@ public:
         const int64_t now = Elapsed();
         int64_t next = next_log_ms_.load();
         if (now < next || !next_log_ms_.compare_exchange_strong(next, now + kIntervalMs)) return;
-        RadiosityLog()->info("form factors: {:.0f}% after {:.0f} s", 100.0 * double(done) / total_,
-                             now / 1000.0);
+        NamedLogger("radiosity")
+            ->info("form factors: {:.0f}% after {:.0f} s", 100.0 * double(done) / total_,
+                   now / 1000.0);
     }
 
-private:
+  private:
     using Clock = std::chrono::steady_clock;
     static constexpr int64_t kIntervalMs = 5000;
     int64_t Elapsed() const {

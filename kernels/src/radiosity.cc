@@ -6,9 +6,9 @@
 #include <numbers>
 
 #include "absl/strings/str_format.h"
+#include "lf/core/log.h"
 #include "lf/kernels/form_factors.h"
 #include "lf/kernels/radiosity_solution.h"
-#include "radiosity_log.h"
 
 namespace lf {
 
@@ -79,8 +79,9 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
     report.patches = int64_t(mesh->patches().size());
     report.sides = int64_t(mesh->sides().size());
     report.patch_size = mesh->patch_size();
-    RadiosityLog()->info("{} patches of size {:.3g}, {} unknowns", report.patches,
-                         report.patch_size, report.sides);
+    NamedLogger("radiosity")
+        ->info("{} patches of size {:.3g}, {} unknowns", report.patches, report.patch_size,
+               report.sides);
 
     std::vector<Rgb> radiosity;
     if (!options.load_solution.empty()) {
@@ -93,7 +94,7 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         report.iterations = loaded.iterations;
         report.residual = loaded.residual;
         radiosity = std::move(loaded.radiosity);
-        RadiosityLog()->info("loaded the solution from {}", options.load_solution);
+        NamedLogger("radiosity")->info("loaded the solution from {}", options.load_solution);
     } else {
         start = std::chrono::steady_clock::now();
         const FormFactors form_factors = ComputeFormFactors(scene, *mesh);
@@ -101,9 +102,10 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         report.form_factor_bytes = form_factors.bytes();
         report.nonzero_form_factors = form_factors.nonzeros();
         report.visibility_rays = form_factors.rays();
-        RadiosityLog()->info("form factors in {:.2f} s: {} non-zero, {:.1f} MiB, {} rays",
-                             report.form_factor_seconds, report.nonzero_form_factors,
-                             double(report.form_factor_bytes) / (1 << 20), report.visibility_rays);
+        NamedLogger("radiosity")
+            ->info("form factors in {:.2f} s: {} non-zero, {:.1f} MiB, {} rays",
+                   report.form_factor_seconds, report.nonzero_form_factors,
+                   double(report.form_factor_bytes) / (1 << 20), report.visibility_rays);
 
         start = std::chrono::steady_clock::now();
         const RadiositySystem system = MakeSystem(scene, *mesh, form_factors);
@@ -115,11 +117,12 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         report.sweeps = solved->sweeps;
         report.residual = solved->residual;
         radiosity = std::move(solved->radiosity);
-        RadiosityLog()->info(
-            "{}: {} iterations ({:.1f} sweeps), relative residual {:.2g}, "
-            "{:.2f} s",
-            RadiositySolverName(options.solver), report.iterations, report.sweeps, report.residual,
-            report.solve_seconds);
+        NamedLogger("radiosity")
+            ->info(
+                "{}: {} iterations ({:.1f} sweeps), relative residual {:.2g}, "
+                "{:.2f} s",
+                RadiositySolverName(options.solver), report.iterations, report.sweeps,
+                report.residual, report.solve_seconds);
     }
 
     if (!options.save_solution.empty()) {

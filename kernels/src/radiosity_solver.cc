@@ -8,7 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "radiosity_log.h"
+#include "lf/core/log.h"
 
 namespace lf {
 
@@ -62,15 +62,15 @@ absl::Status NotConverged(int sweeps, double residual, double tolerance) {
 
 // At most one progress line every few seconds, none for quick solves.
 class SolveLog {
-public:
+  public:
     void Maybe(const char* what, int count, double residual) {
         const auto now = std::chrono::steady_clock::now();
         if (now < next_) return;
         next_ = now + std::chrono::seconds(5);
-        RadiosityLog()->info("{} {}: relative residual {:.3g}", what, count, residual);
+        NamedLogger("radiosity")->info("{} {}: relative residual {:.3g}", what, count, residual);
     }
 
-private:
+  private:
     std::chrono::steady_clock::time_point next_ =
         std::chrono::steady_clock::now() + std::chrono::seconds(5);
 };

@@ -21,12 +21,12 @@ inline void AddInwardBox(Scene& scene, const Vec3d& center, double half, int mat
         scene.meshes.push_back(m);
     };
     // The corners below run outward-facing; listing them reversed makes the normals point in.
-    quad({-h, -h, -h}, {h, -h, -h}, {h, -h, h}, {-h, -h, h});   // floor, normal +y
-    quad({-h, h, -h}, {-h, h, h}, {h, h, h}, {h, h, -h});       // ceiling, normal -y
-    quad({-h, -h, -h}, {-h, -h, h}, {-h, h, h}, {-h, h, -h});   // x = -h, normal +x
-    quad({h, -h, -h}, {h, h, -h}, {h, h, h}, {h, -h, h});       // x = +h, normal -x
-    quad({-h, -h, -h}, {-h, h, -h}, {h, h, -h}, {h, -h, -h});   // z = -h, normal +z
-    quad({-h, -h, h}, {h, -h, h}, {h, h, h}, {-h, h, h});       // z = +h, normal -z
+    quad({-h, -h, -h}, {h, -h, -h}, {h, -h, h}, {-h, -h, h});  // floor, normal +y
+    quad({-h, h, -h}, {-h, h, h}, {h, h, h}, {h, h, -h});      // ceiling, normal -y
+    quad({-h, -h, -h}, {-h, -h, h}, {-h, h, h}, {-h, h, -h});  // x = -h, normal +x
+    quad({h, -h, -h}, {h, h, -h}, {h, h, h}, {h, -h, h});      // x = +h, normal -x
+    quad({-h, -h, -h}, {-h, h, -h}, {h, h, -h}, {h, -h, -h});  // z = -h, normal +z
+    quad({-h, -h, h}, {h, -h, h}, {h, h, h}, {-h, h, h});      // z = +h, normal -z
 }
 
 // A furnace: a closed box of emission le and lambert reflectance rho, camera inside.

@@ -11,7 +11,7 @@ namespace lf {
 namespace {
 
 class SchedulerTest : public ::testing::Test {
-protected:
+  protected:
     SchedulerTest() : scheduler_(Options(), store_, [this] { return now_; }) {}
 
     static SchedulerOptions Options() {
@@ -177,6 +177,75 @@ TEST_F(SchedulerTest, WrongResultIsRefused) {
               absl::StatusCode::kInvalidArgument);
     EXPECT_EQ(scheduler_.Complete("job-nope/0/1", "w", wrong).status().code(),
               absl::StatusCode::kFailedPrecondition);
+}
+
+TEST_F(SchedulerTest, ResultForALeaseTheWorkerDoesNotHoldIsRefused) {
+    const std::string id = Submit(0);
+    const Lease lease = *scheduler_.LeaseTask("a");
+    EXPECT_EQ(scheduler_.Complete(lease.id, "b", Result(lease)).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    EXPECT_FALSE(scheduler_.Heartbeat(lease.id, "b"));
+    ASSERT_TRUE(scheduler_.Fail(lease.id, "b", "?", FailureKind::kTaskError).ok());
+    std::string forged = lease.id;
+    forged.back() = '7';  // an attempt never handed out
+    EXPECT_EQ(scheduler_.Complete(forged, "a", Result(lease)).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(Job(id).tasks_done, 0);
+    EXPECT_EQ(Job(id).retries, 0);
+    EXPECT_TRUE(scheduler_.Heartbeat(lease.id, "a"));
+    EXPECT_TRUE(scheduler_.Complete(lease.id, "a", Result(lease)).ok());
+    EXPECT_EQ(Job(id).tasks_done, 1);
+}
+
+TEST_F(SchedulerTest, WrongResultQueuesTheTaskAgainAtOnce) {
+    const std::string id = Submit(0);
+    scheduler_.LeaseTask("b");  // b is alive
+    const Lease lease = *scheduler_.LeaseTask("a");
+    TileSums wrong(lease.task.rect);  // the right rectangle without its samples
+    EXPECT_EQ(scheduler_.Complete(lease.id, "a", wrong).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(Job(id).retries, 1);
+    EXPECT_EQ(Job(id).tasks_done, 0);
+    EXPECT_FALSE(scheduler_.Heartbeat(lease.id, "a"));
+    EXPECT_EQ(scheduler_.LeaseTask("b")->task.index, lease.task.index);
+}
+
+TEST_F(SchedulerTest, StragglersTaskIsLeasedAgainNearTheEndAndTheFirstResultWins) {
+    const std::string id = Submit(0, 16);  // two tasks
+    const Lease slow = *scheduler_.LeaseTask("slow");
+    const Lease fast = *scheduler_.LeaseTask("fast");
+    now_ += absl::Milliseconds(500);
+    ASSERT_TRUE(scheduler_.Complete(fast.id, "fast", Result(fast)).ok());
+    EXPECT_FALSE(scheduler_.LeaseTask("fast"));  // not slow yet
+    now_ += absl::Seconds(1);
+    EXPECT_FALSE(scheduler_.LeaseTask("slow")) << "its own task is not leased to it again";
+    const std::optional<Lease> copy = scheduler_.LeaseTask("fast");
+    ASSERT_TRUE(copy);
+    EXPECT_EQ(copy->task.index, slow.task.index);
+    EXPECT_FALSE(scheduler_.LeaseTask("idle")) << "one speculative copy at a time";
+    EXPECT_EQ(Job(id).tasks_running, 1);
+    absl::StatusOr<Scheduler::Completion> done =
+        scheduler_.Complete(copy->id, "fast", Result(*copy));
+    ASSERT_TRUE(done.ok()) << done.status();
+    EXPECT_TRUE(done->job_rendered);
+    EXPECT_FALSE(scheduler_.Heartbeat(slow.id, "slow"));  // told to stop
+    EXPECT_EQ(Job(id).tasks_leased, 3);
+    EXPECT_EQ(Job(id).tasks_running, 0);
+}
+
+TEST_F(SchedulerTest, FailedSpeculativeCopyLeavesTheOriginalRunning) {
+    const std::string id = Submit(0, 16);
+    const Lease slow = *scheduler_.LeaseTask("slow");
+    const Lease fast = *scheduler_.LeaseTask("fast");
+    ASSERT_TRUE(scheduler_.Complete(fast.id, "fast", Result(fast)).ok());
+    now_ += absl::Seconds(2);
+    const Lease copy = *scheduler_.LeaseTask("fast");
+    ASSERT_TRUE(scheduler_.Fail(copy.id, "fast", "oops", FailureKind::kTaskError).ok());
+    EXPECT_TRUE(scheduler_.Heartbeat(slow.id, "slow"));
+    EXPECT_EQ(Job(id).tasks_running, 1);
+    EXPECT_FALSE(scheduler_.LeaseTask("fast")) << "it failed there";
+    ASSERT_TRUE(scheduler_.Complete(slow.id, "slow", Result(slow)).ok());
+    EXPECT_EQ(Job(id).tasks_done, 2);
 }
 
 TEST_F(SchedulerTest, CancelStopsLeasesAndIsFinal) {

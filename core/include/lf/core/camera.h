@@ -7,7 +7,7 @@
 namespace lf {
 
 class Camera {
-public:
+  public:
     // `origin` is subtracted from world positions: kernels render in a frame centred on the
     // scene so float precision is spent where the geometry is (see EmbreeScene).
     Camera(const CameraSpec& spec, const Vec3d& origin);
@@ -18,7 +18,7 @@ public:
     int width() const { return width_; }
     int height() const { return height_; }
 
-private:
+  private:
     Vec3 position_, forward_, right_, up_;
     float tan_half_fov_ = 0, aspect_ = 1;
     int width_ = 0, height_ = 0;

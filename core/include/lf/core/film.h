@@ -1,5 +1,6 @@
-// Sample accumulation. Sums are exact fixed point (quantum 2^-50) in 128-bit integers, so adding tiles, passes or threads in any order gives the same bits, and 10^6
-// samples in one pixel lose nothing to rounding.
+// Sample accumulation. Sums are exact fixed point (quantum 2^-50) in 128-bit integers, so adding
+// tiles, passes or threads in any order gives the same bits, and 10^6 samples in one pixel lose
+// nothing to rounding.
 #pragma once
 
 #include <cstdint>
@@ -10,7 +11,7 @@
 namespace lf {
 
 class ExactSum {
-public:
+  public:
     void Add(float x);
     ExactSum& operator+=(const ExactSum& o) {
         fixed_ += o.fixed_;
@@ -27,7 +28,7 @@ public:
     }
     __int128 fixed() const { return fixed_; }
 
-private:
+  private:
     __int128 fixed_ = 0;
 };
 
@@ -52,7 +53,7 @@ struct PixelRect {
 
 struct RenderStats {
     uint64_t samples = 0;
-    uint64_t rays = 0;           // every ray cast, camera and shadow rays included
+    uint64_t rays = 0;             // every ray cast, camera and shadow rays included
     uint64_t invalid_samples = 0;  // NaN or infinite samples, never written
     // Paths cut at the path tracer's hard depth cap (reflectance 1 keeps roulette from ending
     // them). Local mode only: the farm's tile encoding does not carry it.

@@ -10,7 +10,7 @@
 namespace lf {
 
 class Image {
-public:
+  public:
     Image() = default;
     Image(int width, int height) : width_(width), height_(height) {}
 
@@ -28,7 +28,7 @@ public:
 
     Rgb Pixel(int x, int y, const std::string& prefix = "") const;
 
-private:
+  private:
     int width_ = 0, height_ = 0;
     std::map<std::string, std::vector<float>> channels_;
 };

@@ -40,7 +40,7 @@ struct PatchPoint {
 };
 
 class PatchMesh {
-public:
+  public:
     struct Patch {
         int32_t mesh = 0;
         int32_t primitive = 0;                 // scene triangle
@@ -78,7 +78,7 @@ public:
     // Barycentrics (b1, b2) in the scene triangle of the patch point with weights w.
     std::array<double, 2> TriangleBarycentrics(int64_t patch, const std::array<double, 3>& w) const;
 
-private:
+  private:
     struct Triangle {
         int32_t k = 1;
         int64_t first_patch = 0;

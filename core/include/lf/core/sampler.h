@@ -19,7 +19,7 @@ constexpr uint64_t MixBits(uint64_t v) {
 }
 
 class Sampler {
-public:
+  public:
     Sampler(uint64_t seed, int px, int py, uint64_t sample_index)
         : key_(MixBits(MixBits(seed ^ 0x9e3779b97f4a7c15ULL) ^
                        ((uint64_t(uint32_t(px)) << 32) | uint32_t(py))) ^
@@ -32,7 +32,7 @@ public:
         return {float(bits >> 40) * 0x1p-24f, float((bits >> 8) & 0xffffff) * 0x1p-24f};
     }
 
-private:
+  private:
     uint64_t Next() { return MixBits(key_ + (++dimension_) * 0x9e3779b97f4a7c15ULL); }
 
     uint64_t key_;

@@ -23,8 +23,8 @@ struct Material {
     float roughness = 0.1f;  // microfacet alpha
     bool conductor = false;  // glossy with complex IOR eta + i k instead of reflectance
     Rgb eta{1.0f}, k{0.0f};
-    float ior = 1.5f;        // dielectric: interior IOR over exterior IOR
-    Rgb emission{0.0f};      // radiance leaving the front face, W m^-2 sr^-1
+    float ior = 1.5f;    // dielectric: interior IOR over exterior IOR
+    Rgb emission{0.0f};  // radiance leaving the front face, W m^-2 sr^-1
 
     bool IsEmissive() const { return !emission.IsBlack(); }
 };

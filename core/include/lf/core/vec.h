@@ -31,13 +31,19 @@ struct Vec3T {
 };
 
 template <typename T>
-constexpr Vec3T<T> operator*(T s, const Vec3T<T>& v) { return v * s; }
+constexpr Vec3T<T> operator*(T s, const Vec3T<T>& v) {
+    return v * s;
+}
 
 template <typename T>
-constexpr T Dot(const Vec3T<T>& a, const Vec3T<T>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr T Dot(const Vec3T<T>& a, const Vec3T<T>& b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 
 template <typename T>
-constexpr T AbsDot(const Vec3T<T>& a, const Vec3T<T>& b) { return std::abs(Dot(a, b)); }
+constexpr T AbsDot(const Vec3T<T>& a, const Vec3T<T>& b) {
+    return std::abs(Dot(a, b));
+}
 
 template <typename T>
 constexpr Vec3T<T> Cross(const Vec3T<T>& a, const Vec3T<T>& b) {
@@ -45,16 +51,24 @@ constexpr Vec3T<T> Cross(const Vec3T<T>& a, const Vec3T<T>& b) {
 }
 
 template <typename T>
-T LengthSquared(const Vec3T<T>& v) { return Dot(v, v); }
+T LengthSquared(const Vec3T<T>& v) {
+    return Dot(v, v);
+}
 
 template <typename T>
-T Length(const Vec3T<T>& v) { return std::sqrt(Dot(v, v)); }
+T Length(const Vec3T<T>& v) {
+    return std::sqrt(Dot(v, v));
+}
 
 template <typename T>
-Vec3T<T> Normalize(const Vec3T<T>& v) { return v / Length(v); }
+Vec3T<T> Normalize(const Vec3T<T>& v) {
+    return v / Length(v);
+}
 
 template <typename T>
-Vec3T<T> Abs(const Vec3T<T>& v) { return {std::abs(v.x), std::abs(v.y), std::abs(v.z)}; }
+Vec3T<T> Abs(const Vec3T<T>& v) {
+    return {std::abs(v.x), std::abs(v.y), std::abs(v.z)};
+}
 
 template <typename T>
 Vec3T<T> Min(const Vec3T<T>& a, const Vec3T<T>& b) {
@@ -67,14 +81,20 @@ Vec3T<T> Max(const Vec3T<T>& a, const Vec3T<T>& b) {
 }
 
 template <typename T>
-T MaxComponent(const Vec3T<T>& v) { return std::max(v.x, std::max(v.y, v.z)); }
+T MaxComponent(const Vec3T<T>& v) {
+    return std::max(v.x, std::max(v.y, v.z));
+}
 
 template <typename T>
-bool IsFinite(const Vec3T<T>& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool IsFinite(const Vec3T<T>& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 // The normal flipped, if needed, into the hemisphere of v.
 template <typename T>
-Vec3T<T> FaceForward(const Vec3T<T>& n, const Vec3T<T>& v) { return Dot(n, v) < 0 ? -n : n; }
+Vec3T<T> FaceForward(const Vec3T<T>& n, const Vec3T<T>& v) {
+    return Dot(n, v) < 0 ? -n : n;
+}
 
 using Vec3 = Vec3T<float>;
 using Vec3d = Vec3T<double>;
@@ -92,7 +112,8 @@ struct Frame {
         const float sign = std::copysign(1.0f, n.z);
         const float a = -1.0f / (sign + n.z);
         const float b = n.x * n.y * a;
-        return {Vec3(1 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3(b, sign + n.y * n.y * a, -n.y), n};
+        return {Vec3(1 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+                Vec3(b, sign + n.y * n.y * a, -n.y), n};
     }
     Vec3 ToLocal(const Vec3& v) const { return {Dot(v, s), Dot(v, t), Dot(v, n)}; }
     Vec3 FromLocal(const Vec3& v) const { return s * v.x + t * v.y + n * v.z; }

@@ -14,15 +14,15 @@
 namespace lf {
 
 struct BsdfSample {
-    Rgb f;          // BSDF value for (wo, wi); for delta lobes the value that, times |cos|/pdf,
-                    // gives the throughput weight
+    Rgb f;  // BSDF value for (wo, wi); for delta lobes the value that, times |cos|/pdf,
+            // gives the throughput weight
     Vec3 wi;
     float pdf = 0;  // solid angle density; for delta lobes the discrete probability of the lobe
     bool delta = false;
 };
 
 class Bsdf {
-public:
+  public:
     explicit Bsdf(const Material& material);
 
     Rgb Eval(const Vec3& wo, const Vec3& wi) const;
@@ -33,7 +33,7 @@ public:
     // True when every lobe is a Dirac delta: light sampling is useless there.
     bool IsDelta() const;
 
-private:
+  private:
     // The glossy lobe for wo and wi both in the upper hemisphere.
     Rgb GlossyEval(const Vec3& wo, const Vec3& wi) const;
     float GlossyPdf(const Vec3& wo, const Vec3& wi) const;

@@ -21,9 +21,9 @@ struct SurfaceHit {
     Vec3 p_error;  // absolute error bound of p per axis
     Vec3 n;        // unit geometric normal of the front face
     int material = 0;
-    int mesh = -1;      // index in Scene::meshes, or -1 for a sphere
-    int sphere = -1;    // index in Scene::spheres, or -1 for a triangle
-    int primitive = 0;  // triangle index within the mesh
+    int mesh = -1;         // index in Scene::meshes, or -1 for a sphere
+    int sphere = -1;       // index in Scene::spheres, or -1 for a triangle
+    int primitive = 0;     // triangle index within the mesh
     float b1 = 0, b2 = 0;  // barycentrics of vertices 1 and 2 of the triangle
 };
 
@@ -39,7 +39,7 @@ Ray SpawnRay(const SurfacePoint& from, const Vec3& direction);
 Ray SpawnRayTo(const SurfacePoint& from, const SurfacePoint& to);
 
 class EmbreeScene {
-public:
+  public:
     static absl::StatusOr<std::unique_ptr<EmbreeScene>> Build(const Scene& scene);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
@@ -59,7 +59,7 @@ public:
     SurfacePoint TrianglePoint(int mesh, int primitive, float b1, float b2) const;
     SurfacePoint SpherePoint(int sphere, const Vec3& direction_from_center) const;
 
-private:
+  private:
     EmbreeScene(const Scene& scene, const Vec3d& origin);
 
     const Scene& scene_;

@@ -46,7 +46,7 @@ struct FormFactorBlock {
 };
 
 class FormFactors {
-public:
+  public:
     FormFactors() = default;
     FormFactors(int32_t sides, std::vector<PatchGroup> groups, std::vector<FormFactorBlock> blocks,
                 int64_t rays);
@@ -68,7 +68,7 @@ public:
     size_t bytes() const { return bytes_; }  // block values and indices
     int64_t rays() const { return rays_; }   // visibility rays cast
 
-private:
+  private:
     int32_t sides_ = 0;
     std::vector<PatchGroup> groups_;
     std::vector<FormFactorBlock> blocks_;  // sorted by (row_group, col_group)

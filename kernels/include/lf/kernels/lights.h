@@ -20,7 +20,7 @@ struct LightSample {
 };
 
 class LightSampler {
-public:
+  public:
     explicit LightSampler(const EmbreeScene& scene);
 
     bool empty() const { return lights_.empty(); }
@@ -32,7 +32,7 @@ public:
     // emitter hit by a BSDF-sampled ray); used for multiple importance sampling.
     float Pdf(const Vec3& ref, const SurfaceHit& hit) const;
 
-private:
+  private:
     enum class Kind { kTriangle, kSphere, kPoint };
     struct Light {
         Kind kind;
@@ -45,10 +45,10 @@ private:
 
     const EmbreeScene& scene_;
     std::vector<Light> lights_;
-    std::vector<float> pmf_;  // pick probability per light
-    std::vector<float> cdf_;  // its running sum, cdf_.back() == 1
-    std::vector<std::vector<int>> triangle_light_;    // per mesh, per triangle: light or -1
-    std::vector<int> sphere_light_;                   // per sphere: light or -1
+    std::vector<float> pmf_;                        // pick probability per light
+    std::vector<float> cdf_;                        // its running sum, cdf_.back() == 1
+    std::vector<std::vector<int>> triangle_light_;  // per mesh, per triangle: light or -1
+    std::vector<int> sphere_light_;                 // per sphere: light or -1
 };
 
 }  // namespace lf

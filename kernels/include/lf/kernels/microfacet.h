@@ -9,7 +9,7 @@
 namespace lf {
 
 class MicrofacetDistribution {
-public:
+  public:
     // Narrower lobes are mirrors in all but name, yet float rounding of a recomputed half vector
     // (~1e-7 rad) would become a sizeable fraction of their width and D's 1/(pi alpha^2) peak
     // would keep growing without bound.
@@ -35,7 +35,7 @@ public:
     // Solid angle density of SampleWm.
     float PdfWm(const Vec3& wo, const Vec3& wm) const;
 
-private:
+  private:
     Material::Distribution type_;
     float alpha_;
 };

@@ -16,14 +16,14 @@ namespace lf {
 inline constexpr int kMaxPathDepth = 1 << 16;
 
 class PathTracer : public RadianceEstimator {
-public:
+  public:
     // max_depth: the most bounces a path may take; negative means unlimited (roulette, and
     // kMaxPathDepth).
     PathTracer(const EmbreeScene& scene, int max_depth);
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
 
-private:
+  private:
     const EmbreeScene& scene_;
     LightSampler lights_;
     int max_depth_;

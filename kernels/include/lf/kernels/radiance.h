@@ -9,7 +9,7 @@
 namespace lf {
 
 class RadianceEstimator {
-public:
+  public:
     virtual ~RadianceEstimator() = default;
     // An estimate of L along `ray`; counts the rays it casts in stats.rays.
     virtual Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const = 0;

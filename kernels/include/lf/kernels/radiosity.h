@@ -51,7 +51,7 @@ struct RadiosityReport {
 };
 
 class RadiosityRenderer : public RadianceEstimator {
-public:
+  public:
     RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh, std::vector<Rgb> radiosity,
                       RadiosityShading shading, const RadiosityReport& report);
 
@@ -63,7 +63,7 @@ public:
     const PatchMesh& mesh() const { return *mesh_; }
     std::span<const Rgb> radiosity() const { return radiosity_; }  // per side, W m^-2
 
-private:
+  private:
     std::unique_ptr<const PatchMesh> mesh_;  // stable address for the display
     std::vector<Rgb> radiosity_;
     std::unique_ptr<RadiosityDisplay> display_;

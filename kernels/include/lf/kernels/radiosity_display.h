@@ -31,7 +31,7 @@ std::vector<std::array<Rgb, 3>> SmoothCorners(const PatchMesh& mesh,
                                               std::span<const Rgb> radiosity);
 
 class RadiosityDisplay : public RadianceEstimator {
-public:
+  public:
     // `mesh` must outlive the display; `radiosity` has one value per side.
     RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& mesh, std::vector<Rgb> radiosity,
                      RadiosityShading shading);
@@ -42,7 +42,7 @@ public:
     // unknown have radiosity 0.
     Rgb Radiance(int mesh, int primitive, double b1, double b2, bool back) const;
 
-private:
+  private:
     const EmbreeScene& scene_;
     const PatchMesh& mesh_;
     std::vector<Rgb> radiosity_;

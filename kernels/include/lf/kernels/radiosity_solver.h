@@ -69,7 +69,7 @@ double RelativeResidual(const RadiositySystem& system, std::span<const Rgb> b);
 // solution; Preview() adds the ambient term (Cohen et al. 1988), the unshot power spread
 // uniformly with the mean reflectance's interreflection factor, for an early look.
 class ShootingSolver {
-public:
+  public:
     explicit ShootingSolver(const RadiositySystem& system);
 
     void Shoot();             // the group with the most unshot power
@@ -80,7 +80,7 @@ public:
     std::vector<Rgb> Radiosity() const;
     std::vector<Rgb> Preview() const;
 
-private:
+  private:
     struct Sum {
         double c[3] = {0, 0, 0};
     };

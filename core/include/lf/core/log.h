@@ -1,5 +1,5 @@
-// Named spdlog loggers for the farm's modules ("scheduler", "worker", ...): they share the
-// default logger's sinks and level, and every line names its module.
+// Named spdlog loggers for every module ("scene", "render", "radiosity", "scheduler", ...): they
+// share the default logger's sinks and level, and every line names its module.
 #pragma once
 
 #include <spdlog/spdlog.h>

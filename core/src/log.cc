@@ -1,4 +1,4 @@
-#include "server/logging.h"
+#include "lf/core/log.h"
 
 #include <mutex>
 

@@ -1,0 +1,364 @@
+// A real server in this process with fake workers and clients speaking the protocol through
+// gRPC stubs. Workers that misbehave: a result for a task the worker does not hold, an
+// undecodable or wrong-sized result, a worker that never heartbeats, and a straggler; none may
+// change a job's pixels: each job's EXR must equal that of a job rendered by honest workers
+// alone. And load: many clients submitting and watching at once. The fake workers' "render" is a
+// fixed function of (pixel, sample), so no renderer is needed.
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "lf/core/image_io.h"
+#include "lf/core/tile_codec.h"
+#include "server/digest.h"
+#include "server/grpc_service.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+namespace pb = lightfarm::v1;
+
+std::string ReadText(const fs::path& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+class FakeWorkerFarm : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               ("lf_fakefarm_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(dir_);
+        FarmOptions options;
+        options.data_dir = dir_.string();
+        options.scheduler.lease = absl::Milliseconds(500);
+        options.scheduler.speculate_after = speculate_after_;
+        absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
+        ASSERT_TRUE(farm.ok()) << farm.status();
+        farm_ = std::move(*farm);
+        jobs_ = std::make_unique<JobServiceImpl>(*farm_);
+        workers_ = std::make_unique<WorkerServiceImpl>(*farm_);
+        grpc::ServerBuilder builder;
+        int port = 0;
+        builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+        builder.RegisterService(jobs_.get());
+        builder.RegisterService(workers_.get());
+        server_ = builder.BuildAndStart();
+        ASSERT_TRUE(server_ && port > 0);
+        address_ = "127.0.0.1:" + std::to_string(port);
+        auto channel = NewChannel();
+        job_stub_ = pb::JobService::NewStub(channel);
+        worker_stub_ = pb::WorkerService::NewStub(channel);
+        checker_ = std::thread([this] {
+            while (!stop_) {
+                farm_->scheduler().ExpireLeases();
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            }
+        });
+        PutSceneBlob();
+    }
+
+    void TearDown() override {
+        stop_ = true;
+        checker_.join();
+        farm_->scheduler().Shutdown();
+        server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(1));
+        fs::remove_all(dir_);
+    }
+
+    // The Cornell box at 16x16, so 4 tasks of 8x8 pixels.
+    void PutSceneBlob() {
+        nlohmann::json scene =
+            nlohmann::json::parse(ReadText(fs::path(LF_TEST_SCENES) / "cornell_box.json"));
+        scene["camera"]["resolution"] = {16, 16};
+        scene_json_ = scene.dump();
+        scene_hash_ = Sha256Hex(scene_json_);
+        absl::StatusOr<std::unique_ptr<BlobStore::Upload>> upload =
+            farm_->blobs().StartUpload(scene_hash_, scene_json_.size());
+        ASSERT_TRUE(upload.ok()) << upload.status();
+        ASSERT_TRUE((*upload)->Append(scene_json_).ok());
+        ASSERT_TRUE((*upload)->Finish().ok());
+    }
+
+    std::string Submit(pb::JobService::Stub* stub = nullptr, int tile = 8) {
+        pb::SubmitJobRequest request;
+        request.mutable_scene()->set_path("scene.json");
+        request.mutable_scene()->set_hash(scene_hash_);
+        request.mutable_scene()->set_size(scene_json_.size());
+        request.mutable_params()->set_spp(4);
+        request.mutable_params()->set_tile(tile);
+        request.mutable_params()->set_passes(1);
+        pb::SubmitJobResponse response;
+        grpc::ClientContext context;
+        const grpc::Status s =
+            (stub ? stub : job_stub_.get())->SubmitJob(&context, request, &response);
+        EXPECT_TRUE(s.ok()) << s.error_message();
+        return response.job_id();
+    }
+
+    pb::Job GetJob(const std::string& id) {
+        pb::GetJobRequest request;
+        request.set_job_id(id);
+        pb::Job job;
+        grpc::ClientContext context;
+        EXPECT_TRUE(job_stub_->GetJob(&context, request, &job).ok());
+        return job;
+    }
+
+    std::optional<pb::Task> Lease(const std::string& worker, int wait_ms = 0) {
+        pb::LeaseTaskRequest request;
+        request.set_worker_id(worker);
+        request.set_wait_ms(wait_ms);
+        pb::LeaseTaskResponse response;
+        grpc::ClientContext context;
+        EXPECT_TRUE(worker_stub_->LeaseTask(&context, request, &response).ok());
+        if (!response.has_task()) return std::nullopt;
+        return response.task();
+    }
+
+    bool Heartbeat(const pb::Task& task, const std::string& worker) {
+        pb::HeartbeatRequest request;
+        request.set_lease_id(task.lease_id());
+        request.set_worker_id(worker);
+        pb::HeartbeatResponse response;
+        grpc::ClientContext context;
+        EXPECT_TRUE(worker_stub_->Heartbeat(&context, request, &response).ok());
+        return !response.cancelled();
+    }
+
+    // A fresh connection, as another client process would have.
+    std::shared_ptr<grpc::Channel> NewChannel() {
+        grpc::ChannelArguments args;
+        args.SetInt("lightfarm.test.channel", ++channels_);  // no sharing of connections
+        return grpc::CreateCustomChannel(address_, grpc::InsecureChannelCredentials(), args);
+    }
+
+    grpc::Status Complete(const std::string& lease_id, const std::string& worker,
+                          const std::string& bytes) {
+        pb::CompleteTaskRequest request;
+        request.set_lease_id(lease_id);
+        request.set_worker_id(worker);
+        request.set_tile_sums(bytes);
+        pb::CompleteTaskResponse response;
+        grpc::ClientContext context;
+        return worker_stub_->CompleteTask(&context, request, &response);
+    }
+
+    // What an honest worker sends for `task`: a fixed function of (pixel, sample).
+    static std::string HonestResult(const pb::Task& task) {
+        TileSums sums(PixelRect{task.x0(), task.y0(), task.width(), task.height()});
+        for (int y = 0; y < task.height(); ++y) {
+            for (int x = 0; x < task.width(); ++x) {
+                PixelSums& p = sums.pixels[size_t(y * task.width() + x)];
+                for (uint64_t s = task.sample_begin(); s < task.sample_end(); ++s) {
+                    p.Add(s, Rgb(float((task.x0() + x) * 7 + (task.y0() + y) * 3 + s) / 64.0f));
+                }
+            }
+        }
+        return EncodeTileSums(sums);
+    }
+
+    // An honest worker takes and completes tasks until the job has ended.
+    void RenderHonestly(const std::string& job_id, const std::string& worker = "honest") {
+        for (int i = 0; i < 50 && !IsEnded(job_id); ++i) {
+            if (std::optional<pb::Task> task = Lease(worker, 200)) {
+                ASSERT_TRUE(Complete(task->lease_id(), worker, HonestResult(*task)).ok());
+            }
+        }
+        ASSERT_EQ(GetJob(job_id).state(), pb::Job::SUCCEEDED) << GetJob(job_id).error();
+    }
+    bool IsEnded(const std::string& job_id) {
+        const pb::Job::State s = GetJob(job_id).state();
+        return s != pb::Job::QUEUED && s != pb::Job::RUNNING;
+    }
+
+    // The job's pixels equal those of a job rendered by an honest worker alone.
+    void ExpectSameAsHonest(const std::string& job_id) {
+        const std::string reference = Submit();
+        RenderHonestly(reference);
+        absl::StatusOr<std::string> a = farm_->ResultFile(job_id, false);
+        absl::StatusOr<std::string> b = farm_->ResultFile(reference, false);
+        ASSERT_TRUE(a.ok() && b.ok());
+        absl::StatusOr<ExrFile> x = ReadExr(*a), y = ReadExr(*b);
+        ASSERT_TRUE(x.ok() && y.ok());
+        for (const char* ch : {"R", "G", "B", "spp"}) {
+            const std::vector<float>& u = *x->image.FindChannel(ch);
+            const std::vector<float>& v = *y->image.FindChannel(ch);
+            ASSERT_EQ(u.size(), v.size());
+            EXPECT_EQ(0, std::memcmp(u.data(), v.data(), u.size() * sizeof(float))) << ch;
+        }
+    }
+
+    absl::Duration speculate_after_ = absl::Seconds(30);  // no speculation but in StragglerTest
+    fs::path dir_;
+    std::unique_ptr<Farm> farm_;
+    std::unique_ptr<JobServiceImpl> jobs_;
+    std::unique_ptr<WorkerServiceImpl> workers_;
+    std::unique_ptr<grpc::Server> server_;
+    std::unique_ptr<pb::JobService::Stub> job_stub_;
+    std::unique_ptr<pb::WorkerService::Stub> worker_stub_;
+    std::string address_;
+    std::atomic<int> channels_{0};
+    std::atomic<bool> stop_{false};
+    std::thread checker_;
+    std::string scene_json_, scene_hash_;
+};
+
+TEST_F(FakeWorkerFarm, ResultForATaskTheWorkerDoesNotHoldIsRefused) {
+    const std::string job = Submit();
+    const pb::Task task = *Lease("honest");
+    const grpc::Status stolen = Complete(task.lease_id(), "liar", HonestResult(task));
+    EXPECT_EQ(stolen.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+    const grpc::Status forged =
+        Complete(task.job_id() + "/" + std::to_string(task.task_index() + 1) + "/x-1", "liar",
+                 HonestResult(task));
+    EXPECT_EQ(forged.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+    EXPECT_EQ(GetJob(job).tasks_done(), 0);
+    EXPECT_TRUE(Heartbeat(task, "honest"));
+    ASSERT_TRUE(Complete(task.lease_id(), "honest", HonestResult(task)).ok());
+    RenderHonestly(job);
+    ExpectSameAsHonest(job);
+}
+
+TEST_F(FakeWorkerFarm, CorruptAndWrongSizedResultsAreRefusedAndTheTaskRequeued) {
+    const std::string job = Submit();
+    Lease("honest");  // seen alive, so a refused task goes to it rather than back to the liar
+    const pb::Task first = *Lease("liar");
+    std::string corrupt = HonestResult(first);
+    corrupt[corrupt.size() / 2] ^= 0x5a;
+    corrupt.resize(corrupt.size() - 3);
+    EXPECT_EQ(Complete(first.lease_id(), "liar", corrupt).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(GetJob(job).retries(), 1);
+    EXPECT_FALSE(Heartbeat(first, "liar")) << "the refused lease is over";
+
+    const pb::Task second = *Lease("liar");
+    pb::Task bigger = second;
+    bigger.set_width(second.width() + 1);
+    EXPECT_EQ(Complete(second.lease_id(), "liar", HonestResult(bigger)).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(GetJob(job).retries(), 2);
+    EXPECT_EQ(GetJob(job).tasks_done(), 0);
+    // The first honest lease above expires unheard; everything is rendered again honestly.
+    RenderHonestly(job);
+    ExpectSameAsHonest(job);
+}
+
+TEST_F(FakeWorkerFarm, SilentWorkerLosesItsLeaseAndTheTaskIsLeasedAgain) {
+    const std::string job = Submit();
+    const pb::Task silent = *Lease("silent");
+    const auto start = std::chrono::steady_clock::now();
+    std::optional<pb::Task> again;
+    while (!again && std::chrono::steady_clock::now() - start < std::chrono::seconds(5)) {
+        std::optional<pb::Task> task = Lease("honest", 200);
+        if (!task) continue;
+        if (task->task_index() == silent.task_index()) again = task;
+        ASSERT_TRUE(Complete(task->lease_id(), "honest", HonestResult(*task)).ok());
+    }
+    ASSERT_TRUE(again) << "the silent worker's task was never leased again";
+    EXPECT_FALSE(Heartbeat(silent, "silent"));
+    RenderHonestly(job);
+    EXPECT_GE(GetJob(job).retries(), 1);
+    ExpectSameAsHonest(job);
+}
+
+class StragglerTest : public FakeWorkerFarm {
+  protected:
+    StragglerTest() { speculate_after_ = absl::Milliseconds(300); }
+};
+
+TEST_F(StragglerTest, StragglersTaskIsLeasedAgainAndTheFirstResultWins) {
+    const std::string job = Submit();
+    const pb::Task slow = *Lease("slow");
+    std::optional<pb::Task> copy;
+    const auto start = std::chrono::steady_clock::now();
+    while (!copy && std::chrono::steady_clock::now() - start < std::chrono::seconds(5)) {
+        EXPECT_TRUE(Heartbeat(slow, "slow"));  // alive, just slow
+        std::optional<pb::Task> task = Lease("fast", 100);
+        if (!task) continue;
+        if (task->task_index() == slow.task_index()) {
+            copy = task;
+        } else {
+            ASSERT_TRUE(Complete(task->lease_id(), "fast", HonestResult(*task)).ok());
+        }
+    }
+    ASSERT_TRUE(copy) << "the straggler's task was never leased again";
+    ASSERT_TRUE(Complete(copy->lease_id(), "fast", HonestResult(*copy)).ok());
+    EXPECT_EQ(GetJob(job).state(), pb::Job::SUCCEEDED);
+    EXPECT_FALSE(Heartbeat(slow, "slow")) << "the straggler is told to stop";
+    // Its late result comes after the job ended, and changes nothing.
+    EXPECT_EQ(Complete(slow.lease_id(), "slow", HonestResult(slow)).error_code(),
+              grpc::StatusCode::FAILED_PRECONDITION);
+    ExpectSameAsHonest(job);
+}
+
+TEST_F(FakeWorkerFarm, TwentyClientsTwoHundredJobsAWatcherEachNothingLost) {
+    constexpr int kClients = 20, kJobsPerClient = 10, kJobs = kClients * kJobsPerClient;
+    std::mutex mutex;
+    std::vector<std::string> ids;
+    std::vector<std::thread> threads;
+    std::atomic<int> succeeded{0}, watch_errors{0};
+    auto watch = [&](std::string id) {
+        auto stub = pb::JobService::NewStub(NewChannel());
+        grpc::ClientContext context;
+        context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+        pb::WatchJobRequest request;
+        request.set_job_id(id);
+        auto reader = stub->WatchJob(&context, request);
+        pb::Job job;
+        pb::Job::State last = pb::Job::STATE_UNSPECIFIED;
+        while (reader->Read(&job)) last = job.state();
+        if (!reader->Finish().ok()) ++watch_errors;
+        if (last == pb::Job::SUCCEEDED) ++succeeded;
+    };
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::thread> clients;
+    for (int c = 0; c < kClients; ++c) {
+        clients.emplace_back([&] {
+            auto stub = pb::JobService::NewStub(NewChannel());
+            for (int j = 0; j < kJobsPerClient; ++j) {
+                const std::string id = Submit(stub.get(), /*tile=*/16);  // one task
+                std::lock_guard<std::mutex> lock(mutex);
+                ids.push_back(id);
+                threads.emplace_back(watch, id);
+            }
+        });
+    }
+    std::vector<std::thread> workers;
+    for (int w = 0; w < 2; ++w) {
+        workers.emplace_back([&, w] {
+            const std::string name = "worker-" + std::to_string(w);
+            while (succeeded < kJobs &&
+                   std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+                if (std::optional<pb::Task> task = Lease(name, 100)) {
+                    EXPECT_TRUE(Complete(task->lease_id(), name, HonestResult(*task)).ok());
+                }
+            }
+        });
+    }
+    for (std::thread& t : clients) t.join();
+    for (std::thread& t : workers) t.join();
+    for (std::thread& t : threads) t.join();
+    std::printf("%d jobs submitted by %d clients, watched and done in %.1f s\n", kJobs, kClients,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    EXPECT_EQ(succeeded, kJobs);
+    EXPECT_EQ(watch_errors, 0);
+    std::sort(ids.begin(), ids.end());
+    EXPECT_EQ(std::unique(ids.begin(), ids.end()), ids.end()) << "a job id was given twice";
+    EXPECT_EQ(int(farm_->scheduler().List().size()), kJobs);
+}
+
+}  // namespace
+}  // namespace lf

@@ -1,0 +1,257 @@
+// The SQLite job store and what the scheduler rebuilds from it after a crash: records round
+// trip, done tasks come back merged and are not leased again, leases of the dead server are
+// queued again, a job rendered but not written is handed back for its result, and a store that
+// cannot write refuses the submission instead of losing it.
+#include "server/sqlite_job_store.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "server/farm.h"
+#include "server/scheduler.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+
+class SqliteJobStoreTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               ("lf_store_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    std::unique_ptr<SqliteJobStore> OpenStore() {
+        absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
+            SqliteJobStore::Open((dir_ / "jobs.db").string());
+        EXPECT_TRUE(store.ok()) << store.status();
+        return std::move(*store);
+    }
+
+    // A 16x16 image in 8x8 tiles, 4 spp in 2 passes: 8 tasks.
+    static JobSpec Spec() {
+        JobSpec spec;
+        spec.name = "test";
+        spec.plan = {16, 16, 4, 8, 2};
+        return spec;
+    }
+
+    // A result whose pixels depend on the task, so a wrong merge shows in the image.
+    static TileSums Result(const Lease& lease) {
+        TileSums sums(lease.task.rect);
+        for (PixelSums& p : sums.pixels) {
+            for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
+                p.Add(s, Rgb(0.1f * float(lease.task.index + 1)));
+            }
+        }
+        sums.stats.samples = sums.pixels.size() * (lease.task.sample_end - lease.task.sample_begin);
+        return sums;
+    }
+
+    static void CompleteAll(Scheduler& scheduler, const std::string& worker) {
+        while (std::optional<Lease> lease = scheduler.LeaseTask(worker)) {
+            ASSERT_TRUE(scheduler.Complete(lease->id, worker, Result(*lease)).ok());
+        }
+    }
+
+    static std::vector<float> Pixels(const Scheduler& scheduler, const std::string& id) {
+        absl::StatusOr<std::pair<JobRecord, Image>> snapshot = scheduler.Snapshot(id);
+        EXPECT_TRUE(snapshot.ok()) << snapshot.status();
+        return *snapshot->second.FindChannel("R");
+    }
+
+    fs::path dir_;
+};
+
+TEST_F(SqliteJobStoreTest, RecordsRoundTripThroughAReopen) {
+    JobRecord job;
+    job.id = "job-1";
+    job.seq = 7;
+    job.spec = Spec();
+    job.spec.scene = {"scene.json", "ab", 12};
+    job.spec.files = {{"mesh.obj", "cd", 34}};
+    job.spec.seed = 5;
+    job.spec.max_depth = 3;
+    job.spec.priority = -2;
+    job.spec.scene_hash = "hash";
+    job.state = JobState::kFailed;
+    job.error = "why";
+    job.submitted = absl::FromUnixMicros(1'000'001);
+    job.started = absl::FromUnixMicros(1'000'002);
+    job.tasks_total = 8;
+    job.tasks_done = 3;
+    job.retries = 2;
+    job.tasks_leased = 6;
+    job.stats = {10, 20, 1};
+    job.result_path = "/r.exr";
+    ASSERT_TRUE(OpenStore()->Put(job).ok());
+
+    const absl::StatusOr<JobRecord> back = OpenStore()->Get("job-1");
+    ASSERT_TRUE(back.ok()) << back.status();
+    EXPECT_EQ(back->seq, 7u);
+    EXPECT_EQ(back->spec.scene.hash, "ab");
+    ASSERT_EQ(back->spec.files.size(), 1u);
+    EXPECT_EQ(back->spec.files[0].path, "mesh.obj");
+    EXPECT_EQ(back->spec.plan.passes, 2);
+    EXPECT_EQ(back->spec.priority, -2);
+    EXPECT_EQ(back->state, JobState::kFailed);
+    EXPECT_EQ(back->error, "why");
+    EXPECT_EQ(back->started, job.started);
+    EXPECT_EQ(back->finished, absl::InfinitePast());
+    EXPECT_EQ(back->tasks_leased, 6);
+    EXPECT_EQ(back->stats.rays, 20u);
+    EXPECT_EQ(back->result_path, "/r.exr");
+    EXPECT_EQ(OpenStore()->Get("job-2").status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST_F(SqliteJobStoreTest, RestartKeepsDoneTasksAndQueuesTheRest) {
+    // The same job without a crash, for the expected pixels.
+    InMemoryJobStore memory;
+    Scheduler reference({}, memory);
+    const std::string ref_id = *reference.Submit(Spec());
+    CompleteAll(reference, "w");
+    const std::vector<float> expected = Pixels(reference, ref_id);
+
+    std::string id, other;
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        Scheduler before({}, *store);
+        id = *before.Submit(Spec());
+        other = *before.Submit(Spec());  // never started
+        for (int i = 0; i < 3; ++i) {
+            std::optional<Lease> lease = before.LeaseTask("w");
+            ASSERT_TRUE(before.Complete(lease->id, "w", Result(*lease)).ok());
+        }
+        ASSERT_TRUE(before.LeaseTask("w"));  // leased when the server dies
+    }                                        // the crash: nothing more is written
+
+    std::unique_ptr<SqliteJobStore> store = OpenStore();
+    Scheduler after({}, *store);
+    absl::StatusOr<std::vector<std::string>> rendered = after.Recover();
+    ASSERT_TRUE(rendered.ok()) << rendered.status();
+    EXPECT_TRUE(rendered->empty());
+    EXPECT_EQ(after.Get(id)->tasks_done, 3);
+    EXPECT_EQ(after.Get(id)->tasks_running, 0);
+    EXPECT_EQ(after.Get(id)->state, JobState::kRunning);
+    int leased = 0;
+    while (std::optional<Lease> lease = after.LeaseTask("w")) {
+        if (lease->job_id != id) break;
+        EXPECT_GE(lease->task.index, 3) << "a done task was leased again";
+        ++leased;
+        absl::StatusOr<Scheduler::Completion> done = after.Complete(lease->id, "w", Result(*lease));
+        ASSERT_TRUE(done.ok()) << done.status();
+        if (done->job_rendered) {
+            EXPECT_EQ(Pixels(after, id), expected);
+        }
+    }
+    EXPECT_EQ(leased, 5);
+    EXPECT_EQ(after.Get(id)->tasks_leased, 4 + 5);
+    EXPECT_EQ(after.Get(other)->state, JobState::kRunning);  // its first task is leased now
+
+    // Submission order survives: a new job is the newest.
+    const std::string newest = *after.Submit(Spec());
+    EXPECT_EQ(after.List().front().id, newest);
+    EXPECT_NE(newest, id);
+}
+
+TEST_F(SqliteJobStoreTest, JobRenderedButNotWrittenIsHandedBackAfterARestart) {
+    std::string id;
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        Scheduler before({}, *store);
+        id = *before.Submit(Spec());
+        CompleteAll(before, "w");  // the server dies before Finish
+    }
+    std::unique_ptr<SqliteJobStore> store = OpenStore();
+    Scheduler after({}, *store);
+    absl::StatusOr<std::vector<std::string>> rendered = after.Recover();
+    ASSERT_TRUE(rendered.ok()) << rendered.status();
+    EXPECT_EQ(*rendered, std::vector<std::string>{id});
+    EXPECT_FALSE(after.LeaseTask("w"));
+    after.Finish(id, std::string("/results/x.exr"));
+    EXPECT_EQ(after.Get(id)->state, JobState::kSucceeded);
+    EXPECT_TRUE(store->TaskResults(id)->empty()) << "an ended job keeps no task results";
+}
+
+TEST_F(SqliteJobStoreTest, SubmissionRetriedWithItsRequestIdGetsTheSameJob) {
+    JobSpec spec = Spec();
+    spec.request_id = "req-1";
+    std::string id;
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        Scheduler before({}, *store);
+        id = *before.Submit(spec);
+        EXPECT_EQ(*before.Submit(spec), id);  // the answer was lost, the client retries
+    }
+    std::unique_ptr<SqliteJobStore> store = OpenStore();
+    Scheduler after({}, *store);
+    ASSERT_TRUE(after.Recover().ok());
+    EXPECT_EQ(*after.Submit(spec), id) << "a retry after a restart";
+    spec.request_id = "req-2";
+    EXPECT_NE(*after.Submit(spec), id);
+    EXPECT_EQ(after.List().size(), 2u);
+}
+
+// A store whose writes fail on demand, as on a full disk.
+class FailingStore : public InMemoryJobStore {
+  public:
+    bool fail = false;
+    static constexpr uint64_t kFailed = 1;  // InMemoryJobStore's tickets are 0
+    uint64_t QueuePut(const JobRecord& job) override {
+        return fail ? kFailed : InMemoryJobStore::QueuePut(job);
+    }
+    uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) override {
+        return QueuePut(job);
+    }
+    absl::Status WaitDurable(uint64_t ticket) override {
+        return ticket == kFailed ? absl::ResourceExhaustedError("job store: disk full")
+                                 : absl::OkStatus();
+    }
+};
+
+TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs) {
+    FailingStore store;
+    Scheduler scheduler({}, store);
+    const std::string done = *scheduler.Submit(Spec());
+    CompleteAll(scheduler, "w");
+    scheduler.Finish(done, std::string("/results/x.exr"));
+    const std::string running = *scheduler.Submit(Spec());
+    std::optional<Lease> lease = scheduler.LeaseTask("w");
+
+    store.fail = true;
+    const absl::StatusOr<std::string> refused = scheduler.Submit(Spec());
+    EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted);
+    EXPECT_NE(refused.status().message().find("disk full"), std::string_view::npos);
+    EXPECT_EQ(scheduler.List().size(), 2u);
+    // A result that cannot be recorded is refused with the reason, not acknowledged.
+    absl::StatusOr<Scheduler::Completion> result =
+        scheduler.Complete(lease->id, "w", Result(*lease));
+    EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted);
+    EXPECT_EQ(scheduler.Get(running)->state, JobState::kFailed) << "watchers learn it ended";
+    EXPECT_NE(scheduler.Get(running)->error.find("disk full"), std::string::npos);
+    store.fail = false;
+    EXPECT_EQ(scheduler.Get(done)->state, JobState::kSucceeded);
+    EXPECT_EQ(store.Get(running)->state, JobState::kRunning) << "so it runs after a restart";
+}
+
+TEST_F(SqliteJobStoreTest, UnusableDataDirIsAClearError) {
+    std::ofstream(dir_ / "file") << "x";
+    FarmOptions options;
+    options.data_dir = (dir_ / "file" / "data").string();
+    absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
+    ASSERT_FALSE(farm.ok());
+    EXPECT_NE(farm.status().message().find(options.data_dir), std::string_view::npos)
+        << farm.status();
+}
+
+}  // namespace
+}  // namespace lf
