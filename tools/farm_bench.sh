@@ -20,33 +20,13 @@ while [ $# -gt 0 ]; do
   esac
 done
 
-work="$(mktemp -d)"
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
+source tools/farm_common.sh
 
 scene=tests/scenes/cornell_box.json  # 256x256
 now() { date +%s.%N; }
 samples=$((256 * 256 * spp))
 
-"$bin/lightfarm-server" --listen 127.0.0.1:0 --data-dir "$work/data" >"$work/server.out" \
-  2>"$work/server.log" &
-pids+=($!)
-for _ in $(seq 100); do
-  grep -q "listening on" "$work/server.out" 2>/dev/null && break
-  sleep 0.1
-done
-address="$(sed -n 's/^listening on //p' "$work/server.out")"
-[ -n "$address" ] || { echo "farm_bench: the server did not start" >&2; exit 1; }
-for w in 1 2; do
-  "$bin/lightfarm-worker" --server "$address" --threads 1 --cache-dir "$work/cache$w" \
-    2>"$work/worker$w.log" &
-  pids+=($!)
-done
+start_farm farm_bench
 
 best_local=0 best_farm=0 ratios=()
 for round in $(seq "$rounds"); do

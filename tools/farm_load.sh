@@ -18,14 +18,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 
-work="$(mktemp -d)"
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
+source tools/farm_common.sh
 
 python3 -c '
 import json, sys
@@ -33,23 +26,9 @@ scene = json.load(open("tests/scenes/cornell_box.json"))
 scene["camera"]["resolution"] = [8, 8]
 json.dump(scene, open(sys.argv[1], "w"))' "$work/tiny.json"
 
-"$bin/lightfarm-server" --listen 127.0.0.1:0 --data-dir "$work/data" --log-level warn \
-  >"$work/server.out" 2>"$work/server.log" &
-server=$!
-pids+=($server)
-for _ in $(seq 100); do
-  grep -q "listening on" "$work/server.out" 2>/dev/null && break
-  sleep 0.1
-done
-address="$(sed -n 's/^listening on //p' "$work/server.out")"
-[ -n "$address" ] || { echo "farm_load: the server did not start" >&2; exit 1; }
+start_farm farm_load --log-level warn
 hwm() { sed -n 's/^VmHWM:\s*//p' "/proc/$server/status"; }
 echo "server VmHWM idle: $(hwm)"
-for w in 1 2; do
-  "$bin/lightfarm-worker" --server "$address" --threads 1 --cache-dir "$work/cache$w" \
-    2>"$work/worker$w.log" &
-  pids+=($!)
-done
 
 # Each client submits its share one after another and starts a watcher per job.
 t0="$(date +%s.%N)"
