@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -468,6 +469,35 @@ TEST_F(Farm, ServerKilledTwiceMidRenderRendersNoDoneTaskAgain) {
     const TaskCounts c = Tasks(job);
     EXPECT_EQ(c.done, 32);
     EXPECT_LE(c.leased, 32 + 2 * 2) << "done tasks were rendered again";
+}
+
+// Kills at seeded pseudo-random moments, so they land in different phases of the job (queued,
+// mid-render, the last results and the EXR write): the job still ends with the local pixels.
+TEST_F(Farm, ServerKilledAtRandomMomentsLosesNothing) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string job = Submit(scene_, "--spp 256 --seed 11 --tile 16 --passes 2");
+    std::mt19937 rng(2026);
+    std::uniform_int_distribution<int> delay_ms(0, 700);
+    for (int crash = 0; crash < 3; ++crash) {
+        std::this_thread::sleep_for(milliseconds(delay_ms(rng)));
+        CrashAndRestartServer();
+    }
+    ExpectSameAsLocal(job, scene_, 256, 11);
+    EXPECT_EQ(Tasks(job).done, 32);
+}
+
+// The moment the last result is merged the server writes the EXR; a kill then must not leave a
+// job that is done without an image.
+TEST_F(Farm, ServerKilledAsTheLastResultArrivesStillWritesTheImage) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string job = Submit(scene_, "--spp 64 --seed 12 --tile 16 --passes 2");
+    ASSERT_TRUE(WaitForTasksDone(job, 32, milliseconds(30000)));
+    CrashAndRestartServer();
+    ExpectSameAsLocal(job, scene_, 64, 12);
 }
 
 TEST_F(Farm, JobsAboveTheLimitsAreRefusedWithTheLimitNamed) {
