@@ -18,6 +18,7 @@
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "progress_bar.h"
 #include "proto/grpc_status.h"
+#include "radiosity_flags.h"
 #include "server/digest.h"
 #include "server/plan.h"
 #include "server/scene_files.h"
@@ -122,6 +123,8 @@ struct SubmitOptions {
     int tile = 32;
     int passes = 1;
     int priority = 0;
+    std::string method = "path";
+    RadiositySettings radiosity;
 };
 
 absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
@@ -187,6 +190,16 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     params->set_max_depth(o.max_depth);
     params->set_tile(o.tile);
     params->set_passes(o.passes);
+    params->set_method(o.method);
+    if (o.method == "radiosity") {
+        pb::RadiosityParams* r = params->mutable_radiosity();
+        r->set_patches(o.radiosity.patches);
+        r->set_patch_size(o.radiosity.patch_size);
+        r->set_solver(o.radiosity.solver);
+        r->set_tolerance(o.radiosity.tolerance);
+        r->set_max_iterations(o.radiosity.max_iterations);
+        r->set_display(o.radiosity.display);
+    }
     // A retry after a lost answer (the server restarting, say) gets the job of the first attempt.
     req.set_request_id(Sha256Hex(
         absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string())));
@@ -328,6 +341,13 @@ Command AddSubmitCommand(CLI::App& app) {
     cmd->add_option("--priority", o->priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
     cmd->add_option("--name", o->name, "job name (default: the scene file's name)");
+    cmd->add_option("--method", o->method,
+                    "path, or radiosity (Lambertian scenes: every worker solves the radiosity "
+                    "once, then renders display tiles; same bits as `lightfarm render --method "
+                    "radiosity`)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"path", "radiosity"}));
+    AddRadiosityFlags(cmd, o->radiosity);
     return {cmd, [o] {
                 absl::StatusOr<std::string> id = Submit(*o);
                 if (!id.ok()) return ReportError(id.status());

@@ -2,6 +2,7 @@
 
 #include "command.h"
 #include "local_render.h"
+#include "radiosity_flags.h"
 
 namespace lf {
 
@@ -13,8 +14,7 @@ int ReportError(const absl::Status& status) {
 Command AddRenderCommand(CLI::App& app) {
     auto options = std::make_shared<LocalRenderOptions>();
     auto no_progress = std::make_shared<bool>(false);
-    auto solver = std::make_shared<std::string>("gauss-seidel");
-    auto display = std::make_shared<std::string>("smooth");
+    auto radiosity = std::make_shared<RadiositySettings>();
     CLI::App* cmd = app.add_subcommand(
         "render",
         "Render a scene in this process to an OpenEXR image, by path tracing or radiosity,\n"
@@ -72,33 +72,7 @@ Command AddRenderCommand(CLI::App& app) {
         ->check(CLI::IsMember({"path", "radiosity", "auto"}));
 
     const std::string r = "Radiosity";
-    cmd->add_option("--patch-size", options->radiosity.patch_size,
-                    "longest patch edge in scene units (overrides --patches)")
-        ->group(r)
-        ->check(CLI::NonNegativeNumber);
-    cmd->add_option("--patches", options->radiosity.patches, "target number of patches")
-        ->group(r)
-        ->capture_default_str()
-        ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
-    cmd->add_option("--solver", *solver, "jacobi, gauss-seidel or shooting")
-        ->group(r)
-        ->capture_default_str()
-        ->check(CLI::IsMember({"jacobi", "gauss-seidel", "shooting"}));
-    cmd->add_option("--tolerance", options->radiosity.tolerance,
-                    "stop when the relative residual (area-weighted L1) is below this")
-        ->group(r)
-        ->capture_default_str()
-        ->check(CLI::Range(1e-12, 1.0));
-    cmd->add_option("--max-iterations", options->radiosity.max_iterations,
-                    "fail if not converged after this many iterations")
-        ->group(r)
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--radiosity-display", *display,
-                    "flat (one value per patch) or smooth (interpolated at vertices)")
-        ->group(r)
-        ->capture_default_str()
-        ->check(CLI::IsMember({"flat", "smooth"}));
+    AddRadiosityFlags(cmd, *radiosity);
     cmd->add_option("--save-solution", options->radiosity.save_solution,
                     "write the solved radiosity, to render other cameras without solving")
         ->group(r);
@@ -110,11 +84,16 @@ Command AddRenderCommand(CLI::App& app) {
                     "write the solution as a PLY mesh with per-vertex sRGB colours")
         ->group(r);
 
-    return {cmd, [options, no_progress, solver, display] {
+    return {cmd, [options, no_progress, radiosity] {
                 options->progress = !*no_progress;
-                // Both names were checked by CLI11 against the same lists.
-                options->radiosity.solver = ParseRadiositySolver(*solver).value();
-                options->radiosity.display = ParseRadiosityShading(*display).value();
+                absl::StatusOr<RadiosityOptions> parsed = MakeRadiosityOptions(
+                    radiosity->patches, radiosity->patch_size, radiosity->solver,
+                    radiosity->tolerance, radiosity->max_iterations, radiosity->display);
+                if (!parsed.ok()) return ReportError(parsed.status());
+                parsed->save_solution = options->radiosity.save_solution;
+                parsed->load_solution = options->radiosity.load_solution;
+                parsed->export_ply = options->radiosity.export_ply;
+                options->radiosity = *parsed;
                 absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
                 if (!summary.ok()) return ReportError(summary.status());
                 const double s = summary->seconds;

@@ -18,6 +18,47 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Checked here so a bad job is refused at submission rather than failing on every worker.
+absl::Status CheckMethod(const JobSpec& spec) {
+    if (spec.method == "path") return absl::OkStatus();
+    if (spec.method != "radiosity") {
+        return absl::InvalidArgumentError(
+            absl::StrCat("method \"", spec.method, "\": expected path or radiosity"));
+    }
+    const RadiositySettings& r = spec.radiosity;
+    if (r.solver != "jacobi" && r.solver != "gauss-seidel" && r.solver != "shooting") {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "radiosity solver \"", r.solver, "\": expected jacobi, gauss-seidel or shooting"));
+    }
+    if (r.display != "flat" && r.display != "smooth") {
+        return absl::InvalidArgumentError(
+            absl::StrCat("radiosity display \"", r.display, "\": expected flat or smooth"));
+    }
+    if (r.patches < 1 || !(r.patch_size >= 0) || !(r.tolerance > 0 && r.tolerance < 1) ||
+        r.max_iterations < 1) {
+        return absl::InvalidArgumentError(
+            "radiosity: patches and max iterations must be positive, patch size not negative, "
+            "tolerance in (0, 1)");
+    }
+    return absl::OkStatus();
+}
+
+absl::Status CheckRadiosityCanModel(const Scene& scene) {
+    for (const Material& m : scene.materials) {
+        if (m.type != Material::Type::kLambert) {
+            return absl::InvalidArgumentError(absl::StrCat("radiosity: material \"", m.name,
+                                                           "\" is ", MaterialTypeName(m.type),
+                                                           "; radiosity models lambert only"));
+        }
+    }
+    if (!scene.spheres.empty()) {
+        return absl::InvalidArgumentError(absl::StrCat("radiosity: sphere '", scene.spheres[0].name,
+                                                       "' cannot be meshed; radiosity supports "
+                                                       "triangle meshes and quads only"));
+    }
+    return absl::OkStatus();
+}
+
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("farm"); }
 
 // A name no other writer in this process uses at the same time.
@@ -93,6 +134,7 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
         return absl::InvalidArgumentError(
             absl::StrCat("max depth ", spec.max_depth, " is below -1 (unlimited)"));
     }
+    if (absl::Status s = CheckMethod(spec); !s.ok()) return s;
     const std::string scratch = options_.data_dir + "/scratch/submit-" + UniqueSuffix();
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
         spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); },
@@ -101,6 +143,9 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
         Log()->warn("submission of {} refused: {}", spec.scene.path,
                     std::string(scene.status().message()));
         return absl::InvalidArgumentError(scene.status().message());
+    }
+    if (spec.method == "radiosity") {
+        if (absl::Status s = CheckRadiosityCanModel(*scene); !s.ok()) return s;
     }
     const int side = options_.limits.max_resolution;
     if (scene->camera.width > side || scene->camera.height > side) {
@@ -143,7 +188,7 @@ void Farm::FinishJob(const std::string& job_id) {
 absl::Status Farm::WriteImage(const JobRecord& job, const Image& image, const std::string& path) {
     RenderMetadata metadata;
     metadata.scene_hash = job.spec.scene_hash;
-    metadata.method = "path";
+    metadata.method = job.spec.method;
     metadata.spp = job.spec.plan.spp;
     metadata.seed = job.spec.seed;
     metadata.max_depth = job.spec.max_depth;

@@ -49,6 +49,16 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_max_depth(spec.max_depth);
     out->set_tile(spec.plan.tile);
     out->set_passes(spec.plan.passes);
+    out->set_method(spec.method);
+    if (spec.method == "radiosity") {
+        pb::RadiosityParams* r = out->mutable_radiosity();
+        r->set_patches(spec.radiosity.patches);
+        r->set_patch_size(spec.radiosity.patch_size);
+        r->set_solver(spec.radiosity.solver);
+        r->set_tolerance(spec.radiosity.tolerance);
+        r->set_max_iterations(spec.radiosity.max_iterations);
+        r->set_display(spec.radiosity.display);
+    }
 }
 
 void ToProto(const JobRecord& job, pb::Job* out) {
@@ -85,6 +95,12 @@ JobSpec FromProto(const pb::SubmitJobRequest& r) {
     spec.plan.passes = r.params().passes();
     spec.seed = r.params().seed();
     spec.max_depth = r.params().max_depth();
+    if (!r.params().method().empty()) spec.method = r.params().method();
+    if (r.params().has_radiosity()) {
+        const pb::RadiosityParams& p = r.params().radiosity();
+        spec.radiosity = {p.patches(),   p.patch_size(),     p.solver(),
+                          p.tolerance(), p.max_iterations(), p.display()};
+    }
     spec.priority = r.priority();
     return spec;
 }

@@ -26,6 +26,8 @@ struct JobSpec {
     RenderPlanSettings plan;     // width and height come from the scene
     uint64_t seed = 0;
     int max_depth = -1;
+    std::string method = "path";  // or "radiosity"
+    RadiositySettings radiosity;
     int priority = 0;        // higher first
     std::string scene_hash;  // the loader's content hash, for the EXR header
     std::string request_id;  // the client's, for idempotent retries; "" for none

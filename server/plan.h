@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -22,6 +23,17 @@ struct RenderPlanSettings {
     uint64_t spp = 16;
     int tile = 32;
     int passes = 1;  // sample passes per tile, 1..spp
+};
+
+// Radiosity settings of a job in plain values (lf::MakeRadiosityOptions turns them into the
+// kernel's options): `render` and `submit` share them, and the farm carries them.
+struct RadiositySettings {
+    int64_t patches = 4000;
+    double patch_size = 0;
+    std::string solver = "gauss-seidel";
+    double tolerance = 1e-4;
+    int max_iterations = 10000;
+    std::string display = "smooth";
 };
 
 struct RenderTask {

@@ -50,6 +50,14 @@ std::string RecordToJson(const JobRecord& r) {
           {"passes", s.plan.passes},
           {"seed", s.seed},
           {"max_depth", s.max_depth},
+          {"method", s.method},
+          {"radiosity",
+           {{"patches", s.radiosity.patches},
+            {"patch_size", s.radiosity.patch_size},
+            {"solver", s.radiosity.solver},
+            {"tolerance", s.radiosity.tolerance},
+            {"max_iterations", s.radiosity.max_iterations},
+            {"display", s.radiosity.display}}},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
           {"request_id", s.request_id}}},
@@ -88,6 +96,14 @@ absl::StatusOr<JobRecord> RecordFromJson(std::string_view text) {
         r.spec.plan.passes = s.at("passes").get<int>();
         r.spec.seed = s.at("seed").get<uint64_t>();
         r.spec.max_depth = s.at("max_depth").get<int>();
+        r.spec.method = s.value("method", "path");
+        if (s.contains("radiosity")) {
+            const auto& rad = s.at("radiosity");
+            r.spec.radiosity = {
+                rad.at("patches").get<int64_t>(),    rad.at("patch_size").get<double>(),
+                rad.at("solver").get<std::string>(), rad.at("tolerance").get<double>(),
+                rad.at("max_iterations").get<int>(), rad.at("display").get<std::string>()};
+        }
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();
         r.spec.request_id = s.value("request_id", "");

@@ -24,6 +24,12 @@ TaskAssignment FromProto(const pb::Task& t) {
     for (const pb::SceneFile& f : t.files()) task.files.push_back(FromProto(f));
     task.seed = t.params().seed();
     task.max_depth = t.params().max_depth();
+    if (!t.params().method().empty()) task.method = t.params().method();
+    if (t.params().has_radiosity()) {
+        const pb::RadiosityParams& p = t.params().radiosity();
+        task.radiosity = {p.patches(),   p.patch_size(),     p.solver(),
+                          p.tolerance(), p.max_iterations(), p.display()};
+    }
     task.rect = {t.x0(), t.y0(), t.width(), t.height()};
     task.sample_begin = t.sample_begin();
     task.sample_end = t.sample_end();

@@ -9,6 +9,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/film.h"
+#include "server/plan.h"
 #include "server/scene_files.h"
 
 namespace lf {
@@ -21,13 +22,15 @@ struct TaskAssignment {
     std::vector<BlobRef> files;
     uint64_t seed = 0;
     int max_depth = -1;
+    std::string method = "path";  // or "radiosity"
+    RadiositySettings radiosity;
     PixelRect rect;
     uint64_t sample_begin = 0, sample_end = 0;
     absl::Duration heartbeat_interval = absl::Milliseconds(300);
 };
 
 class ServerConnection {
-public:
+  public:
     // Connects lazily; after the server restarts, calls work again within about a second.
     ServerConnection(const std::string& address, std::string worker_id);
     ~ServerConnection();
@@ -45,7 +48,7 @@ public:
     // Writes blob `hash` to `path`.
     absl::Status FetchBlob(const std::string& hash, const std::string& path);
 
-private:
+  private:
     std::string worker_id_;
     struct Stub;  // keeps gRPC headers out of the worker's other files
     std::unique_ptr<Stub> stub_;

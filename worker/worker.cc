@@ -9,6 +9,7 @@
 
 #include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
+#include "lf/kernels/radiosity.h"
 #include "lf/kernels/tile_renderer.h"
 
 namespace lf {
@@ -141,7 +142,21 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
     if (!embree.ok()) return embree.status();
     loaded.embree = std::move(*embree);
     loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
-    loaded.tracer = std::make_unique<PathTracer>(*loaded.embree, task.max_depth);
+    if (task.method == "radiosity") {
+        // Every worker of the job solves the same system to the same bits (the solver is
+        // deterministic for any thread count), so its tiles match `lightfarm render`.
+        const RadiositySettings& r = task.radiosity;
+        absl::StatusOr<RadiosityOptions> radiosity_options = MakeRadiosityOptions(
+            r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
+        if (!radiosity_options.ok()) return radiosity_options.status();
+        radiosity_options->threads = options_.threads;
+        absl::StatusOr<std::unique_ptr<RadiosityRenderer>> radiosity =
+            PrepareRadiosity(*loaded.embree, *radiosity_options);
+        if (!radiosity.ok()) return radiosity.status();
+        loaded.tracer = std::move(*radiosity);
+    } else {
+        loaded.tracer = std::make_unique<PathTracer>(*loaded.embree, task.max_depth);
+    }
     loaded.job_id = task.job_id;
     loaded_ = std::move(loaded);
     Log()->info("job={} task={} scene {} loaded", task.job_id, task.task_index, task.scene.path);

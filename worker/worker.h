@@ -15,6 +15,7 @@
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
+#include "lf/kernels/radiance.h"
 #include "worker/blob_cache.h"
 #include "worker/server_connection.h"
 
@@ -44,7 +45,7 @@ private:
         std::unique_ptr<Scene> scene;  // EmbreeScene keeps a reference
         std::unique_ptr<EmbreeScene> embree;
         std::unique_ptr<Camera> camera;
-        std::unique_ptr<PathTracer> tracer;
+        std::unique_ptr<RadianceEstimator> tracer;  // path tracer or radiosity display
     };
 
     void Execute(const TaskAssignment& task);

@@ -161,4 +161,22 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> PrepareRadiosity(
     return result;
 }
 
+absl::StatusOr<RadiosityOptions> MakeRadiosityOptions(int64_t patches, double patch_size,
+                                                      std::string_view solver, double tolerance,
+                                                      int max_iterations,
+                                                      std::string_view display) {
+    RadiosityOptions o;
+    absl::StatusOr<RadiositySolver> parsed_solver = ParseRadiositySolver(solver);
+    if (!parsed_solver.ok()) return parsed_solver.status();
+    absl::StatusOr<RadiosityShading> parsed_display = ParseRadiosityShading(display);
+    if (!parsed_display.ok()) return parsed_display.status();
+    o.patches = patches;
+    o.patch_size = patch_size;
+    o.solver = *parsed_solver;
+    o.tolerance = tolerance;
+    o.max_iterations = max_iterations;
+    o.display = *parsed_display;
+    return o;
+}
+
 }  // namespace lf

@@ -248,7 +248,7 @@ class Farm : public ::testing::Test {
     // Watches the job to its end, fetches it, and compares every sample channel with a local
     // render of the same scene and settings.
     void ExpectSameAsLocal(const std::string& job, const std::string& scene, uint64_t spp,
-                           uint64_t seed) {
+                           uint64_t seed, const std::string& method_flags = "--method path") {
         const CliRun watch = Farmctl("watch " + job);
         ASSERT_EQ(watch.status, 0) << watch.out << watch.err;
         const std::string farm = (dir_ / (job + ".exr")).string();
@@ -256,12 +256,13 @@ class Farm : public ::testing::Test {
         ASSERT_EQ(fetch.status, 0) << fetch.out << fetch.err;
 
         const std::string local =
-            (dir_ / ("local-" + std::to_string(spp) + "-" + std::to_string(seed) + ".exr"))
+            (dir_ / ("local-" + std::to_string(spp) + "-" + std::to_string(seed) + "-" +
+                     std::to_string(std::hash<std::string>{}(method_flags)) + ".exr"))
                 .string();
         if (!fs::exists(local)) {
             const CliRun r = Lightfarm("render " + scene + " -o " + local + " --spp " +
                                        std::to_string(spp) + " --seed " + std::to_string(seed) +
-                                       " --method path --threads 2 --no-progress");
+                                       " " + method_flags + " --threads 2 --no-progress");
             ASSERT_EQ(r.status, 0) << r.out << r.err;
         }
         absl::StatusOr<ExrFile> a = ReadExr(farm), b = ReadExr(local);
@@ -498,6 +499,28 @@ TEST_F(Farm, ServerKilledAsTheLastResultArrivesStillWritesTheImage) {
     ASSERT_TRUE(WaitForTasksDone(job, 32, milliseconds(30000)));
     CrashAndRestartServer();
     ExpectSameAsLocal(job, scene_, 64, 12);
+}
+
+// Radiosity on the farm: each worker solves the same system to the same bits, then renders its
+// display tiles, so the image is that of `lightfarm render --method radiosity`.
+TEST_F(Farm, RadiosityJobGivesTheLocalPixels) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string flags = "--method radiosity --patches 300 --solver shooting";
+    const std::string job = Submit(scene_, "--spp 2 --seed 6 --tile 16 " + flags);
+    ExpectSameAsLocal(job, scene_, 2, 6, flags);
+}
+
+TEST_F(Farm, RadiosityJobForAGlossySceneIsRefusedAtSubmission) {
+    StartServer();
+    const std::string glossy = (dir_ / "glossy.json").string();
+    nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
+    scene["materials"]["white"] = {{"type", "mirror"}, {"reflectance", {0.9, 0.9, 0.9}}};
+    std::ofstream(glossy) << scene.dump();
+    const CliRun r = Farmctl("submit " + glossy + " --method radiosity");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("radiosity models lambert only"), std::string::npos) << r.err;
 }
 
 TEST_F(Farm, JobsAboveTheLimitsAreRefusedWithTheLimitNamed) {

@@ -11,6 +11,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -69,6 +70,12 @@ class RadiosityRenderer : public RadianceEstimator {
     std::unique_ptr<RadiosityDisplay> display_;
     RadiosityReport report_;
 };
+
+// Options from plain values, as `render`, `submit` and the farm's workers receive them;
+// InvalidArgument naming a bad solver or display name.
+absl::StatusOr<RadiosityOptions> MakeRadiosityOptions(int64_t patches, double patch_size,
+                                                      std::string_view solver, double tolerance,
+                                                      int max_iterations, std::string_view display);
 
 // Fails with InvalidArgument for scenes radiosity cannot represent (spheres, non-lambert
 // materials, reflectance >= 1 with emission), for a solution that does not match the scene,

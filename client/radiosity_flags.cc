@@ -1,0 +1,36 @@
+#include "radiosity_flags.h"
+
+namespace lf {
+
+void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
+    const std::string group = "Radiosity";
+    cmd->add_option("--patch-size", settings.patch_size,
+                    "longest patch edge in scene units (overrides --patches)")
+        ->group(group)
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--patches", settings.patches, "target number of patches")
+        ->group(group)
+        ->capture_default_str()
+        ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
+    cmd->add_option("--solver", settings.solver, "jacobi, gauss-seidel or shooting")
+        ->group(group)
+        ->capture_default_str()
+        ->check(CLI::IsMember({"jacobi", "gauss-seidel", "shooting"}));
+    cmd->add_option("--tolerance", settings.tolerance,
+                    "stop when the relative residual (area-weighted L1) is below this")
+        ->group(group)
+        ->capture_default_str()
+        ->check(CLI::Range(1e-12, 1.0));
+    cmd->add_option("--max-iterations", settings.max_iterations,
+                    "fail if not converged after this many iterations")
+        ->group(group)
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--radiosity-display", settings.display,
+                    "flat (one value per patch) or smooth (interpolated at vertices)")
+        ->group(group)
+        ->capture_default_str()
+        ->check(CLI::IsMember({"flat", "smooth"}));
+}
+
+}  // namespace lf

@@ -1,0 +1,12 @@
+// The radiosity options `render` and `submit` share, parsed into their plain form.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "server/plan.h"
+
+namespace lf {
+
+void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings);
+
+}  // namespace lf
