@@ -1,7 +1,6 @@
 // lightfarm-server: the farm's coordinator. Holds jobs, hands tasks to workers, merges their
 // results and serves the images. See docs/farm.md.
 #include <grpcpp/grpcpp.h>
-#include <signal.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -13,14 +12,10 @@
 
 #include "server/farm.h"
 #include "server/grpc_service.h"
+#include "server/stop_signals.h"
 
 int main(int argc, char** argv) {
-    // Signals are taken by sigwait below; blocked before any thread starts so none gets them.
-    sigset_t signals;
-    sigemptyset(&signals);
-    sigaddset(&signals, SIGINT);
-    sigaddset(&signals, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    const lf::StopSignals stop_signals;  // before any thread starts
 
     CLI::App app{"lightfarm-server: the render farm's coordinator (see docs/farm.md)."};
     std::string listen = "127.0.0.1:7070";
@@ -99,9 +94,7 @@ int main(int argc, char** argv) {
         }
     });
 
-    int signal = 0;
-    sigwait(&signals, &signal);
-    spdlog::info("signal {}: shutting down", signal);
+    spdlog::info("signal {}: shutting down", stop_signals.Wait());
     (*farm)->scheduler().Shutdown();
     server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
     {

@@ -1,5 +1,4 @@
 // lightfarm-worker: renders tasks for a lightfarm-server until SIGTERM. See docs/farm.md.
-#include <signal.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
@@ -9,15 +8,11 @@
 #include <filesystem>
 #include <thread>
 
+#include "server/stop_signals.h"
 #include "worker/worker.h"
 
 int main(int argc, char** argv) {
-    // Signals are taken by sigwait below; blocked before any thread starts so none gets them.
-    sigset_t signals;
-    sigemptyset(&signals);
-    sigaddset(&signals, SIGINT);
-    sigaddset(&signals, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    const lf::StopSignals stop_signals;  // before any thread starts
 
     CLI::App app{"lightfarm-worker: renders tasks of a lightfarm-server (see docs/farm.md)."};
     std::string server;
@@ -55,8 +50,7 @@ int main(int argc, char** argv) {
     spdlog::info("worker={} serving {} with {} threads", id, server, options.threads);
 
     std::thread signal_waiter([&] {
-        int signal = 0;
-        sigwait(&signals, &signal);
+        const int signal = stop_signals.Wait();
         spdlog::info("worker={} signal {}: handing back the task and stopping", id, signal);
         worker.Stop();
     });
