@@ -18,6 +18,7 @@
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "progress_bar.h"
 #include "proto/grpc_status.h"
+#include "proto/radiosity_params.h"
 #include "radiosity_flags.h"
 #include "server/digest.h"
 #include "server/plan.h"
@@ -191,15 +192,7 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     params->set_tile(o.tile);
     params->set_passes(o.passes);
     params->set_method(o.method);
-    if (o.method == "radiosity") {
-        pb::RadiosityParams* r = params->mutable_radiosity();
-        r->set_patches(o.radiosity.patches);
-        r->set_patch_size(o.radiosity.patch_size);
-        r->set_solver(o.radiosity.solver);
-        r->set_tolerance(o.radiosity.tolerance);
-        r->set_max_iterations(o.radiosity.max_iterations);
-        r->set_display(o.radiosity.display);
-    }
+    if (o.method == "radiosity") lf::ToProto(o.radiosity, params->mutable_radiosity());
     // A retry after a lost answer (the server restarting, say) gets the job of the first attempt.
     req.set_request_id(Sha256Hex(
         absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string())));
@@ -342,12 +335,21 @@ Command AddSubmitCommand(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--name", o->name, "job name (default: the scene file's name)");
     cmd->add_option("--method", o->method,
-                    "path, or radiosity (Lambertian scenes: every worker solves the radiosity "
-                    "once, then renders display tiles; same bits as `lightfarm render --method "
-                    "radiosity`)")
+                    "path, or radiosity (Lambertian scenes; same bits as `lightfarm render "
+                    "--method radiosity` with the same options)")
         ->capture_default_str()
         ->check(CLI::IsMember({"path", "radiosity"}));
+    // The farm's own solver: its sweeps split into patch-group tasks.
+    o->radiosity.solver = "jacobi";
     AddRadiosityFlags(cmd, o->radiosity);
+    cmd->add_option("--sweep-tasks", o->radiosity.sweep_tasks,
+                    "--solver jacobi: patch-group tasks per sweep; each worker computes the "
+                    "form-factor rows of its groups once and keeps them. Gauss-Seidel and "
+                    "shooting update one group after another, so with them every worker "
+                    "solves the whole system before rendering display tiles")
+        ->group("Radiosity")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxSweepTasks));
     return {cmd, [o] {
                 absl::StatusOr<std::string> id = Submit(*o);
                 if (!id.ok()) return ReportError(id.status());

@@ -106,4 +106,14 @@ absl::Status BlobStore::Upload::Finish() {
     return absl::OkStatus();
 }
 
+absl::StatusOr<std::string> BlobStore::Put(std::string_view data) {
+    std::string hash = Sha256Hex(data);
+    if (Has(hash)) return hash;
+    absl::StatusOr<std::unique_ptr<Upload>> upload = StartUpload(hash, data.size());
+    if (!upload.ok()) return upload.status();
+    if (absl::Status s = (*upload)->Append(data); !s.ok()) return s;
+    if (absl::Status s = (*upload)->Finish(); !s.ok()) return s;
+    return hash;
+}
+
 }  // namespace lf

@@ -44,6 +44,8 @@ class BlobStore {
     };
     // InvalidArgument for a malformed hash.
     absl::StatusOr<std::unique_ptr<Upload>> StartUpload(const std::string& hash, uint64_t size);
+    // Stores `data` (a blob the server makes itself) and returns its hash.
+    absl::StatusOr<std::string> Put(std::string_view data);
 
   private:
     explicit BlobStore(std::string dir) : dir_(std::move(dir)) {}

@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
+#include "lf/core/radiosity_codec.h"
 #include "lf/core/tile_codec.h"
 #include "server/render_metadata.h"
 #include "server/sqlite_job_store.h"
@@ -35,10 +36,11 @@ absl::Status CheckMethod(const JobSpec& spec) {
             absl::StrCat("radiosity display \"", r.display, "\": expected flat or smooth"));
     }
     if (r.patches < 1 || !(r.patch_size >= 0) || !(r.tolerance > 0 && r.tolerance < 1) ||
-        r.max_iterations < 1) {
-        return absl::InvalidArgumentError(
+        r.max_iterations < 1 || r.sweep_tasks < 1 || r.sweep_tasks > kMaxSweepTasks) {
+        return absl::InvalidArgumentError(absl::StrCat(
             "radiosity: patches and max iterations must be positive, patch size not negative, "
-            "tolerance in (0, 1)");
+            "tolerance in (0, 1), sweep tasks in 1..",
+            kMaxSweepTasks));
     }
     return absl::OkStatus();
 }
@@ -173,6 +175,25 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, *sums);
     if (!done.ok()) return done.status();
     if (done->job_rendered) FinishJob(done->job_id);
+    return absl::OkStatus();
+}
+
+absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
+                                 std::string_view sweep_result) {
+    absl::StatusOr<SweepChunkResult> result = DecodeSweepResult(sweep_result);
+    if (!result.ok()) {
+        const std::string reason = absl::StrCat("undecodable result: ", result.status().message());
+        scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
+        return absl::InvalidArgumentError(
+            absl::StrCat("lease ", lease_id, " from ", worker, ": ", reason));
+    }
+    absl::StatusOr<Scheduler::SweepCompletion> done =
+        scheduler_.CompleteSweep(lease_id, worker, *result);
+    if (!done.ok()) return done.status();
+    if (done->outcome) {
+        scheduler_.Publish(done->job_id, done->outcome->converged,
+                           blobs_->Put(EncodeRadiosity(done->outcome->radiosity)));
+    }
     return absl::OkStatus();
 }
 

@@ -47,6 +47,10 @@ class Farm {
     // Decodes and merges a task's result; writes the job's EXR when it was the last one.
     absl::Status Complete(const std::string& lease_id, const std::string& worker,
                           std::string_view tile_sums);
+    // A radiosity patch-group task's result (lf::EncodeSweepResult); when it ends a sweep,
+    // stores the next sweep's input or the solution as a blob for the workers.
+    absl::Status CompleteSweep(const std::string& lease_id, const std::string& worker,
+                               std::string_view sweep_result);
 
     // The EXR of a succeeded job; with `preview`, also of a running one (what is merged so far).
     absl::StatusOr<std::string> ResultFile(const std::string& job_id, bool preview);

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/log.h"
 #include "proto/grpc_status.h"
+#include "proto/radiosity_params.h"
 
 namespace lf {
 
@@ -50,15 +51,7 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_tile(spec.plan.tile);
     out->set_passes(spec.plan.passes);
     out->set_method(spec.method);
-    if (spec.method == "radiosity") {
-        pb::RadiosityParams* r = out->mutable_radiosity();
-        r->set_patches(spec.radiosity.patches);
-        r->set_patch_size(spec.radiosity.patch_size);
-        r->set_solver(spec.radiosity.solver);
-        r->set_tolerance(spec.radiosity.tolerance);
-        r->set_max_iterations(spec.radiosity.max_iterations);
-        r->set_display(spec.radiosity.display);
-    }
+    if (spec.method == "radiosity") lf::ToProto(spec.radiosity, out->mutable_radiosity());
 }
 
 void ToProto(const JobRecord& job, pb::Job* out) {
@@ -96,11 +89,7 @@ JobSpec FromProto(const pb::SubmitJobRequest& r) {
     spec.seed = r.params().seed();
     spec.max_depth = r.params().max_depth();
     if (!r.params().method().empty()) spec.method = r.params().method();
-    if (r.params().has_radiosity()) {
-        const pb::RadiosityParams& p = r.params().radiosity();
-        spec.radiosity = {p.patches(),   p.patch_size(),     p.solver(),
-                          p.tolerance(), p.max_iterations(), p.display()};
-    }
+    if (r.params().has_radiosity()) spec.radiosity = lf::FromProto(r.params().radiosity());
     spec.priority = r.priority();
     return spec;
 }
@@ -118,6 +107,12 @@ void ToProto(const Lease& lease, const FarmOptions& options, pb::Task* out) {
     out->set_height(lease.task.rect.height);
     out->set_sample_begin(lease.task.sample_begin);
     out->set_sample_end(lease.task.sample_end);
+    if (lease.sweep >= 0) {
+        out->set_kind(pb::Task::RADIOSITY_SWEEP);
+        out->set_sweep(lease.sweep);
+        out->set_chunk(lease.chunk);
+    }
+    out->set_radiosity_hash(lease.radiosity_hash);
     out->set_heartbeat_interval_ms(int(absl::ToInt64Milliseconds(options.heartbeat_interval)));
     out->set_lease_ms(int(absl::ToInt64Milliseconds(options.scheduler.lease)));
 }
@@ -254,7 +249,10 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext*, const pb::Heartb
 grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext*,
                                              const pb::CompleteTaskRequest* req,
                                              pb::CompleteTaskResponse*) {
-    const absl::Status s = farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums());
+    const absl::Status s =
+        req->radiosity_sweep().empty()
+            ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums())
+            : farm_.CompleteSweep(req->lease_id(), req->worker_id(), req->radiosity_sweep());
     if (!s.ok())
         Log()->warn("lease={} CompleteTask refused: {}", req->lease_id(), std::string(s.message()));
     return ToGrpcStatus(s);

@@ -34,7 +34,15 @@ struct RadiositySettings {
     double tolerance = 1e-4;
     int max_iterations = 10000;
     std::string display = "smooth";
+    // On the farm, with solver "jacobi": patch-group tasks per sweep (server/radiosity_solve.h).
+    int sweep_tasks = 8;
 };
+inline constexpr int kMaxSweepTasks = 1024;
+
+// Radiosity jobs the farm solves in patch-group tasks per sweep, rather than on every worker.
+inline bool SolvedInSweeps(const std::string& method, const RadiositySettings& r) {
+    return method == "radiosity" && r.solver == "jacobi";
+}
 
 struct RenderTask {
     int index = 0;  // position in the plan

@@ -38,8 +38,8 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
                                          std::vector<Task>(plan->size()),
                                          {},
                                          RenderMerger(spec.plan.width, spec.plan.height, *plan)});
-    for (int i = 0; i < int(plan->size()); ++i) job->queued.insert(i);
     job->record.spec = spec;
+    QueueStart(*job);
     job->record.submitted = clock_();
     job->record.tasks_total = int(plan->size());
     std::unique_lock<std::mutex> lock(mutex_);
@@ -128,9 +128,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
             }
             job->tasks[size_t(t)].state = TaskState::kDone;
         }
-        for (int t = 0; t < int(plan->size()); ++t) {
-            if (job->tasks[size_t(t)].state != TaskState::kDone) job->queued.insert(t);
-        }
+        QueueStart(*job);
         job->record.tasks_done = int(job->merger.tasks_done());
         job->record.stats = job->merger.stats();
         job->record.tasks_running = 0;
@@ -178,6 +176,7 @@ std::optional<Lease> Scheduler::TryLease(const std::string& worker) {
         }
         for (int t : job->queued) {
             if (avoid_repeats && job->tasks[size_t(t)].failed_on.count(worker)) continue;
+            if (!MayTake(*job, t, worker, now)) continue;
             best = job.get();
             best_task = t;
             break;
@@ -237,7 +236,45 @@ Lease Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time no
     Save(job);
     Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, worker,
                  task.attempts);
-    return Lease{lease_id, job.record.id, job.plan[size_t(t)], job.record.spec};
+    if (!IsSweepTask(job, t)) {
+        return Lease{lease_id, job.record.id, job.plan[size_t(t)], job.record.spec, -1, 0,
+                     job.solution};
+    }
+    const int k = t - int(job.plan.size()), chunks = job.solve->chunks();
+    job.chunk_owner[k % chunks] = worker;
+    return Lease{lease_id,    job.record.id, RenderTask{t, {}, 0, 0}, job.record.spec,
+                 k / chunks,  k % chunks,    job.sweep_input};
+}
+
+void Scheduler::QueueStart(Job& job) {
+    if (SolvedInSweeps(job.record.spec.method, job.record.spec.radiosity) &&
+        job.solution.empty() && !job.merger.Complete()) {
+        // The solve is not recorded: after a restart it runs again, to the same bits, and the
+        // tiles already done stay done.
+        const RadiositySettings& r = job.record.spec.radiosity;
+        job.solve = std::make_unique<RadiositySolve>(r.sweep_tasks, r.tolerance, r.max_iterations);
+        job.sweep_input.clear();
+        QueueSweep(job);
+        return;
+    }
+    for (int t = 0; t < int(job.plan.size()); ++t) {
+        if (job.tasks[size_t(t)].state != TaskState::kDone) job.queued.insert(t);
+    }
+}
+
+void Scheduler::QueueSweep(Job& job) {
+    for (int c = 0; c < job.solve->chunks(); ++c) {
+        job.queued.insert(int(job.tasks.size()));
+        job.tasks.emplace_back();
+    }
+}
+
+bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::Time now) const {
+    if (!IsSweepTask(job, t)) return true;
+    const auto owner = job.chunk_owner.find((t - int(job.plan.size())) % job.solve->chunks());
+    if (owner == job.chunk_owner.end() || owner->second == worker) return true;
+    const auto seen = workers_seen_.find(owner->second);
+    return seen == workers_seen_.end() || now - seen->second >= options_.lease;
 }
 
 std::optional<Scheduler::LeaseRef> Scheduler::Resolve(const std::string& lease_id) {
@@ -291,7 +328,10 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     Job& job = *ref->job;
     Task& task = job.tasks[size_t(ref->task)];
     if (task.state == TaskState::kDone) return Completion{job.record.id, false};
-    if (absl::Status s = job.merger.Add(ref->task, sums); !s.ok()) {
+    absl::Status merged = IsSweepTask(job, ref->task)
+                              ? absl::InvalidArgumentError("a tile result for a sweep task")
+                              : job.merger.Add(ref->task, sums);
+    if (absl::Status s = merged; !s.ok()) {
         const std::string error = absl::StrCat("job=", job.record.id, " task=", ref->task, " from ",
                                                worker, ": ", s.message());
         if (IsCurrent(*ref)) {
@@ -300,18 +340,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
         }
         return absl::InvalidArgumentError(error);
     }
-    if (task.state == TaskState::kLeased) {
-        // Whoever else holds a lease of it (a retry or a speculative copy) learns at its next
-        // heartbeat.
-        for (int attempt : task.live) timeouts_.Remove(LeaseId(job, ref->task, attempt));
-        task.live.clear();
-        --job.record.tasks_running;
-        job.task_time_total += now - task.leased_at;
-        ++job.tasks_timed;
-    } else {
-        job.queued.erase(ref->task);
-    }
-    task.state = TaskState::kDone;
+    MarkDone(job, ref->task, now);
     job.record.tasks_done = int(job.merger.tasks_done());
     job.record.stats = job.merger.stats();
     const uint64_t ticket = store_.QueueTaskDone(job.record, ref->task, EncodeTileSums(sums));
@@ -333,6 +362,90 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
         return absl::Status(s.code(), absl::StrCat("job=", completion.job_id, ": ", s.message()));
     }
     return completion;
+}
+
+void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
+    Task& task = job.tasks[size_t(t)];
+    if (task.state == TaskState::kLeased) {
+        // Whoever else holds a lease of it (a retry or a speculative copy) learns at its next
+        // heartbeat.
+        for (int attempt : task.live) timeouts_.Remove(LeaseId(job, t, attempt));
+        task.live.clear();
+        --job.record.tasks_running;
+        job.task_time_total += now - task.leased_at;
+        ++job.tasks_timed;
+    } else {
+        job.queued.erase(t);
+    }
+    task.state = TaskState::kDone;
+}
+
+absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
+    const std::string& lease_id, const std::string& worker, const SweepChunkResult& result) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const absl::Time now = clock_();
+    workers_seen_[worker] = now;
+    const std::optional<LeaseRef> ref = Resolve(lease_id);
+    if (!ref || !HeldBy(*ref, worker)) {
+        Log()->warn("result for lease {} from {} refused: not a lease it holds", lease_id, worker);
+        return absl::FailedPreconditionError(absl::StrCat(
+            "lease ", lease_id, " is not one of worker ", worker, " in a running job"));
+    }
+    Job& job = *ref->job;
+    if (job.tasks[size_t(ref->task)].state == TaskState::kDone) {
+        return SweepCompletion{job.record.id, std::nullopt};
+    }
+    const int k = ref->task - int(job.plan.size());
+    absl::Status added =
+        !IsSweepTask(job, ref->task) ? absl::InvalidArgumentError("a sweep result for a tile")
+        : result.sweep != k / job.solve->chunks() || result.chunk != k % job.solve->chunks()
+            ? absl::InvalidArgumentError(absl::StrCat("a result of sweep ", result.sweep,
+                                                      " chunk ", result.chunk))
+            : job.solve->Add(result);
+    if (!added.ok()) {
+        const std::string error = absl::StrCat("job=", job.record.id, " task=", ref->task, " from ",
+                                               worker, ": ", added.message());
+        if (IsCurrent(*ref)) {
+            timeouts_.Remove(lease_id);
+            Requeue(*ref, absl::StrCat("result refused: ", added.message()), true);
+        }
+        return absl::InvalidArgumentError(error);
+    }
+    MarkDone(job, ref->task, now);
+    SweepCompletion completion{job.record.id, std::nullopt};
+    if (job.solve->SweepComplete()) {
+        absl::StatusOr<RadiositySolve::Outcome> outcome = job.solve->FinishSweep();
+        if (!outcome.ok()) {
+            FailJob(job, std::string(outcome.status().message()));
+            return completion;
+        }
+        Log()->info("job={} radiosity sweep {}: relative residual {:.3g}{}", job.record.id,
+                    outcome->iterations, outcome->residual, outcome->converged ? ", solved" : "");
+        completion.outcome = std::move(*outcome);
+    }
+    Save(job);
+    return completion;
+}
+
+void Scheduler::Publish(const std::string& job_id, bool converged,
+                        const absl::StatusOr<std::string>& hash) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = active_.find(job_id);
+    if (it == active_.end()) return;  // cancelled meanwhile
+    Job& job = *it->second;
+    if (!hash.ok()) {
+        FailJob(job, absl::StrCat("storing the radiosity: ", hash.status().message()));
+        return;
+    }
+    if (converged) {
+        job.solution = *hash;
+        job.solve.reset();
+        QueueStart(job);
+    } else {
+        job.sweep_input = *hash;
+        QueueSweep(job);
+    }
+    Save(job);
 }
 
 absl::Status Scheduler::Fail(const std::string& lease_id, const std::string& worker,

@@ -22,6 +22,7 @@
 #include "server/job_store.h"
 #include "server/lease_timeouts.h"
 #include "server/merge.h"
+#include "server/radiosity_solve.h"
 
 namespace lf {
 
@@ -37,8 +38,13 @@ struct SchedulerOptions {
 struct Lease {
     std::string id;
     std::string job_id;
-    RenderTask task;
+    RenderTask task;  // a tile; for a sweep task only its index
     JobSpec spec;
+    // Radiosity jobs solved in sweeps (SolvedInSweeps): a patch-group task of sweep `sweep`
+    // (>= 0) reads the blob `radiosity_hash` ("" in sweep 0: the emission, which workers
+    // compute); a display tile (sweep -1) reads the solution from it.
+    int sweep = -1, chunk = 0;
+    std::string radiosity_hash;
 };
 
 enum class FailureKind {
@@ -87,6 +93,21 @@ class Scheduler {
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
                                         const TileSums& sums);
 
+    // A patch-group task's result, taken as Complete takes a tile's. When it completes its
+    // sweep, `outcome` holds the next sweep's input or the solution: the caller stores it as a
+    // blob and calls Publish. A solve that runs out of iterations fails the job.
+    struct SweepCompletion {
+        std::string job_id;
+        std::optional<RadiositySolve::Outcome> outcome;
+    };
+    absl::StatusOr<SweepCompletion> CompleteSweep(const std::string& lease_id,
+                                                  const std::string& worker,
+                                                  const SweepChunkResult& result);
+    // Queues the sweep that reads blob `hash`, or the display tiles when `converged`; fails the
+    // job when the blob could not be stored.
+    void Publish(const std::string& job_id, bool converged,
+                 const absl::StatusOr<std::string>& hash);
+
     // Gives a leased task back. Ignored when the lease is no longer current.
     absl::Status Fail(const std::string& lease_id, const std::string& worker,
                       const std::string& reason, FailureKind kind);
@@ -132,6 +153,14 @@ class Scheduler {
         uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
         absl::Duration task_time_total = absl::ZeroDuration();  // lease to result, tasks done here
         int tasks_timed = 0;
+        // Radiosity solved in sweeps: while `solve` is set, its patch-group tasks follow the
+        // tiles in `tasks` (sweep k's chunk c at plan.size() + k * chunks + c) and the tiles
+        // wait. A chunk goes back to the worker that did it before, which keeps its form-factor
+        // rows; that is soft state, so any worker may take a chunk whose owner is gone.
+        std::unique_ptr<RadiositySolve> solve{};
+        std::string sweep_input{};  // blob of the current sweep's input; "" in sweep 0
+        std::string solution{};     // blob of the solution, once solved
+        std::map<int, std::string> chunk_owner{};
     };
     struct LeaseRef {
         Job* job;
@@ -143,6 +172,14 @@ class Scheduler {
     std::optional<std::pair<std::string, uint64_t>> FindRequest(
         const std::string& request_id) const;
     std::optional<Lease> TryLease(const std::string& worker);
+    // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
+    void QueueStart(Job& job);
+    void QueueSweep(Job& job);
+    static bool IsSweepTask(const Job& job, int task) { return task >= int(job.plan.size()); }
+    // A sweep task goes to its chunk's owner while that worker lives.
+    bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;
+    // The bookkeeping of a task's first accepted result.
+    void MarkDone(Job& job, int task, absl::Time now);
     // A second lease of a task running too long in the job, or -1 (see speculate_after).
     int StragglerFor(const Job& job, const std::string& worker, absl::Time now) const;
     Lease Grant(Job& job, int task, const std::string& worker, absl::Time now);

@@ -57,7 +57,8 @@ std::string RecordToJson(const JobRecord& r) {
             {"solver", s.radiosity.solver},
             {"tolerance", s.radiosity.tolerance},
             {"max_iterations", s.radiosity.max_iterations},
-            {"display", s.radiosity.display}}},
+            {"display", s.radiosity.display},
+            {"sweep_tasks", s.radiosity.sweep_tasks}}},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
           {"request_id", s.request_id}}},
@@ -102,7 +103,8 @@ absl::StatusOr<JobRecord> RecordFromJson(std::string_view text) {
             r.spec.radiosity = {
                 rad.at("patches").get<int64_t>(),    rad.at("patch_size").get<double>(),
                 rad.at("solver").get<std::string>(), rad.at("tolerance").get<double>(),
-                rad.at("max_iterations").get<int>(), rad.at("display").get<std::string>()};
+                rad.at("max_iterations").get<int>(), rad.at("display").get<std::string>(),
+                rad.value("sweep_tasks", RadiositySettings().sweep_tasks)};
         }
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();

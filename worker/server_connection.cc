@@ -6,6 +6,7 @@
 
 #include "lightfarm/v1/worker_service.grpc.pb.h"
 #include "proto/grpc_status.h"
+#include "proto/radiosity_params.h"
 
 namespace lf {
 
@@ -25,11 +26,12 @@ TaskAssignment FromProto(const pb::Task& t) {
     task.seed = t.params().seed();
     task.max_depth = t.params().max_depth();
     if (!t.params().method().empty()) task.method = t.params().method();
-    if (t.params().has_radiosity()) {
-        const pb::RadiosityParams& p = t.params().radiosity();
-        task.radiosity = {p.patches(),   p.patch_size(),     p.solver(),
-                          p.tolerance(), p.max_iterations(), p.display()};
+    if (t.params().has_radiosity()) task.radiosity = lf::FromProto(t.params().radiosity());
+    if (t.kind() == pb::Task::RADIOSITY_SWEEP) {
+        task.sweep = t.sweep();
+        task.chunk = t.chunk();
     }
+    task.radiosity_hash = t.radiosity_hash();
     task.rect = {t.x0(), t.y0(), t.width(), t.height()};
     task.sample_begin = t.sample_begin();
     task.sample_end = t.sample_end();
@@ -85,12 +87,12 @@ absl::StatusOr<bool> ServerConnection::Heartbeat(const std::string& lease_id) {
     return !resp.cancelled();
 }
 
-absl::Status ServerConnection::Complete(const std::string& lease_id, const std::string& tile_sums,
+absl::Status ServerConnection::Complete(const std::string& lease_id, const TaskResult& result,
                                         double seconds) {
     pb::CompleteTaskRequest req;
     req.set_lease_id(lease_id);
     req.set_worker_id(worker_id_);
-    req.set_tile_sums(tile_sums);
+    (result.sweep ? req.mutable_radiosity_sweep() : req.mutable_tile_sums())->assign(result.bytes);
     req.set_seconds(seconds);
     pb::CompleteTaskResponse resp;
     // Rides out a server restart: the result stays valid after its lease.

@@ -26,6 +26,10 @@ struct TaskAssignment {
     RadiositySettings radiosity;
     PixelRect rect;
     uint64_t sample_begin = 0, sample_end = 0;
+    // A radiosity patch-group task when sweep >= 0 (see Lease in server/scheduler.h); the blob
+    // it reads, or a display tile's solution.
+    int sweep = -1, chunk = 0;
+    std::string radiosity_hash;
     absl::Duration heartbeat_interval = absl::Milliseconds(300);
 };
 
@@ -41,8 +45,12 @@ class ServerConnection {
     absl::StatusOr<std::optional<TaskAssignment>> Lease(absl::Duration wait);
     // False: stop the task (its job was cancelled or the lease is gone).
     absl::StatusOr<bool> Heartbeat(const std::string& lease_id);
-    absl::Status Complete(const std::string& lease_id, const std::string& tile_sums,
-                          double seconds);
+    // Encoded TileSums, or a sweep task's lf::EncodeSweepResult.
+    struct TaskResult {
+        std::string bytes;
+        bool sweep = false;
+    };
+    absl::Status Complete(const std::string& lease_id, const TaskResult& result, double seconds);
     // `shutdown`: the worker is stopping, which does not count against the task.
     absl::Status Fail(const std::string& lease_id, const std::string& reason, bool shutdown);
     // Writes blob `hash` to `path`.

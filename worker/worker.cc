@@ -7,7 +7,9 @@
 #include <map>
 #include <thread>
 
+#include "lf/core/file_util.h"
 #include "lf/core/log.h"
+#include "lf/core/radiosity_codec.h"
 #include "lf/core/tile_codec.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/tile_renderer.h"
@@ -89,8 +91,15 @@ void Worker::Execute(const TaskAssignment& task) {
 
     const absl::Time start = absl::Now();
     absl::Status status = PrepareScene(task);
-    std::optional<TileSums> sums;
-    if (status.ok()) sums = Render(task, cancel);
+    ServerConnection::TaskResult result;
+    if (status.ok() && task.sweep >= 0) {
+        absl::StatusOr<std::string> swept = Sweep(task);
+        status = swept.status();
+        if (swept.ok()) result = {std::move(*swept), true};
+    } else if (status.ok()) {
+        status = PrepareTracer(task);
+        if (status.ok()) result.bytes = EncodeTileSums(Render(task, cancel));
+    }
     {
         std::lock_guard<std::mutex> lock(hb_mutex);
         task_over = true;
@@ -107,7 +116,7 @@ void Worker::Execute(const TaskAssignment& task) {
     if (dropped) {
         Log()->info("{} dropped: the job was cancelled or the lease lost", ids);
     } else if (status.ok() && !cancel) {
-        SendResult(task, *sums, absl::ToDoubleSeconds(absl::Now() - start));
+        SendResult(task, result, absl::ToDoubleSeconds(absl::Now() - start));
     } else if (stopping()) {
         Log()->info("{} handed back: worker shutting down", ids);
         (void)server_.Fail(task.lease_id, "worker shutting down", true);
@@ -142,25 +151,86 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
     if (!embree.ok()) return embree.status();
     loaded.embree = std::move(*embree);
     loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
-    if (task.method == "radiosity") {
-        // Every worker of the job solves the same system to the same bits (the solver is
-        // deterministic for any thread count), so its tiles match `lightfarm render`.
-        const RadiositySettings& r = task.radiosity;
-        absl::StatusOr<RadiosityOptions> radiosity_options = MakeRadiosityOptions(
-            r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
-        if (!radiosity_options.ok()) return radiosity_options.status();
-        radiosity_options->threads = options_.threads;
-        absl::StatusOr<std::unique_ptr<RadiosityRenderer>> radiosity =
-            PrepareRadiosity(*loaded.embree, *radiosity_options);
-        if (!radiosity.ok()) return radiosity.status();
-        loaded.tracer = std::move(*radiosity);
-    } else {
-        loaded.tracer = std::make_unique<PathTracer>(*loaded.embree, task.max_depth);
-    }
     loaded.job_id = task.job_id;
     loaded_ = std::move(loaded);
     Log()->info("job={} task={} scene {} loaded", task.job_id, task.task_index, task.scene.path);
     return absl::OkStatus();
+}
+
+absl::Status Worker::PrepareTracer(const TaskAssignment& task) {
+    if (loaded_.tracer) return absl::OkStatus();
+    if (task.method != "radiosity") {
+        loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.max_depth);
+        return absl::OkStatus();
+    }
+    const RadiositySettings& r = task.radiosity;
+    absl::StatusOr<RadiosityOptions> options = MakeRadiosityOptions(
+        r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
+    if (!options.ok()) return options.status();
+    options->threads = options_.threads;
+    absl::StatusOr<std::unique_ptr<RadiosityRenderer>> renderer;
+    if (!task.radiosity_hash.empty()) {  // solved by the farm's sweeps
+        absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task.radiosity_hash);
+        if (!solution.ok()) return solution.status();
+        renderer = RadiosityRendererFor(*loaded_.embree, *options, std::move(*solution));
+    } else {
+        // Every worker of the job solves the same system to the same bits (the solver is
+        // deterministic for any thread count), so its tiles match `lightfarm render`.
+        renderer = PrepareRadiosity(*loaded_.embree, *options);
+    }
+    if (!renderer.ok()) return renderer.status();
+    loaded_.tracer = std::move(*renderer);
+    // The sweeps are over: their form-factor rows are not needed again.
+    loaded_.chunks.clear();
+    loaded_.input.clear();
+    return absl::OkStatus();
+}
+
+absl::StatusOr<std::vector<Rgb>> Worker::ReadRadiosity(const std::string& hash) {
+    absl::StatusOr<std::string> path = cache_.Get(
+        hash, [&](const std::string& h, const std::string& p) { return server_.FetchBlob(h, p); });
+    if (!path.ok()) return path.status();
+    absl::StatusOr<std::string> bytes = ReadFile(*path);
+    if (!bytes.ok()) return bytes.status();
+    return DecodeRadiosity(*bytes);
+}
+
+absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task) {
+    const RadiositySettings& r = task.radiosity;
+    std::unique_ptr<RadiositySweepChunk>& chunk = loaded_.chunks[task.chunk];
+    if (!chunk) {
+        absl::StatusOr<RadiosityOptions> options = MakeRadiosityOptions(
+            r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
+        if (!options.ok()) return options.status();
+        const absl::Time start = absl::Now();
+        absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> built;
+        arena_.execute([&] {
+            built = RadiositySweepChunk::Build(*loaded_.embree, *options, task.chunk,
+                                               r.sweep_tasks);
+        });
+        if (!built.ok()) {
+            loaded_.chunks.erase(task.chunk);
+            return built.status();
+        }
+        chunk = std::move(*built);
+        Log()->info("job={} task={} form factors of chunk {}/{} in {:.2f} s", task.job_id,
+                    task.task_index, task.chunk, r.sweep_tasks,
+                    absl::ToDoubleSeconds(absl::Now() - start));
+    }
+    std::span<const Rgb> input = chunk->emission();
+    if (!task.radiosity_hash.empty()) {
+        if (loaded_.input_hash != task.radiosity_hash) {
+            absl::StatusOr<std::vector<Rgb>> read = ReadRadiosity(task.radiosity_hash);
+            if (!read.ok()) return read.status();
+            loaded_.input = std::move(*read);
+            loaded_.input_hash = task.radiosity_hash;
+        }
+        input = loaded_.input;
+    }
+    absl::StatusOr<SweepChunkResult> result;
+    arena_.execute([&] { result = chunk->Sweep(task.sweep, input); });
+    if (!result.ok()) return result.status();
+    return EncodeSweepResult(*result);
 }
 
 TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& cancel) {
@@ -193,11 +263,11 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
     return tile;
 }
 
-void Worker::SendResult(const TaskAssignment& task, const TileSums& sums, double seconds) {
-    const absl::Status sent = server_.Complete(task.lease_id, EncodeTileSums(sums), seconds);
+void Worker::SendResult(const TaskAssignment& task, const ServerConnection::TaskResult& result,
+                        double seconds) {
+    const absl::Status sent = server_.Complete(task.lease_id, result, seconds);
     if (sent.ok()) {
-        Log()->debug("job={} task={} done in {:.2f} s ({} samples)", task.job_id, task.task_index,
-                     seconds, sums.stats.samples);
+        Log()->debug("job={} task={} done in {:.2f} s", task.job_id, task.task_index, seconds);
     } else {
         Log()->warn("job={} task={} result not taken: {}", task.job_id, task.task_index,
                     std::string(sent.message()));

@@ -1,12 +1,14 @@
-// A stateless farm worker: leases a task, renders its tile and sample range, hands back the
-// exact sums, and again. The only state kept between tasks is a cache: scene blobs on disk and
-// the last job's built scene in memory.
+// A stateless farm worker: leases a task, renders its tile and sample range (or sweeps its
+// patch groups of a radiosity solve), hands back the result, and again. The only state kept
+// between tasks is a cache: scene blobs on disk, and the last job's built scene, radiosity
+// form-factor rows and solution in memory.
 #pragma once
 
 #include <tbb/task_arena.h>
 
 #include <atomic>
 #include <condition_variable>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -16,6 +18,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiance.h"
+#include "lf/kernels/radiosity.h"
 #include "worker/blob_cache.h"
 #include "worker/server_connection.h"
 
@@ -46,13 +49,24 @@ private:
         std::unique_ptr<EmbreeScene> embree;
         std::unique_ptr<Camera> camera;
         std::unique_ptr<RadianceEstimator> tracer;  // path tracer or radiosity display
+        // Radiosity solved in sweeps: the form-factor rows of the chunks this worker swept
+        // (the server gives a chunk back to the worker that has its rows), and the last input.
+        std::map<int, std::unique_ptr<RadiositySweepChunk>> chunks;
+        std::string input_hash;
+        std::vector<Rgb> input;
     };
 
     void Execute(const TaskAssignment& task);
     // The job's scene, built once for consecutive tasks of the same job.
     absl::Status PrepareScene(const TaskAssignment& task);
+    // The job's path tracer or radiosity display, built once per job.
+    absl::Status PrepareTracer(const TaskAssignment& task);
     TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
-    void SendResult(const TaskAssignment& task, const TileSums& sums, double seconds);
+    absl::StatusOr<std::string> Sweep(const TaskAssignment& task);
+    // A radiosity vector the server stored as a blob.
+    absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
+    void SendResult(const TaskAssignment& task, const ServerConnection::TaskResult& result,
+                    double seconds);
     bool stopping() const { return stopping_.load(); }
     void WaitIdle(absl::Duration d);
 

@@ -463,6 +463,11 @@ double FormFactors::RowSum(int32_t i) const {
     return sum;
 }
 
+std::pair<int32_t, int32_t> ChunkGroups(int32_t groups, int chunk, int chunks) {
+    const auto at = [&](int k) { return int32_t(int64_t(groups) * k / std::max(chunks, 1)); };
+    return {at(chunk), at(chunk + 1)};
+}
+
 FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
                                const FormFactorOptions& options) {
     const PairEvaluator evaluator(scene, mesh);
@@ -470,12 +475,17 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
     std::vector<PatchGroup> groups = MakeGroups(mesh, std::max(1, options.group_size));
     std::vector<GroupPlane> planes;
     for (const PatchGroup& g : groups) planes.push_back(PlaneOf(g, sides, evaluator.epsilon()));
+    const auto [row_begin, row_end] = ChunkGroups(int32_t(groups.size()), options.chunk,
+                                                  options.chunks);
+    auto wanted = [&](int32_t g) { return g >= row_begin && g < row_end; };
 
-    // Unordered pairs of groups that may see each other; each task fills both blocks.
+    // Unordered pairs of groups that may see each other; each task fills both blocks (those
+    // of wanted rows).
     std::vector<std::pair<int32_t, int32_t>> tasks;
     int64_t total_work = 0;
     for (int32_t i = 0; i < int32_t(groups.size()); ++i) {
         for (int32_t j = i; j < int32_t(groups.size()); ++j) {
+            if (!wanted(i) && !wanted(j)) continue;
             if (i == j && planes[size_t(i)].planar) continue;
             const double eps = evaluator.epsilon();
             if (AllBehind(groups[size_t(j)], sides, planes[size_t(i)], eps) ||
@@ -508,8 +518,8 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
                 }
             }
         }
-        results[t][0] = ShrinkBlock(gi, gj, rows, cols, ij);
-        if (gi != gj) results[t][1] = ShrinkBlock(gj, gi, cols, rows, ji);
+        if (wanted(gi)) results[t][0] = ShrinkBlock(gi, gj, rows, cols, ij);
+        if (gi != gj && wanted(gj)) results[t][1] = ShrinkBlock(gj, gi, cols, rows, ji);
         progress.Add(int64_t(rows.size()) * cols.size());
     });
 

@@ -1,5 +1,6 @@
 #include "lf/kernels/radiosity.h"
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <chrono>
@@ -144,6 +145,75 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
 }
 
 }  // namespace
+
+absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
+    const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks) {
+    if (chunks < 1 || chunk < 0 || chunk >= chunks) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("radiosity: chunk %d of %d does not exist", chunk, chunks));
+    }
+    if (absl::Status status = CheckReflectance(scene.scene()); !status.ok()) return status;
+    absl::StatusOr<PatchMesh> mesh =
+        PatchMesh::Build(scene.scene(), {options.patch_size, options.patches});
+    if (!mesh.ok()) return mesh.status();
+    std::unique_ptr<RadiositySweepChunk> out(new RadiositySweepChunk());
+    out->chunk_ = chunk;
+    FormFactorOptions ff_options;
+    ff_options.chunk = chunk;
+    ff_options.chunks = chunks;
+    out->form_factors_ = ComputeFormFactors(scene, *mesh, ff_options);
+    out->groups_ =
+        ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
+    out->system_ = MakeSystem(scene, *mesh, out->form_factors_);
+    return out;
+}
+
+absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
+                                                           std::span<const Rgb> b) const {
+    if (int64_t(b.size()) != sides()) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "radiosity sweep %d: %d values for %d unknowns", sweep, b.size(), sides()));
+    }
+    const auto& groups = form_factors_.groups();
+    const auto [g0, g1] = groups_;
+    SweepChunkResult r;
+    r.sweep = sweep;
+    r.chunk = chunk_;
+    r.sides = sides();
+    r.side_begin = g0 < g1 ? groups[size_t(g0)].begin : 0;
+    const int32_t side_end = g0 < g1 ? groups[size_t(g1 - 1)].end : 0;
+    r.input.assign(b.begin() + r.side_begin, b.begin() + side_end);
+    r.output.resize(r.input.size());
+    r.change.resize(size_t(g1 - g0));
+    r.power.resize(size_t(g1 - g0));
+    tbb::parallel_for(g0, g1, [&](int32_t g) {
+        const PatchGroup& group = groups[size_t(g)];
+        const std::span<Rgb> out = std::span<Rgb>(r.output).subspan(
+            size_t(group.begin - r.side_begin), size_t(group.size()));
+        const GroupSweep sums = JacobiGroup(system_, g, b, out);
+        r.change[size_t(g - g0)] = sums.change;
+        r.power[size_t(g - g0)] = sums.power;
+    });
+    return r;
+}
+
+absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
+    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity) {
+    absl::StatusOr<PatchMesh> mesh =
+        PatchMesh::Build(scene.scene(), {options.patch_size, options.patches});
+    if (!mesh.ok()) return mesh.status();
+    if (radiosity.size() != mesh->sides().size()) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("radiosity: a solution of %d values for a mesh of %d unknowns",
+                            radiosity.size(), mesh->sides().size()));
+    }
+    RadiosityReport report;
+    report.patches = int64_t(mesh->patches().size());
+    report.sides = int64_t(mesh->sides().size());
+    report.patch_size = mesh->patch_size();
+    return std::make_unique<RadiosityRenderer>(scene, std::move(*mesh), std::move(radiosity),
+                                               options.display, report);
+}
 
 RadiosityRenderer::RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh,
                                      std::vector<Rgb> radiosity, RadiosityShading shading,

@@ -75,21 +75,20 @@ class SolveLog {
         std::chrono::steady_clock::now() + std::chrono::seconds(5);
 };
 
-// b_next = E + ρ F b for every group at once; the returned value is ||b_next - b||, the
-// residual of b.
-double JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, std::span<Rgb> next) {
+// b_next = E + ρ F b for every group at once, and the sweep's residual sums.
+GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, std::span<Rgb> next) {
     const auto& groups = system.form_factors->groups();
-    std::vector<double> change(groups.size(), 0);
+    std::vector<GroupSweep> parts(groups.size());
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
         const PatchGroup& group = groups[g];
-        std::span<Rgb> out = next.subspan(size_t(group.begin), size_t(group.size()));
-        GatherGroup(system, int32_t(g), b, out);
-        for (int32_t i = group.begin; i < group.end; ++i) {
-            change[g] += Power(system.area[size_t(i)], next[size_t(i)] - b[size_t(i)]);
-        }
+        parts[g] = JacobiGroup(system, int32_t(g), b,
+                               next.subspan(size_t(group.begin), size_t(group.size())));
     });
-    double total = 0;
-    for (double c : change) total += c;
+    GroupSweep total;
+    for (const GroupSweep& p : parts) {
+        total.change += p.change;
+        total.power += p.power;
+    }
     return total;
 }
 
@@ -99,7 +98,8 @@ absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
     std::vector<Rgb> b = system.emission, next(b.size());
     SolveLog log;
     for (;;) {
-        const double residual = JacobiSweep(system, b, next) / SystemPower(system, b);
+        const GroupSweep sweep = JacobiSweep(system, b, next);
+        const double residual = sweep.change / sweep.power;
         ++result.iterations;
         if (residual <= options.tolerance) {
             result.residual = residual;
@@ -232,11 +232,23 @@ void GatherGroup(const RadiositySystem& system, int32_t group, std::span<const R
     }
 }
 
+GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
+                       std::span<Rgb> out) {
+    GatherGroup(system, group, b, out);
+    const PatchGroup& g = system.form_factors->groups()[size_t(group)];
+    GroupSweep sums;
+    for (int32_t i = g.begin; i < g.end; ++i) {
+        const double area = system.area[size_t(i)];
+        sums.change += Power(area, out[size_t(i - g.begin)] - b[size_t(i)]);
+        sums.power += Power(area, b[size_t(i)]);
+    }
+    return sums;
+}
+
 double RelativeResidual(const RadiositySystem& system, std::span<const Rgb> b) {
-    const double norm = SystemPower(system, b);
     std::vector<Rgb> next(b.size());
-    const double residual = JacobiSweep(system, b, next);
-    return norm > 0 ? residual / norm : residual;
+    const GroupSweep sweep = JacobiSweep(system, b, next);
+    return sweep.power > 0 ? sweep.change / sweep.power : sweep.change;
 }
 
 absl::StatusOr<SolveResult> SolveRadiosity(const RadiositySystem& system,

@@ -512,6 +512,49 @@ TEST_F(Farm, RadiosityJobGivesTheLocalPixels) {
     ExpectSameAsLocal(job, scene_, 2, 6, flags);
 }
 
+// With --solver jacobi the farm solves: every sweep is --sweep-tasks patch-group tasks, and
+// each chunk of form-factor rows is computed once, by the worker that keeps sweeping it. The
+// solution, and so the image, has the bits of a local Jacobi solve for any split.
+TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string flags = "--method radiosity --patches 300 --solver jacobi";
+    int chunks = 0;
+    for (int sweep_tasks : {3, 5}) {
+        const std::string job = Submit(
+            scene_, "--spp 2 --seed 6 --tile 16 --sweep-tasks " + std::to_string(sweep_tasks) +
+                        " " + flags);
+        ExpectSameAsLocal(job, scene_, 2, 6, flags);
+        chunks += sweep_tasks;
+    }
+    const std::string logs = ReadText(dir_ / "w1.log") + ReadText(dir_ / "w2.log");
+    int built = 0;
+    for (size_t at = 0; (at = logs.find("form factors of chunk", at)) != std::string::npos; ++at) {
+        ++built;
+    }
+    EXPECT_EQ(built, chunks) << "a chunk's form factors were computed twice:\n" << logs;
+    const std::string server_log = ReadText(dir_ / "server-1.log");
+    EXPECT_NE(server_log.find("radiosity sweep 2: relative residual"), std::string::npos);
+}
+
+// The solve is not recorded: a server killed mid-solve starts it again, to the same bits.
+TEST_F(Farm, ServerKilledMidSolveStillGivesTheLocalPixels) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string flags = "--method radiosity --patches 300 --solver jacobi";
+    const std::string job = Submit(scene_, "--spp 2 --seed 8 --tile 16 " + flags);
+    const auto deadline = Clock::now() + milliseconds(30000);
+    while (ReadText(dir_ / "server-1.log").find("radiosity sweep 3:") == std::string::npos &&
+           Clock::now() < deadline) {
+        std::this_thread::sleep_for(milliseconds(2));
+    }
+    CrashAndRestartServer();
+    ExpectSameAsLocal(job, scene_, 2, 8, flags);
+    EXPECT_NE(ReadText(dir_ / "server-2.log").find("radiosity sweep 1:"), std::string::npos);
+}
+
 TEST_F(Farm, RadiosityJobForAGlossySceneIsRefusedAtSubmission) {
     StartServer();
     const std::string glossy = (dir_ / "glossy.json").string();

@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "lf/core/patch_mesh.h"
@@ -81,7 +82,15 @@ class FormFactors {
 
 struct FormFactorOptions {
     int32_t group_size = 64;
+    // Only the rows of chunk `chunk` of `chunks` (ChunkGroups): the share of one farm task. Its
+    // values are bit for bit those of the whole matrix, as every pair is evaluated in the same
+    // order either way; rows of other chunks are left out (no blocks).
+    int chunk = 0, chunks = 1;
 };
+
+// Chunk `chunk` of `chunks` of `groups` patch groups: [groups * chunk / chunks,
+// groups * (chunk + 1) / chunks), so the chunks cover every group once, in order.
+std::pair<int32_t, int32_t> ChunkGroups(int32_t groups, int chunk, int chunks);
 
 // Runs in the caller's TBB arena; the result does not depend on the thread count.
 FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,

@@ -12,11 +12,14 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "lf/core/patch_mesh.h"
+#include "lf/core/radiosity_codec.h"
 #include "lf/kernels/embree_scene.h"
+#include "lf/kernels/form_factors.h"
 #include "lf/kernels/radiance.h"
 #include "lf/kernels/radiosity_display.h"
 #include "lf/kernels/radiosity_solver.h"
@@ -70,6 +73,36 @@ class RadiosityRenderer : public RadianceEstimator {
     std::unique_ptr<RadiosityDisplay> display_;
     RadiosityReport report_;
 };
+
+// One patch-group task of the farm's Jacobi solve (server/radiosity_solve.h): the form-factor
+// rows of chunk `chunk` of `chunks` of the patch groups, computed once, then swept against the
+// radiosity of each sweep in turn. The sweep's sums are those SolveRadiosity's Jacobi solver
+// makes, so the farm's solution has its bits.
+class RadiositySweepChunk {
+  public:
+    // The same checks as PrepareRadiosity; InvalidArgument for a chunk outside 0..chunks-1.
+    static absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> Build(
+        const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks);
+
+    int32_t sides() const { return int32_t(system_.emission.size()); }
+    // E: the radiosity sweep 0 starts from.
+    const std::vector<Rgb>& emission() const { return system_.emission; }
+    // The chunk's part of one sweep from `b` (all sides); InvalidArgument when b is not one
+    // value per side. Runs in the caller's TBB arena.
+    absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> b) const;
+
+  private:
+    RadiositySweepChunk() = default;
+    int chunk_ = 0;
+    std::pair<int32_t, int32_t> groups_;
+    FormFactors form_factors_;  // the chunk's rows only
+    RadiositySystem system_;
+};
+
+// The renderer of a solution solved elsewhere (by the farm's sweeps): the scene meshed as
+// `options` say, displaying `radiosity`; InvalidArgument unless it holds one value per side.
+absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
+    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity);
 
 // Options from plain values, as `render`, `submit` and the farm's workers receive them;
 // InvalidArgument naming a bad solver or display name.

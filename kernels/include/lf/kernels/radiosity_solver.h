@@ -62,6 +62,15 @@ absl::StatusOr<SolveResult> SolveRadiosity(const RadiositySystem& system,
 void GatherGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
                  std::span<Rgb> out);
 
+// GatherGroup, and the group's share of a Jacobi sweep's residual: change = ||out - b|| and
+// power = ||b|| over the group's sides. A sweep sums these in group order, locally and on the
+// farm alike (server/radiosity_solve.h), so both stop after the same sweep with the same bits.
+struct GroupSweep {
+    double change = 0, power = 0;
+};
+GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
+                       std::span<Rgb> out);
+
 // ||E + ρ F b - b|| / ||b|| in the power norm above (0 when b and E are 0).
 double RelativeResidual(const RadiositySystem& system, std::span<const Rgb> b);
 
