@@ -9,9 +9,9 @@ RadiositySolve::RadiositySolve(int chunks, double tolerance, int max_iterations)
 
 absl::Status RadiositySolve::Add(const SweepChunkResult& r) {
     if (r.sweep != sweep_ || r.chunk < 0 || r.chunk >= chunks_) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "sweep result of sweep %d chunk %d, expected sweep %d chunk 0..%d", r.sweep, r.chunk,
-            sweep_, chunks_ - 1));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("sweep result of sweep %d chunk %d, expected sweep %d chunk 0..%d",
+                            r.sweep, r.chunk, sweep_, chunks_ - 1));
     }
     if (results_[size_t(r.chunk)]) {
         return absl::AlreadyExistsError(
@@ -22,9 +22,9 @@ absl::Status RadiositySolve::Add(const SweepChunkResult& r) {
     }
     for (const auto& other : results_) {
         if (other && other->sides != r.sides) {
-            return absl::InvalidArgumentError(absl::StrFormat(
-                "sweep result of chunk %d has %d unknowns, chunk %d had %d", r.chunk, r.sides,
-                other->chunk, other->sides));
+            return absl::InvalidArgumentError(
+                absl::StrFormat("sweep result of chunk %d has %d unknowns, chunk %d had %d",
+                                r.chunk, r.sides, other->chunk, other->sides));
         }
     }
     if (!input_.empty()) {

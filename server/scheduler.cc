@@ -237,18 +237,18 @@ Lease Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time no
     Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, worker,
                  task.attempts);
     if (!IsSweepTask(job, t)) {
-        return Lease{lease_id, job.record.id, job.plan[size_t(t)], job.record.spec, -1, 0,
-                     job.solution};
+        return Lease{lease_id, job.record.id, job.plan[size_t(t)], job.record.spec, -1,
+                     0,        job.solution};
     }
     const int k = t - int(job.plan.size()), chunks = job.solve->chunks();
     job.chunk_owner[k % chunks] = worker;
-    return Lease{lease_id,    job.record.id, RenderTask{t, {}, 0, 0}, job.record.spec,
-                 k / chunks,  k % chunks,    job.sweep_input};
+    return Lease{lease_id,   job.record.id, RenderTask{t, {}, 0, 0}, job.record.spec,
+                 k / chunks, k % chunks,    job.sweep_input};
 }
 
 void Scheduler::QueueStart(Job& job) {
-    if (SolvedInSweeps(job.record.spec.method, job.record.spec.radiosity) &&
-        job.solution.empty() && !job.merger.Complete()) {
+    if (SolvedInSweeps(job.record.spec.method, job.record.spec.radiosity) && job.solution.empty() &&
+        !job.merger.Complete()) {
         // The solve is not recorded: after a restart it runs again, to the same bits, and the
         // tiles already done stay done.
         const RadiositySettings& r = job.record.spec.radiosity;
@@ -399,8 +399,8 @@ absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
     absl::Status added =
         !IsSweepTask(job, ref->task) ? absl::InvalidArgumentError("a sweep result for a tile")
         : result.sweep != k / job.solve->chunks() || result.chunk != k % job.solve->chunks()
-            ? absl::InvalidArgumentError(absl::StrCat("a result of sweep ", result.sweep,
-                                                      " chunk ", result.chunk))
+            ? absl::InvalidArgumentError(
+                  absl::StrCat("a result of sweep ", result.sweep, " chunk ", result.chunk))
             : job.solve->Add(result);
     if (!added.ok()) {
         const std::string error = absl::StrCat("job=", job.record.id, " task=", ref->task, " from ",

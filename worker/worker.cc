@@ -205,8 +205,8 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task) {
         const absl::Time start = absl::Now();
         absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> built;
         arena_.execute([&] {
-            built = RadiositySweepChunk::Build(*loaded_.embree, *options, task.chunk,
-                                               r.sweep_tasks);
+            built =
+                RadiositySweepChunk::Build(*loaded_.embree, *options, task.chunk, r.sweep_tasks);
         });
         if (!built.ok()) {
             loaded_.chunks.erase(task.chunk);

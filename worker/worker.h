@@ -34,7 +34,7 @@ struct WorkerOptions {
 };
 
 class Worker {
-public:
+  public:
     Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache);
 
     // Leases and renders tasks until Stop.
@@ -42,7 +42,7 @@ public:
     // Thread-safe: stops the current task, hands it back, and makes Run return.
     void Stop();
 
-private:
+  private:
     struct LoadedScene {
         std::string job_id;
         std::unique_ptr<Scene> scene;  // EmbreeScene keeps a reference

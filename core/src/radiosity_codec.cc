@@ -126,7 +126,8 @@ absl::StatusOr<SweepChunkResult> DecodeSweepResult(std::string_view bytes) {
         in.Count(side_count, 6 * sizeof(float)) && in.Count(groups, 2 * sizeof(double))) {
         r.change.resize(size_t(groups));
         r.power.resize(size_t(groups));
-        for (int64_t g = 0; g < groups; ++g) in.Get(r.change[size_t(g)]), in.Get(r.power[size_t(g)]);
+        for (int64_t g = 0; g < groups; ++g)
+            in.Get(r.change[size_t(g)]), in.Get(r.power[size_t(g)]);
         r.input = in.Rgbs(side_count);
         r.output = in.Rgbs(side_count);
     }

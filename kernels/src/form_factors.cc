@@ -475,8 +475,8 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
     std::vector<PatchGroup> groups = MakeGroups(mesh, std::max(1, options.group_size));
     std::vector<GroupPlane> planes;
     for (const PatchGroup& g : groups) planes.push_back(PlaneOf(g, sides, evaluator.epsilon()));
-    const auto [row_begin, row_end] = ChunkGroups(int32_t(groups.size()), options.chunk,
-                                                  options.chunks);
+    const auto [row_begin, row_end] =
+        ChunkGroups(int32_t(groups.size()), options.chunk, options.chunks);
     auto wanted = [&](int32_t g) { return g >= row_begin && g < row_end; };
 
     // Unordered pairs of groups that may see each other; each task fills both blocks (those

@@ -162,14 +162,13 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     ff_options.chunk = chunk;
     ff_options.chunks = chunks;
     out->form_factors_ = ComputeFormFactors(scene, *mesh, ff_options);
-    out->groups_ =
-        ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
+    out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
     out->system_ = MakeSystem(scene, *mesh, out->form_factors_);
     return out;
 }
 
 absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
-                                                           std::span<const Rgb> b) const {
+                                                            std::span<const Rgb> b) const {
     if (int64_t(b.size()) != sides()) {
         return absl::InvalidArgumentError(absl::StrFormat(
             "radiosity sweep %d: %d values for %d unknowns", sweep, b.size(), sides()));

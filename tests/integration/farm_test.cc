@@ -522,9 +522,8 @@ TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
     const std::string flags = "--method radiosity --patches 300 --solver jacobi";
     int chunks = 0;
     for (int sweep_tasks : {3, 5}) {
-        const std::string job = Submit(
-            scene_, "--spp 2 --seed 6 --tile 16 --sweep-tasks " + std::to_string(sweep_tasks) +
-                        " " + flags);
+        const std::string job = Submit(scene_, "--spp 2 --seed 6 --tile 16 --sweep-tasks " +
+                                                   std::to_string(sweep_tasks) + " " + flags);
         ExpectSameAsLocal(job, scene_, 2, 6, flags);
         chunks += sweep_tasks;
     }

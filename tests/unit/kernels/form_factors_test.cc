@@ -306,5 +306,40 @@ TEST(FormFactors, ClosedBoxRowsSumToOne) {
     }
 }
 
+// A farm task computes only its chunk's rows; they must be the whole matrix's bits, or the
+// farm's solution would drift from the local one. The chunks also cover every group once.
+TEST(FormFactors, ChunkRowsAreTheWholeMatrixRows) {
+    auto m = Compute(testing::MakeFurnace(1.0, Vec3d(0, 0, 0), 0.5f, 1.0f, 8), Count(300));
+    const int32_t groups = int32_t(m->ff.groups().size());
+    ASSERT_GT(groups, 3);
+    for (int chunks : {1, 3, groups + 2}) {
+        int32_t next = 0;
+        for (int c = 0; c < chunks; ++c) {
+            const auto [g0, g1] = ChunkGroups(groups, c, chunks);
+            EXPECT_EQ(g0, next);
+            next = g1;
+            FormFactorOptions options;
+            options.chunk = c;
+            options.chunks = chunks;
+            const FormFactors part = ComputeFormFactors(*m->embree, m->mesh, options);
+            for (int32_t g = 0; g < groups; ++g) {
+                const auto whole = m->ff.RowBlocks(g), mine = part.RowBlocks(g);
+                if (g < g0 || g >= g1) {
+                    EXPECT_TRUE(mine.empty()) << "chunk " << c << " holds rows of group " << g;
+                    continue;
+                }
+                ASSERT_EQ(whole.size(), mine.size()) << "group " << g;
+                for (size_t b = 0; b < whole.size(); ++b) {
+                    EXPECT_EQ(whole[b].col_group, mine[b].col_group);
+                    EXPECT_EQ(whole[b].row_begin, mine[b].row_begin);
+                    EXPECT_EQ(whole[b].col_begin, mine[b].col_begin);
+                    EXPECT_EQ(whole[b].values, mine[b].values) << "group " << g;
+                }
+            }
+        }
+        EXPECT_EQ(next, groups);
+    }
+}
+
 }  // namespace
 }  // namespace lf

@@ -29,8 +29,8 @@ absl::StatusOr<std::vector<Rgb>> DecodeRadiosity(std::string_view bytes);
 // group of the run the two sums the residual needs (power norm, see radiosity_solver.h).
 struct SweepChunkResult {
     int32_t sweep = 0, chunk = 0;
-    int32_t sides = 0;       // unknowns of the whole system
-    int32_t side_begin = 0;  // the run: [side_begin, side_begin + input.size())
+    int32_t sides = 0;                  // unknowns of the whole system
+    int32_t side_begin = 0;             // the run: [side_begin, side_begin + input.size())
     std::vector<double> change, power;  // per group: ||output - input||, ||input||
     std::vector<Rgb> input, output;
 };

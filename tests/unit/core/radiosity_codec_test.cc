@@ -1,0 +1,74 @@
+#include "lf/core/radiosity_codec.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace lf {
+namespace {
+
+SweepChunkResult Example() {
+    SweepChunkResult r;
+    r.sweep = 7;
+    r.chunk = 2;
+    r.sides = 10;
+    r.side_begin = 4;
+    r.change = {0.1, std::numeric_limits<double>::denorm_min()};
+    r.power = {3.0, 1e300};
+    r.input = {Rgb(1, 2, 3), Rgb(0.1f, 0.2f, 0.3f), Rgb(-0.0f, 5, 6)};
+    r.output = {Rgb(4, 5, 6), Rgb(7, 8, 9), Rgb(1e-40f, 1e38f, 0)};
+    return r;
+}
+
+TEST(RadiosityCodec, RadiosityRoundTripKeepsEveryBit) {
+    const std::vector<Rgb> values = {Rgb(0.1f, 1e-40f, 3e38f), Rgb(-0.0f, 0, 1)};
+    absl::StatusOr<std::vector<Rgb>> back = DecodeRadiosity(EncodeRadiosity(values));
+    ASSERT_TRUE(back.ok()) << back.status();
+    ASSERT_EQ(back->size(), values.size());
+    for (size_t i = 0; i < values.size(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(std::signbit((*back)[i][c]), std::signbit(values[i][c]));
+            EXPECT_EQ((*back)[i][c], values[i][c]);
+        }
+    }
+}
+
+TEST(RadiosityCodec, SweepResultRoundTripKeepsEveryBit) {
+    const SweepChunkResult r = Example();
+    absl::StatusOr<SweepChunkResult> back = DecodeSweepResult(EncodeSweepResult(r));
+    ASSERT_TRUE(back.ok()) << back.status();
+    EXPECT_EQ(back->sweep, r.sweep);
+    EXPECT_EQ(back->chunk, r.chunk);
+    EXPECT_EQ(back->sides, r.sides);
+    EXPECT_EQ(back->side_begin, r.side_begin);
+    EXPECT_EQ(back->change, r.change);
+    EXPECT_EQ(back->power, r.power);
+    EXPECT_EQ(back->input, r.input);
+    EXPECT_EQ(back->output, r.output);
+}
+
+TEST(RadiosityCodec, GarbageIsRefusedWithAReason) {
+    const std::string good = EncodeSweepResult(Example());
+    EXPECT_FALSE(DecodeSweepResult("").ok());
+    EXPECT_FALSE(DecodeSweepResult(EncodeRadiosity({})).ok());  // the other kind
+    for (size_t cut : {size_t(5), size_t(20), good.size() - 1}) {
+        absl::StatusOr<SweepChunkResult> r = DecodeSweepResult(good.substr(0, cut));
+        EXPECT_FALSE(r.ok()) << cut;
+    }
+    EXPECT_NE(DecodeSweepResult(good + "x").status().message().find("after the end"),
+              std::string::npos);
+    SweepChunkResult outside = Example();
+    outside.side_begin = 8;  // 3 sides from 8 overrun the system's 10
+    absl::StatusOr<SweepChunkResult> r = DecodeSweepResult(EncodeSweepResult(outside));
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.status().message().find("outside"), std::string::npos) << r.status();
+    // A count far beyond the bytes present is refused before anything is allocated.
+    std::string huge = EncodeRadiosity({});
+    huge[8] = huge[9] = huge[10] = char(0xff);
+    huge[11] = char(0x3f);
+    EXPECT_FALSE(DecodeRadiosity(huge).ok());
+}
+
+}  // namespace
+}  // namespace lf
