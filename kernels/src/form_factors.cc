@@ -235,7 +235,9 @@ class PairEvaluator {
     const std::vector<SideGeometry>& sides() const { return sides_; }
     double epsilon() const { return epsilon_; }
 
-    PairFormFactors Evaluate(int32_t ia, int32_t ib) const {
+    // F_ab and F_ba share the visibility rays; `ab` or `ba` false skips that one's quadrature
+    // (a chunk of rows needs only its own), leaving it 0.
+    PairFormFactors Evaluate(int32_t ia, int32_t ib, bool ab = true, bool ba = true) const {
         const SideGeometry &a = sides_[size_t(ia)], &b = sides_[size_t(ib)];
         if (!Facing(a, b, epsilon_)) return {};
         const double distance = Length(a.c - b.c);
@@ -260,8 +262,8 @@ class PairEvaluator {
         f.rays = n;
         if (visible == 0) return f;
         const double v = double(visible) / n;
-        f.ab = v * UnoccludedFormFactor(a, b, level_a);
-        f.ba = v * UnoccludedFormFactor(b, a, level_b);
+        if (ab) f.ab = v * UnoccludedFormFactor(a, b, level_a);
+        if (ba) f.ba = v * UnoccludedFormFactor(b, a, level_b);
         return f;
     }
 
@@ -507,7 +509,7 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
         std::vector<float> ji(gi == gj ? 0 : ij.size(), 0.0f);
         for (int32_t a = rows.begin; a < rows.end; ++a) {
             for (int32_t b = gi == gj ? a + 1 : cols.begin; b < cols.end; ++b) {
-                const PairFormFactors f = evaluator.Evaluate(a, b);
+                const PairFormFactors f = evaluator.Evaluate(a, b, wanted(gi), wanted(gj));
                 task_rays[t] += f.rays;
                 const size_t ra = size_t(a - rows.begin), cb = size_t(b - cols.begin);
                 ij[ra * size_t(cols.size()) + cb] = float(f.ab);
