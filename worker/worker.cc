@@ -93,7 +93,7 @@ void Worker::Execute(const TaskAssignment& task) {
     absl::Status status = PrepareScene(task);
     ServerConnection::TaskResult result;
     if (status.ok() && task.sweep >= 0) {
-        absl::StatusOr<std::string> swept = Sweep(task);
+        absl::StatusOr<std::string> swept = Sweep(task, cancel);
         status = swept.status();
         if (swept.ok()) result = {std::move(*swept), true};
     } else if (status.ok()) {
@@ -195,7 +195,8 @@ absl::StatusOr<std::vector<Rgb>> Worker::ReadRadiosity(const std::string& hash) 
     return DecodeRadiosity(*bytes);
 }
 
-absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task) {
+absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
+                                          const std::atomic<bool>& cancel) {
     const RadiositySettings& r = task.radiosity;
     std::unique_ptr<RadiositySweepChunk>& chunk = loaded_.chunks[task.chunk];
     if (!chunk) {
@@ -205,8 +206,8 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task) {
         const absl::Time start = absl::Now();
         absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> built;
         arena_.execute([&] {
-            built =
-                RadiositySweepChunk::Build(*loaded_.embree, *options, task.chunk, r.sweep_tasks);
+            built = RadiositySweepChunk::Build(*loaded_.embree, *options, task.chunk, r.sweep_tasks,
+                                               &cancel);
         });
         if (!built.ok()) {
             loaded_.chunks.erase(task.chunk);

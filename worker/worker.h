@@ -62,7 +62,7 @@ class Worker {
     // The job's path tracer or radiosity display, built once per job.
     absl::Status PrepareTracer(const TaskAssignment& task);
     TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
-    absl::StatusOr<std::string> Sweep(const TaskAssignment& task);
+    absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A radiosity vector the server stored as a blob.
     absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
     void SendResult(const TaskAssignment& task, const ServerConnection::TaskResult& result,

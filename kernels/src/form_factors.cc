@@ -503,6 +503,7 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
     std::vector<int64_t> task_rays(tasks.size(), 0);
     ProgressLog progress(std::max<int64_t>(total_work, 1));
     tbb::parallel_for(size_t(0), tasks.size(), [&](size_t t) {
+        if (options.cancel && options.cancel->load(std::memory_order_relaxed)) return;
         const auto [gi, gj] = tasks[t];
         const PatchGroup &rows = groups[size_t(gi)], &cols = groups[size_t(gj)];
         std::vector<float> ij(size_t(rows.size()) * size_t(cols.size()), 0.0f);

@@ -147,7 +147,8 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
-    const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks) {
+    const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks,
+    const std::atomic<bool>* cancel) {
     if (chunks < 1 || chunk < 0 || chunk >= chunks) {
         return absl::InvalidArgumentError(
             absl::StrFormat("radiosity: chunk %d of %d does not exist", chunk, chunks));
@@ -161,7 +162,9 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     FormFactorOptions ff_options;
     ff_options.chunk = chunk;
     ff_options.chunks = chunks;
+    ff_options.cancel = cancel;
     out->form_factors_ = ComputeFormFactors(scene, *mesh, ff_options);
+    if (cancel && cancel->load()) return absl::CancelledError("radiosity: form factors cancelled");
     out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
     out->system_ = MakeSystem(scene, *mesh, out->form_factors_);
     return out;

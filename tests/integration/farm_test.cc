@@ -374,6 +374,23 @@ TEST_F(Farm, CancelStopsTheWorkWithinASecond) {
     EXPECT_NE(Farmctl("cancel " + job).status, 0);  // already ended
 }
 
+// Form factors are the long part of a radiosity task: a cancel stops them too.
+TEST_F(Farm, CancelStopsARadiositySolveWithinASecond) {
+    StartServer();
+    StartWorker("w1");
+    // One chunk of form factors for 12k patches: half a minute on one thread.
+    const std::string job =
+        Submit(scene_, "--method radiosity --solver jacobi --patches 12000 --sweep-tasks 1");
+    ASSERT_TRUE(WaitForStatus(job, "1 running", milliseconds(20000)));
+    std::this_thread::sleep_for(milliseconds(500));
+    ASSERT_EQ(Farmctl("cancel " + job).status, 0);
+    const auto start = Clock::now();
+    const CliRun watch = Farmctl("watch " + Submit(scene_, "--spp 4 --tile 32"), 20);
+    EXPECT_EQ(watch.status, 0) << watch.out << watch.err;
+    EXPECT_LT(Clock::now() - start, milliseconds(5000));
+    EXPECT_NE(ReadText(dir_ / "w1.log").find("dropped"), std::string::npos);
+}
+
 TEST_F(Farm, HigherPriorityJobOvertakesAnEarlierOne) {
     StartServer();
     StartWorker("w1");

@@ -16,6 +16,7 @@
 // columns that hold non-zeros. Time and memory grow as n^2 in the number of sides.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -86,6 +87,8 @@ struct FormFactorOptions {
     // values are bit for bit those of the whole matrix, as every pair is evaluated in the same
     // order either way; rows of other chunks are left out (no blocks).
     int chunk = 0, chunks = 1;
+    // Set from another thread: the remaining pairs are skipped (the result is then unusable).
+    const std::atomic<bool>* cancel = nullptr;
 };
 
 // Chunk `chunk` of `chunks` of `groups` patch groups: [groups * chunk / chunks,

@@ -80,9 +80,11 @@ class RadiosityRenderer : public RadianceEstimator {
 // makes, so the farm's solution has its bits.
 class RadiositySweepChunk {
   public:
-    // The same checks as PrepareRadiosity; InvalidArgument for a chunk outside 0..chunks-1.
+    // The same checks as PrepareRadiosity; InvalidArgument for a chunk outside 0..chunks-1;
+    // Cancelled soon after `cancel` is set.
     static absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> Build(
-        const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks);
+        const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks,
+        const std::atomic<bool>* cancel = nullptr);
 
     int32_t sides() const { return int32_t(system_.emission.size()); }
     // E: the radiosity sweep 0 starts from.
