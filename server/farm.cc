@@ -163,15 +163,18 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     return scheduler_.Submit(spec);
 }
 
+absl::Status Farm::RefuseUndecodable(const std::string& lease_id, const std::string& worker,
+                                     const absl::Status& why) {
+    const std::string reason = absl::StrCat("undecodable result: ", why.message());
+    scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
+    return absl::InvalidArgumentError(
+        absl::StrCat("lease ", lease_id, " from ", worker, ": ", reason));
+}
+
 absl::Status Farm::Complete(const std::string& lease_id, const std::string& worker,
                             std::string_view tile_sums) {
     absl::StatusOr<TileSums> sums = DecodeTileSums(tile_sums);
-    if (!sums.ok()) {
-        const std::string reason = absl::StrCat("undecodable result: ", sums.status().message());
-        scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
-        return absl::InvalidArgumentError(
-            absl::StrCat("lease ", lease_id, " from ", worker, ": ", reason));
-    }
+    if (!sums.ok()) return RefuseUndecodable(lease_id, worker, sums.status());
     absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, *sums);
     if (!done.ok()) return done.status();
     if (done->job_rendered) FinishJob(done->job_id);
@@ -181,12 +184,7 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
 absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
                                  std::string_view sweep_result) {
     absl::StatusOr<SweepChunkResult> result = DecodeSweepResult(sweep_result);
-    if (!result.ok()) {
-        const std::string reason = absl::StrCat("undecodable result: ", result.status().message());
-        scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
-        return absl::InvalidArgumentError(
-            absl::StrCat("lease ", lease_id, " from ", worker, ": ", reason));
-    }
+    if (!result.ok()) return RefuseUndecodable(lease_id, worker, result.status());
     absl::StatusOr<Scheduler::SweepCompletion> done =
         scheduler_.CompleteSweep(lease_id, worker, *result);
     if (!done.ok()) return done.status();

@@ -63,6 +63,9 @@ class Farm {
     Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
          std::unique_ptr<JobStore> store);
     absl::Status CheckSceneSize(uint64_t bytes) const;
+    // A result that is not one: the task goes back to the queue as a counted failure.
+    absl::Status RefuseUndecodable(const std::string& lease_id, const std::string& worker,
+                                   const absl::Status& why);
     // Writes the merged image with the render's header attributes, atomically.
     absl::Status WriteImage(const JobRecord& job, const Image& image, const std::string& path);
     void FinishJob(const std::string& job_id);

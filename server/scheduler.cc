@@ -318,28 +318,15 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
                                                           const TileSums& sums) {
     std::unique_lock<std::mutex> lock(mutex_);
     const absl::Time now = clock_();
-    workers_seen_[worker] = now;
-    const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !HeldBy(*ref, worker)) {
-        Log()->warn("result for lease {} from {} refused: not a lease it holds", lease_id, worker);
-        return absl::FailedPreconditionError(absl::StrCat(
-            "lease ", lease_id, " is not one of worker ", worker, " in a running job"));
-    }
+    const absl::StatusOr<LeaseRef> ref = ResultLease(lease_id, worker, now);
+    if (!ref.ok()) return ref.status();
     Job& job = *ref->job;
     Task& task = job.tasks[size_t(ref->task)];
     if (task.state == TaskState::kDone) return Completion{job.record.id, false};
     absl::Status merged = IsSweepTask(job, ref->task)
                               ? absl::InvalidArgumentError("a tile result for a sweep task")
                               : job.merger.Add(ref->task, sums);
-    if (absl::Status s = merged; !s.ok()) {
-        const std::string error = absl::StrCat("job=", job.record.id, " task=", ref->task, " from ",
-                                               worker, ": ", s.message());
-        if (IsCurrent(*ref)) {
-            timeouts_.Remove(lease_id);
-            Requeue(*ref, absl::StrCat("result refused: ", s.message()), true);
-        }
-        return absl::InvalidArgumentError(error);
-    }
+    if (!merged.ok()) return Refuse(*ref, lease_id, worker, merged);
     MarkDone(job, ref->task, now);
     job.record.tasks_done = int(job.merger.tasks_done());
     job.record.stats = job.merger.stats();
@@ -364,6 +351,30 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     return completion;
 }
 
+absl::StatusOr<Scheduler::LeaseRef> Scheduler::ResultLease(const std::string& lease_id,
+                                                           const std::string& worker,
+                                                           absl::Time now) {
+    workers_seen_[worker] = now;
+    const std::optional<LeaseRef> ref = Resolve(lease_id);
+    if (!ref || !HeldBy(*ref, worker)) {
+        Log()->warn("result for lease {} from {} refused: not a lease it holds", lease_id, worker);
+        return absl::FailedPreconditionError(absl::StrCat(
+            "lease ", lease_id, " is not one of worker ", worker, " in a running job"));
+    }
+    return *ref;
+}
+
+absl::Status Scheduler::Refuse(const LeaseRef& ref, const std::string& lease_id,
+                               const std::string& worker, const absl::Status& why) {
+    const std::string error = absl::StrCat("job=", ref.job->record.id, " task=", ref.task, " from ",
+                                           worker, ": ", why.message());
+    if (IsCurrent(ref)) {
+        timeouts_.Remove(lease_id);
+        Requeue(ref, absl::StrCat("result refused: ", why.message()), true);
+    }
+    return absl::InvalidArgumentError(error);
+}
+
 void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
     Task& task = job.tasks[size_t(t)];
     if (task.state == TaskState::kLeased) {
@@ -384,13 +395,8 @@ absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
     const std::string& lease_id, const std::string& worker, const SweepChunkResult& result) {
     std::lock_guard<std::mutex> lock(mutex_);
     const absl::Time now = clock_();
-    workers_seen_[worker] = now;
-    const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !HeldBy(*ref, worker)) {
-        Log()->warn("result for lease {} from {} refused: not a lease it holds", lease_id, worker);
-        return absl::FailedPreconditionError(absl::StrCat(
-            "lease ", lease_id, " is not one of worker ", worker, " in a running job"));
-    }
+    const absl::StatusOr<LeaseRef> ref = ResultLease(lease_id, worker, now);
+    if (!ref.ok()) return ref.status();
     Job& job = *ref->job;
     if (job.tasks[size_t(ref->task)].state == TaskState::kDone) {
         return SweepCompletion{job.record.id, std::nullopt};
@@ -402,15 +408,7 @@ absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
             ? absl::InvalidArgumentError(
                   absl::StrCat("a result of sweep ", result.sweep, " chunk ", result.chunk))
             : job.solve->Add(result);
-    if (!added.ok()) {
-        const std::string error = absl::StrCat("job=", job.record.id, " task=", ref->task, " from ",
-                                               worker, ": ", added.message());
-        if (IsCurrent(*ref)) {
-            timeouts_.Remove(lease_id);
-            Requeue(*ref, absl::StrCat("result refused: ", added.message()), true);
-        }
-        return absl::InvalidArgumentError(error);
-    }
+    if (!added.ok()) return Refuse(*ref, lease_id, worker, added);
     MarkDone(job, ref->task, now);
     SweepCompletion completion{job.record.id, std::nullopt};
     if (job.solve->SweepComplete()) {

@@ -178,6 +178,12 @@ class Scheduler {
     static bool IsSweepTask(const Job& job, int task) { return task >= int(job.plan.size()); }
     // A sweep task goes to its chunk's owner while that worker lives.
     bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;
+    // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).
+    absl::StatusOr<LeaseRef> ResultLease(const std::string& lease_id, const std::string& worker,
+                                         absl::Time now);
+    // Refuses a result: the task goes back to the queue as a counted failure.
+    absl::Status Refuse(const LeaseRef& ref, const std::string& lease_id, const std::string& worker,
+                        const absl::Status& why);
     // The bookkeeping of a task's first accepted result.
     void MarkDone(Job& job, int task, absl::Time now);
     // A second lease of a task running too long in the job, or -1 (see speculate_after).
