@@ -1,6 +1,7 @@
 #include "local_render.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -173,13 +174,21 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     if (adaptive || options.render.spp >= 2) {
         absl::StatusOr<double> estimated = EstimatedRelativeError(out->image);
         if (!estimated.ok()) return estimated.status();
+        absl::StatusOr<double> relmse = EstimatedRelMse(out->image);
+        if (!relmse.ok()) return relmse.status();
         summary.estimated_error = *estimated;
-        summary.high_variance = *estimated > kHighVarianceError;
+        summary.estimated_relmse = *relmse;
+        summary.high_variance = *relmse > kHighVarianceRelMse;
         attributes["lightfarm.estimatedError"] = *estimated;
+        attributes["lightfarm.estimatedRelMse"] = *relmse;
         attributes["lightfarm.highVariance"] = std::string(summary.high_variance ? "yes" : "no");
+        log->info("job={} estimated relative error {:.4f}, estimated relMSE {:.3g}", job_id,
+                  *estimated, *relmse);
         if (summary.high_variance) {
-            log->warn("job={} high variance: estimated relative error {:.3f} (above {})", job_id,
-                      *estimated, kHighVarianceError);
+            log->warn(
+                "job={} high variance: estimated relMSE {:.3g} (above {}), a typical pixel off "
+                "by {:.0f} %",
+                job_id, *relmse, kHighVarianceRelMse, 100 * std::sqrt(*relmse));
         }
     }
     attributes["lightfarm.truncatedPaths"] = std::to_string(out->stats.truncated_paths);

@@ -29,15 +29,19 @@ struct LocalRenderSummary {
     RenderStats stats;
     double seconds = 0;
     int width = 0, height = 0;
-    double estimated_error = -1;  // relative, from A/B; -1 below 2 samples per pixel
+    double estimated_error = -1;   // relative, from A/B; -1 below 2 samples per pixel
+    double estimated_relmse = -1;  // EstimatedRelMse; -1 below 2 samples per pixel
     bool high_variance = false;
     bool adaptive = false;
     AdaptiveReport adaptive_report;
 };
 
-// An image whose own relative error estimate is above this is reported as high variance: at
-// 10 % the noise is plainly visible and its mean is not to be trusted for measurements.
-inline constexpr double kHighVarianceError = 0.1;
+// An image whose own relMSE estimate (EstimatedRelMse) is above this is reported as high
+// variance: relMSE is a mean of squared relative errors, so above 0.01 = 0.1^2 a typical pixel
+// is off by more than 10 % of its value, where noise is plainly visible and the image is not
+// to be trusted for measurements. A per-pixel measure, unlike estimated_error (one RMS over
+// the image against its mean radiance), which a light's few half-covered edge pixels dominate.
+inline constexpr double kHighVarianceRelMse = 0.01;
 
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options);
 

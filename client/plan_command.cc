@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <set>
+#include <vector>
 
 #include "absl/strings/str_format.h"
 #include "command.h"
@@ -12,6 +13,7 @@
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
+#include "lf/kernels/radiosity.h"
 #include "local_executor.h"
 #include "local_render.h"
 #include "server/plan.h"
@@ -22,6 +24,7 @@ namespace {
 
 struct PlanOptions {
     std::string scene_path;
+    std::string method = "auto";
     double target_error = 0.01;
     uint64_t pilot_spp = 8;
     int64_t patches = 4000;
@@ -30,6 +33,74 @@ struct PlanOptions {
 };
 
 std::string Color(const Rgb& c) { return absl::StrFormat("(%.3g, %.3g, %.3g)", c.r, c.g, c.b); }
+
+// Radiosity's cost comes from pilot solves of 1/8 and 1/4 of the target's patches (about 1/4
+// of the target's time together), at least 250: on coarser meshes the walls are a few patches,
+// almost every pair touches, and the cost per pair is no longer the target's.
+constexpr int64_t kRadiosityPilotDivisor = 8, kMinRadiosityPilotPatches = 250;
+
+// Form-factor seconds for n unknowns as b n + a n^2 through the two pilots' times. Every pair
+// of unknowns that see each other is computed and stored, the a n^2; but a pair closer than a
+// few patch sizes takes up to 64 times the quadrature points and 16 times the rays of a far
+// one, and each patch has a bounded number of such neighbours, the b n. On the Cornell box the
+// near pairs are still half the time at 4000 patches, so one pilot scaled by n^2 predicted 10
+// times the measured time. A fit that timing noise bends below 0 falls back to one term.
+double PredictFormFactorSeconds(const RadiosityReport& small, const RadiosityReport& large,
+                                double n) {
+    const double n1 = double(small.sides), n2 = double(large.sides);
+    const double per1 = small.form_factor_seconds / n1, per2 = large.form_factor_seconds / n2;
+    const double a = (per2 - per1) / (n2 - n1), b = per1 - a * n1;
+    if (a < 0) return per2 * n;
+    if (b < 0) return per2 * n * n / n2;
+    return b * n + a * n * n;
+}
+
+// The solve's sweeps each read every stored form factor, and their number depends on the
+// reflectances, not on the mesh, so the solve's time grows as n^2, like the form factors'
+// memory.
+absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& options) {
+    absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(embree.scene(), {0, options.patches});
+    if (!mesh.ok()) return mesh.status();
+    const double n = double(mesh->patches().size()), unknowns = double(mesh->sides().size());
+    std::printf(
+        "radiosity: target %lld patches -> %zu patches of size %.3g, %zu unknowns; form "
+        "factors grow as patches^2 (%.3g pairs at most, docs/radiosity.md)\n",
+        (long long)options.patches, mesh->patches().size(), mesh->patch_size(),
+        mesh->sides().size(), n * n);
+
+    const int64_t small_patches =
+        std::max(options.patches / kRadiosityPilotDivisor, kMinRadiosityPilotPatches);
+    std::vector<RadiosityReport> pilots;
+    for (int64_t patches : {small_patches, 2 * small_patches}) {
+        RadiosityOptions pilot_options;
+        pilot_options.patches = std::min(patches, options.patches);
+        pilot_options.threads = options.threads;
+        absl::StatusOr<std::unique_ptr<RadiosityRenderer>> pilot =
+            PrepareRadiosity(embree, pilot_options);
+        if (!pilot.ok()) return pilot.status();
+        pilots.push_back((*pilot)->report());
+        const RadiosityReport& r = pilots.back();
+        std::printf(
+            "radiosity pilot: %lld patches, %lld unknowns: form factors %.3f s (%.2f MiB), "
+            "solve %.3f s (%d iterations)\n",
+            (long long)r.patches, (long long)r.sides, r.form_factor_seconds,
+            double(r.form_factor_bytes) / (1 << 20), r.solve_seconds, r.iterations);
+        if (pilot_options.patches == options.patches) break;  // the target itself
+    }
+    const RadiosityReport& large = pilots.back();
+    const double form_factor_seconds = pilots.size() == 1
+                                           ? large.form_factor_seconds
+                                           : PredictFormFactorSeconds(pilots[0], large, unknowns);
+    const double squared = std::pow(unknowns / double(large.sides), 2);
+    const double solve_seconds = large.solve_seconds * squared;
+    std::printf(
+        "cost of render --method radiosity --patches %lld: about %.1f s of form factors "
+        "(%.0f MiB) and %.1f s of solve at this speed, %.1f s before the display pass\n",
+        (long long)options.patches, form_factor_seconds,
+        double(large.form_factor_bytes) * squared / (1 << 20), solve_seconds,
+        form_factor_seconds + solve_seconds);
+    return absl::OkStatus();
+}
 
 double TriangleArea(const TriangleMesh& mesh, const std::array<uint32_t, 3>& t) {
     const Vec3d a = mesh.positions[t[0]], b = mesh.positions[t[1]], c = mesh.positions[t[2]];
@@ -78,9 +149,10 @@ absl::Status RunPlan(const PlanOptions& options) {
                 emissive_triangles, emitting_area, emissive_spheres, scene->point_lights.size());
 
     std::string why;
-    absl::StatusOr<std::string> method = ChooseMethod(*scene, "auto", &why);
+    absl::StatusOr<std::string> method = ChooseMethod(*scene, options.method, &why);
     if (!method.ok()) return method.status();
-    std::printf("method (--method auto): %s, because %s\n", method->c_str(), why.c_str());
+    std::printf("method (--method %s): %s, because %s\n", options.method.c_str(), method->c_str(),
+                why.c_str());
 
     // A closed room of albedo rho keeps a path alive for 1/(1 - rho) bounces on average under
     // the roulette; an open scene ends paths sooner.
@@ -97,14 +169,10 @@ absl::Status RunPlan(const PlanOptions& options) {
             "they leave it\n");
     }
 
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
+    if (!embree.ok()) return embree.status();
     if (*method == "radiosity") {
-        absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(*scene, {0, options.patches});
-        if (!mesh.ok()) return mesh.status();
-        const double n = double(mesh->patches().size());
-        std::printf(
-            "radiosity: target %lld patches -> %zu patches of size %.3g; form factors "
-            "grow as patches^2 (%.3g pairs at most, docs/radiosity.md)\n",
-            (long long)options.patches, mesh->patches().size(), mesh->patch_size(), n * n);
+        if (absl::Status s = PrintRadiosityCost(**embree, options); !s.ok()) return s;
     } else {
         std::printf("radiosity: not used\n");
     }
@@ -112,8 +180,6 @@ absl::Status RunPlan(const PlanOptions& options) {
     // A pilot pass of every tile at the full resolution, as the first pass of
     // `render --target-error`: each tile's own estimate predicts the samples it needs, as error
     // falls with 1/sqrt(spp), and the pilot's speed the time.
-    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
-    if (!embree.ok()) return embree.status();
     const Camera camera(scene->camera, (*embree)->origin());
     const PathTracer tracer(**embree, options.max_depth);
     RenderSettings settings;
@@ -152,12 +218,18 @@ Command AddPlanCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "plan",
         "Say what a render of the scene will model and why: materials and lights in use, the\n"
-        "method --method auto picks, the path depth policy, the radiosity patch count, and the\n"
-        "samples and time a target error needs (from a short pilot render's own error\n"
-        "estimate and speed).");
+        "method --method picks, the path depth policy, for radiosity the patch count and the\n"
+        "time and memory of the form factors and the solve (from a pilot solve of fewer\n"
+        "patches), and the samples and time a target error needs (from a short pilot render's\n"
+        "own error estimate and speed).");
     cmd->add_option("scene", options->scene_path, "scene file (JSON)")
         ->required()
         ->check(CLI::ExistingFile);
+    cmd->add_option("--method", options->method,
+                    "the method to cost: path, radiosity (adds the cost of the form factors "
+                    "and the solve, from a pilot solve) or auto (as render --method auto)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"path", "radiosity", "auto"}));
     cmd->add_option("--target-error", options->target_error,
                     "relative error to estimate the cost for")
         ->capture_default_str()
@@ -171,7 +243,7 @@ Command AddPlanCommand(CLI::App& app) {
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str()
         ->check(CLI::Range(-1, 1 << 20));
-    cmd->add_option("--threads", options->threads, "threads of the pilot; 0 = all cores")
+    cmd->add_option("--threads", options->threads, "threads of the pilots; 0 = all cores")
         ->capture_default_str()
         ->check(CLI::Range(0, 1024));
     return {cmd, [options] {

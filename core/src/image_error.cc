@@ -19,6 +19,32 @@ absl::StatusOr<const std::vector<float>*> RequireChannel(const Image& image,
     return channel;
 }
 
+// The mean over pixels and channels of ((A - B) / 2)^2, each divided by R^2 + eps if relative.
+absl::StatusOr<double> MeanSquaredHalfDifference(const Image& image, bool relative) {
+    double sum = 0;
+    size_t n = 0;
+    for (const std::string name : {"R", "G", "B"}) {
+        absl::StatusOr<const std::vector<float>*> a = RequireChannel(image, "A." + name, "image");
+        if (!a.ok()) return a.status();
+        absl::StatusOr<const std::vector<float>*> b = RequireChannel(image, "B." + name, "image");
+        if (!b.ok()) return b.status();
+        const std::vector<float>* x = nullptr;
+        if (relative) {
+            absl::StatusOr<const std::vector<float>*> found = RequireChannel(image, name, "image");
+            if (!found.ok()) return found.status();
+            x = *found;
+        }
+        for (size_t i = 0; i < (*a)->size(); ++i) {
+            const double half = 0.5 * (double((**a)[i]) - (**b)[i]);
+            sum +=
+                x ? half * half / (double((*x)[i]) * (*x)[i] + kRelativeErrorEpsilon) : half * half;
+            ++n;
+        }
+    }
+    if (n == 0) return absl::InvalidArgumentError("the image has no pixels");
+    return sum / n;
+}
+
 }  // namespace
 
 absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& reference) {
@@ -47,23 +73,11 @@ absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& refere
 }
 
 absl::StatusOr<double> EstimatedMse(const Image& image) {
-    double sum = 0;
-    size_t n = 0;
-    for (const char* name : {"R", "G", "B"}) {
-        absl::StatusOr<const std::vector<float>*> a =
-            RequireChannel(image, std::string("A.") + name, "image");
-        if (!a.ok()) return a.status();
-        absl::StatusOr<const std::vector<float>*> b =
-            RequireChannel(image, std::string("B.") + name, "image");
-        if (!b.ok()) return b.status();
-        for (size_t i = 0; i < (*a)->size(); ++i) {
-            const double half = 0.5 * (double((**a)[i]) - (**b)[i]);
-            sum += half * half;
-            ++n;
-        }
-    }
-    if (n == 0) return absl::InvalidArgumentError("the image has no pixels");
-    return sum / n;
+    return MeanSquaredHalfDifference(image, /*relative=*/false);
+}
+
+absl::StatusOr<double> EstimatedRelMse(const Image& image) {
+    return MeanSquaredHalfDifference(image, /*relative=*/true);
 }
 
 double EstimatedRelativeError(const TileSums& tile) {

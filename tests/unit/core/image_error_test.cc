@@ -42,6 +42,42 @@ TEST(ImageError, HalfBufferEstimateIsTheVarianceOfTheMean) {
     EXPECT_NEAR(EstimatedMse(image).value(), 0.125 * 0.125, 1e-9);
 }
 
+// A = x + d, B = x - d per pixel, so ((A - B) / 2)^2 = d^2 and the estimate is analytic. Fifteen
+// pixels of 0.5 off by 1 %, one light-edge pixel of 8 off by 25 %: the relMSE estimate is about
+// the typical pixel's, while the whole image's RMS against its mean radiance is that one
+// pixel's absolute error.
+TEST(ImageError, RelMseEstimateIsThePerPixelRelativeVariance) {
+    constexpr float kValue = 0.5f, kSpread = 0.005f, kEdge = 8.0f, kEdgeSpread = 2.0f;
+    Image image = Constant(4, 4, kValue);
+    for (const char* c : {"A.R", "A.G", "A.B"}) image.Channel(c).assign(16, kValue + kSpread);
+    for (const char* c : {"B.R", "B.G", "B.B"}) image.Channel(c).assign(16, kValue - kSpread);
+    for (const char* c : {"R", "G", "B"}) image.Channel(c)[5] = kEdge;
+    for (const char* c : {"A.R", "A.G", "A.B"}) image.Channel(c)[5] = kEdge + kEdgeSpread;
+    for (const char* c : {"B.R", "B.G", "B.B"}) image.Channel(c)[5] = kEdge - kEdgeSpread;
+
+    const double d = double(kValue + kSpread) - kValue;  // kSpread as the floats hold it
+    const double relmse =
+        (15 * d * d / (double(kValue) * kValue + kRelativeErrorEpsilon) +
+         double(kEdgeSpread) * kEdgeSpread / (double(kEdge) * kEdge + kRelativeErrorEpsilon)) /
+        16;
+    EXPECT_NEAR(EstimatedRelMse(image).value(), relmse, 1e-9 * relmse);
+    EXPECT_LT(std::sqrt(relmse), 0.1);
+    const double mean = (15 * double(kValue) + kEdge) / 16;
+    const double rms = std::sqrt((15 * d * d + double(kEdgeSpread) * kEdgeSpread) / 16);
+    EXPECT_NEAR(EstimatedRelativeError(image).value(), rms / (mean + kRelativeErrorFloor), 1e-9);
+    EXPECT_GT(EstimatedRelativeError(image).value(), 0.5);
+
+    // A black pixel with equal halves adds nothing; a missing R refuses.
+    Image black = Constant(1, 1, 0);
+    EXPECT_EQ(EstimatedRelMse(black).value(), 0);
+    Image halves_only(1, 1);
+    for (const char* c : {"A.R", "A.G", "A.B", "B.R", "B.G", "B.B"}) {
+        halves_only.Channel(c).assign(1, 0);
+    }
+    EXPECT_TRUE(EstimatedMse(halves_only).ok());
+    EXPECT_FALSE(EstimatedRelMse(halves_only).ok());
+}
+
 TEST(ImageError, LogLogSlopeOfAPowerLaw) {
     std::vector<std::pair<double, double>> points;
     for (double t : {0.1, 1.0, 3.0, 40.0}) points.push_back({t, 7 * std::pow(t, -0.5)});

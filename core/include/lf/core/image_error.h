@@ -29,6 +29,12 @@ absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& refere
 // InvalidArgument without the A.* and B.* channels.
 absl::StatusOr<double> EstimatedMse(const Image& image);
 
+// The image's own estimate of its relMSE (CompareImages): the mean over pixels and channels of
+// ((A - B) / 2)^2 / (R^2 + kRelativeErrorEpsilon). Each pixel counts by its error relative to
+// its own value, so a few bright pixels with a large absolute error (a light's edges) weigh no
+// more than any other pixel. InvalidArgument without the R,G,B, A.* and B.* channels.
+absl::StatusOr<double> EstimatedRelMse(const Image& image);
+
 // Floor of the denominator of relative error estimates, in radiance units (W m^-2 sr^-1): a
 // black region is done at once instead of chasing 0/0.
 inline constexpr double kRelativeErrorFloor = 1e-3;
