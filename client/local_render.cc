@@ -174,21 +174,25 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     if (adaptive || options.render.spp >= 2) {
         absl::StatusOr<double> estimated = EstimatedRelativeError(out->image);
         if (!estimated.ok()) return estimated.status();
-        absl::StatusOr<double> relmse = EstimatedRelMse(out->image);
-        if (!relmse.ok()) return relmse.status();
+        absl::StatusOr<VarianceAssessment> variance = AssessVariance(out->image);
+        if (!variance.ok()) return variance.status();
         summary.estimated_error = *estimated;
-        summary.estimated_relmse = *relmse;
-        summary.high_variance = *relmse > kHighVarianceRelMse;
+        summary.estimated_relmse = variance->relmse;
+        summary.high_variance = variance->high;
         attributes["lightfarm.estimatedError"] = *estimated;
-        attributes["lightfarm.estimatedRelMse"] = *relmse;
+        attributes["lightfarm.estimatedRelMse"] = variance->relmse;
+        attributes["lightfarm.estimatedMeanError"] = variance->mean_error;
         attributes["lightfarm.highVariance"] = std::string(summary.high_variance ? "yes" : "no");
-        log->info("job={} estimated relative error {:.4f}, estimated relMSE {:.3g}", job_id,
-                  *estimated, *relmse);
+        log->info(
+            "job={} estimated relative error {:.4f}, estimated relMSE {:.3g}, error of the mean "
+            "{:.3g}",
+            job_id, *estimated, variance->relmse, variance->mean_error);
         if (summary.high_variance) {
             log->warn(
-                "job={} high variance: estimated relMSE {:.3g} (above {}), a typical pixel off "
-                "by {:.0f} %",
-                job_id, *relmse, kHighVarianceRelMse, 100 * std::sqrt(*relmse));
+                "job={} high variance: estimated relMSE {:.3g} (limit {}: a typical pixel off by "
+                "{:.0f} %), relative error of the mean radiance {:.3g} (limit {})",
+                job_id, variance->relmse, kHighVarianceRelMse, 100 * std::sqrt(variance->relmse),
+                variance->mean_error, kHighVarianceMeanError);
         }
     }
     attributes["lightfarm.truncatedPaths"] = std::to_string(out->stats.truncated_paths);

@@ -36,13 +36,6 @@ struct LocalRenderSummary {
     AdaptiveReport adaptive_report;
 };
 
-// An image whose own relMSE estimate (EstimatedRelMse) is above this is reported as high
-// variance: relMSE is a mean of squared relative errors, so above 0.01 = 0.1^2 a typical pixel
-// is off by more than 10 % of its value, where noise is plainly visible and the image is not
-// to be trusted for measurements. A per-pixel measure, unlike estimated_error (one RMS over
-// the image against its mean radiance), which a light's few half-covered edge pixels dominate.
-inline constexpr double kHighVarianceRelMse = 0.01;
-
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options);
 
 // The method for `requested` (path, radiosity or auto) and, in *why, the reason. `auto`:

@@ -80,6 +80,18 @@ absl::StatusOr<double> EstimatedRelMse(const Image& image) {
     return MeanSquaredHalfDifference(image, /*relative=*/true);
 }
 
+absl::StatusOr<VarianceAssessment> AssessVariance(const Image& image) {
+    absl::StatusOr<double> relmse = EstimatedRelMse(image);
+    if (!relmse.ok()) return relmse.status();
+    absl::StatusOr<double> error = EstimatedRelativeError(image);
+    if (!error.ok()) return error.status();
+    VarianceAssessment a;
+    a.relmse = *relmse;
+    a.mean_error = *error / std::sqrt(3.0 * double(image.width()) * double(image.height()));
+    a.high = a.relmse > kHighVarianceRelMse || a.mean_error > kHighVarianceMeanError;
+    return a;
+}
+
 double EstimatedRelativeError(const TileSums& tile) {
     double squared = 0, mean = 0;
     for (const PixelSums& p : tile.pixels) {

@@ -35,6 +35,24 @@ absl::StatusOr<double> EstimatedMse(const Image& image);
 // more than any other pixel. InvalidArgument without the R,G,B, A.* and B.* channels.
 absl::StatusOr<double> EstimatedRelMse(const Image& image);
 
+// An image is reported as high variance when either of two estimates says it is not to be
+// trusted:
+// - its pixels: relMSE (EstimatedRelMse) above 0.01 = 0.1^2, a typical pixel off by more than
+//   10 % of its value, where noise is plainly visible. Per pixel, so a light's few half-covered
+//   edge pixels do not dominate it as they dominate EstimatedRelativeError;
+// - its light: the relative standard error of the image's mean radiance above 5 %. A pixel's
+//   relMSE term is at most 1, so a few fireflies carrying much of the light barely move the
+//   first test; this one is EstimatedRelativeError / sqrt(pixels x 3), which they dominate.
+inline constexpr double kHighVarianceRelMse = 0.01;
+inline constexpr double kHighVarianceMeanError = 0.05;
+
+struct VarianceAssessment {
+    double relmse = 0;      // EstimatedRelMse
+    double mean_error = 0;  // relative standard error of the mean radiance
+    bool high = false;
+};
+absl::StatusOr<VarianceAssessment> AssessVariance(const Image& image);
+
 // Floor of the denominator of relative error estimates, in radiance units (W m^-2 sr^-1): a
 // black region is done at once instead of chasing 0/0.
 inline constexpr double kRelativeErrorFloor = 1e-3;
