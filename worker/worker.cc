@@ -183,6 +183,7 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task) {
     // The sweeps are over: their form-factor rows are not needed again.
     loaded_.chunks.clear();
     loaded_.input.clear();
+    loaded_.input_hash.clear();
     return absl::OkStatus();
 }
 
