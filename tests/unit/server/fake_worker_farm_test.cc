@@ -101,7 +101,11 @@ class FakeWorkerFarm : public ::testing::Test {
         request.mutable_params()->set_tile(tile);
         request.mutable_params()->set_passes(1);
         pb::SubmitJobResponse response;
+        // As a client should: a deadline, and waiting out a connection the loaded machine did
+        // not make at once (seen under ctest -j2: "failed to connect to all addresses").
         grpc::ClientContext context;
+        context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+        context.set_wait_for_ready(true);
         const grpc::Status s =
             (stub ? stub : job_stub_.get())->SubmitJob(&context, request, &response);
         EXPECT_TRUE(s.ok()) << s.error_message();
