@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "adaptive_flags.h"
 #include "command.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "progress_bar.h"
@@ -126,6 +127,7 @@ struct SubmitOptions {
     int priority = 0;
     std::string method = "path";
     RadiositySettings radiosity;
+    AdaptiveSettings adaptive;
 };
 
 absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
@@ -193,6 +195,9 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     params->set_passes(o.passes);
     params->set_method(o.method);
     if (o.method == "radiosity") lf::ToProto(o.radiosity, params->mutable_radiosity());
+    params->set_target_error(o.adaptive.target_error);
+    params->set_time_limit_seconds(o.adaptive.time_limit);
+    params->set_max_spp(o.adaptive.max_spp);
     // A retry after a lost answer (the server restarting, say) gets the job of the first attempt.
     req.set_request_id(Sha256Hex(
         absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string())));
@@ -222,6 +227,11 @@ void PrintJob(const pb::Job& job) {
                 job.width(), job.height(), (unsigned long long)job.params().spp(),
                 (unsigned long long)job.params().seed(), job.params().max_depth(),
                 job.params().tile(), job.params().passes());
+    if (job.params().target_error() > 0 || job.params().time_limit_seconds() > 0) {
+        std::printf("  adaptive  target error %g, time limit %g s, at most %llu spp\n",
+                    job.params().target_error(), job.params().time_limit_seconds(),
+                    (unsigned long long)job.params().max_spp());
+    }
     std::printf("  priority  %d\n", job.priority());
     std::printf("  tasks     %s done, %d running, %d retried, %d leased\n", Progress(job).c_str(),
                 job.tasks_running(), job.retries(), job.tasks_leased());
@@ -331,6 +341,7 @@ Command AddSubmitCommand(CLI::App& app) {
                     "sample passes per tile; each pass of each tile is one task")
         ->capture_default_str()
         ->check(CLI::Range(1, 1 << 20));
+    AddAdaptiveFlags(cmd, o->adaptive);
     cmd->add_option("--priority", o->priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
     cmd->add_option("--name", o->name, "job name (default: the scene file's name)");

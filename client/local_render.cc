@@ -49,17 +49,6 @@ void AddRadiosityAttributes(const RadiosityReport& r, const RadiosityOptions& o,
     (*attributes)["lightfarm.radiosity.solveSeconds"] = r.solve_seconds;
 }
 
-void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveReport& report,
-                           ExrAttributes* attributes) {
-    (*attributes)["lightfarm.targetError"] = settings.target_error;
-    (*attributes)["lightfarm.timeLimit"] = settings.time_limit;
-    (*attributes)["lightfarm.adaptive.worstTileError"] = report.worst_tile_error;
-    (*attributes)["lightfarm.adaptive.tilesAboveTarget"] = report.tiles_above_target;
-    (*attributes)["lightfarm.adaptive.timedOut"] = std::string(report.timed_out ? "yes" : "no");
-    (*attributes)["lightfarm.adaptive.minSpp"] = int(report.min_spp);
-    (*attributes)["lightfarm.adaptive.maxSpp"] = int(report.max_spp);
-}
-
 }  // namespace
 
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
@@ -172,21 +161,16 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         DescribeRender({scene->content_hash, *method, spp, options.render.seed, options.max_depth,
                         out->seconds, out->stats});
     if (adaptive || options.render.spp >= 2) {
-        absl::StatusOr<double> estimated = EstimatedRelativeError(out->image);
-        if (!estimated.ok()) return estimated.status();
-        absl::StatusOr<VarianceAssessment> variance = AssessVariance(out->image);
-        if (!variance.ok()) return variance.status();
-        summary.estimated_error = *estimated;
+        absl::StatusOr<ErrorEstimates> estimates = AddErrorEstimates(out->image, &attributes);
+        if (!estimates.ok()) return estimates.status();
+        const VarianceAssessment* variance = &estimates->variance;
+        summary.estimated_error = estimates->estimated_error;
         summary.estimated_relmse = variance->relmse;
         summary.high_variance = variance->high;
-        attributes["lightfarm.estimatedError"] = *estimated;
-        attributes["lightfarm.estimatedRelMse"] = variance->relmse;
-        attributes["lightfarm.estimatedMeanError"] = variance->mean_error;
-        attributes["lightfarm.highVariance"] = std::string(summary.high_variance ? "yes" : "no");
         log->info(
             "job={} estimated relative error {:.4f}, estimated relMSE {:.3g}, error of the mean "
             "{:.3g}",
-            job_id, *estimated, variance->relmse, variance->mean_error);
+            job_id, summary.estimated_error, variance->relmse, variance->mean_error);
         if (summary.high_variance) {
             log->warn(
                 "job={} high variance: estimated relMSE {:.3g} (limit {}: a typical pixel off by "

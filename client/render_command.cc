@@ -1,5 +1,6 @@
 #include <cstdio>
 
+#include "adaptive_flags.h"
 #include "command.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
@@ -47,22 +48,7 @@ Command AddRenderCommand(CLI::App& app) {
                     "sample passes per tile, as a farm job would split them (same bits)")
         ->capture_default_str()
         ->check(CLI::Range(1, 1 << 24));
-    const std::string a = "Adaptive sampling (docs/convergence.md)";
-    cmd->add_option("--target-error", options->adaptive.target_error,
-                    "stop sampling a tile once its estimated relative error (from the A/B "
-                    "halves) is at most this, e.g. 0.01; --spp is then the first pass")
-        ->group(a)
-        ->check(CLI::Range(1e-6, 1.0));
-    cmd->add_option("--time-limit", options->adaptive.time_limit,
-                    "stop sampling after about this many seconds (every tile gets its first "
-                    "pass); alone, tiles double their samples until then")
-        ->group(a)
-        ->check(CLI::Range(1e-3, 1e7));
-    cmd->add_option("--max-spp", options->adaptive.max_spp,
-                    "most samples per pixel of an adaptive render")
-        ->group(a)
-        ->capture_default_str()
-        ->check(CLI::Range(uint64_t(2), uint64_t(1) << 24));
+    AddAdaptiveFlags(cmd, options->adaptive);
     cmd->add_flag("--no-progress", *no_progress, "no progress bar");
     cmd->add_option("--method", options->method,
                     "path (path tracing, any material), radiosity (finite elements, Lambertian "

@@ -137,6 +137,13 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
             absl::StrCat("max depth ", spec.max_depth, " is below -1 (unlimited)"));
     }
     if (absl::Status s = CheckMethod(spec); !s.ok()) return s;
+    if (absl::Status s = CheckAdaptiveSettings(spec.adaptive); !s.ok()) return s;
+    if (IsAdaptive(spec.adaptive) && spec.adaptive.max_spp > options_.limits.max_spp) {
+        return absl::ResourceExhaustedError(absl::StrCat(
+            "adaptive sampling up to ", spec.adaptive.max_spp,
+            " samples per pixel is above this server's limit of ", options_.limits.max_spp,
+            " (lightfarm-server --max-spp); lower --max-spp"));
+    }
     const std::string scratch = options_.data_dir + "/scratch/submit-" + UniqueSuffix();
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
         spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); },
@@ -196,19 +203,26 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
 }
 
 void Farm::FinishJob(const std::string& job_id) {
-    absl::StatusOr<std::pair<JobRecord, Image>> snapshot = scheduler_.Snapshot(job_id);
+    absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.Snapshot(job_id);
     if (!snapshot.ok()) return;  // cancelled meanwhile
     const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
-    const absl::Status written = WriteImage(snapshot->first, snapshot->second, path);
+    const absl::Status written = WriteImage(*snapshot, true, path);
     scheduler_.Finish(job_id, written.ok() ? absl::StatusOr<std::string>(path)
                                            : absl::StatusOr<std::string>(written));
 }
 
-absl::Status Farm::WriteImage(const JobRecord& job, const Image& image, const std::string& path) {
+void Farm::CheckTimers() {
+    scheduler_.ExpireLeases();
+    for (const std::string& job_id : scheduler_.EnforceTimeLimits()) FinishJob(job_id);
+}
+
+absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete,
+                              const std::string& path) {
+    const JobRecord& job = snapshot.record;
     RenderMetadata metadata;
     metadata.scene_hash = job.spec.scene_hash;
     metadata.method = job.spec.method;
-    metadata.spp = job.spec.plan.spp;
+    metadata.spp = snapshot.adaptive ? snapshot.adaptive->max_spp : job.spec.plan.spp;
     metadata.seed = job.spec.seed;
     metadata.max_depth = job.spec.max_depth;
     metadata.seconds = job.started == absl::InfinitePast()
@@ -218,7 +232,18 @@ absl::Status Farm::WriteImage(const JobRecord& job, const Image& image, const st
     // Renamed into place so a reader never sees half a file, and durable before the job is
     // recorded as succeeded.
     const std::string temp = path + ".tmp-" + UniqueSuffix();
-    if (absl::Status s = WriteExr(temp, image, DescribeRender(metadata)); !s.ok()) return s;
+    ExrAttributes attributes = DescribeRender(metadata);
+    if (const uint64_t spp = snapshot.adaptive ? snapshot.adaptive->min_spp : job.spec.plan.spp;
+        complete && spp >= 2) {
+        if (absl::StatusOr<ErrorEstimates> e = AddErrorEstimates(snapshot.image, &attributes);
+            !e.ok()) {
+            return e.status();
+        }
+    }
+    if (snapshot.adaptive) {
+        AddAdaptiveAttributes(job.spec.adaptive, *snapshot.adaptive, &attributes);
+    }
+    if (absl::Status s = WriteExr(temp, snapshot.image, attributes); !s.ok()) return s;
     return RenameDurably(temp, path);
 }
 
@@ -232,10 +257,10 @@ absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool pre
             job->tasks_total, " tasks done): no result",
             IsFinal(job->state) ? "" : " yet; --preview fetches what is merged so far"));
     }
-    absl::StatusOr<std::pair<JobRecord, Image>> snapshot = scheduler_.Snapshot(job_id);
+    absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.Snapshot(job_id);
     if (!snapshot.ok()) return snapshot.status();
     const std::string path = options_.data_dir + "/previews/" + job_id + ".exr";
-    if (absl::Status s = WriteImage(snapshot->first, snapshot->second, path); !s.ok()) return s;
+    if (absl::Status s = WriteImage(*snapshot, false, path); !s.ok()) return s;
     return path;
 }
 

@@ -55,6 +55,11 @@ class Farm {
     // The EXR of a succeeded job; with `preview`, also of a running one (what is merged so far).
     absl::StatusOr<std::string> ResultFile(const std::string& job_id, bool preview);
 
+    // What the server's timer thread runs every tenth of a second: expired leases go back to the
+    // queue, and adaptive jobs past their time limit stop sampling (and are written if that
+    // completes them).
+    void CheckTimers();
+
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }
     const FarmOptions& options() const { return options_; }
@@ -66,8 +71,10 @@ class Farm {
     // A result that is not one: the task goes back to the queue as a counted failure.
     absl::Status RefuseUndecodable(const std::string& lease_id, const std::string& worker,
                                    const absl::Status& why);
-    // Writes the merged image with the render's header attributes, atomically.
-    absl::Status WriteImage(const JobRecord& job, const Image& image, const std::string& path);
+    // Writes the merged image with the render's header attributes, atomically; the image's own
+    // error estimates only when `complete` (a preview has pixels without samples).
+    absl::Status WriteImage(const Scheduler::JobImage& snapshot, bool complete,
+                            const std::string& path);
     void FinishJob(const std::string& job_id);
 
     const FarmOptions options_;

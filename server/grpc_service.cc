@@ -52,6 +52,9 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_passes(spec.plan.passes);
     out->set_method(spec.method);
     if (spec.method == "radiosity") lf::ToProto(spec.radiosity, out->mutable_radiosity());
+    out->set_target_error(spec.adaptive.target_error);
+    out->set_time_limit_seconds(spec.adaptive.time_limit);
+    out->set_max_spp(spec.adaptive.max_spp);
 }
 
 void ToProto(const JobRecord& job, pb::Job* out) {
@@ -90,6 +93,9 @@ JobSpec FromProto(const pb::SubmitJobRequest& r) {
     spec.max_depth = r.params().max_depth();
     if (!r.params().method().empty()) spec.method = r.params().method();
     if (r.params().has_radiosity()) spec.radiosity = lf::FromProto(r.params().radiosity());
+    spec.adaptive.target_error = r.params().target_error();
+    spec.adaptive.time_limit = r.params().time_limit_seconds();
+    if (r.params().max_spp() != 0) spec.adaptive.max_spp = r.params().max_spp();
     spec.priority = r.priority();
     return spec;
 }

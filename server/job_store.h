@@ -14,6 +14,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/film.h"
+#include "server/adaptive_plan.h"
 #include "server/plan.h"
 #include "server/scene_files.h"
 
@@ -28,10 +29,18 @@ struct JobSpec {
     int max_depth = -1;
     std::string method = "path";  // or "radiosity"
     RadiositySettings radiosity;
-    int priority = 0;        // higher first
-    std::string scene_hash;  // the loader's content hash, for the EXR header
-    std::string request_id;  // the client's, for idempotent retries; "" for none
+    AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused
+    int priority = 0;           // higher first
+    std::string scene_hash;     // the loader's content hash, for the EXR header
+    std::string request_id;     // the client's, for idempotent retries; "" for none
 };
+
+// Radiosity jobs the farm solves in patch-group tasks per sweep, rather than on every worker.
+// Not adaptive ones: their passes are appended to the tasks where the sweeps would go.
+inline bool SolvedInSweeps(const JobSpec& spec) {
+    return spec.method == "radiosity" && spec.radiosity.solver == "jacobi" &&
+           !IsAdaptive(spec.adaptive);
+}
 
 enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled };
 const char* JobStateName(JobState state);

@@ -83,14 +83,15 @@ int main(int argc, char** argv) {
     spdlog::info("listening on {}:{}, data in {}, leases of {} s", host, port, options.data_dir,
                  lease_seconds);
 
-    // The timeout checker: expired leases go back to the queue within a tenth of a second.
+    // The timeout checker: expired leases go back to the queue, and adaptive jobs past their
+    // time limit stop sampling, within a tenth of a second.
     std::mutex mutex;
     std::condition_variable stop_cv;
     bool stop = false;
     std::thread checker([&] {
         std::unique_lock<std::mutex> lock(mutex);
         while (!stop_cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return stop; })) {
-            (*farm)->scheduler().ExpireLeases();
+            (*farm)->CheckTimers();
         }
     });
 

@@ -8,14 +8,36 @@ namespace {
 std::pair<int, int> Key(const PixelRect& r) { return {r.y0, r.x0}; }
 }  // namespace
 
-RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks)
-    : tasks_(std::move(tasks)), done_(tasks_.size(), false), image_(width, height) {
-    for (const RenderTask& t : tasks_) ++passes_per_tile_[Key(t.rect)];
-    // Every channel lf::Image::SetTile writes exists from the start, so a snapshot of an
-    // unfinished render has them all.
-    for (const char* name : {"R", "G", "B", "A.R", "A.G", "A.B", "B.R", "B.G", "B.B", "spp"}) {
-        image_.Channel(name);
+absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums) {
+    if (!(sums.rect == task.rect) || sums.pixels.size() != size_t(task.rect.Area())) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("task ", task.index, ": result covers ", sums.rect.x0, ",", sums.rect.y0,
+                         " ", sums.rect.width, "x", sums.rect.height, ", the task ", task.rect.x0,
+                         ",", task.rect.y0, " ", task.rect.width, "x", task.rect.height));
     }
+    const uint64_t n = task.sample_end - task.sample_begin;
+    for (const PixelSums& p : sums.pixels) {
+        if (p.Count() != n) {
+            return absl::InvalidArgumentError(absl::StrCat("task ", task.index, ": a pixel has ",
+                                                           p.Count(), " samples, the task ", n));
+        }
+    }
+    return absl::OkStatus();
+}
+
+Image EmptyRenderImage(int width, int height) {
+    Image image(width, height);
+    for (const char* name : {"R", "G", "B", "A.R", "A.G", "A.B", "B.R", "B.G", "B.B", "spp"}) {
+        image.Channel(name);
+    }
+    return image;
+}
+
+RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks)
+    : tasks_(std::move(tasks)),
+      done_(tasks_.size(), false),
+      image_(EmptyRenderImage(width, height)) {
+    for (const RenderTask& t : tasks_) ++passes_per_tile_[Key(t.rect)];
 }
 
 absl::Status RenderMerger::Add(int task_index, const TileSums& sums) {
@@ -26,19 +48,7 @@ absl::Status RenderMerger::Add(int task_index, const TileSums& sums) {
     if (done_[size_t(task_index)]) {
         return absl::AlreadyExistsError(absl::StrCat("task ", task_index, " is already merged"));
     }
-    if (!(sums.rect == task.rect) || sums.pixels.size() != size_t(task.rect.Area())) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("task ", task_index, ": result covers ", sums.rect.x0, ",", sums.rect.y0,
-                         " ", sums.rect.width, "x", sums.rect.height, ", the task ", task.rect.x0,
-                         ",", task.rect.y0, " ", task.rect.width, "x", task.rect.height));
-    }
-    const uint64_t n = task.sample_end - task.sample_begin;
-    for (const PixelSums& p : sums.pixels) {
-        if (p.Count() != n) {
-            return absl::InvalidArgumentError(absl::StrCat("task ", task_index, ": a pixel has ",
-                                                           p.Count(), " samples, the task ", n));
-        }
-    }
+    if (absl::Status s = CheckTaskResult(task, sums); !s.ok()) return s;
     auto open = OpenTileFor(task);
     open->second.sums += sums;
     if (--open->second.passes_left == 0) {
@@ -49,6 +59,12 @@ absl::Status RenderMerger::Add(int task_index, const TileSums& sums) {
     ++tasks_done_;
     stats_ += sums.stats;
     return absl::OkStatus();
+}
+
+absl::StatusOr<std::optional<RenderTask>> RenderMerger::Merge(int task_index,
+                                                              const TileSums& sums) {
+    if (absl::Status s = Add(task_index, sums); !s.ok()) return s;
+    return std::nullopt;
 }
 
 std::map<std::pair<int, int>, RenderMerger::OpenTile>::iterator RenderMerger::OpenTileFor(

@@ -4,16 +4,42 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <vector>
 
-#include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "lf/core/film.h"
 #include "lf/core/image.h"
 #include "server/plan.h"
 
 namespace lf {
 
-class RenderMerger {
+// InvalidArgument when `sums` is not `task`'s rectangle with its sample count in every pixel.
+absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums);
+
+// A black image with every channel lf::Image::SetTile writes, so that a snapshot of an
+// unfinished render has them all.
+Image EmptyRenderImage(int width, int height);
+
+// What a job's tile results merge into: a fixed plan (RenderMerger) or one that grows as results
+// show which tiles need more samples (AdaptiveTilePlan, server/adaptive_plan.h).
+class TileMerger {
+  public:
+    virtual ~TileMerger() = default;
+    // The tasks planned so far, by RenderTask::index.
+    virtual const std::vector<RenderTask>& tasks() const = 0;
+    // Merges task `task_index`'s result; returns the task it appended to the plan, if any.
+    virtual absl::StatusOr<std::optional<RenderTask>> Merge(int task_index,
+                                                            const TileSums& sums) = 0;
+    virtual size_t tasks_done() const = 0;
+    // Every planned task merged (or, adaptive, dropped) and none left to plan.
+    virtual bool Complete() const = 0;
+    virtual const RenderStats& stats() const = 0;
+    // R,G,B, A.*, B.* and spp of everything merged so far.
+    virtual Image Snapshot() const = 0;
+};
+
+class RenderMerger : public TileMerger {
   public:
     RenderMerger(int width, int height, std::vector<RenderTask> tasks);
 
@@ -22,14 +48,17 @@ class RenderMerger {
     // merged before (the image is unchanged then).
     absl::Status Add(int task_index, const TileSums& sums);
 
-    size_t tasks_done() const { return tasks_done_; }
-    size_t task_count() const { return tasks_.size(); }
-    bool Complete() const { return tasks_done_ == tasks_.size(); }
-    const RenderStats& stats() const { return stats_; }
+    absl::StatusOr<std::optional<RenderTask>> Merge(int task_index, const TileSums& sums) override;
 
-    // R,G,B, A.*, B.* and spp of everything merged so far; once Complete(), the final image,
-    // bit for bit what local mode (client/local_executor.h) makes of the same settings.
-    Image Snapshot() const;
+    const std::vector<RenderTask>& tasks() const override { return tasks_; }
+    size_t tasks_done() const override { return tasks_done_; }
+    size_t task_count() const { return tasks_.size(); }
+    bool Complete() const override { return tasks_done_ == tasks_.size(); }
+    const RenderStats& stats() const override { return stats_; }
+
+    // Once Complete(), the final image, bit for bit what local mode (client/local_executor.h)
+    // makes of the same settings.
+    Image Snapshot() const override;
 
   private:
     struct OpenTile {

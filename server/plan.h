@@ -39,11 +39,6 @@ struct RadiositySettings {
 };
 inline constexpr int kMaxSweepTasks = 1024;
 
-// Radiosity jobs the farm solves in patch-group tasks per sweep, rather than on every worker.
-inline bool SolvedInSweeps(const std::string& method, const RadiositySettings& r) {
-    return method == "radiosity" && r.solver == "jacobi";
-}
-
 struct RenderTask {
     int index = 0;  // position in the plan
     PixelRect rect;

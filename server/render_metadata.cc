@@ -21,4 +21,30 @@ ExrAttributes DescribeRender(const RenderMetadata& m) {
     };
 }
 
+absl::StatusOr<ErrorEstimates> AddErrorEstimates(const Image& image, ExrAttributes* attributes) {
+    ErrorEstimates e;
+    absl::StatusOr<double> estimated = EstimatedRelativeError(image);
+    if (!estimated.ok()) return estimated.status();
+    absl::StatusOr<VarianceAssessment> variance = AssessVariance(image);
+    if (!variance.ok()) return variance.status();
+    e.estimated_error = *estimated;
+    e.variance = *variance;
+    (*attributes)["lightfarm.estimatedError"] = e.estimated_error;
+    (*attributes)["lightfarm.estimatedRelMse"] = e.variance.relmse;
+    (*attributes)["lightfarm.estimatedMeanError"] = e.variance.mean_error;
+    (*attributes)["lightfarm.highVariance"] = std::string(e.variance.high ? "yes" : "no");
+    return e;
+}
+
+void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveReport& report,
+                           ExrAttributes* attributes) {
+    (*attributes)["lightfarm.targetError"] = settings.target_error;
+    (*attributes)["lightfarm.timeLimit"] = settings.time_limit;
+    (*attributes)["lightfarm.adaptive.worstTileError"] = report.worst_tile_error;
+    (*attributes)["lightfarm.adaptive.tilesAboveTarget"] = report.tiles_above_target;
+    (*attributes)["lightfarm.adaptive.timedOut"] = std::string(report.timed_out ? "yes" : "no");
+    (*attributes)["lightfarm.adaptive.minSpp"] = int(report.min_spp);
+    (*attributes)["lightfarm.adaptive.maxSpp"] = int(report.max_spp);
+}
+
 }  // namespace lf

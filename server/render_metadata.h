@@ -5,8 +5,12 @@
 #include <cstdint>
 #include <string>
 
+#include "absl/status/statusor.h"
 #include "lf/core/film.h"
+#include "lf/core/image.h"
+#include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
+#include "server/adaptive_plan.h"
 
 namespace lf {
 
@@ -21,5 +25,17 @@ struct RenderMetadata {
 };
 
 ExrAttributes DescribeRender(const RenderMetadata& metadata);
+
+// What an image estimates of its own error, from its A/B halves: needs 2 samples per pixel.
+struct ErrorEstimates {
+    double estimated_error = 0;  // EstimatedRelativeError
+    VarianceAssessment variance;
+};
+// Adds them as lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance.
+absl::StatusOr<ErrorEstimates> AddErrorEstimates(const Image& image, ExrAttributes* attributes);
+
+// lightfarm.targetError, .timeLimit and lightfarm.adaptive.*: how an adaptive render ended.
+void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveReport& report,
+                           ExrAttributes* attributes);
 
 }  // namespace lf

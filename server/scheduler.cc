@@ -30,18 +30,33 @@ std::string NewJobId() { return "job-" + RandomHex(10); }
 Scheduler::Scheduler(SchedulerOptions options, JobStore& store, Clock clock)
     : options_(options), store_(store), clock_(std::move(clock)), boot_(RandomHex(6)) {}
 
+absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord record) {
+    const JobSpec& spec = record.spec;
+    auto job = std::make_unique<Job>(Job{std::move(record), nullptr});
+    if (IsAdaptive(spec.adaptive)) {
+        absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan = AdaptiveTilePlan::Make(
+            spec.plan.width, spec.plan.height, spec.plan.spp, spec.plan.tile, spec.adaptive);
+        if (!plan.ok()) return plan.status();
+        job->adaptive = plan->get();
+        job->merger = std::move(*plan);
+    } else {
+        absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(spec.plan);
+        if (!plan.ok()) return plan.status();
+        job->merger = std::make_unique<RenderMerger>(spec.plan.width, spec.plan.height, *plan);
+    }
+    job->tasks.resize(job->merger->tasks().size());
+    return job;
+}
+
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
-    absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(spec.plan);
-    if (!plan.ok()) return plan.status();
-    auto job = std::make_unique<Job>(Job{{},
-                                         *plan,
-                                         std::vector<Task>(plan->size()),
-                                         {},
-                                         RenderMerger(spec.plan.width, spec.plan.height, *plan)});
-    job->record.spec = spec;
+    JobRecord record;
+    record.spec = spec;
+    absl::StatusOr<std::unique_ptr<Job>> made = NewJob(std::move(record));
+    if (!made.ok()) return made.status();
+    std::unique_ptr<Job> job = std::move(*made);
     QueueStart(*job);
     job->record.submitted = clock_();
-    job->record.tasks_total = int(plan->size());
+    job->record.tasks_total = int(job->tasks.size());
     std::unique_lock<std::mutex> lock(mutex_);
     if (std::optional<std::pair<std::string, uint64_t>> earlier = FindRequest(spec.request_id)) {
         lock.unlock();
@@ -55,6 +70,7 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     job->record.seq = next_seq_++;
     const uint64_t ticket = Save(*job);
     job->submit_ticket = ticket;
+    const size_t job_tasks = job->tasks.size();
     active_[id] = std::move(job);
     lock.unlock();
     // Acknowledged only once durable; waiting outside the lock lets submissions and results
@@ -65,8 +81,16 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
         active_.erase(id);
         return s;
     }
-    Log()->info("job={} queued: {} tasks, {}x{}, {} spp, priority {}", id, plan->size(),
-                spec.plan.width, spec.plan.height, spec.plan.spp, spec.priority);
+    if (IsAdaptive(spec.adaptive)) {
+        Log()->info(
+            "job={} queued: {} tiles, {}x{}, first pass {} spp, adaptive up to {} spp, target "
+            "error {}, time limit {} s, priority {}",
+            id, job_tasks, spec.plan.width, spec.plan.height, spec.plan.spp, spec.adaptive.max_spp,
+            spec.adaptive.target_error, spec.adaptive.time_limit, spec.priority);
+    } else {
+        Log()->info("job={} queued: {} tasks, {}x{}, {} spp, priority {}", id, job_tasks,
+                    spec.plan.width, spec.plan.height, spec.plan.spp, spec.priority);
+    }
     return id;
 }
 
@@ -107,35 +131,39 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     for (JobRecord& record : store_.List()) {
         next_seq_ = std::max(next_seq_, record.seq + 1);
         if (IsFinal(record.state) || active_.count(record.id)) continue;
-        absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(record.spec.plan);
-        if (!plan.ok()) return plan.status();
         absl::StatusOr<std::map<int, std::string>> results = store_.TaskResults(record.id);
         if (!results.ok()) return results.status();
-        const int width = record.spec.plan.width, height = record.spec.plan.height;
-        auto job = std::make_unique<Job>(Job{std::move(record),
-                                             *plan,
-                                             std::vector<Task>(plan->size()),
-                                             {},
-                                             RenderMerger(width, height, *plan)});
+        absl::StatusOr<std::unique_ptr<Job>> made = NewJob(std::move(record));
+        if (!made.ok()) return made.status();
+        std::unique_ptr<Job> job = std::move(*made);
+        // In index order, an adaptive plan appends each pass before its result comes up: the
+        // passes it planned depend only on the results before them.
         for (const auto& [t, bytes] : *results) {
             absl::StatusOr<TileSums> sums = DecodeTileSums(bytes);
+            absl::StatusOr<std::optional<RenderTask>> pass =
+                sums.ok() ? job->merger->Merge(t, *sums)
+                          : absl::StatusOr<std::optional<RenderTask>>(sums.status());
             // The store wrote what merged before, so this cannot fail unless the file was
             // damaged; the task is then simply rendered again.
-            if (!sums.ok() || !job->merger.Add(t, *sums).ok()) {
+            if (!pass.ok()) {
                 Log()->warn("job={} task={}: the recorded result is unusable, rendering it again",
                             job->record.id, t);
                 continue;
             }
             job->tasks[size_t(t)].state = TaskState::kDone;
+            if (*pass) job->tasks.resize(job->merger->tasks().size());
         }
         QueueStart(*job);
-        job->record.tasks_done = int(job->merger.tasks_done());
-        job->record.stats = job->merger.stats();
+        job->record.tasks_done = int(job->merger->tasks_done());
+        job->record.tasks_total = int(job->tasks.size());
+        job->record.stats = job->merger->stats();
         job->record.tasks_running = 0;
         Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before",
                     job->record.id, job->record.tasks_done, job->record.tasks_total,
                     job->record.tasks_leased);
-        if (job->merger.Complete()) rendered.push_back(job->record.id);
+        if (EnforceTimeLimit(*job, clock_()) || job->merger->Complete()) {
+            rendered.push_back(job->record.id);
+        }
         Save(*job);
         active_[job->record.id] = std::move(job);
     }
@@ -237,18 +265,17 @@ Lease Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time no
     Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, worker,
                  task.attempts);
     if (!IsSweepTask(job, t)) {
-        return Lease{lease_id, job.record.id, job.plan[size_t(t)], job.record.spec, -1,
+        return Lease{lease_id, job.record.id, job.merger->tasks()[size_t(t)], job.record.spec, -1,
                      0,        job.solution};
     }
-    const int k = t - int(job.plan.size()), chunks = job.solve->chunks();
+    const int k = t - int(job.merger->tasks().size()), chunks = job.solve->chunks();
     job.chunk_owner[k % chunks] = worker;
     return Lease{lease_id,   job.record.id, RenderTask{t, {}, 0, 0}, job.record.spec,
                  k / chunks, k % chunks,    job.sweep_input};
 }
 
 void Scheduler::QueueStart(Job& job) {
-    if (SolvedInSweeps(job.record.spec.method, job.record.spec.radiosity) && job.solution.empty() &&
-        !job.merger.Complete()) {
+    if (SolvedInSweeps(job.record.spec) && job.solution.empty() && !job.merger->Complete()) {
         // The solve is not recorded: after a restart it runs again, to the same bits, and the
         // tiles already done stay done.
         const RadiositySettings& r = job.record.spec.radiosity;
@@ -257,9 +284,50 @@ void Scheduler::QueueStart(Job& job) {
         QueueSweep(job);
         return;
     }
-    for (int t = 0; t < int(job.plan.size()); ++t) {
-        if (job.tasks[size_t(t)].state != TaskState::kDone) job.queued.insert(t);
+    for (int t = 0; t < int(job.merger->tasks().size()); ++t) {
+        if (job.tasks[size_t(t)].state == TaskState::kDone) continue;
+        if (job.adaptive && !job.adaptive->IsPending(t)) continue;
+        job.queued.insert(t);
     }
+}
+
+void Scheduler::QueuePass(Job& job, const RenderTask& pass) {
+    job.tasks.resize(size_t(pass.index) + 1);
+    job.queued.insert(pass.index);
+    job.record.tasks_total = int(job.tasks.size());
+}
+
+bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
+    if (!job.adaptive || job.adaptive->stopped() || job.record.spec.adaptive.time_limit <= 0 ||
+        job.record.started == absl::InfinitePast() ||
+        now - job.record.started < absl::Seconds(job.record.spec.adaptive.time_limit)) {
+        return false;
+    }
+    const std::vector<int> dropped = job.adaptive->Stop();
+    for (int t : dropped) {
+        Task& task = job.tasks[size_t(t)];
+        for (int attempt : task.live) timeouts_.Remove(LeaseId(job, t, attempt));
+        task.live.clear();
+        if (task.state == TaskState::kLeased) --job.record.tasks_running;
+        job.queued.erase(t);
+        task.state = TaskState::kDropped;
+    }
+    job.record.tasks_total -= int(dropped.size());
+    Log()->info("job={} time limit of {} s reached: {} passes dropped, {} tasks merged",
+                job.record.id, job.record.spec.adaptive.time_limit, dropped.size(),
+                job.merger->tasks_done());
+    Save(job);
+    return job.merger->Complete();
+}
+
+std::vector<std::string> Scheduler::EnforceTimeLimits() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::string> rendered;
+    const absl::Time now = clock_();
+    for (auto& [id, job] : active_) {
+        if (EnforceTimeLimit(*job, now)) rendered.push_back(id);
+    }
+    return rendered;
 }
 
 void Scheduler::QueueSweep(Job& job) {
@@ -271,7 +339,8 @@ void Scheduler::QueueSweep(Job& job) {
 
 bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::Time now) const {
     if (!IsSweepTask(job, t)) return true;
-    const auto owner = job.chunk_owner.find((t - int(job.plan.size())) % job.solve->chunks());
+    const auto owner =
+        job.chunk_owner.find((t - int(job.merger->tasks().size())) % job.solve->chunks());
     if (owner == job.chunk_owner.end() || owner->second == worker) return true;
     const auto seen = workers_seen_.find(owner->second);
     return seen == workers_seen_.end() || now - seen->second >= options_.lease;
@@ -322,20 +391,24 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     if (!ref.ok()) return ref.status();
     Job& job = *ref->job;
     Task& task = job.tasks[size_t(ref->task)];
-    if (task.state == TaskState::kDone) return Completion{job.record.id, false};
-    absl::Status merged = IsSweepTask(job, ref->task)
-                              ? absl::InvalidArgumentError("a tile result for a sweep task")
-                              : job.merger.Add(ref->task, sums);
-    if (!merged.ok()) return Refuse(*ref, lease_id, worker, merged);
+    if (task.state == TaskState::kDone || task.state == TaskState::kDropped) {
+        return Completion{job.record.id, false};
+    }
+    absl::StatusOr<std::optional<RenderTask>> merged =
+        IsSweepTask(job, ref->task) ? absl::InvalidArgumentError("a tile result for a sweep task")
+                                    : job.merger->Merge(ref->task, sums);
+    if (!merged.ok()) return Refuse(*ref, lease_id, worker, merged.status());
     MarkDone(job, ref->task, now);
-    job.record.tasks_done = int(job.merger.tasks_done());
-    job.record.stats = job.merger.stats();
+    if (*merged) QueuePass(job, **merged);
+    EnforceTimeLimit(job, now);
+    job.record.tasks_done = int(job.merger->tasks_done());
+    job.record.stats = job.merger->stats();
     const uint64_t ticket = store_.QueueTaskDone(job.record, ref->task, EncodeTileSums(sums));
     ++version_;
     changed_.notify_all();
     Log()->debug("job={} task={} done by {} ({}/{})", job.record.id, ref->task, worker,
                  job.record.tasks_done, job.record.tasks_total);
-    const Completion completion{job.record.id, job.merger.Complete()};
+    const Completion completion{job.record.id, job.merger->Complete()};
     lock.unlock();
     // The worker hears "done" only once the result is durable.
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
@@ -401,7 +474,7 @@ absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
     if (job.tasks[size_t(ref->task)].state == TaskState::kDone) {
         return SweepCompletion{job.record.id, std::nullopt};
     }
-    const int k = ref->task - int(job.plan.size());
+    const int k = ref->task - int(job.merger->tasks().size());
     absl::Status added =
         !IsSweepTask(job, ref->task) ? absl::InvalidArgumentError("a sweep result for a tile")
         : result.sweep != k / job.solve->chunks() || result.chunk != k % job.solve->chunks()
@@ -534,13 +607,20 @@ int Scheduler::ExpireLeases() {
     return int(expired.size());
 }
 
-absl::StatusOr<std::pair<JobRecord, Image>> Scheduler::Snapshot(const std::string& job_id) const {
+absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_id) const {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = active_.find(job_id);
     if (it == active_.end()) {
         return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " is not running"));
     }
-    return std::pair{it->second->record, it->second->merger.Snapshot()};
+    const Job& job = *it->second;
+    JobImage snapshot{job.record, job.merger->Snapshot(), std::nullopt};
+    if (job.adaptive) {
+        absl::StatusOr<AdaptiveReport> report = job.adaptive->Report();
+        if (!report.ok()) return report.status();
+        snapshot.adaptive = std::move(*report);
+    }
+    return snapshot;
 }
 
 void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path) {

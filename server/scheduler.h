@@ -19,6 +19,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/image.h"
+#include "server/adaptive_plan.h"
 #include "server/job_store.h"
 #include "server/lease_timeouts.h"
 #include "server/merge.h"
@@ -118,8 +119,19 @@ class Scheduler {
     // how many.
     int ExpireLeases();
 
-    // A rendered job's record and image, to write as its result.
-    absl::StatusOr<std::pair<JobRecord, Image>> Snapshot(const std::string& job_id) const;
+    // Ends the sampling of adaptive jobs whose time limit has passed since they started: passes
+    // not yet merged are dropped (leases of them hear "stop"), tiles keep their first pass.
+    // Returns the jobs that are now fully rendered, whose result the caller writes and Finishes.
+    std::vector<std::string> EnforceTimeLimits();
+
+    // A rendered job's record and image, to write as its result, and for an adaptive job how its
+    // sampling ended.
+    struct JobImage {
+        JobRecord record;
+        Image image;
+        std::optional<AdaptiveReport> adaptive;
+    };
+    absl::StatusOr<JobImage> Snapshot(const std::string& job_id) const;
 
     // Ends a fully rendered job: succeeded with the result file, or failed with the error.
     void Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path);
@@ -134,7 +146,8 @@ class Scheduler {
     void Shutdown();  // wakes every WaitForChange for good
 
   private:
-    enum class TaskState { kQueued, kLeased, kDone };
+    // kDropped: an adaptive pass the time limit cut; its leases hear "stop".
+    enum class TaskState { kQueued, kLeased, kDone, kDropped };
     struct Task {
         TaskState state = TaskState::kQueued;
         int attempts = 0;                  // leases handed out
@@ -146,15 +159,17 @@ class Scheduler {
     };
     struct Job {
         JobRecord record;
-        std::vector<RenderTask> plan;
-        std::vector<Task> tasks;
-        std::set<int> queued;
-        RenderMerger merger;
+        // The tiles' tasks and their results: a fixed plan, or an adaptive one (`adaptive`, the
+        // same object) whose passes are appended to `tasks` as results ask for them.
+        std::unique_ptr<TileMerger> merger;
+        AdaptiveTilePlan* adaptive = nullptr;
+        std::vector<Task> tasks{};
+        std::set<int> queued{};
         uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
         absl::Duration task_time_total = absl::ZeroDuration();  // lease to result, tasks done here
         int tasks_timed = 0;
         // Radiosity solved in sweeps: while `solve` is set, its patch-group tasks follow the
-        // tiles in `tasks` (sweep k's chunk c at plan.size() + k * chunks + c) and the tiles
+        // tiles in `tasks` (sweep k's chunk c at tiles + k * chunks + c) and the tiles
         // wait. A chunk goes back to the worker that did it before, which keeps its form-factor
         // rows; that is soft state, so any worker may take a chunk whose owner is gone.
         std::unique_ptr<RadiositySolve> solve{};
@@ -175,7 +190,15 @@ class Scheduler {
     // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
     void QueueStart(Job& job);
     void QueueSweep(Job& job);
-    static bool IsSweepTask(const Job& job, int task) { return task >= int(job.plan.size()); }
+    static bool IsSweepTask(const Job& job, int task) {
+        return task >= int(job.merger->tasks().size());
+    }
+    // A job with its tiles planned as its spec says; InvalidArgument when they cannot be.
+    static absl::StatusOr<std::unique_ptr<Job>> NewJob(JobRecord record);
+    // Queues a pass the adaptive plan appended.
+    void QueuePass(Job& job, const RenderTask& pass);
+    // Drops an adaptive job's passes once its time limit has passed; true if that completed it.
+    bool EnforceTimeLimit(Job& job, absl::Time now);
     // A sweep task goes to its chunk's owner while that worker lives.
     bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;
     // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).

@@ -59,6 +59,10 @@ std::string RecordToJson(const JobRecord& r) {
             {"max_iterations", s.radiosity.max_iterations},
             {"display", s.radiosity.display},
             {"sweep_tasks", s.radiosity.sweep_tasks}}},
+          {"adaptive",
+           {{"target_error", s.adaptive.target_error},
+            {"time_limit", s.adaptive.time_limit},
+            {"max_spp", s.adaptive.max_spp}}},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
           {"request_id", s.request_id}}},
@@ -100,11 +104,18 @@ absl::StatusOr<JobRecord> RecordFromJson(std::string_view text) {
         r.spec.method = s.value("method", "path");
         if (s.contains("radiosity")) {
             const auto& rad = s.at("radiosity");
-            r.spec.radiosity = {
-                rad.at("patches").get<int64_t>(),    rad.at("patch_size").get<double>(),
-                rad.at("solver").get<std::string>(), rad.at("tolerance").get<double>(),
-                rad.at("max_iterations").get<int>(), rad.at("display").get<std::string>(),
-                rad.value("sweep_tasks", RadiositySettings().sweep_tasks)};
+            r.spec.radiosity = {rad.at("patches").get<int64_t>(),
+                                rad.at("patch_size").get<double>(),
+                                rad.at("solver").get<std::string>(),
+                                rad.at("tolerance").get<double>(),
+                                rad.at("max_iterations").get<int>(),
+                                rad.at("display").get<std::string>(),
+                                rad.value("sweep_tasks", RadiositySettings().sweep_tasks)};
+        }
+        if (s.contains("adaptive")) {
+            const auto& a = s.at("adaptive");
+            r.spec.adaptive = {a.at("target_error").get<double>(), a.at("time_limit").get<double>(),
+                               a.at("max_spp").get<uint64_t>()};
         }
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();

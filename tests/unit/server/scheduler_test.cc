@@ -78,7 +78,7 @@ TEST_F(SchedulerTest, AllResultsInAnyOrderSucceedTheJob) {
     EXPECT_EQ(Job(id).stats.samples, 0u);  // the fake results carry no stats
     auto snapshot = scheduler_.Snapshot(id);
     ASSERT_TRUE(snapshot.ok());
-    EXPECT_EQ((*snapshot->second.FindChannel("spp"))[0], 4.0f);
+    EXPECT_EQ((*snapshot->image.FindChannel("spp"))[0], 4.0f);
     scheduler_.Finish(id, std::string("/results/x.exr"));
     EXPECT_EQ(Job(id).state, JobState::kSucceeded);
     EXPECT_EQ(Job(id).result_path, "/results/x.exr");

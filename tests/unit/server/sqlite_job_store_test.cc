@@ -64,9 +64,9 @@ class SqliteJobStoreTest : public ::testing::Test {
     }
 
     static std::vector<float> Pixels(const Scheduler& scheduler, const std::string& id) {
-        absl::StatusOr<std::pair<JobRecord, Image>> snapshot = scheduler.Snapshot(id);
+        absl::StatusOr<Scheduler::JobImage> snapshot = scheduler.Snapshot(id);
         EXPECT_TRUE(snapshot.ok()) << snapshot.status();
-        return *snapshot->second.FindChannel("R");
+        return *snapshot->image.FindChannel("R");
     }
 
     fs::path dir_;

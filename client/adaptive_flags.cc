@@ -1,0 +1,25 @@
+#include "adaptive_flags.h"
+
+#include "server/plan.h"
+
+namespace lf {
+
+void AddAdaptiveFlags(CLI::App* cmd, AdaptiveSettings& settings) {
+    const std::string a = "Adaptive sampling (docs/convergence.md)";
+    cmd->add_option("--target-error", settings.target_error,
+                    "stop sampling a tile once its estimated relative error (from the A/B "
+                    "halves) is at most this, e.g. 0.01; --spp is then the first pass")
+        ->group(a)
+        ->check(CLI::Range(1e-6, 1.0));
+    cmd->add_option("--time-limit", settings.time_limit,
+                    "stop sampling about this many seconds after the render starts (every tile "
+                    "gets its first pass); alone, tiles double their samples until then")
+        ->group(a)
+        ->check(CLI::Range(1e-3, 1e7));
+    cmd->add_option("--max-spp", settings.max_spp, "most samples per pixel of an adaptive render")
+        ->group(a)
+        ->capture_default_str()
+        ->check(CLI::Range(uint64_t(2), kMaxSpp));
+}
+
+}  // namespace lf

@@ -1,0 +1,12 @@
+// The adaptive sampling options `render` and `submit` share.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "server/adaptive_plan.h"
+
+namespace lf {
+
+void AddAdaptiveFlags(CLI::App* cmd, AdaptiveSettings& settings);
+
+}  // namespace lf

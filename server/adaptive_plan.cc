@@ -1,0 +1,146 @@
+#include "server/adaptive_plan.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+#include "lf/core/image_error.h"
+
+namespace lf {
+
+namespace {
+uint64_t RoundUpToEven(uint64_t n) { return n + (n & 1); }
+}  // namespace
+
+absl::Status CheckAdaptiveSettings(const AdaptiveSettings& a) {
+    if (!std::isfinite(a.target_error) || a.target_error < 0 || a.target_error > 1) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("target error ", a.target_error, ": expected 0 (none) or up to 1"));
+    }
+    if (!std::isfinite(a.time_limit) || a.time_limit < 0) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("time limit ", a.time_limit, " s: expected 0 (none) or more"));
+    }
+    if (a.max_spp < 2 || a.max_spp > kMaxSpp) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("most samples per pixel ", a.max_spp, ": expected 2 to ", kMaxSpp));
+    }
+    return absl::OkStatus();
+}
+
+uint64_t NextSampleCount(uint64_t n, double error, double target, uint64_t max_spp) {
+    const double predicted = double(n) * (error / target) * (error / target) * 1.1;
+    const double next = std::clamp(predicted, double(n + 2), double(n) * 8);
+    return std::min(max_spp, RoundUpToEven(uint64_t(std::ceil(next))));
+}
+
+AdaptiveTilePlan::AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings)
+    : width_(width), height_(height), settings_(settings) {
+    settings_.max_spp = RoundUpToEven(settings.max_spp);
+}
+
+absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> AdaptiveTilePlan::Make(
+    int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings) {
+    if (absl::Status s = CheckAdaptiveSettings(settings); !s.ok()) return s;
+    std::unique_ptr<AdaptiveTilePlan> plan(new AdaptiveTilePlan(width, height, settings));
+    const uint64_t first =
+        std::min(plan->settings_.max_spp, RoundUpToEven(std::max<uint64_t>(first_spp, 2)));
+    absl::StatusOr<std::vector<RenderTask>> tiles = PlanRender({width, height, first, tile, 1});
+    if (!tiles.ok()) return tiles.status();
+    for (const RenderTask& task : *tiles) {
+        plan->tiles_.push_back({TileSums(task.rect), 1, task.index});
+        plan->tile_of_.push_back(task.index);
+    }
+    plan->tasks_ = std::move(*tiles);
+    plan->merged_.assign(plan->tasks_.size(), false);
+    plan->dropped_.assign(plan->tasks_.size(), false);
+    return plan;
+}
+
+bool AdaptiveTilePlan::IsPending(int t) const {
+    return t >= 0 && size_t(t) < tasks_.size() && !merged_[size_t(t)] && !dropped_[size_t(t)];
+}
+
+absl::StatusOr<std::optional<RenderTask>> AdaptiveTilePlan::Merge(int t, const TileSums& sums) {
+    if (t >= 0 && size_t(t) < tasks_.size() && merged_[size_t(t)]) {
+        return absl::AlreadyExistsError(absl::StrCat("task ", t, " is already merged"));
+    }
+    if (!IsPending(t)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("task ", t, " is not a pass planned and still wanted"));
+    }
+    const RenderTask task = tasks_[size_t(t)];
+    if (absl::Status s = CheckTaskResult(task, sums); !s.ok()) return s;
+    merged_[size_t(t)] = true;
+    ++tasks_done_;
+    stats_ += sums.stats;
+    Tile& tile = tiles_[size_t(tile_of_[size_t(t)])];
+    tile.sums += sums;
+    tile.pending = -1;
+    tile.error = EstimatedRelativeError(tile.sums);
+    const uint64_t n = task.sample_end;
+    const bool reached = settings_.target_error > 0 && tile.error <= settings_.target_error;
+    if (reached || n >= settings_.max_spp || stopped_) return std::nullopt;
+    const uint64_t next =
+        settings_.target_error > 0
+            ? NextSampleCount(n, tile.error, settings_.target_error, settings_.max_spp)
+            : std::min(settings_.max_spp, 2 * n);
+    const RenderTask pass{int(tasks_.size()), task.rect, n, next};
+    tile.pending = pass.index;
+    tasks_.push_back(pass);
+    tile_of_.push_back(tile_of_[size_t(t)]);
+    merged_.push_back(false);
+    dropped_.push_back(false);
+    return pass;
+}
+
+bool AdaptiveTilePlan::Complete() const {
+    return std::all_of(tiles_.begin(), tiles_.end(), [](const Tile& t) { return t.pending < 0; });
+}
+
+std::vector<int> AdaptiveTilePlan::Stop() {
+    stopped_ = true;
+    std::vector<int> dropped;
+    for (Tile& tile : tiles_) {
+        if (tile.pending < 0 || tasks_[size_t(tile.pending)].sample_begin == 0) continue;
+        dropped_[size_t(tile.pending)] = true;
+        dropped.push_back(tile.pending);
+        tile.pending = -1;
+    }
+    return dropped;
+}
+
+void AdaptiveTilePlan::Shorten(int t, uint64_t sample_end) {
+    if (!IsPending(t)) return;
+    RenderTask& task = tasks_[size_t(t)];
+    task.sample_end = std::clamp(RoundUpToEven(sample_end), task.sample_begin + 2, task.sample_end);
+}
+
+Image AdaptiveTilePlan::Snapshot() const {
+    Image image = EmptyRenderImage(width_, height_);
+    for (const Tile& tile : tiles_) image.SetTile(tile.sums);
+    return image;
+}
+
+absl::StatusOr<AdaptiveReport> AdaptiveTilePlan::Report() const {
+    AdaptiveReport report;
+    report.tiles = int(tiles_.size());
+    report.timed_out = stopped_;
+    report.min_spp = settings_.max_spp;
+    for (const Tile& tile : tiles_) {
+        const uint64_t n = tile.sums.pixels[0].Count();
+        report.worst_tile_error = std::max(report.worst_tile_error, tile.error);
+        if (settings_.target_error > 0 && tile.error > settings_.target_error) {
+            ++report.tiles_above_target;
+        }
+        report.min_spp = std::min(report.min_spp, n);
+        report.max_spp = std::max(report.max_spp, n);
+        report.per_tile.push_back({tile.sums.rect, n, tile.error});
+    }
+    absl::StatusOr<double> estimated = EstimatedRelativeError(Snapshot());
+    if (!estimated.ok()) return estimated.status();
+    report.estimated_error = *estimated;
+    return report;
+}
+
+}  // namespace lf

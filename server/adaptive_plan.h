@@ -1,0 +1,108 @@
+// Adaptive sampling as a plan that grows: every tile starts with one pass, and each pass's
+// result decides whether the tile gets another and how many samples it takes. The farm's
+// scheduler queues the passes it appends; local mode (client/local_executor.h) runs them in
+// rounds. A tile's passes depend only on its own samples, so without a time limit the farm and
+// local mode plan the same passes and merge the same bits.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/film.h"
+#include "lf/core/image.h"
+#include "server/merge.h"
+#include "server/plan.h"
+
+namespace lf {
+
+// Each tile gets passes of samples until its estimated relative error (EstimatedRelativeError,
+// from the A/B halves) is at most target_error, it has max_spp samples, or the time limit has
+// passed. Every tile gets its first pass whatever the time limit.
+struct AdaptiveSettings {
+    double target_error = 0;  // relative; 0: none
+    double time_limit = 0;    // seconds; 0: none
+    uint64_t max_spp = 1 << 16;
+};
+
+inline bool IsAdaptive(const AdaptiveSettings& a) { return a.target_error > 0 || a.time_limit > 0; }
+
+// InvalidArgument naming the setting that is out of range (a negative or non-finite target or
+// limit, max_spp below 2 or above kMaxSpp).
+absl::Status CheckAdaptiveSettings(const AdaptiveSettings& a);
+
+struct AdaptiveReport {
+    double estimated_error = 0;  // of the whole image (EstimatedRelativeError)
+    double worst_tile_error = 0;
+    int tiles = 0;
+    int tiles_above_target = 0;  // stopped by max_spp or the time limit
+    bool timed_out = false;
+    uint64_t min_spp = 0, max_spp = 0;
+    struct Tile {
+        PixelRect rect;
+        uint64_t spp = 0;
+        double error = 0;  // EstimatedRelativeError at the end
+    };
+    std::vector<Tile> per_tile;  // in plan order
+};
+
+// The sample count a tile should reach after `n` samples at estimated relative error `error`:
+// the error of a mean falls as 1/sqrt(n), so n (error / target)^2, plus 10 % so that a prediction
+// a little low does not cost a whole extra pass; at least 2 more, at most 8x per pass so one
+// noisy estimate cannot ask for far too much; even, so the A and B halves stay equal.
+uint64_t NextSampleCount(uint64_t n, double error, double target, uint64_t max_spp);
+
+class AdaptiveTilePlan : public TileMerger {
+  public:
+    // The planner's tiles (PlanRender with one pass), each with a first pass of `first_spp`
+    // samples rounded up to even. InvalidArgument for sizes PlanRender refuses and for settings
+    // CheckAdaptiveSettings refuses.
+    static absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> Make(int width, int height,
+                                                                  uint64_t first_spp, int tile,
+                                                                  const AdaptiveSettings& settings);
+
+    // Tile t's first pass is task t; the passes Merge appends follow, in the order of the results
+    // that asked for them.
+    const std::vector<RenderTask>& tasks() const override { return tasks_; }
+    // Merges a pass and appends the tile's next one, unless the tile is done. InvalidArgument for
+    // a result that is not the pass's rectangle and sample count, a task not in the plan or one
+    // Stop dropped; AlreadyExists for a pass merged before.
+    absl::StatusOr<std::optional<RenderTask>> Merge(int task_index, const TileSums& sums) override;
+    size_t tasks_done() const override { return tasks_done_; }
+    bool Complete() const override;
+    const RenderStats& stats() const override { return stats_; }
+    Image Snapshot() const override;
+
+    // The time limit: appends no more passes and drops the planned ones not yet merged, except
+    // tiles' first passes. Returns the dropped task indices.
+    std::vector<int> Stop();
+    bool stopped() const { return stopped_; }
+    // Lowers a planned pass's sample count, so that a round of passes fits the time left (local
+    // mode); `sample_end` is rounded up to even and kept above the pass's first sample.
+    void Shorten(int task_index, uint64_t sample_end);
+    bool IsPending(int task_index) const;  // planned, neither merged nor dropped
+
+    absl::StatusOr<AdaptiveReport> Report() const;
+
+  private:
+    struct Tile {
+        TileSums sums;
+        double error = 1;
+        int pending = -1;  // the pass planned and not merged yet
+    };
+    AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings);
+
+    int width_, height_;
+    AdaptiveSettings settings_;
+    std::vector<Tile> tiles_;
+    std::vector<RenderTask> tasks_;
+    std::vector<int> tile_of_;  // by task
+    std::vector<bool> merged_, dropped_;
+    size_t tasks_done_ = 0;
+    RenderStats stats_;
+    bool stopped_ = false;
+};
+
+}  // namespace lf
