@@ -571,6 +571,63 @@ TEST_F(Farm, ServerKilledMidSolveStillGivesTheLocalPixels) {
     EXPECT_NE(ReadText(dir_ / "server-2.log").find("radiosity sweep 1:"), std::string::npos);
 }
 
+// Adaptive sampling on the farm: passes only for the tiles whose estimated error is above the
+// target, each tile's passes decided by its own samples, so the same pixels as local mode.
+TEST_F(Farm, TargetErrorPlansPassesOnlyWhereNeededAndGivesTheLocalPixels) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string flags = "--method path --tile 16 --target-error 0.08 --max-spp 2048";
+    const std::string job = Submit(scene_, "--spp 4 --seed 5 " + flags);
+    ExpectSameAsLocal(job, scene_, 4, 5, flags);
+    absl::StatusOr<ExrFile> exr = ReadExr((dir_ / (job + ".exr")).string());
+    ASSERT_TRUE(exr.ok()) << exr.status();
+    const ExrAttributes& a = exr->attributes;
+    EXPECT_EQ(std::get<double>(a.at("lightfarm.targetError")), 0.08);
+    EXPECT_EQ(std::get<std::string>(a.at("lightfarm.adaptive.timedOut")), "no");
+    EXPECT_EQ(std::get<int>(a.at("lightfarm.adaptive.tilesAboveTarget")), 0);
+    EXPECT_LE(std::get<double>(a.at("lightfarm.adaptive.worstTileError")), 0.08);
+    EXPECT_GT(std::get<double>(a.at("lightfarm.estimatedError")), 0);
+    // The 16 tiles did not all need the same: some stopped far below the worst one.
+    const int min_spp = std::get<int>(a.at("lightfarm.adaptive.minSpp"));
+    const int max_spp = std::get<int>(a.at("lightfarm.adaptive.maxSpp"));
+    EXPECT_LE(4 * min_spp, max_spp) << min_spp << " to " << max_spp;
+    EXPECT_GT(Tasks(job).total, 16);
+}
+
+TEST_F(Farm, ServerKilledMidAdaptiveRenderReplansTheSamePasses) {
+    StartServer();
+    StartWorker("w1");
+    const std::string flags = "--method path --tile 16 --target-error 0.08 --max-spp 2048";
+    const std::string job = Submit(scene_, "--spp 4 --seed 6 " + flags);
+    ASSERT_TRUE(WaitForTasksDone(job, 20, milliseconds(30000)));
+    CrashAndRestartServer();
+    ExpectSameAsLocal(job, scene_, 4, 6, flags);
+    EXPECT_NE(ReadText(dir_ / "server-2.log").find("recovered"), std::string::npos);
+}
+
+TEST_F(Farm, TimeLimitEndsAnAdaptiveJobOnTime) {
+    StartServer();
+    StartWorker("w1");
+    const auto start = Clock::now();
+    // Without the limit this would sample up to 2^20 per pixel: hours.
+    const std::string job =
+        Submit(scene_, "--spp 2 --tile 32 --time-limit 2 --max-spp 1048576 --method path");
+    const CliRun watch = Farmctl("watch " + job, 30);
+    ASSERT_EQ(watch.status, 0) << watch.out << watch.err;
+    const auto took = Clock::now() - start;
+    EXPECT_GE(took, milliseconds(2000));
+    // The limit, plus a heartbeat for the worker to hear "stop", plus the result's write.
+    EXPECT_LT(took, milliseconds(6000));
+    const std::string out = (dir_ / "timed.exr").string();
+    ASSERT_EQ(Farmctl("fetch " + job + " -o " + out).status, 0);
+    absl::StatusOr<ExrFile> exr = ReadExr(out);
+    ASSERT_TRUE(exr.ok()) << exr.status();
+    EXPECT_EQ(std::get<std::string>(exr->attributes.at("lightfarm.adaptive.timedOut")), "yes");
+    EXPECT_GE(std::get<int>(exr->attributes.at("lightfarm.adaptive.minSpp")), 2);
+    EXPECT_NE(ReadText(dir_ / "server-1.log").find("time limit of 2 s reached"), std::string::npos);
+}
+
 TEST_F(Farm, RadiosityJobForAGlossySceneIsRefusedAtSubmission) {
     StartServer();
     const std::string glossy = (dir_ / "glossy.json").string();

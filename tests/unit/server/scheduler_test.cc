@@ -302,5 +302,82 @@ TEST_F(SchedulerTest, ListIsNewestFirst) {
     EXPECT_EQ(jobs[1].id, a);
 }
 
+// An adaptive job on a 16x16 image in 8x8 tiles, first pass 4 spp. Tile (8, 8) is noisy (the
+// A half reads 0.4, the B half 0.6: a relative error of 0.2 whatever the count), the others flat.
+std::string SubmitAdaptive(Scheduler& scheduler, const AdaptiveSettings& adaptive) {
+    JobSpec spec;
+    spec.name = "adaptive";
+    spec.plan = {16, 16, 4, 8, 1};
+    spec.adaptive = adaptive;
+    absl::StatusOr<std::string> id = scheduler.Submit(spec);
+    EXPECT_TRUE(id.ok()) << id.status();
+    return *id;
+}
+
+TileSums HalvesResult(const Lease& lease) {
+    TileSums sums(lease.task.rect);
+    const bool noisy = lease.task.rect.x0 == 8 && lease.task.rect.y0 == 8;
+    for (PixelSums& p : sums.pixels) {
+        for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
+            p.Add(s, Rgb(noisy ? (s % 2 ? 0.6f : 0.4f) : 0.5f));
+        }
+    }
+    return sums;
+}
+
+TEST_F(SchedulerTest, AdaptiveJobQueuesPassesOnlyForTheTileAboveTheTarget) {
+    const std::string id = SubmitAdaptive(scheduler_, {.target_error = 0.1, .max_spp = 64});
+    EXPECT_EQ(Job(id).tasks_total, 4);
+    std::vector<uint64_t> pass_ends;
+    while (std::optional<Lease> lease = scheduler_.LeaseTask("w")) {
+        if (lease->task.index >= 4) {
+            EXPECT_EQ(lease->task.rect.x0, 8);
+            EXPECT_EQ(lease->task.rect.y0, 8);
+            pass_ends.push_back(lease->task.sample_end);
+        }
+        ASSERT_TRUE(scheduler_.Complete(lease->id, "w", HalvesResult(*lease)).ok());
+    }
+    // Error 0.2 against 0.1 asks for 4x the samples plus 10 %, each pass; never below target.
+    EXPECT_EQ(pass_ends, (std::vector<uint64_t>{18, 64}));
+    EXPECT_EQ(Job(id).tasks_total, 6);
+    EXPECT_EQ(Job(id).tasks_done, 6);
+    auto snapshot = scheduler_.Snapshot(id);
+    ASSERT_TRUE(snapshot.ok());
+    ASSERT_TRUE(snapshot->adaptive.has_value());
+    EXPECT_EQ(snapshot->adaptive->max_spp, 64u);
+    EXPECT_EQ(snapshot->adaptive->min_spp, 4u);
+    EXPECT_EQ(snapshot->adaptive->tiles_above_target, 1);  // stopped by max_spp
+    EXPECT_EQ((*snapshot->image.FindChannel("spp"))[15 * 16 + 15], 64.0f);
+}
+
+TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
+    const std::string id = SubmitAdaptive(scheduler_, {.time_limit = 5, .max_spp = 1 << 10});
+    for (int i = 0; i < 4; ++i) {  // the first passes, each asking for a second
+        const std::optional<Lease> lease = scheduler_.LeaseTask("w");
+        ASSERT_TRUE(lease.has_value());
+        ASSERT_TRUE(scheduler_.Complete(lease->id, "w", HalvesResult(*lease)).ok());
+    }
+    const std::optional<Lease> running = scheduler_.LeaseTask("w");
+    ASSERT_TRUE(running.has_value());
+    EXPECT_EQ(running->task.sample_begin, 4u);
+    EXPECT_EQ(running->task.sample_end, 8u);
+    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
+    now_ += absl::Seconds(5);
+    EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
+    EXPECT_FALSE(scheduler_.Heartbeat(running->id, "w"));  // the worker stops
+    EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
+    // Its late result changes nothing.
+    absl::StatusOr<Scheduler::Completion> late =
+        scheduler_.Complete(running->id, "w", HalvesResult(*running));
+    ASSERT_TRUE(late.ok());
+    EXPECT_FALSE(late->job_rendered);
+    EXPECT_EQ(Job(id).tasks_done, 4);
+    EXPECT_EQ(Job(id).tasks_total, 4);
+    auto snapshot = scheduler_.Snapshot(id);
+    ASSERT_TRUE(snapshot.ok());
+    EXPECT_TRUE(snapshot->adaptive->timed_out);
+    EXPECT_EQ(snapshot->adaptive->max_spp, 4u);
+}
+
 }  // namespace
 }  // namespace lf

@@ -83,6 +83,7 @@ TEST_F(SqliteJobStoreTest, RecordsRoundTripThroughAReopen) {
     job.spec.max_depth = 3;
     job.spec.priority = -2;
     job.spec.scene_hash = "hash";
+    job.spec.adaptive = {0.03, 120, 512};
     job.state = JobState::kFailed;
     job.error = "why";
     job.submitted = absl::FromUnixMicros(1'000'001);
@@ -103,6 +104,9 @@ TEST_F(SqliteJobStoreTest, RecordsRoundTripThroughAReopen) {
     EXPECT_EQ(back->spec.files[0].path, "mesh.obj");
     EXPECT_EQ(back->spec.plan.passes, 2);
     EXPECT_EQ(back->spec.priority, -2);
+    EXPECT_EQ(back->spec.adaptive.target_error, 0.03);
+    EXPECT_EQ(back->spec.adaptive.time_limit, 120);
+    EXPECT_EQ(back->spec.adaptive.max_spp, 512u);
     EXPECT_EQ(back->state, JobState::kFailed);
     EXPECT_EQ(back->error, "why");
     EXPECT_EQ(back->started, job.started);
@@ -251,6 +255,63 @@ TEST_F(SqliteJobStoreTest, UnusableDataDirIsAClearError) {
     ASSERT_FALSE(farm.ok());
     EXPECT_NE(farm.status().message().find(options.data_dir), std::string_view::npos)
         << farm.status();
+}
+
+// An adaptive job's passes are appended as results arrive; after a crash, replaying the recorded
+// results in index order plans the same passes again, so the job ends with the same pixels.
+TEST_F(SqliteJobStoreTest, RestartReplaysAnAdaptiveJobsPasses) {
+    JobSpec spec = Spec();
+    spec.plan.passes = 1;
+    spec.adaptive = {.target_error = 0.1, .time_limit = 0, .max_spp = 64};
+    // Every pixel's halves read 0.4 and 0.6: relative error 0.2 at any count, so each tile goes
+    // 4 -> 18 -> 64 samples.
+    auto halves = [](const Lease& lease) {
+        TileSums sums(lease.task.rect);
+        for (PixelSums& p : sums.pixels) {
+            for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
+                p.Add(s, Rgb(s % 2 ? 0.6f : 0.4f));
+            }
+        }
+        return sums;
+    };
+    InMemoryJobStore memory;
+    Scheduler reference({}, memory);
+    const std::string ref_id = *reference.Submit(spec);
+    while (std::optional<Lease> lease = reference.LeaseTask("w")) {
+        ASSERT_TRUE(reference.Complete(lease->id, "w", halves(*lease)).ok());
+    }
+    EXPECT_EQ(reference.Get(ref_id)->tasks_done, 12);
+    const std::vector<float> expected = Pixels(reference, ref_id);
+
+    std::string id;
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        Scheduler before({}, *store);
+        id = *before.Submit(spec);
+        for (int i = 0; i < 6; ++i) {
+            std::optional<Lease> lease = before.LeaseTask("w");
+            ASSERT_TRUE(before.Complete(lease->id, "w", halves(*lease)).ok());
+        }
+        // The 4 first passes, 4 second ones, and the third passes of the 2 tiles done twice.
+        EXPECT_EQ(before.Get(id)->tasks_total, 10);
+        ASSERT_TRUE(before.LeaseTask("w"));  // leased when the server dies
+    }
+    std::unique_ptr<SqliteJobStore> store = OpenStore();
+    Scheduler after({}, *store);
+    ASSERT_TRUE(after.Recover().ok());
+    EXPECT_EQ(after.Get(id)->tasks_done, 6);
+    EXPECT_EQ(after.Get(id)->tasks_total, 10);
+    int leased = 0;
+    bool rendered = false;
+    while (std::optional<Lease> lease = after.LeaseTask("w")) {
+        ++leased;
+        absl::StatusOr<Scheduler::Completion> done = after.Complete(lease->id, "w", halves(*lease));
+        ASSERT_TRUE(done.ok()) << done.status();
+        rendered |= done->job_rendered;
+    }
+    EXPECT_TRUE(rendered);
+    EXPECT_EQ(leased, 6);
+    EXPECT_EQ(Pixels(after, id), expected);
 }
 
 }  // namespace

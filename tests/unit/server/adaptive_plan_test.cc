@@ -1,0 +1,174 @@
+// The adaptive plan on synthetic tiles whose noise is known: which tiles get more passes, how
+// many samples they ask for, what a time limit drops, and that replaying results in index order
+// rebuilds the same plan (the farm's recovery).
+#include "server/adaptive_plan.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "lf/core/image_error.h"
+
+namespace lf {
+namespace {
+
+// A 16x8 image in two 8x8 tiles: tile 0 (x < 8) is flat, tile 1 has Gaussian noise of relative
+// standard deviation `kSigma` around 0.5. A sample depends on (pixel, sample index) only, as a
+// renderer's does.
+constexpr double kSigma = 0.5;
+
+TileSums Pass(const RenderTask& task) {
+    TileSums sums(task.rect);
+    for (int y = task.rect.y0; y < task.rect.y0 + task.rect.height; ++y) {
+        for (int x = task.rect.x0; x < task.rect.x0 + task.rect.width; ++x) {
+            for (uint64_t s = task.sample_begin; s < task.sample_end; ++s) {
+                std::mt19937_64 rng(uint64_t(y * 16 + x) << 32 | s);
+                const double noise = x < 8 ? 0 : std::normal_distribution<>(0, kSigma)(rng);
+                sums.at(x, y).Add(s, Rgb(float(0.5 * (1 + noise))));
+            }
+        }
+    }
+    return sums;
+}
+
+std::unique_ptr<AdaptiveTilePlan> MakePlan(const AdaptiveSettings& settings, uint64_t first = 4) {
+    absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan =
+        AdaptiveTilePlan::Make(16, 8, first, 8, settings);
+    EXPECT_TRUE(plan.ok()) << plan.status();
+    return std::move(*plan);
+}
+
+// Runs every planned pass to the end, in plan order; returns the results by task index.
+std::map<int, TileSums> RunToEnd(AdaptiveTilePlan& plan) {
+    std::map<int, TileSums> results;
+    for (size_t t = 0; t < plan.tasks().size(); ++t) {
+        const RenderTask task = plan.tasks()[t];
+        if (!plan.IsPending(int(t))) continue;
+        results.emplace(int(t), Pass(task));
+        EXPECT_TRUE(plan.Merge(int(t), results.at(int(t))).ok());
+    }
+    return results;
+}
+
+TEST(NextSampleCount, FollowsTheSquareLawWithinItsBounds) {
+    // 16 (0.2 / 0.1)^2 1.1 = 70.4 -> 72 (even).
+    EXPECT_EQ(NextSampleCount(16, 0.2, 0.1, 1 << 16), 72u);
+    EXPECT_EQ(NextSampleCount(16, 0.101, 0.1, 1 << 16), 18u);  // at least 2 more
+    EXPECT_EQ(NextSampleCount(16, 10, 0.1, 1 << 16), 128u);    // at most 8x
+    EXPECT_EQ(NextSampleCount(16, 0.2, 0.1, 40), 40u);         // at most max_spp
+}
+
+TEST(AdaptiveTilePlan, OnlyTheNoisyTileGetsMorePassesUntilItsErrorIsBelowTheTarget) {
+    const double target = 0.02;
+    auto plan = MakePlan({.target_error = target, .time_limit = 0, .max_spp = 1 << 16});
+    ASSERT_EQ(plan->tasks().size(), 2u);
+    RunToEnd(*plan);
+    ASSERT_TRUE(plan->Complete());
+    absl::StatusOr<AdaptiveReport> report = plan->Report();
+    ASSERT_TRUE(report.ok()) << report.status();
+    EXPECT_EQ(report->per_tile[0].spp, 4u);  // flat: error 0 after the first pass
+    EXPECT_EQ(report->per_tile[0].error, 0);
+    EXPECT_LE(report->per_tile[1].error, target);
+    EXPECT_EQ(report->tiles_above_target, 0);
+    // The relative error of a mean of n samples is sigma / sqrt(n) per channel here, so the
+    // noisy tile needs about (sigma / target)^2 = 625 samples; the 10 % margin and rounding of
+    // the last pass may overshoot, by at most 8x of the pass before.
+    const double needed = kSigma * kSigma / (target * target);
+    EXPECT_GE(double(report->per_tile[1].spp), 0.8 * needed);
+    EXPECT_LE(double(report->per_tile[1].spp), 3 * needed);
+    // Every pass after the first belongs to tile 1 and continues where the last one ended.
+    uint64_t end = plan->tasks()[1].sample_end;
+    for (size_t t = 2; t < plan->tasks().size(); ++t) {
+        EXPECT_EQ(plan->tasks()[t].rect.x0, 8);
+        EXPECT_EQ(plan->tasks()[t].sample_begin, end);
+        end = plan->tasks()[t].sample_end;
+    }
+}
+
+TEST(AdaptiveTilePlan, WithoutATargetTilesDoubleUpToMaxSpp) {
+    auto plan = MakePlan({.target_error = 0, .time_limit = 10, .max_spp = 64});
+    RunToEnd(*plan);
+    absl::StatusOr<AdaptiveReport> report = plan->Report();
+    ASSERT_TRUE(report.ok());
+    EXPECT_EQ(report->min_spp, 64u);
+    EXPECT_EQ(report->max_spp, 64u);
+    EXPECT_EQ(plan->tasks().size(), 2u * 5);  // 4, 8, 16, 32, 64
+}
+
+TEST(AdaptiveTilePlan, StopDropsPlannedPassesButNotFirstOnes) {
+    auto plan = MakePlan({.target_error = 0.001, .time_limit = 1, .max_spp = 1 << 16});
+    // Tile 1's first pass asks for a second; tile 0's first pass is still out.
+    absl::StatusOr<std::optional<RenderTask>> next = plan->Merge(1, Pass(plan->tasks()[1]));
+    ASSERT_TRUE(next.ok() && next->has_value());
+    const int second = (*next)->index;
+    EXPECT_EQ(plan->Stop(), std::vector<int>{second});
+    EXPECT_FALSE(plan->IsPending(second));
+    EXPECT_EQ(plan->Merge(second, Pass(plan->tasks()[size_t(second)])).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    EXPECT_FALSE(plan->Complete());  // tile 0 has no samples yet
+    next = plan->Merge(0, Pass(plan->tasks()[0]));
+    ASSERT_TRUE(next.ok());
+    EXPECT_FALSE(next->has_value());
+    EXPECT_TRUE(plan->Complete());
+    absl::StatusOr<AdaptiveReport> report = plan->Report();
+    ASSERT_TRUE(report.ok());
+    EXPECT_TRUE(report->timed_out);
+    EXPECT_EQ(report->max_spp, 4u);
+    EXPECT_EQ(report->tiles_above_target, 1);
+}
+
+TEST(AdaptiveTilePlan, RefusesResultsThatAreNotThePass) {
+    auto plan = MakePlan({.target_error = 0.01, .time_limit = 0, .max_spp = 1 << 16});
+    RenderTask wrong_count = plan->tasks()[1];
+    wrong_count.sample_end = 6;
+    EXPECT_EQ(plan->Merge(1, Pass(wrong_count)).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(plan->Merge(1, Pass(plan->tasks()[0])).status().code(),
+              absl::StatusCode::kInvalidArgument);  // tile 0's rectangle
+    EXPECT_EQ(plan->Merge(7, Pass(plan->tasks()[0])).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    ASSERT_TRUE(plan->Merge(0, Pass(plan->tasks()[0])).ok());
+    EXPECT_EQ(plan->Merge(0, Pass(plan->tasks()[0])).status().code(),
+              absl::StatusCode::kAlreadyExists);
+    EXPECT_EQ(plan->tasks_done(), 1u);
+}
+
+TEST(AdaptiveTilePlan, ReplayingResultsInIndexOrderRebuildsThePlanAndItsBits) {
+    const AdaptiveSettings settings{.target_error = 0.02, .time_limit = 0, .max_spp = 1 << 16};
+    auto plan = MakePlan(settings);
+    const std::map<int, TileSums> results = RunToEnd(*plan);
+    auto replayed = MakePlan(settings);
+    for (const auto& [t, sums] : results) ASSERT_TRUE(replayed->Merge(t, sums).ok()) << t;
+    ASSERT_EQ(replayed->tasks().size(), plan->tasks().size());
+    for (size_t t = 0; t < plan->tasks().size(); ++t) {
+        EXPECT_EQ(replayed->tasks()[t].sample_end, plan->tasks()[t].sample_end);
+    }
+    EXPECT_TRUE(replayed->Complete());
+    EXPECT_EQ(*replayed->Snapshot().FindChannel("R"), *plan->Snapshot().FindChannel("R"));
+}
+
+TEST(AdaptiveTilePlan, ShortenKeepsPassesEvenAndNonEmpty) {
+    auto plan = MakePlan({.target_error = 0, .time_limit = 5, .max_spp = 1 << 16}, 16);
+    plan->Shorten(0, 7);
+    EXPECT_EQ(plan->tasks()[0].sample_end, 8u);
+    plan->Shorten(0, 0);
+    EXPECT_EQ(plan->tasks()[0].sample_end, 2u);
+    plan->Shorten(1, 100);  // never longer
+    EXPECT_EQ(plan->tasks()[1].sample_end, 16u);
+}
+
+TEST(AdaptiveTilePlan, RefusesSettingsOutOfRange) {
+    for (const AdaptiveSettings& bad :
+         {AdaptiveSettings{.target_error = -0.1}, AdaptiveSettings{.target_error = NAN},
+          AdaptiveSettings{.time_limit = -1}, AdaptiveSettings{.time_limit = INFINITY},
+          AdaptiveSettings{.target_error = 0.1, .max_spp = 1},
+          AdaptiveSettings{.target_error = 0.1, .max_spp = kMaxSpp + 1}}) {
+        EXPECT_EQ(AdaptiveTilePlan::Make(16, 8, 4, 8, bad).status().code(),
+                  absl::StatusCode::kInvalidArgument);
+    }
+}
+
+}  // namespace
+}  // namespace lf
