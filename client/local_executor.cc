@@ -4,9 +4,14 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <mutex>
+#include <queue>
+#include <thread>
+#include <tuple>
 
 #include "lf/core/image_error.h"
 #include "lf/kernels/tile_renderer.h"
@@ -55,79 +60,84 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
                                                  const ProgressFn& progress) {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made = AdaptiveTilePlan::Make(
         camera.width(), camera.height(), settings.spp, settings.tile, adaptive);
     if (!made.ok()) return made.status();
     AdaptiveTilePlan& plan = **made;
+    const size_t tiles = plan.tasks().size();
 
-    RenderOutput out;
+    // Passes wait by their first sample, then plan order, as on the farm: every tile's first
+    // pass before any second one, and the least sampled tiles first, so a time limit leaves
+    // the tiles evenly sampled. No rounds: a tile's next pass starts as soon as its last ends.
+    auto later = [](const RenderTask& a, const RenderTask& b) {
+        return std::tie(a.sample_begin, a.index) > std::tie(b.sample_begin, b.index);
+    };
+    std::priority_queue<RenderTask, std::vector<RenderTask>, decltype(later)> queue(later,
+                                                                                    plan.tasks());
     std::mutex mutex;
-    absl::Status status;
+    std::condition_variable changed;
+    int running = 0;
+    bool finished = false;
     size_t tiles_done = 0;
-    bool shortened = false;
-    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    // Rounds of one pass for every unfinished tile, so that a time limit leaves the tiles
-    // evenly sampled rather than the first ones finished and the rest at their first pass.
-    std::vector<RenderTask> round = plan.tasks();
-    const size_t tiles = round.size();
-    while (!round.empty()) {
-        if (adaptive.time_limit > 0 && out.stats.samples > 0) {
-            const double left = adaptive.time_limit - elapsed();
-            if (left <= 0) {
-                plan.Stop();
-                break;
-            }
-            uint64_t planned = 0;
-            for (const RenderTask& task : round) {
-                planned += (task.sample_end - task.sample_begin) * uint64_t(task.rect.Area());
-            }
-            const double affordable = left / (elapsed() / double(out.stats.samples));
-            if (double(planned) > affordable) {
-                shortened = true;
-                const double scale = affordable / double(planned);
-                for (RenderTask& task : round) {
-                    plan.Shorten(task.index,
-                                 task.sample_begin +
-                                     uint64_t(double(task.sample_end - task.sample_begin) * scale));
-                    task = plan.tasks()[size_t(task.index)];
+    absl::Status status;
+    std::atomic<bool> out_of_time{false};  // cancels the passes the time limit drops
+
+    auto work = [&] {
+        std::unique_lock<std::mutex> lock(mutex);
+        while (true) {
+            changed.wait(lock, [&] { return !queue.empty() || running == 0; });
+            if (queue.empty() || !status.ok()) break;
+            const RenderTask task = queue.top();
+            queue.pop();
+            if (!plan.IsPending(task.index)) continue;  // dropped by the time limit
+            ++running;
+            lock.unlock();
+            // First passes are never dropped, so never cancelled.
+            const TileSums sums =
+                RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
+                           task.sample_end, task.sample_begin == 0 ? nullptr : &out_of_time);
+            lock.lock();
+            --running;
+            if (plan.IsPending(task.index)) {  // else cut short: the time limit dropped it
+                absl::StatusOr<std::optional<RenderTask>> next = plan.Merge(task.index, sums);
+                if (!next.ok()) {
+                    status.Update(next.status());
+                } else if (*next) {
+                    queue.push(**next);
+                } else if (progress) {
+                    progress(++tiles_done, tiles);
                 }
             }
+            changed.notify_all();
         }
-        std::vector<RenderTask> next;
-        arena.execute([&] {
-            tbb::parallel_for(
-                tbb::blocked_range<size_t>(0, round.size(), 1),
-                [&](const tbb::blocked_range<size_t>& range) {
-                    for (size_t k = range.begin(); k != range.end(); ++k) {
-                        const RenderTask& task = round[k];
-                        const TileSums sums =
-                            RenderTile(camera, estimator, task.rect, settings.seed,
-                                       task.sample_begin, task.sample_end);
-                        std::lock_guard<std::mutex> lock(mutex);
-                        absl::StatusOr<std::optional<RenderTask>> pass =
-                            plan.Merge(task.index, sums);
-                        if (!pass.ok()) {
-                            status.Update(pass.status());
-                        } else if (*pass) {
-                            next.push_back(**pass);
-                        } else if (progress) {
-                            progress(++tiles_done, tiles);
-                        }
-                    }
-                },
-                tbb::simple_partitioner());
-        });
-        if (!status.ok()) return status;
-        out.stats = plan.stats();
-        round = std::move(next);
+        finished = true;
+        changed.notify_all();
+    };
+    const int threads = settings.threads > 0
+                            ? settings.threads
+                            : int(std::max(1u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (int i = 0; i < threads; ++i) pool.emplace_back(work);
+    if (adaptive.time_limit > 0) {
+        std::unique_lock<std::mutex> lock(mutex);
+        const auto deadline = start + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double>(adaptive.time_limit));
+        if (!changed.wait_until(lock, deadline, [&] { return finished; })) {
+            plan.Stop();
+            out_of_time = true;
+            changed.notify_all();
+        }
     }
+    for (std::thread& t : pool) t.join();
+    if (!status.ok()) return status;
+
+    RenderOutput out;
+    out.stats = plan.stats();
     out.image = plan.Snapshot();
     absl::StatusOr<AdaptiveReport> report = plan.Report();
     if (!report.ok()) return report.status();
     out.adaptive = std::move(*report);
-    out.adaptive.timed_out |= shortened;
-    out.seconds = elapsed();
+    out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     return out;
 }
 

@@ -38,8 +38,9 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
                                          const RenderSettings& settings,
                                          const ProgressFn& progress = {});
 
-// Adaptive sampling (AdaptiveTilePlan) in rounds of one pass per unfinished tile; a time limit
-// shrinks a round's passes to fit the time left. settings.spp is the first pass of every tile
+// Adaptive sampling (AdaptiveTilePlan) on settings.threads threads, each taking the least
+// sampled tile's pass next; at the time limit the passes under way are cut and dropped, as on
+// the farm. settings.spp is the first pass of every tile
 // (rounded up to even, so A and B are equal halves); settings.passes is ignored. Progress counts
 // finished tiles.
 absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,

@@ -110,12 +110,6 @@ std::vector<int> AdaptiveTilePlan::Stop() {
     return dropped;
 }
 
-void AdaptiveTilePlan::Shorten(int t, uint64_t sample_end) {
-    if (!IsPending(t)) return;
-    RenderTask& task = tasks_[size_t(t)];
-    task.sample_end = std::clamp(RoundUpToEven(sample_end), task.sample_begin + 2, task.sample_end);
-}
-
 Image AdaptiveTilePlan::Snapshot() const {
     Image image = EmptyRenderImage(width_, height_);
     for (const Tile& tile : tiles_) image.SetTile(tile.sums);

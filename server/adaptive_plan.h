@@ -1,8 +1,8 @@
 // Adaptive sampling as a plan that grows: every tile starts with one pass, and each pass's
 // result decides whether the tile gets another and how many samples it takes. The farm's
-// scheduler queues the passes it appends; local mode (client/local_executor.h) runs them in
-// rounds. A tile's passes depend only on its own samples, so without a time limit the farm and
-// local mode plan the same passes and merge the same bits.
+// scheduler queues the passes it appends; local mode (client/local_executor.h) runs them on a
+// thread pool. A tile's passes depend only on its own samples, so without a time limit the farm
+// and local mode plan the same passes and merge the same bits.
 #pragma once
 
 #include <cstdint>
@@ -79,9 +79,6 @@ class AdaptiveTilePlan : public TileMerger {
     // tiles' first passes. Returns the dropped task indices.
     std::vector<int> Stop();
     bool stopped() const { return stopped_; }
-    // Lowers a planned pass's sample count, so that a round of passes fits the time left (local
-    // mode); `sample_end` is rounded up to even and kept above the pass's first sample.
-    void Shorten(int task_index, uint64_t sample_end);
     bool IsPending(int task_index) const;  // planned, neither merged nor dropped
 
     absl::StatusOr<AdaptiveReport> Report() const;

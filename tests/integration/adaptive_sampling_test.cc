@@ -148,10 +148,10 @@ TEST_F(AdaptiveSampling, TimeLimitStopsSampling) {
     const RenderOutput out = Adaptive({.target_error = 1e-4, .time_limit = 0.3});
     EXPECT_TRUE(out.adaptive.timed_out);
     EXPECT_GT(out.adaptive.tiles_above_target, 0);
-    // The first pass, then rounds sized to the time left: well under a few times the limit.
+    // The first passes, then passes cut at the limit: well under a few times the limit.
     EXPECT_LT(out.seconds, 3.0);
 
-    // Without a target, every tile doubles its samples each round until the time is up.
+    // Without a target, tiles double their samples, least sampled first, until the time is up.
     const RenderOutput timed = Adaptive({.time_limit = 0.3});
     EXPECT_TRUE(timed.adaptive.timed_out);
     EXPECT_GE(timed.adaptive.min_spp, 16u);

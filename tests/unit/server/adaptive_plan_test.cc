@@ -149,16 +149,6 @@ TEST(AdaptiveTilePlan, ReplayingResultsInIndexOrderRebuildsThePlanAndItsBits) {
     EXPECT_EQ(*replayed->Snapshot().FindChannel("R"), *plan->Snapshot().FindChannel("R"));
 }
 
-TEST(AdaptiveTilePlan, ShortenKeepsPassesEvenAndNonEmpty) {
-    auto plan = MakePlan({.target_error = 0, .time_limit = 5, .max_spp = 1 << 16}, 16);
-    plan->Shorten(0, 7);
-    EXPECT_EQ(plan->tasks()[0].sample_end, 8u);
-    plan->Shorten(0, 0);
-    EXPECT_EQ(plan->tasks()[0].sample_end, 2u);
-    plan->Shorten(1, 100);  // never longer
-    EXPECT_EQ(plan->tasks()[1].sample_end, 16u);
-}
-
 TEST(AdaptiveTilePlan, RefusesSettingsOutOfRange) {
     for (const AdaptiveSettings& bad :
          {AdaptiveSettings{.target_error = -0.1}, AdaptiveSettings{.target_error = NAN},
