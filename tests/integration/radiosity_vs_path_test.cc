@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
@@ -106,18 +107,36 @@ std::vector<int> Surfaces(const EmbreeScene& scene, const Camera& camera) {
     return region;
 }
 
-TEST(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
-    auto scene = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
-    ASSERT_TRUE(scene.ok()) << scene.status();
-    scene->camera.width = scene->camera.height = kResolution;
-    auto es = EmbreeScene::Build(*scene);
-    ASSERT_TRUE(es.ok()) << es.status();
-    const EmbreeScene& embree = **es;
-    const Camera camera(scene->camera, embree.origin());
-    RenderSettings settings;
-    settings.spp = kSpp;
-    settings.seed = kSeed;
-    const Image path = RenderImage(camera, PathTracer(embree, -1), settings).value().image;
+// The Cornell box at 64 x 64 and its path-traced reference.
+class RadiosityVsPath : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        auto loaded = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
+        ASSERT_TRUE(loaded.ok()) << loaded.status();
+        scene_ = std::move(*loaded);
+        scene_.camera.width = scene_.camera.height = kResolution;
+        auto es = EmbreeScene::Build(scene_);
+        ASSERT_TRUE(es.ok()) << es.status();
+        embree_ = std::move(*es);
+        camera_ = std::make_unique<Camera>(scene_.camera, embree_->origin());
+        settings_.spp = kSpp;
+        settings_.seed = kSeed;
+        path_ = RenderImage(*camera_, PathTracer(*embree_, -1), settings_).value().image;
+    }
+
+    Scene scene_;
+    std::unique_ptr<EmbreeScene> embree_;
+    std::unique_ptr<Camera> camera_;
+    RenderSettings settings_;
+    Image path_;
+};
+
+TEST_F(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
+    const Scene* scene = &scene_;
+    const EmbreeScene& embree = *embree_;
+    const Camera& camera = *camera_;
+    const RenderSettings& settings = settings_;
+    const Image& path = path_;
 
     const std::vector<int> blocks = Blocks(), surfaces = Surfaces(embree, camera);
     const int block_count = (kResolution / kBlock) * (kResolution / kBlock);
@@ -165,18 +184,11 @@ TEST(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
 // Refinement from 250 patches to a target of 0.1 against the uniform mesh of the same size:
 // splitting where the solution varies must beat splitting everywhere. Both are compared with the
 // path tracer as above (block means, noise subtracted), so the reference is unbiased.
-TEST(RadiosityVsPath, RefinementBeatsAUniformMeshOfTheSameSize) {
-    auto scene = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
-    ASSERT_TRUE(scene.ok()) << scene.status();
-    scene->camera.width = scene->camera.height = kResolution;
-    auto es = EmbreeScene::Build(*scene);
-    ASSERT_TRUE(es.ok()) << es.status();
-    const EmbreeScene& embree = **es;
-    const Camera camera(scene->camera, embree.origin());
-    RenderSettings settings;
-    settings.spp = kSpp;
-    settings.seed = kSeed;
-    const Image path = RenderImage(camera, PathTracer(embree, -1), settings).value().image;
+TEST_F(RadiosityVsPath, RefinementBeatsAUniformMeshOfTheSameSize) {
+    const EmbreeScene& embree = *embree_;
+    const Camera& camera = *camera_;
+    const RenderSettings& settings = settings_;
+    const Image& path = path_;
     const std::vector<int> blocks = Blocks();
     const int block_count = (kResolution / kBlock) * (kResolution / kBlock);
     const RegionMeans path_blocks = Means(path, blocks, block_count);
