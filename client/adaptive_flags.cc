@@ -8,7 +8,9 @@ void AddAdaptiveFlags(CLI::App* cmd, AdaptiveSettings& settings) {
     const std::string a = "Adaptive sampling (docs/convergence.md)";
     cmd->add_option("--target-error", settings.target_error,
                     "stop sampling a tile once its estimated relative error (from the A/B "
-                    "halves) is at most this, e.g. 0.01; --spp is then the first pass")
+                    "halves) is at most this, e.g. 0.01; --spp is then the first pass. With "
+                    "--method radiosity, also refine the mesh until its estimated "
+                    "discretisation error is at most this (docs/radiosity.md)")
         ->group(a)
         ->check(CLI::Range(1e-6, 1.0));
     cmd->add_option("--time-limit", settings.time_limit,

@@ -47,6 +47,18 @@ void AddRadiosityAttributes(const RadiosityReport& r, const RadiosityOptions& o,
     (*attributes)["lightfarm.radiosity.loaded"] = std::string(r.loaded ? "yes" : "no");
     (*attributes)["lightfarm.radiosity.formFactorSeconds"] = r.form_factor_seconds;
     (*attributes)["lightfarm.radiosity.solveSeconds"] = r.solve_seconds;
+    (*attributes)["lightfarm.radiosity.estimatedError"] = r.estimated_error;
+    (*attributes)["lightfarm.radiosity.meanEstimatedError"] = r.mean_estimated_error;
+    if (o.target_error > 0) {
+        (*attributes)["lightfarm.radiosity.targetError"] = o.target_error;
+        (*attributes)["lightfarm.radiosity.refinePasses"] = int(r.refinement.size());
+        (*attributes)["lightfarm.radiosity.coarsePatches"] =
+            std::to_string(r.refinement.empty() ? r.patches : r.refinement.front().patches);
+        (*attributes)["lightfarm.radiosity.budgetReached"] =
+            std::string(r.budget_reached ? "yes" : "no");
+        (*attributes)["lightfarm.radiosity.finestAboveTarget"] =
+            std::to_string(r.finest_above_target);
+    }
 }
 
 }  // namespace
@@ -99,6 +111,8 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     if (*method == "radiosity") {
         RadiosityOptions ro = options.radiosity;
         ro.threads = options.render.threads;
+        // The one --target-error bounds both errors: the mesh's and the display's sampling.
+        ro.target_error = options.adaptive.target_error;
         absl::StatusOr<std::unique_ptr<RadiosityRenderer>> r = PrepareRadiosity(**embree, ro);
         if (!r.ok()) return r.status();
         radiosity = r->get();
@@ -109,6 +123,22 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
             "factors {:.2f} s ({} MiB), solve {:.2f} s",
             job_id, rep.patches, rep.sides, rep.iterations, rep.residual, rep.form_factor_seconds,
             rep.form_factor_bytes >> 20, rep.solve_seconds);
+        for (size_t pass = 0; pass < rep.refinement.size(); ++pass) {
+            const RadiosityRefinementPass& p = rep.refinement[pass];
+            log->info(
+                "job={} radiosity refinement pass {}: {} patches, {} unknowns, estimated error "
+                "max {:.3g} mean {:.3g}, {} cells split",
+                job_id, pass + 1, p.patches, p.sides, p.max_error, p.mean_error, p.split);
+        }
+        if (ro.target_error > 0) {
+            log->info("job={} radiosity refinement: estimated error {:.3g} (target {:.3g}){}{}",
+                      job_id, rep.estimated_error, ro.target_error,
+                      rep.budget_reached ? ", stopped by the patch budget" : "",
+                      rep.finest_above_target > 0
+                          ? absl::StrCat(", ", rep.finest_above_target,
+                                         " patches above it at the finest level")
+                          : std::string());
+        }
     } else {
         estimator = std::make_unique<PathTracer>(**embree, options.max_depth);
     }
@@ -181,7 +211,11 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     }
     attributes["lightfarm.truncatedPaths"] = std::to_string(out->stats.truncated_paths);
     if (adaptive) AddAdaptiveAttributes(options.adaptive, out->adaptive, &attributes);
-    if (radiosity) AddRadiosityAttributes(radiosity->report(), options.radiosity, &attributes);
+    if (radiosity) {
+        RadiosityOptions used = options.radiosity;
+        used.target_error = options.adaptive.target_error;
+        AddRadiosityAttributes(radiosity->report(), used, &attributes);
+    }
     if (absl::Status s = WriteExr(options.exr_path, out->image, attributes); !s.ok()) return s;
     if (!options.png_path.empty()) {
         if (absl::Status s = WritePng(options.png_path, out->image); !s.ok()) return s;

@@ -1,5 +1,7 @@
 #include "radiosity_flags.h"
 
+#include "lf/kernels/radiosity.h"
+
 namespace lf {
 
 void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
@@ -12,6 +14,12 @@ void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
         ->group(group)
         ->capture_default_str()
         ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
+    cmd->add_option("--max-patches", settings.max_patches,
+                    "with --target-error: most patches mesh refinement may reach (0: 16 times "
+                    "--patches)")
+        ->group(group)
+        ->capture_default_str()
+        ->check(CLI::Range(int64_t(0), kMaxRefinedPatches));
     cmd->add_option("--solver", settings.solver, "jacobi, gauss-seidel or shooting")
         ->group(group)
         ->capture_default_str()

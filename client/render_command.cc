@@ -79,6 +79,7 @@ Command AddRenderCommand(CLI::App& app) {
                 parsed->save_solution = options->radiosity.save_solution;
                 parsed->load_solution = options->radiosity.load_solution;
                 parsed->export_ply = options->radiosity.export_ply;
+                parsed->max_patches = radiosity->max_patches;
                 options->radiosity = *parsed;
                 absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
                 if (!summary.ok()) return ReportError(summary.status());

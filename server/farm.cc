@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
+#include "lf/core/patch_mesh.h"
 #include "lf/core/radiosity_codec.h"
 #include "lf/core/tile_codec.h"
 #include "server/render_metadata.h"
@@ -36,11 +37,12 @@ absl::Status CheckMethod(const JobSpec& spec) {
             absl::StrCat("radiosity display \"", r.display, "\": expected flat or smooth"));
     }
     if (r.patches < 1 || !(r.patch_size >= 0) || !(r.tolerance > 0 && r.tolerance < 1) ||
-        r.max_iterations < 1 || r.sweep_tasks < 1 || r.sweep_tasks > kMaxSweepTasks) {
+        r.max_iterations < 1 || r.sweep_tasks < 1 || r.sweep_tasks > kMaxSweepTasks ||
+        r.max_patches < 0 || r.max_patches > kMaxRefinedPatches) {
         return absl::InvalidArgumentError(absl::StrCat(
             "radiosity: patches and max iterations must be positive, patch size not negative, "
             "tolerance in (0, 1), sweep tasks in 1..",
-            kMaxSweepTasks));
+            kMaxSweepTasks, ", max patches in 0..", kMaxRefinedPatches));
     }
     return absl::OkStatus();
 }

@@ -36,6 +36,9 @@ struct RadiositySettings {
     std::string display = "smooth";
     // On the farm, with solver "jacobi": patch-group tasks per sweep (server/radiosity_solve.h).
     int sweep_tasks = 8;
+    // Most patches mesh refinement may reach (RadiosityOptions::max_patches); 0: 16 times the
+    // coarse mesh's.
+    int64_t max_patches = 0;
 };
 inline constexpr int kMaxSweepTasks = 1024;
 

@@ -58,7 +58,8 @@ std::string RecordToJson(const JobRecord& r) {
             {"tolerance", s.radiosity.tolerance},
             {"max_iterations", s.radiosity.max_iterations},
             {"display", s.radiosity.display},
-            {"sweep_tasks", s.radiosity.sweep_tasks}}},
+            {"sweep_tasks", s.radiosity.sweep_tasks},
+            {"max_patches", s.radiosity.max_patches}}},
           {"adaptive",
            {{"target_error", s.adaptive.target_error},
             {"time_limit", s.adaptive.time_limit},
@@ -110,7 +111,8 @@ absl::StatusOr<JobRecord> RecordFromJson(std::string_view text) {
                                 rad.at("tolerance").get<double>(),
                                 rad.at("max_iterations").get<int>(),
                                 rad.at("display").get<std::string>(),
-                                rad.value("sweep_tasks", RadiositySettings().sweep_tasks)};
+                                rad.value("sweep_tasks", RadiositySettings().sweep_tasks),
+                                rad.value("max_patches", int64_t(0))};
         }
         if (s.contains("adaptive")) {
             const auto& a = s.at("adaptive");

@@ -27,6 +27,7 @@ TaskAssignment FromProto(const pb::Task& t) {
     task.max_depth = t.params().max_depth();
     if (!t.params().method().empty()) task.method = t.params().method();
     if (t.params().has_radiosity()) task.radiosity = lf::FromProto(t.params().radiosity());
+    task.target_error = t.params().target_error();
     if (t.kind() == pb::Task::RADIOSITY_SWEEP) {
         task.sweep = t.sweep();
         task.chunk = t.chunk();

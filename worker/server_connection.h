@@ -24,6 +24,7 @@ struct TaskAssignment {
     int max_depth = -1;
     std::string method = "path";  // or "radiosity"
     RadiositySettings radiosity;
+    double target_error = 0;  // the job's; radiosity refines its mesh to it
     PixelRect rect;
     uint64_t sample_begin = 0, sample_end = 0;
     // A radiosity patch-group task when sweep >= 0 (see Lease in server/scheduler.h); the blob

@@ -20,6 +20,16 @@ namespace {
 
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("worker"); }
 
+absl::StatusOr<RadiosityOptions> RadiosityOptionsFor(const TaskAssignment& task) {
+    const RadiositySettings& r = task.radiosity;
+    absl::StatusOr<RadiosityOptions> options = MakeRadiosityOptions(
+        r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
+    if (!options.ok()) return options.status();
+    options->target_error = task.target_error;
+    options->max_patches = r.max_patches;
+    return options;
+}
+
 }  // namespace
 
 Worker::Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache)
@@ -163,9 +173,7 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task) {
         loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.max_depth);
         return absl::OkStatus();
     }
-    const RadiositySettings& r = task.radiosity;
-    absl::StatusOr<RadiosityOptions> options = MakeRadiosityOptions(
-        r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
+    absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);
     if (!options.ok()) return options.status();
     options->threads = options_.threads;
     absl::StatusOr<std::unique_ptr<RadiosityRenderer>> renderer;
@@ -201,8 +209,7 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
     const RadiositySettings& r = task.radiosity;
     std::unique_ptr<RadiositySweepChunk>& chunk = loaded_.chunks[task.chunk];
     if (!chunk) {
-        absl::StatusOr<RadiosityOptions> options = MakeRadiosityOptions(
-            r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
+        absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);
         if (!options.ok()) return options.status();
         const absl::Time start = absl::Now();
         absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> built;

@@ -92,6 +92,56 @@ class SideRule {
     std::vector<std::pair<Vec3d, Vec3d>> mesh_bounds_;
 };
 
+// The id of a grid cell given by its corners, in any order.
+PatchCell CellId(int32_t mesh, int32_t primitive, int level, const GridTriangle& cell) {
+    PatchCell id{mesh,
+                 primitive,
+                 level,
+                 std::min({cell[0][0], cell[1][0], cell[2][0]}),
+                 std::min({cell[0][1], cell[1][1], cell[2][1]}),
+                 false};
+    for (const auto& corner : cell) id.up |= corner[0] == id.i && corner[1] == id.j;
+    return id;
+}
+
+// The quarters of a cell in the grid one level finer: at its corners 0, 1, 2, then the middle
+// (turned by 180°). Each keeps the cell's winding.
+std::array<GridTriangle, 4> Quarters(const GridTriangle& c) {
+    auto twice = [](const std::array<int32_t, 2>& a) {
+        return std::array<int32_t, 2>{2 * a[0], 2 * a[1]};
+    };
+    auto mid = [](const std::array<int32_t, 2>& a, const std::array<int32_t, 2>& b) {
+        return std::array<int32_t, 2>{a[0] + b[0], a[1] + b[1]};
+    };
+    const auto m01 = mid(c[0], c[1]), m12 = mid(c[1], c[2]), m20 = mid(c[2], c[0]);
+    return {{{twice(c[0]), m01, m20},
+             {m01, twice(c[1]), m12},
+             {m20, m12, twice(c[2])},
+             {m01, m12, m20}}};
+}
+
+// The quarter holding the point with weights w on a cell's corners, and its weights there (the
+// inverse of the quarters' corner maps).
+int Quarter(std::array<double, 3>& w) {
+    for (int c = 0; c < 3; ++c) {
+        if (w[size_t(c)] >= 0.5) {
+            for (double& x : w) x *= 2;
+            w[size_t(c)] -= 1;
+            return c;
+        }
+    }
+    w = {1 - 2 * w[2], 1 - 2 * w[0], 1 - 2 * w[1]};
+    return 3;
+}
+
+// Rounding can put weights just below 0: clamped and renormalised, so they stay a convex
+// combination.
+void ClampWeights(std::array<double, 3>& w) {
+    double sum = 0;
+    for (double& x : w) sum += (x = std::max(x, 0.0));
+    for (double& x : w) x /= sum;
+}
+
 }  // namespace
 
 std::vector<GridTriangle> SubdivisionCells(int k) {
@@ -152,8 +202,20 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
                                                        " patches"));
     }
 
+    std::vector<PatchCell> split = options.split;
+    std::sort(split.begin(), split.end());
+    split.erase(std::unique(split.begin(), split.end()), split.end());
+    // Checked first: a corrupt list must not nest the recursion below arbitrarily deep.
+    for (const PatchCell& c : split) {
+        if (c.level < 0 || c.level >= kMaxPatchLevel) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                "radiosity: split cell of level ", c.level, " (at most ", kMaxPatchLevel - 1, ")"));
+        }
+    }
+    std::vector<bool> split_seen(split.size(), false);
+
     // Subdivision: grid vertex (i, j) of a triangle with subdivision k is the point with
-    // barycentrics b1 = i/k, b2 = j/k.
+    // barycentrics b1 = i/k, b2 = j/k; at level l, b1 = i/K, b2 = j/K with K = k 2^l.
     pm.triangles_.resize(longest_edges.size());
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const TriangleMesh& mesh = scene.meshes[m];
@@ -181,29 +243,29 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
             const int k = int(std::max(1.0, std::ceil(longest_edges[index] / pm.patch_size_)));
             info.k = k;
             info.first_patch = int64_t(pm.patches_.size());
+            info.first_node = int64_t(pm.nodes_.size());
             info.normal = Normalize(Cross(p1 - p0, p2 - p0));
             const double area = 0.5 * Length(Cross(p1 - p0, p2 - p0)) / (double(k) * k);
 
+            // The vertex of grid point (i, j) of a grid of size K: on the scene triangle's
+            // corners and edges shared with the neighbours that subdivide alike, inside it
+            // shared between the triangle's cells.
+            auto grid_vertex = [&](int K, int i, int j) {
+                if (i == 0 && j == 0) return shared_vertex({tri[0], tri[0], 0, 0}, p0);
+                if (i == K) return shared_vertex({tri[1], tri[1], 0, 0}, p1);
+                if (j == K) return shared_vertex({tri[2], tri[2], 0, 0}, p2);
+                if (j == 0) return edge_vertex(tri[0], tri[1], K, i);
+                if (i == 0) return edge_vertex(tri[0], tri[2], K, j);
+                if (i + j == K) return edge_vertex(tri[1], tri[2], K, j);
+                return uint32_t(pm.vertices_.size());
+            };
             // Row j of the grid holds k + 1 - j vertices.
             std::vector<uint32_t> grid;
             grid.reserve(size_t(k + 1) * (k + 2) / 2);
             for (int j = 0; j <= k; ++j) {
                 for (int i = 0; i + j <= k; ++i) {
-                    uint32_t id;
-                    if (i == 0 && j == 0) {
-                        id = shared_vertex({tri[0], tri[0], 0, 0}, p0);
-                    } else if (i == k) {
-                        id = shared_vertex({tri[1], tri[1], 0, 0}, p1);
-                    } else if (j == k) {
-                        id = shared_vertex({tri[2], tri[2], 0, 0}, p2);
-                    } else if (j == 0) {
-                        id = edge_vertex(tri[0], tri[1], k, i);
-                    } else if (i == 0) {
-                        id = edge_vertex(tri[0], tri[2], k, j);
-                    } else if (i + j == k) {
-                        id = edge_vertex(tri[1], tri[2], k, j);
-                    } else {
-                        id = uint32_t(pm.vertices_.size());
+                    const uint32_t id = grid_vertex(k, i, j);
+                    if (id == pm.vertices_.size()) {
                         const double b1 = double(i) / k, b2 = double(j) / k;
                         pm.vertices_.push_back(p0 * (1 - b1 - b2) + p1 * b1 + p2 * b2);
                     }
@@ -211,17 +273,73 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
                 }
             }
             auto at = [&](int i, int j) { return grid[size_t(j * (k + 1) - j * (j - 1) / 2 + i)]; };
-            for (const GridTriangle& cell : SubdivisionCells(k)) {
+            // Vertices of split cells: a point of level l with even coordinates is one of
+            // level l - 1, so each point is created once, at its coarsest level.
+            std::map<std::array<int32_t, 3>, uint32_t> fine;
+            auto vertex = [&](int level, int i, int j) {
+                while (level > 0 && i % 2 == 0 && j % 2 == 0) {
+                    i /= 2;
+                    j /= 2;
+                    --level;
+                }
+                if (level == 0) return at(i, j);
+                const auto [it, inserted] = fine.try_emplace({level, i, j}, 0);
+                if (!inserted) return it->second;
+                const int K = k << level;
+                const uint32_t id = grid_vertex(K, i, j);
+                if (id == pm.vertices_.size()) {
+                    const double b1 = double(i) / K, b2 = double(j) / K;
+                    pm.vertices_.push_back(p0 * (1 - b1 - b2) + p1 * b1 + p2 * b2);
+                }
+                return it->second = id;
+            };
+            // Cells in patch order, each split one replaced by its quarters (depth first).
+            auto emit = [&](auto& self, int64_t node, const GridTriangle& cell, int level) -> void {
+                const auto found = std::lower_bound(split.begin(), split.end(),
+                                                    CellId(int32_t(m), int32_t(t), level, cell));
+                if (found != split.end() && *found == CellId(int32_t(m), int32_t(t), level, cell)) {
+                    split_seen[size_t(found - split.begin())] = true;
+                    const int64_t first = int64_t(pm.nodes_.size());
+                    pm.nodes_[size_t(node)] = ~first;
+                    pm.nodes_.resize(pm.nodes_.size() + 4);
+                    const std::array<GridTriangle, 4> quarters = Quarters(cell);
+                    for (int q = 0; q < 4; ++q)
+                        self(self, first + q, quarters[size_t(q)], level + 1);
+                    return;
+                }
+                pm.nodes_[size_t(node)] = int64_t(pm.patches_.size());
                 Patch patch;
                 patch.mesh = int32_t(m);
                 patch.primitive = int32_t(t);
-                for (size_t c = 0; c < 3; ++c) patch.vertices[c] = at(cell[c][0], cell[c][1]);
-                patch.area = area;
+                for (size_t c = 0; c < 3; ++c)
+                    patch.vertices[c] = vertex(level, cell[c][0], cell[c][1]);
+                // Exact: quarters of quarters differ from the coarse area by powers of two.
+                patch.area = std::ldexp(area, -2 * level);
                 patch.cell = cell;
+                patch.level = level;
                 pm.patches_.push_back(patch);
+            };
+            const std::vector<GridTriangle> cells = SubdivisionCells(k);
+            pm.nodes_.resize(pm.nodes_.size() + cells.size());
+            for (size_t c = 0; c < cells.size(); ++c) {
+                emit(emit, info.first_node + int64_t(c), cells[c], 0);
             }
+            info.end_patch = int64_t(pm.patches_.size());
         }
     }
+    for (size_t n = 0; n < split.size(); ++n) {
+        if (split_seen[n]) continue;
+        const PatchCell& c = split[n];
+        return absl::InvalidArgumentError(
+            absl::StrCat("radiosity: split cell (mesh ", c.mesh, ", triangle ", c.primitive,
+                         ", level ", c.level, ", ", c.i, ", ", c.j, c.up ? ", up" : ", down",
+                         ") is not a cell of the mesh or not inside a split cell"));
+    }
+    if (int64_t(pm.patches_.size()) > kMaxPatches) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("radiosity: refinement gives more than ", kMaxPatches, " patches"));
+    }
+    pm.split_ = std::move(split);
 
     const SideRule rule(scene);
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
@@ -236,8 +354,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
                     (!material.reflectance.IsBlack() &&
                      rule.SomethingInFront(mesh.positions[mesh.triangles[t][0]], n));
                 if (!needed) continue;
-                const int64_t end = info.first_patch + int64_t(info.k) * info.k;
-                for (int64_t p = info.first_patch; p < end; ++p) {
+                for (int64_t p = info.first_patch; p < info.end_patch; ++p) {
                     pm.patches_[size_t(p)].sides[size_t(back)] = int32_t(pm.sides_.size());
                     pm.sides_.push_back({int32_t(p), back == 1});
                 }
@@ -263,6 +380,11 @@ Vec3d PatchMesh::Centroid(int64_t patch) const {
     return (vertices_[p.vertices[0]] + vertices_[p.vertices[1]] + vertices_[p.vertices[2]]) / 3.0;
 }
 
+PatchCell PatchMesh::Cell(int64_t patch) const {
+    const Patch& p = patches_[size_t(patch)];
+    return CellId(p.mesh, p.primitive, p.level, p.cell);
+}
+
 PatchPoint PatchMesh::Locate(int mesh, int primitive, double b1, double b2) const {
     const Triangle& info = triangle(mesh, primitive);
     const int k = info.k;
@@ -275,19 +397,22 @@ PatchPoint PatchMesh::Locate(int mesh, int primitive, double b1, double b2) cons
     // Row j starts after 2kj - j^2 patches; upward and downward cells alternate along it.
     const int64_t local = int64_t(2 * k - j) * j + 2 * i + (upward ? 0 : 1);
     PatchPoint point;
-    point.patch = info.first_patch + local;
     point.w = upward ? std::array<double, 3>{1 - fx - fy, fx, fy}
                      : std::array<double, 3>{1 - fy, fx + fy - 1, 1 - fx};
-    double sum = 0;
-    for (double& w : point.w) sum += (w = std::max(w, 0.0));
-    for (double& w : point.w) w /= sum;
+    ClampWeights(point.w);
+    int64_t node = nodes_[size_t(info.first_node + local)];
+    while (node < 0) {
+        node = nodes_[size_t(~node + Quarter(point.w))];
+        ClampWeights(point.w);
+    }
+    point.patch = node;
     return point;
 }
 
 std::array<double, 2> PatchMesh::TriangleBarycentrics(int64_t patch,
                                                       const std::array<double, 3>& w) const {
     const Patch& p = patches_[size_t(patch)];
-    const double k = triangle(p.mesh, p.primitive).k;
+    const double k = double(triangle(p.mesh, p.primitive).k << p.level);
     double b1 = 0, b2 = 0;
     for (size_t c = 0; c < 3; ++c) {
         b1 += w[c] * p.cell[c][0];

@@ -3,12 +3,15 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <numbers>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "lf/core/log.h"
 #include "lf/kernels/form_factors.h"
+#include "lf/kernels/radiosity_refinement.h"
 #include "lf/kernels/radiosity_solution.h"
 
 namespace lf {
@@ -59,6 +62,79 @@ RadiositySystem MakeSystem(const EmbreeScene& scene, const PatchMesh& mesh,
     return system;
 }
 
+// Form factors and the solve on one mesh; times and counts add up in `report`.
+absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh& mesh,
+                                       const RadiosityOptions& options, double tolerance,
+                                       RadiosityReport& report) {
+    auto start = std::chrono::steady_clock::now();
+    const FormFactors form_factors = ComputeFormFactors(scene, mesh);
+    const double form_factor_seconds = SecondsSince(start);
+    report.form_factor_seconds += form_factor_seconds;
+    report.form_factor_bytes = form_factors.bytes();
+    report.nonzero_form_factors = form_factors.nonzeros();
+    report.visibility_rays += form_factors.rays();
+    NamedLogger("radiosity")
+        ->info("form factors in {:.2f} s: {} non-zero, {:.1f} MiB, {} rays", form_factor_seconds,
+               form_factors.nonzeros(), double(form_factors.bytes()) / (1 << 20),
+               form_factors.rays());
+
+    start = std::chrono::steady_clock::now();
+    const RadiositySystem system = MakeSystem(scene, mesh, form_factors);
+    absl::StatusOr<SolveResult> solved =
+        SolveRadiosity(system, {options.solver, tolerance, options.max_iterations});
+    if (!solved.ok()) return solved.status();
+    const double solve_seconds = SecondsSince(start);
+    report.solve_seconds += solve_seconds;
+    report.iterations = solved->iterations;
+    report.sweeps = solved->sweeps;
+    report.residual = solved->residual;
+    NamedLogger("radiosity")
+        ->info("{}: {} iterations ({:.1f} sweeps), relative residual {:.2g}, {:.2f} s",
+               RadiositySolverName(options.solver), solved->iterations, solved->sweeps,
+               solved->residual, solve_seconds);
+    return std::move(solved->radiosity);
+}
+
+// Solve, split the patches above the target, mesh again, solve again ... until no patch needs
+// splitting or the budget is spent. `mesh` is the coarse mesh on entry, the final one on return.
+absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
+                                               const RadiosityOptions& options, PatchMesh& mesh,
+                                               RadiosityReport& report) {
+    // The solve's error in B is up to its residual / (1 - ρ) (docs/radiosity.md, Solvers): a
+    // tenth of the target keeps it below the discretisation error asked for wherever ρ < 0.9,
+    // so the indicator measures the mesh, not an unfinished solve.
+    const double tolerance = std::min(options.tolerance, options.target_error / 10);
+    const int64_t budget =
+        std::min(kMaxRefinedPatches, options.max_patches > 0 ? options.max_patches
+                                                             : 16 * int64_t(mesh.patches().size()));
+    PatchMeshOptions mesh_options{mesh.patch_size(), 0};
+    while (true) {
+        absl::StatusOr<std::vector<Rgb>> radiosity = Solve(scene, mesh, options, tolerance, report);
+        if (!radiosity.ok()) return radiosity.status();
+        const DiscretisationError error = EstimateDiscretisationError(mesh, *radiosity);
+        const RefinementStep step = ChooseRefinement(mesh, error, options.target_error, budget);
+        report.refinement.push_back({int64_t(mesh.patches().size()), int64_t(mesh.sides().size()),
+                                     error.max, error.mean, int64_t(step.split.size())});
+        report.budget_reached = step.budget_reached;
+        report.finest_above_target = step.at_finest;
+        NamedLogger("radiosity")
+            ->info(
+                "refinement pass {}: {} patches, estimated error max {:.3g} mean {:.3g} (target "
+                "{:.3g}), {} patches above it, splitting {}{}",
+                report.refinement.size(), mesh.patches().size(), error.max, error.mean,
+                options.target_error, step.above_target, step.split.size(),
+                step.budget_reached ? " (patch budget reached)" : "");
+        if (step.split.empty()) return radiosity;
+        mesh_options.split = mesh.split();
+        mesh_options.split.insert(mesh_options.split.end(), step.split.begin(), step.split.end());
+        const auto start = std::chrono::steady_clock::now();
+        absl::StatusOr<PatchMesh> refined = PatchMesh::Build(scene.scene(), mesh_options);
+        if (!refined.ok()) return refined.status();
+        mesh = std::move(*refined);
+        report.mesh_seconds += SecondsSince(start);
+    }
+}
+
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& scene,
                                                            const RadiosityOptions& options) {
     const Scene& s = scene.scene();
@@ -70,19 +146,20 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         absl::StatusOr<RadiositySolution> solution = LoadRadiositySolution(options.load_solution);
         if (!solution.ok()) return solution.status();
         loaded = std::move(*solution);
-        mesh_options = {loaded.patch_size, 0};
+        mesh_options = {loaded.patch_size, 0, loaded.split};
     }
 
-    auto start = std::chrono::steady_clock::now();
+    const auto start = std::chrono::steady_clock::now();
     absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(s, mesh_options);
-    if (!mesh.ok()) return mesh.status();
+    if (!mesh.ok()) {
+        if (options.load_solution.empty()) return mesh.status();
+        return absl::InvalidArgumentError(
+            absl::StrCat(options.load_solution, ": ", mesh.status().message()));
+    }
     report.mesh_seconds = SecondsSince(start);
-    report.patches = int64_t(mesh->patches().size());
-    report.sides = int64_t(mesh->sides().size());
-    report.patch_size = mesh->patch_size();
     NamedLogger("radiosity")
-        ->info("{} patches of size {:.3g}, {} unknowns", report.patches, report.patch_size,
-               report.sides);
+        ->info("{} patches of size {:.3g}, {} unknowns", mesh->patches().size(), mesh->patch_size(),
+               mesh->sides().size());
 
     std::vector<Rgb> radiosity;
     if (!options.load_solution.empty()) {
@@ -97,38 +174,23 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         radiosity = std::move(loaded.radiosity);
         NamedLogger("radiosity")->info("loaded the solution from {}", options.load_solution);
     } else {
-        start = std::chrono::steady_clock::now();
-        const FormFactors form_factors = ComputeFormFactors(scene, *mesh);
-        report.form_factor_seconds = SecondsSince(start);
-        report.form_factor_bytes = form_factors.bytes();
-        report.nonzero_form_factors = form_factors.nonzeros();
-        report.visibility_rays = form_factors.rays();
-        NamedLogger("radiosity")
-            ->info("form factors in {:.2f} s: {} non-zero, {:.1f} MiB, {} rays",
-                   report.form_factor_seconds, report.nonzero_form_factors,
-                   double(report.form_factor_bytes) / (1 << 20), report.visibility_rays);
-
-        start = std::chrono::steady_clock::now();
-        const RadiositySystem system = MakeSystem(scene, *mesh, form_factors);
-        absl::StatusOr<SolveResult> solved =
-            SolveRadiosity(system, {options.solver, options.tolerance, options.max_iterations});
+        absl::StatusOr<std::vector<Rgb>> solved =
+            options.target_error > 0 ? SolveRefining(scene, options, *mesh, report)
+                                     : Solve(scene, *mesh, options, options.tolerance, report);
         if (!solved.ok()) return solved.status();
-        report.solve_seconds = SecondsSince(start);
-        report.iterations = solved->iterations;
-        report.sweeps = solved->sweeps;
-        report.residual = solved->residual;
-        radiosity = std::move(solved->radiosity);
-        NamedLogger("radiosity")
-            ->info(
-                "{}: {} iterations ({:.1f} sweeps), relative residual {:.2g}, "
-                "{:.2f} s",
-                RadiositySolverName(options.solver), report.iterations, report.sweeps,
-                report.residual, report.solve_seconds);
+        radiosity = std::move(*solved);
     }
+    report.patches = int64_t(mesh->patches().size());
+    report.sides = int64_t(mesh->sides().size());
+    report.patch_size = mesh->patch_size();
+    const DiscretisationError error = EstimateDiscretisationError(*mesh, radiosity);
+    report.estimated_error = error.max;
+    report.mean_estimated_error = error.mean;
 
     if (!options.save_solution.empty()) {
         const RadiositySolution solution{s.content_hash,    mesh->patch_size(), report.patches,
-                                         report.iterations, report.residual,    radiosity};
+                                         report.iterations, report.residual,    radiosity,
+                                         mesh->split()};
         if (absl::Status status = SaveRadiositySolution(options.save_solution, solution);
             !status.ok()) {
             return status;
@@ -144,6 +206,16 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
                                                options.display, report);
 }
 
+// The farm's sweeps solve one fixed mesh; refinement re-meshes between solves.
+absl::Status CheckNoRefinement(const RadiosityOptions& options) {
+    if (options.target_error > 0) {
+        return absl::InvalidArgumentError(
+            "radiosity: a target error refines the mesh between whole solves; it cannot be "
+            "solved in sweeps (use PrepareRadiosity)");
+    }
+    return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
@@ -153,6 +225,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
         return absl::InvalidArgumentError(
             absl::StrFormat("radiosity: chunk %d of %d does not exist", chunk, chunks));
     }
+    if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
     if (absl::Status status = CheckReflectance(scene.scene()); !status.ok()) return status;
     absl::StatusOr<PatchMesh> mesh =
         PatchMesh::Build(scene.scene(), {options.patch_size, options.patches});
@@ -201,6 +274,7 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
 
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity) {
+    if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
     absl::StatusOr<PatchMesh> mesh =
         PatchMesh::Build(scene.scene(), {options.patch_size, options.patches});
     if (!mesh.ok()) return mesh.status();

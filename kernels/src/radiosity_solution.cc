@@ -1,5 +1,6 @@
 #include "lf/kernels/radiosity_solution.h"
 
+#include <array>
 #include <bit>
 #include <cstring>
 #include <fstream>
@@ -14,7 +15,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "the solution file is little-endian");
 
 constexpr char kMagic[8] = {'L', 'F', 'R', 'A', 'D', 'S', 'O', 'L'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 1: no split cells
 // A scene hash is a hex digest; anything longer is a corrupt length field.
 constexpr uint32_t kMaxHashLength = 1024;
 
@@ -42,6 +43,10 @@ absl::Status SaveRadiositySolution(const std::string& path, const RadiositySolut
     Put(out, int64_t(solution.radiosity.size()));
     Put(out, int32_t(solution.iterations));
     Put(out, solution.residual);
+    Put(out, int64_t(solution.split.size()));
+    for (const PatchCell& c : solution.split) {
+        for (int32_t v : {c.mesh, c.primitive, c.level, c.i, c.j, int32_t(c.up)}) Put(out, v);
+    }
     static_assert(sizeof(Rgb) == 3 * sizeof(float));
     out.write(reinterpret_cast<const char*>(solution.radiosity.data()),
               std::streamsize(solution.radiosity.size() * sizeof(Rgb)));
@@ -62,8 +67,8 @@ absl::StatusOr<RadiositySolution> LoadRadiositySolution(const std::string& path)
     if (!in.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0) {
         return corrupt("bad magic");
     }
-    if (!Get(in, version) || version != kVersion) {
-        return corrupt(absl::StrCat("version ", version, ", expected ", kVersion));
+    if (!Get(in, version) || version < 1 || version > kVersion) {
+        return corrupt(absl::StrCat("version ", version, ", expected 1 to ", kVersion));
     }
     if (!Get(in, hash_length) || hash_length > kMaxHashLength) return corrupt("bad scene hash");
     RadiositySolution solution;
@@ -76,6 +81,15 @@ absl::StatusOr<RadiositySolution> LoadRadiositySolution(const std::string& path)
         return corrupt("truncated header");
     }
     solution.iterations = iterations;
+    int64_t split = 0;
+    if (version >= 2 && (!Get(in, split) || split < 0)) return corrupt("truncated header");
+    for (int64_t n = 0; n < split; ++n) {
+        std::array<int32_t, 6> v;
+        for (int32_t& x : v) {
+            if (!Get(in, x)) return corrupt("truncated split cells");
+        }
+        solution.split.push_back({v[0], v[1], v[2], v[3], v[4], v[5] != 0});
+    }
     // The side count must match the bytes that follow before anything is allocated.
     const std::streamoff header_end = in.tellg();
     in.seekg(0, std::ios::end);
@@ -103,9 +117,9 @@ absl::Status CheckRadiositySolution(const RadiositySolution& solution, const std
         solution.radiosity.size() != mesh.sides().size()) {
         return absl::FailedPreconditionError(absl::StrFormat(
             "%s: solution has %d patches and %d sides but meshing the scene at patch size %g "
-            "gives %d and %d; solve again",
+            "with %d split cells gives %d and %d; solve again",
             path, solution.patches, solution.radiosity.size(), solution.patch_size,
-            mesh.patches().size(), mesh.sides().size()));
+            solution.split.size(), mesh.patches().size(), mesh.sides().size()));
     }
     return absl::OkStatus();
 }

@@ -628,6 +628,23 @@ TEST_F(Farm, TimeLimitEndsAnAdaptiveJobOnTime) {
     EXPECT_NE(ReadText(dir_ / "server-1.log").find("time limit of 2 s reached"), std::string::npos);
 }
 
+// A radiosity target refines the mesh, which the sweeps cannot split: every worker refines and
+// solves the same system to the same bits, and the display tiles are sampled adaptively.
+TEST_F(Farm, RadiosityTargetErrorRefinesOnEveryWorkerAndGivesTheLocalPixels) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string flags =
+        "--method radiosity --patches 150 --solver jacobi --tile 16 --target-error 0.2 "
+        "--max-patches 600 --max-spp 64";
+    const std::string job = Submit(scene_, "--spp 2 --seed 4 " + flags);
+    ExpectSameAsLocal(job, scene_, 2, 4, flags);
+    const std::string logs = ReadText(dir_ / "w1.log") + ReadText(dir_ / "w2.log");
+    EXPECT_NE(logs.find("refinement pass 2"), std::string::npos);
+    EXPECT_EQ(logs.find("form factors of chunk"), std::string::npos);
+    EXPECT_EQ(ReadText(dir_ / "server-1.log").find("radiosity sweep"), std::string::npos);
+}
+
 TEST_F(Farm, RadiosityJobForAGlossySceneIsRefusedAtSubmission) {
     StartServer();
     const std::string glossy = (dir_ / "glossy.json").string();

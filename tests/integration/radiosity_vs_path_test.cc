@@ -4,8 +4,11 @@
 // shrink as the mesh refines.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
@@ -55,6 +58,24 @@ RegionMeans Means(const Image& image, const std::vector<int>& region, int region
     return r;
 }
 
+// Radiosity's difference from the path tracer over regions: the mean squared difference is
+// discretisation^2 + noise^2, so subtracting the noise leaves radiosity's own error.
+struct Difference {
+    double rms = 0, noise = 0, debiased = 0;
+};
+
+Difference Compare(const RegionMeans& radiosity, const RegionMeans& path) {
+    double diff2 = 0, noise2 = 0;
+    for (size_t k = 0; k < path.mean.size(); ++k) {
+        const double d = radiosity.mean[k] - path.mean[k];
+        diff2 += d * d;
+        noise2 += path.error[k] * path.error[k];
+    }
+    const double m = double(path.mean.size());
+    return {std::sqrt(diff2 / m), std::sqrt(noise2 / m),
+            std::sqrt(std::max(0.0, diff2 - noise2) / m)};
+}
+
 // 8 x 8-pixel blocks.
 std::vector<int> Blocks() {
     std::vector<int> region(kResolution * kResolution);
@@ -86,18 +107,36 @@ std::vector<int> Surfaces(const EmbreeScene& scene, const Camera& camera) {
     return region;
 }
 
-TEST(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
-    auto scene = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
-    ASSERT_TRUE(scene.ok()) << scene.status();
-    scene->camera.width = scene->camera.height = kResolution;
-    auto es = EmbreeScene::Build(*scene);
-    ASSERT_TRUE(es.ok()) << es.status();
-    const EmbreeScene& embree = **es;
-    const Camera camera(scene->camera, embree.origin());
-    RenderSettings settings;
-    settings.spp = kSpp;
-    settings.seed = kSeed;
-    const Image path = RenderImage(camera, PathTracer(embree, -1), settings).value().image;
+// The Cornell box at 64 x 64 and its path-traced reference.
+class RadiosityVsPath : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        auto loaded = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
+        ASSERT_TRUE(loaded.ok()) << loaded.status();
+        scene_ = std::move(*loaded);
+        scene_.camera.width = scene_.camera.height = kResolution;
+        auto es = EmbreeScene::Build(scene_);
+        ASSERT_TRUE(es.ok()) << es.status();
+        embree_ = std::move(*es);
+        camera_ = std::make_unique<Camera>(scene_.camera, embree_->origin());
+        settings_.spp = kSpp;
+        settings_.seed = kSeed;
+        path_ = RenderImage(*camera_, PathTracer(*embree_, -1), settings_).value().image;
+    }
+
+    Scene scene_;
+    std::unique_ptr<EmbreeScene> embree_;
+    std::unique_ptr<Camera> camera_;
+    RenderSettings settings_;
+    Image path_;
+};
+
+TEST_F(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
+    const Scene* scene = &scene_;
+    const EmbreeScene& embree = *embree_;
+    const Camera& camera = *camera_;
+    const RenderSettings& settings = settings_;
+    const Image& path = path_;
 
     const std::vector<int> blocks = Blocks(), surfaces = Surfaces(embree, camera);
     const int block_count = (kResolution / kBlock) * (kResolution / kBlock);
@@ -122,18 +161,9 @@ TEST(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
         const Image image = RenderImage(camera, **renderer, settings).value().image;
         radiosity_blocks.push_back(Means(image, blocks, block_count));
         radiosity_surfaces.push_back(Means(image, surfaces, surface_count));
-        // The mean squared difference is discretisation^2 + noise^2: subtracting the noise
-        // leaves radiosity's own error.
-        double diff2 = 0, noise2 = 0;
-        for (size_t k = 0; k < path_blocks.mean.size(); ++k) {
-            const double d = radiosity_blocks.back().mean[k] - path_blocks.mean[k];
-            diff2 += d * d;
-            noise2 += path_blocks.error[k] * path_blocks.error[k];
-        }
-        const double m = double(path_blocks.mean.size());
-        debiased.push_back(std::sqrt(std::max(0.0, diff2 - noise2) / m));
-        std::printf("%8ld %10.5f %10.5f %10.5f\n", n, std::sqrt(diff2 / m), std::sqrt(noise2 / m),
-                    debiased.back());
+        const Difference d = Compare(radiosity_blocks.back(), path_blocks);
+        debiased.push_back(d.debiased);
+        std::printf("%8ld %10.5f %10.5f %10.5f\n", n, d.rms, d.noise, d.debiased);
     }
     // The finer the mesh, the closer.
     EXPECT_GT(debiased[0], debiased[1]);
@@ -149,6 +179,56 @@ TEST(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
                     kSigmas * path_surfaces.error[k] + discretisation)
             << scene->meshes[k / 3].name << " channel " << k % 3;
     }
+}
+
+// Refinement from 250 patches to a target of 0.1 against the uniform mesh of the same size:
+// splitting where the solution varies must beat splitting everywhere. Both are compared with the
+// path tracer as above (block means, noise subtracted), so the reference is unbiased.
+TEST_F(RadiosityVsPath, RefinementBeatsAUniformMeshOfTheSameSize) {
+    const EmbreeScene& embree = *embree_;
+    const Camera& camera = *camera_;
+    const RenderSettings& settings = settings_;
+    const Image& path = path_;
+    const std::vector<int> blocks = Blocks();
+    const int block_count = (kResolution / kBlock) * (kResolution / kBlock);
+    const RegionMeans path_blocks = Means(path, blocks, block_count);
+
+    struct Result {
+        int64_t patches = 0;
+        double error = 0;
+    };
+    auto solve = [&](const RadiosityOptions& options) {
+        const auto start = std::chrono::steady_clock::now();
+        auto renderer = PrepareRadiosity(embree, options);
+        EXPECT_TRUE(renderer.ok()) << renderer.status();
+        if (!renderer.ok()) return Result{};
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const Image image = RenderImage(camera, **renderer, settings).value().image;
+        const RadiosityReport& r = (*renderer)->report();
+        const Result result{r.patches,
+                            Compare(Means(image, blocks, block_count), path_blocks).debiased};
+        std::printf(
+            "%6ld patches (target %.2g, %zu passes): indicator max %.3f, mean %.4f; debiased "
+            "block error %.5f; %.2f s\n",
+            r.patches, options.target_error, r.refinement.size(), r.estimated_error,
+            r.mean_estimated_error, result.error, seconds);
+        return result;
+    };
+    RadiosityOptions coarse_options;
+    coarse_options.patches = 250;
+    const Result coarse = solve(coarse_options);
+    RadiosityOptions refined_options = coarse_options;
+    refined_options.target_error = 0.1;
+    const Result refined = solve(refined_options);
+    RadiosityOptions uniform_options;
+    uniform_options.patches = refined.patches;
+    const Result uniform = solve(uniform_options);
+
+    EXPECT_GT(refined.patches, coarse.patches);
+    EXPECT_LT(refined.error, coarse.error);
+    EXPECT_LE(uniform.patches, refined.patches);
+    EXPECT_LT(refined.error, uniform.error);
 }
 
 }  // namespace

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <set>
+#include <tuple>
 
 #include "lf/core/scene_loader.h"
 #include "test_scenes.h"
@@ -130,6 +133,160 @@ TEST(PatchMesh, CornellBoxSides) {
         // into the blocks' closed interiors (which stay dark).
         const bool block = name.rfind("short", 0) == 0 || name.rfind("tall", 0) == 0;
         EXPECT_EQ(p.sides[1] >= 0, block) << name;
+    }
+}
+
+// A unit square as one quad, k = 4 on both halves.
+Scene UnitQuad() {
+    Scene scene = OneTriangle();
+    scene.meshes[0].is_quad = true;
+    scene.meshes[0].positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    scene.meshes[0].triangles = {{0, 1, 2}, {0, 2, 3}};
+    return scene;
+}
+
+// Splits the patches whose centroid is within `radius` of `centre`, `levels` times over: a
+// refinement around a point on the quad's diagonal, so both halves split alike there and T-
+// junctions appear where the levels change.
+PatchMeshOptions RefinedAround(const Scene& scene, const Vec3d& centre, double radius, int levels) {
+    PatchMeshOptions options;
+    options.patch_size = 0.26;  // longest edge sqrt(2): k = 6
+    for (int level = 0; level < levels; ++level) {
+        auto mesh = PatchMesh::Build(scene, options);
+        EXPECT_TRUE(mesh.ok()) << mesh.status();
+        for (int64_t p = 0; p < int64_t(mesh->patches().size()); ++p) {
+            if (Length(mesh->Centroid(p) - centre) < radius) {
+                options.split.push_back(mesh->Cell(p));
+            }
+        }
+    }
+    return options;
+}
+
+double GeometricArea(const PatchMesh& mesh, const PatchMesh::Patch& p) {
+    const Vec3d &a = mesh.vertices()[p.vertices[0]], &b = mesh.vertices()[p.vertices[1]],
+                &c = mesh.vertices()[p.vertices[2]];
+    return 0.5 * Length(Cross(b - a, c - a));
+}
+
+TEST(PatchMesh, SplitCellsTileTheirParentsAndShareVertices) {
+    const Scene scene = UnitQuad();
+    const PatchMeshOptions options = RefinedAround(scene, Vec3d(0.4, 0.4, 0), 0.2, 3);
+    auto mesh = PatchMesh::Build(scene, options);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    const int64_t splits = int64_t(mesh->split().size());
+    EXPECT_EQ(int64_t(mesh->patches().size()), 2 * 36 + 3 * splits);
+    int deepest = 0;
+    double area = 0;
+    for (const auto& p : mesh->patches()) {
+        deepest = std::max(deepest, p.level);
+        // Each patch's corners are its cell's: the stated area (coarse area / 4^level) is the
+        // triangle's.
+        EXPECT_NEAR(GeometricArea(*mesh, p), p.area, 1e-15);
+        EXPECT_EQ(p.area, 0.5 / 36 / double(1 << (2 * p.level)));
+        area += p.area;
+    }
+    EXPECT_EQ(deepest, 3);
+    EXPECT_NEAR(area, 1.0, 1e-12);
+    // Not a global refinement: cells far from the centre stay coarse.
+    EXPECT_EQ(mesh->Locate(0, 0, 0.95, 0.01).patch, mesh->Locate(0, 0, 0.97, 0.02).patch);
+    EXPECT_EQ(mesh->patches()[size_t(mesh->Locate(0, 0, 0.95, 0.01).patch)].level, 0);
+
+    // Every point lands in a patch of its triangle whose corners give it back with weights in
+    // [0, 1]: with the areas summing to the whole, the patches tile it without overlap.
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int n = 0; n < 20000; ++n) {
+        double b1 = u(rng), b2 = u(rng);
+        if (b1 + b2 > 1) std::tie(b1, b2) = std::pair(1 - b1, 1 - b2);
+        const int primitive = n % 2;
+        const PatchPoint point = mesh->Locate(0, primitive, b1, b2);
+        const auto& patch = mesh->patches()[size_t(point.patch)];
+        ASSERT_EQ(patch.primitive, primitive);
+        Vec3d x;
+        for (size_t c = 0; c < 3; ++c) {
+            ASSERT_GE(point.w[c], 0);
+            x += mesh->vertices()[patch.vertices[c]] * point.w[c];
+        }
+        const auto& t = scene.meshes[0].triangles[size_t(primitive)];
+        const auto& v = scene.meshes[0].positions;
+        const Vec3d expected = v[t[0]] * (1 - b1 - b2) + v[t[1]] * b1 + v[t[2]] * b2;
+        ASSERT_NEAR(Length(x - expected), 0, 1e-12) << b1 << " " << b2;
+        const auto back = mesh->TriangleBarycentrics(point.patch, point.w);
+        ASSERT_NEAR(back[0], b1, 1e-12);
+        ASSERT_NEAR(back[1], b2, 1e-12);
+    }
+
+    // Coincident corners are one vertex: within a triangle, across the diagonal where both
+    // halves split alike, and between levels (a corner of a quarter that is a corner of the
+    // cell).
+    std::set<uint32_t> used;
+    for (const auto& p : mesh->patches()) used.insert(p.vertices.begin(), p.vertices.end());
+    EXPECT_EQ(used.size(), mesh->vertices().size());
+    // (Rounded: positions computed by other formulas may differ in the last bits.)
+    std::set<std::pair<int64_t, int64_t>> positions;
+    for (uint32_t v : used) {
+        positions.insert(
+            {std::llround(mesh->vertices()[v].x * 1e9), std::llround(mesh->vertices()[v].y * 1e9)});
+    }
+    EXPECT_EQ(positions.size(), used.size());
+
+    // The split list builds the same mesh again.
+    PatchMeshOptions again;
+    again.patch_size = options.patch_size;
+    again.split = mesh->split();
+    auto rebuilt = PatchMesh::Build(scene, again);
+    ASSERT_TRUE(rebuilt.ok()) << rebuilt.status();
+    ASSERT_EQ(rebuilt->patches().size(), mesh->patches().size());
+    for (size_t p = 0; p < mesh->patches().size(); ++p) {
+        EXPECT_EQ(rebuilt->patches()[p].vertices, mesh->patches()[p].vertices);
+    }
+}
+
+// Splitting cells of the second triangle leaves the first one's patches, vertices and sides as
+// the unsplit mesh has them; without splits every patch is a level-0 cell in grid order.
+TEST(PatchMesh, UnsplitTrianglesAreMeshedAsWithoutRefinement) {
+    const Scene scene = UnitQuad();
+    PatchMeshOptions options;
+    options.patch_size = 0.26;
+    auto plain = PatchMesh::Build(scene, options);
+    ASSERT_TRUE(plain.ok()) << plain.status();
+    EXPECT_TRUE(plain->split().empty());
+    for (int64_t p = 0; p < int64_t(plain->patches().size()); ++p) {
+        const PatchCell cell = plain->Cell(p);
+        EXPECT_EQ(cell.level, 0);
+        EXPECT_EQ(plain
+                      ->Locate(0, cell.primitive, (cell.i + (cell.up ? 0.3 : 0.7)) / 6.0,
+                               (cell.j + (cell.up ? 0.3 : 0.7)) / 6.0)
+                      .patch,
+                  p);
+    }
+    options.split = {{0, 1, 0, 2, 2, true}, {0, 1, 0, 0, 0, false}};
+    auto split = PatchMesh::Build(scene, options);
+    ASSERT_TRUE(split.ok()) << split.status();
+    EXPECT_EQ(split->patches().size(), plain->patches().size() + 6);
+    for (size_t p = 0; p < 36; ++p) {
+        EXPECT_EQ(split->patches()[p].vertices, plain->patches()[p].vertices);
+        EXPECT_EQ(split->patches()[p].area, plain->patches()[p].area);
+        EXPECT_EQ(split->patches()[p].sides, plain->patches()[p].sides);
+    }
+    for (size_t v = 0; v < plain->vertices().size(); ++v) {
+        EXPECT_EQ(split->vertices()[v], plain->vertices()[v]);
+    }
+}
+
+TEST(PatchMesh, RefusesSplitsOutsideTheMesh) {
+    const Scene scene = UnitQuad();
+    for (const PatchCell& bad : {PatchCell{0, 0, 0, 6, 0, true},  // beyond the grid
+                                 PatchCell{0, 2, 0, 0, 0, true},  // no such triangle
+                                 PatchCell{0, 0, 1, 0, 0, true},  // parent not split
+                                 PatchCell{0, 0, kMaxPatchLevel, 0, 0, true}}) {
+        PatchMeshOptions options;
+        options.patch_size = 0.26;
+        options.split = {bad};
+        EXPECT_EQ(PatchMesh::Build(scene, options).status().code(),
+                  absl::StatusCode::kInvalidArgument)
+            << bad.level << " " << bad.i;
     }
 }
 

@@ -84,6 +84,7 @@ TEST_F(SqliteJobStoreTest, RecordsRoundTripThroughAReopen) {
     job.spec.priority = -2;
     job.spec.scene_hash = "hash";
     job.spec.adaptive = {0.03, 120, 512};
+    job.spec.radiosity.max_patches = 999;
     job.state = JobState::kFailed;
     job.error = "why";
     job.submitted = absl::FromUnixMicros(1'000'001);
@@ -107,6 +108,7 @@ TEST_F(SqliteJobStoreTest, RecordsRoundTripThroughAReopen) {
     EXPECT_EQ(back->spec.adaptive.target_error, 0.03);
     EXPECT_EQ(back->spec.adaptive.time_limit, 120);
     EXPECT_EQ(back->spec.adaptive.max_spp, 512u);
+    EXPECT_EQ(back->spec.radiosity.max_patches, 999);
     EXPECT_EQ(back->state, JobState::kFailed);
     EXPECT_EQ(back->error, "why");
     EXPECT_EQ(back->started, job.started);

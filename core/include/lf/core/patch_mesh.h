@@ -3,6 +3,12 @@
 // neighbours, so a hit (mesh, triangle, b1, b2) finds its patch by arithmetic and values can be
 // interpolated at shared vertices.
 //
+// Refinement is local: any cell can be split 2 x 2 into congruent quarters (at the midpoints of
+// its edges), and the quarters again, so a cell of level l is a cell of the grid with k 2^l
+// divisions. A hit finds its coarse cell by arithmetic, then descends through the splits.
+// Where a split cell meets an unsplit one, the midpoint is a vertex of the finer side only (a
+// T-junction: the patches still tile the triangle, as Embree intersects the scene triangles).
+//
 // A patch has two sides. A side gets an unknown (a radiosity value to solve for) only if its
 // radiosity can be non-zero: it is the front of an emitter, or its reflectance is not black and
 // something (a vertex of another triangle or a point light) lies strictly in front of it.
@@ -19,14 +25,35 @@
 
 namespace lf {
 
+// A cell of a scene triangle's subdivision: upward (i, j), (i+1, j), (i, j+1) or downward
+// (i+1, j), (i+1, j+1), (i, j+1) in the grid with k 2^level divisions.
+struct PatchCell {
+    int32_t mesh = 0, primitive = 0;
+    int32_t level = 0;
+    int32_t i = 0, j = 0;
+    bool up = true;
+    auto operator<=>(const PatchCell&) const = default;
+};
+
+// Splits nest at most this deep (4096 times finer than the coarse grid): far below any useful
+// patch size, and grid coordinates k 2^level stay in 32 bits for every k the count limit allows.
+inline constexpr int kMaxPatchLevel = 12;
+
+// The most patches mesh refinement may reach (RadiosityOptions::max_patches): form factors take
+// ~4 bytes per pair of sides, so 32k patches are about 3 GiB.
+inline constexpr int64_t kMaxRefinedPatches = 32768;
+
 struct PatchMeshOptions {
     double patch_size = 0;   // longest patch edge in scene units; 0: derived from `patches`
     int64_t patches = 4000;  // target patch count when patch_size is 0 (never exceeded unless
                              // the scene has more triangles)
+    // Cells split into quarters; a cell of level l > 0 must be a quarter of a split cell. Any
+    // order, duplicates allowed.
+    std::vector<PatchCell> split = {};
 };
 
-// A triangle of the k x k subdivision grid of a scene triangle: its corners (i, j), each the
-// point with barycentrics b1 = i/k, b2 = j/k, in the scene triangle's winding.
+// A triangle of a subdivision grid of a scene triangle: its corners (i, j), each the point with
+// barycentrics b1 = i/K, b2 = j/K (K = k 2^level), in the scene triangle's winding.
 using GridTriangle = std::array<std::array<int32_t, 2>, 3>;
 
 // The k^2 cells of the grid in patch order: row j = 0 .. k-1, along it alternately an upward
@@ -48,14 +75,16 @@ class PatchMesh {
                                                // scene triangle
         std::array<int32_t, 2> sides{-1, -1};  // unknown of the front / back side, or -1
         double area = 0;
-        GridTriangle cell{};  // corners in the scene triangle's grid
+        GridTriangle cell{};  // corners in the scene triangle's grid of level `level`
+        int32_t level = 0;
     };
     struct Side {
         int32_t patch = 0;
         bool back = false;
     };
 
-    // Fails for spheres and non-lambert materials, which radiosity does not model.
+    // Fails for spheres and non-lambert materials, which radiosity does not model, and for a
+    // split cell that is not in the mesh.
     static absl::StatusOr<PatchMesh> Build(const Scene& scene, const PatchMeshOptions& options);
 
     // The patch size used (derived from the target count if the options gave none).
@@ -65,6 +94,8 @@ class PatchMesh {
     // Sorted by mesh, then front sides before back sides, then triangle and sub-triangle, so
     // runs of consecutive sides lie on one side of one surface.
     const std::vector<Side>& sides() const { return sides_; }
+    // The split cells, sorted: with the patch size, all it takes to build this mesh again.
+    const std::vector<PatchCell>& split() const { return split_; }
 
     int Subdivision(int mesh, int primitive) const { return triangle(mesh, primitive).k; }
     // Unit normal of the front face (that of the scene triangle).
@@ -72,6 +103,7 @@ class PatchMesh {
     // Unit normal of a side: the front normal, flipped for a back side.
     Vec3d SideNormal(int32_t side) const;
     Vec3d Centroid(int64_t patch) const;
+    PatchCell Cell(int64_t patch) const;
 
     // The patch containing barycentric point (b1, b2) of a scene triangle.
     PatchPoint Locate(int mesh, int primitive, double b1, double b2) const;
@@ -81,7 +113,8 @@ class PatchMesh {
   private:
     struct Triangle {
         int32_t k = 1;
-        int64_t first_patch = 0;
+        int64_t first_patch = 0, end_patch = 0;
+        int64_t first_node = 0;  // nodes_ of the k^2 coarse cells, in patch order
         Vec3d normal;
     };
 
@@ -93,7 +126,11 @@ class PatchMesh {
     std::vector<Vec3d> vertices_;
     std::vector<Patch> patches_;
     std::vector<Side> sides_;
+    std::vector<PatchCell> split_;
     std::vector<Triangle> triangles_;
+    // The cell tree: a node >= 0 is a patch; ~node is the first of a split cell's four quarters
+    // (the quarters at corners 0, 1, 2 of the cell, then the middle one).
+    std::vector<int64_t> nodes_;
     std::vector<int64_t> mesh_first_triangle_;
 };
 

@@ -5,6 +5,10 @@
 //
 //   auto renderer = PrepareRadiosity(embree_scene, options);  // meshing, form factors, solve
 //   RenderImage(camera, **renderer, settings);                 // any camera, any spp
+//
+// With a target error the mesh is refined where the solution needs it: solve on the coarse
+// mesh, split the patches whose estimated error (radiosity_refinement.h) exceeds the target,
+// solve again, until none does or the patch budget is spent.
 #pragma once
 
 #include <cstdint>
@@ -38,6 +42,20 @@ struct RadiosityOptions {
                                 // patches are ignored): no form factors, no solve
     std::string export_ply;
     int threads = 0;  // 0: all cores
+    // Relative discretisation error to refine the mesh to (EstimateDiscretisationError); 0: no
+    // refinement, the `patches` mesh as it is.
+    double target_error = 0;
+    // Most patches refinement may reach; 0: 16 times the coarse mesh's. Never above
+    // kMaxRefinedPatches.
+    int64_t max_patches = 0;
+};
+
+// One solve of a refinement.
+struct RadiosityRefinementPass {
+    int64_t patches = 0;
+    int64_t sides = 0;
+    double max_error = 0, mean_error = 0;  // estimated (EstimateDiscretisationError)
+    int64_t split = 0;                     // cells split after it
 };
 
 struct RadiosityReport {
@@ -52,6 +70,13 @@ struct RadiosityReport {
     size_t form_factor_bytes = 0;
     int64_t nonzero_form_factors = 0;
     int64_t visibility_rays = 0;
+    // Estimated discretisation error of the returned solution (also without refinement).
+    double estimated_error = 0, mean_estimated_error = 0;
+    // With a target error: every solve (the times above are their sums), and why it stopped
+    // above the target if it did: the patch budget, or patches already at the finest level.
+    std::vector<RadiosityRefinementPass> refinement;
+    bool budget_reached = false;
+    int64_t finest_above_target = 0;
 };
 
 class RadiosityRenderer : public RadianceEstimator {
@@ -80,8 +105,8 @@ class RadiosityRenderer : public RadianceEstimator {
 // makes, so the farm's solution has its bits.
 class RadiositySweepChunk {
   public:
-    // The same checks as PrepareRadiosity; InvalidArgument for a chunk outside 0..chunks-1;
-    // Cancelled soon after `cancel` is set.
+    // The same checks as PrepareRadiosity; InvalidArgument for a chunk outside 0..chunks-1 and
+    // for a target error (refinement needs whole solves); Cancelled soon after `cancel` is set.
     static absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> Build(
         const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks,
         const std::atomic<bool>* cancel = nullptr);
@@ -102,7 +127,8 @@ class RadiositySweepChunk {
 };
 
 // The renderer of a solution solved elsewhere (by the farm's sweeps): the scene meshed as
-// `options` say, displaying `radiosity`; InvalidArgument unless it holds one value per side.
+// `options` say, displaying `radiosity`; InvalidArgument unless it holds one value per side,
+// and for a target error (the sweeps solve an unrefined mesh).
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity);
 

@@ -1,10 +1,12 @@
 // A solved radiosity, saved so other cameras can render it without solving again. The file
-// names the scene by content hash and the meshing by its patch size, so a solution is never
-// applied to a scene or mesh it was not computed for.
+// names the scene by content hash and the meshing by its patch size and split cells, so a
+// solution is never applied to a scene or mesh it was not computed for.
 //
-// Binary, little-endian: "LFRADSOL", u32 version (1), u32 length + bytes of the scene hash,
-// f64 patch size, i64 patch count, i64 side count, i32 iterations, f64 residual, then three
-// f32 (R, G, B radiosity, W m^-2) per side in PatchMesh::sides() order.
+// Binary, little-endian: "LFRADSOL", u32 version (2), u32 length + bytes of the scene hash,
+// f64 patch size, i64 patch count, i64 side count, i32 iterations, f64 residual, i64 count of
+// split cells and six i32 per cell (mesh, triangle, level, i, j, 1 if upward), then three f32
+// (R, G, B radiosity, W m^-2) per side in PatchMesh::sides() order. Version 1, from before
+// refinement, has no split cells and still loads.
 #pragma once
 
 #include <cstdint>
@@ -23,7 +25,8 @@ struct RadiositySolution {
     int64_t patches = 0;
     int iterations = 0;
     double residual = 0;
-    std::vector<Rgb> radiosity;  // per side
+    std::vector<Rgb> radiosity;    // per side
+    std::vector<PatchCell> split;  // PatchMeshOptions::split of the mesh
 };
 
 absl::Status SaveRadiositySolution(const std::string& path, const RadiositySolution& solution);
