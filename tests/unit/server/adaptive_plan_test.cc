@@ -149,6 +149,17 @@ TEST(AdaptiveTilePlan, ReplayingResultsInIndexOrderRebuildsThePlanAndItsBits) {
     EXPECT_EQ(*replayed->Snapshot().FindChannel("R"), *plan->Snapshot().FindChannel("R"));
 }
 
+// A farm preview reports on a plan with tiles not sampled yet.
+TEST(AdaptiveTilePlan, ReportsBeforeEveryTileHasSamples) {
+    auto plan = MakePlan({.target_error = 0.02, .time_limit = 0, .max_spp = 1 << 16});
+    ASSERT_TRUE(plan->Merge(1, Pass(plan->tasks()[1])).ok());
+    absl::StatusOr<AdaptiveReport> report = plan->Report();
+    ASSERT_TRUE(report.ok()) << report.status();
+    EXPECT_EQ(report->min_spp, 0u);
+    EXPECT_EQ(report->per_tile[1].spp, 4u);
+    EXPECT_TRUE(std::isfinite(report->estimated_error));
+}
+
 TEST(AdaptiveTilePlan, RefusesSettingsOutOfRange) {
     for (const AdaptiveSettings& bad :
          {AdaptiveSettings{.target_error = -0.1}, AdaptiveSettings{.target_error = NAN},
