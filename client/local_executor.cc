@@ -64,7 +64,7 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
         camera.width(), camera.height(), settings.spp, settings.tile, adaptive);
     if (!made.ok()) return made.status();
     AdaptiveTilePlan& plan = **made;
-    const size_t tiles = plan.tasks().size();
+    const size_t tiles = plan.tile_count();
 
     // Passes wait by their first sample, then plan order, as on the farm: every tile's first
     // pass before any second one, and the least sampled tiles first, so a time limit leaves
@@ -78,7 +78,6 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
     std::condition_variable changed;
     int running = 0;
     bool finished = false;
-    size_t tiles_done = 0;
     absl::Status status;
     std::atomic<bool> out_of_time{false};  // cancels the passes the time limit drops
 
@@ -93,19 +92,19 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
             ++running;
             lock.unlock();
             // First passes are never dropped, so never cancelled.
+            const bool first = task.sample_end <= plan.first_spp();
             const TileSums sums =
                 RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
-                           task.sample_end, task.sample_begin == 0 ? nullptr : &out_of_time);
+                           task.sample_end, first ? nullptr : &out_of_time);
             lock.lock();
             --running;
             if (plan.IsPending(task.index)) {  // else cut short: the time limit dropped it
-                absl::StatusOr<std::optional<RenderTask>> next = plan.Merge(task.index, sums);
+                absl::StatusOr<std::vector<RenderTask>> next = plan.Merge(task.index, sums);
                 if (!next.ok()) {
                     status.Update(next.status());
-                } else if (*next) {
-                    queue.push(**next);
-                } else if (progress) {
-                    progress(++tiles_done, tiles);
+                } else {
+                    for (const RenderTask& pass : *next) queue.push(pass);
+                    if (progress) progress(plan.tiles_finished(), tiles);
                 }
             }
             changed.notify_all();

@@ -34,34 +34,55 @@ uint64_t NextSampleCount(uint64_t n, double error, double target, uint64_t max_s
     return std::min(max_spp, RoundUpToEven(uint64_t(std::ceil(next))));
 }
 
-AdaptiveTilePlan::AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings)
-    : width_(width), height_(height), settings_(settings) {
+AdaptiveTilePlan::AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings,
+                                   uint64_t max_task_samples)
+    : width_(width),
+      height_(height),
+      settings_(settings),
+      max_task_samples_(std::max<uint64_t>(max_task_samples, 1)) {
     settings_.max_spp = RoundUpToEven(settings.max_spp);
 }
 
 absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> AdaptiveTilePlan::Make(
-    int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings) {
+    int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings,
+    uint64_t max_task_samples) {
     if (absl::Status s = CheckAdaptiveSettings(settings); !s.ok()) return s;
-    std::unique_ptr<AdaptiveTilePlan> plan(new AdaptiveTilePlan(width, height, settings));
-    const uint64_t first =
+    std::unique_ptr<AdaptiveTilePlan> plan(
+        new AdaptiveTilePlan(width, height, settings, max_task_samples));
+    plan->first_ =
         std::min(plan->settings_.max_spp, RoundUpToEven(std::max<uint64_t>(first_spp, 2)));
-    absl::StatusOr<std::vector<RenderTask>> tiles = PlanRender({width, height, first, tile, 1});
+    absl::StatusOr<std::vector<RenderTask>> tiles =
+        PlanRender({width, height, plan->first_, tile, 1});
     if (!tiles.ok()) return tiles.status();
-    for (const RenderTask& task : *tiles) {
-        plan->tiles_.push_back({TileSums(task.rect), 1, task.index});
-        plan->tile_of_.push_back(task.index);
-    }
-    plan->tasks_ = std::move(*tiles);
-    plan->merged_.assign(plan->tasks_.size(), false);
-    plan->dropped_.assign(plan->tasks_.size(), false);
+    for (const RenderTask& task : *tiles) plan->tiles_.push_back({TileSums(task.rect)});
+    for (int t = 0; t < int(plan->tiles_.size()); ++t) plan->AppendPass(t, 0, plan->first_);
     return plan;
+}
+
+std::vector<RenderTask> AdaptiveTilePlan::AppendPass(int t, uint64_t begin, uint64_t end) {
+    Tile& tile = tiles_[size_t(t)];
+    const uint64_t pairs = (end - begin) / 2;
+    const uint64_t samples = (end - begin) * uint64_t(tile.sums.rect.Area());
+    const uint64_t parts = std::min(pairs, (samples + max_task_samples_ - 1) / max_task_samples_);
+    std::vector<RenderTask> appended;
+    for (uint64_t i = 0; i < parts; ++i) {
+        const RenderTask task{int(tasks_.size()), tile.sums.rect, begin + 2 * (pairs * i / parts),
+                              begin + 2 * (pairs * (i + 1) / parts)};
+        tasks_.push_back(task);
+        tile_of_.push_back(t);
+        merged_.push_back(false);
+        dropped_.push_back(false);
+        tile.pending.push_back(task.index);
+        appended.push_back(task);
+    }
+    return appended;
 }
 
 bool AdaptiveTilePlan::IsPending(int t) const {
     return t >= 0 && size_t(t) < tasks_.size() && !merged_[size_t(t)] && !dropped_[size_t(t)];
 }
 
-absl::StatusOr<std::optional<RenderTask>> AdaptiveTilePlan::Merge(int t, const TileSums& sums) {
+absl::StatusOr<std::vector<RenderTask>> AdaptiveTilePlan::Merge(int t, const TileSums& sums) {
     if (t >= 0 && size_t(t) < tasks_.size() && merged_[size_t(t)]) {
         return absl::AlreadyExistsError(absl::StrCat("task ", t, " is already merged"));
     }
@@ -69,44 +90,46 @@ absl::StatusOr<std::optional<RenderTask>> AdaptiveTilePlan::Merge(int t, const T
         return absl::InvalidArgumentError(
             absl::StrCat("task ", t, " is not a pass planned and still wanted"));
     }
-    const RenderTask task = tasks_[size_t(t)];
-    if (absl::Status s = CheckTaskResult(task, sums); !s.ok()) return s;
+    if (absl::Status s = CheckTaskResult(tasks_[size_t(t)], sums); !s.ok()) return s;
     merged_[size_t(t)] = true;
     ++tasks_done_;
     stats_ += sums.stats;
-    Tile& tile = tiles_[size_t(tile_of_[size_t(t)])];
+    const int tile_index = tile_of_[size_t(t)];
+    Tile& tile = tiles_[size_t(tile_index)];
     tile.sums += sums;
-    tile.pending = -1;
     tile.error = EstimatedRelativeError(tile.sums);
-    const uint64_t n = task.sample_end;
+    std::erase(tile.pending, t);
+    // The pass's other tasks are still out: the tile decides on the whole pass.
+    if (!tile.pending.empty()) return std::vector<RenderTask>();
+    const uint64_t n = tile.sums.pixels[0].Count();
     const bool reached = settings_.target_error > 0 && tile.error <= settings_.target_error;
-    if (reached || n >= settings_.max_spp || stopped_) return std::nullopt;
+    if (reached || n >= settings_.max_spp || stopped_) return std::vector<RenderTask>();
     const uint64_t next =
         settings_.target_error > 0
             ? NextSampleCount(n, tile.error, settings_.target_error, settings_.max_spp)
             : std::min(settings_.max_spp, 2 * n);
-    const RenderTask pass{int(tasks_.size()), task.rect, n, next};
-    tile.pending = pass.index;
-    tasks_.push_back(pass);
-    tile_of_.push_back(tile_of_[size_t(t)]);
-    merged_.push_back(false);
-    dropped_.push_back(false);
-    return pass;
+    return AppendPass(tile_index, n, next);
 }
 
-bool AdaptiveTilePlan::Complete() const {
-    return std::all_of(tiles_.begin(), tiles_.end(), [](const Tile& t) { return t.pending < 0; });
+bool AdaptiveTilePlan::Complete() const { return tiles_finished() == tiles_.size(); }
+
+size_t AdaptiveTilePlan::tiles_finished() const {
+    return size_t(std::count_if(tiles_.begin(), tiles_.end(),
+                                [](const Tile& t) { return t.pending.empty(); }));
 }
 
 std::vector<int> AdaptiveTilePlan::Stop() {
     stopped_ = true;
     std::vector<int> dropped;
     for (Tile& tile : tiles_) {
-        if (tile.pending < 0 || tasks_[size_t(tile.pending)].sample_begin == 0) continue;
-        dropped_[size_t(tile.pending)] = true;
-        dropped.push_back(tile.pending);
-        tile.pending = -1;
+        std::erase_if(tile.pending, [&](int t) {
+            if (tasks_[size_t(t)].sample_end <= first_) return false;
+            dropped_[size_t(t)] = true;
+            dropped.push_back(t);
+            return true;
+        });
     }
+    std::sort(dropped.begin(), dropped.end());
     return dropped;
 }
 

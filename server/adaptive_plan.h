@@ -54,32 +54,43 @@ struct AdaptiveReport {
 // noisy estimate cannot ask for far too much; even, so the A and B halves stay equal.
 uint64_t NextSampleCount(uint64_t n, double error, double target, uint64_t max_spp);
 
+// The most pixel samples in one task: a longer pass is split into tasks of consecutive sample
+// ranges, so that one hard tile's last pass (up to 8x the one before) spreads over workers
+// instead of leaving all but one idle at the end. About a second of one core on the Cornell box.
+inline constexpr uint64_t kMaxTaskSamples = uint64_t(1) << 20;
+
 class AdaptiveTilePlan : public TileMerger {
   public:
     // The planner's tiles (PlanRender with one pass), each with a first pass of `first_spp`
-    // samples rounded up to even. InvalidArgument for sizes PlanRender refuses and for settings
+    // samples rounded up to even. A pass of more than `max_task_samples` pixel samples is split
+    // into tasks of consecutive, even-length sample ranges (so each holds as many A as B
+    // samples). InvalidArgument for sizes PlanRender refuses and for settings
     // CheckAdaptiveSettings refuses.
-    static absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> Make(int width, int height,
-                                                                  uint64_t first_spp, int tile,
-                                                                  const AdaptiveSettings& settings);
+    static absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> Make(
+        int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings,
+        uint64_t max_task_samples = kMaxTaskSamples);
 
-    // Tile t's first pass is task t; the passes Merge appends follow, in the order of the results
-    // that asked for them.
+    // The tiles' first passes in plan order, then the passes Merge appends, in the order of the
+    // results that asked for them.
     const std::vector<RenderTask>& tasks() const override { return tasks_; }
-    // Merges a pass and appends the tile's next one, unless the tile is done. InvalidArgument for
-    // a result that is not the pass's rectangle and sample count, a task not in the plan or one
-    // Stop dropped; AlreadyExists for a pass merged before.
-    absl::StatusOr<std::optional<RenderTask>> Merge(int task_index, const TileSums& sums) override;
+    // Merges a task; once the last task of a pass is merged, appends the tile's next pass unless
+    // the tile is done. InvalidArgument for a result that is not the task's rectangle and sample
+    // count, a task not in the plan or one Stop dropped; AlreadyExists for a task merged before.
+    absl::StatusOr<std::vector<RenderTask>> Merge(int task_index, const TileSums& sums) override;
     size_t tasks_done() const override { return tasks_done_; }
     bool Complete() const override;
     const RenderStats& stats() const override { return stats_; }
     Image Snapshot() const override;
 
-    // The time limit: appends no more passes and drops the planned ones not yet merged, except
-    // tiles' first passes. Returns the dropped task indices.
+    // The time limit: appends no more passes and drops the tasks not yet merged, except those of
+    // tiles' first passes. Returns the dropped task indices. A tile keeps the tasks of a split
+    // pass that merged before.
     std::vector<int> Stop();
     bool stopped() const { return stopped_; }
     bool IsPending(int task_index) const;  // planned, neither merged nor dropped
+    uint64_t first_spp() const { return first_; }
+    size_t tile_count() const { return tiles_.size(); }
+    size_t tiles_finished() const;  // tiles with no task out
 
     absl::StatusOr<AdaptiveReport> Report() const;
 
@@ -87,12 +98,17 @@ class AdaptiveTilePlan : public TileMerger {
     struct Tile {
         TileSums sums;
         double error = 1;
-        int pending = -1;  // the pass planned and not merged yet
+        std::vector<int> pending;  // the tasks of the current pass not merged yet
     };
-    AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings);
+    AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings,
+                     uint64_t max_task_samples);
+    // Appends the tasks of tile `tile`'s pass over samples [begin, end).
+    std::vector<RenderTask> AppendPass(int tile, uint64_t begin, uint64_t end);
 
     int width_, height_;
     AdaptiveSettings settings_;
+    uint64_t max_task_samples_;
+    uint64_t first_ = 0;  // samples of the first pass
     std::vector<Tile> tiles_;
     std::vector<RenderTask> tasks_;
     std::vector<int> tile_of_;  // by task

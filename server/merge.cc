@@ -61,10 +61,9 @@ absl::Status RenderMerger::Add(int task_index, const TileSums& sums) {
     return absl::OkStatus();
 }
 
-absl::StatusOr<std::optional<RenderTask>> RenderMerger::Merge(int task_index,
-                                                              const TileSums& sums) {
+absl::StatusOr<std::vector<RenderTask>> RenderMerger::Merge(int task_index, const TileSums& sums) {
     if (absl::Status s = Add(task_index, sums); !s.ok()) return s;
-    return std::nullopt;
+    return std::vector<RenderTask>();
 }
 
 std::map<std::pair<int, int>, RenderMerger::OpenTile>::iterator RenderMerger::OpenTileFor(

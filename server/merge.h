@@ -28,9 +28,8 @@ class TileMerger {
     virtual ~TileMerger() = default;
     // The tasks planned so far, by RenderTask::index.
     virtual const std::vector<RenderTask>& tasks() const = 0;
-    // Merges task `task_index`'s result; returns the task it appended to the plan, if any.
-    virtual absl::StatusOr<std::optional<RenderTask>> Merge(int task_index,
-                                                            const TileSums& sums) = 0;
+    // Merges task `task_index`'s result; returns the tasks it appended to the plan.
+    virtual absl::StatusOr<std::vector<RenderTask>> Merge(int task_index, const TileSums& sums) = 0;
     virtual size_t tasks_done() const = 0;
     // Every planned task merged (or, adaptive, dropped) and none left to plan.
     virtual bool Complete() const = 0;
@@ -48,7 +47,7 @@ class RenderMerger : public TileMerger {
     // merged before (the image is unchanged then).
     absl::Status Add(int task_index, const TileSums& sums);
 
-    absl::StatusOr<std::optional<RenderTask>> Merge(int task_index, const TileSums& sums) override;
+    absl::StatusOr<std::vector<RenderTask>> Merge(int task_index, const TileSums& sums) override;
 
     const std::vector<RenderTask>& tasks() const override { return tasks_; }
     size_t tasks_done() const override { return tasks_done_; }

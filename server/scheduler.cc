@@ -140,9 +140,9 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
         // passes it planned depend only on the results before them.
         for (const auto& [t, bytes] : *results) {
             absl::StatusOr<TileSums> sums = DecodeTileSums(bytes);
-            absl::StatusOr<std::optional<RenderTask>> pass =
+            absl::StatusOr<std::vector<RenderTask>> pass =
                 sums.ok() ? job->merger->Merge(t, *sums)
-                          : absl::StatusOr<std::optional<RenderTask>>(sums.status());
+                          : absl::StatusOr<std::vector<RenderTask>>(sums.status());
             // The store wrote what merged before, so this cannot fail unless the file was
             // damaged; the task is then simply rendered again.
             if (!pass.ok()) {
@@ -151,7 +151,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
                 continue;
             }
             job->tasks[size_t(t)].state = TaskState::kDone;
-            if (*pass) job->tasks.resize(job->merger->tasks().size());
+            job->tasks.resize(job->merger->tasks().size());
         }
         QueueStart(*job);
         job->record.tasks_done = int(job->merger->tasks_done());
@@ -394,12 +394,12 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     if (task.state == TaskState::kDone || task.state == TaskState::kDropped) {
         return Completion{job.record.id, false};
     }
-    absl::StatusOr<std::optional<RenderTask>> merged =
+    absl::StatusOr<std::vector<RenderTask>> merged =
         IsSweepTask(job, ref->task) ? absl::InvalidArgumentError("a tile result for a sweep task")
                                     : job.merger->Merge(ref->task, sums);
     if (!merged.ok()) return Refuse(*ref, lease_id, worker, merged.status());
     MarkDone(job, ref->task, now);
-    if (*merged) QueuePass(job, **merged);
+    for (const RenderTask& pass : *merged) QueuePass(job, pass);
     EnforceTimeLimit(job, now);
     job.record.tasks_done = int(job.merger->tasks_done());
     job.record.stats = job.merger->stats();

@@ -195,7 +195,7 @@ class Scheduler {
     }
     // A job with its tiles planned as its spec says; InvalidArgument when they cannot be.
     static absl::StatusOr<std::unique_ptr<Job>> NewJob(JobRecord record);
-    // Queues a pass the adaptive plan appended.
+    // Queues a task the adaptive plan appended.
     void QueuePass(Job& job, const RenderTask& pass);
     // Drops an adaptive job's passes once its time limit has passed; true if that completed it.
     bool EnforceTimeLimit(Job& job, absl::Time now);

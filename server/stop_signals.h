@@ -7,7 +7,7 @@
 namespace lf {
 
 class StopSignals {
-public:
+  public:
     StopSignals() {
         sigemptyset(&signals_);
         sigaddset(&signals_, SIGINT);
@@ -22,7 +22,7 @@ public:
         return signal;
     }
 
-private:
+  private:
     sigset_t signals_;
 };
 

@@ -33,9 +33,10 @@ TileSums Pass(const RenderTask& task) {
     return sums;
 }
 
-std::unique_ptr<AdaptiveTilePlan> MakePlan(const AdaptiveSettings& settings, uint64_t first = 4) {
+std::unique_ptr<AdaptiveTilePlan> MakePlan(const AdaptiveSettings& settings, uint64_t first = 4,
+                                           uint64_t max_task_samples = kMaxTaskSamples) {
     absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan =
-        AdaptiveTilePlan::Make(16, 8, first, 8, settings);
+        AdaptiveTilePlan::Make(16, 8, first, 8, settings, max_task_samples);
     EXPECT_TRUE(plan.ok()) << plan.status();
     return std::move(*plan);
 }
@@ -100,9 +101,10 @@ TEST(AdaptiveTilePlan, WithoutATargetTilesDoubleUpToMaxSpp) {
 TEST(AdaptiveTilePlan, StopDropsPlannedPassesButNotFirstOnes) {
     auto plan = MakePlan({.target_error = 0.001, .time_limit = 1, .max_spp = 1 << 16});
     // Tile 1's first pass asks for a second; tile 0's first pass is still out.
-    absl::StatusOr<std::optional<RenderTask>> next = plan->Merge(1, Pass(plan->tasks()[1]));
-    ASSERT_TRUE(next.ok() && next->has_value());
-    const int second = (*next)->index;
+    absl::StatusOr<std::vector<RenderTask>> next = plan->Merge(1, Pass(plan->tasks()[1]));
+    ASSERT_TRUE(next.ok());
+    ASSERT_EQ(next->size(), 1u);
+    const int second = (*next)[0].index;
     EXPECT_EQ(plan->Stop(), std::vector<int>{second});
     EXPECT_FALSE(plan->IsPending(second));
     EXPECT_EQ(plan->Merge(second, Pass(plan->tasks()[size_t(second)])).status().code(),
@@ -110,7 +112,7 @@ TEST(AdaptiveTilePlan, StopDropsPlannedPassesButNotFirstOnes) {
     EXPECT_FALSE(plan->Complete());  // tile 0 has no samples yet
     next = plan->Merge(0, Pass(plan->tasks()[0]));
     ASSERT_TRUE(next.ok());
-    EXPECT_FALSE(next->has_value());
+    EXPECT_TRUE(next->empty());
     EXPECT_TRUE(plan->Complete());
     absl::StatusOr<AdaptiveReport> report = plan->Report();
     ASSERT_TRUE(report.ok());
@@ -147,6 +149,60 @@ TEST(AdaptiveTilePlan, ReplayingResultsInIndexOrderRebuildsThePlanAndItsBits) {
     }
     EXPECT_TRUE(replayed->Complete());
     EXPECT_EQ(*replayed->Snapshot().FindChannel("R"), *plan->Snapshot().FindChannel("R"));
+}
+
+// Long passes are split into tasks of consecutive sample ranges, each of even length, which
+// merge in any order into the bits of the unsplit pass; the tile decides once all are in.
+TEST(AdaptiveTilePlan, LongPassesSplitIntoTasksThatMergeToTheSameBits) {
+    const AdaptiveSettings settings{.target_error = 0.02, .time_limit = 0, .max_spp = 1 << 16};
+    auto whole = MakePlan(settings);
+    RunToEnd(*whole);
+    // 8 samples of a 64-pixel tile per task; the first pass (4 spp) fits one.
+    auto split = MakePlan(settings, 4, 8 * 64);
+    ASSERT_EQ(split->tasks().size(), 2u);
+    std::vector<int> out = {0, 1};
+    while (!out.empty()) {
+        // The last task appended first: any order must do.
+        const int t = out.back();
+        out.pop_back();
+        absl::StatusOr<std::vector<RenderTask>> next =
+            split->Merge(t, Pass(split->tasks()[size_t(t)]));
+        ASSERT_TRUE(next.ok()) << next.status();
+        // A next pass comes only once no task of the tile's pass is out.
+        for (const RenderTask& task : *next) {
+            for (int o : out) EXPECT_NE(split->tasks()[size_t(o)].rect.x0, task.rect.x0);
+        }
+        for (const RenderTask& task : *next) {
+            EXPECT_LE(task.sample_end - task.sample_begin, 8u);
+            EXPECT_EQ((task.sample_end - task.sample_begin) % 2, 0u);
+            out.insert(out.begin(), task.index);
+        }
+    }
+    ASSERT_TRUE(split->Complete());
+    EXPECT_GT(split->tasks().size(), whole->tasks().size());
+    EXPECT_EQ(*split->Snapshot().FindChannel("R"), *whole->Snapshot().FindChannel("R"));
+    EXPECT_EQ(*split->Snapshot().FindChannel("spp"), *whole->Snapshot().FindChannel("spp"));
+}
+
+// A split first pass is never dropped; a split later pass keeps the tasks merged before.
+TEST(AdaptiveTilePlan, StopKeepsSplitFirstPassesAndMergedParts) {
+    auto plan = MakePlan({.target_error = 0.001, .time_limit = 1, .max_spp = 1 << 16}, 16, 8 * 64);
+    ASSERT_EQ(plan->tasks().size(), 4u);  // two tasks of 8 samples per tile
+    EXPECT_TRUE(plan->Stop().empty());
+    for (int t = 0; t < 4; ++t) ASSERT_TRUE(plan->Merge(t, Pass(plan->tasks()[size_t(t)])).ok());
+    EXPECT_TRUE(plan->Complete());
+
+    auto later = MakePlan({.target_error = 0.001, .time_limit = 1, .max_spp = 1 << 16}, 16, 8 * 64);
+    for (int t : {2, 3}) ASSERT_TRUE(later->Merge(t, Pass(later->tasks()[size_t(t)])).ok());
+    ASSERT_GT(later->tasks().size(), 5u);  // tile 1's second pass, split
+    ASSERT_TRUE(later->Merge(4, Pass(later->tasks()[4])).ok());
+    const std::vector<int> dropped = later->Stop();
+    EXPECT_EQ(dropped.size(), later->tasks().size() - 5);
+    for (int t : {0, 1}) ASSERT_TRUE(later->Merge(t, Pass(later->tasks()[size_t(t)])).ok());
+    EXPECT_TRUE(later->Complete());
+    absl::StatusOr<AdaptiveReport> report = later->Report();
+    ASSERT_TRUE(report.ok());
+    EXPECT_EQ(report->per_tile[1].spp, later->tasks()[4].sample_end);
 }
 
 // A farm preview reports on a plan with tiles not sampled yet.
