@@ -428,7 +428,9 @@ class PreviousPairs {
         }
     }
 
-    // F_ab and F_ba (a < b) as the previous mesh's evaluation of the same pair left them.
+    // F_ab and F_ba (a < b) as the previous mesh's evaluation of the same pair left them; false
+    // if a patch is new, the pair was not evaluated there, or the previous mesh ordered its sides
+    // the other way (then the rays would have run the other way too).
     bool Find(int32_t a, int32_t b, float& ab, float& ba) const {
         if (form_factors_ == nullptr) return false;
         const int32_t oa = side_[size_t(a)], ob = side_[size_t(b)];
