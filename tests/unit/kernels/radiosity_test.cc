@@ -371,8 +371,9 @@ TEST(Radiosity, RefinementReusesFormFactorsWithTheSameBits) {
         ASSERT_EQ(std::bit_cast<uint32_t>(a.b), std::bit_cast<uint32_t>(b.b)) << "side " << s;
     }
 
-    // Every pass after the first evaluates only the pairs with a new patch. The last one split a
-    // single cell (measured: 1.8 k of 152 k pairs evaluated, 2.1 k of 244 k rays cast).
+    // Every pass after the first evaluates only the pairs with a new patch. The last one follows
+    // the split of a single cell, 4 new of 527 patches, ~1 % of the pairs (measured: 1.8 k of
+    // 152 k pairs evaluated, 2.1 k of 244 k rays cast).
     const std::vector<RadiosityRefinementPass>& passes = r.report().refinement;
     ASSERT_GE(passes.size(), 3u);
     EXPECT_EQ(passes.front().reused_pairs, 0);
