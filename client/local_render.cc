@@ -126,9 +126,11 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         for (size_t pass = 0; pass < rep.refinement.size(); ++pass) {
             const RadiosityRefinementPass& p = rep.refinement[pass];
             log->info(
-                "job={} radiosity refinement pass {}: {} patches, {} unknowns, estimated error "
-                "max {:.3g} mean {:.3g}, {} cells split",
-                job_id, pass + 1, p.patches, p.sides, p.max_error, p.mean_error, p.split);
+                "job={} radiosity refinement pass {}: {} patches, {} unknowns, form factors "
+                "{:.2f} s ({} pairs evaluated, {} reused), estimated error max {:.3g} mean "
+                "{:.3g}, {} cells split",
+                job_id, pass + 1, p.patches, p.sides, p.form_factor_seconds, p.pairs,
+                p.reused_pairs, p.max_error, p.mean_error, p.split);
         }
         if (ro.target_error > 0) {
             log->info("job={} radiosity refinement: estimated error {:.3g} (target {:.3g}){}{}",

@@ -3,9 +3,11 @@
 // path-traced reference image. The numbers in docs/radiosity.md come from here.
 //
 //   radiosity_bench [--scene S] [--patches 1000,4000,16000] [--reference-spp 1024]
+//                   [--target-error 0.2,0.1]  (refine from each patch count to each target)
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -61,6 +63,7 @@ int main(int argc, char** argv) {
     CLI::App app("Radiosity cost and accuracy against mesh size");
     std::string scene_path = std::string(LF_SOURCE_DIR) + "/tests/scenes/cornell_box.json";
     std::vector<int64_t> patch_counts = {1000, 4000, 16000};
+    std::vector<double> targets;
     std::string solver_name = "gauss-seidel";
     uint64_t reference_spp = 0;
     int resolution = 64;
@@ -72,6 +75,9 @@ int main(int argc, char** argv) {
                    "compare with a path-traced image at this many samples per pixel (0: skip)");
     app.add_option("--resolution", resolution, "image size for the comparison");
     app.add_option("--threads", threads, "0: all cores");
+    app.add_option("--target-error", targets,
+                   "refine from each patch count to each of these targets (0: uniform)")
+        ->delimiter(',');
     CLI11_PARSE(app, argc, argv);
 
     auto solver = lf::ParseRadiositySolver(solver_name);
@@ -99,34 +105,51 @@ int main(int argc, char** argv) {
                     RelativeRms(reference, reference, "A.", "B.") / 2);
     }
 
-    std::printf("%8s %7s %8s %8s %8s %10s %9s %9s %6s %7s %9s %9s %8s\n", "patches", "sides",
-                "ff s", "cpu s", "solve s", "nonzeros", "ff MiB", "peak MiB", "iters", "sweeps",
-                "residual", "rays", "vs path");
+    if (targets.empty()) targets = {0};
+    std::printf("%8s %6s %7s %7s %8s %8s %8s %8s %10s %9s %9s %6s %7s %9s %9s %8s\n", "patches",
+                "target", "passes", "sides", "wall s", "ff s", "cpu s", "solve s", "nonzeros",
+                "ff MiB", "peak MiB", "iters", "sweeps", "residual", "rays", "vs path");
     for (int64_t n : patch_counts) {
-        ResetPeakRss();
-        lf::RadiosityOptions options;
-        options.patches = n;
-        options.solver = *solver;
-        options.threads = threads;
-        const double cpu_start = CpuSeconds();
-        auto renderer = lf::PrepareRadiosity(**embree, options);
-        const double cpu = CpuSeconds() - cpu_start;
-        if (!renderer.ok()) {
-            std::fprintf(stderr, "%s\n", renderer.status().ToString().c_str());
-            return 1;
+        for (double target : targets) {
+            ResetPeakRss();
+            lf::RadiosityOptions options;
+            options.patches = n;
+            options.solver = *solver;
+            options.threads = threads;
+            options.target_error = target;
+            const double cpu_start = CpuSeconds();
+            const auto start = std::chrono::steady_clock::now();
+            auto renderer = lf::PrepareRadiosity(**embree, options);
+            const double wall =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            const double cpu = CpuSeconds() - cpu_start;
+            if (!renderer.ok()) {
+                std::fprintf(stderr, "%s\n", renderer.status().ToString().c_str());
+                return 1;
+            }
+            const lf::RadiosityReport& r = (*renderer)->report();
+            const double peak = PeakRssMiB();
+            double difference = NAN;
+            if (reference_spp > 0) {
+                difference = RelativeRms(
+                    lf::RenderImage(camera, **renderer, settings).value().image, reference);
+            }
+            std::printf(
+                "%8ld %6.3g %7zu %7ld %8.2f %8.2f %8.2f %8.2f %10ld %9.1f %9.1f %6d %7.1f %9.2e "
+                "%9ld %8.4f\n",
+                r.patches, target, r.refinement.size(), r.sides, wall, r.form_factor_seconds, cpu,
+                r.solve_seconds, r.nonzero_form_factors, double(r.form_factor_bytes) / (1 << 20),
+                peak, r.iterations, r.sweeps, r.residual, r.visibility_rays, difference);
+            for (size_t pass = 0; pass < r.refinement.size(); ++pass) {
+                const lf::RadiosityRefinementPass& q = r.refinement[pass];
+                std::printf(
+                    "    pass %zu: %ld patches, form factors %.3f s, %ld rays, %ld pairs "
+                    "evaluated, %ld reused, %ld cells split\n",
+                    pass + 1, q.patches, q.form_factor_seconds, q.visibility_rays, q.pairs,
+                    q.reused_pairs, q.split);
+            }
+            std::fflush(stdout);
         }
-        const lf::RadiosityReport& r = (*renderer)->report();
-        const double peak = PeakRssMiB();
-        double difference = NAN;
-        if (reference_spp > 0) {
-            difference =
-                RelativeRms(lf::RenderImage(camera, **renderer, settings).value().image, reference);
-        }
-        std::printf("%8ld %7ld %8.2f %8.2f %8.2f %10ld %9.1f %9.1f %6d %7.1f %9.2e %9ld %8.4f\n",
-                    r.patches, r.sides, r.form_factor_seconds, cpu, r.solve_seconds,
-                    r.nonzero_form_factors, double(r.form_factor_bytes) / (1 << 20), peak,
-                    r.iterations, r.sweeps, r.residual, r.visibility_rays, difference);
-        std::fflush(stdout);
     }
     return 0;
 }

@@ -375,6 +375,94 @@ class ProgressLog {
     std::atomic<int64_t> next_log_ms_{kIntervalMs};
 };
 
+// Reuse of another mesh's form factors -------------------------------------------------------
+
+// A pair's form factors are a function of the two sides alone: their patches' corners (grid
+// points of their scene triangles, placed by the same arithmetic in any mesh of that
+// subdivision), normals, quadrature and ray levels, and rays into the one Embree scene; the pair
+// is evaluated from its lower side index, and unsplit patches keep their order. Groups only
+// decide which pairs are evaluated at all: a pair of groups culled as unable to see each other
+// stores zeros without evaluating them, so a value is reused only from an evaluated pair.
+class PreviousPairs {
+  public:
+    PreviousPairs(const PatchMesh& mesh, const MeshFormFactors& previous) {
+        if (previous.mesh == nullptr || previous.form_factors == nullptr) return;
+        const PatchMesh& old_mesh = *previous.mesh;
+        form_factors_ = previous.form_factors;
+        std::vector<std::pair<PatchCell, int64_t>> cells;
+        cells.reserve(old_mesh.patches().size());
+        for (int64_t p = 0; p < int64_t(old_mesh.patches().size()); ++p) {
+            cells.push_back({old_mesh.Cell(p), p});
+        }
+        std::sort(cells.begin(), cells.end());
+        side_.assign(mesh.sides().size(), -1);
+        for (size_t s = 0; s < side_.size(); ++s) {
+            const PatchMesh::Side& side = mesh.sides()[s];
+            const PatchCell cell = mesh.Cell(side.patch);
+            // The same cell of a triangle subdivided otherwise is another patch.
+            if (old_mesh.Subdivision(cell.mesh, cell.primitive) !=
+                mesh.Subdivision(cell.mesh, cell.primitive)) {
+                continue;
+            }
+            const auto it =
+                std::lower_bound(cells.begin(), cells.end(), std::pair(cell, int64_t(0)));
+            if (it == cells.end() || it->first != cell) continue;
+            side_[s] = old_mesh.patches()[size_t(it->second)].sides[side.back ? 1 : 0];
+        }
+        const FormFactors& old = *form_factors_;
+        groups_ = int32_t(old.groups().size());
+        group_of_.resize(size_t(old.size()));
+        for (int32_t g = 0; g < groups_; ++g) {
+            const PatchGroup& group = old.groups()[size_t(g)];
+            std::fill(group_of_.begin() + group.begin, group_of_.begin() + group.end, g);
+        }
+        block_.assign(size_t(groups_) * size_t(groups_), kCulled);
+        for (int32_t r = 0; r < groups_; ++r) {
+            for (int32_t c = 0; c < groups_; ++c) {
+                if (old.Evaluated(r, c)) block_[size_t(r) * size_t(groups_) + size_t(c)] = kZero;
+            }
+        }
+        for (int32_t b = 0; b < int32_t(old.blocks().size()); ++b) {
+            const FormFactorBlock& block = old.blocks()[size_t(b)];
+            block_[size_t(block.row_group) * size_t(groups_) + size_t(block.col_group)] = b;
+        }
+    }
+
+    // F_ab and F_ba (a < b) as the previous mesh's evaluation of the same pair left them; false
+    // if a patch is new, the pair was not evaluated there, or the previous mesh ordered its sides
+    // the other way (then the rays would have run the other way too).
+    bool Find(int32_t a, int32_t b, float& ab, float& ba) const {
+        if (form_factors_ == nullptr) return false;
+        const int32_t oa = side_[size_t(a)], ob = side_[size_t(b)];
+        if (oa < 0 || ob < 0 || oa >= ob) return false;
+        const int32_t ga = group_of_[size_t(oa)], gb = group_of_[size_t(ob)];
+        const int32_t forward = block_[size_t(ga) * size_t(groups_) + size_t(gb)];
+        const int32_t backward = block_[size_t(gb) * size_t(groups_) + size_t(ga)];
+        if (forward == kCulled || backward == kCulled) return false;
+        ab = Value(forward, oa, ob);
+        ba = Value(backward, ob, oa);
+        return true;
+    }
+
+  private:
+    static constexpr int32_t kCulled = -2, kZero = -1;
+
+    float Value(int32_t block, int32_t row, int32_t col) const {
+        if (block == kZero) return 0;
+        const FormFactorBlock& b = form_factors_->blocks()[size_t(block)];
+        const bool inside =
+            row >= b.row_begin && row < b.row_end && col >= b.col_begin && col < b.col_end;
+        return inside ? b.at(row, col) : 0.0f;
+    }
+
+    const FormFactors* form_factors_ = nullptr;
+    std::vector<int32_t> side_;      // per side: the previous mesh's side on the same cell, or -1
+    int32_t groups_ = 0;             // of the previous form factors
+    std::vector<int32_t> group_of_;  // per previous side
+    std::vector<int32_t> block_;     // per pair of previous groups: index into blocks(), or
+                                     // kZero (evaluated, all zero) or kCulled
+};
+
 }  // namespace
 
 double PointToPolygonFormFactor(const Vec3d& x, const Vec3d& n, std::span<const Vec3d> polygon) {
@@ -398,8 +486,13 @@ double PointToPolygonFormFactor(const Vec3d& x, const Vec3d& n, std::span<const 
 }
 
 FormFactors::FormFactors(int32_t sides, std::vector<PatchGroup> groups,
-                         std::vector<FormFactorBlock> blocks, int64_t rays)
-    : sides_(sides), groups_(std::move(groups)), blocks_(std::move(blocks)), rays_(rays) {
+                         std::vector<FormFactorBlock> blocks, std::vector<bool> evaluated,
+                         const FormFactorWork& work)
+    : sides_(sides),
+      groups_(std::move(groups)),
+      blocks_(std::move(blocks)),
+      evaluated_(std::move(evaluated)),
+      work_(work) {
     std::sort(blocks_.begin(), blocks_.end(), [](const auto& a, const auto& b) {
         return std::pair(a.row_group, a.col_group) < std::pair(b.row_group, b.col_group);
     });
@@ -422,7 +515,7 @@ FormFactors::FormFactors(int32_t sides, std::vector<PatchGroup> groups,
         col_blocks_[size_t(fill[size_t(blocks_[size_t(i)].col_group)]++)] = i;
     }
     bytes_ += (row_start_.size() + col_start_.size() + col_blocks_.size()) * sizeof(int32_t) +
-              groups_.size() * sizeof(PatchGroup);
+              groups_.size() * sizeof(PatchGroup) + evaluated_.size() / 8;
 }
 
 std::span<const FormFactorBlock> FormFactors::RowBlocks(int32_t group) const {
@@ -473,6 +566,7 @@ std::pair<int32_t, int32_t> ChunkGroups(int32_t groups, int chunk, int chunks) {
 FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
                                const FormFactorOptions& options) {
     const PairEvaluator evaluator(scene, mesh);
+    const PreviousPairs previous(mesh, options.previous);
     const std::vector<SideGeometry>& sides = evaluator.sides();
     std::vector<PatchGroup> groups = MakeGroups(mesh, std::max(1, options.group_size));
     std::vector<GroupPlane> planes;
@@ -484,6 +578,7 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
     // Unordered pairs of groups that may see each other; each task fills both blocks (those
     // of wanted rows).
     std::vector<std::pair<int32_t, int32_t>> tasks;
+    std::vector<bool> evaluated(groups.size() * groups.size(), false);
     int64_t total_work = 0;
     for (int32_t i = 0; i < int32_t(groups.size()); ++i) {
         for (int32_t j = i; j < int32_t(groups.size()); ++j) {
@@ -495,12 +590,14 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
                 continue;
             }
             tasks.push_back({i, j});
+            evaluated[size_t(i) * groups.size() + size_t(j)] = wanted(i);
+            evaluated[size_t(j) * groups.size() + size_t(i)] = wanted(j);
             total_work += int64_t(groups[size_t(i)].size()) * groups[size_t(j)].size();
         }
     }
 
     std::vector<std::array<FormFactorBlock, 2>> results(tasks.size());
-    std::vector<int64_t> task_rays(tasks.size(), 0);
+    std::vector<FormFactorWork> task_work(tasks.size());
     ProgressLog progress(std::max<int64_t>(total_work, 1));
     tbb::parallel_for(size_t(0), tasks.size(), [&](size_t t) {
         if (options.cancel && options.cancel->load(std::memory_order_relaxed)) return;
@@ -508,16 +605,25 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
         const PatchGroup &rows = groups[size_t(gi)], &cols = groups[size_t(gj)];
         std::vector<float> ij(size_t(rows.size()) * size_t(cols.size()), 0.0f);
         std::vector<float> ji(gi == gj ? 0 : ij.size(), 0.0f);
+        FormFactorWork& work = task_work[t];
         for (int32_t a = rows.begin; a < rows.end; ++a) {
             for (int32_t b = gi == gj ? a + 1 : cols.begin; b < cols.end; ++b) {
-                const PairFormFactors f = evaluator.Evaluate(a, b, wanted(gi), wanted(gj));
-                task_rays[t] += f.rays;
-                const size_t ra = size_t(a - rows.begin), cb = size_t(b - cols.begin);
-                ij[ra * size_t(cols.size()) + cb] = float(f.ab);
-                if (gi == gj) {
-                    ij[cb * size_t(cols.size()) + ra] = float(f.ba);
+                float ab = 0, ba = 0;
+                if (previous.Find(a, b, ab, ba)) {
+                    ++work.reused_pairs;
                 } else {
-                    ji[cb * size_t(rows.size()) + ra] = float(f.ba);
+                    const PairFormFactors f = evaluator.Evaluate(a, b, wanted(gi), wanted(gj));
+                    ++work.pairs;
+                    work.rays += f.rays;
+                    ab = float(f.ab);
+                    ba = float(f.ba);
+                }
+                const size_t ra = size_t(a - rows.begin), cb = size_t(b - cols.begin);
+                ij[ra * size_t(cols.size()) + cb] = ab;
+                if (gi == gj) {
+                    ij[cb * size_t(cols.size()) + ra] = ba;
+                } else {
+                    ji[cb * size_t(rows.size()) + ra] = ba;
                 }
             }
         }
@@ -527,14 +633,17 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
     });
 
     std::vector<FormFactorBlock> blocks;
-    int64_t rays = 0;
+    FormFactorWork work;
     for (size_t t = 0; t < results.size(); ++t) {
-        rays += task_rays[t];
+        work.rays += task_work[t].rays;
+        work.pairs += task_work[t].pairs;
+        work.reused_pairs += task_work[t].reused_pairs;
         for (FormFactorBlock& b : results[t]) {
             if (!b.values.empty()) blocks.push_back(std::move(b));
         }
     }
-    return FormFactors(int32_t(sides.size()), std::move(groups), std::move(blocks), rays);
+    return FormFactors(int32_t(sides.size()), std::move(groups), std::move(blocks),
+                       std::move(evaluated), work);
 }
 
 std::vector<Rgb> PointLightIrradiance(const EmbreeScene& scene, const PatchMesh& mesh) {

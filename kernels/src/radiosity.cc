@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <numbers>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -42,44 +43,36 @@ absl::Status CheckReflectance(const Scene& scene) {
     return absl::OkStatus();
 }
 
-// E: exitance π L_e on emitters' front sides plus the point lights' direct light reflected.
-RadiositySystem MakeSystem(const EmbreeScene& scene, const PatchMesh& mesh,
-                           const FormFactors& form_factors) {
-    const std::vector<Rgb> irradiance = PointLightIrradiance(scene, mesh);
-    RadiositySystem system;
-    system.form_factors = &form_factors;
-    for (size_t s = 0; s < mesh.sides().size(); ++s) {
-        const PatchMesh::Side& side = mesh.sides()[s];
-        const PatchMesh::Patch& patch = mesh.patches()[size_t(side.patch)];
-        const Material& m =
-            scene.scene().materials[size_t(scene.scene().meshes[size_t(patch.mesh)].material)];
-        Rgb e = m.reflectance * irradiance[s];
-        if (!side.back) e += m.emission * float(std::numbers::pi);
-        system.emission.push_back(e);
-        system.reflectance.push_back(m.reflectance);
-        system.area.push_back(patch.area);
-    }
-    return system;
-}
-
-// Form factors and the solve on one mesh; times and counts add up in `report`.
-absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh& mesh,
-                                       const RadiosityOptions& options, double tolerance,
-                                       RadiosityReport& report) {
-    auto start = std::chrono::steady_clock::now();
-    const FormFactors form_factors = ComputeFormFactors(scene, mesh);
-    const double form_factor_seconds = SecondsSince(start);
-    report.form_factor_seconds += form_factor_seconds;
+// The form factors of `mesh`, reusing `previous`'s where it has them; time and counts add up in
+// `report`.
+FormFactors FormFactorsOf(const EmbreeScene& scene, const PatchMesh& mesh,
+                          const MeshFormFactors& previous, RadiosityReport& report) {
+    const auto start = std::chrono::steady_clock::now();
+    FormFactorOptions options;
+    options.previous = previous;
+    FormFactors form_factors = ComputeFormFactors(scene, mesh, options);
+    const double seconds = SecondsSince(start);
+    const FormFactorWork& work = form_factors.work();
+    report.form_factor_seconds += seconds;
     report.form_factor_bytes = form_factors.bytes();
     report.nonzero_form_factors = form_factors.nonzeros();
-    report.visibility_rays += form_factors.rays();
+    report.visibility_rays += work.rays;
     NamedLogger("radiosity")
-        ->info("form factors in {:.2f} s: {} non-zero, {:.1f} MiB, {} rays", form_factor_seconds,
-               form_factors.nonzeros(), double(form_factors.bytes()) / (1 << 20),
-               form_factors.rays());
+        ->info("form factors in {:.2f} s: {} non-zero, {:.1f} MiB, {} rays, {} pairs evaluated{}",
+               seconds, form_factors.nonzeros(), double(form_factors.bytes()) / (1 << 20),
+               work.rays, work.pairs,
+               previous.form_factors ? absl::StrCat(", ", work.reused_pairs, " reused")
+                                     : std::string());
+    return form_factors;
+}
 
-    start = std::chrono::steady_clock::now();
-    const RadiositySystem system = MakeSystem(scene, mesh, form_factors);
+// The solve on one mesh; times and counts add up in `report`.
+absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh& mesh,
+                                       const FormFactors& form_factors,
+                                       const RadiosityOptions& options, double tolerance,
+                                       RadiosityReport& report) {
+    const auto start = std::chrono::steady_clock::now();
+    const RadiositySystem system = MakeRadiositySystem(scene, mesh, form_factors);
     absl::StatusOr<SolveResult> solved =
         SolveRadiosity(system, {options.solver, tolerance, options.max_iterations});
     if (!solved.ok()) return solved.status();
@@ -108,13 +101,26 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
         std::min(kMaxRefinedPatches, options.max_patches > 0 ? options.max_patches
                                                              : 16 * int64_t(mesh.patches().size()));
     PatchMeshOptions mesh_options{mesh.patch_size(), 0};
-    while (true) {
-        absl::StatusOr<std::vector<Rgb>> radiosity = Solve(scene, mesh, options, tolerance, report);
+    // The previous pass's mesh and form factors, whose unsplit pairs the next pass reuses: at
+    // most two passes' form factors are held at once.
+    PatchMesh previous_mesh;
+    FormFactors previous;
+    for (bool first = true;; first = false) {
+        const double form_factor_seconds = report.form_factor_seconds;
+        FormFactors form_factors = FormFactorsOf(
+            scene, mesh, first ? MeshFormFactors{} : MeshFormFactors{&previous_mesh, &previous},
+            report);
+        previous = FormFactors();  // freed before the solve
+        absl::StatusOr<std::vector<Rgb>> radiosity =
+            Solve(scene, mesh, form_factors, options, tolerance, report);
         if (!radiosity.ok()) return radiosity.status();
         const DiscretisationError error = EstimateDiscretisationError(mesh, *radiosity);
         const RefinementStep step = ChooseRefinement(mesh, error, options.target_error, budget);
+        const FormFactorWork& work = form_factors.work();
         report.refinement.push_back({int64_t(mesh.patches().size()), int64_t(mesh.sides().size()),
-                                     error.max, error.mean, int64_t(step.split.size())});
+                                     error.max, error.mean, int64_t(step.split.size()),
+                                     report.form_factor_seconds - form_factor_seconds, work.rays,
+                                     work.pairs, work.reused_pairs});
         report.budget_reached = step.budget_reached;
         report.finest_above_target = step.at_finest;
         NamedLogger("radiosity")
@@ -130,7 +136,8 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
         const auto start = std::chrono::steady_clock::now();
         absl::StatusOr<PatchMesh> refined = PatchMesh::Build(scene.scene(), mesh_options);
         if (!refined.ok()) return refined.status();
-        mesh = std::move(*refined);
+        previous_mesh = std::exchange(mesh, std::move(*refined));
+        previous = std::move(form_factors);
         report.mesh_seconds += SecondsSince(start);
     }
 }
@@ -176,7 +183,8 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
     } else {
         absl::StatusOr<std::vector<Rgb>> solved =
             options.target_error > 0 ? SolveRefining(scene, options, *mesh, report)
-                                     : Solve(scene, *mesh, options, options.tolerance, report);
+                                     : Solve(scene, *mesh, FormFactorsOf(scene, *mesh, {}, report),
+                                             options, options.tolerance, report);
         if (!solved.ok()) return solved.status();
         radiosity = std::move(*solved);
     }
@@ -218,6 +226,25 @@ absl::Status CheckNoRefinement(const RadiosityOptions& options) {
 
 }  // namespace
 
+RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& mesh,
+                                    const FormFactors& form_factors) {
+    const std::vector<Rgb> irradiance = PointLightIrradiance(scene, mesh);
+    RadiositySystem system;
+    system.form_factors = &form_factors;
+    for (size_t s = 0; s < mesh.sides().size(); ++s) {
+        const PatchMesh::Side& side = mesh.sides()[s];
+        const PatchMesh::Patch& patch = mesh.patches()[size_t(side.patch)];
+        const Material& m =
+            scene.scene().materials[size_t(scene.scene().meshes[size_t(patch.mesh)].material)];
+        Rgb e = m.reflectance * irradiance[s];
+        if (!side.back) e += m.emission * float(std::numbers::pi);
+        system.emission.push_back(e);
+        system.reflectance.push_back(m.reflectance);
+        system.area.push_back(patch.area);
+    }
+    return system;
+}
+
 absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks,
     const std::atomic<bool>* cancel) {
@@ -239,7 +266,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     out->form_factors_ = ComputeFormFactors(scene, *mesh, ff_options);
     if (cancel && cancel->load()) return absl::CancelledError("radiosity: form factors cancelled");
     out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
-    out->system_ = MakeSystem(scene, *mesh, out->form_factors_);
+    out->system_ = MakeRadiositySystem(scene, *mesh, out->form_factors_);
     return out;
 }
 

@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <map>
 #include <numbers>
+#include <tuple>
 
 #include "lf/core/scene_loader.h"
 #include "test_scenes.h"
@@ -338,6 +341,104 @@ TEST(FormFactors, ChunkRowsAreTheWholeMatrixRows) {
             }
         }
         EXPECT_EQ(next, groups);
+    }
+}
+
+// Every block with the same rows, columns and value bits.
+void ExpectSameBits(const FormFactors& a, const FormFactors& b) {
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_EQ(a.groups().size(), b.groups().size());
+    ASSERT_EQ(a.blocks().size(), b.blocks().size());
+    for (size_t i = 0; i < a.blocks().size(); ++i) {
+        const FormFactorBlock &x = a.blocks()[i], &y = b.blocks()[i];
+        EXPECT_EQ(
+            std::tie(x.row_group, x.col_group, x.row_begin, x.row_end, x.col_begin, x.col_end),
+            std::tie(y.row_group, y.col_group, y.row_begin, y.row_end, y.col_begin, y.col_end))
+            << "block " << i;
+        ASSERT_EQ(x.values.size(), y.values.size()) << "block " << i;
+        EXPECT_EQ(0, std::memcmp(x.values.data(), y.values.data(), x.values.size() * sizeof(float)))
+            << "block " << i;
+    }
+}
+
+// Pairs of sides (a < b) of `ff` that evaluation reached (not culled with their groups).
+template <typename Pair>
+int64_t CountEvaluatedPairs(const FormFactors& ff, Pair&& counted) {
+    int64_t pairs = 0;
+    for (int32_t a = 0; a < ff.size(); ++a) {
+        for (int32_t b = a + 1; b < ff.size(); ++b) {
+            pairs += ff.Evaluated(ff.GroupOf(a), ff.GroupOf(b)) && counted(a, b);
+        }
+    }
+    return pairs;
+}
+
+// Two refinement steps on the Cornell box, as SolveRefining takes them: a few coarse cells
+// split, then a few more including quarters of the first. Form factors reusing the previous
+// step's are those computed afresh, bit for bit, and only the pairs of sides with a new patch
+// (or one the previous step culled with its group) are evaluated.
+TEST(FormFactors, ReuseAfterASplitIsTheFreshBits) {
+    auto scene = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    auto m = Compute(std::move(*scene), Count(250));
+    PatchMesh previous_mesh = m->mesh;
+    FormFactors previous = m->ff;
+    for (int step = 0; step < 2; ++step) {
+        // One in 25 patches, about 10 cells, like a late refinement pass; in the second step
+        // also a few quarters of the first step's cells.
+        PatchMeshOptions options{previous_mesh.patch_size(), 0, previous_mesh.split()};
+        int quarters = 0;
+        for (int64_t p = 0; p < int64_t(previous_mesh.patches().size()); ++p) {
+            const bool quarter = step == 1 && previous_mesh.patches()[size_t(p)].level == 1;
+            if (p % 25 == step || (quarter && p % 8 == 0)) {
+                options.split.push_back(previous_mesh.Cell(p));
+                quarters += quarter;
+            }
+        }
+        ASSERT_EQ(quarters > 0, step == 1);
+        absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(m->scene, options);
+        ASSERT_TRUE(mesh.ok()) << mesh.status();
+        FormFactorOptions reuse;
+        reuse.previous = {&previous_mesh, &previous};
+        FormFactors reused = ComputeFormFactors(*m->embree, *mesh, reuse);
+        const FormFactors fresh = ComputeFormFactors(*m->embree, *mesh);
+        ExpectSameBits(reused, fresh);
+
+        // The previous side on the same cell, or -1 for a new patch.
+        std::map<PatchCell, int64_t> cells;
+        for (int64_t p = 0; p < int64_t(previous_mesh.patches().size()); ++p) {
+            cells[previous_mesh.Cell(p)] = p;
+        }
+        std::vector<int32_t> old_side(mesh->sides().size(), -1);
+        int32_t new_sides = 0;
+        for (size_t s = 0; s < old_side.size(); ++s) {
+            const PatchMesh::Side& side = mesh->sides()[s];
+            const auto it = cells.find(mesh->Cell(side.patch));
+            if (it == cells.end()) {
+                ++new_sides;
+                continue;
+            }
+            old_side[s] = previous_mesh.patches()[size_t(it->second)].sides[side.back];
+        }
+        ASSERT_GT(new_sides, 0);
+        const int64_t reusable = CountEvaluatedPairs(fresh, [&](int32_t a, int32_t b) {
+            const int32_t oa = old_side[size_t(a)], ob = old_side[size_t(b)];
+            return oa >= 0 && ob >= 0 &&
+                   previous.Evaluated(previous.GroupOf(oa), previous.GroupOf(ob));
+        });
+        EXPECT_EQ(reused.work().reused_pairs, reusable);
+        EXPECT_EQ(reused.work().pairs + reused.work().reused_pairs, fresh.work().pairs);
+        EXPECT_EQ(fresh.work().pairs,
+                  CountEvaluatedPairs(fresh, [](int32_t, int32_t) { return true; }));
+        // 50 to 80 of ~400 sides are new: 1 - (340/400)^2, a quarter to a third of the pairs,
+        // have one.
+        EXPECT_LT(reused.work().pairs, fresh.work().pairs / 2);
+        EXPECT_LT(reused.work().rays, fresh.work().rays / 2);
+        std::printf("step %d: %d of %d sides new; %ld of %ld pairs evaluated, %ld of %ld rays\n",
+                    step, new_sides, reused.size(), reused.work().pairs, fresh.work().pairs,
+                    reused.work().rays, fresh.work().rays);
+        previous_mesh = std::move(*mesh);
+        previous = std::move(reused);
     }
 }
 

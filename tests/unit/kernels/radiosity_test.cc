@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -338,6 +339,54 @@ TEST(Radiosity, RefinementIsLocalAndMeetsTheTarget) {
         EXPECT_GT(coarse, 0) << name;
         EXPECT_GT(fine, 0) << name;
     }
+}
+
+// Each pass reuses the previous pass's form factors for the pairs of patches it did not split,
+// and the result is the bits of computing them all: the final mesh built directly from its split
+// cells, its form factors computed afresh and solved to the same tolerance (the default 1e-4,
+// below target / 10), gives the same radiosity bit for bit.
+TEST(Radiosity, RefinementReusesFormFactorsWithTheSameBits) {
+    const Scene scene = CornellBox();
+    RadiosityOptions options;
+    options.patches = 250;
+    options.target_error = 0.1;
+    ASSERT_LT(options.tolerance, options.target_error / 10);
+    Prepared p = Prepare(scene, options);
+    ASSERT_TRUE(p.renderer.ok()) << p.renderer.status();
+    const RadiosityRenderer& r = **p.renderer;
+
+    absl::StatusOr<PatchMesh> mesh =
+        PatchMesh::Build(scene, {r.mesh().patch_size(), 0, r.mesh().split()});
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    const FormFactors fresh = ComputeFormFactors(*p.embree, *mesh);
+    const absl::StatusOr<SolveResult> solved =
+        SolveRadiosity(MakeRadiositySystem(*p.embree, *mesh, fresh),
+                       {options.solver, options.tolerance, options.max_iterations});
+    ASSERT_TRUE(solved.ok()) << solved.status();
+    ASSERT_EQ(solved->radiosity.size(), r.radiosity().size());
+    for (size_t s = 0; s < solved->radiosity.size(); ++s) {
+        const Rgb &a = solved->radiosity[s], &b = r.radiosity()[s];
+        ASSERT_EQ(std::bit_cast<uint32_t>(a.r), std::bit_cast<uint32_t>(b.r)) << "side " << s;
+        ASSERT_EQ(std::bit_cast<uint32_t>(a.g), std::bit_cast<uint32_t>(b.g)) << "side " << s;
+        ASSERT_EQ(std::bit_cast<uint32_t>(a.b), std::bit_cast<uint32_t>(b.b)) << "side " << s;
+    }
+
+    // Every pass after the first evaluates only the pairs with a new patch. The last one follows
+    // the split of a single cell, 4 new of 527 patches, ~1 % of the pairs (measured: 1.8 k of
+    // 152 k pairs evaluated, 2.1 k of 244 k rays cast).
+    const std::vector<RadiosityRefinementPass>& passes = r.report().refinement;
+    ASSERT_GE(passes.size(), 3u);
+    EXPECT_EQ(passes.front().reused_pairs, 0);
+    for (size_t pass = 1; pass < passes.size(); ++pass) {
+        EXPECT_GT(passes[pass].reused_pairs, 0) << pass;
+    }
+    const RadiosityRefinementPass& last = passes.back();
+    EXPECT_EQ(last.pairs + last.reused_pairs, fresh.work().pairs);
+    EXPECT_LT(last.pairs, fresh.work().pairs / 20);
+    EXPECT_LT(last.visibility_rays, fresh.work().rays / 20);
+    int64_t rays = 0;
+    for (const RadiosityRefinementPass& pass : passes) rays += pass.visibility_rays;
+    EXPECT_EQ(rays, r.report().visibility_rays);
 }
 
 // A budget below what the target needs: refinement stops at it, splitting the worst patches

@@ -40,7 +40,8 @@ struct PatchCell {
 inline constexpr int kMaxPatchLevel = 12;
 
 // The most patches mesh refinement may reach (RadiosityOptions::max_patches): form factors take
-// ~4 bytes per pair of sides, so 32k patches are about 3 GiB.
+// ~4 bytes per pair of sides, so 32k patches are about 3 GiB (and the previous pass's, held
+// while the last pass's are computed, nearly as much again).
 inline constexpr int64_t kMaxRefinedPatches = 32768;
 
 struct PatchMeshOptions {

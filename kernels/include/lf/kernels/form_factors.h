@@ -14,6 +14,11 @@
 // Storage is block-sparse: sides are cut into groups of consecutive sides on one surface side,
 // and every pair of groups that can see each other keeps a dense float block over the rows and
 // columns that hold non-zeros. Time and memory grow as n^2 in the number of sides.
+//
+// A pair's two entries depend on the pair alone, not on the rest of the mesh: refinement's next
+// pass takes those of pairs whose patches were not split from the previous pass's form factors
+// (FormFactorOptions::previous) and evaluates only the pairs with a new patch, with the same bits
+// as evaluating them all.
 #pragma once
 
 #include <atomic>
@@ -47,11 +52,20 @@ struct FormFactorBlock {
     }
 };
 
+// What a computation cost. A pair is an unordered pair of sides; evaluating it casts its rays and
+// integrates both of its entries.
+struct FormFactorWork {
+    int64_t rays = 0;          // visibility rays cast
+    int64_t pairs = 0;         // pairs evaluated
+    int64_t reused_pairs = 0;  // pairs taken from FormFactorOptions::previous
+};
+
 class FormFactors {
   public:
     FormFactors() = default;
+    // `evaluated`: groups x groups, row-major (Evaluated).
     FormFactors(int32_t sides, std::vector<PatchGroup> groups, std::vector<FormFactorBlock> blocks,
-                int64_t rays);
+                std::vector<bool> evaluated, const FormFactorWork& work);
 
     int32_t size() const { return sides_; }
     const std::vector<PatchGroup>& groups() const { return groups_; }
@@ -66,9 +80,16 @@ class FormFactors {
     float At(int32_t i, int32_t j) const;
     double RowSum(int32_t i) const;
 
+    // Whether the entries of the rows of `row_group` in the columns of `col_group` were
+    // evaluated; those of a pair of groups culled as unable to see each other are 0 without
+    // evaluation, and so are those of rows outside a chunk.
+    bool Evaluated(int32_t row_group, int32_t col_group) const {
+        return evaluated_[size_t(row_group) * groups_.size() + size_t(col_group)];
+    }
+
     int64_t nonzeros() const { return nonzeros_; }
     size_t bytes() const { return bytes_; }  // block values and indices
-    int64_t rays() const { return rays_; }   // visibility rays cast
+    const FormFactorWork& work() const { return work_; }
 
   private:
     int32_t sides_ = 0;
@@ -76,9 +97,16 @@ class FormFactors {
     std::vector<FormFactorBlock> blocks_;  // sorted by (row_group, col_group)
     std::vector<int32_t> row_start_;       // blocks of row group g: [row_start_[g], [g+1])
     std::vector<int32_t> col_start_, col_blocks_;
+    std::vector<bool> evaluated_;  // groups x groups, row-major
     int64_t nonzeros_ = 0;
     size_t bytes_ = 0;
-    int64_t rays_ = 0;
+    FormFactorWork work_;
+};
+
+// Form factors computed for another mesh of the same scene.
+struct MeshFormFactors {
+    const PatchMesh* mesh = nullptr;
+    const FormFactors* form_factors = nullptr;
 };
 
 struct FormFactorOptions {
@@ -89,6 +117,11 @@ struct FormFactorOptions {
     int chunk = 0, chunks = 1;
     // Set from another thread: the remaining pairs are skipped (the result is then unusable).
     const std::atomic<bool>* cancel = nullptr;
+    // Refinement's previous pass: a pair of sides whose patches are both cells of that mesh too
+    // (same cell of a triangle with the same subdivision) takes its entries from there if they
+    // were evaluated, instead of being evaluated again. The result is bit for bit that of
+    // evaluating every pair (docs/radiosity.md). Both pointers or neither.
+    MeshFormFactors previous;
 };
 
 // Chunk `chunk` of `chunks` of `groups` patch groups: [groups * chunk / chunks,

@@ -56,6 +56,10 @@ struct RadiosityRefinementPass {
     int64_t sides = 0;
     double max_error = 0, mean_error = 0;  // estimated (EstimateDiscretisationError)
     int64_t split = 0;                     // cells split after it
+    // Its form factors: those of pairs of patches not split since the previous pass are reused.
+    double form_factor_seconds = 0;
+    int64_t visibility_rays = 0;
+    int64_t pairs = 0, reused_pairs = 0;  // pairs of sides evaluated and reused (FormFactorWork)
 };
 
 struct RadiosityReport {
@@ -131,6 +135,11 @@ class RadiositySweepChunk {
 // and for a target error (the sweeps solve an unrefined mesh).
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity);
+
+// The system B = E + ρ F B of `mesh`: E the exitance π L_e of emitters' front sides plus the
+// point lights' direct light reflected.
+RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& mesh,
+                                    const FormFactors& form_factors);
 
 // Options from plain values, as `render`, `submit` and the farm's workers receive them;
 // InvalidArgument naming a bad solver or display name.
