@@ -97,7 +97,7 @@ absl::StatusOr<std::vector<RenderTask>> AdaptiveTilePlan::Merge(int t, const Til
     const int tile_index = tile_of_[size_t(t)];
     Tile& tile = tiles_[size_t(tile_index)];
     tile.sums += sums;
-    tile.error = EstimatedRelativeError(tile.sums);
+    tile.error = EstimatedTileError(tile.sums);
     std::erase(tile.pending, t);
     // The pass's other tasks are still out: the tile decides on the whole pass.
     if (!tile.pending.empty()) return std::vector<RenderTask>();

@@ -18,9 +18,9 @@
 
 namespace lf {
 
-// Each tile gets passes of samples until its estimated relative error (EstimatedRelativeError,
-// from the A/B halves) is at most target_error, it has max_spp samples, or the time limit has
-// passed. Every tile gets its first pass whatever the time limit.
+// Each tile gets passes of samples until its estimated relative error (EstimatedTileError, the
+// square root of its relMSE from the A/B halves) is at most target_error, it has max_spp
+// samples, or the time limit has passed. Every tile gets its first pass whatever the time limit.
 struct AdaptiveSettings {
     double target_error = 0;  // relative; 0: none
     double time_limit = 0;    // seconds; 0: none
@@ -43,7 +43,7 @@ struct AdaptiveReport {
     struct Tile {
         PixelRect rect;
         uint64_t spp = 0;
-        double error = 0;  // EstimatedRelativeError at the end
+        double error = 0;  // EstimatedTileError at the end
     };
     std::vector<Tile> per_tile;  // in plan order
 };

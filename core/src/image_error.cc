@@ -92,19 +92,17 @@ absl::StatusOr<VarianceAssessment> AssessVariance(const Image& image) {
     return a;
 }
 
-double EstimatedRelativeError(const TileSums& tile) {
-    double squared = 0, mean = 0;
+double EstimatedTileError(const TileSums& tile) {
+    double relmse = 0;
     for (const PixelSums& p : tile.pixels) {
         if (p.count[0] == 0 || p.count[1] == 0) return 1;
         const Rgb half = (p.HalfMean(0) - p.HalfMean(1)) * 0.5f, m = p.Mean();
         for (int c = 0; c < 3; ++c) {
-            squared += double(half[c]) * half[c];
-            mean += m[c];
+            relmse += double(half[c]) * half[c] / (double(m[c]) * m[c] + kRelativeErrorEpsilon);
         }
     }
     const double n = 3.0 * double(tile.pixels.size());
-    if (n == 0) return 0;
-    return std::sqrt(squared / n) / (mean / n + kRelativeErrorFloor);
+    return n == 0 ? 0 : std::sqrt(relmse / n);
 }
 
 absl::StatusOr<double> EstimatedRelativeError(const Image& image) {

@@ -117,23 +117,37 @@ TEST_F(AdaptiveSampling, TrueErrorMatchesTheEstimate) {
         true_relative / out.adaptive.estimated_error, (unsigned long long)out.adaptive.min_spp,
         (unsigned long long)out.adaptive.max_spp, d_mean, d_error);
 
-    // Tile by tile, for the record (a tile's 256 pixels give a noisy truth, so no check):
-    // the true relative RMSE over the estimate.
-    std::vector<double> ratios;
+    // Tile by tile, for the record (a tile's 256 pixels give a noisy truth, so no check): the
+    // true RMSE over the estimate, and the true sqrt(relMSE), what the target bounds (each
+    // pixel's squared error over its reference value squared + epsilon, channels averaged).
+    std::vector<double> ratios, relative;
     for (const AdaptiveReport::Tile& tile : out.adaptive.per_tile) {
-        double t = 0, e = 0;
+        double t = 0, e = 0, rel = 0;
         for (int y = tile.rect.y0; y < tile.rect.y0 + tile.rect.height; ++y) {
             for (int x = tile.rect.x0; x < tile.rect.x0 + tile.rect.width; ++x) {
                 const size_t i = size_t(y) * kResolution + x;
                 t += truth[i] - ref_noise[i];
                 e += own[i];
+                for (const char* c : {"R", "G", "B"}) {
+                    const double v = (*out.image.FindChannel(c))[i];
+                    const double r = (*reference->image.FindChannel(c))[i];
+                    const double h =
+                        0.5 * ((*reference->image.FindChannel(std::string("A.") + c))[i] -
+                               (*reference->image.FindChannel(std::string("B.") + c))[i]);
+                    rel += ((v - r) * (v - r) - h * h) / (r * r + kRelativeErrorEpsilon) / 3;
+                }
             }
         }
         if (e > 0) ratios.push_back(std::sqrt(std::max(0.0, t) / e));
+        relative.push_back(std::sqrt(std::max(0.0, rel / double(tile.rect.Area()))) / tile.error);
     }
     std::sort(ratios.begin(), ratios.end());
+    std::sort(relative.begin(), relative.end());
     std::printf("per tile true / estimated: min %.2f, median %.2f, max %.2f over %zu tiles\n",
                 ratios.front(), ratios[ratios.size() / 2], ratios.back(), ratios.size());
+    std::printf(
+        "per tile true sqrt(relMSE) / estimated: min %.2f, median %.2f, max %.2f (target %.3f)\n",
+        relative.front(), relative[relative.size() / 2], relative.back(), kTarget);
 }
 
 TEST_F(AdaptiveSampling, IsDeterministicForAnyThreadCount) {

@@ -87,5 +87,27 @@ TEST(ImageError, LogLogSlopeOfAPowerLaw) {
     EXPECT_FALSE(LogLogSlope({{1, 1}, {2, 0}}).ok());
 }
 
+// A tile's stopping error is the square root of the relMSE the same pixels give as an image, so
+// each pixel counts relative to itself: a bright pixel does not hide its dim neighbours' noise.
+TEST(EstimatedTileError, IsTheSquareRootOfTheTilesRelMse) {
+    TileSums tile(PixelRect{0, 0, 4, 2});
+    for (int i = 0; i < 8; ++i) {
+        // One bright, steady pixel, as a light; dim ones off by 20 %.
+        const float base = i == 0 ? 20.0f : 0.2f, spread = i == 0 ? 0.0f : 0.2f;
+        for (uint64_t s = 0; s < 16; ++s) {
+            tile.pixels[size_t(i)].Add(s, Rgb(base * (1 + (s % 2 ? spread : -spread))));
+        }
+    }
+    Image image(4, 2);
+    image.SetTile(tile);
+    const double relmse = EstimatedRelMse(image).value();
+    EXPECT_NEAR(EstimatedTileError(tile), std::sqrt(relmse), 1e-6 * std::sqrt(relmse));
+    // Relative to the tile's mean, the bright pixel would make the dim ones' noise look small.
+    EXPECT_GT(EstimatedTileError(tile), 5 * EstimatedRelativeError(image).value());
+
+    TileSums fresh(PixelRect{0, 0, 2, 2});
+    EXPECT_EQ(EstimatedTileError(fresh), 1);  // no samples: no estimate yet
+}
+
 }  // namespace
 }  // namespace lf

@@ -57,13 +57,17 @@ absl::StatusOr<VarianceAssessment> AssessVariance(const Image& image);
 // black region is done at once instead of chasing 0/0.
 inline constexpr double kRelativeErrorFloor = 1e-3;
 
-// The relative error a tile estimates for itself, as Dammertz et al. 2009 do per block:
-// sqrt(mean over pixels and channels of ((A - B) / 2)^2) / (mean radiance + floor). 1 when a
-// pixel has fewer than 2 samples (no estimate yet).
-double EstimatedRelativeError(const TileSums& tile);
-
-// The same over a whole image, from its R,G,B and A.*, B.* channels.
+// The relative error of a whole image: sqrt(mean over pixels and channels of ((A - B) / 2)^2) /
+// (mean radiance + floor), from its R,G,B and A.*, B.* channels. Bright pixels dominate it.
 absl::StatusOr<double> EstimatedRelativeError(const Image& image);
+
+// The error a tile estimates for itself, the stopping rule of adaptive sampling: the square root
+// of its relMSE estimate (EstimatedRelMse over the tile's pixels), each pixel's error relative
+// to its own value, as Dammertz et al. 2009 and Cycles normalise per pixel. Normalising by the
+// tile's mean instead let a tile's few bright pixels (a light's edge) hide the noise of the
+// rest: at equal cost the image's relMSE came out 3x that of uniform sampling (measured,
+// docs/convergence.md). 1 when a pixel has fewer than 2 samples (no estimate yet).
+double EstimatedTileError(const TileSums& tile);
 
 // Least-squares slope of log(y) against log(x); the points must be positive, at least two,
 // with distinct x (InvalidArgument otherwise).
