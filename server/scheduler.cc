@@ -317,7 +317,8 @@ bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
                 job.record.id, job.record.spec.adaptive.time_limit, dropped.size(),
                 job.merger->tasks_done());
     Save(job);
-    return job.merger->Complete();
+    // When nothing was dropped, the last result completed the job and Complete said so.
+    return !dropped.empty() && job.merger->Complete();
 }
 
 std::vector<std::string> Scheduler::EnforceTimeLimits() {

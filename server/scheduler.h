@@ -197,7 +197,8 @@ class Scheduler {
     static absl::StatusOr<std::unique_ptr<Job>> NewJob(JobRecord record);
     // Queues a task the adaptive plan appended.
     void QueuePass(Job& job, const RenderTask& pass);
-    // Drops an adaptive job's passes once its time limit has passed; true if that completed it.
+    // Drops an adaptive job's passes once its time limit has passed; true if dropping them
+    // completed the job (so that it is reported once, here or by Complete).
     bool EnforceTimeLimit(Job& job, absl::Time now);
     // A sweep task goes to its chunk's owner while that worker lives.
     bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;

@@ -364,6 +364,7 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
     now_ += absl::Seconds(5);
     EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
+    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());   // reported once
     EXPECT_FALSE(scheduler_.Heartbeat(running->id, "w"));  // the worker stops
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
     // Its late result changes nothing.
@@ -377,6 +378,22 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     ASSERT_TRUE(snapshot.ok());
     EXPECT_TRUE(snapshot->adaptive->timed_out);
     EXPECT_EQ(snapshot->adaptive->max_spp, 4u);
+}
+
+// A job its last result completed is reported by Complete, and not again by the time limit.
+TEST_F(SchedulerTest, TimeLimitDoesNotReportAJobItsLastResultCompleted) {
+    const std::string id = SubmitAdaptive(scheduler_, {.target_error = 0.5, .time_limit = 5});
+    bool rendered = false;
+    while (std::optional<Lease> lease = scheduler_.LeaseTask("w")) {
+        absl::StatusOr<Scheduler::Completion> done =
+            scheduler_.Complete(lease->id, "w", HalvesResult(*lease));
+        ASSERT_TRUE(done.ok());
+        rendered |= done->job_rendered;
+    }
+    EXPECT_TRUE(rendered);
+    EXPECT_EQ(Job(id).tasks_done, 4);
+    now_ += absl::Seconds(6);
+    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
 }
 
 }  // namespace
