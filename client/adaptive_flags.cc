@@ -1,6 +1,6 @@
 #include "adaptive_flags.h"
 
-#include "server/plan.h"
+#include "lf/job/plan.h"
 
 namespace lf {
 

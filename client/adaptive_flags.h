@@ -3,7 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "server/adaptive_plan.h"
+#include "lf/job/adaptive_plan.h"
 
 namespace lf {
 

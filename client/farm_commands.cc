@@ -19,11 +19,12 @@
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "progress_bar.h"
 #include "proto/grpc_status.h"
-#include "proto/radiosity_params.h"
+#include "lf/wire/conversions.h"
 #include "radiosity_flags.h"
-#include "server/digest.h"
-#include "server/plan.h"
-#include "server/scene_files.h"
+#include "lf/job/digest.h"
+#include "lf/job/job_spec.h"
+#include "lf/job/plan.h"
+#include "lf/job/scene_files.h"
 
 namespace lf {
 
@@ -118,16 +119,7 @@ absl::Status Upload(pb::JobService::Stub& stub, const LocalFile& file, const std
 struct SubmitOptions {
     FarmFlags farm;
     std::string scene_path;
-    std::string name;
-    uint64_t spp = 16;
-    uint64_t seed = 0;
-    int max_depth = -1;
-    int tile = 32;
-    int passes = 1;
-    int priority = 0;
-    std::string method = "path";
-    RadiositySettings radiosity;
-    AdaptiveSettings adaptive;
+    JobSpec spec;  // the scene and files are filled in by Submit
 };
 
 absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
@@ -182,25 +174,17 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
         }
     }
 
-    pb::SubmitJobRequest req;
-    *req.mutable_scene() = files[0].ref;
-    for (size_t i = 1; i < files.size(); ++i) *req.add_files() = files[i].ref;
-    req.set_name(o.name.empty() ? scene_path.filename().string() : o.name);
-    req.set_priority(o.priority);
-    pb::RenderParams* params = req.mutable_params();
-    params->set_spp(o.spp);
-    params->set_seed(o.seed);
-    params->set_max_depth(o.max_depth);
-    params->set_tile(o.tile);
-    params->set_passes(o.passes);
-    params->set_method(o.method);
-    if (o.method == "radiosity") lf::ToProto(o.radiosity, params->mutable_radiosity());
-    params->set_target_error(o.adaptive.target_error);
-    params->set_time_limit_seconds(o.adaptive.time_limit);
-    params->set_max_spp(o.adaptive.max_spp);
+    JobSpec spec = o.spec;
+    std::vector<BlobRef> refs;
+    for (const LocalFile& f : files) refs.push_back(FromProto(f.ref));
+    spec.scene = refs[0];
+    spec.files.assign(refs.begin() + 1, refs.end());
+    if (spec.name.empty()) spec.name = scene_path.filename().string();
     // A retry after a lost answer (the server restarting, say) gets the job of the first attempt.
-    req.set_request_id(Sha256Hex(
-        absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string())));
+    spec.request_id = Sha256Hex(
+        absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string()));
+    pb::SubmitJobRequest req;
+    ToProto(spec, &req);
     pb::SubmitJobResponse resp;
     for (int attempt = 1;; ++attempt) {
         // The server loads the scene to check it, which takes a while for large meshes.
@@ -326,34 +310,34 @@ Command AddSubmitCommand(CLI::App& app) {
         ->required()
         ->check(CLI::ExistingFile);
     AddServerOption(cmd, o->farm);
-    cmd->add_option("--spp", o->spp, "samples per pixel")
+    cmd->add_option("--spp", o->spec.plan.spp, "samples per pixel")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(1), kMaxSpp));
-    cmd->add_option("--seed", o->seed, "random seed")->capture_default_str();
-    cmd->add_option("--max-depth", o->max_depth,
+    cmd->add_option("--seed", o->spec.seed, "random seed")->capture_default_str();
+    cmd->add_option("--max-depth", o->spec.max_depth,
                     "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
         ->capture_default_str()
         ->check(CLI::Range(-1, 1 << 20));
-    cmd->add_option("--tile", o->tile, "tile side in pixels")
+    cmd->add_option("--tile", o->spec.plan.tile, "tile side in pixels")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxFarmTile));
-    cmd->add_option("--passes", o->passes,
+    cmd->add_option("--passes", o->spec.plan.passes,
                     "sample passes per tile; each pass of each tile is one task")
         ->capture_default_str()
         ->check(CLI::Range(1, 1 << 20));
-    AddAdaptiveFlags(cmd, o->adaptive);
-    cmd->add_option("--priority", o->priority, "higher runs first; equal: oldest first")
+    AddAdaptiveFlags(cmd, o->spec.adaptive);
+    cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
-    cmd->add_option("--name", o->name, "job name (default: the scene file's name)");
-    cmd->add_option("--method", o->method,
+    cmd->add_option("--name", o->spec.name, "job name (default: the scene file's name)");
+    cmd->add_option("--method", o->spec.method,
                     "path, or radiosity (Lambertian scenes; same bits as `lightfarm render "
                     "--method radiosity` with the same options)")
         ->capture_default_str()
         ->check(CLI::IsMember({"path", "radiosity"}));
     // The farm's own solver: its sweeps split into patch-group tasks.
-    o->radiosity.solver = "jacobi";
-    AddRadiosityFlags(cmd, o->radiosity);
-    cmd->add_option("--sweep-tasks", o->radiosity.sweep_tasks,
+    o->spec.radiosity.solver = "jacobi";
+    AddRadiosityFlags(cmd, o->spec.radiosity);
+    cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
                     "--solver jacobi: patch-group tasks per sweep; each worker computes the "
                     "form-factor rows of its groups once and keeps them. Gauss-Seidel and "
                     "shooting update one group after another, so with them every worker "

@@ -15,7 +15,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "progress_bar.h"
-#include "server/render_metadata.h"
+#include "lf/job/render_metadata.h"
 
 namespace lf {
 

@@ -7,7 +7,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/scene.h"
 #include "lf/kernels/radiosity.h"
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 
 namespace lf {
 

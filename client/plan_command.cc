@@ -14,9 +14,9 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 #include "local_render.h"
-#include "server/plan.h"
+#include "lf/job/plan.h"
 
 namespace lf {
 

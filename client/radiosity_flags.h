@@ -3,7 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "server/plan.h"
+#include "lf/job/plan.h"
 
 namespace lf {
 

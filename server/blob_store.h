@@ -10,7 +10,7 @@
 #include <string_view>
 
 #include "absl/status/statusor.h"
-#include "server/digest.h"
+#include "lf/job/digest.h"
 
 namespace lf {
 

@@ -11,7 +11,7 @@
 #include "lf/core/patch_mesh.h"
 #include "lf/core/radiosity_codec.h"
 #include "lf/core/tile_codec.h"
-#include "server/render_metadata.h"
+#include "lf/job/render_metadata.h"
 #include "server/sqlite_job_store.h"
 
 namespace lf {

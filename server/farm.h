@@ -26,7 +26,6 @@ struct FarmOptions {
     std::string data_dir;  // jobs.db, blobs/, results/, previews/, scratch/ go here
     SchedulerOptions scheduler;
     JobLimits limits;
-    absl::Duration heartbeat_interval = absl::Milliseconds(300);
 };
 
 class Farm {

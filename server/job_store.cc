@@ -4,22 +4,6 @@
 
 namespace lf {
 
-const char* JobStateName(JobState state) {
-    switch (state) {
-        case JobState::kQueued:
-            return "queued";
-        case JobState::kRunning:
-            return "running";
-        case JobState::kSucceeded:
-            return "succeeded";
-        case JobState::kFailed:
-            return "failed";
-        case JobState::kCancelled:
-            return "cancelled";
-    }
-    return "unknown";
-}
-
 uint64_t InMemoryJobStore::QueuePut(const JobRecord& job) {
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_[job.id] = job;

@@ -13,51 +13,9 @@
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
-#include "lf/core/film.h"
-#include "server/adaptive_plan.h"
-#include "server/plan.h"
-#include "server/scene_files.h"
+#include "lf/job/job_record.h"
 
 namespace lf {
-
-struct JobSpec {
-    std::string name;
-    BlobRef scene;               // the scene JSON
-    std::vector<BlobRef> files;  // the files it names
-    RenderPlanSettings plan;     // width and height come from the scene
-    uint64_t seed = 0;
-    int max_depth = -1;
-    std::string method = "path";  // or "radiosity"
-    RadiositySettings radiosity;
-    AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused
-    int priority = 0;           // higher first
-    std::string scene_hash;     // the loader's content hash, for the EXR header
-    std::string request_id;     // the client's, for idempotent retries; "" for none
-};
-
-// Radiosity jobs the farm solves in patch-group tasks per sweep, rather than on every worker.
-// Not adaptive ones: their passes are appended to the tasks where the sweeps would go.
-inline bool SolvedInSweeps(const JobSpec& spec) {
-    return spec.method == "radiosity" && spec.radiosity.solver == "jacobi" &&
-           !IsAdaptive(spec.adaptive);
-}
-
-enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled };
-const char* JobStateName(JobState state);
-inline bool IsFinal(JobState s) { return s != JobState::kQueued && s != JobState::kRunning; }
-
-struct JobRecord {
-    std::string id;
-    uint64_t seq = 0;  // submission order
-    JobSpec spec;
-    JobState state = JobState::kQueued;
-    std::string error;
-    absl::Time submitted, started = absl::InfinitePast(), finished = absl::InfinitePast();
-    int tasks_total = 0, tasks_done = 0, tasks_running = 0, retries = 0;
-    int tasks_leased = 0;  // leases ever handed out, across server restarts: renders started
-    RenderStats stats;
-    std::string result_path;  // the EXR, once succeeded
-};
 
 class JobStore {
   public:

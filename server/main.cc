@@ -12,7 +12,7 @@
 
 #include "server/farm.h"
 #include "server/grpc_service.h"
-#include "server/stop_signals.h"
+#include "lf/core/stop_signals.h"
 
 int main(int argc, char** argv) {
     const lf::StopSignals stop_signals;  // before any thread starts
@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     options.limits.max_scene_bytes = max_scene_mb << 20;
     // Often enough that a cancel reaches workers within about a second, and several times per
     // lease so one slow answer does not lose it.
-    options.heartbeat_interval = std::min(absl::Milliseconds(300), options.scheduler.lease / 4);
+    options.scheduler.heartbeat_interval = std::min(absl::Milliseconds(300), options.scheduler.lease / 4);
 
     absl::StatusOr<std::unique_ptr<lf::Farm>> farm = lf::Farm::Open(options);
     if (!farm.ok()) {

@@ -177,10 +177,10 @@ bool Scheduler::OtherWorkersAlive(const std::string& worker, absl::Time now) con
     return false;
 }
 
-std::optional<Lease> Scheduler::LeaseTask(const std::string& worker, absl::Time wait_until) {
+std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker, absl::Time wait_until) {
     std::unique_lock<std::mutex> lock(mutex_);
     while (true) {
-        if (std::optional<Lease> lease = TryLease(worker)) return lease;
+        if (std::optional<TaskAssignment> lease = TryLease(worker)) return lease;
         const uint64_t version = version_;
         if (shutdown_ || !changed_.wait_until(lock, absl::ToChronoTime(wait_until),
                                               [&] { return version_ != version || shutdown_; })) {
@@ -189,7 +189,7 @@ std::optional<Lease> Scheduler::LeaseTask(const std::string& worker, absl::Time 
     }
 }
 
-std::optional<Lease> Scheduler::TryLease(const std::string& worker) {
+std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker) {
     const absl::Time now = clock_();
     workers_seen_[worker] = now;
     // A task that failed here goes to another worker when there is one.
@@ -243,7 +243,7 @@ std::string Scheduler::LeaseId(const Job& job, int task, int attempt) const {
     return absl::StrCat(job.record.id, "/", task, "/", boot_, "-", attempt);
 }
 
-Lease Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time now) {
+TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time now) {
     Task& task = job.tasks[size_t(t)];
     if (task.state == TaskState::kQueued) {
         job.queued.erase(t);
@@ -264,14 +264,24 @@ Lease Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time no
     Save(job);
     Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, worker,
                  task.attempts);
+    TaskAssignment lease;
+    lease.lease_id = lease_id;
+    lease.job_id = job.record.id;
+    lease.spec = job.record.spec;
+    lease.lease = options_.lease;
+    lease.heartbeat_interval = options_.heartbeat_interval;
     if (!IsSweepTask(job, t)) {
-        return Lease{lease_id, job.record.id, job.merger->tasks()[size_t(t)], job.record.spec, -1,
-                     0,        job.solution};
+        lease.task = job.merger->tasks()[size_t(t)];
+        lease.radiosity_hash = job.solution;
+        return lease;
     }
     const int k = t - int(job.merger->tasks().size()), chunks = job.solve->chunks();
     job.chunk_owner[k % chunks] = worker;
-    return Lease{lease_id,   job.record.id, RenderTask{t, {}, 0, 0}, job.record.spec,
-                 k / chunks, k % chunks,    job.sweep_input};
+    lease.task.index = t;
+    lease.sweep = k / chunks;
+    lease.chunk = k % chunks;
+    lease.radiosity_hash = job.sweep_input;
+    return lease;
 }
 
 void Scheduler::QueueStart(Job& job) {

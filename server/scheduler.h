@@ -19,10 +19,11 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/image.h"
-#include "server/adaptive_plan.h"
+#include "lf/job/adaptive_plan.h"
+#include "lf/job/task_assignment.h"
 #include "server/job_store.h"
 #include "server/lease_timeouts.h"
-#include "server/merge.h"
+#include "lf/job/merge.h"
 #include "server/radiosity_solve.h"
 
 namespace lf {
@@ -34,18 +35,8 @@ struct SchedulerOptions {
     // running longer than this and longer than twice the job's mean task time; the first result
     // wins (both are the same bits), so one slow worker does not hold the job.
     absl::Duration speculate_after = absl::Seconds(1);
-};
-
-struct Lease {
-    std::string id;
-    std::string job_id;
-    RenderTask task;  // a tile; for a sweep task only its index
-    JobSpec spec;
-    // Radiosity jobs solved in sweeps (SolvedInSweeps): a patch-group task of sweep `sweep`
-    // (>= 0) reads the blob `radiosity_hash` ("" in sweep 0: the emission, which workers
-    // compute); a display tile (sweep -1) reads the solution from it.
-    int sweep = -1, chunk = 0;
-    std::string radiosity_hash;
+    // How often workers heartbeat, told to them with each lease.
+    absl::Duration heartbeat_interval = absl::Milliseconds(300);
 };
 
 enum class FailureKind {
@@ -74,7 +65,7 @@ class Scheduler {
     // failed on this worker; when none is queued, a straggler's task (see speculate_after). Waits
     // until `wait_until` for one to be queued (a long poll: an idle worker starts on a new job at
     // once); nullopt when there is nothing to do.
-    std::optional<Lease> LeaseTask(const std::string& worker,
+    std::optional<TaskAssignment> LeaseTask(const std::string& worker,
                                    absl::Time wait_until = absl::InfinitePast());
 
     // Extends the lease. False means stop: the job was cancelled or the lease is gone.
@@ -186,7 +177,7 @@ class Scheduler {
     // The job of an earlier submission with this request id, and the store ticket to wait for.
     std::optional<std::pair<std::string, uint64_t>> FindRequest(
         const std::string& request_id) const;
-    std::optional<Lease> TryLease(const std::string& worker);
+    std::optional<TaskAssignment> TryLease(const std::string& worker);
     // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
     void QueueStart(Job& job);
     void QueueSweep(Job& job);
@@ -212,7 +203,7 @@ class Scheduler {
     void MarkDone(Job& job, int task, absl::Time now);
     // A second lease of a task running too long in the job, or -1 (see speculate_after).
     int StragglerFor(const Job& job, const std::string& worker, absl::Time now) const;
-    Lease Grant(Job& job, int task, const std::string& worker, absl::Time now);
+    TaskAssignment Grant(Job& job, int task, const std::string& worker, absl::Time now);
     std::string LeaseId(const Job& job, int task, int attempt) const;
     // Where a lease id of this server points, whether or not the lease is still current; nullopt
     // for ids it never handed out (forged, or from before a restart).

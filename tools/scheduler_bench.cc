@@ -30,7 +30,7 @@ lf::JobSpec Spec() {
     return spec;
 }
 
-lf::TileSums Result(const lf::Lease& lease) {
+lf::TileSums Result(const lf::TaskAssignment& lease) {
     lf::TileSums sums(lease.task.rect);
     for (lf::PixelSums& p : sums.pixels) {
         for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
@@ -66,10 +66,10 @@ void Capacity(const fs::path& dir, int workers, double seconds) {
         threads.emplace_back([&, w] {
             const std::string name = "w" + std::to_string(w);
             while (!stop) {
-                std::optional<lf::Lease> lease = scheduler.LeaseTask(name);
+                std::optional<lf::TaskAssignment> lease = scheduler.LeaseTask(name);
                 if (!lease) break;
                 ++leases;
-                if (scheduler.Complete(lease->id, name, Result(*lease)).ok()) ++completions;
+                if (scheduler.Complete(lease->lease_id, name, Result(*lease)).ok()) ++completions;
             }
             ++finished;  // out of tasks
         });
@@ -98,8 +98,8 @@ void Recovery(const fs::path& dir, int jobs) {
             const std::string id = *scheduler.Submit(spec);
             // Half of each job done, so recovery merges results back too.
             for (int t = 0; t < 64; ++t) {
-                std::optional<lf::Lease> lease = scheduler.LeaseTask("w");
-                if (!lease || !scheduler.Complete(lease->id, "w", Result(*lease)).ok()) {
+                std::optional<lf::TaskAssignment> lease = scheduler.LeaseTask("w");
+                if (!lease || !scheduler.Complete(lease->lease_id, "w", Result(*lease)).ok()) {
                     std::fprintf(stderr, "scheduler_bench: job %s: no lease\n", id.c_str());
                     std::exit(1);
                 }

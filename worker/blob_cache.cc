@@ -7,7 +7,7 @@
 #include <fstream>
 #include <vector>
 
-#include "server/digest.h"
+#include "lf/job/digest.h"
 
 namespace lf {
 

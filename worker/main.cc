@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <thread>
 
-#include "server/stop_signals.h"
+#include "lf/core/stop_signals.h"
 #include "worker/worker.h"
 
 int main(int argc, char** argv) {

@@ -6,43 +6,11 @@
 
 #include "lightfarm/v1/worker_service.grpc.pb.h"
 #include "proto/grpc_status.h"
-#include "proto/radiosity_params.h"
+#include "lf/wire/conversions.h"
 
 namespace lf {
 
 namespace pb = lightfarm::v1;
-
-namespace {
-
-BlobRef FromProto(const pb::SceneFile& f) { return {f.path(), f.hash(), f.size()}; }
-
-TaskAssignment FromProto(const pb::Task& t) {
-    TaskAssignment task;
-    task.lease_id = t.lease_id();
-    task.job_id = t.job_id();
-    task.task_index = t.task_index();
-    task.scene = FromProto(t.scene());
-    for (const pb::SceneFile& f : t.files()) task.files.push_back(FromProto(f));
-    task.seed = t.params().seed();
-    task.max_depth = t.params().max_depth();
-    if (!t.params().method().empty()) task.method = t.params().method();
-    if (t.params().has_radiosity()) task.radiosity = lf::FromProto(t.params().radiosity());
-    task.target_error = t.params().target_error();
-    if (t.kind() == pb::Task::RADIOSITY_SWEEP) {
-        task.sweep = t.sweep();
-        task.chunk = t.chunk();
-    }
-    task.radiosity_hash = t.radiosity_hash();
-    task.rect = {t.x0(), t.y0(), t.width(), t.height()};
-    task.sample_begin = t.sample_begin();
-    task.sample_end = t.sample_end();
-    if (t.heartbeat_interval_ms() > 0) {
-        task.heartbeat_interval = absl::Milliseconds(t.heartbeat_interval_ms());
-    }
-    return task;
-}
-
-}  // namespace
 
 struct ServerConnection::Stub {
     std::unique_ptr<pb::WorkerService::Stub> stub;

@@ -9,30 +9,9 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/film.h"
-#include "server/plan.h"
-#include "server/scene_files.h"
+#include "lf/job/task_assignment.h"
 
 namespace lf {
-
-struct TaskAssignment {
-    std::string lease_id;
-    std::string job_id;
-    int task_index = 0;
-    BlobRef scene;
-    std::vector<BlobRef> files;
-    uint64_t seed = 0;
-    int max_depth = -1;
-    std::string method = "path";  // or "radiosity"
-    RadiositySettings radiosity;
-    double target_error = 0;  // the job's; radiosity refines its mesh to it
-    PixelRect rect;
-    uint64_t sample_begin = 0, sample_end = 0;
-    // A radiosity patch-group task when sweep >= 0 (see Lease in server/scheduler.h); the blob
-    // it reads, or a display tile's solution.
-    int sweep = -1, chunk = 0;
-    std::string radiosity_hash;
-    absl::Duration heartbeat_interval = absl::Milliseconds(300);
-};
 
 class ServerConnection {
   public:

@@ -21,11 +21,11 @@ namespace {
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("worker"); }
 
 absl::StatusOr<RadiosityOptions> RadiosityOptionsFor(const TaskAssignment& task) {
-    const RadiositySettings& r = task.radiosity;
+    const RadiositySettings& r = task.spec.radiosity;
     absl::StatusOr<RadiosityOptions> options = MakeRadiosityOptions(
         r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
     if (!options.ok()) return options.status();
-    options->target_error = task.target_error;
+    options->target_error = task.spec.adaptive.target_error;
     options->max_patches = r.max_patches;
     return options;
 }
@@ -121,7 +121,7 @@ void Worker::Execute(const TaskAssignment& task) {
         current_cancel_ = nullptr;
     }
 
-    const std::string ids = "job=" + task.job_id + " task=" + std::to_string(task.task_index);
+    const std::string ids = "job=" + task.job_id + " task=" + std::to_string(task.task.index);
     // A result that was finished before a stop was asked for is still worth sending.
     if (dropped) {
         Log()->info("{} dropped: the job was cancelled or the lease lost", ids);
@@ -142,8 +142,8 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
     auto fetch = [&](const std::string& hash, const std::string& path) {
         return server_.FetchBlob(hash, path);
     };
-    std::vector<const BlobRef*> refs = {&task.scene};
-    for (const BlobRef& ref : task.files) refs.push_back(&ref);
+    std::vector<const BlobRef*> refs = {&task.spec.scene};
+    for (const BlobRef& ref : task.spec.files) refs.push_back(&ref);
     std::map<std::string, std::string> files;  // hash -> cached file
     for (const BlobRef* ref : refs) {
         absl::StatusOr<std::string> path = cache_.Get(ref->hash, fetch);
@@ -151,7 +151,7 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
         files[ref->hash] = *path;
     }
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
-        task.scene, task.files, [&](const std::string& hash) { return files[hash]; },
+        task.spec.scene, task.spec.files, [&](const std::string& hash) { return files[hash]; },
         options_.scratch_dir + "/" + task.job_id);
     cache_.Trim();
     if (!scene.ok()) return scene.status();
@@ -163,14 +163,14 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
     loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
     loaded.job_id = task.job_id;
     loaded_ = std::move(loaded);
-    Log()->info("job={} task={} scene {} loaded", task.job_id, task.task_index, task.scene.path);
+    Log()->info("job={} task={} scene {} loaded", task.job_id, task.task.index, task.spec.scene.path);
     return absl::OkStatus();
 }
 
 absl::Status Worker::PrepareTracer(const TaskAssignment& task) {
     if (loaded_.tracer) return absl::OkStatus();
-    if (task.method != "radiosity") {
-        loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.max_depth);
+    if (task.spec.method != "radiosity") {
+        loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.spec.max_depth);
         return absl::OkStatus();
     }
     absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);
@@ -206,7 +206,7 @@ absl::StatusOr<std::vector<Rgb>> Worker::ReadRadiosity(const std::string& hash) 
 
 absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
                                           const std::atomic<bool>& cancel) {
-    const RadiositySettings& r = task.radiosity;
+    const RadiositySettings& r = task.spec.radiosity;
     std::unique_ptr<RadiositySweepChunk>& chunk = loaded_.chunks[task.chunk];
     if (!chunk) {
         absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);
@@ -223,7 +223,7 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
         }
         chunk = std::move(*built);
         Log()->info("job={} task={} form factors of chunk {}/{} in {:.2f} s", task.job_id,
-                    task.task_index, task.chunk, r.sweep_tasks,
+                    task.task.index, task.chunk, r.sweep_tasks,
                     absl::ToDoubleSeconds(absl::Now() - start));
     }
     std::span<const Rgb> input = chunk->emission();
@@ -247,7 +247,7 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
     // stops the work within a fraction of a second (RenderTile checks between rows), and exact
     // sums make any split of the tile give the same bits.
     constexpr uint64_t kSamplesPerPiece = 1 << 16;
-    const PixelRect& rect = task.rect;
+    const PixelRect& rect = task.task.rect;
     const uint64_t step = std::max<uint64_t>(1, kSamplesPerPiece / uint64_t(rect.width));
     TileSums tile(rect);
     std::mutex stats_mutex;
@@ -258,10 +258,10 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
                 for (int y = rows.begin(); y != rows.end(); ++y) {
                     const PixelRect row_rect{rect.x0, y, rect.width, 1};
                     TileSums row(row_rect);
-                    for (uint64_t s = task.sample_begin; s < task.sample_end && !cancel;
+                    for (uint64_t s = task.task.sample_begin; s < task.task.sample_end && !cancel;
                          s += step) {
-                        row += RenderTile(*loaded_.camera, *loaded_.tracer, row_rect, task.seed, s,
-                                          std::min(s + step, task.sample_end), &cancel);
+                        row += RenderTile(*loaded_.camera, *loaded_.tracer, row_rect, task.spec.seed, s,
+                                          std::min(s + step, task.task.sample_end), &cancel);
                     }
                     std::copy(row.pixels.begin(), row.pixels.end(), &tile.at(rect.x0, y));
                     std::lock_guard<std::mutex> lock(stats_mutex);
@@ -276,9 +276,9 @@ void Worker::SendResult(const TaskAssignment& task, const ServerConnection::Task
                         double seconds) {
     const absl::Status sent = server_.Complete(task.lease_id, result, seconds);
     if (sent.ok()) {
-        Log()->debug("job={} task={} done in {:.2f} s", task.job_id, task.task_index, seconds);
+        Log()->debug("job={} task={} done in {:.2f} s", task.job_id, task.task.index, seconds);
     } else {
-        Log()->warn("job={} task={} result not taken: {}", task.job_id, task.task_index,
+        Log()->warn("job={} task={} result not taken: {}", task.job_id, task.task.index,
                     std::string(sent.message()));
     }
 }

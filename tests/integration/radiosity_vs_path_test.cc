@@ -15,7 +15,7 @@
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/tile_renderer.h"
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 
 namespace lf {
 namespace {

@@ -8,7 +8,7 @@
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 
 namespace lf::testing {
 

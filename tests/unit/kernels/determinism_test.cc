@@ -8,7 +8,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/tile_renderer.h"
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 #include "test_scenes.h"
 
 namespace lf {

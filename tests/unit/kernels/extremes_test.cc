@@ -14,8 +14,7 @@
 #include "lf/core/image_error.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
-#include "local_executor.h"
-#include "local_render.h"
+#include "lf/local/local_executor.h"
 #include "render_path.h"
 #include "test_scenes.h"
 

@@ -10,7 +10,7 @@
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/tile_renderer.h"
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 #include "render_path.h"
 #include "test_scenes.h"
 

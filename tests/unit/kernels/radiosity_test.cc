@@ -16,7 +16,7 @@
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/radiosity_refinement.h"
 #include "lf/kernels/tile_renderer.h"
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 #include "test_scenes.h"
 
 namespace lf {

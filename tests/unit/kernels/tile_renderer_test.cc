@@ -1,5 +1,5 @@
 #include "lf/kernels/tile_renderer.h"
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 
 #include <gtest/gtest.h>
 

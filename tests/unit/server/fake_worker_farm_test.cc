@@ -18,7 +18,7 @@
 
 #include "lf/core/image_io.h"
 #include "lf/core/tile_codec.h"
-#include "server/digest.h"
+#include "lf/job/digest.h"
 #include "server/grpc_service.h"
 
 namespace lf {

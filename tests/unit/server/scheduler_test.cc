@@ -33,7 +33,7 @@ class SchedulerTest : public ::testing::Test {
         return *id;
     }
 
-    static TileSums Result(const Lease& lease) {
+    static TileSums Result(const TaskAssignment& lease) {
         TileSums sums(lease.task.rect);
         for (PixelSums& p : sums.pixels) {
             for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
@@ -64,12 +64,12 @@ TEST_F(SchedulerTest, HigherPriorityFirstThenOlderFirst) {
 
 TEST_F(SchedulerTest, AllResultsInAnyOrderSucceedTheJob) {
     const std::string id = Submit(0);
-    std::vector<Lease> leases;
-    while (std::optional<Lease> l = scheduler_.LeaseTask("w")) leases.push_back(*l);
+    std::vector<TaskAssignment> leases;
+    while (std::optional<TaskAssignment> l = scheduler_.LeaseTask("w")) leases.push_back(*l);
     ASSERT_EQ(leases.size(), 8u);
     for (size_t i = leases.size(); i-- > 0;) {
         absl::StatusOr<Scheduler::Completion> done =
-            scheduler_.Complete(leases[i].id, "w", Result(leases[i]));
+            scheduler_.Complete(leases[i].lease_id, "w", Result(leases[i]));
         ASSERT_TRUE(done.ok()) << done.status();
         EXPECT_EQ(done->job_id, id);
         EXPECT_EQ(done->job_rendered, i == 0);
@@ -87,45 +87,45 @@ TEST_F(SchedulerTest, AllResultsInAnyOrderSucceedTheJob) {
 
 TEST_F(SchedulerTest, HeartbeatsKeepALeaseAndSilenceLosesIt) {
     const std::string id = Submit(0);
-    const Lease lease = *scheduler_.LeaseTask("a");
+    const TaskAssignment lease = *scheduler_.LeaseTask("a");
     for (int i = 0; i < 5; ++i) {
         now_ += absl::Seconds(8);
-        EXPECT_TRUE(scheduler_.Heartbeat(lease.id, "a"));
+        EXPECT_TRUE(scheduler_.Heartbeat(lease.lease_id, "a"));
         EXPECT_EQ(scheduler_.ExpireLeases(), 0);
     }
     now_ += absl::Seconds(10);
     EXPECT_EQ(scheduler_.ExpireLeases(), 1);
-    EXPECT_FALSE(scheduler_.Heartbeat(lease.id, "a"));  // the worker is told to stop
+    EXPECT_FALSE(scheduler_.Heartbeat(lease.lease_id, "a"));  // the worker is told to stop
     EXPECT_EQ(Job(id).retries, 1);
     EXPECT_EQ(Job(id).tasks_running, 0);
 }
 
 TEST_F(SchedulerTest, RetriedTaskGoesToAnotherWorkerWhenThereIsOne) {
     Submit(0);
-    const Lease lease = *scheduler_.LeaseTask("a");
+    const TaskAssignment lease = *scheduler_.LeaseTask("a");
     scheduler_.LeaseTask("b");  // b is alive
-    ASSERT_TRUE(scheduler_.Fail(lease.id, "a", "out of memory", FailureKind::kTaskError).ok());
-    const Lease next_for_a = *scheduler_.LeaseTask("a");
+    ASSERT_TRUE(scheduler_.Fail(lease.lease_id, "a", "out of memory", FailureKind::kTaskError).ok());
+    const TaskAssignment next_for_a = *scheduler_.LeaseTask("a");
     EXPECT_NE(next_for_a.task.index, lease.task.index);
-    const Lease next_for_b = *scheduler_.LeaseTask("b");
+    const TaskAssignment next_for_b = *scheduler_.LeaseTask("b");
     EXPECT_EQ(next_for_b.task.index, lease.task.index);
 }
 
 TEST_F(SchedulerTest, LoneWorkerRetriesItsOwnFailure) {
     Submit(0, 16);  // one tile, two passes
-    const Lease first = *scheduler_.LeaseTask("a");
-    ASSERT_TRUE(scheduler_.Fail(first.id, "a", "flaky", FailureKind::kTaskError).ok());
+    const TaskAssignment first = *scheduler_.LeaseTask("a");
+    ASSERT_TRUE(scheduler_.Fail(first.lease_id, "a", "flaky", FailureKind::kTaskError).ok());
     EXPECT_EQ(scheduler_.LeaseTask("a")->task.index, 0);
 }
 
 TEST_F(SchedulerTest, ThirdFailureFailsTheJobWithTheReason) {
     const std::string id = Submit(0, 16);
     for (int attempt = 1; attempt <= 3; ++attempt) {
-        std::optional<Lease> lease = scheduler_.LeaseTask("w");
+        std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w");
         ASSERT_TRUE(lease.has_value());
         ASSERT_EQ(lease->task.index, 0);
         ASSERT_TRUE(
-            scheduler_.Fail(lease->id, "w", "mesh.obj: no such file", FailureKind::kTaskError)
+            scheduler_.Fail(lease->lease_id, "w", "mesh.obj: no such file", FailureKind::kTaskError)
                 .ok());
         EXPECT_EQ(Job(id).state, attempt < 3 ? JobState::kRunning : JobState::kFailed);
     }
@@ -137,9 +137,9 @@ TEST_F(SchedulerTest, ThirdFailureFailsTheJobWithTheReason) {
 TEST_F(SchedulerTest, ExpiriesCountAsFailuresButShutdownsDoNot) {
     const std::string id = Submit(0, 16);
     for (int i = 0; i < 10; ++i) {
-        const Lease lease = *scheduler_.LeaseTask("w");
+        const TaskAssignment lease = *scheduler_.LeaseTask("w");
         ASSERT_TRUE(
-            scheduler_.Fail(lease.id, "w", "worker shutting down", FailureKind::kWorkerShutdown)
+            scheduler_.Fail(lease.lease_id, "w", "worker shutting down", FailureKind::kWorkerShutdown)
                 .ok());
     }
     EXPECT_EQ(Job(id).state, JobState::kRunning);
@@ -154,15 +154,15 @@ TEST_F(SchedulerTest, ExpiriesCountAsFailuresButShutdownsDoNot) {
 
 TEST_F(SchedulerTest, LateResultOfAnExpiredLeaseIsMergedOnce) {
     const std::string id = Submit(0, 16);
-    const Lease slow = *scheduler_.LeaseTask("slow");
+    const TaskAssignment slow = *scheduler_.LeaseTask("slow");
     now_ += absl::Seconds(11);
     scheduler_.ExpireLeases();
-    const Lease retry = *scheduler_.LeaseTask("fast");
+    const TaskAssignment retry = *scheduler_.LeaseTask("fast");
     ASSERT_EQ(retry.task.index, slow.task.index);
-    ASSERT_TRUE(scheduler_.Complete(slow.id, "slow", Result(slow)).ok());
-    EXPECT_FALSE(scheduler_.Heartbeat(retry.id, "fast"));  // nothing left to do for it
+    ASSERT_TRUE(scheduler_.Complete(slow.lease_id, "slow", Result(slow)).ok());
+    EXPECT_FALSE(scheduler_.Heartbeat(retry.lease_id, "fast"));  // nothing left to do for it
     absl::StatusOr<Scheduler::Completion> again =
-        scheduler_.Complete(retry.id, "fast", Result(retry));
+        scheduler_.Complete(retry.lease_id, "fast", Result(retry));
     ASSERT_TRUE(again.ok());
     EXPECT_FALSE(again->job_rendered);
     EXPECT_EQ(Job(id).tasks_done, 1);
@@ -171,9 +171,9 @@ TEST_F(SchedulerTest, LateResultOfAnExpiredLeaseIsMergedOnce) {
 
 TEST_F(SchedulerTest, WrongResultIsRefused) {
     Submit(0);
-    const Lease lease = *scheduler_.LeaseTask("w");
+    const TaskAssignment lease = *scheduler_.LeaseTask("w");
     TileSums wrong(PixelRect{0, 0, 3, 3});
-    EXPECT_EQ(scheduler_.Complete(lease.id, "w", wrong).status().code(),
+    EXPECT_EQ(scheduler_.Complete(lease.lease_id, "w", wrong).status().code(),
               absl::StatusCode::kInvalidArgument);
     EXPECT_EQ(scheduler_.Complete("job-nope/0/1", "w", wrong).status().code(),
               absl::StatusCode::kFailedPrecondition);
@@ -181,83 +181,83 @@ TEST_F(SchedulerTest, WrongResultIsRefused) {
 
 TEST_F(SchedulerTest, ResultForALeaseTheWorkerDoesNotHoldIsRefused) {
     const std::string id = Submit(0);
-    const Lease lease = *scheduler_.LeaseTask("a");
-    EXPECT_EQ(scheduler_.Complete(lease.id, "b", Result(lease)).status().code(),
+    const TaskAssignment lease = *scheduler_.LeaseTask("a");
+    EXPECT_EQ(scheduler_.Complete(lease.lease_id, "b", Result(lease)).status().code(),
               absl::StatusCode::kFailedPrecondition);
-    EXPECT_FALSE(scheduler_.Heartbeat(lease.id, "b"));
-    ASSERT_TRUE(scheduler_.Fail(lease.id, "b", "?", FailureKind::kTaskError).ok());
-    std::string forged = lease.id;
+    EXPECT_FALSE(scheduler_.Heartbeat(lease.lease_id, "b"));
+    ASSERT_TRUE(scheduler_.Fail(lease.lease_id, "b", "?", FailureKind::kTaskError).ok());
+    std::string forged = lease.lease_id;
     forged.back() = '7';  // an attempt never handed out
     EXPECT_EQ(scheduler_.Complete(forged, "a", Result(lease)).status().code(),
               absl::StatusCode::kFailedPrecondition);
     EXPECT_EQ(Job(id).tasks_done, 0);
     EXPECT_EQ(Job(id).retries, 0);
-    EXPECT_TRUE(scheduler_.Heartbeat(lease.id, "a"));
-    EXPECT_TRUE(scheduler_.Complete(lease.id, "a", Result(lease)).ok());
+    EXPECT_TRUE(scheduler_.Heartbeat(lease.lease_id, "a"));
+    EXPECT_TRUE(scheduler_.Complete(lease.lease_id, "a", Result(lease)).ok());
     EXPECT_EQ(Job(id).tasks_done, 1);
 }
 
 TEST_F(SchedulerTest, WrongResultQueuesTheTaskAgainAtOnce) {
     const std::string id = Submit(0);
     scheduler_.LeaseTask("b");  // b is alive
-    const Lease lease = *scheduler_.LeaseTask("a");
+    const TaskAssignment lease = *scheduler_.LeaseTask("a");
     TileSums wrong(lease.task.rect);  // the right rectangle without its samples
-    EXPECT_EQ(scheduler_.Complete(lease.id, "a", wrong).status().code(),
+    EXPECT_EQ(scheduler_.Complete(lease.lease_id, "a", wrong).status().code(),
               absl::StatusCode::kInvalidArgument);
     EXPECT_EQ(Job(id).retries, 1);
     EXPECT_EQ(Job(id).tasks_done, 0);
-    EXPECT_FALSE(scheduler_.Heartbeat(lease.id, "a"));
+    EXPECT_FALSE(scheduler_.Heartbeat(lease.lease_id, "a"));
     EXPECT_EQ(scheduler_.LeaseTask("b")->task.index, lease.task.index);
 }
 
 TEST_F(SchedulerTest, StragglersTaskIsLeasedAgainNearTheEndAndTheFirstResultWins) {
     const std::string id = Submit(0, 16);  // two tasks
-    const Lease slow = *scheduler_.LeaseTask("slow");
-    const Lease fast = *scheduler_.LeaseTask("fast");
+    const TaskAssignment slow = *scheduler_.LeaseTask("slow");
+    const TaskAssignment fast = *scheduler_.LeaseTask("fast");
     now_ += absl::Milliseconds(500);
-    ASSERT_TRUE(scheduler_.Complete(fast.id, "fast", Result(fast)).ok());
+    ASSERT_TRUE(scheduler_.Complete(fast.lease_id, "fast", Result(fast)).ok());
     EXPECT_FALSE(scheduler_.LeaseTask("fast"));  // not slow yet
     now_ += absl::Seconds(1);
     EXPECT_FALSE(scheduler_.LeaseTask("slow")) << "its own task is not leased to it again";
-    const std::optional<Lease> copy = scheduler_.LeaseTask("fast");
+    const std::optional<TaskAssignment> copy = scheduler_.LeaseTask("fast");
     ASSERT_TRUE(copy);
     EXPECT_EQ(copy->task.index, slow.task.index);
     EXPECT_FALSE(scheduler_.LeaseTask("idle")) << "one speculative copy at a time";
     EXPECT_EQ(Job(id).tasks_running, 1);
     absl::StatusOr<Scheduler::Completion> done =
-        scheduler_.Complete(copy->id, "fast", Result(*copy));
+        scheduler_.Complete(copy->lease_id, "fast", Result(*copy));
     ASSERT_TRUE(done.ok()) << done.status();
     EXPECT_TRUE(done->job_rendered);
-    EXPECT_FALSE(scheduler_.Heartbeat(slow.id, "slow"));  // told to stop
+    EXPECT_FALSE(scheduler_.Heartbeat(slow.lease_id, "slow"));  // told to stop
     EXPECT_EQ(Job(id).tasks_leased, 3);
     EXPECT_EQ(Job(id).tasks_running, 0);
 }
 
 TEST_F(SchedulerTest, FailedSpeculativeCopyLeavesTheOriginalRunning) {
     const std::string id = Submit(0, 16);
-    const Lease slow = *scheduler_.LeaseTask("slow");
-    const Lease fast = *scheduler_.LeaseTask("fast");
-    ASSERT_TRUE(scheduler_.Complete(fast.id, "fast", Result(fast)).ok());
+    const TaskAssignment slow = *scheduler_.LeaseTask("slow");
+    const TaskAssignment fast = *scheduler_.LeaseTask("fast");
+    ASSERT_TRUE(scheduler_.Complete(fast.lease_id, "fast", Result(fast)).ok());
     now_ += absl::Seconds(2);
-    const Lease copy = *scheduler_.LeaseTask("fast");
-    ASSERT_TRUE(scheduler_.Fail(copy.id, "fast", "oops", FailureKind::kTaskError).ok());
-    EXPECT_TRUE(scheduler_.Heartbeat(slow.id, "slow"));
+    const TaskAssignment copy = *scheduler_.LeaseTask("fast");
+    ASSERT_TRUE(scheduler_.Fail(copy.lease_id, "fast", "oops", FailureKind::kTaskError).ok());
+    EXPECT_TRUE(scheduler_.Heartbeat(slow.lease_id, "slow"));
     EXPECT_EQ(Job(id).tasks_running, 1);
     EXPECT_FALSE(scheduler_.LeaseTask("fast")) << "it failed there";
-    ASSERT_TRUE(scheduler_.Complete(slow.id, "slow", Result(slow)).ok());
+    ASSERT_TRUE(scheduler_.Complete(slow.lease_id, "slow", Result(slow)).ok());
     EXPECT_EQ(Job(id).tasks_done, 2);
 }
 
 TEST_F(SchedulerTest, CancelStopsLeasesAndIsFinal) {
     const std::string id = Submit(0);
-    const Lease lease = *scheduler_.LeaseTask("w");
+    const TaskAssignment lease = *scheduler_.LeaseTask("w");
     absl::StatusOr<JobRecord> cancelled = scheduler_.Cancel(id);
     ASSERT_TRUE(cancelled.ok());
     EXPECT_EQ(cancelled->state, JobState::kCancelled);
     EXPECT_EQ(cancelled->tasks_running, 0);
-    EXPECT_FALSE(scheduler_.Heartbeat(lease.id, "w"));
+    EXPECT_FALSE(scheduler_.Heartbeat(lease.lease_id, "w"));
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
-    EXPECT_EQ(scheduler_.Complete(lease.id, "w", Result(lease)).status().code(),
+    EXPECT_EQ(scheduler_.Complete(lease.lease_id, "w", Result(lease)).status().code(),
               absl::StatusCode::kFailedPrecondition);
     EXPECT_EQ(scheduler_.Cancel(id).status().code(), absl::StatusCode::kFailedPrecondition);
     EXPECT_EQ(scheduler_.Cancel("job-unknown").status().code(), absl::StatusCode::kNotFound);
@@ -277,7 +277,7 @@ TEST_F(SchedulerTest, IdleWorkerWaitsForWorkAndGetsItAtOnce) {
         Submit(0);
     });
     const absl::Time start = absl::Now();
-    const std::optional<Lease> lease = scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
+    const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
     submitter.join();
     EXPECT_TRUE(lease.has_value());
     EXPECT_LT(absl::Now() - start, absl::Seconds(5));
@@ -314,7 +314,7 @@ std::string SubmitAdaptive(Scheduler& scheduler, const AdaptiveSettings& adaptiv
     return *id;
 }
 
-TileSums HalvesResult(const Lease& lease) {
+TileSums HalvesResult(const TaskAssignment& lease) {
     TileSums sums(lease.task.rect);
     const bool noisy = lease.task.rect.x0 == 8 && lease.task.rect.y0 == 8;
     for (PixelSums& p : sums.pixels) {
@@ -329,13 +329,13 @@ TEST_F(SchedulerTest, AdaptiveJobQueuesPassesOnlyForTheTileAboveTheTarget) {
     const std::string id = SubmitAdaptive(scheduler_, {.target_error = 0.1, .max_spp = 64});
     EXPECT_EQ(Job(id).tasks_total, 4);
     std::vector<uint64_t> pass_ends;
-    while (std::optional<Lease> lease = scheduler_.LeaseTask("w")) {
+    while (std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w")) {
         if (lease->task.index >= 4) {
             EXPECT_EQ(lease->task.rect.x0, 8);
             EXPECT_EQ(lease->task.rect.y0, 8);
             pass_ends.push_back(lease->task.sample_end);
         }
-        ASSERT_TRUE(scheduler_.Complete(lease->id, "w", HalvesResult(*lease)).ok());
+        ASSERT_TRUE(scheduler_.Complete(lease->lease_id, "w", HalvesResult(*lease)).ok());
     }
     // Error 0.2 against 0.1 asks for 4x the samples plus 10 %, each pass; never below target.
     EXPECT_EQ(pass_ends, (std::vector<uint64_t>{18, 64}));
@@ -353,11 +353,11 @@ TEST_F(SchedulerTest, AdaptiveJobQueuesPassesOnlyForTheTileAboveTheTarget) {
 TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     const std::string id = SubmitAdaptive(scheduler_, {.time_limit = 5, .max_spp = 1 << 10});
     for (int i = 0; i < 4; ++i) {  // the first passes, each asking for a second
-        const std::optional<Lease> lease = scheduler_.LeaseTask("w");
+        const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w");
         ASSERT_TRUE(lease.has_value());
-        ASSERT_TRUE(scheduler_.Complete(lease->id, "w", HalvesResult(*lease)).ok());
+        ASSERT_TRUE(scheduler_.Complete(lease->lease_id, "w", HalvesResult(*lease)).ok());
     }
-    const std::optional<Lease> running = scheduler_.LeaseTask("w");
+    const std::optional<TaskAssignment> running = scheduler_.LeaseTask("w");
     ASSERT_TRUE(running.has_value());
     EXPECT_EQ(running->task.sample_begin, 4u);
     EXPECT_EQ(running->task.sample_end, 8u);
@@ -365,11 +365,11 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     now_ += absl::Seconds(5);
     EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
     EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());   // reported once
-    EXPECT_FALSE(scheduler_.Heartbeat(running->id, "w"));  // the worker stops
+    EXPECT_FALSE(scheduler_.Heartbeat(running->lease_id, "w"));  // the worker stops
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
     // Its late result changes nothing.
     absl::StatusOr<Scheduler::Completion> late =
-        scheduler_.Complete(running->id, "w", HalvesResult(*running));
+        scheduler_.Complete(running->lease_id, "w", HalvesResult(*running));
     ASSERT_TRUE(late.ok());
     EXPECT_FALSE(late->job_rendered);
     EXPECT_EQ(Job(id).tasks_done, 4);
@@ -384,9 +384,9 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
 TEST_F(SchedulerTest, TimeLimitDoesNotReportAJobItsLastResultCompleted) {
     const std::string id = SubmitAdaptive(scheduler_, {.target_error = 0.5, .time_limit = 5});
     bool rendered = false;
-    while (std::optional<Lease> lease = scheduler_.LeaseTask("w")) {
+    while (std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w")) {
         absl::StatusOr<Scheduler::Completion> done =
-            scheduler_.Complete(lease->id, "w", HalvesResult(*lease));
+            scheduler_.Complete(lease->lease_id, "w", HalvesResult(*lease));
         ASSERT_TRUE(done.ok());
         rendered |= done->job_rendered;
     }

@@ -46,7 +46,7 @@ class SqliteJobStoreTest : public ::testing::Test {
     }
 
     // A result whose pixels depend on the task, so a wrong merge shows in the image.
-    static TileSums Result(const Lease& lease) {
+    static TileSums Result(const TaskAssignment& lease) {
         TileSums sums(lease.task.rect);
         for (PixelSums& p : sums.pixels) {
             for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
@@ -58,8 +58,8 @@ class SqliteJobStoreTest : public ::testing::Test {
     }
 
     static void CompleteAll(Scheduler& scheduler, const std::string& worker) {
-        while (std::optional<Lease> lease = scheduler.LeaseTask(worker)) {
-            ASSERT_TRUE(scheduler.Complete(lease->id, worker, Result(*lease)).ok());
+        while (std::optional<TaskAssignment> lease = scheduler.LeaseTask(worker)) {
+            ASSERT_TRUE(scheduler.Complete(lease->lease_id, worker, Result(*lease)).ok());
         }
     }
 
@@ -134,8 +134,8 @@ TEST_F(SqliteJobStoreTest, RestartKeepsDoneTasksAndQueuesTheRest) {
         id = *before.Submit(Spec());
         other = *before.Submit(Spec());  // never started
         for (int i = 0; i < 3; ++i) {
-            std::optional<Lease> lease = before.LeaseTask("w");
-            ASSERT_TRUE(before.Complete(lease->id, "w", Result(*lease)).ok());
+            std::optional<TaskAssignment> lease = before.LeaseTask("w");
+            ASSERT_TRUE(before.Complete(lease->lease_id, "w", Result(*lease)).ok());
         }
         ASSERT_TRUE(before.LeaseTask("w"));  // leased when the server dies
     }                                        // the crash: nothing more is written
@@ -149,11 +149,11 @@ TEST_F(SqliteJobStoreTest, RestartKeepsDoneTasksAndQueuesTheRest) {
     EXPECT_EQ(after.Get(id)->tasks_running, 0);
     EXPECT_EQ(after.Get(id)->state, JobState::kRunning);
     int leased = 0;
-    while (std::optional<Lease> lease = after.LeaseTask("w")) {
+    while (std::optional<TaskAssignment> lease = after.LeaseTask("w")) {
         if (lease->job_id != id) break;
         EXPECT_GE(lease->task.index, 3) << "a done task was leased again";
         ++leased;
-        absl::StatusOr<Scheduler::Completion> done = after.Complete(lease->id, "w", Result(*lease));
+        absl::StatusOr<Scheduler::Completion> done = after.Complete(lease->lease_id, "w", Result(*lease));
         ASSERT_TRUE(done.ok()) << done.status();
         if (done->job_rendered) {
             EXPECT_EQ(Pixels(after, id), expected);
@@ -231,7 +231,7 @@ TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs)
     CompleteAll(scheduler, "w");
     scheduler.Finish(done, std::string("/results/x.exr"));
     const std::string running = *scheduler.Submit(Spec());
-    std::optional<Lease> lease = scheduler.LeaseTask("w");
+    std::optional<TaskAssignment> lease = scheduler.LeaseTask("w");
 
     store.fail = true;
     const absl::StatusOr<std::string> refused = scheduler.Submit(Spec());
@@ -240,7 +240,7 @@ TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs)
     EXPECT_EQ(scheduler.List().size(), 2u);
     // A result that cannot be recorded is refused with the reason, not acknowledged.
     absl::StatusOr<Scheduler::Completion> result =
-        scheduler.Complete(lease->id, "w", Result(*lease));
+        scheduler.Complete(lease->lease_id, "w", Result(*lease));
     EXPECT_EQ(result.status().code(), absl::StatusCode::kResourceExhausted);
     EXPECT_EQ(scheduler.Get(running)->state, JobState::kFailed) << "watchers learn it ended";
     EXPECT_NE(scheduler.Get(running)->error.find("disk full"), std::string::npos);
@@ -267,7 +267,7 @@ TEST_F(SqliteJobStoreTest, RestartReplaysAnAdaptiveJobsPasses) {
     spec.adaptive = {.target_error = 0.1, .time_limit = 0, .max_spp = 64};
     // Every pixel's halves read 0.4 and 0.6: relative error 0.2 at any count, so each tile goes
     // 4 -> 18 -> 64 samples.
-    auto halves = [](const Lease& lease) {
+    auto halves = [](const TaskAssignment& lease) {
         TileSums sums(lease.task.rect);
         for (PixelSums& p : sums.pixels) {
             for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
@@ -279,8 +279,8 @@ TEST_F(SqliteJobStoreTest, RestartReplaysAnAdaptiveJobsPasses) {
     InMemoryJobStore memory;
     Scheduler reference({}, memory);
     const std::string ref_id = *reference.Submit(spec);
-    while (std::optional<Lease> lease = reference.LeaseTask("w")) {
-        ASSERT_TRUE(reference.Complete(lease->id, "w", halves(*lease)).ok());
+    while (std::optional<TaskAssignment> lease = reference.LeaseTask("w")) {
+        ASSERT_TRUE(reference.Complete(lease->lease_id, "w", halves(*lease)).ok());
     }
     EXPECT_EQ(reference.Get(ref_id)->tasks_done, 12);
     const std::vector<float> expected = Pixels(reference, ref_id);
@@ -291,8 +291,8 @@ TEST_F(SqliteJobStoreTest, RestartReplaysAnAdaptiveJobsPasses) {
         Scheduler before({}, *store);
         id = *before.Submit(spec);
         for (int i = 0; i < 6; ++i) {
-            std::optional<Lease> lease = before.LeaseTask("w");
-            ASSERT_TRUE(before.Complete(lease->id, "w", halves(*lease)).ok());
+            std::optional<TaskAssignment> lease = before.LeaseTask("w");
+            ASSERT_TRUE(before.Complete(lease->lease_id, "w", halves(*lease)).ok());
         }
         // The 4 first passes, 4 second ones, and the third passes of the 2 tiles done twice.
         EXPECT_EQ(before.Get(id)->tasks_total, 10);
@@ -305,9 +305,9 @@ TEST_F(SqliteJobStoreTest, RestartReplaysAnAdaptiveJobsPasses) {
     EXPECT_EQ(after.Get(id)->tasks_total, 10);
     int leased = 0;
     bool rendered = false;
-    while (std::optional<Lease> lease = after.LeaseTask("w")) {
+    while (std::optional<TaskAssignment> lease = after.LeaseTask("w")) {
         ++leased;
-        absl::StatusOr<Scheduler::Completion> done = after.Complete(lease->id, "w", halves(*lease));
+        absl::StatusOr<Scheduler::Completion> done = after.Complete(lease->lease_id, "w", halves(*lease));
         ASSERT_TRUE(done.ok()) << done.status();
         rendered |= done->job_rendered;
     }

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <map>
 
-#include "server/digest.h"
+#include "lf/job/digest.h"
 
 namespace lf {
 namespace {

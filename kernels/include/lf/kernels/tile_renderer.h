@@ -1,5 +1,5 @@
 // Rendering a rectangle of the image over a range of samples: the unit of work of farm tasks
-// and of local mode (client/local_executor.h).
+// and of local mode (lf/local/local_executor.h).
 #pragma once
 
 #include <atomic>

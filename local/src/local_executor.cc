@@ -1,4 +1,4 @@
-#include "local_executor.h"
+#include "lf/local/local_executor.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -15,9 +15,9 @@
 
 #include "lf/core/image_error.h"
 #include "lf/kernels/tile_renderer.h"
-#include "server/adaptive_plan.h"
-#include "server/merge.h"
-#include "server/plan.h"
+#include "lf/job/adaptive_plan.h"
+#include "lf/job/merge.h"
+#include "lf/job/plan.h"
 
 namespace lf {
 

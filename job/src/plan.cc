@@ -1,4 +1,4 @@
-#include "server/plan.h"
+#include "lf/job/plan.h"
 
 #include <algorithm>
 

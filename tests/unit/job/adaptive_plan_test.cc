@@ -1,7 +1,7 @@
 // The adaptive plan on synthetic tiles whose noise is known: which tiles get more passes, how
 // many samples they ask for, what a time limit drops, and that replaying results in index order
 // rebuilds the same plan (the farm's recovery).
-#include "server/adaptive_plan.h"
+#include "lf/job/adaptive_plan.h"
 
 #include <gtest/gtest.h>
 

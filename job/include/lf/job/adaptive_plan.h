@@ -1,6 +1,6 @@
 // Adaptive sampling as a plan that grows: every tile starts with one pass, and each pass's
 // result decides whether the tile gets another and how many samples it takes. The farm's
-// scheduler queues the passes it appends; local mode (client/local_executor.h) runs them on a
+// scheduler queues the passes it appends; local mode (lf/local/local_executor.h) runs them on a
 // thread pool. A tile's passes depend only on its own samples, so without a time limit the farm
 // and local mode plan the same passes and merge the same bits.
 #pragma once
@@ -13,8 +13,8 @@
 #include "absl/status/statusor.h"
 #include "lf/core/film.h"
 #include "lf/core/image.h"
-#include "server/merge.h"
-#include "server/plan.h"
+#include "lf/job/merge.h"
+#include "lf/job/plan.h"
 
 namespace lf {
 

@@ -1,6 +1,6 @@
-// The in-process executor of local mode: the farm's planner (server/plan.h) cuts the render into
+// The in-process executor of local mode: the farm's planner (lf/job/plan.h) cuts the render into
 // tasks, TBB threads run them with lf::RenderTile as a worker would, and the farm's merger
-// (server/merge.h) assembles the image. So `lightfarm render` and a farm render of the same job
+// (lf/job/merge.h) assembles the image. So `lightfarm render` and a farm render of the same job
 // are the same code and the same bits.
 #pragma once
 
@@ -12,7 +12,7 @@
 #include "lf/core/camera.h"
 #include "lf/core/image.h"
 #include "lf/kernels/radiance.h"
-#include "server/adaptive_plan.h"
+#include "lf/job/adaptive_plan.h"
 
 namespace lf {
 

@@ -1,4 +1,4 @@
-#include "server/scene_files.h"
+#include "lf/job/scene_files.h"
 
 #include <filesystem>
 #include <fstream>

@@ -1,4 +1,4 @@
-#include "server/adaptive_plan.h"
+#include "lf/job/adaptive_plan.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // The planner covers every sample of every pixel exactly once, keeps a tile's passes together,
 // and refuses plans that are empty or could overflow the exact sums.
-#include "server/plan.h"
+#include "lf/job/plan.h"
 
 #include <gtest/gtest.h>
 

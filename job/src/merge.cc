@@ -1,4 +1,4 @@
-#include "server/merge.h"
+#include "lf/job/merge.h"
 
 #include "absl/strings/str_cat.h"
 

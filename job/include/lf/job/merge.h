@@ -10,7 +10,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/film.h"
 #include "lf/core/image.h"
-#include "server/plan.h"
+#include "lf/job/plan.h"
 
 namespace lf {
 
@@ -22,7 +22,7 @@ absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums);
 Image EmptyRenderImage(int width, int height);
 
 // What a job's tile results merge into: a fixed plan (RenderMerger) or one that grows as results
-// show which tiles need more samples (AdaptiveTilePlan, server/adaptive_plan.h).
+// show which tiles need more samples (AdaptiveTilePlan, lf/job/adaptive_plan.h).
 class TileMerger {
   public:
     virtual ~TileMerger() = default;
@@ -55,7 +55,7 @@ class RenderMerger : public TileMerger {
     bool Complete() const override { return tasks_done_ == tasks_.size(); }
     const RenderStats& stats() const override { return stats_; }
 
-    // Once Complete(), the final image, bit for bit what local mode (client/local_executor.h)
+    // Once Complete(), the final image, bit for bit what local mode (lf/local/local_executor.h)
     // makes of the same settings.
     Image Snapshot() const override;
 

@@ -1,4 +1,4 @@
-#include "server/digest.h"
+#include "lf/job/digest.h"
 
 #include <openssl/evp.h>
 

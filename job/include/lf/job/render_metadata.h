@@ -10,7 +10,7 @@
 #include "lf/core/image.h"
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
-#include "server/adaptive_plan.h"
+#include "lf/job/adaptive_plan.h"
 
 namespace lf {
 

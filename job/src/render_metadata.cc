@@ -1,4 +1,4 @@
-#include "server/render_metadata.h"
+#include "lf/job/render_metadata.h"
 
 #include "lf/version.h"
 

@@ -1,6 +1,6 @@
 // Task results merged in any order give the bits of the whole render; bad or repeated results
 // are refused without touching the image.
-#include "server/merge.h"
+#include "lf/job/merge.h"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,30 @@
+// A job as the coordinator reports and records it: its spec, its state and its progress.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "absl/time/time.h"
+#include "lf/core/film.h"
+#include "lf/job/job_spec.h"
+
+namespace lf {
+
+enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled };
+const char* JobStateName(JobState state);
+inline bool IsFinal(JobState s) { return s != JobState::kQueued && s != JobState::kRunning; }
+
+struct JobRecord {
+    std::string id;
+    uint64_t seq = 0;  // submission order
+    JobSpec spec;
+    JobState state = JobState::kQueued;
+    std::string error;
+    absl::Time submitted, started = absl::InfinitePast(), finished = absl::InfinitePast();
+    int tasks_total = 0, tasks_done = 0, tasks_running = 0, retries = 0;
+    int tasks_leased = 0;  // leases ever handed out, across server restarts: renders started
+    RenderStats stats;
+    std::string result_path;  // the EXR, once succeeded
+};
+
+}  // namespace lf

@@ -1,0 +1,27 @@
+// One leased task as the coordinator hands it out and a worker runs it: which job, which
+// pixels and samples (or which patch-group chunk of a radiosity sweep), and the job's settings.
+#pragma once
+
+#include <string>
+
+#include "absl/time/time.h"
+#include "lf/job/job_spec.h"
+#include "lf/job/plan.h"
+
+namespace lf {
+
+struct TaskAssignment {
+    std::string lease_id;
+    std::string job_id;
+    RenderTask task;  // a tile's rectangle and samples; for a sweep task only its index
+    JobSpec spec;
+    // Radiosity jobs solved in sweeps (SolvedInSweeps): a patch-group task of sweep `sweep`
+    // (>= 0) reads the blob `radiosity_hash` ("" in sweep 0: the emission, which workers
+    // compute); a display tile (sweep -1) reads the solution from it.
+    int sweep = -1, chunk = 0;
+    std::string radiosity_hash;
+    absl::Duration heartbeat_interval = absl::Milliseconds(300);
+    absl::Duration lease = absl::Seconds(10);
+};
+
+}  // namespace lf

@@ -1,0 +1,34 @@
+// The edge between the wire (lightfarm.v1 protobuf messages) and the job model: every
+// conversion of the server, the workers and the client is here, so neither side sees the
+// other's types. Unset fields of older peers keep the job model's defaults.
+#pragma once
+
+#include "lf/job/job_record.h"
+#include "lf/job/job_spec.h"
+#include "lf/job/task_assignment.h"
+#include "lightfarm/v1/job_service.pb.h"
+#include "lightfarm/v1/worker_service.pb.h"
+
+namespace lf {
+
+void ToProto(const BlobRef& ref, lightfarm::v1::SceneFile* out);
+BlobRef FromProto(const lightfarm::v1::SceneFile& file);
+
+void ToProto(const RadiositySettings& settings, lightfarm::v1::RadiosityParams* out);
+RadiositySettings FromProto(const lightfarm::v1::RadiosityParams& params);
+
+// The render settings of a spec (not its scene, name or priority).
+void ToProto(const JobSpec& spec, lightfarm::v1::RenderParams* out);
+// Fills the render settings of `spec` from `params`.
+void FromProto(const lightfarm::v1::RenderParams& params, JobSpec* spec);
+
+void ToProto(const JobSpec& spec, lightfarm::v1::SubmitJobRequest* out);
+JobSpec FromProto(const lightfarm::v1::SubmitJobRequest& request);
+
+lightfarm::v1::Job::State ToProto(JobState state);
+void ToProto(const JobRecord& job, lightfarm::v1::Job* out);
+
+void ToProto(const TaskAssignment& task, lightfarm::v1::Task* out);
+TaskAssignment FromProto(const lightfarm::v1::Task& task);
+
+}  // namespace lf

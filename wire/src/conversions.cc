@@ -1,0 +1,171 @@
+#include "lf/wire/conversions.h"
+
+namespace lf {
+
+namespace pb = lightfarm::v1;
+
+namespace {
+
+int64_t UnixMillis(absl::Time t) { return t == absl::InfinitePast() ? 0 : absl::ToUnixMillis(t); }
+
+}  // namespace
+
+void ToProto(const BlobRef& ref, pb::SceneFile* out) {
+    out->set_path(ref.path);
+    out->set_hash(ref.hash);
+    out->set_size(ref.size);
+}
+
+BlobRef FromProto(const pb::SceneFile& f) { return {f.path(), f.hash(), f.size()}; }
+
+void ToProto(const RadiositySettings& s, pb::RadiosityParams* out) {
+    out->set_patches(s.patches);
+    out->set_patch_size(s.patch_size);
+    out->set_solver(s.solver);
+    out->set_tolerance(s.tolerance);
+    out->set_max_iterations(s.max_iterations);
+    out->set_display(s.display);
+    out->set_sweep_tasks(s.sweep_tasks);
+    out->set_max_patches(s.max_patches);
+}
+
+RadiositySettings FromProto(const pb::RadiosityParams& p) {
+    RadiositySettings s{p.patches(),   p.patch_size(),     p.solver(),
+                        p.tolerance(), p.max_iterations(), p.display()};
+    if (p.sweep_tasks() != 0) s.sweep_tasks = p.sweep_tasks();
+    s.max_patches = p.max_patches();
+    return s;
+}
+
+void ToProto(const JobSpec& spec, pb::RenderParams* out) {
+    out->set_spp(spec.plan.spp);
+    out->set_seed(spec.seed);
+    out->set_max_depth(spec.max_depth);
+    out->set_tile(spec.plan.tile);
+    out->set_passes(spec.plan.passes);
+    out->set_method(spec.method);
+    if (spec.method == "radiosity") ToProto(spec.radiosity, out->mutable_radiosity());
+    out->set_target_error(spec.adaptive.target_error);
+    out->set_time_limit_seconds(spec.adaptive.time_limit);
+    out->set_max_spp(spec.adaptive.max_spp);
+}
+
+void FromProto(const pb::RenderParams& p, JobSpec* spec) {
+    spec->plan.spp = p.spp();
+    spec->plan.tile = p.tile();
+    spec->plan.passes = p.passes();
+    spec->seed = p.seed();
+    spec->max_depth = p.max_depth();
+    if (!p.method().empty()) spec->method = p.method();
+    if (p.has_radiosity()) spec->radiosity = FromProto(p.radiosity());
+    spec->adaptive.target_error = p.target_error();
+    spec->adaptive.time_limit = p.time_limit_seconds();
+    if (p.max_spp() != 0) spec->adaptive.max_spp = p.max_spp();
+}
+
+void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {
+    ToProto(spec.scene, out->mutable_scene());
+    for (const BlobRef& f : spec.files) ToProto(f, out->add_files());
+    ToProto(spec, out->mutable_params());
+    out->set_priority(spec.priority);
+    out->set_name(spec.name);
+    out->set_request_id(spec.request_id);
+}
+
+JobSpec FromProto(const pb::SubmitJobRequest& r) {
+    JobSpec spec;
+    spec.name = r.name().empty() ? r.scene().path() : r.name();
+    spec.request_id = r.request_id();
+    spec.scene = FromProto(r.scene());
+    for (const pb::SceneFile& f : r.files()) spec.files.push_back(FromProto(f));
+    FromProto(r.params(), &spec);
+    spec.priority = r.priority();
+    return spec;
+}
+
+pb::Job::State ToProto(JobState s) {
+    switch (s) {
+        case JobState::kQueued:
+            return pb::Job::QUEUED;
+        case JobState::kRunning:
+            return pb::Job::RUNNING;
+        case JobState::kSucceeded:
+            return pb::Job::SUCCEEDED;
+        case JobState::kFailed:
+            return pb::Job::FAILED;
+        case JobState::kCancelled:
+            return pb::Job::CANCELLED;
+    }
+    return pb::Job::STATE_UNSPECIFIED;
+}
+
+void ToProto(const JobRecord& job, pb::Job* out) {
+    out->set_id(job.id);
+    out->set_name(job.spec.name);
+    out->set_state(ToProto(job.state));
+    out->set_error(job.error);
+    ToProto(job.spec, out->mutable_params());
+    out->set_priority(job.spec.priority);
+    out->set_width(job.spec.plan.width);
+    out->set_height(job.spec.plan.height);
+    out->set_scene_hash(job.spec.scene_hash);
+    out->set_tasks_total(job.tasks_total);
+    out->set_tasks_done(job.tasks_done);
+    out->set_tasks_running(job.tasks_running);
+    out->set_samples(job.stats.samples);
+    out->set_rays(job.stats.rays);
+    out->set_invalid_samples(job.stats.invalid_samples);
+    out->set_submitted_unix_ms(UnixMillis(job.submitted));
+    out->set_started_unix_ms(UnixMillis(job.started));
+    out->set_finished_unix_ms(UnixMillis(job.finished));
+    out->set_retries(job.retries);
+    out->set_tasks_leased(job.tasks_leased);
+}
+
+void ToProto(const TaskAssignment& task, pb::Task* out) {
+    out->set_lease_id(task.lease_id);
+    out->set_job_id(task.job_id);
+    out->set_task_index(task.task.index);
+    ToProto(task.spec.scene, out->mutable_scene());
+    for (const BlobRef& f : task.spec.files) ToProto(f, out->add_files());
+    ToProto(task.spec, out->mutable_params());
+    out->set_x0(task.task.rect.x0);
+    out->set_y0(task.task.rect.y0);
+    out->set_width(task.task.rect.width);
+    out->set_height(task.task.rect.height);
+    out->set_sample_begin(task.task.sample_begin);
+    out->set_sample_end(task.task.sample_end);
+    if (task.sweep >= 0) {
+        out->set_kind(pb::Task::RADIOSITY_SWEEP);
+        out->set_sweep(task.sweep);
+        out->set_chunk(task.chunk);
+    }
+    out->set_radiosity_hash(task.radiosity_hash);
+    out->set_heartbeat_interval_ms(int(absl::ToInt64Milliseconds(task.heartbeat_interval)));
+    out->set_lease_ms(int(absl::ToInt64Milliseconds(task.lease)));
+}
+
+TaskAssignment FromProto(const pb::Task& t) {
+    TaskAssignment task;
+    task.lease_id = t.lease_id();
+    task.job_id = t.job_id();
+    task.task.index = t.task_index();
+    task.spec.scene = FromProto(t.scene());
+    for (const pb::SceneFile& f : t.files()) task.spec.files.push_back(FromProto(f));
+    FromProto(t.params(), &task.spec);
+    if (t.kind() == pb::Task::RADIOSITY_SWEEP) {
+        task.sweep = t.sweep();
+        task.chunk = t.chunk();
+    }
+    task.radiosity_hash = t.radiosity_hash();
+    task.task.rect = {t.x0(), t.y0(), t.width(), t.height()};
+    task.task.sample_begin = t.sample_begin();
+    task.task.sample_end = t.sample_end();
+    if (t.heartbeat_interval_ms() > 0) {
+        task.heartbeat_interval = absl::Milliseconds(t.heartbeat_interval_ms());
+    }
+    if (t.lease_ms() > 0) task.lease = absl::Milliseconds(t.lease_ms());
+    return task;
+}
+
+}  // namespace lf
