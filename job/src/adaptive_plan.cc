@@ -54,7 +54,7 @@ absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> AdaptiveTilePlan::Make(
     absl::StatusOr<std::vector<RenderTask>> tiles =
         PlanRender({width, height, plan->first_, tile, 1});
     if (!tiles.ok()) return tiles.status();
-    for (const RenderTask& task : *tiles) plan->tiles_.push_back({TileSums(task.rect)});
+    for (const RenderTask& task : *tiles) plan->tiles_.push_back({TileSums(task.rect), 1, {}});
     for (int t = 0; t < int(plan->tiles_.size()); ++t) plan->AppendPass(t, 0, plan->first_);
     return plan;
 }
