@@ -6,9 +6,12 @@ namespace lf {
 
 bool IsLegalJobTransition(JobState from, JobState to) {
     switch (from) {
-        case JobState::kQueued: return to != JobState::kQueued && to != JobState::kSucceeded;
-        case JobState::kRunning: return IsFinal(to);
-        default: return false;
+        case JobState::kQueued:
+            return to != JobState::kQueued && to != JobState::kSucceeded;
+        case JobState::kRunning:
+            return IsFinal(to);
+        default:
+            return false;
     }
 }
 

@@ -496,9 +496,8 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
         return Completion{job.record.id, false};
     }
     absl::StatusOr<std::vector<RenderTask>> merged =
-        SweepChunkOf(job, ref->task)
-            ? absl::InvalidArgumentError("a tile result for a sweep task")
-            : job.merger->Merge(ref->task, sums);
+        SweepChunkOf(job, ref->task) ? absl::InvalidArgumentError("a tile result for a sweep task")
+                                     : job.merger->Merge(ref->task, sums);
     if (!merged.ok()) return Refuse(*ref, lease_id, worker, merged.status());
     MarkDone(job, ref->task, now);
     for (const RenderTask& pass : *merged) QueuePass(job, pass);
@@ -575,12 +574,11 @@ absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
     }
     const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(job, ref->task);
     const SweepTaskNumbering::SweepChunk got{result.sweep, result.chunk};
-    absl::Status added =
-        !at ? absl::InvalidArgumentError("a sweep result for a tile")
-        : *at != got
-            ? absl::InvalidArgumentError(
-                  absl::StrCat("a result of sweep ", result.sweep, " chunk ", result.chunk))
-            : job.solve->Add(result);
+    absl::Status added = !at ? absl::InvalidArgumentError("a sweep result for a tile")
+                         : *at != got
+                             ? absl::InvalidArgumentError(absl::StrCat(
+                                   "a result of sweep ", result.sweep, " chunk ", result.chunk))
+                             : job.solve->Add(result);
     if (!added.ok()) return Refuse(*ref, lease_id, worker, added);
     MarkDone(job, ref->task, now);
     SweepCompletion completion{job.record.id, std::nullopt};

@@ -21,8 +21,8 @@
 #include "absl/time/time.h"
 #include "lf/core/image.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/task_assignment.h"
 #include "lf/job/merge.h"
+#include "lf/job/task_assignment.h"
 #include "server/job_state_machine.h"
 #include "server/job_store.h"
 #include "server/lease_timeouts.h"
@@ -68,11 +68,12 @@ class Scheduler {
     absl::StatusOr<std::vector<std::string>> Recover();
 
     // The first queued task of the highest-priority, oldest job that this worker may take (a
-    // task that failed here goes to a live worker it has not failed on, while there is one); when none is queued, a straggler's task (see speculate_after). Waits
-    // until `wait_until` for one to be queued (a long poll: an idle worker starts on a new job at
-    // once); nullopt when there is nothing to do.
+    // task that failed here goes to a live worker it has not failed on, while there is one); when
+    // none is queued, a straggler's task (see speculate_after). Waits until `wait_until` for one to
+    // be queued (a long poll: an idle worker starts on a new job at once); nullopt when there is
+    // nothing to do.
     std::optional<TaskAssignment> LeaseTask(const std::string& worker,
-                                   absl::Time wait_until = absl::InfinitePast());
+                                            absl::Time wait_until = absl::InfinitePast());
 
     // Extends the lease. False means stop: the job was cancelled or the lease is gone.
     bool Heartbeat(const std::string& lease_id, const std::string& worker);
@@ -167,9 +168,9 @@ class Scheduler {
         uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
         SpeculationPolicy speculation{absl::ZeroDuration()};
         // Radiosity solved in sweeps: while `solve` is set, its patch-group tasks follow the
-        // tiles (numbered by `sweeps`, set once the job solves in sweeps) and the tiles wait. A chunk goes back to the worker that did it
-        // before, which keeps its form-factor rows; that is soft state, so any worker may take a
-        // chunk whose owner is gone.
+        // tiles (numbered by `sweeps`, set once the job solves in sweeps) and the tiles wait. A
+        // chunk goes back to the worker that did it before, which keeps its form-factor rows; that
+        // is soft state, so any worker may take a chunk whose owner is gone.
         std::unique_ptr<RadiositySolve> solve{};
         std::optional<SweepTaskNumbering> sweeps{};
         std::string sweep_input{};  // blob of the current sweep's input; "" in sweep 0

@@ -6,11 +6,16 @@ namespace lf {
 
 const char* TaskStateName(TaskState state) {
     switch (state) {
-        case TaskState::kWaiting: return "waiting";
-        case TaskState::kQueued: return "queued";
-        case TaskState::kLeased: return "leased";
-        case TaskState::kDone: return "done";
-        case TaskState::kDropped: return "dropped";
+        case TaskState::kWaiting:
+            return "waiting";
+        case TaskState::kQueued:
+            return "queued";
+        case TaskState::kLeased:
+            return "leased";
+        case TaskState::kDone:
+            return "done";
+        case TaskState::kDropped:
+            return "dropped";
     }
     return "unknown";
 }
@@ -24,7 +29,8 @@ bool IsLegalTaskTransition(TaskState from, TaskState to) {
         case TaskState::kLeased:
             return to == TaskState::kQueued || to == TaskState::kDone || to == TaskState::kDropped;
         case TaskState::kDone:
-        case TaskState::kDropped: return false;
+        case TaskState::kDropped:
+            return false;
     }
     return false;
 }
@@ -46,8 +52,9 @@ absl::Status TaskStateMachine::Transition(int task, TaskState to) {
     }
     TaskState& from = states_[size_t(task)];
     if (!IsLegalTaskTransition(from, to)) {
-        return absl::FailedPreconditionError(absl::StrCat(
-            "task ", task, ": no transition from ", TaskStateName(from), " to ", TaskStateName(to)));
+        return absl::FailedPreconditionError(absl::StrCat("task ", task, ": no transition from ",
+                                                          TaskStateName(from), " to ",
+                                                          TaskStateName(to)));
     }
     if (from == TaskState::kQueued) queued_.erase(task);
     if (to == TaskState::kQueued) queued_.insert(task);

@@ -18,7 +18,8 @@ void TimeoutChecker::Stop() {
 
 void TimeoutChecker::Run() {
     std::unique_lock<std::mutex> lock(mutex_);
-    while (!stop_cv_.wait_for(lock, absl::ToChronoNanoseconds(interval_), [this] { return stop_; })) {
+    while (
+        !stop_cv_.wait_for(lock, absl::ToChronoNanoseconds(interval_), [this] { return stop_; })) {
         // Unlocked, so that Stop need not wait for a tick to be asked to end.
         lock.unlock();
         tick_();

@@ -107,7 +107,8 @@ TEST_F(SchedulerTest, RetriedTaskGoesToAnotherWorkerWhenThereIsOne) {
     Submit(0);
     const TaskAssignment lease = *scheduler_.LeaseTask("a");
     scheduler_.LeaseTask("b");  // b is alive
-    ASSERT_TRUE(scheduler_.Fail(lease.lease_id, "a", "out of memory", FailureKind::kTaskError).ok());
+    ASSERT_TRUE(
+        scheduler_.Fail(lease.lease_id, "a", "out of memory", FailureKind::kTaskError).ok());
     const TaskAssignment next_for_a = *scheduler_.LeaseTask("a");
     EXPECT_NE(next_for_a.task.index, lease.task.index);
     const TaskAssignment next_for_b = *scheduler_.LeaseTask("b");
@@ -140,7 +141,8 @@ TEST_F(SchedulerTest, ThirdFailureFailsTheJobWithTheReason) {
 TEST_F(SchedulerTest, LastErrorShowsWhileTheTaskIsRetried) {
     const std::string id = Submit(0, 16, 1);  // one task
     const TaskAssignment lease = *scheduler_.LeaseTask("w");
-    ASSERT_TRUE(scheduler_.Fail(lease.lease_id, "w", "out of memory", FailureKind::kTaskError).ok());
+    ASSERT_TRUE(
+        scheduler_.Fail(lease.lease_id, "w", "out of memory", FailureKind::kTaskError).ok());
     EXPECT_EQ(Job(id).state, JobState::kRunning);
     EXPECT_EQ(Job(id).last_error, "task 0: out of memory (worker w)");
     EXPECT_EQ(Job(id).error, "");
@@ -164,7 +166,8 @@ TEST_P(AlwaysFailingTaskTest, FailsTheJobAfterMaxFailuresNamingTheTaskAndTheLast
             ASSERT_TRUE(
                 scheduler_.Fail(lease->lease_id, worker, reason, FailureKind::kTaskError).ok());
             if (Job(id).state == JobState::kRunning) {
-                EXPECT_EQ(Job(id).last_error, absl::StrCat("task 0: ", reason, " (worker ", worker, ")"));
+                EXPECT_EQ(Job(id).last_error,
+                          absl::StrCat("task 0: ", reason, " (worker ", worker, ")"));
             }
         }
     }
@@ -186,7 +189,7 @@ TEST_F(SchedulerTest, MadeUpWorkerIdsAreForgottenAfterALease) {
     const TaskAssignment lease = *scheduler_.LeaseTask("real");
     now_ += absl::Seconds(9);
     ASSERT_TRUE(scheduler_.Heartbeat(lease.lease_id, "real"));
-    now_ += absl::Seconds(2);  // the made-up ones are silent for a lease now
+    now_ += absl::Seconds(2);                 // the made-up ones are silent for a lease now
     EXPECT_EQ(scheduler_.ExpireLeases(), 0);  // the timeout checker's tick
     EXPECT_EQ(scheduler_.workers_tracked(), 1u);
 }
@@ -196,7 +199,8 @@ TEST_F(SchedulerTest, ExpiriesCountAsFailuresButShutdownsDoNot) {
     for (int i = 0; i < 10; ++i) {
         const TaskAssignment lease = *scheduler_.LeaseTask("w");
         ASSERT_TRUE(
-            scheduler_.Fail(lease.lease_id, "w", "worker shutting down", FailureKind::kWorkerShutdown)
+            scheduler_
+                .Fail(lease.lease_id, "w", "worker shutting down", FailureKind::kWorkerShutdown)
                 .ok());
     }
     EXPECT_EQ(Job(id).state, JobState::kRunning);
@@ -334,7 +338,8 @@ TEST_F(SchedulerTest, IdleWorkerWaitsForWorkAndGetsItAtOnce) {
         Submit(0);
     });
     const absl::Time start = absl::Now();
-    const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
+    const std::optional<TaskAssignment> lease =
+        scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
     submitter.join();
     EXPECT_TRUE(lease.has_value());
     EXPECT_LT(absl::Now() - start, absl::Seconds(5));
@@ -421,7 +426,7 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
     now_ += absl::Seconds(5);
     EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
-    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());   // reported once
+    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());         // reported once
     EXPECT_FALSE(scheduler_.Heartbeat(running->lease_id, "w"));  // the worker stops
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
     // Its late result changes nothing.
@@ -537,9 +542,8 @@ TEST(SchedulerLockTest, SubmitLooksUpItsRequestWithoutTheLock) {
     store.Hold();
     std::thread submit([&] { EXPECT_TRUE(scheduler.Submit(SmallSpec("req-1")).ok()); });
     store.AwaitBlocked();
-    EXPECT_TRUE(AnsweredWhileTheStoreWaits(store, [&] {
-        EXPECT_TRUE(scheduler.LeaseTask("w").has_value());
-    }));
+    EXPECT_TRUE(AnsweredWhileTheStoreWaits(
+        store, [&] { EXPECT_TRUE(scheduler.LeaseTask("w").has_value()); }));
     submit.join();
 }
 

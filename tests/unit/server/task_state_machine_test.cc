@@ -12,10 +12,10 @@ constexpr TaskState kAll[] = {TaskState::kWaiting, TaskState::kQueued, TaskState
 
 TEST(TaskStateMachine, OnlyTheDiagramsMovesAreLegal) {
     const std::set<std::pair<TaskState, TaskState>> legal = {
-        {TaskState::kWaiting, TaskState::kQueued}, {TaskState::kWaiting, TaskState::kDone},
+        {TaskState::kWaiting, TaskState::kQueued},  {TaskState::kWaiting, TaskState::kDone},
         {TaskState::kWaiting, TaskState::kDropped}, {TaskState::kQueued, TaskState::kLeased},
-        {TaskState::kQueued, TaskState::kDone},    {TaskState::kQueued, TaskState::kDropped},
-        {TaskState::kLeased, TaskState::kQueued},  {TaskState::kLeased, TaskState::kDone},
+        {TaskState::kQueued, TaskState::kDone},     {TaskState::kQueued, TaskState::kDropped},
+        {TaskState::kLeased, TaskState::kQueued},   {TaskState::kLeased, TaskState::kDone},
         {TaskState::kLeased, TaskState::kDropped},
     };
     for (TaskState from : kAll) {
@@ -53,7 +53,7 @@ TEST(TaskStateMachine, QueueAndRunningCountFollowTheStates) {
     EXPECT_EQ(m.running(), 2);
     ASSERT_TRUE(m.Transition(2, TaskState::kQueued).ok());  // its lease failed
     ASSERT_TRUE(m.Transition(0, TaskState::kDropped).ok());
-    ASSERT_TRUE(m.Transition(3, TaskState::kDone).ok());    // a late result
+    ASSERT_TRUE(m.Transition(3, TaskState::kDone).ok());  // a late result
     EXPECT_EQ(m.queued(), (std::set<int>{1, 2}));
     EXPECT_EQ(m.running(), 0);
     EXPECT_EQ(m.count(TaskState::kDropped), 1);
