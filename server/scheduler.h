@@ -1,11 +1,15 @@
-// The farm's task state machine, without I/O or gRPC: jobs are planned into tasks, tasks are
-// leased to workers by job priority then age, leases live while heartbeats extend them, and
-// results merge into the job's image.
+// The farm's scheduler, without I/O or gRPC: jobs are planned into tasks, tasks are leased to
+// workers by job priority then age, leases live while heartbeats extend them, and results merge
+// into the job's image. It composes small units, each tested alone: task states change only
+// through TaskStateMachine, job states through TransitionJob; LeaseTimeouts keeps the lease
+// deadlines, WorkerRegistry the live workers, SpeculationPolicy and TimeLimitReached decide
+// second leases and time limits, SweepTaskNumbering places a solve's tasks; the timeout checker
+// (TimeoutChecker) calls ExpireLeases and EnforceTimeLimits. The store is never read, nor waited
+// for, under the scheduler's lock.
 //
-// Task states are TaskStateMachine's, job states TransitionJob's. A lease that expires or a
-// failure puts the task back in the queue, where workers it has not failed on take it first; the
-// third counted failure fails the job. Cancelling a job drops all its tasks at once: their
-// heartbeats answer "stop".
+// A lease that expires or a failure puts the task back in the queue, where workers it has not
+// failed on take it first; the third counted failure fails the job. Cancelling a job drops all its
+// tasks at once: their heartbeats answer "stop".
 #pragma once
 
 #include <condition_variable>
