@@ -229,6 +229,9 @@ void PrintJob(const pb::Job& job) {
     } else {
         std::printf("  time      %.1f s queued\n", seconds(job.submitted_unix_ms(), now));
     }
+    if (!IsFinal(job.state()) && !job.last_error().empty()) {
+        std::printf("  last error  %s\n", job.last_error().c_str());
+    }
     if (!job.error().empty()) std::printf("  error     %s\n", job.error().c_str());
 }
 

@@ -5,13 +5,11 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
-#include <condition_variable>
 #include <cstdio>
-#include <mutex>
-#include <thread>
 
 #include "server/farm.h"
 #include "server/grpc_service.h"
+#include "server/timeout_checker.h"
 #include "lf/core/stop_signals.h"
 
 int main(int argc, char** argv) {
@@ -83,26 +81,13 @@ int main(int argc, char** argv) {
     spdlog::info("listening on {}:{}, data in {}, leases of {} s", host, port, options.data_dir,
                  lease_seconds);
 
-    // The timeout checker: expired leases go back to the queue, and adaptive jobs past their
-    // time limit stop sampling, within a tenth of a second.
-    std::mutex mutex;
-    std::condition_variable stop_cv;
-    bool stop = false;
-    std::thread checker([&] {
-        std::unique_lock<std::mutex> lock(mutex);
-        while (!stop_cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return stop; })) {
-            (*farm)->CheckTimers();
-        }
-    });
+    // Expired leases go back to the queue, and adaptive jobs past their time limit stop
+    // sampling, within a tenth of a second.
+    lf::TimeoutChecker timeout_checker(absl::Milliseconds(100), [&] { (*farm)->CheckTimers(); });
 
     spdlog::info("signal {}: shutting down", stop_signals.Wait());
     (*farm)->scheduler().Shutdown();
     server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
-    {
-        std::lock_guard<std::mutex> lock(mutex);
-        stop = true;
-    }
-    stop_cv.notify_all();
-    checker.join();
+    timeout_checker.Stop();
     return 0;
 }

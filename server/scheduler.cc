@@ -1,5 +1,6 @@
 #include "server/scheduler.h"
 
+#include <cstdlib>
 #include <random>
 
 #include "absl/strings/numbers.h"
@@ -7,6 +8,7 @@
 #include "absl/strings/str_split.h"
 #include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
+#include "server/time_limit.h"
 
 namespace lf {
 
@@ -25,14 +27,71 @@ std::string RandomHex(int digits) {
 
 std::string NewJobId() { return "job-" + RandomHex(10); }
 
+absl::Status AlreadyEnded(const JobRecord& record) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("job ", record.id, " has already ended (", JobStateName(record.state), ")"));
+}
+
 }  // namespace
 
 Scheduler::Scheduler(SchedulerOptions options, JobStore& store, Clock clock)
-    : options_(options), store_(store), clock_(std::move(clock)), boot_(RandomHex(6)) {}
+    : options_(options),
+      store_(store),
+      clock_(std::move(clock)),
+      boot_(RandomHex(6)),
+      workers_(options.lease) {}
 
-absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord record) {
+Scheduler::Locked::Locked(Scheduler& scheduler) : lock(scheduler.mutex_), scheduler_(scheduler) {}
+
+Scheduler::Locked::~Locked() {
+    if (!lock.owns_lock()) lock.lock();
+    if (scheduler_.to_settle_.empty()) return;
+    std::vector<std::pair<std::string, uint64_t>> ended;
+    for (const std::string& id : scheduler_.to_settle_) {
+        ended.emplace_back(id, scheduler_.ending_.at(id).ticket);
+    }
+    scheduler_.to_settle_.clear();
+    lock.unlock();
+    std::vector<absl::Status> durable;
+    for (const auto& [id, ticket] : ended) durable.push_back(scheduler_.store_.WaitDurable(ticket));
+    lock.lock();
+    for (size_t i = 0; i < ended.size(); ++i) {
+        auto it = scheduler_.ending_.find(ended[i].first);
+        if (!durable[i].ok()) {
+            Log()->error("job={} ended ({}) but not recorded: {}", it->first,
+                         JobStateName(it->second.record.state), std::string(durable[i].message()));
+            // Readers and watchers still learn how it ended; the store, which says it runs, has
+            // it run again after a restart.
+            scheduler_.unrecorded_[it->first] = std::move(it->second.record);
+        }
+        scheduler_.ending_.erase(it);
+    }
+}
+
+void Scheduler::MoveTask(Job& job, int t, TaskState to) {
+    if (absl::Status s = job.states.Transition(t, to); !s.ok()) {
+        Log()->critical("job={} {}", job.record.id, std::string(s.message()));
+        std::abort();
+    }
+}
+
+void Scheduler::MoveJob(Job& job, JobState to) {
+    if (absl::Status s = TransitionJob(job.record, to, clock_()); !s.ok()) {
+        Log()->critical("{}", std::string(s.message()));
+        std::abort();
+    }
+}
+
+void Scheduler::Grow(Job& job, size_t count) {
+    job.states.Resize(count);
+    job.tasks.resize(count);
+}
+
+absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord record) const {
     const JobSpec& spec = record.spec;
-    auto job = std::make_unique<Job>(Job{std::move(record), nullptr});
+    auto job = std::make_unique<Job>();
+    job->record = std::move(record);
+    job->speculation = SpeculationPolicy(options_.speculate_after);
     if (IsAdaptive(spec.adaptive)) {
         absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan = AdaptiveTilePlan::Make(
             spec.plan.width, spec.plan.height, spec.plan.spp, spec.plan.tile, spec.adaptive);
@@ -44,7 +103,7 @@ absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord reco
         if (!plan.ok()) return plan.status();
         job->merger = std::make_unique<RenderMerger>(spec.plan.width, spec.plan.height, *plan);
     }
-    job->tasks.resize(job->merger->tasks().size());
+    Grow(*job, job->merger->tasks().size());
     return job;
 }
 
@@ -57,27 +116,35 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     QueueStart(*job);
     job->record.submitted = clock_();
     job->record.tasks_total = int(job->tasks.size());
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (std::optional<std::pair<std::string, uint64_t>> earlier = FindRequest(spec.request_id)) {
-        lock.unlock();
+    // The store is read before the lock is taken. An earlier submission it does not hold has not
+    // been acknowledged yet, so it is still in memory.
+    std::optional<std::string> stored =
+        spec.request_id.empty() ? std::nullopt : store_.FindRequest(spec.request_id);
+    std::string id = NewJobId();
+    while (store_.Get(id).ok()) id = NewJobId();
+    Locked locked(*this);
+    std::optional<std::pair<std::string, uint64_t>> earlier =
+        stored ? std::pair{*stored, uint64_t(0)} : FindRequestInMemory(spec.request_id);
+    if (earlier) {
+        locked.lock.unlock();
         if (absl::Status s = store_.WaitDurable(earlier->second); !s.ok()) return s;
         Log()->info("job={} submitted again (request {})", earlier->first, spec.request_id);
         return earlier->first;
     }
-    std::string id = NewJobId();
-    while (active_.count(id) || store_.Get(id).ok()) id = NewJobId();
+    // Ids are random: one the store lacks is taken in memory only by a freak.
+    while (active_.count(id) || EndedRecord(id)) id = NewJobId();
     job->record.id = id;
     job->record.seq = next_seq_++;
     const uint64_t ticket = Save(*job);
     job->submit_ticket = ticket;
     const size_t job_tasks = job->tasks.size();
     active_[id] = std::move(job);
-    lock.unlock();
+    locked.lock.unlock();
     // Acknowledged only once durable; waiting outside the lock lets submissions and results
     // share one sync.
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
         Log()->error("job={} refused: {}", id, std::string(s.message()));
-        lock.lock();
+        locked.lock.lock();
         active_.erase(id);
         return s;
     }
@@ -94,23 +161,32 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     return id;
 }
 
-std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequest(
+std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(
     const std::string& request_id) const {
     if (request_id.empty()) return std::nullopt;
     for (const auto& [id, job] : active_) {
         if (job->record.spec.request_id == request_id) return std::pair{id, job->submit_ticket};
     }
-    if (std::optional<std::string> id = store_.FindRequest(request_id)) {
-        return std::pair{*id, uint64_t(0)};
+    for (const auto& [id, ending] : ending_) {
+        if (ending.record.spec.request_id == request_id) return std::pair{id, ending.ticket};
+    }
+    for (const auto& [id, record] : unrecorded_) {
+        if (record.spec.request_id == request_id) return std::pair{id, uint64_t(0)};
     }
     return std::nullopt;
+}
+
+const JobRecord* Scheduler::EndedRecord(const std::string& job_id) const {
+    if (auto it = ending_.find(job_id); it != ending_.end()) return &it->second.record;
+    if (auto it = unrecorded_.find(job_id); it != unrecorded_.end()) return &it->second;
+    return nullptr;
 }
 
 absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
     {
         std::lock_guard<std::mutex> lock(mutex_);
         if (auto it = active_.find(job_id); it != active_.end()) return it->second->record;
-        if (auto it = unrecorded_.find(job_id); it != unrecorded_.end()) return it->second;
+        if (const JobRecord* ended = EndedRecord(job_id)) return *ended;
     }
     return store_.Get(job_id);
 }
@@ -120,25 +196,42 @@ std::vector<JobRecord> Scheduler::List() const {
     std::lock_guard<std::mutex> lock(mutex_);
     for (JobRecord& job : jobs) {
         if (auto it = active_.find(job.id); it != active_.end()) job = it->second->record;
-        if (auto it = unrecorded_.find(job.id); it != unrecorded_.end()) job = it->second;
+        if (const JobRecord* ended = EndedRecord(job.id)) job = *ended;
     }
     return jobs;
 }
 
-absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
+size_t Scheduler::workers_tracked() const {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<std::string> rendered;
+    return workers_.size();
+}
+
+absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
+    // The store is read before the lock is taken.
+    struct Stored {
+        JobRecord record;
+        std::map<int, std::string> results;
+    };
+    std::vector<Stored> stored;
+    uint64_t last_seq = 0;
     for (JobRecord& record : store_.List()) {
-        next_seq_ = std::max(next_seq_, record.seq + 1);
-        if (IsFinal(record.state) || active_.count(record.id)) continue;
+        last_seq = std::max(last_seq, record.seq);
+        if (IsFinal(record.state)) continue;
         absl::StatusOr<std::map<int, std::string>> results = store_.TaskResults(record.id);
         if (!results.ok()) return results.status();
-        absl::StatusOr<std::unique_ptr<Job>> made = NewJob(std::move(record));
+        stored.push_back({std::move(record), std::move(*results)});
+    }
+    Locked locked(*this);
+    next_seq_ = std::max(next_seq_, last_seq + 1);
+    std::vector<std::string> rendered;
+    for (Stored& s : stored) {
+        if (active_.count(s.record.id)) continue;
+        absl::StatusOr<std::unique_ptr<Job>> made = NewJob(std::move(s.record));
         if (!made.ok()) return made.status();
         std::unique_ptr<Job> job = std::move(*made);
         // In index order, an adaptive plan appends each pass before its result comes up: the
         // passes it planned depend only on the results before them.
-        for (const auto& [t, bytes] : *results) {
+        for (const auto& [t, bytes] : s.results) {
             absl::StatusOr<TileSums> sums = DecodeTileSums(bytes);
             absl::StatusOr<std::vector<RenderTask>> pass =
                 sums.ok() ? job->merger->Merge(t, *sums)
@@ -150,14 +243,13 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
                             job->record.id, t);
                 continue;
             }
-            job->tasks[size_t(t)].state = TaskState::kDone;
-            job->tasks.resize(job->merger->tasks().size());
+            MoveTask(*job, t, TaskState::kDone);
+            Grow(*job, job->merger->tasks().size());
         }
         QueueStart(*job);
         job->record.tasks_done = int(job->merger->tasks_done());
         job->record.tasks_total = int(job->tasks.size());
         job->record.stats = job->merger->stats();
-        job->record.tasks_running = 0;
         Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before",
                     job->record.id, job->record.tasks_done, job->record.tasks_total,
                     job->record.tasks_leased);
@@ -170,19 +262,13 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     return rendered;
 }
 
-bool Scheduler::OtherWorkersAlive(const std::string& worker, absl::Time now) const {
-    for (const auto& [w, seen] : workers_seen_) {
-        if (w != worker && now - seen < options_.lease) return true;
-    }
-    return false;
-}
-
-std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker, absl::Time wait_until) {
-    std::unique_lock<std::mutex> lock(mutex_);
+std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker,
+                                                   absl::Time wait_until) {
+    Locked locked(*this);
     while (true) {
         if (std::optional<TaskAssignment> lease = TryLease(worker)) return lease;
         const uint64_t version = version_;
-        if (shutdown_ || !changed_.wait_until(lock, absl::ToChronoTime(wait_until),
+        if (shutdown_ || !changed_.wait_until(locked.lock, absl::ToChronoTime(wait_until),
                                               [&] { return version_ != version || shutdown_; })) {
             return std::nullopt;
         }
@@ -191,9 +277,8 @@ std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker, ab
 
 std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker) {
     const absl::Time now = clock_();
-    workers_seen_[worker] = now;
-    // A task that failed here goes to another worker when there is one.
-    const bool avoid_repeats = OtherWorkersAlive(worker, now);
+    workers_.Seen(worker, now);
+    workers_.ForgetSilent(now);  // so that the workers kept are the live ones
     Job* best = nullptr;
     int best_task = -1;
     for (auto& [id, job] : active_) {
@@ -202,8 +287,7 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker) {
                       job->record.seq > best->record.seq))) {
             continue;
         }
-        for (int t : job->queued) {
-            if (avoid_repeats && job->tasks[size_t(t)].failed_on.count(worker)) continue;
+        for (int t : job->states.queued()) {
             if (!MayTake(*job, t, worker, now)) continue;
             best = job.get();
             best_task = t;
@@ -222,16 +306,14 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker) {
 }
 
 int Scheduler::StragglerFor(const Job& job, const std::string& worker, absl::Time now) const {
-    if (!job.queued.empty()) return -1;
-    absl::Duration limit = options_.speculate_after;
-    if (job.tasks_timed > 0) limit = std::max(limit, 2 * job.task_time_total / job.tasks_timed);
+    if (!job.states.queued().empty()) return -1;
     int oldest = -1;
     for (int t = 0; t < int(job.tasks.size()); ++t) {
         const Task& task = job.tasks[size_t(t)];
-        if (task.state != TaskState::kLeased || task.live.size() != 1 ||
+        if (job.states.state(t) != TaskState::kLeased || task.live.size() != 1 ||
             task.failed_on.count(worker) ||
             task.holders[size_t(*task.live.begin() - 1)] == worker ||
-            now - task.leased_at < limit) {
+            !job.speculation.IsStraggler(now - task.leased_at)) {
             continue;
         }
         if (oldest < 0 || task.leased_at < job.tasks[size_t(oldest)].leased_at) oldest = t;
@@ -245,11 +327,9 @@ std::string Scheduler::LeaseId(const Job& job, int task, int attempt) const {
 
 TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time now) {
     Task& task = job.tasks[size_t(t)];
-    if (task.state == TaskState::kQueued) {
-        job.queued.erase(t);
-        task.state = TaskState::kLeased;
+    if (job.states.state(t) == TaskState::kQueued) {
+        MoveTask(job, t, TaskState::kLeased);
         task.leased_at = now;
-        ++job.record.tasks_running;
     }
     ++task.attempts;
     task.holders.push_back(worker);
@@ -257,10 +337,7 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
     ++job.record.tasks_leased;
     const std::string lease_id = LeaseId(job, t, task.attempts);
     timeouts_.Set(lease_id, now + options_.lease);
-    if (job.record.state == JobState::kQueued) {
-        job.record.state = JobState::kRunning;
-        job.record.started = now;
-    }
+    if (job.record.state == JobState::kQueued) MoveJob(job, JobState::kRunning);
     Save(job);
     Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, worker,
                  task.attempts);
@@ -270,16 +347,16 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
     lease.spec = job.record.spec;
     lease.lease = options_.lease;
     lease.heartbeat_interval = options_.heartbeat_interval;
-    if (!IsSweepTask(job, t)) {
+    const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(job, t);
+    if (!at) {
         lease.task = job.merger->tasks()[size_t(t)];
         lease.radiosity_hash = job.solution;
         return lease;
     }
-    const int k = t - int(job.merger->tasks().size()), chunks = job.solve->chunks();
-    job.chunk_owner[k % chunks] = worker;
+    job.chunk_owner[at->chunk] = worker;
     lease.task.index = t;
-    lease.sweep = k / chunks;
-    lease.chunk = k % chunks;
+    lease.sweep = at->sweep;
+    lease.chunk = at->chunk;
     lease.radiosity_hash = job.sweep_input;
     return lease;
 }
@@ -290,27 +367,35 @@ void Scheduler::QueueStart(Job& job) {
         // tiles already done stay done.
         const RadiositySettings& r = job.record.spec.radiosity;
         job.solve = std::make_unique<RadiositySolve>(r.sweep_tasks, r.tolerance, r.max_iterations);
+        job.sweeps = SweepTaskNumbering{int(job.merger->tasks().size()), job.solve->chunks()};
         job.sweep_input.clear();
         QueueSweep(job);
         return;
     }
     for (int t = 0; t < int(job.merger->tasks().size()); ++t) {
-        if (job.tasks[size_t(t)].state == TaskState::kDone) continue;
+        if (job.states.state(t) != TaskState::kWaiting) continue;
         if (job.adaptive && !job.adaptive->IsPending(t)) continue;
-        job.queued.insert(t);
+        MoveTask(job, t, TaskState::kQueued);
+    }
+}
+
+void Scheduler::QueueSweep(Job& job) {
+    const int sweep = job.solve->sweep();
+    Grow(job, size_t(job.sweeps->ToIndex({sweep + 1, 0})));
+    for (int c = 0; c < job.sweeps->chunks; ++c) {
+        MoveTask(job, job.sweeps->ToIndex({sweep, c}), TaskState::kQueued);
     }
 }
 
 void Scheduler::QueuePass(Job& job, const RenderTask& pass) {
-    job.tasks.resize(size_t(pass.index) + 1);
-    job.queued.insert(pass.index);
+    Grow(job, size_t(pass.index) + 1);
+    MoveTask(job, pass.index, TaskState::kQueued);
     job.record.tasks_total = int(job.tasks.size());
 }
 
 bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
-    if (!job.adaptive || job.adaptive->stopped() || job.record.spec.adaptive.time_limit <= 0 ||
-        job.record.started == absl::InfinitePast() ||
-        now - job.record.started < absl::Seconds(job.record.spec.adaptive.time_limit)) {
+    if (!job.adaptive || job.adaptive->stopped() ||
+        !TimeLimitReached(job.record.spec.adaptive, job.record.started, now)) {
         return false;
     }
     const std::vector<int> dropped = job.adaptive->Stop();
@@ -318,9 +403,7 @@ bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
         Task& task = job.tasks[size_t(t)];
         for (int attempt : task.live) timeouts_.Remove(LeaseId(job, t, attempt));
         task.live.clear();
-        if (task.state == TaskState::kLeased) --job.record.tasks_running;
-        job.queued.erase(t);
-        task.state = TaskState::kDropped;
+        MoveTask(job, t, TaskState::kDropped);
     }
     job.record.tasks_total -= int(dropped.size());
     Log()->info("job={} time limit of {} s reached: {} passes dropped, {} tasks merged",
@@ -332,7 +415,7 @@ bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
 }
 
 std::vector<std::string> Scheduler::EnforceTimeLimits() {
-    std::lock_guard<std::mutex> lock(mutex_);
+    Locked locked(*this);
     std::vector<std::string> rendered;
     const absl::Time now = clock_();
     for (auto& [id, job] : active_) {
@@ -341,20 +424,26 @@ std::vector<std::string> Scheduler::EnforceTimeLimits() {
     return rendered;
 }
 
-void Scheduler::QueueSweep(Job& job) {
-    for (int c = 0; c < job.solve->chunks(); ++c) {
-        job.queued.insert(int(job.tasks.size()));
-        job.tasks.emplace_back();
-    }
+std::optional<SweepTaskNumbering::SweepChunk> Scheduler::SweepChunkOf(const Job& job, int t) {
+    return job.sweeps ? job.sweeps->FromIndex(t) : std::nullopt;
 }
 
 bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::Time now) const {
-    if (!IsSweepTask(job, t)) return true;
-    const auto owner =
-        job.chunk_owner.find((t - int(job.merger->tasks().size())) % job.solve->chunks());
-    if (owner == job.chunk_owner.end() || owner->second == worker) return true;
-    const auto seen = workers_seen_.find(owner->second);
-    return seen == workers_seen_.end() || now - seen->second >= options_.lease;
+    if (const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(job, t)) {
+        const auto owner = job.chunk_owner.find(at->chunk);
+        if (owner != job.chunk_owner.end() && owner->second != worker &&
+            workers_.IsLive(owner->second, now)) {
+            return false;
+        }
+    }
+    const Task& task = job.tasks[size_t(t)];
+    if (!task.failed_on.count(worker)) return true;
+    // It failed here: it waits for a live worker it has not failed on. Once it has failed on
+    // every live worker it is tried again anywhere, so its failures end the job. `failed_on`
+    // holds fewer than max_failures workers, and the workers kept are the live ones.
+    size_t live_failed = 0;
+    for (const std::string& w : task.failed_on) live_failed += workers_.IsLive(w, now);
+    return workers_.size() <= live_failed;
 }
 
 std::optional<Scheduler::LeaseRef> Scheduler::Resolve(const std::string& lease_id) {
@@ -380,15 +469,16 @@ bool Scheduler::HeldBy(const LeaseRef& ref, const std::string& worker) {
 
 bool Scheduler::IsCurrent(const LeaseRef& ref) {
     const Task& task = ref.job->tasks[size_t(ref.task)];
-    return task.state == TaskState::kLeased && task.live.count(ref.attempt);
+    return ref.job->states.state(ref.task) == TaskState::kLeased && task.live.count(ref.attempt);
 }
 
 bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    Locked locked(*this);
     const absl::Time now = clock_();
-    workers_seen_[worker] = now;
     const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !HeldBy(*ref, worker) || !IsCurrent(*ref)) return false;
+    if (!ref || !HeldBy(*ref, worker)) return false;  // a made-up id is not kept
+    workers_.Seen(worker, now);
+    if (!IsCurrent(*ref)) return false;
     timeouts_.Set(lease_id, now + options_.lease);
     return true;
 }
@@ -396,36 +486,37 @@ bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker
 absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lease_id,
                                                           const std::string& worker,
                                                           const TileSums& sums) {
-    std::unique_lock<std::mutex> lock(mutex_);
+    Locked locked(*this);
     const absl::Time now = clock_();
     const absl::StatusOr<LeaseRef> ref = ResultLease(lease_id, worker, now);
     if (!ref.ok()) return ref.status();
     Job& job = *ref->job;
-    Task& task = job.tasks[size_t(ref->task)];
-    if (task.state == TaskState::kDone || task.state == TaskState::kDropped) {
+    const TaskState state = job.states.state(ref->task);
+    if (state == TaskState::kDone || state == TaskState::kDropped) {
         return Completion{job.record.id, false};
     }
     absl::StatusOr<std::vector<RenderTask>> merged =
-        IsSweepTask(job, ref->task) ? absl::InvalidArgumentError("a tile result for a sweep task")
-                                    : job.merger->Merge(ref->task, sums);
+        SweepChunkOf(job, ref->task) ? absl::InvalidArgumentError("a tile result for a sweep task")
+                                     : job.merger->Merge(ref->task, sums);
     if (!merged.ok()) return Refuse(*ref, lease_id, worker, merged.status());
     MarkDone(job, ref->task, now);
     for (const RenderTask& pass : *merged) QueuePass(job, pass);
     EnforceTimeLimit(job, now);
     job.record.tasks_done = int(job.merger->tasks_done());
     job.record.stats = job.merger->stats();
+    job.record.tasks_running = job.states.running();
     const uint64_t ticket = store_.QueueTaskDone(job.record, ref->task, EncodeTileSums(sums));
     ++version_;
     changed_.notify_all();
     Log()->debug("job={} task={} done by {} ({}/{})", job.record.id, ref->task, worker,
                  job.record.tasks_done, job.record.tasks_total);
     const Completion completion{job.record.id, job.merger->Complete()};
-    lock.unlock();
+    locked.lock.unlock();
     // The worker hears "done" only once the result is durable.
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
         // The merge cannot be taken back, and a job whose results are not all recorded would not
         // survive a restart: it fails here, and the worker hears why.
-        lock.lock();
+        locked.lock.lock();
         if (auto it = active_.find(completion.job_id); it != active_.end()) {
             FailJob(*it->second,
                     absl::StrCat("recording the result of task ", ref->task, ": ", s.message()));
@@ -438,13 +529,13 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
 absl::StatusOr<Scheduler::LeaseRef> Scheduler::ResultLease(const std::string& lease_id,
                                                            const std::string& worker,
                                                            absl::Time now) {
-    workers_seen_[worker] = now;
     const std::optional<LeaseRef> ref = Resolve(lease_id);
     if (!ref || !HeldBy(*ref, worker)) {
         Log()->warn("result for lease {} from {} refused: not a lease it holds", lease_id, worker);
         return absl::FailedPreconditionError(absl::StrCat(
             "lease ", lease_id, " is not one of worker ", worker, " in a running job"));
     }
+    workers_.Seen(worker, now);
     return *ref;
 }
 
@@ -461,37 +552,33 @@ absl::Status Scheduler::Refuse(const LeaseRef& ref, const std::string& lease_id,
 
 void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
     Task& task = job.tasks[size_t(t)];
-    if (task.state == TaskState::kLeased) {
+    if (job.states.state(t) == TaskState::kLeased) {
         // Whoever else holds a lease of it (a retry or a speculative copy) learns at its next
         // heartbeat.
         for (int attempt : task.live) timeouts_.Remove(LeaseId(job, t, attempt));
         task.live.clear();
-        --job.record.tasks_running;
-        job.task_time_total += now - task.leased_at;
-        ++job.tasks_timed;
-    } else {
-        job.queued.erase(t);
+        job.speculation.TaskDone(now - task.leased_at);
     }
-    task.state = TaskState::kDone;
+    MoveTask(job, t, TaskState::kDone);
 }
 
 absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
     const std::string& lease_id, const std::string& worker, const SweepChunkResult& result) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    Locked locked(*this);
     const absl::Time now = clock_();
     const absl::StatusOr<LeaseRef> ref = ResultLease(lease_id, worker, now);
     if (!ref.ok()) return ref.status();
     Job& job = *ref->job;
-    if (job.tasks[size_t(ref->task)].state == TaskState::kDone) {
+    if (job.states.state(ref->task) == TaskState::kDone) {
         return SweepCompletion{job.record.id, std::nullopt};
     }
-    const int k = ref->task - int(job.merger->tasks().size());
-    absl::Status added =
-        !IsSweepTask(job, ref->task) ? absl::InvalidArgumentError("a sweep result for a tile")
-        : result.sweep != k / job.solve->chunks() || result.chunk != k % job.solve->chunks()
-            ? absl::InvalidArgumentError(
-                  absl::StrCat("a result of sweep ", result.sweep, " chunk ", result.chunk))
-            : job.solve->Add(result);
+    const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(job, ref->task);
+    const SweepTaskNumbering::SweepChunk got{result.sweep, result.chunk};
+    absl::Status added = !at ? absl::InvalidArgumentError("a sweep result for a tile")
+                         : *at != got
+                             ? absl::InvalidArgumentError(absl::StrCat(
+                                   "a result of sweep ", result.sweep, " chunk ", result.chunk))
+                             : job.solve->Add(result);
     if (!added.ok()) return Refuse(*ref, lease_id, worker, added);
     MarkDone(job, ref->task, now);
     SweepCompletion completion{job.record.id, std::nullopt};
@@ -511,7 +598,7 @@ absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
 
 void Scheduler::Publish(const std::string& job_id, bool converged,
                         const absl::StatusOr<std::string>& hash) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    Locked locked(*this);
     auto it = active_.find(job_id);
     if (it == active_.end()) return;  // cancelled meanwhile
     Job& job = *it->second;
@@ -532,7 +619,7 @@ void Scheduler::Publish(const std::string& job_id, bool converged,
 
 absl::Status Scheduler::Fail(const std::string& lease_id, const std::string& worker,
                              const std::string& reason, FailureKind kind) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    Locked locked(*this);
     const std::optional<LeaseRef> ref = Resolve(lease_id);
     if (!ref || !HeldBy(*ref, worker) || !IsCurrent(*ref)) return absl::OkStatus();
     timeouts_.Remove(lease_id);
@@ -548,6 +635,7 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
     if (counted) {
         ++task.failures;
         task.failed_on.insert(task.holders[size_t(ref.attempt - 1)]);
+        job.record.last_error = absl::StrCat("task ", t, ": ", reason);
     }
     Log()->warn("job={} task={} attempt {} failed: {}{}", job.record.id, t, ref.attempt, reason,
                 counted ? "" : " (not counted)");
@@ -556,55 +644,54 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
         return;
     }
     if (task.live.empty()) {  // otherwise another lease of it is still rendering
-        task.state = TaskState::kQueued;
-        --job.record.tasks_running;
-        job.queued.insert(t);
+        MoveTask(job, t, TaskState::kQueued);
         ++job.record.retries;
     }
     Save(job);
 }
 
 void Scheduler::FailJob(Job& job, const std::string& error) {
-    job.record.state = JobState::kFailed;
+    MoveJob(job, JobState::kFailed);
     job.record.error = error;
     Log()->error("job={} failed: {}", job.record.id, error);
     EndJob(job);
 }
 
-void Scheduler::EndJob(Job& job) {
-    job.record.finished = clock_();
-    job.record.tasks_running = 0;
+JobRecord Scheduler::EndJob(Job& job) {
     for (int t = 0; t < int(job.tasks.size()); ++t) {
         for (int attempt : job.tasks[size_t(t)].live) timeouts_.Remove(LeaseId(job, t, attempt));
     }
-    if (absl::Status s = store_.WaitDurable(Save(job)); !s.ok()) {
-        Log()->error("job={} ended ({}) but not recorded: {}", job.record.id,
-                     JobStateName(job.record.state), std::string(s.message()));
-        // Readers and watchers still learn how it ended; the store, which says it runs, has it
-        // run again after a restart.
-        unrecorded_[job.record.id] = job.record;
-    }
-    active_.erase(job.record.id);  // destroys `job`
+    const std::string id = job.record.id;
+    const uint64_t ticket = Save(job);
+    ending_[id] = Ending{job.record, ticket};
+    to_settle_.push_back(id);
+    active_.erase(id);  // destroys `job`
+    return ending_[id].record;
 }
 
 absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    auto it = active_.find(job_id);
-    if (it == active_.end()) {
-        absl::StatusOr<JobRecord> record = store_.Get(job_id);
-        if (!record.ok()) return record.status();
-        return absl::FailedPreconditionError(
-            absl::StrCat("job ", job_id, " has already ended (", JobStateName(record->state), ")"));
-    }
-    it->second->record.state = JobState::kCancelled;
-    EndJob(*it->second);
-    Log()->info("job={} cancelled", job_id);
-    return store_.Get(job_id);
+    std::optional<JobRecord> cancelled;
+    {
+        Locked locked(*this);
+        if (auto it = active_.find(job_id); it != active_.end()) {
+            MoveJob(*it->second, JobState::kCancelled);
+            cancelled = EndJob(*it->second);
+            Log()->info("job={} cancelled", job_id);
+        } else if (const JobRecord* ended = EndedRecord(job_id)) {
+            return AlreadyEnded(*ended);
+        }
+    }  // the cancellation is durable here, or logged as not recorded
+    if (cancelled) return *cancelled;
+    absl::StatusOr<JobRecord> record = store_.Get(job_id);
+    if (!record.ok()) return record.status();
+    return AlreadyEnded(*record);
 }
 
 int Scheduler::ExpireLeases() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const std::vector<std::string> expired = timeouts_.TakeExpired(clock_());
+    Locked locked(*this);
+    const absl::Time now = clock_();
+    workers_.ForgetSilent(now);
+    const std::vector<std::string> expired = timeouts_.TakeExpired(now);
     for (const std::string& lease_id : expired) {
         const std::optional<LeaseRef> ref = Resolve(lease_id);
         if (!ref || !IsCurrent(*ref)) continue;
@@ -635,7 +722,7 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_i
 }
 
 void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    Locked locked(*this);
     auto it = active_.find(job_id);
     if (it == active_.end()) return;  // cancelled meanwhile
     Job& job = *it->second;
@@ -643,7 +730,7 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
         FailJob(job, absl::StrCat("writing the result: ", result_path.status().message()));
         return;
     }
-    job.record.state = JobState::kSucceeded;
+    MoveJob(job, JobState::kSucceeded);
     job.record.result_path = *result_path;
     Log()->info("job={} succeeded: {} samples -> {}", job_id, job.record.stats.samples,
                 *result_path);
@@ -651,6 +738,8 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
 }
 
 uint64_t Scheduler::Save(Job& job) {
+    // Derived, so that the record cannot disagree with the task states.
+    job.record.tasks_running = IsFinal(job.record.state) ? 0 : job.states.running();
     const uint64_t ticket = store_.QueuePut(job.record);
     ++version_;
     changed_.notify_all();

@@ -1,10 +1,15 @@
-// The farm's task state machine, without I/O or gRPC: jobs are planned into tasks, tasks are
-// leased to workers by job priority then age, leases live while heartbeats extend them, and
-// results merge into the job's image.
+// The farm's scheduler, without I/O or gRPC: jobs are planned into tasks, tasks are leased to
+// workers by job priority then age, leases live while heartbeats extend them, and results merge
+// into the job's image. It composes small units, each tested alone: task states change only
+// through TaskStateMachine, job states through TransitionJob; LeaseTimeouts keeps the lease
+// deadlines, WorkerRegistry the live workers, SpeculationPolicy and TimeLimitReached decide
+// second leases and time limits, SweepTaskNumbering places a solve's tasks; the timeout checker
+// (TimeoutChecker) calls ExpireLeases and EnforceTimeLimits. The store is never read, nor waited
+// for, under the scheduler's lock.
 //
-// Task states: queued -> leased -> done. A lease that expires or a failure puts the task back
-// in the queue, where other workers take it first; the third counted failure fails the job.
-// Cancelling a job drops all its tasks at once: their heartbeats answer "stop".
+// A lease that expires or a failure puts the task back in the queue, where workers it has not
+// failed on take it first; the third counted failure fails the job. Cancelling a job drops all its
+// tasks at once: their heartbeats answer "stop".
 #pragma once
 
 #include <condition_variable>
@@ -20,11 +25,16 @@
 #include "absl/time/time.h"
 #include "lf/core/image.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/merge.h"
 #include "lf/job/task_assignment.h"
+#include "server/job_state_machine.h"
 #include "server/job_store.h"
 #include "server/lease_timeouts.h"
-#include "lf/job/merge.h"
 #include "server/radiosity_solve.h"
+#include "server/speculation.h"
+#include "server/sweep_task_numbering.h"
+#include "server/task_state_machine.h"
+#include "server/worker_registry.h"
 
 namespace lf {
 
@@ -61,12 +71,13 @@ class Scheduler {
     // are fully rendered, whose result the caller writes and Finishes.
     absl::StatusOr<std::vector<std::string>> Recover();
 
-    // The first queued task of the highest-priority, oldest job, preferring tasks that have not
-    // failed on this worker; when none is queued, a straggler's task (see speculate_after). Waits
-    // until `wait_until` for one to be queued (a long poll: an idle worker starts on a new job at
-    // once); nullopt when there is nothing to do.
+    // The first queued task of the highest-priority, oldest job that this worker may take (a
+    // task that failed here goes to a live worker it has not failed on, while there is one); when
+    // none is queued, a straggler's task (see speculate_after). Waits until `wait_until` for one to
+    // be queued (a long poll: an idle worker starts on a new job at once); nullopt when there is
+    // nothing to do.
     std::optional<TaskAssignment> LeaseTask(const std::string& worker,
-                                   absl::Time wait_until = absl::InfinitePast());
+                                            absl::Time wait_until = absl::InfinitePast());
 
     // Extends the lease. False means stop: the job was cancelled or the lease is gone.
     bool Heartbeat(const std::string& lease_id, const std::string& worker);
@@ -106,8 +117,8 @@ class Scheduler {
 
     absl::StatusOr<JobRecord> Cancel(const std::string& job_id);
 
-    // Re-queues the tasks whose lease ran out (each counts as a failure of the task). Returns
-    // how many.
+    // Re-queues the tasks whose lease ran out (each counts as a failure of the task), and
+    // forgets the workers silent for a lease. Returns how many leases expired.
     int ExpireLeases();
 
     // Ends the sampling of adaptive jobs whose time limit has passed since they started: passes
@@ -136,11 +147,13 @@ class Scheduler {
     uint64_t WaitForChange(uint64_t version, absl::Time deadline);
     void Shutdown();  // wakes every WaitForChange for good
 
+    // Workers the scheduler keeps track of: the live ones, and silent ones not yet forgotten
+    // (the timeout checker forgets them within a tick of a lease's silence).
+    size_t workers_tracked() const;
+
   private:
-    // kDropped: an adaptive pass the time limit cut; its leases hear "stop".
-    enum class TaskState { kQueued, kLeased, kDone, kDropped };
+    // What a task's leases left behind; its state is in Job::states.
     struct Task {
-        TaskState state = TaskState::kQueued;
         int attempts = 0;                  // leases handed out
         int failures = 0;                  // counted failures
         std::vector<std::string> holders;  // the worker of each lease, by attempt - 1
@@ -151,19 +164,19 @@ class Scheduler {
     struct Job {
         JobRecord record;
         // The tiles' tasks and their results: a fixed plan, or an adaptive one (`adaptive`, the
-        // same object) whose passes are appended to `tasks` as results ask for them.
+        // same object) whose passes are appended to the tasks as results ask for them.
         std::unique_ptr<TileMerger> merger;
         AdaptiveTilePlan* adaptive = nullptr;
-        std::vector<Task> tasks{};
-        std::set<int> queued{};
+        TaskStateMachine states{};
+        std::vector<Task> tasks{};   // by index, as many as `states`
         uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
-        absl::Duration task_time_total = absl::ZeroDuration();  // lease to result, tasks done here
-        int tasks_timed = 0;
+        SpeculationPolicy speculation{absl::ZeroDuration()};
         // Radiosity solved in sweeps: while `solve` is set, its patch-group tasks follow the
-        // tiles in `tasks` (sweep k's chunk c at tiles + k * chunks + c) and the tiles
-        // wait. A chunk goes back to the worker that did it before, which keeps its form-factor
-        // rows; that is soft state, so any worker may take a chunk whose owner is gone.
+        // tiles (numbered by `sweeps`, set once the job solves in sweeps) and the tiles wait. A
+        // chunk goes back to the worker that did it before, which keeps its form-factor rows; that
+        // is soft state, so any worker may take a chunk whose owner is gone.
         std::unique_ptr<RadiositySolve> solve{};
+        std::optional<SweepTaskNumbering> sweeps{};
         std::string sweep_input{};  // blob of the current sweep's input; "" in sweep 0
         std::string solution{};     // blob of the solution, once solved
         std::map<int, std::string> chunk_owner{};
@@ -173,25 +186,52 @@ class Scheduler {
         int task;
         int attempt;
     };
+    // A job that ended, while its final record is queued but not yet durable: readers find it
+    // here until it is, then in the store.
+    struct Ending {
+        JobRecord record;
+        uint64_t ticket = 0;
+    };
+    // The scheduler's lock. Jobs ended while it is held have their final record queued, not
+    // durable; on release it waits for those writes with the lock released, so no fsync is ever
+    // waited for under it, then moves the jobs from `ending_` to the store's care.
+    class Locked {
+      public:
+        explicit Locked(Scheduler& scheduler);
+        ~Locked();
+        std::unique_lock<std::mutex> lock;
 
-    // The job of an earlier submission with this request id, and the store ticket to wait for.
-    std::optional<std::pair<std::string, uint64_t>> FindRequest(
+      private:
+        Scheduler& scheduler_;
+    };
+
+    // The job of an earlier submission with this request id held in memory, and the store
+    // ticket to wait for.
+    std::optional<std::pair<std::string, uint64_t>> FindRequestInMemory(
         const std::string& request_id) const;
+    // The record of a job that ended and is not (or not yet) in the store.
+    const JobRecord* EndedRecord(const std::string& job_id) const;
     std::optional<TaskAssignment> TryLease(const std::string& worker);
+    // The sweep and chunk of a patch-group task; nullopt for a tile's.
+    static std::optional<SweepTaskNumbering::SweepChunk> SweepChunkOf(const Job& job, int task);
+    // The one way the scheduler moves a task or a job; an illegal move is a broken invariant.
+    void MoveTask(Job& job, int task, TaskState to);
+    void MoveJob(Job& job, JobState to);
+    // Grows the job to `count` tasks, the new ones waiting.
+    static void Grow(Job& job, size_t count);
     // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
     void QueueStart(Job& job);
     void QueueSweep(Job& job);
-    static bool IsSweepTask(const Job& job, int task) {
-        return task >= int(job.merger->tasks().size());
-    }
     // A job with its tiles planned as its spec says; InvalidArgument when they cannot be.
-    static absl::StatusOr<std::unique_ptr<Job>> NewJob(JobRecord record);
+    absl::StatusOr<std::unique_ptr<Job>> NewJob(JobRecord record) const;
     // Queues a task the adaptive plan appended.
     void QueuePass(Job& job, const RenderTask& pass);
     // Drops an adaptive job's passes once its time limit has passed; true if dropping them
     // completed the job (so that it is reported once, here or by Complete).
     bool EnforceTimeLimit(Job& job, absl::Time now);
-    // A sweep task goes to its chunk's owner while that worker lives.
+    // Whether `worker` may take queued task `task` now: a sweep task goes to its chunk's owner
+    // while that worker lives, and a task that failed on `worker` waits for a live worker it has
+    // not failed on, while there is one.
     bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;
     // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).
     absl::StatusOr<LeaseRef> ResultLease(const std::string& lease_id, const std::string& worker,
@@ -201,7 +241,7 @@ class Scheduler {
                         const absl::Status& why);
     // The bookkeeping of a task's first accepted result.
     void MarkDone(Job& job, int task, absl::Time now);
-    // A second lease of a task running too long in the job, or -1 (see speculate_after).
+    // A second lease of a task running too long in the job, or -1 (see SpeculationPolicy).
     int StragglerFor(const Job& job, const std::string& worker, absl::Time now) const;
     TaskAssignment Grant(Job& job, int task, const std::string& worker, absl::Time now);
     std::string LeaseId(const Job& job, int task, int attempt) const;
@@ -214,11 +254,10 @@ class Scheduler {
     // Counts a failure unless `counted` is false; fails the job at max_failures.
     void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
     void FailJob(Job& job, const std::string& error);
-    // Drops the live state of a job in a final state, once its record is durable (so a reader
-    // never finds the ended job in neither place).
-    void EndJob(Job& job);
+    // Ends the live state of a job moved to a final state: its final record is queued and the
+    // job waits in `ending_` until Locked's release finds it durable. Returns that record.
+    JobRecord EndJob(Job& job);
     uint64_t Save(Job& job);  // queues the record's write and wakes watchers; a store ticket
-    bool OtherWorkersAlive(const std::string& worker, absl::Time now) const;
 
     const SchedulerOptions options_;
     JobStore& store_;
@@ -233,9 +272,11 @@ class Scheduler {
     // one: attempts are counted from zero again after a restart.
     const std::string boot_;
     std::map<std::string, std::unique_ptr<Job>> active_;
+    std::map<std::string, Ending> ending_;
+    std::vector<std::string> to_settle_;           // in `ending_`, not yet waited for
     std::map<std::string, JobRecord> unrecorded_;  // ended while the store could not write
     LeaseTimeouts timeouts_;
-    std::map<std::string, absl::Time> workers_seen_;
+    WorkerRegistry workers_;
 };
 
 }  // namespace lf

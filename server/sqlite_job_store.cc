@@ -69,6 +69,7 @@ std::string RecordToJson(const JobRecord& r) {
           {"request_id", s.request_id}}},
         {"state", int(r.state)},
         {"error", r.error},
+        {"last_error", r.last_error},
         {"submitted", TimeToJson(r.submitted)},
         {"started", TimeToJson(r.started)},
         {"finished", TimeToJson(r.finished)},
@@ -124,6 +125,7 @@ absl::StatusOr<JobRecord> RecordFromJson(std::string_view text) {
         r.spec.request_id = s.value("request_id", "");
         r.state = JobState(j.at("state").get<int>());
         r.error = j.at("error").get<std::string>();
+        r.last_error = j.value("last_error", "");
         r.submitted = TimeFromJson(j.at("submitted"));
         r.started = TimeFromJson(j.at("started"));
         r.finished = TimeFromJson(j.at("finished"));

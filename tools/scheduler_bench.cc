@@ -4,6 +4,7 @@
 //
 //   build/bin/scheduler_bench [--workers 10,100,1000] [--seconds 3] [--dir DIR]
 //   build/bin/scheduler_bench --recovery-jobs 200   # restart to first lease with 200 jobs
+//   build/bin/scheduler_bench --made-up-workers 100000  # lease latency after that many ids
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -116,6 +117,33 @@ void Recovery(const fs::path& dir, int jobs) {
                 leased ? "" : " (no lease!)");
 }
 
+// One worker's lease latency after `made_up` worker ids asked for work once, as a hostile client
+// would, and then fell silent for longer than a lease.
+void MadeUpWorkers(const fs::path& dir, int made_up) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::unique_ptr<lf::SqliteJobStore> store = OpenStore(dir);
+    const lf::SchedulerOptions options;
+    absl::Duration offset = absl::ZeroDuration();
+    lf::Scheduler scheduler(options, *store, [&offset] { return absl::Now() + offset; });
+    for (int i = 0; i < made_up; ++i) (void)scheduler.LeaseTask("made-up-" + std::to_string(i));
+    (void)scheduler.Submit(Spec());
+    offset = options.lease + absl::Seconds(1);
+    constexpr int kLeases = 2000;
+    double lease_ms = 0;
+    for (int i = 0; i < kLeases; ++i) {
+        const auto start = Clock::now();
+        std::optional<lf::TaskAssignment> lease = scheduler.LeaseTask("w");
+        lease_ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+        if (!lease) {
+            std::fprintf(stderr, "scheduler_bench: no lease\n");
+            std::exit(1);
+        }
+    }
+    std::printf("%d made-up worker ids, silent past the lease: %.4f ms per lease (mean of %d)\n",
+                made_up, lease_ms / kLeases, kLeases);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -123,15 +151,20 @@ int main(int argc, char** argv) {
     std::vector<int> workers = {10, 100, 1000};
     double seconds = 3;
     int recovery_jobs = 0;
+    int made_up_workers = -1;
     std::string dir = (fs::temp_directory_path() / ("lf_sched_bench_" + std::to_string(getpid())));
     app.add_option("--workers", workers, "simulated worker counts")->delimiter(',');
     app.add_option("--seconds", seconds, "per worker count")->capture_default_str();
     app.add_option("--recovery-jobs", recovery_jobs, "measure the recovery time instead");
+    app.add_option("--made-up-workers", made_up_workers,
+                   "measure one worker's lease latency after this many made-up worker ids");
     app.add_option("--dir", dir, "folder for the store (a real disk)")->capture_default_str();
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
     if (recovery_jobs > 0) {
         Recovery(dir, recovery_jobs);
+    } else if (made_up_workers >= 0) {
+        MadeUpWorkers(dir, made_up_workers);
     } else {
         for (int n : workers) Capacity(dir, n, seconds);
     }

@@ -120,6 +120,7 @@ void ToProto(const JobRecord& job, pb::Job* out) {
     out->set_finished_unix_ms(UnixMillis(job.finished));
     out->set_retries(job.retries);
     out->set_tasks_leased(job.tasks_leased);
+    out->set_last_error(job.last_error);
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {

@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <future>
 #include <thread>
+
+#include "absl/strings/str_cat.h"
 
 namespace lf {
 namespace {
@@ -22,10 +25,10 @@ class SchedulerTest : public ::testing::Test {
     }
 
     // A 16x16 image in 8x8 tiles, 4 spp in 2 passes: 8 tasks.
-    std::string Submit(int priority, int tile = 8) {
+    std::string Submit(int priority, int tile = 8, int passes = 2) {
         JobSpec spec;
         spec.name = "test";
-        spec.plan = {16, 16, 4, tile, 2};
+        spec.plan = {16, 16, 4, tile, passes};
         spec.priority = priority;
         absl::StatusOr<std::string> id = scheduler_.Submit(spec);
         EXPECT_TRUE(id.ok()) << id.status();
@@ -104,7 +107,8 @@ TEST_F(SchedulerTest, RetriedTaskGoesToAnotherWorkerWhenThereIsOne) {
     Submit(0);
     const TaskAssignment lease = *scheduler_.LeaseTask("a");
     scheduler_.LeaseTask("b");  // b is alive
-    ASSERT_TRUE(scheduler_.Fail(lease.lease_id, "a", "out of memory", FailureKind::kTaskError).ok());
+    ASSERT_TRUE(
+        scheduler_.Fail(lease.lease_id, "a", "out of memory", FailureKind::kTaskError).ok());
     const TaskAssignment next_for_a = *scheduler_.LeaseTask("a");
     EXPECT_NE(next_for_a.task.index, lease.task.index);
     const TaskAssignment next_for_b = *scheduler_.LeaseTask("b");
@@ -134,12 +138,69 @@ TEST_F(SchedulerTest, ThirdFailureFailsTheJobWithTheReason) {
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
 }
 
+TEST_F(SchedulerTest, LastErrorShowsWhileTheTaskIsRetried) {
+    const std::string id = Submit(0, 16, 1);  // one task
+    const TaskAssignment lease = *scheduler_.LeaseTask("w");
+    ASSERT_TRUE(
+        scheduler_.Fail(lease.lease_id, "w", "out of memory", FailureKind::kTaskError).ok());
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+    EXPECT_EQ(Job(id).last_error, "task 0: out of memory (worker w)");
+    EXPECT_EQ(Job(id).error, "");
+}
+
+// With any number of workers, a task that fails on every attempt fails its job after
+// max_failures counted failures: once it failed on every live worker it is leased again.
+class AlwaysFailingTaskTest : public SchedulerTest, public ::testing::WithParamInterface<int> {};
+
+TEST_P(AlwaysFailingTaskTest, FailsTheJobAfterMaxFailuresNamingTheTaskAndTheLastReason) {
+    const int workers = GetParam();
+    const std::string id = Submit(0, 16, 1);  // one task
+    int failures = 0;
+    for (int round = 0; round < 10 && !IsFinal(Job(id).state); ++round) {
+        for (int w = 0; w < workers; ++w) {  // every worker asks in turn, so all stay live
+            const std::string worker = absl::StrCat("w", w);
+            const std::optional<TaskAssignment> lease = scheduler_.LeaseTask(worker);
+            if (!lease) continue;
+            ++failures;
+            const std::string reason = absl::StrCat("attempt ", failures, ": out of patches");
+            ASSERT_TRUE(
+                scheduler_.Fail(lease->lease_id, worker, reason, FailureKind::kTaskError).ok());
+            if (Job(id).state == JobState::kRunning) {
+                EXPECT_EQ(Job(id).last_error,
+                          absl::StrCat("task 0: ", reason, " (worker ", worker, ")"));
+            }
+        }
+    }
+    EXPECT_EQ(Job(id).state, JobState::kFailed);
+    EXPECT_EQ(failures, 3);
+    EXPECT_NE(Job(id).error.find("task 0 failed 3 times"), std::string::npos) << Job(id).error;
+    EXPECT_NE(Job(id).error.find("attempt 3: out of patches"), std::string::npos) << Job(id).error;
+}
+
+INSTANTIATE_TEST_SUITE_P(Workers, AlwaysFailingTaskTest, ::testing::Values(1, 2, 3));
+
+TEST_F(SchedulerTest, MadeUpWorkerIdsAreForgottenAfterALease) {
+    for (int i = 0; i < 100'000; ++i) {
+        EXPECT_FALSE(scheduler_.LeaseTask(absl::StrCat("made-up-", i)).has_value());
+        EXPECT_FALSE(scheduler_.Heartbeat("job-x/0/forged-1", absl::StrCat("forged-", i)));
+    }
+    EXPECT_EQ(scheduler_.workers_tracked(), 100'000u);  // the forged heartbeats are not kept
+    Submit(0);
+    const TaskAssignment lease = *scheduler_.LeaseTask("real");
+    now_ += absl::Seconds(9);
+    ASSERT_TRUE(scheduler_.Heartbeat(lease.lease_id, "real"));
+    now_ += absl::Seconds(2);                 // the made-up ones are silent for a lease now
+    EXPECT_EQ(scheduler_.ExpireLeases(), 0);  // the timeout checker's tick
+    EXPECT_EQ(scheduler_.workers_tracked(), 1u);
+}
+
 TEST_F(SchedulerTest, ExpiriesCountAsFailuresButShutdownsDoNot) {
     const std::string id = Submit(0, 16);
     for (int i = 0; i < 10; ++i) {
         const TaskAssignment lease = *scheduler_.LeaseTask("w");
         ASSERT_TRUE(
-            scheduler_.Fail(lease.lease_id, "w", "worker shutting down", FailureKind::kWorkerShutdown)
+            scheduler_
+                .Fail(lease.lease_id, "w", "worker shutting down", FailureKind::kWorkerShutdown)
                 .ok());
     }
     EXPECT_EQ(Job(id).state, JobState::kRunning);
@@ -277,7 +338,8 @@ TEST_F(SchedulerTest, IdleWorkerWaitsForWorkAndGetsItAtOnce) {
         Submit(0);
     });
     const absl::Time start = absl::Now();
-    const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
+    const std::optional<TaskAssignment> lease =
+        scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
     submitter.join();
     EXPECT_TRUE(lease.has_value());
     EXPECT_LT(absl::Now() - start, absl::Seconds(5));
@@ -364,7 +426,7 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
     now_ += absl::Seconds(5);
     EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
-    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());   // reported once
+    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());         // reported once
     EXPECT_FALSE(scheduler_.Heartbeat(running->lease_id, "w"));  // the worker stops
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
     // Its late result changes nothing.
@@ -394,6 +456,95 @@ TEST_F(SchedulerTest, TimeLimitDoesNotReportAJobItsLastResultCompleted) {
     EXPECT_EQ(Job(id).tasks_done, 4);
     now_ += absl::Seconds(6);
     EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
+}
+
+// A store that holds back durability and request lookups while told to, so a test can ask the
+// scheduler questions while another thread waits on the store.
+class HeldStore : public InMemoryJobStore {
+  public:
+    absl::Status WaitDurable(uint64_t ticket) override {
+        Block();
+        return InMemoryJobStore::WaitDurable(ticket);
+    }
+    std::optional<std::string> FindRequest(const std::string& request_id) const override {
+        Block();
+        return InMemoryJobStore::FindRequest(request_id);
+    }
+    void Hold() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        held_ = true;
+    }
+    void Release() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        held_ = false;
+        cv_.notify_all();
+    }
+    void AwaitBlocked() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [this] { return blocked_ > 0; });
+    }
+
+  private:
+    void Block() const {
+        std::unique_lock<std::mutex> lock(mutex_);
+        ++blocked_;
+        cv_.notify_all();
+        cv_.wait(lock, [this] { return !held_; });
+        --blocked_;
+    }
+    mutable std::mutex mutex_;
+    mutable std::condition_variable cv_;
+    bool held_ = false;
+    mutable int blocked_ = 0;
+};
+
+// Runs `question` on another thread while `store` holds back another thread's call; true when it
+// was answered meanwhile, that is without waiting for the store.
+template <typename F>
+bool AnsweredWhileTheStoreWaits(HeldStore& store, F question) {
+    std::future<void> answer = std::async(std::launch::async, question);
+    const bool answered = answer.wait_for(std::chrono::seconds(30)) == std::future_status::ready;
+    store.Release();
+    answer.get();
+    return answered;
+}
+
+JobSpec SmallSpec(const std::string& request_id) {
+    JobSpec spec;
+    spec.name = "held";
+    spec.plan = {16, 16, 4, 8, 1};
+    spec.request_id = request_id;
+    return spec;
+}
+
+TEST(SchedulerLockTest, EndingAJobWaitsForTheStoreWithoutTheLock) {
+    HeldStore store;
+    Scheduler scheduler({}, store);
+    const std::string id = *scheduler.Submit(SmallSpec(""));
+    store.Hold();
+    std::thread cancel([&] {
+        absl::StatusOr<JobRecord> cancelled = scheduler.Cancel(id);
+        EXPECT_TRUE(cancelled.ok()) << cancelled.status();
+    });
+    store.AwaitBlocked();
+    EXPECT_TRUE(AnsweredWhileTheStoreWaits(store, [&] {
+        EXPECT_EQ(scheduler.Get(id)->state, JobState::kCancelled);
+        EXPECT_FALSE(scheduler.LeaseTask("w").has_value());
+    }));
+    cancel.join();
+    EXPECT_EQ(store.Get(id)->state, JobState::kCancelled);
+}
+
+TEST(SchedulerLockTest, SubmitLooksUpItsRequestWithoutTheLock) {
+    HeldStore store;
+    Scheduler scheduler({}, store);
+    const std::string first = *scheduler.Submit(SmallSpec(""));
+    store.Hold();
+    std::thread submit([&] { EXPECT_TRUE(scheduler.Submit(SmallSpec("req-1")).ok()); });
+    store.AwaitBlocked();
+    EXPECT_TRUE(AnsweredWhileTheStoreWaits(
+        store, [&] { EXPECT_TRUE(scheduler.LeaseTask("w").has_value()); }));
+    submit.join();
 }
 
 }  // namespace

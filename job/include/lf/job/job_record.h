@@ -20,6 +20,7 @@ struct JobRecord {
     JobSpec spec;
     JobState state = JobState::kQueued;
     std::string error;
+    std::string last_error;  // the most recent task failure's reason, while its task is retried
     absl::Time submitted, started = absl::InfinitePast(), finished = absl::InfinitePast();
     int tasks_total = 0, tasks_done = 0, tasks_running = 0, retries = 0;
     int tasks_leased = 0;  // leases ever handed out, across server restarts: renders started
