@@ -58,11 +58,14 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     job->record.submitted = clock_();
     job->record.tasks_total = int(job->tasks.size());
     std::unique_lock<std::mutex> lock(mutex_);
-    if (std::optional<std::pair<std::string, uint64_t>> earlier = FindRequest(spec.request_id)) {
+    absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> earlier =
+        FindRequest(spec.request_id);
+    if (!earlier.ok()) return earlier.status();
+    if (*earlier) {
         lock.unlock();
-        if (absl::Status s = store_.WaitDurable(earlier->second); !s.ok()) return s;
-        Log()->info("job={} submitted again (request {})", earlier->first, spec.request_id);
-        return earlier->first;
+        if (absl::Status s = store_.WaitDurable((*earlier)->second); !s.ok()) return s;
+        Log()->info("job={} submitted again (request {})", (*earlier)->first, spec.request_id);
+        return (*earlier)->first;
     }
     std::string id = NewJobId();
     while (active_.count(id) || store_.Get(id).ok()) id = NewJobId();
@@ -94,15 +97,15 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     return id;
 }
 
-std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequest(
+absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> Scheduler::FindRequest(
     const std::string& request_id) const {
     if (request_id.empty()) return std::nullopt;
     for (const auto& [id, job] : active_) {
         if (job->record.spec.request_id == request_id) return std::pair{id, job->submit_ticket};
     }
-    if (std::optional<std::string> id = store_.FindRequest(request_id)) {
-        return std::pair{*id, uint64_t(0)};
-    }
+    absl::StatusOr<std::optional<std::string>> id = store_.FindRequest(request_id);
+    if (!id.ok()) return id.status();
+    if (*id) return std::pair{**id, uint64_t(0)};
     return std::nullopt;
 }
 
@@ -115,10 +118,11 @@ absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
     return store_.Get(job_id);
 }
 
-std::vector<JobRecord> Scheduler::List() const {
-    std::vector<JobRecord> jobs = store_.List();
+absl::StatusOr<std::vector<JobRecord>> Scheduler::List(const JobQuery& query) const {
+    absl::StatusOr<std::vector<JobRecord>> jobs = store_.List(query);
+    if (!jobs.ok()) return jobs.status();
     std::lock_guard<std::mutex> lock(mutex_);
-    for (JobRecord& job : jobs) {
+    for (JobRecord& job : *jobs) {
         if (auto it = active_.find(job.id); it != active_.end()) job = it->second->record;
         if (auto it = unrecorded_.find(job.id); it != unrecorded_.end()) job = it->second;
     }
@@ -128,7 +132,10 @@ std::vector<JobRecord> Scheduler::List() const {
 absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     std::lock_guard<std::mutex> lock(mutex_);
     std::vector<std::string> rendered;
-    for (JobRecord& record : store_.List()) {
+    // A store that cannot list must not start an empty server.
+    absl::StatusOr<std::vector<JobRecord>> recorded = store_.List();
+    if (!recorded.ok()) return recorded.status();
+    for (JobRecord& record : *recorded) {
         next_seq_ = std::max(next_seq_, record.seq + 1);
         if (IsFinal(record.state) || active_.count(record.id)) continue;
         absl::StatusOr<std::map<int, std::string>> results = store_.TaskResults(record.id);

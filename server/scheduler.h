@@ -129,7 +129,8 @@ class Scheduler {
 
     // Running jobs as they are now, ended ones from the store.
     absl::StatusOr<JobRecord> Get(const std::string& job_id) const;
-    std::vector<JobRecord> List() const;
+    // The jobs the query selects from the store, running ones as they are now.
+    absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const;
 
     // Blocks until some job changed after `version` was current, or `deadline`, or Shutdown.
     // Returns the version now.
@@ -175,7 +176,7 @@ class Scheduler {
     };
 
     // The job of an earlier submission with this request id, and the store ticket to wait for.
-    std::optional<std::pair<std::string, uint64_t>> FindRequest(
+    absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> FindRequest(
         const std::string& request_id) const;
     std::optional<TaskAssignment> TryLease(const std::string& worker);
     // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
