@@ -1,5 +1,5 @@
-// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel and delete, each a
-// call to lightfarm-server's JobService. All protobuf handling of the client is in this file.
+// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel and delete, each
+// a call to lightfarm-server's JobService. All protobuf handling of the client is in this file.
 #include <grpcpp/grpcpp.h>
 #include <unistd.h>
 
@@ -367,8 +367,8 @@ Command AddListCommand(CLI::App& app) {
                 const std::unique_ptr<pb::JobService::Stub> stub = Connect(*flags);
                 pb::ListJobsRequest req;
                 int listed = 0;
-                std::printf("%-16s %-10s %8s %11s %9s  %s\n", "JOB", "STATE", "PRIORITY",
-                            "TASKS", "SPP", "NAME");
+                std::printf("%-16s %-10s %8s %11s %9s  %s\n", "JOB", "STATE", "PRIORITY", "TASKS",
+                            "SPP", "NAME");
                 do {
                     req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
                     pb::ListJobsResponse resp;
@@ -471,17 +471,18 @@ Command AddDeleteCommand(CLI::App& app) {
     auto flags = std::make_shared<FarmFlags>();
     auto id = std::make_shared<std::string>();
     CLI::App* cmd = app.add_subcommand(
-        "delete", "Delete an ended job and its result from the server (cancel a running one first).");
+        "delete",
+        "Delete an ended job and its result from the server (cancel a running one first).");
     cmd->add_option("job", *id, "job id")->required();
     AddServerOption(cmd, *flags);
     return {cmd, [flags, id] {
                 pb::DeleteJobRequest req;
                 req.set_job_id(*id);
                 pb::DeleteJobResponse resp;
-                absl::Status s = CallStatus(
-                    Connect(*flags)->DeleteJob(ContextWithDeadline(absl::Seconds(10)).get(), req,
-                                               &resp),
-                    *flags);
+                absl::Status s =
+                    CallStatus(Connect(*flags)->DeleteJob(
+                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
+                               *flags);
                 if (!s.ok()) return ReportError(s);
                 std::printf("job %s deleted\n", id->c_str());
                 return 0;

@@ -100,8 +100,8 @@ BlobStore::Upload::~Upload() {
 
 absl::Status BlobStore::Upload::Append(std::string_view data) {
     if (data.size() > size_ - received_) {
-        return absl::ResourceExhaustedError(absl::StrCat(
-            "blob ", hash_, ": more than the ", size_, " bytes declared arrived; refused"));
+        return absl::ResourceExhaustedError(absl::StrCat("blob ", hash_, ": more than the ", size_,
+                                                         " bytes declared arrived; refused"));
     }
     received_ += data.size();
     digest_.Update(data);

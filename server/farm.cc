@@ -120,9 +120,8 @@ absl::StatusOr<std::unique_ptr<BlobStore::Upload>> Farm::StartUpload(const std::
 
 absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     if (spec.name.size() > kMaxJobNameBytes) {
-        return absl::InvalidArgumentError(absl::StrCat("job name of ", spec.name.size(),
-                                                       " bytes is above the limit of ",
-                                                       kMaxJobNameBytes));
+        return absl::InvalidArgumentError(absl::StrCat(
+            "job name of ", spec.name.size(), " bytes is above the limit of ", kMaxJobNameBytes));
     }
     if (spec.request_id.size() > kMaxRequestIdBytes) {
         return absl::InvalidArgumentError(absl::StrCat("request id of ", spec.request_id.size(),
@@ -149,8 +148,8 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
         if (absl::StatusOr<uint64_t> size = blobs_->SizeOf(ref->hash); !size.ok()) {
             return size.status();
         } else if (*size != ref->size) {
-            return absl::InvalidArgumentError(absl::StrCat(
-                ref->path, ": declared as ", ref->size, " bytes, its blob holds ", *size));
+            return absl::InvalidArgumentError(absl::StrCat(ref->path, ": declared as ", ref->size,
+                                                           " bytes, its blob holds ", *size));
         }
     }
     if (spec.plan.tile > kMaxFarmTile) {
@@ -305,9 +304,8 @@ absl::Status Farm::DeleteJob(const std::string& job_id) {
     absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
     if (!job.ok()) return job.status();
     if (!IsFinal(job->state)) {
-        return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " is ",
-                                                          JobStateName(job->state),
-                                                          ": cancel it before deleting it"));
+        return absl::FailedPreconditionError(absl::StrCat(
+            "job ", job_id, " is ", JobStateName(job->state), ": cancel it before deleting it"));
     }
     if (absl::Status s = store_->Delete(job_id); !s.ok()) return s;
     RemoveJobFiles(job_id);

@@ -71,8 +71,8 @@ grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
                                        pb::SubmitJobResponse* resp) {
     absl::StatusOr<std::string> id = farm_.Submit(FromProto(*req));
     if (!id.ok()) {
-        Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()),
-                    Peer(context), LogSafe(std::string(id.status().message())));
+        Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()), Peer(context),
+                    LogSafe(std::string(id.status().message())));
         return ToGrpcStatus(id.status());
     }
     Log()->info("job={} submitted by {}: \"{}\"", *id, Peer(context), LogSafe(req->name()));
@@ -100,8 +100,8 @@ grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext*, const pb::ListJobsRe
     JobQuery query{.limit = size_t(page_size) + 1};
     if (!req->page_token().empty() &&
         (!absl::SimpleAtoi(req->page_token(), &query.before_seq) || query.before_seq == 0)) {
-        return ToGrpcStatus(absl::InvalidArgumentError(
-            "ListJobs: page_token is not one this server gave out"));
+        return ToGrpcStatus(
+            absl::InvalidArgumentError("ListJobs: page_token is not one this server gave out"));
     }
     absl::StatusOr<std::vector<JobRecord>> jobs = farm_.scheduler().List(query);
     if (!jobs.ok()) return ToGrpcStatus(jobs.status());

@@ -157,8 +157,7 @@ absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
         r.result_path = j.at("result_path").get<std::string>();
         return r;
     } catch (const json::exception& e) {
-        return absl::DataLossError(
-            absl::StrCat("the stored record is unreadable: ", e.what()));
+        return absl::DataLossError(absl::StrCat("the stored record is unreadable: ", e.what()));
     }
 }
 

@@ -119,7 +119,8 @@ int main(int argc, char** argv) {
     bool retention_stop = false;
     std::thread retention([&] {
         std::unique_lock<std::mutex> lock(retention_mutex);
-        while (!retention_cv.wait_for(lock, std::chrono::hours(1), [&] { return retention_stop; })) {
+        const auto stopping = [&] { return retention_stop; };
+        while (!retention_cv.wait_for(lock, std::chrono::hours(1), stopping)) {
             if (absl::StatusOr<int> n = (*farm)->DeleteExpired(absl::Now()); !n.ok()) {
                 spdlog::error("retention: {}", std::string(n.status().message()));
             }

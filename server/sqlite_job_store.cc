@@ -93,8 +93,8 @@ absl::Status Exec(sqlite3* db, const char* sql) {
 absl::StatusOr<JobRecord> Decode(std::string_view id, std::string_view record) {
     absl::StatusOr<JobRecord> job = DecodeJobRecord(record);
     if (job.ok()) return job;
-    return absl::Status(job.status().code(),
-                        absl::StrCat("job store: job ", std::string(id), ": ", job.status().message()));
+    return absl::Status(job.status().code(), absl::StrCat("job store: job ", std::string(id), ": ",
+                                                          job.status().message()));
 }
 
 // Schema versions (PRAGMA user_version): 0, records only, states by enum position, request ids
@@ -116,8 +116,9 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
     // synchronous=FULL: a commit is on disk when it returns, so what was acknowledged survives
     // a crash of the process or of the machine. The busy timeout only matters for a second
     // process (the sqlite3 shell) reading at the same time.
-    absl::Status s = Exec(db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
-                              "PRAGMA busy_timeout=5000;");
+    absl::Status s = Exec(db,
+                          "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
+                          "PRAGMA busy_timeout=5000;");
     int64_t found_version = 0;
     bool old = false;
     if (s.ok()) {
@@ -129,8 +130,8 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
     }
     if (s.ok() && found_version > kSchemaVersion) {
         s = absl::FailedPreconditionError(absl::StrCat(
-            "job store version ", found_version, " is newer than this server's (",
-            kSchemaVersion, "): run a lightfarm-server as new as the one that wrote it"));
+            "job store version ", found_version, " is newer than this server's (", kSchemaVersion,
+            "): run a lightfarm-server as new as the one that wrote it"));
     }
     if (s.ok() && old) s = Migrate(db);
     if (s.ok()) {
@@ -284,11 +285,10 @@ absl::Status SqliteJobStore::Migrate(sqlite3* db) {
     // Version 0 to 1: the columns, filled from the records, which are rewritten with states by
     // name. In one transaction, so that a failure leaves version 0 to try again.
     if (absl::Status s = Exec(db, "BEGIN IMMEDIATE"); !s.ok()) return s;
-    absl::Status status =
-        Exec(db,
-             "DROP INDEX IF EXISTS jobs_by_request;"
-             "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';"
-             "ALTER TABLE jobs ADD COLUMN finished INTEGER;");
+    absl::Status status = Exec(db,
+                               "DROP INDEX IF EXISTS jobs_by_request;"
+                               "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';"
+                               "ALTER TABLE jobs ADD COLUMN finished INTEGER;");
     std::vector<Write> rewrites;
     if (status.ok()) {
         Statement all(db, "SELECT id, record FROM jobs");
@@ -301,8 +301,8 @@ absl::Status SqliteJobStore::Migrate(sqlite3* db) {
     }
     for (size_t i = 0; i < rewrites.size() && status.ok(); ++i) {
         const Write& w = rewrites[i];
-        Statement update(db,
-                         "UPDATE jobs SET record = ?2, request_id = ?3, finished = ?4 WHERE id = ?1");
+        Statement update(
+            db, "UPDATE jobs SET record = ?2, request_id = ?3, finished = ?4 WHERE id = ?1");
         update.Bind(1, w.job_id).Bind(2, w.record).Bind(3, w.request_id).Bind(4, w.finished_us);
         update.Step();
         status = update.status();
@@ -333,8 +333,8 @@ absl::StatusOr<std::vector<JobRecord>> SqliteJobStore::List(const JobQuery& quer
                    "SELECT id, record FROM jobs WHERE seq < ?1"
                    " AND (?2 IS NULL OR (final = 1 AND finished < ?2))"
                    " ORDER BY seq DESC LIMIT ?3");
-    list.Bind(1, query.before_seq == 0 ? std::numeric_limits<int64_t>::max()
-                                       : int64_t(query.before_seq));
+    list.Bind(
+        1, query.before_seq == 0 ? std::numeric_limits<int64_t>::max() : int64_t(query.before_seq));
     list.Bind(2, query.ended_before == absl::InfinitePast()
                      ? std::nullopt
                      : std::optional<int64_t>(absl::ToUnixMicros(query.ended_before)));

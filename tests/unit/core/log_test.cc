@@ -1,8 +1,8 @@
 // LogSafe: a value from the wire cannot forge a log line or reach the terminal raw, and a huge
 // one is cut to a bound that says how long it was.
-#include <gtest/gtest.h>
-
 #include "lf/core/log.h"
+
+#include <gtest/gtest.h>
 
 namespace lf {
 namespace {

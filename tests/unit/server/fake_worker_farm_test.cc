@@ -6,6 +6,7 @@
 // fixed function of (pixel, sample), so no renderer is needed.
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -13,7 +14,6 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <spdlog/sinks/ostream_sink.h>
 #include <sstream>
 #include <thread>
 
@@ -414,9 +414,9 @@ TEST_F(FakeWorkerFarm, JobNameAndRequestIdAboveTheirLimitsAreRefused) {
         grpc::ClientContext context;
         const grpc::Status s = job_stub_->SubmitJob(&context, request, &response);
         EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-        EXPECT_NE(s.error_message().find(std::to_string(name ? kMaxJobNameBytes
-                                                             : kMaxRequestIdBytes)),
-                  std::string::npos)
+        EXPECT_NE(
+            s.error_message().find(std::to_string(name ? kMaxJobNameBytes : kMaxRequestIdBytes)),
+            std::string::npos)
             << s.error_message();
     }
     EXPECT_TRUE(farm_->scheduler().List()->empty());

@@ -3,6 +3,8 @@
 // belongs to the interface: states by name, the integer states of old records still read, an
 // unknown name a clear error. Then what only SQLite has: a database of the first schema is
 // upgraded in place.
+#include "server/job_store.h"
+
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 #include <unistd.h>
@@ -10,8 +12,8 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "absl/strings/str_cat.h"
 #include "server/job_record_codec.h"
-#include "server/job_store.h"
 #include "server/sqlite_job_store.h"
 
 namespace lf {
@@ -80,7 +82,7 @@ TYPED_TEST_SUITE(JobStoreContract, Stores);
 
 TYPED_TEST(JobStoreContract, ListsPagesNewestFirst) {
     for (uint64_t seq = 1; seq <= 5; ++seq) {
-        ASSERT_TRUE(this->store_->Put(Record("j" + std::to_string(seq), seq)).ok());
+        ASSERT_TRUE(this->store_->Put(Record(absl::StrCat("j", seq), seq)).ok());
     }
     EXPECT_EQ(Ids(this->store_->List()), (std::vector<std::string>{"j5", "j4", "j3", "j2", "j1"}));
     EXPECT_EQ(Ids(this->store_->List({.limit = 2})), (std::vector<std::string>{"j5", "j4"}));
@@ -115,7 +117,8 @@ TYPED_TEST(JobStoreContract, RequestIdsAreUnique) {
 }
 
 TYPED_TEST(JobStoreContract, DeleteRemovesTheRecordAndTaskResults) {
-    ASSERT_TRUE(this->store_->WaitDurable(this->store_->QueueTaskDone(Record("a", 1), 0, "sums")).ok());
+    ASSERT_TRUE(
+        this->store_->WaitDurable(this->store_->QueueTaskDone(Record("a", 1), 0, "sums")).ok());
     ASSERT_TRUE(this->store_->Put(Record("b", 2)).ok());
     ASSERT_TRUE(this->store_->Delete("a").ok());
     EXPECT_EQ(this->store_->Get("a").status().code(), absl::StatusCode::kNotFound);
@@ -167,10 +170,9 @@ void WriteVersion0Database(const fs::path& path, const std::vector<JobRecord>& j
     for (const JobRecord& job : jobs) {
         nlohmann::json record = nlohmann::json::parse(EncodeJobRecord(job));
         record["state"] = int(job.state);
-        const std::string sql = "INSERT INTO jobs VALUES ('" + job.id + "', " +
-                                std::to_string(job.seq) + ", " +
-                                std::to_string(int(IsFinal(job.state))) + ", '" + record.dump() +
-                                "')";
+        const std::string sql =
+            "INSERT INTO jobs VALUES ('" + job.id + "', " + std::to_string(job.seq) + ", " +
+            std::to_string(int(IsFinal(job.state))) + ", '" + record.dump() + "')";
         ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
     }
     sqlite3_close(db);
@@ -198,8 +200,8 @@ TEST(SqliteJobStoreUpgrade, FirstSchemaDatabaseIsUpgradedAndReadsAsBefore) {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open((dir / "jobs.db").c_str(), &db), SQLITE_OK);
     sqlite3_stmt* stmt = nullptr;
-    sqlite3_prepare_v2(db, "SELECT json_extract(record, '$.state') FROM jobs WHERE id = 'done'",
-                       -1, &stmt, nullptr);
+    sqlite3_prepare_v2(db, "SELECT json_extract(record, '$.state') FROM jobs WHERE id = 'done'", -1,
+                       &stmt, nullptr);
     ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
     EXPECT_STREQ(reinterpret_cast<const char*>(sqlite3_column_text(stmt, 0)), "succeeded");
     sqlite3_finalize(stmt);
