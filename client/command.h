@@ -30,5 +30,6 @@ Command AddStatusCommand(CLI::App& app);
 Command AddWatchCommand(CLI::App& app);
 Command AddFetchCommand(CLI::App& app);
 Command AddCancelCommand(CLI::App& app);
+Command AddDeleteCommand(CLI::App& app);
 
 }  // namespace lf

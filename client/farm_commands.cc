@@ -1,5 +1,5 @@
-// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch and cancel, each a
-// call to lightfarm-server's JobService. All protobuf handling of the client is in this file.
+// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel and delete, each
+// a call to lightfarm-server's JobService. All protobuf handling of the client is in this file.
 #include <grpcpp/grpcpp.h>
 #include <unistd.h>
 
@@ -358,24 +358,38 @@ Command AddSubmitCommand(CLI::App& app) {
 
 Command AddListCommand(CLI::App& app) {
     auto flags = std::make_shared<FarmFlags>();
+    auto limit = std::make_shared<int>(0);
     CLI::App* cmd = app.add_subcommand("list", "List the server's jobs, newest first.");
+    cmd->add_option("--limit", *limit, "at most this many jobs; 0 lists them all")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     AddServerOption(cmd, *flags);
-    return {
-        cmd, [flags] {
-            pb::ListJobsResponse resp;
-            absl::Status s = CallStatus(
-                Connect(*flags)->ListJobs(ContextWithDeadline(absl::Seconds(10)).get(), {}, &resp),
-                *flags);
-            if (!s.ok()) return ReportError(s);
-            std::printf("%-16s %-10s %8s %11s %9s  %s\n", "JOB", "STATE", "PRIORITY", "TASKS",
-                        "SPP", "NAME");
-            for (const pb::Job& job : resp.jobs()) {
-                std::printf("%-16s %-10s %8d %11s %9llu  %s\n", job.id().c_str(),
-                            StateName(job.state()).c_str(), job.priority(), Progress(job).c_str(),
-                            (unsigned long long)job.params().spp(), job.name().c_str());
-            }
-            return 0;
-        }};
+    return {cmd, [flags, limit] {
+                // A page per call, so that no answer grows with the number of jobs.
+                constexpr int kPage = 500;
+                const std::unique_ptr<pb::JobService::Stub> stub = Connect(*flags);
+                pb::ListJobsRequest req;
+                int listed = 0;
+                std::printf("%-16s %-10s %8s %11s %9s  %s\n", "JOB", "STATE", "PRIORITY", "TASKS",
+                            "SPP", "NAME");
+                do {
+                    req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
+                    pb::ListJobsResponse resp;
+                    absl::Status s = CallStatus(
+                        stub->ListJobs(ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
+                        *flags);
+                    if (!s.ok()) return ReportError(s);
+                    for (const pb::Job& job : resp.jobs()) {
+                        std::printf("%-16s %-10s %8d %11s %9llu  %s\n", job.id().c_str(),
+                                    StateName(job.state()).c_str(), job.priority(),
+                                    Progress(job).c_str(), (unsigned long long)job.params().spp(),
+                                    job.name().c_str());
+                    }
+                    listed += resp.jobs_size();
+                    req.set_page_token(resp.next_page_token());
+                } while (!req.page_token().empty() && (*limit == 0 || listed < *limit));
+                return 0;
+            }};
 }
 
 Command AddStatusCommand(CLI::App& app) {
@@ -454,6 +468,28 @@ Command AddCancelCommand(CLI::App& app) {
             std::printf("job %s %s\n", job.id().c_str(), StateName(job.state()).c_str());
             return 0;
         }};
+}
+
+Command AddDeleteCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "delete",
+        "Delete an ended job and its result from the server (cancel a running one first).");
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id] {
+                pb::DeleteJobRequest req;
+                req.set_job_id(*id);
+                pb::DeleteJobResponse resp;
+                absl::Status s =
+                    CallStatus(Connect(*flags)->DeleteJob(
+                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
+                               *flags);
+                if (!s.ok()) return ReportError(s);
+                std::printf("job %s deleted\n", id->c_str());
+                return 0;
+            }};
 }
 
 }  // namespace lf

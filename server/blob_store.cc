@@ -16,6 +16,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+constexpr char kUploadPrefix[] = ".upload-";
+
 absl::Status Sync(const std::string& path, int flags) {
     const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
     if (fd < 0 || ::fsync(fd) != 0) {
@@ -50,13 +52,32 @@ bool BlobStore::Has(const std::string& hash) const {
 
 std::string BlobStore::PathOf(const std::string& hash) const { return dir_ + "/" + hash; }
 
+absl::StatusOr<uint64_t> BlobStore::SizeOf(const std::string& hash) const {
+    std::error_code ec;
+    const uint64_t size = fs::file_size(PathOf(hash), ec);
+    if (ec) return absl::NotFoundError(absl::StrCat("blob ", hash, ": ", ec.message()));
+    return size;
+}
+
+int BlobStore::SweepUnfinishedUploads() {
+    int removed = 0;
+    std::error_code ec;
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir_, ec)) {
+        if (entry.path().filename().string().rfind(kUploadPrefix, 0) != 0) continue;
+        std::error_code ignored;
+        if (fs::remove(entry.path(), ignored)) ++removed;
+    }
+    return removed;
+}
+
 absl::StatusOr<std::unique_ptr<BlobStore::Upload>> BlobStore::StartUpload(const std::string& hash,
                                                                           uint64_t size) {
     if (!IsSha256Hex(hash)) {
         return absl::InvalidArgumentError("blob hash '" + hash + "' is not a SHA-256 hex digest");
     }
     static std::atomic<uint64_t> counter{0};
-    const std::string temp = absl::StrCat(dir_, "/.upload-", hash, "-", ::getpid(), "-", ++counter);
+    const std::string temp =
+        absl::StrCat(dir_, "/", kUploadPrefix, hash, "-", ::getpid(), "-", ++counter);
     std::unique_ptr<Upload> upload(new Upload(hash, size, PathOf(hash), temp));
     if (!upload->out_) return absl::InternalError(temp + ": cannot create");
     return upload;
@@ -78,11 +99,11 @@ BlobStore::Upload::~Upload() {
 }
 
 absl::Status BlobStore::Upload::Append(std::string_view data) {
-    received_ += data.size();
-    if (received_ > size_) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("blob ", hash_, ": more than the announced ", size_, " bytes"));
+    if (data.size() > size_ - received_) {
+        return absl::ResourceExhaustedError(absl::StrCat("blob ", hash_, ": more than the ", size_,
+                                                         " bytes declared arrived; refused"));
     }
+    received_ += data.size();
     digest_.Update(data);
     out_.write(data.data(), std::streamsize(data.size()));
     if (!out_) return absl::InternalError(temp_path_ + ": " + std::strerror(errno));

@@ -25,10 +25,18 @@ class BlobStore {
 
     bool Has(const std::string& hash) const;
     std::string PathOf(const std::string& hash) const;
+    // The size of a blob that exists.
+    absl::StatusOr<uint64_t> SizeOf(const std::string& hash) const;
+    // Removes the temporary files of uploads that never finished; only while no upload runs
+    // (at start, with the data folder locked). Returns how many.
+    int SweepUnfinishedUploads();
 
     class Upload {
       public:
         ~Upload();  // removes the temporary file unless Finish succeeded
+        // ResourceExhausted, before writing any of `data`, once more bytes arrive than were
+        // declared: the size limits are checked on declared sizes, so they hold only if the
+        // bytes received are counted.
         absl::Status Append(std::string_view data);
         absl::Status Finish();
 

@@ -79,15 +79,22 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
         fs::create_directories(fs::path(options.data_dir) / sub, ec);
         if (ec) return absl::InternalError(options.data_dir + "/" + sub + ": " + ec.message());
     }
+    absl::StatusOr<std::unique_ptr<DataDirLock>> lock = DataDirLock::Acquire(options.data_dir);
+    if (!lock.ok()) return lock.status();
     absl::StatusOr<std::unique_ptr<BlobStore>> blobs = BlobStore::Open(options.data_dir + "/blobs");
     if (!blobs.ok()) return blobs.status();
     absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
         SqliteJobStore::Open(options.data_dir + "/jobs.db");
     if (!store.ok()) return store.status();
     std::unique_ptr<Farm> farm(new Farm(options, std::move(*blobs), std::move(*store)));
+    farm->lock_ = std::move(*lock);
+    farm->SweepTemporaryFiles();
     absl::StatusOr<std::vector<std::string>> rendered = farm->scheduler_.Recover();
     if (!rendered.ok()) return rendered.status();
     for (const std::string& job_id : *rendered) farm->FinishJob(job_id);
+    if (absl::StatusOr<int> expired = farm->DeleteExpired(absl::Now()); !expired.ok()) {
+        return expired.status();
+    }
     return farm;
 }
 
@@ -112,6 +119,15 @@ absl::StatusOr<std::unique_ptr<BlobStore::Upload>> Farm::StartUpload(const std::
 }
 
 absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
+    if (spec.name.size() > kMaxJobNameBytes) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "job name of ", spec.name.size(), " bytes is above the limit of ", kMaxJobNameBytes));
+    }
+    if (spec.request_id.size() > kMaxRequestIdBytes) {
+        return absl::InvalidArgumentError(absl::StrCat("request id of ", spec.request_id.size(),
+                                                       " bytes is above the limit of ",
+                                                       kMaxRequestIdBytes));
+    }
     std::vector<const BlobRef*> refs = {&spec.scene};
     for (const BlobRef& f : spec.files) refs.push_back(&f);
     uint64_t scene_bytes = 0;
@@ -127,6 +143,13 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
         if (!blobs_->Has(ref->hash)) {
             return absl::FailedPreconditionError(
                 absl::StrCat(ref->path, ": blob ", ref->hash, " was not uploaded"));
+        }
+        // The size limit above was checked on the declared sizes.
+        if (absl::StatusOr<uint64_t> size = blobs_->SizeOf(ref->hash); !size.ok()) {
+            return size.status();
+        } else if (*size != ref->size) {
+            return absl::InvalidArgumentError(absl::StrCat(ref->path, ": declared as ", ref->size,
+                                                           " bytes, its blob holds ", *size));
         }
     }
     if (spec.plan.tile > kMaxFarmTile) {
@@ -264,6 +287,71 @@ absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool pre
     const std::string path = options_.data_dir + "/previews/" + job_id + ".exr";
     if (absl::Status s = WriteImage(*snapshot, false, path); !s.ok()) return s;
     return path;
+}
+
+}  // namespace lf
+
+namespace lf {
+
+void Farm::RemoveJobFiles(const std::string& job_id) {
+    for (const char* sub : {"results", "previews"}) {
+        std::error_code ignored;  // a job without such a file
+        fs::remove(fs::path(options_.data_dir) / sub / (job_id + ".exr"), ignored);
+    }
+}
+
+absl::Status Farm::DeleteJob(const std::string& job_id) {
+    absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+    if (!job.ok()) return job.status();
+    if (!IsFinal(job->state)) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "job ", job_id, " is ", JobStateName(job->state), ": cancel it before deleting it"));
+    }
+    if (absl::Status s = store_->Delete(job_id); !s.ok()) return s;
+    RemoveJobFiles(job_id);
+    return absl::OkStatus();
+}
+
+absl::StatusOr<int> Farm::DeleteExpired(absl::Time now) {
+    if (options_.retention <= absl::ZeroDuration()) return 0;
+    // In pages, so that a long-idle server does not load every expired job at once.
+    constexpr size_t kPage = 1000;
+    int deleted = 0;
+    while (true) {
+        absl::StatusOr<std::vector<JobRecord>> expired =
+            store_->List({.limit = kPage, .ended_before = now - options_.retention});
+        if (!expired.ok()) return expired.status();
+        if (expired->empty()) break;
+        uint64_t ticket = 0;
+        for (const JobRecord& job : *expired) ticket = store_->QueueDelete(job.id);
+        if (absl::Status s = store_->WaitDurable(ticket); !s.ok()) return s;
+        for (const JobRecord& job : *expired) RemoveJobFiles(job.id);
+        deleted += int(expired->size());
+    }
+    if (deleted > 0) {
+        Log()->info("deleted {} jobs that ended more than {} ago", deleted,
+                    absl::FormatDuration(options_.retention));
+    }
+    return deleted;
+}
+
+void Farm::SweepTemporaryFiles() {
+    // Nothing in scratch/ or previews/ outlives the request that wrote it, and a result's
+    // temporary file is renamed or removed before its job is recorded.
+    int removed = blobs_->SweepUnfinishedUploads();
+    for (const char* sub : {"scratch", "previews", "results"}) {
+        std::error_code ec;
+        for (const fs::directory_entry& entry :
+             fs::directory_iterator(fs::path(options_.data_dir) / sub, ec)) {
+            if (sub == std::string_view("results") &&
+                entry.path().filename().string().find(".tmp-") == std::string::npos) {
+                continue;
+            }
+            std::error_code ignored;
+            removed += fs::remove_all(entry.path(), ignored) > 0;
+        }
+    }
+    if (removed > 0) Log()->info("removed {} temporary files left by an earlier run", removed);
 }
 
 }  // namespace lf

@@ -10,6 +10,7 @@
 
 #include "absl/status/statusor.h"
 #include "server/blob_store.h"
+#include "server/data_dir_lock.h"
 #include "server/job_store.h"
 #include "server/scheduler.h"
 
@@ -22,16 +23,25 @@ struct JobLimits {
     uint64_t max_spp = uint64_t(1) << 20;
 };
 
+// Strings from the wire that the server keeps and lists: bounded so no request can make
+// `lightfarm list` fail for everyone.
+constexpr size_t kMaxJobNameBytes = 256;
+constexpr size_t kMaxRequestIdBytes = 128;
+
 struct FarmOptions {
     std::string data_dir;  // jobs.db, blobs/, results/, previews/, scratch/ go here
     SchedulerOptions scheduler;
     JobLimits limits;
+    // Ended jobs older than this are deleted (see DeleteExpired); zero keeps them forever.
+    absl::Duration retention = absl::ZeroDuration();
 };
 
 class Farm {
   public:
     // Opens the data folder and takes up the jobs it holds that have not ended (see
-    // Scheduler::Recover), writing the results of those that were fully rendered.
+    // Scheduler::Recover), writing the results of those that were fully rendered. Locks the
+    // folder for the Farm's life (FailedPrecondition when another server holds it), removes the
+    // temporary files a killed server left, and deletes the jobs past retention.
     static absl::StatusOr<std::unique_ptr<Farm>> Open(const FarmOptions& options);
 
     // Checks the limits, the paths and blobs and that the scene loads (InvalidArgument with the
@@ -59,6 +69,12 @@ class Farm {
     // completes them).
     void CheckTimers();
 
+    // Removes an ended job: its record, task results, result and preview files.
+    // FailedPrecondition for a job that has not ended.
+    absl::Status DeleteJob(const std::string& job_id);
+    // Deletes the jobs that ended more than options().retention before `now`; returns how many.
+    absl::StatusOr<int> DeleteExpired(absl::Time now);
+
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }
     const FarmOptions& options() const { return options_; }
@@ -75,8 +91,12 @@ class Farm {
     absl::Status WriteImage(const Scheduler::JobImage& snapshot, bool complete,
                             const std::string& path);
     void FinishJob(const std::string& job_id);
+    void RemoveJobFiles(const std::string& job_id);
+    // The temporary files of writes a killed server did not finish.
+    void SweepTemporaryFiles();
 
     const FarmOptions options_;
+    std::unique_ptr<DataDirLock> lock_;
     std::unique_ptr<BlobStore> blobs_;
     std::unique_ptr<JobStore> store_;
     Scheduler scheduler_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <fstream>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "lf/core/log.h"
 #include "proto/grpc_status.h"
@@ -17,6 +18,9 @@ namespace {
 constexpr size_t kChunkBytes = 1 << 20;
 
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("rpc"); }
+
+// Who called, for the log: the peer's address as gRPC reports it.
+std::string Peer(const grpc::ServerContext* context) { return LogSafe(context->peer()); }
 
 // Streams a file in chunks; stops early when the client goes away.
 grpc::Status StreamFile(grpc::ServerContext* context, const std::string& path,
@@ -62,10 +66,16 @@ grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext*,
     return ToGrpcStatus((*upload)->Finish());
 }
 
-grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext*, const pb::SubmitJobRequest* req,
+grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
+                                       const pb::SubmitJobRequest* req,
                                        pb::SubmitJobResponse* resp) {
     absl::StatusOr<std::string> id = farm_.Submit(FromProto(*req));
-    if (!id.ok()) return ToGrpcStatus(id.status());
+    if (!id.ok()) {
+        Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()), Peer(context),
+                    LogSafe(std::string(id.status().message())));
+        return ToGrpcStatus(id.status());
+    }
+    Log()->info("job={} submitted by {}: \"{}\"", *id, Peer(context), LogSafe(req->name()));
     resp->set_job_id(*id);
     return grpc::Status::OK;
 }
@@ -78,14 +88,47 @@ grpc::Status JobServiceImpl::GetJob(grpc::ServerContext*, const pb::GetJobReques
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext*, const pb::ListJobsRequest*,
+grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext*, const pb::ListJobsRequest* req,
                                       pb::ListJobsResponse* resp) {
-    for (const JobRecord& job : farm_.scheduler().List()) ToProto(job, resp->add_jobs());
+    if (req->page_size() < 0) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("ListJobs: page_size ", req->page_size(), " is negative")));
+    }
+    const int page_size =
+        req->page_size() == 0 ? kDefaultPageSize : std::min(req->page_size(), kMaxPageSize);
+    // The token is the seq of the page's last job: the next page starts below it.
+    JobQuery query{.limit = size_t(page_size) + 1};
+    if (!req->page_token().empty() &&
+        (!absl::SimpleAtoi(req->page_token(), &query.before_seq) || query.before_seq == 0)) {
+        return ToGrpcStatus(
+            absl::InvalidArgumentError("ListJobs: page_token is not one this server gave out"));
+    }
+    absl::StatusOr<std::vector<JobRecord>> jobs = farm_.scheduler().List(query);
+    if (!jobs.ok()) return ToGrpcStatus(jobs.status());
+    if (jobs->size() > size_t(page_size)) {
+        jobs->resize(size_t(page_size));
+        resp->set_next_page_token(absl::StrCat(jobs->back().seq));
+    }
+    for (const JobRecord& job : *jobs) ToProto(job, resp->add_jobs());
     return grpc::Status::OK;
 }
 
 grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::WatchJobRequest* req,
                                       grpc::ServerWriter<pb::Job>* writer) {
+    // Each stream holds a server thread until its job ends: bounded, so that watchers cannot
+    // take every thread (or the memory of thousands).
+    struct Slot {
+        std::atomic<int>& count;
+        ~Slot() { --count; }
+    } slot{watchers_};
+    if (++watchers_ > options_.max_watchers) {
+        Log()->warn("watch of job={} from {} refused: {} watchers already", LogSafe(req->job_id()),
+                    Peer(context), options_.max_watchers);
+        return ToGrpcStatus(absl::ResourceExhaustedError(absl::StrCat(
+            "this server already serves its most watchers, ", options_.max_watchers,
+            " (lightfarm-server --max-watchers): try again later, or poll with `lightfarm "
+            "status`")));
+    }
     // At most five messages a second, and one at least every few seconds so a dead client is
     // noticed.
     constexpr absl::Duration kMinGap = absl::Milliseconds(200), kMaxGap = absl::Seconds(5);
@@ -112,10 +155,11 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::Wa
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext*, const pb::CancelJobRequest* req,
-                                       pb::Job* resp) {
+grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
+                                       const pb::CancelJobRequest* req, pb::Job* resp) {
     absl::StatusOr<JobRecord> job = farm_.scheduler().Cancel(req->job_id());
     if (!job.ok()) return ToGrpcStatus(job.status());
+    Log()->info("job={} cancelled by {}", job->id, Peer(context));
     ToProto(*job, resp);
     return grpc::Status::OK;
 }
@@ -126,6 +170,13 @@ grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context,
     absl::StatusOr<std::string> path = farm_.ResultFile(req->job_id(), req->preview());
     if (!path.ok()) return ToGrpcStatus(path.status());
     return StreamFile(context, *path, writer);
+}
+
+grpc::Status JobServiceImpl::DeleteJob(grpc::ServerContext* context,
+                                       const pb::DeleteJobRequest* req, pb::DeleteJobResponse*) {
+    if (absl::Status s = farm_.DeleteJob(req->job_id()); !s.ok()) return ToGrpcStatus(s);
+    Log()->info("job={} deleted by {}", LogSafe(req->job_id()), Peer(context));
+    return grpc::Status::OK;
 }
 
 grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext*, const pb::LeaseTaskRequest* req,
@@ -147,16 +198,25 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext*, const pb::Heartb
     return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext*,
+grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context,
                                              const pb::CompleteTaskRequest* req,
                                              pb::CompleteTaskResponse*) {
     const absl::Status s =
         req->radiosity_sweep().empty()
             ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums())
             : farm_.CompleteSweep(req->lease_id(), req->worker_id(), req->radiosity_sweep());
-    if (!s.ok())
-        Log()->warn("lease={} CompleteTask refused: {}", req->lease_id(), std::string(s.message()));
+    if (!s.ok()) {
+        Log()->warn("{}", RefusedResultLine(req->lease_id(), req->worker_id(), context->peer(),
+                                            std::string(s.message())));
+    }
     return ToGrpcStatus(s);
+}
+
+std::string RefusedResultLine(std::string_view lease_id, std::string_view worker_id,
+                              std::string_view peer, std::string_view why) {
+    // Every part came from the wire: the ids and the peer, and the reason, which quotes them.
+    return absl::StrCat("lease=", LogSafe(lease_id), " worker=", LogSafe(worker_id), " from ",
+                        LogSafe(peer), ": CompleteTask refused: ", LogSafe(why, 1024));
 }
 
 grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext*, const pb::FailTaskRequest* req,

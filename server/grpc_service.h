@@ -2,15 +2,29 @@
 // and the plain types of Farm and Scheduler. All protobuf conversion of the server is here.
 #pragma once
 
+#include <atomic>
+#include <string>
+#include <string_view>
+
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "lightfarm/v1/worker_service.grpc.pb.h"
 #include "server/farm.h"
 
 namespace lf {
 
+struct JobServiceOptions {
+    // WatchJob streams open at once; each holds one of the server's threads while it lasts.
+    int max_watchers = 256;
+};
+
+// ListJobs pages: the size when the request names none, and the largest.
+constexpr int kDefaultPageSize = 100;
+constexpr int kMaxPageSize = 1000;
+
 class JobServiceImpl final : public lightfarm::v1::JobService::Service {
   public:
-    explicit JobServiceImpl(Farm& farm) : farm_(farm) {}
+    explicit JobServiceImpl(Farm& farm, JobServiceOptions options = {})
+        : farm_(farm), options_(options) {}
 
     grpc::Status MissingBlobs(grpc::ServerContext*, const lightfarm::v1::MissingBlobsRequest*,
                               lightfarm::v1::MissingBlobsResponse*) override;
@@ -29,10 +43,18 @@ class JobServiceImpl final : public lightfarm::v1::JobService::Service {
                            lightfarm::v1::Job*) override;
     grpc::Status FetchResult(grpc::ServerContext*, const lightfarm::v1::FetchResultRequest*,
                              grpc::ServerWriter<lightfarm::v1::Chunk>*) override;
+    grpc::Status DeleteJob(grpc::ServerContext*, const lightfarm::v1::DeleteJobRequest*,
+                           lightfarm::v1::DeleteJobResponse*) override;
 
   private:
     Farm& farm_;
+    const JobServiceOptions options_;
+    std::atomic<int> watchers_{0};
 };
+
+// The log line of a refused result, every value from the wire escaped (lf::LogSafe).
+std::string RefusedResultLine(std::string_view lease_id, std::string_view worker_id,
+                              std::string_view peer, std::string_view why);
 
 class WorkerServiceImpl final : public lightfarm::v1::WorkerService::Service {
   public:

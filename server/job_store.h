@@ -1,7 +1,8 @@
 // Jobs as the server records them, behind a small interface: in memory or in SQLite
-// (server/sqlite_job_store.h). The scheduler keeps the live task and lease state of running jobs
-// itself and writes the job-level record here on every change, and each finished task's result
-// with it, so that a restarted server can rebuild its running jobs; finished jobs live only here.
+// (server/sqlite_job_store.h), each record in the stored form of server/job_record_codec.h. The
+// scheduler keeps the live task and lease state of running jobs itself and writes the job-level
+// record here on every change, and each finished task's result with it, so that a restarted
+// server can rebuild its running jobs; finished jobs live only here.
 #pragma once
 
 #include <cstdint>
@@ -17,25 +18,38 @@
 
 namespace lf {
 
+// Which jobs JobStore::List returns, newest (highest seq) first.
+struct JobQuery {
+    uint64_t before_seq = 0;  // only jobs submitted before this seq; 0: from the newest
+    size_t limit = 0;         // at most this many; 0: all
+    // Only jobs that ended before this time (retention); InfinitePast: every job.
+    absl::Time ended_before = absl::InfinitePast();
+};
+
 class JobStore {
   public:
     virtual ~JobStore() = default;
     // Writes are queued and become durable in the order they were queued; a store may commit
     // many at once (group commit), so that callers can wait for durability without holding
-    // their locks. Each returns a ticket for WaitDurable.
+    // their locks. Each returns a ticket for WaitDurable. A record whose request id another
+    // job holds is refused (AlreadyExists from WaitDurable).
     virtual uint64_t QueuePut(const JobRecord& job) = 0;  // insert or replace, by id
     // The job's record together with the encoded TileSums of its task `task`, in one write. A
     // record in a final state drops the job's task results.
     virtual uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) = 0;
+    // Removes the job's record and task results; nothing to remove is not an error.
+    virtual uint64_t QueueDelete(const std::string& id) = 0;
     // Blocks until the write of `ticket`, and every one before it, is durable; or its error.
     virtual absl::Status WaitDurable(uint64_t ticket) = 0;
     absl::Status Put(const JobRecord& job) { return WaitDurable(QueuePut(job)); }
+    absl::Status Delete(const std::string& id) { return WaitDurable(QueueDelete(id)); }
 
     // Reads see durable writes only.
     virtual absl::StatusOr<JobRecord> Get(const std::string& id) const = 0;  // NotFound
-    virtual std::vector<JobRecord> List() const = 0;                         // newest first
+    virtual absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const = 0;
     // The job submitted with this client request id, if any.
-    virtual std::optional<std::string> FindRequest(const std::string& request_id) const = 0;
+    virtual absl::StatusOr<std::optional<std::string>> FindRequest(
+        const std::string& request_id) const = 0;
     // The results QueueTaskDone recorded for a job that has not ended, by task index.
     virtual absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const = 0;
 };
@@ -48,17 +62,22 @@ class InMemoryJobStore : public JobStore {
     uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) override {
         return QueuePut(job);
     }
-    absl::Status WaitDurable(uint64_t ticket) override { return absl::OkStatus(); }
+    uint64_t QueueDelete(const std::string& id) override;
+    absl::Status WaitDurable(uint64_t ticket) override;
     absl::StatusOr<JobRecord> Get(const std::string& id) const override;
-    std::vector<JobRecord> List() const override;
-    std::optional<std::string> FindRequest(const std::string& request_id) const override;
+    absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const override;
+    absl::StatusOr<std::optional<std::string>> FindRequest(
+        const std::string& request_id) const override;
     absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const override {
         return std::map<int, std::string>{};
     }
 
   private:
+    static constexpr uint64_t kDone = 0;  // the ticket of a write that succeeded
     mutable std::mutex mutex_;
     std::map<std::string, JobRecord> jobs_;
+    uint64_t last_refused_ = 0;
+    std::map<uint64_t, absl::Status> refused_;  // by ticket
 };
 
 }  // namespace lf

@@ -44,6 +44,17 @@ int main(int argc, char** argv) {
     app.add_option("--max-spp", options.limits.max_spp, "most samples per pixel per job")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    double retention_days = 30;
+    app.add_option("--retention-days", retention_days,
+                   "ended jobs older than this are deleted, with their results; 0 keeps them "
+                   "forever")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    lf::JobServiceOptions service_options;
+    app.add_option("--max-watchers", service_options.max_watchers,
+                   "most WatchJob streams open at once (each holds a thread); more are refused")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
@@ -53,6 +64,7 @@ int main(int argc, char** argv) {
     options.scheduler.lease = absl::Seconds(lease_seconds);
     options.scheduler.speculate_after = absl::Seconds(speculate_seconds);
     options.limits.max_scene_bytes = max_scene_mb << 20;
+    options.retention = absl::Hours(24 * retention_days);
     // Often enough that a cancel reaches workers within about a second, and several times per
     // lease so one slow answer does not lose it.
     options.scheduler.heartbeat_interval = std::min(absl::Milliseconds(300), options.scheduler.lease / 4);
@@ -63,16 +75,22 @@ int main(int argc, char** argv) {
                      std::string(farm.status().message()).c_str());
         return 1;
     }
-    lf::JobServiceImpl job_service(**farm);
+    lf::JobServiceImpl job_service(**farm, service_options);
     lf::WorkerServiceImpl worker_service(**farm);
     grpc::ServerBuilder builder;
     int port = 0;
+    // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
+    // port and answering clients at random.
+    builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
     builder.AddListeningPort(listen, grpc::InsecureServerCredentials(), &port);
     builder.RegisterService(&job_service);
     builder.RegisterService(&worker_service);
     std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
     if (!server || port == 0) {
-        std::fprintf(stderr, "lightfarm-server: error: cannot listen on %s\n", listen.c_str());
+        std::fprintf(stderr,
+                     "lightfarm-server: error: cannot listen on %s (is another server using "
+                     "the port?)\n",
+                     listen.c_str());
         return 1;
     }
     const std::string host = listen.substr(0, listen.rfind(':'));
@@ -85,9 +103,17 @@ int main(int argc, char** argv) {
     // sampling, within a tenth of a second.
     lf::TimeoutChecker timeout_checker(absl::Milliseconds(100), [&] { (*farm)->CheckTimers(); });
 
+    // Retention: the jobs that expire while the server runs go within the hour.
+    lf::TimeoutChecker retention(absl::Hours(1), [&] {
+        if (absl::StatusOr<int> n = (*farm)->DeleteExpired(absl::Now()); !n.ok()) {
+            spdlog::error("retention: {}", std::string(n.status().message()));
+        }
+    });
+
     spdlog::info("signal {}: shutting down", stop_signals.Wait());
     (*farm)->scheduler().Shutdown();
     server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
     timeout_checker.Stop();
+    retention.Stop();
     return 0;
 }

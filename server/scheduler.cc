@@ -118,8 +118,12 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     job->record.tasks_total = int(job->tasks.size());
     // The store is read before the lock is taken. An earlier submission it does not hold has not
     // been acknowledged yet, so it is still in memory.
-    std::optional<std::string> stored =
-        spec.request_id.empty() ? std::nullopt : store_.FindRequest(spec.request_id);
+    std::optional<std::string> stored;
+    if (!spec.request_id.empty()) {
+        absl::StatusOr<std::optional<std::string>> found = store_.FindRequest(spec.request_id);
+        if (!found.ok()) return found.status();
+        stored = *found;
+    }
     std::string id = NewJobId();
     while (store_.Get(id).ok()) id = NewJobId();
     Locked locked(*this);
@@ -191,10 +195,11 @@ absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
     return store_.Get(job_id);
 }
 
-std::vector<JobRecord> Scheduler::List() const {
-    std::vector<JobRecord> jobs = store_.List();
+absl::StatusOr<std::vector<JobRecord>> Scheduler::List(const JobQuery& query) const {
+    absl::StatusOr<std::vector<JobRecord>> jobs = store_.List(query);
+    if (!jobs.ok()) return jobs.status();
     std::lock_guard<std::mutex> lock(mutex_);
-    for (JobRecord& job : jobs) {
+    for (JobRecord& job : *jobs) {
         if (auto it = active_.find(job.id); it != active_.end()) job = it->second->record;
         if (const JobRecord* ended = EndedRecord(job.id)) job = *ended;
     }
@@ -214,7 +219,10 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     };
     std::vector<Stored> stored;
     uint64_t last_seq = 0;
-    for (JobRecord& record : store_.List()) {
+    // A store that cannot list must not start an empty server.
+    absl::StatusOr<std::vector<JobRecord>> recorded = store_.List();
+    if (!recorded.ok()) return recorded.status();
+    for (JobRecord& record : *recorded) {
         last_seq = std::max(last_seq, record.seq);
         if (IsFinal(record.state)) continue;
         absl::StatusOr<std::map<int, std::string>> results = store_.TaskResults(record.id);

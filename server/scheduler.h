@@ -140,7 +140,8 @@ class Scheduler {
 
     // Running jobs as they are now, ended ones from the store.
     absl::StatusOr<JobRecord> Get(const std::string& job_id) const;
-    std::vector<JobRecord> List() const;
+    // The jobs the query selects from the store, running ones as they are now.
+    absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const;
 
     // Blocks until some job changed after `version` was current, or `deadline`, or Shutdown.
     // Returns the version now.

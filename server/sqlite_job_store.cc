@@ -2,148 +2,18 @@
 
 #include <sqlite3.h>
 
+#include <limits>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <set>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "lf/core/log.h"
+#include "server/job_record_codec.h"
 
 namespace lf {
 
 namespace {
-
-using nlohmann::json;
-
-// Times as Unix microseconds; absl::InfinitePast (not yet) as null.
-json TimeToJson(absl::Time t) {
-    return t == absl::InfinitePast() ? json(nullptr) : json(absl::ToUnixMicros(t));
-}
-absl::Time TimeFromJson(const json& j) {
-    return j.is_null() ? absl::InfinitePast() : absl::FromUnixMicros(j.get<int64_t>());
-}
-
-json BlobToJson(const BlobRef& b) { return {{"path", b.path}, {"hash", b.hash}, {"size", b.size}}; }
-BlobRef BlobFromJson(const json& j) {
-    return {j.at("path").get<std::string>(), j.at("hash").get<std::string>(),
-            j.at("size").get<uint64_t>()};
-}
-
-// The record as JSON: a proven format, readable with the sqlite3 shell, and new fields need no
-// schema change.
-std::string RecordToJson(const JobRecord& r) {
-    json files = json::array();
-    for (const BlobRef& f : r.spec.files) files.push_back(BlobToJson(f));
-    const JobSpec& s = r.spec;
-    return json{
-        {"id", r.id},
-        {"seq", r.seq},
-        {"spec",
-         {{"name", s.name},
-          {"scene", BlobToJson(s.scene)},
-          {"files", files},
-          {"width", s.plan.width},
-          {"height", s.plan.height},
-          {"spp", s.plan.spp},
-          {"tile", s.plan.tile},
-          {"passes", s.plan.passes},
-          {"seed", s.seed},
-          {"max_depth", s.max_depth},
-          {"method", s.method},
-          {"radiosity",
-           {{"patches", s.radiosity.patches},
-            {"patch_size", s.radiosity.patch_size},
-            {"solver", s.radiosity.solver},
-            {"tolerance", s.radiosity.tolerance},
-            {"max_iterations", s.radiosity.max_iterations},
-            {"display", s.radiosity.display},
-            {"sweep_tasks", s.radiosity.sweep_tasks},
-            {"max_patches", s.radiosity.max_patches}}},
-          {"adaptive",
-           {{"target_error", s.adaptive.target_error},
-            {"time_limit", s.adaptive.time_limit},
-            {"max_spp", s.adaptive.max_spp}}},
-          {"priority", s.priority},
-          {"scene_hash", s.scene_hash},
-          {"request_id", s.request_id}}},
-        {"state", int(r.state)},
-        {"error", r.error},
-        {"last_error", r.last_error},
-        {"submitted", TimeToJson(r.submitted)},
-        {"started", TimeToJson(r.started)},
-        {"finished", TimeToJson(r.finished)},
-        {"tasks_total", r.tasks_total},
-        {"tasks_done", r.tasks_done},
-        {"tasks_running", r.tasks_running},
-        {"retries", r.retries},
-        {"tasks_leased", r.tasks_leased},
-        {"samples", r.stats.samples},
-        {"rays", r.stats.rays},
-        {"invalid_samples", r.stats.invalid_samples},
-        {"result_path", r.result_path},
-    }
-        .dump();
-}
-
-absl::StatusOr<JobRecord> RecordFromJson(std::string_view text) {
-    try {
-        const json j = json::parse(text);
-        JobRecord r;
-        r.id = j.at("id").get<std::string>();
-        r.seq = j.at("seq").get<uint64_t>();
-        const json& s = j.at("spec");
-        r.spec.name = s.at("name").get<std::string>();
-        r.spec.scene = BlobFromJson(s.at("scene"));
-        for (const json& f : s.at("files")) r.spec.files.push_back(BlobFromJson(f));
-        r.spec.plan.width = s.at("width").get<int>();
-        r.spec.plan.height = s.at("height").get<int>();
-        r.spec.plan.spp = s.at("spp").get<uint64_t>();
-        r.spec.plan.tile = s.at("tile").get<int>();
-        r.spec.plan.passes = s.at("passes").get<int>();
-        r.spec.seed = s.at("seed").get<uint64_t>();
-        r.spec.max_depth = s.at("max_depth").get<int>();
-        r.spec.method = s.value("method", "path");
-        if (s.contains("radiosity")) {
-            const auto& rad = s.at("radiosity");
-            r.spec.radiosity = {rad.at("patches").get<int64_t>(),
-                                rad.at("patch_size").get<double>(),
-                                rad.at("solver").get<std::string>(),
-                                rad.at("tolerance").get<double>(),
-                                rad.at("max_iterations").get<int>(),
-                                rad.at("display").get<std::string>(),
-                                rad.value("sweep_tasks", RadiositySettings().sweep_tasks),
-                                rad.value("max_patches", int64_t(0))};
-        }
-        if (s.contains("adaptive")) {
-            const auto& a = s.at("adaptive");
-            r.spec.adaptive = {a.at("target_error").get<double>(), a.at("time_limit").get<double>(),
-                               a.at("max_spp").get<uint64_t>()};
-        }
-        r.spec.priority = s.at("priority").get<int>();
-        r.spec.scene_hash = s.at("scene_hash").get<std::string>();
-        r.spec.request_id = s.value("request_id", "");
-        r.state = JobState(j.at("state").get<int>());
-        r.error = j.at("error").get<std::string>();
-        r.last_error = j.value("last_error", "");
-        r.submitted = TimeFromJson(j.at("submitted"));
-        r.started = TimeFromJson(j.at("started"));
-        r.finished = TimeFromJson(j.at("finished"));
-        r.tasks_total = j.at("tasks_total").get<int>();
-        r.tasks_done = j.at("tasks_done").get<int>();
-        r.tasks_running = j.at("tasks_running").get<int>();
-        r.retries = j.at("retries").get<int>();
-        r.tasks_leased = j.value("tasks_leased", 0);
-        r.stats.samples = j.at("samples").get<uint64_t>();
-        r.stats.rays = j.at("rays").get<uint64_t>();
-        r.stats.invalid_samples = j.at("invalid_samples").get<uint64_t>();
-        r.result_path = j.at("result_path").get<std::string>();
-        return r;
-    } catch (const json::exception& e) {
-        return absl::DataLossError(
-            absl::StrCat("a job record in the store is unreadable: ", e.what()));
-    }
-}
 
 // The connection's last error. A full disk says so in its code, so that the client's message
 // is plain; anything else is the server's problem.
@@ -151,6 +21,10 @@ absl::Status StoreError(sqlite3* db) {
     const std::string message = absl::StrCat("job store: ", sqlite3_errmsg(db));
     if ((sqlite3_extended_errcode(db) & 0xff) == SQLITE_FULL) {
         return absl::ResourceExhaustedError(message);
+    }
+    // A second job with one request id: the scheduler's bug, kept out by the schema.
+    if ((sqlite3_extended_errcode(db) & 0xff) == SQLITE_CONSTRAINT) {
+        return absl::AlreadyExistsError(message);
     }
     return absl::InternalError(message);
 }
@@ -179,6 +53,11 @@ class Statement {
     }
     Statement& Bind(int i, int64_t value) {
         if (rc_ == SQLITE_OK) rc_ = sqlite3_bind_int64(stmt_, i, value);
+        return *this;
+    }
+    Statement& Bind(int i, std::optional<int64_t> value) {
+        if (value) return Bind(i, *value);
+        if (rc_ == SQLITE_OK) rc_ = sqlite3_bind_null(stmt_, i);
         return *this;
     }
     // True while there is a row; check status() after false.
@@ -210,6 +89,18 @@ absl::Status Exec(sqlite3* db, const char* sql) {
     return StoreError(db);
 }
 
+// A stored record, its errors naming the job.
+absl::StatusOr<JobRecord> Decode(std::string_view id, std::string_view record) {
+    absl::StatusOr<JobRecord> job = DecodeJobRecord(record);
+    if (job.ok()) return job;
+    return absl::Status(job.status().code(), absl::StrCat("job store: job ", std::string(id), ": ",
+                                                          job.status().message()));
+}
+
+// Schema versions (PRAGMA user_version): 0, records only, states by enum position, request ids
+// found inside the JSON; 1, the columns List and FindRequest select on, states by name.
+constexpr int kSchemaVersion = 1;
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::string& path) {
@@ -225,20 +116,41 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
     // synchronous=FULL: a commit is on disk when it returns, so what was acknowledged survives
     // a crash of the process or of the machine. The busy timeout only matters for a second
     // process (the sqlite3 shell) reading at the same time.
-    if (absl::Status s =
-            Exec(db,
-                 "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
-                 "PRAGMA busy_timeout=5000;"
+    absl::Status s = Exec(db,
+                          "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
+                          "PRAGMA busy_timeout=5000;");
+    int64_t found_version = 0;
+    bool old = false;
+    if (s.ok()) {
+        Statement version(db, "PRAGMA user_version");
+        if (version.Step()) found_version = version.ColumnInt(0);
+        Statement tables(db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'jobs'");
+        old = tables.Step() && found_version < kSchemaVersion;
+        s = version.status().ok() ? tables.status() : version.status();
+    }
+    if (s.ok() && found_version > kSchemaVersion) {
+        s = absl::FailedPreconditionError(absl::StrCat(
+            "job store version ", found_version, " is newer than this server's (", kSchemaVersion,
+            "): run a lightfarm-server as new as the one that wrote it"));
+    }
+    if (s.ok() && old) s = Migrate(db);
+    if (s.ok()) {
+        s = Exec(db,
                  "CREATE TABLE IF NOT EXISTS jobs (id TEXT PRIMARY KEY,"
-                 "  seq INTEGER NOT NULL, final INTEGER NOT NULL, record TEXT NOT NULL);"
+                 "  seq INTEGER NOT NULL, final INTEGER NOT NULL, record TEXT NOT NULL,"
+                 "  request_id TEXT NOT NULL DEFAULT '', finished INTEGER);"
                  "CREATE TABLE IF NOT EXISTS task_results (job TEXT NOT NULL,"
                  "  task INTEGER NOT NULL, sums BLOB NOT NULL,"
                  "  PRIMARY KEY (job, task));"
-                 "CREATE INDEX IF NOT EXISTS jobs_by_request ON jobs ("
-                 "  json_extract(record, '$.spec.request_id'));");
-        !s.ok()) {
-        return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
+                 "CREATE UNIQUE INDEX IF NOT EXISTS jobs_by_request_id ON jobs (request_id)"
+                 "  WHERE request_id != '';"
+                 "CREATE INDEX IF NOT EXISTS jobs_by_seq ON jobs (seq);"
+                 "CREATE INDEX IF NOT EXISTS ended_jobs ON jobs (finished) WHERE final = 1;");
     }
+    if (s.ok()) {
+        s = Exec(db, absl::StrCat("PRAGMA user_version = ", kSchemaVersion).c_str());
+    }
+    if (!s.ok()) return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
     return store;
 }
 
@@ -254,12 +166,31 @@ SqliteJobStore::~SqliteJobStore() {
     sqlite3_close(db_);
 }
 
-uint64_t SqliteJobStore::QueuePut(const JobRecord& job) {
-    return Queue({job.id, job.seq, IsFinal(job.state), RecordToJson(job)});
+SqliteJobStore::Write SqliteJobStore::PutOf(const JobRecord& job) {
+    Write w{job.id};
+    w.seq = job.seq;
+    w.final = IsFinal(job.state);
+    w.request_id = job.spec.request_id;
+    if (w.final && job.finished != absl::InfinitePast()) {
+        w.finished_us = absl::ToUnixMicros(job.finished);
+    }
+    w.record = EncodeJobRecord(job);
+    return w;
 }
 
+uint64_t SqliteJobStore::QueuePut(const JobRecord& job) { return Queue(PutOf(job)); }
+
 uint64_t SqliteJobStore::QueueTaskDone(const JobRecord& job, int task, std::string result) {
-    return Queue({job.id, job.seq, IsFinal(job.state), RecordToJson(job), task, std::move(result)});
+    Write w = PutOf(job);
+    w.task = task;
+    w.result = std::move(result);
+    return Queue(std::move(w));
+}
+
+uint64_t SqliteJobStore::QueueDelete(const std::string& id) {
+    Write w{id};
+    w.remove = true;
+    return Queue(std::move(w));
 }
 
 uint64_t SqliteJobStore::Queue(Write write) {
@@ -306,7 +237,7 @@ void SqliteJobStore::WriterLoop() {
 
 absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
     // Only the newest record of a job in the batch is written: the earlier ones would be
-    // replaced within the same transaction anyway.
+    // replaced, or deleted, within the same transaction anyway.
     std::map<std::string_view, size_t> newest;
     for (size_t i = 0; i < batch.size(); ++i) newest[batch[i].job_id] = i;
     std::lock_guard<std::mutex> lock(db_mutex_);
@@ -314,6 +245,14 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
     absl::Status status;
     for (size_t i = 0; i < batch.size() && status.ok(); ++i) {
         const Write& w = batch[i];
+        if (w.remove) {
+            Statement drop(db_, "DELETE FROM jobs WHERE id = ?1");
+            drop.Bind(1, w.job_id).Step();
+            Statement drop_results(db_, "DELETE FROM task_results WHERE job = ?1");
+            if (drop.status().ok()) drop_results.Bind(1, w.job_id).Step();
+            status = drop.status().ok() ? drop_results.status() : drop.status();
+            continue;
+        }
         if (w.task >= 0) {
             Statement put(
                 db_, "INSERT OR REPLACE INTO task_results (job, task, sums) VALUES (?1, ?2, ?3)");
@@ -321,10 +260,15 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
             status = put.status();
         }
         if (!status.ok() || newest[w.job_id] != i) continue;
-        Statement put(
-            db_, "INSERT OR REPLACE INTO jobs (id, seq, final, record) VALUES (?1, ?2, ?3, ?4)");
+        // An upsert by id, not INSERT OR REPLACE: a clash of request ids must fail, not delete
+        // the other job.
+        Statement put(db_,
+                      "INSERT INTO jobs (id, seq, final, record, request_id, finished)"
+                      " VALUES (?1, ?2, ?3, ?4, ?5, ?6) ON CONFLICT (id) DO UPDATE SET"
+                      " seq = excluded.seq, final = excluded.final, record = excluded.record,"
+                      " request_id = excluded.request_id, finished = excluded.finished");
         put.Bind(1, w.job_id).Bind(2, int64_t(w.seq)).Bind(3, int64_t(w.final));
-        put.Bind(4, w.record).Step();
+        put.Bind(4, w.record).Bind(5, w.request_id).Bind(6, w.finished_us).Step();
         status = put.status();
         if (status.ok() && w.final) {
             Statement drop(db_, "DELETE FROM task_results WHERE job = ?1");
@@ -337,31 +281,80 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
     return status;
 }
 
+absl::Status SqliteJobStore::Migrate(sqlite3* db) {
+    // Version 0 to 1: the columns, filled from the records, which are rewritten with states by
+    // name. In one transaction, so that a failure leaves version 0 to try again.
+    if (absl::Status s = Exec(db, "BEGIN IMMEDIATE"); !s.ok()) return s;
+    absl::Status status = Exec(db,
+                               "DROP INDEX IF EXISTS jobs_by_request;"
+                               "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';"
+                               "ALTER TABLE jobs ADD COLUMN finished INTEGER;");
+    std::vector<Write> rewrites;
+    if (status.ok()) {
+        Statement all(db, "SELECT id, record FROM jobs");
+        while (status.ok() && all.Step()) {
+            absl::StatusOr<JobRecord> job = Decode(all.Column(0), all.Column(1));
+            if (job.ok()) rewrites.push_back(PutOf(*job));
+            status = job.status();
+        }
+        if (status.ok()) status = all.status();
+    }
+    for (size_t i = 0; i < rewrites.size() && status.ok(); ++i) {
+        const Write& w = rewrites[i];
+        Statement update(
+            db, "UPDATE jobs SET record = ?2, request_id = ?3, finished = ?4 WHERE id = ?1");
+        update.Bind(1, w.job_id).Bind(2, w.record).Bind(3, w.request_id).Bind(4, w.finished_us);
+        update.Step();
+        status = update.status();
+    }
+    if (status.ok()) status = Exec(db, "COMMIT");
+    if (!status.ok()) {
+        Exec(db, "ROLLBACK").IgnoreError();
+        return absl::Status(status.code(),
+                            absl::StrCat("upgrading the job store: ", status.message()));
+    }
+    NamedLogger("store")->info("job store upgraded to version {}: {} jobs", kSchemaVersion,
+                               rewrites.size());
+    return absl::OkStatus();
+}
+
 absl::StatusOr<JobRecord> SqliteJobStore::Get(const std::string& id) const {
     std::lock_guard<std::mutex> lock(db_mutex_);
     Statement get(db_, "SELECT record FROM jobs WHERE id = ?1");
-    if (get.Bind(1, id).Step()) return RecordFromJson(get.Column(0));
+    if (get.Bind(1, id).Step()) return Decode(id, get.Column(0));
     if (!get.status().ok()) return get.status();
     return absl::NotFoundError("no job " + id);
 }
 
-std::vector<JobRecord> SqliteJobStore::List() const {
+absl::StatusOr<std::vector<JobRecord>> SqliteJobStore::List(const JobQuery& query) const {
     std::lock_guard<std::mutex> lock(db_mutex_);
     std::vector<JobRecord> jobs;
-    Statement list(db_, "SELECT record FROM jobs ORDER BY seq DESC");
+    Statement list(db_,
+                   "SELECT id, record FROM jobs WHERE seq < ?1"
+                   " AND (?2 IS NULL OR (final = 1 AND finished < ?2))"
+                   " ORDER BY seq DESC LIMIT ?3");
+    list.Bind(
+        1, query.before_seq == 0 ? std::numeric_limits<int64_t>::max() : int64_t(query.before_seq));
+    list.Bind(2, query.ended_before == absl::InfinitePast()
+                     ? std::nullopt
+                     : std::optional<int64_t>(absl::ToUnixMicros(query.ended_before)));
+    list.Bind(3, query.limit == 0 ? int64_t(-1) : int64_t(query.limit));
     while (list.Step()) {
-        // An unreadable record is skipped rather than hiding every other job.
-        if (absl::StatusOr<JobRecord> job = RecordFromJson(list.Column(0)); job.ok()) {
-            jobs.push_back(std::move(*job));
-        }
+        absl::StatusOr<JobRecord> job = Decode(list.Column(0), list.Column(1));
+        if (!job.ok()) return job.status();
+        jobs.push_back(std::move(*job));
     }
+    if (!list.status().ok()) return list.status();
     return jobs;
 }
 
-std::optional<std::string> SqliteJobStore::FindRequest(const std::string& request_id) const {
+absl::StatusOr<std::optional<std::string>> SqliteJobStore::FindRequest(
+    const std::string& request_id) const {
+    if (request_id.empty()) return std::nullopt;
     std::lock_guard<std::mutex> lock(db_mutex_);
-    Statement find(db_, "SELECT id FROM jobs WHERE json_extract(record, '$.spec.request_id') = ?1");
+    Statement find(db_, "SELECT id FROM jobs WHERE request_id = ?1");
     if (find.Bind(1, request_id).Step()) return std::string(find.Column(0));
+    if (!find.status().ok()) return find.status();
     return std::nullopt;
 }
 

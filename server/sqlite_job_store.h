@@ -9,6 +9,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -27,21 +28,30 @@ class SqliteJobStore : public JobStore {
 
     uint64_t QueuePut(const JobRecord& job) override;
     uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) override;
+    uint64_t QueueDelete(const std::string& id) override;
     absl::Status WaitDurable(uint64_t ticket) override;
     absl::StatusOr<JobRecord> Get(const std::string& id) const override;
-    std::vector<JobRecord> List() const override;
-    std::optional<std::string> FindRequest(const std::string& request_id) const override;
+    absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const override;
+    absl::StatusOr<std::optional<std::string>> FindRequest(
+        const std::string& request_id) const override;
     absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const override;
 
   private:
+    // A record to put, with the columns drawn from it; or, with `remove`, a job to delete.
     struct Write {
         std::string job_id;
-        uint64_t seq;
-        bool final;
-        std::string record;  // JSON
-        int task = -1;       // with a task result when >= 0
+        bool remove = false;
+        uint64_t seq = 0;
+        bool final = false;
+        std::string request_id = {};
+        std::optional<int64_t> finished_us = {};  // ended jobs only
+        std::string record = {};                  // EncodeJobRecord
+        int task = -1;                            // with a task result when >= 0
         std::string result = {};
     };
+    static Write PutOf(const JobRecord& job);
+    // Brings a database of an earlier version to this one's schema (see Open).
+    static absl::Status Migrate(sqlite3* db);
 
     explicit SqliteJobStore(sqlite3* db);
     uint64_t Queue(Write write);

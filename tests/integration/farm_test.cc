@@ -307,7 +307,7 @@ class Farm : public ::testing::Test {
 };
 
 TEST_F(Farm, HelpExplainsEveryFarmCommand) {
-    for (const char* cmd : {"submit", "list", "status", "watch", "fetch", "cancel"}) {
+    for (const char* cmd : {"submit", "list", "status", "watch", "fetch", "cancel", "delete"}) {
         const CliRun r = Lightfarm(std::string(cmd) + " --help");
         EXPECT_EQ(r.status, 0) << cmd;
         EXPECT_NE(r.out.find("--server"), std::string::npos) << cmd << r.out;
@@ -694,6 +694,50 @@ TEST_F(Farm, ServerRefusesADataDirItCannotUse) {
     EXPECT_EQ(server->Wait(milliseconds(5000)), std::optional<int>(1));
     EXPECT_NE(ReadText(dir_ / "server.log").find((dir_ / "file" / "data").string()),
               std::string::npos);
+}
+
+TEST_F(Farm, SecondServerOnAPortInUseRefusesToStart) {
+    StartServer();
+    Child* second = Spawn({std::string(LF_BIN_DIR) + "/lightfarm-server", "--listen", address_,
+                           "--data-dir", (dir_ / "other-data").string()},
+                          "second-server.log");
+    EXPECT_EQ(second->Wait(milliseconds(10000)), std::optional<int>(1));
+    const std::string log = ReadText(dir_ / "second-server.log");
+    EXPECT_NE(log.find("cannot listen on " + address_), std::string::npos) << log;
+    EXPECT_EQ(Farmctl("list").status, 0) << "the first server still answers";
+}
+
+TEST_F(Farm, SecondServerOnADataDirInUseRefusesToStart) {
+    StartServer();
+    Child* second = Spawn({std::string(LF_BIN_DIR) + "/lightfarm-server", "--listen",
+                           "127.0.0.1:0", "--data-dir", (dir_ / "data").string()},
+                          "second-server.log");
+    EXPECT_EQ(second->Wait(milliseconds(10000)), std::optional<int>(1));
+    const std::string log = ReadText(dir_ / "second-server.log");
+    EXPECT_NE(log.find((dir_ / "data").string() + " is in use by another lightfarm-server"),
+              std::string::npos)
+        << log;
+}
+
+TEST_F(Farm, ListFollowsItsLimitAndDeleteRemovesOnlyEndedJobs) {
+    StartServer();
+    const std::string small = WriteScene("cornell16.json", 16);
+    std::vector<std::string> jobs;
+    for (int i = 0; i < 3; ++i) jobs.push_back(Submit(small, "--spp 4"));  // no worker: queued
+    const CliRun two = Farmctl("list --limit 2");
+    ASSERT_EQ(two.status, 0) << two.err;
+    EXPECT_NE(two.out.find(jobs[2]), std::string::npos) << two.out;
+    EXPECT_NE(two.out.find(jobs[1]), std::string::npos) << two.out;
+    EXPECT_EQ(two.out.find(jobs[0]), std::string::npos) << "newest first, two only: " << two.out;
+
+    const CliRun queued = Farmctl("delete " + jobs[0]);
+    EXPECT_NE(queued.status, 0);
+    EXPECT_NE(queued.err.find("cancel it"), std::string::npos) << queued.err;
+    ASSERT_EQ(Farmctl("cancel " + jobs[0]).status, 0);
+    const CliRun deleted = Farmctl("delete " + jobs[0]);
+    EXPECT_EQ(deleted.status, 0) << deleted.err;
+    EXPECT_EQ(Farmctl("list").out.find(jobs[0]), std::string::npos);
+    EXPECT_NE(Farmctl("status " + jobs[0]).status, 0);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 // fixed function of (pixel, sample), so no renderer is needed.
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -17,6 +18,7 @@
 #include <thread>
 
 #include "lf/core/image_io.h"
+#include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
 #include "lf/job/digest.h"
 #include "server/grpc_service.h"
@@ -48,7 +50,7 @@ class FakeWorkerFarm : public ::testing::Test {
         absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
         ASSERT_TRUE(farm.ok()) << farm.status();
         farm_ = std::move(*farm);
-        jobs_ = std::make_unique<JobServiceImpl>(*farm_);
+        jobs_ = std::make_unique<JobServiceImpl>(*farm_, service_options_);
         workers_ = std::make_unique<WorkerServiceImpl>(*farm_);
         grpc::ServerBuilder builder;
         int port = 0;
@@ -93,13 +95,7 @@ class FakeWorkerFarm : public ::testing::Test {
     }
 
     std::string Submit(pb::JobService::Stub* stub = nullptr, int tile = 8) {
-        pb::SubmitJobRequest request;
-        request.mutable_scene()->set_path("scene.json");
-        request.mutable_scene()->set_hash(scene_hash_);
-        request.mutable_scene()->set_size(scene_json_.size());
-        request.mutable_params()->set_spp(4);
-        request.mutable_params()->set_tile(tile);
-        request.mutable_params()->set_passes(1);
+        pb::SubmitJobRequest request = SubmitRequest(tile);
         pb::SubmitJobResponse response;
         // As a client should: a deadline, and waiting out a connection the loaded machine did
         // not make at once (seen under ctest -j2: "failed to connect to all addresses").
@@ -110,6 +106,17 @@ class FakeWorkerFarm : public ::testing::Test {
             (stub ? stub : job_stub_.get())->SubmitJob(&context, request, &response);
         EXPECT_TRUE(s.ok()) << s.error_message();
         return response.job_id();
+    }
+
+    pb::SubmitJobRequest SubmitRequest(int tile = 8) {
+        pb::SubmitJobRequest request;
+        request.mutable_scene()->set_path("scene.json");
+        request.mutable_scene()->set_hash(scene_hash_);
+        request.mutable_scene()->set_size(scene_json_.size());
+        request.mutable_params()->set_spp(4);
+        request.mutable_params()->set_tile(tile);
+        request.mutable_params()->set_passes(1);
+        return request;
     }
 
     pb::Job GetJob(const std::string& id) {
@@ -206,6 +213,7 @@ class FakeWorkerFarm : public ::testing::Test {
     }
 
     absl::Duration speculate_after_ = absl::Seconds(30);  // no speculation but in StragglerTest
+    JobServiceOptions service_options_;
     fs::path dir_;
     std::unique_ptr<Farm> farm_;
     std::unique_ptr<JobServiceImpl> jobs_;
@@ -361,7 +369,180 @@ TEST_F(FakeWorkerFarm, TwentyClientsTwoHundredJobsAWatcherEachNothingLost) {
     EXPECT_EQ(watch_errors, 0);
     std::sort(ids.begin(), ids.end());
     EXPECT_EQ(std::unique(ids.begin(), ids.end()), ids.end()) << "a job id was given twice";
-    EXPECT_EQ(int(farm_->scheduler().List().size()), kJobs);
+    EXPECT_EQ(int(farm_->scheduler().List()->size()), kJobs);
+}
+
+TEST_F(FakeWorkerFarm, UploadStreamingMoreThanItDeclaredIsRefused) {
+    const std::string content(3 << 20, 'x');
+    grpc::ClientContext context;
+    pb::UploadBlobResponse response;
+    auto writer = job_stub_->UploadBlob(&context, &response);
+    pb::UploadBlobRequest chunk;
+    chunk.set_hash(Sha256Hex(content));
+    chunk.set_size(10);  // a lie: it streams 3 MiB
+    for (size_t offset = 0; offset < content.size(); offset += 1 << 20) {
+        chunk.set_data(content.substr(offset, 1 << 20));
+        if (!writer->Write(chunk)) break;
+        chunk.clear_hash();
+        chunk.clear_size();
+    }
+    writer->WritesDone();
+    const grpc::Status s = writer->Finish();
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << s.error_message();
+    EXPECT_NE(s.error_message().find("10 bytes declared"), std::string::npos) << s.error_message();
+    EXPECT_FALSE(farm_->blobs().Has(Sha256Hex(content)));
+}
+
+TEST_F(FakeWorkerFarm, SubmissionDeclaringASmallerSizeThanItsBlobIsRefused) {
+    // The scene size limit adds the declared sizes: they must be the blobs' own.
+    pb::SubmitJobRequest request = SubmitRequest();
+    request.mutable_scene()->set_size(1);
+    pb::SubmitJobResponse response;
+    grpc::ClientContext context;
+    const grpc::Status s = job_stub_->SubmitJob(&context, request, &response);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(s.error_message().find("declared as 1 bytes"), std::string::npos)
+        << s.error_message();
+}
+
+TEST_F(FakeWorkerFarm, JobNameAndRequestIdAboveTheirLimitsAreRefused) {
+    for (const bool name : {true, false}) {
+        pb::SubmitJobRequest request = SubmitRequest();
+        (name ? request.mutable_name() : request.mutable_request_id())
+            ->assign(2 << 20, 'n');  // 2 MiB
+        pb::SubmitJobResponse response;
+        grpc::ClientContext context;
+        const grpc::Status s = job_stub_->SubmitJob(&context, request, &response);
+        EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+        EXPECT_NE(
+            s.error_message().find(std::to_string(name ? kMaxJobNameBytes : kMaxRequestIdBytes)),
+            std::string::npos)
+            << s.error_message();
+    }
+    EXPECT_TRUE(farm_->scheduler().List()->empty());
+}
+
+TEST_F(FakeWorkerFarm, ListJobsPagesNewestFirstUntilTheLastPage) {
+    std::vector<std::string> submitted;
+    for (int i = 0; i < 5; ++i) submitted.insert(submitted.begin(), Submit());
+    std::vector<std::string> listed;
+    std::string token;
+    int pages = 0;
+    do {
+        pb::ListJobsRequest request;
+        request.set_page_size(2);
+        request.set_page_token(token);
+        pb::ListJobsResponse response;
+        grpc::ClientContext context;
+        ASSERT_TRUE(job_stub_->ListJobs(&context, request, &response).ok());
+        EXPECT_LE(response.jobs_size(), 2);
+        for (const pb::Job& job : response.jobs()) listed.push_back(job.id());
+        token = response.next_page_token();
+        ++pages;
+    } while (!token.empty() && pages < 10);
+    EXPECT_EQ(listed, submitted);
+    EXPECT_EQ(pages, 3);
+
+    pb::ListJobsRequest forged;
+    forged.set_page_token("x");
+    pb::ListJobsResponse response;
+    grpc::ClientContext context;
+    EXPECT_EQ(job_stub_->ListJobs(&context, forged, &response).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+}
+
+TEST_F(FakeWorkerFarm, DeleteRemovesAnEndedJobAndRefusesARunningOne) {
+    const std::string job = Submit();
+    auto remove = [&](const std::string& id) {
+        pb::DeleteJobRequest request;
+        request.set_job_id(id);
+        pb::DeleteJobResponse response;
+        grpc::ClientContext context;
+        return job_stub_->DeleteJob(&context, request, &response);
+    };
+    EXPECT_EQ(remove(job).error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+    RenderHonestly(job);
+    const std::string result = *farm_->ResultFile(job, false);
+    ASSERT_TRUE(fs::exists(result));
+    const grpc::Status deleted = remove(job);
+    ASSERT_TRUE(deleted.ok()) << deleted.error_message();
+    pb::GetJobRequest request;
+    request.set_job_id(job);
+    pb::Job got;
+    grpc::ClientContext context;
+    EXPECT_EQ(job_stub_->GetJob(&context, request, &got).error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_FALSE(fs::exists(result));
+    EXPECT_EQ(remove(job).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+class WatcherCapTest : public FakeWorkerFarm {
+  protected:
+    WatcherCapTest() { service_options_.max_watchers = 2; }
+};
+
+TEST_F(WatcherCapTest, WatchBeyondTheCapIsRefusedAndOneEndingFreesItsSlot) {
+    struct Watch {
+        grpc::ClientContext context;
+        std::unique_ptr<grpc::ClientReader<pb::Job>> reader;
+        pb::Job first;
+        bool open = false;
+    };
+    auto watch = [&](const std::string& id, Watch& w) {
+        pb::WatchJobRequest request;
+        request.set_job_id(id);
+        w.reader = job_stub_->WatchJob(&w.context, request);
+        w.open = w.reader->Read(&w.first);  // the first message comes once the slot is taken
+    };
+    const std::string a = Submit(), b = Submit();
+    Watch first, second, third;
+    watch(a, first);
+    watch(b, second);
+    ASSERT_TRUE(first.open && second.open);
+    watch(b, third);
+    EXPECT_FALSE(third.open);
+    const grpc::Status refused = third.reader->Finish();
+    EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+    EXPECT_NE(refused.error_message().find("--max-watchers"), std::string::npos)
+        << refused.error_message();
+
+    RenderHonestly(a);  // the first watch ends with its job
+    pb::Job job;
+    while (first.reader->Read(&job)) {
+    }
+    ASSERT_TRUE(first.reader->Finish().ok());
+    Watch fourth;
+    watch(b, fourth);
+    EXPECT_TRUE(fourth.open) << "the ended watch's slot is free again";
+    second.context.TryCancel();
+    fourth.context.TryCancel();
+    second.reader->Finish();
+    fourth.reader->Finish();
+}
+
+TEST_F(FakeWorkerFarm, ForgedNewlineInAWorkerIdDoesNotReachTheLogRaw) {
+    Submit();
+    const pb::Task task = *Lease("honest");
+    std::ostringstream captured;
+    std::shared_ptr<spdlog::logger> log = NamedLogger("rpc");
+    auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(captured);
+    sink->set_pattern("%v");
+    log->sinks().push_back(sink);
+    const std::string forged = "liar\n[info] job=" + task.job_id() + " succeeded";
+    EXPECT_EQ(Complete(task.lease_id(), forged, HonestResult(task)).error_code(),
+              grpc::StatusCode::FAILED_PRECONDITION);
+    log->flush();
+    log->sinks().pop_back();
+    const std::string text = captured.str();
+    EXPECT_NE(text.find("worker=liar\\n[info] job="), std::string::npos) << text;
+    EXPECT_EQ(text.find("liar\n"), std::string::npos) << text;
+    EXPECT_NE(text.find("from ipv"), std::string::npos) << "the line names the peer: " << text;
+    EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
+}
+
+TEST(RefusedResultLineTest, EveryWireValueIsEscaped) {
+    const std::string line = RefusedResultLine("lease\r1", "w\n2", "ipv4:1.2.3.4:5", "why\x1b");
+    EXPECT_EQ(line,
+              "lease=lease\\r1 worker=w\\n2 from ipv4:1.2.3.4:5: CompleteTask refused: why\\x1b");
 }
 
 }  // namespace

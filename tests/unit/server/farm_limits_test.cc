@@ -32,7 +32,7 @@ TEST(FarmLimitsTest, SceneAboveTheSizeLimitIsRefusedBeforeItIsStoredOrPlanned) {
     const absl::StatusOr<std::string> job = (*farm)->Submit(spec);
     EXPECT_EQ(job.status().code(), absl::StatusCode::kResourceExhausted);
     EXPECT_NE(job.status().message().find("1001 bytes"), std::string_view::npos) << job.status();
-    EXPECT_TRUE((*farm)->scheduler().List().empty());
+    EXPECT_TRUE((*farm)->scheduler().List()->empty());
     fs::remove_all(dir);
 }
 

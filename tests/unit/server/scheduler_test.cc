@@ -358,7 +358,7 @@ TEST_F(SchedulerTest, ShutdownEndsTheWait) {
 
 TEST_F(SchedulerTest, ListIsNewestFirst) {
     const std::string a = Submit(0), b = Submit(0);
-    const std::vector<JobRecord> jobs = scheduler_.List();
+    const std::vector<JobRecord> jobs = *scheduler_.List();
     ASSERT_EQ(jobs.size(), 2u);
     EXPECT_EQ(jobs[0].id, b);
     EXPECT_EQ(jobs[1].id, a);

@@ -165,7 +165,7 @@ TEST_F(SqliteJobStoreTest, RestartKeepsDoneTasksAndQueuesTheRest) {
 
     // Submission order survives: a new job is the newest.
     const std::string newest = *after.Submit(Spec());
-    EXPECT_EQ(after.List().front().id, newest);
+    EXPECT_EQ(after.List()->front().id, newest);
     EXPECT_NE(newest, id);
 }
 
@@ -204,14 +204,14 @@ TEST_F(SqliteJobStoreTest, SubmissionRetriedWithItsRequestIdGetsTheSameJob) {
     EXPECT_EQ(*after.Submit(spec), id) << "a retry after a restart";
     spec.request_id = "req-2";
     EXPECT_NE(*after.Submit(spec), id);
-    EXPECT_EQ(after.List().size(), 2u);
+    EXPECT_EQ(after.List()->size(), 2u);
 }
 
-// A store whose writes fail on demand, as on a full disk.
+// A store whose writes, or reads, fail on demand, as on a full disk or a damaged database.
 class FailingStore : public InMemoryJobStore {
   public:
-    bool fail = false;
-    static constexpr uint64_t kFailed = 1;  // InMemoryJobStore's tickets are 0
+    bool fail = false, fail_reads = false;
+    static constexpr uint64_t kFailed = ~uint64_t(0);  // not one of InMemoryJobStore's tickets
     uint64_t QueuePut(const JobRecord& job) override {
         return fail ? kFailed : InMemoryJobStore::QueuePut(job);
     }
@@ -220,9 +220,27 @@ class FailingStore : public InMemoryJobStore {
     }
     absl::Status WaitDurable(uint64_t ticket) override {
         return ticket == kFailed ? absl::ResourceExhaustedError("job store: disk full")
-                                 : absl::OkStatus();
+                                 : InMemoryJobStore::WaitDurable(ticket);
+    }
+    absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query) const override {
+        if (fail_reads) return absl::DataLossError("job store: database disk image is malformed");
+        return InMemoryJobStore::List(query);
     }
 };
+
+TEST_F(SqliteJobStoreTest, StoreThatCannotListFailsRecoveryInsteadOfStartingEmpty) {
+    FailingStore store;
+    {
+        Scheduler before({}, store);
+        ASSERT_TRUE(before.Submit(Spec()).ok());
+    }
+    store.fail_reads = true;
+    Scheduler after({}, store);
+    const absl::StatusOr<std::vector<std::string>> rendered = after.Recover();
+    EXPECT_EQ(rendered.status().code(), absl::StatusCode::kDataLoss);
+    EXPECT_NE(rendered.status().message().find("malformed"), std::string_view::npos);
+    EXPECT_EQ(after.List().status().code(), absl::StatusCode::kDataLoss) << "nor lists nothing";
+}
 
 TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs) {
     FailingStore store;
@@ -237,7 +255,7 @@ TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs)
     const absl::StatusOr<std::string> refused = scheduler.Submit(Spec());
     EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted);
     EXPECT_NE(refused.status().message().find("disk full"), std::string_view::npos);
-    EXPECT_EQ(scheduler.List().size(), 2u);
+    EXPECT_EQ(scheduler.List()->size(), 2u);
     // A result that cannot be recorded is refused with the reason, not acknowledged.
     absl::StatusOr<Scheduler::Completion> result =
         scheduler.Complete(lease->lease_id, "w", Result(*lease));

@@ -1,0 +1,166 @@
+#include "server/job_record_codec.h"
+
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/str_cat.h"
+
+namespace lf {
+
+namespace {
+
+using nlohmann::json;
+
+// Times as Unix microseconds; absl::InfinitePast (not yet) as null.
+json TimeToJson(absl::Time t) {
+    return t == absl::InfinitePast() ? json(nullptr) : json(absl::ToUnixMicros(t));
+}
+absl::Time TimeFromJson(const json& j) {
+    return j.is_null() ? absl::InfinitePast() : absl::FromUnixMicros(j.get<int64_t>());
+}
+
+json BlobToJson(const BlobRef& b) { return {{"path", b.path}, {"hash", b.hash}, {"size", b.size}}; }
+BlobRef BlobFromJson(const json& j) {
+    return {j.at("path").get<std::string>(), j.at("hash").get<std::string>(),
+            j.at("size").get<uint64_t>()};
+}
+
+// A name; or, in records written before states were stored by name, the enum's position then.
+absl::StatusOr<JobState> StateFromJson(const json& j) {
+    if (j.is_string()) return JobStateFromName(j.get<std::string>());
+    const int legacy = j.get<int>();
+    if (legacy < int(JobState::kQueued) || legacy > int(JobState::kCancelled)) {
+        return absl::InvalidArgumentError(absl::StrCat("unknown job state ", legacy));
+    }
+    return JobState(legacy);
+}
+
+}  // namespace
+
+absl::StatusOr<JobState> JobStateFromName(std::string_view name) {
+    for (JobState s : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
+                       JobState::kFailed, JobState::kCancelled}) {
+        if (name == JobStateName(s)) return s;
+    }
+    return absl::InvalidArgumentError(
+        absl::StrCat("unknown job state \"", std::string(name),
+                     "\": expected queued, running, succeeded, failed or cancelled"));
+}
+
+std::string EncodeJobRecord(const JobRecord& r) {
+    json files = json::array();
+    for (const BlobRef& f : r.spec.files) files.push_back(BlobToJson(f));
+    const JobSpec& s = r.spec;
+    return json{
+        {"id", r.id},
+        {"seq", r.seq},
+        {"spec",
+         {{"name", s.name},
+          {"scene", BlobToJson(s.scene)},
+          {"files", files},
+          {"width", s.plan.width},
+          {"height", s.plan.height},
+          {"spp", s.plan.spp},
+          {"tile", s.plan.tile},
+          {"passes", s.plan.passes},
+          {"seed", s.seed},
+          {"max_depth", s.max_depth},
+          {"method", s.method},
+          {"radiosity",
+           {{"patches", s.radiosity.patches},
+            {"patch_size", s.radiosity.patch_size},
+            {"solver", s.radiosity.solver},
+            {"tolerance", s.radiosity.tolerance},
+            {"max_iterations", s.radiosity.max_iterations},
+            {"display", s.radiosity.display},
+            {"sweep_tasks", s.radiosity.sweep_tasks},
+            {"max_patches", s.radiosity.max_patches}}},
+          {"adaptive",
+           {{"target_error", s.adaptive.target_error},
+            {"time_limit", s.adaptive.time_limit},
+            {"max_spp", s.adaptive.max_spp}}},
+          {"priority", s.priority},
+          {"scene_hash", s.scene_hash},
+          {"request_id", s.request_id}}},
+        {"state", JobStateName(r.state)},
+        {"error", r.error},
+        {"last_error", r.last_error},
+        {"submitted", TimeToJson(r.submitted)},
+        {"started", TimeToJson(r.started)},
+        {"finished", TimeToJson(r.finished)},
+        {"tasks_total", r.tasks_total},
+        {"tasks_done", r.tasks_done},
+        {"tasks_running", r.tasks_running},
+        {"retries", r.retries},
+        {"tasks_leased", r.tasks_leased},
+        {"samples", r.stats.samples},
+        {"rays", r.stats.rays},
+        {"invalid_samples", r.stats.invalid_samples},
+        {"result_path", r.result_path},
+    }
+        .dump();
+}
+
+absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
+    try {
+        const json j = json::parse(text);
+        JobRecord r;
+        r.id = j.at("id").get<std::string>();
+        r.seq = j.at("seq").get<uint64_t>();
+        const json& s = j.at("spec");
+        r.spec.name = s.at("name").get<std::string>();
+        r.spec.scene = BlobFromJson(s.at("scene"));
+        for (const json& f : s.at("files")) r.spec.files.push_back(BlobFromJson(f));
+        r.spec.plan.width = s.at("width").get<int>();
+        r.spec.plan.height = s.at("height").get<int>();
+        r.spec.plan.spp = s.at("spp").get<uint64_t>();
+        r.spec.plan.tile = s.at("tile").get<int>();
+        r.spec.plan.passes = s.at("passes").get<int>();
+        r.spec.seed = s.at("seed").get<uint64_t>();
+        r.spec.max_depth = s.at("max_depth").get<int>();
+        r.spec.method = s.value("method", "path");
+        if (s.contains("radiosity")) {
+            const auto& rad = s.at("radiosity");
+            r.spec.radiosity = {rad.at("patches").get<int64_t>(),
+                                rad.at("patch_size").get<double>(),
+                                rad.at("solver").get<std::string>(),
+                                rad.at("tolerance").get<double>(),
+                                rad.at("max_iterations").get<int>(),
+                                rad.at("display").get<std::string>(),
+                                rad.value("sweep_tasks", RadiositySettings().sweep_tasks),
+                                rad.value("max_patches", int64_t(0))};
+        }
+        if (s.contains("adaptive")) {
+            const auto& a = s.at("adaptive");
+            r.spec.adaptive = {a.at("target_error").get<double>(), a.at("time_limit").get<double>(),
+                               a.at("max_spp").get<uint64_t>()};
+        }
+        r.spec.priority = s.at("priority").get<int>();
+        r.spec.scene_hash = s.at("scene_hash").get<std::string>();
+        r.spec.request_id = s.value("request_id", "");
+        if (absl::StatusOr<JobState> state = StateFromJson(j.at("state")); state.ok()) {
+            r.state = *state;
+        } else {
+            return absl::DataLossError(
+                absl::StrCat("the stored record's state: ", state.status().message()));
+        }
+        r.error = j.at("error").get<std::string>();
+        r.last_error = j.value("last_error", std::string());  // records before it had none
+        r.submitted = TimeFromJson(j.at("submitted"));
+        r.started = TimeFromJson(j.at("started"));
+        r.finished = TimeFromJson(j.at("finished"));
+        r.tasks_total = j.at("tasks_total").get<int>();
+        r.tasks_done = j.at("tasks_done").get<int>();
+        r.tasks_running = j.at("tasks_running").get<int>();
+        r.retries = j.at("retries").get<int>();
+        r.tasks_leased = j.value("tasks_leased", 0);
+        r.stats.samples = j.at("samples").get<uint64_t>();
+        r.stats.rays = j.at("rays").get<uint64_t>();
+        r.stats.invalid_samples = j.at("invalid_samples").get<uint64_t>();
+        r.result_path = j.at("result_path").get<std::string>();
+        return r;
+    } catch (const json::exception& e) {
+        return absl::DataLossError(absl::StrCat("the stored record is unreadable: ", e.what()));
+    }
+}
+
+}  // namespace lf

@@ -1,0 +1,214 @@
+// The JobStore contract, which every store satisfies (in memory and SQLite alike): pages newest
+// first, the retention query, request ids unique, deletes; and the stored record format, which
+// belongs to the interface: states by name, the integer states of old records still read, an
+// unknown name a clear error. Then what only SQLite has: a database of the first schema is
+// upgraded in place.
+#include "server/job_store.h"
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/str_cat.h"
+#include "server/job_record_codec.h"
+#include "server/sqlite_job_store.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TestDir() {
+    const fs::path dir = fs::temp_directory_path() /
+                         ("lf_jobstore_" + std::to_string(::getpid()) + "_" +
+                          ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+JobRecord Record(const std::string& id, uint64_t seq, JobState state = JobState::kRunning) {
+    JobRecord r;
+    r.id = id;
+    r.seq = seq;
+    r.spec.name = "job " + id;
+    r.state = state;
+    r.submitted = absl::FromUnixSeconds(1000 + int64_t(seq));
+    if (IsFinal(state)) r.finished = absl::FromUnixSeconds(2000 + int64_t(seq));
+    return r;
+}
+
+std::vector<std::string> Ids(const absl::StatusOr<std::vector<JobRecord>>& jobs) {
+    EXPECT_TRUE(jobs.ok()) << jobs.status();
+    std::vector<std::string> ids;
+    if (jobs.ok()) {
+        for (const JobRecord& j : *jobs) ids.push_back(j.id);
+    }
+    return ids;
+}
+
+struct InMemory {
+    std::unique_ptr<JobStore> Open(const fs::path&) { return std::make_unique<InMemoryJobStore>(); }
+};
+struct Sqlite {
+    std::unique_ptr<JobStore> Open(const fs::path& dir) {
+        absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
+            SqliteJobStore::Open((dir / "jobs.db").string());
+        EXPECT_TRUE(store.ok()) << store.status();
+        return std::move(*store);
+    }
+};
+
+template <class Factory>
+class JobStoreContract : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = TestDir();
+        store_ = Factory().Open(dir_);
+    }
+    void TearDown() override {
+        store_.reset();
+        fs::remove_all(dir_);
+    }
+    fs::path dir_;
+    std::unique_ptr<JobStore> store_;
+};
+
+using Stores = ::testing::Types<InMemory, Sqlite>;
+TYPED_TEST_SUITE(JobStoreContract, Stores);
+
+TYPED_TEST(JobStoreContract, ListsPagesNewestFirst) {
+    for (uint64_t seq = 1; seq <= 5; ++seq) {
+        ASSERT_TRUE(this->store_->Put(Record(absl::StrCat("j", seq), seq)).ok());
+    }
+    EXPECT_EQ(Ids(this->store_->List()), (std::vector<std::string>{"j5", "j4", "j3", "j2", "j1"}));
+    EXPECT_EQ(Ids(this->store_->List({.limit = 2})), (std::vector<std::string>{"j5", "j4"}));
+    EXPECT_EQ(Ids(this->store_->List({.before_seq = 4, .limit = 2})),
+              (std::vector<std::string>{"j3", "j2"}));
+    EXPECT_EQ(Ids(this->store_->List({.before_seq = 2, .limit = 2})),
+              (std::vector<std::string>{"j1"}));
+}
+
+TYPED_TEST(JobStoreContract, RetentionQueryFindsOnlyJobsEndedBeforeTheTime) {
+    ASSERT_TRUE(this->store_->Put(Record("running", 1)).ok());
+    ASSERT_TRUE(this->store_->Put(Record("old", 2, JobState::kSucceeded)).ok());  // ended 2002
+    ASSERT_TRUE(this->store_->Put(Record("new", 3, JobState::kFailed)).ok());     // ended 2003
+    EXPECT_EQ(Ids(this->store_->List({.ended_before = absl::FromUnixSeconds(2003)})),
+              std::vector<std::string>{"old"});
+    EXPECT_EQ(Ids(this->store_->List({.ended_before = absl::FromUnixSeconds(9999)})),
+              (std::vector<std::string>{"new", "old"}));
+}
+
+TYPED_TEST(JobStoreContract, RequestIdsAreUnique) {
+    JobRecord a = Record("a", 1), b = Record("b", 2);
+    a.spec.request_id = b.spec.request_id = "req";
+    ASSERT_TRUE(this->store_->Put(a).ok());
+    EXPECT_EQ(this->store_->Put(b).code(), absl::StatusCode::kAlreadyExists);
+    EXPECT_EQ(**this->store_->FindRequest("req"), "a");
+    EXPECT_FALSE(this->store_->Get("b").ok());
+    a.state = JobState::kRunning;  // the same job again is not a clash
+    EXPECT_TRUE(this->store_->Put(a).ok());
+    EXPECT_FALSE(this->store_->FindRequest("other")->has_value());
+    EXPECT_TRUE(this->store_->Put(Record("c", 3)).ok()) << "no request id is no clash";
+    EXPECT_TRUE(this->store_->Put(Record("d", 4)).ok());
+}
+
+TYPED_TEST(JobStoreContract, DeleteRemovesTheRecordAndTaskResults) {
+    ASSERT_TRUE(
+        this->store_->WaitDurable(this->store_->QueueTaskDone(Record("a", 1), 0, "sums")).ok());
+    ASSERT_TRUE(this->store_->Put(Record("b", 2)).ok());
+    ASSERT_TRUE(this->store_->Delete("a").ok());
+    EXPECT_EQ(this->store_->Get("a").status().code(), absl::StatusCode::kNotFound);
+    EXPECT_TRUE(this->store_->TaskResults("a")->empty());
+    EXPECT_EQ(Ids(this->store_->List()), std::vector<std::string>{"b"});
+    EXPECT_TRUE(this->store_->Delete("a").ok()) << "nothing to delete is not an error";
+}
+
+TEST(JobRecordCodec, StatesAreStoredByName) {
+    for (JobState s : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
+                       JobState::kFailed, JobState::kCancelled}) {
+        const nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1, s)));
+        EXPECT_EQ(stored.at("state"), JobStateName(s));
+        EXPECT_EQ(DecodeJobRecord(stored.dump())->state, s);
+    }
+}
+
+TEST(JobRecordCodec, IntegerStatesOfOldRecordsStillRead) {
+    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
+    stored["state"] = 3;  // kFailed's position when states were stored so
+    EXPECT_EQ(DecodeJobRecord(stored.dump())->state, JobState::kFailed);
+}
+
+TEST(JobRecordCodec, UnknownStateNameIsAClearError) {
+    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
+    stored["state"] = "paused";
+    const absl::StatusOr<JobRecord> r = DecodeJobRecord(stored.dump());
+    EXPECT_EQ(r.status().code(), absl::StatusCode::kDataLoss);
+    EXPECT_NE(r.status().message().find("unknown job state \"paused\""), std::string_view::npos)
+        << r.status();
+    stored["state"] = 17;
+    EXPECT_EQ(DecodeJobRecord(stored.dump()).status().code(), absl::StatusCode::kDataLoss);
+}
+
+// A database as the first schema made it: records only, states by position, the request id
+// inside the JSON.
+void WriteVersion0Database(const fs::path& path, const std::vector<JobRecord>& jobs) {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db,
+                           "CREATE TABLE jobs (id TEXT PRIMARY KEY, seq INTEGER NOT NULL,"
+                           "  final INTEGER NOT NULL, record TEXT NOT NULL);"
+                           "CREATE TABLE task_results (job TEXT NOT NULL, task INTEGER NOT NULL,"
+                           "  sums BLOB NOT NULL, PRIMARY KEY (job, task));"
+                           "CREATE INDEX jobs_by_request ON jobs ("
+                           "  json_extract(record, '$.spec.request_id'));",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    for (const JobRecord& job : jobs) {
+        nlohmann::json record = nlohmann::json::parse(EncodeJobRecord(job));
+        record["state"] = int(job.state);
+        const std::string sql =
+            "INSERT INTO jobs VALUES ('" + job.id + "', " + std::to_string(job.seq) + ", " +
+            std::to_string(int(IsFinal(job.state))) + ", '" + record.dump() + "')";
+        ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+    }
+    sqlite3_close(db);
+}
+
+TEST(SqliteJobStoreUpgrade, FirstSchemaDatabaseIsUpgradedAndReadsAsBefore) {
+    const fs::path dir = TestDir();
+    JobRecord done = Record("done", 1, JobState::kSucceeded), running = Record("running", 2);
+    running.spec.request_id = "req-2";
+    WriteVersion0Database(dir / "jobs.db", {done, running});
+    {
+        absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
+            SqliteJobStore::Open((dir / "jobs.db").string());
+        ASSERT_TRUE(store.ok()) << store.status();
+        EXPECT_EQ(Ids((*store)->List()), (std::vector<std::string>{"running", "done"}));
+        EXPECT_EQ((*store)->Get("done")->state, JobState::kSucceeded);
+        EXPECT_EQ(**(*store)->FindRequest("req-2"), "running");
+        EXPECT_EQ(Ids((*store)->List({.ended_before = absl::FromUnixSeconds(9999)})),
+                  std::vector<std::string>{"done"});
+        JobRecord clash = Record("clash", 3);
+        clash.spec.request_id = "req-2";
+        EXPECT_EQ((*store)->Put(clash).code(), absl::StatusCode::kAlreadyExists);
+    }
+    // Upgraded once: the records now carry names, and opening again changes nothing.
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open((dir / "jobs.db").c_str(), &db), SQLITE_OK);
+    sqlite3_stmt* stmt = nullptr;
+    sqlite3_prepare_v2(db, "SELECT json_extract(record, '$.state') FROM jobs WHERE id = 'done'", -1,
+                       &stmt, nullptr);
+    ASSERT_EQ(sqlite3_step(stmt), SQLITE_ROW);
+    EXPECT_STREQ(reinterpret_cast<const char*>(sqlite3_column_text(stmt, 0)), "succeeded");
+    sqlite3_finalize(stmt);
+    sqlite3_close(db);
+    EXPECT_TRUE(SqliteJobStore::Open((dir / "jobs.db").string()).ok());
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lf
