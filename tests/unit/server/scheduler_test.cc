@@ -466,7 +466,8 @@ class HeldStore : public InMemoryJobStore {
         Block();
         return InMemoryJobStore::WaitDurable(ticket);
     }
-    std::optional<std::string> FindRequest(const std::string& request_id) const override {
+    absl::StatusOr<std::optional<std::string>> FindRequest(
+        const std::string& request_id) const override {
         Block();
         return InMemoryJobStore::FindRequest(request_id);
     }
