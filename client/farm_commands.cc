@@ -334,8 +334,6 @@ Command AddSubmitCommand(CLI::App& app) {
                     "--method radiosity` with the same options)")
         ->capture_default_str()
         ->check(CLI::IsMember({"path", "radiosity"}));
-    // The farm's own solver: its sweeps split into patch-group tasks.
-    o->spec.radiosity.solver = "jacobi";
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
                     "--solver jacobi: patch-group tasks per sweep; each worker computes the "
