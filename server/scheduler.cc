@@ -56,7 +56,8 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     std::unique_ptr<Job> job = std::move(*made);
     QueueStart(*job);
     job->record.submitted = clock_();
-    job->record.tasks_total = int(job->tasks.size());
+    // The image's tasks: a radiosity solve's sweep tasks are not done the way tiles are.
+    job->record.tasks_total = int(job->merger->tasks().size());
     std::unique_lock<std::mutex> lock(mutex_);
     if (std::optional<std::pair<std::string, uint64_t>> earlier = FindRequest(spec.request_id)) {
         lock.unlock();
@@ -155,7 +156,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
         }
         QueueStart(*job);
         job->record.tasks_done = int(job->merger->tasks_done());
-        job->record.tasks_total = int(job->tasks.size());
+        job->record.tasks_total = int(job->merger->tasks().size());
         job->record.stats = job->merger->stats();
         job->record.tasks_running = 0;
         Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before",
