@@ -84,6 +84,8 @@ class Backoff {
     absl::Duration delay_ = kFirstDelay;
 };
 
+// A new channel: after an outage, retries take a new one, as a channel that failed to connect
+// fails calls fast for a while after the server is back.
 std::unique_ptr<pb::JobService::Stub> Connect(const FarmFlags& flags) {
     return pb::JobService::NewStub(
         grpc::CreateChannel(flags.server, grpc::InsecureChannelCredentials()));
@@ -240,10 +242,9 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     pb::SubmitJobRequest req;
     ToProto(spec, &req);
 
-    std::unique_ptr<pb::JobService::Stub> stub = Connect(o.farm);
     Backoff backoff(o.farm);
     while (true) {
-        absl::StatusOr<std::string> id = SubmitOnce(*stub, o.farm, files, contents, req);
+        absl::StatusOr<std::string> id = SubmitOnce(*Connect(o.farm), o.farm, files, contents, req);
         if (!absl::IsUnavailable(id.status()) ||
             !backoff.Wait("submit", id.status())) {
             return id;
@@ -315,6 +316,7 @@ absl::StatusOr<pb::Job> Watch(const FarmFlags& flags, const std::string& id, Pro
         if (s.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED) continue;
         if (s.error_code() == grpc::StatusCode::UNAVAILABLE &&
             backoff.Wait("watch " + id, CallStatus(s, flags))) {
+            stub = Connect(flags);
             continue;
         }
         if (!s.ok()) return CallStatus(s, flags);
