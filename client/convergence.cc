@@ -18,9 +18,9 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
-#include "radiosity_flags.h"
 #include "lf/local/local_executor.h"
 #include "local_render.h"
+#include "radiosity_flags.h"
 
 extern char** environ;
 

@@ -245,8 +245,7 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     Backoff backoff(o.farm);
     while (true) {
         absl::StatusOr<std::string> id = SubmitOnce(*Connect(o.farm), o.farm, files, contents, req);
-        if (!absl::IsUnavailable(id.status()) ||
-            !backoff.Wait("submit", id.status())) {
+        if (!absl::IsUnavailable(id.status()) || !backoff.Wait("submit", id.status())) {
             return id;
         }
     }

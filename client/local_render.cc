@@ -14,11 +14,11 @@
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "progress_bar.h"
 #include "radiosity_flags.h"
-#include "lf/job/render_metadata.h"
 
 namespace lf {
 

@@ -7,9 +7,9 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/scene.h"
-#include "lf/kernels/radiosity.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/settings.h"
+#include "lf/kernels/radiosity.h"
 #include "lf/local/local_executor.h"
 
 namespace lf {

@@ -11,14 +11,14 @@
 #include "lf/core/image_error.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/plan.h"
+#include "lf/job/settings.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/local/local_executor.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
-#include "lf/job/plan.h"
-#include "lf/job/settings.h"
 
 namespace lf {
 
@@ -55,10 +55,10 @@ std::string DescribeSurface(const Material& m) {
             return "reflectance " + Color(m.reflectance);
         case Material::Type::kGlossy:
             if (m.conductor) {
-                return absl::StrFormat("conductor eta %s k %s (reflectance at normal incidence "
-                                       "%s), roughness %.3g",
-                                       Color(m.eta), Color(m.k), Color(NormalReflectance(m)),
-                                       m.roughness);
+                return absl::StrFormat(
+                    "conductor eta %s k %s (reflectance at normal incidence "
+                    "%s), roughness %.3g",
+                    Color(m.eta), Color(m.k), Color(NormalReflectance(m)), m.roughness);
             }
             return absl::StrFormat("specular tint (F0) %s, roughness %.3g", Color(m.reflectance),
                                    m.roughness);

@@ -62,7 +62,8 @@ absl::Status CheckRadiosityFlagsApply(const CLI::App& cmd, const std::string& me
     for (const CLI::Option* option : cmd.get_options()) {
         if (option->get_group() == kGroup && option->count() > 0) {
             return absl::InvalidArgumentError(
-                absl::StrCat(option->get_name(), " is a radiosity setting, but --method is "
+                absl::StrCat(option->get_name(),
+                             " is a radiosity setting, but --method is "
                              "path: drop it, or use --method radiosity"));
         }
     }

@@ -18,9 +18,9 @@ int ReportError(const absl::Status& status) {
 absl::Status CheckExrPath(const std::string& path) {
     const std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
     if (ext == ".exr") return absl::OkStatus();
-    return absl::InvalidArgumentError(absl::StrCat(
-        "-o ", path, ": the image is written as OpenEXR, so the name must end in .exr",
-        ext == ".png" ? " (--png writes a preview PNG beside it)" : ""));
+    return absl::InvalidArgumentError(
+        absl::StrCat("-o ", path, ": the image is written as OpenEXR, so the name must end in .exr",
+                     ext == ".png" ? " (--png writes a preview PNG beside it)" : ""));
 }
 
 Command AddRenderCommand(CLI::App& app) {
@@ -100,9 +100,10 @@ Command AddRenderCommand(CLI::App& app) {
                     (unsigned long long)summary->stats.invalid_samples, options->exr_path.c_str());
                 std::printf("time: load %.2f s, ", summary->load_seconds);
                 if (const std::optional<RadiosityFigures>& r = summary->radiosity) {
-                    std::printf("radiosity %.2f s (mesh %.2f s, form factors %.2f s, solve %.2f s), ",
-                                summary->radiosity_seconds, summary->mesh_seconds,
-                                r->form_factor_seconds, r->solve_seconds);
+                    std::printf(
+                        "radiosity %.2f s (mesh %.2f s, form factors %.2f s, solve %.2f s), ",
+                        summary->radiosity_seconds, summary->mesh_seconds, r->form_factor_seconds,
+                        r->solve_seconds);
                 }
                 std::printf("render %.2f s, total %.2f s\n", summary->render_seconds,
                             summary->seconds);

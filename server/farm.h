@@ -91,7 +91,7 @@ class Farm {
         int iterations = 0;
         double residual = 0;
     };
-    std::map<std::string, RadiosityFigures> radiosity_;       // by job id
+    std::map<std::string, RadiosityFigures> radiosity_;      // by job id
     std::map<std::string, SweepSolveFigures> sweep_solves_;  // by job id
     std::unique_ptr<BlobStore> blobs_;
     std::unique_ptr<JobStore> store_;

@@ -13,7 +13,9 @@ constexpr char kMagic[4] = {'L', 'F', 'T', 'S'};
 // older build) still decode, with no truncated paths.
 constexpr uint32_t kVersion = 2;
 constexpr uint32_t kOldestVersion = 1;
-constexpr size_t HeaderBytes(uint32_t version) { return 4 + 4 + 4 * 4 + (version == 1 ? 3 : 4) * 8; }
+constexpr size_t HeaderBytes(uint32_t version) {
+    return 4 + 4 + 4 * 4 + (version == 1 ? 3 : 4) * 8;
+}
 constexpr size_t kPixelBytes = 6 * 16 + 2 * 4;
 // 2^28 pixels is a 16k x 16k tile: far beyond any plan, small enough that size arithmetic
 // cannot overflow and a corrupt header cannot make us allocate terabytes.
@@ -103,9 +105,9 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
                                                        rect.y0, " ", rect.width, "x", rect.height));
     }
     if (bytes.size() != EncodedTileSumsSize(rect.Area(), version)) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "tile sums: ", bytes.size(), " bytes for a ", rect.width, "x", rect.height,
-            " tile, which takes ", EncodedTileSumsSize(rect.Area(), version)));
+        return absl::InvalidArgumentError(
+            absl::StrCat("tile sums: ", bytes.size(), " bytes for a ", rect.width, "x", rect.height,
+                         " tile, which takes ", EncodedTileSumsSize(rect.Area(), version)));
     }
     TileSums tile(rect);
     tile.stats.samples = in.U64();

@@ -286,8 +286,8 @@ TEST_F(Cli, OutputThatIsNotExrIsRefused) {
     EXPECT_NE(render.status, 0);
     EXPECT_NE(render.output.find("must end in .exr"), std::string::npos) << render.output;
     EXPECT_FALSE(fs::exists(dir_ / "out.png"));
-    const RunResult fetch = Lightfarm("fetch job-0 -o " + (dir_ / "out.png").string() +
-                                      " --server 127.0.0.1:1");
+    const RunResult fetch =
+        Lightfarm("fetch job-0 -o " + (dir_ / "out.png").string() + " --server 127.0.0.1:1");
     EXPECT_NE(fetch.status, 0);
     EXPECT_NE(fetch.output.find("must end in .exr"), std::string::npos) << fetch.output;
 }
@@ -309,10 +309,9 @@ TEST_F(Cli, RadiosityFlagsWithMethodPathAreRefused) {
     for (const std::string& command :
          {"render " + scene + " -o " + exr + " --spp 1 --no-progress",
           "submit " + scene + " --server 127.0.0.1:1 --retry-seconds 0"}) {
-        for (const auto& [flags, named] : {std::pair{"--patches 300", "--patches"},
-                                           std::pair{"--solver shooting", "--solver"},
-                                           std::pair{"--method path --tolerance 0.01",
-                                                     "--tolerance"}}) {
+        for (const auto& [flags, named] :
+             {std::pair{"--patches 300", "--patches"}, std::pair{"--solver shooting", "--solver"},
+              std::pair{"--method path --tolerance 0.01", "--tolerance"}}) {
             const RunResult r = Lightfarm(command + " " + flags);
             EXPECT_NE(r.status, 0) << command << " " << flags;
             EXPECT_NE(r.output.find(std::string(named) + " is a radiosity setting"),
@@ -348,10 +347,9 @@ TEST_F(Cli, RadiositySummaryReportsEveryPhaseAndTheTotal) {
     ASSERT_TRUE(file.ok()) << file.status();
     const double seconds = std::get<double>(file->attributes.at("lightfarm.seconds"));
     EXPECT_GE(seconds, load + radiosity + render - 0.01) << r.output;
-    EXPECT_GE(seconds + 0.01, std::get<double>(file->attributes.at(
-                                  "lightfarm.radiosity.formFactorSeconds")) +
-                                  std::get<double>(file->attributes.at(
-                                      "lightfarm.radiosity.solveSeconds")));
+    EXPECT_GE(seconds + 0.01,
+              std::get<double>(file->attributes.at("lightfarm.radiosity.formFactorSeconds")) +
+                  std::get<double>(file->attributes.at("lightfarm.radiosity.solveSeconds")));
 }
 
 // `render` and `submit` take their defaults from the job model: the same solver for both.

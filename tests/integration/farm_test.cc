@@ -4,11 +4,11 @@
 // every child is killed in TearDown.
 #include <arpa/inet.h>
 #include <fcntl.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -642,9 +642,8 @@ TEST_F(Farm, SubmitAndWatchRideOutAServerThatIsDown) {
 
     server_->Signal(SIGKILL);
     ASSERT_TRUE(server_->Wait(milliseconds(5000)));
-    Child* watch = Spawn({std::string(LF_BIN_DIR) + "/lightfarm", "watch", job, "--server",
-                          address_},
-                         "watch.log");
+    Child* watch = Spawn(
+        {std::string(LF_BIN_DIR) + "/lightfarm", "watch", job, "--server", address_}, "watch.log");
     ASSERT_TRUE(wait_for_log("watch.log", "retrying")) << ReadText(dir_ / "watch.log");
     StartServer(10, address_);
     StartWorker("w1");

@@ -19,7 +19,8 @@ RenderMetadata PathMetadata() {
 }
 
 TEST(RenderMetadata, PathRenderSaysItsTruncatedPathsAndNoRadiosity) {
-    absl::StatusOr<RenderDescription> d = DescribeRender(PathMetadata(), EmptyRenderImage(4, 4), true);
+    absl::StatusOr<RenderDescription> d =
+        DescribeRender(PathMetadata(), EmptyRenderImage(4, 4), true);
     ASSERT_TRUE(d.ok()) << d.status();
     EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.truncatedPaths")), "3");
     EXPECT_FALSE(d->estimates);  // one sample per pixel: no A/B halves to compare
@@ -41,7 +42,8 @@ TEST(RenderMetadata, RadiosityFiguresAndSettingsGoIntoTheHeader) {
     absl::StatusOr<RenderDescription> d = DescribeRender(m, EmptyRenderImage(4, 4), true);
     ASSERT_TRUE(d.ok()) << d.status();
     const ExrAttributes& a = d->attributes;
-    EXPECT_EQ(std::get<std::string>(a.at("lightfarm.radiosity.solver")), defaults::kRadiositySolver);
+    EXPECT_EQ(std::get<std::string>(a.at("lightfarm.radiosity.solver")),
+              defaults::kRadiositySolver);
     EXPECT_EQ(std::get<std::string>(a.at("lightfarm.radiosity.patches")), "300");
     EXPECT_EQ(std::get<std::string>(a.at("lightfarm.radiosity.unknowns")), "320");
     EXPECT_EQ(std::get<int>(a.at("lightfarm.radiosity.iterations")), 12);

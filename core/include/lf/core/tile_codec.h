@@ -3,8 +3,8 @@
 // rendered in a single piece.
 //
 // Layout, little-endian: "LFTS", u32 version (2), i32 x0 y0 width height, u64 samples rays
-// invalid_samples truncated_paths (version 1 has no truncated_paths), then per pixel row-major: for half 0 then 1, three i128 sums (R, G, B;
-// low 64 bits first), then u32 count[0], u32 count[1].
+// invalid_samples truncated_paths (version 1 has no truncated_paths), then per pixel row-major: for
+// half 0 then 1, three i128 sums (R, G, B; low 64 bits first), then u32 count[0], u32 count[1].
 #pragma once
 
 #include <cstddef>

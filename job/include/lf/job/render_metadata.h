@@ -67,8 +67,8 @@ struct RenderMetadata {
     double seconds = 0;  // the whole render: loading, meshing, solving and sampling
     RenderStats stats;
     AdaptiveSettings adaptive_settings;
-    std::optional<AdaptiveReport> adaptive;  // set for an adaptive render
-    RadiositySettings radiosity_settings;    // method "radiosity"
+    std::optional<AdaptiveReport> adaptive;     // set for an adaptive render
+    RadiositySettings radiosity_settings;       // method "radiosity"
     std::optional<RadiosityFigures> radiosity;  // when known
 };
 
@@ -89,7 +89,7 @@ struct RenderDescription {
 // `complete` and every pixel has at least 2 samples, how an adaptive render ended
 // (lightfarm.targetError, .timeLimit, lightfarm.adaptive.*) and the radiosity solve
 // (lightfarm.radiosity.*).
-absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& metadata,
-                                                 const Image& image, bool complete);
+absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& metadata, const Image& image,
+                                                 bool complete);
 
 }  // namespace lf
