@@ -5,15 +5,16 @@
 #include <string>
 
 #include "absl/status/status.h"
+#include "lf/job/settings.h"
 
 namespace lf {
 
 struct BenchOptions {
     std::string scene_path;
-    uint64_t spp = 16;
+    uint64_t spp = defaults::kSpp;
     int threads = 2;
     int resolution = 256;
-    int max_depth = -1;
+    int max_depth = defaults::kMaxDepth;
     uint64_t raw_rays = 4'000'000;
 };
 

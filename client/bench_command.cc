@@ -13,7 +13,9 @@ Command AddBenchCommand(CLI::App& app) {
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_option("--spp", options->spp, "samples per pixel")->capture_default_str();
-    cmd->add_option("--threads", options->threads, "threads")->capture_default_str();
+    cmd->add_option("--threads", options->threads, "threads, at least 1")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1024));
     cmd->add_option("--resolution", options->resolution, "square image side (0 = scene's)")
         ->capture_default_str();
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")

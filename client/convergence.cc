@@ -20,6 +20,7 @@
 #include "lf/kernels/radiosity.h"
 #include "lf/local/local_executor.h"
 #include "local_render.h"
+#include "radiosity_flags.h"
 
 extern char** environ;
 
@@ -195,12 +196,14 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     if (options.method != "path") {
         for (int64_t patches = options.min_patches; patches <= options.max_patches; patches *= 2) {
             const auto start = Clock::now();
-            RadiosityOptions ro;
-            ro.patches = patches;
-            ro.tolerance = options.radiosity_tolerance;
-            ro.threads = options.threads;
+            RadiositySettings solve;
+            solve.patches = patches;
+            solve.tolerance = options.radiosity_tolerance;
+            absl::StatusOr<RadiosityOptions> ro = RadiosityOptionsOf(solve);
+            if (!ro.ok()) return ro.status();
+            ro->threads = options.threads;
             absl::StatusOr<std::unique_ptr<RadiosityRenderer>> radiosity =
-                PrepareRadiosity(**embree, ro);
+                PrepareRadiosity(**embree, *ro);
             if (!radiosity.ok()) return radiosity.status();
             RenderSettings settings;
             settings.spp = options.radiosity_spp;

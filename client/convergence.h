@@ -11,6 +11,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/image_error.h"
+#include "lf/job/settings.h"
 
 namespace lf {
 
@@ -23,12 +24,12 @@ struct ConvergenceOptions {
     uint64_t max_spp = 256;       // path ladder 1, 2, 4, ... up to this
     uint64_t reference_spp = 4096;
     int64_t min_patches = 250;  // radiosity ladder, doubling
-    int64_t max_patches = 4000;
-    double radiosity_tolerance = 1e-4;
+    int64_t max_patches = defaults::kRadiosityPatches;
+    double radiosity_tolerance = defaults::kRadiosityTolerance;
     uint64_t radiosity_spp = 64;  // camera rays per pixel through the solution (its footprint)
-    uint64_t seed = 0;
+    uint64_t seed = defaults::kSeed;
     int threads = 0;
-    int max_depth = -1;
+    int max_depth = defaults::kMaxDepth;
 };
 
 struct ConvergenceRow {

@@ -37,6 +37,7 @@ constexpr size_t kChunkBytes = 1 << 20;
 
 struct FarmFlags {
     std::string server = "127.0.0.1:7070";
+    double retry_seconds = 60;  // how long submit and watch ride out an unreachable server
 };
 
 void AddServerOption(CLI::App* cmd, FarmFlags& flags) {
@@ -45,6 +46,46 @@ void AddServerOption(CLI::App* cmd, FarmFlags& flags) {
         ->capture_default_str();
 }
 
+void AddRetryOption(CLI::App* cmd, FarmFlags& flags) {
+    cmd->add_option("--retry-seconds", flags.retry_seconds,
+                    "while the server is unreachable (restarting, say), retry for this long "
+                    "before giving up; 0: do not retry")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 86400.0));
+}
+
+// Waits between attempts to reach a server that is down: 0.25 s, doubling up to 5 s, until the
+// budget is spent, saying on stderr what it waits for.
+class Backoff {
+  public:
+    explicit Backoff(const FarmFlags& flags) : budget_(absl::Seconds(flags.retry_seconds)) {}
+
+    // False when the budget is spent: give up with `why`.
+    bool Wait(const std::string& what, const absl::Status& why) {
+        if (waited_ + delay_ > budget_) return false;
+        std::fprintf(stderr, "lightfarm: %s: %s; retrying in %.2g s\n", what.c_str(),
+                     std::string(why.message()).c_str(), absl::ToDoubleSeconds(delay_));
+        absl::SleepFor(delay_);
+        waited_ += delay_;
+        delay_ = std::min(2 * delay_, kMaxDelay);
+        return true;
+    }
+    // The server answered: a later outage gets the whole budget again.
+    void Reset() {
+        waited_ = absl::ZeroDuration();
+        delay_ = kFirstDelay;
+    }
+
+  private:
+    static constexpr absl::Duration kFirstDelay = absl::Milliseconds(250);
+    static constexpr absl::Duration kMaxDelay = absl::Seconds(5);
+    absl::Duration budget_;
+    absl::Duration waited_ = absl::ZeroDuration();
+    absl::Duration delay_ = kFirstDelay;
+};
+
+// A new channel: after an outage, retries take a new one, as a channel that failed to connect
+// fails calls fast for a while after the server is back.
 std::unique_ptr<pb::JobService::Stub> Connect(const FarmFlags& flags) {
     return pb::JobService::NewStub(
         grpc::CreateChannel(flags.server, grpc::InsecureChannelCredentials()));
@@ -116,6 +157,38 @@ absl::Status Upload(pb::JobService::Stub& stub, const LocalFile& file, const std
     return absl::OkStatus();
 }
 
+// Uploads the blobs the server lacks and submits the job: one attempt.
+absl::StatusOr<std::string> SubmitOnce(pb::JobService::Stub& stub, const FarmFlags& flags,
+                                       const std::vector<LocalFile>& files,
+                                       const std::map<std::string, std::string>& contents,
+                                       const pb::SubmitJobRequest& req) {
+    pb::MissingBlobsRequest missing_req;
+    for (const auto& [hash, content] : contents) missing_req.add_hashes(hash);
+    pb::MissingBlobsResponse missing;
+    if (absl::Status s = CallStatus(
+            stub.MissingBlobs(ContextWithDeadline(absl::Seconds(10)).get(), missing_req, &missing),
+            flags);
+        !s.ok()) {
+        return s;
+    }
+    for (const std::string& hash : missing.hashes()) {
+        for (const LocalFile& f : files) {
+            if (f.ref.hash() != hash) continue;
+            if (absl::Status s = Upload(stub, f, contents.at(hash), flags); !s.ok()) return s;
+            break;
+        }
+    }
+
+    pb::SubmitJobResponse resp;
+    // The server loads the scene to check it, which takes a while for large meshes.
+    if (absl::Status s = CallStatus(
+            stub.SubmitJob(ContextWithDeadline(absl::Minutes(2)).get(), req, &resp), flags);
+        !s.ok()) {
+        return s;
+    }
+    return resp.job_id();
+}
+
 struct SubmitOptions {
     FarmFlags farm;
     std::string scene_path;
@@ -156,45 +229,25 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
         if (absl::Status s = add(name, path, std::move(*content)); !s.ok()) return s;
     }
 
-    std::unique_ptr<pb::JobService::Stub> stub = Connect(o.farm);
-    pb::MissingBlobsRequest missing_req;
-    for (const auto& [hash, content] : contents) missing_req.add_hashes(hash);
-    pb::MissingBlobsResponse missing;
-    if (absl::Status s = CallStatus(
-            stub->MissingBlobs(ContextWithDeadline(absl::Seconds(10)).get(), missing_req, &missing),
-            o.farm);
-        !s.ok()) {
-        return s;
-    }
-    for (const std::string& hash : missing.hashes()) {
-        for (const LocalFile& f : files) {
-            if (f.ref.hash() != hash) continue;
-            if (absl::Status s = Upload(*stub, f, contents[hash], o.farm); !s.ok()) return s;
-            break;
-        }
-    }
-
     JobSpec spec = o.spec;
     std::vector<BlobRef> refs;
     for (const LocalFile& f : files) refs.push_back(FromProto(f.ref));
     spec.scene = refs[0];
     spec.files.assign(refs.begin() + 1, refs.end());
     if (spec.name.empty()) spec.name = scene_path.filename().string();
-    // A retry after a lost answer (the server restarting, say) gets the job of the first attempt.
+    // The same id on every attempt: a retry after a lost answer (the server restarting, say)
+    // gets the job of the first attempt.
     spec.request_id = Sha256Hex(
         absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string()));
     pb::SubmitJobRequest req;
     ToProto(spec, &req);
-    pb::SubmitJobResponse resp;
-    for (int attempt = 1;; ++attempt) {
-        // The server loads the scene to check it, which takes a while for large meshes.
-        const grpc::Status s =
-            stub->SubmitJob(ContextWithDeadline(absl::Minutes(2)).get(), req, &resp);
-        if (s.ok()) return resp.job_id();
-        if (s.error_code() != grpc::StatusCode::UNAVAILABLE || attempt == 5) {
-            return CallStatus(s, o.farm);
+
+    Backoff backoff(o.farm);
+    while (true) {
+        absl::StatusOr<std::string> id = SubmitOnce(*Connect(o.farm), o.farm, files, contents, req);
+        if (!absl::IsUnavailable(id.status()) || !backoff.Wait("submit", id.status())) {
+            return id;
         }
-        absl::SleepFor(absl::Seconds(1));
     }
 }
 
@@ -246,25 +299,26 @@ absl::StatusOr<pb::Job> GetJob(const FarmFlags& flags, const std::string& id) {
 }
 
 // Follows the job until it ends. Each call has a deadline; the watch goes on across them and
-// across a short server outage.
+// across a server outage of up to --retry-seconds.
 absl::StatusOr<pb::Job> Watch(const FarmFlags& flags, const std::string& id, ProgressBar& bar) {
     std::unique_ptr<pb::JobService::Stub> stub = Connect(flags);
     pb::WatchJobRequest req;
     req.set_job_id(id);
     pb::Job job;
-    int outages = 0;
+    Backoff backoff(flags);
     while (true) {
         const auto context = ContextWithDeadline(absl::Minutes(1));
         std::unique_ptr<grpc::ClientReader<pb::Job>> reader = stub->WatchJob(context.get(), req);
         while (reader->Read(&job)) {
-            outages = 0;
+            backoff.Reset();
             bar.Update(size_t(job.tasks_done()), size_t(std::max(1, job.tasks_total())));
             if (IsFinal(job.state())) return job;
         }
         const grpc::Status s = reader->Finish();
         if (s.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED) continue;
-        if (s.error_code() == grpc::StatusCode::UNAVAILABLE && ++outages <= 10) {
-            absl::SleepFor(absl::Seconds(1));
+        if (s.error_code() == grpc::StatusCode::UNAVAILABLE &&
+            backoff.Wait("watch " + id, CallStatus(s, flags))) {
+            stub = Connect(flags);
             continue;
         }
         if (!s.ok()) return CallStatus(s, flags);
@@ -313,6 +367,7 @@ Command AddSubmitCommand(CLI::App& app) {
         ->required()
         ->check(CLI::ExistingFile);
     AddServerOption(cmd, o->farm);
+    AddRetryOption(cmd, o->farm);
     cmd->add_option("--spp", o->spec.plan.spp, "samples per pixel")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(1), kMaxSpp));
@@ -337,8 +392,6 @@ Command AddSubmitCommand(CLI::App& app) {
                     "--method radiosity` with the same options)")
         ->capture_default_str()
         ->check(CLI::IsMember({"path", "radiosity"}));
-    // The farm's own solver: its sweeps split into patch-group tasks.
-    o->spec.radiosity.solver = "jacobi";
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
                     "--solver jacobi: patch-group tasks per sweep; each worker computes the "
@@ -348,7 +401,10 @@ Command AddSubmitCommand(CLI::App& app) {
         ->group("Radiosity")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxSweepTasks));
-    return {cmd, [o] {
+    return {cmd, [cmd, o] {
+                if (absl::Status s = CheckRadiosityFlagsApply(*cmd, o->spec.method); !s.ok()) {
+                    return ReportError(s);
+                }
                 absl::StatusOr<std::string> id = Submit(*o);
                 if (!id.ok()) return ReportError(id.status());
                 std::printf("%s\n", id->c_str());
@@ -415,6 +471,7 @@ Command AddWatchCommand(CLI::App& app) {
         "succeeded.");
     cmd->add_option("job", *id, "job id")->required();
     AddServerOption(cmd, *flags);
+    AddRetryOption(cmd, *flags);
     return {cmd, [flags, id] {
                 ProgressBar bar(*id);
                 absl::StatusOr<pb::Job> job = Watch(*flags, *id, bar);
@@ -441,6 +498,7 @@ Command AddFetchCommand(CLI::App& app) {
                   "a running job's tiles merged so far (unfinished tiles have fewer samples)");
     AddServerOption(cmd, *flags);
     return {cmd, [flags, id, out, preview] {
+                if (absl::Status s = CheckExrPath(*out); !s.ok()) return ReportError(s);
                 if (absl::Status s = Fetch(*flags, *id, *out, *preview); !s.ok()) {
                     return ReportError(s);
                 }

@@ -7,15 +7,18 @@
 #include <fstream>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "progress_bar.h"
-#include "lf/job/render_metadata.h"
+#include "radiosity_flags.h"
 
 namespace lf {
 
@@ -32,33 +35,6 @@ absl::Status CheckWritable(const std::string& path) {
     probe.close();
     if (!existed) std::filesystem::remove(path);
     return absl::OkStatus();
-}
-
-void AddRadiosityAttributes(const RadiosityReport& r, const RadiosityOptions& o,
-                            ExrAttributes* attributes) {
-    (*attributes)["lightfarm.radiosity.patches"] = std::to_string(r.patches);
-    (*attributes)["lightfarm.radiosity.unknowns"] = std::to_string(r.sides);
-    (*attributes)["lightfarm.radiosity.patchSize"] = r.patch_size;
-    (*attributes)["lightfarm.radiosity.solver"] = std::string(RadiositySolverName(o.solver));
-    (*attributes)["lightfarm.radiosity.iterations"] = r.iterations;
-    (*attributes)["lightfarm.radiosity.residual"] = r.residual;
-    (*attributes)["lightfarm.radiosity.tolerance"] = o.tolerance;
-    (*attributes)["lightfarm.radiosity.display"] = std::string(RadiosityShadingName(o.display));
-    (*attributes)["lightfarm.radiosity.loaded"] = std::string(r.loaded ? "yes" : "no");
-    (*attributes)["lightfarm.radiosity.formFactorSeconds"] = r.form_factor_seconds;
-    (*attributes)["lightfarm.radiosity.solveSeconds"] = r.solve_seconds;
-    (*attributes)["lightfarm.radiosity.estimatedError"] = r.estimated_error;
-    (*attributes)["lightfarm.radiosity.meanEstimatedError"] = r.mean_estimated_error;
-    if (o.target_error > 0) {
-        (*attributes)["lightfarm.radiosity.targetError"] = o.target_error;
-        (*attributes)["lightfarm.radiosity.refinePasses"] = int(r.refinement.size());
-        (*attributes)["lightfarm.radiosity.coarsePatches"] =
-            std::to_string(r.refinement.empty() ? r.patches : r.refinement.front().patches);
-        (*attributes)["lightfarm.radiosity.budgetReached"] =
-            std::string(r.budget_reached ? "yes" : "no");
-        (*attributes)["lightfarm.radiosity.finestAboveTarget"] =
-            std::to_string(r.finest_above_target);
-    }
 }
 
 }  // namespace
@@ -93,6 +69,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         if (absl::Status s = CheckWritable(*path); !s.ok()) return s;
     }
     auto log = NamedLogger("render");
+    const absl::Time start = absl::Now();
 
     absl::StatusOr<Scene> scene = LoadScene(options.scene_path);
     if (!scene.ok()) return scene.status();
@@ -105,19 +82,30 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
     const Camera camera(scene->camera, (*embree)->origin());
+    LocalRenderSummary summary;
+    summary.load_seconds = absl::ToDoubleSeconds(absl::Now() - start);
 
     std::unique_ptr<RadianceEstimator> estimator;
     const RadiosityRenderer* radiosity = nullptr;
     if (*method == "radiosity") {
-        RadiosityOptions ro = options.radiosity;
+        absl::StatusOr<RadiosityOptions> parsed = RadiosityOptionsOf(options.radiosity);
+        if (!parsed.ok()) return parsed.status();
+        RadiosityOptions ro = *parsed;
+        ro.save_solution = options.save_solution;
+        ro.load_solution = options.load_solution;
+        ro.export_ply = options.export_ply;
         ro.threads = options.render.threads;
         // The one --target-error bounds both errors: the mesh's and the display's sampling.
         ro.target_error = options.adaptive.target_error;
+        const absl::Time solve_start = absl::Now();
         absl::StatusOr<std::unique_ptr<RadiosityRenderer>> r = PrepareRadiosity(**embree, ro);
         if (!r.ok()) return r.status();
         radiosity = r->get();
         estimator = std::move(*r);
         const RadiosityReport& rep = radiosity->report();
+        summary.radiosity_seconds = absl::ToDoubleSeconds(absl::Now() - solve_start);
+        summary.radiosity = RadiosityFiguresOf(rep);
+        summary.mesh_seconds = rep.mesh_seconds;
         log->info(
             "job={} radiosity: {} patches, {} unknowns, {} iterations, residual {:.2e}, form "
             "factors {:.2f} s ({} MiB), solve {:.2f} s",
@@ -179,45 +167,48 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
             job_id, out->stats.truncated_paths, kMaxPathDepth);
     }
 
-    LocalRenderSummary summary;
     summary.job_id = job_id;
     summary.method = *method;
     summary.stats = out->stats;
-    summary.seconds = out->seconds;
+    summary.render_seconds = out->seconds;
     summary.width = camera.width();
     summary.height = camera.height();
     summary.adaptive = adaptive;
     summary.adaptive_report = out->adaptive;
-    const uint64_t spp = adaptive ? out->adaptive.max_spp : options.render.spp;
-    ExrAttributes attributes =
-        DescribeRender({scene->content_hash, *method, spp, options.render.seed, options.max_depth,
-                        out->seconds, out->stats});
-    if (adaptive || options.render.spp >= 2) {
-        absl::StatusOr<ErrorEstimates> estimates = AddErrorEstimates(out->image, &attributes);
-        if (!estimates.ok()) return estimates.status();
-        const VarianceAssessment* variance = &estimates->variance;
-        summary.estimated_error = estimates->estimated_error;
-        summary.estimated_relmse = variance->relmse;
-        summary.high_variance = variance->high;
+    summary.seconds = absl::ToDoubleSeconds(absl::Now() - start);
+
+    RenderMetadata metadata;
+    metadata.scene_hash = scene->content_hash;
+    metadata.method = *method;
+    metadata.spp = adaptive ? out->adaptive.max_spp : options.render.spp;
+    metadata.seed = options.render.seed;
+    metadata.max_depth = options.max_depth;
+    metadata.seconds = summary.seconds;
+    metadata.stats = out->stats;
+    metadata.adaptive_settings = options.adaptive;
+    if (adaptive) metadata.adaptive = out->adaptive;
+    metadata.radiosity_settings = options.radiosity;
+    metadata.radiosity = summary.radiosity;
+    absl::StatusOr<RenderDescription> description = DescribeRender(metadata, out->image, true);
+    if (!description.ok()) return description.status();
+    if (description->estimates) {
+        const VarianceAssessment& variance = description->estimates->variance;
+        summary.estimated_error = description->estimates->estimated_error;
+        summary.estimated_relmse = variance.relmse;
+        summary.high_variance = variance.high;
         log->info(
             "job={} estimated relative error {:.4f}, estimated relMSE {:.3g}, error of the mean "
             "{:.3g}",
-            job_id, summary.estimated_error, variance->relmse, variance->mean_error);
+            job_id, summary.estimated_error, variance.relmse, variance.mean_error);
         if (summary.high_variance) {
             log->warn(
                 "job={} high variance: estimated relMSE {:.3g} (limit {}: a typical pixel off by "
                 "{:.0f} %), relative error of the mean radiance {:.3g} (limit {})",
-                job_id, variance->relmse, kHighVarianceRelMse, 100 * std::sqrt(variance->relmse),
-                variance->mean_error, kHighVarianceMeanError);
+                job_id, variance.relmse, kHighVarianceRelMse, 100 * std::sqrt(variance.relmse),
+                variance.mean_error, kHighVarianceMeanError);
         }
     }
-    attributes["lightfarm.truncatedPaths"] = std::to_string(out->stats.truncated_paths);
-    if (adaptive) AddAdaptiveAttributes(options.adaptive, out->adaptive, &attributes);
-    if (radiosity) {
-        RadiosityOptions used = options.radiosity;
-        used.target_error = options.adaptive.target_error;
-        AddRadiosityAttributes(radiosity->report(), used, &attributes);
-    }
+    const ExrAttributes& attributes = description->attributes;
     if (absl::Status s = WriteExr(options.exr_path, out->image, attributes); !s.ok()) return s;
     if (!options.png_path.empty()) {
         if (absl::Status s = WritePng(options.png_path, out->image); !s.ok()) return s;

@@ -2,10 +2,13 @@
 // or radiosity, through the farm's planner and merger (local_executor.h).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
 #include "lf/core/scene.h"
+#include "lf/job/render_metadata.h"
+#include "lf/job/settings.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/local/local_executor.h"
 
@@ -15,11 +18,13 @@ struct LocalRenderOptions {
     std::string scene_path;
     std::string exr_path;
     std::string png_path;         // empty: no preview
-    std::string method = "path";  // path | radiosity | auto
+    std::string method = defaults::kMethod;  // path | radiosity | auto
     RenderSettings render;
     AdaptiveSettings adaptive;  // used when a target error or a time limit is set
-    int max_depth = -1;
-    RadiosityOptions radiosity;
+    int max_depth = defaults::kMaxDepth;
+    RadiositySettings radiosity;
+    // Radiosity's files (RadiosityOptions): a solution to save or load, a PLY to export.
+    std::string save_solution, load_solution, export_ply;
     bool progress = true;
 };
 
@@ -27,7 +32,11 @@ struct LocalRenderSummary {
     std::string job_id;
     std::string method;
     RenderStats stats;
+    // Phases: loading the scene (and building its BVH), radiosity's whole preparation (meshing,
+    // form factors, solve; its parts in `radiosity`), sampling the image; and the total.
+    double load_seconds = 0, radiosity_seconds = 0, mesh_seconds = 0, render_seconds = 0;
     double seconds = 0;
+    std::optional<RadiosityFigures> radiosity;
     int width = 0, height = 0;
     double estimated_error = -1;   // relative, from A/B; -1 below 2 samples per pixel
     double estimated_relmse = -1;  // EstimatedRelMse; -1 below 2 samples per pixel

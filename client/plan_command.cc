@@ -11,12 +11,14 @@
 #include "lf/core/image_error.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/plan.h"
+#include "lf/job/settings.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/local/local_executor.h"
 #include "local_render.h"
-#include "lf/job/plan.h"
+#include "radiosity_flags.h"
 
 namespace lf {
 
@@ -27,12 +29,44 @@ struct PlanOptions {
     std::string method = "auto";
     double target_error = 0.01;
     uint64_t pilot_spp = 8;
-    int64_t patches = 4000;
-    int max_depth = -1;
+    int64_t patches = defaults::kRadiosityPatches;
+    int max_depth = defaults::kMaxDepth;
     int threads = 0;
 };
 
 std::string Color(const Rgb& c) { return absl::StrFormat("(%.3g, %.3g, %.3g)", c.r, c.g, c.b); }
+
+// The fraction of light a surface reflects at normal incidence: a conductor's comes from its
+// complex index of refraction (Fresnel), every other reflecting surface's from its reflectance.
+Rgb NormalReflectance(const Material& m) {
+    if (m.type != Material::Type::kGlossy || !m.conductor) return m.reflectance;
+    auto f0 = [](float eta, float k) {
+        return ((eta - 1) * (eta - 1) + k * k) / ((eta + 1) * (eta + 1) + k * k);
+    };
+    return Rgb(f0(m.eta.r, m.k.r), f0(m.eta.g, m.k.g), f0(m.eta.b, m.k.b));
+}
+
+// The parameters the material's model uses, and only those: a dielectric has an index of
+// refraction, not a reflectance; a conductor has eta and k.
+std::string DescribeSurface(const Material& m) {
+    switch (m.type) {
+        case Material::Type::kLambert:
+        case Material::Type::kMirror:
+            return "reflectance " + Color(m.reflectance);
+        case Material::Type::kGlossy:
+            if (m.conductor) {
+                return absl::StrFormat(
+                    "conductor eta %s k %s (reflectance at normal incidence "
+                    "%s), roughness %.3g",
+                    Color(m.eta), Color(m.k), Color(NormalReflectance(m)), m.roughness);
+            }
+            return absl::StrFormat("specular tint (F0) %s, roughness %.3g", Color(m.reflectance),
+                                   m.roughness);
+        case Material::Type::kDielectric:
+            return absl::StrFormat("index of refraction %.3g", m.ior);
+    }
+    return "";
+}
 
 // Radiosity's cost comes from pilot solves of 1/8 and 1/4 of the target's patches (about 1/4
 // of the target's time together), at least 250: on coarser meshes the walls are a few patches,
@@ -72,11 +106,13 @@ absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& op
         std::max(options.patches / kRadiosityPilotDivisor, kMinRadiosityPilotPatches);
     std::vector<RadiosityReport> pilots;
     for (int64_t patches : {small_patches, 2 * small_patches}) {
-        RadiosityOptions pilot_options;
-        pilot_options.patches = std::min(patches, options.patches);
-        pilot_options.threads = options.threads;
+        RadiositySettings settings;
+        settings.patches = std::min(patches, options.patches);
+        absl::StatusOr<RadiosityOptions> pilot_options = RadiosityOptionsOf(settings);
+        if (!pilot_options.ok()) return pilot_options.status();
+        pilot_options->threads = options.threads;
         absl::StatusOr<std::unique_ptr<RadiosityRenderer>> pilot =
-            PrepareRadiosity(embree, pilot_options);
+            PrepareRadiosity(embree, *pilot_options);
         if (!pilot.ok()) return pilot.status();
         pilots.push_back((*pilot)->report());
         const RadiosityReport& r = pilots.back();
@@ -87,7 +123,7 @@ absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& op
             (long long)r.patches, (long long)r.sides, r.form_factor_seconds,
             double(r.form_factor_bytes) / (1 << 20), r.solve_seconds, r.iterations,
             r.mean_estimated_error, r.estimated_error);
-        if (pilot_options.patches == options.patches) break;  // the target itself
+        if (settings.patches == options.patches) break;  // the target itself
     }
     const RadiosityReport& large = pilots.back();
     const double form_factor_seconds = pilots.size() == 1
@@ -131,14 +167,14 @@ absl::Status RunPlan(const PlanOptions& options) {
     bool dielectric = false;
     for (int i : used) {
         const Material& m = scene->materials[size_t(i)];
-        std::printf("  %s: %s, reflectance %s", m.name.c_str(), MaterialTypeName(m.type),
-                    Color(m.reflectance).c_str());
+        std::printf("  %s: %s, %s", m.name.c_str(), MaterialTypeName(m.type),
+                    DescribeSurface(m).c_str());
         if (m.IsEmissive()) std::printf(", emits %s W m^-2 sr^-1", Color(m.emission).c_str());
         std::printf("\n");
         if (m.type == Material::Type::kDielectric) {
             dielectric = true;
         } else {
-            max_reflectance = std::max(max_reflectance, m.reflectance.MaxComponent());
+            max_reflectance = std::max(max_reflectance, NormalReflectance(m).MaxComponent());
         }
     }
 

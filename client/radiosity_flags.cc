@@ -1,11 +1,16 @@
 #include "radiosity_flags.h"
 
+#include "absl/strings/str_cat.h"
 #include "lf/kernels/radiosity.h"
 
 namespace lf {
 
+namespace {
+constexpr const char* kGroup = "Radiosity";
+}  // namespace
+
 void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
-    const std::string group = "Radiosity";
+    const std::string group = kGroup;
     cmd->add_option("--patch-size", settings.patch_size,
                     "longest patch edge in scene units (overrides --patches)")
         ->group(group)
@@ -39,6 +44,30 @@ void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
         ->group(group)
         ->capture_default_str()
         ->check(CLI::IsMember({"flat", "smooth"}));
+}
+
+absl::StatusOr<RadiosityOptions> RadiosityOptionsOf(const RadiositySettings& settings) {
+    absl::StatusOr<RadiosityOptions> options =
+        MakeRadiosityOptions(settings.patches, settings.patch_size, settings.solver,
+                             settings.tolerance, settings.max_iterations, settings.display);
+    if (!options.ok()) return options.status();
+    options->max_patches = settings.max_patches;
+    return options;
+}
+
+absl::Status CheckRadiosityFlagsApply(const CLI::App& cmd, const std::string& method) {
+    if (method != "path") return absl::OkStatus();
+    // Every option in the Radiosity group, the command's own (--sweep-tasks, --save-solution)
+    // included.
+    for (const CLI::Option* option : cmd.get_options()) {
+        if (option->get_group() == kGroup && option->count() > 0) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(option->get_name(),
+                             " is a radiosity setting, but --method is "
+                             "path: drop it, or use --method radiosity"));
+        }
+    }
+    return absl::OkStatus();
 }
 
 }  // namespace lf

@@ -1,5 +1,8 @@
 #include <cstdio>
+#include <filesystem>
 
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
 #include "adaptive_flags.h"
 #include "command.h"
 #include "local_render.h"
@@ -12,10 +15,17 @@ int ReportError(const absl::Status& status) {
     return 1;
 }
 
+absl::Status CheckExrPath(const std::string& path) {
+    const std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
+    if (ext == ".exr") return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat("-o ", path, ": the image is written as OpenEXR, so the name must end in .exr",
+                     ext == ".png" ? " (--png writes a preview PNG beside it)" : ""));
+}
+
 Command AddRenderCommand(CLI::App& app) {
     auto options = std::make_shared<LocalRenderOptions>();
     auto no_progress = std::make_shared<bool>(false);
-    auto radiosity = std::make_shared<RadiositySettings>();
     CLI::App* cmd = app.add_subcommand(
         "render",
         "Render a scene in this process to an OpenEXR image, by path tracing or radiosity,\n"
@@ -58,32 +68,29 @@ Command AddRenderCommand(CLI::App& app) {
         ->check(CLI::IsMember({"path", "radiosity", "auto"}));
 
     const std::string r = "Radiosity";
-    AddRadiosityFlags(cmd, *radiosity);
-    cmd->add_option("--save-solution", options->radiosity.save_solution,
+    AddRadiosityFlags(cmd, options->radiosity);
+    cmd->add_option("--save-solution", options->save_solution,
                     "write the solved radiosity, to render other cameras without solving")
         ->group(r);
-    cmd->add_option("--load-solution", options->radiosity.load_solution,
+    cmd->add_option("--load-solution", options->load_solution,
                     "reuse a saved solution (must match the scene and mesh)")
         ->group(r)
         ->check(CLI::ExistingFile);
-    cmd->add_option("--export-ply", options->radiosity.export_ply,
+    cmd->add_option("--export-ply", options->export_ply,
                     "write the solution as a PLY mesh with per-vertex sRGB colours")
         ->group(r);
 
-    return {cmd, [options, no_progress, radiosity] {
+    return {cmd, [cmd, options, no_progress] {
                 options->progress = !*no_progress;
-                absl::StatusOr<RadiosityOptions> parsed = MakeRadiosityOptions(
-                    radiosity->patches, radiosity->patch_size, radiosity->solver,
-                    radiosity->tolerance, radiosity->max_iterations, radiosity->display);
-                if (!parsed.ok()) return ReportError(parsed.status());
-                parsed->save_solution = options->radiosity.save_solution;
-                parsed->load_solution = options->radiosity.load_solution;
-                parsed->export_ply = options->radiosity.export_ply;
-                parsed->max_patches = radiosity->max_patches;
-                options->radiosity = *parsed;
+                if (absl::Status s = CheckExrPath(options->exr_path); !s.ok()) {
+                    return ReportError(s);
+                }
+                if (absl::Status s = CheckRadiosityFlagsApply(*cmd, options->method); !s.ok()) {
+                    return ReportError(s);
+                }
                 absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
                 if (!summary.ok()) return ReportError(summary.status());
-                const double s = summary->seconds;
+                const double s = summary->render_seconds;
                 std::printf(
                     "job %s: %s, %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
                     "%llu NaN/Inf samples -> %s\n",
@@ -91,6 +98,15 @@ Command AddRenderCommand(CLI::App& app) {
                     summary->height, (unsigned long long)summary->stats.samples, s,
                     summary->stats.samples / s * 1e-6, summary->stats.rays / s * 1e-6,
                     (unsigned long long)summary->stats.invalid_samples, options->exr_path.c_str());
+                std::printf("time: load %.2f s, ", summary->load_seconds);
+                if (const std::optional<RadiosityFigures>& r = summary->radiosity) {
+                    std::printf(
+                        "radiosity %.2f s (mesh %.2f s, form factors %.2f s, solve %.2f s), ",
+                        summary->radiosity_seconds, summary->mesh_seconds, r->form_factor_seconds,
+                        r->solve_seconds);
+                }
+                std::printf("render %.2f s, total %.2f s\n", summary->render_seconds,
+                            summary->seconds);
                 if (summary->estimated_error >= 0) {
                     std::printf("estimated relative error %.4f%s\n", summary->estimated_error,
                                 summary->high_variance ? " (high variance)" : "");

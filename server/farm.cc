@@ -204,11 +204,15 @@ absl::Status Farm::RefuseUndecodable(const std::string& lease_id, const std::str
 }
 
 absl::Status Farm::Complete(const std::string& lease_id, const std::string& worker,
-                            std::string_view tile_sums) {
+                            std::string_view tile_sums, std::optional<RadiosityFigures> radiosity) {
     absl::StatusOr<TileSums> sums = DecodeTileSums(tile_sums);
     if (!sums.ok()) return RefuseUndecodable(lease_id, worker, sums.status());
     absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, *sums);
     if (!done.ok()) return done.status();
+    if (radiosity) {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        radiosity_[done->job_id] = *radiosity;
+    }
     if (done->job_rendered) FinishJob(done->job_id);
     return absl::OkStatus();
 }
@@ -220,6 +224,10 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
     absl::StatusOr<Scheduler::SweepCompletion> done =
         scheduler_.CompleteSweep(lease_id, worker, *result);
     if (!done.ok()) return done.status();
+    if (done->outcome && done->outcome->converged) {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        sweep_solves_[done->job_id] = {done->outcome->iterations, done->outcome->residual};
+    }
     if (done->outcome) {
         scheduler_.Publish(done->job_id, done->outcome->converged,
                            blobs_->Put(EncodeRadiosity(done->outcome->radiosity)));
@@ -232,6 +240,11 @@ void Farm::FinishJob(const std::string& job_id) {
     if (!snapshot.ok()) return;  // cancelled meanwhile
     const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
     const absl::Status written = WriteImage(*snapshot, true, path);
+    {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        radiosity_.erase(job_id);
+        sweep_solves_.erase(job_id);
+    }
     scheduler_.Finish(job_id, written.ok() ? absl::StatusOr<std::string>(path)
                                            : absl::StatusOr<std::string>(written));
 }
@@ -254,20 +267,27 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
                            ? 0.0
                            : absl::ToDoubleSeconds(absl::Now() - job.started);
     metadata.stats = job.stats;
+    metadata.adaptive_settings = job.spec.adaptive;
+    metadata.adaptive = snapshot.adaptive;
+    metadata.radiosity_settings = job.spec.radiosity;
+    {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        if (auto it = radiosity_.find(job.id); it != radiosity_.end()) {
+            metadata.radiosity = it->second;
+            // The display tiles' workers read the farm's solution: the solve's figures are ours.
+            if (auto solve = sweep_solves_.find(job.id); solve != sweep_solves_.end()) {
+                metadata.radiosity->iterations = solve->second.iterations;
+                metadata.radiosity->residual = solve->second.residual;
+            }
+        }
+    }
+    absl::StatusOr<RenderDescription> description =
+        DescribeRender(metadata, snapshot.image, complete);
+    if (!description.ok()) return description.status();
+    const ExrAttributes& attributes = description->attributes;
     // Renamed into place so a reader never sees half a file, and durable before the job is
     // recorded as succeeded.
     const std::string temp = path + ".tmp-" + UniqueSuffix();
-    ExrAttributes attributes = DescribeRender(metadata);
-    if (const uint64_t spp = snapshot.adaptive ? snapshot.adaptive->min_spp : job.spec.plan.spp;
-        complete && spp >= 2) {
-        if (absl::StatusOr<ErrorEstimates> e = AddErrorEstimates(snapshot.image, &attributes);
-            !e.ok()) {
-            return e.status();
-        }
-    }
-    if (snapshot.adaptive) {
-        AddAdaptiveAttributes(job.spec.adaptive, *snapshot.adaptive, &attributes);
-    }
     if (absl::Status s = WriteExr(temp, snapshot.image, attributes); !s.ok()) return s;
     return RenameDurably(temp, path);
 }

@@ -4,11 +4,15 @@
 // store's, which the services use directly.
 #pragma once
 
+#include <map>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "absl/status/statusor.h"
+#include "lf/job/render_metadata.h"
 #include "server/blob_store.h"
 #include "server/data_dir_lock.h"
 #include "server/job_store.h"
@@ -54,8 +58,10 @@ class Farm {
                                                                    uint64_t size);
 
     // Decodes and merges a task's result; writes the job's EXR when it was the last one.
+    // `radiosity`: what the worker's radiosity solve reported, for that EXR's header.
     absl::Status Complete(const std::string& lease_id, const std::string& worker,
-                          std::string_view tile_sums);
+                          std::string_view tile_sums,
+                          std::optional<RadiosityFigures> radiosity = std::nullopt);
     // A radiosity patch-group task's result (lf::EncodeSweepResult); when it ends a sweep,
     // stores the next sweep's input or the solution as a blob for the workers.
     absl::Status CompleteSweep(const std::string& lease_id, const std::string& worker,
@@ -97,6 +103,16 @@ class Farm {
 
     const FarmOptions options_;
     std::unique_ptr<DataDirLock> lock_;
+    // Radiosity figures of running jobs, for their EXR headers: the workers' reports, and of
+    // jobs solved in sweeps, the iterations and residual of the farm's own solve. Kept in
+    // memory: after a restart a header lacks what the workers reported before it.
+    std::mutex radiosity_mutex_;
+    struct SweepSolveFigures {
+        int iterations = 0;
+        double residual = 0;
+    };
+    std::map<std::string, RadiosityFigures> radiosity_;      // by job id
+    std::map<std::string, SweepSolveFigures> sweep_solves_;  // by job id
     std::unique_ptr<BlobStore> blobs_;
     std::unique_ptr<JobStore> store_;
     Scheduler scheduler_;

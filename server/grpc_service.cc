@@ -203,7 +203,10 @@ grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context,
                                              pb::CompleteTaskResponse*) {
     const absl::Status s =
         req->radiosity_sweep().empty()
-            ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums())
+            ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums(),
+                             req->has_radiosity()
+                                 ? std::optional<RadiosityFigures>(FromProto(req->radiosity()))
+                                 : std::nullopt)
             : farm_.CompleteSweep(req->lease_id(), req->worker_id(), req->radiosity_sweep());
     if (!s.ok()) {
         Log()->warn("{}", RefusedResultLine(req->lease_id(), req->worker_id(), context->peer(),

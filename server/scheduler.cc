@@ -115,7 +115,8 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     std::unique_ptr<Job> job = std::move(*made);
     QueueStart(*job);
     job->record.submitted = clock_();
-    job->record.tasks_total = int(job->tasks.size());
+    // The image's tasks: a radiosity solve's sweep tasks are not done the way tiles are.
+    job->record.tasks_total = int(job->merger->tasks().size());
     // The store is read before the lock is taken. An earlier submission it does not hold has not
     // been acknowledged yet, so it is still in memory.
     std::optional<std::string> stored;
@@ -256,7 +257,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
         }
         QueueStart(*job);
         job->record.tasks_done = int(job->merger->tasks_done());
-        job->record.tasks_total = int(job->tasks.size());
+        job->record.tasks_total = int(job->merger->tasks().size());
         job->record.stats = job->merger->stats();
         Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before",
                     job->record.id, job->record.tasks_done, job->record.tasks_total,

@@ -63,6 +63,7 @@ absl::Status ServerConnection::Complete(const std::string& lease_id, const TaskR
     req.set_worker_id(worker_id_);
     (result.sweep ? req.mutable_radiosity_sweep() : req.mutable_tile_sums())->assign(result.bytes);
     req.set_seconds(seconds);
+    if (result.radiosity) ToProto(*result.radiosity, req.mutable_radiosity());
     pb::CompleteTaskResponse resp;
     // Rides out a server restart: the result stays valid after its lease.
     const auto context = ContextWithDeadline(absl::Seconds(30));

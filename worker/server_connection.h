@@ -9,6 +9,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/film.h"
+#include "lf/job/render_metadata.h"
 #include "lf/job/task_assignment.h"
 
 namespace lf {
@@ -29,6 +30,7 @@ class ServerConnection {
     struct TaskResult {
         std::string bytes;
         bool sweep = false;
+        std::optional<RadiosityFigures> radiosity;  // a radiosity job's tile: for the EXR header
     };
     absl::Status Complete(const std::string& lease_id, const TaskResult& result, double seconds);
     // `shutdown`: the worker is stopping, which does not count against the task.

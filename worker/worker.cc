@@ -105,10 +105,13 @@ void Worker::Execute(const TaskAssignment& task) {
     if (status.ok() && task.sweep >= 0) {
         absl::StatusOr<std::string> swept = Sweep(task, cancel);
         status = swept.status();
-        if (swept.ok()) result = {std::move(*swept), true};
+        if (swept.ok()) result = {std::move(*swept), true, std::nullopt};
     } else if (status.ok()) {
         status = PrepareTracer(task);
         if (status.ok()) result.bytes = EncodeTileSums(Render(task, cancel));
+        if (const auto* r = dynamic_cast<const RadiosityRenderer*>(loaded_.tracer.get())) {
+            result.radiosity = RadiosityFiguresOf(r->report());
+        }
     }
     {
         std::lock_guard<std::mutex> lock(hb_mutex);

@@ -9,8 +9,13 @@ namespace lf {
 namespace {
 
 constexpr char kMagic[4] = {'L', 'F', 'T', 'S'};
-constexpr uint32_t kVersion = 1;
-constexpr size_t kHeaderBytes = 4 + 4 + 4 * 4 + 3 * 8;
+// Version 2 added truncated_paths after invalid_samples; version 1 tiles (from workers of an
+// older build) still decode, with no truncated paths.
+constexpr uint32_t kVersion = 2;
+constexpr uint32_t kOldestVersion = 1;
+constexpr size_t HeaderBytes(uint32_t version) {
+    return 4 + 4 + 4 * 4 + (version == 1 ? 3 : 4) * 8;
+}
 constexpr size_t kPixelBytes = 6 * 16 + 2 * 4;
 // 2^28 pixels is a 16k x 16k tile: far beyond any plan, small enough that size arithmetic
 // cannot overflow and a corrupt header cannot make us allocate terabytes.
@@ -41,7 +46,11 @@ class Reader {
 
 }  // namespace
 
-size_t EncodedTileSumsSize(int64_t pixels) { return kHeaderBytes + size_t(pixels) * kPixelBytes; }
+size_t EncodedTileSumsSize(int64_t pixels, uint32_t version) {
+    return HeaderBytes(version) + size_t(pixels) * kPixelBytes;
+}
+
+size_t EncodedTileSumsSize(int64_t pixels) { return EncodedTileSumsSize(pixels, kVersion); }
 
 std::string EncodeTileSums(const TileSums& tile) {
     std::string out;
@@ -51,7 +60,8 @@ std::string EncodeTileSums(const TileSums& tile) {
     for (int v : {tile.rect.x0, tile.rect.y0, tile.rect.width, tile.rect.height}) {
         PutU32(out, uint32_t(v));
     }
-    for (uint64_t v : {tile.stats.samples, tile.stats.rays, tile.stats.invalid_samples}) {
+    for (uint64_t v : {tile.stats.samples, tile.stats.rays, tile.stats.invalid_samples,
+                       tile.stats.truncated_paths}) {
         PutU64(out, v);
     }
     for (const PixelSums& p : tile.pixels) {
@@ -69,14 +79,20 @@ std::string EncodeTileSums(const TileSums& tile) {
 }
 
 absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
-    if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, 4) != 0) {
+    if (bytes.size() < HeaderBytes(kOldestVersion) || std::memcmp(bytes.data(), kMagic, 4) != 0) {
         return absl::InvalidArgumentError(absl::StrCat("tile sums: not an encoded tile (",
                                                        bytes.size(), " bytes, no LFTS header)"));
     }
     Reader in(bytes.substr(4));
-    if (const uint32_t version = in.U32(); version != kVersion) {
+    const uint32_t version = in.U32();
+    if (version < kOldestVersion || version > kVersion) {
+        return absl::InvalidArgumentError(absl::StrCat("tile sums: version ", version,
+                                                       " is not one of the supported ",
+                                                       kOldestVersion, "..", kVersion));
+    }
+    if (bytes.size() < HeaderBytes(version)) {
         return absl::InvalidArgumentError(
-            absl::StrCat("tile sums: version ", version, " is not the supported ", kVersion));
+            absl::StrCat("tile sums: ", bytes.size(), " bytes, shorter than a header"));
     }
     PixelRect rect;
     rect.x0 = in.I32();
@@ -88,15 +104,16 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
         return absl::InvalidArgumentError(absl::StrCat("tile sums: bad rectangle ", rect.x0, ",",
                                                        rect.y0, " ", rect.width, "x", rect.height));
     }
-    if (bytes.size() != EncodedTileSumsSize(rect.Area())) {
+    if (bytes.size() != EncodedTileSumsSize(rect.Area(), version)) {
         return absl::InvalidArgumentError(
             absl::StrCat("tile sums: ", bytes.size(), " bytes for a ", rect.width, "x", rect.height,
-                         " tile, which takes ", EncodedTileSumsSize(rect.Area())));
+                         " tile, which takes ", EncodedTileSumsSize(rect.Area(), version)));
     }
     TileSums tile(rect);
     tile.stats.samples = in.U64();
     tile.stats.rays = in.U64();
     tile.stats.invalid_samples = in.U64();
+    if (version >= 2) tile.stats.truncated_paths = in.U64();
     for (PixelSums& p : tile.pixels) {
         for (int h = 0; h < 2; ++h) {
             for (int c = 0; c < 3; ++c) {

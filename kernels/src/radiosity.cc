@@ -314,6 +314,10 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     report.patches = int64_t(mesh->patches().size());
     report.sides = int64_t(mesh->sides().size());
     report.patch_size = mesh->patch_size();
+    // As PrepareRadiosity reports it, so the farm's EXR header says what local mode's does.
+    const DiscretisationError error = EstimateDiscretisationError(*mesh, radiosity);
+    report.estimated_error = error.max;
+    report.mean_estimated_error = error.mean;
     return std::make_unique<RadiosityRenderer>(scene, std::move(*mesh), std::move(radiosity),
                                                options.display, report);
 }

@@ -263,5 +263,109 @@ TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
         << glossy.output;
 }
 
+// A dielectric has an index of refraction and a conductor eta and k, not a reflectance: plan
+// prints what each material's model uses.
+TEST_F(Cli, PlanPrintsWhatEachMaterialUses) {
+    const RunResult r = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
+                                  "/materials.json --pilot-spp 2 --threads 2");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("glass: dielectric, index of refraction 1.5\n"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("gold: glossy, conductor eta (0.143, 0.374"), std::string::npos)
+        << r.output;
+    EXPECT_EQ(r.output.find("glass: dielectric, reflectance"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("gold: glossy, reflectance"), std::string::npos) << r.output;
+}
+
+// Images are OpenEXR: a name that says otherwise is refused before any work, by render and by
+// fetch (which refuses before it asks a server).
+TEST_F(Cli, OutputThatIsNotExrIsRefused) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const RunResult render =
+        Lightfarm("render " + scene + " -o " + (dir_ / "out.png").string() + " --spp 1");
+    EXPECT_NE(render.status, 0);
+    EXPECT_NE(render.output.find("must end in .exr"), std::string::npos) << render.output;
+    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+    const RunResult fetch =
+        Lightfarm("fetch job-0 -o " + (dir_ / "out.png").string() + " --server 127.0.0.1:1");
+    EXPECT_NE(fetch.status, 0);
+    EXPECT_NE(fetch.output.find("must end in .exr"), std::string::npos) << fetch.output;
+}
+
+TEST_F(Cli, BenchRefusesFewerThanOneThread) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    for (const char* threads : {"0", "-1"}) {
+        const RunResult r = Lightfarm("bench " + scene + " --threads " + threads);
+        EXPECT_NE(r.status, 0) << threads;
+        EXPECT_NE(r.output.find("--threads"), std::string::npos) << r.output;
+    }
+}
+
+// A radiosity flag with --method path would be ignored: render and submit refuse it, naming the
+// flag (submit before it contacts a server).
+TEST_F(Cli, RadiosityFlagsWithMethodPathAreRefused) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::string exr = (dir_ / "p.exr").string();
+    for (const std::string& command :
+         {"render " + scene + " -o " + exr + " --spp 1 --no-progress",
+          "submit " + scene + " --server 127.0.0.1:1 --retry-seconds 0"}) {
+        for (const auto& [flags, named] :
+             {std::pair{"--patches 300", "--patches"}, std::pair{"--solver shooting", "--solver"},
+              std::pair{"--method path --tolerance 0.01", "--tolerance"}}) {
+            const RunResult r = Lightfarm(command + " " + flags);
+            EXPECT_NE(r.status, 0) << command << " " << flags;
+            EXPECT_NE(r.output.find(std::string(named) + " is a radiosity setting"),
+                      std::string::npos)
+                << r.output;
+        }
+    }
+    EXPECT_FALSE(fs::exists(exr));
+}
+
+// Every phase of a radiosity render is reported, and the header's seconds are the total.
+TEST_F(Cli, RadiositySummaryReportsEveryPhaseAndTheTotal) {
+    std::ifstream in(std::string(LF_TEST_SCENES) + "/cornell_box.json");
+    nlohmann::json scene = nlohmann::json::parse(in);
+    scene["camera"]["resolution"] = {32, 32};
+    const std::string path = Write("cornell_32.json", scene.dump());
+    const std::string exr = (dir_ / "r.exr").string();
+    const RunResult r = Lightfarm("render " + path + " -o " + exr +
+                                  " --method radiosity --patches 300 --spp 1 --no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    double load = -1, radiosity = -1, mesh = -1, ff = -1, solve = -1, render = -1, total = -1;
+    const size_t at = r.output.find("time: ");
+    ASSERT_NE(at, std::string::npos) << r.output;
+    ASSERT_EQ(std::sscanf(r.output.c_str() + at,
+                          "time: load %lf s, radiosity %lf s (mesh %lf s, form factors %lf s, "
+                          "solve %lf s), render %lf s, total %lf s",
+                          &load, &radiosity, &mesh, &ff, &solve, &render, &total),
+              7)
+        << r.output;
+    EXPECT_GE(radiosity, ff + solve - 0.01) << r.output;
+    EXPECT_GE(total, load + radiosity + render - 0.01) << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    const double seconds = std::get<double>(file->attributes.at("lightfarm.seconds"));
+    EXPECT_GE(seconds, load + radiosity + render - 0.01) << r.output;
+    EXPECT_GE(seconds + 0.01,
+              std::get<double>(file->attributes.at("lightfarm.radiosity.formFactorSeconds")) +
+                  std::get<double>(file->attributes.at("lightfarm.radiosity.solveSeconds")));
+}
+
+// `render` and `submit` take their defaults from the job model: the same solver for both.
+TEST_F(Cli, RenderAndSubmitShareTheirDefaults) {
+    for (const char* command : {"render --help", "submit --help"}) {
+        const RunResult r = Lightfarm(command);
+        ASSERT_EQ(r.status, 0) << r.output;
+        for (const char* text : {"--solver TEXT:{jacobi,gauss-seidel,shooting}=jacobi",
+                                 "--spp UINT:UINT in [1 - 16777216]=16", "--max-depth",
+                                 "--max-spp UINT:UINT in [2 - 16777216]=65536",
+                                 "--patches INT:INT in [1 - 16777216]=4000"}) {
+            EXPECT_NE(r.output.find(text), std::string::npos) << command << ": " << text << "\n"
+                                                              << r.output;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lf

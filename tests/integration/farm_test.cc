@@ -2,10 +2,13 @@
 // binaries, ports chosen by the OS. Farm renders must equal `lightfarm render` bit for bit,
 // whatever the workers, tiles, passes, or a worker killed halfway. Every wait is bounded and
 // every child is killed in TearDown.
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,6 +19,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -278,6 +282,12 @@ class Farm : public ::testing::Test {
                                        " " + method_flags + " --threads 2 --no-progress");
             ASSERT_EQ(r.status, 0) << r.out << r.err;
         }
+        ExpectSameImageAndHeader(farm, local);
+    }
+
+    // Every channel bit for bit, and the same header attributes with the same values but for
+    // the timings, which no two runs share.
+    void ExpectSameImageAndHeader(const std::string& farm, const std::string& local) {
         absl::StatusOr<ExrFile> a = ReadExr(farm), b = ReadExr(local);
         ASSERT_TRUE(a.ok()) << a.status();
         ASSERT_TRUE(b.ok()) << b.status();
@@ -289,11 +299,20 @@ class Farm : public ::testing::Test {
             EXPECT_EQ(0, std::memcmp(x->data(), y->data(), x->size() * sizeof(float)))
                 << "channel " << ch << " differs from the local render";
         }
-        for (const char* key : {"lightfarm.sceneHash", "lightfarm.method", "lightfarm.spp",
-                                "lightfarm.seed", "lightfarm.maxDepth", "lightfarm.rays",
-                                "lightfarm.invalidSamples", "lightfarm.version"}) {
-            ASSERT_TRUE(a->attributes.count(key)) << key;
-            EXPECT_EQ(a->attributes.at(key), b->attributes.at(key)) << key;
+        const std::set<std::string> timings = {"lightfarm.seconds",
+                                               "lightfarm.radiosity.formFactorSeconds",
+                                               "lightfarm.radiosity.solveSeconds"};
+        std::set<std::string> farm_names, local_names;
+        for (const auto& [name, value] : a->attributes) {
+            if (name.rfind("lightfarm.", 0) == 0) farm_names.insert(name);
+        }
+        for (const auto& [name, value] : b->attributes) {
+            if (name.rfind("lightfarm.", 0) == 0) local_names.insert(name);
+        }
+        EXPECT_EQ(farm_names, local_names);
+        for (const std::string& name : farm_names) {
+            if (timings.count(name) || !b->attributes.count(name)) continue;
+            EXPECT_EQ(a->attributes.at(name), b->attributes.at(name)) << name;
         }
         EXPECT_TRUE(a->attributes.count("lightfarm.seconds"));
     }
@@ -567,6 +586,85 @@ TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
     EXPECT_EQ(built, chunks) << "a chunk's form factors were computed twice:\n" << logs;
     const std::string server_log = ReadText(dir_ / "server-1.log");
     EXPECT_NE(server_log.find("radiosity sweep 2: relative residual"), std::string::npos);
+}
+
+// One command line, two ways: `lightfarm render FLAGS` and `lightfarm submit FLAGS` then
+// `fetch` give the same pixels and the same header but for timings, whatever the method: path,
+// radiosity with its default solver (jacobi, which the farm solves in sweeps), adaptive.
+TEST_F(Farm, SameCommandLineGivesTheSameImageAndHeaderLocallyAndOnTheFarm) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    int run = 0;
+    for (const std::string flags :
+         {"--spp 4 --seed 2 --tile 16", "--method radiosity --patches 300 --spp 2 --tile 16",
+          "--spp 4 --seed 3 --tile 16 --target-error 0.1 --max-spp 256"}) {
+        SCOPED_TRACE(flags);
+        const std::string job = Submit(scene_, flags);
+        const CliRun watch = Farmctl("watch " + job);
+        ASSERT_EQ(watch.status, 0) << watch.out << watch.err;
+        const std::string farm = (dir_ / (job + ".exr")).string();
+        const CliRun fetch = Farmctl("fetch " + job + " -o " + farm);
+        ASSERT_EQ(fetch.status, 0) << fetch.out << fetch.err;
+        const std::string local = (dir_ / ("local" + std::to_string(++run) + ".exr")).string();
+        const CliRun r =
+            Lightfarm("render " + scene_ + " -o " + local + " " + flags + " --no-progress");
+        ASSERT_EQ(r.status, 0) << r.out << r.err;
+        ExpectSameImageAndHeader(farm, local);
+        // A finished job shows every task done, a radiosity solve's sweeps and all.
+        const TaskCounts tasks = Tasks(job);
+        EXPECT_EQ(tasks.done, tasks.total);
+        EXPECT_GT(tasks.total, 0);
+    }
+}
+
+// A port nothing listens on now, for a server started later.
+std::string ReservePort() {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    addr.sin_port = 0;
+    socklen_t len = sizeof addr;
+    const bool ok = bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0 &&
+                    getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len) == 0;
+    close(fd);
+    return ok ? "127.0.0.1:" + std::to_string(ntohs(addr.sin_port)) : "";
+}
+
+// docs/farm.md: clients ride out a server restart. A submit started while the server is down
+// waits for it (saying so on stderr) and gets its job; so does a watch started during an
+// outage.
+TEST_F(Farm, SubmitAndWatchRideOutAServerThatIsDown) {
+    address_ = ReservePort();
+    ASSERT_FALSE(address_.empty());
+    auto wait_for_log = [&](const std::string& log, const std::string& text) {
+        const auto deadline = Clock::now() + milliseconds(10000);
+        while (ReadText(dir_ / log).find(text) == std::string::npos) {
+            if (Clock::now() > deadline) return false;
+            std::this_thread::sleep_for(milliseconds(20));
+        }
+        return true;
+    };
+    Child* submit = Spawn({std::string(LF_BIN_DIR) + "/lightfarm", "submit", scene_, "--spp", "2",
+                           "--server", address_},
+                          "submit.log");
+    ASSERT_TRUE(wait_for_log("submit.log", "retrying")) << ReadText(dir_ / "submit.log");
+    StartServer(10, address_);
+    const std::string job = submit->ReadLine(milliseconds(20000));
+    EXPECT_EQ(submit->Wait(milliseconds(5000)), std::optional<int>(0));
+    ASSERT_EQ(job.rfind("job-", 0), 0u) << job;
+
+    server_->Signal(SIGKILL);
+    ASSERT_TRUE(server_->Wait(milliseconds(5000)));
+    Child* watch = Spawn(
+        {std::string(LF_BIN_DIR) + "/lightfarm", "watch", job, "--server", address_}, "watch.log");
+    ASSERT_TRUE(wait_for_log("watch.log", "retrying")) << ReadText(dir_ / "watch.log");
+    StartServer(10, address_);
+    StartWorker("w1");
+    EXPECT_EQ(watch->Wait(milliseconds(20000)), std::optional<int>(0))
+        << ReadText(dir_ / "watch.log");
+    EXPECT_NE(Farmctl("list").out.find(job), std::string::npos);
 }
 
 // The solve is not recorded: a server killed mid-solve starts it again, to the same bits.

@@ -169,4 +169,40 @@ TaskAssignment FromProto(const pb::Task& t) {
     return task;
 }
 
+void ToProto(const RadiosityFigures& f, pb::RadiosityReport* out) {
+    out->set_patches(f.patches);
+    out->set_unknowns(f.unknowns);
+    out->set_patch_size(f.patch_size);
+    out->set_loaded(f.loaded);
+    out->set_iterations(f.iterations);
+    out->set_residual(f.residual);
+    out->set_form_factor_seconds(f.form_factor_seconds);
+    out->set_solve_seconds(f.solve_seconds);
+    out->set_estimated_error(f.estimated_error);
+    out->set_mean_estimated_error(f.mean_estimated_error);
+    out->set_refine_passes(f.refine_passes);
+    out->set_coarse_patches(f.coarse_patches);
+    out->set_budget_reached(f.budget_reached);
+    out->set_finest_above_target(f.finest_above_target);
+}
+
+RadiosityFigures FromProto(const pb::RadiosityReport& r) {
+    RadiosityFigures f;
+    f.patches = r.patches();
+    f.unknowns = r.unknowns();
+    f.patch_size = r.patch_size();
+    f.loaded = r.loaded();
+    f.iterations = r.iterations();
+    f.residual = r.residual();
+    f.form_factor_seconds = r.form_factor_seconds();
+    f.solve_seconds = r.solve_seconds();
+    f.estimated_error = r.estimated_error();
+    f.mean_estimated_error = r.mean_estimated_error();
+    f.refine_passes = r.refine_passes();
+    f.coarse_patches = r.coarse_patches();
+    f.budget_reached = r.budget_reached();
+    f.finest_above_target = r.finest_above_target();
+    return f;
+}
+
 }  // namespace lf

@@ -18,6 +18,7 @@ TileSums MakeTile() {
     tile.pixels[0].sum[1][2] = ExactSum::FromFixed(-(static_cast<__int128>(1) << 126));
     tile.pixels[1].sum[0][0] = ExactSum::FromFixed((static_cast<__int128>(1) << 126) + 12345);
     tile.stats = {30, 123456789012ULL, 2};
+    tile.stats.truncated_paths = 7;
     return tile;
 }
 
@@ -31,6 +32,7 @@ TEST(TileCodec, RoundTripKeepsEveryBit) {
     EXPECT_EQ(back->stats.samples, 30u);
     EXPECT_EQ(back->stats.rays, 123456789012ULL);
     EXPECT_EQ(back->stats.invalid_samples, 2u);
+    EXPECT_EQ(back->stats.truncated_paths, 7u);
     for (size_t i = 0; i < tile.pixels.size(); ++i) {
         for (int h = 0; h < 2; ++h) {
             EXPECT_EQ(back->pixels[i].count[h], tile.pixels[i].count[h]);
@@ -43,8 +45,24 @@ TEST(TileCodec, RoundTripKeepsEveryBit) {
 TEST(TileCodec, LittleEndianHeader) {
     const std::string bytes = EncodeTileSums(MakeTile());
     EXPECT_EQ(bytes.substr(0, 4), "LFTS");
-    EXPECT_EQ(bytes[4], 1);  // version 1, low byte first
+    EXPECT_EQ(bytes[4], 2);  // version 2, low byte first
     EXPECT_EQ(bytes[8], 5);  // x0
+}
+
+// A worker of the previous build sends version 1, without truncated_paths: its tiles still merge.
+TEST(TileCodec, Version1TilesDecodeWithNoTruncatedPaths) {
+    const TileSums tile = MakeTile();
+    std::string v1 = EncodeTileSums(tile);
+    constexpr size_t kTruncatedPathsOffset = 4 + 4 + 4 * 4 + 3 * 8;
+    v1.erase(kTruncatedPathsOffset, 8);
+    v1[4] = 1;
+    absl::StatusOr<TileSums> back = DecodeTileSums(v1);
+    ASSERT_TRUE(back.ok()) << back.status();
+    EXPECT_EQ(back->stats.samples, 30u);
+    EXPECT_EQ(back->stats.invalid_samples, 2u);
+    EXPECT_EQ(back->stats.truncated_paths, 0u);
+    EXPECT_EQ(back->pixels[1].sum[0][0], tile.pixels[1].sum[0][0]);
+    EXPECT_EQ(back->pixels[5].count[1], tile.pixels[5].count[1]);
 }
 
 TEST(TileCodec, GarbageIsRefusedWithAReason) {

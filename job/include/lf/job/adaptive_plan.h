@@ -15,6 +15,7 @@
 #include "lf/core/image.h"
 #include "lf/job/merge.h"
 #include "lf/job/plan.h"
+#include "lf/job/settings.h"
 
 namespace lf {
 
@@ -24,7 +25,7 @@ namespace lf {
 struct AdaptiveSettings {
     double target_error = 0;  // relative; 0: none
     double time_limit = 0;    // seconds; 0: none
-    uint64_t max_spp = 1 << 16;
+    uint64_t max_spp = defaults::kAdaptiveMaxSpp;
 };
 
 inline bool IsAdaptive(const AdaptiveSettings& a) { return a.target_error > 0 || a.time_limit > 0; }

@@ -10,6 +10,7 @@
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
+#include "lf/job/settings.h"
 
 namespace lf {
 
@@ -18,9 +19,9 @@ struct JobSpec {
     BlobRef scene;               // the scene JSON
     std::vector<BlobRef> files;  // the files it names
     RenderPlanSettings plan;     // width and height come from the scene
-    uint64_t seed = 0;
-    int max_depth = -1;
-    std::string method = "path";  // or "radiosity"
+    uint64_t seed = defaults::kSeed;
+    int max_depth = defaults::kMaxDepth;
+    std::string method = defaults::kMethod;  // or "radiosity"
     RadiositySettings radiosity;
     AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused
     int priority = 0;           // higher first

@@ -9,6 +9,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/film.h"
+#include "lf/job/settings.h"
 
 namespace lf {
 
@@ -20,22 +21,22 @@ inline constexpr uint64_t kMaxSpp = uint64_t(1) << 24;
 
 struct RenderPlanSettings {
     int width = 0, height = 0;
-    uint64_t spp = 16;
-    int tile = 32;
-    int passes = 1;  // sample passes per tile, 1..spp
+    uint64_t spp = defaults::kSpp;
+    int tile = defaults::kTile;
+    int passes = defaults::kPasses;  // sample passes per tile, 1..spp
 };
 
 // Radiosity settings of a job in plain values (lf::MakeRadiosityOptions turns them into the
 // kernel's options): `render` and `submit` share them, and the farm carries them.
 struct RadiositySettings {
-    int64_t patches = 4000;
+    int64_t patches = defaults::kRadiosityPatches;
     double patch_size = 0;
-    std::string solver = "gauss-seidel";
-    double tolerance = 1e-4;
-    int max_iterations = 10000;
-    std::string display = "smooth";
+    std::string solver = defaults::kRadiositySolver;
+    double tolerance = defaults::kRadiosityTolerance;
+    int max_iterations = defaults::kRadiosityMaxIterations;
+    std::string display = defaults::kRadiosityDisplay;
     // On the farm, with solver "jacobi": patch-group tasks per sweep (server/radiosity_solve.h).
-    int sweep_tasks = 8;
+    int sweep_tasks = defaults::kRadiositySweepTasks;
     // Most patches mesh refinement may reach (RadiosityOptions::max_patches); 0: 16 times the
     // coarse mesh's.
     int64_t max_patches = 0;

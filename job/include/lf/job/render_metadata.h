@@ -1,8 +1,10 @@
-// The EXR header attributes that say how an image was made, the same for `lightfarm render`
-// and the farm.
+// The EXR header attributes that say how an image was made. `lightfarm render` and the farm's
+// coordinator both build them with DescribeRender from the same inputs, so the two headers of
+// one command line differ only in timings and host names.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -11,31 +13,83 @@
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/plan.h"
 
 namespace lf {
 
-struct RenderMetadata {
-    std::string scene_hash;
-    std::string method;  // "path"
-    uint64_t spp = 0;
-    uint64_t seed = 0;
-    int max_depth = -1;
-    double seconds = 0;
-    RenderStats stats;
+// What a radiosity solve reports, in plain numbers: the farm carries them from the worker that
+// solved to the coordinator that writes the header.
+struct RadiosityFigures {
+    int64_t patches = 0;
+    int64_t unknowns = 0;
+    double patch_size = 0;
+    bool loaded = false;  // from a saved solution
+    int iterations = 0;
+    double residual = 0;
+    double form_factor_seconds = 0, solve_seconds = 0;
+    double estimated_error = 0, mean_estimated_error = 0;
+    // With a target error: mesh refinement's passes, the first mesh's patches, and why it
+    // stopped above the target if it did.
+    int refine_passes = 0;
+    int64_t coarse_patches = 0;
+    bool budget_reached = false;
+    int64_t finest_above_target = 0;
 };
 
-ExrAttributes DescribeRender(const RenderMetadata& metadata);
+// The figures of a kernel's lf::RadiosityReport. A template so that the job model need not
+// depend on the kernels; local mode and the worker both convert through it.
+template <class Report>
+RadiosityFigures RadiosityFiguresOf(const Report& r) {
+    RadiosityFigures f;
+    f.patches = r.patches;
+    f.unknowns = r.sides;
+    f.patch_size = r.patch_size;
+    f.loaded = r.loaded;
+    f.iterations = r.iterations;
+    f.residual = r.residual;
+    f.form_factor_seconds = r.form_factor_seconds;
+    f.solve_seconds = r.solve_seconds;
+    f.estimated_error = r.estimated_error;
+    f.mean_estimated_error = r.mean_estimated_error;
+    f.refine_passes = int(r.refinement.size());
+    f.coarse_patches = r.refinement.empty() ? r.patches : r.refinement.front().patches;
+    f.budget_reached = r.budget_reached;
+    f.finest_above_target = r.finest_above_target;
+    return f;
+}
+
+struct RenderMetadata {
+    std::string scene_hash;
+    std::string method;  // "path" or "radiosity"
+    uint64_t spp = 0;    // adaptive: the most any pixel got
+    uint64_t seed = 0;
+    int max_depth = -1;
+    double seconds = 0;  // the whole render: loading, meshing, solving and sampling
+    RenderStats stats;
+    AdaptiveSettings adaptive_settings;
+    std::optional<AdaptiveReport> adaptive;     // set for an adaptive render
+    RadiositySettings radiosity_settings;       // method "radiosity"
+    std::optional<RadiosityFigures> radiosity;  // when known
+};
 
 // What an image estimates of its own error, from its A/B halves: needs 2 samples per pixel.
 struct ErrorEstimates {
     double estimated_error = 0;  // EstimatedRelativeError
     VarianceAssessment variance;
 };
-// Adds them as lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance.
-absl::StatusOr<ErrorEstimates> AddErrorEstimates(const Image& image, ExrAttributes* attributes);
 
-// lightfarm.targetError, .timeLimit and lightfarm.adaptive.*: how an adaptive render ended.
-void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveReport& report,
-                           ExrAttributes* attributes);
+struct RenderDescription {
+    ExrAttributes attributes;
+    std::optional<ErrorEstimates> estimates;  // when computed
+};
+
+// Every lightfarm.* attribute of a render: how it was made (version, scene hash, method,
+// settings, timing, ray and sample counts, truncated paths), the image's own error estimates
+// (lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance) when
+// `complete` and every pixel has at least 2 samples, how an adaptive render ended
+// (lightfarm.targetError, .timeLimit, lightfarm.adaptive.*) and the radiosity solve
+// (lightfarm.radiosity.*).
+absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& metadata, const Image& image,
+                                                 bool complete);
 
 }  // namespace lf

@@ -13,15 +13,16 @@
 #include "lf/core/image.h"
 #include "lf/kernels/radiance.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/settings.h"
 
 namespace lf {
 
 struct RenderSettings {
-    uint64_t spp = 16;
-    uint64_t seed = 0;
+    uint64_t spp = defaults::kSpp;
+    uint64_t seed = defaults::kSeed;
     int threads = 0;  // 0: all cores
-    int tile = 32;
-    int passes = 1;  // sample passes per tile, as on the farm
+    int tile = defaults::kTile;
+    int passes = defaults::kPasses;  // sample passes per tile, as on the farm
 };
 
 struct RenderOutput {

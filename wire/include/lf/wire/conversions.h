@@ -5,6 +5,7 @@
 
 #include "lf/job/job_record.h"
 #include "lf/job/job_spec.h"
+#include "lf/job/render_metadata.h"
 #include "lf/job/task_assignment.h"
 #include "lightfarm/v1/job_service.pb.h"
 #include "lightfarm/v1/worker_service.pb.h"
@@ -30,5 +31,8 @@ void ToProto(const JobRecord& job, lightfarm::v1::Job* out);
 
 void ToProto(const TaskAssignment& task, lightfarm::v1::Task* out);
 TaskAssignment FromProto(const lightfarm::v1::Task& task);
+
+void ToProto(const RadiosityFigures& figures, lightfarm::v1::RadiosityReport* out);
+RadiosityFigures FromProto(const lightfarm::v1::RadiosityReport& report);
 
 }  // namespace lf

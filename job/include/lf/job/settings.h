@@ -1,0 +1,28 @@
+// The defaults of every render setting, in one place: `render`, `submit`, `plan`, `converge`,
+// `bench`, the coordinator and the workers all take theirs from here (through JobSpec,
+// RenderPlanSettings, RadiositySettings and AdaptiveSettings, whose members start at these), so
+// the same command line means the same render locally and on the farm.
+#pragma once
+
+#include <cstdint>
+
+namespace lf::defaults {
+
+inline constexpr uint64_t kSpp = 16;
+inline constexpr uint64_t kSeed = 0;
+inline constexpr int kTile = 32;
+inline constexpr int kPasses = 1;
+inline constexpr int kMaxDepth = -1;  // unlimited: Russian roulette ends paths
+inline constexpr const char* kMethod = "path";
+inline constexpr uint64_t kAdaptiveMaxSpp = uint64_t(1) << 16;
+
+inline constexpr int64_t kRadiosityPatches = 4000;
+// Jacobi: the farm splits each of its sweeps into patch-group tasks, and in one process it is
+// about as fast as Gauss-Seidel (docs/radiosity.md), so one solver serves both.
+inline constexpr const char* kRadiositySolver = "jacobi";
+inline constexpr double kRadiosityTolerance = 1e-4;
+inline constexpr int kRadiosityMaxIterations = 10000;
+inline constexpr const char* kRadiosityDisplay = "smooth";
+inline constexpr int kRadiositySweepTasks = 8;
+
+}  // namespace lf::defaults
