@@ -317,14 +317,14 @@ Command AddSubmitCommand(CLI::App& app) {
     cmd->add_option("--max-depth", o->spec.max_depth,
                     "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
         ->capture_default_str()
-        ->check(CLI::Range(-1, 1 << 20));
+        ->check(CLI::Range(-1, kMaxDepthLimit));
     cmd->add_option("--tile", o->spec.plan.tile, "tile side in pixels")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxFarmTile));
     cmd->add_option("--passes", o->spec.plan.passes,
                     "sample passes per tile; each pass of each tile is one task")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1 << 20));
+        ->check(CLI::Range(1, kMaxPasses));
     AddAdaptiveFlags(cmd, o->spec.adaptive);
     cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
@@ -333,7 +333,8 @@ Command AddSubmitCommand(CLI::App& app) {
                     "path, or radiosity (Lambertian scenes; same bits as `lightfarm render "
                     "--method radiosity` with the same options)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"path", "radiosity"}));
+        ->check(
+            CLI::IsMember(std::vector<std::string>(kRenderMethods.begin(), kRenderMethods.end())));
     // The farm's own solver: its sweeps split into patch-group tasks.
     o->spec.radiosity.solver = "jacobi";
     AddRadiosityFlags(cmd, o->spec.radiosity);

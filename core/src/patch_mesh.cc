@@ -27,12 +27,19 @@ int64_t PatchCount(const std::vector<double>& longest_edges, double size) {
 }
 
 // The largest patch size is one patch per triangle; halving finds a size that is too fine,
-// then bisection the coarsest size whose count still fits under the target.
+// then bisection the coarsest size whose count still fits under the target. Both loops are
+// bounded whatever the input: a target of at most kMaxPatches is exceeded after about 14
+// halvings of any edge that is not degenerate, and for one that is (every edge 0) the halving
+// gives up after kMaxHalvings.
 double PatchSizeForCount(const std::vector<double>& longest_edges, int64_t target) {
+    constexpr int kMaxHalvings = 64;
     double hi = *std::max_element(longest_edges.begin(), longest_edges.end());
     if (PatchCount(longest_edges, hi) >= target) return hi;
     double lo = hi;
-    while (PatchCount(longest_edges, lo) <= target) lo *= 0.5;
+    for (int halvings = 0; PatchCount(longest_edges, lo) <= target; ++halvings) {
+        if (halvings == kMaxHalvings) return hi;
+        lo *= 0.5;
+    }
     for (int iteration = 0; iteration < 64; ++iteration) {
         const double mid = std::sqrt(lo * hi);
         if (mid <= lo || mid >= hi) break;
@@ -193,6 +200,16 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
         }
     }
     if (longest_edges.empty()) return absl::InvalidArgumentError("radiosity: no triangles");
+    // Before the search: a target above the limit could never be met, and would only make
+    // the search look for a size it cannot find.
+    if (options.patch_size <= 0 && (options.patches < 1 || options.patches > kMaxPatches)) {
+        return absl::InvalidArgumentError(absl::StrCat("radiosity: target of ", options.patches,
+                                                       " patches: expected 1 to ", kMaxPatches));
+    }
+    if (!(options.patch_size >= 0 && std::isfinite(options.patch_size))) {
+        return absl::InvalidArgumentError(absl::StrCat("radiosity: patch size ", options.patch_size,
+                                                       ": expected a finite size, 0 or more"));
+    }
 
     pm.patch_size_ = options.patch_size > 0 ? options.patch_size
                                             : PatchSizeForCount(longest_edges, options.patches);
