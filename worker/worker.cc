@@ -49,16 +49,22 @@ void Worker::WaitIdle(absl::Duration d) {
 
 void Worker::Run() {
     absl::Duration idle = options_.min_idle;
-    bool reachable = true;
+    absl::StatusCode last = absl::StatusCode::kOk;  // logged when it changes, not every retry
     while (!stopping()) {
         absl::StatusOr<std::optional<TaskAssignment>> task = server_.Lease(options_.lease_wait);
-        if (task.ok() != reachable) {
-            reachable = task.ok();
-            if (reachable) {
+        if (task.status().code() != last) {
+            last = task.status().code();
+            const std::string why(task.status().message());
+            if (task.ok()) {
                 Log()->info("worker={} server reachable again", server_.worker_id());
+            } else if (last == absl::StatusCode::kFailedPrecondition) {
+                // Another build (LeaseTask's version check). Retried rather than exiting, so a
+                // server brought to this build gets its workers back without restarting them.
+                Log()->error("worker={} refused by the server, retrying until it accepts this "
+                             "build: {}",
+                             server_.worker_id(), why);
             } else {
-                Log()->warn("worker={} server unreachable, retrying: {}", server_.worker_id(),
-                            std::string(task.status().message()));
+                Log()->warn("worker={} server unreachable, retrying: {}", server_.worker_id(), why);
             }
         }
         if (!task.ok()) {
