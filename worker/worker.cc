@@ -106,14 +106,14 @@ void Worker::Execute(const TaskAssignment& task) {
     });
 
     const absl::Time start = absl::Now();
-    absl::Status status = PrepareScene(task);
+    absl::Status status = PrepareScene(task, cancel);
     ServerConnection::TaskResult result;
     if (status.ok() && task.sweep >= 0) {
         absl::StatusOr<std::string> swept = Sweep(task, cancel);
         status = swept.status();
         if (swept.ok()) result = {std::move(*swept), true};
     } else if (status.ok()) {
-        status = PrepareTracer(task);
+        status = PrepareTracer(task, cancel);
         if (status.ok()) result.bytes = EncodeTileSums(Render(task, cancel));
     }
     {
@@ -142,7 +142,7 @@ void Worker::Execute(const TaskAssignment& task) {
     }
 }
 
-absl::Status Worker::PrepareScene(const TaskAssignment& task) {
+absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel) {
     if (loaded_.job_id == task.job_id) return absl::OkStatus();
     loaded_ = {};
     auto fetch = [&](const std::string& hash, const std::string& path) {
@@ -151,7 +151,9 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
     std::vector<const BlobRef*> refs = {&task.spec.scene};
     for (const BlobRef& ref : task.spec.files) refs.push_back(&ref);
     std::map<std::string, std::string> files;  // hash -> cached file
+    auto cancelled = [&] { return absl::CancelledError("scene loading cancelled"); };
     for (const BlobRef* ref : refs) {
+        if (cancel) return cancelled();
         absl::StatusOr<std::string> path = cache_.Get(ref->hash, fetch);
         if (!path.ok()) return path.status();
         files[ref->hash] = *path;
@@ -161,6 +163,7 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
         options_.scratch_dir + "/" + task.job_id);
     cache_.Trim();
     if (!scene.ok()) return scene.status();
+    if (cancel) return cancelled();
     LoadedScene loaded;
     loaded.scene = std::make_unique<Scene>(std::move(*scene));
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*loaded.scene);
@@ -173,7 +176,7 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
     return absl::OkStatus();
 }
 
-absl::Status Worker::PrepareTracer(const TaskAssignment& task) {
+absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel) {
     if (loaded_.tracer) return absl::OkStatus();
     if (task.spec.method != "radiosity") {
         loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.spec.max_depth);
@@ -182,6 +185,7 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task) {
     absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);
     if (!options.ok()) return options.status();
     options->threads = options_.threads;
+    options->cancel = &cancel;  // meshing, form factors and the solve stop on a cancel
     absl::StatusOr<std::unique_ptr<RadiosityRenderer>> renderer;
     if (!task.radiosity_hash.empty()) {  // solved by the farm's sweeps
         absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task.radiosity_hash);

@@ -58,9 +58,10 @@ class Worker {
 
     void Execute(const TaskAssignment& task);
     // The job's scene, built once for consecutive tasks of the same job.
-    absl::Status PrepareScene(const TaskAssignment& task);
+    // Each returns Cancelled soon after `cancel` is set.
+    absl::Status PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // The job's path tracer or radiosity display, built once per job.
-    absl::Status PrepareTracer(const TaskAssignment& task);
+    absl::Status PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel);
     TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A radiosity vector the server stored as a blob.

@@ -1,6 +1,7 @@
 #include "lf/core/patch_mesh.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <compare>
 #include <limits>
@@ -47,6 +48,8 @@ double PatchSizeForCount(const std::vector<double>& longest_edges, int64_t targe
     }
     return hi;
 }
+
+absl::Status MeshingCancelled() { return absl::CancelledError("radiosity: meshing cancelled"); }
 
 double LongestEdge(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
     return std::sqrt(std::max({LengthSquared(b - a), LengthSquared(c - b), LengthSquared(a - c)}));
@@ -164,6 +167,9 @@ std::vector<GridTriangle> SubdivisionCells(int k) {
 }
 
 absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOptions& options) {
+    auto cancelled = [&] {
+        return options.cancel && options.cancel->load(std::memory_order_relaxed);
+    };
     if (!scene.spheres.empty()) {
         return absl::InvalidArgumentError(
             absl::StrCat("radiosity: sphere '", scene.spheres.front().name,
@@ -252,6 +258,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
                                  pa + (mesh.positions[b] - pa) * (double(position) / k));
         };
         for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+            if (cancelled()) return MeshingCancelled();
             const auto& tri = mesh.triangles[t];
             const Vec3d &p0 = mesh.positions[tri[0]], &p1 = mesh.positions[tri[1]],
                         &p2 = mesh.positions[tri[2]];
@@ -280,6 +287,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
             std::vector<uint32_t> grid;
             grid.reserve(size_t(k + 1) * (k + 2) / 2);
             for (int j = 0; j <= k; ++j) {
+                if (cancelled()) return MeshingCancelled();
                 for (int i = 0; i + j <= k; ++i) {
                     const uint32_t id = grid_vertex(k, i, j);
                     if (id == pm.vertices_.size()) {
@@ -339,6 +347,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
             const std::vector<GridTriangle> cells = SubdivisionCells(k);
             pm.nodes_.resize(pm.nodes_.size() + cells.size());
             for (size_t c = 0; c < cells.size(); ++c) {
+                if (c % 4096 == 0 && cancelled()) return MeshingCancelled();
                 emit(emit, info.first_node + int64_t(c), cells[c], 0);
             }
             info.end_patch = int64_t(pm.patches_.size());
@@ -364,6 +373,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
         const Material& material = scene.materials[size_t(mesh.material)];
         for (int back = 0; back < 2; ++back) {
             for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+                if (cancelled()) return MeshingCancelled();
                 const Triangle& info = pm.triangles_[size_t(pm.mesh_first_triangle_[m]) + t];
                 const Vec3d n = back ? -info.normal : info.normal;
                 const bool needed =

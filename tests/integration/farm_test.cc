@@ -681,5 +681,28 @@ TEST_F(Farm, ServerRefusesADataDirItCannotUse) {
               std::string::npos);
 }
 
+// SIGTERM in the middle of a radiosity task (form factors of 12k patches: half a minute) stops
+// the worker within a second, handing the task back.
+TEST_F(Farm, TerminatedWorkerStopsARadiosityTaskWithinASecond) {
+    StartServer();
+    Child* worker = StartWorker("w1");
+    const std::string job =
+        Submit(scene_, "--method radiosity --solver gauss-seidel --patches 12000");
+    ASSERT_TRUE(WaitForStatus(job, "1 running", milliseconds(20000)));
+    // Meshed (the radiosity log says so): the form factors have begun.
+    const auto meshed_by = Clock::now() + milliseconds(20000);
+    while (ReadText(dir_ / "w1.log").find("unknowns") == std::string::npos) {
+        ASSERT_LT(Clock::now(), meshed_by) << "the worker never meshed the scene";
+        std::this_thread::sleep_for(milliseconds(10));
+    }
+    const auto start = Clock::now();
+    worker->Signal(SIGTERM);
+    ASSERT_EQ(worker->Wait(milliseconds(5000)), std::optional<int>(0));
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    EXPECT_LT(seconds, 1.0);
+    std::printf("worker exited %.3f s after SIGTERM\n", seconds);
+    EXPECT_NE(ReadText(dir_ / "w1.log").find("handed back"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace lf
