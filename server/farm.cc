@@ -111,10 +111,8 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
             " samples per pixel is above this server's limit of ", options_.limits.max_spp,
             " (lightfarm-server --max-spp); lower --max-spp"));
     }
-    const std::string scratch = options_.data_dir + "/scratch/submit-" + UniqueSuffix();
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
-        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); },
-        scratch);
+        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); });
     if (!scene.ok()) {
         Log()->warn("submission of {} refused: {}", spec.scene.path,
                     std::string(scene.status().message()));

@@ -159,8 +159,7 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
         files[ref->hash] = *path;
     }
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
-        task.spec.scene, task.spec.files, [&](const std::string& hash) { return files[hash]; },
-        options_.scratch_dir + "/" + task.job_id);
+        task.spec.scene, task.spec.files, [&](const std::string& hash) { return files[hash]; });
     cache_.Trim();
     if (!scene.ok()) return scene.status();
     if (cancel) return cancelled();

@@ -26,7 +26,6 @@ namespace lf {
 
 struct WorkerOptions {
     int threads = 1;
-    std::string scratch_dir;  // where scenes are laid out while they load
     // An idle worker long-polls the server for this long per call...
     absl::Duration lease_wait = absl::Seconds(1);
     // ...and backs off from this to that while the server cannot be reached.
