@@ -159,13 +159,15 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
         files[ref->hash] = *path;
     }
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
-        task.spec.scene, task.spec.files, [&](const std::string& hash) { return files[hash]; });
+        task.spec.scene, task.spec.files, [&](const std::string& hash) { return files[hash]; },
+        &cancel);
     cache_.Trim();
     if (!scene.ok()) return scene.status();
     if (cancel) return cancelled();
     LoadedScene loaded;
     loaded.scene = std::make_unique<Scene>(std::move(*scene));
-    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*loaded.scene);
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree =
+        EmbreeScene::Build(*loaded.scene, &cancel);
     if (!embree.ok()) return embree.status();
     loaded.embree = std::move(*embree);
     loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());

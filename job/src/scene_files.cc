@@ -26,7 +26,8 @@ absl::Status CheckScenePath(const std::string& path) {
 
 absl::StatusOr<Scene> LoadSceneFromBlobs(
     const BlobRef& scene, const std::vector<BlobRef>& files,
-    const std::function<std::string(const std::string& hash)>& blob_file) {
+    const std::function<std::string(const std::string& hash)>& blob_file,
+    const std::atomic<bool>* cancel) {
     if (absl::Status s = CheckScenePath(scene.path); !s.ok()) return s;
     std::map<std::string, std::string> hash_of;  // by name
     for (const BlobRef& file : files) {
@@ -40,6 +41,7 @@ absl::StatusOr<Scene> LoadSceneFromBlobs(
     // The blob files are this machine's; a message says which upload failed, not where it is.
     auto read_blob = [&](const std::string& name,
                          const std::string& hash) -> absl::StatusOr<std::string> {
+        if (cancel && cancel->load()) return absl::CancelledError("loading cancelled");
         absl::StatusOr<std::string> bytes = ReadFile(blob_file(hash));
         if (!bytes.ok()) {
             return absl::InternalError(absl::StrCat("the uploaded ", name, " (blob ", hash,

@@ -117,6 +117,14 @@ TEST_F(SceneFilesTest, OneNameWithTwoContentsIsRefused) {
     EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument) << scene.status();
 }
 
+TEST_F(SceneFilesTest, LoadingStopsOnceCancelled) {
+    std::atomic<bool> cancel{true};
+    const absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
+        Put("scene.json", SceneNaming({"up.obj"})), {Put("up.obj", kTriangle)},
+        [&](const std::string& hash) { return (dir_ / "blobs" / hash).string(); }, &cancel);
+    EXPECT_TRUE(absl::IsCancelled(scene.status())) << scene.status();
+}
+
 TEST_F(SceneFilesTest, NamesAreKeysWithoutControlCharacters) {
     EXPECT_TRUE(CheckScenePath("../x.obj").ok());
     EXPECT_TRUE(CheckScenePath("/abs/x.obj").ok());

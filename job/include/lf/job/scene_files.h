@@ -4,6 +4,7 @@
 // with it and nothing else of the machine it is loaded on.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -33,9 +34,11 @@ absl::Status CheckScenePath(const std::string& path);
 // Parses the scene whose JSON is blob `scene`, reading the files it names from `files` by the
 // exact name in the JSON (`blob_file` maps a hash to the local file holding that blob). A name
 // not among `files` is an error naming the JSON field and the name only, whatever exists on this
-// machine. InvalidArgument also for two files of one name with different contents.
+// machine. InvalidArgument also for two files of one name with different contents; Cancelled
+// once `cancel` is set, checked before each file.
 absl::StatusOr<Scene> LoadSceneFromBlobs(
     const BlobRef& scene, const std::vector<BlobRef>& files,
-    const std::function<std::string(const std::string& hash)>& blob_file);
+    const std::function<std::string(const std::string& hash)>& blob_file,
+    const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace lf
