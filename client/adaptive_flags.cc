@@ -1,5 +1,6 @@
 #include "adaptive_flags.h"
 
+#include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 
 namespace lf {
@@ -12,12 +13,12 @@ void AddAdaptiveFlags(CLI::App* cmd, AdaptiveSettings& settings) {
                     "--method radiosity, also refine the mesh until its estimated "
                     "discretisation error is at most this (docs/radiosity.md)")
         ->group(a)
-        ->check(CLI::Range(1e-6, 1.0));
+        ->check(CLI::Range(kMinTargetError, kMaxTargetError));
     cmd->add_option("--time-limit", settings.time_limit,
                     "stop sampling about this many seconds after the render starts (every tile "
                     "gets its first pass); alone, tiles double their samples until then")
         ->group(a)
-        ->check(CLI::Range(1e-3, 1e7));
+        ->check(CLI::Range(kMinTimeLimit, kMaxTimeLimit));
     cmd->add_option("--max-spp", settings.max_spp, "most samples per pixel of an adaptive render")
         ->group(a)
         ->capture_default_str()

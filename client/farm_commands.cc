@@ -114,14 +114,18 @@ absl::StatusOr<std::string> ReadFile(const fs::path& path) {
     return text.str();
 }
 
-// Every string in the scene JSON that names a file beside it: the files the server and workers
-// need. Finding them by looking, not by schema, keeps this right as the format grows.
+// Every string in the scene JSON that names a file as `render` would find it (relative to the
+// scene's folder, `../` and absolute names included): the files the server and workers need,
+// keyed by the name as written, which is all the farm looks them up by. Finding them by looking,
+// not by schema, keeps this right as the format grows.
 void CollectFileNames(const nlohmann::json& node, const fs::path& dir,
                       std::map<std::string, fs::path>& found) {
     if (node.is_string()) {
         const std::string name = node.get<std::string>();
+        if (name.empty()) return;
+        const fs::path path = fs::path(name).is_absolute() ? fs::path(name) : dir / name;
         std::error_code ec;
-        if (!name.empty() && fs::is_regular_file(dir / name, ec)) found[name] = dir / name;
+        if (fs::is_regular_file(path, ec)) found[name] = path.lexically_normal();
     } else if (node.is_structured()) {
         for (const auto& child : node) CollectFileNames(child, dir, found);
     }
@@ -360,7 +364,8 @@ Command AddSubmitCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "submit",
         "Send a scene to a lightfarm-server as a job and print its id (the last line).\n"
-        "The scene file and every file it names beside it (meshes) are uploaded; files the\n"
+        "The scene file and every file it names (meshes; wherever `render` would find them)\n"
+        "are uploaded, and the farm reads only those; files the\n"
         "server already has are not sent again. Same settings give the same bits as\n"
         "`lightfarm render`, whatever the tile size, passes or workers.");
     cmd->add_option("scene", o->scene_path, "scene file (JSON)")
@@ -375,14 +380,14 @@ Command AddSubmitCommand(CLI::App& app) {
     cmd->add_option("--max-depth", o->spec.max_depth,
                     "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
         ->capture_default_str()
-        ->check(CLI::Range(-1, 1 << 20));
+        ->check(CLI::Range(-1, kMaxDepthLimit));
     cmd->add_option("--tile", o->spec.plan.tile, "tile side in pixels")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxFarmTile));
     cmd->add_option("--passes", o->spec.plan.passes,
                     "sample passes per tile; each pass of each tile is one task")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1 << 20));
+        ->check(CLI::Range(1, kMaxPasses));
     AddAdaptiveFlags(cmd, o->spec.adaptive);
     cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
@@ -391,7 +396,8 @@ Command AddSubmitCommand(CLI::App& app) {
                     "path, or radiosity (Lambertian scenes; same bits as `lightfarm render "
                     "--method radiosity` with the same options)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"path", "radiosity"}));
+        ->check(
+            CLI::IsMember(std::vector<std::string>(kRenderMethods.begin(), kRenderMethods.end())));
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
                     "--solver jacobi: patch-group tasks per sweep; each worker computes the "

@@ -1,5 +1,9 @@
 #include "radiosity_flags.h"
 
+#include <limits>
+#include <vector>
+
+#include "lf/job/job_spec.h"
 #include "absl/strings/str_cat.h"
 #include "lf/kernels/radiosity.h"
 
@@ -7,6 +11,11 @@ namespace lf {
 
 namespace {
 constexpr const char* kGroup = "Radiosity";
+
+template <size_t N>
+CLI::IsMember OneOf(const std::array<std::string_view, N>& names) {
+    return CLI::IsMember(std::vector<std::string>(names.begin(), names.end()));
+}
 }  // namespace
 
 void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
@@ -14,11 +23,11 @@ void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
     cmd->add_option("--patch-size", settings.patch_size,
                     "longest patch edge in scene units (overrides --patches)")
         ->group(group)
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::Range(0.0, std::numeric_limits<double>::max()));
     cmd->add_option("--patches", settings.patches, "target number of patches")
         ->group(group)
         ->capture_default_str()
-        ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
+        ->check(CLI::Range(int64_t(1), kMaxPatchTarget));
     cmd->add_option("--max-patches", settings.max_patches,
                     "with --target-error: most patches mesh refinement may reach (0: 16 times "
                     "--patches)")
@@ -28,12 +37,12 @@ void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
     cmd->add_option("--solver", settings.solver, "jacobi, gauss-seidel or shooting")
         ->group(group)
         ->capture_default_str()
-        ->check(CLI::IsMember({"jacobi", "gauss-seidel", "shooting"}));
+        ->check(OneOf(kRadiositySolvers));
     cmd->add_option("--tolerance", settings.tolerance,
                     "stop when the relative residual (area-weighted L1) is below this")
         ->group(group)
         ->capture_default_str()
-        ->check(CLI::Range(1e-12, 1.0));
+        ->check(CLI::Range(kMinTolerance, kMaxTolerance));
     cmd->add_option("--max-iterations", settings.max_iterations,
                     "fail if not converged after this many iterations")
         ->group(group)
@@ -43,7 +52,7 @@ void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
                     "flat (one value per patch) or smooth (interpolated at vertices)")
         ->group(group)
         ->capture_default_str()
-        ->check(CLI::IsMember({"flat", "smooth"}));
+        ->check(OneOf(kRadiosityDisplays));
 }
 
 absl::StatusOr<RadiosityOptions> RadiosityOptionsOf(const RadiositySettings& settings) {

@@ -5,6 +5,7 @@
 #include "absl/strings/str_cat.h"
 #include "adaptive_flags.h"
 #include "command.h"
+#include "lf/job/job_spec.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
 
@@ -42,12 +43,12 @@ Command AddRenderCommand(CLI::App& app) {
     cmd->add_option("--png", options->png_path, "also write an sRGB PNG preview (clamped)");
     cmd->add_option("--spp", options->render.spp, "samples per pixel")
         ->capture_default_str()
-        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 24));
+        ->check(CLI::Range(uint64_t(1), kMaxSpp));
     cmd->add_option("--seed", options->render.seed, "random seed")->capture_default_str();
     cmd->add_option("--max-depth", options->max_depth,
                     "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
         ->capture_default_str()
-        ->check(CLI::Range(-1, 1 << 20));
+        ->check(CLI::Range(-1, kMaxDepthLimit));
     cmd->add_option("--threads", options->render.threads, "worker threads; 0 = all cores")
         ->capture_default_str()
         ->check(CLI::Range(0, 1024));

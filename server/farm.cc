@@ -20,33 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Checked here so a bad job is refused at submission rather than failing on every worker.
-absl::Status CheckMethod(const JobSpec& spec) {
-    if (spec.method == "path") return absl::OkStatus();
-    if (spec.method != "radiosity") {
-        return absl::InvalidArgumentError(
-            absl::StrCat("method \"", spec.method, "\": expected path or radiosity"));
-    }
-    const RadiositySettings& r = spec.radiosity;
-    if (r.solver != "jacobi" && r.solver != "gauss-seidel" && r.solver != "shooting") {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "radiosity solver \"", r.solver, "\": expected jacobi, gauss-seidel or shooting"));
-    }
-    if (r.display != "flat" && r.display != "smooth") {
-        return absl::InvalidArgumentError(
-            absl::StrCat("radiosity display \"", r.display, "\": expected flat or smooth"));
-    }
-    if (r.patches < 1 || !(r.patch_size >= 0) || !(r.tolerance > 0 && r.tolerance < 1) ||
-        r.max_iterations < 1 || r.sweep_tasks < 1 || r.sweep_tasks > kMaxSweepTasks ||
-        r.max_patches < 0 || r.max_patches > kMaxRefinedPatches) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "radiosity: patches and max iterations must be positive, patch size not negative, "
-            "tolerance in (0, 1), sweep tasks in 1..",
-            kMaxSweepTasks, ", max patches in 0..", kMaxRefinedPatches));
-    }
-    return absl::OkStatus();
-}
-
 absl::Status CheckRadiosityCanModel(const Scene& scene) {
     for (const Material& m : scene.materials) {
         if (m.type != Material::Type::kLambert) {
@@ -119,6 +92,9 @@ absl::StatusOr<std::unique_ptr<BlobStore::Upload>> Farm::StartUpload(const std::
 }
 
 absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
+    // The CLI's limits (lf/job/job_spec.h): a bad job is refused here rather than failing, or
+    // running without end, on every worker.
+    if (absl::Status s = CheckJobSettings(spec); !s.ok()) return s;
     if (spec.name.size() > kMaxJobNameBytes) {
         return absl::InvalidArgumentError(absl::StrCat(
             "job name of ", spec.name.size(), " bytes is above the limit of ", kMaxJobNameBytes));
@@ -152,27 +128,14 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
                                                            " bytes, its blob holds ", *size));
         }
     }
-    if (spec.plan.tile > kMaxFarmTile) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("tile ", spec.plan.tile, " is above ", kMaxFarmTile,
-                         ", the largest whose result fits one message"));
-    }
-    if (spec.max_depth < -1) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("max depth ", spec.max_depth, " is below -1 (unlimited)"));
-    }
-    if (absl::Status s = CheckMethod(spec); !s.ok()) return s;
-    if (absl::Status s = CheckAdaptiveSettings(spec.adaptive); !s.ok()) return s;
     if (IsAdaptive(spec.adaptive) && spec.adaptive.max_spp > options_.limits.max_spp) {
         return absl::ResourceExhaustedError(absl::StrCat(
             "adaptive sampling up to ", spec.adaptive.max_spp,
             " samples per pixel is above this server's limit of ", options_.limits.max_spp,
             " (lightfarm-server --max-spp); lower --max-spp"));
     }
-    const std::string scratch = options_.data_dir + "/scratch/submit-" + UniqueSuffix();
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
-        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); },
-        scratch);
+        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); });
     if (!scene.ok()) {
         Log()->warn("submission of {} refused: {}", spec.scene.path,
                     std::string(scene.status().message()));

@@ -6,8 +6,9 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "lf/core/log.h"
-#include "proto/grpc_status.h"
+#include "lf/version.h"
 #include "lf/wire/conversions.h"
+#include "proto/grpc_status.h"
 
 namespace lf {
 
@@ -183,6 +184,11 @@ grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext*, const pb::LeaseT
                                           pb::LeaseTaskResponse* resp) {
     if (req->worker_id().empty()) {
         return ToGrpcStatus(absl::InvalidArgumentError("LeaseTask: worker_id is empty"));
+    }
+    if (req->version() != kBuildVersion) {
+        return ToGrpcStatus(absl::FailedPreconditionError(absl::StrCat(
+            "worker version ", req->version().empty() ? "(none)" : req->version(),
+            ", server version ", kBuildVersion, ": run workers of the server's build")));
     }
     const absl::Duration wait = absl::Milliseconds(std::clamp(req->wait_ms(), 0, 10000));
     if (std::optional<TaskAssignment> lease =

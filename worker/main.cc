@@ -5,7 +5,6 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <filesystem>
 #include <thread>
 
 #include "lf/core/stop_signals.h"
@@ -44,7 +43,6 @@ int main(int argc, char** argv) {
     char host[256] = "worker";
     gethostname(host, sizeof host - 1);
     const std::string id = std::string(host) + "-" + std::to_string(::getpid());
-    options.scratch_dir = cache_dir + "/scratch-" + std::to_string(::getpid());
     lf::ServerConnection connection(server, id);
     lf::Worker worker(options, connection, **cache);
     spdlog::info("worker={} serving {} with {} threads", id, server, options.threads);
@@ -56,7 +54,5 @@ int main(int argc, char** argv) {
     });
     worker.Run();
     signal_waiter.join();
-    std::error_code ignored;
-    std::filesystem::remove_all(options.scratch_dir, ignored);
     return 0;
 }

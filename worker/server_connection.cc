@@ -4,9 +4,10 @@
 
 #include <fstream>
 
+#include "lf/version.h"
+#include "lf/wire/conversions.h"
 #include "lightfarm/v1/worker_service.grpc.pb.h"
 #include "proto/grpc_status.h"
-#include "lf/wire/conversions.h"
 
 namespace lf {
 
@@ -34,6 +35,7 @@ absl::StatusOr<std::optional<TaskAssignment>> ServerConnection::Lease(absl::Dura
     pb::LeaseTaskRequest req;
     req.set_worker_id(worker_id_);
     req.set_wait_ms(int(absl::ToInt64Milliseconds(wait)));
+    req.set_version(kBuildVersion);
     pb::LeaseTaskResponse resp;
     // Waiting for the connection (rather than failing at once while the channel is in
     // backoff) is what makes the channel reconnect as soon as a restarted server listens.

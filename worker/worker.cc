@@ -49,16 +49,22 @@ void Worker::WaitIdle(absl::Duration d) {
 
 void Worker::Run() {
     absl::Duration idle = options_.min_idle;
-    bool reachable = true;
+    absl::StatusCode last = absl::StatusCode::kOk;  // logged when it changes, not every retry
     while (!stopping()) {
         absl::StatusOr<std::optional<TaskAssignment>> task = server_.Lease(options_.lease_wait);
-        if (task.ok() != reachable) {
-            reachable = task.ok();
-            if (reachable) {
+        if (task.status().code() != last) {
+            last = task.status().code();
+            const std::string why(task.status().message());
+            if (task.ok()) {
                 Log()->info("worker={} server reachable again", server_.worker_id());
+            } else if (last == absl::StatusCode::kFailedPrecondition) {
+                // Another build (LeaseTask's version check). Retried rather than exiting, so a
+                // server brought to this build gets its workers back without restarting them.
+                Log()->error("worker={} refused by the server, retrying until it accepts this "
+                             "build: {}",
+                             server_.worker_id(), why);
             } else {
-                Log()->warn("worker={} server unreachable, retrying: {}", server_.worker_id(),
-                            std::string(task.status().message()));
+                Log()->warn("worker={} server unreachable, retrying: {}", server_.worker_id(), why);
             }
         }
         if (!task.ok()) {
@@ -100,14 +106,14 @@ void Worker::Execute(const TaskAssignment& task) {
     });
 
     const absl::Time start = absl::Now();
-    absl::Status status = PrepareScene(task);
+    absl::Status status = PrepareScene(task, cancel);
     ServerConnection::TaskResult result;
     if (status.ok() && task.sweep >= 0) {
         absl::StatusOr<std::string> swept = Sweep(task, cancel);
         status = swept.status();
         if (swept.ok()) result = {std::move(*swept), true, std::nullopt};
     } else if (status.ok()) {
-        status = PrepareTracer(task);
+        status = PrepareTracer(task, cancel);
         if (status.ok()) result.bytes = EncodeTileSums(Render(task, cancel));
         if (const auto* r = dynamic_cast<const RadiosityRenderer*>(loaded_.tracer.get())) {
             result.radiosity = RadiosityFiguresOf(r->report());
@@ -139,7 +145,7 @@ void Worker::Execute(const TaskAssignment& task) {
     }
 }
 
-absl::Status Worker::PrepareScene(const TaskAssignment& task) {
+absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel) {
     if (loaded_.job_id == task.job_id) return absl::OkStatus();
     loaded_ = {};
     auto fetch = [&](const std::string& hash, const std::string& path) {
@@ -148,19 +154,23 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
     std::vector<const BlobRef*> refs = {&task.spec.scene};
     for (const BlobRef& ref : task.spec.files) refs.push_back(&ref);
     std::map<std::string, std::string> files;  // hash -> cached file
+    auto cancelled = [&] { return absl::CancelledError("scene loading cancelled"); };
     for (const BlobRef* ref : refs) {
+        if (cancel) return cancelled();
         absl::StatusOr<std::string> path = cache_.Get(ref->hash, fetch);
         if (!path.ok()) return path.status();
         files[ref->hash] = *path;
     }
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
         task.spec.scene, task.spec.files, [&](const std::string& hash) { return files[hash]; },
-        options_.scratch_dir + "/" + task.job_id);
+        &cancel);
     cache_.Trim();
     if (!scene.ok()) return scene.status();
+    if (cancel) return cancelled();
     LoadedScene loaded;
     loaded.scene = std::make_unique<Scene>(std::move(*scene));
-    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*loaded.scene);
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree =
+        EmbreeScene::Build(*loaded.scene, &cancel);
     if (!embree.ok()) return embree.status();
     loaded.embree = std::move(*embree);
     loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
@@ -170,7 +180,7 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task) {
     return absl::OkStatus();
 }
 
-absl::Status Worker::PrepareTracer(const TaskAssignment& task) {
+absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel) {
     if (loaded_.tracer) return absl::OkStatus();
     if (task.spec.method != "radiosity") {
         loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.spec.max_depth);
@@ -179,6 +189,7 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task) {
     absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);
     if (!options.ok()) return options.status();
     options->threads = options_.threads;
+    options->cancel = &cancel;  // meshing, form factors and the solve stop on a cancel
     absl::StatusOr<std::unique_ptr<RadiosityRenderer>> renderer;
     if (!task.radiosity_hash.empty()) {  // solved by the farm's sweeps
         absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task.radiosity_hash);

@@ -26,7 +26,6 @@ namespace lf {
 
 struct WorkerOptions {
     int threads = 1;
-    std::string scratch_dir;  // where scenes are laid out while they load
     // An idle worker long-polls the server for this long per call...
     absl::Duration lease_wait = absl::Seconds(1);
     // ...and backs off from this to that while the server cannot be reached.
@@ -58,9 +57,10 @@ class Worker {
 
     void Execute(const TaskAssignment& task);
     // The job's scene, built once for consecutive tasks of the same job.
-    absl::Status PrepareScene(const TaskAssignment& task);
+    // Each returns Cancelled soon after `cancel` is set.
+    absl::Status PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // The job's path tracer or radiosity display, built once per job.
-    absl::Status PrepareTracer(const TaskAssignment& task);
+    absl::Status PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel);
     TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A radiosity vector the server stored as a blob.

@@ -416,25 +416,29 @@ TriangleMesh ParsePly(std::string_view bytes) {
 
 }  // namespace
 
-absl::StatusOr<TriangleMesh> LoadMesh(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
+absl::StatusOr<TriangleMesh> ParseMesh(const std::string& bytes, const std::string& name) {
+    std::string extension = std::filesystem::path(name).extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
     if (extension != ".obj" && extension != ".ply") {
-        return absl::InvalidArgumentError(absl::StrCat(path, ": unknown mesh format \"", extension,
+        return absl::InvalidArgumentError(absl::StrCat(name, ": unknown mesh format \"", extension,
                                                        "\" (expected .obj or .ply)"));
     }
-    absl::StatusOr<std::string> bytes = ReadFile(path);
-    if (!bytes.ok()) return bytes.status();
     try {
-        TriangleMesh mesh = extension == ".obj" ? ParseObj(*bytes) : ParsePly(*bytes);
+        TriangleMesh mesh = extension == ".obj" ? ParseObj(bytes) : ParsePly(bytes);
         if (mesh.positions.empty()) Fail("", "no vertices");
         if (mesh.triangles.empty()) Fail("", "no faces");
-        mesh.name = std::filesystem::path(path).stem().string();
+        mesh.name = std::filesystem::path(name).stem().string();
         return mesh;
     } catch (const MeshError& e) {
-        return absl::InvalidArgumentError(absl::StrCat(path, e.where, ": ", e.message));
+        return absl::InvalidArgumentError(absl::StrCat(name, e.where, ": ", e.message));
     }
+}
+
+absl::StatusOr<TriangleMesh> LoadMesh(const std::string& path) {
+    absl::StatusOr<std::string> bytes = ReadFile(path);
+    if (!bytes.ok()) return bytes.status();
+    return ParseMesh(*bytes, path);
 }
 
 }  // namespace lf

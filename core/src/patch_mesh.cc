@@ -1,6 +1,7 @@
 #include "lf/core/patch_mesh.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <compare>
 #include <limits>
@@ -27,12 +28,19 @@ int64_t PatchCount(const std::vector<double>& longest_edges, double size) {
 }
 
 // The largest patch size is one patch per triangle; halving finds a size that is too fine,
-// then bisection the coarsest size whose count still fits under the target.
+// then bisection the coarsest size whose count still fits under the target. Both loops are
+// bounded whatever the input: a target of at most kMaxPatches is exceeded after about 14
+// halvings of any edge that is not degenerate, and for one that is (every edge 0) the halving
+// gives up after kMaxHalvings.
 double PatchSizeForCount(const std::vector<double>& longest_edges, int64_t target) {
+    constexpr int kMaxHalvings = 64;
     double hi = *std::max_element(longest_edges.begin(), longest_edges.end());
     if (PatchCount(longest_edges, hi) >= target) return hi;
     double lo = hi;
-    while (PatchCount(longest_edges, lo) <= target) lo *= 0.5;
+    for (int halvings = 0; PatchCount(longest_edges, lo) <= target; ++halvings) {
+        if (halvings == kMaxHalvings) return hi;
+        lo *= 0.5;
+    }
     for (int iteration = 0; iteration < 64; ++iteration) {
         const double mid = std::sqrt(lo * hi);
         if (mid <= lo || mid >= hi) break;
@@ -40,6 +48,8 @@ double PatchSizeForCount(const std::vector<double>& longest_edges, int64_t targe
     }
     return hi;
 }
+
+absl::Status MeshingCancelled() { return absl::CancelledError("radiosity: meshing cancelled"); }
 
 double LongestEdge(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
     return std::sqrt(std::max({LengthSquared(b - a), LengthSquared(c - b), LengthSquared(a - c)}));
@@ -157,6 +167,9 @@ std::vector<GridTriangle> SubdivisionCells(int k) {
 }
 
 absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOptions& options) {
+    auto cancelled = [&] {
+        return options.cancel && options.cancel->load(std::memory_order_relaxed);
+    };
     if (!scene.spheres.empty()) {
         return absl::InvalidArgumentError(
             absl::StrCat("radiosity: sphere '", scene.spheres.front().name,
@@ -193,6 +206,16 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
         }
     }
     if (longest_edges.empty()) return absl::InvalidArgumentError("radiosity: no triangles");
+    // Before the search: a target above the limit could never be met, and would only make
+    // the search look for a size it cannot find.
+    if (options.patch_size <= 0 && (options.patches < 1 || options.patches > kMaxPatches)) {
+        return absl::InvalidArgumentError(absl::StrCat("radiosity: target of ", options.patches,
+                                                       " patches: expected 1 to ", kMaxPatches));
+    }
+    if (!(options.patch_size >= 0 && std::isfinite(options.patch_size))) {
+        return absl::InvalidArgumentError(absl::StrCat("radiosity: patch size ", options.patch_size,
+                                                       ": expected a finite size, 0 or more"));
+    }
 
     pm.patch_size_ = options.patch_size > 0 ? options.patch_size
                                             : PatchSizeForCount(longest_edges, options.patches);
@@ -235,6 +258,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
                                  pa + (mesh.positions[b] - pa) * (double(position) / k));
         };
         for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+            if (cancelled()) return MeshingCancelled();
             const auto& tri = mesh.triangles[t];
             const Vec3d &p0 = mesh.positions[tri[0]], &p1 = mesh.positions[tri[1]],
                         &p2 = mesh.positions[tri[2]];
@@ -263,6 +287,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
             std::vector<uint32_t> grid;
             grid.reserve(size_t(k + 1) * (k + 2) / 2);
             for (int j = 0; j <= k; ++j) {
+                if (cancelled()) return MeshingCancelled();
                 for (int i = 0; i + j <= k; ++i) {
                     const uint32_t id = grid_vertex(k, i, j);
                     if (id == pm.vertices_.size()) {
@@ -322,6 +347,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
             const std::vector<GridTriangle> cells = SubdivisionCells(k);
             pm.nodes_.resize(pm.nodes_.size() + cells.size());
             for (size_t c = 0; c < cells.size(); ++c) {
+                if (c % 4096 == 0 && cancelled()) return MeshingCancelled();
                 emit(emit, info.first_node + int64_t(c), cells[c], 0);
             }
             info.end_patch = int64_t(pm.patches_.size());
@@ -347,6 +373,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
         const Material& material = scene.materials[size_t(mesh.material)];
         for (int back = 0; back < 2; ++back) {
             for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+                if (cancelled()) return MeshingCancelled();
                 const Triangle& info = pm.triangles_[size_t(pm.mesh_first_triangle_[m]) + t];
                 const Vec3d n = back ? -info.normal : info.normal;
                 const bool needed =

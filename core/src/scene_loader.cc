@@ -314,7 +314,7 @@ int DropDegenerate(TriangleMesh& mesh) {
 
 class SceneParser {
   public:
-    explicit SceneParser(std::string base_dir) : base_dir_(std::move(base_dir)) {}
+    explicit SceneParser(const SceneFileReader& read_file) : read_file_(read_file) {}
 
     Scene Parse(const Json& json, const std::string& text) {
         hash_.Update(text);
@@ -502,27 +502,28 @@ class SceneParser {
 
     TriangleMesh LoadMeshShape(const Node& n) {
         const Node file = n.Get("file");
-        std::filesystem::path path(file.String());
-        if (path.empty()) file.Fail("empty file name");
-        if (path.is_relative()) path = std::filesystem::path(base_dir_) / path;
-        const std::string resolved = path.lexically_normal().string();
-
-        auto cached = mesh_cache_.find(resolved);
+        const std::string name = file.String();
+        if (name.empty()) file.Fail("empty file name");
+        // Errors name the file as the scene does, never where a reader found it.
+        auto fail = [&](const absl::Status& status) {
+            throw LoadError{absl::Status(
+                status.code(), absl::StrCat(file.path(), " \"", name, "\": ", status.message()))};
+        };
+        // Keyed by the name as written ("./m.obj" is "m.obj"), never by where the reader found
+        // it: the same keys, so the same content hash, on the farm as on the user's disk.
+        const std::string key = std::filesystem::path(name).lexically_normal().string();
+        auto cached = mesh_cache_.find(key);
         if (cached == mesh_cache_.end()) {
-            absl::StatusOr<TriangleMesh> loaded = LoadMesh(resolved);
+            absl::StatusOr<std::string> bytes = read_file_(name);
+            if (!bytes.ok()) fail(bytes.status());
+            absl::StatusOr<TriangleMesh> loaded = ParseMesh(*bytes, name);
             if (!loaded.ok()) {
                 throw LoadError{
                     absl::Status(loaded.status().code(),
                                  absl::StrCat(file.path(), ": ", loaded.status().message()))};
             }
-            absl::StatusOr<std::string> bytes = ReadFile(resolved);
-            if (!bytes.ok()) {
-                throw LoadError{
-                    absl::Status(bytes.status().code(),
-                                 absl::StrCat(file.path(), ": ", bytes.status().message()))};
-            }
             hash_.Update(*bytes);
-            cached = mesh_cache_.emplace(resolved, *std::move(loaded)).first;
+            cached = mesh_cache_.emplace(key, *std::move(loaded)).first;
         }
         TriangleMesh mesh = cached->second;
 
@@ -536,7 +537,7 @@ class SceneParser {
         }
         for (const Vec3d& p : mesh.positions) {
             if (MaxComponent(Abs(p)) > kMaxCoordinate) {
-                n.Fail(absl::StrCat("a vertex of ", resolved, " lies beyond ±1e15",
+                n.Fail(absl::StrCat("a vertex of ", name, " lies beyond ±1e15",
                                     n.Has("transform") ? " after the transform" : "", ": (", p.x,
                                     ", ", p.y, ", ", p.z, ")"));
             }
@@ -562,7 +563,7 @@ class SceneParser {
         return light;
     }
 
-    std::string base_dir_;
+    const SceneFileReader& read_file_;
     std::vector<std::string> warnings_;
     std::map<std::string, int> material_index_;
     std::map<std::string, TriangleMesh> mesh_cache_;
@@ -572,18 +573,26 @@ class SceneParser {
 
 }  // namespace
 
+SceneFileReader ReadBeside(const std::string& base_dir) {
+    return [base_dir](const std::string& name) {
+        std::filesystem::path path(name);
+        if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
+        return ReadFile(path.lexically_normal().string());
+    };
+}
+
 absl::StatusOr<Scene> LoadScene(const std::string& path) {
     absl::StatusOr<std::string> text = ReadFile(path);
     if (!text.ok()) return text.status();
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    return ParseScene(*text, path, parent.empty() ? "." : parent.string());
+    return ParseScene(*text, path, ReadBeside(parent.empty() ? "." : parent.string()));
 }
 
 absl::StatusOr<Scene> ParseScene(const std::string& json_text, const std::string& source,
-                                 const std::string& base_dir) {
+                                 const SceneFileReader& read_file) {
     Json root;
     if (absl::Status status = ParseJson(json_text, source, root); !status.ok()) return status;
-    SceneParser parser(base_dir);
+    SceneParser parser(read_file);
     absl::StatusOr<Scene> scene;
     try {
         scene = parser.Parse(root, json_text);

@@ -1,57 +1,65 @@
 #include "lf/job/scene_files.h"
 
-#include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <map>
 
-#include "absl/strings/str_split.h"
+#include "absl/strings/escaping.h"
+#include "absl/strings/str_cat.h"
+#include "lf/core/file_util.h"
 #include "lf/core/scene_loader.h"
 
 namespace lf {
 
-namespace fs = std::filesystem;
-
 absl::Status CheckScenePath(const std::string& path) {
-    bool ok = !path.empty() && path[0] != '/' && path.find('\\') == std::string::npos;
-    for (absl::string_view part : absl::StrSplit(path, '/')) {
-        ok = ok && !part.empty() && part != "." && part != "..";
+    if (path.empty() || path.size() > kMaxScenePathBytes) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "scene file name of ", path.size(), " bytes: expected 1 to ", kMaxScenePathBytes));
     }
-    if (ok) return absl::OkStatus();
-    return absl::InvalidArgumentError(
-        "scene file path '" + path +
-        "' must be relative to the scene's folder and stay inside it (no '..', not absolute)");
+    for (unsigned char c : path) {
+        if (c < 0x20 || c == 0x7f) {
+            return absl::InvalidArgumentError(
+                absl::StrCat("scene file name with control character ", int(c), ": \"",
+                             absl::CHexEscape(path), "\""));
+        }
+    }
+    return absl::OkStatus();
 }
 
 absl::StatusOr<Scene> LoadSceneFromBlobs(
     const BlobRef& scene, const std::vector<BlobRef>& files,
     const std::function<std::string(const std::string& hash)>& blob_file,
-    const std::string& scratch_dir) {
+    const std::atomic<bool>* cancel) {
     if (absl::Status s = CheckScenePath(scene.path); !s.ok()) return s;
-    std::error_code ec;
-    fs::create_directories(scratch_dir, ec);
-    if (ec) return absl::InternalError(scratch_dir + ": " + ec.message());
-    struct Cleanup {
-        std::string dir;
-        ~Cleanup() {
-            std::error_code ignored;
-            fs::remove_all(dir, ignored);
-        }
-    } cleanup{scratch_dir};
-
+    std::map<std::string, std::string> hash_of;  // by name
     for (const BlobRef& file : files) {
         if (absl::Status s = CheckScenePath(file.path); !s.ok()) return s;
-        const fs::path target = fs::path(scratch_dir) / file.path;
-        fs::create_directories(target.parent_path(), ec);
-        // A hard link costs nothing; a copy works across file systems.
-        fs::create_hard_link(blob_file(file.hash), target, ec);
-        if (ec) fs::copy_file(blob_file(file.hash), target, ec);
-        if (ec) return absl::InternalError(file.path + ": " + ec.message());
+        const auto [it, inserted] = hash_of.emplace(file.path, file.hash);
+        if (!inserted && it->second != file.hash) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                scene.path, ": \"", file.path, "\" uploaded twice with different contents"));
+        }
     }
-    std::ifstream in(blob_file(scene.hash), std::ios::binary);
-    if (!in) return absl::InternalError(scene.path + ": its blob cannot be read");
-    std::stringstream json;
-    json << in.rdbuf();
-    return ParseScene(json.str(), scene.path, scratch_dir);
+    // The blob files are this machine's; a message says which upload failed, not where it is.
+    auto read_blob = [&](const std::string& name,
+                         const std::string& hash) -> absl::StatusOr<std::string> {
+        if (cancel && cancel->load()) return absl::CancelledError("loading cancelled");
+        absl::StatusOr<std::string> bytes = ReadFile(blob_file(hash));
+        if (!bytes.ok()) {
+            return absl::InternalError(absl::StrCat("the uploaded ", name, " (blob ", hash,
+                                                    ") cannot be read on this machine"));
+        }
+        return bytes;
+    };
+    const SceneFileReader read_uploaded =
+        [&](const std::string& name) -> absl::StatusOr<std::string> {
+        const auto it = hash_of.find(name);
+        if (it == hash_of.end()) {
+            return absl::NotFoundError("not among the files uploaded with the scene");
+        }
+        return read_blob(name, it->second);
+    };
+    absl::StatusOr<std::string> json = read_blob(scene.path, scene.hash);
+    if (!json.ok()) return json.status();
+    return ParseScene(*json, scene.path, read_uploaded);
 }
 
 }  // namespace lf

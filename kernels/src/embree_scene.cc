@@ -25,7 +25,13 @@ namespace {
 constexpr float kTNear = std::numeric_limits<float>::min();
 
 void OnEmbreeError(void*, RTCError code, const char* message) {
+    if (code == RTC_ERROR_CANCELLED) return;  // asked for: Build says so
     spdlog::error("embree: error {}: {}", int(code), message ? message : "");
+}
+
+// False stops the build.
+bool KeepBuilding(void* cancel, double) {
+    return !static_cast<const std::atomic<bool>*>(cancel)->load(std::memory_order_relaxed);
 }
 
 }  // namespace
@@ -64,7 +70,8 @@ EmbreeScene::~EmbreeScene() {
     if (handles_->device) rtcReleaseDevice(handles_->device);
 }
 
-absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& scene) {
+absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& scene,
+                                                                const std::atomic<bool>* cancel) {
     const auto [lo, hi] = scene.Bounds();
     const Vec3d origin = (lo + hi) * 0.5;
     std::unique_ptr<EmbreeScene> es(new EmbreeScene(scene, origin));
@@ -76,6 +83,10 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
     // Robust mode keeps the triangle test watertight along shared edges: no light leaks.
     rtcSetSceneFlags(h.scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(h.scene, RTC_BUILD_QUALITY_HIGH);
+    if (cancel) {
+        rtcSetSceneProgressMonitorFunction(h.scene, KeepBuilding,
+                                           const_cast<void*>(static_cast<const void*>(cancel)));
+    }
 
     es->positions_.resize(scene.meshes.size());
     h.vertex_buffers.resize(scene.meshes.size());
@@ -116,6 +127,7 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
         rtcReleaseGeometry(geom);
     }
     rtcCommitScene(h.scene);
+    if (cancel && cancel->load()) return absl::CancelledError("embree: scene build cancelled");
     if (rtcGetDeviceError(h.device) != RTC_ERROR_NONE) {
         return absl::InternalError("embree: scene build failed (see log)");
     }

@@ -580,7 +580,10 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
     std::vector<std::pair<int32_t, int32_t>> tasks;
     std::vector<bool> evaluated(groups.size() * groups.size(), false);
     int64_t total_work = 0;
-    for (int32_t i = 0; i < int32_t(groups.size()); ++i) {
+    auto cancelled = [&] {
+        return options.cancel && options.cancel->load(std::memory_order_relaxed);
+    };
+    for (int32_t i = 0; i < int32_t(groups.size()) && !cancelled(); ++i) {
         for (int32_t j = i; j < int32_t(groups.size()); ++j) {
             if (!wanted(i) && !wanted(j)) continue;
             if (i == j && planes[size_t(i)].planar) continue;
@@ -600,13 +603,14 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
     std::vector<FormFactorWork> task_work(tasks.size());
     ProgressLog progress(std::max<int64_t>(total_work, 1));
     tbb::parallel_for(size_t(0), tasks.size(), [&](size_t t) {
-        if (options.cancel && options.cancel->load(std::memory_order_relaxed)) return;
+        if (cancelled()) return;
         const auto [gi, gj] = tasks[t];
         const PatchGroup &rows = groups[size_t(gi)], &cols = groups[size_t(gj)];
         std::vector<float> ij(size_t(rows.size()) * size_t(cols.size()), 0.0f);
         std::vector<float> ji(gi == gj ? 0 : ij.size(), 0.0f);
         FormFactorWork& work = task_work[t];
         for (int32_t a = rows.begin; a < rows.end; ++a) {
+            if (cancelled()) return;  // a pair of large groups is many rays
             for (int32_t b = gi == gj ? a + 1 : cols.begin; b < cols.end; ++b) {
                 float ab = 0, ba = 0;
                 if (previous.Find(a, b, ab, ba)) {

@@ -43,14 +43,23 @@ absl::Status CheckReflectance(const Scene& scene) {
     return absl::OkStatus();
 }
 
+bool IsCancelled(const std::atomic<bool>* cancel) { return cancel && cancel->load(); }
+absl::Status FormFactorsCancelled() {
+    return absl::CancelledError("radiosity: form factors cancelled");
+}
+
 // The form factors of `mesh`, reusing `previous`'s where it has them; time and counts add up in
-// `report`.
-FormFactors FormFactorsOf(const EmbreeScene& scene, const PatchMesh& mesh,
-                          const MeshFormFactors& previous, RadiosityReport& report) {
+// `report`. Cancelled once `cancel` is set.
+absl::StatusOr<FormFactors> FormFactorsOf(const EmbreeScene& scene, const PatchMesh& mesh,
+                                          const MeshFormFactors& previous,
+                                          const std::atomic<bool>* cancel,
+                                          RadiosityReport& report) {
     const auto start = std::chrono::steady_clock::now();
     FormFactorOptions options;
     options.previous = previous;
+    options.cancel = cancel;
     FormFactors form_factors = ComputeFormFactors(scene, mesh, options);
+    if (IsCancelled(cancel)) return FormFactorsCancelled();
     const double seconds = SecondsSince(start);
     const FormFactorWork& work = form_factors.work();
     report.form_factor_seconds += seconds;
@@ -74,7 +83,7 @@ absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh
     const auto start = std::chrono::steady_clock::now();
     const RadiositySystem system = MakeRadiositySystem(scene, mesh, form_factors);
     absl::StatusOr<SolveResult> solved =
-        SolveRadiosity(system, {options.solver, tolerance, options.max_iterations});
+        SolveRadiosity(system, {options.solver, tolerance, options.max_iterations, options.cancel});
     if (!solved.ok()) return solved.status();
     const double solve_seconds = SecondsSince(start);
     report.solve_seconds += solve_seconds;
@@ -101,15 +110,18 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
         std::min(kMaxRefinedPatches, options.max_patches > 0 ? options.max_patches
                                                              : 16 * int64_t(mesh.patches().size()));
     PatchMeshOptions mesh_options{mesh.patch_size(), 0};
+    mesh_options.cancel = options.cancel;
     // The previous pass's mesh and form factors, whose unsplit pairs the next pass reuses: at
     // most two passes' form factors are held at once.
     PatchMesh previous_mesh;
     FormFactors previous;
     for (bool first = true;; first = false) {
         const double form_factor_seconds = report.form_factor_seconds;
-        FormFactors form_factors = FormFactorsOf(
+        absl::StatusOr<FormFactors> computed = FormFactorsOf(
             scene, mesh, first ? MeshFormFactors{} : MeshFormFactors{&previous_mesh, &previous},
-            report);
+            options.cancel, report);
+        if (!computed.ok()) return computed.status();
+        FormFactors form_factors = std::move(*computed);
         previous = FormFactors();  // freed before the solve
         absl::StatusOr<std::vector<Rgb>> radiosity =
             Solve(scene, mesh, form_factors, options, tolerance, report);
@@ -155,11 +167,14 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         loaded = std::move(*solution);
         mesh_options = {loaded.patch_size, 0, loaded.split};
     }
+    mesh_options.cancel = options.cancel;
 
     const auto start = std::chrono::steady_clock::now();
     absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(s, mesh_options);
     if (!mesh.ok()) {
-        if (options.load_solution.empty()) return mesh.status();
+        if (options.load_solution.empty() || absl::IsCancelled(mesh.status())) {
+            return mesh.status();
+        }
         return absl::InvalidArgumentError(
             absl::StrCat(options.load_solution, ": ", mesh.status().message()));
     }
@@ -181,10 +196,15 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         radiosity = std::move(loaded.radiosity);
         NamedLogger("radiosity")->info("loaded the solution from {}", options.load_solution);
     } else {
-        absl::StatusOr<std::vector<Rgb>> solved =
-            options.target_error > 0 ? SolveRefining(scene, options, *mesh, report)
-                                     : Solve(scene, *mesh, FormFactorsOf(scene, *mesh, {}, report),
-                                             options, options.tolerance, report);
+        absl::StatusOr<std::vector<Rgb>> solved;
+        if (options.target_error > 0) {
+            solved = SolveRefining(scene, options, *mesh, report);
+        } else {
+            absl::StatusOr<FormFactors> form_factors =
+                FormFactorsOf(scene, *mesh, {}, options.cancel, report);
+            if (!form_factors.ok()) return form_factors.status();
+            solved = Solve(scene, *mesh, *form_factors, options, options.tolerance, report);
+        }
         if (!solved.ok()) return solved.status();
         radiosity = std::move(*solved);
     }
@@ -254,8 +274,9 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     }
     if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
     if (absl::Status status = CheckReflectance(scene.scene()); !status.ok()) return status;
-    absl::StatusOr<PatchMesh> mesh =
-        PatchMesh::Build(scene.scene(), {options.patch_size, options.patches});
+    PatchMeshOptions mesh_options{options.patch_size, options.patches};
+    mesh_options.cancel = cancel;
+    absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(scene.scene(), mesh_options);
     if (!mesh.ok()) return mesh.status();
     std::unique_ptr<RadiositySweepChunk> out(new RadiositySweepChunk());
     out->chunk_ = chunk;
@@ -264,7 +285,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     ff_options.chunks = chunks;
     ff_options.cancel = cancel;
     out->form_factors_ = ComputeFormFactors(scene, *mesh, ff_options);
-    if (cancel && cancel->load()) return absl::CancelledError("radiosity: form factors cancelled");
+    if (IsCancelled(cancel)) return FormFactorsCancelled();
     out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
     out->system_ = MakeRadiositySystem(scene, *mesh, out->form_factors_);
     return out;
@@ -302,8 +323,9 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity) {
     if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
-    absl::StatusOr<PatchMesh> mesh =
-        PatchMesh::Build(scene.scene(), {options.patch_size, options.patches});
+    PatchMeshOptions mesh_options{options.patch_size, options.patches};
+    mesh_options.cancel = options.cancel;
+    absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(scene.scene(), mesh_options);
     if (!mesh.ok()) return mesh.status();
     if (radiosity.size() != mesh->sides().size()) {
         return absl::InvalidArgumentError(

@@ -75,11 +75,20 @@ class SolveLog {
         std::chrono::steady_clock::now() + std::chrono::seconds(5);
 };
 
-// b_next = E + ρ F b for every group at once, and the sweep's residual sums.
-GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, std::span<Rgb> next) {
+bool IsCancelled(const std::atomic<bool>* cancel) {
+    return cancel && cancel->load(std::memory_order_relaxed);
+}
+
+absl::Status SolveCancelled() { return absl::CancelledError("radiosity: solve cancelled"); }
+
+// b_next = E + ρ F b for every group at once, and the sweep's residual sums. Once `cancel` is
+// set the remaining groups are skipped (the sums are then meaningless).
+GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, std::span<Rgb> next,
+                       const std::atomic<bool>* cancel = nullptr) {
     const auto& groups = system.form_factors->groups();
     std::vector<GroupSweep> parts(groups.size());
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
+        if (IsCancelled(cancel)) return;
         const PatchGroup& group = groups[g];
         parts[g] = JacobiGroup(system, int32_t(g), b,
                                next.subspan(size_t(group.begin), size_t(group.size())));
@@ -98,7 +107,8 @@ absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
     std::vector<Rgb> b = system.emission, next(b.size());
     SolveLog log;
     for (;;) {
-        const GroupSweep sweep = JacobiSweep(system, b, next);
+        const GroupSweep sweep = JacobiSweep(system, b, next, options.cancel);
+        if (IsCancelled(options.cancel)) return SolveCancelled();
         const double residual = sweep.change / sweep.power;
         ++result.iterations;
         if (residual <= options.tolerance) {
@@ -127,6 +137,7 @@ absl::StatusOr<SolveResult> SolveGaussSeidel(const RadiositySystem& system,
     for (;;) {
         double change = 0;
         for (size_t g = 0; g < groups.size(); ++g) {
+            if (IsCancelled(options.cancel)) return SolveCancelled();
             const PatchGroup& group = groups[g];
             updated.resize(size_t(group.size()));
             GatherGroup(system, int32_t(g), b, updated);
@@ -162,6 +173,7 @@ absl::StatusOr<SolveResult> SolveShooting(const RadiositySystem& system,
     SolveResult result;
     int exact_checks = 0;
     for (;;) {
+        if (IsCancelled(options.cancel)) return SolveCancelled();
         if (shooter.residual() <= options.tolerance) {
             result.radiosity = shooter.Radiosity();
             result.residual = RelativeResidual(system, result.radiosity);

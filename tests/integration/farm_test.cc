@@ -838,5 +838,47 @@ TEST_F(Farm, ListFollowsItsLimitAndDeleteRemovesOnlyEndedJobs) {
     EXPECT_NE(Farmctl("status " + jobs[0]).status, 0);
 }
 
+// `submit` uploads every file the scene names as `render` finds it, `../` and absolute names
+// included, and the farm loads them by those names from the uploads alone: the same pixels.
+TEST_F(Farm, SceneWithParentAndAbsoluteMeshNamesGivesTheLocalPixels) {
+    fs::create_directories(dir_ / "scenes");
+    fs::create_directories(dir_ / "meshes");
+    fs::create_directories(dir_ / "elsewhere");
+    std::ofstream(dir_ / "meshes" / "a.obj")
+        << "v 0.1 0.1 0.2\nv 0.3 0.1 0.2\nv 0.1 0.3 0.25\nf 1 2 3\n";
+    std::ofstream(dir_ / "elsewhere" / "b.obj")
+        << "v 0.3 0.2 0.3\nv 0.45 0.2 0.3\nv 0.3 0.4 0.35\nf 1 2 3\n";
+    nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
+    scene["shapes"].push_back(
+        {{"type", "mesh"}, {"material", "white"}, {"file", "../meshes/a.obj"}});
+    scene["shapes"].push_back(
+        {{"type", "mesh"}, {"material", "red"}, {"file", (dir_ / "elsewhere" / "b.obj").string()}});
+    const std::string path = (dir_ / "scenes" / "s.json").string();
+    std::ofstream(path) << scene.dump(1);
+    StartServer();
+    StartWorker("w1");
+    ExpectSameAsLocal(Submit(path, "--spp 4 --seed 3"), path, 4, 3);
+}
+
+// SIGTERM in the middle of a radiosity task (form factors of 12k patches: half a minute) stops
+// the worker within a second, handing the task back.
+TEST_F(Farm, TerminatedWorkerStopsARadiosityTaskWithinASecond) {
+    StartServer();
+    Child* worker = StartWorker("w1");
+    const std::string job =
+        Submit(scene_, "--method radiosity --solver gauss-seidel --patches 12000");
+    ASSERT_TRUE(WaitForStatus(job, "1 running", milliseconds(20000)));
+    // Meshed (the radiosity log says so): the form factors have begun.
+    ASSERT_TRUE(WaitForText(dir_ / "w1.log", "unknowns", milliseconds(20000)).has_value())
+        << "the worker never meshed the scene";
+    const auto start = Clock::now();
+    worker->Signal(SIGTERM);
+    ASSERT_EQ(worker->Wait(milliseconds(5000)), std::optional<int>(0));
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    EXPECT_LT(seconds, 1.0);
+    std::printf("worker exited %.3f s after SIGTERM\n", seconds);
+    EXPECT_NE(ReadText(dir_ / "w1.log").find("handed back"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace lf

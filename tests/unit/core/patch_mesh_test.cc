@@ -88,6 +88,49 @@ TEST(PatchMesh, TargetCountIsTheCoarsestFit) {
     }
 }
 
+// A target count above the mesher's limit once sent the size search into an endless loop:
+// every count it tried stayed at or under the target. Any target and any size now ends, with an
+// error or a mesh within the limits.
+TEST(PatchMesh, SearchEndsForAnyTargetOrSize) {
+    const Scene scene = OneTriangle();
+    PatchMeshOptions huge_target;
+    huge_target.patches = int64_t(1) << 40;
+    auto refused = PatchMesh::Build(scene, huge_target);
+    ASSERT_FALSE(refused.ok());
+    EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(refused.status().message().find("1099511627776 patches"), std::string::npos)
+        << refused.status();
+
+    PatchMeshOptions tiny;
+    tiny.patches = int64_t(1) << 40;  // ignored: the size decides
+    tiny.patch_size = 1e-300;
+    EXPECT_EQ(PatchMesh::Build(scene, tiny).status().code(), absl::StatusCode::kInvalidArgument);
+
+    PatchMeshOptions huge;
+    huge.patch_size = 1e300;
+    auto one = PatchMesh::Build(scene, huge);
+    ASSERT_TRUE(one.ok()) << one.status();
+    EXPECT_EQ(one->patches().size(), 1u);
+
+    for (double bad : {std::nan(""), double(INFINITY), -1.0}) {
+        PatchMeshOptions options;
+        options.patch_size = bad;
+        EXPECT_EQ(PatchMesh::Build(scene, options).status().code(),
+                  absl::StatusCode::kInvalidArgument)
+            << bad;
+    }
+
+    // Every edge degenerate: no size gives more patches than triangles.
+    Scene flat = OneTriangle();
+    flat.meshes[0].positions = {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}};
+    PatchMeshOptions many;
+    many.patches = 1000;
+    auto degenerate = PatchMesh::Build(flat, many);
+    if (degenerate.ok()) {
+        EXPECT_EQ(degenerate->patches().size(), 1u);
+    }
+}
+
 int CountBackSides(const PatchMesh& mesh) {
     int back = 0;
     for (const auto& s : mesh.sides()) back += s.back;

@@ -76,7 +76,7 @@ class SceneLoaderTest : public ::testing::Test {
     }
 
     absl::StatusOr<Scene> Parse(const std::string& json) {
-        return ParseScene(json, "scene.json", dir_.string());
+        return ParseScene(json, "scene.json", ReadBeside(dir_.string()));
     }
 
     // Parsing must fail with a message containing `expected`.
@@ -415,7 +415,7 @@ TEST_F(SceneLoaderTest, MeshErrorsNameTheShapeAndTheFile) {
                          "\"" + extra + "}");
     };
     ExpectError(mesh_shape("missing.obj"),
-                "scene.json: shapes[1].file: ", absl::StatusCode::kNotFound);
+                "scene.json: shapes[1].file \"missing.obj\": ", absl::StatusCode::kNotFound);
     ExpectError(mesh_shape("missing.obj"), "missing.obj: cannot open", absl::StatusCode::kNotFound);
     Write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
     ExpectError(mesh_shape("range.obj"), "range.obj:4: face refers to vertex 9");

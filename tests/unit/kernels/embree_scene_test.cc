@@ -34,6 +34,17 @@ TEST(EmbreeScene, SphereHitFromOutsideAndInside) {
     EXPECT_NEAR(inside->n.x, 1.0f, 1e-5f);
 }
 
+// A worker's cancel reaches Embree's BVH build through its progress monitor.
+TEST(EmbreeScene, BuildStopsOnceCancelled) {
+    const Scene scene = testing::MakeFurnace(1.0, Vec3d(), 0.5f, 1.0f, 4);
+    std::atomic<bool> cancel{true};
+    const auto cancelled = EmbreeScene::Build(scene, &cancel);
+    EXPECT_TRUE(absl::IsCancelled(cancelled.status())) << cancelled.status();
+    cancel = false;
+    const auto built = EmbreeScene::Build(scene, &cancel);
+    EXPECT_TRUE(built.ok()) << built.status();
+}
+
 TEST(EmbreeScene, TriangleHitReportsFrontNormalAndBarycentrics) {
     Scene scene = testing::MakeFurnace(1.0, Vec3d(), 0.5f, 1.0f, 4);
     auto es = EmbreeScene::Build(scene);

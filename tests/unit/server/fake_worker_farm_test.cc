@@ -21,6 +21,7 @@
 #include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
 #include "lf/job/digest.h"
+#include "lf/version.h"
 #include "server/grpc_service.h"
 
 namespace lf {
@@ -130,6 +131,7 @@ class FakeWorkerFarm : public ::testing::Test {
 
     std::optional<pb::Task> Lease(const std::string& worker, int wait_ms = 0) {
         pb::LeaseTaskRequest request;
+        request.set_version(kBuildVersion);
         request.set_worker_id(worker);
         request.set_wait_ms(wait_ms);
         pb::LeaseTaskResponse response;

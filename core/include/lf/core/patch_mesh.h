@@ -16,6 +16,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -51,6 +52,8 @@ struct PatchMeshOptions {
     // Cells split into quarters; a cell of level l > 0 must be a quarter of a split cell. Any
     // order, duplicates allowed.
     std::vector<PatchCell> split = {};
+    // Set from another thread: Build returns Cancelled within a row of one triangle's grid.
+    const std::atomic<bool>* cancel = nullptr;
 };
 
 // A triangle of a subdivision grid of a scene triangle: its corners (i, j), each the point with

@@ -3,10 +3,13 @@
 // (`render`) fills it from the same flags, so both see the same defaults (settings.h).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
@@ -28,6 +31,26 @@ struct JobSpec {
     std::string scene_hash;     // the loader's content hash, for the EXR header
     std::string request_id;     // the client's, for idempotent retries; "" for none
 };
+
+// The limits of a job's settings, one list for the CLI's flags (`render`, `submit`) and the
+// coordinator's check of a submission, so the wire refuses exactly what the CLI refuses. Spp and
+// tile limits are kMaxSpp and kMaxFarmTile (plan.h); the patch budget kMaxRefinedPatches.
+inline constexpr int kMaxDepthLimit = 1 << 20;  // max_depth in -1 (unlimited)..this
+inline constexpr int kMaxPasses = 1 << 20;
+// Far beyond what an O(n^2) radiosity solve can handle; below the mesher's own hard limit.
+inline constexpr int64_t kMaxPatchTarget = int64_t(1) << 24;
+inline constexpr double kMinTolerance = 1e-12, kMaxTolerance = 1.0;
+inline constexpr double kMinTargetError = 1e-6, kMaxTargetError = 1.0;  // or 0: none
+inline constexpr double kMinTimeLimit = 1e-3, kMaxTimeLimit = 1e7;      // seconds, or 0: none
+inline constexpr std::array<std::string_view, 2> kRenderMethods = {"path", "radiosity"};
+inline constexpr std::array<std::string_view, 3> kRadiositySolvers = {"jacobi", "gauss-seidel",
+                                                                      "shooting"};
+inline constexpr std::array<std::string_view, 2> kRadiosityDisplays = {"flat", "smooth"};
+
+// Ok if every setting of `spec` is within the limits above (the scene and its files are checked
+// where they are loaded); otherwise InvalidArgument naming the field and its allowed range, e.g.
+// "radiosity.patches 1099511627776: expected 1 to 16777216".
+absl::Status CheckJobSettings(const JobSpec& spec);
 
 // Radiosity jobs the farm solves in patch-group tasks per sweep, rather than on every worker.
 // Not adaptive ones: their passes are appended to the tasks where the sweeps would go.

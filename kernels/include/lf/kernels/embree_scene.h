@@ -5,6 +5,7 @@
 // beyond them (SpawnRay), so there is no self-intersection at any scale.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -40,7 +41,9 @@ Ray SpawnRayTo(const SurfacePoint& from, const SurfacePoint& to);
 
 class EmbreeScene {
   public:
-    static absl::StatusOr<std::unique_ptr<EmbreeScene>> Build(const Scene& scene);
+    // Cancelled once `cancel` is set: Embree's BVH build asks its progress monitor often.
+    static absl::StatusOr<std::unique_ptr<EmbreeScene>> Build(
+        const Scene& scene, const std::atomic<bool>* cancel = nullptr);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;

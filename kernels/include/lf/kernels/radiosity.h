@@ -11,6 +11,7 @@
 // solve again, until none does or the patch budget is spent.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -48,6 +49,9 @@ struct RadiosityOptions {
     // Most patches refinement may reach; 0: 16 times the coarse mesh's. Never above
     // kMaxRefinedPatches.
     int64_t max_patches = 0;
+    // Set from another thread: meshing, form factors and the solve stop within a fraction of a
+    // second and the call returns Cancelled.
+    const std::atomic<bool>* cancel = nullptr;
 };
 
 // One solve of a refinement.
@@ -149,7 +153,8 @@ absl::StatusOr<RadiosityOptions> MakeRadiosityOptions(int64_t patches, double pa
 
 // Fails with InvalidArgument for scenes radiosity cannot represent (spheres, non-lambert
 // materials, reflectance >= 1 with emission), for a solution that does not match the scene,
-// and with ResourceExhausted if the solver does not converge within the iteration limit.
+// with ResourceExhausted if the solver does not converge within the iteration limit, and with
+// Cancelled soon after options.cancel is set.
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> PrepareRadiosity(
     const EmbreeScene& scene, const RadiosityOptions& options);
 

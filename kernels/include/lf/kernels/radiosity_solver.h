@@ -14,6 +14,7 @@
 // the group holding the most unshot power into the scene, one group at a time.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -44,6 +45,8 @@ struct SolveOptions {
     double tolerance = 1e-4;
     // Sweeps; for shooting, shots adding up to this many sweeps' worth of form factors.
     int max_iterations = 10000;
+    // Set from another thread: the solve returns Cancelled within one patch group's work.
+    const std::atomic<bool>* cancel = nullptr;
 };
 
 struct SolveResult {

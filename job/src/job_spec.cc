@@ -1,0 +1,71 @@
+#include "lf/job/job_spec.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/str_cat.h"
+#include "lf/core/patch_mesh.h"
+
+namespace lf {
+
+namespace {
+
+template <typename T>
+absl::Status InRange(const char* field, T value, T lo, T hi) {
+    if (value >= lo && value <= hi) return absl::OkStatus();  // false for NaN
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, " ", value, ": expected ", lo, " to ", hi));
+}
+
+// 0 for none, or a value in [lo, hi].
+absl::Status NoneOrInRange(const char* field, double value, double lo, double hi) {
+    if (value == 0 || (value >= lo && value <= hi)) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, " ", value, ": expected 0 (none) or ", lo, " to ", hi));
+}
+
+template <size_t N>
+absl::Status OneOf(const char* field, const std::string& value,
+                   const std::array<std::string_view, N>& names) {
+    if (std::find(names.begin(), names.end(), value) != names.end()) return absl::OkStatus();
+    std::string expected;
+    for (std::string_view name : names) {
+        absl::StrAppend(&expected, expected.empty() ? "" : ", ", std::string(name));
+    }
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, " \"", value, "\": expected one of ", expected));
+}
+
+}  // namespace
+
+absl::Status CheckJobSettings(const JobSpec& spec) {
+    const RadiositySettings& r = spec.radiosity;
+    const absl::Status checks[] = {
+        InRange("spp", spec.plan.spp, uint64_t(1), kMaxSpp),
+        InRange("tile", spec.plan.tile, 1, kMaxFarmTile),
+        InRange("passes", spec.plan.passes, 1, kMaxPasses),
+        InRange("max_depth", spec.max_depth, -1, kMaxDepthLimit),
+        OneOf("method", spec.method, kRenderMethods),
+        NoneOrInRange("adaptive.target_error", spec.adaptive.target_error, kMinTargetError,
+                      kMaxTargetError),
+        NoneOrInRange("adaptive.time_limit", spec.adaptive.time_limit, kMinTimeLimit,
+                      kMaxTimeLimit),
+        InRange("adaptive.max_spp", spec.adaptive.max_spp, uint64_t(2), kMaxSpp),
+        InRange("radiosity.patches", r.patches, int64_t(1), kMaxPatchTarget),
+        // Finite: an infinite size would mesh every triangle as one patch, which no flag can ask.
+        InRange("radiosity.patch_size", r.patch_size, 0.0, std::numeric_limits<double>::max()),
+        OneOf("radiosity.solver", r.solver, kRadiositySolvers),
+        InRange("radiosity.tolerance", r.tolerance, kMinTolerance, kMaxTolerance),
+        InRange("radiosity.max_iterations", r.max_iterations, 1, std::numeric_limits<int>::max()),
+        OneOf("radiosity.display", r.display, kRadiosityDisplays),
+        InRange("radiosity.sweep_tasks", r.sweep_tasks, 1, kMaxSweepTasks),
+        InRange("radiosity.max_patches", r.max_patches, int64_t(0), kMaxRefinedPatches),
+    };
+    for (const absl::Status& s : checks) {
+        if (!s.ok()) return s;
+    }
+    return absl::OkStatus();
+}
+
+}  // namespace lf

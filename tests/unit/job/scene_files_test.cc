@@ -1,0 +1,137 @@
+// A farm scene reads only the files uploaded with it, by the name its JSON writes: `../` and
+// absolute names are keys like any other and load the same scene (same content hash) as
+// `render` does from disk, while a name that was not uploaded is refused with one message that
+// says nothing of this machine's files.
+#include "lf/job/scene_files.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "lf/core/scene_loader.h"
+#include "lf/job/digest.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kTriangle[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+constexpr char kOtherTriangle[] = "v 0 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\n";
+
+std::string SceneNaming(const std::vector<std::string>& files) {
+    std::string shapes;
+    for (const std::string& f : files) {
+        shapes += std::string(shapes.empty() ? "" : ", ") +
+                  R"({"type": "mesh", "material": "lamp", "file": ")" + f + "\"}";
+    }
+    return R"({"camera": {"position": [0, 0, -1], "look_at": [0, 0, 0], "fov_y_deg": 40, )"
+           R"("resolution": [4, 4]}, "materials": {"lamp": {"type": "lambert", )"
+           R"("reflectance": [0.5, 0.5, 0.5], "emission": [1, 1, 1]}}, "shapes": [)" +
+           shapes + "]}";
+}
+
+class SceneFilesTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               ("lf_scene_files_" + std::to_string(::getpid()) + "_" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_ / "scenes");
+        fs::create_directories(dir_ / "meshes");
+        fs::create_directories(dir_ / "blobs");
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    // Stores `bytes` as a blob named by its hash and returns its reference under `name`.
+    BlobRef Put(const std::string& name, const std::string& bytes) {
+        const std::string hash = Sha256Hex(bytes);
+        std::ofstream(dir_ / "blobs" / hash, std::ios::binary) << bytes;
+        return {name, hash, bytes.size()};
+    }
+    absl::StatusOr<Scene> Load(const BlobRef& scene, const std::vector<BlobRef>& files) {
+        return LoadSceneFromBlobs(scene, files, [&](const std::string& hash) {
+            return (dir_ / "blobs" / hash).string();
+        });
+    }
+
+    fs::path dir_;
+};
+
+TEST_F(SceneFilesTest, ParentAndAbsoluteNamesLoadTheSceneRenderLoads) {
+    std::ofstream(dir_ / "meshes" / "up.obj") << kTriangle;
+    std::ofstream(dir_ / "abs.obj") << kOtherTriangle;
+    const std::string absolute = (dir_ / "abs.obj").string();
+    const std::string json = SceneNaming({"../meshes/up.obj", absolute});
+    std::ofstream(dir_ / "scenes" / "s.json") << json;
+
+    const absl::StatusOr<Scene> local = LoadScene((dir_ / "scenes" / "s.json").string());
+    ASSERT_TRUE(local.ok()) << local.status();
+    const absl::StatusOr<Scene> farm = Load(
+        Put("s.json", json), {Put("../meshes/up.obj", kTriangle), Put(absolute, kOtherTriangle)});
+    ASSERT_TRUE(farm.ok()) << farm.status();
+    EXPECT_EQ(farm->content_hash, local->content_hash);
+    ASSERT_EQ(farm->meshes.size(), 2u);
+    EXPECT_EQ(farm->meshes[1].positions, local->meshes[1].positions);
+}
+
+TEST_F(SceneFilesTest, NameNotUploadedIsRefusedWithoutSayingWhatExistsHere) {
+    // /etc/hostname exists on the machine loading the scene, the other path does not: the two
+    // refusals must read alike, name only the scene's own words, and leak no content.
+    std::string messages[2];
+    const std::string names[2] = {"/etc/hostname", "/no/such/dir/x.obj"};
+    for (int i = 0; i < 2; ++i) {
+        const absl::StatusOr<Scene> forged =
+            Load(Put("scene.json", SceneNaming({"up.obj", names[i]})), {Put("up.obj", kTriangle)});
+        ASSERT_FALSE(forged.ok());
+        EXPECT_EQ(forged.status().code(), absl::StatusCode::kNotFound);
+        messages[i] = std::string(forged.status().message());
+        EXPECT_EQ(messages[i], "scene.json: shapes[1].file \"" + names[i] +
+                                   "\": not among the files uploaded with the scene");
+        EXPECT_EQ(messages[i].find(dir_.string()), std::string::npos) << messages[i];
+    }
+    // A relative escape, too: resolved by name only, never against any folder.
+    const absl::StatusOr<Scene> escape =
+        Load(Put("scene.json", SceneNaming({"../../../../../../etc/passwd"})),
+             {Put("up.obj", kTriangle)});
+    EXPECT_EQ(escape.status().code(), absl::StatusCode::kNotFound) << escape.status();
+}
+
+TEST_F(SceneFilesTest, UnreadableBlobErrorNamesTheUploadNotTheBlobFile) {
+    BlobRef mesh = Put("up.obj", kTriangle);
+    fs::remove(dir_ / "blobs" / mesh.hash);
+    const absl::StatusOr<Scene> scene = Load(Put("scene.json", SceneNaming({"up.obj"})), {mesh});
+    ASSERT_FALSE(scene.ok());
+    EXPECT_NE(scene.status().message().find("up.obj"), std::string::npos) << scene.status();
+    EXPECT_EQ(scene.status().message().find(dir_.string()), std::string::npos) << scene.status();
+}
+
+TEST_F(SceneFilesTest, OneNameWithTwoContentsIsRefused) {
+    const absl::StatusOr<Scene> scene =
+        Load(Put("scene.json", SceneNaming({"up.obj"})),
+             {Put("up.obj", kTriangle), Put("up.obj", kOtherTriangle)});
+    EXPECT_EQ(scene.status().code(), absl::StatusCode::kInvalidArgument) << scene.status();
+}
+
+TEST_F(SceneFilesTest, LoadingStopsOnceCancelled) {
+    std::atomic<bool> cancel{true};
+    const absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
+        Put("scene.json", SceneNaming({"up.obj"})), {Put("up.obj", kTriangle)},
+        [&](const std::string& hash) { return (dir_ / "blobs" / hash).string(); }, &cancel);
+    EXPECT_TRUE(absl::IsCancelled(scene.status())) << scene.status();
+}
+
+TEST_F(SceneFilesTest, NamesAreKeysWithoutControlCharacters) {
+    EXPECT_TRUE(CheckScenePath("../x.obj").ok());
+    EXPECT_TRUE(CheckScenePath("/abs/x.obj").ok());
+    EXPECT_FALSE(CheckScenePath("").ok());
+    EXPECT_FALSE(CheckScenePath("a\nb.obj").ok());
+    EXPECT_FALSE(CheckScenePath(std::string(kMaxScenePathBytes + 1, 'a')).ok());
+}
+
+}  // namespace
+}  // namespace lf

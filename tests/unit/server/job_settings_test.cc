@@ -1,0 +1,90 @@
+// Every setting of a submission is checked with the CLI's limits (lf/job/job_spec.h): a job the
+// CLI would refuse, forged on the wire, is refused by the coordinator naming the field, before a
+// worker could lease it (a radiosity target of 2^40 patches once sent workers into an endless
+// loop).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+
+#include "lf/core/patch_mesh.h"
+#include "lf/job/job_spec.h"
+#include "server/farm.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BadSetting {
+    std::string field;
+    std::function<void(JobSpec&)> set;
+};
+
+TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
+    const fs::path dir = fs::temp_directory_path() / ("lf_settings_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    FarmOptions options;
+    options.data_dir = dir.string();
+    absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
+    ASSERT_TRUE(farm.ok()) << farm.status();
+
+    const std::vector<BadSetting> bad = {
+        {"spp", [](JobSpec& s) { s.plan.spp = 0; }},
+        {"spp", [](JobSpec& s) { s.plan.spp = kMaxSpp + 1; }},
+        {"tile", [](JobSpec& s) { s.plan.tile = 0; }},
+        {"tile", [](JobSpec& s) { s.plan.tile = kMaxFarmTile + 1; }},
+        {"passes", [](JobSpec& s) { s.plan.passes = 0; }},
+        {"passes", [](JobSpec& s) { s.plan.passes = kMaxPasses + 1; }},
+        {"max_depth", [](JobSpec& s) { s.max_depth = -2; }},
+        {"max_depth", [](JobSpec& s) { s.max_depth = kMaxDepthLimit + 1; }},
+        {"method", [](JobSpec& s) { s.method = "photon"; }},
+        {"adaptive.target_error", [](JobSpec& s) { s.adaptive.target_error = 1e-9; }},
+        {"adaptive.target_error", [](JobSpec& s) { s.adaptive.target_error = NAN; }},
+        {"adaptive.time_limit", [](JobSpec& s) { s.adaptive.time_limit = -1; }},
+        {"adaptive.time_limit", [](JobSpec& s) { s.adaptive.time_limit = INFINITY; }},
+        {"adaptive.max_spp", [](JobSpec& s) { s.adaptive.max_spp = 1; }},
+        {"adaptive.max_spp", [](JobSpec& s) { s.adaptive.max_spp = kMaxSpp + 1; }},
+        {"radiosity.patches", [](JobSpec& s) { s.radiosity.patches = 0; }},
+        {"radiosity.patches", [](JobSpec& s) { s.radiosity.patches = int64_t(1) << 40; }},
+        {"radiosity.patches", [](JobSpec& s) { s.radiosity.patches = kMaxPatchTarget + 1; }},
+        {"radiosity.patch_size", [](JobSpec& s) { s.radiosity.patch_size = -1; }},
+        {"radiosity.patch_size", [](JobSpec& s) { s.radiosity.patch_size = NAN; }},
+        {"radiosity.patch_size", [](JobSpec& s) { s.radiosity.patch_size = INFINITY; }},
+        {"radiosity.solver", [](JobSpec& s) { s.radiosity.solver = "newton"; }},
+        {"radiosity.tolerance", [](JobSpec& s) { s.radiosity.tolerance = 0; }},
+        {"radiosity.tolerance", [](JobSpec& s) { s.radiosity.tolerance = 2; }},
+        {"radiosity.max_iterations", [](JobSpec& s) { s.radiosity.max_iterations = 0; }},
+        {"radiosity.display", [](JobSpec& s) { s.radiosity.display = "wireframe"; }},
+        {"radiosity.sweep_tasks", [](JobSpec& s) { s.radiosity.sweep_tasks = 0; }},
+        {"radiosity.sweep_tasks", [](JobSpec& s) { s.radiosity.sweep_tasks = kMaxSweepTasks + 1; }},
+        {"radiosity.max_patches", [](JobSpec& s) { s.radiosity.max_patches = -1; }},
+        {"radiosity.max_patches",
+         [](JobSpec& s) { s.radiosity.max_patches = kMaxRefinedPatches + 1; }},
+    };
+    for (const BadSetting& b : bad) {
+        JobSpec spec;
+        spec.method = "radiosity";
+        spec.scene = {"scene.json", std::string(64, 'a'), 10};
+        b.set(spec);
+        const absl::StatusOr<std::string> job = (*farm)->Submit(spec);
+        EXPECT_EQ(job.status().code(), absl::StatusCode::kInvalidArgument) << b.field;
+        EXPECT_EQ(job.status().message().substr(0, b.field.size() + 1), b.field + " ")
+            << job.status();
+    }
+    // The CLI's defaults, and its limits themselves, pass the check.
+    JobSpec edge;
+    edge.plan = {0, 0, kMaxSpp, kMaxFarmTile, kMaxPasses};
+    edge.max_depth = kMaxDepthLimit;
+    edge.radiosity.patches = kMaxPatchTarget;
+    edge.radiosity.sweep_tasks = kMaxSweepTasks;
+    edge.radiosity.max_patches = kMaxRefinedPatches;
+    EXPECT_TRUE(CheckJobSettings(JobSpec{}).ok()) << CheckJobSettings(JobSpec{});
+    EXPECT_TRUE(CheckJobSettings(edge).ok()) << CheckJobSettings(edge);
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lf
