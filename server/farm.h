@@ -4,7 +4,9 @@
 // store's, which the services use directly.
 #pragma once
 
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 
@@ -52,6 +54,7 @@ class Farm {
                                std::string_view sweep_result);
 
     // The EXR of a succeeded job; with `preview`, also of a running one (what is merged so far).
+    // A preview is written again only when a task was merged since the last one.
     absl::StatusOr<std::string> ResultFile(const std::string& job_id, bool preview);
 
     // What the server's timer thread runs every tenth of a second: expired leases go back to the
@@ -75,11 +78,16 @@ class Farm {
     absl::Status WriteImage(const Scheduler::JobImage& snapshot, bool complete,
                             const std::string& path);
     void FinishJob(const std::string& job_id);
+    // Snapshot and WriteImage, one job at a time: the image being written is the only one in
+    // the server's memory (the merged tiles are in files, lf/job/tile_store.h).
+    absl::Status WriteSnapshot(const std::string& job_id, bool complete, const std::string& path);
 
     const FarmOptions options_;
     std::unique_ptr<BlobStore> blobs_;
     std::unique_ptr<JobStore> store_;
     Scheduler scheduler_;
+    std::mutex image_mutex_;
+    std::map<std::string, int> previewed_;  // tasks done at each running job's last preview
 };
 
 }  // namespace lf

@@ -44,6 +44,10 @@ int main(int argc, char** argv) {
     app.add_option("--max-spp", options.limits.max_spp, "most samples per pixel per job")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    app.add_option("--max-active-jobs", options.scheduler.max_active_jobs,
+                   "most jobs queued or running at once")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
