@@ -44,6 +44,14 @@ std::string UniqueSuffix() {
     return absl::StrCat(::getpid(), "-", ++counter);
 }
 
+// The scheduler's options with each job's tiles in a file under the data folder's scratch/.
+SchedulerOptions WithTileFiles(SchedulerOptions options, const std::string& data_dir) {
+    options.tile_stores = [dir = data_dir + "/scratch"](std::vector<PixelRect> tiles) {
+        return MakeFileTileStore(dir, std::move(tiles));
+    };
+    return options;
+}
+
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
@@ -76,7 +84,7 @@ Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
     : options_(options),
       blobs_(std::move(blobs)),
       store_(std::move(store)),
-      scheduler_(options.scheduler, *store_) {}
+      scheduler_(WithTileFiles(options.scheduler, options.data_dir), *store_) {}
 
 absl::Status Farm::CheckSceneSize(uint64_t bytes) const {
     if (bytes <= options_.limits.max_scene_bytes) return absl::OkStatus();
@@ -198,16 +206,23 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
     return absl::OkStatus();
 }
 
-void Farm::FinishJob(const std::string& job_id) {
+absl::Status Farm::WriteSnapshot(const std::string& job_id, bool complete,
+                                 const std::string& path) {
+    std::lock_guard<std::mutex> lock(image_mutex_);
     absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.Snapshot(job_id);
-    if (!snapshot.ok()) return;  // cancelled meanwhile
+    if (!snapshot.ok()) return snapshot.status();
+    return WriteImage(*snapshot, complete, path);
+}
+
+void Farm::FinishJob(const std::string& job_id) {
     const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
-    const absl::Status written = WriteImage(*snapshot, true, path);
+    const absl::Status written = WriteSnapshot(job_id, true, path);
     {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         radiosity_.erase(job_id);
         sweep_solves_.erase(job_id);
     }
+    if (absl::IsFailedPrecondition(written)) return;  // cancelled meanwhile
     scheduler_.Finish(job_id, written.ok() ? absl::StatusOr<std::string>(path)
                                            : absl::StatusOr<std::string>(written));
 }
@@ -258,6 +273,10 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
 absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool preview) {
     absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
     if (!job.ok()) return job.status();
+    if (IsFinal(job->state)) {
+        std::lock_guard<std::mutex> lock(image_mutex_);
+        previewed_.erase(job_id);
+    }
     if (job->state == JobState::kSucceeded) return job->result_path;
     if (!preview || IsFinal(job->state)) {
         return absl::FailedPreconditionError(absl::StrCat(
@@ -265,10 +284,15 @@ absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool pre
             job->tasks_total, " tasks done): no result",
             IsFinal(job->state) ? "" : " yet; --preview fetches what is merged so far"));
     }
-    absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.Snapshot(job_id);
-    if (!snapshot.ok()) return snapshot.status();
     const std::string path = options_.data_dir + "/previews/" + job_id + ".exr";
-    if (absl::Status s = WriteImage(*snapshot, false, path); !s.ok()) return s;
+    {
+        std::lock_guard<std::mutex> lock(image_mutex_);
+        auto it = previewed_.find(job_id);
+        if (it != previewed_.end() && it->second == job->tasks_done) return path;
+    }
+    if (absl::Status s = WriteSnapshot(job_id, false, path); !s.ok()) return s;
+    std::lock_guard<std::mutex> lock(image_mutex_);
+    previewed_[job_id] = job->tasks_done;
     return path;
 }
 

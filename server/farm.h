@@ -68,6 +68,7 @@ class Farm {
                                std::string_view sweep_result);
 
     // The EXR of a succeeded job; with `preview`, also of a running one (what is merged so far).
+    // A preview is written again only when a task was merged since the last one.
     absl::StatusOr<std::string> ResultFile(const std::string& job_id, bool preview);
 
     // What the server's timer thread runs every tenth of a second: expired leases go back to the
@@ -100,6 +101,9 @@ class Farm {
     void RemoveJobFiles(const std::string& job_id);
     // The temporary files of writes a killed server did not finish.
     void SweepTemporaryFiles();
+    // Snapshot and WriteImage, one job at a time: the image being written is the only one in
+    // the server's memory (the merged tiles are in files, lf/job/tile_store.h).
+    absl::Status WriteSnapshot(const std::string& job_id, bool complete, const std::string& path);
 
     const FarmOptions options_;
     std::unique_ptr<DataDirLock> lock_;
@@ -116,6 +120,8 @@ class Farm {
     std::unique_ptr<BlobStore> blobs_;
     std::unique_ptr<JobStore> store_;
     Scheduler scheduler_;
+    std::mutex image_mutex_;
+    std::map<std::string, int> previewed_;  // tasks done at each running job's last preview
 };
 
 }  // namespace lf

@@ -55,6 +55,10 @@ int main(int argc, char** argv) {
                    "most WatchJob streams open at once (each holds a thread); more are refused")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    app.add_option("--max-active-jobs", options.scheduler.max_active_jobs,
+                   "most jobs queued or running at once")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);

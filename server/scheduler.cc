@@ -6,6 +6,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "lf/core/image_error.h"
 #include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
 #include "server/time_limit.h"
@@ -93,15 +94,20 @@ absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord reco
     job->record = std::move(record);
     job->speculation = SpeculationPolicy(options_.speculate_after);
     if (IsAdaptive(spec.adaptive)) {
-        absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan = AdaptiveTilePlan::Make(
-            spec.plan.width, spec.plan.height, spec.plan.spp, spec.plan.tile, spec.adaptive);
+        absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan =
+            AdaptiveTilePlan::Make(spec.plan.width, spec.plan.height, spec.plan.spp,
+                                   spec.plan.tile, spec.adaptive, kMaxTaskSamples,
+                                   options_.tile_stores);
         if (!plan.ok()) return plan.status();
         job->adaptive = plan->get();
         job->merger = std::move(*plan);
     } else {
         absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(spec.plan);
         if (!plan.ok()) return plan.status();
-        job->merger = std::make_unique<RenderMerger>(spec.plan.width, spec.plan.height, *plan);
+        absl::StatusOr<std::unique_ptr<RenderMerger>> merger = RenderMerger::Make(
+            spec.plan.width, spec.plan.height, std::move(*plan), options_.tile_stores);
+        if (!merger.ok()) return merger.status();
+        job->merger = std::move(*merger);
     }
     Grow(*job, job->merger->tasks().size());
     return job;
@@ -135,6 +141,11 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
         if (absl::Status s = store_.WaitDurable(earlier->second); !s.ok()) return s;
         Log()->info("job={} submitted again (request {})", earlier->first, spec.request_id);
         return earlier->first;
+    }
+    if (active_.size() >= options_.max_active_jobs) {
+        return absl::ResourceExhaustedError(
+            absl::StrCat(active_.size(), " jobs are queued or running, this server's limit "
+                         "(lightfarm-server --max-active-jobs); submit again once some end"));
     }
     // Ids are random: one the store lacks is taken in memory only by a freak.
     while (active_.count(id) || EndedRecord(id)) id = NewJobId();
@@ -715,17 +726,27 @@ int Scheduler::ExpireLeases() {
 }
 
 absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_id) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    auto it = active_.find(job_id);
-    if (it == active_.end()) {
-        return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " is not running"));
+    JobImage snapshot;
+    std::shared_ptr<const TileStore> tiles;  // outlives the job if it ends meanwhile
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        auto it = active_.find(job_id);
+        if (it == active_.end()) {
+            return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " is not running"));
+        }
+        const Job& job = *it->second;
+        snapshot.record = job.record;
+        tiles = job.merger->store();
+        if (job.adaptive) snapshot.adaptive = job.adaptive->TileReport();
     }
-    const Job& job = *it->second;
-    JobImage snapshot{job.record, job.merger->Snapshot(), std::nullopt};
-    if (job.adaptive) {
-        absl::StatusOr<AdaptiveReport> report = job.adaptive->Report();
-        if (!report.ok()) return report.status();
-        snapshot.adaptive = std::move(*report);
+    const RenderPlanSettings& plan = snapshot.record.spec.plan;
+    absl::StatusOr<Image> image = RenderImageOf(*tiles, plan.width, plan.height);
+    if (!image.ok()) return image.status();
+    snapshot.image = std::move(*image);
+    if (snapshot.adaptive) {
+        absl::StatusOr<double> estimated = EstimatedRelativeError(snapshot.image);
+        if (!estimated.ok()) return estimated.status();
+        snapshot.adaptive->estimated_error = *estimated;
     }
     return snapshot;
 }

@@ -47,6 +47,11 @@ struct SchedulerOptions {
     absl::Duration speculate_after = absl::Seconds(1);
     // How often workers heartbeat, told to them with each lease.
     absl::Duration heartbeat_interval = absl::Milliseconds(300);
+    // Where each job's merged tiles are kept (lf/job/tile_store.h): the coordinator keeps them
+    // in files, so that a job's memory does not grow with its image.
+    TileStoreFactory tile_stores = MakeMemoryTileStore;
+    // Jobs queued or running at once; a submission beyond is refused (ResourceExhausted).
+    size_t max_active_jobs = 1000;
 };
 
 enum class FailureKind {
@@ -62,7 +67,8 @@ class Scheduler {
 
     // Plans and queues the job; `spec` must be validated. Returns the job id once the job is in
     // the store (an error, and nothing queued, when the store cannot take it). A request id
-    // seen before returns that submission's job.
+    // seen before returns that submission's job. ResourceExhausted when max_active_jobs jobs are
+    // queued or running.
     absl::StatusOr<std::string> Submit(const JobSpec& spec);
 
     // Takes up the jobs the store holds that have not ended, as a server restarting does: their
@@ -127,7 +133,9 @@ class Scheduler {
     std::vector<std::string> EnforceTimeLimits();
 
     // A rendered job's record and image, to write as its result, and for an adaptive job how its
-    // sampling ended.
+    // sampling ended. The image is read from the job's tile store one tile at a time after the
+    // lock is released: a preview of a running job may show one tile's newer result beside
+    // another's older one, never half a tile.
     struct JobImage {
         JobRecord record;
         Image image;

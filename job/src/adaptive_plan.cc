@@ -35,9 +35,8 @@ uint64_t NextSampleCount(uint64_t n, double error, double target, uint64_t max_s
 }
 
 AdaptiveTilePlan::AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings,
-                                   uint64_t max_task_samples)
-    : width_(width),
-      height_(height),
+                                   uint64_t max_task_samples, std::shared_ptr<TileStore> store)
+    : TileMerger(width, height, std::move(store)),
       settings_(settings),
       max_task_samples_(std::max<uint64_t>(max_task_samples, 1)) {
     settings_.max_spp = RoundUpToEven(settings.max_spp);
@@ -45,16 +44,18 @@ AdaptiveTilePlan::AdaptiveTilePlan(int width, int height, const AdaptiveSettings
 
 absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> AdaptiveTilePlan::Make(
     int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings,
-    uint64_t max_task_samples) {
+    uint64_t max_task_samples, const TileStoreFactory& make_store) {
     if (absl::Status s = CheckAdaptiveSettings(settings); !s.ok()) return s;
-    std::unique_ptr<AdaptiveTilePlan> plan(
-        new AdaptiveTilePlan(width, height, settings, max_task_samples));
-    plan->first_ =
-        std::min(plan->settings_.max_spp, RoundUpToEven(std::max<uint64_t>(first_spp, 2)));
-    absl::StatusOr<std::vector<RenderTask>> tiles =
-        PlanRender({width, height, plan->first_, tile, 1});
+    const uint64_t first =
+        std::min(RoundUpToEven(settings.max_spp), RoundUpToEven(std::max<uint64_t>(first_spp, 2)));
+    absl::StatusOr<std::vector<RenderTask>> tiles = PlanRender({width, height, first, tile, 1});
     if (!tiles.ok()) return tiles.status();
-    for (const RenderTask& task : *tiles) plan->tiles_.push_back({TileSums(task.rect), 1, {}});
+    absl::StatusOr<std::unique_ptr<TileStore>> store = make_store(TileRects(*tiles));
+    if (!store.ok()) return store.status();
+    std::unique_ptr<AdaptiveTilePlan> plan(
+        new AdaptiveTilePlan(width, height, settings, max_task_samples, std::move(*store)));
+    plan->first_ = first;
+    for (const RenderTask& task : *tiles) plan->tiles_.push_back({task.rect, 0, 1, {}});
     for (int t = 0; t < int(plan->tiles_.size()); ++t) plan->AppendPass(t, 0, plan->first_);
     return plan;
 }
@@ -62,11 +63,11 @@ absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> AdaptiveTilePlan::Make(
 std::vector<RenderTask> AdaptiveTilePlan::AppendPass(int t, uint64_t begin, uint64_t end) {
     Tile& tile = tiles_[size_t(t)];
     const uint64_t pairs = (end - begin) / 2;
-    const uint64_t samples = (end - begin) * uint64_t(tile.sums.rect.Area());
+    const uint64_t samples = (end - begin) * uint64_t(tile.rect.Area());
     const uint64_t parts = std::min(pairs, (samples + max_task_samples_ - 1) / max_task_samples_);
     std::vector<RenderTask> appended;
     for (uint64_t i = 0; i < parts; ++i) {
-        const RenderTask task{int(tasks_.size()), tile.sums.rect, begin + 2 * (pairs * i / parts),
+        const RenderTask task{int(tasks_.size()), tile.rect, begin + 2 * (pairs * i / parts),
                               begin + 2 * (pairs * (i + 1) / parts)};
         tasks_.push_back(task);
         tile_of_.push_back(t);
@@ -91,17 +92,21 @@ absl::StatusOr<std::vector<RenderTask>> AdaptiveTilePlan::Merge(int t, const Til
             absl::StrCat("task ", t, " is not a pass planned and still wanted"));
     }
     if (absl::Status s = CheckTaskResult(tasks_[size_t(t)], sums); !s.ok()) return s;
+    const int tile_index = tile_of_[size_t(t)];
+    absl::StatusOr<TileSums> merged = mutable_store().Get(tile_index);
+    if (!merged.ok()) return merged.status();
+    *merged += sums;
+    if (absl::Status s = mutable_store().Put(tile_index, *merged); !s.ok()) return s;
     merged_[size_t(t)] = true;
     ++tasks_done_;
     stats_ += sums.stats;
-    const int tile_index = tile_of_[size_t(t)];
     Tile& tile = tiles_[size_t(tile_index)];
-    tile.sums += sums;
-    tile.error = EstimatedTileError(tile.sums);
+    tile.spp = merged->pixels[0].Count();
+    tile.error = EstimatedTileError(*merged);
     std::erase(tile.pending, t);
     // The pass's other tasks are still out: the tile decides on the whole pass.
     if (!tile.pending.empty()) return std::vector<RenderTask>();
-    const uint64_t n = tile.sums.pixels[0].Count();
+    const uint64_t n = tile.spp;
     const bool reached = settings_.target_error > 0 && tile.error <= settings_.target_error;
     if (reached || n >= settings_.max_spp || stopped_) return std::vector<RenderTask>();
     const uint64_t next =
@@ -133,30 +138,31 @@ std::vector<int> AdaptiveTilePlan::Stop() {
     return dropped;
 }
 
-Image AdaptiveTilePlan::Snapshot() const {
-    Image image = EmptyRenderImage(width_, height_);
-    for (const Tile& tile : tiles_) image.SetTile(tile.sums);
-    return image;
+absl::StatusOr<AdaptiveReport> AdaptiveTilePlan::Report() const {
+    AdaptiveReport report = TileReport();
+    absl::StatusOr<Image> snapshot = Snapshot();
+    if (!snapshot.ok()) return snapshot.status();
+    absl::StatusOr<double> estimated = EstimatedRelativeError(*snapshot);
+    if (!estimated.ok()) return estimated.status();
+    report.estimated_error = *estimated;
+    return report;
 }
 
-absl::StatusOr<AdaptiveReport> AdaptiveTilePlan::Report() const {
+AdaptiveReport AdaptiveTilePlan::TileReport() const {
     AdaptiveReport report;
     report.tiles = int(tiles_.size());
     report.timed_out = stopped_;
     report.min_spp = settings_.max_spp;
     for (const Tile& tile : tiles_) {
-        const uint64_t n = tile.sums.pixels[0].Count();
+        const uint64_t n = tile.spp;
         report.worst_tile_error = std::max(report.worst_tile_error, tile.error);
         if (settings_.target_error > 0 && tile.error > settings_.target_error) {
             ++report.tiles_above_target;
         }
         report.min_spp = std::min(report.min_spp, n);
         report.max_spp = std::max(report.max_spp, n);
-        report.per_tile.push_back({tile.sums.rect, n, tile.error});
+        report.per_tile.push_back({tile.rect, n, tile.error});
     }
-    absl::StatusOr<double> estimated = EstimatedRelativeError(Snapshot());
-    if (!estimated.ok()) return estimated.status();
-    report.estimated_error = *estimated;
     return report;
 }
 

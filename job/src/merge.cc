@@ -33,11 +33,36 @@ Image EmptyRenderImage(int width, int height) {
     return image;
 }
 
+std::vector<PixelRect> TileRects(const std::vector<RenderTask>& tasks) {
+    std::vector<PixelRect> rects;
+    std::map<std::pair<int, int>, size_t> seen;  // by (y0, x0)
+    for (const RenderTask& t : tasks) {
+        if (seen.emplace(Key(t.rect), rects.size()).second) rects.push_back(t.rect);
+    }
+    return rects;
+}
+
 RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks)
-    : tasks_(std::move(tasks)),
-      done_(tasks_.size(), false),
-      image_(EmptyRenderImage(width, height)) {
-    for (const RenderTask& t : tasks_) ++passes_per_tile_[Key(t.rect)];
+    : RenderMerger(width, height, tasks, *MakeMemoryTileStore(TileRects(tasks))) {}
+
+RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks,
+                           std::shared_ptr<TileStore> store)
+    : TileMerger(width, height, std::move(store)),
+      tasks_(std::move(tasks)),
+      done_(tasks_.size(), false) {
+    std::map<std::pair<int, int>, int> tile_at;
+    for (int t = 0; t < int(this->store()->tiles().size()); ++t) {
+        tile_at[Key(this->store()->tiles()[size_t(t)])] = t;
+    }
+    for (const RenderTask& task : tasks_) tile_of_.push_back(tile_at.at(Key(task.rect)));
+}
+
+absl::StatusOr<std::unique_ptr<RenderMerger>> RenderMerger::Make(
+    int width, int height, std::vector<RenderTask> tasks, const TileStoreFactory& make_store) {
+    absl::StatusOr<std::unique_ptr<TileStore>> store = make_store(TileRects(tasks));
+    if (!store.ok()) return store.status();
+    return std::unique_ptr<RenderMerger>(
+        new RenderMerger(width, height, std::move(tasks), std::move(*store)));
 }
 
 absl::Status RenderMerger::Add(int task_index, const TileSums& sums) {
@@ -49,12 +74,11 @@ absl::Status RenderMerger::Add(int task_index, const TileSums& sums) {
         return absl::AlreadyExistsError(absl::StrCat("task ", task_index, " is already merged"));
     }
     if (absl::Status s = CheckTaskResult(task, sums); !s.ok()) return s;
-    auto open = OpenTileFor(task);
-    open->second.sums += sums;
-    if (--open->second.passes_left == 0) {
-        image_.SetTile(open->second.sums);
-        open_.erase(open);
-    }
+    const int tile = tile_of_[size_t(task_index)];
+    absl::StatusOr<TileSums> merged = mutable_store().Get(tile);
+    if (!merged.ok()) return merged.status();
+    *merged += sums;
+    if (absl::Status s = mutable_store().Put(tile, *merged); !s.ok()) return s;
     done_[size_t(task_index)] = true;
     ++tasks_done_;
     stats_ += sums.stats;
@@ -64,21 +88,6 @@ absl::Status RenderMerger::Add(int task_index, const TileSums& sums) {
 absl::StatusOr<std::vector<RenderTask>> RenderMerger::Merge(int task_index, const TileSums& sums) {
     if (absl::Status s = Add(task_index, sums); !s.ok()) return s;
     return std::vector<RenderTask>();
-}
-
-std::map<std::pair<int, int>, RenderMerger::OpenTile>::iterator RenderMerger::OpenTileFor(
-    const RenderTask& task) {
-    auto it = open_.find(Key(task.rect));
-    if (it != open_.end()) return it;
-    return open_
-        .emplace(Key(task.rect), OpenTile{TileSums(task.rect), passes_per_tile_[Key(task.rect)]})
-        .first;
-}
-
-Image RenderMerger::Snapshot() const {
-    Image image = image_;
-    for (const auto& [key, tile] : open_) image.SetTile(tile.sums);
-    return image;
 }
 
 }  // namespace lf

@@ -48,7 +48,9 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
             tbb::simple_partitioner());
     });
     if (!status.ok()) return status;
-    RenderOutput out{merger.Snapshot(), merger.stats(), 0, {}};
+    absl::StatusOr<Image> image = merger.Snapshot();
+    if (!image.ok()) return image.status();
+    RenderOutput out{std::move(*image), merger.stats(), 0, {}};
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
 }
@@ -132,7 +134,9 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
 
     RenderOutput out;
     out.stats = plan.stats();
-    out.image = plan.Snapshot();
+    absl::StatusOr<Image> image = plan.Snapshot();
+    if (!image.ok()) return image.status();
+    out.image = std::move(*image);
     absl::StatusOr<AdaptiveReport> report = plan.Report();
     if (!report.ok()) return report.status();
     out.adaptive = std::move(*report);

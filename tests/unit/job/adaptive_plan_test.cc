@@ -148,7 +148,7 @@ TEST(AdaptiveTilePlan, ReplayingResultsInIndexOrderRebuildsThePlanAndItsBits) {
         EXPECT_EQ(replayed->tasks()[t].sample_end, plan->tasks()[t].sample_end);
     }
     EXPECT_TRUE(replayed->Complete());
-    EXPECT_EQ(*replayed->Snapshot().FindChannel("R"), *plan->Snapshot().FindChannel("R"));
+    EXPECT_EQ(*replayed->Snapshot()->FindChannel("R"), *plan->Snapshot()->FindChannel("R"));
 }
 
 // Long passes are split into tasks of consecutive sample ranges, each of even length, which
@@ -180,8 +180,8 @@ TEST(AdaptiveTilePlan, LongPassesSplitIntoTasksThatMergeToTheSameBits) {
     }
     ASSERT_TRUE(split->Complete());
     EXPECT_GT(split->tasks().size(), whole->tasks().size());
-    EXPECT_EQ(*split->Snapshot().FindChannel("R"), *whole->Snapshot().FindChannel("R"));
-    EXPECT_EQ(*split->Snapshot().FindChannel("spp"), *whole->Snapshot().FindChannel("spp"));
+    EXPECT_EQ(*split->Snapshot()->FindChannel("R"), *whole->Snapshot()->FindChannel("R"));
+    EXPECT_EQ(*split->Snapshot()->FindChannel("spp"), *whole->Snapshot()->FindChannel("spp"));
 }
 
 // A split first pass is never dropped; a split later pass keeps the tasks merged before.

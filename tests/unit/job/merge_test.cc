@@ -62,20 +62,20 @@ TEST(RenderMerger, AnyOrderGivesTheBitsOfTheWholeRender) {
         }
         ASSERT_TRUE(merger.Complete());
         EXPECT_EQ(merger.stats().samples, uint64_t(kWidth * kHeight) * kSpp);
-        ExpectSameBits(merger.Snapshot(), reference);
+        ExpectSameBits(*merger.Snapshot(), reference);
     }
 }
 
 TEST(RenderMerger, SnapshotShowsWhatArrived) {
     const std::vector<RenderTask> plan = *PlanRender({kWidth, kHeight, kSpp, 8, 2});
     RenderMerger merger(kWidth, kHeight, plan);
-    const Image empty = merger.Snapshot();
+    const Image empty = *merger.Snapshot();
     for (const char* ch : {"R", "G", "B", "A.R", "B.B", "spp"}) {
         ASSERT_NE(empty.FindChannel(ch), nullptr) << ch;
     }
     const RenderTask& first = plan[0];
     ASSERT_TRUE(merger.Add(0, RenderFake(first.rect, first.sample_begin, first.sample_end)).ok());
-    const Image partial = merger.Snapshot();
+    const Image partial = *merger.Snapshot();
     const std::vector<float>& spp = *partial.FindChannel("spp");
     EXPECT_EQ(spp[0], float(first.sample_end - first.sample_begin));
     EXPECT_EQ(spp[size_t(kWidth) * (kHeight - 1)], 0.0f);
@@ -86,7 +86,7 @@ TEST(RenderMerger, RefusesRepeatedAndMismatchedResults) {
     RenderMerger merger(kWidth, kHeight, plan);
     const RenderTask& t = plan[1];
     ASSERT_TRUE(merger.Add(1, RenderFake(t.rect, t.sample_begin, t.sample_end)).ok());
-    const Image before = merger.Snapshot();
+    const Image before = *merger.Snapshot();
 
     EXPECT_EQ(merger.Add(1, RenderFake(t.rect, t.sample_begin, t.sample_end)).code(),
               absl::StatusCode::kAlreadyExists);
@@ -97,7 +97,7 @@ TEST(RenderMerger, RefusesRepeatedAndMismatchedResults) {
     EXPECT_EQ(merger.Add(int(plan.size()), RenderFake(t.rect, 0, 1)).code(),
               absl::StatusCode::kInvalidArgument);
     EXPECT_EQ(merger.tasks_done(), 1u);
-    ExpectSameBits(merger.Snapshot(), before);
+    ExpectSameBits(*merger.Snapshot(), before);
 }
 
 }  // namespace

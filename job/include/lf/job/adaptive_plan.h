@@ -16,6 +16,7 @@
 #include "lf/job/merge.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
+#include "lf/job/tile_store.h"
 
 namespace lf {
 
@@ -65,23 +66,25 @@ class AdaptiveTilePlan : public TileMerger {
     // The planner's tiles (PlanRender with one pass), each with a first pass of `first_spp`
     // samples rounded up to even. A pass of more than `max_task_samples` pixel samples is split
     // into tasks of consecutive, even-length sample ranges (so each holds as many A as B
-    // samples). InvalidArgument for sizes PlanRender refuses and for settings
-    // CheckAdaptiveSettings refuses.
+    // samples). Each tile's running sums are kept where `make_store` says. InvalidArgument for
+    // sizes PlanRender refuses and for settings CheckAdaptiveSettings refuses; the factory's
+    // error when it cannot make the store.
     static absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> Make(
         int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings,
-        uint64_t max_task_samples = kMaxTaskSamples);
+        uint64_t max_task_samples = kMaxTaskSamples,
+        const TileStoreFactory& make_store = MakeMemoryTileStore);
 
     // The tiles' first passes in plan order, then the passes Merge appends, in the order of the
     // results that asked for them.
     const std::vector<RenderTask>& tasks() const override { return tasks_; }
     // Merges a task; once the last task of a pass is merged, appends the tile's next pass unless
     // the tile is done. InvalidArgument for a result that is not the task's rectangle and sample
-    // count, a task not in the plan or one Stop dropped; AlreadyExists for a task merged before.
+    // count, a task not in the plan or one Stop dropped; AlreadyExists for a task merged before;
+    // the store's error when it cannot read or write the tile (the task is then not merged).
     absl::StatusOr<std::vector<RenderTask>> Merge(int task_index, const TileSums& sums) override;
     size_t tasks_done() const override { return tasks_done_; }
     bool Complete() const override;
     const RenderStats& stats() const override { return stats_; }
-    Image Snapshot() const override;
 
     // The time limit: appends no more passes and drops the tasks not yet merged, except those of
     // tiles' first passes. Returns the dropped task indices. A tile keeps the tasks of a split
@@ -93,20 +96,24 @@ class AdaptiveTilePlan : public TileMerger {
     size_t tile_count() const { return tiles_.size(); }
     size_t tiles_finished() const;  // tiles with no task out
 
+    // How the sampling ended: TileReport with the estimated error of the Snapshot.
     absl::StatusOr<AdaptiveReport> Report() const;
+    // All but estimated_error, without reading the store: a caller may make and measure the
+    // snapshot elsewhere (the scheduler does, outside its lock).
+    AdaptiveReport TileReport() const;
 
   private:
     struct Tile {
-        TileSums sums;
+        PixelRect rect;
+        uint64_t spp = 0;  // samples merged in each pixel
         double error = 1;
         std::vector<int> pending;  // the tasks of the current pass not merged yet
     };
     AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings,
-                     uint64_t max_task_samples);
+                     uint64_t max_task_samples, std::shared_ptr<TileStore> store);
     // Appends the tasks of tile `tile`'s pass over samples [begin, end).
     std::vector<RenderTask> AppendPass(int tile, uint64_t begin, uint64_t end);
 
-    int width_, height_;
     AdaptiveSettings settings_;
     uint64_t max_task_samples_;
     uint64_t first_ = 0;  // samples of the first pass

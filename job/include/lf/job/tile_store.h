@@ -1,0 +1,53 @@
+// Where a merger keeps its tiles' exact sums between results: in memory (local mode), or in a
+// file (the coordinator), so that a farm job's resident memory is the tile being merged, not its
+// image. A store's tiles are fixed when it is made; Get and Put may be called from any thread.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "lf/core/film.h"
+#include "lf/core/image.h"
+
+namespace lf {
+
+class TileStore {
+  public:
+    virtual ~TileStore() = default;
+    const std::vector<PixelRect>& tiles() const { return tiles_; }
+
+    // The sums last put for tile `tile`; zero sums of its rectangle before the first Put.
+    virtual absl::StatusOr<TileSums> Get(int tile) const = 0;
+    // Replaces tile `tile`'s sums. InvalidArgument, and nothing stored, when `sums` does not
+    // cover exactly that tile.
+    virtual absl::Status Put(int tile, const TileSums& sums) = 0;
+
+  protected:
+    explicit TileStore(std::vector<PixelRect> tiles) : tiles_(std::move(tiles)) {}
+    absl::Status CheckTile(int tile, const TileSums& sums) const;
+    absl::Status CheckIndex(int tile) const;
+
+  private:
+    std::vector<PixelRect> tiles_;
+};
+
+// Makes the store of one merger, given its tiles.
+using TileStoreFactory =
+    std::function<absl::StatusOr<std::unique_ptr<TileStore>>(std::vector<PixelRect> tiles)>;
+
+absl::StatusOr<std::unique_ptr<TileStore>> MakeMemoryTileStore(std::vector<PixelRect> tiles);
+
+// A sparse file in `dir` holding every tile at a fixed offset (104 bytes a pixel), unlinked as
+// soon as it is open: it goes when the store is destroyed or the process dies, and a restarted
+// coordinator rebuilds it from the task results its job store recorded.
+absl::StatusOr<std::unique_ptr<TileStore>> MakeFileTileStore(const std::string& dir,
+                                                             std::vector<PixelRect> tiles);
+
+// R,G,B, A.*, B.* and spp of every tile's sums, reading one tile at a time (pixels outside every
+// tile are black with spp 0).
+absl::StatusOr<Image> RenderImageOf(const TileStore& store, int width, int height);
+
+}  // namespace lf
