@@ -17,7 +17,7 @@ namespace lf {
 struct LocalRenderOptions {
     std::string scene_path;
     std::string exr_path;
-    std::string png_path;         // empty: no preview
+    std::string png_path;                    // empty: no preview
     std::string method = defaults::kMethod;  // path | radiosity | auto
     RenderSettings render;
     AdaptiveSettings adaptive;  // used when a target error or a time limit is set

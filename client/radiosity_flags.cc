@@ -3,8 +3,8 @@
 #include <limits>
 #include <vector>
 
-#include "lf/job/job_spec.h"
 #include "absl/strings/str_cat.h"
+#include "lf/job/job_spec.h"
 #include "lf/kernels/radiosity.h"
 
 namespace lf {

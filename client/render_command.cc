@@ -81,48 +81,47 @@ Command AddRenderCommand(CLI::App& app) {
                     "write the solution as a PLY mesh with per-vertex sRGB colours")
         ->group(r);
 
-    return {cmd, [cmd, options, no_progress] {
-                options->progress = !*no_progress;
-                if (absl::Status s = CheckExrPath(options->exr_path); !s.ok()) {
-                    return ReportError(s);
-                }
-                if (absl::Status s = CheckRadiosityFlagsApply(*cmd, options->method); !s.ok()) {
-                    return ReportError(s);
-                }
-                absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
-                if (!summary.ok()) return ReportError(summary.status());
-                const double s = summary->render_seconds;
+    return {
+        cmd, [cmd, options, no_progress] {
+            options->progress = !*no_progress;
+            if (absl::Status s = CheckExrPath(options->exr_path); !s.ok()) {
+                return ReportError(s);
+            }
+            if (absl::Status s = CheckRadiosityFlagsApply(*cmd, options->method); !s.ok()) {
+                return ReportError(s);
+            }
+            absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
+            if (!summary.ok()) return ReportError(summary.status());
+            const double s = summary->render_seconds;
+            std::printf(
+                "job %s: %s, %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
+                "%llu NaN/Inf samples -> %s\n",
+                summary->job_id.c_str(), summary->method.c_str(), summary->width, summary->height,
+                (unsigned long long)summary->stats.samples, s, summary->stats.samples / s * 1e-6,
+                summary->stats.rays / s * 1e-6, (unsigned long long)summary->stats.invalid_samples,
+                options->exr_path.c_str());
+            std::printf("time: load %.2f s, ", summary->load_seconds);
+            if (const std::optional<RadiosityFigures>& r = summary->radiosity) {
+                std::printf("radiosity %.2f s (mesh %.2f s, form factors %.2f s, solve %.2f s), ",
+                            summary->radiosity_seconds, summary->mesh_seconds,
+                            r->form_factor_seconds, r->solve_seconds);
+            }
+            std::printf("render %.2f s, total %.2f s\n", summary->render_seconds, summary->seconds);
+            if (summary->estimated_error >= 0) {
+                std::printf("estimated relative error %.4f%s\n", summary->estimated_error,
+                            summary->high_variance ? " (high variance)" : "");
+            }
+            if (summary->adaptive) {
+                const AdaptiveReport& a = summary->adaptive_report;
                 std::printf(
-                    "job %s: %s, %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
-                    "%llu NaN/Inf samples -> %s\n",
-                    summary->job_id.c_str(), summary->method.c_str(), summary->width,
-                    summary->height, (unsigned long long)summary->stats.samples, s,
-                    summary->stats.samples / s * 1e-6, summary->stats.rays / s * 1e-6,
-                    (unsigned long long)summary->stats.invalid_samples, options->exr_path.c_str());
-                std::printf("time: load %.2f s, ", summary->load_seconds);
-                if (const std::optional<RadiosityFigures>& r = summary->radiosity) {
-                    std::printf(
-                        "radiosity %.2f s (mesh %.2f s, form factors %.2f s, solve %.2f s), ",
-                        summary->radiosity_seconds, summary->mesh_seconds, r->form_factor_seconds,
-                        r->solve_seconds);
-                }
-                std::printf("render %.2f s, total %.2f s\n", summary->render_seconds,
-                            summary->seconds);
-                if (summary->estimated_error >= 0) {
-                    std::printf("estimated relative error %.4f%s\n", summary->estimated_error,
-                                summary->high_variance ? " (high variance)" : "");
-                }
-                if (summary->adaptive) {
-                    const AdaptiveReport& a = summary->adaptive_report;
-                    std::printf(
-                        "adaptive: %llu..%llu spp per pixel, worst tile %.4f, %d of %d tiles "
-                        "above the target%s\n",
-                        (unsigned long long)a.min_spp, (unsigned long long)a.max_spp,
-                        a.worst_tile_error, a.tiles_above_target, a.tiles,
-                        a.timed_out ? ", time limit reached" : "");
-                }
-                return 0;
-            }};
+                    "adaptive: %llu..%llu spp per pixel, worst tile %.4f, %d of %d tiles "
+                    "above the target%s\n",
+                    (unsigned long long)a.min_spp, (unsigned long long)a.max_spp,
+                    a.worst_tile_error, a.tiles_above_target, a.tiles,
+                    a.timed_out ? ", time limit reached" : "");
+            }
+            return 0;
+        }};
 }
 
 }  // namespace lf

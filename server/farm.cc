@@ -144,11 +144,8 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     }
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
         spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); });
-    if (!scene.ok()) {
-        Log()->warn("submission of {} refused: {}", spec.scene.path,
-                    std::string(scene.status().message()));
-        return absl::InvalidArgumentError(scene.status().message());
-    }
+    // The service logs the refusal with its caller.
+    if (!scene.ok()) return absl::InvalidArgumentError(scene.status().message());
     if (spec.method == "radiosity") {
         if (absl::Status s = CheckRadiosityCanModel(*scene); !s.ok()) return s;
     }

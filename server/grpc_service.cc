@@ -23,11 +23,15 @@ std::shared_ptr<spdlog::logger> Log() { return NamedLogger("rpc"); }
 // Who called, for the log: the peer's address as gRPC reports it.
 std::string Peer(const grpc::ServerContext* context) { return LogSafe(context->peer()); }
 
-// Streams a file in chunks; stops early when the client goes away.
+// Streams a file in chunks; stops early when the client goes away. The client hears `what` could
+// not be read, never where the file is: paths of the data folder stay in the server's log.
 grpc::Status StreamFile(grpc::ServerContext* context, const std::string& path,
-                        grpc::ServerWriter<pb::Chunk>* writer) {
+                        const std::string& what, grpc::ServerWriter<pb::Chunk>* writer) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) return grpc::Status(grpc::StatusCode::NOT_FOUND, path + ": cannot be read");
+    if (!in) {
+        Log()->error("{}: {} cannot be read", what, path);
+        return grpc::Status(grpc::StatusCode::NOT_FOUND, what + " cannot be read on the server");
+    }
     std::string buffer(kChunkBytes, '\0');
     pb::Chunk chunk;
     while (in) {
@@ -170,7 +174,7 @@ grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context,
                                          grpc::ServerWriter<pb::Chunk>* writer) {
     absl::StatusOr<std::string> path = farm_.ResultFile(req->job_id(), req->preview());
     if (!path.ok()) return ToGrpcStatus(path.status());
-    return StreamFile(context, *path, writer);
+    return StreamFile(context, *path, "the result of job " + req->job_id(), writer);
 }
 
 grpc::Status JobServiceImpl::DeleteJob(grpc::ServerContext* context,
@@ -243,7 +247,7 @@ grpc::Status WorkerServiceImpl::FetchBlob(grpc::ServerContext* context,
     if (!farm_.blobs().Has(req->hash())) {
         return ToGrpcStatus(absl::NotFoundError("no blob " + req->hash()));
     }
-    return StreamFile(context, farm_.blobs().PathOf(req->hash()), writer);
+    return StreamFile(context, farm_.blobs().PathOf(req->hash()), "blob " + req->hash(), writer);
 }
 
 }  // namespace lf

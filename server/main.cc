@@ -7,10 +7,10 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
+#include "lf/core/stop_signals.h"
 #include "server/farm.h"
 #include "server/grpc_service.h"
 #include "server/timeout_checker.h"
-#include "lf/core/stop_signals.h"
 
 int main(int argc, char** argv) {
     const lf::StopSignals stop_signals;  // before any thread starts
@@ -71,7 +71,8 @@ int main(int argc, char** argv) {
     options.retention = absl::Hours(24 * retention_days);
     // Often enough that a cancel reaches workers within about a second, and several times per
     // lease so one slow answer does not lose it.
-    options.scheduler.heartbeat_interval = std::min(absl::Milliseconds(300), options.scheduler.lease / 4);
+    options.scheduler.heartbeat_interval =
+        std::min(absl::Milliseconds(300), options.scheduler.lease / 4);
 
     absl::StatusOr<std::unique_ptr<lf::Farm>> farm = lf::Farm::Open(options);
     if (!farm.ok()) {

@@ -95,9 +95,8 @@ absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord reco
     job->speculation = SpeculationPolicy(options_.speculate_after);
     if (IsAdaptive(spec.adaptive)) {
         absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan =
-            AdaptiveTilePlan::Make(spec.plan.width, spec.plan.height, spec.plan.spp,
-                                   spec.plan.tile, spec.adaptive, kMaxTaskSamples,
-                                   options_.tile_stores);
+            AdaptiveTilePlan::Make(spec.plan.width, spec.plan.height, spec.plan.spp, spec.plan.tile,
+                                   spec.adaptive, kMaxTaskSamples, options_.tile_stores);
         if (!plan.ok()) return plan.status();
         job->adaptive = plan->get();
         job->merger = std::move(*plan);
@@ -139,12 +138,14 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     if (earlier) {
         locked.lock.unlock();
         if (absl::Status s = store_.WaitDurable(earlier->second); !s.ok()) return s;
-        Log()->info("job={} submitted again (request {})", earlier->first, spec.request_id);
+        Log()->info("job={} submitted again (request {})", earlier->first,
+                    LogSafe(spec.request_id));
         return earlier->first;
     }
     if (active_.size() >= options_.max_active_jobs) {
         return absl::ResourceExhaustedError(
-            absl::StrCat(active_.size(), " jobs are queued or running, this server's limit "
+            absl::StrCat(active_.size(),
+                         " jobs are queued or running, this server's limit "
                          "(lightfarm-server --max-active-jobs); submit again once some end"));
     }
     // Ids are random: one the store lacks is taken in memory only by a freak.
@@ -318,7 +319,8 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker) {
     for (auto& [id, job] : active_) {
         if (const int t = StragglerFor(*job, worker, now); t >= 0) {
             Log()->info("job={} task={} running for {}: leased again to {}", id, t,
-                        absl::FormatDuration(now - job->tasks[size_t(t)].leased_at), worker);
+                        absl::FormatDuration(now - job->tasks[size_t(t)].leased_at),
+                        LogSafe(worker));
             return Grant(*job, t, worker, now);
         }
     }
@@ -359,7 +361,7 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
     timeouts_.Set(lease_id, now + options_.lease);
     if (job.record.state == JobState::kQueued) MoveJob(job, JobState::kRunning);
     Save(job);
-    Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, worker,
+    Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, LogSafe(worker),
                  task.attempts);
     TaskAssignment lease;
     lease.lease_id = lease_id;
@@ -528,7 +530,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     const uint64_t ticket = store_.QueueTaskDone(job.record, ref->task, EncodeTileSums(sums));
     ++version_;
     changed_.notify_all();
-    Log()->debug("job={} task={} done by {} ({}/{})", job.record.id, ref->task, worker,
+    Log()->debug("job={} task={} done by {} ({}/{})", job.record.id, ref->task, LogSafe(worker),
                  job.record.tasks_done, job.record.tasks_total);
     const Completion completion{job.record.id, job.merger->Complete()};
     locked.lock.unlock();
@@ -551,7 +553,8 @@ absl::StatusOr<Scheduler::LeaseRef> Scheduler::ResultLease(const std::string& le
                                                            absl::Time now) {
     const std::optional<LeaseRef> ref = Resolve(lease_id);
     if (!ref || !HeldBy(*ref, worker)) {
-        Log()->warn("result for lease {} from {} refused: not a lease it holds", lease_id, worker);
+        Log()->warn("result for lease {} from {} refused: not a lease it holds", LogSafe(lease_id),
+                    LogSafe(worker));
         return absl::FailedPreconditionError(absl::StrCat(
             "lease ", lease_id, " is not one of worker ", worker, " in a running job"));
     }
@@ -657,8 +660,8 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
         task.failed_on.insert(task.holders[size_t(ref.attempt - 1)]);
         job.record.last_error = absl::StrCat("task ", t, ": ", reason);
     }
-    Log()->warn("job={} task={} attempt {} failed: {}{}", job.record.id, t, ref.attempt, reason,
-                counted ? "" : " (not counted)");
+    Log()->warn("job={} task={} attempt {} failed: {}{}", job.record.id, t, ref.attempt,
+                LogSafe(reason), counted ? "" : " (not counted)");
     if (task.failures >= options_.max_failures) {
         FailJob(job, absl::StrCat("task ", t, " failed ", task.failures, " times; last: ", reason));
         return;
@@ -673,7 +676,7 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
 void Scheduler::FailJob(Job& job, const std::string& error) {
     MoveJob(job, JobState::kFailed);
     job.record.error = error;
-    Log()->error("job={} failed: {}", job.record.id, error);
+    Log()->error("job={} failed: {}", job.record.id, LogSafe(error));
     EndJob(job);
 }
 

@@ -50,9 +50,10 @@ void Run(const char* name, lf::TileMerger& merger, long start_kb) {
     if (!image.ok()) std::exit(1);
     const long snapshot_kb = PeakKb() - start_kb;
     const double pixels = double(merger.width()) * merger.height();
-    std::printf("%-18s %6zu tasks  merging %8.1f MB (%6.1f B/px)  +snapshot %8.1f MB (%6.1f B/px)\n",
-                name, merger.tasks().size(), merged_kb / 1024.0, merged_kb * 1024.0 / pixels,
-                snapshot_kb / 1024.0, snapshot_kb * 1024.0 / pixels);
+    std::printf(
+        "%-18s %6zu tasks  merging %8.1f MB (%6.1f B/px)  +snapshot %8.1f MB (%6.1f B/px)\n", name,
+        merger.tasks().size(), merged_kb / 1024.0, merged_kb * 1024.0 / pixels,
+        snapshot_kb / 1024.0, snapshot_kb * 1024.0 / pixels);
     std::fflush(stdout);
 }
 
@@ -86,7 +87,8 @@ int main(int argc, char** argv) {
     std::printf("%dx%d, %d px tiles, %llu spp\n", size, size, tile, (unsigned long long)spp);
     std::fflush(stdout);  // not again by each child
     for (const bool file : {false, true}) {
-        const lf::TileStoreFactory stores = file ? in_file : lf::TileStoreFactory(lf::MakeMemoryTileStore);
+        const lf::TileStoreFactory stores =
+            file ? in_file : lf::TileStoreFactory(lf::MakeMemoryTileStore);
         InChild([&] {
             const long start = PeakKb();
             absl::StatusOr<std::vector<lf::RenderTask>> plan =

@@ -60,9 +60,10 @@ void Worker::Run() {
             } else if (last == absl::StatusCode::kFailedPrecondition) {
                 // Another build (LeaseTask's version check). Retried rather than exiting, so a
                 // server brought to this build gets its workers back without restarting them.
-                Log()->error("worker={} refused by the server, retrying until it accepts this "
-                             "build: {}",
-                             server_.worker_id(), why);
+                Log()->error(
+                    "worker={} refused by the server, retrying until it accepts this "
+                    "build: {}",
+                    server_.worker_id(), why);
             } else {
                 Log()->warn("worker={} server unreachable, retrying: {}", server_.worker_id(), why);
             }
@@ -176,7 +177,8 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
     loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
     loaded.job_id = task.job_id;
     loaded_ = std::move(loaded);
-    Log()->info("job={} task={} scene {} loaded", task.job_id, task.task.index, task.spec.scene.path);
+    Log()->info("job={} task={} scene {} loaded", task.job_id, task.task.index,
+                task.spec.scene.path);
     return absl::OkStatus();
 }
 
@@ -274,8 +276,9 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
                     TileSums row(row_rect);
                     for (uint64_t s = task.task.sample_begin; s < task.task.sample_end && !cancel;
                          s += step) {
-                        row += RenderTile(*loaded_.camera, *loaded_.tracer, row_rect, task.spec.seed, s,
-                                          std::min(s + step, task.task.sample_end), &cancel);
+                        row +=
+                            RenderTile(*loaded_.camera, *loaded_.tracer, row_rect, task.spec.seed,
+                                       s, std::min(s + step, task.task.sample_end), &cancel);
                     }
                     std::copy(row.pixels.begin(), row.pixels.end(), &tile.at(rect.x0, y));
                     std::lock_guard<std::mutex> lock(stats_mutex);

@@ -120,10 +120,10 @@ class FileTileStore : public TileStore {
                                     : ::pread(fd_, data, size, off_t(offset));
             if (n < 0 && errno == EINTR) continue;
             if (n <= 0) {
-                return absl::UnavailableError(absl::StrCat(
-                    name_, ": cannot ", write ? "write" : "read", " tile ", tile, " (",
-                    RectText(tiles()[size_t(tile)]), "): ",
-                    n < 0 ? std::strerror(errno) : "end of file"));
+                return absl::UnavailableError(
+                    absl::StrCat(name_, ": cannot ", write ? "write" : "read", " tile ", tile, " (",
+                                 RectText(tiles()[size_t(tile)]),
+                                 "): ", n < 0 ? std::strerror(errno) : "end of file"));
             }
             data += n;
             size -= size_t(n);
@@ -177,8 +177,8 @@ absl::StatusOr<std::unique_ptr<TileStore>> MakeFileTileStore(const std::string& 
     // Sparse: a tile takes disk space once it is written, and reads as zero sums before.
     if (::ftruncate(fd, off_t(store->size())) != 0) {
         return absl::UnavailableError(absl::StrCat(name, ": cannot size the tile file to ",
-                                                   store->size(), " bytes: ",
-                                                   std::strerror(errno)));
+                                                   store->size(),
+                                                   " bytes: ", std::strerror(errno)));
     }
     return store;
 }

@@ -14,10 +14,10 @@
 #include <tuple>
 
 #include "lf/core/image_error.h"
-#include "lf/kernels/tile_renderer.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/merge.h"
 #include "lf/job/plan.h"
+#include "lf/kernels/tile_renderer.h"
 
 namespace lf {
 

@@ -33,7 +33,7 @@ RunResult Lightfarm(const std::string& args) {
 }
 
 class Cli : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         dir_ = fs::temp_directory_path() / ("lf_cli_" + std::to_string(::getpid()));
         fs::create_directories(dir_);
@@ -48,9 +48,9 @@ protected:
 
 TEST_F(Cli, RenderWritesExrWithMetadataAndPng) {
     const std::string exr = (dir_ / "c.exr").string(), png = (dir_ / "c.png").string();
-    const RunResult r = Lightfarm("render " + std::string(LF_TEST_SCENES) +
-                            "/cornell_box.json -o " + exr + " --png " + png +
-                            " --spp 2 --seed 3 --threads 2 --tile 16 --no-progress");
+    const RunResult r =
+        Lightfarm("render " + std::string(LF_TEST_SCENES) + "/cornell_box.json -o " + exr +
+                  " --png " + png + " --spp 2 --seed 3 --threads 2 --tile 16 --no-progress");
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("samples/s"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("NaN"), std::string::npos) << r.output;
@@ -60,9 +60,9 @@ TEST_F(Cli, RenderWritesExrWithMetadataAndPng) {
     for (const char* ch : {"R", "G", "B", "A.R", "B.R", "spp"}) {
         EXPECT_NE(file->image.FindChannel(ch), nullptr) << ch;
     }
-    for (const char* key : {"lightfarm.sceneHash", "lightfarm.method", "lightfarm.spp",
-                            "lightfarm.seed", "lightfarm.maxDepth", "lightfarm.seconds",
-                            "lightfarm.version"}) {
+    for (const char* key :
+         {"lightfarm.sceneHash", "lightfarm.method", "lightfarm.spp", "lightfarm.seed",
+          "lightfarm.maxDepth", "lightfarm.seconds", "lightfarm.version"}) {
         EXPECT_TRUE(file->attributes.count(key)) << key;
     }
     EXPECT_EQ(std::get<int>(file->attributes.at("lightfarm.spp")), 2);
@@ -119,7 +119,7 @@ TEST_F(Cli, AbsurdOptionsAreRefused) {
     EXPECT_NE(Lightfarm(base + " --tile 0").status, 0);
     EXPECT_NE(Lightfarm(base + " --max-depth -5").status, 0);
     const RunResult unwritable = Lightfarm(base.substr(0, base.find(" -o ")) +
-                                     " -o /nonexistent/dir/x.exr --spp 1 --no-progress");
+                                           " -o /nonexistent/dir/x.exr --spp 1 --no-progress");
     EXPECT_NE(unwritable.status, 0);
     EXPECT_NE(unwritable.output.find("/nonexistent/dir/x.exr"), std::string::npos)
         << unwritable.output;
@@ -136,8 +136,8 @@ TEST_F(Cli, AutoPicksRadiosityForLambertianScenesAndSaysWhy) {
     const std::string exr = (dir_ / "r.exr").string(), solution = (dir_ / "r.sol").string();
     const RunResult r = Lightfarm("render " + scene + " -o " + exr +
                                   " --method auto --patches 300 --spp 1 --no-progress "
-                                  "--save-solution " + solution + " --export-ply " +
-                                  (dir_ / "r.ply").string());
+                                  "--save-solution " +
+                                  solution + " --export-ply " + (dir_ / "r.ply").string());
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("method radiosity (every material is Lambertian)"), std::string::npos)
         << r.output;
@@ -151,7 +151,8 @@ TEST_F(Cli, AutoPicksRadiosityForLambertianScenesAndSaysWhy) {
     const std::string again = (dir_ / "again.exr").string();
     const RunResult loaded = Lightfarm("render " + scene + " -o " + again +
                                        " --method radiosity --patches 300 --spp 1 --no-progress "
-                                       "--load-solution " + solution);
+                                       "--load-solution " +
+                                       solution);
     ASSERT_EQ(loaded.status, 0) << loaded.output;
     absl::StatusOr<ExrFile> second = ReadExr(again);
     ASSERT_TRUE(second.ok());
@@ -200,20 +201,18 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
 
     // Radiosity's refusal comes before any rendering.
     const RunResult refused = Lightfarm("converge " + std::string(LF_TEST_SCENES) +
-                                        "/materials.json --out " + out.string() +
-                                        " --method both");
+                                        "/materials.json --out " + out.string() + " --method both");
     EXPECT_NE(refused.status, 0);
-    EXPECT_NE(refused.output.find("radiosity cannot model this scene: material"),
-              std::string::npos)
+    EXPECT_NE(refused.output.find("radiosity cannot model this scene: material"), std::string::npos)
         << refused.output;
 }
 
 TEST_F(Cli, TargetErrorRecordsTheEstimateInTheHeader) {
     const std::string exr = (dir_ / "t.exr").string();
-    const RunResult r = Lightfarm("render " + std::string(LF_TEST_SCENES) +
-                                  "/cornell_box.json -o " + exr +
-                                  " --spp 4 --target-error 0.3 --time-limit 60 --threads 2 "
-                                  "--no-progress");
+    const RunResult r =
+        Lightfarm("render " + std::string(LF_TEST_SCENES) + "/cornell_box.json -o " + exr +
+                  " --spp 4 --target-error 0.3 --time-limit 60 --threads 2 "
+                  "--no-progress");
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("estimated relative error"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("0 of 64 tiles above the target"), std::string::npos) << r.output;

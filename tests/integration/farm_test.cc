@@ -807,8 +807,8 @@ TEST_F(Farm, SecondServerOnAPortInUseRefusesToStart) {
 
 TEST_F(Farm, SecondServerOnADataDirInUseRefusesToStart) {
     StartServer();
-    Child* second = Spawn({std::string(LF_BIN_DIR) + "/lightfarm-server", "--listen",
-                           "127.0.0.1:0", "--data-dir", (dir_ / "data").string()},
+    Child* second = Spawn({std::string(LF_BIN_DIR) + "/lightfarm-server", "--listen", "127.0.0.1:0",
+                           "--data-dir", (dir_ / "data").string()},
                           "second-server.log");
     EXPECT_EQ(second->Wait(milliseconds(10000)), std::optional<int>(1));
     const std::string log = ReadText(dir_ / "second-server.log");

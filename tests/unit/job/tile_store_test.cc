@@ -122,7 +122,8 @@ TEST_F(FileTileStoreTest, ReadsZeroSumsBeforeAPutAndThePutSumsAfter) {
     for (size_t i = 0; i < sums.pixels.size(); ++i) {
         EXPECT_EQ(after->pixels[i].Count(), 6u);
         for (int h = 0; h < 2; ++h) {
-            for (int c = 0; c < 3; ++c) EXPECT_EQ(after->pixels[i].sum[h][c], sums.pixels[i].sum[h][c]);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_EQ(after->pixels[i].sum[h][c], sums.pixels[i].sum[h][c]);
         }
     }
     // The file is unlinked once open: nothing is left behind, whatever happens to the process.

@@ -15,7 +15,7 @@ namespace lf {
 namespace {
 
 class Determinism : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         scene_ = testing::MakeFurnace(1.0, Vec3d(), 0.7f, 1.0f, 24);
         // A sphere and a glossy box face so several BSDFs and light kinds are involved.
@@ -52,8 +52,8 @@ protected:
 
 TEST_F(Determinism, SameBitsForAnyTileSizePassesAndThreadCount) {
     const Image reference = Render(24, 1, 1);
-    for (auto [tile, threads, passes] : {std::tuple{1, 2, 1}, {5, 2, 3}, {7, 1, 2}, {16, 2, 6},
-                                         {64, 2, 4}}) {
+    for (auto [tile, threads, passes] :
+         {std::tuple{1, 2, 1}, {5, 2, 3}, {7, 1, 2}, {16, 2, 6}, {64, 2, 4}}) {
         const Image other = Render(tile, threads, passes);
         for (const auto& [name, data] : reference.channels()) {
             EXPECT_EQ(data, *other.FindChannel(name)) << name << " tile " << tile;
@@ -70,7 +70,8 @@ TEST_F(Determinism, SamplePassesAddUpToTheSameBits) {
     for (size_t i = 0; i < whole.pixels.size(); ++i) {
         EXPECT_EQ(whole.pixels[i].Count(), parts.pixels[i].Count());
         for (int h = 0; h < 2; ++h) {
-            for (int c = 0; c < 3; ++c) EXPECT_EQ(whole.pixels[i].sum[h][c], parts.pixels[i].sum[h][c]);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_EQ(whole.pixels[i].sum[h][c], parts.pixels[i].sum[h][c]);
         }
     }
 }

@@ -37,8 +37,8 @@ class Furnace : public ::testing::TestWithParam<FurnaceCase> {};
 TEST_P(Furnace, RadianceIsEmissionOverOneMinusAlbedo) {
     const FurnaceCase c = GetParam();
     const float le = 0.5f;
-    const Scene scene = testing::MakeFurnace(c.half, Vec3d(c.offset, c.offset, c.offset), c.rho,
-                                             le, 16);
+    const Scene scene =
+        testing::MakeFurnace(c.half, Vec3d(c.offset, c.offset, c.offset), c.rho, le, 16);
     const RenderOutput out = Render(scene, 64);
     const double expected = le / (1.0 - c.rho);
     EXPECT_EQ(out.stats.invalid_samples, 0u);
@@ -54,18 +54,18 @@ TEST_P(Furnace, RadianceIsEmissionOverOneMinusAlbedo) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Albedos, Furnace,
-    ::testing::Values(FurnaceCase{0.0f, 1.0, 0.0}, FurnaceCase{0.5f, 1.0, 0.0},
-                      FurnaceCase{0.9f, 1.0, 0.0},
-                      // Scale extremes and far from the origin: leaks or self-intersection
-                      // would lose energy and show here.
-                      FurnaceCase{0.9f, 1e-4, 0.0}, FurnaceCase{0.9f, 1e5, 0.0},
-                      FurnaceCase{0.9f, 1.0, 1e5}, FurnaceCase{0.5f, 1e3, 1e5}),
-    [](const auto& info) {
-        return "rho" + std::to_string(int(info.param.rho * 100)) + "_case" +
-               std::to_string(info.index);
-    });
+INSTANTIATE_TEST_SUITE_P(Albedos, Furnace,
+                         ::testing::Values(FurnaceCase{0.0f, 1.0, 0.0}, FurnaceCase{0.5f, 1.0, 0.0},
+                                           FurnaceCase{0.9f, 1.0, 0.0},
+                                           // Scale extremes and far from the origin: leaks or
+                                           // self-intersection would lose energy and show here.
+                                           FurnaceCase{0.9f, 1e-4, 0.0},
+                                           FurnaceCase{0.9f, 1e5, 0.0}, FurnaceCase{0.9f, 1.0, 1e5},
+                                           FurnaceCase{0.5f, 1e3, 1e5}),
+                         [](const auto& info) {
+                             return "rho" + std::to_string(int(info.param.rho * 100)) + "_case" +
+                                    std::to_string(info.index);
+                         });
 
 TEST(Furnace, MaxDepthTruncatesTheNeumannSeries) {
     // With at most N bounces, L = Le (1 + rho + ... + rho^N).
@@ -112,7 +112,8 @@ TEST(PointLight, LambertianPlaneMatchesInverseSquareLaw) {
             double sum = 0, sum2 = 0;
             for (int j = 0; j < kGrid; ++j) {
                 for (int i = 0; i < kGrid; ++i) {
-                    const Ray r = camera.GenerateRay(px, py, (i + 0.5f) / kGrid, (j + 0.5f) / kGrid);
+                    const Ray r =
+                        camera.GenerateRay(px, py, (i + 0.5f) / kGrid, (j + 0.5f) / kGrid);
                     const double t = -double(r.o.y) / r.d.y;
                     const Vec3d x(r.o.x + t * r.d.x, 0, r.o.z + t * r.d.z);
                     const double dist2 = LengthSquared(light - x);

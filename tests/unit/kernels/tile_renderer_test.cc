@@ -1,17 +1,18 @@
 #include "lf/kernels/tile_renderer.h"
-#include "lf/local/local_executor.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
+#include "lf/local/local_executor.h"
+
 namespace lf {
 namespace {
 
 // Returns NaN for every third sample index, +inf for every fifth, else the sample index.
 class PoisonedEstimator : public RadianceEstimator {
-public:
+  public:
     Rgb Li(const Ray&, Sampler& sampler, RenderStats& stats) const override {
         ++stats.rays;
         const uint64_t s = uint64_t(sampler.Get1D() * 1e6);

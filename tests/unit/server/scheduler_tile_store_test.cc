@@ -55,8 +55,8 @@ class SchedulerTileStoreTest : public ::testing::Test {
         TileSums sums(lease.task.rect);
         for (size_t i = 0; i < sums.pixels.size(); ++i) {
             for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
-                sums.pixels[i].Add(s, Rgb(0.1f * float(lease.task.index + 1) + float(i % 7),
-                                          float(s % 3), 0.25f));
+                sums.pixels[i].Add(
+                    s, Rgb(0.1f * float(lease.task.index + 1) + float(i % 7), float(s % 3), 0.25f));
             }
         }
         return sums;

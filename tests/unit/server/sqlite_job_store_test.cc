@@ -153,7 +153,8 @@ TEST_F(SqliteJobStoreTest, RestartKeepsDoneTasksAndQueuesTheRest) {
         if (lease->job_id != id) break;
         EXPECT_GE(lease->task.index, 3) << "a done task was leased again";
         ++leased;
-        absl::StatusOr<Scheduler::Completion> done = after.Complete(lease->lease_id, "w", Result(*lease));
+        absl::StatusOr<Scheduler::Completion> done =
+            after.Complete(lease->lease_id, "w", Result(*lease));
         ASSERT_TRUE(done.ok()) << done.status();
         if (done->job_rendered) {
             EXPECT_EQ(Pixels(after, id), expected);
@@ -325,7 +326,8 @@ TEST_F(SqliteJobStoreTest, RestartReplaysAnAdaptiveJobsPasses) {
     bool rendered = false;
     while (std::optional<TaskAssignment> lease = after.LeaseTask("w")) {
         ++leased;
-        absl::StatusOr<Scheduler::Completion> done = after.Complete(lease->lease_id, "w", halves(*lease));
+        absl::StatusOr<Scheduler::Completion> done =
+            after.Complete(lease->lease_id, "w", halves(*lease));
         ASSERT_TRUE(done.ok()) << done.status();
         rendered |= done->job_rendered;
     }

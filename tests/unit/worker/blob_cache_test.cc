@@ -17,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 class BlobCacheTest : public ::testing::Test {
-protected:
+  protected:
     void SetUp() override {
         dir_ = fs::temp_directory_path() / ("lf_blob_cache_" + std::to_string(::getpid()));
         fs::remove_all(dir_);

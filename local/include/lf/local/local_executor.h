@@ -11,9 +11,9 @@
 #include "absl/status/statusor.h"
 #include "lf/core/camera.h"
 #include "lf/core/image.h"
-#include "lf/kernels/radiance.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/settings.h"
+#include "lf/kernels/radiance.h"
 
 namespace lf {
 
