@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "lf/core/image_io.h"
+#include "test_dir.h"
 
 namespace lf {
 namespace {
@@ -125,11 +126,7 @@ std::string ReadText(const fs::path& path) {
 class Farm : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("lf_farm_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
+        dir_ = lf::testing::FreshTestDir("lf_farm");
         scene_ = WriteScene("cornell64.json", 64);
     }
 

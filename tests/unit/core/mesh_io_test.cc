@@ -9,18 +9,15 @@
 #include <filesystem>
 #include <fstream>
 
+#include "test_dir.h"
+
 namespace lf {
 namespace {
 
 // A directory of its own per test process: ctest may run test cases in parallel.
 class MeshIoTest : public ::testing::Test {
   protected:
-    void SetUp() override {
-        dir_ = std::filesystem::path(::testing::TempDir()) /
-               ("lf_mesh_io_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::create_directories(dir_);
-    }
+    void SetUp() override { dir_ = lf::testing::FreshTestDir("lf_mesh_io"); }
     void TearDown() override { std::filesystem::remove_all(dir_); }
 
     std::string Write(const std::string& name, const std::string& bytes) {

@@ -11,6 +11,8 @@
 #include <numbers>
 #include <sstream>
 
+#include "test_dir.h"
+
 namespace lf {
 namespace {
 
@@ -63,10 +65,7 @@ std::string SceneJson(const std::string& shapes, const std::string& materials = 
 class SceneLoaderTest : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = std::filesystem::path(::testing::TempDir()) /
-               ("lf_scene_loader_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::create_directories(dir_);
+        dir_ = lf::testing::FreshTestDir("lf_scene_loader");
         CapturedLog().str("");
     }
     void TearDown() override { std::filesystem::remove_all(dir_); }

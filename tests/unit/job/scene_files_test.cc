@@ -13,6 +13,7 @@
 
 #include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
+#include "test_dir.h"
 
 namespace lf {
 namespace {
@@ -37,10 +38,7 @@ std::string SceneNaming(const std::vector<std::string>& files) {
 class SceneFilesTest : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("lf_scene_files_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
+        dir_ = lf::testing::FreshTestDir("lf_scene_files");
         fs::create_directories(dir_ / "scenes");
         fs::create_directories(dir_ / "meshes");
         fs::create_directories(dir_ / "blobs");

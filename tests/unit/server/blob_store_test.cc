@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "test_dir.h"
+
 namespace lf {
 namespace {
 
@@ -17,10 +19,7 @@ namespace fs = std::filesystem;
 class BlobStoreTest : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("lf_blobs_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
+        dir_ = lf::testing::FreshTestDir("lf_blobs");
         blobs_ = std::move(*BlobStore::Open(dir_.string()));
     }
     void TearDown() override { fs::remove_all(dir_); }

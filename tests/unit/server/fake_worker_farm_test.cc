@@ -23,6 +23,7 @@
 #include "lf/job/digest.h"
 #include "lf/version.h"
 #include "server/grpc_service.h"
+#include "test_dir.h"
 
 namespace lf {
 namespace {
@@ -40,10 +41,7 @@ std::string ReadText(const fs::path& path) {
 class FakeWorkerFarm : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("lf_fakefarm_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
+        dir_ = lf::testing::FreshTestDir("lf_fakefarm");
         FarmOptions options;
         options.data_dir = dir_.string();
         options.scheduler.lease = absl::Milliseconds(500);

@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "server/job_record_codec.h"
 #include "server/sqlite_job_store.h"
+#include "test_dir.h"
 
 namespace lf {
 namespace {
@@ -22,11 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TestDir() {
-    const fs::path dir = fs::temp_directory_path() /
-                         ("lf_jobstore_" + std::to_string(::getpid()) + "_" +
-                          ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = lf::testing::FreshTestDir("lf_jobstore");
     return dir;
 }
 

@@ -9,6 +9,7 @@
 
 #include "server/scheduler.h"
 #include "server/sqlite_job_store.h"
+#include "test_dir.h"
 
 namespace lf {
 namespace {
@@ -18,10 +19,7 @@ namespace fs = std::filesystem;
 class SchedulerTileStoreTest : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("lf_sched_tiles_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
+        dir_ = lf::testing::FreshTestDir("lf_sched_tiles");
         fs::create_directories(dir_ / "tiles");
     }
     void TearDown() override { fs::remove_all(dir_); }

@@ -13,6 +13,7 @@
 
 #include "server/farm.h"
 #include "server/scheduler.h"
+#include "test_dir.h"
 
 namespace lf {
 namespace {
@@ -21,13 +22,7 @@ namespace fs = std::filesystem;
 
 class SqliteJobStoreTest : public ::testing::Test {
   protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("lf_store_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
+    void SetUp() override { dir_ = lf::testing::FreshTestDir("lf_store"); }
     void TearDown() override { fs::remove_all(dir_); }
 
     std::unique_ptr<SqliteJobStore> OpenStore() {
