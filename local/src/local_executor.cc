@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <filesystem>
 #include <mutex>
 #include <queue>
 #include <thread>
@@ -21,6 +22,21 @@
 
 namespace lf {
 
+namespace {
+
+// Where a local render keeps its tiles' exact sums (104 bytes a pixel): in memory for images up
+// to 2048x2048, in an unlinked temporary file above, as the farm does, so that a large render's
+// peak memory is its float image (40 bytes a pixel) rather than the sums of every tile.
+TileStoreFactory TileStoreFor(const Camera& camera) {
+    constexpr int64_t kInMemoryPixels = int64_t(2048) * 2048;
+    if (int64_t(camera.width()) * camera.height() <= kInMemoryPixels) return MakeMemoryTileStore;
+    return [](std::vector<PixelRect> tiles) {
+        return MakeFileTileStore(std::filesystem::temp_directory_path().string(), std::move(tiles));
+    };
+}
+
+}  // namespace
+
 absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEstimator& estimator,
                                          const RenderSettings& settings,
                                          const ProgressFn& progress) {
@@ -28,7 +44,10 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
     absl::StatusOr<std::vector<RenderTask>> tasks =
         PlanRender({camera.width(), camera.height(), settings.spp, settings.tile, settings.passes});
     if (!tasks.ok()) return tasks.status();
-    RenderMerger merger(camera.width(), camera.height(), *tasks);
+    absl::StatusOr<std::unique_ptr<RenderMerger>> made =
+        RenderMerger::Make(camera.width(), camera.height(), *tasks, TileStoreFor(camera));
+    if (!made.ok()) return made.status();
+    RenderMerger& merger = **made;
     std::mutex mutex;
     absl::Status status;
     tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
@@ -63,7 +82,8 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made = AdaptiveTilePlan::Make(
-        camera.width(), camera.height(), settings.spp, settings.tile, adaptive);
+        camera.width(), camera.height(), settings.spp, settings.tile, adaptive, kMaxTaskSamples,
+        TileStoreFor(camera));
     if (!made.ok()) return made.status();
     AdaptiveTilePlan& plan = **made;
     const size_t tiles = plan.tile_count();
