@@ -333,16 +333,21 @@ TEST_F(SchedulerTest, WaitForChangeWakesOnAnyChange) {
 
 TEST_F(SchedulerTest, IdleWorkerWaitsForWorkAndGetsItAtOnce) {
     EXPECT_FALSE(scheduler_.LeaseTask("w", absl::Now() + absl::Milliseconds(20)).has_value());
-    std::thread submitter([this] {
+    // The delay only lets the worker start waiting first.
+    absl::Time submitted;
+    std::thread submitter([&] {
         absl::SleepFor(absl::Milliseconds(50));
         Submit(0);
+        submitted = absl::Now();
     });
-    const absl::Time start = absl::Now();
     const std::optional<TaskAssignment> lease =
         scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
+    const absl::Time leased = absl::Now();
     submitter.join();
     EXPECT_TRUE(lease.has_value());
-    EXPECT_LT(absl::Now() - start, absl::Seconds(5));
+    // Woken by the submission, not by a poll: well under the 20 s it would otherwise wait (a
+    // wake-up takes microseconds; the bound leaves room for a loaded machine).
+    EXPECT_LT(leased - submitted, absl::Milliseconds(500));
 }
 
 TEST_F(SchedulerTest, ShutdownEndsTheWait) {
