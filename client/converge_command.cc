@@ -2,6 +2,7 @@
 
 #include "command.h"
 #include "convergence.h"
+#include "lf/job/job_spec.h"
 
 namespace lf {
 
@@ -36,17 +37,17 @@ Command AddConvergeCommand(CLI::App& app) {
     cmd->add_option("--reference-spp", options->reference_spp,
                     "spp of the path-traced reference when none is given")
         ->capture_default_str()
-        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 24));
+        ->check(CLI::Range(uint64_t(1), kMaxSpp));
     cmd->add_option("--min-patches", options->min_patches, "smallest radiosity patch target")
         ->capture_default_str()
-        ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
+        ->check(CLI::Range(int64_t(1), kMaxPatchTarget));
     cmd->add_option("--max-patches", options->max_patches, "largest radiosity patch target")
         ->capture_default_str()
-        ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
+        ->check(CLI::Range(int64_t(1), kMaxPatchTarget));
     cmd->add_option("--tolerance", options->radiosity_tolerance,
                     "radiosity solver tolerance (relative residual)")
         ->capture_default_str()
-        ->check(CLI::Range(1e-12, 1.0));
+        ->check(CLI::Range(kMinTolerance, kMaxTolerance));
     cmd->add_option("--radiosity-spp", options->radiosity_spp,
                     "camera rays per pixel through a radiosity solution")
         ->capture_default_str()
@@ -58,7 +59,7 @@ Command AddConvergeCommand(CLI::App& app) {
         ->check(CLI::Range(0, 1024));
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str()
-        ->check(CLI::Range(-1, 1 << 20));
+        ->check(CLI::Range(-1, kMaxDepthLimit));
     return {cmd, [options] {
                 absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
                 if (!result.ok()) return ReportError(result.status());

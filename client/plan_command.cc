@@ -11,6 +11,7 @@
 #include "lf/core/image_error.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
 #include "lf/kernels/embree_scene.h"
@@ -284,10 +285,10 @@ Command AddPlanCommand(CLI::App& app) {
         ->check(CLI::Range(uint64_t(2), uint64_t(1) << 16));
     cmd->add_option("--patches", options->patches, "radiosity patch target")
         ->capture_default_str()
-        ->check(CLI::Range(int64_t(1), int64_t(1) << 24));
+        ->check(CLI::Range(int64_t(1), kMaxPatchTarget));
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str()
-        ->check(CLI::Range(-1, 1 << 20));
+        ->check(CLI::Range(-1, kMaxDepthLimit));
     cmd->add_option("--threads", options->threads, "threads of the pilots; 0 = all cores")
         ->capture_default_str()
         ->check(CLI::Range(0, 1024));

@@ -58,7 +58,7 @@ Command AddRenderCommand(CLI::App& app) {
     cmd->add_option("--passes", options->render.passes,
                     "sample passes per tile, as a farm job would split them (same bits)")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1 << 24));
+        ->check(CLI::Range(1, kMaxPasses));
     AddAdaptiveFlags(cmd, options->adaptive);
     cmd->add_flag("--no-progress", *no_progress, "no progress bar");
     cmd->add_option("--method", options->method,
