@@ -654,9 +654,13 @@ TEST_F(Farm, SubmitAndWatchRideOutAServerThatIsDown) {
 
     server_->Signal(SIGKILL);
     ASSERT_TRUE(server_->Wait(milliseconds(5000)));
+    const auto outage_start = Clock::now();
     Child* watch = Spawn(
         {std::string(LF_BIN_DIR) + "/lightfarm", "watch", job, "--server", address_}, "watch.log");
     ASSERT_TRUE(wait_for_log("watch.log", "retrying")) << ReadText(dir_ / "watch.log");
+    // An outage longer than the ten one-second retries after which `watch` used to give up.
+    std::this_thread::sleep_until(outage_start + milliseconds(12000));
+    ASSERT_FALSE(watch->Wait(milliseconds(0)).has_value()) << ReadText(dir_ / "watch.log");
     StartServer(10, address_);
     StartWorker("w1");
     EXPECT_EQ(watch->Wait(milliseconds(20000)), std::optional<int>(0))
