@@ -93,10 +93,8 @@ absl::StatusOr<std::vector<RenderTask>> AdaptiveTilePlan::Merge(int t, const Til
     }
     if (absl::Status s = CheckTaskResult(tasks_[size_t(t)], sums); !s.ok()) return s;
     const int tile_index = tile_of_[size_t(t)];
-    absl::StatusOr<TileSums> merged = mutable_store().Get(tile_index);
+    const absl::StatusOr<TileSums> merged = AddToTile(tile_index, sums);
     if (!merged.ok()) return merged.status();
-    *merged += sums;
-    if (absl::Status s = mutable_store().Put(tile_index, *merged); !s.ok()) return s;
     merged_[size_t(t)] = true;
     ++tasks_done_;
     stats_ += sums.stats;

@@ -42,6 +42,14 @@ std::vector<PixelRect> TileRects(const std::vector<RenderTask>& tasks) {
     return rects;
 }
 
+absl::StatusOr<TileSums> TileMerger::AddToTile(int tile, const TileSums& sums) {
+    absl::StatusOr<TileSums> merged = store_->Get(tile);
+    if (!merged.ok()) return merged.status();
+    *merged += sums;
+    if (absl::Status s = store_->Put(tile, *merged); !s.ok()) return s;
+    return merged;
+}
+
 RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks)
     : RenderMerger(width, height, tasks, *MakeMemoryTileStore(TileRects(tasks))) {}
 
@@ -74,11 +82,10 @@ absl::Status RenderMerger::Add(int task_index, const TileSums& sums) {
         return absl::AlreadyExistsError(absl::StrCat("task ", task_index, " is already merged"));
     }
     if (absl::Status s = CheckTaskResult(task, sums); !s.ok()) return s;
-    const int tile = tile_of_[size_t(task_index)];
-    absl::StatusOr<TileSums> merged = mutable_store().Get(tile);
-    if (!merged.ok()) return merged.status();
-    *merged += sums;
-    if (absl::Status s = mutable_store().Put(tile, *merged); !s.ok()) return s;
+    if (absl::StatusOr<TileSums> merged = AddToTile(tile_of_[size_t(task_index)], sums);
+        !merged.ok()) {
+        return merged.status();
+    }
     done_[size_t(task_index)] = true;
     ++tasks_done_;
     stats_ += sums.stats;
