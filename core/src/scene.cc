@@ -14,6 +14,8 @@ const char* MaterialTypeName(Material::Type type) {
             return "glossy";
         case Material::Type::kDielectric:
             return "dielectric";
+        case Material::Type::kPrincipled:
+            return "principled";
     }
     return "unknown";
 }
@@ -41,6 +43,17 @@ bool Scene::AllLambertian() const {
         if (m.type != Material::Type::kLambert) return false;
     }
     return true;
+}
+
+bool Scene::HasLights() const {
+    if (!point_lights.empty() || !spot_lights.empty() || !directional_lights.empty()) return true;
+    for (const TriangleMesh& mesh : meshes) {
+        if (materials[size_t(mesh.material)].IsEmissive()) return true;
+    }
+    for (const Sphere& sphere : spheres) {
+        if (materials[size_t(sphere.material)].IsEmissive()) return true;
+    }
+    return false;
 }
 
 }  // namespace lf

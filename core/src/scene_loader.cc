@@ -344,14 +344,7 @@ class SceneParser {
             }
         }
 
-        bool lit = !scene.point_lights.empty();
-        for (const TriangleMesh& mesh : scene.meshes) {
-            lit |= scene.materials[mesh.material].IsEmissive();
-        }
-        for (const Sphere& sphere : scene.spheres) {
-            lit |= scene.materials[sphere.material].IsEmissive();
-        }
-        if (!lit) {
+        if (!scene.HasLights()) {
             warnings_.push_back("no emissive shape and no point light: the image will be black");
         }
 

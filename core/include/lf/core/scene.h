@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,21 +14,82 @@
 
 namespace lf {
 
+// An image's texels, decoded once per process (lf/core/texture_io.h) and shared by every
+// material and scene that uses it. Rows run from the top of the image down, so texture
+// coordinate v = 0 is the top row (glTF's convention; OBJ's v is flipped on import).
+struct TextureImage {
+    std::string name;  // as the scene names it, for messages: "wood.png", "car.glb#image2"
+    int width = 0, height = 0;
+    int channels = 0;  // 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA), interleaved
+    // Exactly one of these holds the texels: 8-bit files stay 8-bit (a quarter of the memory;
+    // sRGB is decoded at lookup through a table), HDR and EXR files are linear float.
+    std::vector<uint8_t> texels8;
+    std::vector<float> texels32;
+};
+
+// How a material parameter reads a texture: which image, how coordinates outside [0, 1] wrap,
+// whether texels are sRGB-encoded colour or linear data, and KHR_texture_transform's
+// uv' = translate(offset) * rotate(rotation) * scale(scale) * uv.
+struct TextureRef {
+    enum class Wrap { kRepeat, kClampToEdge, kMirroredRepeat };
+
+    int image = -1;  // index in Scene::textures; -1: no texture
+    Wrap wrap_s = Wrap::kRepeat, wrap_t = Wrap::kRepeat;
+    bool srgb = false;    // colour textures (base colour, emission); data textures are linear
+    bool nearest = false; // the sampler asks for nearest-texel filtering; bilinear otherwise
+    Vec2 offset{0, 0};
+    float rotation = 0;  // radians, counter-clockwise in uv
+    Vec2 scale{1, 1};
+
+    bool valid() const { return image >= 0; }
+};
+
 struct Material {
-    enum class Type { kLambert, kMirror, kGlossy, kDielectric };
+    enum class Type { kLambert, kMirror, kGlossy, kDielectric, kPrincipled };
     enum class Distribution { kGgx, kBeckmann };
+    enum class AlphaMode { kOpaque, kMask };
 
     std::string name;
     Type type = Type::kLambert;
-    Rgb reflectance{0.8f};  // lambert albedo; mirror and glossy (dielectric-like) F0 tint
+    // lambert albedo; mirror and glossy (dielectric-like) F0 tint; principled base colour
+    Rgb reflectance{0.8f};
     Distribution distribution = Distribution::kGgx;
-    float roughness = 0.1f;  // microfacet alpha
+    // glossy: the microfacet alpha. principled: glTF's perceptual roughness r, GGX alpha = r^2.
+    float roughness = 0.1f;
     bool conductor = false;  // glossy with complex IOR eta + i k instead of reflectance
     Rgb eta{1.0f}, k{0.0f};
-    float ior = 1.5f;    // dielectric: interior IOR over exterior IOR
+    float ior = 1.5f;    // dielectric and principled: interior IOR over exterior IOR
     Rgb emission{0.0f};  // radiance leaving the front face, W m^-2 sr^-1
 
+    // The principled material: the glTF 2.0 metallic-roughness BRDF (its Appendix B) with
+    // KHR_materials_transmission, _ior and _volume. Textures multiply their factors:
+    // base colour (and opacity, its alpha) by `base_color_texture` (also lambert's albedo),
+    // roughness by the metallic-roughness texture's G channel and metallic by its B channel,
+    // emission by `emission_texture`.
+    float metallic = 0;
+    // Weight of the dielectric specular layer (KHR_materials_specular's factor): 0 leaves the
+    // Lambertian base alone.
+    float specular = 1;
+    float transmission = 0;  // fraction of the dielectric base that is transmitted, not diffuse
+    // KHR_materials_volume: above 0 the mesh is closed solid glass that refracts on entry and
+    // exit; 0 is a thin wall that transmits without bending.
+    float thickness = 0;
+    Rgb attenuation_color{1.0f};  // the colour white light takes after attenuation_distance
+    float attenuation_distance = std::numeric_limits<float>::infinity();  // metres
+    TextureRef base_color_texture, metallic_roughness_texture, normal_texture, emission_texture;
+    float normal_scale = 1;  // scales the normal map's x and y (glTF normalTexture.scale)
+    float opacity = 1;       // base colour alpha factor; with the texture's alpha, for kMask
+    AlphaMode alpha_mode = AlphaMode::kOpaque;
+    float alpha_cutoff = 0.5f;  // kMask: opacity below this is a hole
+    // Single-sided surfaces (glTF doubleSided false) are invisible from behind, as in glTF
+    // viewers, unless the material transmits (its back faces are where light leaves).
+    bool double_sided = true;
+
     bool IsEmissive() const { return !emission.IsBlack(); }
+    bool IsTextured() const {
+        return base_color_texture.valid() || metallic_roughness_texture.valid() ||
+               normal_texture.valid() || emission_texture.valid();
+    }
 };
 
 const char* MaterialTypeName(Material::Type type);
@@ -38,6 +101,11 @@ struct TriangleMesh {
     int material = 0;
     std::vector<Vec3d> positions;
     std::vector<std::array<uint32_t, 3>> triangles;
+    // Per-vertex attributes, each empty or as long as positions. Without normals the mesh is
+    // flat-shaded; tangents (xyz, and w = ±1 the bitangent's sign) serve normal maps.
+    std::vector<Vec3> normals;  // unit, in the same space as positions
+    std::vector<Vec2> uvs;      // TEXCOORD_0: v = 0 is the top of the image
+    std::vector<std::array<float, 4>> tangents;
     // True when the mesh came from a `quad` shape: (v0,v1,v2),(v0,v2,v3). Radiosity meshes
     // such shapes as a grid of quads rather than triangles.
     bool is_quad = false;
@@ -55,6 +123,22 @@ struct PointLight {
     Rgb intensity;  // W/sr per channel
 };
 
+// A point light whose intensity falls off between two cones around `direction`
+// (KHR_lights_punctual's spot): full inside inner_cone, zero outside outer_cone.
+struct SpotLight {
+    Vec3d position;
+    Vec3d direction;  // unit, the way the light points
+    Rgb intensity;    // W/sr per channel on the axis
+    double inner_cone = 0;                  // radians, half-angle
+    double outer_cone = 3.14159265358979 / 4;  // radians, half-angle, > inner_cone
+};
+
+// Light from infinitely far away (the sun): parallel rays along `direction`.
+struct DirectionalLight {
+    Vec3d direction;  // unit, the way the light travels
+    Rgb irradiance;   // W/m^2 per channel on a surface facing the light
+};
+
 struct CameraSpec {
     Vec3d position{0, 0, 0};
     Vec3d look_at{0, 0, 1};
@@ -70,6 +154,10 @@ struct Scene {
     std::vector<TriangleMesh> meshes;
     std::vector<Sphere> spheres;
     std::vector<PointLight> point_lights;
+    std::vector<SpotLight> spot_lights;
+    std::vector<DirectionalLight> directional_lights;
+    // Images the materials' TextureRefs index; shared, so a copied scene costs no texels.
+    std::vector<std::shared_ptr<const TextureImage>> textures;
 
     std::string source;        // path of the scene file, for messages
     std::string content_hash;  // hex digest of the scene file and every mesh file it names
@@ -78,6 +166,7 @@ struct Scene {
     // Axis-aligned bounds of all geometry.
     std::pair<Vec3d, Vec3d> Bounds() const;
     bool AllLambertian() const;
+    bool HasLights() const;  // any emitter: emissive material or a light of any kind
 };
 
 }  // namespace lf
