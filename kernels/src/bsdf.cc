@@ -62,10 +62,12 @@ std::optional<Vec3> Refract(const Vec3& wo, float eta, float* etap) {
 
 }  // namespace
 
-Bsdf::Bsdf(const Material& material)
+Bsdf::Bsdf(const Material& material) : Bsdf(material, SurfaceParams::Of(material)) {}
+
+Bsdf::Bsdf(const Material& material, const SurfaceParams& params)
     : type_(material.type),
       conductor_(material.conductor),
-      reflectance_(material.reflectance),
+      reflectance_(params.base_color),
       eta_(material.eta),
       k_(material.k),
       ior_(material.ior),

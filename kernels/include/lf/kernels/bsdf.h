@@ -21,9 +21,21 @@ struct BsdfSample {
     bool delta = false;
 };
 
+// The parameters that vary across a surface, at one point: the material's factors times its
+// textures there (lf/kernels/shading.h). Everything else of the BSDF comes from the Material.
+struct SurfaceParams {
+    Rgb base_color;   // lambert albedo, principled base colour
+    float metallic = 0;
+    float roughness = 0;  // principled: perceptual roughness r
+
+    static SurfaceParams Of(const Material& m) { return {m.reflectance, m.metallic, m.roughness}; }
+};
+
 class Bsdf {
   public:
+    // The material's own constant parameters.
     explicit Bsdf(const Material& material);
+    Bsdf(const Material& material, const SurfaceParams& params);
 
     Rgb Eval(const Vec3& wo, const Vec3& wi) const;
     float Pdf(const Vec3& wo, const Vec3& wi) const;
