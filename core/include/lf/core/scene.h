@@ -22,9 +22,11 @@ struct TextureImage {
     int width = 0, height = 0;
     int channels = 0;  // 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA), interleaved
     // Exactly one of these holds the texels: 8-bit files stay 8-bit (a quarter of the memory;
-    // sRGB is decoded at lookup through a table), HDR and EXR files are linear float.
+    // sRGB is decoded at lookup through a table), 16-bit ones become float in [0, 1] (still
+    // encoded), HDR and EXR files are float radiance (`hdr`), which no sRGB curve applies to.
     std::vector<uint8_t> texels8;
     std::vector<float> texels32;
+    bool hdr = false;
 };
 
 // How a material parameter reads a texture: which image, how coordinates outside [0, 1] wrap,

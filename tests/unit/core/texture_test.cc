@@ -1,0 +1,184 @@
+#include "lf/core/texture.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "image_files.h"
+#include "lf/core/file_util.h"
+#include "lf/core/image_io.h"
+#include "lf/core/texture_io.h"
+#include "test_dir.h"
+
+namespace lf {
+namespace {
+
+// 4 x 2 texels, each channel a distinct value: red counts columns, green rows.
+TextureImage Gradient(int channels = 3) {
+    TextureImage image;
+    image.width = 4;
+    image.height = 2;
+    image.channels = channels;
+    for (int y = 0; y < 2; ++y) {
+        for (int x = 0; x < 4; ++x) {
+            const uint8_t texel[4] = {uint8_t(40 * x), uint8_t(100 * y), 7, uint8_t(255 - 50 * x)};
+            image.texels8.insert(image.texels8.end(), texel, texel + channels);
+        }
+    }
+    return image;
+}
+
+TextureRef Nearest(TextureRef::Wrap wrap = TextureRef::Wrap::kRepeat) {
+    TextureRef ref;
+    ref.image = 0;
+    ref.nearest = true;
+    ref.wrap_s = ref.wrap_t = wrap;
+    return ref;
+}
+
+TEST(Texture, UvOriginIsTheTopLeftTexel) {
+    const TextureImage image = Gradient();
+    // (0, 0) is the top-left corner; v grows downwards, u to the right.
+    EXPECT_FLOAT_EQ(Lookup(image, Nearest(), {0.01f, 0.01f}).rgb.g, 0);
+    EXPECT_FLOAT_EQ(Lookup(image, Nearest(), {0.01f, 0.99f}).rgb.g, 100 / 255.0f);
+    EXPECT_FLOAT_EQ(Lookup(image, Nearest(), {0.99f, 0.01f}).rgb.r, 120 / 255.0f);
+    EXPECT_FLOAT_EQ(Lookup(image, Nearest(), {0.3f, 0.2f}).rgb.r, 40 / 255.0f);
+}
+
+TEST(Texture, WrapModesAddressTheDocumentedTexels) {
+    const TextureImage image = Gradient();
+    auto column = [&](TextureRef::Wrap wrap, float u) {
+        return int(std::lround(Lookup(image, Nearest(wrap), {u, 0.25f}).rgb.r * 255 / 40));
+    };
+    // u = 1.1 is texel 4.4: repeat wraps to 0, clamp stays at 3, mirror reflects to 3.
+    EXPECT_EQ(column(TextureRef::Wrap::kRepeat, 1.1f), 0);
+    EXPECT_EQ(column(TextureRef::Wrap::kClampToEdge, 1.1f), 3);
+    EXPECT_EQ(column(TextureRef::Wrap::kMirroredRepeat, 1.1f), 3);
+    EXPECT_EQ(column(TextureRef::Wrap::kMirroredRepeat, 1.6f), 1);
+    EXPECT_EQ(column(TextureRef::Wrap::kRepeat, -0.1f), 3);
+    EXPECT_EQ(column(TextureRef::Wrap::kClampToEdge, -0.1f), 0);
+    EXPECT_EQ(column(TextureRef::Wrap::kMirroredRepeat, -0.1f), 0);
+    // Far outside, NaN and infinite coordinates still address a texel of the image.
+    for (const float u : {1e30f, -1e30f, NAN, INFINITY}) {
+        for (const auto wrap : {TextureRef::Wrap::kRepeat, TextureRef::Wrap::kClampToEdge,
+                                TextureRef::Wrap::kMirroredRepeat}) {
+            const int c = column(wrap, u);
+            EXPECT_TRUE(c >= 0 && c <= 3) << u;
+            TextureRef bilinear = Nearest(wrap);
+            bilinear.nearest = false;
+            EXPECT_TRUE(std::isfinite(Lookup(image, bilinear, {u, u}).rgb.r)) << u;
+        }
+    }
+}
+
+TEST(Texture, BilinearIsExactAtTexelCentresAndLinearBetween) {
+    const TextureImage image = Gradient();
+    TextureRef ref = Nearest(TextureRef::Wrap::kClampToEdge);
+    ref.nearest = false;
+    // Centres of columns 1 and 2 are at u = 1.5/4 and 2.5/4.
+    EXPECT_NEAR(Lookup(image, ref, {1.5f / 4, 0.25f}).rgb.r, 40 / 255.0f, 1e-6);
+    EXPECT_NEAR(Lookup(image, ref, {2.5f / 4, 0.25f}).rgb.r, 80 / 255.0f, 1e-6);
+    EXPECT_NEAR(Lookup(image, ref, {2.0f / 4, 0.25f}).rgb.r, 60 / 255.0f, 1e-6);
+    EXPECT_NEAR(Lookup(image, ref, {1.5f / 4, 0.5f}).rgb.g, 50 / 255.0f, 1e-6);
+}
+
+TEST(Texture, ColourTexturesAreSrgbDecodedAndAlphaIsNot) {
+    const TextureImage image = Gradient(4);
+    TextureRef ref = Nearest();
+    ref.srgb = true;
+    const Rgba texel = Lookup(image, ref, {0.3f, 0.2f});  // column 1: 40, 0, 7, 205
+    const float encoded = 40 / 255.0f;
+    EXPECT_NEAR(texel.rgb.r, std::pow((encoded + 0.055f) / 1.055f, 2.4f), 1e-6);
+    EXPECT_NEAR(texel.a, 205 / 255.0f, 1e-6);
+    ref.srgb = false;
+    EXPECT_NEAR(Lookup(image, ref, {0.3f, 0.2f}).rgb.r, encoded, 1e-6);
+}
+
+TEST(Texture, TransformFollowsTheExtensionsWorkedExample) {
+    // KHR_texture_transform: offset [0, 1], rotation pi/2, scale 0.5 uses the lower-left
+    // quadrant of the image, rotated.
+    TextureRef ref;
+    ref.offset = {0, 1};
+    ref.rotation = float(M_PI / 2);
+    ref.scale = {0.5f, 0.5f};
+    for (const Vec2 corner : {Vec2{0, 0}, Vec2{1, 0}, Vec2{0, 1}, Vec2{1, 1}}) {
+        const Vec2 t = TransformUv(ref, corner);
+        EXPECT_TRUE(t.x > -1e-6f && t.x < 0.5f + 1e-6f) << t.x;
+        EXPECT_TRUE(t.y > 0.5f - 1e-6f && t.y < 1 + 1e-6f) << t.y;
+    }
+    // The second example flips v: offset [0, 1], scale [1, -1].
+    ref = TextureRef{};
+    ref.offset = {0, 1};
+    ref.scale = {1, -1};
+    EXPECT_NEAR(TransformUv(ref, {0.25f, 0.1f}).y, 0.9f, 1e-6);
+}
+
+TEST(TextureIo, DecodesPngWithItsChannelsAndSharesTheImage) {
+    const TextureImage source = Gradient(4);
+    const std::string png = testing::PngBytes(4, 2, 4, source.texels8);
+    const auto first = DecodeTexture(png, "a.png");
+    ASSERT_TRUE(first.ok()) << first.status();
+    EXPECT_EQ((*first)->width, 4);
+    EXPECT_EQ((*first)->height, 2);
+    EXPECT_EQ((*first)->channels, 4);
+    EXPECT_EQ((*first)->texels8, source.texels8);
+    // Another name for the same bytes is the same decoded image: loaded once per process.
+    const auto second = DecodeTexture(png, "elsewhere/b.png");
+    ASSERT_TRUE(second.ok());
+    EXPECT_EQ(first->get(), second->get());
+}
+
+TEST(TextureIo, DecodesExrAsLinearRadiance) {
+    Image exr(3, 2);
+    for (int i = 0; i < 6; ++i) {
+        exr.Channel("R")[size_t(i)] = 0.5f * float(i);
+        exr.Channel("G")[size_t(i)] = 100.0f;  // beyond 8 bits' range: radiance, not a colour
+        exr.Channel("B")[size_t(i)] = 0.25f;
+    }
+    const std::string path = (testing::FreshTestDir("texture_exr") / "sky.exr").string();
+    ASSERT_TRUE(WriteExr(path, exr, {}).ok());
+    const auto decoded = DecodeTexture(*ReadFile(path), "sky.exr");
+    ASSERT_TRUE(decoded.ok()) << decoded.status();
+    const TextureImage& image = **decoded;
+    EXPECT_TRUE(image.hdr);
+    ASSERT_EQ(image.width, 3);
+    ASSERT_EQ(image.height, 2);
+    // Texel (2, 1) is pixel 5: R = 2.5 (exact in half precision). No sRGB curve applies to
+    // radiance, whatever the reference asks.
+    const Rgba texel = Texel(image, 2, 1, /*srgb=*/true);
+    EXPECT_FLOAT_EQ(texel.rgb.r, 2.5f);
+    EXPECT_FLOAT_EQ(texel.rgb.g, 100.0f);
+    EXPECT_FLOAT_EQ(texel.rgb.b, 0.25f);
+    EXPECT_FLOAT_EQ(texel.a, 1.0f);
+}
+
+TEST(TextureIo, RefusesAnAbsurdSizeFromTheHeaderAlone) {
+    // A valid PNG header claiming 100000 x 100000 texels and no data: refused before allocating.
+    std::string png = testing::PngBytes(1, 1, 3, {1, 2, 3});
+    const auto put32 = [&](size_t at, uint32_t v) {
+        for (int i = 0; i < 4; ++i) png[at + size_t(i)] = char(v >> (24 - 8 * i));
+    };
+    put32(16, 100000);  // IHDR width
+    put32(20, 100000);  // IHDR height
+    const auto decoded = DecodeTexture(png, "huge.png");
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_EQ(decoded.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(decoded.status().message().find("huge.png"), std::string::npos);
+    EXPECT_NE(decoded.status().message().find("100000 x 100000"), std::string::npos)
+        << decoded.status();
+}
+
+TEST(TextureIo, GarbageAndTruncatedFilesAreClearErrors) {
+    const std::string png = testing::PngBytes(4, 2, 3, std::vector<uint8_t>(24, 9));
+    for (const std::string& bytes :
+         {std::string("not an image at all"), png.substr(0, png.size() / 2), std::string(),
+          std::string("\x76\x2f\x31\x01garbage", 11)}) {
+        const auto decoded = DecodeTexture(bytes, "bad.png");
+        ASSERT_FALSE(decoded.ok());
+        EXPECT_EQ(decoded.status().code(), absl::StatusCode::kInvalidArgument);
+        EXPECT_EQ(decoded.status().message().substr(0, 9), "bad.png: ") << decoded.status();
+    }
+}
+
+}  // namespace
+}  // namespace lf
