@@ -3,6 +3,9 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <map>
+#include <tuple>
+#include <unordered_map>
 #include <bit>
 #include <cctype>
 #include <cerrno>
@@ -49,82 +52,428 @@ std::vector<std::string> SplitFields(std::string_view line) {
 
 // ---- Wavefront OBJ ---------------------------------------------------------------------------
 
-// tinyobjloader does not say which line a face or vertex came from. On an error this finds the
-// line of the first record with `keyword` for which visit(number of fields) returns true.
-template <typename Visit>
-size_t FindObjLine(std::string_view text, std::string_view keyword, Visit visit) {
+// tinyobjloader does not say which line a record came from. On an error this finds the line
+// number (from 1) of the first line at or after `from` whose fields `match`; 0 if none does.
+template <typename Match>
+size_t FindLine(std::string_view text, Match match, size_t from = 1) {
     size_t line = 0, pos = 0;
     while (pos < text.size()) {
         // Line ends as tinyobjloader counts them: \n, \r\n or a lone \r.
         const size_t end = std::min(text.find_first_of("\r\n", pos), text.size());
-        const std::vector<std::string> fields = SplitFields(text.substr(pos, end - pos));
         ++line;
+        if (line >= from) {
+            const std::vector<std::string> fields = SplitFields(text.substr(pos, end - pos));
+            if (!fields.empty() && match(fields)) return line;
+        }
         pos = end + (text.substr(end, 2) == "\r\n" ? 2 : 1);
-        if (!fields.empty() && fields[0] == keyword && visit(fields.size() - 1)) return line;
     }
     return 0;
 }
 
-TriangleMesh ParseObj(const std::string& text) {
-    tinyobj::ObjReaderConfig config;
-    config.triangulate = false;  // fan triangulation below, after checking every index
-    config.vertex_color = false;
-    tinyobj::ObjReader reader;
-    // Materials belong in the scene file, so `mtllib` is ignored.
-    if (!reader.ParseFromString(text, "", config)) {
-        const std::string& error = reader.Error();
+// The line of the `n`-th (from 0) record `keyword` with at least `min_fields` fields after it.
+size_t FindRecordLine(std::string_view text, std::string_view keyword, size_t n,
+                      size_t min_fields = 0) {
+    size_t seen = 0;
+    return FindLine(text, [&](const std::vector<std::string>& f) {
+        return f[0] == keyword && f.size() > min_fields && seen++ == n;
+    });
+}
+
+bool EqualsIgnoringCase(std::string_view a, std::string_view b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](char x, char y) {
+        return std::tolower(static_cast<unsigned char>(x)) ==
+               std::tolower(static_cast<unsigned char>(y));
+    });
+}
+
+// `name` as the scene's file reader knows it: relative names are relative to the folder of the
+// file that names them, as OBJ and MTL files mean them.
+std::string Beside(const std::string& file, const std::string& name) {
+    const std::filesystem::path path(name);
+    if (path.is_absolute()) return path.lexically_normal().string();
+    return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
+}
+
+// An MTL file as read, for messages that name its lines.
+struct MtlText {
+    std::string name;  // as the reader knows it
+    std::string text;
+};
+
+// Reads `mtllib` files through the scene's file reader (tinyobjloader would open them from
+// the working directory), and remembers which file each material came from.
+class MtlReader : public tinyobj::MaterialReader {
+  public:
+    MtlReader(const SceneFileReader& read_file, std::string obj_name)
+        : read_file_(read_file), obj_name_(std::move(obj_name)) {}
+
+    bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                    std::map<std::string, int>* index, std::string* warn,
+                    std::string* err) override {
+        const std::string path = Beside(obj_name_, name);
+        absl::StatusOr<std::string> text = read_file_(path);
+        if (!text.ok()) {
+            if (failure_.empty()) {
+                failed_name_ = name;
+                failure_ = absl::StrCat("mtllib \"", path, "\": ", text.status().message());
+            }
+            return false;
+        }
+        std::istringstream stream(*text);
+        tinyobj::LoadMtl(index, materials, &stream, warn, err);
+        file_of_.resize(materials->size(), files_.size());
+        files_.push_back({path, *std::move(text)});
+        return true;
+    }
+
+    // The first MTL file that could not be read, and why; empty when all were.
+    const std::string& failed_name() const { return failed_name_; }
+    const std::string& failure() const { return failure_; }
+    const MtlText& FileOf(size_t material) const { return files_[file_of_[material]]; }
+
+  private:
+    const SceneFileReader& read_file_;
+    std::string obj_name_;
+    std::vector<MtlText> files_;
+    std::vector<size_t> file_of_;  // by material index
+    std::string failed_name_, failure_;
+};
+
+// Turns the MTL materials the faces use into lf::Materials (docs/scene-format.md, "Meshes"),
+// collecting the image files they name.
+class MtlConverter {
+  public:
+    MtlConverter(const MtlReader& reader, MeshFile& out) : reader_(reader), out_(out) {}
+
+    Material Convert(const tinyobj::material_t& mtl, size_t index) {
+        const MtlText& file = reader_.FileOf(index);
+        // Each value's line, for messages: the key's first line after `newmtl NAME`.
+        const size_t start = FindLine(file.text, [&](const std::vector<std::string>& f) {
+            return f[0] == "newmtl" && f.size() > 1 && f[1] == mtl.name;
+        });
+        auto where = [&](const char* key) {
+            const size_t line = FindLine(
+                file.text,
+                [&](const std::vector<std::string>& f) { return EqualsIgnoringCase(f[0], key); },
+                start);
+            return absl::StrCat(file.name, ":", line > 0 ? line : start);
+        };
+        auto color = [&](const tinyobj::real_t* c, const char* key, float max) {
+            const Rgb rgb(c[0], c[1], c[2]);
+            for (int i = 0; i < 3; ++i) {
+                if (!(rgb[i] >= 0 && std::isfinite(rgb[i]))) {
+                    Fail("", absl::StrCat(where(key), ": material \"", mtl.name, "\": ", key,
+                                          " must be finite and ≥ 0"));
+                }
+            }
+            if (rgb.MaxComponent() <= max) return rgb;
+            out_.warnings.push_back(absl::StrCat(where(key), ": material \"", mtl.name, "\": ", key,
+                                                 " above ", max, " clamped to ", max));
+            return Rgb(std::min(rgb.r, max), std::min(rgb.g, max), std::min(rgb.b, max));
+        };
+        auto texture = [&](const std::string& name, const tinyobj::texture_option_t& option,
+                           const char* key, bool srgb) {
+            return Texture(Beside(file.name, name), option, absl::StrCat(where(key), ": ", key),
+                           srgb);
+        };
+
+        Material m;
+        m.name = absl::StrCat(file.name, "#", mtl.name);
+        m.reflectance = color(mtl.diffuse, "Kd", 1);
+        m.emission = color(mtl.emission, "Ke", std::numeric_limits<float>::max());
+        if (!mtl.diffuse_texname.empty()) {
+            m.base_color_texture = texture(mtl.diffuse_texname, mtl.diffuse_texopt, "map_Kd", true);
+        }
+        if (!mtl.emissive_texname.empty()) {
+            m.emission_texture = texture(mtl.emissive_texname, mtl.emissive_texopt, "map_Ke", true);
+        }
+        // `norm` is a tangent-space normal map; so is what Blender writes as map_Bump.
+        const bool norm = !mtl.normal_texname.empty();
+        const std::string& normal_map = norm ? mtl.normal_texname : mtl.bump_texname;
+        if (!normal_map.empty()) {
+            const tinyobj::texture_option_t& option = norm ? mtl.normal_texopt : mtl.bump_texopt;
+            m.normal_texture = texture(normal_map, option, norm ? "norm" : "map_Bump", false);
+            m.normal_scale = option.bump_multiplier;
+        }
+
+        // Blinn-Phong specular (illum 2 and up) as the principled material's dielectric layer,
+        // its exponent as perceptual roughness the way Blender's OBJ importer maps it.
+        const float ks = std::clamp(Rgb(mtl.specular[0], mtl.specular[1], mtl.specular[2])
+                                        .MaxComponent(),
+                                    0.0f, 1.0f);
+        const bool specular = mtl.illum >= 2 && ks > 0;
+        m.specular = specular ? ks : 0;
+        m.roughness =
+            mtl.roughness > 0
+                ? std::min(float(mtl.roughness), 1.0f)
+                : 1 - std::sqrt(std::clamp(float(mtl.shininess), 0.0f, 1000.0f) / 1000);
+        m.metallic = std::clamp(float(mtl.metallic), 0.0f, 1.0f);
+        // Exporters write Ni 1 (or less) when they mean nothing: it would remove all reflection.
+        if (mtl.ior > 1 && std::isfinite(mtl.ior)) m.ior = mtl.ior;
+
+        const float d = std::isfinite(mtl.dissolve) ? std::clamp(float(mtl.dissolve), 0.0f, 1.0f)
+                                                    : 1.0f;
+        const bool refracts = mtl.illum == 4 || mtl.illum == 6 || mtl.illum == 7 || mtl.illum == 9;
+        if (d < 1 && refracts) {
+            m.transmission = 1 - d;  // glass: the illumination models that refract
+        } else if (d < 1 || (!mtl.alpha_texname.empty() &&
+                             mtl.alpha_texname == mtl.diffuse_texname)) {
+            // A cut-out: opacity d, times the base colour texture's alpha when map_d names it.
+            m.opacity = d;
+            m.alpha_mode = Material::AlphaMode::kMask;
+        }
+        if (!mtl.alpha_texname.empty() && mtl.alpha_texname != mtl.diffuse_texname) {
+            Unsupported(mtl, where("map_d"), "map_d naming another file than map_Kd",
+                        "the cut-out");
+        }
+        for (const auto& [name, key] : {std::pair{&mtl.specular_texname, "map_Ks"},
+                                        {&mtl.specular_highlight_texname, "map_Ns"},
+                                        {&mtl.roughness_texname, "map_Pr"},
+                                        {&mtl.metallic_texname, "map_Pm"},
+                                        {&mtl.displacement_texname, "disp"},
+                                        {&mtl.reflection_texname, "refl"}}) {
+            if (!name->empty()) Unsupported(mtl, where(key), key, "its variation");
+        }
+
+        if (specular || m.metallic > 0 || m.transmission > 0 || m.normal_texture.valid() ||
+            m.emission_texture.valid()) {
+            m.type = Material::Type::kPrincipled;
+        }
+        return m;
+    }
+
+  private:
+    void Unsupported(const tinyobj::material_t& mtl, const std::string& where,
+                     const char* what, const char* lost) {
+        out_.warnings.push_back(absl::StrCat(where, ": material \"", mtl.name, "\": ", what,
+                                             " is not supported; ", lost, " is lost"));
+    }
+
+    // A texture of the MTL file, its -s and -o options turned into a transform of the stored
+    // (flipped) v: image v = 1 - (s (1 - v') + o) = s v' + (1 - s - o).
+    TextureRef Texture(const std::string& name, const tinyobj::texture_option_t& option,
+                       const std::string& where, bool srgb) {
+        TextureRef ref;
+        const auto found = std::find_if(out_.textures.begin(), out_.textures.end(),
+                                        [&](const MeshFile::Texture& t) { return t.name == name; });
+        ref.image = int(found - out_.textures.begin());
+        if (found == out_.textures.end()) out_.textures.push_back({name, where});
+        ref.srgb = option.colorspace.empty() ? srgb : EqualsIgnoringCase(option.colorspace, "srgb");
+        if (option.clamp) ref.wrap_s = ref.wrap_t = TextureRef::Wrap::kClampToEdge;
+        ref.scale = {float(option.scale[0]), float(option.scale[1])};
+        ref.offset = {float(option.origin_offset[0]),
+                      float(1 - option.scale[1] - option.origin_offset[1])};
+        return ref;
+    }
+
+    const MtlReader& reader_;
+    MeshFile& out_;
+};
+
+// (position, normal, texture coordinate) indices of a face corner: each distinct triple is one
+// vertex of the mesh. A corner without a usable normal in a mesh with normals takes its face's
+// normal: its normal index is then -2 - face, its own vertex.
+struct Corner {
+    int64_t v, n, t;
+    bool operator==(const Corner&) const = default;
+};
+
+struct CornerHash {
+    size_t operator()(const Corner& c) const {
+        return std::hash<int64_t>()(c.v * 0x9E3779B97F4A7C15 ^ c.n * 0xC2B2AE3D27D4EB4F ^ c.t);
+    }
+};
+
+// Builds one mesh of the faces of one material.
+struct ObjMeshBuilder {
+    TriangleMesh mesh;
+    std::unordered_map<Corner, uint32_t, CornerHash> vertex_of;
+    bool normals = false, uvs = false;
+    int material = -1;
+    size_t first_face = 0;
+};
+
+MeshFile ParseObj(const std::string& text, const std::string& name,
+                  const SceneFileReader* read_file) {
+    tinyobj::attrib_t attrib;
+    std::vector<tinyobj::shape_t> shapes;
+    std::vector<tinyobj::material_t> materials;
+    std::string warning, error;
+    std::istringstream stream(text);
+    std::optional<MtlReader> mtl_reader;
+    if (read_file) mtl_reader.emplace(*read_file, name);
+    // Fan triangulation below, after checking every index; without a reader `mtllib` is ignored.
+    if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warning, &error, &stream,
+                          mtl_reader ? &*mtl_reader : nullptr, false, false)) {
         const size_t at = error.rfind("line ");
         const size_t line =
             at == std::string::npos ? 0 : std::strtoul(error.c_str() + at + 5, nullptr, 10);
         Fail(LineSuffix(line),
              "tinyobjloader: " + error.substr(0, error.find_last_not_of("\n ") + 1));
     }
-    if (reader.Warning().find("Degenerated face") != std::string::npos) {
+    if (warning.find("Degenerated face") != std::string::npos) {
         // tinyobjloader silently drops faces with fewer than three corners.
-        Fail(LineSuffix(FindObjLine(text, "f", [](size_t n) { return n < 3; })),
+        Fail(LineSuffix(FindLine(text,
+                                 [](const std::vector<std::string>& f) {
+                                     return f[0] == "f" && f.size() < 4;
+                                 })),
              "face with fewer than 3 vertices");
     }
+    if (mtl_reader && !mtl_reader->failure().empty()) {
+        Fail(LineSuffix(FindLine(text,
+                                 [&](const std::vector<std::string>& f) {
+                                     return f[0] == "mtllib" &&
+                                            std::find(f.begin(), f.end(),
+                                                      mtl_reader->failed_name()) != f.end();
+                                 })),
+             mtl_reader->failure());
+    }
+    if (const size_t at = warning.find("material [ '"); read_file && at != std::string::npos) {
+        const std::string material =
+            warning.substr(at + 12, warning.find("' ]", at) - (at + 12));
+        Fail(LineSuffix(FindLine(text,
+                                 [&](const std::vector<std::string>& f) {
+                                     return f[0] == "usemtl" && f.size() > 1 && f[1] == material;
+                                 })),
+             absl::StrCat("usemtl \"", material, "\": no MTL file of this OBJ defines it"));
+    }
 
-    TriangleMesh mesh;
-    const std::vector<tinyobj::real_t>& v = reader.GetAttrib().vertices;
-    mesh.positions.reserve(v.size() / 3);
+    std::vector<Vec3d> positions;
+    const std::vector<tinyobj::real_t>& v = attrib.vertices;
+    positions.reserve(v.size() / 3);
     for (size_t i = 0; i + 2 < v.size(); i += 3) {
         const Vec3d p(v[i], v[i + 1], v[i + 2]);
         if (!IsFinite(p)) {
-            size_t seen = 0;
-            const size_t line = FindObjLine(text, "v", [&](size_t) { return seen++ == i / 3; });
-            Fail(LineSuffix(line), absl::StrCat("vertex ", i / 3 + 1, " is not finite"));
+            Fail(LineSuffix(FindRecordLine(text, "v", i / 3)),
+                 absl::StrCat("vertex ", i / 3 + 1, " is not finite"));
         }
-        mesh.positions.push_back(p);
+        positions.push_back(p);
+    }
+    // Unit normals; a zero one (some exporters write them) counts as none.
+    std::vector<std::optional<Vec3>> normals;
+    for (size_t i = 0; i + 2 < attrib.normals.size(); i += 3) {
+        const Vec3 n(attrib.normals[i], attrib.normals[i + 1], attrib.normals[i + 2]);
+        if (!IsFinite(n)) {
+            Fail(LineSuffix(FindRecordLine(text, "vn", i / 3)),
+                 absl::StrCat("normal ", i / 3 + 1, " is not finite"));
+        }
+        normals.push_back(LengthSquared(n) > 0 ? std::optional(Normalize(n)) : std::nullopt);
+    }
+    std::vector<Vec2> uvs;
+    for (size_t i = 0; i + 1 < attrib.texcoords.size(); i += 2) {
+        const Vec2 uv{attrib.texcoords[i], 1 - attrib.texcoords[i + 1]};
+        if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) {
+            Fail(LineSuffix(FindRecordLine(text, "vt", i / 2)),
+                 absl::StrCat("texture coordinate ", i / 2 + 1, " is not finite"));
+        }
+        uvs.push_back(uv);
     }
 
-    const int64_t vertex_count = int64_t(mesh.positions.size());
+    if (positions.empty()) Fail("", "no vertices");
+    // First pass: check every index, and find each material's mesh and what it has.
+    std::vector<ObjMeshBuilder> builders;
+    std::map<int, size_t> builder_of;  // by material id
     size_t face = 0;
-    for (const tinyobj::shape_t& shape : reader.GetShapes()) {
-        const std::vector<tinyobj::index_t>& indices = shape.mesh.indices;
+    for (const tinyobj::shape_t& shape : shapes) {
         size_t first = 0;
-        for (const unsigned int corners : shape.mesh.num_face_vertices) {
-            for (size_t c = first; c < first + corners; ++c) {
-                const int64_t index = indices[c].vertex_index;
-                if (index < 0 || index >= vertex_count) {
-                    size_t seen = 0;
-                    const size_t line =
-                        FindObjLine(text, "f", [&](size_t n) { return n >= 3 && seen++ == face; });
-                    Fail(LineSuffix(line),
-                         absl::StrCat("face refers to vertex ", index + 1, " but the file has ",
-                                      vertex_count, " vertices"));
-                }
+        for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
+            const size_t corners = shape.mesh.num_face_vertices[f];
+            const int material = read_file ? shape.mesh.material_ids[f] : -1;
+            auto [it, added] = builder_of.try_emplace(material, builders.size());
+            if (added) {
+                builders.emplace_back();
+                builders.back().material = material;
+                builders.back().first_face = face;
             }
-            for (size_t c = first + 1; c + 1 < first + corners; ++c) {
-                mesh.triangles.push_back({uint32_t(indices[first].vertex_index),
-                                          uint32_t(indices[c].vertex_index),
-                                          uint32_t(indices[c + 1].vertex_index)});
+            ObjMeshBuilder& builder = builders[it->second];
+            for (size_t c = first; c < first + corners; ++c) {
+                const tinyobj::index_t& index = shape.mesh.indices[c];
+                // -1 is "not given" for a normal or texture coordinate.
+                for (const auto& [i, count, optional, what, plural] :
+                     {std::tuple{int64_t(index.vertex_index), positions.size(), false, "vertex",
+                                 "vertices"},
+                      {int64_t(index.normal_index), normals.size(), true, "normal", "normals"},
+                      {int64_t(index.texcoord_index), uvs.size(), true, "texture coordinate",
+                       "texture coordinates"}}) {
+                    if ((i >= 0 || (optional && i == -1)) && i < int64_t(count)) continue;
+                    Fail(LineSuffix(FindRecordLine(text, "f", face, 3)),
+                         absl::StrCat("face refers to ", what, " ", i + 1, " but the file has ",
+                                      count, " ", plural));
+                }
+                builder.normals |= index.normal_index >= 0 && normals[index.normal_index];
+                builder.uvs |= index.texcoord_index >= 0;
             }
             first += corners;
             ++face;
         }
     }
-    return mesh;
+
+    if (builders.empty()) Fail("", "no faces");
+    // Second pass: one vertex per distinct (position, normal, uv) corner.
+    face = 0;
+    for (const tinyobj::shape_t& shape : shapes) {
+        size_t first = 0;
+        for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
+            const size_t corners = shape.mesh.num_face_vertices[f];
+            ObjMeshBuilder& b =
+                builders[builder_of.at(read_file ? shape.mesh.material_ids[f] : -1)];
+            const tinyobj::index_t* corner = &shape.mesh.indices[first];
+            // Newell's normal of the polygon, for corners without a normal of their own.
+            Vec3d newell;
+            for (size_t c = 0; c < corners && b.normals; ++c) {
+                const Vec3d& p = positions[corner[c].vertex_index];
+                const Vec3d& q = positions[corner[(c + 1) % corners].vertex_index];
+                newell += Cross(p, q);
+            }
+            const Vec3 face_normal =
+                LengthSquared(newell) > 0 ? Vec3(Normalize(newell)) : Vec3(0, 0, 1);
+            uint32_t vertex[3];
+            for (size_t c = 0; c < corners; ++c) {
+                const tinyobj::index_t& i = corner[c];
+                const bool has_normal = i.normal_index >= 0 && normals[i.normal_index];
+                const Corner key{i.vertex_index,
+                                 !b.normals ? -1 : has_normal ? i.normal_index : -2 - int64_t(face),
+                                 b.uvs ? i.texcoord_index : -1};
+                auto [it, added] = b.vertex_of.try_emplace(key, uint32_t(b.mesh.positions.size()));
+                if (added) {
+                    b.mesh.positions.push_back(positions[i.vertex_index]);
+                    if (b.normals) {
+                        b.mesh.normals.push_back(has_normal ? *normals[i.normal_index]
+                                                            : face_normal);
+                    }
+                    // A corner without one in a mesh with them reads the texel at vt 0 0.
+                    if (b.uvs) {
+                        b.mesh.uvs.push_back(i.texcoord_index >= 0 ? uvs[i.texcoord_index]
+                                                                   : Vec2{0, 1});
+                    }
+                }
+                vertex[std::min<size_t>(c, 2)] = it->second;
+                if (c >= 2) {
+                    b.mesh.triangles.push_back({vertex[0], vertex[1], vertex[2]});
+                    vertex[1] = vertex[2];
+                }
+            }
+            first += corners;
+            ++face;
+        }
+    }
+
+    MeshFile out;
+    std::optional<MtlConverter> converter;
+    if (mtl_reader) converter.emplace(*mtl_reader, out);
+    for (ObjMeshBuilder& b : builders) {
+        if (b.material >= 0) {
+            b.mesh.material = int(out.materials.size());
+            out.materials.push_back(converter->Convert(materials[size_t(b.material)],
+                                                       size_t(b.material)));
+        } else {
+            b.mesh.material = -1;
+            out.unassigned_where.push_back(
+                absl::StrCat(name, LineSuffix(FindRecordLine(text, "f", b.first_face, 3))));
+        }
+        out.meshes.push_back(std::move(b.mesh));
+    }
+    return out;
 }
 
 // ---- PLY -------------------------------------------------------------------------------------
@@ -259,6 +608,24 @@ class PlyBodyReader {
     uint64_t record_ = 0;
 };
 
+// Zero vertex normals (written by some tools for vertices they had no normal for) become the
+// area-weighted mean of the normals of the faces around the vertex.
+void FillZeroNormals(TriangleMesh& mesh) {
+    std::vector<Vec3d> sums;
+    for (size_t i = 0; i < mesh.normals.size(); ++i) {
+        if (LengthSquared(mesh.normals[i]) > 0) continue;
+        if (sums.empty()) {
+            sums.resize(mesh.positions.size());
+            for (const std::array<uint32_t, 3>& t : mesh.triangles) {
+                const Vec3d& a = mesh.positions[t[0]];
+                const Vec3d n = Cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
+                for (const uint32_t v : t) sums[v] += n;
+            }
+        }
+        mesh.normals[i] = LengthSquared(sums[i]) > 0 ? Vec3(Normalize(sums[i])) : Vec3(0, 0, 1);
+    }
+}
+
 TriangleMesh ParsePly(std::string_view bytes) {
     size_t pos = 0, line = 0;
     auto next_line = [&]() -> std::optional<std::string_view> {
@@ -368,20 +735,33 @@ TriangleMesh ParsePly(std::string_view bytes) {
     for (const PlyElement& e : elements) {
         if (e.properties.empty()) continue;
         const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
-        const int axes[3] = {find(e, "x", false), find(e, "y", false), find(e, "z", false)};
+        // Positions of x, y, z, nx, ny, nz, u, v among the element's properties (or -1).
+        int slot_of[8] = {find(e, "x", false), find(e, "y", false), find(e, "z", false),
+                          find(e, "nx", false), find(e, "ny", false), find(e, "nz", false),
+                          -1, -1};
+        const bool normals = is_vertex && slot_of[3] >= 0 && slot_of[4] >= 0 && slot_of[5] >= 0;
+        if (!normals) slot_of[3] = slot_of[4] = slot_of[5] = -1;
+        for (const auto& [u, v] : {std::pair{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"},
+                                   {"texture_s", "texture_t"}}) {
+            if (is_vertex && slot_of[6] < 0 && find(e, u, false) >= 0 && find(e, v, false) >= 0) {
+                slot_of[6] = find(e, u, false);
+                slot_of[7] = find(e, v, false);
+            }
+        }
+        const bool uvs = slot_of[6] >= 0;
         const int corner_list = is_face ? find_corners(e) : -1;
         // A count larger than the file can hold must not turn into a huge allocation.
         if (is_vertex) mesh.positions.reserve(std::min<uint64_t>(e.count, bytes.size()));
         for (uint64_t r = 0; r < e.count; ++r) {
             reader.StartRecord(e.name, r);
-            Vec3d p;
+            double slot[8] = {};
             corners.clear();
             for (int k = 0; k < int(e.properties.size()); ++k) {
                 const PlyProperty& property = e.properties[k];
                 if (!property.count_type) {
                     const double value = reader.Read(property.type);
-                    for (int a = 0; a < 3; ++a) {
-                        if (is_vertex && axes[a] == k) p[a] = value;
+                    for (int a = 0; a < 8; ++a) {
+                        if (is_vertex && slot_of[a] == k) slot[a] = value;
                     }
                     continue;
                 }
@@ -398,8 +778,19 @@ TriangleMesh ParsePly(std::string_view bytes) {
                 }
             }
             if (is_vertex) {
+                const Vec3d p(slot[0], slot[1], slot[2]);
                 if (!IsFinite(p)) reader.Fail("coordinate is not finite");
                 mesh.positions.push_back(p);
+                const Vec3 n{float(slot[3]), float(slot[4]), float(slot[5])};
+                if (!IsFinite(n)) reader.Fail("normal is not finite");
+                // A zero normal is filled in from the faces around the vertex, below.
+                if (normals) mesh.normals.push_back(LengthSquared(n) > 0 ? Normalize(n) : n);
+                // Like OBJ's, PLY's v = 0 is the bottom of the image.
+                const Vec2 uv{float(slot[6]), float(1 - slot[7])};
+                if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) {
+                    reader.Fail("texture coordinate is not finite");
+                }
+                if (uvs) mesh.uvs.push_back(uv);
             }
             if (!is_face) continue;
             if (corners.size() < 3) {
@@ -411,12 +802,12 @@ TriangleMesh ParsePly(std::string_view bytes) {
             }
         }
     }
+    FillZeroNormals(mesh);
     return mesh;
 }
 
-}  // namespace
-
-absl::StatusOr<TriangleMesh> ParseMesh(const std::string& bytes, const std::string& name) {
+absl::StatusOr<MeshFile> ParseMeshFile(const std::string& bytes, const std::string& name,
+                                       const SceneFileReader* read_file) {
     std::string extension = std::filesystem::path(name).extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });
@@ -425,14 +816,36 @@ absl::StatusOr<TriangleMesh> ParseMesh(const std::string& bytes, const std::stri
                                                        "\" (expected .obj or .ply)"));
     }
     try {
-        TriangleMesh mesh = extension == ".obj" ? ParseObj(bytes) : ParsePly(bytes);
-        if (mesh.positions.empty()) Fail("", "no vertices");
-        if (mesh.triangles.empty()) Fail("", "no faces");
-        mesh.name = std::filesystem::path(name).stem().string();
-        return mesh;
+        MeshFile file;
+        if (extension == ".obj") {
+            file = ParseObj(bytes, name, read_file);
+        } else {
+            file.meshes.push_back(ParsePly(bytes));
+            file.meshes[0].material = -1;
+            file.unassigned_where.push_back(name);
+            if (file.meshes[0].positions.empty()) Fail("", "no vertices");
+            if (file.meshes[0].triangles.empty()) Fail("", "no faces");
+        }
+        for (TriangleMesh& mesh : file.meshes) {
+            mesh.name = std::filesystem::path(name).stem().string();
+        }
+        return file;
     } catch (const MeshError& e) {
         return absl::InvalidArgumentError(absl::StrCat(name, e.where, ": ", e.message));
     }
+}
+
+}  // namespace
+
+absl::StatusOr<TriangleMesh> ParseMesh(const std::string& bytes, const std::string& name) {
+    absl::StatusOr<MeshFile> file = ParseMeshFile(bytes, name, nullptr);
+    if (!file.ok()) return file.status();
+    return std::move(file->meshes[0]);
+}
+
+absl::StatusOr<MeshFile> ParseMeshWithMaterials(const std::string& bytes, const std::string& name,
+                                                const SceneFileReader& read_file) {
+    return ParseMeshFile(bytes, name, &read_file);
 }
 
 absl::StatusOr<TriangleMesh> LoadMesh(const std::string& path) {

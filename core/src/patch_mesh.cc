@@ -166,22 +166,48 @@ std::vector<GridTriangle> SubdivisionCells(int k) {
     return cells;
 }
 
+std::string RadiosityLimitation(const Scene& scene) {
+    for (const TriangleMesh& mesh : scene.meshes) {
+        const Material& m = scene.materials[size_t(mesh.material)];
+        const std::string material = absl::StrCat("material \"", m.name, "\" ");
+        if (m.type != Material::Type::kLambert) {
+            return absl::StrCat(material, "is ", MaterialTypeName(m.type),
+                                "; radiosity models lambert only");
+        }
+        // A patch has one reflectance: a texture would be averaged away.
+        if (m.base_color_texture.valid() || m.emission_texture.valid()) {
+            const bool base = m.base_color_texture.valid();
+            const int image = (base ? m.base_color_texture : m.emission_texture).image;
+            return absl::StrCat(material, "has a texture (",
+                                base ? "base_color_texture" : "emission_texture", " \"",
+                                scene.textures[size_t(image)]->name,
+                                "\"), which radiosity does not model");
+        }
+        if (m.alpha_mode == Material::AlphaMode::kMask) {
+            return material + "is a cut-out (alpha mask), which radiosity does not model";
+        }
+        if (!m.double_sided) {
+            return material + "is single-sided, which radiosity does not model";
+        }
+    }
+    if (!scene.spheres.empty()) {
+        return absl::StrCat("sphere \"", scene.spheres.front().name,
+                            "\" cannot be meshed; radiosity supports triangle meshes and quads "
+                            "only");
+    }
+    if (!scene.spot_lights.empty()) return "the scene has a spot light; radiosity takes point lights";
+    if (!scene.directional_lights.empty()) {
+        return "the scene has a directional light; radiosity takes point lights";
+    }
+    return "";
+}
+
 absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOptions& options) {
     auto cancelled = [&] {
         return options.cancel && options.cancel->load(std::memory_order_relaxed);
     };
-    if (!scene.spheres.empty()) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("radiosity: sphere '", scene.spheres.front().name,
-                         "' cannot be meshed; radiosity supports triangle meshes and quads only"));
-    }
-    for (const TriangleMesh& mesh : scene.meshes) {
-        const Material& material = scene.materials[size_t(mesh.material)];
-        if (material.type != Material::Type::kLambert) {
-            return absl::InvalidArgumentError(absl::StrCat(
-                "radiosity: mesh '", mesh.name, "' uses ", MaterialTypeName(material.type),
-                " material '", material.name, "'; radiosity handles lambert materials only"));
-        }
+    if (const std::string why = RadiosityLimitation(scene); !why.empty()) {
+        return absl::InvalidArgumentError("radiosity: " + why);
     }
     if (!(options.patch_size >= 0) || (options.patch_size == 0 && options.patches <= 0)) {
         return absl::InvalidArgumentError(

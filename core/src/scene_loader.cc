@@ -23,6 +23,7 @@
 #include "lf/core/file_util.h"
 #include "lf/core/log.h"
 #include "lf/core/mesh_io.h"
+#include "lf/core/texture_io.h"
 
 namespace lf {
 namespace {
@@ -312,6 +313,31 @@ int DropDegenerate(TriangleMesh& mesh) {
     return int(before - mesh.triangles.size());
 }
 
+// Moves a mesh's positions and normals by `transform`: normals by its inverse transpose.
+void TransformMesh(const Affine& transform, TriangleMesh& mesh) {
+    for (Vec3d& p : mesh.positions) p = transform.Apply(p);
+    // The cofactor matrix is det(M) M^-T: its sign keeps normals on their side.
+    const double sign = transform.Determinant() < 0 ? -1 : 1;
+    const Vec3d cofactor[3] = {Cross(transform.Row(1), transform.Row(2)),
+                               Cross(transform.Row(2), transform.Row(0)),
+                               Cross(transform.Row(0), transform.Row(1))};
+    for (Vec3& n : mesh.normals) {
+        const Vec3d d(n);
+        n = Vec3(Normalize(Vec3d(Dot(cofactor[0], d), Dot(cofactor[1], d), Dot(cofactor[2], d)) *
+                           sign));
+    }
+    // A mirroring transform would turn front faces into back faces; keep them in front.
+    if (transform.Determinant() < 0) {
+        for (std::array<uint32_t, 3>& t : mesh.triangles) std::swap(t[1], t[2]);
+    }
+}
+
+// A mesh file's meshes as a scene uses them.
+struct CachedMeshFile {
+    std::vector<TriangleMesh> meshes;
+    std::string unassigned_where;  // where faces without a material are, when they need one
+};
+
 class SceneParser {
   public:
     explicit SceneParser(const SceneFileReader& read_file) : read_file_(read_file) {}
@@ -339,13 +365,12 @@ class SceneParser {
         for (const Node& shape : shapes) ParseShape(shape, scene);
 
         if (const std::optional<Node> lights = root.Find("lights")) {
-            for (const Node& light : lights->Elements()) {
-                scene.point_lights.push_back(ParseLight(light));
-            }
+            for (const Node& light : lights->Elements()) ParseLight(light, scene);
         }
+        scene.textures = textures_;
 
         if (!scene.HasLights()) {
-            warnings_.push_back("no emissive shape and no point light: the image will be black");
+            warnings_.push_back("no emissive shape and no light: the image will be black");
         }
 
         scene.dropped_degenerate = dropped_degenerate_;
@@ -395,9 +420,13 @@ class SceneParser {
         m.name = name;
         const Node type = n.Get("type");
         const std::string type_name = type.String();
-        if (type_name == "lambert" || type_name == "mirror") {
+        if (type_name == "lambert") {
+            n.WarnUnknownKeys(
+                {"type", "reflectance", "base_color", "base_color_texture", "emission"});
+            ParseBaseColor(n, m);
+        } else if (type_name == "mirror") {
             n.WarnUnknownKeys({"type", "reflectance", "emission"});
-            m.type = type_name == "lambert" ? Material::Type::kLambert : Material::Type::kMirror;
+            m.type = Material::Type::kMirror;
             m.reflectance = n.Get("reflectance").Color(1);
         } else if (type_name == "glossy") {
             n.WarnUnknownKeys(
@@ -429,30 +458,188 @@ class SceneParser {
             n.WarnUnknownKeys({"type", "ior", "emission"});
             m.type = Material::Type::kDielectric;
             m.ior = n.Get("ior").PositiveFloat();
+        } else if (type_name == "principled") {
+            ParsePrincipled(n, m);
         } else {
             type.Fail(absl::StrCat("unknown material type \"", type_name,
-                                   "\"; expected lambert, mirror, glossy or dielectric"));
+                                   "\"; expected lambert, mirror, glossy, dielectric or principled"));
         }
         if (const std::optional<Node> emission = n.Find("emission")) {
             m.emission = emission->Color(kMaxRadiance);
+        } else if (m.emission_texture.valid()) {
+            m.emission = Rgb(1);  // the texture alone gives the radiance
         }
         return m;
+    }
+
+    // Lambert's albedo and principled's base colour: `base_color` or its older name
+    // `reflectance`, times `base_color_texture` when given. Without a texture the colour is
+    // required; with one it defaults to white, the texture alone.
+    void ParseBaseColor(const Node& n, Material& m) {
+        if (n.Has("reflectance") && n.Has("base_color")) {
+            n.Fail("give either base_color or reflectance (the same thing), not both");
+        }
+        if (const std::optional<Node> texture = n.Find("base_color_texture")) {
+            m.base_color_texture = ParseTexture(*texture, true);
+        }
+        const std::string key = n.Has("base_color") ? "base_color" : "reflectance";
+        if (n.Has(key) || !m.base_color_texture.valid()) m.reflectance = n.Get(key).Color(1);
+        if (!n.Has(key) && m.base_color_texture.valid()) m.reflectance = Rgb(1);
+    }
+
+    // glTF 2.0's metallic-roughness material; defaults as Blender's Principled BSDF.
+    void ParsePrincipled(const Node& n, Material& m) {
+        n.WarnUnknownKeys({"type", "base_color", "reflectance", "base_color_texture", "metallic",
+                           "roughness", "metallic_roughness_texture", "specular", "ior",
+                           "transmission", "thickness", "attenuation_color",
+                           "attenuation_distance", "normal_texture", "normal_scale", "emission",
+                           "emission_texture", "opacity", "alpha_mode", "alpha_cutoff",
+                           "double_sided"});
+        m.type = Material::Type::kPrincipled;
+        if (!n.Has("base_color") && !n.Has("reflectance") && !n.Has("base_color_texture")) {
+            m.reflectance = Rgb(0.8f);
+        } else {
+            ParseBaseColor(n, m);
+        }
+        auto fraction = [&](const char* key, float fallback) {
+            const std::optional<Node> value = n.Find(key);
+            return value ? float(value->NumberIn(0, 1, "in [0, 1]")) : fallback;
+        };
+        m.metallic = fraction("metallic", 0);
+        m.roughness = fraction("roughness", 0.5f);
+        m.specular = fraction("specular", 1);
+        m.transmission = fraction("transmission", 0);
+        m.opacity = fraction("opacity", 1);
+        m.alpha_cutoff = fraction("alpha_cutoff", 0.5f);
+        if (const std::optional<Node> ior = n.Find("ior")) m.ior = ior->PositiveFloat();
+        if (const std::optional<Node> thickness = n.Find("thickness")) {
+            m.thickness = float(thickness->NumberIn(0, kMaxCoordinate, "≥ 0 (metres)"));
+        }
+        if (const std::optional<Node> color = n.Find("attenuation_color")) {
+            m.attenuation_color = color->Color(1);
+        }
+        if (const std::optional<Node> distance = n.Find("attenuation_distance")) {
+            m.attenuation_distance = distance->PositiveFloat();
+        }
+        if (const std::optional<Node> texture = n.Find("metallic_roughness_texture")) {
+            m.metallic_roughness_texture = ParseTexture(*texture, false);
+        }
+        if (const std::optional<Node> texture = n.Find("normal_texture")) {
+            m.normal_texture = ParseTexture(*texture, false);
+        }
+        if (const std::optional<Node> scale = n.Find("normal_scale")) {
+            m.normal_scale = float(scale->NumberIn(-kMaxFloat, kMaxFloat, "a finite float"));
+        }
+        if (const std::optional<Node> texture = n.Find("emission_texture")) {
+            m.emission_texture = ParseTexture(*texture, true);
+        }
+        if (const std::optional<Node> mode = n.Find("alpha_mode")) {
+            const std::string name = mode->String();
+            if (name != "opaque" && name != "mask") {
+                mode->Fail(absl::StrCat("unknown alpha mode \"", name, "\"; expected opaque or mask"));
+            }
+            m.alpha_mode = name == "mask" ? Material::AlphaMode::kMask : Material::AlphaMode::kOpaque;
+        }
+        if (const std::optional<Node> sided = n.Find("double_sided")) {
+            if (!sided->json().is_boolean()) {
+                sided->Fail(absl::StrCat("expected true or false, got ", Describe(sided->json())));
+            }
+            m.double_sided = sided->json().get<bool>();
+        }
+    }
+
+    // A texture: a file name, or {"file", "wrap", "filter", "transform"}.
+    TextureRef ParseTexture(const Node& n, bool srgb) {
+        TextureRef ref;
+        ref.srgb = srgb;
+        if (n.json().is_string()) {
+            ref.image = TextureIndex(n.String(), n.path());
+            return ref;
+        }
+        n.ExpectObject({"file", "wrap", "filter", "transform"});
+        const Node file = n.Get("file");
+        ref.image = TextureIndex(file.String(), file.path());
+        if (const std::optional<Node> wrap = n.Find("wrap")) {
+            const std::string name = wrap->String();
+            if (name != "repeat" && name != "clamp" && name != "mirror") {
+                wrap->Fail(absl::StrCat("unknown wrap mode \"", name,
+                                        "\"; expected repeat, clamp or mirror"));
+            }
+            ref.wrap_s = ref.wrap_t = name == "repeat"  ? TextureRef::Wrap::kRepeat
+                                      : name == "clamp" ? TextureRef::Wrap::kClampToEdge
+                                                        : TextureRef::Wrap::kMirroredRepeat;
+        }
+        if (const std::optional<Node> filter = n.Find("filter")) {
+            const std::string name = filter->String();
+            if (name != "linear" && name != "nearest") {
+                filter->Fail(
+                    absl::StrCat("unknown filter \"", name, "\"; expected linear or nearest"));
+            }
+            ref.nearest = name == "nearest";
+        }
+        if (const std::optional<Node> transform = n.Find("transform")) {
+            transform->ExpectObject({"offset", "rotation_deg", "scale"});
+            auto pair = [&](const char* key, Vec2 fallback, bool nonzero) {
+                const std::optional<Node> value = transform->Find(key);
+                if (!value) return fallback;
+                const std::vector<Node> e = value->Elements(2);
+                const Vec2 v{float(e[0].Coordinate()), float(e[1].Coordinate())};
+                if (nonzero && (v.x == 0 || v.y == 0)) value->Fail("must not be zero");
+                return v;
+            };
+            ref.offset = pair("offset", ref.offset, false);
+            ref.scale = pair("scale", ref.scale, true);
+            if (const std::optional<Node> rotation = transform->Find("rotation_deg")) {
+                ref.rotation = float(rotation->Number() * std::numbers::pi / 180);
+            }
+        }
+        return ref;
+    }
+
+    // The index in Scene::textures of image file `name`, read and decoded once per scene.
+    // `where` (a JSON path, an MTL file's line) starts messages.
+    int TextureIndex(const std::string& name, const std::string& where) {
+        if (name.empty()) throw LoadError{absl::InvalidArgumentError(where + ": empty file name")};
+        const std::string key = std::filesystem::path(name).lexically_normal().string();
+        if (const auto found = texture_index_.find(key); found != texture_index_.end()) {
+            return found->second;
+        }
+        absl::StatusOr<std::string> bytes = read_file_(name);
+        if (!bytes.ok()) {
+            throw LoadError{absl::Status(bytes.status().code(),
+                                         absl::StrCat(where, " \"", name, "\": ",
+                                                      bytes.status().message()))};
+        }
+        hash_.Update(*bytes);
+        absl::StatusOr<std::shared_ptr<const TextureImage>> image = DecodeTexture(*bytes, name);
+        if (!image.ok()) {
+            throw LoadError{absl::Status(image.status().code(),
+                                         absl::StrCat(where, ": ", image.status().message()))};
+        }
+        textures_.push_back(*std::move(image));
+        return texture_index_[key] = int(textures_.size() - 1);
     }
 
     void ParseShape(const Node& n, Scene& scene) {
         n.RequireObject();
         const Node type = n.Get("type");
         const std::string type_name = type.String();
-        const Node material = n.Get("material");
-        const auto found = material_index_.find(material.String());
-        if (found == material_index_.end()) {
-            material.Fail(absl::StrCat("unknown material \"", material.String(), "\""));
+        // A mesh file may give its own materials; every other shape names one.
+        const std::optional<Node> material =
+            type_name == "mesh" ? n.Find("material") : std::optional(n.Get("material"));
+        int material_index = -1;
+        if (material) {
+            const auto found = material_index_.find(material->String());
+            if (found == material_index_.end()) {
+                material->Fail(absl::StrCat("unknown material \"", material->String(), "\""));
+            }
+            material_index = found->second;
         }
         const std::string name = n.Has("name") ? n.Get("name").String() : n.path();
 
         if (type_name == "sphere") {
             n.WarnUnknownKeys({"type", "material", "name", "center", "radius"});
-            Sphere sphere{name, found->second, n.Get("center").Vector(), 0};
+            Sphere sphere{name, material_index, n.Get("center").Vector(), 0};
             const Node radius = n.Get("radius");
             sphere.radius = radius.Number();
             if (!(sphere.radius > 0 && sphere.radius <= kMaxCoordinate)) {
@@ -462,104 +649,225 @@ class SceneParser {
             return;
         }
 
-        TriangleMesh mesh;
+        std::vector<TriangleMesh> meshes;
         if (type_name == "quad" || type_name == "triangle") {
             n.WarnUnknownKeys({"type", "material", "name", "vertices"});
             const bool quad = type_name == "quad";
+            TriangleMesh& mesh = meshes.emplace_back();
             for (const Node& v : n.Get("vertices").Elements(quad ? 4 : 3)) {
                 mesh.positions.push_back(v.Vector());
             }
             mesh.triangles.push_back({0, 1, 2});
             if (quad) mesh.triangles.push_back({0, 2, 3});
             mesh.is_quad = quad;
+            mesh.material = material_index;
         } else if (type_name == "mesh") {
             n.WarnUnknownKeys({"type", "material", "name", "file", "transform"});
-            mesh = LoadMeshShape(n);
+            meshes = LoadMeshShape(n, material_index, scene);
         } else {
             type.Fail(absl::StrCat("unknown shape type \"", type_name,
                                    "\"; expected quad, triangle, mesh or sphere"));
         }
-        mesh.name = name;
-        mesh.material = found->second;
 
-        const int dropped = DropDegenerate(mesh);
-        if (mesh.triangles.empty()) {
-            n.Fail("every triangle is degenerate (zero area or repeated vertices)");
+        bool kept = false;
+        for (TriangleMesh& mesh : meshes) {
+            // One mesh per material of the file: each named for its material.
+            mesh.name = meshes.size() == 1
+                            ? name
+                            : absl::StrCat(name, " (", scene.materials[mesh.material].name, ")");
+            const int dropped = DropDegenerate(mesh);
+            dropped_degenerate_ += dropped;
+            if (mesh.triangles.empty()) continue;
+            // Radiosity grids an is_quad mesh between its four corners, which no longer holds
+            // once a triangle is gone.
+            if (dropped > 0) mesh.is_quad = false;
+            scene.meshes.push_back(std::move(mesh));
+            kept = true;
         }
-        // Radiosity grids an is_quad mesh between its four corners, which no longer holds once
-        // a triangle is gone.
-        if (dropped > 0) mesh.is_quad = false;
-        dropped_degenerate_ += dropped;
-        scene.meshes.push_back(std::move(mesh));
+        if (!kept) n.Fail("every triangle is degenerate (zero area or repeated vertices)");
     }
 
-    TriangleMesh LoadMeshShape(const Node& n) {
+    // A mesh file's meshes: with `material_index` (>= 0) one mesh of that material, otherwise
+    // one per material of the file (an OBJ's MTL files), those materials added to the scene.
+    std::vector<TriangleMesh> LoadMeshShape(const Node& n, int material_index, Scene& scene) {
         const Node file = n.Get("file");
         const std::string name = file.String();
         if (name.empty()) file.Fail("empty file name");
         // Errors name the file as the scene does, never where a reader found it.
+        const std::string where = absl::StrCat(file.path(), " \"", name, "\"");
         auto fail = [&](const absl::Status& status) {
-            throw LoadError{absl::Status(
-                status.code(), absl::StrCat(file.path(), " \"", name, "\": ", status.message()))};
+            throw LoadError{absl::Status(status.code(), absl::StrCat(where, ": ", status.message()))};
         };
         // Keyed by the name as written ("./m.obj" is "m.obj"), never by where the reader found
         // it: the same keys, so the same content hash, on the farm as on the user's disk.
-        const std::string key = std::filesystem::path(name).lexically_normal().string();
+        const bool own_materials = material_index < 0;
+        const std::pair key(std::filesystem::path(name).lexically_normal().string(), own_materials);
         auto cached = mesh_cache_.find(key);
         if (cached == mesh_cache_.end()) {
             absl::StatusOr<std::string> bytes = read_file_(name);
             if (!bytes.ok()) fail(bytes.status());
-            absl::StatusOr<TriangleMesh> loaded = ParseMesh(*bytes, name);
-            if (!loaded.ok()) {
-                throw LoadError{
-                    absl::Status(loaded.status().code(),
-                                 absl::StrCat(file.path(), ": ", loaded.status().message()))};
-            }
             hash_.Update(*bytes);
-            cached = mesh_cache_.emplace(key, *std::move(loaded)).first;
+            // MTL files count in the content hash like the meshes that name them.
+            const SceneFileReader read_and_hash = [&](const std::string& mtl) {
+                absl::StatusOr<std::string> text = read_file_(mtl);
+                if (text.ok()) hash_.Update(*text);
+                return text;
+            };
+            absl::StatusOr<MeshFile> loaded;
+            if (own_materials) {
+                loaded = ParseMeshWithMaterials(*bytes, name, read_and_hash);
+            } else if (absl::StatusOr<TriangleMesh> mesh = ParseMesh(*bytes, name); mesh.ok()) {
+                loaded.emplace().meshes.push_back(*std::move(mesh));
+            } else {
+                loaded = mesh.status();
+            }
+            if (!loaded.ok()) {
+                throw LoadError{absl::Status(loaded.status().code(),
+                                             absl::StrCat(file.path(), ": ", loaded.status().message()))};
+            }
+            for (const std::string& warning : loaded->warnings) {
+                warnings_.push_back(absl::StrCat(where, ": ", warning));
+            }
+            cached = mesh_cache_.emplace(key, AddFileMaterials(*std::move(loaded), where, scene)).first;
         }
-        TriangleMesh mesh = cached->second;
+        if (!cached->second.unassigned_where.empty()) {
+            n.Fail(absl::StrCat("missing required key \"material\": the faces of ",
+                                cached->second.unassigned_where,
+                                " have no material from the file (only an OBJ file's mtllib "
+                                "and usemtl give one)"));
+        }
+        std::vector<TriangleMesh> meshes = cached->second.meshes;
+        if (!own_materials) meshes[0].material = material_index;
 
-        if (const std::optional<Node> transform_node = n.Find("transform")) {
-            const Affine transform = ParseTransform(*transform_node);
-            for (Vec3d& p : mesh.positions) p = transform.Apply(p);
-            // A mirroring transform would turn front faces into back faces; keep them in front.
-            if (transform.Determinant() < 0) {
-                for (std::array<uint32_t, 3>& t : mesh.triangles) std::swap(t[1], t[2]);
+        for (TriangleMesh& mesh : meshes) {
+            if (const std::optional<Node> transform_node = n.Find("transform")) {
+                TransformMesh(ParseTransform(*transform_node), mesh);
+            }
+            for (const Vec3d& p : mesh.positions) {
+                if (MaxComponent(Abs(p)) > kMaxCoordinate) {
+                    n.Fail(absl::StrCat("a vertex of ", name, " lies beyond ±1e15",
+                                        n.Has("transform") ? " after the transform" : "", ": (",
+                                        p.x, ", ", p.y, ", ", p.z, ")"));
+                }
             }
         }
-        for (const Vec3d& p : mesh.positions) {
-            if (MaxComponent(Abs(p)) > kMaxCoordinate) {
-                n.Fail(absl::StrCat("a vertex of ", name, " lies beyond ±1e15",
-                                    n.Has("transform") ? " after the transform" : "", ": (", p.x,
-                                    ", ", p.y, ", ", p.z, ")"));
-            }
-        }
-        return mesh;
+        return meshes;
     }
 
-    PointLight ParseLight(const Node& n) {
+    // A mesh file's materials join the scene's, their textures its textures; the meshes'
+    // material indices become the scene's.
+    CachedMeshFile AddFileMaterials(MeshFile file, const std::string& where, Scene& scene) {
+        std::vector<int> image_of;
+        for (const MeshFile::Texture& texture : file.textures) {
+            image_of.push_back(TextureIndex(texture.name, absl::StrCat(where, ": ", texture.where)));
+        }
+        const int first = int(scene.materials.size());
+        for (Material& m : file.materials) {
+            for (TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture,
+                                    &m.normal_texture, &m.emission_texture}) {
+                if (ref->valid()) ref->image = image_of[size_t(ref->image)];
+            }
+            scene.materials.push_back(std::move(m));
+        }
+        for (TriangleMesh& mesh : file.meshes) {
+            if (mesh.material >= 0) mesh.material += first;
+        }
+        return {std::move(file.meshes),
+                file.unassigned_where.empty() ? "" : file.unassigned_where[0]};
+    }
+
+    void ParseLight(const Node& n, Scene& scene) {
         n.RequireObject();
         const Node type = n.Get("type");
-        if (type.String() != "point") {
-            type.Fail(absl::StrCat("unknown light type \"", type.String(), "\"; expected point"));
+        const std::string type_name = type.String();
+        if (type_name == "point") {
+            n.WarnUnknownKeys({"type", "position", "intensity", "power", "intensity_cd", "color"});
+            scene.point_lights.push_back(
+                {n.Get("position").Vector(), RadiantIntensity(n, 4 * std::numbers::pi)});
+        } else if (type_name == "spot") {
+            n.WarnUnknownKeys({"type", "position", "direction", "intensity", "power",
+                               "intensity_cd", "color", "inner_cone_deg", "outer_cone_deg"});
+            SpotLight light;
+            light.position = n.Get("position").Vector();
+            light.direction = Direction(n.Get("direction"));
+            double inner_deg = 0, outer_deg = 45;
+            if (const std::optional<Node> inner = n.Find("inner_cone_deg")) {
+                inner_deg = inner->NumberIn(0, 90, "in [0, 90) degrees");
+            }
+            if (const std::optional<Node> outer = n.Find("outer_cone_deg")) {
+                outer_deg = outer->NumberIn(0, 90, "in (0, 90] degrees");
+            }
+            if (!(inner_deg < outer_deg)) {
+                n.Fail(absl::StrCat("inner_cone_deg (", inner_deg,
+                                    ") must be below outer_cone_deg (", outer_deg, ")"));
+            }
+            light.inner_cone = inner_deg * std::numbers::pi / 180;
+            light.outer_cone = outer_deg * std::numbers::pi / 180;
+            // KHR_lights_punctual's falloff, squared linear in cos between the cones, integrates
+            // to a third of the band's solid angle.
+            const double cos_inner = std::cos(light.inner_cone);
+            const double cos_outer = std::cos(light.outer_cone);
+            light.intensity = RadiantIntensity(
+                n, 2 * std::numbers::pi * (1 - cos_inner + (cos_inner - cos_outer) / 3));
+            scene.spot_lights.push_back(light);
+        } else if (type_name == "directional") {
+            n.WarnUnknownKeys({"type", "direction", "irradiance", "illuminance_lux", "color"});
+            DirectionalLight light;
+            light.direction = Direction(n.Get("direction"));
+            if (n.Has("irradiance") == n.Has("illuminance_lux")) {
+                n.Fail("give exactly one of irradiance (W/m^2) or illuminance_lux (lx)");
+            }
+            if (n.Has("color") && n.Has("irradiance")) {
+                n.Fail("color goes with illuminance_lux; irradiance is a colour itself");
+            }
+            light.irradiance = n.Has("irradiance")
+                                   ? n.Get("irradiance").Color(kMaxRadiance)
+                                   : Photometric(n, n.Get("illuminance_lux"));
+            scene.directional_lights.push_back(light);
+        } else {
+            type.Fail(absl::StrCat("unknown light type \"", type_name,
+                                   "\"; expected point, spot or directional"));
         }
-        n.WarnUnknownKeys({"type", "position", "intensity", "power"});
-        PointLight light{n.Get("position").Vector(), Rgb()};
-        if (n.Has("intensity") == n.Has("power")) {
-            n.Fail("give exactly one of intensity (W/sr) or power (W)");
+    }
+
+    // A unit direction from a non-zero vector.
+    static Vec3d Direction(const Node& n) {
+        const Vec3d v = n.Vector();
+        if (LengthSquared(v) == 0) n.Fail("must not be zero");
+        return Normalize(v);
+    }
+
+    // A light's intensity in W/sr: given, from its power in W over `solid_angle` (the light's
+    // emission integrated over directions, relative to its peak), or photometric in candela.
+    static Rgb RadiantIntensity(const Node& n, double solid_angle) {
+        if (int(n.Has("intensity")) + int(n.Has("power")) + int(n.Has("intensity_cd")) != 1) {
+            n.Fail("give exactly one of intensity (W/sr), power (W) or intensity_cd (cd)");
         }
-        light.intensity = n.Has("intensity")
-                              ? n.Get("intensity").Color(kMaxRadiance)
-                              : n.Get("power").Color(float(4 * std::numbers::pi) * kMaxRadiance) /
-                                    float(4 * std::numbers::pi);
-        return light;
+        if (n.Has("color") && !n.Has("intensity_cd")) {
+            n.Fail("color goes with intensity_cd; intensity and power are colours themselves");
+        }
+        if (n.Has("intensity")) return n.Get("intensity").Color(kMaxRadiance);
+        if (n.Has("power")) {
+            return n.Get("power").Color(float(solid_angle) * kMaxRadiance) / float(solid_angle);
+        }
+        return Photometric(n, n.Get("intensity_cd"));
+    }
+
+    // A photometric quantity (cd or lx) of the light's `color` as radiometric (W/sr or W/m^2)
+    // at 683 lm/W, as KHR_lights_punctual and Blender convert them.
+    static Rgb Photometric(const Node& light, const Node& value) {
+        const double v = value.NumberIn(0, 683.0 * kMaxRadiance, "≥ 0 and at most 6.8e12");
+        const Rgb color = light.Has("color") ? light.Get("color").Color(1) : Rgb(1);
+        return color * float(v / 683);
     }
 
     const SceneFileReader& read_file_;
     std::vector<std::string> warnings_;
     std::map<std::string, int> material_index_;
-    std::map<std::string, TriangleMesh> mesh_cache_;
+    // By name and whether the file's own materials were read.
+    std::map<std::pair<std::string, bool>, CachedMeshFile> mesh_cache_;
+    std::map<std::string, int> texture_index_;  // by file name, into textures_
+    std::vector<std::shared_ptr<const TextureImage>> textures_;
     Fnv1a128 hash_;
     int dropped_degenerate_ = 0;
 };

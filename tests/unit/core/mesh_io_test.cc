@@ -4,11 +4,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <bit>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
+#include "lf/core/scene_loader.h"
 #include "test_dir.h"
 
 namespace lf {
@@ -63,9 +65,179 @@ TEST_F(MeshIoTest, ObjPolygonsAreFanTriangulated) {
                                                        "f -4 -3 -1\n"));
     ASSERT_TRUE(mesh.ok()) << mesh.status();
     EXPECT_EQ(mesh->name, "square");
-    ASSERT_EQ(mesh->positions.size(), 4u);
+    // The triangle's corners have no normal, so they take their face's: vertices of their own.
+    ASSERT_EQ(mesh->positions.size(), 7u);
     EXPECT_EQ(mesh->positions[2], Vec3d(1, 1, 0));
-    EXPECT_EQ(mesh->triangles, (Triangles{{0, 1, 2}, {0, 2, 3}, {0, 1, 3}}));
+    EXPECT_EQ(mesh->positions[6], Vec3d(0, 1, 0));
+    EXPECT_EQ(mesh->triangles, (Triangles{{0, 1, 2}, {0, 2, 3}, {4, 5, 6}}));
+    ASSERT_EQ(mesh->normals.size(), 7u);
+    for (const Vec3& n : mesh->normals) EXPECT_EQ(n, Vec3(0, 0, 1));
+    EXPECT_TRUE(mesh->uvs.empty());
+}
+
+// Corners sharing a position but not a normal become separate vertices; the same (position,
+// normal, uv) triple is one vertex. OBJ's v = 0 is the image's bottom, stored as 1 - v.
+TEST_F(MeshIoTest, ObjNormalsAndUvsMakeOneVertexPerDistinctCorner) {
+    absl::StatusOr<TriangleMesh> mesh = LoadMesh(Write("crease.obj",
+                                                       "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                                       "vn 0 0 2\nvn 1 0 0\nvn 0 0 0\n"
+                                                       "vt 0 0\nvt 1 0.25\nvt 0 1\n"
+                                                       "f 1/1/1 2/2/1 3/3/1\n"
+                                                       "f 1/1/2 3/3/2 4/1/2\n"
+                                                       "f 2/2/1 1/1/1 3/3/3\n"));
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    // Face 1: three vertices; face 2: three more (normal 2); face 3 reuses two of face 1's, and
+    // its zero normal at vertex 3 is replaced by the face's (0, 0, -1): a new vertex.
+    EXPECT_EQ(mesh->triangles, (Triangles{{0, 1, 2}, {3, 4, 5}, {1, 0, 6}}));
+    ASSERT_EQ(mesh->positions.size(), 7u);
+    ASSERT_EQ(mesh->normals.size(), 7u);
+    ASSERT_EQ(mesh->uvs.size(), 7u);
+    EXPECT_EQ(mesh->normals[0], Vec3(0, 0, 1));  // normalised
+    EXPECT_EQ(mesh->normals[3], Vec3(1, 0, 0));
+    EXPECT_EQ(mesh->normals[6], Vec3(0, 0, -1));
+    EXPECT_EQ(mesh->positions[5], Vec3d(0, 0, 1));
+    EXPECT_FLOAT_EQ(mesh->uvs[0].x, 0);
+    EXPECT_FLOAT_EQ(mesh->uvs[0].y, 1);
+    EXPECT_FLOAT_EQ(mesh->uvs[1].x, 1);
+    EXPECT_FLOAT_EQ(mesh->uvs[1].y, 0.75f);
+    EXPECT_FLOAT_EQ(mesh->uvs[2].y, 0);
+
+    ExpectError("n.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n",
+                "n.obj:5: face refers to normal 2 but the file has 1 normals");
+    ExpectError("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\n\nf 1/1 2/3 3/1\n",
+                "t.obj:6: face refers to texture coordinate 3 but the file has 1 texture");
+    ExpectError("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 1e400 0 1\nf 1//1 2//2 3//1\n",
+                "nan.obj:5: normal 2 is not finite");
+}
+
+// An OBJ's MTL file through the reader: faces split per material, Kd, map_Kd (with its -s and -o
+// options on the flipped v), Ke, d and the Blinn-Phong terms.
+TEST_F(MeshIoTest, ObjMtlMaterialsSplitTheFaces) {
+    std::filesystem::create_directories(dir_ / "models" / "tex");
+    Write("models/scene.mtl",
+          "newmtl wood\n"
+          "Kd 0.5 0.4 0.3\n"
+          "map_Kd -s 2 4 1 -o 0.25 0.5 0 tex/wood.png\n"
+          "\n"
+          "newmtl lamp\n"
+          "Kd 0 0 0\nKe 4 3 2\n"
+          "newmtl leaf\n"
+          "Kd 0.2 0.6 0.1\nd 0.4\nillum 2\nKs 0.5 0.5 0.5\nNs 250\nNi 1.45\n"
+          "newmtl glass\n"
+          "Kd 1 1 1\nd 0.1\nillum 7\nNi 1.5\nmap_Ks spec.png\n"
+          "newmtl unused\nmap_Kd missing.png\n");
+    const std::string obj =
+        "mtllib scene.mtl\n"
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+        "usemtl lamp\nf 1 2 3\n"
+        "usemtl wood\nf 2 4 3\n"
+        "usemtl lamp\nf 3 2 4\n"
+        "usemtl leaf\nf 1 2 4\n"
+        "usemtl glass\nf 1 3 4\n";
+    absl::StatusOr<MeshFile> file =
+        ParseMeshWithMaterials(obj, "models/scene.obj", ReadBeside(dir_.string()));
+    ASSERT_TRUE(file.ok()) << file.status();
+    ASSERT_EQ(file->meshes.size(), 4u);
+    ASSERT_EQ(file->materials.size(), 4u);
+    EXPECT_TRUE(file->unassigned_where.empty());
+    const std::vector<Material>& m = file->materials;
+    // In the order the faces first use them; the unused material is not converted.
+    EXPECT_EQ(m[0].name, "models/scene.mtl#lamp");
+    EXPECT_EQ(m[1].name, "models/scene.mtl#wood");
+    EXPECT_EQ(file->meshes[0].material, 0);
+    EXPECT_EQ(file->meshes[0].triangles.size(), 2u);  // both lamp faces
+    EXPECT_EQ(file->meshes[1].material, 1);
+    EXPECT_EQ(file->meshes[1].triangles.size(), 1u);
+    EXPECT_EQ(file->meshes[1].positions.size(), 3u);  // only the vertices it uses
+
+    EXPECT_EQ(m[0].type, Material::Type::kLambert);
+    EXPECT_EQ(m[0].emission, Rgb(4, 3, 2));
+    EXPECT_FALSE(m[0].IsTextured());
+
+    EXPECT_EQ(m[1].type, Material::Type::kLambert);
+    EXPECT_EQ(m[1].reflectance, Rgb(0.5f, 0.4f, 0.3f));
+    ASSERT_TRUE(m[1].base_color_texture.valid());
+    ASSERT_EQ(file->textures.size(), 1u);
+    EXPECT_EQ(file->textures[0].name, "models/tex/wood.png");
+    EXPECT_EQ(file->textures[0].where, "models/scene.mtl:3: map_Kd");
+    const TextureRef& wood = m[1].base_color_texture;
+    EXPECT_TRUE(wood.srgb);
+    EXPECT_FLOAT_EQ(wood.scale.x, 2);
+    EXPECT_FLOAT_EQ(wood.scale.y, 4);
+    EXPECT_FLOAT_EQ(wood.offset.x, 0.25f);
+    EXPECT_FLOAT_EQ(wood.offset.y, 1 - 4 - 0.5f);
+
+    // d < 1 without a refracting illum: a cut-out at half the opacity.
+    EXPECT_EQ(m[2].type, Material::Type::kPrincipled);
+    EXPECT_EQ(m[2].alpha_mode, Material::AlphaMode::kMask);
+    EXPECT_FLOAT_EQ(m[2].opacity, 0.4f);
+    EXPECT_FLOAT_EQ(m[2].alpha_cutoff, 0.5f);
+    EXPECT_FLOAT_EQ(m[2].specular, 0.5f);
+    EXPECT_FLOAT_EQ(m[2].roughness, 1 - std::sqrt(0.25f));
+    EXPECT_FLOAT_EQ(m[2].ior, 1.45f);
+
+    // illum 7 refracts: d < 1 is transmission.
+    EXPECT_EQ(m[3].type, Material::Type::kPrincipled);
+    EXPECT_FLOAT_EQ(m[3].transmission, 0.9f);
+    EXPECT_EQ(m[3].alpha_mode, Material::AlphaMode::kOpaque);
+    EXPECT_FLOAT_EQ(m[3].specular, 0);
+    ASSERT_EQ(file->warnings.size(), 1u);
+    EXPECT_EQ(file->warnings[0],
+              "models/scene.mtl:20: material \"glass\": map_Ks is not supported; its variation "
+              "is lost");
+}
+
+TEST_F(MeshIoTest, ObjMaterialErrorsNameTheLine) {
+    auto parse = [&](const std::string& obj) {
+        return ParseMeshWithMaterials(obj, "m.obj", ReadBeside(dir_.string()));
+    };
+    const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    absl::StatusOr<MeshFile> missing = parse(triangle + "mtllib gone.mtl\nf 1 2 3\n");
+    ASSERT_FALSE(missing.ok());
+    EXPECT_NE(missing.status().message().find("m.obj:4: mtllib \"gone.mtl\": "),
+              std::string::npos)
+        << missing.status();
+    Write("a.mtl", "newmtl a\nKd 0.5 0.5 0.5\n");
+    absl::StatusOr<MeshFile> unknown = parse("mtllib a.mtl\n" + triangle + "usemtl b\nf 1 2 3\n");
+    ASSERT_FALSE(unknown.ok());
+    EXPECT_NE(unknown.status().message().find(
+                  "m.obj:5: usemtl \"b\": no MTL file of this OBJ defines it"),
+              std::string::npos)
+        << unknown.status();
+    Write("bad.mtl", "newmtl a\n\nKd 0.5 -1 0.5\n");
+    absl::StatusOr<MeshFile> bad = parse("mtllib bad.mtl\n" + triangle + "usemtl a\nf 1 2 3\n");
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.status().message().find("m.obj: bad.mtl:3: material \"a\": Kd must be finite"),
+              std::string::npos)
+        << bad.status();
+
+    // Faces before any usemtl have no material: the scene must give one.
+    absl::StatusOr<MeshFile> partly =
+        parse("mtllib a.mtl\n" + triangle + "\nf 1 2 3\nusemtl a\nf 3 2 1\n");
+    ASSERT_TRUE(partly.ok()) << partly.status();
+    ASSERT_EQ(partly->meshes.size(), 2u);
+    EXPECT_EQ(partly->meshes[0].material, -1);
+    EXPECT_EQ(partly->unassigned_where, std::vector<std::string>{"m.obj:6"});
+}
+
+TEST_F(MeshIoTest, PlyNormalsAndTextureCoordinates) {
+    absl::StatusOr<TriangleMesh> mesh =
+        LoadMesh(Write("n.ply",
+                       "ply\nformat ascii 1.0\nelement vertex 3\n"
+                       "property float x\nproperty float y\nproperty float z\n"
+                       "property float nx\nproperty float ny\nproperty float nz\n"
+                       "property float s\nproperty float t\n"
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                       "0 0 0 0 0 3 0 0\n1 0 0 0 0 0 1 0.25\n0 1 0 0 1 0 0 1\n3 0 1 2\n"));
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    ASSERT_EQ(mesh->normals.size(), 3u);
+    EXPECT_EQ(mesh->normals[0], Vec3(0, 0, 1));
+    EXPECT_EQ(mesh->normals[1], Vec3(0, 0, 1));  // zero: from the faces around it
+    EXPECT_EQ(mesh->normals[2], Vec3(0, 1, 0));
+    ASSERT_EQ(mesh->uvs.size(), 3u);
+    EXPECT_FLOAT_EQ(mesh->uvs[1].x, 1);
+    EXPECT_FLOAT_EQ(mesh->uvs[1].y, 0.75f);
+    EXPECT_FLOAT_EQ(mesh->uvs[2].y, 0);
 }
 
 TEST_F(MeshIoTest, ObjErrorsNameTheLine) {

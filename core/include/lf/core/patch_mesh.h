@@ -18,6 +18,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -25,6 +26,12 @@
 #include "lf/core/vec.h"
 
 namespace lf {
+
+// Why radiosity cannot model `scene` ("material \"wood\" has a texture (base_color_texture
+// \"wood.png\"), which radiosity does not model"), or empty when it can: radiosity solves for one
+// radiosity per patch side, so it takes triangle meshes whose materials are untextured, opaque,
+// double-sided lambert, lit by emission and point lights.
+std::string RadiosityLimitation(const Scene& scene);
 
 // A cell of a scene triangle's subdivision: upward (i, j), (i+1, j), (i, j+1) or downward
 // (i+1, j), (i+1, j+1), (i, j+1) in the grid with k 2^level divisions.
