@@ -11,6 +11,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "image_files.h"
 #include "test_dir.h"
 
 namespace lf {
@@ -284,7 +285,7 @@ TEST_F(SceneLoaderTest, NoLightIsAWarning) {
     ASSERT_TRUE(Parse(SceneJson(R"({"type": "quad", "material": "white",
                                     "vertices": [[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]})"))
                     .ok());
-    EXPECT_NE(CapturedLog().str().find("no emissive shape and no point light"), std::string::npos);
+    EXPECT_NE(CapturedLog().str().find("no emissive shape and no light"), std::string::npos);
 }
 
 TEST_F(SceneLoaderTest, MissingSceneFile) {
@@ -337,13 +338,14 @@ TEST_F(SceneLoaderTest, StructureErrorsNameThePath) {
         SceneJson(R"({"type": "sphere", "material": "lamp", "center": [0, 0, 0], "radius": 0})"),
         "scene.json: shapes[0].radius: must be in (0, 1e15]");
     ExpectError(SceneJson(kQuad, kMaterials, kCamera,
-                          R"(, "lights": [{"type": "spot", "position": [0, 0, 0]}])"),
-                "scene.json: lights[0].type: unknown light type \"spot\"");
+                          R"(, "lights": [{"type": "area", "position": [0, 0, 0]}])"),
+                "scene.json: lights[0].type: unknown light type \"area\"; expected point, spot or "
+                "directional");
     ExpectError(
         SceneJson(kQuad, kMaterials, kCamera,
                   R"(, "lights": [{"type": "point", "position": [0, 0, 0], "power": [1, 1, 1], )"
                   R"("intensity": [1, 1, 1]}])"),
-        "scene.json: lights[0]: give exactly one of intensity (W/sr) or power (W)");
+        "scene.json: lights[0]: give exactly one of intensity (W/sr), power (W) or intensity_cd");
 }
 
 TEST_F(SceneLoaderTest, MaterialErrorsNameThePath) {
@@ -441,6 +443,331 @@ TEST_F(SceneLoaderTest, MeshErrorsNameTheShapeAndTheFile) {
     ExpectError(
         mesh_shape("ok.obj", R"(, "transform": {"rotate": {"axis": [0, 0, 0], "angle_deg": 5}})"),
         "scene.json: shapes[1].transform.rotate.axis: must not be zero");
+}
+
+// A 2 x 1 RGBA PNG: an opaque red texel and a half-transparent blue one.
+std::string TexturePng() {
+    return lf::testing::PngBytes(2, 1, 4, {255, 0, 0, 255, 0, 0, 255, 128});
+}
+
+constexpr char kMtl[] =
+    "newmtl wood\n"
+    "Kd 1 1 1\n"
+    "map_Kd wood.png\n"
+    "newmtl lamp\n"
+    "Kd 0 0 0\n"
+    "Ke 5 5 5\n"
+    "newmtl veil\n"
+    "Kd 0.5 0.5 0.5\n"
+    "d 0.25\n";
+
+// Two triangles in the z = 0 plane, smooth normals tilted in x, texture coordinates, three
+// materials of the MTL file.
+constexpr char kObj[] =
+    "mtllib m.mtl\n"
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+    "vn 1 0 1\nvn 0 0 1\n"
+    "vt 0 0\nvt 1 0\nvt 0 1\n"
+    "usemtl wood\nf 1/1/1 2/2/2 3/3/2\n"
+    "usemtl lamp\nf 2/2/2 4/1/2 3/3/2\n"
+    "usemtl veil\nf 3/3/2 2/2/2 4/1/1\n";
+
+TEST_F(SceneLoaderTest, ObjWithMtlBringsItsMaterialsAndTextures) {
+    Write("m.obj", kObj);
+    Write("m.mtl", kMtl);
+    Write("wood.png", TexturePng());
+    // Scale x by 2: the normal (1, 0, 1) goes by the inverse transpose to (0.5, 0, 1).
+    absl::StatusOr<Scene> scene = Parse(SceneJson(
+        R"({"type": "mesh", "name": "obj", "file": "m.obj", "transform": {"scale": [2, 1, 1]}},
+           {"type": "quad", "material": "white", "vertices": [[0, 0, 1], [1, 0, 1], [1, 1, 1],
+            [0, 1, 1]]})",
+        R"({"white": {"type": "lambert", "base_color_texture": "./wood.png"}})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    // The JSON's material first, then the file's in the order its faces use them.
+    ASSERT_EQ(scene->materials.size(), 4u);
+    EXPECT_EQ(scene->materials[1].name, "m.mtl#wood");
+    EXPECT_EQ(scene->materials[2].name, "m.mtl#lamp");
+    EXPECT_EQ(scene->materials[3].name, "m.mtl#veil");
+    // wood.png once for the JSON's "./wood.png" and the MTL's "wood.png".
+    ASSERT_EQ(scene->textures.size(), 1u);
+    EXPECT_EQ(scene->textures[0]->width, 2);
+    EXPECT_EQ(scene->materials[0].base_color_texture.image, 0);
+    EXPECT_EQ(scene->materials[0].reflectance, Rgb(1));
+    const Material& wood = scene->materials[1];
+    EXPECT_EQ(wood.type, Material::Type::kLambert);
+    EXPECT_EQ(wood.base_color_texture.image, 0);
+    EXPECT_TRUE(wood.base_color_texture.srgb);
+    EXPECT_EQ(scene->materials[2].emission, Rgb(5));
+    EXPECT_EQ(scene->materials[3].alpha_mode, Material::AlphaMode::kMask);
+    EXPECT_FLOAT_EQ(scene->materials[3].opacity, 0.25f);
+
+    ASSERT_EQ(scene->meshes.size(), 4u);
+    const TriangleMesh& first = scene->meshes[0];
+    EXPECT_EQ(first.name, "obj (m.mtl#wood)");
+    EXPECT_EQ(first.material, 1);
+    EXPECT_EQ(scene->meshes[1].material, 2);
+    EXPECT_EQ(scene->meshes[2].material, 3);
+    EXPECT_EQ(scene->meshes[3].material, 0);
+    ASSERT_EQ(first.positions.size(), 3u);
+    EXPECT_EQ(first.positions[1], Vec3d(2, 0, 0));
+    ASSERT_EQ(first.normals.size(), 3u);
+    const Vec3 tilted = Normalize(Vec3(0.5f, 0, 1));
+    EXPECT_FLOAT_EQ(first.normals[0].x, tilted.x);
+    EXPECT_FLOAT_EQ(first.normals[0].y, 0);
+    EXPECT_FLOAT_EQ(first.normals[0].z, tilted.z);
+    EXPECT_EQ(first.normals[1], Vec3(0, 0, 1));
+    ASSERT_EQ(first.uvs.size(), 3u);
+    EXPECT_FLOAT_EQ(first.uvs[0].y, 1);  // vt 0 0: the bottom of the image
+    EXPECT_FLOAT_EQ(first.uvs[2].y, 0);
+
+    // The MTL file and the texture count in the content hash.
+    const std::string json = SceneJson(R"({"type": "mesh", "file": "m.obj"})");
+    absl::StatusOr<Scene> before = Parse(json);
+    ASSERT_TRUE(before.ok()) << before.status();
+    Write("m.mtl", std::string(kMtl) + "\n");
+    absl::StatusOr<Scene> after_mtl = Parse(json);
+    ASSERT_TRUE(after_mtl.ok()) << after_mtl.status();
+    EXPECT_NE(after_mtl->content_hash, before->content_hash);
+    Write("wood.png", lf::testing::PngBytes(1, 1, 3, {1, 2, 3}));
+    absl::StatusOr<Scene> after_png = Parse(json);
+    ASSERT_TRUE(after_png.ok()) << after_png.status();
+    EXPECT_NE(after_png->content_hash, after_mtl->content_hash);
+}
+
+TEST_F(SceneLoaderTest, AMeshShapesMaterialOverridesTheFiles) {
+    Write("m.obj", kObj);  // its MTL file is not even there: not read
+    absl::StatusOr<Scene> scene =
+        Parse(SceneJson(R"({"type": "mesh", "material": "lamp", "file": "m.obj"})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_EQ(scene->meshes.size(), 1u);
+    EXPECT_EQ(scene->meshes[0].material, 1);
+    EXPECT_EQ(scene->meshes[0].triangles.size(), 3u);
+    EXPECT_EQ(scene->materials.size(), 2u);
+    EXPECT_TRUE(scene->textures.empty());
+}
+
+TEST_F(SceneLoaderTest, ObjMaterialErrorsNameTheFileAndLine) {
+    const std::string json = SceneJson(R"({"type": "mesh", "file": "m.obj"})");
+    Write("m.obj", kObj);
+    ExpectError(json, "scene.json: shapes[0].file: m.obj:1: mtllib \"m.mtl\": ",
+                absl::StatusCode::kInvalidArgument);
+    Write("m.mtl", kMtl);
+    ExpectError(json, "scene.json: shapes[0].file \"m.obj\": m.mtl:3: map_Kd \"wood.png\": ",
+                absl::StatusCode::kNotFound);
+    Write("wood.png", "not a png");
+    ExpectError(json, "scene.json: shapes[0].file \"m.obj\": m.mtl:3: map_Kd: ");
+    Write("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    ExpectError(SceneJson(R"({"type": "mesh", "file": "plain.obj"})"),
+                "scene.json: shapes[0]: missing required key \"material\": the faces of "
+                "plain.obj:4 have no material from the file");
+    Write("plain.ply",
+          "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+          "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+          "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    ExpectError(SceneJson(R"({"type": "mesh", "file": "plain.ply"})"),
+                "scene.json: shapes[0]: missing required key \"material\": the faces of "
+                "plain.ply have no material");
+    ExpectError(SceneJson(R"({"type": "quad", "vertices": []})"),
+                "scene.json: shapes[0]: missing required key \"material\"");
+}
+
+TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
+    Write("wood.png", TexturePng());
+    Write("mr.png", lf::testing::PngBytes(1, 1, 3, {0, 128, 255}));
+    absl::StatusOr<Scene> scene = Parse(SceneJson(
+        kQuad,
+        R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
+            "plain": {"type": "principled"},
+            "car_paint": {"type": "principled", "base_color": [0.5, 0.1, 0.1], "metallic": 0.3,
+                "roughness": 0.2, "specular": 0.7, "ior": 1.45, "transmission": 0.25,
+                "thickness": 0.01, "attenuation_color": [0.9, 0.8, 0.7],
+                "attenuation_distance": 0.5, "opacity": 0.6, "alpha_mode": "mask",
+                "alpha_cutoff": 0.3, "double_sided": false, "emission": [0.1, 0.2, 0.3],
+                "base_color_texture": {"file": "wood.png", "wrap": "mirror", "filter": "nearest",
+                    "transform": {"offset": [0.5, 0.25], "rotation_deg": 90,
+                                  "scale": [2, -1]}},
+                "metallic_roughness_texture": "mr.png",
+                "normal_texture": {"file": "mr.png", "wrap": "clamp"}, "normal_scale": 0.5,
+                "emission_texture": "wood.png"},
+            "glow": {"type": "principled", "emission_texture": "wood.png"}})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_TRUE(CapturedLog().str().empty()) << CapturedLog().str();
+    ASSERT_EQ(scene->textures.size(), 2u);
+    const Material& plain = scene->materials[1];
+    EXPECT_EQ(plain.type, Material::Type::kPrincipled);
+    EXPECT_EQ(plain.reflectance, Rgb(0.8f));
+    EXPECT_FLOAT_EQ(plain.metallic, 0);
+    EXPECT_FLOAT_EQ(plain.roughness, 0.5f);
+    EXPECT_FLOAT_EQ(plain.specular, 1);
+    EXPECT_FLOAT_EQ(plain.ior, 1.5f);
+    EXPECT_FALSE(plain.IsTextured());
+    EXPECT_FALSE(plain.IsEmissive());
+
+    const Material& m = scene->materials[2];
+    EXPECT_EQ(m.reflectance, Rgb(0.5f, 0.1f, 0.1f));
+    EXPECT_FLOAT_EQ(m.metallic, 0.3f);
+    EXPECT_FLOAT_EQ(m.roughness, 0.2f);
+    EXPECT_FLOAT_EQ(m.specular, 0.7f);
+    EXPECT_FLOAT_EQ(m.ior, 1.45f);
+    EXPECT_FLOAT_EQ(m.transmission, 0.25f);
+    EXPECT_FLOAT_EQ(m.thickness, 0.01f);
+    EXPECT_EQ(m.attenuation_color, Rgb(0.9f, 0.8f, 0.7f));
+    EXPECT_FLOAT_EQ(m.attenuation_distance, 0.5f);
+    EXPECT_FLOAT_EQ(m.opacity, 0.6f);
+    EXPECT_EQ(m.alpha_mode, Material::AlphaMode::kMask);
+    EXPECT_FLOAT_EQ(m.alpha_cutoff, 0.3f);
+    EXPECT_FALSE(m.double_sided);
+    EXPECT_EQ(m.emission, Rgb(0.1f, 0.2f, 0.3f));
+    const TextureRef& base = m.base_color_texture;
+    EXPECT_EQ(base.image, 0);
+    EXPECT_TRUE(base.srgb);
+    EXPECT_TRUE(base.nearest);
+    EXPECT_EQ(base.wrap_s, TextureRef::Wrap::kMirroredRepeat);
+    EXPECT_EQ(base.wrap_t, TextureRef::Wrap::kMirroredRepeat);
+    EXPECT_FLOAT_EQ(base.offset.x, 0.5f);
+    EXPECT_FLOAT_EQ(base.offset.y, 0.25f);
+    EXPECT_FLOAT_EQ(base.rotation, float(std::numbers::pi / 2));
+    EXPECT_FLOAT_EQ(base.scale.x, 2);
+    EXPECT_FLOAT_EQ(base.scale.y, -1);
+    EXPECT_EQ(m.metallic_roughness_texture.image, 1);
+    EXPECT_FALSE(m.metallic_roughness_texture.srgb);
+    EXPECT_EQ(m.normal_texture.image, 1);
+    EXPECT_FALSE(m.normal_texture.srgb);
+    EXPECT_EQ(m.normal_texture.wrap_s, TextureRef::Wrap::kClampToEdge);
+    EXPECT_FLOAT_EQ(m.normal_scale, 0.5f);
+    EXPECT_EQ(m.emission_texture.image, 0);
+    EXPECT_TRUE(m.emission_texture.srgb);
+    // An emission texture alone is the radiance: its factor defaults to 1.
+    EXPECT_EQ(scene->materials[3].emission, Rgb(1));
+    EXPECT_EQ(scene->materials[3].reflectance, Rgb(0.8f));
+}
+
+TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
+    Write("wood.png", TexturePng());
+    auto with_material = [](const std::string& material) {
+        return SceneJson(
+            kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
+                       "m": )" + material + "}");
+    };
+    const std::string p = R"({"type": "principled", )";
+    ExpectError(with_material(p + R"("metallic": 2})"),
+                "scene.json: materials.m.metallic: must be in [0, 1], got 2");
+    ExpectError(with_material(p + R"("roughness": -0.1})"),
+                "scene.json: materials.m.roughness: must be in [0, 1], got -0.1");
+    ExpectError(with_material(p + R"("transmission": 1.5})"),
+                "scene.json: materials.m.transmission: must be in [0, 1], got 1.5");
+    ExpectError(with_material(p + R"("ior": 0})"),
+                "scene.json: materials.m.ior: must be a positive float, got 0");
+    ExpectError(with_material(p + R"("thickness": -1})"),
+                "scene.json: materials.m.thickness: must be ≥ 0 (metres), got -1");
+    ExpectError(with_material(p + R"("attenuation_distance": 0})"),
+                "scene.json: materials.m.attenuation_distance: must be a positive float");
+    ExpectError(with_material(p + R"("base_color": [1, 1, 2]})"),
+                "scene.json: materials.m.base_color[2]: must be in [0, 1], got 2");
+    ExpectError(with_material(p + R"("base_color": [1, 1, 1], "reflectance": [1, 1, 1]})"),
+                "scene.json: materials.m: give either base_color or reflectance");
+    ExpectError(with_material(p + R"("alpha_mode": "blend"})"),
+                "scene.json: materials.m.alpha_mode: unknown alpha mode \"blend\"; expected "
+                "opaque or mask");
+    ExpectError(with_material(p + R"("double_sided": "yes"})"),
+                "scene.json: materials.m.double_sided: expected true or false, got string");
+    ExpectError(with_material(p + R"("base_color_texture": "nope.png"})"),
+                "scene.json: materials.m.base_color_texture \"nope.png\": ",
+                absl::StatusCode::kNotFound);
+    ExpectError(with_material(p + R"("normal_texture": {"file": "nope.png"}})"),
+                "scene.json: materials.m.normal_texture.file \"nope.png\": ",
+                absl::StatusCode::kNotFound);
+    ExpectError(with_material(p + R"("base_color_texture": {"file": "wood.png", "wrap": "tile"}})"),
+                "scene.json: materials.m.base_color_texture.wrap: unknown wrap mode \"tile\"; "
+                "expected repeat, clamp or mirror");
+    ExpectError(
+        with_material(p + R"("base_color_texture": {"file": "wood.png", "filter": "cubic"}})"),
+        "scene.json: materials.m.base_color_texture.filter: unknown filter \"cubic\"");
+    ExpectError(with_material(p + R"("base_color_texture": {"file": "wood.png", )"
+                                  R"("transform": {"scale": [1, 0]}}})"),
+                "scene.json: materials.m.base_color_texture.transform.scale: must not be zero");
+    ExpectError(with_material(p + R"("base_color_texture": {"wrap": "clamp"}})"),
+                "scene.json: materials.m.base_color_texture: missing required key \"file\"");
+    Write("bad.png", "GIF89a not a png");
+    ExpectError(with_material(p + R"("base_color_texture": "bad.png"})"),
+                "scene.json: materials.m.base_color_texture: ");
+    ExpectError(with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], )"
+                              R"("base_color_texture": 7})"),
+                "scene.json: materials.m.base_color_texture: expected an object, got number");
+}
+
+TEST_F(SceneLoaderTest, SpotAndDirectionalLights) {
+    const double pi = std::numbers::pi;
+    absl::StatusOr<Scene> scene = Parse(SceneJson(
+        kQuad, kMaterials, kCamera,
+        R"(, "lights": [
+            {"type": "spot", "position": [0, 3, 0], "direction": [0, -2, 0],
+             "intensity": [1, 2, 3], "inner_cone_deg": 20, "outer_cone_deg": 30},
+            {"type": "spot", "position": [0, 3, 0], "direction": [1, 0, 0], "power": [10, 10, 10]},
+            {"type": "spot", "position": [0, 3, 0], "direction": [1, 0, 0],
+             "intensity_cd": 683, "color": [1, 0.5, 0]},
+            {"type": "directional", "direction": [0, 0, -3], "irradiance": [2, 2, 2]},
+            {"type": "directional", "direction": [1, -1, 0], "illuminance_lux": 1366,
+             "color": [1, 1, 0.5]},
+            {"type": "point", "position": [0, 1, 0], "intensity_cd": 68.3}])"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_TRUE(CapturedLog().str().empty()) << CapturedLog().str();
+    ASSERT_EQ(scene->spot_lights.size(), 3u);
+    const SpotLight& spot = scene->spot_lights[0];
+    EXPECT_EQ(spot.position, Vec3d(0, 3, 0));
+    EXPECT_EQ(spot.direction, Vec3d(0, -1, 0));
+    EXPECT_EQ(spot.intensity, Rgb(1, 2, 3));
+    EXPECT_DOUBLE_EQ(spot.inner_cone, 20 * pi / 180);
+    EXPECT_DOUBLE_EQ(spot.outer_cone, 30 * pi / 180);
+    // Power over the falloff's solid angle 2 pi (1 - cos i + (cos i - cos o) / 3), with the
+    // default cones 0 and 45 degrees.
+    const double c45 = std::cos(pi / 4);
+    EXPECT_DOUBLE_EQ(scene->spot_lights[1].inner_cone, 0);
+    EXPECT_DOUBLE_EQ(scene->spot_lights[1].outer_cone, pi / 4);
+    EXPECT_NEAR(scene->spot_lights[1].intensity.g, 10 / (2 * pi * (1 - 1 + (1 - c45) / 3)), 1e-4);
+    // 683 cd of colour (1, 0.5, 0) is (1, 0.5, 0) W/sr.
+    EXPECT_EQ(scene->spot_lights[2].intensity, Rgb(1, 0.5f, 0));
+    ASSERT_EQ(scene->directional_lights.size(), 2u);
+    EXPECT_EQ(scene->directional_lights[0].direction, Vec3d(0, 0, -1));
+    EXPECT_EQ(scene->directional_lights[0].irradiance, Rgb(2));
+    ExpectNear(scene->directional_lights[1].direction, Normalize(Vec3d(1, -1, 0)));
+    EXPECT_EQ(scene->directional_lights[1].irradiance, Rgb(2, 2, 1));
+    ASSERT_EQ(scene->point_lights.size(), 1u);
+    EXPECT_FLOAT_EQ(scene->point_lights[0].intensity.r, 0.1f);
+}
+
+TEST_F(SceneLoaderTest, LightErrorsNameThePath) {
+    auto with_light = [](const std::string& light) {
+        return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + light + "]");
+    };
+    const std::string spot = R"({"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1], )";
+    ExpectError(with_light(spot + R"("direction": [0, 0, 0]})"),
+                "scene.json: lights[0].direction: must not be zero");
+    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "inner_cone_deg": 30, )"
+                                  R"("outer_cone_deg": 20})"),
+                "scene.json: lights[0]: inner_cone_deg (30) must be below outer_cone_deg (20)");
+    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 95})"),
+                "scene.json: lights[0].outer_cone_deg: must be in (0, 90] degrees, got 95");
+    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "inner_cone_deg": -1})"),
+                "scene.json: lights[0].inner_cone_deg: must be in [0, 90) degrees, got -1");
+    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 0})"),
+                "scene.json: lights[0]: inner_cone_deg (0) must be below outer_cone_deg (0)");
+    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "color": [1, 0, 0]})"),
+                "scene.json: lights[0]: color goes with intensity_cd");
+    ExpectError(with_light(R"({"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1]})"),
+                "scene.json: lights[0]: missing required key \"direction\"");
+    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1]})"),
+                "scene.json: lights[0]: give exactly one of irradiance (W/m^2) or "
+                "illuminance_lux (lx)");
+    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1], )"
+                           R"("illuminance_lux": -5})"),
+                "scene.json: lights[0].illuminance_lux: must be ≥ 0");
+    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1], )"
+                           R"("irradiance": [1, 1, 1], "color": [1, 1, 1]})"),
+                "scene.json: lights[0]: color goes with illuminance_lux");
+    ExpectError(with_light(R"({"type": "point", "position": [0, 0, 0], "intensity_cd": 1, )"
+                           R"("color": [2, 1, 1]})"),
+                "scene.json: lights[0].color[0]: must be in [0, 1], got 2");
 }
 
 }  // namespace
