@@ -16,6 +16,7 @@
 #include "absl/time/time.h"
 #include "adaptive_flags.h"
 #include "command.h"
+#include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
@@ -131,6 +132,23 @@ void CollectFileNames(const nlohmann::json& node, const fs::path& dir,
     }
 }
 
+// Files named inside other files (an OBJ's MTL files, their textures) are the ones loading the
+// scene asks for: a reader that records each name it is asked for finds them. Errors are left
+// to the server, which reports them as `render` would.
+void CollectFilesTheSceneReads(const std::string& text, const fs::path& scene_path,
+                               std::map<std::string, fs::path>& found) {
+    const fs::path dir = scene_path.parent_path();
+    const SceneFileReader beside = ReadBeside(dir.empty() ? "." : dir.string());
+    (void)ParseScene(text, scene_path.string(), [&](const std::string& name) {
+        absl::StatusOr<std::string> bytes = beside(name);
+        if (bytes.ok()) {
+            const fs::path path(name);
+            found[name] = (path.is_absolute() ? path : dir / path).lexically_normal();
+        }
+        return bytes;
+    });
+}
+
 struct LocalFile {
     pb::SceneFile ref;
     fs::path path;
@@ -206,7 +224,10 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     std::map<std::string, fs::path> names;
     // A file that is not JSON goes up alone: the server's loader says what is wrong with it.
     const nlohmann::json json = nlohmann::json::parse(*scene_text, nullptr, false);
-    if (!json.is_discarded()) CollectFileNames(json, scene_path.parent_path(), names);
+    if (!json.is_discarded()) {
+        CollectFileNames(json, scene_path.parent_path(), names);
+        CollectFilesTheSceneReads(*scene_text, scene_path, names);
+    }
 
     std::vector<LocalFile> files;
     std::map<std::string, std::string> contents;  // by hash

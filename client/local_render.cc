@@ -13,6 +13,7 @@
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
+#include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
@@ -49,15 +50,8 @@ absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& 
         return absl::InvalidArgumentError(
             absl::StrCat("--method ", requested, ": expected path, radiosity or auto"));
     }
-    for (const Material& m : scene.materials) {
-        if (m.type != Material::Type::kLambert) {
-            *why = absl::StrCat("material \"", m.name, "\" is ", MaterialTypeName(m.type),
-                                ", which radiosity cannot model");
-            return std::string("path");
-        }
-    }
-    if (!scene.spheres.empty()) {
-        *why = "the scene has spheres, which radiosity does not mesh";
+    if (std::string limitation = RadiosityLimitation(scene); !limitation.empty()) {
+        *why = std::move(limitation);
         return std::string("path");
     }
     *why = "every material is Lambertian";

@@ -5,6 +5,7 @@
 #include <set>
 #include <vector>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "command.h"
 #include "lf/core/camera.h"
@@ -47,13 +48,32 @@ Rgb NormalReflectance(const Material& m) {
     return Rgb(f0(m.eta.r, m.k.r), f0(m.eta.g, m.k.g), f0(m.eta.b, m.k.b));
 }
 
+// Which of the material's parameters a texture drives.
+std::string DescribeTextures(const Material& m) {
+    std::string names;
+    for (const auto& [ref, name] : {std::pair{&m.base_color_texture, "base colour"},
+                                    {&m.metallic_roughness_texture, "metallic-roughness"},
+                                    {&m.normal_texture, "normal"},
+                                    {&m.emission_texture, "emission"}}) {
+        if (ref->valid()) absl::StrAppend(&names, names.empty() ? ", textures: " : ", ", name);
+    }
+    return names;
+}
+
 // The parameters the material's model uses, and only those: a dielectric has an index of
 // refraction, not a reflectance; a conductor has eta and k.
 std::string DescribeSurface(const Material& m) {
     switch (m.type) {
         case Material::Type::kLambert:
         case Material::Type::kMirror:
-            return "reflectance " + Color(m.reflectance);
+            return "reflectance " + Color(m.reflectance) + DescribeTextures(m);
+        case Material::Type::kPrincipled:
+            return absl::StrFormat(
+                       "base colour %s, metallic %.3g, roughness %.3g, specular %.3g, index of "
+                       "refraction %.3g, transmission %.3g",
+                       Color(m.reflectance), m.metallic, m.roughness, m.specular, m.ior,
+                       m.transmission) +
+                   DescribeTextures(m);
         case Material::Type::kGlossy:
             if (m.conductor) {
                 return absl::StrFormat(
@@ -191,8 +211,11 @@ absl::Status RunPlan(const PlanOptions& options) {
     for (const Sphere& s : scene->spheres) {
         if (scene->materials[size_t(s.material)].IsEmissive()) ++emissive_spheres;
     }
-    std::printf("lights: %d emissive triangles (%.4g m^2), %d emissive spheres, %zu point lights\n",
-                emissive_triangles, emitting_area, emissive_spheres, scene->point_lights.size());
+    std::printf(
+        "lights: %d emissive triangles (%.4g m^2), %d emissive spheres, %zu point lights, %zu "
+        "spot lights, %zu directional lights\n",
+        emissive_triangles, emitting_area, emissive_spheres, scene->point_lights.size(),
+        scene->spot_lights.size(), scene->directional_lights.size());
 
     std::string why;
     absl::StatusOr<std::string> method = ChooseMethod(*scene, options.method, &why);

@@ -21,17 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 
 absl::Status CheckRadiosityCanModel(const Scene& scene) {
-    for (const Material& m : scene.materials) {
-        if (m.type != Material::Type::kLambert) {
-            return absl::InvalidArgumentError(absl::StrCat("radiosity: material \"", m.name,
-                                                           "\" is ", MaterialTypeName(m.type),
-                                                           "; radiosity models lambert only"));
-        }
-    }
-    if (!scene.spheres.empty()) {
-        return absl::InvalidArgumentError(absl::StrCat("radiosity: sphere '", scene.spheres[0].name,
-                                                       "' cannot be meshed; radiosity supports "
-                                                       "triangle meshes and quads only"));
+    if (const std::string why = RadiosityLimitation(scene); !why.empty()) {
+        return absl::InvalidArgumentError("radiosity: " + why);
     }
     return absl::OkStatus();
 }

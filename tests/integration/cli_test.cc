@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "image_files.h"
 #include "lf/core/image_io.h"
 
 namespace lf {
@@ -171,6 +172,47 @@ TEST_F(Cli, RadiosityRefusesWhatItCannotModel) {
     EXPECT_EQ(automatic.status, 0) << automatic.output;
     EXPECT_NE(automatic.output.find("method path (material"), std::string::npos)
         << automatic.output;
+}
+
+// A texture or a principled material is beyond radiosity: auto says so and takes the path
+// tracer; radiosity asked for refuses with the same reason.
+TEST_F(Cli, AutoTakesThePathTracerForTexturesAndSaysWhy) {
+    Write("wood.png", lf::testing::PngBytes(1, 1, 3, {200, 100, 50}));
+    auto scene = [&](const std::string& material) {
+        return Write("textured.json", R"({"camera": {"position": [0, 0, -3], "look_at": [0, 0, 0],
+            "fov_y_deg": 40, "resolution": [8, 8]},
+            "materials": {"wood": )" + material + R"(,
+                          "lamp": {"type": "lambert", "reflectance": [0, 0, 0],
+                                   "emission": [1, 1, 1]}},
+            "shapes": [{"type": "quad", "material": "wood",
+                        "vertices": [[-1, -1, 0], [-1, 1, 0], [1, 1, 0], [1, -1, 0]]},
+                       {"type": "quad", "material": "lamp",
+                        "vertices": [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1]]}]})");
+    };
+    const std::string textured =
+        scene(R"({"type": "lambert", "base_color_texture": "wood.png"})");
+    const std::string exr = (dir_ / "t.exr").string();
+    const RunResult automatic =
+        Lightfarm("render " + textured + " -o " + exr + " --method auto --spp 1 --no-progress");
+    ASSERT_EQ(automatic.status, 0) << automatic.output;
+    EXPECT_NE(automatic.output.find("method path (material \"wood\" has a texture "
+                                    "(base_color_texture \"wood.png\"), which radiosity does "
+                                    "not model)"),
+              std::string::npos)
+        << automatic.output;
+    const RunResult radiosity = Lightfarm("render " + textured + " -o " + exr +
+                                          " --method radiosity --spp 1 --no-progress");
+    EXPECT_NE(radiosity.status, 0);
+    EXPECT_NE(radiosity.output.find("radiosity: material \"wood\" has a texture"),
+              std::string::npos)
+        << radiosity.output;
+
+    const std::string principled = scene(R"({"type": "principled", "metallic": 1})");
+    const RunResult plan = Lightfarm("plan " + principled + " --pilot-spp 1 --threads 2");
+    EXPECT_NE(plan.output.find("method (--method auto): path, because material \"wood\" is "
+                               "principled; radiosity models lambert only"),
+              std::string::npos)
+        << plan.output;
 }
 
 TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
