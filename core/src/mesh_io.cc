@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <map>
 #include <tuple>
-#include <unordered_map>
 #include <bit>
 #include <cctype>
 #include <cerrno>
@@ -270,27 +269,42 @@ class MtlConverter {
     MeshFile& out_;
 };
 
-// (position, normal, texture coordinate) indices of a face corner: each distinct triple is one
-// vertex of the mesh. A corner without a usable normal in a mesh with normals takes its face's
-// normal: its normal index is then -2 - face, its own vertex.
-struct Corner {
-    int64_t v, n, t;
-    bool operator==(const Corner&) const = default;
-};
-
-struct CornerHash {
-    size_t operator()(const Corner& c) const {
-        return std::hash<int64_t>()(c.v * 0x9E3779B97F4A7C15 ^ c.n * 0xC2B2AE3D27D4EB4F ^ c.t);
-    }
-};
-
 // Builds one mesh of the faces of one material.
 struct ObjMeshBuilder {
     TriangleMesh mesh;
-    std::unordered_map<Corner, uint32_t, CornerHash> vertex_of;
     bool normals = false, uvs = false;
     int material = -1;
     size_t first_face = 0;
+};
+
+// The mesh vertices made from a file's corners: each distinct (position, normal, texture
+// coordinate) index triple of a mesh is one vertex. Chained per file position, since a position
+// has only a few distinct corners (one per crease or seam): faster than hashing the triples.
+class CornerVertices {
+  public:
+    explicit CornerVertices(size_t positions) : first_(positions, -1) {}
+
+    // The vertex of (v, n, t) in mesh `builder`, or -1 if there is none yet.
+    int64_t Find(int64_t v, int64_t n, int64_t t, uint32_t builder) const {
+        for (int64_t k = first_[size_t(v)]; k >= 0; k = made_[size_t(k)].next) {
+            const Made& m = made_[size_t(k)];
+            if (m.n == n && m.t == t && m.builder == builder) return m.vertex;
+        }
+        return -1;
+    }
+    void Add(int64_t v, int64_t n, int64_t t, uint32_t builder, uint32_t vertex) {
+        made_.push_back({n, t, first_[size_t(v)], builder, vertex});
+        first_[size_t(v)] = int64_t(made_.size() - 1);
+    }
+
+  private:
+    struct Made {
+        int64_t n, t;
+        int64_t next;  // the previous vertex made at the same position, or -1
+        uint32_t builder, vertex;
+    };
+    std::vector<int64_t> first_;  // by file position: its last vertex made, or -1
+    std::vector<Made> made_;
 };
 
 MeshFile ParseObj(const std::string& text, const std::string& name,
@@ -299,7 +313,14 @@ MeshFile ParseObj(const std::string& text, const std::string& name,
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
     std::string warning, error;
-    std::istringstream stream(text);
+    // Reads `text` in place: a copy would double the memory of a large file.
+    struct TextBuffer : std::streambuf {
+        explicit TextBuffer(const std::string& text) {
+            char* begin = const_cast<char*>(text.data());
+            setg(begin, begin, begin + text.size());
+        }
+    } buffer(text);
+    std::istream stream(&buffer);
     std::optional<MtlReader> mtl_reader;
     if (read_file) mtl_reader.emplace(*read_file, name);
     // Fan triangulation below, after checking every index; without a reader `mtllib` is ignored.
@@ -409,14 +430,17 @@ MeshFile ParseObj(const std::string& text, const std::string& name,
     }
 
     if (builders.empty()) Fail("", "no faces");
-    // Second pass: one vertex per distinct (position, normal, uv) corner.
+    // Second pass: one vertex per distinct (position, normal, uv) corner. A corner without a
+    // usable normal in a mesh with normals takes its face's normal: its normal index is then
+    // -2 - face, its own vertex.
+    CornerVertices made(positions.size());
     face = 0;
     for (const tinyobj::shape_t& shape : shapes) {
         size_t first = 0;
         for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
             const size_t corners = shape.mesh.num_face_vertices[f];
-            ObjMeshBuilder& b =
-                builders[builder_of.at(read_file ? shape.mesh.material_ids[f] : -1)];
+            const size_t builder = builder_of.at(read_file ? shape.mesh.material_ids[f] : -1);
+            ObjMeshBuilder& b = builders[builder];
             const tinyobj::index_t* corner = &shape.mesh.indices[first];
             // Newell's normal of the polygon, for corners without a normal of their own.
             Vec3d newell;
@@ -431,11 +455,14 @@ MeshFile ParseObj(const std::string& text, const std::string& name,
             for (size_t c = 0; c < corners; ++c) {
                 const tinyobj::index_t& i = corner[c];
                 const bool has_normal = i.normal_index >= 0 && normals[i.normal_index];
-                const Corner key{i.vertex_index,
-                                 !b.normals ? -1 : has_normal ? i.normal_index : -2 - int64_t(face),
-                                 b.uvs ? i.texcoord_index : -1};
-                auto [it, added] = b.vertex_of.try_emplace(key, uint32_t(b.mesh.positions.size()));
-                if (added) {
+                const int64_t n = !b.normals   ? -1
+                                  : has_normal ? i.normal_index
+                                               : -2 - int64_t(face);
+                const int64_t t = b.uvs ? i.texcoord_index : -1;
+                int64_t v = made.Find(i.vertex_index, n, t, uint32_t(builder));
+                if (v < 0) {
+                    v = int64_t(b.mesh.positions.size());
+                    made.Add(i.vertex_index, n, t, uint32_t(builder), uint32_t(v));
                     b.mesh.positions.push_back(positions[i.vertex_index]);
                     if (b.normals) {
                         b.mesh.normals.push_back(has_normal ? *normals[i.normal_index]
@@ -447,7 +474,7 @@ MeshFile ParseObj(const std::string& text, const std::string& name,
                                                                    : Vec2{0, 1});
                     }
                 }
-                vertex[std::min<size_t>(c, 2)] = it->second;
+                vertex[std::min<size_t>(c, 2)] = uint32_t(v);
                 if (c >= 2) {
                     b.mesh.triangles.push_back({vertex[0], vertex[1], vertex[2]});
                     vertex[1] = vertex[2];
@@ -468,8 +495,11 @@ MeshFile ParseObj(const std::string& text, const std::string& name,
                                                        size_t(b.material)));
         } else {
             b.mesh.material = -1;
-            out.unassigned_where.push_back(
-                absl::StrCat(name, LineSuffix(FindRecordLine(text, "f", b.first_face, 3))));
+            // Only a loader that reads materials needs where faces without one are.
+            if (read_file) {
+                out.unassigned_where.push_back(
+                    absl::StrCat(name, LineSuffix(FindRecordLine(text, "f", b.first_face, 3))));
+            }
         }
         out.meshes.push_back(std::move(b.mesh));
     }

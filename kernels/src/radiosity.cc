@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "lf/core/log.h"
+#include "lf/core/patch_mesh.h"
 #include "lf/kernels/form_factors.h"
 #include "lf/kernels/radiosity_refinement.h"
 #include "lf/kernels/radiosity_solution.h"
@@ -23,8 +24,12 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The solver refuses this too, by side index; here the user learns which material it is.
+// The solver refuses this too, by side index; here the user learns which material it is. What
+// radiosity cannot model at all is said first: a textured albedo's factor of 1 is no albedo.
 absl::Status CheckReflectance(const Scene& scene) {
+    if (const std::string why = RadiosityLimitation(scene); !why.empty()) {
+        return absl::InvalidArgumentError("radiosity: " + why);
+    }
     bool emits = false;
     for (const PointLight& light : scene.point_lights) emits |= !light.intensity.IsBlack();
     for (const TriangleMesh& mesh : scene.meshes) {

@@ -208,7 +208,7 @@ TEST_F(Cli, AutoTakesThePathTracerForTexturesAndSaysWhy) {
         << radiosity.output;
 
     const std::string principled = scene(R"({"type": "principled", "metallic": 1})");
-    const RunResult plan = Lightfarm("plan " + principled + " --pilot-spp 1 --threads 2");
+    const RunResult plan = Lightfarm("plan " + principled + " --pilot-spp 2 --threads 2");
     EXPECT_NE(plan.output.find("method (--method auto): path, because material \"wood\" is "
                                "principled; radiosity models lambert only"),
               std::string::npos)

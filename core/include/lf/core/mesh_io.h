@@ -27,7 +27,8 @@ struct MeshFile {
     std::vector<TriangleMesh> meshes;
     std::vector<Material> materials;  // their TextureRef::image index `textures`
     std::vector<Texture> textures;
-    // Where a mesh's faces with material -1 start ("car.obj:12"), for a loader that needs one.
+    // Where the faces with material -1 start ("car.obj:12"), when the file's materials were
+    // read: a loader needs one for them.
     std::vector<std::string> unassigned_where;
     std::vector<std::string> warnings;  // what the file asks for that is not modelled
 };
