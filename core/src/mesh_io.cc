@@ -3,8 +3,6 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
-#include <map>
-#include <tuple>
 #include <bit>
 #include <cctype>
 #include <cerrno>
@@ -14,9 +12,11 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -197,26 +197,24 @@ class MtlConverter {
 
         // Blinn-Phong specular (illum 2 and up) as the principled material's dielectric layer,
         // its exponent as perceptual roughness the way Blender's OBJ importer maps it.
-        const float ks = std::clamp(Rgb(mtl.specular[0], mtl.specular[1], mtl.specular[2])
-                                        .MaxComponent(),
-                                    0.0f, 1.0f);
+        const float ks = std::clamp(
+            Rgb(mtl.specular[0], mtl.specular[1], mtl.specular[2]).MaxComponent(), 0.0f, 1.0f);
         const bool specular = mtl.illum >= 2 && ks > 0;
         m.specular = specular ? ks : 0;
-        m.roughness =
-            mtl.roughness > 0
-                ? std::min(float(mtl.roughness), 1.0f)
-                : 1 - std::sqrt(std::clamp(float(mtl.shininess), 0.0f, 1000.0f) / 1000);
+        m.roughness = mtl.roughness > 0
+                          ? std::min(float(mtl.roughness), 1.0f)
+                          : 1 - std::sqrt(std::clamp(float(mtl.shininess), 0.0f, 1000.0f) / 1000);
         m.metallic = std::clamp(float(mtl.metallic), 0.0f, 1.0f);
         // Exporters write Ni 1 (or less) when they mean nothing: it would remove all reflection.
         if (mtl.ior > 1 && std::isfinite(mtl.ior)) m.ior = mtl.ior;
 
-        const float d = std::isfinite(mtl.dissolve) ? std::clamp(float(mtl.dissolve), 0.0f, 1.0f)
-                                                    : 1.0f;
+        const float d =
+            std::isfinite(mtl.dissolve) ? std::clamp(float(mtl.dissolve), 0.0f, 1.0f) : 1.0f;
         const bool refracts = mtl.illum == 4 || mtl.illum == 6 || mtl.illum == 7 || mtl.illum == 9;
         if (d < 1 && refracts) {
             m.transmission = 1 - d;  // glass: the illumination models that refract
-        } else if (d < 1 || (!mtl.alpha_texname.empty() &&
-                             mtl.alpha_texname == mtl.diffuse_texname)) {
+        } else if (d < 1 ||
+                   (!mtl.alpha_texname.empty() && mtl.alpha_texname == mtl.diffuse_texname)) {
             // A cut-out: opacity d, times the base colour texture's alpha when map_d names it.
             m.opacity = d;
             m.alpha_mode = Material::AlphaMode::kMask;
@@ -242,8 +240,8 @@ class MtlConverter {
     }
 
   private:
-    void Unsupported(const tinyobj::material_t& mtl, const std::string& where,
-                     const char* what, const char* lost) {
+    void Unsupported(const tinyobj::material_t& mtl, const std::string& where, const char* what,
+                     const char* lost) {
         out_.warnings.push_back(absl::StrCat(where, ": material \"", mtl.name, "\": ", what,
                                              " is not supported; ", lost, " is lost"));
     }
@@ -334,10 +332,9 @@ MeshFile ParseObj(const std::string& text, const std::string& name,
     }
     if (warning.find("Degenerated face") != std::string::npos) {
         // tinyobjloader silently drops faces with fewer than three corners.
-        Fail(LineSuffix(FindLine(text,
-                                 [](const std::vector<std::string>& f) {
-                                     return f[0] == "f" && f.size() < 4;
-                                 })),
+        Fail(LineSuffix(FindLine(
+                 text,
+                 [](const std::vector<std::string>& f) { return f[0] == "f" && f.size() < 4; })),
              "face with fewer than 3 vertices");
     }
     if (mtl_reader && !mtl_reader->failure().empty()) {
@@ -350,8 +347,7 @@ MeshFile ParseObj(const std::string& text, const std::string& name,
              mtl_reader->failure());
     }
     if (const size_t at = warning.find("material [ '"); read_file && at != std::string::npos) {
-        const std::string material =
-            warning.substr(at + 12, warning.find("' ]", at) - (at + 12));
+        const std::string material = warning.substr(at + 12, warning.find("' ]", at) - (at + 12));
         Fail(LineSuffix(FindLine(text,
                                  [&](const std::vector<std::string>& f) {
                                      return f[0] == "usemtl" && f.size() > 1 && f[1] == material;
@@ -491,8 +487,8 @@ MeshFile ParseObj(const std::string& text, const std::string& name,
     for (ObjMeshBuilder& b : builders) {
         if (b.material >= 0) {
             b.mesh.material = int(out.materials.size());
-            out.materials.push_back(converter->Convert(materials[size_t(b.material)],
-                                                       size_t(b.material)));
+            out.materials.push_back(
+                converter->Convert(materials[size_t(b.material)], size_t(b.material)));
         } else {
             b.mesh.material = -1;
             // Only a loader that reads materials needs where faces without one are.
@@ -766,12 +762,19 @@ TriangleMesh ParsePly(std::string_view bytes) {
         if (e.properties.empty()) continue;
         const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
         // Positions of x, y, z, nx, ny, nz, u, v among the element's properties (or -1).
-        int slot_of[8] = {find(e, "x", false), find(e, "y", false), find(e, "z", false),
-                          find(e, "nx", false), find(e, "ny", false), find(e, "nz", false),
-                          -1, -1};
+        int slot_of[8] = {find(e, "x", false),
+                          find(e, "y", false),
+                          find(e, "z", false),
+                          find(e, "nx", false),
+                          find(e, "ny", false),
+                          find(e, "nz", false),
+                          -1,
+                          -1};
         const bool normals = is_vertex && slot_of[3] >= 0 && slot_of[4] >= 0 && slot_of[5] >= 0;
         if (!normals) slot_of[3] = slot_of[4] = slot_of[5] = -1;
-        for (const auto& [u, v] : {std::pair{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"},
+        for (const auto& [u, v] : {std::pair{"u", "v"},
+                                   {"s", "t"},
+                                   {"texture_u", "texture_v"},
                                    {"texture_s", "texture_t"}}) {
             if (is_vertex && slot_of[6] < 0 && find(e, u, false) >= 0 && find(e, v, false) >= 0) {
                 slot_of[6] = find(e, u, false);

@@ -178,10 +178,9 @@ std::string RadiosityLimitation(const Scene& scene) {
         if (m.base_color_texture.valid() || m.emission_texture.valid()) {
             const bool base = m.base_color_texture.valid();
             const int image = (base ? m.base_color_texture : m.emission_texture).image;
-            return absl::StrCat(material, "has a texture (",
-                                base ? "base_color_texture" : "emission_texture", " \"",
-                                scene.textures[size_t(image)]->name,
-                                "\"), which radiosity does not model");
+            return absl::StrCat(
+                material, "has a texture (", base ? "base_color_texture" : "emission_texture",
+                " \"", scene.textures[size_t(image)]->name, "\"), which radiosity does not model");
         }
         if (m.alpha_mode == Material::AlphaMode::kMask) {
             return material + "is a cut-out (alpha mask), which radiosity does not model";
@@ -195,7 +194,8 @@ std::string RadiosityLimitation(const Scene& scene) {
                             "\" cannot be meshed; radiosity supports triangle meshes and quads "
                             "only");
     }
-    if (!scene.spot_lights.empty()) return "the scene has a spot light; radiosity takes point lights";
+    if (!scene.spot_lights.empty())
+        return "the scene has a spot light; radiosity takes point lights";
     if (!scene.directional_lights.empty()) {
         return "the scene has a directional light; radiosity takes point lights";
     }

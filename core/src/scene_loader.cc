@@ -323,8 +323,8 @@ void TransformMesh(const Affine& transform, TriangleMesh& mesh) {
                                Cross(transform.Row(0), transform.Row(1))};
     for (Vec3& n : mesh.normals) {
         const Vec3d d(n);
-        n = Vec3(Normalize(Vec3d(Dot(cofactor[0], d), Dot(cofactor[1], d), Dot(cofactor[2], d)) *
-                           sign));
+        n = Vec3(
+            Normalize(Vec3d(Dot(cofactor[0], d), Dot(cofactor[1], d), Dot(cofactor[2], d)) * sign));
     }
     // A mirroring transform would turn front faces into back faces; keep them in front.
     if (transform.Determinant() < 0) {
@@ -461,8 +461,9 @@ class SceneParser {
         } else if (type_name == "principled") {
             ParsePrincipled(n, m);
         } else {
-            type.Fail(absl::StrCat("unknown material type \"", type_name,
-                                   "\"; expected lambert, mirror, glossy, dielectric or principled"));
+            type.Fail(
+                absl::StrCat("unknown material type \"", type_name,
+                             "\"; expected lambert, mirror, glossy, dielectric or principled"));
         }
         if (const std::optional<Node> emission = n.Find("emission")) {
             m.emission = emission->Color(kMaxRadiance);
@@ -489,11 +490,26 @@ class SceneParser {
 
     // glTF 2.0's metallic-roughness material; defaults as Blender's Principled BSDF.
     void ParsePrincipled(const Node& n, Material& m) {
-        n.WarnUnknownKeys({"type", "base_color", "reflectance", "base_color_texture", "metallic",
-                           "roughness", "metallic_roughness_texture", "specular", "ior",
-                           "transmission", "thickness", "attenuation_color",
-                           "attenuation_distance", "normal_texture", "normal_scale", "emission",
-                           "emission_texture", "opacity", "alpha_mode", "alpha_cutoff",
+        n.WarnUnknownKeys({"type",
+                           "base_color",
+                           "reflectance",
+                           "base_color_texture",
+                           "metallic",
+                           "roughness",
+                           "metallic_roughness_texture",
+                           "specular",
+                           "ior",
+                           "transmission",
+                           "thickness",
+                           "attenuation_color",
+                           "attenuation_distance",
+                           "normal_texture",
+                           "normal_scale",
+                           "emission",
+                           "emission_texture",
+                           "opacity",
+                           "alpha_mode",
+                           "alpha_cutoff",
                            "double_sided"});
         m.type = Material::Type::kPrincipled;
         if (!n.Has("base_color") && !n.Has("reflectance") && !n.Has("base_color_texture")) {
@@ -536,9 +552,11 @@ class SceneParser {
         if (const std::optional<Node> mode = n.Find("alpha_mode")) {
             const std::string name = mode->String();
             if (name != "opaque" && name != "mask") {
-                mode->Fail(absl::StrCat("unknown alpha mode \"", name, "\"; expected opaque or mask"));
+                mode->Fail(
+                    absl::StrCat("unknown alpha mode \"", name, "\"; expected opaque or mask"));
             }
-            m.alpha_mode = name == "mask" ? Material::AlphaMode::kMask : Material::AlphaMode::kOpaque;
+            m.alpha_mode =
+                name == "mask" ? Material::AlphaMode::kMask : Material::AlphaMode::kOpaque;
         }
         if (const std::optional<Node> sided = n.Find("double_sided")) {
             if (!sided->json().is_boolean()) {
@@ -606,9 +624,9 @@ class SceneParser {
         }
         absl::StatusOr<std::string> bytes = read_file_(name);
         if (!bytes.ok()) {
-            throw LoadError{absl::Status(bytes.status().code(),
-                                         absl::StrCat(where, " \"", name, "\": ",
-                                                      bytes.status().message()))};
+            throw LoadError{
+                absl::Status(bytes.status().code(),
+                             absl::StrCat(where, " \"", name, "\": ", bytes.status().message()))};
         }
         hash_.Update(*bytes);
         absl::StatusOr<std::shared_ptr<const TextureImage>> image = DecodeTexture(*bytes, name);
@@ -696,7 +714,8 @@ class SceneParser {
         // Errors name the file as the scene does, never where a reader found it.
         const std::string where = absl::StrCat(file.path(), " \"", name, "\"");
         auto fail = [&](const absl::Status& status) {
-            throw LoadError{absl::Status(status.code(), absl::StrCat(where, ": ", status.message()))};
+            throw LoadError{
+                absl::Status(status.code(), absl::StrCat(where, ": ", status.message()))};
         };
         // Keyed by the name as written ("./m.obj" is "m.obj"), never by where the reader found
         // it: the same keys, so the same content hash, on the farm as on the user's disk.
@@ -722,13 +741,15 @@ class SceneParser {
                 loaded = mesh.status();
             }
             if (!loaded.ok()) {
-                throw LoadError{absl::Status(loaded.status().code(),
-                                             absl::StrCat(file.path(), ": ", loaded.status().message()))};
+                throw LoadError{
+                    absl::Status(loaded.status().code(),
+                                 absl::StrCat(file.path(), ": ", loaded.status().message()))};
             }
             for (const std::string& warning : loaded->warnings) {
                 warnings_.push_back(absl::StrCat(where, ": ", warning));
             }
-            cached = mesh_cache_.emplace(key, AddFileMaterials(*std::move(loaded), where, scene)).first;
+            cached =
+                mesh_cache_.emplace(key, AddFileMaterials(*std::move(loaded), where, scene)).first;
         }
         if (!cached->second.unassigned_where.empty()) {
             n.Fail(absl::StrCat("missing required key \"material\": the faces of ",
@@ -739,10 +760,10 @@ class SceneParser {
         std::vector<TriangleMesh> meshes = cached->second.meshes;
         if (!own_materials) meshes[0].material = material_index;
 
+        const std::optional<Node> transform_node = n.Find("transform");
+        const Affine transform = transform_node ? ParseTransform(*transform_node) : Affine();
         for (TriangleMesh& mesh : meshes) {
-            if (const std::optional<Node> transform_node = n.Find("transform")) {
-                TransformMesh(ParseTransform(*transform_node), mesh);
-            }
+            if (transform_node) TransformMesh(transform, mesh);
             for (const Vec3d& p : mesh.positions) {
                 if (MaxComponent(Abs(p)) > kMaxCoordinate) {
                     n.Fail(absl::StrCat("a vertex of ", name, " lies beyond ±1e15",
@@ -759,7 +780,8 @@ class SceneParser {
     CachedMeshFile AddFileMaterials(MeshFile file, const std::string& where, Scene& scene) {
         std::vector<int> image_of;
         for (const MeshFile::Texture& texture : file.textures) {
-            image_of.push_back(TextureIndex(texture.name, absl::StrCat(where, ": ", texture.where)));
+            image_of.push_back(
+                TextureIndex(texture.name, absl::StrCat(where, ": ", texture.where)));
         }
         const int first = int(scene.materials.size());
         for (Material& m : file.materials) {
@@ -820,9 +842,8 @@ class SceneParser {
             if (n.Has("color") && n.Has("irradiance")) {
                 n.Fail("color goes with illuminance_lux; irradiance is a colour itself");
             }
-            light.irradiance = n.Has("irradiance")
-                                   ? n.Get("irradiance").Color(kMaxRadiance)
-                                   : Photometric(n, n.Get("illuminance_lux"));
+            light.irradiance = n.Has("irradiance") ? n.Get("irradiance").Color(kMaxRadiance)
+                                                   : Photometric(n, n.Get("illuminance_lux"));
             scene.directional_lights.push_back(light);
         } else {
             type.Fail(absl::StrCat("unknown light type \"", type_name,

@@ -181,7 +181,8 @@ TEST_F(Cli, AutoTakesThePathTracerForTexturesAndSaysWhy) {
     auto scene = [&](const std::string& material) {
         return Write("textured.json", R"({"camera": {"position": [0, 0, -3], "look_at": [0, 0, 0],
             "fov_y_deg": 40, "resolution": [8, 8]},
-            "materials": {"wood": )" + material + R"(,
+            "materials": {"wood": )" + material +
+                                          R"(,
                           "lamp": {"type": "lambert", "reflectance": [0, 0, 0],
                                    "emission": [1, 1, 1]}},
             "shapes": [{"type": "quad", "material": "wood",
@@ -189,8 +190,7 @@ TEST_F(Cli, AutoTakesThePathTracerForTexturesAndSaysWhy) {
                        {"type": "quad", "material": "lamp",
                         "vertices": [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1]]}]})");
     };
-    const std::string textured =
-        scene(R"({"type": "lambert", "base_color_texture": "wood.png"})");
+    const std::string textured = scene(R"({"type": "lambert", "base_color_texture": "wood.png"})");
     const std::string exr = (dir_ / "t.exr").string();
     const RunResult automatic =
         Lightfarm("render " + textured + " -o " + exr + " --method auto --spp 1 --no-progress");

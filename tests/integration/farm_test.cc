@@ -25,6 +25,7 @@
 #include <thread>
 #include <vector>
 
+#include "image_files.h"
 #include "lf/core/image_io.h"
 #include "test_dir.h"
 
@@ -768,6 +769,28 @@ TEST_F(Farm, RadiosityJobForAGlossySceneIsRefusedAtSubmission) {
     const CliRun r = Farmctl("submit " + glossy + " --method radiosity");
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.err.find("radiosity models lambert only"), std::string::npos) << r.err;
+}
+
+// Files named inside files (an OBJ's MTL, the MTL's texture) are uploaded with the scene: the
+// server finds them and refuses radiosity for the texture, not for a missing file.
+TEST_F(Farm, FilesAnObjNamesAreUploadedWithTheScene) {
+    StartServer();
+    fs::create_directories(dir_ / "models");
+    std::ofstream(dir_ / "models" / "box.obj")
+        << "mtllib box.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl wood\nf 1/1 2/1 3/1\n";
+    std::ofstream(dir_ / "models" / "box.mtl") << "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd wood.png\n";
+    std::ofstream(dir_ / "models" / "wood.png", std::ios::binary)
+        << lf::testing::PngBytes(1, 1, 3, {200, 100, 50});
+    nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
+    scene["shapes"].push_back({{"type", "mesh"}, {"file", "models/box.obj"}});
+    const std::string textured = (dir_ / "textured.json").string();
+    std::ofstream(textured) << scene.dump();
+    const CliRun r = Farmctl("submit " + textured + " --method radiosity");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("radiosity: material \"models/box.mtl#wood\" has a texture "
+                         "(base_color_texture \"models/wood.png\")"),
+              std::string::npos)
+        << r.err;
 }
 
 TEST_F(Farm, JobsAboveTheLimitsAreRefusedWithTheLimitNamed) {

@@ -4,8 +4,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -194,8 +194,7 @@ TEST_F(MeshIoTest, ObjMaterialErrorsNameTheLine) {
     const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
     absl::StatusOr<MeshFile> missing = parse(triangle + "mtllib gone.mtl\nf 1 2 3\n");
     ASSERT_FALSE(missing.ok());
-    EXPECT_NE(missing.status().message().find("m.obj:4: mtllib \"gone.mtl\": "),
-              std::string::npos)
+    EXPECT_NE(missing.status().message().find("m.obj:4: mtllib \"gone.mtl\": "), std::string::npos)
         << missing.status();
     Write("a.mtl", "newmtl a\nKd 0.5 0.5 0.5\n");
     absl::StatusOr<MeshFile> unknown = parse("mtllib a.mtl\n" + triangle + "usemtl b\nf 1 2 3\n");

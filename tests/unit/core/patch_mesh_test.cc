@@ -376,9 +376,7 @@ TEST(PatchMesh, RadiosityLimitationSaysWhy) {
     EXPECT_EQ(why([](Scene& s) { s.directional_lights.emplace_back(); }),
               "the scene has a directional light; radiosity takes point lights");
     // A material no shape uses does not matter.
-    EXPECT_EQ(why([](Scene& s) {
-                  s.materials.emplace_back().type = Material::Type::kDielectric;
-              }),
+    EXPECT_EQ(why([](Scene& s) { s.materials.emplace_back().type = Material::Type::kDielectric; }),
               "");
     Scene spot = OneTriangle();
     spot.spot_lights.emplace_back();

@@ -574,9 +574,9 @@ TEST_F(SceneLoaderTest, ObjMaterialErrorsNameTheFileAndLine) {
 TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
     Write("wood.png", TexturePng());
     Write("mr.png", lf::testing::PngBytes(1, 1, 3, {0, 128, 255}));
-    absl::StatusOr<Scene> scene = Parse(SceneJson(
-        kQuad,
-        R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
+    absl::StatusOr<Scene> scene = Parse(
+        SceneJson(kQuad,
+                  R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
             "plain": {"type": "principled"},
             "car_paint": {"type": "principled", "base_color": [0.5, 0.1, 0.1], "metallic": 0.3,
                 "roughness": 0.2, "specular": 0.7, "ior": 1.45, "transmission": 0.25,
@@ -647,7 +647,8 @@ TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
     auto with_material = [](const std::string& material) {
         return SceneJson(
             kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
-                       "m": )" + material + "}");
+                       "m": )" +
+                       material + "}");
     };
     const std::string p = R"({"type": "principled", )";
     ExpectError(with_material(p + R"("metallic": 2})"),
@@ -671,12 +672,12 @@ TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
                 "opaque or mask");
     ExpectError(with_material(p + R"("double_sided": "yes"})"),
                 "scene.json: materials.m.double_sided: expected true or false, got string");
-    ExpectError(with_material(p + R"("base_color_texture": "nope.png"})"),
-                "scene.json: materials.m.base_color_texture \"nope.png\": ",
-                absl::StatusCode::kNotFound);
-    ExpectError(with_material(p + R"("normal_texture": {"file": "nope.png"}})"),
-                "scene.json: materials.m.normal_texture.file \"nope.png\": ",
-                absl::StatusCode::kNotFound);
+    ExpectError(
+        with_material(p + R"("base_color_texture": "nope.png"})"),
+        "scene.json: materials.m.base_color_texture \"nope.png\": ", absl::StatusCode::kNotFound);
+    ExpectError(
+        with_material(p + R"("normal_texture": {"file": "nope.png"}})"),
+        "scene.json: materials.m.normal_texture.file \"nope.png\": ", absl::StatusCode::kNotFound);
     ExpectError(with_material(p + R"("base_color_texture": {"file": "wood.png", "wrap": "tile"}})"),
                 "scene.json: materials.m.base_color_texture.wrap: unknown wrap mode \"tile\"; "
                 "expected repeat, clamp or mirror");
@@ -698,9 +699,8 @@ TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
 
 TEST_F(SceneLoaderTest, SpotAndDirectionalLights) {
     const double pi = std::numbers::pi;
-    absl::StatusOr<Scene> scene = Parse(SceneJson(
-        kQuad, kMaterials, kCamera,
-        R"(, "lights": [
+    absl::StatusOr<Scene> scene = Parse(SceneJson(kQuad, kMaterials, kCamera,
+                                                  R"(, "lights": [
             {"type": "spot", "position": [0, 3, 0], "direction": [0, -2, 0],
              "intensity": [1, 2, 3], "inner_cone_deg": 20, "outer_cone_deg": 30},
             {"type": "spot", "position": [0, 3, 0], "direction": [1, 0, 0], "power": [10, 10, 10]},
