@@ -196,11 +196,12 @@ class MtlConverter {
         }
 
         // Blinn-Phong specular (illum 2 and up) as the principled material's dielectric layer,
-        // its exponent as perceptual roughness the way Blender's OBJ importer maps it.
-        const float ks = std::clamp(
-            Rgb(mtl.specular[0], mtl.specular[1], mtl.specular[2]).MaxComponent(), 0.0f, 1.0f);
+        // the way Blender's OBJ importer maps it: Ks's mean is Blender's Specular, whose 0.5
+        // (what its exporter writes by default) is the plain dielectric, specular weight 1; Ns
+        // is the perceptual roughness 1 - sqrt(Ns / 1000).
+        const float ks = (mtl.specular[0] + mtl.specular[1] + mtl.specular[2]) / 3;
         const bool specular = mtl.illum >= 2 && ks > 0;
-        m.specular = specular ? ks : 0;
+        m.specular = specular ? std::min(2 * ks, 1.0f) : 0;
         m.roughness = mtl.roughness > 0
                           ? std::min(float(mtl.roughness), 1.0f)
                           : 1 - std::sqrt(std::clamp(float(mtl.shininess), 0.0f, 1000.0f) / 1000);

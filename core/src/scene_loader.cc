@@ -350,6 +350,7 @@ class SceneParser {
             if (version->Number() != 1) version->Fail("unsupported; this build reads version 1");
         }
         Scene scene;
+        textures_ = &scene.textures;
         scene.camera = ParseCamera(root.Get("camera"));
 
         const Node materials = root.Get("materials");
@@ -367,7 +368,6 @@ class SceneParser {
         if (const std::optional<Node> lights = root.Find("lights")) {
             for (const Node& light : lights->Elements()) ParseLight(light, scene);
         }
-        scene.textures = textures_;
 
         if (!scene.HasLights()) {
             warnings_.push_back("no emissive shape and no light: the image will be black");
@@ -634,8 +634,8 @@ class SceneParser {
             throw LoadError{absl::Status(image.status().code(),
                                          absl::StrCat(where, ": ", image.status().message()))};
         }
-        textures_.push_back(*std::move(image));
-        return texture_index_[key] = int(textures_.size() - 1);
+        textures_->push_back(*std::move(image));
+        return texture_index_[key] = int(textures_->size() - 1);
     }
 
     void ParseShape(const Node& n, Scene& scene) {
@@ -887,8 +887,8 @@ class SceneParser {
     std::map<std::string, int> material_index_;
     // By name and whether the file's own materials were read.
     std::map<std::pair<std::string, bool>, CachedMeshFile> mesh_cache_;
-    std::map<std::string, int> texture_index_;  // by file name, into textures_
-    std::vector<std::shared_ptr<const TextureImage>> textures_;
+    std::map<std::string, int> texture_index_;  // by file name, into *textures_
+    std::vector<std::shared_ptr<const TextureImage>>* textures_ = nullptr;  // the scene's
     Fnv1a128 hash_;
     int dropped_degenerate_ = 0;
 };
