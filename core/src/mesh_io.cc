@@ -19,7 +19,9 @@
 #include <tuple>
 #include <vector>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "lf/core/file_util.h"
 
 namespace lf {
@@ -147,14 +149,24 @@ class MtlConverter {
     Material Convert(const tinyobj::material_t& mtl, size_t index) {
         const MtlText& file = reader_.FileOf(index);
         // Each value's line, for messages: the key's first line after `newmtl NAME`.
+        // tinyobjloader names a material by the rest of its `newmtl` line.
         const size_t start = FindLine(file.text, [&](const std::vector<std::string>& f) {
-            return f[0] == "newmtl" && f.size() > 1 && f[1] == mtl.name;
+            return f[0] == "newmtl" && absl::StrJoin(f.begin() + 1, f.end(), " ") ==
+                                           absl::StripAsciiWhitespace(mtl.name);
         });
-        auto where = [&](const char* key) {
+        const size_t end = FindLine(
+            file.text, [](const std::vector<std::string>& f) { return f[0] == "newmtl"; },
+            start + 1);
+        // The line of `key` in this material's block, or 0.
+        auto line_of = [&](const char* key) {
             const size_t line = FindLine(
                 file.text,
                 [&](const std::vector<std::string>& f) { return EqualsIgnoringCase(f[0], key); },
                 start);
+            return end == 0 || line < end ? line : 0;
+        };
+        auto where = [&](const char* key) {
+            const size_t line = line_of(key);
             return absl::StrCat(file.name, ":", line > 0 ? line : start);
         };
         auto color = [&](const tinyobj::real_t* c, const char* key, float max) {
@@ -178,8 +190,12 @@ class MtlConverter {
 
         Material m;
         m.name = absl::StrCat(file.name, "#", mtl.name);
-        m.reflectance = color(mtl.diffuse, "Kd", 1);
-        m.emission = color(mtl.emission, "Ke", std::numeric_limits<float>::max());
+        // Without Kd, Blender's default 0.8, or the texture alone (tinyobjloader would say 0).
+        m.reflectance = start == 0 || line_of("Kd") > 0 ? color(mtl.diffuse, "Kd", 1)
+                        : mtl.diffuse_texname.empty()   ? Rgb(0.8f)
+                                                        : Rgb(1);
+        // The scene loader's bound on emitted radiance, 500 times the sun's.
+        m.emission = color(mtl.emission, "Ke", 1e10f);
         if (!mtl.diffuse_texname.empty()) {
             m.base_color_texture = texture(mtl.diffuse_texname, mtl.diffuse_texopt, "map_Kd", true);
         }

@@ -125,7 +125,9 @@ TEST_F(MeshIoTest, ObjMtlMaterialsSplitTheFaces) {
           "Kd 0.2 0.6 0.1\nd 0.4\nillum 2\nKs 0.1 0.2 0.3\nNs 250\nNi 1.45\n"
           "newmtl glass\n"
           "Kd 1 1 1\nd 0.1\nillum 7\nNi 1.5\nmap_Ks spec.png\n"
-          "newmtl unused\nmap_Kd missing.png\n");
+          "newmtl unused\nmap_Kd missing.png\n"
+          "newmtl plain\n"
+          "newmtl painted\nmap_Kd tex/wood.png\n");
     const std::string obj =
         "mtllib scene.mtl\n"
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
@@ -133,12 +135,14 @@ TEST_F(MeshIoTest, ObjMtlMaterialsSplitTheFaces) {
         "usemtl wood\nf 2 4 3\n"
         "usemtl lamp\nf 3 2 4\n"
         "usemtl leaf\nf 1 2 4\n"
-        "usemtl glass\nf 1 3 4\n";
+        "usemtl glass\nf 1 3 4\n"
+        "usemtl plain\nf 4 3 1\n"
+        "usemtl painted\nf 4 1 3\n";
     absl::StatusOr<MeshFile> file =
         ParseMeshWithMaterials(obj, "models/scene.obj", ReadBeside(dir_.string()));
     ASSERT_TRUE(file.ok()) << file.status();
-    ASSERT_EQ(file->meshes.size(), 4u);
-    ASSERT_EQ(file->materials.size(), 4u);
+    ASSERT_EQ(file->meshes.size(), 6u);
+    ASSERT_EQ(file->materials.size(), 6u);
     EXPECT_TRUE(file->unassigned_where.empty());
     const std::vector<Material>& m = file->materials;
     // In the order the faces first use them; the unused material is not converted.
@@ -181,6 +185,10 @@ TEST_F(MeshIoTest, ObjMtlMaterialsSplitTheFaces) {
     EXPECT_FLOAT_EQ(m[3].transmission, 0.9f);
     EXPECT_EQ(m[3].alpha_mode, Material::AlphaMode::kOpaque);
     EXPECT_FLOAT_EQ(m[3].specular, 0);
+    // Without Kd: Blender's default, or white under a texture (shared with wood's).
+    EXPECT_EQ(m[4].reflectance, Rgb(0.8f));
+    EXPECT_EQ(m[5].reflectance, Rgb(1));
+    EXPECT_EQ(m[5].base_color_texture.image, 0);
     ASSERT_EQ(file->warnings.size(), 1u);
     EXPECT_EQ(file->warnings[0],
               "models/scene.mtl:20: material \"glass\": map_Ks is not supported; its variation "
