@@ -36,12 +36,7 @@ Rgb Bsdf::GlossyEval(const Vec3& wo, const Vec3& wi) const {
     const Vec3 wm = Normalize(wo + wi);
     const float cos_om = Dot(wo, wm);
     const Rgb fresnel = conductor_ ? FrComplex(cos_om, eta_, k_) : FrSchlick(reflectance_, cos_om);
-    // D G F / (4 cos_o cos_i) with G = 1 / (1 + Lambda_o + Lambda_i) multiplied through, so no
-    // grazing direction makes a Lambda infinite.
-    const float co = wo.z, ci = wi.z;
-    const float denom =
-        4 * (co * ci + ci * distribution_.CosLambda(wo) + co * distribution_.CosLambda(wi));
-    return fresnel * (distribution_.D(wm) / denom);
+    return fresnel * (distribution_.D(wm) * distribution_.GOverCosines(wo, wi) / 4);
 }
 
 float Bsdf::GlossyPdf(const Vec3& wo, const Vec3& wi) const {

@@ -43,10 +43,11 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
                 std::abs(material.ior - 1) > kMinIorContrast),
       distribution_(Material::Distribution::kGgx,
                     Clamp01(params.roughness) * Clamp01(params.roughness)),
-      // Without a specular layer the base needs no albedo scaling and the table is not built.
-      albedo_(specular_ > 0 ? &GgxAlbedo::Get() : nullptr),
+      // Lambert's limit (no layer, no metal) needs no table: it is not built for it.
+      albedo_(specular_ > 0 || metallic_ > 0 ? &GgxAlbedo::Get() : nullptr),
       albedo_roughness_(GgxAlbedo::At(Clamp01(params.roughness))) {
-    const float layer_average = albedo_ ? specular_ * albedo_->Average(albedo_roughness_, f0_) : 0;
+    const float layer_average =
+        specular_ > 0 ? specular_ * albedo_->Average(albedo_roughness_, f0_) : 0;
     const float remaining = 1 - layer_average;
     diffuse_scale_ =
         remaining > 1e-6f ? (1 - metallic_) * (1 - transmission_) * kInvPi / remaining : 0;
@@ -63,14 +64,32 @@ float PrincipledBsdf::LayerFresnel(float cos_om, bool outside) const {
 
 PrincipledBsdf::LobePick PrincipledBsdf::Pick(const Vec3& wo) const {
     const float cos = std::min(std::abs(wo.z), 1.0f);
-    const float layer = specular_ * SchlickScalar(f0_, cos);
+    const bool outside = Outside(wo);
+    // Fresnel as the lobes see it: outside, averaged over the light the microfacets reflect,
+    // E(f0) / E(1) (Schlick is linear in f0, so one table serves the layer and the metal); at
+    // grazing incidence that is far below Fresnel at the macro normal, which would starve the
+    // base and transmission of samples. Inside a solid, at the macro normal with its total
+    // internal reflection.
+    float layer, metal;
+    if (albedo_ && outside) {
+        const float e0 = albedo_->E(cos, albedo_roughness_, 0);
+        const float e1 = albedo_->E(cos, albedo_roughness_, 1);
+        const auto mean_fresnel = [&](float f0) {
+            return e1 > 0 ? e0 / e1 + f0 * (1 - e0 / e1) : 1;
+        };
+        layer = specular_ * mean_fresnel(f0_);
+        metal = mean_fresnel(base_.Average());
+    } else {
+        layer = LayerFresnel(cos, outside);
+        metal = FrSchlick(base_, cos).Average();
+    }
     const float rest = std::max(1 - layer, kPickFloor);
     const float dielectric = 1 - metallic_;
     LobePick p;
-    p.reflect = metallic_ * std::max(FrSchlick(base_, cos).Average(), kPickFloor) +
-                dielectric * specular_ * std::max(SchlickScalar(f0_, cos), kPickFloor);
+    p.reflect = metallic_ * std::max(metal, kPickFloor) +
+                dielectric * std::max(layer, kPickFloor * specular_);
     p.transmit = dielectric * transmission_ * rest;
-    if (Outside(wo) && diffuse_scale_ > 0) {
+    if (outside && diffuse_scale_ > 0) {
         p.diffuse = dielectric * (1 - transmission_) * rest * std::max(base_.Average(), kPickFloor);
     }
     const float total = p.reflect + p.transmit + p.diffuse;
@@ -102,7 +121,7 @@ float PrincipledBsdf::ReflectionPdf(const Vec3& wo, const Vec3& wi) const {
 
 Rgb PrincipledBsdf::DiffuseEval(const Vec3& wo, const Vec3& wi) const {
     if (diffuse_scale_ == 0) return {};
-    if (!albedo_) return base_ * diffuse_scale_;
+    if (specular_ == 0) return base_ * diffuse_scale_;
     const float keep_o = 1 - specular_ * albedo_->E(wo.z, albedo_roughness_, f0_);
     const float keep_i = 1 - specular_ * albedo_->E(wi.z, albedo_roughness_, f0_);
     return base_ * (diffuse_scale_ * keep_o * keep_i);
@@ -139,13 +158,11 @@ Rgb PrincipledBsdf::RefractionEval(const Vec3& wo, const Vec3& wi) const {
     // Snell's law from the inside would cancel catastrophically near the critical angle.
     const float fresnel = LayerFresnel(wo.z > 0 ? cos_om : -cos_im, true);
     const float half = cos_im + cos_om / eta;
-    const float co = std::abs(wo.z), ci = std::abs(wi.z);
-    const float g_denom =
-        co * ci + ci * distribution_.CosLambda(wo) + co * distribution_.CosLambda(wi);
-    // Walter et al. (2007) eq. 21 with G multiplied through; radiance crossing into the medium
-    // on wi's side is compressed by 1 / eta^2 (pbrt-v4's TransportMode::Radiance).
-    const float value = weight * (1 - fresnel) * distribution_.D(*wm) * -cos_im * cos_om /
-                        (half * half * g_denom * eta * eta);
+    // Walter et al. (2007) eq. 21; radiance crossing into the medium on wi's side is compressed
+    // by 1 / eta^2 (pbrt-v4's TransportMode::Radiance).
+    const float value = weight * (1 - fresnel) * distribution_.D(*wm) *
+                        distribution_.GOverCosines(wo, wi) * -cos_im * cos_om /
+                        (half * half * eta * eta);
     return Rgb(std::max(0.0f, value));
 }
 

@@ -10,6 +10,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lf/core/sampler.h"
@@ -48,6 +49,17 @@ inline double GammaQ(double a, double x) {
 }
 
 inline double ChiSquarePValue(double chi2, int dof) { return GammaQ(0.5 * dof, 0.5 * chi2); }
+
+// Normal, oblique, grazing and back-side incidence, azimuth off the bin edges, named for test
+// case names.
+inline std::vector<std::pair<std::string, Vec3>> Chi2IncidentDirections() {
+    return {
+        {"Normal", Spherical(0, 0)},
+        {"Oblique45", Spherical(Radians(45), 0.5)},
+        {"Grazing80", Spherical(Radians(80), 2.0)},
+        {"Back130", Spherical(Radians(130), 4.0)},
+    };
+}
 
 inline constexpr int kThetaRes = 10;  // pi / 10 per row: the horizon is a row boundary
 inline constexpr int kPhiRes = 2 * kThetaRes;

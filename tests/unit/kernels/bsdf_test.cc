@@ -95,15 +95,8 @@ struct Chi2Case {
 };
 
 std::vector<Chi2Case> Chi2Cases() {
-    // Normal, oblique, grazing and back-side incidence, azimuth off the bin edges.
-    const std::vector<std::pair<std::string, Vec3>> wos = {
-        {"Normal", Spherical(0, 0)},
-        {"Oblique45", Spherical(Radians(45), 0.5)},
-        {"Grazing80", Spherical(Radians(80), 2.0)},
-        {"Back130", Spherical(Radians(130), 4.0)},
-    };
     std::vector<Chi2Case> cases;
-    for (const auto& [wo_name, wo] : wos) {
+    for (const auto& [wo_name, wo] : testing::Chi2IncidentDirections()) {
         cases.push_back({"Lambert_" + wo_name, Lambert(Rgb(0.5f)), wo});
         for (auto [d, d_name] : {std::pair(kGgx, "Ggx"), std::pair(kBeckmann, "Beckmann")}) {
             for (auto [alpha, a_name] : {std::pair(0.05f, "005"), std::pair(0.2f, "020"),
@@ -459,6 +452,20 @@ TEST(Microfacet, ShadowingIsHeightCorrelated) {
                 const double expected = 1 / (1 + lambda(alpha, to) + lambda(alpha, ti));
                 EXPECT_NEAR(distribution.G(Spherical(to, 0.1), Spherical(ti, 2.5)), expected, 1e-5)
                     << alpha << " " << to << " " << ti;
+            }
+        }
+    }
+}
+
+TEST(Microfacet, GOverCosinesIsGDividedByTheCosines) {
+    for (auto d : {kGgx, kBeckmann}) {
+        const MicrofacetDistribution distribution(d, 0.3f);
+        for (double to : {0.0, 0.7, 1.4, 2.0}) {
+            for (double ti : {0.2, 1.0, 1.55, 2.9}) {
+                const Vec3 wo = Spherical(to, 0.1), wi = Spherical(ti, 2.5);
+                const double expected = distribution.G(wo, wi) / std::abs(double(wo.z) * wi.z);
+                EXPECT_NEAR(distribution.GOverCosines(wo, wi), expected, 1e-5 * expected)
+                    << int(d) << " " << to << " " << ti;
             }
         }
     }

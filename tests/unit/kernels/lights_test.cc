@@ -27,17 +27,23 @@ double SpotFalloff(double cos_to_axis, double inner, double outer) {
     return a * a;
 }
 
+SpotLight DownwardSpot(const Vec3d& position, const Rgb& intensity, double inner_degrees,
+                       double outer_degrees) {
+    SpotLight spot;
+    spot.position = position;
+    spot.direction = Vec3d(0, -1, 0);
+    spot.intensity = intensity;
+    spot.inner_cone = Radians(inner_degrees);
+    spot.outer_cone = Radians(outer_degrees);
+    return spot;
+}
+
 // A spot light at height h pointing straight down: irradiance I cos(theta) / r^2 inside the
 // inner cone, zero outside the outer cone, the falloff between.
 TEST(SpotLight, LambertianPlaneMatchesClosedForm) {
     const Rgb rho(0.5f, 0.25f, 0.75f);
     Scene scene = testing::PlaneUnderCamera(rho);
-    SpotLight spot;
-    spot.position = Vec3d(0.3, 1.0, -0.2);
-    spot.direction = Vec3d(0, -1, 0);
-    spot.intensity = Rgb(10.0f, 5.0f, 2.0f);
-    spot.inner_cone = Radians(25);
-    spot.outer_cone = Radians(45);
+    const SpotLight spot = DownwardSpot(Vec3d(0.3, 1.0, -0.2), Rgb(10.0f, 5.0f, 2.0f), 25, 45);
     scene.spot_lights.push_back(spot);
     const RenderOutput out = testing::RenderPath(scene, kSpp).out;
 
@@ -69,15 +75,10 @@ TEST(SpotLight, LambertianPlaneMatchesClosedForm) {
     }
 }
 
-// A spot whose cones are equal has a hard edge; glTF guards the division with 0.001.
+// The sampler's radiance at points swept from the axis to beyond the outer cone.
 TEST(SpotLight, SamplerFollowsTheExtensionsFalloff) {
     Scene scene = testing::PlaneUnderCamera(Rgb(0.5f));
-    SpotLight spot;
-    spot.position = Vec3d(0, 2, 0);
-    spot.direction = Vec3d(0, -1, 0);
-    spot.intensity = Rgb(3.0f);
-    spot.inner_cone = Radians(10);
-    spot.outer_cone = Radians(30);
+    const SpotLight spot = DownwardSpot(Vec3d(0, 2, 0), Rgb(3.0f), 10, 30);
     scene.spot_lights.push_back(spot);
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
@@ -188,13 +189,7 @@ TEST(DirectionalLight, ShadowRayReachesBeyondTheScene) {
 TEST(LightSampler, PicksDeltaLightsByPower) {
     Scene scene = testing::PlaneUnderCamera(Rgb(0.5f));  // bounds 100 x 0 x 100: R = 50 sqrt 2
     scene.point_lights.push_back({Vec3d(0, 1, 0), Rgb(1.0f)});
-    SpotLight spot;
-    spot.position = Vec3d(1, 1, 0);
-    spot.direction = Vec3d(0, -1, 0);
-    spot.intensity = Rgb(100.0f);
-    spot.inner_cone = Radians(20);
-    spot.outer_cone = Radians(40);
-    scene.spot_lights.push_back(spot);
+    scene.spot_lights.push_back(DownwardSpot(Vec3d(1, 1, 0), Rgb(100.0f), 20, 40));
     scene.directional_lights.push_back({Vec3d(0, -1, 0), Rgb(0.001f)});
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
