@@ -24,6 +24,7 @@ namespace {
 using testing::Albedo;
 using testing::EstimateAlbedo;
 using testing::FurnaceDirections;
+using testing::Spherical;
 using testing::UniformSphere;
 
 struct Params {
@@ -158,6 +159,13 @@ TEST(PrincipledBsdf, WhiteFurnaceNeverExceedsOne) {
                         EXPECT_NEAR(a.mean.g, 1, 4 * a.stderr_.g + 2e-3)
                             << Describe(p) << " cos " << wo.z;
                     }
+                    // Nearly smooth glass loses nothing either: what is not reflected is
+                    // transmitted (from inside a solid, beyond the critical angle, reflected).
+                    if (metallic == 0 && transmission == 1 && roughness <= 0.1f &&
+                        std::abs(wo.z) >= 0.3f) {
+                        EXPECT_GT(a.mean.g, 0.99 - 4 * a.stderr_.g)
+                            << Describe(p) << " cos " << wo.z;
+                    }
                 }
             }
         }
@@ -237,7 +245,62 @@ TEST(PrincipledBsdf, SampleAgreesWithEvalAndPdf) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Limits: lambert and the GGX conductor.
+// Limits: smooth glass, lambert and the GGX conductor.
+
+// At roughness 0 the lobes collapse onto the mirror and refraction directions: a thin wall
+// lets light straight through, a solid bends it by Snell's law, and the share reflected is
+// Fresnel's (Schlick with F0 from the IOR).
+TEST(PrincipledBsdf, SmoothGlassReflectsAndRefractsLikeADielectric) {
+    for (float thickness : {0.0f, 1.0f}) {
+        Params p;
+        p.roughness = 0;
+        p.transmission = 1;
+        p.thickness = thickness;
+        const Bsdf bsdf(Principled(p));
+        const float f0 = 0.04f;
+        for (float cos : {0.9f, 0.6f, 0.3f}) {
+            const Vec3 wo = Spherical(std::acos(cos), 0.4);
+            constexpr int n = 20000;
+            // GGX's tails are long even at the smallest alpha (1e-3): most, not all, samples lie
+            // within 0.02 rad of the ideal direction.
+            constexpr float kNear = 0.9998f;
+            int reflected = 0, near_ideal = 0;
+            for (int i = 0; i < n; ++i) {
+                Sampler sampler(97, 0, 0, uint64_t(i));
+                const float uc = sampler.Get1D();
+                const auto bs = bsdf.Sample(wo, uc, sampler.Get2D());
+                if (!bs) continue;  // a far tail's facet sends it below the horizon
+                Vec3 ideal;
+                if (bs->wi.z > 0) {
+                    ++reflected;
+                    ideal = Vec3(-wo.x, -wo.y, wo.z);
+                } else if (thickness == 0) {
+                    ideal = -wo;
+                } else {
+                    // Snell: the tangential component shrinks by the IOR, azimuth turned by pi.
+                    const Vec3 t = Vec3(-wo.x, -wo.y, 0) / p.ior;
+                    ideal = t + Vec3(0, 0, -std::sqrt(1 - LengthSquared(t)));
+                }
+                if (Dot(bs->wi, ideal) > kNear) ++near_ideal;
+            }
+            EXPECT_GT(near_ideal, 0.95 * n) << thickness << " " << cos;
+            // Samples are picked in proportion to the lobes' energy, up to the pick's
+            // approximation of it: compare the energy itself.
+            const Albedo a = EstimateAlbedo(bsdf, wo, 101, n);
+            const double fresnel = f0 + (1 - f0) * std::pow(1 - cos, 5);
+            EXPECT_GT(reflected, 0);
+            EXPECT_NEAR(a.mean.g, 1, 4 * a.stderr_.g + 2e-3) << thickness << " " << cos;
+            double reflected_energy = 0;
+            for (int i = 0; i < n; ++i) {
+                Sampler sampler(101, 0, 0, uint64_t(i));
+                const float uc = sampler.Get1D();
+                const auto bs = bsdf.Sample(wo, uc, sampler.Get2D());
+                if (bs && bs->wi.z > 0) reflected_energy += bs->f.g * bs->wi.z / bs->pdf;
+            }
+            EXPECT_NEAR(reflected_energy / n, fresnel, 5e-3) << thickness << " " << cos;
+        }
+    }
+}
 
 TEST(PrincipledBsdf, WithoutSpecularMetalOrTransmissionIsLambert) {
     Params p;
