@@ -5,6 +5,7 @@
 
 #include "lf/kernels/microfacet.h"
 #include "tbb/parallel_for.h"
+#include "tbb/task_arena.h"
 
 namespace lf {
 namespace {
@@ -35,45 +36,51 @@ GgxAlbedo::GgxAlbedo()
       b_(a_.size()),
       a_average_(size_t(kRoughnessSize)),
       b_average_(size_t(kRoughnessSize)) {
-    // Rows are independent: one task per roughness.
-    tbb::parallel_for(0, kRoughnessSize, [&](int j) {
-        const float r = RoughnessAt(j);
-        const MicrofacetDistribution distribution(Material::Distribution::kGgx, r * r);
-        for (int i = 0; i < kMuSize; ++i) {
-            // At mu = 0 exactly nothing is seen; the limit is taken just above it.
-            const float mu = std::max(MuAt(i), 1e-4f);
-            const Vec3 wo(std::sqrt(1 - mu * mu), 0, mu);
-            double a = 0, b = 0;
-            for (int y = 0; y < kQuadrature; ++y) {
-                for (int x = 0; x < kQuadrature; ++x) {
-                    const Vec2 u((x + 0.5f) / kQuadrature, (y + 0.5f) / kQuadrature);
-                    const Vec3 wm = distribution.SampleWm(wo, u);
-                    const float cos_om = Dot(wo, wm);
-                    if (cos_om <= 0) continue;
-                    const Vec3 wi = wm * (2 * cos_om) - wo;
-                    if (wi.z <= 0) continue;
-                    // Visible-normal sampling leaves the weight G2 / G1(wo).
-                    const double w = distribution.G(wo, wi) / distribution.G1(wo);
-                    const double m = 1 - std::min(1.0f, cos_om);
-                    const double m5 = (m * m) * (m * m) * m;
-                    a += w * (1 - m5);
-                    b += w * m5;
+    // Rows are independent: one task per roughness. Isolated, because the first Get() may come
+    // from inside a render's parallel loop: a thread waiting here must not pick up one of that
+    // loop's tasks, which would re-enter this static initialiser.
+    tbb::this_task_arena::isolate([&] {
+        tbb::parallel_for(0, kRoughnessSize, [&](int j) {
+            const float r = RoughnessAt(j);
+            const MicrofacetDistribution distribution(Material::Distribution::kGgx, r * r);
+            for (int i = 0; i < kMuSize; ++i) {
+                // At mu = 0 exactly nothing is seen; the limit is taken just above it.
+                const float mu = std::max(MuAt(i), 1e-4f);
+                const Vec3 wo(std::sqrt(1 - mu * mu), 0, mu);
+                double a = 0, b = 0;
+                for (int y = 0; y < kQuadrature; ++y) {
+                    for (int x = 0; x < kQuadrature; ++x) {
+                        const Vec2 u((x + 0.5f) / kQuadrature, (y + 0.5f) / kQuadrature);
+                        const Vec3 wm = distribution.SampleWm(wo, u);
+                        const float cos_om = Dot(wo, wm);
+                        if (cos_om <= 0) continue;
+                        const Vec3 wi = wm * (2 * cos_om) - wo;
+                        if (wi.z <= 0) continue;
+                        // Visible-normal sampling leaves the weight G2 / G1(wo).
+                        const double w = distribution.G(wo, wi) / distribution.G1(wo);
+                        const double m = 1 - std::min(1.0f, cos_om);
+                        const double m5 = (m * m) * (m * m) * m;
+                        a += w * (1 - m5);
+                        b += w * m5;
+                    }
                 }
+                const double n = double(kQuadrature) * kQuadrature;
+                a_[size_t(j * kMuSize + i)] = float(a / n);
+                b_[size_t(j * kMuSize + i)] = float(b / n);
             }
-            const double n = double(kQuadrature) * kQuadrature;
-            a_[size_t(j * kMuSize + i)] = float(a / n);
-            b_[size_t(j * kMuSize + i)] = float(b / n);
-        }
-        // 2 int E(mu) mu dmu of the piecewise-linear E, exactly, segment by segment.
-        double a_avg = 0, b_avg = 0;
-        for (int i = 0; i + 1 < kMuSize; ++i) {
-            const double m0 = MuAt(i), m1 = MuAt(i + 1), h = m1 - m0;
-            const double w0 = h * (2 * m0 + m1) / 6, w1 = h * (m0 + 2 * m1) / 6;
-            a_avg += 2 * (w0 * a_[size_t(j * kMuSize + i)] + w1 * a_[size_t(j * kMuSize + i + 1)]);
-            b_avg += 2 * (w0 * b_[size_t(j * kMuSize + i)] + w1 * b_[size_t(j * kMuSize + i + 1)]);
-        }
-        a_average_[size_t(j)] = float(a_avg);
-        b_average_[size_t(j)] = float(b_avg);
+            // 2 int E(mu) mu dmu of the piecewise-linear E, exactly, segment by segment.
+            double a_avg = 0, b_avg = 0;
+            for (int i = 0; i + 1 < kMuSize; ++i) {
+                const double m0 = MuAt(i), m1 = MuAt(i + 1), h = m1 - m0;
+                const double w0 = h * (2 * m0 + m1) / 6, w1 = h * (m0 + 2 * m1) / 6;
+                a_avg +=
+                    2 * (w0 * a_[size_t(j * kMuSize + i)] + w1 * a_[size_t(j * kMuSize + i + 1)]);
+                b_avg +=
+                    2 * (w0 * b_[size_t(j * kMuSize + i)] + w1 * b_[size_t(j * kMuSize + i + 1)]);
+            }
+            a_average_[size_t(j)] = float(a_avg);
+            b_average_[size_t(j)] = float(b_avg);
+        });
     });
 }
 
