@@ -14,8 +14,9 @@ namespace {
 constexpr float kInvPi = std::numbers::inv_pi_v<float>;
 constexpr float kMinCos = kBsdfMinCos;
 
-// Lobe picking uses Fresnel at the macro normal, which can vanish where the lobe (taken over
-// its microfacets) does not; a floor keeps every lobe that exists sampled.
+// Lobe picking estimates each lobe's share from wo alone; where the estimate vanishes but the lobe
+// does not (Fresnel 1 at the macro normal inside a solid, a black base), a floor keeps every lobe
+// that exists sampled.
 constexpr float kPickFloor = 0.05f;
 
 // Solids with an IOR this close to one refract by less than float resolves; they are treated as
