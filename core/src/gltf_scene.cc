@@ -105,15 +105,16 @@ double Determinant(const Matrix& m) {
     return Dot(r0, Cross(r1, r2));
 }
 
-// Normals transform by the inverse transpose of the linear part: its cofactor matrix, up to
-// the determinant's positive or negative scale, which normalizing removes (the sign is kept so
-// normals stay on the side their winding says).
+// Normals transform by the inverse transpose of the linear part: its cofactor matrix over the
+// determinant, whose size normalizing removes but whose sign must stay (a mirror flips the
+// winding, and the normal must follow the flipped front face).
 Matrix NormalMatrix(const Matrix& m) {
+    const double sign = Determinant(m) < 0 ? -1 : 1;
     Matrix n{};
     for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 3; ++c) {
             const int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
-            n[r][c] = m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1];
+            n[r][c] = sign * (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]);
         }
     }
     return n;
@@ -234,6 +235,9 @@ class GltfImporter {
             Warn(absl::StrCat("renders scene ", index, " of ", model_.scenes.size(),
                               " (the file's default)"));
         }
+        // Every material, in file order, so scene material i is glTF material i (after those
+        // already in the scene); the default material only when a primitive needs it.
+        for (int i = 0; i < int(model_.materials.size()); ++i) Material(i, "materials");
         visited_.assign(model_.nodes.size(), false);
         const tinygltf::Scene& gltf_scene = model_.scenes[size_t(index)];
         for (size_t i = 0; i < gltf_scene.nodes.size(); ++i) {
