@@ -132,6 +132,22 @@ TEST_F(GltfSceneTest, ImportsShadingAttributesThroughTheNodeTransforms) {
     EXPECT_EQ(quad.uvs[1].x, 1);
     EXPECT_EQ(quad.uvs[2].y, 0);
     EXPECT_TRUE(scene->meshes[1].normals.empty());
+    EXPECT_TRUE(quad.tangents.empty());  // no normal map, no need
+}
+
+TEST_F(GltfSceneTest, TangentsAreComputedForANormalMapWhenTheFileHasNone) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["materials"][0]["normalTexture"] = {{"index", 0}};
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const TriangleMesh& quad = scene->meshes[0];
+    ASSERT_EQ(quad.tangents.size(), 4u);
+    // u grows along the quad's local +x, which the quarter turn about +y takes to -z; v falls
+    // along local +y (up in the image), which is cross(normal, tangent): w = +1.
+    for (const auto& t : quad.tangents) {
+        ExpectNear(Vec3d(t[0], t[1], t[2]), {0, 0, -1}, 1e-6);
+        EXPECT_EQ(t[3], 1);
+    }
 }
 
 TEST_F(GltfSceneTest, NormalsUseTheInverseTransposeAndMirrorsKeepFrontFaces) {
