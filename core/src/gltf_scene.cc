@@ -949,6 +949,16 @@ absl::Status AppendGltf(const std::string& bytes, const std::string& name,
     if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
         return absl::InvalidArgumentError("larger than 4 GB");
     }
+    if (binary) {
+        // tinygltf says only "Invalid glTF binary" for the commonest .glb fault: a cut-off copy.
+        uint32_t declared = 0;
+        if (bytes.size() >= 12) std::memcpy(&declared, bytes.data() + 8, 4);
+        if (bytes.size() < 12 || declared > bytes.size()) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                "truncated glTF binary (.glb): ", bytes.size(), " bytes, its header ",
+                bytes.size() < 12 ? "alone needs 12" : absl::StrCat("declares ", declared)));
+        }
+    }
     const bool ok =
         binary ? loader.LoadBinaryFromMemory(&model, &err, &warn,
                                              reinterpret_cast<const unsigned char*>(bytes.data()),
@@ -958,7 +968,9 @@ absl::Status AppendGltf(const std::string& bytes, const std::string& name,
     if (!ok) {
         // A file the reader could not give is the cause the user can act on.
         for (const auto& [uri, status] : context.read_errors) {
-            return absl::Status(status.code(), absl::StrCat("\"", uri, "\": ", status.message()));
+            // Images that cannot be read only warn in tinygltf: this is a buffer.
+            return absl::Status(status.code(),
+                                absl::StrCat("buffer uri \"", uri, "\": ", status.message()));
         }
         absl::StripTrailingAsciiWhitespace(&err);
         return absl::InvalidArgumentError(
