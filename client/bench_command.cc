@@ -18,16 +18,8 @@ Command AddBenchCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(1, 1024));
     AddCameraFlag(cmd, options->scene);
-    cmd->add_option_function<std::string>(
-           "--resolution",
-           [options](const std::string& text) {
-               const absl::Status s = ParseResolution(text, &options->scene.width,
-                                                      &options->scene.height, &options->resolution);
-               if (!s.ok()) throw CLI::ValidationError(std::string(s.message()));
-               if (options->scene.width > 0) options->resolution = 0;
-           },
-           "image size WxH, or N for a square N x N (0 = the scene's; default 256)")
-        ->type_name("WxH|N");
+    AddResolutionFlag(cmd, options->scene, &options->resolution, 65536,
+                      "image size WxH, or N for a square N x N (0 = the scene's; default 256)");
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str();
     cmd->add_option("--rays", options->raw_rays, "rays for the raw Embree measurement")

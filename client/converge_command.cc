@@ -1,9 +1,9 @@
 #include <cstdio>
 
 #include "command.h"
-#include "scene_flags.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
+#include "scene_flags.h"
 
 namespace lf {
 
@@ -29,18 +29,8 @@ Command AddConvergeCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::IsMember({"path", "radiosity", "both"}));
     AddCameraFlag(cmd, options->scene);
-    cmd->add_option_function<std::string>(
-           "--resolution",
-           [options](const std::string& text) {
-               const absl::Status s = ParseResolution(text, &options->scene.width,
-                                                      &options->scene.height, &options->resolution);
-               if (!s.ok() || options->resolution > 16384) {
-                   throw CLI::ValidationError(s.ok() ? "--resolution N: at most 16384"
-                                                     : std::string(s.message()));
-               }
-           },
-           "image size WxH, or N for width N with the scene's aspect (0 = the scene's)")
-        ->type_name("WxH|N");
+    AddResolutionFlag(cmd, options->scene, &options->resolution, 16384,
+                      "image size WxH, or N for width N with the scene's aspect (0 = the scene's)");
     cmd->add_option("--max-spp", options->max_spp, "largest spp of the path ladder")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(2), uint64_t(1) << 20));

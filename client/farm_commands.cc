@@ -15,17 +15,17 @@
 #include "absl/time/time.h"
 #include "adaptive_flags.h"
 #include "command.h"
-#include "scene_flags.h"
+#include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
-#include "lf/core/scene_loader.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "progress_bar.h"
 #include "proto/grpc_status.h"
 #include "radiosity_flags.h"
+#include "scene_flags.h"
 
 namespace lf {
 

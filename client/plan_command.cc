@@ -7,7 +7,6 @@
 
 #include "absl/strings/str_format.h"
 #include "command.h"
-#include "scene_flags.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_error.h"
 #include "lf/core/patch_mesh.h"
@@ -21,6 +20,7 @@
 #include "lf/local/local_executor.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
+#include "scene_flags.h"
 
 namespace lf {
 

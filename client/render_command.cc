@@ -5,10 +5,10 @@
 #include "absl/strings/str_cat.h"
 #include "adaptive_flags.h"
 #include "command.h"
-#include "scene_flags.h"
 #include "lf/job/job_spec.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
+#include "scene_flags.h"
 
 namespace lf {
 

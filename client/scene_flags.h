@@ -5,17 +5,17 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "absl/status/status.h"
 #include "lf/core/scene_loader.h"
 
 namespace lf {
 
-// "WxH" ("1920x1080") into *width and *height; a bare "N" too when `single` is not null (then
-// *single = N and the size is left alone). InvalidArgument otherwise.
-absl::Status ParseResolution(const std::string& text, int* width, int* height, int* single);
-
 // --camera NAME, filling options.camera.
 void AddCameraFlag(CLI::App* cmd, SceneOptions& options);
+
+// --resolution WxH into options.width and height; with `single`, also a bare N (at most
+// `max_single`) into *single, for the commands whose --resolution N came first.
+void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, int* single, int max_single,
+                       const std::string& help);
 
 // --camera and --resolution WxH, filling `options`.
 void AddSceneFlags(CLI::App* cmd, SceneOptions& options);

@@ -98,8 +98,8 @@ void WriteScene(const fs::path& dir, int64_t triangles, int meshes, int texture_
         WritePng(dir / image, texture_side, m);
         j["images"].push_back({{"uri", image}});
         j["textures"].push_back({{"source", m}});
-        j["materials"].push_back(
-            {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", m}}}, {"metallicFactor", 0}}}});
+        j["materials"].push_back({{"pbrMetallicRoughness",
+                                   {{"baseColorTexture", {{"index", m}}}, {"metallicFactor", 0}}}});
         const int mesh = b.AddMesh("grid" + std::to_string(m),
                                    {{"POSITION", b.AddFloats<3>(positions)},
                                     {"NORMAL", b.AddFloats<3>(normals)},
@@ -163,9 +163,10 @@ int main(int argc, char** argv) {
     const double geometry = heap_scene - texel_bytes;
     std::printf("load: %.2f s for %.0f triangles and %.1f M texels (%.0f MB decoded)\n",
                 load_seconds, tris, texels / 1e6, texel_bytes / 1e6);
-    std::printf("scene heap: %.1f MB: %.1f B per triangle (geometry and attributes), "
-                "%.2f B per texel\n",
-                heap_scene / 1e6, geometry / tris, texel_bytes / texels);
+    std::printf(
+        "scene heap: %.1f MB: %.1f B per triangle (geometry and attributes), "
+        "%.2f B per texel\n",
+        heap_scene / 1e6, geometry / tris, texel_bytes / texels);
 
     const double resident0 = ResidentBytes();
     start = std::chrono::steady_clock::now();
@@ -177,10 +178,11 @@ int main(int argc, char** argv) {
     }
     const double heap_embree = HeapBytes() - heap0 - heap_scene;
     const double resident_embree = ResidentBytes() - resident0;
-    std::printf("EmbreeScene build: %.2f s, heap %.1f MB (%.1f B per triangle), resident "
-                "+%.1f MB (%.1f B per triangle, with the BVH)\n",
-                build_seconds, heap_embree / 1e6, heap_embree / tris, resident_embree / 1e6,
-                resident_embree / tris);
+    std::printf(
+        "EmbreeScene build: %.2f s, heap %.1f MB (%.1f B per triangle), resident "
+        "+%.1f MB (%.1f B per triangle, with the BVH)\n",
+        build_seconds, heap_embree / 1e6, heap_embree / tris, resident_embree / 1e6,
+        resident_embree / tris);
     if (!keep) fs::remove_all(dir);
     return 0;
 }

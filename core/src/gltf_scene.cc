@@ -30,9 +30,9 @@ constexpr double kLumensPerWatt = 683;
 // (a warning); in extensionsRequired it is an error.
 const std::set<std::string>& SupportedExtensions() {
     static const std::set<std::string> kSupported = {
-        "KHR_lights_punctual",          "KHR_materials_emissive_strength",
-        "KHR_materials_ior",            "KHR_materials_transmission",
-        "KHR_materials_volume",         "KHR_materials_specular",
+        "KHR_lights_punctual",   "KHR_materials_emissive_strength",
+        "KHR_materials_ior",     "KHR_materials_transmission",
+        "KHR_materials_volume",  "KHR_materials_specular",
         "KHR_texture_transform",
     };
     return kSupported;
@@ -47,13 +47,15 @@ std::string WhatIsLost(const std::string& extension) {
         {"KHR_materials_anisotropy", "anisotropic roughness; rendered isotropic"},
         {"KHR_materials_dispersion", "dispersion; one IOR for all wavelengths"},
         {"KHR_materials_unlit", "unlit shading; the material is lit as a PBR one"},
-        {"KHR_materials_pbrSpecularGlossiness", "the specular-glossiness material; the "
-                                                "metallic-roughness fallback is used"},
+        {"KHR_materials_pbrSpecularGlossiness",
+         "the specular-glossiness material; the "
+         "metallic-roughness fallback is used"},
         {"KHR_materials_variants", "material variants; the default materials are used"},
         {"KHR_texture_basisu", "Basis Universal textures; the fallback images are used"},
         {"EXT_texture_webp", "WebP textures; the fallback images are used"},
-        {"KHR_draco_mesh_compression", "Draco-compressed geometry; the uncompressed fallback is "
-                                       "used"},
+        {"KHR_draco_mesh_compression",
+         "Draco-compressed geometry; the uncompressed fallback is "
+         "used"},
         {"EXT_meshopt_compression", "meshopt-compressed geometry; the fallback is used"},
         {"KHR_mesh_quantization", "nothing if the quantized attributes are floats"},
         {"EXT_mesh_gpu_instancing", "the instances; each mesh is rendered once"},
@@ -92,8 +94,8 @@ Matrix Multiply(const Matrix& a, const Matrix& b) {
     Matrix out{};
     for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 4; ++c) {
-            out[r][c] = a[r][0] * b[0][c] + a[r][1] * b[1][c] + a[r][2] * b[2][c] +
-                        (c == 3 ? a[r][3] : 0);
+            out[r][c] =
+                a[r][0] * b[0][c] + a[r][1] * b[1][c] + a[r][2] * b[2][c] + (c == 3 ? a[r][3] : 0);
         }
     }
     return out;
@@ -168,27 +170,43 @@ Matrix LocalTransform(const tinygltf::Node& node, const std::string& where) {
 
 const char* ComponentTypeName(int type) {
     switch (type) {
-        case TINYGLTF_COMPONENT_TYPE_BYTE: return "BYTE";
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "UNSIGNED_BYTE";
-        case TINYGLTF_COMPONENT_TYPE_SHORT: return "SHORT";
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "UNSIGNED_SHORT";
-        case TINYGLTF_COMPONENT_TYPE_INT: return "INT";
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "UNSIGNED_INT";
-        case TINYGLTF_COMPONENT_TYPE_FLOAT: return "FLOAT";
-        case TINYGLTF_COMPONENT_TYPE_DOUBLE: return "DOUBLE";
-        default: return "unknown";
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+            return "BYTE";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+            return "UNSIGNED_BYTE";
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+            return "SHORT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+            return "UNSIGNED_SHORT";
+        case TINYGLTF_COMPONENT_TYPE_INT:
+            return "INT";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+            return "UNSIGNED_INT";
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+            return "FLOAT";
+        case TINYGLTF_COMPONENT_TYPE_DOUBLE:
+            return "DOUBLE";
+        default:
+            return "unknown";
     }
 }
 
 const char* ModeName(int mode) {
     switch (mode) {
-        case TINYGLTF_MODE_POINTS: return "POINTS";
-        case TINYGLTF_MODE_LINE: return "LINES";
-        case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP";
-        case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP";
-        case TINYGLTF_MODE_TRIANGLE_STRIP: return "TRIANGLE_STRIP";
-        case TINYGLTF_MODE_TRIANGLE_FAN: return "TRIANGLE_FAN";
-        default: return "unknown";
+        case TINYGLTF_MODE_POINTS:
+            return "POINTS";
+        case TINYGLTF_MODE_LINE:
+            return "LINES";
+        case TINYGLTF_MODE_LINE_LOOP:
+            return "LINE_LOOP";
+        case TINYGLTF_MODE_LINE_STRIP:
+            return "LINE_STRIP";
+        case TINYGLTF_MODE_TRIANGLE_STRIP:
+            return "TRIANGLE_STRIP";
+        case TINYGLTF_MODE_TRIANGLE_FAN:
+            return "TRIANGLE_FAN";
+        default:
+            return "unknown";
     }
 }
 
@@ -238,8 +256,7 @@ struct AccessorData {
 class GltfImporter {
   public:
     GltfImporter(const tinygltf::Model& model, const std::string& name, const GltfImport& options,
-                 Scene& scene, std::vector<GltfCamera>& cameras,
-                 std::vector<std::string>& warnings,
+                 Scene& scene, std::vector<GltfCamera>& cameras, std::vector<std::string>& warnings,
                  const std::map<int, absl::StatusOr<std::shared_ptr<const TextureImage>>>& images,
                  const std::map<std::string, absl::Status>& read_errors)
         : model_(model),
@@ -254,8 +271,9 @@ class GltfImporter {
     void Import() {
         CheckExtensions();
         if (!model_.animations.empty()) {
-            Warn(absl::StrCat(model_.animations.size(), " animations ignored: the rest pose is "
-                                                        "rendered"));
+            Warn(absl::StrCat(model_.animations.size(),
+                              " animations ignored: the rest pose is "
+                              "rendered"));
         }
         if (!model_.skins.empty()) Warn("skins ignored: meshes are rendered unskinned");
         if (model_.scenes.empty()) Fail("scenes", "the file has no scene");
@@ -358,8 +376,8 @@ class GltfImporter {
         const size_t element = size_t(d.component_size) * size_t(d.components);
         d.stride = view.byteStride > 0 ? view.byteStride : element;
         if (d.stride < element) {
-            Fail(view_at, absl::StrCat("byteStride ", d.stride, " is below the element size ",
-                                       element));
+            Fail(view_at,
+                 absl::StrCat("byteStride ", d.stride, " is below the element size ", element));
         }
         if (d.count > 0) {
             const size_t end = a.byteOffset + d.stride * (d.count - 1) + element;
@@ -395,8 +413,12 @@ class GltfImporter {
                 float& v = out[i * size_t(components) + size_t(c)];
                 const unsigned char* p = e + c * d.component_size;
                 switch (d.component_type) {
-                    case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&v, p, 4); break;
-                    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = float(*p) / 255.0f; break;
+                    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+                        std::memcpy(&v, p, 4);
+                        break;
+                    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+                        v = float(*p) / 255.0f;
+                        break;
                     case TINYGLTF_COMPONENT_TYPE_BYTE:
                         v = std::max(float(int8_t(*p)) / 127.0f, -1.0f);
                         break;
@@ -418,8 +440,8 @@ class GltfImporter {
                                                  ", which glTF does not allow here"));
                 }
                 if (!std::isfinite(v)) {
-                    Fail(where, absl::StrCat("accessors[", index, "] element ", i, " component ",
-                                             c, " is ", v));
+                    Fail(where, absl::StrCat("accessors[", index, "] element ", i, " component ", c,
+                                             " is ", v));
                 }
             }
         }
@@ -435,14 +457,18 @@ class GltfImporter {
         for (size_t i = 0; i < d.count; ++i) {
             const unsigned char* p = d.data + i * d.stride;
             switch (d.component_type) {
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: out[i] = *p; break;
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+                    out[i] = *p;
+                    break;
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
                     uint16_t s;
                     std::memcpy(&s, p, 2);
                     out[i] = s;
                     break;
                 }
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&out[i], p, 4); break;
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+                    std::memcpy(&out[i], p, 4);
+                    break;
                 default:
                     Fail(where, absl::StrCat("accessors[", index, "] has componentType ",
                                              ComponentTypeName(d.component_type),
@@ -496,8 +522,9 @@ class GltfImporter {
                 if (normals.size() != positions.size()) Fail(at + "NORMAL", "count differs");
                 out.normals.resize(n);
                 for (size_t i = 0; i < n; ++i) {
-                    const Vec3d v = ApplyLinear(
-                        normal_matrix, Vec3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]));
+                    const Vec3d v =
+                        ApplyLinear(normal_matrix,
+                                    Vec3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]));
                     const double length = Length(v);
                     if (!(length > 0)) {
                         Fail(at + "NORMAL", absl::StrCat("normal ", i, " is zero"));
@@ -533,16 +560,16 @@ class GltfImporter {
                 for (size_t i = 0; i < n; ++i) indices[i] = uint32_t(i);
             }
             if (indices.size() % 3 != 0) {
-                Fail(where, absl::StrCat(indices.size(), " indices is not a whole number of "
-                                                         "triangles"));
+                Fail(where, absl::StrCat(indices.size(),
+                                         " indices is not a whole number of "
+                                         "triangles"));
             }
             out.triangles.resize(indices.size() / 3);
             for (size_t i = 0; i < out.triangles.size(); ++i) {
                 // A mirroring transform would turn front faces into back faces.
-                out.triangles[i] = det < 0 ? std::array{indices[3 * i], indices[3 * i + 2],
-                                                        indices[3 * i + 1]}
-                                           : std::array{indices[3 * i], indices[3 * i + 1],
-                                                        indices[3 * i + 2]};
+                out.triangles[i] =
+                    det < 0 ? std::array{indices[3 * i], indices[3 * i + 2], indices[3 * i + 1]}
+                            : std::array{indices[3 * i], indices[3 * i + 1], indices[3 * i + 2]};
             }
             if (out.triangles.empty()) {
                 Warn(absl::StrCat(where, ": no triangles, skipped"));
@@ -563,8 +590,9 @@ class GltfImporter {
         const tinygltf::Camera& camera = model_.cameras[size_t(node.camera)];
         const std::string at = absl::StrCat("cameras[", node.camera, "]", Quoted(camera.name));
         if (camera.type != "perspective") {
-            Fail(at, absl::StrCat("type \"", camera.type, "\" is not supported; lightfarm renders "
-                                                          "perspective cameras only"));
+            Fail(at, absl::StrCat("type \"", camera.type,
+                                  "\" is not supported; lightfarm renders "
+                                  "perspective cameras only"));
         }
         const tinygltf::PerspectiveCamera& p = camera.perspective;
         if (!(p.yfov > 0 && p.yfov < std::numbers::pi)) {
@@ -584,10 +612,10 @@ class GltfImporter {
         if (!(aspect >= 1e-3 && aspect <= 1e3)) {
             Fail(at, absl::StrCat("aspectRatio ", p.aspectRatio, " is not within [0.001, 1000]"));
         }
-        spec.width = aspect >= 1 ? kGltfLongerSide
-                                 : std::max(1, int(std::lround(kGltfLongerSide * aspect)));
-        spec.height = aspect >= 1 ? std::max(1, int(std::lround(kGltfLongerSide / aspect)))
-                                  : kGltfLongerSide;
+        spec.width =
+            aspect >= 1 ? kGltfLongerSide : std::max(1, int(std::lround(kGltfLongerSide * aspect)));
+        spec.height =
+            aspect >= 1 ? std::max(1, int(std::lround(kGltfLongerSide / aspect))) : kGltfLongerSide;
         cameras_.push_back(std::move(out));
     }
 
@@ -601,8 +629,8 @@ class GltfImporter {
                                   model_.lights.size(), ")"));
         }
         const tinygltf::Light& light = model_.lights[size_t(index)];
-        const std::string light_at = absl::StrCat("KHR_lights_punctual.lights[", index, "]",
-                                                  Quoted(light.name));
+        const std::string light_at =
+            absl::StrCat("KHR_lights_punctual.lights[", index, "]", Quoted(light.name));
         Rgb color(1.0f);
         if (!light.color.empty()) {
             if (light.color.size() != 3) Fail(light_at, "color needs 3 numbers");
@@ -661,8 +689,8 @@ class GltfImporter {
         return m;
     }
 
-    static double Number(const tinygltf::Value& object, const char* key, double fallback,
-                         double lo, double hi, const std::string& where) {
+    static double Number(const tinygltf::Value& object, const char* key, double fallback, double lo,
+                         double hi, const std::string& where) {
         if (!object.Has(key)) return fallback;
         const tinygltf::Value& v = object.Get(key);
         if (!v.IsNumber()) Fail(where, absl::StrCat(key, " is not a number"));
@@ -692,7 +720,8 @@ class GltfImporter {
 
     static Rgb Color(const std::vector<double>& v, const std::string& where, const char* key) {
         for (double c : v) {
-            if (!(c >= 0 && c <= 1)) Fail(where, absl::StrCat(key, " holds ", c, ", not in [0, 1]"));
+            if (!(c >= 0 && c <= 1))
+                Fail(where, absl::StrCat(key, " holds ", c, ", not in [0, 1]"));
         }
         return Rgb(float(v[0]), float(v[1]), float(v[2]));
     }
@@ -721,8 +750,7 @@ class GltfImporter {
         }
         m.metallic = float(pbr.metallicFactor);
         m.roughness = float(pbr.roughnessFactor);
-        m.base_color_texture = Texture(pbr.baseColorTexture.index,
-                                       pbr.baseColorTexture.texCoord,
+        m.base_color_texture = Texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
                                        pbr.baseColorTexture.extensions, true,
                                        where + ".pbrMetallicRoughness.baseColorTexture");
         m.metallic_roughness_texture =
@@ -734,16 +762,16 @@ class GltfImporter {
         m.normal_scale = float(g.normalTexture.scale);
         if (!std::isfinite(m.normal_scale)) Fail(where, "normalTexture.scale is not finite");
         if (g.occlusionTexture.index >= 0) {
-            Warn(absl::StrCat(where, ": occlusionTexture ignored (a path tracer computes "
-                                     "occlusion itself)"));
+            Warn(absl::StrCat(where,
+                              ": occlusionTexture ignored (a path tracer computes "
+                              "occlusion itself)"));
         }
-        m.emission_texture = Texture(g.emissiveTexture.index, g.emissiveTexture.texCoord,
-                                     g.emissiveTexture.extensions, true,
-                                     where + ".emissiveTexture");
+        m.emission_texture =
+            Texture(g.emissiveTexture.index, g.emissiveTexture.texCoord,
+                    g.emissiveTexture.extensions, true, where + ".emissiveTexture");
         if (g.emissiveFactor.size() != 3) Fail(where, "emissiveFactor needs 3 numbers");
         Rgb emission = Color(g.emissiveFactor, where, "emissiveFactor");
-        if (const tinygltf::Value* e =
-                Extension(g.extensions, "KHR_materials_emissive_strength")) {
+        if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_emissive_strength")) {
             emission = emission * float(Number(*e, "emissiveStrength", 1, 0, 1e10,
                                                where + ".KHR_materials_emissive_strength"));
         }
@@ -762,12 +790,12 @@ class GltfImporter {
         if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_volume")) {
             const std::string at = where + ".KHR_materials_volume";
             m.thickness = float(Number(*e, "thicknessFactor", 0, 0, 1e15, at));
-            m.attenuation_distance = float(Number(*e, "attenuationDistance",
-                                                  std::numeric_limits<double>::infinity(), 0,
-                                                  std::numeric_limits<double>::infinity(), at));
+            m.attenuation_distance =
+                float(Number(*e, "attenuationDistance", std::numeric_limits<double>::infinity(), 0,
+                             std::numeric_limits<double>::infinity(), at));
             if (!(m.attenuation_distance > 0)) Fail(at, "attenuationDistance must be above 0");
-            m.attenuation_color = Color(Numbers(*e, "attenuationColor", {1, 1, 1}, at), at,
-                                        "attenuationColor");
+            m.attenuation_color =
+                Color(Numbers(*e, "attenuationColor", {1, 1, 1}, at), at, "attenuationColor");
             if (e->Has("thicknessTexture")) {
                 Warn(at + ": thicknessTexture ignored; only whether thickness is 0 matters");
             }
@@ -841,10 +869,14 @@ class GltfImporter {
 
     static TextureRef::Wrap Wrap(int mode, const std::string& where) {
         switch (mode) {
-            case TINYGLTF_TEXTURE_WRAP_REPEAT: return TextureRef::Wrap::kRepeat;
-            case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureRef::Wrap::kClampToEdge;
-            case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureRef::Wrap::kMirroredRepeat;
-            default: Fail(where, absl::StrCat("sampler wrap mode ", mode, " is unknown"));
+            case TINYGLTF_TEXTURE_WRAP_REPEAT:
+                return TextureRef::Wrap::kRepeat;
+            case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+                return TextureRef::Wrap::kClampToEdge;
+            case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+                return TextureRef::Wrap::kMirroredRepeat;
+            default:
+                Fail(where, absl::StrCat("sampler wrap mode ", mode, " is unknown"));
         }
     }
 
@@ -925,7 +957,8 @@ bool DecodeImage(tinygltf::Image* image, const int index, std::string*, std::str
                                  ? absl::StrCat(context->name, "#image", index)
                                  : image->uri;
     context->images.emplace(
-        index, DecodeTexture(std::string(reinterpret_cast<const char*>(bytes), size_t(size)), name));
+        index,
+        DecodeTexture(std::string(reinterpret_cast<const char*>(bytes), size_t(size)), name));
     return true;
 }
 

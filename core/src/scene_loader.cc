@@ -371,8 +371,8 @@ class SceneParser {
   private:
     Scene Finish(Scene& scene) {
         if (options_.width > 0 || options_.height > 0) {
-            if (!(options_.width >= 1 && options_.width <= kMaxResolution &&
-                  options_.height >= 1 && options_.height <= kMaxResolution &&
+            if (!(options_.width >= 1 && options_.width <= kMaxResolution && options_.height >= 1 &&
+                  options_.height <= kMaxResolution &&
                   int64_t(options_.width) * options_.height <= kMaxPixels)) {
                 throw LoadError{absl::InvalidArgumentError(absl::StrCat(
                     "resolution ", options_.width, "x", options_.height, ": expected 1 to ",
@@ -416,17 +416,16 @@ class SceneParser {
         };
         const size_t first_mesh = scene.meshes.size();
         std::vector<std::string> warnings;
-        const absl::Status status =
-            AppendGltf(bytes, name, hashing_reader, {base_dir, transform.m}, scene, gltf_cameras_,
-                       warnings);
+        const absl::Status status = AppendGltf(bytes, name, hashing_reader, {base_dir, transform.m},
+                                               scene, gltf_cameras_, warnings);
         for (const std::string& w : warnings) warnings_.push_back(absl::StrCat(name, ": ", w));
         if (!status.ok()) fail(status);
         for (size_t i = first_mesh; i < scene.meshes.size(); ++i) {
             dropped_degenerate_ += DropDegenerate(scene.meshes[i]);
             for (const Vec3d& p : scene.meshes[i].positions) {
                 if (MaxComponent(Abs(p)) > kMaxCoordinate) {
-                    fail(absl::InvalidArgumentError(absl::StrCat(
-                        "mesh \"", scene.meshes[i].name, "\" has a vertex beyond ±1e15")));
+                    fail(absl::InvalidArgumentError(absl::StrCat("mesh \"", scene.meshes[i].name,
+                                                                 "\" has a vertex beyond ±1e15")));
                 }
             }
         }

@@ -903,7 +903,8 @@ GltfFiles WriteGltfScene(const fs::path& dir) {
     std::ofstream(dir / "scene.glb", std::ios::binary) << glb;
     std::ofstream(dir / "tex.png", std::ios::binary) << png;
     std::ofstream(dir / "unrelated.png", std::ios::binary) << png + "x";
-    return {(dir / "scene.gltf").string(), (dir / "scene.glb").string(),
+    return {(dir / "scene.gltf").string(),
+            (dir / "scene.glb").string(),
             {Sha256Hex(gltf), Sha256Hex(b.bin()), Sha256Hex(png)}};
 }
 

@@ -83,9 +83,9 @@ TEST_F(GltfRender, RendersTheSamePixelsAsTheEquivalentJsonScene) {
 
 TEST_F(GltfRender, RenderCommandTakesGltfCameraAndResolution) {
     const std::string exr = (dir_ / "out.exr").string();
-    const auto [status, out] = Lightfarm("render " + (dir_ / "scene.gltf").string() + " -o " +
-                                         exr + " --spp 2 --camera Front --resolution 40x20 "
-                                               "--no-progress");
+    const auto [status, out] = Lightfarm("render " + (dir_ / "scene.gltf").string() + " -o " + exr +
+                                         " --spp 2 --camera Front --resolution 40x20 "
+                                         "--no-progress");
     ASSERT_EQ(status, 0) << out;
     absl::StatusOr<ExrFile> file = ReadExr(exr);
     ASSERT_TRUE(file.ok()) << file.status();

@@ -41,8 +41,7 @@ class GltfBuilder {
     template <size_t N>
     int AddFloats(const std::vector<std::array<float, N>>& values) {
         static constexpr const char* kTypes[] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
-        return AddAccessor(values.data(), values.size() * N * 4, kFloat, kTypes[N],
-                           values.size());
+        return AddAccessor(values.data(), values.size() * N * 4, kFloat, kTypes[N], values.size());
     }
     int AddIndices(const std::vector<uint32_t>& indices) {
         return AddAccessor(indices.data(), indices.size() * 4, kUnsignedInt, "SCALAR",
@@ -114,8 +113,7 @@ inline std::vector<uint8_t> TestTexels() {
 inline GltfBuilder TexturedTestScene() {
     GltfBuilder b;
     nlohmann::json& j = b.json();
-    const int quad_positions =
-        b.AddFloats<3>({{{0, 0, 0}}, {{1, 0, 0}}, {{1, 1, 0}}, {{0, 1, 0}}});
+    const int quad_positions = b.AddFloats<3>({{{0, 0, 0}}, {{1, 0, 0}}, {{1, 1, 0}}, {{0, 1, 0}}});
     const int quad_normals = b.AddFloats<3>({{{0, 0, 1}}, {{0, 0, 1}}, {{0, 0, 1}}, {{0, 0, 1}}});
     const int quad_uvs = b.AddFloats<2>({{{0, 1}}, {{1, 1}}, {{1, 0}}, {{0, 0}}});
     const int quad_indices = b.AddIndices({0, 1, 2, 0, 2, 3});
@@ -133,19 +131,16 @@ inline GltfBuilder TexturedTestScene() {
         {{"name", "red"},
          {"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.1, 0.1, 1}}, {"metallicFactor", 0}}},
          {"doubleSided", true}}};
-    const int quad = b.AddMesh("quad",
-                               {{"POSITION", quad_positions},
-                                {"NORMAL", quad_normals},
-                                {"TEXCOORD_0", quad_uvs}},
-                               quad_indices, 0);
+    const int quad = b.AddMesh(
+        "quad", {{"POSITION", quad_positions}, {"NORMAL", quad_normals}, {"TEXCOORD_0", quad_uvs}},
+        quad_indices, 0);
     const int tri = b.AddMesh("tri", {{"POSITION", tri_positions}}, -1, 1);
     const double s = std::sqrt(0.5);  // a quarter turn about +y
-    const int quad_node =
-        b.AddNode({{"name", "Quad"}, {"mesh", quad}, {"rotation", {0, s, 0, s}}});
-    const int tri_node = b.AddNode(
-        {{"name", "Mirror"},
-         {"mesh", tri},
-         {"matrix", {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -3, 1}}});
+    const int quad_node = b.AddNode({{"name", "Quad"}, {"mesh", quad}, {"rotation", {0, s, 0, s}}});
+    const int tri_node =
+        b.AddNode({{"name", "Mirror"},
+                   {"mesh", tri},
+                   {"matrix", {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -3, 1}}});
     const int root = b.AddNode({{"name", "Root"},
                                 {"translation", {1, 0, 0}},
                                 {"scale", {2, 2, 2}},

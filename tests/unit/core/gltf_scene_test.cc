@@ -1,8 +1,6 @@
 #include "lf/core/gltf_scene.h"
 
 #include <gtest/gtest.h>
-#include <spdlog/sinks/ostream_sink.h>
-#include <spdlog/spdlog.h>
 
 #include <cmath>
 #include <filesystem>
@@ -15,6 +13,7 @@
 #include "image_files.h"
 #include "lf/core/scene_loader.h"
 #include "lf/core/texture.h"
+#include "scene_log.h"
 #include "test_dir.h"
 
 namespace lf {
@@ -23,17 +22,7 @@ namespace {
 using testing::GltfBuilder;
 using Json = nlohmann::json;
 
-// Routes the "scene" logger into a string the tests can search.
-std::ostringstream& CapturedLog() {
-    static std::ostringstream* const log = [] {
-        auto* stream = new std::ostringstream;
-        spdlog::drop("scene");
-        spdlog::register_logger(std::make_shared<spdlog::logger>(
-            "scene", std::make_shared<spdlog::sinks::ostream_sink_mt>(*stream)));
-        return stream;
-    }();
-    return *log;
-}
+std::ostringstream& CapturedLog() { return testing::CapturedSceneLog(); }
 
 void ExpectNear(const Vec3d& a, const Vec3d& b, double tolerance = 1e-12) {
     EXPECT_NEAR(a.x, b.x, tolerance);
@@ -78,8 +67,7 @@ class GltfSceneTest : public ::testing::Test {
     }
 
     // The load's error message, which the test expects to contain every one of `parts`.
-    void ExpectError(const absl::StatusOr<Scene>& scene,
-                     std::initializer_list<std::string> parts) {
+    void ExpectError(const absl::StatusOr<Scene>& scene, std::initializer_list<std::string> parts) {
         ASSERT_FALSE(scene.ok());
         for (const std::string& part : parts) {
             EXPECT_NE(scene.status().message().find(part), std::string::npos)
@@ -155,8 +143,8 @@ TEST_F(GltfSceneTest, NormalsUseTheInverseTransposeAndMirrorsKeepFrontFaces) {
     // A 45-degree slope in xz, squashed 4x along x: its normal must tilt toward x, not z.
     const int p = b.AddFloats<3>({{{0, 0, 0}}, {{1, 0, -1}}, {{0, 1, 0}}});
     const double r = std::sqrt(0.5);
-    const int n = b.AddFloats<3>({{{float(r), 0, float(r)}}, {{float(r), 0, float(r)}},
-                                  {{float(r), 0, float(r)}}});
+    const int n = b.AddFloats<3>(
+        {{{float(r), 0, float(r)}}, {{float(r), 0, float(r)}}, {{float(r), 0, float(r)}}});
     const int slope = b.AddMesh("slope", {{"POSITION", p}, {"NORMAL", n}}, -1, -1);
     b.AddNode({{"mesh", slope}, {"scale", {0.25, 1, -1}}});
     b.AddNode({{"camera", 0}});
@@ -298,8 +286,8 @@ TEST_F(GltfSceneTest, SpotAndDirectionalLightsPointDownTheirNodesMinusZ) {
     const int spot = b.AddNode({{"translation", {0, 3, 0}},
                                 {"rotation", {-s, 0, 0, s}},
                                 {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
-    const int sun = b.AddNode({{"rotation", {-s, 0, 0, s}},
-                               {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
+    const int sun = b.AddNode(
+        {{"rotation", {-s, 0, 0, s}}, {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
     j["scenes"][0]["nodes"].push_back(spot);
     j["scenes"][0]["nodes"].push_back(sun);
     const absl::StatusOr<Scene> scene = Load(b);
@@ -383,16 +371,16 @@ TEST_F(GltfSceneTest, JsonSceneIncludesAGltfWithItsCameraOrItsOwn) {
         ParseScene(with_camera, "scene.json", ReadBeside(dir_.string()));
     ASSERT_TRUE(own.ok()) << own.status();
     EXPECT_EQ(own->camera.width, 64);
-    const absl::StatusOr<Scene> named = ParseScene(with_camera, "scene.json",
-                                                   ReadBeside(dir_.string()), {.camera = "Front"});
+    const absl::StatusOr<Scene> named =
+        ParseScene(with_camera, "scene.json", ReadBeside(dir_.string()), {.camera = "Front"});
     ASSERT_TRUE(named.ok()) << named.status();
     ExpectNear(named->camera.position, {3, 11, 6});
     // Neither a JSON camera nor a glTF one.
     GltfBuilder no_camera = b;
     no_camera.json()["scenes"][0]["nodes"] = {2, 4};
     Write("models/car.gltf", no_camera.Gltf("car.bin"));
-    const absl::StatusOr<Scene> none = ParseScene(
-        R"({"materials": {}, "shapes": [)" + shape + "]}", "scene.json", ReadBeside(dir_.string()));
+    const absl::StatusOr<Scene> none = ParseScene(R"({"materials": {}, "shapes": [)" + shape + "]}",
+                                                  "scene.json", ReadBeside(dir_.string()));
     ExpectError(none, {"scene.json", "camera", "no included glTF has a camera"});
 }
 
@@ -416,7 +404,8 @@ TEST_F(GltfSceneTest, TruncatedGlbIsRefused) {
 TEST_F(GltfSceneTest, MissingBufferOrTextureFileIsNamed) {
     GltfBuilder b = testing::TexturedTestScene();
     Write("scene.gltf", b.Gltf("gone.bin"));
-    ExpectError(LoadScene((dir_ / "scene.gltf").string()), {"scene.gltf", "buffer uri \"gone.bin\""});
+    ExpectError(LoadScene((dir_ / "scene.gltf").string()),
+                {"scene.gltf", "buffer uri \"gone.bin\""});
     b.json()["images"][0]["uri"] = "missing.png";
     ExpectError(Load(b), {"scene.gltf", "images[0] \"checker\"", "missing.png"});
 }
@@ -481,9 +470,9 @@ TEST_F(GltfSceneTest, RequiredUnsupportedExtensionsOrthographicAndMissingCameras
                           "does not support KHR_draco_mesh_compression, EXT_meshopt_compression"});
 
     GltfBuilder ortho = testing::TexturedTestScene();
-    ortho.json()["cameras"][0] = {{"type", "orthographic"},
-                                  {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0},
-                                                    {"zfar", 10}}}};
+    ortho.json()["cameras"][0] = {
+        {"type", "orthographic"},
+        {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0}, {"zfar", 10}}}};
     ExpectError(Load(ortho), {"cameras[0]", "orthographic", "perspective cameras only"});
 
     GltfBuilder none = testing::TexturedTestScene();

@@ -11,9 +11,9 @@
 #include <fstream>
 #include <map>
 
-#include "lf/core/scene_loader.h"
 #include "gltf_files.h"
 #include "image_files.h"
+#include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
 #include "test_dir.h"
 
@@ -147,7 +147,9 @@ TEST_F(SceneFilesTest, GltfAndGlbBlobsLoadAsRenderLoadsThem) {
     const absl::StatusOr<Scene> local = LoadScene((dir_ / "scenes" / "s.gltf").string(), options);
     ASSERT_TRUE(local.ok()) << local.status();
     const std::vector<BlobRef> files = {Put("s.bin", b.bin()), Put("tex.png", png)};
-    const auto blob_file = [&](const std::string& hash) { return (dir_ / "blobs" / hash).string(); };
+    const auto blob_file = [&](const std::string& hash) {
+        return (dir_ / "blobs" / hash).string();
+    };
     const absl::StatusOr<Scene> farm =
         LoadSceneFromBlobs(Put("s.gltf", b.Gltf("s.bin")), files, blob_file, nullptr, options);
     ASSERT_TRUE(farm.ok()) << farm.status();
@@ -170,9 +172,8 @@ TEST_F(SceneFilesTest, GltfAndGlbBlobsLoadAsRenderLoadsThem) {
               std::string::npos)
         << bad_farm.status();
     // Only what was uploaded: the image, named as the glTF names it, is not here.
-    const absl::StatusOr<Scene> no_image =
-        LoadSceneFromBlobs(Put("s.glb", testing::TexturedTestScene().Glb()),
-                           {Put("s.bin", b.bin())}, blob_file);
+    const absl::StatusOr<Scene> no_image = LoadSceneFromBlobs(
+        Put("s.glb", testing::TexturedTestScene().Glb()), {Put("s.bin", b.bin())}, blob_file);
     ASSERT_FALSE(no_image.ok());
     EXPECT_NE(no_image.status().message().find("uri \"tex.png\": not among the files uploaded"),
               std::string::npos)

@@ -24,7 +24,7 @@ struct JobSpec {
     std::vector<BlobRef> files;  // the files it names
     // --camera and --resolution: the view of the scene this job renders (the loader checks them)
     SceneOptions scene_options;
-    RenderPlanSettings plan;     // width and height come from the scene and scene_options
+    RenderPlanSettings plan;  // width and height come from the scene and scene_options
     uint64_t seed = defaults::kSeed;
     int max_depth = defaults::kMaxDepth;
     std::string method = defaults::kMethod;  // or "radiosity"
