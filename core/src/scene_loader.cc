@@ -327,8 +327,9 @@ class SceneParser {
             if (version->Number() != 1) version->Fail("unsupported; this build reads version 1");
         }
         Scene scene;
-        // Optional when an included glTF brings a camera (ResolveCamera).
-        const std::optional<Node> camera = root.Find("camera");
+        // Optional when an included glTF may bring a camera (ResolveCamera).
+        const std::optional<Node> camera =
+            IncludesGltf(root) ? root.Find("camera") : std::optional(root.Get("camera"));
         if (camera) scene.camera = ParseCamera(*camera);
 
         const Node materials = root.Get("materials");
@@ -382,11 +383,18 @@ class SceneParser {
             scene.camera.height = options_.height;
         }
         if (!scene.HasLights()) {
-            warnings_.push_back("no emissive shape and no light: the image will be black");
+            warnings_.push_back("no emissive shape and no point light: the image will be black");
         }
         scene.dropped_degenerate = dropped_degenerate_;
         scene.content_hash = hash_.Hex();
         return std::move(scene);
+    }
+
+    static bool IncludesGltf(const Node& root) {
+        const Json& shapes = root.json().contains("shapes") ? root.json()["shapes"] : Json();
+        return shapes.is_array() && std::any_of(shapes.begin(), shapes.end(), [](const Json& s) {
+                   return s.is_object() && s.value("type", Json()) == "gltf";
+               });
     }
 
     // The JSON's camera unless --camera names a glTF one; the first glTF camera without either.
