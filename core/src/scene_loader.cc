@@ -403,6 +403,11 @@ class SceneParser {
         if (!json_camera && gltf_cameras_.empty()) {
             root.Fail("missing required key \"camera\" (no included glTF has a camera)");
         }
+        if (gltf_cameras_.empty()) {
+            root.Fail(absl::StrCat("--camera \"", options_.camera,
+                                   "\": the scene has no named cameras (only glTF cameras have "
+                                   "names)"));
+        }
         absl::StatusOr<CameraSpec> camera = ChooseGltfCamera(gltf_cameras_, options_.camera);
         if (!camera.ok()) {
             throw LoadError{absl::Status(camera.status().code(),

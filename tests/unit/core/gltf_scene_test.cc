@@ -382,6 +382,12 @@ TEST_F(GltfSceneTest, JsonSceneIncludesAGltfWithItsCameraOrItsOwn) {
     const absl::StatusOr<Scene> none = ParseScene(R"({"materials": {}, "shapes": [)" + shape + "]}",
                                                   "scene.json", ReadBeside(dir_.string()));
     ExpectError(none, {"scene.json", "camera", "no included glTF has a camera"});
+    const absl::StatusOr<Scene> unnamed =
+        ParseScene(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov_y_deg": 30,
+                       "resolution": [64, 48]}, "materials": {}, "shapes": [)" +
+                       shape + "]}",
+                   "scene.json", ReadBeside(dir_.string()), {.camera = "Front"});
+    ExpectError(unnamed, {"scene.json", "--camera \"Front\": the scene has no named cameras"});
 }
 
 // Bad input: each refused with the file, the glTF object and what is wrong, nothing crashed.
