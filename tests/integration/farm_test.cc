@@ -919,6 +919,16 @@ TEST_F(Farm, TexturedGltfSceneGivesTheLocalPixels) {
     // Another seed: ExpectSameAsLocal keeps local renders by spp, seed and flags.
     const std::string glb_job = Submit(files.glb, "--spp 8 --seed 6 --tile 16 " + flags);
     ExpectSameAsLocal(glb_job, files.glb, 8, 6, flags);
+    // A JSON scene in another folder including the glTF by a relative name: its buffer and
+    // image are uploaded by the names the loader asked for ("../gltf/scene.bin").
+    fs::create_directories(dir_ / "json");
+    std::ofstream(dir_ / "json" / "lit.json")
+        << R"({"materials": {}, "shapes": [{"type": "gltf", "file": "../gltf/scene.gltf",)"
+           R"( "transform": {"translate": [0, 0.5, 0]}}], "lights": [{"type": "point",)"
+           R"( "position": [2, 3, 3], "intensity": [5, 5, 5]}]})";
+    const std::string json = (dir_ / "json" / "lit.json").string();
+    const std::string json_job = Submit(json, "--spp 8 --seed 7 --tile 16 " + flags);
+    ExpectSameAsLocal(json_job, json, 8, 7, flags);
     // Uploaded: the files the loader read (the glTF, its buffer, its image), not what else
     // lies in the folder.
     std::set<std::string> blobs;
