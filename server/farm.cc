@@ -143,7 +143,8 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
             " (lightfarm-server --max-spp); lower --max-spp"));
     }
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
-        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); });
+        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); },
+        nullptr, spec.scene_options);
     // The service logs the refusal with its caller.
     if (!scene.ok()) return absl::InvalidArgumentError(scene.status().message());
     if (spec.method == "radiosity") {
