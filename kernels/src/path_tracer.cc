@@ -15,11 +15,12 @@ float PowerHeuristic(float pdf_a, float pdf_b) {
     return a + b > 0 ? a / (a + b) : 0;
 }
 
-// The interior a path is in after leaving a surface of material `index` in direction wi
-// (wo the direction it arrived from, both against the geometric normal ng): a crossing of a
-// solid transmitter's surface enters it (against ng) or leaves it (along ng).
-int MediumAfter(int medium, int index, const Material& material, float cos_o_ng, float cos_i_ng) {
-    if (cos_o_ng * cos_i_ng > 0 || !HasInterior(material)) return medium;
+// The interior a path is in after leaving a surface of material `index` in direction wi:
+// a transmission through a solid transmitter's surface enters it (against the geometric
+// normal) or leaves it (along it).
+int MediumAfter(int medium, int index, const Material& material, float cos_i_ng,
+                bool transmitted) {
+    if (!transmitted || !HasInterior(material)) return medium;
     return cos_i_ng < 0 ? index : -1;
 }
 
@@ -53,7 +54,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         const Material& material = materials[size_t(hit->material)];
         const Vec3& ng = hit->n;
         const float cos_o_ng = -Dot(ray.d, ng);
-        const Shading sh = Shade(scene_, *hit);
+        const Shading sh = Shade(scene_, *hit, -ray.d);
 
         if (cos_o_ng > 0 && !sh.emission.IsBlack()) {
             if (delta_bounce) {
@@ -71,12 +72,18 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
 
         // The BSDF lives in the shading frame; the geometric normal decides sides. A direction
         // the two put on different sides of the surface (reflection for one, transmission for
-        // the other) carries nothing: that is where shading normals would leak light.
+        // the other) carries nothing: that is where shading normals would leak light. The one
+        // exception is reflection just below a smooth mesh's facet near the terminator, which
+        // the smooth surface still reflects: allowed when the ray from Hanika's lifted point
+        // misses its own triangle (other geometry is the ray's business).
         const Frame frame = Frame::FromNormal(sh.ns);
         const Vec3 wo = frame.ToLocal(-ray.d);
         const auto consistent = [&](const Vec3& wi_world, const Vec3& wi) {
             const float cos_i_ng = Dot(wi_world, ng);
-            return cos_i_ng != 0 && (cos_i_ng * cos_o_ng > 0) == (wi.z * wo.z > 0);
+            if (cos_i_ng == 0) return false;
+            const bool reflect = wi.z * wo.z > 0;
+            if ((cos_i_ng * cos_o_ng > 0) == reflect) return true;
+            return reflect && cos_o_ng > 0 && sh.ClearsFacet(wi_world);
         };
         const Bsdf bsdf(material, sh.params);
 
@@ -93,8 +100,8 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
                         const float w =
                             ls->delta ? 1.0f : PowerHeuristic(ls->pdf, bsdf.Pdf(wo, wi));
                         Rgb contribution = beta * f * radiance * (w / ls->pdf);
-                        const int through = MediumAfter(medium, hit->material, material, cos_o_ng,
-                                                        Dot(ls->wi, ng));
+                        const int through = MediumAfter(medium, hit->material, material,
+                                                        Dot(ls->wi, ng), wi.z * wo.z < 0);
                         if (through >= 0) {
                             contribution *= Transmittance(materials[size_t(through)],
                                                           Length(ls->point.p - hit->p));
@@ -113,9 +120,10 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         if (!consistent(wi, bs->wi)) break;
         beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
         if (beta.IsBlack()) break;
-        const float cos_i_ng = Dot(wi, ng);
-        const int next_medium = MediumAfter(medium, hit->material, material, cos_o_ng, cos_i_ng);
-        if (cos_i_ng * cos_o_ng < 0 && HasInterior(material)) {
+        const bool transmitted = bs->wi.z * wo.z < 0;
+        const int next_medium =
+            MediumAfter(medium, hit->material, material, Dot(wi, ng), transmitted);
+        if (transmitted && HasInterior(material)) {
             // Radiance is scaled by 1/eta^2 across the interface; roulette must not see that.
             const float eta = cos_o_ng > 0 ? material.ior : 1 / material.ior;
             eta_scale *= eta * eta;

@@ -13,6 +13,7 @@ namespace lf {
 struct Shading {
     SurfacePoint point;  // the hit: p, its error bound, the geometric normal n
     // Unit shading normal on the geometric normal's side; equals point.n on flat geometry.
+    // Bent, where needed, so that wo is on the same side of it as of the geometric normal.
     Vec3 ns;
     Vec2 uv;
     SurfaceParams params;
@@ -21,11 +22,20 @@ struct Shading {
     // vertex normals describe; where rays leaving on the normals' side start.
     Vec3 p_outer;
 
-    // Where a ray leaving in direction w starts from: p_outer on the outer side, else the hit.
+    // The triangle's vertices (render space) on smooth meshes, for ClearsFacet.
+    Vec3 v[3];
+
+    // Where a ray leaving in direction w starts from: p_outer for reflection the shading normal
+    // allows just below the facet (see ClearsFacet), else the hit.
     SurfacePoint Leaving(const Vec3& w) const;
+    // For w just below the facet's plane on the front (cos with n < 0) near a smooth mesh's
+    // terminator, where the shading normal says it is still above the surface: true when the
+    // ray from p_outer passes outside this triangle, so it does not go through the surface.
+    bool ClearsFacet(const Vec3& w) const;
 };
 
-Shading Shade(const EmbreeScene& scene, const SurfaceHit& hit);
+// The interaction at `hit` seen from direction wo (unit, away from the surface).
+Shading Shade(const EmbreeScene& scene, const SurfaceHit& hit, const Vec3& wo);
 
 // The radiance a light sample on an emitter carries: `radiance` (the material's emission
 // factor, as LightSampler gives it) times the emission texture at the sample; black in an
