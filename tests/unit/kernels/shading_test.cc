@@ -341,5 +341,29 @@ TEST(SmoothShading, NoBlackTerminator) {
     });
 }
 
+// No light leaks: a flat quad (normal +y) whose vertex normals lean 45 degrees towards +x,
+// under a point light below its plane that the leaning normals would still call lit. The
+// quad is open, so only the renderer's side rule keeps that light out: every pixel is black.
+TEST(SmoothShading, NoLightLeaksFromBelowTheSurface) {
+    Scene scene;
+    scene.materials.push_back(Material{});
+    TriangleMesh quad;
+    const double s = 50;
+    quad.positions = {{-s, 0, -s}, {-s, 0, s}, {s, 0, s}, {s, 0, -s}};
+    quad.normals.assign(4, Normalize(Vec3(1, 1, 0)));
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(quad);
+    scene.point_lights.push_back({{3, -1, 0}, Rgb(100)});
+    scene.camera.position = {0, 3, 0};
+    scene.camera.look_at = {0, 0, 0};
+    scene.camera.up = {0, 0, 1};
+    scene.camera.fov_y_deg = 60;
+    scene.camera.width = scene.camera.height = 8;
+    const RenderOutput out = testing::RenderPath(scene, 16).out;
+    for (int y = 0; y < 8; ++y) {
+        for (int x = 0; x < 8; ++x) EXPECT_EQ(out.image.Pixel(x, y), Rgb(0)) << x << "," << y;
+    }
+}
+
 }  // namespace
 }  // namespace lf
