@@ -341,23 +341,24 @@ TEST(SmoothShading, NoBlackTerminator) {
     });
 }
 
-// No light leaks: a flat quad (normal +y) whose vertex normals lean 45 degrees towards +x,
-// under a point light below its plane that the leaning normals would still call lit. The
-// quad is open, so only the renderer's side rule keeps that light out: every pixel is black.
+// No light leaks: a flat quad (normal +y) whose vertex normals lean 45 degrees towards its
+// centre line x = 0 (a bowl, so Hanika's point is the hit itself), under a point light below
+// its plane that the leaning normals near x = -1 still call lit. The quad is open, so only the
+// renderer's side rule keeps that light out: every pixel is black.
 TEST(SmoothShading, NoLightLeaksFromBelowTheSurface) {
     Scene scene;
     scene.materials.push_back(Material{});
     TriangleMesh quad;
-    const double s = 50;
-    quad.positions = {{-s, 0, -s}, {-s, 0, s}, {s, 0, s}, {s, 0, -s}};
-    quad.normals.assign(4, Normalize(Vec3(1, 1, 0)));
+    quad.positions = {{-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}};
+    const Vec3 lean_right = Normalize(Vec3(1, 1, 0)), lean_left = Normalize(Vec3(-1, 1, 0));
+    quad.normals = {lean_right, lean_right, lean_left, lean_left};
     quad.triangles = {{0, 1, 2}, {0, 2, 3}};
     scene.meshes.push_back(quad);
-    scene.point_lights.push_back({{3, -1, 0}, Rgb(100)});
-    scene.camera.position = {0, 3, 0};
-    scene.camera.look_at = {0, 0, 0};
+    scene.point_lights.push_back({{5, -1, 0}, Rgb(100)});
+    scene.camera.position = {-0.75, 2, 0};
+    scene.camera.look_at = {-0.75, 0, 0};
     scene.camera.up = {0, 0, 1};
-    scene.camera.fov_y_deg = 60;
+    scene.camera.fov_y_deg = 20;
     scene.camera.width = scene.camera.height = 8;
     const RenderOutput out = testing::RenderPath(scene, 16).out;
     for (int y = 0; y < 8; ++y) {
