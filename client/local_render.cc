@@ -13,6 +13,7 @@
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
+#include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
@@ -52,6 +53,11 @@ absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& 
     for (const Material& m : scene.materials) {
         if (m.type != Material::Type::kLambert) {
             *why = absl::StrCat("material \"", m.name, "\" is ", MaterialTypeName(m.type),
+                                ", which radiosity cannot model");
+            return std::string("path");
+        }
+        if (const char* what = RadiosityLacks(m)) {
+            *why = absl::StrCat("material \"", m.name, "\" has ", what,
                                 ", which radiosity cannot model");
             return std::string("path");
         }
