@@ -191,8 +191,8 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
         }
         if (const char* what = RadiosityLacks(material)) {
             return absl::InvalidArgumentError(absl::StrCat(
-                "radiosity: mesh '", mesh.name, "' uses material '", material.name, "' with ",
-                what, ", which radiosity does not model; render it with --method path"));
+                "radiosity: mesh '", mesh.name, "' uses material '", material.name, "' with ", what,
+                ", which radiosity does not model; render it with --method path"));
         }
     }
     if (!(options.patch_size >= 0) || (options.patch_size == 0 && options.patches <= 0)) {

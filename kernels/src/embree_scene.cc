@@ -29,7 +29,7 @@ struct EmbreeScene::Handles {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<float> sphere_buffer;  // x,y,z,r per sphere
-    std::vector<MeshFilter> filters;  // per mesh that needs a filter function
+    std::vector<MeshFilter> filters;   // per mesh that needs a filter function
 };
 
 namespace {
@@ -67,9 +67,9 @@ absl::Status CheckTextures(const Scene& scene, const Material& m) {
                                   &m.normal_texture, &m.emission_texture}) {
         if (!ref->valid()) continue;
         if (size_t(ref->image) >= scene.textures.size() || !scene.textures[size_t(ref->image)]) {
-            return absl::InvalidArgumentError(
-                absl::StrCat(scene.source, ": material '", m.name, "' uses texture ", ref->image,
-                             " of ", scene.textures.size()));
+            return absl::InvalidArgumentError(absl::StrCat(scene.source, ": material '", m.name,
+                                                           "' uses texture ", ref->image, " of ",
+                                                           scene.textures.size()));
         }
     }
     return absl::OkStatus();

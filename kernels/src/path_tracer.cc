@@ -18,8 +18,7 @@ float PowerHeuristic(float pdf_a, float pdf_b) {
 // The interior a path is in after leaving a surface of material `index` in direction wi:
 // a transmission through a solid transmitter's surface enters it (against the geometric
 // normal) or leaves it (along it).
-int MediumAfter(int medium, int index, const Material& material, float cos_i_ng,
-                bool transmitted) {
+int MediumAfter(int medium, int index, const Material& material, float cos_i_ng, bool transmitted) {
     if (!transmitted || !HasInterior(material)) return medium;
     return cos_i_ng < 0 ? index : -1;
 }
@@ -93,7 +92,8 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
             if (const auto ls = lights_.Sample(hit->p, u_pick, u_light)) {
                 const Vec3 wi = frame.ToLocal(ls->wi);
                 const Rgb f = consistent(ls->wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
-                const Rgb radiance = f.IsBlack() ? Rgb() : EmissionAt(scene_, ls->point, ls->radiance);
+                const Rgb radiance =
+                    f.IsBlack() ? Rgb() : EmissionAt(scene_, ls->point, ls->radiance);
                 if (!radiance.IsBlack()) {
                     ++stats.rays;
                     if (!scene_.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) {

@@ -59,8 +59,8 @@ bool TangentAt(const EmbreeScene& es, const TriangleMesh& mesh, const SurfaceHit
 
 // The normal map's normal at the hit, or `n` where the map cannot apply (no uvs or tangent,
 // or a texel that points below the geometric surface).
-Vec3 NormalMapped(const EmbreeScene& es, const Material& m, const SurfaceHit& hit,
-                  const Vec2& uv, const Vec3& n) {
+Vec3 NormalMapped(const EmbreeScene& es, const Material& m, const SurfaceHit& hit, const Vec2& uv,
+                  const Vec3& n) {
     if (hit.mesh < 0) return n;
     const TriangleMesh& mesh = es.scene().meshes[size_t(hit.mesh)];
     if (mesh.uvs.empty()) return n;

@@ -123,13 +123,12 @@ TEST_P(SingleSided, BackFacesAreSkippedUnlessTheMaterialTransmits) {
     EXPECT_EQ((*es)->Occluded(Ray{back.o, back.d, 4}), c.hit_from_behind);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Materials, SingleSided,
-    ::testing::Values(SidedCase{true, Material::Type::kLambert, 0, true},
-                      SidedCase{false, Material::Type::kLambert, 0, false},
-                      SidedCase{false, Material::Type::kPrincipled, 0, false},
-                      SidedCase{false, Material::Type::kPrincipled, 1, true},
-                      SidedCase{false, Material::Type::kDielectric, 0, true}));
+INSTANTIATE_TEST_SUITE_P(Materials, SingleSided,
+                         ::testing::Values(SidedCase{true, Material::Type::kLambert, 0, true},
+                                           SidedCase{false, Material::Type::kLambert, 0, false},
+                                           SidedCase{false, Material::Type::kPrincipled, 0, false},
+                                           SidedCase{false, Material::Type::kPrincipled, 1, true},
+                                           SidedCase{false, Material::Type::kDielectric, 0, true}));
 
 // Attribute arrays of the wrong length and textures that do not exist are refused, not read.
 TEST(EmbreeSceneInput, BadAttributesAndTextureRefsAreRefused) {

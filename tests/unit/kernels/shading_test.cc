@@ -234,7 +234,8 @@ TriangleMesh SphereMesh(int segments, int rings, double radius, bool smooth) {
         for (int i = 0; i < segments; ++i) {
             // Counter-clockwise seen from outside: front faces point out.
             if (j > 0) m.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j)});
-            if (j < rings - 1) m.triangles.push_back({at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)});
+            if (j < rings - 1)
+                m.triangles.push_back({at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)});
         }
     }
     return m;
@@ -290,7 +291,8 @@ SphereComparison CompareWithAnalytic(const Scene& mesh_scene, double sigmas) {
             const size_t i = size_t(py) * size_t(w) + size_t(px);
             // Variance of each pixel mean from its two half-sample estimates.
             const double var = ((double(aa[i]) - ab[i]) * (aa[i] - ab[i]) +
-                                (double(ba[i]) - bb[i]) * (ba[i] - bb[i])) / 4;
+                                (double(ba[i]) - bb[i]) * (ba[i] - bb[i])) /
+                               4;
             const double excess = std::max(0.0, std::abs(gb[i] - ga[i]) - sigmas * std::sqrt(var));
             result.max_relative = std::max(result.max_relative, excess / ga[i]);
             ++result.pixels;
