@@ -1,6 +1,7 @@
 #include "lf/kernels/lights.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 
 namespace lf {
@@ -10,6 +11,12 @@ constexpr float kPi = std::numbers::pi_v<float>;
 
 // Power over the three channels; the average, not luminance, so a pure blue light counts.
 float PowerWeight(const Rgb& c) { return c.Average(); }
+
+// KHR_lights_punctual's recommended spot falloff as a linear map of the cosine to the axis,
+// clamped and squared: 0 outside the outer cone, 1 inside the inner.
+float ConeScale(const SpotLight& spot) {
+    return 1 / std::max(0.001f, float(std::cos(spot.inner_cone) - std::cos(spot.outer_cone)));
+}
 }  // namespace
 
 LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
@@ -45,6 +52,25 @@ LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
         lights_.push_back({Kind::kPoint, int(i), 0, 0});
         weights.push_back(4 * std::numbers::pi * PowerWeight(scene.point_lights[i].intensity));
     }
+    for (size_t i = 0; i < scene.spot_lights.size(); ++i) {
+        const SpotLight& spot = scene.spot_lights[i];
+        const float scale = ConeScale(spot);
+        spot_cones_.push_back(
+            {Vec3(Normalize(spot.direction)), scale, -float(std::cos(spot.outer_cone)) * scale});
+        lights_.push_back({Kind::kSpot, int(i), 0, 0});
+        // The solid angle of the cone halfway through the falloff.
+        const double half_angle = (spot.inner_cone + spot.outer_cone) / 2;
+        weights.push_back(2 * std::numbers::pi * (1 - std::cos(half_angle)) *
+                          PowerWeight(spot.intensity));
+    }
+    const auto [lo, hi] = scene.Bounds();
+    scene_radius_ = float(Length(hi - lo) / 2);
+    for (size_t i = 0; i < scene.directional_lights.size(); ++i) {
+        lights_.push_back({Kind::kDirectional, int(i), 0, 0});
+        // What falls on the scene's bounding sphere's cross-section.
+        weights.push_back(std::numbers::pi * double(scene_radius_) * scene_radius_ *
+                          PowerWeight(scene.directional_lights[i].irradiance));
+    }
     double total = 0;
     for (double w : weights) total += w;
     cdf_.resize(weights.size());
@@ -69,19 +95,13 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, float u_pick,
     const Light& light = lights_[size_t(li)];
     const Scene& scene = scene_.scene();
 
-    LightSample ls;
-    if (light.kind == Kind::kPoint) {
-        const PointLight& pl = scene.point_lights[size_t(light.index)];
-        ls.point.p = Vec3(pl.position - scene_.origin());
-        const Vec3 d = ls.point.p - ref;
-        const float dist2 = LengthSquared(d);
-        if (!(dist2 > 0)) return std::nullopt;
-        ls.wi = d / std::sqrt(dist2);
-        ls.radiance = pl.intensity / dist2;
-        ls.pdf = pick;
-        ls.delta = true;
+    if (light.kind == Kind::kPoint || light.kind == Kind::kSpot ||
+        light.kind == Kind::kDirectional) {
+        std::optional<LightSample> ls = SampleDelta(light, ref);
+        if (ls) ls->pdf = pick;
         return ls;
     }
+    LightSample ls;
     Rgb emission;
     if (light.kind == Kind::kTriangle) {
         // Uniform on the triangle (Osada et al. square-root parameterisation).
@@ -103,6 +123,40 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, float u_pick,
     if (cos_light <= 0) return std::nullopt;  // emission leaves the front face only
     ls.radiance = emission;
     ls.pdf = pick * dist2 / (cos_light * light.area);
+    return ls;
+}
+
+std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const Vec3& ref) const {
+    const Scene& scene = scene_.scene();
+    LightSample ls;
+    ls.delta = true;
+    if (light.kind == Kind::kDirectional) {
+        const DirectionalLight& dl = scene.directional_lights[size_t(light.index)];
+        ls.wi = -Vec3(Normalize(dl.direction));
+        // Beyond the bounding sphere from any point inside it (and at least one unit away when
+        // the scene has no extent).
+        ls.point.p = ref + ls.wi * (2 * scene_radius_ + Length(ref) + 1);
+        ls.point.n = -ls.wi;
+        ls.radiance = dl.irradiance;
+        return ls;
+    }
+    const bool spot = light.kind == Kind::kSpot;
+    const Vec3d position = spot ? scene.spot_lights[size_t(light.index)].position
+                                : scene.point_lights[size_t(light.index)].position;
+    ls.point.p = Vec3(position - scene_.origin());
+    const Vec3 d = ls.point.p - ref;
+    const float dist2 = LengthSquared(d);
+    if (!(dist2 > 0)) return std::nullopt;
+    ls.wi = d / std::sqrt(dist2);
+    ls.point.n = -ls.wi;
+    if (!spot) {
+        ls.radiance = scene.point_lights[size_t(light.index)].intensity / dist2;
+        return ls;
+    }
+    const SpotCone& cone = spot_cones_[size_t(light.index)];
+    const float a = std::clamp(-Dot(cone.direction, ls.wi) * cone.scale + cone.offset, 0.0f, 1.0f);
+    if (a == 0) return std::nullopt;  // outside the outer cone: no shadow ray needed
+    ls.radiance = scene.spot_lights[size_t(light.index)].intensity * (a * a / dist2);
     return ls;
 }
 

@@ -61,6 +61,11 @@ float MicrofacetDistribution::G(const Vec3& wo, const Vec3& wi) const {
     return denom > 0 ? co * ci / denom : 0;
 }
 
+float MicrofacetDistribution::GOverCosines(const Vec3& wo, const Vec3& wi) const {
+    const float co = std::abs(wo.z), ci = std::abs(wi.z);
+    return 1 / (co * ci + ci * CosLambda(wo) + co * CosLambda(wi));
+}
+
 Vec3 MicrofacetDistribution::SampleWm(const Vec3& wo, const Vec2& u) const {
     const float phi = 2 * kPi * u.y;
     if (type_ == Material::Distribution::kBeckmann) {

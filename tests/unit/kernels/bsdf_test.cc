@@ -13,28 +13,26 @@
 #include <utility>
 #include <vector>
 
+#include "bsdf_albedo.h"
+#include "chi_square.h"
 #include "lf/core/sampler.h"
 #include "lf/kernels/fresnel.h"
 #include "lf/kernels/microfacet.h"
+#include "sphere_quadrature.h"
 
 namespace lf {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
-Vec3 Spherical(double theta, double phi) {
-    return Vec3(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-                float(std::cos(theta)));
-}
-
-double Radians(double degrees) { return degrees * kPi / 180; }
-
-Vec3 UniformSphere(const Vec2& u) {
-    const float z = 1 - 2 * u.x;
-    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-    const float phi = 2 * std::numbers::pi_v<float> * u.y;
-    return {r * std::cos(phi), r * std::sin(phi), z};
-}
+using testing::Albedo;
+using testing::ChiSquarePValue;
+using testing::EstimateAlbedo;
+using testing::FurnaceDirections;
+using testing::Integrate1D;
+using testing::kFurnaceSamples;
+using testing::kPi;
+using testing::Radians;
+using testing::Spherical;
+using testing::UniformSphere;
 
 Material Lambert(Rgb rho) {
     Material m;
@@ -78,107 +76,6 @@ Material Dielectric(float ior) {
 constexpr auto kGgx = Material::Distribution::kGgx;
 constexpr auto kBeckmann = Material::Distribution::kBeckmann;
 
-constexpr std::array<double, 5> kGaussNodes = {-0.9061798459386640, -0.5384693101056831, 0,
-                                               0.5384693101056831, 0.9061798459386640};
-constexpr std::array<double, 5> kGaussWeights = {0.2369268850561891, 0.4786286704993665,
-                                                 0.5688888888888889, 0.4786286704993665,
-                                                 0.2369268850561891};
-
-// Composite 5-point Gauss–Legendre over [a, b] split into n pieces.
-template <typename F>
-double Integrate1D(const F& f, double a, double b, int n) {
-    const double h = (b - a) / n;
-    double sum = 0;
-    for (int i = 0; i < n; ++i) {
-        const double mid = a + (i + 0.5) * h;
-        for (int j = 0; j < 5; ++j) sum += kGaussWeights[j] * f(mid + 0.5 * h * kGaussNodes[j]);
-    }
-    return sum * 0.5 * h;
-}
-
-template <typename F>
-double GaussLegendre2D(const F& f, double x0, double x1, double y0, double y1) {
-    const double hx = 0.5 * (x1 - x0), hy = 0.5 * (y1 - y0);
-    double sum = 0;
-    for (int i = 0; i < 5; ++i) {
-        for (int j = 0; j < 5; ++j) {
-            sum += kGaussWeights[i] * kGaussWeights[j] *
-                   f(x0 + hx * (1 + kGaussNodes[i]), y0 + hy * (1 + kGaussNodes[j]));
-        }
-    }
-    return sum * hx * hy;
-}
-
-// Splits the rectangle in four until the quadrants agree with their parent to abs_tol plus
-// rel_tol of the value; the relative part keeps float noise in f from forcing endless splits.
-template <typename F>
-double Adaptive2D(const F& f, double x0, double x1, double y0, double y1, double whole,
-                  double abs_tol, double rel_tol, int depth) {
-    const double xm = 0.5 * (x0 + x1), ym = 0.5 * (y0 + y1);
-    const std::array<double, 4> q = {
-        GaussLegendre2D(f, x0, xm, y0, ym), GaussLegendre2D(f, xm, x1, y0, ym),
-        GaussLegendre2D(f, x0, xm, ym, y1), GaussLegendre2D(f, xm, x1, ym, y1)};
-    const double sum = q[0] + q[1] + q[2] + q[3];
-    if (depth == 0 || std::abs(sum - whole) <= abs_tol + rel_tol * std::abs(sum)) return sum;
-    const double t = abs_tol / 4;
-    return Adaptive2D(f, x0, xm, y0, ym, q[0], t, rel_tol, depth - 1) +
-           Adaptive2D(f, xm, x1, y0, ym, q[1], t, rel_tol, depth - 1) +
-           Adaptive2D(f, x0, xm, ym, y1, q[2], t, rel_tol, depth - 1) +
-           Adaptive2D(f, xm, x1, ym, y1, q[3], t, rel_tol, depth - 1);
-}
-
-// Integral of f(direction) over the solid angle theta in [t0, t1], phi in [p0, p1]. It starts
-// from n x n pieces so that no lobe can hide between the first nodes: a GGX lobe of alpha 0.05
-// seen at 80 degrees is under 0.02 rad wide across the plane of incidence.
-template <typename F>
-double IntegrateSolidAngle(const F& f, double t0, double t1, double p0, double p1, int n,
-                           double abs_tol) {
-    const auto g = [&](double theta, double phi) {
-        return std::sin(theta) * f(Spherical(theta, phi));
-    };
-    const double ht = (t1 - t0) / n, hp = (p1 - p0) / n;
-    double sum = 0;
-    for (int i = 0; i < n; ++i) {
-        for (int j = 0; j < n; ++j) {
-            const double a0 = t0 + i * ht, a1 = a0 + ht, b0 = p0 + j * hp, b1 = b0 + hp;
-            sum += Adaptive2D(g, a0, a1, b0, b1, GaussLegendre2D(g, a0, a1, b0, b1),
-                              abs_tol / (n * n), 1e-6, 12);
-        }
-    }
-    return sum;
-}
-
-// Regularised upper incomplete gamma function Q(a, x) (Numerical Recipes' gammq).
-double GammaQ(double a, double x) {
-    if (x <= 0) return 1;
-    const double log_prefactor = -x + a * std::log(x) - std::lgamma(a);
-    if (x < a + 1) {
-        double term = 1 / a, sum = term;
-        for (int n = 1; n < 1000 && std::abs(term) > std::abs(sum) * 1e-15; ++n) {
-            term *= x / (a + n);
-            sum += term;
-        }
-        return 1 - sum * std::exp(log_prefactor);
-    }
-    constexpr double kTiny = 1e-300;
-    double b = x + 1 - a, c = 1 / kTiny, d = 1 / b, h = d;
-    for (int i = 1; i < 1000; ++i) {
-        const double an = -i * (i - a);
-        b += 2;
-        d = an * d + b;
-        if (std::abs(d) < kTiny) d = kTiny;
-        c = b + an / c;
-        if (std::abs(c) < kTiny) c = kTiny;
-        d = 1 / d;
-        const double delta = d * c;
-        h *= delta;
-        if (std::abs(delta - 1) < 1e-15) break;
-    }
-    return std::exp(log_prefactor) * h;
-}
-
-double ChiSquarePValue(double chi2, int dof) { return GammaQ(0.5 * dof, 0.5 * chi2); }
-
 TEST(Chi2Helper, MatchesClosedForms) {
     for (double x : {0.1, 1.0, 3.0, 10.0, 40.0}) {
         EXPECT_NEAR(ChiSquarePValue(x, 2), std::exp(-x / 2), 1e-12) << x;
@@ -189,13 +86,7 @@ TEST(Chi2Helper, MatchesClosedForms) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Chi-square goodness of fit of Sample against Pdf (after pbrt-v4's bsdfs_test and Mitsuba).
-
-constexpr int kThetaRes = 10;  // pi / 10 per row: the horizon is a row boundary
-constexpr int kPhiRes = 2 * kThetaRes;
-constexpr int kChi2Samples = 1'000'000;
-constexpr double kMinExpected = 5;
-constexpr double kSignificance = 0.01;
+// Chi-square goodness of fit of Sample against Pdf.
 
 struct Chi2Case {
     std::string name;
@@ -204,15 +95,8 @@ struct Chi2Case {
 };
 
 std::vector<Chi2Case> Chi2Cases() {
-    // Normal, oblique, grazing and back-side incidence, azimuth off the bin edges.
-    const std::vector<std::pair<std::string, Vec3>> wos = {
-        {"Normal", Spherical(0, 0)},
-        {"Oblique45", Spherical(Radians(45), 0.5)},
-        {"Grazing80", Spherical(Radians(80), 2.0)},
-        {"Back130", Spherical(Radians(130), 4.0)},
-    };
     std::vector<Chi2Case> cases;
-    for (const auto& [wo_name, wo] : wos) {
+    for (const auto& [wo_name, wo] : testing::Chi2IncidentDirections()) {
         cases.push_back({"Lambert_" + wo_name, Lambert(Rgb(0.5f)), wo});
         for (auto [d, d_name] : {std::pair(kGgx, "Ggx"), std::pair(kBeckmann, "Beckmann")}) {
             for (auto [alpha, a_name] : {std::pair(0.05f, "005"), std::pair(0.2f, "020"),
@@ -229,87 +113,7 @@ class BsdfChi2 : public ::testing::TestWithParam<Chi2Case> {};
 
 TEST_P(BsdfChi2, SampleMatchesPdf) {
     const Chi2Case& c = GetParam();
-    const Bsdf bsdf(c.material);
-    const int num_tests = int(Chi2Cases().size());
-
-    // Observed: histogram of sampled directions; the extra last cell counts failed samples.
-    constexpr int kCells = kThetaRes * kPhiRes;
-    std::vector<double> observed(kCells + 1, 0.0);
-    const uint64_t seed = std::hash<std::string>{}(c.name);
-    for (int i = 0; i < kChi2Samples; ++i) {
-        Sampler sampler(seed, 0, 0, uint64_t(i));
-        const float uc = sampler.Get1D();
-        const Vec2 u = sampler.Get2D();
-        const std::optional<BsdfSample> bs = bsdf.Sample(c.wo, uc, u);
-        if (!bs) {
-            ++observed[kCells];
-            continue;
-        }
-        ASSERT_FALSE(bs->delta);
-        const double theta = std::acos(std::clamp(double(bs->wi.z), -1.0, 1.0));
-        double phi = std::atan2(double(bs->wi.y), double(bs->wi.x));
-        if (phi < 0) phi += 2 * kPi;
-        const int ti = std::min(int(theta / kPi * kThetaRes), kThetaRes - 1);
-        const int pi = std::min(int(phi / (2 * kPi) * kPhiRes), kPhiRes - 1);
-        ++observed[size_t(ti * kPhiRes + pi)];
-    }
-
-    // Expected: Pdf integrated over each cell, to a small fraction of a count.
-    std::vector<double> expected(kCells + 1, 0.0);
-    double integral = 0;
-    for (int ti = 0; ti < kThetaRes; ++ti) {
-        for (int pi = 0; pi < kPhiRes; ++pi) {
-            const double p =
-                IntegrateSolidAngle([&](const Vec3& wi) { return double(bsdf.Pdf(c.wo, wi)); },
-                                    ti * kPi / kThetaRes, (ti + 1) * kPi / kThetaRes,
-                                    pi * 2 * kPi / kPhiRes, (pi + 1) * 2 * kPi / kPhiRes, 4, 1e-7);
-            expected[size_t(ti * kPhiRes + pi)] = p * kChi2Samples;
-            integral += p;
-        }
-    }
-    // Samples that Sample rejects are exactly the mass Pdf does not cover.
-    expected[kCells] = std::max(0.0, 1 - integral) * kChi2Samples;
-
-    const double fail_fraction = observed[kCells] / kChi2Samples;
-    EXPECT_LE(integral, 1 + 1e-4) << "Pdf integrates to more than one";
-    const double fail_sigma =
-        std::sqrt(std::max(fail_fraction * (1 - fail_fraction), 1.0 / kChi2Samples) / kChi2Samples);
-    EXPECT_NEAR(1 - integral, fail_fraction, 5 * fail_sigma + 1e-4 /* quadrature */)
-        << "missing Pdf mass differs from the fraction of failed samples";
-
-    // Pool the cells with small expected counts, smallest first, until the pool is big enough.
-    std::vector<int> order(kCells + 1);
-    for (int i = 0; i <= kCells; ++i) order[size_t(i)] = i;
-    std::sort(order.begin(), order.end(),
-              [&](int a, int b) { return expected[size_t(a)] < expected[size_t(b)]; });
-    double chi2 = 0, pooled_observed = 0, pooled_expected = 0;
-    int dof = 0;
-    for (int i : order) {
-        const double e = expected[size_t(i)], o = observed[size_t(i)];
-        if (e == 0) {
-            ASSERT_LE(o, kChi2Samples * 1e-5) << "samples in cell " << i << " of zero density";
-        } else if (e < kMinExpected || (pooled_expected > 0 && pooled_expected < kMinExpected)) {
-            pooled_observed += o;
-            pooled_expected += e;
-        } else {
-            chi2 += (o - e) * (o - e) / e;
-            ++dof;
-        }
-    }
-    if (pooled_expected > 0) {
-        chi2 += (pooled_observed - pooled_expected) * (pooled_observed - pooled_expected) /
-                pooled_expected;
-        ++dof;
-    }
-    // The counts (failures included) sum to the sample count: one constraint.
-    dof -= 1;
-    ASSERT_GT(dof, 0);
-    const double p_value = ChiSquarePValue(chi2, dof);
-    // Sidak: every case is tested at a level that keeps the family-wise rate at kSignificance.
-    const double level = 1 - std::pow(1 - kSignificance, 1.0 / num_tests);
-    std::printf("[chi2] %-24s integral %.6f failed %.6f chi2 %9.2f dof %3d p %.4f\n",
-                c.name.c_str(), integral, fail_fraction, chi2, dof, p_value);
-    EXPECT_GT(p_value, level) << "chi2 " << chi2 << " with " << dof << " dof";
+    testing::ExpectSamplingMatchesPdf(Bsdf(c.material), c.wo, c.name, int(Chi2Cases().size()));
 }
 
 INSTANTIATE_TEST_SUITE_P(AllNonDelta, BsdfChi2, ::testing::ValuesIn(Chi2Cases()),
@@ -379,52 +183,6 @@ TEST(Bsdf, Reciprocity) {
 
 // ---------------------------------------------------------------------------------------------
 // Energy conservation: the directional albedo, the mean of f |cos| / pdf over Sample.
-
-struct Albedo {
-    Rgb mean;
-    Rgb stderr_;        // standard error of the mean per channel
-    double max_weight;  // largest single-sample weight over channels
-};
-
-Albedo EstimateAlbedo(const Bsdf& bsdf, const Vec3& wo, uint64_t seed, int n) {
-    std::array<double, 3> sum{}, sum2{};
-    double max_weight = 0;
-    for (int i = 0; i < n; ++i) {
-        Sampler sampler(seed, 0, 0, uint64_t(i));
-        const float uc = sampler.Get1D();
-        const std::optional<BsdfSample> bs = bsdf.Sample(wo, uc, sampler.Get2D());
-        if (!bs) continue;  // a failed sample carries no energy
-        const Rgb w = bs->f * (std::abs(bs->wi.z) / bs->pdf);
-        EXPECT_TRUE(w.IsFinite());
-        for (int c = 0; c < 3; ++c) {
-            sum[size_t(c)] += w[c];
-            sum2[size_t(c)] += double(w[c]) * w[c];
-            max_weight = std::max(max_weight, double(w[c]));
-        }
-    }
-    Albedo a{};
-    a.max_weight = max_weight;
-    for (int c = 0; c < 3; ++c) {
-        const double mean = sum[size_t(c)] / n;
-        const double var = std::max(0.0, sum2[size_t(c)] / n - mean * mean);
-        a.mean[c] = float(mean);
-        a.stderr_[c] = float(std::sqrt(var / (n - 1)));
-    }
-    return a;
-}
-
-// Incident directions at cos theta 1 .. 0.01, front and back.
-std::vector<Vec3> FurnaceDirections() {
-    std::vector<Vec3> wos;
-    for (float cos : {1.0f, 0.9f, 0.7f, 0.5f, 0.3f, 0.15f, 0.05f, 0.01f}) {
-        const Vec3 w = Spherical(std::acos(cos), 0.7);
-        wos.push_back(w);
-        wos.push_back(Vec3(w.x, w.y, -w.z));
-    }
-    return wos;
-}
-
-constexpr int kFurnaceSamples = 20000;
 
 TEST(Bsdf, LambertAlbedoIsReflectance) {
     const Rgb rho(0.2f, 0.5f, 0.8f);
@@ -694,6 +452,20 @@ TEST(Microfacet, ShadowingIsHeightCorrelated) {
                 const double expected = 1 / (1 + lambda(alpha, to) + lambda(alpha, ti));
                 EXPECT_NEAR(distribution.G(Spherical(to, 0.1), Spherical(ti, 2.5)), expected, 1e-5)
                     << alpha << " " << to << " " << ti;
+            }
+        }
+    }
+}
+
+TEST(Microfacet, GOverCosinesIsGDividedByTheCosines) {
+    for (auto d : {kGgx, kBeckmann}) {
+        const MicrofacetDistribution distribution(d, 0.3f);
+        for (double to : {0.0, 0.7, 1.4, 2.0}) {
+            for (double ti : {0.2, 1.0, 1.55, 2.9}) {
+                const Vec3 wo = Spherical(to, 0.1), wi = Spherical(ti, 2.5);
+                const double expected = distribution.G(wo, wi) / std::abs(double(wo.z) * wi.z);
+                EXPECT_NEAR(distribution.GOverCosines(wo, wi), expected, 1e-5 * expected)
+                    << int(d) << " " << to << " " << ti;
             }
         }
     }

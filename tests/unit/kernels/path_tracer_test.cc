@@ -11,6 +11,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/tile_renderer.h"
 #include "lf/local/local_executor.h"
+#include "plane_render.h"
 #include "render_path.h"
 #include "test_scenes.h"
 
@@ -82,59 +83,19 @@ TEST(Furnace, MaxDepthTruncatesTheNeumannSeries) {
 // A point light of intensity I at height h over a Lambertian plane of albedo rho:
 // L(x) = rho/pi * I cos(theta) / r^2 with cos(theta) = h / r.
 TEST(PointLight, LambertianPlaneMatchesInverseSquareLaw) {
-    Scene scene;
-    Material plane;
-    plane.reflectance = Rgb(0.5f, 0.25f, 0.75f);
-    scene.materials.push_back(plane);
-    TriangleMesh m;
-    const double s = 50;
-    m.positions = {{-s, 0, -s}, {-s, 0, s}, {s, 0, s}, {s, 0, -s}};  // normal +y
-    m.triangles = {{0, 1, 2}, {0, 2, 3}};
-    scene.meshes.push_back(m);
+    const Rgb rho(0.5f, 0.25f, 0.75f);
+    Scene scene = testing::PlaneUnderCamera(rho);
     const Vec3d light(0.3, 1.0, -0.2);
     const Rgb intensity(10.0f, 5.0f, 2.0f);
     scene.point_lights.push_back({light, intensity});
-    scene.camera.position = {0, 3, 0};
-    scene.camera.look_at = {0, 0, 0};
-    scene.camera.up = {0, 0, 1};
-    scene.camera.fov_y_deg = 60;
-    scene.camera.width = scene.camera.height = 16;
-
     const uint64_t spp = 64;
     const RenderOutput out = Render(scene, spp, -1);
-    auto es = EmbreeScene::Build(scene);
-    const Camera camera(scene.camera, Vec3d());
-    // The expected pixel value is the mean of L over the pixel's footprint; integrate it on a
-    // fine grid, and take the spread over the footprint as the per-sample standard deviation.
-    constexpr int kGrid = 24;
-    for (int py = 0; py < 16; ++py) {
-        for (int px = 0; px < 16; ++px) {
-            double sum = 0, sum2 = 0;
-            for (int j = 0; j < kGrid; ++j) {
-                for (int i = 0; i < kGrid; ++i) {
-                    const Ray r =
-                        camera.GenerateRay(px, py, (i + 0.5f) / kGrid, (j + 0.5f) / kGrid);
-                    const double t = -double(r.o.y) / r.d.y;
-                    const Vec3d x(r.o.x + t * r.d.x, 0, r.o.z + t * r.d.z);
-                    const double dist2 = LengthSquared(light - x);
-                    const double cos_theta = light.y / std::sqrt(dist2);
-                    const double L = cos_theta / dist2 / std::numbers::pi;  // per unit rho*I
-                    sum += L;
-                    sum2 += L * L;
-                }
-            }
-            const double n = kGrid * kGrid;
-            const double mean = sum / n;
-            const double sd = std::sqrt(std::max(0.0, sum2 / n - mean * mean));
-            const Rgb got = out.image.Pixel(px, py);
-            for (int c = 0; c < 3; ++c) {
-                const double k = double(plane.reflectance[c]) * intensity[c];
-                // Midpoint-rule error is far below the sampling error; 1e-5 covers float rounding.
-                const double tol = kSigmas * k * sd / std::sqrt(double(spp)) + 1e-5 * k * mean;
-                EXPECT_NEAR(got[c], k * mean, tol) << "pixel " << px << "," << py << " ch " << c;
-            }
-        }
-    }
+    const int compared = testing::ExpectPlaneMatches(scene, out.image, spp, [&](const Vec3d& x) {
+        const double dist2 = LengthSquared(light - x);
+        const double cos_theta = light.y / std::sqrt(dist2);
+        return rho * intensity * float(cos_theta / dist2 / std::numbers::pi);
+    });
+    EXPECT_EQ(compared, testing::kPlaneImageSize * testing::kPlaneImageSize);
 }
 
 }  // namespace

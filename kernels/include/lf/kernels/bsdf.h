@@ -1,7 +1,8 @@
-// BSDFs of the four material types, evaluated and sampled in a local shading frame whose +z is
-// the front face's normal. Reflection happens on both faces (lambert, mirror, glossy): a pair
-// of directions on the back side is treated as its mirror image on the front. For dielectrics
-// +z is the outside. Values are f(wo, wi) without the cosine; Pdf is per solid angle.
+// BSDFs of the five material types (the principled one in lf/kernels/principled_bsdf.h),
+// evaluated and sampled in a local shading frame whose +z is the front face's normal.
+// Reflection happens on both faces (lambert, mirror, glossy, principled): a pair of directions on
+// the back side is treated as its mirror image on the front. For dielectrics (and principled
+// solids) +z is the outside. Values are f(wo, wi) without the cosine; Pdf is per solid angle.
 #pragma once
 
 #include <optional>
@@ -9,22 +10,16 @@
 #include "lf/core/rgb.h"
 #include "lf/core/scene.h"
 #include "lf/core/vec.h"
+#include "lf/kernels/bsdf_sample.h"
 #include "lf/kernels/microfacet.h"
+#include "lf/kernels/principled_bsdf.h"
 
 namespace lf {
-
-struct BsdfSample {
-    Rgb f;  // BSDF value for (wo, wi); for delta lobes the value that, times |cos|/pdf,
-            // gives the throughput weight
-    Vec3 wi;
-    float pdf = 0;  // solid angle density; for delta lobes the discrete probability of the lobe
-    bool delta = false;
-};
 
 // The parameters that vary across a surface, at one point: the material's factors times its
 // textures there (lf/kernels/shading.h). Everything else of the BSDF comes from the Material.
 struct SurfaceParams {
-    Rgb base_color;   // lambert albedo, principled base colour
+    Rgb base_color;  // lambert albedo, principled base colour
     float metallic = 0;
     float roughness = 0;  // principled: perceptual roughness r
 
@@ -57,6 +52,7 @@ class Bsdf {
     Rgb reflectance_, eta_, k_;
     float ior_;
     MicrofacetDistribution distribution_;
+    std::optional<PrincipledBsdf> principled_;  // kPrincipled only
 };
 
 }  // namespace lf

@@ -28,6 +28,10 @@ class MicrofacetDistribution {
     float G1(const Vec3& w) const;
     // Height-correlated masking-shadowing, 1 / (1 + Lambda(wo) + Lambda(wi)).
     float G(const Vec3& wo, const Vec3& wi) const;
+    // G(wo, wi) / (|cos theta_o| |cos theta_i|), which every microfacet BSDF divides by, with G
+    // multiplied through so that no grazing direction makes a Lambda infinite. Both cosines
+    // must be nonzero.
+    float GOverCosines(const Vec3& wo, const Vec3& wi) const;
 
     // A microfacet normal for wo (wo.z > 0): GGX samples the visible normals (Heitz 2018), whose
     // reflections are all potentially valid; Beckmann samples D(wm) cos(theta_m).

@@ -1,0 +1,242 @@
+#include "lf/kernels/principled_bsdf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "lf/kernels/bsdf.h"
+#include "lf/kernels/bsdf_sampling.h"
+#include "lf/kernels/fresnel.h"
+
+namespace lf {
+namespace {
+
+constexpr float kInvPi = std::numbers::inv_pi_v<float>;
+constexpr float kMinCos = kBsdfMinCos;
+
+// Lobe picking estimates each lobe's share from wo alone; where the estimate vanishes but the lobe
+// does not (Fresnel 1 at the macro normal inside a solid, a black base), a floor keeps every lobe
+// that exists sampled.
+constexpr float kPickFloor = 0.05f;
+
+// Solids with an IOR this close to one refract by less than float resolves; they are treated as
+// thin walls.
+constexpr float kMinIorContrast = 1e-3f;
+
+float Clamp01(float x) { return x > 0 ? std::min(x, 1.0f) : 0.0f; }  // NaN -> 0
+
+float SchlickScalar(float f0, float cos) {
+    const float m = std::clamp(1 - cos, 0.0f, 1.0f);
+    return f0 + (1 - f0) * ((m * m) * (m * m) * m);
+}
+
+}  // namespace
+
+PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& params)
+    : base_(Clamp01(params.base_color.r), Clamp01(params.base_color.g),
+            Clamp01(params.base_color.b)),
+      metallic_(Clamp01(params.metallic)),
+      specular_(Clamp01(material.specular)),
+      transmission_(Clamp01(material.transmission)),
+      ior_(material.ior),
+      f0_(((material.ior - 1) / (material.ior + 1)) * ((material.ior - 1) / (material.ior + 1))),
+      refracts_(transmission_ > 0 && material.thickness > 0 &&
+                std::abs(material.ior - 1) > kMinIorContrast),
+      distribution_(Material::Distribution::kGgx,
+                    Clamp01(params.roughness) * Clamp01(params.roughness)),
+      // Lambert's limit (no layer, no metal) needs no table: it is not built for it.
+      albedo_(specular_ > 0 || metallic_ > 0 ? &GgxAlbedo::Get() : nullptr),
+      albedo_roughness_(GgxAlbedo::At(Clamp01(params.roughness))) {
+    const float layer_average =
+        specular_ > 0 ? specular_ * albedo_->Average(albedo_roughness_, f0_) : 0;
+    const float remaining = 1 - layer_average;
+    diffuse_scale_ =
+        remaining > 1e-6f ? (1 - metallic_) * (1 - transmission_) * kInvPi / remaining : 0;
+}
+
+float PrincipledBsdf::LayerFresnel(float cos_om, bool outside) const {
+    if (outside) return specular_ * SchlickScalar(f0_, cos_om);
+    // From inside a solid: Schlick at the cosine the refracted direction would have outside;
+    // 1 under total internal reflection.
+    const float sin2_t = (1 - cos_om * cos_om) * ior_ * ior_;
+    if (sin2_t >= 1) return specular_;
+    return specular_ * SchlickScalar(f0_, std::sqrt(1 - sin2_t));
+}
+
+PrincipledBsdf::LobePick PrincipledBsdf::Pick(const Vec3& wo) const {
+    const float cos = std::min(std::abs(wo.z), 1.0f);
+    const bool outside = Outside(wo);
+    // Fresnel as the lobes see it: outside, averaged over the light the microfacets reflect,
+    // E(f0) / E(1) (Schlick is linear in f0, so one table serves the layer and the metal); at
+    // grazing incidence that is far below Fresnel at the macro normal, which would starve the
+    // base and transmission of samples. Inside a solid, at the macro normal with its total
+    // internal reflection.
+    float layer, metal;
+    if (albedo_ && outside) {
+        const float e0 = albedo_->E(cos, albedo_roughness_, 0);
+        const float e1 = albedo_->E(cos, albedo_roughness_, 1);
+        const auto mean_fresnel = [&](float f0) {
+            return e1 > 0 ? e0 / e1 + f0 * (1 - e0 / e1) : 1;
+        };
+        layer = specular_ * mean_fresnel(f0_);
+        metal = mean_fresnel(base_.Average());
+    } else {
+        layer = LayerFresnel(cos, outside);
+        metal = FrSchlick(base_, cos).Average();
+    }
+    const float rest = std::max(1 - layer, kPickFloor);
+    const float dielectric = 1 - metallic_;
+    LobePick p;
+    p.reflect = metallic_ * std::max(metal, kPickFloor) +
+                dielectric * std::max(layer, kPickFloor * specular_);
+    p.transmit = dielectric * transmission_ * rest;
+    if (outside && diffuse_scale_ > 0) {
+        p.diffuse = dielectric * (1 - transmission_) * rest * std::max(base_.Average(), kPickFloor);
+    }
+    const float total = p.reflect + p.transmit + p.diffuse;
+    if (!(total > 0)) return {};
+    p.reflect /= total;
+    p.transmit /= total;
+    p.diffuse /= total;
+    return p;
+}
+
+Rgb PrincipledBsdf::ReflectionEval(const Vec3& wo, const Vec3& wi, bool outside) const {
+    const Vec3 wm = Normalize(wo + wi);
+    const float cos_om = Dot(wo, wm);
+    // D G / (4 cos_o cos_i) with G multiplied through, as in the glossy BSDF.
+    const float denom =
+        4 * (wo.z * wi.z + wi.z * distribution_.CosLambda(wo) + wo.z * distribution_.CosLambda(wi));
+    const float dg = distribution_.D(wm) / denom;
+    const Rgb conductor = FrSchlick(base_, cos_om) * metallic_;
+    const float layer = (1 - metallic_) * LayerFresnel(cos_om, outside);
+    return (conductor + Rgb(layer)) * dg;
+}
+
+float PrincipledBsdf::ReflectionPdf(const Vec3& wo, const Vec3& wi) const {
+    const Vec3 wm = Normalize(wo + wi);
+    const float cos_om = Dot(wo, wm);
+    if (!(cos_om > 0)) return 0;
+    return distribution_.PdfWm(wo, wm) / (4 * cos_om);
+}
+
+Rgb PrincipledBsdf::DiffuseEval(const Vec3& wo, const Vec3& wi) const {
+    if (diffuse_scale_ == 0) return {};
+    if (specular_ == 0) return base_ * diffuse_scale_;
+    const float keep_o = 1 - specular_ * albedo_->E(wo.z, albedo_roughness_, f0_);
+    const float keep_i = 1 - specular_ * albedo_->E(wi.z, albedo_roughness_, f0_);
+    return base_ * (diffuse_scale_ * keep_o * keep_i);
+}
+
+Rgb PrincipledBsdf::ThinTransmissionEval(const Vec3& wo, const Vec3& wi) const {
+    const float weight = (1 - metallic_) * transmission_;
+    if (!(weight > 0)) return {};
+    const Vec3 wm = Normalize(wo + wi);
+    const float denom =
+        4 * (wo.z * wi.z + wi.z * distribution_.CosLambda(wo) + wo.z * distribution_.CosLambda(wi));
+    return Rgb(weight * (1 - LayerFresnel(Dot(wo, wm), true)) * distribution_.D(wm) / denom);
+}
+
+std::optional<Vec3> PrincipledBsdf::RefractionNormal(const Vec3& wo, const Vec3& wi) const {
+    Vec3 wm = wo + wi * RelativeEta(wo);
+    const float length2 = LengthSquared(wm);
+    if (!(length2 > 0)) return std::nullopt;
+    wm = wm / std::sqrt(length2);
+    if (wm.z * wo.z < 0) wm = -wm;
+    // Light cannot pass through a microfacet it sees from behind.
+    if (Dot(wo, wm) <= 0 || Dot(wi, wm) >= 0) return std::nullopt;
+    return wm;
+}
+
+Rgb PrincipledBsdf::RefractionEval(const Vec3& wo, const Vec3& wi) const {
+    const float weight = (1 - metallic_) * transmission_;
+    if (!(weight > 0)) return {};
+    const std::optional<Vec3> wm = RefractionNormal(wo, wi);
+    if (!wm) return {};
+    const float eta = RelativeEta(wo);
+    const float cos_om = Dot(wo, *wm), cos_im = Dot(wi, *wm);
+    // Schlick at the outside direction's own cosine: the same for the path and its reverse, where
+    // Snell's law from the inside would cancel catastrophically near the critical angle.
+    const float fresnel = LayerFresnel(wo.z > 0 ? cos_om : -cos_im, true);
+    const float half = cos_im + cos_om / eta;
+    // Walter et al. (2007) eq. 21; radiance crossing into the medium on wi's side is compressed
+    // by 1 / eta^2 (pbrt-v4's TransportMode::Radiance).
+    const float value = weight * (1 - fresnel) * distribution_.D(*wm) *
+                        distribution_.GOverCosines(wo, wi) * -cos_im * cos_om /
+                        (half * half * eta * eta);
+    return Rgb(std::max(0.0f, value));
+}
+
+float PrincipledBsdf::RefractionPdf(const Vec3& wo, const Vec3& wi) const {
+    const std::optional<Vec3> wm = RefractionNormal(wo, wi);
+    if (!wm) return 0;
+    const float eta = RelativeEta(wo);
+    const float cos_om = Dot(wo, *wm), cos_im = Dot(wi, *wm);
+    const float half = cos_im + cos_om / eta;
+    // Jacobian of the refraction wm -> wi.
+    return distribution_.PdfWm(ToUpper(wo), ToUpper(*wm)) * -cos_im / (half * half);
+}
+
+Rgb PrincipledBsdf::Eval(const Vec3& wo, const Vec3& wi) const {
+    if (std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return {};
+    const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+    if (SameHemisphere(wo, wi)) {
+        const bool outside = Outside(wo);
+        Rgb f = ReflectionEval(wo_up, wi_up, outside);
+        if (outside) f += DiffuseEval(wo_up, wi_up);
+        return f;
+    }
+    return refracts_ ? RefractionEval(wo, wi) : ThinTransmissionEval(wo_up, wi_up);
+}
+
+float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
+    if (std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return 0;
+    const LobePick pick = Pick(wo);
+    const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+    if (SameHemisphere(wo, wi)) {
+        float pdf = pick.diffuse * wi_up.z * kInvPi;
+        if (pick.reflect > 0) pdf += pick.reflect * ReflectionPdf(wo_up, wi_up);
+        return pdf;
+    }
+    if (!(pick.transmit > 0)) return 0;
+    return pick.transmit * (refracts_ ? RefractionPdf(wo, wi) : ReflectionPdf(wo_up, wi_up));
+}
+
+std::optional<BsdfSample> PrincipledBsdf::Sample(const Vec3& wo, float uc, const Vec2& u) const {
+    if (!(std::abs(wo.z) >= kMinCos)) return std::nullopt;
+    const LobePick pick = Pick(wo);
+    const Vec3 wo_up = ToUpper(wo);
+    const float side = wo.z > 0 ? 1.0f : -1.0f;
+    Vec3 wi_up;  // in the frame mirrored so that wo_up.z > 0
+    float eta = 1;
+    if (uc < pick.reflect + pick.diffuse) {
+        if (uc < pick.reflect) {
+            const Vec3 wm = distribution_.SampleWm(wo_up, u);
+            wi_up = wm * (2 * Dot(wo_up, wm)) - wo_up;
+        } else {
+            wi_up = SampleCosineHemisphere(u);
+        }
+        if (wi_up.z < kMinCos) return std::nullopt;
+    } else {
+        if (!(pick.transmit > 0)) return std::nullopt;
+        const Vec3 wm = distribution_.SampleWm(wo_up, u);
+        if (refracts_) {
+            eta = RelativeEta(wo);
+            const std::optional<Vec3> refracted = Refract(wo_up, wm, eta);
+            if (!refracted) return std::nullopt;  // total internal reflection at this facet
+            wi_up = *refracted;
+        } else {
+            // A thin wall: the reflection passes through, mirrored to the other side.
+            wi_up = wm * (2 * Dot(wo_up, wm)) - wo_up;
+            wi_up.z = -wi_up.z;
+        }
+        if (wi_up.z > -kMinCos) return std::nullopt;
+    }
+    const Vec3 wi(wi_up.x, wi_up.y, side * wi_up.z);
+    // Eval and Pdf recompute the half vector from (wo, wi), exactly as MIS weights elsewhere will.
+    const float pdf = Pdf(wo, wi);
+    if (!(pdf > 0)) return std::nullopt;
+    return BsdfSample{Eval(wo, wi), wi, pdf, false, eta};
+}
+
+}  // namespace lf
