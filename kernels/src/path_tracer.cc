@@ -123,11 +123,8 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         const bool transmitted = bs->wi.z * wo.z < 0;
         const int next_medium =
             MediumAfter(medium, hit->material, material, Dot(wi, ng), transmitted);
-        if (transmitted && HasInterior(material)) {
-            // Radiance is scaled by 1/eta^2 across the interface; roulette must not see that.
-            const float eta = cos_o_ng > 0 ? material.ior : 1 / material.ior;
-            eta_scale *= eta * eta;
-        }
+        // Radiance is scaled by 1/eta^2 across a refracting interface; roulette must not see it.
+        eta_scale *= bs->eta * bs->eta;
         medium = next_medium;
         delta_bounce = bs->delta;
         prev_pdf = bs->pdf;
