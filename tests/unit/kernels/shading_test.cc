@@ -123,6 +123,42 @@ TEST(TextureOrientation, BaseColourTextureScalesLambertAlbedo) {
     }
 }
 
+// The metallic-roughness texture's G channel scales roughness and its B channel metallic (its
+// R, occlusion in some exports, is ignored); the base colour texture scales the base colour.
+TEST(TexturedParams, FactorsTimesTexels) {
+    Scene scene;
+    auto mr = std::make_shared<TextureImage>();
+    mr->width = mr->height = 1;
+    mr->channels = 3;
+    mr->texels32 = {0.1f, 0.5f, 0.25f};
+    scene.textures.push_back(mr);
+    scene.textures.push_back(Quadrants());
+    Material m;
+    m.type = Material::Type::kPrincipled;
+    m.reflectance = Rgb(0.5f);
+    m.roughness = 0.8f;
+    m.metallic = 0.6f;
+    m.metallic_roughness_texture.image = 0;
+    m.base_color_texture.image = 1;
+    m.base_color_texture.srgb = true;
+    m.base_color_texture.nearest = true;
+    scene.materials.push_back(m);
+    scene.meshes.push_back(UvQuad(1, 0, 0));
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    const Vec3 down(0, 0, -1);
+    // (-0.5, 0.5) is in the top-left (red) quadrant, (0.5, -0.5) in the bottom-right (white).
+    const std::optional<SurfaceHit> red = (*es)->Intersect(Ray{Vec3(-0.5f, 0.5f, 1), down});
+    const std::optional<SurfaceHit> white = (*es)->Intersect(Ray{Vec3(0.5f, -0.5f, 1), down});
+    ASSERT_TRUE(red && white);
+    const SurfaceParams a = Shade(**es, *red, -down).params;
+    const SurfaceParams b = Shade(**es, *white, -down).params;
+    EXPECT_FLOAT_EQ(a.roughness, 0.4f);
+    EXPECT_FLOAT_EQ(a.metallic, 0.15f);
+    EXPECT_EQ(a.base_color, Rgb(0.5f, 0, 0));
+    EXPECT_EQ(b.base_color, Rgb(0.5f));
+}
+
 // Checks every pixel of a render against the mean over its footprint of `radiance` along each
 // camera ray (render space); the per-sample standard deviation over the footprint gives the
 // tolerance (the renders here have no other noise: one point light, nothing to bounce off).
