@@ -66,6 +66,10 @@ absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& 
         *why = "the scene has spheres, which radiosity does not mesh";
         return std::string("path");
     }
+    if (!scene.spot_lights.empty() || !scene.directional_lights.empty()) {
+        *why = "the scene has spot or directional lights, which radiosity does not model";
+        return std::string("path");
+    }
     *why = "every material is Lambertian";
     return std::string("radiosity");
 }

@@ -1,6 +1,7 @@
-// Radiosity models lambert materials with one albedo and two sides per patch: scenes with
-// principled materials, textures, alpha masks or single-sided surfaces are refused with a
-// message naming the mesh and material, never rendered wrongly or crashed on.
+// Radiosity models lambert materials with one albedo and two sides per patch, lit by emitters
+// and point lights: scenes with principled materials, textures, alpha masks, single-sided
+// surfaces, spot or directional lights are refused with a message naming what, never rendered
+// wrongly or crashed on.
 #include <gtest/gtest.h>
 
 #include "lf/kernels/embree_scene.h"
@@ -54,6 +55,19 @@ TEST(RadiosityMaterials, TexturedMaskedAndSingleSidedLambertAreRefused) {
     EXPECT_EQ(RefusalOf(single),
               "radiosity: mesh 'floor' uses material 'card' with a single side, which radiosity "
               "does not model; render it with --method path");
+}
+
+TEST(RadiosityMaterials, SpotAndDirectionalLightsAreRefused) {
+    Scene scene = testing::MakeFurnace(1.0, Vec3d(), 0.5f, 1.0f, 8);
+    scene.directional_lights.push_back({Vec3d(0, -1, 0), Rgb(1)});
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    RadiosityOptions options;
+    options.patches = 64;
+    const auto renderer = PrepareRadiosity(**es, options);
+    EXPECT_EQ(renderer.status().message(),
+              "radiosity: the scene has spot or directional lights, which radiosity does not "
+              "model; render it with --method path");
 }
 
 }  // namespace
