@@ -13,6 +13,7 @@
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
+#include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
@@ -55,9 +56,18 @@ absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& 
                                 ", which radiosity cannot model");
             return std::string("path");
         }
+        if (const char* what = RadiosityLacks(m)) {
+            *why = absl::StrCat("material \"", m.name, "\" has ", what,
+                                ", which radiosity cannot model");
+            return std::string("path");
+        }
     }
     if (!scene.spheres.empty()) {
         *why = "the scene has spheres, which radiosity does not mesh";
+        return std::string("path");
+    }
+    if (!scene.spot_lights.empty() || !scene.directional_lights.empty()) {
+        *why = "the scene has spot or directional lights, which radiosity does not model";
         return std::string("path");
     }
     *why = "every material is Lambertian";

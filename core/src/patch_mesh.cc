@@ -166,6 +166,13 @@ std::vector<GridTriangle> SubdivisionCells(int k) {
     return cells;
 }
 
+const char* RadiosityLacks(const Material& material) {
+    if (material.IsTextured()) return "textures";
+    if (material.alpha_mode == Material::AlphaMode::kMask) return "an alpha mask";
+    if (!material.double_sided) return "a single side";
+    return nullptr;
+}
+
 absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOptions& options) {
     auto cancelled = [&] {
         return options.cancel && options.cancel->load(std::memory_order_relaxed);
@@ -181,6 +188,11 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
             return absl::InvalidArgumentError(absl::StrCat(
                 "radiosity: mesh '", mesh.name, "' uses ", MaterialTypeName(material.type),
                 " material '", material.name, "'; radiosity handles lambert materials only"));
+        }
+        if (const char* what = RadiosityLacks(material)) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                "radiosity: mesh '", mesh.name, "' uses material '", material.name, "' with ", what,
+                ", which radiosity does not model; render it with --method path"));
         }
     }
     if (!(options.patch_size >= 0) || (options.patch_size == 0 && options.patches <= 0)) {

@@ -23,6 +23,14 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Radiosity's exitance comes from emitters and point lights only.
+absl::Status CheckLights(const Scene& scene) {
+    if (scene.spot_lights.empty() && scene.directional_lights.empty()) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        "radiosity: the scene has spot or directional lights, which radiosity does not model; "
+        "render it with --method path");
+}
+
 // The solver refuses this too, by side index; here the user learns which material it is.
 absl::Status CheckReflectance(const Scene& scene) {
     bool emits = false;
@@ -157,6 +165,7 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& scene,
                                                            const RadiosityOptions& options) {
     const Scene& s = scene.scene();
+    if (absl::Status status = CheckLights(s); !status.ok()) return status;
     if (absl::Status status = CheckReflectance(s); !status.ok()) return status;
     RadiosityReport report;
     PatchMeshOptions mesh_options{options.patch_size, options.patches};
@@ -273,6 +282,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
             absl::StrFormat("radiosity: chunk %d of %d does not exist", chunk, chunks));
     }
     if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
+    if (absl::Status status = CheckLights(scene.scene()); !status.ok()) return status;
     if (absl::Status status = CheckReflectance(scene.scene()); !status.ok()) return status;
     PatchMeshOptions mesh_options{options.patch_size, options.patches};
     mesh_options.cancel = cancel;

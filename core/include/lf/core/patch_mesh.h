@@ -45,6 +45,10 @@ inline constexpr int kMaxPatchLevel = 12;
 // while the last pass's are computed, nearly as much again).
 inline constexpr int64_t kMaxRefinedPatches = 32768;
 
+// What a lambert material has that radiosity does not model (one albedo and two sides per
+// patch): "textures", "an alpha mask" or "a single side"; nullptr when nothing.
+const char* RadiosityLacks(const Material& material);
+
 struct PatchMeshOptions {
     double patch_size = 0;   // longest patch edge in scene units; 0: derived from `patches`
     int64_t patches = 4000;  // target patch count when patch_size is 0 (never exceeded unless
