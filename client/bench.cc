@@ -53,7 +53,7 @@ double RawRaysPerSecond(const EmbreeScene& scene, uint64_t count, int threads) {
 }  // namespace
 
 absl::Status RunBench(const BenchOptions& options) {
-    absl::StatusOr<Scene> scene = LoadScene(options.scene_path);
+    absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
     if (options.resolution > 0) {
         scene->camera.width = scene->camera.height = options.resolution;

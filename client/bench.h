@@ -5,6 +5,7 @@
 #include <string>
 
 #include "absl/status/status.h"
+#include "lf/core/scene_loader.h"
 #include "lf/job/settings.h"
 
 namespace lf {
@@ -13,7 +14,8 @@ struct BenchOptions {
     std::string scene_path;
     uint64_t spp = defaults::kSpp;
     int threads = 2;
-    int resolution = 256;
+    int resolution = 256;  // square side, 0: the scene's; unused when scene gives WxH
+    SceneOptions scene;
     int max_depth = defaults::kMaxDepth;
     uint64_t raw_rays = 4'000'000;
 };

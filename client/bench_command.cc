@@ -1,5 +1,6 @@
 #include "bench.h"
 #include "command.h"
+#include "scene_flags.h"
 
 namespace lf {
 
@@ -9,15 +10,16 @@ Command AddBenchCommand(CLI::App& app) {
         "bench",
         "Measure path samples/s and rays/s on a scene, and Embree's raw closest-hit rate for\n"
         "incoherent rays in the same scene (the hardware limit for comparison).");
-    cmd->add_option("scene", options->scene_path, "scene file (JSON)")
+    cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_option("--spp", options->spp, "samples per pixel")->capture_default_str();
     cmd->add_option("--threads", options->threads, "threads, at least 1")
         ->capture_default_str()
         ->check(CLI::Range(1, 1024));
-    cmd->add_option("--resolution", options->resolution, "square image side (0 = scene's)")
-        ->capture_default_str();
+    AddCameraFlag(cmd, options->scene);
+    AddResolutionFlag(cmd, options->scene, &options->resolution, 65536,
+                      "image size WxH, or N for a square N x N (0 = the scene's; default 256)");
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str();
     cmd->add_option("--rays", options->raw_rays, "rays for the raw Embree measurement")

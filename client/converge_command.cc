@@ -3,6 +3,7 @@
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
+#include "scene_flags.h"
 
 namespace lf {
 
@@ -17,7 +18,7 @@ Command AddConvergeCommand(CLI::App& app) {
         "drawn by gnuplot).\n"
         "Without --reference, a path-traced reference is rendered first (and the output says\n"
         "so). See docs/convergence.md.");
-    cmd->add_option("scene", options->scene_path, "scene file (JSON)")
+    cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_option("--out", options->out_dir, "output directory (created)")->required();
@@ -27,10 +28,9 @@ Command AddConvergeCommand(CLI::App& app) {
     cmd->add_option("--method", options->method, "path, radiosity or both")
         ->capture_default_str()
         ->check(CLI::IsMember({"path", "radiosity", "both"}));
-    cmd->add_option("--resolution", options->resolution,
-                    "image width (height keeps the aspect); 0 = the scene's")
-        ->capture_default_str()
-        ->check(CLI::Range(0, 16384));
+    AddCameraFlag(cmd, options->scene);
+    AddResolutionFlag(cmd, options->scene, &options->resolution, 16384,
+                      "image size WxH, or N for width N with the scene's aspect (0 = the scene's)");
     cmd->add_option("--max-spp", options->max_spp, "largest spp of the path ladder")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(2), uint64_t(1) << 20));

@@ -113,7 +113,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     std::filesystem::create_directories(options.out_dir, ec);
     if (ec) return absl::PermissionDeniedError(options.out_dir + ": " + ec.message());
 
-    absl::StatusOr<Scene> scene = LoadScene(options.scene_path);
+    absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
     if (options.resolution > 0) {
         CameraSpec& c = scene->camera;

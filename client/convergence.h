@@ -11,6 +11,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/image_error.h"
+#include "lf/core/scene_loader.h"
 #include "lf/job/settings.h"
 
 namespace lf {
@@ -21,6 +22,7 @@ struct ConvergenceOptions {
     std::string reference_path;   // empty: render our own path-traced reference
     std::string method = "both";  // path | radiosity | both
     int resolution = 0;           // image width, height keeps the aspect; 0: the scene's
+    SceneOptions scene;           // --camera; --resolution WxH (then `resolution` is 0)
     uint64_t max_spp = 256;       // path ladder 1, 2, 4, ... up to this
     uint64_t reference_spp = 4096;
     int64_t min_patches = 250;  // radiosity ladder, doubling

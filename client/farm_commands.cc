@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "absl/strings/ascii.h"
@@ -26,6 +25,7 @@
 #include "progress_bar.h"
 #include "proto/grpc_status.h"
 #include "radiosity_flags.h"
+#include "scene_flags.h"
 
 namespace lf {
 
@@ -115,43 +115,29 @@ absl::StatusOr<std::string> ReadFile(const fs::path& path) {
     return text.str();
 }
 
-// Every string in the scene JSON that names a file as `render` would find it (relative to the
-// scene's folder, `../` and absolute names included): the files the server and workers need,
-// keyed by the name as written, which is all the farm looks them up by. Finding them by looking,
-// not by schema, keeps this right as the format grows.
-void CollectFileNames(const nlohmann::json& node, const fs::path& dir,
-                      std::map<std::string, fs::path>& found) {
-    if (node.is_string()) {
-        const std::string name = node.get<std::string>();
-        if (name.empty()) return;
-        const fs::path path = fs::path(name).is_absolute() ? fs::path(name) : dir / name;
-        std::error_code ec;
-        if (fs::is_regular_file(path, ec)) found[name] = path.lexically_normal();
-    } else if (node.is_structured()) {
-        for (const auto& child : node) CollectFileNames(child, dir, found);
-    }
-}
-
-// Files named inside other files (an OBJ's MTL files, their textures) are the ones loading the
-// scene asks for: a reader that records each name it is asked for finds them. Errors are left
-// to the server, which reports them as `render` would.
-void CollectFilesTheSceneReads(const std::string& text, const fs::path& scene_path,
-                               std::map<std::string, fs::path>& found) {
-    const fs::path dir = scene_path.parent_path();
-    const SceneFileReader beside = ReadBeside(dir.empty() ? "." : dir.string());
-    (void)ParseScene(text, scene_path.string(), [&](const std::string& name) {
+// Loads the scene here, as `render` would, through a reader that records every file the loader
+// reads by the name it asks for (the name the server and workers look it up by): exactly the
+// files the farm needs (meshes, MTL files, included glTFs, their buffers and images), whatever
+// the format. A scene that does not load is refused here, with the loader's message, before
+// anything is uploaded. Returns the files' contents by name.
+absl::StatusOr<std::map<std::string, std::string>> ReadSceneFiles(const fs::path& scene_path,
+                                                                  const std::string& scene_text,
+                                                                  const SceneOptions& options) {
+    std::map<std::string, std::string> read;
+    const fs::path parent = scene_path.parent_path();
+    const SceneFileReader beside = ReadBeside(parent.empty() ? "." : parent.string());
+    const SceneFileReader recording = [&](const std::string& name) {
         absl::StatusOr<std::string> bytes = beside(name);
-        if (bytes.ok()) {
-            const fs::path path(name);
-            found[name] = (path.is_absolute() ? path : dir / path).lexically_normal();
-        }
+        if (bytes.ok()) read[name] = *bytes;
         return bytes;
-    });
+    };
+    absl::StatusOr<Scene> scene = ParseScene(scene_text, scene_path.string(), recording, options);
+    if (!scene.ok()) return scene.status();
+    return read;
 }
 
 struct LocalFile {
     pb::SceneFile ref;
-    fs::path path;
 };
 
 absl::Status Upload(pb::JobService::Stub& stub, const LocalFile& file, const std::string& content,
@@ -221,22 +207,17 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     const fs::path scene_path(o.scene_path);
     absl::StatusOr<std::string> scene_text = ReadFile(scene_path);
     if (!scene_text.ok()) return scene_text.status();
-    std::map<std::string, fs::path> names;
-    // A file that is not JSON goes up alone: the server's loader says what is wrong with it.
-    const nlohmann::json json = nlohmann::json::parse(*scene_text, nullptr, false);
-    if (!json.is_discarded()) {
-        CollectFileNames(json, scene_path.parent_path(), names);
-        CollectFilesTheSceneReads(*scene_text, scene_path, names);
-    }
+    absl::StatusOr<std::map<std::string, std::string>> read =
+        ReadSceneFiles(scene_path, *scene_text, o.spec.scene_options);
+    if (!read.ok()) return read.status();
 
     std::vector<LocalFile> files;
     std::map<std::string, std::string> contents;  // by hash
-    auto add = [&](const std::string& name, const fs::path& path,
-                   std::string content) -> absl::Status {
+    auto add = [&](const std::string& name, std::string content) -> absl::Status {
         if (absl::Status s = CheckScenePath(name); !s.ok()) {
             return absl::InvalidArgumentError(absl::StrCat(o.scene_path, ": ", s.message()));
         }
-        LocalFile f{{}, path};
+        LocalFile f;
         f.ref.set_path(name);
         f.ref.set_hash(Sha256Hex(content));
         f.ref.set_size(content.size());
@@ -244,14 +225,11 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
         files.push_back(std::move(f));
         return absl::OkStatus();
     };
-    if (absl::Status s = add(scene_path.filename().string(), scene_path, *scene_text); !s.ok()) {
+    if (absl::Status s = add(scene_path.filename().string(), *scene_text); !s.ok()) {
         return s;
     }
-    for (const auto& [name, path] : names) {
-        if (fs::equivalent(path, scene_path)) continue;
-        absl::StatusOr<std::string> content = ReadFile(path);
-        if (!content.ok()) return content.status();
-        if (absl::Status s = add(name, path, std::move(*content)); !s.ok()) return s;
+    for (auto& [name, content] : *read) {
+        if (absl::Status s = add(name, std::move(content)); !s.ok()) return s;
     }
 
     JobSpec spec = o.spec;
@@ -389,9 +367,10 @@ Command AddSubmitCommand(CLI::App& app) {
         "are uploaded, and the farm reads only those; files the\n"
         "server already has are not sent again. Same settings give the same bits as\n"
         "`lightfarm render`, whatever the tile size, passes or workers.");
-    cmd->add_option("scene", o->scene_path, "scene file (JSON)")
+    cmd->add_option("scene", o->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
+    AddSceneFlags(cmd, o->spec.scene_options);
     AddServerOption(cmd, o->farm);
     AddRetryOption(cmd, o->farm);
     cmd->add_option("--spp", o->spec.plan.spp, "samples per pixel")

@@ -65,7 +65,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     auto log = NamedLogger("render");
     const absl::Time start = absl::Now();
 
-    absl::StatusOr<Scene> scene = LoadScene(options.scene_path);
+    absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
     const std::string job_id = "local-" + scene->content_hash.substr(0, 8);
     std::string why;

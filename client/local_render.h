@@ -7,6 +7,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/scene.h"
+#include "lf/core/scene_loader.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/settings.h"
 #include "lf/kernels/radiosity.h"
@@ -16,6 +17,7 @@ namespace lf {
 
 struct LocalRenderOptions {
     std::string scene_path;
+    SceneOptions scene;  // --camera, --resolution
     std::string exr_path;
     std::string png_path;                    // empty: no preview
     std::string method = defaults::kMethod;  // path | radiosity | auto

@@ -21,6 +21,7 @@
 #include "lf/local/local_executor.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
+#include "scene_flags.h"
 
 namespace lf {
 
@@ -28,6 +29,7 @@ namespace {
 
 struct PlanOptions {
     std::string scene_path;
+    SceneOptions scene;
     std::string method = "auto";
     double target_error = 0.01;
     uint64_t pilot_spp = 8;
@@ -174,7 +176,7 @@ double TriangleArea(const TriangleMesh& mesh, const std::array<uint32_t, 3>& t) 
 }
 
 absl::Status RunPlan(const PlanOptions& options) {
-    absl::StatusOr<Scene> scene = LoadScene(options.scene_path);
+    absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
     std::printf("scene %s: %dx%d, %zu meshes, %zu spheres, %zu point lights\n",
                 options.scene_path.c_str(), scene->camera.width, scene->camera.height,
@@ -291,9 +293,10 @@ Command AddPlanCommand(CLI::App& app) {
         "time and memory of the form factors and the solve (from a pilot solve of fewer\n"
         "patches), and the samples and time a target error needs (from a short pilot render's\n"
         "own error estimate and speed).");
-    cmd->add_option("scene", options->scene_path, "scene file (JSON)")
+    cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
+    AddSceneFlags(cmd, options->scene);
     cmd->add_option("--method", options->method,
                     "the method to cost: path, radiosity (adds the cost of the form factors "
                     "and the solve, from a pilot solve) or auto (as render --method auto)")

@@ -8,6 +8,7 @@
 #include "lf/job/job_spec.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
+#include "scene_flags.h"
 
 namespace lf {
 
@@ -36,9 +37,10 @@ Command AddRenderCommand(CLI::App& app) {
         "difference estimates the error) and spp, with header attributes lightfarm.* saying\n"
         "how the image was made. Same seed and settings give the same bits for any --tile and\n"
         "--threads.");
-    cmd->add_option("scene", options->scene_path, "scene file (JSON)")
+    cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
+    AddSceneFlags(cmd, options->scene);
     cmd->add_option("-o,--output", options->exr_path, "output OpenEXR file")->required();
     cmd->add_option("--png", options->png_path, "also write an sRGB PNG preview (clamped)");
     cmd->add_option("--spp", options->render.spp, "samples per pixel")

@@ -20,13 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-absl::Status CheckRadiosityCanModel(const Scene& scene) {
-    if (const std::string why = RadiosityLimitation(scene); !why.empty()) {
-        return absl::InvalidArgumentError("radiosity: " + why);
-    }
-    return absl::OkStatus();
-}
-
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("farm"); }
 
 // A name no other writer in this process uses at the same time.
@@ -134,11 +127,12 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
             " (lightfarm-server --max-spp); lower --max-spp"));
     }
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
-        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); });
+        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); },
+        nullptr, spec.scene_options);
     // The service logs the refusal with its caller.
     if (!scene.ok()) return absl::InvalidArgumentError(scene.status().message());
     if (spec.method == "radiosity") {
-        if (absl::Status s = CheckRadiosityCanModel(*scene); !s.ok()) return s;
+        if (absl::Status s = RadiosityRefusal(*scene); !s.ok()) return s;
     }
     const int side = options_.limits.max_resolution;
     if (scene->camera.width > side || scene->camera.height > side) {

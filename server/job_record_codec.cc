@@ -78,6 +78,8 @@ std::string EncodeJobRecord(const JobRecord& r) {
            {{"target_error", s.adaptive.target_error},
             {"time_limit", s.adaptive.time_limit},
             {"max_spp", s.adaptive.max_spp}}},
+          {"camera", s.scene_options.camera},
+          {"resolution", {s.scene_options.width, s.scene_options.height}},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
           {"request_id", s.request_id}}},
@@ -133,6 +135,12 @@ absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
             const auto& a = s.at("adaptive");
             r.spec.adaptive = {a.at("target_error").get<double>(), a.at("time_limit").get<double>(),
                                a.at("max_spp").get<uint64_t>()};
+        }
+        // Records before --camera and --resolution have neither: the scene's own view.
+        r.spec.scene_options.camera = s.value("camera", std::string());
+        if (s.contains("resolution")) {
+            r.spec.scene_options.width = s.at("resolution").at(0).get<int>();
+            r.spec.scene_options.height = s.at("resolution").at(1).get<int>();
         }
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();

@@ -164,7 +164,7 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
     }
     absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
         task.spec.scene, task.spec.files, [&](const std::string& hash) { return files[hash]; },
-        &cancel);
+        &cancel, task.spec.scene_options);
     cache_.Trim();
     if (!scene.ok()) return scene.status();
     if (cancel) return cancelled();

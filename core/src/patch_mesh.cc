@@ -169,46 +169,51 @@ std::vector<GridTriangle> SubdivisionCells(int k) {
 std::string RadiosityLimitation(const Scene& scene) {
     for (const TriangleMesh& mesh : scene.meshes) {
         const Material& m = scene.materials[size_t(mesh.material)];
-        const std::string material = absl::StrCat("material \"", m.name, "\" ");
+        const std::string what =
+            absl::StrCat("material \"", m.name, "\" (mesh \"", mesh.name, "\") ");
         if (m.type != Material::Type::kLambert) {
-            return absl::StrCat(material, "is ", MaterialTypeName(m.type),
+            return absl::StrCat(what, "is ", MaterialTypeName(m.type),
                                 "; radiosity models lambert only");
         }
-        // A patch has one reflectance: a texture would be averaged away.
-        if (m.base_color_texture.valid() || m.emission_texture.valid()) {
-            const bool base = m.base_color_texture.valid();
-            const int image = (base ? m.base_color_texture : m.emission_texture).image;
-            return absl::StrCat(
-                material, "has a texture (", base ? "base_color_texture" : "emission_texture",
-                " \"", scene.textures[size_t(image)]->name, "\"), which radiosity does not model");
+        // A patch has one albedo: a texture would be averaged away.
+        for (const auto& [ref, key] :
+             {std::pair{&m.base_color_texture, "base_color_texture"},
+              {&m.emission_texture, "emission_texture"},
+              {&m.normal_texture, "normal_texture"},
+              {&m.metallic_roughness_texture, "metallic_roughness_texture"}}) {
+            if (!ref->valid()) continue;
+            return absl::StrCat(what, "has a texture (", key, " \"",
+                                scene.textures[size_t(ref->image)]->name,
+                                "\"), which radiosity does not model");
         }
         if (m.alpha_mode == Material::AlphaMode::kMask) {
-            return material + "is a cut-out (alpha mask), which radiosity does not model";
+            return what + "has an alpha mask, which radiosity does not model";
         }
-        if (!m.double_sided) {
-            return material + "is single-sided, which radiosity does not model";
-        }
+        if (!m.double_sided) return what + "is single-sided, which radiosity does not model";
     }
     if (!scene.spheres.empty()) {
         return absl::StrCat("sphere \"", scene.spheres.front().name,
                             "\" cannot be meshed; radiosity supports triangle meshes and quads "
                             "only");
     }
-    if (!scene.spot_lights.empty())
-        return "the scene has a spot light; radiosity takes point lights";
-    if (!scene.directional_lights.empty()) {
-        return "the scene has a directional light; radiosity takes point lights";
+    if (!scene.spot_lights.empty() || !scene.directional_lights.empty()) {
+        return "the scene has spot or directional lights, which radiosity does not model";
     }
     return "";
+}
+
+absl::Status RadiosityRefusal(const Scene& scene) {
+    const std::string why = RadiosityLimitation(scene);
+    if (why.empty()) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat("radiosity: ", why, "; render it with --method path"));
 }
 
 absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOptions& options) {
     auto cancelled = [&] {
         return options.cancel && options.cancel->load(std::memory_order_relaxed);
     };
-    if (const std::string why = RadiosityLimitation(scene); !why.empty()) {
-        return absl::InvalidArgumentError("radiosity: " + why);
-    }
+    if (absl::Status refused = RadiosityRefusal(scene); !refused.ok()) return refused;
     if (!(options.patch_size >= 0) || (options.patch_size == 0 && options.patches <= 0)) {
         return absl::InvalidArgumentError(
             "radiosity: give a positive patch size or a positive patch count");

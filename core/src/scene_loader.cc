@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -21,6 +22,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/file_util.h"
+#include "lf/core/gltf_scene.h"
 #include "lf/core/log.h"
 #include "lf/core/mesh_io.h"
 #include "lf/core/texture_io.h"
@@ -340,7 +342,8 @@ struct CachedMeshFile {
 
 class SceneParser {
   public:
-    explicit SceneParser(const SceneFileReader& read_file) : read_file_(read_file) {}
+    SceneParser(const SceneFileReader& read_file, const SceneOptions& options)
+        : read_file_(read_file), options_(options) {}
 
     Scene Parse(const Json& json, const std::string& text) {
         hash_.Update(text);
@@ -351,7 +354,10 @@ class SceneParser {
         }
         Scene scene;
         textures_ = &scene.textures;
-        scene.camera = ParseCamera(root.Get("camera"));
+        // Optional when an included glTF may bring a camera (ResolveCamera).
+        const std::optional<Node> camera =
+            IncludesGltf(root) ? root.Find("camera") : std::optional(root.Get("camera"));
+        if (camera) scene.camera = ParseCamera(*camera);
 
         const Node materials = root.Get("materials");
         materials.RequireObject();
@@ -369,18 +375,120 @@ class SceneParser {
             for (const Node& light : lights->Elements()) ParseLight(light, scene);
         }
 
-        if (!scene.HasLights()) {
-            warnings_.push_back("no emissive shape and no light: the image will be black");
-        }
+        ResolveCamera(root, camera.has_value(), scene);
+        return Finish(scene);
+    }
 
-        scene.dropped_degenerate = dropped_degenerate_;
-        scene.content_hash = hash_.Hex();
-        return scene;
+    // A glTF file as the whole scene: its camera, or the one options_.camera names.
+    Scene ParseGltf(const std::string& bytes, const std::string& source) {
+        hash_.Update(bytes);
+        Scene scene;
+        // The reader resolves names beside the scene file already.
+        ImportGltf(bytes, std::filesystem::path(source).filename().string(), "", Affine(), scene,
+                   [](const absl::Status& s) { throw LoadError{s}; });
+        absl::StatusOr<CameraSpec> camera = ChooseGltfCamera(gltf_cameras_, options_.camera);
+        if (!camera.ok()) throw LoadError{camera.status()};
+        scene.camera = *camera;
+        return Finish(scene);
     }
 
     const std::vector<std::string>& warnings() const { return warnings_; }
 
   private:
+    Scene Finish(Scene& scene) {
+        if (options_.width > 0 || options_.height > 0) {
+            if (!(options_.width >= 1 && options_.width <= kMaxResolution && options_.height >= 1 &&
+                  options_.height <= kMaxResolution &&
+                  int64_t(options_.width) * options_.height <= kMaxPixels)) {
+                throw LoadError{absl::InvalidArgumentError(absl::StrCat(
+                    "resolution ", options_.width, "x", options_.height, ": expected 1 to ",
+                    kMaxResolution, " per side and at most 2^28 pixels"))};
+            }
+            scene.camera.width = options_.width;
+            scene.camera.height = options_.height;
+        }
+        if (!scene.HasLights()) {
+            warnings_.push_back("no emissive shape and no light: the image will be black");
+        }
+        scene.dropped_degenerate = dropped_degenerate_;
+        scene.content_hash = hash_.Hex();
+        return std::move(scene);
+    }
+
+    static bool IncludesGltf(const Node& root) {
+        const Json& shapes = root.json().contains("shapes") ? root.json()["shapes"] : Json();
+        return shapes.is_array() && std::any_of(shapes.begin(), shapes.end(), [](const Json& s) {
+                   return s.is_object() && s.value("type", Json()) == "gltf";
+               });
+    }
+
+    // The JSON's camera unless --camera names a glTF one; the first glTF camera without either.
+    void ResolveCamera(const Node& root, bool json_camera, Scene& scene) {
+        if (json_camera && options_.camera.empty()) return;
+        if (!json_camera && gltf_cameras_.empty()) {
+            root.Fail("missing required key \"camera\" (no included glTF has a camera)");
+        }
+        if (gltf_cameras_.empty()) {
+            root.Fail(absl::StrCat("--camera \"", options_.camera,
+                                   "\": the scene has no named cameras (only glTF cameras have "
+                                   "names)"));
+        }
+        absl::StatusOr<CameraSpec> camera = ChooseGltfCamera(gltf_cameras_, options_.camera);
+        if (!camera.ok()) {
+            throw LoadError{absl::Status(camera.status().code(),
+                                         absl::StrCat("--camera: ", camera.status().message()))};
+        }
+        scene.camera = *camera;
+    }
+
+    // Appends glTF `name` (read as `bytes`) to `scene`, every file it reads hashed, its meshes
+    // checked as a JSON mesh's are. `fail` throws the error with the caller's context.
+    void ImportGltf(const std::string& bytes, const std::string& name, const std::string& base_dir,
+                    const Affine& transform, Scene& scene,
+                    const std::function<void(const absl::Status&)>& fail) {
+        const SceneFileReader hashing_reader =
+            [&](const std::string& file) -> absl::StatusOr<std::string> {
+            absl::StatusOr<std::string> read = read_file_(file);
+            if (read.ok()) hash_.Update(*read);
+            return read;
+        };
+        const size_t first_mesh = scene.meshes.size();
+        std::vector<std::string> warnings;
+        const absl::Status status = AppendGltf(bytes, name, hashing_reader, {base_dir, transform.m},
+                                               scene, gltf_cameras_, warnings);
+        for (const std::string& w : warnings) warnings_.push_back(absl::StrCat(name, ": ", w));
+        if (!status.ok()) fail(status);
+        for (size_t i = first_mesh; i < scene.meshes.size(); ++i) {
+            dropped_degenerate_ += DropDegenerate(scene.meshes[i]);
+            for (const Vec3d& p : scene.meshes[i].positions) {
+                if (MaxComponent(Abs(p)) > kMaxCoordinate) {
+                    fail(absl::InvalidArgumentError(absl::StrCat("mesh \"", scene.meshes[i].name,
+                                                                 "\" has a vertex beyond ±1e15")));
+                }
+            }
+        }
+        std::erase_if(scene.meshes, [](const TriangleMesh& m) { return m.triangles.empty(); });
+    }
+
+    // {"type": "gltf", "file": ..., "transform": ...}: a glTF file's meshes, materials, lights
+    // and cameras in a JSON scene.
+    void ParseGltfShape(const Node& n, Scene& scene) {
+        n.WarnUnknownKeys({"type", "file", "transform"});
+        const Node file = n.Get("file");
+        const std::string name = file.String();
+        if (name.empty()) file.Fail("empty file name");
+        auto fail = [&](const absl::Status& status) {
+            throw LoadError{absl::Status(
+                status.code(), absl::StrCat(file.path(), " \"", name, "\": ", status.message()))};
+        };
+        absl::StatusOr<std::string> bytes = read_file_(name);
+        if (!bytes.ok()) fail(bytes.status());
+        hash_.Update(*bytes);
+        const std::optional<Node> transform = n.Find("transform");
+        ImportGltf(*bytes, name, std::filesystem::path(name).parent_path().string(),
+                   transform ? ParseTransform(*transform) : Affine(), scene, fail);
+    }
+
     CameraSpec ParseCamera(const Node& n) {
         n.ExpectObject({"position", "look_at", "up", "fov_y_deg", "resolution"});
         CameraSpec camera;
@@ -642,6 +750,7 @@ class SceneParser {
         n.RequireObject();
         const Node type = n.Get("type");
         const std::string type_name = type.String();
+        if (type_name == "gltf") return ParseGltfShape(n, scene);
         // A mesh file may give its own materials; every other shape names one.
         const std::optional<Node> material =
             type_name == "mesh" ? n.Find("material") : std::optional(n.Get("material"));
@@ -883,6 +992,8 @@ class SceneParser {
     }
 
     const SceneFileReader& read_file_;
+    const SceneOptions& options_;
+    std::vector<GltfCamera> gltf_cameras_;
     std::vector<std::string> warnings_;
     std::map<std::string, int> material_index_;
     // By name and whether the file's own materials were read.
@@ -903,21 +1014,24 @@ SceneFileReader ReadBeside(const std::string& base_dir) {
     };
 }
 
-absl::StatusOr<Scene> LoadScene(const std::string& path) {
+absl::StatusOr<Scene> LoadScene(const std::string& path, const SceneOptions& options) {
     absl::StatusOr<std::string> text = ReadFile(path);
     if (!text.ok()) return text.status();
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    return ParseScene(*text, path, ReadBeside(parent.empty() ? "." : parent.string()));
+    return ParseScene(*text, path, ReadBeside(parent.empty() ? "." : parent.string()), options);
 }
 
 absl::StatusOr<Scene> ParseScene(const std::string& json_text, const std::string& source,
-                                 const SceneFileReader& read_file) {
+                                 const SceneFileReader& read_file, const SceneOptions& options) {
+    const bool gltf = IsGltfName(source);
     Json root;
-    if (absl::Status status = ParseJson(json_text, source, root); !status.ok()) return status;
-    SceneParser parser(read_file);
+    if (!gltf) {
+        if (absl::Status status = ParseJson(json_text, source, root); !status.ok()) return status;
+    }
+    SceneParser parser(read_file, options);
     absl::StatusOr<Scene> scene;
     try {
-        scene = parser.Parse(root, json_text);
+        scene = gltf ? parser.ParseGltf(json_text, source) : parser.Parse(root, json_text);
         scene->source = source;
     } catch (const LoadError& e) {
         scene = absl::Status(e.status.code(), absl::StrCat(source, ": ", e.status.message()));

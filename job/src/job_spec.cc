@@ -65,6 +65,12 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
     for (const absl::Status& s : checks) {
         if (!s.ok()) return s;
     }
+    // The camera name appears in messages and logs, like a file name.
+    if (!spec.scene_options.camera.empty()) {
+        if (absl::Status s = CheckScenePath(spec.scene_options.camera); !s.ok()) {
+            return absl::InvalidArgumentError(absl::StrCat("camera: ", s.message()));
+        }
+    }
     return absl::OkStatus();
 }
 

@@ -27,7 +27,7 @@ absl::Status CheckScenePath(const std::string& path) {
 absl::StatusOr<Scene> LoadSceneFromBlobs(
     const BlobRef& scene, const std::vector<BlobRef>& files,
     const std::function<std::string(const std::string& hash)>& blob_file,
-    const std::atomic<bool>* cancel) {
+    const std::atomic<bool>* cancel, const SceneOptions& options) {
     if (absl::Status s = CheckScenePath(scene.path); !s.ok()) return s;
     std::map<std::string, std::string> hash_of;  // by name
     for (const BlobRef& file : files) {
@@ -59,7 +59,7 @@ absl::StatusOr<Scene> LoadSceneFromBlobs(
     };
     absl::StatusOr<std::string> json = read_blob(scene.path, scene.hash);
     if (!json.ok()) return json.status();
-    return ParseScene(*json, scene.path, read_uploaded);
+    return ParseScene(*json, scene.path, read_uploaded, options);
 }
 
 }  // namespace lf

@@ -7,15 +7,29 @@
 #include <cstring>
 #include <limits>
 
+#include "absl/strings/str_cat.h"
 #include "lf/kernels/float_util.h"
+#include "lf/kernels/shading.h"
 
 namespace lf {
+
+namespace {
+
+// What a filtered mesh's filter function tests (the geometry's user data).
+struct MeshFilter {
+    const EmbreeScene* scene;
+    int mesh;
+    bool alpha_mask;    // rays pass through holes of the base colour's alpha
+    bool single_sided;  // rays pass through back faces
+};
+
+}  // namespace
 
 struct EmbreeScene::Handles {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
-    std::vector<std::vector<float>> vertex_buffers;  // x,y,z per vertex, padded for SSE loads
-    std::vector<float> sphere_buffer;                // x,y,z,r per sphere
+    std::vector<float> sphere_buffer;  // x,y,z,r per sphere
+    std::vector<MeshFilter> filters;   // per mesh that needs a filter function
 };
 
 namespace {
@@ -32,6 +46,60 @@ void OnEmbreeError(void*, RTCError code, const char* message) {
 // False stops the build.
 bool KeepBuilding(void* cancel, double) {
     return !static_cast<const std::atomic<bool>*>(cancel)->load(std::memory_order_relaxed);
+}
+
+// Each per-vertex attribute is absent or given for every vertex; texture refs name an image.
+absl::Status CheckMesh(const Scene& scene, const TriangleMesh& mesh) {
+    const size_t n = mesh.positions.size();
+    const auto check = [&](size_t size, const char* what) -> absl::Status {
+        if (size == 0 || size == n) return absl::OkStatus();
+        return absl::InvalidArgumentError(absl::StrCat(scene.source, ": mesh '", mesh.name,
+                                                       "' has ", size, " ", what, " for ", n,
+                                                       " vertices"));
+    };
+    if (absl::Status s = check(mesh.normals.size(), "normals"); !s.ok()) return s;
+    if (absl::Status s = check(mesh.uvs.size(), "texture coordinates"); !s.ok()) return s;
+    return check(mesh.tangents.size(), "tangents");
+}
+
+absl::Status CheckTextures(const Scene& scene, const Material& m) {
+    for (const TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture,
+                                  &m.normal_texture, &m.emission_texture}) {
+        if (!ref->valid()) continue;
+        if (size_t(ref->image) >= scene.textures.size() || !scene.textures[size_t(ref->image)]) {
+            return absl::InvalidArgumentError(absl::StrCat(scene.source, ": material '", m.name,
+                                                           "' uses texture ", ref->image, " of ",
+                                                           scene.textures.size()));
+        }
+    }
+    return absl::OkStatus();
+}
+
+// Embree calls this for every candidate hit on a filtered mesh, before accepting it.
+void FilterHits(const RTCFilterFunctionNArguments* args) {
+    const auto& f = *static_cast<const MeshFilter*>(args->geometryUserPtr);
+    const Scene& scene = f.scene->scene();
+    const TriangleMesh& mesh = scene.meshes[size_t(f.mesh)];
+    const Material& material = scene.materials[size_t(mesh.material)];
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const int prim = int(RTCHitN_primID(args->hit, args->N, i));
+        if (f.single_sided) {
+            const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                         RTCRayN_dir_z(args->ray, args->N, i));
+            Vec3 p0, p1, p2;
+            f.scene->Triangle(f.mesh, prim, &p0, &p1, &p2);
+            if (Dot(d, Cross(p1 - p0, p2 - p0)) > 0) {
+                args->valid[i] = 0;
+                continue;
+            }
+        }
+        if (f.alpha_mask) {
+            const Vec2 uv = TriangleUv(mesh, prim, RTCHitN_u(args->hit, args->N, i),
+                                       RTCHitN_v(args->hit, args->N, i));
+            if (IsCutOut(scene, material, uv)) args->valid[i] = 0;
+        }
+    }
 }
 
 }  // namespace
@@ -88,25 +156,36 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
                                            const_cast<void*>(static_cast<const void*>(cancel)));
     }
 
+    for (const Material& m : scene.materials) {
+        if (absl::Status s = CheckTextures(scene, m); !s.ok()) return s;
+    }
+    static_assert(sizeof(Vec3) == 3 * sizeof(float), "Embree reads positions_ as FLOAT3");
     es->positions_.resize(scene.meshes.size());
-    h.vertex_buffers.resize(scene.meshes.size());
+    // Filters hold pointers into this vector: sized once, never reallocated.
+    h.filters.reserve(scene.meshes.size());
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const TriangleMesh& mesh = scene.meshes[m];
+        if (absl::Status s = CheckMesh(scene, mesh); !s.ok()) return s;
         std::vector<Vec3>& pos = es->positions_[m];
-        std::vector<float>& vb = h.vertex_buffers[m];
-        pos.reserve(mesh.positions.size());
-        vb.reserve(mesh.positions.size() * 3 + 1);
-        for (const Vec3d& p : mesh.positions) {
-            pos.push_back(Vec3(p - origin));
-            vb.insert(vb.end(), {pos.back().x, pos.back().y, pos.back().z});
-        }
-        vb.push_back(0.0f);  // Embree may read 16 bytes from the last vertex
+        pos.reserve(mesh.positions.size() + 1);
+        for (const Vec3d& p : mesh.positions) pos.push_back(Vec3(p - origin));
+        pos.push_back(Vec3());  // Embree may read 16 bytes from the last vertex
         RTCGeometry geom = rtcNewGeometry(h.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vb.data(), 0,
-                                   3 * sizeof(float), mesh.positions.size());
+        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, pos.data(),
+                                   0, sizeof(Vec3), mesh.positions.size());
         rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                    mesh.triangles.data(), 0, 3 * sizeof(uint32_t),
                                    mesh.triangles.size());
+        const Material& material = scene.materials[size_t(mesh.material)];
+        const bool alpha_mask = material.alpha_mode == Material::AlphaMode::kMask;
+        const bool single_sided = !material.double_sided && !Transmits(material);
+        // Ordinary meshes keep Embree's fast path: no callback per candidate hit.
+        if (alpha_mask || single_sided) {
+            h.filters.push_back({es.get(), int(m), alpha_mask, single_sided});
+            rtcSetGeometryUserData(geom, &h.filters.back());
+            rtcSetGeometryIntersectFilterFunction(geom, FilterHits);
+            rtcSetGeometryOccludedFilterFunction(geom, FilterHits);
+        }
         rtcCommitGeometry(geom);
         const unsigned id = rtcAttachGeometry(h.scene, geom);
         rtcReleaseGeometry(geom);
@@ -152,6 +231,10 @@ SurfacePoint EmbreeScene::TrianglePoint(int mesh, int primitive, float b1, float
     sp.p = p0 * b0 + p1 * b1 + p2 * b2;
     sp.p_error = (Abs(p0 * b0) + Abs(p1 * b1) + Abs(p2 * b2)) * Gamma(7);
     sp.n = Normalize(Cross(p1 - p0, p2 - p0));
+    sp.mesh = mesh;
+    sp.primitive = primitive;
+    sp.b1 = b1;
+    sp.b2 = b2;
     return sp;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "lf/kernels/bsdf.h"
+#include "lf/kernels/shading.h"
 
 namespace lf {
 
@@ -14,7 +15,13 @@ float PowerHeuristic(float pdf_a, float pdf_b) {
     return a + b > 0 ? a / (a + b) : 0;
 }
 
-SurfacePoint AsPoint(const SurfaceHit& hit) { return {hit.p, hit.p_error, hit.n}; }
+// The interior a path is in after leaving a surface of material `index` in direction wi:
+// a transmission through a solid transmitter's surface enters it (against the geometric
+// normal) or leaves it (along it).
+int MediumAfter(int medium, int index, const Material& material, float cos_i_ng, bool transmitted) {
+    if (!transmitted || !HasInterior(material)) return medium;
+    return cos_i_ng < 0 ? index : -1;
+}
 
 // Roulette spares the first bounce: direct and one-bounce light are never cut.
 constexpr int kRouletteStartDepth = 1;
@@ -32,20 +39,28 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
     float prev_pdf = 0;
     Vec3 prev_p;
     float eta_scale = 1;
+    // The solid transmitter whose interior the ray travels through (a material index), or -1.
+    int medium = -1;
 
     for (int depth = 0;; ++depth) {
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
         if (!hit) break;
+        if (medium >= 0) {
+            beta *= Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
+            if (beta.IsBlack()) break;
+        }
         const Material& material = materials[size_t(hit->material)];
-        const bool front = Dot(ray.d, hit->n) < 0;
+        const Vec3& ng = hit->n;
+        const float cos_o_ng = -Dot(ray.d, ng);
+        const Shading sh = Shade(scene_, *hit, -ray.d);
 
-        if (front && material.IsEmissive()) {
+        if (cos_o_ng > 0 && !sh.emission.IsBlack()) {
             if (delta_bounce) {
-                L += beta * material.emission;
+                L += beta * sh.emission;
             } else {
                 const float light_pdf = lights_.Pdf(prev_p, *hit);
-                L += beta * material.emission * PowerHeuristic(prev_pdf, light_pdf);
+                L += beta * sh.emission * PowerHeuristic(prev_pdf, light_pdf);
             }
         }
         if (depth == max_depth_) break;
@@ -54,23 +69,44 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
             break;
         }
 
-        const Frame frame = Frame::FromNormal(hit->n);
+        // The BSDF lives in the shading frame; the geometric normal decides sides. A direction
+        // the two put on different sides of the surface (reflection for one, transmission for
+        // the other) carries nothing: that is where shading normals would leak light. The one
+        // exception is reflection just below a smooth mesh's facet near the terminator, which
+        // the smooth surface still reflects: allowed when the ray from Hanika's lifted point
+        // misses its own triangle (other geometry is the ray's business).
+        const Frame frame = Frame::FromNormal(sh.ns);
         const Vec3 wo = frame.ToLocal(-ray.d);
-        const Bsdf bsdf(material);
-        const SurfacePoint here = AsPoint(*hit);
+        const auto consistent = [&](const Vec3& wi_world, const Vec3& wi) {
+            const float cos_i_ng = Dot(wi_world, ng);
+            if (cos_i_ng == 0) return false;
+            const bool reflect = wi.z * wo.z > 0;
+            if ((cos_i_ng * cos_o_ng > 0) == reflect) return true;
+            return reflect && cos_o_ng > 0 && sh.ClearsFacet(wi_world);
+        };
+        const Bsdf bsdf(material, sh.params);
 
         if (!bsdf.IsDelta()) {
             const float u_pick = sampler.Get1D();
             const Vec2 u_light = sampler.Get2D();
             if (const auto ls = lights_.Sample(hit->p, u_pick, u_light)) {
                 const Vec3 wi = frame.ToLocal(ls->wi);
-                const Rgb f = bsdf.Eval(wo, wi) * std::abs(wi.z);
-                if (!f.IsBlack()) {
+                const Rgb f = consistent(ls->wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
+                const Rgb radiance =
+                    f.IsBlack() ? Rgb() : EmissionAt(scene_, ls->point, ls->radiance);
+                if (!radiance.IsBlack()) {
                     ++stats.rays;
-                    if (!scene_.Occluded(SpawnRayTo(here, ls->point))) {
+                    if (!scene_.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) {
                         const float w =
                             ls->delta ? 1.0f : PowerHeuristic(ls->pdf, bsdf.Pdf(wo, wi));
-                        L += beta * f * ls->radiance * (w / ls->pdf);
+                        Rgb contribution = beta * f * radiance * (w / ls->pdf);
+                        const int through = MediumAfter(medium, hit->material, material,
+                                                        Dot(ls->wi, ng), wi.z * wo.z < 0);
+                        if (through >= 0) {
+                            contribution *= Transmittance(materials[size_t(through)],
+                                                          Length(ls->point.p - hit->p));
+                        }
+                        L += contribution;
                     }
                 }
             }
@@ -80,18 +116,20 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         const Vec2 u = sampler.Get2D();
         const std::optional<BsdfSample> bs = bsdf.Sample(wo, uc, u);
         if (!bs || !(bs->pdf > 0)) break;
+        const Vec3 wi = frame.FromLocal(bs->wi);
+        if (!consistent(wi, bs->wi)) break;
         beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
         if (beta.IsBlack()) break;
-        if (bs->delta && bs->wi.z * wo.z < 0) {
-            // Radiance is scaled by 1/eta^2 across the interface; roulette must not see that.
-            const float eta = wo.z > 0 ? material.ior : 1 / material.ior;
-            eta_scale *= eta * eta;
-        }
+        const bool transmitted = bs->wi.z * wo.z < 0;
+        const int next_medium =
+            MediumAfter(medium, hit->material, material, Dot(wi, ng), transmitted);
+        // Radiance is scaled by 1/eta^2 across a refracting interface; roulette must not see it.
+        eta_scale *= bs->eta * bs->eta;
+        medium = next_medium;
         delta_bounce = bs->delta;
         prev_pdf = bs->pdf;
         prev_p = hit->p;
-        const Vec3 wi = frame.FromLocal(bs->wi);
-        ray = SpawnRay(here, wi);
+        ray = SpawnRay(sh.Leaving(wi), wi);
 
         if (depth >= kRouletteStartDepth) {
             const float q = std::max(0.0f, 1 - beta.MaxComponent() * eta_scale);

@@ -27,9 +27,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 // The solver refuses this too, by side index; here the user learns which material it is. What
 // radiosity cannot model at all is said first: a textured albedo's factor of 1 is no albedo.
 absl::Status CheckReflectance(const Scene& scene) {
-    if (const std::string why = RadiosityLimitation(scene); !why.empty()) {
-        return absl::InvalidArgumentError("radiosity: " + why);
-    }
+    if (absl::Status refused = RadiosityRefusal(scene); !refused.ok()) return refused;
     bool emits = false;
     for (const PointLight& light : scene.point_lights) emits |= !light.intensity.IsBlack();
     for (const TriangleMesh& mesh : scene.meshes) {

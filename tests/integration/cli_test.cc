@@ -195,22 +195,23 @@ TEST_F(Cli, AutoTakesThePathTracerForTexturesAndSaysWhy) {
     const RunResult automatic =
         Lightfarm("render " + textured + " -o " + exr + " --method auto --spp 1 --no-progress");
     ASSERT_EQ(automatic.status, 0) << automatic.output;
-    EXPECT_NE(automatic.output.find("method path (material \"wood\" has a texture "
-                                    "(base_color_texture \"wood.png\"), which radiosity does "
-                                    "not model)"),
+    EXPECT_NE(automatic.output.find("method path (material \"wood\" (mesh \"shapes[0]\") has "
+                                    "a texture (base_color_texture \"wood.png\"), which "
+                                    "radiosity does not model)"),
               std::string::npos)
         << automatic.output;
     const RunResult radiosity = Lightfarm("render " + textured + " -o " + exr +
                                           " --method radiosity --spp 1 --no-progress");
     EXPECT_NE(radiosity.status, 0);
-    EXPECT_NE(radiosity.output.find("radiosity: material \"wood\" has a texture"),
+    EXPECT_NE(radiosity.output.find("radiosity: material \"wood\" (mesh \"shapes[0]\") has a "
+                                    "texture"),
               std::string::npos)
         << radiosity.output;
 
     const std::string principled = scene(R"({"type": "principled", "metallic": 1})");
     const RunResult plan = Lightfarm("plan " + principled + " --pilot-spp 2 --threads 2");
-    EXPECT_NE(plan.output.find("method (--method auto): path, because material \"wood\" is "
-                               "principled; radiosity models lambert only"),
+    EXPECT_NE(plan.output.find("method (--method auto): path, because material \"wood\" (mesh "
+                               "\"shapes[0]\") is principled; radiosity models lambert only"),
               std::string::npos)
         << plan.output;
 }

@@ -25,8 +25,10 @@
 #include <thread>
 #include <vector>
 
+#include "gltf_files.h"
 #include "image_files.h"
 #include "lf/core/image_io.h"
+#include "lf/job/digest.h"
 #include "test_dir.h"
 
 namespace lf {
@@ -787,8 +789,9 @@ TEST_F(Farm, FilesAnObjNamesAreUploadedWithTheScene) {
     std::ofstream(textured) << scene.dump();
     const CliRun r = Farmctl("submit " + textured + " --method radiosity");
     EXPECT_NE(r.status, 0);
-    EXPECT_NE(r.err.find("radiosity: material \"models/box.mtl#wood\" has a texture "
-                         "(base_color_texture \"models/wood.png\")"),
+    EXPECT_NE(r.err.find("radiosity: material \"models/box.mtl#wood\" (mesh "), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("has a texture (base_color_texture \"models/wood.png\")"),
               std::string::npos)
         << r.err;
 }
@@ -902,6 +905,82 @@ TEST_F(Farm, TerminatedWorkerStopsARadiosityTaskWithinASecond) {
     EXPECT_LT(seconds, 1.0);
     std::printf("worker exited %.3f s after SIGTERM\n", seconds);
     EXPECT_NE(ReadText(dir_ / "w1.log").find("handed back"), std::string::npos);
+}
+
+// The textured glTF of the import tests, its quad glowing so the image is not black: a .gltf
+// with its .bin and image in a folder of their own, and a .glb with the image beside it.
+struct GltfFiles {
+    std::string gltf, glb;
+    std::vector<std::string> hashes;  // of every file the .gltf scene reads, itself included
+};
+
+GltfFiles WriteGltfScene(const fs::path& dir) {
+    fs::create_directories(dir);
+    testing::GltfBuilder b = testing::TexturedTestScene();
+    b.json()["materials"][0]["emissiveFactor"] = {1, 0.5, 0.25};
+    b.json()["materials"][0]["emissiveTexture"] = {{"index", 0}};
+    const std::string gltf = b.Gltf("scene.bin"), glb = b.Glb();
+    const std::string png = testing::PngBytes(2, 2, 4, testing::TestTexels());
+    std::ofstream(dir / "scene.gltf", std::ios::binary) << gltf;
+    std::ofstream(dir / "scene.bin", std::ios::binary) << b.bin();
+    std::ofstream(dir / "scene.glb", std::ios::binary) << glb;
+    std::ofstream(dir / "tex.png", std::ios::binary) << png;
+    std::ofstream(dir / "unrelated.png", std::ios::binary) << png + "x";
+    return {(dir / "scene.gltf").string(),
+            (dir / "scene.glb").string(),
+            {Sha256Hex(gltf), Sha256Hex(b.bin()), Sha256Hex(png)}};
+}
+
+TEST_F(Farm, TexturedGltfSceneGivesTheLocalPixels) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const GltfFiles files = WriteGltfScene(dir_ / "gltf");
+    const std::string flags = "--method path --resolution 48x32 --camera Front";
+    const std::string job = Submit(files.gltf, "--spp 8 --seed 5 --tile 16 " + flags);
+    ExpectSameAsLocal(job, files.gltf, 8, 5, flags);
+    // Another seed: ExpectSameAsLocal keeps local renders by spp, seed and flags.
+    const std::string glb_job = Submit(files.glb, "--spp 8 --seed 6 --tile 16 " + flags);
+    ExpectSameAsLocal(glb_job, files.glb, 8, 6, flags);
+    // A JSON scene in another folder including the glTF by a relative name: its buffer and
+    // image are uploaded by the names the loader asked for ("../gltf/scene.bin").
+    fs::create_directories(dir_ / "json");
+    std::ofstream(dir_ / "json" / "lit.json")
+        << R"({"materials": {}, "shapes": [{"type": "gltf", "file": "../gltf/scene.gltf",)"
+           R"( "transform": {"translate": [0, 0.5, 0]}}], "lights": [{"type": "point",)"
+           R"( "position": [2, 3, 3], "intensity": [5, 5, 5]}]})";
+    const std::string json = (dir_ / "json" / "lit.json").string();
+    const std::string json_job = Submit(json, "--spp 8 --seed 7 --tile 16 " + flags);
+    ExpectSameAsLocal(json_job, json, 8, 7, flags);
+    // Uploaded: the files the loader read (the glTF, its buffer, its image), not what else
+    // lies in the folder.
+    std::set<std::string> blobs;
+    for (const auto& e : fs::directory_iterator(dir_ / "data" / "blobs")) {
+        blobs.insert(e.path().filename().string());
+    }
+    for (const std::string& hash : files.hashes) EXPECT_TRUE(blobs.count(hash)) << hash;
+    const std::string unrelated = Sha256Hex(ReadText(dir_ / "gltf" / "unrelated.png"));
+    EXPECT_FALSE(blobs.count(unrelated));
+}
+
+TEST_F(Farm, BadGltfIsRefusedAtSubmissionWithTheLoadersMessage) {
+    StartServer();
+    const GltfFiles files = WriteGltfScene(dir_ / "gltf");
+    nlohmann::json gltf = nlohmann::json::parse(ReadText(files.gltf));
+    gltf["meshes"][1]["primitives"][0]["mode"] = 1;
+    std::ofstream(files.gltf) << gltf.dump();
+    const CliRun local = Lightfarm("render " + files.gltf + " -o " + (dir_ / "x.exr").string());
+    const CliRun farm = Farmctl("submit " + files.gltf);
+    EXPECT_NE(farm.status, 0);
+    const std::string message = "meshes[1] \"tri\".primitives[0]: mode 1 (LINES) is not supported";
+    EXPECT_NE(local.err.find(message), std::string::npos) << local.err;
+    EXPECT_NE(farm.err.find(message), std::string::npos) << farm.err;
+    // A texture missing on submission: refused before anything is uploaded.
+    fs::remove(dir_ / "gltf" / "tex.png");
+    const CliRun missing = Farmctl("submit " + files.glb);
+    EXPECT_NE(missing.status, 0);
+    EXPECT_NE(missing.err.find("images[0] \"checker\": uri \"tex.png\""), std::string::npos)
+        << missing.err;
 }
 
 }  // namespace

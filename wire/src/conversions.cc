@@ -48,6 +48,9 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_target_error(spec.adaptive.target_error);
     out->set_time_limit_seconds(spec.adaptive.time_limit);
     out->set_max_spp(spec.adaptive.max_spp);
+    out->set_camera(spec.scene_options.camera);
+    out->set_width(spec.scene_options.width);
+    out->set_height(spec.scene_options.height);
 }
 
 void FromProto(const pb::RenderParams& p, JobSpec* spec) {
@@ -61,6 +64,7 @@ void FromProto(const pb::RenderParams& p, JobSpec* spec) {
     spec->adaptive.target_error = p.target_error();
     spec->adaptive.time_limit = p.time_limit_seconds();
     if (p.max_spp() != 0) spec->adaptive.max_spp = p.max_spp();
+    spec->scene_options = {p.camera(), p.width(), p.height()};
 }
 
 void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {

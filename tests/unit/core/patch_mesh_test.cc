@@ -353,35 +353,44 @@ TEST(PatchMesh, RadiosityLimitationSaysWhy) {
     auto why = [](void (*change)(Scene&)) {
         Scene scene = OneTriangle();
         scene.materials[0].name = "wood";
+        scene.meshes[0].name = "floor";
         change(scene);
         return RadiosityLimitation(scene);
     };
     EXPECT_EQ(why([](Scene&) {}), "");
     EXPECT_EQ(why([](Scene& s) { s.materials[0].type = Material::Type::kPrincipled; }),
-              "material \"wood\" is principled; radiosity models lambert only");
+              "material \"wood\" (mesh \"floor\") is principled; radiosity models lambert only");
     EXPECT_EQ(why([](Scene& s) {
                   auto image = std::make_shared<TextureImage>();
                   image->name = "wood.png";
                   s.textures.push_back(image);
                   s.materials[0].base_color_texture.image = 0;
               }),
-              "material \"wood\" has a texture (base_color_texture \"wood.png\"), which "
-              "radiosity does not model");
+              "material \"wood\" (mesh \"floor\") has a texture (base_color_texture "
+              "\"wood.png\"), which radiosity does not model");
     EXPECT_EQ(why([](Scene& s) { s.materials[0].alpha_mode = Material::AlphaMode::kMask; }),
-              "material \"wood\" is a cut-out (alpha mask), which radiosity does not model");
+              "material \"wood\" (mesh \"floor\") has an alpha mask, which radiosity does not "
+              "model");
     EXPECT_EQ(why([](Scene& s) { s.materials[0].double_sided = false; }),
-              "material \"wood\" is single-sided, which radiosity does not model");
+              "material \"wood\" (mesh \"floor\") is single-sided, which radiosity does not "
+              "model");
+    EXPECT_EQ(why([](Scene& s) {
+                  s.spheres.push_back({"ball", 0, Vec3d(), 1});
+              }),
+              "sphere \"ball\" cannot be meshed; radiosity supports triangle meshes and quads "
+              "only");
     EXPECT_EQ(why([](Scene& s) { s.spot_lights.emplace_back(); }),
-              "the scene has a spot light; radiosity takes point lights");
+              "the scene has spot or directional lights, which radiosity does not model");
     EXPECT_EQ(why([](Scene& s) { s.directional_lights.emplace_back(); }),
-              "the scene has a directional light; radiosity takes point lights");
+              "the scene has spot or directional lights, which radiosity does not model");
     // A material no shape uses does not matter.
     EXPECT_EQ(why([](Scene& s) { s.materials.emplace_back().type = Material::Type::kDielectric; }),
               "");
     Scene spot = OneTriangle();
     spot.spot_lights.emplace_back();
     EXPECT_EQ(PatchMesh::Build(spot, {}).status().message(),
-              "radiosity: the scene has a spot light; radiosity takes point lights");
+              "radiosity: the scene has spot or directional lights, which radiosity does not "
+              "model; render it with --method path");
 }
 
 }  // namespace

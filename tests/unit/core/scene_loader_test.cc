@@ -1,8 +1,6 @@
 #include "lf/core/scene_loader.h"
 
 #include <gtest/gtest.h>
-#include <spdlog/sinks/ostream_sink.h>
-#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -12,22 +10,13 @@
 #include <sstream>
 
 #include "image_files.h"
+#include "scene_log.h"
 #include "test_dir.h"
 
 namespace lf {
 namespace {
 
-// Routes the "scene" logger into a string the tests can search.
-std::ostringstream& CapturedLog() {
-    static std::ostringstream* const log = [] {
-        auto* stream = new std::ostringstream;
-        spdlog::drop("scene");
-        spdlog::register_logger(std::make_shared<spdlog::logger>(
-            "scene", std::make_shared<spdlog::sinks::ostream_sink_mt>(*stream)));
-        return stream;
-    }();
-    return *log;
-}
+std::ostringstream& CapturedLog() { return testing::CapturedSceneLog(); }
 
 size_t Count(const std::string& text, const std::string& part) {
     size_t n = 0;

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <map>
 
+#include "gltf_files.h"
+#include "image_files.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
 #include "test_dir.h"
@@ -129,6 +131,53 @@ TEST_F(SceneFilesTest, NamesAreKeysWithoutControlCharacters) {
     EXPECT_FALSE(CheckScenePath("").ok());
     EXPECT_FALSE(CheckScenePath("a\nb.obj").ok());
     EXPECT_FALSE(CheckScenePath(std::string(kMaxScenePathBytes + 1, 'a')).ok());
+}
+
+// A glTF scene blob keeps its name's extension, which is what makes it load as glTF: .glb and
+// .gltf (with its buffer and image uploaded by the names the glTF writes) load the scene render
+// loads, a camera and resolution chosen as render would, and a bad one is refused with the
+// message render gives.
+TEST_F(SceneFilesTest, GltfAndGlbBlobsLoadAsRenderLoadsThem) {
+    testing::GltfBuilder b = testing::TexturedTestScene();
+    const std::string png = testing::PngBytes(2, 2, 4, testing::TestTexels());
+    std::ofstream(dir_ / "scenes" / "s.gltf") << b.Gltf("s.bin");
+    std::ofstream(dir_ / "scenes" / "s.bin", std::ios::binary) << b.bin();
+    std::ofstream(dir_ / "scenes" / "tex.png", std::ios::binary) << png;
+    const SceneOptions options{.camera = "Front", .width = 20, .height = 10};
+    const absl::StatusOr<Scene> local = LoadScene((dir_ / "scenes" / "s.gltf").string(), options);
+    ASSERT_TRUE(local.ok()) << local.status();
+    const std::vector<BlobRef> files = {Put("s.bin", b.bin()), Put("tex.png", png)};
+    const auto blob_file = [&](const std::string& hash) {
+        return (dir_ / "blobs" / hash).string();
+    };
+    const absl::StatusOr<Scene> farm =
+        LoadSceneFromBlobs(Put("s.gltf", b.Gltf("s.bin")), files, blob_file, nullptr, options);
+    ASSERT_TRUE(farm.ok()) << farm.status();
+    EXPECT_EQ(farm->content_hash, local->content_hash);
+    EXPECT_EQ(farm->camera.width, 20);
+    EXPECT_EQ(farm->textures.size(), 1u);
+    const absl::StatusOr<Scene> glb =
+        LoadSceneFromBlobs(Put("s.glb", b.Glb()), files, blob_file, nullptr, options);
+    ASSERT_TRUE(glb.ok()) << glb.status();
+    EXPECT_EQ(glb->meshes[0].positions, local->meshes[0].positions);
+
+    b.json()["meshes"][0]["primitives"][0]["mode"] = 0;
+    const absl::StatusOr<Scene> bad_local =
+        ParseScene(b.Gltf("s.bin"), "s.gltf", ReadBeside((dir_ / "scenes").string()));
+    const absl::StatusOr<Scene> bad_farm =
+        LoadSceneFromBlobs(Put("s.gltf", b.Gltf("s.bin")), files, blob_file);
+    ASSERT_FALSE(bad_farm.ok());
+    EXPECT_EQ(bad_farm.status().message(), bad_local.status().message());
+    EXPECT_NE(bad_farm.status().message().find("s.gltf: meshes[0] \"quad\".primitives[0]: mode 0"),
+              std::string::npos)
+        << bad_farm.status();
+    // Only what was uploaded: the image, named as the glTF names it, is not here.
+    const absl::StatusOr<Scene> no_image = LoadSceneFromBlobs(
+        Put("s.glb", testing::TexturedTestScene().Glb()), {Put("s.bin", b.bin())}, blob_file);
+    ASSERT_FALSE(no_image.ok());
+    EXPECT_NE(no_image.status().message().find("uri \"tex.png\": not among the files uploaded"),
+              std::string::npos)
+        << no_image.status();
 }
 
 }  // namespace

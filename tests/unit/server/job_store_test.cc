@@ -139,6 +139,23 @@ TEST(JobRecordCodec, IntegerStatesOfOldRecordsStillRead) {
     EXPECT_EQ(DecodeJobRecord(stored.dump())->state, JobState::kFailed);
 }
 
+TEST(JobRecordCodec, CameraAndResolutionSurviveAndOldRecordsHaveNone) {
+    JobRecord job = Record("a", 1);
+    job.spec.scene_options = {.camera = "Side", .width = 640, .height = 360};
+    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(job));
+    const absl::StatusOr<JobRecord> back = DecodeJobRecord(stored.dump());
+    ASSERT_TRUE(back.ok()) << back.status();
+    EXPECT_EQ(back->spec.scene_options.camera, "Side");
+    EXPECT_EQ(back->spec.scene_options.width, 640);
+    EXPECT_EQ(back->spec.scene_options.height, 360);
+    stored["spec"].erase("camera");
+    stored["spec"].erase("resolution");
+    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
+    ASSERT_TRUE(old.ok()) << old.status();
+    EXPECT_EQ(old->spec.scene_options.camera, "");
+    EXPECT_EQ(old->spec.scene_options.width, 0);
+}
+
 TEST(JobRecordCodec, UnknownStateNameIsAClearError) {
     nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
     stored["state"] = "paused";

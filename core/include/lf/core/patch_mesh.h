@@ -27,11 +27,16 @@
 
 namespace lf {
 
-// Why radiosity cannot model `scene` ("material \"wood\" has a texture (base_color_texture
-// \"wood.png\"), which radiosity does not model"), or empty when it can: radiosity solves for one
-// radiosity per patch side, so it takes triangle meshes whose materials are untextured, opaque,
-// double-sided lambert, lit by emission and point lights.
+// Why radiosity cannot model `scene` ("material \"wood\" (mesh \"floor\") has a texture
+// (base_color_texture \"wood.png\"), which radiosity does not model"), or empty when it can:
+// radiosity solves for one radiosity per patch side, so it takes triangle meshes whose materials
+// are untextured, opaque, double-sided lambert, lit by emission and point lights. Only materials
+// some mesh uses count. `--method auto` logs it when it picks the path tracer.
 std::string RadiosityLimitation(const Scene& scene);
+
+// RadiosityLimitation as the error radiosity refuses a scene with (meshing, the solver, the
+// farm's submission), or OK.
+absl::Status RadiosityRefusal(const Scene& scene);
 
 // A cell of a scene triangle's subdivision: upward (i, j), (i+1, j), (i, j+1) or downward
 // (i+1, j), (i+1, j+1), (i, j+1) in the grid with k 2^level divisions.

@@ -19,11 +19,21 @@ using SceneFileReader = std::function<absl::StatusOr<std::string>(const std::str
 // Relative names against `base_dir`, absolute ones as they are: a scene on the user's disk.
 SceneFileReader ReadBeside(const std::string& base_dir);
 
-// Files beside the scene file (ReadBeside of its folder).
-absl::StatusOr<Scene> LoadScene(const std::string& path);
+// What the user asks of a scene beyond its file (`--camera`, `--resolution`).
+struct SceneOptions {
+    // A glTF camera by its node's (or its own) name, also one of a glTF a JSON scene includes,
+    // in place of the JSON's camera. Empty: the JSON's camera, else the first glTF camera.
+    std::string camera;
+    int width = 0, height = 0;  // above 0: the image size, whatever the scene says
+};
 
-// `source` names the text in messages.
+// Files beside the scene file (ReadBeside of its folder).
+absl::StatusOr<Scene> LoadScene(const std::string& path, const SceneOptions& options = {});
+
+// `source` names the text in messages; a name ending in .gltf or .glb (any case) is a glTF 2.0
+// file (lf/core/gltf_scene.h), anything else a JSON scene.
 absl::StatusOr<Scene> ParseScene(const std::string& json_text, const std::string& source,
-                                 const SceneFileReader& read_file);
+                                 const SceneFileReader& read_file,
+                                 const SceneOptions& options = {});
 
 }  // namespace lf

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "lf/core/scene_loader.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
@@ -21,7 +22,9 @@ struct JobSpec {
     std::string name;
     BlobRef scene;               // the scene JSON
     std::vector<BlobRef> files;  // the files it names
-    RenderPlanSettings plan;     // width and height come from the scene
+    // --camera and --resolution: the view of the scene this job renders (the loader checks them)
+    SceneOptions scene_options;
+    RenderPlanSettings plan;  // width and height come from the scene and scene_options
     uint64_t seed = defaults::kSeed;
     int max_depth = defaults::kMaxDepth;
     std::string method = defaults::kMethod;  // or "radiosity"

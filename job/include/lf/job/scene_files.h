@@ -12,6 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/scene.h"
+#include "lf/core/scene_loader.h"
 
 namespace lf {
 
@@ -35,10 +36,11 @@ absl::Status CheckScenePath(const std::string& path);
 // exact name in the JSON (`blob_file` maps a hash to the local file holding that blob). A name
 // not among `files` is an error naming the JSON field and the name only, whatever exists on this
 // machine. InvalidArgument also for two files of one name with different contents; Cancelled
-// once `cancel` is set, checked before each file.
+// once `cancel` is set, checked before each file. A scene blob whose name ends in .gltf or .glb
+// is a glTF file (ParseScene); `options` are the job's --camera and --resolution.
 absl::StatusOr<Scene> LoadSceneFromBlobs(
     const BlobRef& scene, const std::vector<BlobRef>& files,
     const std::function<std::string(const std::string& hash)>& blob_file,
-    const std::atomic<bool>* cancel = nullptr);
+    const std::atomic<bool>* cancel = nullptr, const SceneOptions& options = {});
 
 }  // namespace lf

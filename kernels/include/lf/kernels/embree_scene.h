@@ -31,6 +31,10 @@ struct SurfaceHit {
 // A point on a surface with its error bound and normal: where rays start and end.
 struct SurfacePoint {
     Vec3 p, p_error, n;
+    // The triangle it lies on, when it came from TrianglePoint (light samples): lets the path
+    // tracer read the emitter's textures there. mesh -1 otherwise.
+    int mesh = -1, primitive = 0;
+    float b1 = 0, b2 = 0;
 };
 
 // A ray origin just outside p's error box on the side of w.
@@ -48,14 +52,14 @@ class EmbreeScene {
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
+    // Neither sees alpha-mask holes nor the back faces of single-sided, non-transmissive meshes:
+    // Embree filter functions on just those meshes skip such hits.
     std::optional<SurfaceHit> Intersect(const Ray& ray) const;
     bool Occluded(const Ray& ray) const;
 
     const Scene& scene() const { return scene_; }
     const Vec3d& origin() const { return origin_; }
 
-    // Render-space geometry, for light sampling and meshing.
-    const std::vector<Vec3>& positions(int mesh) const { return positions_[size_t(mesh)]; }
     Vec3 SphereCenter(int sphere) const { return sphere_centers_[size_t(sphere)]; }
     // Vertices of triangle `primitive` of `mesh` in render space.
     void Triangle(int mesh, int primitive, Vec3* p0, Vec3* p1, Vec3* p2) const;
@@ -69,6 +73,9 @@ class EmbreeScene {
     Vec3d origin_;
     struct Handles;
     std::unique_ptr<Handles> handles_;
+    // Render-space float positions per mesh, one padding vertex at the end: also Embree's vertex
+    // buffer (shared, not copied). Normals, uvs and tangents are read from the Scene itself:
+    // translation to render space leaves them unchanged.
     std::vector<std::vector<Vec3>> positions_;
     std::vector<Vec3> sphere_centers_;
     unsigned sphere_geometry_ = ~0u;

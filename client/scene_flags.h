@@ -1,0 +1,23 @@
+// --camera and --resolution: the view of a scene, for every command that loads one (render,
+// plan, converge, bench, submit).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "lf/core/scene_loader.h"
+
+namespace lf {
+
+// --camera NAME, filling options.camera.
+void AddCameraFlag(CLI::App* cmd, SceneOptions& options);
+
+// --resolution WxH into options.width and height; with `single`, also a bare N (at most
+// `max_single`) into *single, for the commands whose --resolution N came first.
+void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, int* single, int max_single,
+                       const std::string& help);
+
+// --camera and --resolution WxH, filling `options`.
+void AddSceneFlags(CLI::App* cmd, SceneOptions& options);
+
+}  // namespace lf

@@ -1,0 +1,64 @@
+// The surface interaction at a hit: where the BSDF is evaluated (the shading frame from
+// interpolated vertex normals and normal maps), what it is made of there (the material's
+// factors times its textures), and where rays leaving it start (Hanika's shadow-terminator
+// offset on smooth meshes). The geometric normal stays in SurfaceHit::n: it decides sides.
+#pragma once
+
+#include "lf/core/scene.h"
+#include "lf/kernels/bsdf.h"
+#include "lf/kernels/embree_scene.h"
+
+namespace lf {
+
+struct Shading {
+    SurfacePoint point;  // the hit: p, its error bound, the geometric normal n
+    // Unit shading normal on the geometric normal's side; equals point.n on flat geometry.
+    // Bent, where needed, so that wo is on the same side of it as of the geometric normal.
+    Vec3 ns;
+    Vec2 uv;
+    SurfaceParams params;
+    Rgb emission;  // radiance leaving the front face: factor times emission texture
+    // Hanika's P' (Ray Tracing Gems II, ch. 4): the hit lifted towards the smooth surface the
+    // vertex normals describe; where rays leaving on the normals' side start.
+    Vec3 p_outer;
+
+    // The triangle's vertices (render space) on smooth meshes, for ClearsFacet.
+    Vec3 v[3];
+
+    // Where a ray leaving in direction w starts from: p_outer for reflection the shading normal
+    // allows just below the facet (see ClearsFacet), else the hit.
+    SurfacePoint Leaving(const Vec3& w) const;
+    // For w just below the facet's plane on the front (cos with n < 0) near a smooth mesh's
+    // terminator, where the shading normal says it is still above the surface: true when the
+    // ray from p_outer passes outside this triangle, so it does not go through the surface.
+    bool ClearsFacet(const Vec3& w) const;
+};
+
+// The interaction at `hit` seen from direction wo (unit, away from the surface).
+Shading Shade(const EmbreeScene& scene, const SurfaceHit& hit, const Vec3& wo);
+
+// The radiance a light sample on an emitter carries: `radiance` (the material's emission
+// factor, as LightSampler gives it) times the emission texture at the sample; black in an
+// alpha-mask hole, which emits nothing because rays pass through it.
+Rgb EmissionAt(const EmbreeScene& scene, const SurfacePoint& light_point, const Rgb& radiance);
+
+// TEXCOORD_0 of a triangle's point; (0, 0) on meshes without uvs.
+Vec2 TriangleUv(const TriangleMesh& mesh, int primitive, float b1, float b2);
+
+// The material's opacity at uv: its factor times the base colour texture's alpha.
+float Opacity(const Scene& scene, const Material& material, const Vec2& uv);
+
+// True when rays pass through the material at uv (an alpha-mask hole).
+bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv);
+
+// Materials whose back faces let light out: single-sided culling spares them.
+bool Transmits(const Material& material);
+
+// Solid transmitters (principled with thickness > 0, dielectric): a path that crosses their
+// surface against the geometric normal is inside until it crosses back.
+bool HasInterior(const Material& material);
+
+// Beer's law through `distance` of `material`'s interior.
+Rgb Transmittance(const Material& material, float distance);
+
+}  // namespace lf

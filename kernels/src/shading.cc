@@ -1,0 +1,215 @@
+#include "lf/kernels/shading.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "lf/core/texture.h"
+#include "lf/kernels/float_util.h"
+
+namespace lf {
+namespace {
+
+Rgba Sample(const Scene& scene, const TextureRef& ref, const Vec2& uv) {
+    return Lookup(*scene.textures[size_t(ref.image)], ref, uv);
+}
+
+// The triangle's dp/du and dp/dv from its uvs (pbrt-v4's Triangle::InteractionFromIntersection);
+// false when the uvs are degenerate.
+bool UvDerivatives(const EmbreeScene& es, const TriangleMesh& mesh, const SurfaceHit& hit,
+                   Vec3* dpdu, Vec3* dpdv) {
+    const auto& tri = mesh.triangles[size_t(hit.primitive)];
+    Vec3 p0, p1, p2;
+    es.Triangle(hit.mesh, hit.primitive, &p0, &p1, &p2);
+    const Vec2 uv0 = mesh.uvs[tri[0]], uv1 = mesh.uvs[tri[1]], uv2 = mesh.uvs[tri[2]];
+    const float du02 = uv0.x - uv2.x, dv02 = uv0.y - uv2.y;
+    const float du12 = uv1.x - uv2.x, dv12 = uv1.y - uv2.y;
+    const float det = du02 * dv12 - dv02 * du12;
+    if (!(std::abs(det) > 1e-12f)) return false;
+    const Vec3 dp02 = p0 - p2, dp12 = p1 - p2;
+    *dpdu = (dp02 * dv12 - dp12 * dv02) / det;
+    *dpdv = (dp12 * du02 - dp02 * du12) / det;
+    return IsFinite(*dpdu) && IsFinite(*dpdv) && LengthSquared(*dpdu) > 0;
+}
+
+// The tangent and the bitangent's sign (glTF: bitangent = sign * cross(normal, tangent)) at the
+// hit: the mesh's tangents interpolated, or else the triangle's dp/du with the sign that makes
+// the bitangent point towards decreasing v (up in the image, the normal map's +y).
+bool TangentAt(const EmbreeScene& es, const TriangleMesh& mesh, const SurfaceHit& hit,
+               const Vec3& n, Vec3* tangent, float* sign) {
+    const auto& tri = mesh.triangles[size_t(hit.primitive)];
+    if (!mesh.tangents.empty()) {
+        const float b[3] = {1 - hit.b1 - hit.b2, hit.b1, hit.b2};
+        Vec3 t;
+        float w = 0;
+        for (int i = 0; i < 3; ++i) {
+            const auto& ti = mesh.tangents[tri[size_t(i)]];
+            t += Vec3(ti[0], ti[1], ti[2]) * b[i];
+            w += ti[3] * b[i];
+        }
+        *tangent = t;
+        *sign = w < 0 ? -1.0f : 1.0f;
+        return true;
+    }
+    Vec3 dpdu, dpdv;
+    if (!UvDerivatives(es, mesh, hit, &dpdu, &dpdv)) return false;
+    *tangent = dpdu;
+    *sign = Dot(Cross(n, dpdu), dpdv) < 0 ? 1.0f : -1.0f;
+    return true;
+}
+
+// The normal map's normal at the hit, or `n` where the map cannot apply (no uvs or tangent,
+// or a texel that points below the geometric surface).
+Vec3 NormalMapped(const EmbreeScene& es, const Material& m, const SurfaceHit& hit, const Vec2& uv,
+                  const Vec3& n) {
+    if (hit.mesh < 0) return n;
+    const TriangleMesh& mesh = es.scene().meshes[size_t(hit.mesh)];
+    if (mesh.uvs.empty()) return n;
+    Vec3 t;
+    float sign;
+    if (!TangentAt(es, mesh, hit, n, &t, &sign)) return n;
+    t = t - n * Dot(n, t);  // Gram-Schmidt against the shading normal
+    if (!(LengthSquared(t) > 0)) return n;
+    t = Normalize(t);
+    const Vec3 b = Cross(n, t) * sign;
+    // Texels hold (n + 1) / 2 as linear data; the scale applies to x and y (glTF).
+    const Rgb c = Sample(es.scene(), m.normal_texture, uv).rgb;
+    const float x = (2 * c.r - 1) * m.normal_scale, y = (2 * c.g - 1) * m.normal_scale;
+    const float z = 2 * c.b - 1;
+    const Vec3 mapped = t * x + b * y + n * z;
+    if (!(LengthSquared(mapped) > 0) || !(Dot(mapped, hit.n) > 0)) return n;
+    return Normalize(mapped);
+}
+
+}  // namespace
+
+SurfacePoint Shading::Leaving(const Vec3& w) const {
+    // Only rays that dip below the facet need P'. Above it the flat facet is the better origin:
+    // on a convex mesh nothing can shadow it there, while P' lies outside the mesh, where
+    // neighbouring facets turning away from the light would (an 8x4 sphere lost 11% of its
+    // lit radiance that way).
+    if (!(Dot(w, ns) > 0) || !(Dot(w, point.n) < 0) || p_outer == point.p) return point;
+    // P' is P plus a vector with a non-negative component along n; only the final sum rounds.
+    return {p_outer, point.p_error + Abs(p_outer) * Gamma(2), point.n};
+}
+
+bool Shading::ClearsFacet(const Vec3& w) const {
+    const float lift = Dot(p_outer - point.p, point.n), cos_w = Dot(w, point.n);
+    if (!(lift > 0) || !(cos_w < 0)) return false;
+    // Where the ray meets the facet's plane; inside all three edges (counter-clockwise about n)
+    // means inside the triangle.
+    const Vec3 q = p_outer + w * (lift / -cos_w);
+    for (int i = 0; i < 3; ++i) {
+        const Vec3& a = v[i];
+        const Vec3& b = v[(i + 1) % 3];
+        if (Dot(Cross(b - a, q - a), point.n) < 0) return true;
+    }
+    return false;
+}
+
+Vec2 TriangleUv(const TriangleMesh& mesh, int primitive, float b1, float b2) {
+    if (mesh.uvs.empty()) return {0, 0};
+    const auto& tri = mesh.triangles[size_t(primitive)];
+    const Vec2 uv0 = mesh.uvs[tri[0]], uv1 = mesh.uvs[tri[1]], uv2 = mesh.uvs[tri[2]];
+    const float b0 = 1 - b1 - b2;
+    return {b0 * uv0.x + b1 * uv1.x + b2 * uv2.x, b0 * uv0.y + b1 * uv1.y + b2 * uv2.y};
+}
+
+float Opacity(const Scene& scene, const Material& material, const Vec2& uv) {
+    float a = material.opacity;
+    if (material.base_color_texture.valid()) a *= Sample(scene, material.base_color_texture, uv).a;
+    return a;
+}
+
+bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv) {
+    return material.alpha_mode == Material::AlphaMode::kMask &&
+           Opacity(scene, material, uv) < material.alpha_cutoff;
+}
+
+bool Transmits(const Material& material) {
+    return material.type == Material::Type::kDielectric ||
+           (material.type == Material::Type::kPrincipled && material.transmission > 0);
+}
+
+bool HasInterior(const Material& material) {
+    return material.type == Material::Type::kDielectric ||
+           (material.type == Material::Type::kPrincipled && material.transmission > 0 &&
+            material.thickness > 0);
+}
+
+Rgb Transmittance(const Material& material, float distance) {
+    if (!std::isfinite(material.attenuation_distance) || !(distance > 0)) return Rgb(1);
+    Rgb t;
+    for (int c = 0; c < 3; ++c) {
+        // sigma = -ln(colour) / d, so exp(-sigma * distance) = colour^(distance / d).
+        t[c] = std::pow(std::max(0.0f, material.attenuation_color[c]),
+                        distance / material.attenuation_distance);
+    }
+    return t;
+}
+
+Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
+    const Scene& scene = es.scene();
+    const Material& m = scene.materials[size_t(hit.material)];
+    Shading s;
+    s.point = {hit.p, hit.p_error, hit.n};
+    s.ns = hit.n;
+    s.p_outer = hit.p;
+    if (hit.mesh >= 0) {
+        const TriangleMesh& mesh = scene.meshes[size_t(hit.mesh)];
+        s.uv = TriangleUv(mesh, hit.primitive, hit.b1, hit.b2);
+        if (!mesh.normals.empty()) {
+            const auto& tri = mesh.triangles[size_t(hit.primitive)];
+            const float b[3] = {1 - hit.b1 - hit.b2, hit.b1, hit.b2};
+            es.Triangle(hit.mesh, hit.primitive, &s.v[0], &s.v[1], &s.v[2]);
+            Vec3 n_sum, lift;
+            for (int i = 0; i < 3; ++i) {
+                const Vec3 ni = FaceForward(mesh.normals[tri[size_t(i)]], hit.n);
+                n_sum += ni * b[i];
+                // Hanika: project P onto each vertex's tangent plane where P lies below it.
+                lift -= ni * (b[i] * std::min(0.0f, Dot(hit.p - s.v[i], ni)));
+            }
+            if (LengthSquared(n_sum) > 0) s.ns = Normalize(n_sum);
+            s.p_outer = hit.p + lift;
+        }
+    }
+    if (m.normal_texture.valid()) s.ns = NormalMapped(es, m, hit, s.uv, s.ns);
+    // A view from the geometric front below the shading hemisphere (grazing, at the silhouette
+    // of a coarse smooth mesh or under a steep normal map) would make every reflection
+    // inconsistent, a black rim: bend ns until wo is just on its side, as Cycles'
+    // ensure_valid_reflection does.
+    constexpr float kMinCosView = 0.01f;
+    const float side = Dot(wo, hit.n) < 0 ? -1.0f : 1.0f;
+    const float cos_o = Dot(wo, s.ns);
+    if (side * cos_o < kMinCosView) s.ns = Normalize(s.ns + wo * (side * kMinCosView - cos_o));
+
+    s.params = SurfaceParams::Of(m);
+    if (m.base_color_texture.valid()) {
+        s.params.base_color *= Sample(scene, m.base_color_texture, s.uv).rgb;
+    }
+    if (m.metallic_roughness_texture.valid()) {
+        const Rgb mr = Sample(scene, m.metallic_roughness_texture, s.uv).rgb;
+        s.params.roughness *= mr.g;
+        s.params.metallic *= mr.b;
+    }
+    s.emission = m.emission;
+    if (m.IsEmissive() && m.emission_texture.valid()) {
+        s.emission *= Sample(scene, m.emission_texture, s.uv).rgb;
+    }
+    return s;
+}
+
+Rgb EmissionAt(const EmbreeScene& es, const SurfacePoint& light_point, const Rgb& radiance) {
+    if (light_point.mesh < 0) return radiance;
+    const Scene& scene = es.scene();
+    const TriangleMesh& mesh = scene.meshes[size_t(light_point.mesh)];
+    const Material& m = scene.materials[size_t(mesh.material)];
+    if (!m.emission_texture.valid() && m.alpha_mode != Material::AlphaMode::kMask) {
+        return radiance;
+    }
+    const Vec2 uv = TriangleUv(mesh, light_point.primitive, light_point.b1, light_point.b2);
+    if (IsCutOut(scene, m, uv)) return Rgb(0);
+    if (!m.emission_texture.valid()) return radiance;
+    return radiance * Sample(scene, m.emission_texture, uv).rgb;
+}
+
+}  // namespace lf

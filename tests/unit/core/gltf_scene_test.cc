@@ -1,0 +1,499 @@
+#include "lf/core/gltf_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "gltf_files.h"
+#include "image_files.h"
+#include "lf/core/scene_loader.h"
+#include "lf/core/texture.h"
+#include "scene_log.h"
+#include "test_dir.h"
+
+namespace lf {
+namespace {
+
+using testing::GltfBuilder;
+using Json = nlohmann::json;
+
+std::ostringstream& CapturedLog() { return testing::CapturedSceneLog(); }
+
+void ExpectNear(const Vec3d& a, const Vec3d& b, double tolerance = 1e-12) {
+    EXPECT_NEAR(a.x, b.x, tolerance);
+    EXPECT_NEAR(a.y, b.y, tolerance);
+    EXPECT_NEAR(a.z, b.z, tolerance);
+}
+
+// Each triangle's corners in order: what two meshes must agree on to be the same surface,
+// whatever order their vertex arrays are in.
+std::vector<std::array<Vec3d, 3>> Corners(const TriangleMesh& mesh) {
+    std::vector<std::array<Vec3d, 3>> out;
+    for (const auto& t : mesh.triangles) {
+        out.push_back({mesh.positions[t[0]], mesh.positions[t[1]], mesh.positions[t[2]]});
+    }
+    return out;
+}
+
+class GltfSceneTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = testing::FreshTestDir("lf_gltf_scene");
+        CapturedLog().str("");
+        Write("tex.png", testing::PngBytes(2, 2, 4, testing::TestTexels()));
+    }
+    void TearDown() override { std::filesystem::remove_all(dir_); }
+
+    void Write(const std::string& name, const std::string& bytes) {
+        std::filesystem::create_directories((dir_ / name).parent_path());
+        std::ofstream(dir_ / name, std::ios::binary) << bytes;
+    }
+
+    // Writes `b` as name (.gltf with name.bin beside it, or .glb) and loads it.
+    absl::StatusOr<Scene> Load(const GltfBuilder& b, const std::string& name = "scene.gltf",
+                               const SceneOptions& options = {}) {
+        if (name.ends_with(".glb")) {
+            Write(name, b.Glb());
+        } else {
+            Write(name, b.Gltf(std::filesystem::path(name).stem().string() + ".bin"));
+            Write(std::filesystem::path(name).stem().string() + ".bin", b.bin());
+        }
+        return LoadScene((dir_ / name).string(), options);
+    }
+
+    // The load's error message, which the test expects to contain every one of `parts`.
+    void ExpectError(const absl::StatusOr<Scene>& scene, std::initializer_list<std::string> parts) {
+        ASSERT_FALSE(scene.ok());
+        for (const std::string& part : parts) {
+            EXPECT_NE(scene.status().message().find(part), std::string::npos)
+                << "\"" << part << "\" not in: " << scene.status().message();
+        }
+    }
+
+    std::filesystem::path dir_;
+};
+
+TEST_F(GltfSceneTest, LoadsTheSameGeometryCameraAndLightsAsTheEquivalentJson) {
+    const absl::StatusOr<Scene> gltf = Load(testing::TexturedTestScene());
+    ASSERT_TRUE(gltf.ok()) << gltf.status();
+    const absl::StatusOr<Scene> json =
+        ParseScene(testing::TexturedTestSceneJson(), "scene.json", ReadBeside(dir_.string()));
+    ASSERT_TRUE(json.ok()) << json.status();
+
+    ASSERT_EQ(gltf->meshes.size(), json->meshes.size());
+    for (size_t m = 0; m < gltf->meshes.size(); ++m) {
+        EXPECT_EQ(gltf->meshes[m].material, json->meshes[m].material);
+        const auto a = Corners(gltf->meshes[m]), b = Corners(json->meshes[m]);
+        ASSERT_EQ(a.size(), b.size()) << m;
+        for (size_t t = 0; t < a.size(); ++t) {
+            for (int c = 0; c < 3; ++c) ExpectNear(a[t][c], b[t][c]);
+        }
+    }
+    const CameraSpec &gc = gltf->camera, &jc = json->camera;
+    ExpectNear(gc.position, jc.position);
+    ExpectNear(Normalize(gc.look_at - gc.position), Normalize(jc.look_at - jc.position));
+    ExpectNear(gc.up, jc.up);
+    EXPECT_DOUBLE_EQ(gc.fov_y_deg, jc.fov_y_deg);
+    EXPECT_EQ(gc.width, 1024);  // the longer side; the other from aspectRatio 1.5
+    EXPECT_EQ(gc.height, 683);
+    ASSERT_EQ(gltf->point_lights.size(), 1u);
+    ExpectNear(gltf->point_lights[0].position, json->point_lights[0].position);
+    // 6830 cd of colour (1, 0.5, 0.25) at 683 lm/W.
+    EXPECT_FLOAT_EQ(gltf->point_lights[0].intensity.r, 10);
+    EXPECT_FLOAT_EQ(gltf->point_lights[0].intensity.g, 5);
+    EXPECT_FLOAT_EQ(gltf->point_lights[0].intensity.b, 2.5);
+}
+
+TEST_F(GltfSceneTest, ImportsShadingAttributesThroughTheNodeTransforms) {
+    const absl::StatusOr<Scene> scene = Load(testing::TexturedTestScene());
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const TriangleMesh& quad = scene->meshes[0];
+    ASSERT_EQ(quad.normals.size(), 4u);
+    ASSERT_EQ(quad.uvs.size(), 4u);
+    // The +z normal turned a quarter about +y faces +x; uniform scale leaves it unit.
+    for (const Vec3& n : quad.normals) ExpectNear(Vec3d(n), {1, 0, 0}, 1e-6);
+    EXPECT_EQ(quad.uvs[1].x, 1);
+    EXPECT_EQ(quad.uvs[2].y, 0);
+    EXPECT_TRUE(scene->meshes[1].normals.empty());
+    EXPECT_TRUE(quad.tangents.empty());  // no normal map, no need
+}
+
+TEST_F(GltfSceneTest, TangentsAreComputedForANormalMapWhenTheFileHasNone) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["materials"][0]["normalTexture"] = {{"index", 0}};
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const TriangleMesh& quad = scene->meshes[0];
+    ASSERT_EQ(quad.tangents.size(), 4u);
+    // u grows along the quad's local +x, which the quarter turn about +y takes to -z; v falls
+    // along local +y (up in the image), which is cross(normal, tangent): w = +1.
+    for (const auto& t : quad.tangents) {
+        ExpectNear(Vec3d(t[0], t[1], t[2]), {0, 0, -1}, 1e-6);
+        EXPECT_EQ(t[3], 1);
+    }
+}
+
+TEST_F(GltfSceneTest, NormalsUseTheInverseTransposeAndMirrorsKeepFrontFaces) {
+    GltfBuilder b;
+    // A 45-degree slope in xz, squashed 4x along x: its normal must tilt toward x, not z.
+    const int p = b.AddFloats<3>({{{0, 0, 0}}, {{1, 0, -1}}, {{0, 1, 0}}});
+    const double r = std::sqrt(0.5);
+    const int n = b.AddFloats<3>(
+        {{{float(r), 0, float(r)}}, {{float(r), 0, float(r)}}, {{float(r), 0, float(r)}}});
+    const int slope = b.AddMesh("slope", {{"POSITION", p}, {"NORMAL", n}}, -1, -1);
+    b.AddNode({{"mesh", slope}, {"scale", {0.25, 1, -1}}});
+    b.AddNode({{"camera", 0}});
+    b.json()["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 1}, {"znear", 1}}}}};
+    b.json()["scenes"] = {{{"nodes", {0, 1}}}};
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const TriangleMesh& mesh = scene->meshes[0];
+    // The surface is z' = x' * 4 after (x/4, y, -z): normal (4, 0, -1)/sqrt(17) by the
+    // inverse transpose diag(4, 1, -1) of (r, 0, r).
+    ExpectNear(Vec3d(mesh.normals[0]), Normalize(Vec3d(4, 0, -1)), 1e-6);
+    // Scale with a negative determinant mirrors: the winding flips so the geometric front face
+    // still agrees with the normals.
+    const auto& t = mesh.triangles[0];
+    const Vec3d front = Cross(mesh.positions[t[1]] - mesh.positions[t[0]],
+                              mesh.positions[t[2]] - mesh.positions[t[0]]);
+    EXPECT_GT(Dot(front, Vec3d(mesh.normals[0])), 0);
+    EXPECT_EQ(scene->camera.width, kGltfLongerSide);  // no aspectRatio: square
+    EXPECT_EQ(scene->camera.height, kGltfLongerSide);
+    // A primitive without material gets glTF's default material.
+    const Material& m = scene->materials[size_t(mesh.material)];
+    EXPECT_EQ(m.type, Material::Type::kPrincipled);
+    EXPECT_EQ(m.metallic, 1);
+    EXPECT_EQ(m.roughness, 1);
+    EXPECT_FALSE(m.double_sided);
+}
+
+TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedImages) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Json& j = b.json();
+    // A second texture of the same image with the default sampler, used by a material with every
+    // extension the importer reads.
+    j["textures"].push_back({{"source", 0}});
+    j["materials"].push_back(
+        {{"name", "glass"},
+         {"pbrMetallicRoughness",
+          {{"baseColorFactor", {0.9, 0.8, 0.7, 0.6}},
+           {"metallicFactor", 0.25},
+           {"roughnessFactor", 0.3},
+           {"metallicRoughnessTexture",
+            {{"index", 1},
+             {"extensions",
+              {{"KHR_texture_transform",
+                {{"offset", {0.5, 0.25}}, {"rotation", 0.1}, {"scale", {2, 3}}}}}}}}}},
+         {"normalTexture", {{"index", 1}, {"scale", 0.5}}},
+         {"occlusionTexture", {{"index", 1}}},
+         {"emissiveFactor", {1, 0.5, 0}},
+         {"emissiveTexture", {{"index", 0}}},
+         {"alphaMode", "MASK"},
+         {"alphaCutoff", 0.3},
+         {"extensions",
+          {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
+           {"KHR_materials_transmission", {{"transmissionFactor", 0.75}}},
+           {"KHR_materials_ior", {{"ior", 1.33}}},
+           {"KHR_materials_volume",
+            {{"thicknessFactor", 0.1},
+             {"attenuationDistance", 2},
+             {"attenuationColor", {0.5, 0.6, 0.7}}}}}}});
+    j["materials"].push_back({{"name", "blend"}, {"alphaMode", "BLEND"}});
+    j["meshes"][1]["primitives"][0]["material"] = 2;
+    j["meshes"][0]["primitives"].push_back(j["meshes"][1]["primitives"][0]);
+    j["meshes"][0]["primitives"][1]["material"] = 3;
+    j["extensionsUsed"] = {"KHR_lights_punctual", "KHR_texture_transform",
+                           "KHR_materials_clearcoat"};
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+
+    ASSERT_EQ(scene->materials.size(), 4u);
+    const Material& textured = scene->materials[0];
+    EXPECT_EQ(textured.type, Material::Type::kPrincipled);
+    EXPECT_EQ(textured.roughness, 0.5f);
+    ASSERT_TRUE(textured.base_color_texture.valid());
+    EXPECT_TRUE(textured.base_color_texture.srgb);
+    EXPECT_TRUE(textured.base_color_texture.nearest);
+    EXPECT_EQ(textured.base_color_texture.wrap_s, TextureRef::Wrap::kClampToEdge);
+    EXPECT_EQ(textured.base_color_texture.wrap_t, TextureRef::Wrap::kClampToEdge);
+    EXPECT_TRUE(textured.double_sided == false);
+    EXPECT_TRUE(scene->materials[1].double_sided);
+
+    const Material& glass = scene->materials[2];
+    EXPECT_FLOAT_EQ(glass.reflectance.g, 0.8f);
+    EXPECT_FLOAT_EQ(glass.opacity, 0.6f);
+    EXPECT_FLOAT_EQ(glass.metallic, 0.25f);
+    EXPECT_FLOAT_EQ(glass.roughness, 0.3f);
+    const TextureRef& mr = glass.metallic_roughness_texture;
+    EXPECT_FALSE(mr.srgb);
+    EXPECT_FALSE(mr.nearest);
+    EXPECT_EQ(mr.wrap_s, TextureRef::Wrap::kRepeat);
+    EXPECT_FLOAT_EQ(mr.offset.x, 0.5f);
+    EXPECT_FLOAT_EQ(mr.offset.y, 0.25f);
+    EXPECT_FLOAT_EQ(mr.rotation, 0.1f);
+    EXPECT_FLOAT_EQ(mr.scale.y, 3);
+    EXPECT_FALSE(glass.normal_texture.srgb);
+    EXPECT_FLOAT_EQ(glass.normal_scale, 0.5f);
+    EXPECT_TRUE(glass.emission_texture.srgb);
+    // Emitted radiance: emissiveFactor times emissiveStrength.
+    EXPECT_FLOAT_EQ(glass.emission.r, 4);
+    EXPECT_FLOAT_EQ(glass.emission.g, 2);
+    EXPECT_FLOAT_EQ(glass.transmission, 0.75f);
+    EXPECT_FLOAT_EQ(glass.ior, 1.33f);
+    EXPECT_FLOAT_EQ(glass.thickness, 0.1f);
+    EXPECT_FLOAT_EQ(glass.attenuation_distance, 2);
+    EXPECT_FLOAT_EQ(glass.attenuation_color.b, 0.7f);
+    EXPECT_EQ(glass.alpha_mode, Material::AlphaMode::kMask);
+    EXPECT_FLOAT_EQ(glass.alpha_cutoff, 0.3f);
+    const Material& blend = scene->materials[3];
+    EXPECT_EQ(blend.alpha_mode, Material::AlphaMode::kMask);
+    EXPECT_FLOAT_EQ(blend.alpha_cutoff, 0.5f);
+
+    // One image, decoded once, shared by every ref to it, texels top row first.
+    ASSERT_EQ(scene->textures.size(), 1u);
+    EXPECT_EQ(textured.base_color_texture.image, mr.image);
+    EXPECT_EQ(glass.emission_texture.image, mr.image);
+    const TextureImage& image = *scene->textures[0];
+    EXPECT_EQ(image.width, 2);
+    const Rgba top_right = Texel(image, 1, 0, false);
+    EXPECT_FLOAT_EQ(top_right.rgb.g, 1);
+    EXPECT_FLOAT_EQ(Texel(image, 1, 1, false).a, 128 / 255.0f);
+
+    const std::string log = CapturedLog().str();
+    EXPECT_NE(log.find("occlusionTexture ignored"), std::string::npos) << log;
+    EXPECT_NE(log.find("BLEND rendered as MASK"), std::string::npos) << log;
+    EXPECT_NE(log.find("extension KHR_materials_clearcoat not supported: the clear coat layer"),
+              std::string::npos)
+        << log;
+}
+
+TEST_F(GltfSceneTest, SpotAndDirectionalLightsPointDownTheirNodesMinusZ) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Json& j = b.json();
+    j["extensions"]["KHR_lights_punctual"]["lights"].push_back(
+        {{"type", "spot"},
+         {"intensity", 683},
+         {"range", 5},
+         {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.4}}}});
+    j["extensions"]["KHR_lights_punctual"]["lights"].push_back(
+        {{"type", "directional"}, {"color", {0.5, 1, 1}}, {"intensity", 1366}});
+    const double s = std::sqrt(0.5);  // a quarter turn about +x: -z becomes -y, straight down
+    const int spot = b.AddNode({{"translation", {0, 3, 0}},
+                                {"rotation", {-s, 0, 0, s}},
+                                {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+    const int sun = b.AddNode(
+        {{"rotation", {-s, 0, 0, s}}, {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
+    j["scenes"][0]["nodes"].push_back(spot);
+    j["scenes"][0]["nodes"].push_back(sun);
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_EQ(scene->spot_lights.size(), 1u);
+    const SpotLight& light = scene->spot_lights[0];
+    ExpectNear(light.position, {0, 3, 0});
+    ExpectNear(light.direction, {0, -1, 0}, 1e-12);
+    EXPECT_FLOAT_EQ(light.intensity.g, 1);  // 683 cd
+    EXPECT_DOUBLE_EQ(light.inner_cone, 0.2);
+    EXPECT_DOUBLE_EQ(light.outer_cone, 0.4);
+    ASSERT_EQ(scene->directional_lights.size(), 1u);
+    ExpectNear(scene->directional_lights[0].direction, {0, -1, 0}, 1e-12);
+    EXPECT_FLOAT_EQ(scene->directional_lights[0].irradiance.r, 1);  // 0.5 * 1366 lx / 683
+    EXPECT_FLOAT_EQ(scene->directional_lights[0].irradiance.g, 2);
+    EXPECT_NE(CapturedLog().str().find("range ignored"), std::string::npos);
+}
+
+TEST_F(GltfSceneTest, GlbAndEmbeddedBuffersLoadTheSameScene) {
+    const GltfBuilder b = testing::TexturedTestScene();
+    const absl::StatusOr<Scene> gltf = Load(b);
+    const absl::StatusOr<Scene> glb = Load(b, "scene.GLB");
+    Write("embedded.gltf", b.GltfEmbedded());
+    const absl::StatusOr<Scene> embedded = LoadScene((dir_ / "embedded.gltf").string());
+    ASSERT_TRUE(gltf.ok()) << gltf.status();
+    ASSERT_TRUE(glb.ok()) << glb.status();
+    ASSERT_TRUE(embedded.ok()) << embedded.status();
+    for (const Scene* other : {&*glb, &*embedded}) {
+        ASSERT_EQ(other->meshes.size(), gltf->meshes.size());
+        EXPECT_EQ(other->meshes[0].positions[2], gltf->meshes[0].positions[2]);
+        EXPECT_EQ(other->textures.size(), 1u);
+    }
+    // The content hash covers the buffer and the image: another texture, another hash.
+    Write("tex.png", testing::PngBytes(1, 1, 3, {1, 2, 3}));
+    const absl::StatusOr<Scene> retextured = LoadScene((dir_ / "scene.gltf").string());
+    ASSERT_TRUE(retextured.ok()) << retextured.status();
+    EXPECT_NE(retextured->content_hash, gltf->content_hash);
+}
+
+TEST_F(GltfSceneTest, CameraOptionPicksACameraByNameAndUnknownNamesListTheCameras) {
+    GltfBuilder b = testing::TexturedTestScene();
+    const int side = b.AddNode({{"name", "Side"}, {"camera", 0}, {"translation", {9, 1, 0}}});
+    b.json()["scenes"][0]["nodes"].push_back(side);
+    const absl::StatusOr<Scene> first = Load(b);
+    ASSERT_TRUE(first.ok()) << first.status();
+    ExpectNear(first->camera.position, {3, 1, 6});
+    const absl::StatusOr<Scene> picked = Load(b, "scene.gltf", {.camera = "Side"});
+    ASSERT_TRUE(picked.ok()) << picked.status();
+    ExpectNear(picked->camera.position, {9, 1, 0});
+    ExpectError(Load(b, "scene.gltf", {.camera = "Top"}),
+                {"scene.gltf", "no camera named \"Top\"", "\"Front\", \"Side\""});
+    // --resolution overrides the glTF's.
+    const absl::StatusOr<Scene> sized =
+        Load(b, "scene.gltf", {.camera = "", .width = 40, .height = 30});
+    ASSERT_TRUE(sized.ok()) << sized.status();
+    EXPECT_EQ(sized->camera.width, 40);
+    EXPECT_EQ(sized->camera.height, 30);
+}
+
+TEST_F(GltfSceneTest, JsonSceneIncludesAGltfWithItsCameraOrItsOwn) {
+    const GltfBuilder b = testing::TexturedTestScene();
+    Write("models/car.gltf", b.Gltf("car.bin"));
+    Write("models/car.bin", b.bin());
+    Write("models/tex.png", testing::PngBytes(2, 2, 4, testing::TestTexels()));
+    const std::string shape =
+        R"({"type": "gltf", "file": "models/car.gltf", "transform": {"translate": [0, 10, 0]}})";
+    // No JSON camera: the glTF's, moved with the file like everything in it.
+    const absl::StatusOr<Scene> included = ParseScene(
+        R"({"materials": {}, "shapes": [)" + shape + "]}", "scene.json", ReadBeside(dir_.string()));
+    ASSERT_TRUE(included.ok()) << included.status();
+    ExpectNear(included->camera.position, {3, 11, 6});
+    ExpectNear(included->point_lights[0].position, {3, 15, 0});
+    ExpectNear(included->meshes[0].positions[0], {1, 10, 0});
+    EXPECT_EQ(included->textures.size(), 1u);
+    // A JSON camera wins, unless --camera names a glTF one.
+    const std::string with_camera =
+        R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov_y_deg": 30,
+            "resolution": [64, 48]}, "materials": {}, "shapes": [)" +
+        shape + "]}";
+    const absl::StatusOr<Scene> own =
+        ParseScene(with_camera, "scene.json", ReadBeside(dir_.string()));
+    ASSERT_TRUE(own.ok()) << own.status();
+    EXPECT_EQ(own->camera.width, 64);
+    const absl::StatusOr<Scene> named =
+        ParseScene(with_camera, "scene.json", ReadBeside(dir_.string()), {.camera = "Front"});
+    ASSERT_TRUE(named.ok()) << named.status();
+    ExpectNear(named->camera.position, {3, 11, 6});
+    // Neither a JSON camera nor a glTF one.
+    GltfBuilder no_camera = b;
+    no_camera.json()["scenes"][0]["nodes"] = {2, 4};
+    Write("models/car.gltf", no_camera.Gltf("car.bin"));
+    const absl::StatusOr<Scene> none = ParseScene(R"({"materials": {}, "shapes": [)" + shape + "]}",
+                                                  "scene.json", ReadBeside(dir_.string()));
+    ExpectError(none, {"scene.json", "camera", "no included glTF has a camera"});
+    const absl::StatusOr<Scene> unnamed =
+        ParseScene(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov_y_deg": 30,
+                       "resolution": [64, 48]}, "materials": {}, "shapes": [)" +
+                       shape + "]}",
+                   "scene.json", ReadBeside(dir_.string()), {.camera = "Front"});
+    ExpectError(unnamed, {"scene.json", "--camera \"Front\": the scene has no named cameras"});
+}
+
+// Bad input: each refused with the file, the glTF object and what is wrong, nothing crashed.
+
+TEST_F(GltfSceneTest, TruncatedGlbIsRefused) {
+    const std::string glb = testing::TexturedTestScene().Glb();
+    for (size_t size : {size_t(3), size_t(12), size_t(30), glb.size() / 2, glb.size() - 1}) {
+        Write("cut.glb", glb.substr(0, size));
+        const absl::StatusOr<Scene> scene = LoadScene((dir_ / "cut.glb").string());
+        ASSERT_FALSE(scene.ok()) << size;
+        EXPECT_NE(scene.status().message().find("cut.glb"), std::string::npos)
+            << scene.status().message();
+        if (size >= 4) {  // shorter is not recognisably a .glb at all
+            EXPECT_NE(scene.status().message().find("truncated glTF binary"), std::string::npos)
+                << scene.status().message();
+        }
+    }
+}
+
+TEST_F(GltfSceneTest, MissingBufferOrTextureFileIsNamed) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Write("scene.gltf", b.Gltf("gone.bin"));
+    ExpectError(LoadScene((dir_ / "scene.gltf").string()),
+                {"scene.gltf", "buffer uri \"gone.bin\""});
+    b.json()["images"][0]["uri"] = "missing.png";
+    ExpectError(Load(b), {"scene.gltf", "images[0] \"checker\"", "missing.png"});
+}
+
+TEST_F(GltfSceneTest, BufferViewOrAccessorBeyondItsBufferIsRefused) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["bufferViews"][0]["byteLength"] = 1 << 20;
+    ExpectError(Load(b), {"scene.gltf", "meshes[0] \"quad\".primitives[0].attributes.POSITION",
+                          "bufferViews[0]", "beyond buffer 0"});
+    GltfBuilder c = testing::TexturedTestScene();
+    c.json()["accessors"][0]["count"] = 40;
+    ExpectError(Load(c), {"accessors[0]", "40 elements", "beyond bufferViews[0]"});
+}
+
+TEST_F(GltfSceneTest, NanOrInfinityInAnAccessorIsRefused) {
+    GltfBuilder b;
+    const int p = b.AddFloats<3>({{{0, 0, 0}}, {{1, NAN, 0}}, {{0, 1, 0}}});
+    const int inf = b.AddFloats<3>({{{0, 0, 0}}, {{1, 0, 0}}, {{0, INFINITY, 0}}});
+    b.AddMesh("bad", {{"POSITION", p}}, -1, -1);
+    b.AddNode({{"mesh", 0}});
+    b.json()["scenes"] = {{{"nodes", {0}}}};
+    ExpectError(Load(b), {"meshes[0] \"bad\"", "POSITION", "element 1 component 1 is nan"});
+    b.json()["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = inf;
+    ExpectError(Load(b), {"element 2 component 1 is inf"});
+}
+
+TEST_F(GltfSceneTest, UnsupportedPrimitiveModesSparseAccessorsAndComponentTypesAreRefused) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["meshes"][1]["primitives"][0]["mode"] = 1;
+    ExpectError(Load(b), {"meshes[1] \"tri\".primitives[0]", "mode 1 (LINES)", "only triangles"});
+
+    GltfBuilder sparse = testing::TexturedTestScene();
+    sparse.json()["accessors"][4]["sparse"] = {
+        {"count", 1},
+        {"indices", {{"bufferView", 3}, {"componentType", 5125}}},
+        {"values", {{"bufferView", 4}}}};
+    ExpectError(Load(sparse), {"meshes[1] \"tri\"", "accessors[4]", "sparse"});
+
+    GltfBuilder shorts = testing::TexturedTestScene();
+    const std::vector<uint16_t> values(9, 1);
+    const int a = shorts.AddAccessor(values.data(), 18, GltfBuilder::kUnsignedShort, "VEC3", 3);
+    shorts.json()["meshes"][1]["primitives"][0]["attributes"]["POSITION"] = a;
+    ExpectError(Load(shorts), {"POSITION", "UNSIGNED_SHORT (not normalized); expected FLOAT"});
+}
+
+TEST_F(GltfSceneTest, AbsurdlyLargeImageIsRefusedNamingIt) {
+    // A PNG whose header claims 100000 x 100000 texels: refused from the header.
+    std::string png = testing::PngBytes(1, 1, 3, {1, 2, 3});
+    for (int offset : {16, 20}) {
+        png[offset] = 0, png[offset + 1] = 1, png[offset + 2] = char(0x86),
+        png[offset + 3] = char(0xa0);
+    }
+    Write("tex.png", png);
+    ExpectError(Load(testing::TexturedTestScene()), {"scene.gltf", "images[0] \"checker\""});
+}
+
+TEST_F(GltfSceneTest, RequiredUnsupportedExtensionsOrthographicAndMissingCamerasAreRefused) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["extensionsRequired"] = {"KHR_lights_punctual", "KHR_draco_mesh_compression",
+                                      "EXT_meshopt_compression"};
+    ExpectError(Load(b), {"extensionsRequired",
+                          "does not support KHR_draco_mesh_compression, EXT_meshopt_compression"});
+
+    GltfBuilder ortho = testing::TexturedTestScene();
+    ortho.json()["cameras"][0] = {
+        {"type", "orthographic"},
+        {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0}, {"zfar", 10}}}};
+    ExpectError(Load(ortho), {"cameras[0]", "orthographic", "perspective cameras only"});
+
+    GltfBuilder none = testing::TexturedTestScene();
+    none.json()["scenes"][0]["nodes"] = {2, 4};
+    ExpectError(Load(none), {"scene.gltf", "no camera", "include the file from a JSON scene"});
+}
+
+TEST_F(GltfSceneTest, NodeCyclesAndBadIndicesAreRefused) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["nodes"][0]["children"].push_back(2);
+    ExpectError(Load(b), {"nodes[2] \"Root\"", "not a tree"});
+    GltfBuilder c = testing::TexturedTestScene();
+    c.json()["meshes"][0]["primitives"][0]["material"] = 7;
+    ExpectError(Load(c), {"meshes[0] \"quad\".primitives[0]", "material 7 does not exist"});
+}
+
+}  // namespace
+}  // namespace lf
