@@ -140,7 +140,8 @@ class MtlReader : public tinyobj::MaterialReader {
     std::string failed_name_, failure_;
 };
 
-// Turns the MTL materials the faces use into lf::Materials (docs/scene-format.md, "Meshes"),
+// Turns the MTL materials the faces use into lf::Materials (docs/scene-format.md, "OBJ
+// materials (MTL)"),
 // collecting the image files they name.
 class MtlConverter {
   public:
