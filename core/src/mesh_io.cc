@@ -141,8 +141,7 @@ class MtlReader : public tinyobj::MaterialReader {
 };
 
 // Turns the MTL materials the faces use into lf::Materials (docs/scene-format.md, "OBJ
-// materials (MTL)"),
-// collecting the image files they name.
+// materials (MTL)"), collecting the image files they name.
 class MtlConverter {
   public:
     MtlConverter(const MtlReader& reader, MeshFile& out) : reader_(reader), out_(out) {}
