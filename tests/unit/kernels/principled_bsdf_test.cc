@@ -389,7 +389,9 @@ TEST(PrincipledBsdf, Reciprocity) {
             }
         }
         EXPECT_GT(reflected, 1000) << Describe(spread[m]);
-        if (solid) EXPECT_GT(refracted, 1000) << Describe(spread[m]);
+        if (solid) {
+            EXPECT_GT(refracted, 1000) << Describe(spread[m]);
+        }
     }
 }
 
