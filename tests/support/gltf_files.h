@@ -160,10 +160,11 @@ inline GltfBuilder TexturedTestScene() {
     return b;
 }
 
-// TexturedTestScene in lightfarm's JSON, lambert materials standing in for the principled ones.
-// The quad: R_y(90) maps (x, y, z) to (z, y, -x), then scale 2 and translate (1, 0, 0). The
-// triangle: mirrored in x and moved to z = -3, then the same; its winding is flipped to keep its
-// front face.
+// TexturedTestScene in lightfarm's JSON, with the same principled materials and texture. The
+// quad, which needs texture coordinates and normals that a JSON quad cannot carry, comes from
+// TexturedTestQuadObj through the glTF node's world transform: R_y(90) maps (x, y, z) to
+// (z, y, -x), then scale 2 and translate (1, 0, 0). The triangle: mirrored in x and moved to
+// z = -3, then the same; its winding is flipped to keep its front face.
 inline std::string TexturedTestSceneJson() {
     const double fov = 0.8 * 180 / 3.14159265358979323846;
     // Ordered: lightfarm numbers materials in file order.
@@ -174,18 +175,38 @@ inline std::string TexturedTestSceneJson() {
           {"up", {0, 1, 0}},
           {"fov_y_deg", fov},
           {"resolution", {1024, 683}}}},
+        // glTF's defaults where the file says nothing: roughness 1, single-sided.
         {"materials",
-         {{"textured", {{"type", "lambert"}, {"reflectance", {1, 1, 1}}}},
-          {"red", {{"type", "lambert"}, {"reflectance", {0.8, 0.1, 0.1}}}}}},
+         {{"textured",
+           {{"type", "principled"},
+            {"base_color", {1, 1, 1}},
+            {"base_color_texture", {{"file", "tex.png"}, {"wrap", "clamp"}, {"filter", "nearest"}}},
+            {"metallic", 0},
+            {"roughness", 0.5},
+            {"double_sided", false}}},
+          {"red",
+           {{"type", "principled"},
+            {"base_color", {0.8, 0.1, 0.1}},
+            {"metallic", 0},
+            {"roughness", 1}}}}},
         {"shapes",
-         {{{"type", "quad"},
+         {{{"type", "mesh"},
+           {"file", "quad.obj"},
            {"material", "textured"},
-           {"vertices", {{1, 0, 0}, {1, 0, -2}, {1, 2, -2}, {1, 2, 0}}}},
+           {"transform", {{"matrix", {0, 0, 2, 1, 0, 2, 0, 0, -2, 0, 0, 0, 0, 0, 0, 1}}}}},
           {{"type", "triangle"},
            {"material", "red"},
            {"vertices", {{1, 0, -6}, {1, 2, -6}, {-1, 0, -6}}}}}},
         {"lights", {{{"type", "point"}, {"position", {3, 5, 0}}, {"intensity", {10, 5, 2.5}}}}}};
     return j.dump();
+}
+
+// TexturedTestScene's quad mesh as OBJ: OBJ's v runs up the image, so vt v is 1 - glTF's v.
+inline std::string TexturedTestQuadObj() {
+    return "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+           "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+           "vn 0 0 1\n"
+           "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
 }
 
 }  // namespace lf::testing

@@ -81,19 +81,47 @@ class GltfSceneTest : public ::testing::Test {
 TEST_F(GltfSceneTest, LoadsTheSameGeometryCameraAndLightsAsTheEquivalentJson) {
     const absl::StatusOr<Scene> gltf = Load(testing::TexturedTestScene());
     ASSERT_TRUE(gltf.ok()) << gltf.status();
+    Write("quad.obj", testing::TexturedTestQuadObj());
     const absl::StatusOr<Scene> json =
         ParseScene(testing::TexturedTestSceneJson(), "scene.json", ReadBeside(dir_.string()));
     ASSERT_TRUE(json.ok()) << json.status();
 
     ASSERT_EQ(gltf->meshes.size(), json->meshes.size());
     for (size_t m = 0; m < gltf->meshes.size(); ++m) {
-        EXPECT_EQ(gltf->meshes[m].material, json->meshes[m].material);
-        const auto a = Corners(gltf->meshes[m]), b = Corners(json->meshes[m]);
+        const TriangleMesh &gm = gltf->meshes[m], &jm = json->meshes[m];
+        EXPECT_EQ(gm.material, jm.material);
+        const auto a = Corners(gm), b = Corners(jm);
         ASSERT_EQ(a.size(), b.size()) << m;
         for (size_t t = 0; t < a.size(); ++t) {
             for (int c = 0; c < 3; ++c) ExpectNear(a[t][c], b[t][c]);
         }
+        // Both vertex orders are the files' own, which agree here.
+        ASSERT_EQ(gm.uvs.size(), jm.uvs.size()) << m;
+        for (size_t v = 0; v < gm.uvs.size(); ++v) {
+            EXPECT_FLOAT_EQ(gm.uvs[v].x, jm.uvs[v].x);
+            EXPECT_FLOAT_EQ(gm.uvs[v].y, jm.uvs[v].y);
+        }
+        ASSERT_EQ(gm.normals.size(), jm.normals.size()) << m;
+        for (size_t v = 0; v < gm.normals.size(); ++v) {
+            ExpectNear(Vec3d(gm.normals[v]), Vec3d(jm.normals[v]), 1e-6);
+        }
     }
+    ASSERT_EQ(gltf->materials.size(), json->materials.size());
+    for (size_t i = 0; i < json->materials.size(); ++i) {
+        const Material &g = gltf->materials[i], &j = json->materials[i];
+        EXPECT_EQ(g.type, j.type) << i;
+        EXPECT_EQ(g.reflectance, j.reflectance) << i;
+        EXPECT_EQ(g.metallic, j.metallic) << i;
+        EXPECT_EQ(g.roughness, j.roughness) << i;
+        EXPECT_EQ(g.double_sided, j.double_sided) << i;
+        EXPECT_EQ(g.base_color_texture.valid(), j.base_color_texture.valid()) << i;
+        EXPECT_EQ(g.base_color_texture.nearest, j.base_color_texture.nearest) << i;
+        EXPECT_EQ(g.base_color_texture.wrap_s, j.base_color_texture.wrap_s) << i;
+    }
+    // One decode of tex.png, whichever format named it.
+    ASSERT_EQ(gltf->textures.size(), 1u);
+    ASSERT_EQ(json->textures.size(), 1u);
+    EXPECT_EQ(gltf->textures[0].get(), json->textures[0].get());
     const CameraSpec &gc = gltf->camera, &jc = json->camera;
     ExpectNear(gc.position, jc.position);
     ExpectNear(Normalize(gc.look_at - gc.position), Normalize(jc.look_at - jc.position));
