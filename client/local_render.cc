@@ -173,6 +173,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
 
     RenderMetadata metadata;
     metadata.scene_hash = scene->content_hash;
+    metadata.camera = options.scene.camera;
     metadata.method = *method;
     metadata.spp = adaptive ? out->adaptive.max_spp : options.render.spp;
     metadata.seed = options.render.seed;

@@ -219,6 +219,7 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
     const JobRecord& job = snapshot.record;
     RenderMetadata metadata;
     metadata.scene_hash = job.spec.scene_hash;
+    metadata.camera = job.spec.scene_options.camera;
     metadata.method = job.spec.method;
     metadata.spp = snapshot.adaptive ? snapshot.adaptive->max_spp : job.spec.plan.spp;
     metadata.seed = job.spec.seed;

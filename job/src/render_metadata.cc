@@ -85,6 +85,7 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
                                                  bool complete) {
     RenderDescription d;
     d.attributes = DescribeMethod(m);
+    if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
     // An adaptive render's first pass gives every pixel at least 2 samples (it is even).
     const uint64_t fewest_spp = m.adaptive ? m.adaptive->min_spp : m.spp;
     if (complete && fewest_spp >= 2) {

@@ -30,6 +30,17 @@ TEST(RenderMetadata, PathRenderSaysItsTruncatedPathsAndNoRadiosity) {
     }
 }
 
+TEST(RenderMetadata, ACameraPickedByNameIsNamedAndTheScenesOwnIsNot) {
+    RenderMetadata m = PathMetadata();
+    absl::StatusOr<RenderDescription> own = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(own.ok()) << own.status();
+    EXPECT_FALSE(own->attributes.count("lightfarm.camera"));
+    m.camera = "Closeup";
+    absl::StatusOr<RenderDescription> picked = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(picked.ok()) << picked.status();
+    EXPECT_EQ(std::get<std::string>(picked->attributes.at("lightfarm.camera")), "Closeup");
+}
+
 TEST(RenderMetadata, RadiosityFiguresAndSettingsGoIntoTheHeader) {
     RenderMetadata m = PathMetadata();
     m.method = "radiosity";

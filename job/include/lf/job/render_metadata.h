@@ -60,6 +60,7 @@ RadiosityFigures RadiosityFiguresOf(const Report& r) {
 
 struct RenderMetadata {
     std::string scene_hash;
+    std::string camera;  // the glTF camera --camera picked; "" for the scene's own
     std::string method;  // "path" or "radiosity"
     uint64_t spp = 0;    // adaptive: the most any pixel got
     uint64_t seed = 0;
@@ -83,7 +84,8 @@ struct RenderDescription {
     std::optional<ErrorEstimates> estimates;  // when computed
 };
 
-// Every lightfarm.* attribute of a render: how it was made (version, scene hash, method,
+// Every lightfarm.* attribute of a render: how it was made (version, scene hash, camera when
+// picked by name, method,
 // settings, timing, ray and sample counts, truncated paths), the image's own error estimates
 // (lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance) when
 // `complete` and every pixel has at least 2 samples, how an adaptive render ended
