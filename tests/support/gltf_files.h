@@ -149,7 +149,9 @@ inline GltfBuilder TexturedTestScene() {
                      {"name", "cam"},
                      {"perspective", {{"yfov", 0.8}, {"aspectRatio", 1.5}, {"znear", 0.1}}}}};
     const int camera = b.AddNode({{"name", "Front"}, {"camera", 0}, {"translation", {3, 1, 6}}});
+    // Required, as Blender's exporter marks it whenever it writes lights.
     j["extensionsUsed"] = {"KHR_lights_punctual"};
+    j["extensionsRequired"] = {"KHR_lights_punctual"};
     j["extensions"]["KHR_lights_punctual"]["lights"] = {
         {{"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 6830}}};
     const int lamp = b.AddNode({{"name", "Lamp"},
