@@ -174,6 +174,23 @@ class Node {
         return json_.get<std::string>();
     }
 
+    // One of `choices`, by its spelling in the file; anything else is an error naming `what`
+    // and listing the spellings ("expected a, b or c").
+    template <typename T>
+    T OneOf(std::string_view what,
+            std::initializer_list<std::pair<std::string_view, T>> choices) const {
+        const std::string name = String();
+        std::string expected;
+        size_t i = 0;
+        for (const auto& [spelling, value] : choices) {
+            if (spelling == name) return value;
+            expected += absl::StrCat(i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ",
+                                     std::string(spelling));
+            ++i;
+        }
+        Fail(absl::StrCat("unknown ", std::string(what), " \"", name, "\"; expected ", expected));
+    }
+
     double Number() const {
         if (!json_.is_number()) Fail(absl::StrCat("expected a number, got ", Describe(json_)));
         const double value = json_.get<double>();
@@ -541,13 +558,10 @@ class SceneParser {
                 {"type", "distribution", "roughness", "reflectance", "eta", "k", "emission"});
             m.type = Material::Type::kGlossy;
             if (const std::optional<Node> distribution = n.Find("distribution")) {
-                const std::string d = distribution->String();
-                if (d != "ggx" && d != "beckmann") {
-                    distribution->Fail(
-                        absl::StrCat("unknown distribution \"", d, "\"; expected ggx or beckmann"));
-                }
-                m.distribution =
-                    d == "ggx" ? Material::Distribution::kGgx : Material::Distribution::kBeckmann;
+                m.distribution = distribution->OneOf<Material::Distribution>(
+                    "distribution",
+                    {{"ggx", Material::Distribution::kGgx},
+                     {"beckmann", Material::Distribution::kBeckmann}});
             }
             m.roughness = n.Get("roughness").PositiveFloat();
             if (n.Has("eta") || n.Has("k")) {
@@ -658,13 +672,9 @@ class SceneParser {
             m.emission_texture = ParseTexture(*texture, true);
         }
         if (const std::optional<Node> mode = n.Find("alpha_mode")) {
-            const std::string name = mode->String();
-            if (name != "opaque" && name != "mask") {
-                mode->Fail(
-                    absl::StrCat("unknown alpha mode \"", name, "\"; expected opaque or mask"));
-            }
-            m.alpha_mode =
-                name == "mask" ? Material::AlphaMode::kMask : Material::AlphaMode::kOpaque;
+            m.alpha_mode = mode->OneOf<Material::AlphaMode>(
+                "alpha mode",
+                {{"opaque", Material::AlphaMode::kOpaque}, {"mask", Material::AlphaMode::kMask}});
         }
         if (const std::optional<Node> sided = n.Find("double_sided")) {
             if (!sided->json().is_boolean()) {
@@ -686,22 +696,14 @@ class SceneParser {
         const Node file = n.Get("file");
         ref.image = TextureIndex(file.String(), file.path());
         if (const std::optional<Node> wrap = n.Find("wrap")) {
-            const std::string name = wrap->String();
-            if (name != "repeat" && name != "clamp" && name != "mirror") {
-                wrap->Fail(absl::StrCat("unknown wrap mode \"", name,
-                                        "\"; expected repeat, clamp or mirror"));
-            }
-            ref.wrap_s = ref.wrap_t = name == "repeat"  ? TextureRef::Wrap::kRepeat
-                                      : name == "clamp" ? TextureRef::Wrap::kClampToEdge
-                                                        : TextureRef::Wrap::kMirroredRepeat;
+            ref.wrap_s = ref.wrap_t =
+                wrap->OneOf<TextureRef::Wrap>("wrap mode",
+                                              {{"repeat", TextureRef::Wrap::kRepeat},
+                                               {"clamp", TextureRef::Wrap::kClampToEdge},
+                                               {"mirror", TextureRef::Wrap::kMirroredRepeat}});
         }
         if (const std::optional<Node> filter = n.Find("filter")) {
-            const std::string name = filter->String();
-            if (name != "linear" && name != "nearest") {
-                filter->Fail(
-                    absl::StrCat("unknown filter \"", name, "\"; expected linear or nearest"));
-            }
-            ref.nearest = name == "nearest";
+            ref.nearest = filter->OneOf<bool>("filter", {{"linear", false}, {"nearest", true}});
         }
         if (const std::optional<Node> transform = n.Find("transform")) {
             transform->ExpectObject({"offset", "rotation_deg", "scale"});
