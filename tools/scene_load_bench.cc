@@ -111,9 +111,8 @@ void WriteScene(const fs::path& dir, int64_t triangles, int meshes, int texture_
                      {"perspective", {{"yfov", 0.8}, {"aspectRatio", 1.5}, {"znear", 0.01}}}}};
     // Pitched 30 degrees down, so the grids fill the view and `lightfarm bench --keep`'s scene
     // measures shading, not misses.
-    nodes.push_back(b.AddNode({{"camera", 0},
-                               {"translation", {3.3, 2, 4}},
-                               {"rotation", {-0.258819, 0, 0, 0.965926}}}));
+    nodes.push_back(b.AddNode(
+        {{"camera", 0}, {"translation", {3.3, 2, 4}}, {"rotation", {-0.258819, 0, 0, 0.965926}}}));
     j["extensionsUsed"] = {"KHR_lights_punctual"};
     j["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 5000}}};
     nodes.push_back(b.AddNode({{"translation", {3.3, 3, 0.5}},

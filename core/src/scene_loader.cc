@@ -184,7 +184,9 @@ class Node {
         size_t i = 0;
         for (const auto& [spelling, value] : choices) {
             if (spelling == name) return value;
-            expected += absl::StrCat(i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ",
+            expected += absl::StrCat(i == 0                    ? ""
+                                     : i + 1 == choices.size() ? " or "
+                                                               : ", ",
                                      std::string(spelling));
             ++i;
         }
@@ -559,9 +561,8 @@ class SceneParser {
             m.type = Material::Type::kGlossy;
             if (const std::optional<Node> distribution = n.Find("distribution")) {
                 m.distribution = distribution->OneOf<Material::Distribution>(
-                    "distribution",
-                    {{"ggx", Material::Distribution::kGgx},
-                     {"beckmann", Material::Distribution::kBeckmann}});
+                    "distribution", {{"ggx", Material::Distribution::kGgx},
+                                     {"beckmann", Material::Distribution::kBeckmann}});
             }
             m.roughness = n.Get("roughness").PositiveFloat();
             if (n.Has("eta") || n.Has("k")) {
@@ -696,11 +697,10 @@ class SceneParser {
         const Node file = n.Get("file");
         ref.image = TextureIndex(file.String(), file.path());
         if (const std::optional<Node> wrap = n.Find("wrap")) {
-            ref.wrap_s = ref.wrap_t =
-                wrap->OneOf<TextureRef::Wrap>("wrap mode",
-                                              {{"repeat", TextureRef::Wrap::kRepeat},
-                                               {"clamp", TextureRef::Wrap::kClampToEdge},
-                                               {"mirror", TextureRef::Wrap::kMirroredRepeat}});
+            ref.wrap_s = ref.wrap_t = wrap->OneOf<TextureRef::Wrap>(
+                "wrap mode", {{"repeat", TextureRef::Wrap::kRepeat},
+                              {"clamp", TextureRef::Wrap::kClampToEdge},
+                              {"mirror", TextureRef::Wrap::kMirroredRepeat}});
         }
         if (const std::optional<Node> filter = n.Find("filter")) {
             ref.nearest = filter->OneOf<bool>("filter", {{"linear", false}, {"nearest", true}});

@@ -96,8 +96,10 @@ Rgba Lookup(const TextureImage& image, const TextureRef& ref, const Vec2& uv_in)
     }
     // Texel centres sit at half-integers: the four around the point, weighted by distance.
     const double x = double(uv.x) * w - 0.5, y = double(uv.y) * h - 0.5;
-    const double x0 = std::isfinite(x) ? std::floor(x) : 0, y0 = std::isfinite(y) ? std::floor(y) : 0;
-    const float fx = float(std::isfinite(x) ? x - x0 : 0), fy = float(std::isfinite(y) ? y - y0 : 0);
+    const double x0 = std::isfinite(x) ? std::floor(x) : 0,
+                 y0 = std::isfinite(y) ? std::floor(y) : 0;
+    const float fx = float(std::isfinite(x) ? x - x0 : 0),
+                fy = float(std::isfinite(y) ? y - y0 : 0);
     const int xa = WrapIndex(x0, w, ref.wrap_s), xb = WrapIndex(x0 + 1, w, ref.wrap_s);
     const int ya = WrapIndex(y0, h, ref.wrap_t), yb = WrapIndex(y0 + 1, h, ref.wrap_t);
     const Rgba t00 = Texel(image, xa, ya, ref.srgb), t10 = Texel(image, xb, ya, ref.srgb);

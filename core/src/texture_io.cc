@@ -23,9 +23,9 @@ bool IsExr(const std::string& bytes) {
 absl::Status CheckSize(const std::string& name, int64_t width, int64_t height) {
     if (width < 1 || height < 1 || width > kMaxTextureSide || height > kMaxTextureSide ||
         width * height > kMaxTextureTexels) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            name, ": image of ", width, " x ", height, " texels; at most ", kMaxTextureSide,
-            " on a side and 2^28 in all are accepted"));
+        return absl::InvalidArgumentError(absl::StrCat(name, ": image of ", width, " x ", height,
+                                                       " texels; at most ", kMaxTextureSide,
+                                                       " on a side and 2^28 in all are accepted"));
     }
     return absl::OkStatus();
 }
@@ -77,8 +77,8 @@ absl::StatusOr<TextureImage> DecodeExr(const std::string& bytes, const std::stri
         }
         return image;
     } catch (const std::exception& e) {
-        return absl::InvalidArgumentError(absl::StrCat(name, ": not a readable OpenEXR image: ",
-                                                       e.what()));
+        return absl::InvalidArgumentError(
+            absl::StrCat(name, ": not a readable OpenEXR image: ", e.what()));
     }
 }
 
@@ -109,9 +109,8 @@ absl::StatusOr<TextureImage> DecodeStb(const std::string& bytes, const std::stri
     const int length = int(bytes.size());
     int width = 0, height = 0, channels = 0;
     if (!stbi_info_from_memory(data, length, &width, &height, &channels)) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(name, ": not a PNG, JPEG, HDR or EXR image (", stbi_failure_reason(),
-                         ")"));
+        return absl::InvalidArgumentError(absl::StrCat(
+            name, ": not a PNG, JPEG, HDR or EXR image (", stbi_failure_reason(), ")"));
     }
     // From the header alone, before a byte of texels is allocated.
     if (absl::Status s = CheckSize(name, width, height); !s.ok()) return s;
@@ -179,8 +178,8 @@ absl::StatusOr<std::shared_ptr<const TextureImage>> DecodeTexture(const std::str
             if (std::shared_ptr<const TextureImage> image = it->second.lock()) return image;
         }
     }
-    absl::StatusOr<TextureImage> decoded = IsExr(bytes) ? DecodeExr(bytes, name)
-                                                        : DecodeStb(bytes, name);
+    absl::StatusOr<TextureImage> decoded =
+        IsExr(bytes) ? DecodeExr(bytes, name) : DecodeStb(bytes, name);
     if (!decoded.ok()) return decoded.status();
     decoded->name = name;
     auto image = std::make_shared<const TextureImage>(*std::move(decoded));

@@ -37,8 +37,8 @@ struct TextureRef {
 
     int image = -1;  // index in Scene::textures; -1: no texture
     Wrap wrap_s = Wrap::kRepeat, wrap_t = Wrap::kRepeat;
-    bool srgb = false;    // colour textures (base colour, emission); data textures are linear
-    bool nearest = false; // the sampler asks for nearest-texel filtering; bilinear otherwise
+    bool srgb = false;     // colour textures (base colour, emission); data textures are linear
+    bool nearest = false;  // the sampler asks for nearest-texel filtering; bilinear otherwise
     Vec2 offset{0, 0};
     float rotation = 0;  // radians, counter-clockwise in uv
     Vec2 scale{1, 1};
@@ -129,9 +129,9 @@ struct PointLight {
 // (KHR_lights_punctual's spot): full inside inner_cone, zero outside outer_cone.
 struct SpotLight {
     Vec3d position;
-    Vec3d direction;  // unit, the way the light points
-    Rgb intensity;    // W/sr per channel on the axis
-    double inner_cone = 0;                  // radians, half-angle
+    Vec3d direction;                           // unit, the way the light points
+    Rgb intensity;                             // W/sr per channel on the axis
+    double inner_cone = 0;                     // radians, half-angle
     double outer_cone = 3.14159265358979 / 4;  // radians, half-angle, > inner_cone
 };
 
