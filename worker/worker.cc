@@ -148,6 +148,12 @@ void Worker::Execute(const TaskAssignment& task) {
 
 absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel) {
     if (loaded_.job_id == task.job_id) return absl::OkStatus();
+    // The previous job's geometry and BVH go now, its decoded textures only after this load:
+    // a texture the next job uses too (the next frame of a shot, say) is then shared, not
+    // decoded again (DecodeTexture keeps each file content once while anything holds it).
+    const std::vector<std::shared_ptr<const TextureImage>> previous_textures =
+        loaded_.scene ? loaded_.scene->textures
+                      : std::vector<std::shared_ptr<const TextureImage>>{};
     loaded_ = {};
     auto fetch = [&](const std::string& hash, const std::string& path) {
         return server_.FetchBlob(hash, path);

@@ -330,6 +330,12 @@ class GltfImporter {
         if (visited_[size_t(index)]) Fail(where, "reached twice: the node hierarchy is not a tree");
         visited_[size_t(index)] = true;
         const Matrix world = Multiply(parent, LocalTransform(node, where));
+        // Each node's numbers are finite, but a chain of large scales can overflow.
+        for (const auto& row : world) {
+            for (const double v : row) {
+                if (!std::isfinite(v)) Fail(where, "its world transform overflows double range");
+            }
+        }
         if (node.mesh >= 0) AddMesh(node.mesh, world, where);
         if (node.camera >= 0) AddCamera(node, world, where);
         if (const auto light = node.extensions.find("KHR_lights_punctual");
@@ -646,6 +652,13 @@ class GltfImporter {
         const Rgb radiometric = color * float(light.intensity / kLumensPerWatt);
         const Vec3d position = Apply(world, Vec3d(0, 0, 0));
         const Vec3d axis = ApplyLinear(world, Vec3d(0, 0, -1));
+        // A node scaled to zero (a common way to hide one) leaves spot and directional lights
+        // no direction: they light nothing.
+        if (light.type != "point" && !(Length(axis) > 0)) {
+            Warn(absl::StrCat(where, ": ", light.type,
+                              " light under a transform that flattens its axis, skipped"));
+            return;
+        }
         if (light.type == "point") {
             scene_.point_lights.push_back({position, radiometric});
         } else if (light.type == "spot") {

@@ -38,6 +38,12 @@ using Json = nlohmann::ordered_json;
 constexpr double kMaxCoordinate = 1e15;
 constexpr int kMaxResolution = 65536;
 constexpr int64_t kMaxPixels = int64_t(1) << 28;
+// False for NaN too, which a comparison of the largest component would let through.
+bool WithinCoordinateRange(const Vec3d& p) {
+    return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate &&
+           std::abs(p.z) <= kMaxCoordinate;
+}
+
 // Twice a triangle's area below this fraction of its longest edge squared is within double
 // rounding of zero: the triangle has no reliable normal and no area to sample.
 constexpr double kDegenerateRatio = 1e-12;
@@ -480,7 +486,7 @@ class SceneParser {
         for (size_t i = first_mesh; i < scene.meshes.size(); ++i) {
             dropped_degenerate_ += DropDegenerate(scene.meshes[i]);
             for (const Vec3d& p : scene.meshes[i].positions) {
-                if (MaxComponent(Abs(p)) > kMaxCoordinate) {
+                if (!WithinCoordinateRange(p)) {
                     fail(absl::InvalidArgumentError(absl::StrCat("mesh \"", scene.meshes[i].name,
                                                                  "\" has a vertex beyond ±1e15")));
                 }
@@ -876,7 +882,7 @@ class SceneParser {
         for (TriangleMesh& mesh : meshes) {
             if (transform_node) TransformMesh(transform, mesh);
             for (const Vec3d& p : mesh.positions) {
-                if (MaxComponent(Abs(p)) > kMaxCoordinate) {
+                if (!WithinCoordinateRange(p)) {
                     n.Fail(absl::StrCat("a vertex of ", name, " lies beyond ±1e15",
                                         n.Has("transform") ? " after the transform" : "", ": (",
                                         p.x, ", ", p.y, ", ", p.z, ")"));

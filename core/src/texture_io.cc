@@ -5,6 +5,7 @@
 #include <openssl/evp.h>
 #include <stb_image.h>
 
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <map>
@@ -28,6 +29,14 @@ absl::Status CheckSize(const std::string& name, int64_t width, int64_t height) {
                                                        " on a side and 2^28 in all are accepted"));
     }
     return absl::OkStatus();
+}
+
+// Half floats and RGBE can hold infinities and NaNs; as texels they would poison every path
+// that reads them, so they read as 0.
+void ZeroNonFinite(std::vector<float>& texels) {
+    for (float& t : texels) {
+        if (!std::isfinite(t)) t = 0;
+    }
 }
 
 // OpenEXR reads through an IStream; this one serves the file's bytes from memory.
@@ -75,6 +84,7 @@ absl::StatusOr<TextureImage> DecodeExr(const std::string& bytes, const std::stri
             image.texels32.insert(image.texels32.end(), {float(p.r), float(p.g), float(p.b)});
             if (alpha) image.texels32.push_back(float(p.a));
         }
+        ZeroNonFinite(image.texels32);
         return image;
     } catch (const std::exception& e) {
         return absl::InvalidArgumentError(
@@ -125,6 +135,7 @@ absl::StatusOr<TextureImage> DecodeStb(const std::string& bytes, const std::stri
         if (!texels) return fail();
         image.texels32.assign(texels, texels + count * size_t(channels));
         stbi_image_free(texels);
+        ZeroNonFinite(image.texels32);
         image.hdr = true;
     } else if (stbi_is_16_bit_from_memory(data, length)) {
         stbi_us* texels = stbi_load_16_from_memory(data, length, &width, &height, &channels, 0);

@@ -184,7 +184,9 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
 
     s.params = SurfaceParams::Of(m);
     if (m.base_color_texture.valid()) {
-        s.params.base_color *= Sample(scene, m.base_color_texture, s.uv).rgb;
+        // An HDR or EXR colour texture can exceed 1, which no albedo may.
+        const Rgb texel = Sample(scene, m.base_color_texture, s.uv).rgb;
+        for (int c = 0; c < 3; ++c) s.params.base_color[c] *= std::min(texel[c], 1.0f);
     }
     if (m.metallic_roughness_texture.valid()) {
         const Rgb mr = Sample(scene, m.metallic_roughness_texture, s.uv).rgb;

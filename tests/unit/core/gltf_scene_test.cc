@@ -523,5 +523,32 @@ TEST_F(GltfSceneTest, NodeCyclesAndBadIndicesAreRefused) {
     ExpectError(Load(c), {"meshes[0] \"quad\".primitives[0]", "material 7 does not exist"});
 }
 
+// Every number finite, yet the product of two nested scales of 1e200 is not: refused, rather
+// than NaN vertices slipping past the coordinate check.
+TEST_F(GltfSceneTest, ATransformChainThatOverflowsIsRefused) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["nodes"][2]["scale"] = {1e200, 1e200, 1e200};  // "Root"
+    b.json()["nodes"][0]["scale"] = {1e200, 1e200, 1e200};  // "Quad", its child
+    ExpectError(Load(b), {"nodes[0] \"Quad\"", "overflows"});
+}
+
+// A node scaled flat along its axis (a hidden light) leaves a spot or sun no direction: it is
+// skipped with a warning instead of lighting everything with NaN.
+TEST_F(GltfSceneTest, ALightFlattenedAlongItsAxisIsSkippedWithAWarning) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Json& j = b.json();
+    j["extensions"]["KHR_lights_punctual"]["lights"].push_back(
+        {{"type", "spot"}, {"intensity", 683}, {"spot", {{"outerConeAngle", 0.4}}}});
+    j["scenes"][0]["nodes"].push_back(b.AddNode(
+        {{"scale", {1, 1, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}}));
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_TRUE(scene->spot_lights.empty());
+    EXPECT_EQ(scene->point_lights.size(), 1u);
+    EXPECT_NE(CapturedLog().str().find("spot light under a transform that flattens its axis"),
+              std::string::npos)
+        << CapturedLog().str();
+}
+
 }  // namespace
 }  // namespace lf

@@ -152,6 +152,21 @@ TEST(TextureIo, DecodesExrAsLinearRadiance) {
     EXPECT_FLOAT_EQ(texel.a, 1.0f);
 }
 
+// Infinities and NaNs in a float image would poison every path that reads them.
+TEST(TextureIo, NonFiniteTexelsReadAsZero) {
+    Image exr(2, 1);
+    exr.Channel("R") = {INFINITY, 1.5f};
+    exr.Channel("G") = {NAN, 2.0f};
+    exr.Channel("B") = {-INFINITY, 0.5f};
+    const std::string path = (testing::FreshTestDir("texture_nan") / "bad.exr").string();
+    ASSERT_TRUE(WriteExr(path, exr, {}).ok());
+    const auto decoded = DecodeTexture(*ReadFile(path), "bad.exr");
+    ASSERT_TRUE(decoded.ok()) << decoded.status();
+    const Rgba first = Texel(**decoded, 0, 0, false), second = Texel(**decoded, 1, 0, false);
+    EXPECT_EQ(first.rgb, Rgb(0));
+    EXPECT_EQ(second.rgb, Rgb(1.5f, 2.0f, 0.5f));
+}
+
 TEST(TextureIo, RefusesAnAbsurdSizeFromTheHeaderAlone) {
     // A valid PNG header claiming 100000 x 100000 texels and no data: refused before allocating.
     std::string png = testing::PngBytes(1, 1, 3, {1, 2, 3});
