@@ -104,10 +104,8 @@ PrincipledBsdf::LobePick PrincipledBsdf::Pick(const Vec3& wo) const {
 Rgb PrincipledBsdf::ReflectionEval(const Vec3& wo, const Vec3& wi, bool outside) const {
     const Vec3 wm = Normalize(wo + wi);
     const float cos_om = Dot(wo, wm);
-    // D G / (4 cos_o cos_i) with G multiplied through, as in the glossy BSDF.
-    const float denom =
-        4 * (wo.z * wi.z + wi.z * distribution_.CosLambda(wo) + wo.z * distribution_.CosLambda(wi));
-    const float dg = distribution_.D(wm) / denom;
+    // D G / (4 cos_o cos_i), as in the glossy BSDF.
+    const float dg = distribution_.D(wm) * distribution_.GOverCosines(wo, wi) / 4;
     const Rgb conductor = FrSchlick(base_, cos_om) * metallic_;
     const float layer = (1 - metallic_) * LayerFresnel(cos_om, outside);
     return (conductor + Rgb(layer)) * dg;
@@ -132,9 +130,8 @@ Rgb PrincipledBsdf::ThinTransmissionEval(const Vec3& wo, const Vec3& wi) const {
     const float weight = (1 - metallic_) * transmission_;
     if (!(weight > 0)) return {};
     const Vec3 wm = Normalize(wo + wi);
-    const float denom =
-        4 * (wo.z * wi.z + wi.z * distribution_.CosLambda(wo) + wo.z * distribution_.CosLambda(wi));
-    return Rgb(weight * (1 - LayerFresnel(Dot(wo, wm), true)) * distribution_.D(wm) / denom);
+    return Rgb(weight * (1 - LayerFresnel(Dot(wo, wm), true)) * distribution_.D(wm) *
+               distribution_.GOverCosines(wo, wi) / 4);
 }
 
 std::optional<Vec3> PrincipledBsdf::RefractionNormal(const Vec3& wo, const Vec3& wi) const {
