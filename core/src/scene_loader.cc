@@ -25,6 +25,7 @@
 #include "lf/core/gltf_scene.h"
 #include "lf/core/log.h"
 #include "lf/core/mesh_io.h"
+#include "lf/core/mesh_tangents.h"
 #include "lf/core/texture_io.h"
 
 namespace lf {
@@ -1041,6 +1042,8 @@ absl::StatusOr<Scene> ParseScene(const std::string& json_text, const std::string
     try {
         scene = gltf ? parser.ParseGltf(json_text, source) : parser.Parse(root, json_text);
         scene->source = source;
+        // After every transform: tangents are not transformed with the meshes.
+        ComputeMissingTangents(*scene);
     } catch (const LoadError& e) {
         scene = absl::Status(e.status.code(), absl::StrCat(source, ": ", e.status.message()));
     }

@@ -13,47 +13,22 @@ Rgba Sample(const Scene& scene, const TextureRef& ref, const Vec2& uv) {
     return Lookup(*scene.textures[size_t(ref.image)], ref, uv);
 }
 
-// The triangle's dp/du and dp/dv from its uvs (pbrt-v4's Triangle::InteractionFromIntersection);
-// false when the uvs are degenerate.
-bool UvDerivatives(const EmbreeScene& es, const TriangleMesh& mesh, const SurfaceHit& hit,
-                   Vec3* dpdu, Vec3* dpdv) {
-    const auto& tri = mesh.triangles[size_t(hit.primitive)];
-    Vec3 p0, p1, p2;
-    es.Triangle(hit.mesh, hit.primitive, &p0, &p1, &p2);
-    const Vec2 uv0 = mesh.uvs[tri[0]], uv1 = mesh.uvs[tri[1]], uv2 = mesh.uvs[tri[2]];
-    const float du02 = uv0.x - uv2.x, dv02 = uv0.y - uv2.y;
-    const float du12 = uv1.x - uv2.x, dv12 = uv1.y - uv2.y;
-    const float det = du02 * dv12 - dv02 * du12;
-    if (!(std::abs(det) > 1e-12f)) return false;
-    const Vec3 dp02 = p0 - p2, dp12 = p1 - p2;
-    *dpdu = (dp02 * dv12 - dp12 * dv02) / det;
-    *dpdv = (dp12 * du02 - dp02 * du12) / det;
-    return IsFinite(*dpdu) && IsFinite(*dpdv) && LengthSquared(*dpdu) > 0;
-}
-
 // The tangent and the bitangent's sign (glTF: bitangent = sign * cross(normal, tangent)) at the
-// hit: the mesh's tangents interpolated, or else the triangle's dp/du with the sign that makes
-// the bitangent point towards decreasing v (up in the image, the normal map's +y).
-bool TangentAt(const EmbreeScene& es, const TriangleMesh& mesh, const SurfaceHit& hit,
-               const Vec3& n, Vec3* tangent, float* sign) {
+// hit: the mesh's tangents (from its file, or lf::ComputeTangents when the scene loaded)
+// interpolated; false for a mesh without them.
+bool TangentAt(const TriangleMesh& mesh, const SurfaceHit& hit, Vec3* tangent, float* sign) {
+    if (mesh.tangents.empty()) return false;
     const auto& tri = mesh.triangles[size_t(hit.primitive)];
-    if (!mesh.tangents.empty()) {
-        const float b[3] = {1 - hit.b1 - hit.b2, hit.b1, hit.b2};
-        Vec3 t;
-        float w = 0;
-        for (int i = 0; i < 3; ++i) {
-            const auto& ti = mesh.tangents[tri[size_t(i)]];
-            t += Vec3(ti[0], ti[1], ti[2]) * b[i];
-            w += ti[3] * b[i];
-        }
-        *tangent = t;
-        *sign = w < 0 ? -1.0f : 1.0f;
-        return true;
+    const float b[3] = {1 - hit.b1 - hit.b2, hit.b1, hit.b2};
+    Vec3 t;
+    float w = 0;
+    for (int i = 0; i < 3; ++i) {
+        const auto& ti = mesh.tangents[tri[size_t(i)]];
+        t += Vec3(ti[0], ti[1], ti[2]) * b[i];
+        w += ti[3] * b[i];
     }
-    Vec3 dpdu, dpdv;
-    if (!UvDerivatives(es, mesh, hit, &dpdu, &dpdv)) return false;
-    *tangent = dpdu;
-    *sign = Dot(Cross(n, dpdu), dpdv) < 0 ? 1.0f : -1.0f;
+    *tangent = t;
+    *sign = w < 0 ? -1.0f : 1.0f;
     return true;
 }
 
@@ -66,7 +41,7 @@ Vec3 NormalMapped(const EmbreeScene& es, const Material& m, const SurfaceHit& hi
     if (mesh.uvs.empty()) return n;
     Vec3 t;
     float sign;
-    if (!TangentAt(es, mesh, hit, n, &t, &sign)) return n;
+    if (!TangentAt(mesh, hit, &t, &sign)) return n;
     t = t - n * Dot(n, t);  // Gram-Schmidt against the shading normal
     if (!(LengthSquared(t) > 0)) return n;
     t = Normalize(t);

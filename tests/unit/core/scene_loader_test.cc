@@ -461,6 +461,32 @@ constexpr char kObj[] =
     "usemtl lamp\nf 2/2/2 4/1/2 3/3/2\n"
     "usemtl veil\nf 3/3/2 2/2/2 4/1/1\n";
 
+// A normal map needs tangents; an OBJ has none, so the loader computes them once, per vertex,
+// after the shape's transform: here u runs along +x scaled by 2, and v down the image along -y.
+TEST_F(SceneLoaderTest, NormalMappedMeshesWithoutTangentsGetThemAtLoad) {
+    Write("bumps.png", lf::testing::PngBytes(1, 1, 3, {128, 128, 255}));
+    Write("q.obj",
+          "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+          "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+    absl::StatusOr<Scene> scene = Parse(SceneJson(
+        R"({"type": "mesh", "file": "q.obj", "material": "bumpy",
+            "transform": {"scale": [2, 1, 1]}},
+           {"type": "mesh", "file": "q.obj", "material": "flat"})",
+        R"({"bumpy": {"type": "principled", "normal_texture": "bumps.png"},
+            "flat": {"type": "principled"}})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const TriangleMesh& bumpy = scene->meshes[0];
+    ASSERT_EQ(bumpy.tangents.size(), bumpy.positions.size());
+    for (const auto& t : bumpy.tangents) {
+        EXPECT_NEAR(t[0], 1, 1e-6);
+        EXPECT_NEAR(t[1], 0, 1e-6);
+        EXPECT_NEAR(t[2], 0, 1e-6);
+        // The bitangent cross(n, t) = (0, 1, 0) points up the image, towards decreasing v.
+        EXPECT_EQ(t[3], 1);
+    }
+    EXPECT_TRUE(scene->meshes[1].tangents.empty());  // no normal map, no need
+}
+
 TEST_F(SceneLoaderTest, ObjWithMtlBringsItsMaterialsAndTextures) {
     Write("m.obj", kObj);
     Write("m.mtl", kMtl);

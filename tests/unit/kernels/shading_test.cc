@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "lf/core/camera.h"
+#include "lf/core/mesh_tangents.h"
 #include "lf/kernels/embree_scene.h"
 #include "render_path.h"
 #include "test_scenes.h"
@@ -192,7 +193,7 @@ void ExpectPixelsMatch(const Scene& scene, const RenderOutput& out, uint64_t spp
 struct NormalMapCase {
     Vec3 texel_normal;  // tangent space, before the scale
     float scale;
-    bool given_tangents;  // else computed from the uvs
+    bool given_tangents;  // else lf::ComputeTangents from the uvs, as the loaders do
 };
 
 class NormalMap : public ::testing::TestWithParam<NormalMapCase> {};
@@ -220,8 +221,12 @@ TEST_P(NormalMap, ShadesLikeTheTiltedPlane) {
     quad.positions = {{-s, 0, -s}, {-s, 0, s}, {s, 0, s}, {s, 0, -s}};  // normal +y
     quad.uvs = {{0, 0}, {0, 1}, {1, 1}, {1, 0}};
     quad.normals.assign(4, Vec3(0, 1, 0));
-    if (c.given_tangents) quad.tangents.assign(4, {1, 0, 0, 1});
     quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    if (c.given_tangents) {
+        quad.tangents.assign(4, {1, 0, 0, 1});
+    } else {
+        ComputeTangents(quad);
+    }
     scene.meshes.push_back(quad);
     const Vec3d light(0.3, 1.0, -0.2);
     const Rgb intensity(10.0f, 5.0f, 2.0f);
