@@ -194,8 +194,11 @@ class MtlConverter {
         m.reflectance = start == 0 || line_of("Kd") > 0 ? color(mtl.diffuse, "Kd", 1)
                         : mtl.diffuse_texname.empty()   ? Rgb(0.8f)
                                                         : Rgb(1);
-        // The scene loader's bound on emitted radiance, 500 times the sun's.
-        m.emission = color(mtl.emission, "Ke", 1e10f);
+        // The scene loader's bound on emitted radiance, 500 times the sun's. A map_Ke without Ke
+        // emits the texture itself, as a JSON emission_texture alone does.
+        m.emission = line_of("Ke") > 0 || mtl.emissive_texname.empty()
+                         ? color(mtl.emission, "Ke", 1e10f)
+                         : Rgb(1);
         if (!mtl.diffuse_texname.empty()) {
             m.base_color_texture = texture(mtl.diffuse_texname, mtl.diffuse_texopt, "map_Kd", true);
         }

@@ -461,6 +461,28 @@ constexpr char kObj[] =
     "usemtl lamp\nf 2/2/2 4/1/2 3/3/2\n"
     "usemtl veil\nf 3/3/2 2/2/2 4/1/1\n";
 
+// map_Ke alone emits the texture (as a JSON emission_texture alone does); with Ke, the two
+// multiply.
+TEST_F(SceneLoaderTest, MtlEmissionMapWithoutKeEmitsTheTexture) {
+    Write("glow.png", lf::testing::PngBytes(1, 1, 3, {255, 255, 255}));
+    Write("g.obj",
+          "mtllib g.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+          "usemtl alone\nf 1/1 2/2 3/3\nusemtl dim\nf 1/1 3/3 2/2\n");
+    Write("g.mtl", "newmtl alone\nmap_Ke glow.png\nnewmtl dim\nKe 0.5 0.5 0.5\nmap_Ke glow.png\n");
+    absl::StatusOr<Scene> scene = Parse(SceneJson(R"({"type": "mesh", "file": "g.obj"})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const auto material = [&](const std::string& name) -> const Material& {
+        for (const Material& m : scene->materials) {
+            if (m.name == "g.mtl#" + name) return m;
+        }
+        ADD_FAILURE() << "no material " << name;
+        return scene->materials[0];
+    };
+    EXPECT_EQ(material("alone").emission, Rgb(1));
+    EXPECT_TRUE(material("alone").emission_texture.valid());
+    EXPECT_EQ(material("dim").emission, Rgb(0.5f));
+}
+
 // A normal map needs tangents; an OBJ has none, so the loader computes them once, per vertex,
 // after the shape's transform: here u runs along +x scaled by 2, and v down the image along -y.
 TEST_F(SceneLoaderTest, NormalMappedMeshesWithoutTangentsGetThemAtLoad) {
