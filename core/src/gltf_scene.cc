@@ -769,6 +769,10 @@ class GltfImporter {
                 float(Number(*e, "attenuationDistance", std::numeric_limits<double>::infinity(), 0,
                              std::numeric_limits<double>::infinity(), at));
             if (!(m.attenuation_distance > 0)) Fail(at, "attenuationDistance must be above 0");
+            // The extension gives it in the file's world space; a JSON scene that includes the
+            // file scales that space by its transform (a uniform scale's factor; the mean one
+            // of an anisotropic scale).
+            m.attenuation_distance *= float(std::cbrt(std::abs(Determinant(options_.transform))));
             m.attenuation_color =
                 Color(Numbers(*e, "attenuationColor", {1, 1, 1}, at), at, "attenuationColor");
             if (e->Has("thicknessTexture")) {

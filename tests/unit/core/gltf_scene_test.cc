@@ -375,6 +375,23 @@ TEST_F(GltfSceneTest, CameraOptionPicksACameraByNameAndUnknownNamesListTheCamera
     EXPECT_EQ(sized->camera.height, 30);
 }
 
+// attenuationDistance is a length in the file's world space: a JSON scene that includes the
+// file at a hundredth of its size absorbs over a hundredth of the distance.
+TEST_F(GltfSceneTest, AnIncludingTransformScalesTheAttenuationDistance) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["materials"][0]["extensions"]["KHR_materials_volume"] = {
+        {"thicknessFactor", 0.1}, {"attenuationDistance", 2}};
+    const absl::StatusOr<Scene> direct = Load(b, "glass.gltf");
+    ASSERT_TRUE(direct.ok()) << direct.status();
+    EXPECT_FLOAT_EQ(direct->materials[0].attenuation_distance, 2);
+    const absl::StatusOr<Scene> included = ParseScene(
+        R"({"materials": {}, "shapes": [{"type": "gltf", "file": "glass.gltf",
+            "transform": {"scale": 0.01}}]})",
+        "scene.json", ReadBeside(dir_.string()));
+    ASSERT_TRUE(included.ok()) << included.status();
+    EXPECT_FLOAT_EQ(included->materials[0].attenuation_distance, 0.02f);
+}
+
 TEST_F(GltfSceneTest, JsonSceneIncludesAGltfWithItsCameraOrItsOwn) {
     const GltfBuilder b = testing::TexturedTestScene();
     Write("models/car.gltf", b.Gltf("car.bin"));
