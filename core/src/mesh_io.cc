@@ -53,22 +53,35 @@ std::vector<std::string> SplitFields(std::string_view line) {
 
 // ---- Wavefront OBJ ---------------------------------------------------------------------------
 
-// tinyobjloader does not say which line a record came from. On an error this finds the line
-// number (from 1) of the first line at or after `from` whose fields `match`; 0 if none does.
-template <typename Match>
-size_t FindLine(std::string_view text, Match match, size_t from = 1) {
+// Calls visit(line, fields) for each non-blank line at or after `from` (lines count from 1,
+// ending as tinyobjloader counts them: \n, \r\n or a lone \r) until it returns false.
+template <typename Visit>
+void ForEachLine(std::string_view text, Visit visit, size_t from = 1) {
     size_t line = 0, pos = 0;
     while (pos < text.size()) {
-        // Line ends as tinyobjloader counts them: \n, \r\n or a lone \r.
         const size_t end = std::min(text.find_first_of("\r\n", pos), text.size());
         ++line;
         if (line >= from) {
             const std::vector<std::string> fields = SplitFields(text.substr(pos, end - pos));
-            if (!fields.empty() && match(fields)) return line;
+            if (!fields.empty() && !visit(line, fields)) return;
         }
         pos = end + (text.substr(end, 2) == "\r\n" ? 2 : 1);
     }
-    return 0;
+}
+
+// tinyobjloader does not say which line a record came from. On an error this finds the line
+// number (from 1) of the first line at or after `from` whose fields `match`; 0 if none does.
+template <typename Match>
+size_t FindLine(std::string_view text, Match match, size_t from = 1) {
+    size_t found = 0;
+    ForEachLine(
+        text,
+        [&](size_t line, const std::vector<std::string>& fields) {
+            if (match(fields)) found = line;
+            return found == 0;
+        },
+        from);
+    return found;
 }
 
 // The line of the `n`-th (from 0) record `keyword` with at least `min_fields` fields after it.
@@ -95,10 +108,33 @@ std::string Beside(const std::string& file, const std::string& name) {
     return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
 }
 
-// An MTL file as read, for messages that name its lines.
+// An MTL file as read, for messages that name its lines: each material's block (from its
+// `newmtl` line to the next) with the line of the first use of each keyword (lowercase) in it,
+// found in one pass, so naming the lines of thousands of materials costs no search each.
 struct MtlText {
+    struct Block {
+        size_t start = 0;  // the `newmtl` line
+        std::map<std::string, size_t> lines;
+    };
+
+    MtlText(std::string name_, std::string text_) : name(std::move(name_)), text(std::move(text_)) {
+        Block* block = nullptr;
+        ForEachLine(text, [&](size_t line, const std::vector<std::string>& f) {
+            if (f[0] == "newmtl") {
+                // tinyobjloader names a material by the rest of its `newmtl` line.
+                const auto [it, inserted] =
+                    blocks.try_emplace(absl::StrJoin(f.begin() + 1, f.end(), " "), Block{line, {}});
+                block = inserted ? &it->second : nullptr;  // the first definition's lines
+            } else if (block) {
+                block->lines.try_emplace(absl::AsciiStrToLower(f[0]), line);
+            }
+            return true;
+        });
+    }
+
     std::string name;  // as the reader knows it
     std::string text;
+    std::map<std::string, Block> blocks;  // by material name
 };
 
 // Reads `mtllib` files through the scene's file reader (tinyobjloader would open them from
@@ -123,7 +159,7 @@ class MtlReader : public tinyobj::MaterialReader {
         std::istringstream stream(*text);
         tinyobj::LoadMtl(index, materials, &stream, warn, err);
         file_of_.resize(materials->size(), files_.size());
-        files_.push_back({path, *std::move(text)});
+        files_.emplace_back(path, *std::move(text));
         return true;
     }
 
@@ -148,22 +184,15 @@ class MtlConverter {
 
     Material Convert(const tinyobj::material_t& mtl, size_t index) {
         const MtlText& file = reader_.FileOf(index);
-        // Each value's line, for messages: the key's first line after `newmtl NAME`.
-        // tinyobjloader names a material by the rest of its `newmtl` line.
-        const size_t start = FindLine(file.text, [&](const std::vector<std::string>& f) {
-            return f[0] == "newmtl" && absl::StrJoin(f.begin() + 1, f.end(), " ") ==
-                                           absl::StripAsciiWhitespace(mtl.name);
-        });
-        const size_t end = FindLine(
-            file.text, [](const std::vector<std::string>& f) { return f[0] == "newmtl"; },
-            start + 1);
+        // Each value's line, for messages: the key's first line in the material's block.
+        const auto found = file.blocks.find(std::string(absl::StripAsciiWhitespace(mtl.name)));
+        const MtlText::Block* block = found == file.blocks.end() ? nullptr : &found->second;
+        const size_t start = block ? block->start : 0;
         // The line of `key` in this material's block, or 0.
-        auto line_of = [&](const char* key) {
-            const size_t line = FindLine(
-                file.text,
-                [&](const std::vector<std::string>& f) { return EqualsIgnoringCase(f[0], key); },
-                start);
-            return end == 0 || line < end ? line : 0;
+        auto line_of = [&](const char* key) -> size_t {
+            if (!block) return 0;
+            const auto it = block->lines.find(absl::AsciiStrToLower(key));
+            return it == block->lines.end() ? 0 : it->second;
         };
         auto where = [&](const char* key) {
             const size_t line = line_of(key);
