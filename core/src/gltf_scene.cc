@@ -20,7 +20,6 @@ namespace lf {
 namespace {
 
 namespace fs = std::filesystem;
-using Matrix = std::array<std::array<double, 4>, 3>;
 
 // Photometric to radiometric: KHR_lights_punctual gives candela and lux; at 683 lm/W (the
 // luminous efficacy the extension and Blender's exporter assume) they are W/sr and W/m^2.
@@ -77,54 +76,10 @@ struct GltfError {
     throw GltfError{absl::StrCat(where, ": ", message)};
 }
 
-Vec3d Apply(const Matrix& m, const Vec3d& p) {
-    Vec3d out;
-    for (int r = 0; r < 3; ++r) out[r] = m[r][0] * p.x + m[r][1] * p.y + m[r][2] * p.z + m[r][3];
-    return out;
-}
-
-Vec3d ApplyLinear(const Matrix& m, const Vec3d& v) {
-    Vec3d out;
-    for (int r = 0; r < 3; ++r) out[r] = m[r][0] * v.x + m[r][1] * v.y + m[r][2] * v.z;
-    return out;
-}
-
-// a * b: b first, then a.
-Matrix Multiply(const Matrix& a, const Matrix& b) {
-    Matrix out{};
-    for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 4; ++c) {
-            out[r][c] =
-                a[r][0] * b[0][c] + a[r][1] * b[1][c] + a[r][2] * b[2][c] + (c == 3 ? a[r][3] : 0);
-        }
-    }
-    return out;
-}
-
-double Determinant(const Matrix& m) {
-    const Vec3d r0(m[0][0], m[0][1], m[0][2]), r1(m[1][0], m[1][1], m[1][2]),
-        r2(m[2][0], m[2][1], m[2][2]);
-    return Dot(r0, Cross(r1, r2));
-}
-
-// Normals transform by the inverse transpose of the linear part: its cofactor matrix over the
-// determinant, whose size normalizing removes but whose sign must stay (a mirror flips the
-// winding, and the normal must follow the flipped front face).
-Matrix NormalMatrix(const Matrix& m) {
-    const double sign = Determinant(m) < 0 ? -1 : 1;
-    Matrix n{};
-    for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) {
-            const int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
-            n[r][c] = sign * (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]);
-        }
-    }
-    return n;
-}
-
 // The node's own transform: its matrix (column-major) or translation * rotation * scale.
-Matrix LocalTransform(const tinygltf::Node& node, const std::string& where) {
-    Matrix m{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
+Affine LocalTransform(const tinygltf::Node& node, const std::string& where) {
+    Affine local;
+    auto& m = local.m;
     auto check = [&](const std::vector<double>& v, size_t size, const char* key) {
         if (!v.empty() && v.size() != size) {
             Fail(where, absl::StrCat(key, " has ", v.size(), " numbers, expected ", size));
@@ -145,7 +100,7 @@ Matrix LocalTransform(const tinygltf::Node& node, const std::string& where) {
             node.matrix[15] != 1) {
             Fail(where, "matrix is not affine (its last row must be 0, 0, 0, 1)");
         }
-        return m;
+        return local;
     }
     if (!node.rotation.empty()) {
         double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2],
@@ -165,7 +120,7 @@ Matrix LocalTransform(const tinygltf::Node& node, const std::string& where) {
     if (!node.translation.empty()) {
         for (int r = 0; r < 3; ++r) m[r][3] = node.translation[r];
     }
-    return m;
+    return local;
 }
 
 const char* ComponentTypeName(int type) {
@@ -285,7 +240,7 @@ class GltfImporter {
         }
     }
 
-    void VisitNode(int index, const Matrix& parent, const std::string& ref) {
+    void VisitNode(int index, const Affine& parent, const std::string& ref) {
         if (index < 0 || index >= int(model_.nodes.size())) {
             Fail(ref, absl::StrCat(index, " is not a node index (the file has ",
                                    model_.nodes.size(), ")"));
@@ -295,13 +250,9 @@ class GltfImporter {
         // glTF's hierarchy is a forest: a node reached twice is a cycle or a shared child.
         if (visited_[size_t(index)]) Fail(where, "reached twice: the node hierarchy is not a tree");
         visited_[size_t(index)] = true;
-        const Matrix world = Multiply(parent, LocalTransform(node, where));
+        const Affine world = LocalTransform(node, where).Then(parent);
         // Each node's numbers are finite, but a chain of large scales can overflow.
-        for (const auto& row : world) {
-            for (const double v : row) {
-                if (!std::isfinite(v)) Fail(where, "its world transform overflows double range");
-            }
-        }
+        if (!world.IsFinite()) Fail(where, "its world transform overflows double range");
         if (node.mesh >= 0) AddMesh(node.mesh, world, where);
         if (node.camera >= 0) AddCamera(node, world, where);
         if (const auto light = node.extensions.find("KHR_lights_punctual");
@@ -454,13 +405,13 @@ class GltfImporter {
         return out;
     }
 
-    void AddMesh(int index, const Matrix& world, const std::string& node_where) {
+    void AddMesh(int index, const Affine& world, const std::string& node_where) {
         if (index >= int(model_.meshes.size())) {
             Fail(node_where, absl::StrCat("mesh ", index, " does not exist"));
         }
         const tinygltf::Mesh& mesh = model_.meshes[size_t(index)];
-        const Matrix normal_matrix = NormalMatrix(world);
-        const double det = Determinant(world);
+        const Affine normal_matrix = world.NormalMatrix();
+        const double det = world.Determinant();
         if (!(std::abs(det) > 0)) Fail(node_where, "its transform is singular (flattens the mesh)");
         for (size_t p = 0; p < mesh.primitives.size(); ++p) {
             const tinygltf::Primitive& prim = mesh.primitives[p];
@@ -486,17 +437,16 @@ class GltfImporter {
             const size_t n = positions.size() / 3;
             out.positions.resize(n);
             for (size_t i = 0; i < n; ++i) {
-                out.positions[i] = Apply(
-                    world, Vec3d(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]));
+                out.positions[i] = world.Apply(
+                    Vec3d(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]));
             }
             if (const int normal = attribute("NORMAL"); normal >= 0) {
                 const std::vector<float> normals = Floats(normal, 3, at + "NORMAL");
                 if (normals.size() != positions.size()) Fail(at + "NORMAL", "count differs");
                 out.normals.resize(n);
                 for (size_t i = 0; i < n; ++i) {
-                    const Vec3d v =
-                        ApplyLinear(normal_matrix,
-                                    Vec3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]));
+                    const Vec3d v = normal_matrix.ApplyLinear(
+                        Vec3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]));
                     const double length = Length(v);
                     if (!(length > 0)) {
                         Fail(at + "NORMAL", absl::StrCat("normal ", i, " is zero"));
@@ -517,7 +467,7 @@ class GltfImporter {
                 for (size_t i = 0; i < n; ++i) {
                     // Tangents lie in the surface and move with it; a mirror flips the
                     // bitangent's handedness.
-                    const Vec3d v = ApplyLinear(world, Vec3d(t[4 * i], t[4 * i + 1], t[4 * i + 2]));
+                    const Vec3d v = world.ApplyLinear(Vec3d(t[4 * i], t[4 * i + 1], t[4 * i + 2]));
                     const double length = Length(v);
                     const Vec3 unit = length > 0 ? Vec3(v / length) : Vec3(1, 0, 0);
                     out.tangents[i] = {unit.x, unit.y, unit.z,
@@ -551,7 +501,7 @@ class GltfImporter {
         }
     }
 
-    void AddCamera(const tinygltf::Node& node, const Matrix& world, const std::string& where) {
+    void AddCamera(const tinygltf::Node& node, const Affine& world, const std::string& where) {
         if (node.camera >= int(model_.cameras.size())) {
             Fail(where, absl::StrCat("camera ", node.camera, " does not exist"));
         }
@@ -570,9 +520,9 @@ class GltfImporter {
         out.name = node.name.empty() ? camera.name : node.name;
         CameraSpec& spec = out.spec;
         // The camera looks down its node's -Z with +Y up.
-        spec.position = Apply(world, Vec3d(0, 0, 0));
-        const Vec3d forward = ApplyLinear(world, Vec3d(0, 0, -1));
-        spec.up = ApplyLinear(world, Vec3d(0, 1, 0));
+        spec.position = world.Apply(Vec3d(0, 0, 0));
+        const Vec3d forward = world.ApplyLinear(Vec3d(0, 0, -1));
+        spec.up = world.ApplyLinear(Vec3d(0, 1, 0));
         if (!(Length(Cross(forward, spec.up)) > 0)) Fail(where, "its transform is singular");
         spec.look_at = spec.position + Normalize(forward);
         spec.fov_y_deg = p.yfov * 180 / std::numbers::pi;
@@ -587,7 +537,7 @@ class GltfImporter {
         cameras_.push_back(std::move(out));
     }
 
-    void AddLight(const tinygltf::Value& light_index, const Matrix& world,
+    void AddLight(const tinygltf::Value& light_index, const Affine& world,
                   const std::string& where) {
         const std::string at = where + ".extensions.KHR_lights_punctual.light";
         if (!light_index.IsNumber()) Fail(at, "missing or not a number");
@@ -612,8 +562,8 @@ class GltfImporter {
         }
         if (light.range > 0) range_ignored_ = true;
         const Rgb radiometric = color * float(light.intensity / kLumensPerWatt);
-        const Vec3d position = Apply(world, Vec3d(0, 0, 0));
-        const Vec3d axis = ApplyLinear(world, Vec3d(0, 0, -1));
+        const Vec3d position = world.Apply(Vec3d(0, 0, 0));
+        const Vec3d axis = world.ApplyLinear(Vec3d(0, 0, -1));
         // A node scaled to zero (a common way to hide one) leaves spot and directional lights
         // no direction: they light nothing.
         if (light.type != "point" && !(Length(axis) > 0)) {
@@ -772,7 +722,7 @@ class GltfImporter {
             // The extension gives it in the file's world space; a JSON scene that includes the
             // file scales that space by its transform (a uniform scale's factor; the mean one
             // of an anisotropic scale).
-            m.attenuation_distance *= float(std::cbrt(std::abs(Determinant(options_.transform))));
+            m.attenuation_distance *= float(std::cbrt(std::abs(options_.transform.Determinant())));
             m.attenuation_color =
                 Color(Numbers(*e, "attenuationColor", {1, 1, 1}, at), at, "attenuationColor");
             if (e->Has("thicknessTexture")) {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/affine.h"
 #include "lf/core/file_util.h"
 #include "lf/core/gltf_scene.h"
 #include "lf/core/log.h"
@@ -256,32 +257,6 @@ class Node {
     std::vector<std::string>* warnings_;
 };
 
-// x -> M x + t, with M the 3x3 part of `m` and t its last column.
-struct Affine {
-    std::array<std::array<double, 4>, 3> m{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
-
-    Vec3d Apply(const Vec3d& p) const {
-        Vec3d out;
-        for (int r = 0; r < 3; ++r) {
-            out[r] = m[r][0] * p.x + m[r][1] * p.y + m[r][2] * p.z + m[r][3];
-        }
-        return out;
-    }
-    // This transform followed by `next`.
-    Affine Then(const Affine& next) const {
-        Affine out;
-        for (int r = 0; r < 3; ++r) {
-            for (int c = 0; c < 4; ++c) {
-                out.m[r][c] = next.m[r][0] * m[0][c] + next.m[r][1] * m[1][c] +
-                              next.m[r][2] * m[2][c] + (c == 3 ? next.m[r][3] : 0);
-            }
-        }
-        return out;
-    }
-    Vec3d Row(int r) const { return {m[r][0], m[r][1], m[r][2]}; }
-    double Determinant() const { return Dot(Row(0), Cross(Row(1), Row(2))); }
-};
-
 Affine ParseTransform(const Node& n) {
     n.ExpectObject({"scale", "rotate", "translate", "matrix"});
     Affine transform;
@@ -344,16 +319,8 @@ int DropDegenerate(TriangleMesh& mesh) {
 // Moves a mesh's positions and normals by `transform`: normals by its inverse transpose.
 void TransformMesh(const Affine& transform, TriangleMesh& mesh) {
     for (Vec3d& p : mesh.positions) p = transform.Apply(p);
-    // The cofactor matrix is det(M) M^-T: its sign keeps normals on their side.
-    const double sign = transform.Determinant() < 0 ? -1 : 1;
-    const Vec3d cofactor[3] = {Cross(transform.Row(1), transform.Row(2)),
-                               Cross(transform.Row(2), transform.Row(0)),
-                               Cross(transform.Row(0), transform.Row(1))};
-    for (Vec3& n : mesh.normals) {
-        const Vec3d d(n);
-        n = Vec3(
-            Normalize(Vec3d(Dot(cofactor[0], d), Dot(cofactor[1], d), Dot(cofactor[2], d)) * sign));
-    }
+    const Affine normal_matrix = transform.NormalMatrix();
+    for (Vec3& n : mesh.normals) n = Vec3(Normalize(normal_matrix.ApplyLinear(Vec3d(n))));
     // A mirroring transform would turn front faces into back faces; keep them in front.
     if (transform.Determinant() < 0) {
         for (std::array<uint32_t, 3>& t : mesh.triangles) std::swap(t[1], t[2]);
@@ -480,7 +447,7 @@ class SceneParser {
         };
         const size_t first_mesh = scene.meshes.size();
         std::vector<std::string> warnings;
-        const absl::Status status = AppendGltf(bytes, name, hashing_reader, {base_dir, transform.m},
+        const absl::Status status = AppendGltf(bytes, name, hashing_reader, {base_dir, transform},
                                                scene, gltf_cameras_, warnings);
         for (const std::string& w : warnings) warnings_.push_back(absl::StrCat(name, ": ", w));
         if (!status.ok()) fail(status);

@@ -5,12 +5,12 @@
 // and how.
 #pragma once
 
-#include <array>
 #include <string>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "lf/core/affine.h"
 #include "lf/core/scene.h"
 #include "lf/core/scene_loader.h"
 
@@ -31,9 +31,9 @@ struct GltfImport {
     // for a glTF that is itself the scene file (the reader resolves beside it), "models" for
     // "models/car.gltf" included from a JSON scene.
     std::string base_dir;
-    // Rows of an affine 3x4 matrix applied after the file's own node transforms: a JSON scene's
-    // "transform" of the included file.
-    std::array<std::array<double, 4>, 3> transform{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
+    // Applied after the file's own node transforms: a JSON scene's "transform" of the included
+    // file.
+    Affine transform;
 };
 
 // Appends the default scene of glTF file `name` (its bytes `bytes`, JSON or binary) to `scene`:

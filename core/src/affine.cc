@@ -1,0 +1,39 @@
+#include "lf/core/affine.h"
+
+#include <cmath>
+
+namespace lf {
+
+Affine Affine::Then(const Affine& next) const {
+    Affine out;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) {
+            out.m[r][c] = next.m[r][0] * m[0][c] + next.m[r][1] * m[1][c] + next.m[r][2] * m[2][c] +
+                          (c == 3 ? next.m[r][3] : 0);
+        }
+    }
+    return out;
+}
+
+Affine Affine::NormalMatrix() const {
+    const double sign = Determinant() < 0 ? -1 : 1;
+    const Vec3d cofactor[3] = {Cross(Row(1), Row(2)), Cross(Row(2), Row(0)), Cross(Row(0), Row(1))};
+    // M^-1's columns are these over det(M), so they are the rows of det(M) M^-T.
+    Affine n;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) n.m[r][c] = sign * cofactor[r][c];
+        n.m[r][3] = 0;
+    }
+    return n;
+}
+
+bool Affine::IsFinite() const {
+    for (const auto& row : m) {
+        for (const double v : row) {
+            if (!std::isfinite(v)) return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace lf
