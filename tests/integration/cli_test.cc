@@ -75,6 +75,27 @@ TEST_F(Cli, RenderWritesExrWithMetadataAndPng) {
     EXPECT_TRUE(fs::exists(png));
 }
 
+// The demo scene (tests/scenes/gltf_demo), laid out as Blender's exporter writes a file: the
+// lights extension required, emissive strength, glass with a volume, gold, a textured floor, a
+// sun and a spot light. It renders with every sample finite and its camera in the header.
+TEST_F(Cli, GltfDemoSceneRendersEveryFeatureWithoutAnInvalidSample) {
+    const std::string exr = (dir_ / "demo.exr").string();
+    const RunResult r = Lightfarm("render " + std::string(LF_TEST_SCENES) +
+                                  "/gltf_demo/demo.gltf -o " + exr +
+                                  " --spp 4 --resolution 48x32 --camera Camera --no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find(" 0 NaN/Inf samples"), std::string::npos) << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    EXPECT_EQ(file->image.width(), 48);
+    EXPECT_EQ(file->image.height(), 32);
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.invalidSamples")), "0");
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.camera")), "Camera");
+    double sum = 0;
+    for (const float v : *file->image.FindChannel("R")) sum += v;
+    EXPECT_GT(sum, 0);
+}
+
 // The high-variance flag follows the typical pixel, not the light's few half-covered edge
 // pixels: the Cornell box at 64^2 measured 0.037 to 0.041 estimated relMSE at 4 spp (flagged)
 // and 0.0012 at 256 spp (not), over seeds 0 to 2.
