@@ -33,7 +33,6 @@ void ComputeTangents(TriangleMesh& mesh) {
     }
 }
 
-
 void ComputeMissingTangents(Scene& scene) {
     for (TriangleMesh& mesh : scene.meshes) {
         if (mesh.tangents.empty() && !mesh.uvs.empty() &&

@@ -80,9 +80,9 @@ TEST_F(Cli, RenderWritesExrWithMetadataAndPng) {
 // sun and a spot light. It renders with every sample finite and its camera in the header.
 TEST_F(Cli, GltfDemoSceneRendersEveryFeatureWithoutAnInvalidSample) {
     const std::string exr = (dir_ / "demo.exr").string();
-    const RunResult r = Lightfarm("render " + std::string(LF_TEST_SCENES) +
-                                  "/gltf_demo/demo.gltf -o " + exr +
-                                  " --spp 4 --resolution 48x32 --camera Camera --no-progress");
+    const RunResult r =
+        Lightfarm("render " + std::string(LF_TEST_SCENES) + "/gltf_demo/demo.gltf -o " + exr +
+                  " --spp 4 --resolution 48x32 --camera Camera --no-progress");
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find(" 0 NaN/Inf samples"), std::string::npos) << r.output;
     absl::StatusOr<ExrFile> file = ReadExr(exr);

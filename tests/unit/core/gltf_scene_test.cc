@@ -379,8 +379,8 @@ TEST_F(GltfSceneTest, CameraOptionPicksACameraByNameAndUnknownNamesListTheCamera
 // file at a hundredth of its size absorbs over a hundredth of the distance.
 TEST_F(GltfSceneTest, AnIncludingTransformScalesTheAttenuationDistance) {
     GltfBuilder b = testing::TexturedTestScene();
-    b.json()["materials"][0]["extensions"]["KHR_materials_volume"] = {
-        {"thicknessFactor", 0.1}, {"attenuationDistance", 2}};
+    b.json()["materials"][0]["extensions"]["KHR_materials_volume"] = {{"thicknessFactor", 0.1},
+                                                                      {"attenuationDistance", 2}};
     const absl::StatusOr<Scene> direct = Load(b, "glass.gltf");
     ASSERT_TRUE(direct.ok()) << direct.status();
     EXPECT_FLOAT_EQ(direct->materials[0].attenuation_distance, 2);
