@@ -9,6 +9,18 @@
 
 namespace lf::testing {
 
+// A square image of `size` pixels from `position` towards `look_at`.
+inline CameraSpec SquareCamera(const Vec3d& position, const Vec3d& look_at, const Vec3d& up,
+                               double fov_y_deg, int size) {
+    CameraSpec camera;
+    camera.position = position;
+    camera.look_at = look_at;
+    camera.up = up;
+    camera.fov_y_deg = fov_y_deg;
+    camera.width = camera.height = size;
+    return camera;
+}
+
 // A closed axis-aligned box, all six faces facing inward, every face of material 0.
 inline void AddInwardBox(Scene& scene, const Vec3d& center, double half, int material) {
     const double h = half;
@@ -38,11 +50,8 @@ inline Scene MakeFurnace(double half, const Vec3d& center, float rho, float le, 
     m.emission = Rgb(le);
     scene.materials.push_back(m);
     AddInwardBox(scene, center, half, 0);
-    scene.camera.position = center + Vec3d(0.1, -0.2, 0.05) * half;
-    scene.camera.look_at = center + Vec3d(1, 0.3, 0.7) * half;
-    scene.camera.up = {0, 1, 0};
-    scene.camera.fov_y_deg = 90;
-    scene.camera.width = scene.camera.height = resolution;
+    scene.camera = SquareCamera(center + Vec3d(0.1, -0.2, 0.05) * half,
+                                center + Vec3d(1, 0.3, 0.7) * half, {0, 1, 0}, 90, resolution);
     return scene;
 }
 

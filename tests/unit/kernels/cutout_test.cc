@@ -5,6 +5,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/shading.h"
 #include "render_path.h"
+#include "test_scenes.h"
 
 namespace lf {
 namespace {
@@ -44,10 +45,7 @@ Scene MaskedQuadOverEmitter() {
     TriangleMesh back = Quad(1, -1);
     for (Vec3d& p : back.positions) p = Vec3d(p.x * 4, p.y * 4, p.z);
     scene.meshes.push_back(back);
-    scene.camera.position = {0, 0, 1};
-    scene.camera.look_at = {0, 0, 0};
-    scene.camera.fov_y_deg = 90;
-    scene.camera.width = scene.camera.height = 16;
+    scene.camera = testing::SquareCamera({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 90, 16);
     return scene;
 }
 

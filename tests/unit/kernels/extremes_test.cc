@@ -57,11 +57,7 @@ Scene TinyEmitterScene(Material::Type floor_type, float reflectance) {
     scene.materials = {floor, lamp};
     scene.meshes.push_back(Quad({-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, 0));
     scene.meshes.push_back(Quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, 1));  // faces -y
-    scene.camera.position = {0, 0.5, 0};
-    scene.camera.look_at = {0, 0, 0};
-    scene.camera.up = {0, 0, 1};
-    scene.camera.fov_y_deg = 60;
-    scene.camera.width = scene.camera.height = 16;
+    scene.camera = testing::SquareCamera({0, 0.5, 0}, {0, 0, 0}, {0, 0, 1}, 60, 16);
     return scene;
 }
 

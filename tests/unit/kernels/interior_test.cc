@@ -62,10 +62,7 @@ TEST_P(Interior, TransmittedRadianceFollowsBeersLaw) {
     back.positions = {{-5, 5, -2}, {-5, -5, -2}, {5, -5, -2}, {5, 5, -2}};
     back.triangles = {{0, 1, 2}, {0, 2, 3}};
     scene.meshes.push_back(back);
-    scene.camera.position = {0, 0, 10};
-    scene.camera.look_at = {0, 0, 0};
-    scene.camera.fov_y_deg = 2;
-    scene.camera.width = scene.camera.height = 8;
+    scene.camera = testing::SquareCamera({0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 2, 8);
 
     const RenderOutput out = testing::RenderPath(scene, 64).out;
     const Camera camera(scene.camera, Vec3d());

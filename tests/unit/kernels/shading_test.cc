@@ -231,11 +231,7 @@ TEST_P(NormalMap, ShadesLikeTheTiltedPlane) {
     const Vec3d light(0.3, 1.0, -0.2);
     const Rgb intensity(10.0f, 5.0f, 2.0f);
     scene.point_lights.push_back({light, intensity});
-    scene.camera.position = {0, 3, 0};
-    scene.camera.look_at = {0, 0, 0};
-    scene.camera.up = {0, 0, 1};
-    scene.camera.fov_y_deg = 60;
-    scene.camera.width = scene.camera.height = 16;
+    scene.camera = testing::SquareCamera({0, 3, 0}, {0, 0, 0}, {0, 0, 1}, 60, 16);
 
     const Vec3d tn(c.texel_normal.x * c.scale, c.texel_normal.y * c.scale, c.texel_normal.z);
     const Vec3d n = Normalize(Vec3d(tn.x, tn.z, -tn.y));
@@ -288,11 +284,7 @@ Scene LitSphereScene() {
     m.reflectance = Rgb(0.8f);
     scene.materials.push_back(m);
     scene.point_lights.push_back({{4, 3, 5}, Rgb(50)});
-    scene.camera.position = {0, 0, 4};
-    scene.camera.look_at = {0, 0, 0};
-    scene.camera.up = {0, 1, 0};
-    scene.camera.fov_y_deg = 35;
-    scene.camera.width = scene.camera.height = 32;
+    scene.camera = testing::SquareCamera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 35, 32);
     return scene;
 }
 
@@ -398,11 +390,7 @@ TEST(SmoothShading, NoLightLeaksFromBelowTheSurface) {
     quad.triangles = {{0, 1, 2}, {0, 2, 3}};
     scene.meshes.push_back(quad);
     scene.point_lights.push_back({{5, -1, 0}, Rgb(100)});
-    scene.camera.position = {-0.75, 2, 0};
-    scene.camera.look_at = {-0.75, 0, 0};
-    scene.camera.up = {0, 0, 1};
-    scene.camera.fov_y_deg = 20;
-    scene.camera.width = scene.camera.height = 8;
+    scene.camera = testing::SquareCamera({-0.75, 2, 0}, {-0.75, 0, 0}, {0, 0, 1}, 20, 8);
     const RenderOutput out = testing::RenderPath(scene, 16).out;
     for (int y = 0; y < 8; ++y) {
         for (int x = 0; x < 8; ++x) EXPECT_EQ(out.image.Pixel(x, y), Rgb(0)) << x << "," << y;
