@@ -483,7 +483,8 @@ class SceneParser {
     }
 
     CameraSpec ParseCamera(const Node& n) {
-        n.ExpectObject({"position", "look_at", "up", "fov_y_deg", "resolution"});
+        n.ExpectObject({"position", "look_at", "up", "fov_y_deg", "resolution", "aperture_radius",
+                        "focus_distance"});
         CameraSpec camera;
         camera.position = n.Get("position").Vector();
         const Node look_at = n.Get("look_at");
@@ -511,6 +512,15 @@ class SceneParser {
         if (int64_t(camera.width) * camera.height > kMaxPixels) {
             resolution.Fail(
                 absl::StrCat(camera.width, " x ", camera.height, " is more than 2^28 pixels"));
+        }
+        if (const std::optional<Node> aperture = n.Find("aperture_radius")) {
+            camera.aperture_radius = aperture->NumberIn(0, kMaxCoordinate, "≥ 0 (scene units)");
+        }
+        // By default the camera focuses on what it looks at.
+        camera.focus_distance = Length(view);
+        if (const std::optional<Node> focus = n.Find("focus_distance")) {
+            camera.focus_distance = focus->NumberIn(0, kMaxCoordinate, "above 0 (scene units)");
+            if (camera.focus_distance == 0) focus->Fail("must be above 0 (scene units)");
         }
         return camera;
     }

@@ -13,7 +13,8 @@ TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, co
             for (uint64_t s = sample_begin; s < sample_end; ++s) {
                 Sampler sampler(seed, x, y, s);
                 const Vec2 film = sampler.Get2D();
-                const Ray ray = camera.GenerateRay(x, y, film.x, film.y);
+                const Vec2 lens = camera.HasLens() ? sampler.Get2D() : Vec2{};
+                const Ray ray = camera.GenerateRay(x, y, film.x, film.y, lens);
                 Rgb L = estimator.Li(ray, sampler, tile.stats);
                 if (!L.IsFinite()) {
                     ++tile.stats.invalid_samples;

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <numbers>
 
 namespace lf {
@@ -41,6 +43,55 @@ TEST(Camera, OriginIsSubtracted) {
     const Camera cam(Spec(), Vec3d(1, 2, 3));
     const Ray r = cam.GenerateRay(0, 0, 0.5f, 0.5f);
     EXPECT_EQ(r.o, Vec3(0, 0, 0));
+}
+
+// Where a ray meets the plane z = z0 (the camera looks along +z from z = 3).
+Vec3 AtDepth(const Ray& r, float z0) { return r.o + r.d * ((z0 - r.o.z) / r.d.z); }
+
+// Thin lens: every ray through one film point, whatever lens point it leaves from, passes through
+// the same point of the focal plane (that point stays sharp), and that point is where the pinhole
+// ray through the film point goes.
+TEST(Camera, ThinLensFocusesEveryLensPointOnTheFocalPlane) {
+    CameraSpec spec = Spec();
+    spec.aperture_radius = 0.2;
+    spec.focus_distance = 4;
+    const Camera lens(spec, Vec3d(0, 0, 0));
+    const Camera pinhole(Spec(), Vec3d(0, 0, 0));
+    ASSERT_TRUE(lens.HasLens());
+    ASSERT_FALSE(pinhole.HasLens());
+    const Vec3 sharp = AtDepth(pinhole.GenerateRay(37, 81, 0.25f, 0.5f), 3 + 4);
+    for (const Vec2 u : {Vec2{0.1f, 0.9f}, Vec2{0.5f, 0.5f}, Vec2{0.99f, 0.01f}, Vec2{0.3f, 0.6f}}) {
+        const Ray r = lens.GenerateRay(37, 81, 0.25f, 0.5f, u);
+        const Vec3 p = AtDepth(r, 3 + 4);
+        EXPECT_NEAR(p.x, sharp.x, 1e-5);
+        EXPECT_NEAR(p.y, sharp.y, 1e-5);
+        // The ray leaves from the lens disk, in the plane through the camera across the view.
+        EXPECT_NEAR(r.o.z, 3, 1e-6);
+        EXPECT_LE(std::hypot(r.o.x - 1, r.o.y - 2), 0.2f + 1e-6f);
+    }
+}
+
+// Off the focal plane, the rays through the image centre from the whole lens cover a disk: the
+// circle of confusion, of diameter 2 R |z - f| / f at distance z (similar triangles).
+TEST(Camera, ThinLensBlurCircleHasTheThinLensDiameter) {
+    CameraSpec spec = Spec();
+    spec.aperture_radius = 0.1;
+    spec.focus_distance = 5;
+    const Camera lens(spec, Vec3d(0, 0, 0));
+    for (const double z : {2.0, 8.0, 20.0}) {
+        float widest = 0;
+        constexpr int kGrid = 64;
+        for (int i = 0; i < kGrid; ++i) {
+            for (int j = 0; j < kGrid; ++j) {
+                const Vec2 u{(i + 0.5f) / kGrid, (j + 0.5f) / kGrid};
+                const Vec3 p = AtDepth(lens.GenerateRay(100, 50, 0.0f, 0.0f, u), float(3 + z));
+                widest = std::max(widest, 2 * std::hypot(p.x - 1, p.y - 2));
+            }
+        }
+        const double expected = 2 * 0.1 * std::abs(z - 5) / 5;
+        // The grid's outermost samples sit half a cell inside the rim.
+        EXPECT_NEAR(widest, expected, expected * 2.0 / kGrid + 1e-5) << z;
+    }
 }
 
 }  // namespace

@@ -483,6 +483,27 @@ TEST_F(SceneLoaderTest, MtlEmissionMapWithoutKeEmitsTheTexture) {
     EXPECT_EQ(material("dim").emission, Rgb(0.5f));
 }
 
+// A thin-lens camera focuses on what it looks at unless told otherwise; a negative aperture or a
+// zero focus distance is an error naming the key.
+TEST_F(SceneLoaderTest, ThinLensCameraKeys) {
+    const std::string lens =
+        R"({"position": [0, 0, -5], "look_at": [0, 0, 0], "fov_y_deg": 40,
+            "resolution": [32, 24], "aperture_radius": 0.05)";
+    absl::StatusOr<Scene> scene = Parse(SceneJson(kQuad, kMaterials, lens + "}"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_EQ(scene->camera.aperture_radius, 0.05);
+    EXPECT_EQ(scene->camera.focus_distance, 5);
+    scene = Parse(SceneJson(kQuad, kMaterials, lens + R"(, "focus_distance": 2.5})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_EQ(scene->camera.focus_distance, 2.5);
+    ExpectError(SceneJson(kQuad, kMaterials,
+                          R"({"position": [0, 0, -5], "look_at": [0, 0, 0], "fov_y_deg": 40,
+                              "resolution": [32, 24], "aperture_radius": -1})"),
+                "scene.json: camera.aperture_radius: must be ≥ 0 (scene units), got -1");
+    ExpectError(SceneJson(kQuad, kMaterials, lens + R"(, "focus_distance": 0})"),
+                "scene.json: camera.focus_distance: must be above 0 (scene units)");
+}
+
 // A normal map needs tangents; an OBJ has none, so the loader computes them once, per vertex,
 // after the shape's transform: here u runs along +x scaled by 2, and v down the image along -y.
 TEST_F(SceneLoaderTest, NormalMappedMeshesWithoutTangentsGetThemAtLoad) {

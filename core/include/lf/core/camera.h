@@ -12,8 +12,12 @@ class Camera {
     // scene so float precision is spent where the geometry is (see EmbreeScene).
     Camera(const CameraSpec& spec, const Vec3d& origin);
 
-    // Ray through film point (px + u, py + v); px counts from the left, py from the top.
-    Ray GenerateRay(int px, int py, float u, float v) const;
+    // Ray through film point (px + u, py + v); px counts from the left, py from the top. With a
+    // lens, `lens` (uniform in [0, 1)^2) picks the point on the aperture it leaves from.
+    Ray GenerateRay(int px, int py, float u, float v, const Vec2& lens = {}) const;
+
+    // Whether rays need a lens sample: a pinhole takes none, so its renders keep their bits.
+    bool HasLens() const { return lens_radius_ > 0; }
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -21,6 +25,7 @@ class Camera {
   private:
     Vec3 position_, forward_, right_, up_;
     float tan_half_fov_ = 0, aspect_ = 1;
+    float lens_radius_ = 0, focus_distance_ = 1;
     int width_ = 0, height_ = 0;
 };
 

@@ -148,6 +148,11 @@ struct CameraSpec {
     double fov_y_deg = 45;
     int width = 256;
     int height = 256;
+    // Thin lens (distributed ray tracing): rays leave a disk of this radius around `position`,
+    // perpendicular to the view, and meet again on the plane focus_distance along the view axis.
+    // 0: a pinhole, everything sharp.
+    double aperture_radius = 0;
+    double focus_distance = 1;  // scene units; used only with an aperture
 };
 
 struct Scene {
