@@ -60,7 +60,8 @@ TEST(Camera, ThinLensFocusesEveryLensPointOnTheFocalPlane) {
     ASSERT_TRUE(lens.HasLens());
     ASSERT_FALSE(pinhole.HasLens());
     const Vec3 sharp = AtDepth(pinhole.GenerateRay(37, 81, 0.25f, 0.5f), 3 + 4);
-    for (const Vec2 u : {Vec2{0.1f, 0.9f}, Vec2{0.5f, 0.5f}, Vec2{0.99f, 0.01f}, Vec2{0.3f, 0.6f}}) {
+    for (const Vec2 u :
+         {Vec2{0.1f, 0.9f}, Vec2{0.5f, 0.5f}, Vec2{0.99f, 0.01f}, Vec2{0.3f, 0.6f}}) {
         const Ray r = lens.GenerateRay(37, 81, 0.25f, 0.5f, u);
         const Vec3 p = AtDepth(r, 3 + 4);
         EXPECT_NEAR(p.x, sharp.x, 1e-5);
