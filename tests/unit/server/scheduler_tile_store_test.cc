@@ -10,6 +10,7 @@
 #include "server/scheduler.h"
 #include "server/sqlite_job_store.h"
 #include "test_dir.h"
+#include "test_job_store.h"
 
 namespace lf {
 namespace {
@@ -24,12 +25,7 @@ class SchedulerTileStoreTest : public ::testing::Test {
     }
     void TearDown() override { fs::remove_all(dir_); }
 
-    std::unique_ptr<SqliteJobStore> OpenStore() {
-        absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
-            SqliteJobStore::Open((dir_ / "jobs.db").string());
-        EXPECT_TRUE(store.ok()) << store.status();
-        return std::move(*store);
-    }
+    std::unique_ptr<SqliteJobStore> OpenStore() { return lf::testing::OpenJobStore(dir_); }
 
     SchedulerOptions InFiles() const {
         SchedulerOptions options;

@@ -14,6 +14,7 @@
 #include "server/farm.h"
 #include "server/scheduler.h"
 #include "test_dir.h"
+#include "test_job_store.h"
 
 namespace lf {
 namespace {
@@ -25,12 +26,7 @@ class SqliteJobStoreTest : public ::testing::Test {
     void SetUp() override { dir_ = lf::testing::FreshTestDir("lf_store"); }
     void TearDown() override { fs::remove_all(dir_); }
 
-    std::unique_ptr<SqliteJobStore> OpenStore() {
-        absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
-            SqliteJobStore::Open((dir_ / "jobs.db").string());
-        EXPECT_TRUE(store.ok()) << store.status();
-        return std::move(*store);
-    }
+    std::unique_ptr<SqliteJobStore> OpenStore() { return lf::testing::OpenJobStore(dir_); }
 
     // A 16x16 image in 8x8 tiles, 4 spp in 2 passes: 8 tasks.
     static JobSpec Spec() {
