@@ -46,7 +46,10 @@ bool Scene::AllLambertian() const {
 }
 
 bool Scene::HasLights() const {
-    if (!point_lights.empty() || !spot_lights.empty() || !directional_lights.empty()) return true;
+    if (!point_lights.empty() || !spot_lights.empty() || !directional_lights.empty() ||
+        environment) {
+        return true;
+    }
     for (const TriangleMesh& mesh : meshes) {
         if (materials[size_t(mesh.material)].IsEmissive()) return true;
     }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,9 @@ struct Material {
     Rgb eta{1.0f}, k{0.0f};
     float ior = 1.5f;    // dielectric and principled: interior IOR over exterior IOR
     Rgb emission{0.0f};  // radiance leaving the front face, W m^-2 sr^-1
+    // Emission leaves both faces (JSON "two_sided"), each with radiance `emission`: a panel
+    // that glows on both sides emits twice the power of a one-sided one.
+    bool two_sided_emission = false;
 
     // The principled material: the glTF 2.0 metallic-roughness BRDF (its Appendix B) with
     // KHR_materials_transmission, _ior and _volume. Textures multiply their factors:
@@ -125,20 +129,53 @@ struct PointLight {
     Rgb intensity;  // W/sr per channel
 };
 
-// A point light whose intensity falls off between two cones around `direction`
-// (KHR_lights_punctual's spot): full inside inner_cone, zero outside outer_cone.
+// A point light whose intensity falls off between two cones around `direction`: full inside
+// inner_cone, zero outside outer_cone. Between them, with c = cos(angle to the axis):
+//  - kSmoothstep (JSON scenes, pbrt-v4's SpotLight): smoothstep(cos outer, cos inner, c);
+//  - kKhrLightsPunctual (glTF): KHR_lights_punctual's clamp((c - cos outer) /
+//    (cos inner - cos outer), 0, 1)^2, so glTF scenes look as their authors saw them.
 struct SpotLight {
+    enum class Falloff { kSmoothstep, kKhrLightsPunctual };
+
     Vec3d position;
     Vec3d direction;                           // unit, the way the light points
     Rgb intensity;                             // W/sr per channel on the axis
     double inner_cone = 0;                     // radians, half-angle
     double outer_cone = 3.14159265358979 / 4;  // radians, half-angle, > inner_cone
+    Falloff falloff = Falloff::kSmoothstep;
 };
 
-// Light from infinitely far away (the sun): parallel rays along `direction`.
+// Light from far away along `direction`. With angular_diameter 0 a delta light (parallel rays,
+// sharp shadows); above 0 a disk of that apparent diameter (the sun: about 0.53 degrees) of
+// uniform radiance irradiance / (pi sin^2(angular_diameter / 2)), so a surface facing it
+// receives `irradiance` either way and shadows get penumbrae.
 struct DirectionalLight {
-    Vec3d direction;  // unit, the way the light travels
-    Rgb irradiance;   // W/m^2 per channel on a surface facing the light
+    Vec3d direction;              // unit, the way the light travels
+    Rgb irradiance;               // W/m^2 per channel on a surface facing the light
+    double angular_diameter = 0;  // radians, full apex angle of the cone, in [0, pi/2]
+};
+
+// Light arriving from every direction at infinity (a sky). Without a map its radiance is
+// `radiance` everywhere; with one, the map's texel times `radiance` (which carries the scene's
+// `scale` or photometric normalisation). The map is latitude-longitude with +y up: world
+// direction d is first turned by -rotate_y about +y (so a positive rotate_y turns the sky
+// counter-clockwise seen from above, as Blender's and pbrt's rotations do), then read at
+// u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, texel row 0 at the top (v = 0).
+struct EnvironmentLight {
+    Rgb radiance{1.0f};                       // W m^-2 sr^-1 per channel (times the map's texel)
+    std::shared_ptr<const TextureImage> map;  // HDR/EXR texels, linear; null: uniform
+    double rotate_y = 0;                      // radians
+};
+
+// How each sample is placed in its pixel: box (the seeds' sensor: uniform over the pixel
+// square) or, by filter importance sampling (pbrt-v4), at an offset drawn from the filter's
+// own distribution, so every sample keeps weight 1 and sums stay exact. `width` is the filter's
+// full support in pixels (box: 1 only; gaussian: sigma = width / 6; blackman-harris: the
+// window's length). Separable: x and y offsets are drawn independently.
+struct PixelFilter {
+    enum class Type { kBox, kGaussian, kBlackmanHarris };
+    Type type = Type::kBox;
+    double width = 1;
 };
 
 struct CameraSpec {
@@ -153,6 +190,7 @@ struct CameraSpec {
     // 0: a pinhole, everything sharp.
     double aperture_radius = 0;
     double focus_distance = 1;  // scene units; used only with an aperture
+    PixelFilter filter;
 };
 
 struct Scene {
@@ -163,6 +201,7 @@ struct Scene {
     std::vector<PointLight> point_lights;
     std::vector<SpotLight> spot_lights;
     std::vector<DirectionalLight> directional_lights;
+    std::optional<EnvironmentLight> environment;  // at most one sky
     // Images the materials' TextureRefs index; shared, so a copied scene costs no texels.
     std::vector<std::shared_ptr<const TextureImage>> textures;
 

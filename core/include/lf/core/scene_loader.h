@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -25,6 +26,8 @@ struct SceneOptions {
     // in place of the JSON's camera. Empty: the JSON's camera, else the first glTF camera.
     std::string camera;
     int width = 0, height = 0;  // above 0: the image size, whatever the scene says
+    // `--filter`: the pixel filter, whatever the scene's camera says (glTF cameras have none).
+    std::optional<PixelFilter> filter;
 };
 
 // Files beside the scene file (ReadBeside of its folder).

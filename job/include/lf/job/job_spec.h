@@ -27,6 +27,8 @@ struct JobSpec {
     RenderPlanSettings plan;  // width and height come from the scene and scene_options
     uint64_t seed = defaults::kSeed;
     int max_depth = defaults::kMaxDepth;
+    double clamp = 0;   // RenderSettings::clamp (lf/local/local_executor.h); 0: off
+    uint32_t aovs = 0;  // lf/core/aov.h flags
     std::string method = defaults::kMethod;  // or "radiosity"
     RadiositySettings radiosity;
     AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused

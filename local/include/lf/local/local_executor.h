@@ -23,6 +23,10 @@ struct RenderSettings {
     int threads = 0;  // 0: all cores
     int tile = defaults::kTile;
     int passes = defaults::kPasses;  // sample passes per tile, as on the farm
+    // `--clamp`: above 0, a sample whose radiance exceeds it in some channel is scaled down
+    // so that channel equals it (biased: it removes fireflies and energy with them).
+    double clamp = 0;
+    uint32_t aovs = 0;  // lf/core/aov.h flags: first-hit AOV channels to add
 };
 
 struct RenderOutput {
