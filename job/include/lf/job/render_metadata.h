@@ -12,6 +12,7 @@
 #include "lf/core/image.h"
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
+#include "lf/core/scene.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/plan.h"
 
@@ -65,8 +66,9 @@ struct RenderMetadata {
     uint64_t spp = 0;    // adaptive: the most any pixel got
     uint64_t seed = 0;
     int max_depth = -1;
-    double clamp = 0;   // 0: no clamping; otherwise the image is biased (lightfarm.clamp)
-    uint32_t aovs = 0;  // lf/core/aov.h flags of the AOV channels the image has
+    double clamp = 0;    // 0: no clamping; otherwise the image is biased (lightfarm.clamp)
+    uint32_t aovs = 0;   // lf/core/aov.h flags of the AOV channels the image has
+    PixelFilter filter;  // the camera's, after --filter
     double seconds = 0;  // the whole render: loading, meshing, solving and sampling
     RenderStats stats;
     AdaptiveSettings adaptive_settings;
