@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "chi_square_counts.h"
+#include "chi_square.h"
 #include "lf/core/sampler.h"
 #include "lf/kernels/light_bounds.h"
 
