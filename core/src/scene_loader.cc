@@ -1071,9 +1071,16 @@ class SceneParser {
         if (photometric && scale_node) {
             scale_node->Fail("luminance_nits sets the sky's strength already; give one of the two");
         }
+        // A map's texels are not bounded here; its factor, like a uniform sky, is.
+        const auto checked = [&]() {
+            if (!(light.radiance.MaxComponent() <= kMaxRadiance)) {
+                n.Fail("too bright: the sky's radiance (or a map's factor) is over 1e10");
+            }
+            return light;
+        };
         if (!file) {
             light.radiance = StrengthValue(n, *strength) * float(scale);
-            return light;
+            return checked();
         }
         if (strength && !photometric) {
             strength->value.Fail(
@@ -1099,10 +1106,7 @@ class SceneParser {
                                                          "≥ 0 and at most 6.8e12");
             light.radiance = tint * float(nits / (kLumensPerWatt * mean));
         }
-        if (!(light.radiance.MaxComponent() <= kMaxRadiance)) {
-            n.Fail("too bright: the sky's scale is over 1e10");
-        }
-        return light;
+        return checked();
     }
 
     // The luminance (Rec.709 Y) of a lat-long map times `tint`, averaged over the sphere of

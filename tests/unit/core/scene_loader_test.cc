@@ -59,6 +59,18 @@ std::string SceneJson(const std::string& shapes, const std::string& materials = 
            shapes + "]" + extra + "}";
 }
 
+// A scene whose material "m" is `material` (and "lamp" emits, so the scene has light).
+std::string WithMaterial(const std::string& material) {
+    return SceneJson(kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], )"
+                            R"("emission": [1, 1, 1]}, "m": )" +
+                                material + "}");
+}
+
+// A scene with `lights`, the JSON array's elements.
+std::string WithLights(const std::string& lights) {
+    return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + lights + "]");
+}
+
 class SceneLoaderTest : public ::testing::Test {
   protected:
     void SetUp() override {
@@ -346,38 +358,32 @@ TEST_F(SceneLoaderTest, StructureErrorsNameThePath) {
 }
 
 TEST_F(SceneLoaderTest, MaterialErrorsNameThePath) {
-    auto with_material = [](const std::string& material) {
-        return SceneJson(
-            kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
-                                   "m": )" +
-                       material + "}");
-    };
-    ExpectError(with_material(R"({"type": "metal"})"),
+    ExpectError(WithMaterial(R"({"type": "metal"})"),
                 "scene.json: materials.m.type: unknown material type \"metal\"");
-    ExpectError(with_material(R"({"type": "lambert"})"),
+    ExpectError(WithMaterial(R"({"type": "lambert"})"),
                 "scene.json: materials.m: missing required key \"reflectance\"");
-    ExpectError(with_material(R"({"type": "mirror", "reflectance": [1, 1.5, 1]})"),
+    ExpectError(WithMaterial(R"({"type": "mirror", "reflectance": [1, 1.5, 1]})"),
                 "scene.json: materials.m.reflectance[1]: must be in [0, 1], got 1.5");
     ExpectError(
-        with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [-1, 0, 0]})"),
+        WithMaterial(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [-1, 0, 0]})"),
         "scene.json: materials.m.emission[0]: must be ≥ 0");
     // Absurdly bright: the light sampler's power would overflow and the film would clamp.
     ExpectError(
-        with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [1, 3e38, 0]})"),
+        WithMaterial(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [1, 3e38, 0]})"),
         "scene.json: materials.m.emission[1]: must be ≥ 0 and at most 1e+10, got 3e+38");
-    ExpectError(with_material(R"({"type": "glossy", "roughness": 0, "reflectance": [1, 1, 1]})"),
+    ExpectError(WithMaterial(R"({"type": "glossy", "roughness": 0, "reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m.roughness: must be a positive float, got 0");
-    ExpectError(with_material(R"({"type": "glossy", "roughness": 0.1, "distribution": "phong", )"
-                              R"("reflectance": [1, 1, 1]})"),
+    ExpectError(WithMaterial(R"({"type": "glossy", "roughness": 0.1, "distribution": "phong", )"
+                             R"("reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m.distribution: unknown distribution \"phong\"");
-    ExpectError(with_material(R"({"type": "glossy", "roughness": 0.1, "reflectance": [1, 1, 1], )"
-                              R"("eta": [1, 1, 1], "k": [0, 0, 0]})"),
+    ExpectError(WithMaterial(R"({"type": "glossy", "roughness": 0.1, "reflectance": [1, 1, 1], )"
+                             R"("eta": [1, 1, 1], "k": [0, 0, 0]})"),
                 "scene.json: materials.m: give either reflectance or eta and k, not both");
-    ExpectError(with_material(R"({"type": "glossy", "roughness": 0.1, "eta": [1, 1, 1]})"),
+    ExpectError(WithMaterial(R"({"type": "glossy", "roughness": 0.1, "eta": [1, 1, 1]})"),
                 "scene.json: materials.m: missing required key \"k\"");
-    ExpectError(with_material(R"({"type": "dielectric", "ior": -1.5})"),
+    ExpectError(WithMaterial(R"({"type": "dielectric", "ior": -1.5})"),
                 "scene.json: materials.m.ior: must be a positive float");
-    ExpectError(with_material("[]"), "scene.json: materials.m: expected an object, got array");
+    ExpectError(WithMaterial("[]"), "scene.json: materials.m: expected an object, got array");
 }
 
 TEST_F(SceneLoaderTest, CameraErrorsNameThePath) {
@@ -710,56 +716,50 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
 
 TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
     Write("wood.png", TexturePng());
-    auto with_material = [](const std::string& material) {
-        return SceneJson(
-            kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
-                       "m": )" +
-                       material + "}");
-    };
     const std::string p = R"({"type": "principled", )";
-    ExpectError(with_material(p + R"("metallic": 2})"),
+    ExpectError(WithMaterial(p + R"("metallic": 2})"),
                 "scene.json: materials.m.metallic: must be in [0, 1], got 2");
-    ExpectError(with_material(p + R"("roughness": -0.1})"),
+    ExpectError(WithMaterial(p + R"("roughness": -0.1})"),
                 "scene.json: materials.m.roughness: must be in [0, 1], got -0.1");
-    ExpectError(with_material(p + R"("transmission": 1.5})"),
+    ExpectError(WithMaterial(p + R"("transmission": 1.5})"),
                 "scene.json: materials.m.transmission: must be in [0, 1], got 1.5");
-    ExpectError(with_material(p + R"("ior": 0})"),
+    ExpectError(WithMaterial(p + R"("ior": 0})"),
                 "scene.json: materials.m.ior: must be a positive float, got 0");
-    ExpectError(with_material(p + R"("thickness": -1})"),
+    ExpectError(WithMaterial(p + R"("thickness": -1})"),
                 "scene.json: materials.m.thickness: must be ≥ 0 (metres), got -1");
-    ExpectError(with_material(p + R"("attenuation_distance": 0})"),
+    ExpectError(WithMaterial(p + R"("attenuation_distance": 0})"),
                 "scene.json: materials.m.attenuation_distance: must be a positive float");
-    ExpectError(with_material(p + R"("base_color": [1, 1, 2]})"),
+    ExpectError(WithMaterial(p + R"("base_color": [1, 1, 2]})"),
                 "scene.json: materials.m.base_color[2]: must be in [0, 1], got 2");
-    ExpectError(with_material(p + R"("base_color": [1, 1, 1], "reflectance": [1, 1, 1]})"),
+    ExpectError(WithMaterial(p + R"("base_color": [1, 1, 1], "reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m: give either base_color or reflectance");
-    ExpectError(with_material(p + R"("alpha_mode": "blend"})"),
+    ExpectError(WithMaterial(p + R"("alpha_mode": "blend"})"),
                 "scene.json: materials.m.alpha_mode: unknown alpha mode \"blend\"; expected "
                 "opaque or mask");
-    ExpectError(with_material(p + R"("double_sided": "yes"})"),
+    ExpectError(WithMaterial(p + R"("double_sided": "yes"})"),
                 "scene.json: materials.m.double_sided: expected true or false, got string");
     ExpectError(
-        with_material(p + R"("base_color_texture": "nope.png"})"),
+        WithMaterial(p + R"("base_color_texture": "nope.png"})"),
         "scene.json: materials.m.base_color_texture \"nope.png\": ", absl::StatusCode::kNotFound);
     ExpectError(
-        with_material(p + R"("normal_texture": {"file": "nope.png"}})"),
+        WithMaterial(p + R"("normal_texture": {"file": "nope.png"}})"),
         "scene.json: materials.m.normal_texture.file \"nope.png\": ", absl::StatusCode::kNotFound);
-    ExpectError(with_material(p + R"("base_color_texture": {"file": "wood.png", "wrap": "tile"}})"),
+    ExpectError(WithMaterial(p + R"("base_color_texture": {"file": "wood.png", "wrap": "tile"}})"),
                 "scene.json: materials.m.base_color_texture.wrap: unknown wrap mode \"tile\"; "
                 "expected repeat, clamp or mirror");
     ExpectError(
-        with_material(p + R"("base_color_texture": {"file": "wood.png", "filter": "cubic"}})"),
+        WithMaterial(p + R"("base_color_texture": {"file": "wood.png", "filter": "cubic"}})"),
         "scene.json: materials.m.base_color_texture.filter: unknown filter \"cubic\"");
-    ExpectError(with_material(p + R"("base_color_texture": {"file": "wood.png", )"
-                                  R"("transform": {"scale": [1, 0]}}})"),
+    ExpectError(WithMaterial(p + R"("base_color_texture": {"file": "wood.png", )"
+                                 R"("transform": {"scale": [1, 0]}}})"),
                 "scene.json: materials.m.base_color_texture.transform.scale: must not be zero");
-    ExpectError(with_material(p + R"("base_color_texture": {"wrap": "clamp"}})"),
+    ExpectError(WithMaterial(p + R"("base_color_texture": {"wrap": "clamp"}})"),
                 "scene.json: materials.m.base_color_texture: missing required key \"file\"");
     Write("bad.png", "GIF89a not a png");
-    ExpectError(with_material(p + R"("base_color_texture": "bad.png"})"),
+    ExpectError(WithMaterial(p + R"("base_color_texture": "bad.png"})"),
                 "scene.json: materials.m.base_color_texture: ");
-    ExpectError(with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], )"
-                              R"("base_color_texture": 7})"),
+    ExpectError(WithMaterial(R"({"type": "lambert", "reflectance": [1, 1, 1], )"
+                             R"("base_color_texture": 7})"),
                 "scene.json: materials.m.base_color_texture: expected an object, got number");
 }
 
@@ -806,38 +806,35 @@ TEST_F(SceneLoaderTest, SpotAndDirectionalLights) {
 }
 
 TEST_F(SceneLoaderTest, LightErrorsNameThePath) {
-    auto with_light = [](const std::string& light) {
-        return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + light + "]");
-    };
     const std::string spot = R"({"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1], )";
-    ExpectError(with_light(spot + R"("direction": [0, 0, 0]})"),
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 0]})"),
                 "scene.json: lights[0].direction: must not be zero");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "inner_cone_deg": 30, )"
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "inner_cone_deg": 30, )"
                                   R"("outer_cone_deg": 20})"),
                 "scene.json: lights[0].outer_cone_deg: 20 must be above lights[0].inner_cone_deg "
                 "(30)");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 95})"),
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 95})"),
                 "scene.json: lights[0].outer_cone_deg: must be in (0, 90] degrees, got 95");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "inner_cone_deg": -1})"),
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "inner_cone_deg": -1})"),
                 "scene.json: lights[0].inner_cone_deg: must be in [0, 90) degrees, got -1");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 0})"),
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 0})"),
                 "scene.json: lights[0].outer_cone_deg: 0 must be above the default inner_angle_deg "
                 "(0)");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "color": [1, 0, 0]})"),
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "color": [1, 0, 0]})"),
                 "scene.json: lights[0].intensity: an [r, g, b] strength is a colour itself; with "
                 "color or temperature_k give a number");
-    ExpectError(with_light(R"({"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1]})"),
+    ExpectError(WithLights(R"({"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1]})"),
                 "scene.json: lights[0]: missing required key \"direction\"");
-    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1]})"),
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, 0, 1]})"),
                 "scene.json: lights[0]: give exactly one of irradiance (W/m^2) or "
                 "illuminance_lux (lx)");
-    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1], )"
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, 0, 1], )"
                            R"("illuminance_lux": -5})"),
                 "scene.json: lights[0].illuminance_lux: must be ≥ 0");
-    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1], )"
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, 0, 1], )"
                            R"("irradiance": [1, 1, 1], "color": [1, 1, 1]})"),
                 "scene.json: lights[0].irradiance: an [r, g, b] strength is a colour itself");
-    ExpectError(with_light(R"({"type": "point", "position": [0, 0, 0], "intensity_cd": 1, )"
+    ExpectError(WithLights(R"({"type": "point", "position": [0, 0, 0], "intensity_cd": 1, )"
                            R"("color": [2, 1, 1]})"),
                 "scene.json: lights[0].color[0]: must be in [0, 1], got 2");
 }
@@ -889,41 +886,38 @@ TEST_F(SceneLoaderTest, PhotometricLightsAndColourTemperatures) {
 }
 
 TEST_F(SceneLoaderTest, PhotometricAndColourErrorsNameThePath) {
-    auto with_light = [](const std::string& light) {
-        return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + light + "]");
-    };
     const std::string point = R"({"type": "point", "position": [0, 0, 0], )";
-    ExpectError(with_light(point + R"("intensity_cd": 1, "temperature_k": 0})"),
+    ExpectError(WithLights(point + R"("intensity_cd": 1, "temperature_k": 0})"),
                 "scene.json: lights[0].temperature_k: must be in [1000, 40000] kelvin, got 0");
-    ExpectError(with_light(point + R"("intensity_cd": 1, "temperature_k": 50000})"),
+    ExpectError(WithLights(point + R"("intensity_cd": 1, "temperature_k": 50000})"),
                 "scene.json: lights[0].temperature_k: must be in [1000, 40000] kelvin, got 50000");
-    ExpectError(with_light(point + R"("intensity": [1, 1, 1], "power_lm": 5})"),
+    ExpectError(WithLights(point + R"("intensity": [1, 1, 1], "power_lm": 5})"),
                 "scene.json: lights[0]: give a radiometric strength (intensity or power) or a "
                 "photometric one (intensity_cd or power_lm), not both");
     ExpectError(
-        with_light(point + R"("intensity_cd": 1, "color": [1, 1, 1], "temperature_k": 3000})"),
+        WithLights(point + R"("intensity_cd": 1, "color": [1, 1, 1], "temperature_k": 3000})"),
         "scene.json: lights[0]: give color or temperature_k, not both");
-    ExpectError(with_light(point + R"("intensity_cd": 1, "color": [0, 0, 0]})"),
+    ExpectError(WithLights(point + R"("intensity_cd": 1, "color": [0, 0, 0]})"),
                 "scene.json: lights[0].color: has luminance 0: a photometric strength cannot give "
                 "it any light");
-    ExpectError(with_light(R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, )"
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, )"
                            R"("angular_diameter_deg": 91})"),
                 "scene.json: lights[0].angular_diameter_deg: must be in [0, 90] degrees, got 91");
-    ExpectError(with_light(R"({"type": "directional", "direction": [0, -1, 0], )"
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, -1, 0], )"
                            R"("illuminance_lux": 1, "irradiance": [1, 1, 1]})"),
                 "scene.json: lights[0]: give a radiometric strength (irradiance) or a photometric "
                 "one (illuminance_lux), not both");
     const std::string spot =
         R"({"type": "spot", "position": [0, 0, 0], "direction": [0, 0, 1], "intensity": 1, )";
-    ExpectError(with_light(spot + R"("inner_angle_deg": 30, "outer_angle_deg": 20})"),
+    ExpectError(WithLights(spot + R"("inner_angle_deg": 30, "outer_angle_deg": 20})"),
                 "scene.json: lights[0].outer_angle_deg: 20 must be above "
                 "lights[0].inner_angle_deg (30)");
-    ExpectError(with_light(spot + R"("inner_angle_deg": 30, "outer_angle_deg": 30})"),
+    ExpectError(WithLights(spot + R"("inner_angle_deg": 30, "outer_angle_deg": 30})"),
                 "scene.json: lights[0].outer_angle_deg: 30 must be above");
-    ExpectError(with_light(spot + R"("inner_angle_deg": 50})"),
+    ExpectError(WithLights(spot + R"("inner_angle_deg": 50})"),
                 "scene.json: lights[0].inner_angle_deg: 50 must be below the default "
                 "outer_angle_deg (45)");
-    ExpectError(with_light(spot + R"("outer_angle_deg": 20, "outer_cone_deg": 20})"),
+    ExpectError(WithLights(spot + R"("outer_angle_deg": 20, "outer_cone_deg": 20})"),
                 "scene.json: lights[0]: give outer_angle_deg or its older name outer_cone_deg, "
                 "not both");
 }
@@ -965,27 +959,22 @@ TEST_F(SceneLoaderTest, PhotometricEmission) {
 
 TEST_F(SceneLoaderTest, EmissionErrorsNameThePath) {
     Write("glow.png", lf::testing::PngBytes(1, 1, 3, {255, 255, 255}));
-    auto with_material = [](const std::string& material) {
-        return SceneJson(kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], )"
-                                R"("emission": [1, 1, 1]}, "m": )" +
-                                    material + "}");
-    };
     const std::string lambert = R"({"type": "lambert", "reflectance": [1, 1, 1], )";
-    ExpectError(with_material(lambert + R"("power_lm": 100})"),
+    ExpectError(WithMaterial(lambert + R"("power_lm": 100})"),
                 "scene.json: materials.m.power_lm: no shape uses this material");
-    ExpectError(with_material(lambert + R"("emission": [1, 1, 1], "luminance_nits": 5})"),
+    ExpectError(WithMaterial(lambert + R"("emission": [1, 1, 1], "luminance_nits": 5})"),
                 "scene.json: materials.m: give a radiometric strength (emission) or a photometric "
                 "one (luminance_nits or power_lm), not both");
-    ExpectError(with_material(lambert + R"("luminance_nits": -1})"),
+    ExpectError(WithMaterial(lambert + R"("luminance_nits": -1})"),
                 "scene.json: materials.m.luminance_nits: must be ≥ 0");
-    ExpectError(with_material(lambert + R"("temperature_k": 3000})"),
+    ExpectError(WithMaterial(lambert + R"("temperature_k": 3000})"),
                 "scene.json: materials.m: color and temperature_k are the emission's colour");
-    ExpectError(with_material(lambert + R"("emission": [1, 1, 1], "temperature_k": 3000})"),
+    ExpectError(WithMaterial(lambert + R"("emission": [1, 1, 1], "temperature_k": 3000})"),
                 "scene.json: materials.m.emission: an [r, g, b] strength is a colour itself");
-    ExpectError(with_material(lambert + R"("two_sided": 1, "emission": [1, 1, 1]})"),
+    ExpectError(WithMaterial(lambert + R"("two_sided": 1, "emission": [1, 1, 1]})"),
                 "scene.json: materials.m.two_sided: expected true or false, got number 1");
-    ExpectError(with_material(R"({"type": "principled", "emission_texture": "glow.png", )"
-                              R"("power_lm": 10})"),
+    ExpectError(WithMaterial(R"({"type": "principled", "emission_texture": "glow.png", )"
+                             R"("power_lm": 10})"),
                 "scene.json: materials.m.power_lm: cannot spread a power over an "
                 "emission_texture");
 }
@@ -995,11 +984,8 @@ TEST_F(SceneLoaderTest, EnvironmentLights) {
     // mean luminance over the sphere is 1/2.
     Write("sky.hdr", lf::testing::HdrBytes(4, 2, {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1,  //
                                                   0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}));
-    auto with_sky = [](const std::string& sky) {
-        return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + sky + "]");
-    };
     auto environment = [&](const std::string& sky) {
-        absl::StatusOr<Scene> scene = Parse(with_sky(sky));
+        absl::StatusOr<Scene> scene = Parse(WithLights(sky));
         EXPECT_TRUE(scene.ok()) << scene.status();
         EXPECT_TRUE(CapturedLog().str().empty()) << CapturedLog().str();
         return scene.ok() && scene->environment ? *scene->environment : EnvironmentLight{};
@@ -1034,31 +1020,31 @@ TEST_F(SceneLoaderTest, EnvironmentErrorsNameThePath) {
     Write("sky.png", lf::testing::PngBytes(2, 1, 3, {255, 255, 255, 0, 0, 0}));
     Write("black.hdr", lf::testing::HdrBytes(2, 1, {0, 0, 0, 0, 0, 0}));
     Write("bad.hdr", "#?RADIANCE\nnot an image");
-    auto with_sky = [](const std::string& sky) {
-        return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + sky + "]");
-    };
-    ExpectError(with_sky(R"({"type": "environment", "file": "nope.hdr"})"),
+    ExpectError(WithLights(R"({"type": "environment", "file": "nope.hdr"})"),
                 "scene.json: lights[0].file \"nope.hdr\": ", absl::StatusCode::kNotFound);
-    ExpectError(with_sky(R"({"type": "environment", "file": "bad.hdr"})"),
+    ExpectError(WithLights(R"({"type": "environment", "file": "bad.hdr"})"),
                 "scene.json: lights[0].file: ");
-    ExpectError(with_sky(R"({"type": "environment", "file": "sky.png"})"),
+    ExpectError(WithLights(R"({"type": "environment", "file": "sky.png"})"),
                 "scene.json: lights[0].file: \"sky.png\" is an 8- or 16-bit image of display "
                 "values, not radiance");
-    ExpectError(with_sky(R"({"type": "environment", "file": "black.hdr", "luminance_nits": 1})"),
+    ExpectError(WithLights(R"({"type": "environment", "file": "black.hdr", "luminance_nits": 1})"),
                 "scene.json: lights[0].file: \"black.hdr\" is black");
-    ExpectError(with_sky(R"({"type": "environment", "radiance": [1, 1, 1]}, )"
-                         R"({"type": "environment", "radiance": [1, 1, 1]})"),
+    ExpectError(WithLights(R"({"type": "environment", "radiance": [1, 1, 1]}, )"
+                           R"({"type": "environment", "radiance": [1, 1, 1]})"),
                 "scene.json: lights[1]: a second environment light (the first is lights[0]): a "
                 "scene has at most one sky");
-    ExpectError(with_sky(R"({"type": "environment", "radiance": [1, 1, 1], "scale": -1})"),
+    ExpectError(WithLights(R"({"type": "environment", "radiance": [1, 1, 1], "scale": -1})"),
                 "scene.json: lights[0].scale: must be ≥ 0 and at most 1e10, got -1");
-    ExpectError(with_sky(R"({"type": "environment", "luminance_nits": -2})"),
+    ExpectError(WithLights(R"({"type": "environment", "radiance": 1e10, "scale": 2})"),
+                "scene.json: lights[0]: too bright: the sky's radiance (or a map's factor) is over "
+                "1e10");
+    ExpectError(WithLights(R"({"type": "environment", "luminance_nits": -2})"),
                 "scene.json: lights[0].luminance_nits: must be ≥ 0");
-    ExpectError(with_sky(R"({"type": "environment", "luminance_nits": 2, "scale": 2})"),
+    ExpectError(WithLights(R"({"type": "environment", "luminance_nits": 2, "scale": 2})"),
                 "scene.json: lights[0].scale: luminance_nits sets the sky's strength already");
-    ExpectError(with_sky(R"({"type": "environment", "radiance": [1, 1, 1], "file": "sky.hdr"})"),
+    ExpectError(WithLights(R"({"type": "environment", "radiance": [1, 1, 1], "file": "sky.hdr"})"),
                 "scene.json: lights[0].radiance: a uniform sky's radiance; with a file");
-    ExpectError(with_sky(R"({"type": "environment"})"),
+    ExpectError(WithLights(R"({"type": "environment"})"),
                 "scene.json: lights[0]: give exactly one of radiance (W m^-2 sr^-1) or "
                 "luminance_nits (cd/m^2)");
 }
