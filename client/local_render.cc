@@ -1,10 +1,6 @@
 #include "local_render.h"
 
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
@@ -18,27 +14,11 @@
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
+#include "output_flags.h"
 #include "progress_bar.h"
 #include "radiosity_flags.h"
 
 namespace lf {
-
-namespace {
-
-// Fails before any rendering, so an hour of work is not lost to a typo in the output path.
-absl::Status CheckWritable(const std::string& path) {
-    if (path.empty()) return absl::OkStatus();
-    const bool existed = std::filesystem::exists(path);
-    std::ofstream probe(path, std::ios::app);
-    if (!probe) {
-        return absl::PermissionDeniedError(path + ": cannot write here: " + std::strerror(errno));
-    }
-    probe.close();
-    if (!existed) std::filesystem::remove(path);
-    return absl::OkStatus();
-}
-
-}  // namespace
 
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
                                          std::string* why) {
@@ -178,6 +158,9 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     metadata.spp = adaptive ? out->adaptive.max_spp : options.render.spp;
     metadata.seed = options.render.seed;
     metadata.max_depth = options.max_depth;
+    metadata.clamp = options.render.clamp;
+    metadata.aovs = options.render.aovs;
+    metadata.filter = scene->camera.filter;
     metadata.seconds = summary.seconds;
     metadata.stats = out->stats;
     metadata.adaptive_settings = options.adaptive;
@@ -203,10 +186,14 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
                 variance.mean_error, kHighVarianceMeanError);
         }
     }
-    const ExrAttributes& attributes = description->attributes;
-    if (absl::Status s = WriteExr(options.exr_path, out->image, attributes); !s.ok()) return s;
+    if (!options.exr_path.empty()) {
+        const ExrAttributes& attributes = description->attributes;
+        if (absl::Status s = WriteExr(options.exr_path, out->image, attributes); !s.ok()) return s;
+    }
     if (!options.png_path.empty()) {
-        if (absl::Status s = WritePng(options.png_path, out->image); !s.ok()) return s;
+        if (absl::Status s = WritePng(options.png_path, out->image, options.preview); !s.ok()) {
+            return s;
+        }
     }
     return summary;
 }
