@@ -9,7 +9,7 @@
 
 namespace lf {
 
-void AddSampleFlags(CLI::App* cmd, double& clamp, uint32_t& aovs) {
+void AddClampFlag(CLI::App* cmd, double& clamp) {
     cmd->add_option_function<double>(
            "--clamp",
            [&clamp](double l) {
@@ -23,6 +23,10 @@ void AddSampleFlags(CLI::App* cmd, double& clamp, uint32_t& aovs) {
            "to tame fireflies; 0 = off (default). Biased: it removes energy, and the estimated "
            "error does not include that bias (the EXR says so in lightfarm.bias)")
         ->type_name("L");
+}
+
+void AddSampleFlags(CLI::App* cmd, double& clamp, uint32_t& aovs) {
+    AddClampFlag(cmd, clamp);
     cmd->add_option_function<std::string>(
            "--aov",
            [&aovs](const std::string& list) {
