@@ -128,7 +128,9 @@ TEST(Png, ClampIsTheSrgbCurveClipped) {
     for (size_t i = 0; i < values.size(); ++i) {
         const int expected = std::isnan(values[i]) ? 0 : SrgbByte(values[i]);
         for (int k = 0; k < 3; ++k) EXPECT_EQ(bytes[i * 3 + k], expected) << values[i];
-        if (!std::isnan(values[i])) EXPECT_EQ(EncodeSrgb8(values[i]), expected) << values[i];
+        if (!std::isnan(values[i])) {
+            EXPECT_EQ(EncodeSrgb8(values[i]), expected) << values[i];
+        }
     }
     std::filesystem::remove(path);
 }
