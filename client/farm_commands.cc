@@ -370,7 +370,7 @@ absl::Status FetchOutputs(const FarmFlags& flags, const std::string& id, const O
     absl::StatusOr<ExrFile> file = ReadExr(exr);
     absl::Status written =
         file.ok() ? WritePng(paths.png, file->image, preview_options) : file.status();
-    std::error_code ignored;  // the temporary file is gone already if the fetch failed
+    std::error_code ignored;  // a temporary file left behind is harmless
     if (paths.exr.empty()) fs::remove(exr, ignored);
     return written;
 }

@@ -1,6 +1,5 @@
 #include <cstdio>
 
-#include "absl/strings/str_cat.h"
 #include "adaptive_flags.h"
 #include "command.h"
 #include "lf/job/job_spec.h"
