@@ -5,11 +5,13 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "lf/core/aov.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/patch_mesh.h"
+#include "lf/core/pixel_filter.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
@@ -106,11 +108,15 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     } else {
         estimator = std::make_unique<PathTracer>(**embree, options.max_depth);
     }
-    log->info("job={} rendering {} ({}x{}, {} spp, seed {}, max depth {}, tile {})", job_id,
-              options.scene_path, camera.width(), camera.height(), options.render.spp,
-              options.render.seed,
-              options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
-              options.render.tile);
+    log->info(
+        "job={} rendering {} ({}x{}, {} spp, seed {}, max depth {}, tile {}, {} filter{}{})",
+        job_id, options.scene_path, camera.width(), camera.height(), options.render.spp,
+        options.render.seed,
+        options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
+        options.render.tile, DescribePixelFilter(scene->camera.filter),
+        options.render.clamp > 0 ? absl::StrCat(", clamp ", options.render.clamp, " (biased)")
+                                 : std::string(),
+        options.render.aovs != 0 ? ", AOVs " + AovListName(options.render.aovs) : std::string());
     const bool adaptive = options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
     if (adaptive) {
         log->info(
