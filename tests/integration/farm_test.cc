@@ -618,6 +618,66 @@ TEST_F(Farm, SameCommandLineGivesTheSameImageAndHeaderLocallyAndOnTheFarm) {
     }
 }
 
+// fetch -o out.png writes the same preview `render -o out.png` writes from the same command
+// line (exposure and tone curve included), and --png adds it beside the EXR; no temporary file
+// is left behind.
+TEST_F(Farm, FetchWritesThePngPreviewAsRenderDoes) {
+    StartServer();
+    StartWorker("w1");
+    const std::string flags = "--spp 2 --seed 4 --tile 16";
+    const std::string preview = " --exposure 1.5 --tonemap filmic";
+    const std::string job = Submit(scene_, flags);
+    ASSERT_EQ(Farmctl("watch " + job).status, 0);
+    const fs::path fetched = dir_ / "fetched";
+    fs::create_directories(fetched);
+    const std::string png = (fetched / "farm.png").string();
+    const CliRun fetch = Farmctl("fetch " + job + " -o " + png + preview);
+    ASSERT_EQ(fetch.status, 0) << fetch.out << fetch.err;
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(fetched)) {
+        names.push_back(e.path().filename().string());
+    }
+    EXPECT_EQ(names, std::vector<std::string>{"farm.png"});
+    const std::string exr = (dir_ / "farm.exr").string(), beside = (dir_ / "beside.png").string();
+    const CliRun both = Farmctl("fetch " + job + " -o " + exr + " --png " + beside + preview);
+    ASSERT_EQ(both.status, 0) << both.out << both.err;
+    EXPECT_NE(both.out.find(exr + " and " + beside), std::string::npos) << both.out;
+    const std::string local = (dir_ / "local.png").string();
+    const CliRun r =
+        Lightfarm("render " + scene_ + " -o " + local + " " + flags + preview + " --no-progress");
+    ASSERT_EQ(r.status, 0) << r.out << r.err;
+    EXPECT_EQ(ReadText(png), ReadText(local));
+    EXPECT_EQ(ReadText(beside), ReadText(local));
+    EXPECT_TRUE(ReadExr(exr).ok());
+}
+
+// End to end (needs the sampling pipeline of issue 13 on the wire and in the workers): --clamp,
+// --aov and --filter give the same image and header on the farm as locally.
+TEST_F(Farm, ClampAovsAndFilterGiveTheSameImageAndHeaderLocallyAndOnTheFarm) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string flags =
+        "--spp 4 --seed 2 --tile 16 --clamp 2 --aov all --filter blackman-harris:2";
+    const std::string job = Submit(scene_, flags);
+    ASSERT_EQ(Farmctl("watch " + job).status, 0);
+    const std::string farm = (dir_ / "farm.exr").string(), local = (dir_ / "local.exr").string();
+    ASSERT_EQ(Farmctl("fetch " + job + " -o " + farm).status, 0);
+    const CliRun r =
+        Lightfarm("render " + scene_ + " -o " + local + " " + flags + " --no-progress");
+    ASSERT_EQ(r.status, 0) << r.out << r.err;
+    ExpectSameImageAndHeader(farm, local);
+    absl::StatusOr<ExrFile> file = ReadExr(farm);
+    ASSERT_TRUE(file.ok()) << file.status();
+    ASSERT_TRUE(file->attributes.count("lightfarm.clamp") &&
+                file->attributes.count("lightfarm.aovs"));
+    EXPECT_EQ(std::get<double>(file->attributes.at("lightfarm.clamp")), 2.0);
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.aovs")), "albedo,normal,depth");
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.filter")),
+              "blackman-harris 2 px");
+    EXPECT_NE(file->image.FindChannel("depth.Z"), nullptr);
+}
+
 // A port nothing listens on now, for a server started later.
 std::string ReservePort() {
     const int fd = socket(AF_INET, SOCK_STREAM, 0);
