@@ -20,16 +20,24 @@ constexpr uint64_t kSpp = 64;
 
 double Radians(double degrees) { return degrees * kPi / 180; }
 
-// KHR_lights_punctual's recommended falloff, written from the extension's text.
-double SpotFalloff(double cos_to_axis, double inner, double outer) {
+// The spot falloffs, written from their definitions: KHR_lights_punctual's recommended
+// clamp((c - cos outer) / (cos inner - cos outer), 0, 1)^2, and pbrt-v4's
+// smoothstep(cos outer, cos inner, c).
+double SpotFalloff(double cos_to_axis, double inner, double outer, SpotLight::Falloff falloff) {
     const double scale = 1 / std::max(0.001, std::cos(inner) - std::cos(outer));
     const double a = std::clamp((cos_to_axis - std::cos(outer)) * scale, 0.0, 1.0);
-    return a * a;
+    return falloff == SpotLight::Falloff::kSmoothstep ? a * a * (3 - 2 * a) : a * a;
+}
+
+const char* FalloffName(SpotLight::Falloff falloff) {
+    return falloff == SpotLight::Falloff::kSmoothstep ? "smoothstep" : "khr";
 }
 
 SpotLight DownwardSpot(const Vec3d& position, const Rgb& intensity, double inner_degrees,
-                       double outer_degrees) {
+                       double outer_degrees,
+                       SpotLight::Falloff falloff = SpotLight::Falloff::kSmoothstep) {
     SpotLight spot;
+    spot.falloff = falloff;
     spot.position = position;
     spot.direction = Vec3d(0, -1, 0);
     spot.intensity = intensity;
@@ -38,12 +46,20 @@ SpotLight DownwardSpot(const Vec3d& position, const Rgb& intensity, double inner
     return spot;
 }
 
+class SpotFalloffTest : public ::testing::TestWithParam<SpotLight::Falloff> {};
+
+INSTANTIATE_TEST_SUITE_P(Falloffs, SpotFalloffTest,
+                         ::testing::Values(SpotLight::Falloff::kSmoothstep,
+                                           SpotLight::Falloff::kKhrLightsPunctual),
+                         [](const auto& info) { return std::string(FalloffName(info.param)); });
+
 // A spot light at height h pointing straight down: irradiance I cos(theta) / r^2 inside the
 // inner cone, zero outside the outer cone, the falloff between.
-TEST(SpotLight, LambertianPlaneMatchesClosedForm) {
+TEST_P(SpotFalloffTest, LambertianPlaneMatchesClosedForm) {
     const Rgb rho(0.5f, 0.25f, 0.75f);
     Scene scene = testing::PlaneUnderCamera(rho);
-    const SpotLight spot = DownwardSpot(Vec3d(0.3, 1.0, -0.2), Rgb(10.0f, 5.0f, 2.0f), 25, 45);
+    const SpotLight spot =
+        DownwardSpot(Vec3d(0.3, 1.0, -0.2), Rgb(10.0f, 5.0f, 2.0f), 25, 45, GetParam());
     scene.spot_lights.push_back(spot);
     const RenderOutput out = testing::RenderPath(scene, kSpp).out;
 
@@ -52,7 +68,8 @@ TEST(SpotLight, LambertianPlaneMatchesClosedForm) {
         const Vec3d d = spot.position - x;
         const double dist2 = LengthSquared(d);
         const double cos_theta = d.y / std::sqrt(dist2);  // to the plane's normal and the axis
-        const double falloff = SpotFalloff(cos_theta, spot.inner_cone, spot.outer_cone);
+        const double falloff =
+            SpotFalloff(cos_theta, spot.inner_cone, spot.outer_cone, spot.falloff);
         if (falloff == 1) {
             ++inside;
         } else if (falloff == 0) {
@@ -76,9 +93,9 @@ TEST(SpotLight, LambertianPlaneMatchesClosedForm) {
 }
 
 // The sampler's radiance at points swept from the axis to beyond the outer cone.
-TEST(SpotLight, SamplerFollowsTheExtensionsFalloff) {
+TEST_P(SpotFalloffTest, SamplerFollowsTheFalloff) {
     Scene scene = testing::PlaneUnderCamera(Rgb(0.5f));
-    const SpotLight spot = DownwardSpot(Vec3d(0, 2, 0), Rgb(3.0f), 10, 30);
+    const SpotLight spot = DownwardSpot(Vec3d(0, 2, 0), Rgb(3.0f), 10, 30, GetParam());
     scene.spot_lights.push_back(spot);
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
@@ -90,7 +107,8 @@ TEST(SpotLight, SamplerFollowsTheExtensionsFalloff) {
         const Vec3 ref = light + Vec3(float(1.5 * std::sin(a)), -float(1.5 * std::cos(a)), 0);
         const std::optional<LightSample> ls = sampler.Sample(ref, 0.5f, {0.5f, 0.5f});
         const double expected =
-            3 * SpotFalloff(std::cos(a), spot.inner_cone, spot.outer_cone) / (1.5 * 1.5);
+            3 * SpotFalloff(std::cos(a), spot.inner_cone, spot.outer_cone, spot.falloff) /
+            (1.5 * 1.5);
         if (expected == 0) {
             EXPECT_FALSE(ls) << angle;
             continue;
@@ -184,18 +202,31 @@ TEST(DirectionalLight, ShadowRayReachesBeyondTheScene) {
     }
 }
 
-// Picking follows power: a spot ~ 2 pi (1 - cos((inner + outer) / 2)) I, a directional light
+// The solid angle a spot's falloff integrates to, 2 pi times its integral over cos(theta), by
+// the midpoint rule.
+double SpotSolidAngle(const SpotLight& spot) {
+    constexpr int kSteps = 100000;
+    double sum = 0;
+    for (int i = 0; i < kSteps; ++i) {
+        const double c = -1 + 2 * (i + 0.5) / kSteps;
+        sum += SpotFalloff(c, spot.inner_cone, spot.outer_cone, spot.falloff);
+    }
+    return 2 * kPi * sum * 2 / kSteps;
+}
+
+// Picking follows power: a spot ~ its falloff's solid angle times I, a directional light
 // ~ pi R^2 E with R the scene's bounding radius, a point light 4 pi I.
 TEST(LightSampler, PicksDeltaLightsByPower) {
     Scene scene = testing::PlaneUnderCamera(Rgb(0.5f));  // bounds 100 x 0 x 100: R = 50 sqrt 2
     scene.point_lights.push_back({Vec3d(0, 1, 0), Rgb(1.0f)});
-    scene.spot_lights.push_back(DownwardSpot(Vec3d(1, 1, 0), Rgb(100.0f), 20, 40));
+    const SpotLight spot = DownwardSpot(Vec3d(1, 1, 0), Rgb(100.0f), 20, 40);
+    scene.spot_lights.push_back(spot);
     scene.directional_lights.push_back({Vec3d(0, -1, 0), Rgb(0.001f)});
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
     const LightSampler sampler(**es);
     const double w_point = 4 * kPi;
-    const double w_spot = 2 * kPi * (1 - std::cos(Radians(30))) * 100;
+    const double w_spot = SpotSolidAngle(spot) * 100;
     const double r = 50 * std::sqrt(2.0);
     const double w_sun = kPi * r * r * 0.001;
     const double total = w_point + w_spot + w_sun;
