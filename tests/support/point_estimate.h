@@ -3,6 +3,8 @@
 // closed form is known at a few points.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -40,6 +42,15 @@ inline PointEstimate EstimateRadiance(const RadianceEstimator& estimator, const 
         e.standard_error[c] = e.sample_sd[c] / std::sqrt(double(n));
     }
     return e;
+}
+
+// Expects each channel of the estimate within k standard errors (and float rounding) of
+// `expected`.
+inline void ExpectEstimateNear(const PointEstimate& e, const Rgb& expected, double k = 5) {
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(e.mean[c], expected[c], k * e.standard_error[c] + 1e-5 * expected[c])
+            << "channel " << c;
+    }
 }
 
 // A ray from world point `from` towards world point `to`, in the render space of a scene whose

@@ -61,14 +61,6 @@ double UpwardIrradiance(const TextureImage& map, float scale) {
     return e;
 }
 
-// Expects the estimate within kSigmas standard errors (and float rounding) of `expected`.
-void ExpectEstimate(const testing::PointEstimate& e, const Rgb& expected) {
-    for (int c = 0; c < 3; ++c) {
-        EXPECT_NEAR(e.mean[c], expected[c], kSigmas * e.standard_error[c] + 1e-5 * expected[c])
-            << "channel " << c;
-    }
-}
-
 struct Traced {
     std::unique_ptr<EmbreeScene> embree;
     std::unique_ptr<PathTracer> tracer;
@@ -95,7 +87,7 @@ TEST(EnvironmentLight, UniformSkyOverOpenPlaneRendersRhoL) {
     Scene scene = testing::PlaneUnderCamera(rho);
     scene.environment = EnvironmentLight{sky, nullptr, 0};
     const Traced t = Trace(scene);
-    ExpectEstimate(PlanePoint(t, 4000), rho * sky);
+    testing::ExpectEstimateNear(PlanePoint(t, 4000), rho * sky);
     const testing::PointEstimate up = testing::EstimateRadiance(
         *t.tracer, testing::RayBetween(Vec3d(0, 3, 0), Vec3d(0.2, 4, 0.1), t.embree->origin()), 4);
     for (int c = 0; c < 3; ++c) EXPECT_EQ(up.mean[c], sky[c]);
@@ -108,7 +100,7 @@ TEST(EnvironmentLight, HalfLitMapOverUpwardPlaneRendersRho) {
     Scene scene = testing::PlaneUnderCamera(rho);
     scene.environment =
         EnvironmentLight{scale, Map(16, 8, [](int, int y) { return y < 4 ? 1.0f : 0.0f; }), 0.7};
-    ExpectEstimate(PlanePoint(Trace(scene), 4000), rho * scale);
+    testing::ExpectEstimateNear(PlanePoint(Trace(scene), 4000), rho * scale);
 }
 
 // A small bright sun in a dim sky: the plane's radiance is rho / pi times the texel sum E, and
@@ -119,7 +111,7 @@ TEST(EnvironmentLight, SunInSkyMapRendersItsTexelSum) {
     scene.environment = EnvironmentLight{Rgb(1.0f), SunInSky(), 0};
     const double e = UpwardIrradiance(*scene.environment->map, 1);
     const testing::PointEstimate got = PlanePoint(Trace(scene), 4000);
-    ExpectEstimate(got, rho * float(e / kPi));
+    testing::ExpectEstimateNear(got, rho * float(e / kPi));
     std::printf("[env] path tracer, 4000 samples: relative standard error %.4f\n",
                 got.standard_error[1] / got.mean[1]);
 }
@@ -238,8 +230,10 @@ TEST(EnvironmentLight, RotateYTurnsTheSkyCounterClockwise) {
         const testing::PointEstimate got = testing::EstimateRadiance(
             *tr.tracer, testing::RayBetween(n * 2.0 + up * 0.1, up * 0.1, tr.embree->origin()),
             4000);
-        ExpectEstimate(got, rho * float(irradiance / kPi));
-        if (irradiance == 0) EXPECT_EQ(got.mean[1], 0) << "psi " << psi;
+        testing::ExpectEstimateNear(got, rho * float(irradiance / kPi));
+        if (irradiance == 0) {
+            EXPECT_EQ(got.mean[1], 0) << "psi " << psi;
+        }
         // Looking out along psi from in front of the plane: the column itself when psi is its
         // azimuth.
         const testing::PointEstimate sky = testing::EstimateRadiance(

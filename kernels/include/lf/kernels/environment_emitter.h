@@ -1,10 +1,9 @@
 // The scene's environment light (a sky at infinity) as the path tracer sees it: the radiance
 // arriving along a direction, and directions sampled towards it. A uniform sky samples the
 // sphere uniformly; a latitude-longitude map is importance sampled by luminance times
-// sin(theta) through a piecewise-constant 2D distribution over its texels. Le is constant over
-// each texel (nearest lookup), the same pieces the distribution is constant on, so the
-// sampler's density is exactly proportional to what it integrates wherever the map is uniform
-// in sin(theta), and Le / pdf never divides a texel's value by another texel's density.
+// sin(theta) through a piecewise-constant 2D distribution over its texels. Le reads the nearest
+// texel, so it is constant on exactly the pieces the distribution is: a sample's Le / pdf is
+// one texel's value over that texel's density, and Pdf(w) is the density Sample draws w with.
 #pragma once
 
 #include <optional>
