@@ -25,26 +25,27 @@ std::vector<PiecewiseConstant1D> Rows(std::span<const float> f, int nu, int nv) 
 }  // namespace
 
 PiecewiseConstant1D::PiecewiseConstant1D(std::span<const float> f)
-    : f_(f.size()), cdf_(f.size() + 1, 0.0) {
+    : f_(f.size()), cdf_(f.size() + 1, 0.0f) {
     const size_t n = f.size();
+    std::vector<double> sum(n + 1, 0.0);
     for (size_t i = 0; i < n; ++i) {
         f_[i] = Sanitised(f[i]);
-        cdf_[i + 1] = cdf_[i] + double(f_[i]) / double(n);
+        sum[i + 1] = sum[i] + double(f_[i]) / double(n);
     }
-    integral_ = cdf_[n];
+    integral_ = sum[n];
     for (size_t i = 1; i <= n; ++i) {
         // Nothing to sample: uniform, so Sample still returns points (of density 0).
-        cdf_[i] = integral_ > 0 ? cdf_[i] / integral_ : double(i) / double(n);
+        cdf_[i] = float(integral_ > 0 ? sum[i] / integral_ : double(i) / double(n));
     }
     if (n > 0) cdf_[n] = 1;
 }
 
 float PiecewiseConstant1D::Sample(float u, float* pdf, int* piece) const {
     // The last piece whose CDF starts at or below u: it has positive width, since u < 1.
-    const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), double(u));
+    const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
     const int i = std::clamp(int(it - cdf_.begin()) - 1, 0, size() - 1);
-    const double width = cdf_[size_t(i) + 1] - cdf_[size_t(i)];
-    const double du = width > 0 ? (double(u) - cdf_[size_t(i)]) / width : 0.5;
+    const double lo = cdf_[size_t(i)], width = double(cdf_[size_t(i) + 1]) - lo;
+    const double du = width > 0 ? (double(u) - lo) / width : 0.5;
     *piece = i;
     *pdf = Density(i);
     // Rounding must not carry the point into the next piece, where the density differs.

@@ -103,6 +103,23 @@ TEST(EnvironmentLight, HalfLitMapOverUpwardPlaneRendersRho) {
     testing::ExpectEstimateNear(PlanePoint(Trace(scene), 4000), rho * scale);
 }
 
+// An 8-bit map holds sRGB-encoded colour: texel 128 is 0.2158605 linear, times `radiance`.
+TEST(EnvironmentLight, EightBitMapIsDecodedFromSrgb) {
+    auto map = std::make_shared<TextureImage>();
+    map->name = "sky.png";
+    map->width = 2;
+    map->height = 1;
+    map->channels = 3;
+    map->texels8 = {255, 255, 255, 128, 64, 0};  // u < 1/2: white; u > 1/2: (128, 64, 0)
+    const EnvironmentEmitter sky(EnvironmentLight{Rgb(2.0f), map, 0});
+    // u = 0.5 + atan2(x, -z) / (2 pi): x < 0 reads the left half, x > 0 the right.
+    EXPECT_EQ(sky.Le(Vec3(-1, 0, 0)), Rgb(2.0f));
+    const Rgb right = sky.Le(Vec3(1, 0, 0));
+    EXPECT_NEAR(right.r, 2 * 0.2158605f, 1e-6f);
+    EXPECT_NEAR(right.g, 2 * 0.0512695f, 1e-6f);
+    EXPECT_EQ(right.b, 0);
+}
+
 // A small bright sun in a dim sky: the plane's radiance is rho / pi times the texel sum E, and
 // importance sampling (with MIS against the BSDF) gets there.
 TEST(EnvironmentLight, SunInSkyMapRendersItsTexelSum) {

@@ -269,6 +269,23 @@ TEST(SunDisk, UnoccludedPlaneReceivesTheDeltaLightsIrradiance) {
     }
 }
 
+// A disk 40 degrees across, 20 degrees off the zenith, entirely above the horizon: still
+// E cos(theta0) on the plane. BSDF samples hit so wide a disk often, so this checks their MIS
+// combination with the light samples.
+TEST(SunDisk, WideDiskCombinesLightAndBsdfSamples) {
+    const Rgb rho(0.5f, 0.25f, 0.75f), e(2.0f, 1.0f, 0.5f);
+    const double theta0 = Radians(20);
+    const Vec3d direction(-std::sin(theta0), -std::cos(theta0), 0);
+    const Scene scene = DirectionalScene(rho, {direction, e, Radians(40)});
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok());
+    const PathTracer tracer(**es, -1);
+    testing::ExpectEstimateNear(
+        testing::EstimateRadiance(
+            tracer, testing::RayBetween(Vec3d(0, 3, 0), Vec3d(0.4, 0, 0.3), (*es)->origin()), 4000),
+        rho * e * float(std::cos(theta0) / kPi));
+}
+
 // A camera ray (or a mirror's) into the disk sees its radiance E / (pi sin^2 alpha); a ray just
 // outside it sees nothing.
 TEST(SunDisk, RaysIntoTheDiskSeeItsRadiance) {

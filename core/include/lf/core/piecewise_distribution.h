@@ -12,7 +12,7 @@ namespace lf {
 
 class PiecewiseConstant1D {
   public:
-    // f: the function's value on each of f.size() equal pieces of [0, 1); non-negative and
+    // f: the function's value on each of f.size() >= 1 equal pieces of [0, 1); non-negative and
     // finite (negative or non-finite values count as 0). An all-zero f samples uniformly but has
     // density 0 everywhere: there is nothing to sample.
     explicit PiecewiseConstant1D(std::span<const float> f);
@@ -29,7 +29,9 @@ class PiecewiseConstant1D {
 
   private:
     std::vector<float> f_;
-    std::vector<double> cdf_;  // size() + 1 entries, cdf_[0] = 0, cdf_.back() = 1
+    // size() + 1 entries, cdf_[0] = 0, cdf_.back() = 1; summed in double, stored in float (a
+    // 16k x 8k environment map's rows hold 128 M entries).
+    std::vector<float> cdf_;
     double integral_ = 0;
 };
 
