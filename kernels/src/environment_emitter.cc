@@ -12,9 +12,10 @@ namespace lf {
 namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 
-Rgb NonNegative(const Rgb& c) {
-    return {std::max(c.r, 0.0f), std::max(c.g, 0.0f), std::max(c.b, 0.0f)};
-}
+// HDR files can hold negative, infinite or NaN texels: they emit nothing rather than poison
+// the image.
+float Radiance(float v) { return std::isfinite(v) && v > 0 ? v : 0.0f; }
+Rgb NonNegative(const Rgb& c) { return {Radiance(c.r), Radiance(c.g), Radiance(c.b)}; }
 
 bool HasMap(const EnvironmentLight& light) {
     return light.map && light.map->width > 0 && light.map->height > 0;

@@ -89,14 +89,17 @@ LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
     std::vector<size_t> sun_lights;
     for (size_t i = 0; i < scene.directional_lights.size(); ++i) {
         const DirectionalLight& dl = scene.directional_lights[i];
-        if (dl.angular_diameter > 0) {
-            // E = L pi sin^2(alpha) for a disk of half-angle alpha facing the surface.
-            const double alpha = dl.angular_diameter / 2;
-            const double sin_alpha = std::sin(alpha), sin_half = std::sin(alpha / 2);
+        // E = L pi sin^2(alpha) for a disk of half-angle alpha facing the surface.
+        const double alpha = dl.angular_diameter / 2;
+        const double sin_alpha = std::sin(alpha), sin_half = std::sin(alpha / 2);
+        const SunDisk sun{-Vec3(Normalize(dl.direction)), float(2 * sin_half * sin_half),
+                          dl.irradiance * float(1 / (std::numbers::pi * sin_alpha * sin_alpha))};
+        // A disk so small that its radiance or density overflows float is the delta light.
+        if (alpha > 0 && sun.one_minus_cos > 0 && std::isfinite(sun.radiance.MaxComponent()) &&
+            std::isfinite(1 / (2 * kPi * sun.one_minus_cos))) {
             sun_lights.push_back(lights_.size());
             lights_.push_back({Kind::kSun, int(suns_.size()), 0, 0, false});
-            suns_.push_back({-Vec3(Normalize(dl.direction)), float(2 * sin_half * sin_half),
-                             dl.irradiance / float(std::numbers::pi * sin_alpha * sin_alpha)});
+            suns_.push_back(sun);
         } else {
             lights_.push_back({Kind::kDirectional, int(i), 0, 0, false});
         }

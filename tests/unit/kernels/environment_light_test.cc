@@ -120,6 +120,26 @@ TEST(EnvironmentLight, EightBitMapIsDecodedFromSrgb) {
     EXPECT_EQ(right.b, 0);
 }
 
+// Negative, infinite and NaN texels (HDR files can hold them) emit nothing and are never drawn.
+TEST(EnvironmentLight, NonFiniteTexelsEmitNothing) {
+    const float bad[] = {-1.0f, INFINITY, NAN};
+    const EnvironmentEmitter sky(EnvironmentLight{
+        Rgb(1.0f), Map(4, 1, [&](int x, int) { return x < 3 ? bad[x] : 2.0f; }), 0});
+    for (int i = 0; i < 1000; ++i) {
+        Sampler sampler(3, 0, 0, uint64_t(i));
+        const auto ds = sky.Sample(sampler.Get2D());
+        ASSERT_TRUE(ds);
+        ASSERT_EQ(ds->radiance, Rgb(2.0f));
+        ASSERT_GT(ds->wi.x, 0);  // u in [3/4, 1): atan2(x, -z) in [pi/2, pi)
+    }
+    // u = 0.125, 0.375 and 0.625: atan2(x, -z) = -3 pi / 4, -pi / 4, pi / 4.
+    for (const Vec3& w : {Vec3(-1, 0, 1), Vec3(-1, 0, -1), Vec3(1, 0, -1)}) {
+        EXPECT_EQ(sky.Le(Normalize(w)), Rgb(0.0f));
+        EXPECT_EQ(sky.Pdf(Normalize(w)), 0);
+    }
+    EXPECT_TRUE(std::isfinite(sky.MeanRadiance().g));
+}
+
 // A small bright sun in a dim sky: the plane's radiance is rho / pi times the texel sum E, and
 // importance sampling (with MIS against the BSDF) gets there.
 TEST(EnvironmentLight, SunInSkyMapRendersItsTexelSum) {

@@ -286,6 +286,20 @@ TEST(SunDisk, WideDiskCombinesLightAndBsdfSamples) {
         rho * e * float(std::cos(theta0) / kPi));
 }
 
+// A disk too small for float (its radiance E / (pi sin^2 alpha) would overflow) is sampled as
+// the delta light it is indistinguishable from.
+TEST(SunDisk, VanishingDiskIsTheDeltaLight) {
+    const Scene scene = DirectionalScene(Rgb(0.5f), {Vec3d(0, -1, 0), Rgb(1.0f), 1e-30});
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok());
+    const LightSampler sampler(**es);
+    const auto ls = sampler.Sample(Vec3(0, 0, 0), 0.5f, {0.5f, 0.5f});
+    ASSERT_TRUE(ls);
+    EXPECT_TRUE(ls->delta);
+    EXPECT_EQ(ls->radiance, Rgb(1.0f));
+    EXPECT_EQ(sampler.EscapedRadiance(Vec3(0, 1, 0)), Rgb(0.0f));
+}
+
 // A camera ray (or a mirror's) into the disk sees its radiance E / (pi sin^2 alpha); a ray just
 // outside it sees nothing.
 TEST(SunDisk, RaysIntoTheDiskSeeItsRadiance) {
