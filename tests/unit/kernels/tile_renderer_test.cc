@@ -5,7 +5,10 @@
 #include <cmath>
 #include <limits>
 
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/path_tracer.h"
 #include "lf/local/local_executor.h"
+#include "test_scenes.h"
 
 namespace lf {
 namespace {
@@ -13,6 +16,8 @@ namespace {
 // Returns NaN for every third sample index, +inf for every fifth, else the sample index.
 class PoisonedEstimator : public RadianceEstimator {
   public:
+    PoisonedEstimator() : geometry_(EmbreeScene::Build(empty_).value()) {}
+    const EmbreeScene& geometry() const override { return *geometry_; }
     Rgb Li(const Ray&, Sampler& sampler, RenderStats& stats) const override {
         ++stats.rays;
         const uint64_t s = uint64_t(sampler.Get1D() * 1e6);
@@ -20,6 +25,10 @@ class PoisonedEstimator : public RadianceEstimator {
         if (s % 5 == 0) return Rgb(std::numeric_limits<float>::infinity(), 0.0f, 0.0f);
         return Rgb(1.0f);
     }
+
+  private:
+    Scene empty_;
+    std::unique_ptr<EmbreeScene> geometry_;
 };
 
 CameraSpec SmallCamera() {
@@ -52,9 +61,36 @@ TEST(RenderTile, CancelStopsWork) {
     const Camera camera(SmallCamera(), Vec3d());
     const PoisonedEstimator estimator;
     std::atomic<bool> cancel{true};
-    const TileSums tile = RenderTile(camera, estimator, {0, 0, 7, 5}, 0, 0, 8, &cancel);
+    const TileSums tile = RenderTile(camera, estimator, {0, 0, 7, 5}, 0, 0, 8, {}, &cancel);
     EXPECT_EQ(tile.stats.rays, 0u);
     EXPECT_EQ(tile.stats.samples, 0u);
+}
+
+// The box filter places sample s of pixel (x, y) at its sampler's first two numbers, exactly as
+// the tile renderer did before filters: the sums of a tile are those of that loop, bit for bit.
+TEST(RenderTile, BoxFilterKeepsTheBitsOfThePixelSquareSamples) {
+    Scene scene = testing::MakeFurnace(1.0, Vec3d(), 0.6f, 1.0f, 10);
+    scene.spheres.push_back({"ball", 0, Vec3d(0.4, -0.5, 0.6), 0.3});
+    const std::unique_ptr<EmbreeScene> embree = EmbreeScene::Build(scene).value();
+    const Camera camera(scene.camera, embree->origin());
+    const PathTracer tracer(*embree, -1);
+    const PixelRect rect{2, 3, 5, 4};
+    const TileSums tile = RenderTile(camera, tracer, rect, 7, 0, 6);
+    for (int y = rect.y0; y < rect.y0 + rect.height; ++y) {
+        for (int x = rect.x0; x < rect.x0 + rect.width; ++x) {
+            PixelSums expected;
+            RenderStats stats;
+            for (uint64_t s = 0; s < 6; ++s) {
+                Sampler sampler(7, x, y, s);
+                const Vec2 film = sampler.Get2D();
+                expected.Add(s,
+                             tracer.Li(camera.GenerateRay(x, y, film.x, film.y), sampler, stats));
+            }
+            for (int h = 0; h < 2; ++h) {
+                for (int c = 0; c < 3; ++c) EXPECT_EQ(tile.at(x, y).sum[h][c], expected.sum[h][c]);
+            }
+        }
+    }
 }
 
 }  // namespace
