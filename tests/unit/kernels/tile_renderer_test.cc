@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -89,6 +90,49 @@ TEST(RenderTile, BoxFilterKeepsTheBitsOfThePixelSquareSamples) {
             for (int h = 0; h < 2; ++h) {
                 for (int c = 0; c < 3; ++c) EXPECT_EQ(tile.at(x, y).sum[h][c], expected.sum[h][c]);
             }
+        }
+    }
+}
+
+// An emitter of radiance 1 filling the right half of the view (from film x = width/2 on) and
+// nothing on the left: every sample is 0 or 1, and a pixel's mean estimates the chance that its
+// sample lands right of the edge. With the box filter that is a step at the edge; with a gaussian
+// of width w it is the truncated normal's CDF (sigma = w/6) at the pixel centre's distance from the
+// edge. Each column's mean over its rows is compared within 5 binomial standard errors.
+TEST(RenderTile, GaussianFilterBlursAnEdgeByItsCdf) {
+    constexpr int kSize = 32, kSpp = 64;
+    Scene scene;
+    Material emitter;
+    emitter.reflectance = Rgb(0.0f);
+    emitter.emission = Rgb(1.0f);
+    scene.materials.push_back(emitter);
+    TriangleMesh half;
+    // x <= 0, which is the right of the view: the camera's right is forward x up = -x.
+    half.positions = {{0, -10, 0}, {-10, -10, 0}, {-10, 10, 0}, {0, 10, 0}};
+    half.triangles = {{0, 1, 2}, {0, 2, 3}};  // front face towards the camera at -z
+    scene.meshes.push_back(half);
+    scene.camera = testing::SquareCamera({0, 0, -1}, {0, 0, 0}, {0, 1, 0}, 60, kSize);
+    const std::unique_ptr<EmbreeScene> embree = EmbreeScene::Build(scene).value();
+    const PathTracer tracer(*embree, -1);
+    for (const double width : {0.0, 4.0}) {
+        CameraSpec spec = scene.camera;
+        if (width > 0) spec.filter = {PixelFilter::Type::kGaussian, width};
+        const Camera camera(spec, embree->origin());
+        const TileSums tile = RenderTile(camera, tracer, {0, 0, kSize, kSize}, 3, 0, kSpp);
+        for (int x = 0; x < kSize; ++x) {
+            double sum = 0;
+            for (int y = 0; y < kSize; ++y) sum += tile.at(x, y).Mean().g;
+            const double mean = sum / kSize;
+            // The pixel centre's film x is x + 0.5; the edge is at kSize / 2.
+            const double d = x + 0.5 - kSize / 2;
+            double expected = d > 0 ? 1 : 0;
+            if (width > 0) {
+                const double s = width / 6 * std::sqrt(2.0), edge = std::erf(width / 2 / s);
+                expected = std::clamp((std::erf(d / s) + edge) / (2 * edge), 0.0, 1.0);
+            }
+            const double n = double(kSize) * kSpp;
+            const double tolerance = 5 * std::sqrt(expected * (1 - expected) / n) + 1e-6;
+            EXPECT_NEAR(mean, expected, tolerance) << "width " << width << " column " << x;
         }
     }
 }
