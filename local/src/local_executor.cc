@@ -24,12 +24,13 @@ namespace lf {
 
 namespace {
 
-// Where a local render keeps its tiles' exact sums (104 bytes a pixel): in memory for images up
-// to 2048x2048, in an unlinked temporary file above, as the farm does, so that a large render's
-// peak memory is its float image (40 bytes a pixel) rather than the sums of every tile.
-TileStoreFactory TileStoreFor(const Camera& camera) {
-    constexpr int64_t kInMemoryPixels = int64_t(2048) * 2048;
-    if (int64_t(camera.width()) * camera.height() <= kInMemoryPixels) return MakeMemoryTileStore;
+// Where a local render keeps its tiles' exact sums (104 bytes a pixel, about twice that with
+// AOVs): in memory for images up to 2048x2048 (1448x1448 with AOVs, the same memory), in an
+// unlinked temporary file above, as the farm does, so that a large render's peak memory is its
+// float image (40 bytes a pixel, 68 with every AOV) rather than the sums of every tile.
+TileStoreFactory TileStoreFor(const Camera& camera, uint32_t aovs) {
+    const int64_t in_memory_pixels = int64_t(2048) * 2048 / (aovs != 0 ? 2 : 1);
+    if (int64_t(camera.width()) * camera.height() <= in_memory_pixels) return MakeMemoryTileStore;
     return [](std::vector<PixelRect> tiles, uint32_t aovs) {
         return MakeFileTileStore(std::filesystem::temp_directory_path().string(), std::move(tiles),
                                  aovs);
@@ -49,8 +50,9 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
     absl::StatusOr<std::vector<RenderTask>> tasks =
         PlanRender({camera.width(), camera.height(), settings.spp, settings.tile, settings.passes});
     if (!tasks.ok()) return tasks.status();
-    absl::StatusOr<std::unique_ptr<RenderMerger>> made = RenderMerger::Make(
-        camera.width(), camera.height(), *tasks, TileStoreFor(camera), settings.aovs);
+    absl::StatusOr<std::unique_ptr<RenderMerger>> made =
+        RenderMerger::Make(camera.width(), camera.height(), *tasks,
+                           TileStoreFor(camera, settings.aovs), settings.aovs);
     if (!made.ok()) return made.status();
     RenderMerger& merger = **made;
     std::mutex mutex;
@@ -87,9 +89,9 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
                                                  const ProgressFn& progress) {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made =
-        AdaptiveTilePlan::Make(camera.width(), camera.height(), settings.spp, settings.tile,
-                               adaptive, kMaxTaskSamples, TileStoreFor(camera), settings.aovs);
+    absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made = AdaptiveTilePlan::Make(
+        camera.width(), camera.height(), settings.spp, settings.tile, adaptive, kMaxTaskSamples,
+        TileStoreFor(camera, settings.aovs), settings.aovs);
     if (!made.ok()) return made.status();
     AdaptiveTilePlan& plan = **made;
     const size_t tiles = plan.tile_count();
