@@ -141,7 +141,8 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
     const uint32_t aovs = version >= kAovVersion ? in.U32() : 0;
     if (version >= kAovVersion && (aovs == 0 || (aovs & ~kAllAovs) != 0)) {
         return absl::InvalidArgumentError(
-            absl::StrCat("tile sums: AOV flags ", aovs, " are not a set of ", kAllAovs));
+            absl::StrCat("tile sums: AOV flags ", aovs,
+                         ": expected a non-empty sum of 1 (albedo), 2 (normal) and 4 (depth)"));
     }
     if (bytes.size() != EncodedSize(rect.Area(), version, aovs)) {
         return absl::InvalidArgumentError(
