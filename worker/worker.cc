@@ -288,8 +288,10 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
                             std::min(s + step, task.task.sample_end), options, &cancel);
                     }
                     std::copy(row.pixels.begin(), row.pixels.end(), &tile.at(rect.x0, y));
-                    std::copy(row.aov_pixels.begin(), row.aov_pixels.end(),
-                              tile.aov_pixels.begin() + ptrdiff_t(tile.Index(rect.x0, y)));
+                    if (options.aovs != 0) {
+                        std::copy(row.aov_pixels.begin(), row.aov_pixels.end(),
+                                  tile.aov_pixels.begin() + ptrdiff_t(tile.Index(rect.x0, y)));
+                    }
                     std::lock_guard<std::mutex> lock(stats_mutex);
                     tile.stats += row.stats;
                 }
