@@ -91,13 +91,20 @@ FilterSampler::FilterSampler(const PixelFilter& filter) : radius_(filter.width /
     }
     cdf_[0] = 0;
     cdf_[kBins] = 1;  // exactly: u < 1 then always falls in a bin
+    guide_.resize(kBins);
+    int i = 0;
+    for (int j = 0; j < kBins; ++j) {
+        while (i + 1 < kBins && cdf_[size_t(i) + 1] <= double(j) / kBins) ++i;
+        guide_[size_t(j)] = i;
+    }
 }
 
 double FilterSampler::Offset(double u) const {
     if (cdf_.empty()) return u - 0.5;
-    // The bin whose CDF interval holds u; bins of zero mass are never picked.
-    const auto above = std::upper_bound(cdf_.begin() + 1, cdf_.end() - 1, u);
-    const size_t i = size_t(above - cdf_.begin()) - 1;
+    // The last bin starting at or below u: its CDF interval holds u, and bins of zero mass are
+    // never picked.
+    size_t i = size_t(guide_[size_t(std::clamp(int(u * kBins), 0, kBins - 1))]);
+    while (i + 1 < size_t(kBins) && cdf_[i + 1] <= u) ++i;
     const double mass = cdf_[i + 1] - cdf_[i];
     const double t = mass > 0 ? std::clamp((u - cdf_[i]) / mass, 0.0, 1.0) : 0.5;
     return -radius_ + 2 * radius_ * (double(i) + t) / kBins;

@@ -55,6 +55,11 @@ class FilterSampler {
   private:
     double radius_ = 0.5;
     std::vector<double> cdf_;  // kBins + 1 values from 0 to 1; empty for the box filter
+    // A guide table (Devroye's "indexed search"): guide_[j] is the last bin whose CDF value is
+    // at most j / kBins, where the search for u in [j, j + 1) / kBins starts; a few steps on
+    // from there instead of a binary search's ten unpredictable branches. It finds the bin a
+    // binary search finds, so the offsets do not depend on it.
+    std::vector<int> guide_;
 };
 
 }  // namespace lf
