@@ -50,9 +50,9 @@ std::vector<PixelRect> TileRects(const std::vector<RenderTask>& tasks) {
 
 absl::StatusOr<TileSums> TileMerger::AddToTile(int tile, const TileSums& sums) {
     if (sums.aovs != store_->aovs()) {
-        return absl::InvalidArgumentError(absl::StrCat("result with AOVs \"",
-                                                       AovListName(sums.aovs), "\", the job's \"",
-                                                       AovListName(store_->aovs()), "\""));
+        return absl::InvalidArgumentError(absl::StrCat("result with AOVs [", AovListName(sums.aovs),
+                                                       "], the job's [",
+                                                       AovListName(store_->aovs()), "]"));
     }
     absl::StatusOr<TileSums> merged = store_->Get(tile);
     if (!merged.ok()) return merged.status();

@@ -187,8 +187,8 @@ absl::Status TileStore::CheckTile(int tile, const TileSums& sums) const {
     }
     if (sums.aovs != aovs_ || sums.aov_pixels.size() != (aovs_ != 0 ? sums.pixels.size() : 0)) {
         return absl::InvalidArgumentError(
-            absl::StrCat("tile ", tile, ": sums with AOVs \"", AovListName(sums.aovs),
-                         "\", the store keeps \"", AovListName(aovs_), "\""));
+            absl::StrCat("tile ", tile, ": sums with AOVs [", AovListName(sums.aovs),
+                         "], the store keeps [", AovListName(aovs_), "]"));
     }
     return absl::OkStatus();
 }

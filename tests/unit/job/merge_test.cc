@@ -159,7 +159,7 @@ TEST(RenderMerger, RefusesResultsWithOtherAovsThanTheJob) {
         const absl::Status s =
             merger.Add(0, RenderFake(t.rect, t.sample_begin, t.sample_end, wrong));
         EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
-        EXPECT_NE(s.message().find("the job's \"depth\""), std::string_view::npos) << s;
+        EXPECT_NE(s.message().find("the job's [depth]"), std::string_view::npos) << s;
     }
     EXPECT_EQ(merger.tasks_done(), 0u);
     EXPECT_TRUE(merger.Add(0, RenderFake(t.rect, t.sample_begin, t.sample_end, kAovDepth)).ok());

@@ -48,7 +48,7 @@ struct PixelSums {
 
 // What a camera ray's first hit shows, for the AOVs (lf/core/aov.h).
 struct FirstHit {
-    Rgb albedo;       // the surface's reflectance there (lf/kernels/aov_renderer.h says which)
+    Rgb albedo;       // the surface's reflectance there (lf/kernels/aov_tracer.h says which)
     Vec3 normal;      // world-space unit shading normal
     float depth = 0;  // distance from the ray's origin
 };
