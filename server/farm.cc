@@ -30,8 +30,9 @@ std::string UniqueSuffix() {
 
 // The scheduler's options with each job's tiles in a file under the data folder's scratch/.
 SchedulerOptions WithTileFiles(SchedulerOptions options, const std::string& data_dir) {
-    options.tile_stores = [dir = data_dir + "/scratch"](std::vector<PixelRect> tiles) {
-        return MakeFileTileStore(dir, std::move(tiles));
+    options.tile_stores = [dir = data_dir + "/scratch"](std::vector<PixelRect> tiles,
+                                                        uint32_t aovs) {
+        return MakeFileTileStore(dir, std::move(tiles), aovs);
     };
     return options;
 }

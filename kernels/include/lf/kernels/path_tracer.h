@@ -26,6 +26,7 @@ class PathTracer : public RadianceEstimator {
     PathTracer(const EmbreeScene& scene, int max_depth);
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
+    const EmbreeScene& geometry() const override { return scene_; }
 
   private:
     const EmbreeScene& scene_;
