@@ -439,8 +439,8 @@ TEST_F(Cli, BadAovClampFilterAndToneFlagsAreRefused) {
         {"--filter box:2", "--filter box:2: width 2: the box filter is one pixel wide"},
     };
     for (const auto& [flags, message] : cases) {
-        for (const std::string command : {"render " + scene + " -o " + (dir_ / "x.exr").string(),
-                                          "submit " + scene + " --server 127.0.0.1:1"}) {
+        for (const std::string& command : {"render " + scene + " -o " + (dir_ / "x.exr").string(),
+                                           "submit " + scene + " --server 127.0.0.1:1"}) {
             const RunResult r = Lightfarm(command + " --spp 1 " + flags);
             EXPECT_NE(r.status, 0) << command << " " << flags;
             EXPECT_NE(r.output.find(message), std::string::npos) << flags << ": " << r.output;

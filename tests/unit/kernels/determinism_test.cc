@@ -96,10 +96,13 @@ TEST_F(Determinism, SamplePassesAddUpToTheSameBits) {
         for (size_t i = 0; i < whole.pixels.size(); ++i) {
             EXPECT_EQ(whole.pixels[i].Count(), parts.pixels[i].Count());
             for (int h = 0; h < 2; ++h) {
-                for (int c = 0; c < 3; ++c)
+                for (int c = 0; c < 3; ++c) {
                     EXPECT_EQ(whole.pixels[i].sum[h][c], parts.pixels[i].sum[h][c]);
+                }
             }
-            if (options.aovs != 0) EXPECT_EQ(whole.aov_pixels[i], parts.aov_pixels[i]);
+            if (options.aovs != 0) {
+                EXPECT_EQ(whole.aov_pixels[i], parts.aov_pixels[i]);
+            }
         }
     }
 }
