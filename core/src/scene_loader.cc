@@ -631,6 +631,11 @@ class SceneParser {
     void ParseEmission(const Node& n, Material& m) {
         if (const std::optional<Node> two_sided = n.Find("two_sided")) {
             m.two_sided_emission = two_sided->Bool();
+            if (m.two_sided_emission && !m.VisibleFromBehind()) {
+                two_sided->Fail(
+                    "a single-sided surface (double_sided false) cannot be seen, so cannot emit, "
+                    "from behind: set double_sided true");
+            }
         }
         const std::optional<Strength> strength = FindStrength(n,
                                                               {{"emission", "W m^-2 sr^-1", false},
@@ -1117,7 +1122,9 @@ class SceneParser {
         for (int y = 0; y < map.height; ++y) {
             double row = 0;
             for (int x = 0; x < map.width; ++x) {
-                row += (Texel(map, x, y, false).rgb * tint).Luminance();
+                // Cleaned as the renderer cleans it (EmittableRadiance), so that the mean is
+                // that of the light it will emit.
+                row += EmittableRadiance(Texel(map, x, y, false).rgb * tint).Luminance();
             }
             const double weight = std::cos(std::numbers::pi * y / map.height) -
                                   std::cos(std::numbers::pi * (y + 1) / map.height);

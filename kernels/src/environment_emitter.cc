@@ -12,11 +12,6 @@ namespace lf {
 namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 
-// HDR files can hold negative, infinite or NaN texels: they emit nothing rather than poison
-// the image.
-float Radiance(float v) { return std::isfinite(v) && v > 0 ? v : 0.0f; }
-Rgb NonNegative(const Rgb& c) { return {Radiance(c.r), Radiance(c.g), Radiance(c.b)}; }
-
 bool HasMap(const EnvironmentLight& light) {
     return light.map && light.map->width > 0 && light.map->height > 0;
 }
@@ -26,7 +21,7 @@ EnvironmentEmitter::EnvironmentEmitter(const EnvironmentLight& light)
     : light_(light),
       cos_rotation_(float(std::cos(light.rotate_y))),
       sin_rotation_(float(std::sin(light.rotate_y))),
-      mean_(NonNegative(light.radiance)) {
+      mean_(EmittableRadiance(light.radiance)) {
     if (!HasMap(light_)) return;
     const TextureImage& map = *light_.map;
     const int w = map.width, h = map.height;
@@ -49,12 +44,12 @@ EnvironmentEmitter::EnvironmentEmitter(const EnvironmentLight& light)
 }
 
 Rgb EnvironmentEmitter::MapValue(const Vec2& uv) const {
-    if (!HasMap(light_)) return NonNegative(light_.radiance);
+    if (!HasMap(light_)) return EmittableRadiance(light_.radiance);
     const TextureImage& map = *light_.map;
     const int x = std::clamp(int(uv.x * float(map.width)), 0, map.width - 1);
     const int y = std::clamp(int(uv.y * float(map.height)), 0, map.height - 1);
     // 8- and 16-bit maps are sRGB-encoded colour; Texel leaves HDR texels alone.
-    return NonNegative(Texel(map, x, y, /*srgb=*/true).rgb * light_.radiance);
+    return EmittableRadiance(Texel(map, x, y, /*srgb=*/true).rgb * light_.radiance);
 }
 
 Vec2 EnvironmentEmitter::MapUv(const Vec3& w) const {

@@ -14,22 +14,34 @@ constexpr float kPi = std::numbers::pi_v<float>;
 // Power over the three channels; the average, not luminance, so a pure blue light counts.
 float PowerWeight(const Rgb& c) { return c.Average(); }
 
-// Width in cos of a spot light's falloff: from cos(outer) up to cos(outer) + width, so that its
-// slope stays finite when the cones (nearly) coincide.
-double FalloffWidth(const SpotLight& spot) {
-    return std::max(0.001, std::cos(spot.inner_cone) - std::cos(spot.outer_cone));
+// 1 - cos(angle), exact also for angles so small that cos rounds to 1.
+double OneMinusCos(double angle) {
+    const double s = std::sin(angle / 2);
+    return 2 * s * s;
+}
+
+// A spot light's cone sizes as 1 - cos: the outer cone's, at least 1e-12 so that a cone of
+// under a microradian still has a float extent, and the falloff band's width from there
+// towards the axis, at least a millionth of the cone so that its slope stays finite when the
+// cones (nearly) coincide.
+struct SpotBand {
+    double outer, width;
+};
+SpotBand Band(const SpotLight& spot) {
+    const double outer = std::max(OneMinusCos(spot.outer_cone), 1e-12);
+    return {outer, std::max(outer - OneMinusCos(spot.inner_cone), 1e-6 * outer)};
 }
 
 // The falloff as a function of t = (cos - cos outer) / width in [0, 1].
 float Falloff(float t, bool smooth) { return smooth ? t * t * (3 - 2 * t) : t * t; }
 
 // The solid angle a spot light's falloff integrates to: 2 pi times the integral of the falloff
-// over cos in [-1, 1], which is 1 from cos(outer) + width up, and width times the mean of
-// t^2 (1/3) or of the smoothstep (1/2) below it.
+// over cos in [-1, 1], which is 1 inside the band (1 - cos below outer - width) and the mean of
+// t^2 (1/3) or of the smoothstep (1/2) over the band: positive for any cones.
 double SpotSolidAngle(const SpotLight& spot) {
-    const double width = FalloffWidth(spot);
+    const SpotBand band = Band(spot);
     const double mean = spot.falloff == SpotLight::Falloff::kSmoothstep ? 0.5 : 1.0 / 3;
-    return 2 * std::numbers::pi * (1 - std::cos(spot.outer_cone) - width * (1 - mean));
+    return 2 * std::numbers::pi * (band.outer - band.width + band.width * mean);
 }
 }  // namespace
 
@@ -75,9 +87,9 @@ LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
     }
     for (size_t i = 0; i < scene.spot_lights.size(); ++i) {
         const SpotLight& spot = scene.spot_lights[i];
-        const float scale = float(1 / FalloffWidth(spot));
-        spot_cones_.push_back({Vec3(Normalize(spot.direction)), scale,
-                               -float(std::cos(spot.outer_cone)) * scale,
+        const SpotBand band = Band(spot);
+        spot_cones_.push_back({Vec3(Normalize(spot.direction)), float(band.outer),
+                               float(1 / band.width),
                                spot.falloff == SpotLight::Falloff::kSmoothstep});
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
         weights.push_back(SpotSolidAngle(spot) * PowerWeight(spot.intensity));
@@ -147,8 +159,19 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, float u_pick,
         return ls;
     }
     if (light.kind == Kind::kSun || light.kind == Kind::kEnvironment) {
-        std::optional<LightSample> ls = SampleInfinite(light, ref, u);
-        if (ls) ls->pdf *= pick;
+        // The lights at infinity are weighed as one: a sampled direction carries all their
+        // radiance (sky behind a sun, overlapping suns) at the density with which any of them
+        // would have produced it, as a BSDF ray escaping the same way is (EscapedRadiance,
+        // EscapedPdf), so the two MIS weights sum to 1 wherever they overlap.
+        const std::optional<Vec3> wi = SampleInfiniteDirection(light, u);
+        if (!wi) return std::nullopt;
+        LightSample ls;
+        ls.wi = *wi;
+        ls.radiance = EscapedRadiance(ls.wi);
+        ls.pdf = EscapedPdf(ls.wi);
+        if (!(ls.pdf > 0) || ls.radiance.IsBlack()) return std::nullopt;
+        ls.point.p = InfinitePoint(ref, ls.wi);
+        ls.point.n = -ls.wi;
         return ls;
     }
     LightSample ls;
@@ -177,9 +200,7 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, float u_pick,
     return ls;
 }
 
-std::optional<LightSample> LightSampler::SampleInfinite(const Light& light, const Vec3& ref,
-                                                        const Vec2& u) const {
-    LightSample ls;
+std::optional<Vec3> LightSampler::SampleInfiniteDirection(const Light& light, const Vec2& u) const {
     if (light.kind == Kind::kSun) {
         // Uniform in the cone: cos(theta) uniform in [cos alpha, 1].
         const SunDisk& sun = suns_[size_t(light.index)];
@@ -187,20 +208,12 @@ std::optional<LightSample> LightSampler::SampleInfinite(const Light& light, cons
         const float sin_theta = std::sqrt(std::max(0.0f, omc * (2 - omc)));
         const float phi = 2 * kPi * u.y;
         const Frame frame = Frame::FromNormal(sun.axis);
-        ls.wi = Normalize(
+        return Normalize(
             frame.FromLocal(Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), 1 - omc)));
-        ls.radiance = sun.radiance;
-        ls.pdf = 1 / (2 * kPi * sun.one_minus_cos);
-    } else {
-        const std::optional<EnvironmentEmitter::DirectionSample> ds = environment_->Sample(u);
-        if (!ds || ds->radiance.IsBlack()) return std::nullopt;
-        ls.wi = ds->wi;
-        ls.radiance = ds->radiance;
-        ls.pdf = ds->pdf;
     }
-    ls.point.p = InfinitePoint(ref, ls.wi);
-    ls.point.n = -ls.wi;
-    return ls;
+    const std::optional<EnvironmentEmitter::DirectionSample> ds = environment_->Sample(u);
+    if (!ds) return std::nullopt;
+    return ds->wi;
 }
 
 Vec3 LightSampler::InfinitePoint(const Vec3& ref, const Vec3& wi) const {
@@ -235,7 +248,11 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
         return ls;
     }
     const SpotCone& cone = spot_cones_[size_t(light.index)];
-    const float t = std::clamp(-Dot(cone.direction, ls.wi) * cone.scale + cone.offset, 0.0f, 1.0f);
+    // 1 - cos of the angle to the axis as |d - axis|^2 / 2 (d = -wi, from the light): exact for
+    // narrow cones, where cos itself rounds to 1 in float.
+    const float one_minus_cos = 0.5f * LengthSquared(ls.wi + cone.direction);
+    const float t =
+        std::clamp((cone.one_minus_cos_outer - one_minus_cos) * cone.inv_width, 0.0f, 1.0f);
     if (t == 0) return std::nullopt;  // outside the outer cone: no shadow ray needed
     ls.radiance =
         scene.spot_lights[size_t(light.index)].intensity * (Falloff(t, cone.smooth) / dist2);

@@ -106,7 +106,7 @@ bool Transmits(const Material& material) {
 }
 
 bool EmitsFromBack(const Material& material) {
-    return material.two_sided_emission && (material.double_sided || Transmits(material));
+    return material.two_sided_emission && material.VisibleFromBehind();
 }
 
 bool HasInterior(const Material& material) {

@@ -22,9 +22,9 @@ pb::PixelFilterType ToProto(PixelFilter::Type type) {
     return pb::FILTER_UNSET;
 }
 
-// The filter `--filter` asked for, or nullopt for the scene's own (also for a type this build
-// does not know: CheckJobSettings cannot refuse what it never sees, so such a job renders with
-// the scene's filter rather than a made-up one).
+// The filter `--filter` asked for, or nullopt for the scene's own. JobService refuses a type
+// this build does not know before converting, and workers are leased tasks only by a
+// coordinator of their own build (lf::kBuildVersion), so no other value arrives here.
 std::optional<PixelFilter> FilterFromProto(const pb::RenderParams& p) {
     switch (p.filter_type()) {
         case pb::FILTER_BOX:

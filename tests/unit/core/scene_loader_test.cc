@@ -6,12 +6,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
 #include "gltf_files.h"
 #include "image_files.h"
 #include "lf/core/blackbody.h"
+#include "lf/core/image_io.h"
 #include "scene_log.h"
 #include "test_dir.h"
 
@@ -971,6 +973,11 @@ TEST_F(SceneLoaderTest, EmissionErrorsNameThePath) {
                 "scene.json: materials.m: color and temperature_k are the emission's colour");
     ExpectError(WithMaterial(lambert + R"("emission": [1, 1, 1], "temperature_k": 3000})"),
                 "scene.json: materials.m.emission: an [r, g, b] strength is a colour itself");
+    // Two-sided emission needs a back face rays can hit.
+    ExpectError(WithMaterial(R"({"type": "principled", "double_sided": false, "two_sided": true, )"
+                             R"("power_lm": 10})"),
+                "scene.json: materials.m.two_sided: a single-sided surface (double_sided false) "
+                "cannot be seen, so cannot emit, from behind");
     ExpectError(WithMaterial(lambert + R"("two_sided": 1, "emission": [1, 1, 1]})"),
                 "scene.json: materials.m.two_sided: expected true or false, got number 1");
     ExpectError(WithMaterial(R"({"type": "principled", "emission_texture": "glow.png", )"
@@ -1014,6 +1021,22 @@ TEST_F(SceneLoaderTest, EnvironmentLights) {
     EXPECT_EQ(environment(R"({"type": "environment", "file": "sky.hdr", "luminance_nits": 683})")
                   .radiance,
               Rgb(2));
+}
+
+// Texels the renderer does not emit (NaN, infinite, negative: lf::EmittableRadiance) do not
+// count in the map's mean either, so luminance_nits sets the light that is actually emitted.
+TEST_F(SceneLoaderTest, PhotometricSkyIgnoresTexelsThatEmitNothing) {
+    // Top row 1, bottom row NaN, +inf, -5 and 0: as emitted, the half-lit map of mean 1/2.
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    Image image(4, 2);
+    for (const char* c : {"R", "G", "B"}) image.Channel(c) = {1, 1, 1, 1, nan, inf, -5, 0};
+    ASSERT_TRUE(WriteExr((dir_ / "sky.exr").string(), image, {}).ok());
+    const absl::StatusOr<Scene> scene =
+        Parse(WithLights(R"({"type": "environment", "file": "sky.exr", "luminance_nits": 683})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_TRUE(scene->environment);
+    EXPECT_EQ(scene->environment->radiance, Rgb(2));
 }
 
 TEST_F(SceneLoaderTest, EnvironmentErrorsNameThePath) {

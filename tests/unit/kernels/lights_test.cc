@@ -26,7 +26,7 @@ double Radians(double degrees) { return degrees * kPi / 180; }
 // clamp((c - cos outer) / (cos inner - cos outer), 0, 1)^2, and pbrt-v4's
 // smoothstep(cos outer, cos inner, c).
 double SpotFalloff(double cos_to_axis, double inner, double outer, SpotLight::Falloff falloff) {
-    const double scale = 1 / std::max(0.001, std::cos(inner) - std::cos(outer));
+    const double scale = 1 / (std::cos(inner) - std::cos(outer));
     const double a = std::clamp((cos_to_axis - std::cos(outer)) * scale, 0.0, 1.0);
     return falloff == SpotLight::Falloff::kSmoothstep ? a * a * (3 - 2 * a) : a * a;
 }
@@ -121,6 +121,51 @@ TEST_P(SpotFalloffTest, SamplerFollowsTheFalloff) {
         EXPECT_NEAR(ls->radiance.g, expected, 1e-5 * expected + 1e-6) << angle;
         EXPECT_NEAR(Length(ls->wi), 1, 1e-6);
         EXPECT_NEAR(Dot(ls->wi, Normalize(light - ref)), 1, 1e-6);
+    }
+}
+
+// Cones of a degree or two, where cos(inner) and cos(outer) differ by less than 1e-3 and a float
+// cosine barely tells them apart: the falloff is still full on the axis and follows its formula
+// across the band, and the light is picked with its exact share of the power (beside a point
+// light of known power).
+TEST_P(SpotFalloffTest, NarrowConesKeepTheirFalloffAndTheirShareOfThePower) {
+    for (const auto& [inner, outer] : {std::pair{0.0, 1.0}, {0.5, 1.0}, {1.4, 1.5}}) {
+        Scene scene = testing::PlaneUnderCamera(Rgb(0.5f));
+        const SpotLight spot = DownwardSpot(Vec3d(0, 2, 0), Rgb(3.0f), inner, outer, GetParam());
+        scene.spot_lights.push_back(spot);
+        scene.point_lights.push_back({Vec3d(1, 2, 0), Rgb(0.01f)});
+        auto es = EmbreeScene::Build(scene);
+        ASSERT_TRUE(es.ok());
+        const LightSampler sampler(**es);
+        const Vec3 light = Vec3(spot.position - (*es)->origin());
+
+        // Power shares: 4 pi I for the point; 2 pi (1 - cos inner + band * mean) I for the
+        // spot, the band (cos inner - cos outer) weighted by the falloff's mean (1/2 or 1/3).
+        const double mean = GetParam() == SpotLight::Falloff::kSmoothstep ? 0.5 : 1.0 / 3;
+        const double band = std::cos(Radians(inner)) - std::cos(Radians(outer));
+        const double spot_weight = 2 * kPi * (1 - std::cos(Radians(inner)) + band * mean) * 3;
+        const double point_weight = 4 * kPi * 0.01;
+        const double spot_pmf = spot_weight / (spot_weight + point_weight);
+        // The point light comes first in the sampler's order, the spot last.
+        const std::optional<LightSample> on_axis =
+            sampler.Sample(light - Vec3(0, 1.5f, 0), 0.9999f, {0.5f, 0.5f});
+        ASSERT_TRUE(on_axis) << inner << ".." << outer;
+        EXPECT_NEAR(on_axis->pdf, spot_pmf, 1e-5 * spot_pmf) << inner << ".." << outer;
+        EXPECT_NEAR(on_axis->radiance.g, 3 / (1.5 * 1.5), 1e-5) << inner << ".." << outer;
+
+        for (double angle = 0; angle < outer + 0.2; angle += 0.05) {
+            const double a = Radians(angle);
+            const Vec3 ref = light + Vec3(float(1.5 * std::sin(a)), -float(1.5 * std::cos(a)), 0);
+            const std::optional<LightSample> ls = sampler.Sample(ref, 0.9999f, {0.5f, 0.5f});
+            const double expected =
+                3 * SpotFalloff(std::cos(a), spot.inner_cone, spot.outer_cone, spot.falloff) /
+                (1.5 * 1.5);
+            // 1e-3 of the peak: a float direction resolves angles of a degree to about 1e-6
+            // rad, which moves the falloff by up to (1e-6 / band width in rad) of its range.
+            const double got = ls ? ls->radiance.g : 0;
+            EXPECT_NEAR(got, expected, 2e-3 * 3 / (1.5 * 1.5))
+                << inner << ".." << outer << " at " << angle;
+        }
     }
 }
 
@@ -284,6 +329,24 @@ TEST(SunDisk, WideDiskCombinesLightAndBsdfSamples) {
         testing::EstimateRadiance(
             tracer, testing::RayBetween(Vec3d(0, 3, 0), Vec3d(0.4, 0, 0.3), (*es)->origin()), 4000),
         rho * e * float(std::cos(theta0) / kPi));
+}
+
+// A uniform sky behind a wide sun: light samples and escaping BSDF rays weigh the two lights
+// at infinity as one, so where they overlap nothing is lost or counted twice. The plane
+// receives E cos(theta0) from the disk (a cap entirely above the horizon) and pi L from the sky.
+TEST(SunDisk, SkyBehindAWideDiskAddsUp) {
+    const Rgb rho(0.5f, 0.25f, 0.75f), e(2.0f, 1.0f, 0.5f), sky(0.3f, 0.4f, 0.5f);
+    const double theta0 = Radians(20);
+    const Vec3d direction(-std::sin(theta0), -std::cos(theta0), 0);
+    Scene scene = DirectionalScene(rho, {direction, e, Radians(40)});
+    scene.environment = EnvironmentLight{sky, nullptr, 0};
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok());
+    const PathTracer tracer(**es, -1);
+    testing::ExpectEstimateNear(
+        testing::EstimateRadiance(
+            tracer, testing::RayBetween(Vec3d(0, 3, 0), Vec3d(0.4, 0, 0.3), (*es)->origin()), 4000),
+        rho * (e * float(std::cos(theta0) / kPi) + sky));
 }
 
 // A disk too small for float (its radiance E / (pi sin^2 alpha) would overflow) is sampled as

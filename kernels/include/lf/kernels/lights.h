@@ -53,11 +53,12 @@ class LightSampler {
         float area;
         bool two_sided;  // area lights: emission leaves the back face too
     };
-    // A spot light's cone in render space: with t = clamp(cos * scale + offset, 0, 1) its
-    // falloff is t^2 (KHR_lights_punctual) or t^2 (3 - 2 t) (smoothstep).
+    // A spot light's cone in render space: with c = 1 - cos(angle to the axis) and
+    // t = clamp((one_minus_cos_outer - c) * inv_width, 0, 1) its falloff is t^2
+    // (KHR_lights_punctual) or t^2 (3 - 2 t) (smoothstep).
     struct SpotCone {
         Vec3 direction;
-        float scale, offset;
+        float one_minus_cos_outer, inv_width;
         bool smooth;
     };
     // A sun disk: directions within angle alpha of `axis` (towards the sun) carry `radiance`.
@@ -72,8 +73,8 @@ class LightSampler {
 
     int LightIndex(const SurfaceHit& hit) const;
     std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref) const;
-    std::optional<LightSample> SampleInfinite(const Light& light, const Vec3& ref,
-                                              const Vec2& u) const;
+    // A direction towards a sun disk (uniform in its cone) or the environment (by its map).
+    std::optional<Vec3> SampleInfiniteDirection(const Light& light, const Vec2& u) const;
     // Where a shadow ray from ref towards a light at infinity in direction wi ends.
     Vec3 InfinitePoint(const Vec3& ref, const Vec3& wi) const;
 
