@@ -95,6 +95,23 @@ TEST_P(SpotFalloffTest, LambertianPlaneMatchesClosedForm) {
 }
 
 // The sampler's radiance at points swept from the axis to beyond the outer cone.
+// A light sample at a point 1.5 below `spot` (at `light`, in render space) and `degrees` off its
+// axis, and the radiance the closed form gives there: intensity (green) times falloff / r^2.
+struct SpotProbe {
+    Vec3 ref;
+    std::optional<LightSample> sample;
+    double expected;
+};
+SpotProbe ProbeSpot(const LightSampler& sampler, const Vec3& light, const SpotLight& spot,
+                    double degrees, float u_pick) {
+    const double a = Radians(degrees);
+    const Vec3 ref = light + Vec3(float(1.5 * std::sin(a)), -float(1.5 * std::cos(a)), 0);
+    return {ref, sampler.Sample(ref, u_pick, {0.5f, 0.5f}),
+            spot.intensity.g *
+                SpotFalloff(std::cos(a), spot.inner_cone, spot.outer_cone, spot.falloff) /
+                (1.5 * 1.5)};
+}
+
 TEST_P(SpotFalloffTest, SamplerFollowsTheFalloff) {
     Scene scene = testing::PlaneUnderCamera(Rgb(0.5f));
     const SpotLight spot = DownwardSpot(Vec3d(0, 2, 0), Rgb(3.0f), 10, 30, GetParam());
@@ -104,13 +121,7 @@ TEST_P(SpotFalloffTest, SamplerFollowsTheFalloff) {
     const LightSampler sampler(**es);
     const Vec3 light = Vec3(spot.position - (*es)->origin());
     for (double angle = 0; angle < 60; angle += 0.5) {
-        // A reference point below the light at `angle` off the axis, 1.5 away.
-        const double a = Radians(angle);
-        const Vec3 ref = light + Vec3(float(1.5 * std::sin(a)), -float(1.5 * std::cos(a)), 0);
-        const std::optional<LightSample> ls = sampler.Sample(ref, 0.5f, {0.5f, 0.5f});
-        const double expected =
-            3 * SpotFalloff(std::cos(a), spot.inner_cone, spot.outer_cone, spot.falloff) /
-            (1.5 * 1.5);
+        const auto [ref, ls, expected] = ProbeSpot(sampler, light, spot, angle, 0.5f);
         if (expected == 0) {
             EXPECT_FALSE(ls) << angle;
             continue;
@@ -154,13 +165,8 @@ TEST_P(SpotFalloffTest, NarrowConesKeepTheirFalloffAndTheirShareOfThePower) {
         EXPECT_NEAR(on_axis->radiance.g, 3 / (1.5 * 1.5), 1e-5) << inner << ".." << outer;
 
         for (double angle = 0; angle < outer + 0.2; angle += 0.05) {
-            const double a = Radians(angle);
-            const Vec3 ref = light + Vec3(float(1.5 * std::sin(a)), -float(1.5 * std::cos(a)), 0);
-            const std::optional<LightSample> ls = sampler.Sample(ref, 0.9999f, {0.5f, 0.5f});
-            const double expected =
-                3 * SpotFalloff(std::cos(a), spot.inner_cone, spot.outer_cone, spot.falloff) /
-                (1.5 * 1.5);
-            // 1e-3 of the peak: a float direction resolves angles of a degree to about 1e-6
+            const auto [ref, ls, expected] = ProbeSpot(sampler, light, spot, angle, 0.9999f);
+            // 2e-3 of the peak: a float direction resolves angles of a degree to about 1e-6
             // rad, which moves the falloff by up to (1e-6 / band width in rad) of its range.
             const double got = ls ? ls->radiance.g : 0;
             EXPECT_NEAR(got, expected, 2e-3 * 3 / (1.5 * 1.5))
@@ -314,40 +320,33 @@ TEST(SunDisk, UnoccludedPlaneReceivesTheDeltaLightsIrradiance) {
     }
 }
 
-// A disk 40 degrees across, 20 degrees off the zenith, entirely above the horizon: still
-// E cos(theta0) on the plane. BSDF samples hit so wide a disk often, so this checks their MIS
-// combination with the light samples.
-TEST(SunDisk, WideDiskCombinesLightAndBsdfSamples) {
+// A sun disk of 40 degrees at 20 degrees from the zenith (a cap entirely above the horizon,
+// so the plane receives E cos(theta0) from it), optionally in front of a uniform sky, over a
+// Lambertian plane: the path tracer's radiance against the closed form.
+void ExpectWideSunOverPlane(const std::optional<Rgb>& sky) {
     const Rgb rho(0.5f, 0.25f, 0.75f), e(2.0f, 1.0f, 0.5f);
     const double theta0 = Radians(20);
     const Vec3d direction(-std::sin(theta0), -std::cos(theta0), 0);
-    const Scene scene = DirectionalScene(rho, {direction, e, Radians(40)});
+    Scene scene = DirectionalScene(rho, {direction, e, Radians(40)});
+    if (sky) scene.environment = EnvironmentLight{*sky, nullptr, 0};
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
     const PathTracer tracer(**es, -1);
     testing::ExpectEstimateNear(
         testing::EstimateRadiance(
             tracer, testing::RayBetween(Vec3d(0, 3, 0), Vec3d(0.4, 0, 0.3), (*es)->origin()), 4000),
-        rho * e * float(std::cos(theta0) / kPi));
+        rho * (e * float(std::cos(theta0) / kPi) + sky.value_or(Rgb(0.0f))));
 }
+
+// A disk 40 degrees across, 20 degrees off the zenith, entirely above the horizon: still
+// E cos(theta0) on the plane. BSDF samples hit so wide a disk often, so this checks their MIS
+// combination with the light samples.
+TEST(SunDisk, WideDiskCombinesLightAndBsdfSamples) { ExpectWideSunOverPlane(std::nullopt); }
 
 // A uniform sky behind a wide sun: light samples and escaping BSDF rays weigh the two lights
 // at infinity as one, so where they overlap nothing is lost or counted twice. The plane
-// receives E cos(theta0) from the disk (a cap entirely above the horizon) and pi L from the sky.
-TEST(SunDisk, SkyBehindAWideDiskAddsUp) {
-    const Rgb rho(0.5f, 0.25f, 0.75f), e(2.0f, 1.0f, 0.5f), sky(0.3f, 0.4f, 0.5f);
-    const double theta0 = Radians(20);
-    const Vec3d direction(-std::sin(theta0), -std::cos(theta0), 0);
-    Scene scene = DirectionalScene(rho, {direction, e, Radians(40)});
-    scene.environment = EnvironmentLight{sky, nullptr, 0};
-    auto es = EmbreeScene::Build(scene);
-    ASSERT_TRUE(es.ok());
-    const PathTracer tracer(**es, -1);
-    testing::ExpectEstimateNear(
-        testing::EstimateRadiance(
-            tracer, testing::RayBetween(Vec3d(0, 3, 0), Vec3d(0.4, 0, 0.3), (*es)->origin()), 4000),
-        rho * (e * float(std::cos(theta0) / kPi) + sky));
-}
+// receives pi L from the sky besides the disk's irradiance.
+TEST(SunDisk, SkyBehindAWideDiskAddsUp) { ExpectWideSunOverPlane(Rgb(0.3f, 0.4f, 0.5f)); }
 
 // A disk too small for float (its radiance E / (pi sin^2 alpha) would overflow) is sampled as
 // the delta light it is indistinguishable from.
