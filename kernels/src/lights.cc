@@ -1,10 +1,16 @@
 #include "lf/kernels/lights.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 
+#include "lf/kernels/light_bounds.h"
 #include "lf/kernels/shading.h"
+#include "lf/kernels/sphere_cone_sampling.h"
+#include "lf/kernels/spherical_triangle.h"
 
 namespace lf {
 
@@ -43,6 +49,26 @@ double SpotSolidAngle(const SpotLight& spot) {
     const double mean = spot.falloff == SpotLight::Falloff::kSmoothstep ? 0.5 : 1.0 / 3;
     return 2 * std::numbers::pi * (band.outer - band.width + band.width * mean);
 }
+
+// The largest float below 1, for mapping [0, 1) onto itself after a division.
+constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+
+// Barycentrics (b1, b2) of x, a point on (or, by rounding, next to) the triangle p0 p1 p2, clamped
+// into it.
+Vec2 Barycentrics(const Vec3& x, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+    const Vec3d e1 = Vec3d(p1) - Vec3d(p0), e2 = Vec3d(p2) - Vec3d(p0), q = Vec3d(x) - Vec3d(p0);
+    const double d11 = Dot(e1, e1), d12 = Dot(e1, e2), d22 = Dot(e2, e2);
+    const double q1 = Dot(q, e1), q2 = Dot(q, e2);
+    const double det = d11 * d22 - d12 * d12;
+    double b1 = std::max(0.0, (d22 * q1 - d12 * q2) / det);
+    double b2 = std::max(0.0, (d11 * q2 - d12 * q1) / det);
+    if (b1 + b2 > 1) {
+        const double sum = b1 + b2;
+        b1 /= sum;
+        b2 /= sum;
+    }
+    return Vec2(float(b1), float(b2));
+}
 }  // namespace
 
 bool LightSampler::SunDisk::Contains(const Vec3& w) const {
@@ -50,9 +76,12 @@ bool LightSampler::SunDisk::Contains(const Vec3& w) const {
     return LengthSquared(w - axis) <= 2 * one_minus_cos;
 }
 
-LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
+LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
+    : scene_(es), strategy_(strategy) {
     const Scene& scene = es.scene();
     std::vector<double> weights;
+    // The finite lights' bounds for the BVH, by light index, in the units of `weights`.
+    std::vector<LightBounds> bounds;
     triangle_light_.resize(scene.meshes.size());
     for (size_t m = 0; m < scene.meshes.size(); ++m) {
         const TriangleMesh& mesh = scene.meshes[m];
@@ -68,6 +97,7 @@ LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
             triangle_light_[m][t] = int(lights_.size());
             lights_.push_back({Kind::kTriangle, int(m), int(t), area, two_sided});
             weights.push_back(double(kPi) * area * PowerWeight(mat.emission) * (two_sided ? 2 : 1));
+            bounds.push_back(TriangleLightBounds(p0, p1, p2, PowerWeight(mat.emission), two_sided));
         }
     }
     sphere_light_.assign(scene.spheres.size(), -1);
@@ -80,10 +110,16 @@ LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
         sphere_light_[s] = int(lights_.size());
         lights_.push_back({Kind::kSphere, int(s), 0, area, two_sided});
         weights.push_back(double(kPi) * area * PowerWeight(mat.emission) * (two_sided ? 2 : 1));
+        // Seen from inside, a two-sided sphere's normals still cover every direction.
+        bounds.push_back(SphereLightBounds(es.SphereCenter(int(s)), float(r),
+                                           PowerWeight(mat.emission) * (two_sided ? 2 : 1)));
     }
     for (size_t i = 0; i < scene.point_lights.size(); ++i) {
+        const PointLight& point = scene.point_lights[i];
         lights_.push_back({Kind::kPoint, int(i), 0, 0, false});
-        weights.push_back(4 * std::numbers::pi * PowerWeight(scene.point_lights[i].intensity));
+        weights.push_back(4 * std::numbers::pi * PowerWeight(point.intensity));
+        bounds.push_back(
+            PointLightBounds(Vec3(point.position - es.origin()), PowerWeight(point.intensity)));
     }
     for (size_t i = 0; i < scene.spot_lights.size(); ++i) {
         const SpotLight& spot = scene.spot_lights[i];
@@ -93,7 +129,15 @@ LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
                                spot.falloff == SpotLight::Falloff::kSmoothstep});
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
         weights.push_back(SpotSolidAngle(spot) * PowerWeight(spot.intensity));
+        // The outer cosine rounded down (a wider cone) so that even a cone whose cosine rounds
+        // to 1 in float keeps a positive pick probability wherever it shines.
+        const float cos_outer = std::nextafter(float(1 - band.outer), -1.0f);
+        const float cos_inner = std::max(float(1 - (band.outer - band.width)), cos_outer);
+        bounds.push_back(SpotLightBounds(Vec3(spot.position - es.origin()),
+                                         spot_cones_.back().direction, PowerWeight(spot.intensity),
+                                         cos_inner, cos_outer));
     }
+    finite_count_ = lights_.size();
     const auto [lo, hi] = scene.Bounds();
     scene_radius_ = float(Length(hi - lo) / 2);
     // Lights at infinity: what falls on the scene's bounding sphere's cross-section.
@@ -138,19 +182,40 @@ LightSampler::LightSampler(const EmbreeScene& es) : scene_(es) {
         cdf_[i] = float(acc);
     }
     if (!cdf_.empty()) cdf_.back() = 1.0f;
+    // Sample sends u_pick below cdf_[finite_count_ - 1] to the BVH: exactly that probability.
+    if (finite_count_ > 0) finite_pmf_ = cdf_[finite_count_ - 1];
+    if (strategy_ == LightStrategy::kBvh) {
+        absl::StatusOr<LightBvh> bvh = LightBvh::Build(bounds);
+        if (bvh.ok()) {
+            bvh_ = *std::move(bvh);
+        } else {
+            spdlog::warn("light BVH: {}; lights are picked by power",
+                         std::string(bvh.status().message()));
+            strategy_ = LightStrategy::kPower;
+        }
+    }
     for (size_t light : sun_lights) sun_pmf_.push_back(pmf_[light]);
     if (environment_) environment_pmf_ = pmf_[environment_light];
 }
 
-std::optional<LightSample> LightSampler::Sample(const Vec3& ref, float u_pick,
+std::optional<LightSample> LightSampler::Sample(const Vec3& ref, const Vec3& n, float u_pick,
                                                 const Vec2& u) const {
     if (lights_.empty()) return std::nullopt;
-    const int index = int(std::upper_bound(cdf_.begin(), cdf_.end(), u_pick) - cdf_.begin());
-    const int li = std::min(index, int(lights_.size()) - 1);
-    const float pick = pmf_[size_t(li)];
+    int li = 0;
+    float pick = 0;
+    if (strategy_ == LightStrategy::kBvh && u_pick < finite_pmf_) {
+        const std::optional<LightPick> bvh_pick =
+            bvh_.Sample(ref, n, std::min(u_pick / finite_pmf_, kOneMinusEpsilon));
+        if (!bvh_pick) return std::nullopt;
+        li = bvh_pick->light;
+        pick = finite_pmf_ * bvh_pick->pmf;
+    } else {
+        const int index = int(std::upper_bound(cdf_.begin(), cdf_.end(), u_pick) - cdf_.begin());
+        li = std::min(index, int(lights_.size()) - 1);
+        pick = pmf_[size_t(li)];
+    }
     if (!(pick > 0)) return std::nullopt;
     const Light& light = lights_[size_t(li)];
-    const Scene& scene = scene_.scene();
 
     if (light.kind == Kind::kPoint || light.kind == Kind::kSpot ||
         light.kind == Kind::kDirectional) {
@@ -174,18 +239,47 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, float u_pick,
         ls.point.n = -ls.wi;
         return ls;
     }
+    std::optional<LightSample> ls = SampleArea(light, ref, u);
+    if (ls) ls->pdf *= pick;
+    return ls;
+}
+
+std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Vec3& ref,
+                                                    const Vec2& u) const {
+    const Scene& scene = scene_.scene();
+    const bool bvh = strategy_ == LightStrategy::kBvh;
     LightSample ls;
     Rgb emission;
+    float solid_angle_pdf = 0;  // set when the point was sampled by solid angle
     if (light.kind == Kind::kTriangle) {
-        // Uniform on the triangle (Osada et al. square-root parameterisation).
-        const float su = std::sqrt(u.x);
-        ls.point = scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y);
+        Vec3 p0, p1, p2;
+        scene_.Triangle(light.index, light.primitive, &p0, &p1, &p2);
+        const SphericalTriangle st(ref, p0, p1, p2);
+        if (bvh && st.samplable()) {
+            const Vec2 b = Barycentrics(st.Sample(u).point, p0, p1, p2);
+            ls.point = scene_.TrianglePoint(light.index, light.primitive, b.x, b.y);
+            solid_angle_pdf = st.Pdf();
+        } else {
+            // Uniform on the triangle (Osada et al. square-root parameterisation).
+            const float su = std::sqrt(u.x);
+            ls.point = scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y);
+        }
         emission = scene.materials[size_t(scene.meshes[size_t(light.index)].material)].emission;
     } else {
-        const float z = 1 - 2 * u.x;
-        const float r = std::sqrt(std::max(0.0f, 1 - z * z));
-        const float phi = 2 * kPi * u.y;
-        ls.point = scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z));
+        if (bvh) {
+            const std::optional<SphereConeSample> s =
+                SampleSphereCone(ref, scene_.SphereCenter(light.index),
+                                 float(scene.spheres[size_t(light.index)].radius), u);
+            if (!s) return std::nullopt;
+            ls.point = scene_.SpherePoint(light.index, s->normal);
+            solid_angle_pdf = s->pdf;
+        } else {
+            const float z = 1 - 2 * u.x;
+            const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+            const float phi = 2 * kPi * u.y;
+            ls.point =
+                scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z));
+        }
         emission = scene.materials[size_t(scene.spheres[size_t(light.index)].material)].emission;
     }
     const Vec3 d = ls.point.p - ref;
@@ -196,8 +290,26 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, float u_pick,
     const float cos_light = light.two_sided ? std::abs(cos_front) : cos_front;
     if (!(cos_light > 0)) return std::nullopt;  // a one-sided emitter seen from behind
     ls.radiance = emission;
-    ls.pdf = pick * dist2 / (cos_light * light.area);
+    ls.pdf = solid_angle_pdf > 0 ? solid_angle_pdf : dist2 / (cos_light * light.area);
     return ls;
+}
+
+float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const SurfaceHit& hit) const {
+    if (strategy_ == LightStrategy::kBvh) {
+        if (light.kind == Kind::kSphere) {
+            return SphereConePdf(ref, scene_.SphereCenter(light.index),
+                                 float(scene_.scene().spheres[size_t(light.index)].radius), hit.p);
+        }
+        Vec3 p0, p1, p2;
+        scene_.Triangle(light.index, light.primitive, &p0, &p1, &p2);
+        const SphericalTriangle st(ref, p0, p1, p2);
+        if (st.samplable()) return st.Pdf();
+    }
+    const Vec3 d = hit.p - ref;
+    const float dist2 = LengthSquared(d);
+    const float cos_light = std::abs(Dot(hit.n, d)) / std::sqrt(dist2);
+    if (!(cos_light > 0)) return 0;
+    return dist2 / (cos_light * light.area);
 }
 
 std::optional<Vec3> LightSampler::SampleInfiniteDirection(const Light& light, const Vec2& u) const {
@@ -264,14 +376,13 @@ int LightSampler::LightIndex(const SurfaceHit& hit) const {
     return triangle_light_[size_t(hit.mesh)][size_t(hit.primitive)];
 }
 
-float LightSampler::Pdf(const Vec3& ref, const SurfaceHit& hit) const {
+float LightSampler::Pdf(const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const {
     const int li = LightIndex(hit);
     if (li < 0) return 0;
-    const Vec3 d = hit.p - ref;
-    const float dist2 = LengthSquared(d);
-    const float cos_light = std::abs(Dot(hit.n, d)) / std::sqrt(dist2);
-    if (!(cos_light > 0)) return 0;
-    return pmf_[size_t(li)] * dist2 / (cos_light * lights_[size_t(li)].area);
+    const float pick =
+        strategy_ == LightStrategy::kBvh ? finite_pmf_ * bvh_.Pmf(ref, n, li) : pmf_[size_t(li)];
+    if (!(pick > 0)) return 0;
+    return pick * AreaPdf(lights_[size_t(li)], ref, hit);
 }
 
 Rgb LightSampler::EscapedRadiance(const Vec3& w) const {

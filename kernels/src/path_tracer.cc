@@ -28,8 +28,8 @@ constexpr int kRouletteStartDepth = 1;
 
 }  // namespace
 
-PathTracer::PathTracer(const EmbreeScene& scene, int max_depth)
-    : scene_(scene), lights_(scene), max_depth_(max_depth) {}
+PathTracer::PathTracer(const EmbreeScene& scene, int max_depth, LightStrategy strategy)
+    : scene_(scene), lights_(scene, strategy), max_depth_(max_depth) {}
 
 Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) const {
     const std::vector<Material>& materials = scene_.scene().materials;
@@ -37,7 +37,9 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
     Ray ray = camera_ray;
     bool delta_bounce = true;  // the camera ray sees emission with full weight
     float prev_pdf = 0;
-    Vec3 prev_p;
+    // The previous vertex and its shading normal: the light sampler's Pdf for an emitter a
+    // BSDF-sampled ray hits must see what its Sample saw there.
+    Vec3 prev_p, prev_n;
     float eta_scale = 1;
     // The solid transmitter whose interior the ray travels through (a material index), or -1.
     int medium = -1;
@@ -68,7 +70,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
             if (delta_bounce) {
                 L += beta * sh.emission;
             } else {
-                const float light_pdf = lights_.Pdf(prev_p, *hit);
+                const float light_pdf = lights_.Pdf(prev_p, prev_n, *hit);
                 L += beta * sh.emission * PowerHeuristic(prev_pdf, light_pdf);
             }
         }
@@ -98,7 +100,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         if (!bsdf.IsDelta()) {
             const float u_pick = sampler.Get1D();
             const Vec2 u_light = sampler.Get2D();
-            if (const auto ls = lights_.Sample(hit->p, u_pick, u_light)) {
+            if (const auto ls = lights_.Sample(hit->p, sh.ns, u_pick, u_light)) {
                 const Vec3 wi = frame.ToLocal(ls->wi);
                 const Rgb f = consistent(ls->wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
                 const Rgb radiance =
@@ -138,6 +140,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         delta_bounce = bs->delta;
         prev_pdf = bs->pdf;
         prev_p = hit->p;
+        prev_n = sh.ns;
         ray = SpawnRay(sh.Leaving(wi), wi);
 
         if (depth >= kRouletteStartDepth) {

@@ -2,8 +2,19 @@
 // (area lights, uniform by area, from the back too when two-sided), the delta lights (point,
 // spot with smoothstep or KHR_lights_punctual falloff, directional) and the lights at infinity
 // that BSDF-sampled rays can also reach: sun disks (directional lights with an angular
-// diameter, uniform in their cone) and the environment. A light is picked with probability
-// proportional to its power, so a tiny bright emitter gets the samples it needs.
+// diameter, uniform in their cone) and the environment.
+//
+// Two strategies (LightStrategy):
+// - kPower: a light is picked with probability proportional to its power, so a tiny bright
+//   emitter gets the samples it needs; triangles and spheres are sampled uniformly by area.
+// - kBvh (the default): the lights at infinity and directional lights keep their power
+//   probabilities (as one group, so EscapedPdf is the same under both strategies), and the
+//   finite lights (triangles, spheres, point and spot lights) share the rest, chosen among by a
+//   light BVH (lf/kernels/light_bvh.h) by their importance at the shading point and normal.
+//   Triangles that subtend a solid angle worth it are sampled uniformly in it (spherical
+//   triangles, lf/kernels/spherical_triangle.h), the others by area; spheres within their
+//   visible cone (lf/kernels/sphere_cone_sampling.h). Pdf takes the same decisions, which
+//   depend only on the reference point, its normal and the light.
 #pragma once
 
 #include <optional>
@@ -11,8 +22,11 @@
 
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/environment_emitter.h"
+#include "lf/kernels/light_bvh.h"
 
 namespace lf {
+
+enum class LightStrategy { kPower, kBvh };
 
 struct LightSample {
     Rgb radiance;        // L_e arriving at the reference point; for delta lights the value that
@@ -27,16 +41,22 @@ struct LightSample {
 
 class LightSampler {
   public:
-    explicit LightSampler(const EmbreeScene& scene);
+    // A scene whose light bounds the BVH refuses (powers beyond float) falls back to kPower,
+    // with a warning.
+    explicit LightSampler(const EmbreeScene& scene, LightStrategy strategy = LightStrategy::kBvh);
 
     bool empty() const { return lights_.empty(); }
     size_t size() const { return lights_.size(); }
+    LightStrategy strategy() const { return strategy_; }
 
-    std::optional<LightSample> Sample(const Vec3& ref, float u_pick, const Vec2& u) const;
+    // A light sample for the reference point `ref` with (shading) normal `n`, unit, or zero in a
+    // volume; kPower ignores n.
+    std::optional<LightSample> Sample(const Vec3& ref, const Vec3& n, float u_pick,
+                                      const Vec2& u) const;
 
-    // Density, per solid angle at `ref`, with which Sample would have produced `hit` (an
-    // emitter hit by a BSDF-sampled ray); used for multiple importance sampling.
-    float Pdf(const Vec3& ref, const SurfaceHit& hit) const;
+    // Density, per solid angle at `ref`, with which Sample(ref, n, ...) would have produced
+    // `hit` (an emitter hit by a BSDF-sampled ray); used for multiple importance sampling.
+    float Pdf(const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;
 
     // Radiance of the lights at infinity (sun disks, environment) arriving along a ray that
     // leaves the scene in direction w (unit), and the density per solid angle with which Sample
@@ -72,6 +92,11 @@ class LightSampler {
     };
 
     int LightIndex(const SurfaceHit& hit) const;
+    // A point on area light `light` (triangle or sphere) for u, with its density per solid
+    // angle at ref, not yet times the pick probability.
+    std::optional<LightSample> SampleArea(const Light& light, const Vec3& ref, const Vec2& u) const;
+    // The density with which SampleArea yields `hit` on area light `light` from ref.
+    float AreaPdf(const Light& light, const Vec3& ref, const SurfaceHit& hit) const;
     std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref) const;
     // A direction towards a sun disk (uniform in its cone) or the environment (by its map).
     std::optional<Vec3> SampleInfiniteDirection(const Light& light, const Vec2& u) const;
@@ -79,8 +104,14 @@ class LightSampler {
     Vec3 InfinitePoint(const Vec3& ref, const Vec3& wi) const;
 
     const EmbreeScene& scene_;
-    std::vector<Light> lights_;
-    std::vector<float> pmf_;                        // pick probability per light
+    LightStrategy strategy_;
+    std::vector<Light> lights_;  // the finite lights first: [0, finite_count_)
+    size_t finite_count_ = 0;
+    // kPower: pick probability per light. kBvh: the same for the lights at infinity; the finite
+    // lights' sum is finite_pmf_, the BVH shares it.
+    std::vector<float> pmf_;
+    float finite_pmf_ = 0;
+    LightBvh bvh_;                                  // kBvh: over lights_[0, finite_count_)
     std::vector<float> cdf_;                        // its running sum, cdf_.back() == 1
     std::vector<std::vector<int>> triangle_light_;  // per mesh, per triangle: light or -1
     std::vector<int> sphere_light_;                 // per sphere: light or -1

@@ -22,8 +22,9 @@ inline constexpr int kMaxPathDepth = 1 << 16;
 class PathTracer : public RadianceEstimator {
   public:
     // max_depth: the most bounces a path may take; negative means unlimited (roulette, and
-    // kMaxPathDepth).
-    PathTracer(const EmbreeScene& scene, int max_depth);
+    // kMaxPathDepth). strategy: how next-event estimation picks and samples lights.
+    PathTracer(const EmbreeScene& scene, int max_depth,
+               LightStrategy strategy = LightStrategy::kBvh);
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
     const EmbreeScene& geometry() const override { return scene_; }
