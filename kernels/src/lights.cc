@@ -69,6 +69,45 @@ Vec2 Barycentrics(const Vec3& x, const Vec3& p0, const Vec3& p1, const Vec3& p2)
     }
     return Vec2(float(b1), float(b2));
 }
+
+// pbrt-v4's warp of a spherical triangle's sample space towards the receiver's cosine: a
+// bilinear density over [0, 1]^2 whose corners carry |cos| at the vertex they map to (u = (0, y)
+// and (1, 0) map to b, (0, 1) to a, (1, 1) to c; at least 0.01 so no part is left unsampled).
+// Uniform sampling in solid angle leaves the cosine's variance, which dominates for a large
+// emitter seen at grazing angles.
+class CosineWarp {
+  public:
+    CosineWarp(const Vec3& ref, const Vec3& n, const Vec3& v0, const Vec3& v1, const Vec3& v2) {
+        const auto weight = [&](const Vec3& v) {
+            return std::max(0.01f, std::abs(Dot(n, Normalize(v - ref))));
+        };
+        w_[0] = w_[1] = weight(v1);
+        w_[2] = weight(v0);
+        w_[3] = weight(v2);
+    }
+
+    // u distributed by the bilinear density, for u uniform in [0, 1)^2.
+    Vec2 Sample(const Vec2& u) const {
+        const float y = SampleLinear(u.y, w_[0] + w_[1], w_[2] + w_[3]);
+        return {SampleLinear(u.x, Lerp(y, w_[0], w_[2]), Lerp(y, w_[1], w_[3])), y};
+    }
+    float Pdf(const Vec2& p) const {
+        return 4 *
+               ((1 - p.x) * (1 - p.y) * w_[0] + p.x * (1 - p.y) * w_[1] + (1 - p.x) * p.y * w_[2] +
+                p.x * p.y * w_[3]) /
+               (w_[0] + w_[1] + w_[2] + w_[3]);
+    }
+
+  private:
+    static float Lerp(float t, float a, float b) { return (1 - t) * a + t * b; }
+    // x in [0, 1) with density proportional to Lerp(x, a, b) (a, b > 0).
+    static float SampleLinear(float u, float a, float b) {
+        const float x = u * (a + b) / (a + std::sqrt(Lerp(u, a * a, b * b)));
+        return std::min(x, kOneMinusEpsilon);
+    }
+
+    float w_[4];
+};
 }  // namespace
 
 bool LightSampler::SunDisk::Contains(const Vec3& w) const {
@@ -239,13 +278,13 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, const Vec3& n, 
         ls.point.n = -ls.wi;
         return ls;
     }
-    std::optional<LightSample> ls = SampleArea(light, ref, u);
+    std::optional<LightSample> ls = SampleArea(light, ref, n, u);
     if (ls) ls->pdf *= pick;
     return ls;
 }
 
 std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Vec3& ref,
-                                                    const Vec2& u) const {
+                                                    const Vec3& n, const Vec2& u) const {
     const Scene& scene = scene_.scene();
     const bool bvh = strategy_ == LightStrategy::kBvh;
     LightSample ls;
@@ -256,9 +295,15 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
         scene_.Triangle(light.index, light.primitive, &p0, &p1, &p2);
         const SphericalTriangle st(ref, p0, p1, p2);
         if (bvh && st.samplable()) {
-            const Vec2 b = Barycentrics(st.Sample(u).point, p0, p1, p2);
-            ls.point = scene_.TrianglePoint(light.index, light.primitive, b.x, b.y);
+            Vec2 uw = u;
             solid_angle_pdf = st.Pdf();
+            if (n != Vec3(0, 0, 0)) {
+                const CosineWarp warp(ref, n, p0, p1, p2);
+                uw = warp.Sample(u);
+                solid_angle_pdf *= warp.Pdf(uw);
+            }
+            const Vec2 b = Barycentrics(st.Sample(uw).point, p0, p1, p2);
+            ls.point = scene_.TrianglePoint(light.index, light.primitive, b.x, b.y);
         } else {
             // Uniform on the triangle (Osada et al. square-root parameterisation).
             const float su = std::sqrt(u.x);
@@ -294,7 +339,8 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
     return ls;
 }
 
-float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const SurfaceHit& hit) const {
+float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const Vec3& n,
+                            const SurfaceHit& hit) const {
     if (strategy_ == LightStrategy::kBvh) {
         if (light.kind == Kind::kSphere) {
             return SphereConePdf(ref, scene_.SphereCenter(light.index),
@@ -303,7 +349,10 @@ float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const SurfaceHi
         Vec3 p0, p1, p2;
         scene_.Triangle(light.index, light.primitive, &p0, &p1, &p2);
         const SphericalTriangle st(ref, p0, p1, p2);
-        if (st.samplable()) return st.Pdf();
+        if (st.samplable()) {
+            if (n == Vec3(0, 0, 0)) return st.Pdf();
+            return st.Pdf() * CosineWarp(ref, n, p0, p1, p2).Pdf(st.Invert(Normalize(hit.p - ref)));
+        }
     }
     const Vec3 d = hit.p - ref;
     const float dist2 = LengthSquared(d);
@@ -382,7 +431,7 @@ float LightSampler::Pdf(const Vec3& ref, const Vec3& n, const SurfaceHit& hit) c
     const float pick =
         strategy_ == LightStrategy::kBvh ? finite_pmf_ * bvh_.Pmf(ref, n, li) : pmf_[size_t(li)];
     if (!(pick > 0)) return 0;
-    return pick * AreaPdf(lights_[size_t(li)], ref, hit);
+    return pick * AreaPdf(lights_[size_t(li)], ref, n, hit);
 }
 
 Rgb LightSampler::EscapedRadiance(const Vec3& w) const {

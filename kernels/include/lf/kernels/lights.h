@@ -11,10 +11,11 @@
 //   probabilities (as one group, so EscapedPdf is the same under both strategies), and the
 //   finite lights (triangles, spheres, point and spot lights) share the rest, chosen among by a
 //   light BVH (lf/kernels/light_bvh.h) by their importance at the shading point and normal.
-//   Triangles that subtend a solid angle worth it are sampled uniformly in it (spherical
-//   triangles, lf/kernels/spherical_triangle.h), the others by area; spheres within their
-//   visible cone (lf/kernels/sphere_cone_sampling.h). Pdf takes the same decisions, which
-//   depend only on the reference point, its normal and the light.
+//   Triangles that subtend a solid angle worth it are sampled in it (spherical triangles,
+//   lf/kernels/spherical_triangle.h; warped by the receiver's cosine as in pbrt-v4 when there
+//   is a normal), the others by area; spheres within their visible cone
+//   (lf/kernels/sphere_cone_sampling.h). Pdf takes the same decisions, which depend only on
+//   the reference point, its normal and the light.
 #pragma once
 
 #include <optional>
@@ -93,10 +94,12 @@ class LightSampler {
 
     int LightIndex(const SurfaceHit& hit) const;
     // A point on area light `light` (triangle or sphere) for u, with its density per solid
-    // angle at ref, not yet times the pick probability.
-    std::optional<LightSample> SampleArea(const Light& light, const Vec3& ref, const Vec2& u) const;
+    // angle at ref (normal n, for the cosine warp of large triangles), not yet times the pick
+    // probability.
+    std::optional<LightSample> SampleArea(const Light& light, const Vec3& ref, const Vec3& n,
+                                          const Vec2& u) const;
     // The density with which SampleArea yields `hit` on area light `light` from ref.
-    float AreaPdf(const Light& light, const Vec3& ref, const SurfaceHit& hit) const;
+    float AreaPdf(const Light& light, const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;
     std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref) const;
     // A direction towards a sun disk (uniform in its cone) or the environment (by its map).
     std::optional<Vec3> SampleInfiniteDirection(const Light& light, const Vec2& u) const;
