@@ -1,4 +1,5 @@
-// Direct-lighting error (light reflected once, emitters seen directly left out) of the two light
+// Direct-lighting error (light reflected once, emitters seen directly left out; --bounces -1 for
+// full paths) of the two light
 // strategies (LightStrategy::kPower: picks by power, area sampling; kBvh: light BVH, spherical
 // triangles, sphere cones) on the Cornell box and on a scene with many small emitters at
 // different distances, against a high-sample reference
@@ -8,7 +9,7 @@
 // RMSE falls as 1 / sqrt(samples).
 //
 //   light_sampling_bench [--emitters 1000] [--spp 4,16,64] [--reference-spp 1024]
-//                        [--resolution 64] [--threads 0]
+//                        [--bounces 1] [--resolution 64] [--threads 0]
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -63,10 +64,10 @@ lf::Scene ManyEmitters(int count, int resolution) {
     return scene;
 }
 
-// The light reflected once from what each pixel sees, R, G, B per pixel: a one-bounce render
+// The light reflected from what each pixel sees, R, G, B per pixel: a render of `bounces` bounces
 // minus a render of emission alone from the same camera samples (same seed), so that emitters
 // seen directly, whose edges alias alike under either strategy, do not swamp the comparison.
-// `seconds`: the one-bounce render's wall time.
+// `seconds`: the first render's wall time.
 struct DirectLight {
     std::vector<double> rgb;
     double seconds = 0;
@@ -87,11 +88,11 @@ lf::Image RenderDepth(const lf::EmbreeScene& es, const lf::Camera& camera,
 }
 
 DirectLight Render(const lf::EmbreeScene& es, const lf::Camera& camera, lf::LightStrategy strategy,
-                   uint64_t spp, uint64_t seed, int threads) {
+                   int bounces, uint64_t spp, uint64_t seed, int threads) {
     DirectLight direct;
     double emission_seconds = 0;
     const lf::Image bounce =
-        RenderDepth(es, camera, strategy, 1, spp, seed, threads, &direct.seconds);
+        RenderDepth(es, camera, strategy, bounces, spp, seed, threads, &direct.seconds);
     const lf::Image emission =
         RenderDepth(es, camera, strategy, 0, spp, seed, threads, &emission_seconds);
     for (const char* c : {"R", "G", "B"}) {
@@ -112,8 +113,14 @@ double RelativeRmse(const std::vector<double>& a, const std::vector<double>& b) 
     return std::sqrt(squared / double(a.size())) / (sum / double(a.size()));
 }
 
-int Bench(const std::string& name, const lf::Scene& scene, const std::vector<uint64_t>& spps,
-          uint64_t reference_spp, int threads) {
+struct Options {
+    std::vector<uint64_t> spps = {4, 16, 64};
+    uint64_t reference_spp = 1024;
+    int bounces = 1;
+    int threads = 0;
+};
+
+int Bench(const std::string& name, const lf::Scene& scene, const Options& o) {
     auto es = lf::EmbreeScene::Build(scene);
     if (!es.ok()) {
         std::fprintf(stderr, "%s: %s\n", name.c_str(), es.status().ToString().c_str());
@@ -121,14 +128,16 @@ int Bench(const std::string& name, const lf::Scene& scene, const std::vector<uin
     }
     const lf::Camera camera(scene.camera, (*es)->origin());
     const DirectLight reference =
-        Render(**es, camera, lf::LightStrategy::kBvh, reference_spp, 12345, threads);
+        Render(**es, camera, lf::LightStrategy::kBvh, o.bounces, o.reference_spp, 12345, o.threads);
     std::printf("%s: %d x %d, reference %lu spp (kBvh) in %.2f s\n", name.c_str(),
-                scene.camera.width, scene.camera.height, reference_spp, reference.seconds);
+                scene.camera.width, scene.camera.height, o.reference_spp, reference.seconds);
     std::printf("  %6s %8s %9s %9s %14s\n", "spp", "strategy", "seconds", "rel RMSE",
                 "RMSE@t(power)");
-    for (uint64_t spp : spps) {
-        const DirectLight power = Render(**es, camera, lf::LightStrategy::kPower, spp, 1, threads);
-        const DirectLight bvh = Render(**es, camera, lf::LightStrategy::kBvh, spp, 1, threads);
+    for (uint64_t spp : o.spps) {
+        const DirectLight power =
+            Render(**es, camera, lf::LightStrategy::kPower, o.bounces, spp, 1, o.threads);
+        const DirectLight bvh =
+            Render(**es, camera, lf::LightStrategy::kBvh, o.bounces, spp, 1, o.threads);
         const double e_power = RelativeRmse(power.rgb, reference.rgb);
         const double e_bvh = RelativeRmse(bvh.rgb, reference.rgb);
         std::printf("  %6lu %8s %9.3f %9.4f %14.4f\n", spp, "power", power.seconds, e_power,
@@ -147,18 +156,18 @@ int main(int argc, char** argv) {
     CLI::App app("Direct-lighting RMSE of the power and light-BVH light strategies");
     std::string cornell = std::string(LF_SOURCE_DIR) + "/tests/scenes/cornell_box.json";
     int emitters = 1000;
-    std::vector<uint64_t> spps = {4, 16, 64};
-    uint64_t reference_spp = 1024;
     int resolution = 64;
-    int threads = 0;
+    Options o;
     app.add_option("--cornell", cornell, "Cornell box scene file");
     app.add_option("--emitters", emitters, "small emitters in the many-lights scene")
         ->check(CLI::Range(1, 1000000));
-    app.add_option("--spp", spps, "sample counts to compare")->delimiter(',');
-    app.add_option("--reference-spp", reference_spp, "samples per pixel of the reference")
+    app.add_option("--spp", o.spps, "sample counts to compare")->delimiter(',');
+    app.add_option("--reference-spp", o.reference_spp, "samples per pixel of the reference")
         ->check(CLI::PositiveNumber);
+    app.add_option("--bounces", o.bounces, "1: direct light; -1: full paths")
+        ->check(CLI::Range(-1, 1000));
     app.add_option("--resolution", resolution, "image size")->check(CLI::Range(1, 4096));
-    app.add_option("--threads", threads, "0: all cores");
+    app.add_option("--threads", o.threads, "0: all cores");
     CLI11_PARSE(app, argc, argv);
 
     auto box = lf::LoadScene(cornell);
@@ -167,7 +176,6 @@ int main(int argc, char** argv) {
         return 1;
     }
     box->camera.width = box->camera.height = resolution;
-    if (Bench("cornell box", *box, spps, reference_spp, threads) != 0) return 1;
-    return Bench(std::to_string(emitters) + " emitters", ManyEmitters(emitters, resolution), spps,
-                 reference_spp, threads);
+    if (Bench("cornell box", *box, o) != 0) return 1;
+    return Bench(std::to_string(emitters) + " emitters", ManyEmitters(emitters, resolution), o);
 }
