@@ -53,23 +53,6 @@ double SpotSolidAngle(const SpotLight& spot) {
 // The largest float below 1, for mapping [0, 1) onto itself after a division.
 constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 
-// Barycentrics (b1, b2) of x, a point on (or, by rounding, next to) the triangle p0 p1 p2, clamped
-// into it.
-Vec2 Barycentrics(const Vec3& x, const Vec3& p0, const Vec3& p1, const Vec3& p2) {
-    const Vec3d e1 = Vec3d(p1) - Vec3d(p0), e2 = Vec3d(p2) - Vec3d(p0), q = Vec3d(x) - Vec3d(p0);
-    const double d11 = Dot(e1, e1), d12 = Dot(e1, e2), d22 = Dot(e2, e2);
-    const double q1 = Dot(q, e1), q2 = Dot(q, e2);
-    const double det = d11 * d22 - d12 * d12;
-    double b1 = std::max(0.0, (d22 * q1 - d12 * q2) / det);
-    double b2 = std::max(0.0, (d11 * q2 - d12 * q1) / det);
-    if (b1 + b2 > 1) {
-        const double sum = b1 + b2;
-        b1 /= sum;
-        b2 /= sum;
-    }
-    return Vec2(float(b1), float(b2));
-}
-
 // pbrt-v4's warp of a spherical triangle's sample space towards the receiver's cosine: a
 // bilinear density over [0, 1]^2 whose corners carry |cos| at the vertex they map to (u = (0, y)
 // and (1, 0) map to b, (0, 1) to a, (1, 1) to c; at least 0.01 so no part is left unsampled).
@@ -302,7 +285,7 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
                 uw = warp.Sample(u);
                 solid_angle_pdf *= warp.Pdf(uw);
             }
-            const Vec2 b = Barycentrics(st.Sample(uw).point, p0, p1, p2);
+            const Vec2 b = st.Sample(uw).b;
             ls.point = scene_.TrianglePoint(light.index, light.primitive, b.x, b.y);
         } else {
             // Uniform on the triangle (Osada et al. square-root parameterisation).

@@ -2,17 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+#include <limits>
 
 namespace lf {
 namespace {
-
-// Angle between unit vectors, accurate near 0 and pi where acos(dot) is not.
-double AngleBetween(const Vec3d& v1, const Vec3d& v2) {
-    if (Dot(v1, v2) < 0)
-        return std::numbers::pi - 2 * std::asin(std::min(1.0, Length(v1 + v2) / 2));
-    return 2 * std::asin(std::min(1.0, Length(v2 - v1) / 2));
-}
 
 // Van Oosterom & Strackee: tan(omega / 2) = |a.(b x c)| / (|a||b||c| + (a.b)|c| + (a.c)|b| +
 // (b.c)|a|) for the vectors from the viewpoint to the vertices. atan2 keeps the quadrant, so
@@ -23,6 +16,30 @@ double SolidAngle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
     if (numerator == 0 || la == 0 || lb == 0 || lc == 0) return 0;
     const double denominator = la * lb * lc + Dot(a, b) * lc + Dot(a, c) * lb + Dot(b, c) * la;
     return 2 * std::atan2(numerator, denominator);
+}
+
+// The same for unit vectors, whose lengths need not be computed.
+double UnitSolidAngle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    const double numerator = std::abs(Dot(a, Cross(b, c)));
+    if (numerator == 0) return 0;
+    return 2 * std::atan2(numerator, 1 + Dot(a, b) + Dot(a, c) + Dot(b, c));
+}
+
+// An upper bound on the solid angle of the triangle d0 d1 d2 (vertices relative to the viewpoint)
+// from its area A, its plane's distance h and a lower bound r_min on the distance to any of its
+// points: the solid angle is the integral of cos / r^2 = h / r^3 over the triangle, at most
+// A min(1 / r_min^2, h / r_min^3). Infinite when the viewpoint may be within the triangle's
+// bounding sphere. Costs two square roots and no trigonometry, so far triangles skip the rest.
+double SolidAngleBound(const Vec3d& d0, const Vec3d& d1, const Vec3d& d2) {
+    const Vec3d centroid = (d0 + d1 + d2) / 3.0;
+    const double radius =
+        std::sqrt(std::max({LengthSquared(d0 - centroid), LengthSquared(d1 - centroid),
+                            LengthSquared(d2 - centroid)}));
+    const double r_min = Length(centroid) - radius;
+    if (!(r_min > 0)) return std::numeric_limits<double>::infinity();
+    const Vec3d normal = Cross(d1 - d0, d2 - d0);  // |normal| = 2 A
+    const double r2 = r_min * r_min;
+    return 0.5 * std::min(Length(normal) / r2, std::abs(Dot(normal, d0)) / (r2 * r_min));
 }
 
 // The component of v orthogonal to the unit vector w, normalised.
@@ -37,27 +54,39 @@ float TriangleSolidAngle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Ve
 
 SphericalTriangle::SphericalTriangle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Vec3& v2)
     : p_(p), v0_(v0), v1_(v1), v2_(v2) {
-    solid_angle_ = SolidAngle(v0_ - p_, v1_ - p_, v2_ - p_);
+    const Vec3d d0 = v0_ - p_, d1 = v1_ - p_, d2 = v2_ - p_;
+    // Half the threshold leaves room for the rounding of the exact solid angle below, so the bound
+    // only ever skips triangles that the exact test would reject too.
+    if (SolidAngleBound(d0, d1, d2) < 0.5 * kMinSphericalTriangleSolidAngle) return;
+    const double l0 = Length(d0), l1 = Length(d1), l2 = Length(d2);
+    if (l0 == 0 || l1 == 0 || l2 == 0) return;
+    a_ = d0 / l0;
+    b_ = d1 / l1;
+    c_ = d2 / l2;
+    solid_angle_ = UnitSolidAngle(a_, b_, c_);
     if (!(solid_angle_ >= kMinSphericalTriangleSolidAngle &&
           solid_angle_ <= kMaxSphericalTriangleSolidAngle)) {
         return;
     }
-    a_ = Normalize(v0_ - p_);
-    b_ = Normalize(v1_ - p_);
-    c_ = Normalize(v2_ - p_);
-    const Vec3d n_ab = Cross(a_, b_), n_ca = Cross(c_, a_);
-    if (LengthSquared(n_ab) == 0 || LengthSquared(n_ca) == 0) return;
-    // The angle at a between the great circles a-b and a-c.
-    alpha_ = AngleBetween(Normalize(n_ab), -Normalize(n_ca));
-    samplable_ = std::sin(alpha_) > 0;
+    // alpha is the angle between the planes through a, b and a, c: cos alpha is the cosine of
+    // their normals, and |(a x b) x (a x c)| = |a . (b x c)| gives its sine without acos/asin.
+    const Vec3d n_ab = Cross(a_, b_), n_ac = Cross(a_, c_);
+    const double norms = Length(n_ab) * Length(n_ac);
+    if (norms == 0) return;
+    cos_alpha_ = std::clamp(Dot(n_ab, n_ac) / norms, -1.0, 1.0);
+    sin_alpha_ = std::abs(Dot(a_, Cross(b_, c_))) / norms;
+    samplable_ = sin_alpha_ > 0;
 }
 
 SphericalTriangleSample SphericalTriangle::Sample(const Vec2& u) const {
     // Arvo's first step: the sub-triangle a b c' of area u0 * A, with c' on the arc a-c, from
     // the spherical law of cosines; q = cos of the arc a-c'.
     const double area = u.x * solid_angle_;
-    const double s = std::sin(area - alpha_), t = std::cos(area - alpha_);
-    const double cos_alpha = std::cos(alpha_), sin_alpha = std::sin(alpha_);
+    const double sin_area = std::sin(area), cos_area = std::cos(area);
+    const double cos_alpha = cos_alpha_, sin_alpha = sin_alpha_;
+    // s and t are the sine and cosine of area - alpha.
+    const double s = sin_area * cos_alpha - cos_area * sin_alpha;
+    const double t = cos_area * cos_alpha + sin_area * sin_alpha;
     const double k1 = t - cos_alpha;
     const double k2 = s + sin_alpha * Dot(a_, b_);
     const double q = std::clamp(
@@ -85,7 +114,7 @@ SphericalTriangleSample SphericalTriangle::Sample(const Vec2& u) const {
         }
     }
     const Vec3d point = v0_ + e1 * b1 + e2 * b2;
-    return {Normalize(Vec3(w)), Vec3(point), float(1 / solid_angle_)};
+    return {Normalize(Vec3(w)), Vec3(point), Vec2(float(b1), float(b2)), float(1 / solid_angle_)};
 }
 
 Vec2 SphericalTriangle::Invert(const Vec3& wi) const {
@@ -95,7 +124,7 @@ Vec2 SphericalTriangle::Invert(const Vec3& wi) const {
     if (LengthSquared(bw) == 0) return {0.5f, 0.0f};  // w == b: every u0 maps there
     Vec3d c_prime = Normalize(Cross(bw, Cross(c_, a_)));
     if (Dot(c_prime, a_ + c_) < 0) c_prime = -c_prime;
-    const double u0 = SolidAngle(a_, b_, c_prime) / solid_angle_;
+    const double u0 = UnitSolidAngle(a_, b_, c_prime) / solid_angle_;
     const double one_minus_cos = 1 - Dot(c_prime, b_);
     const double u1 = one_minus_cos > 0 ? (1 - Dot(w, b_)) / one_minus_cos : 0;
     return {float(std::clamp(u0, 0.0, 1.0)), float(std::clamp(u1, 0.0, 1.0))};

@@ -33,11 +33,14 @@ float TriangleSolidAngle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Ve
 struct SphericalTriangleSample {
     Vec3 wi;        // unit, from the reference point towards the triangle
     Vec3 point;     // where the ray p + t * wi meets the triangle
+    Vec2 b;         // its barycentrics (b1, b2): point = v0 + b1 (v1 - v0) + b2 (v2 - v0)
     float pdf = 0;  // per unit solid angle at p: 1 / solid angle
 };
 
 // The triangle projected on the unit sphere about p. Computed in double internally: Arvo's
-// formulas subtract nearly equal cosines when the triangle is small.
+// formulas subtract nearly equal cosines when the triangle is small. Construction is cheap for
+// triangles that are far away (a conservative bound rules them out before any trigonometry), as
+// it runs once per light sample and per MIS weight.
 class SphericalTriangle {
   public:
     SphericalTriangle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Vec3& v2);
@@ -57,8 +60,9 @@ class SphericalTriangle {
 
   private:
     Vec3d p_, v0_, v1_, v2_;
-    Vec3d a_, b_, c_;   // unit directions from p to v0, v1, v2
-    double alpha_ = 0;  // spherical angle at a
+    Vec3d a_, b_, c_;  // unit directions from p to v0, v1, v2
+    // The spherical angle alpha at a, kept as its cosine and sine: Sample needs only those.
+    double cos_alpha_ = 1, sin_alpha_ = 0;
     double solid_angle_ = 0;
     bool samplable_ = false;
 };
