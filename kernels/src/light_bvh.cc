@@ -175,7 +175,9 @@ std::optional<LightPick> LightBvh::Descend(const Vec3& p, const Vec3& n, Choose&
         index = children[size_t(child)];
     }
     const Node& leaf = nodes_[index];
-    if (leaf.bounds.Importance(p, n) == 0) return std::nullopt;  // a single light out of reach
+    // Below the root, p_child > 0 already said the leaf's importance is positive; a root leaf (a
+    // single light) may still be out of reach.
+    if (index == 0 && leaf.bounds.Importance(p, n) == 0) return std::nullopt;
     return LightPick{int(leaf.child_or_light), pmf};
 }
 
