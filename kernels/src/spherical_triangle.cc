@@ -28,8 +28,9 @@ double UnitSolidAngle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
 // An upper bound on the solid angle of the triangle d0 d1 d2 (vertices relative to the viewpoint)
 // from its area A, its plane's distance h and a lower bound r_min on the distance to any of its
 // points: the solid angle is the integral of cos / r^2 = h / r^3 over the triangle, at most
-// A min(1 / r_min^2, h / r_min^3). Infinite when the viewpoint may be within the triangle's
-// bounding sphere. Costs two square roots and no trigonometry, so far triangles skip the rest.
+// A h / r_min^3 = |N . d0| / (2 r_min^3) for the normal N = (d1 - d0) x (d2 - d0). Infinite when
+// the viewpoint may be within the triangle's bounding sphere. Costs two square roots and no
+// trigonometry, so far triangles skip the rest.
 double SolidAngleBound(const Vec3d& d0, const Vec3d& d1, const Vec3d& d2) {
     const Vec3d centroid = (d0 + d1 + d2) / 3.0;
     const double radius =
@@ -37,9 +38,7 @@ double SolidAngleBound(const Vec3d& d0, const Vec3d& d1, const Vec3d& d2) {
                             LengthSquared(d2 - centroid)}));
     const double r_min = Length(centroid) - radius;
     if (!(r_min > 0)) return std::numeric_limits<double>::infinity();
-    const Vec3d normal = Cross(d1 - d0, d2 - d0);  // |normal| = 2 A
-    const double r2 = r_min * r_min;
-    return 0.5 * std::min(Length(normal) / r2, std::abs(Dot(normal, d0)) / (r2 * r_min));
+    return 0.5 * std::abs(Dot(Cross(d1 - d0, d2 - d0), d0)) / (r_min * r_min * r_min);
 }
 
 // The component of v orthogonal to the unit vector w, normalised.
@@ -71,7 +70,7 @@ SphericalTriangle::SphericalTriangle(const Vec3& p, const Vec3& v0, const Vec3& 
     // alpha is the angle between the planes through a, b and a, c: cos alpha is the cosine of
     // their normals, and |(a x b) x (a x c)| = |a . (b x c)| gives its sine without acos/asin.
     const Vec3d n_ab = Cross(a_, b_), n_ac = Cross(a_, c_);
-    const double norms = Length(n_ab) * Length(n_ac);
+    const double norms = std::sqrt(LengthSquared(n_ab) * LengthSquared(n_ac));
     if (norms == 0) return;
     cos_alpha_ = std::clamp(Dot(n_ab, n_ac) / norms, -1.0, 1.0);
     sin_alpha_ = std::abs(Dot(a_, Cross(b_, c_))) / norms;

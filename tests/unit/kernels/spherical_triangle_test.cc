@@ -115,6 +115,33 @@ TEST(SphericalTriangleTest, DegenerateAndOutOfRangeAreLeftToAreaSampling) {
     expect_not_samplable(huge, "nearly a hemisphere");
 }
 
+// The cheap bound that lets far triangles skip the exact solid angle never changes the decision:
+// for random triangles seen from distances where their solid angles straddle the threshold,
+// samplable() is exactly "the solid angle is within [min, max]".
+TEST(SphericalTriangleTest, FarTriangleShortcutKeepsTheThreshold) {
+    int samplable = 0, small = 0;
+    for (int i = 0; i < 20000; ++i) {
+        Sampler sampler(7, i, 0, 0);
+        const auto point = [&sampler] {
+            return Vec3(sampler.Get1D(), sampler.Get1D(), sampler.Get1D()) * 2.0f - Vec3(1, 1, 1);
+        };
+        const Vec3 v0 = point(), v1 = point(), v2 = point();
+        // Distances from 1 to 1000 (log-uniform) in a random direction.
+        const float distance = std::pow(1000.0f, sampler.Get1D());
+        const Vec3 p = Normalize(point()) * distance;
+        const float omega = TriangleSolidAngle(p, v0, v1, v2);
+        // Leave out solid angles within rounding of the threshold, where float and double differ.
+        if (std::abs(omega / kMinSphericalTriangleSolidAngle - 1) < 1e-4f) continue;
+        const bool in_range =
+            omega >= kMinSphericalTriangleSolidAngle && omega <= kMaxSphericalTriangleSolidAngle;
+        const SphericalTriangle st(p, v0, v1, v2);
+        EXPECT_EQ(st.samplable(), in_range) << "case " << i << " solid angle " << omega;
+        (in_range ? samplable : small) += 1;
+    }
+    EXPECT_GT(samplable, 1000);
+    EXPECT_GT(small, 1000);
+}
+
 // The barycentrics (of v1, v2) where the ray p + t w meets the triangle's plane (Moller-Trumbore
 // in double), if it meets it in front of p.
 std::optional<std::array<double, 2>> HitBarycentrics(const TriangleCase& c, const Vec3& wi) {
