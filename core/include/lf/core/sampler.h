@@ -1,9 +1,11 @@
-// Counter-based random numbers: every value is a pure function of (seed, pixel, sample index,
-// dimension), so any split of the work into tiles, passes or threads gives the same bits.
+// Counter-based sample values: every value is a pure function of (seed, pixel, sample index,
+// dimension), so any split of the work into tiles, passes or threads gives the same bits, and
+// samples [a, b) of a pixel continue its samples [0, a).
 #pragma once
 
 #include <cstdint>
 
+#include "lf/core/sobol.h"
 #include "lf/core/vec.h"
 
 namespace lf {
@@ -18,24 +20,58 @@ constexpr uint64_t MixBits(uint64_t v) {
     return v;
 }
 
+// How a pixel's samples are spread over the unit hypercube:
+//  - kIndependent: hashed independent uniform values; error falls as spp^-1/2.
+//  - kSobol: each Get1D/Get2D is its own shuffled, Owen-scrambled Sobol (0,2)-sequence
+//    (lf/core/sobol.h), independent across pixels and dimensions: the first 2^m samples of a
+//    pixel stratify every 2D projection a path asks for together, so smooth integrands
+//    converge faster than spp^-1/2 and the rest no slower.
+enum class SamplerType { kIndependent, kSobol };
+
 class Sampler {
   public:
-    Sampler(uint64_t seed, int px, int py, uint64_t sample_index)
-        : key_(MixBits(MixBits(seed ^ 0x9e3779b97f4a7c15ULL) ^
-                       ((uint64_t(uint32_t(px)) << 32) | uint32_t(py))) ^
-               MixBits(sample_index + 0x632be59bd9b4e019ULL)) {}
+    Sampler(uint64_t seed, int px, int py, uint64_t sample_index,
+            SamplerType type = SamplerType::kIndependent)
+        : pixel_key_(MixBits(MixBits(seed ^ 0x9e3779b97f4a7c15ULL) ^
+                             ((uint64_t(uint32_t(px)) << 32) | uint32_t(py)))),
+          key_(pixel_key_ ^ MixBits(sample_index + 0x632be59bd9b4e019ULL)),
+          sample_index_(uint32_t(sample_index)),
+          type_(type) {}
 
-    // Uniform in [0, 1), 24 random bits so the float is exact and never rounds up to 1.
-    float Get1D() { return float(Next() >> 40) * 0x1p-24f; }
+    // Uniform in [0, 1), 24 bits so the float is exact and never rounds up to 1.
+    float Get1D() {
+        if (type_ == SamplerType::kSobol) {
+            const uint64_t h = NextDimensionHash();
+            const uint32_t index = NestedUniformScramble(sample_index_, uint32_t(h));
+            return ToFloat(NestedUniformScramble(SobolDimension0(index), uint32_t(h >> 32)));
+        }
+        return float(Next() >> 40) * 0x1p-24f;
+    }
     Vec2 Get2D() {
+        if (type_ == SamplerType::kSobol) {
+            const uint64_t h = NextDimensionHash();
+            const uint32_t index = NestedUniformScramble(sample_index_, uint32_t(h));
+            const uint64_t h2 = MixBits(h);
+            return {ToFloat(NestedUniformScramble(SobolDimension0(index), uint32_t(h >> 32))),
+                    ToFloat(NestedUniformScramble(SobolDimension1(index), uint32_t(h2)))};
+        }
         const uint64_t bits = Next();
         return {float(bits >> 40) * 0x1p-24f, float((bits >> 8) & 0xffffff) * 0x1p-24f};
     }
 
   private:
-    uint64_t Next() { return MixBits(key_ + (++dimension_) * 0x9e3779b97f4a7c15ULL); }
+    static constexpr uint64_t kGolden = 0x9e3779b97f4a7c15ULL;
 
+    uint64_t Next() { return MixBits(key_ + (++dimension_) * kGolden); }
+    // The seeds of one Get1D/Get2D of this pixel: the same for all its samples, so they share
+    // one scrambled sequence.
+    uint64_t NextDimensionHash() { return MixBits(pixel_key_ + (++dimension_) * kGolden); }
+    static float ToFloat(uint32_t fixed) { return float(fixed >> 8) * 0x1p-24f; }
+
+    uint64_t pixel_key_;
     uint64_t key_;
+    uint32_t sample_index_;
+    SamplerType type_;
     uint64_t dimension_ = 0;
 };
 
