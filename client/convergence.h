@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,9 @@ struct ConvergenceRow {
     int64_t budget = 0;  // spp or patches
     double seconds = 0;
     ImageError error;
+    // The image's own estimate of its relmse from its A/B halves (lf::EstimatedRelMse), to
+    // compare with `error.relmse`; path images of 2 spp or more only.
+    std::optional<double> estimated_relmse;
 };
 
 struct ConvergenceResult {
@@ -50,5 +54,8 @@ struct ConvergenceResult {
 };
 
 absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& options);
+
+// The row's estimated_relmse as a CSV field: "" when there is none.
+std::string EstimatedRelMseField(const ConvergenceRow& row);
 
 }  // namespace lf

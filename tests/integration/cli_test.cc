@@ -250,7 +250,7 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     std::ifstream csv(out / "convergence.csv");
     std::string line;
     ASSERT_TRUE(std::getline(csv, line));
-    EXPECT_EQ(line, "method,budget,seconds,rmse,relmse,smape");
+    EXPECT_EQ(line, "method,budget,seconds,rmse,relmse,smape,estimated_relmse");
     std::vector<std::string> rows;
     while (std::getline(csv, line)) rows.push_back(line);
     // spp 1, 2, 4 and patch targets 100, 200.
