@@ -258,9 +258,13 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     EXPECT_EQ(rows[0].rfind("path,1,", 0), 0u) << rows[0];
     EXPECT_EQ(rows[3].rfind("radiosity,", 0), 0u) << rows[3];
     for (const std::string& row : rows) {
-        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 5) << row;
+        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 6) << row;
         EXPECT_EQ(row.find("nan"), std::string::npos) << row;
     }
+    // The image's own estimate from 2 spp on, for path rows only.
+    EXPECT_EQ(rows[0].back(), ',') << rows[0];
+    EXPECT_NE(rows[1].back(), ',') << rows[1];
+    EXPECT_EQ(rows[3].back(), ',') << rows[3];
     EXPECT_GT(fs::file_size(out / "convergence.png"), 1000u);
 
     // Radiosity's refusal comes before any rendering.
