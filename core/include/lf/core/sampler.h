@@ -23,9 +23,12 @@ constexpr uint64_t MixBits(uint64_t v) {
 // How a pixel's samples are spread over the unit hypercube:
 //  - kIndependent: hashed independent uniform values; error falls as spp^-1/2.
 //  - kSobol: each Get1D/Get2D is its own shuffled, Owen-scrambled Sobol (0,2)-sequence
-//    (lf/core/sobol.h), independent across pixels and dimensions: the first 2^m samples of a
-//    pixel stratify every 2D projection a path asks for together, so smooth integrands
-//    converge faster than spp^-1/2 and the rest no slower.
+//    (lf/core/sobol.h), independent across pixels and dimensions, so every 2D projection a
+//    path asks for is stratified and smooth integrands converge faster than spp^-1/2.
+//    Even and odd samples are two independent such sequences (sample s is point s/2 of
+//    sequence s%2): the image's A and B halves (lf::PixelSums) are then independent
+//    randomised-QMC estimates, and their difference stays an honest error estimate, which it
+//    would not be if the halves were two correlated parts of one net.
 enum class SamplerType { kIndependent, kSobol };
 
 class Sampler {
@@ -35,14 +38,15 @@ class Sampler {
         : pixel_key_(MixBits(MixBits(seed ^ 0x9e3779b97f4a7c15ULL) ^
                              ((uint64_t(uint32_t(px)) << 32) | uint32_t(py)))),
           key_(pixel_key_ ^ MixBits(sample_index + 0x632be59bd9b4e019ULL)),
-          sample_index_(uint32_t(sample_index)),
+          sobol_key_(MixBits(pixel_key_ ^ (sample_index & 1))),
+          sobol_index_(uint32_t(sample_index >> 1)),
           type_(type) {}
 
     // Uniform in [0, 1), 24 bits so the float is exact and never rounds up to 1.
     float Get1D() {
         if (type_ == SamplerType::kSobol) {
             const uint64_t h = NextDimensionHash();
-            const uint32_t index = NestedUniformScramble(sample_index_, uint32_t(h));
+            const uint32_t index = NestedUniformScramble(sobol_index_, uint32_t(h));
             return ToFloat(NestedUniformScramble(SobolDimension0(index), uint32_t(h >> 32)));
         }
         return float(Next() >> 40) * 0x1p-24f;
@@ -50,7 +54,7 @@ class Sampler {
     Vec2 Get2D() {
         if (type_ == SamplerType::kSobol) {
             const uint64_t h = NextDimensionHash();
-            const uint32_t index = NestedUniformScramble(sample_index_, uint32_t(h));
+            const uint32_t index = NestedUniformScramble(sobol_index_, uint32_t(h));
             const uint64_t h2 = MixBits(h);
             return {ToFloat(NestedUniformScramble(SobolDimension0(index), uint32_t(h >> 32))),
                     ToFloat(NestedUniformScramble(SobolDimension1(index), uint32_t(h2)))};
@@ -63,14 +67,15 @@ class Sampler {
     static constexpr uint64_t kGolden = 0x9e3779b97f4a7c15ULL;
 
     uint64_t Next() { return MixBits(key_ + (++dimension_) * kGolden); }
-    // The seeds of one Get1D/Get2D of this pixel: the same for all its samples, so they share
-    // one scrambled sequence.
-    uint64_t NextDimensionHash() { return MixBits(pixel_key_ + (++dimension_) * kGolden); }
+    // The seeds of one Get1D/Get2D of this pixel and half: the same for all its samples, so
+    // they share one scrambled sequence.
+    uint64_t NextDimensionHash() { return MixBits(sobol_key_ + (++dimension_) * kGolden); }
     static float ToFloat(uint32_t fixed) { return float(fixed >> 8) * 0x1p-24f; }
 
     uint64_t pixel_key_;
     uint64_t key_;
-    uint32_t sample_index_;
+    uint64_t sobol_key_;    // the pixel's and the sample's half
+    uint32_t sobol_index_;  // the sample's index within its half
     SamplerType type_;
     uint64_t dimension_ = 0;
 };
