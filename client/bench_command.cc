@@ -18,6 +18,7 @@ Command AddBenchCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(1, 1024));
     AddCameraFlag(cmd, options->scene);
+    AddFilterFlag(cmd, options->scene);
     AddResolutionFlag(cmd, options->scene, &options->resolution, 65536,
                       "image size WxH, or N for a square N x N (0 = the scene's; default 256)");
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")

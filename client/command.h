@@ -18,10 +18,6 @@ struct Command {
 // Prints "lightfarm: error: <message>" and returns 1.
 int ReportError(const absl::Status& status);
 
-// InvalidArgument unless `path` ends in .exr: images are written as OpenEXR, and EXR bytes in a
-// file named .png would be taken for a broken PNG.
-absl::Status CheckExrPath(const std::string& path);
-
 Command AddRenderCommand(CLI::App& app);
 Command AddBenchCommand(CLI::App& app);
 Command AddConvergeCommand(CLI::App& app);

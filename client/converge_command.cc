@@ -30,6 +30,7 @@ Command AddConvergeCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::IsMember({"path", "radiosity", "both"}));
     AddCameraFlag(cmd, options->scene);
+    AddFilterFlag(cmd, options->scene);
     AddResolutionFlag(cmd, options->scene, &options->resolution, 16384,
                       "image size WxH, or N for width N with the scene's aspect (0 = the scene's)");
     cmd->add_option("--max-spp", options->max_spp, "largest spp of the path ladder")

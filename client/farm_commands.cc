@@ -15,6 +15,7 @@
 #include "absl/time/time.h"
 #include "adaptive_flags.h"
 #include "command.h"
+#include "lf/core/image_io.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
 #include "lf/job/job_spec.h"
@@ -22,9 +23,11 @@
 #include "lf/job/scene_files.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
+#include "output_flags.h"
 #include "progress_bar.h"
 #include "proto/grpc_status.h"
 #include "radiosity_flags.h"
+#include "sample_flags.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -356,6 +359,22 @@ absl::Status Fetch(const FarmFlags& flags, const std::string& id, const std::str
     return absl::OkStatus();
 }
 
+// The job's EXR at paths.exr, and its preview at paths.png, made here from the EXR (fetched into
+// a temporary file when -o names only the PNG).
+absl::Status FetchOutputs(const FarmFlags& flags, const std::string& id, const OutputPaths& paths,
+                          const PngOptions& preview_options, bool preview) {
+    if (absl::Status s = CheckWritable(paths.png); !s.ok()) return s;
+    const std::string exr = paths.exr.empty() ? paths.png + ".exr.part" : paths.exr;
+    if (absl::Status s = Fetch(flags, id, exr, preview); !s.ok()) return s;
+    if (paths.png.empty()) return absl::OkStatus();
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    absl::Status written =
+        file.ok() ? WritePng(paths.png, file->image, preview_options) : file.status();
+    std::error_code ignored;  // a temporary file left behind is harmless
+    if (paths.exr.empty()) fs::remove(exr, ignored);
+    return written;
+}
+
 }  // namespace
 
 Command AddSubmitCommand(CLI::App& app) {
@@ -388,6 +407,7 @@ Command AddSubmitCommand(CLI::App& app) {
                     "sample passes per tile; each pass of each tile is one task")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxPasses));
+    AddSampleFlags(cmd, o->spec.clamp, o->spec.aovs);
     AddAdaptiveFlags(cmd, o->spec.adaptive);
     cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
@@ -493,22 +513,26 @@ Command AddWatchCommand(CLI::App& app) {
 Command AddFetchCommand(CLI::App& app) {
     auto flags = std::make_shared<FarmFlags>();
     auto id = std::make_shared<std::string>();
-    auto out = std::make_shared<std::string>();
+    auto output = std::make_shared<OutputFlags>();
     auto preview = std::make_shared<bool>(false);
     CLI::App* cmd = app.add_subcommand(
         "fetch",
-        "Download a job's OpenEXR result (the same channels and header as `lightfarm render`).");
+        "Download a job's OpenEXR result (the same channels and header as `lightfarm render`),\n"
+        "or its PNG preview (-o out.png, or --png beside the EXR), made here as `render` makes\n"
+        "it.");
     cmd->add_option("job", *id, "job id")->required();
-    cmd->add_option("-o,--output", *out, "output OpenEXR file")->required();
+    AddOutputFlags(cmd, *output);
     cmd->add_flag("--preview", *preview,
                   "a running job's tiles merged so far (unfinished tiles have fewer samples)");
     AddServerOption(cmd, *flags);
-    return {cmd, [flags, id, out, preview] {
-                if (absl::Status s = CheckExrPath(*out); !s.ok()) return ReportError(s);
-                if (absl::Status s = Fetch(*flags, *id, *out, *preview); !s.ok()) {
+    return {cmd, [flags, id, output, preview] {
+                absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
+                if (!paths.ok()) return ReportError(paths.status());
+                if (absl::Status s = FetchOutputs(*flags, *id, *paths, output->preview, *preview);
+                    !s.ok()) {
                     return ReportError(s);
                 }
-                std::printf("job %s -> %s\n", id->c_str(), out->c_str());
+                std::printf("job %s -> %s\n", id->c_str(), OutputNames(*paths).c_str());
                 return 0;
             }};
 }

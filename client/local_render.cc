@@ -1,44 +1,26 @@
 #include "local_render.h"
 
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "lf/core/aov.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/patch_mesh.h"
+#include "lf/core/pixel_filter.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
+#include "output_flags.h"
 #include "progress_bar.h"
 #include "radiosity_flags.h"
 
 namespace lf {
-
-namespace {
-
-// Fails before any rendering, so an hour of work is not lost to a typo in the output path.
-absl::Status CheckWritable(const std::string& path) {
-    if (path.empty()) return absl::OkStatus();
-    const bool existed = std::filesystem::exists(path);
-    std::ofstream probe(path, std::ios::app);
-    if (!probe) {
-        return absl::PermissionDeniedError(path + ": cannot write here: " + std::strerror(errno));
-    }
-    probe.close();
-    if (!existed) std::filesystem::remove(path);
-    return absl::OkStatus();
-}
-
-}  // namespace
 
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
                                          std::string* why) {
@@ -126,11 +108,15 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     } else {
         estimator = std::make_unique<PathTracer>(**embree, options.max_depth);
     }
-    log->info("job={} rendering {} ({}x{}, {} spp, seed {}, max depth {}, tile {})", job_id,
-              options.scene_path, camera.width(), camera.height(), options.render.spp,
-              options.render.seed,
-              options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
-              options.render.tile);
+    log->info(
+        "job={} rendering {} ({}x{}, {} spp, seed {}, max depth {}, tile {}, {} filter{}{})",
+        job_id, options.scene_path, camera.width(), camera.height(), options.render.spp,
+        options.render.seed,
+        options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
+        options.render.tile, DescribePixelFilter(scene->camera.filter),
+        options.render.clamp > 0 ? absl::StrCat(", clamp ", options.render.clamp, " (biased)")
+                                 : std::string(),
+        options.render.aovs != 0 ? ", AOVs " + AovListName(options.render.aovs) : std::string());
     const bool adaptive = options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
     if (adaptive) {
         log->info(
@@ -178,6 +164,9 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     metadata.spp = adaptive ? out->adaptive.max_spp : options.render.spp;
     metadata.seed = options.render.seed;
     metadata.max_depth = options.max_depth;
+    metadata.clamp = options.render.clamp;
+    metadata.aovs = options.render.aovs;
+    metadata.filter = scene->camera.filter;
     metadata.seconds = summary.seconds;
     metadata.stats = out->stats;
     metadata.adaptive_settings = options.adaptive;
@@ -203,10 +192,14 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
                 variance.mean_error, kHighVarianceMeanError);
         }
     }
-    const ExrAttributes& attributes = description->attributes;
-    if (absl::Status s = WriteExr(options.exr_path, out->image, attributes); !s.ok()) return s;
+    if (!options.exr_path.empty()) {
+        const ExrAttributes& attributes = description->attributes;
+        if (absl::Status s = WriteExr(options.exr_path, out->image, attributes); !s.ok()) return s;
+    }
     if (!options.png_path.empty()) {
-        if (absl::Status s = WritePng(options.png_path, out->image); !s.ok()) return s;
+        if (absl::Status s = WritePng(options.png_path, out->image, options.preview); !s.ok()) {
+            return s;
+        }
     }
     return summary;
 }

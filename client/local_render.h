@@ -6,6 +6,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "lf/core/image_io.h"
 #include "lf/core/scene.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/render_metadata.h"
@@ -17,12 +18,13 @@ namespace lf {
 
 struct LocalRenderOptions {
     std::string scene_path;
-    SceneOptions scene;  // --camera, --resolution
-    std::string exr_path;
+    SceneOptions scene;                      // --camera, --resolution, --filter
+    std::string exr_path;                    // empty: no EXR (-o out.png)
     std::string png_path;                    // empty: no preview
+    PngOptions preview;                      // --exposure, --tonemap
     std::string method = defaults::kMethod;  // path | radiosity | auto
-    RenderSettings render;
-    AdaptiveSettings adaptive;  // used when a target error or a time limit is set
+    RenderSettings render;                   // with --clamp and --aov
+    AdaptiveSettings adaptive;               // used when a target error or a time limit is set
     int max_depth = defaults::kMaxDepth;
     RadiositySettings radiosity;
     // Radiosity's files (RadiosityOptions): a solution to save or load, a PLY to export.

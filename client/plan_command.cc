@@ -21,6 +21,7 @@
 #include "lf/local/local_executor.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
+#include "sample_flags.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -36,6 +37,8 @@ struct PlanOptions {
     int64_t patches = defaults::kRadiosityPatches;
     int max_depth = defaults::kMaxDepth;
     int threads = 0;
+    double clamp =
+        0;  // --clamp: the pilot's noise, and so the samples, are those of a clamped render
 };
 
 std::string Color(const Rgb& c) { return absl::StrFormat("(%.3g, %.3g, %.3g)", c.r, c.g, c.b); }
@@ -256,6 +259,7 @@ absl::Status RunPlan(const PlanOptions& options) {
     RenderSettings settings;
     settings.spp = options.pilot_spp;
     settings.threads = options.threads;
+    settings.clamp = options.clamp;
     const AdaptiveSettings pilot_only{.target_error = options.target_error,
                                       .max_spp = options.pilot_spp};
     absl::StatusOr<RenderOutput> pilot = RenderImageAdaptive(camera, tracer, settings, pilot_only);
@@ -318,6 +322,7 @@ Command AddPlanCommand(CLI::App& app) {
     cmd->add_option("--threads", options->threads, "threads of the pilots; 0 = all cores")
         ->capture_default_str()
         ->check(CLI::Range(0, 1024));
+    AddClampFlag(cmd, options->clamp);
     return {cmd, [options] {
                 const absl::Status status = RunPlan(*options);
                 return status.ok() ? 0 : ReportError(status);

@@ -1,13 +1,12 @@
 #include <cstdio>
-#include <filesystem>
 
-#include "absl/strings/ascii.h"
-#include "absl/strings/str_cat.h"
 #include "adaptive_flags.h"
 #include "command.h"
 #include "lf/job/job_spec.h"
 #include "local_render.h"
+#include "output_flags.h"
 #include "radiosity_flags.h"
+#include "sample_flags.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -17,32 +16,24 @@ int ReportError(const absl::Status& status) {
     return 1;
 }
 
-absl::Status CheckExrPath(const std::string& path) {
-    const std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
-    if (ext == ".exr") return absl::OkStatus();
-    return absl::InvalidArgumentError(
-        absl::StrCat("-o ", path, ": the image is written as OpenEXR, so the name must end in .exr",
-                     ext == ".png" ? " (--png writes a preview PNG beside it)" : ""));
-}
-
 Command AddRenderCommand(CLI::App& app) {
     auto options = std::make_shared<LocalRenderOptions>();
+    auto output = std::make_shared<OutputFlags>();
     auto no_progress = std::make_shared<bool>(false);
     CLI::App* cmd = app.add_subcommand(
         "render",
-        "Render a scene in this process to an OpenEXR image, by path tracing or radiosity,\n"
-        "through the same planner and merger as the farm.\n"
-        "The EXR holds float32 R,G,B (mean radiance per pixel, W m^-2 sr^-1, box filter), the\n"
-        "two half-sample estimates A.R,A.G,A.B and B.R,B.G,B.B (even and odd samples; their\n"
-        "difference estimates the error) and spp, with header attributes lightfarm.* saying\n"
-        "how the image was made. Same seed and settings give the same bits for any --tile and\n"
-        "--threads.");
+        "Render a scene in this process to an OpenEXR image and/or a PNG preview, by path\n"
+        "tracing or radiosity, through the same planner and merger as the farm.\n"
+        "The EXR holds float32 R,G,B (mean radiance per pixel, W m^-2 sr^-1, linear Rec.709,\n"
+        "through the pixel filter), the two half-sample estimates A.R,A.G,A.B and B.R,B.G,B.B\n"
+        "(even and odd samples; their difference estimates the error), spp, and the --aov\n"
+        "channels, with header attributes lightfarm.* saying how the image was made. Same seed\n"
+        "and settings give the same bits for any --tile and --threads.");
     cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
     AddSceneFlags(cmd, options->scene);
-    cmd->add_option("-o,--output", options->exr_path, "output OpenEXR file")->required();
-    cmd->add_option("--png", options->png_path, "also write an sRGB PNG preview (clamped)");
+    AddOutputFlags(cmd, *output);
     cmd->add_option("--spp", options->render.spp, "samples per pixel")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(1), kMaxSpp));
@@ -61,6 +52,7 @@ Command AddRenderCommand(CLI::App& app) {
                     "sample passes per tile, as a farm job would split them (same bits)")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxPasses));
+    AddSampleFlags(cmd, options->render.clamp, options->render.aovs);
     AddAdaptiveFlags(cmd, options->adaptive);
     cmd->add_flag("--no-progress", *no_progress, "no progress bar");
     cmd->add_option("--method", options->method,
@@ -84,11 +76,13 @@ Command AddRenderCommand(CLI::App& app) {
         ->group(r);
 
     return {
-        cmd, [cmd, options, no_progress] {
+        cmd, [cmd, options, output, no_progress] {
             options->progress = !*no_progress;
-            if (absl::Status s = CheckExrPath(options->exr_path); !s.ok()) {
-                return ReportError(s);
-            }
+            absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
+            if (!paths.ok()) return ReportError(paths.status());
+            options->exr_path = paths->exr;
+            options->png_path = paths->png;
+            options->preview = output->preview;
             if (absl::Status s = CheckRadiosityFlagsApply(*cmd, options->method); !s.ok()) {
                 return ReportError(s);
             }
@@ -101,7 +95,7 @@ Command AddRenderCommand(CLI::App& app) {
                 summary->job_id.c_str(), summary->method.c_str(), summary->width, summary->height,
                 (unsigned long long)summary->stats.samples, s, summary->stats.samples / s * 1e-6,
                 summary->stats.rays / s * 1e-6, (unsigned long long)summary->stats.invalid_samples,
-                options->exr_path.c_str());
+                OutputNames(*paths).c_str());
             std::printf("time: load %.2f s, ", summary->load_seconds);
             if (const std::optional<RadiosityFigures>& r = summary->radiosity) {
                 std::printf("radiosity %.2f s (mesh %.2f s, form factors %.2f s, solve %.2f s), ",
@@ -110,8 +104,14 @@ Command AddRenderCommand(CLI::App& app) {
             }
             std::printf("render %.2f s, total %.2f s\n", summary->render_seconds, summary->seconds);
             if (summary->estimated_error >= 0) {
-                std::printf("estimated relative error %.4f%s\n", summary->estimated_error,
-                            summary->high_variance ? " (high variance)" : "");
+                std::printf("estimated relative error %.4f%s%s\n", summary->estimated_error,
+                            summary->high_variance ? " (high variance)" : "",
+                            options->render.clamp > 0
+                                ? " (noise only: --clamp biases the image, and this error does "
+                                  "not include that bias)"
+                                : "");
+            } else if (options->render.clamp > 0) {
+                std::printf("--clamp %g: the image is biased\n", options->render.clamp);
             }
             if (summary->adaptive) {
                 const AdaptiveReport& a = summary->adaptive_report;

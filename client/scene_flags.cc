@@ -1,8 +1,10 @@
 #include "scene_flags.h"
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "lf/core/pixel_filter.h"
 
 namespace lf {
 namespace {
@@ -26,7 +28,45 @@ absl::Status ParseResolution(const std::string& text, int* width, int* height, i
     return absl::OkStatus();
 }
 
+// "TYPE" or "TYPE:WIDTH" (width in pixels; default 1 for box, kDefaultFilterWidth otherwise).
+absl::StatusOr<PixelFilter> ParseFilter(const std::string& text) {
+    const size_t colon = text.find(':');
+    const std::string name = text.substr(0, colon);
+    const std::optional<PixelFilter::Type> type = PixelFilterTypeFromName(name);
+    if (!type) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "--filter ", text, ": unknown filter \"", name,
+            "\"; expected box, gaussian or blackman-harris, optionally :WIDTH in pixels"));
+    }
+    PixelFilter filter{*type, *type == PixelFilter::Type::kBox ? 1.0 : kDefaultFilterWidth};
+    if (colon != std::string::npos && !absl::SimpleAtod(text.substr(colon + 1), &filter.width)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--filter ", text, ": the width after ':' must be a number of pixels"));
+    }
+    if (absl::Status s = CheckPixelFilter(filter); !s.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("--filter ", text, ": ", s.message()));
+    }
+    return filter;
+}
+
 }  // namespace
+
+void AddFilterFlag(CLI::App* cmd, SceneOptions& options) {
+    cmd->add_option_function<std::string>(
+           "--filter",
+           [&options](const std::string& text) {
+               absl::StatusOr<PixelFilter> filter = ParseFilter(text);
+               if (!filter.ok()) throw CLI::ValidationError(std::string(filter.status().message()));
+               options.filter = *filter;
+           },
+           absl::StrCat("pixel filter, in place of the scene camera's (default: the scene's, "
+                        "else box): box (each sample uniform in its pixel), gaussian (sigma = "
+                        "width/6) or blackman-harris, with an optional :WIDTH, the filter's full "
+                        "support in pixels (",
+                        kMinFilterWidth, " to ", kMaxFilterWidth, ", default ", kDefaultFilterWidth,
+                        "; box is 1). Samples are placed by the filter, keeping equal weights"))
+        ->type_name("TYPE[:WIDTH]");
+}
 
 void AddCameraFlag(CLI::App* cmd, SceneOptions& options) {
     cmd->add_option("--camera", options.camera,
@@ -57,6 +97,7 @@ void AddSceneFlags(CLI::App* cmd, SceneOptions& options) {
     AddResolutionFlag(
         cmd, options, nullptr, 0,
         "image size WxH in pixels, instead of the scene's (JSON resolution or glTF camera)");
+    AddFilterFlag(cmd, options);
 }
 
 }  // namespace lf

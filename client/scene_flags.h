@@ -1,5 +1,5 @@
-// --camera and --resolution: the view of a scene, for every command that loads one (render,
-// plan, converge, bench, submit).
+// --camera, --resolution and --filter: the view of a scene, for every command that loads one
+// (render, plan, converge, bench, submit).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,7 +17,11 @@ void AddCameraFlag(CLI::App* cmd, SceneOptions& options);
 void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, int* single, int max_single,
                        const std::string& help);
 
-// --camera and --resolution WxH, filling `options`.
+// --filter TYPE[:WIDTH] into options.filter: the pixel filter, in place of the scene camera's.
+inline constexpr double kDefaultFilterWidth = 3;  // pixels, gaussian and blackman-harris
+void AddFilterFlag(CLI::App* cmd, SceneOptions& options);
+
+// --camera, --resolution WxH and --filter, filling `options`.
 void AddSceneFlags(CLI::App* cmd, SceneOptions& options);
 
 }  // namespace lf

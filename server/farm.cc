@@ -30,8 +30,9 @@ std::string UniqueSuffix() {
 
 // The scheduler's options with each job's tiles in a file under the data folder's scratch/.
 SchedulerOptions WithTileFiles(SchedulerOptions options, const std::string& data_dir) {
-    options.tile_stores = [dir = data_dir + "/scratch"](std::vector<PixelRect> tiles) {
-        return MakeFileTileStore(dir, std::move(tiles));
+    options.tile_stores = [dir = data_dir + "/scratch"](std::vector<PixelRect> tiles,
+                                                        uint32_t aovs) {
+        return MakeFileTileStore(dir, std::move(tiles), aovs);
     };
     return options;
 }
@@ -145,6 +146,9 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     spec.plan.width = scene->camera.width;
     spec.plan.height = scene->camera.height;
     spec.scene_hash = scene->content_hash;
+    // The filter the scene resolves to (its camera's, or --filter's), kept with the job for the
+    // EXR header, which is written without loading the scene again.
+    spec.scene_options.filter = scene->camera.filter;
     return scheduler_.Submit(spec);
 }
 
@@ -224,6 +228,9 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
     metadata.spp = snapshot.adaptive ? snapshot.adaptive->max_spp : job.spec.plan.spp;
     metadata.seed = job.spec.seed;
     metadata.max_depth = job.spec.max_depth;
+    metadata.clamp = job.spec.clamp;
+    metadata.aovs = job.spec.aovs;
+    metadata.filter = job.spec.scene_options.filter.value_or(PixelFilter{});
     metadata.seconds = job.started == absl::InfinitePast()
                            ? 0.0
                            : absl::ToDoubleSeconds(absl::Now() - job.started);

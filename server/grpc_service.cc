@@ -74,6 +74,13 @@ grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext*,
 grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
                                        const pb::SubmitJobRequest* req,
                                        pb::SubmitJobResponse* resp) {
+    // Proto3 keeps enum values this build does not know; JobSpec cannot hold them, so they are
+    // refused here rather than rendered as something the client did not ask for.
+    if (!pb::PixelFilterType_IsValid(req->params().filter_type())) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("params.filter_type ", req->params().filter_type(),
+                         ": unknown pixel filter; expected box, gaussian or blackman-harris")));
+    }
     absl::StatusOr<std::string> id = farm_.Submit(FromProto(*req));
     if (!id.ok()) {
         Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()), Peer(context),

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/pixel_filter.h"
 
 namespace lf {
 
@@ -22,6 +23,22 @@ json BlobToJson(const BlobRef& b) { return {{"path", b.path}, {"hash", b.hash}, 
 BlobRef BlobFromJson(const json& j) {
     return {j.at("path").get<std::string>(), j.at("hash").get<std::string>(),
             j.at("size").get<uint64_t>()};
+}
+
+// `--filter` as {"type": name, "width": pixels}, or null for the scene's own.
+json FilterToJson(const std::optional<PixelFilter>& f) {
+    if (!f) return nullptr;
+    return {{"type", PixelFilterTypeName(f->type)}, {"width", f->width}};
+}
+absl::StatusOr<std::optional<PixelFilter>> FilterFromJson(const json& j) {
+    if (j.is_null()) return std::nullopt;
+    const std::string name = j.at("type").get<std::string>();
+    const std::optional<PixelFilter::Type> type = PixelFilterTypeFromName(name);
+    if (!type) {
+        return absl::DataLossError(
+            absl::StrCat("the stored record's filter \"", name, "\" is not a pixel filter"));
+    }
+    return PixelFilter{*type, j.at("width").get<double>()};
 }
 
 // A name; or, in records written before states were stored by name, the enum's position then.
@@ -80,6 +97,9 @@ std::string EncodeJobRecord(const JobRecord& r) {
             {"max_spp", s.adaptive.max_spp}}},
           {"camera", s.scene_options.camera},
           {"resolution", {s.scene_options.width, s.scene_options.height}},
+          {"filter", FilterToJson(s.scene_options.filter)},
+          {"clamp", s.clamp},
+          {"aovs", s.aovs},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
           {"request_id", s.request_id}}},
@@ -142,6 +162,14 @@ absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
             r.spec.scene_options.width = s.at("resolution").at(0).get<int>();
             r.spec.scene_options.height = s.at("resolution").at(1).get<int>();
         }
+        // Records before --filter, --clamp and --aov have none of them: off.
+        if (s.contains("filter")) {
+            absl::StatusOr<std::optional<PixelFilter>> filter = FilterFromJson(s.at("filter"));
+            if (!filter.ok()) return filter.status();
+            r.spec.scene_options.filter = *filter;
+        }
+        r.spec.clamp = s.value("clamp", 0.0);
+        r.spec.aovs = s.value("aovs", uint32_t(0));
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();
         r.spec.request_id = s.value("request_id", "");

@@ -96,7 +96,7 @@ absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord reco
     if (IsAdaptive(spec.adaptive)) {
         absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan =
             AdaptiveTilePlan::Make(spec.plan.width, spec.plan.height, spec.plan.spp, spec.plan.tile,
-                                   spec.adaptive, kMaxTaskSamples, options_.tile_stores);
+                                   spec.adaptive, kMaxTaskSamples, options_.tile_stores, spec.aovs);
         if (!plan.ok()) return plan.status();
         job->adaptive = plan->get();
         job->merger = std::move(*plan);
@@ -104,7 +104,7 @@ absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord reco
         absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(spec.plan);
         if (!plan.ok()) return plan.status();
         absl::StatusOr<std::unique_ptr<RenderMerger>> merger = RenderMerger::Make(
-            spec.plan.width, spec.plan.height, std::move(*plan), options_.tile_stores);
+            spec.plan.width, spec.plan.height, std::move(*plan), options_.tile_stores, spec.aovs);
         if (!merger.ok()) return merger.status();
         job->merger = std::move(*merger);
     }

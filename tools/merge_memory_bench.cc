@@ -81,8 +81,8 @@ int main(int argc, char** argv) {
     app.add_option("--dir", dir, "folder of the tile files")->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
-    const lf::TileStoreFactory in_file = [&](std::vector<lf::PixelRect> tiles) {
-        return lf::MakeFileTileStore(dir, std::move(tiles));
+    const lf::TileStoreFactory in_file = [&](std::vector<lf::PixelRect> tiles, uint32_t aovs) {
+        return lf::MakeFileTileStore(dir, std::move(tiles), aovs);
     };
     std::printf("%dx%d, %d px tiles, %llu spp\n", size, size, tile, (unsigned long long)spp);
     std::fflush(stdout);  // not again by each child

@@ -271,7 +271,8 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
     constexpr uint64_t kSamplesPerPiece = 1 << 16;
     const PixelRect& rect = task.task.rect;
     const uint64_t step = std::max<uint64_t>(1, kSamplesPerPiece / uint64_t(rect.width));
-    TileSums tile(rect);
+    const SampleOptions options{task.spec.clamp, task.spec.aovs};
+    TileSums tile(rect, options.aovs);
     std::mutex stats_mutex;
     arena_.execute([&] {
         tbb::parallel_for(
@@ -279,14 +280,18 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
             [&](const tbb::blocked_range<int>& rows) {
                 for (int y = rows.begin(); y != rows.end(); ++y) {
                     const PixelRect row_rect{rect.x0, y, rect.width, 1};
-                    TileSums row(row_rect);
+                    TileSums row(row_rect, options.aovs);
                     for (uint64_t s = task.task.sample_begin; s < task.task.sample_end && !cancel;
                          s += step) {
-                        row +=
-                            RenderTile(*loaded_.camera, *loaded_.tracer, row_rect, task.spec.seed,
-                                       s, std::min(s + step, task.task.sample_end), &cancel);
+                        row += RenderTile(
+                            *loaded_.camera, *loaded_.tracer, row_rect, task.spec.seed, s,
+                            std::min(s + step, task.task.sample_end), options, &cancel);
                     }
                     std::copy(row.pixels.begin(), row.pixels.end(), &tile.at(rect.x0, y));
+                    if (options.aovs != 0) {
+                        std::copy(row.aov_pixels.begin(), row.aov_pixels.end(),
+                                  tile.aov_pixels.begin() + ptrdiff_t(tile.Index(rect.x0, y)));
+                    }
                     std::lock_guard<std::mutex> lock(stats_mutex);
                     tile.stats += row.stats;
                 }

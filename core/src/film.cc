@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
+
+#include "lf/core/aov.h"
 
 namespace lf {
 
@@ -59,9 +62,51 @@ Rgb PixelSums::HalfMean(int half) const {
     return m;
 }
 
+void AovSums::Add(uint32_t aovs, const FirstHit& hit) {
+    if (aovs & kAovAlbedo) {
+        for (int c = 0; c < 3; ++c) albedo[c].Add(hit.albedo[c]);
+    }
+    if (aovs & kAovNormal) {
+        for (int c = 0; c < 3; ++c) normal[c].Add(hit.normal[c]);
+    }
+    if (aovs & kAovDepth) {
+        depth.Add(hit.depth);
+        ++depth_hits;
+    }
+}
+
+AovSums& AovSums::operator+=(const AovSums& o) {
+    for (int c = 0; c < 3; ++c) {
+        albedo[c] += o.albedo[c];
+        normal[c] += o.normal[c];
+    }
+    depth += o.depth;
+    depth_hits += o.depth_hits;
+    return *this;
+}
+
+Rgb AovSums::Albedo(uint32_t samples) const {
+    Rgb m(0);
+    if (samples == 0) return m;
+    for (int c = 0; c < 3; ++c) m[c] = float(albedo[c].Value() / samples);
+    return m;
+}
+
+Vec3 AovSums::Normal(uint32_t samples) const {
+    if (samples == 0) return {};
+    return {float(normal[0].Value() / samples), float(normal[1].Value() / samples),
+            float(normal[2].Value() / samples)};
+}
+
+float AovSums::Depth() const {
+    if (depth_hits == 0) return std::numeric_limits<float>::infinity();
+    return float(depth.Value() / depth_hits);
+}
+
 TileSums& TileSums::operator+=(const TileSums& o) {
-    assert(o.rect == rect);
+    assert(o.rect == rect && o.aovs == aovs);
     for (size_t i = 0; i < pixels.size(); ++i) pixels[i] += o.pixels[i];
+    for (size_t i = 0; i < aov_pixels.size(); ++i) aov_pixels[i] += o.aov_pixels[i];
     stats += o.stats;
     return *this;
 }

@@ -579,7 +579,8 @@ class GltfImporter {
                 Fail(light_at, absl::StrCat("spot cone angles ", inner, " and ", outer,
                                             " must satisfy 0 <= inner < outer <= pi/2"));
             }
-            scene_.spot_lights.push_back({position, Normalize(axis), radiometric, inner, outer});
+            scene_.spot_lights.push_back({position, Normalize(axis), radiometric, inner, outer,
+                                          SpotLight::Falloff::kKhrLightsPunctual});
         } else if (light.type == "directional") {
             scene_.directional_lights.push_back({Normalize(axis), radiometric});
         } else {

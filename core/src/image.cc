@@ -1,5 +1,7 @@
 #include "lf/core/image.h"
 
+#include "lf/core/aov.h"
+
 namespace lf {
 
 std::vector<float>& Image::Channel(const std::string& name) {
@@ -35,6 +37,33 @@ void Image::SetTile(const TileSums& tile) {
                 (*half[1][c])[i] = b[c];
             }
             spp[i] = float(p.Count());
+        }
+    }
+    if (tile.aovs != 0) SetAovs(tile);
+}
+
+void Image::SetAovs(const TileSums& tile) {
+    std::vector<float>* albedo[3] = {};
+    std::vector<float>* normal[3] = {};
+    std::vector<float>* depth = nullptr;
+    for (int c = 0; c < 3; ++c) {
+        if (tile.aovs & kAovAlbedo) albedo[c] = &Channel(kAovAlbedoChannels[c]);
+        if (tile.aovs & kAovNormal) normal[c] = &Channel(kAovNormalChannels[c]);
+    }
+    if (tile.aovs & kAovDepth) depth = &Channel(kAovDepthChannel);
+    const PixelRect& r = tile.rect;
+    for (int y = r.y0; y < r.y0 + r.height; ++y) {
+        for (int x = r.x0; x < r.x0 + r.width; ++x) {
+            const AovSums& a = tile.aov_pixels[tile.Index(x, y)];
+            const uint32_t n = tile.at(x, y).Count();
+            const size_t i = size_t(y) * width_ + x;
+            const Rgb rho = a.Albedo(n);
+            const Vec3 ns = a.Normal(n);
+            for (int c = 0; c < 3; ++c) {
+                if (albedo[c]) (*albedo[c])[i] = rho[c];
+                if (normal[c]) (*normal[c])[i] = ns[c];
+            }
+            if (depth) (*depth)[i] = a.Depth();
         }
     }
 }

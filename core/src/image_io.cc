@@ -2,7 +2,9 @@
 
 #include <ImfAttribute.h>
 #include <ImfChannelList.h>
+#include <ImfChromaticitiesAttribute.h>
 #include <ImfDoubleAttribute.h>
+#include <ImfFloatAttribute.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
@@ -32,8 +34,15 @@ absl::Status WriteExr(const std::string& path, const Image& image,
                 header.insert(name, Imf::StringAttribute(*s));
             } else if (const auto* i = std::get_if<int>(&value)) {
                 header.insert(name, Imf::IntAttribute(*i));
+            } else if (const auto* d = std::get_if<double>(&value)) {
+                header.insert(name, Imf::DoubleAttribute(*d));
+            } else if (const auto* f = std::get_if<float>(&value)) {
+                header.insert(name, Imf::FloatAttribute(*f));
             } else {
-                header.insert(name, Imf::DoubleAttribute(std::get<double>(value)));
+                const auto& c = std::get<ExrChromaticities>(value);
+                header.insert(name, Imf::ChromaticitiesAttribute(Imf::Chromaticities(
+                                        {c.red_x, c.red_y}, {c.green_x, c.green_y},
+                                        {c.blue_x, c.blue_y}, {c.white_x, c.white_y})));
             }
         }
         Imf::FrameBuffer frame;
@@ -75,6 +84,14 @@ absl::StatusOr<ExrFile> ReadExr(const std::string& path) {
                 out.attributes[it.name()] = i->value();
             } else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute())) {
                 out.attributes[it.name()] = d->value();
+            } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&it.attribute())) {
+                out.attributes[it.name()] = f->value();
+            } else if (const auto* c =
+                           dynamic_cast<const Imf::ChromaticitiesAttribute*>(&it.attribute())) {
+                const Imf::Chromaticities& v = c->value();
+                out.attributes[it.name()] =
+                    ExrChromaticities{v.red.x,  v.red.y,  v.green.x, v.green.y,
+                                      v.blue.x, v.blue.y, v.white.x, v.white.y};
             }
         }
         return out;
@@ -89,14 +106,14 @@ uint8_t EncodeSrgb8(float linear) {
     return uint8_t(std::lround(s * 255.0f));
 }
 
-absl::Status WritePng(const std::string& path, const Image& image, float exposure) {
-    const float scale = std::exp2(exposure);
+absl::Status WritePng(const std::string& path, const Image& image, const PngOptions& options) {
+    const float scale = float(std::exp2(options.exposure));
     std::vector<uint8_t> rgb(size_t(image.width()) * image.height() * 3);
     for (int y = 0; y < image.height(); ++y) {
         for (int x = 0; x < image.width(); ++x) {
             const Rgb c = image.Pixel(x, y) * scale;
             uint8_t* out = &rgb[(size_t(y) * image.width() + x) * 3];
-            for (int k = 0; k < 3; ++k) out[k] = EncodeSrgb8(c[k]);
+            for (int k = 0; k < 3; ++k) out[k] = EncodeSrgb8(ApplyToneCurve(options.tone, c[k]));
         }
     }
     png_image png{};

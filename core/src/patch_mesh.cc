@@ -196,8 +196,18 @@ std::string RadiosityLimitation(const Scene& scene) {
                             "\" cannot be meshed; radiosity supports triangle meshes and quads "
                             "only");
     }
+    for (const DirectionalLight& light : scene.directional_lights) {
+        if (light.angular_diameter > 0) {
+            return "the scene has a sun disk (a directional light with an angular diameter), "
+                   "which radiosity does not model";
+        }
+    }
     if (!scene.spot_lights.empty() || !scene.directional_lights.empty()) {
         return "the scene has spot or directional lights, which radiosity does not model";
+    }
+    if (scene.environment) {
+        return "the scene has an environment light, which radiosity does not model (its patches "
+               "see only each other)";
     }
     return "";
 }
@@ -408,7 +418,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
                 const Triangle& info = pm.triangles_[size_t(pm.mesh_first_triangle_[m]) + t];
                 const Vec3d n = back ? -info.normal : info.normal;
                 const bool needed =
-                    (!back && material.IsEmissive()) ||
+                    ((!back || material.two_sided_emission) && material.IsEmissive()) ||
                     (!material.reflectance.IsBlack() &&
                      rule.SomethingInFront(mesh.positions[mesh.triangles[t][0]], n));
                 if (!needed) continue;

@@ -16,17 +16,21 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string_view>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/affine.h"
+#include "lf/core/blackbody.h"
 #include "lf/core/file_util.h"
 #include "lf/core/gltf_scene.h"
 #include "lf/core/log.h"
 #include "lf/core/mesh_io.h"
 #include "lf/core/mesh_tangents.h"
+#include "lf/core/pixel_filter.h"
+#include "lf/core/texture.h"
 #include "lf/core/texture_io.h"
 
 namespace lf {
@@ -54,6 +58,13 @@ constexpr float kMaxFloat = std::numeric_limits<float>::max();
 // radiance. Far above it, a light's power overflows float in the light sampler and samples
 // reach the film's clamp (1e15, film.cc), both silently wrong.
 constexpr float kMaxRadiance = 1e10f;
+
+// Keys any material may have besides its type's: its emission (docs/scene-format.md, Emission).
+constexpr std::array<std::string_view, 6> kEmissionKeys = {
+    "emission", "luminance_nits", "power_lm", "color", "temperature_k", "two_sided"};
+// Luminous efficacy of the photometric units: 683 lm per W of luminance-1 colour, as
+// KHR_lights_punctual and Blender convert (the peak of the photopic curve, 555 nm).
+constexpr double kLumensPerWatt = 683;
 
 // Validation runs many levels deep; an error unwinds to ParseScene as this exception, which adds
 // the source name, so every check stays one line.
@@ -139,9 +150,12 @@ class Node {
     }
 
     // Unknown keys are most likely typos, but they do not make the scene unusable.
-    void WarnUnknownKeys(std::initializer_list<std::string_view> known) const {
+    // `also`: keys every object of a kind shares (a material's emission keys).
+    void WarnUnknownKeys(std::initializer_list<std::string_view> known,
+                         std::span<const std::string_view> also = {}) const {
         for (const auto& [key, value] : json_.items()) {
-            if (std::find(known.begin(), known.end(), key) == known.end()) {
+            if (std::find(known.begin(), known.end(), key) == known.end() &&
+                std::find(also.begin(), also.end(), key) == also.end()) {
                 warnings_->push_back(absl::StrCat(Child(key), ": unknown key, ignored"));
             }
         }
@@ -199,6 +213,12 @@ class Node {
             ++i;
         }
         Fail(absl::StrCat("unknown ", std::string(what), " \"", name, "\"; expected ", expected));
+    }
+
+    bool Bool() const {
+        if (!json_.is_boolean())
+            Fail(absl::StrCat("expected true or false, got ", Describe(json_)));
+        return json_.get<bool>();
     }
 
     double Number() const {
@@ -363,6 +383,7 @@ class SceneParser {
         const std::vector<Node> shapes = root.Get("shapes").Elements();
         if (shapes.empty()) root.Get("shapes").Fail("no shapes; a scene needs at least one");
         for (const Node& shape : shapes) ParseShape(shape, scene);
+        ResolveEmittedPower(scene);
 
         if (const std::optional<Node> lights = root.Find("lights")) {
             for (const Node& light : lights->Elements()) ParseLight(light, scene);
@@ -399,6 +420,14 @@ class SceneParser {
             }
             scene.camera.width = options_.width;
             scene.camera.height = options_.height;
+        }
+        if (options_.filter) {
+            if (const absl::Status status = CheckPixelFilter(*options_.filter); !status.ok()) {
+                throw LoadError{absl::InvalidArgumentError(
+                    absl::StrCat("--filter ", PixelFilterTypeName(options_.filter->type), ": ",
+                                 status.message()))};
+            }
+            scene.camera.filter = *options_.filter;
         }
         if (!scene.HasLights()) {
             warnings_.push_back("no emissive shape and no light: the image will be black");
@@ -484,7 +513,7 @@ class SceneParser {
 
     CameraSpec ParseCamera(const Node& n) {
         n.ExpectObject({"position", "look_at", "up", "fov_y_deg", "resolution", "aperture_radius",
-                        "focus_distance"});
+                        "focus_distance", "filter"});
         CameraSpec camera;
         camera.position = n.Get("position").Vector();
         const Node look_at = n.Get("look_at");
@@ -522,7 +551,28 @@ class SceneParser {
             camera.focus_distance = focus->NumberIn(0, kMaxCoordinate, "above 0 (scene units)");
             if (camera.focus_distance == 0) focus->Fail("must be above 0 (scene units)");
         }
+        if (const std::optional<Node> filter = n.Find("filter"))
+            camera.filter = ParseFilter(*filter);
         return camera;
+    }
+
+    // {"type": "box" | "gaussian" | "blackman-harris", "width": pixels}. Without a width: 1 for
+    // the box, 3 for the others (pbrt-v4's default Gaussian, sigma 0.5 pixel, radius 1.5).
+    static PixelFilter ParseFilter(const Node& n) {
+        n.ExpectObject({"type", "width"});
+        const Node type = n.Get("type");
+        const std::optional<PixelFilter::Type> found = PixelFilterTypeFromName(type.String());
+        if (!found) {
+            type.Fail(absl::StrCat("unknown filter type \"", type.String(),
+                                   "\"; expected box, gaussian or blackman-harris"));
+        }
+        PixelFilter filter{*found, *found == PixelFilter::Type::kBox ? 1.0 : 3.0};
+        const std::optional<Node> width = n.Find("width");
+        if (width) filter.width = width->Number();
+        if (const absl::Status status = CheckPixelFilter(filter); !status.ok()) {
+            (width ? *width : n).Fail(std::string(status.message()));
+        }
+        return filter;
     }
 
     Material ParseMaterial(const std::string& name, const Node& n) {
@@ -532,16 +582,16 @@ class SceneParser {
         const Node type = n.Get("type");
         const std::string type_name = type.String();
         if (type_name == "lambert") {
-            n.WarnUnknownKeys(
-                {"type", "reflectance", "base_color", "base_color_texture", "emission"});
+            n.WarnUnknownKeys({"type", "reflectance", "base_color", "base_color_texture"},
+                              kEmissionKeys);
             ParseBaseColor(n, m);
         } else if (type_name == "mirror") {
-            n.WarnUnknownKeys({"type", "reflectance", "emission"});
+            n.WarnUnknownKeys({"type", "reflectance"}, kEmissionKeys);
             m.type = Material::Type::kMirror;
             m.reflectance = n.Get("reflectance").Color(1);
         } else if (type_name == "glossy") {
-            n.WarnUnknownKeys(
-                {"type", "distribution", "roughness", "reflectance", "eta", "k", "emission"});
+            n.WarnUnknownKeys({"type", "distribution", "roughness", "reflectance", "eta", "k"},
+                              kEmissionKeys);
             m.type = Material::Type::kGlossy;
             if (const std::optional<Node> distribution = n.Find("distribution")) {
                 m.distribution = distribution->OneOf<Material::Distribution>(
@@ -562,7 +612,7 @@ class SceneParser {
                 m.reflectance = n.Get("reflectance").Color(1);
             }
         } else if (type_name == "dielectric") {
-            n.WarnUnknownKeys({"type", "ior", "emission"});
+            n.WarnUnknownKeys({"type", "ior"}, kEmissionKeys);
             m.type = Material::Type::kDielectric;
             m.ior = n.Get("ior").PositiveFloat();
         } else if (type_name == "principled") {
@@ -572,12 +622,47 @@ class SceneParser {
                 absl::StrCat("unknown material type \"", type_name,
                              "\"; expected lambert, mirror, glossy, dielectric or principled"));
         }
-        if (const std::optional<Node> emission = n.Find("emission")) {
-            m.emission = emission->Color(kMaxRadiance);
-        } else if (m.emission_texture.valid()) {
-            m.emission = Rgb(1);  // the texture alone gives the radiance
-        }
+        ParseEmission(n, m);
         return m;
+    }
+
+    // `emission` (W m^-2 sr^-1), `luminance_nits` or `power_lm` with their colour, and
+    // `two_sided`. power_lm waits for every shape (ResolveEmittedPower): it is spread over them.
+    void ParseEmission(const Node& n, Material& m) {
+        if (const std::optional<Node> two_sided = n.Find("two_sided")) {
+            m.two_sided_emission = two_sided->Bool();
+            if (m.two_sided_emission && !m.VisibleFromBehind()) {
+                two_sided->Fail(
+                    "a single-sided surface (double_sided false) cannot be seen, so cannot emit, "
+                    "from behind: set double_sided true");
+            }
+        }
+        const std::optional<Strength> strength = FindStrength(n,
+                                                              {{"emission", "W m^-2 sr^-1", false},
+                                                               {"luminance_nits", "cd/m^2", true},
+                                                               {"power_lm", "lm", true}},
+                                                              false);
+        if (!strength) {
+            if (n.Has("color") || n.Has("temperature_k")) {
+                n.Fail(
+                    "color and temperature_k are the emission's colour: give them with emission (a "
+                    "number), luminance_nits or power_lm (the surface's colour is base_color)");
+            }
+            if (m.emission_texture.valid()) m.emission = Rgb(1);  // the texture alone
+            return;
+        }
+        if (std::string_view(strength->key.name) != "power_lm") {
+            m.emission = StrengthValue(n, *strength);
+            return;
+        }
+        if (m.emission_texture.valid()) {
+            strength->value.Fail(
+                "cannot spread a power over an emission_texture (its mean over the surface is "
+                "unknown); give luminance_nits, which the texture multiplies");
+        }
+        // Luminance 1 for now; ResolveEmittedPower scales it once the area is known.
+        m.emission = LightColor(n, true);
+        pending_power_.push_back({material_index_.at(m.name), strength->value});
     }
 
     // Lambert's albedo and principled's base colour: `base_color` or its older name
@@ -612,12 +697,12 @@ class SceneParser {
                            "attenuation_distance",
                            "normal_texture",
                            "normal_scale",
-                           "emission",
                            "emission_texture",
                            "opacity",
                            "alpha_mode",
                            "alpha_cutoff",
-                           "double_sided"});
+                           "double_sided"},
+                          kEmissionKeys);
         m.type = Material::Type::kPrincipled;
         if (!n.Has("base_color") && !n.Has("reflectance") && !n.Has("base_color_texture")) {
             m.reflectance = Rgb(0.8f);
@@ -661,12 +746,8 @@ class SceneParser {
                 "alpha mode",
                 {{"opaque", Material::AlphaMode::kOpaque}, {"mask", Material::AlphaMode::kMask}});
         }
-        if (const std::optional<Node> sided = n.Find("double_sided")) {
-            if (!sided->json().is_boolean()) {
-                sided->Fail(absl::StrCat("expected true or false, got ", Describe(sided->json())));
-            }
-            m.double_sided = sided->json().get<bool>();
-        }
+        if (const std::optional<Node> sided = n.Find("double_sided"))
+            m.double_sided = sided->Bool();
     }
 
     // A texture: a file name, or {"file", "wrap", "filter", "transform"}.
@@ -711,11 +792,18 @@ class SceneParser {
     // The index in Scene::textures of image file `name`, read and decoded once per scene.
     // `where` (a JSON path, an MTL file's line) starts messages.
     int TextureIndex(const std::string& name, const std::string& where) {
-        if (name.empty()) throw LoadError{absl::InvalidArgumentError(where + ": empty file name")};
         const std::string key = std::filesystem::path(name).lexically_normal().string();
         if (const auto found = texture_index_.find(key); found != texture_index_.end()) {
             return found->second;
         }
+        textures_->push_back(DecodeFile(name, where));
+        return texture_index_[key] = int(textures_->size() - 1);
+    }
+
+    // Image file `name`, read through the scene's reader (so `submit` uploads it) and hashed.
+    std::shared_ptr<const TextureImage> DecodeFile(const std::string& name,
+                                                   const std::string& where) {
+        if (name.empty()) throw LoadError{absl::InvalidArgumentError(where + ": empty file name")};
         absl::StatusOr<std::string> bytes = read_file_(name);
         if (!bytes.ok()) {
             throw LoadError{
@@ -728,8 +816,7 @@ class SceneParser {
             throw LoadError{absl::Status(image.status().code(),
                                          absl::StrCat(where, ": ", image.status().message()))};
         }
-        textures_->push_back(*std::move(image));
-        return texture_index_[key] = int(textures_->size() - 1);
+        return *std::move(image);
     }
 
     void ParseShape(const Node& n, Scene& scene) {
@@ -898,52 +985,152 @@ class SceneParser {
         const Node type = n.Get("type");
         const std::string type_name = type.String();
         if (type_name == "point") {
-            n.WarnUnknownKeys({"type", "position", "intensity", "power", "intensity_cd", "color"});
+            n.WarnUnknownKeys({"type", "position", "intensity", "power", "intensity_cd", "power_lm",
+                               "color", "temperature_k"});
             scene.point_lights.push_back(
                 {n.Get("position").Vector(), RadiantIntensity(n, 4 * std::numbers::pi)});
         } else if (type_name == "spot") {
-            n.WarnUnknownKeys({"type", "position", "direction", "intensity", "power",
-                               "intensity_cd", "color", "inner_cone_deg", "outer_cone_deg"});
-            SpotLight light;
-            light.position = n.Get("position").Vector();
-            light.direction = Direction(n.Get("direction"));
-            double inner_deg = 0, outer_deg = 45;
-            if (const std::optional<Node> inner = n.Find("inner_cone_deg")) {
-                inner_deg = inner->NumberIn(0, 90, "in [0, 90) degrees");
-            }
-            if (const std::optional<Node> outer = n.Find("outer_cone_deg")) {
-                outer_deg = outer->NumberIn(0, 90, "in (0, 90] degrees");
-            }
-            if (!(inner_deg < outer_deg)) {
-                n.Fail(absl::StrCat("inner_cone_deg (", inner_deg,
-                                    ") must be below outer_cone_deg (", outer_deg, ")"));
-            }
-            light.inner_cone = inner_deg * std::numbers::pi / 180;
-            light.outer_cone = outer_deg * std::numbers::pi / 180;
-            // KHR_lights_punctual's falloff, squared linear in cos between the cones, integrates
-            // to a third of the band's solid angle.
-            const double cos_inner = std::cos(light.inner_cone);
-            const double cos_outer = std::cos(light.outer_cone);
-            light.intensity = RadiantIntensity(
-                n, 2 * std::numbers::pi * (1 - cos_inner + (cos_inner - cos_outer) / 3));
-            scene.spot_lights.push_back(light);
+            scene.spot_lights.push_back(ParseSpot(n));
         } else if (type_name == "directional") {
-            n.WarnUnknownKeys({"type", "direction", "irradiance", "illuminance_lux", "color"});
+            n.WarnUnknownKeys({"type", "direction", "irradiance", "illuminance_lux", "color",
+                               "temperature_k", "angular_diameter_deg"});
             DirectionalLight light;
             light.direction = Direction(n.Get("direction"));
-            if (n.Has("irradiance") == n.Has("illuminance_lux")) {
-                n.Fail("give exactly one of irradiance (W/m^2) or illuminance_lux (lx)");
+            light.irradiance = StrengthValue(
+                n, *FindStrength(
+                       n, {{"irradiance", "W/m^2", false}, {"illuminance_lux", "lx", true}}, true));
+            if (const std::optional<Node> diameter = n.Find("angular_diameter_deg")) {
+                light.angular_diameter =
+                    diameter->NumberIn(0, 90, "in [0, 90] degrees") * std::numbers::pi / 180;
             }
-            if (n.Has("color") && n.Has("irradiance")) {
-                n.Fail("color goes with illuminance_lux; irradiance is a colour itself");
-            }
-            light.irradiance = n.Has("irradiance") ? n.Get("irradiance").Color(kMaxRadiance)
-                                                   : Photometric(n, n.Get("illuminance_lux"));
             scene.directional_lights.push_back(light);
+        } else if (type_name == "environment") {
+            if (scene.environment) {
+                n.Fail(absl::StrCat("a second environment light (the first is ", environment_path_,
+                                    "): a scene has at most one sky"));
+            }
+            environment_path_ = n.path();
+            scene.environment = ParseEnvironment(n);
         } else {
             type.Fail(absl::StrCat("unknown light type \"", type_name,
-                                   "\"; expected point, spot or directional"));
+                                   "\"; expected point, spot, directional or environment"));
         }
+    }
+
+    SpotLight ParseSpot(const Node& n) {
+        // inner_cone_deg and outer_cone_deg: the names before issue 13, still read.
+        n.WarnUnknownKeys({"type", "position", "direction", "intensity", "power", "intensity_cd",
+                           "power_lm", "color", "temperature_k", "inner_angle_deg",
+                           "outer_angle_deg", "inner_cone_deg", "outer_cone_deg"});
+        SpotLight light;
+        light.falloff = SpotLight::Falloff::kSmoothstep;
+        light.position = n.Get("position").Vector();
+        light.direction = Direction(n.Get("direction"));
+        auto angle = [&](const char* key, const char* alias) -> std::optional<Node> {
+            if (n.Has(key) && n.Has(alias)) {
+                n.Fail(absl::StrCat("give ", key, " or its older name ", alias, ", not both"));
+            }
+            return n.Has(key) ? n.Find(key) : n.Find(alias);
+        };
+        const std::optional<Node> inner = angle("inner_angle_deg", "inner_cone_deg");
+        const std::optional<Node> outer = angle("outer_angle_deg", "outer_cone_deg");
+        const double inner_deg = inner ? inner->NumberIn(0, 90, "in [0, 90) degrees") : 0;
+        const double outer_deg = outer ? outer->NumberIn(0, 90, "in (0, 90] degrees") : 45;
+        if (!(inner_deg < outer_deg)) {
+            const std::string fade = ": the light fades out between the two cones";
+            if (!outer) {
+                inner->Fail(absl::StrCat(inner_deg, " must be below the default outer_angle_deg (",
+                                         outer_deg, ")", fade));
+            }
+            outer->Fail(absl::StrCat(outer_deg, " must be above ",
+                                     inner ? inner->path() : "the default inner_angle_deg", " (",
+                                     inner_deg, ")", fade));
+        }
+        light.inner_cone = inner_deg * std::numbers::pi / 180;
+        light.outer_cone = outer_deg * std::numbers::pi / 180;
+        // The smoothstep falloff's solid angle: the inner cone, 2 pi (1 - cos inner), plus the
+        // band between the cones, where smoothstep of cos averages exactly 1/2 (s(t) + s(1 - t)
+        // = 1), 2 pi (cos inner - cos outer) / 2.
+        const double cos_inner = std::cos(light.inner_cone);
+        const double cos_outer = std::cos(light.outer_cone);
+        light.intensity =
+            RadiantIntensity(n, 2 * std::numbers::pi * (1 - (cos_inner + cos_outer) / 2));
+        return light;
+    }
+
+    EnvironmentLight ParseEnvironment(const Node& n) {
+        n.WarnUnknownKeys({"type", "radiance", "luminance_nits", "file", "scale", "rotate_y_deg",
+                           "color", "temperature_k"});
+        EnvironmentLight light;
+        if (const std::optional<Node> rotate = n.Find("rotate_y_deg")) {
+            light.rotate_y =
+                rotate->NumberIn(-1e6, 1e6, "within ±1e6 degrees") * std::numbers::pi / 180;
+        }
+        const std::optional<Node> file = n.Find("file");
+        const std::optional<Node> scale_node = n.Find("scale");
+        const double scale =
+            scale_node ? scale_node->NumberIn(0, kMaxRadiance, "≥ 0 and at most 1e10") : 1;
+        const std::optional<Strength> strength = FindStrength(
+            n, {{"radiance", "W m^-2 sr^-1", false}, {"luminance_nits", "cd/m^2", true}}, !file);
+        const bool photometric = strength && strength->key.photometric;
+        if (photometric && scale_node) {
+            scale_node->Fail("luminance_nits sets the sky's strength already; give one of the two");
+        }
+        // A map's texels are not bounded here; its factor, like a uniform sky, is.
+        const auto checked = [&]() {
+            if (!(light.radiance.MaxComponent() <= kMaxRadiance)) {
+                n.Fail("too bright: the sky's radiance (or a map's factor) is over 1e10");
+            }
+            return light;
+        };
+        if (!file) {
+            light.radiance = StrengthValue(n, *strength) * float(scale);
+            return checked();
+        }
+        if (strength && !photometric) {
+            strength->value.Fail(
+                "a uniform sky's radiance; with a file the map's texels are the radiance (scale, "
+                "color or temperature_k multiply them)");
+        }
+        const std::string name = file->String();
+        light.map = DecodeFile(name, file->path());
+        if (!light.map->hdr) {
+            file->Fail(absl::StrCat("\"", name,
+                                    "\" is an 8- or 16-bit image of display values, not radiance; "
+                                    "give a Radiance HDR or OpenEXR map"));
+        }
+        const Rgb tint = LightColor(n, photometric);
+        if (!photometric) {
+            light.radiance = tint * float(scale);
+        } else {
+            const double mean = MeanLuminance(*light.map, tint);
+            if (!(mean > 0)) {
+                file->Fail(absl::StrCat("\"", name, "\" is black: luminance_nits cannot scale it"));
+            }
+            const double nits = strength->value.NumberIn(0, kLumensPerWatt * kMaxRadiance,
+                                                         "≥ 0 and at most 6.8e12");
+            light.radiance = tint * float(nits / (kLumensPerWatt * mean));
+        }
+        return checked();
+    }
+
+    // The luminance (Rec.709 Y) of a lat-long map times `tint`, averaged over the sphere of
+    // directions: each texel weighs its solid angle, (cos theta_top - cos theta_bottom) of its
+    // row times 2 pi / width, its radiance taken as constant over it.
+    static double MeanLuminance(const TextureImage& map, const Rgb& tint) {
+        double sum = 0;
+        for (int y = 0; y < map.height; ++y) {
+            double row = 0;
+            for (int x = 0; x < map.width; ++x) {
+                // Cleaned as the renderer cleans it (EmittableRadiance), so that the mean is
+                // that of the light it will emit.
+                row += EmittableRadiance(Texel(map, x, y, false).rgb * tint).Luminance();
+            }
+            const double weight = std::cos(std::numbers::pi * y / map.height) -
+                                  std::cos(std::numbers::pi * (y + 1) / map.height);
+            sum += weight * row / map.width;
+        }
+        return sum / 2;  // the weights sum to 2 (the sphere's 4 pi over 2 pi)
     }
 
     // A unit direction from a non-zero vector.
@@ -953,28 +1140,144 @@ class SceneParser {
         return Normalize(v);
     }
 
-    // A light's intensity in W/sr: given, from its power in W over `solid_angle` (the light's
-    // emission integrated over directions, relative to its peak), or photometric in candela.
-    static Rgb RadiantIntensity(const Node& n, double solid_angle) {
-        if (int(n.Has("intensity")) + int(n.Has("power")) + int(n.Has("intensity_cd")) != 1) {
-            n.Fail("give exactly one of intensity (W/sr), power (W) or intensity_cd (cd)");
+    // A light's strength: a key, its unit (for messages), whether it is photometric, and what
+    // divides it into the stored quantity (a power over the emission's solid angle).
+    struct StrengthKey {
+        const char* name;
+        const char* unit;
+        bool photometric;
+        double divisor = 1;
+    };
+    struct Strength {
+        StrengthKey key;
+        Node value;
+    };
+
+    // The one strength of `keys` that light `n` gives; none (when not `required`) or several
+    // are errors.
+    static std::optional<Strength> FindStrength(const Node& n,
+                                                std::initializer_list<StrengthKey> keys,
+                                                bool required) {
+        std::optional<Strength> found;
+        bool radiometric = false, photometric = false;
+        int given = 0;
+        for (const StrengthKey& key : keys) {
+            if (std::optional<Node> value = n.Find(key.name)) {
+                found.emplace(Strength{key, *value});
+                (key.photometric ? photometric : radiometric) = true;
+                ++given;
+            }
         }
-        if (n.Has("color") && !n.Has("intensity_cd")) {
-            n.Fail("color goes with intensity_cd; intensity and power are colours themselves");
+        if (given == 1 || (given == 0 && !required)) return found;
+        auto list = [&](std::optional<bool> photometric_only) {
+            std::vector<std::string> names;
+            for (const StrengthKey& key : keys) {
+                if (photometric_only && key.photometric != *photometric_only) continue;
+                names.push_back(photometric_only ? std::string(key.name)
+                                                 : absl::StrCat(key.name, " (", key.unit, ")"));
+            }
+            std::string text;
+            for (size_t i = 0; i < names.size(); ++i) {
+                text += absl::StrCat(i == 0 ? "" : i + 1 == names.size() ? " or " : ", ", names[i]);
+            }
+            return text;
+        };
+        if (radiometric && photometric) {
+            n.Fail(absl::StrCat("give a radiometric strength (", list(false),
+                                ") or a photometric one (", list(true), "), not both"));
         }
-        if (n.Has("intensity")) return n.Get("intensity").Color(kMaxRadiance);
-        if (n.Has("power")) {
-            return n.Get("power").Color(float(solid_angle) * kMaxRadiance) / float(solid_angle);
-        }
-        return Photometric(n, n.Get("intensity_cd"));
+        n.Fail(absl::StrCat("give exactly one of ", list(std::nullopt)));
     }
 
-    // A photometric quantity (cd or lx) of the light's `color` as radiometric (W/sr or W/m^2)
-    // at 683 lm/W, as KHR_lights_punctual and Blender convert them.
-    static Rgb Photometric(const Node& light, const Node& value) {
-        const double v = value.NumberIn(0, 683.0 * kMaxRadiance, "≥ 0 and at most 6.8e12");
-        const Rgb color = light.Has("color") ? light.Get("color").Color(1) : Rgb(1);
-        return color * float(v / 683);
+    // A strength as the radiometric quantity the scene model keeps (W/sr, W/m^2 or
+    // W m^-2 sr^-1 per channel). Radiometric: [r, g, b], or a number times the light's colour.
+    // Photometric: a number times the colour at luminance 1, at 683 lm/W.
+    static Rgb StrengthValue(const Node& light, const Strength& strength) {
+        const Node& value = strength.value;
+        const float divisor = float(strength.key.divisor);
+        if (!strength.key.photometric && value.json().is_array()) {
+            if (light.Has("color") || light.Has("temperature_k")) {
+                value.Fail(
+                    "an [r, g, b] strength is a colour itself; with color or temperature_k give a "
+                    "number");
+            }
+            return value.Color(divisor * kMaxRadiance) / divisor;
+        }
+        const double per_watt = strength.key.photometric ? kLumensPerWatt : 1;
+        const double v =
+            value.NumberIn(0, per_watt * divisor * kMaxRadiance,
+                           absl::StrCat("≥ 0 and at most ", per_watt * divisor * kMaxRadiance));
+        const Rgb radiometric =
+            LightColor(light, strength.key.photometric) * float(v / per_watt / divisor);
+        if (!(radiometric.MaxComponent() <= kMaxRadiance)) {
+            value.Fail("too bright: a channel is over 1e10 (500 times the sun's radiance)");
+        }
+        return radiometric;
+    }
+
+    // A light's intensity in W/sr: given, or its power over `solid_angle` (the light's emission
+    // integrated over directions, relative to its peak), radiometric or photometric.
+    static Rgb RadiantIntensity(const Node& n, double solid_angle) {
+        return StrengthValue(n, *FindStrength(n,
+                                              {{"intensity", "W/sr", false},
+                                               {"power", "W", false, solid_angle},
+                                               {"intensity_cd", "cd", true},
+                                               {"power_lm", "lm", true, solid_angle}},
+                                              true));
+    }
+
+    // A light's or emitter's colour: `color` or `temperature_k` (a black body, luminance 1),
+    // white by default. With a photometric strength `color` is scaled to luminance 1, so the
+    // strength alone sets the luminous quantity.
+    static Rgb LightColor(const Node& light, bool photometric) {
+        if (light.Has("color") && light.Has("temperature_k")) {
+            light.Fail("give color or temperature_k, not both");
+        }
+        if (const std::optional<Node> kelvin = light.Find("temperature_k")) {
+            return BlackbodyRgb(
+                kelvin->NumberIn(kMinBlackbodyK, kMaxBlackbodyK, "in [1000, 40000] kelvin"));
+        }
+        const std::optional<Node> color = light.Find("color");
+        if (!color) return Rgb(1);
+        const Rgb c = color->Color(1);
+        if (!photometric) return c;
+        if (!(c.Luminance() > 0)) {
+            color->Fail("has luminance 0: a photometric strength cannot give it any light");
+        }
+        return c / c.Luminance();
+    }
+
+    // Each power_lm material's luminance: its power over the area of every shape using it, out
+    // of one face (pi L A) or both (2 pi L A).
+    void ResolveEmittedPower(Scene& scene) {
+        for (const PendingPower& pending : pending_power_) {
+            double area = 0;
+            for (const TriangleMesh& mesh : scene.meshes) {
+                if (mesh.material != pending.material) continue;
+                for (const std::array<uint32_t, 3>& t : mesh.triangles) {
+                    const Vec3d& a = mesh.positions[t[0]];
+                    area += Length(Cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a)) / 2;
+                }
+            }
+            for (const Sphere& sphere : scene.spheres) {
+                if (sphere.material == pending.material) {
+                    area += 4 * std::numbers::pi * sphere.radius * sphere.radius;
+                }
+            }
+            if (!(area > 0)) {
+                pending.value.Fail("no shape uses this material: the power has no area to leave");
+            }
+            Material& m = scene.materials[size_t(pending.material)];
+            const double lumens = pending.value.NumberIn(0, kMaxFloat, "≥ 0 (lumens)");
+            const double faces = m.two_sided_emission ? 2 : 1;
+            const double nits = lumens / (faces * std::numbers::pi * area);
+            m.emission *= float(nits / kLumensPerWatt);
+            if (!(m.emission.MaxComponent() <= kMaxRadiance)) {
+                pending.value.Fail(absl::StrCat("too bright: ", nits,
+                                                " cd/m^2 over the material's area of ", area,
+                                                " is over 1e10 W m^-2 sr^-1"));
+            }
+        }
     }
 
     const SceneFileReader& read_file_;
@@ -982,6 +1285,13 @@ class SceneParser {
     std::vector<GltfCamera> gltf_cameras_;
     std::vector<std::string> warnings_;
     std::map<std::string, int> material_index_;
+    // power_lm emitters, resolved once every shape is loaded.
+    struct PendingPower {
+        int material;
+        Node value;
+    };
+    std::vector<PendingPower> pending_power_;
+    std::string environment_path_;  // the first environment light's JSON path
     // By name and whether the file's own materials were read.
     std::map<std::pair<std::string, bool>, CachedMeshFile> mesh_cache_;
     std::map<std::string, int> texture_index_;  // by file name, into *textures_

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/aov.h"
 
 namespace lf {
 
@@ -10,13 +11,19 @@ namespace {
 
 constexpr char kMagic[4] = {'L', 'F', 'T', 'S'};
 // Version 2 added truncated_paths after invalid_samples; version 1 tiles (from workers of an
-// older build) still decode, with no truncated paths.
+// older build) still decode, with no truncated paths. Version 3 adds AOVs; tiles without them
+// stay version 2, so their bytes are those of builds before AOVs.
 constexpr uint32_t kVersion = 2;
+constexpr uint32_t kAovVersion = 3;
 constexpr uint32_t kOldestVersion = 1;
 constexpr size_t HeaderBytes(uint32_t version) {
-    return 4 + 4 + 4 * 4 + (version == 1 ? 3 : 4) * 8;
+    return 4 + 4 + 4 * 4 + (version == 1 ? 3 : 4) * 8 + (version >= kAovVersion ? 4 : 0);
 }
 constexpr size_t kPixelBytes = 6 * 16 + 2 * 4;
+constexpr size_t AovPixelBytes(uint32_t aovs) {
+    return (aovs & kAovAlbedo ? 3 * 16 : 0) + (aovs & kAovNormal ? 3 * 16 : 0) +
+           (aovs & kAovDepth ? 16 + 4 : 0);
+}
 // 2^28 pixels is a 16k x 16k tile: far beyond any plan, small enough that size arithmetic
 // cannot overflow and a corrupt header cannot make us allocate terabytes.
 constexpr int64_t kMaxPixels = int64_t(1) << 28;
@@ -39,24 +46,37 @@ class Reader {
         return v;
     }
     int32_t I32() { return int32_t(U32()); }
+    ExactSum Sum() {
+        const uint64_t lo = U64(), hi = U64();
+        return ExactSum::FromFixed(
+            static_cast<__int128>((static_cast<unsigned __int128>(hi) << 64) | lo));
+    }
 
   private:
     const char* p_;
 };
 
-}  // namespace
-
-size_t EncodedTileSumsSize(int64_t pixels, uint32_t version) {
-    return HeaderBytes(version) + size_t(pixels) * kPixelBytes;
+void PutSum(std::string& out, const ExactSum& sum) {
+    const auto v = static_cast<unsigned __int128>(sum.fixed());
+    PutU64(out, uint64_t(v));
+    PutU64(out, uint64_t(v >> 64));
 }
 
-size_t EncodedTileSumsSize(int64_t pixels) { return EncodedTileSumsSize(pixels, kVersion); }
+size_t EncodedSize(int64_t pixels, uint32_t version, uint32_t aovs) {
+    return HeaderBytes(version) + size_t(pixels) * (kPixelBytes + AovPixelBytes(aovs));
+}
+
+}  // namespace
+
+size_t EncodedTileSumsSize(int64_t pixels, uint32_t aovs) {
+    return EncodedSize(pixels, aovs == 0 ? kVersion : kAovVersion, aovs);
+}
 
 std::string EncodeTileSums(const TileSums& tile) {
     std::string out;
-    out.reserve(EncodedTileSumsSize(tile.rect.Area()));
+    out.reserve(EncodedTileSumsSize(tile.rect.Area(), tile.aovs));
     out.append(kMagic, 4);
-    PutU32(out, kVersion);
+    PutU32(out, tile.aovs == 0 ? kVersion : kAovVersion);
     for (int v : {tile.rect.x0, tile.rect.y0, tile.rect.width, tile.rect.height}) {
         PutU32(out, uint32_t(v));
     }
@@ -64,16 +84,25 @@ std::string EncodeTileSums(const TileSums& tile) {
                        tile.stats.truncated_paths}) {
         PutU64(out, v);
     }
+    if (tile.aovs != 0) PutU32(out, tile.aovs);
     for (const PixelSums& p : tile.pixels) {
         for (int h = 0; h < 2; ++h) {
-            for (int c = 0; c < 3; ++c) {
-                const auto v = static_cast<unsigned __int128>(p.sum[h][c].fixed());
-                PutU64(out, uint64_t(v));
-                PutU64(out, uint64_t(v >> 64));
-            }
+            for (int c = 0; c < 3; ++c) PutSum(out, p.sum[h][c]);
         }
         PutU32(out, p.count[0]);
         PutU32(out, p.count[1]);
+    }
+    for (const AovSums& a : tile.aov_pixels) {
+        if (tile.aovs & kAovAlbedo) {
+            for (const ExactSum& s : a.albedo) PutSum(out, s);
+        }
+        if (tile.aovs & kAovNormal) {
+            for (const ExactSum& s : a.normal) PutSum(out, s);
+        }
+        if (tile.aovs & kAovDepth) {
+            PutSum(out, a.depth);
+            PutU32(out, a.depth_hits);
+        }
     }
     return out;
 }
@@ -85,10 +114,10 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
     }
     Reader in(bytes.substr(4));
     const uint32_t version = in.U32();
-    if (version < kOldestVersion || version > kVersion) {
+    if (version < kOldestVersion || version > kAovVersion) {
         return absl::InvalidArgumentError(absl::StrCat("tile sums: version ", version,
                                                        " is not one of the supported ",
-                                                       kOldestVersion, "..", kVersion));
+                                                       kOldestVersion, "..", kAovVersion));
     }
     if (bytes.size() < HeaderBytes(version)) {
         return absl::InvalidArgumentError(
@@ -104,26 +133,42 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
         return absl::InvalidArgumentError(absl::StrCat("tile sums: bad rectangle ", rect.x0, ",",
                                                        rect.y0, " ", rect.width, "x", rect.height));
     }
-    if (bytes.size() != EncodedTileSumsSize(rect.Area(), version)) {
+    RenderStats stats;
+    stats.samples = in.U64();
+    stats.rays = in.U64();
+    stats.invalid_samples = in.U64();
+    if (version >= 2) stats.truncated_paths = in.U64();
+    const uint32_t aovs = version >= kAovVersion ? in.U32() : 0;
+    if (version >= kAovVersion && (aovs == 0 || (aovs & ~kAllAovs) != 0)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("tile sums: AOV flags ", aovs,
+                         ": expected a non-empty sum of 1 (albedo), 2 (normal) and 4 (depth)"));
+    }
+    if (bytes.size() != EncodedSize(rect.Area(), version, aovs)) {
         return absl::InvalidArgumentError(
             absl::StrCat("tile sums: ", bytes.size(), " bytes for a ", rect.width, "x", rect.height,
-                         " tile, which takes ", EncodedTileSumsSize(rect.Area(), version)));
+                         " tile, which takes ", EncodedSize(rect.Area(), version, aovs)));
     }
-    TileSums tile(rect);
-    tile.stats.samples = in.U64();
-    tile.stats.rays = in.U64();
-    tile.stats.invalid_samples = in.U64();
-    if (version >= 2) tile.stats.truncated_paths = in.U64();
+    TileSums tile(rect, aovs);
+    tile.stats = stats;
     for (PixelSums& p : tile.pixels) {
         for (int h = 0; h < 2; ++h) {
-            for (int c = 0; c < 3; ++c) {
-                const uint64_t lo = in.U64(), hi = in.U64();
-                const auto v = (static_cast<unsigned __int128>(hi) << 64) | lo;
-                p.sum[h][c] = ExactSum::FromFixed(static_cast<__int128>(v));
-            }
+            for (int c = 0; c < 3; ++c) p.sum[h][c] = in.Sum();
         }
         p.count[0] = in.U32();
         p.count[1] = in.U32();
+    }
+    for (AovSums& a : tile.aov_pixels) {
+        if (aovs & kAovAlbedo) {
+            for (ExactSum& s : a.albedo) s = in.Sum();
+        }
+        if (aovs & kAovNormal) {
+            for (ExactSum& s : a.normal) s = in.Sum();
+        }
+        if (aovs & kAovDepth) {
+            a.depth = in.Sum();
+            a.depth_hits = in.U32();
+        }
     }
     return tile;
 }

@@ -44,13 +44,13 @@ AdaptiveTilePlan::AdaptiveTilePlan(int width, int height, const AdaptiveSettings
 
 absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> AdaptiveTilePlan::Make(
     int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings,
-    uint64_t max_task_samples, const TileStoreFactory& make_store) {
+    uint64_t max_task_samples, const TileStoreFactory& make_store, uint32_t aovs) {
     if (absl::Status s = CheckAdaptiveSettings(settings); !s.ok()) return s;
     const uint64_t first =
         std::min(RoundUpToEven(settings.max_spp), RoundUpToEven(std::max<uint64_t>(first_spp, 2)));
     absl::StatusOr<std::vector<RenderTask>> tiles = PlanRender({width, height, first, tile, 1});
     if (!tiles.ok()) return tiles.status();
-    absl::StatusOr<std::unique_ptr<TileStore>> store = make_store(TileRects(*tiles));
+    absl::StatusOr<std::unique_ptr<TileStore>> store = make_store(TileRects(*tiles), aovs);
     if (!store.ok()) return store.status();
     std::unique_ptr<AdaptiveTilePlan> plan(
         new AdaptiveTilePlan(width, height, settings, max_task_samples, std::move(*store)));

@@ -5,7 +5,9 @@
 #include <limits>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/aov.h"
 #include "lf/core/patch_mesh.h"
+#include "lf/core/pixel_filter.h"
 
 namespace lf {
 
@@ -43,9 +45,14 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
     const RadiositySettings& r = spec.radiosity;
     const absl::Status checks[] = {
         InRange("spp", spec.plan.spp, uint64_t(1), kMaxSpp),
-        InRange("tile", spec.plan.tile, 1, kMaxFarmTile),
+        // With AOVs a result takes up to 220 bytes a pixel, so tiles are smaller.
+        InRange(spec.aovs == 0 ? "tile" : "tile (with AOVs)", spec.plan.tile, 1,
+                spec.aovs == 0 ? kMaxFarmTile : kMaxFarmAovTile),
         InRange("passes", spec.plan.passes, 1, kMaxPasses),
         InRange("max_depth", spec.max_depth, -1, kMaxDepthLimit),
+        // Finite: an infinite cap is no cap, and the CLI's 0 says that.
+        InRange("clamp", spec.clamp, 0.0, std::numeric_limits<double>::max()),
+        InRange("aovs", spec.aovs, 0u, uint32_t(kAllAovs)),
         OneOf("method", spec.method, kRenderMethods),
         NoneOrInRange("adaptive.target_error", spec.adaptive.target_error, kMinTargetError,
                       kMaxTargetError),
@@ -69,6 +76,11 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
     if (!spec.scene_options.camera.empty()) {
         if (absl::Status s = CheckScenePath(spec.scene_options.camera); !s.ok()) {
             return absl::InvalidArgumentError(absl::StrCat("camera: ", s.message()));
+        }
+    }
+    if (spec.scene_options.filter) {
+        if (absl::Status s = CheckPixelFilter(*spec.scene_options.filter); !s.ok()) {
+            return absl::InvalidArgumentError(absl::StrCat("filter ", s.message()));
         }
     }
     return absl::OkStatus();

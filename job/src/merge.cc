@@ -1,6 +1,7 @@
 #include "lf/job/merge.h"
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/aov.h"
 
 namespace lf {
 
@@ -25,11 +26,16 @@ absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums) {
     return absl::OkStatus();
 }
 
-Image EmptyRenderImage(int width, int height) {
+Image EmptyRenderImage(int width, int height, uint32_t aovs) {
     Image image(width, height);
     for (const char* name : {"R", "G", "B", "A.R", "A.G", "A.B", "B.R", "B.G", "B.B", "spp"}) {
         image.Channel(name);
     }
+    for (int c = 0; c < 3; ++c) {
+        if (aovs & kAovAlbedo) image.Channel(kAovAlbedoChannels[c]);
+        if (aovs & kAovNormal) image.Channel(kAovNormalChannels[c]);
+    }
+    if (aovs & kAovDepth) image.Channel(kAovDepthChannel);
     return image;
 }
 
@@ -43,6 +49,11 @@ std::vector<PixelRect> TileRects(const std::vector<RenderTask>& tasks) {
 }
 
 absl::StatusOr<TileSums> TileMerger::AddToTile(int tile, const TileSums& sums) {
+    if (sums.aovs != store_->aovs()) {
+        return absl::InvalidArgumentError(absl::StrCat("result with AOVs [", AovListName(sums.aovs),
+                                                       "], the job's [",
+                                                       AovListName(store_->aovs()), "]"));
+    }
     absl::StatusOr<TileSums> merged = store_->Get(tile);
     if (!merged.ok()) return merged.status();
     *merged += sums;
@@ -50,8 +61,8 @@ absl::StatusOr<TileSums> TileMerger::AddToTile(int tile, const TileSums& sums) {
     return merged;
 }
 
-RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks)
-    : RenderMerger(width, height, tasks, *MakeMemoryTileStore(TileRects(tasks))) {}
+RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks, uint32_t aovs)
+    : RenderMerger(width, height, tasks, *MakeMemoryTileStore(TileRects(tasks), aovs)) {}
 
 RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks,
                            std::shared_ptr<TileStore> store)
@@ -65,9 +76,11 @@ RenderMerger::RenderMerger(int width, int height, std::vector<RenderTask> tasks,
     for (const RenderTask& task : tasks_) tile_of_.push_back(tile_at.at(Key(task.rect)));
 }
 
-absl::StatusOr<std::unique_ptr<RenderMerger>> RenderMerger::Make(
-    int width, int height, std::vector<RenderTask> tasks, const TileStoreFactory& make_store) {
-    absl::StatusOr<std::unique_ptr<TileStore>> store = make_store(TileRects(tasks));
+absl::StatusOr<std::unique_ptr<RenderMerger>> RenderMerger::Make(int width, int height,
+                                                                 std::vector<RenderTask> tasks,
+                                                                 const TileStoreFactory& make_store,
+                                                                 uint32_t aovs) {
+    absl::StatusOr<std::unique_ptr<TileStore>> store = make_store(TileRects(tasks), aovs);
     if (!store.ok()) return store.status();
     return std::unique_ptr<RenderMerger>(
         new RenderMerger(width, height, std::move(tasks), std::move(*store)));

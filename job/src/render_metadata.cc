@@ -1,5 +1,8 @@
 #include "lf/job/render_metadata.h"
 
+#include "absl/strings/str_cat.h"
+#include "lf/core/aov.h"
+#include "lf/core/pixel_filter.h"
 #include "lf/version.h"
 
 namespace lf {
@@ -7,6 +10,22 @@ namespace lf {
 namespace {
 
 std::string YesNo(bool b) { return b ? "yes" : "no"; }
+
+// Each channel the image has: the radiance with its error halves and sample counts, and the
+// AOVs asked for.
+std::string DescribeChannels(const RenderMetadata& m) {
+    std::string text = absl::StrCat(
+        "R,G,B: mean radiance W m^-2 sr^-1 (", DescribePixelFilter(m.filter),
+        " filter); A.*, B.*: means of the even and odd samples; spp: samples per pixel");
+    if (m.aovs & kAovAlbedo) absl::StrAppend(&text, "; albedo.R,G,B: first-hit albedo");
+    if (m.aovs & kAovNormal) {
+        absl::StrAppend(&text, "; normal.X,Y,Z: first-hit world-space shading normal");
+    }
+    if (m.aovs & kAovDepth) {
+        absl::StrAppend(&text, "; depth.Z: first-hit distance from the camera along the ray");
+    }
+    return text;
+}
 
 ExrAttributes DescribeMethod(const RenderMetadata& m) {
     return {
@@ -20,10 +39,25 @@ ExrAttributes DescribeMethod(const RenderMetadata& m) {
         {"lightfarm.invalidSamples", std::to_string(m.stats.invalid_samples)},
         {"lightfarm.truncatedPaths", std::to_string(m.stats.truncated_paths)},
         {"lightfarm.rays", std::to_string(m.stats.rays)},
-        {"lightfarm.channels",
-         std::string("R,G,B: mean radiance W m^-2 sr^-1 (box filter); A.*, B.*: means of the "
-                     "even and odd samples; spp: samples per pixel")},
+        {"lightfarm.channels", DescribeChannels(m)},
+        {"lightfarm.filter", DescribePixelFilter(m.filter)},
+        {"lightfarm.units", absl::StrCat("R,G,B: radiance W m^-2 sr^-1, linear Rec.709 RGB",
+                                         m.aovs & kAovDepth ? "; depth.Z: scene units" : "")},
+        // What a viewer needs to show the radiance in absolute terms: the primaries, and the
+        // luminance in cd/m^2 of RGB (1, 1, 1), whose Y is 1 W m^-2 sr^-1, i.e. 683 cd/m^2.
+        {"chromaticities", kRec709Chromaticities},
+        {"whiteLuminance", 683.0f},
     };
+}
+
+// --clamp caps each sample, so the image is biased; the A/B estimates see only its variance.
+void AddClampAttributes(double clamp, ExrAttributes& attributes) {
+    attributes["lightfarm.clamp"] = clamp;
+    attributes["lightfarm.bias"] = absl::StrCat(
+        "clamp: each sample's radiance is scaled down so that no channel exceeds ", clamp,
+        " W m^-2 sr^-1, so the image is biased (darker where bright paths were cut); "
+        "lightfarm.estimatedError and the other error estimates measure the noise only, not "
+        "this bias");
 }
 
 absl::StatusOr<ErrorEstimates> AddErrorEstimates(const Image& image, ExrAttributes& attributes) {
@@ -86,6 +120,8 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     RenderDescription d;
     d.attributes = DescribeMethod(m);
     if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
+    if (m.aovs != 0) d.attributes["lightfarm.aovs"] = AovListName(m.aovs);
+    if (m.clamp > 0) AddClampAttributes(m.clamp, d.attributes);
     // An adaptive render's first pass gives every pixel at least 2 samples (it is even).
     const uint64_t fewest_spp = m.adaptive ? m.adaptive->min_spp : m.spp;
     if (complete && fewest_spp >= 2) {

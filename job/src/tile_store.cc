@@ -8,6 +8,7 @@
 #include <mutex>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/aov.h"
 #include "lf/job/merge.h"
 
 namespace lf {
@@ -20,8 +21,9 @@ std::string RectText(const PixelRect& r) {
 
 class MemoryTileStore : public TileStore {
   public:
-    explicit MemoryTileStore(std::vector<PixelRect> tiles) : TileStore(std::move(tiles)) {
-        for (const PixelRect& r : this->tiles()) sums_.emplace_back(r);
+    MemoryTileStore(std::vector<PixelRect> tiles, uint32_t aovs)
+        : TileStore(std::move(tiles), aovs) {
+        for (const PixelRect& r : this->tiles()) sums_.emplace_back(r, aovs);
     }
 
     absl::StatusOr<TileSums> Get(int tile) const override {
@@ -42,42 +44,65 @@ class MemoryTileStore : public TileStore {
     std::vector<TileSums> sums_;
 };
 
-// A pixel's sums on disk: six 128-bit fixed-point sums, then the two half counts; no padding.
+// A pixel's sums on disk: six 128-bit fixed-point sums, then the two half counts, then the
+// store's AOVs (all seven sums of AovSums and the depth hits when it has any); no padding.
 constexpr size_t kPixelBytes = 6 * sizeof(__int128) + 2 * sizeof(uint32_t);
+constexpr size_t kAovPixelBytes = 7 * sizeof(__int128) + sizeof(uint32_t);
 
-void EncodePixel(const PixelSums& p, char* out) {
-    for (int h = 0; h < 2; ++h) {
-        for (int c = 0; c < 3; ++c) {
-            const __int128 fixed = p.sum[h][c].fixed();
-            std::memcpy(out, &fixed, sizeof(fixed));
-            out += sizeof(fixed);
-        }
-    }
-    std::memcpy(out, p.count, sizeof(p.count));
+char* PutSum(const ExactSum& sum, char* out) {
+    const __int128 fixed = sum.fixed();
+    std::memcpy(out, &fixed, sizeof(fixed));
+    return out + sizeof(fixed);
 }
 
-PixelSums DecodePixel(const char* in) {
-    PixelSums p;
+const char* GetSum(const char* in, ExactSum* sum) {
+    __int128 fixed;
+    std::memcpy(&fixed, in, sizeof(fixed));
+    *sum = ExactSum::FromFixed(fixed);
+    return in + sizeof(fixed);
+}
+
+char* EncodePixel(const PixelSums& p, char* out) {
     for (int h = 0; h < 2; ++h) {
-        for (int c = 0; c < 3; ++c) {
-            __int128 fixed;
-            std::memcpy(&fixed, in, sizeof(fixed));
-            p.sum[h][c] = ExactSum::FromFixed(fixed);
-            in += sizeof(fixed);
-        }
+        for (int c = 0; c < 3; ++c) out = PutSum(p.sum[h][c], out);
     }
-    std::memcpy(p.count, in, sizeof(p.count));
-    return p;
+    std::memcpy(out, p.count, sizeof(p.count));
+    return out + sizeof(p.count);
+}
+
+const char* DecodePixel(const char* in, PixelSums* p) {
+    for (int h = 0; h < 2; ++h) {
+        for (int c = 0; c < 3; ++c) in = GetSum(in, &p->sum[h][c]);
+    }
+    std::memcpy(p->count, in, sizeof(p->count));
+    return in + sizeof(p->count);
+}
+
+void EncodeAovs(const AovSums& a, char* out) {
+    for (const ExactSum& s : a.albedo) out = PutSum(s, out);
+    for (const ExactSum& s : a.normal) out = PutSum(s, out);
+    out = PutSum(a.depth, out);
+    std::memcpy(out, &a.depth_hits, sizeof(a.depth_hits));
+}
+
+void DecodeAovs(const char* in, AovSums* a) {
+    for (ExactSum& s : a->albedo) in = GetSum(in, &s);
+    for (ExactSum& s : a->normal) in = GetSum(in, &s);
+    in = GetSum(in, &a->depth);
+    std::memcpy(&a->depth_hits, in, sizeof(a->depth_hits));
 }
 
 class FileTileStore : public TileStore {
   public:
-    FileTileStore(std::vector<PixelRect> tiles, int fd, std::string name)
-        : TileStore(std::move(tiles)), fd_(fd), name_(std::move(name)) {
+    FileTileStore(std::vector<PixelRect> tiles, uint32_t aovs, int fd, std::string name)
+        : TileStore(std::move(tiles), aovs),
+          pixel_bytes_(kPixelBytes + (aovs != 0 ? kAovPixelBytes : 0)),
+          fd_(fd),
+          name_(std::move(name)) {
         uint64_t offset = 0;
         for (const PixelRect& r : this->tiles()) {
             offsets_.push_back(offset);
-            offset += uint64_t(r.Area()) * kPixelBytes;
+            offset += uint64_t(r.Area()) * pixel_bytes_;
         }
         size_ = offset;
     }
@@ -87,8 +112,8 @@ class FileTileStore : public TileStore {
 
     absl::StatusOr<TileSums> Get(int tile) const override {
         if (absl::Status s = CheckIndex(tile); !s.ok()) return s;
-        TileSums sums(tiles()[size_t(tile)]);
-        std::vector<char> bytes(sums.pixels.size() * kPixelBytes);
+        TileSums sums(tiles()[size_t(tile)], aovs());
+        std::vector<char> bytes(sums.pixels.size() * pixel_bytes_);
         {
             std::lock_guard<std::mutex> lock(mutex_);
             if (absl::Status s = Transfer(tile, bytes.data(), bytes.size(), false); !s.ok()) {
@@ -96,16 +121,18 @@ class FileTileStore : public TileStore {
             }
         }
         for (size_t i = 0; i < sums.pixels.size(); ++i) {
-            sums.pixels[i] = DecodePixel(&bytes[i * kPixelBytes]);
+            const char* aov = DecodePixel(&bytes[i * pixel_bytes_], &sums.pixels[i]);
+            if (aovs() != 0) DecodeAovs(aov, &sums.aov_pixels[i]);
         }
         return sums;
     }
 
     absl::Status Put(int tile, const TileSums& sums) override {
         if (absl::Status s = CheckTile(tile, sums); !s.ok()) return s;
-        std::vector<char> bytes(sums.pixels.size() * kPixelBytes);
+        std::vector<char> bytes(sums.pixels.size() * pixel_bytes_);
         for (size_t i = 0; i < sums.pixels.size(); ++i) {
-            EncodePixel(sums.pixels[i], &bytes[i * kPixelBytes]);
+            char* aov = EncodePixel(sums.pixels[i], &bytes[i * pixel_bytes_]);
+            if (aovs() != 0) EncodeAovs(sums.aov_pixels[i], aov);
         }
         std::lock_guard<std::mutex> lock(mutex_);
         return Transfer(tile, bytes.data(), bytes.size(), true);
@@ -132,6 +159,7 @@ class FileTileStore : public TileStore {
         return absl::OkStatus();
     }
 
+    const size_t pixel_bytes_;
     const int fd_;
     const std::string name_;
     std::vector<uint64_t> offsets_;
@@ -157,15 +185,22 @@ absl::Status TileStore::CheckTile(int tile, const TileSums& sums) const {
                                                        ": sums of ", RectText(sums.rect), " with ",
                                                        sums.pixels.size(), " pixels"));
     }
+    if (sums.aovs != aovs_ || sums.aov_pixels.size() != (aovs_ != 0 ? sums.pixels.size() : 0)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("tile ", tile, ": sums with AOVs [", AovListName(sums.aovs),
+                         "], the store keeps [", AovListName(aovs_), "]"));
+    }
     return absl::OkStatus();
 }
 
-absl::StatusOr<std::unique_ptr<TileStore>> MakeMemoryTileStore(std::vector<PixelRect> tiles) {
-    return std::make_unique<MemoryTileStore>(std::move(tiles));
+absl::StatusOr<std::unique_ptr<TileStore>> MakeMemoryTileStore(std::vector<PixelRect> tiles,
+                                                               uint32_t aovs) {
+    return std::make_unique<MemoryTileStore>(std::move(tiles), aovs);
 }
 
 absl::StatusOr<std::unique_ptr<TileStore>> MakeFileTileStore(const std::string& dir,
-                                                             std::vector<PixelRect> tiles) {
+                                                             std::vector<PixelRect> tiles,
+                                                             uint32_t aovs) {
     std::string name = dir + "/tiles-XXXXXX";
     const int fd = ::mkstemp(name.data());
     if (fd < 0) {
@@ -173,7 +208,7 @@ absl::StatusOr<std::unique_ptr<TileStore>> MakeFileTileStore(const std::string& 
             absl::StrCat(dir, ": cannot make a tile file: ", std::strerror(errno)));
     }
     ::unlink(name.c_str());
-    auto store = std::make_unique<FileTileStore>(std::move(tiles), fd, name);
+    auto store = std::make_unique<FileTileStore>(std::move(tiles), aovs, fd, name);
     // Sparse: a tile takes disk space once it is written, and reads as zero sums before.
     if (::ftruncate(fd, off_t(store->size())) != 0) {
         return absl::UnavailableError(absl::StrCat(name, ": cannot size the tile file to ",
@@ -184,7 +219,7 @@ absl::StatusOr<std::unique_ptr<TileStore>> MakeFileTileStore(const std::string& 
 }
 
 absl::StatusOr<Image> RenderImageOf(const TileStore& store, int width, int height) {
-    Image image = EmptyRenderImage(width, height);
+    Image image = EmptyRenderImage(width, height, store.aovs());
     for (int t = 0; t < int(store.tiles().size()); ++t) {
         absl::StatusOr<TileSums> sums = store.Get(t);
         if (!sums.ok()) return sums.status();

@@ -45,7 +45,16 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
     for (int depth = 0;; ++depth) {
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
-        if (!hit) break;
+        if (!hit) {
+            // Lights at infinity: the sky and sun disks.
+            const Vec3 w = Normalize(ray.d);
+            const Rgb le = lights_.EscapedRadiance(w);
+            if (!le.IsBlack()) {
+                L += beta * le *
+                     (delta_bounce ? 1.0f : PowerHeuristic(prev_pdf, lights_.EscapedPdf(w)));
+            }
+            break;
+        }
         if (medium >= 0) {
             beta *= Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
             if (beta.IsBlack()) break;
@@ -55,7 +64,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         const float cos_o_ng = -Dot(ray.d, ng);
         const Shading sh = Shade(scene_, *hit, -ray.d);
 
-        if (cos_o_ng > 0 && !sh.emission.IsBlack()) {
+        if ((cos_o_ng > 0 || EmitsFromBack(material)) && !sh.emission.IsBlack()) {
             if (delta_bounce) {
                 L += beta * sh.emission;
             } else {

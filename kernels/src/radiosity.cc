@@ -260,7 +260,7 @@ RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& m
         const Material& m =
             scene.scene().materials[size_t(scene.scene().meshes[size_t(patch.mesh)].material)];
         Rgb e = m.reflectance * irradiance[s];
-        if (!side.back) e += m.emission * float(std::numbers::pi);
+        if (!side.back || m.two_sided_emission) e += m.emission * float(std::numbers::pi);
         system.emission.push_back(e);
         system.reflectance.push_back(m.reflectance);
         system.area.push_back(patch.area);

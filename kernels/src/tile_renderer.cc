@@ -1,18 +1,20 @@
 #include "lf/kernels/tile_renderer.h"
 
+#include "lf/kernels/aov_tracer.h"
+
 namespace lf {
 
 TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, const PixelRect& rect,
                     uint64_t seed, uint64_t sample_begin, uint64_t sample_end,
-                    const std::atomic<bool>* cancel) {
-    TileSums tile(rect);
+                    const SampleOptions& options, const std::atomic<bool>* cancel) {
+    TileSums tile(rect, options.aovs);
     for (int y = rect.y0; y < rect.y0 + rect.height; ++y) {
         if (cancel && cancel->load(std::memory_order_relaxed)) break;
         for (int x = rect.x0; x < rect.x0 + rect.width; ++x) {
             PixelSums& pixel = tile.at(x, y);
             for (uint64_t s = sample_begin; s < sample_end; ++s) {
                 Sampler sampler(seed, x, y, s);
-                const Vec2 film = sampler.Get2D();
+                const Vec2 film = camera.SampleFilm(sampler.Get2D());
                 const Vec2 lens = camera.HasLens() ? sampler.Get2D() : Vec2{};
                 const Ray ray = camera.GenerateRay(x, y, film.x, film.y, lens);
                 Rgb L = estimator.Li(ray, sampler, tile.stats);
@@ -20,7 +22,17 @@ TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, co
                     ++tile.stats.invalid_samples;
                     L = Rgb(0);
                 }
+                if (options.clamp > 0 && L.MaxComponent() > options.clamp) {
+                    L *= float(options.clamp / L.MaxComponent());
+                }
                 pixel.Add(s, L);
+                if (options.aovs != 0) {
+                    ++tile.stats.rays;
+                    if (const std::optional<FirstHit> hit =
+                            TraceFirstHit(estimator.geometry(), ray)) {
+                        tile.aov_pixels[tile.Index(x, y)].Add(options.aovs, *hit);
+                    }
+                }
             }
         }
         tile.stats.samples += uint64_t(rect.width) * (sample_end - sample_begin);

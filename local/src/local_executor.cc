@@ -24,15 +24,21 @@ namespace lf {
 
 namespace {
 
-// Where a local render keeps its tiles' exact sums (104 bytes a pixel): in memory for images up
-// to 2048x2048, in an unlinked temporary file above, as the farm does, so that a large render's
-// peak memory is its float image (40 bytes a pixel) rather than the sums of every tile.
-TileStoreFactory TileStoreFor(const Camera& camera) {
-    constexpr int64_t kInMemoryPixels = int64_t(2048) * 2048;
-    if (int64_t(camera.width()) * camera.height() <= kInMemoryPixels) return MakeMemoryTileStore;
-    return [](std::vector<PixelRect> tiles) {
-        return MakeFileTileStore(std::filesystem::temp_directory_path().string(), std::move(tiles));
+// Where a local render keeps its tiles' exact sums (104 bytes a pixel, about twice that with
+// AOVs): in memory for images up to 2048x2048 (1448x1448 with AOVs, the same memory), in an
+// unlinked temporary file above, as the farm does, so that a large render's peak memory is its
+// float image (40 bytes a pixel, 68 with every AOV) rather than the sums of every tile.
+TileStoreFactory TileStoreFor(const Camera& camera, uint32_t aovs) {
+    const int64_t in_memory_pixels = int64_t(2048) * 2048 / (aovs != 0 ? 2 : 1);
+    if (int64_t(camera.width()) * camera.height() <= in_memory_pixels) return MakeMemoryTileStore;
+    return [](std::vector<PixelRect> tiles, uint32_t aovs) {
+        return MakeFileTileStore(std::filesystem::temp_directory_path().string(), std::move(tiles),
+                                 aovs);
     };
+}
+
+SampleOptions SampleOptionsOf(const RenderSettings& settings) {
+    return {settings.clamp, settings.aovs};
 }
 
 }  // namespace
@@ -45,7 +51,8 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
         PlanRender({camera.width(), camera.height(), settings.spp, settings.tile, settings.passes});
     if (!tasks.ok()) return tasks.status();
     absl::StatusOr<std::unique_ptr<RenderMerger>> made =
-        RenderMerger::Make(camera.width(), camera.height(), *tasks, TileStoreFor(camera));
+        RenderMerger::Make(camera.width(), camera.height(), *tasks,
+                           TileStoreFor(camera, settings.aovs), settings.aovs);
     if (!made.ok()) return made.status();
     RenderMerger& merger = **made;
     std::mutex mutex;
@@ -57,8 +64,9 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
             [&](const tbb::blocked_range<size_t>& range) {
                 for (size_t i = range.begin(); i != range.end(); ++i) {
                     const RenderTask& task = (*tasks)[i];
-                    const TileSums sums = RenderTile(camera, estimator, task.rect, settings.seed,
-                                                     task.sample_begin, task.sample_end);
+                    const TileSums sums =
+                        RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
+                                   task.sample_end, SampleOptionsOf(settings));
                     std::lock_guard<std::mutex> lock(mutex);
                     status.Update(merger.Add(task.index, sums));
                     if (progress) progress(merger.tasks_done(), merger.task_count());
@@ -83,7 +91,7 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
     const auto start = Clock::now();
     absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made = AdaptiveTilePlan::Make(
         camera.width(), camera.height(), settings.spp, settings.tile, adaptive, kMaxTaskSamples,
-        TileStoreFor(camera));
+        TileStoreFor(camera, settings.aovs), settings.aovs);
     if (!made.ok()) return made.status();
     AdaptiveTilePlan& plan = **made;
     const size_t tiles = plan.tile_count();
@@ -115,9 +123,9 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
             lock.unlock();
             // First passes are never dropped, so never cancelled.
             const bool first = task.sample_end <= plan.first_spp();
-            const TileSums sums =
-                RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
-                           task.sample_end, first ? nullptr : &out_of_time);
+            const TileSums sums = RenderTile(
+                camera, estimator, task.rect, settings.seed, task.sample_begin, task.sample_end,
+                SampleOptionsOf(settings), first ? nullptr : &out_of_time);
             lock.lock();
             --running;
             if (plan.IsPending(task.index)) {  // else cut short: the time limit dropped it

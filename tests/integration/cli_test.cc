@@ -1,8 +1,10 @@
 // The `lightfarm` binary end to end: a render writes an EXR whose header says how it was
 // made, and bad input fails with a message naming what and where.
 #include <gtest/gtest.h>
+#include <stb_image.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -344,19 +346,178 @@ TEST_F(Cli, PlanPrintsWhatEachMaterialUses) {
     EXPECT_EQ(r.output.find("gold: glossy, reflectance"), std::string::npos) << r.output;
 }
 
-// Images are OpenEXR: a name that says otherwise is refused before any work, by render and by
-// fetch (which refuses before it asks a server).
-TEST_F(Cli, OutputThatIsNotExrIsRefused) {
+// -o writes OpenEXR (.exr) or the PNG preview (.png): any other name is refused before any
+// work, by render and by fetch (which refuses before it asks a server).
+TEST_F(Cli, OutputThatIsNeitherExrNorPngIsRefused) {
     const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
     const RunResult render =
-        Lightfarm("render " + scene + " -o " + (dir_ / "out.png").string() + " --spp 1");
+        Lightfarm("render " + scene + " -o " + (dir_ / "out.tif").string() + " --spp 1");
     EXPECT_NE(render.status, 0);
-    EXPECT_NE(render.output.find("must end in .exr"), std::string::npos) << render.output;
-    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+    EXPECT_NE(render.output.find("-o " + (dir_ / "out.tif").string() +
+                                 ": expected a name ending "
+                                 "in .exr"),
+              std::string::npos)
+        << render.output;
+    EXPECT_FALSE(fs::exists(dir_ / "out.tif"));
     const RunResult fetch =
-        Lightfarm("fetch job-0 -o " + (dir_ / "out.png").string() + " --server 127.0.0.1:1");
+        Lightfarm("fetch job-0 -o " + (dir_ / "out.tif").string() + " --server 127.0.0.1:1");
     EXPECT_NE(fetch.status, 0);
-    EXPECT_NE(fetch.output.find("must end in .exr"), std::string::npos) << fetch.output;
+    EXPECT_NE(fetch.output.find("expected a name ending in .exr"), std::string::npos)
+        << fetch.output;
+    EXPECT_EQ(fetch.output.find("not reachable"), std::string::npos) << fetch.output;
+    // A PNG -o is the preview already: --png beside it is refused, not silently a second copy.
+    const RunResult twice = Lightfarm("render " + scene + " -o " + (dir_ / "a.png").string() +
+                                      " --png " + (dir_ / "b.png").string() + " --spp 1");
+    EXPECT_NE(twice.status, 0);
+    EXPECT_NE(twice.output.find("--png"), std::string::npos) << twice.output;
+}
+
+// R,G,B of a PNG file, decoded by stb_image.
+std::vector<int> DecodePng(const std::string& path) {
+    int w = 0, h = 0, channels = 0;
+    unsigned char* data = stbi_load(path.c_str(), &w, &h, &channels, 3);
+    if (!data) return {};
+    std::vector<int> out(data, data + size_t(w) * h * 3);
+    stbi_image_free(data);
+    return out;
+}
+
+// -o out.png writes the sRGB preview and nothing else (today's bytes: the clamped sRGB curve of
+// the EXR's R,G,B), and --exposure scales only the PNG: the EXR of the same render keeps its
+// bits, and the preview is the EXR's radiance times 2^EV, encoded.
+TEST_F(Cli, PngOutputIsThePreviewAndExposureScalesOnlyIt) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::string common = " --spp 2 --seed 5 --resolution 24x24 --threads 2 --no-progress";
+    const std::string only_png = (dir_ / "only" / "p.png").string();
+    fs::create_directories(dir_ / "only");
+    const RunResult png = Lightfarm("render " + scene + " -o " + only_png + common);
+    ASSERT_EQ(png.status, 0) << png.output;
+    EXPECT_NE(png.output.find("-> " + only_png), std::string::npos) << png.output;
+    std::vector<std::string> written;
+    for (const auto& entry : fs::directory_iterator(dir_ / "only")) {
+        written.push_back(entry.path().filename().string());
+    }
+    EXPECT_EQ(written, std::vector<std::string>{"p.png"});
+
+    const std::string exr = (dir_ / "e.exr").string(), bright = (dir_ / "bright.png").string();
+    const RunResult r = Lightfarm("render " + scene + " -o " + exr + " --png " + bright +
+                                  " --exposure 1.5" + common);
+    ASSERT_EQ(r.status, 0) << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    const std::vector<int> plain = DecodePng(only_png), scaled = DecodePng(bright);
+    ASSERT_EQ(plain.size(), size_t(24 * 24 * 3));
+    ASSERT_EQ(scaled.size(), plain.size());
+    int brighter = 0;
+    for (int y = 0; y < 24; ++y) {
+        for (int x = 0; x < 24; ++x) {
+            const Rgb c = file->image.Pixel(x, y);
+            for (int k = 0; k < 3; ++k) {
+                const size_t i = (size_t(y) * 24 + x) * 3 + k;
+                EXPECT_EQ(plain[i], EncodeSrgb8(c[k])) << x << "," << y;
+                EXPECT_EQ(scaled[i], EncodeSrgb8(c[k] * float(std::exp2(1.5)))) << x << "," << y;
+                brighter += scaled[i] > plain[i];
+            }
+        }
+    }
+    EXPECT_GT(brighter, 24 * 24);  // most of the image is lit
+    // The EXR is never scaled: the same render without --exposure has the same bits.
+    const std::string exr2 = (dir_ / "e2.exr").string();
+    ASSERT_EQ(Lightfarm("render " + scene + " -o " + exr2 + common).status, 0);
+    absl::StatusOr<ExrFile> file2 = ReadExr(exr2);
+    ASSERT_TRUE(file2.ok()) << file2.status();
+    EXPECT_EQ(*file->image.FindChannel("R"), *file2->image.FindChannel("R"));
+}
+
+// The flags of issue 13 refuse bad values at parse time, naming the flag, in render and in
+// submit (before any server is asked).
+TEST_F(Cli, BadAovClampFilterAndToneFlagsAreRefused) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"--aov albedo,shadow", "--aov albedo,shadow: unknown AOV \"shadow\""},
+        {"--clamp -1", "--clamp -1: expected a radiance >= 0"},
+        {"--clamp nan", "--clamp"},
+        {"--filter lanczos", "--filter lanczos: unknown filter \"lanczos\""},
+        {"--filter gaussian:wide", "--filter gaussian:wide: the width after ':'"},
+        {"--filter gaussian:100", "--filter gaussian:100: width 100: expected 0.5 to 16"},
+        {"--filter box:2", "--filter box:2: width 2: the box filter is one pixel wide"},
+    };
+    for (const auto& [flags, message] : cases) {
+        for (const std::string& command : {"render " + scene + " -o " + (dir_ / "x.exr").string(),
+                                           "submit " + scene + " --server 127.0.0.1:1"}) {
+            const RunResult r = Lightfarm(command + " --spp 1 " + flags);
+            EXPECT_NE(r.status, 0) << command << " " << flags;
+            EXPECT_NE(r.output.find(message), std::string::npos) << flags << ": " << r.output;
+            EXPECT_EQ(r.output.find("not reachable"), std::string::npos) << r.output;
+        }
+    }
+    for (const std::string flags : {"--tonemap aces", "--exposure 100"}) {
+        const RunResult r =
+            Lightfarm("render " + scene + " -o " + (dir_ / "x.exr").string() + " " + flags);
+        EXPECT_NE(r.status, 0) << flags;
+        EXPECT_NE(r.output.find(flags.substr(0, flags.find(' '))), std::string::npos) << r.output;
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "x.exr"));
+}
+
+// --help explains the new flags: the clamp's bias, the filters and their default width, the
+// AOV names, the tone curves and that exposure leaves the EXR alone.
+TEST_F(Cli, HelpExplainsTheOutputFlags) {
+    const RunResult r = Lightfarm("render --help");
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* text : {"--clamp", "Biased", "--filter", "blackman-harris", "default 3",
+                             "--aov", "albedo", "depth", "--tonemap", "filmic", "--exposure",
+                             "EXR is never scaled", ".png writes only"}) {
+        EXPECT_NE(r.output.find(text), std::string::npos) << text;
+    }
+    const RunResult submit = Lightfarm("submit --help");
+    for (const char* text : {"--clamp", "--filter", "--aov"}) {
+        EXPECT_NE(submit.output.find(text), std::string::npos) << text;
+    }
+    const RunResult fetch = Lightfarm("fetch --help");
+    for (const char* text : {"--png", "--exposure", "--tonemap"}) {
+        EXPECT_NE(fetch.output.find(text), std::string::npos) << text;
+    }
+}
+
+// --clamp and --aov go into the header (lightfarm.clamp, lightfarm.bias, lightfarm.aovs) and
+// the summary says the error estimate leaves the clamp's bias out.
+TEST_F(Cli, ClampAndAovsAreInTheHeader) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::string exr = (dir_ / "c.exr").string();
+    const RunResult r = Lightfarm("render " + scene + " -o " + exr +
+                                  " --spp 2 --resolution 16x16 --clamp 4 --aov normal,albedo "
+                                  "--no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("noise only: --clamp biases the image"), std::string::npos) << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    const ExrAttributes& a = file->attributes;
+    EXPECT_EQ(std::get<double>(a.at("lightfarm.clamp")), 4.0);
+    EXPECT_NE(std::get<std::string>(a.at("lightfarm.bias")).find("biased"), std::string::npos);
+    EXPECT_EQ(std::get<std::string>(a.at("lightfarm.aovs")), "albedo,normal");
+    EXPECT_EQ(std::get<std::string>(a.at("lightfarm.filter")), "box");
+    EXPECT_EQ(std::get<float>(a.at("whiteLuminance")), 683.0f);
+    EXPECT_EQ(std::get<ExrChromaticities>(a.at("chromaticities")), kRec709Chromaticities);
+}
+
+// End to end (needs the sampling pipeline of issue 13: the loader's --filter, the film's AOV
+// channels): --filter reaches the header through the loaded camera, and --aov all adds the AOV
+// channels.
+TEST_F(Cli, FilterAndAovChannelsReachTheImage) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::string exr = (dir_ / "f.exr").string();
+    const RunResult r =
+        Lightfarm("render " + scene + " -o " + exr +
+                  " --spp 2 --resolution 16x16 --filter gaussian --aov all --no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.filter")), "gaussian 3 px");
+    for (const char* ch :
+         {"albedo.R", "albedo.G", "albedo.B", "normal.X", "normal.Y", "normal.Z", "depth.Z"}) {
+        EXPECT_NE(file->image.FindChannel(ch), nullptr) << ch;
+    }
 }
 
 TEST_F(Cli, BenchRefusesFewerThanOneThread) {

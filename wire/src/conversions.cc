@@ -1,5 +1,7 @@
 #include "lf/wire/conversions.h"
 
+#include <optional>
+
 namespace lf {
 
 namespace pb = lightfarm::v1;
@@ -7,6 +9,34 @@ namespace pb = lightfarm::v1;
 namespace {
 
 int64_t UnixMillis(absl::Time t) { return t == absl::InfinitePast() ? 0 : absl::ToUnixMillis(t); }
+
+pb::PixelFilterType ToProto(PixelFilter::Type type) {
+    switch (type) {
+        case PixelFilter::Type::kBox:
+            return pb::FILTER_BOX;
+        case PixelFilter::Type::kGaussian:
+            return pb::FILTER_GAUSSIAN;
+        case PixelFilter::Type::kBlackmanHarris:
+            return pb::FILTER_BLACKMAN_HARRIS;
+    }
+    return pb::FILTER_UNSET;
+}
+
+// The filter `--filter` asked for, or nullopt for the scene's own. JobService refuses a type
+// this build does not know before converting, and workers are leased tasks only by a
+// coordinator of their own build (lf::kBuildVersion), so no other value arrives here.
+std::optional<PixelFilter> FilterFromProto(const pb::RenderParams& p) {
+    switch (p.filter_type()) {
+        case pb::FILTER_BOX:
+            return PixelFilter{PixelFilter::Type::kBox, p.filter_width()};
+        case pb::FILTER_GAUSSIAN:
+            return PixelFilter{PixelFilter::Type::kGaussian, p.filter_width()};
+        case pb::FILTER_BLACKMAN_HARRIS:
+            return PixelFilter{PixelFilter::Type::kBlackmanHarris, p.filter_width()};
+        default:
+            return std::nullopt;
+    }
+}
 
 }  // namespace
 
@@ -51,6 +81,12 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_camera(spec.scene_options.camera);
     out->set_width(spec.scene_options.width);
     out->set_height(spec.scene_options.height);
+    out->set_clamp(spec.clamp);
+    out->set_aovs(spec.aovs);
+    if (const std::optional<PixelFilter>& filter = spec.scene_options.filter) {
+        out->set_filter_type(ToProto(filter->type));
+        out->set_filter_width(filter->width);
+    }
 }
 
 void FromProto(const pb::RenderParams& p, JobSpec* spec) {
@@ -64,7 +100,9 @@ void FromProto(const pb::RenderParams& p, JobSpec* spec) {
     spec->adaptive.target_error = p.target_error();
     spec->adaptive.time_limit = p.time_limit_seconds();
     if (p.max_spp() != 0) spec->adaptive.max_spp = p.max_spp();
-    spec->scene_options = {p.camera(), p.width(), p.height()};
+    spec->scene_options = {p.camera(), p.width(), p.height(), FilterFromProto(p)};
+    spec->clamp = p.clamp();
+    spec->aovs = p.aovs();
 }
 
 void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {

@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <random>
+
+#include "lf/core/aov.h"
 
 namespace lf {
 namespace {
@@ -48,7 +52,7 @@ TEST(PixelSums, HalvesSplitByParityAndMeanIsExact) {
     EXPECT_EQ(p.count[0], 5u);
     EXPECT_EQ(p.count[1], 5u);
     EXPECT_FLOAT_EQ(p.Mean().r, 4.5f);
-    EXPECT_FLOAT_EQ(p.HalfMean(0).r, 4.0f);  // 0 2 4 6 8
+    EXPECT_FLOAT_EQ(p.HalfMean(0).r, 4.0f);   // 0 2 4 6 8
     EXPECT_FLOAT_EQ(p.HalfMean(1).g, 10.0f);  // 2*(1 3 5 7 9)/5
     EXPECT_FLOAT_EQ(p.Mean().b, 1.0f);
 }
@@ -61,6 +65,43 @@ TEST(ExactSum, SmallAndLargeValuesKeepPrecision) {
     big.Add(1e12f);
     big.Add(1.0f);
     EXPECT_DOUBLE_EQ(big.Value(), double(1e12f) + 1.0);
+}
+
+// AOV means: albedo and normal over every sample (misses count as 0), depth over the hits only,
+// +inf for a pixel no sample hit.
+TEST(AovSums, MeansOverSamplesAndDepthOverHits) {
+    AovSums a;
+    a.Add(kAllAovs, FirstHit{Rgb(0.5f, 0.25f, 1), Vec3(0, 1, 0), 2});
+    a.Add(kAllAovs, FirstHit{Rgb(0.25f, 0.25f, 0), Vec3(0, 0, -1), 4});
+    // Two more samples missed: 4 samples in the pixel.
+    EXPECT_EQ(a.depth_hits, 2u);
+    const Rgb albedo = a.Albedo(4);
+    EXPECT_FLOAT_EQ(albedo.r, 0.1875f);
+    EXPECT_FLOAT_EQ(albedo.g, 0.125f);
+    EXPECT_FLOAT_EQ(albedo.b, 0.25f);
+    const Vec3 n = a.Normal(4);
+    EXPECT_FLOAT_EQ(n.y, 0.25f);
+    EXPECT_FLOAT_EQ(n.z, -0.25f);
+    EXPECT_FLOAT_EQ(a.Depth(), 3.0f);
+    EXPECT_EQ(AovSums().Depth(), std::numeric_limits<float>::infinity());
+    EXPECT_EQ(AovSums().Albedo(0).r, 0.0f);
+    // Only the requested AOVs are summed.
+    AovSums depth_only;
+    depth_only.Add(kAovDepth, FirstHit{Rgb(1), Vec3(1, 0, 0), 5});
+    EXPECT_EQ(depth_only.albedo[0], ExactSum());
+    EXPECT_EQ(depth_only.normal[0], ExactSum());
+    EXPECT_FLOAT_EQ(depth_only.Depth(), 5.0f);
+}
+
+// Depths beyond 2^50 clamp there, so kMaxSpp (2^24) samples of the largest depth still fit in the
+// 127 bits: doubling one clamped sample 24 times gives 2^74, positive and exact.
+TEST(AovSums, LargestDepthsOverTheMostSamplesDoNotOverflow) {
+    AovSums a;
+    a.Add(kAovDepth, FirstHit{Rgb(), Vec3(), 3e38f});
+    for (int i = 0; i < 24; ++i) a += a;
+    EXPECT_EQ(a.depth_hits, 1u << 24);
+    EXPECT_EQ(a.depth.Value(), std::ldexp(1.0, 74));
+    EXPECT_EQ(a.Depth(), float(std::ldexp(1.0, 50)));
 }
 
 }  // namespace

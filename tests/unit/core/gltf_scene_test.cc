@@ -327,6 +327,7 @@ TEST_F(GltfSceneTest, SpotAndDirectionalLightsPointDownTheirNodesMinusZ) {
     EXPECT_FLOAT_EQ(light.intensity.g, 1);  // 683 cd
     EXPECT_DOUBLE_EQ(light.inner_cone, 0.2);
     EXPECT_DOUBLE_EQ(light.outer_cone, 0.4);
+    EXPECT_EQ(light.falloff, SpotLight::Falloff::kKhrLightsPunctual);  // as glTF viewers show it
     ASSERT_EQ(scene->directional_lights.size(), 1u);
     ExpectNear(scene->directional_lights[0].direction, {0, -1, 0}, 1e-12);
     EXPECT_FLOAT_EQ(scene->directional_lights[0].irradiance.r, 1);  // 0.5 * 1366 lx / 683

@@ -383,6 +383,16 @@ TEST(PatchMesh, RadiosityLimitationSaysWhy) {
               "the scene has spot or directional lights, which radiosity does not model");
     EXPECT_EQ(why([](Scene& s) { s.directional_lights.emplace_back(); }),
               "the scene has spot or directional lights, which radiosity does not model");
+    EXPECT_EQ(why([](Scene& s) {
+                  s.directional_lights.push_back({Vec3d(0, -1, 0), Rgb(1.0f), 0.01});
+              }),
+              "the scene has a sun disk (a directional light with an angular diameter), which "
+              "radiosity does not model");
+    EXPECT_EQ(why([](Scene& s) { s.environment.emplace(); }),
+              "the scene has an environment light, which radiosity does not model (its patches "
+              "see only each other)");
+    // Two-sided emission is modelled: both sides of an emitter's patches get unknowns.
+    EXPECT_EQ(why([](Scene& s) { s.materials[0].two_sided_emission = true; }), "");
     // A material no shape uses does not matter.
     EXPECT_EQ(why([](Scene& s) { s.materials.emplace_back().type = Material::Type::kDielectric; }),
               "");

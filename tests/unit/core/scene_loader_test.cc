@@ -6,10 +6,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
+#include "gltf_files.h"
 #include "image_files.h"
+#include "lf/core/blackbody.h"
+#include "lf/core/image_io.h"
 #include "scene_log.h"
 #include "test_dir.h"
 
@@ -36,6 +40,11 @@ void ExpectNear(const Vec3d& a, const Vec3d& b) {
     EXPECT_NEAR(a.z, b.z, 1e-12);
 }
 
+// Relative: float arithmetic in the loader (a division by a luminance, by 683).
+void ExpectRgbNear(const Rgb& a, const Rgb& b, double relative = 1e-6) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], relative * b.MaxComponent()) << "ch " << c;
+}
+
 constexpr char kCamera[] =
     R"({"position": [0, 0, -5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40,
         "resolution": [32, 24]})";
@@ -50,6 +59,18 @@ std::string SceneJson(const std::string& shapes, const std::string& materials = 
                       const std::string& camera = kCamera, const std::string& extra = "") {
     return R"({"camera": )" + camera + R"(, "materials": )" + materials + R"(, "shapes": [)" +
            shapes + "]" + extra + "}";
+}
+
+// A scene whose material "m" is `material` (and "lamp" emits, so the scene has light).
+std::string WithMaterial(const std::string& material) {
+    return SceneJson(kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], )"
+                            R"("emission": [1, 1, 1]}, "m": )" +
+                                material + "}");
+}
+
+// A scene with `lights`, the JSON array's elements.
+std::string WithLights(const std::string& lights) {
+    return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + lights + "]");
 }
 
 class SceneLoaderTest : public ::testing::Test {
@@ -328,48 +349,43 @@ TEST_F(SceneLoaderTest, StructureErrorsNameThePath) {
         "scene.json: shapes[0].radius: must be in (0, 1e15]");
     ExpectError(SceneJson(kQuad, kMaterials, kCamera,
                           R"(, "lights": [{"type": "area", "position": [0, 0, 0]}])"),
-                "scene.json: lights[0].type: unknown light type \"area\"; expected point, spot or "
-                "directional");
+                "scene.json: lights[0].type: unknown light type \"area\"; expected point, spot, "
+                "directional or environment");
     ExpectError(
         SceneJson(kQuad, kMaterials, kCamera,
                   R"(, "lights": [{"type": "point", "position": [0, 0, 0], "power": [1, 1, 1], )"
                   R"("intensity": [1, 1, 1]}])"),
-        "scene.json: lights[0]: give exactly one of intensity (W/sr), power (W) or intensity_cd");
+        "scene.json: lights[0]: give exactly one of intensity (W/sr), power (W), intensity_cd (cd) "
+        "or power_lm (lm)");
 }
 
 TEST_F(SceneLoaderTest, MaterialErrorsNameThePath) {
-    auto with_material = [](const std::string& material) {
-        return SceneJson(
-            kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
-                                   "m": )" +
-                       material + "}");
-    };
-    ExpectError(with_material(R"({"type": "metal"})"),
+    ExpectError(WithMaterial(R"({"type": "metal"})"),
                 "scene.json: materials.m.type: unknown material type \"metal\"");
-    ExpectError(with_material(R"({"type": "lambert"})"),
+    ExpectError(WithMaterial(R"({"type": "lambert"})"),
                 "scene.json: materials.m: missing required key \"reflectance\"");
-    ExpectError(with_material(R"({"type": "mirror", "reflectance": [1, 1.5, 1]})"),
+    ExpectError(WithMaterial(R"({"type": "mirror", "reflectance": [1, 1.5, 1]})"),
                 "scene.json: materials.m.reflectance[1]: must be in [0, 1], got 1.5");
     ExpectError(
-        with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [-1, 0, 0]})"),
+        WithMaterial(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [-1, 0, 0]})"),
         "scene.json: materials.m.emission[0]: must be ≥ 0");
     // Absurdly bright: the light sampler's power would overflow and the film would clamp.
     ExpectError(
-        with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [1, 3e38, 0]})"),
+        WithMaterial(R"({"type": "lambert", "reflectance": [1, 1, 1], "emission": [1, 3e38, 0]})"),
         "scene.json: materials.m.emission[1]: must be ≥ 0 and at most 1e+10, got 3e+38");
-    ExpectError(with_material(R"({"type": "glossy", "roughness": 0, "reflectance": [1, 1, 1]})"),
+    ExpectError(WithMaterial(R"({"type": "glossy", "roughness": 0, "reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m.roughness: must be a positive float, got 0");
-    ExpectError(with_material(R"({"type": "glossy", "roughness": 0.1, "distribution": "phong", )"
-                              R"("reflectance": [1, 1, 1]})"),
+    ExpectError(WithMaterial(R"({"type": "glossy", "roughness": 0.1, "distribution": "phong", )"
+                             R"("reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m.distribution: unknown distribution \"phong\"");
-    ExpectError(with_material(R"({"type": "glossy", "roughness": 0.1, "reflectance": [1, 1, 1], )"
-                              R"("eta": [1, 1, 1], "k": [0, 0, 0]})"),
+    ExpectError(WithMaterial(R"({"type": "glossy", "roughness": 0.1, "reflectance": [1, 1, 1], )"
+                             R"("eta": [1, 1, 1], "k": [0, 0, 0]})"),
                 "scene.json: materials.m: give either reflectance or eta and k, not both");
-    ExpectError(with_material(R"({"type": "glossy", "roughness": 0.1, "eta": [1, 1, 1]})"),
+    ExpectError(WithMaterial(R"({"type": "glossy", "roughness": 0.1, "eta": [1, 1, 1]})"),
                 "scene.json: materials.m: missing required key \"k\"");
-    ExpectError(with_material(R"({"type": "dielectric", "ior": -1.5})"),
+    ExpectError(WithMaterial(R"({"type": "dielectric", "ior": -1.5})"),
                 "scene.json: materials.m.ior: must be a positive float");
-    ExpectError(with_material("[]"), "scene.json: materials.m: expected an object, got array");
+    ExpectError(WithMaterial("[]"), "scene.json: materials.m: expected an object, got array");
 }
 
 TEST_F(SceneLoaderTest, CameraErrorsNameThePath) {
@@ -702,56 +718,50 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
 
 TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
     Write("wood.png", TexturePng());
-    auto with_material = [](const std::string& material) {
-        return SceneJson(
-            kQuad, R"({"lamp": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [1, 1, 1]},
-                       "m": )" +
-                       material + "}");
-    };
     const std::string p = R"({"type": "principled", )";
-    ExpectError(with_material(p + R"("metallic": 2})"),
+    ExpectError(WithMaterial(p + R"("metallic": 2})"),
                 "scene.json: materials.m.metallic: must be in [0, 1], got 2");
-    ExpectError(with_material(p + R"("roughness": -0.1})"),
+    ExpectError(WithMaterial(p + R"("roughness": -0.1})"),
                 "scene.json: materials.m.roughness: must be in [0, 1], got -0.1");
-    ExpectError(with_material(p + R"("transmission": 1.5})"),
+    ExpectError(WithMaterial(p + R"("transmission": 1.5})"),
                 "scene.json: materials.m.transmission: must be in [0, 1], got 1.5");
-    ExpectError(with_material(p + R"("ior": 0})"),
+    ExpectError(WithMaterial(p + R"("ior": 0})"),
                 "scene.json: materials.m.ior: must be a positive float, got 0");
-    ExpectError(with_material(p + R"("thickness": -1})"),
+    ExpectError(WithMaterial(p + R"("thickness": -1})"),
                 "scene.json: materials.m.thickness: must be ≥ 0 (metres), got -1");
-    ExpectError(with_material(p + R"("attenuation_distance": 0})"),
+    ExpectError(WithMaterial(p + R"("attenuation_distance": 0})"),
                 "scene.json: materials.m.attenuation_distance: must be a positive float");
-    ExpectError(with_material(p + R"("base_color": [1, 1, 2]})"),
+    ExpectError(WithMaterial(p + R"("base_color": [1, 1, 2]})"),
                 "scene.json: materials.m.base_color[2]: must be in [0, 1], got 2");
-    ExpectError(with_material(p + R"("base_color": [1, 1, 1], "reflectance": [1, 1, 1]})"),
+    ExpectError(WithMaterial(p + R"("base_color": [1, 1, 1], "reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m: give either base_color or reflectance");
-    ExpectError(with_material(p + R"("alpha_mode": "blend"})"),
+    ExpectError(WithMaterial(p + R"("alpha_mode": "blend"})"),
                 "scene.json: materials.m.alpha_mode: unknown alpha mode \"blend\"; expected "
                 "opaque or mask");
-    ExpectError(with_material(p + R"("double_sided": "yes"})"),
+    ExpectError(WithMaterial(p + R"("double_sided": "yes"})"),
                 "scene.json: materials.m.double_sided: expected true or false, got string");
     ExpectError(
-        with_material(p + R"("base_color_texture": "nope.png"})"),
+        WithMaterial(p + R"("base_color_texture": "nope.png"})"),
         "scene.json: materials.m.base_color_texture \"nope.png\": ", absl::StatusCode::kNotFound);
     ExpectError(
-        with_material(p + R"("normal_texture": {"file": "nope.png"}})"),
+        WithMaterial(p + R"("normal_texture": {"file": "nope.png"}})"),
         "scene.json: materials.m.normal_texture.file \"nope.png\": ", absl::StatusCode::kNotFound);
-    ExpectError(with_material(p + R"("base_color_texture": {"file": "wood.png", "wrap": "tile"}})"),
+    ExpectError(WithMaterial(p + R"("base_color_texture": {"file": "wood.png", "wrap": "tile"}})"),
                 "scene.json: materials.m.base_color_texture.wrap: unknown wrap mode \"tile\"; "
                 "expected repeat, clamp or mirror");
     ExpectError(
-        with_material(p + R"("base_color_texture": {"file": "wood.png", "filter": "cubic"}})"),
+        WithMaterial(p + R"("base_color_texture": {"file": "wood.png", "filter": "cubic"}})"),
         "scene.json: materials.m.base_color_texture.filter: unknown filter \"cubic\"");
-    ExpectError(with_material(p + R"("base_color_texture": {"file": "wood.png", )"
-                                  R"("transform": {"scale": [1, 0]}}})"),
+    ExpectError(WithMaterial(p + R"("base_color_texture": {"file": "wood.png", )"
+                                 R"("transform": {"scale": [1, 0]}}})"),
                 "scene.json: materials.m.base_color_texture.transform.scale: must not be zero");
-    ExpectError(with_material(p + R"("base_color_texture": {"wrap": "clamp"}})"),
+    ExpectError(WithMaterial(p + R"("base_color_texture": {"wrap": "clamp"}})"),
                 "scene.json: materials.m.base_color_texture: missing required key \"file\"");
     Write("bad.png", "GIF89a not a png");
-    ExpectError(with_material(p + R"("base_color_texture": "bad.png"})"),
+    ExpectError(WithMaterial(p + R"("base_color_texture": "bad.png"})"),
                 "scene.json: materials.m.base_color_texture: ");
-    ExpectError(with_material(R"({"type": "lambert", "reflectance": [1, 1, 1], )"
-                              R"("base_color_texture": 7})"),
+    ExpectError(WithMaterial(R"({"type": "lambert", "reflectance": [1, 1, 1], )"
+                             R"("base_color_texture": 7})"),
                 "scene.json: materials.m.base_color_texture: expected an object, got number");
 }
 
@@ -777,55 +787,377 @@ TEST_F(SceneLoaderTest, SpotAndDirectionalLights) {
     EXPECT_EQ(spot.intensity, Rgb(1, 2, 3));
     EXPECT_DOUBLE_EQ(spot.inner_cone, 20 * pi / 180);
     EXPECT_DOUBLE_EQ(spot.outer_cone, 30 * pi / 180);
-    // Power over the falloff's solid angle 2 pi (1 - cos i + (cos i - cos o) / 3), with the
-    // default cones 0 and 45 degrees.
+    EXPECT_EQ(spot.falloff, SpotLight::Falloff::kSmoothstep);
+    // Power over the smoothstep falloff's solid angle 2 pi (1 - (cos i + cos o) / 2), with the
+    // default cones 0 and 45 degrees (checked against quadrature in photometry_test.cc).
     const double c45 = std::cos(pi / 4);
     EXPECT_DOUBLE_EQ(scene->spot_lights[1].inner_cone, 0);
     EXPECT_DOUBLE_EQ(scene->spot_lights[1].outer_cone, pi / 4);
-    EXPECT_NEAR(scene->spot_lights[1].intensity.g, 10 / (2 * pi * (1 - 1 + (1 - c45) / 3)), 1e-4);
-    // 683 cd of colour (1, 0.5, 0) is (1, 0.5, 0) W/sr.
-    EXPECT_EQ(scene->spot_lights[2].intensity, Rgb(1, 0.5f, 0));
+    EXPECT_NEAR(scene->spot_lights[1].intensity.g, 10 / (2 * pi * (1 - (1 + c45) / 2)), 1e-4);
+    // 683 cd of colour (1, 0.5, 0), normalised to luminance 1 (its Y is 0.2126 + 0.7152 / 2).
+    const float y = 0.2126f + 0.7152f * 0.5f;
+    ExpectRgbNear(scene->spot_lights[2].intensity, Rgb(1 / y, 0.5f / y, 0));
     ASSERT_EQ(scene->directional_lights.size(), 2u);
     EXPECT_EQ(scene->directional_lights[0].direction, Vec3d(0, 0, -1));
     EXPECT_EQ(scene->directional_lights[0].irradiance, Rgb(2));
     ExpectNear(scene->directional_lights[1].direction, Normalize(Vec3d(1, -1, 0)));
-    EXPECT_EQ(scene->directional_lights[1].irradiance, Rgb(2, 2, 1));
+    // 1366 lx of (1, 1, 0.5), luminance 0.2126 + 0.7152 + 0.0722 / 2.
+    ExpectRgbNear(scene->directional_lights[1].irradiance, Rgb(2, 2, 1) / 0.9639f);
     ASSERT_EQ(scene->point_lights.size(), 1u);
     EXPECT_FLOAT_EQ(scene->point_lights[0].intensity.r, 0.1f);
 }
 
 TEST_F(SceneLoaderTest, LightErrorsNameThePath) {
-    auto with_light = [](const std::string& light) {
-        return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + light + "]");
-    };
     const std::string spot = R"({"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1], )";
-    ExpectError(with_light(spot + R"("direction": [0, 0, 0]})"),
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 0]})"),
                 "scene.json: lights[0].direction: must not be zero");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "inner_cone_deg": 30, )"
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "inner_cone_deg": 30, )"
                                   R"("outer_cone_deg": 20})"),
-                "scene.json: lights[0]: inner_cone_deg (30) must be below outer_cone_deg (20)");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 95})"),
+                "scene.json: lights[0].outer_cone_deg: 20 must be above lights[0].inner_cone_deg "
+                "(30)");
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 95})"),
                 "scene.json: lights[0].outer_cone_deg: must be in (0, 90] degrees, got 95");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "inner_cone_deg": -1})"),
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "inner_cone_deg": -1})"),
                 "scene.json: lights[0].inner_cone_deg: must be in [0, 90) degrees, got -1");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 0})"),
-                "scene.json: lights[0]: inner_cone_deg (0) must be below outer_cone_deg (0)");
-    ExpectError(with_light(spot + R"("direction": [0, 0, 1], "color": [1, 0, 0]})"),
-                "scene.json: lights[0]: color goes with intensity_cd");
-    ExpectError(with_light(R"({"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1]})"),
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "outer_cone_deg": 0})"),
+                "scene.json: lights[0].outer_cone_deg: 0 must be above the default inner_angle_deg "
+                "(0)");
+    ExpectError(WithLights(spot + R"("direction": [0, 0, 1], "color": [1, 0, 0]})"),
+                "scene.json: lights[0].intensity: an [r, g, b] strength is a colour itself; with "
+                "color or temperature_k give a number");
+    ExpectError(WithLights(R"({"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1]})"),
                 "scene.json: lights[0]: missing required key \"direction\"");
-    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1]})"),
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, 0, 1]})"),
                 "scene.json: lights[0]: give exactly one of irradiance (W/m^2) or "
                 "illuminance_lux (lx)");
-    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1], )"
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, 0, 1], )"
                            R"("illuminance_lux": -5})"),
                 "scene.json: lights[0].illuminance_lux: must be ≥ 0");
-    ExpectError(with_light(R"({"type": "directional", "direction": [0, 0, 1], )"
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, 0, 1], )"
                            R"("irradiance": [1, 1, 1], "color": [1, 1, 1]})"),
-                "scene.json: lights[0]: color goes with illuminance_lux");
-    ExpectError(with_light(R"({"type": "point", "position": [0, 0, 0], "intensity_cd": 1, )"
+                "scene.json: lights[0].irradiance: an [r, g, b] strength is a colour itself");
+    ExpectError(WithLights(R"({"type": "point", "position": [0, 0, 0], "intensity_cd": 1, )"
                            R"("color": [2, 1, 1]})"),
                 "scene.json: lights[0].color[0]: must be in [0, 1], got 2");
+}
+
+// Photometric strengths of every light: the colour (given or a black body) at luminance 1,
+// times the number, at 683 lm/W; radiometric numbers times the colour as given.
+TEST_F(SceneLoaderTest, PhotometricLightsAndColourTemperatures) {
+    const double pi = std::numbers::pi;
+    absl::StatusOr<Scene> scene = Parse(SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [
+        {"type": "point", "position": [0, 1, 0], "intensity_cd": 683, "color": [1, 1, 1]},
+        {"type": "point", "position": [0, 1, 0], "intensity_cd": 683, "temperature_k": 2856},
+        {"type": "point", "position": [0, 1, 0], "power_lm": 2732},
+        {"type": "point", "position": [0, 1, 0], "intensity": 2, "temperature_k": 6500},
+        {"type": "point", "position": [0, 1, 0], "intensity": 2, "color": [1, 0.5, 0.25]},
+        {"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "power_lm": 683,
+         "inner_angle_deg": 10, "outer_angle_deg": 40, "color": [0, 0, 1]},
+        {"type": "directional", "direction": [0, -1, 0], "illuminance_lux": 100000,
+         "temperature_k": 5800, "angular_diameter_deg": 0.53}])"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_TRUE(CapturedLog().str().empty()) << CapturedLog().str();
+    ASSERT_EQ(scene->point_lights.size(), 5u);
+    EXPECT_EQ(scene->point_lights[0].intensity, Rgb(1));  // 683 cd of white: 1 W/sr
+    ExpectRgbNear(scene->point_lights[1].intensity, BlackbodyRgb(2856));
+    EXPECT_NEAR(scene->point_lights[1].intensity.Luminance(), 1, 1e-6);
+    // 2732 lm = 4 x 683 lm over the sphere's 4 pi sr: 683 / pi cd, 1 / pi W/sr.
+    ExpectRgbNear(scene->point_lights[2].intensity, Rgb(float(1 / pi)));
+    ExpectRgbNear(scene->point_lights[3].intensity, BlackbodyRgb(6500) * 2);
+    EXPECT_EQ(scene->point_lights[4].intensity, Rgb(2, 1, 0.5f));  // radiometric: not normalised
+    ASSERT_EQ(scene->spot_lights.size(), 1u);
+    const SpotLight& spot = scene->spot_lights[0];
+    EXPECT_DOUBLE_EQ(spot.inner_cone, 10 * pi / 180);
+    EXPECT_DOUBLE_EQ(spot.outer_cone, 40 * pi / 180);
+    // The smoothstep falloff's solid angle by quadrature over the cone (midpoint rule, 1e5
+    // steps: relative error ~1e-10): 683 lm of luminance-1 blue over it.
+    double solid_angle = 0;
+    constexpr int kSteps = 100000;
+    for (int i = 0; i < kSteps; ++i) {
+        const double theta = (i + 0.5) / kSteps * spot.outer_cone;
+        const double cos_inner = std::cos(spot.inner_cone), cos_outer = std::cos(spot.outer_cone);
+        const double t =
+            std::clamp((std::cos(theta) - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+        solid_angle += 2 * pi * std::sin(theta) * t * t * (3 - 2 * t) * spot.outer_cone / kSteps;
+    }
+    ExpectRgbNear(spot.intensity, Rgb(0, 0, float(1 / 0.0722 / solid_angle)));
+    ASSERT_EQ(scene->directional_lights.size(), 1u);
+    const DirectionalLight& sun = scene->directional_lights[0];
+    ExpectRgbNear(sun.irradiance, BlackbodyRgb(5800) * float(100000 / 683.0));
+    EXPECT_DOUBLE_EQ(sun.angular_diameter, 0.53 * pi / 180);
+}
+
+TEST_F(SceneLoaderTest, PhotometricAndColourErrorsNameThePath) {
+    const std::string point = R"({"type": "point", "position": [0, 0, 0], )";
+    ExpectError(WithLights(point + R"("intensity_cd": 1, "temperature_k": 0})"),
+                "scene.json: lights[0].temperature_k: must be in [1000, 40000] kelvin, got 0");
+    ExpectError(WithLights(point + R"("intensity_cd": 1, "temperature_k": 50000})"),
+                "scene.json: lights[0].temperature_k: must be in [1000, 40000] kelvin, got 50000");
+    ExpectError(WithLights(point + R"("intensity": [1, 1, 1], "power_lm": 5})"),
+                "scene.json: lights[0]: give a radiometric strength (intensity or power) or a "
+                "photometric one (intensity_cd or power_lm), not both");
+    ExpectError(
+        WithLights(point + R"("intensity_cd": 1, "color": [1, 1, 1], "temperature_k": 3000})"),
+        "scene.json: lights[0]: give color or temperature_k, not both");
+    ExpectError(WithLights(point + R"("intensity_cd": 1, "color": [0, 0, 0]})"),
+                "scene.json: lights[0].color: has luminance 0: a photometric strength cannot give "
+                "it any light");
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, )"
+                           R"("angular_diameter_deg": 91})"),
+                "scene.json: lights[0].angular_diameter_deg: must be in [0, 90] degrees, got 91");
+    ExpectError(WithLights(R"({"type": "directional", "direction": [0, -1, 0], )"
+                           R"("illuminance_lux": 1, "irradiance": [1, 1, 1]})"),
+                "scene.json: lights[0]: give a radiometric strength (irradiance) or a photometric "
+                "one (illuminance_lux), not both");
+    const std::string spot =
+        R"({"type": "spot", "position": [0, 0, 0], "direction": [0, 0, 1], "intensity": 1, )";
+    ExpectError(WithLights(spot + R"("inner_angle_deg": 30, "outer_angle_deg": 20})"),
+                "scene.json: lights[0].outer_angle_deg: 20 must be above "
+                "lights[0].inner_angle_deg (30)");
+    ExpectError(WithLights(spot + R"("inner_angle_deg": 30, "outer_angle_deg": 30})"),
+                "scene.json: lights[0].outer_angle_deg: 30 must be above");
+    ExpectError(WithLights(spot + R"("inner_angle_deg": 50})"),
+                "scene.json: lights[0].inner_angle_deg: 50 must be below the default "
+                "outer_angle_deg (45)");
+    ExpectError(WithLights(spot + R"("outer_angle_deg": 20, "outer_cone_deg": 20})"),
+                "scene.json: lights[0]: give outer_angle_deg or its older name outer_cone_deg, "
+                "not both");
+}
+
+// Emission: two-sided, photometric luminance, and power spread over every shape using the
+// material (pi L A from one face, 2 pi L A from two; a sphere's area 4 pi r^2).
+TEST_F(SceneLoaderTest, PhotometricEmission) {
+    const double pi = std::numbers::pi;
+    const std::string quad = R"({"type": "quad", "material": "%", "vertices": [[0, 0, 0], )"
+                             R"([0, 0, 2], [2, 0, 2], [2, 0, 0]]})";
+    auto quad_of = [&](const std::string& material) {
+        std::string q = quad;
+        return q.replace(q.find('%'), 1, material);
+    };
+    absl::StatusOr<Scene> scene = Parse(SceneJson(
+        quad_of("nits") + ", " + quad_of("one") + ", " + quad_of("one") + ", " + quad_of("two") +
+            R"(, {"type": "sphere", "material": "ball", "center": [0, 0, 0], "radius": 0.5})",
+        R"({"nits": {"type": "lambert", "reflectance": [0, 0, 0], "luminance_nits": 683,
+                     "temperature_k": 4000},
+            "one": {"type": "lambert", "reflectance": [0, 0, 0], "power_lm": 1000},
+            "two": {"type": "lambert", "reflectance": [0, 0, 0], "power_lm": 1000,
+                    "two_sided": true, "color": [1, 0, 0]},
+            "ball": {"type": "principled", "power_lm": 1000},
+            "panel": {"type": "lambert", "reflectance": [0, 0, 0], "emission": 3,
+                      "color": [1, 0.5, 0.5], "two_sided": true}})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_TRUE(CapturedLog().str().empty()) << CapturedLog().str();
+    const std::vector<Material>& m = scene->materials;
+    ExpectRgbNear(m[0].emission, BlackbodyRgb(4000));
+    EXPECT_FALSE(m[0].two_sided_emission);
+    // Two quads of area 4 share "one": L = 1000 / (pi 8) cd/m^2.
+    ExpectRgbNear(m[1].emission, Rgb(float(1000 / (pi * 8) / 683)));
+    EXPECT_TRUE(m[2].two_sided_emission);
+    ExpectRgbNear(m[2].emission, Rgb(float(1000 / (2 * pi * 4) / 683 / 0.2126), 0, 0));
+    ExpectRgbNear(m[3].emission, Rgb(float(1000 / (pi * pi) / 683)));  // sphere area pi
+    EXPECT_EQ(m[4].emission, Rgb(3, 1.5f, 1.5f));
+    EXPECT_TRUE(m[4].two_sided_emission);
+}
+
+TEST_F(SceneLoaderTest, EmissionErrorsNameThePath) {
+    Write("glow.png", lf::testing::PngBytes(1, 1, 3, {255, 255, 255}));
+    const std::string lambert = R"({"type": "lambert", "reflectance": [1, 1, 1], )";
+    ExpectError(WithMaterial(lambert + R"("power_lm": 100})"),
+                "scene.json: materials.m.power_lm: no shape uses this material");
+    ExpectError(WithMaterial(lambert + R"("emission": [1, 1, 1], "luminance_nits": 5})"),
+                "scene.json: materials.m: give a radiometric strength (emission) or a photometric "
+                "one (luminance_nits or power_lm), not both");
+    ExpectError(WithMaterial(lambert + R"("luminance_nits": -1})"),
+                "scene.json: materials.m.luminance_nits: must be ≥ 0");
+    ExpectError(WithMaterial(lambert + R"("temperature_k": 3000})"),
+                "scene.json: materials.m: color and temperature_k are the emission's colour");
+    ExpectError(WithMaterial(lambert + R"("emission": [1, 1, 1], "temperature_k": 3000})"),
+                "scene.json: materials.m.emission: an [r, g, b] strength is a colour itself");
+    // Two-sided emission needs a back face rays can hit.
+    ExpectError(WithMaterial(R"({"type": "principled", "double_sided": false, "two_sided": true, )"
+                             R"("power_lm": 10})"),
+                "scene.json: materials.m.two_sided: a single-sided surface (double_sided false) "
+                "cannot be seen, so cannot emit, from behind");
+    ExpectError(WithMaterial(lambert + R"("two_sided": 1, "emission": [1, 1, 1]})"),
+                "scene.json: materials.m.two_sided: expected true or false, got number 1");
+    ExpectError(WithMaterial(R"({"type": "principled", "emission_texture": "glow.png", )"
+                             R"("power_lm": 10})"),
+                "scene.json: materials.m.power_lm: cannot spread a power over an "
+                "emission_texture");
+}
+
+TEST_F(SceneLoaderTest, EnvironmentLights) {
+    // Top row white, bottom row black: the upper hemisphere is 1, the lower 0, so the map's
+    // mean luminance over the sphere is 1/2.
+    Write("sky.hdr", lf::testing::HdrBytes(4, 2, {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1,  //
+                                                  0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}));
+    auto environment = [&](const std::string& sky) {
+        absl::StatusOr<Scene> scene = Parse(WithLights(sky));
+        EXPECT_TRUE(scene.ok()) << scene.status();
+        EXPECT_TRUE(CapturedLog().str().empty()) << CapturedLog().str();
+        return scene.ok() && scene->environment ? *scene->environment : EnvironmentLight{};
+    };
+    EXPECT_EQ(environment(R"({"type": "environment", "radiance": [1, 2, 3]})").radiance,
+              Rgb(1, 2, 3));
+    EXPECT_EQ(environment(R"({"type": "environment", "radiance": [1, 2, 3], "scale": 2})").radiance,
+              Rgb(2, 4, 6));
+    EXPECT_EQ(environment(R"({"type": "environment", "luminance_nits": 683})").radiance, Rgb(1));
+    ExpectRgbNear(
+        environment(R"({"type": "environment", "luminance_nits": 683, "temperature_k": 9000})")
+            .radiance,
+        BlackbodyRgb(9000));
+    const EnvironmentLight map =
+        environment(R"({"type": "environment", "file": "sky.hdr", "rotate_y_deg": 90})");
+    ASSERT_NE(map.map, nullptr);
+    EXPECT_EQ(map.map->width, 4);
+    EXPECT_TRUE(map.map->hdr);
+    EXPECT_EQ(map.radiance, Rgb(1));
+    EXPECT_DOUBLE_EQ(map.rotate_y, std::numbers::pi / 2);
+    EXPECT_EQ(environment(R"({"type": "environment", "file": "sky.hdr", "scale": 3, )"
+                          R"("color": [1, 0.5, 0.5]})")
+                  .radiance,
+              Rgb(3, 1.5f, 1.5f));
+    // Photometric with a map: its mean luminance (1/2) becomes 683 cd/m^2.
+    EXPECT_EQ(environment(R"({"type": "environment", "file": "sky.hdr", "luminance_nits": 683})")
+                  .radiance,
+              Rgb(2));
+}
+
+// Texels the renderer does not emit (NaN, infinite, negative: lf::EmittableRadiance) do not
+// count in the map's mean either, so luminance_nits sets the light that is actually emitted.
+TEST_F(SceneLoaderTest, PhotometricSkyIgnoresTexelsThatEmitNothing) {
+    // Top row 1, bottom row NaN, +inf, -5 and 0: as emitted, the half-lit map of mean 1/2.
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    Image image(4, 2);
+    for (const char* c : {"R", "G", "B"}) image.Channel(c) = {1, 1, 1, 1, nan, inf, -5, 0};
+    ASSERT_TRUE(WriteExr((dir_ / "sky.exr").string(), image, {}).ok());
+    const absl::StatusOr<Scene> scene =
+        Parse(WithLights(R"({"type": "environment", "file": "sky.exr", "luminance_nits": 683})"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_TRUE(scene->environment);
+    EXPECT_EQ(scene->environment->radiance, Rgb(2));
+}
+
+TEST_F(SceneLoaderTest, EnvironmentErrorsNameThePath) {
+    Write("sky.png", lf::testing::PngBytes(2, 1, 3, {255, 255, 255, 0, 0, 0}));
+    Write("black.hdr", lf::testing::HdrBytes(2, 1, {0, 0, 0, 0, 0, 0}));
+    Write("bad.hdr", "#?RADIANCE\nnot an image");
+    ExpectError(WithLights(R"({"type": "environment", "file": "nope.hdr"})"),
+                "scene.json: lights[0].file \"nope.hdr\": ", absl::StatusCode::kNotFound);
+    ExpectError(WithLights(R"({"type": "environment", "file": "bad.hdr"})"),
+                "scene.json: lights[0].file: ");
+    ExpectError(WithLights(R"({"type": "environment", "file": "sky.png"})"),
+                "scene.json: lights[0].file: \"sky.png\" is an 8- or 16-bit image of display "
+                "values, not radiance");
+    ExpectError(WithLights(R"({"type": "environment", "file": "black.hdr", "luminance_nits": 1})"),
+                "scene.json: lights[0].file: \"black.hdr\" is black");
+    ExpectError(WithLights(R"({"type": "environment", "radiance": [1, 1, 1]}, )"
+                           R"({"type": "environment", "radiance": [1, 1, 1]})"),
+                "scene.json: lights[1]: a second environment light (the first is lights[0]): a "
+                "scene has at most one sky");
+    ExpectError(WithLights(R"({"type": "environment", "radiance": [1, 1, 1], "scale": -1})"),
+                "scene.json: lights[0].scale: must be ≥ 0 and at most 1e10, got -1");
+    ExpectError(WithLights(R"({"type": "environment", "radiance": 1e10, "scale": 2})"),
+                "scene.json: lights[0]: too bright: the sky's radiance (or a map's factor) is over "
+                "1e10");
+    ExpectError(WithLights(R"({"type": "environment", "luminance_nits": -2})"),
+                "scene.json: lights[0].luminance_nits: must be ≥ 0");
+    ExpectError(WithLights(R"({"type": "environment", "luminance_nits": 2, "scale": 2})"),
+                "scene.json: lights[0].scale: luminance_nits sets the sky's strength already");
+    ExpectError(WithLights(R"({"type": "environment", "radiance": [1, 1, 1], "file": "sky.hdr"})"),
+                "scene.json: lights[0].radiance: a uniform sky's radiance; with a file");
+    ExpectError(WithLights(R"({"type": "environment"})"),
+                "scene.json: lights[0]: give exactly one of radiance (W m^-2 sr^-1) or "
+                "luminance_nits (cd/m^2)");
+}
+
+// The sky file is read through the scene's reader, as meshes and textures are, so `submit`
+// (which uploads exactly what that reader was asked for) uploads it, and it counts in the
+// content hash.
+TEST_F(SceneLoaderTest, SkyFileIsReadThroughTheSceneReader) {
+    Write("sky.hdr", lf::testing::HdrBytes(1, 1, {1, 1, 1}));
+    std::vector<std::string> read;
+    const SceneFileReader beside = ReadBeside(dir_.string());
+    const SceneFileReader recording = [&](const std::string& name) {
+        read.push_back(name);
+        return beside(name);
+    };
+    const std::string json = SceneJson(
+        kQuad, kMaterials, kCamera, R"(, "lights": [{"type": "environment", "file": "sky.hdr"}])");
+    const absl::StatusOr<Scene> scene = ParseScene(json, "scene.json", recording);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_EQ(read, std::vector<std::string>{"sky.hdr"});
+    Write("sky.hdr", lf::testing::HdrBytes(1, 1, {2, 2, 2}));
+    const absl::StatusOr<Scene> changed = Parse(json);
+    ASSERT_TRUE(changed.ok()) << changed.status();
+    EXPECT_NE(changed->content_hash, scene->content_hash);
+}
+
+TEST_F(SceneLoaderTest, CameraFilterAndTheFilterOption) {
+    auto with_filter = [](const std::string& filter) {
+        return SceneJson(kQuad, kMaterials,
+                         R"({"position": [0, 0, -5], "look_at": [0, 0, 0], "fov_y_deg": 40, )"
+                         R"("resolution": [8, 8], "filter": )" +
+                             filter + "}");
+    };
+    auto filter_of = [&](const std::string& filter) {
+        absl::StatusOr<Scene> scene = Parse(with_filter(filter));
+        EXPECT_TRUE(scene.ok()) << scene.status();
+        return scene.ok() ? scene->camera.filter : PixelFilter{};
+    };
+    const PixelFilter gaussian = filter_of(R"({"type": "gaussian", "width": 2})");
+    EXPECT_EQ(gaussian.type, PixelFilter::Type::kGaussian);
+    EXPECT_EQ(gaussian.width, 2);
+    const PixelFilter blackman_harris = filter_of(R"({"type": "blackman-harris"})");
+    EXPECT_EQ(blackman_harris.type, PixelFilter::Type::kBlackmanHarris);
+    EXPECT_EQ(blackman_harris.width, 3);
+    EXPECT_EQ(filter_of(R"({"type": "box"})").width, 1);
+    EXPECT_EQ(Parse(SceneJson(kQuad))->camera.filter.type, PixelFilter::Type::kBox);
+
+    ExpectError(with_filter(R"({"type": "mitchell"})"),
+                "scene.json: camera.filter.type: unknown filter type \"mitchell\"; expected box, "
+                "gaussian or blackman-harris");
+    ExpectError(with_filter(R"({"type": "gaussian", "width": 40})"),
+                "scene.json: camera.filter.width: width 40: expected 0.5 to 16 pixels");
+    ExpectError(with_filter(R"({"type": "box", "width": 2})"),
+                "scene.json: camera.filter.width: width 2: the box filter is one pixel wide");
+    ExpectError(with_filter(R"("gaussian")"), "scene.json: camera.filter: expected an object");
+
+    // --filter replaces the scene's, a JSON camera's and a glTF camera's alike.
+    const PixelFilter option{PixelFilter::Type::kBlackmanHarris, 1.5};
+    const absl::StatusOr<Scene> json =
+        ParseScene(with_filter(R"({"type": "gaussian", "width": 2})"), "scene.json",
+                   ReadBeside(dir_.string()), {.filter = option});
+    ASSERT_TRUE(json.ok()) << json.status();
+    EXPECT_EQ(json->camera.filter.type, option.type);
+    EXPECT_EQ(json->camera.filter.width, 1.5);
+    Write("tex.png", lf::testing::PngBytes(2, 2, 4, lf::testing::TestTexels()));
+    const absl::StatusOr<Scene> gltf = ParseScene(lf::testing::TexturedTestScene().Glb(), "s.glb",
+                                                  ReadBeside(dir_.string()), {.filter = option});
+    ASSERT_TRUE(gltf.ok()) << gltf.status();
+    EXPECT_EQ(gltf->camera.filter.type, option.type);
+    const absl::StatusOr<Scene> bad =
+        ParseScene(SceneJson(kQuad), "scene.json", ReadBeside(dir_.string()),
+                   {.filter = PixelFilter{PixelFilter::Type::kGaussian, 0.1}});
+    EXPECT_EQ(bad.status().message(),
+              "scene.json: --filter gaussian: width 0.1: expected 0.5 to 16 pixels");
+}
+
+// glTF spots keep KHR_lights_punctual's falloff, JSON spots get pbrt-v4's smoothstep.
+TEST_F(SceneLoaderTest, GltfSpotsKeepTheirFalloff) {
+    lf::testing::GltfBuilder b = lf::testing::TexturedTestScene();
+    b.json()["extensions"]["KHR_lights_punctual"]["lights"].push_back(
+        {{"type", "spot"}, {"intensity", 683}, {"spot", {{"outerConeAngle", 0.4}}}});
+    b.json()["scenes"][0]["nodes"].push_back(
+        b.AddNode({{"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}}));
+    Write("tex.png", lf::testing::PngBytes(2, 2, 4, lf::testing::TestTexels()));
+    const absl::StatusOr<Scene> scene = ParseScene(b.Glb(), "s.glb", ReadBeside(dir_.string()));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_EQ(scene->spot_lights.size(), 1u);
+    EXPECT_EQ(scene->spot_lights[0].falloff, SpotLight::Falloff::kKhrLightsPunctual);
+    // Its colour is glTF's, not normalised: KHR_lights_punctual's candela are of `color` as is.
+    EXPECT_EQ(scene->point_lights[0].intensity, Rgb(10, 5, 2.5f));
 }
 
 }  // namespace

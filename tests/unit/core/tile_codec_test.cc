@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "lf/core/aov.h"
+
 namespace lf {
 namespace {
 
@@ -63,6 +65,55 @@ TEST(TileCodec, Version1TilesDecodeWithNoTruncatedPaths) {
     EXPECT_EQ(back->stats.truncated_paths, 0u);
     EXPECT_EQ(back->pixels[1].sum[0][0], tile.pixels[1].sum[0][0]);
     EXPECT_EQ(back->pixels[5].count[1], tile.pixels[5].count[1]);
+}
+
+// A tile of MakeTile's sums with AOV sums in every pixel, extremes included.
+TileSums MakeAovTile(uint32_t aovs) {
+    const TileSums plain = MakeTile();
+    TileSums tile(plain.rect, aovs);
+    tile.pixels = plain.pixels;
+    tile.stats = plain.stats;
+    for (size_t i = 0; i < tile.aov_pixels.size(); ++i) {
+        const FirstHit hit{Rgb(0.25f * float(i), 0.5f, 1), Vec3(-0.6f, 0.8f, float(i) * 1e-3f),
+                           1e15f * float(i)};
+        for (int s = 0; s < 3; ++s) tile.aov_pixels[i].Add(aovs, hit);
+    }
+    if (aovs & kAovNormal) {
+        tile.aov_pixels[2].normal[1] = ExactSum::FromFixed(-(static_cast<__int128>(1) << 125));
+    }
+    return tile;
+}
+
+TEST(TileCodec, AovTilesAreVersion3AndKeepEveryBit) {
+    for (uint32_t aovs = 1; aovs <= kAllAovs; ++aovs) {
+        const TileSums tile = MakeAovTile(aovs);
+        const std::string bytes = EncodeTileSums(tile);
+        EXPECT_EQ(bytes[4], 3);
+        EXPECT_EQ(bytes.size(), EncodedTileSumsSize(6, aovs));
+        absl::StatusOr<TileSums> back = DecodeTileSums(bytes);
+        ASSERT_TRUE(back.ok()) << back.status();
+        EXPECT_EQ(back->aovs, aovs);
+        EXPECT_EQ(back->stats.truncated_paths, 7u);
+        ASSERT_EQ(back->aov_pixels.size(), 6u);
+        for (size_t i = 0; i < 6; ++i) {
+            EXPECT_EQ(back->aov_pixels[i], tile.aov_pixels[i]) << "aovs " << aovs << " pixel " << i;
+            EXPECT_EQ(back->pixels[i].sum[1][2], tile.pixels[i].sum[1][2]);
+        }
+        // Garbage AOV flags and a cut tile are refused.
+        std::string zero = bytes, unknown = bytes;
+        constexpr size_t kAovOffset = 4 + 4 + 4 * 4 + 4 * 8;
+        zero[kAovOffset] = 0;
+        unknown[kAovOffset] = char(aovs | 8);
+        EXPECT_NE(DecodeTileSums(zero).status().message().find("AOV flags 0"),
+                  absl::string_view::npos);
+        EXPECT_NE(DecodeTileSums(unknown).status().message().find("AOV flags"),
+                  absl::string_view::npos);
+        EXPECT_NE(DecodeTileSums(bytes.substr(0, bytes.size() - 4))
+                      .status()
+                      .message()
+                      .find("bytes for a 3x2 tile"),
+                  absl::string_view::npos);
+    }
 }
 
 TEST(TileCodec, GarbageIsRefusedWithAReason) {

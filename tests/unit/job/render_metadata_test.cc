@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lf/core/aov.h"
 #include "lf/job/merge.h"
 
 namespace lf {
@@ -28,6 +29,77 @@ TEST(RenderMetadata, PathRenderSaysItsTruncatedPathsAndNoRadiosity) {
     for (const auto& [name, value] : d->attributes) {
         EXPECT_NE(name.rfind("lightfarm.radiosity.", 0), 0u) << name;
     }
+}
+
+// Every header says what its numbers are: radiance in linear Rec.709, with OpenEXR's own
+// attributes for viewers that convert to absolute luminance (Y = 1 is 683 cd/m^2).
+TEST(RenderMetadata, TheHeaderGivesTheUnitsAndPrimaries) {
+    absl::StatusOr<RenderDescription> d =
+        DescribeRender(PathMetadata(), EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(d.ok()) << d.status();
+    const ExrAttributes& a = d->attributes;
+    EXPECT_EQ(std::get<std::string>(a.at("lightfarm.units")),
+              "R,G,B: radiance W m^-2 sr^-1, linear Rec.709 RGB");
+    const auto& c = std::get<ExrChromaticities>(a.at("chromaticities"));
+    // ITU-R BT.709 primaries and the D65 white point.
+    EXPECT_EQ(c, (ExrChromaticities{0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f}));
+    EXPECT_EQ(std::get<float>(a.at("whiteLuminance")), 683.0f);
+}
+
+TEST(RenderMetadata, TheFilterIsAlwaysNamed) {
+    RenderMetadata m = PathMetadata();
+    absl::StatusOr<RenderDescription> box = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(box.ok()) << box.status();
+    EXPECT_EQ(std::get<std::string>(box->attributes.at("lightfarm.filter")), "box");
+    m.filter = {PixelFilter::Type::kGaussian, 3};
+    absl::StatusOr<RenderDescription> gaussian = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(gaussian.ok()) << gaussian.status();
+    EXPECT_EQ(std::get<std::string>(gaussian->attributes.at("lightfarm.filter")), "gaussian 3 px");
+    EXPECT_NE(std::get<std::string>(gaussian->attributes.at("lightfarm.channels"))
+                  .find("(gaussian 3 px filter)"),
+              std::string::npos);
+}
+
+TEST(RenderMetadata, AovsAreListedOnlyWhenThereAreAny) {
+    RenderMetadata m = PathMetadata();
+    absl::StatusOr<RenderDescription> none = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(none.ok()) << none.status();
+    EXPECT_FALSE(none->attributes.count("lightfarm.aovs"));
+    EXPECT_EQ(std::get<std::string>(none->attributes.at("lightfarm.channels")).find("albedo"),
+              std::string::npos);
+    m.aovs = kAllAovs;
+    absl::StatusOr<RenderDescription> all = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(all.ok()) << all.status();
+    EXPECT_EQ(std::get<std::string>(all->attributes.at("lightfarm.aovs")), "albedo,normal,depth");
+    const std::string channels = std::get<std::string>(all->attributes.at("lightfarm.channels"));
+    for (const char* ch : {"albedo.R,G,B", "normal.X,Y,Z", "depth.Z"}) {
+        EXPECT_NE(channels.find(ch), std::string::npos) << ch << " in " << channels;
+    }
+    EXPECT_NE(std::get<std::string>(all->attributes.at("lightfarm.units")).find("depth.Z"),
+              std::string::npos);
+    m.aovs = kAovNormal;
+    absl::StatusOr<RenderDescription> normal = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(normal.ok()) << normal.status();
+    EXPECT_EQ(std::get<std::string>(normal->attributes.at("lightfarm.aovs")), "normal");
+}
+
+// --clamp biases the image: the header says so, and that the error estimates leave the bias
+// out. Without clamping there is nothing to say.
+TEST(RenderMetadata, AClampedImageSaysItIsBiased) {
+    RenderMetadata m = PathMetadata();
+    absl::StatusOr<RenderDescription> plain = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(plain.ok()) << plain.status();
+    EXPECT_FALSE(plain->attributes.count("lightfarm.clamp"));
+    EXPECT_FALSE(plain->attributes.count("lightfarm.bias"));
+    m.clamp = 10;
+    absl::StatusOr<RenderDescription> clamped = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(clamped.ok()) << clamped.status();
+    EXPECT_EQ(std::get<double>(clamped->attributes.at("lightfarm.clamp")), 10.0);
+    const std::string bias = std::get<std::string>(clamped->attributes.at("lightfarm.bias"));
+    EXPECT_EQ(bias.rfind("clamp: ", 0), 0u) << bias;
+    EXPECT_NE(bias.find("biased"), std::string::npos) << bias;
+    EXPECT_NE(bias.find("lightfarm.estimatedError"), std::string::npos) << bias;
+    EXPECT_NE(bias.find("not this bias"), std::string::npos) << bias;
 }
 
 TEST(RenderMetadata, ACameraPickedByNameIsNamedAndTheScenesOwnIsNot) {

@@ -180,5 +180,27 @@ TEST_F(SceneFilesTest, GltfAndGlbBlobsLoadAsRenderLoadsThem) {
         << no_image.status();
 }
 
+// An environment light's sky file is a scene file like a mesh: uploaded by the name the JSON
+// writes, loaded from that blob on the farm, and refused by its JSON path when not uploaded.
+TEST_F(SceneFilesTest, SkyFileLoadsFromItsBlob) {
+    const std::string sky = testing::HdrBytes(2, 1, {1, 1, 1, 0.5f, 0.5f, 0.5f});
+    std::ofstream(dir_ / "scenes" / "sky.hdr", std::ios::binary) << sky;
+    std::ofstream(dir_ / "scenes" / "up.obj") << kTriangle;
+    std::string json = SceneNaming({"up.obj"});
+    json.insert(json.size() - 1, R"(, "lights": [{"type": "environment", "file": "sky.hdr"}])");
+    std::ofstream(dir_ / "scenes" / "s.json") << json;
+    const absl::StatusOr<Scene> local = LoadScene((dir_ / "scenes" / "s.json").string());
+    ASSERT_TRUE(local.ok()) << local.status();
+    const absl::StatusOr<Scene> farm =
+        Load(Put("s.json", json), {Put("up.obj", kTriangle), Put("sky.hdr", sky)});
+    ASSERT_TRUE(farm.ok()) << farm.status();
+    EXPECT_EQ(farm->content_hash, local->content_hash);
+    ASSERT_TRUE(farm->environment && farm->environment->map);
+    EXPECT_EQ(farm->environment->map->width, 2);
+    const absl::StatusOr<Scene> missing = Load(Put("s.json", json), {Put("up.obj", kTriangle)});
+    EXPECT_EQ(missing.status().message(),
+              "s.json: lights[0].file \"sky.hdr\": not among the files uploaded with the scene");
+}
+
 }  // namespace
 }  // namespace lf

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <random>
 
+#include "lf/core/aov.h"
 #include "lf/core/sampler.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/merge.h"
@@ -21,14 +22,18 @@ namespace fs = std::filesystem;
 
 // A made-up sample, a pure function of (pixel, sample), over orders of magnitude so that the
 // bits depend on the sums being exact.
-TileSums RenderFake(const RenderTask& task) {
-    TileSums tile(task.rect);
+TileSums RenderFake(const RenderTask& task, uint32_t aovs = 0) {
+    TileSums tile(task.rect, aovs);
     for (int y = task.rect.y0; y < task.rect.y0 + task.rect.height; ++y) {
         for (int x = task.rect.x0; x < task.rect.x0 + task.rect.width; ++x) {
             for (uint64_t s = task.sample_begin; s < task.sample_end; ++s) {
                 Sampler sampler(5, x, y, s);
                 const float u = sampler.Get1D();
                 tile.at(x, y).Add(s, Rgb(std::exp(12 * u - 6), u * (x % 5 == 0 ? 3 : 0.1f), u));
+                if (aovs != 0 && u > 0.2f) {
+                    tile.aov_pixels[tile.Index(x, y)].Add(
+                        aovs, {Rgb(u, 1 - u, 0.5f), Vec3(0, u, -1), std::exp(30 * u)});
+                }
             }
         }
     }
@@ -55,8 +60,8 @@ class FileTileStoreTest : public ::testing::Test {
     void TearDown() override { fs::remove_all(dir_); }
 
     TileStoreFactory InFiles() const {
-        return [dir = dir_.string()](std::vector<PixelRect> tiles) {
-            return MakeFileTileStore(dir, std::move(tiles));
+        return [dir = dir_.string()](std::vector<PixelRect> tiles, uint32_t aovs) {
+            return MakeFileTileStore(dir, std::move(tiles), aovs);
         };
     }
 
@@ -81,6 +86,27 @@ TEST_F(FileTileStoreTest, FixedPlanSnapshotsHaveTheBitsOfTheMemoryStore) {
     }
     ASSERT_TRUE((*file)->Complete());
     ExpectSameBits(*(*file)->Snapshot(), *memory.Snapshot());
+}
+
+TEST_F(FileTileStoreTest, AovSnapshotsHaveTheBitsOfTheMemoryStore) {
+    constexpr int kWidth = 19, kHeight = 13;
+    for (uint32_t aovs : {uint32_t(kAovNormal), kAllAovs}) {
+        absl::StatusOr<std::vector<RenderTask>> plan = PlanRender({kWidth, kHeight, 6, 8, 2});
+        ASSERT_TRUE(plan.ok()) << plan.status();
+        RenderMerger memory(kWidth, kHeight, *plan, aovs);
+        absl::StatusOr<std::unique_ptr<RenderMerger>> file =
+            RenderMerger::Make(kWidth, kHeight, *plan, InFiles(), aovs);
+        ASSERT_TRUE(file.ok()) << file.status();
+        ExpectSameBits(*(*file)->Snapshot(), *memory.Snapshot());
+        for (const RenderTask& task : *plan) {
+            const TileSums sums = RenderFake(task, aovs);
+            ASSERT_TRUE(memory.Add(task.index, sums).ok());
+            ASSERT_TRUE((*file)->Add(task.index, sums).ok());
+        }
+        const Image image = *(*file)->Snapshot();
+        ASSERT_NE(image.FindChannel("normal.Y"), nullptr);
+        ExpectSameBits(image, *memory.Snapshot());
+    }
 }
 
 TEST_F(FileTileStoreTest, AdaptivePlanPlansAndMergesAsWithTheMemoryStore) {
@@ -109,7 +135,7 @@ TEST_F(FileTileStoreTest, AdaptivePlanPlansAndMergesAsWithTheMemoryStore) {
 
 TEST_F(FileTileStoreTest, ReadsZeroSumsBeforeAPutAndThePutSumsAfter) {
     const PixelRect a{0, 0, 4, 3}, b{4, 0, 2, 3};
-    absl::StatusOr<std::unique_ptr<TileStore>> store = MakeFileTileStore(dir_.string(), {a, b});
+    absl::StatusOr<std::unique_ptr<TileStore>> store = MakeFileTileStore(dir_.string(), {a, b}, 0);
     ASSERT_TRUE(store.ok()) << store.status();
     absl::StatusOr<TileSums> before = (*store)->Get(1);
     ASSERT_TRUE(before.ok());
@@ -132,7 +158,7 @@ TEST_F(FileTileStoreTest, ReadsZeroSumsBeforeAPutAndThePutSumsAfter) {
 
 TEST_F(FileTileStoreTest, RefusesATileOfTheWrongSize) {
     const PixelRect a{0, 0, 4, 3};
-    absl::StatusOr<std::unique_ptr<TileStore>> store = MakeFileTileStore(dir_.string(), {a});
+    absl::StatusOr<std::unique_ptr<TileStore>> store = MakeFileTileStore(dir_.string(), {a}, 0);
     ASSERT_TRUE(store.ok()) << store.status();
     const absl::Status wrong = (*store)->Put(0, TileSums(PixelRect{0, 0, 4, 4}));
     EXPECT_EQ(wrong.code(), absl::StatusCode::kInvalidArgument);
@@ -143,8 +169,24 @@ TEST_F(FileTileStoreTest, RefusesATileOfTheWrongSize) {
     EXPECT_EQ(kept->pixels.size(), 12u);
 }
 
+TEST_F(FileTileStoreTest, RefusesSumsWithOtherAovsThanTheStore) {
+    const PixelRect a{0, 0, 4, 3};
+    for (const TileStoreFactory& make : {InFiles(), TileStoreFactory(MakeMemoryTileStore)}) {
+        absl::StatusOr<std::unique_ptr<TileStore>> store = make({a}, kAovAlbedo);
+        ASSERT_TRUE(store.ok()) << store.status();
+        EXPECT_EQ((*store)->aovs(), uint32_t(kAovAlbedo));
+        const absl::Status plain = (*store)->Put(0, TileSums(a));
+        EXPECT_EQ(plain.code(), absl::StatusCode::kInvalidArgument);
+        EXPECT_NE(plain.message().find("the store keeps [albedo]"), std::string_view::npos)
+            << plain;
+        EXPECT_EQ((*store)->Put(0, TileSums(a, kAllAovs)).code(),
+                  absl::StatusCode::kInvalidArgument);
+        EXPECT_TRUE((*store)->Put(0, TileSums(a, kAovAlbedo)).ok());
+    }
+}
+
 TEST(MemoryTileStore, RefusesATileOfTheWrongSize) {
-    absl::StatusOr<std::unique_ptr<TileStore>> store = MakeMemoryTileStore({{0, 0, 4, 3}});
+    absl::StatusOr<std::unique_ptr<TileStore>> store = MakeMemoryTileStore({{0, 0, 4, 3}}, 0);
     ASSERT_TRUE(store.ok());
     EXPECT_EQ((*store)->Put(0, TileSums(PixelRect{1, 0, 4, 3})).code(),
               absl::StatusCode::kInvalidArgument);
@@ -152,7 +194,7 @@ TEST(MemoryTileStore, RefusesATileOfTheWrongSize) {
 
 TEST_F(FileTileStoreTest, UnwritableFolderIsAnErrorNamingIt) {
     absl::StatusOr<std::unique_ptr<TileStore>> store =
-        MakeFileTileStore((dir_ / "missing").string(), {{0, 0, 4, 3}});
+        MakeFileTileStore((dir_ / "missing").string(), {{0, 0, 4, 3}}, 0);
     ASSERT_FALSE(store.ok());
     EXPECT_NE(store.status().message().find("missing"), std::string_view::npos) << store.status();
 }

@@ -4,6 +4,7 @@
 
 #include <tuple>
 
+#include "lf/core/aov.h"
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
@@ -32,22 +33,31 @@ class Determinism : public ::testing::Test {
         embree_ = std::move(*es);
         camera_ = std::make_unique<Camera>(scene_.camera, embree_->origin());
         tracer_ = std::make_unique<PathTracer>(*embree_, -1);
+        CameraSpec filtered = scene_.camera;
+        filtered.filter = {PixelFilter::Type::kGaussian, 3};
+        gaussian_camera_ = std::make_unique<Camera>(filtered, embree_->origin());
     }
 
-    Image Render(int tile, int threads, int passes) const {
+    // `extras`: every AOV, a gaussian filter 3 px wide and a clamp of 1.5.
+    Image Render(int tile, int threads, int passes, bool extras = false) const {
         RenderSettings s;
         s.spp = 6;
         s.seed = 42;
         s.tile = tile;
         s.threads = threads;
         s.passes = passes;
-        return RenderImage(*camera_, *tracer_, s).value().image;
+        if (extras) {
+            s.aovs = kAllAovs;
+            s.clamp = 1.5;
+        }
+        return RenderImage(extras ? *gaussian_camera_ : *camera_, *tracer_, s).value().image;
     }
 
     Scene scene_;
     std::unique_ptr<EmbreeScene> embree_;
     std::unique_ptr<Camera> camera_;
     std::unique_ptr<PathTracer> tracer_;
+    std::unique_ptr<Camera> gaussian_camera_;
 };
 
 TEST_F(Determinism, SameBitsForAnyTileSizePassesAndThreadCount) {
@@ -61,17 +71,38 @@ TEST_F(Determinism, SameBitsForAnyTileSizePassesAndThreadCount) {
     }
 }
 
+TEST_F(Determinism, AovsFiltersAndClampKeepTheBitsForAnyTileSizePassesAndThreadCount) {
+    const Image reference = Render(24, 1, 1, true);
+    ASSERT_NE(reference.FindChannel("depth.Z"), nullptr);
+    for (auto [tile, threads, passes] : {std::tuple{1, 2, 1}, {7, 1, 2}, {16, 2, 6}}) {
+        const Image other = Render(tile, threads, passes, true);
+        ASSERT_EQ(other.channels().size(), reference.channels().size());
+        for (const auto& [name, data] : reference.channels()) {
+            EXPECT_EQ(data, *other.FindChannel(name)) << name << " tile " << tile;
+        }
+    }
+    // The filter moves samples, so the image differs from the box-filtered one.
+    EXPECT_NE(*reference.FindChannel("R"), *Render(24, 1, 1).FindChannel("R"));
+}
+
 TEST_F(Determinism, SamplePassesAddUpToTheSameBits) {
     const PixelRect rect{3, 5, 9, 7};
-    const TileSums whole = RenderTile(*camera_, *tracer_, rect, 9, 0, 8);
-    TileSums parts = RenderTile(*camera_, *tracer_, rect, 9, 5, 8);
-    parts += RenderTile(*camera_, *tracer_, rect, 9, 0, 2);
-    parts += RenderTile(*camera_, *tracer_, rect, 9, 2, 5);
-    for (size_t i = 0; i < whole.pixels.size(); ++i) {
-        EXPECT_EQ(whole.pixels[i].Count(), parts.pixels[i].Count());
-        for (int h = 0; h < 2; ++h) {
-            for (int c = 0; c < 3; ++c)
-                EXPECT_EQ(whole.pixels[i].sum[h][c], parts.pixels[i].sum[h][c]);
+    for (const SampleOptions options : {SampleOptions{}, SampleOptions{2.0, kAllAovs}}) {
+        const TileSums whole = RenderTile(*gaussian_camera_, *tracer_, rect, 9, 0, 8, options);
+        TileSums parts = RenderTile(*gaussian_camera_, *tracer_, rect, 9, 5, 8, options);
+        parts += RenderTile(*gaussian_camera_, *tracer_, rect, 9, 0, 2, options);
+        parts += RenderTile(*gaussian_camera_, *tracer_, rect, 9, 2, 5, options);
+        ASSERT_EQ(whole.aov_pixels.size(), parts.aov_pixels.size());
+        for (size_t i = 0; i < whole.pixels.size(); ++i) {
+            EXPECT_EQ(whole.pixels[i].Count(), parts.pixels[i].Count());
+            for (int h = 0; h < 2; ++h) {
+                for (int c = 0; c < 3; ++c) {
+                    EXPECT_EQ(whole.pixels[i].sum[h][c], parts.pixels[i].sum[h][c]);
+                }
+            }
+            if (options.aovs != 0) {
+                EXPECT_EQ(whole.aov_pixels[i], parts.aov_pixels[i]);
+            }
         }
     }
 }

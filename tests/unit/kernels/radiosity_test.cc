@@ -230,6 +230,58 @@ TEST(Radiosity, PlyExportWritesTheSharedVertices) {
     fs::remove(path);
 }
 
+// A square emitter of radiance Le between two equal receivers at equal distances above and
+// below it, each facing it. The emitter's front faces up: one-sided it leaves the lower receiver
+// dark; two-sided its back has radiosity pi Le too and the lower receiver gets what the upper
+// one does (mirror images: the same form factors up to their quadrature, 5e-4).
+TEST(Radiosity, TwoSidedEmitterLightsBothSides) {
+    const float le = 2.0f;
+    for (const bool two_sided : {false, true}) {
+        Scene scene;
+        Material emitter;
+        emitter.reflectance = Rgb(0.0f);
+        emitter.emission = Rgb(le);
+        emitter.two_sided_emission = two_sided;
+        Material receiver;
+        receiver.reflectance = Rgb(0.5f);
+        scene.materials = {emitter, receiver};
+        const auto square = [&](double y, bool up, int material) {
+            TriangleMesh m;
+            m.material = material;
+            m.is_quad = true;
+            m.positions = {{-0.5, y, -0.5}, {-0.5, y, 0.5}, {0.5, y, 0.5}, {0.5, y, -0.5}};
+            m.triangles = up ? std::vector<std::array<uint32_t, 3>>{{0, 1, 2}, {0, 2, 3}}
+                             : std::vector<std::array<uint32_t, 3>>{{0, 2, 1}, {0, 3, 2}};
+            return m;
+        };
+        scene.meshes = {square(0, true, 0), square(0.7, false, 1), square(-0.7, true, 1)};
+        RadiosityOptions options;
+        options.patches = 96;
+        Prepared p = Prepare(scene, options);
+        ASSERT_TRUE(p.renderer.ok()) << p.renderer.status();
+        const RadiosityRenderer& r = **p.renderer;
+        double power[3] = {};  // per mesh, front sides only for the receivers
+        bool emitter_back = false;
+        for (size_t s = 0; s < r.mesh().sides().size(); ++s) {
+            const PatchMesh::Side& side = r.mesh().sides()[s];
+            const PatchMesh::Patch& patch = r.mesh().patches()[size_t(side.patch)];
+            if (patch.mesh == 0 && side.back) {
+                emitter_back = true;
+                EXPECT_NEAR(r.radiosity()[s].r, kPi * le, 1e-5 * kPi * le);
+            }
+            if (patch.mesh > 0 && side.back) continue;
+            power[patch.mesh] += patch.area * r.radiosity()[s].r;
+        }
+        EXPECT_EQ(emitter_back, two_sided);
+        EXPECT_GT(power[1], 0);
+        if (two_sided) {
+            EXPECT_NEAR(power[2], power[1], 1e-3 * power[1]);
+        } else {
+            EXPECT_EQ(power[2], 0);
+        }
+    }
+}
+
 TEST(Radiosity, RefusesWhatItCannotRepresent) {
     Scene spheres = testing::MakeFurnace(1.0, Vec3d(), 0.5f, 1.0f, 8);
     spheres.spheres.push_back({"ball", 0, Vec3d(), 0.2});

@@ -405,6 +405,19 @@ TEST_F(FakeWorkerFarm, SubmissionDeclaringASmallerSizeThanItsBlobIsRefused) {
         << s.error_message();
 }
 
+TEST_F(FakeWorkerFarm, AnUnknownPixelFilterIsRefusedNamingTheField) {
+    pb::SubmitJobRequest request = SubmitRequest();
+    request.mutable_params()->set_filter_type(static_cast<pb::PixelFilterType>(77));
+    request.mutable_params()->set_filter_width(3);
+    pb::SubmitJobResponse response;
+    grpc::ClientContext context;
+    const grpc::Status s = job_stub_->SubmitJob(&context, request, &response);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(s.error_message().find("params.filter_type 77"), std::string::npos)
+        << s.error_message();
+    EXPECT_TRUE(farm_->scheduler().List()->empty());
+}
+
 TEST_F(FakeWorkerFarm, JobNameAndRequestIdAboveTheirLimitsAreRefused) {
     for (const bool name : {true, false}) {
         pb::SubmitJobRequest request = SubmitRequest();

@@ -9,7 +9,9 @@
 #include <filesystem>
 #include <functional>
 
+#include "lf/core/aov.h"
 #include "lf/core/patch_mesh.h"
+#include "lf/core/pixel_filter.h"
 #include "lf/job/job_spec.h"
 #include "server/farm.h"
 
@@ -36,6 +38,28 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
         {"spp", [](JobSpec& s) { s.plan.spp = kMaxSpp + 1; }},
         {"tile", [](JobSpec& s) { s.plan.tile = 0; }},
         {"tile", [](JobSpec& s) { s.plan.tile = kMaxFarmTile + 1; }},
+        {"tile",
+         [](JobSpec& s) {
+             s.aovs = kAllAovs;
+             s.plan.tile = kMaxFarmAovTile + 1;
+         }},
+        {"clamp", [](JobSpec& s) { s.clamp = -1; }},
+        {"clamp", [](JobSpec& s) { s.clamp = NAN; }},
+        {"clamp", [](JobSpec& s) { s.clamp = INFINITY; }},
+        {"aovs", [](JobSpec& s) { s.aovs = kAllAovs + 1; }},
+        {"filter",
+         [](JobSpec& s) {
+             s.scene_options.filter = PixelFilter{PixelFilter::Type::kBox, 2};
+         }},
+        {"filter",
+         [](JobSpec& s) {
+             s.scene_options.filter =
+                 PixelFilter{PixelFilter::Type::kGaussian, kMaxFilterWidth * 2};
+         }},
+        {"filter",
+         [](JobSpec& s) {
+             s.scene_options.filter = PixelFilter{PixelFilter::Type::kBlackmanHarris, NAN};
+         }},
         {"passes", [](JobSpec& s) { s.plan.passes = 0; }},
         {"passes", [](JobSpec& s) { s.plan.passes = kMaxPasses + 1; }},
         {"max_depth", [](JobSpec& s) { s.max_depth = -2; }},
@@ -81,6 +105,12 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     edge.radiosity.patches = kMaxPatchTarget;
     edge.radiosity.sweep_tasks = kMaxSweepTasks;
     edge.radiosity.max_patches = kMaxRefinedPatches;
+    edge.clamp = 1e300;
+    JobSpec aov_edge = edge;
+    aov_edge.aovs = kAllAovs;
+    aov_edge.plan.tile = kMaxFarmAovTile;
+    aov_edge.scene_options.filter = PixelFilter{PixelFilter::Type::kGaussian, kMaxFilterWidth};
+    EXPECT_TRUE(CheckJobSettings(aov_edge).ok()) << CheckJobSettings(aov_edge);
     EXPECT_TRUE(CheckJobSettings(JobSpec{}).ok()) << CheckJobSettings(JobSpec{});
     EXPECT_TRUE(CheckJobSettings(edge).ok()) << CheckJobSettings(edge);
     fs::remove_all(dir);

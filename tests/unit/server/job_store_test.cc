@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/aov.h"
 #include "server/job_record_codec.h"
 #include "server/sqlite_job_store.h"
 #include "test_dir.h"
@@ -154,6 +155,29 @@ TEST(JobRecordCodec, CameraAndResolutionSurviveAndOldRecordsHaveNone) {
     ASSERT_TRUE(old.ok()) << old.status();
     EXPECT_EQ(old->spec.scene_options.camera, "");
     EXPECT_EQ(old->spec.scene_options.width, 0);
+}
+
+TEST(JobRecordCodec, FilterClampAndAovsSurviveAndOldRecordsHaveNone) {
+    JobRecord job = Record("a", 1);
+    job.spec.scene_options.filter = PixelFilter{PixelFilter::Type::kBlackmanHarris, 2.5};
+    job.spec.clamp = 12.5;
+    job.spec.aovs = kAovAlbedo | kAovDepth;
+    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(job));
+    const absl::StatusOr<JobRecord> back = DecodeJobRecord(stored.dump());
+    ASSERT_TRUE(back.ok()) << back.status();
+    ASSERT_TRUE(back->spec.scene_options.filter.has_value());
+    EXPECT_EQ(back->spec.scene_options.filter->type, PixelFilter::Type::kBlackmanHarris);
+    EXPECT_EQ(back->spec.scene_options.filter->width, 2.5);
+    EXPECT_EQ(back->spec.clamp, 12.5);
+    EXPECT_EQ(back->spec.aovs, uint32_t(kAovAlbedo | kAovDepth));
+    stored["spec"]["filter"]["type"] = "lanczos";
+    EXPECT_EQ(DecodeJobRecord(stored.dump()).status().code(), absl::StatusCode::kDataLoss);
+    for (const char* key : {"filter", "clamp", "aovs"}) stored["spec"].erase(key);
+    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
+    ASSERT_TRUE(old.ok()) << old.status();
+    EXPECT_FALSE(old->spec.scene_options.filter.has_value());
+    EXPECT_EQ(old->spec.clamp, 0);
+    EXPECT_EQ(old->spec.aovs, 0u);
 }
 
 TEST(JobRecordCodec, UnknownStateNameIsAClearError) {

@@ -29,8 +29,9 @@ class SchedulerTileStoreTest : public ::testing::Test {
 
     SchedulerOptions InFiles() const {
         SchedulerOptions options;
-        options.tile_stores = [dir = (dir_ / "tiles").string()](std::vector<PixelRect> tiles) {
-            return MakeFileTileStore(dir, std::move(tiles));
+        options.tile_stores = [dir = (dir_ / "tiles").string()](std::vector<PixelRect> tiles,
+                                                                uint32_t aovs) {
+            return MakeFileTileStore(dir, std::move(tiles), aovs);
         };
         return options;
     }

@@ -19,6 +19,11 @@ enum AovFlag : uint32_t {
 };
 inline constexpr uint32_t kAllAovs = kAovAlbedo | kAovNormal | kAovDepth;
 
+// The EXR channels of each AOV, as lf::Image names them.
+inline constexpr const char* kAovAlbedoChannels[3] = {"albedo.R", "albedo.G", "albedo.B"};
+inline constexpr const char* kAovNormalChannels[3] = {"normal.X", "normal.Y", "normal.Z"};
+inline constexpr const char* kAovDepthChannel = "depth.Z";
+
 // `--aov` lists: comma-separated names (albedo, normal, depth) or "all"; "" is none.
 // InvalidArgument naming an unknown name and the known ones.
 absl::StatusOr<uint32_t> ParseAovList(std::string_view list);

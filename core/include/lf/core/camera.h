@@ -1,6 +1,7 @@
-// Pinhole camera exactly as docs/scene-format.md defines it.
+// Pinhole or thin-lens camera exactly as docs/scene-format.md defines it, with its pixel filter.
 #pragma once
 
+#include "lf/core/pixel_filter.h"
 #include "lf/core/ray.h"
 #include "lf/core/scene.h"
 
@@ -16,6 +17,11 @@ class Camera {
     // lens, `lens` (uniform in [0, 1)^2) picks the point on the aperture it leaves from.
     Ray GenerateRay(int px, int py, float u, float v, const Vec2& lens = {}) const;
 
+    // Where in its pixel a sample with film numbers u (uniform in [0, 1)^2) lands, for
+    // GenerateRay: distributed like the camera's pixel filter (FilterSampler); u itself for the
+    // box filter.
+    Vec2 SampleFilm(const Vec2& u) const { return filter_.Sample(u); }
+
     // Whether rays need a lens sample: a pinhole takes none, so its renders keep their bits.
     bool HasLens() const { return lens_radius_ > 0; }
 
@@ -27,6 +33,7 @@ class Camera {
     float tan_half_fov_ = 0, aspect_ = 1;
     float lens_radius_ = 0, focus_distance_ = 1;
     int width_ = 0, height_ = 0;
+    FilterSampler filter_;
 };
 
 }  // namespace lf

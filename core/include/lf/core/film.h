@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "lf/core/rgb.h"
+#include "lf/core/vec.h"
 
 namespace lf {
 
@@ -45,6 +46,32 @@ struct PixelSums {
     Rgb HalfMean(int half) const;
 };
 
+// What a camera ray's first hit shows, for the AOVs (lf/core/aov.h).
+struct FirstHit {
+    Rgb albedo;       // the surface's reflectance there (lf/kernels/aov_tracer.h says which)
+    Vec3 normal;      // world-space unit shading normal
+    float depth = 0;  // distance from the ray's origin
+};
+
+// The AOVs of one pixel's samples, summed exactly like the radiance. Albedo and normal are summed
+// over the samples that hit (a miss adds 0) and averaged over all samples (PixelSums::Count);
+// depth is summed and averaged over the `depth_hits` samples that hit only, +inf when none did.
+// Each value goes through ExactSum's clamp to +-2^50, so a depth (scene units reach 1e15) times
+// kMaxSpp = 2^24 samples stays inside the 127 bits: 2^(50 + 50 + 24) = 2^124.
+struct AovSums {
+    ExactSum albedo[3], normal[3], depth;
+    uint32_t depth_hits = 0;
+
+    // Adds only the AOVs `aovs` (flags) asks for, so unrequested sums stay zero.
+    void Add(uint32_t aovs, const FirstHit& hit);
+    AovSums& operator+=(const AovSums& o);
+    bool operator==(const AovSums&) const = default;
+    // Means over `samples` samples (PixelSums::Count()); 0 when there are none.
+    Rgb Albedo(uint32_t samples) const;
+    Vec3 Normal(uint32_t samples) const;
+    float Depth() const;  // +inf when no sample hit
+};
+
 struct PixelRect {
     int x0 = 0, y0 = 0, width = 0, height = 0;
     int64_t Area() const { return int64_t(width) * height; }
@@ -72,13 +99,17 @@ struct TileSums {
     PixelRect rect;
     std::vector<PixelSums> pixels;  // row-major within rect
     RenderStats stats;
+    uint32_t aovs = 0;                // lf/core/aov.h flags of the AOVs summed in aov_pixels
+    std::vector<AovSums> aov_pixels;  // row-major like pixels; empty when aovs is 0
 
-    explicit TileSums(const PixelRect& r) : rect(r), pixels(size_t(r.Area())) {}
-    PixelSums& at(int x, int y) { return pixels[size_t(y - rect.y0) * rect.width + (x - rect.x0)]; }
-    const PixelSums& at(int x, int y) const {
-        return pixels[size_t(y - rect.y0) * rect.width + (x - rect.x0)];
+    explicit TileSums(const PixelRect& r, uint32_t aov_flags = 0)
+        : rect(r), pixels(size_t(r.Area())), aovs(aov_flags) {
+        if (aovs != 0) aov_pixels.resize(pixels.size());
     }
-    TileSums& operator+=(const TileSums& o);  // same rect
+    size_t Index(int x, int y) const { return size_t(y - rect.y0) * rect.width + (x - rect.x0); }
+    PixelSums& at(int x, int y) { return pixels[Index(x, y)]; }
+    const PixelSums& at(int x, int y) const { return pixels[Index(x, y)]; }
+    TileSums& operator+=(const TileSums& o);  // same rect and AOVs
 };
 
 }  // namespace lf

@@ -23,12 +23,15 @@ class Image {
     const std::map<std::string, std::vector<float>>& channels() const { return channels_; }
 
     // Writes a tile's means: R,G,B and the two half-sample estimates A.R.. and B.R..,
-    // plus the per-pixel sample count in `spp`.
+    // plus the per-pixel sample count in `spp`, and the AOV channels of tile.aovs
+    // (lf/core/aov.h: albedo.R/G/B, normal.X/Y/Z, depth.Z), each a mean as AovSums defines.
     void SetTile(const TileSums& tile);
 
     Rgb Pixel(int x, int y, const std::string& prefix = "") const;
 
   private:
+    void SetAovs(const TileSums& tile);
+
     int width_ = 0, height_ = 0;
     std::map<std::string, std::vector<float>> channels_;
 };

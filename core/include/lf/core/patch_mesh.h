@@ -10,8 +10,9 @@
 // T-junction: the patches still tile the triangle, as Embree intersects the scene triangles).
 //
 // A patch has two sides. A side gets an unknown (a radiosity value to solve for) only if its
-// radiosity can be non-zero: it is the front of an emitter, or its reflectance is not black and
-// something (a vertex of another triangle or a point light) lies strictly in front of it.
+// radiosity can be non-zero: it is the front of an emitter (either side of a two-sided one), or
+// its reflectance is not black and something (a vertex of another triangle or a point light)
+// lies strictly in front of it.
 // Every other side has radiosity exactly zero: in a closed box only the inward sides remain.
 #pragma once
 

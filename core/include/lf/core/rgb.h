@@ -36,6 +36,13 @@ struct Rgb {
     bool IsFinite() const { return std::isfinite(r) && std::isfinite(g) && std::isfinite(b); }
 };
 
+// An emitted colour with its NaN, infinite and negative channels as 0: HDR files can hold such
+// texels, and they must emit nothing rather than poison an image or a normalisation.
+inline Rgb EmittableRadiance(const Rgb& c) {
+    const auto channel = [](float v) { return std::isfinite(v) && v > 0 ? v : 0.0f; };
+    return {channel(c.r), channel(c.g), channel(c.b)};
+}
+
 constexpr Rgb operator*(float s, const Rgb& c) { return c * s; }
 
 }  // namespace lf

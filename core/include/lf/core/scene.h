@@ -92,6 +92,12 @@ struct Material {
     bool double_sided = true;
 
     bool IsEmissive() const { return !emission.IsBlack(); }
+    // Whether rays can hit the back face: double-sided, or a transmitter whose back faces are
+    // where light leaves it. Only then can two_sided_emission emit from the back.
+    bool VisibleFromBehind() const {
+        return double_sided || type == Type::kDielectric ||
+               (type == Type::kPrincipled && transmission > 0);
+    }
     bool IsTextured() const {
         return base_color_texture.valid() || metallic_roughness_texture.valid() ||
                normal_texture.valid() || emission_texture.valid();

@@ -68,11 +68,11 @@ class AdaptiveTilePlan : public TileMerger {
     // into tasks of consecutive, even-length sample ranges (so each holds as many A as B
     // samples). Each tile's running sums are kept where `make_store` says. InvalidArgument for
     // sizes PlanRender refuses and for settings CheckAdaptiveSettings refuses; the factory's
-    // error when it cannot make the store.
+    // error when it cannot make the store. Results carry the AOVs `aovs` (lf/core/aov.h).
     static absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> Make(
         int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings,
         uint64_t max_task_samples = kMaxTaskSamples,
-        const TileStoreFactory& make_store = MakeMemoryTileStore);
+        const TileStoreFactory& make_store = MakeMemoryTileStore, uint32_t aovs = 0);
 
     // The tiles' first passes in plan order, then the passes Merge appends, in the order of the
     // results that asked for them.

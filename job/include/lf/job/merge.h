@@ -19,9 +19,9 @@ namespace lf {
 // InvalidArgument when `sums` is not `task`'s rectangle with its sample count in every pixel.
 absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums);
 
-// A black image with every channel lf::Image::SetTile writes, so that a snapshot of an
-// unfinished render has them all.
-Image EmptyRenderImage(int width, int height);
+// A black image with every channel lf::Image::SetTile writes for tiles with AOVs `aovs`, so that
+// a snapshot of an unfinished render has them all.
+Image EmptyRenderImage(int width, int height, uint32_t aovs = 0);
 
 // The distinct rectangles of `tasks`, in the order they first appear.
 std::vector<PixelRect> TileRects(const std::vector<RenderTask>& tasks);
@@ -55,7 +55,7 @@ class TileMerger {
         : width_(width), height_(height), store_(std::move(store)) {}
     TileStore& mutable_store() { return *store_; }
     // Adds `sums` to tile `tile`'s in the store; the tile's sums after, or the store's error (and
-    // nothing added).
+    // nothing added). InvalidArgument when `sums` carries other AOVs than the store.
     absl::StatusOr<TileSums> AddToTile(int tile, const TileSums& sums);
 
   private:
@@ -65,17 +65,18 @@ class TileMerger {
 
 class RenderMerger : public TileMerger {
   public:
-    // Keeps the tiles in memory.
-    RenderMerger(int width, int height, std::vector<RenderTask> tasks);
+    // Keeps the tiles in memory; results carry the AOVs `aovs` (lf/core/aov.h flags).
+    RenderMerger(int width, int height, std::vector<RenderTask> tasks, uint32_t aovs = 0);
     // Keeps the tiles where `make_store` says; its error when it cannot make the store.
     static absl::StatusOr<std::unique_ptr<RenderMerger>> Make(int width, int height,
                                                               std::vector<RenderTask> tasks,
-                                                              const TileStoreFactory& make_store);
+                                                              const TileStoreFactory& make_store,
+                                                              uint32_t aovs = 0);
 
     // Adds the result of task `task_index`. InvalidArgument when `sums` is not that task's
-    // rectangle with that task's sample count in every pixel; AlreadyExists when the task was
-    // merged before (the image is unchanged then); the store's error when it cannot read or
-    // write the tile (the task is then not merged).
+    // rectangle with that task's sample count in every pixel and the merger's AOVs; AlreadyExists
+    // when the task was merged before (the image is unchanged then); the store's error when it
+    // cannot read or write the tile (the task is then not merged).
     absl::Status Add(int task_index, const TileSums& sums);
 
     absl::StatusOr<std::vector<RenderTask>> Merge(int task_index, const TileSums& sums) override;

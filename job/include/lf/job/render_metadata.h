@@ -88,13 +88,16 @@ struct RenderDescription {
     std::optional<ErrorEstimates> estimates;  // when computed
 };
 
-// Every lightfarm.* attribute of a render: how it was made (version, scene hash, camera when
-// picked by name, method,
-// settings, timing, ray and sample counts, truncated paths), the image's own error estimates
-// (lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance) when
-// `complete` and every pixel has at least 2 samples, how an adaptive render ended
-// (lightfarm.targetError, .timeLimit, lightfarm.adaptive.*) and the radiosity solve
-// (lightfarm.radiosity.*).
+// Every attribute of a render's header: how it was made (lightfarm.version, scene hash, camera
+// when picked by name, method, settings, timing, ray and sample counts, truncated paths), what
+// the channels hold (lightfarm.channels, lightfarm.aovs when there are AOVs, lightfarm.filter),
+// their units (lightfarm.units and OpenEXR's standard chromaticities, Rec.709 with D65, and
+// whiteLuminance = 683 cd/m^2 for RGB (1, 1, 1)), the bias of --clamp (lightfarm.clamp and
+// lightfarm.bias, only when clamping), the image's own error estimates
+// (lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance: noise only,
+// never the clamp's bias) when `complete` and every pixel has at least 2 samples, how an
+// adaptive render ended (lightfarm.targetError, .timeLimit, lightfarm.adaptive.*) and the
+// radiosity solve (lightfarm.radiosity.*).
 absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& metadata, const Image& image,
                                                  bool complete);
 

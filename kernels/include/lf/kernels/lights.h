@@ -1,13 +1,16 @@
 // Every emitter of a scene, sampled for next-event estimation: emissive triangles and spheres
-// (area lights, uniform by area) and the delta lights: point, spot (KHR_lights_punctual's cone
-// falloff) and directional. A light is picked with probability proportional to its power, so a
-// tiny bright emitter gets the samples it needs.
+// (area lights, uniform by area, from the back too when two-sided), the delta lights (point,
+// spot with smoothstep or KHR_lights_punctual falloff, directional) and the lights at infinity
+// that BSDF-sampled rays can also reach: sun disks (directional lights with an angular
+// diameter, uniform in their cone) and the environment. A light is picked with probability
+// proportional to its power, so a tiny bright emitter gets the samples it needs.
 #pragma once
 
 #include <optional>
 #include <vector>
 
 #include "lf/kernels/embree_scene.h"
+#include "lf/kernels/environment_emitter.h"
 
 namespace lf {
 
@@ -15,7 +18,7 @@ struct LightSample {
     Rgb radiance;        // L_e arriving at the reference point; for delta lights the value that
                          // times the cosine is the irradiance: intensity / r^2 (point, spot),
                          // the irradiance itself (directional)
-    SurfacePoint point;  // on the light; for a directional light a point beyond the scene
+    SurfacePoint point;  // on the light; for lights at infinity a point beyond the scene
     Vec3 wi;             // unit, from the reference point to the light
     float pdf = 0;       // solid angle density times the pick probability; for a delta light
                          // just the pick probability
@@ -35,23 +38,45 @@ class LightSampler {
     // emitter hit by a BSDF-sampled ray); used for multiple importance sampling.
     float Pdf(const Vec3& ref, const SurfaceHit& hit) const;
 
+    // Radiance of the lights at infinity (sun disks, environment) arriving along a ray that
+    // leaves the scene in direction w (unit), and the density per solid angle with which Sample
+    // would have produced w: what a BSDF-sampled ray that hits nothing sees, and its MIS weight.
+    Rgb EscapedRadiance(const Vec3& w) const;
+    float EscapedPdf(const Vec3& w) const;
+
   private:
-    enum class Kind { kTriangle, kSphere, kPoint, kSpot, kDirectional };
+    enum class Kind { kTriangle, kSphere, kPoint, kSpot, kDirectional, kSun, kEnvironment };
     struct Light {
         Kind kind;
-        int index;      // mesh (triangle) / sphere / point, spot or directional light
+        int index;      // mesh (triangle) / sphere / point, spot, directional light / sun disk
         int primitive;  // triangle within the mesh
         float area;
+        bool two_sided;  // area lights: emission leaves the back face too
     };
-    // A spot light's cone in render space, with KHR_lights_punctual's falloff
-    // clamp(cos * scale + offset, 0, 1)^2.
+    // A spot light's cone in render space: with c = 1 - cos(angle to the axis) and
+    // t = clamp((one_minus_cos_outer - c) * inv_width, 0, 1) its falloff is t^2
+    // (KHR_lights_punctual) or t^2 (3 - 2 t) (smoothstep).
     struct SpotCone {
         Vec3 direction;
-        float scale, offset;
+        float one_minus_cos_outer, inv_width;
+        bool smooth;
+    };
+    // A sun disk: directions within angle alpha of `axis` (towards the sun) carry `radiance`.
+    // 1 - cos(alpha) is kept apart: for the sun (alpha = 0.0046) cos(alpha) in float is 1 to
+    // within 0.5 % of that difference.
+    struct SunDisk {
+        Vec3 axis;
+        float one_minus_cos;
+        Rgb radiance;
+        bool Contains(const Vec3& w) const;
     };
 
     int LightIndex(const SurfaceHit& hit) const;
     std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref) const;
+    // A direction towards a sun disk (uniform in its cone) or the environment (by its map).
+    std::optional<Vec3> SampleInfiniteDirection(const Light& light, const Vec2& u) const;
+    // Where a shadow ray from ref towards a light at infinity in direction wi ends.
+    Vec3 InfinitePoint(const Vec3& ref, const Vec3& wi) const;
 
     const EmbreeScene& scene_;
     std::vector<Light> lights_;
@@ -60,8 +85,12 @@ class LightSampler {
     std::vector<std::vector<int>> triangle_light_;  // per mesh, per triangle: light or -1
     std::vector<int> sphere_light_;                 // per sphere: light or -1
     std::vector<SpotCone> spot_cones_;              // per spot light
-    // Radius of a sphere about the render-space origin holding all geometry: shadow rays to a
-    // directional light end beyond it.
+    std::vector<SunDisk> suns_;                     // per directional light with a diameter
+    std::vector<float> sun_pmf_;                    // their pick probabilities
+    std::optional<EnvironmentEmitter> environment_;
+    float environment_pmf_ = 0;
+    // Radius of a sphere about the render-space origin holding all geometry: shadow rays to
+    // lights at infinity end beyond it.
     float scene_radius_ = 0;
 };
 

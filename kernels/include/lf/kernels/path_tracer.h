@@ -1,6 +1,7 @@
 // Unidirectional path tracing of the full rendering equation: next-event estimation with
-// multiple importance sampling (power heuristic) for area lights, next-event estimation for
-// point lights, BSDF sampling at every vertex and Russian roulette on the path throughput.
+// multiple importance sampling (power heuristic) for area lights and the lights at infinity
+// (environment, sun disks), which rays that leave the scene see; next-event estimation for
+// delta lights, BSDF sampling at every vertex and Russian roulette on the path throughput.
 // BSDFs are evaluated in the shading frame at each hit (lf/kernels/shading.h: vertex normals,
 // normal maps, textures) while the geometric normal decides sides; paths inside solid
 // transmitters are attenuated by Beer's law.
@@ -25,6 +26,7 @@ class PathTracer : public RadianceEstimator {
     PathTracer(const EmbreeScene& scene, int max_depth);
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
+    const EmbreeScene& geometry() const override { return scene_; }
 
   private:
     const EmbreeScene& scene_;

@@ -95,6 +95,7 @@ class RadiosityRenderer : public RadianceEstimator {
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override {
         return display_->Li(ray, sampler, stats);
     }
+    const EmbreeScene& geometry() const override { return display_->geometry(); }
 
     const RadiosityReport& report() const { return report_; }
     const PatchMesh& mesh() const { return *mesh_; }

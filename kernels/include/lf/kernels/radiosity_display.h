@@ -37,6 +37,7 @@ class RadiosityDisplay : public RadianceEstimator {
                      RadiosityShading shading);
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
+    const EmbreeScene& geometry() const override { return scene_; }
 
     // Radiance leaving one side of the point (b1, b2) of a scene triangle. Sides without an
     // unknown have radiosity 0.

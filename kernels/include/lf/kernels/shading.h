@@ -17,7 +17,7 @@ struct Shading {
     Vec3 ns;
     Vec2 uv;
     SurfaceParams params;
-    Rgb emission;  // radiance leaving the front face: factor times emission texture
+    Rgb emission;  // radiance leaving the front (both, if two-sided): factor times texture
     // Hanika's P' (Ray Tracing Gems II, ch. 4): the hit lifted towards the smooth surface the
     // vertex normals describe; where rays leaving on the normals' side start.
     Vec3 p_outer;
@@ -53,6 +53,10 @@ bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv);
 
 // Materials whose back faces let light out: single-sided culling spares them.
 bool Transmits(const Material& material);
+
+// Emission leaves the back face too: two-sided emitters whose back faces rays can reach (a
+// single-sided mesh's back is invisible, so neither hits nor light samples see it glow).
+bool EmitsFromBack(const Material& material);
 
 // Solid transmitters (principled with thickness > 0, dielectric): a path that crosses their
 // surface against the geometric normal is inside until it crosses back.

@@ -11,11 +11,21 @@
 
 namespace lf {
 
+// What every sample of a render does besides estimating radiance; both default to nothing, and
+// then a tile has the bits it had before either existed.
+struct SampleOptions {
+    // Above 0: a sample whose radiance exceeds it in some channel is scaled so that its largest
+    // channel equals it (Cycles' sample clamp: the hue stays, fireflies and their energy go).
+    double clamp = 0;
+    uint32_t aovs = 0;  // lf/core/aov.h flags: the first-hit AOVs to sum (aov_tracer.h)
+};
+
 // Samples [sample_begin, sample_end) of every pixel of `rect`. Sample s of pixel (x, y) uses
-// Sampler(seed, x, y, s) and its first two numbers place it in the pixel (box filter), so the
-// result depends on nothing else: not the tiling, not the thread.
+// Sampler(seed, x, y, s); its first two numbers place it in the pixel through the camera's
+// pixel filter (Camera::SampleFilm), and it adds to pixel (x, y) alone with weight 1, so the
+// result depends on nothing else: not the tiling, not the thread. AOVs draw no random numbers.
 TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, const PixelRect& rect,
                     uint64_t seed, uint64_t sample_begin, uint64_t sample_end,
-                    const std::atomic<bool>* cancel = nullptr);
+                    const SampleOptions& options = {}, const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace lf
