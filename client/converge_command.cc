@@ -3,6 +3,7 @@
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
+#include "sample_flags.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -62,6 +63,7 @@ Command AddConvergeCommand(CLI::App& app) {
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str()
         ->check(CLI::Range(-1, kMaxDepthLimit));
+    AddSamplerFlag(cmd, options->sampler);
     return {cmd, [options] {
                 absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
                 if (!result.ok()) return ReportError(result.status());

@@ -150,6 +150,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         settings.spp = spp;
         settings.seed = seed;
         settings.threads = options.threads;
+        settings.sampler = options.sampler;
         return RenderImage(camera, path_tracer, settings);
     };
 
@@ -224,6 +225,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             settings.spp = options.radiosity_spp;
             settings.seed = options.seed;
             settings.threads = options.threads;
+            settings.sampler = options.sampler;
             absl::StatusOr<RenderOutput> out = RenderImage(camera, **radiosity, settings);
             if (!out.ok()) return out.status();
             if (absl::Status s = add_row("radiosity", (*radiosity)->report().patches,

@@ -33,6 +33,7 @@ struct ConvergenceOptions {
     uint64_t seed = defaults::kSeed;
     int threads = 0;
     int max_depth = defaults::kMaxDepth;
+    SamplerType sampler = defaults::kSampler;  // of the ladder, the own reference, radiosity
 };
 
 struct ConvergenceRow {

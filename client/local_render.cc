@@ -166,6 +166,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     metadata.max_depth = options.max_depth;
     metadata.clamp = options.render.clamp;
     metadata.aovs = options.render.aovs;
+    metadata.sampler = options.render.sampler;
     metadata.filter = scene->camera.filter;
     metadata.seconds = summary.seconds;
     metadata.stats = out->stats;

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string_view>
 
 #include "lf/core/sobol.h"
 #include "lf/core/vec.h"
@@ -30,6 +32,16 @@ constexpr uint64_t MixBits(uint64_t v) {
 //    randomised-QMC estimates, and their difference stays an honest error estimate, which it
 //    would not be if the halves were two correlated parts of one net.
 enum class SamplerType { kIndependent, kSobol };
+
+// The names of `--sampler`, the job record and the EXR header (lightfarm.sampler).
+constexpr const char* SamplerTypeName(SamplerType type) {
+    return type == SamplerType::kSobol ? "sobol" : "independent";
+}
+constexpr std::optional<SamplerType> SamplerTypeFromName(std::string_view name) {
+    if (name == "sobol") return SamplerType::kSobol;
+    if (name == "independent") return SamplerType::kIndependent;
+    return std::nullopt;
+}
 
 class Sampler {
   public:
