@@ -51,25 +51,25 @@ class Sampler {
                              ((uint64_t(uint32_t(px)) << 32) | uint32_t(py)))),
           key_(pixel_key_ ^ MixBits(sample_index + 0x632be59bd9b4e019ULL)),
           sobol_key_(MixBits(pixel_key_ ^ (sample_index & 1))),
-          sobol_index_(uint32_t(sample_index >> 1)),
+          reversed_sobol_index_(ReverseBits32(uint32_t(sample_index >> 1))),
           type_(type) {}
 
     // Uniform in [0, 1), 24 bits so the float is exact and never rounds up to 1.
     float Get1D() {
         if (type_ == SamplerType::kSobol) {
             const uint64_t h = NextDimensionHash();
-            const uint32_t index = NestedUniformScramble(sobol_index_, uint32_t(h));
-            return ToFloat(NestedUniformScramble(SobolDimension0(index), uint32_t(h >> 32)));
+            return ToFloat(ScrambledDimension0(ShuffledReversedIndex(h), h));
         }
         return float(Next() >> 40) * 0x1p-24f;
     }
     Vec2 Get2D() {
         if (type_ == SamplerType::kSobol) {
             const uint64_t h = NextDimensionHash();
-            const uint32_t index = NestedUniformScramble(sobol_index_, uint32_t(h));
-            const uint64_t h2 = MixBits(h);
-            return {ToFloat(NestedUniformScramble(SobolDimension0(index), uint32_t(h >> 32))),
-                    ToFloat(NestedUniformScramble(SobolDimension1(index), uint32_t(h2)))};
+            const uint32_t reversed = ShuffledReversedIndex(h);
+            // NestedUniformScramble(SobolDimension1(index), seed), index = ReverseBits32(reversed)
+            const uint32_t y = ReverseBits32(
+                LaineKarrasPermutation(ReversedSobolDimension1(reversed), uint32_t(MixBits(h))));
+            return {ToFloat(ScrambledDimension0(reversed, h)), ToFloat(y)};
         }
         const uint64_t bits = Next();
         return {float(bits >> 40) * 0x1p-24f, float((bits >> 8) & 0xffffff) * 0x1p-24f};
@@ -83,11 +83,22 @@ class Sampler {
     // they share one scrambled sequence.
     uint64_t NextDimensionHash() { return MixBits(sobol_key_ + (++dimension_) * kGolden); }
     static float ToFloat(uint32_t fixed) { return float(fixed >> 8) * 0x1p-24f; }
+    // The draw's shuffled index, NestedUniformScramble(index in the half, seed), reversed: the
+    // scramble reverses, hashes and reverses back, and the reversal is kept for the next step.
+    uint32_t ShuffledReversedIndex(uint64_t h) const {
+        return LaineKarrasPermutation(reversed_sobol_index_, uint32_t(h));
+    }
+    // NestedUniformScramble(SobolDimension0(index), seed): dimension 0 is the reversed index,
+    // so the scramble's inner reversal gives the index itself.
+    static uint32_t ScrambledDimension0(uint32_t reversed_index, uint64_t h) {
+        return ReverseBits32(
+            LaineKarrasPermutation(ReverseBits32(reversed_index), uint32_t(h >> 32)));
+    }
 
     uint64_t pixel_key_;
     uint64_t key_;
-    uint64_t sobol_key_;    // the pixel's and the sample's half
-    uint32_t sobol_index_;  // the sample's index within its half
+    uint64_t sobol_key_;             // the pixel's and the sample's half
+    uint32_t reversed_sobol_index_;  // the sample's index within its half, bit-reversed
     SamplerType type_;
     uint64_t dimension_ = 0;
 };

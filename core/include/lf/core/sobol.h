@@ -44,8 +44,9 @@ constexpr uint32_t SobolDimension0(uint32_t index) { return ReverseBits32(index)
 namespace sobol_internal {
 // Dimension 1's generator matrix is Pascal's triangle mod 2: index bit k contributes column
 // c_k, whose bit j (from the most significant) is binomial(k, j) mod 2; so c_0 = 1 << 31 and
-// c_k = c_{k-1} ^ (c_{k-1} >> 1). Tabulated per index byte: four lookups per point.
-constexpr std::array<std::array<uint32_t, 256>, 4> MakeDimension1Tables() {
+// c_k = c_{k-1} ^ (c_{k-1} >> 1). Tabulated in the bit-reversed domain the scrambles work in
+// (reversed index bit 31 - k contributes the reversed c_k) per index byte: four lookups.
+constexpr std::array<std::array<uint32_t, 256>, 4> MakeReversedDimension1Tables() {
     std::array<uint32_t, 32> column{};
     column[0] = 1u << 31;
     for (int k = 1; k < 32; ++k) column[k] = column[k - 1] ^ (column[k - 1] >> 1);
@@ -54,20 +55,28 @@ constexpr std::array<std::array<uint32_t, 256>, 4> MakeDimension1Tables() {
         for (uint32_t value = 0; value < 256; ++value) {
             uint32_t x = 0;
             for (int bit = 0; bit < 8; ++bit) {
-                if (value & (1u << bit)) x ^= column[8 * byte + bit];
+                if (value & (1u << bit)) x ^= ReverseBits32(column[31 - (8 * byte + bit)]);
             }
             tables[byte][value] = x;
         }
     }
     return tables;
 }
-inline constexpr std::array<std::array<uint32_t, 256>, 4> kDimension1 = MakeDimension1Tables();
+inline constexpr std::array<std::array<uint32_t, 256>, 4> kReversedDimension1 =
+    MakeReversedDimension1Tables();
 }  // namespace sobol_internal
 
+// ReverseBits32(SobolDimension1(ReverseBits32(reversed_index))): dimension 1 where index and
+// point are both bit-reversed, as NestedUniformScramble's inner hash sees them; the sampler
+// works there to save the reversals.
+constexpr uint32_t ReversedSobolDimension1(uint32_t reversed_index) {
+    const auto& t = sobol_internal::kReversedDimension1;
+    return t[0][reversed_index & 0xff] ^ t[1][(reversed_index >> 8) & 0xff] ^
+           t[2][(reversed_index >> 16) & 0xff] ^ t[3][reversed_index >> 24];
+}
+
 constexpr uint32_t SobolDimension1(uint32_t index) {
-    const auto& t = sobol_internal::kDimension1;
-    return t[0][index & 0xff] ^ t[1][(index >> 8) & 0xff] ^ t[2][(index >> 16) & 0xff] ^
-           t[3][index >> 24];
+    return ReverseBits32(ReversedSobolDimension1(ReverseBits32(index)));
 }
 
 }  // namespace lf
