@@ -45,26 +45,28 @@ constexpr std::optional<SamplerType> SamplerTypeFromName(std::string_view name) 
 
 class Sampler {
   public:
+    // Independent: one key per sample. Sobol: one per pixel and half, the same for all its
+    // samples, so that each draw's hash seeds one scrambled sequence they all share.
     Sampler(uint64_t seed, int px, int py, uint64_t sample_index,
             SamplerType type = SamplerType::kIndependent)
-        : pixel_key_(MixBits(MixBits(seed ^ 0x9e3779b97f4a7c15ULL) ^
-                             ((uint64_t(uint32_t(px)) << 32) | uint32_t(py)))),
-          key_(pixel_key_ ^ MixBits(sample_index + 0x632be59bd9b4e019ULL)),
-          sobol_key_(MixBits(pixel_key_ ^ (sample_index & 1))),
-          reversed_sobol_index_(ReverseBits32(uint32_t(sample_index >> 1))),
+        : key_(type == SamplerType::kSobol
+                   ? MixBits(PixelKey(seed, px, py) ^ (sample_index & 1))
+                   : PixelKey(seed, px, py) ^ MixBits(sample_index + 0x632be59bd9b4e019ULL)),
+          reversed_sobol_index_(
+              type == SamplerType::kSobol ? ReverseBits32(uint32_t(sample_index >> 1)) : 0),
           type_(type) {}
 
     // Uniform in [0, 1), 24 bits so the float is exact and never rounds up to 1.
     float Get1D() {
         if (type_ == SamplerType::kSobol) {
-            const uint64_t h = NextDimensionHash();
+            const uint64_t h = Next();
             return ToFloat(ScrambledDimension0(ShuffledReversedIndex(h), h));
         }
         return float(Next() >> 40) * 0x1p-24f;
     }
     Vec2 Get2D() {
         if (type_ == SamplerType::kSobol) {
-            const uint64_t h = NextDimensionHash();
+            const uint64_t h = Next();
             const uint32_t reversed = ShuffledReversedIndex(h);
             // NestedUniformScramble(SobolDimension1(index), seed), index = ReverseBits32(reversed)
             const uint32_t y = ReverseBits32(
@@ -78,10 +80,12 @@ class Sampler {
   private:
     static constexpr uint64_t kGolden = 0x9e3779b97f4a7c15ULL;
 
+    static uint64_t PixelKey(uint64_t seed, int px, int py) {
+        return MixBits(MixBits(seed ^ kGolden) ^ ((uint64_t(uint32_t(px)) << 32) | uint32_t(py)));
+    }
+
+    // The next draw's hash: its random bits (independent) or its scrambles' seeds (Sobol).
     uint64_t Next() { return MixBits(key_ + (++dimension_) * kGolden); }
-    // The seeds of one Get1D/Get2D of this pixel and half: the same for all its samples, so
-    // they share one scrambled sequence.
-    uint64_t NextDimensionHash() { return MixBits(sobol_key_ + (++dimension_) * kGolden); }
     static float ToFloat(uint32_t fixed) { return float(fixed >> 8) * 0x1p-24f; }
     // The draw's shuffled index, NestedUniformScramble(index in the half, seed), reversed: the
     // scramble reverses, hashes and reverses back, and the reversal is kept for the next step.
@@ -95,9 +99,7 @@ class Sampler {
             LaineKarrasPermutation(ReverseBits32(reversed_index), uint32_t(h >> 32)));
     }
 
-    uint64_t pixel_key_;
     uint64_t key_;
-    uint64_t sobol_key_;             // the pixel's and the sample's half
     uint32_t reversed_sobol_index_;  // the sample's index within its half, bit-reversed
     SamplerType type_;
     uint64_t dimension_ = 0;
