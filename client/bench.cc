@@ -66,6 +66,7 @@ absl::Status RunBench(const BenchOptions& options) {
     RenderSettings settings;
     settings.spp = options.spp;
     settings.threads = options.threads;
+    settings.sampler = options.sampler;
     absl::StatusOr<RenderOutput> rendered = RenderImage(camera, tracer, settings);
     if (!rendered.ok()) return rendered.status();
     const RenderOutput& out = *rendered;
@@ -73,11 +74,11 @@ absl::Status RunBench(const BenchOptions& options) {
 
     const double sps = double(out.stats.samples) / out.seconds;
     const double rps = double(out.stats.rays) / out.seconds;
-    std::printf("scene            %s (%dx%d, %llu spp, max depth %s, %d threads)\n",
+    std::printf("scene            %s (%dx%d, %llu spp, max depth %s, %d threads, %s sampler)\n",
                 options.scene_path.c_str(), camera.width(), camera.height(),
                 (unsigned long long)options.spp,
                 options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth).c_str(),
-                options.threads);
+                options.threads, SamplerTypeName(options.sampler));
     std::printf("path tracing     %.3f M samples/s, %.3f M rays/s, %.2f rays/sample, %.2f s\n",
                 sps * 1e-6, rps * 1e-6, double(out.stats.rays) / double(out.stats.samples),
                 out.seconds);

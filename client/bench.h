@@ -17,6 +17,7 @@ struct BenchOptions {
     int resolution = 256;  // square side, 0: the scene's; unused when scene gives WxH
     SceneOptions scene;
     int max_depth = defaults::kMaxDepth;
+    SamplerType sampler = defaults::kSampler;
     uint64_t raw_rays = 4'000'000;
 };
 

@@ -1,5 +1,6 @@
 #include "bench.h"
 #include "command.h"
+#include "sample_flags.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -23,6 +24,7 @@ Command AddBenchCommand(CLI::App& app) {
                       "image size WxH, or N for a square N x N (0 = the scene's; default 256)");
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str();
+    AddSamplerFlag(cmd, options->sampler);
     cmd->add_option("--rays", options->raw_rays, "rays for the raw Embree measurement")
         ->capture_default_str();
     return {cmd, [options] {

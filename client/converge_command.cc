@@ -3,6 +3,7 @@
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
+#include "sample_flags.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -13,7 +14,8 @@ Command AddConvergeCommand(CLI::App& app) {
         "converge",
         "Measure error against time: render a ladder of budgets (path tracing: 1, 2, 4, ...\n"
         "spp; radiosity: doubling patch counts), compare each image with a reference and write\n"
-        "DIR/convergence.csv (method,budget,seconds,rmse,relmse,smape) and DIR/convergence.png\n"
+        "DIR/convergence.csv (method,budget,seconds,rmse,relmse,smape,estimated_relmse) and "
+        "DIR/convergence.png\n"
         "(log-log relative RMSE, sqrt(relmse), against seconds, fitted slope per method;\n"
         "drawn by gnuplot).\n"
         "Without --reference, a path-traced reference is rendered first (and the output says\n"
@@ -61,6 +63,7 @@ Command AddConvergeCommand(CLI::App& app) {
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str()
         ->check(CLI::Range(-1, kMaxDepthLimit));
+    AddSamplerFlag(cmd, options->sampler);
     return {cmd, [options] {
                 absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
                 if (!result.ok()) return ReportError(result.status());
@@ -68,11 +71,12 @@ Command AddConvergeCommand(CLI::App& app) {
                 if (result->reference_rmse > 0) {
                     std::printf(" (its own RMSE estimate from A/B: %.3e)", result->reference_rmse);
                 }
-                std::printf("\nmethod,budget,seconds,rmse,relmse,smape\n");
+                std::printf("\nmethod,budget,seconds,rmse,relmse,smape,estimated_relmse\n");
                 for (const ConvergenceRow& row : result->rows) {
-                    std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e\n", row.method.c_str(),
+                    std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s\n", row.method.c_str(),
                                 (long long)row.budget, row.seconds, row.error.rmse,
-                                row.error.relmse, row.error.smape);
+                                row.error.relmse, row.error.smape,
+                                EstimatedRelMseField(row).c_str());
                 }
                 for (const auto& [method, slope] : result->slopes) {
                     std::printf("%s: sqrt(relmse) ~ seconds^%.3f\n", method.c_str(), slope);

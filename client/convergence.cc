@@ -46,6 +46,14 @@ std::string GnuplotQuote(const std::string& s) {
 // root falls as time^-1/2 for plain Monte Carlo.
 double RelativeRmse(const ConvergenceRow& row) { return std::sqrt(row.error.relmse); }
 
+}  // namespace
+
+std::string EstimatedRelMseField(const ConvergenceRow& row) {
+    return row.estimated_relmse ? absl::StrFormat("%.6e", *row.estimated_relmse) : "";
+}
+
+namespace {
+
 std::string MethodTitle(const std::string& method) {
     return method == "path" ? "path tracing" : "radiosity";
 }
@@ -92,10 +100,11 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
 
 absl::Status WriteCsv(const ConvergenceResult& result) {
     std::ofstream csv(result.csv_path);
-    csv << "method,budget,seconds,rmse,relmse,smape\n";
+    csv << "method,budget,seconds,rmse,relmse,smape,estimated_relmse\n";
     for (const ConvergenceRow& row : result.rows) {
-        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e\n", row.method, row.budget, row.seconds,
-                               row.error.rmse, row.error.relmse, row.error.smape);
+        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e,%s\n", row.method, row.budget,
+                               row.seconds, row.error.rmse, row.error.relmse, row.error.smape,
+                               EstimatedRelMseField(row));
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.csv_path + ": cannot write");
@@ -141,6 +150,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         settings.spp = spp;
         settings.seed = seed;
         settings.threads = options.threads;
+        settings.sampler = options.sampler;
         return RenderImage(camera, path_tracer, settings);
     };
 
@@ -178,7 +188,13 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
                        const Image& image) -> absl::Status {
         absl::StatusOr<ImageError> error = CompareImages(image, reference);
         if (!error.ok()) return error.status();
-        result.rows.push_back({method, budget, seconds, *error});
+        // Path images estimate their own error from 2 spp on; a radiosity image's A/B halves
+        // see only the display's sampling, not the solution's error.
+        std::optional<double> estimated;
+        if (method == "path" && budget >= 2) {
+            if (absl::StatusOr<double> e = EstimatedRelMse(image); e.ok()) estimated = *e;
+        }
+        result.rows.push_back({method, budget, seconds, *error, estimated});
         log->info("job={} {} budget {}: {:.3f} s, rmse {:.4e}", job_id, method, budget, seconds,
                   error->rmse);
         return absl::OkStatus();
@@ -209,6 +225,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             settings.spp = options.radiosity_spp;
             settings.seed = options.seed;
             settings.threads = options.threads;
+            settings.sampler = options.sampler;
             absl::StatusOr<RenderOutput> out = RenderImage(camera, **radiosity, settings);
             if (!out.ok()) return out.status();
             if (absl::Status s = add_row("radiosity", (*radiosity)->report().patches,

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ struct ConvergenceOptions {
     uint64_t seed = defaults::kSeed;
     int threads = 0;
     int max_depth = defaults::kMaxDepth;
+    SamplerType sampler = defaults::kSampler;  // of the ladder, the own reference, radiosity
 };
 
 struct ConvergenceRow {
@@ -39,6 +41,9 @@ struct ConvergenceRow {
     int64_t budget = 0;  // spp or patches
     double seconds = 0;
     ImageError error;
+    // The image's own estimate of its relmse from its A/B halves (lf::EstimatedRelMse), to
+    // compare with `error.relmse`; path images of 2 spp or more only.
+    std::optional<double> estimated_relmse;
 };
 
 struct ConvergenceResult {
@@ -50,5 +55,8 @@ struct ConvergenceResult {
 };
 
 absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& options);
+
+// The row's estimated_relmse as a CSV field: "" when there is none.
+std::string EstimatedRelMseField(const ConvergenceRow& row);
 
 }  // namespace lf

@@ -407,7 +407,7 @@ Command AddSubmitCommand(CLI::App& app) {
                     "sample passes per tile; each pass of each tile is one task")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxPasses));
-    AddSampleFlags(cmd, o->spec.clamp, o->spec.aovs);
+    AddSampleFlags(cmd, o->spec.sampler, o->spec.clamp, o->spec.aovs);
     AddAdaptiveFlags(cmd, o->spec.adaptive);
     cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();

@@ -109,9 +109,10 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         estimator = std::make_unique<PathTracer>(**embree, options.max_depth);
     }
     log->info(
-        "job={} rendering {} ({}x{}, {} spp, seed {}, max depth {}, tile {}, {} filter{}{})",
+        "job={} rendering {} ({}x{}, {} spp, {} sampler, seed {}, max depth {}, tile {}, {} "
+        "filter{}{})",
         job_id, options.scene_path, camera.width(), camera.height(), options.render.spp,
-        options.render.seed,
+        SamplerTypeName(options.render.sampler), options.render.seed,
         options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
         options.render.tile, DescribePixelFilter(scene->camera.filter),
         options.render.clamp > 0 ? absl::StrCat(", clamp ", options.render.clamp, " (biased)")
@@ -166,6 +167,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     metadata.max_depth = options.max_depth;
     metadata.clamp = options.render.clamp;
     metadata.aovs = options.render.aovs;
+    metadata.sampler = options.render.sampler;
     metadata.filter = scene->camera.filter;
     metadata.seconds = summary.seconds;
     metadata.stats = out->stats;

@@ -37,8 +37,9 @@ struct PlanOptions {
     int64_t patches = defaults::kRadiosityPatches;
     int max_depth = defaults::kMaxDepth;
     int threads = 0;
-    double clamp =
-        0;  // --clamp: the pilot's noise, and so the samples, are those of a clamped render
+    // --sampler and --clamp: the pilot's noise, and so the samples, are those of the render's
+    SamplerType sampler = defaults::kSampler;
+    double clamp = 0;
 };
 
 std::string Color(const Rgb& c) { return absl::StrFormat("(%.3g, %.3g, %.3g)", c.r, c.g, c.b); }
@@ -260,6 +261,7 @@ absl::Status RunPlan(const PlanOptions& options) {
     settings.spp = options.pilot_spp;
     settings.threads = options.threads;
     settings.clamp = options.clamp;
+    settings.sampler = options.sampler;
     const AdaptiveSettings pilot_only{.target_error = options.target_error,
                                       .max_spp = options.pilot_spp};
     absl::StatusOr<RenderOutput> pilot = RenderImageAdaptive(camera, tracer, settings, pilot_only);
@@ -322,6 +324,7 @@ Command AddPlanCommand(CLI::App& app) {
     cmd->add_option("--threads", options->threads, "threads of the pilots; 0 = all cores")
         ->capture_default_str()
         ->check(CLI::Range(0, 1024));
+    AddSamplerFlag(cmd, options->sampler);
     AddClampFlag(cmd, options->clamp);
     return {cmd, [options] {
                 const absl::Status status = RunPlan(*options);

@@ -1,6 +1,7 @@
 #include "sample_flags.h"
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -8,6 +9,28 @@
 #include "lf/core/aov.h"
 
 namespace lf {
+
+void AddSamplerFlag(CLI::App* cmd, SamplerType& sampler) {
+    cmd->add_option_function<std::string>(
+           "--sampler",
+           [&sampler](const std::string& name) {
+               const std::optional<SamplerType> type = SamplerTypeFromName(name);
+               if (!type) {
+                   throw CLI::ValidationError(
+                       absl::StrCat("--sampler ", name, ": expected independent or sobol"));
+               }
+               sampler = *type;
+           },
+           absl::StrCat(
+               "where each sample's random numbers come from: sobol (Owen-scrambled Sobol "
+               "points, stratified and low-discrepancy in every pair of dimensions a path uses, "
+               "so on smooth integrands the error falls faster than spp^-1/2) or independent "
+               "(the older hashed random numbers, error as spp^-1/2, for comparison); both are "
+               "pure functions of seed, pixel and sample, so tiles, passes and workers give the "
+               "same bits. Default ",
+               SamplerTypeName(sampler)))
+        ->type_name("independent|sobol");
+}
 
 void AddClampFlag(CLI::App* cmd, double& clamp) {
     cmd->add_option_function<double>(
@@ -25,7 +48,8 @@ void AddClampFlag(CLI::App* cmd, double& clamp) {
         ->type_name("L");
 }
 
-void AddSampleFlags(CLI::App* cmd, double& clamp, uint32_t& aovs) {
+void AddSampleFlags(CLI::App* cmd, SamplerType& sampler, double& clamp, uint32_t& aovs) {
+    AddSamplerFlag(cmd, sampler);
     AddClampFlag(cmd, clamp);
     cmd->add_option_function<std::string>(
            "--aov",

@@ -1,16 +1,23 @@
-// --clamp and --aov: what each sample contributes beyond its radiance, for the commands that
-// render an image (`render`, `submit`; `plan` takes --clamp, which changes the noise it costs).
+// --sampler, --clamp and --aov: where each sample's random numbers come from and what it
+// contributes beyond its radiance, for the commands that render an image (`render`, `submit`;
+// `plan`, `bench` and `converge` take --sampler, and `plan` --clamp, which change the noise and
+// so what a render costs).
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
 
+#include "lf/core/sampler.h"
+
 namespace lf {
+
+// --sampler independent|sobol into `sampler`; its default is what `sampler` holds.
+void AddSamplerFlag(CLI::App* cmd, SamplerType& sampler);
 
 // --clamp L into `clamp` (>= 0; 0 = off).
 void AddClampFlag(CLI::App* cmd, double& clamp);
 
-// --clamp, and --aov LIST into `aovs` (lf/core/aov.h flags).
-void AddSampleFlags(CLI::App* cmd, double& clamp, uint32_t& aovs);
+// --sampler, --clamp, and --aov LIST into `aovs` (lf/core/aov.h flags).
+void AddSampleFlags(CLI::App* cmd, SamplerType& sampler, double& clamp, uint32_t& aovs);
 
 }  // namespace lf

@@ -230,6 +230,7 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
     metadata.max_depth = job.spec.max_depth;
     metadata.clamp = job.spec.clamp;
     metadata.aovs = job.spec.aovs;
+    metadata.sampler = job.spec.sampler;
     metadata.filter = job.spec.scene_options.filter.value_or(PixelFilter{});
     metadata.seconds = job.started == absl::InfinitePast()
                            ? 0.0

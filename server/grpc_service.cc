@@ -81,6 +81,11 @@ grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
             absl::StrCat("params.filter_type ", req->params().filter_type(),
                          ": unknown pixel filter; expected box, gaussian or blackman-harris")));
     }
+    if (!pb::SamplerType_IsValid(req->params().sampler())) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("params.sampler ", req->params().sampler(),
+                         ": unknown sampler; expected independent or sobol")));
+    }
     absl::StatusOr<std::string> id = farm_.Submit(FromProto(*req));
     if (!id.ok()) {
         Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()), Peer(context),

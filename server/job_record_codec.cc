@@ -100,6 +100,7 @@ std::string EncodeJobRecord(const JobRecord& r) {
           {"filter", FilterToJson(s.scene_options.filter)},
           {"clamp", s.clamp},
           {"aovs", s.aovs},
+          {"sampler", SamplerTypeName(s.sampler)},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
           {"request_id", s.request_id}}},
@@ -170,6 +171,15 @@ absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
         }
         r.spec.clamp = s.value("clamp", 0.0);
         r.spec.aovs = s.value("aovs", uint32_t(0));
+        // Records before --sampler were rendered with independent numbers; a job resumed from
+        // one must keep them, or its remaining tiles would not match those already merged.
+        const std::string sampler = s.value("sampler", "independent");
+        if (const std::optional<SamplerType> type = SamplerTypeFromName(sampler)) {
+            r.spec.sampler = *type;
+        } else {
+            return absl::DataLossError(
+                absl::StrCat("the stored record's sampler \"", sampler, "\" is not a sampler"));
+        }
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();
         r.spec.request_id = s.value("request_id", "");

@@ -271,7 +271,7 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
     constexpr uint64_t kSamplesPerPiece = 1 << 16;
     const PixelRect& rect = task.task.rect;
     const uint64_t step = std::max<uint64_t>(1, kSamplesPerPiece / uint64_t(rect.width));
-    const SampleOptions options{task.spec.clamp, task.spec.aovs};
+    const SampleOptions options{task.spec.clamp, task.spec.aovs, task.spec.sampler};
     TileSums tile(rect, options.aovs);
     std::mutex stats_mutex;
     arena_.execute([&] {

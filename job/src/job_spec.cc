@@ -78,6 +78,11 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
             return absl::InvalidArgumentError(absl::StrCat("camera: ", s.message()));
         }
     }
+    // A cast from the wire or a record could hold any value; SampleOptions takes only these.
+    if (spec.sampler != SamplerType::kIndependent && spec.sampler != SamplerType::kSobol) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("sampler ", int(spec.sampler), ": expected independent or sobol"));
+    }
     if (spec.scene_options.filter) {
         if (absl::Status s = CheckPixelFilter(*spec.scene_options.filter); !s.ok()) {
             return absl::InvalidArgumentError(absl::StrCat("filter ", s.message()));

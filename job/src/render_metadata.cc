@@ -35,6 +35,7 @@ ExrAttributes DescribeMethod(const RenderMetadata& m) {
         {"lightfarm.spp", int(m.spp)},
         {"lightfarm.seed", std::to_string(m.seed)},
         {"lightfarm.maxDepth", m.max_depth},
+        {"lightfarm.sampler", std::string(SamplerTypeName(m.sampler))},
         {"lightfarm.seconds", m.seconds},
         {"lightfarm.invalidSamples", std::to_string(m.stats.invalid_samples)},
         {"lightfarm.truncatedPaths", std::to_string(m.stats.truncated_paths)},

@@ -13,7 +13,7 @@ TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, co
         for (int x = rect.x0; x < rect.x0 + rect.width; ++x) {
             PixelSums& pixel = tile.at(x, y);
             for (uint64_t s = sample_begin; s < sample_end; ++s) {
-                Sampler sampler(seed, x, y, s);
+                Sampler sampler(seed, x, y, s, options.sampler);
                 const Vec2 film = camera.SampleFilm(sampler.Get2D());
                 const Vec2 lens = camera.HasLens() ? sampler.Get2D() : Vec2{};
                 const Ray ray = camera.GenerateRay(x, y, film.x, film.y, lens);

@@ -38,7 +38,7 @@ TileStoreFactory TileStoreFor(const Camera& camera, uint32_t aovs) {
 }
 
 SampleOptions SampleOptionsOf(const RenderSettings& settings) {
-    return {settings.clamp, settings.aovs};
+    return {settings.clamp, settings.aovs, settings.sampler};
 }
 
 }  // namespace

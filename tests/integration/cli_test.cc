@@ -69,6 +69,7 @@ TEST_F(Cli, RenderWritesExrWithMetadataAndPng) {
         EXPECT_TRUE(file->attributes.count(key)) << key;
     }
     EXPECT_EQ(std::get<int>(file->attributes.at("lightfarm.spp")), 2);
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.sampler")), "sobol");
     // Two samples leave a typical pixel about 20 % off: flagged, in the log and header.
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.highVariance")), "yes");
     EXPECT_GT(std::get<double>(file->attributes.at("lightfarm.estimatedRelMse")), 0.01);
@@ -252,7 +253,7 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     std::ifstream csv(out / "convergence.csv");
     std::string line;
     ASSERT_TRUE(std::getline(csv, line));
-    EXPECT_EQ(line, "method,budget,seconds,rmse,relmse,smape");
+    EXPECT_EQ(line, "method,budget,seconds,rmse,relmse,smape,estimated_relmse");
     std::vector<std::string> rows;
     while (std::getline(csv, line)) rows.push_back(line);
     // spp 1, 2, 4 and patch targets 100, 200.
@@ -260,9 +261,13 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     EXPECT_EQ(rows[0].rfind("path,1,", 0), 0u) << rows[0];
     EXPECT_EQ(rows[3].rfind("radiosity,", 0), 0u) << rows[3];
     for (const std::string& row : rows) {
-        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 5) << row;
+        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 6) << row;
         EXPECT_EQ(row.find("nan"), std::string::npos) << row;
     }
+    // The image's own estimate from 2 spp on, for path rows only.
+    EXPECT_EQ(rows[0].back(), ',') << rows[0];
+    EXPECT_NE(rows[1].back(), ',') << rows[1];
+    EXPECT_EQ(rows[3].back(), ',') << rows[3];
     EXPECT_GT(fs::file_size(out / "convergence.png"), 1000u);
 
     // Radiosity's refusal comes before any rendering.
@@ -437,6 +442,7 @@ TEST_F(Cli, BadAovClampFilterAndToneFlagsAreRefused) {
         {"--filter gaussian:wide", "--filter gaussian:wide: the width after ':'"},
         {"--filter gaussian:100", "--filter gaussian:100: width 100: expected 0.5 to 16"},
         {"--filter box:2", "--filter box:2: width 2: the box filter is one pixel wide"},
+        {"--sampler halton", "--sampler halton: expected independent or sobol"},
     };
     for (const auto& [flags, message] : cases) {
         for (const std::string& command : {"render " + scene + " -o " + (dir_ / "x.exr").string(),
@@ -476,14 +482,15 @@ TEST_F(Cli, HelpExplainsTheOutputFlags) {
     }
 }
 
-// --clamp and --aov go into the header (lightfarm.clamp, lightfarm.bias, lightfarm.aovs) and
-// the summary says the error estimate leaves the clamp's bias out.
-TEST_F(Cli, ClampAndAovsAreInTheHeader) {
+// --clamp, --aov and --sampler go into the header (lightfarm.clamp, lightfarm.bias,
+// lightfarm.aovs, lightfarm.sampler) and the summary says the error estimate leaves the clamp's
+// bias out.
+TEST_F(Cli, ClampAovsAndSamplerAreInTheHeader) {
     const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
     const std::string exr = (dir_ / "c.exr").string();
     const RunResult r = Lightfarm("render " + scene + " -o " + exr +
                                   " --spp 2 --resolution 16x16 --clamp 4 --aov normal,albedo "
-                                  "--no-progress");
+                                  "--sampler independent --no-progress");
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("noise only: --clamp biases the image"), std::string::npos) << r.output;
     absl::StatusOr<ExrFile> file = ReadExr(exr);
@@ -492,6 +499,7 @@ TEST_F(Cli, ClampAndAovsAreInTheHeader) {
     EXPECT_EQ(std::get<double>(a.at("lightfarm.clamp")), 4.0);
     EXPECT_NE(std::get<std::string>(a.at("lightfarm.bias")).find("biased"), std::string::npos);
     EXPECT_EQ(std::get<std::string>(a.at("lightfarm.aovs")), "albedo,normal");
+    EXPECT_EQ(std::get<std::string>(a.at("lightfarm.sampler")), "independent");
     EXPECT_EQ(std::get<std::string>(a.at("lightfarm.filter")), "box");
     EXPECT_EQ(std::get<float>(a.at("whiteLuminance")), 683.0f);
     EXPECT_EQ(std::get<ExrChromaticities>(a.at("chromaticities")), kRec709Chromaticities);
@@ -577,6 +585,21 @@ TEST_F(Cli, RadiositySummaryReportsEveryPhaseAndTheTotal) {
 }
 
 // `render` and `submit` take their defaults from the job model: the same solver for both.
+// Every command that samples an image takes --sampler, says what the two are, and defaults to
+// Sobol.
+TEST_F(Cli, HelpExplainsTheSampler) {
+    for (const char* command :
+         {"render --help", "submit --help", "bench --help", "converge --help", "plan --help"}) {
+        const RunResult r = Lightfarm(command);
+        ASSERT_EQ(r.status, 0) << r.output;
+        for (const char* text : {"--sampler independent|sobol", "low-discrepancy", "spp^-1/2",
+                                 "for comparison", "Default sobol"}) {
+            EXPECT_NE(r.output.find(text), std::string::npos) << command << ": " << text << "\n"
+                                                              << r.output;
+        }
+    }
+}
+
 TEST_F(Cli, RenderAndSubmitShareTheirDefaults) {
     for (const char* command : {"render --help", "submit --help"}) {
         const RunResult r = Lightfarm(command);

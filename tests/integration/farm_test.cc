@@ -678,12 +678,14 @@ TEST_F(Farm, FetchWritesThePngPreviewAsRenderDoes) {
 
 // End to end (needs the sampling pipeline of issue 13 on the wire and in the workers): --clamp,
 // --aov and --filter give the same image and header on the farm as locally.
-TEST_F(Farm, ClampAovsAndFilterGiveTheSameImageAndHeaderLocallyAndOnTheFarm) {
+// The other Farm tests render with the default sampler (sobol); this one with the other.
+TEST_F(Farm, ClampAovsFilterAndSamplerGiveTheSameImageAndHeaderLocallyAndOnTheFarm) {
     StartServer();
     StartWorker("w1");
     StartWorker("w2");
     const std::string flags =
-        "--spp 4 --seed 2 --tile 16 --clamp 2 --aov all --filter blackman-harris:2";
+        "--spp 4 --seed 2 --tile 16 --clamp 2 --aov all "
+        "--filter blackman-harris:2 --sampler independent";
     const std::string job = Submit(scene_, flags);
     ASSERT_EQ(Farmctl("watch " + job).status, 0);
     const std::string farm = (dir_ / "farm.exr").string(), local = (dir_ / "local.exr").string();
@@ -700,6 +702,7 @@ TEST_F(Farm, ClampAovsAndFilterGiveTheSameImageAndHeaderLocallyAndOnTheFarm) {
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.aovs")), "albedo,normal,depth");
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.filter")),
               "blackman-harris 2 px");
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.sampler")), "independent");
     EXPECT_NE(file->image.FindChannel("depth.Z"), nullptr);
 }
 

@@ -18,7 +18,7 @@ struct PathRender {
 };
 
 inline PathRender RenderPath(const Scene& scene, uint64_t spp, int max_depth = -1,
-                             uint64_t seed = 1) {
+                             uint64_t seed = 1, SamplerType sampler = defaults::kSampler) {
     auto es = EmbreeScene::Build(scene);
     EXPECT_TRUE(es.ok()) << es.status();
     const Camera camera(scene.camera, (*es)->origin());
@@ -27,6 +27,7 @@ inline PathRender RenderPath(const Scene& scene, uint64_t spp, int max_depth = -
     settings.spp = spp;
     settings.seed = seed;
     settings.tile = 8;
+    settings.sampler = sampler;
     return {RenderImage(camera, tracer, settings).value(), std::move(*es)};
 }
 

@@ -38,6 +38,15 @@ std::optional<PixelFilter> FilterFromProto(const pb::RenderParams& p) {
     }
 }
 
+pb::SamplerType ToProto(SamplerType type) {
+    return type == SamplerType::kSobol ? pb::SAMPLER_SOBOL : pb::SAMPLER_INDEPENDENT;
+}
+
+// JobService refuses values this build does not know before converting, as for the filter.
+SamplerType FromProto(pb::SamplerType type) {
+    return type == pb::SAMPLER_SOBOL ? SamplerType::kSobol : SamplerType::kIndependent;
+}
+
 }  // namespace
 
 void ToProto(const BlobRef& ref, pb::SceneFile* out) {
@@ -83,6 +92,7 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_height(spec.scene_options.height);
     out->set_clamp(spec.clamp);
     out->set_aovs(spec.aovs);
+    out->set_sampler(ToProto(spec.sampler));
     if (const std::optional<PixelFilter>& filter = spec.scene_options.filter) {
         out->set_filter_type(ToProto(filter->type));
         out->set_filter_width(filter->width);
@@ -103,6 +113,7 @@ void FromProto(const pb::RenderParams& p, JobSpec* spec) {
     spec->scene_options = {p.camera(), p.width(), p.height(), FilterFromProto(p)};
     spec->clamp = p.clamp();
     spec->aovs = p.aovs();
+    spec->sampler = FromProto(p.sampler());
 }
 
 void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {

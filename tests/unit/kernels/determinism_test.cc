@@ -39,8 +39,10 @@ class Determinism : public ::testing::Test {
     }
 
     // `extras`: every AOV, a gaussian filter 3 px wide and a clamp of 1.5.
-    Image Render(int tile, int threads, int passes, bool extras = false) const {
+    Image Render(int tile, int threads, int passes, bool extras = false,
+                 SamplerType sampler = defaults::kSampler) const {
         RenderSettings s;
+        s.sampler = sampler;
         s.spp = 6;
         s.seed = 42;
         s.tile = tile;
@@ -60,15 +62,27 @@ class Determinism : public ::testing::Test {
     std::unique_ptr<Camera> gaussian_camera_;
 };
 
+// Both samplers: Sobol's sample s is point s/2 of the pixel's half s%2, so passes that start
+// at odd samples (6 spp in 4 passes: [0,1) [1,3) [3,4) [4,6)) must continue both halves.
 TEST_F(Determinism, SameBitsForAnyTileSizePassesAndThreadCount) {
-    const Image reference = Render(24, 1, 1);
-    for (auto [tile, threads, passes] :
-         {std::tuple{1, 2, 1}, {5, 2, 3}, {7, 1, 2}, {16, 2, 6}, {64, 2, 4}}) {
-        const Image other = Render(tile, threads, passes);
-        for (const auto& [name, data] : reference.channels()) {
-            EXPECT_EQ(data, *other.FindChannel(name)) << name << " tile " << tile;
+    for (const SamplerType sampler : {SamplerType::kSobol, SamplerType::kIndependent}) {
+        const Image reference = Render(24, 1, 1, false, sampler);
+        for (auto [tile, threads, passes] :
+             {std::tuple{1, 2, 1}, {5, 2, 3}, {7, 1, 2}, {16, 2, 6}, {64, 2, 4}}) {
+            const Image other = Render(tile, threads, passes, false, sampler);
+            for (const auto& [name, data] : reference.channels()) {
+                EXPECT_EQ(data, *other.FindChannel(name))
+                    << name << " tile " << tile << " " << SamplerTypeName(sampler);
+            }
         }
     }
+}
+
+// The setting reaches the kernel: the two samplers' images are the same scene's, not the same
+// bits.
+TEST_F(Determinism, TheSamplerChangesTheNoise) {
+    EXPECT_NE(*Render(24, 1, 1, false, SamplerType::kSobol).FindChannel("R"),
+              *Render(24, 1, 1, false, SamplerType::kIndependent).FindChannel("R"));
 }
 
 TEST_F(Determinism, AovsFiltersAndClampKeepTheBitsForAnyTileSizePassesAndThreadCount) {
@@ -87,7 +101,9 @@ TEST_F(Determinism, AovsFiltersAndClampKeepTheBitsForAnyTileSizePassesAndThreadC
 
 TEST_F(Determinism, SamplePassesAddUpToTheSameBits) {
     const PixelRect rect{3, 5, 9, 7};
-    for (const SampleOptions options : {SampleOptions{}, SampleOptions{2.0, kAllAovs}}) {
+    for (const SampleOptions options :
+         {SampleOptions{}, SampleOptions{2.0, kAllAovs}, SampleOptions{0, 0, SamplerType::kSobol},
+          SampleOptions{2.0, kAllAovs, SamplerType::kSobol}}) {
         const TileSums whole = RenderTile(*gaussian_camera_, *tracer_, rect, 9, 0, 8, options);
         TileSums parts = RenderTile(*gaussian_camera_, *tracer_, rect, 9, 5, 8, options);
         parts += RenderTile(*gaussian_camera_, *tracer_, rect, 9, 0, 2, options);

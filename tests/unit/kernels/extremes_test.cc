@@ -174,9 +174,15 @@ TEST(Extremes, TinyBrightEmitterMatchesTheAnalyticIrradiance) {
 TEST(Extremes, FirefliesAreFlaggedAsHighVariance) {
     const Scene mirror = TinyEmitterScene(Material::Type::kMirror, 0.95f);
     const Scene diffuse = TinyEmitterScene(Material::Type::kLambert, 0.5f);
+    // Independent samples: the camera sees the lamp in the mirror only through the pixel
+    // position, a 2D integral that Sobol points stratify, so each half of a middle pixel gets
+    // its share of hits to within one and there is no firefly to flag (with seed 4 the A and B
+    // halves agree in every pixel). Fireflies are what independent numbers make here.
     for (uint64_t seed : {1, 2, 3, 4, 5, 6}) {
         const VarianceAssessment m =
-            AssessVariance(testing::RenderPath(mirror, 1024, -1, seed).out.image).value();
+            AssessVariance(
+                testing::RenderPath(mirror, 1024, -1, seed, SamplerType::kIndependent).out.image)
+                .value();
         const VarianceAssessment d =
             AssessVariance(testing::RenderPath(diffuse, 64, -1, seed).out.image).value();
         EXPECT_TRUE(m.high) << "seed " << seed;

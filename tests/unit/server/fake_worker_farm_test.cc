@@ -418,6 +418,17 @@ TEST_F(FakeWorkerFarm, AnUnknownPixelFilterIsRefusedNamingTheField) {
     EXPECT_TRUE(farm_->scheduler().List()->empty());
 }
 
+TEST_F(FakeWorkerFarm, AnUnknownSamplerIsRefusedNamingTheField) {
+    pb::SubmitJobRequest request = SubmitRequest();
+    request.mutable_params()->set_sampler(static_cast<pb::SamplerType>(77));
+    pb::SubmitJobResponse response;
+    grpc::ClientContext context;
+    const grpc::Status s = job_stub_->SubmitJob(&context, request, &response);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(s.error_message().find("params.sampler 77"), std::string::npos) << s.error_message();
+    EXPECT_TRUE(farm_->scheduler().List()->empty());
+}
+
 TEST_F(FakeWorkerFarm, JobNameAndRequestIdAboveTheirLimitsAreRefused) {
     for (const bool name : {true, false}) {
         pb::SubmitJobRequest request = SubmitRequest();

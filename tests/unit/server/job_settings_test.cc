@@ -65,6 +65,7 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
         {"max_depth", [](JobSpec& s) { s.max_depth = -2; }},
         {"max_depth", [](JobSpec& s) { s.max_depth = kMaxDepthLimit + 1; }},
         {"method", [](JobSpec& s) { s.method = "photon"; }},
+        {"sampler", [](JobSpec& s) { s.sampler = static_cast<SamplerType>(7); }},
         {"adaptive.target_error", [](JobSpec& s) { s.adaptive.target_error = 1e-9; }},
         {"adaptive.target_error", [](JobSpec& s) { s.adaptive.target_error = NAN; }},
         {"adaptive.time_limit", [](JobSpec& s) { s.adaptive.time_limit = -1; }},
@@ -112,6 +113,8 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     aov_edge.scene_options.filter = PixelFilter{PixelFilter::Type::kGaussian, kMaxFilterWidth};
     EXPECT_TRUE(CheckJobSettings(aov_edge).ok()) << CheckJobSettings(aov_edge);
     EXPECT_TRUE(CheckJobSettings(JobSpec{}).ok()) << CheckJobSettings(JobSpec{});
+    EXPECT_EQ(JobSpec{}.sampler, SamplerType::kSobol);
+    edge.sampler = SamplerType::kIndependent;
     EXPECT_TRUE(CheckJobSettings(edge).ok()) << CheckJobSettings(edge);
     fs::remove_all(dir);
 }

@@ -180,6 +180,29 @@ TEST(JobRecordCodec, FilterClampAndAovsSurviveAndOldRecordsHaveNone) {
     EXPECT_EQ(old->spec.aovs, 0u);
 }
 
+// A record written before --sampler was rendered with independent numbers: resumed, its
+// remaining tiles must use them too, whatever the default is now.
+TEST(JobRecordCodec, SamplerSurvivesAndOldRecordsKeepIndependentNumbers) {
+    for (const SamplerType sampler : {SamplerType::kSobol, SamplerType::kIndependent}) {
+        JobRecord job = Record("a", 1);
+        job.spec.sampler = sampler;
+        const absl::StatusOr<JobRecord> back = DecodeJobRecord(EncodeJobRecord(job));
+        ASSERT_TRUE(back.ok()) << back.status();
+        EXPECT_EQ(back->spec.sampler, sampler);
+    }
+    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
+    EXPECT_EQ(stored.at("spec").at("sampler"), "sobol");  // the default
+    stored["spec"]["sampler"] = "halton";
+    const absl::StatusOr<JobRecord> unknown = DecodeJobRecord(stored.dump());
+    EXPECT_EQ(unknown.status().code(), absl::StatusCode::kDataLoss);
+    EXPECT_NE(unknown.status().message().find("sampler \"halton\""), std::string_view::npos)
+        << unknown.status();
+    stored["spec"].erase("sampler");
+    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
+    ASSERT_TRUE(old.ok()) << old.status();
+    EXPECT_EQ(old->spec.sampler, SamplerType::kIndependent);
+}
+
 TEST(JobRecordCodec, UnknownStateNameIsAClearError) {
     nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
     stored["state"] = "paused";

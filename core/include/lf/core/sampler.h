@@ -1,9 +1,13 @@
-// Counter-based random numbers: every value is a pure function of (seed, pixel, sample index,
-// dimension), so any split of the work into tiles, passes or threads gives the same bits.
+// Counter-based sample values: every value is a pure function of (seed, pixel, sample index,
+// dimension), so any split of the work into tiles, passes or threads gives the same bits, and
+// samples [a, b) of a pixel continue its samples [0, a).
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string_view>
 
+#include "lf/core/sobol.h"
 #include "lf/core/vec.h"
 
 namespace lf {
@@ -18,24 +22,86 @@ constexpr uint64_t MixBits(uint64_t v) {
     return v;
 }
 
+// How a pixel's samples are spread over the unit hypercube:
+//  - kIndependent: hashed independent uniform values; error falls as spp^-1/2.
+//  - kSobol: each Get1D/Get2D is its own shuffled, Owen-scrambled Sobol (0,2)-sequence
+//    (lf/core/sobol.h), independent across pixels and dimensions, so every 2D projection a
+//    path asks for is stratified and smooth integrands converge faster than spp^-1/2.
+//    Even and odd samples are two independent such sequences (sample s is point s/2 of
+//    sequence s%2): the image's A and B halves (lf::PixelSums) are then independent
+//    randomised-QMC estimates, and their difference stays an honest error estimate, which it
+//    would not be if the halves were two correlated parts of one net.
+enum class SamplerType { kIndependent, kSobol };
+
+// The names of `--sampler`, the job record and the EXR header (lightfarm.sampler).
+constexpr const char* SamplerTypeName(SamplerType type) {
+    return type == SamplerType::kSobol ? "sobol" : "independent";
+}
+constexpr std::optional<SamplerType> SamplerTypeFromName(std::string_view name) {
+    if (name == "sobol") return SamplerType::kSobol;
+    if (name == "independent") return SamplerType::kIndependent;
+    return std::nullopt;
+}
+
 class Sampler {
   public:
-    Sampler(uint64_t seed, int px, int py, uint64_t sample_index)
-        : key_(MixBits(MixBits(seed ^ 0x9e3779b97f4a7c15ULL) ^
-                       ((uint64_t(uint32_t(px)) << 32) | uint32_t(py))) ^
-               MixBits(sample_index + 0x632be59bd9b4e019ULL)) {}
+    // Independent: one key per sample. Sobol: one per pixel and half, the same for all its
+    // samples, so that each draw's hash seeds one scrambled sequence they all share.
+    Sampler(uint64_t seed, int px, int py, uint64_t sample_index,
+            SamplerType type = SamplerType::kIndependent)
+        : key_(type == SamplerType::kSobol
+                   ? MixBits(PixelKey(seed, px, py) ^ (sample_index & 1))
+                   : PixelKey(seed, px, py) ^ MixBits(sample_index + 0x632be59bd9b4e019ULL)),
+          reversed_sobol_index_(
+              type == SamplerType::kSobol ? ReverseBits32(uint32_t(sample_index >> 1)) : 0),
+          type_(type) {}
 
-    // Uniform in [0, 1), 24 random bits so the float is exact and never rounds up to 1.
-    float Get1D() { return float(Next() >> 40) * 0x1p-24f; }
+    // Uniform in [0, 1), 24 bits so the float is exact and never rounds up to 1.
+    float Get1D() {
+        if (type_ == SamplerType::kSobol) {
+            const uint64_t h = Next();
+            return ToFloat(ScrambledDimension0(ShuffledReversedIndex(h), h));
+        }
+        return float(Next() >> 40) * 0x1p-24f;
+    }
     Vec2 Get2D() {
+        if (type_ == SamplerType::kSobol) {
+            const uint64_t h = Next();
+            const uint32_t reversed = ShuffledReversedIndex(h);
+            // NestedUniformScramble(SobolDimension1(index), seed), index = ReverseBits32(reversed)
+            const uint32_t y = ReverseBits32(
+                LaineKarrasPermutation(ReversedSobolDimension1(reversed), uint32_t(MixBits(h))));
+            return {ToFloat(ScrambledDimension0(reversed, h)), ToFloat(y)};
+        }
         const uint64_t bits = Next();
         return {float(bits >> 40) * 0x1p-24f, float((bits >> 8) & 0xffffff) * 0x1p-24f};
     }
 
   private:
-    uint64_t Next() { return MixBits(key_ + (++dimension_) * 0x9e3779b97f4a7c15ULL); }
+    static constexpr uint64_t kGolden = 0x9e3779b97f4a7c15ULL;
+
+    static uint64_t PixelKey(uint64_t seed, int px, int py) {
+        return MixBits(MixBits(seed ^ kGolden) ^ ((uint64_t(uint32_t(px)) << 32) | uint32_t(py)));
+    }
+
+    // The next draw's hash: its random bits (independent) or its scrambles' seeds (Sobol).
+    uint64_t Next() { return MixBits(key_ + (++dimension_) * kGolden); }
+    static float ToFloat(uint32_t fixed) { return float(fixed >> 8) * 0x1p-24f; }
+    // The draw's shuffled index, NestedUniformScramble(index in the half, seed), reversed: the
+    // scramble reverses, hashes and reverses back, and the reversal is kept for the next step.
+    uint32_t ShuffledReversedIndex(uint64_t h) const {
+        return LaineKarrasPermutation(reversed_sobol_index_, uint32_t(h));
+    }
+    // NestedUniformScramble(SobolDimension0(index), seed): dimension 0 is the reversed index,
+    // so the scramble's inner reversal gives the index itself.
+    static uint32_t ScrambledDimension0(uint32_t reversed_index, uint64_t h) {
+        return ReverseBits32(
+            LaineKarrasPermutation(ReverseBits32(reversed_index), uint32_t(h >> 32)));
+    }
 
     uint64_t key_;
+    uint32_t reversed_sobol_index_;  // the sample's index within its half, bit-reversed
+    SamplerType type_;
     uint64_t dimension_ = 0;
 };
 

@@ -29,6 +29,7 @@ struct JobSpec {
     int max_depth = defaults::kMaxDepth;
     double clamp = 0;   // RenderSettings::clamp (lf/local/local_executor.h); 0: off
     uint32_t aovs = 0;  // lf/core/aov.h flags
+    SamplerType sampler = defaults::kSampler;
     std::string method = defaults::kMethod;  // or "radiosity"
     RadiositySettings radiosity;
     AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused

@@ -15,6 +15,7 @@
 #include "lf/core/scene.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/plan.h"
+#include "lf/job/settings.h"
 
 namespace lf {
 
@@ -69,6 +70,7 @@ struct RenderMetadata {
     double clamp = 0;    // 0: no clamping; otherwise the image is biased (lightfarm.clamp)
     uint32_t aovs = 0;   // lf/core/aov.h flags of the AOV channels the image has
     PixelFilter filter;  // the camera's, after --filter
+    SamplerType sampler = defaults::kSampler;  // lightfarm.sampler
     double seconds = 0;  // the whole render: loading, meshing, solving and sampling
     RenderStats stats;
     AdaptiveSettings adaptive_settings;
@@ -89,7 +91,8 @@ struct RenderDescription {
 };
 
 // Every attribute of a render's header: how it was made (lightfarm.version, scene hash, camera
-// when picked by name, method, settings, timing, ray and sample counts, truncated paths), what
+// when picked by name, method, settings with lightfarm.sampler, timing, ray and sample counts,
+// truncated paths), what
 // the channels hold (lightfarm.channels, lightfarm.aovs when there are AOVs, lightfarm.filter),
 // their units (lightfarm.units and OpenEXR's standard chromaticities, Rec.709 with D65, and
 // whiteLuminance = 683 cd/m^2 for RGB (1, 1, 1)), the bias of --clamp (lightfarm.clamp and

@@ -6,6 +6,8 @@
 
 #include <cstdint>
 
+#include "lf/core/sampler.h"
+
 namespace lf::defaults {
 
 inline constexpr uint64_t kSpp = 16;
@@ -14,6 +16,8 @@ inline constexpr int kTile = 32;
 inline constexpr int kPasses = 1;
 inline constexpr int kMaxDepth = -1;  // unlimited: Russian roulette ends paths
 inline constexpr const char* kMethod = "path";
+// Owen-scrambled Sobol points ("sobol"): lower error at equal samples than "independent".
+inline constexpr SamplerType kSampler = SamplerType::kSobol;
 inline constexpr uint64_t kAdaptiveMaxSpp = uint64_t(1) << 16;
 
 inline constexpr int64_t kRadiosityPatches = 4000;

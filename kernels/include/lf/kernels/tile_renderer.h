@@ -7,23 +7,27 @@
 
 #include "lf/core/camera.h"
 #include "lf/core/film.h"
+#include "lf/core/sampler.h"
 #include "lf/kernels/radiance.h"
 
 namespace lf {
 
-// What every sample of a render does besides estimating radiance; both default to nothing, and
-// then a tile has the bits it had before either existed.
+// What every sample of a render does besides estimating radiance and where its random numbers
+// come from. The defaults are the kernel's oldest behaviour (no clamp, no AOVs, independent
+// numbers: a tile has the bits it had before these options existed); jobs and local renders
+// pass their own, whose sampler defaults to defaults::kSampler (lf/job/settings.h).
 struct SampleOptions {
     // Above 0: a sample whose radiance exceeds it in some channel is scaled so that its largest
     // channel equals it (Cycles' sample clamp: the hue stays, fireflies and their energy go).
     double clamp = 0;
     uint32_t aovs = 0;  // lf/core/aov.h flags: the first-hit AOVs to sum (aov_tracer.h)
+    SamplerType sampler = SamplerType::kIndependent;
 };
 
 // Samples [sample_begin, sample_end) of every pixel of `rect`. Sample s of pixel (x, y) uses
-// Sampler(seed, x, y, s); its first two numbers place it in the pixel through the camera's
-// pixel filter (Camera::SampleFilm), and it adds to pixel (x, y) alone with weight 1, so the
-// result depends on nothing else: not the tiling, not the thread. AOVs draw no random numbers.
+// Sampler(seed, x, y, s, options.sampler); its first two numbers place it in the pixel through the
+// camera's pixel filter (Camera::SampleFilm), and it adds to pixel (x, y) alone with weight 1, so
+// the result depends on nothing else: not the tiling, not the thread. AOVs draw no random numbers.
 TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, const PixelRect& rect,
                     uint64_t seed, uint64_t sample_begin, uint64_t sample_end,
                     const SampleOptions& options = {}, const std::atomic<bool>* cancel = nullptr);

@@ -26,7 +26,8 @@ struct RenderSettings {
     // `--clamp`: above 0, a sample whose radiance exceeds it in some channel is scaled down
     // so that channel equals it (biased: it removes fireflies and energy with them).
     double clamp = 0;
-    uint32_t aovs = 0;  // lf/core/aov.h flags: first-hit AOV channels to add
+    uint32_t aovs = 0;                         // lf/core/aov.h flags: first-hit AOV channels to add
+    SamplerType sampler = defaults::kSampler;  // `--sampler`
 };
 
 struct RenderOutput {
