@@ -21,13 +21,12 @@
 #include <optional>
 #include <vector>
 
+#include "lf/core/light_strategy.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/environment_emitter.h"
 #include "lf/kernels/light_bvh.h"
 
 namespace lf {
-
-enum class LightStrategy { kPower, kBvh };
 
 struct LightSample {
     Rgb radiance;        // L_e arriving at the reference point; for delta lights the value that
