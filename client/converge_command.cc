@@ -1,25 +1,59 @@
 #include <cstdio>
 
+#include "absl/strings/str_format.h"
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
-#include "sample_flags.h"
 #include "scene_flags.h"
 
 namespace lf {
+
+namespace {
+
+// Per configuration its slopes, speed and errors at equal time, the first as the baseline.
+void PrintSummary(const ConvergenceResult& result) {
+    const TimeRange& t = result.equal_time;
+    const ConfigSummary& base = result.configs.front();
+    std::printf(
+        "\npath tracing, fitted over %llu to %llu spp (each ladder's rungs there); equal time: "
+        "errors at %.4g s, the longest time every configuration reaches, and their ratios to %s "
+        "there and as the geometric mean over %.4g to %.4g s (each curve interpolated as a power "
+        "law between its rungs)\n",
+        (unsigned long long)base.fit.from, (unsigned long long)base.fit.to, t.to,
+        ConfigName(base.config).c_str(), t.from, t.to);
+    if (!result.fit_note.empty()) std::printf("(%s)\n", result.fit_note.c_str());
+    const std::string rule(126, '-');
+    std::printf("%-18s %9s %9s %11s %11s %11s %17s %17s\n%-18s %9s %9s %11s %11s %11s %17s %17s\n",
+                "configuration", "slope rel", "slope", "samples/s", "RMSE", "relMSE", "RMSE ratio",
+                "relMSE ratio", "", "RMSE", "", "", "at equal time", "at equal time",
+                "at end, mean", "at end, mean");
+    std::printf("%s\n", rule.c_str());
+    for (const ConfigSummary& c : result.configs) {
+        std::printf("%-18s %9.3f %9.3f %10.3fM %11.4e %11.4e %8.3f, %6.3f %8.3f, %6.3f\n",
+                    ConfigName(c.config).c_str(), c.relative_rmse_slope, c.rmse_slope,
+                    c.samples_per_second * 1e-6, c.rmse_at_equal_time, c.relmse_at_equal_time,
+                    c.rmse_ratio_at_end, c.rmse_ratio_mean, c.relmse_ratio_at_end,
+                    c.relmse_ratio_mean);
+    }
+}
+
+}  // namespace
 
 Command AddConvergeCommand(CLI::App& app) {
     auto options = std::make_shared<ConvergenceOptions>();
     CLI::App* cmd = app.add_subcommand(
         "converge",
         "Measure error against time: render a ladder of budgets (path tracing: 1, 2, 4, ...\n"
-        "spp; radiosity: doubling patch counts), compare each image with a reference and write\n"
-        "DIR/convergence.csv (method,budget,seconds,rmse,relmse,smape,estimated_relmse) and "
-        "DIR/convergence.png\n"
-        "(log-log relative RMSE, sqrt(relmse), against seconds, fitted slope per method;\n"
-        "drawn by gnuplot).\n"
-        "Without --reference, a path-traced reference is rendered first (and the output says\n"
-        "so). See docs/convergence.md.");
+        "spp, per configuration of sampler and light strategy; radiosity: doubling patch\n"
+        "counts), compare each image with one reference and write DIR/convergence.csv\n"
+        "(method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling),\n"
+        "DIR/summary.csv and a table (per configuration: slopes of relative RMSE and RMSE\n"
+        "against time over --fit-spp, samples/s, errors at equal time and their ratio to the\n"
+        "first configuration) and DIR/convergence.png (log-log error against seconds; gnuplot).\n"
+        "Compare configurations with --sampler independent,sobol --light-sampling power,bvh\n"
+        "(every pair) or --compare independent/power,sobol/bvh.\n"
+        "Without --reference, the most efficient configuration renders one (DIR/reference.exr;\n"
+        "the output says which). See docs/convergence.md.");
     cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
@@ -63,25 +97,67 @@ Command AddConvergeCommand(CLI::App& app) {
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str()
         ->check(CLI::Range(-1, kMaxDepthLimit));
-    AddSamplerFlag(cmd, options->sampler);
-    return {cmd, [options] {
+    auto samplers = std::make_shared<std::string>(SamplerTypeName(options->configs[0].sampler));
+    auto strategies =
+        std::make_shared<std::string>(LightStrategyName(options->configs[0].light_strategy));
+    auto compare = std::make_shared<std::string>();
+    auto fit = std::make_shared<std::string>();
+    CLI::Option* sampler_option =
+        cmd->add_option("--sampler", *samplers,
+                        "samplers of the path ladders, a comma-separated list of independent "
+                        "and sobol; with --light-sampling, every pair is a configuration")
+            ->capture_default_str();
+    CLI::Option* lights_option =
+        cmd->add_option("--light-sampling", *strategies,
+                        "light strategies of the path ladders, a comma-separated list of power "
+                        "and bvh")
+            ->capture_default_str();
+    cmd->add_option("--compare", *compare,
+                    "configurations of the path ladders, SAMPLER/LIGHTS, comma-separated, e.g. "
+                    "independent/power,sobol/bvh; the first is the baseline of the ratios")
+        ->excludes(sampler_option)
+        ->excludes(lights_option);
+    cmd->add_option("--fit-spp", *fit,
+                    "FROM:TO: the rungs the slopes, speeds and equal-time errors use (default "
+                    "16:1024, or the whole ladder when that holds fewer than two rungs)");
+    return {cmd, [options, samplers, strategies, compare, fit] {
+                absl::StatusOr<std::vector<RenderConfig>> configs =
+                    compare->empty() ? ConfigProduct(*samplers, *strategies)
+                                     : ParseConfigList(*compare);
+                if (!configs.ok()) return ReportError(configs.status());
+                options->configs = *configs;
+                if (!fit->empty()) {
+                    absl::StatusOr<SppRange> range = ParseSppRange(*fit);
+                    if (!range.ok()) return ReportError(range.status());
+                    options->fit_spp = *range;
+                    options->fit_spp_given = true;
+                }
                 absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
                 if (!result.ok()) return ReportError(result.status());
                 std::printf("%s", result->reference.c_str());
                 if (result->reference_rmse > 0) {
                     std::printf(" (its own RMSE estimate from A/B: %.3e)", result->reference_rmse);
                 }
-                std::printf("\nmethod,budget,seconds,rmse,relmse,smape,estimated_relmse\n");
+                std::printf("\n%s\n", kConvergenceCsvHeader);
                 for (const ConvergenceRow& row : result->rows) {
-                    std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s\n", row.method.c_str(),
-                                (long long)row.budget, row.seconds, row.error.rmse,
-                                row.error.relmse, row.error.smape,
-                                EstimatedRelMseField(row).c_str());
+                    std::printf(
+                        "%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
+                        (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
+                        row.error.smape, EstimatedRelMseField(row).c_str(),
+                        SamplerTypeName(row.config.sampler),
+                        row.method == "path" ? LightStrategyName(row.config.light_strategy) : "");
                 }
-                for (const auto& [method, slope] : result->slopes) {
-                    std::printf("%s: sqrt(relmse) ~ seconds^%.3f\n", method.c_str(), slope);
+                if (!result->configs.empty()) PrintSummary(*result);
+                if (result->radiosity_slope != 0) {
+                    std::printf("radiosity: sqrt(relmse) ~ seconds^%.3f\n",
+                                result->radiosity_slope);
                 }
-                std::printf("-> %s, %s\n", result->csv_path.c_str(), result->png_path.c_str());
+                std::printf("-> %s", result->csv_path.c_str());
+                for (const std::string* path :
+                     {&result->summary_path, &result->png_path, &result->reference_exr_path}) {
+                    if (!path->empty()) std::printf(", %s", path->c_str());
+                }
+                std::printf("\n");
                 return 0;
             }};
 }

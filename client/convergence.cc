@@ -8,13 +8,18 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
@@ -25,6 +30,77 @@
 extern char** environ;
 
 namespace lf {
+
+std::string ConfigName(const RenderConfig& config) {
+    return absl::StrCat(SamplerTypeName(config.sampler), "/",
+                        LightStrategyName(config.light_strategy));
+}
+
+namespace {
+
+// Comma-separated names, each known to `from_name`, none twice.
+template <class T, class FromName>
+absl::StatusOr<std::vector<T>> ParseNames(const std::string& flag, const std::string& list,
+                                          FromName from_name, const std::string& expected) {
+    std::vector<T> out;
+    const std::vector<std::string> names = absl::StrSplit(list, ',');
+    for (const std::string& name : names) {
+        const std::optional<T> value = from_name(name);
+        if (!value) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(flag, " ", list, ": \"", name, "\" is not ", expected));
+        }
+        if (std::find(out.begin(), out.end(), *value) != out.end()) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(flag, " ", list, ": \"", name, "\" is listed twice"));
+        }
+        out.push_back(*value);
+    }
+    return out;
+}
+
+std::optional<RenderConfig> ConfigFromName(const std::string& name) {
+    const size_t slash = name.find('/');
+    if (slash == std::string::npos) return std::nullopt;
+    const std::optional<SamplerType> sampler = SamplerTypeFromName(name.substr(0, slash));
+    const std::optional<LightStrategy> strategy = LightStrategyFromName(name.substr(slash + 1));
+    if (!sampler || !strategy) return std::nullopt;
+    return RenderConfig{*sampler, *strategy};
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<RenderConfig>> ParseConfigList(const std::string& list) {
+    return ParseNames<RenderConfig>("--compare", list, ConfigFromName,
+                                    "SAMPLER/LIGHTS with SAMPLER independent or sobol and "
+                                    "LIGHTS power or bvh, e.g. sobol/bvh");
+}
+
+absl::StatusOr<std::vector<RenderConfig>> ConfigProduct(const std::string& samplers,
+                                                        const std::string& light_strategies) {
+    absl::StatusOr<std::vector<SamplerType>> s =
+        ParseNames<SamplerType>("--sampler", samplers, SamplerTypeFromName, "independent or sobol");
+    if (!s.ok()) return s.status();
+    absl::StatusOr<std::vector<LightStrategy>> l = ParseNames<LightStrategy>(
+        "--light-sampling", light_strategies, LightStrategyFromName, "power or bvh");
+    if (!l.ok()) return l.status();
+    std::vector<RenderConfig> out;
+    for (SamplerType sampler : *s) {
+        for (LightStrategy strategy : *l) out.push_back({sampler, strategy});
+    }
+    return out;
+}
+
+absl::StatusOr<SppRange> ParseSppRange(const std::string& text) {
+    const std::vector<std::string> parts = absl::StrSplit(text, ':');
+    SppRange range;
+    if (parts.size() != 2 || !absl::SimpleAtoi(parts[0], &range.from) ||
+        !absl::SimpleAtoi(parts[1], &range.to) || range.from < 1 || range.from >= range.to) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "--fit-spp ", text, ": expected FROM:TO, spp with 1 <= FROM < TO, e.g. 16:1024"));
+    }
+    return range;
+}
 
 namespace {
 
@@ -41,10 +117,15 @@ std::string GnuplotQuote(const std::string& s) {
     return out + "'";
 }
 
-// What the plot and the slopes use: relmse weighs every pixel by its own brightness, where RMSE
-// is dominated by the few pixels on the light's edges (docs/convergence.md), and its square
-// root falls as time^-1/2 for plain Monte Carlo.
+// What the plot's first panel and the relative slopes use: relmse weighs every pixel by its
+// own brightness, where RMSE is dominated by the few pixels on the light's edges
+// (docs/convergence.md), and its square root falls as time^-1/2 for plain Monte Carlo.
 double RelativeRmse(const ConvergenceRow& row) { return std::sqrt(row.error.relmse); }
+
+// A curve of the plot and the legend's slope: a path configuration's or radiosity's.
+std::string CurveName(const ConvergenceRow& row) {
+    return row.method == "path" ? ConfigName(row.config) : "radiosity";
+}
 
 }  // namespace
 
@@ -54,32 +135,53 @@ std::string EstimatedRelMseField(const ConvergenceRow& row) {
 
 namespace {
 
-std::string MethodTitle(const std::string& method) {
-    return method == "path" ? "path tracing" : "radiosity";
-}
-
-// gnuplot draws the plot (a Debian package, deploy/install-deps.sh); the script stays next to
-// the PNG so the figure can be restyled without rendering again.
+// gnuplot draws the plot (a Debian package, deploy/install-deps.sh): relative RMSE and RMSE
+// against time side by side, one curve per configuration and radiosity. The script stays next
+// to the PNG so the figure can be restyled without rendering again.
 absl::Status Plot(const ConvergenceResult& result, const std::string& script_path) {
     std::ofstream gp(script_path);
-    gp << "set terminal pngcairo size 900,600 font 'sans,11'\n"
-       << "set output " << GnuplotQuote(result.png_path) << "\n"
-       << "set logscale xy\nset grid\nset key top right\n"
-       << "set xlabel 'wall-clock seconds'\n"
-       << "set ylabel 'relative RMSE, sqrt(relmse), against the reference'\n"
-       << "set title 'Error against time'\n";
-    std::string plot = "plot";
-    for (const auto& [method, slope] : result.slopes) {
-        gp << "$" << method << " << EOD\n";
+    gp << "set terminal pngcairo size 1400,600 font 'sans,11'\n"
+       << "set output " << GnuplotQuote(result.png_path) << "\n";
+    int index = 0;
+    std::vector<std::string> relative_plot, rmse_plot;
+    auto add_curve = [&](const std::string& name, const std::string& method, double relative_slope,
+                         const std::string& rmse_slope) {
+        const std::string block = absl::StrCat("$curve", index++);
+        gp << block << " << EOD\n";
         for (const ConvergenceRow& row : result.rows) {
-            if (row.method == method) gp << row.seconds << " " << RelativeRmse(row) << "\n";
+            if (CurveName(row) == name && row.method == method) {
+                gp << row.seconds << " " << RelativeRmse(row) << " " << row.error.rmse << "\n";
+            }
         }
         gp << "EOD\n";
-        if (plot != "plot") plot += ",";
-        plot += absl::StrFormat(" $%s using 1:2 with linespoints pt 7 title '%s (slope %.2f)'",
-                                method, MethodTitle(method), slope);
+        const std::string title = method == "path" ? "path tracing, " + name : "radiosity";
+        relative_plot.push_back(absl::StrFormat(
+            "%s using 1:2 with linespoints pt 7 title %s", block,
+            GnuplotQuote(absl::StrFormat("%s (slope %.2f)", title, relative_slope))));
+        rmse_plot.push_back(absl::StrFormat(
+            "%s using 1:3 with linespoints pt 7 title %s", block,
+            GnuplotQuote(rmse_slope.empty() ? title : title + " (slope " + rmse_slope + ")")));
+    };
+    for (const ConfigSummary& c : result.configs) {
+        add_curve(ConfigName(c.config), "path", c.relative_rmse_slope,
+                  absl::StrFormat("%.2f", c.rmse_slope));
     }
-    gp << plot << "\n";
+    const bool radiosity = std::any_of(result.rows.begin(), result.rows.end(),
+                                       [](const ConvergenceRow& r) { return r.method != "path"; });
+    if (radiosity) add_curve("radiosity", "radiosity", result.radiosity_slope, "");
+    std::string title = "Error against time";
+    if (!result.configs.empty()) {
+        const SppRange& fit = result.configs.front().fit;
+        absl::StrAppendFormat(&title, "; path slopes fitted over %d to %d spp", fit.from, fit.to);
+    }
+    gp << "set multiplot layout 1,2 title " << GnuplotQuote(title) << "\n"
+       << "set logscale xy\nset grid\nset key bottom left\n"
+       << "set xlabel 'wall-clock seconds'\n"
+       << "set ylabel 'relative RMSE, sqrt(relmse), against the reference'\n"
+       << "plot " << absl::StrJoin(relative_plot, ", ") << "\n"
+       << "set ylabel 'RMSE against the reference (radiance)'\n"
+       << "plot " << absl::StrJoin(rmse_plot, ", ") << "\n"
+       << "unset multiplot\n";
     gp.close();
     if (!gp) return absl::InternalError(script_path + ": cannot write");
 
@@ -100,14 +202,145 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
 
 absl::Status WriteCsv(const ConvergenceResult& result) {
     std::ofstream csv(result.csv_path);
-    csv << "method,budget,seconds,rmse,relmse,smape,estimated_relmse\n";
+    csv << kConvergenceCsvHeader << "\n";
     for (const ConvergenceRow& row : result.rows) {
-        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e,%s\n", row.method, row.budget,
-                               row.seconds, row.error.rmse, row.error.relmse, row.error.smape,
-                               EstimatedRelMseField(row));
+        csv << absl::StrFormat(
+            "%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s\n", row.method, row.budget, row.seconds,
+            row.error.rmse, row.error.relmse, row.error.smape, EstimatedRelMseField(row),
+            SamplerTypeName(row.config.sampler),
+            row.method == "path" ? LightStrategyName(row.config.light_strategy) : "");
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.csv_path + ": cannot write");
+    return absl::OkStatus();
+}
+
+absl::Status WriteSummaryCsv(const ConvergenceResult& result) {
+    std::ofstream csv(result.summary_path);
+    csv << kSummaryCsvHeader << "\n";
+    for (const ConfigSummary& c : result.configs) {
+        csv << absl::StrFormat(
+            "%s,%s,%d,%d,%.4f,%.4f,%.6e,%.6g,%.6g,%.6e,%.6e,%.4f,%.4f,%.4f,%.4f\n",
+            SamplerTypeName(c.config.sampler), LightStrategyName(c.config.light_strategy),
+            c.fit.from, c.fit.to, c.relative_rmse_slope, c.rmse_slope, c.samples_per_second,
+            result.equal_time.from, result.equal_time.to, c.rmse_at_equal_time,
+            c.relmse_at_equal_time, c.rmse_ratio_at_end, c.rmse_ratio_mean, c.relmse_ratio_at_end,
+            c.relmse_ratio_mean);
+    }
+    csv.close();
+    if (!csv) return absl::PermissionDeniedError(result.summary_path + ": cannot write");
+    return absl::OkStatus();
+}
+
+// The path ladder's rungs: 1, 2, 4, ... up to max_spp.
+std::vector<uint64_t> Ladder(uint64_t max_spp) {
+    std::vector<uint64_t> rungs;
+    for (uint64_t spp = 1; spp <= max_spp; spp *= 2) rungs.push_back(spp);
+    return rungs;
+}
+
+// The ladder's rungs the slopes are fitted over, as the first and last of them: --fit-spp's
+// when it holds two rungs, else (when it was not given) the whole ladder, with a note for the
+// output.
+absl::StatusOr<SppRange> FitRange(const ConvergenceOptions& options, std::string* note) {
+    std::vector<uint64_t> inside;
+    for (uint64_t spp : Ladder(options.max_spp)) {
+        if (spp >= options.fit_spp.from && spp <= options.fit_spp.to) inside.push_back(spp);
+    }
+    if (inside.size() >= 2) return SppRange{inside.front(), inside.back()};
+    const std::string why =
+        absl::StrFormat("--fit-spp %d:%d holds fewer than two rungs of the ladder 1 to %d spp",
+                        options.fit_spp.from, options.fit_spp.to, options.max_spp);
+    if (options.fit_spp_given) {
+        return absl::InvalidArgumentError(why + "; widen it or raise --max-spp");
+    }
+    *note = why + ": the slopes are fitted over the whole ladder";
+    return SppRange{1, Ladder(options.max_spp).back()};
+}
+
+// Slopes, speed and curves of one configuration's rungs within `fit`.
+struct FittedLadder {
+    ConfigSummary summary;
+    ErrorCurve rmse, relmse;
+};
+
+absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const RenderConfig& config,
+                                       const SppRange& fit, int64_t pixels) {
+    FittedLadder out;
+    out.summary.config = config;
+    out.summary.fit = fit;
+    ErrorCurve relative;
+    double samples = 0, seconds = 0;
+    for (const ConvergenceRow& row : result.rows) {
+        if (row.method != "path" || !(row.config == config) || uint64_t(row.budget) < fit.from ||
+            uint64_t(row.budget) > fit.to) {
+            continue;
+        }
+        relative.push_back({row.seconds, RelativeRmse(row)});
+        out.rmse.push_back({row.seconds, row.error.rmse});
+        out.relmse.push_back({row.seconds, row.error.relmse});
+        samples += double(row.budget) * double(pixels);
+        seconds += row.seconds;
+    }
+    const std::string name = ConfigName(config);
+    absl::StatusOr<double> relative_slope = LogLogSlope(relative);
+    absl::StatusOr<double> rmse_slope = LogLogSlope(out.rmse);
+    for (const absl::StatusOr<double>* slope : {&relative_slope, &rmse_slope}) {
+        if (!slope->ok()) {
+            return absl::InvalidArgumentError(absl::StrCat(name, ": no slope from its rungs of ",
+                                                           fit.from, " to ", fit.to, " spp (",
+                                                           slope->status().message(), ")"));
+        }
+    }
+    out.summary.relative_rmse_slope = *relative_slope;
+    out.summary.rmse_slope = *rmse_slope;
+    out.summary.samples_per_second = seconds > 0 ? samples / seconds : 0;
+    return out;
+}
+
+// Per configuration its slopes and speed, and the errors at equal time against the first: each
+// curve (its fit range's rungs) interpolated as a power law between its own rungs, over the
+// times every configuration covers.
+absl::Status Summarize(const ConvergenceOptions& options, int64_t pixels,
+                       ConvergenceResult& result) {
+    absl::StatusOr<SppRange> fit = FitRange(options, &result.fit_note);
+    if (!fit.ok()) return fit.status();
+    std::vector<FittedLadder> ladders;
+    std::vector<ErrorCurve> rmse_curves;
+    for (const RenderConfig& config : options.configs) {
+        absl::StatusOr<FittedLadder> ladder = FitLadder(result, config, *fit, pixels);
+        if (!ladder.ok()) return ladder.status();
+        rmse_curves.push_back(ladder->rmse);
+        ladders.push_back(*std::move(ladder));
+    }
+    absl::StatusOr<TimeRange> range = CommonTimeRange(rmse_curves);
+    if (!range.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "no equal-time comparison over ", fit->from, " to ", fit->to,
+            " spp: ", range.status().message(), "; widen --fit-spp or raise --max-spp"));
+    }
+    result.equal_time = *range;
+    const FittedLadder& base = ladders.front();
+    for (FittedLadder& ladder : ladders) {
+        ConfigSummary& s = ladder.summary;
+        absl::StatusOr<double> rmse = ErrorAtTime(ladder.rmse, range->to);
+        absl::StatusOr<double> relmse = ErrorAtTime(ladder.relmse, range->to);
+        absl::StatusOr<double> rmse_mean = MeanRatioOverTime(base.rmse, ladder.rmse, *range);
+        absl::StatusOr<double> relmse_mean = MeanRatioOverTime(base.relmse, ladder.relmse, *range);
+        for (const absl::StatusOr<double>* v : {&rmse, &relmse, &rmse_mean, &relmse_mean}) {
+            if (!v->ok()) return v->status();
+        }
+        s.rmse_at_equal_time = *rmse;
+        s.relmse_at_equal_time = *relmse;
+        s.rmse_ratio_mean = *rmse_mean;
+        s.relmse_ratio_mean = *relmse_mean;
+        result.configs.push_back(s);
+    }
+    for (ConfigSummary& s : result.configs) {
+        s.rmse_ratio_at_end = s.rmse_at_equal_time / result.configs.front().rmse_at_equal_time;
+        s.relmse_ratio_at_end =
+            s.relmse_at_equal_time / result.configs.front().relmse_at_equal_time;
+    }
     return absl::OkStatus();
 }
 
@@ -117,6 +350,15 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     if (options.method != "path" && options.method != "radiosity" && options.method != "both") {
         return absl::InvalidArgumentError(
             absl::StrCat("--method ", options.method, ": expected path, radiosity or both"));
+    }
+    if (options.configs.empty()) return absl::InvalidArgumentError("no configuration to render");
+    const bool path = options.method != "radiosity";
+    std::string unused_note;
+    if (path) {
+        // Refuse a bad --fit-spp before rendering anything.
+        if (absl::StatusOr<SppRange> fit = FitRange(options, &unused_note); !fit.ok()) {
+            return fit.status();
+        }
     }
     std::error_code ec;
     std::filesystem::create_directories(options.out_dir, ec);
@@ -143,20 +385,52 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
     const Camera camera(scene->camera, (*embree)->origin());
-    const PathTracer path_tracer(**embree, options.max_depth);
+    const int64_t pixels = int64_t(camera.width()) * camera.height();
 
-    auto render_path = [&](uint64_t spp, uint64_t seed) {
+    auto render_path = [&](const RenderConfig& config, uint64_t spp, uint64_t seed) {
+        const PathTracer path_tracer(**embree, options.max_depth, config.light_strategy);
         RenderSettings settings;
         settings.spp = spp;
         settings.seed = seed;
         settings.threads = options.threads;
-        settings.sampler = options.sampler;
+        settings.sampler = config.sampler;
         return RenderImage(camera, path_tracer, settings);
     };
 
     ConvergenceResult result;
-    result.csv_path = (std::filesystem::path(options.out_dir) / "convergence.csv").string();
-    result.png_path = (std::filesystem::path(options.out_dir) / "convergence.png").string();
+    const std::filesystem::path dir(options.out_dir);
+    result.csv_path = (dir / "convergence.csv").string();
+    result.png_path = (dir / "convergence.png").string();
+
+    // The path ladders first: with no reference given, the most efficient of them renders it.
+    // Rung by rung, every configuration in turn, so that a change in the machine's load (it is
+    // often shared) falls on all of them alike; the rows stay ladder by ladder.
+    const std::vector<uint64_t> rungs = path ? Ladder(options.max_spp) : std::vector<uint64_t>{};
+    const size_t path_rows = rungs.size() * options.configs.size();
+    result.rows.resize(path_rows);
+    std::vector<Image> images(path_rows);  // of result.rows, until the reference is known
+    for (size_t k = 0; k < rungs.size(); ++k) {
+        for (size_t c = 0; c < options.configs.size(); ++c) {
+            const RenderConfig& config = options.configs[c];
+            absl::StatusOr<RenderOutput> out = render_path(config, rungs[k], options.seed);
+            if (!out.ok()) return out.status();
+            log->info("job={} {} {} spp: {:.3f} s", job_id, ConfigName(config), rungs[k],
+                      out->seconds);
+            ConvergenceRow& row = result.rows[c * rungs.size() + k];
+            row.method = "path";
+            row.config = config;
+            row.budget = int64_t(rungs[k]);
+            row.seconds = out->seconds;
+            // Images estimate their own error from 2 spp on.
+            if (rungs[k] >= 2) {
+                if (absl::StatusOr<double> e = EstimatedRelMse(out->image); e.ok()) {
+                    row.estimated_relmse = *e;
+                }
+            }
+            images[c * rungs.size() + k] = std::move(out->image);
+        }
+    }
+
     Image reference;
     if (!options.reference_path.empty()) {
         absl::StatusOr<ExrFile> file = ReadExr(options.reference_path);
@@ -170,45 +444,70 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         }
         result.reference = "reference " + options.reference_path;
     } else {
-        // Another seed, so the reference's noise is independent of the ladder's.
-        log->info("job={} no reference given: path tracing one at {} spp", job_id,
-                  options.reference_spp);
-        absl::StatusOr<RenderOutput> out = render_path(options.reference_spp, options.seed + 1);
+        // The configuration whose top rung has the least estimated MSE (A/B halves) times
+        // seconds: the least error for the reference's time. Without path ladders, the first.
+        RenderConfig best = options.configs.front();
+        std::string why = "the first configuration";
+        double best_cost = std::numeric_limits<double>::infinity();
+        for (size_t i = 0; i < path_rows; ++i) {
+            if (uint64_t(result.rows[i].budget) != rungs.back()) continue;
+            absl::StatusOr<double> mse = EstimatedMse(images[i]);
+            if (!mse.ok()) continue;
+            const double cost = *mse * result.rows[i].seconds;
+            if (cost < best_cost) {
+                best_cost = cost;
+                best = result.rows[i].config;
+                why = absl::StrFormat(
+                    "the most efficient at %d spp by its own A/B error estimate: estimated MSE "
+                    "x seconds",
+                    rungs.back());
+            }
+        }
+        // Another seed, so the reference's noise is independent of the ladders'.
+        const uint64_t seed = options.seed + 1;
+        log->info("job={} no reference given: path tracing one with {} at {} spp", job_id,
+                  ConfigName(best), options.reference_spp);
+        absl::StatusOr<RenderOutput> out = render_path(best, options.reference_spp, seed);
         if (!out.ok()) return out.status();
-        reference = std::move(out->image);
         result.reference = absl::StrFormat(
-            "no reference given: own path-traced reference, %d spp, seed %d, %.1f s",
-            options.reference_spp, options.seed + 1, out->seconds);
+            "no reference given: own path-traced reference, %d spp, %s (%s), seed %d, %.1f s",
+            options.reference_spp, ConfigName(best), why, seed, out->seconds);
+        RenderMetadata metadata;
+        metadata.scene_hash = scene->content_hash;
+        metadata.camera = options.scene.camera;
+        metadata.method = "path";
+        metadata.spp = options.reference_spp;
+        metadata.seed = seed;
+        metadata.max_depth = options.max_depth;
+        metadata.sampler = best.sampler;
+        metadata.filter = scene->camera.filter;
+        metadata.seconds = out->seconds;
+        metadata.stats = out->stats;
+        absl::StatusOr<RenderDescription> description = DescribeRender(metadata, out->image, true);
+        if (!description.ok()) return description.status();
+        description->attributes["lightfarm.light_sampling"] =
+            std::string(LightStrategyName(best.light_strategy));
+        description->attributes["lightfarm.converge.reference"] = result.reference;
+        result.reference_exr_path = (dir / "reference.exr").string();
+        if (absl::Status s =
+                WriteExr(result.reference_exr_path, out->image, description->attributes);
+            !s.ok()) {
+            return s;
+        }
+        reference = std::move(out->image);
     }
     if (absl::StatusOr<double> mse = EstimatedMse(reference); mse.ok()) {
         result.reference_rmse = std::sqrt(*mse);
     }
-
-    auto add_row = [&](const std::string& method, int64_t budget, double seconds,
-                       const Image& image) -> absl::Status {
-        absl::StatusOr<ImageError> error = CompareImages(image, reference);
+    for (size_t i = 0; i < result.rows.size(); ++i) {
+        absl::StatusOr<ImageError> error = CompareImages(images[i], reference);
         if (!error.ok()) return error.status();
-        // Path images estimate their own error from 2 spp on; a radiosity image's A/B halves
-        // see only the display's sampling, not the solution's error.
-        std::optional<double> estimated;
-        if (method == "path" && budget >= 2) {
-            if (absl::StatusOr<double> e = EstimatedRelMse(image); e.ok()) estimated = *e;
-        }
-        result.rows.push_back({method, budget, seconds, *error, estimated});
-        log->info("job={} {} budget {}: {:.3f} s, rmse {:.4e}", job_id, method, budget, seconds,
-                  error->rmse);
-        return absl::OkStatus();
-    };
-
-    if (options.method != "radiosity") {
-        for (uint64_t spp = 1; spp <= options.max_spp; spp *= 2) {
-            absl::StatusOr<RenderOutput> out = render_path(spp, options.seed);
-            if (!out.ok()) return out.status();
-            if (absl::Status s = add_row("path", int64_t(spp), out->seconds, out->image); !s.ok()) {
-                return s;
-            }
-        }
+        result.rows[i].error = *error;
+        log->info("job={} {} {} spp: rmse {:.4e}", job_id, ConfigName(result.rows[i].config),
+                  result.rows[i].budget, error->rmse);
     }
+    images.clear();
+
     if (options.method != "path") {
         for (int64_t patches = options.min_patches; patches <= options.max_patches; patches *= 2) {
             const auto start = Clock::now();
@@ -225,33 +524,45 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             settings.spp = options.radiosity_spp;
             settings.seed = options.seed;
             settings.threads = options.threads;
-            settings.sampler = options.sampler;
+            settings.sampler = options.configs.front().sampler;
             absl::StatusOr<RenderOutput> out = RenderImage(camera, **radiosity, settings);
             if (!out.ok()) return out.status();
-            if (absl::Status s = add_row("radiosity", (*radiosity)->report().patches,
-                                         SecondsSince(start), out->image);
-                !s.ok()) {
-                return s;
-            }
+            absl::StatusOr<ImageError> error = CompareImages(out->image, reference);
+            if (!error.ok()) return error.status();
+            // A radiosity image's A/B halves see only the display's sampling, not the
+            // solution's error: no estimate.
+            ConvergenceRow row;
+            row.method = "radiosity";
+            row.config = options.configs.front();
+            row.budget = (*radiosity)->report().patches;
+            row.seconds = SecondsSince(start);
+            row.error = *error;
+            result.rows.push_back(row);
+            log->info("job={} radiosity {} patches: {:.3f} s, rmse {:.4e}", job_id, row.budget,
+                      row.seconds, error->rmse);
         }
     }
     if (absl::Status s = WriteCsv(result); !s.ok()) return s;
 
-    for (const std::string method : {"path", "radiosity"}) {
+    if (path) {
+        if (absl::Status s = Summarize(options, pixels, result); !s.ok()) return s;
+        result.summary_path = (dir / "summary.csv").string();
+        if (absl::Status s = WriteSummaryCsv(result); !s.ok()) return s;
+    }
+    if (options.method != "path") {
         std::vector<std::pair<double, double>> points;
         for (const ConvergenceRow& row : result.rows) {
-            if (row.method == method) points.push_back({row.seconds, RelativeRmse(row)});
+            if (row.method == "radiosity") points.push_back({row.seconds, RelativeRmse(row)});
         }
-        if (points.empty()) continue;
         absl::StatusOr<double> slope = LogLogSlope(points);
         if (!slope.ok()) {
             return absl::InvalidArgumentError(
-                absl::StrCat(method, ": no slope from its ladder (", slope.status().message(),
-                             "); widen it with --max-spp or --max-patches"));
+                absl::StrCat("radiosity: no slope from its ladder (", slope.status().message(),
+                             "); widen it with --min-patches and --max-patches"));
         }
-        result.slopes[method] = *slope;
+        result.radiosity_slope = *slope;
     }
-    const std::string script = (std::filesystem::path(options.out_dir) / "convergence.gp").string();
+    const std::string script = (dir / "convergence.gp").string();
     if (absl::Status s = Plot(result, script); !s.ok()) return s;
     return result;
 }

@@ -1,7 +1,9 @@
 // `lightfarm converge`: the trade between time and accuracy, measured. Renders a ladder of
-// budgets per method (samples per pixel for the path tracer, patch counts for radiosity),
-// compares each image with a reference and writes convergence.csv and a log-log plot of relative
-// RMSE against time with the fitted slope per method (docs/convergence.md).
+// budgets per method (samples per pixel for the path tracer, patch counts for radiosity) and,
+// for the path tracer, per configuration (sampler and light strategy), compares each image with
+// one reference and writes convergence.csv, a log-log plot of relative RMSE against time, and
+// per configuration the fitted slopes and the error at equal time relative to the first
+// configuration (docs/convergence.md).
 #pragma once
 
 #include <cstdint>
@@ -11,11 +13,39 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "lf/core/error_curve.h"
 #include "lf/core/image_error.h"
+#include "lf/core/light_strategy.h"
+#include "lf/core/sampler.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/settings.h"
 
 namespace lf {
+
+// What a path-traced ladder varies: where the random numbers come from and how next-event
+// estimation picks lights.
+struct RenderConfig {
+    SamplerType sampler = defaults::kSampler;
+    LightStrategy light_strategy = LightStrategy::kBvh;  // PathTracer's default
+    bool operator==(const RenderConfig&) const = default;
+};
+
+// "sobol/bvh": how the CSV, the table, the plot and --compare name it.
+std::string ConfigName(const RenderConfig& config);
+
+// --compare "independent/power,sobol/bvh": configurations in the order given.
+absl::StatusOr<std::vector<RenderConfig>> ParseConfigList(const std::string& list);
+
+// --sampler and --light-sampling lists ("independent,sobol" and "power,bvh"): every pair,
+// samplers outermost, so the first configuration pairs the first of each.
+absl::StatusOr<std::vector<RenderConfig>> ConfigProduct(const std::string& samplers,
+                                                        const std::string& light_strategies);
+
+// --fit-spp "16:1024": the rungs whose slopes the summary fits.
+struct SppRange {
+    uint64_t from = 16, to = 1024;  // the range
+};
+absl::StatusOr<SppRange> ParseSppRange(const std::string& text);
 
 struct ConvergenceOptions {
     std::string scene_path;
@@ -33,12 +63,19 @@ struct ConvergenceOptions {
     uint64_t seed = defaults::kSeed;
     int threads = 0;
     int max_depth = defaults::kMaxDepth;
-    SamplerType sampler = defaults::kSampler;  // of the ladder, the own reference, radiosity
+    // Path ladders, one per configuration; the first is the baseline of the equal-time ratios
+    // and its sampler displays radiosity.
+    std::vector<RenderConfig> configs = {RenderConfig{}};
+    SppRange fit_spp;
+    // Set when --fit-spp was given: then a ladder with fewer than two rungs in it is an error;
+    // otherwise the fit falls back to the whole ladder (and says so).
+    bool fit_spp_given = false;
 };
 
 struct ConvergenceRow {
     std::string method;
-    int64_t budget = 0;  // spp or patches
+    RenderConfig config;  // path rows; radiosity rows: the sampler of its display
+    int64_t budget = 0;   // spp or patches
     double seconds = 0;
     ImageError error;
     // The image's own estimate of its relmse from its A/B halves (lf::EstimatedRelMse), to
@@ -46,15 +83,43 @@ struct ConvergenceRow {
     std::optional<double> estimated_relmse;
 };
 
+// A configuration's ladder summed up over the rungs of its fit range.
+struct ConfigSummary {
+    RenderConfig config;
+    SppRange fit;  // the rungs used: --fit-spp's, or the whole ladder when it holds fewer than two
+    double relative_rmse_slope = 0;  // of log sqrt(relmse) against log seconds
+    double rmse_slope = 0;           // of log rmse against log seconds
+    double samples_per_second = 0;   // over the fit range's rungs
+    // At equal time (ErrorAtTime at ConvergenceResult::equal_time.to), and the typical ratio to
+    // the first configuration over the equal-time range (MeanRatioOverTime); 1 for the first.
+    double rmse_at_equal_time = 0, relmse_at_equal_time = 0;
+    double rmse_ratio_at_end = 1, relmse_ratio_at_end = 1;
+    double rmse_ratio_mean = 1, relmse_ratio_mean = 1;
+};
+
 struct ConvergenceResult {
     std::vector<ConvergenceRow> rows;
-    std::map<std::string, double> slopes;  // of sqrt(relmse) against seconds, per method
-    std::string reference;                 // what the reference was, for the user
-    double reference_rmse = 0;             // the reference's own error estimate (A/B), 0 if unknown
-    std::string csv_path, png_path;
+    std::vector<ConfigSummary> configs;  // path ladders, in the options' order
+    std::string fit_note;                // when a fit fell back to the whole ladder, why
+    TimeRange equal_time;                // the times every configuration's fit range covers
+    double radiosity_slope = 0;          // of sqrt(relmse) against seconds, with radiosity rows
+    std::string reference;               // what the reference was, for the user
+    double reference_rmse = 0;           // the reference's own error estimate (A/B), 0 if unknown
+    std::string csv_path, png_path, summary_path;
+    std::string reference_exr_path;  // the own reference, written for reuse with --reference
 };
 
 absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& options);
+
+// convergence.csv: a row per image; sampler and light_sampling were added at the end (the light
+// strategy is empty for radiosity, the sampler there is its display's).
+inline constexpr const char* kConvergenceCsvHeader =
+    "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling";
+// summary.csv: a row per path configuration (ConfigSummary).
+inline constexpr const char* kSummaryCsvHeader =
+    "sampler,light_sampling,fit_from_spp,fit_to_spp,relative_rmse_slope,rmse_slope,"
+    "samples_per_second,equal_time_from,equal_time_to,rmse_at_equal_time,relmse_at_equal_time,"
+    "rmse_ratio_at_end,rmse_ratio_mean,relmse_ratio_at_end,relmse_ratio_mean";
 
 // The row's estimated_relmse as a CSV field: "" when there is none.
 std::string EstimatedRelMseField(const ConvergenceRow& row);

@@ -253,7 +253,8 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     std::ifstream csv(out / "convergence.csv");
     std::string line;
     ASSERT_TRUE(std::getline(csv, line));
-    EXPECT_EQ(line, "method,budget,seconds,rmse,relmse,smape,estimated_relmse");
+    EXPECT_EQ(line,
+              "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling");
     std::vector<std::string> rows;
     while (std::getline(csv, line)) rows.push_back(line);
     // spp 1, 2, 4 and patch targets 100, 200.
@@ -261,12 +262,15 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     EXPECT_EQ(rows[0].rfind("path,1,", 0), 0u) << rows[0];
     EXPECT_EQ(rows[3].rfind("radiosity,", 0), 0u) << rows[3];
     for (const std::string& row : rows) {
-        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 6) << row;
+        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 8) << row;
         EXPECT_EQ(row.find("nan"), std::string::npos) << row;
     }
-    // The image's own estimate from 2 spp on, for path rows only.
-    EXPECT_EQ(rows[0].back(), ',') << rows[0];
-    EXPECT_NE(rows[1].back(), ',') << rows[1];
+    // The image's own estimate from 2 spp on, for path rows only; the light strategy for path
+    // rows only.
+    EXPECT_NE(rows[0].find(",,sobol,bvh"), std::string::npos) << rows[0];
+    EXPECT_NE(rows[1].find("e-"), std::string::npos) << rows[1];
+    EXPECT_EQ(rows[1].find(",,"), std::string::npos) << rows[1];
+    EXPECT_NE(rows[3].find(",,sobol,"), std::string::npos) << rows[3];
     EXPECT_EQ(rows[3].back(), ',') << rows[3];
     EXPECT_GT(fs::file_size(out / "convergence.png"), 1000u);
 
