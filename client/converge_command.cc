@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstdio>
 
 #include "absl/strings/str_format.h"
@@ -9,6 +10,9 @@
 namespace lf {
 
 namespace {
+
+// Above this share of the smallest measured MSE, the reference's own noise is worth a warning.
+constexpr double kReferenceNoiseWarning = 0.05;
 
 // Per configuration its slopes, speed and errors at equal time, the first as the baseline.
 void PrintSummary(const ConvergenceResult& result) {
@@ -22,6 +26,20 @@ void PrintSummary(const ConvergenceResult& result) {
         (unsigned long long)base.fit.from, (unsigned long long)base.fit.to, t.to,
         ConfigName(base.config).c_str(), t.from, t.to);
     if (!result.fit_note.empty()) std::printf("(%s)\n", result.fit_note.c_str());
+    // The reference's noise adds to every measured MSE (the two are independent), most to the
+    // smallest, so it flattens the best configuration's curve and raises its ratios.
+    const ConvergenceRow* best = nullptr;
+    for (const ConvergenceRow& row : result.rows) {
+        if (row.method == "path" && (!best || row.error.rmse < best->error.rmse)) best = &row;
+    }
+    const double share = best ? std::pow(result.reference_rmse / best->error.rmse, 2) : 0;
+    if (share > kReferenceNoiseWarning) {
+        std::printf(
+            "(the reference's own MSE, estimated from its A/B halves, is %.0f %% of the smallest "
+            "measured, %s at %lld spp: it flattens the best curves and raises their ratios; "
+            "raise --reference-spp)\n",
+            100 * share, ConfigName(best->config).c_str(), (long long)best->budget);
+    }
     const std::string rule(126, '-');
     std::printf("%-18s %9s %9s %11s %11s %11s %17s %17s\n%-18s %9s %9s %11s %11s %11s %17s %17s\n",
                 "configuration", "slope rel", "slope", "samples/s", "RMSE", "relMSE", "RMSE ratio",
