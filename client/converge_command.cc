@@ -1,6 +1,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "command.h"
 #include "convergence.h"
@@ -122,22 +123,31 @@ Command AddConvergeCommand(CLI::App& app) {
     auto fit = std::make_shared<std::string>();
     CLI::Option* sampler_option =
         cmd->add_option("--sampler", *samplers,
-                        "samplers of the path ladders, a comma-separated list of independent "
-                        "and sobol; with --light-sampling, every pair is a configuration")
-            ->capture_default_str();
+                        absl::StrCat("samplers of the path ladders, comma-separated: sobol "
+                                     "(Owen-scrambled Sobol points, low-discrepancy, so on smooth "
+                                     "integrands the error falls faster than spp^-1/2) and "
+                                     "independent (hashed random numbers, error as spp^-1/2, for "
+                                     "comparison); with --light-sampling, every pair is a "
+                                     "configuration. Default ",
+                                     *samplers))
+            ->type_name("independent|sobol,...");
     CLI::Option* lights_option =
         cmd->add_option("--light-sampling", *strategies,
-                        "light strategies of the path ladders, a comma-separated list of power "
-                        "and bvh")
-            ->capture_default_str();
+                        absl::StrCat("light strategies of the path ladders, comma-separated: bvh "
+                                     "(a light BVH by importance at the shading point) and power "
+                                     "(by power alone). Default ",
+                                     *strategies))
+            ->type_name("power|bvh,...");
     cmd->add_option("--compare", *compare,
                     "configurations of the path ladders, SAMPLER/LIGHTS, comma-separated, e.g. "
                     "independent/power,sobol/bvh; the first is the baseline of the ratios")
+        ->type_name("SAMPLER/LIGHTS,...")
         ->excludes(sampler_option)
         ->excludes(lights_option);
     cmd->add_option("--fit-spp", *fit,
                     "FROM:TO: the rungs the slopes, speeds and equal-time errors use (default "
-                    "16:1024, or the whole ladder when that holds fewer than two rungs)");
+                    "16:1024, or the whole ladder when that holds fewer than two rungs)")
+        ->type_name("FROM:TO");
     return {cmd, [options, samplers, strategies, compare, fit] {
                 absl::StatusOr<std::vector<RenderConfig>> configs =
                     compare->empty() ? ConfigProduct(*samplers, *strategies)
