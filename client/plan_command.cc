@@ -282,18 +282,18 @@ absl::Status RunPlan(const PlanOptions& options) {
         (unsigned long long)p->pilot_spp[0], (unsigned long long)p->pilot_spp[1], p->pilot_seconds,
         p->median_rate, p->tiles);
     std::printf(
-        "cost of render --target-error %.4g --spp %llu: about %.0f spp on average (%.0f to %.0f "
-        "with every tile's rate bounded by 1/2 either way; %llu in the hardest tile, %d of %d "
-        "tiles at --max-spp), %.1f s at this speed (%.1f to %.1f)\n",
-        options.target_error, (unsigned long long)options.first_spp, p->mean_spp, p->low_mean_spp,
-        p->high_mean_spp, (unsigned long long)p->hardest_tile_spp, p->tiles_at_max_spp, p->tiles,
-        p->seconds, p->low_seconds, p->high_seconds);
+        "cost of render --target-error %.4g --spp %llu: about %.0f spp on average (%.0f if "
+        "every tile's error fell as spp^-1/2; %llu in the hardest tile, %d of %d tiles at "
+        "--max-spp), %.1f s at this speed (%.1f); the pilot costs %.0f %% of that\n",
+        options.target_error, (unsigned long long)options.first_spp, p->mean_spp, p->high_mean_spp,
+        (unsigned long long)p->hardest_tile_spp, p->tiles_at_max_spp, p->tiles, p->seconds,
+        p->high_seconds, 100 * p->pilot_seconds / std::max(p->seconds, 1e-9));
     if (p->tiles_disagreeing > 0) {
         std::printf(
             "warning: in %d of %d tiles the pilot's second stage has over 1.5x the error its first "
             "predicted (the first alone predicts %.0f spp): noise a short pilot does not see, "
-            "such as caustics and fireflies; expect the upper end, and a longer --pilot-spp to "
-            "narrow the range\n",
+            "such as caustics and fireflies; the prediction is less sure, a longer --pilot-spp "
+            "makes it surer\n",
             p->tiles_disagreeing, p->tiles, p->first_stage_mean_spp);
     }
     return absl::OkStatus();

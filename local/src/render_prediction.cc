@@ -74,7 +74,7 @@ absl::StatusOr<RenderPrediction> PredictAdaptiveRender(const Camera& camera,
     const std::vector<AdaptiveReport::Tile>& a = first->adaptive.per_tile;
     const std::vector<AdaptiveReport::Tile>& b = second->adaptive.per_tile;
     std::vector<double> rates;
-    double samples = 0, low = 0, high = 0, first_stage = 0, pixels = 0;
+    double samples = 0, high = 0, first_stage = 0, pixels = 0;
     for (size_t t = 0; t < a.size() && t < b.size(); ++t) {
         const TilePilot tile{a[t].rect.Area(), a[t].spp, b[t].spp, a[t].error, b[t].error};
         const double rate = ConvergenceRate(tile);
@@ -91,8 +91,7 @@ absl::StatusOr<RenderPrediction> PredictAdaptiveRender(const Camera& camera,
         const double n = predict(tile, rate);
         const double area = double(tile.pixels);
         samples += n * area;
-        low += predict(tile, std::max(rate, 0.5)) * area;
-        high += predict(tile, std::min(rate, 0.5)) * area;
+        high += predict(tile, 0.5) * area;
         // The first stage alone, as if its error fell at the Monte Carlo rate.
         const double e2 = tile.e1 * std::sqrt(double(tile.n1) / double(tile.n2));
         first_stage += predict({tile.pixels, tile.n1, tile.n2, tile.e1, e2}, 0.5) * area;
@@ -107,11 +106,9 @@ absl::StatusOr<RenderPrediction> PredictAdaptiveRender(const Camera& camera,
         p.median_rate = rates[rates.size() / 2];
     }
     p.mean_spp = samples / pixels;
-    p.low_mean_spp = low / pixels;
     p.high_mean_spp = high / pixels;
     p.first_stage_mean_spp = first_stage / pixels;
     p.seconds = samples * seconds_per_sample;
-    p.low_seconds = low * seconds_per_sample;
     p.high_seconds = high * seconds_per_sample;
     return p;
 }

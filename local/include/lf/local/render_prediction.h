@@ -21,9 +21,12 @@ struct TilePilot {
     double e1 = 0, e2 = 0;
 };
 
-// The measured rate is clamped to this: below 1/4 a tile would ask for max_spp on one noisy
-// pair of estimates; Sobol on a smooth tile reaches about 3/4, nothing here converges faster.
-inline constexpr double kMinConvergenceRate = 0.25, kMaxConvergenceRate = 1.0;
+// The measured rate is clamped to this. A rate below 1/2 between the stages is the estimate
+// catching up with noise the first stage did not see (caustics, fireflies); once seen, the
+// error of a mean of finite variance falls as n^-1/2. Extrapolating a lower rate predicted
+// 18x the samples on the glTF demo (one tile at max_spp) and 2.5x on materials.json
+// (docs/convergence.md). Sobol on a smooth tile reaches about 3/4, nothing here faster than 1.
+inline constexpr double kMinConvergenceRate = 0.5, kMaxConvergenceRate = 1.0;
 
 // The exponent of e(n) = e2 (n / n2)^-rate through the tile's two points, clamped.
 double ConvergenceRate(const TilePilot& tile);
@@ -37,13 +40,12 @@ uint64_t PredictTileSamples(const TilePilot& tile, double rate, uint64_t first, 
                             uint64_t max_spp);
 
 struct RenderPrediction {
-    double mean_spp = 0;                  // over the pixels, from the tiles' measured rates
-    double low_mean_spp = 0;              // the same with every rate at least 1/2
-    double high_mean_spp = 0;             // the same with every rate at most 1/2
-    uint64_t hardest_tile_spp = 0;        // the most any tile takes
-    int tiles = 0, tiles_at_max_spp = 0;  // predicted to stop at max_spp, not the target
-    double seconds = 0, low_seconds = 0, high_seconds = 0;  // at the pilot's speed
-    double median_rate = 0;  // of the tiles' measured rates (before clamping)
+    double mean_spp = 0;       // over the pixels, from the tiles' measured rates
+    double high_mean_spp = 0;  // the same with every rate 1/2: Sobol's faster rate may not last
+    uint64_t hardest_tile_spp = 0;         // the most any tile takes
+    int tiles = 0, tiles_at_max_spp = 0;   // predicted to stop at max_spp, not the target
+    double seconds = 0, high_seconds = 0;  // at the pilot's speed
+    double median_rate = 0;                // of the tiles' measured rates (before clamping)
     // The tiles whose second stage's error is more than 1.5x what the first stage predicted at
     // the Monte Carlo rate 1/2: noise the first stage did not see (fireflies, caustics).
     int tiles_disagreeing = 0;
