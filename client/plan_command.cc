@@ -44,8 +44,10 @@ struct PlanOptions {
     int64_t patches = defaults::kRadiosityPatches;
     int max_depth = defaults::kMaxDepth;
     int threads = 0;
-    // --sampler and --clamp: the pilot's noise, and so the samples, are those of the render's
+    // --sampler, --light-sampling and --clamp: the pilot's noise, and so the samples, are
+    // those of the render's
     SamplerType sampler = defaults::kSampler;
+    LightStrategy light_strategy = defaults::kLightStrategy;
     double clamp = 0;
 };
 
@@ -263,7 +265,7 @@ absl::Status RunPlan(const PlanOptions& options) {
     // that how fast it falls is measured rather than assumed (docs/convergence.md, "Error
     // estimates and plan predictions").
     const Camera camera(scene->camera, (*embree)->origin());
-    const PathTracer tracer(**embree, options.max_depth);
+    const PathTracer tracer(**embree, options.max_depth, options.light_strategy);
     RenderSettings settings;
     settings.spp = options.first_spp;
     settings.seed = options.seed;
@@ -348,6 +350,7 @@ Command AddPlanCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(0, 1024));
     AddSamplerFlag(cmd, options->sampler);
+    AddLightSamplingFlag(cmd, options->light_strategy);
     AddClampFlag(cmd, options->clamp);
     return {cmd, [options] {
                 const absl::Status status = RunPlan(*options);

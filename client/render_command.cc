@@ -52,7 +52,8 @@ Command AddRenderCommand(CLI::App& app) {
                     "sample passes per tile, as a farm job would split them (same bits)")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxPasses));
-    AddSampleFlags(cmd, options->render.sampler, options->render.clamp, options->render.aovs);
+    AddSampleFlags(cmd, options->render.sampler, options->render.light_strategy,
+                   options->render.clamp, options->render.aovs);
     AddAdaptiveFlags(cmd, options->adaptive);
     cmd->add_flag("--no-progress", *no_progress, "no progress bar");
     cmd->add_option("--method", options->method,
