@@ -6,7 +6,7 @@
 // (emitters seen directly left out); --bounces -1 for full paths.
 //
 // Each strategy renders --repeat times with different seeds, alternating power and bvh so that
-// both see the same machine load; per sample count it prints the seconds (summed), the relative
+// both see the same machine load; per sample count it prints the CPU seconds (summed), the relative
 // RMSE, and the three ratios bvh / power: variance at equal spp, time at equal spp, and RMSE at
 // equal time, sqrt(var ratio * time ratio), since the MSE falls as 1 / samples.
 //
@@ -14,9 +14,9 @@
 //                        [--spp 4,16,64] [--reference-spp 1024] [--bounces 1]
 //                        [--sampler sobol] [--repeat 3] [--resolution 64] [--threads 0]
 #include <CLI/CLI.hpp>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -107,6 +107,14 @@ struct Options {
     lf::SamplerType sampler = lf::defaults::kSampler;
 };
 
+// The process's CPU time: unlike wall time it does not count the time other processes on a
+// shared machine take from this one.
+double CpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 lf::Image RenderDepth(const lf::EmbreeScene& es, const lf::Camera& camera,
                       lf::LightStrategy strategy, int max_depth, uint64_t spp, uint64_t seed,
                       const Options& o, double* seconds) {
@@ -116,16 +124,16 @@ lf::Image RenderDepth(const lf::EmbreeScene& es, const lf::Camera& camera,
     settings.seed = seed;
     settings.threads = o.threads;
     settings.sampler = o.sampler;
-    const auto start = std::chrono::steady_clock::now();
+    const double start = CpuSeconds();
     lf::Image image = lf::RenderImage(camera, tracer, settings).value().image;
-    *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    *seconds = CpuSeconds() - start;
     return image;
 }
 
 // The light reflected from what each pixel sees, R, G, B per pixel: a render of o.bounces
 // bounces minus a render of emission alone from the same camera samples (same seed), so that
 // emitters seen directly, whose edges alias alike under either strategy, do not swamp the
-// comparison. `seconds`: the first render's wall time (building the tracer included, as a job
+// comparison. `seconds`: the first render's CPU time (building the tracer included, as a job
 // would pay it).
 struct Reflected {
     std::vector<double> rgb;
