@@ -61,7 +61,7 @@ absl::Status RunBench(const BenchOptions& options) {
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
     const Camera camera(scene->camera, (*embree)->origin());
-    const PathTracer tracer(**embree, options.max_depth);
+    const PathTracer tracer(**embree, options.max_depth, options.light_strategy);
 
     RenderSettings settings;
     settings.spp = options.spp;
@@ -74,11 +74,14 @@ absl::Status RunBench(const BenchOptions& options) {
 
     const double sps = double(out.stats.samples) / out.seconds;
     const double rps = double(out.stats.rays) / out.seconds;
-    std::printf("scene            %s (%dx%d, %llu spp, max depth %s, %d threads, %s sampler)\n",
-                options.scene_path.c_str(), camera.width(), camera.height(),
-                (unsigned long long)options.spp,
-                options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth).c_str(),
-                options.threads, SamplerTypeName(options.sampler));
+    std::printf(
+        "scene            %s (%dx%d, %llu spp, max depth %s, %d threads, %s sampler, %s light "
+        "sampling)\n",
+        options.scene_path.c_str(), camera.width(), camera.height(),
+        (unsigned long long)options.spp,
+        options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth).c_str(),
+        options.threads, SamplerTypeName(options.sampler),
+        LightStrategyName(options.light_strategy));
     std::printf("path tracing     %.3f M samples/s, %.3f M rays/s, %.2f rays/sample, %.2f s\n",
                 sps * 1e-6, rps * 1e-6, double(out.stats.rays) / double(out.stats.samples),
                 out.seconds);

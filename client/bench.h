@@ -18,6 +18,7 @@ struct BenchOptions {
     SceneOptions scene;
     int max_depth = defaults::kMaxDepth;
     SamplerType sampler = defaults::kSampler;
+    LightStrategy light_strategy = defaults::kLightStrategy;
     uint64_t raw_rays = 4'000'000;
 };
 

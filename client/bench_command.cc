@@ -25,6 +25,7 @@ Command AddBenchCommand(CLI::App& app) {
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str();
     AddSamplerFlag(cmd, options->sampler);
+    AddLightSamplingFlag(cmd, options->light_strategy);
     cmd->add_option("--rays", options->raw_rays, "rays for the raw Embree measurement")
         ->capture_default_str();
     return {cmd, [options] {

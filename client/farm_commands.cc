@@ -270,6 +270,14 @@ void PrintJob(const pb::Job& job) {
                 job.width(), job.height(), (unsigned long long)job.params().spp(),
                 (unsigned long long)job.params().seed(), job.params().max_depth(),
                 job.params().tile(), job.params().passes());
+    JobSpec spec;
+    FromProto(job.params(), &spec);
+    // Radiosity samples no lights: its light strategy would say nothing.
+    std::printf("  sampling  %s sampler%s\n", SamplerTypeName(spec.sampler),
+                spec.method == "radiosity"
+                    ? ""
+                    : absl::StrCat(", ", LightStrategyName(spec.light_strategy), " light sampling")
+                          .c_str());
     if (job.params().target_error() > 0 || job.params().time_limit_seconds() > 0) {
         std::printf("  adaptive  target error %g, time limit %g s, at most %llu spp\n",
                     job.params().target_error(), job.params().time_limit_seconds(),
@@ -407,7 +415,7 @@ Command AddSubmitCommand(CLI::App& app) {
                     "sample passes per tile; each pass of each tile is one task")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxPasses));
-    AddSampleFlags(cmd, o->spec.sampler, o->spec.clamp, o->spec.aovs);
+    AddSampleFlags(cmd, o->spec.sampler, o->spec.light_strategy, o->spec.clamp, o->spec.aovs);
     AddAdaptiveFlags(cmd, o->spec.adaptive);
     cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();

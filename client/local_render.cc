@@ -106,13 +106,18 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
                           : std::string());
         }
     } else {
-        estimator = std::make_unique<PathTracer>(**embree, options.max_depth);
+        estimator = std::make_unique<PathTracer>(**embree, options.max_depth,
+                                                 options.render.light_strategy);
     }
     log->info(
-        "job={} rendering {} ({}x{}, {} spp, {} sampler, seed {}, max depth {}, tile {}, {} "
+        "job={} rendering {} ({}x{}, {} spp, {} sampler{}, seed {}, max depth {}, tile {}, {} "
         "filter{}{})",
         job_id, options.scene_path, camera.width(), camera.height(), options.render.spp,
-        SamplerTypeName(options.render.sampler), options.render.seed,
+        SamplerTypeName(options.render.sampler),
+        *method == "path" ? absl::StrCat(", ", LightStrategyName(options.render.light_strategy),
+                                         " light sampling")
+                          : std::string(),
+        options.render.seed,
         options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
         options.render.tile, DescribePixelFilter(scene->camera.filter),
         options.render.clamp > 0 ? absl::StrCat(", clamp ", options.render.clamp, " (biased)")
@@ -168,6 +173,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     metadata.clamp = options.render.clamp;
     metadata.aovs = options.render.aovs;
     metadata.sampler = options.render.sampler;
+    metadata.light_strategy = options.render.light_strategy;
     metadata.filter = scene->camera.filter;
     metadata.seconds = summary.seconds;
     metadata.stats = out->stats;

@@ -19,6 +19,7 @@
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/local/local_executor.h"
+#include "lf/local/render_prediction.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
 #include "sample_flags.h"
@@ -34,11 +35,19 @@ struct PlanOptions {
     std::string method = "auto";
     double target_error = 0.01;
     uint64_t pilot_spp = 8;
+    // The render's own settings, which decide its passes: --spp (its first pass), --tile,
+    // --seed and --max-spp.
+    uint64_t first_spp = defaults::kSpp;
+    int tile = defaults::kTile;
+    uint64_t seed = defaults::kSeed;
+    uint64_t max_spp = defaults::kAdaptiveMaxSpp;
     int64_t patches = defaults::kRadiosityPatches;
     int max_depth = defaults::kMaxDepth;
     int threads = 0;
-    // --sampler and --clamp: the pilot's noise, and so the samples, are those of the render's
+    // --sampler, --light-sampling and --clamp: the pilot's noise, and so the samples, are
+    // those of the render's
     SamplerType sampler = defaults::kSampler;
+    LightStrategy light_strategy = defaults::kLightStrategy;
     double clamp = 0;
 };
 
@@ -252,39 +261,43 @@ absl::Status RunPlan(const PlanOptions& options) {
         std::printf("radiosity: not used\n");
     }
 
-    // A pilot pass of every tile at the full resolution, as the first pass of
-    // `render --target-error`: each tile's own estimate predicts the samples it needs, as error
-    // falls with 1/sqrt(spp), and the pilot's speed the time.
+    // A pilot in two stages at the full resolution, each tile's error measured after both, so
+    // that how fast it falls is measured rather than assumed (docs/convergence.md, "Error
+    // estimates and plan predictions").
     const Camera camera(scene->camera, (*embree)->origin());
-    const PathTracer tracer(**embree, options.max_depth);
+    const PathTracer tracer(**embree, options.max_depth, options.light_strategy);
     RenderSettings settings;
-    settings.spp = options.pilot_spp;
+    settings.spp = options.first_spp;
+    settings.seed = options.seed;
+    settings.tile = options.tile;
     settings.threads = options.threads;
     settings.clamp = options.clamp;
     settings.sampler = options.sampler;
-    const AdaptiveSettings pilot_only{.target_error = options.target_error,
-                                      .max_spp = options.pilot_spp};
-    absl::StatusOr<RenderOutput> pilot = RenderImageAdaptive(camera, tracer, settings, pilot_only);
-    if (!pilot.ok()) return pilot.status();
-    double pixel_samples = 0, worst = 0;
-    for (const AdaptiveReport::Tile& tile : pilot->adaptive.per_tile) {
-        const double ratio = tile.error / options.target_error;
-        const double spp =
-            std::clamp(double(tile.spp) * ratio * ratio, double(tile.spp), double(kMaxSpp));
-        pixel_samples += spp * double(tile.rect.Area());
-        worst = std::max(worst, spp);
+    const AdaptiveSettings adaptive{.target_error = options.target_error,
+                                    .max_spp = options.max_spp};
+    absl::StatusOr<RenderPrediction> p =
+        PredictAdaptiveRender(camera, tracer, settings, adaptive, options.pilot_spp);
+    if (!p.ok()) return p.status();
+    std::printf(
+        "pilot (path tracing): %llu then %llu spp in every tile, %.2f s; the tiles' error falls "
+        "as spp^-%.2f (median over %d tiles; Monte Carlo's rate is 1/2)\n",
+        (unsigned long long)p->pilot_spp[0], (unsigned long long)p->pilot_spp[1], p->pilot_seconds,
+        p->median_rate, p->tiles);
+    std::printf(
+        "cost of render --target-error %.4g --spp %llu: about %.0f spp on average (%.0f if "
+        "every tile's error fell as spp^-1/2; %llu in the hardest tile, %d of %d tiles at "
+        "--max-spp), %.1f s at this speed (%.1f); the pilot costs %.0f %% of that\n",
+        options.target_error, (unsigned long long)options.first_spp, p->mean_spp, p->high_mean_spp,
+        (unsigned long long)p->hardest_tile_spp, p->tiles_at_max_spp, p->tiles, p->seconds,
+        p->high_seconds, 100 * p->pilot_seconds / std::max(p->seconds, 1e-9));
+    if (p->tiles_disagreeing > 0) {
+        std::printf(
+            "warning: in %d of %d tiles the pilot's second stage has over 1.5x the error its first "
+            "predicted (the first alone predicts %.0f spp): noise a short pilot does not see, "
+            "such as caustics and fireflies; the prediction is less sure, a longer --pilot-spp "
+            "makes it surer\n",
+            p->tiles_disagreeing, p->tiles, p->first_stage_mean_spp);
     }
-    const double pixels = double(camera.width()) * camera.height();
-    const double seconds_per_sample = pilot->seconds / double(pilot->stats.samples);
-    std::printf(
-        "pilot (path tracing): %llu spp in %.2f s, estimated relative error %.4f over "
-        "the image, worst tile %.4f\n",
-        (unsigned long long)pilot->adaptive.max_spp, pilot->seconds,
-        pilot->adaptive.estimated_error, pilot->adaptive.worst_tile_error);
-    std::printf(
-        "cost of render --target-error %.4g: about %.0f spp on average (%.0f in the "
-        "hardest tile), %.1f s at this speed\n",
-        options.target_error, pixel_samples / pixels, worst, pixel_samples * seconds_per_sample);
     return absl::OkStatus();
 }
 
@@ -297,8 +310,9 @@ Command AddPlanCommand(CLI::App& app) {
         "Say what a render of the scene will model and why: materials and lights in use, the\n"
         "method --method picks, the path depth policy, for radiosity the patch count and the\n"
         "time and memory of the form factors and the solve (from a pilot solve of fewer\n"
-        "patches), and the samples and time a target error needs (from a short pilot render's\n"
-        "own error estimate and speed).");
+        "patches), and the samples and time a target error needs (from a two-stage pilot\n"
+        "render's own error estimates, how fast they fall, and its speed; give the render's\n"
+        "--spp, --tile, --seed and --max-spp for its passes).");
     cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
@@ -312,9 +326,20 @@ Command AddPlanCommand(CLI::App& app) {
                     "relative error to estimate the cost for")
         ->capture_default_str()
         ->check(CLI::Range(1e-6, 1.0));
-    cmd->add_option("--pilot-spp", options->pilot_spp, "samples per pixel of the pilot render")
+    cmd->add_option("--pilot-spp", options->pilot_spp,
+                    "samples per pixel of the pilot's first stage; the second takes 4x")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(2), uint64_t(1) << 16));
+    cmd->add_option("--spp", options->first_spp, "the render's --spp: its first pass")
+        ->capture_default_str()
+        ->check(CLI::Range(uint64_t(1), kMaxSpp));
+    cmd->add_option("--tile", options->tile, "the render's --tile")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 65536));
+    cmd->add_option("--seed", options->seed, "the render's --seed")->capture_default_str();
+    cmd->add_option("--max-spp", options->max_spp, "the render's --max-spp")
+        ->capture_default_str()
+        ->check(CLI::Range(uint64_t(2), kMaxSpp));
     cmd->add_option("--patches", options->patches, "radiosity patch target")
         ->capture_default_str()
         ->check(CLI::Range(int64_t(1), kMaxPatchTarget));
@@ -325,6 +350,7 @@ Command AddPlanCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(0, 1024));
     AddSamplerFlag(cmd, options->sampler);
+    AddLightSamplingFlag(cmd, options->light_strategy);
     AddClampFlag(cmd, options->clamp);
     return {cmd, [options] {
                 const absl::Status status = RunPlan(*options);

@@ -52,7 +52,8 @@ Command AddRenderCommand(CLI::App& app) {
                     "sample passes per tile, as a farm job would split them (same bits)")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxPasses));
-    AddSampleFlags(cmd, options->render.sampler, options->render.clamp, options->render.aovs);
+    AddSampleFlags(cmd, options->render.sampler, options->render.light_strategy,
+                   options->render.clamp, options->render.aovs);
     AddAdaptiveFlags(cmd, options->adaptive);
     cmd->add_flag("--no-progress", *no_progress, "no progress bar");
     cmd->add_option("--method", options->method,
@@ -115,12 +116,17 @@ Command AddRenderCommand(CLI::App& app) {
             }
             if (summary->adaptive) {
                 const AdaptiveReport& a = summary->adaptive_report;
+                double samples = 0, pixels = 0;  // the mean spp, what `plan` predicts
+                for (const AdaptiveReport::Tile& t : a.per_tile) {
+                    samples += double(t.spp) * t.rect.Area();
+                    pixels += double(t.rect.Area());
+                }
                 std::printf(
-                    "adaptive: %llu..%llu spp per pixel, worst tile %.4f, %d of %d tiles "
-                    "above the target%s\n",
+                    "adaptive: %llu..%llu spp per pixel (mean %.0f), worst tile %.4f, %d of %d "
+                    "tiles above the target%s\n",
                     (unsigned long long)a.min_spp, (unsigned long long)a.max_spp,
-                    a.worst_tile_error, a.tiles_above_target, a.tiles,
-                    a.timed_out ? ", time limit reached" : "");
+                    pixels > 0 ? samples / pixels : 0, a.worst_tile_error, a.tiles_above_target,
+                    a.tiles, a.timed_out ? ", time limit reached" : "");
             }
             return 0;
         }};

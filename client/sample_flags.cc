@@ -3,6 +3,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
@@ -10,26 +11,51 @@
 
 namespace lf {
 
-void AddSamplerFlag(CLI::App* cmd, SamplerType& sampler) {
+namespace {
+
+// A flag that takes one of two names (`first|second`) into `value` through the setting's own
+// name functions, refusing any other name as "FLAG NAME: expected first or second"; the help
+// ends with the default, the name `value` holds.
+template <typename T>
+void AddChoiceFlag(CLI::App* cmd, const std::string& flag, T& value,
+                   std::optional<T> (*from_name)(std::string_view), const char* (*name_of)(T),
+                   const std::string& first, const std::string& second, const std::string& help) {
     cmd->add_option_function<std::string>(
-           "--sampler",
-           [&sampler](const std::string& name) {
-               const std::optional<SamplerType> type = SamplerTypeFromName(name);
-               if (!type) {
+           flag,
+           [&value, flag, from_name, first, second](const std::string& name) {
+               const std::optional<T> parsed = from_name(name);
+               if (!parsed) {
                    throw CLI::ValidationError(
-                       absl::StrCat("--sampler ", name, ": expected independent or sobol"));
+                       absl::StrCat(flag, " ", name, ": expected ", first, " or ", second));
                }
-               sampler = *type;
+               value = *parsed;
            },
-           absl::StrCat(
-               "where each sample's random numbers come from: sobol (Owen-scrambled Sobol "
-               "points, stratified and low-discrepancy in every pair of dimensions a path uses, "
-               "so on smooth integrands the error falls faster than spp^-1/2) or independent "
-               "(the older hashed random numbers, error as spp^-1/2, for comparison); both are "
-               "pure functions of seed, pixel and sample, so tiles, passes and workers give the "
-               "same bits. Default ",
-               SamplerTypeName(sampler)))
-        ->type_name("independent|sobol");
+           absl::StrCat(help, " Default ", name_of(value)))
+        ->type_name(first + "|" + second);
+}
+
+}  // namespace
+
+void AddSamplerFlag(CLI::App* cmd, SamplerType& sampler) {
+    AddChoiceFlag(cmd, "--sampler", sampler, &SamplerTypeFromName, &SamplerTypeName, "independent",
+                  "sobol",
+                  "where each sample's random numbers come from: sobol (Owen-scrambled Sobol "
+                  "points, stratified and low-discrepancy in every pair of dimensions a path "
+                  "uses, so on smooth integrands the error falls faster than spp^-1/2) or "
+                  "independent (the older hashed random numbers, error as spp^-1/2, for "
+                  "comparison); both are pure functions of seed, pixel and sample, so tiles, "
+                  "passes and workers give the same bits.");
+}
+
+void AddLightSamplingFlag(CLI::App* cmd, LightStrategy& strategy) {
+    AddChoiceFlag(cmd, "--light-sampling", strategy, &LightStrategyFromName, &LightStrategyName,
+                  "power", "bvh",
+                  "how the path tracer picks a light and a point on it at each vertex: bvh (a "
+                  "light BVH weighs every light by its importance at the shading point, and "
+                  "triangles and spheres that look large are sampled by the solid angle they "
+                  "subtend: less noise among many lights or near large ones) or power (a light "
+                  "with probability proportional to its power, a point on it by area, as before "
+                  "bvh existed, for comparison); both are unbiased, the same image on average.");
 }
 
 void AddClampFlag(CLI::App* cmd, double& clamp) {
@@ -48,8 +74,10 @@ void AddClampFlag(CLI::App* cmd, double& clamp) {
         ->type_name("L");
 }
 
-void AddSampleFlags(CLI::App* cmd, SamplerType& sampler, double& clamp, uint32_t& aovs) {
+void AddSampleFlags(CLI::App* cmd, SamplerType& sampler, LightStrategy& light_strategy,
+                    double& clamp, uint32_t& aovs) {
     AddSamplerFlag(cmd, sampler);
+    AddLightSamplingFlag(cmd, light_strategy);
     AddClampFlag(cmd, clamp);
     cmd->add_option_function<std::string>(
            "--aov",

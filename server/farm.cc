@@ -231,6 +231,7 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
     metadata.clamp = job.spec.clamp;
     metadata.aovs = job.spec.aovs;
     metadata.sampler = job.spec.sampler;
+    metadata.light_strategy = job.spec.light_strategy;
     metadata.filter = job.spec.scene_options.filter.value_or(PixelFilter{});
     metadata.seconds = job.started == absl::InfinitePast()
                            ? 0.0

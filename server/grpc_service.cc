@@ -86,6 +86,11 @@ grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
             absl::StrCat("params.sampler ", req->params().sampler(),
                          ": unknown sampler; expected independent or sobol")));
     }
+    if (!pb::LightStrategy_IsValid(req->params().light_strategy())) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("params.light_strategy ", req->params().light_strategy(),
+                         ": unknown light sampling strategy; expected power or bvh")));
+    }
     absl::StatusOr<std::string> id = farm_.Submit(FromProto(*req));
     if (!id.ok()) {
         Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()), Peer(context),

@@ -101,6 +101,7 @@ std::string EncodeJobRecord(const JobRecord& r) {
           {"clamp", s.clamp},
           {"aovs", s.aovs},
           {"sampler", SamplerTypeName(s.sampler)},
+          {"light_strategy", LightStrategyName(s.light_strategy)},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
           {"request_id", s.request_id}}},
@@ -179,6 +180,15 @@ absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
         } else {
             return absl::DataLossError(
                 absl::StrCat("the stored record's sampler \"", sampler, "\" is not a sampler"));
+        }
+        // Records before --light-sampling were rendered picking lights by power; resumed, they must
+        // keep it, or their remaining tiles would not match those already merged.
+        const std::string light = s.value("light_strategy", "power");
+        if (const std::optional<LightStrategy> strategy = LightStrategyFromName(light)) {
+            r.spec.light_strategy = *strategy;
+        } else {
+            return absl::DataLossError(absl::StrCat("the stored record's light_strategy \"", light,
+                                                    "\" is not power or bvh"));
         }
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();

@@ -1,25 +1,30 @@
-// Direct-lighting error (light reflected once, emitters seen directly left out; --bounces -1 for
-// full paths) of the two light
-// strategies (LightStrategy::kPower: picks by power, area sampling; kBvh: light BVH, spherical
-// triangles, sphere cones) on the Cornell box and on a scene with many small emitters at
-// different distances, against a high-sample reference
-// (rendered with kBvh; both strategies are unbiased). For each strategy and sample count: the
-// wall time, the RMSE relative to the reference's mean, and that RMSE scaled to the power
-// strategy's time at the same spp (RMSE * sqrt(t / t_power)): the equal-time comparison, since
-// RMSE falls as 1 / sqrt(samples).
+// Light-sampling error of the two light strategies (LightStrategy::kPower: picks by power, area
+// sampling; kBvh: light BVH, spherical rectangles and triangles, sphere cones) against a
+// high-sample reference (rendered with kBvh; both strategies are unbiased), on the repository's
+// scenes (--scene, any number) and on synthetic ones: many small emitters at different distances
+// (--emitters) and a big lamp close to a wall (--lamp). By default the light reflected once
+// (emitters seen directly left out); --bounces -1 for full paths.
 //
-//   light_sampling_bench [--emitters 1000] [--spp 4,16,64] [--reference-spp 1024]
-//                        [--bounces 1] [--resolution 64] [--threads 0]
+// Each strategy renders --repeat times with different seeds, alternating power and bvh so that
+// both see the same machine load; per sample count it prints the CPU seconds (summed), the relative
+// RMSE, and the three ratios bvh / power: variance at equal spp, time at equal spp, and RMSE at
+// equal time, sqrt(var ratio * time ratio), since the MSE falls as 1 / samples.
+//
+//   light_sampling_bench [--scene a.json --scene b.gltf] [--emitters 1000] [--lamp]
+//                        [--spp 4,16,64] [--reference-spp 1024] [--bounces 1]
+//                        [--sampler sobol] [--repeat 3] [--resolution 64] [--threads 0]
 #include <CLI/CLI.hpp>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "lf/core/camera.h"
+#include "lf/core/sampler.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/local/local_executor.h"
@@ -64,53 +69,33 @@ lf::Scene ManyEmitters(int count, int resolution) {
     return scene;
 }
 
-// The light reflected from what each pixel sees, R, G, B per pixel: a render of `bounces` bounces
-// minus a render of emission alone from the same camera samples (same seed), so that emitters
-// seen directly, whose edges alias alike under either strategy, do not swamp the comparison.
-// `seconds`: the first render's wall time.
-struct DirectLight {
-    std::vector<double> rgb;
-    double seconds = 0;
-};
-
-lf::Image RenderDepth(const lf::EmbreeScene& es, const lf::Camera& camera,
-                      lf::LightStrategy strategy, int max_depth, uint64_t spp, uint64_t seed,
-                      int threads, double* seconds) {
-    const lf::PathTracer tracer(es, max_depth, strategy);
-    lf::RenderSettings settings;
-    settings.spp = spp;
-    settings.seed = seed;
-    settings.threads = threads;
-    const auto start = std::chrono::steady_clock::now();
-    lf::Image image = lf::RenderImage(camera, tracer, settings).value().image;
-    *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return image;
-}
-
-DirectLight Render(const lf::EmbreeScene& es, const lf::Camera& camera, lf::LightStrategy strategy,
-                   int bounces, uint64_t spp, uint64_t seed, int threads) {
-    DirectLight direct;
-    double emission_seconds = 0;
-    const lf::Image bounce =
-        RenderDepth(es, camera, strategy, bounces, spp, seed, threads, &direct.seconds);
-    const lf::Image emission =
-        RenderDepth(es, camera, strategy, 0, spp, seed, threads, &emission_seconds);
-    for (const char* c : {"R", "G", "B"}) {
-        const std::vector<float>& a = *bounce.FindChannel(c);
-        const std::vector<float>& b = *emission.FindChannel(c);
-        for (size_t i = 0; i < a.size(); ++i) direct.rgb.push_back(double(a[i]) - b[i]);
-    }
-    return direct;
-}
-
-// sqrt(mean of (a - b)^2) / mean of b.
-double RelativeRmse(const std::vector<double>& a, const std::vector<double>& b) {
-    double squared = 0, sum = 0;
-    for (size_t i = 0; i < a.size(); ++i) {
-        squared += (a[i] - b[i]) * (a[i] - b[i]);
-        sum += b[i];
-    }
-    return std::sqrt(squared / double(a.size())) / (sum / double(a.size()));
+// A 4 x 3 wall with a floor, lit by a 1 x 1 lamp 0.15 in front of the wall and facing it: the
+// wall near the lamp sees it under nearly a hemisphere, where area sampling's 1 / r^2 and
+// cosines vary most. The camera looks at the wall past the lamp's dark back.
+lf::Scene NearLamp(int resolution) {
+    lf::Scene scene;
+    lf::Material white;
+    white.reflectance = lf::Rgb(0.7f);
+    lf::Material glow;
+    glow.reflectance = lf::Rgb(0.0f);
+    glow.emission = lf::Rgb(4.0f, 3.5f, 3.0f);
+    scene.materials = {white, glow};
+    lf::TriangleMesh room;
+    room.positions = {{-2, -1, 0}, {2, -1, 0},  {2, 2, 0},  {-2, 2, 0},   // wall, facing +z
+                      {-2, -1, 0}, {-2, -1, 3}, {2, -1, 3}, {2, -1, 0}};  // floor, facing +y
+    room.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+    scene.meshes.push_back(room);
+    lf::TriangleMesh lamp;
+    lamp.material = 1;
+    lamp.positions = {{-0.5, 0, 0.15}, {-0.5, 1, 0.15}, {0.5, 1, 0.15}, {0.5, 0, 0.15}};
+    lamp.triangles = {{0, 1, 2}, {0, 2, 3}};  // facing -z, towards the wall
+    scene.meshes.push_back(lamp);
+    scene.camera.position = {1.2, 0.8, 3};
+    scene.camera.look_at = {0, 0.5, 0};
+    scene.camera.up = {0, 1, 0};
+    scene.camera.fov_y_deg = 60;
+    scene.camera.width = scene.camera.height = resolution;
+    return scene;
 }
 
 struct Options {
@@ -118,7 +103,69 @@ struct Options {
     uint64_t reference_spp = 1024;
     int bounces = 1;
     int threads = 0;
+    int repeat = 3;
+    lf::SamplerType sampler = lf::defaults::kSampler;
 };
+
+// The process's CPU time: unlike wall time it does not count the time other processes on a
+// shared machine take from this one.
+double CpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+lf::Image RenderDepth(const lf::EmbreeScene& es, const lf::Camera& camera,
+                      lf::LightStrategy strategy, int max_depth, uint64_t spp, uint64_t seed,
+                      const Options& o, double* seconds) {
+    const lf::PathTracer tracer(es, max_depth, strategy);
+    lf::RenderSettings settings;
+    settings.spp = spp;
+    settings.seed = seed;
+    settings.threads = o.threads;
+    settings.sampler = o.sampler;
+    const double start = CpuSeconds();
+    lf::Image image = lf::RenderImage(camera, tracer, settings).value().image;
+    *seconds = CpuSeconds() - start;
+    return image;
+}
+
+// The light reflected from what each pixel sees, R, G, B per pixel: a render of o.bounces
+// bounces minus a render of emission alone from the same camera samples (same seed), so that
+// emitters seen directly, whose edges alias alike under either strategy, do not swamp the
+// comparison. `seconds`: the first render's CPU time (building the tracer included, as a job
+// would pay it).
+struct Reflected {
+    std::vector<double> rgb;
+    double seconds = 0;
+};
+
+Reflected Render(const lf::EmbreeScene& es, const lf::Camera& camera, lf::LightStrategy strategy,
+                 uint64_t spp, uint64_t seed, const Options& o) {
+    Reflected reflected;
+    double emission_seconds = 0;
+    const lf::Image bounce =
+        RenderDepth(es, camera, strategy, o.bounces, spp, seed, o, &reflected.seconds);
+    const lf::Image emission =
+        RenderDepth(es, camera, strategy, 0, spp, seed, o, &emission_seconds);
+    for (const char* c : {"R", "G", "B"}) {
+        const std::vector<float>& a = *bounce.FindChannel(c);
+        const std::vector<float>& b = *emission.FindChannel(c);
+        for (size_t i = 0; i < a.size(); ++i) reflected.rgb.push_back(double(a[i]) - b[i]);
+    }
+    return reflected;
+}
+
+// Mean of (a - b)^2 over the mean of b squared: the relative MSE.
+double RelativeMse(const std::vector<double>& a, const std::vector<double>& b) {
+    double squared = 0, sum = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        squared += (a[i] - b[i]) * (a[i] - b[i]);
+        sum += b[i];
+    }
+    const double mean = sum / double(a.size());
+    return squared / double(a.size()) / (mean * mean);
+}
 
 int Bench(const std::string& name, const lf::Scene& scene, const Options& o) {
     auto es = lf::EmbreeScene::Build(scene);
@@ -127,24 +174,30 @@ int Bench(const std::string& name, const lf::Scene& scene, const Options& o) {
         return 1;
     }
     const lf::Camera camera(scene.camera, (*es)->origin());
-    const DirectLight reference =
-        Render(**es, camera, lf::LightStrategy::kBvh, o.bounces, o.reference_spp, 12345, o.threads);
-    std::printf("%s: %d x %d, reference %lu spp (kBvh) in %.2f s\n", name.c_str(),
-                scene.camera.width, scene.camera.height, o.reference_spp, reference.seconds);
-    std::printf("  %6s %8s %9s %9s %14s\n", "spp", "strategy", "seconds", "rel RMSE",
-                "RMSE@t(power)");
+    const Reflected reference =
+        Render(**es, camera, lf::LightStrategy::kBvh, o.reference_spp, 12345, o);
+    std::printf("%s: %d x %d, %s, bounces %d, reference %lu spp (bvh) in %.2f s\n", name.c_str(),
+                scene.camera.width, scene.camera.height, lf::SamplerTypeName(o.sampler), o.bounces,
+                o.reference_spp, reference.seconds);
+    std::printf("  %6s %9s %9s %10s %10s %9s %9s %11s\n", "spp", "s power", "s bvh", "rRMSE pow",
+                "rRMSE bvh", "var b/p", "time b/p", "eqtime b/p");
     for (uint64_t spp : o.spps) {
-        const DirectLight power =
-            Render(**es, camera, lf::LightStrategy::kPower, o.bounces, spp, 1, o.threads);
-        const DirectLight bvh =
-            Render(**es, camera, lf::LightStrategy::kBvh, o.bounces, spp, 1, o.threads);
-        const double e_power = RelativeRmse(power.rgb, reference.rgb);
-        const double e_bvh = RelativeRmse(bvh.rgb, reference.rgb);
-        std::printf("  %6lu %8s %9.3f %9.4f %14.4f\n", spp, "power", power.seconds, e_power,
-                    e_power);
-        std::printf("  %6lu %8s %9.3f %9.4f %14.4f   (bvh / power at equal time: %.2f)\n", spp,
-                    "bvh", bvh.seconds, e_bvh, e_bvh * std::sqrt(bvh.seconds / power.seconds),
-                    e_bvh * std::sqrt(bvh.seconds / power.seconds) / e_power);
+        double seconds[2] = {0, 0}, mse[2] = {0, 0};
+        for (int r = 0; r < o.repeat; ++r) {
+            // Alternate which goes first, so neither always runs on a warmer or quieter machine.
+            for (int k = 0; k < 2; ++k) {
+                const int s = (k + r) % 2;  // 0: power, 1: bvh
+                const Reflected image = Render(
+                    **es, camera, s == 0 ? lf::LightStrategy::kPower : lf::LightStrategy::kBvh, spp,
+                    uint64_t(1 + r), o);
+                seconds[s] += image.seconds;
+                mse[s] += RelativeMse(image.rgb, reference.rgb) / o.repeat;
+            }
+        }
+        const double var_ratio = mse[1] / mse[0], time_ratio = seconds[1] / seconds[0];
+        std::printf("  %6lu %9.3f %9.3f %10.4f %10.4f %9.3f %9.3f %11.3f\n", spp, seconds[0],
+                    seconds[1], std::sqrt(mse[0]), std::sqrt(mse[1]), var_ratio, time_ratio,
+                    std::sqrt(var_ratio * time_ratio));
         std::fflush(stdout);
     }
     return 0;
@@ -153,29 +206,52 @@ int Bench(const std::string& name, const lf::Scene& scene, const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    CLI::App app("Direct-lighting RMSE of the power and light-BVH light strategies");
-    std::string cornell = std::string(LF_SOURCE_DIR) + "/tests/scenes/cornell_box.json";
-    int emitters = 1000;
+    CLI::App app("Light-sampling RMSE of the power and light-BVH light strategies");
+    std::vector<std::string> scenes;
+    int emitters = 0;
+    bool lamp = false;
     int resolution = 64;
+    std::string sampler = lf::SamplerTypeName(lf::defaults::kSampler);
     Options o;
-    app.add_option("--cornell", cornell, "Cornell box scene file");
-    app.add_option("--emitters", emitters, "small emitters in the many-lights scene")
-        ->check(CLI::Range(1, 1000000));
+    app.add_option("--scene", scenes, "scene files (json, glTF) to measure");
+    app.add_option("--emitters", emitters, "also a scene of this many small emitters (0: none)")
+        ->check(CLI::Range(0, 1000000));
+    app.add_flag("--lamp", lamp, "also a big lamp close to a wall");
     app.add_option("--spp", o.spps, "sample counts to compare")->delimiter(',');
     app.add_option("--reference-spp", o.reference_spp, "samples per pixel of the reference")
         ->check(CLI::PositiveNumber);
     app.add_option("--bounces", o.bounces, "1: direct light; -1: full paths")
         ->check(CLI::Range(-1, 1000));
+    app.add_option("--sampler", sampler, "sobol or independent");
+    app.add_option("--repeat", o.repeat, "renders per strategy and sample count")
+        ->check(CLI::Range(1, 1000));
     app.add_option("--resolution", resolution, "image size")->check(CLI::Range(1, 4096));
     app.add_option("--threads", o.threads, "0: all cores");
     CLI11_PARSE(app, argc, argv);
-
-    auto box = lf::LoadScene(cornell);
-    if (!box.ok()) {
-        std::fprintf(stderr, "%s\n", box.status().ToString().c_str());
+    const std::optional<lf::SamplerType> type = lf::SamplerTypeFromName(sampler);
+    if (!type) {
+        std::fprintf(stderr, "--sampler: unknown sampler '%s'\n", sampler.c_str());
         return 1;
     }
-    box->camera.width = box->camera.height = resolution;
-    if (Bench("cornell box", *box, o) != 0) return 1;
-    return Bench(std::to_string(emitters) + " emitters", ManyEmitters(emitters, resolution), o);
+    o.sampler = *type;
+    if (scenes.empty() && emitters == 0 && !lamp) {
+        scenes.push_back(std::string(LF_SOURCE_DIR) + "/tests/scenes/cornell_box.json");
+        emitters = 1000;
+    }
+
+    for (const std::string& path : scenes) {
+        auto scene = lf::LoadScene(path);
+        if (!scene.ok()) {
+            std::fprintf(stderr, "%s\n", scene.status().ToString().c_str());
+            return 1;
+        }
+        scene->camera.width = scene->camera.height = resolution;
+        if (Bench(path.substr(path.find_last_of('/') + 1), *scene, o) != 0) return 1;
+    }
+    if (lamp && Bench("lamp near a wall", NearLamp(resolution), o) != 0) return 1;
+    if (emitters > 0 &&
+        Bench(std::to_string(emitters) + " emitters", ManyEmitters(emitters, resolution), o) != 0) {
+        return 1;
+    }
+    return 0;
 }

@@ -191,7 +191,9 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
 absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel) {
     if (loaded_.tracer) return absl::OkStatus();
     if (task.spec.method != "radiosity") {
-        loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.spec.max_depth);
+        // Cached per job (loaded_.job_id), so the job's one light strategy is the tracer's.
+        loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.spec.max_depth,
+                                                      task.spec.light_strategy);
         return absl::OkStatus();
     }
     absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);

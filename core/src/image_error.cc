@@ -1,5 +1,6 @@
 #include "lf/core/image_error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -19,8 +20,8 @@ absl::StatusOr<const std::vector<float>*> RequireChannel(const Image& image,
     return channel;
 }
 
-// The mean over pixels and channels of ((A - B) / 2)^2, each divided by R^2 + eps if relative.
-absl::StatusOr<double> MeanSquaredHalfDifference(const Image& image, bool relative) {
+// The mean over pixels and channels of ((A - B) / 2)^2.
+absl::StatusOr<double> MeanSquaredHalfDifference(const Image& image) {
     double sum = 0;
     size_t n = 0;
     for (const std::string name : {"R", "G", "B"}) {
@@ -28,21 +29,48 @@ absl::StatusOr<double> MeanSquaredHalfDifference(const Image& image, bool relati
         if (!a.ok()) return a.status();
         absl::StatusOr<const std::vector<float>*> b = RequireChannel(image, "B." + name, "image");
         if (!b.ok()) return b.status();
-        const std::vector<float>* x = nullptr;
-        if (relative) {
-            absl::StatusOr<const std::vector<float>*> found = RequireChannel(image, name, "image");
-            if (!found.ok()) return found.status();
-            x = *found;
-        }
         for (size_t i = 0; i < (*a)->size(); ++i) {
             const double half = 0.5 * (double((**a)[i]) - (**b)[i]);
-            sum +=
-                x ? half * half / (double((*x)[i]) * (*x)[i] + kRelativeErrorEpsilon) : half * half;
+            sum += half * half;
             ++n;
         }
     }
     if (n == 0) return absl::InvalidArgumentError("the image has no pixels");
     return sum / n;
+}
+
+// One channel of a width x height rectangle, row-major: each pixel's mean and its two halves.
+struct ChannelPlanes {
+    const float* value;
+    const float* a;
+    const float* b;
+};
+
+// The sum over the rectangle's pixels of ((A - B) / 2)^2 / (p^2 + eps), p = min(R, max(min(A,
+// B), mean of the neighbours)), the neighbours (up to 8) inside the rectangle; EstimatedRelMse
+// says why.
+double SumOfRelativeVariances(int width, int height, const ChannelPlanes& c) {
+    double sum = 0;
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            double neighbours = 0;
+            int k = 0;
+            for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy) {
+                for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx) {
+                    if (xx == x && yy == y) continue;
+                    neighbours += c.value[size_t(yy) * width + xx];
+                    ++k;
+                }
+            }
+            const size_t i = size_t(y) * width + x;
+            const double own = c.value[i];
+            const double steady = std::min(c.a[i], c.b[i]);
+            const double p = k > 0 ? std::min(own, std::max(steady, neighbours / k)) : own;
+            const double half = 0.5 * (double(c.a[i]) - c.b[i]);
+            sum += half * half / (p * p + kRelativeErrorEpsilon);
+        }
+    }
+    return sum;
 }
 
 }  // namespace
@@ -72,12 +100,23 @@ absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& refere
     return ImageError{std::sqrt(squared / n), relative / n, symmetric / n};
 }
 
-absl::StatusOr<double> EstimatedMse(const Image& image) {
-    return MeanSquaredHalfDifference(image, /*relative=*/false);
-}
+absl::StatusOr<double> EstimatedMse(const Image& image) { return MeanSquaredHalfDifference(image); }
 
 absl::StatusOr<double> EstimatedRelMse(const Image& image) {
-    return MeanSquaredHalfDifference(image, /*relative=*/true);
+    double sum = 0;
+    for (const std::string name : {"R", "G", "B"}) {
+        absl::StatusOr<const std::vector<float>*> x = RequireChannel(image, name, "image");
+        if (!x.ok()) return x.status();
+        absl::StatusOr<const std::vector<float>*> a = RequireChannel(image, "A." + name, "image");
+        if (!a.ok()) return a.status();
+        absl::StatusOr<const std::vector<float>*> b = RequireChannel(image, "B." + name, "image");
+        if (!b.ok()) return b.status();
+        sum += SumOfRelativeVariances(image.width(), image.height(),
+                                      {(*x)->data(), (*a)->data(), (*b)->data()});
+    }
+    const double n = 3.0 * double(image.width()) * double(image.height());
+    if (n == 0) return absl::InvalidArgumentError("the image has no pixels");
+    return sum / n;
 }
 
 absl::StatusOr<VarianceAssessment> AssessVariance(const Image& image) {
@@ -93,16 +132,27 @@ absl::StatusOr<VarianceAssessment> AssessVariance(const Image& image) {
 }
 
 double EstimatedTileError(const TileSums& tile) {
-    double relmse = 0;
-    for (const PixelSums& p : tile.pixels) {
+    if (tile.pixels.empty()) return 0;
+    const size_t n = tile.pixels.size();
+    // Channel c of the means, then of the A and B halves, each n floats.
+    std::vector<float> planes(9 * n);
+    for (size_t i = 0; i < n; ++i) {
+        const PixelSums& p = tile.pixels[i];
         if (p.count[0] == 0 || p.count[1] == 0) return 1;
-        const Rgb half = (p.HalfMean(0) - p.HalfMean(1)) * 0.5f, m = p.Mean();
+        const Rgb mean = p.Mean(), a = p.HalfMean(0), b = p.HalfMean(1);
         for (int c = 0; c < 3; ++c) {
-            relmse += double(half[c]) * half[c] / (double(m[c]) * m[c] + kRelativeErrorEpsilon);
+            planes[(3 * size_t(c)) * n + i] = mean[c];
+            planes[(3 * size_t(c) + 1) * n + i] = a[c];
+            planes[(3 * size_t(c) + 2) * n + i] = b[c];
         }
     }
-    const double n = 3.0 * double(tile.pixels.size());
-    return n == 0 ? 0 : std::sqrt(relmse / n);
+    double relmse = 0;
+    for (size_t c = 0; c < 3; ++c) {
+        const float* base = planes.data() + 3 * c * n;
+        relmse += SumOfRelativeVariances(tile.rect.width, tile.rect.height,
+                                         {base, base + n, base + 2 * n});
+    }
+    return std::sqrt(relmse / (3.0 * double(n)));
 }
 
 absl::StatusOr<double> EstimatedRelativeError(const Image& image) {

@@ -83,6 +83,11 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         return absl::InvalidArgumentError(
             absl::StrCat("sampler ", int(spec.sampler), ": expected independent or sobol"));
     }
+    if (spec.light_strategy != LightStrategy::kPower &&
+        spec.light_strategy != LightStrategy::kBvh) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("light_strategy ", int(spec.light_strategy), ": expected power or bvh"));
+    }
     if (spec.scene_options.filter) {
         if (absl::Status s = CheckPixelFilter(*spec.scene_options.filter); !s.ok()) {
             return absl::InvalidArgumentError(absl::StrCat("filter ", s.message()));

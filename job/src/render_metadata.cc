@@ -122,6 +122,9 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     d.attributes = DescribeMethod(m);
     if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
     if (m.aovs != 0) d.attributes["lightfarm.aovs"] = AovListName(m.aovs);
+    if (m.method == "path") {
+        d.attributes["lightfarm.light_sampling"] = std::string(LightStrategyName(m.light_strategy));
+    }
     if (m.clamp > 0) AddClampAttributes(m.clamp, d.attributes);
     // An adaptive render's first pass gives every pixel at least 2 samples (it is even).
     const uint64_t fewest_spp = m.adaptive ? m.adaptive->min_spp : m.spp;

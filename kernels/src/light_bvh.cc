@@ -174,11 +174,11 @@ std::optional<LightPick> LightBvh::Descend(const Vec3& p, const Vec3& n, Choose&
         pmf *= p_child;
         index = children[size_t(child)];
     }
-    const Node& leaf = nodes_[index];
-    // Below the root, p_child > 0 already said the leaf's importance is positive; a root leaf (a
-    // single light) may still be out of reach.
-    if (index == 0 && leaf.bounds.Importance(p, n) == 0) return std::nullopt;
-    return LightPick{int(leaf.child_or_light), pmf};
+    // Below the root, p_child > 0 already said the leaf's importance is positive. A single light
+    // is picked everywhere, with probability 1: where it cannot reach p its own sampling finds
+    // nothing, and the importance it would take to tell costs a scene with one lamp (a Cornell
+    // box) a few percent of its time.
+    return LightPick{int(nodes_[index].child_or_light), pmf};
 }
 
 std::optional<LightPick> LightBvh::Sample(const Vec3& p, const Vec3& n, float u) const {

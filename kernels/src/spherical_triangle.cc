@@ -51,20 +51,21 @@ float TriangleSolidAngle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Ve
     return float(SolidAngle(Vec3d(v0) - pd, Vec3d(v1) - pd, Vec3d(v2) - pd));
 }
 
-SphericalTriangle::SphericalTriangle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Vec3& v2)
+SphericalTriangle::SphericalTriangle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Vec3& v2,
+                                     float min_solid_angle)
     : p_(p), v0_(v0), v1_(v1), v2_(v2) {
+    min_solid_angle = std::max(min_solid_angle, kMinSphericalTriangleSolidAngle);
     const Vec3d d0 = v0_ - p_, d1 = v1_ - p_, d2 = v2_ - p_;
     // Half the threshold leaves room for the rounding of the exact solid angle below, so the bound
     // only ever skips triangles that the exact test would reject too.
-    if (SolidAngleBound(d0, d1, d2) < 0.5 * kMinSphericalTriangleSolidAngle) return;
+    if (SolidAngleBound(d0, d1, d2) < 0.5 * min_solid_angle) return;
     const double l0 = Length(d0), l1 = Length(d1), l2 = Length(d2);
     if (l0 == 0 || l1 == 0 || l2 == 0) return;
     a_ = d0 / l0;
     b_ = d1 / l1;
     c_ = d2 / l2;
     solid_angle_ = UnitSolidAngle(a_, b_, c_);
-    if (!(solid_angle_ >= kMinSphericalTriangleSolidAngle &&
-          solid_angle_ <= kMaxSphericalTriangleSolidAngle)) {
+    if (!(solid_angle_ >= min_solid_angle && solid_angle_ <= kMaxSphericalTriangleSolidAngle)) {
         return;
     }
     // alpha is the angle between the planes through a, b and a, c: cos alpha is the cosine of

@@ -568,6 +568,7 @@ TEST_F(Cli, BadAovClampFilterAndToneFlagsAreRefused) {
         {"--filter gaussian:100", "--filter gaussian:100: width 100: expected 0.5 to 16"},
         {"--filter box:2", "--filter box:2: width 2: the box filter is one pixel wide"},
         {"--sampler halton", "--sampler halton: expected independent or sobol"},
+        {"--light-sampling uniform", "--light-sampling uniform: expected power or bvh"},
     };
     for (const auto& [flags, message] : cases) {
         for (const std::string& command : {"render " + scene + " -o " + (dir_ / "x.exr").string(),
@@ -711,18 +712,74 @@ TEST_F(Cli, RadiositySummaryReportsEveryPhaseAndTheTotal) {
 
 // `render` and `submit` take their defaults from the job model: the same solver for both.
 // Every command that samples an image takes --sampler, says what the two are, and defaults to
-// Sobol.
-TEST_F(Cli, HelpExplainsTheSampler) {
-    for (const char* command :
-         {"render --help", "submit --help", "bench --help", "converge --help", "plan --help"}) {
-        const RunResult r = Lightfarm(command);
+// Sobol; those that path trace one take --light-sampling likewise, defaulting to the light BVH.
+TEST_F(Cli, HelpExplainsTheSamplerAndTheLightSampling) {
+    const std::vector<const char*> sampler = {"--sampler independent|sobol", "low-discrepancy",
+                                              "spp^-1/2", "for comparison", "Default sobol"};
+    const std::vector<const char*> light = {"--light-sampling power|bvh", "light BVH",
+                                            "solid angle", "proportional to its power",
+                                            "Default bvh"};
+    for (const std::string command : {"render", "submit", "bench", "converge", "plan"}) {
+        const RunResult r = Lightfarm(command + " --help");
         ASSERT_EQ(r.status, 0) << r.output;
-        for (const char* text : {"--sampler independent|sobol", "low-discrepancy", "spp^-1/2",
-                                 "for comparison", "Default sobol"}) {
+        // converge compares lists of light strategies (converge --compare) with its own flag.
+        std::vector<const char*> texts = sampler;
+        if (command != "converge") texts.insert(texts.end(), light.begin(), light.end());
+        for (const char* text : texts) {
             EXPECT_NE(r.output.find(text), std::string::npos) << command << ": " << text << "\n"
                                                               << r.output;
         }
     }
+}
+
+// The mean radiance of an image and the variance of that mean, from each pixel's independent
+// A/B halves: the mean of n samples is (A + B) / 2, and E[(A - B)^2] / 4 is its variance.
+struct ImageMean {
+    double mean = 0, variance = 0;
+};
+ImageMean MeanOfImage(const Image& image) {
+    ImageMean m;
+    const size_t n = image.FindChannel("R")->size();
+    for (const char* c : {"R", "G", "B"}) {
+        const std::vector<float>& a = *image.FindChannel(std::string("A.") + c);
+        const std::vector<float>& b = *image.FindChannel(std::string("B.") + c);
+        for (size_t i = 0; i < n; ++i) {
+            m.mean += 0.5 * (double(a[i]) + b[i]) / double(n);
+            m.variance += 0.25 * (double(a[i]) - b[i]) * (double(a[i]) - b[i]) / double(n * n);
+        }
+    }
+    return m;
+}
+
+// --light-sampling reaches the path tracer: with the same seed, power and bvh give different
+// bits, and the header and the log name each; both are unbiased, so bvh's mean with another
+// seed (independent of power's) is power's within 4 standard errors of their difference.
+TEST_F(Cli, LightSamplingReachesThePathTracerAndKeepsTheMean) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    auto render = [&](const std::string& strategy, int seed) -> absl::StatusOr<ExrFile> {
+        const std::string exr = (dir_ / (strategy + std::to_string(seed) + ".exr")).string();
+        const RunResult r =
+            Lightfarm("render " + scene + " -o " + exr + " --spp 16 --resolution 32x32 --seed " +
+                      std::to_string(seed) + " --light-sampling " + strategy + " --no-progress");
+        EXPECT_EQ(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find(strategy + " light sampling"), std::string::npos) << r.output;
+        absl::StatusOr<ExrFile> file = ReadExr(exr);
+        if (file.ok()) {
+            EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.light_sampling")),
+                      strategy);
+        }
+        return file;
+    };
+    const absl::StatusOr<ExrFile> power = render("power", 1), bvh = render("bvh", 1),
+                                  bvh_other_seed = render("bvh", 2);
+    ASSERT_TRUE(power.ok() && bvh.ok() && bvh_other_seed.ok());
+    EXPECT_NE(*power->image.FindChannel("R"), *bvh->image.FindChannel("R"));
+    const ImageMean p = MeanOfImage(power->image), b = MeanOfImage(bvh_other_seed->image);
+    ASSERT_GT(p.variance, 0);
+    ASSERT_GT(b.variance, 0);
+    EXPECT_LT(std::abs(p.mean - b.mean), 4 * std::sqrt(p.variance + b.variance))
+        << "power " << p.mean << " +- " << std::sqrt(p.variance) << ", bvh " << b.mean << " +- "
+        << std::sqrt(b.variance);
 }
 
 TEST_F(Cli, RenderAndSubmitShareTheirDefaults) {

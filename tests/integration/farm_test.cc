@@ -678,16 +678,20 @@ TEST_F(Farm, FetchWritesThePngPreviewAsRenderDoes) {
 
 // End to end (needs the sampling pipeline of issue 13 on the wire and in the workers): --clamp,
 // --aov and --filter give the same image and header on the farm as locally.
-// The other Farm tests render with the default sampler (sobol); this one with the other.
-TEST_F(Farm, ClampAovsFilterAndSamplerGiveTheSameImageAndHeaderLocallyAndOnTheFarm) {
+// The other Farm tests render with the default sampler (sobol) and light sampling (bvh); this
+// one with the others, which `status` names.
+TEST_F(Farm, ClampAovsFilterSamplerAndLightSamplingGiveTheSameImageAndHeaderLocallyAndOnTheFarm) {
     StartServer();
     StartWorker("w1");
     StartWorker("w2");
     const std::string flags =
         "--spp 4 --seed 2 --tile 16 --clamp 2 --aov all "
-        "--filter blackman-harris:2 --sampler independent";
+        "--filter blackman-harris:2 --sampler independent --light-sampling power";
     const std::string job = Submit(scene_, flags);
     ASSERT_EQ(Farmctl("watch " + job).status, 0);
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_NE(status.out.find("independent sampler, power light sampling"), std::string::npos)
+        << status.out;
     const std::string farm = (dir_ / "farm.exr").string(), local = (dir_ / "local.exr").string();
     ASSERT_EQ(Farmctl("fetch " + job + " -o " + farm).status, 0);
     const CliRun r =
@@ -703,6 +707,7 @@ TEST_F(Farm, ClampAovsFilterAndSamplerGiveTheSameImageAndHeaderLocallyAndOnTheFa
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.filter")),
               "blackman-harris 2 px");
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.sampler")), "independent");
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.light_sampling")), "power");
     EXPECT_NE(file->image.FindChannel("depth.Z"), nullptr);
 }
 

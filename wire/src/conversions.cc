@@ -47,6 +47,15 @@ SamplerType FromProto(pb::SamplerType type) {
     return type == pb::SAMPLER_SOBOL ? SamplerType::kSobol : SamplerType::kIndependent;
 }
 
+pb::LightStrategy ToProto(LightStrategy strategy) {
+    return strategy == LightStrategy::kBvh ? pb::LIGHT_STRATEGY_BVH : pb::LIGHT_STRATEGY_POWER;
+}
+
+// Refused by JobService when unknown, as the sampler is.
+LightStrategy FromProto(pb::LightStrategy strategy) {
+    return strategy == pb::LIGHT_STRATEGY_BVH ? LightStrategy::kBvh : LightStrategy::kPower;
+}
+
 }  // namespace
 
 void ToProto(const BlobRef& ref, pb::SceneFile* out) {
@@ -93,6 +102,7 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_clamp(spec.clamp);
     out->set_aovs(spec.aovs);
     out->set_sampler(ToProto(spec.sampler));
+    out->set_light_strategy(ToProto(spec.light_strategy));
     if (const std::optional<PixelFilter>& filter = spec.scene_options.filter) {
         out->set_filter_type(ToProto(filter->type));
         out->set_filter_width(filter->width);
@@ -114,6 +124,7 @@ void FromProto(const pb::RenderParams& p, JobSpec* spec) {
     spec->clamp = p.clamp();
     spec->aovs = p.aovs();
     spec->sampler = FromProto(p.sampler());
+    spec->light_strategy = FromProto(p.light_strategy());
 }
 
 void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {

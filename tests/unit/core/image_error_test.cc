@@ -45,7 +45,8 @@ TEST(ImageError, HalfBufferEstimateIsTheVarianceOfTheMean) {
 // A = x + d, B = x - d per pixel, so ((A - B) / 2)^2 = d^2 and the estimate is analytic. Fifteen
 // pixels of 0.5 off by 1 %, one light-edge pixel of 8 off by 25 %: the relMSE estimate is about
 // the typical pixel's, while the whole image's RMS against its mean radiance is that one
-// pixel's absolute error.
+// pixel's absolute error. The bright pixel is bright in both halves, so it is measured against
+// the dimmer half, 6, not against its dim neighbours.
 TEST(ImageError, RelMseEstimateIsThePerPixelRelativeVariance) {
     constexpr float kValue = 0.5f, kSpread = 0.005f, kEdge = 8.0f, kEdgeSpread = 2.0f;
     Image image = Constant(4, 4, kValue);
@@ -58,7 +59,8 @@ TEST(ImageError, RelMseEstimateIsThePerPixelRelativeVariance) {
     const double d = double(kValue + kSpread) - kValue;  // kSpread as the floats hold it
     const double relmse =
         (15 * d * d / (double(kValue) * kValue + kRelativeErrorEpsilon) +
-         double(kEdgeSpread) * kEdgeSpread / (double(kEdge) * kEdge + kRelativeErrorEpsilon)) /
+         double(kEdgeSpread) * kEdgeSpread /
+             (double(kEdge - kEdgeSpread) * (kEdge - kEdgeSpread) + kRelativeErrorEpsilon)) /
         16;
     EXPECT_NEAR(EstimatedRelMse(image).value(), relmse, 1e-9 * relmse);
     EXPECT_LT(std::sqrt(relmse), 0.1);
@@ -85,6 +87,30 @@ TEST(ImageError, LogLogSlopeOfAPowerLaw) {
     EXPECT_FALSE(LogLogSlope({{1, 1}}).ok());
     EXPECT_FALSE(LogLogSlope({{1, 1}, {1, 2}}).ok());
     EXPECT_FALSE(LogLogSlope({{1, 1}, {2, 0}}).ok());
+}
+
+// A firefly: one sample of 100 in one half of a pixel of 0.5 among pixels of 0.5. Its own mean,
+// 25.4, would divide its error away (a term of about 1); the other half and the neighbours,
+// which do not hold it, put it at 0.5, as the reference would. Beside a light (neighbours of 17)
+// a dim pixel keeps its own value, so the light does not hide its noise.
+TEST(ImageError, RelMseEstimateDoesNotLetAFireflyDivideItselfAway) {
+    constexpr float kValue = 0.5f, kFirefly = 100.0f;
+    Image image = Constant(3, 3, kValue);
+    for (const char* c : {"A.R", "A.G", "A.B"}) image.Channel(c)[4] = (kFirefly + kValue) / 2;
+    for (const char* c : {"R", "G", "B"}) image.Channel(c)[4] = (kFirefly + 3 * kValue) / 4;
+    const double half = ((kFirefly + kValue) / 2 - kValue) / 2;
+    const double firefly = half * half / (double(kValue) * kValue + kRelativeErrorEpsilon) / 9;
+    EXPECT_NEAR(EstimatedRelMse(image).value(), firefly, 1e-6 * firefly);
+    EXPECT_GT(EstimatedRelMse(image).value(), 100);
+
+    constexpr float kLight = 17.0f, kSpread = 0.05f;
+    Image beside = Constant(3, 3, kLight);
+    for (const char* c : {"R", "G", "B"}) beside.Channel(c)[4] = kValue;
+    for (const char* c : {"A.R", "A.G", "A.B"}) beside.Channel(c)[4] = kValue + kSpread;
+    for (const char* c : {"B.R", "B.G", "B.B"}) beside.Channel(c)[4] = kValue - kSpread;
+    const double d = double(kValue + kSpread) - kValue;
+    const double dim = d * d / (double(kValue) * kValue + kRelativeErrorEpsilon) / 9;
+    EXPECT_NEAR(EstimatedRelMse(beside).value(), dim, 1e-5 * dim);
 }
 
 // A tile's stopping error is the square root of the relMSE the same pixels give as an image, so

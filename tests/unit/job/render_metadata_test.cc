@@ -113,6 +113,23 @@ TEST(RenderMetadata, ACameraPickedByNameIsNamedAndTheScenesOwnIsNot) {
     EXPECT_EQ(std::get<std::string>(picked->attributes.at("lightfarm.camera")), "Closeup");
 }
 
+// A path-traced image names how its paths sampled lights; radiosity samples none, so its
+// header says nothing of it.
+TEST(RenderMetadata, LightSamplingIsNamedForPathTracingOnly) {
+    RenderMetadata m = PathMetadata();
+    for (const LightStrategy strategy : {LightStrategy::kPower, LightStrategy::kBvh}) {
+        m.light_strategy = strategy;
+        absl::StatusOr<RenderDescription> d = DescribeRender(m, EmptyRenderImage(4, 4), true);
+        ASSERT_TRUE(d.ok()) << d.status();
+        EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.light_sampling")),
+                  LightStrategyName(strategy));
+    }
+    m.method = "radiosity";
+    absl::StatusOr<RenderDescription> radiosity = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(radiosity.ok()) << radiosity.status();
+    EXPECT_FALSE(radiosity->attributes.count("lightfarm.light_sampling"));
+}
+
 TEST(RenderMetadata, RadiosityFiguresAndSettingsGoIntoTheHeader) {
     RenderMetadata m = PathMetadata();
     m.method = "radiosity";

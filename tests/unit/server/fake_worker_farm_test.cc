@@ -13,9 +13,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
@@ -418,14 +421,22 @@ TEST_F(FakeWorkerFarm, AnUnknownPixelFilterIsRefusedNamingTheField) {
     EXPECT_TRUE(farm_->scheduler().List()->empty());
 }
 
-TEST_F(FakeWorkerFarm, AnUnknownSamplerIsRefusedNamingTheField) {
-    pb::SubmitJobRequest request = SubmitRequest();
-    request.mutable_params()->set_sampler(static_cast<pb::SamplerType>(77));
-    pb::SubmitJobResponse response;
-    grpc::ClientContext context;
-    const grpc::Status s = job_stub_->SubmitJob(&context, request, &response);
-    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-    EXPECT_NE(s.error_message().find("params.sampler 77"), std::string::npos) << s.error_message();
+TEST_F(FakeWorkerFarm, AnUnknownSamplerOrLightStrategyIsRefusedNamingTheField) {
+    const std::vector<std::pair<std::string, std::function<void(pb::RenderParams&)>>> cases = {
+        {"params.sampler 77",
+         [](pb::RenderParams& p) { p.set_sampler(static_cast<pb::SamplerType>(77)); }},
+        {"params.light_strategy 77",
+         [](pb::RenderParams& p) { p.set_light_strategy(static_cast<pb::LightStrategy>(77)); }},
+    };
+    for (const auto& [field, set] : cases) {
+        pb::SubmitJobRequest request = SubmitRequest();
+        set(*request.mutable_params());
+        pb::SubmitJobResponse response;
+        grpc::ClientContext context;
+        const grpc::Status s = job_stub_->SubmitJob(&context, request, &response);
+        EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << field;
+        EXPECT_NE(s.error_message().find(field), std::string::npos) << s.error_message();
+    }
     EXPECT_TRUE(farm_->scheduler().List()->empty());
 }
 

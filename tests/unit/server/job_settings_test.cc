@@ -66,6 +66,7 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
         {"max_depth", [](JobSpec& s) { s.max_depth = kMaxDepthLimit + 1; }},
         {"method", [](JobSpec& s) { s.method = "photon"; }},
         {"sampler", [](JobSpec& s) { s.sampler = static_cast<SamplerType>(7); }},
+        {"light_strategy", [](JobSpec& s) { s.light_strategy = static_cast<LightStrategy>(7); }},
         {"adaptive.target_error", [](JobSpec& s) { s.adaptive.target_error = 1e-9; }},
         {"adaptive.target_error", [](JobSpec& s) { s.adaptive.target_error = NAN; }},
         {"adaptive.time_limit", [](JobSpec& s) { s.adaptive.time_limit = -1; }},
@@ -114,7 +115,9 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     EXPECT_TRUE(CheckJobSettings(aov_edge).ok()) << CheckJobSettings(aov_edge);
     EXPECT_TRUE(CheckJobSettings(JobSpec{}).ok()) << CheckJobSettings(JobSpec{});
     EXPECT_EQ(JobSpec{}.sampler, SamplerType::kSobol);
+    EXPECT_EQ(JobSpec{}.light_strategy, LightStrategy::kBvh);
     edge.sampler = SamplerType::kIndependent;
+    edge.light_strategy = LightStrategy::kPower;
     EXPECT_TRUE(CheckJobSettings(edge).ok()) << CheckJobSettings(edge);
     fs::remove_all(dir);
 }

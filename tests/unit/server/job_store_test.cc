@@ -10,7 +10,9 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/aov.h"
@@ -180,27 +182,46 @@ TEST(JobRecordCodec, FilterClampAndAovsSurviveAndOldRecordsHaveNone) {
     EXPECT_EQ(old->spec.aovs, 0u);
 }
 
+// A setting the record stores by name (`key`): each of `values` survives, the default is stored
+// as `default_name`, a name no build knows is data loss naming it, and a record without the key
+// reads as `before`, what jobs rendered with before the setting existed.
+template <typename T>
+void ExpectNamedSettingSurvives(const std::string& key, T JobSpec::*field,
+                                std::initializer_list<T> values, const std::string& default_name,
+                                T before) {
+    for (const T value : values) {
+        JobRecord job = Record("a", 1);
+        job.spec.*field = value;
+        const absl::StatusOr<JobRecord> back = DecodeJobRecord(EncodeJobRecord(job));
+        ASSERT_TRUE(back.ok()) << back.status();
+        EXPECT_EQ(back->spec.*field, value) << key;
+    }
+    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
+    EXPECT_EQ(stored.at("spec").at(key), default_name);
+    stored["spec"][key] = "halton";
+    const absl::StatusOr<JobRecord> unknown = DecodeJobRecord(stored.dump());
+    EXPECT_EQ(unknown.status().code(), absl::StatusCode::kDataLoss);
+    EXPECT_NE(unknown.status().message().find(key + " \"halton\""), std::string_view::npos)
+        << unknown.status();
+    stored["spec"].erase(key);
+    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
+    ASSERT_TRUE(old.ok()) << old.status();
+    EXPECT_EQ(old->spec.*field, before) << key;
+}
+
 // A record written before --sampler was rendered with independent numbers: resumed, its
 // remaining tiles must use them too, whatever the default is now.
 TEST(JobRecordCodec, SamplerSurvivesAndOldRecordsKeepIndependentNumbers) {
-    for (const SamplerType sampler : {SamplerType::kSobol, SamplerType::kIndependent}) {
-        JobRecord job = Record("a", 1);
-        job.spec.sampler = sampler;
-        const absl::StatusOr<JobRecord> back = DecodeJobRecord(EncodeJobRecord(job));
-        ASSERT_TRUE(back.ok()) << back.status();
-        EXPECT_EQ(back->spec.sampler, sampler);
-    }
-    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
-    EXPECT_EQ(stored.at("spec").at("sampler"), "sobol");  // the default
-    stored["spec"]["sampler"] = "halton";
-    const absl::StatusOr<JobRecord> unknown = DecodeJobRecord(stored.dump());
-    EXPECT_EQ(unknown.status().code(), absl::StatusCode::kDataLoss);
-    EXPECT_NE(unknown.status().message().find("sampler \"halton\""), std::string_view::npos)
-        << unknown.status();
-    stored["spec"].erase("sampler");
-    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
-    ASSERT_TRUE(old.ok()) << old.status();
-    EXPECT_EQ(old->spec.sampler, SamplerType::kIndependent);
+    ExpectNamedSettingSurvives("sampler", &JobSpec::sampler,
+                               {SamplerType::kSobol, SamplerType::kIndependent}, "sobol",
+                               SamplerType::kIndependent);
+}
+
+// Likewise a record from before --light-sampling picked its lights by power.
+TEST(JobRecordCodec, LightStrategySurvivesAndOldRecordsKeepPickingByPower) {
+    ExpectNamedSettingSurvives("light_strategy", &JobSpec::light_strategy,
+                               {LightStrategy::kBvh, LightStrategy::kPower}, "bvh",
+                               LightStrategy::kPower);
 }
 
 TEST(JobRecordCodec, UnknownStateNameIsAClearError) {

@@ -30,9 +30,19 @@ absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& refere
 absl::StatusOr<double> EstimatedMse(const Image& image);
 
 // The image's own estimate of its relMSE (CompareImages): the mean over pixels and channels of
-// ((A - B) / 2)^2 / (R^2 + kRelativeErrorEpsilon). Each pixel counts by its error relative to
-// its own value, so a few bright pixels with a large absolute error (a light's edges) weigh no
-// more than any other pixel. InvalidArgument without the R,G,B, A.* and B.* channels.
+// ((A - B) / 2)^2 / (p^2 + kRelativeErrorEpsilon), p the pixel's value as far as its noise
+// lets us know it: min(R, max(min(A, B), mean of its up to 8 neighbours)). Each pixel counts by
+// its error relative to its own value, so a few bright pixels with a large absolute error (a
+// light's edges) weigh no more than any other pixel.
+// Why not R itself: R^2 = AB + ((A - B) / 2)^2, so a pixel's term was at most 1 and a firefly
+// divided itself away, while the true relMSE divides by the reference's value. With R the
+// estimate was 0.2-0.5x the true relMSE below 32 spp (0.03x at 2 spp with caustics), while the
+// same numerator over the reference's value is within 0.75-1.2x at every spp (measured,
+// docs/convergence.md "Error estimates and plan predictions"). A firefly lands in one half, so
+// the other half and the neighbours, which do not hold it, give p; a pixel that is bright in
+// both halves (a small highlight) keeps its own value; the outer minimum keeps R where the
+// neighbours are brighter (beside a light), which would hide a dim pixel's noise.
+// InvalidArgument without the R,G,B, A.* and B.* channels.
 absl::StatusOr<double> EstimatedRelMse(const Image& image);
 
 // An image is reported as high variance when either of two estimates says it is not to be
@@ -62,7 +72,8 @@ inline constexpr double kRelativeErrorFloor = 1e-3;
 absl::StatusOr<double> EstimatedRelativeError(const Image& image);
 
 // The error a tile estimates for itself, the stopping rule of adaptive sampling: the square root
-// of its relMSE estimate (EstimatedRelMse over the tile's pixels), each pixel's error relative
+// of its relMSE estimate (EstimatedRelMse over the tile's pixels, the neighbours taken inside the
+// tile, so a tile that is the whole image gives the image's value), each pixel's error relative
 // to its own value, as Dammertz et al. 2009 and Cycles normalise per pixel. Normalising by the
 // tile's mean instead let a tile's few bright pixels (a light's edge) hide the noise of the
 // rest: at equal cost the image's relMSE came out 3x that of uniform sampling (measured,

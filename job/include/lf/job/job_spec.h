@@ -30,6 +30,8 @@ struct JobSpec {
     double clamp = 0;   // RenderSettings::clamp (lf/local/local_executor.h); 0: off
     uint32_t aovs = 0;  // lf/core/aov.h flags
     SamplerType sampler = defaults::kSampler;
+    // The path tracer's; the job records and the EXR header name it (power or bvh).
+    LightStrategy light_strategy = defaults::kLightStrategy;
     std::string method = defaults::kMethod;  // or "radiosity"
     RadiositySettings radiosity;
     AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused

@@ -71,6 +71,8 @@ struct RenderMetadata {
     uint32_t aovs = 0;   // lf/core/aov.h flags of the AOV channels the image has
     PixelFilter filter;  // the camera's, after --filter
     SamplerType sampler = defaults::kSampler;  // lightfarm.sampler
+    // lightfarm.light_sampling, for method "path" (radiosity samples no lights)
+    LightStrategy light_strategy = defaults::kLightStrategy;
     double seconds = 0;  // the whole render: loading, meshing, solving and sampling
     RenderStats stats;
     AdaptiveSettings adaptive_settings;
@@ -91,8 +93,8 @@ struct RenderDescription {
 };
 
 // Every attribute of a render's header: how it was made (lightfarm.version, scene hash, camera
-// when picked by name, method, settings with lightfarm.sampler, timing, ray and sample counts,
-// truncated paths), what
+// when picked by name, method, settings with lightfarm.sampler and, for path tracing,
+// lightfarm.light_sampling, timing, ray and sample counts, truncated paths), what
 // the channels hold (lightfarm.channels, lightfarm.aovs when there are AOVs, lightfarm.filter),
 // their units (lightfarm.units and OpenEXR's standard chromaticities, Rec.709 with D65, and
 // whiteLuminance = 683 cd/m^2 for RGB (1, 1, 1)), the bias of --clamp (lightfarm.clamp and

@@ -43,10 +43,11 @@ class LightBvh {
     bool empty() const { return nodes_.empty(); }
     size_t node_count() const { return nodes_.size(); }
 
-    // A light for u uniform in [0, 1), with its probability; nullopt if no light can reach p,
-    // and also, as in pbrt-v4, when the walk ends in a subtree whose bounds promised light that
-    // none of its lights gives (then the Pmfs sum to less than 1; a failed pick contributes
-    // zero and the estimate stays unbiased: every light that can reach p has Pmf > 0).
+    // A light for u uniform in [0, 1), with its probability; nullopt if no light can reach p
+    // (a tree of one light picks it regardless, with probability 1), and also, as in pbrt-v4, when
+    // the walk ends in a subtree whose bounds promised light that none of its lights gives (then
+    // the Pmfs sum to less than 1; a failed pick contributes zero and the estimate stays unbiased:
+    // every light that can reach p has Pmf > 0).
     std::optional<LightPick> Sample(const Vec3& p, const Vec3& n, float u) const;
     // The probability that Sample(p, n, .) picks `light`; 0 for a light left out or out of range.
     float Pmf(const Vec3& p, const Vec3& n, int light) const;

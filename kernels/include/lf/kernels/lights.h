@@ -7,13 +7,17 @@
 // Two strategies (LightStrategy):
 // - kPower: a light is picked with probability proportional to its power, so a tiny bright
 //   emitter gets the samples it needs; triangles and spheres are sampled uniformly by area.
+// Two consecutive triangles of a mesh that form a rectangle (a quad light, the Cornell box's
+// lamp) are one light under both strategies: by area, that is the same as picking one of the two
+// by power; by solid angle, one spherical rectangle instead of a pick and a spherical triangle.
 // - kBvh (the default): the lights at infinity and directional lights keep their power
 //   probabilities (as one group, so EscapedPdf is the same under both strategies), and the
 //   finite lights (triangles, spheres, point and spot lights) share the rest, chosen among by a
 //   light BVH (lf/kernels/light_bvh.h) by their importance at the shading point and normal.
-//   Triangles that subtend a solid angle worth it are sampled in it (spherical triangles,
-//   lf/kernels/spherical_triangle.h; warped by the receiver's cosine as in pbrt-v4 when there
-//   is a normal), the others by area; spheres within their visible cone
+//   Triangles and rectangles that subtend a solid angle worth it are sampled in it (spherical
+//   triangles and rectangles, lf/kernels/spherical_triangle.h, spherical_rectangle.h; warped by
+//   the receiver's cosine as in pbrt-v4 when there is a normal), the others by area; spheres
+//   within their visible cone
 //   (lf/kernels/sphere_cone_sampling.h). Pdf takes the same decisions, which depend only on
 //   the reference point, its normal and the light.
 #pragma once
@@ -65,13 +69,34 @@ class LightSampler {
     float EscapedPdf(const Vec3& w) const;
 
   private:
-    enum class Kind { kTriangle, kSphere, kPoint, kSpot, kDirectional, kSun, kEnvironment };
+    enum class Kind {
+        kTriangle,
+        kRectangle,
+        kSphere,
+        kPoint,
+        kSpot,
+        kDirectional,
+        kSun,
+        kEnvironment
+    };
     struct Light {
         Kind kind;
-        int index;      // mesh (triangle) / sphere / point, spot, directional light / sun disk
-        int primitive;  // triangle within the mesh
+        // mesh (triangle, rectangle) / sphere / point, spot, directional light / sun disk
+        int index;
+        int primitive;  // triangle within the mesh; a rectangle's: its entry in rectangles_
         float area;
         bool two_sided;  // area lights: emission leaves the back face too
+    };
+    // Two triangles of one mesh forming the rectangle corner + s ex + t ey, s, t in [0, 1].
+    // Per triangle, its first vertex and the dual vectors of its edges: the barycentrics of a
+    // point q in the plane are (Dot(q - origin, dual1), Dot(q - origin, dual2)).
+    struct Rectangle {
+        Vec3 corner, ex, ey;
+        struct Half {
+            int primitive;
+            Vec3 origin, dual1, dual2;
+        };
+        Half halves[2];
     };
     // A spot light's cone in render space: with c = 1 - cos(angle to the axis) and
     // t = clamp((one_minus_cos_outer - c) * inv_width, 0, 1) its falloff is t^2
@@ -91,6 +116,8 @@ class LightSampler {
         bool Contains(const Vec3& w) const;
     };
 
+    // The rectangle triangles t and t + 1 of mesh m form, if they do.
+    static std::optional<Rectangle> FormRectangle(const EmbreeScene& es, int m, int t);
     int LightIndex(const SurfaceHit& hit) const;
     // A point on area light `light` (triangle or sphere) for u, with its density per solid
     // angle at ref (normal n, for the cosine warp of large triangles), not yet times the pick
@@ -99,6 +126,8 @@ class LightSampler {
                                           const Vec2& u) const;
     // The density with which SampleArea yields `hit` on area light `light` from ref.
     float AreaPdf(const Light& light, const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;
+    // The point at (s, t) of rectangle light `light`, on whichever of its triangles holds it.
+    SurfacePoint RectanglePoint(const Light& light, const Vec2& st) const;
     std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref) const;
     // A direction towards a sun disk (uniform in its cone) or the environment (by its map).
     std::optional<Vec3> SampleInfiniteDirection(const Light& light, const Vec2& u) const;
@@ -113,8 +142,9 @@ class LightSampler {
     // lights' sum is finite_pmf_, the BVH shares it.
     std::vector<float> pmf_;
     float finite_pmf_ = 0;
-    LightBvh bvh_;                                  // kBvh: over lights_[0, finite_count_)
-    std::vector<float> cdf_;                        // its running sum, cdf_.back() == 1
+    LightBvh bvh_;            // kBvh: over lights_[0, finite_count_)
+    std::vector<float> cdf_;  // its running sum, cdf_.back() == 1
+    std::vector<Rectangle> rectangles_;
     std::vector<std::vector<int>> triangle_light_;  // per mesh, per triangle: light or -1
     std::vector<int> sphere_light_;                 // per sphere: light or -1
     std::vector<SpotCone> spot_cones_;              // per spot light

@@ -43,11 +43,14 @@ struct SphericalTriangleSample {
 // it runs once per light sample and per MIS weight.
 class SphericalTriangle {
   public:
-    SphericalTriangle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Vec3& v2);
+    // min_solid_angle (at least kMinSphericalTriangleSolidAngle): below it samplable() is false;
+    // a caller that samples by area below a higher threshold saves the trigonometry there.
+    SphericalTriangle(const Vec3& p, const Vec3& v0, const Vec3& v1, const Vec3& v2,
+                      float min_solid_angle = kMinSphericalTriangleSolidAngle);
 
     float solid_angle() const { return float(solid_angle_); }
     // Whether Sample and Invert may be used: the triangle is not degenerate as seen from p and
-    // its solid angle is within [kMinSphericalTriangleSolidAngle, kMaxSphericalTriangleSolidAngle].
+    // its solid angle is within [min_solid_angle, kMaxSphericalTriangleSolidAngle].
     bool samplable() const { return samplable_; }
     // 1 / solid angle if samplable(), else 0.
     float Pdf() const { return samplable_ ? float(1 / solid_angle_) : 0.0f; }

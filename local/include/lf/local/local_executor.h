@@ -28,6 +28,9 @@ struct RenderSettings {
     double clamp = 0;
     uint32_t aovs = 0;                         // lf/core/aov.h flags: first-hit AOV channels to add
     SamplerType sampler = defaults::kSampler;  // `--sampler`
+    // `--light-sampling`: RenderImage takes an estimator already built, so this is for the
+    // caller that builds it (PathTracer(scene, max_depth, light_strategy)), as local mode does.
+    LightStrategy light_strategy = defaults::kLightStrategy;
 };
 
 struct RenderOutput {
