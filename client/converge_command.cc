@@ -134,8 +134,11 @@ Command AddConvergeCommand(CLI::App& app) {
     CLI::Option* lights_option =
         cmd->add_option("--light-sampling", *strategies,
                         absl::StrCat("light strategies of the path ladders, comma-separated: bvh "
-                                     "(a light BVH by importance at the shading point) and power "
-                                     "(by power alone). Default ",
+                                     "(a light BVH weighs every light by its importance at the "
+                                     "shading point; triangles and spheres that look large are "
+                                     "sampled by the solid angle they subtend) and power (a light "
+                                     "with probability proportional to its power, a point on it "
+                                     "by area, for comparison). Default ",
                                      *strategies))
             ->type_name("power|bvh,...");
     cmd->add_option("--compare", *compare,

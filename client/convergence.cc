@@ -394,6 +394,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         settings.seed = seed;
         settings.threads = options.threads;
         settings.sampler = config.sampler;
+        settings.light_strategy = config.light_strategy;
         return RenderImage(camera, path_tracer, settings);
     };
 
@@ -480,13 +481,12 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         metadata.seed = seed;
         metadata.max_depth = options.max_depth;
         metadata.sampler = best.sampler;
+        metadata.light_strategy = best.light_strategy;
         metadata.filter = scene->camera.filter;
         metadata.seconds = out->seconds;
         metadata.stats = out->stats;
         absl::StatusOr<RenderDescription> description = DescribeRender(metadata, out->image, true);
         if (!description.ok()) return description.status();
-        description->attributes["lightfarm.light_sampling"] =
-            std::string(LightStrategyName(best.light_strategy));
         description->attributes["lightfarm.converge.reference"] = result.reference;
         result.reference_exr_path = (dir / "reference.exr").string();
         if (absl::Status s =

@@ -26,7 +26,7 @@ namespace lf {
 // estimation picks lights.
 struct RenderConfig {
     SamplerType sampler = defaults::kSampler;
-    LightStrategy light_strategy = LightStrategy::kBvh;  // PathTracer's default
+    LightStrategy light_strategy = defaults::kLightStrategy;
     bool operator==(const RenderConfig&) const = default;
 };
 
