@@ -41,18 +41,19 @@ void PrintSummary(const ConvergenceResult& result) {
             "raise --reference-spp)\n",
             100 * share, ConfigName(best->config).c_str(), (long long)best->budget);
     }
-    const std::string rule(126, '-');
-    std::printf("%-18s %9s %9s %11s %11s %11s %17s %17s\n%-18s %9s %9s %11s %11s %11s %17s %17s\n",
-                "configuration", "slope rel", "slope", "samples/s", "RMSE", "relMSE", "RMSE ratio",
-                "relMSE ratio", "", "RMSE", "", "", "at equal time", "at equal time",
-                "at end, mean", "at end, mean");
+    const std::string rule(136, '-');
+    std::printf(
+        "%-18s %9s %9s %9s %11s %11s %11s %17s %17s\n%-18s %9s %9s %9s %11s %11s %11s %17s %17s\n",
+        "configuration", "slope rel", "slope", "slope", "samples/s", "RMSE", "relMSE", "RMSE ratio",
+        "relMSE ratio", "", "RMSE", "RMSE", "per spp", "", "at equal time", "at equal time",
+        "at end, mean", "at end, mean");
     std::printf("%s\n", rule.c_str());
     for (const ConfigSummary& c : result.configs) {
-        std::printf("%-18s %9.3f %9.3f %10.3fM %11.4e %11.4e %8.3f, %6.3f %8.3f, %6.3f\n",
+        std::printf("%-18s %9.3f %9.3f %9.3f %10.3fM %11.4e %11.4e %8.3f, %6.3f %8.3f, %6.3f\n",
                     ConfigName(c.config).c_str(), c.relative_rmse_slope, c.rmse_slope,
-                    c.samples_per_second * 1e-6, c.rmse_at_equal_time, c.relmse_at_equal_time,
-                    c.rmse_ratio_at_end, c.rmse_ratio_mean, c.relmse_ratio_at_end,
-                    c.relmse_ratio_mean);
+                    c.rmse_spp_slope, c.samples_per_second * 1e-6, c.rmse_at_equal_time,
+                    c.relmse_at_equal_time, c.rmse_ratio_at_end, c.rmse_ratio_mean,
+                    c.relmse_ratio_at_end, c.relmse_ratio_mean);
     }
 }
 

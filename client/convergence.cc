@@ -220,12 +220,12 @@ absl::Status WriteSummaryCsv(const ConvergenceResult& result) {
     csv << kSummaryCsvHeader << "\n";
     for (const ConfigSummary& c : result.configs) {
         csv << absl::StrFormat(
-            "%s,%s,%d,%d,%.4f,%.4f,%.6e,%.6g,%.6g,%.6e,%.6e,%.4f,%.4f,%.4f,%.4f\n",
+            "%s,%s,%d,%d,%.4f,%.4f,%.6e,%.6g,%.6g,%.6e,%.6e,%.4f,%.4f,%.4f,%.4f,%.4f\n",
             SamplerTypeName(c.config.sampler), LightStrategyName(c.config.light_strategy),
             c.fit.from, c.fit.to, c.relative_rmse_slope, c.rmse_slope, c.samples_per_second,
             result.equal_time.from, result.equal_time.to, c.rmse_at_equal_time,
             c.relmse_at_equal_time, c.rmse_ratio_at_end, c.rmse_ratio_mean, c.relmse_ratio_at_end,
-            c.relmse_ratio_mean);
+            c.relmse_ratio_mean, c.rmse_spp_slope);
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.summary_path + ": cannot write");
@@ -269,7 +269,7 @@ absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const Re
     FittedLadder out;
     out.summary.config = config;
     out.summary.fit = fit;
-    ErrorCurve relative;
+    ErrorCurve relative, by_spp;
     double samples = 0, seconds = 0;
     for (const ConvergenceRow& row : result.rows) {
         if (row.method != "path" || !(row.config == config) || uint64_t(row.budget) < fit.from ||
@@ -278,6 +278,7 @@ absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const Re
         }
         relative.push_back({row.seconds, RelativeRmse(row)});
         out.rmse.push_back({row.seconds, row.error.rmse});
+        by_spp.push_back({double(row.budget), row.error.rmse});
         out.relmse.push_back({row.seconds, row.error.relmse});
         samples += double(row.budget) * double(pixels);
         seconds += row.seconds;
@@ -285,7 +286,8 @@ absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const Re
     const std::string name = ConfigName(config);
     absl::StatusOr<double> relative_slope = LogLogSlope(relative);
     absl::StatusOr<double> rmse_slope = LogLogSlope(out.rmse);
-    for (const absl::StatusOr<double>* slope : {&relative_slope, &rmse_slope}) {
+    absl::StatusOr<double> spp_slope = LogLogSlope(by_spp);
+    for (const absl::StatusOr<double>* slope : {&relative_slope, &rmse_slope, &spp_slope}) {
         if (!slope->ok()) {
             return absl::InvalidArgumentError(absl::StrCat(name, ": no slope from its rungs of ",
                                                            fit.from, " to ", fit.to, " spp (",
@@ -294,6 +296,7 @@ absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const Re
     }
     out.summary.relative_rmse_slope = *relative_slope;
     out.summary.rmse_slope = *rmse_slope;
+    out.summary.rmse_spp_slope = *spp_slope;
     out.summary.samples_per_second = seconds > 0 ? samples / seconds : 0;
     return out;
 }

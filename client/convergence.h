@@ -89,7 +89,10 @@ struct ConfigSummary {
     SppRange fit;  // the rungs used: --fit-spp's, or the whole ladder when it holds fewer than two
     double relative_rmse_slope = 0;  // of log sqrt(relmse) against log seconds
     double rmse_slope = 0;           // of log rmse against log seconds
-    double samples_per_second = 0;   // over the fit range's rungs
+    // Of log rmse against log spp: the same as rmse_slope at a constant speed, and free of
+    // timing noise (a machine whose load changes during the ladders bends the time axis).
+    double rmse_spp_slope = 0;
+    double samples_per_second = 0;  // over the fit range's rungs
     // At equal time (ErrorAtTime at ConvergenceResult::equal_time.to), and the typical ratio to
     // the first configuration over the equal-time range (MeanRatioOverTime); 1 for the first.
     double rmse_at_equal_time = 0, relmse_at_equal_time = 0;
@@ -119,7 +122,7 @@ inline constexpr const char* kConvergenceCsvHeader =
 inline constexpr const char* kSummaryCsvHeader =
     "sampler,light_sampling,fit_from_spp,fit_to_spp,relative_rmse_slope,rmse_slope,"
     "samples_per_second,equal_time_from,equal_time_to,rmse_at_equal_time,relmse_at_equal_time,"
-    "rmse_ratio_at_end,rmse_ratio_mean,relmse_ratio_at_end,relmse_ratio_mean";
+    "rmse_ratio_at_end,rmse_ratio_mean,relmse_ratio_at_end,relmse_ratio_mean,rmse_spp_slope";
 
 // The row's estimated_relmse as a CSV field: "" when there is none.
 std::string EstimatedRelMseField(const ConvergenceRow& row);
