@@ -13,6 +13,10 @@ uint64_t RoundUpToEven(uint64_t n) { return n + (n & 1); }
 
 double ErrorAt(const TilePilot& tile, double rate, uint64_t n) {
     const double x = double(n);
+    // A first stage without noise (every sample black: the light the tile sees is rare)
+    // measured nothing to interpolate from: up to n2 the error is the second stage's at the
+    // Monte Carlo rate, not 0 (or 0 times infinity between the stages, which stopped the replay).
+    if (!(tile.e1 > 0) && x <= double(tile.n2)) return tile.e2 * std::sqrt(double(tile.n2) / x);
     if (x <= double(tile.n1)) return tile.e1 * std::sqrt(double(tile.n1) / x);
     if (x <= double(tile.n2)) {
         const double t = std::log(x / double(tile.n1)) / std::log(double(tile.n2) / tile.n1);

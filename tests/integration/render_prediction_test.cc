@@ -28,6 +28,18 @@ TEST(PredictTileSamples, FollowsThePassRule) {
     EXPECT_EQ(PredictTileSamples(tile, 0.5, 16, 0.5, 65536), 16u);    // the first pass suffices
 }
 
+// A tile whose first stage saw no noise (all its samples black: the light it reaches is rare)
+// but whose second did: its error at n2 was measured at 0.2, and error does not rise with
+// samples, so no count up to n2 meets a target of 0.01. The log-linear model between the
+// stages divided by e1 = 0 and stopped the replay at the first pass (NaN, or 0 below n1).
+TEST(PredictTileSamples, FirstStageWithoutNoiseDoesNotEndTheTile) {
+    const TilePilot tile{256, 8, 32, 0.0, 0.2};
+    for (const uint64_t first : {4u, 16u, 32u}) {
+        EXPECT_GT(PredictTileSamples(tile, ConvergenceRate(tile), first, 0.01, 65536), 32u)
+            << "first pass " << first;
+    }
+}
+
 // A small render of the glossy room, its prediction first: within 2x of the samples it took.
 // Fixed seeds, so the same numbers every run.
 TEST(PredictAdaptiveRender, IsWithinTwiceTheRendersSamples) {

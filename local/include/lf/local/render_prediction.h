@@ -35,7 +35,7 @@ double ConvergenceRate(const TilePilot& tile);
 // `first` samples, then NextSampleCount after each pass, until the error is at most `target` or
 // the tile has `max_spp`. The error after n samples is log-linear in n between the pilot's two
 // points, the power law of exponent `rate` through (n2, e2) above them, and falls as n^-1/2
-// below n1.
+// below n1 (below n2 through (n2, e2) when e1 is 0: a first stage that saw no noise).
 uint64_t PredictTileSamples(const TilePilot& tile, double rate, uint64_t first, double target,
                             uint64_t max_spp);
 
