@@ -279,10 +279,10 @@ absl::Status RunPlan(const PlanOptions& options) {
         PredictAdaptiveRender(camera, tracer, settings, adaptive, options.pilot_spp);
     if (!p.ok()) return p.status();
     std::printf(
-        "pilot (path tracing): %llu then %llu spp in every tile, %.2f s; the tiles' error falls "
-        "as spp^-%.2f (median over %d tiles; Monte Carlo's rate is 1/2)\n",
+        "pilot (path tracing): %llu then %llu spp in every tile, %.2f s; the tiles' error goes "
+        "as spp^%.2f (median over %d tiles; Monte Carlo's is spp^-0.5)\n",
         (unsigned long long)p->pilot_spp[0], (unsigned long long)p->pilot_spp[1], p->pilot_seconds,
-        p->median_rate, p->tiles);
+        -p->median_rate, p->tiles);
     std::printf(
         "cost of render --target-error %.4g --spp %llu: about %.0f spp on average (%.0f if "
         "every tile's error fell as spp^-1/2; %llu in the hardest tile, %d of %d tiles at "

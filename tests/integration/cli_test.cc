@@ -458,6 +458,17 @@ TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
         << glossy.output;
 }
 
+// A median rate below 0 (the error estimate rising between the pilot's stages, as on a 4x4
+// Cornell box) was printed "spp^--0.81": the exponent is printed with its own sign.
+TEST_F(Cli, PlanPrintsTheMeasuredExponentWithItsSign) {
+    const RunResult r = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
+                                  "/cornell_box.json --method path --resolution 4x4 --threads 2");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("error goes as spp^0.81 (median over 1 tiles"), std::string::npos)
+        << r.output;
+    EXPECT_EQ(r.output.find("spp^--"), std::string::npos) << r.output;
+}
+
 // A dielectric has an index of refraction and a conductor eta and k, not a reflectance: plan
 // prints what each material's model uses.
 TEST_F(Cli, PlanPrintsWhatEachMaterialUses) {
