@@ -11,7 +11,6 @@
 #include "lf/kernels/light_bounds.h"
 #include "lf/kernels/shading.h"
 #include "lf/kernels/sphere_cone_sampling.h"
-#include "lf/kernels/spherical_rectangle.h"
 #include "lf/kernels/spherical_triangle.h"
 
 namespace lf {
@@ -86,10 +85,10 @@ class CosineWarp {
                                   const Vec3& v2) {
         return CosineWarp(ref, n, v1, v1, v0, v2);
     }
-    // For SphericalRectangle(ref, corner, ex, ey): u is the point's (s, t) on the rectangle.
-    static CosineWarp ForRectangle(const Vec3& ref, const Vec3& n, const Vec3& corner,
-                                   const Vec3& ex, const Vec3& ey) {
-        return CosineWarp(ref, n, corner, corner + ex, corner + ey, corner + ex + ey);
+    // For SphericalRectangle(ref, r): u is the point's (s, t) on the rectangle.
+    static CosineWarp ForRectangle(const Vec3& ref, const Vec3& n, const RectangleFrame& r) {
+        return CosineWarp(ref, n, r.corner, r.corner + r.ex, r.corner + r.ey,
+                          r.corner + r.ex + r.ey);
     }
 
     // u distributed by the bilinear density, for u uniform in [0, 1)^2.
@@ -154,7 +153,7 @@ std::optional<LightSampler::Rectangle> LightSampler::FormRectangle(const EmbreeS
         !(Dot(Cross(a[1] - a[0], a[2] - a[0]), Cross(b[1] - b[0], b[2] - b[0])) > 0)) {
         return std::nullopt;
     }
-    Rectangle r{corner, ex, ey, {}};
+    Rectangle r{RectangleFrame(corner, ex, ey), {}};
     for (int half = 0; half < 2; ++half) {
         const std::array<Vec3, 3>& v = half == 0 ? a : b;
         Rectangle::Half& h = r.halves[half];
@@ -197,7 +196,8 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
                 Vec3 q0, q1, q2;
                 es.Triangle(int(m), int(t + 1), &q0, &q1, &q2);
                 b = Union(b, TriangleLightBounds(q0, q1, q2, radiance, two_sided));
-                const float rectangle_area = Length(Cross(rectangle->ex, rectangle->ey));
+                const float rectangle_area =
+                    Length(Cross(rectangle->frame.ex, rectangle->frame.ey));
                 lights_.push_back(
                     {Kind::kRectangle, int(m), int(rectangles_.size()), rectangle_area, two_sided});
                 rectangles_.push_back(*rectangle);
@@ -387,10 +387,10 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
         const Rectangle& r = rectangles_[size_t(light.primitive)];
         Vec2 st = u;  // uniform on the rectangle unless sampled by solid angle
         if (bvh) {
-            const SphericalRectangle sr(ref, r.corner, r.ex, r.ey, kMinSampledSolidAngle);
+            const SphericalRectangle sr(ref, r.frame, kMinSampledSolidAngle);
             if (sr.samplable()) {
                 solid_angle_pdf = sr.Pdf();
-                st = sr.Sample(warped(CosineWarp::ForRectangle(ref, n, r.corner, r.ex, r.ey))).uv;
+                st = sr.Sample(warped(CosineWarp::ForRectangle(ref, n, r.frame))).uv;
             }
         }
         ls.point = RectanglePoint(light, st);
@@ -434,11 +434,11 @@ float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const Vec3& n,
         const bool warp = n != Vec3(0, 0, 0);
         if (light.kind == Kind::kRectangle) {
             const Rectangle& r = rectangles_[size_t(light.primitive)];
-            const SphericalRectangle sr(ref, r.corner, r.ex, r.ey, kMinSampledSolidAngle);
+            const SphericalRectangle sr(ref, r.frame, kMinSampledSolidAngle);
             if (sr.samplable()) {
-                return sr.Pdf() * (warp ? CosineWarp::ForRectangle(ref, n, r.corner, r.ex, r.ey)
-                                              .Pdf(sr.Invert(hit.p))
-                                        : 1.0f);
+                return sr.Pdf() *
+                       (warp ? CosineWarp::ForRectangle(ref, n, r.frame).Pdf(sr.Invert(hit.p))
+                             : 1.0f);
             }
         } else {
             Vec3 p0, p1, p2;
@@ -519,7 +519,7 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
 
 SurfacePoint LightSampler::RectanglePoint(const Light& light, const Vec2& st) const {
     const Rectangle& r = rectangles_[size_t(light.primitive)];
-    const Vec3 q = r.corner + r.ex * st.x + r.ey * st.y;
+    const Vec3 q = r.frame.corner + r.frame.ex * st.x + r.frame.ey * st.y;
     const Rectangle::Half* h = &r.halves[0];
     float b1 = Dot(q - h->origin, h->dual1), b2 = Dot(q - h->origin, h->dual2);
     if (!(b1 >= 0 && b2 >= 0 && b1 + b2 <= 1)) {

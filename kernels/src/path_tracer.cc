@@ -45,6 +45,13 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
     int medium = -1;
 
     for (int depth = 0;; ++depth) {
+        // The bounce's random numbers, drawn before the ray is traced: a Sobol draw is a chain
+        // of dependent hashes, which the processor computes while Embree traverses instead of
+        // stalling on it where the value is used. Every bounce takes the same dimensions in the
+        // same order, whatever happens at it: the two discrete choices (which light, which BSDF
+        // lobe) share one pair, then the point on the light, the BSDF direction, the roulette.
+        const Vec2 u_choice = sampler.Get2D(), u_light = sampler.Get2D(), u_bsdf = sampler.Get2D();
+        const float u_roulette = sampler.Get1D();
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
         if (!hit) {
@@ -98,9 +105,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         const Bsdf bsdf(material, sh.params);
 
         if (!bsdf.IsDelta()) {
-            const float u_pick = sampler.Get1D();
-            const Vec2 u_light = sampler.Get2D();
-            if (const auto ls = lights_.Sample(hit->p, sh.ns, u_pick, u_light)) {
+            if (const auto ls = lights_.Sample(hit->p, sh.ns, u_choice.x, u_light)) {
                 const Vec3 wi = frame.ToLocal(ls->wi);
                 const Rgb f = consistent(ls->wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
                 const Rgb radiance =
@@ -123,9 +128,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
             }
         }
 
-        const float uc = sampler.Get1D();
-        const Vec2 u = sampler.Get2D();
-        const std::optional<BsdfSample> bs = bsdf.Sample(wo, uc, u);
+        const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
         if (!bs || !(bs->pdf > 0)) break;
         const Vec3 wi = frame.FromLocal(bs->wi);
         if (!consistent(wi, bs->wi)) break;
@@ -145,7 +148,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
 
         if (depth >= kRouletteStartDepth) {
             const float q = std::max(0.0f, 1 - beta.MaxComponent() * eta_scale);
-            if (sampler.Get1D() < q) break;
+            if (u_roulette < q) break;
             beta /= 1 - q;
         }
     }

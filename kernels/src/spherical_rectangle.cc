@@ -5,31 +5,37 @@
 
 namespace lf {
 
-SphericalRectangle::SphericalRectangle(const Vec3& p, const Vec3& corner, const Vec3& ex,
-                                       const Vec3& ey, float min_solid_angle)
-    : p_(p), corner_(corner), ex_(ex), ey_(ey) {
-    min_solid_angle = std::max(min_solid_angle, kMinSphericalTriangleSolidAngle);
-    const float ex_length = Length(ex_), ey_length = Length(ey_);
+RectangleFrame::RectangleFrame(const Vec3& corner, const Vec3& ex, const Vec3& ey)
+    : corner(corner), ex(ex), ey(ey), ex_length(Length(ex)), ey_length(Length(ey)) {
     if (!(ex_length > 0 && ey_length > 0)) return;
+    x = ex / ex_length;
+    y = ey / ey_length;
+    normal = Cross(x, y);
+    center = corner + (ex + ey) * 0.5f;
+    half_diagonal = 0.5f * std::sqrt(ex_length * ex_length + ey_length * ey_length);
+}
+
+SphericalRectangle::SphericalRectangle(const Vec3& p, const RectangleFrame& r,
+                                       float min_solid_angle)
+    : p_(p), corner_(r.corner), ex_(r.ex), ey_(r.ey), x_(r.x), y_(r.y) {
+    min_solid_angle = std::max(min_solid_angle, kMinSphericalTriangleSolidAngle);
+    if (!(r.ex_length > 0 && r.ey_length > 0)) return;
     const Vec3 d = corner_ - p_;
     // The frame's z points to p's side, wherever the rectangle's normal points.
-    x_ = ex_ / ex_length;
-    y_ = ey_ / ey_length;
-    z0_ = -std::abs(Dot(d, Cross(x_, y_)));
+    z0_ = -std::abs(Dot(d, r.normal));
     if (!(z0_ < 0)) return;
     // Far rectangles skip the trigonometry: the solid angle is the integral of |z0| / r^3 over
     // the area, at most A |z0| / r_min^3, with r_min from the bounding sphere about the centre.
     // Half the threshold leaves room for rounding, as for triangles.
-    const float r_min = Length(d + (ex_ + ey_) * 0.5f) -
-                        0.5f * std::sqrt(ex_length * ex_length + ey_length * ey_length);
+    const float r_min = Length(r.center - p_) - r.half_diagonal;
     if (r_min > 0 &&
-        ex_length * ey_length * -z0_ < 0.5f * min_solid_angle * r_min * r_min * r_min) {
+        r.ex_length * r.ey_length * -z0_ < 0.5f * min_solid_angle * r_min * r_min * r_min) {
         return;
     }
     x0_ = Dot(d, x_);
     y0_ = Dot(d, y_);
-    x1_ = x0_ + ex_length;
-    y1_ = y0_ + ey_length;
+    x1_ = x0_ + r.ex_length;
+    y1_ = y0_ + r.ey_length;
     b0_ = -y0_ / std::sqrt(z0_ * z0_ + y0_ * y0_);
     b1_ = y1_ / std::sqrt(z0_ * z0_ + y1_ * y1_);
     k_ = AngleSum(x0_);

@@ -44,7 +44,7 @@ class SphericalRectangleTest : public ::testing::TestWithParam<RectangleCase> {}
 
 TEST_P(SphericalRectangleTest, SolidAngleIsTheTwoTrianglesAndPdfItsInverse) {
     const RectangleCase& c = GetParam();
-    const SphericalRectangle sr(c.p, c.corner, c.ex, c.ey);
+    const SphericalRectangle sr(c.p, RectangleFrame(c.corner, c.ex, c.ey));
     ASSERT_TRUE(sr.samplable());
     const double expected = PartSolidAngle(c, 0, 1, 0, 1);
     // Float: the four angles near pi / 2 each round to about 1e-7.
@@ -57,7 +57,7 @@ TEST_P(SphericalRectangleTest, SolidAngleIsTheTwoTrianglesAndPdfItsInverse) {
 // direction towards it, and Invert takes it back to its u.
 TEST_P(SphericalRectangleTest, UniformInSolidAngleAndInvertible) {
     const RectangleCase& c = GetParam();
-    const SphericalRectangle sr(c.p, c.corner, c.ex, c.ey);
+    const SphericalRectangle sr(c.p, RectangleFrame(c.corner, c.ex, c.ey));
     ASSERT_TRUE(sr.samplable());
     constexpr int kGrid = 8, kSamples = 200'000;
     std::vector<double> observed(kGrid * kGrid, 0), expected(kGrid * kGrid, 0);
@@ -100,21 +100,22 @@ INSTANTIATE_TEST_SUITE_P(Rectangles, SphericalRectangleTest, ::testing::ValuesIn
 
 TEST(SphericalRectangle, NotSamplableInItsPlaneFarAwayOrBelowTheMinimum) {
     const Vec3 corner(0, 0, 0), ex(1, 0, 0), ey(0, 1, 0);
-    EXPECT_FALSE(SphericalRectangle({2, 0.5f, 0}, corner, ex, ey).samplable());
-    EXPECT_FALSE(SphericalRectangle({0.5f, 0.5f, 0}, corner, ex, ey).samplable());
-    EXPECT_EQ(SphericalRectangle({0.5f, 0.5f, 0}, corner, ex, ey).Pdf(), 0);
-    EXPECT_FALSE(SphericalRectangle({0.5f, 0.5f, 500}, corner, ex, ey).samplable());
+    const RectangleFrame frame(corner, ex, ey);
+    EXPECT_FALSE(SphericalRectangle({2, 0.5f, 0}, frame).samplable());
+    EXPECT_FALSE(SphericalRectangle({0.5f, 0.5f, 0}, frame).samplable());
+    EXPECT_EQ(SphericalRectangle({0.5f, 0.5f, 0}, frame).Pdf(), 0);
+    EXPECT_FALSE(SphericalRectangle({0.5f, 0.5f, 500}, frame).samplable());
     // 1 / 25 sr from 5 above: samplable unless the caller asks for more.
-    EXPECT_TRUE(SphericalRectangle({0.5f, 0.5f, 5}, corner, ex, ey).samplable());
-    EXPECT_FALSE(SphericalRectangle({0.5f, 0.5f, 5}, corner, ex, ey, 0.25f).samplable());
-    EXPECT_TRUE(SphericalRectangle({0.5f, 0.5f, 1}, corner, ex, ey, 0.25f).samplable());
+    EXPECT_TRUE(SphericalRectangle({0.5f, 0.5f, 5}, frame).samplable());
+    EXPECT_FALSE(SphericalRectangle({0.5f, 0.5f, 5}, frame, 0.25f).samplable());
+    EXPECT_TRUE(SphericalRectangle({0.5f, 0.5f, 1}, frame, 0.25f).samplable());
     // The bound that skips the trigonometry never rejects what the exact test would take:
     // points along the axis where the solid angle crosses the threshold.
     for (float z = 0.5f; z < 4; z *= 1.01f) {
         const Vec3 p(0.3f, 0.6f, z);
         const double omega = PartSolidAngle({"", p, corner, ex, ey}, 0, 1, 0, 1);
         if (std::abs(omega / 0.25 - 1) < 1e-4) continue;
-        EXPECT_EQ(SphericalRectangle(p, corner, ex, ey, 0.25f).samplable(), omega >= 0.25) << z;
+        EXPECT_EQ(SphericalRectangle(p, frame, 0.25f).samplable(), omega >= 0.25) << z;
     }
 }
 

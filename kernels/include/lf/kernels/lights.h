@@ -29,6 +29,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/environment_emitter.h"
 #include "lf/kernels/light_bvh.h"
+#include "lf/kernels/spherical_rectangle.h"
 
 namespace lf {
 
@@ -91,7 +92,7 @@ class LightSampler {
     // Per triangle, its first vertex and the dual vectors of its edges: the barycentrics of a
     // point q in the plane are (Dot(q - origin, dual1), Dot(q - origin, dual2)).
     struct Rectangle {
-        Vec3 corner, ex, ey;
+        RectangleFrame frame;
         struct Half {
             int primitive;
             Vec3 origin, dual1, dual2;
