@@ -1,0 +1,122 @@
+#include "lf/kernels/whitted.h"
+
+#include <cmath>
+#include <optional>
+
+#include "lf/kernels/bsdf.h"
+#include "lf/kernels/shading.h"
+
+namespace lf {
+
+namespace {
+
+// The interior a ray is in after leaving a surface of material `index` in direction wi, as in
+// the path tracer: a transmission through a solid transmitter's surface enters it (against the
+// geometric normal) or leaves it (along it).
+int MediumAfter(int medium, int index, const Material& material, float cos_i_ng, bool transmitted) {
+    if (!transmitted || !HasInterior(material)) return medium;
+    return cos_i_ng < 0 ? index : -1;
+}
+
+}  // namespace
+
+WhittedTracer::WhittedTracer(const EmbreeScene& scene, int max_depth, LightStrategy strategy)
+    : scene_(scene),
+      lights_(scene, strategy),
+      max_depth_(max_depth < 0 ? kWhittedUnlimitedDepth : max_depth),
+      unlimited_(max_depth < 0) {}
+
+Rgb WhittedTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) const {
+    return Trace(camera_ray, 0, -1, sampler, stats);
+}
+
+Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler,
+                         RenderStats& stats) const {
+    const std::vector<Material>& materials = scene_.scene().materials;
+    ++stats.rays;
+    const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
+    // Every ray here left the camera or a delta lobe: emission counts with full weight.
+    if (!hit) return lights_.EscapedRadiance(Normalize(ray.d));
+    Rgb beta(1);
+    if (medium >= 0) {
+        beta = Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
+        if (beta.IsBlack()) return {};
+    }
+    const Material& material = materials[size_t(hit->material)];
+    const Vec3& ng = hit->n;
+    const float cos_o_ng = -Dot(ray.d, ng);
+    const Shading sh = Shade(scene_, *hit, -ray.d);
+
+    Rgb L;
+    if ((cos_o_ng > 0 || EmitsFromBack(material)) && !sh.emission.IsBlack()) L += sh.emission;
+    if (depth == max_depth_) {
+        if (unlimited_) ++stats.truncated_paths;
+        return beta * L;
+    }
+
+    // Sides as in the path tracer: the BSDF lives in the shading frame, the geometric normal
+    // decides sides, and a direction the two disagree on carries nothing (except reflection
+    // just below a smooth mesh's facet that clears it, Shading::ClearsFacet).
+    const Frame frame = Frame::FromNormal(sh.ns);
+    const Vec3 wo = frame.ToLocal(-ray.d);
+    const auto consistent = [&](const Vec3& wi_world, const Vec3& wi) {
+        const float cos_i_ng = Dot(wi_world, ng);
+        if (cos_i_ng == 0) return false;
+        const bool reflect = wi.z * wo.z > 0;
+        if ((cos_i_ng * cos_o_ng > 0) == reflect) return true;
+        return reflect && cos_o_ng > 0 && sh.ClearsFacet(wi_world);
+    };
+    const Bsdf bsdf(material, sh.params);
+
+    if (!bsdf.IsDelta()) {
+        // Direct light only: one light sample, no MIS (nothing else reaches the light from
+        // here), and the ray tree ends.
+        const float u_pick = sampler.Get1D();
+        const Vec2 u_light = sampler.Get2D();
+        const std::optional<LightSample> ls = lights_.Sample(hit->p, sh.ns, u_pick, u_light);
+        if (!ls || !(ls->pdf > 0)) return beta * L;
+        const Vec3 wi = frame.ToLocal(ls->wi);
+        const Rgb f = consistent(ls->wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
+        if (f.IsBlack()) return beta * L;
+        const Rgb radiance = EmissionAt(scene_, ls->point, ls->radiance);
+        if (radiance.IsBlack()) return beta * L;
+        ++stats.rays;
+        if (scene_.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) return beta * L;
+        Rgb direct = f * radiance / ls->pdf;
+        const int through =
+            MediumAfter(medium, hit->material, material, Dot(ls->wi, ng), wi.z * wo.z < 0);
+        if (through >= 0) {
+            direct *= Transmittance(materials[size_t(through)], Length(ls->point.p - hit->p));
+        }
+        return beta * (L + direct);
+    }
+
+    // A delta BSDF: every lobe is followed, weighted by its value times the cosine (what
+    // Bsdf::Sample's f |cos| / pdf is before the division by the lobe's choice probability).
+    // uc = 0 picks the reflection (when Fresnel reflects anything), uc = 1 the refraction
+    // (none under total internal reflection); a mirror has one lobe.
+    const bool dielectric = material.type == Material::Type::kDielectric;
+    const std::optional<BsdfSample> lobes[2] = {
+        bsdf.Sample(wo, 0, Vec2()),
+        dielectric ? bsdf.Sample(wo, 1, Vec2()) : std::nullopt,
+    };
+    bool reflected = false, refracted = false;
+    for (const std::optional<BsdfSample>& lobe : lobes) {
+        if (!lobe || !(lobe->pdf > 0)) continue;
+        const bool transmitted = lobe->wi.z * wo.z < 0;
+        // With a Fresnel reflectance of 0, uc = 0 yields the refraction too: follow it once.
+        bool& done = transmitted ? refracted : reflected;
+        if (done) continue;
+        done = true;
+        const Vec3 wi = frame.FromLocal(lobe->wi);
+        if (!consistent(wi, lobe->wi)) continue;
+        const Rgb weight = lobe->f * std::abs(lobe->wi.z);
+        if (weight.IsBlack()) continue;
+        const int next_medium =
+            MediumAfter(medium, hit->material, material, Dot(wi, ng), transmitted);
+        L += weight * Trace(SpawnRay(sh.Leaving(wi), wi), depth + 1, next_medium, sampler, stats);
+    }
+    return beta * L;
+}
+
+}  // namespace lf
