@@ -1,5 +1,6 @@
 #include "lf/kernels/whitted.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -18,7 +19,72 @@ int MediumAfter(int medium, int index, const Material& material, float cos_i_ng,
     return cos_i_ng < 0 ? index : -1;
 }
 
+bool IsSpecular(const Material& m) {
+    return m.type == Material::Type::kMirror || m.type == Material::Type::kDielectric;
+}
+
+// Reflects light, but not as a delta BSDF: a vertex Whitted ends a ray tree at.
+bool ReflectsDiffusely(const Material& m) {
+    if (IsSpecular(m)) return false;
+    return m.type != Material::Type::kLambert || !m.reflectance.IsBlack();
+}
+
 }  // namespace
+
+std::vector<std::string> WhittedMissingTerms(const Scene& scene) {
+    const auto material = [&](int index) -> const Material& {
+        return scene.materials[size_t(index)];
+    };
+    // The non-specular reflectors: their triangles' planes (unit normal n, offset n.p) and
+    // their spheres.
+    bool specular = false, one_plane = true, have_plane = false;
+    Vec3d plane_n;
+    double plane_d = 0;
+    int diffuse_triangles = 0, diffuse_spheres = 0;
+    for (const TriangleMesh& mesh : scene.meshes) {
+        const Material& m = material(mesh.material);
+        specular = specular || IsSpecular(m);
+        if (!ReflectsDiffusely(m)) continue;
+        for (const auto& t : mesh.triangles) {
+            const Vec3d& a = mesh.positions[t[0]];
+            const Vec3d n = Cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
+            if (LengthSquared(n) == 0) continue;  // degenerate: not a surface
+            ++diffuse_triangles;
+            const Vec3d u = Normalize(n);
+            if (!have_plane) {
+                have_plane = true;
+                plane_n = u;
+                plane_d = Dot(u, a);
+                continue;
+            }
+            // Coplanar up to orientation, to a relative 1e-9 of the offset.
+            const double tolerance = 1e-9 * std::max(1.0, std::abs(plane_d));
+            const bool parallel = std::abs(std::abs(Dot(u, plane_n)) - 1) < 1e-9;
+            if (!parallel || std::abs(Dot(plane_n, a) - plane_d) > tolerance) one_plane = false;
+        }
+    }
+    for (const Sphere& s : scene.spheres) {
+        const Material& m = material(s.material);
+        specular = specular || IsSpecular(m);
+        if (ReflectsDiffusely(m)) ++diffuse_spheres;
+    }
+    const bool diffuse = diffuse_triangles + diffuse_spheres > 0;
+    const bool sees_itself = diffuse_spheres > 1 ||
+                             (diffuse_spheres == 1 && diffuse_triangles > 0) ||
+                             (diffuse_triangles > 0 && !one_plane);
+    std::vector<std::string> missing;
+    if (sees_itself) {
+        missing.push_back(
+            "diffuse and glossy interreflection (L D D+ S* E: indirect light, colour bleeding, "
+            "glossy reflections of lit surfaces)");
+    }
+    if (specular && diffuse) {
+        missing.push_back(
+            "caustics (L S+ D S* E: light that mirrors and glass reflect or refract onto other "
+            "surfaces; shadows of glass are black)");
+    }
+    return missing;
+}
 
 WhittedTracer::WhittedTracer(const EmbreeScene& scene, int max_depth, LightStrategy strategy)
     : scene_(scene),
@@ -50,7 +116,8 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
     Rgb L;
     if ((cos_o_ng > 0 || EmitsFromBack(material)) && !sh.emission.IsBlack()) L += sh.emission;
     if (depth == max_depth_) {
-        if (unlimited_) ++stats.truncated_paths;
+        // Only a specular hit would have gone on: the cap cut its ray tree.
+        if (unlimited_ && IsSpecular(material)) ++stats.truncated_paths;
         return beta * L;
     }
 

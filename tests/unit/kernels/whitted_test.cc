@@ -261,5 +261,49 @@ TEST(Whitted, AreaLightIsSampledWithShadowRays) {
     testing::ExpectEstimateNear(e, Rgb(float(0.5 * 3 * f)));
 }
 
+// The rule of WhittedMissingTerms on scenes whose answer is plain: one lit plane, and one
+// diffuse sphere on its own, see nothing of themselves (exact); a plane with a mirror sphere
+// lacks only caustics; a closed box lacks interreflection; a diffuse sphere on a plane, both.
+TEST(Whitted, MissingTermsFollowTheSceneRule) {
+    const auto has = [](const std::vector<std::string>& terms, const char* word) {
+        for (const std::string& t : terms) {
+            if (t.find(word) != std::string::npos) return true;
+        }
+        return false;
+    };
+    Scene plane = testing::PlaneUnderCamera(Rgb(0.5f));
+    plane.point_lights.push_back({Vec3d(0, 1, 0), Rgb(1.0f)});
+    EXPECT_TRUE(WhittedMissingTerms(plane).empty());
+
+    Scene ball;
+    AddMaterial(ball, Material::Type::kLambert, Rgb(0.5f));
+    ball.spheres.push_back({"ball", 0, Vec3d(), 1});
+    EXPECT_TRUE(WhittedMissingTerms(ball).empty());
+
+    Scene mirror = plane;
+    const int chrome = AddMaterial(mirror, Material::Type::kMirror, Rgb(0.9f));
+    mirror.spheres.push_back({"mirror", chrome, Vec3d(0, 1, 0), 0.5});
+    const std::vector<std::string> caustics = WhittedMissingTerms(mirror);
+    EXPECT_EQ(caustics.size(), 1u);
+    EXPECT_TRUE(has(caustics, "caustics"));
+
+    // Emitters and black surfaces reflect nothing: a glass sphere between emitting walls misses
+    // nothing (and FresnelSplittingEqualsPathTracerChoice checks it converges there).
+    EXPECT_TRUE(WhittedMissingTerms(GlassBeforeWall()).empty());
+
+    Scene box;
+    AddMaterial(box, Material::Type::kLambert, Rgb(0.5f));
+    testing::AddInwardBox(box, Vec3d(), 1, 0);
+    const std::vector<std::string> room = WhittedMissingTerms(box);
+    EXPECT_EQ(room.size(), 1u);
+    EXPECT_TRUE(has(room, "interreflection"));
+
+    Scene both = mirror;
+    both.spheres.push_back({"ball", 0, Vec3d(2, 1, 0), 0.5});
+    const std::vector<std::string> all = WhittedMissingTerms(both);
+    EXPECT_TRUE(has(all, "interreflection"));
+    EXPECT_TRUE(has(all, "caustics"));
+}
+
 }  // namespace
 }  // namespace lf

@@ -15,6 +15,10 @@
 // max_depth; elsewhere it is a fast, low-noise preview (docs/rendering.md).
 #pragma once
 
+#include <string>
+#include <vector>
+
+#include "lf/core/scene.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/lights.h"
 #include "lf/kernels/radiance.h"
@@ -47,5 +51,16 @@ class WhittedTracer : public RadianceEstimator {
     int max_depth_;
     bool unlimited_;
 };
+
+// The light transport a Whitted render of `scene` leaves out, one phrase per kind, each naming
+// its paths in Heckbert's notation; empty when Whitted is exact for the scene (it then converges
+// to the path tracer's image at the same depth). The rule, decided from the scene description
+// without tracing rays, so it errs towards naming a term the geometry might not produce:
+// - interreflection (L D D+ S* E): a non-specular surface (Lambertian with a non-black albedo,
+//   glossy, principled) may see another one: unless all of them are one plane or one sphere
+//   (neither sees itself), it is missed, so a closed room is never exact;
+// - caustics (L S+ D S* E): a mirror or dielectric may send light onto a non-specular surface:
+//   missed whenever the scene has both.
+std::vector<std::string> WhittedMissingTerms(const Scene& scene);
 
 }  // namespace lf
