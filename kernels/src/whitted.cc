@@ -90,7 +90,11 @@ WhittedTracer::WhittedTracer(const EmbreeScene& scene, int max_depth, LightStrat
     : scene_(scene),
       lights_(scene, strategy),
       max_depth_(max_depth < 0 ? kWhittedUnlimitedDepth : max_depth),
-      unlimited_(max_depth < 0) {}
+      unlimited_(max_depth < 0) {
+    for (size_t i = 0; i < lights_.size(); ++i) {
+        if (lights_.IsDeltaLight(i)) delta_lights_.push_back(i);
+    }
+}
 
 Rgb WhittedTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) const {
     return Trace(camera_ray, 0, -1, sampler, stats);
@@ -136,26 +140,41 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
     const Bsdf bsdf(material, sh.params);
 
     if (!bsdf.IsDelta()) {
-        // Direct light only: one light sample, no MIS (nothing else reaches the light from
-        // here), and the ray tree ends.
-        const float u_pick = sampler.Get1D();
-        const Vec2 u_light = sampler.Get2D();
-        const std::optional<LightSample> ls = lights_.Sample(hit->p, sh.ns, u_pick, u_light);
-        if (!ls || !(ls->pdf > 0)) return beta * L;
-        const Vec3 wi = frame.ToLocal(ls->wi);
-        const Rgb f = consistent(ls->wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
-        if (f.IsBlack()) return beta * L;
-        const Rgb radiance = EmissionAt(scene_, ls->point, ls->radiance);
-        if (radiance.IsBlack()) return beta * L;
-        ++stats.rays;
-        if (scene_.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) return beta * L;
-        Rgb direct = f * radiance / ls->pdf;
-        const int through =
-            MediumAfter(medium, hit->material, material, Dot(ls->wi, ng), wi.z * wo.z < 0);
-        if (through >= 0) {
-            direct *= Transmittance(materials[size_t(through)], Length(ls->point.p - hit->p));
+        // Direct light only, and the ray tree ends: every delta light, as Whitted's shadow rays
+        // (no noise from picking among them), plus one sample of the LightSampler for the
+        // others, whose delta picks are dropped (the non-delta picks alone estimate the rest
+        // without bias, each weighted by its own pick probability). No MIS: nothing else
+        // reaches the lights from here.
+        const auto direct = [&](const LightSample& ls) -> Rgb {
+            if (!(ls.pdf > 0)) return {};
+            const Vec3 wi = frame.ToLocal(ls.wi);
+            const Rgb f = consistent(ls.wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
+            if (f.IsBlack()) return {};
+            const Rgb radiance = EmissionAt(scene_, ls.point, ls.radiance);
+            if (radiance.IsBlack()) return {};
+            ++stats.rays;
+            if (scene_.Occluded(SpawnRayTo(sh.Leaving(ls.wi), ls.point))) return {};
+            Rgb contribution = f * radiance / ls.pdf;
+            const int through =
+                MediumAfter(medium, hit->material, material, Dot(ls.wi, ng), wi.z * wo.z < 0);
+            if (through >= 0) {
+                contribution *=
+                    Transmittance(materials[size_t(through)], Length(ls.point.p - hit->p));
+            }
+            return contribution;
+        };
+        for (const size_t i : delta_lights_) {
+            if (const std::optional<LightSample> ls = lights_.SampleDeltaLight(i, hit->p)) {
+                L += direct(*ls);
+            }
         }
-        return beta * (L + direct);
+        if (delta_lights_.size() < lights_.size()) {
+            const float u_pick = sampler.Get1D();
+            const Vec2 u_light = sampler.Get2D();
+            const std::optional<LightSample> ls = lights_.Sample(hit->p, sh.ns, u_pick, u_light);
+            if (ls && !ls->delta) L += direct(*ls);
+        }
+        return beta * L;
     }
 
     // A delta BSDF: every lobe is followed, weighted by its value times the cosine (what

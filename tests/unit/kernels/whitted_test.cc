@@ -89,6 +89,35 @@ TEST(Whitted, PointLightOnLambertianPlaneMatchesClosedForm) {
     EXPECT_EQ(compared, testing::kPlaneImageSize * testing::kPlaneImageSize);
 }
 
+// Every delta light gets its own shadow ray at every hit, as in Whitted's ray tracer: with three
+// point lights (one behind a wall that shadows the point) the radiance along a ray is the same
+// in every sample, the closed-form sum of the unshadowed ones.
+TEST(Whitted, SumsEveryDeltaLightWithoutNoise) {
+    const Rgb rho(0.6f, 0.4f, 0.2f);
+    Scene scene = testing::PlaneUnderCamera(rho);
+    const PointLight lights[] = {{Vec3d(0.5, 1.0, 0.2), Rgb(3.0f)},
+                                 {Vec3d(-0.8, 2.0, -0.4), Rgb(1.0f, 2.0f, 4.0f)},
+                                 {Vec3d(3.0, 0.5, 0.0), Rgb(50.0f)}};
+    for (const PointLight& light : lights) scene.point_lights.push_back(light);
+    // A wall at x = 2 (normal -x) between the third light and the point.
+    AddQuad(scene, 0, {2, 0, -5}, {2, 5, -5}, {2, 5, 5}, {2, 0, 5});
+    const auto es = Build(scene);
+    const WhittedTracer tracer(*es, -1);
+    const Vec3d x(0.1, 0, 0.05);
+    Rgb expected;
+    for (int i = 0; i < 2; ++i) {
+        const Vec3d d = lights[i].position - x;
+        const double r2 = LengthSquared(d);
+        expected += rho * lights[i].intensity * float(d.y / std::sqrt(r2) / (kPi * r2));
+    }
+    const testing::PointEstimate e = testing::EstimateRadiance(
+        tracer, testing::RayBetween(x + Vec3d(0, 1, 0.2), x, es->origin()), 64);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(e.mean[c], expected[c], 1e-4 * expected[c]) << "channel " << c;
+        EXPECT_LE(e.sample_sd[c], 1e-6 * expected[c]) << "channel " << c;
+    }
+}
+
 // At max depth 1 both methods estimate emission plus direct light at the first hit (and what a
 // mirror shows at its first bounce, emission only): a grey box with a point light, a quad area
 // light under the ceiling and a mirror sphere, seen along rays to walls, floor, lamp and mirror.

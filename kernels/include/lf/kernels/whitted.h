@@ -1,12 +1,13 @@
 // Whitted ray tracing (Whitted 1980; Heckbert's L D? S* E paths): the path tracer's special case
 // without diffuse interreflection. At a surface that is not a perfect specular one (Lambertian,
-// glossy, principled) a Whitted ray takes direct light only: one next-event estimate from the
-// LightSampler, as the path tracer's (delta lights exactly; area lights, sun disks and the
-// environment with a shadow ray to a sampled point, weight 1 / pdf, no MIS since no BSDF-sampled
-// ray competes), and ends there. At a mirror or dielectric (a delta BSDF) it follows every lobe
-// with its weight instead of choosing one: the reflection and, for dielectrics, the refraction,
-// weighted by Fresnel, up to max_depth. Emitters seen directly or through specular chains and
-// the lights at infinity that camera and specular rays escape to add their radiance.
+// glossy, principled) a Whitted ray takes direct light only and ends there: a shadow ray to every
+// delta light (point, spot, directional), and one next-event estimate from the LightSampler for
+// the others (area lights, sun disks and the environment: a shadow ray to a sampled point,
+// weight 1 / pdf, no MIS since no BSDF-sampled ray competes). At a mirror or dielectric (a delta
+// BSDF) it follows every lobe with its weight instead of choosing one: the reflection and, for
+// dielectrics, the refraction, weighted by Fresnel, up to max_depth. Emitters seen directly or
+// through specular chains and the lights at infinity that camera and specular rays escape to add
+// their radiance.
 //
 // What it misses, by Heckbert's notation: every path with a diffuse or glossy vertex that is not
 // the one next to the light (L D D+ (S|D)* E: interreflection, colour bleeding, indirect light in
@@ -50,6 +51,7 @@ class WhittedTracer : public RadianceEstimator {
     LightSampler lights_;
     int max_depth_;
     bool unlimited_;
+    std::vector<size_t> delta_lights_;  // the LightSampler's delta lights, summed at every hit
 };
 
 // The light transport a Whitted render of `scene` leaves out, one phrase per kind, each naming
