@@ -6,6 +6,7 @@
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
+#include "local_render.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -81,9 +82,14 @@ Command AddConvergeCommand(CLI::App& app) {
     cmd->add_option("--reference", options->reference_path,
                     "reference OpenEXR of the same size (R,G,B)")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--method", options->method, "path, radiosity or both")
+    cmd->add_option("--method", options->method,
+                    "path, radiosity, both (path and radiosity) or whitted (a spp ladder of "
+                    "Whitted ray tracing against the path-traced reference: its error levels off "
+                    "at the light transport it leaves out)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"path", "radiosity", "both"}));
+        ->check([](const std::string& m) {
+            return m == "both" ? std::string() : MethodFlagError(m, false);
+        });
     AddCameraFlag(cmd, options->scene);
     AddFilterFlag(cmd, options->scene);
     AddResolutionFlag(cmd, options->scene, &options->resolution, 16384,
@@ -152,46 +158,46 @@ Command AddConvergeCommand(CLI::App& app) {
                     "FROM:TO: the rungs the slopes, speeds and equal-time errors use (default "
                     "16:1024, or the whole ladder when that holds fewer than two rungs)")
         ->type_name("FROM:TO");
-    return {cmd, [options, samplers, strategies, compare, fit] {
-                absl::StatusOr<std::vector<RenderConfig>> configs =
-                    compare->empty() ? ConfigProduct(*samplers, *strategies)
-                                     : ParseConfigList(*compare);
-                if (!configs.ok()) return ReportError(configs.status());
-                options->configs = *configs;
-                if (!fit->empty()) {
-                    absl::StatusOr<SppRange> range = ParseSppRange(*fit);
-                    if (!range.ok()) return ReportError(range.status());
-                    options->fit_spp = *range;
-                    options->fit_spp_given = true;
-                }
-                absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
-                if (!result.ok()) return ReportError(result.status());
-                std::printf("%s", result->reference.c_str());
-                if (result->reference_rmse > 0) {
-                    std::printf(" (its own RMSE estimate from A/B: %.3e)", result->reference_rmse);
-                }
-                std::printf("\n%s\n", kConvergenceCsvHeader);
-                for (const ConvergenceRow& row : result->rows) {
-                    std::printf(
-                        "%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
-                        (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
-                        row.error.smape, EstimatedRelMseField(row).c_str(),
-                        SamplerTypeName(row.config.sampler),
-                        row.method == "path" ? LightStrategyName(row.config.light_strategy) : "");
-                }
-                if (!result->configs.empty()) PrintSummary(*result);
-                if (result->radiosity_slope != 0) {
-                    std::printf("radiosity: sqrt(relmse) ~ seconds^%.3f\n",
-                                result->radiosity_slope);
-                }
-                std::printf("-> %s", result->csv_path.c_str());
-                for (const std::string* path :
-                     {&result->summary_path, &result->png_path, &result->reference_exr_path}) {
-                    if (!path->empty()) std::printf(", %s", path->c_str());
-                }
-                std::printf("\n");
-                return 0;
-            }};
+    return {
+        cmd, [options, samplers, strategies, compare, fit] {
+            absl::StatusOr<std::vector<RenderConfig>> configs =
+                compare->empty() ? ConfigProduct(*samplers, *strategies)
+                                 : ParseConfigList(*compare);
+            if (!configs.ok()) return ReportError(configs.status());
+            options->configs = *configs;
+            if (!fit->empty()) {
+                absl::StatusOr<SppRange> range = ParseSppRange(*fit);
+                if (!range.ok()) return ReportError(range.status());
+                options->fit_spp = *range;
+                options->fit_spp_given = true;
+            }
+            absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
+            if (!result.ok()) return ReportError(result.status());
+            std::printf("%s", result->reference.c_str());
+            if (result->reference_rmse > 0) {
+                std::printf(" (its own RMSE estimate from A/B: %.3e)", result->reference_rmse);
+            }
+            std::printf("\n%s\n", kConvergenceCsvHeader);
+            for (const ConvergenceRow& row : result->rows) {
+                std::printf(
+                    "%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
+                    (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
+                    row.error.smape, EstimatedRelMseField(row).c_str(),
+                    SamplerTypeName(row.config.sampler),
+                    row.method != "radiosity" ? LightStrategyName(row.config.light_strategy) : "");
+            }
+            if (!result->configs.empty()) PrintSummary(*result);
+            if (result->radiosity_slope != 0) {
+                std::printf("radiosity: sqrt(relmse) ~ seconds^%.3f\n", result->radiosity_slope);
+            }
+            std::printf("-> %s", result->csv_path.c_str());
+            for (const std::string* path :
+                 {&result->summary_path, &result->png_path, &result->reference_exr_path}) {
+                if (!path->empty()) std::printf(", %s", path->c_str());
+            }
+            std::printf("\n");
+            return 0;
+        }};
 }
 
 }  // namespace lf

@@ -876,5 +876,31 @@ TEST_F(Cli, PlanRecommendsWhittedOnlyAsAPreviewNamingWhatItLeavesOut) {
     }
 }
 
+// converge --method whitted: a spp ladder of Whitted images against the path-traced reference,
+// with the light sampling named, and no path ladder; the reserved methods are refused as not
+// implemented yet there too.
+TEST_F(Cli, ConvergeLaddersWhittedAgainstThePathTracedReference) {
+    const fs::path out = dir_ / "conv_whitted";
+    const std::string base = "converge " + std::string(LF_TEST_SCENES) + "/materials.json --out " +
+                             out.string() + " --threads 2 ";
+    const RunResult r = Lightfarm(base +
+                                  "--resolution 16 --max-spp 4 --reference-spp 16 "
+                                  "--method whitted");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("own path-traced reference, 16 spp"), std::string::npos) << r.output;
+    const std::vector<std::vector<std::string>> rows = ReadCsv(out / "convergence.csv");
+    ASSERT_EQ(rows.size(), 4u);  // the header; spp 1, 2, 4
+    for (size_t i = 1; i < rows.size(); ++i) {
+        ASSERT_EQ(rows[i].size(), 9u);
+        EXPECT_EQ(rows[i][0], "whitted");
+        EXPECT_EQ(rows[i][1], std::to_string(1 << (i - 1)));
+        EXPECT_EQ(rows[i][8], "bvh");
+    }
+    EXPECT_GT(fs::file_size(out / "convergence.png"), 1000u);
+    const RunResult refused = Lightfarm(base + "--method ppm");
+    EXPECT_NE(refused.status, 0);
+    EXPECT_NE(refused.output.find("not implemented yet"), std::string::npos) << refused.output;
+}
+
 }  // namespace
 }  // namespace lf
