@@ -179,12 +179,10 @@ Command AddConvergeCommand(CLI::App& app) {
             }
             std::printf("\n%s\n", kConvergenceCsvHeader);
             for (const ConvergenceRow& row : result->rows) {
-                std::printf(
-                    "%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
-                    (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
-                    row.error.smape, EstimatedRelMseField(row).c_str(),
-                    SamplerTypeName(row.config.sampler),
-                    row.method != "radiosity" ? LightStrategyName(row.config.light_strategy) : "");
+                std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
+                            (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
+                            row.error.smape, EstimatedRelMseField(row).c_str(),
+                            SamplerTypeName(row.config.sampler), LightSamplingField(row));
             }
             if (!result->configs.empty()) PrintSummary(*result);
             if (result->radiosity_slope != 0) {

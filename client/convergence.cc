@@ -130,6 +130,10 @@ std::string CurveName(const ConvergenceRow& row) {
 
 }  // namespace
 
+const char* LightSamplingField(const ConvergenceRow& row) {
+    return row.method == "radiosity" ? "" : LightStrategyName(row.config.light_strategy);
+}
+
 std::string EstimatedRelMseField(const ConvergenceRow& row) {
     return row.estimated_relmse ? absl::StrFormat("%.6e", *row.estimated_relmse) : "";
 }
@@ -210,11 +214,10 @@ absl::Status WriteCsv(const ConvergenceResult& result) {
     std::ofstream csv(result.csv_path);
     csv << kConvergenceCsvHeader << "\n";
     for (const ConvergenceRow& row : result.rows) {
-        csv << absl::StrFormat(
-            "%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s\n", row.method, row.budget, row.seconds,
-            row.error.rmse, row.error.relmse, row.error.smape, EstimatedRelMseField(row),
-            SamplerTypeName(row.config.sampler),
-            row.method != "radiosity" ? LightStrategyName(row.config.light_strategy) : "");
+        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s\n", row.method, row.budget,
+                               row.seconds, row.error.rmse, row.error.relmse, row.error.smape,
+                               EstimatedRelMseField(row), SamplerTypeName(row.config.sampler),
+                               LightSamplingField(row));
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.csv_path + ": cannot write");

@@ -129,5 +129,8 @@ inline constexpr const char* kSummaryCsvHeader =
 
 // The row's estimated_relmse as a CSV field: "" when there is none.
 std::string EstimatedRelMseField(const ConvergenceRow& row);
+// The CSV's light_sampling field: the strategy of the methods that sample lights (path,
+// whitted), empty for radiosity.
+const char* LightSamplingField(const ConvergenceRow& row);
 
 }  // namespace lf
