@@ -158,44 +158,46 @@ Command AddConvergeCommand(CLI::App& app) {
                     "FROM:TO: the rungs the slopes, speeds and equal-time errors use (default "
                     "16:1024, or the whole ladder when that holds fewer than two rungs)")
         ->type_name("FROM:TO");
-    return {
-        cmd, [options, samplers, strategies, compare, fit] {
-            absl::StatusOr<std::vector<RenderConfig>> configs =
-                compare->empty() ? ConfigProduct(*samplers, *strategies)
-                                 : ParseConfigList(*compare);
-            if (!configs.ok()) return ReportError(configs.status());
-            options->configs = *configs;
-            if (!fit->empty()) {
-                absl::StatusOr<SppRange> range = ParseSppRange(*fit);
-                if (!range.ok()) return ReportError(range.status());
-                options->fit_spp = *range;
-                options->fit_spp_given = true;
-            }
-            absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
-            if (!result.ok()) return ReportError(result.status());
-            std::printf("%s", result->reference.c_str());
-            if (result->reference_rmse > 0) {
-                std::printf(" (its own RMSE estimate from A/B: %.3e)", result->reference_rmse);
-            }
-            std::printf("\n%s\n", kConvergenceCsvHeader);
-            for (const ConvergenceRow& row : result->rows) {
-                std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
-                            (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
-                            row.error.smape, EstimatedRelMseField(row).c_str(),
-                            SamplerTypeName(row.config.sampler), LightSamplingField(row));
-            }
-            if (!result->configs.empty()) PrintSummary(*result);
-            if (result->radiosity_slope != 0) {
-                std::printf("radiosity: sqrt(relmse) ~ seconds^%.3f\n", result->radiosity_slope);
-            }
-            std::printf("-> %s", result->csv_path.c_str());
-            for (const std::string* path :
-                 {&result->summary_path, &result->png_path, &result->reference_exr_path}) {
-                if (!path->empty()) std::printf(", %s", path->c_str());
-            }
-            std::printf("\n");
-            return 0;
-        }};
+    return {cmd, [options, samplers, strategies, compare, fit] {
+                absl::StatusOr<std::vector<RenderConfig>> configs =
+                    compare->empty() ? ConfigProduct(*samplers, *strategies)
+                                     : ParseConfigList(*compare);
+                if (!configs.ok()) return ReportError(configs.status());
+                options->configs = *configs;
+                if (!fit->empty()) {
+                    absl::StatusOr<SppRange> range = ParseSppRange(*fit);
+                    if (!range.ok()) return ReportError(range.status());
+                    options->fit_spp = *range;
+                    options->fit_spp_given = true;
+                }
+                absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
+                if (!result.ok()) return ReportError(result.status());
+                std::printf("%s", result->reference.c_str());
+                if (result->reference_rmse > 0) {
+                    std::printf(" (its own RMSE estimate from A/B: %.3e)", result->reference_rmse);
+                }
+                std::printf("\n%s\n", kConvergenceCsvHeader);
+                for (const ConvergenceRow& row : result->rows) {
+                    std::printf(
+                        "%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
+                        (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
+                        row.error.smape, EstimatedRelMseField(row).c_str(),
+                        SamplerTypeName(row.config.sampler),
+                        LightSamplingField(row));
+                }
+                if (!result->configs.empty()) PrintSummary(*result);
+                if (result->radiosity_slope != 0) {
+                    std::printf("radiosity: sqrt(relmse) ~ seconds^%.3f\n",
+                                result->radiosity_slope);
+                }
+                std::printf("-> %s", result->csv_path.c_str());
+                for (const std::string* path :
+                     {&result->summary_path, &result->png_path, &result->reference_exr_path}) {
+                    if (!path->empty()) std::printf(", %s", path->c_str());
+                }
+                std::printf("\n");
+                return 0;
+            }};
 }
 
 }  // namespace lf
