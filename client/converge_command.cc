@@ -6,6 +6,7 @@
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
+#include "local_render.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -81,9 +82,14 @@ Command AddConvergeCommand(CLI::App& app) {
     cmd->add_option("--reference", options->reference_path,
                     "reference OpenEXR of the same size (R,G,B)")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--method", options->method, "path, radiosity or both")
+    cmd->add_option("--method", options->method,
+                    "path, radiosity, both (path and radiosity) or whitted (a spp ladder of "
+                    "Whitted ray tracing against the path-traced reference: its error levels off "
+                    "at the light transport it leaves out)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"path", "radiosity", "both"}));
+        ->check([](const std::string& m) {
+            return m == "both" ? std::string() : MethodFlagError(m, false);
+        });
     AddCameraFlag(cmd, options->scene);
     AddFilterFlag(cmd, options->scene);
     AddResolutionFlag(cmd, options->scene, &options->resolution, 16384,
@@ -177,7 +183,7 @@ Command AddConvergeCommand(CLI::App& app) {
                         (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
                         row.error.smape, EstimatedRelMseField(row).c_str(),
                         SamplerTypeName(row.config.sampler),
-                        row.method == "path" ? LightStrategyName(row.config.light_strategy) : "");
+                        LightSamplingField(row));
                 }
                 if (!result->configs.empty()) PrintSummary(*result);
                 if (result->radiosity_slope != 0) {
