@@ -327,9 +327,21 @@ absl::Status Summarize(const ConvergenceOptions& options, int64_t pixels,
     }
     absl::StatusOr<TimeRange> range = CommonTimeRange(rmse_curves);
     if (!range.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "no equal-time comparison over ", fit->from, " to ", fit->to,
-            " spp: ", range.status().message(), "; widen --fit-spp or raise --max-spp"));
+        result.equal_time_note = absl::StrCat("no equal-time comparison over ", fit->from, " to ",
+                                              fit->to, " spp: ", range.status().message(),
+                                              "; widen --fit-spp or raise --max-spp");
+        constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+        for (FittedLadder& ladder : ladders) {
+            ConfigSummary& s = ladder.summary;
+            s.rmse_at_equal_time = s.relmse_at_equal_time = kNone;
+            // The baseline's ratios to itself stay 1.
+            if (!result.configs.empty()) {
+                s.rmse_ratio_at_end = s.relmse_ratio_at_end = kNone;
+                s.rmse_ratio_mean = s.relmse_ratio_mean = kNone;
+            }
+            result.configs.push_back(s);
+        }
+        return absl::OkStatus();
     }
     result.equal_time = *range;
     const FittedLadder& base = ladders.front();

@@ -107,10 +107,14 @@ struct ConvergenceResult {
     std::vector<ConfigSummary> configs;  // path ladders, in the options' order
     std::string fit_note;                // when a fit fell back to the whole ladder, why
     TimeRange equal_time;                // the times every configuration's fit range covers
-    double radiosity_slope = 0;          // of sqrt(relmse) against seconds, with radiosity rows
-    double whitted_slope = 0;            // the same for whitted rows
-    std::string reference;               // what the reference was, for the user
-    double reference_rmse = 0;           // the reference's own error estimate (A/B), 0 if unknown
+    // Why there is no equal-time comparison (the ladders share no time: a short ladder whose
+    // rungs timing noise scatters, or configurations of very different speed); then the
+    // equal-time errors and ratios are NaN and the slopes and speeds still stand.
+    std::string equal_time_note;
+    double radiosity_slope = 0;  // of sqrt(relmse) against seconds, with radiosity rows
+    double whitted_slope = 0;    // the same for whitted rows
+    std::string reference;       // what the reference was, for the user
+    double reference_rmse = 0;   // the reference's own error estimate (A/B), 0 if unknown
     std::string csv_path, png_path, summary_path;
     std::string reference_exr_path;  // the own reference, written for reuse with --reference
 };
