@@ -125,18 +125,9 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
         return beta * L;
     }
 
-    // Sides as in the path tracer: the BSDF lives in the shading frame, the geometric normal
-    // decides sides, and a direction the two disagree on carries nothing (except reflection
-    // just below a smooth mesh's facet that clears it, Shading::ClearsFacet).
+    // The BSDF lives in the shading frame; Shading::SidesAgree decides by the geometric normal.
     const Frame frame = Frame::FromNormal(sh.ns);
     const Vec3 wo = frame.ToLocal(-ray.d);
-    const auto consistent = [&](const Vec3& wi_world, const Vec3& wi) {
-        const float cos_i_ng = Dot(wi_world, ng);
-        if (cos_i_ng == 0) return false;
-        const bool reflect = wi.z * wo.z > 0;
-        if ((cos_i_ng * cos_o_ng > 0) == reflect) return true;
-        return reflect && cos_o_ng > 0 && sh.ClearsFacet(wi_world);
-    };
     const Bsdf bsdf(material, sh.params);
 
     if (!bsdf.IsDelta()) {
@@ -148,7 +139,9 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
         const auto direct = [&](const LightSample& ls) -> Rgb {
             if (!(ls.pdf > 0)) return {};
             const Vec3 wi = frame.ToLocal(ls.wi);
-            const Rgb f = consistent(ls.wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
+            const Rgb f = sh.SidesAgree(-ray.d, ls.wi, wi.z * wo.z > 0)
+                              ? bsdf.Eval(wo, wi) * std::abs(wi.z)
+                              : Rgb();
             if (f.IsBlack()) return {};
             const Rgb radiance = EmissionAt(scene_, ls.point, ls.radiance);
             if (radiance.IsBlack()) return {};
@@ -195,7 +188,7 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
         if (done) continue;
         done = true;
         const Vec3 wi = frame.FromLocal(lobe->wi);
-        if (!consistent(wi, lobe->wi)) continue;
+        if (!sh.SidesAgree(-ray.d, wi, lobe->wi.z * wo.z > 0)) continue;
         const Rgb weight = lobe->f * std::abs(lobe->wi.z);
         if (weight.IsBlack()) continue;
         const int next_medium =
