@@ -190,32 +190,38 @@ TEST(FrameMerger, AStoreFailureMidTaskThenARetryAddsEachTileOnce) {
     ExpectSameBits(*merger->Snapshot(), reference);
 }
 
-// Path i splats 1 onto pixel i mod P; with an odd P = 777 each pixel gets paths of both parities
-// in turn, so N = 4P paths give every pixel 2 splats per half: 2 x P / (N/2) = 1 in each half,
-// and 4 x P / N = 1 in all, exactly.
+// Path i splats (1, 2, 0.5) onto pixel i mod P. With an odd P = 777 and tasks of P paths, task
+// k gives pixel j one path of parity k + j, so after any even number of tasks every pixel has as
+// many splats per half as each half has paths per pixel: each half and their mean are exactly
+// (1, 2, 0.5), mid-render (divided by the paths merged so far) as at the end.
 TEST(FrameMerger, SplatsAreDividedByTheLightPathsPerPixel) {
     FramePlanSettings s = Settings(FramePlanKind::kLightPaths);
     s.light_paths = 4 * kWidth * kHeight;
+    s.max_paths_per_task = kWidth * kHeight;
     const std::vector<FrameTask> plan = *PlanFrameRender(s);
+    ASSERT_EQ(plan.size(), 4u);
     std::unique_ptr<FrameMerger> merger =
         *FrameMerger::Make(kWidth, kHeight, kTile, FramePlanKind::kLightPaths, plan);
-    for (const FrameTask& t : plan) {
+    for (int k : {3, 0, 2, 1}) {
+        const FrameTask& t = plan[size_t(k)];
         SplatList splats(kWidth, kHeight);
         for (uint64_t i = t.path_begin; i < t.path_end; ++i) {
             const int pixel = int(i % uint64_t(kWidth * kHeight));
             splats.Add(pixel % kWidth, pixel / kWidth, int(i & 1), Rgb(1, 2, 0.5f));
         }
         ASSERT_TRUE(merger->Add(t.index, TileSums(PixelRect{}), splats).ok());
-    }
-    EXPECT_EQ(merger->normalization().paths[0], uint64_t(2 * kWidth * kHeight));
-    const Image image = *merger->Snapshot();
-    for (int y = 0; y < kHeight; ++y) {
-        for (int x = 0; x < kWidth; ++x) {
-            for (const char* prefix : {"", "A.", "B."}) {
-                const Rgb v = image.Pixel(x, y, prefix);
-                EXPECT_EQ(v[0], 1.0f) << prefix << x << "," << y;
-                EXPECT_EQ(v[1], 2.0f);
-                EXPECT_EQ(v[2], 0.5f);
+        if (merger->tasks_done() % 2 != 0) continue;
+        EXPECT_EQ(merger->normalization().paths[0], merger->tasks_done() / 2 * kWidth * kHeight);
+        const Image image = *merger->Snapshot();
+        for (int y = 0; y < kHeight; ++y) {
+            for (int x = 0; x < kWidth; ++x) {
+                for (const char* prefix : {"", "A.", "B."}) {
+                    const Rgb v = image.Pixel(x, y, prefix);
+                    ASSERT_EQ(v[0], 1.0f)
+                        << prefix << x << "," << y << " after " << merger->tasks_done() << " tasks";
+                    ASSERT_EQ(v[1], 2.0f);
+                    ASSERT_EQ(v[2], 0.5f);
+                }
             }
         }
     }

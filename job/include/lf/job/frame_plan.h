@@ -57,7 +57,11 @@ struct FrameTask {
     uint64_t sample_begin = 0, sample_end = 0;
     // Whole-frame part: light paths [path_begin, path_end) of the job (kLightPaths) or photon
     // passes [path_begin, path_end) (kPhotonPasses, equal to the sample range); 0, 0 for
-    // kCameraAndLight, whose light paths are those of its camera samples.
+    // kCameraAndLight, whose light paths are those of its camera samples. A kernel should draw
+    // light path i's numbers as a pure function of i, so any split gives the same paths, with
+    // half i & 1; e.g. Sampler(seed, q mod W, q / W, 2 (j / P) + (i & 1)) with j = i >> 1,
+    // q = j mod P, P = W x H: each pixel-equivalent q then walks its own Sobol sequences, one
+    // per half, in order, and the sampler's half is the splat's.
     uint64_t path_begin = 0, path_end = 0;
 };
 
