@@ -1,0 +1,122 @@
+#include "method_choice.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "lf/core/patch_mesh.h"
+#include "lf/kernels/whitted.h"
+
+namespace lf {
+
+namespace {
+
+bool FocusesLight(const Material& m) {
+    switch (m.type) {
+        case Material::Type::kMirror:
+        case Material::Type::kDielectric:
+            return true;
+        case Material::Type::kGlossy:
+            return m.roughness < kCausticRoughness;
+        case Material::Type::kPrincipled:
+            // glTF's perceptual roughness r is alpha = r^2; a smooth metal or a clear
+            // transmitter focuses light.
+            return (m.transmission > 0 || m.metallic > 0.5f) &&
+                   m.roughness * m.roughness < kCausticRoughness;
+        case Material::Type::kLambert:
+            return false;
+    }
+    return false;
+}
+
+bool Scatters(const Material& m) {
+    if (FocusesLight(m)) return false;
+    return m.type != Material::Type::kLambert || !m.reflectance.IsBlack();
+}
+
+double TriangleArea(const TriangleMesh& mesh, const std::array<uint32_t, 3>& t) {
+    const Vec3d& a = mesh.positions[t[0]];
+    return 0.5 * Length(Cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a));
+}
+
+}  // namespace
+
+SceneTransport AnalyzeTransport(const Scene& scene) {
+    SceneTransport out;
+    out.radiosity_limitation = RadiosityLimitation(scene);
+    out.whitted_missing = WhittedMissingTerms(scene);
+
+    std::vector<bool> used(scene.materials.size(), false);
+    std::vector<double> emitting_area(scene.materials.size(), 0);
+    for (const TriangleMesh& mesh : scene.meshes) {
+        used[size_t(mesh.material)] = true;
+        for (const auto& t : mesh.triangles) {
+            emitting_area[size_t(mesh.material)] += TriangleArea(mesh, t);
+        }
+    }
+    for (const Sphere& s : scene.spheres) {
+        used[size_t(s.material)] = true;
+        emitting_area[size_t(s.material)] += 4 * std::numbers::pi * s.radius * s.radius;
+    }
+    const auto [lo, hi] = scene.Bounds();
+    const Vec3d d = hi - lo;
+    const double box_area = 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
+
+    bool area_lights = false;
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        const Material& m = scene.materials[i];
+        if (!used[i]) continue;
+        if (FocusesLight(m)) out.specular.push_back(m.name);
+        if (Scatters(m)) out.diffuse = true;
+        if (!m.IsEmissive()) continue;
+        area_lights = true;
+        // A scene without finite bounds has no size to compare with: nothing counts as small.
+        const double fraction =
+            box_area > 0 && std::isfinite(box_area) ? emitting_area[i] / box_area : 1;
+        if (fraction < kSmallEmitterFraction) {
+            out.small_emitters.push_back(absl::StrCat("emitter \"", m.name, "\" (",
+                                                      absl::SixDigits(100 * fraction),
+                                                      " % of the scene's bounding surface)"));
+        }
+    }
+    const auto count = [](size_t n, const char* what) {
+        return absl::StrCat(n, " ", what, n == 1 ? "" : "s");
+    };
+    if (!scene.point_lights.empty()) {
+        out.small_emitters.push_back(count(scene.point_lights.size(), "point light"));
+    }
+    if (!scene.spot_lights.empty()) {
+        out.small_emitters.push_back(count(scene.spot_lights.size(), "spot light"));
+    }
+    if (!scene.directional_lights.empty()) {
+        out.small_emitters.push_back(
+            count(scene.directional_lights.size(), "directional light or sun"));
+    }
+    out.point_like_only = !area_lights && !scene.environment &&
+                          (!scene.point_lights.empty() || !scene.spot_lights.empty() ||
+                           !scene.directional_lights.empty());
+    return out;
+}
+
+MethodChoice ChooseAutomatically(const Scene& scene) {
+    const SceneTransport t = AnalyzeTransport(scene);
+    if (t.radiosity_limitation.empty()) {
+        return {"radiosity", "every material is Lambertian: radiosity is exact and noiseless"};
+    }
+    if (t.caustics()) {
+        return {"bdpt", absl::StrCat("caustics (L S+ D E): light from ",
+                                     absl::StrJoin(t.small_emitters, ", "), " through ",
+                                     absl::StrJoin(t.specular, ", "),
+                                     "; camera paths find them only by hitting a small emitter")};
+    }
+    if (t.whitted_missing.empty()) {
+        return {"whitted",
+                absl::StrCat("no interreflection and no caustics: classic ray tracing is exact "
+                             "here",
+                             t.point_like_only ? " (point-like lights only)" : "")};
+    }
+    return {"path", t.radiosity_limitation};
+}
+
+}  // namespace lf

@@ -1,0 +1,53 @@
+// What `--method auto` and `plan` read from a scene description, without tracing a ray: which
+// light transport the scene has, and so which method renders it best (Heckbert's notation:
+// L light, D diffuse or glossy, S specular, E eye).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lf/core/scene.h"
+
+namespace lf {
+
+struct SceneTransport {
+    // Empty when radiosity models the scene exactly (all Lambertian, triangle meshes, area
+    // lights): else why not (lf/core/patch_mesh.h).
+    std::string radiosity_limitation;
+    // Materials (by name) whose reflection or refraction is a delta or nearly so: mirrors,
+    // dielectrics, transmissive principled materials, and glossy ones sharper than
+    // kCausticRoughness. They focus light into caustics that only paths starting at the light
+    // (or photons) find cheaply.
+    std::vector<std::string> specular;
+    bool diffuse = false;  // some surface reflects diffusely or glossily (a caustic's receiver)
+    // Emitters small enough that a path tracer's camera paths rarely hit them after a specular
+    // bounce, one phrase each: point and spot lights, directional lights and suns, and the area
+    // emitters if their area is below kSmallEmitterFraction of the scene's bounding-box surface.
+    std::vector<std::string> small_emitters;
+    bool point_like_only = false;  // every light is a point, spot or directional light
+    // What Whitted misses here (lf/kernels/whitted.h): empty when it is exact.
+    std::vector<std::string> whitted_missing;
+
+    // L S+ D E paths from a small emitter: caustics.
+    bool caustics() const { return !specular.empty() && diffuse && !small_emitters.empty(); }
+};
+
+// Glossy materials with a microfacet alpha below this behave as mirrors for caustics.
+inline constexpr float kCausticRoughness = 0.1f;
+// Area emitters below this fraction of the scene's bounding-box surface count as small (the
+// Cornell box's lamp is 0.7 %).
+inline constexpr double kSmallEmitterFraction = 0.02;
+
+SceneTransport AnalyzeTransport(const Scene& scene);
+
+struct MethodChoice {
+    std::string method;
+    std::string why;
+};
+
+// `--method auto`: radiosity where it is exact (view-independent, noiseless); bdpt for caustics
+// from small emitters; whitted where it is exact (point-like lights, no interreflection, no
+// caustics: it then equals the path tracer, faster and noiseless); otherwise the path tracer.
+MethodChoice ChooseAutomatically(const Scene& scene);
+
+}  // namespace lf
