@@ -76,10 +76,22 @@ double SumOfRelativeVariances(int width, int height, const ChannelPlanes& c) {
 }  // namespace
 
 absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& reference) {
+    return CompareImageRegion(image, reference, PixelRect{0, 0, image.width(), image.height()});
+}
+
+absl::StatusOr<ImageError> CompareImageRegion(const Image& image, const Image& reference,
+                                              const PixelRect& region) {
     if (image.width() != reference.width() || image.height() != reference.height()) {
         return absl::InvalidArgumentError(absl::StrCat("image is ", image.width(), "x",
                                                        image.height(), " but the reference is ",
                                                        reference.width(), "x", reference.height()));
+    }
+    if (region.width < 0 || region.height < 0 || region.x0 < 0 || region.y0 < 0 ||
+        int64_t(region.x0) + region.width > image.width() ||
+        int64_t(region.y0) + region.height > image.height()) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "region ", region.x0, ",", region.y0, " ", region.width, "x", region.height,
+            " leaves the ", image.width(), "x", image.height(), " image"));
     }
     double squared = 0, relative = 0, symmetric = 0;
     size_t n = 0;
@@ -88,15 +100,18 @@ absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& refere
         if (!x.ok()) return x.status();
         absl::StatusOr<const std::vector<float>*> r = RequireChannel(reference, name, "reference");
         if (!r.ok()) return r.status();
-        for (size_t i = 0; i < (*x)->size(); ++i) {
-            const double xi = (**x)[i], ri = (**r)[i], d = xi - ri;
-            squared += d * d;
-            relative += d * d / (ri * ri + kRelativeErrorEpsilon);
-            symmetric += std::abs(d) / (std::abs(xi) + std::abs(ri) + kRelativeErrorEpsilon);
-            ++n;
+        for (int y = region.y0; y < region.y0 + region.height; ++y) {
+            for (int x0 = region.x0; x0 < region.x0 + region.width; ++x0) {
+                const size_t i = size_t(y) * size_t(image.width()) + size_t(x0);
+                const double xi = (**x)[i], ri = (**r)[i], d = xi - ri;
+                squared += d * d;
+                relative += d * d / (ri * ri + kRelativeErrorEpsilon);
+                symmetric += std::abs(d) / (std::abs(xi) + std::abs(ri) + kRelativeErrorEpsilon);
+                ++n;
+            }
         }
     }
-    if (n == 0) return absl::InvalidArgumentError("the images have no pixels");
+    if (n == 0) return absl::InvalidArgumentError("the images have no pixels in the region");
     return ImageError{std::sqrt(squared / n), relative / n, symmetric / n};
 }
 

@@ -28,6 +28,19 @@ TEST(ImageError, MetricsMatchTheirDefinitions) {
     EXPECT_EQ(CompareImages(reference, reference).value().rmse, 0);
 }
 
+TEST(ImageError, RegionCountsItsPixelsOnly) {
+    const Image reference = Constant(4, 3, 0.5f);
+    Image image = Constant(4, 3, 0.5f);
+    image.Channel("G")[size_t(1 * 4 + 2)] = 1.5f;  // pixel (2, 1): inside the region
+    image.Channel("R")[0] = 9.0f;                  // pixel (0, 0): outside it
+    const ImageError e = CompareImageRegion(image, reference, PixelRect{2, 1, 2, 2}).value();
+    EXPECT_DOUBLE_EQ(e.rmse, std::sqrt(1.0 / 12));  // one of 4 px x 3 channels off by 1
+    EXPECT_GT(CompareImages(image, reference).value().rmse, e.rmse);
+    EXPECT_FALSE(CompareImageRegion(image, reference, PixelRect{3, 0, 2, 1}).ok());
+    EXPECT_FALSE(CompareImageRegion(image, reference, PixelRect{0, 0, 0, 0}).ok());
+    EXPECT_FALSE(CompareImageRegion(image, reference, PixelRect{-1, 0, 1, 1}).ok());
+}
+
 TEST(ImageError, RefusesMismatchedImages) {
     EXPECT_FALSE(CompareImages(Constant(2, 1, 0), Constant(1, 2, 0)).ok());
     EXPECT_FALSE(CompareImages(Image(1, 1), Constant(1, 1, 0)).ok());

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "lf/core/film.h"
 #include "lf/core/image.h"
 
 namespace lf {
@@ -23,6 +24,10 @@ struct ImageError {
 // Over every pixel and the R, G, B channels. InvalidArgument when the sizes differ or a
 // channel is missing.
 absl::StatusOr<ImageError> CompareImages(const Image& image, const Image& reference);
+// The same over the pixels of `region` alone (a caustic, a highlight: where methods differ).
+// InvalidArgument also when the region is empty or leaves the image.
+absl::StatusOr<ImageError> CompareImageRegion(const Image& image, const Image& reference,
+                                              const PixelRect& region);
 
 // The image's own estimate of its mean squared error: the mean over pixels and channels of
 // ((A - B) / 2)^2, unbiased for the variance of R,G,B when A and B hold equally many samples.
