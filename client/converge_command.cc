@@ -17,7 +17,7 @@ namespace {
 constexpr double kReferenceNoiseWarning = 0.05;
 
 // Per configuration its slopes, speed and errors at equal time, the first as the baseline.
-void PrintSummary(const ConvergenceResult& result) {
+void PrintSummary(const ConvergenceResult& result, const std::optional<PixelRect>& region) {
     const TimeRange& t = result.equal_time;
     const ConfigSummary& base = result.configs.front();
     std::printf("\npath tracing, fitted over %llu to %llu spp (each ladder's rungs there); ",
@@ -59,6 +59,14 @@ void PrintSummary(const ConvergenceResult& result) {
                     c.rmse_spp_slope, c.samples_per_second * 1e-6, c.rmse_at_equal_time,
                     c.relmse_at_equal_time, c.rmse_ratio_at_end, c.rmse_ratio_mean,
                     c.relmse_ratio_at_end, c.relmse_ratio_mean);
+    }
+    if (!region) return;
+    std::printf("\nregion %d,%d %dx%d:\n%-18s %17s %17s\n", region->x0, region->y0, region->width,
+                region->height, "configuration", "RMSE at eq. time", "ratio end, mean");
+    for (const ConfigSummary& c : result.configs) {
+        std::printf("%-18s %17.4e %8.3f, %6.3f\n", ConfigName(c.config).c_str(),
+                    c.region_rmse_at_equal_time, c.region_rmse_ratio_at_end,
+                    c.region_rmse_ratio_mean);
     }
 }
 
@@ -158,17 +166,28 @@ Command AddConvergeCommand(CLI::App& app) {
         ->type_name("SAMPLER/LIGHTS,...")
         ->excludes(sampler_option)
         ->excludes(lights_option);
+    auto region = std::make_shared<std::string>();
+    cmd->add_option("--region", *region,
+                    "X,Y,W,H: also measure the errors of this rectangle of the image (pixels from "
+                    "the top left; e.g. the caustic under a glass sphere), in both CSVs and the "
+                    "table")
+        ->type_name("X,Y,W,H");
     cmd->add_option("--fit-spp", *fit,
                     "FROM:TO: the rungs the slopes, speeds and equal-time errors use (default "
                     "16:1024, or the whole ladder when that holds fewer than two rungs)")
         ->type_name("FROM:TO");
     return {
-        cmd, [options, samplers, strategies, compare, fit] {
+        cmd, [options, samplers, strategies, compare, fit, region] {
             absl::StatusOr<std::vector<RenderConfig>> configs =
                 compare->empty() ? ConfigProduct(*samplers, *strategies)
                                  : ParseConfigList(*compare);
             if (!configs.ok()) return ReportError(configs.status());
             options->configs = *configs;
+            if (!region->empty()) {
+                absl::StatusOr<PixelRect> rect = ParseRegion(*region);
+                if (!rect.ok()) return ReportError(rect.status());
+                options->region = *rect;
+            }
             if (!fit->empty()) {
                 absl::StatusOr<SppRange> range = ParseSppRange(*fit);
                 if (!range.ok()) return ReportError(range.status());
@@ -183,12 +202,13 @@ Command AddConvergeCommand(CLI::App& app) {
             }
             std::printf("\n%s\n", kConvergenceCsvHeader);
             for (const ConvergenceRow& row : result->rows) {
-                std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
+                std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s,%s\n", row.method.c_str(),
                             (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
                             row.error.smape, EstimatedRelMseField(row).c_str(),
-                            SamplerTypeName(row.config.sampler), LightSamplingField(row));
+                            SamplerTypeName(row.config.sampler), LightSamplingField(row),
+                            RegionFields(row).c_str());
             }
-            if (!result->configs.empty()) PrintSummary(*result);
+            if (!result->configs.empty()) PrintSummary(*result, options->region);
             if (result->radiosity_slope != 0) {
                 std::printf("radiosity: sqrt(relmse) ~ seconds^%.3f\n", result->radiosity_slope);
             }

@@ -103,6 +103,20 @@ absl::StatusOr<SppRange> ParseSppRange(const std::string& text) {
     return range;
 }
 
+absl::StatusOr<PixelRect> ParseRegion(const std::string& text) {
+    const std::vector<std::string> parts = absl::StrSplit(text, ',');
+    PixelRect r;
+    if (parts.size() != 4 || !absl::SimpleAtoi(parts[0], &r.x0) ||
+        !absl::SimpleAtoi(parts[1], &r.y0) || !absl::SimpleAtoi(parts[2], &r.width) ||
+        !absl::SimpleAtoi(parts[3], &r.height) || r.x0 < 0 || r.y0 < 0 || r.width < 1 ||
+        r.height < 1) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--region ", text,
+                         ": expected X,Y,W,H in pixels (X, Y >= 0; W, H >= 1), e.g. 40,80,32,16"));
+    }
+    return r;
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -136,6 +150,12 @@ const char* LightSamplingField(const ConvergenceRow& row) {
 
 std::string EstimatedRelMseField(const ConvergenceRow& row) {
     return row.estimated_relmse ? absl::StrFormat("%.6e", *row.estimated_relmse) : "";
+}
+
+std::string RegionFields(const ConvergenceRow& row) {
+    return row.region_error
+               ? absl::StrFormat("%.6e,%.6e", row.region_error->rmse, row.region_error->relmse)
+               : ",";
 }
 
 namespace {
@@ -214,10 +234,10 @@ absl::Status WriteCsv(const ConvergenceResult& result) {
     std::ofstream csv(result.csv_path);
     csv << kConvergenceCsvHeader << "\n";
     for (const ConvergenceRow& row : result.rows) {
-        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s\n", row.method, row.budget,
+        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s,%s\n", row.method, row.budget,
                                row.seconds, row.error.rmse, row.error.relmse, row.error.smape,
                                EstimatedRelMseField(row), SamplerTypeName(row.config.sampler),
-                               LightSamplingField(row));
+                               LightSamplingField(row), RegionFields(row));
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.csv_path + ": cannot write");
@@ -229,12 +249,14 @@ absl::Status WriteSummaryCsv(const ConvergenceResult& result) {
     csv << kSummaryCsvHeader << "\n";
     for (const ConfigSummary& c : result.configs) {
         csv << absl::StrFormat(
-            "%s,%s,%d,%d,%.4f,%.4f,%.6e,%.6g,%.6g,%.6e,%.6e,%.4f,%.4f,%.4f,%.4f,%.4f\n",
+            "%s,%s,%d,%d,%.4f,%.4f,%.6e,%.6g,%.6g,%.6e,%.6e,%.4f,%.4f,%.4f,%.4f,%.4f,%.6e,%.4f,%."
+            "4f\n",
             SamplerTypeName(c.config.sampler), LightStrategyName(c.config.light_strategy),
             c.fit.from, c.fit.to, c.relative_rmse_slope, c.rmse_slope, c.samples_per_second,
             result.equal_time.from, result.equal_time.to, c.rmse_at_equal_time,
             c.relmse_at_equal_time, c.rmse_ratio_at_end, c.rmse_ratio_mean, c.relmse_ratio_at_end,
-            c.relmse_ratio_mean, c.rmse_spp_slope);
+            c.relmse_ratio_mean, c.rmse_spp_slope, c.region_rmse_at_equal_time,
+            c.region_rmse_ratio_at_end, c.region_rmse_ratio_mean);
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.summary_path + ": cannot write");
@@ -271,6 +293,7 @@ absl::StatusOr<SppRange> FitRange(const ConvergenceOptions& options, std::string
 struct FittedLadder {
     ConfigSummary summary;
     ErrorCurve rmse, relmse;
+    ErrorCurve region_rmse;  // with --region
 };
 
 absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const RenderConfig& config,
@@ -289,6 +312,7 @@ absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const Re
         out.rmse.push_back({row.seconds, row.error.rmse});
         by_spp.push_back({double(row.budget), row.error.rmse});
         out.relmse.push_back({row.seconds, row.error.relmse});
+        if (row.region_error) out.region_rmse.push_back({row.seconds, row.region_error->rmse});
         samples += double(row.budget) * double(pixels);
         seconds += row.seconds;
     }
@@ -358,12 +382,23 @@ absl::Status Summarize(const ConvergenceOptions& options, int64_t pixels,
         s.relmse_at_equal_time = *relmse;
         s.rmse_ratio_mean = *rmse_mean;
         s.relmse_ratio_mean = *relmse_mean;
+        if (!ladder.region_rmse.empty()) {
+            absl::StatusOr<double> region = ErrorAtTime(ladder.region_rmse, range->to);
+            absl::StatusOr<double> region_mean =
+                MeanRatioOverTime(base.region_rmse, ladder.region_rmse, *range);
+            for (const absl::StatusOr<double>* v : {&region, &region_mean}) {
+                if (!v->ok()) return v->status();
+            }
+            s.region_rmse_at_equal_time = *region;
+            s.region_rmse_ratio_mean = *region_mean;
+        }
         result.configs.push_back(s);
     }
     for (ConfigSummary& s : result.configs) {
-        s.rmse_ratio_at_end = s.rmse_at_equal_time / result.configs.front().rmse_at_equal_time;
-        s.relmse_ratio_at_end =
-            s.relmse_at_equal_time / result.configs.front().relmse_at_equal_time;
+        const ConfigSummary& first = result.configs.front();
+        s.rmse_ratio_at_end = s.rmse_at_equal_time / first.rmse_at_equal_time;
+        s.relmse_ratio_at_end = s.relmse_at_equal_time / first.relmse_at_equal_time;
+        s.region_rmse_ratio_at_end = s.region_rmse_at_equal_time / first.region_rmse_at_equal_time;
     }
     return absl::OkStatus();
 }
@@ -412,6 +447,28 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     if (!embree.ok()) return embree.status();
     const Camera camera(scene->camera, (*embree)->origin());
     const int64_t pixels = int64_t(camera.width()) * camera.height();
+    if (const std::optional<PixelRect>& r = options.region;
+        r && (int64_t(r->x0) + r->width > camera.width() ||
+              int64_t(r->y0) + r->height > camera.height())) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "--region %d,%d,%d,%d leaves the %dx%d image (--resolution sets its size)", r->x0,
+            r->y0, r->width, r->height, camera.width(), camera.height()));
+    }
+    // The row's errors against the reference: the whole image's and, with --region, the
+    // region's.
+    const auto compare = [&](const Image& image, const Image& reference,
+                             ConvergenceRow& row) -> absl::Status {
+        absl::StatusOr<ImageError> error = CompareImages(image, reference);
+        if (!error.ok()) return error.status();
+        row.error = *error;
+        if (options.region) {
+            absl::StatusOr<ImageError> region =
+                CompareImageRegion(image, reference, *options.region);
+            if (!region.ok()) return region.status();
+            row.region_error = *region;
+        }
+        return absl::OkStatus();
+    };
 
     auto render_path = [&](const RenderConfig& config, uint64_t spp, uint64_t seed) {
         const PathTracer path_tracer(**embree, options.max_depth, config.light_strategy);
@@ -526,11 +583,9 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         result.reference_rmse = std::sqrt(*mse);
     }
     for (size_t i = 0; i < result.rows.size(); ++i) {
-        absl::StatusOr<ImageError> error = CompareImages(images[i], reference);
-        if (!error.ok()) return error.status();
-        result.rows[i].error = *error;
+        if (absl::Status s = compare(images[i], reference, result.rows[i]); !s.ok()) return s;
         log->info("job={} {} {} spp: rmse {:.4e}", job_id, ConfigName(result.rows[i].config),
-                  result.rows[i].budget, error->rmse);
+                  result.rows[i].budget, result.rows[i].error.rmse);
     }
     images.clear();
 
@@ -553,8 +608,6 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             settings.sampler = options.configs.front().sampler;
             absl::StatusOr<RenderOutput> out = RenderImage(camera, **radiosity, settings);
             if (!out.ok()) return out.status();
-            absl::StatusOr<ImageError> error = CompareImages(out->image, reference);
-            if (!error.ok()) return error.status();
             // A radiosity image's A/B halves see only the display's sampling, not the
             // solution's error: no estimate.
             ConvergenceRow row;
@@ -562,10 +615,10 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             row.config = options.configs.front();
             row.budget = (*radiosity)->report().patches;
             row.seconds = SecondsSince(start);
-            row.error = *error;
+            if (absl::Status s = compare(out->image, reference, row); !s.ok()) return s;
             result.rows.push_back(row);
             log->info("job={} radiosity {} patches: {:.3f} s, rmse {:.4e}", job_id, row.budget,
-                      row.seconds, error->rmse);
+                      row.seconds, row.error.rmse);
         }
     }
     if (options.method == "whitted") {
@@ -582,14 +635,12 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             settings.light_strategy = config.light_strategy;
             absl::StatusOr<RenderOutput> out = RenderImage(camera, whitted, settings);
             if (!out.ok()) return out.status();
-            absl::StatusOr<ImageError> error = CompareImages(out->image, reference);
-            if (!error.ok()) return error.status();
             ConvergenceRow row;
             row.method = "whitted";
             row.config = config;
             row.budget = int64_t(spp);
             row.seconds = out->seconds;
-            row.error = *error;
+            if (absl::Status s = compare(out->image, reference, row); !s.ok()) return s;
             if (spp >= 2) {
                 if (absl::StatusOr<double> e = EstimatedRelMse(out->image); e.ok()) {
                     row.estimated_relmse = *e;
@@ -597,7 +648,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             }
             result.rows.push_back(row);
             log->info("job={} whitted {} spp: {:.3f} s, rmse {:.4e}", job_id, spp, row.seconds,
-                      error->rmse);
+                      row.error.rmse);
         }
         std::vector<std::pair<double, double>> points;
         for (const ConvergenceRow& row : result.rows) {

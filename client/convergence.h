@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -14,6 +15,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/error_curve.h"
+#include "lf/core/film.h"
 #include "lf/core/image_error.h"
 #include "lf/core/light_strategy.h"
 #include "lf/core/sampler.h"
@@ -72,7 +74,12 @@ struct ConvergenceOptions {
     // Set when --fit-spp was given: then a ladder with fewer than two rungs in it is an error;
     // otherwise the fit falls back to the whole ladder (and says so).
     bool fit_spp_given = false;
+    // --region X,Y,W,H: the errors of that rectangle too (a caustic, where methods differ most).
+    std::optional<PixelRect> region;
 };
+
+// --region "X,Y,W,H" (pixels of the rendered image, W and H at least 1).
+absl::StatusOr<PixelRect> ParseRegion(const std::string& text);
 
 struct ConvergenceRow {
     std::string method;
@@ -83,6 +90,7 @@ struct ConvergenceRow {
     // The image's own estimate of its relmse from its A/B halves (lf::EstimatedRelMse), to
     // compare with `error.relmse`; path images of 2 spp or more only.
     std::optional<double> estimated_relmse;
+    std::optional<ImageError> region_error;  // with --region
 };
 
 // A configuration's ladder summed up over the rungs of its fit range.
@@ -100,6 +108,11 @@ struct ConfigSummary {
     double rmse_at_equal_time = 0, relmse_at_equal_time = 0;
     double rmse_ratio_at_end = 1, relmse_ratio_at_end = 1;
     double rmse_ratio_mean = 1, relmse_ratio_mean = 1;
+    // With --region: the region's RMSE at equal time and its ratio to the first configuration's
+    // (at the end of the common time range and as the geometric mean over it); NaN without.
+    double region_rmse_at_equal_time = std::numeric_limits<double>::quiet_NaN();
+    double region_rmse_ratio_at_end = std::numeric_limits<double>::quiet_NaN();
+    double region_rmse_ratio_mean = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct ConvergenceResult {
@@ -122,17 +135,22 @@ struct ConvergenceResult {
 absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& options);
 
 // convergence.csv: a row per image; sampler and light_sampling were added at the end (the light
-// strategy is empty for radiosity, the sampler there is its display's).
+// strategy is empty for radiosity, the sampler there is its display's), then the --region errors
+// (empty without it).
 inline constexpr const char* kConvergenceCsvHeader =
-    "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling";
+    "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling,region_rmse,"
+    "region_relmse";
 // summary.csv: a row per path configuration (ConfigSummary).
 inline constexpr const char* kSummaryCsvHeader =
     "sampler,light_sampling,fit_from_spp,fit_to_spp,relative_rmse_slope,rmse_slope,"
     "samples_per_second,equal_time_from,equal_time_to,rmse_at_equal_time,relmse_at_equal_time,"
-    "rmse_ratio_at_end,rmse_ratio_mean,relmse_ratio_at_end,relmse_ratio_mean,rmse_spp_slope";
+    "rmse_ratio_at_end,rmse_ratio_mean,relmse_ratio_at_end,relmse_ratio_mean,rmse_spp_slope,"
+    "region_rmse_at_equal_time,region_rmse_ratio_at_end,region_rmse_ratio_mean";
 
 // The row's estimated_relmse as a CSV field: "" when there is none.
 std::string EstimatedRelMseField(const ConvergenceRow& row);
+// The CSV's region_rmse and region_relmse fields: ",," less the commas when there is none.
+std::string RegionFields(const ConvergenceRow& row);
 // The CSV's light_sampling field: the strategy of the methods that sample lights (path,
 // whitted), empty for radiosity.
 const char* LightSamplingField(const ConvergenceRow& row);

@@ -257,7 +257,8 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     std::string line;
     ASSERT_TRUE(std::getline(csv, line));
     EXPECT_EQ(line,
-              "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling");
+              "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling,"
+              "region_rmse,region_relmse");
     std::vector<std::string> rows;
     while (std::getline(csv, line)) rows.push_back(line);
     // spp 1, 2, 4 and patch targets 100, 200.
@@ -265,14 +266,14 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     EXPECT_EQ(rows[0].rfind("path,1,", 0), 0u) << rows[0];
     EXPECT_EQ(rows[3].rfind("radiosity,", 0), 0u) << rows[3];
     for (const std::string& row : rows) {
-        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 8) << row;
+        EXPECT_EQ(std::count(row.begin(), row.end(), ','), 10) << row;
         EXPECT_EQ(row.find("nan"), std::string::npos) << row;
     }
     // The image's own estimate from 2 spp on, for path rows only; the light strategy for path
     // rows only.
     EXPECT_NE(rows[0].find(",,sobol,bvh"), std::string::npos) << rows[0];
     EXPECT_NE(rows[1].find("e-"), std::string::npos) << rows[1];
-    EXPECT_EQ(rows[1].find(",,"), std::string::npos) << rows[1];
+    EXPECT_EQ(rows[1].find(",,sobol"), std::string::npos) << rows[1];
     EXPECT_NE(rows[3].find(",,sobol,"), std::string::npos) << rows[3];
     EXPECT_EQ(rows[3].back(), ',') << rows[3];
     EXPECT_GT(fs::file_size(out / "convergence.png"), 1000u);
@@ -314,13 +315,15 @@ TEST_F(Cli, ConvergeComparesEveryPairOfSamplerAndLightStrategyAgainstOneReferenc
     // that the ladders share time however timing noise scatters rungs of a millisecond.
     ASSERT_EQ(rows.size(), 1u + 4 * 6);
     EXPECT_EQ(absl::StrJoin(rows[0], ","),
-              "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling");
+              "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling,"
+              "region_rmse,region_relmse");
     const std::vector<std::pair<std::string, std::string>> configs = {
         {"independent", "power"}, {"independent", "bvh"}, {"sobol", "power"}, {"sobol", "bvh"}};
     for (size_t c = 0; c < configs.size(); ++c) {
         for (int k = 0; k < 6; ++k) {
             const std::vector<std::string>& row = rows[1 + c * 6 + k];
-            ASSERT_EQ(row.size(), 9u);
+            ASSERT_EQ(row.size(), 11u);
+            EXPECT_EQ(row[9], "");  // no --region
             EXPECT_EQ(row[0], "path");
             EXPECT_EQ(row[1], std::to_string(1 << k));
             EXPECT_EQ(row[7], configs[c].first);
@@ -369,10 +372,23 @@ TEST_F(Cli, ConvergeExplicitConfigurationsKeepTheirOrderAndTheFirstIsTheBaseline
     const RunResult r = Lightfarm("converge " + std::string(LF_TEST_SCENES) + "/cornell_box.json" +
                                   " --out " + out.string() +
                                   " --method path --resolution 16 --max-spp 8 --reference-spp 64 "
-                                  "--compare sobol/bvh,independent/power --threads 2");
+                                  "--compare sobol/bvh,independent/power --threads 2 "
+                                  "--region 4,8,6,5");
     ASSERT_EQ(r.status, 0) << r.output;
+    // --region: each row's region errors, measured over those 30 pixels only, differ from the
+    // whole image's; the summary's region ratio of the baseline to itself is 1.
+    const auto rows = ReadCsv(out / "convergence.csv");
+    ASSERT_EQ(rows.size(), 1u + 2 * 4);
+    for (size_t i = 1; i < rows.size(); ++i) {
+        ASSERT_EQ(rows[i].size(), 11u);
+        EXPECT_GT(std::stod(rows[i][9]), 0) << absl::StrJoin(rows[i], ",");
+        EXPECT_NE(rows[i][9], rows[i][3]);
+    }
+    EXPECT_NE(r.output.find("region 4,8 6x5:"), std::string::npos) << r.output;
     const auto summary = ReadCsv(out / "summary.csv");
     ASSERT_EQ(summary.size(), 3u);
+    ASSERT_EQ(summary[0].back(), "region_rmse_ratio_mean");
+    EXPECT_EQ(summary[1][summary[0].size() - 2], "1.0000");
     EXPECT_EQ(summary[1][0] + "/" + summary[1][1], "sobol/bvh");
     EXPECT_EQ(summary[2][0] + "/" + summary[2][1], "independent/power");
     EXPECT_EQ(summary[1][11], "1.0000");
@@ -396,6 +412,9 @@ TEST_F(Cli, ConvergeBadListsAreRefusedBeforeRendering) {
         {"--light-sampling power,", "--light-sampling power,: \"\" is not power or bvh"},
         {"--compare sobol/bvh --sampler independent", "excludes"},
         {"--fit-spp 8:4", "--fit-spp 8:4: expected FROM:TO"},
+        {"--region 1,2,3", "--region 1,2,3: expected X,Y,W,H"},
+        {"--region 0,0,0,4", "--region 0,0,0,4: expected X,Y,W,H"},
+        {"--region 10,0,8,8", "--region 10,0,8,8 leaves the 16x16 image"},
         {"--fit-spp 16:64", "--fit-spp 16:64 holds fewer than two rungs of the ladder 1 to 8 spp"},
     };
     for (const auto& [args, message] : cases) {
@@ -893,7 +912,7 @@ TEST_F(Cli, ConvergeLaddersWhittedAgainstThePathTracedReference) {
     const std::vector<std::vector<std::string>> rows = ReadCsv(out / "convergence.csv");
     ASSERT_EQ(rows.size(), 4u);  // the header; spp 1, 2, 4
     for (size_t i = 1; i < rows.size(); ++i) {
-        ASSERT_EQ(rows[i].size(), 9u);
+        ASSERT_EQ(rows[i].size(), 11u);
         EXPECT_EQ(rows[i][0], "whitted");
         EXPECT_EQ(rows[i][1], std::to_string(1 << (i - 1)));
         EXPECT_EQ(rows[i][8], "bvh");
