@@ -6,6 +6,7 @@
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
+#include "local_render.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -19,13 +20,17 @@ constexpr double kReferenceNoiseWarning = 0.05;
 void PrintSummary(const ConvergenceResult& result) {
     const TimeRange& t = result.equal_time;
     const ConfigSummary& base = result.configs.front();
-    std::printf(
-        "\npath tracing, fitted over %llu to %llu spp (each ladder's rungs there); equal time: "
-        "errors at %.4g s, the longest time every configuration reaches, and their ratios to %s "
-        "there and as the geometric mean over %.4g to %.4g s (each curve interpolated as a power "
-        "law between its rungs)\n",
-        (unsigned long long)base.fit.from, (unsigned long long)base.fit.to, t.to,
-        ConfigName(base.config).c_str(), t.from, t.to);
+    std::printf("\npath tracing, fitted over %llu to %llu spp (each ladder's rungs there); ",
+                (unsigned long long)base.fit.from, (unsigned long long)base.fit.to);
+    if (result.equal_time_note.empty()) {
+        std::printf(
+            "equal time: errors at %.4g s, the longest time every configuration reaches, and "
+            "their ratios to %s there and as the geometric mean over %.4g to %.4g s (each curve "
+            "interpolated as a power law between its rungs)\n",
+            t.to, ConfigName(base.config).c_str(), t.from, t.to);
+    } else {
+        std::printf("%s: the equal-time columns are nan\n", result.equal_time_note.c_str());
+    }
     if (!result.fit_note.empty()) std::printf("(%s)\n", result.fit_note.c_str());
     // The reference's noise adds to every measured MSE (the two are independent), most to the
     // smallest, so it flattens the best configuration's curve and raises its ratios.
@@ -81,9 +86,14 @@ Command AddConvergeCommand(CLI::App& app) {
     cmd->add_option("--reference", options->reference_path,
                     "reference OpenEXR of the same size (R,G,B)")
         ->check(CLI::ExistingFile);
-    cmd->add_option("--method", options->method, "path, radiosity or both")
+    cmd->add_option("--method", options->method,
+                    "path, radiosity, both (path and radiosity) or whitted (a spp ladder of "
+                    "Whitted ray tracing against the path-traced reference: its error levels off "
+                    "at the light transport it leaves out)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"path", "radiosity", "both"}));
+        ->check([](const std::string& m) {
+            return m == "both" ? std::string() : MethodFlagError(m, false);
+        });
     AddCameraFlag(cmd, options->scene);
     AddFilterFlag(cmd, options->scene);
     AddResolutionFlag(cmd, options->scene, &options->resolution, 16384,
@@ -152,46 +162,44 @@ Command AddConvergeCommand(CLI::App& app) {
                     "FROM:TO: the rungs the slopes, speeds and equal-time errors use (default "
                     "16:1024, or the whole ladder when that holds fewer than two rungs)")
         ->type_name("FROM:TO");
-    return {cmd, [options, samplers, strategies, compare, fit] {
-                absl::StatusOr<std::vector<RenderConfig>> configs =
-                    compare->empty() ? ConfigProduct(*samplers, *strategies)
-                                     : ParseConfigList(*compare);
-                if (!configs.ok()) return ReportError(configs.status());
-                options->configs = *configs;
-                if (!fit->empty()) {
-                    absl::StatusOr<SppRange> range = ParseSppRange(*fit);
-                    if (!range.ok()) return ReportError(range.status());
-                    options->fit_spp = *range;
-                    options->fit_spp_given = true;
-                }
-                absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
-                if (!result.ok()) return ReportError(result.status());
-                std::printf("%s", result->reference.c_str());
-                if (result->reference_rmse > 0) {
-                    std::printf(" (its own RMSE estimate from A/B: %.3e)", result->reference_rmse);
-                }
-                std::printf("\n%s\n", kConvergenceCsvHeader);
-                for (const ConvergenceRow& row : result->rows) {
-                    std::printf(
-                        "%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
-                        (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
-                        row.error.smape, EstimatedRelMseField(row).c_str(),
-                        SamplerTypeName(row.config.sampler),
-                        row.method == "path" ? LightStrategyName(row.config.light_strategy) : "");
-                }
-                if (!result->configs.empty()) PrintSummary(*result);
-                if (result->radiosity_slope != 0) {
-                    std::printf("radiosity: sqrt(relmse) ~ seconds^%.3f\n",
-                                result->radiosity_slope);
-                }
-                std::printf("-> %s", result->csv_path.c_str());
-                for (const std::string* path :
-                     {&result->summary_path, &result->png_path, &result->reference_exr_path}) {
-                    if (!path->empty()) std::printf(", %s", path->c_str());
-                }
-                std::printf("\n");
-                return 0;
-            }};
+    return {
+        cmd, [options, samplers, strategies, compare, fit] {
+            absl::StatusOr<std::vector<RenderConfig>> configs =
+                compare->empty() ? ConfigProduct(*samplers, *strategies)
+                                 : ParseConfigList(*compare);
+            if (!configs.ok()) return ReportError(configs.status());
+            options->configs = *configs;
+            if (!fit->empty()) {
+                absl::StatusOr<SppRange> range = ParseSppRange(*fit);
+                if (!range.ok()) return ReportError(range.status());
+                options->fit_spp = *range;
+                options->fit_spp_given = true;
+            }
+            absl::StatusOr<ConvergenceResult> result = RunConvergence(*options);
+            if (!result.ok()) return ReportError(result.status());
+            std::printf("%s", result->reference.c_str());
+            if (result->reference_rmse > 0) {
+                std::printf(" (its own RMSE estimate from A/B: %.3e)", result->reference_rmse);
+            }
+            std::printf("\n%s\n", kConvergenceCsvHeader);
+            for (const ConvergenceRow& row : result->rows) {
+                std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s\n", row.method.c_str(),
+                            (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
+                            row.error.smape, EstimatedRelMseField(row).c_str(),
+                            SamplerTypeName(row.config.sampler), LightSamplingField(row));
+            }
+            if (!result->configs.empty()) PrintSummary(*result);
+            if (result->radiosity_slope != 0) {
+                std::printf("radiosity: sqrt(relmse) ~ seconds^%.3f\n", result->radiosity_slope);
+            }
+            std::printf("-> %s", result->csv_path.c_str());
+            for (const std::string* path :
+                 {&result->summary_path, &result->png_path, &result->reference_exr_path}) {
+                if (!path->empty()) std::printf(", %s", path->c_str());
+            }
+            std::printf("\n");
+            return 0;
+        }};
 }
 
 }  // namespace lf

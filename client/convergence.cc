@@ -23,6 +23,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
+#include "lf/kernels/whitted.h"
 #include "lf/local/local_executor.h"
 #include "local_render.h"
 #include "radiosity_flags.h"
@@ -124,10 +125,14 @@ double RelativeRmse(const ConvergenceRow& row) { return std::sqrt(row.error.relm
 
 // A curve of the plot and the legend's slope: a path configuration's or radiosity's.
 std::string CurveName(const ConvergenceRow& row) {
-    return row.method == "path" ? ConfigName(row.config) : "radiosity";
+    return row.method == "path" ? ConfigName(row.config) : row.method;
 }
 
 }  // namespace
+
+const char* LightSamplingField(const ConvergenceRow& row) {
+    return row.method == "radiosity" ? "" : LightStrategyName(row.config.light_strategy);
+}
 
 std::string EstimatedRelMseField(const ConvergenceRow& row) {
     return row.estimated_relmse ? absl::StrFormat("%.6e", *row.estimated_relmse) : "";
@@ -154,7 +159,9 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
             }
         }
         gp << "EOD\n";
-        const std::string title = method == "path" ? "path tracing, " + name : "radiosity";
+        const std::string title = method == "path"      ? "path tracing, " + name
+                                  : method == "whitted" ? "whitted (biased: levels off)"
+                                                        : "radiosity";
         relative_plot.push_back(absl::StrFormat(
             "%s using 1:2 with linespoints pt 7 title %s", block,
             GnuplotQuote(absl::StrFormat("%s (slope %.2f)", title, relative_slope))));
@@ -166,9 +173,12 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
         add_curve(ConfigName(c.config), "path", c.relative_rmse_slope,
                   absl::StrFormat("%.2f", c.rmse_slope));
     }
-    const bool radiosity = std::any_of(result.rows.begin(), result.rows.end(),
-                                       [](const ConvergenceRow& r) { return r.method != "path"; });
-    if (radiosity) add_curve("radiosity", "radiosity", result.radiosity_slope, "");
+    const auto any = [&](const char* method) {
+        return std::any_of(result.rows.begin(), result.rows.end(),
+                           [&](const ConvergenceRow& r) { return r.method == method; });
+    };
+    if (any("radiosity")) add_curve("radiosity", "radiosity", result.radiosity_slope, "");
+    if (any("whitted")) add_curve("whitted", "whitted", result.whitted_slope, "");
     std::string title = "Error against time";
     if (!result.configs.empty()) {
         const SppRange& fit = result.configs.front().fit;
@@ -204,11 +214,10 @@ absl::Status WriteCsv(const ConvergenceResult& result) {
     std::ofstream csv(result.csv_path);
     csv << kConvergenceCsvHeader << "\n";
     for (const ConvergenceRow& row : result.rows) {
-        csv << absl::StrFormat(
-            "%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s\n", row.method, row.budget, row.seconds,
-            row.error.rmse, row.error.relmse, row.error.smape, EstimatedRelMseField(row),
-            SamplerTypeName(row.config.sampler),
-            row.method == "path" ? LightStrategyName(row.config.light_strategy) : "");
+        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s\n", row.method, row.budget,
+                               row.seconds, row.error.rmse, row.error.relmse, row.error.smape,
+                               EstimatedRelMseField(row), SamplerTypeName(row.config.sampler),
+                               LightSamplingField(row));
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.csv_path + ": cannot write");
@@ -318,9 +327,21 @@ absl::Status Summarize(const ConvergenceOptions& options, int64_t pixels,
     }
     absl::StatusOr<TimeRange> range = CommonTimeRange(rmse_curves);
     if (!range.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "no equal-time comparison over ", fit->from, " to ", fit->to,
-            " spp: ", range.status().message(), "; widen --fit-spp or raise --max-spp"));
+        result.equal_time_note = absl::StrCat("no equal-time comparison over ", fit->from, " to ",
+                                              fit->to, " spp: ", range.status().message(),
+                                              "; widen --fit-spp or raise --max-spp");
+        constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+        for (FittedLadder& ladder : ladders) {
+            ConfigSummary& s = ladder.summary;
+            s.rmse_at_equal_time = s.relmse_at_equal_time = kNone;
+            // The baseline's ratios to itself stay 1.
+            if (!result.configs.empty()) {
+                s.rmse_ratio_at_end = s.relmse_ratio_at_end = kNone;
+                s.rmse_ratio_mean = s.relmse_ratio_mean = kNone;
+            }
+            result.configs.push_back(s);
+        }
+        return absl::OkStatus();
     }
     result.equal_time = *range;
     const FittedLadder& base = ladders.front();
@@ -350,12 +371,14 @@ absl::Status Summarize(const ConvergenceOptions& options, int64_t pixels,
 }  // namespace
 
 absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& options) {
-    if (options.method != "path" && options.method != "radiosity" && options.method != "both") {
-        return absl::InvalidArgumentError(
-            absl::StrCat("--method ", options.method, ": expected path, radiosity or both"));
+    if (options.method != "path" && options.method != "radiosity" && options.method != "both" &&
+        options.method != "whitted") {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "--method ", options.method, ": expected path, radiosity, both or whitted"));
     }
     if (options.configs.empty()) return absl::InvalidArgumentError("no configuration to render");
-    const bool path = options.method != "radiosity";
+    const bool path = options.method == "path" || options.method == "both";
+    const bool with_radiosity = options.method == "radiosity" || options.method == "both";
     std::string unused_note;
     if (path) {
         // Refuse a bad --fit-spp before rendering anything.
@@ -374,7 +397,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         c.height = std::max(1, int(std::lround(double(c.height) * options.resolution / c.width)));
         c.width = options.resolution;
     }
-    if (options.method != "path") {
+    if (with_radiosity) {
         std::string why;
         absl::StatusOr<std::string> automatic = ChooseMethod(*scene, "auto", &why);
         if (!automatic.ok()) return automatic.status();
@@ -511,7 +534,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     }
     images.clear();
 
-    if (options.method != "path") {
+    if (with_radiosity) {
         for (int64_t patches = options.min_patches; patches <= options.max_patches; patches *= 2) {
             const auto start = Clock::now();
             RadiositySettings solve;
@@ -545,6 +568,46 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
                       row.seconds, error->rmse);
         }
     }
+    if (options.method == "whitted") {
+        // Whitted's ladder against the same reference: its error falls with the pixel and
+        // area-light sampling, then levels off at what it leaves out (WhittedMissingTerms).
+        const RenderConfig& config = options.configs.front();
+        const WhittedTracer whitted(**embree, options.max_depth, config.light_strategy);
+        for (uint64_t spp : Ladder(options.max_spp)) {
+            RenderSettings settings;
+            settings.spp = spp;
+            settings.seed = options.seed;
+            settings.threads = options.threads;
+            settings.sampler = config.sampler;
+            settings.light_strategy = config.light_strategy;
+            absl::StatusOr<RenderOutput> out = RenderImage(camera, whitted, settings);
+            if (!out.ok()) return out.status();
+            absl::StatusOr<ImageError> error = CompareImages(out->image, reference);
+            if (!error.ok()) return error.status();
+            ConvergenceRow row;
+            row.method = "whitted";
+            row.config = config;
+            row.budget = int64_t(spp);
+            row.seconds = out->seconds;
+            row.error = *error;
+            if (spp >= 2) {
+                if (absl::StatusOr<double> e = EstimatedRelMse(out->image); e.ok()) {
+                    row.estimated_relmse = *e;
+                }
+            }
+            result.rows.push_back(row);
+            log->info("job={} whitted {} spp: {:.3f} s, rmse {:.4e}", job_id, spp, row.seconds,
+                      error->rmse);
+        }
+        std::vector<std::pair<double, double>> points;
+        for (const ConvergenceRow& row : result.rows) {
+            if (row.method == "whitted") points.push_back({row.seconds, RelativeRmse(row)});
+        }
+        // A ladder too fast to time has no slope; the curve is drawn all the same.
+        if (absl::StatusOr<double> slope = LogLogSlope(points); slope.ok()) {
+            result.whitted_slope = *slope;
+        }
+    }
     if (absl::Status s = WriteCsv(result); !s.ok()) return s;
 
     if (path) {
@@ -552,7 +615,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         result.summary_path = (dir / "summary.csv").string();
         if (absl::Status s = WriteSummaryCsv(result); !s.ok()) return s;
     }
-    if (options.method != "path") {
+    if (with_radiosity) {
         std::vector<std::pair<double, double>> points;
         for (const ConvergenceRow& row : result.rows) {
             if (row.method == "radiosity") points.push_back({row.seconds, RelativeRmse(row)});

@@ -50,11 +50,13 @@ absl::StatusOr<SppRange> ParseSppRange(const std::string& text);
 struct ConvergenceOptions {
     std::string scene_path;
     std::string out_dir;
-    std::string reference_path;   // empty: render our own path-traced reference
-    std::string method = "both";  // path | radiosity | both
-    int resolution = 0;           // image width, height keeps the aspect; 0: the scene's
-    SceneOptions scene;           // --camera; --resolution WxH (then `resolution` is 0)
-    uint64_t max_spp = 256;       // path ladder 1, 2, 4, ... up to this
+    std::string reference_path;  // empty: render our own path-traced reference
+    // path | radiosity | both (path and radiosity) | whitted (its ladder against the path-traced
+    // reference: the error levels off at what Whitted leaves out)
+    std::string method = "both";
+    int resolution = 0;      // image width, height keeps the aspect; 0: the scene's
+    SceneOptions scene;      // --camera; --resolution WxH (then `resolution` is 0)
+    uint64_t max_spp = 256;  // path ladder 1, 2, 4, ... up to this
     uint64_t reference_spp = 4096;
     int64_t min_patches = 250;  // radiosity ladder, doubling
     int64_t max_patches = defaults::kRadiosityPatches;
@@ -105,9 +107,14 @@ struct ConvergenceResult {
     std::vector<ConfigSummary> configs;  // path ladders, in the options' order
     std::string fit_note;                // when a fit fell back to the whole ladder, why
     TimeRange equal_time;                // the times every configuration's fit range covers
-    double radiosity_slope = 0;          // of sqrt(relmse) against seconds, with radiosity rows
-    std::string reference;               // what the reference was, for the user
-    double reference_rmse = 0;           // the reference's own error estimate (A/B), 0 if unknown
+    // Why there is no equal-time comparison (the ladders share no time: a short ladder whose
+    // rungs timing noise scatters, or configurations of very different speed); then the
+    // equal-time errors and ratios are NaN and the slopes and speeds still stand.
+    std::string equal_time_note;
+    double radiosity_slope = 0;  // of sqrt(relmse) against seconds, with radiosity rows
+    double whitted_slope = 0;    // the same for whitted rows
+    std::string reference;       // what the reference was, for the user
+    double reference_rmse = 0;   // the reference's own error estimate (A/B), 0 if unknown
     std::string csv_path, png_path, summary_path;
     std::string reference_exr_path;  // the own reference, written for reuse with --reference
 };
@@ -126,5 +133,8 @@ inline constexpr const char* kSummaryCsvHeader =
 
 // The row's estimated_relmse as a CSV field: "" when there is none.
 std::string EstimatedRelMseField(const ConvergenceRow& row);
+// The CSV's light_sampling field: the strategy of the methods that sample lights (path,
+// whitted), empty for radiosity.
+const char* LightSamplingField(const ConvergenceRow& row);
 
 }  // namespace lf

@@ -23,6 +23,7 @@
 #include "lf/job/scene_files.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
+#include "local_render.h"
 #include "output_flags.h"
 #include "progress_bar.h"
 #include "proto/grpc_status.h"
@@ -421,11 +422,12 @@ Command AddSubmitCommand(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--name", o->spec.name, "job name (default: the scene file's name)");
     cmd->add_option("--method", o->spec.method,
-                    "path, or radiosity (Lambertian scenes; same bits as `lightfarm render "
-                    "--method radiosity` with the same options)")
+                    "path, radiosity (Lambertian scenes; same bits as `lightfarm render "
+                    "--method radiosity` with the same options) or whitted (direct light and "
+                    "specular chains only, a preview); bdpt, light and ppm are reserved, not "
+                    "implemented yet")
         ->capture_default_str()
-        ->check(
-            CLI::IsMember(std::vector<std::string>(kRenderMethods.begin(), kRenderMethods.end())));
+        ->check([](const std::string& m) { return MethodFlagError(m, false); });
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
                     "--solver jacobi: patch-group tasks per sweep; each worker computes the "

@@ -13,9 +13,12 @@
 #include "lf/core/patch_mesh.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/job_spec.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
+#include "lf/kernels/ray_tracer.h"
+#include "lf/kernels/whitted.h"
 #include "output_flags.h"
 #include "progress_bar.h"
 #include "radiosity_flags.h"
@@ -24,20 +27,35 @@ namespace lf {
 
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
                                          std::string* why) {
-    if (requested == "path" || requested == "radiosity") {
+    if (requested != "auto") {
+        // The job model's names: implemented, reserved for issue 15's methods (Unimplemented,
+        // saying so) or unknown.
+        if (std::string error = MethodFlagError(requested, true); !error.empty()) {
+            return absl::Status(CheckMethod(requested).code(), "--" + error);
+        }
         *why = "requested";
         return requested;
     }
-    if (requested != "auto") {
-        return absl::InvalidArgumentError(
-            absl::StrCat("--method ", requested, ": expected path, radiosity or auto"));
-    }
+    // Whitted is never chosen: it is exact only in scenes without interreflection or caustics
+    // (WhittedMissingTerms), which `plan` reports; a preview is the user's choice.
     if (std::string limitation = RadiosityLimitation(scene); !limitation.empty()) {
         *why = std::move(limitation);
         return std::string("path");
     }
     *why = "every material is Lambertian";
     return std::string("radiosity");
+}
+
+std::string MethodFlagError(const std::string& method, bool allow_auto) {
+    if (allow_auto && method == "auto") return "";
+    const absl::Status s = CheckMethod(method);
+    if (s.ok()) return "";
+    std::string message(s.message());
+    const std::string expected = "expected one of ";
+    if (const size_t at = message.find(expected); allow_auto && at != std::string::npos) {
+        message.insert(at + expected.size(), "auto, ");
+    }
+    return message;
 }
 
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options) {
@@ -106,19 +124,30 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
                           : std::string());
         }
     } else {
-        estimator = std::make_unique<PathTracer>(**embree, options.max_depth,
-                                                 options.render.light_strategy);
+        absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
+            MakeRayTracer(*method, **embree, options.max_depth, options.render.light_strategy);
+        if (!tracer.ok()) return tracer.status();
+        estimator = std::move(*tracer);
+        if (*method == "whitted") {
+            for (const std::string& term : WhittedMissingTerms(*scene)) {
+                log->info("job={} whitted leaves out {}", job_id, term);
+            }
+        }
     }
     log->info(
         "job={} rendering {} ({}x{}, {} spp, {} sampler{}, seed {}, max depth {}, tile {}, {} "
         "filter{}{})",
         job_id, options.scene_path, camera.width(), camera.height(), options.render.spp,
         SamplerTypeName(options.render.sampler),
-        *method == "path" ? absl::StrCat(", ", LightStrategyName(options.render.light_strategy),
-                                         " light sampling")
-                          : std::string(),
+        IsRayTracingMethod(*method)
+            ? absl::StrCat(", ", LightStrategyName(options.render.light_strategy),
+                           " light sampling")
+            : std::string(),
         options.render.seed,
-        options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth),
+        options.max_depth >= 0 ? std::to_string(options.max_depth)
+        : *method == "whitted"
+            ? absl::StrCat("unlimited (whitted: ", kWhittedUnlimitedDepth, " specular bounces)")
+            : "unlimited",
         options.render.tile, DescribePixelFilter(scene->camera.filter),
         options.render.clamp > 0 ? absl::StrCat(", clamp ", options.render.clamp, " (biased)")
                                  : std::string(),
@@ -146,7 +175,12 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
                   out->stats.invalid_samples);
     }
 
-    if (out->stats.truncated_paths > 0) {
+    if (out->stats.truncated_paths > 0 && *method == "whitted") {
+        log->warn(
+            "job={} {} specular rays reached whitted's depth cap of {} and were cut (--max-depth "
+            "sets it)",
+            job_id, out->stats.truncated_paths, kWhittedUnlimitedDepth);
+    } else if (out->stats.truncated_paths > 0) {
         log->warn(
             "job={} {} paths reached the depth cap of {} bounces and were cut (a "
             "reflectance of 1 keeps Russian roulette from ending them)",

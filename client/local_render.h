@@ -22,7 +22,7 @@ struct LocalRenderOptions {
     std::string exr_path;                    // empty: no EXR (-o out.png)
     std::string png_path;                    // empty: no preview
     PngOptions preview;                      // --exposure, --tonemap
-    std::string method = defaults::kMethod;  // path | radiosity | auto
+    std::string method = defaults::kMethod;  // path | radiosity | whitted | auto
     RenderSettings render;                   // with --clamp and --aov
     AdaptiveSettings adaptive;               // used when a target error or a time limit is set
     int max_depth = defaults::kMaxDepth;
@@ -51,10 +51,16 @@ struct LocalRenderSummary {
 
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options);
 
-// The method for `requested` (path, radiosity or auto) and, in *why, the reason. `auto`:
-// radiosity models exactly the scenes it can (all Lambertian, no spheres) and is
-// view-independent; everything else needs the path tracer.
+// The method for `requested` (path, radiosity, whitted or auto) and, in *why, the reason.
+// `auto`: radiosity models exactly the scenes it can (all Lambertian, no spheres) and is
+// view-independent; everything else needs the path tracer. Never whitted, which misses
+// interreflection and caustics in nearly every scene (lf/kernels/whitted.h,
+// WhittedMissingTerms). The methods reserved for issue 15 (bdpt, light, ppm) are Unimplemented.
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
                                          std::string* why);
+
+// The CLI's check of a --method flag: "" when the job model accepts `method` (or it is "auto"
+// and allow_auto), else the message: reserved methods say they are not implemented yet.
+std::string MethodFlagError(const std::string& method, bool allow_auto);
 
 }  // namespace lf

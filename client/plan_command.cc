@@ -18,6 +18,8 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
+#include "lf/kernels/ray_tracer.h"
+#include "lf/kernels/whitted.h"
 #include "lf/local/local_executor.h"
 #include "lf/local/render_prediction.h"
 #include "local_render.h"
@@ -237,7 +239,24 @@ absl::Status RunPlan(const PlanOptions& options) {
     if (!method.ok()) return method.status();
     std::printf("method (--method %s): %s, because %s\n", options.method.c_str(), method->c_str(),
                 why.c_str());
+    // Whitted is never auto's choice; plan says what it would give (lf/kernels/whitted.h).
+    if (const std::vector<std::string> missing = WhittedMissingTerms(*scene); missing.empty()) {
+        std::printf(
+            "whitted: exact for this scene (direct light and specular chains are all its light "
+            "transport): --method whitted converges to the path tracer's image at less cost\n");
+    } else {
+        std::printf("whitted: recommended only as a preview (--method whitted); it leaves out:\n");
+        for (const std::string& term : missing) std::printf("  - %s\n", term.c_str());
+    }
 
+    if (*method == "whitted") {
+        // Splitting at each glass hit doubles the rays: the depth bounds the work.
+        std::printf(
+            "whitted depth: at most %d specular bounces%s; a ray tree splits in two at every "
+            "dielectric hit and ends at the first non-specular one\n",
+            options.max_depth < 0 ? kWhittedUnlimitedDepth : options.max_depth,
+            options.max_depth < 0 ? " (its cap for an unlimited --max-depth)" : "");
+    }
     // A closed room of albedo rho keeps a path alive for 1/(1 - rho) bounces on average under
     // the roulette; an open scene ends paths sooner.
     std::printf(
@@ -265,7 +284,11 @@ absl::Status RunPlan(const PlanOptions& options) {
     // that how fast it falls is measured rather than assumed (docs/convergence.md, "Error
     // estimates and plan predictions").
     const Camera camera(scene->camera, (*embree)->origin());
-    const PathTracer tracer(**embree, options.max_depth, options.light_strategy);
+    // Radiosity's display error is costed with the path tracer's pilot, as before.
+    const std::string pilot_method = *method == "whitted" ? "whitted" : "path";
+    absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
+        MakeRayTracer(pilot_method, **embree, options.max_depth, options.light_strategy);
+    if (!tracer.ok()) return tracer.status();
     RenderSettings settings;
     settings.spp = options.first_spp;
     settings.seed = options.seed;
@@ -276,11 +299,12 @@ absl::Status RunPlan(const PlanOptions& options) {
     const AdaptiveSettings adaptive{.target_error = options.target_error,
                                     .max_spp = options.max_spp};
     absl::StatusOr<RenderPrediction> p =
-        PredictAdaptiveRender(camera, tracer, settings, adaptive, options.pilot_spp);
+        PredictAdaptiveRender(camera, **tracer, settings, adaptive, options.pilot_spp);
     if (!p.ok()) return p.status();
     std::printf(
-        "pilot (path tracing): %llu then %llu spp in every tile, %.2f s; the tiles' error goes "
+        "pilot (%s): %llu then %llu spp in every tile, %.2f s; the tiles' error goes "
         "as spp^%.2f (median over %d tiles; Monte Carlo's is spp^-0.5)\n",
+        pilot_method == "whitted" ? "whitted ray tracing" : "path tracing",
         (unsigned long long)p->pilot_spp[0], (unsigned long long)p->pilot_spp[1], p->pilot_seconds,
         -p->median_rate, p->tiles);
     std::printf(
@@ -319,9 +343,10 @@ Command AddPlanCommand(CLI::App& app) {
     AddSceneFlags(cmd, options->scene);
     cmd->add_option("--method", options->method,
                     "the method to cost: path, radiosity (adds the cost of the form factors "
-                    "and the solve, from a pilot solve) or auto (as render --method auto)")
+                    "and the solve, from a pilot solve), whitted (the pilot traces it) or auto "
+                    "(as render --method auto)")
         ->capture_default_str()
-        ->check(CLI::IsMember({"path", "radiosity", "auto"}));
+        ->check([](const std::string& m) { return MethodFlagError(m, true); });
     cmd->add_option("--target-error", options->target_error,
                     "relative error to estimate the cost for")
         ->capture_default_str()

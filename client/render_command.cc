@@ -58,10 +58,13 @@ Command AddRenderCommand(CLI::App& app) {
     cmd->add_flag("--no-progress", *no_progress, "no progress bar");
     cmd->add_option("--method", options->method,
                     "path (path tracing, any material), radiosity (finite elements, Lambertian "
-                    "quads and triangles only, view-independent) or auto (radiosity when every "
-                    "material is Lambertian and there are no spheres; the log says why)")
+                    "quads and triangles only, view-independent), whitted (direct light and "
+                    "mirror/glass reflection and refraction only: a fast preview without "
+                    "interreflection or caustics) or auto (radiosity when every material is "
+                    "Lambertian and there are no spheres; the log says why). bdpt, light and ppm "
+                    "are reserved, not implemented yet")
         ->capture_default_str()
-        ->check(CLI::IsMember({"path", "radiosity", "auto"}));
+        ->check([](const std::string& m) { return MethodFlagError(m, true); });
 
     const std::string r = "Radiosity";
     AddRadiosityFlags(cmd, options->radiosity);

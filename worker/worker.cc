@@ -12,6 +12,7 @@
 #include "lf/core/radiosity_codec.h"
 #include "lf/core/tile_codec.h"
 #include "lf/kernels/radiosity.h"
+#include "lf/kernels/ray_tracer.h"
 #include "lf/kernels/tile_renderer.h"
 
 namespace lf {
@@ -192,8 +193,11 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic
     if (loaded_.tracer) return absl::OkStatus();
     if (task.spec.method != "radiosity") {
         // Cached per job (loaded_.job_id), so the job's one light strategy is the tracer's.
-        loaded_.tracer = std::make_unique<PathTracer>(*loaded_.embree, task.spec.max_depth,
-                                                      task.spec.light_strategy);
+        // path or whitted; the coordinator refused every other name (CheckJobSettings).
+        absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer = MakeRayTracer(
+            task.spec.method, *loaded_.embree, task.spec.max_depth, task.spec.light_strategy);
+        if (!tracer.ok()) return tracer.status();
+        loaded_.tracer = std::move(*tracer);
         return absl::OkStatus();
     }
     absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);

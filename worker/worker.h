@@ -47,7 +47,7 @@ class Worker {
         std::unique_ptr<Scene> scene;  // EmbreeScene keeps a reference
         std::unique_ptr<EmbreeScene> embree;
         std::unique_ptr<Camera> camera;
-        std::unique_ptr<RadianceEstimator> tracer;  // path tracer or radiosity display
+        std::unique_ptr<RadianceEstimator> tracer;  // path or Whitted tracer, radiosity display
         // Radiosity solved in sweeps: the form-factor rows of the chunks this worker swept
         // (the server gives a chunk back to the worker that has its rows), and the last input.
         std::map<int, std::unique_ptr<RadiositySweepChunk>> chunks;

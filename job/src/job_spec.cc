@@ -39,7 +39,37 @@ absl::Status OneOf(const char* field, const std::string& value,
         absl::StrCat(field, " \"", value, "\": expected one of ", expected));
 }
 
+std::string_view ReservedMethodName(std::string_view method) {
+    if (method == "bdpt") return "bidirectional path tracing";
+    if (method == "light") return "light tracing";
+    if (method == "ppm") return "progressive photon mapping";
+    return "";
+}
+
 }  // namespace
+
+absl::Status CheckMethod(const std::string& method) {
+    if (std::find(kRenderMethods.begin(), kRenderMethods.end(), method) != kRenderMethods.end()) {
+        return absl::OkStatus();
+    }
+    std::string implemented;
+    for (std::string_view name : kRenderMethods) {
+        absl::StrAppend(&implemented, implemented.empty() ? "" : ", ", std::string(name));
+    }
+    if (std::find(kReservedMethods.begin(), kReservedMethods.end(), method) !=
+        kReservedMethods.end()) {
+        return absl::UnimplementedError(
+            absl::StrCat("method \"", method, "\" (", std::string(ReservedMethodName(method)),
+                         "): not implemented yet in this build; use ", implemented));
+    }
+    std::string reserved;
+    for (std::string_view name : kReservedMethods) {
+        absl::StrAppend(&reserved, reserved.empty() ? "" : ", ", std::string(name));
+    }
+    return absl::InvalidArgumentError(
+        absl::StrCat("method \"", method, "\": expected one of ", implemented,
+                     " (not implemented yet in this build: ", reserved, ")"));
+}
 
 absl::Status CheckJobSettings(const JobSpec& spec) {
     const RadiositySettings& r = spec.radiosity;
@@ -53,7 +83,7 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         // Finite: an infinite cap is no cap, and the CLI's 0 says that.
         InRange("clamp", spec.clamp, 0.0, std::numeric_limits<double>::max()),
         InRange("aovs", spec.aovs, 0u, uint32_t(kAllAovs)),
-        OneOf("method", spec.method, kRenderMethods),
+        CheckMethod(spec.method),
         NoneOrInRange("adaptive.target_error", spec.adaptive.target_error, kMinTargetError,
                       kMaxTargetError),
         NoneOrInRange("adaptive.time_limit", spec.adaptive.time_limit, kMinTimeLimit,

@@ -122,7 +122,7 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     d.attributes = DescribeMethod(m);
     if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
     if (m.aovs != 0) d.attributes["lightfarm.aovs"] = AovListName(m.aovs);
-    if (m.method == "path") {
+    if (m.method == "path" || m.method == "whitted") {  // the methods that sample lights
         d.attributes["lightfarm.light_sampling"] = std::string(LightStrategyName(m.light_strategy));
     }
     if (m.clamp > 0) AddClampAttributes(m.clamp, d.attributes);

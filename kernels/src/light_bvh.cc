@@ -181,7 +181,7 @@ std::optional<LightPick> LightBvh::Descend(const Vec3& p, const Vec3& n, Choose&
     return LightPick{int(nodes_[index].child_or_light), pmf};
 }
 
-std::optional<LightPick> LightBvh::Sample(const Vec3& p, const Vec3& n, float u) const {
+std::optional<LightPick> LightBvh::SampleTree(const Vec3& p, const Vec3& n, float u) const {
     return Descend(p, n, [&u](float p_first) {
         // Reuse u: rescale its position within the chosen interval back to [0, 1).
         if (u < p_first) {

@@ -354,6 +354,18 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, const Vec3& n, 
     return ls;
 }
 
+bool LightSampler::IsDeltaLight(size_t i) const {
+    const Kind kind = lights_[i].kind;
+    return kind == Kind::kPoint || kind == Kind::kSpot || kind == Kind::kDirectional;
+}
+
+std::optional<LightSample> LightSampler::SampleDeltaLight(size_t i, const Vec3& ref) const {
+    if (!IsDeltaLight(i)) return std::nullopt;
+    std::optional<LightSample> ls = SampleDelta(lights_[i], ref);
+    if (ls) ls->pdf = 1;
+    return ls;
+}
+
 std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Vec3& ref,
                                                     const Vec3& n, const Vec2& u) const {
     const Scene& scene = scene_.scene();

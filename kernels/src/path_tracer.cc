@@ -87,27 +87,17 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
             break;
         }
 
-        // The BSDF lives in the shading frame; the geometric normal decides sides. A direction
-        // the two put on different sides of the surface (reflection for one, transmission for
-        // the other) carries nothing: that is where shading normals would leak light. The one
-        // exception is reflection just below a smooth mesh's facet near the terminator, which
-        // the smooth surface still reflects: allowed when the ray from Hanika's lifted point
-        // misses its own triangle (other geometry is the ray's business).
+        // The BSDF lives in the shading frame; Shading::SidesAgree decides by the geometric normal.
         const Frame frame = Frame::FromNormal(sh.ns);
         const Vec3 wo = frame.ToLocal(-ray.d);
-        const auto consistent = [&](const Vec3& wi_world, const Vec3& wi) {
-            const float cos_i_ng = Dot(wi_world, ng);
-            if (cos_i_ng == 0) return false;
-            const bool reflect = wi.z * wo.z > 0;
-            if ((cos_i_ng * cos_o_ng > 0) == reflect) return true;
-            return reflect && cos_o_ng > 0 && sh.ClearsFacet(wi_world);
-        };
         const Bsdf bsdf(material, sh.params);
 
         if (!bsdf.IsDelta()) {
             if (const auto ls = lights_.Sample(hit->p, sh.ns, u_choice.x, u_light)) {
                 const Vec3 wi = frame.ToLocal(ls->wi);
-                const Rgb f = consistent(ls->wi, wi) ? bsdf.Eval(wo, wi) * std::abs(wi.z) : Rgb();
+                const Rgb f = sh.SidesAgree(-ray.d, ls->wi, wi.z * wo.z > 0)
+                                  ? bsdf.Eval(wo, wi) * std::abs(wi.z)
+                                  : Rgb();
                 const Rgb radiance =
                     f.IsBlack() ? Rgb() : EmissionAt(scene_, ls->point, ls->radiance);
                 if (!radiance.IsBlack()) {
@@ -131,7 +121,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
         if (!bs || !(bs->pdf > 0)) break;
         const Vec3 wi = frame.FromLocal(bs->wi);
-        if (!consistent(wi, bs->wi)) break;
+        if (!sh.SidesAgree(-ray.d, wi, bs->wi.z * wo.z > 0)) break;
         beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
         if (beta.IsBlack()) break;
         const bool transmitted = bs->wi.z * wo.z < 0;

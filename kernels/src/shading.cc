@@ -67,6 +67,13 @@ SurfacePoint Shading::Leaving(const Vec3& w) const {
     return {p_outer, point.p_error + Abs(p_outer) * Gamma(2), point.n};
 }
 
+bool Shading::SidesAgree(const Vec3& wo, const Vec3& wi, bool reflect) const {
+    const float cos_o = Dot(wo, point.n), cos_i = Dot(wi, point.n);
+    if (cos_i == 0) return false;
+    if ((cos_i * cos_o > 0) == reflect) return true;
+    return reflect && cos_o > 0 && ClearsFacet(wi);
+}
+
 bool Shading::ClearsFacet(const Vec3& w) const {
     const float lift = Dot(p_outer - point.p, point.n), cos_w = Dot(w, point.n);
     if (!(lift > 0) || !(cos_w < 0)) return false;

@@ -615,7 +615,7 @@ TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
 
 // One command line, two ways: `lightfarm render FLAGS` and `lightfarm submit FLAGS` then
 // `fetch` give the same pixels and the same header but for timings, whatever the method: path,
-// radiosity with its default solver (jacobi, which the farm solves in sweeps), adaptive.
+// radiosity with its default solver (jacobi, which the farm solves in sweeps), adaptive, whitted.
 TEST_F(Farm, SameCommandLineGivesTheSameImageAndHeaderLocallyAndOnTheFarm) {
     StartServer();
     StartWorker("w1");
@@ -623,7 +623,8 @@ TEST_F(Farm, SameCommandLineGivesTheSameImageAndHeaderLocallyAndOnTheFarm) {
     int run = 0;
     for (const std::string flags :
          {"--spp 4 --seed 2 --tile 16", "--method radiosity --patches 300 --spp 2 --tile 16",
-          "--spp 4 --seed 3 --tile 16 --target-error 0.1 --max-spp 256"}) {
+          "--spp 4 --seed 3 --tile 16 --target-error 0.1 --max-spp 256",
+          "--method whitted --spp 4 --seed 5 --tile 16"}) {
         SCOPED_TRACE(flags);
         const std::string job = Submit(scene_, flags);
         const CliRun watch = Farmctl("watch " + job);

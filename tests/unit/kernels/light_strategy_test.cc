@@ -159,6 +159,20 @@ void ExpectLessVariance(const StrategyEstimates& e, double ratio) {
     }
 }
 
+// Under the centre of a downward square of side a at height h over a plane of albedo rho, both
+// strategies estimate rho Le F (F the view factor of the square from the point under its
+// centre), the BVH with at most half the variance.
+void ExpectUnderSquareBothRightLessVariance(const Scene& scene, const Rgb& rho, const Rgb& le,
+                                            double a, double h) {
+    const StrategyEstimates e = EstimateBoth(scene, {0, 0, 0}, 20000);
+    ExpectSameMean(e);
+    const double x = a / h, sx = std::sqrt(1 + x * x);
+    const double f = 4 * (2 * x / sx * std::atan(x / sx)) / (2 * kPi);
+    testing::ExpectEstimateNear(e.bvh, rho * le * float(f));
+    testing::ExpectEstimateNear(e.power, rho * le * float(f));
+    ExpectLessVariance(e, 0.5);
+}
+
 // A 4 x 4 emitter 0.3 above the point: from there it covers most of the hemisphere, and area
 // sampling's 1 / r^2 and cosines make most of its variance. (The cosine warp does nothing here:
 // the triangles' corners all lie at the same grazing angle.) Both agree with the closed form
@@ -168,13 +182,7 @@ TEST(LightStrategy, LargeNearbyEmitterSameMeanLessVariance) {
     const double a = 2, h = 0.3;
     Scene scene = testing::PlaneUnderCamera(rho);
     AddDownwardSquare(scene, AddEmitter(scene, le), a, h);
-    const StrategyEstimates e = EstimateBoth(scene, {0, 0, 0}, 20000);
-    ExpectSameMean(e);
-    const double x = a / h, sx = std::sqrt(1 + x * x);
-    const double f = 4 * (2 * x / sx * std::atan(x / sx)) / (2 * kPi);
-    testing::ExpectEstimateNear(e.bvh, rho * le * float(f));
-    testing::ExpectEstimateNear(e.power, rho * le * float(f));
-    ExpectLessVariance(e, 0.5);
+    ExpectUnderSquareBothRightLessVariance(scene, rho, le, a, h);
 }
 
 // The same as one rectangle light (spherical rectangle sampling): the same mean, less variance;
@@ -199,13 +207,7 @@ TEST(LightStrategy, RectangleLightSameMeanLessVarianceAndPdfMatchesSample) {
             }
         }
     }
-    const StrategyEstimates e = EstimateBoth(scene, {0, 0, 0}, 20000);
-    ExpectSameMean(e);
-    const double x = a / h, sx = std::sqrt(1 + x * x);
-    const double f = 4 * (2 * x / sx * std::atan(x / sx)) / (2 * kPi);
-    testing::ExpectEstimateNear(e.bvh, rho * le * float(f));
-    testing::ExpectEstimateNear(e.power, rho * le * float(f));
-    ExpectLessVariance(e, 0.5);
+    ExpectUnderSquareBothRightLessVariance(scene, rho, le, a, h);
 }
 
 // 300 small emitters (triangles 0.1 across) at distances from 1 to 30 (few enough close by not

@@ -48,7 +48,12 @@ class LightBvh {
     // the walk ends in a subtree whose bounds promised light that none of its lights gives (then
     // the Pmfs sum to less than 1; a failed pick contributes zero and the estimate stays unbiased:
     // every light that can reach p has Pmf > 0).
-    std::optional<LightPick> Sample(const Vec3& p, const Vec3& n, float u) const;
+    std::optional<LightPick> Sample(const Vec3& p, const Vec3& n, float u) const {
+        // Inline for a tree of one light (a Cornell box's lamp), which Descend would pick anyway:
+        // the call is a measurable part of such a scene's light sampling.
+        if (nodes_.size() == 1) return LightPick{int(nodes_[0].child_or_light), 1.0f};
+        return SampleTree(p, n, u);
+    }
     // The probability that Sample(p, n, .) picks `light`; 0 for a light left out or out of range.
     float Pmf(const Vec3& p, const Vec3& n, int light) const;
 
@@ -65,6 +70,7 @@ class LightBvh {
         Vec3 centroid;
     };
 
+    std::optional<LightPick> SampleTree(const Vec3& p, const Vec3& n, float u) const;
     int BuildNode(std::vector<BuildLight>& lights, size_t begin, size_t end, int depth,
                   uint64_t trail);
 

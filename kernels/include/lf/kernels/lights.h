@@ -59,6 +59,12 @@ class LightSampler {
     std::optional<LightSample> Sample(const Vec3& ref, const Vec3& n, float u_pick,
                                       const Vec2& u) const;
 
+    // Light i (of size()) when it is a delta light (point, spot, directional without a
+    // diameter), as Sample gives it at `ref` but with pdf 1; nullopt for the others: for
+    // estimators that sum every delta light instead of picking one (lf/kernels/whitted.h).
+    bool IsDeltaLight(size_t i) const;
+    std::optional<LightSample> SampleDeltaLight(size_t i, const Vec3& ref) const;
+
     // Density, per solid angle at `ref`, with which Sample(ref, n, ...) would have produced
     // `hit` (an emitter hit by a BSDF-sampled ray); used for multiple importance sampling.
     float Pdf(const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;

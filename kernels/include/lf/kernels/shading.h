@@ -32,6 +32,12 @@ struct Shading {
     // terminator, where the shading normal says it is still above the surface: true when the
     // ray from p_outer passes outside this triangle, so it does not go through the surface.
     bool ClearsFacet(const Vec3& w) const;
+    // Whether light may scatter between wo and wi (world space, away from the surface; length
+    // irrelevant), which the BSDF in the shading frame calls a reflection or not (`reflect`).
+    // The geometric normal decides sides: a direction the two put on different sides carries
+    // nothing, as that is where shading normals would leak light; the one exception is
+    // reflection just below a smooth mesh's facet near the terminator that clears it.
+    bool SidesAgree(const Vec3& wo, const Vec3& wi, bool reflect) const;
 };
 
 // The interaction at `hit` seen from direction wo (unit, away from the surface).

@@ -1,0 +1,74 @@
+// The rendering methods a job may name (lf/job/job_spec.h): the implemented ones pass, the ones
+// issue 15 reserves are refused as not implemented yet (not as unknown), anything else as
+// unknown with the lists; and a Whitted render's header names its method and light sampling.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "lf/job/job_spec.h"
+#include "lf/job/merge.h"
+#include "lf/job/render_metadata.h"
+
+namespace lf {
+namespace {
+
+TEST(Method, ImplementedMethodsPassTheJobCheck) {
+    for (const char* method : {"path", "radiosity", "whitted"}) {
+        JobSpec spec;
+        spec.method = method;
+        EXPECT_TRUE(CheckMethod(method).ok()) << method;
+        EXPECT_TRUE(CheckJobSettings(spec).ok()) << method << ": " << CheckJobSettings(spec);
+    }
+}
+
+TEST(Method, ReservedMethodsAreNotImplementedYetNamingTheMethod) {
+    const struct {
+        const char* name;
+        const char* what;
+    } reserved[] = {{"bdpt", "bidirectional path tracing"},
+                    {"light", "light tracing"},
+                    {"ppm", "progressive photon mapping"}};
+    ASSERT_EQ(std::size(reserved), kReservedMethods.size());
+    for (const auto& r : reserved) {
+        JobSpec spec;
+        spec.method = r.name;
+        const absl::Status s = CheckJobSettings(spec);
+        EXPECT_EQ(s.code(), absl::StatusCode::kUnimplemented) << s;
+        const std::string message(s.message());
+        EXPECT_EQ(message.rfind(std::string("method \"") + r.name + "\"", 0), 0u) << message;
+        EXPECT_NE(message.find(r.what), std::string::npos) << message;
+        EXPECT_NE(message.find("not implemented yet"), std::string::npos) << message;
+        EXPECT_NE(message.find("whitted"), std::string::npos) << "names the alternatives";
+    }
+}
+
+TEST(Method, UnknownMethodIsInvalidAndListsBoth) {
+    const absl::Status s = CheckMethod("photon");
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+    const std::string message(s.message());
+    for (const char* name : {"path", "radiosity", "whitted", "bdpt", "light", "ppm"}) {
+        EXPECT_NE(message.find(name), std::string::npos) << name << " in " << message;
+    }
+    EXPECT_EQ(CheckMethod("").code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(CheckMethod("Whitted").code(), absl::StatusCode::kInvalidArgument);
+}
+
+// Whitted samples lights as the path tracer does, so its header names the light strategy, and
+// nothing of radiosity.
+TEST(Method, WhittedHeaderNamesItsMethodAndLightSampling) {
+    RenderMetadata m;
+    m.scene_hash = "abc";
+    m.method = "whitted";
+    m.spp = 1;
+    m.light_strategy = LightStrategy::kPower;
+    absl::StatusOr<RenderDescription> d = DescribeRender(m, EmptyRenderImage(4, 4), true);
+    ASSERT_TRUE(d.ok()) << d.status();
+    EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.method")), "whitted");
+    EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.light_sampling")), "power");
+    for (const auto& [name, value] : d->attributes) {
+        EXPECT_NE(name.rfind("lightfarm.radiosity.", 0), 0u) << name;
+    }
+}
+
+}  // namespace
+}  // namespace lf
