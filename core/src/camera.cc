@@ -9,7 +9,7 @@
 namespace lf {
 
 Camera::Camera(const CameraSpec& spec, const Vec3d& origin)
-    : width_(spec.width), height_(spec.height), filter_(spec.filter) {
+    : width_(spec.width), height_(spec.height), filter_spec_(spec.filter), filter_(spec.filter) {
     const Vec3d f = Normalize(spec.look_at - spec.position);
     const Vec3d r = Normalize(Cross(f, spec.up));
     const Vec3d u = Cross(r, f);

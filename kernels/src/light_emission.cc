@@ -165,6 +165,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
         case Kind::kTriangle:
         case Kind::kSphere: {
             es.point = AreaPoint(light, u_pos);
+            es.on_surface = true;
             es.pdf_pos = 1 / light.area;
             Vec2 u = u_dir;
             Vec3 n = es.point.n;

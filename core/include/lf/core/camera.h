@@ -68,6 +68,8 @@ class Camera {
 
     int width() const { return width_; }
     int height() const { return height_; }
+    // The pixel filter the camera was made with (methods that splat check it).
+    const PixelFilter& filter() const { return filter_spec_; }
 
   private:
     // Where ray's film point falls (raster coordinates) and the cosine of ray.d with the view
@@ -80,6 +82,7 @@ class Camera {
     float film_area_ = 1;  // of the film at distance 1 from the pinhole
     float lens_area_ = 1;  // pi r^2, or 1 for a pinhole
     int width_ = 0, height_ = 0;
+    PixelFilter filter_spec_;
     FilterSampler filter_;
 };
 

@@ -42,6 +42,9 @@ struct EmissionSample {
     float pdf_pos = 0;   // area density of point (1 for a delta position)
     float pdf_dir = 0;   // solid-angle density of w given point (1 for a delta direction)
     bool delta_pos = false, delta_dir = false;
+    // An area light: point lies on the emitter's surface (point.n its geometric normal), so a
+    // camera can see it; false for point, spot and the lights at infinity.
+    bool on_surface = false;
 
     // The ray that leaves the emitter, starting outside the point's error bound.
     Ray ray() const { return SpawnRay(point, w); }
