@@ -124,6 +124,144 @@ TEST(LightTracer, CancelledRenderStopsEarly) {
     EXPECT_TRUE(splats.entries().empty());
 }
 
+// The estimate of a block of pixels (the average of R, G and B over it) and its variance.
+struct BlockEstimate {
+    double mean = 0, variance = 0;
+};
+
+constexpr int kBlock = 8;
+
+// The path tracer's blocks, their variances from each pixel's halves: (A - B)^2 / 4 estimates
+// the variance of a pixel's mean, and pixels are independent.
+std::vector<BlockEstimate> PathBlocks(const Image& image) {
+    const int bw = image.width() / kBlock, bh = image.height() / kBlock;
+    std::vector<BlockEstimate> blocks(size_t(bw * bh));
+    for (int y = 0; y < bh * kBlock; ++y) {
+        for (int x = 0; x < bw * kBlock; ++x) {
+            BlockEstimate& b = blocks[size_t((y / kBlock) * bw + x / kBlock)];
+            const double a = image.Pixel(x, y, "A.").Average();
+            const double c = image.Pixel(x, y, "B.").Average();
+            const double n = kBlock * kBlock;
+            b.mean += image.Pixel(x, y).Average() / n;
+            b.variance += (a - c) * (a - c) / 4 / (n * n);
+        }
+    }
+    return blocks;
+}
+
+// The light tracer's blocks from `batches` independent ranges of light paths: a light path
+// splats into several pixels of a block, so pixels are not independent; the batch means are.
+std::vector<BlockEstimate> LightBlocks(const testing::FrameSetup& s, int batches,
+                                       uint64_t paths_per_batch) {
+    const int bw = s.camera->width() / kBlock, bh = s.camera->height() / kBlock;
+    std::vector<std::vector<double>> per_batch(size_t(bw * bh));
+    for (int k = 0; k < batches; ++k) {
+        const uint64_t begin = uint64_t(k) * paths_per_batch;
+        const Image image =
+            testing::RenderFramePaths(*s.renderer, *s.camera, begin, begin + paths_per_batch).image;
+        std::vector<double> sums(per_batch.size(), 0.0);
+        for (int y = 0; y < bh * kBlock; ++y) {
+            for (int x = 0; x < bw * kBlock; ++x) {
+                sums[size_t((y / kBlock) * bw + x / kBlock)] +=
+                    image.Pixel(x, y).Average() / (kBlock * kBlock);
+            }
+        }
+        for (size_t b = 0; b < sums.size(); ++b) per_batch[b].push_back(sums[b]);
+    }
+    std::vector<BlockEstimate> blocks(per_batch.size());
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        double mean = 0, var = 0;
+        for (double m : per_batch[b]) mean += m / batches;
+        for (double m : per_batch[b]) var += (m - mean) * (m - mean) / (batches - 1);
+        blocks[b] = {mean, var / batches};
+    }
+    return blocks;
+}
+
+// Blocks where some pixel sees a mirror or glass first: the light tracer cannot connect a delta
+// vertex to the camera, so what is seen in them (E S+ ... paths) is the path tracer's alone.
+std::vector<bool> SpecularBlocks(const EmbreeScene& es, const Camera& camera) {
+    const int bw = camera.width() / kBlock, bh = camera.height() / kBlock;
+    std::vector<bool> specular(size_t(bw * bh), false);
+    constexpr int kGrid = 4;
+    for (int y = 0; y < bh * kBlock; ++y) {
+        for (int x = 0; x < bw * kBlock; ++x) {
+            for (int j = 0; j < kGrid * kGrid; ++j) {
+                const Ray ray = camera.GenerateRay(x, y, (j % kGrid + 0.5f) / kGrid,
+                                                   (j / kGrid + 0.5f) / kGrid);
+                const std::optional<SurfaceHit> hit = es.Intersect(ray);
+                if (!hit) continue;
+                const Material::Type type = es.scene().materials[size_t(hit->material)].type;
+                if (type == Material::Type::kMirror || type == Material::Type::kDielectric) {
+                    specular[size_t((y / kBlock) * bw + x / kBlock)] = true;
+                }
+            }
+        }
+    }
+    return specular;
+}
+
+// The two-sided normal quantile for a family-wise error of alpha over n tests (Bonferroni).
+double BonferroniZ(double alpha, int n) {
+    const double p = alpha / n;
+    double lo = 0, hi = 40;
+    for (int i = 0; i < 200; ++i) {
+        const double mid = (lo + hi) / 2;
+        (std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+    }
+    return hi;
+}
+
+// Light tracing and path tracing at the same max_depth agree block by block (8x8 pixels) within
+// their variances: each block's z with a Bonferroni threshold over the blocks, and the mean z
+// (a bias common to all blocks) within its own.
+void ExpectLightMatchesPath(const char* scene_name, int size, int max_depth, uint64_t spp,
+                            int batches, uint64_t paths_per_batch) {
+    const Scene scene = LoadTestScene(scene_name, size);
+    FrameRenderSettings settings;
+    settings.max_depth = max_depth;
+    settings.seed = 3;
+    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", settings);
+    const std::vector<BlockEstimate> light = LightBlocks(s, batches, paths_per_batch);
+    const std::vector<BlockEstimate> path =
+        PathBlocks(testing::RenderPath(scene, spp, max_depth, 5).out.image);
+    const std::vector<bool> specular = SpecularBlocks(*s.embree, *s.camera);
+    int compared = 0;
+    for (bool b : specular) compared += b ? 0 : 1;
+    ASSERT_GT(compared, int(specular.size()) / 2);
+    const double threshold = BonferroniZ(1e-3, compared);
+    double z_sum = 0, worst = 0;
+    for (size_t b = 0; b < light.size(); ++b) {
+        if (specular[b]) continue;
+        const double se = std::sqrt(light[b].variance + path[b].variance);
+        const double z = (light[b].mean - path[b].mean) / se;
+        z_sum += z;
+        worst = std::max(worst, std::abs(z));
+        EXPECT_LT(std::abs(z), threshold)
+            << scene_name << " block " << b << ": light " << light[b].mean << " +- "
+            << std::sqrt(light[b].variance) << ", path " << path[b].mean << " +- "
+            << std::sqrt(path[b].variance);
+        // Noise small enough for the comparison to mean something: 5 % of the block.
+        EXPECT_LT(se, 0.05 * path[b].mean + 1e-3) << scene_name << " block " << b;
+    }
+    const double mean_z = z_sum / std::sqrt(double(compared));
+    std::printf(
+        "[light] %s: %d blocks of %zu compared, largest |z| %.2f (threshold %.2f), "
+        "sum z / sqrt(n) %.2f\n",
+        scene_name, compared, light.size(), worst, threshold, mean_z);
+    EXPECT_LT(std::abs(mean_z), BonferroniZ(1e-3, 1));
+}
+
+TEST(LightTracer, MatchesPathTracerOnCornellBox) {
+    ExpectLightMatchesPath("cornell_box.json", 32, 3, 256, 64, 32 * 32 * 256 / 64);
+}
+
+// The glass sphere's caustic on the floor, the mirror's, the glossy box and plastic sphere; the
+// blocks that see the mirror or the glass are left out (see SpecularBlocks).
+TEST(LightTracer, MatchesPathTracerOnMaterials) {
+    ExpectLightMatchesPath("materials.json", 48, 5, 256, 64, 48 * 48 * 256 / 64);
+}
+
 TEST(FrameRendererFactory, BuildsLightAndRefusesWhatItCannot) {
     EXPECT_TRUE(IsFrameMethod("light"));
     EXPECT_TRUE(IsFrameMethod("bdpt"));
