@@ -6,6 +6,7 @@
 
 #include "lf/core/disk_sampling.h"
 #include "lf/kernels/bsdf_sampling.h"
+#include "lf/kernels/light_list.h"
 #include "lf/kernels/shading.h"
 
 namespace lf {
@@ -13,15 +14,6 @@ namespace lf {
 namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
-
-// Power over the three channels, as LightSampler weighs lights (the average, not luminance).
-float PowerWeight(const Rgb& c) { return c.Average(); }
-
-// 1 - cos(angle), exact also for angles so small that cos rounds to 1.
-double OneMinusCos(double angle) {
-    const double s = std::sin(angle / 2);
-    return 2 * s * s;
-}
 
 // A direction at 1 - cos(theta) = omc from `axis`, azimuth 2 pi u.
 Vec3 ConeDirection(const Vec3& axis, float omc, float u) {
@@ -39,51 +31,36 @@ float OneMinusCosBetween(const Vec3& a, const Vec3& b) { return 0.5f * LengthSqu
 EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
     const Scene& scene = es.scene();
     std::vector<double> weights;
-    triangle_light_.resize(scene.meshes.size());
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-        const TriangleMesh& mesh = scene.meshes[m];
-        triangle_light_[m].assign(mesh.triangles.size(), -1);
-        const Material& mat = scene.materials[size_t(mesh.material)];
-        if (!mat.IsEmissive()) continue;
-        const bool two_sided = EmitsFromBack(mat);
-        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-            Vec3 p0, p1, p2;
-            es.Triangle(int(m), int(t), &p0, &p1, &p2);
-            const float area = 0.5f * Length(Cross(p1 - p0, p2 - p0));
-            if (!(area > 0)) continue;
-            triangle_light_[m][t] = int(lights_.size());
-            lights_.push_back({Kind::kTriangle, int(m), int(t), area, two_sided});
-            weights.push_back(double(kPi) * area * PowerWeight(mat.emission) * (two_sided ? 2 : 1));
-        }
-    }
+    triangle_light_ = NoTriangleLights(scene);
+    ForEachEmissiveTriangle(es, [&](const EmissiveTriangle& tri) {
+        triangle_light_[size_t(tri.mesh)][size_t(tri.primitive)] = int(lights_.size());
+        lights_.push_back({Kind::kTriangle, tri.mesh, tri.primitive, tri.area, tri.two_sided});
+        weights.push_back(AreaLightWeight(tri.area, tri.material->emission, tri.two_sided));
+        return 1;
+    });
     sphere_light_.assign(scene.spheres.size(), -1);
     for (size_t s = 0; s < scene.spheres.size(); ++s) {
-        const Material& mat = scene.materials[size_t(scene.spheres[s].material)];
-        if (!mat.IsEmissive()) continue;
-        const double r = scene.spheres[s].radius;
-        const float area = float(4 * std::numbers::pi * r * r);
-        const bool two_sided = EmitsFromBack(mat);
+        const std::optional<SphereEmitter> sphere = EmissiveSphere(scene, s);
+        if (!sphere) continue;
         sphere_light_[s] = int(lights_.size());
-        lights_.push_back({Kind::kSphere, int(s), 0, area, two_sided});
-        weights.push_back(double(kPi) * area * PowerWeight(mat.emission) * (two_sided ? 2 : 1));
+        lights_.push_back({Kind::kSphere, int(s), 0, sphere->area, sphere->two_sided});
+        weights.push_back(AreaLightWeight(
+            sphere->area, scene.materials[size_t(scene.spheres[s].material)].emission,
+            sphere->two_sided));
     }
     for (size_t i = 0; i < scene.point_lights.size(); ++i) {
         lights_.push_back({Kind::kPoint, int(i), 0, 0, false});
-        weights.push_back(4 * std::numbers::pi * PowerWeight(scene.point_lights[i].intensity));
+        weights.push_back(4 * std::numbers::pi * LightPowerWeight(scene.point_lights[i].intensity));
     }
     for (size_t i = 0; i < scene.spot_lights.size(); ++i) {
         const SpotLight& spot = scene.spot_lights[i];
-        // The cone sizes as LightSampler clamps them (lights.cc, Band), so both see one falloff.
-        const double outer = std::max(OneMinusCos(spot.outer_cone), 1e-12);
-        const double width = std::max(outer - OneMinusCos(spot.inner_cone), 1e-6 * outer);
-        const bool smooth = spot.falloff == SpotLight::Falloff::kSmoothstep;
+        // The cone sizes as LightSampler clamps them, so both see one falloff.
+        const SpotBand band = SpotBandOf(spot);
         spots_.push_back({Vec3(spot.position - es.origin()), Vec3(Normalize(spot.direction)),
-                          float(outer), float(1 / width), smooth, spot.intensity});
+                          float(band.outer), float(1 / band.width),
+                          spot.falloff == SpotLight::Falloff::kSmoothstep, spot.intensity});
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
-        // The falloff's solid angle: 2 pi (outer - width + width * mean falloff over the band).
-        const double solid_angle =
-            2 * std::numbers::pi * (outer - width + width * (smooth ? 0.5 : 1.0 / 3));
-        weights.push_back(solid_angle * PowerWeight(spot.intensity));
+        weights.push_back(SpotFalloffSolidAngle(spot) * LightPowerWeight(spot.intensity));
     }
     const auto [lo, hi] = scene.Bounds();
     const float radius = float(Length(hi - lo) / 2);
@@ -93,40 +70,24 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
     for (size_t i = 0; i < scene.directional_lights.size(); ++i) {
         const DirectionalLight& dl = scene.directional_lights[i];
         // The same sun disk, and the same fallback to a delta light, as LightSampler's.
-        const double alpha = dl.angular_diameter / 2;
-        const double sin_alpha = std::sin(alpha);
-        const SunDisk sun{-Vec3(Normalize(dl.direction)), float(OneMinusCos(alpha)),
-                          dl.irradiance * float(1 / (std::numbers::pi * sin_alpha * sin_alpha))};
-        if (alpha > 0 && sun.one_minus_cos > 0 && std::isfinite(sun.radiance.MaxComponent()) &&
-            std::isfinite(1 / (2 * kPi * sun.one_minus_cos))) {
+        if (const std::optional<SunDisk> sun = SunDiskOf(dl)) {
             lights_.push_back({Kind::kSun, int(suns_.size()), 0, 0, false});
-            suns_.push_back(sun);
+            suns_.push_back(*sun);
             // The flux through the disk: pi R^2 times the radiance integrated over the cone.
-            weights.push_back(cross_section * 2 * std::numbers::pi * sun.one_minus_cos *
-                              PowerWeight(sun.radiance));
+            weights.push_back(cross_section * 2 * std::numbers::pi * sun->one_minus_cos *
+                              LightPowerWeight(sun->radiance));
         } else {
             lights_.push_back({Kind::kDirectional, int(i), 0, 0, false});
-            weights.push_back(cross_section * PowerWeight(dl.irradiance));
+            weights.push_back(cross_section * LightPowerWeight(dl.irradiance));
         }
     }
     if (scene.environment) {
         environment_.emplace(*scene.environment);
         lights_.push_back({Kind::kEnvironment, 0, 0, 0, false});
         weights.push_back(cross_section * 4 * std::numbers::pi *
-                          PowerWeight(environment_->MeanRadiance()));
+                          LightPowerWeight(environment_->MeanRadiance()));
     }
-    double total = 0;
-    for (double w : weights) total += w;
-    pmf_.resize(weights.size());
-    cdf_.resize(weights.size());
-    double acc = 0;
-    for (size_t i = 0; i < weights.size(); ++i) {
-        const double p = total > 0 ? weights[i] / total : 1.0 / double(weights.size());
-        acc += p;
-        pmf_[i] = float(p);
-        cdf_[i] = float(acc);
-    }
-    if (!cdf_.empty()) cdf_.back() = 1.0f;
+    picks_ = LightPickTable::FromWeights(weights);
 }
 
 SurfacePoint EmissionSampler::AreaPoint(const Light& light, const Vec2& u) const {
@@ -152,11 +113,10 @@ Rgb EmissionSampler::AreaEmission(const Light& light, const SurfacePoint& point)
 std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& u_pos,
                                                       const Vec2& u_dir) const {
     if (lights_.empty()) return std::nullopt;
-    const int index = int(std::upper_bound(cdf_.begin(), cdf_.end(), u_pick) - cdf_.begin());
-    const int li = std::min(index, int(lights_.size()) - 1);
+    const int li = picks_.Pick(u_pick);
     EmissionSample es;
     es.light = li;
-    es.pick = pmf_[size_t(li)];
+    es.pick = picks_.pmf[size_t(li)];
     if (!(es.pick > 0)) return std::nullopt;
     const Light& light = lights_[size_t(li)];
     const Scene& scene = scene_.scene();
@@ -212,7 +172,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
             es.pdf_dir = 1 / (2 * kPi * cone.one_minus_cos_outer);
             const float t =
                 std::clamp((cone.one_minus_cos_outer - omc) * cone.inv_width, 0.0f, 1.0f);
-            es.le = cone.intensity * (cone.smooth ? t * t * (3 - 2 * t) : t * t);
+            es.le = cone.intensity * SpotBandFalloff(t, cone.smooth);
             break;
         }
         case Kind::kDirectional:
@@ -267,9 +227,7 @@ float EmissionSampler::InfiniteDirPdf(const Light& light, const Vec3& w) const {
         }
         case Kind::kSun: {
             const SunDisk& sun = suns_[size_t(light.index)];
-            return OneMinusCosBetween(wi, sun.axis) <= sun.one_minus_cos
-                       ? 1 / (2 * kPi * sun.one_minus_cos)
-                       : 0.0f;
+            return sun.Contains(wi) ? 1 / (2 * kPi * sun.one_minus_cos) : 0.0f;
         }
         case Kind::kEnvironment:
             return environment_->Pdf(wi);
@@ -305,7 +263,7 @@ EmissionPdf EmissionSampler::EscapedPdfLe(const Vec3& w) const {
     for (size_t i = 0; i < lights_.size(); ++i) {
         const Kind kind = lights_[i].kind;
         if (kind == Kind::kSun || kind == Kind::kEnvironment) {
-            pdf.dir += pmf_[i] * InfiniteDirPdf(lights_[i], -w);
+            pdf.dir += picks_.pmf[i] * InfiniteDirPdf(lights_[i], -w);
         }
     }
     return pdf;

@@ -45,26 +45,25 @@ FrameRenderSettings Unlimited() {
     return settings;
 }
 
+// The furnace sphere's image mean is 1 within 4.5 standard errors, which are small enough for
+// that to mean something.
+void ExpectFurnaceIsOne(const Scene& scene, const char* what) {
+    const testing::MeanAndError m = BatchedFrameMean(scene, Unlimited(), 32, 1 << 15);
+    std::printf("[light] %s: %.5f +- %.5f (expected 1)\n", what, m.mean, m.standard_error);
+    EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, 4.5 * m.standard_error) << what;
+    EXPECT_LT(m.standard_error, 0.01) << what << ": too few paths for the test to mean anything";
+}
+
 // pbrt-v4's test: inside a sphere of albedo 0.5 lit by a point light of intensity pi at its
 // centre the radiance is 1 everywhere.
 TEST(LightTracer, PointLitFurnaceSphereIsOne) {
-    const Scene scene = testing::PointLitFurnaceSphere(16);
-    const testing::MeanAndError m = BatchedFrameMean(scene, Unlimited(), 32, 1 << 15);
-    std::printf("[light] point-lit furnace sphere: %.5f +- %.5f (expected 1)\n", m.mean,
-                m.standard_error);
-    EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, 4.5 * m.standard_error);
-    EXPECT_LT(m.standard_error, 0.01) << "too few paths for the test to mean anything";
+    ExpectFurnaceIsOne(testing::PointLitFurnaceSphere(16), "point-lit furnace sphere");
 }
 
 // The same sphere emitting Le = 0.5 instead: L = 1, the emitter seen directly (the light
 // vertex connected to the camera) plus every bounce.
 TEST(LightTracer, EmissiveFurnaceSphereIsOne) {
-    const Scene scene = testing::EmissiveFurnaceSphere(16);
-    const testing::MeanAndError m = BatchedFrameMean(scene, Unlimited(), 32, 1 << 15);
-    std::printf("[light] emissive furnace sphere: %.5f +- %.5f (expected 1)\n", m.mean,
-                m.standard_error);
-    EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, 4.5 * m.standard_error);
-    EXPECT_LT(m.standard_error, 0.01);
+    ExpectFurnaceIsOne(testing::EmissiveFurnaceSphere(16), "emissive furnace sphere");
 }
 
 // max_depth 0 leaves the emitter seen directly: Le = 0.5, with no noise at all but the

@@ -30,6 +30,7 @@
 #include "lf/core/rgb.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/environment_emitter.h"
+#include "lf/kernels/light_list.h"
 
 namespace lf {
 
@@ -62,7 +63,7 @@ class EmissionSampler {
     bool empty() const { return lights_.empty(); }
     size_t size() const { return lights_.size(); }
     // Probability with which Sample picks `light`.
-    float Pmf(int light) const { return pmf_[size_t(light)]; }
+    float Pmf(int light) const { return picks_.pmf[size_t(light)]; }
     // Radius of the sphere about the render-space origin that holds the scene: the disk the
     // lights at infinity emit from has this radius.
     float scene_radius() const { return scene_radius_; }
@@ -97,18 +98,13 @@ class EmissionSampler {
         float area;     // area lights
         bool two_sided;
     };
-    // As in LightSampler: with c = 1 - cos(angle to the axis), the falloff is t^2 or
-    // t^2 (3 - 2 t) for t = clamp((one_minus_cos_outer - c) * inv_width, 0, 1).
+    // A spot light's cone (SpotBandOf, as LightSampler's): with c = 1 - cos(angle to the axis),
+    // the falloff is SpotBandFalloff(clamp((one_minus_cos_outer - c) * inv_width, 0, 1)).
     struct SpotCone {
         Vec3 position, direction;
         float one_minus_cos_outer, inv_width;
         bool smooth;
         Rgb intensity;
-    };
-    struct SunDisk {
-        Vec3 axis;  // towards the sun
-        float one_minus_cos;
-        Rgb radiance;
     };
 
     // An area light's point for u, with its normal and Le there (Le before the side test).
@@ -119,7 +115,7 @@ class EmissionSampler {
 
     const EmbreeScene& scene_;
     std::vector<Light> lights_;
-    std::vector<float> pmf_, cdf_;
+    LightPickTable picks_;
     std::vector<std::vector<int>> triangle_light_;  // per mesh, per triangle: light or -1
     std::vector<int> sphere_light_;                 // per sphere: light or -1
     std::vector<SpotCone> spots_;                   // per spot light
