@@ -9,6 +9,7 @@
 #include <string>
 
 #include "lf/kernels/light_bounds.h"
+#include "lf/kernels/light_list.h"
 #include "lf/kernels/shading.h"
 #include "lf/kernels/sphere_cone_sampling.h"
 #include "lf/kernels/spherical_triangle.h"
@@ -17,39 +18,6 @@ namespace lf {
 
 namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
-
-// Power over the three channels; the average, not luminance, so a pure blue light counts.
-float PowerWeight(const Rgb& c) { return c.Average(); }
-
-// 1 - cos(angle), exact also for angles so small that cos rounds to 1.
-double OneMinusCos(double angle) {
-    const double s = std::sin(angle / 2);
-    return 2 * s * s;
-}
-
-// A spot light's cone sizes as 1 - cos: the outer cone's, at least 1e-12 so that a cone of
-// under a microradian still has a float extent, and the falloff band's width from there
-// towards the axis, at least a millionth of the cone so that its slope stays finite when the
-// cones (nearly) coincide.
-struct SpotBand {
-    double outer, width;
-};
-SpotBand Band(const SpotLight& spot) {
-    const double outer = std::max(OneMinusCos(spot.outer_cone), 1e-12);
-    return {outer, std::max(outer - OneMinusCos(spot.inner_cone), 1e-6 * outer)};
-}
-
-// The falloff as a function of t = (cos - cos outer) / width in [0, 1].
-float Falloff(float t, bool smooth) { return smooth ? t * t * (3 - 2 * t) : t * t; }
-
-// The solid angle a spot light's falloff integrates to: 2 pi times the integral of the falloff
-// over cos in [-1, 1], which is 1 inside the band (1 - cos below outer - width) and the mean of
-// t^2 (1/3) or of the smoothstep (1/2) over the band: positive for any cones.
-double SpotSolidAngle(const SpotLight& spot) {
-    const SpotBand band = Band(spot);
-    const double mean = spot.falloff == SpotLight::Falloff::kSmoothstep ? 0.5 : 1.0 / 3;
-    return 2 * std::numbers::pi * (band.outer - band.width + band.width * mean);
-}
 
 // Triangles and rectangles subtending less than this many steradians are sampled by area.
 // Solid-angle sampling costs a full path in a Cornell box (64 x 64, Sobol, light_sampling_bench)
@@ -164,88 +132,74 @@ std::optional<LightSampler::Rectangle> LightSampler::FormRectangle(const EmbreeS
     return r;
 }
 
-bool LightSampler::SunDisk::Contains(const Vec3& w) const {
-    // |w - axis|^2 = 2 (1 - cos): exact for small angles, where cos itself rounds to 1.
-    return LengthSquared(w - axis) <= 2 * one_minus_cos;
-}
-
 LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
     : scene_(es), strategy_(strategy) {
     const Scene& scene = es.scene();
     std::vector<double> weights;
     // The finite lights' bounds for the BVH, by light index, in the units of `weights`.
     std::vector<LightBounds> bounds;
-    triangle_light_.resize(scene.meshes.size());
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-        const TriangleMesh& mesh = scene.meshes[m];
-        triangle_light_[m].assign(mesh.triangles.size(), -1);
-        const Material& mat = scene.materials[size_t(mesh.material)];
-        if (!mat.IsEmissive()) continue;
-        const bool two_sided = EmitsFromBack(mat);
-        const float radiance = PowerWeight(mat.emission);
-        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-            Vec3 p0, p1, p2;
-            es.Triangle(int(m), int(t), &p0, &p1, &p2);
-            const float area = 0.5f * Length(Cross(p1 - p0, p2 - p0));
-            if (!(area > 0)) continue;
-            triangle_light_[m][t] = int(lights_.size());
-            std::optional<Rectangle> rectangle;
-            if (t + 1 < mesh.triangles.size()) rectangle = FormRectangle(es, int(m), int(t));
-            LightBounds b = TriangleLightBounds(p0, p1, p2, radiance, two_sided);
-            if (rectangle) {
-                Vec3 q0, q1, q2;
-                es.Triangle(int(m), int(t + 1), &q0, &q1, &q2);
-                b = Union(b, TriangleLightBounds(q0, q1, q2, radiance, two_sided));
-                const float rectangle_area =
-                    Length(Cross(rectangle->frame.ex, rectangle->frame.ey));
-                lights_.push_back(
-                    {Kind::kRectangle, int(m), int(rectangles_.size()), rectangle_area, two_sided});
-                rectangles_.push_back(*rectangle);
-                triangle_light_[m][t + 1] = triangle_light_[m][t];
-                ++t;
-            } else {
-                lights_.push_back({Kind::kTriangle, int(m), int(t), area, two_sided});
-            }
-            weights.push_back(double(kPi) * lights_.back().area * radiance * (two_sided ? 2 : 1));
-            bounds.push_back(b);
+    triangle_light_ = NoTriangleLights(scene);
+    ForEachEmissiveTriangle(es, [&](const EmissiveTriangle& tri) {
+        const int m = tri.mesh, t = tri.primitive;
+        const bool two_sided = tri.two_sided;
+        const float radiance = LightPowerWeight(tri.material->emission);
+        triangle_light_[size_t(m)][size_t(t)] = int(lights_.size());
+        std::optional<Rectangle> rectangle;
+        if (size_t(t) + 1 < triangle_light_[size_t(m)].size()) {
+            rectangle = FormRectangle(es, m, t);
         }
-    }
+        LightBounds b = TriangleLightBounds(tri.p[0], tri.p[1], tri.p[2], radiance, two_sided);
+        if (rectangle) {
+            Vec3 q0, q1, q2;
+            es.Triangle(m, t + 1, &q0, &q1, &q2);
+            b = Union(b, TriangleLightBounds(q0, q1, q2, radiance, two_sided));
+            const float rectangle_area = Length(Cross(rectangle->frame.ex, rectangle->frame.ey));
+            lights_.push_back(
+                {Kind::kRectangle, m, int(rectangles_.size()), rectangle_area, two_sided});
+            rectangles_.push_back(*rectangle);
+            triangle_light_[size_t(m)][size_t(t) + 1] = triangle_light_[size_t(m)][size_t(t)];
+        } else {
+            lights_.push_back({Kind::kTriangle, m, t, tri.area, two_sided});
+        }
+        weights.push_back(AreaLightWeight(lights_.back().area, tri.material->emission, two_sided));
+        bounds.push_back(b);
+        return rectangle ? 2 : 1;
+    });
     sphere_light_.assign(scene.spheres.size(), -1);
     for (size_t s = 0; s < scene.spheres.size(); ++s) {
-        const Material& mat = scene.materials[size_t(scene.spheres[s].material)];
-        if (!mat.IsEmissive()) continue;
-        const double r = scene.spheres[s].radius;
-        const float area = float(4 * std::numbers::pi * r * r);
-        const bool two_sided = EmitsFromBack(mat);
+        const std::optional<SphereEmitter> sphere = EmissiveSphere(scene, s);
+        if (!sphere) continue;
+        const Rgb& emission = scene.materials[size_t(scene.spheres[s].material)].emission;
         sphere_light_[s] = int(lights_.size());
-        lights_.push_back({Kind::kSphere, int(s), 0, area, two_sided});
-        weights.push_back(double(kPi) * area * PowerWeight(mat.emission) * (two_sided ? 2 : 1));
+        lights_.push_back({Kind::kSphere, int(s), 0, sphere->area, sphere->two_sided});
+        weights.push_back(AreaLightWeight(sphere->area, emission, sphere->two_sided));
         // Seen from inside, a two-sided sphere's normals still cover every direction.
-        bounds.push_back(SphereLightBounds(es.SphereCenter(int(s)), float(r),
-                                           PowerWeight(mat.emission) * (two_sided ? 2 : 1)));
+        bounds.push_back(
+            SphereLightBounds(es.SphereCenter(int(s)), float(scene.spheres[s].radius),
+                              LightPowerWeight(emission) * (sphere->two_sided ? 2 : 1)));
     }
     for (size_t i = 0; i < scene.point_lights.size(); ++i) {
         const PointLight& point = scene.point_lights[i];
         lights_.push_back({Kind::kPoint, int(i), 0, 0, false});
-        weights.push_back(4 * std::numbers::pi * PowerWeight(point.intensity));
-        bounds.push_back(
-            PointLightBounds(Vec3(point.position - es.origin()), PowerWeight(point.intensity)));
+        weights.push_back(4 * std::numbers::pi * LightPowerWeight(point.intensity));
+        bounds.push_back(PointLightBounds(Vec3(point.position - es.origin()),
+                                          LightPowerWeight(point.intensity)));
     }
     for (size_t i = 0; i < scene.spot_lights.size(); ++i) {
         const SpotLight& spot = scene.spot_lights[i];
-        const SpotBand band = Band(spot);
+        const SpotBand band = SpotBandOf(spot);
         spot_cones_.push_back({Vec3(Normalize(spot.direction)), float(band.outer),
                                float(1 / band.width),
                                spot.falloff == SpotLight::Falloff::kSmoothstep});
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
-        weights.push_back(SpotSolidAngle(spot) * PowerWeight(spot.intensity));
+        weights.push_back(SpotFalloffSolidAngle(spot) * LightPowerWeight(spot.intensity));
         // The outer cosine rounded down (a wider cone) so that even a cone whose cosine rounds
         // to 1 in float keeps a positive pick probability wherever it shines.
         const float cos_outer = std::nextafter(float(1 - band.outer), -1.0f);
         const float cos_inner = std::max(float(1 - (band.outer - band.width)), cos_outer);
         bounds.push_back(SpotLightBounds(Vec3(spot.position - es.origin()),
-                                         spot_cones_.back().direction, PowerWeight(spot.intensity),
-                                         cos_inner, cos_outer));
+                                         spot_cones_.back().direction,
+                                         LightPowerWeight(spot.intensity), cos_inner, cos_outer));
     }
     finite_count_ = lights_.size();
     const auto [lo, hi] = scene.Bounds();
@@ -255,21 +209,14 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
     std::vector<size_t> sun_lights;
     for (size_t i = 0; i < scene.directional_lights.size(); ++i) {
         const DirectionalLight& dl = scene.directional_lights[i];
-        // E = L pi sin^2(alpha) for a disk of half-angle alpha facing the surface.
-        const double alpha = dl.angular_diameter / 2;
-        const double sin_alpha = std::sin(alpha), sin_half = std::sin(alpha / 2);
-        const SunDisk sun{-Vec3(Normalize(dl.direction)), float(2 * sin_half * sin_half),
-                          dl.irradiance * float(1 / (std::numbers::pi * sin_alpha * sin_alpha))};
-        // A disk so small that its radiance or density overflows float is the delta light.
-        if (alpha > 0 && sun.one_minus_cos > 0 && std::isfinite(sun.radiance.MaxComponent()) &&
-            std::isfinite(1 / (2 * kPi * sun.one_minus_cos))) {
+        if (const std::optional<SunDisk> sun = SunDiskOf(dl)) {
             sun_lights.push_back(lights_.size());
             lights_.push_back({Kind::kSun, int(suns_.size()), 0, 0, false});
-            suns_.push_back(sun);
+            suns_.push_back(*sun);
         } else {
             lights_.push_back({Kind::kDirectional, int(i), 0, 0, false});
         }
-        weights.push_back(cross_section * PowerWeight(dl.irradiance));
+        weights.push_back(cross_section * LightPowerWeight(dl.irradiance));
     }
     size_t environment_light = 0;
     if (scene.environment) {
@@ -278,20 +225,11 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
         lights_.push_back({Kind::kEnvironment, 0, 0, 0, false});
         // Radiance L from every direction puts pi L on each point of a surface facing it.
         weights.push_back(cross_section * std::numbers::pi *
-                          PowerWeight(environment_->MeanRadiance()));
+                          LightPowerWeight(environment_->MeanRadiance()));
     }
-    double total = 0;
-    for (double w : weights) total += w;
-    cdf_.resize(weights.size());
-    pmf_.resize(weights.size());
-    double acc = 0;
-    for (size_t i = 0; i < weights.size(); ++i) {
-        const double p = total > 0 ? weights[i] / total : 1.0 / double(weights.size());
-        acc += p;
-        pmf_[i] = float(p);
-        cdf_[i] = float(acc);
-    }
-    if (!cdf_.empty()) cdf_.back() = 1.0f;
+    LightPickTable picks = LightPickTable::FromWeights(weights);
+    pmf_ = std::move(picks.pmf);
+    cdf_ = std::move(picks.cdf);
     // Sample sends u_pick below cdf_[finite_count_ - 1] to the BVH: exactly that probability.
     if (finite_count_ > 0) finite_pmf_ = cdf_[finite_count_ - 1];
     if (strategy_ == LightStrategy::kBvh) {
@@ -524,8 +462,8 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
     const float t =
         std::clamp((cone.one_minus_cos_outer - one_minus_cos) * cone.inv_width, 0.0f, 1.0f);
     if (t == 0) return std::nullopt;  // outside the outer cone: no shadow ray needed
-    ls.radiance =
-        scene.spot_lights[size_t(light.index)].intensity * (Falloff(t, cone.smooth) / dist2);
+    ls.radiance = scene.spot_lights[size_t(light.index)].intensity *
+                  (SpotBandFalloff(t, cone.smooth) / dist2);
     return ls;
 }
 

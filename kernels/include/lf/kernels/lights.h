@@ -29,6 +29,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/environment_emitter.h"
 #include "lf/kernels/light_bvh.h"
+#include "lf/kernels/light_list.h"
 #include "lf/kernels/spherical_rectangle.h"
 
 namespace lf {
@@ -113,16 +114,6 @@ class LightSampler {
         float one_minus_cos_outer, inv_width;
         bool smooth;
     };
-    // A sun disk: directions within angle alpha of `axis` (towards the sun) carry `radiance`.
-    // 1 - cos(alpha) is kept apart: for the sun (alpha = 0.0046) cos(alpha) in float is 1 to
-    // within 0.5 % of that difference.
-    struct SunDisk {
-        Vec3 axis;
-        float one_minus_cos;
-        Rgb radiance;
-        bool Contains(const Vec3& w) const;
-    };
-
     // The rectangle triangles t and t + 1 of mesh m form, if they do.
     static std::optional<Rectangle> FormRectangle(const EmbreeScene& es, int m, int t);
     int LightIndex(const SurfaceHit& hit) const;
