@@ -25,6 +25,12 @@ int MediumAfter(int medium, int index, const Material& material, float cos_i_ng,
     return cos_i_ng < 0 ? index : -1;
 }
 
+float PowerHeuristic(float pdf_a, float pdf_b) {
+    const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
+    if (std::isinf(a)) return 1;
+    return a + b > 0 ? a / (a + b) : 0;
+}
+
 // Photons traced per parallel chunk: enough to amortise the task, few enough to balance.
 constexpr uint64_t kPhotonChunk = 4096;
 
@@ -116,8 +122,8 @@ float PpmRenderer::Radius(uint64_t pass) const {
     return float(initial_radius_ * std::sqrt(PpmRadiusRatioSquared(settings_.alpha, pass)));
 }
 
-void PpmRenderer::TraceRange(uint64_t pass, uint64_t begin, uint64_t end,
-                             std::vector<Photon>& out, RenderStats& stats) const {
+void PpmRenderer::TraceRange(uint64_t pass, uint64_t begin, uint64_t end, std::vector<Photon>& out,
+                             RenderStats& stats) const {
     const std::vector<Material>& materials = scene_.scene().materials;
     const int max_depth = settings_.max_depth;
     const uint64_t photon_seed = MixBits(settings_.seed ^ kPhotonSeedSalt);
@@ -166,8 +172,8 @@ void PpmRenderer::TraceRange(uint64_t pass, uint64_t begin, uint64_t end,
             if (!(cos_o_ng > 0)) break;
             beta *= bs->f * (std::abs(wo.z) * cos_i_ng / (cos_o_ng * bs->pdf) * bs->eta * bs->eta);
             if (beta.IsBlack() || !beta.IsFinite()) break;
-            medium = MediumAfter(medium, hit->material, material, Dot(wi, hit->n),
-                                 bs->wi.z * wo.z < 0);
+            medium =
+                MediumAfter(medium, hit->material, material, Dot(wi, hit->n), bs->wi.z * wo.z < 0);
             ray = SpawnRay(sh.Leaving(wi), wi);
             if (depth >= kRouletteStartDepth) {
                 const float q = std::max(0.0f, 1 - beta.MaxComponent() / emitted_max);
@@ -184,15 +190,14 @@ PhotonMap PpmRenderer::TracePhotons(uint64_t pass, RenderStats& stats,
     const size_t chunks = size_t((n + kPhotonChunk - 1) / kPhotonChunk);
     std::vector<std::vector<Photon>> parts(chunks);
     std::vector<RenderStats> part_stats(chunks);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks, 1),
-                      [&](const tbb::blocked_range<size_t>& range) {
-                          for (size_t c = range.begin(); c != range.end(); ++c) {
-                              if (cancel && cancel->load(std::memory_order_relaxed)) return;
-                              const uint64_t begin = c * kPhotonChunk;
-                              TraceRange(pass, begin, std::min(n, begin + kPhotonChunk),
-                                         parts[c], part_stats[c]);
-                          }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, chunks, 1), [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t c = range.begin(); c != range.end(); ++c) {
+                if (cancel && cancel->load(std::memory_order_relaxed)) return;
+                const uint64_t begin = c * kPhotonChunk;
+                TraceRange(pass, begin, std::min(n, begin + kPhotonChunk), parts[c], part_stats[c]);
+            }
+        });
     size_t total = 0;
     for (const std::vector<Photon>& part : parts) total += part.size();
     std::vector<Photon> photons;
@@ -248,27 +253,8 @@ Rgb PpmRenderer::Li(const Ray& camera_ray, const PhotonMap& map, Sampler& sample
 
         if (!bsdf.IsDelta()) {
             // Direct light: the photons hold none (they are stored from their second hit on).
-            if (const auto ls = lights_.Sample(hit->p, sh.ns, u_choice.x, u_light)) {
-                const Vec3 wi = frame.ToLocal(ls->wi);
-                const Rgb f = sh.SidesAgree(wo_world, ls->wi, wi.z * wo.z > 0)
-                                  ? bsdf.Eval(wo, wi) * std::abs(wi.z)
-                                  : Rgb();
-                const Rgb radiance =
-                    f.IsBlack() ? Rgb() : EmissionAt(scene_, ls->point, ls->radiance);
-                if (!radiance.IsBlack() && ls->pdf > 0) {
-                    ++stats.rays;
-                    if (!scene_.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) {
-                        Rgb contribution = beta * f * radiance * (1 / ls->pdf);
-                        const int through = MediumAfter(medium, hit->material, material,
-                                                        Dot(ls->wi, ng), wi.z * wo.z < 0);
-                        if (through >= 0) {
-                            contribution *= Transmittance(materials[size_t(through)],
-                                                          Length(ls->point.p - hit->p));
-                        }
-                        L += contribution;
-                    }
-                }
-            }
+            L += beta *
+                 DirectLight(*hit, sh, wo_world, bsdf, medium, u_choice, u_light, u_bsdf, stats);
             // Indirect light: the density estimate, over photons whose path fits in max_depth.
             const int max_photon_depth = max_depth < 0 ? kMaxPathDepth : max_depth - 1 - depth;
             Rgb sum(0);
@@ -298,6 +284,66 @@ Rgb PpmRenderer::Li(const Ray& camera_ray, const PhotonMap& map, Sampler& sample
             beta /= 1 - q;
         }
     }
+    return L;
+}
+
+// One light sample and one BSDF sample combined by the power heuristic, as the path tracer's
+// first bounce: the light sampler alone would miss what it cannot sample (it gives density 0
+// there, e.g. a sphere light seen from a point on that sphere), and glossy lobes are sampled
+// better by the BSDF.
+Rgb PpmRenderer::DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec3& wo_world,
+                             const Bsdf& bsdf, int medium, const Vec2& u_choice,
+                             const Vec2& u_light, const Vec2& u_bsdf, RenderStats& stats) const {
+    const std::vector<Material>& materials = scene_.scene().materials;
+    const Material& material = materials[size_t(hit.material)];
+    const Vec3& ng = hit.n;
+    const Frame frame = Frame::FromNormal(sh.ns);
+    const Vec3 wo = frame.ToLocal(wo_world);
+    // Beer's law when light reaching the vertex from direction w crosses a solid's interior.
+    auto transmittance = [&](const Vec3& w, bool transmitted, float distance) {
+        const int through = MediumAfter(medium, hit.material, material, Dot(w, ng), transmitted);
+        return through >= 0 ? Transmittance(materials[size_t(through)], distance) : Rgb(1.0f);
+    };
+    Rgb L(0);
+    if (const auto ls = lights_.Sample(hit.p, sh.ns, u_choice.x, u_light)) {
+        const Vec3 wi = frame.ToLocal(ls->wi);
+        const Rgb f = sh.SidesAgree(wo_world, ls->wi, wi.z * wo.z > 0)
+                          ? bsdf.Eval(wo, wi) * std::abs(wi.z)
+                          : Rgb();
+        const Rgb radiance = f.IsBlack() ? Rgb() : EmissionAt(scene_, ls->point, ls->radiance);
+        if (!radiance.IsBlack() && ls->pdf > 0) {
+            ++stats.rays;
+            if (!scene_.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) {
+                const float w = ls->delta ? 1.0f : PowerHeuristic(ls->pdf, bsdf.Pdf(wo, wi));
+                L += f * radiance * (w / ls->pdf) *
+                     transmittance(ls->wi, wi.z * wo.z < 0, Length(ls->point.p - hit.p));
+            }
+        }
+    }
+    const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
+    if (!bs || !(bs->pdf > 0)) return L;
+    const Vec3 wi = frame.FromLocal(bs->wi);
+    if (!sh.SidesAgree(wo_world, wi, bs->wi.z * wo.z > 0)) return L;
+    const Rgb weight = bs->f * (std::abs(bs->wi.z) / bs->pdf);
+    if (weight.IsBlack()) return L;
+    const Ray ray = SpawnRay(sh.Leaving(wi), wi);
+    ++stats.rays;
+    const std::optional<SurfaceHit> light_hit = scene_.Intersect(ray);
+    if (!light_hit) {
+        const Rgb le = lights_.EscapedRadiance(wi);
+        if (!le.IsBlack()) {
+            L += weight * le * (bs->delta ? 1.0f : PowerHeuristic(bs->pdf, lights_.EscapedPdf(wi)));
+        }
+        return L;
+    }
+    const Material& light_material = materials[size_t(light_hit->material)];
+    if (!(Dot(wi, light_hit->n) < 0 || EmitsFromBack(light_material))) return L;
+    const Shading light_sh = Shade(scene_, *light_hit, -wi);
+    if (light_sh.emission.IsBlack()) return L;
+    const float w =
+        bs->delta ? 1.0f : PowerHeuristic(bs->pdf, lights_.Pdf(hit.p, sh.ns, *light_hit));
+    L += weight * light_sh.emission * w *
+         transmittance(wi, bs->wi.z * wo.z < 0, light_hit->t * Length(ray.d));
     return L;
 }
 

@@ -21,10 +21,10 @@
 namespace lf {
 
 struct Photon {
-    Vec3 p;        // render space, on a non-delta surface
-    Vec3 wi;       // unit, towards where the photon came from (the BSDF's wi at p)
-    Rgb power;     // flux carried, W; the pass's estimate divides by the photons emitted
-    int depth = 0; // scattering events before arriving at p (>= 1: direct light is not stored)
+    Vec3 p;         // render space, on a non-delta surface
+    Vec3 wi;        // unit, towards where the photon came from (the BSDF's wi at p)
+    Rgb power;      // flux carried, W; the pass's estimate divides by the photons emitted
+    int depth = 0;  // scattering events before arriving at p (>= 1: direct light is not stored)
 };
 
 class PhotonMap {

@@ -16,8 +16,8 @@
 //   the camera vertex instead, as pbrt-v4's SPPM does.
 // - Camera: sample p of pixel (x, y) follows delta bounces (mirrors, dielectrics) to the first
 //   non-delta vertex, or escapes. L = emission seen along the way (and the lights at infinity
-//   on escape) + next-event estimation of direct light there (a LightSampler sample, weight
-//   1 / pdf: no BSDF-sampled ray competes) + the density estimate
+//   on escape) + direct light there (one LightSampler sample and one BSDF sample, combined
+//   by the power heuristic as the path tracer's first bounce) + the density estimate
 //   sum f(wo, wi_photon) Phi_photon / (pi r_p^2 N_emitted) over the photons within r_p. Glossy
 //   surfaces gather too, with the BSDF evaluated.
 // Path lengths match the path tracer's max_depth: a photon that scattered k times before
@@ -43,6 +43,7 @@
 #include "lf/kernels/light_emission.h"
 #include "lf/kernels/lights.h"
 #include "lf/kernels/photon_map.h"
+#include "lf/kernels/shading.h"
 
 namespace lf {
 
@@ -102,6 +103,12 @@ class PpmRenderer : public FrameRenderer {
     // Photons [begin, end) of pass `pass`, appended to `out`.
     void TraceRange(uint64_t pass, uint64_t begin, uint64_t end, std::vector<Photon>& out,
                     RenderStats& stats) const;
+
+    // Direct light at a camera vertex (non-delta BSDF, outgoing direction wo_world, inside
+    // `medium`), by multiple importance sampling of the lights and the BSDF.
+    Rgb DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec3& wo_world,
+                    const Bsdf& bsdf, int medium, const Vec2& u_choice, const Vec2& u_light,
+                    const Vec2& u_bsdf, RenderStats& stats) const;
 
     const EmbreeScene& scene_;
     const Camera& camera_;
