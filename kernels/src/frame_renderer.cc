@@ -5,6 +5,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/kernels/light_tracer.h"
+#include "lf/kernels/ppm.h"
 
 namespace lf {
 
@@ -25,9 +26,17 @@ absl::StatusOr<std::unique_ptr<FrameRenderer>> MakeFrameRenderer(
         }
         return std::make_unique<LightTracer>(scene, camera, settings);
     }
-    // The other frame methods (bdpt, ppm) are added with their renderers.
-    return absl::InvalidArgumentError(
-        absl::StrCat("method ", std::string(method), ": no frame renderer (frame methods: light)"));
+    if (method == "ppm") {
+        // Photons are gathered at camera samples placed by filter importance sampling, as the
+        // path tracer's: every pixel filter works.
+        absl::StatusOr<std::unique_ptr<PpmRenderer>> ppm =
+            PpmRenderer::Create(scene, camera, settings);
+        if (!ppm.ok()) return ppm.status();
+        return std::unique_ptr<FrameRenderer>(std::move(*ppm));
+    }
+    // bdpt is added with its renderer.
+    return absl::InvalidArgumentError(absl::StrCat(
+        "method ", std::string(method), ": no frame renderer (frame methods: light, ppm)"));
 }
 
 }  // namespace lf

@@ -305,6 +305,11 @@ TEST(FrameRendererFactory, BuildsLightAndRefusesWhatItCannot) {
     ASSERT_TRUE(es.ok());
     const Camera camera(scene.camera, (*es)->origin());
     EXPECT_TRUE(MakeFrameRenderer("light", **es, camera, {}).ok());
+    EXPECT_TRUE(MakeFrameRenderer("ppm", **es, camera, {}).ok());
+    FrameRenderSettings bad_alpha;
+    bad_alpha.alpha = 1;
+    EXPECT_EQ(MakeFrameRenderer("ppm", **es, camera, bad_alpha).status().code(),
+              absl::StatusCode::kInvalidArgument);
     const auto path = MakeFrameRenderer("path", **es, camera, {});
     EXPECT_EQ(path.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(path.status().message().find("path"), std::string::npos);
@@ -315,6 +320,8 @@ TEST(FrameRendererFactory, BuildsLightAndRefusesWhatItCannot) {
     EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
     EXPECT_NE(refused.status().message().find("light"), std::string::npos);
     EXPECT_NE(refused.status().message().find("gaussian"), std::string::npos);
+    // Photons are gathered at filter-importance-sampled camera samples: any filter.
+    EXPECT_TRUE(MakeFrameRenderer("ppm", **es, gaussian, {}).ok());
 }
 
 }  // namespace
