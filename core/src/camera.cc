@@ -2,13 +2,14 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "lf/core/disk_sampling.h"
 
 namespace lf {
 
 Camera::Camera(const CameraSpec& spec, const Vec3d& origin)
-    : width_(spec.width), height_(spec.height), filter_(spec.filter) {
+    : width_(spec.width), height_(spec.height), filter_spec_(spec.filter), filter_(spec.filter) {
     const Vec3d f = Normalize(spec.look_at - spec.position);
     const Vec3d r = Normalize(Cross(f, spec.up));
     const Vec3d u = Cross(r, f);
@@ -20,6 +21,8 @@ Camera::Camera(const CameraSpec& spec, const Vec3d& origin)
     aspect_ = float(width_) / float(height_);
     lens_radius_ = float(spec.aperture_radius);
     focus_distance_ = float(spec.focus_distance);
+    film_area_ = 4 * tan_half_fov_ * tan_half_fov_ * aspect_;
+    lens_area_ = lens_radius_ > 0 ? std::numbers::pi_v<float> * lens_radius_ * lens_radius_ : 1;
 }
 
 Ray Camera::GenerateRay(int px, int py, float u, float v, const Vec2& lens) const {
@@ -32,6 +35,63 @@ Ray Camera::GenerateRay(int px, int py, float u, float v, const Vec2& lens) cons
     const Vec2 d = SampleUniformDiskConcentric(lens);
     const Vec3 offset = right_ * (d.x * lens_radius_) + up_ * (d.y * lens_radius_);
     return Ray{position_ + offset, Normalize(focus - offset)};
+}
+
+std::optional<Vec2> Camera::Raster(const Ray& ray, float* cos_theta) const {
+    const float cos = Dot(ray.d, forward_);
+    if (!(cos > 0)) return std::nullopt;
+    // The film point at distance 1 along the view axis that GenerateRay would have aimed at: the
+    // pinhole's own direction, or for a lens the pinhole ray through the point where this ray
+    // crosses the focal plane.
+    Vec3 through = ray.d / cos;
+    if (lens_radius_ > 0) {
+        const Vec3 focus = ray.o + ray.d * (focus_distance_ / cos);
+        through = (focus - position_) / focus_distance_;
+    }
+    const float x = Dot(through, right_) / (tan_half_fov_ * aspect_);
+    const float y = Dot(through, up_) / tan_half_fov_;
+    const Vec2 raster{(x + 1) * 0.5f * width_, (1 - y) * 0.5f * height_};
+    if (!(raster.x >= 0 && raster.x < width_ && raster.y >= 0 && raster.y < height_)) {
+        return std::nullopt;
+    }
+    *cos_theta = cos;
+    return raster;
+}
+
+float Camera::We(const Ray& ray, Vec2* raster) const {
+    float cos = 0;
+    const std::optional<Vec2> r = Raster(ray, &cos);
+    if (!r) return 0;
+    if (raster) *raster = *r;
+    // Uniform over film area at distance 1 (dA = cos^3 dw there) and over the lens; one more
+    // cosine for the lens's projected area.
+    const float cos2 = cos * cos;
+    return 1 / (film_area_ * lens_area_ * cos2 * cos2);
+}
+
+Camera::ImportancePdf Camera::PdfWe(const Ray& ray) const {
+    float cos = 0;
+    if (!Raster(ray, &cos)) return {};
+    return {1 / lens_area_, 1 / (film_area_ * cos * cos * cos)};
+}
+
+std::optional<Camera::ImportanceSample> Camera::SampleWi(const Vec3& ref,
+                                                         const Vec2& u_lens) const {
+    ImportanceSample s;
+    s.lens_point = position_;
+    if (lens_radius_ > 0) {
+        const Vec2 d = SampleUniformDiskConcentric(u_lens);
+        s.lens_point += right_ * (d.x * lens_radius_) + up_ * (d.y * lens_radius_);
+    }
+    const Vec3 to_ref = ref - s.lens_point;
+    s.distance = Length(to_ref);
+    if (!(s.distance > 0)) return std::nullopt;
+    const Ray ray{s.lens_point, to_ref / s.distance};
+    s.we = We(ray, &s.raster);
+    if (!(s.we > 0)) return std::nullopt;
+    s.wi = -ray.d;
+    s.pdf = s.distance * s.distance / (Dot(ray.d, forward_) * lens_area_);
+    return s;
 }
 
 }  // namespace lf

@@ -31,6 +31,12 @@ bool Bsdf::IsDelta() const {
     return type_ == Material::Type::kMirror || type_ == Material::Type::kDielectric;
 }
 
+float Bsdf::RefractionEta(const Vec3& wo, const Vec3& wi) const {
+    if (principled_) return principled_->RefractionEta(wo, wi);
+    if (type_ != Material::Type::kDielectric || !(wo.z * wi.z < 0)) return 1;
+    return wo.z > 0 ? ior_ : 1 / ior_;
+}
+
 Rgb Bsdf::GlossyEval(const Vec3& wo, const Vec3& wi) const {
     // Both directions lie above the surface, so wo + wi is never zero and wo.wm > 0.
     const Vec3 wm = Normalize(wo + wi);

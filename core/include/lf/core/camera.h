@@ -1,6 +1,8 @@
 // Pinhole or thin-lens camera exactly as docs/scene-format.md defines it, with its pixel filter.
 #pragma once
 
+#include <optional>
+
 #include "lf/core/pixel_filter.h"
 #include "lf/core/ray.h"
 #include "lf/core/scene.h"
@@ -25,14 +27,62 @@ class Camera {
     // Whether rays need a lens sample: a pinhole takes none, so its renders keep their bits.
     bool HasLens() const { return lens_radius_ > 0; }
 
+    // Importance: the camera's end of a light path (pbrt-v4's PerspectiveCamera::We, PDF_We,
+    // SampleWi), normalised as pbrt does: We cos integrated over the film's directions and the
+    // lens's area (a pinhole counts as area 1) is 1. A pixel's measurement is width * height *
+    // We over the rays whose film point falls in that pixel (box filter: every film point of a
+    // pixel counts alike, as SampleFilm places camera rays). A light tracer therefore adds each
+    // contribution at its raster position and scales the image by width * height / (light
+    // paths). Other filters: a contribution at raster position r goes to every pixel (x, y)
+    // whose filter support holds it, weighted by the filter normalised to integrate to 1,
+    // f(r - (x + 0.5, y + 0.5)) / integral of f, instead of to the one pixel holding r.
+
+    // The importance of a ray leaving the lens (ray.o on it, ray.d unit), and where its film
+    // point falls in raster coordinates (x from the left, y from the top, in pixels, as
+    // GenerateRay's px + u, py + v) when raster is given. 0 for rays off the film.
+    float We(const Ray& ray, Vec2* raster = nullptr) const;
+
+    // The densities with which GenerateRay's rays (film point uniform over the film, lens point
+    // uniform over the lens) leave the camera: pos per area of lens (1 for a pinhole), dir per
+    // solid angle. Both 0 for rays off the film.
+    struct ImportancePdf {
+        float pos = 0, dir = 0;
+    };
+    ImportancePdf PdfWe(const Ray& ray) const;
+
+    // Connects `ref` (render space) to the camera: a point on the lens for u_lens (the same map
+    // GenerateRay uses, so GenerateRay with that lens sample and the returned raster position
+    // gives the ray through ref), the unit direction from ref to it, the density of that lens
+    // point per solid angle at ref (pinhole: distance^2 / cos, as pbrt's lens area of 1), and
+    // the importance We of the ray from the lens point to ref. nullopt when ref is behind the
+    // camera or off the film.
+    struct ImportanceSample {
+        Vec2 raster;  // x from the left, y from the top, in pixels
+        Vec3 lens_point;
+        Vec3 wi;  // unit, from ref towards lens_point
+        float distance = 0;
+        float pdf = 0;
+        float we = 0;
+    };
+    std::optional<ImportanceSample> SampleWi(const Vec3& ref, const Vec2& u_lens = {}) const;
+
     int width() const { return width_; }
     int height() const { return height_; }
+    // The pixel filter the camera was made with (methods that splat check it).
+    const PixelFilter& filter() const { return filter_spec_; }
 
   private:
+    // Where ray's film point falls (raster coordinates) and the cosine of ray.d with the view
+    // axis; nullopt when behind the camera or off the film.
+    std::optional<Vec2> Raster(const Ray& ray, float* cos_theta) const;
+
     Vec3 position_, forward_, right_, up_;
     float tan_half_fov_ = 0, aspect_ = 1;
     float lens_radius_ = 0, focus_distance_ = 1;
+    float film_area_ = 1;  // of the film at distance 1 from the pinhole
+    float lens_area_ = 1;  // pi r^2, or 1 for a pinhole
     int width_ = 0, height_ = 0;
+    PixelFilter filter_spec_;
     FilterSampler filter_;
 };
 

@@ -40,6 +40,12 @@ class Bsdf {
     // True when every lobe is a Dirac delta: light sampling is useless there.
     bool IsDelta() const;
 
+    // For a pair that crosses a refracting interface (a dielectric, a principled solid), the IOR
+    // on wi's side over the IOR on wo's side, as BsdfSample::eta reports it; else 1. Eval
+    // divides such pairs by its square (radiance); light paths, which carry importance's adjoint,
+    // multiply it back (pbrt-v4's TransportMode::Importance, lf/kernels/light_tracer.h).
+    float RefractionEta(const Vec3& wo, const Vec3& wi) const;
+
   private:
     // The glossy lobe for wo and wi both in the upper hemisphere.
     Rgb GlossyEval(const Vec3& wo, const Vec3& wi) const;

@@ -47,6 +47,10 @@ class PrincipledBsdf {
     Rgb Eval(const Vec3& wo, const Vec3& wi) const;
     float Pdf(const Vec3& wo, const Vec3& wi) const;
     std::optional<BsdfSample> Sample(const Vec3& wo, float uc, const Vec2& u) const;
+    // Bsdf::RefractionEta: RelativeEta(wo) for a pair across a solid's interface, else 1.
+    float RefractionEta(const Vec3& wo, const Vec3& wi) const {
+        return refracts_ && wo.z * wi.z < 0 ? RelativeEta(wo) : 1.0f;
+    }
 
   private:
     // Probabilities of sampling the reflection (conductor and specular layer share GGX visible

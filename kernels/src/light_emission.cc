@@ -1,0 +1,314 @@
+#include "lf/kernels/light_emission.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "lf/core/disk_sampling.h"
+#include "lf/kernels/bsdf_sampling.h"
+#include "lf/kernels/shading.h"
+
+namespace lf {
+
+namespace {
+constexpr float kPi = std::numbers::pi_v<float>;
+constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+
+// Power over the three channels, as LightSampler weighs lights (the average, not luminance).
+float PowerWeight(const Rgb& c) { return c.Average(); }
+
+// 1 - cos(angle), exact also for angles so small that cos rounds to 1.
+double OneMinusCos(double angle) {
+    const double s = std::sin(angle / 2);
+    return 2 * s * s;
+}
+
+// A direction at 1 - cos(theta) = omc from `axis`, azimuth 2 pi u.
+Vec3 ConeDirection(const Vec3& axis, float omc, float u) {
+    const float sin_theta = std::sqrt(std::max(0.0f, omc * (2 - omc)));
+    const float phi = 2 * kPi * u;
+    const Frame frame = Frame::FromNormal(axis);
+    return Normalize(
+        frame.FromLocal(Vec3(sin_theta * std::cos(phi), sin_theta * std::sin(phi), 1 - omc)));
+}
+
+// 1 - cos of the angle between unit vectors a and b, as |a - b|^2 / 2: exact for small angles.
+float OneMinusCosBetween(const Vec3& a, const Vec3& b) { return 0.5f * LengthSquared(a - b); }
+}  // namespace
+
+EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
+    const Scene& scene = es.scene();
+    std::vector<double> weights;
+    triangle_light_.resize(scene.meshes.size());
+    for (size_t m = 0; m < scene.meshes.size(); ++m) {
+        const TriangleMesh& mesh = scene.meshes[m];
+        triangle_light_[m].assign(mesh.triangles.size(), -1);
+        const Material& mat = scene.materials[size_t(mesh.material)];
+        if (!mat.IsEmissive()) continue;
+        const bool two_sided = EmitsFromBack(mat);
+        for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+            Vec3 p0, p1, p2;
+            es.Triangle(int(m), int(t), &p0, &p1, &p2);
+            const float area = 0.5f * Length(Cross(p1 - p0, p2 - p0));
+            if (!(area > 0)) continue;
+            triangle_light_[m][t] = int(lights_.size());
+            lights_.push_back({Kind::kTriangle, int(m), int(t), area, two_sided});
+            weights.push_back(double(kPi) * area * PowerWeight(mat.emission) * (two_sided ? 2 : 1));
+        }
+    }
+    sphere_light_.assign(scene.spheres.size(), -1);
+    for (size_t s = 0; s < scene.spheres.size(); ++s) {
+        const Material& mat = scene.materials[size_t(scene.spheres[s].material)];
+        if (!mat.IsEmissive()) continue;
+        const double r = scene.spheres[s].radius;
+        const float area = float(4 * std::numbers::pi * r * r);
+        const bool two_sided = EmitsFromBack(mat);
+        sphere_light_[s] = int(lights_.size());
+        lights_.push_back({Kind::kSphere, int(s), 0, area, two_sided});
+        weights.push_back(double(kPi) * area * PowerWeight(mat.emission) * (two_sided ? 2 : 1));
+    }
+    for (size_t i = 0; i < scene.point_lights.size(); ++i) {
+        lights_.push_back({Kind::kPoint, int(i), 0, 0, false});
+        weights.push_back(4 * std::numbers::pi * PowerWeight(scene.point_lights[i].intensity));
+    }
+    for (size_t i = 0; i < scene.spot_lights.size(); ++i) {
+        const SpotLight& spot = scene.spot_lights[i];
+        // The cone sizes as LightSampler clamps them (lights.cc, Band), so both see one falloff.
+        const double outer = std::max(OneMinusCos(spot.outer_cone), 1e-12);
+        const double width = std::max(outer - OneMinusCos(spot.inner_cone), 1e-6 * outer);
+        const bool smooth = spot.falloff == SpotLight::Falloff::kSmoothstep;
+        spots_.push_back({Vec3(spot.position - es.origin()), Vec3(Normalize(spot.direction)),
+                          float(outer), float(1 / width), smooth, spot.intensity});
+        lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
+        // The falloff's solid angle: 2 pi (outer - width + width * mean falloff over the band).
+        const double solid_angle =
+            2 * std::numbers::pi * (outer - width + width * (smooth ? 0.5 : 1.0 / 3));
+        weights.push_back(solid_angle * PowerWeight(spot.intensity));
+    }
+    const auto [lo, hi] = scene.Bounds();
+    const float radius = float(Length(hi - lo) / 2);
+    // A scene without geometry still gets a disk for its lights at infinity.
+    scene_radius_ = radius > 0 && std::isfinite(radius) ? radius : 1.0f;
+    const double cross_section = std::numbers::pi * double(scene_radius_) * scene_radius_;
+    for (size_t i = 0; i < scene.directional_lights.size(); ++i) {
+        const DirectionalLight& dl = scene.directional_lights[i];
+        // The same sun disk, and the same fallback to a delta light, as LightSampler's.
+        const double alpha = dl.angular_diameter / 2;
+        const double sin_alpha = std::sin(alpha);
+        const SunDisk sun{-Vec3(Normalize(dl.direction)), float(OneMinusCos(alpha)),
+                          dl.irradiance * float(1 / (std::numbers::pi * sin_alpha * sin_alpha))};
+        if (alpha > 0 && sun.one_minus_cos > 0 && std::isfinite(sun.radiance.MaxComponent()) &&
+            std::isfinite(1 / (2 * kPi * sun.one_minus_cos))) {
+            lights_.push_back({Kind::kSun, int(suns_.size()), 0, 0, false});
+            suns_.push_back(sun);
+            // The flux through the disk: pi R^2 times the radiance integrated over the cone.
+            weights.push_back(cross_section * 2 * std::numbers::pi * sun.one_minus_cos *
+                              PowerWeight(sun.radiance));
+        } else {
+            lights_.push_back({Kind::kDirectional, int(i), 0, 0, false});
+            weights.push_back(cross_section * PowerWeight(dl.irradiance));
+        }
+    }
+    if (scene.environment) {
+        environment_.emplace(*scene.environment);
+        lights_.push_back({Kind::kEnvironment, 0, 0, 0, false});
+        weights.push_back(cross_section * 4 * std::numbers::pi *
+                          PowerWeight(environment_->MeanRadiance()));
+    }
+    double total = 0;
+    for (double w : weights) total += w;
+    pmf_.resize(weights.size());
+    cdf_.resize(weights.size());
+    double acc = 0;
+    for (size_t i = 0; i < weights.size(); ++i) {
+        const double p = total > 0 ? weights[i] / total : 1.0 / double(weights.size());
+        acc += p;
+        pmf_[i] = float(p);
+        cdf_[i] = float(acc);
+    }
+    if (!cdf_.empty()) cdf_.back() = 1.0f;
+}
+
+SurfacePoint EmissionSampler::AreaPoint(const Light& light, const Vec2& u) const {
+    if (light.kind == Kind::kTriangle) {
+        // Uniform on the triangle (Osada et al.'s square-root parameterisation).
+        const float su = std::sqrt(u.x);
+        return scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y);
+    }
+    const float z = 1 - 2 * u.x;
+    const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+    const float phi = 2 * kPi * u.y;
+    return scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z));
+}
+
+Rgb EmissionSampler::AreaEmission(const Light& light, const SurfacePoint& point) const {
+    const Scene& scene = scene_.scene();
+    const int material = light.kind == Kind::kTriangle
+                             ? scene.meshes[size_t(light.index)].material
+                             : scene.spheres[size_t(light.index)].material;
+    return EmissionAt(scene_, point, scene.materials[size_t(material)].emission);
+}
+
+std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& u_pos,
+                                                      const Vec2& u_dir) const {
+    if (lights_.empty()) return std::nullopt;
+    const int index = int(std::upper_bound(cdf_.begin(), cdf_.end(), u_pick) - cdf_.begin());
+    const int li = std::min(index, int(lights_.size()) - 1);
+    EmissionSample es;
+    es.light = li;
+    es.pick = pmf_[size_t(li)];
+    if (!(es.pick > 0)) return std::nullopt;
+    const Light& light = lights_[size_t(li)];
+    const Scene& scene = scene_.scene();
+
+    switch (light.kind) {
+        case Kind::kTriangle:
+        case Kind::kSphere: {
+            es.point = AreaPoint(light, u_pos);
+            es.on_surface = true;
+            es.pdf_pos = 1 / light.area;
+            Vec2 u = u_dir;
+            Vec3 n = es.point.n;
+            float side = 1;
+            if (light.two_sided) {
+                // u.x picks the side and is stretched back over [0, 1).
+                if (u.x < 0.5f) {
+                    u.x = std::min(2 * u.x, kOneMinusEpsilon);
+                } else {
+                    u.x = std::min(2 * (u.x - 0.5f), kOneMinusEpsilon);
+                    n = -n;
+                }
+                side = 0.5f;
+            }
+            const Vec3 local = SampleCosineHemisphere(u);
+            if (!(local.z > 0)) return std::nullopt;
+            es.w = Normalize(Frame::FromNormal(n).FromLocal(local));
+            es.pdf_dir = side * local.z / kPi;
+            es.le = AreaEmission(light, es.point);
+            break;
+        }
+        case Kind::kPoint: {
+            es.point.p = Vec3(scene.point_lights[size_t(light.index)].position - scene_.origin());
+            es.delta_pos = true;
+            es.pdf_pos = 1;
+            const float z = 1 - 2 * u_dir.x;
+            const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+            const float phi = 2 * kPi * u_dir.y;
+            es.w = Vec3(r * std::cos(phi), r * std::sin(phi), z);
+            es.point.n = es.w;
+            es.pdf_dir = 1 / (4 * kPi);
+            es.le = scene.point_lights[size_t(light.index)].intensity;
+            break;
+        }
+        case Kind::kSpot: {
+            const SpotCone& cone = spots_[size_t(light.index)];
+            es.point.p = cone.position;
+            es.delta_pos = true;
+            es.pdf_pos = 1;
+            // Uniform in the outer cone: 1 - cos(theta) uniform in [0, 1 - cos outer].
+            const float omc = u_dir.x * cone.one_minus_cos_outer;
+            es.w = ConeDirection(cone.direction, omc, u_dir.y);
+            es.point.n = es.w;
+            es.pdf_dir = 1 / (2 * kPi * cone.one_minus_cos_outer);
+            const float t =
+                std::clamp((cone.one_minus_cos_outer - omc) * cone.inv_width, 0.0f, 1.0f);
+            es.le = cone.intensity * (cone.smooth ? t * t * (3 - 2 * t) : t * t);
+            break;
+        }
+        case Kind::kDirectional:
+        case Kind::kSun:
+        case Kind::kEnvironment: {
+            Vec3 wi;  // towards the light
+            if (light.kind == Kind::kDirectional) {
+                const DirectionalLight& dl = scene.directional_lights[size_t(light.index)];
+                wi = -Vec3(Normalize(dl.direction));
+                es.delta_dir = true;
+                es.pdf_dir = 1;
+                es.le = dl.irradiance;
+            } else if (light.kind == Kind::kSun) {
+                const SunDisk& sun = suns_[size_t(light.index)];
+                wi = ConeDirection(sun.axis, u_dir.x * sun.one_minus_cos, u_dir.y);
+                es.pdf_dir = 1 / (2 * kPi * sun.one_minus_cos);
+                es.le = sun.radiance;
+            } else {
+                const std::optional<EnvironmentEmitter::DirectionSample> ds =
+                    environment_->Sample(u_dir);
+                if (!ds) return std::nullopt;
+                wi = ds->wi;
+                es.pdf_dir = ds->pdf;
+                es.le = ds->radiance;
+            }
+            // The disk perpendicular to wi, tangent to the bounding sphere on the light's side.
+            const Frame frame = Frame::FromNormal(wi);
+            const Vec2 d = SampleUniformDiskConcentric(u_pos);
+            es.point.p = (wi + frame.s * d.x + frame.t * d.y) * scene_radius_;
+            es.w = -wi;
+            es.point.n = es.w;
+            es.pdf_pos = 1 / (kPi * scene_radius_ * scene_radius_);
+            break;
+        }
+    }
+    if (!(es.pdf_pos > 0 && es.pdf_dir > 0) || es.le.IsBlack()) return std::nullopt;
+    return es;
+}
+
+int EmissionSampler::LightOf(const SurfaceHit& hit) const {
+    if (hit.sphere >= 0) return sphere_light_[size_t(hit.sphere)];
+    if (hit.mesh < 0) return -1;
+    return triangle_light_[size_t(hit.mesh)][size_t(hit.primitive)];
+}
+
+float EmissionSampler::InfiniteDirPdf(const Light& light, const Vec3& w) const {
+    const Vec3 wi = -w;
+    switch (light.kind) {
+        case Kind::kDirectional: {
+            const DirectionalLight& dl = scene_.scene().directional_lights[size_t(light.index)];
+            return wi == -Vec3(Normalize(dl.direction)) ? 1.0f : 0.0f;
+        }
+        case Kind::kSun: {
+            const SunDisk& sun = suns_[size_t(light.index)];
+            return OneMinusCosBetween(wi, sun.axis) <= sun.one_minus_cos
+                       ? 1 / (2 * kPi * sun.one_minus_cos)
+                       : 0.0f;
+        }
+        case Kind::kEnvironment:
+            return environment_->Pdf(wi);
+        default:
+            return 0;
+    }
+}
+
+EmissionPdf EmissionSampler::PdfLe(int li, const Vec3& p, const Vec3& n, const Vec3& w) const {
+    (void)p;  // uniform by area: the density does not depend on where on the light
+    const Light& light = lights_[size_t(li)];
+    switch (light.kind) {
+        case Kind::kTriangle:
+        case Kind::kSphere: {
+            const float cos = Dot(n, w);
+            if (!light.two_sided && !(cos > 0)) return {1 / light.area, 0};
+            return {1 / light.area, std::abs(cos) / kPi * (light.two_sided ? 0.5f : 1.0f)};
+        }
+        case Kind::kPoint:
+            return {1, 1 / (4 * kPi)};
+        case Kind::kSpot: {
+            const SpotCone& cone = spots_[size_t(light.index)];
+            const bool inside = OneMinusCosBetween(w, cone.direction) <= cone.one_minus_cos_outer;
+            return {1, inside ? 1 / (2 * kPi * cone.one_minus_cos_outer) : 0.0f};
+        }
+        default:
+            return {1 / (kPi * scene_radius_ * scene_radius_), InfiniteDirPdf(light, w)};
+    }
+}
+
+EmissionPdf EmissionSampler::EscapedPdfLe(const Vec3& w) const {
+    EmissionPdf pdf{1 / (kPi * scene_radius_ * scene_radius_), 0};
+    for (size_t i = 0; i < lights_.size(); ++i) {
+        const Kind kind = lights_[i].kind;
+        if (kind == Kind::kSun || kind == Kind::kEnvironment) {
+            pdf.dir += pmf_[i] * InfiniteDirPdf(lights_[i], -w);
+        }
+    }
+    return pdf;
+}
+
+}  // namespace lf

@@ -1,0 +1,289 @@
+// Light tracing (lf/kernels/light_tracer.h): pbrt-v4's furnace spheres, agreement with the path
+// tracer region by region, split invariance, and the frame-method factory.
+#include "lf/kernels/light_tracer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "frame_render.h"
+#include "frame_scenes.h"
+#include "lf/core/scene_loader.h"
+#include "render_path.h"
+
+namespace lf {
+namespace {
+
+// The image mean of R, G, B averaged, over K independent batches of light paths, with its
+// standard error from the spread of the batch means.
+testing::MeanAndError BatchedFrameMean(const Scene& scene, const FrameRenderSettings& settings,
+                                       int batches, uint64_t paths_per_batch) {
+    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", settings);
+    std::vector<double> means;
+    for (int b = 0; b < batches; ++b) {
+        const uint64_t begin = uint64_t(b) * paths_per_batch;
+        const Image image =
+            testing::RenderFramePaths(*s.renderer, *s.camera, begin, begin + paths_per_batch).image;
+        double sum = 0;
+        for (const char* c : {"R", "G", "B"}) {
+            for (float v : *image.FindChannel(c)) sum += v;
+        }
+        means.push_back(sum / (3.0 * image.width() * image.height()));
+    }
+    double mean = 0, var = 0;
+    for (double m : means) mean += m / batches;
+    for (double m : means) var += (m - mean) * (m - mean) / (batches - 1);
+    return {mean, std::sqrt(var / batches)};
+}
+
+FrameRenderSettings Unlimited() {
+    FrameRenderSettings settings;
+    settings.max_depth = -1;
+    settings.seed = 7;
+    return settings;
+}
+
+// pbrt-v4's test: inside a sphere of albedo 0.5 lit by a point light of intensity pi at its
+// centre the radiance is 1 everywhere.
+TEST(LightTracer, PointLitFurnaceSphereIsOne) {
+    const Scene scene = testing::PointLitFurnaceSphere(16);
+    const testing::MeanAndError m = BatchedFrameMean(scene, Unlimited(), 32, 1 << 15);
+    std::printf("[light] point-lit furnace sphere: %.5f +- %.5f (expected 1)\n", m.mean,
+                m.standard_error);
+    EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, 4.5 * m.standard_error);
+    EXPECT_LT(m.standard_error, 0.01) << "too few paths for the test to mean anything";
+}
+
+// The same sphere emitting Le = 0.5 instead: L = 1, the emitter seen directly (the light
+// vertex connected to the camera) plus every bounce.
+TEST(LightTracer, EmissiveFurnaceSphereIsOne) {
+    const Scene scene = testing::EmissiveFurnaceSphere(16);
+    const testing::MeanAndError m = BatchedFrameMean(scene, Unlimited(), 32, 1 << 15);
+    std::printf("[light] emissive furnace sphere: %.5f +- %.5f (expected 1)\n", m.mean,
+                m.standard_error);
+    EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, 4.5 * m.standard_error);
+    EXPECT_LT(m.standard_error, 0.01);
+}
+
+// max_depth 0 leaves the emitter seen directly: Le = 0.5, with no noise at all but the
+// estimator's (each pixel's value is Le for a box filter, up to the splat count).
+TEST(LightTracer, DepthZeroIsTheEmitterSeenDirectly) {
+    const Scene scene = testing::EmissiveFurnaceSphere(16);
+    FrameRenderSettings settings = Unlimited();
+    settings.max_depth = 0;
+    const testing::MeanAndError m = BatchedFrameMean(scene, settings, 16, 1 << 14);
+    EXPECT_NEAR(m.mean, 0.5, 4.5 * m.standard_error + 1e-6);
+}
+
+Scene LoadTestScene(const char* name, int size) {
+    absl::StatusOr<Scene> scene = LoadScene(std::string(LF_TEST_SCENES) + "/" + name);
+    EXPECT_TRUE(scene.ok()) << scene.status();
+    scene->camera.width = scene->camera.height = size;
+    return *std::move(scene);
+}
+
+// One work item and the same paths in sub-ranges (odd sizes, across chunk boundaries) give the
+// same splat list, entry for entry, and the same counts.
+TEST(LightTracer, AnySplitGivesTheSameSplats) {
+    const Scene scene = LoadTestScene("materials.json", 24);
+    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", Unlimited());
+    const int w = s.camera->width(), h = s.camera->height();
+    constexpr uint64_t kPaths = 20000;
+    SplatList whole(w, h);
+    TileSums whole_sums(PixelRect{});
+    s.renderer->Render({PixelRect{}, 0, 0, 0, kPaths}, whole_sums, whole);
+    SplatList parts(w, h);
+    TileSums part_sums(PixelRect{});
+    for (const auto [begin, end] : {std::pair<uint64_t, uint64_t>{0, 1},
+                                    {1, 1023},
+                                    {1023, 5000},
+                                    {5000, 5001},
+                                    {5001, kPaths}}) {
+        SplatList part(w, h);
+        s.renderer->Render({PixelRect{}, 0, 0, begin, end}, part_sums, part);
+        parts += part;
+    }
+    EXPECT_GT(whole.entries().size(), 100u);
+    EXPECT_EQ(whole.entries(), parts.entries());
+    EXPECT_EQ(whole_sums.stats.samples, kPaths);
+    EXPECT_EQ(part_sums.stats.samples, kPaths);
+    EXPECT_EQ(whole_sums.stats.rays, part_sums.stats.rays);
+    EXPECT_EQ(whole_sums.stats.invalid_samples, part_sums.stats.invalid_samples);
+}
+
+TEST(LightTracer, CancelledRenderStopsEarly) {
+    const Scene scene = LoadTestScene("cornell_box.json", 16);
+    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", Unlimited());
+    std::atomic<bool> cancel{true};
+    SplatList splats(16, 16);
+    TileSums sums(PixelRect{});
+    s.renderer->Render({PixelRect{}, 0, 0, 0, 1 << 20}, sums, splats, &cancel);
+    EXPECT_EQ(sums.stats.samples, 0u);
+    EXPECT_TRUE(splats.entries().empty());
+}
+
+// The estimate of a block of pixels (the average of R, G and B over it) and its variance.
+struct BlockEstimate {
+    double mean = 0, variance = 0;
+};
+
+constexpr int kBlock = 8;
+
+// The path tracer's blocks, their variances from each pixel's halves: (A - B)^2 / 4 estimates
+// the variance of a pixel's mean, and pixels are independent.
+std::vector<BlockEstimate> PathBlocks(const Image& image) {
+    const int bw = image.width() / kBlock, bh = image.height() / kBlock;
+    std::vector<BlockEstimate> blocks(size_t(bw * bh));
+    for (int y = 0; y < bh * kBlock; ++y) {
+        for (int x = 0; x < bw * kBlock; ++x) {
+            BlockEstimate& b = blocks[size_t((y / kBlock) * bw + x / kBlock)];
+            const double a = image.Pixel(x, y, "A.").Average();
+            const double c = image.Pixel(x, y, "B.").Average();
+            const double n = kBlock * kBlock;
+            b.mean += image.Pixel(x, y).Average() / n;
+            b.variance += (a - c) * (a - c) / 4 / (n * n);
+        }
+    }
+    return blocks;
+}
+
+// The light tracer's blocks from `batches` independent ranges of light paths: a light path
+// splats into several pixels of a block, so pixels are not independent; the batch means are.
+std::vector<BlockEstimate> LightBlocks(const testing::FrameSetup& s, int batches,
+                                       uint64_t paths_per_batch) {
+    const int bw = s.camera->width() / kBlock, bh = s.camera->height() / kBlock;
+    std::vector<std::vector<double>> per_batch(size_t(bw * bh));
+    for (int k = 0; k < batches; ++k) {
+        const uint64_t begin = uint64_t(k) * paths_per_batch;
+        const Image image =
+            testing::RenderFramePaths(*s.renderer, *s.camera, begin, begin + paths_per_batch).image;
+        std::vector<double> sums(per_batch.size(), 0.0);
+        for (int y = 0; y < bh * kBlock; ++y) {
+            for (int x = 0; x < bw * kBlock; ++x) {
+                sums[size_t((y / kBlock) * bw + x / kBlock)] +=
+                    image.Pixel(x, y).Average() / (kBlock * kBlock);
+            }
+        }
+        for (size_t b = 0; b < sums.size(); ++b) per_batch[b].push_back(sums[b]);
+    }
+    std::vector<BlockEstimate> blocks(per_batch.size());
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        double mean = 0, var = 0;
+        for (double m : per_batch[b]) mean += m / batches;
+        for (double m : per_batch[b]) var += (m - mean) * (m - mean) / (batches - 1);
+        blocks[b] = {mean, var / batches};
+    }
+    return blocks;
+}
+
+// Blocks where some pixel sees a mirror or glass first: the light tracer cannot connect a delta
+// vertex to the camera, so what is seen in them (E S+ ... paths) is the path tracer's alone.
+std::vector<bool> SpecularBlocks(const EmbreeScene& es, const Camera& camera) {
+    const int bw = camera.width() / kBlock, bh = camera.height() / kBlock;
+    std::vector<bool> specular(size_t(bw * bh), false);
+    constexpr int kGrid = 4;
+    for (int y = 0; y < bh * kBlock; ++y) {
+        for (int x = 0; x < bw * kBlock; ++x) {
+            for (int j = 0; j < kGrid * kGrid; ++j) {
+                const Ray ray = camera.GenerateRay(x, y, (j % kGrid + 0.5f) / kGrid,
+                                                   (j / kGrid + 0.5f) / kGrid);
+                const std::optional<SurfaceHit> hit = es.Intersect(ray);
+                if (!hit) continue;
+                const Material::Type type = es.scene().materials[size_t(hit->material)].type;
+                if (type == Material::Type::kMirror || type == Material::Type::kDielectric) {
+                    specular[size_t((y / kBlock) * bw + x / kBlock)] = true;
+                }
+            }
+        }
+    }
+    return specular;
+}
+
+// The two-sided normal quantile for a family-wise error of alpha over n tests (Bonferroni).
+double BonferroniZ(double alpha, int n) {
+    const double p = alpha / n;
+    double lo = 0, hi = 40;
+    for (int i = 0; i < 200; ++i) {
+        const double mid = (lo + hi) / 2;
+        (std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+    }
+    return hi;
+}
+
+// Light tracing and path tracing at the same max_depth agree block by block (8x8 pixels) within
+// their variances: each block's z with a Bonferroni threshold over the blocks, and the mean z
+// (a bias common to all blocks) within its own.
+void ExpectLightMatchesPath(const char* scene_name, int size, int max_depth, uint64_t spp,
+                            int batches, uint64_t paths_per_batch) {
+    const Scene scene = LoadTestScene(scene_name, size);
+    FrameRenderSettings settings;
+    settings.max_depth = max_depth;
+    settings.seed = 3;
+    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", settings);
+    const std::vector<BlockEstimate> light = LightBlocks(s, batches, paths_per_batch);
+    const std::vector<BlockEstimate> path =
+        PathBlocks(testing::RenderPath(scene, spp, max_depth, 5).out.image);
+    const std::vector<bool> specular = SpecularBlocks(*s.embree, *s.camera);
+    int compared = 0;
+    for (bool b : specular) compared += b ? 0 : 1;
+    ASSERT_GT(compared, int(specular.size()) / 2);
+    const double threshold = BonferroniZ(1e-3, compared);
+    double z_sum = 0, worst = 0;
+    for (size_t b = 0; b < light.size(); ++b) {
+        if (specular[b]) continue;
+        const double se = std::sqrt(light[b].variance + path[b].variance);
+        const double z = (light[b].mean - path[b].mean) / se;
+        z_sum += z;
+        worst = std::max(worst, std::abs(z));
+        EXPECT_LT(std::abs(z), threshold)
+            << scene_name << " block " << b << ": light " << light[b].mean << " +- "
+            << std::sqrt(light[b].variance) << ", path " << path[b].mean << " +- "
+            << std::sqrt(path[b].variance);
+        // Noise small enough for the comparison to mean something: 5 % of the block.
+        EXPECT_LT(se, 0.05 * path[b].mean + 1e-3) << scene_name << " block " << b;
+    }
+    const double mean_z = z_sum / std::sqrt(double(compared));
+    std::printf(
+        "[light] %s: %d blocks of %zu compared, largest |z| %.2f (threshold %.2f), "
+        "sum z / sqrt(n) %.2f\n",
+        scene_name, compared, light.size(), worst, threshold, mean_z);
+    EXPECT_LT(std::abs(mean_z), BonferroniZ(1e-3, 1));
+}
+
+TEST(LightTracer, MatchesPathTracerOnCornellBox) {
+    ExpectLightMatchesPath("cornell_box.json", 32, 3, 256, 64, 32 * 32 * 256 / 64);
+}
+
+// The glass sphere's caustic on the floor, the mirror's, the glossy box and plastic sphere; the
+// blocks that see the mirror or the glass are left out (see SpecularBlocks).
+TEST(LightTracer, MatchesPathTracerOnMaterials) {
+    ExpectLightMatchesPath("materials.json", 48, 5, 256, 64, 48 * 48 * 256 / 64);
+}
+
+TEST(FrameRendererFactory, BuildsLightAndRefusesWhatItCannot) {
+    EXPECT_TRUE(IsFrameMethod("light"));
+    EXPECT_TRUE(IsFrameMethod("bdpt"));
+    EXPECT_TRUE(IsFrameMethod("ppm"));
+    EXPECT_FALSE(IsFrameMethod("path"));
+    EXPECT_FALSE(IsFrameMethod("whitted"));
+    Scene scene = testing::PointLitFurnaceSphere(8);
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok());
+    const Camera camera(scene.camera, (*es)->origin());
+    EXPECT_TRUE(MakeFrameRenderer("light", **es, camera, {}).ok());
+    const auto path = MakeFrameRenderer("path", **es, camera, {});
+    EXPECT_EQ(path.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(path.status().message().find("path"), std::string::npos);
+
+    scene.camera.filter = {PixelFilter::Type::kGaussian, 2};
+    const Camera gaussian(scene.camera, (*es)->origin());
+    const auto refused = MakeFrameRenderer("light", **es, gaussian, {});
+    EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_NE(refused.status().message().find("light"), std::string::npos);
+    EXPECT_NE(refused.status().message().find("gaussian"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace lf
