@@ -19,6 +19,7 @@
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/frame_settings.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
@@ -406,6 +407,12 @@ absl::Status Summarize(const ConvergenceOptions& options, int64_t pixels,
 }  // namespace
 
 absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& options) {
+    // The frame methods render locally (`render --method`) but have no ladder here yet.
+    if (UsesFramePlan(options.method)) {
+        return absl::UnimplementedError(absl::StrCat("converge --method ", options.method,
+                                                     ": not implemented yet for this method; "
+                                                     "expected path, radiosity, both or whitted"));
+    }
     if (options.method != "path" && options.method != "radiosity" && options.method != "both" &&
         options.method != "whitted") {
         return absl::InvalidArgumentError(absl::StrCat(

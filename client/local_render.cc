@@ -16,6 +16,7 @@
 #include "lf/job/job_spec.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
+#include "lf/kernels/frame_renderer.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/ray_tracer.h"
 #include "lf/kernels/whitted.h"
@@ -28,8 +29,7 @@ namespace lf {
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
                                          std::string* why) {
     if (requested != "auto") {
-        // The job model's names: implemented, reserved for issue 15's methods (Unimplemented,
-        // saying so) or unknown.
+        // The job model's names, or unknown.
         if (std::string error = MethodFlagError(requested, true); !error.empty()) {
             return absl::Status(CheckMethod(requested).code(), "--" + error);
         }
@@ -80,8 +80,33 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     summary.load_seconds = absl::ToDoubleSeconds(absl::Now() - start);
 
     std::unique_ptr<RadianceEstimator> estimator;
+    std::unique_ptr<FrameRenderer> frame_renderer;  // light, bdpt, ppm
+    std::optional<FramePlanSettings> frame_plan;
     const RadiosityRenderer* radiosity = nullptr;
-    if (*method == "radiosity") {
+    const bool adaptive = options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
+    if (UsesFramePlan(*method)) {
+        // The job model's checks, so local mode refuses what the coordinator refuses.
+        if (options.render.aovs != 0 || adaptive) {
+            JobSpec spec;
+            spec.method = *method;
+            spec.aovs = options.render.aovs;
+            spec.adaptive = options.adaptive;
+            if (absl::Status s = CheckJobSettings(spec); !s.ok()) return s;
+        }
+        if (absl::Status s = CheckPhotonSettings(options.ppm); !s.ok()) return s;
+        absl::StatusOr<FramePlanSettings> plan =
+            FramePlanSettingsOf(*method, {camera.width(), camera.height(), options.render.spp,
+                                          options.render.tile, options.render.passes});
+        if (!plan.ok()) return plan.status();
+        frame_plan = *plan;
+        absl::StatusOr<std::unique_ptr<FrameRenderer>> made = MakeFrameRenderer(
+            *method, **embree, camera,
+            FrameRenderSettingsOf<FrameRenderSettings>(options.max_depth, options.render.seed,
+                                                       options.render.sampler, options.render.clamp,
+                                                       options.render.light_strategy, options.ppm));
+        if (!made.ok()) return made.status();
+        frame_renderer = std::move(*made);
+    } else if (*method == "radiosity") {
         absl::StatusOr<RadiosityOptions> parsed = RadiosityOptionsOf(options.radiosity);
         if (!parsed.ok()) return parsed.status();
         RadiosityOptions ro = *parsed;
@@ -152,7 +177,21 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         options.render.clamp > 0 ? absl::StrCat(", clamp ", options.render.clamp, " (biased)")
                                  : std::string(),
         options.render.aovs != 0 ? ", AOVs " + AovListName(options.render.aovs) : std::string());
-    const bool adaptive = options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
+    if (frame_plan) {
+        log->info(
+            "job={} {}", job_id,
+            frame_plan->kind == FramePlanKind::kLightPaths
+                ? absl::StrCat(frame_plan->light_paths, " light paths in ranges of ",
+                               frame_plan->max_paths_per_task)
+            : frame_plan->kind == FramePlanKind::kPhotonPasses
+                ? absl::StrCat(frame_plan->spp, " photon passes of ", options.ppm.photons_per_pass,
+                               " photons, alpha ", options.ppm.alpha, ", first radius ",
+                               options.ppm.initial_radius > 0
+                                   ? absl::StrCat(options.ppm.initial_radius)
+                                   : std::string("the kernel's choice"),
+                               ", tile ", frame_plan->tile)
+                : std::string("a light subpath per camera sample"));
+    }
     if (adaptive) {
         log->info(
             "job={} adaptive: first pass {} spp, target error {}, time limit {} s, at "
@@ -165,7 +204,9 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         if (options.progress) bar.Update(done, n);
     };
     absl::StatusOr<RenderOutput> out =
-        adaptive
+        frame_renderer
+            ? RenderFrameImage(camera, *frame_renderer, *frame_plan, options.render, progress)
+        : adaptive
             ? RenderImageAdaptive(camera, *estimator, options.render, options.adaptive, progress)
             : RenderImage(camera, *estimator, options.render, progress);
     if (options.progress) bar.Finish();
@@ -215,6 +256,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     if (adaptive) metadata.adaptive = out->adaptive;
     metadata.radiosity_settings = options.radiosity;
     metadata.radiosity = summary.radiosity;
+    metadata.ppm = options.ppm;
     absl::StatusOr<RenderDescription> description = DescribeRender(metadata, out->image, true);
     if (!description.ok()) return description.status();
     if (description->estimates) {

@@ -1,5 +1,6 @@
-// `lightfarm render`: a scene file to an EXR (and PNG preview) in this process, by path tracing
-// or radiosity, through the farm's planner and merger (local_executor.h).
+// `lightfarm render`: a scene file to an EXR (and PNG preview) in this process, by any method
+// (path tracing, radiosity, Whitted, and the frame methods light, bdpt, ppm), through the farm's
+// planners and mergers (local_executor.h).
 #pragma once
 
 #include <optional>
@@ -9,6 +10,7 @@
 #include "lf/core/image_io.h"
 #include "lf/core/scene.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/frame_settings.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/settings.h"
 #include "lf/kernels/radiosity.h"
@@ -22,11 +24,12 @@ struct LocalRenderOptions {
     std::string exr_path;                    // empty: no EXR (-o out.png)
     std::string png_path;                    // empty: no preview
     PngOptions preview;                      // --exposure, --tonemap
-    std::string method = defaults::kMethod;  // path | radiosity | whitted | auto
+    std::string method = defaults::kMethod;  // kRenderMethods or auto
     RenderSettings render;                   // with --clamp and --aov
     AdaptiveSettings adaptive;               // used when a target error or a time limit is set
     int max_depth = defaults::kMaxDepth;
     RadiositySettings radiosity;
+    PhotonSettings ppm;  // --photons, --ppm-radius, --ppm-alpha
     // Radiosity's files (RadiosityOptions): a solution to save or load, a PLY to export.
     std::string save_solution, load_solution, export_ply;
     bool progress = true;
@@ -55,12 +58,12 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
 // `auto`: radiosity models exactly the scenes it can (all Lambertian, no spheres) and is
 // view-independent; everything else needs the path tracer. Never whitted, which misses
 // interreflection and caustics in nearly every scene (lf/kernels/whitted.h,
-// WhittedMissingTerms). The methods reserved for issue 15 (bdpt, light, ppm) are Unimplemented.
+// WhittedMissingTerms). Nor the frame methods (light, bdpt, ppm), which are the user's choice.
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
                                          std::string* why);
 
 // The CLI's check of a --method flag: "" when the job model accepts `method` (or it is "auto"
-// and allow_auto), else the message: reserved methods say they are not implemented yet.
+// and allow_auto), else the message listing the methods.
 std::string MethodFlagError(const std::string& method, bool allow_auto);
 
 }  // namespace lf

@@ -12,6 +12,7 @@
 #include "lf/core/image_error.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/frame_settings.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
@@ -237,6 +238,15 @@ absl::Status RunPlan(const PlanOptions& options) {
     std::string why;
     absl::StatusOr<std::string> method = ChooseMethod(*scene, options.method, &why);
     if (!method.ok()) return method.status();
+    // Their pilots (light paths, photon passes) are not costed yet: a path-traced pilot would
+    // answer for another estimator.
+    if (UsesFramePlan(*method)) {
+        return absl::UnimplementedError(
+            absl::StrCat("plan --method ", *method,
+                         ": no pilot for this method yet; `lightfarm render "
+                         "--method ",
+                         *method, "` renders it"));
+    }
     std::printf("method (--method %s): %s, because %s\n", options.method.c_str(), method->c_str(),
                 why.c_str());
     // Whitted is never auto's choice; plan says what it would give (lf/kernels/whitted.h).

@@ -5,6 +5,7 @@
 #include "lf/job/job_spec.h"
 #include "local_render.h"
 #include "output_flags.h"
+#include "photon_flags.h"
 #include "radiosity_flags.h"
 #include "sample_flags.h"
 #include "scene_flags.h"
@@ -23,7 +24,8 @@ Command AddRenderCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "render",
         "Render a scene in this process to an OpenEXR image and/or a PNG preview, by path\n"
-        "tracing or radiosity, through the same planner and merger as the farm.\n"
+        "tracing, radiosity, Whitted ray tracing, light tracing, bidirectional path tracing or\n"
+        "progressive photon mapping, through the same planner and merger as the farm.\n"
         "The EXR holds float32 R,G,B (mean radiance per pixel, W m^-2 sr^-1, linear Rec.709,\n"
         "through the pixel filter), the two half-sample estimates A.R,A.G,A.B and B.R,B.G,B.B\n"
         "(even and odd samples; their difference estimates the error), spp, and the --aov\n"
@@ -60,11 +62,18 @@ Command AddRenderCommand(CLI::App& app) {
                     "path (path tracing, any material), radiosity (finite elements, Lambertian "
                     "quads and triangles only, view-independent), whitted (direct light and "
                     "mirror/glass reflection and refraction only: a fast preview without "
-                    "interreflection or caustics) or auto (radiosity when every material is "
-                    "Lambertian and there are no spheres; the log says why). bdpt, light and ppm "
-                    "are reserved, not implemented yet")
+                    "interreflection or caustics), light (light tracing: --spp light paths per "
+                    "pixel from the lights, each connected to the camera and splatted anywhere on "
+                    "the image), bdpt (bidirectional path tracing: every connection of a camera "
+                    "and a light subpath, weighted by MIS), ppm (progressive photon mapping: --spp "
+                    "passes of --photons photons each, a shrinking gather radius; consistent, "
+                    "biased at any finite pass count) or auto (radiosity when every material is "
+                    "Lambertian and there are no spheres; the log says why). light, bdpt and ppm "
+                    "take no --aov nor adaptive sampling")
         ->capture_default_str()
         ->check([](const std::string& m) { return MethodFlagError(m, true); });
+
+    AddPhotonFlags(cmd, options->ppm);
 
     const std::string r = "Radiosity";
     AddRadiosityFlags(cmd, options->radiosity);
@@ -88,6 +97,9 @@ Command AddRenderCommand(CLI::App& app) {
             options->png_path = paths->png;
             options->preview = output->preview;
             if (absl::Status s = CheckRadiosityFlagsApply(*cmd, options->method); !s.ok()) {
+                return ReportError(s);
+            }
+            if (absl::Status s = CheckPhotonFlagsApply(*cmd, options->method); !s.ok()) {
                 return ReportError(s);
             }
             absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);

@@ -88,6 +88,14 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     // The CLI's limits (lf/job/job_spec.h): a bad job is refused here rather than failing, or
     // running without end, on every worker.
     if (absl::Status s = CheckJobSettings(spec); !s.ok()) return s;
+    // The job model, the wire and the workers' kernels know the frame methods, but the scheduler
+    // plans only tiles so far: refused rather than path traced under another name.
+    if (UsesFramePlan(spec.method)) {
+        return absl::UnimplementedError(absl::StrCat(
+            "method \"", spec.method,
+            "\": the farm does not schedule frame methods yet; `lightfarm render --method ",
+            spec.method, "` renders it in this process"));
+    }
     if (spec.name.size() > kMaxJobNameBytes) {
         return absl::InvalidArgumentError(absl::StrCat(
             "job name of ", spec.name.size(), " bytes is above the limit of ", kMaxJobNameBytes));

@@ -102,6 +102,10 @@ std::string EncodeJobRecord(const JobRecord& r) {
           {"aovs", s.aovs},
           {"sampler", SamplerTypeName(s.sampler)},
           {"light_strategy", LightStrategyName(s.light_strategy)},
+          {"ppm",
+           {{"photons_per_pass", s.ppm.photons_per_pass},
+            {"initial_radius", s.ppm.initial_radius},
+            {"alpha", s.ppm.alpha}}},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
           {"request_id", s.request_id}}},
@@ -169,6 +173,12 @@ absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
             absl::StatusOr<std::optional<PixelFilter>> filter = FilterFromJson(s.at("filter"));
             if (!filter.ok()) return filter.status();
             r.spec.scene_options.filter = *filter;
+        }
+        // Records before --method ppm have no photon settings: the defaults.
+        if (s.contains("ppm")) {
+            const auto& p = s.at("ppm");
+            r.spec.ppm = {p.at("photons_per_pass").get<uint64_t>(),
+                          p.at("initial_radius").get<double>(), p.at("alpha").get<double>()};
         }
         r.spec.clamp = s.value("clamp", 0.0);
         r.spec.aovs = s.value("aovs", uint32_t(0));

@@ -39,36 +39,27 @@ absl::Status OneOf(const char* field, const std::string& value,
         absl::StrCat(field, " \"", value, "\": expected one of ", expected));
 }
 
-std::string_view ReservedMethodName(std::string_view method) {
-    if (method == "bdpt") return "bidirectional path tracing";
-    if (method == "light") return "light tracing";
-    if (method == "ppm") return "progressive photon mapping";
-    return "";
+// The frame methods splat light paths anywhere on the image or average photon passes per pixel:
+// their plan has no per-pixel first hits to make AOVs of, and no tile whose error alone decides
+// its next pass, so neither AOVs nor adaptive sampling apply.
+absl::Status CheckFrameMethodSettings(const JobSpec& spec) {
+    if (!UsesFramePlan(spec.method)) return absl::OkStatus();
+    if (spec.aovs != 0) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "aovs: method \"", spec.method, "\" makes no AOV channels; use method path"));
+    }
+    if (IsAdaptive(spec.adaptive)) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "adaptive: method \"", spec.method,
+            "\" has no adaptive sampling (no target error or time limit); set spp instead"));
+    }
+    return absl::OkStatus();
 }
 
 }  // namespace
 
 absl::Status CheckMethod(const std::string& method) {
-    if (std::find(kRenderMethods.begin(), kRenderMethods.end(), method) != kRenderMethods.end()) {
-        return absl::OkStatus();
-    }
-    std::string implemented;
-    for (std::string_view name : kRenderMethods) {
-        absl::StrAppend(&implemented, implemented.empty() ? "" : ", ", std::string(name));
-    }
-    if (std::find(kReservedMethods.begin(), kReservedMethods.end(), method) !=
-        kReservedMethods.end()) {
-        return absl::UnimplementedError(
-            absl::StrCat("method \"", method, "\" (", std::string(ReservedMethodName(method)),
-                         "): not implemented yet in this build; use ", implemented));
-    }
-    std::string reserved;
-    for (std::string_view name : kReservedMethods) {
-        absl::StrAppend(&reserved, reserved.empty() ? "" : ", ", std::string(name));
-    }
-    return absl::InvalidArgumentError(
-        absl::StrCat("method \"", method, "\": expected one of ", implemented,
-                     " (not implemented yet in this build: ", reserved, ")"));
+    return OneOf("method", method, kRenderMethods);
 }
 
 absl::Status CheckJobSettings(const JobSpec& spec) {
@@ -98,6 +89,8 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         OneOf("radiosity.display", r.display, kRadiosityDisplays),
         InRange("radiosity.sweep_tasks", r.sweep_tasks, 1, kMaxSweepTasks),
         InRange("radiosity.max_patches", r.max_patches, int64_t(0), kMaxRefinedPatches),
+        CheckPhotonSettings(spec.ppm),
+        CheckFrameMethodSettings(spec),
     };
     for (const absl::Status& s : checks) {
         if (!s.ok()) return s;

@@ -114,6 +114,40 @@ void AddRadiosityAttributes(const RenderMetadata& m, ExrAttributes& attributes) 
     }
 }
 
+// Light tracing traces spp light paths per pixel-equivalent; BDPT one light subpath per camera
+// sample: the same count, spp x W x H.
+void AddLightPathAttributes(const RenderMetadata& m, const Image& image,
+                            ExrAttributes& attributes) {
+    const uint64_t pixels = uint64_t(image.width()) * uint64_t(image.height());
+    attributes["lightfarm.lightPaths"] = std::to_string(m.spp * pixels);
+    attributes["lightfarm.lightPathsPerPixel"] = std::to_string(m.spp);
+}
+
+// Photon mapping is consistent, not unbiased: after N passes the kernel's radius leaves a bias
+// that falls as N^(alpha - 1), and the A/B error estimates do not see it.
+void AddPhotonAttributes(const RenderMetadata& m, ExrAttributes& attributes) {
+    const PhotonSettings& p = m.ppm;
+    attributes["lightfarm.ppm.passes"] = std::to_string(m.spp);
+    attributes["lightfarm.ppm.photonsPerPass"] = std::to_string(p.photons_per_pass);
+    attributes["lightfarm.ppm.initialRadius"] = p.initial_radius;
+    attributes["lightfarm.ppm.alpha"] = p.alpha;
+    attributes["lightfarm.ppm.radiusSchedule"] = absl::StrCat(
+        "r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1), r_0 = ",
+        p.initial_radius > 0 ? absl::StrCat(p.initial_radius, " scene units")
+                             : std::string("the kernel's choice from the scene's size and frame"),
+        ", alpha = ", p.alpha, " (Knaus and Zwicker 2011)");
+    const std::string bias = absl::StrCat(
+        "ppm: density estimation over the radius r_i of each pass blurs the light, so the image "
+        "is biased; the bias falls as passes^(alpha - 1) = passes^",
+        p.alpha - 1,
+        " and lightfarm.estimatedError and the other error estimates measure the "
+        "noise only, not this bias");
+    auto [it, inserted] = attributes.try_emplace("lightfarm.bias", bias);
+    if (!inserted) {
+        std::get<std::string>(it->second) += "; " + bias;
+    }
+}
+
 }  // namespace
 
 absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const Image& image,
@@ -122,7 +156,8 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     d.attributes = DescribeMethod(m);
     if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
     if (m.aovs != 0) d.attributes["lightfarm.aovs"] = AovListName(m.aovs);
-    if (m.method == "path" || m.method == "whitted") {  // the methods that sample lights
+    // The methods that sample lights at camera-path vertices.
+    if (m.method == "path" || m.method == "whitted" || m.method == "bdpt" || m.method == "ppm") {
         d.attributes["lightfarm.light_sampling"] = std::string(LightStrategyName(m.light_strategy));
     }
     if (m.clamp > 0) AddClampAttributes(m.clamp, d.attributes);
@@ -135,6 +170,8 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     }
     if (m.adaptive) AddAdaptiveAttributes(m.adaptive_settings, *m.adaptive, d.attributes);
     if (m.method == "radiosity") AddRadiosityAttributes(m, d.attributes);
+    if (m.method == "light" || m.method == "bdpt") AddLightPathAttributes(m, image, d.attributes);
+    if (m.method == "ppm") AddPhotonAttributes(m, d.attributes);
     return d;
 }
 

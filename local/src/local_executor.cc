@@ -14,8 +14,10 @@
 #include <thread>
 #include <tuple>
 
+#include "absl/strings/str_cat.h"
 #include "lf/core/image_error.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/frame_merge.h"
 #include "lf/job/merge.h"
 #include "lf/job/plan.h"
 #include "lf/kernels/tile_renderer.h"
@@ -70,6 +72,52 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
                     std::lock_guard<std::mutex> lock(mutex);
                     status.Update(merger.Add(task.index, sums));
                     if (progress) progress(merger.tasks_done(), merger.task_count());
+                }
+            },
+            tbb::simple_partitioner());
+    });
+    if (!status.ok()) return status;
+    absl::StatusOr<Image> image = merger.Snapshot();
+    if (!image.ok()) return image.status();
+    RenderOutput out{std::move(*image), merger.stats(), 0, {}};
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+absl::StatusOr<RenderOutput> RenderFrameImage(const Camera& camera, const FrameRenderer& renderer,
+                                              const FramePlanSettings& plan,
+                                              const RenderSettings& settings,
+                                              const ProgressFn& progress) {
+    const auto start = std::chrono::steady_clock::now();
+    if (plan.width != camera.width() || plan.height != camera.height()) {
+        return absl::InvalidArgumentError(absl::StrCat("frame plan ", plan.width, "x", plan.height,
+                                                       " is not the camera's ", camera.width(), "x",
+                                                       camera.height()));
+    }
+    absl::StatusOr<std::vector<FrameTask>> tasks = PlanFrameRender(plan);
+    if (!tasks.ok()) return tasks.status();
+    // Two stores (camera sums, splat sums), each as a tile render's, in a file above 2048x2048.
+    absl::StatusOr<std::unique_ptr<FrameMerger>> made = FrameMerger::Make(
+        plan.width, plan.height, plan.tile, plan.kind, *tasks, TileStoreFor(camera, 0));
+    if (!made.ok()) return made.status();
+    FrameMerger& merger = **made;
+    std::mutex mutex;
+    absl::Status status;
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, tasks->size(), 1),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t i = range.begin(); i != range.end(); ++i) {
+                    const FrameTask& task = (*tasks)[i];
+                    const FrameWork work{task.rect, task.sample_begin, task.sample_end,
+                                         task.path_begin, task.path_end};
+                    TileSums camera_sums(task.rect, 0);
+                    SplatList splats(plan.width, plan.height);
+                    renderer.Render(work, camera_sums, splats);
+                    std::lock_guard<std::mutex> lock(mutex);
+                    status.Update(merger.Add(task.index, camera_sums, splats));
+                    if (progress) progress(merger.tasks_done(), merger.tasks().size());
                 }
             },
             tbb::simple_partitioner());

@@ -839,9 +839,8 @@ namespace lf {
 namespace {
 
 // `--method whitted` renders, logs what it leaves out of the scene and says so in the header;
-// the methods issue 15 reserves are refused by render, submit and plan as not implemented yet,
-// naming what is.
-TEST_F(Cli, WhittedRendersAndReservedMethodsAreNotImplementedYet) {
+// unknown methods are refused by render, submit and plan, naming the methods.
+TEST_F(Cli, WhittedRendersAndUnknownMethodsAreRefused) {
     const std::string scene = std::string(LF_TEST_SCENES) + "/materials.json";
     const std::string exr = (dir_ / "w.exr").string();
     const RunResult r = Lightfarm("render " + scene + " -o " + exr +
@@ -855,16 +854,54 @@ TEST_F(Cli, WhittedRendersAndReservedMethodsAreNotImplementedYet) {
 
     for (const std::string command :
          {"render " + scene + " -o " + exr, "submit " + scene, "plan " + scene}) {
-        for (const char* method : {"bdpt", "light", "ppm"}) {
-            const RunResult refused = Lightfarm(command + " --method " + method);
-            EXPECT_NE(refused.status, 0) << command << " " << method;
-            EXPECT_NE(refused.output.find("not implemented yet in this build"), std::string::npos)
-                << command << " " << method << "\n"
-                << refused.output;
-        }
         const RunResult unknown = Lightfarm(command + " --method photon");
         EXPECT_NE(unknown.status, 0);
         EXPECT_NE(unknown.output.find("expected one of"), std::string::npos) << unknown.output;
+        EXPECT_NE(unknown.output.find("ppm"), std::string::npos) << unknown.output;
+    }
+}
+
+// `render --method light` goes through the frame plan and merger: any --threads, --passes
+// (light-path ranges) and --tile (splat tiles) give the same bits, and the header names the
+// method and its light paths. Photon flags with another method, AOVs and adaptive sampling with
+// a frame method, and plan's pilot of a frame method are refused, saying why.
+TEST_F(Cli, LightTracingRendersTheSameBitsForAnySplit) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::string base = "render " + scene + " --method light --spp 2 --resolution 24x24 " +
+                             "--max-depth 3 --no-progress -o ";
+    const std::string one = (dir_ / "l1.exr").string(), two = (dir_ / "l2.exr").string();
+    const RunResult a = Lightfarm(base + one + " --threads 1 --passes 1");
+    ASSERT_EQ(a.status, 0) << a.output;
+    const RunResult b = Lightfarm(base + two + " --threads 2 --passes 7 --tile 5");
+    ASSERT_EQ(b.status, 0) << b.output;
+    absl::StatusOr<ExrFile> fa = ReadExr(one), fb = ReadExr(two);
+    ASSERT_TRUE(fa.ok() && fb.ok());
+    ASSERT_EQ(fa->image.channels().size(), fb->image.channels().size());
+    for (const auto& [name, values] : fa->image.channels()) {
+        const std::vector<float>* other = fb->image.FindChannel(name);
+        ASSERT_NE(other, nullptr) << name;
+        EXPECT_EQ(values, *other) << name;
+    }
+    EXPECT_EQ(std::get<std::string>(fa->attributes.at("lightfarm.method")), "light");
+    EXPECT_EQ(std::get<std::string>(fa->attributes.at("lightfarm.lightPaths")),
+              std::to_string(2 * 24 * 24));
+    double sum = 0;
+    for (float v : *fa->image.FindChannel("G")) sum += v;
+    EXPECT_GT(sum, 0) << "the lights reach the camera";
+
+    const struct {
+        std::string args, expected;
+    } refused[] = {
+        {"render " + scene + " -o " + one + " --photons 100", "--photons is a photon mapping"},
+        {"render " + scene + " -o " + one + " --method light --aov albedo", "no AOV"},
+        {"render " + scene + " -o " + one + " --method light --target-error 0.1", "adaptive"},
+        {"render " + scene + " -o " + one + " --method ppm --ppm-alpha 1", "--ppm-alpha 1"},
+        {"plan " + scene + " --method light", "no pilot for this method yet"},
+    };
+    for (const auto& r : refused) {
+        const RunResult out = Lightfarm(r.args);
+        EXPECT_NE(out.status, 0) << r.args;
+        EXPECT_NE(out.output.find(r.expected), std::string::npos) << r.args << "\n" << out.output;
     }
 }
 

@@ -93,6 +93,12 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_passes(spec.plan.passes);
     out->set_method(spec.method);
     if (spec.method == "radiosity") ToProto(spec.radiosity, out->mutable_radiosity());
+    if (spec.method == "ppm") {
+        pb::PhotonParams* ppm = out->mutable_ppm();
+        ppm->set_photons_per_pass(spec.ppm.photons_per_pass);
+        ppm->set_initial_radius(spec.ppm.initial_radius);
+        ppm->set_alpha(spec.ppm.alpha);
+    }
     out->set_target_error(spec.adaptive.target_error);
     out->set_time_limit_seconds(spec.adaptive.time_limit);
     out->set_max_spp(spec.adaptive.max_spp);
@@ -117,6 +123,12 @@ void FromProto(const pb::RenderParams& p, JobSpec* spec) {
     spec->max_depth = p.max_depth();
     if (!p.method().empty()) spec->method = p.method();
     if (p.has_radiosity()) spec->radiosity = FromProto(p.radiosity());
+    if (p.has_ppm()) {  // zero fields keep the defaults
+        if (p.ppm().photons_per_pass() != 0)
+            spec->ppm.photons_per_pass = p.ppm().photons_per_pass();
+        spec->ppm.initial_radius = p.ppm().initial_radius();
+        if (p.ppm().alpha() != 0) spec->ppm.alpha = p.ppm().alpha();
+    }
     spec->adaptive.target_error = p.target_error();
     spec->adaptive.time_limit = p.time_limit_seconds();
     if (p.max_spp() != 0) spec->adaptive.max_spp = p.max_spp();
@@ -204,6 +216,10 @@ void ToProto(const TaskAssignment& task, pb::Task* out) {
         out->set_kind(pb::Task::RADIOSITY_SWEEP);
         out->set_sweep(task.sweep);
         out->set_chunk(task.chunk);
+    } else if (UsesFramePlan(task.spec.method)) {
+        out->set_kind(pb::Task::FRAME);
+        out->set_path_begin(task.path_begin);
+        out->set_path_end(task.path_end);
     }
     out->set_radiosity_hash(task.radiosity_hash);
     out->set_heartbeat_interval_ms(int(absl::ToInt64Milliseconds(task.heartbeat_interval)));
@@ -221,6 +237,10 @@ TaskAssignment FromProto(const pb::Task& t) {
     if (t.kind() == pb::Task::RADIOSITY_SWEEP) {
         task.sweep = t.sweep();
         task.chunk = t.chunk();
+    }
+    if (t.kind() == pb::Task::FRAME) {
+        task.path_begin = t.path_begin();
+        task.path_end = t.path_end();
     }
     task.radiosity_hash = t.radiosity_hash();
     task.task.rect = {t.x0(), t.y0(), t.width(), t.height()};

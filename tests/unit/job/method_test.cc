@@ -1,6 +1,6 @@
-// The rendering methods a job may name (lf/job/job_spec.h): the implemented ones pass, the ones
-// issue 15 reserves are refused as not implemented yet (not as unknown), anything else as
-// unknown with the lists; and a Whitted render's header names its method and light sampling.
+// The rendering methods a job may name (lf/job/job_spec.h): each of them passes, anything else is
+// refused as unknown with the list; and a Whitted render's header names its method and light
+// sampling.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -12,8 +12,8 @@
 namespace lf {
 namespace {
 
-TEST(Method, ImplementedMethodsPassTheJobCheck) {
-    for (const char* method : {"path", "radiosity", "whitted"}) {
+TEST(Method, EveryMethodPassesTheJobCheck) {
+    for (const char* method : {"path", "radiosity", "whitted", "light", "bdpt", "ppm"}) {
         JobSpec spec;
         spec.method = method;
         EXPECT_TRUE(CheckMethod(method).ok()) << method;
@@ -21,28 +21,7 @@ TEST(Method, ImplementedMethodsPassTheJobCheck) {
     }
 }
 
-TEST(Method, ReservedMethodsAreNotImplementedYetNamingTheMethod) {
-    const struct {
-        const char* name;
-        const char* what;
-    } reserved[] = {{"bdpt", "bidirectional path tracing"},
-                    {"light", "light tracing"},
-                    {"ppm", "progressive photon mapping"}};
-    ASSERT_EQ(std::size(reserved), kReservedMethods.size());
-    for (const auto& r : reserved) {
-        JobSpec spec;
-        spec.method = r.name;
-        const absl::Status s = CheckJobSettings(spec);
-        EXPECT_EQ(s.code(), absl::StatusCode::kUnimplemented) << s;
-        const std::string message(s.message());
-        EXPECT_EQ(message.rfind(std::string("method \"") + r.name + "\"", 0), 0u) << message;
-        EXPECT_NE(message.find(r.what), std::string::npos) << message;
-        EXPECT_NE(message.find("not implemented yet"), std::string::npos) << message;
-        EXPECT_NE(message.find("whitted"), std::string::npos) << "names the alternatives";
-    }
-}
-
-TEST(Method, UnknownMethodIsInvalidAndListsBoth) {
+TEST(Method, UnknownMethodIsInvalidAndListsEveryMethod) {
     const absl::Status s = CheckMethod("photon");
     EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
     const std::string message(s.message());

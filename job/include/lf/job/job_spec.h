@@ -12,6 +12,7 @@
 #include "absl/status/status.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/frame_settings.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
 #include "lf/job/settings.h"
@@ -34,6 +35,7 @@ struct JobSpec {
     LightStrategy light_strategy = defaults::kLightStrategy;
     std::string method = defaults::kMethod;  // kRenderMethods
     RadiositySettings radiosity;
+    PhotonSettings ppm;         // method "ppm" (lf/job/frame_settings.h)
     AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused
     int priority = 0;           // higher first
     std::string scene_hash;     // the loader's content hash, for the EXR header
@@ -54,16 +56,14 @@ inline constexpr double kMinTolerance = 1e-12, kMaxTolerance = 1.0;
 inline constexpr double kMinTargetError = 1e-6, kMaxTargetError = 1.0;  // or 0: none
 inline constexpr double kMinTimeLimit = 1e-3, kMaxTimeLimit = 1e7;      // seconds, or 0: none
 // "whitted": Whitted ray tracing (lf/kernels/whitted.h), direct light and specular chains only.
-inline constexpr std::array<std::string_view, 3> kRenderMethods = {"path", "radiosity", "whitted"};
-// Methods of issue 15 whose names are taken but whose estimators this build lacks: a job naming
-// one is refused as not implemented yet (Unimplemented), not as an unknown method.
-// bdpt: bidirectional path tracing; light: light tracing (paths from the lights, splatted onto
-// the film); ppm: progressive photon mapping.
-inline constexpr std::array<std::string_view, 3> kReservedMethods = {"bdpt", "light", "ppm"};
+// The frame methods (lf/job/frame_settings.h, planned by lf/job/frame_plan.h): "light", light
+// tracing (paths from the lights, splatted onto the film); "bdpt", bidirectional path tracing;
+// "ppm", progressive photon mapping. Whether this build's kernels implement one is the kernel
+// factory's to say (lf::MakeFrameRenderer), when the render starts.
+inline constexpr std::array<std::string_view, 6> kRenderMethods = {"path",  "radiosity", "whitted",
+                                                                   "light", "bdpt",      "ppm"};
 
-// Ok for kRenderMethods; Unimplemented for kReservedMethods ("method \"bdpt\" (bidirectional
-// path tracing): not implemented yet in this build; use path, radiosity or whitted");
-// InvalidArgument listing both for anything else.
+// Ok for kRenderMethods; InvalidArgument listing them for anything else.
 absl::Status CheckMethod(const std::string& method);
 inline constexpr std::array<std::string_view, 3> kRadiositySolvers = {"jacobi", "gauss-seidel",
                                                                       "shooting"};

@@ -14,6 +14,7 @@
 #include "lf/core/image_io.h"
 #include "lf/core/scene.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/frame_settings.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
 
@@ -63,7 +64,7 @@ RadiosityFigures RadiosityFiguresOf(const Report& r) {
 struct RenderMetadata {
     std::string scene_hash;
     std::string camera;  // the glTF camera --camera picked; "" for the scene's own
-    std::string method;  // "path" or "radiosity"
+    std::string method;  // kRenderMethods (lf/job/job_spec.h)
     uint64_t spp = 0;    // adaptive: the most any pixel got
     uint64_t seed = 0;
     int max_depth = -1;
@@ -71,7 +72,8 @@ struct RenderMetadata {
     uint32_t aovs = 0;   // lf/core/aov.h flags of the AOV channels the image has
     PixelFilter filter;  // the camera's, after --filter
     SamplerType sampler = defaults::kSampler;  // lightfarm.sampler
-    // lightfarm.light_sampling, for method "path" (radiosity samples no lights)
+    // lightfarm.light_sampling, for the methods that sample lights at camera-path vertices (path,
+    // whitted, bdpt, ppm; not radiosity nor light tracing)
     LightStrategy light_strategy = defaults::kLightStrategy;
     double seconds = 0;  // the whole render: loading, meshing, solving and sampling
     RenderStats stats;
@@ -79,6 +81,7 @@ struct RenderMetadata {
     std::optional<AdaptiveReport> adaptive;     // set for an adaptive render
     RadiositySettings radiosity_settings;       // method "radiosity"
     std::optional<RadiosityFigures> radiosity;  // when known
+    PhotonSettings ppm;                         // method "ppm"
 };
 
 // What an image estimates of its own error, from its A/B halves: needs 2 samples per pixel.
@@ -101,8 +104,10 @@ struct RenderDescription {
 // lightfarm.bias, only when clamping), the image's own error estimates
 // (lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance: noise only,
 // never the clamp's bias) when `complete` and every pixel has at least 2 samples, how an
-// adaptive render ended (lightfarm.targetError, .timeLimit, lightfarm.adaptive.*) and the
-// radiosity solve (lightfarm.radiosity.*).
+// adaptive render ended (lightfarm.targetError, .timeLimit, lightfarm.adaptive.*), the
+// radiosity solve (lightfarm.radiosity.*), the light paths of light tracing and BDPT
+// (lightfarm.lightPaths, lightfarm.lightPathsPerPixel) and photon mapping's passes, photons and
+// radius schedule with the bias it leaves (lightfarm.ppm.*, lightfarm.bias).
 absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& metadata, const Image& image,
                                                  bool complete);
 
