@@ -1,12 +1,15 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
 #include "local_render.h"
+#include "photon_flags.h"
 #include "scene_flags.h"
 
 namespace lf {
@@ -20,7 +23,7 @@ constexpr double kReferenceNoiseWarning = 0.05;
 void PrintSummary(const ConvergenceResult& result, const std::optional<PixelRect>& region) {
     const TimeRange& t = result.equal_time;
     const ConfigSummary& base = result.configs.front();
-    std::printf("\npath tracing, fitted over %llu to %llu spp (each ladder's rungs there); ",
+    std::printf("\nspp ladders, fitted over %llu to %llu spp (each ladder's rungs there); ",
                 (unsigned long long)base.fit.from, (unsigned long long)base.fit.to);
     if (result.equal_time_note.empty()) {
         std::printf(
@@ -36,7 +39,9 @@ void PrintSummary(const ConvergenceResult& result, const std::optional<PixelRect
     // smallest, so it flattens the best configuration's curve and raises its ratios.
     const ConvergenceRow* best = nullptr;
     for (const ConvergenceRow& row : result.rows) {
-        if (row.method == "path" && (!best || row.error.rmse < best->error.rmse)) best = &row;
+        if (IsLadderMethod(row.method) && (!best || row.error.rmse < best->error.rmse)) {
+            best = &row;
+        }
     }
     const double share = best ? std::pow(result.reference_rmse / best->error.rmse, 2) : 0;
     if (share > kReferenceNoiseWarning) {
@@ -46,25 +51,25 @@ void PrintSummary(const ConvergenceResult& result, const std::optional<PixelRect
             "raise --reference-spp)\n",
             100 * share, ConfigName(best->config).c_str(), (long long)best->budget);
     }
-    const std::string rule(136, '-');
+    const std::string rule(142, '-');
     std::printf(
-        "%-18s %9s %9s %9s %11s %11s %11s %17s %17s\n%-18s %9s %9s %9s %11s %11s %11s %17s %17s\n",
+        "%-24s %9s %9s %9s %11s %11s %11s %17s %17s\n%-24s %9s %9s %9s %11s %11s %11s %17s %17s\n",
         "configuration", "slope rel", "slope", "slope", "samples/s", "RMSE", "relMSE", "RMSE ratio",
         "relMSE ratio", "", "RMSE", "RMSE", "per spp", "", "at equal time", "at equal time",
         "at end, mean", "at end, mean");
     std::printf("%s\n", rule.c_str());
     for (const ConfigSummary& c : result.configs) {
-        std::printf("%-18s %9.3f %9.3f %9.3f %10.3fM %11.4e %11.4e %8.3f, %6.3f %8.3f, %6.3f\n",
+        std::printf("%-24s %9.3f %9.3f %9.3f %10.3fM %11.4e %11.4e %8.3f, %6.3f %8.3f, %6.3f\n",
                     ConfigName(c.config).c_str(), c.relative_rmse_slope, c.rmse_slope,
                     c.rmse_spp_slope, c.samples_per_second * 1e-6, c.rmse_at_equal_time,
                     c.relmse_at_equal_time, c.rmse_ratio_at_end, c.rmse_ratio_mean,
                     c.relmse_ratio_at_end, c.relmse_ratio_mean);
     }
     if (!region) return;
-    std::printf("\nregion %d,%d %dx%d:\n%-18s %17s %17s\n", region->x0, region->y0, region->width,
+    std::printf("\nregion %d,%d %dx%d:\n%-24s %17s %17s\n", region->x0, region->y0, region->width,
                 region->height, "configuration", "RMSE at eq. time", "ratio end, mean");
     for (const ConfigSummary& c : result.configs) {
-        std::printf("%-18s %17.4e %8.3f, %6.3f\n", ConfigName(c.config).c_str(),
+        std::printf("%-24s %17.4e %8.3f, %6.3f\n", ConfigName(c.config).c_str(),
                     c.region_rmse_at_equal_time, c.region_rmse_ratio_at_end,
                     c.region_rmse_ratio_mean);
     }
@@ -95,13 +100,14 @@ Command AddConvergeCommand(CLI::App& app) {
                     "reference OpenEXR of the same size (R,G,B)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--method", options->method,
-                    "path, radiosity, both (path and radiosity) or whitted (a spp ladder of "
+                    "path, radiosity, both (path and radiosity), whitted (a spp ladder of "
                     "Whitted ray tracing against the path-traced reference: its error levels off "
-                    "at the light transport it leaves out)")
-        ->capture_default_str()
-        ->check([](const std::string& m) {
-            return m == "both" ? std::string() : MethodFlagError(m, false);
-        });
+                    "at the light transport it leaves out), or a comma-separated list of the "
+                    "spp-ladder methods path, light, bdpt and ppm (e.g. path,bdpt,ppm: one ladder "
+                    "per method and configuration; budget = spp, light paths per pixel for light, "
+                    "photon passes for ppm)")
+        ->capture_default_str();
+    AddPhotonFlags(cmd, options->ppm);
     AddCameraFlag(cmd, options->scene);
     AddFilterFlag(cmd, options->scene);
     AddResolutionFlag(cmd, options->scene, &options->resolution, 16384,
@@ -177,12 +183,20 @@ Command AddConvergeCommand(CLI::App& app) {
                     "16:1024, or the whole ladder when that holds fewer than two rungs)")
         ->type_name("FROM:TO");
     return {
-        cmd, [options, samplers, strategies, compare, fit, region] {
+        cmd, [cmd, options, samplers, strategies, compare, fit, region] {
             absl::StatusOr<std::vector<RenderConfig>> configs =
                 compare->empty() ? ConfigProduct(*samplers, *strategies)
                                  : ParseConfigList(*compare);
             if (!configs.ok()) return ReportError(configs.status());
             options->configs = *configs;
+            // The photon flags apply when some ladder is ppm's.
+            const bool ppm = absl::StrContains(options->method, "ppm") ||
+                             std::any_of(configs->begin(), configs->end(),
+                                         [](const RenderConfig& c) { return c.method == "ppm"; });
+            if (absl::Status s = CheckPhotonFlagsApply(*cmd, ppm ? "ppm" : options->method);
+                !s.ok()) {
+                return ReportError(s);
+            }
             if (!region->empty()) {
                 absl::StatusOr<PixelRect> rect = ParseRegion(*region);
                 if (!rect.ok()) return ReportError(rect.status());

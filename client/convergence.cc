@@ -22,6 +22,7 @@
 #include "lf/job/frame_settings.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
+#include "lf/kernels/frame_renderer.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/whitted.h"
@@ -33,8 +34,11 @@ extern char** environ;
 
 namespace lf {
 
+bool IsLadderMethod(const std::string& method) { return method == "path" || UsesFramePlan(method); }
+
 std::string ConfigName(const RenderConfig& config) {
-    return absl::StrCat(SamplerTypeName(config.sampler), "/",
+    return absl::StrCat(config.method == "path" ? "" : config.method + "/",
+                        SamplerTypeName(config.sampler), "/",
                         LightStrategyName(config.light_strategy));
 }
 
@@ -62,20 +66,22 @@ absl::StatusOr<std::vector<T>> ParseNames(const std::string& flag, const std::st
 }
 
 std::optional<RenderConfig> ConfigFromName(const std::string& name) {
-    const size_t slash = name.find('/');
-    if (slash == std::string::npos) return std::nullopt;
-    const std::optional<SamplerType> sampler = SamplerTypeFromName(name.substr(0, slash));
-    const std::optional<LightStrategy> strategy = LightStrategyFromName(name.substr(slash + 1));
+    std::vector<std::string> parts = absl::StrSplit(name, '/');
+    if (parts.size() == 2) parts.insert(parts.begin(), "path");
+    if (parts.size() != 3 || !IsLadderMethod(parts[0])) return std::nullopt;
+    const std::optional<SamplerType> sampler = SamplerTypeFromName(parts[1]);
+    const std::optional<LightStrategy> strategy = LightStrategyFromName(parts[2]);
     if (!sampler || !strategy) return std::nullopt;
-    return RenderConfig{*sampler, *strategy};
+    return RenderConfig{parts[0], *sampler, *strategy};
 }
 
 }  // namespace
 
 absl::StatusOr<std::vector<RenderConfig>> ParseConfigList(const std::string& list) {
     return ParseNames<RenderConfig>("--compare", list, ConfigFromName,
-                                    "SAMPLER/LIGHTS with SAMPLER independent or sobol and "
-                                    "LIGHTS power or bvh, e.g. sobol/bvh");
+                                    "[METHOD/]SAMPLER/LIGHTS with METHOD path, light, bdpt or ppm, "
+                                    "SAMPLER independent or sobol and LIGHTS power or bvh, e.g. "
+                                    "sobol/bvh or bdpt/sobol/bvh");
 }
 
 absl::StatusOr<std::vector<RenderConfig>> ConfigProduct(const std::string& samplers,
@@ -88,7 +94,7 @@ absl::StatusOr<std::vector<RenderConfig>> ConfigProduct(const std::string& sampl
     if (!l.ok()) return l.status();
     std::vector<RenderConfig> out;
     for (SamplerType sampler : *s) {
-        for (LightStrategy strategy : *l) out.push_back({sampler, strategy});
+        for (LightStrategy strategy : *l) out.push_back({"path", sampler, strategy});
     }
     return out;
 }
@@ -140,7 +146,7 @@ double RelativeRmse(const ConvergenceRow& row) { return std::sqrt(row.error.relm
 
 // A curve of the plot and the legend's slope: a path configuration's or radiosity's.
 std::string CurveName(const ConvergenceRow& row) {
-    return row.method == "path" ? ConfigName(row.config) : row.method;
+    return IsLadderMethod(row.method) ? ConfigName(row.config) : row.method;
 }
 
 }  // namespace
@@ -180,9 +186,11 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
             }
         }
         gp << "EOD\n";
-        const std::string title = method == "path"      ? "path tracing, " + name
-                                  : method == "whitted" ? "whitted (biased: levels off)"
-                                                        : "radiosity";
+        const std::string title = method == "path"         ? "path tracing, " + name
+                                  : method == "ppm"        ? name + " (biased: falls slower)"
+                                  : IsLadderMethod(method) ? name
+                                  : method == "whitted"    ? "whitted (biased: levels off)"
+                                                           : "radiosity";
         relative_plot.push_back(absl::StrFormat(
             "%s using 1:2 with linespoints pt 7 title %s", block,
             GnuplotQuote(absl::StrFormat("%s (slope %.2f)", title, relative_slope))));
@@ -191,7 +199,7 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
             GnuplotQuote(rmse_slope.empty() ? title : title + " (slope " + rmse_slope + ")")));
     };
     for (const ConfigSummary& c : result.configs) {
-        add_curve(ConfigName(c.config), "path", c.relative_rmse_slope,
+        add_curve(ConfigName(c.config), c.config.method, c.relative_rmse_slope,
                   absl::StrFormat("%.2f", c.rmse_slope));
     }
     const auto any = [&](const char* method) {
@@ -305,8 +313,8 @@ absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const Re
     ErrorCurve relative, by_spp;
     double samples = 0, seconds = 0;
     for (const ConvergenceRow& row : result.rows) {
-        if (row.method != "path" || !(row.config == config) || uint64_t(row.budget) < fit.from ||
-            uint64_t(row.budget) > fit.to) {
+        if (!IsLadderMethod(row.method) || !(row.config == config) ||
+            uint64_t(row.budget) < fit.from || uint64_t(row.budget) > fit.to) {
             continue;
         }
         relative.push_back({row.seconds, RelativeRmse(row)});
@@ -338,13 +346,13 @@ absl::StatusOr<FittedLadder> FitLadder(const ConvergenceResult& result, const Re
 // Per configuration its slopes and speed, and the errors at equal time against the first: each
 // curve (its fit range's rungs) interpolated as a power law between its own rungs, over the
 // times every configuration covers.
-absl::Status Summarize(const ConvergenceOptions& options, int64_t pixels,
-                       ConvergenceResult& result) {
+absl::Status Summarize(const ConvergenceOptions& options, const std::vector<RenderConfig>& configs,
+                       int64_t pixels, ConvergenceResult& result) {
     absl::StatusOr<SppRange> fit = FitRange(options, &result.fit_note);
     if (!fit.ok()) return fit.status();
     std::vector<FittedLadder> ladders;
     std::vector<ErrorCurve> rmse_curves;
-    for (const RenderConfig& config : options.configs) {
+    for (const RenderConfig& config : configs) {
         absl::StatusOr<FittedLadder> ladder = FitLadder(result, config, *fit, pixels);
         if (!ladder.ok()) return ladder.status();
         rmse_curves.push_back(ladder->rmse);
@@ -404,22 +412,53 @@ absl::Status Summarize(const ConvergenceOptions& options, int64_t pixels,
     return absl::OkStatus();
 }
 
+// The ladders' configurations: --method's ladder methods (path for "both"; none for radiosity
+// and whitted) times the sampler and light configurations, or --compare's own when they name
+// their methods.
+absl::StatusOr<std::vector<RenderConfig>> LadderConfigs(const ConvergenceOptions& options) {
+    if (options.configs.empty()) return absl::InvalidArgumentError("no configuration to render");
+    if (options.method == "radiosity" || options.method == "whitted") {
+        return std::vector<RenderConfig>{};
+    }
+    const std::string list = options.method == "both" ? "path" : options.method;
+    absl::StatusOr<std::vector<std::string>> methods = ParseNames<std::string>(
+        "--method", list,
+        [](const std::string& name) -> std::optional<std::string> {
+            if (!IsLadderMethod(name)) return std::nullopt;
+            return name;
+        },
+        "path, radiosity, both, whitted or a list of path, light, bdpt and ppm");
+    if (!methods.ok()) return methods.status();
+    const bool explicit_methods =
+        std::any_of(options.configs.begin(), options.configs.end(),
+                    [](const RenderConfig& c) { return c.method != "path"; });
+    if (explicit_methods) {
+        if (*methods != std::vector<std::string>{"path"}) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                "--method ", options.method,
+                " with --compare configurations that name their methods: give the methods in "
+                "one place"));
+        }
+        return options.configs;
+    }
+    std::vector<RenderConfig> out;
+    for (const std::string& method : *methods) {
+        for (RenderConfig config : options.configs) {
+            config.method = method;
+            out.push_back(config);
+        }
+    }
+    return out;
+}
+
 }  // namespace
 
 absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& options) {
-    // The frame methods render locally (`render --method`) but have no ladder here yet.
-    if (UsesFramePlan(options.method)) {
-        return absl::UnimplementedError(absl::StrCat("converge --method ", options.method,
-                                                     ": not implemented yet for this method; "
-                                                     "expected path, radiosity, both or whitted"));
-    }
-    if (options.method != "path" && options.method != "radiosity" && options.method != "both" &&
-        options.method != "whitted") {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "--method ", options.method, ": expected path, radiosity, both or whitted"));
-    }
-    if (options.configs.empty()) return absl::InvalidArgumentError("no configuration to render");
-    const bool path = options.method == "path" || options.method == "both";
+    absl::StatusOr<std::vector<RenderConfig>> ladder_configs = LadderConfigs(options);
+    if (!ladder_configs.ok()) return ladder_configs.status();
+    const std::vector<RenderConfig>& configs = *ladder_configs;
+    if (absl::Status s = CheckPhotonSettings(options.ppm); !s.ok()) return s;
+    const bool path = !configs.empty();
     const bool with_radiosity = options.method == "radiosity" || options.method == "both";
     std::string unused_note;
     if (path) {
@@ -477,15 +516,30 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         return absl::OkStatus();
     };
 
-    auto render_path = [&](const RenderConfig& config, uint64_t spp, uint64_t seed) {
-        const PathTracer path_tracer(**embree, options.max_depth, config.light_strategy);
+    // A rung of a ladder: the path tracer's tiles, or a frame method's plan (budget = spp: light
+    // paths per pixel for light, photon passes for ppm) with the defaults `render` uses.
+    auto render_path = [&](const RenderConfig& config, uint64_t spp,
+                           uint64_t seed) -> absl::StatusOr<RenderOutput> {
         RenderSettings settings;
         settings.spp = spp;
         settings.seed = seed;
         settings.threads = options.threads;
         settings.sampler = config.sampler;
         settings.light_strategy = config.light_strategy;
-        return RenderImage(camera, path_tracer, settings);
+        if (config.method == "path") {
+            const PathTracer path_tracer(**embree, options.max_depth, config.light_strategy);
+            return RenderImage(camera, path_tracer, settings);
+        }
+        absl::StatusOr<FramePlanSettings> plan =
+            FramePlanSettingsOf(config.method, {camera.width(), camera.height(), spp, settings.tile,
+                                                std::min<int>(settings.passes, int(spp))});
+        if (!plan.ok()) return plan.status();
+        absl::StatusOr<std::unique_ptr<FrameRenderer>> renderer = MakeFrameRenderer(
+            config.method, **embree, camera,
+            FrameRenderSettingsOf<FrameRenderSettings>(options.max_depth, seed, config.sampler, 0,
+                                                       config.light_strategy, options.ppm));
+        if (!renderer.ok()) return renderer.status();
+        return RenderFrameImage(camera, **renderer, *plan, settings);
     };
 
     ConvergenceResult result;
@@ -497,18 +551,18 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     // Rung by rung, every configuration in turn, so that a change in the machine's load (it is
     // often shared) falls on all of them alike; the rows stay ladder by ladder.
     const std::vector<uint64_t> rungs = path ? Ladder(options.max_spp) : std::vector<uint64_t>{};
-    const size_t path_rows = rungs.size() * options.configs.size();
+    const size_t path_rows = rungs.size() * configs.size();
     result.rows.resize(path_rows);
     std::vector<Image> images(path_rows);  // of result.rows, until the reference is known
     for (size_t k = 0; k < rungs.size(); ++k) {
-        for (size_t c = 0; c < options.configs.size(); ++c) {
-            const RenderConfig& config = options.configs[c];
+        for (size_t c = 0; c < configs.size(); ++c) {
+            const RenderConfig& config = configs[c];
             absl::StatusOr<RenderOutput> out = render_path(config, rungs[k], options.seed);
             if (!out.ok()) return out.status();
             log->info("job={} {} {} spp: {:.3f} s", job_id, ConfigName(config), rungs[k],
                       out->seconds);
             ConvergenceRow& row = result.rows[c * rungs.size() + k];
-            row.method = "path";
+            row.method = config.method;
             row.config = config;
             row.budget = int64_t(rungs[k]);
             row.seconds = out->seconds;
@@ -536,12 +590,17 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         result.reference = "reference " + options.reference_path;
     } else {
         // The configuration whose top rung has the least estimated MSE (A/B halves) times
-        // seconds: the least error for the reference's time. Without path ladders, the first.
+        // seconds: the least error for the reference's time. Only the unbiased methods that see
+        // everything qualify: path and bdpt (ppm is biased; light tracing cannot see mirrors,
+        // glass or the sky). Without such a ladder, the path tracer with the first
+        // configuration's sampler and lights.
         RenderConfig best = options.configs.front();
+        best.method = "path";
         std::string why = "the first configuration";
         double best_cost = std::numeric_limits<double>::infinity();
         for (size_t i = 0; i < path_rows; ++i) {
             if (uint64_t(result.rows[i].budget) != rungs.back()) continue;
+            if (result.rows[i].method != "path" && result.rows[i].method != "bdpt") continue;
             absl::StatusOr<double> mse = EstimatedMse(images[i]);
             if (!mse.ok()) continue;
             const double cost = *mse * result.rows[i].seconds;
@@ -556,17 +615,18 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         }
         // Another seed, so the reference's noise is independent of the ladders'.
         const uint64_t seed = options.seed + 1;
-        log->info("job={} no reference given: path tracing one with {} at {} spp", job_id,
+        const std::string kind = best.method == "path" ? "path-traced" : best.method;
+        log->info("job={} no reference given: rendering a {} one with {} at {} spp", job_id, kind,
                   ConfigName(best), options.reference_spp);
         absl::StatusOr<RenderOutput> out = render_path(best, options.reference_spp, seed);
         if (!out.ok()) return out.status();
         result.reference = absl::StrFormat(
-            "no reference given: own path-traced reference, %d spp, %s (%s), seed %d, %.1f s",
+            "no reference given: own %s reference, %d spp, %s (%s), seed %d, %.1f s", kind,
             options.reference_spp, ConfigName(best), why, seed, out->seconds);
         RenderMetadata metadata;
         metadata.scene_hash = scene->content_hash;
         metadata.camera = options.scene.camera;
-        metadata.method = "path";
+        metadata.method = best.method;
         metadata.spp = options.reference_spp;
         metadata.seed = seed;
         metadata.max_depth = options.max_depth;
@@ -669,7 +729,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     if (absl::Status s = WriteCsv(result); !s.ok()) return s;
 
     if (path) {
-        if (absl::Status s = Summarize(options, pixels, result); !s.ok()) return s;
+        if (absl::Status s = Summarize(options, configs, pixels, result); !s.ok()) return s;
         result.summary_path = (dir / "summary.csv").string();
         if (absl::Status s = WriteSummaryCsv(result); !s.ok()) return s;
     }

@@ -20,22 +20,30 @@
 #include "lf/core/light_strategy.h"
 #include "lf/core/sampler.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/frame_settings.h"
 #include "lf/job/settings.h"
 
 namespace lf {
 
-// What a path-traced ladder varies: where the random numbers come from and how next-event
-// estimation picks lights.
+// What a ladder varies: the method (the path tracer or a frame method: light, bdpt, ppm), where
+// the random numbers come from and how next-event estimation picks lights.
 struct RenderConfig {
+    std::string method = "path";
     SamplerType sampler = defaults::kSampler;
     LightStrategy light_strategy = defaults::kLightStrategy;
     bool operator==(const RenderConfig&) const = default;
 };
 
-// "sobol/bvh": how the CSV, the table, the plot and --compare name it.
+// The methods converge renders as spp ladders: budget = spp (light paths per pixel for light,
+// photon passes for ppm).
+bool IsLadderMethod(const std::string& method);
+
+// "sobol/bvh" for the path tracer, "bdpt/sobol/bvh" for the others: how the table, the plot and
+// --compare name it.
 std::string ConfigName(const RenderConfig& config);
 
-// --compare "independent/power,sobol/bvh": configurations in the order given.
+// --compare "independent/power,sobol/bvh,bdpt/sobol/bvh": configurations in the order given,
+// each [METHOD/]SAMPLER/LIGHTS (METHOD a ladder method, path when left out).
 absl::StatusOr<std::vector<RenderConfig>> ParseConfigList(const std::string& list);
 
 // --sampler and --light-sampling lists ("independent,sobol" and "power,bvh"): every pair,
@@ -54,8 +62,10 @@ struct ConvergenceOptions {
     std::string out_dir;
     std::string reference_path;  // empty: render our own path-traced reference
     // path | radiosity | both (path and radiosity) | whitted (its ladder against the path-traced
-    // reference: the error levels off at what Whitted leaves out)
+    // reference: the error levels off at what Whitted leaves out) | a comma-separated list of
+    // ladder methods (path, light, bdpt, ppm), each laddered in every configuration of `configs`
     std::string method = "both";
+    PhotonSettings ppm;      // the ppm ladders' --photons, --ppm-radius, --ppm-alpha
     int resolution = 0;      // image width, height keeps the aspect; 0: the scene's
     SceneOptions scene;      // --camera; --resolution WxH (then `resolution` is 0)
     uint64_t max_spp = 256;  // path ladder 1, 2, 4, ... up to this

@@ -403,9 +403,10 @@ TEST_F(Cli, ConvergeBadListsAreRefusedBeforeRendering) {
                              " --out " + (dir_ / "bad").string() + " --resolution 16 --max-spp 8 ";
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"--compare sobol/foo",
-         "--compare sobol/foo: \"sobol/foo\" is not SAMPLER/LIGHTS with SAMPLER independent or "
-         "sobol and LIGHTS power or bvh"},
-        {"--compare sobol", "--compare sobol: \"sobol\" is not SAMPLER/LIGHTS"},
+         "--compare sobol/foo: \"sobol/foo\" is not [METHOD/]SAMPLER/LIGHTS with METHOD path, "
+         "light, bdpt or ppm, SAMPLER independent or sobol and LIGHTS power or bvh"},
+        {"--compare sobol", "--compare sobol: \"sobol\" is not [METHOD/]SAMPLER/LIGHTS"},
+        {"--compare whitted/sobol/bvh", "\"whitted/sobol/bvh\" is not [METHOD/]SAMPLER/LIGHTS"},
         {"--compare sobol/bvh,sobol/bvh", "\"sobol/bvh\" is listed twice"},
         {"--sampler sobol,halton",
          "--sampler sobol,halton: \"halton\" is not independent or sobol"},
@@ -935,8 +936,7 @@ TEST_F(Cli, PlanRecommendsWhittedOnlyAsAPreviewNamingWhatItLeavesOut) {
 }
 
 // converge --method whitted: a spp ladder of Whitted images against the path-traced reference,
-// with the light sampling named, and no path ladder; the reserved methods are refused as not
-// implemented yet there too.
+// with the light sampling named, and no path ladder.
 TEST_F(Cli, ConvergeLaddersWhittedAgainstThePathTracedReference) {
     const fs::path out = dir_ / "conv_whitted";
     const std::string base = "converge " + std::string(LF_TEST_SCENES) + "/materials.json --out " +
@@ -955,9 +955,47 @@ TEST_F(Cli, ConvergeLaddersWhittedAgainstThePathTracedReference) {
         EXPECT_EQ(rows[i][8], "bvh");
     }
     EXPECT_GT(fs::file_size(out / "convergence.png"), 1000u);
-    const RunResult refused = Lightfarm(base + "--method ppm");
-    EXPECT_NE(refused.status, 0);
-    EXPECT_NE(refused.output.find("not implemented yet"), std::string::npos) << refused.output;
+}
+
+// converge --method path,light,ppm: one ladder per method against one reference, named by the
+// method in the CSV and the summary (the path tracer keeps its old name); the reference comes
+// from an unbiased method that sees everything (path here: light tracing cannot see the glass).
+TEST_F(Cli, ConvergeLaddersEveryListedMethod) {
+    const fs::path out = dir_ / "conv_methods";
+    const std::string base =
+        "converge " + std::string(LF_TEST_SCENES) + "/materials.json --threads 2 --resolution 16 ";
+    const RunResult r = Lightfarm(base + "--out " + out.string() +
+                                  " --max-spp 8 --reference-spp 32 --method path,light,ppm "
+                                  "--photons 2048");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("own path-traced reference, 32 spp"), std::string::npos) << r.output;
+    const std::vector<std::vector<std::string>> rows = ReadCsv(out / "convergence.csv");
+    ASSERT_EQ(rows.size(), 1u + 3 * 4);  // spp 1, 2, 4, 8 per method
+    const std::vector<std::string> methods = {"path", "light", "ppm"};
+    for (size_t m = 0; m < methods.size(); ++m) {
+        for (size_t k = 0; k < 4; ++k) {
+            const std::vector<std::string>& row = rows[1 + m * 4 + k];
+            EXPECT_EQ(row[0], methods[m]);
+            EXPECT_EQ(row[1], std::to_string(1 << k));
+            EXPECT_GT(std::stod(row[3]), 0);
+        }
+    }
+    for (const std::string name : {"sobol/bvh ", "light/sobol/bvh ", "ppm/sobol/bvh "}) {
+        EXPECT_NE(r.output.find("\n" + name), std::string::npos) << name << "\n" << r.output;
+    }
+    EXPECT_EQ(ReadCsv(out / "summary.csv").size(), 1u + 3);
+
+    for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+             {"--method path,foo", "--method path,foo: \"foo\" is not path, radiosity, both"},
+             {"--method path,path", "\"path\" is listed twice"},
+             {"--method path --photons 100", "--photons"},
+             {"--method light --compare bdpt/sobol/bvh", "give the methods in one place"},
+             {"--method path --ppm-alpha 1", "--ppm-alpha 1: expected above 0 and below 1"}}) {
+        const RunResult refused = Lightfarm(base + "--out " + (dir_ / "bad").string() + " " + args);
+        EXPECT_NE(refused.status, 0) << args;
+        EXPECT_NE(refused.output.find(message), std::string::npos) << args << "\n"
+                                                                   << refused.output;
+    }
 }
 
 }  // namespace
