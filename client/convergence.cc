@@ -22,12 +22,11 @@
 #include "lf/job/frame_settings.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/frame_renderer.h"
-#include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/whitted.h"
 #include "lf/local/local_executor.h"
 #include "local_render.h"
+#include "method_render.h"
 #include "radiosity_flags.h"
 
 extern char** environ;
@@ -516,30 +515,17 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         return absl::OkStatus();
     };
 
-    // A rung of a ladder: the path tracer's tiles, or a frame method's plan (budget = spp: light
-    // paths per pixel for light, photon passes for ppm) with the defaults `render` uses.
-    auto render_path = [&](const RenderConfig& config, uint64_t spp,
-                           uint64_t seed) -> absl::StatusOr<RenderOutput> {
-        RenderSettings settings;
-        settings.spp = spp;
+    // A rung of a ladder (budget = spp: light paths per pixel for light, photon passes for
+    // ppm), as `render` makes it.
+    auto render_path = [&](const RenderConfig& config, uint64_t spp, uint64_t seed) {
+        MethodRenderSettings settings;
+        settings.max_depth = options.max_depth;
         settings.seed = seed;
-        settings.threads = options.threads;
         settings.sampler = config.sampler;
         settings.light_strategy = config.light_strategy;
-        if (config.method == "path") {
-            const PathTracer path_tracer(**embree, options.max_depth, config.light_strategy);
-            return RenderImage(camera, path_tracer, settings);
-        }
-        absl::StatusOr<FramePlanSettings> plan =
-            FramePlanSettingsOf(config.method, {camera.width(), camera.height(), spp, settings.tile,
-                                                std::min<int>(settings.passes, int(spp))});
-        if (!plan.ok()) return plan.status();
-        absl::StatusOr<std::unique_ptr<FrameRenderer>> renderer = MakeFrameRenderer(
-            config.method, **embree, camera,
-            FrameRenderSettingsOf<FrameRenderSettings>(options.max_depth, seed, config.sampler, 0,
-                                                       config.light_strategy, options.ppm));
-        if (!renderer.ok()) return renderer.status();
-        return RenderFrameImage(camera, **renderer, *plan, settings);
+        settings.threads = options.threads;
+        settings.ppm = options.ppm;
+        return RenderWithMethod(config.method, **embree, camera, settings, spp);
     };
 
     ConvergenceResult result;
