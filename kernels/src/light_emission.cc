@@ -68,6 +68,7 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
         weights.push_back(double(kPi) * area * PowerWeight(mat.emission) * (two_sided ? 2 : 1));
     }
     for (size_t i = 0; i < scene.point_lights.size(); ++i) {
+        point_light_.push_back(int(lights_.size()));
         lights_.push_back({Kind::kPoint, int(i), 0, 0, false});
         weights.push_back(4 * std::numbers::pi * PowerWeight(scene.point_lights[i].intensity));
     }
@@ -79,6 +80,7 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
         const bool smooth = spot.falloff == SpotLight::Falloff::kSmoothstep;
         spots_.push_back({Vec3(spot.position - es.origin()), Vec3(Normalize(spot.direction)),
                           float(outer), float(1 / width), smooth, spot.intensity});
+        spot_light_.push_back(int(lights_.size()));
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
         // The falloff's solid angle: 2 pi (outer - width + width * mean falloff over the band).
         const double solid_angle =
@@ -97,6 +99,7 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
         const double sin_alpha = std::sin(alpha);
         const SunDisk sun{-Vec3(Normalize(dl.direction)), float(OneMinusCos(alpha)),
                           dl.irradiance * float(1 / (std::numbers::pi * sin_alpha * sin_alpha))};
+        directional_light_.push_back(int(lights_.size()));
         if (alpha > 0 && sun.one_minus_cos > 0 && std::isfinite(sun.radiance.MaxComponent()) &&
             std::isfinite(1 / (2 * kPi * sun.one_minus_cos))) {
             lights_.push_back({Kind::kSun, int(suns_.size()), 0, 0, false});
@@ -255,6 +258,15 @@ int EmissionSampler::LightOf(const SurfaceHit& hit) const {
     if (hit.sphere >= 0) return sphere_light_[size_t(hit.sphere)];
     if (hit.mesh < 0) return -1;
     return triangle_light_[size_t(hit.mesh)][size_t(hit.primitive)];
+}
+
+int EmissionSampler::LightOf(const LightSample& sample) const {
+    if (sample.sphere >= 0) return sphere_light_[size_t(sample.sphere)];
+    if (sample.point_light >= 0) return point_light_[size_t(sample.point_light)];
+    if (sample.spot_light >= 0) return spot_light_[size_t(sample.spot_light)];
+    if (sample.directional_light >= 0) return directional_light_[size_t(sample.directional_light)];
+    if (sample.point.mesh < 0) return -1;
+    return triangle_light_[size_t(sample.point.mesh)][size_t(sample.point.primitive)];
 }
 
 float EmissionSampler::InfiniteDirPdf(const Light& light, const Vec3& w) const {
