@@ -168,6 +168,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
         case Kind::kTriangle:
         case Kind::kSphere: {
             es.point = AreaPoint(light, u_pos);
+            if (light.kind == Kind::kSphere) es.sphere = light.index;
             es.pdf_pos = 1 / light.area;
             Vec2 u = u_dir;
             Vec3 n = es.point.n;

@@ -43,6 +43,7 @@ struct EmissionSample {
     float pdf_pos = 0;   // area density of point (1 for a delta position)
     float pdf_dir = 0;   // solid-angle density of w given point (1 for a delta direction)
     bool delta_pos = false, delta_dir = false;
+    int sphere = -1;  // sphere lights: the sphere (Scene::spheres) the point lies on
 
     // The ray that leaves the emitter, starting outside the point's error bound.
     Ray ray() const { return SpawnRay(point, w); }
