@@ -34,6 +34,9 @@ struct BdptVertex {
     bool infinite = false, delta_light = false;
     Vec3 w;
     int light = -1;
+    // Area-light endpoints and emitters the camera subpath hit: the primitive, for the
+    // LightSampler's density of choosing this point (LightSampler::Pdf).
+    int mesh = -1, primitive = 0, sphere = -1;
     // Surfaces: a delta lobe was sampled here (the vertex cannot be connected).
     bool delta = false;
     Rgb beta;
@@ -156,6 +159,26 @@ float BdptRenderer::PdfLightOrigin(const BdptVertex& v, const BdptVertex& next) 
     return emission_.Pmf(v.light) * emission_.PdfLe(v.light, v.p, v.ng, w).pos;
 }
 
+float BdptRenderer::NeeRatio(const BdptVertex& v, const BdptVertex& ref) const {
+    // Delta lights: both strategies pick them (the emission pick stands for both).
+    if (v.delta_light) return 1;
+    const float emit = PdfLightOrigin(v, ref);
+    if (!(emit > 0)) return 1;
+    if (v.infinite) return lights_.EscapedPdf(DirectionTo(ref, v)) / emit;
+    SurfaceHit hit;
+    hit.p = v.p;
+    hit.n = v.ng;
+    hit.mesh = v.mesh;
+    hit.primitive = v.primitive;
+    hit.sphere = v.sphere;
+    if (hit.mesh < 0 && hit.sphere < 0) return 1;
+    const Vec3 d = v.p - ref.p;
+    const float dist2 = LengthSquared(d);
+    if (!(dist2 > 0)) return 1;
+    const float cos_light = std::abs(Dot(v.ng, d)) / std::sqrt(dist2);
+    return lights_.Pdf(ref.p, ref.ns, hit) * cos_light / (dist2 * emit);
+}
+
 float BdptRenderer::PdfTo(const BdptVertex& v, const BdptVertex* prev,
                           const BdptVertex& next) const {
     if (v.type == BdptVertex::Type::kLight) return PdfLight(v, next);
@@ -262,6 +285,9 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
             (Dot(ray.d, hit->n) < 0 || EmitsFromBack(material))) {
             v.light = emission_.LightOf(*hit);
             if (v.light >= 0) v.le = v.sh.emission;
+            v.mesh = hit->mesh;
+            v.primitive = hit->primitive;
+            v.sphere = hit->sphere;
         }
         path.push_back(std::move(v));
         if (++bounces >= max_vertices) return;
@@ -318,6 +344,9 @@ void BdptRenderer::LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_d
     v.delta_light = es->delta_pos || es->delta_dir;
     v.on_surface = !v.infinite && !es->delta_pos;
     v.point = es->point;
+    v.mesh = es->point.mesh;
+    v.primitive = es->point.primitive;
+    v.sphere = es->sphere;
     v.p = es->point.p;
     v.ng = v.ns = es->point.n;
     v.w = es->w;
@@ -369,17 +398,32 @@ float BdptRenderer::MisWeight(Path& light, Path& camera, int s, int t) const {
     std::swap(pt_delta, pt->delta);
     if (qs) std::swap(qs_delta, qs->delta);
 
-    // Power heuristic: the sum over the other strategies of (p_i / p_{s,t})^2.
+    // Power heuristic: the sum over the other strategies of (p_i / p_{s,t})^2. The chain
+    // gives every strategy with a light vertex x0 the emission density of x0; strategy 1 (next
+    // event) samples x0 with the LightSampler instead, so its own term is scaled by
+    // nee = p_LightSampler(x0 | x1) / p_emission(x0), and when it is the strategy weighed, all the
+    // others by 1 / nee.
     double sum = 0, ri = 1;
     for (int i = t - 1; i > 0; --i) {
         ri *= Remap0(camera[size_t(i)].pdf_rev) / Remap0(camera[size_t(i)].pdf_fwd);
-        if (!camera[size_t(i)].delta && !camera[size_t(i - 1)].delta) sum += ri * ri;
+        if (!camera[size_t(i)].delta && !camera[size_t(i - 1)].delta) {
+            // s = 0: the term of i = t - 1 is next-event estimation's from camera[t - 2].
+            const double nee = s == 0 && i == t - 1 ? NeeRatio(*pt, *pt_minus) : 1.0;
+            sum += ri * ri * nee * nee;
+        }
     }
     ri = 1;
     for (int i = s - 1; i >= 0; --i) {
         ri *= Remap0(light[size_t(i)].pdf_rev) / Remap0(light[size_t(i)].pdf_fwd);
         const bool delta_before = i > 0 ? light[size_t(i - 1)].delta : light[0].delta_light;
-        if (!light[size_t(i)].delta && !delta_before) sum += ri * ri;
+        if (!light[size_t(i)].delta && !delta_before) {
+            const double nee = s >= 2 && i == 1 ? NeeRatio(light[0], light[1]) : 1.0;
+            sum += ri * ri * nee * nee;
+        }
+    }
+    if (s == 1) {
+        const double nee = NeeRatio(light[0], *pt);
+        if (nee > 0) sum /= nee * nee;
     }
 
     std::swap(pt_delta, pt->delta);
@@ -436,6 +480,9 @@ Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
         sampled.delta_light = ls->delta;
         sampled.on_surface = !ls->delta && !sampled.infinite;
         sampled.point = ls->point;
+        sampled.mesh = ls->point.mesh;
+        sampled.primitive = ls->point.primitive;
+        sampled.sphere = ls->sphere;
         sampled.p = ls->point.p;
         sampled.ng = sampled.ns = ls->point.n;
         sampled.w = -ls->wi;

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -244,6 +245,75 @@ TEST(Bdpt, MatchesThePathTracerUnderADirectionalLight) {
     scene.directional_lights.push_back({Normalize(Vec3d(0.3, -1, 0.4)), Rgb(2, 1.8f, 1.5f), 0});
     scene.camera = testing::SquareCamera({0, 1.2, -3}, {0, 0.4, 0}, {0, 1, 0}, 45, 32);
     CompareWithPathTracer("directional light", scene, 256, 512, 6);
+}
+
+// An open scene: a floor, a back wall, a glossy and a diffuse sphere, lit by whatever the
+// caller adds.
+Scene OpenScene() {
+    Scene scene;
+    Material white;
+    white.reflectance = Rgb(0.7f);
+    scene.materials.push_back(white);
+    Material glossy;
+    glossy.type = Material::Type::kGlossy;
+    glossy.roughness = 0.3f;
+    glossy.reflectance = Rgb(0.5f);
+    scene.materials.push_back(glossy);
+    Material red;
+    red.reflectance = Rgb(0.6f, 0.1f, 0.1f);
+    scene.materials.push_back(red);
+    TriangleMesh floor;
+    floor.material = 0;
+    floor.positions = {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}};
+    floor.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(floor);
+    TriangleMesh wall;
+    wall.material = 0;
+    wall.positions = {{-2, 0, 1}, {2, 0, 1}, {2, 2, 1}, {-2, 2, 1}};
+    wall.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(wall);
+    scene.spheres.push_back({"glossy", 1, {-0.5, 0.4, 0}, 0.4});
+    scene.spheres.push_back({"red", 2, {0.5, 0.4, -0.2}, 0.4});
+    scene.camera = testing::SquareCamera({0, 1.2, -3}, {0, 0.4, 0}, {0, 1, 0}, 45, 32);
+    return scene;
+}
+
+TEST(Bdpt, MatchesThePathTracerUnderASkyAndASunDisk) {
+    // Lights at infinity: camera paths that escape see them (s = 0), light paths start on the
+    // disk outside the scene, weighed as one light as the LightSampler does.
+    Scene scene = OpenScene();
+    scene.environment = EnvironmentLight{};
+    scene.environment->radiance = Rgb(0.3f, 0.4f, 0.6f);
+    scene.directional_lights.push_back(
+        {Normalize(Vec3d(-0.4, -1, 0.3)), Rgb(2, 1.8f, 1.5f), 5 * std::numbers::pi / 180});
+    CompareWithPathTracer("sky and sun", scene, 256, 512, 6);
+}
+
+TEST(Bdpt, MatchesThePathTracerUnderASpotLight) {
+    Scene scene = OpenScene();
+    SpotLight spot;
+    spot.position = {0.3, 1.8, -0.8};
+    spot.direction = Normalize(Vec3d(-0.3, -1, 0.5));
+    spot.intensity = Rgb(3, 2.5f, 2);
+    spot.inner_cone = 0.3;
+    spot.outer_cone = 0.5;
+    scene.spot_lights.push_back(spot);
+    CompareWithPathTracer("spot light", scene, 256, 512, 6);
+}
+
+TEST(Bdpt, MatchesThePathTracerThroughAThinLensAndAbsorbingGlass) {
+    // The camera's lens (t = 1 connections sample a lens point) and Beer's law in the glass
+    // sphere, on both subpaths and on connections through it.
+    Scene scene = LoadSmall("materials.json", 32);
+    scene.camera.aperture_radius = 0.01;
+    scene.camera.focus_distance = 1.0;
+    for (Material& m : scene.materials) {
+        if (m.type == Material::Type::kDielectric) {
+            m.attenuation_color = Rgb(0.3f, 0.6f, 0.9f);
+            m.attenuation_distance = 0.1f;
+        }
+    }
+    CompareWithPathTracer("thin lens, absorbing glass", scene, 256, 512, 8);
 }
 
 TEST(Bdpt, AnySplitOfTheWorkGivesTheSameBits) {

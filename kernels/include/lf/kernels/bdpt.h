@@ -12,9 +12,11 @@
 // the same path, computed from per-vertex forward and reverse area densities (pbrt's
 // remapped-pdf recursion): a delta lobe's density is remapped to 1 and a delta vertex (or a
 // vertex next to one, or a delta light) cannot be the end of a connection, so those strategies
-// drop out of the sum. The light vertex's density in the weights is the EmissionSampler's
-// (pick by power, then PdfLe), also for s = 1, whose sample comes from the LightSampler: the
-// weights still sum to 1 over the strategies, so every estimate stays unbiased.
+// drop out of the sum. A light vertex's density is the EmissionSampler's (pick by power, then
+// PdfLe) for the strategies with s >= 2, and the LightSampler's (LightSampler::Pdf, EscapedPdf)
+// for s = 1, as each strategy really samples it, so the weights sum to 1 over the strategies
+// that can make a path, whatever points either sampler can or cannot reach (delta lights: the
+// emission pick stands for both).
 //
 // Light subpaths carry importance: the adjoint BSDF (no 1/eta^2 across refraction) and the
 // shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) of Veach's thesis 5.3. Paths in
@@ -102,6 +104,10 @@ class BdptRenderer : public FrameRenderer {
     float PdfTo(const BdptVertex& v, const BdptVertex* prev, const BdptVertex& next) const;
     float PdfLight(const BdptVertex& light, const BdptVertex& next) const;
     float PdfLightOrigin(const BdptVertex& light, const BdptVertex& next) const;
+    // p_LightSampler(light | ref) / p_emission(light): how much likelier next-event estimation
+    // from `ref` picks the light vertex's point than the emission sampler does (both per area,
+    // per solid angle for lights at infinity); 1 for delta lights and where either is unknown.
+    float NeeRatio(const BdptVertex& light, const BdptVertex& ref) const;
     // f times the cosine at v towards unit direction `dir` (importance: the adjoint BSDF and the
     // shading-normal correction).
     Rgb FCos(const BdptVertex& v, const Vec3& dir, bool importance) const;
