@@ -290,9 +290,9 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
             v.sphere = hit->sphere;
         }
         path.push_back(std::move(v));
-        if (++bounces >= max_vertices) return;
-        if (bounces > kMaxPathDepth) {
-            ++stats.truncated_paths;
+        if (++bounces >= max_vertices) {
+            // Unlimited depth stops only at kMaxPathDepth (see the header): a cut path.
+            if (settings_.max_depth < 0) ++stats.truncated_paths;
             return;
         }
         BdptVertex& cur = path.back();
@@ -361,7 +361,7 @@ void BdptRenderer::LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_d
     const float cos = v.on_surface ? std::abs(Dot(es->point.n, es->w)) : 1.0f;
     v.beta = es->le * (cos / (es->pick * es->pdf_pos * es->pdf_dir));
     path.push_back(v);
-    const int max_vertices = settings_.max_depth < 0 ? kMaxPathDepth + 1 : settings_.max_depth;
+    const int max_vertices = settings_.max_depth < 0 ? kMaxPathDepth : settings_.max_depth;
     Walk(es->ray(), path[0].beta, es->pdf_dir, max_vertices, true, sampler, path, stats);
 }
 
