@@ -37,6 +37,9 @@ struct BdptVertex {
     // Area-light endpoints and emitters the camera subpath hit: the primitive, for the
     // LightSampler's density of choosing this point (LightSampler::Pdf).
     int mesh = -1, primitive = 0, sphere = -1;
+    // A light subpath's first vertex: NeeRatio(it, the second vertex), which every strategy
+    // with s >= 2 needs (computed once per light subpath).
+    float nee_ratio = 1;
     // Surfaces: a delta lobe was sampled here (the vertex cannot be connected).
     bool delta = false;
     Rgb beta;
@@ -417,7 +420,7 @@ float BdptRenderer::MisWeight(Path& light, Path& camera, int s, int t) const {
         ri *= Remap0(light[size_t(i)].pdf_rev) / Remap0(light[size_t(i)].pdf_fwd);
         const bool delta_before = i > 0 ? light[size_t(i - 1)].delta : light[0].delta_light;
         if (!light[size_t(i)].delta && !delta_before) {
-            const double nee = s >= 2 && i == 1 ? NeeRatio(light[0], light[1]) : 1.0;
+            const double nee = s >= 2 && i == 1 ? light[0].nee_ratio : 1.0;
             sum += ri * ri * nee * nee;
         }
     }
@@ -542,6 +545,7 @@ Rgb BdptRenderer::Sample(int x, int y, uint64_t sample_index, SplatList& splats,
     LightSubpath(u_pick, u_pos, u_dir, sampler, light, stats);
 
     const int nc = int(camera.size()), nl = int(light.size());
+    if (nl >= 2) light[0].nee_ratio = NeeRatio(light[0], light[1]);
     // s = 1 uses its own light sample, so it needs a slot even without a light subpath.
     if (light.empty()) light.emplace_back();
     Rgb L(0);
