@@ -25,11 +25,12 @@
 //
 // Depth and roulette: max_depth counts bounces as the path tracer does: a path of s + t
 // vertices has s + t - 2 bounces, and strategies with more than max_depth are not made, so the
-// image converges to the path tracer's at the same max_depth. Negative max_depth: unlimited
-// (kMaxPathDepth caps each subpath). Both subpaths play Russian roulette from their second
-// bounce on, the camera subpath on its throughput (times eta^2, as the path tracer), the light
-// subpath on its throughput relative to the emitted one; roulette only scales contributions,
-// so the weights (which ignore it) still sum to 1.
+// image converges to the path tracer's at the same max_depth (except for what the path tracer
+// cannot sample: delta lights seen through mirrors and glass, i.e. their caustics). Negative
+// max_depth: unlimited (kMaxPathDepth caps each subpath). Both subpaths play Russian roulette from
+// their second bounce on, the camera subpath on its throughput (times eta^2, as the path tracer),
+// the light subpath on its throughput relative to the emitted one; roulette only scales
+// contributions, so the weights (which ignore it) still sum to 1.
 //
 // Random numbers. Camera sample s of pixel (x, y) draws from Sampler(seed, x, y, s, sampler),
 // in this fixed order: the film point (2D, through Camera::SampleFilm), the lens point (2D,
