@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/pixel_filter.h"
+#include "lf/kernels/bdpt.h"
 #include "lf/kernels/light_tracer.h"
 #include "lf/kernels/ppm.h"
 
@@ -34,9 +35,14 @@ absl::StatusOr<std::unique_ptr<FrameRenderer>> MakeFrameRenderer(
         if (!ppm.ok()) return ppm.status();
         return std::unique_ptr<FrameRenderer>(std::move(*ppm));
     }
-    // bdpt is added with its renderer.
+    if (method == "bdpt") {
+        absl::StatusOr<std::unique_ptr<BdptRenderer>> bdpt =
+            BdptRenderer::Make(scene, camera, settings);
+        if (!bdpt.ok()) return bdpt.status();
+        return std::unique_ptr<FrameRenderer>(std::move(*bdpt));
+    }
     return absl::InvalidArgumentError(absl::StrCat(
-        "method ", std::string(method), ": no frame renderer (frame methods: light, ppm)"));
+        "method ", std::string(method), ": no frame renderer (frame methods: light, bdpt, ppm)"));
 }
 
 }  // namespace lf

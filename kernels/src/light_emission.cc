@@ -49,6 +49,7 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
             sphere->two_sided));
     }
     for (size_t i = 0; i < scene.point_lights.size(); ++i) {
+        point_light_.push_back(int(lights_.size()));
         lights_.push_back({Kind::kPoint, int(i), 0, 0, false});
         weights.push_back(4 * std::numbers::pi * LightPowerWeight(scene.point_lights[i].intensity));
     }
@@ -59,6 +60,7 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
         spots_.push_back({Vec3(spot.position - es.origin()), Vec3(Normalize(spot.direction)),
                           float(band.outer), float(1 / band.width),
                           spot.falloff == SpotLight::Falloff::kSmoothstep, spot.intensity});
+        spot_light_.push_back(int(lights_.size()));
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
         weights.push_back(SpotFalloffSolidAngle(spot) * LightPowerWeight(spot.intensity));
     }
@@ -70,6 +72,7 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
     for (size_t i = 0; i < scene.directional_lights.size(); ++i) {
         const DirectionalLight& dl = scene.directional_lights[i];
         // The same sun disk, and the same fallback to a delta light, as LightSampler's.
+        directional_light_.push_back(int(lights_.size()));
         if (const std::optional<SunDisk> sun = SunDiskOf(dl)) {
             lights_.push_back({Kind::kSun, int(suns_.size()), 0, 0, false});
             suns_.push_back(*sun);
@@ -126,6 +129,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
         case Kind::kSphere: {
             es.point = AreaPoint(light, u_pos);
             es.on_surface = true;
+            if (light.kind == Kind::kSphere) es.sphere = light.index;
             es.pdf_pos = 1 / light.area;
             Vec2 u = u_dir;
             Vec3 n = es.point.n;
@@ -216,6 +220,15 @@ int EmissionSampler::LightOf(const SurfaceHit& hit) const {
     if (hit.sphere >= 0) return sphere_light_[size_t(hit.sphere)];
     if (hit.mesh < 0) return -1;
     return triangle_light_[size_t(hit.mesh)][size_t(hit.primitive)];
+}
+
+int EmissionSampler::LightOf(const LightSample& sample) const {
+    if (sample.sphere >= 0) return sphere_light_[size_t(sample.sphere)];
+    if (sample.point_light >= 0) return point_light_[size_t(sample.point_light)];
+    if (sample.spot_light >= 0) return spot_light_[size_t(sample.spot_light)];
+    if (sample.directional_light >= 0) return directional_light_[size_t(sample.directional_light)];
+    if (sample.point.mesh < 0) return -1;
+    return triangle_light_[size_t(sample.point.mesh)][size_t(sample.point.primitive)];
 }
 
 float EmissionSampler::InfiniteDirPdf(const Light& light, const Vec3& w) const {

@@ -360,6 +360,7 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
             ls.point =
                 scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z));
         }
+        ls.sphere = light.index;
         emission = scene.materials[size_t(scene.spheres[size_t(light.index)].material)].emission;
     }
     const Vec3 d = ls.point.p - ref;
@@ -436,6 +437,7 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
     ls.delta = true;
     if (light.kind == Kind::kDirectional) {
         const DirectionalLight& dl = scene.directional_lights[size_t(light.index)];
+        ls.directional_light = light.index;
         ls.wi = -Vec3(Normalize(dl.direction));
         ls.point.p = InfinitePoint(ref, ls.wi);
         ls.point.n = -ls.wi;
@@ -445,6 +447,7 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
     const bool spot = light.kind == Kind::kSpot;
     const Vec3d position = spot ? scene.spot_lights[size_t(light.index)].position
                                 : scene.point_lights[size_t(light.index)].position;
+    (spot ? ls.spot_light : ls.point_light) = light.index;
     ls.point.p = Vec3(position - scene_.origin());
     const Vec3 d = ls.point.p - ref;
     const float dist2 = LengthSquared(d);

@@ -9,9 +9,16 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// From p on or inside the sphere there is no cone: every direction sees it.
+// From p on or inside the sphere there is no cone: every direction sees it. "On" includes the
+// rounding of a point on the sphere itself (a hit on an emissive sphere seen from inside lies
+// half the time just outside it in float): seen from just outside, the cone would be a
+// hemisphere whose every ray meets the sphere at p itself, so next-event estimation from the
+// inside of a spherical emitter would find nothing while its Pdf says otherwise. Area sampling
+// stays exact for points that truly lie within the tolerance outside.
+constexpr double kOnSphereTolerance = 1e-5;  // relative, on the squared distance
 bool Inside(const Vec3& p, const Vec3& center, float radius) {
-    return LengthSquared(Vec3d(p) - Vec3d(center)) <= double(radius) * radius;
+    return LengthSquared(Vec3d(p) - Vec3d(center)) <=
+           double(radius) * radius * (1 + kOnSphereTolerance);
 }
 
 // 1 - cos(theta_max) of the cone sin^2(theta_max) = sin2, written so that it keeps its digits

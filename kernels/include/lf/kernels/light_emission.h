@@ -31,6 +31,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/environment_emitter.h"
 #include "lf/kernels/light_list.h"
+#include "lf/kernels/lights.h"
 
 namespace lf {
 
@@ -46,6 +47,7 @@ struct EmissionSample {
     // An area light: point lies on the emitter's surface (point.n its geometric normal), so a
     // camera can see it; false for point, spot and the lights at infinity.
     bool on_surface = false;
+    int sphere = -1;  // sphere lights: the sphere (Scene::spheres) the point lies on
 
     // The ray that leaves the emitter, starting outside the point's error bound.
     Ray ray() const { return SpawnRay(point, w); }
@@ -64,6 +66,12 @@ class EmissionSampler {
     size_t size() const { return lights_.size(); }
     // Probability with which Sample picks `light`.
     float Pmf(int light) const { return picks_.pmf[size_t(light)]; }
+    // Whether `light` is at infinity (directional, sun disk, environment): its rays start on the
+    // disk outside the scene and its densities are per solid angle of direction.
+    bool AtInfinity(int light) const {
+        const Kind kind = lights_[size_t(light)].kind;
+        return kind == Kind::kDirectional || kind == Kind::kSun || kind == Kind::kEnvironment;
+    }
     // Radius of the sphere about the render-space origin that holds the scene: the disk the
     // lights at infinity emit from has this radius.
     float scene_radius() const { return scene_radius_; }
@@ -75,6 +83,10 @@ class EmissionSampler {
 
     // The light a surface hit is on (an emissive triangle or sphere), or -1.
     int LightOf(const SurfaceHit& hit) const;
+    // The light a LightSampler sample came from (its point's triangle or sphere, or its point,
+    // spot or directional light), or -1 for the lights at infinity, which LightSampler weighs as
+    // one (EscapedPdfLe gives their density).
+    int LightOf(const LightSample& sample) const;
 
     // The densities (without the pick probability) with which Sample, having picked `light`,
     // would emit from point p (normal n: the surface's geometric normal for area lights, ignored
@@ -118,7 +130,9 @@ class EmissionSampler {
     LightPickTable picks_;
     std::vector<std::vector<int>> triangle_light_;  // per mesh, per triangle: light or -1
     std::vector<int> sphere_light_;                 // per sphere: light or -1
-    std::vector<SpotCone> spots_;                   // per spot light
+    // The lights of the scene's point, spot and directional lights, by their index there.
+    std::vector<int> point_light_, spot_light_, directional_light_;
+    std::vector<SpotCone> spots_;  // per spot light
     std::vector<SunDisk> suns_;
     std::optional<EnvironmentEmitter> environment_;
     float scene_radius_ = 1;

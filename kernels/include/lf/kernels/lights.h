@@ -43,6 +43,12 @@ struct LightSample {
     float pdf = 0;       // solid angle density times the pick probability; for a delta light
                          // just the pick probability
     bool delta = false;  // point, spot, directional: not reachable by BSDF sampling
+    // Which emitter of the scene this is, for estimators that weigh the sample with another
+    // sampler's densities (BDPT, via EmissionSampler::LightOf): the sphere (Scene::spheres) a
+    // sphere light's point lies on, or the index of the point, spot or directional light in its
+    // Scene list; -1 otherwise. Triangles carry point.mesh and point.primitive; the lights at
+    // infinity (sun disks, environment) are weighed as one and name none.
+    int sphere = -1, point_light = -1, spot_light = -1, directional_light = -1;
 };
 
 class LightSampler {

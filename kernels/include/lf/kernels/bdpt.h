@@ -1,0 +1,129 @@
+// Bidirectional path tracing (`--method bdpt`; Veach 1997, ch. 10, with pbrt-v4's
+// BDPTIntegrator as the model). Each camera sample traces a camera subpath and a light subpath
+// and joins every prefix pair (s light vertices, t camera vertices) into a full path:
+//  - s = 0: the camera subpath reaches an emitter itself (area lights, and the sky and sun
+//    disks when it escapes);
+//  - s = 1: next-event estimation from a camera vertex with the path tracer's LightSampler
+//    (lf/kernels/lights.h), its strategy and its delta lights;
+//  - t = 1: a light vertex connected to the camera (Camera::SampleWi): the contribution lands
+//    on whatever pixel the connection's raster position falls in, so it is splatted;
+//  - s, t >= 2: a shadow ray between a light vertex and a camera vertex.
+// The strategies are weighed by the power heuristic over all strategies that could have made
+// the same path, computed from per-vertex forward and reverse area densities (pbrt's
+// remapped-pdf recursion): a delta lobe's density is remapped to 1 and a delta vertex (or a
+// vertex next to one, or a delta light) cannot be the end of a connection, so those strategies
+// drop out of the sum. A light vertex's density is the EmissionSampler's (pick by power, then
+// PdfLe) for the strategies with s >= 2, and the LightSampler's (LightSampler::Pdf, EscapedPdf)
+// for s = 1, as each strategy really samples it, so the weights sum to 1 over the strategies
+// that can make a path, whatever points either sampler can or cannot reach (delta lights: the
+// emission pick stands for both).
+//
+// Light subpaths carry importance: the adjoint BSDF (no 1/eta^2 across refraction) and the
+// shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) of Veach's thesis 5.3. Paths in
+// the interiors of solid transmitters are attenuated by Beer's law as in the path tracer, on
+// both subpaths and on connection segments; both subpaths start outside every interior.
+//
+// Depth and roulette: max_depth counts bounces as the path tracer does: a path of s + t
+// vertices has s + t - 2 bounces, and strategies with more than max_depth are not made, so the
+// image converges to the path tracer's at the same max_depth (except for what the path tracer
+// cannot sample: delta lights seen through mirrors and glass, i.e. their caustics). Negative
+// max_depth: unlimited (kMaxPathDepth caps each subpath). Both subpaths play Russian roulette from
+// their second bounce on, the camera subpath on its throughput (times eta^2, as the path tracer),
+// the light subpath on its throughput relative to the emitted one; roulette only scales
+// contributions, so the weights (which ignore it) still sum to 1.
+//
+// Random numbers. Camera sample s of pixel (x, y) draws from Sampler(seed, x, y, s, sampler),
+// in this fixed order: the film point (2D, through Camera::SampleFilm), the lens point (2D,
+// only when the camera has a lens), the light subpath's emission (1D light pick, 2D position,
+// 2D direction), then four draws per camera vertex (2D: next-event light pick and BSDF lobe;
+// 2D next-event point; 2D BSDF direction; 1D roulette), then four per light vertex (2D lobe;
+// 2D lens point of its t = 1 connection; 2D direction; 1D roulette). The result is a pure
+// function of (seed, pixel, sample): any split of the samples over tasks and threads gives the
+// same sums.
+//
+// Where results go. The t >= 2 strategies of a sample add up to one camera sample of its pixel
+// (PixelSums::Add with the sample's index); each t = 1 contribution is splatted into the
+// SplatList at the pixel holding its raster position, half = the camera sample's parity, with
+// pbrt's film-normalised importance: a pixel is its camera mean plus its splat sum times
+// W H / N, N the camera samples of the frame (lf/job/frame_merge.h). Only the box filter is
+// supported (Make refuses the others): a splat goes to one pixel.
+#pragma once
+
+#include <atomic>
+#include <memory>
+
+#include "absl/status/statusor.h"
+#include "lf/core/camera.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/frame_renderer.h"
+#include "lf/kernels/light_emission.h"
+#include "lf/kernels/lights.h"
+
+namespace lf {
+
+struct BdptVertex;
+
+class BdptRenderer : public FrameRenderer {
+  public:
+    // The renderer for `scene` seen through `camera` (both must outlive it). FailedPrecondition
+    // naming bdpt and the filter when the scene's camera has a pixel filter other than box.
+    static absl::StatusOr<std::unique_ptr<BdptRenderer>> Make(const EmbreeScene& scene,
+                                                              const Camera& camera,
+                                                              const FrameRenderSettings& settings);
+    BdptRenderer(const EmbreeScene& scene, const Camera& camera,
+                 const FrameRenderSettings& settings);
+    ~BdptRenderer() override;
+
+    // Camera samples [work.sample_begin, work.sample_end) of every pixel of work.rect; the path
+    // range is unused (a sample's light subpath is its own). Rows run in parallel (tbb), each
+    // into its own sums, which are then added exactly.
+    void Render(const FrameWork& work, TileSums& camera, SplatList& splats,
+                const std::atomic<bool>* cancel = nullptr) const override;
+
+    // One camera sample of pixel (x, y): its t >= 2 strategies' sum (unclamped) is returned,
+    // its t = 1 contributions (clamped per splat) added to `splats`. Rays cast go to stats.rays,
+    // non-finite splats to stats.invalid_samples. For tests and Render.
+    Rgb Sample(int x, int y, uint64_t sample_index, SplatList& splats, RenderStats& stats) const;
+
+  private:
+    struct Scratch;
+    using Path = std::vector<BdptVertex>;
+
+    // Extends `path` (whose last vertex is where `ray` starts) by up to `max_vertices` vertices.
+    void Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool importance, Sampler& sampler,
+              Path& path, RenderStats& stats) const;
+    // The light subpath of the emission numbers; empty when the sample carries no light.
+    void LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_dir, Sampler& sampler,
+                      Path& path, RenderStats& stats) const;
+    // Strategy (s, t) for t >= 2 (camera sum) or t = 1 (then *raster is set when it
+    // contributes); 0 when it does not apply or is occluded. Weighted.
+    Rgb Connect(Path& light, Path& camera, int s, int t, Vec2* raster, RenderStats& stats) const;
+    float MisWeight(Path& light, Path& camera, int s, int t) const;
+
+    // Densities (area measure at `next`, or solid angle when next is at infinity).
+    float ConvertDensity(const BdptVertex& from, float pdf, const BdptVertex& next) const;
+    float PdfTo(const BdptVertex& v, const BdptVertex* prev, const BdptVertex& next) const;
+    float PdfLight(const BdptVertex& light, const BdptVertex& next) const;
+    float PdfLightOrigin(const BdptVertex& light, const BdptVertex& next) const;
+    // p_LightSampler(light | ref) / p_emission(light): how much likelier next-event estimation
+    // from `ref` picks the light vertex's point than the emission sampler does (both per area,
+    // per solid angle for lights at infinity); 1 for delta lights and where either is unknown.
+    float NeeRatio(const BdptVertex& light, const BdptVertex& ref) const;
+    // f times the cosine at v towards unit direction `dir` (importance: the adjoint BSDF and the
+    // shading-normal correction).
+    Rgb FCos(const BdptVertex& v, const Vec3& dir, bool importance) const;
+    // Beer's law along the segment from surface vertex `from` towards `to`, 0 when occluded.
+    Rgb Transmission(const BdptVertex& from, const BdptVertex& to, RenderStats& stats) const;
+    // The interior a ray leaving surface vertex v in direction dir travels through, or -1.
+    int MediumToward(const BdptVertex& v, const Vec3& dir) const;
+
+    const EmbreeScene& scene_;
+    const Camera& camera_;
+    FrameRenderSettings settings_;
+    LightSampler lights_;
+    EmissionSampler emission_;
+    float infinite_pdf_pos_;  // 1 / (pi R^2): the density of the disk lights at infinity use
+    bool has_infinite_;       // the scene has a sky or a sun disk that escaping rays see
+};
+
+}  // namespace lf
