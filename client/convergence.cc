@@ -18,6 +18,7 @@
 #include "lf/core/camera.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
+#include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/frame_settings.h"
 #include "lf/job/render_metadata.h"
@@ -478,10 +479,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         c.width = options.resolution;
     }
     if (with_radiosity) {
-        std::string why;
-        absl::StatusOr<std::string> automatic = ChooseMethod(*scene, "auto", &why);
-        if (!automatic.ok()) return automatic.status();
-        if (*automatic != "radiosity") {
+        if (const std::string why = RadiosityLimitation(*scene); !why.empty()) {
             return absl::InvalidArgumentError(absl::StrCat(
                 "--method ", options.method, ": radiosity cannot model this scene: ", why));
         }

@@ -20,6 +20,7 @@
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/ray_tracer.h"
 #include "lf/kernels/whitted.h"
+#include "method_choice.h"
 #include "output_flags.h"
 #include "progress_bar.h"
 #include "radiosity_flags.h"
@@ -36,14 +37,9 @@ absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& 
         *why = "requested";
         return requested;
     }
-    // Whitted is never chosen: it is exact only in scenes without interreflection or caustics
-    // (WhittedMissingTerms), which `plan` reports; a preview is the user's choice.
-    if (std::string limitation = RadiosityLimitation(scene); !limitation.empty()) {
-        *why = std::move(limitation);
-        return std::string("path");
-    }
-    *why = "every material is Lambertian";
-    return std::string("radiosity");
+    MethodChoice choice = ChooseAutomatically(scene);
+    *why = std::move(choice.why);
+    return choice.method;
 }
 
 std::string MethodFlagError(const std::string& method, bool allow_auto) {

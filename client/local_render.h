@@ -54,11 +54,9 @@ struct LocalRenderSummary {
 
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options);
 
-// The method for `requested` (path, radiosity, whitted or auto) and, in *why, the reason.
-// `auto`: radiosity models exactly the scenes it can (all Lambertian, no spheres) and is
-// view-independent; everything else needs the path tracer. Never whitted, which misses
-// interreflection and caustics in nearly every scene (lf/kernels/whitted.h,
-// WhittedMissingTerms). Nor the frame methods (light, bdpt, ppm), which are the user's choice.
+// The method for `requested` (a method name or auto) and, in *why, the reason. `auto`:
+// ChooseAutomatically (method_choice.h): radiosity where it is exact, bdpt for caustics from
+// small emitters, whitted where it is exact, else the path tracer.
 absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
                                          std::string* why);
 

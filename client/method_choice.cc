@@ -1,9 +1,11 @@
 #include "method_choice.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/kernels/whitted.h"
@@ -75,9 +77,9 @@ SceneTransport AnalyzeTransport(const Scene& scene) {
         const double fraction =
             box_area > 0 && std::isfinite(box_area) ? emitting_area[i] / box_area : 1;
         if (fraction < kSmallEmitterFraction) {
-            out.small_emitters.push_back(absl::StrCat("emitter \"", m.name, "\" (",
-                                                      absl::SixDigits(100 * fraction),
-                                                      " % of the scene's bounding surface)"));
+            out.small_emitters.push_back(
+                absl::StrFormat("emitter \"%s\" (%.2g %% of the scene's bounding surface)", m.name,
+                                100 * fraction));
         }
     }
     const auto count = [](size_t n, const char* what) {
@@ -93,6 +95,18 @@ SceneTransport AnalyzeTransport(const Scene& scene) {
         out.small_emitters.push_back(
             count(scene.directional_lights.size(), "directional light or sun"));
     }
+    if (!scene.point_lights.empty()) {
+        out.delta_lights.push_back(count(scene.point_lights.size(), "point light"));
+    }
+    if (!scene.spot_lights.empty()) {
+        out.delta_lights.push_back(count(scene.spot_lights.size(), "spot light"));
+    }
+    const size_t parallel =
+        size_t(std::count_if(scene.directional_lights.begin(), scene.directional_lights.end(),
+                             [](const DirectionalLight& l) { return !(l.angular_diameter > 0); }));
+    if (parallel > 0) {
+        out.delta_lights.push_back(count(parallel, "directional light without a sun disk"));
+    }
     out.point_like_only = !area_lights && !scene.environment &&
                           (!scene.point_lights.empty() || !scene.spot_lights.empty() ||
                            !scene.directional_lights.empty());
@@ -101,20 +115,25 @@ SceneTransport AnalyzeTransport(const Scene& scene) {
 
 MethodChoice ChooseAutomatically(const Scene& scene) {
     const SceneTransport t = AnalyzeTransport(scene);
-    if (t.radiosity_limitation.empty()) {
-        return {"radiosity", "every material is Lambertian: radiosity is exact and noiseless"};
-    }
-    if (t.caustics()) {
-        return {"bdpt", absl::StrCat("caustics (L S+ D E): light from ",
-                                     absl::StrJoin(t.small_emitters, ", "), " through ",
-                                     absl::StrJoin(t.specular, ", "),
-                                     "; camera paths find them only by hitting a small emitter")};
-    }
-    if (t.whitted_missing.empty()) {
+    // Whitted before radiosity: where it is exact it has no meshing error either.
+    if (t.whitted_missing.empty() && scene.HasLights()) {
         return {"whitted",
                 absl::StrCat("no interreflection and no caustics: classic ray tracing is exact "
                              "here",
                              t.point_like_only ? " (point-like lights only)" : "")};
+    }
+    if (t.radiosity_limitation.empty()) {
+        return {"radiosity", "every material is Lambertian"};
+    }
+    if (t.caustics()) {
+        return {
+            "bdpt",
+            absl::StrCat("caustics (L S+ D E): light from ", absl::StrJoin(t.small_emitters, ", "),
+                         " through ", absl::StrJoin(t.specular, ", "),
+                         t.delta_caustics()
+                             ? "; the path tracer cannot sample those of the " +
+                                   absl::StrJoin(t.delta_lights, ", ") + " at all"
+                             : "; camera paths find them only by hitting a small emitter")};
     }
     return {"path", t.radiosity_limitation};
 }

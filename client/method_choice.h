@@ -25,11 +25,17 @@ struct SceneTransport {
     // emitters if their area is below kSmallEmitterFraction of the scene's bounding-box surface.
     std::vector<std::string> small_emitters;
     bool point_like_only = false;  // every light is a point, spot or directional light
+    // Point, spot and directional lights without a disk: their caustics (L S+ D E with a delta
+    // light) are paths the path tracer cannot sample at all (a BSDF sample never hits a point
+    // light, a shadow ray never passes glass), so it converges to an image without them.
+    std::vector<std::string> delta_lights;
     // What Whitted misses here (lf/kernels/whitted.h): empty when it is exact.
     std::vector<std::string> whitted_missing;
 
     // L S+ D E paths from a small emitter: caustics.
     bool caustics() const { return !specular.empty() && diffuse && !small_emitters.empty(); }
+    // The caustics of delta lights: the path tracer (and Whitted) leave them out.
+    bool delta_caustics() const { return !specular.empty() && diffuse && !delta_lights.empty(); }
 };
 
 // Glossy materials with a microfacet alpha below this behave as mirrors for caustics.
@@ -45,9 +51,10 @@ struct MethodChoice {
     std::string why;
 };
 
-// `--method auto`: radiosity where it is exact (view-independent, noiseless); bdpt for caustics
-// from small emitters; whitted where it is exact (point-like lights, no interreflection, no
-// caustics: it then equals the path tracer, faster and noiseless); otherwise the path tracer.
+// `--method auto`: whitted where it is exact (no interreflection, no caustics: it then equals
+// the path tracer, faster, and has no meshing error); radiosity where it is exact
+// (view-independent, noiseless); bdpt for caustics from small emitters; otherwise the path
+// tracer.
 MethodChoice ChooseAutomatically(const Scene& scene);
 
 }  // namespace lf

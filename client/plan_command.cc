@@ -2,11 +2,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <set>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "command.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_error.h"
@@ -24,6 +26,9 @@
 #include "lf/local/local_executor.h"
 #include "lf/local/render_prediction.h"
 #include "local_render.h"
+#include "method_choice.h"
+#include "method_render.h"
+#include "photon_flags.h"
 #include "radiosity_flags.h"
 #include "sample_flags.h"
 #include "scene_flags.h"
@@ -52,6 +57,8 @@ struct PlanOptions {
     SamplerType sampler = defaults::kSampler;
     LightStrategy light_strategy = defaults::kLightStrategy;
     double clamp = 0;
+    PhotonSettings ppm;  // the ppm pilot's --photons, --ppm-radius, --ppm-alpha
+    bool compare_methods = true;
 };
 
 std::string Color(const Rgb& c) { return absl::StrFormat("(%.3g, %.3g, %.3g)", c.r, c.g, c.b); }
@@ -191,6 +198,84 @@ double TriangleArea(const TriangleMesh& mesh, const std::array<uint32_t, 3>& t) 
     return 0.5 * Length(Cross(b - a, c - a));
 }
 
+// The Monte Carlo methods that render this scene completely, each costed for the target from
+// a two-stage pilot over the whole image (RenderWithMethod, PredictMethodCost), fastest first
+// named. Light tracing only where it sees everything (no mirror, glass or sky to look at);
+// Whitted only where it is exact.
+absl::Status PrintMethodCosts(const Scene& scene, const EmbreeScene& embree, const Camera& camera,
+                              const PlanOptions& options, const std::string& chosen) {
+    const SceneTransport transport = AnalyzeTransport(scene);
+    std::vector<std::string> methods = {"path", "bdpt", "ppm"};
+    if (transport.specular.empty() && !scene.environment) methods.push_back("light");
+    if (transport.whitted_missing.empty()) methods.push_back("whitted");
+    const uint64_t stages[2] = {options.pilot_spp, 4 * options.pilot_spp};
+    std::printf(
+        "methods for --target-error %.4g: pilots of %llu then %llu spp over the whole image; "
+        "error = sqrt of the A/B relMSE estimate (ppm's bias is not in it: its noise falls as "
+        "passes^-alpha/2, the rate used)\n",
+        options.target_error, (unsigned long long)stages[0], (unsigned long long)stages[1]);
+    std::printf("  %-8s %9s %10s %6s %14s %14s\n", "method", "pilot s", "error", "rate",
+                "spp to target", "s to target");
+    MethodRenderSettings settings;
+    settings.max_depth = options.max_depth;
+    settings.seed = options.seed;
+    settings.sampler = options.sampler;
+    settings.light_strategy = options.light_strategy;
+    settings.clamp = options.clamp;
+    settings.threads = options.threads;
+    settings.tile = options.tile;
+    settings.ppm = options.ppm;
+    std::string fastest, path_note;
+    double fastest_seconds = std::numeric_limits<double>::infinity(), path_seconds = 0;
+    for (const std::string& method : methods) {
+        MethodPilotStage measured[2];
+        for (int k = 0; k < 2; ++k) {
+            absl::StatusOr<RenderOutput> out =
+                RenderWithMethod(method, embree, camera, settings, stages[k]);
+            if (!out.ok()) return out.status();
+            absl::StatusOr<double> relmse = EstimatedRelMse(out->image);
+            if (!relmse.ok()) return relmse.status();
+            measured[k] = {stages[k], out->seconds, std::sqrt(*relmse)};
+        }
+        const double ppm_rate = options.ppm.alpha / 2;
+        absl::StatusOr<MethodCost> cost =
+            method == "ppm" ? PredictMethodCost(measured[0], measured[1], options.target_error,
+                                                ppm_rate, ppm_rate)
+                            : PredictMethodCost(measured[0], measured[1], options.target_error,
+                                                kMinConvergenceRate, kMaxConvergenceRate);
+        if (!cost.ok()) return cost.status();
+        // The path tracer converges to an image without the caustics of delta lights: costed, but
+        // not a candidate.
+        const bool incomplete = method == "path" && transport.delta_caustics();
+        std::printf("  %-8s %9.2f %10.4g %6.2f %14.0f %14.1f%s\n", method.c_str(),
+                    measured[0].seconds + measured[1].seconds, measured[1].error, cost->rate,
+                    cost->spp, cost->seconds,
+                    incomplete ? absl::StrCat("  (incomplete: no caustics of the ",
+                                              absl::StrJoin(transport.delta_lights, ", "), ")")
+                                     .c_str()
+                               : "");
+        if (method == "path") path_seconds = cost->seconds;
+        if (!incomplete && cost->seconds < fastest_seconds) {
+            fastest_seconds = cost->seconds;
+            fastest = method;
+        }
+    }
+    std::printf("fastest to the target by its pilot: %s", fastest.c_str());
+    if (fastest != "path" && fastest_seconds > 0 && !transport.delta_caustics()) {
+        std::printf(" (%.1fx faster than path)", path_seconds / fastest_seconds);
+    }
+    std::printf("%s\n",
+                fastest == chosen
+                    ? ", the method chosen"
+                    : absl::StrCat("; the method chosen is ", chosen, " (--method)").c_str());
+    if (transport.caustics()) {
+        std::printf(
+            "  caustics here: a short pilot of path tracing sees little of them, so its error "
+            "and cost are underestimated most\n");
+    }
+    return absl::OkStatus();
+}
+
 absl::Status RunPlan(const PlanOptions& options) {
     absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
@@ -238,18 +323,9 @@ absl::Status RunPlan(const PlanOptions& options) {
     std::string why;
     absl::StatusOr<std::string> method = ChooseMethod(*scene, options.method, &why);
     if (!method.ok()) return method.status();
-    // Their pilots (light paths, photon passes) are not costed yet: a path-traced pilot would
-    // answer for another estimator.
-    if (UsesFramePlan(*method)) {
-        return absl::UnimplementedError(
-            absl::StrCat("plan --method ", *method,
-                         ": no pilot for this method yet; `lightfarm render "
-                         "--method ",
-                         *method, "` renders it"));
-    }
     std::printf("method (--method %s): %s, because %s\n", options.method.c_str(), method->c_str(),
                 why.c_str());
-    // Whitted is never auto's choice; plan says what it would give (lf/kernels/whitted.h).
+    // What Whitted would give (lf/kernels/whitted.h), whether or not it is the method.
     if (const std::vector<std::string> missing = WhittedMissingTerms(*scene); missing.empty()) {
         std::printf(
             "whitted: exact for this scene (direct light and specular chains are all its light "
@@ -290,10 +366,13 @@ absl::Status RunPlan(const PlanOptions& options) {
         std::printf("radiosity: not used\n");
     }
 
+    const Camera camera(scene->camera, (*embree)->origin());
+    // The frame methods are not adaptive: the comparison of methods is their cost.
+    if (UsesFramePlan(*method)) return PrintMethodCosts(*scene, **embree, camera, options, *method);
+
     // A pilot in two stages at the full resolution, each tile's error measured after both, so
     // that how fast it falls is measured rather than assumed (docs/convergence.md, "Error
     // estimates and plan predictions").
-    const Camera camera(scene->camera, (*embree)->origin());
     // Radiosity's display error is costed with the path tracer's pilot, as before.
     const std::string pilot_method = *method == "whitted" ? "whitted" : "path";
     absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
@@ -332,7 +411,7 @@ absl::Status RunPlan(const PlanOptions& options) {
             "makes it surer\n",
             p->tiles_disagreeing, p->tiles, p->first_stage_mean_spp);
     }
-    return absl::OkStatus();
+    return PrintMethodCosts(*scene, **embree, camera, options, *method);
 }
 
 }  // namespace
@@ -346,15 +425,19 @@ Command AddPlanCommand(CLI::App& app) {
         "time and memory of the form factors and the solve (from a pilot solve of fewer\n"
         "patches), and the samples and time a target error needs (from a two-stage pilot\n"
         "render's own error estimates, how fast they fall, and its speed; give the render's\n"
-        "--spp, --tile, --seed and --max-spp for its passes).");
+        "--spp, --tile, --seed and --max-spp for its passes), then the same target's cost for\n"
+        "each Monte Carlo method that renders the scene completely (path, bdpt, ppm; light\n"
+        "where nothing specular or sky is seen; whitted where it is exact), each from a\n"
+        "two-stage pilot of the whole image, and which is fastest.");
     cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
     AddSceneFlags(cmd, options->scene);
     cmd->add_option("--method", options->method,
                     "the method to cost: path, radiosity (adds the cost of the form factors "
-                    "and the solve, from a pilot solve), whitted (the pilot traces it) or auto "
-                    "(as render --method auto)")
+                    "and the solve, from a pilot solve), whitted (the pilot traces it), light, "
+                    "bdpt, ppm, or auto (as render --method auto). Every Monte Carlo method that "
+                    "renders the scene completely is costed as well, from its own pilot")
         ->capture_default_str()
         ->check([](const std::string& m) { return MethodFlagError(m, true); });
     cmd->add_option("--target-error", options->target_error,
@@ -387,6 +470,7 @@ Command AddPlanCommand(CLI::App& app) {
     AddSamplerFlag(cmd, options->sampler);
     AddLightSamplingFlag(cmd, options->light_strategy);
     AddClampFlag(cmd, options->clamp);
+    AddPhotonFlags(cmd, options->ppm);
     return {cmd, [options] {
                 const absl::Status status = RunPlan(*options);
                 return status.ok() ? 0 : ReportError(status);

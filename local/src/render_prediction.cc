@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 
 namespace lf {
 
@@ -115,6 +116,35 @@ absl::StatusOr<RenderPrediction> PredictAdaptiveRender(const Camera& camera,
     p.seconds = samples * seconds_per_sample;
     p.high_seconds = high * seconds_per_sample;
     return p;
+}
+
+absl::StatusOr<MethodCost> PredictMethodCost(const MethodPilotStage& first,
+                                             const MethodPilotStage& second, double target_error,
+                                             double min_rate, double max_rate) {
+    if (first.spp == 0 || second.spp <= first.spp || !(second.seconds >= 0) ||
+        !(target_error > 0) || !(min_rate > 0) || min_rate > max_rate) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "method pilot: stages of %d and %d spp, target error %g, rates [%g, %g]: expected "
+            "0 < first < second spp, a positive target and 0 < min rate <= max rate",
+            first.spp, second.spp, target_error, min_rate, max_rate));
+    }
+    MethodCost cost;
+    cost.stages[0] = first;
+    cost.stages[1] = second;
+    const double log_spp = std::log(double(second.spp) / double(first.spp));
+    const double measured = first.error > 0 && second.error > 0
+                                ? std::log(first.error / second.error) / log_spp
+                                : min_rate;
+    cost.rate = std::clamp(measured, min_rate, max_rate);
+    if (!(second.error > 0)) {  // nothing left to converge (a black or noiseless image)
+        cost.spp = double(first.spp);
+        cost.seconds = first.seconds;
+        return cost;
+    }
+    const double factor = std::pow(second.error / target_error, 1 / cost.rate);
+    cost.spp = double(second.spp) * std::max(1.0, factor);
+    cost.seconds = second.seconds * cost.spp / double(second.spp);
+    return cost;
 }
 
 }  // namespace lf

@@ -197,12 +197,47 @@ TEST_F(Cli, RadiosityRefusesWhatItCannotModel) {
     const RunResult automatic = Lightfarm("render " + scene + " -o " + (dir_ / "m.exr").string() +
                                           " --method auto --spp 1 --no-progress");
     EXPECT_EQ(automatic.status, 0) << automatic.output;
-    EXPECT_NE(automatic.output.find("method path (material"), std::string::npos)
+    // Auto sees the caustics of its small lamp and its point light through glass and a mirror.
+    EXPECT_NE(automatic.output.find("method bdpt (caustics (L S+ D E): light from emitter "
+                                    "\"light\" (0.74 % of the scene's bounding surface), 1 "
+                                    "point light through mirror, glass; the path tracer cannot "
+                                    "sample those of the 1 point light at all)"),
+              std::string::npos)
         << automatic.output;
 }
 
+// --method auto reads the scene's light transport: caustics from a small lamp through glass
+// and a mirror take bdpt; a lit plane alone (no interreflection, no caustics) takes Whitted,
+// exact there; the Cornell box (all Lambertian) radiosity.
+TEST_F(Cli, AutoPicksTheMethodTheSceneRequiresAndSaysWhy) {
+    const auto method_line = [&](const std::string& scene) {
+        const RunResult r = Lightfarm("render " + scene + " -o " + (dir_ / "a.exr").string() +
+                                      " --method auto --spp 2 --resolution 8x8 --no-progress");
+        EXPECT_EQ(r.status, 0) << r.output;
+        const size_t at = r.output.find(" method ");
+        return at == std::string::npos ? r.output
+                                       : r.output.substr(at + 1, r.output.find('\n', at) - at - 1);
+    };
+    EXPECT_EQ(method_line(std::string(LF_TEST_SCENES) + "/caustic.json")
+                  .rfind("method bdpt (caustics (L S+ D E): light from emitter \"light\" (0.", 0),
+              0u);
+    const std::string plane =
+        Write("plane.json", R"({"camera": {"position": [0, 3, 0], "look_at": [0, 0, 0],
+                                "up": [0, 0, 1], "fov_y_deg": 60, "resolution": [16, 16]},
+            "materials": {"grey": {"type": "lambert", "reflectance": [0.5, 0.5, 0.5]}},
+            "shapes": [{"type": "quad", "material": "grey",
+                        "vertices": [[-5, 0, -5], [-5, 0, 5], [5, 0, 5], [5, 0, -5]]}],
+            "lights": [{"type": "point", "position": [0, 2, 0], "power": [5, 5, 5]}]})");
+    EXPECT_EQ(method_line(plane),
+              "method whitted (no interreflection and no caustics: classic ray tracing is exact "
+              "here (point-like lights only))");
+    EXPECT_EQ(method_line(std::string(LF_TEST_SCENES) + "/cornell_box.json"),
+              "method radiosity (every material is Lambertian)");
+}
+
 // A texture or a principled material is beyond radiosity: auto says so and takes the path
-// tracer; radiosity asked for refuses with the same reason.
+// tracer (two walls that light each other: Whitted would miss that); radiosity asked for
+// refuses with the same reason.
 TEST_F(Cli, AutoTakesThePathTracerForTexturesAndSaysWhy) {
     Write("wood.png", lf::testing::PngBytes(1, 1, 3, {200, 100, 50}));
     auto scene = [&](const std::string& material) {
@@ -214,6 +249,8 @@ TEST_F(Cli, AutoTakesThePathTracerForTexturesAndSaysWhy) {
                                    "emission": [1, 1, 1]}},
             "shapes": [{"type": "quad", "material": "wood",
                         "vertices": [[-1, -1, 0], [-1, 1, 0], [1, 1, 0], [1, -1, 0]]},
+                       {"type": "quad", "material": "wood",
+                        "vertices": [[-1, -1, -1], [-1, -1, 0], [1, -1, 0], [1, -1, -1]]},
                        {"type": "quad", "material": "lamp",
                         "vertices": [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1]]}]})");
     };
@@ -473,12 +510,20 @@ TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
                                         "/materials.json --method radiosity --threads 2");
     EXPECT_NE(refused.status, 0);
     EXPECT_NE(refused.output.find("radiosity"), std::string::npos) << refused.output;
+    // Every complete method costed from its own pilot, the path tracer named incomplete where a
+    // point light's caustics are beyond it, and the fastest complete one named.
     const RunResult glossy = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
-                                       "/materials.json --pilot-spp 2 --threads 2");
+                                       "/materials.json --pilot-spp 2 --threads 2 --photons 4096");
     ASSERT_EQ(glossy.status, 0) << glossy.output;
-    EXPECT_NE(glossy.output.find("method (--method auto): path, because material"),
-              std::string::npos)
+    for (const char* text :
+         {"method (--method auto): bdpt, because caustics", "methods for --target-error 0.01",
+          "\n  path ", "(incomplete: no caustics of the 1 point light)", "\n  bdpt ", "\n  ppm ",
+          "fastest to the target by its pilot: "}) {
+        EXPECT_NE(glossy.output.find(text), std::string::npos) << text << "\n" << glossy.output;
+    }
+    EXPECT_EQ(glossy.output.find("fastest to the target by its pilot: path"), std::string::npos)
         << glossy.output;
+    EXPECT_EQ(glossy.output.find("\n  light "), std::string::npos) << "light sees no glass";
 }
 
 // A median rate below 0 (the error estimate rising between the pilot's stages, as on a 4x4
@@ -864,8 +909,8 @@ TEST_F(Cli, WhittedRendersAndUnknownMethodsAreRefused) {
 
 // `render --method light` goes through the frame plan and merger: any --threads, --passes
 // (light-path ranges) and --tile (splat tiles) give the same bits, and the header names the
-// method and its light paths. Photon flags with another method, AOVs and adaptive sampling with
-// a frame method, and plan's pilot of a frame method are refused, saying why.
+// method and its light paths. Photon flags with another method, and AOVs and adaptive sampling
+// with a frame method, are refused, saying why.
 TEST_F(Cli, LightTracingRendersTheSameBitsForAnySplit) {
     const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
     const std::string base = "render " + scene + " --method light --spp 2 --resolution 24x24 " +
@@ -897,7 +942,6 @@ TEST_F(Cli, LightTracingRendersTheSameBitsForAnySplit) {
         {"render " + scene + " -o " + one + " --method light --aov albedo", "no AOV"},
         {"render " + scene + " -o " + one + " --method light --target-error 0.1", "adaptive"},
         {"render " + scene + " -o " + one + " --method ppm --ppm-alpha 1", "--ppm-alpha 1"},
-        {"plan " + scene + " --method light", "no pilot for this method yet"},
     };
     for (const auto& r : refused) {
         const RunResult out = Lightfarm(r.args);
@@ -906,7 +950,7 @@ TEST_F(Cli, LightTracingRendersTheSameBitsForAnySplit) {
     }
 }
 
-// plan never picks whitted for auto but says what it would give: exact where nothing of the
+// plan says what whitted would give whatever the method: exact where nothing of the
 // scene's light is interreflected or focused (one lit plane), a preview with its missing terms
 // named in the Cornell box; with --method whitted its pilot traces Whitted's rays.
 TEST_F(Cli, PlanRecommendsWhittedOnlyAsAPreviewNamingWhatItLeavesOut) {

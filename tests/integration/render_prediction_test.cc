@@ -75,3 +75,36 @@ TEST(PredictAdaptiveRender, IsWithinTwiceTheRendersSamples) {
 
 }  // namespace
 }  // namespace lf
+
+namespace lf {
+namespace {
+
+// The method comparison's arithmetic: error 0.2 at 4 spp and 0.1 at 16 falls as spp^-1/2, so a
+// target of 0.05 takes 64 spp, 16 s at the second stage's 4 spp/s.
+TEST(PredictMethodCost, FollowsThePowerLawThroughTheStages) {
+    const MethodCost c = PredictMethodCost({4, 1.0, 0.2}, {16, 4.0, 0.1}, 0.05, 0.5, 1).value();
+    EXPECT_NEAR(c.rate, 0.5, 1e-12);
+    EXPECT_NEAR(c.spp, 64, 1e-9);
+    EXPECT_NEAR(c.seconds, 16, 1e-9);
+    // Measured 2 (the second stage lucky): clamped to 1, so (0.025 / 0.01)^1 x 16 spp.
+    const MethodCost fast = PredictMethodCost({4, 1, 0.4}, {16, 4, 0.025}, 0.01, 0.5, 1).value();
+    EXPECT_NEAR(fast.rate, 1, 1e-12);
+    EXPECT_NEAR(fast.spp, 40, 1e-9);
+    // Photon mapping's rate alpha / 2 = 1/3: the target 4x below takes 4^3 = 64x the passes.
+    const MethodCost ppm =
+        PredictMethodCost({4, 1, 0.2}, {16, 4, 0.1}, 0.025, 1.0 / 3, 1.0 / 3).value();
+    EXPECT_NEAR(ppm.spp, 16 * 64, 1e-6);
+    // Met already: the second stage's cost; noiseless: the first's.
+    EXPECT_EQ(PredictMethodCost({4, 1, 0.2}, {16, 4, 0.1}, 0.5, 0.5, 1).value().spp, 16);
+    EXPECT_EQ(PredictMethodCost({4, 1, 0}, {16, 4, 0}, 0.5, 0.5, 1).value().seconds, 1);
+}
+
+TEST(PredictMethodCost, RefusesStagesOutOfOrderAndTargetsBelowZero) {
+    EXPECT_FALSE(PredictMethodCost({16, 1, 0.2}, {4, 4, 0.1}, 0.05, 0.5, 1).ok());
+    EXPECT_FALSE(PredictMethodCost({0, 1, 0.2}, {4, 4, 0.1}, 0.05, 0.5, 1).ok());
+    EXPECT_FALSE(PredictMethodCost({4, 1, 0.2}, {16, 4, 0.1}, 0, 0.5, 1).ok());
+    EXPECT_FALSE(PredictMethodCost({4, 1, 0.2}, {16, 4, 0.1}, 0.05, 1, 0.5).ok());
+}
+
+}  // namespace
+}  // namespace lf

@@ -372,7 +372,7 @@ TEST(Bdpt, AnySplitOfTheWorkGivesTheSameBits) {
     TileSums merged(rect);
     SplatList merged_splats(16, 16);
     for (const PixelRect part : {PixelRect{0, 0, 16, 7}, PixelRect{0, 7, 16, 9}}) {
-        for (const auto [begin, end] : {std::pair<uint64_t, uint64_t>{0, 4}, {4, 6}}) {
+        for (const auto& [begin, end] : {std::pair<uint64_t, uint64_t>{0, 4}, {4, 6}}) {
             TileSums sums(part);
             SplatList splats(16, 16);
             renderer.Render(FrameWork{part, begin, end, 0, 0}, sums, splats);

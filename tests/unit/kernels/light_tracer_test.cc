@@ -95,7 +95,7 @@ TEST(LightTracer, AnySplitGivesTheSameSplats) {
     s.renderer->Render({PixelRect{}, 0, 0, 0, kPaths}, whole_sums, whole);
     SplatList parts(w, h);
     TileSums part_sums(PixelRect{});
-    for (const auto [begin, end] : {std::pair<uint64_t, uint64_t>{0, 1},
+    for (const auto& [begin, end] : {std::pair<uint64_t, uint64_t>{0, 1},
                                     {1, 1023},
                                     {1023, 5000},
                                     {5000, 5001},

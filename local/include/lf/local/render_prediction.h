@@ -66,4 +66,28 @@ absl::StatusOr<RenderPrediction> PredictAdaptiveRender(const Camera& camera,
                                                        const AdaptiveSettings& adaptive,
                                                        uint64_t pilot_spp);
 
+// `plan`'s comparison of methods: each method's whole-image error, the square root of its A/B
+// relMSE estimate (EstimatedRelMse), after a pilot of two stages, extrapolated along the power
+// law through them to the spp and seconds a target error takes at the method's own speed.
+struct MethodPilotStage {
+    uint64_t spp = 0;
+    double seconds = 0;
+    double error = 0;
+};
+
+struct MethodCost {
+    MethodPilotStage stages[2];
+    double rate = 0;     // of error ~ spp^-rate, measured between the stages and clamped
+    double spp = 0;      // to reach the target error (at least the second stage's)
+    double seconds = 0;  // at the second stage's samples per second
+};
+
+// From the two stages (stages[0].spp < stages[1].spp) and the clamp of the rate: unbiased
+// Monte Carlo [kMinConvergenceRate, kMaxConvergenceRate]; photon mapping's noise falls as
+// N^(-alpha/2), its own clamp. InvalidArgument when a stage is empty or the target is not
+// positive; a method whose error is 0 costs its first stage.
+absl::StatusOr<MethodCost> PredictMethodCost(const MethodPilotStage& first,
+                                             const MethodPilotStage& second, double target_error,
+                                             double min_rate, double max_rate);
+
 }  // namespace lf
