@@ -18,11 +18,12 @@ struct PathRender {
 };
 
 inline PathRender RenderPath(const Scene& scene, uint64_t spp, int max_depth = -1,
-                             uint64_t seed = 1, SamplerType sampler = defaults::kSampler) {
+                             uint64_t seed = 1, SamplerType sampler = defaults::kSampler,
+                             LightStrategy strategy = LightStrategy::kBvh) {
     auto es = EmbreeScene::Build(scene);
     EXPECT_TRUE(es.ok()) << es.status();
     const Camera camera(scene.camera, (*es)->origin());
-    const PathTracer tracer(**es, max_depth);
+    const PathTracer tracer(**es, max_depth, strategy);
     RenderSettings settings;
     settings.spp = spp;
     settings.seed = seed;

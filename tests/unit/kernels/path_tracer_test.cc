@@ -6,6 +6,7 @@
 
 #include <numbers>
 
+#include "frame_scenes.h"
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
@@ -67,6 +68,25 @@ INSTANTIATE_TEST_SUITE_P(Albedos, Furnace,
                              return "rho" + std::to_string(int(info.param.rho * 100)) + "_case" +
                                     std::to_string(info.index);
                          });
+
+// pbrt-v4's integrator tests, as every method has them (frame_scenes.h): inside a sphere of
+// albedo 0.5 lit by a point light of intensity pi at its centre, and inside the same sphere
+// emitting 0.5, the radiance is 1 everywhere; under both light strategies (the BVH's sphere
+// sampling from a point on the emitter itself lost light once).
+TEST(Furnace, PbrtSpheresHaveMeanRadianceOne) {
+    for (const LightStrategy strategy : {LightStrategy::kPower, LightStrategy::kBvh}) {
+        for (const bool emissive : {false, true}) {
+            const Scene scene =
+                emissive ? testing::EmissiveFurnaceSphere(16) : testing::PointLitFurnaceSphere(16);
+            const RenderOutput out =
+                testing::RenderPath(scene, 256, -1, 1, SamplerType::kSobol, strategy).out;
+            const testing::MeanAndError m = testing::ChannelMean(out.image, "G");
+            EXPECT_LT(m.standard_error, 0.01);
+            EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, kSigmas * m.standard_error)
+                << (emissive ? "emissive" : "point light") << ", " << LightStrategyName(strategy);
+        }
+    }
+}
 
 TEST(Furnace, MaxDepthTruncatesTheNeumannSeries) {
     // With at most N bounces, L = Le (1 + rho + ... + rho^N).

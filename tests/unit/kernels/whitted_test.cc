@@ -11,6 +11,7 @@
 #include <numbers>
 #include <optional>
 
+#include "frame_scenes.h"
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
@@ -115,6 +116,31 @@ TEST(Whitted, SumsEveryDeltaLightWithoutNoise) {
     for (int c = 0; c < 3; ++c) {
         EXPECT_NEAR(e.mean[c], expected[c], 1e-4 * expected[c]) << "channel " << c;
         EXPECT_LE(e.sample_sd[c], 1e-6 * expected[c]) << "channel " << c;
+    }
+}
+
+// pbrt's furnace spheres (frame_scenes.h) have radiance 1 from their interreflection; Whitted
+// keeps the emission and the direct light only: with the point light albedo x E / pi = 0.5,
+// exactly and without noise; the emissive sphere 0.5 + 0.5 x 0.5 = 0.75 (the sphere is its own
+// area light), within the noise of sampling it.
+TEST(Whitted, FurnaceSpheresKeepTheirDirectTermOnly) {
+    for (const bool emissive : {false, true}) {
+        const Scene scene =
+            emissive ? testing::EmissiveFurnaceSphere(8) : testing::PointLitFurnaceSphere(8);
+        const auto es = Build(scene);
+        const WhittedTracer tracer(*es, -1);
+        const Camera camera(scene.camera, es->origin());
+        for (const auto& [px, py] : {std::pair{0, 0}, {3, 5}, {7, 7}}) {
+            constexpr int kSamples = 1024;
+            const testing::PointEstimate e = testing::EstimateRadiance(
+                tracer, camera.GenerateRay(px, py, 0.5f, 0.5f, Vec2{}), kSamples);
+            if (emissive) {
+                EXPECT_NEAR(e.mean[1], 0.75, 5 * e.sample_sd[1] / std::sqrt(kSamples) + 1e-6);
+            } else {
+                EXPECT_NEAR(e.mean[1], 0.5, 1e-4);
+                EXPECT_LE(e.sample_sd[1], 1e-6);
+            }
+        }
     }
 }
 
