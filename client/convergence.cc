@@ -259,13 +259,14 @@ absl::Status WriteSummaryCsv(const ConvergenceResult& result) {
     for (const ConfigSummary& c : result.configs) {
         csv << absl::StrFormat(
             "%s,%s,%d,%d,%.4f,%.4f,%.6e,%.6g,%.6g,%.6e,%.6e,%.4f,%.4f,%.4f,%.4f,%.4f,%.6e,%.4f,%."
-            "4f\n",
+            "4f,"
+            "%s\n",
             SamplerTypeName(c.config.sampler), LightStrategyName(c.config.light_strategy),
             c.fit.from, c.fit.to, c.relative_rmse_slope, c.rmse_slope, c.samples_per_second,
             result.equal_time.from, result.equal_time.to, c.rmse_at_equal_time,
             c.relmse_at_equal_time, c.rmse_ratio_at_end, c.rmse_ratio_mean, c.relmse_ratio_at_end,
             c.relmse_ratio_mean, c.rmse_spp_slope, c.region_rmse_at_equal_time,
-            c.region_rmse_ratio_at_end, c.region_rmse_ratio_mean);
+            c.region_rmse_ratio_at_end, c.region_rmse_ratio_mean, c.config.method);
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.summary_path + ": cannot write");

@@ -150,12 +150,12 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
 inline constexpr const char* kConvergenceCsvHeader =
     "method,budget,seconds,rmse,relmse,smape,estimated_relmse,sampler,light_sampling,region_rmse,"
     "region_relmse";
-// summary.csv: a row per path configuration (ConfigSummary).
+// summary.csv: a row per ladder configuration (ConfigSummary); its method last.
 inline constexpr const char* kSummaryCsvHeader =
     "sampler,light_sampling,fit_from_spp,fit_to_spp,relative_rmse_slope,rmse_slope,"
     "samples_per_second,equal_time_from,equal_time_to,rmse_at_equal_time,relmse_at_equal_time,"
     "rmse_ratio_at_end,rmse_ratio_mean,relmse_ratio_at_end,relmse_ratio_mean,rmse_spp_slope,"
-    "region_rmse_at_equal_time,region_rmse_ratio_at_end,region_rmse_ratio_mean";
+    "region_rmse_at_equal_time,region_rmse_ratio_at_end,region_rmse_ratio_mean,method";
 
 // The row's estimated_relmse as a CSV field: "" when there is none.
 std::string EstimatedRelMseField(const ConvergenceRow& row);

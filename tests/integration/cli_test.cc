@@ -424,8 +424,9 @@ TEST_F(Cli, ConvergeExplicitConfigurationsKeepTheirOrderAndTheFirstIsTheBaseline
     EXPECT_NE(r.output.find("region 4,8 6x5:"), std::string::npos) << r.output;
     const auto summary = ReadCsv(out / "summary.csv");
     ASSERT_EQ(summary.size(), 3u);
-    ASSERT_EQ(summary[0].back(), "region_rmse_ratio_mean");
-    EXPECT_EQ(summary[1][summary[0].size() - 2], "1.0000");
+    ASSERT_EQ(summary[0][summary[0].size() - 2], "region_rmse_ratio_mean");
+    EXPECT_EQ(summary[1][summary[0].size() - 3], "1.0000");
+    EXPECT_EQ(summary[1].back(), "path");
     EXPECT_EQ(summary[1][0] + "/" + summary[1][1], "sobol/bvh");
     EXPECT_EQ(summary[2][0] + "/" + summary[2][1], "independent/power");
     EXPECT_EQ(summary[1][11], "1.0000");
@@ -1027,7 +1028,9 @@ TEST_F(Cli, ConvergeLaddersEveryListedMethod) {
     for (const std::string name : {"sobol/bvh ", "light/sobol/bvh ", "ppm/sobol/bvh "}) {
         EXPECT_NE(r.output.find("\n" + name), std::string::npos) << name << "\n" << r.output;
     }
-    EXPECT_EQ(ReadCsv(out / "summary.csv").size(), 1u + 3);
+    const auto summary = ReadCsv(out / "summary.csv");
+    ASSERT_EQ(summary.size(), 1u + 3);
+    for (size_t m = 0; m < methods.size(); ++m) EXPECT_EQ(summary[1 + m].back(), methods[m]);
 
     for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
              {"--method path,foo", "--method path,foo: \"foo\" is not path, radiosity, both"},
