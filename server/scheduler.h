@@ -24,7 +24,9 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/image.h"
+#include "lf/core/splat_list.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/frame_merge.h"
 #include "lf/job/merge.h"
 #include "lf/job/task_assignment.h"
 #include "server/job_state_machine.h"
@@ -94,13 +96,16 @@ class Scheduler {
     // `worker` (FailedPrecondition), and a result of the wrong rectangle or sample count
     // (InvalidArgument; a current lease's task is then queued again as a counted failure).
     // `job_rendered` says the job is now fully rendered: the caller writes the result and calls
-    // Finish.
+    // Finish. A frame method's task (lf/job/frame_plan.h) comes with `splats`, its splat list
+    // (coalesced here), and `sums` its camera part (a 0x0 tile with the stats when it has none);
+    // InvalidArgument for splats of a tile task, a frame task's result without them, another
+    // frame's splats or the wrong camera part.
     struct Completion {
         std::string job_id;
         bool job_rendered = false;
     };
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
-                                        const TileSums& sums);
+                                        const TileSums& sums, SplatList* splats = nullptr);
 
     // A patch-group task's result, taken as Complete takes a tile's. When it completes its
     // sweep, `outcome` holds the next sweep's input or the solution: the caller stores it as a
@@ -176,6 +181,9 @@ class Scheduler {
         // same object) whose passes are appended to the tasks as results ask for them.
         std::unique_ptr<TileMerger> merger;
         AdaptiveTilePlan* adaptive = nullptr;
+        // Frame methods (UsesFramePlan): their frame passes and merged sums, instead of `merger`
+        // (then null). The Task* helpers below answer for either.
+        std::unique_ptr<FrameMerger> frame{};
         TaskStateMachine states{};
         std::vector<Task> tasks{};   // by index, as many as `states`
         uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
@@ -226,6 +234,12 @@ class Scheduler {
     // The one way the scheduler moves a task or a job; an illegal move is a broken invariant.
     void MoveTask(Job& job, int task, TaskState to);
     void MoveJob(Job& job, JobState to);
+    // The job's planned tasks, those merged, whether all are, and their stats: the tile merger's
+    // or the frame merger's.
+    static size_t TaskCount(const Job& job);
+    static size_t TasksDone(const Job& job);
+    static bool Rendered(const Job& job);
+    static const RenderStats& StatsOf(const Job& job);
     // Grows the job to `count` tasks, the new ones waiting.
     static void Grow(Job& job, size_t count);
     // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
