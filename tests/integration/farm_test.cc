@@ -1150,6 +1150,30 @@ TEST_P(FarmFrame, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
     EXPECT_LE(c.leased, 16 + 2 * 2) << "done tasks were rendered again";
 }
 
+// A running frame job's preview is the image of the light paths merged so far (normalised by
+// them, so not darker than the final image would be); a cancel stops the kernel mid-task.
+TEST_P(FarmFrame, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
+    StartServer();
+    StartWorker("w1");
+    const std::string job = Submit(scene_, Flags(1024, 3, "--passes 16"));
+    ASSERT_TRUE(WaitForTasksDone(job, 2, milliseconds(60000)));
+    const std::string preview = (dir_ / "preview.exr").string();
+    const CliRun fetch = Farmctl("fetch --preview " + job + " -o " + preview);
+    ASSERT_EQ(fetch.status, 0) << fetch.err;
+    absl::StatusOr<ExrFile> partial = ReadExr(preview);
+    ASSERT_TRUE(partial.ok()) << partial.status();
+    const std::vector<float>& r = *partial->image.FindChannel("R");
+    double sum = 0;
+    for (float v : r) sum += v;
+    // This Cornell box's mean R is about 0.2; a preview divided by all the job's paths instead
+    // of those merged (2 or 3 of 16 tasks by now) would be 5 to 8 times darker.
+    EXPECT_GT(sum / double(r.size()), 0.1) << "the preview is not normalised by merged paths";
+    ASSERT_TRUE(WaitForStatus(job, "1 running", milliseconds(20000)));
+    ASSERT_EQ(Farmctl("cancel " + job).status, 0);
+    EXPECT_TRUE(WaitForText(dir_ / "w1.log", "dropped", milliseconds(1000)).has_value())
+        << "the worker still renders a second after the cancel";
+}
+
 // The kernels splat with the box filter only: another filter is refused at submission, naming
 // the method and the filter, rather than failing on every worker.
 TEST_P(FarmFrame, NonBoxFilterIsRefusedAtSubmission) {
