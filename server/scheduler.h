@@ -1,11 +1,12 @@
 // The farm's scheduler, without I/O or gRPC: jobs are planned into tasks, tasks are leased to
 // workers by job priority then age, leases live while heartbeats extend them, and results merge
-// into the job's image. It composes small units, each tested alone: task states change only
-// through TaskStateMachine, job states through TransitionJob; LeaseTimeouts keeps the lease
-// deadlines, WorkerRegistry the live workers, SpeculationPolicy and TimeLimitReached decide
-// second leases and time limits, SweepTaskNumbering places a solve's tasks; the timeout checker
-// (TimeoutChecker) calls ExpireLeases and EnforceTimeLimits. The store is never read, nor waited
-// for, under the scheduler's lock.
+// into the job's image. Tile jobs merge through a TileMerger, frame-method jobs (light, bdpt, ppm)
+// through a FrameMerger (lf/job/frame_merge.h), whose results carry splats. It composes small
+// units, each tested alone: task states change only through TaskStateMachine, job states through
+// TransitionJob; LeaseTimeouts keeps the lease deadlines, WorkerRegistry the live workers,
+// SpeculationPolicy and TimeLimitReached decide second leases and time limits, SweepTaskNumbering
+// places a solve's tasks; the timeout checker (TimeoutChecker) calls ExpireLeases and
+// EnforceTimeLimits. The store is never read, nor waited for, under the scheduler's lock.
 //
 // A lease that expires or a failure puts the task back in the queue, where workers it has not
 // failed on take it first; the third counted failure fails the job. Cancelling a job drops all its
@@ -245,7 +246,9 @@ class Scheduler {
     // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
     void QueueStart(Job& job);
     void QueueSweep(Job& job);
-    // A job with its tiles planned as its spec says; InvalidArgument when they cannot be.
+    // A job with its tasks planned as its spec says: tiles (fixed or adaptive), or for a frame
+    // method the frame passes local mode plans (lf::FramePlanSettingsOf); InvalidArgument when
+    // they cannot be.
     absl::StatusOr<std::unique_ptr<Job>> NewJob(JobRecord record) const;
     // Queues a task the adaptive plan appended.
     void QueuePass(Job& job, const RenderTask& pass);
