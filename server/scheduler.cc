@@ -789,7 +789,8 @@ int Scheduler::ExpireLeases() {
 
 absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_id) const {
     JobImage snapshot;
-    std::shared_ptr<const TileStore> tiles;  // outlives the job if it ends meanwhile
+    std::shared_ptr<const TileStore> tiles;            // outlives the job if it ends meanwhile
+    std::optional<FrameMerger::SnapshotSource> frame;  // a frame job's stores, the same
     {
         std::lock_guard<std::mutex> lock(mutex_);
         auto it = active_.find(job_id);
@@ -799,19 +800,17 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_i
         const Job& job = *it->second;
         snapshot.record = job.record;
         if (job.frame) {
-            // The frame merger's stores are read under the lock (a merge may not run meanwhile,
-            // since the splat normalisation must match the tiles read): one tile at a time, but
-            // every tile of the frame.
-            absl::StatusOr<Image> image = job.frame->Snapshot();
-            if (!image.ok()) return image.status();
-            snapshot.image = std::move(*image);
-            return snapshot;
+            // Read after the lock is released, as a tile job's store: a preview may show a tile
+            // merged meanwhile with the normalisation before it; a complete job's is exact.
+            frame = job.frame->snapshot_source();
+        } else {
+            tiles = job.merger->store();
         }
-        tiles = job.merger->store();
         if (job.adaptive) snapshot.adaptive = job.adaptive->TileReport();
     }
     const RenderPlanSettings& plan = snapshot.record.spec.plan;
-    absl::StatusOr<Image> image = RenderImageOf(*tiles, plan.width, plan.height);
+    absl::StatusOr<Image> image =
+        frame ? frame->Read() : RenderImageOf(*tiles, plan.width, plan.height);
     if (!image.ok()) return image.status();
     snapshot.image = std::move(*image);
     if (snapshot.adaptive) {
