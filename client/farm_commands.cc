@@ -25,6 +25,7 @@
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "local_render.h"
 #include "output_flags.h"
+#include "photon_flags.h"
 #include "progress_bar.h"
 #include "proto/grpc_status.h"
 #include "radiosity_flags.h"
@@ -267,6 +268,8 @@ void PrintJob(const pb::Job& job) {
     auto seconds = [](int64_t from, int64_t to) { return double(to - from) / 1000.0; };
     std::printf("job %s: %s\n", job.id().c_str(), StateName(job.state()).c_str());
     std::printf("  name      %s\n", job.name().c_str());
+    std::printf("  method    %s\n",
+                job.params().method().empty() ? "path" : job.params().method().c_str());
     std::printf("  image     %dx%d, %llu spp, seed %llu, max depth %d, tile %d, %d passes\n",
                 job.width(), job.height(), (unsigned long long)job.params().spp(),
                 (unsigned long long)job.params().seed(), job.params().max_depth(),
@@ -423,11 +426,14 @@ Command AddSubmitCommand(CLI::App& app) {
     cmd->add_option("--name", o->spec.name, "job name (default: the scene file's name)");
     cmd->add_option("--method", o->spec.method,
                     "path, radiosity (Lambertian scenes; same bits as `lightfarm render "
-                    "--method radiosity` with the same options) or whitted (direct light and "
-                    "specular chains only, a preview); bdpt, light and ppm are reserved, not "
-                    "implemented yet")
+                    "--method radiosity` with the same options), whitted (direct light and "
+                    "specular chains only, a preview), or a frame method: light (light tracing), "
+                    "bdpt (bidirectional path tracing), ppm (progressive photon mapping). Every "
+                    "method gives the bits of `lightfarm render` with the same options; the "
+                    "frame methods take no --aov nor adaptive sampling")
         ->capture_default_str()
         ->check([](const std::string& m) { return MethodFlagError(m, false); });
+    AddPhotonFlags(cmd, o->spec.ppm);
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
                     "--solver jacobi: patch-group tasks per sweep; each worker computes the "
@@ -439,6 +445,9 @@ Command AddSubmitCommand(CLI::App& app) {
         ->check(CLI::Range(1, kMaxSweepTasks));
     return {cmd, [cmd, o] {
                 if (absl::Status s = CheckRadiosityFlagsApply(*cmd, o->spec.method); !s.ok()) {
+                    return ReportError(s);
+                }
+                if (absl::Status s = CheckPhotonFlagsApply(*cmd, o->spec.method); !s.ok()) {
                     return ReportError(s);
                 }
                 absl::StatusOr<std::string> id = Submit(*o);
@@ -462,8 +471,8 @@ Command AddListCommand(CLI::App& app) {
                 const std::unique_ptr<pb::JobService::Stub> stub = Connect(*flags);
                 pb::ListJobsRequest req;
                 int listed = 0;
-                std::printf("%-16s %-10s %8s %11s %9s  %s\n", "JOB", "STATE", "PRIORITY", "TASKS",
-                            "SPP", "NAME");
+                std::printf("%-16s %-10s %-9s %8s %11s %9s  %s\n", "JOB", "STATE", "METHOD",
+                            "PRIORITY", "TASKS", "SPP", "NAME");
                 do {
                     req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
                     pb::ListJobsResponse resp;
@@ -472,10 +481,12 @@ Command AddListCommand(CLI::App& app) {
                         *flags);
                     if (!s.ok()) return ReportError(s);
                     for (const pb::Job& job : resp.jobs()) {
-                        std::printf("%-16s %-10s %8d %11s %9llu  %s\n", job.id().c_str(),
-                                    StateName(job.state()).c_str(), job.priority(),
-                                    Progress(job).c_str(), (unsigned long long)job.params().spp(),
-                                    job.name().c_str());
+                        std::printf(
+                            "%-16s %-10s %-9s %8d %11s %9llu  %s\n", job.id().c_str(),
+                            StateName(job.state()).c_str(),
+                            job.params().method().empty() ? "path" : job.params().method().c_str(),
+                            job.priority(), Progress(job).c_str(),
+                            (unsigned long long)job.params().spp(), job.name().c_str());
                     }
                     listed += resp.jobs_size();
                     req.set_page_token(resp.next_page_token());

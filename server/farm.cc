@@ -6,10 +6,13 @@
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/patch_mesh.h"
+#include "lf/core/pixel_filter.h"
 #include "lf/core/radiosity_codec.h"
+#include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
 #include "lf/job/render_metadata.h"
 #include "server/sqlite_job_store.h"
@@ -88,14 +91,6 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     // The CLI's limits (lf/job/job_spec.h): a bad job is refused here rather than failing, or
     // running without end, on every worker.
     if (absl::Status s = CheckJobSettings(spec); !s.ok()) return s;
-    // The job model, the wire and the workers' kernels know the frame methods, but the scheduler
-    // plans only tiles so far: refused rather than path traced under another name.
-    if (UsesFramePlan(spec.method)) {
-        return absl::UnimplementedError(absl::StrCat(
-            "method \"", spec.method,
-            "\": the farm does not schedule frame methods yet; `lightfarm render --method ",
-            spec.method, "` renders it in this process"));
-    }
     if (spec.name.size() > kMaxJobNameBytes) {
         return absl::InvalidArgumentError(absl::StrCat(
             "job name of ", spec.name.size(), " bytes is above the limit of ", kMaxJobNameBytes));
@@ -143,6 +138,15 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     if (spec.method == "radiosity") {
         if (absl::Status s = RadiosityRefusal(*scene); !s.ok()) return s;
     }
+    // The frame methods' kernels splat into the pixel that holds a splat's raster position (the
+    // box filter) and refuse other filters (lf::MakeFrameRenderer): refused here, once, rather
+    // than failing on every worker. Revisit when a frame kernel splats with filter weights.
+    if (UsesFramePlan(spec.method) && scene->camera.filter.type != PixelFilter::Type::kBox) {
+        return absl::FailedPreconditionError(
+            absl::StrCat("method ", spec.method, ": the pixel filter ",
+                         DescribePixelFilter(scene->camera.filter),
+                         " is not supported; the frame methods splat with the box filter only"));
+    }
     const int side = options_.limits.max_resolution;
     if (scene->camera.width > side || scene->camera.height > side) {
         return absl::ResourceExhaustedError(absl::StrCat("resolution ", scene->camera.width, "x",
@@ -164,15 +168,29 @@ absl::Status Farm::RefuseUndecodable(const std::string& lease_id, const std::str
                                      const absl::Status& why) {
     const std::string reason = absl::StrCat("undecodable result: ", why.message());
     scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
+    // The scheduler's lease ids are "job/task/attempt": named as its own refusals name them.
+    const std::vector<std::string> parts = absl::StrSplit(lease_id, '/');
+    const std::string task =
+        parts.size() == 3 ? absl::StrCat("job=", parts[0], " task=", parts[1], " ") : "";
     return absl::InvalidArgumentError(
-        absl::StrCat("lease ", lease_id, " from ", worker, ": ", reason));
+        absl::StrCat(task, "lease ", lease_id, " from ", worker, ": ", reason));
 }
 
 absl::Status Farm::Complete(const std::string& lease_id, const std::string& worker,
-                            std::string_view tile_sums, std::optional<RadiosityFigures> radiosity) {
+                            std::string_view tile_sums, std::optional<RadiosityFigures> radiosity,
+                            std::optional<std::string_view> splats) {
     absl::StatusOr<TileSums> sums = DecodeTileSums(tile_sums);
     if (!sums.ok()) return RefuseUndecodable(lease_id, worker, sums.status());
-    absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, *sums);
+    // Checked whole before anything is allocated (lf::DecodeSplatList); its frame and the
+    // camera part are the scheduler's to check against the task.
+    std::optional<SplatList> list;
+    if (splats) {
+        absl::StatusOr<SplatList> decoded = DecodeSplatList(*splats);
+        if (!decoded.ok()) return RefuseUndecodable(lease_id, worker, decoded.status());
+        list = std::move(*decoded);
+    }
+    absl::StatusOr<Scheduler::Completion> done =
+        scheduler_.Complete(lease_id, worker, *sums, list ? &*list : nullptr);
     if (!done.ok()) return done.status();
     if (radiosity) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
@@ -248,6 +266,7 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
     metadata.adaptive_settings = job.spec.adaptive;
     metadata.adaptive = snapshot.adaptive;
     metadata.radiosity_settings = job.spec.radiosity;
+    metadata.ppm = job.spec.ppm;
     {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         if (auto it = radiosity_.find(job.id); it != radiosity_.end()) {

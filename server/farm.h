@@ -58,10 +58,14 @@ class Farm {
                                                                    uint64_t size);
 
     // Decodes and merges a task's result; writes the job's EXR when it was the last one.
-    // `radiosity`: what the worker's radiosity solve reported, for that EXR's header.
+    // `radiosity`: what the worker's radiosity solve reported, for that EXR's header. `splats`:
+    // a frame task's splat list (lf::EncodeSplatList), with `tile_sums` its camera part. A
+    // result that does not decode, or does not fit its task, is refused naming the job, the
+    // task and the worker, and the task goes back to the queue as a counted failure.
     absl::Status Complete(const std::string& lease_id, const std::string& worker,
                           std::string_view tile_sums,
-                          std::optional<RadiosityFigures> radiosity = std::nullopt);
+                          std::optional<RadiosityFigures> radiosity = std::nullopt,
+                          std::optional<std::string_view> splats = std::nullopt);
     // A radiosity patch-group task's result (lf::EncodeSweepResult); when it ends a sweep,
     // stores the next sweep's input or the solution as a blob for the workers.
     absl::Status CompleteSweep(const std::string& lease_id, const std::string& worker,

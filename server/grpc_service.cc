@@ -233,7 +233,10 @@ grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context,
             ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums(),
                              req->has_radiosity()
                                  ? std::optional<RadiosityFigures>(FromProto(req->radiosity()))
-                                 : std::nullopt)
+                                 : std::nullopt,
+                             // An encoded list is never empty: empty means a tile's result.
+                             req->splats().empty() ? std::nullopt
+                                                   : std::optional<std::string_view>(req->splats()))
             : farm_.CompleteSweep(req->lease_id(), req->worker_id(), req->radiosity_sweep());
     if (!s.ok()) {
         Log()->warn("{}", RefusedResultLine(req->lease_id(), req->worker_id(), context->peer(),

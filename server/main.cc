@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "lf/core/stop_signals.h"
+#include "lf/job/frame_settings.h"
 #include "server/farm.h"
 #include "server/grpc_service.h"
 #include "server/timeout_checker.h"
@@ -87,6 +88,9 @@ int main(int argc, char** argv) {
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
     // port and answering clients at random.
     builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+    // A frame task's result (camera sums and splats) may be far above gRPC's 4 MiB default; the
+    // bound is the largest one the plans make (lf::kMaxTaskResultBytes, docs/farm.md).
+    builder.SetMaxReceiveMessageSize(lf::kMaxTaskResultBytes);
     builder.AddListeningPort(listen, grpc::InsecureServerCredentials(), &port);
     builder.RegisterService(&job_service);
     builder.RegisterService(&worker_service);

@@ -9,6 +9,8 @@
 #include "lf/core/image_error.h"
 #include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
+#include "lf/job/frame_settings.h"
+#include "server/frame_result_codec.h"
 #include "server/time_limit.h"
 
 namespace lf {
@@ -83,17 +85,46 @@ void Scheduler::MoveJob(Job& job, JobState to) {
     }
 }
 
+size_t Scheduler::TaskCount(const Job& job) {
+    return job.frame ? job.frame->tasks().size() : job.merger->tasks().size();
+}
+
+size_t Scheduler::TasksDone(const Job& job) {
+    return job.frame ? job.frame->tasks_done() : job.merger->tasks_done();
+}
+
+bool Scheduler::Rendered(const Job& job) {
+    return job.frame ? job.frame->Complete() : job.merger->Complete();
+}
+
+const RenderStats& Scheduler::StatsOf(const Job& job) {
+    return job.frame ? job.frame->stats() : job.merger->stats();
+}
+
 void Scheduler::Grow(Job& job, size_t count) {
     job.states.Resize(count);
     job.tasks.resize(count);
 }
 
 absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord record) const {
-    const JobSpec& spec = record.spec;
     auto job = std::make_unique<Job>();
     job->record = std::move(record);
+    // The job's own copy: `record` was moved from, its strings (the method) emptied.
+    const JobSpec& spec = job->record.spec;
     job->speculation = SpeculationPolicy(options_.speculate_after);
-    if (IsAdaptive(spec.adaptive)) {
+    if (UsesFramePlan(spec.method)) {
+        // The plan local mode makes of the same settings (lf::RenderFrameImage), so the merged
+        // sums are its bits; the merger's tiles in the same stores as a tile job's.
+        absl::StatusOr<FramePlanSettings> settings = FramePlanSettingsOf(spec.method, spec.plan);
+        if (!settings.ok()) return settings.status();
+        absl::StatusOr<std::vector<FrameTask>> plan = PlanFrameRender(*settings);
+        if (!plan.ok()) return plan.status();
+        absl::StatusOr<std::unique_ptr<FrameMerger>> merger =
+            FrameMerger::Make(settings->width, settings->height, settings->tile, settings->kind,
+                              std::move(*plan), options_.tile_stores);
+        if (!merger.ok()) return merger.status();
+        job->frame = std::move(*merger);
+    } else if (IsAdaptive(spec.adaptive)) {
         absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan =
             AdaptiveTilePlan::Make(spec.plan.width, spec.plan.height, spec.plan.spp, spec.plan.tile,
                                    spec.adaptive, kMaxTaskSamples, options_.tile_stores, spec.aovs);
@@ -108,7 +139,7 @@ absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord reco
         if (!merger.ok()) return merger.status();
         job->merger = std::move(*merger);
     }
-    Grow(*job, job->merger->tasks().size());
+    Grow(*job, TaskCount(*job));
     return job;
 }
 
@@ -121,7 +152,7 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     QueueStart(*job);
     job->record.submitted = clock_();
     // The image's tasks: a radiosity solve's sweep tasks are not done the way tiles are.
-    job->record.tasks_total = int(job->merger->tasks().size());
+    job->record.tasks_total = int(TaskCount(*job));
     // The store is read before the lock is taken. An earlier submission it does not hold has not
     // been acknowledged yet, so it is still in memory.
     std::optional<std::string> stored;
@@ -253,28 +284,36 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
         // In index order, an adaptive plan appends each pass before its result comes up: the
         // passes it planned depend only on the results before them.
         for (const auto& [t, bytes] : s.results) {
-            absl::StatusOr<TileSums> sums = DecodeTileSums(bytes);
-            absl::StatusOr<std::vector<RenderTask>> pass =
-                sums.ok() ? job->merger->Merge(t, *sums)
-                          : absl::StatusOr<std::vector<RenderTask>>(sums.status());
+            absl::Status merged;
+            if (job->frame) {
+                absl::StatusOr<FrameResult> result = DecodeFrameResult(bytes);
+                merged = result.ok() ? job->frame->Add(t, result->camera, result->splats)
+                                     : result.status();
+            } else {
+                absl::StatusOr<TileSums> sums = DecodeTileSums(bytes);
+                absl::StatusOr<std::vector<RenderTask>> pass =
+                    sums.ok() ? job->merger->Merge(t, *sums)
+                              : absl::StatusOr<std::vector<RenderTask>>(sums.status());
+                merged = pass.status();
+            }
             // The store wrote what merged before, so this cannot fail unless the file was
             // damaged; the task is then simply rendered again.
-            if (!pass.ok()) {
+            if (!merged.ok()) {
                 Log()->warn("job={} task={}: the recorded result is unusable, rendering it again",
                             job->record.id, t);
                 continue;
             }
             MoveTask(*job, t, TaskState::kDone);
-            Grow(*job, job->merger->tasks().size());
+            Grow(*job, TaskCount(*job));
         }
         QueueStart(*job);
-        job->record.tasks_done = int(job->merger->tasks_done());
-        job->record.tasks_total = int(job->merger->tasks().size());
-        job->record.stats = job->merger->stats();
+        job->record.tasks_done = int(TasksDone(*job));
+        job->record.tasks_total = int(TaskCount(*job));
+        job->record.stats = StatsOf(*job);
         Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before",
                     job->record.id, job->record.tasks_done, job->record.tasks_total,
                     job->record.tasks_leased);
-        if (EnforceTimeLimit(*job, clock_()) || job->merger->Complete()) {
+        if (EnforceTimeLimit(*job, clock_()) || Rendered(*job)) {
             rendered.push_back(job->record.id);
         }
         Save(*job);
@@ -370,6 +409,13 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
     lease.lease = options_.lease;
     lease.heartbeat_interval = options_.heartbeat_interval;
     const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(job, t);
+    if (job.frame) {
+        const FrameTask& frame = job.frame->tasks()[size_t(t)];
+        lease.task = RenderTask{frame.index, frame.rect, frame.sample_begin, frame.sample_end};
+        lease.path_begin = frame.path_begin;
+        lease.path_end = frame.path_end;
+        return lease;
+    }
     if (!at) {
         lease.task = job.merger->tasks()[size_t(t)];
         lease.radiosity_hash = job.solution;
@@ -394,7 +440,7 @@ void Scheduler::QueueStart(Job& job) {
         QueueSweep(job);
         return;
     }
-    for (int t = 0; t < int(job.merger->tasks().size()); ++t) {
+    for (int t = 0; t < int(TaskCount(job)); ++t) {
         if (job.states.state(t) != TaskState::kWaiting) continue;
         if (job.adaptive && !job.adaptive->IsPending(t)) continue;
         MoveTask(job, t, TaskState::kQueued);
@@ -507,7 +553,7 @@ bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker
 
 absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lease_id,
                                                           const std::string& worker,
-                                                          const TileSums& sums) {
+                                                          const TileSums& sums, SplatList* splats) {
     Locked locked(*this);
     const absl::Time now = clock_();
     const absl::StatusOr<LeaseRef> ref = ResultLease(lease_id, worker, now);
@@ -517,22 +563,35 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     if (state == TaskState::kDone || state == TaskState::kDropped) {
         return Completion{job.record.id, false};
     }
-    absl::StatusOr<std::vector<RenderTask>> merged =
-        SweepChunkOf(job, ref->task) ? absl::InvalidArgumentError("a tile result for a sweep task")
-                                     : job.merger->Merge(ref->task, sums);
+    absl::StatusOr<std::vector<RenderTask>> merged = std::vector<RenderTask>{};
+    if (SweepChunkOf(job, ref->task)) {
+        merged = absl::InvalidArgumentError("a tile result for a sweep task");
+    } else if (job.frame) {
+        // Frame plans are fixed: a merge appends no task.
+        const absl::Status added =
+            !splats ? absl::InvalidArgumentError("a frame task's result without its splats")
+                    : job.frame->Add(ref->task, sums, *splats);
+        if (!added.ok()) merged = added;
+    } else if (splats) {
+        merged = absl::InvalidArgumentError("splats in the result of a tile task");
+    } else {
+        merged = job.merger->Merge(ref->task, sums);
+    }
     if (!merged.ok()) return Refuse(*ref, lease_id, worker, merged.status());
     MarkDone(job, ref->task, now);
     for (const RenderTask& pass : *merged) QueuePass(job, pass);
     EnforceTimeLimit(job, now);
-    job.record.tasks_done = int(job.merger->tasks_done());
-    job.record.stats = job.merger->stats();
+    job.record.tasks_done = int(TasksDone(job));
+    job.record.stats = StatsOf(job);
     job.record.tasks_running = job.states.running();
-    const uint64_t ticket = store_.QueueTaskDone(job.record, ref->task, EncodeTileSums(sums));
+    // A frame task's record holds its splats too, so that a restart merges the same sums.
+    const uint64_t ticket = store_.QueueTaskDone(
+        job.record, ref->task, job.frame ? EncodeFrameResult(sums, *splats) : EncodeTileSums(sums));
     ++version_;
     changed_.notify_all();
     Log()->debug("job={} task={} done by {} ({}/{})", job.record.id, ref->task, LogSafe(worker),
                  job.record.tasks_done, job.record.tasks_total);
-    const Completion completion{job.record.id, job.merger->Complete()};
+    const Completion completion{job.record.id, Rendered(job)};
     locked.lock.unlock();
     // The worker hears "done" only once the result is durable.
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
@@ -730,7 +789,8 @@ int Scheduler::ExpireLeases() {
 
 absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_id) const {
     JobImage snapshot;
-    std::shared_ptr<const TileStore> tiles;  // outlives the job if it ends meanwhile
+    std::shared_ptr<const TileStore> tiles;            // outlives the job if it ends meanwhile
+    std::optional<FrameMerger::SnapshotSource> frame;  // a frame job's stores, the same
     {
         std::lock_guard<std::mutex> lock(mutex_);
         auto it = active_.find(job_id);
@@ -739,11 +799,18 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_i
         }
         const Job& job = *it->second;
         snapshot.record = job.record;
-        tiles = job.merger->store();
+        if (job.frame) {
+            // Read after the lock is released, as a tile job's store: a preview may show a tile
+            // merged meanwhile with the normalisation before it; a complete job's is exact.
+            frame = job.frame->snapshot_source();
+        } else {
+            tiles = job.merger->store();
+        }
         if (job.adaptive) snapshot.adaptive = job.adaptive->TileReport();
     }
     const RenderPlanSettings& plan = snapshot.record.spec.plan;
-    absl::StatusOr<Image> image = RenderImageOf(*tiles, plan.width, plan.height);
+    absl::StatusOr<Image> image =
+        frame ? frame->Read() : RenderImageOf(*tiles, plan.width, plan.height);
     if (!image.ok()) return image.status();
     snapshot.image = std::move(*image);
     if (snapshot.adaptive) {

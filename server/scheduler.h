@@ -1,11 +1,12 @@
 // The farm's scheduler, without I/O or gRPC: jobs are planned into tasks, tasks are leased to
 // workers by job priority then age, leases live while heartbeats extend them, and results merge
-// into the job's image. It composes small units, each tested alone: task states change only
-// through TaskStateMachine, job states through TransitionJob; LeaseTimeouts keeps the lease
-// deadlines, WorkerRegistry the live workers, SpeculationPolicy and TimeLimitReached decide
-// second leases and time limits, SweepTaskNumbering places a solve's tasks; the timeout checker
-// (TimeoutChecker) calls ExpireLeases and EnforceTimeLimits. The store is never read, nor waited
-// for, under the scheduler's lock.
+// into the job's image. Tile jobs merge through a TileMerger, frame-method jobs (light, bdpt, ppm)
+// through a FrameMerger (lf/job/frame_merge.h), whose results carry splats. It composes small
+// units, each tested alone: task states change only through TaskStateMachine, job states through
+// TransitionJob; LeaseTimeouts keeps the lease deadlines, WorkerRegistry the live workers,
+// SpeculationPolicy and TimeLimitReached decide second leases and time limits, SweepTaskNumbering
+// places a solve's tasks; the timeout checker (TimeoutChecker) calls ExpireLeases and
+// EnforceTimeLimits. The store is never read, nor waited for, under the scheduler's lock.
 //
 // A lease that expires or a failure puts the task back in the queue, where workers it has not
 // failed on take it first; the third counted failure fails the job. Cancelling a job drops all its
@@ -24,7 +25,9 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/image.h"
+#include "lf/core/splat_list.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/frame_merge.h"
 #include "lf/job/merge.h"
 #include "lf/job/task_assignment.h"
 #include "server/job_state_machine.h"
@@ -94,13 +97,16 @@ class Scheduler {
     // `worker` (FailedPrecondition), and a result of the wrong rectangle or sample count
     // (InvalidArgument; a current lease's task is then queued again as a counted failure).
     // `job_rendered` says the job is now fully rendered: the caller writes the result and calls
-    // Finish.
+    // Finish. A frame method's task (lf/job/frame_plan.h) comes with `splats`, its splat list
+    // (coalesced here), and `sums` its camera part (a 0x0 tile with the stats when it has none);
+    // InvalidArgument for splats of a tile task, a frame task's result without them, another
+    // frame's splats or the wrong camera part.
     struct Completion {
         std::string job_id;
         bool job_rendered = false;
     };
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
-                                        const TileSums& sums);
+                                        const TileSums& sums, SplatList* splats = nullptr);
 
     // A patch-group task's result, taken as Complete takes a tile's. When it completes its
     // sweep, `outcome` holds the next sweep's input or the solution: the caller stores it as a
@@ -176,6 +182,9 @@ class Scheduler {
         // same object) whose passes are appended to the tasks as results ask for them.
         std::unique_ptr<TileMerger> merger;
         AdaptiveTilePlan* adaptive = nullptr;
+        // Frame methods (UsesFramePlan): their frame passes and merged sums, instead of `merger`
+        // (then null). The Task* helpers below answer for either.
+        std::unique_ptr<FrameMerger> frame{};
         TaskStateMachine states{};
         std::vector<Task> tasks{};   // by index, as many as `states`
         uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
@@ -226,12 +235,20 @@ class Scheduler {
     // The one way the scheduler moves a task or a job; an illegal move is a broken invariant.
     void MoveTask(Job& job, int task, TaskState to);
     void MoveJob(Job& job, JobState to);
+    // The job's planned tasks, those merged, whether all are, and their stats: the tile merger's
+    // or the frame merger's.
+    static size_t TaskCount(const Job& job);
+    static size_t TasksDone(const Job& job);
+    static bool Rendered(const Job& job);
+    static const RenderStats& StatsOf(const Job& job);
     // Grows the job to `count` tasks, the new ones waiting.
     static void Grow(Job& job, size_t count);
     // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
     void QueueStart(Job& job);
     void QueueSweep(Job& job);
-    // A job with its tiles planned as its spec says; InvalidArgument when they cannot be.
+    // A job with its tasks planned as its spec says: tiles (fixed or adaptive), or for a frame
+    // method the frame passes local mode plans (lf::FramePlanSettingsOf); InvalidArgument when
+    // they cannot be.
     absl::StatusOr<std::unique_ptr<Job>> NewJob(JobRecord record) const;
     // Queues a task the adaptive plan appended.
     void QueuePass(Job& job, const RenderTask& pass);

@@ -4,6 +4,7 @@
 
 #include <fstream>
 
+#include "lf/job/frame_settings.h"
 #include "lf/version.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/worker_service.grpc.pb.h"
@@ -25,6 +26,8 @@ ServerConnection::ServerConnection(const std::string& address, std::string worke
     args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
     args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
     args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
+    // The coordinator takes results up to this (frame tasks' splats: docs/farm.md).
+    args.SetMaxSendMessageSize(kMaxTaskResultBytes);
     stub_->stub = pb::WorkerService::NewStub(
         grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args));
 }
@@ -66,6 +69,7 @@ absl::Status ServerConnection::Complete(const std::string& lease_id, const TaskR
     (result.sweep ? req.mutable_radiosity_sweep() : req.mutable_tile_sums())->assign(result.bytes);
     req.set_seconds(seconds);
     if (result.radiosity) ToProto(*result.radiosity, req.mutable_radiosity());
+    if (result.splats) req.set_splats(*result.splats);
     pb::CompleteTaskResponse resp;
     // Rides out a server restart: the result stays valid after its lease.
     const auto context = ContextWithDeadline(absl::Seconds(30));

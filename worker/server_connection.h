@@ -31,6 +31,8 @@ class ServerConnection {
         std::string bytes;
         bool sweep = false;
         std::optional<RadiosityFigures> radiosity;  // a radiosity job's tile: for the EXR header
+        // A frame task's splat list (lf::EncodeSplatList); `bytes` is then its camera part.
+        std::optional<std::string> splats;
     };
     absl::Status Complete(const std::string& lease_id, const TaskResult& result, double seconds);
     // `shutdown`: the worker is stopping, which does not count against the task.

@@ -7,10 +7,13 @@
 #include <map>
 #include <thread>
 
+#include "absl/strings/str_cat.h"
 #include "lf/core/file_util.h"
 #include "lf/core/log.h"
 #include "lf/core/radiosity_codec.h"
+#include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
+#include "lf/job/frame_settings.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/ray_tracer.h"
 #include "lf/kernels/tile_renderer.h"
@@ -114,6 +117,8 @@ void Worker::Execute(const TaskAssignment& task) {
         absl::StatusOr<std::string> swept = Sweep(task, cancel);
         status = swept.status();
         if (swept.ok()) result = {std::move(*swept), true, std::nullopt};
+    } else if (status.ok() && UsesFramePlan(task.spec.method)) {
+        status = RenderFrame(task, cancel, result);
     } else if (status.ok()) {
         status = PrepareTracer(task, cancel);
         if (status.ok()) result.bytes = EncodeTileSums(Render(task, cancel));
@@ -304,6 +309,40 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
             });
     });
     return tile;
+}
+
+absl::Status Worker::RenderFrame(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                                 ServerConnection::TaskResult& result) {
+    if (!loaded_.frame) {
+        // Cached per job (loaded_.job_id), through the conversions local mode uses, so one job's
+        // settings give local mode's kernel.
+        const JobSpec& spec = task.spec;
+        absl::StatusOr<std::unique_ptr<FrameRenderer>> made = MakeFrameRenderer(
+            spec.method, *loaded_.embree, *loaded_.camera,
+            FrameRenderSettingsOf<FrameRenderSettings>(spec.max_depth, spec.seed, spec.sampler,
+                                                       spec.clamp, spec.light_strategy, spec.ppm));
+        if (!made.ok()) return made.status();
+        loaded_.frame = std::move(*made);
+    }
+    const FrameWork work{task.task.rect, task.task.sample_begin, task.task.sample_end,
+                         task.path_begin, task.path_end};
+    TileSums camera(task.task.rect, 0);
+    SplatList splats(loaded_.camera->width(), loaded_.camera->height());
+    // The renderer runs tbb inside: in this worker's arena, so --threads bounds it.
+    arena_.execute([&] { loaded_.frame->Render(work, camera, splats, &cancel); });
+    if (cancel) return absl::CancelledError("frame task cancelled");
+    result.bytes = EncodeTileSums(camera);
+    result.splats = EncodeSplatList(splats);
+    const size_t bytes = result.bytes.size() + result.splats->size();
+    // Above the bound the coordinator would refuse the message: said here, in its terms.
+    if (bytes > size_t(kMaxTaskResultBytes) - 4096) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "the result of job ", task.job_id, " task ", task.task.index, " is ", bytes,
+            " bytes, above the coordinator's bound of ", kMaxTaskResultBytes,
+            " (lf::kMaxTaskResultBytes): render with more --passes (fewer light paths a task) "
+            "or a finite --max-depth"));
+    }
+    return absl::OkStatus();
 }
 
 void Worker::SendResult(const TaskAssignment& task, const ServerConnection::TaskResult& result,

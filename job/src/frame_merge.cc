@@ -184,14 +184,16 @@ absl::Status FrameMerger::Add(int task_index, const TileSums& camera, SplatList&
     return absl::OkStatus();
 }
 
-absl::StatusOr<Image> FrameMerger::Snapshot() const {
-    Image image = EmptyRenderImage(width_, height_);
-    for (int t = 0; t < int(camera_->tiles().size()); ++t) {
-        absl::StatusOr<TileSums> camera = camera_->Get(t);
-        if (!camera.ok()) return camera.status();
-        absl::StatusOr<TileSums> splats = splats_->Get(t);
-        if (!splats.ok()) return splats.status();
-        SetFrameTile(image, *camera, *splats, norm_);
+absl::StatusOr<Image> FrameMerger::Snapshot() const { return snapshot_source().Read(); }
+
+absl::StatusOr<Image> FrameMerger::SnapshotSource::Read() const {
+    Image image = EmptyRenderImage(width, height);
+    for (int t = 0; t < int(camera->tiles().size()); ++t) {
+        absl::StatusOr<TileSums> camera_sums = camera->Get(t);
+        if (!camera_sums.ok()) return camera_sums.status();
+        absl::StatusOr<TileSums> splat_sums = splats->Get(t);
+        if (!splat_sums.ok()) return splat_sums.status();
+        SetFrameTile(image, *camera_sums, *splat_sums, norm);
     }
     return image;
 }

@@ -1077,5 +1077,124 @@ TEST_F(Farm, BadGltfIsRefusedAtSubmissionWithTheLoadersMessage) {
         << missing.err;
 }
 
+// The frame methods (light paths or photon passes over the whole frame, splats merged exactly):
+// on the farm, the bits and header of `lightfarm render` with the same flags, whichever worker
+// renders which task, a worker killed mid-task, or the coordinator killed mid-job. bdpt and ppm
+// join the list below when their kernels land (a one-line change).
+class FarmFrame : public Farm, public ::testing::WithParamInterface<std::string> {
+  protected:
+    std::string Flags(uint64_t spp, uint64_t seed, const std::string& more = "") const {
+        return "--method " + GetParam() + " --spp " + std::to_string(spp) + " --seed " +
+               std::to_string(seed) + " " + more;
+    }
+    // The flags local mode takes besides --spp and --seed (ExpectSameAsLocal adds those).
+    std::string LocalFlags(const std::string& more = "") const {
+        return "--method " + GetParam() + " " + more;
+    }
+    // Whether the worker's log names a task of the job.
+    bool WorkerTookPart(const std::string& worker, const std::string& job) {
+        return ReadText(dir_ / (worker + ".log")).find("job=" + job + " task=") !=
+               std::string::npos;
+    }
+};
+
+INSTANTIATE_TEST_SUITE_P(Methods, FarmFrame, ::testing::Values("light"),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                             return info.param;
+                         });
+
+// --passes 16: 16 tasks, each a range of light paths whose splats land all over the frame, from
+// both workers; tiles of 16 group the splats unlike local mode's default.
+TEST_P(FarmFrame, TwoWorkersGiveTheLocalBitsAndHeader) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string job = Submit(scene_, Flags(16, 5, "--passes 16 --tile 16"));
+    ExpectSameAsLocal(job, scene_, 16, 5, LocalFlags("--passes 16 --tile 16"));
+    EXPECT_EQ(Tasks(job).done, 16);
+    EXPECT_TRUE(WorkerTookPart("w1", job));
+    EXPECT_TRUE(WorkerTookPart("w2", job));
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_NE(status.out.find("method    " + GetParam()), std::string::npos) << status.out;
+    const CliRun list = Farmctl("list");
+    EXPECT_NE(list.out.find(GetParam()), std::string::npos) << list.out;
+}
+
+TEST_P(FarmFrame, KilledWorkerDoesNotChangeTheImage) {
+    StartServer(/*lease_seconds=*/1);
+    Child* doomed = StartWorker("doomed");
+    StartWorker("survivor");
+    const std::string job = Submit(scene_, Flags(256, 9, "--passes 16"));
+    ASSERT_TRUE(WaitForStatus(job, "running", milliseconds(20000)));
+    std::this_thread::sleep_for(milliseconds(150));  // mid-task
+    doomed->Signal(SIGKILL);
+    ExpectSameAsLocal(job, scene_, 256, 9, LocalFlags("--passes 16"));
+    const TaskCounts c = Tasks(job);
+    EXPECT_EQ(c.done, 16);
+    EXPECT_GT(c.leased, c.total) << "no task was leased again";
+}
+
+// Results merged before the kill are recorded with their splats and merged once on restart; a
+// result merged twice, or lost, would change the bits.
+TEST_P(FarmFrame, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string job = Submit(scene_, Flags(256, 7, "--passes 16"));
+    ASSERT_TRUE(WaitForTasksDone(job, 4, milliseconds(30000)));
+    CrashAndRestartServer();
+    EXPECT_GE(Tasks(job).done, 2) << "acknowledged results were lost";
+    ExpectSameAsLocal(job, scene_, 256, 7, LocalFlags("--passes 16"));
+    const TaskCounts c = Tasks(job);
+    EXPECT_EQ(c.done, 16);
+    EXPECT_LE(c.leased, 16 + 2 * 2) << "done tasks were rendered again";
+}
+
+// A running frame job's preview is the image of the light paths merged so far (normalised by
+// them, so not darker than the final image would be); a cancel stops the kernel mid-task.
+TEST_P(FarmFrame, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
+    StartServer();
+    StartWorker("w1");
+    const std::string job = Submit(scene_, Flags(1024, 3, "--passes 16"));
+    ASSERT_TRUE(WaitForTasksDone(job, 2, milliseconds(60000)));
+    const std::string preview = (dir_ / "preview.exr").string();
+    const CliRun fetch = Farmctl("fetch --preview " + job + " -o " + preview);
+    ASSERT_EQ(fetch.status, 0) << fetch.err;
+    absl::StatusOr<ExrFile> partial = ReadExr(preview);
+    ASSERT_TRUE(partial.ok()) << partial.status();
+    const std::vector<float>& r = *partial->image.FindChannel("R");
+    double sum = 0;
+    for (float v : r) sum += v;
+    // This Cornell box's mean R is about 0.2; a preview divided by all the job's paths instead
+    // of those merged (2 or 3 of 16 tasks by now) would be 5 to 8 times darker.
+    EXPECT_GT(sum / double(r.size()), 0.1) << "the preview is not normalised by merged paths";
+    ASSERT_TRUE(WaitForStatus(job, "1 running", milliseconds(20000)));
+    ASSERT_EQ(Farmctl("cancel " + job).status, 0);
+    EXPECT_TRUE(WaitForText(dir_ / "w1.log", "dropped", milliseconds(1000)).has_value())
+        << "the worker still renders a second after the cancel";
+}
+
+// The kernels splat with the box filter only: another filter is refused at submission, naming
+// the method and the filter, rather than failing on every worker.
+TEST_P(FarmFrame, NonBoxFilterIsRefusedAtSubmission) {
+    StartServer();
+    const CliRun r = Farmctl("submit " + scene_ + " " + Flags(4, 1, "--filter gaussian:2"));
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.err.find("method " + GetParam()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("gaussian"), std::string::npos) << r.err;
+}
+
+TEST(FarmFrameFlags, PhotonFlagsAreRefusedForOtherMethodsOnSubmit) {
+    const std::string cmd = std::string(LF_BIN_DIR) + "/lightfarm submit " + LF_TEST_SCENES +
+                            "/cornell_box.json --method light --photons 1000 "
+                            "--server 127.0.0.1:1 2>&1";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    std::string out;
+    char buf[4096];
+    while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+    EXPECT_NE(WEXITSTATUS(pclose(pipe)), 0);
+    EXPECT_NE(out.find("--photons"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace lf

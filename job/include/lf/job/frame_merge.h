@@ -77,6 +77,19 @@ class FrameMerger {
     // bits local mode makes of the same render.
     absl::StatusOr<Image> Snapshot() const;
 
+    // What Snapshot reads, to be read after the caller's lock is released (the coordinator
+    // takes previews without holding its scheduler while every tile is read): the stores,
+    // shared, and the normalisation as it is now. Tiles merged after this call may show with
+    // the older normalisation, a preview's blemish only: nothing merges once Complete(), so a
+    // source taken then reads Snapshot's bits.
+    struct SnapshotSource {
+        int width = 0, height = 0;
+        std::shared_ptr<const TileStore> camera, splats;
+        SplatNormalization norm;
+        absl::StatusOr<Image> Read() const;
+    };
+    SnapshotSource snapshot_source() const { return {width_, height_, camera_, splats_, norm_}; }
+
   private:
     FrameMerger(int width, int height, int tile, FramePlanKind kind, std::vector<FrameTask> tasks,
                 std::unique_ptr<TileStore> camera, std::unique_ptr<TileStore> splats);
@@ -88,7 +101,7 @@ class FrameMerger {
     int width_, height_, tile_, columns_;
     FramePlanKind kind_;
     std::vector<FrameTask> tasks_;
-    std::unique_ptr<TileStore> camera_, splats_;
+    std::shared_ptr<TileStore> camera_, splats_;  // shared with snapshot sources
     std::vector<bool> done_;
     // Tasks partly merged when a store failed: slots (splat tile t, camera tile T + t) added.
     std::map<int, std::vector<bool>> partial_;

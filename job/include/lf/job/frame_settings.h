@@ -46,6 +46,15 @@ inline constexpr int kPpmMaxTile = 1024;
 // + 1) entries before coalescing (64 bytes each in memory).
 inline constexpr uint64_t kMaxLightPathsPerTask = kDefaultPathsPerTask;
 
+// The largest task result a worker sends and the coordinator takes (CompleteTaskRequest), on
+// both ends of the wire in place of gRPC's 4 MiB default: a frame task's result is its camera
+// sums (104 bytes a pixel, at most kPpmMaxTile^2 pixels: 104 MiB) and its splat list (53 bytes
+// an entry after coalescing, at most 2 entries a pixel of the frame: 879 MB on a 3840x2160
+// frame whatever the task's paths or depth). So any task of a frame up to 4K, or of any frame
+// whose light paths per task x (max depth + 1) x 53 bytes stay below it, fits; a worker whose
+// result does not fails the task saying so (docs/farm.md, "Message sizes").
+inline constexpr int kMaxTaskResultBytes = 1 << 30;
+
 // The frame plan of `method` (a frame method) for a render of plan.width x plan.height:
 // - light: spp x W x H light paths (spp light paths per pixel-equivalent, so `--spp` means the
 //   same effort per pixel as for the path tracer), in consecutive ranges of
