@@ -67,9 +67,11 @@ Command AddRenderCommand(CLI::App& app) {
                     "the image), bdpt (bidirectional path tracing: every connection of a camera "
                     "and a light subpath, weighted by MIS), ppm (progressive photon mapping: --spp "
                     "passes of --photons photons each, a shrinking gather radius; consistent, "
-                    "biased at any finite pass count) or auto (radiosity when every material is "
-                    "Lambertian and there are no spheres; the log says why). light, bdpt and ppm "
-                    "take no --aov nor adaptive sampling")
+                    "biased at any finite pass count) or auto (whitted where it is exact: no "
+                    "interreflection nor caustics; else radiosity where it is exact: Lambertian "
+                    "quads and triangles; else bdpt for caustics of small emitters through "
+                    "specular surfaces; else path; the log says why). light, bdpt and ppm take no "
+                    "--aov nor adaptive sampling")
         ->capture_default_str()
         ->check([](const std::string& m) { return MethodFlagError(m, true); });
 

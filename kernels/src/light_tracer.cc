@@ -39,9 +39,10 @@ void LightTracer::Splat(const Vec2& raster, int half, Rgb value, SplatList& spla
     if (value.IsBlack()) return;
     const int w = camera_.width(), h = camera_.height();
     if (settings_.clamp > 0) {
-        // In pixel units: one light path per pixel-equivalent makes a pixel's estimate W H times
-        // its splat, as a camera sample makes it its radiance.
-        const double limit = settings_.clamp / (double(w) * h);
+        // A splat's share of its pixel is splat x W H / N; with N = W H k paths (k per pixel)
+        // that is splat / k, as a camera sample's is radiance / spp: the splat is on the scale of
+        // a camera sample's radiance, so the limit is the clamp itself (BDPT's t = 1 rule).
+        const double limit = settings_.clamp;
         if (value.MaxComponent() > limit) value *= float(limit / value.MaxComponent());
     }
     // Raster positions on the film's far edges may round to W or H.

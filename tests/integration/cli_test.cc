@@ -681,6 +681,12 @@ TEST_F(Cli, HelpExplainsTheOutputFlags) {
                              "EXR is never scaled", ".png writes only"}) {
         EXPECT_NE(r.output.find(text), std::string::npos) << text;
     }
+    // --method auto's rule as ChooseAutomatically applies it (whitted, radiosity, bdpt, path),
+    // not the older radiosity-or-path rule.
+    for (const char* text : {"auto (whitted where it is exact", "else bdpt for caustics"}) {
+        EXPECT_NE(r.output.find(text), std::string::npos) << text;
+    }
+    EXPECT_EQ(r.output.find("there are no spheres"), std::string::npos);
     const RunResult submit = Lightfarm("submit --help");
     for (const char* text : {"--clamp", "--filter", "--aov"}) {
         EXPECT_NE(submit.output.find(text), std::string::npos) << text;

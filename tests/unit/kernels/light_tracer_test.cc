@@ -76,6 +76,19 @@ TEST(LightTracer, DepthZeroIsTheEmitterSeenDirectly) {
     EXPECT_NEAR(m.mean, 0.5, 4.5 * m.standard_error + 1e-6);
 }
 
+// --clamp bounds each splat as the path tracer bounds a camera sample: a splat's share of its
+// pixel is splat x W H / N, the same as a camera sample's radiance / spp when N = W H spp light
+// paths, so the limit is the clamp itself. A clamp far above the furnace's splats (a few units)
+// leaves the mean at 1; dividing the limit by W H (as the tracer once did) darkened it tenfold.
+TEST(LightTracer, ClampFarAboveTheSplatsLeavesTheFurnaceAtOne) {
+    FrameRenderSettings settings = Unlimited();
+    settings.clamp = 100;
+    const testing::MeanAndError m =
+        BatchedFrameMean(testing::PointLitFurnaceSphere(16), settings, 32, 1 << 15);
+    std::printf("[light] clamp 100: %.5f +- %.5f (expected 1)\n", m.mean, m.standard_error);
+    EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, 4.5 * m.standard_error);
+}
+
 Scene LoadTestScene(const char* name, int size) {
     absl::StatusOr<Scene> scene = LoadScene(std::string(LF_TEST_SCENES) + "/" + name);
     EXPECT_TRUE(scene.ok()) << scene.status();
@@ -96,10 +109,10 @@ TEST(LightTracer, AnySplitGivesTheSameSplats) {
     SplatList parts(w, h);
     TileSums part_sums(PixelRect{});
     for (const auto& [begin, end] : {std::pair<uint64_t, uint64_t>{0, 1},
-                                    {1, 1023},
-                                    {1023, 5000},
-                                    {5000, 5001},
-                                    {5001, kPaths}}) {
+                                     {1, 1023},
+                                     {1023, 5000},
+                                     {5000, 5001},
+                                     {5001, kPaths}}) {
         SplatList part(w, h);
         s.renderer->Render({PixelRect{}, 0, 0, begin, end}, part_sums, part);
         parts += part;

@@ -39,8 +39,9 @@
 //   |wi . ns|) (Veach's eq. 5.17, pbrt-v3's CorrectShadingNormal), wo towards the light, wi
 //   onwards: with it the light tracer converges to the path tracer's image on smooth meshes.
 //
-// Clamp: a splat whose largest channel, in pixel units (value x W H, one light path per
-// pixel-equivalent), exceeds settings.clamp is scaled down to it. Non-finite splats are dropped
+// Clamp: a splat whose largest channel exceeds settings.clamp is scaled down to it. A splat is
+// on a camera sample's scale: with k light paths per pixel (N = W H k) it adds splat x W H / N
+// = splat / k to its pixel, as a camera sample adds radiance / spp. Non-finite splats are dropped
 // and counted in RenderStats::invalid_samples; samples counts light paths, rays every ray
 // (light rays and shadow rays to the camera).
 //
