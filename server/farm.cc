@@ -138,14 +138,14 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     if (spec.method == "radiosity") {
         if (absl::Status s = RadiosityRefusal(*scene); !s.ok()) return s;
     }
-    // The frame methods' kernels splat into the pixel that holds a splat's raster position (the
-    // box filter) and refuse other filters (lf::MakeFrameRenderer): refused here, once, rather
-    // than failing on every worker. Revisit when a frame kernel splats with filter weights.
-    if (UsesFramePlan(spec.method) && scene->camera.filter.type != PixelFilter::Type::kBox) {
+    // The splatting kernels refuse filters other than the box (SplatsLightPaths): refused here,
+    // once, rather than failing on every worker. Revisit when they splat with filter weights.
+    if (SplatsLightPaths(spec.method) && scene->camera.filter.type != PixelFilter::Type::kBox) {
         return absl::FailedPreconditionError(
             absl::StrCat("method ", spec.method, ": the pixel filter ",
                          DescribePixelFilter(scene->camera.filter),
-                         " is not supported; the frame methods splat with the box filter only"));
+                         " is not supported; light tracing and bdpt splat with the box filter "
+                         "only"));
     }
     const int side = options_.limits.max_resolution;
     if (scene->camera.width > side || scene->camera.height > side) {

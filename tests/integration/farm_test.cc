@@ -1091,6 +1091,15 @@ class FarmFrame : public Farm, public ::testing::WithParamInterface<std::string>
     std::string LocalFlags(const std::string& more = "") const {
         return "--method " + GetParam() + " " + more;
     }
+    // 16 tasks of the method on the 64x64 scene: light paths in 16 ranges (splats grouped by
+    // tiles of 16, unlike local mode's default); bdpt's whole frame in 16 sample passes, each
+    // task's splats landing anywhere; ppm's 16 ranges of passes, with few photons a pass so
+    // that hundreds of passes stay quick.
+    std::string Split() const {
+        if (GetParam() == "light") return "--passes 16 --tile 16";
+        if (GetParam() == "bdpt") return "--passes 16 --tile 64";
+        return "--passes 16 --photons 4096";
+    }
     // Whether the worker's log names a task of the job.
     bool WorkerTookPart(const std::string& worker, const std::string& job) {
         return ReadText(dir_ / (worker + ".log")).find("job=" + job + " task=") !=
@@ -1098,19 +1107,18 @@ class FarmFrame : public Farm, public ::testing::WithParamInterface<std::string>
     }
 };
 
-INSTANTIATE_TEST_SUITE_P(Methods, FarmFrame, ::testing::Values("light"),
+INSTANTIATE_TEST_SUITE_P(Methods, FarmFrame, ::testing::Values("light", "bdpt", "ppm"),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                              return info.param;
                          });
 
-// --passes 16: 16 tasks, each a range of light paths whose splats land all over the frame, from
-// both workers; tiles of 16 group the splats unlike local mode's default.
+// Split(): 16 tasks, whose splats land all over the frame, from both workers.
 TEST_P(FarmFrame, TwoWorkersGiveTheLocalBitsAndHeader) {
     StartServer();
     StartWorker("w1");
     StartWorker("w2");
-    const std::string job = Submit(scene_, Flags(16, 5, "--passes 16 --tile 16"));
-    ExpectSameAsLocal(job, scene_, 16, 5, LocalFlags("--passes 16 --tile 16"));
+    const std::string job = Submit(scene_, Flags(16, 5, Split()));
+    ExpectSameAsLocal(job, scene_, 16, 5, LocalFlags(Split()));
     EXPECT_EQ(Tasks(job).done, 16);
     EXPECT_TRUE(WorkerTookPart("w1", job));
     EXPECT_TRUE(WorkerTookPart("w2", job));
@@ -1124,11 +1132,11 @@ TEST_P(FarmFrame, KilledWorkerDoesNotChangeTheImage) {
     StartServer(/*lease_seconds=*/1);
     Child* doomed = StartWorker("doomed");
     StartWorker("survivor");
-    const std::string job = Submit(scene_, Flags(256, 9, "--passes 16"));
+    const std::string job = Submit(scene_, Flags(256, 9, Split()));
     ASSERT_TRUE(WaitForStatus(job, "running", milliseconds(20000)));
     std::this_thread::sleep_for(milliseconds(150));  // mid-task
     doomed->Signal(SIGKILL);
-    ExpectSameAsLocal(job, scene_, 256, 9, LocalFlags("--passes 16"));
+    ExpectSameAsLocal(job, scene_, 256, 9, LocalFlags(Split()));
     const TaskCounts c = Tasks(job);
     EXPECT_EQ(c.done, 16);
     EXPECT_GT(c.leased, c.total) << "no task was leased again";
@@ -1140,11 +1148,11 @@ TEST_P(FarmFrame, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
     StartServer();
     StartWorker("w1");
     StartWorker("w2");
-    const std::string job = Submit(scene_, Flags(256, 7, "--passes 16"));
+    const std::string job = Submit(scene_, Flags(256, 7, Split()));
     ASSERT_TRUE(WaitForTasksDone(job, 4, milliseconds(30000)));
     CrashAndRestartServer();
     EXPECT_GE(Tasks(job).done, 2) << "acknowledged results were lost";
-    ExpectSameAsLocal(job, scene_, 256, 7, LocalFlags("--passes 16"));
+    ExpectSameAsLocal(job, scene_, 256, 7, LocalFlags(Split()));
     const TaskCounts c = Tasks(job);
     EXPECT_EQ(c.done, 16);
     EXPECT_LE(c.leased, 16 + 2 * 2) << "done tasks were rendered again";
@@ -1155,7 +1163,7 @@ TEST_P(FarmFrame, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
 TEST_P(FarmFrame, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
     StartServer();
     StartWorker("w1");
-    const std::string job = Submit(scene_, Flags(1024, 3, "--passes 16"));
+    const std::string job = Submit(scene_, Flags(1024, 3, Split()));
     ASSERT_TRUE(WaitForTasksDone(job, 2, milliseconds(60000)));
     const std::string preview = (dir_ / "preview.exr").string();
     const CliRun fetch = Farmctl("fetch --preview " + job + " -o " + preview);
@@ -1176,9 +1184,18 @@ TEST_P(FarmFrame, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
 
 // The kernels splat with the box filter only: another filter is refused at submission, naming
 // the method and the filter, rather than failing on every worker.
-TEST_P(FarmFrame, NonBoxFilterIsRefusedAtSubmission) {
+// Light tracing and bdpt splat with the box filter only and are refused other filters at
+// submission; ppm gathers at filter-sampled camera samples and renders them as locally.
+TEST_P(FarmFrame, NonBoxFilterIsRefusedAtSubmissionWhereTheKernelSplats) {
     StartServer();
-    const CliRun r = Farmctl("submit " + scene_ + " " + Flags(4, 1, "--filter gaussian:2"));
+    const std::string filter = "--filter gaussian:2 " + Split();
+    if (GetParam() == "ppm") {
+        StartWorker("w1");
+        const std::string job = Submit(scene_, Flags(4, 1, filter));
+        ExpectSameAsLocal(job, scene_, 4, 1, LocalFlags(filter));
+        return;
+    }
+    const CliRun r = Farmctl("submit " + scene_ + " " + Flags(4, 1, filter));
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.err.find("method " + GetParam()), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("gaussian"), std::string::npos) << r.err;
