@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "lf/kernels/bsdf.h"
+#include "lf/kernels/next_event.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/shading.h"
 #include "tbb/parallel_for.h"
@@ -15,14 +16,6 @@ namespace {
 
 // As the path tracer: roulette spares the first bounce.
 constexpr int kRouletteStartDepth = 1;
-
-// The interior a path is in after leaving a surface of material `index` in direction w (the
-// path tracer's rule): a transmission through a solid's surface enters it (against the
-// geometric normal) or leaves it (along it).
-int MediumAfter(int medium, int index, const Material& material, float cos_ng, bool transmitted) {
-    if (!transmitted || !HasInterior(material)) return medium;
-    return cos_ng < 0 ? index : -1;
-}
 
 }  // namespace
 
@@ -130,8 +123,8 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
                         ++stats.rays;
                         const SurfacePoint lens_point{cs->lens_point, Vec3(), Vec3()};
                         if (!scene_.Occluded(SpawnRayTo(sh.Leaving(cs->wi), lens_point))) {
-                            const int through = MediumAfter(medium, hit->material, material,
-                                                            Dot(cs->wi, ng), !reflect);
+                            const int through = InteriorAfter(medium, hit->material, material,
+                                                              Dot(cs->wi, ng), !reflect);
                             if (through >= 0) {
                                 value *= Transmittance(materials[size_t(through)],
                                                        Length(cs->lens_point - hit->p));
@@ -159,7 +152,7 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
         beta *= bs->f *
                 (bs->eta * bs->eta * std::abs(wo.z) * std::abs(cos_i_ng) / (cos_o_ng * bs->pdf));
         if (beta.IsBlack() || !beta.IsFinite()) break;
-        medium = MediumAfter(medium, hit->material, material, cos_i_ng, transmitted);
+        medium = InteriorAfter(medium, hit->material, material, cos_i_ng, transmitted);
         ray = SpawnRay(sh.Leaving(wi_world), wi_world);
 
         if (bounce >= kRouletteStartDepth) {

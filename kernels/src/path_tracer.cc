@@ -3,25 +3,12 @@
 #include <algorithm>
 
 #include "lf/kernels/bsdf.h"
+#include "lf/kernels/next_event.h"
 #include "lf/kernels/shading.h"
 
 namespace lf {
 
 namespace {
-
-float PowerHeuristic(float pdf_a, float pdf_b) {
-    const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
-    if (std::isinf(a)) return 1;
-    return a + b > 0 ? a / (a + b) : 0;
-}
-
-// The interior a path is in after leaving a surface of material `index` in direction wi:
-// a transmission through a solid transmitter's surface enters it (against the geometric
-// normal) or leaves it (along it).
-int MediumAfter(int medium, int index, const Material& material, float cos_i_ng, bool transmitted) {
-    if (!transmitted || !HasInterior(material)) return medium;
-    return cos_i_ng < 0 ? index : -1;
-}
 
 // Roulette spares the first bounce: direct and one-bounce light are never cut.
 constexpr int kRouletteStartDepth = 1;
@@ -93,29 +80,8 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         const Bsdf bsdf(material, sh.params);
 
         if (!bsdf.IsDelta()) {
-            if (const auto ls = lights_.Sample(hit->p, sh.ns, u_choice.x, u_light)) {
-                const Vec3 wi = frame.ToLocal(ls->wi);
-                const Rgb f = sh.SidesAgree(-ray.d, ls->wi, wi.z * wo.z > 0)
-                                  ? bsdf.Eval(wo, wi) * std::abs(wi.z)
-                                  : Rgb();
-                const Rgb radiance =
-                    f.IsBlack() ? Rgb() : EmissionAt(scene_, ls->point, ls->radiance);
-                if (!radiance.IsBlack()) {
-                    ++stats.rays;
-                    if (!scene_.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) {
-                        const float w =
-                            ls->delta ? 1.0f : PowerHeuristic(ls->pdf, bsdf.Pdf(wo, wi));
-                        Rgb contribution = beta * f * radiance * (w / ls->pdf);
-                        const int through = MediumAfter(medium, hit->material, material,
-                                                        Dot(ls->wi, ng), wi.z * wo.z < 0);
-                        if (through >= 0) {
-                            contribution *= Transmittance(materials[size_t(through)],
-                                                          Length(ls->point.p - hit->p));
-                        }
-                        L += contribution;
-                    }
-                }
-            }
+            L += NextEventEstimate(scene_, lights_, *hit, sh, -ray.d, bsdf, medium, beta,
+                                   u_choice.x, u_light, stats);
         }
 
         const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
@@ -126,7 +92,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         if (beta.IsBlack()) break;
         const bool transmitted = bs->wi.z * wo.z < 0;
         const int next_medium =
-            MediumAfter(medium, hit->material, material, Dot(wi, ng), transmitted);
+            InteriorAfter(medium, hit->material, material, Dot(wi, ng), transmitted);
         // Radiance is scaled by 1/eta^2 across a refracting interface; roulette must not see it.
         eta_scale *= bs->eta * bs->eta;
         medium = next_medium;

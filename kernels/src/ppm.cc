@@ -11,25 +11,13 @@
 #include "absl/strings/str_cat.h"
 #include "lf/kernels/aov_tracer.h"
 #include "lf/kernels/bsdf.h"
+#include "lf/kernels/next_event.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/shading.h"
 
 namespace lf {
 
 namespace {
-
-// The interior a path is in after leaving a surface of material `index` in direction wi, as in
-// the path tracer.
-int MediumAfter(int medium, int index, const Material& material, float cos_i_ng, bool transmitted) {
-    if (!transmitted || !HasInterior(material)) return medium;
-    return cos_i_ng < 0 ? index : -1;
-}
-
-float PowerHeuristic(float pdf_a, float pdf_b) {
-    const float a = pdf_a * pdf_a, b = pdf_b * pdf_b;
-    if (std::isinf(a)) return 1;
-    return a + b > 0 ? a / (a + b) : 0;
-}
 
 // Photons traced per parallel chunk: enough to amortise the task, few enough to balance.
 constexpr uint64_t kPhotonChunk = 4096;
@@ -172,8 +160,8 @@ void PpmRenderer::TraceRange(uint64_t pass, uint64_t begin, uint64_t end, std::v
             if (!(cos_o_ng > 0)) break;
             beta *= bs->f * (std::abs(wo.z) * cos_i_ng / (cos_o_ng * bs->pdf) * bs->eta * bs->eta);
             if (beta.IsBlack() || !beta.IsFinite()) break;
-            medium =
-                MediumAfter(medium, hit->material, material, Dot(wi, hit->n), bs->wi.z * wo.z < 0);
+            medium = InteriorAfter(medium, hit->material, material, Dot(wi, hit->n),
+                                   bs->wi.z * wo.z < 0);
             ray = SpawnRay(sh.Leaving(wi), wi);
             if (depth >= kRouletteStartDepth) {
                 const float q = std::max(0.0f, 1 - beta.MaxComponent() / emitted_max);
@@ -275,7 +263,7 @@ Rgb PpmRenderer::Li(const Ray& camera_ray, const PhotonMap& map, Sampler& sample
         if (!sh.SidesAgree(wo_world, wi, bs->wi.z * wo.z > 0)) break;
         beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
         if (beta.IsBlack()) break;
-        medium = MediumAfter(medium, hit->material, material, Dot(wi, ng), bs->wi.z * wo.z < 0);
+        medium = InteriorAfter(medium, hit->material, material, Dot(wi, ng), bs->wi.z * wo.z < 0);
         eta_scale *= bs->eta * bs->eta;
         ray = SpawnRay(sh.Leaving(wi), wi);
         if (depth >= kRouletteStartDepth) {
@@ -295,31 +283,16 @@ Rgb PpmRenderer::DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec
                              const Bsdf& bsdf, int medium, const Vec2& u_choice,
                              const Vec2& u_light, const Vec2& u_bsdf, RenderStats& stats) const {
     const std::vector<Material>& materials = scene_.scene().materials;
-    const Material& material = materials[size_t(hit.material)];
-    const Vec3& ng = hit.n;
     const Frame frame = Frame::FromNormal(sh.ns);
     const Vec3 wo = frame.ToLocal(wo_world);
-    // Beer's law when light reaching the vertex from direction w crosses a solid's interior.
+    Rgb L = NextEventEstimate(scene_, lights_, hit, sh, wo_world, bsdf, medium, Rgb(1.0f),
+                              u_choice.x, u_light, stats);
+    // Beer's law when the BSDF sample reaches an emitter through a solid's interior.
     auto transmittance = [&](const Vec3& w, bool transmitted, float distance) {
-        const int through = MediumAfter(medium, hit.material, material, Dot(w, ng), transmitted);
+        const int through = InteriorAfter(medium, hit.material, materials[size_t(hit.material)],
+                                          Dot(w, hit.n), transmitted);
         return through >= 0 ? Transmittance(materials[size_t(through)], distance) : Rgb(1.0f);
     };
-    Rgb L(0);
-    if (const auto ls = lights_.Sample(hit.p, sh.ns, u_choice.x, u_light)) {
-        const Vec3 wi = frame.ToLocal(ls->wi);
-        const Rgb f = sh.SidesAgree(wo_world, ls->wi, wi.z * wo.z > 0)
-                          ? bsdf.Eval(wo, wi) * std::abs(wi.z)
-                          : Rgb();
-        const Rgb radiance = f.IsBlack() ? Rgb() : EmissionAt(scene_, ls->point, ls->radiance);
-        if (!radiance.IsBlack() && ls->pdf > 0) {
-            ++stats.rays;
-            if (!scene_.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) {
-                const float w = ls->delta ? 1.0f : PowerHeuristic(ls->pdf, bsdf.Pdf(wo, wi));
-                L += f * radiance * (w / ls->pdf) *
-                     transmittance(ls->wi, wi.z * wo.z < 0, Length(ls->point.p - hit.p));
-            }
-        }
-    }
     const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
     if (!bs || !(bs->pdf > 0)) return L;
     const Vec3 wi = frame.FromLocal(bs->wi);

@@ -1,0 +1,31 @@
+#include "lf/kernels/next_event.h"
+
+namespace lf {
+
+Rgb NextEventEstimate(const EmbreeScene& scene, const LightSampler& lights, const SurfaceHit& hit,
+                      const Shading& sh, const Vec3& wo_world, const Bsdf& bsdf, int medium,
+                      const Rgb& beta, float u_pick, const Vec2& u_light, RenderStats& stats) {
+    const std::optional<LightSample> ls = lights.Sample(hit.p, sh.ns, u_pick, u_light);
+    if (!ls) return Rgb();
+    const std::vector<Material>& materials = scene.scene().materials;
+    const Frame frame = Frame::FromNormal(sh.ns);
+    const Vec3 wo = frame.ToLocal(wo_world);
+    const Vec3 wi = frame.ToLocal(ls->wi);
+    const Rgb f = sh.SidesAgree(wo_world, ls->wi, wi.z * wo.z > 0)
+                      ? bsdf.Eval(wo, wi) * std::abs(wi.z)
+                      : Rgb();
+    const Rgb radiance = f.IsBlack() ? Rgb() : EmissionAt(scene, ls->point, ls->radiance);
+    if (radiance.IsBlack() || !(ls->pdf > 0)) return Rgb();
+    ++stats.rays;
+    if (scene.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) return Rgb();
+    const float w = ls->delta ? 1.0f : PowerHeuristic(ls->pdf, bsdf.Pdf(wo, wi));
+    Rgb contribution = beta * f * radiance * (w / ls->pdf);
+    const int through = InteriorAfter(medium, hit.material, materials[size_t(hit.material)],
+                                      Dot(ls->wi, hit.n), wi.z * wo.z < 0);
+    if (through >= 0) {
+        contribution *= Transmittance(materials[size_t(through)], Length(ls->point.p - hit.p));
+    }
+    return contribution;
+}
+
+}  // namespace lf
