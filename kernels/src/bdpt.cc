@@ -65,7 +65,8 @@ struct BdptVertex {
 
 namespace {
 
-// pbrt's remap of the densities of delta lobes (0) in the MIS recursion.
+// pbrt's remap of zero densities in the MIS recursion (those that no strategy samples, such as
+// a camera or light endpoint's reverse density; delta lobes have their own, see Walk).
 float Remap0(float f) { return f != 0 ? f : 1; }
 
 // As the path tracer (path_tracer.cc): the interior after crossing or leaving a surface.
@@ -320,8 +321,22 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
         pdf_fwd = bs->pdf;
         float pdf_rev = cur.bsdf->Pdf(bs->wi, wo);
         if (bs->delta) {
+            // A delta lobe has no density. For the MIS ratios it counts as density 1 in the
+            // measure that reflection and refraction preserve, n^2 times projected solid angle,
+            // as in Veach's thesis (10.3.5), where the geometry terms stay: n_wi^2 |cos wi| per
+            // solid angle towards wi and n_wo^2 |cos wo| back towards wo (both divided by
+            // n_wo^2 here; a factor common to the two directions cancels in every ratio). Then
+            // two strategies that traverse a specular chain from opposite ends compare as they
+            // truly do: a camera path E D S S L through glass to a small lamp against the light
+            // path L S S D joined to the camera by p_emission(L) p(L -> S) / (p_camera(D)
+            // p(D -> S)) in projected solid angle. pbrt-v4 remaps the area density to 1
+            // instead, which drops the geometry term of every segment that leaves a delta
+            // vertex and so misjudges that ratio by G(D, S) / G(S, L): in a caustic where the
+            // floor D almost touches the glass it is thousands, and the camera path took the
+            // weight that belongs to light tracing (BdptTest's caustic test measures it).
             cur.delta = true;
-            pdf_fwd = pdf_rev = 0;
+            pdf_fwd = bs->eta * bs->eta * std::abs(Dot(wi, cur.ng));
+            pdf_rev = std::abs(Dot(cur.wo, cur.ng));
         }
         prev.pdf_rev = ConvertDensity(cur, pdf_rev, prev);
         medium = MediumAfter(medium, cur.material, material, Dot(wi, cur.ng), transmitted);

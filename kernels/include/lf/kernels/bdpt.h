@@ -10,13 +10,15 @@
 //  - s, t >= 2: a shadow ray between a light vertex and a camera vertex.
 // The strategies are weighed by the power heuristic over all strategies that could have made
 // the same path, computed from per-vertex forward and reverse area densities (pbrt's
-// remapped-pdf recursion): a delta lobe's density is remapped to 1 and a delta vertex (or a
-// vertex next to one, or a delta light) cannot be the end of a connection, so those strategies
-// drop out of the sum. A light vertex's density is the EmissionSampler's (pick by power, then
-// PdfLe) for the strategies with s >= 2, and the LightSampler's (LightSampler::Pdf, EscapedPdf)
-// for s = 1, as each strategy really samples it, so the weights sum to 1 over the strategies
-// that can make a path, whatever points either sampler can or cannot reach (delta lights: the
-// emission pick stands for both).
+// recursion). A delta lobe's density counts as 1 in projected solid angle times n^2, the measure
+// specular scattering preserves, and keeps the geometry term of its segment (Veach 10.3.5; pbrt
+// remaps the area density to 1, which drops it and misweighs caustics: see Walk); a delta vertex
+// (or a vertex next to one, or a delta light) cannot be the end of a connection, so those
+// strategies drop out of the sum. A light vertex's density is the EmissionSampler's (pick by power,
+// then PdfLe) for the strategies with s >= 2, and the LightSampler's (LightSampler::Pdf,
+// EscapedPdf) for s = 1, as each strategy really samples it, so the weights sum to 1 over the
+// strategies that can make a path, whatever points either sampler can or cannot reach (delta
+// lights: the emission pick stands for both).
 //
 // Light subpaths carry importance: the adjoint BSDF (no 1/eta^2 across refraction) and the
 // shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) of Veach's thesis 5.3. Paths in
