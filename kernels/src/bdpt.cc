@@ -13,6 +13,7 @@
 #include "absl/status/status.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/kernels/bsdf.h"
+#include "lf/kernels/next_event.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/shading.h"
 
@@ -68,12 +69,6 @@ namespace {
 // pbrt's remap of zero densities in the MIS recursion (those that no strategy samples, such as
 // a camera or light endpoint's reverse density; delta lobes have their own, see Walk).
 float Remap0(float f) { return f != 0 ? f : 1; }
-
-// As the path tracer (path_tracer.cc): the interior after crossing or leaving a surface.
-int MediumAfter(int medium, int index, const Material& material, float cos_i_ng, bool transmitted) {
-    if (!transmitted || !HasInterior(material)) return medium;
-    return cos_i_ng < 0 ? index : -1;
-}
 
 // Unit direction from a to b; towards the light for b at infinity, along its light for a.
 Vec3 DirectionTo(const BdptVertex& a, const BdptVertex& b) {
@@ -220,8 +215,8 @@ Rgb BdptRenderer::FCos(const BdptVertex& v, const Vec3& dir, bool importance) co
 int BdptRenderer::MediumToward(const BdptVertex& v, const Vec3& dir) const {
     if (v.type != BdptVertex::Type::kSurface) return -1;
     const bool transmitted = v.frame.ToLocal(dir).z * v.frame.ToLocal(v.wo).z < 0;
-    return MediumAfter(v.medium, v.material, scene_.scene().materials[size_t(v.material)],
-                       Dot(dir, v.ng), transmitted);
+    return InteriorAfter(v.medium, v.material, scene_.scene().materials[size_t(v.material)],
+                         Dot(dir, v.ng), transmitted);
 }
 
 Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to,
@@ -295,7 +290,7 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
         }
         path.push_back(std::move(v));
         if (++bounces >= max_vertices) {
-            // Unlimited depth stops only at kMaxPathDepth (see the header): a cut path.
+            // Unlimited depth stops at kBdptUnlimitedDepth (see the header): a cut path.
             if (settings_.max_depth < 0) ++stats.truncated_paths;
             return;
         }
@@ -339,7 +334,7 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
             pdf_rev = std::abs(Dot(cur.wo, cur.ng));
         }
         prev.pdf_rev = ConvertDensity(cur, pdf_rev, prev);
-        medium = MediumAfter(medium, cur.material, material, Dot(wi, cur.ng), transmitted);
+        medium = InteriorAfter(medium, cur.material, material, Dot(wi, cur.ng), transmitted);
         ray = SpawnRay(cur.sh.Leaving(wi), wi);
         if (bounces >= kRouletteStartBounce) {
             const float relative =
@@ -379,7 +374,7 @@ void BdptRenderer::LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_d
     const float cos = v.on_surface ? std::abs(Dot(es->point.n, es->w)) : 1.0f;
     v.beta = es->le * (cos / (es->pick * es->pdf_pos * es->pdf_dir));
     path.push_back(v);
-    const int max_vertices = settings_.max_depth < 0 ? kMaxPathDepth : settings_.max_depth;
+    const int max_vertices = settings_.max_depth < 0 ? kBdptUnlimitedDepth : settings_.max_depth;
     Walk(es->ray(), path[0].beta, es->pdf_dir, max_vertices, true, sampler, path, stats);
 }
 
@@ -555,7 +550,7 @@ Rgb BdptRenderer::Sample(int x, int y, uint64_t sample_index, SplatList& splats,
     cv.beta = Rgb(1);
     camera.push_back(cv);
     const Camera::ImportancePdf pdf = camera_.PdfWe(Ray{ray.o, Normalize(ray.d)});
-    const int max_depth = settings_.max_depth < 0 ? kMaxPathDepth : settings_.max_depth;
+    const int max_depth = settings_.max_depth < 0 ? kBdptUnlimitedDepth : settings_.max_depth;
     Walk(ray, Rgb(1), pdf.dir, max_depth + 1, false, sampler, camera, stats);
     LightSubpath(u_pick, u_pos, u_dir, sampler, light, stats);
 

@@ -188,6 +188,22 @@ TEST(Bdpt, FurnaceWithAMaxDepthSumsItsBounces) {
     EXPECT_NEAR(m.value, 0.875, 5 * m.error);
 }
 
+// A furnace of reflectance 1 (roulette never ends a path) with unlimited depth: every subpath
+// runs to the cap, kBdptUnlimitedDepth bounces, and is counted as cut; the render ends (with
+// 65536 vertices a subpath one sample took minutes) and is finite: the emission summed over at
+// most the bounces two capped subpaths join, 0.5 (1 + 2 x 128). A hang here is the failure.
+TEST(Bdpt, WhiteFurnaceWithUnlimitedDepthStopsAtTheCap) {
+    Scene scene = FurnaceSphere(0.5f);
+    scene.materials[0].reflectance = Rgb(1.0f);
+    scene.camera.width = scene.camera.height = 2;
+    const BdptFrame f = RenderBdpt(scene, 2, -1);  // one sample in each half
+    EXPECT_GT(f.stats.truncated_paths, 0u);
+    EXPECT_EQ(f.stats.invalid_samples, 0u);
+    const Mean m = FrameMean(f);
+    EXPECT_GT(m.value, 0.5);
+    EXPECT_LE(m.value, 0.5 * (1 + 2 * kBdptUnlimitedDepth));
+}
+
 Scene LoadSmall(const std::string& file, int size) {
     SceneOptions options;
     options.width = options.height = size;
