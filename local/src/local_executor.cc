@@ -43,6 +43,40 @@ SampleOptions SampleOptionsOf(const RenderSettings& settings) {
     return {settings.clamp, settings.aovs, settings.sampler};
 }
 
+// Runs tasks 0..count-1 on `threads` threads (0: all cores), each task once: render(i) makes
+// its result in parallel, merge(i, result) adds it under one lock (mergers are not
+// thread-safe); the first merge error is returned. Exact sums make the order irrelevant.
+template <class Render, class Merge>
+absl::Status RunTasks(int threads, size_t count, const Render& render, const Merge& merge) {
+    std::mutex mutex;
+    absl::Status status;
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, count, 1),
+            [&](const tbb::blocked_range<size_t>& range) {
+                for (size_t i = range.begin(); i != range.end(); ++i) {
+                    auto result = render(i);
+                    std::lock_guard<std::mutex> lock(mutex);
+                    status.Update(merge(i, result));
+                }
+            },
+            tbb::simple_partitioner());
+    });
+    return status;
+}
+
+// The image the merger holds once every task is in, and the time since `start`.
+template <class Merger>
+absl::StatusOr<RenderOutput> Finish(const Merger& merger,
+                                    std::chrono::steady_clock::time_point start) {
+    absl::StatusOr<Image> image = merger.Snapshot();
+    if (!image.ok()) return image.status();
+    RenderOutput out{std::move(*image), merger.stats(), 0, {}};
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
 }  // namespace
 
 absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEstimator& estimator,
@@ -57,31 +91,20 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
                            TileStoreFor(camera, settings.aovs), settings.aovs);
     if (!made.ok()) return made.status();
     RenderMerger& merger = **made;
-    std::mutex mutex;
-    absl::Status status;
-    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    arena.execute([&] {
-        tbb::parallel_for(
-            tbb::blocked_range<size_t>(0, tasks->size(), 1),
-            [&](const tbb::blocked_range<size_t>& range) {
-                for (size_t i = range.begin(); i != range.end(); ++i) {
-                    const RenderTask& task = (*tasks)[i];
-                    const TileSums sums =
-                        RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
-                                   task.sample_end, SampleOptionsOf(settings));
-                    std::lock_guard<std::mutex> lock(mutex);
-                    status.Update(merger.Add(task.index, sums));
-                    if (progress) progress(merger.tasks_done(), merger.task_count());
-                }
-            },
-            tbb::simple_partitioner());
-    });
+    const absl::Status status = RunTasks(
+        settings.threads, tasks->size(),
+        [&](size_t i) {
+            const RenderTask& task = (*tasks)[i];
+            return RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
+                              task.sample_end, SampleOptionsOf(settings));
+        },
+        [&](size_t i, const TileSums& sums) {
+            const absl::Status added = merger.Add((*tasks)[i].index, sums);
+            if (progress) progress(merger.tasks_done(), merger.task_count());
+            return added;
+        });
     if (!status.ok()) return status;
-    absl::StatusOr<Image> image = merger.Snapshot();
-    if (!image.ok()) return image.status();
-    RenderOutput out{std::move(*image), merger.stats(), 0, {}};
-    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return out;
+    return Finish(merger, start);
 }
 
 absl::StatusOr<RenderOutput> RenderFrameImage(const Camera& camera, const FrameRenderer& renderer,
@@ -101,33 +124,27 @@ absl::StatusOr<RenderOutput> RenderFrameImage(const Camera& camera, const FrameR
         plan.width, plan.height, plan.tile, plan.kind, *tasks, TileStoreFor(camera, 0));
     if (!made.ok()) return made.status();
     FrameMerger& merger = **made;
-    std::mutex mutex;
-    absl::Status status;
-    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
-    arena.execute([&] {
-        tbb::parallel_for(
-            tbb::blocked_range<size_t>(0, tasks->size(), 1),
-            [&](const tbb::blocked_range<size_t>& range) {
-                for (size_t i = range.begin(); i != range.end(); ++i) {
-                    const FrameTask& task = (*tasks)[i];
-                    const FrameWork work{task.rect, task.sample_begin, task.sample_end,
-                                         task.path_begin, task.path_end};
-                    TileSums camera_sums(task.rect, 0);
-                    SplatList splats(plan.width, plan.height);
-                    renderer.Render(work, camera_sums, splats);
-                    std::lock_guard<std::mutex> lock(mutex);
-                    status.Update(merger.Add(task.index, camera_sums, splats));
-                    if (progress) progress(merger.tasks_done(), merger.tasks().size());
-                }
-            },
-            tbb::simple_partitioner());
-    });
+    struct Result {
+        TileSums camera;
+        SplatList splats;
+    };
+    const absl::Status status = RunTasks(
+        settings.threads, tasks->size(),
+        [&](size_t i) {
+            const FrameTask& task = (*tasks)[i];
+            Result result{TileSums(task.rect, 0), SplatList(plan.width, plan.height)};
+            renderer.Render(
+                {task.rect, task.sample_begin, task.sample_end, task.path_begin, task.path_end},
+                result.camera, result.splats);
+            return result;
+        },
+        [&](size_t i, Result& result) {
+            const absl::Status added = merger.Add((*tasks)[i].index, result.camera, result.splats);
+            if (progress) progress(merger.tasks_done(), merger.tasks().size());
+            return added;
+        });
     if (!status.ok()) return status;
-    absl::StatusOr<Image> image = merger.Snapshot();
-    if (!image.ok()) return image.status();
-    RenderOutput out{std::move(*image), merger.stats(), 0, {}};
-    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return out;
+    return Finish(merger, start);
 }
 
 absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
