@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/le_bytes.h"
 
 namespace lf {
 
@@ -15,34 +16,6 @@ constexpr size_t kHeaderBytes = 4 + 4 + 4 + 4 + 8;
 constexpr size_t kEntryBytes = 4 + 1 + 3 * 16;
 // Pixel indices are u32 and y * width + x must not wrap.
 constexpr int64_t kMaxPixels = int64_t(1) << 31;
-
-void PutU32(std::string& out, uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(char(uint8_t(v >> (8 * i))));
-}
-void PutU64(std::string& out, uint64_t v) {
-    for (int i = 0; i < 8; ++i) out.push_back(char(uint8_t(v >> (8 * i))));
-}
-
-class Reader {
-  public:
-    explicit Reader(std::string_view bytes) : p_(bytes.data()) {}
-    uint8_t U8() { return uint8_t(*p_++); }
-    uint32_t U32() {
-        uint32_t v = 0;
-        for (int i = 0; i < 4; ++i) v |= uint32_t(uint8_t(p_[i])) << (8 * i);
-        p_ += 4;
-        return v;
-    }
-    uint64_t U64() { return uint64_t(U32()) | (uint64_t(U32()) << 32); }
-    ExactSum Sum() {
-        const uint64_t lo = U64(), hi = U64();
-        return ExactSum::FromFixed(
-            static_cast<__int128>((static_cast<unsigned __int128>(hi) << 64) | lo));
-    }
-
-  private:
-    const char* p_;
-};
 
 absl::Status Bad(const std::string& what) {
     return absl::InvalidArgumentError(absl::StrCat("splat list: ", what));
@@ -64,11 +37,7 @@ std::string EncodeSplatList(SplatList& list) {
     for (const SplatEntry& e : entries) {
         PutU32(out, e.pixel);
         out.push_back(char(e.half));
-        for (const ExactSum& s : e.rgb) {
-            const auto v = static_cast<unsigned __int128>(s.fixed());
-            PutU64(out, uint64_t(v));
-            PutU64(out, uint64_t(v >> 64));
-        }
+        for (const ExactSum& s : e.rgb) PutSum(out, s);
     }
     return out;
 }
@@ -77,7 +46,7 @@ absl::StatusOr<SplatList> DecodeSplatList(std::string_view bytes) {
     if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, 4) != 0) {
         return Bad(absl::StrCat("not an encoded list (", bytes.size(), " bytes, no LFSP header)"));
     }
-    Reader in(bytes.substr(4));
+    LeReader in(bytes.substr(4));
     const uint32_t version = in.U32();
     if (version != kVersion) {
         return Bad(absl::StrCat("version ", version, " is not the supported ", kVersion));

@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/aov.h"
+#include "lf/core/le_bytes.h"
 
 namespace lf {
 
@@ -27,40 +28,6 @@ constexpr size_t AovPixelBytes(uint32_t aovs) {
 // 2^28 pixels is a 16k x 16k tile: far beyond any plan, small enough that size arithmetic
 // cannot overflow and a corrupt header cannot make us allocate terabytes.
 constexpr int64_t kMaxPixels = int64_t(1) << 28;
-
-void PutU64(std::string& out, uint64_t v) {
-    for (int i = 0; i < 8; ++i) out.push_back(char(uint8_t(v >> (8 * i))));
-}
-void PutU32(std::string& out, uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(char(uint8_t(v >> (8 * i))));
-}
-
-class Reader {
-  public:
-    explicit Reader(std::string_view bytes) : p_(bytes.data()) {}
-    uint64_t U64() { return uint64_t(U32()) | (uint64_t(U32()) << 32); }
-    uint32_t U32() {
-        uint32_t v = 0;
-        for (int i = 0; i < 4; ++i) v |= uint32_t(uint8_t(p_[i])) << (8 * i);
-        p_ += 4;
-        return v;
-    }
-    int32_t I32() { return int32_t(U32()); }
-    ExactSum Sum() {
-        const uint64_t lo = U64(), hi = U64();
-        return ExactSum::FromFixed(
-            static_cast<__int128>((static_cast<unsigned __int128>(hi) << 64) | lo));
-    }
-
-  private:
-    const char* p_;
-};
-
-void PutSum(std::string& out, const ExactSum& sum) {
-    const auto v = static_cast<unsigned __int128>(sum.fixed());
-    PutU64(out, uint64_t(v));
-    PutU64(out, uint64_t(v >> 64));
-}
 
 size_t EncodedSize(int64_t pixels, uint32_t version, uint32_t aovs) {
     return HeaderBytes(version) + size_t(pixels) * (kPixelBytes + AovPixelBytes(aovs));
@@ -112,7 +79,7 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
         return absl::InvalidArgumentError(absl::StrCat("tile sums: not an encoded tile (",
                                                        bytes.size(), " bytes, no LFTS header)"));
     }
-    Reader in(bytes.substr(4));
+    LeReader in(bytes.substr(4));
     const uint32_t version = in.U32();
     if (version < kOldestVersion || version > kAovVersion) {
         return absl::InvalidArgumentError(absl::StrCat("tile sums: version ", version,
