@@ -115,6 +115,10 @@ SceneTransport AnalyzeTransport(const Scene& scene) {
 
 MethodChoice ChooseAutomatically(const Scene& scene) {
     const SceneTransport t = AnalyzeTransport(scene);
+    // No light: every method renders black; no form factors or pilots to spend on it.
+    if (!scene.HasLights()) {
+        return {"path", "the scene has no lights: the image is black whatever the method"};
+    }
     // Whitted before radiosity: where it is exact it has no meshing error either.
     if (t.whitted_missing.empty() && scene.HasLights()) {
         return {"whitted",

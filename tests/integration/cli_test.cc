@@ -208,7 +208,7 @@ TEST_F(Cli, RadiosityRefusesWhatItCannotModel) {
 
 // --method auto reads the scene's light transport: caustics from a small lamp through glass
 // and a mirror take bdpt; a lit plane alone (no interreflection, no caustics) takes Whitted,
-// exact there; the Cornell box (all Lambertian) radiosity.
+// exact there; the Cornell box (all Lambertian) radiosity; a scene without lights no solve.
 TEST_F(Cli, AutoPicksTheMethodTheSceneRequiresAndSaysWhy) {
     const auto method_line = [&](const std::string& scene) {
         const RunResult r = Lightfarm("render " + scene + " -o " + (dir_ / "a.exr").string() +
@@ -233,6 +233,14 @@ TEST_F(Cli, AutoPicksTheMethodTheSceneRequiresAndSaysWhy) {
               "here (point-like lights only))");
     EXPECT_EQ(method_line(std::string(LF_TEST_SCENES) + "/cornell_box.json"),
               "method radiosity (every material is Lambertian)");
+    const std::string dark =
+        Write("dark.json", R"({"camera": {"position": [0, 3, 0], "look_at": [0, 0, 0],
+                               "up": [0, 0, 1], "fov_y_deg": 60, "resolution": [16, 16]},
+            "materials": {"grey": {"type": "lambert", "reflectance": [0.5, 0.5, 0.5]}},
+            "shapes": [{"type": "quad", "material": "grey",
+                        "vertices": [[-5, 0, -5], [-5, 0, 5], [5, 0, 5], [5, 0, -5]]}]})");
+    EXPECT_EQ(method_line(dark),
+              "method path (the scene has no lights: the image is black whatever the method)");
 }
 
 // A texture or a principled material is beyond radiosity: auto says so and takes the path
