@@ -58,8 +58,10 @@ inline constexpr uint64_t kMaxLightPathsPerTask = kDefaultPathsPerTask;
 // an entry after coalescing, at most 2 entries a pixel of the frame: 879 MB on a 3840x2160
 // frame whatever the task's paths or depth). So any task of a frame up to 4K, or of any frame
 // whose light paths per task x (max depth + 1) x 53 bytes stay below it, fits; a worker whose
-// result does not fails the task saying so (docs/farm.md, "Message sizes").
-inline constexpr int kMaxTaskResultBytes = 1 << 30;
+// result does not fails the task saying so (docs/farm.md, "Message sizes"). Below SQLite's
+// default blob limit (10^9 bytes, SQLITE_MAX_LENGTH): the coordinator records each result as one
+// blob, and a result it took but could not record would fail the job after the merge.
+inline constexpr int kMaxTaskResultBytes = 960'000'000;
 
 // The frame plan of `method` (a frame method) for a render of plan.width x plan.height:
 // - light: spp x W x H light paths (spp light paths per pixel-equivalent, so `--spp` means the
