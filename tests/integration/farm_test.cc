@@ -1095,10 +1095,10 @@ class FarmFrame : public Farm, public ::testing::WithParamInterface<std::string>
     // tiles of 16, unlike local mode's default); bdpt's whole frame in 16 sample passes, each
     // task's splats landing anywhere; ppm's 16 ranges of passes, with few photons a pass so
     // that hundreds of passes stay quick.
-    std::string Split() const {
+    std::string Split(uint64_t photons = 4096) const {
         if (GetParam() == "light") return "--passes 16 --tile 16";
         if (GetParam() == "bdpt") return "--passes 16 --tile 64";
-        return "--passes 16 --photons 4096";
+        return "--passes 16 --photons " + std::to_string(photons);
     }
     // Whether the worker's log names a task of the job.
     bool WorkerTookPart(const std::string& worker, const std::string& job) {
@@ -1132,11 +1132,14 @@ TEST_P(FarmFrame, KilledWorkerDoesNotChangeTheImage) {
     StartServer(/*lease_seconds=*/1);
     Child* doomed = StartWorker("doomed");
     StartWorker("survivor");
-    const std::string job = Submit(scene_, Flags(256, 9, Split()));
+    // ppm's tasks of 16 passes of 4096 photons took a tenth of a second: the kill at 150 ms
+    // could fall between two tasks and leave nothing to lease again.
+    const std::string split = Split(/*photons=*/65536);
+    const std::string job = Submit(scene_, Flags(256, 9, split));
     ASSERT_TRUE(WaitForStatus(job, "running", milliseconds(20000)));
     std::this_thread::sleep_for(milliseconds(150));  // mid-task
     doomed->Signal(SIGKILL);
-    ExpectSameAsLocal(job, scene_, 256, 9, LocalFlags(Split()));
+    ExpectSameAsLocal(job, scene_, 256, 9, LocalFlags(split));
     const TaskCounts c = Tasks(job);
     EXPECT_EQ(c.done, 16);
     EXPECT_GT(c.leased, c.total) << "no task was leased again";
