@@ -38,8 +38,8 @@ absl::StatusOr<FramePlanSettings> FramePlanSettingsOf(std::string_view method,
                                                       const RenderPlanSettings& plan) {
     const std::optional<FramePlanKind> kind = FramePlanKindOf(method);
     if (!kind) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("method \"", std::string(method), "\" is not a frame method (light, bdpt, ppm)"));
+        return absl::InvalidArgumentError(absl::StrCat(
+            "method \"", std::string(method), "\" is not a frame method (light, bdpt, ppm)"));
     }
     if (plan.width <= 0 || plan.height <= 0) {
         return absl::InvalidArgumentError(
