@@ -9,6 +9,18 @@
 
 namespace lf::testing {
 
+// A quad of material `material` with corners a, b, c, d (two triangles, one light where it
+// emits); its front normal is normalize((b - a) x (c - a)).
+inline void AddQuad(Scene& scene, int material, const Vec3d& a, const Vec3d& b, const Vec3d& c,
+                    const Vec3d& d) {
+    TriangleMesh m;
+    m.material = material;
+    m.is_quad = true;
+    m.positions = {a, b, c, d};
+    m.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(m);
+}
+
 // A square image of `size` pixels from `position` towards `look_at`.
 inline CameraSpec SquareCamera(const Vec3d& position, const Vec3d& look_at, const Vec3d& up,
                                double fov_y_deg, int size) {

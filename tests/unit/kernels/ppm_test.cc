@@ -34,15 +34,7 @@ std::unique_ptr<EmbreeScene> Build(const Scene& scene) {
     return std::move(*es);
 }
 
-void AddQuad(Scene& scene, int material, const Vec3d& a, const Vec3d& b, const Vec3d& c,
-             const Vec3d& d) {
-    TriangleMesh m;
-    m.material = material;
-    m.is_quad = true;
-    m.positions = {a, b, c, d};
-    m.triangles = {{0, 1, 2}, {0, 2, 3}};
-    scene.meshes.push_back(m);
-}
+using testing::AddQuad;
 
 std::unique_ptr<PpmRenderer> MakePpm(const EmbreeScene& es, const Camera& camera,
                                      const FrameRenderSettings& settings) {

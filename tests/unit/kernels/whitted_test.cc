@@ -31,17 +31,7 @@ std::unique_ptr<EmbreeScene> Build(const Scene& scene) {
     return std::move(*es);
 }
 
-// A quad of material `material` with corners a, b, c, d; its front normal is
-// normalize((b - a) x (c - a)).
-void AddQuad(Scene& scene, int material, const Vec3d& a, const Vec3d& b, const Vec3d& c,
-             const Vec3d& d) {
-    TriangleMesh m;
-    m.material = material;
-    m.is_quad = true;
-    m.positions = {a, b, c, d};
-    m.triangles = {{0, 1, 2}, {0, 2, 3}};
-    scene.meshes.push_back(m);
-}
+using testing::AddQuad;
 
 int AddMaterial(Scene& scene, Material::Type type, const Rgb& reflectance,
                 const Rgb& emission = Rgb(0.0f)) {
