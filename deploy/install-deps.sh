@@ -8,6 +8,8 @@ packages=(
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   libssl-dev libsqlite3-dev libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox
+  libcpp-httplib-dev
+  iproute2 openssl python3 python3-yaml
 )
 missing=()
 for p in "${packages[@]}"; do
