@@ -27,6 +27,8 @@
 #include "output_flags.h"
 #include "photon_flags.h"
 #include "progress_bar.h"
+#include "proto/channel.h"
+#include "proto/channel_flags.h"
 #include "proto/grpc_status.h"
 #include "radiosity_flags.h"
 #include "sample_flags.h"
@@ -42,14 +44,23 @@ namespace {
 constexpr size_t kChunkBytes = 1 << 20;
 
 struct FarmFlags {
-    std::string server = "127.0.0.1:7070";
+    ChannelOptions channel{.address = "127.0.0.1:7070"};
     double retry_seconds = 60;  // how long submit and watch ride out an unreachable server
 };
 
+// --server and the TLS and token flags; files they name are checked once the command line is
+// parsed, so that a wrong path is said before any work.
 void AddServerOption(CLI::App* cmd, FarmFlags& flags) {
-    cmd->add_option("--server", flags.server, "HOST:PORT of lightfarm-server")
+    cmd->add_option("--server", flags.channel.address, "HOST:PORT of lightfarm-server")
         ->envname("LIGHTFARM_SERVER")
         ->capture_default_str();
+    AddChannelFlags(cmd, &flags.channel);
+    cmd->parse_complete_callback([&flags] {
+        if (absl::StatusOr<std::shared_ptr<grpc::Channel>> channel = OpenChannel(flags.channel);
+            !channel.ok()) {
+            throw CLI::ValidationError(std::string(channel.status().message()));
+        }
+    });
 }
 
 void AddRetryOption(CLI::App* cmd, FarmFlags& flags) {
@@ -93,15 +104,22 @@ class Backoff {
 // A new channel: after an outage, retries take a new one, as a channel that failed to connect
 // fails calls fast for a while after the server is back.
 std::unique_ptr<pb::JobService::Stub> Connect(const FarmFlags& flags) {
-    return pb::JobService::NewStub(
-        grpc::CreateChannel(flags.server, grpc::InsecureChannelCredentials()));
+    absl::StatusOr<std::shared_ptr<grpc::Channel>> channel = OpenChannel(flags.channel);
+    if (!channel.ok()) {
+        // The files were readable when the command line was parsed (AddServerOption): one
+        // removed since leaves nothing to retry with.
+        std::fprintf(stderr, "lightfarm: error: %s\n",
+                     std::string(channel.status().message()).c_str());
+        std::exit(2);
+    }
+    return pb::JobService::NewStub(*channel);
 }
 
 // The server's own words, with where it was asked when it could not be reached.
 absl::Status CallStatus(const grpc::Status& s, const FarmFlags& flags) {
     if (s.error_code() == grpc::StatusCode::UNAVAILABLE) {
         return absl::UnavailableError(
-            absl::StrCat("server ", flags.server, " not reachable: ", s.error_message()));
+            absl::StrCat("server ", flags.channel.address, " not reachable: ", s.error_message()));
     }
     return FromGrpcStatus(s);
 }
@@ -268,6 +286,7 @@ void PrintJob(const pb::Job& job) {
     auto seconds = [](int64_t from, int64_t to) { return double(to - from) / 1000.0; };
     std::printf("job %s: %s\n", job.id().c_str(), StateName(job.state()).c_str());
     std::printf("  name      %s\n", job.name().c_str());
+    if (!job.owner().empty()) std::printf("  owner     %s\n", job.owner().c_str());
     std::printf("  method    %s\n",
                 job.params().method().empty() ? "path" : job.params().method().c_str());
     std::printf("  image     %dx%d, %llu spp, seed %llu, max depth %d, tile %d, %d passes\n",
@@ -471,8 +490,8 @@ Command AddListCommand(CLI::App& app) {
                 const std::unique_ptr<pb::JobService::Stub> stub = Connect(*flags);
                 pb::ListJobsRequest req;
                 int listed = 0;
-                std::printf("%-16s %-10s %-9s %8s %11s %9s  %s\n", "JOB", "STATE", "METHOD",
-                            "PRIORITY", "TASKS", "SPP", "NAME");
+                std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s  %s\n", "JOB", "STATE", "OWNER",
+                            "METHOD", "PRIORITY", "TASKS", "SPP", "NAME");
                 do {
                     req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
                     pb::ListJobsResponse resp;
@@ -482,8 +501,9 @@ Command AddListCommand(CLI::App& app) {
                     if (!s.ok()) return ReportError(s);
                     for (const pb::Job& job : resp.jobs()) {
                         std::printf(
-                            "%-16s %-10s %-9s %8d %11s %9llu  %s\n", job.id().c_str(),
+                            "%-16s %-10s %-12s %-9s %8d %11s %9llu  %s\n", job.id().c_str(),
                             StateName(job.state()).c_str(),
+                            job.owner().empty() ? "-" : job.owner().c_str(),
                             job.params().method().empty() ? "path" : job.params().method().c_str(),
                             job.priority(), Progress(job).c_str(),
                             (unsigned long long)job.params().spp(), job.name().c_str());

@@ -23,6 +23,11 @@ std::shared_ptr<spdlog::logger> Log() { return NamedLogger("rpc"); }
 // Who called, for the log: the peer's address as gRPC reports it.
 std::string Peer(const grpc::ServerContext* context) { return LogSafe(context->peer()); }
 
+// The token's name, or "anonymous" with authentication off.
+std::string Who(const Caller& caller) {
+    return caller.name.empty() ? "anonymous" : absl::StrCat("token ", caller.name);
+}
+
 // Streams a file in chunks; stops early when the client goes away. The client hears `what` could
 // not be read, never where the file is: paths of the data folder stay in the server's log.
 grpc::Status StreamFile(grpc::ServerContext* context, const std::string& path,
@@ -45,19 +50,60 @@ grpc::Status StreamFile(grpc::ServerContext* context, const std::string& path,
     return grpc::Status::OK;
 }
 
+// The bearer token of the call, as its `authorization` metadata carries it.
+std::optional<std::string_view> AuthorizationOf(const grpc::ServerContext* context) {
+    const auto& metadata = context->client_metadata();
+    auto it = metadata.find("authorization");
+    if (it == metadata.end()) return std::nullopt;
+    return std::string_view(it->second.data(), it->second.size());
+}
+
 }  // namespace
 
-grpc::Status JobServiceImpl::MissingBlobs(grpc::ServerContext*, const pb::MissingBlobsRequest* req,
+absl::StatusOr<Caller> CallGuard::Check(grpc::ServerContext* context, const char* rpc,
+                                        Action action) const {
+    absl::StatusOr<Caller> caller = auth.Authenticate(AuthorizationOf(context));
+    absl::Status s = caller.ok() ? Permit(*caller, action) : caller.status();
+    if (s.ok() && action == Action::kWork && worker_certificates &&
+        !context->auth_context()->IsPeerAuthenticated()) {
+        s = absl::UnauthenticatedError(
+            "workers must present a client certificate signed by the server's --tls-client-ca "
+            "(lightfarm-worker --tls-cert FILE --tls-key FILE)");
+    }
+    if (!s.ok()) {
+        Log()->warn("{} from {} refused: {}", rpc, Peer(context),
+                    LogSafe(std::string(s.message())));
+        return s;
+    }
+    return caller;
+}
+
+absl::StatusOr<JobRecord> JobServiceImpl::VisibleJob(const Caller& caller,
+                                                     const std::string& job_id) const {
+    absl::StatusOr<JobRecord> job = farm_.scheduler().Get(job_id);
+    if (job.ok() && !MaySee(caller, job->spec.owner))
+        return absl::NotFoundError("no job " + job_id);
+    return job;
+}
+
+grpc::Status JobServiceImpl::MissingBlobs(grpc::ServerContext* context,
+                                          const pb::MissingBlobsRequest* req,
                                           pb::MissingBlobsResponse* resp) {
+    if (auto c = guard_.Check(context, "MissingBlobs", Action::kUploadBlobs); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
     for (const std::string& hash : req->hashes()) {
         if (!farm_.blobs().Has(hash)) resp->add_hashes(hash);
     }
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext*,
+grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext* context,
                                         grpc::ServerReader<pb::UploadBlobRequest>* reader,
                                         pb::UploadBlobResponse*) {
+    if (auto c = guard_.Check(context, "UploadBlob", Action::kUploadBlobs); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
     pb::UploadBlobRequest chunk;
     if (!reader->Read(&chunk)) {
         return ToGrpcStatus(absl::InvalidArgumentError("UploadBlob: empty stream"));
@@ -74,6 +120,8 @@ grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext*,
 grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
                                        const pb::SubmitJobRequest* req,
                                        pb::SubmitJobResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "SubmitJob", Action::kSubmit);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
     // Proto3 keeps enum values this build does not know; JobSpec cannot hold them, so they are
     // refused here rather than rendered as something the client did not ask for.
     if (!pb::PixelFilterType_IsValid(req->params().filter_type())) {
@@ -91,27 +139,34 @@ grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
             absl::StrCat("params.light_strategy ", req->params().light_strategy(),
                          ": unknown light sampling strategy; expected power or bvh")));
     }
-    absl::StatusOr<std::string> id = farm_.Submit(FromProto(*req));
+    JobSpec spec = FromProto(*req);
+    spec.owner = caller->name;
+    absl::StatusOr<std::string> id = farm_.Submit(std::move(spec));
     if (!id.ok()) {
         Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()), Peer(context),
                     LogSafe(std::string(id.status().message())));
         return ToGrpcStatus(id.status());
     }
-    Log()->info("job={} submitted by {}: \"{}\"", *id, Peer(context), LogSafe(req->name()));
+    Log()->info("job={} submitted by {} from {}: \"{}\"", *id, Who(*caller), Peer(context),
+                LogSafe(req->name()));
     resp->set_job_id(*id);
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::GetJob(grpc::ServerContext*, const pb::GetJobRequest* req,
+grpc::Status JobServiceImpl::GetJob(grpc::ServerContext* context, const pb::GetJobRequest* req,
                                     pb::Job* resp) {
-    absl::StatusOr<JobRecord> job = farm_.scheduler().Get(req->job_id());
+    absl::StatusOr<Caller> caller = guard_.Check(context, "GetJob", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id());
     if (!job.ok()) return ToGrpcStatus(job.status());
     ToProto(*job, resp);
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext*, const pb::ListJobsRequest* req,
+grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext* context, const pb::ListJobsRequest* req,
                                       pb::ListJobsResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "ListJobs", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
     if (req->page_size() < 0) {
         return ToGrpcStatus(absl::InvalidArgumentError(
             absl::StrCat("ListJobs: page_size ", req->page_size(), " is negative")));
@@ -120,6 +175,7 @@ grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext*, const pb::ListJobsRe
         req->page_size() == 0 ? kDefaultPageSize : std::min(req->page_size(), kMaxPageSize);
     // The token is the seq of the page's last job: the next page starts below it.
     JobQuery query{.limit = size_t(page_size) + 1};
+    if (caller->role != Role::kAdmin) query.owner = caller->name;
     if (!req->page_token().empty() &&
         (!absl::SimpleAtoi(req->page_token(), &query.before_seq) || query.before_seq == 0)) {
         return ToGrpcStatus(
@@ -137,6 +193,12 @@ grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext*, const pb::ListJobsRe
 
 grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::WatchJobRequest* req,
                                       grpc::ServerWriter<pb::Job>* writer) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "WatchJob", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    // Checked once: a job's owner never changes.
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
     // Each stream holds a server thread until its job ends: bounded, so that watchers cannot
     // take every thread (or the memory of thousands).
     struct Slot {
@@ -179,9 +241,14 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::Wa
 
 grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
                                        const pb::CancelJobRequest* req, pb::Job* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "CancelJob", Action::kCancelJob);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(*caller, req->job_id()); !seen.ok()) {
+        return ToGrpcStatus(seen.status());
+    }
     absl::StatusOr<JobRecord> job = farm_.scheduler().Cancel(req->job_id());
     if (!job.ok()) return ToGrpcStatus(job.status());
-    Log()->info("job={} cancelled by {}", job->id, Peer(context));
+    Log()->info("job={} cancelled by {} from {}", job->id, Who(*caller), Peer(context));
     ToProto(*job, resp);
     return grpc::Status::OK;
 }
@@ -189,6 +256,11 @@ grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
 grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context,
                                          const pb::FetchResultRequest* req,
                                          grpc::ServerWriter<pb::Chunk>* writer) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "FetchResult", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
     absl::StatusOr<std::string> path = farm_.ResultFile(req->job_id(), req->preview());
     if (!path.ok()) return ToGrpcStatus(path.status());
     return StreamFile(context, *path, "the result of job " + req->job_id(), writer);
@@ -196,13 +268,23 @@ grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context,
 
 grpc::Status JobServiceImpl::DeleteJob(grpc::ServerContext* context,
                                        const pb::DeleteJobRequest* req, pb::DeleteJobResponse*) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "DeleteJob", Action::kDeleteJob);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
     if (absl::Status s = farm_.DeleteJob(req->job_id()); !s.ok()) return ToGrpcStatus(s);
-    Log()->info("job={} deleted by {}", LogSafe(req->job_id()), Peer(context));
+    Log()->info("job={} deleted by {} from {}", LogSafe(req->job_id()), Who(*caller),
+                Peer(context));
     return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext*, const pb::LeaseTaskRequest* req,
+grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context,
+                                          const pb::LeaseTaskRequest* req,
                                           pb::LeaseTaskResponse* resp) {
+    if (auto c = guard_.Check(context, "LeaseTask", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
     if (req->worker_id().empty()) {
         return ToGrpcStatus(absl::InvalidArgumentError("LeaseTask: worker_id is empty"));
     }
@@ -219,8 +301,12 @@ grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext*, const pb::LeaseT
     return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext*, const pb::HeartbeatRequest* req,
+grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* context,
+                                          const pb::HeartbeatRequest* req,
                                           pb::HeartbeatResponse* resp) {
+    if (auto c = guard_.Check(context, "Heartbeat", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
     resp->set_cancelled(!farm_.scheduler().Heartbeat(req->lease_id(), req->worker_id()));
     return grpc::Status::OK;
 }
@@ -228,6 +314,9 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext*, const pb::Heartb
 grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context,
                                              const pb::CompleteTaskRequest* req,
                                              pb::CompleteTaskResponse*) {
+    if (auto c = guard_.Check(context, "CompleteTask", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
     const absl::Status s =
         req->radiosity_sweep().empty()
             ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums(),
@@ -252,8 +341,11 @@ std::string RefusedResultLine(std::string_view lease_id, std::string_view worker
                         LogSafe(peer), ": CompleteTask refused: ", LogSafe(why, 1024));
 }
 
-grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext*, const pb::FailTaskRequest* req,
-                                         pb::FailTaskResponse*) {
+grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext* context,
+                                         const pb::FailTaskRequest* req, pb::FailTaskResponse*) {
+    if (auto c = guard_.Check(context, "FailTask", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
     const FailureKind kind = req->kind() == pb::FailTaskRequest::WORKER_SHUTDOWN
                                  ? FailureKind::kWorkerShutdown
                                  : FailureKind::kTaskError;
@@ -264,6 +356,9 @@ grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext*, const pb::FailTas
 grpc::Status WorkerServiceImpl::FetchBlob(grpc::ServerContext* context,
                                           const pb::FetchBlobRequest* req,
                                           grpc::ServerWriter<pb::Chunk>* writer) {
+    if (auto c = guard_.Check(context, "FetchBlob", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
     if (!farm_.blobs().Has(req->hash())) {
         return ToGrpcStatus(absl::NotFoundError("no blob " + req->hash()));
     }

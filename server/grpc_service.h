@@ -8,9 +8,23 @@
 
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "lightfarm/v1/worker_service.grpc.pb.h"
+#include "server/auth.h"
 #include "server/farm.h"
 
 namespace lf {
+
+// Who may call (lf/server/auth.h), for both services.
+struct CallGuard {
+    Authenticator& auth;
+    // With mutual TLS (lightfarm-server --tls-client-ca): WorkerService calls must come with a
+    // client certificate the CA signed, besides a worker token.
+    bool worker_certificates = false;
+
+    // The caller of `rpc` if it may take `action`; UNAUTHENTICATED or PERMISSION_DENIED with the
+    // reason otherwise, and the refusal logged with the peer.
+    absl::StatusOr<Caller> Check(grpc::ServerContext* context, const char* rpc,
+                                 Action action) const;
+};
 
 struct JobServiceOptions {
     // WatchJob streams open at once; each holds one of the server's threads while it lasts.
@@ -23,8 +37,8 @@ constexpr int kMaxPageSize = 1000;
 
 class JobServiceImpl final : public lightfarm::v1::JobService::Service {
   public:
-    explicit JobServiceImpl(Farm& farm, JobServiceOptions options = {})
-        : farm_(farm), options_(options) {}
+    JobServiceImpl(Farm& farm, CallGuard guard, JobServiceOptions options = {})
+        : farm_(farm), guard_(guard), options_(options) {}
 
     grpc::Status MissingBlobs(grpc::ServerContext*, const lightfarm::v1::MissingBlobsRequest*,
                               lightfarm::v1::MissingBlobsResponse*) override;
@@ -47,7 +61,12 @@ class JobServiceImpl final : public lightfarm::v1::JobService::Service {
                            lightfarm::v1::DeleteJobResponse*) override;
 
   private:
+    // The job if `caller` may see it; NotFound, as for a job that does not exist, otherwise, so
+    // that job ids of others tell nothing.
+    absl::StatusOr<JobRecord> VisibleJob(const Caller& caller, const std::string& job_id) const;
+
     Farm& farm_;
+    const CallGuard guard_;
     const JobServiceOptions options_;
     std::atomic<int> watchers_{0};
 };
@@ -58,7 +77,7 @@ std::string RefusedResultLine(std::string_view lease_id, std::string_view worker
 
 class WorkerServiceImpl final : public lightfarm::v1::WorkerService::Service {
   public:
-    explicit WorkerServiceImpl(Farm& farm) : farm_(farm) {}
+    WorkerServiceImpl(Farm& farm, CallGuard guard) : farm_(farm), guard_(guard) {}
 
     grpc::Status LeaseTask(grpc::ServerContext*, const lightfarm::v1::LeaseTaskRequest*,
                            lightfarm::v1::LeaseTaskResponse*) override;
@@ -73,6 +92,7 @@ class WorkerServiceImpl final : public lightfarm::v1::WorkerService::Service {
 
   private:
     Farm& farm_;
+    const CallGuard guard_;
 };
 
 }  // namespace lf

@@ -108,7 +108,8 @@ std::string EncodeJobRecord(const JobRecord& r) {
             {"alpha", s.ppm.alpha}}},
           {"priority", s.priority},
           {"scene_hash", s.scene_hash},
-          {"request_id", s.request_id}}},
+          {"request_id", s.request_id},
+          {"owner", s.owner}}},
         {"state", JobStateName(r.state)},
         {"error", r.error},
         {"last_error", r.last_error},
@@ -203,6 +204,7 @@ absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
         r.spec.priority = s.at("priority").get<int>();
         r.spec.scene_hash = s.at("scene_hash").get<std::string>();
         r.spec.request_id = s.value("request_id", "");
+        r.spec.owner = s.value("owner", "");
         if (absl::StatusOr<JobState> state = StateFromJson(j.at("state")); state.ok()) {
             r.state = *state;
         } else {

@@ -11,6 +11,7 @@ namespace {
 // Whether `job` passes the query's filters (not its limit).
 bool Matches(const JobQuery& query, const JobRecord& job) {
     if (query.before_seq != 0 && job.seq >= query.before_seq) return false;
+    if (query.owner && job.spec.owner != *query.owner) return false;
     if (query.ended_before == absl::InfinitePast()) return true;
     return IsFinal(job.state) && job.finished < query.ended_before;
 }

@@ -24,6 +24,8 @@ struct JobQuery {
     size_t limit = 0;         // at most this many; 0: all
     // Only jobs that ended before this time (retention); InfinitePast: every job.
     absl::Time ended_before = absl::InfinitePast();
+    // Only the jobs of this owner (JobSpec::owner); nullopt: everyone's.
+    std::optional<std::string> owner;
 };
 
 class JobStore {

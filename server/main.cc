@@ -11,7 +11,11 @@
 #include "lf/job/frame_settings.h"
 #include "server/farm.h"
 #include "server/grpc_service.h"
+#include "server/listen_policy.h"
+#include "server/server_credentials.h"
 #include "server/timeout_checker.h"
+#include "server/token_command.h"
+#include "server/token_store.h"
 
 int main(int argc, char** argv) {
     const lf::StopSignals stop_signals;  // before any thread starts
@@ -23,7 +27,23 @@ int main(int argc, char** argv) {
     std::string log_level = "info";
     app.add_option("--listen", listen, "HOST:PORT to serve on; port 0 picks a free one")
         ->capture_default_str();
-    app.add_option("--data-dir", options.data_dir, "folder for blobs and results")->required();
+    app.add_option("--data-dir", options.data_dir,
+                   "folder for jobs, blobs, results and tokens (required to serve)");
+    lf::ServerTlsFiles tls;
+    app.add_option("--tls-cert", tls.cert,
+                   "PEM certificate (chain) of the server: TLS on the gRPC port");
+    app.add_option("--tls-key", tls.key, "PEM private key of --tls-cert");
+    app.add_option("--tls-client-ca", tls.client_ca,
+                   "PEM CA of client certificates: workers must present one it signed (mutual "
+                   "TLS); other clients may, and a certificate of another CA is refused");
+    bool insecure = false;
+    app.add_flag("--insecure", insecure,
+                 "allow listening beyond loopback without TLS (the traffic and its tokens are "
+                 "readable on the network)");
+    bool check_config = false;
+    app.add_flag("--check-config", check_config,
+                 "check the options, the TLS files and the data folder, print \"config ok\" and "
+                 "exit without serving");
     app.add_option("--lease-seconds", lease_seconds,
                    "a task goes back to the queue when its worker is silent this long")
         ->capture_default_str()
@@ -62,7 +82,30 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
+    lf::TokenCommand token_command(app);
     CLI11_PARSE(app, argc, argv);
+    if (std::optional<int> status = token_command.Run()) return *status;
+    const auto fail = [](const absl::Status& s) {
+        std::fprintf(stderr, "lightfarm-server: error: %s\n", std::string(s.message()).c_str());
+        return 1;
+    };
+    if (options.data_dir.empty()) {
+        return fail(absl::InvalidArgumentError("--data-dir is required"));
+    }
+    if (absl::Status s = lf::CheckListenPolicy(listen, tls.enabled(), insecure); !s.ok()) {
+        return fail(s);
+    }
+    absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
+        lf::MakeServerCredentials(tls);
+    if (!credentials.ok()) return fail(credentials.status());
+    absl::StatusOr<std::unique_ptr<lf::TokenStore>> tokens = lf::TokenStore::Open(options.data_dir);
+    if (!tokens.ok()) return fail(tokens.status());
+    // Beyond loopback every call needs a token, even before the first one is made.
+    const bool auth_required = !lf::IsLoopbackHost(lf::ListenHost(listen));
+    if (check_config) {
+        std::printf("config ok\n");
+        return 0;
+    }
 
     spdlog::set_default_logger(spdlog::stderr_color_mt("server"));
     spdlog::set_level(spdlog::level::from_str(log_level));
@@ -76,13 +119,11 @@ int main(int argc, char** argv) {
         std::min(absl::Milliseconds(300), options.scheduler.lease / 4);
 
     absl::StatusOr<std::unique_ptr<lf::Farm>> farm = lf::Farm::Open(options);
-    if (!farm.ok()) {
-        std::fprintf(stderr, "lightfarm-server: error: %s\n",
-                     std::string(farm.status().message()).c_str());
-        return 1;
-    }
-    lf::JobServiceImpl job_service(**farm, service_options);
-    lf::WorkerServiceImpl worker_service(**farm);
+    if (!farm.ok()) return fail(farm.status());
+    lf::Authenticator auth(std::move(*tokens), auth_required);
+    const lf::CallGuard guard{auth, !tls.client_ca.empty()};
+    lf::JobServiceImpl job_service(**farm, guard, service_options);
+    lf::WorkerServiceImpl worker_service(**farm, guard);
     grpc::ServerBuilder builder;
     int port = 0;
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
@@ -91,7 +132,7 @@ int main(int argc, char** argv) {
     // A frame task's result (camera sums and splats) may be far above gRPC's 4 MiB default; the
     // bound is the largest one the plans make (lf::kMaxTaskResultBytes, docs/farm.md).
     builder.SetMaxReceiveMessageSize(lf::kMaxTaskResultBytes);
-    builder.AddListeningPort(listen, grpc::InsecureServerCredentials(), &port);
+    builder.AddListeningPort(listen, *credentials, &port);
     builder.RegisterService(&job_service);
     builder.RegisterService(&worker_service);
     std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
@@ -105,8 +146,19 @@ int main(int argc, char** argv) {
     const std::string host = listen.substr(0, listen.rfind(':'));
     std::printf("listening on %s:%d\n", host.c_str(), port);
     std::fflush(stdout);
-    spdlog::info("listening on {}:{}, data in {}, leases of {} s", host, port, options.data_dir,
-                 lease_seconds);
+    spdlog::info(
+        "listening on {}:{} ({}), data in {}, leases of {} s", host, port,
+        tls.enabled() ? (tls.client_ca.empty() ? "TLS" : "TLS, worker certificates") : "no TLS",
+        options.data_dir, lease_seconds);
+    if (auth.enabled()) {
+        spdlog::info("authentication on: every call needs a token ({})",
+                     auth_required ? "listening beyond loopback" : "tokens exist");
+    } else {
+        spdlog::warn(
+            "authentication off: no tokens in {}/{} and listening on loopback; anyone "
+            "on this machine may use the farm",
+            options.data_dir, lf::TokenStore::kFileName);
+    }
 
     // Expired leases go back to the queue, and adaptive jobs past their time limit stop
     // sampling, within a tenth of a second.

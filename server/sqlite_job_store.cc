@@ -10,84 +10,11 @@
 #include "absl/strings/str_join.h"
 #include "lf/core/log.h"
 #include "server/job_record_codec.h"
+#include "server/sqlite_statement.h"
 
 namespace lf {
 
 namespace {
-
-// The connection's last error. A full disk says so in its code, so that the client's message
-// is plain; anything else is the server's problem.
-absl::Status StoreError(sqlite3* db) {
-    const std::string message = absl::StrCat("job store: ", sqlite3_errmsg(db));
-    if ((sqlite3_extended_errcode(db) & 0xff) == SQLITE_FULL) {
-        return absl::ResourceExhaustedError(message);
-    }
-    // A second job with one request id: the scheduler's bug, kept out by the schema.
-    if ((sqlite3_extended_errcode(db) & 0xff) == SQLITE_CONSTRAINT) {
-        return absl::AlreadyExistsError(message);
-    }
-    return absl::InternalError(message);
-}
-
-// A prepared statement, finalized on scope exit.
-class Statement {
-  public:
-    Statement(sqlite3* db, const char* sql) : db_(db) {
-        rc_ = sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr);
-    }
-    ~Statement() { sqlite3_finalize(stmt_); }
-    Statement(const Statement&) = delete;
-    Statement& operator=(const Statement&) = delete;
-
-    Statement& Bind(int i, std::string_view text) {
-        if (rc_ == SQLITE_OK) {
-            rc_ = sqlite3_bind_text(stmt_, i, text.data(), int(text.size()), SQLITE_TRANSIENT);
-        }
-        return *this;
-    }
-    Statement& BindBlob(int i, std::string_view bytes) {
-        if (rc_ == SQLITE_OK) {
-            rc_ = sqlite3_bind_blob(stmt_, i, bytes.data(), int(bytes.size()), SQLITE_TRANSIENT);
-        }
-        return *this;
-    }
-    Statement& Bind(int i, int64_t value) {
-        if (rc_ == SQLITE_OK) rc_ = sqlite3_bind_int64(stmt_, i, value);
-        return *this;
-    }
-    Statement& Bind(int i, std::optional<int64_t> value) {
-        if (value) return Bind(i, *value);
-        if (rc_ == SQLITE_OK) rc_ = sqlite3_bind_null(stmt_, i);
-        return *this;
-    }
-    // True while there is a row; check status() after false.
-    bool Step() {
-        if (rc_ != SQLITE_OK && rc_ != SQLITE_ROW) return false;
-        rc_ = sqlite3_step(stmt_);
-        if (rc_ == SQLITE_ROW) return true;
-        if (rc_ == SQLITE_DONE) rc_ = SQLITE_OK;
-        return false;
-    }
-    absl::Status status() const {
-        if (rc_ == SQLITE_OK || rc_ == SQLITE_ROW) return absl::OkStatus();
-        return StoreError(db_);
-    }
-    std::string_view Column(int i) const {
-        const void* data = sqlite3_column_blob(stmt_, i);
-        return {static_cast<const char*>(data), size_t(sqlite3_column_bytes(stmt_, i))};
-    }
-    int64_t ColumnInt(int i) const { return sqlite3_column_int64(stmt_, i); }
-
-  private:
-    sqlite3* db_;
-    sqlite3_stmt* stmt_ = nullptr;
-    int rc_;
-};
-
-absl::Status Exec(sqlite3* db, const char* sql) {
-    if (sqlite3_exec(db, sql, nullptr, nullptr, nullptr) == SQLITE_OK) return absl::OkStatus();
-    return StoreError(db);
-}
 
 // A stored record, its errors naming the job.
 absl::StatusOr<JobRecord> Decode(std::string_view id, std::string_view record) {
@@ -332,6 +259,10 @@ absl::StatusOr<std::vector<JobRecord>> SqliteJobStore::List(const JobQuery& quer
     Statement list(db_,
                    "SELECT id, record FROM jobs WHERE seq < ?1"
                    " AND (?2 IS NULL OR (final = 1 AND finished < ?2))"
+                   // The owner is read from the record rather than a column of its own: a
+                   // submitter's list scans the newest jobs until its page is full, and old
+                   // stores need no migration.
+                   " AND (?4 IS NULL OR json_extract(record, '$.spec.owner') = ?4)"
                    " ORDER BY seq DESC LIMIT ?3");
     list.Bind(
         1, query.before_seq == 0 ? std::numeric_limits<int64_t>::max() : int64_t(query.before_seq));
@@ -339,6 +270,7 @@ absl::StatusOr<std::vector<JobRecord>> SqliteJobStore::List(const JobQuery& quer
                      ? std::nullopt
                      : std::optional<int64_t>(absl::ToUnixMicros(query.ended_before)));
     list.Bind(3, query.limit == 0 ? int64_t(-1) : int64_t(query.limit));
+    if (query.owner) list.Bind(4, *query.owner);
     while (list.Step()) {
         absl::StatusOr<JobRecord> job = Decode(list.Column(0), list.Column(1));
         if (!job.ok()) return job.status();

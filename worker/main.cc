@@ -8,19 +8,27 @@
 #include <thread>
 
 #include "lf/core/stop_signals.h"
+#include "proto/channel_flags.h"
 #include "worker/worker.h"
 
 int main(int argc, char** argv) {
     const lf::StopSignals stop_signals;  // before any thread starts
 
     CLI::App app{"lightfarm-worker: renders tasks of a lightfarm-server (see docs/farm.md)."};
-    std::string server;
+    lf::ChannelOptions channel;
     lf::WorkerOptions options;
     options.threads = int(std::max(1u, std::thread::hardware_concurrency()));
     std::string cache_dir = "/tmp/lightfarm-worker-cache";
     uint64_t cache_mb = 2048;
     std::string log_level = "info";
-    app.add_option("--server", server, "HOST:PORT of the server")->required();
+    app.add_option("--server", channel.address, "HOST:PORT of the server")
+        ->envname("LIGHTFARM_SERVER")
+        ->required();
+    lf::AddChannelFlags(&app, &channel);
+    bool check_config = false;
+    app.add_flag("--check-config", check_config,
+                 "check the options, the TLS and token files and the cache folder, print "
+                 "\"config ok\" and exit without connecting");
     app.add_option("--threads", options.threads, "render threads")
         ->capture_default_str()
         ->check(CLI::Range(1, 1024));
@@ -31,21 +39,28 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
+    const auto fail = [](const absl::Status& s) {
+        std::fprintf(stderr, "lightfarm-worker: error: %s\n", std::string(s.message()).c_str());
+        return 1;
+    };
     spdlog::set_default_logger(spdlog::stderr_color_mt("worker"));
     spdlog::set_level(spdlog::level::from_str(log_level));
     absl::StatusOr<std::unique_ptr<lf::BlobCache>> cache =
         lf::BlobCache::Open(cache_dir + "/blobs", cache_mb << 20);
-    if (!cache.ok()) {
-        std::fprintf(stderr, "lightfarm-worker: error: %s\n",
-                     std::string(cache.status().message()).c_str());
-        return 1;
-    }
+    if (!cache.ok()) return fail(cache.status());
     char host[256] = "worker";
     gethostname(host, sizeof host - 1);
     const std::string id = std::string(host) + "-" + std::to_string(::getpid());
-    lf::ServerConnection connection(server, id);
-    lf::Worker worker(options, connection, **cache);
-    spdlog::info("worker={} serving {} with {} threads", id, server, options.threads);
+    absl::StatusOr<std::unique_ptr<lf::ServerConnection>> connection =
+        lf::ServerConnection::Open(channel, id);
+    if (!connection.ok()) return fail(connection.status());
+    if (check_config) {
+        std::printf("config ok\n");
+        return 0;
+    }
+    lf::Worker worker(options, **connection, **cache);
+    spdlog::info("worker={} serving {} with {} threads ({})", id, channel.address, options.threads,
+                 channel.tls_ca.empty() ? "no TLS" : "TLS");
 
     std::thread signal_waiter([&] {
         const int signal = stop_signals.Wait();

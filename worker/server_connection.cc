@@ -18,8 +18,11 @@ struct ServerConnection::Stub {
     std::unique_ptr<pb::WorkerService::Stub> stub;
 };
 
-ServerConnection::ServerConnection(const std::string& address, std::string worker_id)
-    : worker_id_(std::move(worker_id)), stub_(std::make_unique<Stub>()) {
+ServerConnection::ServerConnection(std::string worker_id)
+    : worker_id_(std::move(worker_id)), stub_(std::make_unique<Stub>()) {}
+
+absl::StatusOr<std::unique_ptr<ServerConnection>> ServerConnection::Open(
+    const ChannelOptions& options, std::string worker_id) {
     grpc::ChannelArguments args;
     // gRPC's default reconnect backoff grows to two minutes; a restarted server should get its
     // workers back at once.
@@ -28,8 +31,11 @@ ServerConnection::ServerConnection(const std::string& address, std::string worke
     args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
     // The coordinator takes results up to this (frame tasks' splats: docs/farm.md).
     args.SetMaxSendMessageSize(kMaxTaskResultBytes);
-    stub_->stub = pb::WorkerService::NewStub(
-        grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args));
+    absl::StatusOr<std::shared_ptr<grpc::Channel>> channel = OpenChannel(options, args);
+    if (!channel.ok()) return channel.status();
+    std::unique_ptr<ServerConnection> connection(new ServerConnection(std::move(worker_id)));
+    connection->stub_->stub = pb::WorkerService::NewStub(*channel);
+    return connection;
 }
 
 ServerConnection::~ServerConnection() = default;

@@ -11,13 +11,16 @@
 #include "lf/core/film.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/task_assignment.h"
+#include "proto/channel.h"
 
 namespace lf {
 
 class ServerConnection {
   public:
     // Connects lazily; after the server restarts, calls work again within about a second.
-    ServerConnection(const std::string& address, std::string worker_id);
+    // InvalidArgument or NotFound naming the flag for TLS or token files that cannot be used.
+    static absl::StatusOr<std::unique_ptr<ServerConnection>> Open(const ChannelOptions& options,
+                                                                  std::string worker_id);
     ~ServerConnection();
 
     const std::string& worker_id() const { return worker_id_; }
@@ -41,6 +44,7 @@ class ServerConnection {
     absl::Status FetchBlob(const std::string& hash, const std::string& path);
 
   private:
+    explicit ServerConnection(std::string worker_id);
     std::string worker_id_;
     struct Stub;  // keeps gRPC headers out of the worker's other files
     std::unique_ptr<Stub> stub_;

@@ -197,6 +197,7 @@ void ToProto(const JobRecord& job, pb::Job* out) {
     out->set_retries(job.retries);
     out->set_tasks_leased(job.tasks_leased);
     out->set_last_error(job.last_error);
+    out->set_owner(job.spec.owner);
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {

@@ -52,8 +52,8 @@ class FakeWorkerFarm : public ::testing::Test {
         absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
         ASSERT_TRUE(farm.ok()) << farm.status();
         farm_ = std::move(*farm);
-        jobs_ = std::make_unique<JobServiceImpl>(*farm_, service_options_);
-        workers_ = std::make_unique<WorkerServiceImpl>(*farm_);
+        jobs_ = std::make_unique<JobServiceImpl>(*farm_, CallGuard{*auth_}, service_options_);
+        workers_ = std::make_unique<WorkerServiceImpl>(*farm_, CallGuard{*auth_});
         grpc::ServerBuilder builder;
         int port = 0;
         builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
@@ -219,6 +219,7 @@ class FakeWorkerFarm : public ::testing::Test {
     JobServiceOptions service_options_;
     fs::path dir_;
     std::unique_ptr<Farm> farm_;
+    std::unique_ptr<Authenticator> auth_ = Authenticator::Off();
     std::unique_ptr<JobServiceImpl> jobs_;
     std::unique_ptr<WorkerServiceImpl> workers_;
     std::unique_ptr<grpc::Server> server_;

@@ -30,7 +30,7 @@ class WorkerVersionTest : public ::testing::Test {
         absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
         ASSERT_TRUE(farm.ok()) << farm.status();
         farm_ = std::move(*farm);
-        service_ = std::make_unique<WorkerServiceImpl>(*farm_);
+        service_ = std::make_unique<WorkerServiceImpl>(*farm_, CallGuard{*auth_});
         grpc::ServerBuilder builder;
         int port = 0;
         builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
@@ -61,6 +61,7 @@ class WorkerVersionTest : public ::testing::Test {
 
     fs::path dir_;
     std::unique_ptr<Farm> farm_;
+    std::unique_ptr<Authenticator> auth_ = Authenticator::Off();
     std::unique_ptr<WorkerServiceImpl> service_;
     std::unique_ptr<grpc::Server> server_;
     std::string address_;
@@ -86,9 +87,11 @@ TEST_F(WorkerVersionTest, WorkerWithoutVersionIsRefused) {
 
 TEST_F(WorkerVersionTest, WorkerOfThisBuildIsServed) {
     EXPECT_TRUE(Lease(kBuildVersion).ok());
-    ServerConnection connection(address_, "real-worker");
+    absl::StatusOr<std::unique_ptr<ServerConnection>> connection =
+        ServerConnection::Open({.address = address_}, "real-worker");
+    ASSERT_TRUE(connection.ok()) << connection.status();
     const absl::StatusOr<std::optional<TaskAssignment>> lease =
-        connection.Lease(absl::Milliseconds(10));
+        (*connection)->Lease(absl::Milliseconds(10));
     EXPECT_TRUE(lease.ok()) << lease.status();
 }
 
@@ -128,11 +131,13 @@ TEST(WorkerVersionRetry, RefusedWorkerKeepsRetryingWithItsVersionUntilStopped) {
     const fs::path dir = fs::temp_directory_path() / ("lf_version_w_" + std::to_string(::getpid()));
     absl::StatusOr<std::unique_ptr<BlobCache>> cache = BlobCache::Open(dir.string(), 1 << 20);
     ASSERT_TRUE(cache.ok()) << cache.status();
-    ServerConnection connection("127.0.0.1:" + std::to_string(port), "old-worker");
+    absl::StatusOr<std::unique_ptr<ServerConnection>> connection =
+        ServerConnection::Open({.address = "127.0.0.1:" + std::to_string(port)}, "old-worker");
+    ASSERT_TRUE(connection.ok()) << connection.status();
     WorkerOptions options;
     options.min_idle = absl::Milliseconds(1);
     options.max_idle = absl::Milliseconds(8);
-    Worker worker(options, connection, **cache);
+    Worker worker(options, **connection, **cache);
     std::thread run([&] { worker.Run(); });
     const std::vector<std::string> versions = service.WaitForLeases(3);
     worker.Stop();

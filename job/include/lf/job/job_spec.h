@@ -40,6 +40,9 @@ struct JobSpec {
     int priority = 0;           // higher first
     std::string scene_hash;     // the loader's content hash, for the EXR header
     std::string request_id;     // the client's, for idempotent retries; "" for none
+    // The name of the token that submitted it (the server sets it, never the client); "" when
+    // the server ran without authentication. A submitter token sees only its own jobs.
+    std::string owner;
 };
 
 // The limits of a job's settings, one list for the CLI's flags (`render`, `submit`) and the

@@ -1,0 +1,295 @@
+// The services behind TLS and tokens, over real gRPC channels made as `lightfarm` and
+// `lightfarm-worker` make them (lf::OpenChannel): each role can do what it may and nothing
+// else, and nothing of another submitter's job leaks through any call.
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "lf/job/digest.h"
+#include "lf/version.h"
+#include "lightfarm/v1/job_service.grpc.pb.h"
+#include "lightfarm/v1/worker_service.grpc.pb.h"
+#include "proto/channel.h"
+#include "server/grpc_service.h"
+#include "server/server_credentials.h"
+#include "test_dir.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+namespace pb = lightfarm::v1;
+
+std::string ReadText(const fs::path& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// A CA, the server's certificate for 127.0.0.1, a worker's certificate from the CA and one from
+// another CA, made by the openssl command (deploy/install-deps.sh installs it).
+void MakeCertificates(const fs::path& dir) {
+    const std::string d = dir.string();
+    const std::string script =
+        "set -e; cd '" + d +
+        "'; q='-days 2 -sha256'; "
+        "for ca in ca other; do openssl req -x509 -newkey rsa:2048 -nodes -keyout $ca.key "
+        "-out $ca.crt $q -subj /CN=$ca; done; "
+        "openssl req -newkey rsa:2048 -nodes -keyout server.key -out server.csr -subj "
+        "/CN=server; printf 'subjectAltName=IP:127.0.0.1\\n' > san; "
+        "openssl x509 -req -in server.csr -CA ca.crt -CAkey ca.key -CAcreateserial -out "
+        "server.crt $q -extfile san; "
+        "for w in worker:ca rogue:other; do n=${w%:*}; c=${w#*:}; "
+        "openssl req -newkey rsa:2048 -nodes -keyout $n.key -out $n.csr -subj /CN=$n; "
+        "openssl x509 -req -in $n.csr -CA $c.crt -CAkey $c.key -CAcreateserial -out $n.crt $q; "
+        "done";
+    ASSERT_EQ(std::system(("(" + script + ") >/dev/null 2>&1").c_str()), 0)
+        << "openssl could not make the test certificates";
+}
+
+class GuardedServices : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = testing::FreshTestDir("lf_guarded");
+        MakeCertificates(dir_);
+        FarmOptions options;
+        options.data_dir = (dir_ / "data").string();
+        absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
+        ASSERT_TRUE(farm.ok()) << farm.status();
+        farm_ = std::move(*farm);
+        auto tokens = TokenStore::Open(options.data_dir);
+        ASSERT_TRUE(tokens.ok());
+        for (auto [name, role] :
+             {std::pair{"alice", Role::kSubmitter}, std::pair{"bob", Role::kSubmitter},
+              std::pair{"node", Role::kWorker}, std::pair{"root", Role::kAdmin}}) {
+            absl::StatusOr<std::string> token = (*tokens)->Create(name, role);
+            ASSERT_TRUE(token.ok());
+            std::ofstream(dir_ / (std::string(name) + ".token")) << *token << "\n";
+        }
+        auth_ = std::make_unique<Authenticator>(std::move(*tokens), true);
+        jobs_ = std::make_unique<JobServiceImpl>(*farm_, CallGuard{*auth_, true});
+        workers_ = std::make_unique<WorkerServiceImpl>(*farm_, CallGuard{*auth_, true});
+        auto credentials = MakeServerCredentials({.cert = (dir_ / "server.crt").string(),
+                                                  .key = (dir_ / "server.key").string(),
+                                                  .client_ca = (dir_ / "ca.crt").string()});
+        ASSERT_TRUE(credentials.ok()) << credentials.status();
+        grpc::ServerBuilder builder;
+        int port = 0;
+        builder.AddListeningPort("127.0.0.1:0", *credentials, &port);
+        builder.RegisterService(jobs_.get());
+        builder.RegisterService(workers_.get());
+        server_ = builder.BuildAndStart();
+        ASSERT_TRUE(server_ && port > 0);
+        address_ = "127.0.0.1:" + std::to_string(port);
+
+        const std::string scene = ReadText(fs::path(LF_TEST_SCENES) / "cornell_box.json");
+        scene_ = {"scene.json", Sha256Hex(scene), scene.size()};
+        auto upload = farm_->blobs().StartUpload(scene_.hash, scene_.size);
+        ASSERT_TRUE(upload.ok());
+        ASSERT_TRUE((*upload)->Append(scene).ok() && (*upload)->Finish().ok());
+    }
+    void TearDown() override {
+        farm_->scheduler().Shutdown();
+        server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(1));
+        fs::remove_all(dir_);
+    }
+
+    // A channel as `lightfarm --tls-ca ca.crt --token-file WHO.token` makes it; "" for no token.
+    std::shared_ptr<grpc::Channel> Channel(const std::string& who, const std::string& cert = "") {
+        ChannelOptions options{.address = address_, .tls_ca = (dir_ / "ca.crt").string()};
+        if (!who.empty()) options.token_file = (dir_ / (who + ".token")).string();
+        if (!cert.empty()) {
+            options.tls_cert = (dir_ / (cert + ".crt")).string();
+            options.tls_key = (dir_ / (cert + ".key")).string();
+        }
+        auto channel = OpenChannel(options);
+        EXPECT_TRUE(channel.ok()) << channel.status();
+        return *channel;
+    }
+    std::unique_ptr<pb::JobService::Stub> Jobs(const std::string& who) {
+        return pb::JobService::NewStub(Channel(who));
+    }
+    static std::unique_ptr<grpc::ClientContext> Context() {
+        auto context = std::make_unique<grpc::ClientContext>();
+        context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+        return context;
+    }
+
+    grpc::Status Submit(pb::JobService::Stub& stub, std::string* id) {
+        pb::SubmitJobRequest request;
+        request.mutable_scene()->set_path(scene_.path);
+        request.mutable_scene()->set_hash(scene_.hash);
+        request.mutable_scene()->set_size(scene_.size);
+        request.mutable_params()->set_spp(1);
+        request.mutable_params()->set_width(8);
+        request.mutable_params()->set_height(8);
+        request.mutable_params()->set_tile(8);
+        request.mutable_params()->set_passes(1);
+        pb::SubmitJobResponse response;
+        grpc::Status s = stub.SubmitJob(Context().get(), request, &response);
+        *id = response.job_id();
+        return s;
+    }
+    grpc::Status Lease(const std::shared_ptr<grpc::Channel>& channel) {
+        pb::LeaseTaskRequest request;
+        request.set_worker_id("w");
+        request.set_version(kBuildVersion);
+        pb::LeaseTaskResponse response;
+        return pb::WorkerService::NewStub(channel)->LeaseTask(Context().get(), request, &response);
+    }
+    std::vector<std::string> ListedIds(const std::string& who) {
+        pb::ListJobsResponse response;
+        EXPECT_TRUE(Jobs(who)->ListJobs(Context().get(), {}, &response).ok());
+        std::vector<std::string> ids;
+        for (const pb::Job& job : response.jobs()) ids.push_back(job.id());
+        return ids;
+    }
+
+    fs::path dir_;
+    std::unique_ptr<Farm> farm_;
+    std::unique_ptr<Authenticator> auth_;
+    std::unique_ptr<JobServiceImpl> jobs_;
+    std::unique_ptr<WorkerServiceImpl> workers_;
+    std::unique_ptr<grpc::Server> server_;
+    std::string address_;
+    BlobRef scene_;
+};
+
+TEST_F(GuardedServices, SubmitterSeesOnlyItsOwnJobsAdminSeesAll) {
+    std::string alice_job, bob_job;
+    ASSERT_TRUE(Submit(*Jobs("alice"), &alice_job).ok());
+    ASSERT_TRUE(Submit(*Jobs("bob"), &bob_job).ok());
+
+    EXPECT_EQ(ListedIds("alice"), std::vector<std::string>{alice_job});
+    EXPECT_EQ(ListedIds("bob"), std::vector<std::string>{bob_job});
+    EXPECT_EQ(ListedIds("root"), (std::vector<std::string>{bob_job, alice_job}));
+
+    pb::GetJobRequest get;
+    get.set_job_id(alice_job);
+    pb::Job job;
+    ASSERT_TRUE(Jobs("alice")->GetJob(Context().get(), get, &job).ok());
+    EXPECT_EQ(job.owner(), "alice");
+    ASSERT_TRUE(Jobs("root")->GetJob(Context().get(), get, &job).ok());
+
+    // Bob learns nothing of Alice's job: each call answers as for a job that does not exist.
+    pb::GetJobRequest missing;
+    missing.set_job_id("job-0000000000");
+    const grpc::Status absent = Jobs("bob")->GetJob(Context().get(), missing, &job);
+    EXPECT_EQ(absent.error_code(), grpc::StatusCode::NOT_FOUND);
+    const auto expect_hidden = [&](const grpc::Status& s) {
+        EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND) << s.error_message();
+        EXPECT_EQ(s.error_message(), "no job " + alice_job);
+    };
+    auto bob = Jobs("bob");
+    expect_hidden(bob->GetJob(Context().get(), get, &job));
+    pb::CancelJobRequest cancel;
+    cancel.set_job_id(alice_job);
+    expect_hidden(bob->CancelJob(Context().get(), cancel, &job));
+    pb::DeleteJobRequest del;
+    del.set_job_id(alice_job);
+    pb::DeleteJobResponse deleted;
+    expect_hidden(bob->DeleteJob(Context().get(), del, &deleted));
+    pb::FetchResultRequest fetch;
+    fetch.set_job_id(alice_job);
+    fetch.set_preview(true);
+    {
+        auto context = Context();
+        auto reader = bob->FetchResult(context.get(), fetch);
+        pb::Chunk chunk;
+        EXPECT_FALSE(reader->Read(&chunk));
+        expect_hidden(reader->Finish());
+    }
+    pb::WatchJobRequest watch;
+    watch.set_job_id(alice_job);
+    {
+        auto context = Context();
+        auto reader = bob->WatchJob(context.get(), watch);
+        pb::Job update;
+        EXPECT_FALSE(reader->Read(&update));
+        expect_hidden(reader->Finish());
+    }
+    // Alice's own calls work, and the admin may cancel anyone's job.
+    EXPECT_TRUE(Jobs("alice")->CancelJob(Context().get(), cancel, &job).ok());
+    pb::CancelJobRequest cancel_bob;
+    cancel_bob.set_job_id(bob_job);
+    EXPECT_TRUE(Jobs("root")->CancelJob(Context().get(), cancel_bob, &job).ok());
+}
+
+TEST_F(GuardedServices, RolesAreKeptApart) {
+    std::string id;
+    const grpc::Status worker_submit = Submit(*Jobs("node"), &id);
+    EXPECT_EQ(worker_submit.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+    EXPECT_EQ(worker_submit.error_message(),
+              "token \"node\" has role worker, which may not submit jobs");
+    pb::ListJobsResponse list;
+    EXPECT_EQ(Jobs("node")->ListJobs(Context().get(), {}, &list).error_code(),
+              grpc::StatusCode::PERMISSION_DENIED);
+
+    // A submitter with a valid client certificate still may not lease.
+    const grpc::Status submitter_lease = Lease(Channel("alice", "worker"));
+    EXPECT_EQ(submitter_lease.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+    EXPECT_EQ(Lease(Channel("node", "worker")).error_code(), grpc::StatusCode::OK);
+    EXPECT_EQ(Lease(Channel("root", "worker")).error_code(), grpc::StatusCode::OK);
+}
+
+TEST_F(GuardedServices, CallsWithoutOrWithAWrongTokenAreUnauthenticated) {
+    std::string id;
+    const grpc::Status none = Submit(*Jobs(""), &id);
+    EXPECT_EQ(none.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+    EXPECT_NE(none.error_message().find("--token-file"), std::string::npos);
+    std::ofstream(dir_ / "forged.token") << "lf1_" << std::string(64, '0') << "\n";
+    const grpc::Status forged = Submit(*Jobs("forged"), &id);
+    EXPECT_EQ(forged.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+    EXPECT_EQ(Lease(Channel("", "worker")).error_code(), grpc::StatusCode::UNAUTHENTICATED);
+}
+
+TEST_F(GuardedServices, WorkersNeedACertificateFromTheClientCa) {
+    const grpc::Status no_cert = Lease(Channel("node"));
+    EXPECT_EQ(no_cert.error_code(), grpc::StatusCode::UNAUTHENTICATED);
+    EXPECT_NE(no_cert.error_message().find("client certificate"), std::string::npos);
+    // Another CA's certificate fails the handshake: the call never reaches the service.
+    const grpc::Status rogue = Lease(Channel("node", "rogue"));
+    EXPECT_EQ(rogue.error_code(), grpc::StatusCode::UNAVAILABLE) << rogue.error_message();
+}
+
+TEST_F(GuardedServices, ClientThatDoesNotTrustTheServerCannotConnect) {
+    auto channel = OpenChannel({.address = address_,
+                                .tls_ca = (dir_ / "other.crt").string(),
+                                .token_file = (dir_ / "root.token").string()});
+    ASSERT_TRUE(channel.ok());
+    pb::ListJobsResponse list;
+    const grpc::Status s = pb::JobService::NewStub(*channel)->ListJobs(Context().get(), {}, &list);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAVAILABLE) << s.error_message();
+}
+
+TEST(ChannelOptions, UnusableFilesAreErrorsNamingTheFlag) {
+    auto missing = OpenChannel({.address = "127.0.0.1:1", .tls_ca = "/nonexistent/ca.crt"});
+    ASSERT_FALSE(missing.ok());
+    EXPECT_EQ(missing.status().message(), "--tls-ca /nonexistent/ca.crt: cannot be read");
+    auto cert_alone = OpenChannel({.address = "127.0.0.1:1", .tls_cert = "x.crt"});
+    EXPECT_TRUE(absl::IsInvalidArgument(cert_alone.status()));
+    const fs::path dir = testing::FreshTestDir("lf_channel");
+    std::ofstream(dir / "empty.token") << "\n";
+    std::ofstream(dir / "not.pem") << "hello\n";
+    auto empty =
+        OpenChannel({.address = "127.0.0.1:1", .token_file = (dir / "empty.token").string()});
+    EXPECT_TRUE(absl::IsInvalidArgument(empty.status())) << empty.status();
+    auto not_pem = OpenChannel({.address = "127.0.0.1:1", .tls_ca = (dir / "not.pem").string()});
+    EXPECT_TRUE(absl::IsInvalidArgument(not_pem.status())) << not_pem.status();
+    fs::remove_all(dir);
+}
+
+TEST(ServerCredentials, InconsistentTlsFlagsAreRefused) {
+    EXPECT_TRUE(MakeServerCredentials({}).ok());
+    EXPECT_TRUE(absl::IsInvalidArgument(MakeServerCredentials({.cert = "a.crt"}).status()));
+    EXPECT_TRUE(absl::IsInvalidArgument(MakeServerCredentials({.key = "a.key"}).status()));
+    EXPECT_TRUE(
+        absl::IsNotFound(MakeServerCredentials({.cert = "/nonexistent.crt", .key = "k"}).status()));
+}
+
+}  // namespace
+}  // namespace lf
