@@ -201,7 +201,16 @@ grpc::Status JobServiceImpl::DeleteJob(grpc::ServerContext* context,
     return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext*, const pb::LeaseTaskRequest* req,
+grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext*, const pb::ListWorkersRequest*,
+                                         pb::ListWorkersResponse* resp) {
+    for (const WorkerStatus& worker : farm_.scheduler().Workers()) {
+        ToProto(worker, resp->add_workers());
+    }
+    return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context,
+                                          const pb::LeaseTaskRequest* req,
                                           pb::LeaseTaskResponse* resp) {
     if (req->worker_id().empty()) {
         return ToGrpcStatus(absl::InvalidArgumentError("LeaseTask: worker_id is empty"));
@@ -211,9 +220,15 @@ grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext*, const pb::LeaseT
             "worker version ", req->version().empty() ? "(none)" : req->version(),
             ", server version ", kBuildVersion, ": run workers of the server's build")));
     }
+    if (req->name().size() > kMaxWorkerNameBytes) {
+        return ToGrpcStatus(absl::InvalidArgumentError(absl::StrCat(
+            "LeaseTask: worker name of ", req->name().size(), " bytes is above the limit of ",
+            kMaxWorkerNameBytes)));
+    }
+    const WorkerDescription about{req->name(), context->peer(), req->version()};
     const absl::Duration wait = absl::Milliseconds(std::clamp(req->wait_ms(), 0, 10000));
     if (std::optional<TaskAssignment> lease =
-            farm_.scheduler().LeaseTask(req->worker_id(), absl::Now() + wait)) {
+            farm_.scheduler().LeaseTask(req->worker_id(), absl::Now() + wait, &about)) {
         ToProto(*lease, resp->mutable_task());
     }
     return grpc::Status::OK;

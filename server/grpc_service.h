@@ -20,6 +20,8 @@ struct JobServiceOptions {
 // ListJobs pages: the size when the request names none, and the largest.
 constexpr int kDefaultPageSize = 100;
 constexpr int kMaxPageSize = 1000;
+// A worker's --name, as LeaseTask takes it.
+constexpr size_t kMaxWorkerNameBytes = 128;
 
 class JobServiceImpl final : public lightfarm::v1::JobService::Service {
   public:
@@ -45,6 +47,8 @@ class JobServiceImpl final : public lightfarm::v1::JobService::Service {
                              grpc::ServerWriter<lightfarm::v1::Chunk>*) override;
     grpc::Status DeleteJob(grpc::ServerContext*, const lightfarm::v1::DeleteJobRequest*,
                            lightfarm::v1::DeleteJobResponse*) override;
+    grpc::Status ListWorkers(grpc::ServerContext*, const lightfarm::v1::ListWorkersRequest*,
+                             lightfarm::v1::ListWorkersResponse*) override;
 
   private:
     Farm& farm_;
