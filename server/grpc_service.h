@@ -20,8 +20,6 @@ struct JobServiceOptions {
 // ListJobs pages: the size when the request names none, and the largest.
 constexpr int kDefaultPageSize = 100;
 constexpr int kMaxPageSize = 1000;
-// A worker's --name, as LeaseTask takes it.
-constexpr size_t kMaxWorkerNameBytes = 128;
 
 class JobServiceImpl final : public lightfarm::v1::JobService::Service {
   public:

@@ -11,6 +11,7 @@
 #include "lf/job/frame_settings.h"
 #include "server/farm.h"
 #include "server/grpc_service.h"
+#include "server/http_listener.h"
 #include "server/timeout_checker.h"
 
 int main(int argc, char** argv) {
@@ -60,6 +61,9 @@ int main(int argc, char** argv) {
                    "most jobs queued or running at once")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    std::string http;
+    app.add_option("--http", http,
+                   "HOST:PORT to serve GET /healthz and /metrics (Prometheus) on; off if unset");
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
@@ -83,6 +87,8 @@ int main(int argc, char** argv) {
     }
     lf::JobServiceImpl job_service(**farm, service_options);
     lf::WorkerServiceImpl worker_service(**farm);
+    // grpc.health.v1.Health: SERVING for "" while the server runs, NOT_SERVING from shutdown on.
+    grpc::EnableDefaultHealthCheckService(true);
     grpc::ServerBuilder builder;
     int port = 0;
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
@@ -107,6 +113,21 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     spdlog::info("listening on {}:{}, data in {}, leases of {} s", host, port, options.data_dir,
                  lease_seconds);
+    std::unique_ptr<lf::HttpListener> http_listener;
+    if (!http.empty()) {
+        absl::StatusOr<std::unique_ptr<lf::HttpListener>> started =
+            lf::HttpListener::Start(http, **farm);
+        if (!started.ok()) {
+            std::fprintf(stderr, "lightfarm-server: error: %s\n",
+                         std::string(started.status().message()).c_str());
+            return 1;
+        }
+        http_listener = std::move(*started);
+        // Port 0 picks one: say which, as for --listen.
+        std::printf("http on %s:%d\n", http.substr(0, http.rfind(':')).c_str(),
+                    http_listener->port());
+        std::fflush(stdout);
+    }
 
     // Expired leases go back to the queue, and adaptive jobs past their time limit stop
     // sampling, within a tenth of a second.
@@ -120,6 +141,7 @@ int main(int argc, char** argv) {
     });
 
     spdlog::info("signal {}: shutting down", stop_signals.Wait());
+    server->GetHealthCheckService()->SetServingStatus(false);
     (*farm)->scheduler().Shutdown();
     server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
     timeout_checker.Stop();

@@ -7,7 +7,11 @@
 #include <cstdio>
 #include <thread>
 
+#include "absl/strings/str_cat.h"
+
+#include "lf/core/log.h"
 #include "lf/core/stop_signals.h"
+#include "lf/job/worker_status.h"
 #include "worker/worker.h"
 
 int main(int argc, char** argv) {
@@ -20,7 +24,17 @@ int main(int argc, char** argv) {
     std::string cache_dir = "/tmp/lightfarm-worker-cache";
     uint64_t cache_mb = 2048;
     std::string log_level = "info";
+    char host[256] = "worker";
+    gethostname(host, sizeof host - 1);
+    std::string name = host;
     app.add_option("--server", server, "HOST:PORT of the server")->required();
+    app.add_option("--name", name, "what `lightfarm workers` calls this worker")
+        ->capture_default_str()
+        ->check([](const std::string& n) {
+            return n.size() <= lf::kMaxWorkerNameBytes
+                       ? std::string()
+                       : absl::StrCat("at most ", lf::kMaxWorkerNameBytes, " bytes");
+        });
     app.add_option("--threads", options.threads, "render threads")
         ->capture_default_str()
         ->check(CLI::Range(1, 1024));
@@ -40,12 +54,11 @@ int main(int argc, char** argv) {
                      std::string(cache.status().message()).c_str());
         return 1;
     }
-    char host[256] = "worker";
-    gethostname(host, sizeof host - 1);
     const std::string id = std::string(host) + "-" + std::to_string(::getpid());
-    lf::ServerConnection connection(server, id);
+    lf::ServerConnection connection(server, id, name);
     lf::Worker worker(options, connection, **cache);
-    spdlog::info("worker={} serving {} with {} threads", id, server, options.threads);
+    spdlog::info("worker={} ({}) serving {} with {} threads", id, lf::LogSafe(name), server,
+                 options.threads);
 
     std::thread signal_waiter([&] {
         const int signal = stop_signals.Wait();

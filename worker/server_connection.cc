@@ -18,8 +18,9 @@ struct ServerConnection::Stub {
     std::unique_ptr<pb::WorkerService::Stub> stub;
 };
 
-ServerConnection::ServerConnection(const std::string& address, std::string worker_id)
-    : worker_id_(std::move(worker_id)), stub_(std::make_unique<Stub>()) {
+ServerConnection::ServerConnection(const std::string& address, std::string worker_id,
+                                   std::string name)
+    : worker_id_(std::move(worker_id)), name_(std::move(name)), stub_(std::make_unique<Stub>()) {
     grpc::ChannelArguments args;
     // gRPC's default reconnect backoff grows to two minutes; a restarted server should get its
     // workers back at once.
@@ -39,6 +40,7 @@ absl::StatusOr<std::optional<TaskAssignment>> ServerConnection::Lease(absl::Dura
     req.set_worker_id(worker_id_);
     req.set_wait_ms(int(absl::ToInt64Milliseconds(wait)));
     req.set_version(kBuildVersion);
+    req.set_name(name_);
     pb::LeaseTaskResponse resp;
     // Waiting for the connection (rather than failing at once while the channel is in
     // backoff) is what makes the channel reconnect as soon as a restarted server listens.

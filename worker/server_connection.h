@@ -17,7 +17,8 @@ namespace lf {
 class ServerConnection {
   public:
     // Connects lazily; after the server restarts, calls work again within about a second.
-    ServerConnection(const std::string& address, std::string worker_id);
+    // `name` is for people (lightfarm workers); the server tells workers apart by `worker_id`.
+    ServerConnection(const std::string& address, std::string worker_id, std::string name = "");
     ~ServerConnection();
 
     const std::string& worker_id() const { return worker_id_; }
@@ -42,6 +43,7 @@ class ServerConnection {
 
   private:
     std::string worker_id_;
+    std::string name_;
     struct Stub;  // keeps gRPC headers out of the worker's other files
     std::unique_ptr<Stub> stub_;
 };

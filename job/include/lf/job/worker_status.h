@@ -1,11 +1,15 @@
 // A worker as the coordinator sees it: what `lightfarm workers` lists (wire: ListWorkers).
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "absl/time/time.h"
 
 namespace lf {
+
+// The longest worker name (lightfarm-worker --name) the server takes.
+constexpr size_t kMaxWorkerNameBytes = 128;
 
 struct WorkerStatus {
     std::string id;       // the worker process' own id (host-pid)
