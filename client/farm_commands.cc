@@ -626,8 +626,8 @@ Command AddWorkersCommand(CLI::App& app) {
                     // terminal.
                     std::printf("%-20s %-24s %-30s %-5s %-22s %.1f s ago\n",
                                 LogSafe(w.name().empty() ? w.id() : w.name(), 64).c_str(),
-                                LogSafe(w.address(), 64).c_str(),
-                                LogSafe(w.version(), 64).c_str(), busy ? "busy" : "idle",
+                                LogSafe(w.address(), 64).c_str(), LogSafe(w.version(), 64).c_str(),
+                                busy ? "busy" : "idle",
                                 busy ? absl::StrCat(w.job_id(), "/", w.task_index()).c_str() : "-",
                                 w.seconds_since_seen());
                 }

@@ -221,9 +221,9 @@ grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context,
             ", server version ", kBuildVersion, ": run workers of the server's build")));
     }
     if (req->name().size() > kMaxWorkerNameBytes) {
-        return ToGrpcStatus(absl::InvalidArgumentError(absl::StrCat(
-            "LeaseTask: worker name of ", req->name().size(), " bytes is above the limit of ",
-            kMaxWorkerNameBytes)));
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("LeaseTask: worker name of ", req->name().size(),
+                         " bytes is above the limit of ", kMaxWorkerNameBytes)));
     }
     const WorkerDescription about{req->name(), context->peer(), req->version()};
     const absl::Duration wait = absl::Milliseconds(std::clamp(req->wait_ms(), 0, 10000));

@@ -13,8 +13,9 @@ Histogram::Histogram(std::vector<double> upper_bounds)
       buckets_(std::make_unique<std::atomic<uint64_t>[]>(upper_bounds_.size() + 1)) {}
 
 void Histogram::Observe(double value) {
-    const size_t bucket = size_t(std::lower_bound(upper_bounds_.begin(), upper_bounds_.end(), value) -
-                                 upper_bounds_.begin());
+    const size_t bucket =
+        size_t(std::lower_bound(upper_bounds_.begin(), upper_bounds_.end(), value) -
+               upper_bounds_.begin());
     buckets_[bucket].fetch_add(1, std::memory_order_relaxed);
     sum_.fetch_add(value, std::memory_order_relaxed);
 }
@@ -39,7 +40,8 @@ std::string FormatMetricValue(double value) {
     return std::string(buffer, r.ptr);
 }
 
-void MetricsText::Family(const std::string& name, const std::string& help, const std::string& type) {
+void MetricsText::Family(const std::string& name, const std::string& help,
+                         const std::string& type) {
     absl::StrAppend(&text_, "# HELP ", name, " ", help, "\n# TYPE ", name, " ", type, "\n");
 }
 
@@ -53,7 +55,8 @@ void MetricsText::AddGauge(const std::string& name, const std::string& help, dou
     absl::StrAppend(&text_, name, " ", FormatMetricValue(value), "\n");
 }
 
-void MetricsText::AddGauge(const std::string& name, const std::string& help, const std::string& label,
+void MetricsText::AddGauge(const std::string& name, const std::string& help,
+                           const std::string& label,
                            const std::vector<std::pair<std::string, double>>& values) {
     Family(name, help, "gauge");
     for (const auto& [label_value, value] : values) {
@@ -71,8 +74,8 @@ void MetricsText::AddHistogram(const std::string& name, const std::string& help,
                                    : "+Inf";
         absl::StrAppend(&text_, name, "_bucket{le=\"", le, "\"} ", histogram.cumulative[i], "\n");
     }
-    absl::StrAppend(&text_, name, "_sum ", FormatMetricValue(histogram.sum), "\n", name,
-                    "_count ", histogram.count(), "\n");
+    absl::StrAppend(&text_, name, "_sum ", FormatMetricValue(histogram.sum), "\n", name, "_count ",
+                    histogram.count(), "\n");
 }
 
 }  // namespace lf

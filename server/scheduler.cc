@@ -301,7 +301,9 @@ SchedulerLoad Scheduler::Load() {
         load.tasks_running += job->states.running();
     }
     load.workers_live = int(workers_.size());
-    for (const auto& [worker, ref] : LeasesByWorker()) load.workers_busy += workers_.IsLive(worker, now);
+    for (const auto& [worker, ref] : LeasesByWorker()) {
+        load.workers_busy += workers_.IsLive(worker, now);
+    }
     return load;
 }
 
@@ -372,8 +374,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     return rendered;
 }
 
-std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker,
-                                                   absl::Time wait_until,
+std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker, absl::Time wait_until,
                                                    const WorkerDescription* about) {
     Locked locked(*this);
     while (true) {

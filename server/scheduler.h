@@ -72,8 +72,8 @@ struct SchedulerMetrics {
 struct SchedulerLoad {
     int jobs_queued = 0, jobs_running = 0;
     int64_t tasks_queued = 0, tasks_running = 0;  // across active jobs
-    int workers_live = 0;  // seen within a lease
-    int workers_busy = 0;  // live and holding a current lease
+    int workers_live = 0;                         // seen within a lease
+    int workers_busy = 0;                         // live and holding a current lease
 };
 
 enum class FailureKind {

@@ -24,8 +24,7 @@ class WorkerRegistry {
     explicit WorkerRegistry(absl::Duration alive_for) : alive_for_(alive_for) {}
 
     // `about`, when given, replaces what the worker said of itself before.
-    void Seen(const std::string& worker, absl::Time now,
-              const WorkerDescription* about = nullptr);
+    void Seen(const std::string& worker, absl::Time now, const WorkerDescription* about = nullptr);
     // Forgets the workers not seen for `alive_for` by `now`; returns how many.
     int ForgetSilent(absl::Time now);
 

@@ -8,7 +8,6 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
-
 #include "lf/core/log.h"
 #include "lf/core/stop_signals.h"
 #include "lf/job/worker_status.h"

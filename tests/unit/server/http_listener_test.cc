@@ -63,8 +63,9 @@ TEST_F(HttpListenerTest, MetricsFollowSubmissionLeaseAndResult) {
          {"lightfarm_jobs{state=\"queued\"} 0", "lightfarm_tasks{state=\"queued\"} 0",
           "lightfarm_workers{state=\"live\"} 0", "lightfarm_queue_depth 0",
           "lightfarm_leases_total 0", "lightfarm_task_failures_total 0",
-          "lightfarm_task_duration_seconds_count 0", "# TYPE lightfarm_store_write_seconds histogram",
-          "# TYPE lightfarm_jobs gauge", "# TYPE lightfarm_leases_total counter"}) {
+          "lightfarm_task_duration_seconds_count 0",
+          "# TYPE lightfarm_store_write_seconds histogram", "# TYPE lightfarm_jobs gauge",
+          "# TYPE lightfarm_leases_total counter"}) {
         EXPECT_TRUE(Has(text, line)) << line << " not in\n" << text;
     }
 
@@ -81,8 +82,8 @@ TEST_F(HttpListenerTest, MetricsFollowSubmissionLeaseAndResult) {
         farm_->scheduler().LeaseTask("w1", absl::InfinitePast(), &about);
     ASSERT_TRUE(lease);
     farm_->scheduler().LeaseTask("w2");  // a second worker, busy too
-    ASSERT_TRUE(farm_->scheduler().Fail(lease->lease_id, "w1", "boom", FailureKind::kTaskError)
-                    .ok());
+    ASSERT_TRUE(
+        farm_->scheduler().Fail(lease->lease_id, "w1", "boom", FailureKind::kTaskError).ok());
     text = Metrics();
     EXPECT_TRUE(Has(text, "lightfarm_jobs{state=\"running\"} 1")) << text;
     EXPECT_TRUE(Has(text, "lightfarm_jobs{state=\"queued\"} 0")) << text;
