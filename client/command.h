@@ -31,5 +31,6 @@ Command AddWatchCommand(CLI::App& app);
 Command AddFetchCommand(CLI::App& app);
 Command AddCancelCommand(CLI::App& app);
 Command AddDeleteCommand(CLI::App& app);
+Command AddWorkersCommand(CLI::App& app);
 
 }  // namespace lf

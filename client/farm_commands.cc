@@ -1,5 +1,6 @@
-// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel and delete, each
-// a call to lightfarm-server's JobService. All protobuf handling of the client is in this file.
+// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel, delete and
+// workers, each a call to lightfarm-server's JobService. All protobuf handling of the client is
+// in this file.
 #include <grpcpp/grpcpp.h>
 #include <unistd.h>
 
@@ -16,6 +17,7 @@
 #include "adaptive_flags.h"
 #include "command.h"
 #include "lf/core/image_io.h"
+#include "lf/core/log.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
 #include "lf/job/job_spec.h"
@@ -617,6 +619,38 @@ Command AddDeleteCommand(CLI::App& app) {
                                *flags);
                 if (!s.ok()) return ReportError(s);
                 std::printf("job %s deleted\n", id->c_str());
+                return 0;
+            }};
+}
+
+Command AddWorkersCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    CLI::App* cmd = app.add_subcommand(
+        "workers",
+        "List the workers the server heard from within a lease: name, address, version, state,\n"
+        "task and seconds since each was last heard from.");
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags] {
+                pb::ListWorkersRequest req;
+                pb::ListWorkersResponse resp;
+                absl::Status s =
+                    CallStatus(Connect(*flags)->ListWorkers(
+                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
+                               *flags);
+                if (!s.ok()) return ReportError(s);
+                std::printf("%-20s %-24s %-30s %-5s %-22s %s\n", "NAME", "ADDRESS", "VERSION",
+                            "STATE", "TASK", "LAST-HEARTBEAT");
+                for (const pb::WorkerInfo& w : resp.workers()) {
+                    const bool busy = w.state() == pb::WorkerInfo::BUSY;
+                    // Names and versions come from the workers: escaped, so none can move the
+                    // terminal.
+                    std::printf("%-20s %-24s %-30s %-5s %-22s %.1f s ago\n",
+                                LogSafe(w.name().empty() ? w.id() : w.name(), 64).c_str(),
+                                LogSafe(w.address(), 64).c_str(), LogSafe(w.version(), 64).c_str(),
+                                busy ? "busy" : "idle",
+                                busy ? absl::StrCat(w.job_id(), "/", w.task_index()).c_str() : "-",
+                                w.seconds_since_seen());
+                }
                 return 0;
             }};
 }

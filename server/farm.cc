@@ -15,7 +15,6 @@
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
 #include "lf/job/render_metadata.h"
-#include "server/sqlite_job_store.h"
 
 namespace lf {
 
@@ -68,7 +67,7 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
 }
 
 Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
-           std::unique_ptr<JobStore> store)
+           std::unique_ptr<SqliteJobStore> store)
     : options_(options),
       blobs_(std::move(blobs)),
       store_(std::move(store)),

@@ -17,6 +17,7 @@
 #include "server/data_dir_lock.h"
 #include "server/job_store.h"
 #include "server/scheduler.h"
+#include "server/sqlite_job_store.h"
 
 namespace lf {
 
@@ -88,11 +89,12 @@ class Farm {
 
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }
+    const SqliteJobStore& store() const { return *store_; }
     const FarmOptions& options() const { return options_; }
 
   private:
     Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
-         std::unique_ptr<JobStore> store);
+         std::unique_ptr<SqliteJobStore> store);
     absl::Status CheckSceneSize(uint64_t bytes) const;
     // A result that is not one: the task goes back to the queue as a counted failure.
     absl::Status RefuseUndecodable(const std::string& lease_id, const std::string& worker,
@@ -122,7 +124,7 @@ class Farm {
     std::map<std::string, RadiosityFigures> radiosity_;      // by job id
     std::map<std::string, SweepSolveFigures> sweep_solves_;  // by job id
     std::unique_ptr<BlobStore> blobs_;
-    std::unique_ptr<JobStore> store_;
+    std::unique_ptr<SqliteJobStore> store_;
     Scheduler scheduler_;
     std::mutex image_mutex_;
     std::map<std::string, int> previewed_;  // tasks done at each running job's last preview

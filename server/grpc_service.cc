@@ -279,6 +279,19 @@ grpc::Status JobServiceImpl::DeleteJob(grpc::ServerContext* context,
     return grpc::Status::OK;
 }
 
+grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context,
+                                         const pb::ListWorkersRequest*,
+                                         pb::ListWorkersResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "ListWorkers", Action::kListWorkers);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    for (WorkerStatus& worker : farm_.scheduler().Workers()) {
+        // A submitter sees that a worker is busy, not with whose job.
+        if (worker.busy() && !VisibleJob(*caller, worker.job_id).ok()) worker.job_id = "(other)";
+        ToProto(worker, resp->add_workers());
+    }
+    return grpc::Status::OK;
+}
+
 grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context,
                                           const pb::LeaseTaskRequest* req,
                                           pb::LeaseTaskResponse* resp) {
@@ -293,9 +306,15 @@ grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context,
             "worker version ", req->version().empty() ? "(none)" : req->version(),
             ", server version ", kBuildVersion, ": run workers of the server's build")));
     }
+    if (req->name().size() > kMaxWorkerNameBytes) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("LeaseTask: worker name of ", req->name().size(),
+                         " bytes is above the limit of ", kMaxWorkerNameBytes)));
+    }
+    const WorkerDescription about{req->name(), context->peer(), req->version()};
     const absl::Duration wait = absl::Milliseconds(std::clamp(req->wait_ms(), 0, 10000));
     if (std::optional<TaskAssignment> lease =
-            farm_.scheduler().LeaseTask(req->worker_id(), absl::Now() + wait)) {
+            farm_.scheduler().LeaseTask(req->worker_id(), absl::Now() + wait, &about)) {
         ToProto(*lease, resp->mutable_task());
     }
     return grpc::Status::OK;

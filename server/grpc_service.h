@@ -59,6 +59,8 @@ class JobServiceImpl final : public lightfarm::v1::JobService::Service {
                              grpc::ServerWriter<lightfarm::v1::Chunk>*) override;
     grpc::Status DeleteJob(grpc::ServerContext*, const lightfarm::v1::DeleteJobRequest*,
                            lightfarm::v1::DeleteJobResponse*) override;
+    grpc::Status ListWorkers(grpc::ServerContext*, const lightfarm::v1::ListWorkersRequest*,
+                             lightfarm::v1::ListWorkersResponse*) override;
 
   private:
     // The job if `caller` may see it; NotFound, as for a job that does not exist, otherwise, so

@@ -24,4 +24,11 @@ std::vector<std::string> LeaseTimeouts::TakeExpired(absl::Time now) {
     return expired;
 }
 
+std::vector<std::string> LeaseTimeouts::lease_ids() const {
+    std::vector<std::string> ids;
+    ids.reserve(by_id_.size());
+    for (const auto& [id, deadline] : by_id_) ids.push_back(id);
+    return ids;
+}
+
 }  // namespace lf

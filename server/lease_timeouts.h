@@ -17,6 +17,7 @@ class LeaseTimeouts {
     // Removes and returns the leases whose deadline is at or before `now`, earliest first.
     std::vector<std::string> TakeExpired(absl::Time now);
     size_t size() const { return by_id_.size(); }
+    std::vector<std::string> lease_ids() const;  // by id
 
   private:
     std::multimap<absl::Time, std::string> by_deadline_;

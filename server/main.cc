@@ -11,6 +11,7 @@
 #include "lf/job/frame_settings.h"
 #include "server/farm.h"
 #include "server/grpc_service.h"
+#include "server/http_listener.h"
 #include "server/listen_policy.h"
 #include "server/server_credentials.h"
 #include "server/timeout_checker.h"
@@ -80,6 +81,9 @@ int main(int argc, char** argv) {
                    "most jobs queued or running at once")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    std::string http;
+    app.add_option("--http", http,
+                   "HOST:PORT to serve GET /healthz and /metrics (Prometheus) on; off if unset");
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
     lf::TokenCommand token_command(app);
@@ -124,6 +128,9 @@ int main(int argc, char** argv) {
     const lf::CallGuard guard{auth, !tls.client_ca.empty()};
     lf::JobServiceImpl job_service(**farm, guard, service_options);
     lf::WorkerServiceImpl worker_service(**farm, guard);
+    // grpc.health.v1.Health: SERVING for "" while the server runs, NOT_SERVING from shutdown on.
+    // It answers without a token, as Kubernetes' gRPC probes and load balancers ask.
+    grpc::EnableDefaultHealthCheckService(true);
     grpc::ServerBuilder builder;
     int port = 0;
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
@@ -159,6 +166,18 @@ int main(int argc, char** argv) {
             "on this machine may use the farm",
             options.data_dir, lf::TokenStore::kFileName);
     }
+    // Plain HTTP without tokens: it serves health and farm-wide counts, nothing of any job.
+    std::unique_ptr<lf::HttpListener> http_listener;
+    if (!http.empty()) {
+        absl::StatusOr<std::unique_ptr<lf::HttpListener>> started =
+            lf::HttpListener::Start(http, **farm);
+        if (!started.ok()) return fail(started.status());
+        http_listener = std::move(*started);
+        // Port 0 picks one: say which, as for --listen.
+        std::printf("http on %s:%d\n", http.substr(0, http.rfind(':')).c_str(),
+                    http_listener->port());
+        std::fflush(stdout);
+    }
 
     // Expired leases go back to the queue, and adaptive jobs past their time limit stop
     // sampling, within a tenth of a second.
@@ -172,6 +191,7 @@ int main(int argc, char** argv) {
     });
 
     spdlog::info("signal {}: shutting down", stop_signals.Wait());
+    server->GetHealthCheckService()->SetServingStatus(false);
     (*farm)->scheduler().Shutdown();
     server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
     timeout_checker.Stop();

@@ -255,6 +255,58 @@ size_t Scheduler::workers_tracked() const {
     return workers_.size();
 }
 
+std::map<std::string, Scheduler::LeaseRef> Scheduler::LeasesByWorker() {
+    std::map<std::string, LeaseRef> held;
+    // The deadlines are kept for current leases only: fewer than the tasks of running jobs.
+    for (const std::string& lease_id : timeouts_.lease_ids()) {
+        const std::optional<LeaseRef> ref = Resolve(lease_id);
+        if (!ref || !IsCurrent(*ref)) continue;
+        const std::string& worker =
+            ref->job->tasks[size_t(ref->task)].holders[size_t(ref->attempt - 1)];
+        auto [it, added] = held.emplace(worker, *ref);
+        if (!added && it->second.attempt < ref->attempt) it->second = *ref;
+    }
+    return held;
+}
+
+std::vector<WorkerStatus> Scheduler::Workers() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const absl::Time now = clock_();
+    workers_.ForgetSilent(now);
+    const std::map<std::string, LeaseRef> held = LeasesByWorker();
+    std::vector<WorkerStatus> workers;
+    for (WorkerRegistry::Entry& entry : workers_.List()) {
+        WorkerStatus& w = workers.emplace_back();
+        w.id = std::move(entry.id);
+        w.name = std::move(entry.about.name);
+        w.address = std::move(entry.about.address);
+        w.version = std::move(entry.about.version);
+        w.since_seen = now - entry.last_seen;
+        if (auto it = held.find(w.id); it != held.end()) {
+            w.job_id = it->second.job->record.id;
+            w.task = it->second.task;
+        }
+    }
+    return workers;
+}
+
+SchedulerLoad Scheduler::Load() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const absl::Time now = clock_();
+    workers_.ForgetSilent(now);
+    SchedulerLoad load;
+    for (const auto& [id, job] : active_) {
+        ++(job->record.state == JobState::kQueued ? load.jobs_queued : load.jobs_running);
+        load.tasks_queued += job->states.count(TaskState::kQueued);
+        load.tasks_running += job->states.running();
+    }
+    load.workers_live = int(workers_.size());
+    for (const auto& [worker, ref] : LeasesByWorker()) {
+        load.workers_busy += workers_.IsLive(worker, now);
+    }
+    return load;
+}
+
 absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     // The store is read before the lock is taken.
     struct Stored {
@@ -322,11 +374,11 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     return rendered;
 }
 
-std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker,
-                                                   absl::Time wait_until) {
+std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker, absl::Time wait_until,
+                                                   const WorkerDescription* about) {
     Locked locked(*this);
     while (true) {
-        if (std::optional<TaskAssignment> lease = TryLease(worker)) return lease;
+        if (std::optional<TaskAssignment> lease = TryLease(worker, about)) return lease;
         const uint64_t version = version_;
         if (shutdown_ || !changed_.wait_until(locked.lock, absl::ToChronoTime(wait_until),
                                               [&] { return version_ != version || shutdown_; })) {
@@ -335,9 +387,10 @@ std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker,
     }
 }
 
-std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker) {
+std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
+                                                  const WorkerDescription* about) {
     const absl::Time now = clock_();
-    workers_.Seen(worker, now);
+    workers_.Seen(worker, now, about);
     workers_.ForgetSilent(now);  // so that the workers kept are the live ones
     Job* best = nullptr;
     int best_task = -1;
@@ -396,6 +449,7 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
     task.holders.push_back(worker);
     task.live.insert(task.attempts);
     ++job.record.tasks_leased;
+    metrics_.leases.Add();
     const std::string lease_id = LeaseId(job, t, task.attempts);
     timeouts_.Set(lease_id, now + options_.lease);
     if (job.record.state == JobState::kQueued) MoveJob(job, JobState::kRunning);
@@ -640,6 +694,7 @@ void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
         for (int attempt : task.live) timeouts_.Remove(LeaseId(job, t, attempt));
         task.live.clear();
         job.speculation.TaskDone(now - task.leased_at);
+        metrics_.task_seconds.Observe(absl::ToDoubleSeconds(now - task.leased_at));
     }
     MoveTask(job, t, TaskState::kDone);
 }
@@ -715,6 +770,7 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
     Task& task = job.tasks[size_t(t)];
     task.live.erase(ref.attempt);
     if (counted) {
+        metrics_.task_failures.Add();
         ++task.failures;
         task.failed_on.insert(task.holders[size_t(ref.attempt - 1)]);
         job.record.last_error = absl::StrCat("task ", t, ": ", reason);

@@ -30,9 +30,11 @@
 #include "lf/job/frame_merge.h"
 #include "lf/job/merge.h"
 #include "lf/job/task_assignment.h"
+#include "lf/job/worker_status.h"
 #include "server/job_state_machine.h"
 #include "server/job_store.h"
 #include "server/lease_timeouts.h"
+#include "server/metrics.h"
 #include "server/radiosity_solve.h"
 #include "server/speculation.h"
 #include "server/sweep_task_numbering.h"
@@ -55,6 +57,23 @@ struct SchedulerOptions {
     TileStoreFactory tile_stores = MakeMemoryTileStore;
     // Jobs queued or running at once; a submission beyond is refused (ResourceExhausted).
     size_t max_active_jobs = 1000;
+};
+
+// Counted as the scheduler works; read by /metrics at any time, without the scheduler's lock.
+struct SchedulerMetrics {
+    Counter leases;         // leases handed out, second leases of stragglers included
+    Counter task_failures;  // counted failures: expired leases, task errors, refused results
+    // Per task done while leased: seconds from its lease to its accepted result (the render
+    // and the result's transfer), as the server's clock measures them.
+    Histogram task_seconds{{0.1, 0.25, 0.5, 1, 2.5, 5, 10, 30, 60, 120, 300, 600, 1800, 3600}};
+};
+
+// What is queued and running now, for /metrics.
+struct SchedulerLoad {
+    int jobs_queued = 0, jobs_running = 0;
+    int64_t tasks_queued = 0, tasks_running = 0;  // across active jobs
+    int workers_live = 0;                         // seen within a lease
+    int workers_busy = 0;                         // live and holding a current lease
 };
 
 enum class FailureKind {
@@ -84,9 +103,10 @@ class Scheduler {
     // task that failed here goes to a live worker it has not failed on, while there is one); when
     // none is queued, a straggler's task (see speculate_after). Waits until `wait_until` for one to
     // be queued (a long poll: an idle worker starts on a new job at once); nullopt when there is
-    // nothing to do.
+    // nothing to do. `about`: what the worker says of itself, for Workers().
     std::optional<TaskAssignment> LeaseTask(const std::string& worker,
-                                            absl::Time wait_until = absl::InfinitePast());
+                                            absl::Time wait_until = absl::InfinitePast(),
+                                            const WorkerDescription* about = nullptr);
 
     // Extends the lease. False means stop: the job was cancelled or the lease is gone.
     bool Heartbeat(const std::string& lease_id, const std::string& worker);
@@ -166,6 +186,12 @@ class Scheduler {
     // (the timeout checker forgets them within a tick of a lease's silence).
     size_t workers_tracked() const;
 
+    // The live workers by id (a worker silent for a lease is forgotten), each with the task it
+    // holds a current lease of.
+    std::vector<WorkerStatus> Workers();
+    SchedulerLoad Load();
+    const SchedulerMetrics& metrics() const { return metrics_; }
+
   private:
     // What a task's leases left behind; its state is in Job::states.
     struct Task {
@@ -229,7 +255,10 @@ class Scheduler {
         const std::string& request_id) const;
     // The record of a job that ended and is not (or not yet) in the store.
     const JobRecord* EndedRecord(const std::string& job_id) const;
-    std::optional<TaskAssignment> TryLease(const std::string& worker);
+    std::optional<TaskAssignment> TryLease(const std::string& worker,
+                                           const WorkerDescription* about);
+    // The current lease each worker holds (the newest, should one hold two).
+    std::map<std::string, LeaseRef> LeasesByWorker();
     // The sweep and chunk of a patch-group task; nullopt for a tile's.
     static std::optional<SweepTaskNumbering::SweepChunk> SweepChunkOf(const Job& job, int task);
     // The one way the scheduler moves a task or a job; an illegal move is a broken invariant.
@@ -303,6 +332,7 @@ class Scheduler {
     std::map<std::string, JobRecord> unrecorded_;  // ended while the store could not write
     LeaseTimeouts timeouts_;
     WorkerRegistry workers_;
+    SchedulerMetrics metrics_;
 };
 
 }  // namespace lf

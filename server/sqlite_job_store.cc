@@ -145,7 +145,9 @@ void SqliteJobStore::WriterLoop() {
         batch.swap(queue_);
         const uint64_t last = last_ticket_, first = last - batch.size() + 1;
         lock.unlock();
+        const absl::Time start = absl::Now();
         const absl::Status status = Commit(batch);
+        write_seconds_.Observe(absl::ToDoubleSeconds(absl::Now() - start));
         if (!status.ok()) {
             // Writes nobody waits for (leases) are lost here but for this line; the next write
             // of their job carries the state again.
@@ -157,6 +159,7 @@ void SqliteJobStore::WriterLoop() {
         }
         lock.lock();
         if (!status.ok()) failed_.emplace_back(first, last, status);
+        last_commit_ = status;
         durable_ = last;
         durable_cv_.notify_all();
     }
@@ -243,6 +246,32 @@ absl::Status SqliteJobStore::Migrate(sqlite3* db) {
     NamedLogger("store")->info("job store upgraded to version {}: {} jobs", kSchemaVersion,
                                rewrites.size());
     return absl::OkStatus();
+}
+
+absl::Status SqliteJobStore::Health() const {
+    {
+        std::lock_guard<std::mutex> lock(queue_mutex_);
+        if (!last_commit_.ok()) return last_commit_;
+    }
+    std::lock_guard<std::mutex> lock(db_mutex_);
+    Statement read(db_, "SELECT COUNT(*) FROM jobs WHERE seq < 0");
+    read.Step();
+    return read.status();
+}
+
+absl::StatusOr<std::map<JobState, int64_t>> SqliteJobStore::CountEnded() const {
+    std::lock_guard<std::mutex> lock(db_mutex_);
+    Statement count(db_,
+                    "SELECT json_extract(record, '$.state'), COUNT(*) FROM jobs WHERE final = 1"
+                    " GROUP BY 1");
+    std::map<JobState, int64_t> counts;
+    while (count.Step()) {
+        absl::StatusOr<JobState> state = JobStateFromName(count.Column(0));
+        if (!state.ok()) return state.status();
+        counts[*state] = count.ColumnInt(1);
+    }
+    if (!count.status().ok()) return count.status();
+    return counts;
 }
 
 absl::StatusOr<JobRecord> SqliteJobStore::Get(const std::string& id) const {

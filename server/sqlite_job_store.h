@@ -15,6 +15,7 @@
 #include <tuple>
 
 #include "server/job_store.h"
+#include "server/metrics.h"
 
 struct sqlite3;
 
@@ -35,6 +36,13 @@ class SqliteJobStore : public JobStore {
     absl::StatusOr<std::optional<std::string>> FindRequest(
         const std::string& request_id) const override;
     absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const override;
+
+    // For /healthz: Ok while the database answers a read and the last commit succeeded.
+    absl::Status Health() const;
+    // Ended jobs kept (see retention), by final state.
+    absl::StatusOr<std::map<JobState, int64_t>> CountEnded() const;
+    // Seconds of each commit of the writer thread: a transaction of queued writes and its sync.
+    const Histogram& write_seconds() const { return write_seconds_; }
 
   private:
     // A record to put, with the columns drawn from it; or, with `remove`, a job to delete.
@@ -61,13 +69,16 @@ class SqliteJobStore : public JobStore {
     mutable std::mutex db_mutex_;  // the connection: the writer's transaction or a read
     sqlite3* db_;
 
-    std::mutex queue_mutex_;
+    mutable std::mutex queue_mutex_;
     std::condition_variable queued_cv_, durable_cv_;
     std::deque<Write> queue_;
     uint64_t last_ticket_ = 0, durable_ = 0;  // tickets issued; committed (or failed) through
     std::vector<std::tuple<uint64_t, uint64_t, absl::Status>> failed_;  // (first, last, error)
     bool stop_ = false;
-    std::thread writer_;
+    absl::Status last_commit_;  // under queue_mutex_
+    Histogram write_seconds_{
+        {0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10}};
+    std::thread writer_;  // last: it starts in the constructor and uses the members above
 };
 
 }  // namespace lf

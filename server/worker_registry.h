@@ -1,21 +1,30 @@
 // The workers the scheduler has heard from lately, ordered by when each was last seen, so that
 // forgetting the silent ones is cheap and the live ones are counted without a scan: any id a
-// client makes up is kept only while it keeps calling.
+// client makes up is kept only while it keeps calling. Each keeps what it said of itself at its
+// last lease request (name, address, version), for `lightfarm workers`.
 #pragma once
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "absl/time/time.h"
 
 namespace lf {
+
+struct WorkerDescription {
+    std::string name;     // lightfarm-worker --name, by default its host name
+    std::string address;  // the peer of its last lease request, as gRPC names it
+    std::string version;  // its build (lf::kBuildVersion)
+};
 
 class WorkerRegistry {
   public:
     // A worker is live while it was seen less than `alive_for` ago (the lease).
     explicit WorkerRegistry(absl::Duration alive_for) : alive_for_(alive_for) {}
 
-    void Seen(const std::string& worker, absl::Time now);
+    // `about`, when given, replaces what the worker said of itself before.
+    void Seen(const std::string& worker, absl::Time now, const WorkerDescription* about = nullptr);
     // Forgets the workers not seen for `alive_for` by `now`; returns how many.
     int ForgetSilent(absl::Time now);
 
@@ -23,10 +32,23 @@ class WorkerRegistry {
     // The workers kept: after ForgetSilent(now), the ones live at `now`.
     size_t size() const { return by_worker_.size(); }
 
+    struct Entry {
+        std::string id;
+        WorkerDescription about;
+        absl::Time last_seen;
+    };
+    // The workers kept, by id.
+    std::vector<Entry> List() const;
+
   private:
+    using BySeen = std::multimap<absl::Time, std::string>;
+    struct Kept {
+        BySeen::iterator seen;
+        WorkerDescription about;
+    };
     const absl::Duration alive_for_;
-    std::multimap<absl::Time, std::string> by_seen_;
-    std::map<std::string, std::multimap<absl::Time, std::string>::iterator> by_worker_;
+    BySeen by_seen_;
+    std::map<std::string, Kept> by_worker_;
 };
 
 }  // namespace lf

@@ -14,7 +14,7 @@
 namespace lf {
 
 class BlobCache {
-public:
+  public:
     // Writes blob `hash` to the given path.
     using Fetch = std::function<absl::Status(const std::string& hash, const std::string& path)>;
 
@@ -31,7 +31,7 @@ public:
 
     uint64_t bytes() const { return bytes_; }
 
-private:
+  private:
     BlobCache(std::string dir, uint64_t max_bytes) : dir_(std::move(dir)), max_bytes_(max_bytes) {}
     std::string PathOf(const std::string& hash) const { return dir_ + "/" + hash; }
     void Touch(const std::string& hash, uint64_t size);

@@ -7,7 +7,10 @@
 #include <cstdio>
 #include <thread>
 
+#include "absl/strings/str_cat.h"
+#include "lf/core/log.h"
 #include "lf/core/stop_signals.h"
+#include "lf/job/worker_status.h"
 #include "proto/channel_flags.h"
 #include "worker/worker.h"
 
@@ -21,10 +24,20 @@ int main(int argc, char** argv) {
     std::string cache_dir = "/tmp/lightfarm-worker-cache";
     uint64_t cache_mb = 2048;
     std::string log_level = "info";
+    char host[256] = "worker";
+    gethostname(host, sizeof host - 1);
+    std::string name = host;
     app.add_option("--server", channel.address, "HOST:PORT of the server")
         ->envname("LIGHTFARM_SERVER")
         ->required();
     lf::AddChannelFlags(&app, &channel);
+    app.add_option("--name", name, "what `lightfarm workers` calls this worker")
+        ->capture_default_str()
+        ->check([](const std::string& n) {
+            return n.size() <= lf::kMaxWorkerNameBytes
+                       ? std::string()
+                       : absl::StrCat("at most ", lf::kMaxWorkerNameBytes, " bytes");
+        });
     bool check_config = false;
     app.add_flag("--check-config", check_config,
                  "check the options, the TLS and token files and the cache folder, print "
@@ -48,19 +61,17 @@ int main(int argc, char** argv) {
     absl::StatusOr<std::unique_ptr<lf::BlobCache>> cache =
         lf::BlobCache::Open(cache_dir + "/blobs", cache_mb << 20);
     if (!cache.ok()) return fail(cache.status());
-    char host[256] = "worker";
-    gethostname(host, sizeof host - 1);
     const std::string id = std::string(host) + "-" + std::to_string(::getpid());
     absl::StatusOr<std::unique_ptr<lf::ServerConnection>> connection =
-        lf::ServerConnection::Open(channel, id);
+        lf::ServerConnection::Open(channel, id, name);
     if (!connection.ok()) return fail(connection.status());
     if (check_config) {
         std::printf("config ok\n");
         return 0;
     }
     lf::Worker worker(options, **connection, **cache);
-    spdlog::info("worker={} serving {} with {} threads ({})", id, channel.address, options.threads,
-                 channel.tls_ca.empty() ? "no TLS" : "TLS");
+    spdlog::info("worker={} ({}) serving {} with {} threads ({})", id, lf::LogSafe(name),
+                 channel.address, options.threads, channel.tls_ca.empty() ? "no TLS" : "TLS");
 
     std::thread signal_waiter([&] {
         const int signal = stop_signals.Wait();

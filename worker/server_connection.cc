@@ -18,11 +18,11 @@ struct ServerConnection::Stub {
     std::unique_ptr<pb::WorkerService::Stub> stub;
 };
 
-ServerConnection::ServerConnection(std::string worker_id)
-    : worker_id_(std::move(worker_id)), stub_(std::make_unique<Stub>()) {}
+ServerConnection::ServerConnection(std::string worker_id, std::string name)
+    : worker_id_(std::move(worker_id)), name_(std::move(name)), stub_(std::make_unique<Stub>()) {}
 
 absl::StatusOr<std::unique_ptr<ServerConnection>> ServerConnection::Open(
-    const ChannelOptions& options, std::string worker_id) {
+    const ChannelOptions& options, std::string worker_id, std::string name) {
     grpc::ChannelArguments args;
     // gRPC's default reconnect backoff grows to two minutes; a restarted server should get its
     // workers back at once.
@@ -33,7 +33,8 @@ absl::StatusOr<std::unique_ptr<ServerConnection>> ServerConnection::Open(
     args.SetMaxSendMessageSize(kMaxTaskResultBytes);
     absl::StatusOr<std::shared_ptr<grpc::Channel>> channel = OpenChannel(options, args);
     if (!channel.ok()) return channel.status();
-    std::unique_ptr<ServerConnection> connection(new ServerConnection(std::move(worker_id)));
+    std::unique_ptr<ServerConnection> connection(
+        new ServerConnection(std::move(worker_id), std::move(name)));
     connection->stub_->stub = pb::WorkerService::NewStub(*channel);
     return connection;
 }
@@ -45,6 +46,7 @@ absl::StatusOr<std::optional<TaskAssignment>> ServerConnection::Lease(absl::Dura
     req.set_worker_id(worker_id_);
     req.set_wait_ms(int(absl::ToInt64Milliseconds(wait)));
     req.set_version(kBuildVersion);
+    req.set_name(name_);
     pb::LeaseTaskResponse resp;
     // Waiting for the connection (rather than failing at once while the channel is in
     // backoff) is what makes the channel reconnect as soon as a restarted server listens.

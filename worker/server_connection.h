@@ -19,8 +19,10 @@ class ServerConnection {
   public:
     // Connects lazily; after the server restarts, calls work again within about a second.
     // InvalidArgument or NotFound naming the flag for TLS or token files that cannot be used.
+    // `name` is for people (lightfarm workers); the server tells workers apart by `worker_id`.
     static absl::StatusOr<std::unique_ptr<ServerConnection>> Open(const ChannelOptions& options,
-                                                                  std::string worker_id);
+                                                                  std::string worker_id,
+                                                                  std::string name = "");
     ~ServerConnection();
 
     const std::string& worker_id() const { return worker_id_; }
@@ -44,8 +46,9 @@ class ServerConnection {
     absl::Status FetchBlob(const std::string& hash, const std::string& path);
 
   private:
-    explicit ServerConnection(std::string worker_id);
+    ServerConnection(std::string worker_id, std::string name);
     std::string worker_id_;
+    std::string name_;
     struct Stub;  // keeps gRPC headers out of the worker's other files
     std::unique_ptr<Stub> stub_;
 };

@@ -254,6 +254,17 @@ TaskAssignment FromProto(const pb::Task& t) {
     return task;
 }
 
+void ToProto(const WorkerStatus& worker, pb::WorkerInfo* out) {
+    out->set_id(worker.id);
+    out->set_name(worker.name);
+    out->set_address(worker.address);
+    out->set_version(worker.version);
+    out->set_state(worker.busy() ? pb::WorkerInfo::BUSY : pb::WorkerInfo::IDLE);
+    out->set_job_id(worker.job_id);
+    out->set_task_index(worker.task);
+    out->set_seconds_since_seen(absl::ToDoubleSeconds(worker.since_seen));
+}
+
 void ToProto(const RadiosityFigures& f, pb::RadiosityReport* out) {
     out->set_patches(f.patches);
     out->set_unknowns(f.unknowns);

@@ -103,6 +103,36 @@ TEST_F(SchedulerTest, HeartbeatsKeepALeaseAndSilenceLosesIt) {
     EXPECT_EQ(Job(id).tasks_running, 0);
 }
 
+TEST_F(SchedulerTest, WorkersShowTheirTaskWhileLeasedAndGoWhenSilent) {
+    const std::string id = Submit(0);
+    const WorkerDescription about{"render-07", "ipv4:10.0.0.7:40000", "v1"};
+    const TaskAssignment lease = *scheduler_.LeaseTask("a", absl::InfinitePast(), &about);
+    now_ += absl::Seconds(2);
+    std::vector<WorkerStatus> workers = scheduler_.Workers();
+    ASSERT_EQ(workers.size(), 1u);
+    EXPECT_EQ(workers[0].id, "a");
+    EXPECT_EQ(workers[0].name, "render-07");
+    EXPECT_EQ(workers[0].address, "ipv4:10.0.0.7:40000");
+    EXPECT_EQ(workers[0].version, "v1");
+    EXPECT_TRUE(workers[0].busy());
+    EXPECT_EQ(workers[0].job_id, id);
+    EXPECT_EQ(workers[0].task, lease.task.index);
+    EXPECT_EQ(workers[0].since_seen, absl::Seconds(2));
+    EXPECT_EQ(scheduler_.Load().workers_busy, 1);
+
+    ASSERT_TRUE(scheduler_.Complete(lease.lease_id, "a", Result(lease)).ok());
+    workers = scheduler_.Workers();
+    ASSERT_EQ(workers.size(), 1u);
+    EXPECT_FALSE(workers[0].busy());
+    EXPECT_EQ(workers[0].since_seen, absl::ZeroDuration());  // the result counts as heard from
+    EXPECT_EQ(scheduler_.Load().workers_busy, 0);
+    EXPECT_EQ(scheduler_.Load().workers_live, 1);
+
+    now_ += absl::Seconds(10);  // silent for a lease: forgotten
+    EXPECT_TRUE(scheduler_.Workers().empty());
+    EXPECT_EQ(scheduler_.Load().workers_live, 0);
+}
+
 TEST_F(SchedulerTest, RetriedTaskGoesToAnotherWorkerWhenThereIsOne) {
     Submit(0);
     const TaskAssignment lease = *scheduler_.LeaseTask("a");

@@ -31,10 +31,12 @@ class WorkerVersionTest : public ::testing::Test {
         ASSERT_TRUE(farm.ok()) << farm.status();
         farm_ = std::move(*farm);
         service_ = std::make_unique<WorkerServiceImpl>(*farm_, CallGuard{*auth_});
+        jobs_ = std::make_unique<JobServiceImpl>(*farm_, CallGuard{*auth_});
         grpc::ServerBuilder builder;
         int port = 0;
         builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
         builder.RegisterService(service_.get());
+        builder.RegisterService(jobs_.get());
         server_ = builder.BuildAndStart();
         ASSERT_TRUE(server_ && port > 0);
         address_ = "127.0.0.1:" + std::to_string(port);
@@ -48,10 +50,11 @@ class WorkerVersionTest : public ::testing::Test {
         fs::remove_all(dir_);
     }
 
-    grpc::Status Lease(const std::string& version) {
+    grpc::Status Lease(const std::string& version, const std::string& name = "") {
         pb::LeaseTaskRequest request;
         request.set_worker_id("w");
         request.set_version(version);
+        request.set_name(name);
         pb::LeaseTaskResponse response;
         grpc::ClientContext context;
         context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
@@ -63,6 +66,7 @@ class WorkerVersionTest : public ::testing::Test {
     std::unique_ptr<Farm> farm_;
     std::unique_ptr<Authenticator> auth_ = Authenticator::Off();
     std::unique_ptr<WorkerServiceImpl> service_;
+    std::unique_ptr<JobServiceImpl> jobs_;
     std::unique_ptr<grpc::Server> server_;
     std::string address_;
     std::unique_ptr<pb::WorkerService::Stub> stub_;
@@ -93,6 +97,34 @@ TEST_F(WorkerVersionTest, WorkerOfThisBuildIsServed) {
     const absl::StatusOr<std::optional<TaskAssignment>> lease =
         (*connection)->Lease(absl::Milliseconds(10));
     EXPECT_TRUE(lease.ok()) << lease.status();
+}
+
+TEST_F(WorkerVersionTest, ServedWorkerIsListedWithItsNameAddressAndVersion) {
+    absl::StatusOr<std::unique_ptr<ServerConnection>> connection =
+        ServerConnection::Open({.address = address_}, "real-worker", "render-07");
+    ASSERT_TRUE(connection.ok()) << connection.status();
+    ASSERT_TRUE((*connection)->Lease(absl::Milliseconds(10)).ok());
+    const auto jobs =
+        pb::JobService::NewStub(grpc::CreateChannel(address_, grpc::InsecureChannelCredentials()));
+    pb::ListWorkersResponse listed;
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(30));
+    ASSERT_TRUE(jobs->ListWorkers(&context, pb::ListWorkersRequest(), &listed).ok());
+    ASSERT_EQ(listed.workers_size(), 1);
+    const pb::WorkerInfo& w = listed.workers(0);
+    EXPECT_EQ(w.id(), "real-worker");
+    EXPECT_EQ(w.name(), "render-07");
+    EXPECT_EQ(w.address().rfind("ipv4:127.0.0.1:", 0), 0u) << w.address();
+    EXPECT_EQ(w.version(), kBuildVersion);
+    EXPECT_EQ(w.state(), pb::WorkerInfo::IDLE);  // nothing to lease
+    EXPECT_GE(w.seconds_since_seen(), 0);
+    EXPECT_LT(w.seconds_since_seen(), 30);
+}
+
+TEST_F(WorkerVersionTest, WorkerNameAboveTheLimitIsRefused) {
+    const grpc::Status s = Lease(kBuildVersion, std::string(kMaxWorkerNameBytes + 1, 'n'));
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_TRUE(Lease(kBuildVersion, std::string(kMaxWorkerNameBytes, 'n')).ok());
 }
 
 // A server of another build: every lease is refused. The worker keeps asking (with backoff)

@@ -1,0 +1,159 @@
+// lightfarm-server --http: the /metrics and /healthz handlers against a real Farm in a temporary
+// data folder (the counts follow a submission, a lease and a result), and the listener itself on
+// a port the OS picks, and refusing a port in use.
+#include "server/http_listener.h"
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "lf/core/film.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+
+class HttpListenerTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("lf_http_" + std::to_string(::getpid()));
+        fs::remove_all(dir_);
+        FarmOptions options;
+        options.data_dir = dir_.string();
+        absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
+        ASSERT_TRUE(farm.ok()) << farm.status();
+        farm_ = std::move(*farm);
+    }
+    void TearDown() override {
+        farm_.reset();
+        fs::remove_all(dir_);
+    }
+
+    // A 16x16 image in 8x8 tiles, 4 spp in 2 passes: 8 tasks.
+    std::string Submit() {
+        JobSpec spec;
+        spec.name = "metrics";
+        spec.plan = {16, 16, 4, 8, 2};
+        absl::StatusOr<std::string> id = farm_->scheduler().Submit(spec);
+        EXPECT_TRUE(id.ok()) << id.status();
+        return *id;
+    }
+
+    std::string Metrics() {
+        const HttpAnswer answer = MetricsAnswer(*farm_);
+        EXPECT_EQ(answer.status, 200) << answer.body;
+        EXPECT_EQ(answer.content_type, "text/plain; version=0.0.4; charset=utf-8");
+        return answer.body;
+    }
+
+    static bool Has(const std::string& text, const std::string& line) {
+        return text.find("\n" + line + "\n") != std::string::npos;
+    }
+
+    fs::path dir_;
+    std::unique_ptr<Farm> farm_;
+};
+
+TEST_F(HttpListenerTest, MetricsFollowSubmissionLeaseAndResult) {
+    std::string text = Metrics();
+    for (const char* line :
+         {"lightfarm_jobs{state=\"queued\"} 0", "lightfarm_tasks{state=\"queued\"} 0",
+          "lightfarm_workers{state=\"live\"} 0", "lightfarm_queue_depth 0",
+          "lightfarm_leases_total 0", "lightfarm_task_failures_total 0",
+          "lightfarm_task_duration_seconds_count 0",
+          "# TYPE lightfarm_store_write_seconds histogram", "# TYPE lightfarm_jobs gauge",
+          "# TYPE lightfarm_leases_total counter"}) {
+        EXPECT_TRUE(Has(text, line)) << line << " not in\n" << text;
+    }
+
+    const std::string job = Submit();
+    text = Metrics();
+    EXPECT_TRUE(Has(text, "lightfarm_jobs{state=\"queued\"} 1")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_tasks{state=\"queued\"} 8")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_queue_depth 8")) << text;
+    // The submission was committed before it was acknowledged.
+    EXPECT_FALSE(Has(text, "lightfarm_store_write_seconds_count 0")) << text;
+
+    const WorkerDescription about{"render-07", "ipv4:10.0.0.7:5000", "v"};
+    std::optional<TaskAssignment> lease =
+        farm_->scheduler().LeaseTask("w1", absl::InfinitePast(), &about);
+    ASSERT_TRUE(lease);
+    farm_->scheduler().LeaseTask("w2");  // a second worker, busy too
+    ASSERT_TRUE(
+        farm_->scheduler().Fail(lease->lease_id, "w1", "boom", FailureKind::kTaskError).ok());
+    text = Metrics();
+    EXPECT_TRUE(Has(text, "lightfarm_jobs{state=\"running\"} 1")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_jobs{state=\"queued\"} 0")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_tasks{state=\"queued\"} 7")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_tasks{state=\"running\"} 1")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_workers{state=\"live\"} 2")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_workers{state=\"busy\"} 1")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_workers{state=\"idle\"} 1")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_leases_total 2")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_task_failures_total 1")) << text;
+
+    lease = farm_->scheduler().LeaseTask("w1");
+    ASSERT_TRUE(lease);
+    TileSums sums(lease->task.rect);
+    for (PixelSums& p : sums.pixels) {
+        for (uint64_t s = lease->task.sample_begin; s < lease->task.sample_end; ++s) {
+            p.Add(s, Rgb(0.5f));
+        }
+    }
+    ASSERT_TRUE(farm_->scheduler().Complete(lease->lease_id, "w1", sums).ok());
+    text = Metrics();
+    EXPECT_TRUE(Has(text, "lightfarm_task_duration_seconds_count 1")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_leases_total 3")) << text;
+
+    ASSERT_TRUE(farm_->scheduler().Cancel(job).ok());
+    text = Metrics();
+    EXPECT_TRUE(Has(text, "lightfarm_jobs{state=\"cancelled\"} 1")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_jobs{state=\"running\"} 0")) << text;
+    EXPECT_TRUE(Has(text, "lightfarm_tasks{state=\"queued\"} 0")) << text;
+}
+
+TEST_F(HttpListenerTest, HealthzIsOkWhileTheStoreIsUsable) {
+    const HttpAnswer answer = HealthzAnswer(*farm_);
+    EXPECT_EQ(answer.status, 200);
+    EXPECT_EQ(answer.body, "ok\n");
+}
+
+TEST_F(HttpListenerTest, ListensOnAPortTheSystemPicksAndRefusesATakenOne) {
+    absl::StatusOr<std::unique_ptr<HttpListener>> listener =
+        HttpListener::Start("127.0.0.1:0", *farm_);
+    ASSERT_TRUE(listener.ok()) << listener.status();
+    const int port = (*listener)->port();
+    ASSERT_GT(port, 0);
+
+    httplib::Client client("127.0.0.1", port);
+    client.set_connection_timeout(5);
+    httplib::Result healthz = client.Get("/healthz");
+    ASSERT_TRUE(healthz) << httplib::to_string(healthz.error());
+    EXPECT_EQ(healthz->status, 200);
+    EXPECT_EQ(healthz->body, "ok\n");
+    httplib::Result metrics = client.Get("/metrics");
+    ASSERT_TRUE(metrics);
+    EXPECT_NE(metrics->body.find("# TYPE lightfarm_queue_depth gauge"), std::string::npos);
+    EXPECT_EQ(client.Get("/nothing")->status, 404);
+
+    const std::string taken = "127.0.0.1:" + std::to_string(port);
+    absl::StatusOr<std::unique_ptr<HttpListener>> second = HttpListener::Start(taken, *farm_);
+    ASSERT_FALSE(second.ok());
+    EXPECT_EQ(second.status().code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_NE(second.status().message().find("cannot listen on " + taken + " for --http"),
+              std::string::npos)
+        << second.status();
+}
+
+TEST_F(HttpListenerTest, RefusesAnAddressWithoutAPort) {
+    EXPECT_EQ(HttpListener::Start("localhost", *farm_).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(HttpListener::Start("localhost:http", *farm_).status().code(),
+              absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace lf
