@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
@@ -119,6 +120,15 @@ std::unique_ptr<pb::JobService::Stub> Connect(const FarmFlags& flags) {
 
 // The server's own words, with where it was asked when it could not be reached.
 absl::Status CallStatus(const grpc::Status& s, const FarmFlags& flags) {
+    // gRPC reports a TLS handshake that failed on a certificate or on a plain-text peer as
+    // UNAVAILABLE, like a server that is down; retrying cannot help, so it is said at once.
+    if (s.error_code() == grpc::StatusCode::UNAVAILABLE &&
+        absl::StrContains(s.error_message(), "SSL_ERROR_SSL")) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "TLS handshake with server ", flags.channel.address, " failed (", s.error_message(),
+            "): check --tls-ca, the server's certificate names, and --tls-cert/--tls-key if the "
+            "server asks for client certificates"));
+    }
     if (s.error_code() == grpc::StatusCode::UNAVAILABLE) {
         return absl::UnavailableError(
             absl::StrCat("server ", flags.channel.address, " not reachable: ", s.error_message()));
@@ -355,8 +365,8 @@ absl::StatusOr<pb::Job> Watch(const FarmFlags& flags, const std::string& id, Pro
         }
         const grpc::Status s = reader->Finish();
         if (s.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED) continue;
-        if (s.error_code() == grpc::StatusCode::UNAVAILABLE &&
-            backoff.Wait("watch " + id, CallStatus(s, flags))) {
+        if (const absl::Status status = CallStatus(s, flags);
+            absl::IsUnavailable(status) && backoff.Wait("watch " + id, status)) {
             stub = Connect(flags);
             continue;
         }
