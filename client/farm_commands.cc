@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "absl/strings/ascii.h"
@@ -175,8 +176,35 @@ struct LocalFile {
     pb::SceneFile ref;
 };
 
+// Uploads whose bytes add up to this show a progress bar (on a terminal).
+constexpr uint64_t kProgressBarBytes = uint64_t(16) << 20;
+
+// Sends what the server lacks of one blob: from where its bytes end (BlobUploadOffset), so an
+// upload that broke resumes instead of starting over. `sent` counts the bytes the server holds
+// of the blobs uploaded so far, of `total`, for `bar` (null: no bar).
 absl::Status Upload(pb::JobService::Stub& stub, const LocalFile& file, const std::string& content,
-                    const FarmFlags& flags) {
+                    const FarmFlags& flags, uint64_t& sent, uint64_t total, ProgressBar* bar) {
+    auto failed = [&](const absl::Status& s) {
+        return absl::Status(s.code(), absl::StrCat(file.ref.path(), ": upload: ", s.message()));
+    };
+    pb::BlobUploadOffsetRequest where;
+    where.set_hash(file.ref.hash());
+    where.set_size(file.ref.size());
+    pb::BlobUploadOffsetResponse held;
+    const grpc::Status asked =
+        stub.BlobUploadOffset(ContextWithDeadline(absl::Seconds(10)).get(), where, &held);
+    // A server of an earlier version, without the call, takes whole uploads only.
+    if (!asked.ok() && asked.error_code() != grpc::StatusCode::UNIMPLEMENTED) {
+        return failed(CallStatus(asked, flags));
+    }
+    const size_t offset = std::min<uint64_t>(held.offset(), content.size());
+    if (offset > 0 && offset < content.size()) {
+        std::fprintf(stderr, "lightfarm: %s: the server holds %zu of %zu bytes; sending the rest\n",
+                     file.ref.path().c_str(), offset, content.size());
+    }
+    sent += offset;
+    if (offset == content.size()) return absl::OkStatus();
+
     const auto context = ContextWithDeadline(absl::Minutes(10));
     pb::UploadBlobResponse response;
     std::unique_ptr<grpc::ClientWriter<pb::UploadBlobRequest>> writer =
@@ -184,19 +212,21 @@ absl::Status Upload(pb::JobService::Stub& stub, const LocalFile& file, const std
     pb::UploadBlobRequest chunk;
     chunk.set_hash(file.ref.hash());
     chunk.set_size(file.ref.size());
-    size_t offset = 0;
+    chunk.set_offset(offset);
+    size_t at = offset;
     do {
-        const size_t n = std::min(kChunkBytes, content.size() - offset);
-        chunk.set_data(content.data() + offset, n);
-        offset += n;
+        const size_t n = std::min(kChunkBytes, content.size() - at);
+        chunk.set_data(content.data() + at, n);
         if (!writer->Write(chunk)) break;
+        at += n;
+        sent += n;
+        if (bar) bar->Update(sent, total);
         chunk.clear_hash();
         chunk.clear_size();
-    } while (offset < content.size());
+        chunk.clear_offset();
+    } while (at < content.size());
     writer->WritesDone();
-    if (absl::Status s = CallStatus(writer->Finish(), flags); !s.ok()) {
-        return absl::Status(s.code(), absl::StrCat(file.ref.path(), ": upload: ", s.message()));
-    }
+    if (absl::Status s = CallStatus(writer->Finish(), flags); !s.ok()) return failed(s);
     return absl::OkStatus();
 }
 
@@ -214,13 +244,27 @@ absl::StatusOr<std::string> SubmitOnce(pb::JobService::Stub& stub, const FarmFla
         !s.ok()) {
         return s;
     }
+    std::vector<const LocalFile*> uploads;
+    uint64_t total = 0, sent = 0;
     for (const std::string& hash : missing.hashes()) {
         for (const LocalFile& f : files) {
             if (f.ref.hash() != hash) continue;
-            if (absl::Status s = Upload(stub, f, contents.at(hash), flags); !s.ok()) return s;
+            uploads.push_back(&f);
+            total += f.ref.size();
             break;
         }
     }
+    std::optional<ProgressBar> bar;
+    if (total >= kProgressBarBytes) bar.emplace("upload");
+    for (const LocalFile* f : uploads) {
+        const absl::Status s =
+            Upload(stub, *f, contents.at(f->ref.hash()), flags, sent, total, bar ? &*bar : nullptr);
+        if (!s.ok()) {
+            if (bar) bar->Finish();  // the bar's line ends before the error's
+            return s;
+        }
+    }
+    if (bar) bar->Finish();
 
     pb::SubmitJobResponse resp;
     // The server loads the scene to check it, which takes a while for large meshes.
@@ -283,7 +327,10 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     Backoff backoff(o.farm);
     while (true) {
         absl::StatusOr<std::string> id = SubmitOnce(*Connect(o.farm), o.farm, files, contents, req);
-        if (!absl::IsUnavailable(id.status()) || !backoff.Wait("submit", id.status())) {
+        // Aborted: another client was uploading one of the blobs; the retry resumes from its
+        // bytes, or finds the blob stored.
+        const bool transient = absl::IsUnavailable(id.status()) || absl::IsAborted(id.status());
+        if (!transient || !backoff.Wait("submit", id.status())) {
             return id;
         }
     }

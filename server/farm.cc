@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <set>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
@@ -81,9 +82,10 @@ absl::Status Farm::CheckSceneSize(uint64_t bytes) const {
 }
 
 absl::StatusOr<std::unique_ptr<BlobStore::Upload>> Farm::StartUpload(const std::string& hash,
-                                                                     uint64_t size) {
+                                                                     uint64_t size,
+                                                                     uint64_t offset) {
     if (absl::Status s = CheckSceneSize(size); !s.ok()) return s;
-    return blobs_->StartUpload(hash, size);
+    return blobs_->StartUpload(hash, size, offset);
 }
 
 absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
@@ -109,6 +111,7 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
             absl::StrCat(spec.plan.spp, " samples per pixel is above this server's limit of ",
                          options_.limits.max_spp, " (lightfarm-server --max-spp)"));
     }
+    std::shared_lock<std::shared_mutex> blobs_in_use(blob_users_);
     for (const BlobRef* ref : refs) {
         if (absl::Status s = CheckScenePath(ref->path); !s.ok()) return s;
         if (!blobs_->Has(ref->hash)) {
@@ -334,15 +337,38 @@ absl::Status Farm::DeleteJob(const std::string& job_id) {
     }
     if (absl::Status s = store_->Delete(job_id); !s.ok()) return s;
     RemoveJobFiles(job_id);
+    // The job is gone either way: a blob left now goes at the next hourly sweep.
+    if (absl::StatusOr<BlobStore::Removed> removed = RemoveUnusedBlobs(absl::Now());
+        !removed.ok()) {
+        Log()->error("job={} deleted; its blobs stay: {}", job_id,
+                     std::string(removed.status().message()));
+    }
     return absl::OkStatus();
 }
 
+absl::StatusOr<BlobStore::Removed> Farm::RemoveUnusedBlobs(absl::Time now) {
+    std::unique_lock<std::shared_mutex> no_submission(blob_users_);
+    std::set<std::string> used = scheduler_.BlobsInUse();
+    absl::StatusOr<std::vector<JobRecord>> stored = store_->List();
+    if (!stored.ok()) return stored.status();
+    for (const JobRecord& job : *stored) {
+        used.insert(job.spec.scene.hash);
+        for (const BlobRef& file : job.spec.files) used.insert(file.hash);
+    }
+    const BlobStore::Removed removed =
+        blobs_->RemoveUnused(used, now - kUnusedBlobGrace, now - kPartialUploadLifetime);
+    if (removed.blobs > 0 || removed.partials > 0) {
+        Log()->info("removed {} blobs no job uses ({} bytes) and {} stale partial uploads",
+                    removed.blobs, removed.blob_bytes, removed.partials);
+    }
+    return removed;
+}
+
 absl::StatusOr<int> Farm::DeleteExpired(absl::Time now) {
-    if (options_.retention <= absl::ZeroDuration()) return 0;
     // In pages, so that a long-idle server does not load every expired job at once.
     constexpr size_t kPage = 1000;
     int deleted = 0;
-    while (true) {
+    while (options_.retention > absl::ZeroDuration()) {
         absl::StatusOr<std::vector<JobRecord>> expired =
             store_->List({.limit = kPage, .ended_before = now - options_.retention});
         if (!expired.ok()) return expired.status();
@@ -356,6 +382,9 @@ absl::StatusOr<int> Farm::DeleteExpired(absl::Time now) {
     if (deleted > 0) {
         Log()->info("deleted {} jobs that ended more than {} ago", deleted,
                     absl::FormatDuration(options_.retention));
+    }
+    if (absl::StatusOr<BlobStore::Removed> removed = RemoveUnusedBlobs(now); !removed.ok()) {
+        return removed.status();
     }
     return deleted;
 }

@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <shared_mutex>
 #include <string>
 #include <string_view>
 
@@ -33,6 +34,12 @@ struct JobLimits {
 constexpr size_t kMaxJobNameBytes = 256;
 constexpr size_t kMaxRequestIdBytes = 128;
 
+// A blob no job names is kept this long after it was uploaded, or last found stored by
+// MissingBlobs or BlobUploadOffset: its client may be about to submit the job that names it.
+constexpr absl::Duration kUnusedBlobGrace = absl::Hours(1);
+// A partial upload not written for this long is given up and removed.
+constexpr absl::Duration kPartialUploadLifetime = absl::Hours(24);
+
 struct FarmOptions {
     std::string data_dir;  // jobs.db, blobs/, results/, previews/, scratch/ go here
     SchedulerOptions scheduler;
@@ -54,9 +61,11 @@ class Farm {
     // job. ResourceExhausted, naming the limit, for a job above the limits.
     absl::StatusOr<std::string> Submit(JobSpec spec);
 
-    // A blob upload, refused when the blob alone is above the scene size limit.
+    // A blob upload from byte `offset` (BlobStore::StartUpload), refused when the blob alone is
+    // above the scene size limit.
     absl::StatusOr<std::unique_ptr<BlobStore::Upload>> StartUpload(const std::string& hash,
-                                                                   uint64_t size);
+                                                                   uint64_t size,
+                                                                   uint64_t offset = 0);
 
     // Decodes and merges a task's result; writes the job's EXR when it was the last one.
     // `radiosity`: what the worker's radiosity solve reported, for that EXR's header. `splats`:
@@ -81,11 +90,16 @@ class Farm {
     // completes them).
     void CheckTimers();
 
-    // Removes an ended job: its record, task results, result and preview files.
-    // FailedPrecondition for a job that has not ended.
+    // Removes an ended job: its record, task results, result and preview files, and the blobs
+    // no other job uses (RemoveUnusedBlobs). FailedPrecondition for a job that has not ended.
     absl::Status DeleteJob(const std::string& job_id);
-    // Deletes the jobs that ended more than options().retention before `now`; returns how many.
+    // Deletes the jobs that ended more than options().retention before `now`, then removes
+    // unused blobs and stale partial uploads (RemoveUnusedBlobs); returns how many jobs.
     absl::StatusOr<int> DeleteExpired(absl::Time now);
+    // Removes the blobs that no job in the store or in memory names or reads (radiosity sweeps)
+    // and that were not uploaded or found stored within kUnusedBlobGrace before `now`, and the
+    // partial uploads not written within kPartialUploadLifetime.
+    absl::StatusOr<BlobStore::Removed> RemoveUnusedBlobs(absl::Time now);
 
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }
@@ -124,6 +138,9 @@ class Farm {
     std::map<std::string, RadiosityFigures> radiosity_;      // by job id
     std::map<std::string, SweepSolveFigures> sweep_solves_;  // by job id
     std::unique_ptr<BlobStore> blobs_;
+    // Shared by a submission from its blob checks until its job is held by the scheduler, and
+    // taken alone by RemoveUnusedBlobs, so that no blob goes between the two.
+    std::shared_mutex blob_users_;
     std::unique_ptr<SqliteJobStore> store_;
     Scheduler scheduler_;
     std::mutex image_mutex_;

@@ -93,8 +93,21 @@ grpc::Status JobServiceImpl::MissingBlobs(grpc::ServerContext* context,
         return ToGrpcStatus(c.status());
     }
     for (const std::string& hash : req->hashes()) {
-        if (!farm_.blobs().Has(hash)) resp->add_hashes(hash);
+        // Touched: the client will not upload it, and may submit a job naming it.
+        if (!farm_.blobs().Touch(hash)) resp->add_hashes(hash);
     }
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::BlobUploadOffset(grpc::ServerContext* context,
+                                              const pb::BlobUploadOffsetRequest* req,
+                                              pb::BlobUploadOffsetResponse* resp) {
+    if (auto c = guard_.Check(context, "BlobUploadOffset", Action::kUploadBlobs); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    absl::StatusOr<uint64_t> offset = farm_.blobs().UploadOffset(req->hash(), req->size());
+    if (!offset.ok()) return ToGrpcStatus(offset.status());
+    resp->set_offset(*offset);
     return grpc::Status::OK;
 }
 
@@ -108,13 +121,35 @@ grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext* context,
     if (!reader->Read(&chunk)) {
         return ToGrpcStatus(absl::InvalidArgumentError("UploadBlob: empty stream"));
     }
+    const std::string hash = LogSafe(chunk.hash());
     absl::StatusOr<std::unique_ptr<BlobStore::Upload>> upload =
-        farm_.StartUpload(chunk.hash(), chunk.size());
-    if (!upload.ok()) return ToGrpcStatus(upload.status());
+        farm_.StartUpload(chunk.hash(), chunk.size(), chunk.offset());
+    // Another stream stored it meanwhile: what this one brings is not needed.
+    if (absl::IsAlreadyExists(upload.status())) return grpc::Status::OK;
+    if (!upload.ok()) {
+        Log()->warn("blob {}: upload from {} refused: {}", hash, Peer(context),
+                    LogSafe(std::string(upload.status().message())));
+        return ToGrpcStatus(upload.status());
+    }
+    BlobStore::Upload& up = **upload;
+    if (up.offset() > 0) {
+        Log()->info("blob {}: upload from {} resumes at byte {} of {}", hash, Peer(context),
+                    up.offset(), chunk.size());
+    }
+    absl::Status s;
     do {
-        if (absl::Status s = (*upload)->Append(chunk.data()); !s.ok()) return ToGrpcStatus(s);
-    } while (reader->Read(&chunk));
-    return ToGrpcStatus((*upload)->Finish());
+        s = up.Append(chunk.data());
+    } while (s.ok() && reader->Read(&chunk));
+    if (s.ok()) s = up.Finish();
+    if (s.ok()) {
+        Log()->info("blob {}: stored, {} bytes, {} of them received from {} in this upload", hash,
+                    up.offset() + up.received(), up.received(), Peer(context));
+    } else {
+        Log()->warn("blob {}: upload from {} ended after {} bytes received (from byte {}): {}",
+                    hash, Peer(context), up.received(), up.offset(),
+                    LogSafe(std::string(s.message())));
+    }
+    return ToGrpcStatus(s);
 }
 
 grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,

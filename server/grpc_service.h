@@ -42,6 +42,9 @@ class JobServiceImpl final : public lightfarm::v1::JobService::Service {
 
     grpc::Status MissingBlobs(grpc::ServerContext*, const lightfarm::v1::MissingBlobsRequest*,
                               lightfarm::v1::MissingBlobsResponse*) override;
+    grpc::Status BlobUploadOffset(grpc::ServerContext*,
+                                  const lightfarm::v1::BlobUploadOffsetRequest*,
+                                  lightfarm::v1::BlobUploadOffsetResponse*) override;
     grpc::Status UploadBlob(grpc::ServerContext*,
                             grpc::ServerReader<lightfarm::v1::UploadBlobRequest>*,
                             lightfarm::v1::UploadBlobResponse*) override;

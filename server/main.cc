@@ -13,6 +13,7 @@
 #include "server/grpc_service.h"
 #include "server/http_listener.h"
 #include "server/listen_policy.h"
+#include "server/retention_flag.h"
 #include "server/server_credentials.h"
 #include "server/timeout_checker.h"
 #include "server/token_command.h"
@@ -67,11 +68,22 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     double retention_days = 30;
-    app.add_option("--retention-days", retention_days,
-                   "ended jobs older than this are deleted, with their results; 0 keeps them "
-                   "forever")
-        ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+    CLI::Option* days_option =
+        app.add_option("--retention-days", retention_days,
+                       "ended jobs older than this are deleted, with their results; 0 keeps "
+                       "them forever")
+            ->capture_default_str()
+            ->check(CLI::NonNegativeNumber);
+    std::string retention_text;
+    app.add_option("--retention", retention_text,
+                   "as --retention-days, as a duration: 7d, 12h, 30m, 1d12h; 0 keeps them forever")
+        ->excludes(days_option)
+        ->check(CLI::Validator(
+            [](std::string& text) {
+                absl::StatusOr<absl::Duration> d = lf::ParseRetention(text);
+                return d.ok() ? std::string() : std::string(d.status().message());
+            },
+            "DURATION"));
     lf::JobServiceOptions service_options;
     app.add_option("--max-watchers", service_options.max_watchers,
                    "most WatchJob streams open at once (each holds a thread); more are refused")
@@ -116,7 +128,8 @@ int main(int argc, char** argv) {
     options.scheduler.lease = absl::Seconds(lease_seconds);
     options.scheduler.speculate_after = absl::Seconds(speculate_seconds);
     options.limits.max_scene_bytes = max_scene_mb << 20;
-    options.retention = absl::Hours(24 * retention_days);
+    options.retention = retention_text.empty() ? absl::Hours(24 * retention_days)
+                                               : *lf::ParseRetention(retention_text);
     // Often enough that a cancel reaches workers within about a second, and several times per
     // lease so one slow answer does not lose it.
     options.scheduler.heartbeat_interval =

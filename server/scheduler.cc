@@ -250,6 +250,24 @@ absl::StatusOr<std::vector<JobRecord>> Scheduler::List(const JobQuery& query) co
     return jobs;
 }
 
+std::set<std::string> Scheduler::BlobsInUse() const {
+    std::set<std::string> hashes;
+    auto add_spec = [&](const JobRecord& record) {
+        hashes.insert(record.spec.scene.hash);
+        for (const BlobRef& file : record.spec.files) hashes.insert(file.hash);
+    };
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [id, job] : active_) {
+        add_spec(job->record);
+        for (const std::string* hash : {&job->sweep_input, &job->solution}) {
+            if (!hash->empty()) hashes.insert(*hash);
+        }
+    }
+    for (const auto& [id, ending] : ending_) add_spec(ending.record);
+    for (const auto& [id, record] : unrecorded_) add_spec(record);
+    return hashes;
+}
+
 size_t Scheduler::workers_tracked() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return workers_.size();

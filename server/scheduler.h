@@ -177,6 +177,10 @@ class Scheduler {
     // The jobs the query selects from the store, running ones as they are now.
     absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const;
 
+    // The blobs the jobs held in memory read (queued, running, or ended and not yet recorded):
+    // their scenes' files and the radiosity sweeps' inputs and solutions.
+    std::set<std::string> BlobsInUse() const;
+
     // Blocks until some job changed after `version` was current, or `deadline`, or Shutdown.
     // Returns the version now.
     uint64_t WaitForChange(uint64_t version, absl::Time deadline);

@@ -25,6 +25,7 @@
 #include <thread>
 #include <vector>
 
+#include "cutting_proxy.h"
 #include "gltf_files.h"
 #include "image_files.h"
 #include "lf/core/image_io.h"
@@ -1055,6 +1056,74 @@ TEST_F(Farm, TexturedGltfSceneGivesTheLocalPixels) {
     for (const std::string& hash : files.hashes) EXPECT_TRUE(blobs.count(hash)) << hash;
     const std::string unrelated = Sha256Hex(ReadText(dir_ / "gltf" / "unrelated.png"));
     EXPECT_FALSE(blobs.count(unrelated));
+}
+
+TEST_F(Farm, BrokenUploadResumesWhereTheServersBytesEndAndTheJobRenders) {
+    StartServer();
+    StartWorker("w1");
+    // A texture of 24 MB that costs nothing to decode: a 2x2 PNG, then bytes a PNG reader
+    // never reads (past IEND). The test is about the upload, not the image.
+    fs::create_directories(dir_ / "big");
+    std::string png = testing::PngBytes(2, 2, 4, testing::TestTexels());
+    std::mt19937 random(16);
+    std::string junk(24 << 20, '\0');
+    for (char& c : junk) c = char(random());
+    png += junk;
+    std::ofstream(dir_ / "big" / "tex.png", std::ios::binary) << png;
+    std::ofstream(dir_ / "big" / "quad.obj") << testing::TexturedTestQuadObj();
+    std::ofstream(dir_ / "big" / "scene.json") << testing::TexturedTestSceneJson();
+    const std::string scene = (dir_ / "big" / "scene.json").string();
+    const fs::path partial =
+        dir_ / "data" / "blobs" / "partial" / (Sha256Hex(png) + "-" + std::to_string(png.size()));
+    const fs::path server_log = dir_ / "server-1.log";
+
+    testing::CuttingProxy proxy(std::stoi(address_.substr(address_.rfind(':') + 1)));
+    const std::string via = " --server 127.0.0.1:" + std::to_string(proxy.port());
+    const std::string settings = " --spp 4 --tile 16 --resolution 48x32";
+
+    // The connection drops 8 MB into the upload, and this submit does not retry: it fails, and
+    // the server keeps the bytes that arrived.
+    proxy.CutNextAfter(8 << 20);
+    const CliRun first = Lightfarm("submit " + scene + settings + via + " --retry-seconds 0");
+    EXPECT_NE(first.status, 0);
+    EXPECT_NE(first.err.find("tex.png: upload"), std::string::npos) << first.err;
+    ASSERT_EQ(proxy.connections_cut(), 1);
+    ASSERT_TRUE(WaitForText(server_log, "upload from", milliseconds(10000)));
+    ASSERT_TRUE(WaitForText(server_log, "ended after", milliseconds(10000)));
+    const uint64_t held = fs::file_size(partial);
+    EXPECT_GT(held, uint64_t(1) << 20);
+    EXPECT_LT(held, png.size());
+
+    // A second submit: its first connection drops 8 MB later too, and it retries by itself.
+    // Each attempt asks the server where its bytes end and sends only the rest.
+    proxy.CutNextAfter(8 << 20);
+    const CliRun second = Lightfarm("submit " + scene + settings + via);
+    ASSERT_EQ(second.status, 0) << second.err;
+    EXPECT_EQ(proxy.connections_cut(), 2);
+    EXPECT_NE(second.err.find("tex.png: the server holds"), std::string::npos) << second.err;
+    // Both attempts resumed: at the bytes the first submit left, then at those the cut attempt
+    // added. What a cut connection had sent but the server had not read yet (socket buffers,
+    // HTTP/2 windows) is sent again, as no client can know of it.
+    const std::string log = ReadText(server_log);
+    std::vector<uint64_t> resumed_at;
+    const std::string resumes = "resumes at byte ";
+    for (size_t at = log.find(resumes); at != std::string::npos; at = log.find(resumes, at + 1)) {
+        resumed_at.push_back(std::stoull(log.substr(at + resumes.size())));
+    }
+    ASSERT_EQ(resumed_at.size(), 2u) << log;
+    EXPECT_EQ(resumed_at[0], held);
+    EXPECT_GT(resumed_at[1], held);
+    // The last attempt sent the rest and no more, but for the scene's small files, the calls
+    // and their framing (a restart would send all 24 MB).
+    const uint64_t rest = png.size() - resumed_at[1];
+    EXPECT_GE(proxy.bytes_of_last_connection(), rest);
+    EXPECT_LT(proxy.bytes_of_last_connection(), rest + (256 << 10)) << "rest " << rest;
+    EXPECT_NE(log.find("stored, " + std::to_string(png.size()) + " bytes"), std::string::npos)
+        << log;
+    EXPECT_FALSE(fs::exists(partial));
+
+    const CliRun watch = Farmctl("watch " + second.LastLine());
+    EXPECT_EQ(watch.status, 0) << watch.out << watch.err;
 }
 
 TEST_F(Farm, BadGltfIsRefusedAtSubmissionWithTheLoadersMessage) {
