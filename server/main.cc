@@ -11,6 +11,7 @@
 #include "lf/job/frame_settings.h"
 #include "server/farm.h"
 #include "server/grpc_service.h"
+#include "server/health_port.h"
 #include "server/http_listener.h"
 #include "server/listen_policy.h"
 #include "server/retention_flag.h"
@@ -94,6 +95,10 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     std::string http;
+    std::string grpc_health;
+    app.add_option("--grpc-health", grpc_health,
+                   "HOST:PORT of a plain-text gRPC port that serves only grpc.health.v1.Health, "
+                   "for probes that cannot speak TLS (Kubernetes' grpc probe); off if unset");
     app.add_option("--http", http,
                    "HOST:PORT to serve GET /healthz and /metrics (Prometheus) on; off if unset");
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
@@ -179,6 +184,17 @@ int main(int argc, char** argv) {
             "on this machine may use the farm",
             options.data_dir, lf::TokenStore::kFileName);
     }
+    // Health alone, in plain text: it tells whether the server runs and nothing else, so it
+    // needs neither TLS nor a token.
+    std::optional<lf::HealthPort> health_port;
+    if (!grpc_health.empty()) {
+        absl::StatusOr<lf::HealthPort> health = lf::StartHealthPort(grpc_health);
+        if (!health.ok()) return fail(health.status());
+        health_port = std::move(*health);
+        std::printf("grpc health on %s:%d\n", grpc_health.substr(0, grpc_health.rfind(':')).c_str(),
+                    health_port->port);
+        std::fflush(stdout);
+    }
     // Plain HTTP without tokens: it serves health and farm-wide counts, nothing of any job.
     std::unique_ptr<lf::HttpListener> http_listener;
     if (!http.empty()) {
@@ -205,8 +221,10 @@ int main(int argc, char** argv) {
 
     spdlog::info("signal {}: shutting down", stop_signals.Wait());
     server->GetHealthCheckService()->SetServingStatus(false);
+    if (health_port) health_port->server->GetHealthCheckService()->SetServingStatus(false);
     (*farm)->scheduler().Shutdown();
     server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+    if (health_port) health_port->server->Shutdown(std::chrono::system_clock::now());
     timeout_checker.Stop();
     retention.Stop();
     return 0;

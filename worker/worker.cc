@@ -68,6 +68,12 @@ void Worker::Run() {
                     "worker={} refused by the server, retrying until it accepts this "
                     "build: {}",
                     server_.worker_id(), why);
+            } else if (last == absl::StatusCode::kUnauthenticated ||
+                       last == absl::StatusCode::kPermissionDenied) {
+                // A token or certificate the server does not take (yet): retried, so that
+                // creating the token or fixing the server's CA needs no worker restart.
+                Log()->error("worker={} refused by the server, retrying: {}", server_.worker_id(),
+                             why);
             } else {
                 Log()->warn("worker={} server unreachable, retrying: {}", server_.worker_id(), why);
             }

@@ -81,6 +81,11 @@ def port_of(hostport):
     return int(m.group(2)) if m else None
 
 
+def server_ports(v):
+    """The ports a server's flags listen on: --listen, --http and --grpc-health."""
+    return {port_of(v[f]) for f in ("--listen", "--http", "--grpc-health") if v.get(f)}
+
+
 def host_of(hostport):
     m = re.fullmatch(r"(.*):(\d+)", hostport or "")
     return m.group(1) if m else None
@@ -313,9 +318,9 @@ def check_dockerfile(stages, pki):
     if server:
         args = server["cmd"]
         v = flag_values(args)
-        if server["expose"] != {port_of(v.get("--listen")), port_of(v.get("--http"))}:
+        if server["expose"] != server_ports(v):
             fail(DOCKERFILE, f"target server: EXPOSE {sorted(server['expose'])} is not the "
-                             f"ports of CMD's --listen and --http")
+                             f"ports of CMD's --listen, --http and --grpc-health")
         if server["volume"] != [v.get("--data-dir")]:
             fail(DOCKERFILE, f"target server: VOLUME {server['volume']} is not CMD's "
                              f"--data-dir {v.get('--data-dir')}")
@@ -404,10 +409,11 @@ def check_compose(docs, images, pki):
                               f"Dockerfile target {target} does not EXPOSE "
                               f"{sorted(image['expose'])}")
         if image["exe"] == "lightfarm-server":
-            listen = {port_of(v.get("--listen")), port_of(v.get("--http"))}
+            listen = server_ports(v)
             if listen != image["expose"]:
-                errors.append(f"{where}: --listen/--http ports {sorted(listen, key=str)} are not "
-                              f"the Dockerfile's EXPOSE {sorted(image['expose'])}")
+                errors.append(f"{where}: --listen/--http/--grpc-health ports "
+                              f"{sorted(listen, key=str)} are not the Dockerfile's EXPOSE "
+                              f"{sorted(image['expose'])}")
             test = (svc.get("healthcheck") or {}).get("test")
             if not test:
                 errors.append(f"{where}: no healthcheck")
@@ -582,19 +588,22 @@ def check_kubernetes(docs, images, pki):
 
             if image["exe"] == "lightfarm-server":
                 grpc_port, http_port = port_of(v.get("--listen")), port_of(v.get("--http"))
-                if {grpc_port, http_port} != set(ports):
-                    errors.append(f"{where}: --listen/--http ports {grpc_port}, {http_port} are "
-                                  f"not the containerPorts {sorted(ports)}")
+                health_port = port_of(v.get("--grpc-health")) if v.get("--grpc-health") else None
+                if server_ports(v) != set(ports):
+                    errors.append(f"{where}: --listen/--http/--grpc-health ports {grpc_port}, "
+                                  f"{http_port}, {health_port} are not the containerPorts "
+                                  f"{sorted(ports)}")
                 probes = {k: c.get(k) for k in ("readinessProbe", "livenessProbe")}
                 for kind, probe in probes.items():
                     if not probe:
                         errors.append(f"{where}: no {kind}")
                 for kind in ("readinessProbe", "livenessProbe", "startupProbe"):
                     probe = c.get(kind) or {}
-                    if "grpc" in probe and probe["grpc"].get("port") != grpc_port:
-                        errors.append(f"{where}: {kind} grpc port {probe['grpc'].get('port')} "
-                                      f"is not --listen's {grpc_port}")
-                    if "grpc" in probe and v.get("--tls-cert") and "--insecure" not in v:
+                    probed = probe.get("grpc", {}).get("port")
+                    if "grpc" in probe and probed not in (grpc_port, health_port):
+                        errors.append(f"{where}: {kind} grpc port {probed} is neither "
+                                      f"--listen's {grpc_port} nor --grpc-health's {health_port}")
+                    if "grpc" in probe and probed == grpc_port and v.get("--tls-cert"):
                         errors.append(f"{where}: {kind} is a grpc probe, which speaks "
                                       f"plaintext, on the TLS port {grpc_port}")
                     if "httpGet" in probe:
