@@ -108,10 +108,19 @@ absl::StatusOr<std::shared_ptr<grpc::Channel>> OpenChannel(const ChannelOptions&
     }
     absl::StatusOr<std::string> token = LoadToken(options);
     if (!token.ok()) return token.status();
+    // Keepalive pings find a connection whose link went down (a cable, a host gone, a
+    // partition) within 15 s: without them a call waits on TCP's retransmissions, which back off
+    // to minutes, long after the link is back. lightfarm-server accepts pings this often.
+    grpc::ChannelArguments channel_args = args;
+    channel_args.SetInt(GRPC_ARG_KEEPALIVE_TIME_MS,
+                        int(kKeepaliveInterval / absl::Milliseconds(1)));
+    channel_args.SetInt(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 5000);
+    channel_args.SetInt(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+    channel_args.SetInt(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
     std::vector<std::unique_ptr<grpc::experimental::ClientInterceptorFactoryInterface>> factories;
     if (!token->empty()) factories.push_back(std::make_unique<TokenInterceptorFactory>(*token));
-    return grpc::experimental::CreateCustomChannelWithInterceptors(options.address, credentials,
-                                                                   args, std::move(factories));
+    return grpc::experimental::CreateCustomChannelWithInterceptors(
+        options.address, credentials, channel_args, std::move(factories));
 }
 
 }  // namespace lf

@@ -10,8 +10,13 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 
 namespace lf {
+
+// How often OpenChannel's channels ping an idle connection; servers must accept pings this often
+// (GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS at most this).
+inline constexpr absl::Duration kKeepaliveInterval = absl::Seconds(10);
 
 struct ChannelOptions {
     std::string address;   // HOST:PORT

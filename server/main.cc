@@ -9,6 +9,7 @@
 
 #include "lf/core/stop_signals.h"
 #include "lf/job/frame_settings.h"
+#include "proto/channel.h"
 #include "server/farm.h"
 #include "server/grpc_service.h"
 #include "server/health_port.h"
@@ -154,6 +155,12 @@ int main(int argc, char** argv) {
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
     // port and answering clients at random.
     builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+    // Clients and workers ping every lf::kKeepaliveInterval to find dead links (proto/channel.h);
+    // gRPC's default would answer pings that often with GOAWAY.
+    builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+    builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,
+                               int(lf::kKeepaliveInterval / absl::Milliseconds(2)));
+    builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PING_STRIKES, 0);
     // A frame task's result (camera sums and splats) may be far above gRPC's 4 MiB default; the
     // bound is the largest one the plans make (lf::kMaxTaskResultBytes, docs/farm.md).
     builder.SetMaxReceiveMessageSize(lf::kMaxTaskResultBytes);

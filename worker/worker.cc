@@ -37,7 +37,20 @@ absl::StatusOr<RadiosityOptions> RadiosityOptionsFor(const TaskAssignment& task)
 }  // namespace
 
 Worker::Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache)
-    : options_(std::move(options)), server_(server), cache_(cache), arena_(options_.threads) {}
+    : options_(std::move(options)),
+      server_(server),
+      cache_(cache),
+      arena_(options_.threads),
+      sender_([this] { SenderLoop(); }) {}
+
+Worker::~Worker() {
+    {
+        std::lock_guard<std::mutex> lock(send_mutex_);
+        sender_stop_ = true;
+    }
+    send_cv_.notify_all();
+    sender_.join();  // sends what was handed over first
+}
 
 void Worker::Stop() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -87,6 +100,7 @@ void Worker::Run() {
         if (!*task) continue;  // the server already waited
         Execute(**task);
     }
+    FlushSends();  // a result finished before the stop is still worth its upload
     Log()->info("worker={} stopped", server_.worker_id());
 }
 
@@ -148,7 +162,7 @@ void Worker::Execute(const TaskAssignment& task) {
     if (dropped) {
         Log()->info("{} dropped: the job was cancelled or the lease lost", ids);
     } else if (status.ok() && !cancel) {
-        SendResult(task, result, absl::ToDoubleSeconds(absl::Now() - start));
+        SendResult(task, std::move(result), absl::ToDoubleSeconds(absl::Now() - start));
     } else if (stopping()) {
         Log()->info("{} handed back: worker shutting down", ids);
         (void)server_.Fail(task.lease_id, "worker shutting down", true);
@@ -351,14 +365,40 @@ absl::Status Worker::RenderFrame(const TaskAssignment& task, const std::atomic<b
     return absl::OkStatus();
 }
 
-void Worker::SendResult(const TaskAssignment& task, const ServerConnection::TaskResult& result,
+void Worker::SendResult(const TaskAssignment& task, ServerConnection::TaskResult result,
                         double seconds) {
-    const absl::Status sent = server_.Complete(task.lease_id, result, seconds);
-    if (sent.ok()) {
-        Log()->debug("job={} task={} done in {:.2f} s", task.job_id, task.task.index, seconds);
-    } else {
-        Log()->warn("job={} task={} result not taken: {}", task.job_id, task.task.index,
-                    std::string(sent.message()));
+    std::unique_lock<std::mutex> lock(send_mutex_);
+    send_cv_.wait(lock, [&] { return !pending_ && !sending_; });
+    pending_ = PendingResult{task, std::move(result), seconds};
+    send_cv_.notify_all();
+}
+
+void Worker::FlushSends() {
+    std::unique_lock<std::mutex> lock(send_mutex_);
+    send_cv_.wait(lock, [&] { return !pending_ && !sending_; });
+}
+
+void Worker::SenderLoop() {
+    std::unique_lock<std::mutex> lock(send_mutex_);
+    while (true) {
+        send_cv_.wait(lock, [&] { return pending_ || sender_stop_; });
+        if (!pending_) return;  // stopping, and everything handed over is sent
+        const PendingResult sending = std::move(*pending_);
+        pending_.reset();
+        sending_ = true;
+        lock.unlock();
+        const TaskAssignment& task = sending.task;
+        const absl::Status sent = server_.Complete(task.lease_id, sending.result, sending.seconds);
+        if (sent.ok()) {
+            Log()->debug("job={} task={} done in {:.2f} s", task.job_id, task.task.index,
+                         sending.seconds);
+        } else {
+            Log()->warn("job={} task={} result not taken: {}", task.job_id, task.task.index,
+                        std::string(sent.message()));
+        }
+        lock.lock();
+        sending_ = false;
+        send_cv_.notify_all();
     }
 }
 

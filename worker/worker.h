@@ -11,7 +11,9 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 
 #include "absl/status/status.h"
 #include "lf/core/camera.h"
@@ -36,6 +38,8 @@ struct WorkerOptions {
 class Worker {
   public:
     Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache);
+    // Sends the result handed over last, then returns.
+    ~Worker();
 
     // Leases and renders tasks until Stop.
     void Run();
@@ -72,8 +76,14 @@ class Worker {
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A radiosity vector the server stored as a blob.
     absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
-    void SendResult(const TaskAssignment& task, const ServerConnection::TaskResult& result,
+    // Hands the result to the sender thread, after the previous one was sent: the upload of a
+    // result overlaps the lease and render of the next task (over a slow link, a 64x64 tile's
+    // 400 kB take a few hundred milliseconds), and at most one result waits in memory.
+    void SendResult(const TaskAssignment& task, ServerConnection::TaskResult result,
                     double seconds);
+    void SenderLoop();
+    // Waits until the result handed over last is sent.
+    void FlushSends();
     bool stopping() const { return stopping_.load(); }
     void WaitIdle(absl::Duration d);
 
@@ -87,6 +97,18 @@ class Worker {
     std::mutex mutex_;
     std::condition_variable wake_;
     std::atomic<bool>* current_cancel_ = nullptr;  // guarded by mutex_
+
+    struct PendingResult {
+        TaskAssignment task;
+        ServerConnection::TaskResult result;
+        double seconds = 0;
+    };
+    std::mutex send_mutex_;
+    std::condition_variable send_cv_;
+    std::optional<PendingResult> pending_;  // guarded by send_mutex_: handed over, not yet sent
+    bool sending_ = false;                  // guarded by send_mutex_
+    bool sender_stop_ = false;              // guarded by send_mutex_
+    std::thread sender_;                    // last: starts once the rest is built
 };
 
 }  // namespace lf
