@@ -6,8 +6,8 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 
+#include "lf/core/file_util.h"
 #include "lf/job/digest.h"
 #include "lf/version.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
@@ -22,13 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace pb = lightfarm::v1;
-
-std::string ReadText(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 // A CA, the server's certificate for 127.0.0.1, a worker's certificate from the CA and one from
 // another CA, made by the openssl command (deploy/install-deps.sh installs it).
@@ -86,11 +79,13 @@ class GuardedServices : public ::testing::Test {
         ASSERT_TRUE(server_ && port > 0);
         address_ = "127.0.0.1:" + std::to_string(port);
 
-        const std::string scene = ReadText(fs::path(LF_TEST_SCENES) / "cornell_box.json");
-        scene_ = {"scene.json", Sha256Hex(scene), scene.size()};
+        const absl::StatusOr<std::string> scene =
+            ReadFile((fs::path(LF_TEST_SCENES) / "cornell_box.json").string());
+        ASSERT_TRUE(scene.ok()) << scene.status();
+        scene_ = {"scene.json", Sha256Hex(*scene), scene->size()};
         auto upload = farm_->blobs().StartUpload(scene_.hash, scene_.size);
         ASSERT_TRUE(upload.ok());
-        ASSERT_TRUE((*upload)->Append(scene).ok() && (*upload)->Finish().ok());
+        ASSERT_TRUE((*upload)->Append(*scene).ok() && (*upload)->Finish().ok());
     }
     void TearDown() override {
         farm_->scheduler().Shutdown();
