@@ -1,6 +1,7 @@
 // The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel, delete and
 // workers, each a call to lightfarm-server's JobService. All protobuf handling of the client is
 // in this file.
+#include <google/protobuf/util/json_util.h>
 #include <grpcpp/grpcpp.h>
 #include <unistd.h>
 
@@ -135,6 +136,24 @@ absl::Status CallStatus(const grpc::Status& s, const FarmFlags& flags) {
             absl::StrCat("server ", flags.channel.address, " not reachable: ", s.error_message()));
     }
     return FromGrpcStatus(s);
+}
+
+void AddJsonFlag(CLI::App* cmd, bool& json) {
+    cmd->add_flag("--json", json,
+                  "one JSON object a line instead of the table: the wire message's fields "
+                  "(lightfarm.v1, proto field names, every field present)");
+}
+
+// The message as one line of JSON, as protobuf's own mapping writes it (strings escaped, so no
+// name a worker or submitter chose can move the terminal).
+void PrintJson(const google::protobuf::Message& message) {
+    google::protobuf::util::JsonPrintOptions options;
+    options.always_print_primitive_fields = true;
+    options.preserve_proto_field_names = true;
+    std::string line;
+    if (google::protobuf::util::MessageToJsonString(message, &line, options).ok()) {
+        std::printf("%s\n", line.c_str());
+    }
 }
 
 std::string StateName(pb::Job::State s) { return absl::AsciiStrToLower(pb::Job::State_Name(s)); }
@@ -538,19 +557,23 @@ Command AddSubmitCommand(CLI::App& app) {
 Command AddListCommand(CLI::App& app) {
     auto flags = std::make_shared<FarmFlags>();
     auto limit = std::make_shared<int>(0);
+    auto json = std::make_shared<bool>(false);
     CLI::App* cmd = app.add_subcommand("list", "List the server's jobs, newest first.");
     cmd->add_option("--limit", *limit, "at most this many jobs; 0 lists them all")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
+    AddJsonFlag(cmd, *json);
     AddServerOption(cmd, *flags);
-    return {cmd, [flags, limit] {
+    return {cmd, [flags, limit, json] {
                 // A page per call, so that no answer grows with the number of jobs.
                 constexpr int kPage = 500;
                 const std::unique_ptr<pb::JobService::Stub> stub = Connect(*flags);
                 pb::ListJobsRequest req;
                 int listed = 0;
-                std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s  %s\n", "JOB", "STATE", "OWNER",
-                            "METHOD", "PRIORITY", "TASKS", "SPP", "NAME");
+                if (!*json) {
+                    std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s  %s\n", "JOB", "STATE",
+                                "OWNER", "METHOD", "PRIORITY", "TASKS", "SPP", "NAME");
+                }
                 do {
                     req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
                     pb::ListJobsResponse resp;
@@ -559,6 +582,10 @@ Command AddListCommand(CLI::App& app) {
                         *flags);
                     if (!s.ok()) return ReportError(s);
                     for (const pb::Job& job : resp.jobs()) {
+                        if (*json) {
+                            PrintJson(job);
+                            continue;
+                        }
                         std::printf(
                             "%-16s %-10s %-12s %-9s %8d %11s %9llu  %s\n", job.id().c_str(),
                             StateName(job.state()).c_str(),
@@ -577,13 +604,19 @@ Command AddListCommand(CLI::App& app) {
 Command AddStatusCommand(CLI::App& app) {
     auto flags = std::make_shared<FarmFlags>();
     auto id = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
     CLI::App* cmd = app.add_subcommand("status", "Show one job: state, progress, error.");
     cmd->add_option("job", *id, "job id")->required();
+    AddJsonFlag(cmd, *json);
     AddServerOption(cmd, *flags);
-    return {cmd, [flags, id] {
+    return {cmd, [flags, id, json] {
                 absl::StatusOr<pb::Job> job = GetJob(*flags, *id);
                 if (!job.ok()) return ReportError(job.status());
-                PrintJob(*job);
+                if (*json) {
+                    PrintJson(*job);
+                } else {
+                    PrintJob(*job);
+                }
                 return 0;
             }};
 }
@@ -686,8 +719,10 @@ Command AddWorkersCommand(CLI::App& app) {
         "workers",
         "List the workers the server heard from within a lease: name, address, version, state,\n"
         "task and seconds since each was last heard from.");
+    auto json = std::make_shared<bool>(false);
+    AddJsonFlag(cmd, *json);
     AddServerOption(cmd, *flags);
-    return {cmd, [flags] {
+    return {cmd, [flags, json] {
                 pb::ListWorkersRequest req;
                 pb::ListWorkersResponse resp;
                 absl::Status s =
@@ -695,6 +730,10 @@ Command AddWorkersCommand(CLI::App& app) {
                                    ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
                                *flags);
                 if (!s.ok()) return ReportError(s);
+                if (*json) {
+                    for (const pb::WorkerInfo& w : resp.workers()) PrintJson(w);
+                    return 0;
+                }
                 std::printf("%-20s %-24s %-30s %-5s %-22s %s\n", "NAME", "ADDRESS", "VERSION",
                             "STATE", "TASK", "LAST-HEARTBEAT");
                 for (const pb::WorkerInfo& w : resp.workers()) {

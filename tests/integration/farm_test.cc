@@ -348,6 +348,43 @@ TEST_F(Farm, HelpExplainsEveryFarmCommand) {
     }
 }
 
+// `--json` on list, status and workers: one object a line, with the wire message's field names,
+// that a script can parse and that agrees with the table.
+TEST_F(Farm, ListStatusAndWorkersPrintOneJsonObjectALine) {
+    StartServer();
+    Spawn({std::string(LF_BIN_DIR) + "/lightfarm-worker", "--server", address_, "--threads", "1",
+           "--name", "node \"7\"", "--cache-dir", (dir_ / "cache-json").string()},
+          "w-json.log");
+    const std::string first = Submit(scene_, "--spp 2 --tile 32 --name first");
+    const std::string second = Submit(scene_, "--spp 2 --tile 32 --name second");
+    ASSERT_EQ(Farmctl("watch " + second).status, 0);
+    ASSERT_EQ(Farmctl("watch " + first).status, 0);
+
+    const CliRun list = Farmctl("list --json");
+    ASSERT_EQ(list.status, 0) << list.err;
+    std::vector<nlohmann::json> jobs;
+    std::istringstream lines(list.out);
+    for (std::string line; std::getline(lines, line);) jobs.push_back(nlohmann::json::parse(line));
+    ASSERT_EQ(jobs.size(), 2u) << list.out;
+    EXPECT_EQ(jobs[0]["id"], second);  // newest first, as the table
+    EXPECT_EQ(jobs[1]["id"], first);
+    EXPECT_EQ(jobs[1]["name"], "first");
+    EXPECT_EQ(jobs[1]["state"], "SUCCEEDED");
+    EXPECT_EQ(jobs[1]["tasks_done"], jobs[1]["tasks_total"]);
+    EXPECT_EQ(jobs[1]["params"]["spp"], "2");  // 64-bit integers are strings in protobuf's JSON
+
+    const CliRun status = Farmctl("status --json " + first);
+    ASSERT_EQ(status.status, 0) << status.err;
+    EXPECT_EQ(nlohmann::json::parse(status.out), jobs[1]);
+
+    const CliRun workers = Farmctl("workers --json");
+    ASSERT_EQ(workers.status, 0) << workers.err;
+    const nlohmann::json worker = nlohmann::json::parse(workers.out);
+    EXPECT_EQ(worker["name"], "node \"7\"");  // escaped, and read back as it was given
+    EXPECT_EQ(worker["state"], "IDLE");
+    EXPECT_FALSE(worker["version"].get<std::string>().empty());
+}
+
 TEST_F(Farm, SameBitsAsLocalRenderForAnyWorkersAndTiles) {
     StartServer();
     StartWorker("w1");
