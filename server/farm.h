@@ -14,6 +14,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/job/render_metadata.h"
+#include "lf/job/task_status.h"
 #include "server/blob_store.h"
 #include "server/data_dir_lock.h"
 #include "server/job_store.h"
@@ -100,6 +101,16 @@ class Farm {
     // and that were not uploaded or found stored within kUnusedBlobGrace before `now`, and the
     // partial uploads not written within kPartialUploadLifetime.
     absl::StatusOr<BlobStore::Removed> RemoveUnusedBlobs(absl::Time now);
+
+    // A job's tasks: a queued or running job's as the scheduler holds them now, an ended job's
+    // as recorded when it ended. NotFound for a job the farm does not know.
+    absl::StatusOr<std::vector<TaskStatus>> Tasks(const std::string& job_id);
+    // The job's captured task log lines after `after_seq` (one task's when `task` is set), at
+    // most `max_lines` of them.
+    absl::StatusOr<TaskLogPage> TaskLogs(const std::string& job_id, std::optional<int> task,
+                                         int64_t after_seq, int max_lines);
+    // A queued or running job's new priority; FailedPrecondition once it has ended.
+    absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
 
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }

@@ -1,0 +1,48 @@
+// A task and its log as the coordinator shows them: what `lightfarm tasks`, `lightfarm logs`
+// and the dashboard list (wire: ListTasks, GetTaskLogs).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/time/time.h"
+
+namespace lf {
+
+enum class TaskKind { kTile, kFrame, kRadiositySweep };
+
+struct TaskStatus {
+    enum class State { kWaiting, kQueued, kRunning, kDone, kDropped };
+    int index = 0;
+    State state = State::kQueued;
+    TaskKind kind = TaskKind::kTile;
+    int x = 0, y = 0, width = 0, height = 0;  // a tile's pixels; the whole frame for kFrame
+    uint64_t samples = 0;                     // per pixel, for a tile
+    int attempts = 0, failures = 0;
+    std::string worker;                       // of the current or last lease
+    absl::Time leased = absl::InfinitePast();    // the current or last lease
+    absl::Time finished = absl::InfinitePast();  // its result merged
+    absl::Duration duration;  // lease to merged result, or running so far
+    std::string last_error;
+    int log_lines = 0;
+};
+
+// One line a worker logged while running a task.
+struct TaskLogLine {
+    int64_t seq = 0;  // increases through the job's log
+    int task = 0;
+    int attempt = 1;
+    std::string worker;
+    absl::Time time;    // the worker's clock
+    std::string level;  // spdlog's level name
+    std::string text;
+};
+
+struct TaskLogPage {
+    std::vector<TaskLogLine> lines;
+    int64_t next_seq = 0;  // after_seq of the next page
+    bool job_ended = false;
+};
+
+}  // namespace lf
