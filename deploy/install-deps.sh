@@ -10,6 +10,8 @@ packages=(
   gnuplot-nox
   libcpp-httplib-dev
   iproute2 openssl python3 python3-yaml
+  python3-grpcio python3-protobuf
+  chromium nodejs npm
 )
 missing=()
 for p in "${packages[@]}"; do
