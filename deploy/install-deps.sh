@@ -11,12 +11,17 @@ packages=(
   libcpp-httplib-dev
   iproute2 openssl python3 python3-yaml
   python3-grpcio python3-protobuf
-  chromium nodejs npm
+  chromium
 )
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Node.js and npm for the dashboard's browser tests: Debian's, unless a node and npm (from
+# NodeSource, say, whose nodejs package conflicts with Debian's npm) are on the PATH already.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  missing+=(nodejs npm)
+fi
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
   exit 0
