@@ -1,0 +1,29 @@
+"""lightfarm: a Python client of the lightfarm render farm (docs/python.md).
+
+    import lightfarm
+
+    with lightfarm.Client("127.0.0.1:7070", token_file="alice.token") as farm:
+        job_id = farm.submit("tests/scenes/cornell_box.json", spp=16, resolution=(64, 64))
+        for progress in farm.watch(job_id):
+            print(f"{progress.state.name} {progress.fraction:.0%}")
+        farm.fetch(job_id, "cornell.exr")
+
+The gRPC stubs (lightfarm.v1) are generated from proto/ when the repository is built; the
+importable package is build/python/lightfarm.
+"""
+
+from .client import (DEFAULT_SERVER, METHODS, Client, Job, JobState, LogLine, Progress, Task,
+                     Worker, load_token)
+from .errors import (Aborted, AlreadyExists, Cancelled, DeadlineExceeded, FailedPrecondition,
+                     Internal, InvalidArgument, LightfarmError, NotFound, OutOfRange,
+                     PermissionDenied, ResourceExhausted, TlsError, Unauthenticated, Unavailable,
+                     Unimplemented)
+from .scene import scene_files
+
+__all__ = [
+    "Client", "Job", "JobState", "LogLine", "Progress", "Task", "Worker", "DEFAULT_SERVER",
+    "METHODS", "load_token", "scene_files", "LightfarmError", "Aborted", "AlreadyExists",
+    "Cancelled", "DeadlineExceeded", "FailedPrecondition", "Internal", "InvalidArgument",
+    "NotFound", "OutOfRange", "PermissionDenied", "ResourceExhausted", "TlsError",
+    "Unauthenticated", "Unavailable", "Unimplemented",
+]
