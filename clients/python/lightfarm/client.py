@@ -316,14 +316,14 @@ class Client:
     def __exit__(self, *exc) -> None:
         self.close()
 
-    def _error(self, e: grpc.RpcError) -> LightfarmError:
-        return errors.from_rpc_error(e, self.server)
+    def _error(self, e: grpc.RpcError, call: str = "") -> LightfarmError:
+        return errors.from_rpc_error(e, self.server, call)
 
     def _unary(self, method: str, request, timeout: float = UNARY_SECONDS):
         try:
             return getattr(self._stub, method)(request, timeout=timeout, metadata=self._metadata)
         except grpc.RpcError as e:
-            raise self._error(e) from None
+            raise self._error(e, method) from None
 
     # --- jobs ---
     def get(self, job_id: str) -> Job:
@@ -412,7 +412,7 @@ class Client:
             except grpc.RpcError as e:
                 if e.code() == grpc.StatusCode.DEADLINE_EXCEEDED:
                     continue
-                err = self._error(e)
+                err = self._error(e, "WatchJob")
                 if isinstance(err, errors.Unavailable) and backoff.wait():
                     self._connect()
                     continue
@@ -447,7 +447,7 @@ class Client:
                     f.write(chunk.data)
         except grpc.RpcError as e:
             _remove(temp)
-            raise self._error(e) from None
+            raise self._error(e, "FetchResult") from None
         except BaseException:
             _remove(temp)
             raise
@@ -578,7 +578,7 @@ class Client:
             raise self._upload_error(file, e) from None
 
     def _upload_error(self, file: common_pb2.SceneFile, e: grpc.RpcError) -> LightfarmError:
-        err = self._error(e)
+        err = self._error(e, "UploadBlob")
         return type(err)(f"{file.path}: upload: {err.message}", err.code)
 
 

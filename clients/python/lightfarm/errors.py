@@ -111,10 +111,16 @@ _BY_CODE = {cls.default_code: cls for cls in (
     DeadlineExceeded, Cancelled, Internal)}
 
 
-def from_rpc_error(error: grpc.RpcError, server: str = "") -> LightfarmError:
-    """The :class:`LightfarmError` for a failed gRPC call, with the server's message."""
+def from_rpc_error(error: grpc.RpcError, server: str = "", call: str = "") -> LightfarmError:
+    """The :class:`LightfarmError` for a failed gRPC call (``call``, a JobService method, for
+    a message when the server gives none), with the server's message."""
     code = error.code() if hasattr(error, "code") else grpc.StatusCode.UNKNOWN
-    details = (error.details() if hasattr(error, "details") else None) or str(error)
+    details = error.details() if hasattr(error, "details") else None
+    if not details:
+        if code == grpc.StatusCode.UNIMPLEMENTED:
+            details = f"{call or 'the call'}: not implemented by server {server}"
+        else:
+            details = f"{call or 'the call'}: {code.name} without a message"
     if code == grpc.StatusCode.UNAVAILABLE and ("SSL_ERROR_SSL" in details or
                                                 "Ssl handshake failed" in details):
         return TlsError(f"TLS handshake with server {server} failed ({details}): check tls_ca, "

@@ -1,0 +1,358 @@
+"""The Python client against a real farm: lightfarm-server (TLS, tokens) and two
+lightfarm-worker processes on a free port of 127.0.0.1, in a temporary folder.
+
+Environment (set by ctest, clients/python/CMakeLists.txt): PYTHONPATH=build/python,
+LF_BIN_DIR (the build's bin folder) and LF_TEST_SCENES (tests/scenes). Needs openssl.
+"""
+
+import builtins
+import json
+import os
+import secrets
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import lightfarm
+
+BIN = os.environ.get("LF_BIN_DIR", "")
+SCENES = os.environ.get("LF_TEST_SCENES", "")
+EXR_MAGIC = bytes([0x76, 0x2F, 0x31, 0x01])
+SMALL = dict(spp=4, resolution=(32, 32), tile=8, passes=2)  # 32 tasks, well under a second
+WATCHED = dict(spp=256, resolution=(64, 64), tile=16, passes=2)  # 32 tasks, a few seconds
+
+
+def cornell():
+    return os.path.join(SCENES, "cornell_box.json")
+
+
+class Farm:
+    """The server, its tokens and certificates, and two workers."""
+
+    def __init__(self):
+        self.dir = tempfile.mkdtemp(prefix="lightfarm-python-")
+        self.data = self.path("server-data")
+        self.procs = []
+        self.certificates()
+        self.tokens = {}
+        for name, role in (("alice", "submitter"), ("bob", "submitter"), ("root", "admin"),
+                           ("node", "worker")):
+            r = subprocess.run([self.bin("lightfarm-server"), "token", "create", "--data-dir",
+                                self.data, "--name", name, "--role", role],
+                               capture_output=True, text=True, check=True)
+            self.tokens[name] = r.stdout.strip().splitlines()[-1]
+            with open(self.path(name + ".token"), "w") as f:
+                f.write(self.tokens[name] + "\n")
+        server = self.spawn("server", [
+            self.bin("lightfarm-server"), "--listen", "127.0.0.1:0", "--data-dir", self.data,
+            "--tls-cert", self.path("server.crt"), "--tls-key", self.path("server.key"),
+            "--lease-seconds", "5", "--log-level", "warn"], stdout=subprocess.PIPE)
+        line = server.stdout.readline().strip()
+        if not line.startswith("listening on "):
+            raise RuntimeError(f"server did not start: {line!r} {self.log('server')}")
+        self.address = line[len("listening on "):]
+        for name in ("w1", "w2"):
+            self.spawn(name, [
+                self.bin("lightfarm-worker"), "--server", self.address, "--tls-ca",
+                self.path("ca.crt"), "--token-file", self.path("node.token"), "--name", name,
+                "--threads", "1", "--cache-dir", self.path("cache-" + name), "--log-level",
+                "warn"])
+
+    def path(self, *names):
+        return os.path.join(self.dir, *names)
+
+    @staticmethod
+    def bin(name):
+        return os.path.join(BIN, name)
+
+    def spawn(self, name, argv, stdout=subprocess.DEVNULL):
+        with open(self.path(name + ".log"), "w") as log:
+            p = subprocess.Popen(argv, stdout=stdout, stderr=log, text=True)
+        self.procs.append(p)
+        return p
+
+    def log(self, name):
+        try:
+            with open(self.path(name + ".log")) as f:
+                return f.read()[-3000:]
+        except OSError:
+            return ""
+
+    def certificates(self):
+        def ssl(*args):
+            subprocess.run(["openssl"] + list(args), cwd=self.dir, check=True,
+                           capture_output=True)
+
+        for ca in ("ca", "other-ca"):
+            ssl("ecparam", "-name", "prime256v1", "-genkey", "-noout", "-out", ca + ".key")
+            ssl("req", "-x509", "-new", "-key", ca + ".key", "-days", "2", "-subj",
+                f"/CN=lightfarm python test {ca}", "-out", ca + ".crt")
+        ssl("ecparam", "-name", "prime256v1", "-genkey", "-noout", "-out", "server.key")
+        ssl("req", "-new", "-key", "server.key", "-subj", "/CN=127.0.0.1", "-out", "server.csr")
+        with open(self.path("server.ext"), "w") as f:
+            f.write("subjectAltName=IP:127.0.0.1\nextendedKeyUsage=serverAuth\n")
+        ssl("x509", "-req", "-in", "server.csr", "-CA", "ca.crt", "-CAkey", "ca.key",
+            "-CAcreateserial", "-days", "2", "-extfile", "server.ext", "-out", "server.crt")
+
+    def client(self, token="alice", ca="ca.crt", **kwargs):
+        return lightfarm.Client(self.address, token_file=self.path(token + ".token"),
+                                tls_ca=self.path(ca), **kwargs)
+
+    def cli(self, *args, token="alice"):
+        """`lightfarm ARGS` against the farm, with TLS and a token."""
+        return subprocess.run(
+            [self.bin("lightfarm")] + list(args) + [
+                "--server", self.address, "--tls-ca", self.path("ca.crt"), "--token-file",
+                self.path(token + ".token")], capture_output=True, text=True, timeout=120)
+
+    def stop(self):
+        for p in reversed(self.procs):
+            p.terminate()
+        for p in self.procs:
+            try:
+                p.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+            if p.stdout:
+                p.stdout.close()
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+class ClientTest(unittest.TestCase):
+    farm = None
+
+    @classmethod
+    def setUpClass(cls):
+        if not BIN or not SCENES:
+            raise unittest.SkipTest("LF_BIN_DIR and LF_TEST_SCENES are not set (run by ctest)")
+        if shutil.which("openssl") is None:
+            raise unittest.SkipTest("no openssl")
+        cls.farm = Farm()
+        cls.alice = cls.farm.client("alice")
+        # The workers are up once the server lists them.
+        deadline = time.monotonic() + 20
+        while len(cls.alice.workers()) < 2:
+            if time.monotonic() > deadline:
+                raise RuntimeError("workers did not register: " + cls.farm.log("w1"))
+            time.sleep(0.1)
+
+    @classmethod
+    def tearDownClass(cls):
+        if cls.farm:
+            cls.alice.close()
+            cls.farm.stop()
+
+    def test_submit_watch_fetch_list(self):
+        # Big enough (a few seconds) for the watch to see progress between start and end.
+        job_id = self.alice.submit(cornell(), name="python cornell", **WATCHED)
+        snapshots = builtins.list(self.alice.watch(job_id))
+        seconds = (snapshots[-1].job.finished_unix_ms - snapshots[-1].job.started_unix_ms) / 1000
+        print(f"\n  watched job: {len(snapshots)} snapshots in {seconds:.1f} s", file=sys.stderr)
+        done = [p.tasks_done for p in snapshots]
+        self.assertEqual(done, sorted(done), "progress never goes back")
+        self.assertGreaterEqual(len(set(done)), 3, f"rising progress: {snapshots}")
+        fractions = [p.fraction for p in snapshots]
+        self.assertEqual(fractions, sorted(fractions))
+        self.assertEqual(snapshots[-1].state, lightfarm.JobState.SUCCEEDED, snapshots[-1])
+        self.assertTrue(all(not p.final for p in snapshots[:-1]))
+        self.assertEqual(snapshots[-1].fraction, 1.0)
+        self.assertEqual(snapshots[-1].tasks_total, 32)
+        self.assertGreater(snapshots[-1].samples, 0)
+
+        job = self.alice.get(job_id)
+        self.assertEqual((job.width, job.height), (64, 64))
+        self.assertEqual(job.params.spp, 256)
+        self.assertEqual(job.name, "python cornell")
+        self.assertEqual(job.owner, "alice")
+        self.assertEqual(self.alice.wait(job_id).state, lightfarm.JobState.SUCCEEDED)
+
+        out = self.farm.path("python.exr")
+        self.assertEqual(self.alice.fetch(job_id, out), out)
+        with open(out, "rb") as f:
+            exr = f.read()
+        self.assertEqual(exr[:4], EXR_MAGIC)
+        # Three float channels of 64x64 pixels at least, plus a header, compressed or not.
+        self.assertGreater(len(exr), 1000)
+        self.assertLess(len(exr), 10 << 20)
+        self.assertFalse(os.path.exists(out + ".part"))
+        cli_out = self.farm.path("cli.exr")
+        r = self.farm.cli("fetch", job_id, "-o", cli_out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(cli_out, "rb") as f:
+            self.assertEqual(f.read(), exr, "the CLI's fetch writes the same bytes")
+
+        self.assertIn(job_id, [j.id for j in self.alice.list()])
+        self.assertIn(job_id, [j.id for j in self.alice.list(page_size=1)], "paging")
+        with self.farm.client("root") as admin:
+            self.assertIn(job_id, [j.id for j in admin.list()])
+
+    def test_obj_mtl_and_texture_are_uploaded(self):
+        folder = self.farm.path("obj-scene")
+        os.makedirs(os.path.join(folder, "meshes"))
+        os.makedirs(os.path.join(folder, "textures"))
+        shutil.copy(os.path.join(SCENES, "gltf_demo", "checker.png"),
+                    os.path.join(folder, "textures", "checker.png"))
+        with open(os.path.join(folder, "meshes", "panel.obj"), "w") as f:
+            f.write("mtllib panel.mtl\nv 0.1 0.1 0.3\nv 0.4 0.1 0.3\nv 0.4 0.4 0.3\n"
+                    "v 0.1 0.4 0.3\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl checker\n"
+                    "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n")
+        with open(os.path.join(folder, "meshes", "panel.mtl"), "w") as f:
+            f.write("newmtl checker\nKd 1 1 1\nmap_Kd ../textures/checker.png\n")
+        with open(cornell()) as f:
+            scene = json.load(f)
+        scene["shapes"].append({"type": "mesh", "name": "panel", "file": "meshes/panel.obj"})
+        scene_path = os.path.join(folder, "panel.json")
+        with open(scene_path, "w") as f:
+            json.dump(scene, f)
+        _, files = lightfarm.scene_files(scene_path)
+        self.assertEqual([n for n, _ in files],
+                         ["meshes/panel.mtl", "meshes/panel.obj", "textures/checker.png"])
+        job_id = self.alice.submit(scene_path, spp=2, resolution=(16, 16), tile=16)
+        job = self.alice.wait(job_id)
+        self.assertEqual(job.state, lightfarm.JobState.SUCCEEDED, job.error)
+
+    def test_gltf_scene(self):
+        job_id = self.alice.submit(os.path.join(SCENES, "gltf_demo", "demo.gltf"), spp=2,
+                                   resolution=(16, 16), tile=16)
+        job = self.alice.wait(job_id)
+        self.assertEqual(job.state, lightfarm.JobState.SUCCEEDED, job.error)
+
+    def test_cancel(self):
+        job_id = self.alice.submit(cornell(), spp=4096, resolution=(128, 128), tile=32,
+                                   name="long")
+        for progress in self.alice.watch(job_id):
+            if progress.state == lightfarm.JobState.RUNNING:
+                break
+        job = self.alice.cancel(job_id)
+        self.assertEqual(job.state, lightfarm.JobState.CANCELLED)
+        self.assertEqual(self.alice.wait(job_id).state, lightfarm.JobState.CANCELLED)
+        r = self.farm.cli("status", job_id, "--json")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(json.loads(r.stdout)["state"], "CANCELLED")
+        with self.assertRaises(lightfarm.FailedPrecondition):
+            self.alice.cancel(job_id)
+        with self.assertRaises(lightfarm.FailedPrecondition):
+            self.alice.fetch(job_id, self.farm.path("cancelled.exr"))
+        self.assertFalse(os.path.exists(self.farm.path("cancelled.exr.part")))
+        self.alice.delete(job_id)
+        with self.assertRaises(lightfarm.NotFound):
+            self.alice.get(job_id)
+
+    def test_wrong_token(self):
+        with open(self.farm.path("wrong.token"), "w") as f:
+            f.write(secrets.token_hex(32) + "\n")
+        with self.farm.client("wrong") as c:
+            with self.assertRaises(lightfarm.Unauthenticated) as caught:
+                builtins.list(c.list())
+        self.assertEqual(caught.exception.code.name, "UNAUTHENTICATED")
+        with lightfarm.Client(self.farm.address, token="",
+                              tls_ca=self.farm.path("ca.crt")) as c:
+            with self.assertRaises(lightfarm.Unauthenticated):
+                c.workers()
+
+    def test_worker_token_cannot_submit(self):
+        with self.farm.client("node") as c:
+            with self.assertRaises(lightfarm.PermissionDenied):
+                c.submit(cornell(), **SMALL)
+
+    def test_submitter_sees_only_its_own_jobs(self):
+        job_id = self.alice.submit(cornell(), priority=-5, **SMALL)
+        with self.farm.client("bob") as bob:
+            with self.assertRaises(lightfarm.NotFound):
+                bob.get(job_id)
+            with self.assertRaises(lightfarm.NotFound):
+                bob.cancel(job_id)
+            self.assertNotIn(job_id, [j.id for j in bob.list()])
+        self.alice.wait(job_id)
+
+    def test_tls(self):
+        # Every other test talks TLS with the right CA; another CA's certificate is refused.
+        with self.farm.client("alice", ca="other-ca.crt", retry_seconds=0) as c:
+            with self.assertRaises(lightfarm.TlsError) as caught:
+                c.workers()
+        self.assertIn("TLS handshake", caught.exception.message)
+        with self.assertRaises(lightfarm.InvalidArgument):
+            self.farm.client("alice", ca="alice.token")  # not a PEM file
+        with self.assertRaises(lightfarm.InvalidArgument):
+            lightfarm.Client(self.farm.address, tls_cert=self.farm.path("server.crt"),
+                             tls_key=self.farm.path("server.key"))  # no CA
+
+    def test_malformed_scene(self):
+        bad = self.farm.path("bad.json")
+        with open(bad, "w") as f:
+            f.write('{"camera": {"position": [0, 0, 0], "look_at": [0, 0, 1]}, "shapes": [')
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.submit(bad, **SMALL)
+        self.assertIn("bad.json", caught.exception.message)
+        self.assertEqual(caught.exception.code.name, "INVALID_ARGUMENT")
+
+        odd = self.farm.path("odd.json")
+        with open(cornell()) as f:
+            scene = json.load(f)
+        scene["shapes"][0]["type"] = "hexagon"
+        with open(odd, "w") as f:
+            json.dump(scene, f)
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.submit(odd, **SMALL)
+        self.assertIn("shapes[0]", caught.exception.message)
+
+        missing = self.farm.path("missing.json")
+        scene["shapes"][0] = {"type": "mesh", "file": "nowhere.obj"}
+        with open(missing, "w") as f:
+            json.dump(scene, f)
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.submit(missing)
+        self.assertIn("nowhere.obj", caught.exception.message)
+
+        with self.assertRaises(lightfarm.InvalidArgument):
+            self.alice.submit(cornell(), method="raytrace")
+        # A setting out of range, refused by the server.
+        with self.assertRaises(lightfarm.InvalidArgument):
+            self.alice.submit(cornell(), spp=4, tile=0)
+
+    def test_not_found(self):
+        with self.assertRaises(lightfarm.NotFound):
+            self.alice.get("no-such-job")
+        with self.assertRaises(lightfarm.NotFound):
+            builtins.list(self.alice.watch("no-such-job"))
+
+    def test_workers(self):
+        names = sorted(w.name for w in self.alice.workers())
+        self.assertEqual(names, ["w1", "w2"])
+
+    def test_tasks_logs_priority(self):
+        """ListTasks, GetTaskLogs and SetJobPriority: checked where this server implements them,
+        else they must say Unimplemented."""
+        job_id = self.alice.submit(cornell(), **SMALL)
+        unimplemented = []
+        try:
+            job = self.alice.set_priority(job_id, 7)
+            self.assertEqual(job.priority, 7)
+        except lightfarm.Unimplemented as e:
+            self.assertIn("SetJobPriority", e.message)
+            unimplemented.append("SetJobPriority")
+        except lightfarm.FailedPrecondition:
+            pass  # it ended already
+        job = self.alice.wait(job_id)
+        try:
+            tasks = self.alice.tasks(job_id)
+            self.assertEqual(len(tasks), job.tasks_total)
+            self.assertTrue(all(t.state == "DONE" for t in tasks), tasks)
+        except lightfarm.Unimplemented as e:
+            self.assertIn("ListTasks", e.message)
+            unimplemented.append("ListTasks")
+        try:
+            builtins.list(self.alice.logs(job_id))
+        except lightfarm.Unimplemented as e:
+            self.assertIn("GetTaskLogs", e.message)
+            unimplemented.append("GetTaskLogs")
+        if unimplemented:
+            print(f"\n  not implemented by this server: {', '.join(unimplemented)}",
+                  file=sys.stderr)
+
+if __name__ == "__main__":
+    unittest.main()
