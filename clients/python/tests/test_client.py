@@ -6,23 +6,30 @@ LF_BIN_DIR (the build's bin folder) and LF_TEST_SCENES (tests/scenes). Needs ope
 """
 
 import builtins
+import hashlib
 import json
 import os
 import secrets
 import shutil
+import socket
 import subprocess
 import sys
 import tempfile
 import time
 import unittest
 
+import grpc
+
 import lightfarm
+from lightfarm.v1 import job_service_pb2 as pb
 
 BIN = os.environ.get("LF_BIN_DIR", "")
 SCENES = os.environ.get("LF_TEST_SCENES", "")
+DOCS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "docs",
+                    "python.md")
 EXR_MAGIC = bytes([0x76, 0x2F, 0x31, 0x01])
 SMALL = dict(spp=4, resolution=(32, 32), tile=8, passes=2)  # 32 tasks, well under a second
-WATCHED = dict(spp=256, resolution=(64, 64), tile=16, passes=2)  # 32 tasks, a few seconds
+WATCHED = dict(spp=512, resolution=(64, 64), tile=16, passes=2)  # 32 tasks, a few seconds
 
 
 def cornell():
@@ -165,7 +172,7 @@ class ClientTest(unittest.TestCase):
 
         job = self.alice.get(job_id)
         self.assertEqual((job.width, job.height), (64, 64))
-        self.assertEqual(job.params.spp, 256)
+        self.assertEqual(job.params.spp, 512)
         self.assertEqual(job.name, "python cornell")
         self.assertEqual(job.owner, "alice")
         self.assertEqual(self.alice.wait(job_id).state, lightfarm.JobState.SUCCEEDED)
@@ -214,6 +221,68 @@ class ClientTest(unittest.TestCase):
         job_id = self.alice.submit(scene_path, spp=2, resolution=(16, 16), tile=16)
         job = self.alice.wait(job_id)
         self.assertEqual(job.state, lightfarm.JobState.SUCCEEDED, job.error)
+
+    def test_upload_resumes(self):
+        """A broken upload of a 2.5 MiB mesh keeps its first MiB on the server; submit sends the
+        rest only."""
+        folder = self.farm.path("resume")
+        os.makedirs(folder)
+        rows = ["v %.6f 0.05 %.6f" % (0.1 + i * 1e-6, 0.1 + i * 1e-6) for i in range(90000)]
+        mesh = ("\n".join(rows) + "\nv 0.3 0.05 0.1\nv 0.1 0.05 0.3\nf -3 -2 -1\n").encode()
+        self.assertGreater(len(mesh), 2 << 20)
+        with open(os.path.join(folder, "big.obj"), "wb") as f:
+            f.write(mesh)
+        with open(cornell()) as f:
+            scene = json.load(f)
+        scene["shapes"].append({"type": "mesh", "material": "white", "file": "big.obj"})
+        with open(os.path.join(folder, "big.json"), "w") as f:
+            json.dump(scene, f)
+        digest = hashlib.sha256(mesh).hexdigest()
+        stub = self.alice._stub
+        md = self.alice._metadata
+
+        def broken():
+            yield pb.UploadBlobRequest(hash=digest, size=len(mesh), data=mesh[:1 << 20])
+            time.sleep(0.5)  # the server takes the chunk before the stream breaks
+            raise RuntimeError("the link breaks")
+
+        with self.assertRaises(grpc.RpcError):
+            stub.UploadBlob(broken(), timeout=10, metadata=md)
+        deadline = time.monotonic() + 10
+        while stub.BlobUploadOffset(pb.BlobUploadOffsetRequest(hash=digest, size=len(mesh)),
+                                    timeout=10, metadata=md).offset != 1 << 20:
+            self.assertLess(time.monotonic(), deadline, "the server kept the first MiB")
+            time.sleep(0.05)
+
+        offsets = []
+        real = stub.UploadBlob
+
+        def recording(requests, **kwargs):
+            def tap():
+                for i, r in enumerate(requests):
+                    if i == 0:
+                        offsets.append((r.hash, r.offset))
+                    yield r
+            return real(tap(), **kwargs)
+
+        stub.UploadBlob = recording
+        try:
+            job_id = self.alice.submit(os.path.join(folder, "big.json"), spp=1,
+                                       resolution=(16, 16), tile=16)
+        finally:
+            stub.UploadBlob = real
+        self.assertIn((digest, 1 << 20), offsets)
+        job = self.alice.wait(job_id)
+        self.assertEqual(job.state, lightfarm.JobState.SUCCEEDED, job.error)
+        # Stored now: a second submission uploads nothing.
+        offsets.clear()
+        stub.UploadBlob = recording
+        try:
+            self.alice.wait(self.alice.submit(os.path.join(folder, "big.json"), spp=1,
+                                              resolution=(16, 16), tile=16))
+        finally:
+            stub.UploadBlob = real
+        self.assertEqual(offsets, [])
 
     def test_gltf_scene(self):
         job_id = self.alice.submit(os.path.join(SCENES, "gltf_demo", "demo.gltf"), spp=2,
@@ -319,6 +388,34 @@ class ClientTest(unittest.TestCase):
             self.alice.get("no-such-job")
         with self.assertRaises(lightfarm.NotFound):
             builtins.list(self.alice.watch("no-such-job"))
+
+    def test_unreachable(self):
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]  # free, and nothing listens once closed
+        with lightfarm.Client(f"127.0.0.1:{port}", token="x", retry_seconds=0) as c:
+            with self.assertRaises(lightfarm.Unavailable) as caught:
+                c.get("job")
+        self.assertIn(f"127.0.0.1:{port}", caught.exception.message)
+
+    def test_docs_example(self):
+        """docs/python.md's example, as written, from a folder that has tests/scenes."""
+        with open(DOCS) as f:
+            text = f.read()
+        example = text.split("## Example", 1)[1].split("```python\n", 1)[1].split("```", 1)[0]
+        cwd = self.farm.path("docs-example")
+        os.makedirs(os.path.join(cwd, "tests"))
+        os.symlink(SCENES, os.path.join(cwd, "tests", "scenes"))
+        env = dict(os.environ, LIGHTFARM_SERVER=self.farm.address,
+                   LIGHTFARM_TOKEN=self.farm.tokens["alice"],
+                   LIGHTFARM_TLS_CA=self.farm.path("ca.crt"))
+        r = subprocess.run([sys.executable, "-c", example], cwd=cwd, env=env,
+                           capture_output=True, text=True, timeout=120)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("SUCCEEDED", r.stdout)
+        self.assertIn("cornell.exr written", r.stdout)
+        with open(os.path.join(cwd, "cornell.exr"), "rb") as f:
+            self.assertEqual(f.read(4), EXR_MAGIC)
 
     def test_workers(self):
         names = sorted(w.name for w in self.alice.workers())
