@@ -401,9 +401,10 @@ class Client:
         req = pb.WatchJobRequest(job_id=job_id)
         while True:
             last: Optional[Job] = None
+            stream = self._stub.WatchJob(req, timeout=WATCH_STREAM_SECONDS,
+                                         metadata=self._metadata)
             try:
-                for m in self._stub.WatchJob(req, timeout=WATCH_STREAM_SECONDS,
-                                             metadata=self._metadata):
+                for m in stream:
                     backoff.reset()
                     last = Job.from_proto(m)
                     yield Progress.of(last)
@@ -417,6 +418,8 @@ class Client:
                     self._connect()
                     continue
                 raise err from None
+            finally:
+                stream.cancel()  # a caller that stops iterating early ends the stream now
             if last is not None and last.state.final:
                 return
             # The stream ended without a final state (a server going away): look again.
