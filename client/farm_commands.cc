@@ -15,6 +15,7 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "adaptive_flags.h"
@@ -355,6 +356,24 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     }
 }
 
+// "2026-11-26 23:41:07" in the machine's time zone, as a user reads a clock.
+std::string LocalTime(int64_t unix_ms) {
+    return absl::FormatTime("%Y-%m-%d %H:%M:%S", absl::FromUnixMillis(unix_ms),
+                            absl::LocalTimeZone());
+}
+
+// How long the job has rendered (from its first lease to its end, or to now), or "-" before
+// its first lease: "42s", "3m07s", "2h05m".
+std::string ElapsedText(const pb::Job& job) {
+    if (job.started_unix_ms() <= 0) return "-";
+    const int64_t end =
+        job.finished_unix_ms() > 0 ? job.finished_unix_ms() : absl::ToUnixMillis(absl::Now());
+    const int64_t s = std::max<int64_t>(0, (end - job.started_unix_ms()) / 1000);
+    if (s < 60) return absl::StrCat(s, "s");
+    if (s < 3600) return absl::StrFormat("%dm%02ds", s / 60, s % 60);
+    return absl::StrFormat("%dh%02dm", s / 3600, s / 60 % 60);
+}
+
 std::string Progress(const pb::Job& job) {
     return absl::StrCat(job.tasks_done(), "/", job.tasks_total());
 }
@@ -397,6 +416,13 @@ void PrintJob(const pb::Job& job) {
     } else {
         std::printf("  time      %.1f s queued\n", seconds(job.submitted_unix_ms(), now));
     }
+    std::string when = absl::StrCat("  submitted ", LocalTime(job.submitted_unix_ms()));
+    if (job.started_unix_ms() > 0)
+        absl::StrAppend(&when, ", started ", LocalTime(job.started_unix_ms()));
+    if (job.finished_unix_ms() > 0) {
+        absl::StrAppend(&when, ", ended ", LocalTime(job.finished_unix_ms()));
+    }
+    std::printf("%s\n", when.c_str());
     if (!IsFinal(job.state()) && !job.last_error().empty()) {
         std::printf("  last error  %s\n", job.last_error().c_str());
     }
@@ -571,8 +597,9 @@ Command AddListCommand(CLI::App& app) {
                 pb::ListJobsRequest req;
                 int listed = 0;
                 if (!*json) {
-                    std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s  %s\n", "JOB", "STATE",
-                                "OWNER", "METHOD", "PRIORITY", "TASKS", "SPP", "NAME");
+                    std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s %-19s %8s  %s\n", "JOB",
+                                "STATE", "OWNER", "METHOD", "PRIORITY", "TASKS", "SPP", "SUBMITTED",
+                                "TIME", "NAME");
                 }
                 do {
                     req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
@@ -587,12 +614,14 @@ Command AddListCommand(CLI::App& app) {
                             continue;
                         }
                         std::printf(
-                            "%-16s %-10s %-12s %-9s %8d %11s %9llu  %s\n", job.id().c_str(),
-                            StateName(job.state()).c_str(),
+                            "%-16s %-10s %-12s %-9s %8d %11s %9llu %-19s %8s  %s\n",
+                            job.id().c_str(), StateName(job.state()).c_str(),
                             job.owner().empty() ? "-" : job.owner().c_str(),
                             job.params().method().empty() ? "path" : job.params().method().c_str(),
                             job.priority(), Progress(job).c_str(),
-                            (unsigned long long)job.params().spp(), job.name().c_str());
+                            (unsigned long long)job.params().spp(),
+                            LocalTime(job.submitted_unix_ms()).c_str(), ElapsedText(job).c_str(),
+                            job.name().c_str());
                     }
                     listed += resp.jobs_size();
                     req.set_page_token(resp.next_page_token());

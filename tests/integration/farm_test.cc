@@ -19,6 +19,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -502,6 +503,10 @@ TEST_F(Farm, HigherPriorityJobOvertakesAnEarlierOne) {
     const CliRun list = Farmctl("list");
     EXPECT_NE(list.out.find(high), std::string::npos) << list.out;
     EXPECT_LT(list.out.find(high), list.out.find(low)) << "newest first:\n" << list.out;
+    // Each row says when its job was submitted, as a local date and time.
+    EXPECT_TRUE(
+        std::regex_search(list.out, std::regex(high + R"(.* \d{4}-\d\d-\d\d \d\d:\d\d:\d\d )")))
+        << list.out;
     Farmctl("cancel " + low);
 }
 
