@@ -848,7 +848,7 @@ Command AddLogsCommand(CLI::App& app) {
                     const absl::Status s = CallStatus(
                         stub->GetTaskLogs(ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
                         *flags);
-                    if (*follow && absl::IsUnavailable(s) && backoff.Wait("logs " + *id, s)) {
+                    if (absl::IsUnavailable(s) && backoff.Wait("logs " + *id, s)) {
                         stub = Connect(*flags);
                         continue;
                     }
