@@ -32,5 +32,7 @@ Command AddFetchCommand(CLI::App& app);
 Command AddCancelCommand(CLI::App& app);
 Command AddDeleteCommand(CLI::App& app);
 Command AddWorkersCommand(CLI::App& app);
+Command AddTasksCommand(CLI::App& app);
+Command AddLogsCommand(CLI::App& app);
 
 }  // namespace lf
