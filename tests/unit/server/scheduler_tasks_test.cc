@@ -2,6 +2,7 @@
 // and the task list handed on when a job ends (OnTasksEnded), with a fake clock.
 #include <gtest/gtest.h>
 
+#include "lease_results.h"
 #include "server/scheduler.h"
 
 namespace lf {
@@ -26,13 +27,7 @@ class SchedulerTasksTest : public ::testing::Test {
     }
 
     static TileSums Result(const TaskAssignment& lease) {
-        TileSums sums(lease.task.rect);
-        for (PixelSums& p : sums.pixels) {
-            for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
-                p.Add(s, Rgb(0.5f));
-            }
-        }
-        return sums;
+        return testing::UniformResult(lease, Rgb(0.5f));
     }
 
     std::vector<TaskStatus> Tasks(const std::string& id) {

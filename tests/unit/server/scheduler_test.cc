@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "lease_results.h"
 
 namespace lf {
 namespace {
@@ -37,13 +38,7 @@ class SchedulerTest : public ::testing::Test {
     }
 
     static TileSums Result(const TaskAssignment& lease) {
-        TileSums sums(lease.task.rect);
-        for (PixelSums& p : sums.pixels) {
-            for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
-                p.Add(s, Rgb(0.5f));
-            }
-        }
-        return sums;
+        return testing::UniformResult(lease, Rgb(0.5f));
     }
 
     JobRecord Job(const std::string& id) { return *scheduler_.Get(id); }

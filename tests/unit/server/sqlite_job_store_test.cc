@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "lease_results.h"
 #include "server/farm.h"
 #include "server/scheduler.h"
 #include "test_dir.h"
@@ -38,12 +39,7 @@ class SqliteJobStoreTest : public ::testing::Test {
 
     // A result whose pixels depend on the task, so a wrong merge shows in the image.
     static TileSums Result(const TaskAssignment& lease) {
-        TileSums sums(lease.task.rect);
-        for (PixelSums& p : sums.pixels) {
-            for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
-                p.Add(s, Rgb(0.1f * float(lease.task.index + 1)));
-            }
-        }
+        TileSums sums = testing::UniformResult(lease, Rgb(0.1f * float(lease.task.index + 1)));
         sums.stats.samples = sums.pixels.size() * (lease.task.sample_end - lease.task.sample_begin);
         return sums;
     }
