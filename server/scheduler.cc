@@ -843,6 +843,29 @@ absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
     return AlreadyEnded(*record);
 }
 
+absl::StatusOr<JobRecord> Scheduler::SetPriority(const std::string& job_id, int priority) {
+    JobRecord record;
+    uint64_t ticket = 0;
+    {
+        Locked locked(*this);
+        auto it = active_.find(job_id);
+        if (it == active_.end()) {
+            if (const JobRecord* ended = EndedRecord(job_id)) return AlreadyEnded(*ended);
+            locked.lock.unlock();  // the store is never read under the lock
+            absl::StatusOr<JobRecord> stored = store_.Get(job_id);
+            if (!stored.ok()) return stored.status();
+            return AlreadyEnded(*stored);
+        }
+        Job& job = *it->second;
+        Log()->info("job={} priority {} -> {}", job_id, job.record.spec.priority, priority);
+        job.record.spec.priority = priority;
+        ticket = Save(job);
+        record = job.record;
+    }
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
+    return record;
+}
+
 int Scheduler::ExpireLeases() {
     Locked locked(*this);
     const absl::Time now = clock_();

@@ -149,6 +149,11 @@ class Scheduler {
 
     absl::StatusOr<JobRecord> Cancel(const std::string& job_id);
 
+    // A queued or running job's new priority: its queued tasks are leased in the new order from
+    // the next lease on. Returns the record once it is durable; FailedPrecondition for a job that
+    // has ended, NotFound for one the store does not hold.
+    absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
+
     // Re-queues the tasks whose lease ran out (each counts as a failure of the task), and
     // forgets the workers silent for a lease. Returns how many leases expired.
     int ExpireLeases();
