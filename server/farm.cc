@@ -55,7 +55,11 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
     absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
         SqliteJobStore::Open(options.data_dir + "/jobs.db");
     if (!store.ok()) return store.status();
-    std::unique_ptr<Farm> farm(new Farm(options, std::move(*blobs), std::move(*store)));
+    absl::StatusOr<std::unique_ptr<TaskLogStore>> logs =
+        TaskLogStore::Open(options.data_dir + "/logs.db", options.task_logs);
+    if (!logs.ok()) return logs.status();
+    std::unique_ptr<Farm> farm(
+        new Farm(options, std::move(*blobs), std::move(*store), std::move(*logs)));
     farm->lock_ = std::move(*lock);
     farm->SweepTemporaryFiles();
     absl::StatusOr<std::vector<std::string>> rendered = farm->scheduler_.Recover();
@@ -68,11 +72,19 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
 }
 
 Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
-           std::unique_ptr<SqliteJobStore> store)
+           std::unique_ptr<SqliteJobStore> store, std::unique_ptr<TaskLogStore> logs)
     : options_(options),
       blobs_(std::move(blobs)),
       store_(std::move(store)),
-      scheduler_(WithTileFiles(options.scheduler, options.data_dir), *store_) {}
+      logs_(std::move(logs)),
+      scheduler_(WithTileFiles(options.scheduler, options.data_dir), *store_) {
+    scheduler_.OnTasksEnded([this](const std::string& job_id, std::vector<TaskStatus> tasks) {
+        // The job has ended either way: `lightfarm tasks` then lists none of its tasks.
+        if (absl::Status s = logs_->RecordTasks(job_id, tasks); !s.ok()) {
+            Log()->error("job={} tasks not recorded: {}", job_id, std::string(s.message()));
+        }
+    });
+}
 
 absl::Status Farm::CheckSceneSize(uint64_t bytes) const {
     if (bytes <= options_.limits.max_scene_bytes) return absl::OkStatus();
@@ -337,6 +349,7 @@ absl::Status Farm::DeleteJob(const std::string& job_id) {
     }
     if (absl::Status s = store_->Delete(job_id); !s.ok()) return s;
     RemoveJobFiles(job_id);
+    RemoveJobLogs({job_id});
     // The job is gone either way: a blob left now goes at the next hourly sweep.
     if (absl::StatusOr<BlobStore::Removed> removed = RemoveUnusedBlobs(absl::Now());
         !removed.ok()) {
@@ -376,7 +389,12 @@ absl::StatusOr<int> Farm::DeleteExpired(absl::Time now) {
         uint64_t ticket = 0;
         for (const JobRecord& job : *expired) ticket = store_->QueueDelete(job.id);
         if (absl::Status s = store_->WaitDurable(ticket); !s.ok()) return s;
-        for (const JobRecord& job : *expired) RemoveJobFiles(job.id);
+        std::vector<std::string> ids;
+        for (const JobRecord& job : *expired) {
+            RemoveJobFiles(job.id);
+            ids.push_back(job.id);
+        }
+        RemoveJobLogs(ids);
         deleted += int(expired->size());
     }
     if (deleted > 0) {
@@ -387,6 +405,54 @@ absl::StatusOr<int> Farm::DeleteExpired(absl::Time now) {
         return removed.status();
     }
     return deleted;
+}
+
+void Farm::RemoveJobLogs(const std::vector<std::string>& job_ids) {
+    // The jobs are gone either way; lines left behind are found by no one.
+    if (absl::Status s = logs_->Delete(job_ids); !s.ok()) {
+        Log()->error("the task logs of {} deleted jobs stay in logs.db: {}", job_ids.size(),
+                     std::string(s.message()));
+    }
+}
+
+absl::StatusOr<std::vector<TaskStatus>> Farm::Tasks(const std::string& job_id) {
+    std::optional<std::vector<TaskStatus>> tasks = scheduler_.Tasks(job_id);
+    if (!tasks) {
+        absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+        if (!job.ok()) return job.status();
+        // Ended: as recorded when it ended (a job ended just now may not be yet).
+        absl::StatusOr<std::vector<TaskStatus>> recorded = logs_->Tasks(job_id);
+        if (!recorded.ok()) return recorded.status();
+        tasks = std::move(*recorded);
+    }
+    absl::StatusOr<std::map<int, int>> counts = logs_->LineCounts(job_id);
+    if (!counts.ok()) return counts.status();
+    for (TaskStatus& task : *tasks) {
+        if (auto it = counts->find(task.index); it != counts->end()) task.log_lines = it->second;
+    }
+    return *tasks;
+}
+
+absl::StatusOr<TaskLogPage> Farm::TaskLogs(const std::string& job_id, std::optional<int> task,
+                                           int64_t after_seq, int max_lines) {
+    // Whether the job has ended is read before its lines: the last lines of its tasks are kept
+    // before their results are taken (TakeTaskLog), so none follow an ended job's page.
+    absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+    if (!job.ok()) return job.status();
+    const int page_size = max_lines <= 0 ? kMaxTaskLogPage : std::min(max_lines, kMaxTaskLogPage);
+    absl::StatusOr<TaskLogPage> page = logs_->Read(job_id, task, after_seq, page_size);
+    if (!page.ok()) return page.status();
+    page->job_ended = IsFinal(job->state) && int(page->lines.size()) < page_size;
+    return page;
+}
+
+absl::Status Farm::TakeTaskLog(const std::string& lease_id, const std::string& worker,
+                               std::vector<TaskLogLine> lines) {
+    if (lines.empty()) return absl::OkStatus();
+    const std::optional<Scheduler::LeaseHolder> holder = scheduler_.HolderOf(lease_id, worker);
+    if (!holder) return absl::OkStatus();
+    return logs_->Append(holder->job_id, holder->task, holder->attempt, holder->worker,
+                         std::move(lines));
 }
 
 void Farm::SweepTemporaryFiles() {

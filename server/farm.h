@@ -20,6 +20,7 @@
 #include "server/job_store.h"
 #include "server/scheduler.h"
 #include "server/sqlite_job_store.h"
+#include "server/task_log_store.h"
 
 namespace lf {
 
@@ -40,10 +41,13 @@ constexpr size_t kMaxRequestIdBytes = 128;
 constexpr absl::Duration kUnusedBlobGrace = absl::Hours(1);
 // A partial upload not written for this long is given up and removed.
 constexpr absl::Duration kPartialUploadLifetime = absl::Hours(24);
+// The most task log lines one TaskLogs call returns.
+constexpr int kMaxTaskLogPage = 1000;
 
 struct FarmOptions {
-    std::string data_dir;  // jobs.db, blobs/, results/, previews/, scratch/ go here
+    std::string data_dir;  // jobs.db, logs.db, blobs/, results/, previews/, scratch/ go here
     SchedulerOptions scheduler;
+    TaskLogLimits task_logs;
     JobLimits limits;
     // Ended jobs older than this are deleted (see DeleteExpired); zero keeps them forever.
     absl::Duration retention = absl::ZeroDuration();
@@ -106,9 +110,15 @@ class Farm {
     // as recorded when it ended. NotFound for a job the farm does not know.
     absl::StatusOr<std::vector<TaskStatus>> Tasks(const std::string& job_id);
     // The job's captured task log lines after `after_seq` (one task's when `task` is set), at
-    // most `max_lines` of them.
+    // most `max_lines` of them (kMaxTaskLogPage when 0 or more). NotFound for a job the farm
+    // does not know.
     absl::StatusOr<TaskLogPage> TaskLogs(const std::string& job_id, std::optional<int> task,
                                          int64_t after_seq, int max_lines);
+    // Keeps the log lines a worker sent with a heartbeat or a result of lease `lease_id`, under
+    // its task and attempt. Call before the result is taken: the job may end with it. Lines of
+    // a lease `worker` does not hold, or of an ended job, are dropped (and Ok returned).
+    absl::Status TakeTaskLog(const std::string& lease_id, const std::string& worker,
+                             std::vector<TaskLogLine> lines);
     // A queued or running job's new priority; FailedPrecondition once it has ended.
     absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
 
@@ -119,7 +129,7 @@ class Farm {
 
   private:
     Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
-         std::unique_ptr<SqliteJobStore> store);
+         std::unique_ptr<SqliteJobStore> store, std::unique_ptr<TaskLogStore> logs);
     absl::Status CheckSceneSize(uint64_t bytes) const;
     // A result that is not one: the task goes back to the queue as a counted failure.
     absl::Status RefuseUndecodable(const std::string& lease_id, const std::string& worker,
@@ -130,6 +140,7 @@ class Farm {
                             const std::string& path);
     void FinishJob(const std::string& job_id);
     void RemoveJobFiles(const std::string& job_id);
+    void RemoveJobLogs(const std::vector<std::string>& job_ids);
     // The temporary files of writes a killed server did not finish.
     void SweepTemporaryFiles();
     // Snapshot and WriteImage, one job at a time: the image being written is the only one in
@@ -153,6 +164,7 @@ class Farm {
     // taken alone by RemoveUnusedBlobs, so that no blob goes between the two.
     std::shared_mutex blob_users_;
     std::unique_ptr<SqliteJobStore> store_;
+    std::unique_ptr<TaskLogStore> logs_;
     Scheduler scheduler_;
     std::mutex image_mutex_;
     std::map<std::string, int> previewed_;  // tasks done at each running job's last preview

@@ -49,6 +49,17 @@ Scheduler::Locked::Locked(Scheduler& scheduler) : lock(scheduler.mutex_), schedu
 Scheduler::Locked::~Locked() {
     if (!lock.owns_lock()) lock.lock();
     if (scheduler_.to_settle_.empty()) return;
+    // Taken with the jobs SettleEnded waits for: their tasks are handed on once they are durable
+    // (or logged as not recorded), with the lock released for the callback to write.
+    std::vector<std::pair<std::string, std::vector<TaskStatus>>> tasks;
+    tasks.swap(scheduler_.ended_tasks_);
+    SettleEnded();
+    lock.unlock();
+    if (!scheduler_.tasks_ended_) return;
+    for (auto& [id, statuses] : tasks) scheduler_.tasks_ended_(id, std::move(statuses));
+}
+
+void Scheduler::Locked::SettleEnded() {
     std::vector<std::pair<std::string, uint64_t>> ended;
     for (const std::string& id : scheduler_.to_settle_) {
         ended.emplace_back(id, scheduler_.ending_.at(id).ticket);
@@ -266,6 +277,81 @@ std::set<std::string> Scheduler::BlobsInUse() const {
     for (const auto& [id, ending] : ending_) add_spec(ending.record);
     for (const auto& [id, record] : unrecorded_) add_spec(record);
     return hashes;
+}
+
+std::optional<std::vector<TaskStatus>> Scheduler::Tasks(const std::string& job_id) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = active_.find(job_id);
+    if (it == active_.end()) return std::nullopt;
+    return TaskStatuses(*it->second, clock_());
+}
+
+std::vector<TaskStatus> Scheduler::TaskStatuses(const Job& job, absl::Time now) const {
+    std::vector<TaskStatus> statuses(job.tasks.size());
+    for (int t = 0; t < int(job.tasks.size()); ++t) {
+        const Task& task = job.tasks[size_t(t)];
+        TaskStatus& status = statuses[size_t(t)];
+        status.index = t;
+        switch (job.states.state(t)) {
+            case TaskState::kWaiting:
+                status.state = TaskStatus::State::kWaiting;
+                break;
+            case TaskState::kQueued:
+                status.state = TaskStatus::State::kQueued;
+                break;
+            case TaskState::kLeased:
+                status.state = TaskStatus::State::kRunning;
+                break;
+            case TaskState::kDone:
+                status.state = TaskStatus::State::kDone;
+                break;
+            case TaskState::kDropped:
+                status.state = TaskStatus::State::kDropped;
+                break;
+        }
+        PixelRect rect;
+        if (job.frame) {
+            const FrameTask& frame = job.frame->tasks()[size_t(t)];
+            status.kind = TaskKind::kFrame;
+            // A light-path task has no camera part: it covers the frame.
+            rect = frame.rect.width > 0
+                       ? frame.rect
+                       : PixelRect{0, 0, job.record.spec.plan.width, job.record.spec.plan.height};
+            status.samples = frame.sample_end - frame.sample_begin;
+        } else if (SweepChunkOf(job, t)) {
+            status.kind = TaskKind::kRadiositySweep;
+        } else {
+            const RenderTask& tile = job.merger->tasks()[size_t(t)];
+            status.kind = TaskKind::kTile;
+            rect = tile.rect;
+            status.samples = tile.sample_end - tile.sample_begin;
+        }
+        status.x = rect.x0;
+        status.y = rect.y0;
+        status.width = rect.width;
+        status.height = rect.height;
+        status.attempts = task.attempts;
+        status.failures = task.failures;
+        status.last_error = task.last_error;
+        if (task.attempts == 0) continue;  // never leased: no holder, no times
+        status.worker = task.holders.back();
+        status.leased = task.leased_at;
+        status.finished = task.finished;
+        if (status.state == TaskStatus::State::kDone) {
+            status.duration = task.finished - task.leased_at;
+        } else if (status.state == TaskStatus::State::kRunning) {
+            status.duration = now - task.leased_at;
+        }
+    }
+    return statuses;
+}
+
+std::optional<Scheduler::LeaseHolder> Scheduler::HolderOf(const std::string& lease_id,
+                                                          const std::string& worker) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::optional<LeaseRef> ref = Resolve(lease_id);
+    if (!ref || !HeldBy(*ref, worker)) return std::nullopt;
+    return LeaseHolder{ref->job->record.id, ref->task, ref->attempt, worker};
 }
 
 size_t Scheduler::workers_tracked() const {
@@ -706,6 +792,7 @@ absl::Status Scheduler::Refuse(const LeaseRef& ref, const std::string& lease_id,
 
 void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
     Task& task = job.tasks[size_t(t)];
+    task.finished = now;
     if (job.states.state(t) == TaskState::kLeased) {
         // Whoever else holds a lease of it (a retry or a speculative copy) learns at its next
         // heartbeat.
@@ -791,6 +878,7 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
         metrics_.task_failures.Add();
         ++task.failures;
         task.failed_on.insert(task.holders[size_t(ref.attempt - 1)]);
+        task.last_error = reason;
         job.record.last_error = absl::StrCat("task ", t, ": ", reason);
     }
     Log()->warn("job={} task={} attempt {} failed: {}{}", job.record.id, t, ref.attempt,
@@ -818,6 +906,7 @@ JobRecord Scheduler::EndJob(Job& job) {
         for (int attempt : job.tasks[size_t(t)].live) timeouts_.Remove(LeaseId(job, t, attempt));
     }
     const std::string id = job.record.id;
+    ended_tasks_.emplace_back(id, TaskStatuses(job, clock_()));
     const uint64_t ticket = Save(job);
     ending_[id] = Ending{job.record, ticket};
     to_settle_.push_back(id);

@@ -30,6 +30,7 @@
 #include "lf/job/frame_merge.h"
 #include "lf/job/merge.h"
 #include "lf/job/task_assignment.h"
+#include "lf/job/task_status.h"
 #include "lf/job/worker_status.h"
 #include "server/job_state_machine.h"
 #include "server/job_store.h"
@@ -191,6 +192,28 @@ class Scheduler {
     uint64_t WaitForChange(uint64_t version, absl::Time deadline);
     void Shutdown();  // wakes every WaitForChange for good
 
+    // A queued or running job's tasks as they are now (TaskStatus::log_lines left 0: the logs
+    // are not the scheduler's); nullopt for a job that is not queued or running.
+    std::optional<std::vector<TaskStatus>> Tasks(const std::string& job_id) const;
+
+    // Whom a lease belongs to, for the log lines that come with its heartbeats and results.
+    struct LeaseHolder {
+        std::string job_id;
+        int task = 0;
+        int attempt = 0;  // 1 for the task's first lease
+        std::string worker;
+    };
+    // Where a lease id of this server points when `worker` holds it, current or not, while its
+    // job is queued or running; nullopt otherwise (a made-up id, another worker's lease, a lease
+    // from before a restart, or a job that has ended).
+    std::optional<LeaseHolder> HolderOf(const std::string& lease_id, const std::string& worker);
+
+    // Called with an ended job's tasks as they were when it ended, after the scheduler's lock is
+    // released and the job's final record is durable (or logged as not recorded), so that they
+    // can be kept once the job leaves memory. Set before the first job is submitted or recovered.
+    using TasksEnded = std::function<void(const std::string& job_id, std::vector<TaskStatus>)>;
+    void OnTasksEnded(TasksEnded callback) { tasks_ended_ = std::move(callback); }
+
     // Workers the scheduler keeps track of: the live ones, and silent ones not yet forgotten
     // (the timeout checker forgets them within a tick of a lease's silence).
     size_t workers_tracked() const;
@@ -209,6 +232,8 @@ class Scheduler {
         std::vector<std::string> holders;  // the worker of each lease, by attempt - 1
         std::set<int> live;    // attempts whose lease is current: two when one is speculative
         absl::Time leased_at;  // when it last left the queue
+        absl::Time finished = absl::InfinitePast();  // its first result merged
+        std::string last_error;                      // of its last counted failure
         std::set<std::string> failed_on;
     };
     struct Job {
@@ -255,6 +280,8 @@ class Scheduler {
         std::unique_lock<std::mutex> lock;
 
       private:
+        // Waits for the ended jobs' records with the lock released.
+        void SettleEnded();
         Scheduler& scheduler_;
     };
 
@@ -318,6 +345,8 @@ class Scheduler {
     // Counts a failure unless `counted` is false; fails the job at max_failures.
     void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
     void FailJob(Job& job, const std::string& error);
+    // The job's tasks as Tasks() reports them.
+    std::vector<TaskStatus> TaskStatuses(const Job& job, absl::Time now) const;
     // Ends the live state of a job moved to a final state: its final record is queued and the
     // job waits in `ending_` until Locked's release finds it durable. Returns that record.
     JobRecord EndJob(Job& job);
@@ -339,6 +368,9 @@ class Scheduler {
     std::map<std::string, Ending> ending_;
     std::vector<std::string> to_settle_;           // in `ending_`, not yet waited for
     std::map<std::string, JobRecord> unrecorded_;  // ended while the store could not write
+    // Ended jobs' tasks, for tasks_ended_ once the lock is released.
+    std::vector<std::pair<std::string, std::vector<TaskStatus>>> ended_tasks_;
+    TasksEnded tasks_ended_;
     LeaseTimeouts timeouts_;
     WorkerRegistry workers_;
     SchedulerMetrics metrics_;

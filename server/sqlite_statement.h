@@ -59,6 +59,8 @@ class Statement {
         if (rc_ == SQLITE_DONE) rc_ = SQLITE_OK;
         return false;
     }
+    // For the next row's bindings: the statement runs again, its bindings kept until rebound.
+    void Reset() { sqlite3_reset(stmt_); }
     absl::Status status() const {
         if (rc_ == SQLITE_OK || rc_ == SQLITE_ROW) return absl::OkStatus();
         return SqliteError(db_);
