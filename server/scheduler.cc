@@ -100,6 +100,15 @@ size_t Scheduler::TaskCount(const Job& job) {
     return job.frame ? job.frame->tasks().size() : job.merger->tasks().size();
 }
 
+uint64_t Scheduler::TaskSamples(const Job& job, int task) {
+    if (SweepChunkOf(job, task)) return 0;
+    const auto samples = [](const auto& t) {
+        return uint64_t(t.rect.width) * uint64_t(t.rect.height) * (t.sample_end - t.sample_begin);
+    };
+    return job.frame ? samples(job.frame->tasks()[size_t(task)])
+                     : samples(job.merger->tasks()[size_t(task)]);
+}
+
 size_t Scheduler::TasksDone(const Job& job) {
     return job.frame ? job.frame->tasks_done() : job.merger->tasks_done();
 }
@@ -802,6 +811,8 @@ void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
         metrics_.task_seconds.Observe(absl::ToDoubleSeconds(now - task.leased_at));
     }
     MoveTask(job, t, TaskState::kDone);
+    metrics_.tasks_done.Add(now, 1);
+    metrics_.samples_done.Add(now, TaskSamples(job, t));
 }
 
 absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
