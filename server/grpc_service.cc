@@ -58,6 +58,22 @@ std::optional<std::string_view> AuthorizationOf(const grpc::ServerContext* conte
     return std::string_view(it->second.data(), it->second.size());
 }
 
+// Keeps the task log lines that came with a worker's heartbeat or result: before the message is
+// acted on, since its job may end with it. A store that cannot write costs the lines, not the
+// result.
+template <typename Request>
+void TakeTaskLog(Farm& farm, const Request& req) {
+    if (req.log().empty()) return;
+    std::vector<TaskLogLine> lines;
+    lines.reserve(size_t(req.log_size()));
+    for (const pb::WorkerLogLine& line : req.log()) lines.push_back(FromProto(line));
+    if (absl::Status s = farm.TakeTaskLog(req.lease_id(), req.worker_id(), std::move(lines));
+        !s.ok()) {
+        Log()->error("lease={} worker={}: task log lines lost: {}", LogSafe(req.lease_id()),
+                     LogSafe(req.worker_id()), std::string(s.message()));
+    }
+}
+
 }  // namespace
 
 absl::StatusOr<Caller> CallGuard::Check(grpc::ServerContext* context, const char* rpc,
@@ -343,6 +359,38 @@ grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context,
     return grpc::Status::OK;
 }
 
+grpc::Status JobServiceImpl::ListTasks(grpc::ServerContext* context,
+                                       const pb::ListTasksRequest* req,
+                                       pb::ListTasksResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "ListTasks", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
+    absl::StatusOr<std::vector<TaskStatus>> tasks = farm_.Tasks(req->job_id());
+    if (!tasks.ok()) return ToGrpcStatus(tasks.status());
+    for (const TaskStatus& task : *tasks) ToProto(task, resp->add_tasks());
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::GetTaskLogs(grpc::ServerContext* context,
+                                         const pb::GetTaskLogsRequest* req,
+                                         pb::GetTaskLogsResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "GetTaskLogs", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
+    absl::StatusOr<TaskLogPage> page = farm_.TaskLogs(
+        req->job_id(), req->has_task_index() ? std::optional<int>(req->task_index()) : std::nullopt,
+        req->after_seq(), req->max_lines());
+    if (!page.ok()) return ToGrpcStatus(page.status());
+    for (const TaskLogLine& line : page->lines) ToProto(line, resp->add_lines());
+    resp->set_next_seq(page->next_seq);
+    resp->set_job_ended(page->job_ended);
+    return grpc::Status::OK;
+}
+
 grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context,
                                           const pb::LeaseTaskRequest* req,
                                           pb::LeaseTaskResponse* resp) {
@@ -377,6 +425,7 @@ grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* context,
     if (auto c = guard_.Check(context, "Heartbeat", Action::kWork); !c.ok()) {
         return ToGrpcStatus(c.status());
     }
+    TakeTaskLog(farm_, *req);
     resp->set_cancelled(!farm_.scheduler().Heartbeat(req->lease_id(), req->worker_id()));
     return grpc::Status::OK;
 }
@@ -387,6 +436,7 @@ grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context,
     if (auto c = guard_.Check(context, "CompleteTask", Action::kWork); !c.ok()) {
         return ToGrpcStatus(c.status());
     }
+    TakeTaskLog(farm_, *req);
     const absl::Status s =
         req->radiosity_sweep().empty()
             ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums(),
@@ -416,6 +466,7 @@ grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext* context,
     if (auto c = guard_.Check(context, "FailTask", Action::kWork); !c.ok()) {
         return ToGrpcStatus(c.status());
     }
+    TakeTaskLog(farm_, *req);
     const FailureKind kind = req->kind() == pb::FailTaskRequest::WORKER_SHUTDOWN
                                  ? FailureKind::kWorkerShutdown
                                  : FailureKind::kTaskError;

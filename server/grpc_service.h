@@ -67,6 +67,10 @@ class JobServiceImpl final : public lightfarm::v1::JobService::Service {
                            lightfarm::v1::DeleteJobResponse*) override;
     grpc::Status ListWorkers(grpc::ServerContext*, const lightfarm::v1::ListWorkersRequest*,
                              lightfarm::v1::ListWorkersResponse*) override;
+    grpc::Status ListTasks(grpc::ServerContext*, const lightfarm::v1::ListTasksRequest*,
+                           lightfarm::v1::ListTasksResponse*) override;
+    grpc::Status GetTaskLogs(grpc::ServerContext*, const lightfarm::v1::GetTaskLogsRequest*,
+                             lightfarm::v1::GetTaskLogsResponse*) override;
 
   private:
     // The job if `caller` may see it; NotFound, as for a job that does not exist, otherwise, so

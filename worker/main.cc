@@ -58,6 +58,8 @@ int main(int argc, char** argv) {
     };
     spdlog::set_default_logger(spdlog::stderr_color_mt("worker"));
     spdlog::set_level(spdlog::level::from_str(log_level));
+    // Before any other logger is made: each clones the default logger's sinks.
+    const std::shared_ptr<lf::TaskLogSink> task_logs = lf::TaskLogSink::Install();
     absl::StatusOr<std::unique_ptr<lf::BlobCache>> cache =
         lf::BlobCache::Open(cache_dir + "/blobs", cache_mb << 20);
     if (!cache.ok()) return fail(cache.status());
@@ -69,7 +71,7 @@ int main(int argc, char** argv) {
         std::printf("config ok\n");
         return 0;
     }
-    lf::Worker worker(options, **connection, **cache);
+    lf::Worker worker(options, **connection, **cache, *task_logs);
     spdlog::info("worker={} ({}) serving {} with {} threads ({})", id, lf::LogSafe(name),
                  channel.address, options.threads, channel.tls_ca.empty() ? "no TLS" : "TLS");
 

@@ -58,10 +58,12 @@ absl::StatusOr<std::optional<TaskAssignment>> ServerConnection::Lease(absl::Dura
     return FromProto(resp.task());
 }
 
-absl::StatusOr<bool> ServerConnection::Heartbeat(const std::string& lease_id) {
+absl::StatusOr<bool> ServerConnection::Heartbeat(const std::string& lease_id,
+                                                 std::vector<TaskLogLine> log) {
     pb::HeartbeatRequest req;
     req.set_lease_id(lease_id);
     req.set_worker_id(worker_id_);
+    for (const TaskLogLine& line : log) ToProto(line, req.add_log());
     pb::HeartbeatResponse resp;
     const grpc::Status s =
         stub_->stub->Heartbeat(ContextWithDeadline(absl::Seconds(2)).get(), req, &resp);
@@ -78,6 +80,7 @@ absl::Status ServerConnection::Complete(const std::string& lease_id, const TaskR
     req.set_seconds(seconds);
     if (result.radiosity) ToProto(*result.radiosity, req.mutable_radiosity());
     if (result.splats) req.set_splats(*result.splats);
+    for (const TaskLogLine& line : result.log) ToProto(line, req.add_log());
     pb::CompleteTaskResponse resp;
     // Rides out a server restart: the result stays valid after its lease.
     const auto context = ContextWithDeadline(absl::Seconds(30));
@@ -86,12 +89,13 @@ absl::Status ServerConnection::Complete(const std::string& lease_id, const TaskR
 }
 
 absl::Status ServerConnection::Fail(const std::string& lease_id, const std::string& reason,
-                                    bool shutdown) {
+                                    bool shutdown, std::vector<TaskLogLine> log) {
     pb::FailTaskRequest req;
     req.set_lease_id(lease_id);
     req.set_worker_id(worker_id_);
     req.set_reason(reason);
     req.set_kind(shutdown ? pb::FailTaskRequest::WORKER_SHUTDOWN : pb::FailTaskRequest::TASK_ERROR);
+    for (const TaskLogLine& line : log) ToProto(line, req.add_log());
     pb::FailTaskResponse resp;
     return FromGrpcStatus(
         stub_->stub->FailTask(ContextWithDeadline(absl::Seconds(5)).get(), req, &resp));

@@ -11,6 +11,7 @@
 #include "lf/core/film.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/task_assignment.h"
+#include "lf/job/task_status.h"
 #include "proto/channel.h"
 
 namespace lf {
@@ -29,8 +30,9 @@ class ServerConnection {
 
     // Waits up to `wait` for work; nullopt: none.
     absl::StatusOr<std::optional<TaskAssignment>> Lease(absl::Duration wait);
-    // False: stop the task (its job was cancelled or the lease is gone).
-    absl::StatusOr<bool> Heartbeat(const std::string& lease_id);
+    // False: stop the task (its job was cancelled or the lease is gone). `log`: the task's
+    // lines captured since the last heartbeat.
+    absl::StatusOr<bool> Heartbeat(const std::string& lease_id, std::vector<TaskLogLine> log);
     // Encoded TileSums, or a sweep task's lf::EncodeSweepResult.
     struct TaskResult {
         std::string bytes;
@@ -38,10 +40,12 @@ class ServerConnection {
         std::optional<RadiosityFigures> radiosity;  // a radiosity job's tile: for the EXR header
         // A frame task's splat list (lf::EncodeSplatList); `bytes` is then its camera part.
         std::optional<std::string> splats;
+        std::vector<TaskLogLine> log;  // the task's lines no heartbeat took
     };
     absl::Status Complete(const std::string& lease_id, const TaskResult& result, double seconds);
     // `shutdown`: the worker is stopping, which does not count against the task.
-    absl::Status Fail(const std::string& lease_id, const std::string& reason, bool shutdown);
+    absl::Status Fail(const std::string& lease_id, const std::string& reason, bool shutdown,
+                      std::vector<TaskLogLine> log);
     // Writes blob `hash` to `path`.
     absl::Status FetchBlob(const std::string& hash, const std::string& path);
 

@@ -34,12 +34,30 @@ absl::StatusOr<RadiosityOptions> RadiosityOptionsFor(const TaskAssignment& task)
     return options;
 }
 
+// What a lease asks for, for its first log line.
+std::string DescribeTask(const TaskAssignment& task) {
+    if (task.sweep >= 0) {
+        return absl::StrCat("radiosity sweep ", task.sweep, " patch group ", task.chunk, " of ",
+                            task.spec.radiosity.sweep_tasks);
+    }
+    const PixelRect& r = task.task.rect;
+    std::string what =
+        absl::StrCat(task.spec.method, ", pixels ", r.x0, ",", r.y0, " ", r.width, "x", r.height,
+                     ", samples ", task.task.sample_begin, "-", task.task.sample_end, " (",
+                     task.task.sample_end - task.task.sample_begin, " spp)");
+    if (task.path_end > task.path_begin) {
+        absl::StrAppend(&what, ", light paths ", task.path_begin, "-", task.path_end);
+    }
+    return what;
+}
+
 }  // namespace
 
-Worker::Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache)
+Worker::Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache, TaskLogSink& logs)
     : options_(std::move(options)),
       server_(server),
       cache_(cache),
+      logs_(logs),
       arena_(options_.threads),
       sender_([this] { SenderLoop(); }) {}
 
@@ -105,6 +123,10 @@ void Worker::Run() {
 }
 
 void Worker::Execute(const TaskAssignment& task) {
+    // Everything logged from here until End, the kernels' lines included, is the task's.
+    const std::shared_ptr<TaskLog> log = logs_.Begin();
+    const std::string ids = "job=" + task.job_id + " task=" + std::to_string(task.task.index);
+    Log()->info("{} leased: {}", ids, DescribeTask(task));
     std::atomic<bool> cancel{false};
     {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -121,7 +143,8 @@ void Worker::Execute(const TaskAssignment& task) {
         while (!hb_wake.wait_for(lock, absl::ToChronoNanoseconds(task.heartbeat_interval),
                                  [&] { return task_over; })) {
             lock.unlock();
-            const absl::StatusOr<bool> keep = server_.Heartbeat(task.lease_id);
+            // Lines of a heartbeat that does not arrive are lost: the next one carries newer.
+            const absl::StatusOr<bool> keep = server_.Heartbeat(task.lease_id, log->Take());
             lock.lock();
             if (keep.ok() && !*keep) {
                 dropped = true;
@@ -131,21 +154,10 @@ void Worker::Execute(const TaskAssignment& task) {
     });
 
     const absl::Time start = absl::Now();
-    absl::Status status = PrepareScene(task, cancel);
     ServerConnection::TaskResult result;
-    if (status.ok() && task.sweep >= 0) {
-        absl::StatusOr<std::string> swept = Sweep(task, cancel);
-        status = swept.status();
-        if (swept.ok()) result = {std::move(*swept), true, std::nullopt};
-    } else if (status.ok() && UsesFramePlan(task.spec.method)) {
-        status = RenderFrame(task, cancel, result);
-    } else if (status.ok()) {
-        status = PrepareTracer(task, cancel);
-        if (status.ok()) result.bytes = EncodeTileSums(Render(task, cancel));
-        if (const auto* r = dynamic_cast<const RadiosityRenderer*>(loaded_.tracer.get())) {
-            result.radiosity = RadiosityFiguresOf(r->report());
-        }
-    }
+    RenderStats stats;
+    absl::Status status = PrepareScene(task, cancel);
+    if (status.ok()) status = RunTask(task, cancel, result, stats);
     {
         std::lock_guard<std::mutex> lock(hb_mutex);
         task_over = true;
@@ -157,23 +169,53 @@ void Worker::Execute(const TaskAssignment& task) {
         current_cancel_ = nullptr;
     }
 
-    const std::string ids = "job=" + task.job_id + " task=" + std::to_string(task.task.index);
+    const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
     // A result that was finished before a stop was asked for is still worth sending.
     if (dropped) {
         Log()->info("{} dropped: the job was cancelled or the lease lost", ids);
+        logs_.End();
     } else if (status.ok() && !cancel) {
-        SendResult(task, std::move(result), absl::ToDoubleSeconds(absl::Now() - start));
+        Log()->info("{} rendered in {:.2f} s: {} samples, {} rays, {} NaN/Inf samples", ids,
+                    seconds, stats.samples, stats.rays, stats.invalid_samples);
+        logs_.End();
+        result.log = log->Take();
+        SendResult(task, std::move(result), seconds);
     } else if (stopping()) {
         Log()->info("{} handed back: worker shutting down", ids);
-        (void)server_.Fail(task.lease_id, "worker shutting down", true);
+        logs_.End();
+        (void)server_.Fail(task.lease_id, "worker shutting down", true, log->Take());
     } else {
-        Log()->error("{} failed: {}", ids, std::string(status.message()));
-        (void)server_.Fail(task.lease_id, std::string(status.message()), false);
+        Log()->error("{} failed after {:.2f} s: {}", ids, seconds, std::string(status.message()));
+        logs_.End();
+        (void)server_.Fail(task.lease_id, std::string(status.message()), false, log->Take());
     }
 }
 
+absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                             ServerConnection::TaskResult& result, RenderStats& stats) {
+    if (task.sweep >= 0) {
+        absl::StatusOr<std::string> swept = Sweep(task, cancel);
+        if (!swept.ok()) return swept.status();
+        result = {std::move(*swept), true, std::nullopt};
+        return absl::OkStatus();
+    }
+    if (UsesFramePlan(task.spec.method)) return RenderFrame(task, cancel, result, stats);
+    if (absl::Status s = PrepareTracer(task, cancel); !s.ok()) return s;
+    const TileSums sums = Render(task, cancel);
+    stats = sums.stats;
+    result.bytes = EncodeTileSums(sums);
+    if (const auto* r = dynamic_cast<const RadiosityRenderer*>(loaded_.tracer.get())) {
+        result.radiosity = RadiosityFiguresOf(r->report());
+    }
+    return absl::OkStatus();
+}
+
 absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel) {
-    if (loaded_.job_id == task.job_id) return absl::OkStatus();
+    if (loaded_.job_id == task.job_id) {
+        Log()->info("job={} task={} scene {} already loaded", task.job_id, task.task.index,
+                    task.spec.scene.path);
+        return absl::OkStatus();
+    }
     // The previous job's geometry and BVH go now, its decoded textures only after this load:
     // a texture the next job uses too (the next frame of a shot, say) is then shared, not
     // decoded again (DecodeTexture keeps each file content once while anything holds it).
@@ -181,7 +223,9 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
         loaded_.scene ? loaded_.scene->textures
                       : std::vector<std::shared_ptr<const TextureImage>>{};
     loaded_ = {};
+    int fetched = 0;  // the others were in the cache
     auto fetch = [&](const std::string& hash, const std::string& path) {
+        ++fetched;
         return server_.FetchBlob(hash, path);
     };
     std::vector<const BlobRef*> refs = {&task.spec.scene};
@@ -209,8 +253,9 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
     loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
     loaded.job_id = task.job_id;
     loaded_ = std::move(loaded);
-    Log()->info("job={} task={} scene {} loaded", task.job_id, task.task.index,
-                task.spec.scene.path);
+    Log()->info("job={} task={} scene {} loaded: {} files, {} fetched from the server, {} cached",
+                task.job_id, task.task.index, task.spec.scene.path, refs.size(), fetched,
+                int(refs.size()) - fetched);
     return absl::OkStatus();
 }
 
@@ -332,7 +377,7 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
 }
 
 absl::Status Worker::RenderFrame(const TaskAssignment& task, const std::atomic<bool>& cancel,
-                                 ServerConnection::TaskResult& result) {
+                                 ServerConnection::TaskResult& result, RenderStats& stats) {
     if (!loaded_.frame) {
         // Cached per job (loaded_.job_id), through the conversions local mode uses, so one job's
         // settings give local mode's kernel.
@@ -351,6 +396,7 @@ absl::Status Worker::RenderFrame(const TaskAssignment& task, const std::atomic<b
     // The renderer runs tbb inside: in this worker's arena, so --threads bounds it.
     arena_.execute([&] { loaded_.frame->Render(work, camera, splats, &cancel); });
     if (cancel) return absl::CancelledError("frame task cancelled");
+    stats = camera.stats;
     result.bytes = EncodeTileSums(camera);
     result.splats = EncodeSplatList(splats);
     const size_t bytes = result.bytes.size() + result.splats->size();
@@ -379,6 +425,8 @@ void Worker::FlushSends() {
 }
 
 void Worker::SenderLoop() {
+    // It sends one task's result while the next task runs: its lines are neither's log.
+    TaskLogSink::IgnoreThisThread();
     std::unique_lock<std::mutex> lock(send_mutex_);
     while (true) {
         send_cv_.wait(lock, [&] { return pending_ || sender_stop_; });

@@ -24,6 +24,7 @@
 #include "lf/kernels/radiosity.h"
 #include "worker/blob_cache.h"
 #include "worker/server_connection.h"
+#include "worker/task_log_sink.h"
 
 namespace lf {
 
@@ -37,7 +38,9 @@ struct WorkerOptions {
 
 class Worker {
   public:
-    Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache);
+    // `logs`: the sink that captures each task's lines (TaskLogSink::Install), sent with the
+    // task's heartbeats and its result.
+    Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache, TaskLogSink& logs);
     // Sends the result handed over last, then returns.
     ~Worker();
 
@@ -68,11 +71,14 @@ class Worker {
     // The job's path tracer or radiosity display, built once per job.
     absl::Status PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel);
     TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
+    // A tile or frame task's camera sums, or a sweep's result: `result` and its stats.
+    absl::Status RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                         ServerConnection::TaskResult& result, RenderStats& stats);
     // A frame method's task (lf::FrameTask): its camera sums and its splat list, encoded; the
     // renderer is built once per job. FailedPrecondition when the result is above what the
     // coordinator takes (lf::kMaxTaskResultBytes).
     absl::Status RenderFrame(const TaskAssignment& task, const std::atomic<bool>& cancel,
-                             ServerConnection::TaskResult& result);
+                             ServerConnection::TaskResult& result, RenderStats& stats);
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A radiosity vector the server stored as a blob.
     absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
@@ -90,6 +96,7 @@ class Worker {
     const WorkerOptions options_;
     ServerConnection& server_;
     BlobCache& cache_;
+    TaskLogSink& logs_;
     LoadedScene loaded_;
     tbb::task_arena arena_;
 

@@ -265,6 +265,84 @@ void ToProto(const WorkerStatus& worker, pb::WorkerInfo* out) {
     out->set_seconds_since_seen(absl::ToDoubleSeconds(worker.since_seen));
 }
 
+namespace {
+
+// Unix milliseconds, 0 for a time not reached yet.
+int64_t UnixMs(absl::Time t) { return t == absl::InfinitePast() ? 0 : absl::ToUnixMillis(t); }
+
+pb::TaskInfo::State ToProto(TaskStatus::State state) {
+    switch (state) {
+        case TaskStatus::State::kWaiting:
+            return pb::TaskInfo::WAITING;
+        case TaskStatus::State::kQueued:
+            return pb::TaskInfo::QUEUED;
+        case TaskStatus::State::kRunning:
+            return pb::TaskInfo::RUNNING;
+        case TaskStatus::State::kDone:
+            return pb::TaskInfo::DONE;
+        case TaskStatus::State::kDropped:
+            return pb::TaskInfo::DROPPED;
+    }
+    return pb::TaskInfo::STATE_UNSPECIFIED;
+}
+
+pb::TaskInfo::Kind ToProto(TaskKind kind) {
+    switch (kind) {
+        case TaskKind::kTile:
+            return pb::TaskInfo::TILE;
+        case TaskKind::kFrame:
+            return pb::TaskInfo::FRAME;
+        case TaskKind::kRadiositySweep:
+            return pb::TaskInfo::RADIOSITY_SWEEP;
+    }
+    return pb::TaskInfo::KIND_UNSPECIFIED;
+}
+
+}  // namespace
+
+void ToProto(const TaskStatus& task, pb::TaskInfo* out) {
+    out->set_index(task.index);
+    out->set_state(ToProto(task.state));
+    out->set_kind(ToProto(task.kind));
+    out->set_x(task.x);
+    out->set_y(task.y);
+    out->set_width(task.width);
+    out->set_height(task.height);
+    out->set_samples(task.samples);
+    out->set_attempts(task.attempts);
+    out->set_failures(task.failures);
+    out->set_worker(task.worker);
+    out->set_leased_unix_ms(UnixMs(task.leased));
+    out->set_finished_unix_ms(UnixMs(task.finished));
+    out->set_seconds(absl::ToDoubleSeconds(task.duration));
+    out->set_last_error(task.last_error);
+    out->set_log_lines(task.log_lines);
+}
+
+void ToProto(const TaskLogLine& line, pb::TaskLogLine* out) {
+    out->set_seq(line.seq);
+    out->set_task_index(line.task);
+    out->set_attempt(line.attempt);
+    out->set_worker(line.worker);
+    out->set_unix_ms(absl::ToUnixMillis(line.time));
+    out->set_level(line.level);
+    out->set_text(line.text);
+}
+
+void ToProto(const TaskLogLine& line, pb::WorkerLogLine* out) {
+    out->set_unix_ms(absl::ToUnixMillis(line.time));
+    out->set_level(line.level);
+    out->set_text(line.text);
+}
+
+TaskLogLine FromProto(const pb::WorkerLogLine& line) {
+    TaskLogLine out;
+    out.time = absl::FromUnixMillis(line.unix_ms());
+    out.level = line.level();
+    out.text = line.text();
+    return out;
+}
+
 void ToProto(const RadiosityFigures& f, pb::RadiosityReport* out) {
     out->set_patches(f.patches);
     out->set_unknowns(f.unknowns);

@@ -169,7 +169,8 @@ TEST(WorkerVersionRetry, RefusedWorkerKeepsRetryingWithItsVersionUntilStopped) {
     WorkerOptions options;
     options.min_idle = absl::Milliseconds(1);
     options.max_idle = absl::Milliseconds(8);
-    Worker worker(options, **connection, **cache);
+    TaskLogSink logs;
+    Worker worker(options, **connection, **cache, logs);
     std::thread run([&] { worker.Run(); });
     const std::vector<std::string> versions = service.WaitForLeases(3);
     worker.Stop();

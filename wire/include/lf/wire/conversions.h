@@ -7,6 +7,7 @@
 #include "lf/job/job_spec.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/task_assignment.h"
+#include "lf/job/task_status.h"
 #include "lf/job/worker_status.h"
 #include "lightfarm/v1/job_service.pb.h"
 #include "lightfarm/v1/worker_service.pb.h"
@@ -34,6 +35,12 @@ void ToProto(const TaskAssignment& task, lightfarm::v1::Task* out);
 TaskAssignment FromProto(const lightfarm::v1::Task& task);
 
 void ToProto(const WorkerStatus& worker, lightfarm::v1::WorkerInfo* out);
+
+void ToProto(const TaskStatus& task, lightfarm::v1::TaskInfo* out);
+void ToProto(const TaskLogLine& line, lightfarm::v1::TaskLogLine* out);
+// A line as the worker captured it: its time, level and text; the server knows the rest.
+void ToProto(const TaskLogLine& line, lightfarm::v1::WorkerLogLine* out);
+TaskLogLine FromProto(const lightfarm::v1::WorkerLogLine& line);
 
 void ToProto(const RadiosityFigures& figures, lightfarm::v1::RadiosityReport* out);
 RadiosityFigures FromProto(const lightfarm::v1::RadiosityReport& report);
