@@ -84,10 +84,10 @@ try {
     start('lightfarm-worker', ['--server', grpcAddress, '--token-file', workerToken, '--name', name, '--threads', '1', '--cache-dir', join(dir, `cache-${name}`)]);
   }
 
-  // Enough small tasks to watch for a few seconds: 8x8 tiles of 64x64, passes of 64 samples.
+  // Enough small tasks to watch for some 20 s: 16 tiles of 64x64 in passes of 256 samples.
   const scene = join(scenesDir, 'cornell_box.json');
   const submit = (extra) => cli(['submit', scene, '--resolution', '64x64', '--tile', '16', ...extra], aliceToken).split('\n').pop().trim();
-  const job = submit(['--spp', '512', '--passes', '8', '--name', 'watched']);
+  const job = submit(['--spp', '2048', '--passes', '8', '--name', 'watched']);
   console.log(`job ${job} submitted`);
 
   browser = await chromium.launch({
