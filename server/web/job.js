@@ -43,10 +43,17 @@ export function mount(root, id) {
     }
   }
 
+  // One rectangle per tile not yet finished: running while any of its passes runs, else queued.
   function drawTiles(job, list) {
+    const tiles = new Map();
+    for (const t of list) {
+      if (t.kind !== 'tile' || t.state === 'done' || t.state === 'dropped') continue;
+      const key = `${t.x},${t.y}`;
+      if (!tiles.has(key) || t.state === 'running') tiles.set(key, t);
+    }
     overlay.setAttribute('viewBox', `0 0 ${job.width} ${job.height}`);
-    overlay.replaceChildren(...list.filter((t) => t.kind === 'tile' && t.state !== 'done' && t.state !== 'dropped')
-      .map((t) => svg('rect', { x: t.x, y: t.y, width: t.width, height: t.height, class: t.state })));
+    overlay.replaceChildren(...[...tiles.values()].map((t) =>
+      svg('rect', { x: t.x, y: t.y, width: t.width, height: t.height, class: t.state === 'running' ? 'running' : 'queued' })));
   }
 
   function openLog(task) {
@@ -73,7 +80,7 @@ export function mount(root, id) {
         h('td', {}, `${job.width}×${job.height}, ${job.spp} spp`), h('td', {}, progress(job.tasks_done, job.tasks_total)),
         h('td', {}, time(job.submitted_ms)), h('td', {}, time(job.started_ms)), h('td', {}, time(job.finished_ms)),
         h('td', {}, duration(job.eta_s)))]),
-    job.error ? h('p', { class: 'error' }, job.error) : null);
+    h('p', { class: 'error' }, job.error));
     cancel.disabled = ended(job.state);
     setPriority.disabled = ended(job.state);
     if (!editing) priority.value = job.priority;

@@ -136,7 +136,7 @@ try {
   await until('the new preview loaded', () => page.evaluate(() => document.getElementById('preview').complete && document.getElementById('preview').naturalWidth === 64));
   check(!previews[0].equals(previews[previews.length - 1]), `the preview loads and changes (${previews.length} images, ${previews[0].length} then ${previews[previews.length - 1].length} bytes)`);
   const shaded = await page.$$eval('#tiles rect', (r) => r.length);
-  console.log(`${shaded} tiles shaded as queued or running`);
+  check(shaded >= 1 && shaded <= 16, `${shaded} of the 16 tiles shaded as queued or running`);
 
   // A task's log opens.
   await page.waitForSelector('tr.task.done');
