@@ -9,6 +9,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
 #include "lf/core/log.h"
+#include "server/listen_policy.h"
 #include "server/web_assets.h"
 
 namespace lf {
@@ -273,6 +274,15 @@ HttpAnswer Dashboard::Serve(const HttpRequest& request) {
 }
 
 absl::StatusOr<Caller> Dashboard::CallerOf(const HttpRequest& request) {
+    if (!auth_.enabled() && !(IsLoopbackHost(request.remote_addr) &&
+                              IsLoopbackHost(ListenHost(request.Header("host").value_or(""))))) {
+        // Without tokens everyone is an admin: only this machine may be, through an address
+        // that names it (a page of another site renamed to 127.0.0.1 names itself).
+        return absl::PermissionDeniedError(
+            "authentication is off (no tokens): the dashboard answers only this machine at "
+            "localhost or 127.0.0.1; make a token (lightfarm-server token create) to open it to "
+            "others");
+    }
     std::optional<std::string> header = request.Header("authorization");
     if (!header) {
         if (std::optional<std::string> cookies = request.Header("cookie")) {
@@ -440,8 +450,8 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
                 !body["priority"].is_number_integer() ||
                 body["priority"].get<int64_t>() < std::numeric_limits<int32_t>::min() ||
                 body["priority"].get<int64_t>() > std::numeric_limits<int32_t>::max()) {
-                return ErrorAnswer(absl::InvalidArgumentError(
-                    "expected {\"priority\": N}, N a 32-bit integer"));
+                return ErrorAnswer(
+                    absl::InvalidArgumentError("expected {\"priority\": N}, N a 32-bit integer"));
             }
             absl::StatusOr<JobRecord> changed =
                 farm_.SetPriority(id, int(body["priority"].get<int64_t>()));
@@ -468,9 +478,8 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
         for (const auto* p : {&task, &after, &max}) {
             if (!p->ok()) return ErrorAnswer(p->status());
         }
-        absl::StatusOr<TaskLogPage> page =
-            farm_.TaskLogs(id, *task < 0 ? std::nullopt : std::optional<int>(int(*task)), *after,
-                           int(*max));
+        absl::StatusOr<TaskLogPage> page = farm_.TaskLogs(
+            id, *task < 0 ? std::nullopt : std::optional<int>(int(*task)), *after, int(*max));
         if (!page.ok()) return ErrorAnswer(page.status());
         Json lines = Json::array();
         for (const TaskLogLine& l : page->lines) {
@@ -482,8 +491,8 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
                              {"level", l.level},
                              {"text", l.text}});
         }
-        return JsonAnswer(200,
-                          {{"lines", lines}, {"next_seq", page->next_seq}, {"ended", page->job_ended}});
+        return JsonAnswer(
+            200, {{"lines", lines}, {"next_seq", page->next_seq}, {"ended", page->job_ended}});
     }
     if (what == "preview.png" || what == "metadata") {
         absl::StatusOr<std::shared_ptr<const Preview>> preview = PreviewOf(*job);
@@ -513,6 +522,7 @@ absl::StatusOr<std::shared_ptr<const Dashboard::Preview>> Dashboard::PreviewOf(
         // A job that failed or was cancelled keeps the last preview shown of it.
         if (it != previews_.end() &&
             ((it->second->tasks_done == job.tasks_done && it->second->state == job.state) ||
+             (!IsFinal(job.state) && absl::Now() - it->second->made < options_.preview_min_age) ||
              (IsFinal(job.state) && job.state != JobState::kSucceeded))) {
             it->second->used = ++preview_clock_;
             return it->second;
@@ -528,8 +538,8 @@ absl::StatusOr<std::shared_ptr<const Dashboard::Preview>> Dashboard::PreviewOf(
     // Filmic: highlights roll off instead of clipping, as a look at a render in progress wants.
     absl::StatusOr<std::string> png = EncodePng(exr->image, {.tone = ToneCurve::kFilmic});
     if (!png.ok()) return png.status();
-    auto preview = std::make_shared<Preview>(
-        Preview{job.tasks_done, job.state, std::move(*png), std::move(exr->attributes), 0});
+    auto preview = std::make_shared<Preview>(Preview{job.tasks_done, job.state, std::move(*png),
+                                                     std::move(exr->attributes), absl::Now(), 0});
     std::lock_guard<std::mutex> lock(previews_mutex_);
     preview->used = ++preview_clock_;
     previews_[job.id] = preview;

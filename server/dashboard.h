@@ -3,7 +3,9 @@
 // caller is who its token says (an `lf_token` cookie set by signing in, or Authorization:
 // Bearer) and sees what the gRPC API would show that token: a submitter its own jobs (another's
 // answers 404 exactly as a job that does not exist), workers without other owners' job ids;
-// worker tokens may not use it. Plain logic over HttpRequest and HttpAnswer, tested without HTTP.
+// worker tokens may not use it. With authentication off (no tokens, gRPC on loopback) everyone
+// is an anonymous admin, as on the gRPC port, but only from this machine and through a loopback
+// Host (against DNS rebinding). Plain logic over HttpRequest and HttpAnswer, tested without HTTP.
 //
 //   GET  /, /web/NAME                 the pages
 //   GET  /api/session                 who is signed in (401 when no one is and tokens are on)
@@ -31,6 +33,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 #include "lf/core/image_io.h"
 #include "server/auth.h"
 #include "server/farm.h"
@@ -40,6 +43,9 @@ namespace lf {
 
 struct DashboardOptions {
     bool tls = false;  // served over HTTPS: the cookie is Secure, the page's origin https://
+    // A running job's preview is made again (its EXR written and read, its PNG encoded) at most
+    // this often, however many tabs watch it and however fast its tasks merge.
+    absl::Duration preview_min_age = absl::Seconds(2);
 };
 
 class Dashboard {
@@ -60,6 +66,7 @@ class Dashboard {
         JobState state = JobState::kQueued;
         std::string png;
         ExrAttributes attributes;
+        absl::Time made;
         uint64_t used = 0;  // the cache's clock when last asked for
     };
 
@@ -72,7 +79,7 @@ class Dashboard {
     // The job when `caller` may see it; NotFound alike for another's job and for none.
     absl::StatusOr<JobRecord> VisibleJob(const Caller& caller, const std::string& job_id);
     // The job's image as merged so far (or its result), encoded again only when a task was
-    // merged since.
+    // merged since, and not more often than preview_min_age while the job runs.
     absl::StatusOr<std::shared_ptr<const Preview>> PreviewOf(const JobRecord& job);
 
     Farm& farm_;

@@ -306,8 +306,7 @@ grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
 
 grpc::Status JobServiceImpl::SetJobPriority(grpc::ServerContext* context,
                                             const pb::SetJobPriorityRequest* req, pb::Job* resp) {
-    absl::StatusOr<Caller> caller =
-        guard_.Check(context, "SetJobPriority", Action::kSetPriority);
+    absl::StatusOr<Caller> caller = guard_.Check(context, "SetJobPriority", Action::kSetPriority);
     if (!caller.ok()) return ToGrpcStatus(caller.status());
     if (absl::StatusOr<JobRecord> seen = VisibleJob(*caller, req->job_id()); !seen.ok()) {
         return ToGrpcStatus(seen.status());

@@ -17,6 +17,7 @@ struct HttpRequest {
     std::map<std::string, std::string> query;    // decoded; the first of repeated names
     std::map<std::string, std::string> headers;  // names in lower case
     std::string body;
+    std::string remote_addr;  // the peer's IP address
 
     std::optional<std::string> Header(const std::string& lower_case_name) const {
         auto it = headers.find(lower_case_name);

@@ -30,7 +30,7 @@ constexpr time_t kKeepAliveSeconds = 1;
 constexpr size_t kMaxBodyBytes = 64 << 10;
 
 HttpRequest FromHttplib(const httplib::Request& r) {
-    HttpRequest request{r.method, r.path, {}, {}, r.body};
+    HttpRequest request{r.method, r.path, {}, {}, r.body, r.remote_addr};
     for (const auto& [name, value] : r.params) request.query.emplace(name, value);
     for (const auto& [name, value] : r.headers) {
         std::string lower = name;
@@ -124,8 +124,8 @@ absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(
     auto server = std::make_unique<Server>();
     const bool tls = !options.tls_cert.empty() && !options.tls_key.empty();
     if (tls) {
-        server->http = std::make_unique<httplib::SSLServer>(options.tls_cert.c_str(),
-                                                            options.tls_key.c_str());
+        server->http =
+            std::make_unique<httplib::SSLServer>(options.tls_cert.c_str(), options.tls_key.c_str());
         if (!server->http->is_valid()) {
             return absl::FailedPreconditionError(
                 absl::StrCat("--http ", host_port, ": cannot use --tls-cert ", options.tls_cert,

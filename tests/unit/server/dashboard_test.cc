@@ -2,7 +2,7 @@
 // a socket: signing in and being refused, what each token sees (another's job answers as no
 // job), the JSON of jobs, tasks, workers and the farm, cancel and priority, the preview PNG
 // (decoded, and changed by a merged task), the CSRF checks of POSTs, bounds on what a request
-// names, and the embedded pages with their headers.
+// names, anonymous admins only on loopback, and the embedded pages with their headers.
 #include "server/dashboard.h"
 
 #include <gtest/gtest.h>
@@ -69,17 +69,20 @@ class DashboardTest : public ::testing::Test {
         return *id;
     }
 
-    // Leases a task and merges a result of `value` in every pixel through the Farm.
-    void RenderOne(const std::string& worker, float value) {
+    // Leases a task and merges a result of `value` in every pixel through the Farm; false when
+    // no task is queued.
+    bool RenderOne(const std::string& worker, float value) {
         std::optional<TaskAssignment> lease = farm_->scheduler().LeaseTask(worker);
-        ASSERT_TRUE(lease);
+        if (!lease) return false;
         TileSums sums(lease->task.rect);
         for (PixelSums& p : sums.pixels) {
             for (uint64_t s = lease->task.sample_begin; s < lease->task.sample_end; ++s) {
                 p.Add(s, Rgb(value));
             }
         }
-        ASSERT_TRUE(farm_->Complete(lease->lease_id, worker, EncodeTileSums(sums)).ok());
+        const absl::Status merged = farm_->Complete(lease->lease_id, worker, EncodeTileSums(sums));
+        EXPECT_TRUE(merged.ok()) << merged;
+        return merged.ok();
     }
 
     static HttpRequest Get(const std::string& path, const std::string& token = "") {
@@ -94,6 +97,7 @@ class DashboardTest : public ::testing::Test {
             }
         }
         r.headers["host"] = kHost;
+        r.remote_addr = "127.0.0.1";
         if (!token.empty()) r.headers["cookie"] = std::string("theme=dark; lf_token=") + token;
         return r;
     }
@@ -233,6 +237,18 @@ TEST_F(DashboardTest, AuthOffEveryoneIsAnAnonymousAdmin) {
     HttpRequest forged = Post("/api/jobs/" + job + "/cancel", Json::object());
     forged.headers["origin"] = "http://evil.example";
     EXPECT_EQ(open.Serve(forged).status, 403);
+    // Nor another machine, nor a page of another site renamed to 127.0.0.1 (DNS rebinding).
+    HttpRequest remote = Get("/api/jobs");
+    remote.remote_addr = "10.0.0.7";
+    EXPECT_EQ(open.Serve(remote).status, 403);
+    HttpRequest rebound = Get("/api/jobs");
+    rebound.headers["host"] = "evil.example:8080";
+    EXPECT_EQ(open.Serve(rebound).status, 403);
+    HttpRequest named = Get("/api/jobs");
+    named.headers["host"] = "localhost:8080";
+    named.remote_addr = "::1";
+    EXPECT_EQ(open.Serve(named).status, 200);
+    EXPECT_EQ(farm_->scheduler().Get(job)->state, JobState::kQueued);
 }
 
 TEST_F(DashboardTest, JobTasksAndFarmJsonFollowTheWork) {
@@ -246,8 +262,8 @@ TEST_F(DashboardTest, JobTasksAndFarmJsonFollowTheWork) {
     EXPECT_TRUE(j["eta_s"].is_null());
     EXPECT_EQ(j["width"], 16);
 
-    RenderOne("w1", 0.5f);
-    RenderOne("w1", 0.5f);
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
     j = Call(Get("/api/jobs/" + job, alice_), 200);
     EXPECT_EQ(j["state"], "running");
     EXPECT_EQ(j["tasks_done"], 2);
@@ -299,8 +315,10 @@ TEST_F(DashboardTest, CancelAndPriorityChangeTheJob) {
 }
 
 TEST_F(DashboardTest, PreviewIsAPngThatChangesWhenATaskMerges) {
+    dashboard_ = std::make_unique<Dashboard>(
+        *farm_, *auth_, DashboardOptions{.preview_min_age = absl::ZeroDuration()});
     const std::string job = Submit("alice");
-    RenderOne("w1", 0.5f);
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
     const std::string path = "/api/jobs/" + job + "/preview.png";
     const HttpAnswer first = dashboard_->Serve(Get(path, alice_));
     ASSERT_EQ(first.status, 200) << first.body;
@@ -325,7 +343,7 @@ TEST_F(DashboardTest, PreviewIsAPngThatChangesWhenATaskMerges) {
     again.headers["if-none-match"] = etag;
     EXPECT_EQ(dashboard_->Serve(again).status, 304);
 
-    RenderOne("w1", 0.9f);
+    ASSERT_TRUE(RenderOne("w1", 0.9f));
     const HttpAnswer second = dashboard_->Serve(again);  // the old ETag
     ASSERT_EQ(second.status, 200);
     EXPECT_NE(HeaderOf(second, "ETag"), etag);
@@ -344,6 +362,28 @@ TEST_F(DashboardTest, PreviewIsAPngThatChangesWhenATaskMerges) {
     const Json metadata = Call(Get("/api/jobs/" + job + "/metadata", alice_), 200);
     EXPECT_EQ(metadata["attributes"]["lightfarm.spp"], 4);
     EXPECT_TRUE(metadata["attributes"]["lightfarm.method"].is_string());
+}
+
+// Many tabs on a job whose tasks merge fast cost one preview per preview_min_age.
+TEST_F(DashboardTest, ARunningJobsPreviewIsMadeAtMostOncePerMinimumAge) {
+    dashboard_ = std::make_unique<Dashboard>(*farm_, *auth_,
+                                             DashboardOptions{.preview_min_age = absl::Hours(1)});
+    const std::string job = Submit("alice");
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
+    const std::string path = "/api/jobs/" + job + "/preview.png";
+    const HttpAnswer first = dashboard_->Serve(Get(path, alice_));
+    ASSERT_EQ(first.status, 200);
+    ASSERT_TRUE(RenderOne("w1", 0.9f));
+    const HttpAnswer soon = dashboard_->Serve(Get(path, alice_));
+    EXPECT_EQ(soon.body, first.body);
+    EXPECT_EQ(HeaderOf(soon, "ETag"), HeaderOf(first, "ETag"));
+    // Ended, it is made again at once: the last tasks are never left out.
+    while (RenderOne("w1", 0.9f)) {
+    }
+    ASSERT_EQ(farm_->scheduler().Get(job)->state, JobState::kSucceeded);
+    const HttpAnswer final = dashboard_->Serve(Get(path, alice_));
+    ASSERT_EQ(final.status, 200);
+    EXPECT_NE(final.body, first.body);
 }
 
 TEST_F(DashboardTest, WhatARequestNamesIsBounded) {
