@@ -2,7 +2,7 @@
 // lightfarm CLI from the build, and Debian's headless Chromium driven by playwright-core.
 // Checks: a wrong token is refused; signed in, a job submitted from the CLI appears and its
 // progress rises; the preview loads and changes while tiles land; a task's log opens; a job
-// cancelled from the page is cancelled for the CLI too. Screenshots of every page go to
+// cancelled from the page (after its priority was raised there) is so for the CLI too. Screenshots of every page go to
 // SCREENSHOTS (the build's web-screenshots/).
 //
 //   node dashboard_e2e.mjs BIN_DIR SCENES_DIR SCREENSHOTS_DIR
@@ -156,10 +156,17 @@ try {
   check(true, `the farm page shows the queue depth (${await page.textContent('#queue-depth .value')}) and throughput`);
   await page.screenshot({ path: join(shotsDir, 'farm.png'), fullPage: true });
 
-  // Cancel a job from its page; the CLI agrees.
+  // Raise a job's priority and cancel it from its page; the CLI agrees.
   const doomed = submit(['--spp', '65536', '--passes', '64', '--name', 'doomed']);
   await page.goto(`${base}/#/job/${doomed}`);
   await page.waitForSelector('#state');
+  await page.fill('#priority', '5');
+  await page.click('#set-priority');
+  const raised = await until('the new priority', () => {
+    const line = cli(['status', doomed, '--json'], aliceToken);
+    return /"priority":\s*5\b/.test(line) && line;
+  });
+  check(raised, 'a priority set on the page is the one the CLI sees');
   page.once('dialog', (d) => d.accept());
   await page.click('#cancel');
   await until('the cancelled state', async () => (await page.textContent('#state')) === 'cancelled');
