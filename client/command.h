@@ -33,5 +33,7 @@ Command AddCancelCommand(CLI::App& app);
 Command AddPriorityCommand(CLI::App& app);
 Command AddDeleteCommand(CLI::App& app);
 Command AddWorkersCommand(CLI::App& app);
+Command AddTasksCommand(CLI::App& app);
+Command AddLogsCommand(CLI::App& app);
 
 }  // namespace lf

@@ -1,6 +1,6 @@
 // The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel, priority,
-// delete and workers, each a call to lightfarm-server's JobService. All protobuf handling of the
-// client is in this file.
+// delete, workers, tasks and logs, each a call to lightfarm-server's JobService. All protobuf
+// handling of the client is in this file.
 #include <google/protobuf/util/json_util.h>
 #include <grpcpp/grpcpp.h>
 #include <unistd.h>
@@ -15,6 +15,7 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "adaptive_flags.h"
@@ -397,7 +398,8 @@ void PrintJob(const pb::Job& job) {
     } else {
         std::printf("  time      %.1f s queued\n", seconds(job.submitted_unix_ms(), now));
     }
-    if (!IsFinal(job.state()) && !job.last_error().empty()) {
+    // A failed job's error names the failing task; its last error says what that one did.
+    if ((!IsFinal(job.state()) || job.state() == pb::Job::FAILED) && !job.last_error().empty()) {
         std::printf("  last error  %s\n", job.last_error().c_str());
     }
     if (!job.error().empty()) std::printf("  error     %s\n", job.error().c_str());
@@ -773,6 +775,124 @@ Command AddWorkersCommand(CLI::App& app) {
                                 w.seconds_since_seen());
                 }
                 return 0;
+            }};
+}
+
+namespace {
+
+std::string TaskStateName(pb::TaskInfo::State s) {
+    return absl::AsciiStrToLower(pb::TaskInfo::State_Name(s));
+}
+
+std::string TaskKindName(pb::TaskInfo::Kind k) {
+    return absl::AsciiStrToLower(pb::TaskInfo::Kind_Name(k));
+}
+
+// "2026-11-26 23:40:01.123 task 3 #1 worker-a info     text", in the local time zone. The text
+// was made safe by the server; the worker's id is escaped here.
+void PrintLogLine(const pb::TaskLogLine& line) {
+    const std::string time = absl::FormatTime(
+        "%Y-%m-%d %H:%M:%E3S", absl::FromUnixMillis(line.unix_ms()), absl::LocalTimeZone());
+    std::printf("%s task %d #%d %s %-8s %s\n", time.c_str(), line.task_index(), line.attempt(),
+                LogSafe(line.worker(), 64).c_str(), line.level().c_str(), line.text().c_str());
+}
+
+}  // namespace
+
+Command AddTasksCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand(
+        "tasks",
+        "List a job's tasks: state, kind, pixels, leases handed out, the worker of the last one,\n"
+        "how long it ran (or runs so far) and its last error. An ended job's as the server\n"
+        "recorded them when it ended.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddJsonFlag(cmd, *json);
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id, json] {
+                pb::ListTasksRequest req;
+                req.set_job_id(*id);
+                pb::ListTasksResponse resp;
+                absl::Status s =
+                    CallStatus(Connect(*flags)->ListTasks(
+                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
+                               *flags);
+                if (!s.ok()) return ReportError(s);
+                if (*json) {
+                    for (const pb::TaskInfo& t : resp.tasks()) PrintJson(t);
+                    return 0;
+                }
+                std::printf("%5s %-8s %-15s %-17s %8s %-20s %9s  %s\n", "TASK", "STATE", "KIND",
+                            "PIXELS", "ATTEMPTS", "WORKER", "DURATION", "LAST-ERROR");
+                for (const pb::TaskInfo& t : resp.tasks()) {
+                    const std::string pixels =
+                        t.width() > 0
+                            ? absl::StrCat(t.x(), ",", t.y(), " ", t.width(), "x", t.height())
+                            : "-";
+                    const std::string duration =
+                        t.leased_unix_ms() > 0 ? absl::StrFormat("%.2f s", t.seconds()) : "-";
+                    std::printf("%5d %-8s %-15s %-17s %8d %-20s %9s  %s\n", t.index(),
+                                TaskStateName(t.state()).c_str(), TaskKindName(t.kind()).c_str(),
+                                pixels.c_str(), t.attempts(),
+                                t.worker().empty() ? "-" : LogSafe(t.worker(), 20).c_str(),
+                                duration.c_str(), LogSafe(t.last_error(), 200).c_str());
+                }
+                return 0;
+            }};
+}
+
+Command AddLogsCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto task = std::make_shared<int>(-1);
+    auto follow = std::make_shared<bool>(false);
+    auto json = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand(
+        "logs",
+        "Print what workers logged while running a job's tasks, in the order the server took\n"
+        "the lines: time, task, attempt (#1 is the first lease), worker, level, text. The server\n"
+        "keeps each task's most recent lines (docs/farm.md, Tasks and logs).");
+    cmd->add_option("job", *id, "job id")->required();
+    cmd->add_option("--task", *task, "only this task's lines (its index, as `lightfarm tasks`)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--follow,-f", *follow,
+                  "keep printing new lines (polling twice a second) until the job ends; exit 0");
+    AddJsonFlag(cmd, *json);
+    AddServerOption(cmd, *flags);
+    AddRetryOption(cmd, *flags);
+    return {cmd, [flags, id, task, follow, json] {
+                std::unique_ptr<pb::JobService::Stub> stub = Connect(*flags);
+                pb::GetTaskLogsRequest req;
+                req.set_job_id(*id);
+                if (*task >= 0) req.set_task_index(*task);
+                Backoff backoff(*flags);
+                while (true) {
+                    pb::GetTaskLogsResponse resp;
+                    const absl::Status s = CallStatus(
+                        stub->GetTaskLogs(ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
+                        *flags);
+                    if (absl::IsUnavailable(s) && backoff.Wait("logs " + *id, s)) {
+                        stub = Connect(*flags);
+                        continue;
+                    }
+                    if (!s.ok()) return ReportError(s);
+                    backoff.Reset();
+                    for (const pb::TaskLogLine& line : resp.lines()) {
+                        if (*json) {
+                            PrintJson(line);
+                        } else {
+                            PrintLogLine(line);
+                        }
+                    }
+                    std::fflush(stdout);
+                    req.set_after_seq(resp.next_seq());
+                    if (resp.job_ended()) return 0;
+                    if (!resp.lines().empty()) continue;  // more may be kept: the next page
+                    if (!*follow) return 0;
+                    absl::SleepFor(absl::Milliseconds(500));
+                }
             }};
 }
 

@@ -352,6 +352,14 @@ std::vector<TaskStatus> Scheduler::TaskStatuses(const Job& job, absl::Time now) 
             status.duration = now - task.leased_at;
         }
     }
+    // An ended job's tasks that were not done never will be: its failing task included, whose
+    // last failure ended the job before it went back to the queue.
+    if (IsFinal(job.record.state)) {
+        for (TaskStatus& status : statuses) {
+            if (status.state != TaskStatus::State::kDone)
+                status.state = TaskStatus::State::kDropped;
+        }
+    }
     return statuses;
 }
 

@@ -331,7 +331,8 @@ class Farm : public ::testing::Test {
 };
 
 TEST_F(Farm, HelpExplainsEveryFarmCommand) {
-    for (const char* cmd : {"submit", "list", "status", "watch", "fetch", "cancel", "delete"}) {
+    for (const char* cmd :
+         {"submit", "list", "status", "watch", "fetch", "cancel", "delete", "tasks", "logs"}) {
         const CliRun r = Lightfarm(std::string(cmd) + " --help");
         EXPECT_EQ(r.status, 0) << cmd;
         EXPECT_NE(r.out.find("--server"), std::string::npos) << cmd << r.out;
@@ -383,6 +384,102 @@ TEST_F(Farm, ListStatusAndWorkersPrintOneJsonObjectALine) {
     EXPECT_EQ(worker["name"], "node \"7\"");  // escaped, and read back as it was given
     EXPECT_EQ(worker["state"], "IDLE");
     EXPECT_FALSE(worker["version"].get<std::string>().empty());
+}
+
+std::vector<nlohmann::json> JsonLines(const std::string& out) {
+    std::vector<nlohmann::json> objects;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);) {
+        objects.push_back(nlohmann::json::parse(line));
+    }
+    return objects;
+}
+
+// `lightfarm logs` prints what the worker logged during each task, one task's with --task, as
+// JSON with --json; `lightfarm tasks` lists them. A task failing on its worker (its scene's
+// blob gone from the server) fails the job naming the task and its error, and --follow prints
+// the error lines until the job ends.
+TEST_F(Farm, LogsAndTasksShowWhatEachTaskDidAndWhyOneFailed) {
+    StartServer();
+    Child* worker = StartWorker("w1");
+    const std::string job = Submit(scene_, "--spp 2 --tile 32");  // 4 tasks
+    ASSERT_EQ(Farmctl("watch " + job).status, 0);
+
+    const CliRun logs = Farmctl("logs " + job);
+    ASSERT_EQ(logs.status, 0) << logs.err;
+    for (int t = 0; t < 4; ++t) {
+        const std::string ids = " task " + std::to_string(t) + " #1 ";
+        EXPECT_NE(logs.out.find(ids), std::string::npos) << logs.out;
+        EXPECT_NE(logs.out.find("task=" + std::to_string(t) + " leased: path, pixels"),
+                  std::string::npos)
+            << logs.out;
+    }
+    EXPECT_NE(logs.out.find("rendered in"), std::string::npos) << logs.out;
+
+    const CliRun one = Farmctl("logs " + job + " --task 2");
+    ASSERT_EQ(one.status, 0) << one.err;
+    std::istringstream lines(one.out);
+    int count = 0;
+    for (std::string line; std::getline(lines, line); ++count) {
+        EXPECT_NE(line.find(" task 2 #1 "), std::string::npos) << line;
+    }
+    EXPECT_GE(count, 3) << one.out;  // leased, scene, rendered
+
+    const std::vector<nlohmann::json> json = JsonLines(Farmctl("logs --json " + job).out);
+    ASSERT_FALSE(json.empty());
+    std::set<int> tasks_logged;
+    for (const nlohmann::json& line : json) {
+        tasks_logged.insert(line["task_index"].get<int>());
+        EXPECT_EQ(line["attempt"], 1);
+        EXPECT_EQ(line["level"], "info");
+        EXPECT_FALSE(line["worker"].get<std::string>().empty());
+    }
+    EXPECT_EQ(tasks_logged, (std::set<int>{0, 1, 2, 3}));
+
+    const std::vector<nlohmann::json> tasks = JsonLines(Farmctl("tasks --json " + job).out);
+    ASSERT_EQ(tasks.size(), 4u);
+    for (const nlohmann::json& task : tasks) {
+        EXPECT_EQ(task["state"], "DONE");
+        EXPECT_EQ(task["kind"], "TILE");
+        EXPECT_EQ(task["width"], 32);
+        EXPECT_EQ(task["attempts"], 1);
+        EXPECT_GE(task["log_lines"].get<int>(), 3);
+    }
+
+    // A new worker with an empty cache, for a job whose blob the server lost: each lease fails.
+    worker->Signal(SIGTERM);
+    ASSERT_TRUE(worker->Wait(milliseconds(10000)));
+    const std::string failing = Submit(WriteScene("cornell32.json", 32), "--spp 2 --tile 32");
+    for (const auto& e : fs::directory_iterator(dir_ / "data" / "blobs")) {
+        if (e.is_regular_file()) fs::remove(e.path());
+    }
+    StartWorker("w2");
+    const CliRun follow = Farmctl("logs --follow " + failing);
+    ASSERT_EQ(follow.status, 0) << follow.err;
+    EXPECT_NE(follow.out.find(" task 0 #3 "), std::string::npos) << follow.out;
+    EXPECT_NE(follow.out.find("error"), std::string::npos) << follow.out;
+    EXPECT_NE(follow.out.find("task=0 failed after"), std::string::npos) << follow.out;
+    EXPECT_NE(follow.out.find("no blob"), std::string::npos) << follow.out;
+
+    const CliRun status = Farmctl("status " + failing);
+    EXPECT_NE(status.out.find("failed"), std::string::npos) << status.out;
+    EXPECT_NE(status.out.find("error     task 0 failed 3 times; last: no blob"), std::string::npos)
+        << status.out;
+    EXPECT_NE(status.out.find("last error  task 0: no blob"), std::string::npos) << status.out;
+    const std::vector<nlohmann::json> failed = JsonLines(Farmctl("tasks --json " + failing).out);
+    ASSERT_EQ(failed.size(), 1u);
+    EXPECT_EQ(failed[0]["state"], "DROPPED");
+    EXPECT_EQ(failed[0]["failures"], 3);
+    EXPECT_NE(failed[0]["last_error"].get<std::string>().find("no blob"), std::string::npos);
+
+    // An ended job's tasks and logs outlive the server; they go with the job.
+    CrashAndRestartServer();
+    EXPECT_EQ(JsonLines(Farmctl("tasks --json " + job).out).size(), 4u);
+    EXPECT_EQ(JsonLines(Farmctl("logs --json " + job).out).size(), json.size());
+    ASSERT_EQ(Farmctl("delete " + job).status, 0);
+    const CliRun gone = Farmctl("logs " + job);
+    EXPECT_NE(gone.status, 0);
+    EXPECT_NE(gone.err.find("no job " + job), std::string::npos) << gone.err;
 }
 
 TEST_F(Farm, SameBitsAsLocalRenderForAnyWorkersAndTiles) {

@@ -575,6 +575,81 @@ TEST_F(FakeWorkerFarm, ForgedNewlineInAWorkerIdDoesNotReachTheLogRaw) {
     EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
 }
 
+// A worker's task log lines are kept under its lease's task and attempt only when it holds that
+// lease; the last ones come with the result and are kept before the job ends with it, so a
+// client that sees the job ended has every line.
+TEST_F(FakeWorkerFarm, TaskLogLinesAreKeptOnlyFromTheLeasesWorkerAndBeforeItsJobEnds) {
+    const std::string job = Submit(nullptr, /*tile=*/16);  // one task
+    const pb::Task task = *Lease("honest");
+    const auto heartbeat = [&](const std::string& lease_id, const std::string& worker,
+                               const std::string& text) {
+        pb::HeartbeatRequest request;
+        request.set_lease_id(lease_id);
+        request.set_worker_id(worker);
+        pb::WorkerLogLine* line = request.add_log();
+        line->set_unix_ms(1'700'000'000'000);
+        line->set_level("info");
+        line->set_text(text);
+        pb::HeartbeatResponse response;
+        grpc::ClientContext context;
+        EXPECT_TRUE(worker_stub_->Heartbeat(&context, request, &response).ok());
+    };
+    heartbeat(task.lease_id(), "honest", "rendering");
+    heartbeat(task.lease_id(), "liar", "forged by another worker");
+    heartbeat(task.job_id() + "/0/x-1", "honest", "forged lease");
+
+    pb::CompleteTaskRequest result;
+    result.set_lease_id(task.lease_id());
+    result.set_worker_id("honest");
+    result.set_tile_sums(HonestResult(task));
+    pb::WorkerLogLine* last = result.add_log();
+    last->set_level("error");
+    last->set_text("done");
+    pb::CompleteTaskResponse completed;
+    {
+        grpc::ClientContext context;
+        ASSERT_TRUE(worker_stub_->CompleteTask(&context, result, &completed).ok());
+    }
+    EXPECT_EQ(GetJob(job).state(), pb::Job::SUCCEEDED);
+
+    pb::GetTaskLogsRequest request;
+    request.set_job_id(job);
+    pb::GetTaskLogsResponse logs;
+    {
+        grpc::ClientContext context;
+        ASSERT_TRUE(job_stub_->GetTaskLogs(&context, request, &logs).ok());
+    }
+    ASSERT_EQ(logs.lines_size(), 2);
+    EXPECT_EQ(logs.lines(0).text(), "rendering");
+    EXPECT_EQ(logs.lines(0).unix_ms(), 1'700'000'000'000);
+    EXPECT_EQ(logs.lines(1).text(), "done");
+    EXPECT_EQ(logs.lines(1).level(), "error");
+    for (const pb::TaskLogLine& line : logs.lines()) {
+        EXPECT_EQ(line.task_index(), task.task_index());
+        EXPECT_EQ(line.attempt(), 1);
+        EXPECT_EQ(line.worker(), "honest");
+    }
+    EXPECT_EQ(logs.next_seq(), logs.lines(1).seq());
+    EXPECT_TRUE(logs.job_ended());
+
+    pb::ListTasksRequest list;
+    list.set_job_id(job);
+    pb::ListTasksResponse tasks;
+    {
+        grpc::ClientContext context;
+        ASSERT_TRUE(job_stub_->ListTasks(&context, list, &tasks).ok());
+    }
+    ASSERT_EQ(tasks.tasks_size(), 1);
+    EXPECT_EQ(tasks.tasks(0).state(), pb::TaskInfo::DONE);
+    EXPECT_EQ(tasks.tasks(0).worker(), "honest");
+    EXPECT_EQ(tasks.tasks(0).log_lines(), 2);
+
+    request.set_job_id("job-0000000000");
+    grpc::ClientContext context;
+    EXPECT_EQ(job_stub_->GetTaskLogs(&context, request, &logs).error_code(),
+              grpc::StatusCode::NOT_FOUND);
+}
+
 TEST(RefusedResultLineTest, EveryWireValueIsEscaped) {
     const std::string line = RefusedResultLine("lease\r1", "w\n2", "ipv4:1.2.3.4:5", "why\x1b");
     EXPECT_EQ(line,

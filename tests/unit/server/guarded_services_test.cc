@@ -207,6 +207,18 @@ TEST_F(GuardedServices, SubmitterSeesOnlyItsOwnJobsAdminSeesAll) {
         EXPECT_FALSE(reader->Read(&update));
         expect_hidden(reader->Finish());
     }
+    pb::ListTasksRequest list_tasks;
+    list_tasks.set_job_id(alice_job);
+    pb::ListTasksResponse tasks;
+    expect_hidden(bob->ListTasks(Context().get(), list_tasks, &tasks));
+    EXPECT_EQ(tasks.tasks_size(), 0);
+    pb::GetTaskLogsRequest get_logs;
+    get_logs.set_job_id(alice_job);
+    pb::GetTaskLogsResponse logs;
+    expect_hidden(bob->GetTaskLogs(Context().get(), get_logs, &logs));
+    ASSERT_TRUE(Jobs("alice")->ListTasks(Context().get(), list_tasks, &tasks).ok());
+    EXPECT_GT(tasks.tasks_size(), 0);
+    EXPECT_TRUE(Jobs("alice")->GetTaskLogs(Context().get(), get_logs, &logs).ok());
     // Alice's own calls work, and the admin may cancel anyone's job.
     EXPECT_TRUE(Jobs("alice")->CancelJob(Context().get(), cancel, &job).ok());
     pb::CancelJobRequest cancel_bob;

@@ -126,9 +126,9 @@ TEST_F(SchedulerTasksTest, AnEndedJobsTasksAreHandedOnOnceAndLeaveMemory) {
     EXPECT_EQ(tasks[size_t(lease.task.index)].state, TaskStatus::State::kDone);
     EXPECT_EQ(tasks[size_t(lease.task.index)].worker, "a");
     EXPECT_EQ(tasks[size_t(lease.task.index)].duration, absl::Seconds(1));
-    int queued = 0;
-    for (const TaskStatus& t : tasks) queued += t.state == TaskStatus::State::kQueued;
-    EXPECT_EQ(queued, 3);
+    int dropped = 0;  // never to be done
+    for (const TaskStatus& t : tasks) dropped += t.state == TaskStatus::State::kDropped;
+    EXPECT_EQ(dropped, 3);
 }
 
 TEST_F(SchedulerTasksTest, AFailedJobsTasksKeepTheFailingTasksLastError) {
@@ -141,6 +141,7 @@ TEST_F(SchedulerTasksTest, AFailedJobsTasksKeepTheFailingTasksLastError) {
     }
     EXPECT_EQ(scheduler_.Get(id)->state, JobState::kFailed);
     ASSERT_EQ(ended_.count(id), 1u);
+    EXPECT_EQ(ended_[id][0].state, TaskStatus::State::kDropped);
     EXPECT_EQ(ended_[id][0].failures, 3);
     EXPECT_EQ(ended_[id][0].attempts, 3);
     EXPECT_EQ(ended_[id][0].last_error, "bad scene (worker a)");
