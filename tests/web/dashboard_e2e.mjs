@@ -167,6 +167,9 @@ try {
     return /"priority":\s*5\b/.test(line) && line;
   });
   check(raised, 'a priority set on the page is the one the CLI sees');
+  const answer = cli(['priority', doomed, '7'], aliceToken);
+  await until('the page to show the CLI\'s priority', async () => (await page.inputValue('#priority')) === '7');
+  check(true, `a priority set with the CLI (${answer}) shows on the page`);
   page.once('dialog', (d) => d.accept());
   await page.click('#cancel');
   await until('the cancelled state', async () => (await page.textContent('#state')) === 'cancelled');
