@@ -204,11 +204,22 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
     }
     // Health and farm-wide counts without a token; the dashboard behind the same tokens (and
-    // the same certificate) as the gRPC port.
+    // the same certificate) as the gRPC port, and under the same rule: beyond loopback, tokens
+    // travel only over TLS unless --insecure.
     std::unique_ptr<lf::HttpListener> http_listener;
     if (!http.empty()) {
-        absl::StatusOr<std::unique_ptr<lf::HttpListener>> started = lf::HttpListener::Start(
-            http, **farm, {.dashboard_auth = &auth, .tls_cert = tls.cert, .tls_key = tls.key});
+        const bool dashboard = lf::CheckListenPolicy(http, tls.enabled(), insecure).ok();
+        if (!dashboard) {
+            spdlog::warn(
+                "--http {}: the dashboard is off: beyond loopback it needs TLS (--tls-cert, "
+                "--tls-key) or --insecure; /healthz and /metrics are served",
+                http);
+        }
+        absl::StatusOr<std::unique_ptr<lf::HttpListener>> started =
+            lf::HttpListener::Start(http, **farm,
+                                    {.dashboard_auth = dashboard ? &auth : nullptr,
+                                     .tls_cert = tls.cert,
+                                     .tls_key = tls.key});
         if (!started.ok()) return fail(started.status());
         http_listener = std::move(*started);
         // Port 0 picks one: say which, as for --listen.
