@@ -4,6 +4,9 @@ import { get, post } from './api.js';
 import { duration, h, progress, svg, table, time } from './format.js';
 
 const ended = (state) => ['succeeded', 'failed', 'cancelled'].includes(state);
+// Rows of the tasks table: a job may have thousands of tasks; those worth a look come first.
+const kMaxTaskRows = 200;
+const rank = (t) => (t.state === 'running' ? 0 : t.failures > 0 ? 1 : t.state === 'done' ? 2 : 3);
 
 export function mount(root, id) {
   const path = `jobs/${encodeURIComponent(id)}`;
@@ -74,7 +77,8 @@ export function mount(root, id) {
   }
 
   async function refresh() {
-    const job = await get(path);
+    // Both asked at once, drawn together: the summary and the tasks agree.
+    const [job, { tasks: list }] = await Promise.all([get(path), get(`${path}/tasks`)]);
     summary.replaceChildren(table(['State', 'Owner', 'Method', 'Size', 'Progress', 'Submitted', 'Started', 'Finished', 'ETA'], [
       h('tr', {}, h('td', { class: 'state', id: 'state' }, job.state), h('td', {}, job.owner || '—'), h('td', {}, job.method),
         h('td', {}, `${job.width}×${job.height}, ${job.spp} spp`), h('td', {}, progress(job.tasks_done, job.tasks_total)),
@@ -85,13 +89,14 @@ export function mount(root, id) {
     setPriority.disabled = ended(job.state);
     if (!editing) priority.value = job.priority;
 
-    const { tasks: list } = await get(`${path}/tasks`);
     drawTiles(job, list);
-    tasks.replaceChildren(table(['Task', 'State', 'Worker', 'Attempts', 'Duration', 'Log lines'], list.map((t) =>
+    const rows = [...list].sort((a, b) => rank(a) - rank(b) || a.index - b.index).slice(0, kMaxTaskRows);
+    tasks.replaceChildren(table(['Task', 'State', 'Worker', 'Attempts', 'Duration', 'Log lines'], rows.map((t) =>
       h('tr', { class: `task ${t.state}${t.index === logTask ? ' open' : ''}`, 'data-task': t.index, onclick: () => openLog(t.index) },
         h('td', {}, `${t.index} (${t.kind} ${t.x},${t.y} ${t.width}×${t.height})`), h('td', {}, t.state),
         h('td', {}, t.worker || '—'), h('td', { class: 'number' }, String(t.attempts)),
-        h('td', {}, t.attempts ? `${(t.duration_ms / 1000).toFixed(1)} s` : '—'), h('td', { class: 'number' }, String(t.log_lines))))));
+        h('td', {}, t.attempts ? `${(t.duration_ms / 1000).toFixed(1)} s` : '—'), h('td', { class: 'number' }, String(t.log_lines))))),
+    list.length > rows.length ? h('p', {}, `${list.length - rows.length} more tasks not listed (running, failed and done ones first).`) : '');
 
     // The preview is fetched again only when a task was merged since (or the job ended).
     const version = `${job.tasks_done}-${job.state}`;
