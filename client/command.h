@@ -30,6 +30,7 @@ Command AddStatusCommand(CLI::App& app);
 Command AddWatchCommand(CLI::App& app);
 Command AddFetchCommand(CLI::App& app);
 Command AddCancelCommand(CLI::App& app);
+Command AddPriorityCommand(CLI::App& app);
 Command AddDeleteCommand(CLI::App& app);
 Command AddWorkersCommand(CLI::App& app);
 Command AddTasksCommand(CLI::App& app);

@@ -1,6 +1,6 @@
-// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel, delete,
-// workers, tasks and logs, each a call to lightfarm-server's JobService. All protobuf handling of
-// the client is in this file.
+// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel, priority,
+// delete, workers, tasks and logs, each a call to lightfarm-server's JobService. All protobuf
+// handling of the client is in this file.
 #include <google/protobuf/util/json_util.h>
 #include <grpcpp/grpcpp.h>
 #include <unistd.h>
@@ -719,6 +719,31 @@ Command AddCancelCommand(CLI::App& app) {
             std::printf("job %s %s\n", job.id().c_str(), StateName(job.state()).c_str());
             return 0;
         }};
+}
+
+Command AddPriorityCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto priority = std::make_shared<int>(0);
+    CLI::App* cmd = app.add_subcommand(
+        "priority",
+        "Change a queued or running job's priority: higher runs first, from the next task on.");
+    cmd->add_option("job", *id, "job id")->required();
+    cmd->add_option("priority", *priority, "the new priority (submit's --priority)")->required();
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id, priority] {
+                pb::SetJobPriorityRequest req;
+                req.set_job_id(*id);
+                req.set_priority(*priority);
+                pb::Job job;
+                absl::Status s =
+                    CallStatus(Connect(*flags)->SetJobPriority(
+                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &job),
+                               *flags);
+                if (!s.ok()) return ReportError(s);
+                std::printf("job %s priority %d\n", job.id().c_str(), job.priority());
+                return 0;
+            }};
 }
 
 Command AddDeleteCommand(CLI::App& app) {

@@ -18,11 +18,11 @@ int main(int argc, char** argv) {
         ->capture_default_str();
 
     const std::vector<lf::Command> commands = {
-        lf::AddRenderCommand(app), lf::AddBenchCommand(app),  lf::AddConvergeCommand(app),
-        lf::AddPlanCommand(app),   lf::AddSubmitCommand(app), lf::AddListCommand(app),
-        lf::AddStatusCommand(app), lf::AddWatchCommand(app),  lf::AddFetchCommand(app),
-        lf::AddCancelCommand(app), lf::AddDeleteCommand(app), lf::AddWorkersCommand(app),
-        lf::AddTasksCommand(app),  lf::AddLogsCommand(app),
+        lf::AddRenderCommand(app),  lf::AddBenchCommand(app),    lf::AddConvergeCommand(app),
+        lf::AddPlanCommand(app),    lf::AddSubmitCommand(app),   lf::AddListCommand(app),
+        lf::AddStatusCommand(app),  lf::AddWatchCommand(app),    lf::AddFetchCommand(app),
+        lf::AddCancelCommand(app),  lf::AddPriorityCommand(app), lf::AddDeleteCommand(app),
+        lf::AddWorkersCommand(app), lf::AddTasksCommand(app),    lf::AddLogsCommand(app),
     };
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::from_str(log_level));

@@ -37,6 +37,8 @@ const char* ActionName(Action action) {
             return "see jobs";
         case Action::kCancelJob:
             return "cancel jobs";
+        case Action::kSetPriority:
+            return "change job priorities";
         case Action::kDeleteJob:
             return "delete jobs";
         case Action::kListWorkers:

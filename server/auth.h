@@ -25,6 +25,7 @@ enum class Action {
     kSubmit,
     kReadJobs,     // GetJob, ListJobs, WatchJob, FetchResult: own jobs, or all for an admin
     kCancelJob,    // own jobs, or all for an admin
+    kSetPriority,  // own jobs, or all for an admin
     kDeleteJob,    // own jobs, or all for an admin
     kListWorkers,  // the farm's workers: admins and submitters
     kWork,         // LeaseTask, Heartbeat, CompleteTask, FailTask, FetchBlob

@@ -475,3 +475,11 @@ void Farm::SweepTemporaryFiles() {
 }
 
 }  // namespace lf
+
+namespace lf {
+
+absl::StatusOr<JobRecord> Farm::SetPriority(const std::string& job_id, int priority) {
+    return scheduler_.SetPriority(job_id, priority);
+}
+
+}  // namespace lf

@@ -304,6 +304,21 @@ grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
     return grpc::Status::OK;
 }
 
+grpc::Status JobServiceImpl::SetJobPriority(grpc::ServerContext* context,
+                                            const pb::SetJobPriorityRequest* req, pb::Job* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "SetJobPriority", Action::kSetPriority);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(*caller, req->job_id()); !seen.ok()) {
+        return ToGrpcStatus(seen.status());
+    }
+    absl::StatusOr<JobRecord> job = farm_.SetPriority(req->job_id(), req->priority());
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    Log()->info("job={} priority set to {} by {} from {}", job->id, req->priority(), Who(*caller),
+                Peer(context));
+    ToProto(*job, resp);
+    return grpc::Status::OK;
+}
+
 grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context,
                                          const pb::FetchResultRequest* req,
                                          grpc::ServerWriter<pb::Chunk>* writer) {

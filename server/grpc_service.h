@@ -58,6 +58,9 @@ class JobServiceImpl final : public lightfarm::v1::JobService::Service {
                           grpc::ServerWriter<lightfarm::v1::Job>*) override;
     grpc::Status CancelJob(grpc::ServerContext*, const lightfarm::v1::CancelJobRequest*,
                            lightfarm::v1::Job*) override;
+    grpc::Status SetJobPriority(grpc::ServerContext*,
+                                const lightfarm::v1::SetJobPriorityRequest*,
+                                lightfarm::v1::Job*) override;
     grpc::Status FetchResult(grpc::ServerContext*, const lightfarm::v1::FetchResultRequest*,
                              grpc::ServerWriter<lightfarm::v1::Chunk>*) override;
     grpc::Status DeleteJob(grpc::ServerContext*, const lightfarm::v1::DeleteJobRequest*,

@@ -3,11 +3,13 @@
 #include <httplib.h>
 #include <sys/socket.h>
 
+#include <cctype>
 #include <thread>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "lf/core/log.h"
+#include "server/dashboard.h"
 #include "server/metrics.h"
 
 namespace lf {
@@ -19,6 +21,30 @@ std::shared_ptr<spdlog::logger> Log() { return NamedLogger("http"); }
 constexpr char kText[] = "text/plain; charset=utf-8";
 // The exposition format's content type, version 0.0.4.
 constexpr char kMetricsType[] = "text/plain; version=0.0.4; charset=utf-8";
+
+// Each connection holds one of these threads while it is open: enough for probes, scrapes and a
+// few browsers' connections, which keep-alive holds no longer than kKeepAliveSeconds when idle.
+constexpr int kThreads = 16;
+constexpr time_t kKeepAliveSeconds = 1;
+// The dashboard's requests are small: a token, a priority.
+constexpr size_t kMaxBodyBytes = 64 << 10;
+
+HttpRequest FromHttplib(const httplib::Request& r) {
+    HttpRequest request{r.method, r.path, {}, {}, r.body, r.remote_addr};
+    for (const auto& [name, value] : r.params) request.query.emplace(name, value);
+    for (const auto& [name, value] : r.headers) {
+        std::string lower = name;
+        for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+        request.headers.emplace(std::move(lower), value);
+    }
+    return request;
+}
+
+void Reply(HttpAnswer a, httplib::Response& response) {
+    response.status = a.status;
+    for (auto& [name, value] : a.headers) response.set_header(name, value);
+    if (a.status != 304) response.set_content(std::move(a.body), a.content_type.c_str());
+}
 
 HttpAnswer Unavailable(const absl::Status& why) {
     return {503, kText, absl::StrCat("not ok: ", why.message(), "\n")};
@@ -74,15 +100,16 @@ HttpAnswer MetricsAnswer(Farm& farm) {
 }
 
 struct HttpListener::Server {
-    httplib::Server http;
+    std::unique_ptr<httplib::Server> http;  // an httplib::SSLServer under TLS
+    std::unique_ptr<Dashboard> dashboard;
     std::thread thread;
 };
 
 HttpListener::HttpListener(std::unique_ptr<Server> server, int port)
     : server_(std::move(server)), port_(port) {}
 
-absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(const std::string& host_port,
-                                                                  Farm& farm) {
+absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(
+    const std::string& host_port, Farm& farm, const HttpListenerOptions& options) {
     const size_t colon = host_port.rfind(':');
     int port = 0;
     if (colon == std::string::npos || colon == 0 ||
@@ -95,37 +122,62 @@ absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(const std::str
         host = host.substr(1, host.size() - 2);  // [::1]:9090
     }
     auto server = std::make_unique<Server>();
+    const bool tls = !options.tls_cert.empty() && !options.tls_key.empty();
+    if (tls) {
+        server->http =
+            std::make_unique<httplib::SSLServer>(options.tls_cert.c_str(), options.tls_key.c_str());
+        if (!server->http->is_valid()) {
+            return absl::FailedPreconditionError(
+                absl::StrCat("--http ", host_port, ": cannot use --tls-cert ", options.tls_cert,
+                             " and --tls-key ", options.tls_key, " for HTTPS"));
+        }
+    } else {
+        server->http = std::make_unique<httplib::Server>();
+    }
+    httplib::Server& http = *server->http;
     // httplib sets SO_REUSEPORT, with which a second server would share the port and answer
     // scrapes at random: only SO_REUSEADDR, so that a port in use is an error.
-    server->http.set_socket_options([](socket_t sock) {
+    http.set_socket_options([](socket_t sock) {
         int yes = 1;
         setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
     });
+    http.new_task_queue = [] { return new httplib::ThreadPool(kThreads); };
+    http.set_keep_alive_timeout(kKeepAliveSeconds);
+    http.set_payload_max_length(kMaxBodyBytes);
     auto answer = [&farm](HttpAnswer (*handler)(Farm&)) {
         return [&farm, handler](const httplib::Request&, httplib::Response& response) {
-            HttpAnswer a = handler(farm);
-            response.status = a.status;
-            response.set_content(std::move(a.body), a.content_type.c_str());
+            Reply(handler(farm), response);
         };
     };
-    server->http.Get("/healthz", answer(&HealthzAnswer));
-    server->http.Get("/metrics", answer(&MetricsAnswer));
-    const bool bound = port == 0 ? (port = server->http.bind_to_any_port(host)) > 0
-                                 : server->http.bind_to_port(host, port);
+    http.Get("/healthz", answer(&HealthzAnswer));
+    http.Get("/metrics", answer(&MetricsAnswer));
+    if (options.dashboard_auth) {
+        server->dashboard =
+            std::make_unique<Dashboard>(farm, *options.dashboard_auth, DashboardOptions{tls});
+        Dashboard* dashboard = server->dashboard.get();
+        auto serve = [dashboard](const httplib::Request& request, httplib::Response& response) {
+            Reply(dashboard->Serve(FromHttplib(request)), response);
+        };
+        http.Get("/|/web/.*|/api/.*", serve);
+        http.Post("/api/.*", serve);
+    }
+    const bool bound =
+        port == 0 ? (port = http.bind_to_any_port(host)) > 0 : http.bind_to_port(host, port);
     if (!bound) {
         return absl::FailedPreconditionError(absl::StrCat(
             "cannot listen on ", host_port, " for --http (is another process using the port?)"));
     }
-    httplib::Server* http = &server->http;
-    server->thread = std::thread([http] { http->listen_after_bind(); });
+    server->thread = std::thread([&http] { http.listen_after_bind(); });
     // stop() does nothing until the loop runs: wait for it, so the destructor can end it.
-    while (!server->http.is_running()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    Log()->info("serving /healthz and /metrics on {}:{}", host, port);
+    while (!http.is_running()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    Log()->info("serving /healthz, /metrics{} on {}://{}:{}",
+                options.dashboard_auth ? " and the dashboard" : "", tls ? "https" : "http", host,
+                port);
     return std::unique_ptr<HttpListener>(new HttpListener(std::move(server), port));
 }
 
 HttpListener::~HttpListener() {
-    server_->http.stop();
+    server_->http->stop();
     server_->thread.join();
 }
 

@@ -101,7 +101,8 @@ int main(int argc, char** argv) {
                    "HOST:PORT of a plain-text gRPC port that serves only grpc.health.v1.Health, "
                    "for probes that cannot speak TLS (Kubernetes' grpc probe); off if unset");
     app.add_option("--http", http,
-                   "HOST:PORT to serve GET /healthz and /metrics (Prometheus) on; off if unset");
+                   "HOST:PORT to serve GET /healthz, /metrics (Prometheus) and the web dashboard "
+                   "on, over HTTPS with --tls-cert and --tls-key; off if unset");
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
     lf::TokenCommand token_command(app);
@@ -202,11 +203,23 @@ int main(int argc, char** argv) {
                     health_port->port);
         std::fflush(stdout);
     }
-    // Plain HTTP without tokens: it serves health and farm-wide counts, nothing of any job.
+    // Health and farm-wide counts without a token; the dashboard behind the same tokens (and
+    // the same certificate) as the gRPC port, and under the same rule: beyond loopback, tokens
+    // travel only over TLS unless --insecure.
     std::unique_ptr<lf::HttpListener> http_listener;
     if (!http.empty()) {
+        const bool dashboard = lf::CheckListenPolicy(http, tls.enabled(), insecure).ok();
+        if (!dashboard) {
+            spdlog::warn(
+                "--http {}: the dashboard is off: beyond loopback it needs TLS (--tls-cert, "
+                "--tls-key) or --insecure; /healthz and /metrics are served",
+                http);
+        }
         absl::StatusOr<std::unique_ptr<lf::HttpListener>> started =
-            lf::HttpListener::Start(http, **farm);
+            lf::HttpListener::Start(http, **farm,
+                                    {.dashboard_auth = dashboard ? &auth : nullptr,
+                                     .tls_cert = tls.cert,
+                                     .tls_key = tls.key});
         if (!started.ok()) return fail(started.status());
         http_listener = std::move(*started);
         // Port 0 picks one: say which, as for --listen.

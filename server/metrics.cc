@@ -8,6 +8,36 @@
 
 namespace lf {
 
+namespace {
+
+int64_t UnixMinute(absl::Time t) { return absl::ToUnixSeconds(t) / 60; }
+
+}  // namespace
+
+void MinuteCounts::Add(absl::Time now, uint64_t n) {
+    const int64_t minute = UnixMinute(now);
+    Bucket& b = buckets_[size_t(minute % kMinutes)];
+    if (b.minute.load(std::memory_order_relaxed) != minute) {
+        // Emptied before it is stamped: a reader that sees the new minute sees no old count.
+        b.count.store(0, std::memory_order_relaxed);
+        b.minute.store(minute, std::memory_order_release);
+    }
+    b.count.fetch_add(n, std::memory_order_relaxed);
+}
+
+std::vector<uint64_t> MinuteCounts::LastHour(absl::Time now) const {
+    const int64_t last = UnixMinute(now);
+    std::vector<uint64_t> counts;
+    counts.reserve(kMinutes);
+    for (int64_t minute = last - kMinutes + 1; minute <= last; ++minute) {
+        const Bucket& b = buckets_[size_t(minute % kMinutes)];
+        counts.push_back(b.minute.load(std::memory_order_acquire) == minute
+                             ? b.count.load(std::memory_order_relaxed)
+                             : 0);
+    }
+    return counts;
+}
+
 Histogram::Histogram(std::vector<double> upper_bounds)
     : upper_bounds_(std::move(upper_bounds)),
       buckets_(std::make_unique<std::atomic<uint64_t>[]>(upper_bounds_.size() + 1)) {}

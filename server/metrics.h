@@ -4,12 +4,15 @@
 // their owners (the scheduler, the store) when the text is made.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "absl/time/time.h"
 
 namespace lf {
 
@@ -45,6 +48,24 @@ class Histogram {
     const std::vector<double> upper_bounds_;
     std::unique_ptr<std::atomic<uint64_t>[]> buckets_;  // not cumulative; the last is +Inf
     std::atomic<double> sum_{0};
+};
+
+// Counts per wall-clock minute over the last hour, for the dashboard's throughput chart: a ring
+// of one bucket per minute, reused an hour later. Adds come from one thread at a time (the
+// scheduler's lock serializes them); reads from any thread, without a lock.
+class MinuteCounts {
+  public:
+    static constexpr int kMinutes = 60;
+    void Add(absl::Time now, uint64_t n);
+    // The kMinutes minutes up to and including the one of `now`, oldest first.
+    std::vector<uint64_t> LastHour(absl::Time now) const;
+
+  private:
+    struct Bucket {
+        std::atomic<int64_t> minute{-1};  // since the Unix epoch
+        std::atomic<uint64_t> count{0};
+    };
+    std::array<Bucket, kMinutes> buckets_;
 };
 
 // Builds the exposition text, one metric family (HELP, TYPE, samples) per call.

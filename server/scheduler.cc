@@ -100,6 +100,15 @@ size_t Scheduler::TaskCount(const Job& job) {
     return job.frame ? job.frame->tasks().size() : job.merger->tasks().size();
 }
 
+uint64_t Scheduler::TaskSamples(const Job& job, int task) {
+    if (SweepChunkOf(job, task)) return 0;
+    const auto samples = [](const auto& t) {
+        return uint64_t(t.rect.width) * uint64_t(t.rect.height) * (t.sample_end - t.sample_begin);
+    };
+    return job.frame ? samples(job.frame->tasks()[size_t(task)])
+                     : samples(job.merger->tasks()[size_t(task)]);
+}
+
 size_t Scheduler::TasksDone(const Job& job) {
     return job.frame ? job.frame->tasks_done() : job.merger->tasks_done();
 }
@@ -810,6 +819,8 @@ void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
         metrics_.task_seconds.Observe(absl::ToDoubleSeconds(now - task.leased_at));
     }
     MoveTask(job, t, TaskState::kDone);
+    metrics_.tasks_done.Add(now, 1);
+    metrics_.samples_done.Add(now, TaskSamples(job, t));
 }
 
 absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
@@ -938,6 +949,29 @@ absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
     absl::StatusOr<JobRecord> record = store_.Get(job_id);
     if (!record.ok()) return record.status();
     return AlreadyEnded(*record);
+}
+
+absl::StatusOr<JobRecord> Scheduler::SetPriority(const std::string& job_id, int priority) {
+    JobRecord record;
+    uint64_t ticket = 0;
+    {
+        Locked locked(*this);
+        auto it = active_.find(job_id);
+        if (it == active_.end()) {
+            if (const JobRecord* ended = EndedRecord(job_id)) return AlreadyEnded(*ended);
+            locked.lock.unlock();  // the store is never read under the lock
+            absl::StatusOr<JobRecord> stored = store_.Get(job_id);
+            if (!stored.ok()) return stored.status();
+            return AlreadyEnded(*stored);
+        }
+        Job& job = *it->second;
+        Log()->info("job={} priority {} -> {}", job_id, job.record.spec.priority, priority);
+        job.record.spec.priority = priority;
+        ticket = Save(job);
+        record = job.record;
+    }
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
+    return record;
 }
 
 int Scheduler::ExpireLeases() {

@@ -67,6 +67,10 @@ struct SchedulerMetrics {
     // Per task done while leased: seconds from its lease to its accepted result (the render
     // and the result's transfer), as the server's clock measures them.
     Histogram task_seconds{{0.1, 0.25, 0.5, 1, 2.5, 5, 10, 30, 60, 120, 300, 600, 1800, 3600}};
+    // Tasks merged, and the samples they brought (pixels times samples per pixel of their camera
+    // part), per minute of the last hour: the dashboard's throughput.
+    MinuteCounts tasks_done;
+    MinuteCounts samples_done;
 };
 
 // What is queued and running now, for /metrics.
@@ -149,6 +153,11 @@ class Scheduler {
                       const std::string& reason, FailureKind kind);
 
     absl::StatusOr<JobRecord> Cancel(const std::string& job_id);
+
+    // A queued or running job's new priority: its queued tasks are leased in the new order from
+    // the next lease on. Returns the record once it is durable; FailedPrecondition for a job that
+    // has ended, NotFound for one the store does not hold.
+    absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
 
     // Re-queues the tasks whose lease ran out (each counts as a failure of the task), and
     // forgets the workers silent for a lease. Returns how many leases expired.
@@ -301,6 +310,8 @@ class Scheduler {
     static size_t TasksDone(const Job& job);
     static bool Rendered(const Job& job);
     static const RenderStats& StatsOf(const Job& job);
+    // Pixels times samples per pixel of a task's camera part; 0 for a radiosity sweep's.
+    static uint64_t TaskSamples(const Job& job, int task);
     // Grows the job to `count` tasks, the new ones waiting.
     static void Grow(Job& job, size_t count);
     // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.

@@ -106,7 +106,10 @@ uint8_t EncodeSrgb8(float linear) {
     return uint8_t(std::lround(s * 255.0f));
 }
 
-absl::Status WritePng(const std::string& path, const Image& image, const PngOptions& options) {
+namespace {
+
+// R,G,B of every pixel, 8-bit sRGB, row by row.
+std::vector<uint8_t> Srgb8Pixels(const Image& image, const PngOptions& options) {
     const float scale = float(std::exp2(options.exposure));
     std::vector<uint8_t> rgb(size_t(image.width()) * image.height() * 3);
     for (int y = 0; y < image.height(); ++y) {
@@ -116,11 +119,40 @@ absl::Status WritePng(const std::string& path, const Image& image, const PngOpti
             for (int k = 0; k < 3; ++k) out[k] = EncodeSrgb8(ApplyToneCurve(options.tone, c[k]));
         }
     }
+    return rgb;
+}
+
+png_image PngHeader(const Image& image) {
     png_image png{};
     png.version = PNG_IMAGE_VERSION;
     png.width = png_uint_32(image.width());
     png.height = png_uint_32(image.height());
     png.format = PNG_FORMAT_RGB;
+    return png;
+}
+
+}  // namespace
+
+absl::StatusOr<std::string> EncodePng(const Image& image, const PngOptions& options) {
+    const std::vector<uint8_t> rgb = Srgb8Pixels(image, options);
+    png_image png = PngHeader(image);
+    png_alloc_size_t size = 0;  // asked first, then written
+    std::string bytes;
+    if (png_image_write_to_memory(&png, nullptr, &size, 0, rgb.data(), 0, nullptr)) {
+        bytes.resize(size);
+        if (png_image_write_to_memory(&png, bytes.data(), &size, 0, rgb.data(), 0, nullptr)) {
+            bytes.resize(size);
+            return bytes;
+        }
+    }
+    std::string message = png.message;
+    png_image_free(&png);
+    return absl::InternalError("cannot encode PNG: " + message);
+}
+
+absl::Status WritePng(const std::string& path, const Image& image, const PngOptions& options) {
+    const std::vector<uint8_t> rgb = Srgb8Pixels(image, options);
+    png_image png = PngHeader(image);
     if (!png_image_write_to_file(&png, path.c_str(), 0, rgb.data(), 0, nullptr)) {
         std::string message = png.message;
         png_image_free(&png);

@@ -10,14 +10,16 @@
   certificates are docs/deploy.md's, made by its own openssl commands);
 - ports, Secret names and keys, mount paths, volumes, the user and the flags' paths agree across
   the Dockerfile, compose.yaml, the Kubernetes manifests and the systemd units;
+- probes and scrapes of --http use HTTPS where the server has a certificate;
 - a real server with docs/deploy.md's certificates accepts a worker's client certificate and a
-  token, answers Compose's health check, and serves the metric the HPA scales on.
+  token, answers Compose's health check, and serves the metric the HPA scales on over HTTPS.
 
 Every failure names the file and the mismatch; all are printed, then the exit status is 1.
 """
 import os
 import re
 import shutil
+import ssl
 import subprocess
 import sys
 import tempfile
@@ -612,6 +614,11 @@ def check_kubernetes(docs, images, pki):
                             errors.append(f"{where}: {kind} asks {hg.get('path')} on "
                                           f"{hg.get('port')}, not /healthz on --http's "
                                           f"{http_port}")
+                        # --http speaks HTTPS when the server has a certificate.
+                        scheme = "HTTPS" if v.get("--tls-cert") else "HTTP"
+                        if hg.get("scheme", "HTTP") != scheme:
+                            errors.append(f"{where}: {kind} asks with scheme "
+                                          f"{hg.get('scheme', 'HTTP')}, not {scheme}")
                     if "tcpSocket" in probe and resolve(probe["tcpSocket"].get("port")) not in ports:
                         errors.append(f"{where}: {kind} tcpSocket port "
                                       f"{probe['tcpSocket'].get('port')} is no containerPort")
@@ -632,6 +639,10 @@ def check_kubernetes(docs, images, pki):
                     fail(p, f"StatefulSet {name}: serviceName {spec.get('serviceName')} is not "
                             f"its Service")
                 annotations = spec["template"]["metadata"].get("annotations") or {}
+                if annotations.get("prometheus.io/scheme", "http") != (
+                        "https" if v.get("--tls-cert") else "http"):
+                    fail(p, f"StatefulSet {name}: prometheus.io/scheme "
+                            f"{annotations.get('prometheus.io/scheme')} is not --http's")
                 if str(annotations.get("prometheus.io/port")) != str(http_port):
                     fail(p, f"StatefulSet {name}: prometheus.io/port "
                             f"{annotations.get('prometheus.io/port')} is not --http's {http_port}")
@@ -898,12 +909,16 @@ def check_live(pki, compose_found, k8s_found, systemd_found):
         if not grpc or not http:
             errors.append(f"{rel(DOCS)}: a server with its certificates did not start: {lines}")
             return
-        metrics = urllib.request.urlopen(f"http://127.0.0.1:{http}/metrics", timeout=10).read()
+        # With --tls-cert, --http speaks HTTPS with the same certificate (names 127.0.0.1).
+        tls = ssl.create_default_context(cafile=pki["ca.crt"])
+        metrics = urllib.request.urlopen(f"https://127.0.0.1:{http}/metrics", timeout=10,
+                                         context=tls).read()
         if not re.search(rf"^{HPA_METRIC}\b", metrics.decode(), re.M):
             errors.append(f"{rel(K8S)}/worker-hpa.yaml: the server's /metrics has no {HPA_METRIC}")
         test = compose_found.get("healthcheck")
         if test and shutil.which("bash"):
-            script = [t.replace("127.0.0.1/8080", f"127.0.0.1/{http}") for t in test[1:]]
+            script = [re.sub(r"127\.0\.0\.1([/:])8080", rf"127.0.0.1\g<1>{http}", t)
+                      for t in test[1:]]
             r = subprocess.run(script, capture_output=True, text=True, timeout=20)
             if r.returncode != 0:
                 errors.append(f"{rel(COMPOSE)}: the server's healthcheck fails against a real "

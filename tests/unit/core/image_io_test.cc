@@ -135,6 +135,26 @@ TEST(Png, ClampIsTheSrgbCurveClipped) {
     std::filesystem::remove(path);
 }
 
+// In memory: the same pixels as the file, decoded by stb from the bytes.
+TEST(Png, EncodedInMemoryDecodesToTheFilesPixels) {
+    const Image image = Ramp(kRampValues);
+    const PngOptions options{.exposure = 1, .tone = ToneCurve::kFilmic};
+    absl::StatusOr<std::string> png = EncodePng(image, options);
+    ASSERT_TRUE(png.ok()) << png.status();
+    const std::string path = TempPath("memory.png");
+    ASSERT_TRUE(WritePng(path, image, options).ok());
+    const std::vector<int> from_file = DecodePng(path, int(kRampValues.size()));
+    int w = 0, h = 0, channels = 0;
+    unsigned char* data = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(png->data()),
+                                                int(png->size()), &w, &h, &channels, 3);
+    ASSERT_NE(data, nullptr);
+    EXPECT_EQ(w, int(kRampValues.size()));
+    EXPECT_EQ(h, 1);
+    EXPECT_EQ(std::vector<int>(data, data + size_t(w) * h * 3), from_file);
+    stbi_image_free(data);
+    std::filesystem::remove(path);
+}
+
 // --exposure EV multiplies the linear values by 2^EV before encoding: each EV doubles them.
 TEST(Png, ExposureDoublesLinearValuesPerEv) {
     const std::string path = TempPath("exposure.png");

@@ -11,9 +11,9 @@
 namespace lf {
 namespace {
 
-constexpr Action kAllActions[] = {Action::kUploadBlobs, Action::kSubmit,    Action::kReadJobs,
-                                  Action::kCancelJob,   Action::kDeleteJob, Action::kListWorkers,
-                                  Action::kWork};
+constexpr Action kAllActions[] = {Action::kUploadBlobs, Action::kSubmit,      Action::kReadJobs,
+                                  Action::kCancelJob,   Action::kSetPriority, Action::kDeleteJob,
+                                  Action::kListWorkers, Action::kWork};
 
 TEST(Permit, AdminMayDoEverything) {
     for (Action a : kAllActions) EXPECT_TRUE(Permit({"root", Role::kAdmin}, a).ok());

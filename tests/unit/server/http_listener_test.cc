@@ -1,6 +1,6 @@
 // lightfarm-server --http: the /metrics and /healthz handlers against a real Farm in a temporary
 // data folder (the counts follow a submission, a lease and a result), and the listener itself on
-// a port the OS picks, and refusing a port in use.
+// a port the OS picks, refusing a port in use, and over HTTPS with the dashboard.
 #include "server/http_listener.h"
 
 #include <gtest/gtest.h>
@@ -146,6 +146,47 @@ TEST_F(HttpListenerTest, ListensOnAPortTheSystemPicksAndRefusesATakenOne) {
     EXPECT_NE(second.status().message().find("cannot listen on " + taken + " for --http"),
               std::string::npos)
         << second.status();
+}
+
+// A certificate of its own for 127.0.0.1, made by the openssl command (deploy/install-deps.sh
+// installs it): HTTPS with the dashboard, which plain HTTP cannot reach.
+TEST_F(HttpListenerTest, ServesHttpsAndTheDashboardWithTheServersCertificate) {
+    const std::string cert = (dir_ / "server.crt").string(), key = (dir_ / "server.key").string();
+    const std::string make =
+        "openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=server -addext "
+        "subjectAltName=IP:127.0.0.1 -keyout '" +
+        key + "' -out '" + cert + "' >/dev/null 2>&1";
+    ASSERT_EQ(std::system(make.c_str()), 0) << "openssl could not make a certificate";
+    std::unique_ptr<Authenticator> auth = Authenticator::Off();
+    absl::StatusOr<std::unique_ptr<HttpListener>> listener = HttpListener::Start(
+        "127.0.0.1:0", *farm_, {.dashboard_auth = auth.get(), .tls_cert = cert, .tls_key = key});
+    ASSERT_TRUE(listener.ok()) << listener.status();
+    const int port = (*listener)->port();
+
+    httplib::SSLClient client("127.0.0.1", port);
+    client.set_ca_cert_path(cert.c_str());
+    client.enable_server_certificate_verification(true);
+    httplib::Result healthz = client.Get("/healthz");
+    ASSERT_TRUE(healthz) << httplib::to_string(healthz.error());
+    EXPECT_EQ(healthz->body, "ok\n");
+    httplib::Result page = client.Get("/");
+    ASSERT_TRUE(page);
+    EXPECT_EQ(page->status, 200);
+    EXPECT_NE(page->get_header_value("Content-Security-Policy").find("default-src 'none'"),
+              std::string::npos);
+    httplib::Result jobs = client.Get("/api/jobs");
+    ASSERT_TRUE(jobs);
+    EXPECT_EQ(jobs->status, 200) << jobs->body;
+    EXPECT_EQ(jobs->get_header_value("Content-Type"), "application/json");
+
+    httplib::Client plain("127.0.0.1", port);
+    plain.set_read_timeout(5);
+    httplib::Result refused = plain.Get("/healthz");
+    EXPECT_TRUE(!refused || refused->status != 200) << "plain HTTP answered on the HTTPS port";
+
+    absl::StatusOr<std::unique_ptr<HttpListener>> bad = HttpListener::Start(
+        "127.0.0.1:0", *farm_, {.tls_cert = cert, .tls_key = (dir_ / "none.key").string()});
+    EXPECT_EQ(bad.status().code(), absl::StatusCode::kFailedPrecondition) << bad.status();
 }
 
 TEST_F(HttpListenerTest, RefusesAnAddressWithoutAPort) {

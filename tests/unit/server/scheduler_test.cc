@@ -60,6 +60,28 @@ TEST_F(SchedulerTest, HigherPriorityFirstThenOlderFirst) {
     EXPECT_EQ(Job(high_old).tasks_running, 8);
 }
 
+TEST_F(SchedulerTest, RaisedPriorityIsLeasedFirstAndRecorded) {
+    const std::string first = Submit(0), second = Submit(0);
+    EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, first);
+    absl::StatusOr<JobRecord> raised = scheduler_.SetPriority(second, 3);
+    ASSERT_TRUE(raised.ok()) << raised.status();
+    EXPECT_EQ(raised->spec.priority, 3);
+    EXPECT_EQ(store_.Get(second)->spec.priority, 3);  // saved, not only in memory
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, second);
+    EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, first);
+    // Lowered below the other again: the other's queued tasks come first.
+    ASSERT_TRUE(scheduler_.SetPriority(first, -1).ok());
+    const std::string third = Submit(0);
+    EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, third);
+}
+
+TEST_F(SchedulerTest, PriorityOfAnEndedOrUnknownJobIsRefused) {
+    const std::string id = Submit(0);
+    ASSERT_TRUE(scheduler_.Cancel(id).ok());
+    EXPECT_TRUE(absl::IsFailedPrecondition(scheduler_.SetPriority(id, 1).status()));
+    EXPECT_TRUE(absl::IsNotFound(scheduler_.SetPriority("nope", 1).status()));
+}
+
 TEST_F(SchedulerTest, AllResultsInAnyOrderSucceedTheJob) {
     const std::string id = Submit(0);
     std::vector<TaskAssignment> leases;

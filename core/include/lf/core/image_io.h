@@ -47,5 +47,7 @@ struct PngOptions {
 
 // R,G,B times 2^exposure, through the tone curve, sRGB-encoded in 8 bits per channel.
 absl::Status WritePng(const std::string& path, const Image& image, const PngOptions& options = {});
+// The same PNG in memory, for a server that answers with it.
+absl::StatusOr<std::string> EncodePng(const Image& image, const PngOptions& options = {});
 
 }  // namespace lf

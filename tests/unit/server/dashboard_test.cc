@@ -1,0 +1,437 @@
+// The dashboard's handlers against a real Farm in a temporary data folder, without a browser or
+// a socket: signing in and being refused, what each token sees (another's job answers as no
+// job), the JSON of jobs, tasks, workers and the farm, cancel and priority, the preview PNG
+// (decoded, and changed by a merged task), the CSRF checks of POSTs, bounds on what a request
+// names, anonymous admins only on loopback, and the embedded pages with their headers.
+#include "server/dashboard.h"
+
+#include <gtest/gtest.h>
+#include <stb_image.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_split.h"
+#include "lf/core/tile_codec.h"
+#include "server/web_assets.h"
+#include "test_dir.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+constexpr char kHost[] = "127.0.0.1:8080";
+constexpr char kOrigin[] = "http://127.0.0.1:8080";
+
+std::string HeaderOf(const HttpAnswer& a, const std::string& name) {
+    for (const auto& [n, v] : a.headers) {
+        if (n == name) return v;
+    }
+    return "";
+}
+
+class DashboardTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = testing::FreshTestDir("lf_dashboard");
+        FarmOptions options;
+        options.data_dir = dir_.string();
+        absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
+        ASSERT_TRUE(farm.ok()) << farm.status();
+        farm_ = std::move(*farm);
+        absl::StatusOr<std::unique_ptr<TokenStore>> tokens = TokenStore::Open(dir_.string());
+        absl::StatusOr<std::unique_ptr<TokenStore>> admin = TokenStore::Open(dir_.string());
+        ASSERT_TRUE(tokens.ok() && admin.ok());
+        alice_ = *(*admin)->Create("alice", Role::kSubmitter);
+        bob_ = *(*admin)->Create("bob", Role::kSubmitter);
+        root_ = *(*admin)->Create("root", Role::kAdmin);
+        worker_ = *(*admin)->Create("node-1", Role::kWorker);
+        auth_ = std::make_unique<Authenticator>(std::move(*tokens), false);
+        dashboard_ = std::make_unique<Dashboard>(*farm_, *auth_, DashboardOptions{});
+    }
+    void TearDown() override {
+        dashboard_.reset();
+        farm_.reset();
+        fs::remove_all(dir_);
+    }
+
+    // A 16x16 image in 8x8 tiles, 4 spp in 2 passes: 8 tasks.
+    std::string Submit(const std::string& owner) {
+        JobSpec spec;
+        spec.name = "of " + owner;
+        spec.owner = owner;
+        spec.plan = {16, 16, 4, 8, 2};
+        absl::StatusOr<std::string> id = farm_->scheduler().Submit(spec);
+        EXPECT_TRUE(id.ok()) << id.status();
+        return *id;
+    }
+
+    // Leases a task and merges a result of `value` in every pixel through the Farm; false when
+    // no task is queued.
+    bool RenderOne(const std::string& worker, float value) {
+        std::optional<TaskAssignment> lease = farm_->scheduler().LeaseTask(worker);
+        if (!lease) return false;
+        TileSums sums(lease->task.rect);
+        for (PixelSums& p : sums.pixels) {
+            for (uint64_t s = lease->task.sample_begin; s < lease->task.sample_end; ++s) {
+                p.Add(s, Rgb(value));
+            }
+        }
+        const absl::Status merged = farm_->Complete(lease->lease_id, worker, EncodeTileSums(sums));
+        EXPECT_TRUE(merged.ok()) << merged;
+        return merged.ok();
+    }
+
+    static HttpRequest Get(const std::string& path, const std::string& token = "") {
+        HttpRequest r;
+        r.path = path;
+        const size_t q = path.find('?');
+        if (q != std::string::npos) {
+            r.path = path.substr(0, q);
+            for (absl::string_view pair : absl::StrSplit(path.substr(q + 1), '&')) {
+                std::pair<std::string, std::string> kv = absl::StrSplit(pair, '=');
+                r.query.insert(kv);
+            }
+        }
+        r.headers["host"] = kHost;
+        r.remote_addr = "127.0.0.1";
+        if (!token.empty()) r.headers["cookie"] = std::string("theme=dark; lf_token=") + token;
+        return r;
+    }
+    static HttpRequest Post(const std::string& path, const Json& body,
+                            const std::string& token = "") {
+        HttpRequest r = Get(path, token);
+        r.method = "POST";
+        r.body = body.dump();
+        r.headers["content-type"] = "application/json";
+        r.headers["origin"] = kOrigin;
+        return r;
+    }
+
+    // Serves the request, expecting `status`, and parses the JSON answer.
+    Json Call(const HttpRequest& request, int status) {
+        const HttpAnswer a = dashboard_->Serve(request);
+        EXPECT_EQ(a.status, status) << request.method << " " << request.path << ": " << a.body;
+        EXPECT_EQ(a.content_type, "application/json") << request.path;
+        EXPECT_EQ(HeaderOf(a, "Cache-Control"), "no-store");
+        return Json::parse(a.body, nullptr, false);
+    }
+
+    fs::path dir_;
+    std::unique_ptr<Farm> farm_;
+    std::unique_ptr<Authenticator> auth_;
+    std::unique_ptr<Dashboard> dashboard_;
+    std::string alice_, bob_, root_, worker_;
+};
+
+TEST_F(DashboardTest, UnauthenticatedWrongAndWorkerTokensAreRefused) {
+    const Json none = Call(Get("/api/jobs"), 401);
+    EXPECT_TRUE(none.contains("error"));
+    Call(Get("/api/jobs", "lf1_" + std::string(64, '0')), 401);
+    Call(Get("/api/session", "garbage"), 401);
+    const Json worker = Call(Get("/api/jobs", worker_), 403);
+    EXPECT_TRUE(absl::StrContains(worker["error"].get<std::string>(), "role worker"));
+    HttpRequest bearer = Get("/api/session");
+    bearer.headers["authorization"] = "Bearer " + alice_;
+    const Json me = Call(bearer, 200);
+    EXPECT_EQ(me["name"], "alice");
+    EXPECT_EQ(me["role"], "submitter");
+    EXPECT_EQ(me["auth"], true);
+}
+
+TEST_F(DashboardTest, SignInSetsAStrictHttpOnlyCookieOnlyForAValidToken) {
+    const HttpAnswer ok = dashboard_->Serve(Post("/api/session", {{"token", alice_}}));
+    ASSERT_EQ(ok.status, 200) << ok.body;
+    const std::string cookie = HeaderOf(ok, "Set-Cookie");
+    EXPECT_TRUE(absl::StartsWith(cookie, "lf_token=" + alice_ + ";")) << cookie;
+    EXPECT_TRUE(absl::StrContains(cookie, "HttpOnly")) << cookie;
+    EXPECT_TRUE(absl::StrContains(cookie, "SameSite=Strict")) << cookie;
+    EXPECT_FALSE(absl::StrContains(cookie, "Secure")) << "plain HTTP: " << cookie;
+
+    for (const std::string& bad : {std::string("lf1_nope"), worker_}) {
+        const HttpAnswer refused = dashboard_->Serve(Post("/api/session", {{"token", bad}}));
+        EXPECT_NE(refused.status, 200);
+        EXPECT_EQ(HeaderOf(refused, "Set-Cookie"), "");
+    }
+    Call(Post("/api/session", {{"nothing", 1}}), 400);
+
+    const HttpAnswer out = dashboard_->Serve(Post("/api/session/end", Json::object()));
+    EXPECT_TRUE(absl::StrContains(HeaderOf(out, "Set-Cookie"), "Max-Age=0"));
+
+    Dashboard over_tls(*farm_, *auth_, DashboardOptions{.tls = true});
+    HttpRequest tls = Post("/api/session", {{"token", alice_}});
+    tls.headers["origin"] = std::string("https://") + kHost;
+    const HttpAnswer secure = over_tls.Serve(tls);
+    ASSERT_EQ(secure.status, 200) << secure.body;
+    EXPECT_TRUE(absl::StrContains(HeaderOf(secure, "Set-Cookie"), "; Secure"));
+}
+
+TEST_F(DashboardTest, PostsFromAnotherOriginOrNotJsonAreRefused) {
+    const std::string job = Submit("alice");
+    HttpRequest form = Post("/api/jobs/" + job + "/cancel", Json::object(), alice_);
+    form.headers["content-type"] = "application/x-www-form-urlencoded";
+    Call(form, 403);
+    HttpRequest foreign = Post("/api/jobs/" + job + "/cancel", Json::object(), alice_);
+    foreign.headers["origin"] = "http://evil.example";
+    Call(foreign, 403);
+    HttpRequest no_origin = Post("/api/jobs/" + job + "/cancel", Json::object(), alice_);
+    no_origin.headers.erase("origin");
+    Call(no_origin, 403);
+    HttpRequest login = Post("/api/session", {{"token", alice_}});
+    login.headers["origin"] = "http://evil.example";
+    Call(login, 403);
+    EXPECT_EQ(farm_->scheduler().Get(job)->state, JobState::kQueued);
+    // A script's bearer token is not something a browser adds to a forged request.
+    HttpRequest script = Post("/api/jobs/" + job + "/cancel", Json::object());
+    script.headers.erase("origin");
+    script.headers["authorization"] = "Bearer " + alice_;
+    Call(script, 200);
+    EXPECT_EQ(farm_->scheduler().Get(job)->state, JobState::kCancelled);
+}
+
+TEST_F(DashboardTest, SubmittersSeeOnlyTheirJobsAnotherAnswersAsNone) {
+    const std::string mine = Submit("alice"), theirs = Submit("bob");
+    const Json listed = Call(Get("/api/jobs", alice_), 200);
+    ASSERT_EQ(listed["jobs"].size(), 1u);
+    EXPECT_EQ(listed["jobs"][0]["id"], mine);
+    EXPECT_EQ(Call(Get("/api/jobs", root_), 200)["jobs"].size(), 2u);
+
+    const std::string unknown = "job-0000000000";
+    for (const std::string what : {"", "/tasks", "/logs", "/preview.png", "/metadata"}) {
+        const Json other = Call(Get("/api/jobs/" + theirs + what, alice_), 404);
+        const Json none = Call(Get("/api/jobs/" + unknown + what, alice_), 404);
+        EXPECT_EQ(other["error"], "no job " + theirs) << what;
+        EXPECT_EQ(none["error"], "no job " + unknown) << what;
+    }
+    Call(Post("/api/jobs/" + theirs + "/cancel", Json::object(), alice_), 404);
+    Call(Post("/api/jobs/" + theirs + "/priority", {{"priority", 9}}, alice_), 404);
+    EXPECT_EQ(farm_->scheduler().Get(theirs)->state, JobState::kQueued);
+    EXPECT_EQ(farm_->scheduler().Get(theirs)->spec.priority, 0);
+    Call(Get("/api/jobs/" + theirs, root_), 200);
+
+    // Workers busy with bob's job: alice sees that they are busy, not with what.
+    farm_->scheduler().SetPriority(theirs, 5).IgnoreError();
+    ASSERT_TRUE(farm_->scheduler().LeaseTask("w1"));
+    const Json seen_by_alice = Call(Get("/api/workers", alice_), 200);
+    ASSERT_EQ(seen_by_alice["workers"].size(), 1u);
+    EXPECT_EQ(seen_by_alice["workers"][0]["state"], "busy");
+    EXPECT_EQ(seen_by_alice["workers"][0]["job_id"], "(other)");
+    EXPECT_EQ(Call(Get("/api/workers", root_), 200)["workers"][0]["job_id"], theirs);
+    EXPECT_EQ(Call(Get("/api/workers", bob_), 200)["workers"][0]["job_id"], theirs);
+}
+
+TEST_F(DashboardTest, AuthOffEveryoneIsAnAnonymousAdmin) {
+    std::unique_ptr<Authenticator> off = Authenticator::Off();
+    Dashboard open(*farm_, *off, DashboardOptions{});
+    const std::string job = Submit("");
+    const HttpAnswer me = open.Serve(Get("/api/session"));
+    ASSERT_EQ(me.status, 200);
+    EXPECT_EQ(Json::parse(me.body)["role"], "admin");
+    EXPECT_EQ(Json::parse(me.body)["auth"], false);
+    const HttpAnswer jobs = open.Serve(Get("/api/jobs"));
+    EXPECT_EQ(Json::parse(jobs.body)["jobs"][0]["id"], job);
+    // Still no forged POST: a page on another site could reach a loopback server.
+    HttpRequest forged = Post("/api/jobs/" + job + "/cancel", Json::object());
+    forged.headers["origin"] = "http://evil.example";
+    EXPECT_EQ(open.Serve(forged).status, 403);
+    // Nor another machine, nor a page of another site renamed to 127.0.0.1 (DNS rebinding).
+    HttpRequest remote = Get("/api/jobs");
+    remote.remote_addr = "10.0.0.7";
+    EXPECT_EQ(open.Serve(remote).status, 403);
+    HttpRequest rebound = Get("/api/jobs");
+    rebound.headers["host"] = "evil.example:8080";
+    EXPECT_EQ(open.Serve(rebound).status, 403);
+    HttpRequest named = Get("/api/jobs");
+    named.headers["host"] = "localhost:8080";
+    named.remote_addr = "::1";
+    EXPECT_EQ(open.Serve(named).status, 200);
+    EXPECT_EQ(farm_->scheduler().Get(job)->state, JobState::kQueued);
+}
+
+TEST_F(DashboardTest, JobTasksAndFarmJsonFollowTheWork) {
+    const std::string job = Submit("alice");
+    Json j = Call(Get("/api/jobs/" + job, alice_), 200);
+    EXPECT_EQ(j["state"], "queued");
+    EXPECT_EQ(j["owner"], "alice");
+    EXPECT_EQ(j["tasks_total"], 8);
+    EXPECT_EQ(j["tasks_done"], 0);
+    EXPECT_TRUE(j["started_ms"].is_null());
+    EXPECT_TRUE(j["eta_s"].is_null());
+    EXPECT_EQ(j["width"], 16);
+
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
+    j = Call(Get("/api/jobs/" + job, alice_), 200);
+    EXPECT_EQ(j["state"], "running");
+    EXPECT_EQ(j["tasks_done"], 2);
+    EXPECT_TRUE(j["started_ms"].is_number());
+    EXPECT_TRUE(j["eta_s"].is_number());
+    EXPECT_GE(j["eta_s"].get<double>(), 0);
+
+    const Json tasks = Call(Get("/api/jobs/" + job + "/tasks", alice_), 200)["tasks"];
+    ASSERT_EQ(tasks.size(), 8u);
+    int done = 0;
+    for (const Json& t : tasks) {
+        done += t["state"] == "done";
+        EXPECT_EQ(t["width"], 8);
+        if (t["state"] == "done") {
+            EXPECT_EQ(t["worker"], "w1");
+        }
+    }
+    EXPECT_EQ(done, 2);
+    const Json logs = Call(Get("/api/jobs/" + job + "/logs?task=0&after=0", alice_), 200);
+    EXPECT_TRUE(logs["lines"].is_array());
+
+    const Json farm = Call(Get("/api/farm", alice_), 200);
+    EXPECT_EQ(farm["queue_depth"], 6);
+    EXPECT_EQ(farm["jobs_running"], 1);
+    ASSERT_EQ(farm["tasks_per_minute"].size(), size_t(MinuteCounts::kMinutes));
+    // Both merged within the last minute or two (the minute may have turned between them).
+    const Json& per_minute = farm["tasks_per_minute"];
+    EXPECT_EQ(per_minute[58].get<int>() + per_minute[59].get<int>(), 2);
+    // 2 tasks of 8x8 pixels and 2 of the 4 samples each.
+    EXPECT_EQ(farm["samples_per_minute"][58].get<int>() + farm["samples_per_minute"][59].get<int>(),
+              2 * 8 * 8 * 2);
+}
+
+TEST_F(DashboardTest, CancelAndPriorityChangeTheJob) {
+    const std::string first = Submit("alice"), second = Submit("alice");
+    Json j = Call(Post("/api/jobs/" + second + "/priority", {{"priority", 7}}, alice_), 200);
+    EXPECT_EQ(j["priority"], 7);
+    EXPECT_EQ(farm_->scheduler().Get(second)->spec.priority, 7);
+    EXPECT_EQ(farm_->scheduler().LeaseTask("w")->job_id, second);
+    for (const Json& bad : {Json{{"priority", "high"}}, Json{{"priority", 1.5}},
+                            Json{{"priority", int64_t(1) << 40}}, Json::object()}) {
+        Call(Post("/api/jobs/" + second + "/priority", bad, alice_), 400);
+    }
+    j = Call(Post("/api/jobs/" + first + "/cancel", Json::object(), alice_), 200);
+    EXPECT_EQ(j["state"], "cancelled");
+    EXPECT_EQ(farm_->scheduler().Get(first)->state, JobState::kCancelled);
+    Call(Post("/api/jobs/" + first + "/cancel", Json::object(), alice_), 409);
+    Call(Post("/api/jobs/" + first + "/priority", {{"priority", 1}}, alice_), 409);
+}
+
+TEST_F(DashboardTest, PreviewIsAPngThatChangesWhenATaskMerges) {
+    dashboard_ = std::make_unique<Dashboard>(
+        *farm_, *auth_, DashboardOptions{.preview_min_age = absl::ZeroDuration()});
+    const std::string job = Submit("alice");
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
+    const std::string path = "/api/jobs/" + job + "/preview.png";
+    const HttpAnswer first = dashboard_->Serve(Get(path, alice_));
+    ASSERT_EQ(first.status, 200) << first.body;
+    EXPECT_EQ(first.content_type, "image/png");
+    auto decode = [](const std::string& png) {
+        int w = 0, h = 0, channels = 0;
+        unsigned char* data =
+            stbi_load_from_memory(reinterpret_cast<const unsigned char*>(png.data()),
+                                  int(png.size()), &w, &h, &channels, 3);
+        EXPECT_NE(data, nullptr);
+        EXPECT_EQ(w, 16);
+        EXPECT_EQ(h, 16);
+        std::vector<unsigned char> rgb;
+        if (data) rgb.assign(data, data + size_t(w) * h * 3);
+        stbi_image_free(data);
+        return rgb;
+    };
+    const std::vector<unsigned char> before = decode(first.body);
+    const std::string etag = HeaderOf(first, "ETag");
+    ASSERT_FALSE(etag.empty());
+    HttpRequest again = Get(path, alice_);
+    again.headers["if-none-match"] = etag;
+    EXPECT_EQ(dashboard_->Serve(again).status, 304);
+
+    ASSERT_TRUE(RenderOne("w1", 0.9f));
+    const HttpAnswer second = dashboard_->Serve(again);  // the old ETag
+    ASSERT_EQ(second.status, 200);
+    EXPECT_NE(HeaderOf(second, "ETag"), etag);
+    const std::vector<unsigned char> after = decode(second.body);
+    ASSERT_EQ(after.size(), before.size());
+    EXPECT_NE(after, before);
+    // The tile's second pass (0.9) brightened its first (0.5); the other tiles stay black.
+    size_t brighter = 0, black = 0;
+    for (size_t i = 0; i < after.size(); ++i) {
+        brighter += before[i] > 0 && after[i] > before[i];
+        black += before[i] == 0 && after[i] == 0;
+    }
+    EXPECT_EQ(brighter, size_t(8 * 8 * 3));
+    EXPECT_EQ(black, size_t(3 * 8 * 8 * 3));
+
+    const Json metadata = Call(Get("/api/jobs/" + job + "/metadata", alice_), 200);
+    EXPECT_EQ(metadata["attributes"]["lightfarm.spp"], 4);
+    EXPECT_TRUE(metadata["attributes"]["lightfarm.method"].is_string());
+}
+
+// Many tabs on a job whose tasks merge fast cost one preview per preview_min_age.
+TEST_F(DashboardTest, ARunningJobsPreviewIsMadeAtMostOncePerMinimumAge) {
+    dashboard_ = std::make_unique<Dashboard>(*farm_, *auth_,
+                                             DashboardOptions{.preview_min_age = absl::Hours(1)});
+    const std::string job = Submit("alice");
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
+    const std::string path = "/api/jobs/" + job + "/preview.png";
+    const HttpAnswer first = dashboard_->Serve(Get(path, alice_));
+    ASSERT_EQ(first.status, 200);
+    ASSERT_TRUE(RenderOne("w1", 0.9f));
+    const HttpAnswer soon = dashboard_->Serve(Get(path, alice_));
+    EXPECT_EQ(soon.body, first.body);
+    EXPECT_EQ(HeaderOf(soon, "ETag"), HeaderOf(first, "ETag"));
+    // Ended, it is made again at once: the last tasks are never left out.
+    while (RenderOne("w1", 0.9f)) {
+    }
+    ASSERT_EQ(farm_->scheduler().Get(job)->state, JobState::kSucceeded);
+    const HttpAnswer final = dashboard_->Serve(Get(path, alice_));
+    ASSERT_EQ(final.status, 200);
+    EXPECT_NE(final.body, first.body);
+}
+
+TEST_F(DashboardTest, WhatARequestNamesIsBounded) {
+    Submit("alice");
+    Call(Get("/api/jobs?limit=0", alice_), 400);
+    Call(Get("/api/jobs?limit=100000", alice_), 400);
+    Call(Get("/api/jobs?limit=abc", alice_), 400);
+    Call(Get("/api/jobs?limit=1", alice_), 200);
+    Call(Get("/api/jobs?before=-1", alice_), 400);
+    Call(Get("/api/jobs/" + std::string(10000, 'a'), alice_), 404);
+    Call(Get("/api/jobs/job-1%2F..%2Fx/tasks", alice_), 404);
+    Call(Get("/api/jobs/a/b/c/d", alice_), 404);
+    const std::string job = Submit("alice");
+    Call(Get("/api/jobs/" + job + "/logs?max=100000", alice_), 400);
+    Call(Get("/api/jobs/" + job + "/logs?task=-2", alice_), 400);
+    Call(Get("/api/nothing", alice_), 404);
+    HttpRequest put = Get("/api/jobs", alice_);
+    put.method = "PUT";
+    EXPECT_EQ(dashboard_->Serve(put).status, 405);
+}
+
+TEST_F(DashboardTest, PagesAreEmbeddedWithTheirTypesAndAStrictPolicy) {
+    const HttpAnswer index = dashboard_->Serve(Get("/"));
+    ASSERT_EQ(index.status, 200);
+    EXPECT_EQ(index.content_type, "text/html; charset=utf-8");
+    EXPECT_TRUE(absl::StrContains(index.body, "/web/app.js"));
+    const std::string policy = HeaderOf(index, "Content-Security-Policy");
+    EXPECT_TRUE(absl::StrContains(policy, "default-src 'none'")) << policy;
+    EXPECT_TRUE(absl::StrContains(policy, "script-src 'self'")) << policy;
+    EXPECT_FALSE(absl::StrContains(policy, "unsafe")) << policy;
+    EXPECT_EQ(HeaderOf(index, "X-Content-Type-Options"), "nosniff");
+
+    const HttpAnswer script = dashboard_->Serve(Get("/web/app.js"));
+    ASSERT_EQ(script.status, 200);
+    EXPECT_EQ(script.content_type, "text/javascript; charset=utf-8");
+    HttpRequest cached = Get("/web/app.js");
+    cached.headers["if-none-match"] = HeaderOf(script, "ETag");
+    EXPECT_EQ(dashboard_->Serve(cached).status, 304);
+    EXPECT_EQ(dashboard_->Serve(Get("/web/style.css")).content_type, "text/css; charset=utf-8");
+    EXPECT_EQ(dashboard_->Serve(Get("/web/nothing.js")).status, 404);
+    EXPECT_EQ(dashboard_->Serve(Get("/web/../farm.cc")).status, 404);
+    // No page names anything beyond this server.
+    for (const WebAsset& asset : WebAssets()) {
+        const std::string content(asset.content);  // Debian's absl takes no std::string_view
+        EXPECT_FALSE(absl::StrContains(content, "https://")) << asset.name;
+        EXPECT_FALSE(absl::StrContains(content, "//cdn")) << asset.name;
+    }
+}
+
+}  // namespace
+}  // namespace lf

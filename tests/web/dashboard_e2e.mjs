@@ -1,0 +1,196 @@
+// The dashboard end to end: a real lightfarm-server with tokens, two lightfarm-workers and the
+// lightfarm CLI from the build, and Debian's headless Chromium driven by playwright-core.
+// Checks: a wrong token is refused; signed in, a job submitted from the CLI appears and its
+// progress rises; the preview loads and changes while tiles land; a task's log opens; a job
+// cancelled from the page (after its priority was raised there) is so for the CLI too. Screenshots of every page go to
+// SCREENSHOTS (the build's web-screenshots/).
+//
+//   node dashboard_e2e.mjs BIN_DIR SCENES_DIR SCREENSHOTS_DIR
+import { spawn, execFileSync } from 'node:child_process';
+import { mkdirSync, mkdtempSync, rmSync, writeFileSync, readFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { chromium } from 'playwright-core';
+
+const [binDir, scenesDir, shotsDir] = process.argv.slice(2);
+if (!shotsDir) {
+  console.error('usage: node dashboard_e2e.mjs BIN_DIR SCENES_DIR SCREENSHOTS_DIR');
+  process.exit(2);
+}
+const dir = mkdtempSync(join(tmpdir(), 'lf_dashboard_e2e_'));
+const dataDir = join(dir, 'data');
+mkdirSync(shotsDir, { recursive: true });
+const children = [];
+const bin = (name) => join(binDir, name);
+
+function token(name, role) {
+  const out = execFileSync(bin('lightfarm-server'), ['token', 'create', '--data-dir', dataDir, '--name', name, '--role', role], { encoding: 'utf8' });
+  const file = join(dir, `${name}.token`);
+  writeFileSync(file, out.trim().split('\n').pop() + '\n', { mode: 0o600 });
+  return file;
+}
+
+// Starts a process; resolves with the first stdout line matching `ready` (its match), keeping
+// its output for the failure report.
+function start(name, args, ready) {
+  const child = spawn(bin(name), args, { stdio: ['ignore', 'pipe', 'pipe'] });
+  child.log = '';
+  children.push(child);
+  return new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`${name} did not start:\n${child.log}`)), 20000);
+    const take = (chunk) => {
+      child.log += chunk;
+      const match = ready && child.log.match(ready);
+      if (match) { clearTimeout(timer); resolve(match); }
+    };
+    child.stdout.on('data', take);
+    child.stderr.on('data', take);
+    child.on('exit', (code) => reject(new Error(`${name} exited with ${code}:\n${child.log}`)));
+    if (!ready) { clearTimeout(timer); resolve(null); }
+  });
+}
+
+function cli(args, tokenFile) {
+  return execFileSync(bin('lightfarm'), [...args, '--server', grpcAddress, '--token-file', tokenFile], { encoding: 'utf8', timeout: 60000 }).trim();
+}
+
+async function until(what, check, seconds = 30) {
+  const end = Date.now() + seconds * 1000;
+  for (;;) {
+    const value = await check();
+    if (value) return value;
+    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
+    await new Promise((r) => setTimeout(r, 100));
+  }
+}
+
+function check(condition, message) {
+  if (!condition) throw new Error(message);
+  console.log(`ok: ${message}`);
+}
+
+let grpcAddress;
+let browser;
+try {
+  const adminToken = token('admin', 'admin');
+  const aliceToken = token('alice', 'submitter');
+  const workerToken = token('render-node', 'worker');
+  const server = start('lightfarm-server', ['--listen', '127.0.0.1:0', '--http', '127.0.0.1:0', '--data-dir', dataDir, '--lease-seconds', '5'], /http on ([\d.]+:\d+)/);
+  const grpcPort = await until('the gRPC port', () => (children[0].log.match(/listening on ([\d.]+:\d+)/) || [])[1]);
+  grpcAddress = grpcPort;
+  const httpAddress = (await server)[1];
+  const base = `http://${httpAddress}`;
+  for (const name of ['w1', 'w2']) {
+    start('lightfarm-worker', ['--server', grpcAddress, '--token-file', workerToken, '--name', name, '--threads', '1', '--cache-dir', join(dir, `cache-${name}`)]);
+  }
+
+  // Enough small tasks to watch for some 20 s: 16 tiles of 64x64 in passes of 256 samples.
+  const scene = join(scenesDir, 'cornell_box.json');
+  const submit = (extra) => cli(['submit', scene, '--resolution', '64x64', '--tile', '16', ...extra], aliceToken).split('\n').pop().trim();
+  const job = submit(['--spp', '2048', '--passes', '8', '--name', 'watched']);
+  console.log(`job ${job} submitted`);
+
+  browser = await chromium.launch({
+    executablePath: '/usr/bin/chromium',
+    args: ['--headless=new', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--disable-background-networking'],
+  });
+  const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  page.on('console', (m) => { if (m.type() === 'error' && !/401|404|409/.test(m.text())) errors.push(m.text()); });
+
+  // Not signed in: the sign-in page; a wrong token is refused.
+  await page.goto(base);
+  await page.waitForSelector('form#signin');
+  await page.fill('#token', 'lf1_' + '0'.repeat(64));
+  await page.click('form#signin button');
+  await until('the refusal', async () => (await page.textContent('#signin-error')).length > 0);
+  check(page.url().includes('#/signin'), `a wrong token is refused: "${await page.textContent('#signin-error')}"`);
+  const api = await context.request.get(`${base}/api/jobs`, { headers: { Authorization: 'Bearer lf1_nope' } });
+  check(api.status() === 401, 'the API refuses a wrong bearer token with 401');
+  await page.screenshot({ path: join(shotsDir, 'signin.png'), fullPage: true });
+
+  // Signed in as alice: the job appears and its progress rises.
+  await page.fill('#token', readFileSync(aliceToken, 'utf8').trim());
+  await page.click('form#signin button');
+  const row = `tr.job[data-id="${job}"]`;
+  await page.waitForSelector(row, { timeout: 15000 });
+  check(true, 'the job submitted from the CLI appears on the jobs page');
+  const done = async () => Number((await page.textContent(`${row} .progress .label`)).split('/')[0]);
+  const first = await until('progress', async () => { const d = await done(); return d > 0 ? d : 0; });
+  const later = await until('rising progress', async () => { const d = await done(); return d > first ? d : 0; });
+  check(later > first, `progress rises on the jobs page (${first} then ${later} tasks)`);
+  await page.screenshot({ path: join(shotsDir, 'jobs.png'), fullPage: true });
+
+  // The job's page: the preview loads and changes while tiles land.
+  const previews = [];
+  page.on('response', async (r) => {
+    if (r.url().includes('/preview.png') && r.status() === 200) previews.push(await r.body());
+  });
+  await page.click(`${row} a`);
+  await page.waitForSelector('#summary table');
+  await until('a loaded preview', () => page.evaluate(() => document.getElementById('preview').naturalWidth > 0));
+  const firstSrc = await page.getAttribute('#preview', 'src');
+  await until('a changed preview', async () => previews.length >= 2 && (await page.getAttribute('#preview', 'src')) !== firstSrc, 40);
+  await until('the new preview loaded', () => page.evaluate(() => document.getElementById('preview').complete && document.getElementById('preview').naturalWidth === 64));
+  check(!previews[0].equals(previews[previews.length - 1]), `the preview loads and changes (${previews.length} images, ${previews[0].length} then ${previews[previews.length - 1].length} bytes)`);
+  const shaded = await page.$$eval('#tiles rect', (r) => r.length);
+  check(shaded >= 1 && shaded <= 16, `${shaded} of the 16 tiles shaded as queued or running`);
+
+  // A task's log opens.
+  await page.waitForSelector('tr.task.done');
+  await page.click('tr.task.done');
+  await until('log lines', async () => (await page.$$('#log .line')).length > 0, 20);
+  check(true, `a task's log opens: "${(await page.textContent('#log .line')).slice(0, 100)}"`);
+  await page.screenshot({ path: join(shotsDir, 'job.png'), fullPage: true });
+
+  // Workers and the farm.
+  await page.goto(`${base}/#/workers`);
+  await until('two workers', async () => (await page.$$('tr.worker')).length === 2);
+  check(true, 'the workers page lists both workers');
+  await page.screenshot({ path: join(shotsDir, 'workers.png'), fullPage: true });
+  await page.goto(`${base}/#/farm`);
+  await page.waitForSelector('#queue-depth .value');
+  await until('tasks in the chart', () => page.$$eval('svg.chart rect', (r) => r.some((e) => Number(e.getAttribute('height')) > 0)));
+  check(true, `the farm page shows the queue depth (${await page.textContent('#queue-depth .value')}) and throughput`);
+  await page.screenshot({ path: join(shotsDir, 'farm.png'), fullPage: true });
+
+  // Raise a job's priority and cancel it from its page; the CLI agrees.
+  const doomed = submit(['--spp', '65536', '--passes', '64', '--name', 'doomed']);
+  await page.goto(`${base}/#/job/${doomed}`);
+  await page.waitForSelector('#state');
+  await page.fill('#priority', '5');
+  await page.click('#set-priority');
+  const raised = await until('the new priority', () => {
+    const line = cli(['status', doomed, '--json'], aliceToken);
+    return /"priority":\s*5\b/.test(line) && line;
+  });
+  check(raised, 'a priority set on the page is the one the CLI sees');
+  const answer = cli(['priority', doomed, '7'], aliceToken);
+  await until('the page to show the CLI\'s priority', async () => (await page.inputValue('#priority')) === '7');
+  check(true, `a priority set with the CLI (${answer}) shows on the page`);
+  page.once('dialog', (d) => d.accept());
+  await page.click('#cancel');
+  await until('the cancelled state', async () => (await page.textContent('#state')) === 'cancelled');
+  const status = cli(['status', doomed], aliceToken);
+  check(/cancelled/i.test(status), `cancelled from the page, and the CLI agrees: ${status.split('\n')[0]}`);
+  await page.screenshot({ path: join(shotsDir, 'job-cancelled.png'), fullPage: true });
+
+  // Alice may not see the admin's jobs: an admin's job answers 404.
+  const adminJob = cli(['submit', scene, '--resolution', '16x16', '--spp', '1', '--name', 'admins'], adminToken).split('\n').pop().trim();
+  const hidden = await context.request.get(`${base}/api/jobs/${adminJob}`);
+  check(hidden.status() === 404, "another owner's job is not found for alice");
+
+  check(errors.length === 0, `no errors on the pages${errors.length ? ': ' + errors.join('; ') : ''}`);
+  console.log('dashboard e2e: all checks passed');
+} catch (error) {
+  console.error(`FAILED: ${error.stack || error}`);
+  for (const child of children) console.error(`---- ${child.spawnargs.slice(0, 2).join(' ')}\n${child.log.slice(-4000)}`);
+  process.exitCode = 1;
+} finally {
+  if (browser) await browser.close();
+  for (const child of children) child.kill('SIGTERM');
+  await new Promise((r) => setTimeout(r, 300));
+  rmSync(dir, { recursive: true, force: true });
+}
