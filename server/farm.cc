@@ -323,7 +323,15 @@ absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool pre
         auto it = previewed_.find(job_id);
         if (it != previewed_.end() && it->second == job->tasks_done) return path;
     }
-    if (absl::Status s = WriteSnapshot(job_id, false, path); !s.ok()) return s;
+    if (absl::Status s = WriteSnapshot(job_id, false, path); !s.ok()) {
+        // The job ended since it was read: its last task merged meanwhile. Its result, once
+        // written, is the preview asked for.
+        absl::StatusOr<JobRecord> now = scheduler_.Get(job_id);
+        if (absl::IsFailedPrecondition(s) && now.ok() && IsFinal(now->state)) {
+            return ResultFile(job_id, preview);
+        }
+        return s;
+    }
     std::lock_guard<std::mutex> lock(image_mutex_);
     previewed_[job_id] = job->tasks_done;
     return path;

@@ -77,6 +77,15 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
     if (s.ok()) {
         s = Exec(db, absl::StrCat("PRAGMA user_version = ", kSchemaVersion).c_str());
     }
+    if (s.ok() && sqlite3_open_v2(path.c_str(), &store->read_db_, SQLITE_OPEN_READWRITE, nullptr) !=
+                      SQLITE_OK) {
+        s = absl::UnavailableError(
+            absl::StrCat("cannot open a reading connection: ",
+                         store->read_db_ ? sqlite3_errmsg(store->read_db_) : "?"));
+    }
+    // A reader of a WAL database waits only while another connection recovers or checkpoints
+    // it, briefly; the timeout keeps that from being an error.
+    if (s.ok()) s = Exec(store->read_db_, "PRAGMA busy_timeout=5000;");
     if (!s.ok()) return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
     return store;
 }
@@ -90,6 +99,7 @@ SqliteJobStore::~SqliteJobStore() {
     }
     queued_cv_.notify_all();
     writer_.join();
+    sqlite3_close(read_db_);
     sqlite3_close(db_);
 }
 
@@ -253,15 +263,15 @@ absl::Status SqliteJobStore::Health() const {
         std::lock_guard<std::mutex> lock(queue_mutex_);
         if (!last_commit_.ok()) return last_commit_;
     }
-    std::lock_guard<std::mutex> lock(db_mutex_);
-    Statement read(db_, "SELECT COUNT(*) FROM jobs WHERE seq < 0");
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    Statement read(read_db_, "SELECT COUNT(*) FROM jobs WHERE seq < 0");
     read.Step();
     return read.status();
 }
 
 absl::StatusOr<std::map<JobState, int64_t>> SqliteJobStore::CountEnded() const {
-    std::lock_guard<std::mutex> lock(db_mutex_);
-    Statement count(db_,
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    Statement count(read_db_,
                     "SELECT json_extract(record, '$.state'), COUNT(*) FROM jobs WHERE final = 1"
                     " GROUP BY 1");
     std::map<JobState, int64_t> counts;
@@ -274,18 +284,32 @@ absl::StatusOr<std::map<JobState, int64_t>> SqliteJobStore::CountEnded() const {
     return counts;
 }
 
+absl::StatusOr<JobRecord> SqliteJobStore::DecodeCached(std::string_view id,
+                                                       std::string_view record) const {
+    const size_t hash = std::hash<std::string_view>{}(record);
+    if (auto it = decoded_.find(std::string(id));
+        it != decoded_.end() && it->second.first == hash) {
+        return it->second.second;
+    }
+    absl::StatusOr<JobRecord> job = Decode(id, record);
+    if (!job.ok()) return job;
+    if (decoded_.size() >= kDecodedCacheSize) decoded_.clear();
+    decoded_.insert_or_assign(std::string(id), std::make_pair(hash, *job));
+    return job;
+}
+
 absl::StatusOr<JobRecord> SqliteJobStore::Get(const std::string& id) const {
-    std::lock_guard<std::mutex> lock(db_mutex_);
-    Statement get(db_, "SELECT record FROM jobs WHERE id = ?1");
-    if (get.Bind(1, id).Step()) return Decode(id, get.Column(0));
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    Statement get(read_db_, "SELECT record FROM jobs WHERE id = ?1");
+    if (get.Bind(1, id).Step()) return DecodeCached(id, get.Column(0));
     if (!get.status().ok()) return get.status();
     return absl::NotFoundError("no job " + id);
 }
 
 absl::StatusOr<std::vector<JobRecord>> SqliteJobStore::List(const JobQuery& query) const {
-    std::lock_guard<std::mutex> lock(db_mutex_);
+    std::lock_guard<std::mutex> lock(read_mutex_);
     std::vector<JobRecord> jobs;
-    Statement list(db_,
+    Statement list(read_db_,
                    "SELECT id, record FROM jobs WHERE seq < ?1"
                    " AND (?2 IS NULL OR (final = 1 AND finished < ?2))"
                    // The owner is read from the record rather than a column of its own: a
@@ -301,7 +325,7 @@ absl::StatusOr<std::vector<JobRecord>> SqliteJobStore::List(const JobQuery& quer
     list.Bind(3, query.limit == 0 ? int64_t(-1) : int64_t(query.limit));
     if (query.owner) list.Bind(4, *query.owner);
     while (list.Step()) {
-        absl::StatusOr<JobRecord> job = Decode(list.Column(0), list.Column(1));
+        absl::StatusOr<JobRecord> job = DecodeCached(list.Column(0), list.Column(1));
         if (!job.ok()) return job.status();
         jobs.push_back(std::move(*job));
     }
@@ -312,8 +336,8 @@ absl::StatusOr<std::vector<JobRecord>> SqliteJobStore::List(const JobQuery& quer
 absl::StatusOr<std::optional<std::string>> SqliteJobStore::FindRequest(
     const std::string& request_id) const {
     if (request_id.empty()) return std::nullopt;
-    std::lock_guard<std::mutex> lock(db_mutex_);
-    Statement find(db_, "SELECT id FROM jobs WHERE request_id = ?1");
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    Statement find(read_db_, "SELECT id FROM jobs WHERE request_id = ?1");
     if (find.Bind(1, request_id).Step()) return std::string(find.Column(0));
     if (!find.status().ok()) return find.status();
     return std::nullopt;
@@ -321,9 +345,9 @@ absl::StatusOr<std::optional<std::string>> SqliteJobStore::FindRequest(
 
 absl::StatusOr<std::map<int, std::string>> SqliteJobStore::TaskResults(
     const std::string& id) const {
-    std::lock_guard<std::mutex> lock(db_mutex_);
+    std::lock_guard<std::mutex> lock(read_mutex_);
     std::map<int, std::string> results;
-    Statement get(db_, "SELECT task, sums FROM task_results WHERE job = ?1");
+    Statement get(read_db_, "SELECT task, sums FROM task_results WHERE job = ?1");
     get.Bind(1, id);
     while (get.Step()) results[int(get.ColumnInt(0))] = std::string(get.Column(1));
     if (!get.status().ok()) return get.status();

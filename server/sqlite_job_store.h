@@ -13,6 +13,7 @@
 #include <string>
 #include <thread>
 #include <tuple>
+#include <unordered_map>
 
 #include "server/job_store.h"
 #include "server/metrics.h"
@@ -66,8 +67,20 @@ class SqliteJobStore : public JobStore {
     void WriterLoop();
     absl::Status Commit(const std::deque<Write>& batch);  // one transaction
 
-    mutable std::mutex db_mutex_;  // the connection: the writer's transaction or a read
+    std::mutex db_mutex_;  // the writer's connection: its transactions, and Open's setup
     sqlite3* db_;
+    // Reads go through a connection of their own: under WAL they see the last commit without
+    // waiting for the writer's transaction and sync, and a long read (a dashboard's job list)
+    // never holds up a commit that a task's result waits for.
+    mutable std::mutex read_mutex_;
+    sqlite3* read_db_ = nullptr;
+    // Decoded records by id with a hash of their stored text (under read_mutex_): lists of the
+    // same jobs, polled by dashboards, parse each record's JSON once, not on every poll. A
+    // record whose text changed is decoded again; the cache is emptied when it reaches
+    // kDecodedCacheSize.
+    static constexpr size_t kDecodedCacheSize = 20000;
+    mutable std::unordered_map<std::string, std::pair<size_t, JobRecord>> decoded_;
+    absl::StatusOr<JobRecord> DecodeCached(std::string_view id, std::string_view record) const;
 
     mutable std::mutex queue_mutex_;
     std::condition_variable queued_cv_, durable_cv_;

@@ -6,8 +6,9 @@ A tab is simulated by the requests the page makes (server/web/*.js, every 2 s wh
   jobs page:    GET /api/jobs?limit=100
   job page:     GET /api/jobs/ID, /api/jobs/ID/tasks, /api/jobs/ID/logs?task=0&after=N (a
                 task's log open), /api/jobs/ID/preview.png whenever tasks_done changed, and
-                /api/jobs/ID/metadata once; ID follows the newest running job
-  workers page: GET /api/workers;  farm page: GET /api/farm
+                /api/jobs/ID/metadata once and when the job ends; then the tab opens the
+                newest running job (one jobs request), as a user following the farm would
+  workers page: GET /api/workers;  farm page: GET /api/farm (every 5 s)
 Of the 20 tabs, 10 show the jobs page, 8 a job, 1 the workers and 1 the farm. They sign in with
 an admin token (authentication is on, as on a real farm) and run in a process of their own at
 nice 19, so that on this small machine they take CPU from the farm only when it idles: what is
@@ -100,13 +101,28 @@ port, token, tabs, stop_file = int(sys.argv[1]), sys.argv[2], int(sys.argv[3]), 
 headers = {"Authorization": "Bearer " + token}
 latencies, lock = [], threading.Lock()
 
+failures = []
+
 def tab(kind):
-    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+    conn = None
     def get(path):
+        nonlocal conn
         t = time.perf_counter()
-        conn.request("GET", path, headers=headers)
-        r = conn.getresponse()
-        body = r.read()
+        # A browser keeps a connection alive while the server does (it closes idle ones after
+        # a second), and opens a new one when it is gone: so does a tab here.
+        for attempt in (1, 2):
+            if conn is None:
+                conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+            try:
+                conn.request("GET", path, headers=headers)
+                r = conn.getresponse()
+                body = r.read()
+                break
+            except (http.client.RemoteDisconnected, ConnectionError, BrokenPipeError):
+                conn.close()
+                conn = None
+                if attempt == 2:
+                    raise
         with lock:
             latencies.append(time.perf_counter() - t)
         if r.status != 200:
@@ -122,9 +138,11 @@ def tab(kind):
         elif kind == "farm":
             get("/api/farm")
         else:
-            running = [j for j in json.loads(get("/api/jobs?limit=100"))["jobs"] if j["state"] == "running"]
-            if running and (job is None or running[0]["id"] != job):
-                job, shown, log_after, metadata = running[0]["id"], None, 0, False
+            if job is None:  # the user opens the newest running job from the jobs page
+                running = [j for j in json.loads(get("/api/jobs?limit=100"))["jobs"]
+                           if j["state"] == "running"]
+                if running:
+                    job, shown, log_after, metadata = running[0]["id"], None, 0, False
             if job:
                 j = json.loads(get(f"/api/jobs/{job}"))
                 get(f"/api/jobs/{job}/tasks")
@@ -137,15 +155,28 @@ def tab(kind):
                     if not metadata:
                         metadata = True
                         get(f"/api/jobs/{job}/metadata")
-        time.sleep(max(0.0, 2.0 - (time.perf_counter() - start)))
+                if j["state"] in ("succeeded", "failed", "cancelled"):
+                    get(f"/api/jobs/{job}/metadata")  # the page reads the final header
+                    job = None  # and the user moves on to the next running job
+        period = 5.0 if kind == "farm" else 2.0
+        time.sleep(max(0.0, period - (time.perf_counter() - start)))
+
+def guarded(kind):
+    try:
+        tab(kind)
+    except BaseException as e:
+        with lock:
+            failures.append(f"{kind} tab: {e!r}")
 
 kinds = ["jobs"] * (tabs // 2) + ["job"] * (tabs - tabs // 2 - 2) + ["workers", "farm"]
-threads = [threading.Thread(target=tab, args=(k,), daemon=True) for k in kinds[:tabs]]
+threads = [threading.Thread(target=guarded, args=(k,), daemon=True) for k in kinds[:tabs]]
 for t in threads:
     t.start()
     time.sleep(2.0 / len(threads))  # tabs opened over one polling period, not in lockstep
 for t in threads:
     t.join()
+if failures:
+    sys.exit("\n".join(failures))
 latencies.sort()
 print(json.dumps({"requests": len(latencies),
                   "p50_ms": 1000 * latencies[len(latencies) // 2] if latencies else 0,
@@ -168,7 +199,7 @@ def run(args, tabs, scene):
             time.sleep(2.5)  # every tab open before the first job
         cpu0 = cpu_seconds(farm.server.pid)
         with lightfarm.Client(farm.grpc, token=farm.tokens["submitter"]) as client:
-            ids = [client.submit(scene, spp=16, tile=16, name=f"bench-{i}") for i in range(args.jobs)]
+            ids = [client.submit(scene, spp=args.spp, tile=16, name=f"bench-{i}") for i in range(args.jobs)]
             for job_id in ids:
                 job = client.wait(job_id)
                 if job.state.name != "SUCCEEDED":
@@ -197,11 +228,12 @@ def main():
     parser.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
     parser.add_argument("--jobs", type=int, default=200)
     parser.add_argument("--tabs", type=int, default=20)
+    parser.add_argument("--spp", type=int, default=16)
     parser.add_argument("--rounds", type=int, default=2)
     args = parser.parse_args()
     work = tempfile.mkdtemp(prefix="lf_dash_scene.")
     scene = json.load(open(os.path.join(ROOT, "tests/scenes/cornell_box.json")))
-    scene["camera"]["resolution"] = [32, 32]  # 4 tiles of 16x16: 800 tasks in all
+    scene["camera"]["resolution"] = [64, 64]  # 16 tiles of 16x16: 3200 tasks in all
     scene_path = os.path.join(work, "cornell32.json")
     json.dump(scene, open(scene_path, "w"))
     results = {0: [], args.tabs: []}
