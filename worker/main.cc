@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <thread>
 
@@ -48,7 +49,9 @@ int main(int argc, char** argv) {
     app.add_option("--cache-dir", cache_dir, "scene blob cache, one per worker (kept across runs)")
         ->capture_default_str();
     app.add_option("--cache-mb", cache_mb, "cache budget in MiB")->capture_default_str();
-    app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+    app.add_option("--log-level", log_level,
+                   "what stderr shows: trace, debug, info, warn, error or off (each task's log "
+                   "for the server keeps info and above in any case)")
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
@@ -56,8 +59,12 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "lightfarm-worker: error: %s\n", std::string(s.message()).c_str());
         return 1;
     };
+    const spdlog::level::level_enum level = spdlog::level::from_str(log_level);
     spdlog::set_default_logger(spdlog::stderr_color_mt("worker"));
-    spdlog::set_level(spdlog::level::from_str(log_level));
+    // --log-level is what stderr shows. The loggers pass info and above whatever it is: a task's
+    // log on the server (lightfarm logs) says what the task did even on a quiet worker.
+    spdlog::default_logger()->sinks().front()->set_level(level);
+    spdlog::set_level(std::min(level, spdlog::level::info));
     // Before any other logger is made: each clones the default logger's sinks.
     const std::shared_ptr<lf::TaskLogSink> task_logs = lf::TaskLogSink::Install();
     absl::StatusOr<std::unique_ptr<lf::BlobCache>> cache =
