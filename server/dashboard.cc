@@ -110,38 +110,10 @@ Json JobJson(const JobRecord& job, absl::Time now) {
     };
 }
 
-const char* TaskStateName(TaskStatus::State state) {
-    switch (state) {
-        case TaskStatus::State::kWaiting:
-            return "waiting";
-        case TaskStatus::State::kQueued:
-            return "queued";
-        case TaskStatus::State::kRunning:
-            return "running";
-        case TaskStatus::State::kDone:
-            return "done";
-        case TaskStatus::State::kDropped:
-            return "dropped";
-    }
-    return "?";
-}
-
-const char* TaskKindName(TaskKind kind) {
-    switch (kind) {
-        case TaskKind::kTile:
-            return "tile";
-        case TaskKind::kFrame:
-            return "frame";
-        case TaskKind::kRadiositySweep:
-            return "sweep";
-    }
-    return "?";
-}
-
 Json TaskJson(const TaskStatus& t) {
     return {
         {"index", t.index},
-        {"state", TaskStateName(t.state)},
+        {"state", TaskStatusName(t.state)},
         {"kind", TaskKindName(t.kind)},
         {"x", t.x},
         {"y", t.y},

@@ -31,32 +31,6 @@ absl::Time FromUnixMs(int64_t ms) {
     return ms == 0 ? absl::InfinitePast() : absl::FromUnixMillis(ms);
 }
 
-const char* StateName(TaskStatus::State state) {
-    switch (state) {
-        case TaskStatus::State::kWaiting:
-            return "waiting";
-        case TaskStatus::State::kQueued:
-            return "queued";
-        case TaskStatus::State::kRunning:
-            return "running";
-        case TaskStatus::State::kDone:
-            return "done";
-        case TaskStatus::State::kDropped:
-            return "dropped";
-    }
-    return "queued";
-}
-
-// Both recorded by this file: an unknown name is a damaged row, read as the default.
-TaskStatus::State StateFromName(std::string_view name) {
-    for (TaskStatus::State s :
-         {TaskStatus::State::kWaiting, TaskStatus::State::kQueued, TaskStatus::State::kRunning,
-          TaskStatus::State::kDone, TaskStatus::State::kDropped}) {
-        if (name == StateName(s)) return s;
-    }
-    return TaskStatus::State::kQueued;
-}
-
 // Commits on Commit(), rolls back otherwise.
 class Transaction {
   public:
@@ -285,7 +259,7 @@ absl::Status TaskLogStore::RecordTasks(const std::string& job_id,
     for (const TaskStatus& t : tasks) {
         insert.Bind(1, job_id)
             .Bind(2, int64_t(t.index))
-            .Bind(3, StateName(t.state))
+            .Bind(3, TaskStatusName(t.state))
             .Bind(4, int64_t(t.kind))
             .Bind(5, int64_t(t.x))
             .Bind(6, int64_t(t.y))
@@ -317,7 +291,8 @@ absl::StatusOr<std::vector<TaskStatus>> TaskLogStore::Tasks(const std::string& j
     while (select.Step()) {
         TaskStatus& t = tasks.emplace_back();
         t.index = int(select.ColumnInt(0));
-        t.state = StateFromName(select.Column(1));
+        // Recorded by this file: an unknown name is a damaged row, read as queued.
+        t.state = TaskStatusFromName(select.Column(1)).value_or(TaskStatus::State::kQueued);
         const int64_t kind = select.ColumnInt(2);
         t.kind = kind >= 0 && kind <= int64_t(TaskKind::kRadiositySweep) ? TaskKind(kind)
                                                                          : TaskKind::kTile;

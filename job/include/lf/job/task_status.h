@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/time/time.h"
@@ -20,13 +22,21 @@ struct TaskStatus {
     int x = 0, y = 0, width = 0, height = 0;  // a tile's pixels; the whole frame for kFrame
     uint64_t samples = 0;                     // per pixel, for a tile
     int attempts = 0, failures = 0;
-    std::string worker;                       // of the current or last lease
+    std::string worker;                          // of the current or last lease
     absl::Time leased = absl::InfinitePast();    // the current or last lease
     absl::Time finished = absl::InfinitePast();  // its result merged
-    absl::Duration duration;  // lease to merged result, or running so far
+    absl::Duration duration;                     // lease to merged result, or running so far
     std::string last_error;
     int log_lines = 0;
 };
+
+// "waiting", "queued", "running", "done", "dropped": as the dashboard shows a state and the
+// task log store records it.
+const char* TaskStatusName(TaskStatus::State state);
+// The state a TaskStatusName names; nullopt for any other string.
+std::optional<TaskStatus::State> TaskStatusFromName(std::string_view name);
+// "tile", "frame", "sweep".
+const char* TaskKindName(TaskKind kind);
 
 // One line a worker logged while running a task.
 struct TaskLogLine {
