@@ -14,16 +14,13 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "lf/core/photometry.h"
 #include "lf/core/texture_io.h"
 
 namespace lf {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Photometric to radiometric: KHR_lights_punctual gives candela and lux; at 683 lm/W (the
-// luminous efficacy the extension and Blender's exporter assume) they are W/sr and W/m^2.
-constexpr double kLumensPerWatt = 683;
 
 // The extensions this importer reads. Anything else in extensionsUsed loses what it describes
 // (a warning); in extensionsRequired it is an error.
@@ -561,6 +558,7 @@ class GltfImporter {
             Fail(light_at, absl::StrCat("intensity ", light.intensity, " must be in [0, 1e13]"));
         }
         if (light.range > 0) range_ignored_ = true;
+        // KHR_lights_punctual gives candela and lux: at 683 lm/W they are W/sr and W/m^2.
         const Rgb radiometric = color * float(light.intensity / kLumensPerWatt);
         const Vec3d position = world.Apply(Vec3d(0, 0, 0));
         const Vec3d axis = world.ApplyLinear(Vec3d(0, 0, -1));

@@ -29,6 +29,7 @@
 #include "lf/core/log.h"
 #include "lf/core/mesh_io.h"
 #include "lf/core/mesh_tangents.h"
+#include "lf/core/photometry.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/core/texture.h"
 #include "lf/core/texture_io.h"
@@ -62,9 +63,6 @@ constexpr float kMaxRadiance = 1e10f;
 // Keys any material may have besides its type's: its emission (docs/scene-format.md, Emission).
 constexpr std::array<std::string_view, 6> kEmissionKeys = {
     "emission", "luminance_nits", "power_lm", "color", "temperature_k", "two_sided"};
-// Luminous efficacy of the photometric units: 683 lm per W of luminance-1 colour, as
-// KHR_lights_punctual and Blender convert (the peak of the photopic curve, 555 nm).
-constexpr double kLumensPerWatt = 683;
 
 // Validation runs many levels deep; an error unwinds to ParseScene as this exception, which adds
 // the source name, so every check stays one line.
