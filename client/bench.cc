@@ -12,8 +12,8 @@
 #include "lf/core/sampler.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/path_tracer.h"
 #include "lf/local/local_executor.h"
+#include "lf/local/method_factory.h"
 
 namespace lf {
 
@@ -61,13 +61,15 @@ absl::Status RunBench(const BenchOptions& options) {
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
     const Camera camera(scene->camera, (*embree)->origin());
-    const PathTracer tracer(**embree, options.max_depth, options.light_strategy);
+    absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
+        MakeRayTracer(Method::kPath, **embree, options.max_depth, options.light_strategy);
+    if (!tracer.ok()) return tracer.status();
 
     RenderSettings settings;
     settings.spp = options.spp;
     settings.threads = options.threads;
     settings.sampler = options.sampler;
-    absl::StatusOr<RenderOutput> rendered = RenderImage(camera, tracer, settings);
+    absl::StatusOr<RenderOutput> rendered = RenderImage(camera, **tracer, settings);
     if (!rendered.ok()) return rendered.status();
     const RenderOutput& out = *rendered;
     const double raw = RawRaysPerSecond(**embree, options.raw_rays, options.threads);

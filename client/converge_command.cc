@@ -8,7 +8,6 @@
 #include "command.h"
 #include "convergence.h"
 #include "lf/job/job_spec.h"
-#include "local_render.h"
 #include "photon_flags.h"
 #include "scene_flags.h"
 
@@ -190,9 +189,10 @@ Command AddConvergeCommand(CLI::App& app) {
             if (!configs.ok()) return ReportError(configs.status());
             options->configs = *configs;
             // The photon flags apply when some ladder is ppm's.
-            const bool ppm = absl::StrContains(options->method, "ppm") ||
-                             std::any_of(configs->begin(), configs->end(),
-                                         [](const RenderConfig& c) { return c.method == "ppm"; });
+            const bool ppm =
+                absl::StrContains(options->method, "ppm") ||
+                std::any_of(configs->begin(), configs->end(),
+                            [](const RenderConfig& c) { return c.method == Method::kPpm; });
             if (absl::Status s = CheckPhotonFlagsApply(*cmd, ppm ? "ppm" : options->method);
                 !s.ok()) {
                 return ReportError(s);
@@ -216,11 +216,11 @@ Command AddConvergeCommand(CLI::App& app) {
             }
             std::printf("\n%s\n", kConvergenceCsvHeader);
             for (const ConvergenceRow& row : result->rows) {
-                std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s,%s\n", row.method.c_str(),
-                            (long long)row.budget, row.seconds, row.error.rmse, row.error.relmse,
-                            row.error.smape, EstimatedRelMseField(row).c_str(),
-                            SamplerTypeName(row.config.sampler), LightSamplingField(row),
-                            RegionFields(row).c_str());
+                std::printf("%s,%lld,%.4f,%.4e,%.4e,%.4e,%s,%s,%s,%s\n",
+                            std::string(MethodName(row.method)).c_str(), (long long)row.budget,
+                            row.seconds, row.error.rmse, row.error.relmse, row.error.smape,
+                            EstimatedRelMseField(row).c_str(), SamplerTypeName(row.config.sampler),
+                            LightSamplingField(row), RegionFields(row).c_str());
             }
             if (!result->configs.empty()) PrintSummary(*result, options->region);
             if (result->radiosity_slope != 0) {

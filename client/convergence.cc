@@ -24,22 +24,22 @@
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/radiosity.h"
-#include "lf/kernels/whitted.h"
 #include "lf/local/local_executor.h"
-#include "local_render.h"
-#include "method_render.h"
-#include "radiosity_flags.h"
+#include "lf/local/method_factory.h"
+#include "lf/local/method_render.h"
 
 extern char** environ;
 
 namespace lf {
 
-bool IsLadderMethod(const std::string& method) { return method == "path" || UsesFramePlan(method); }
+bool IsLadderMethod(Method method) {
+    return method == Method::kPath || Info(method).work == WorkKind::kFramePasses;
+}
 
 std::string ConfigName(const RenderConfig& config) {
-    return absl::StrCat(config.method == "path" ? "" : config.method + "/",
-                        SamplerTypeName(config.sampler), "/",
-                        LightStrategyName(config.light_strategy));
+    return absl::StrCat(config.method == Method::kPath ? "" : MethodName(config.method),
+                        config.method == Method::kPath ? "" : "/", SamplerTypeName(config.sampler),
+                        "/", LightStrategyName(config.light_strategy));
 }
 
 namespace {
@@ -67,12 +67,13 @@ absl::StatusOr<std::vector<T>> ParseNames(const std::string& flag, const std::st
 
 std::optional<RenderConfig> ConfigFromName(const std::string& name) {
     std::vector<std::string> parts = absl::StrSplit(name, '/');
-    if (parts.size() == 2) parts.insert(parts.begin(), "path");
-    if (parts.size() != 3 || !IsLadderMethod(parts[0])) return std::nullopt;
+    if (parts.size() == 2) parts.insert(parts.begin(), std::string(MethodName(Method::kPath)));
+    const std::optional<Method> method = FindMethod(parts.size() == 3 ? parts[0] : "");
+    if (!method || !IsLadderMethod(*method)) return std::nullopt;
     const std::optional<SamplerType> sampler = SamplerTypeFromName(parts[1]);
     const std::optional<LightStrategy> strategy = LightStrategyFromName(parts[2]);
     if (!sampler || !strategy) return std::nullopt;
-    return RenderConfig{parts[0], *sampler, *strategy};
+    return RenderConfig{*method, *sampler, *strategy};
 }
 
 }  // namespace
@@ -94,7 +95,7 @@ absl::StatusOr<std::vector<RenderConfig>> ConfigProduct(const std::string& sampl
     if (!l.ok()) return l.status();
     std::vector<RenderConfig> out;
     for (SamplerType sampler : *s) {
-        for (LightStrategy strategy : *l) out.push_back({"path", sampler, strategy});
+        for (LightStrategy strategy : *l) out.push_back({Method::kPath, sampler, strategy});
     }
     return out;
 }
@@ -146,13 +147,16 @@ double RelativeRmse(const ConvergenceRow& row) { return std::sqrt(row.error.relm
 
 // A curve of the plot and the legend's slope: a path configuration's or radiosity's.
 std::string CurveName(const ConvergenceRow& row) {
-    return IsLadderMethod(row.method) ? ConfigName(row.config) : row.method;
+    return IsLadderMethod(row.method) ? ConfigName(row.config)
+                                      : std::string(MethodName(row.method));
 }
 
 }  // namespace
 
 const char* LightSamplingField(const ConvergenceRow& row) {
-    return row.method == "radiosity" ? "" : LightStrategyName(row.config.light_strategy);
+    return Info(row.method).work == WorkKind::kRadiosity
+               ? ""
+               : LightStrategyName(row.config.light_strategy);
 }
 
 std::string EstimatedRelMseField(const ConvergenceRow& row) {
@@ -176,7 +180,7 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
        << "set output " << GnuplotQuote(result.png_path) << "\n";
     int index = 0;
     std::vector<std::string> relative_plot, rmse_plot;
-    auto add_curve = [&](const std::string& name, const std::string& method, double relative_slope,
+    auto add_curve = [&](const std::string& name, Method method, double relative_slope,
                          const std::string& rmse_slope) {
         const std::string block = absl::StrCat("$curve", index++);
         gp << block << " << EOD\n";
@@ -186,11 +190,11 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
             }
         }
         gp << "EOD\n";
-        const std::string title = method == "path"         ? "path tracing, " + name
-                                  : method == "ppm"        ? name + " (biased: falls slower)"
-                                  : IsLadderMethod(method) ? name
-                                  : method == "whitted"    ? "whitted (biased: levels off)"
-                                                           : "radiosity";
+        const std::string title = method == Method::kPath      ? "path tracing, " + name
+                                  : method == Method::kPpm     ? name + " (biased: falls slower)"
+                                  : IsLadderMethod(method)     ? name
+                                  : method == Method::kWhitted ? "whitted (biased: levels off)"
+                                                               : "radiosity";
         relative_plot.push_back(absl::StrFormat(
             "%s using 1:2 with linespoints pt 7 title %s", block,
             GnuplotQuote(absl::StrFormat("%s (slope %.2f)", title, relative_slope))));
@@ -202,12 +206,14 @@ absl::Status Plot(const ConvergenceResult& result, const std::string& script_pat
         add_curve(ConfigName(c.config), c.config.method, c.relative_rmse_slope,
                   absl::StrFormat("%.2f", c.rmse_slope));
     }
-    const auto any = [&](const char* method) {
+    const auto any = [&](Method method) {
         return std::any_of(result.rows.begin(), result.rows.end(),
                            [&](const ConvergenceRow& r) { return r.method == method; });
     };
-    if (any("radiosity")) add_curve("radiosity", "radiosity", result.radiosity_slope, "");
-    if (any("whitted")) add_curve("whitted", "whitted", result.whitted_slope, "");
+    if (any(Method::kRadiosity)) {
+        add_curve("radiosity", Method::kRadiosity, result.radiosity_slope, "");
+    }
+    if (any(Method::kWhitted)) add_curve("whitted", Method::kWhitted, result.whitted_slope, "");
     std::string title = "Error against time";
     if (!result.configs.empty()) {
         const SppRange& fit = result.configs.front().fit;
@@ -243,10 +249,11 @@ absl::Status WriteCsv(const ConvergenceResult& result) {
     std::ofstream csv(result.csv_path);
     csv << kConvergenceCsvHeader << "\n";
     for (const ConvergenceRow& row : result.rows) {
-        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s,%s\n", row.method, row.budget,
-                               row.seconds, row.error.rmse, row.error.relmse, row.error.smape,
-                               EstimatedRelMseField(row), SamplerTypeName(row.config.sampler),
-                               LightSamplingField(row), RegionFields(row));
+        csv << absl::StrFormat("%s,%d,%.4f,%.6e,%.6e,%.6e,%s,%s,%s,%s\n", MethodName(row.method),
+                               row.budget, row.seconds, row.error.rmse, row.error.relmse,
+                               row.error.smape, EstimatedRelMseField(row),
+                               SamplerTypeName(row.config.sampler), LightSamplingField(row),
+                               RegionFields(row));
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.csv_path + ": cannot write");
@@ -266,7 +273,7 @@ absl::Status WriteSummaryCsv(const ConvergenceResult& result) {
             result.equal_time.from, result.equal_time.to, c.rmse_at_equal_time,
             c.relmse_at_equal_time, c.rmse_ratio_at_end, c.rmse_ratio_mean, c.relmse_ratio_at_end,
             c.relmse_ratio_mean, c.rmse_spp_slope, c.region_rmse_at_equal_time,
-            c.region_rmse_ratio_at_end, c.region_rmse_ratio_mean, c.config.method);
+            c.region_rmse_ratio_at_end, c.region_rmse_ratio_mean, MethodName(c.config.method));
     }
     csv.close();
     if (!csv) return absl::PermissionDeniedError(result.summary_path + ": cannot write");
@@ -418,23 +425,26 @@ absl::Status Summarize(const ConvergenceOptions& options, const std::vector<Rend
 // their methods.
 absl::StatusOr<std::vector<RenderConfig>> LadderConfigs(const ConvergenceOptions& options) {
     if (options.configs.empty()) return absl::InvalidArgumentError("no configuration to render");
-    if (options.method == "radiosity" || options.method == "whitted") {
+    const std::optional<Method> single = FindMethod(options.method);
+    if (single == Method::kRadiosity || single == Method::kWhitted) {
         return std::vector<RenderConfig>{};
     }
-    const std::string list = options.method == "both" ? "path" : options.method;
-    absl::StatusOr<std::vector<std::string>> methods = ParseNames<std::string>(
+    const std::string list =
+        options.method == "both" ? std::string(MethodName(Method::kPath)) : options.method;
+    absl::StatusOr<std::vector<Method>> methods = ParseNames<Method>(
         "--method", list,
-        [](const std::string& name) -> std::optional<std::string> {
-            if (!IsLadderMethod(name)) return std::nullopt;
-            return name;
+        [](const std::string& name) -> std::optional<Method> {
+            const std::optional<Method> method = FindMethod(name);
+            if (!method || !IsLadderMethod(*method)) return std::nullopt;
+            return method;
         },
         "path, radiosity, both, whitted or a list of path, light, bdpt and ppm");
     if (!methods.ok()) return methods.status();
     const bool explicit_methods =
         std::any_of(options.configs.begin(), options.configs.end(),
-                    [](const RenderConfig& c) { return c.method != "path"; });
+                    [](const RenderConfig& c) { return c.method != Method::kPath; });
     if (explicit_methods) {
-        if (*methods != std::vector<std::string>{"path"}) {
+        if (*methods != std::vector<Method>{Method::kPath}) {
             return absl::InvalidArgumentError(absl::StrCat(
                 "--method ", options.method,
                 " with --compare configurations that name their methods: give the methods in "
@@ -443,7 +453,7 @@ absl::StatusOr<std::vector<RenderConfig>> LadderConfigs(const ConvergenceOptions
         return options.configs;
     }
     std::vector<RenderConfig> out;
-    for (const std::string& method : *methods) {
+    for (const Method method : *methods) {
         for (RenderConfig config : options.configs) {
             config.method = method;
             out.push_back(config);
@@ -460,7 +470,8 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     const std::vector<RenderConfig>& configs = *ladder_configs;
     if (absl::Status s = CheckPhotonSettings(options.ppm); !s.ok()) return s;
     const bool path = !configs.empty();
-    const bool with_radiosity = options.method == "radiosity" || options.method == "both";
+    const bool with_radiosity =
+        FindMethod(options.method) == Method::kRadiosity || options.method == "both";
     std::string unused_note;
     if (path) {
         // Refuse a bad --fit-spp before rendering anything.
@@ -580,12 +591,13 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         // glass or the sky). Without such a ladder, the path tracer with the first
         // configuration's sampler and lights.
         RenderConfig best = options.configs.front();
-        best.method = "path";
+        best.method = Method::kPath;
         std::string why = "the first configuration";
         double best_cost = std::numeric_limits<double>::infinity();
         for (size_t i = 0; i < path_rows; ++i) {
             if (uint64_t(result.rows[i].budget) != rungs.back()) continue;
-            if (result.rows[i].method != "path" && result.rows[i].method != "bdpt") continue;
+            const Method method = result.rows[i].method;
+            if (method != Method::kPath && method != Method::kBdpt) continue;
             absl::StatusOr<double> mse = EstimatedMse(images[i]);
             if (!mse.ok()) continue;
             const double cost = *mse * result.rows[i].seconds;
@@ -600,7 +612,8 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         }
         // Another seed, so the reference's noise is independent of the ladders'.
         const uint64_t seed = options.seed + 1;
-        const std::string kind = best.method == "path" ? "path-traced" : best.method;
+        const std::string kind =
+            best.method == Method::kPath ? "path-traced" : std::string(MethodName(best.method));
         log->info("job={} no reference given: rendering a {} one with {} at {} spp", job_id, kind,
                   ConfigName(best), options.reference_spp);
         absl::StatusOr<RenderOutput> out = render_path(best, options.reference_spp, seed);
@@ -611,7 +624,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         RenderMetadata metadata;
         metadata.scene_hash = scene->content_hash;
         metadata.camera = options.scene.camera;
-        metadata.method = best.method;
+        metadata.method = std::string(MethodName(best.method));
         metadata.spp = options.reference_spp;
         metadata.seed = seed;
         metadata.max_depth = options.max_depth;
@@ -647,7 +660,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             RadiositySettings solve;
             solve.patches = patches;
             solve.tolerance = options.radiosity_tolerance;
-            absl::StatusOr<RadiosityOptions> ro = RadiosityOptionsOf(solve);
+            absl::StatusOr<RadiosityOptions> ro = RadiosityOptionsOf(solve, 0);
             if (!ro.ok()) return ro.status();
             ro->threads = options.threads;
             absl::StatusOr<std::unique_ptr<RadiosityRenderer>> radiosity =
@@ -663,7 +676,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             // A radiosity image's A/B halves see only the display's sampling, not the
             // solution's error: no estimate.
             ConvergenceRow row;
-            row.method = "radiosity";
+            row.method = Method::kRadiosity;
             row.config = options.configs.front();
             row.budget = (*radiosity)->report().patches;
             row.seconds = SecondsSince(start);
@@ -673,11 +686,13 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
                       row.seconds, row.error.rmse);
         }
     }
-    if (options.method == "whitted") {
+    if (FindMethod(options.method) == Method::kWhitted) {
         // Whitted's ladder against the same reference: its error falls with the pixel and
         // area-light sampling, then levels off at what it leaves out (WhittedMissingTerms).
         const RenderConfig& config = options.configs.front();
-        const WhittedTracer whitted(**embree, options.max_depth, config.light_strategy);
+        absl::StatusOr<std::unique_ptr<RadianceEstimator>> whitted =
+            MakeRayTracer(Method::kWhitted, **embree, options.max_depth, config.light_strategy);
+        if (!whitted.ok()) return whitted.status();
         for (uint64_t spp : Ladder(options.max_spp)) {
             RenderSettings settings;
             settings.spp = spp;
@@ -685,10 +700,10 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             settings.threads = options.threads;
             settings.sampler = config.sampler;
             settings.light_strategy = config.light_strategy;
-            absl::StatusOr<RenderOutput> out = RenderImage(camera, whitted, settings);
+            absl::StatusOr<RenderOutput> out = RenderImage(camera, **whitted, settings);
             if (!out.ok()) return out.status();
             ConvergenceRow row;
-            row.method = "whitted";
+            row.method = Method::kWhitted;
             row.config = config;
             row.budget = int64_t(spp);
             row.seconds = out->seconds;
@@ -704,7 +719,7 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
         }
         std::vector<std::pair<double, double>> points;
         for (const ConvergenceRow& row : result.rows) {
-            if (row.method == "whitted") points.push_back({row.seconds, RelativeRmse(row)});
+            if (row.method == Method::kWhitted) points.push_back({row.seconds, RelativeRmse(row)});
         }
         // A ladder too fast to time has no slope; the curve is drawn all the same.
         if (absl::StatusOr<double> slope = LogLogSlope(points); slope.ok()) {
@@ -721,7 +736,8 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
     if (with_radiosity) {
         std::vector<std::pair<double, double>> points;
         for (const ConvergenceRow& row : result.rows) {
-            if (row.method == "radiosity") points.push_back({row.seconds, RelativeRmse(row)});
+            if (row.method == Method::kRadiosity)
+                points.push_back({row.seconds, RelativeRmse(row)});
         }
         absl::StatusOr<double> slope = LogLogSlope(points);
         if (!slope.ok()) {

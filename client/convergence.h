@@ -21,6 +21,7 @@
 #include "lf/core/sampler.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/frame_settings.h"
+#include "lf/job/method_registry.h"
 #include "lf/job/settings.h"
 
 namespace lf {
@@ -28,7 +29,7 @@ namespace lf {
 // What a ladder varies: the method (the path tracer or a frame method: light, bdpt, ppm), where
 // the random numbers come from and how next-event estimation picks lights.
 struct RenderConfig {
-    std::string method = "path";
+    Method method = Method::kPath;
     SamplerType sampler = defaults::kSampler;
     LightStrategy light_strategy = defaults::kLightStrategy;
     bool operator==(const RenderConfig&) const = default;
@@ -36,7 +37,7 @@ struct RenderConfig {
 
 // The methods converge renders as spp ladders: budget = spp (light paths per pixel for light,
 // photon passes for ppm).
-bool IsLadderMethod(const std::string& method);
+bool IsLadderMethod(Method method);
 
 // "sobol/bvh" for the path tracer, "bdpt/sobol/bvh" for the others: how the table, the plot and
 // --compare name it.
@@ -92,7 +93,7 @@ struct ConvergenceOptions {
 absl::StatusOr<PixelRect> ParseRegion(const std::string& text);
 
 struct ConvergenceRow {
-    std::string method;
+    Method method = Method::kPath;
     RenderConfig config;  // path rows; radiosity rows: the sampler of its display
     int64_t budget = 0;   // spp or patches
     double seconds = 0;

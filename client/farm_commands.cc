@@ -29,7 +29,7 @@
 #include "lf/job/scene_files.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
-#include "local_render.h"
+#include "method_flags.h"
 #include "output_flags.h"
 #include "photon_flags.h"
 #include "progress_bar.h"
@@ -394,7 +394,7 @@ void PrintJob(const pb::Job& job) {
     FromProto(job.params(), &spec);
     // Radiosity samples no lights: its light strategy would say nothing.
     std::printf("  sampling  %s sampler%s\n", SamplerTypeName(spec.sampler),
-                spec.method == "radiosity"
+                FindMethod(spec.method) == Method::kRadiosity
                     ? ""
                     : absl::StrCat(", ", LightStrategyName(spec.light_strategy), " light sampling")
                           .c_str());

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -21,13 +22,13 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
-#include "lf/kernels/ray_tracer.h"
 #include "lf/kernels/whitted.h"
 #include "lf/local/local_executor.h"
+#include "lf/local/method_choice.h"
+#include "lf/local/method_factory.h"
+#include "lf/local/method_render.h"
 #include "lf/local/render_prediction.h"
-#include "local_render.h"
-#include "method_choice.h"
-#include "method_render.h"
+#include "method_flags.h"
 #include "photon_flags.h"
 #include "radiosity_flags.h"
 #include "sample_flags.h"
@@ -154,7 +155,7 @@ absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& op
     for (int64_t patches : {small_patches, 2 * small_patches}) {
         RadiositySettings settings;
         settings.patches = std::min(patches, options.patches);
-        absl::StatusOr<RadiosityOptions> pilot_options = RadiosityOptionsOf(settings);
+        absl::StatusOr<RadiosityOptions> pilot_options = RadiosityOptionsOf(settings, 0);
         if (!pilot_options.ok()) return pilot_options.status();
         pilot_options->threads = options.threads;
         absl::StatusOr<std::unique_ptr<RadiosityRenderer>> pilot =
@@ -203,11 +204,11 @@ double TriangleArea(const TriangleMesh& mesh, const std::array<uint32_t, 3>& t) 
 // named. Light tracing only where it sees everything (no mirror, glass or sky to look at);
 // Whitted only where it is exact.
 absl::Status PrintMethodCosts(const Scene& scene, const EmbreeScene& embree, const Camera& camera,
-                              const PlanOptions& options, const std::string& chosen) {
+                              const PlanOptions& options, Method chosen) {
     const SceneTransport transport = AnalyzeTransport(scene);
-    std::vector<std::string> methods = {"path", "bdpt", "ppm"};
-    if (transport.specular.empty() && !scene.environment) methods.push_back("light");
-    if (transport.whitted_missing.empty()) methods.push_back("whitted");
+    std::vector<Method> methods = {Method::kPath, Method::kBdpt, Method::kPpm};
+    if (transport.specular.empty() && !scene.environment) methods.push_back(Method::kLight);
+    if (transport.whitted_missing.empty()) methods.push_back(Method::kWhitted);
     const uint64_t stages[2] = {options.pilot_spp, 4 * options.pilot_spp};
     std::printf(
         "methods for --target-error %.4g: pilots of %llu then %llu spp over the whole image; "
@@ -225,9 +226,9 @@ absl::Status PrintMethodCosts(const Scene& scene, const EmbreeScene& embree, con
     settings.threads = options.threads;
     settings.tile = options.tile;
     settings.ppm = options.ppm;
-    std::string fastest, path_note;
+    std::optional<Method> fastest;
     double fastest_seconds = std::numeric_limits<double>::infinity(), path_seconds = 0;
-    for (const std::string& method : methods) {
+    for (const Method method : methods) {
         MethodPilotStage measured[2];
         for (int k = 0; k < 2; ++k) {
             absl::StatusOr<RenderOutput> out =
@@ -239,35 +240,39 @@ absl::Status PrintMethodCosts(const Scene& scene, const EmbreeScene& embree, con
         }
         const double ppm_rate = options.ppm.alpha / 2;
         absl::StatusOr<MethodCost> cost =
-            method == "ppm" ? PredictMethodCost(measured[0], measured[1], options.target_error,
-                                                ppm_rate, ppm_rate)
-                            : PredictMethodCost(measured[0], measured[1], options.target_error,
-                                                kMinConvergenceRate, kMaxConvergenceRate);
+            method == Method::kPpm
+                ? PredictMethodCost(measured[0], measured[1], options.target_error, ppm_rate,
+                                    ppm_rate)
+                : PredictMethodCost(measured[0], measured[1], options.target_error,
+                                    kMinConvergenceRate, kMaxConvergenceRate);
         if (!cost.ok()) return cost.status();
         // The path tracer converges to an image without the caustics of delta lights: costed, but
         // not a candidate.
-        const bool incomplete = method == "path" && transport.delta_caustics();
-        std::printf("  %-8s %9.2f %10.4g %6.2f %14.0f %14.1f%s\n", method.c_str(),
+        const bool incomplete = method == Method::kPath && transport.delta_caustics();
+        std::printf("  %-8s %9.2f %10.4g %6.2f %14.0f %14.1f%s\n",
+                    std::string(MethodName(method)).c_str(),
                     measured[0].seconds + measured[1].seconds, measured[1].error, cost->rate,
                     cost->spp, cost->seconds,
                     incomplete ? absl::StrCat("  (incomplete: no caustics of the ",
                                               absl::StrJoin(transport.delta_lights, ", "), ")")
                                      .c_str()
                                : "");
-        if (method == "path") path_seconds = cost->seconds;
+        if (method == Method::kPath) path_seconds = cost->seconds;
         if (!incomplete && cost->seconds < fastest_seconds) {
             fastest_seconds = cost->seconds;
             fastest = method;
         }
     }
-    std::printf("fastest to the target by its pilot: %s", fastest.c_str());
-    if (fastest != "path" && fastest_seconds > 0 && !transport.delta_caustics()) {
+    std::printf("fastest to the target by its pilot: %s",
+                fastest ? std::string(MethodName(*fastest)).c_str() : "");
+    if (fastest != Method::kPath && fastest_seconds > 0 && !transport.delta_caustics()) {
         std::printf(" (%.1fx faster than path)", path_seconds / fastest_seconds);
     }
-    std::printf("%s\n",
-                fastest == chosen
-                    ? ", the method chosen"
-                    : absl::StrCat("; the method chosen is ", chosen, " (--method)").c_str());
+    std::printf(
+        "%s\n",
+        fastest == chosen
+            ? ", the method chosen"
+            : absl::StrCat("; the method chosen is ", MethodName(chosen), " (--method)").c_str());
     if (transport.caustics()) {
         std::printf(
             "  caustics here: a short pilot of path tracing sees little of them, so its error "
@@ -320,11 +325,10 @@ absl::Status RunPlan(const PlanOptions& options) {
         emissive_triangles, emitting_area, emissive_spheres, scene->point_lights.size(),
         scene->spot_lights.size(), scene->directional_lights.size());
 
-    std::string why;
-    absl::StatusOr<std::string> method = ChooseMethod(*scene, options.method, &why);
-    if (!method.ok()) return method.status();
-    std::printf("method (--method %s): %s, because %s\n", options.method.c_str(), method->c_str(),
-                why.c_str());
+    const MethodChoice choice = ChooseMethod(*scene, MethodOfFlag(options.method));
+    const Method method = choice.method;
+    std::printf("method (--method %s): %s, because %s\n", options.method.c_str(),
+                std::string(MethodName(method)).c_str(), choice.why.c_str());
     // What Whitted would give (lf/kernels/whitted.h), whether or not it is the method.
     if (const std::vector<std::string> missing = WhittedMissingTerms(*scene); missing.empty()) {
         std::printf(
@@ -335,7 +339,7 @@ absl::Status RunPlan(const PlanOptions& options) {
         for (const std::string& term : missing) std::printf("  - %s\n", term.c_str());
     }
 
-    if (*method == "whitted") {
+    if (method == Method::kWhitted) {
         // Splitting at each glass hit doubles the rays: the depth bounds the work.
         std::printf(
             "whitted depth: at most %d specular bounces%s; a ray tree splits in two at every "
@@ -360,7 +364,7 @@ absl::Status RunPlan(const PlanOptions& options) {
 
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
-    if (*method == "radiosity") {
+    if (Info(method).work == WorkKind::kRadiosity) {
         if (absl::Status s = PrintRadiosityCost(**embree, options); !s.ok()) return s;
     } else {
         std::printf("radiosity: not used\n");
@@ -368,13 +372,15 @@ absl::Status RunPlan(const PlanOptions& options) {
 
     const Camera camera(scene->camera, (*embree)->origin());
     // The frame methods are not adaptive: the comparison of methods is their cost.
-    if (UsesFramePlan(*method)) return PrintMethodCosts(*scene, **embree, camera, options, *method);
+    if (Info(method).work == WorkKind::kFramePasses) {
+        return PrintMethodCosts(*scene, **embree, camera, options, method);
+    }
 
     // A pilot in two stages at the full resolution, each tile's error measured after both, so
     // that how fast it falls is measured rather than assumed (docs/convergence.md, "Error
     // estimates and plan predictions").
     // Radiosity's display error is costed with the path tracer's pilot, as before.
-    const std::string pilot_method = *method == "whitted" ? "whitted" : "path";
+    const Method pilot_method = method == Method::kWhitted ? Method::kWhitted : Method::kPath;
     absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
         MakeRayTracer(pilot_method, **embree, options.max_depth, options.light_strategy);
     if (!tracer.ok()) return tracer.status();
@@ -393,7 +399,7 @@ absl::Status RunPlan(const PlanOptions& options) {
     std::printf(
         "pilot (%s): %llu then %llu spp in every tile, %.2f s; the tiles' error goes "
         "as spp^%.2f (median over %d tiles; Monte Carlo's is spp^-0.5)\n",
-        pilot_method == "whitted" ? "whitted ray tracing" : "path tracing",
+        pilot_method == Method::kWhitted ? "whitted ray tracing" : "path tracing",
         (unsigned long long)p->pilot_spp[0], (unsigned long long)p->pilot_spp[1], p->pilot_seconds,
         -p->median_rate, p->tiles);
     std::printf(
@@ -411,7 +417,7 @@ absl::Status RunPlan(const PlanOptions& options) {
             "makes it surer\n",
             p->tiles_disagreeing, p->tiles, p->first_stage_mean_spp);
     }
-    return PrintMethodCosts(*scene, **embree, camera, options, *method);
+    return PrintMethodCosts(*scene, **embree, camera, options, method);
 }
 
 }  // namespace

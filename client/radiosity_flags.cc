@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/patch_mesh.h"
 #include "lf/job/job_spec.h"
-#include "lf/kernels/radiosity.h"
 
 namespace lf {
 
@@ -53,15 +53,6 @@ void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
         ->group(group)
         ->capture_default_str()
         ->check(OneOf(kRadiosityDisplays));
-}
-
-absl::StatusOr<RadiosityOptions> RadiosityOptionsOf(const RadiositySettings& settings) {
-    absl::StatusOr<RadiosityOptions> options =
-        MakeRadiosityOptions(settings.patches, settings.patch_size, settings.solver,
-                             settings.tolerance, settings.max_iterations, settings.display);
-    if (!options.ok()) return options.status();
-    options->max_patches = settings.max_patches;
-    return options;
 }
 
 absl::Status CheckRadiosityFlagsApply(const CLI::App& cmd, const std::string& method) {

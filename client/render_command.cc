@@ -1,11 +1,14 @@
 #include <cstdio>
+#include <optional>
 
 #include "adaptive_flags.h"
 #include "command.h"
 #include "lf/job/job_spec.h"
-#include "local_render.h"
+#include "lf/local/local_render.h"
+#include "method_flags.h"
 #include "output_flags.h"
 #include "photon_flags.h"
+#include "progress_bar.h"
 #include "radiosity_flags.h"
 #include "sample_flags.h"
 #include "scene_flags.h"
@@ -17,10 +20,26 @@ int ReportError(const absl::Status& status) {
     return 1;
 }
 
+namespace {
+
+// The bar starts with the sampling, as its elapsed time and estimate are the sampling's.
+class BarProgress : public RenderProgress {
+  public:
+    void Start() override { bar_.emplace("render"); }
+    void Update(size_t done, size_t total) override { bar_->Update(done, total); }
+    void Finish() override { bar_->Finish(); }
+
+  private:
+    std::optional<ProgressBar> bar_;
+};
+
+}  // namespace
+
 Command AddRenderCommand(CLI::App& app) {
     auto options = std::make_shared<LocalRenderOptions>();
     auto output = std::make_shared<OutputFlags>();
     auto no_progress = std::make_shared<bool>(false);
+    auto method = std::make_shared<std::string>(defaults::kMethod);
     CLI::App* cmd = app.add_subcommand(
         "render",
         "Render a scene in this process to an OpenEXR image and/or a PNG preview, by path\n"
@@ -58,7 +77,7 @@ Command AddRenderCommand(CLI::App& app) {
                    options->render.clamp, options->render.aovs);
     AddAdaptiveFlags(cmd, options->adaptive);
     cmd->add_flag("--no-progress", *no_progress, "no progress bar");
-    cmd->add_option("--method", options->method,
+    cmd->add_option("--method", *method,
                     "path (path tracing, any material), radiosity (finite elements, Lambertian "
                     "quads and triangles only, view-independent), whitted (direct light and "
                     "mirror/glass reflection and refraction only: a fast preview without "
@@ -91,29 +110,34 @@ Command AddRenderCommand(CLI::App& app) {
         ->group(r);
 
     return {
-        cmd, [cmd, options, output, no_progress] {
-            options->progress = !*no_progress;
+        cmd, [cmd, options, output, no_progress, method] {
             absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
             if (!paths.ok()) return ReportError(paths.status());
             options->exr_path = paths->exr;
             options->png_path = paths->png;
             options->preview = output->preview;
-            if (absl::Status s = CheckRadiosityFlagsApply(*cmd, options->method); !s.ok()) {
+            if (absl::Status s = CheckRadiosityFlagsApply(*cmd, *method); !s.ok()) {
                 return ReportError(s);
             }
-            if (absl::Status s = CheckPhotonFlagsApply(*cmd, options->method); !s.ok()) {
+            if (absl::Status s = CheckPhotonFlagsApply(*cmd, *method); !s.ok()) {
                 return ReportError(s);
             }
+            for (const std::string* path : {&options->exr_path, &options->png_path}) {
+                if (absl::Status s = CheckWritable(*path); !s.ok()) return ReportError(s);
+            }
+            options->method = MethodOfFlag(*method);
+            BarProgress bar;
+            options->progress = *no_progress ? nullptr : &bar;
             absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
             if (!summary.ok()) return ReportError(summary.status());
             const double s = summary->render_seconds;
             std::printf(
                 "job %s: %s, %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
                 "%llu NaN/Inf samples -> %s\n",
-                summary->job_id.c_str(), summary->method.c_str(), summary->width, summary->height,
-                (unsigned long long)summary->stats.samples, s, summary->stats.samples / s * 1e-6,
-                summary->stats.rays / s * 1e-6, (unsigned long long)summary->stats.invalid_samples,
-                OutputNames(*paths).c_str());
+                summary->job_id.c_str(), std::string(MethodName(summary->method)).c_str(),
+                summary->width, summary->height, (unsigned long long)summary->stats.samples, s,
+                summary->stats.samples / s * 1e-6, summary->stats.rays / s * 1e-6,
+                (unsigned long long)summary->stats.invalid_samples, OutputNames(*paths).c_str());
             std::printf("time: load %.2f s, ", summary->load_seconds);
             if (const std::optional<RadiosityFigures>& r = summary->radiosity) {
                 std::printf("radiosity %.2f s (mesh %.2f s, form factors %.2f s, solve %.2f s), ",

@@ -10,11 +10,10 @@
 #include "absl/strings/str_split.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
-#include "lf/core/patch_mesh.h"
-#include "lf/core/pixel_filter.h"
 #include "lf/core/radiosity_codec.h"
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
+#include "lf/job/method_registry.h"
 #include "lf/job/render_metadata.h"
 
 namespace lf {
@@ -149,18 +148,8 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
         nullptr, spec.scene_options);
     // The service logs the refusal with its caller.
     if (!scene.ok()) return absl::InvalidArgumentError(scene.status().message());
-    if (spec.method == "radiosity") {
-        if (absl::Status s = RadiosityRefusal(*scene); !s.ok()) return s;
-    }
-    // The splatting kernels refuse filters other than the box (SplatsLightPaths): refused here,
-    // once, rather than failing on every worker. Revisit when they splat with filter weights.
-    if (SplatsLightPaths(spec.method) && scene->camera.filter.type != PixelFilter::Type::kBox) {
-        return absl::FailedPreconditionError(
-            absl::StrCat("method ", spec.method, ": the pixel filter ",
-                         DescribePixelFilter(scene->camera.filter),
-                         " is not supported; light tracing and bdpt splat with the box filter "
-                         "only"));
-    }
+    // Refused here, once, rather than failing on every worker.
+    if (absl::Status s = CheckMethodTakesScene(MethodOf(spec), *scene); !s.ok()) return s;
     const int side = options_.limits.max_resolution;
     if (scene->camera.width > side || scene->camera.height > side) {
         return absl::ResourceExhaustedError(absl::StrCat("resolution ", scene->camera.width, "x",
@@ -261,39 +250,25 @@ void Farm::CheckTimers() {
 absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete,
                               const std::string& path) {
     const JobRecord& job = snapshot.record;
-    RenderMetadata metadata;
-    metadata.scene_hash = job.spec.scene_hash;
-    metadata.camera = job.spec.scene_options.camera;
-    metadata.method = job.spec.method;
-    metadata.spp = snapshot.adaptive ? snapshot.adaptive->max_spp : job.spec.plan.spp;
-    metadata.seed = job.spec.seed;
-    metadata.max_depth = job.spec.max_depth;
-    metadata.clamp = job.spec.clamp;
-    metadata.aovs = job.spec.aovs;
-    metadata.sampler = job.spec.sampler;
-    metadata.light_strategy = job.spec.light_strategy;
-    metadata.filter = job.spec.scene_options.filter.value_or(PixelFilter{});
-    metadata.seconds = job.started == absl::InfinitePast()
-                           ? 0.0
-                           : absl::ToDoubleSeconds(absl::Now() - job.started);
-    metadata.stats = job.stats;
-    metadata.adaptive_settings = job.spec.adaptive;
-    metadata.adaptive = snapshot.adaptive;
-    metadata.radiosity_settings = job.spec.radiosity;
-    metadata.ppm = job.spec.ppm;
+    RenderOutcome outcome;
+    outcome.seconds = job.started == absl::InfinitePast()
+                          ? 0.0
+                          : absl::ToDoubleSeconds(absl::Now() - job.started);
+    outcome.stats = job.stats;
+    outcome.adaptive = snapshot.adaptive;
     {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         if (auto it = radiosity_.find(job.id); it != radiosity_.end()) {
-            metadata.radiosity = it->second;
+            outcome.radiosity = it->second;
             // The display tiles' workers read the farm's solution: the solve's figures are ours.
             if (auto solve = sweep_solves_.find(job.id); solve != sweep_solves_.end()) {
-                metadata.radiosity->iterations = solve->second.iterations;
-                metadata.radiosity->residual = solve->second.residual;
+                outcome.radiosity->iterations = solve->second.iterations;
+                outcome.radiosity->residual = solve->second.residual;
             }
         }
     }
     absl::StatusOr<RenderDescription> description =
-        DescribeRender(metadata, snapshot.image, complete);
+        DescribeRender(MetadataOf(job.spec, outcome), snapshot.image, complete);
     if (!description.ok()) return description.status();
     const ExrAttributes& attributes = description->attributes;
     // Renamed into place so a reader never sees half a file, and durable before the job is

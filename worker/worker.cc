@@ -15,24 +15,14 @@
 #include "lf/core/tile_codec.h"
 #include "lf/job/frame_settings.h"
 #include "lf/kernels/radiosity.h"
-#include "lf/kernels/ray_tracer.h"
 #include "lf/kernels/tile_renderer.h"
+#include "lf/local/method_factory.h"
 
 namespace lf {
 
 namespace {
 
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("worker"); }
-
-absl::StatusOr<RadiosityOptions> RadiosityOptionsFor(const TaskAssignment& task) {
-    const RadiositySettings& r = task.spec.radiosity;
-    absl::StatusOr<RadiosityOptions> options = MakeRadiosityOptions(
-        r.patches, r.patch_size, r.solver, r.tolerance, r.max_iterations, r.display);
-    if (!options.ok()) return options.status();
-    options->target_error = task.spec.adaptive.target_error;
-    options->max_patches = r.max_patches;
-    return options;
-}
 
 // What a lease asks for, for its first log line.
 std::string DescribeTask(const TaskAssignment& task) {
@@ -261,16 +251,17 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
 
 absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel) {
     if (loaded_.tracer) return absl::OkStatus();
-    if (task.spec.method != "radiosity") {
+    const Method method = MethodOf(task.spec);
+    if (Info(method).work != WorkKind::kRadiosity) {
         // Cached per job (loaded_.job_id), so the job's one light strategy is the tracer's.
-        // path or whitted; the coordinator refused every other name (CheckJobSettings).
-        absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer = MakeRayTracer(
-            task.spec.method, *loaded_.embree, task.spec.max_depth, task.spec.light_strategy);
+        absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
+            MakeRayTracer(method, *loaded_.embree, task.spec.max_depth, task.spec.light_strategy);
         if (!tracer.ok()) return tracer.status();
         loaded_.tracer = std::move(*tracer);
         return absl::OkStatus();
     }
-    absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);
+    absl::StatusOr<RadiosityOptions> options =
+        RadiosityOptionsOf(task.spec.radiosity, task.spec.adaptive.target_error);
     if (!options.ok()) return options.status();
     options->threads = options_.threads;
     options->cancel = &cancel;  // meshing, form factors and the solve stop on a cancel
@@ -307,7 +298,8 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
     const RadiositySettings& r = task.spec.radiosity;
     std::unique_ptr<RadiositySweepChunk>& chunk = loaded_.chunks[task.chunk];
     if (!chunk) {
-        absl::StatusOr<RadiosityOptions> options = RadiosityOptionsFor(task);
+        absl::StatusOr<RadiosityOptions> options =
+            RadiosityOptionsOf(task.spec.radiosity, task.spec.adaptive.target_error);
         if (!options.ok()) return options.status();
         const absl::Time start = absl::Now();
         absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> built;
@@ -383,9 +375,7 @@ absl::Status Worker::RenderFrame(const TaskAssignment& task, const std::atomic<b
         // settings give local mode's kernel.
         const JobSpec& spec = task.spec;
         absl::StatusOr<std::unique_ptr<FrameRenderer>> made = MakeFrameRenderer(
-            spec.method, *loaded_.embree, *loaded_.camera,
-            FrameRenderSettingsOf<FrameRenderSettings>(spec.max_depth, spec.seed, spec.sampler,
-                                                       spec.clamp, spec.light_strategy, spec.ppm));
+            MethodOf(spec), *loaded_.embree, *loaded_.camera, FrameRenderSettingsOf(spec));
         if (!made.ok()) return made.status();
         loaded_.frame = std::move(*made);
     }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "lf/job/method_registry.h"
 
 namespace lf {
 
@@ -28,10 +29,8 @@ absl::Status CheckPhotonSettings(const PhotonSettings& ppm) {
 }
 
 std::optional<FramePlanKind> FramePlanKindOf(std::string_view method) {
-    if (method == "light") return FramePlanKind::kLightPaths;
-    if (method == "bdpt") return FramePlanKind::kCameraAndLight;
-    if (method == "ppm") return FramePlanKind::kPhotonPasses;
-    return std::nullopt;
+    const std::optional<Method> m = FindMethod(method);
+    return m ? Info(*m).frame_plan : std::nullopt;
 }
 
 absl::StatusOr<FramePlanSettings> FramePlanSettingsOf(std::string_view method,

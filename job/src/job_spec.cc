@@ -39,16 +39,16 @@ absl::Status OneOf(const char* field, const std::string& value,
         absl::StrCat(field, " \"", value, "\": expected one of ", expected));
 }
 
-// The frame methods splat light paths anywhere on the image or average photon passes per pixel:
-// their plan has no per-pixel first hits to make AOVs of, and no tile whose error alone decides
-// its next pass, so neither AOVs nor adaptive sampling apply.
-absl::Status CheckFrameMethodSettings(const JobSpec& spec) {
-    if (!UsesFramePlan(spec.method)) return absl::OkStatus();
-    if (spec.aovs != 0) {
+// The methods' own limits (MethodInfo): the frame methods make no AOVs and sample no
+// adaptive passes. Ok for an unknown method, which CheckJobSettings refuses first.
+absl::Status CheckMethodSettings(const JobSpec& spec) {
+    const std::optional<Method> method = FindMethod(spec.method);
+    if (!method) return absl::OkStatus();
+    if (spec.aovs != 0 && !Info(*method).aovs) {
         return absl::InvalidArgumentError(absl::StrCat(
             "aovs: method \"", spec.method, "\" makes no AOV channels; use method path"));
     }
-    if (IsAdaptive(spec.adaptive)) {
+    if (IsAdaptive(spec.adaptive) && !Info(*method).adaptive) {
         return absl::InvalidArgumentError(absl::StrCat(
             "adaptive: method \"", spec.method,
             "\" has no adaptive sampling (no target error or time limit); set spp instead"));
@@ -57,10 +57,6 @@ absl::Status CheckFrameMethodSettings(const JobSpec& spec) {
 }
 
 }  // namespace
-
-absl::Status CheckMethod(const std::string& method) {
-    return OneOf("method", method, kRenderMethods);
-}
 
 absl::Status CheckJobSettings(const JobSpec& spec) {
     const RadiositySettings& r = spec.radiosity;
@@ -74,7 +70,7 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         // Finite: an infinite cap is no cap, and the CLI's 0 says that.
         InRange("clamp", spec.clamp, 0.0, std::numeric_limits<double>::max()),
         InRange("aovs", spec.aovs, 0u, uint32_t(kAllAovs)),
-        CheckMethod(spec.method),
+        ParseMethod(spec.method).status(),
         NoneOrInRange("adaptive.target_error", spec.adaptive.target_error, kMinTargetError,
                       kMaxTargetError),
         NoneOrInRange("adaptive.time_limit", spec.adaptive.time_limit, kMinTimeLimit,
@@ -90,7 +86,7 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         InRange("radiosity.sweep_tasks", r.sweep_tasks, 1, kMaxSweepTasks),
         InRange("radiosity.max_patches", r.max_patches, int64_t(0), kMaxRefinedPatches),
         CheckPhotonSettings(spec.ppm),
-        CheckFrameMethodSettings(spec),
+        CheckMethodSettings(spec),
     };
     for (const absl::Status& s : checks) {
         if (!s.ok()) return s;

@@ -3,6 +3,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/aov.h"
 #include "lf/core/pixel_filter.h"
+#include "lf/job/method_registry.h"
 #include "lf/version.h"
 
 namespace lf {
@@ -156,8 +157,9 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     d.attributes = DescribeMethod(m);
     if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
     if (m.aovs != 0) d.attributes["lightfarm.aovs"] = AovListName(m.aovs);
-    // The methods that sample lights at camera-path vertices.
-    if (m.method == "path" || m.method == "whitted" || m.method == "bdpt" || m.method == "ppm") {
+    const std::optional<Method> method = FindMethod(m.method);
+    const MethodInfo* info = method ? &Info(*method) : nullptr;
+    if (info && info->samples_lights) {
         d.attributes["lightfarm.light_sampling"] = std::string(LightStrategyName(m.light_strategy));
     }
     if (m.clamp > 0) AddClampAttributes(m.clamp, d.attributes);
@@ -169,10 +171,34 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
         d.estimates = *e;
     }
     if (m.adaptive) AddAdaptiveAttributes(m.adaptive_settings, *m.adaptive, d.attributes);
-    if (m.method == "radiosity") AddRadiosityAttributes(m, d.attributes);
-    if (m.method == "light" || m.method == "bdpt") AddLightPathAttributes(m, image, d.attributes);
-    if (m.method == "ppm") AddPhotonAttributes(m, d.attributes);
+    if (!info) return d;
+    if (info->work == WorkKind::kRadiosity) AddRadiosityAttributes(m, d.attributes);
+    if (info->splats_light_paths) AddLightPathAttributes(m, image, d.attributes);
+    if (info->frame_plan == FramePlanKind::kPhotonPasses) AddPhotonAttributes(m, d.attributes);
     return d;
+}
+
+RenderMetadata MetadataOf(const JobSpec& spec, const RenderOutcome& outcome) {
+    RenderMetadata m;
+    m.scene_hash = spec.scene_hash;
+    m.camera = spec.scene_options.camera;
+    m.method = spec.method;
+    m.spp = outcome.adaptive ? outcome.adaptive->max_spp : spec.plan.spp;
+    m.seed = spec.seed;
+    m.max_depth = spec.max_depth;
+    m.clamp = spec.clamp;
+    m.aovs = spec.aovs;
+    m.sampler = spec.sampler;
+    m.light_strategy = spec.light_strategy;
+    m.filter = spec.scene_options.filter.value_or(PixelFilter{});
+    m.seconds = outcome.seconds;
+    m.stats = outcome.stats;
+    m.adaptive_settings = spec.adaptive;
+    m.adaptive = outcome.adaptive;
+    m.radiosity_settings = spec.radiosity;
+    m.radiosity = outcome.radiosity;
+    m.ppm = spec.ppm;
+    return m;
 }
 
 }  // namespace lf

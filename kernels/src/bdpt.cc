@@ -10,8 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "absl/status/status.h"
-#include "lf/core/pixel_filter.h"
 #include "lf/kernels/bsdf.h"
 #include "lf/kernels/next_event.h"
 #include "lf/kernels/path_tracer.h"
@@ -89,18 +87,6 @@ constexpr int kRouletteStartBounce = 2;  // the path tracer's depth 1: its secon
 struct BdptRenderer::Scratch {
     Path camera, light;
 };
-
-absl::StatusOr<std::unique_ptr<BdptRenderer>> BdptRenderer::Make(
-    const EmbreeScene& scene, const Camera& camera, const FrameRenderSettings& settings) {
-    const PixelFilter& filter = scene.scene().camera.filter;
-    if (filter.type != PixelFilter::Type::kBox) {
-        return absl::FailedPreconditionError(
-            "method bdpt splats light paths to single pixels and supports only the box pixel "
-            "filter, not " +
-            DescribePixelFilter(filter));
-    }
-    return std::make_unique<BdptRenderer>(scene, camera, settings);
-}
 
 BdptRenderer::BdptRenderer(const EmbreeScene& scene, const Camera& camera,
                            const FrameRenderSettings& settings)

@@ -13,6 +13,7 @@
 #include "lf/job/frame_merge.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/frame_renderer.h"
+#include "lf/local/method_factory.h"
 
 namespace lf::testing {
 
@@ -60,7 +61,7 @@ inline FrameSetup MakeFrameSetup(const Scene& scene, std::string_view method,
     EXPECT_TRUE(es.ok()) << es.status();
     s.embree = std::move(*es);
     s.camera = std::make_unique<Camera>(scene.camera, s.embree->origin());
-    auto r = MakeFrameRenderer(method, *s.embree, *s.camera, settings);
+    auto r = MakeFrameRenderer(*FindMethod(method), *s.embree, *s.camera, settings);
     EXPECT_TRUE(r.ok()) << r.status();
     s.renderer = std::move(*r);
     return s;

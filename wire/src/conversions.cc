@@ -2,6 +2,8 @@
 
 #include <optional>
 
+#include "lf/job/method_registry.h"
+
 namespace lf {
 
 namespace pb = lightfarm::v1;
@@ -92,8 +94,13 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_tile(spec.plan.tile);
     out->set_passes(spec.plan.passes);
     out->set_method(spec.method);
-    if (spec.method == "radiosity") ToProto(spec.radiosity, out->mutable_radiosity());
-    if (spec.method == "ppm") {
+    // Each method's own settings only; an unknown name the coordinator refuses carries none.
+    const std::optional<Method> method = FindMethod(spec.method);
+    const MethodInfo* info = method ? &Info(*method) : nullptr;
+    if (info && info->work == WorkKind::kRadiosity) {
+        ToProto(spec.radiosity, out->mutable_radiosity());
+    }
+    if (info && info->frame_plan == FramePlanKind::kPhotonPasses) {
         pb::PhotonParams* ppm = out->mutable_ppm();
         ppm->set_photons_per_pass(spec.ppm.photons_per_pass);
         ppm->set_initial_radius(spec.ppm.initial_radius);

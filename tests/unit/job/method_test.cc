@@ -1,12 +1,13 @@
-// The rendering methods a job may name (lf/job/job_spec.h): each of them passes, anything else is
-// refused as unknown with the list; and a Whitted render's header names its method and light
-// sampling.
+// The rendering methods a job may name (lf/job/method_registry.h): each of them passes, anything
+// else is refused as unknown with the list; and a Whitted render's header names its method and
+// light sampling.
 #include <gtest/gtest.h>
 
 #include <string>
 
 #include "lf/job/job_spec.h"
 #include "lf/job/merge.h"
+#include "lf/job/method_registry.h"
 #include "lf/job/render_metadata.h"
 
 namespace lf {
@@ -16,20 +17,20 @@ TEST(Method, EveryMethodPassesTheJobCheck) {
     for (const char* method : {"path", "radiosity", "whitted", "light", "bdpt", "ppm"}) {
         JobSpec spec;
         spec.method = method;
-        EXPECT_TRUE(CheckMethod(method).ok()) << method;
+        EXPECT_TRUE(ParseMethod(method).ok()) << method;
         EXPECT_TRUE(CheckJobSettings(spec).ok()) << method << ": " << CheckJobSettings(spec);
     }
 }
 
 TEST(Method, UnknownMethodIsInvalidAndListsEveryMethod) {
-    const absl::Status s = CheckMethod("photon");
+    const absl::Status s = ParseMethod("photon").status();
     EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
     const std::string message(s.message());
     for (const char* name : {"path", "radiosity", "whitted", "bdpt", "light", "ppm"}) {
         EXPECT_NE(message.find(name), std::string::npos) << name << " in " << message;
     }
-    EXPECT_EQ(CheckMethod("").code(), absl::StatusCode::kInvalidArgument);
-    EXPECT_EQ(CheckMethod("Whitted").code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(ParseMethod("").status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(ParseMethod("Whitted").status().code(), absl::StatusCode::kInvalidArgument);
 }
 
 // Whitted samples lights as the path tracer does, so its header names the light strategy, and

@@ -17,6 +17,7 @@
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
+#include "lf/local/method_factory.h"
 #include "render_path.h"
 #include "test_scenes.h"
 
@@ -43,7 +44,7 @@ BdptFrame RenderBdpt(const Scene& scene, uint64_t spp, int max_depth, uint64_t s
     FrameRenderSettings settings;
     settings.max_depth = max_depth;
     settings.seed = seed;
-    auto renderer = BdptRenderer::Make(**es, camera, settings);
+    auto renderer = MakeFrameRenderer(Method::kBdpt, **es, camera, settings);
     EXPECT_TRUE(renderer.ok()) << renderer.status();
     const int w = camera.width(), h = camera.height();
     const PixelRect rect{0, 0, w, h};
@@ -483,7 +484,7 @@ TEST(Bdpt, RefusesPixelFiltersOtherThanTheBox) {
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
     const Camera camera(scene.camera, (*es)->origin());
-    auto renderer = BdptRenderer::Make(**es, camera, FrameRenderSettings{});
+    auto renderer = MakeFrameRenderer(Method::kBdpt, **es, camera, FrameRenderSettings{});
     ASSERT_FALSE(renderer.ok());
     EXPECT_EQ(renderer.status().code(), absl::StatusCode::kFailedPrecondition);
     EXPECT_NE(renderer.status().message().find("bdpt"), std::string::npos);

@@ -11,6 +11,7 @@
 #include "frame_render.h"
 #include "frame_scenes.h"
 #include "lf/core/scene_loader.h"
+#include "lf/local/method_factory.h"
 #include "render_path.h"
 
 namespace lf {
@@ -308,33 +309,34 @@ TEST(LightTracer, MatchesPathTracerForALightInsideGlass) {
 }
 
 TEST(FrameRendererFactory, BuildsLightAndRefusesWhatItCannot) {
-    EXPECT_TRUE(IsFrameMethod("light"));
-    EXPECT_TRUE(IsFrameMethod("bdpt"));
-    EXPECT_TRUE(IsFrameMethod("ppm"));
-    EXPECT_FALSE(IsFrameMethod("path"));
-    EXPECT_FALSE(IsFrameMethod("whitted"));
+    auto is_frame_method = [](Method m) { return Info(m).work == WorkKind::kFramePasses; };
+    EXPECT_TRUE(is_frame_method(Method::kLight));
+    EXPECT_TRUE(is_frame_method(Method::kBdpt));
+    EXPECT_TRUE(is_frame_method(Method::kPpm));
+    EXPECT_FALSE(is_frame_method(Method::kPath));
+    EXPECT_FALSE(is_frame_method(Method::kWhitted));
     Scene scene = testing::PointLitFurnaceSphere(8);
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
     const Camera camera(scene.camera, (*es)->origin());
-    EXPECT_TRUE(MakeFrameRenderer("light", **es, camera, {}).ok());
-    EXPECT_TRUE(MakeFrameRenderer("ppm", **es, camera, {}).ok());
+    EXPECT_TRUE(MakeFrameRenderer(Method::kLight, **es, camera, {}).ok());
+    EXPECT_TRUE(MakeFrameRenderer(Method::kPpm, **es, camera, {}).ok());
     FrameRenderSettings bad_alpha;
     bad_alpha.alpha = 1;
-    EXPECT_EQ(MakeFrameRenderer("ppm", **es, camera, bad_alpha).status().code(),
+    EXPECT_EQ(MakeFrameRenderer(Method::kPpm, **es, camera, bad_alpha).status().code(),
               absl::StatusCode::kInvalidArgument);
-    const auto path = MakeFrameRenderer("path", **es, camera, {});
+    const auto path = MakeFrameRenderer(Method::kPath, **es, camera, {});
     EXPECT_EQ(path.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(path.status().message().find("path"), std::string::npos);
 
     scene.camera.filter = {PixelFilter::Type::kGaussian, 2};
     const Camera gaussian(scene.camera, (*es)->origin());
-    const auto refused = MakeFrameRenderer("light", **es, gaussian, {});
+    const auto refused = MakeFrameRenderer(Method::kLight, **es, gaussian, {});
     EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
     EXPECT_NE(refused.status().message().find("light"), std::string::npos);
     EXPECT_NE(refused.status().message().find("gaussian"), std::string::npos);
     // Photons are gathered at filter-importance-sampled camera samples: any filter.
-    EXPECT_TRUE(MakeFrameRenderer("ppm", **es, gaussian, {}).ok());
+    EXPECT_TRUE(MakeFrameRenderer(Method::kPpm, **es, gaussian, {}).ok());
 }
 
 }  // namespace

@@ -32,16 +32,10 @@ inline constexpr uint64_t kMaxPhotonsPerPass = uint64_t(1) << 28;
 // "ppm.alpha 1: expected above 0 and below 1".
 absl::Status CheckPhotonSettings(const PhotonSettings& ppm);
 
-// The plan kind of a frame method ("light", "bdpt", "ppm"); nullopt for the others (path,
-// radiosity, whitted), which are planned in tiles (lf/job/plan.h).
+// The plan kind of a frame method (MethodInfo::frame_plan); nullopt for the others and for
+// unknown names.
 std::optional<FramePlanKind> FramePlanKindOf(std::string_view method);
 inline bool UsesFramePlan(std::string_view method) { return FramePlanKindOf(method).has_value(); }
-// Whether `method` splats light paths onto the film (light, bdpt): their kernels put a splat in
-// the pixel that holds its raster position, the box filter's footprint, and refuse other pixel
-// filters (lf::MakeFrameRenderer); ppm gathers at filter-sampled camera samples and takes any.
-inline bool SplatsLightPaths(std::string_view method) {
-    return method == "light" || method == "bdpt";
-}
 
 // `ppm`'s tile: the whole frame up to this side. Each task of a tile rebuilds the photon maps of
 // its passes (a pass's map is a pure function of the pass), so every extra tile repeats the

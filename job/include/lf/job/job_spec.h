@@ -13,6 +13,7 @@
 #include "lf/core/scene_loader.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/frame_settings.h"
+#include "lf/job/method_registry.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
 #include "lf/job/settings.h"
@@ -33,7 +34,7 @@ struct JobSpec {
     SamplerType sampler = defaults::kSampler;
     // The path tracer's; the job records and the EXR header name it (power or bvh).
     LightStrategy light_strategy = defaults::kLightStrategy;
-    std::string method = defaults::kMethod;  // kRenderMethods
+    std::string method = defaults::kMethod;  // a name of lf/job/method_registry.h
     RadiositySettings radiosity;
     PhotonSettings ppm;         // method "ppm" (lf/job/frame_settings.h)
     AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused
@@ -58,16 +59,6 @@ inline constexpr int64_t kMaxPatchTarget = int64_t(1) << 24;
 inline constexpr double kMinTolerance = 1e-12, kMaxTolerance = 1.0;
 inline constexpr double kMinTargetError = 1e-6, kMaxTargetError = 1.0;  // or 0: none
 inline constexpr double kMinTimeLimit = 1e-3, kMaxTimeLimit = 1e7;      // seconds, or 0: none
-// "whitted": Whitted ray tracing (lf/kernels/whitted.h), direct light and specular chains only.
-// The frame methods (lf/job/frame_settings.h, planned by lf/job/frame_plan.h): "light", light
-// tracing (paths from the lights, splatted onto the film); "bdpt", bidirectional path tracing;
-// "ppm", progressive photon mapping. Whether this build's kernels implement one is the kernel
-// factory's to say (lf::MakeFrameRenderer), when the render starts.
-inline constexpr std::array<std::string_view, 6> kRenderMethods = {"path",  "radiosity", "whitted",
-                                                                   "light", "bdpt",      "ppm"};
-
-// Ok for kRenderMethods; InvalidArgument listing them for anything else.
-absl::Status CheckMethod(const std::string& method);
 inline constexpr std::array<std::string_view, 3> kRadiositySolvers = {"jacobi", "gauss-seidel",
                                                                       "shooting"};
 inline constexpr std::array<std::string_view, 2> kRadiosityDisplays = {"flat", "smooth"};
@@ -80,7 +71,7 @@ absl::Status CheckJobSettings(const JobSpec& spec);
 // Radiosity jobs the farm solves in patch-group tasks per sweep, rather than on every worker.
 // Not adaptive ones: their passes are appended to the tasks where the sweeps would go.
 inline bool SolvedInSweeps(const JobSpec& spec) {
-    return spec.method == "radiosity" && spec.radiosity.solver == "jacobi" &&
+    return FindMethod(spec.method) == Method::kRadiosity && spec.radiosity.solver == "jacobi" &&
            !IsAdaptive(spec.adaptive);
 }
 

@@ -15,6 +15,7 @@
 #include "lf/core/scene.h"
 #include "lf/job/adaptive_plan.h"
 #include "lf/job/frame_settings.h"
+#include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
 
@@ -64,7 +65,7 @@ RadiosityFigures RadiosityFiguresOf(const Report& r) {
 struct RenderMetadata {
     std::string scene_hash;
     std::string camera;  // the glTF camera --camera picked; "" for the scene's own
-    std::string method;  // kRenderMethods (lf/job/job_spec.h)
+    std::string method;  // a name of lf/job/method_registry.h
     uint64_t spp = 0;    // adaptive: the most any pixel got
     uint64_t seed = 0;
     int max_depth = -1;
@@ -83,6 +84,18 @@ struct RenderMetadata {
     std::optional<RadiosityFigures> radiosity;  // when known
     PhotonSettings ppm;                         // method "ppm"
 };
+
+// What a render of a job measured, for its header.
+struct RenderOutcome {
+    double seconds = 0;  // the whole render: loading, meshing, solving and sampling
+    RenderStats stats;
+    std::optional<AdaptiveReport> adaptive;  // set for an adaptive render
+    std::optional<RadiosityFigures> radiosity;
+};
+
+// The metadata of `spec` rendered with `outcome`, local mode's and the farm's alike (so their
+// headers differ only in timings). spec.scene_options.filter is the filter the scene resolved to.
+RenderMetadata MetadataOf(const JobSpec& spec, const RenderOutcome& outcome);
 
 // What an image estimates of its own error, from its A/B halves: needs 2 samples per pixel.
 struct ErrorEstimates {

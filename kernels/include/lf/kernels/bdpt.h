@@ -54,13 +54,12 @@
 // SplatList at the pixel holding its raster position, half = the camera sample's parity, with
 // pbrt's film-normalised importance: a pixel is its camera mean plus its splat sum times
 // W H / N, N the camera samples of the frame (lf/job/frame_merge.h). Only the box filter is
-// supported (Make refuses the others): a splat goes to one pixel.
+// supported (lf::MakeFrameRenderer refuses the others): a splat goes to one pixel.
 #pragma once
 
 #include <atomic>
 #include <memory>
 
-#include "absl/status/statusor.h"
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/frame_renderer.h"
@@ -76,11 +75,8 @@ struct BdptVertex;
 
 class BdptRenderer : public FrameRenderer {
   public:
-    // The renderer for `scene` seen through `camera` (both must outlive it). FailedPrecondition
-    // naming bdpt and the filter when the scene's camera has a pixel filter other than box.
-    static absl::StatusOr<std::unique_ptr<BdptRenderer>> Make(const EmbreeScene& scene,
-                                                              const Camera& camera,
-                                                              const FrameRenderSettings& settings);
+    // scene and camera must outlive the renderer. The camera's pixel filter is taken as box
+    // (lf::MakeFrameRenderer refuses others).
     BdptRenderer(const EmbreeScene& scene, const Camera& camera,
                  const FrameRenderSettings& settings);
     ~BdptRenderer() override;

@@ -10,15 +10,12 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
-#include <string_view>
 
-#include "absl/status/statusor.h"
 #include "lf/core/camera.h"
 #include "lf/core/film.h"
 #include "lf/core/light_strategy.h"
 #include "lf/core/sampler.h"
 #include "lf/core/splat_list.h"
-#include "lf/kernels/embree_scene.h"
 
 namespace lf {
 
@@ -62,15 +59,5 @@ class FrameRenderer {
     virtual void Render(const FrameWork& work, TileSums& camera, SplatList& splats,
                         const std::atomic<bool>* cancel = nullptr) const = 0;
 };
-
-// True for the methods MakeFrameRenderer builds: "light", "bdpt", "ppm".
-bool IsFrameMethod(std::string_view method);
-
-// The renderer for `method` over `scene` seen through `camera` (both must outlive it).
-// InvalidArgument naming the method for any other; FailedPrecondition naming the method and
-// what it lacks when the scene holds something the method does not handle.
-absl::StatusOr<std::unique_ptr<FrameRenderer>> MakeFrameRenderer(
-    std::string_view method, const EmbreeScene& scene, const Camera& camera,
-    const FrameRenderSettings& settings);
 
 }  // namespace lf

@@ -45,7 +45,7 @@
 // and counted in RenderStats::invalid_samples; samples counts light paths, rays every ray
 // (light rays and shadow rays to the camera).
 //
-// Only the box pixel filter: MakeFrameRenderer refuses others (a splat goes to the one pixel
+// Only the box pixel filter: lf::MakeFrameRenderer refuses others (a splat goes to the one pixel
 // that holds its raster position). Thin-lens cameras are handled (a lens point per vertex).
 #pragma once
 

@@ -4,11 +4,11 @@
 #pragma once
 
 #include <cstdint>
-#include <string>
 
 #include "absl/status/statusor.h"
 #include "lf/core/camera.h"
 #include "lf/job/frame_settings.h"
+#include "lf/job/method_registry.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/local/local_executor.h"
 
@@ -27,7 +27,7 @@ struct MethodRenderSettings {
 
 // `spp` samples per pixel of `method` (light paths per pixel for light, photon passes for ppm),
 // planned as `render` plans it by default. InvalidArgument naming the method for any other.
-absl::StatusOr<RenderOutput> RenderWithMethod(const std::string& method, const EmbreeScene& scene,
+absl::StatusOr<RenderOutput> RenderWithMethod(Method method, const EmbreeScene& scene,
                                               const Camera& camera,
                                               const MethodRenderSettings& settings, uint64_t spp);
 

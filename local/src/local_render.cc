@@ -1,4 +1,4 @@
-#include "local_render.h"
+#include "lf/local/local_render.h"
 
 #include <cmath>
 
@@ -10,64 +10,29 @@
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
-#include "lf/core/patch_mesh.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/frame_renderer.h"
 #include "lf/kernels/path_tracer.h"
-#include "lf/kernels/ray_tracer.h"
 #include "lf/kernels/whitted.h"
-#include "method_choice.h"
-#include "output_flags.h"
-#include "progress_bar.h"
-#include "radiosity_flags.h"
+#include "lf/local/method_choice.h"
+#include "lf/local/method_factory.h"
 
 namespace lf {
 
-absl::StatusOr<std::string> ChooseMethod(const Scene& scene, const std::string& requested,
-                                         std::string* why) {
-    if (requested != "auto") {
-        // The job model's names, or unknown.
-        if (std::string error = MethodFlagError(requested, true); !error.empty()) {
-            return absl::Status(CheckMethod(requested).code(), "--" + error);
-        }
-        *why = "requested";
-        return requested;
-    }
-    MethodChoice choice = ChooseAutomatically(scene);
-    *why = std::move(choice.why);
-    return choice.method;
-}
-
-std::string MethodFlagError(const std::string& method, bool allow_auto) {
-    if (allow_auto && method == "auto") return "";
-    const absl::Status s = CheckMethod(method);
-    if (s.ok()) return "";
-    std::string message(s.message());
-    const std::string expected = "expected one of ";
-    if (const size_t at = message.find(expected); allow_auto && at != std::string::npos) {
-        message.insert(at + expected.size(), "auto, ");
-    }
-    return message;
-}
-
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options) {
-    for (const std::string* path : {&options.exr_path, &options.png_path}) {
-        if (absl::Status s = CheckWritable(*path); !s.ok()) return s;
-    }
     auto log = NamedLogger("render");
     const absl::Time start = absl::Now();
 
     absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
     const std::string job_id = "local-" + scene->content_hash.substr(0, 8);
-    std::string why;
-    absl::StatusOr<std::string> method = ChooseMethod(*scene, options.method, &why);
-    if (!method.ok()) return method.status();
-    log->info("job={} method {} ({})", job_id, *method, why);
+    const MethodChoice choice = ChooseMethod(*scene, options.method);
+    const Method method = choice.method;
+    const MethodInfo& info = Info(method);
+    log->info("job={} method {} ({})", job_id, info.name, choice.why);
 
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
@@ -80,38 +45,50 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     std::optional<FramePlanSettings> frame_plan;
     const RadiosityRenderer* radiosity = nullptr;
     const bool adaptive = options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
-    if (UsesFramePlan(*method)) {
+    // The job this render is, as the farm would run it: its kernels' settings and its header.
+    JobSpec job;
+    job.method = std::string(info.name);
+    job.scene_options = options.scene;
+    job.scene_options.filter = scene->camera.filter;
+    job.plan = {camera.width(), camera.height(), options.render.spp, options.render.tile,
+                options.render.passes};
+    job.seed = options.render.seed;
+    job.max_depth = options.max_depth;
+    job.clamp = options.render.clamp;
+    job.aovs = options.render.aovs;
+    job.sampler = options.render.sampler;
+    job.light_strategy = options.render.light_strategy;
+    job.radiosity = options.radiosity;
+    job.ppm = options.ppm;
+    job.adaptive = options.adaptive;
+    job.scene_hash = scene->content_hash;
+    if (info.work == WorkKind::kFramePasses) {
         // The job model's checks, so local mode refuses what the coordinator refuses.
         if (options.render.aovs != 0 || adaptive) {
             JobSpec spec;
-            spec.method = *method;
+            spec.method = job.method;
             spec.aovs = options.render.aovs;
             spec.adaptive = options.adaptive;
             if (absl::Status s = CheckJobSettings(spec); !s.ok()) return s;
         }
         if (absl::Status s = CheckPhotonSettings(options.ppm); !s.ok()) return s;
-        absl::StatusOr<FramePlanSettings> plan =
-            FramePlanSettingsOf(*method, {camera.width(), camera.height(), options.render.spp,
-                                          options.render.tile, options.render.passes});
+        absl::StatusOr<FramePlanSettings> plan = FramePlanSettingsOf(job.method, job.plan);
         if (!plan.ok()) return plan.status();
         frame_plan = *plan;
-        absl::StatusOr<std::unique_ptr<FrameRenderer>> made = MakeFrameRenderer(
-            *method, **embree, camera,
-            FrameRenderSettingsOf<FrameRenderSettings>(options.max_depth, options.render.seed,
-                                                       options.render.sampler, options.render.clamp,
-                                                       options.render.light_strategy, options.ppm));
+        absl::StatusOr<std::unique_ptr<FrameRenderer>> made =
+            MakeFrameRenderer(method, **embree, camera, FrameRenderSettingsOf(job));
         if (!made.ok()) return made.status();
         frame_renderer = std::move(*made);
-    } else if (*method == "radiosity") {
-        absl::StatusOr<RadiosityOptions> parsed = RadiosityOptionsOf(options.radiosity);
+    } else if (info.work == WorkKind::kRadiosity) {
+        // The one --target-error bounds both errors: the mesh's and the display's sampling.
+        absl::StatusOr<RadiosityOptions> parsed =
+            RadiosityOptionsOf(options.radiosity, options.adaptive.target_error);
         if (!parsed.ok()) return parsed.status();
         RadiosityOptions ro = *parsed;
         ro.save_solution = options.save_solution;
         ro.load_solution = options.load_solution;
         ro.export_ply = options.export_ply;
         ro.threads = options.render.threads;
-        // The one --target-error bounds both errors: the mesh's and the display's sampling.
-        ro.target_error = options.adaptive.target_error;
         const absl::Time solve_start = absl::Now();
         absl::StatusOr<std::unique_ptr<RadiosityRenderer>> r = PrepareRadiosity(**embree, ro);
         if (!r.ok()) return r.status();
@@ -146,10 +123,10 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         }
     } else {
         absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
-            MakeRayTracer(*method, **embree, options.max_depth, options.render.light_strategy);
+            MakeRayTracer(method, **embree, options.max_depth, options.render.light_strategy);
         if (!tracer.ok()) return tracer.status();
         estimator = std::move(*tracer);
-        if (*method == "whitted") {
+        if (method == Method::kWhitted) {
             for (const std::string& term : WhittedMissingTerms(*scene)) {
                 log->info("job={} whitted leaves out {}", job_id, term);
             }
@@ -160,13 +137,13 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         "filter{}{})",
         job_id, options.scene_path, camera.width(), camera.height(), options.render.spp,
         SamplerTypeName(options.render.sampler),
-        IsRayTracingMethod(*method)
+        info.work == WorkKind::kTiles
             ? absl::StrCat(", ", LightStrategyName(options.render.light_strategy),
                            " light sampling")
             : std::string(),
         options.render.seed,
         options.max_depth >= 0 ? std::to_string(options.max_depth)
-        : *method == "whitted"
+        : method == Method::kWhitted
             ? absl::StrCat("unlimited (whitted: ", kWhittedUnlimitedDepth, " specular bounces)")
             : "unlimited",
         options.render.tile, DescribePixelFilter(scene->camera.filter),
@@ -195,9 +172,9 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
             job_id, options.render.spp, options.adaptive.target_error, options.adaptive.time_limit,
             options.adaptive.max_spp);
     }
-    ProgressBar bar("render");
+    if (options.progress) options.progress->Start();
     const ProgressFn progress = [&](size_t done, size_t n) {
-        if (options.progress) bar.Update(done, n);
+        if (options.progress) options.progress->Update(done, n);
     };
     absl::StatusOr<RenderOutput> out =
         frame_renderer
@@ -205,14 +182,14 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         : adaptive
             ? RenderImageAdaptive(camera, *estimator, options.render, options.adaptive, progress)
             : RenderImage(camera, *estimator, options.render, progress);
-    if (options.progress) bar.Finish();
+    if (options.progress) options.progress->Finish();
     if (!out.ok()) return out.status();
     if (out->stats.invalid_samples > 0) {
         log->warn("job={} {} NaN or infinite samples were discarded (counted as zero)", job_id,
                   out->stats.invalid_samples);
     }
 
-    if (out->stats.truncated_paths > 0 && *method == "whitted") {
+    if (out->stats.truncated_paths > 0 && method == Method::kWhitted) {
         log->warn(
             "job={} {} specular rays reached whitted's depth cap of {} and were cut (--max-depth "
             "sets it)",
@@ -225,7 +202,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     }
 
     summary.job_id = job_id;
-    summary.method = *method;
+    summary.method = method;
     summary.stats = out->stats;
     summary.render_seconds = out->seconds;
     summary.width = camera.width();
@@ -234,26 +211,13 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     summary.adaptive_report = out->adaptive;
     summary.seconds = absl::ToDoubleSeconds(absl::Now() - start);
 
-    RenderMetadata metadata;
-    metadata.scene_hash = scene->content_hash;
-    metadata.camera = options.scene.camera;
-    metadata.method = *method;
-    metadata.spp = adaptive ? out->adaptive.max_spp : options.render.spp;
-    metadata.seed = options.render.seed;
-    metadata.max_depth = options.max_depth;
-    metadata.clamp = options.render.clamp;
-    metadata.aovs = options.render.aovs;
-    metadata.sampler = options.render.sampler;
-    metadata.light_strategy = options.render.light_strategy;
-    metadata.filter = scene->camera.filter;
-    metadata.seconds = summary.seconds;
-    metadata.stats = out->stats;
-    metadata.adaptive_settings = options.adaptive;
-    if (adaptive) metadata.adaptive = out->adaptive;
-    metadata.radiosity_settings = options.radiosity;
-    metadata.radiosity = summary.radiosity;
-    metadata.ppm = options.ppm;
-    absl::StatusOr<RenderDescription> description = DescribeRender(metadata, out->image, true);
+    RenderOutcome outcome;
+    outcome.seconds = summary.seconds;
+    outcome.stats = out->stats;
+    if (adaptive) outcome.adaptive = out->adaptive;
+    outcome.radiosity = summary.radiosity;
+    absl::StatusOr<RenderDescription> description =
+        DescribeRender(MetadataOf(job, outcome), out->image, true);
     if (!description.ok()) return description.status();
     if (description->estimates) {
         const VarianceAssessment& variance = description->estimates->variance;

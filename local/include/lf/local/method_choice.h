@@ -3,10 +3,12 @@
 // L light, D diffuse or glossy, S specular, E eye).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lf/core/scene.h"
+#include "lf/job/method_registry.h"
 
 namespace lf {
 
@@ -47,7 +49,7 @@ inline constexpr double kSmallEmitterFraction = 0.02;
 SceneTransport AnalyzeTransport(const Scene& scene);
 
 struct MethodChoice {
-    std::string method;
+    Method method;
     std::string why;
 };
 
@@ -56,5 +58,8 @@ struct MethodChoice {
 // (view-independent, noiseless); bdpt for caustics from small emitters; otherwise the path
 // tracer.
 MethodChoice ChooseAutomatically(const Scene& scene);
+
+// `requested`, "requested"; or for nullopt (`--method auto`) ChooseAutomatically.
+MethodChoice ChooseMethod(const Scene& scene, std::optional<Method> requested);
 
 }  // namespace lf

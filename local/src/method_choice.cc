@@ -1,4 +1,4 @@
-#include "method_choice.h"
+#include "lf/local/method_choice.h"
 
 #include <algorithm>
 #include <cmath>
@@ -117,21 +117,21 @@ MethodChoice ChooseAutomatically(const Scene& scene) {
     const SceneTransport t = AnalyzeTransport(scene);
     // No light: every method renders black; no form factors or pilots to spend on it.
     if (!scene.HasLights()) {
-        return {"path", "the scene has no lights: the image is black whatever the method"};
+        return {Method::kPath, "the scene has no lights: the image is black whatever the method"};
     }
     // Whitted before radiosity: where it is exact it has no meshing error either.
     if (t.whitted_missing.empty() && scene.HasLights()) {
-        return {"whitted",
+        return {Method::kWhitted,
                 absl::StrCat("no interreflection and no caustics: classic ray tracing is exact "
                              "here",
                              t.point_like_only ? " (point-like lights only)" : "")};
     }
     if (t.radiosity_limitation.empty()) {
-        return {"radiosity", "every material is Lambertian"};
+        return {Method::kRadiosity, "every material is Lambertian"};
     }
     if (t.caustics()) {
         return {
-            "bdpt",
+            Method::kBdpt,
             absl::StrCat("caustics (L S+ D E): light from ", absl::StrJoin(t.small_emitters, ", "),
                          " through ", absl::StrJoin(t.specular, ", "),
                          t.delta_caustics()
@@ -139,7 +139,12 @@ MethodChoice ChooseAutomatically(const Scene& scene) {
                                    absl::StrJoin(t.delta_lights, ", ") + " at all"
                              : "; camera paths find them only by hitting a small emitter")};
     }
-    return {"path", t.radiosity_limitation};
+    return {Method::kPath, t.radiosity_limitation};
+}
+
+MethodChoice ChooseMethod(const Scene& scene, std::optional<Method> requested) {
+    if (requested) return {*requested, "requested"};
+    return ChooseAutomatically(scene);
 }
 
 }  // namespace lf

@@ -1,11 +1,10 @@
-#include "method_render.h"
+#include "lf/local/method_render.h"
 
-#include "lf/kernels/frame_renderer.h"
-#include "lf/kernels/ray_tracer.h"
+#include "lf/local/method_factory.h"
 
 namespace lf {
 
-absl::StatusOr<RenderOutput> RenderWithMethod(const std::string& method, const EmbreeScene& scene,
+absl::StatusOr<RenderOutput> RenderWithMethod(Method method, const EmbreeScene& scene,
                                               const Camera& camera,
                                               const MethodRenderSettings& settings, uint64_t spp) {
     RenderSettings render;
@@ -16,14 +15,14 @@ absl::StatusOr<RenderOutput> RenderWithMethod(const std::string& method, const E
     render.clamp = settings.clamp;
     render.sampler = settings.sampler;
     render.light_strategy = settings.light_strategy;
-    if (IsRayTracingMethod(method)) {
+    if (Info(method).work == WorkKind::kTiles) {
         absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
             MakeRayTracer(method, scene, settings.max_depth, settings.light_strategy);
         if (!tracer.ok()) return tracer.status();
         return RenderImage(camera, **tracer, render);
     }
     absl::StatusOr<FramePlanSettings> plan = FramePlanSettingsOf(
-        method, {camera.width(), camera.height(), spp, render.tile, render.passes});
+        MethodName(method), {camera.width(), camera.height(), spp, render.tile, render.passes});
     if (!plan.ok()) return plan.status();
     absl::StatusOr<std::unique_ptr<FrameRenderer>> renderer =
         MakeFrameRenderer(method, scene, camera,

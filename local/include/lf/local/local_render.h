@@ -1,0 +1,68 @@
+// `lightfarm render` without its flags and output: a scene file to an EXR (and PNG preview) in
+// this process, by any method (path tracing, radiosity, Whitted, and the frame methods light,
+// bdpt, ppm), through the farm's planners and mergers (local_executor.h). The CLI prints the
+// summary.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "lf/core/image_io.h"
+#include "lf/core/scene_loader.h"
+#include "lf/job/frame_settings.h"
+#include "lf/job/method_registry.h"
+#include "lf/job/render_metadata.h"
+#include "lf/job/settings.h"
+#include "lf/local/local_executor.h"
+
+namespace lf {
+
+// What the CLI shows of the sampling (its progress bar): Start when it starts, Update from any
+// thread, Finish when it ends.
+class RenderProgress {
+  public:
+    virtual ~RenderProgress() = default;
+    virtual void Start() = 0;
+    virtual void Update(size_t done, size_t total) = 0;
+    virtual void Finish() = 0;
+};
+
+struct LocalRenderOptions {
+    std::string scene_path;
+    SceneOptions scene;    // --camera, --resolution, --filter
+    std::string exr_path;  // empty: no EXR (-o out.png)
+    std::string png_path;  // empty: no preview
+    PngOptions preview;    // --exposure, --tonemap
+    std::optional<Method> method = FindMethod(defaults::kMethod);  // nullopt: auto (ChooseMethod)
+    RenderSettings render;                                         // with --clamp and --aov
+    AdaptiveSettings adaptive;  // used when a target error or a time limit is set
+    int max_depth = defaults::kMaxDepth;
+    RadiositySettings radiosity;
+    PhotonSettings ppm;  // --photons, --ppm-radius, --ppm-alpha
+    // Radiosity's files (RadiosityOptions): a solution to save or load, a PLY to export.
+    std::string save_solution, load_solution, export_ply;
+    RenderProgress* progress = nullptr;  // none when null
+};
+
+struct LocalRenderSummary {
+    std::string job_id;
+    Method method = Method::kPath;
+    RenderStats stats;
+    // Phases: loading the scene (and building its BVH), radiosity's whole preparation (meshing,
+    // form factors, solve; its parts in `radiosity`), sampling the image; and the total.
+    double load_seconds = 0, radiosity_seconds = 0, mesh_seconds = 0, render_seconds = 0;
+    double seconds = 0;
+    std::optional<RadiosityFigures> radiosity;
+    int width = 0, height = 0;
+    double estimated_error = -1;   // relative, from A/B; -1 below 2 samples per pixel
+    double estimated_relmse = -1;  // EstimatedRelMse; -1 below 2 samples per pixel
+    bool high_variance = false;
+    bool adaptive = false;
+    AdaptiveReport adaptive_report;
+};
+
+// Renders and writes the files; logs as the farm's jobs do (job=local-<scene hash>).
+absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options);
+
+}  // namespace lf

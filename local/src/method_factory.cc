@@ -1,0 +1,65 @@
+#include "lf/local/method_factory.h"
+
+#include "absl/strings/str_cat.h"
+#include "lf/kernels/bdpt.h"
+#include "lf/kernels/light_tracer.h"
+#include "lf/kernels/path_tracer.h"
+#include "lf/kernels/ppm.h"
+#include "lf/kernels/whitted.h"
+
+namespace lf {
+
+absl::StatusOr<std::unique_ptr<RadianceEstimator>> MakeRayTracer(Method method,
+                                                                 const EmbreeScene& scene,
+                                                                 int max_depth,
+                                                                 LightStrategy strategy) {
+    switch (method) {
+        case Method::kPath:
+            return std::make_unique<PathTracer>(scene, max_depth, strategy);
+        case Method::kWhitted:
+            return std::make_unique<WhittedTracer>(scene, max_depth, strategy);
+        default:
+            return absl::InvalidArgumentError(absl::StrCat(
+                "method \"", MethodName(method), "\": not a ray-tracing method (path, whitted)"));
+    }
+}
+
+absl::StatusOr<std::unique_ptr<FrameRenderer>> MakeFrameRenderer(
+    Method method, const EmbreeScene& scene, const Camera& camera,
+    const FrameRenderSettings& settings) {
+    if (absl::Status s = CheckMethodTakesFilter(method, camera.filter()); !s.ok()) return s;
+    switch (method) {
+        case Method::kLight:
+            return std::make_unique<LightTracer>(scene, camera, settings);
+        case Method::kBdpt:
+            return std::make_unique<BdptRenderer>(scene, camera, settings);
+        case Method::kPpm: {
+            absl::StatusOr<std::unique_ptr<PpmRenderer>> ppm =
+                PpmRenderer::Create(scene, camera, settings);
+            if (!ppm.ok()) return ppm.status();
+            return std::unique_ptr<FrameRenderer>(std::move(*ppm));
+        }
+        default:
+            return absl::InvalidArgumentError(
+                absl::StrCat("method ", MethodName(method),
+                             ": no frame renderer (frame methods: light, bdpt, ppm)"));
+    }
+}
+
+FrameRenderSettings FrameRenderSettingsOf(const JobSpec& spec) {
+    return FrameRenderSettingsOf<FrameRenderSettings>(spec.max_depth, spec.seed, spec.sampler,
+                                                      spec.clamp, spec.light_strategy, spec.ppm);
+}
+
+absl::StatusOr<RadiosityOptions> RadiosityOptionsOf(const RadiositySettings& settings,
+                                                    double target_error) {
+    absl::StatusOr<RadiosityOptions> options =
+        MakeRadiosityOptions(settings.patches, settings.patch_size, settings.solver,
+                             settings.tolerance, settings.max_iterations, settings.display);
+    if (!options.ok()) return options.status();
+    options->target_error = target_error;
+    options->max_patches = settings.max_patches;
+    return options;
+}
+
+}  // namespace lf
