@@ -5,15 +5,16 @@
 
 namespace lf {
 
-std::string RandomLeaseId() {
+std::string RandomHex(int digits) {
     static const char kHex[] = "0123456789abcdef";
     std::random_device random;
-    std::string id;
-    for (int word = 0; word < 4; ++word) {
-        uint32_t bits = random();
-        for (int i = 0; i < 8; ++i, bits >>= 4) id.push_back(kHex[bits & 15]);
+    std::string hex;
+    uint32_t bits = 0;
+    for (int i = 0; i < digits; ++i, bits >>= 4) {
+        if (i % 8 == 0) bits = random();
+        hex.push_back(kHex[bits & 15]);
     }
-    return id;
+    return hex;
 }
 
 std::string LeaseTable::Grant(const std::string& job_id, int task, int attempt,

@@ -27,8 +27,9 @@ struct Lease {
     bool current = true;
 };
 
-// 32 hex digits from std::random_device.
-std::string RandomLeaseId();
+// `digits` hex digits from std::random_device: unguessable ids.
+std::string RandomHex(int digits);
+inline std::string RandomLeaseId() { return RandomHex(32); }
 
 class LeaseTable {
   public:

@@ -27,6 +27,13 @@ void ScheduledJob::Move(int t, TaskState to) {
     }
 }
 
+void ScheduledJob::MoveTo(absl::Time now, JobState to) {
+    if (absl::Status s = TransitionJob(record, to, now); !s.ok()) {
+        NamedLogger("scheduler")->critical("{}", std::string(s.message()));
+        std::abort();
+    }
+}
+
 void ScheduledJob::Queue(const std::vector<int>& ready) {
     states.Resize(execution->task_count());
     tasks.resize(execution->task_count());

@@ -38,8 +38,9 @@ struct ScheduledJob {
                                                               const TileStoreFactory& tile_stores,
                                                               absl::Duration speculate_after);
 
-    // The one way a task moves; an illegal move is a broken invariant.
+    // The one way a task moves, and the job; an illegal move is a broken invariant.
     void Move(int task, TaskState to);
+    void MoveTo(absl::Time now, JobState to);
     // Grows to the execution's tasks and queues those of `tasks` that wait.
     void Queue(const std::vector<int>& tasks);
     // The record's counts and stats from the execution and the task states.

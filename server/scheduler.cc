@@ -1,7 +1,6 @@
 #include "server/scheduler.h"
 
 #include <cstdlib>
-#include <random>
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_error.h"
@@ -12,15 +11,6 @@ namespace lf {
 namespace {
 
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("scheduler"); }
-
-std::string RandomHex(int digits) {
-    static std::mt19937_64 rng{std::random_device{}()};
-    static const char kHex[] = "0123456789abcdef";
-    std::string hex;
-    uint64_t bits = rng();
-    for (int i = 0; i < digits; ++i, bits >>= 4) hex.push_back(kHex[bits & 15]);
-    return hex;
-}
 
 std::string NewJobId() { return "job-" + RandomHex(10); }
 
@@ -38,7 +28,7 @@ Scheduler::Locked::Locked(Scheduler& scheduler) : lock(scheduler.mutex_), schedu
 
 Scheduler::Locked::~Locked() {
     if (!lock.owns_lock()) lock.lock();
-    if (scheduler_.to_settle_.empty()) return;
+    if (!scheduler_.ended_.has_unsettled()) return;
     // Taken with the jobs SettleEnded waits for: their tasks are handed on once they are durable
     // (or logged as not recorded), with the lock released for the callback to write.
     std::vector<std::pair<std::string, std::vector<TaskStatus>>> tasks;
@@ -50,33 +40,12 @@ Scheduler::Locked::~Locked() {
 }
 
 void Scheduler::Locked::SettleEnded() {
-    std::vector<std::pair<std::string, uint64_t>> ended;
-    for (const std::string& id : scheduler_.to_settle_) {
-        ended.emplace_back(id, scheduler_.ending_.at(id).ticket);
-    }
-    scheduler_.to_settle_.clear();
+    const std::vector<std::pair<std::string, uint64_t>> ended = scheduler_.ended_.TakeUnsettled();
     lock.unlock();
     std::vector<absl::Status> durable;
     for (const auto& [id, ticket] : ended) durable.push_back(scheduler_.store_.WaitDurable(ticket));
     lock.lock();
-    for (size_t i = 0; i < ended.size(); ++i) {
-        auto it = scheduler_.ending_.find(ended[i].first);
-        if (!durable[i].ok()) {
-            Log()->error("job={} ended ({}) but not recorded: {}", it->first,
-                         JobStateName(it->second.record.state), std::string(durable[i].message()));
-            // Readers and watchers still learn how it ended; the store, which says it runs, has
-            // it run again after a restart.
-            scheduler_.unrecorded_[it->first] = std::move(it->second.record);
-        }
-        scheduler_.ending_.erase(it);
-    }
-}
-
-void Scheduler::MoveJob(Job& job, JobState to) {
-    if (absl::Status s = TransitionJob(job.record, to, clock_()); !s.ok()) {
-        Log()->critical("{}", std::string(s.message()));
-        std::abort();
-    }
+    for (size_t i = 0; i < ended.size(); ++i) scheduler_.ended_.Settle(ended[i].first, durable[i]);
 }
 
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
@@ -115,7 +84,7 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
                          "(lightfarm-server --max-active-jobs); submit again once some end"));
     }
     // Ids are random: one the store lacks is taken in memory only by a freak.
-    while (active_.count(id) || EndedRecord(id)) id = NewJobId();
+    while (active_.count(id) || ended_.Find(id)) id = NewJobId();
     job->record.id = id;
     job->record.seq = next_seq_++;
     const uint64_t ticket = Save(*job);
@@ -141,26 +110,14 @@ std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(
     for (const auto& [id, job] : active_) {
         if (job->record.spec.request_id == request_id) return std::pair{id, job->submit_ticket};
     }
-    for (const auto& [id, ending] : ending_) {
-        if (ending.record.spec.request_id == request_id) return std::pair{id, ending.ticket};
-    }
-    for (const auto& [id, record] : unrecorded_) {
-        if (record.spec.request_id == request_id) return std::pair{id, uint64_t(0)};
-    }
-    return std::nullopt;
-}
-
-const JobRecord* Scheduler::EndedRecord(const std::string& job_id) const {
-    if (auto it = ending_.find(job_id); it != ending_.end()) return &it->second.record;
-    if (auto it = unrecorded_.find(job_id); it != unrecorded_.end()) return &it->second;
-    return nullptr;
+    return ended_.FindRequest(request_id);
 }
 
 absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
     {
         std::lock_guard<std::mutex> lock(mutex_);
         if (auto it = active_.find(job_id); it != active_.end()) return it->second->record;
-        if (const JobRecord* ended = EndedRecord(job_id)) return *ended;
+        if (const JobRecord* ended = ended_.Find(job_id)) return *ended;
     }
     return store_.Get(job_id);
 }
@@ -171,24 +128,20 @@ absl::StatusOr<std::vector<JobRecord>> Scheduler::List(const JobQuery& query) co
     std::lock_guard<std::mutex> lock(mutex_);
     for (JobRecord& job : *jobs) {
         if (auto it = active_.find(job.id); it != active_.end()) job = it->second->record;
-        if (const JobRecord* ended = EndedRecord(job.id)) job = *ended;
+        if (const JobRecord* ended = ended_.Find(job.id)) job = *ended;
     }
     return jobs;
 }
 
 std::set<std::string> Scheduler::BlobsInUse() const {
     std::set<std::string> hashes;
-    auto add_spec = [&](const JobRecord& record) {
-        hashes.insert(record.spec.scene.hash);
-        for (const BlobRef& file : record.spec.files) hashes.insert(file.hash);
-    };
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& [id, job] : active_) {
-        add_spec(job->record);
+        hashes.insert(job->record.spec.scene.hash);
+        for (const BlobRef& file : job->record.spec.files) hashes.insert(file.hash);
         job->execution->AddBlobsInUse(hashes);
     }
-    for (const auto& [id, ending] : ending_) add_spec(ending.record);
-    for (const auto& [id, record] : unrecorded_) add_spec(record);
+    ended_.AddBlobsInUse(hashes);
     return hashes;
 }
 
@@ -375,7 +328,7 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
     metrics_.leases.Add();
     TaskAssignment lease;
     lease.lease_id = leases_.Grant(job.id(), t, task.attempts, worker, now + options_.lease);
-    if (job.record.state == JobState::kQueued) MoveJob(job, JobState::kRunning);
+    if (job.record.state == JobState::kQueued) job.MoveTo(clock_(), JobState::kRunning);
     Save(job);
     Log()->debug("job={} task={} leased to {} (attempt {})", job.id(), t, LogSafe(worker),
                  task.attempts);
@@ -589,7 +542,7 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
 }
 
 void Scheduler::FailJob(Job& job, const std::string& error) {
-    MoveJob(job, JobState::kFailed);
+    job.MoveTo(clock_(), JobState::kFailed);
     job.record.error = error;
     Log()->error("job={} failed: {}", job.record.id, LogSafe(error));
     EndJob(job);
@@ -600,10 +553,9 @@ JobRecord Scheduler::EndJob(Job& job) {
     ended_tasks_.emplace_back(id, job.Statuses(leases_, clock_()));
     leases_.ForgetJob(id);
     const uint64_t ticket = Save(job);
-    ending_[id] = Ending{job.record, ticket};
-    to_settle_.push_back(id);
+    JobRecord record = job.record;
     active_.erase(id);  // destroys `job`
-    return ending_[id].record;
+    return ended_.Add(std::move(record), ticket);
 }
 
 absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
@@ -611,10 +563,10 @@ absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
     {
         Locked locked(*this);
         if (auto it = active_.find(job_id); it != active_.end()) {
-            MoveJob(*it->second, JobState::kCancelled);
+            it->second->MoveTo(clock_(), JobState::kCancelled);
             cancelled = EndJob(*it->second);
             Log()->info("job={} cancelled", job_id);
-        } else if (const JobRecord* ended = EndedRecord(job_id)) {
+        } else if (const JobRecord* ended = ended_.Find(job_id)) {
             return AlreadyEnded(*ended);
         }
     }  // the cancellation is durable here, or logged as not recorded
@@ -631,7 +583,7 @@ absl::StatusOr<JobRecord> Scheduler::SetPriority(const std::string& job_id, int 
         Locked locked(*this);
         auto it = active_.find(job_id);
         if (it == active_.end()) {
-            if (const JobRecord* ended = EndedRecord(job_id)) return AlreadyEnded(*ended);
+            if (const JobRecord* ended = ended_.Find(job_id)) return AlreadyEnded(*ended);
             locked.lock.unlock();  // the store is never read under the lock
             absl::StatusOr<JobRecord> stored = store_.Get(job_id);
             if (!stored.ok()) return stored.status();
@@ -698,7 +650,7 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
         FailJob(job, absl::StrCat("writing the result: ", result_path.status().message()));
         return;
     }
-    MoveJob(job, JobState::kSucceeded);
+    job.MoveTo(clock_(), JobState::kSucceeded);
     job.record.result_path = *result_path;
     Log()->info("job={} succeeded: {} samples -> {}", job_id, job.record.stats.samples,
                 *result_path);

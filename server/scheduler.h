@@ -31,6 +31,7 @@
 #include "lf/job/task_assignment.h"
 #include "lf/job/task_status.h"
 #include "lf/job/worker_status.h"
+#include "server/ended_jobs.h"
 #include "server/job_state_machine.h"
 #include "server/job_store.h"
 #include "server/lease_table.h"
@@ -232,15 +233,9 @@ class Scheduler {
         const Lease* lease;
         std::string id;
     };
-    // A job that ended, while its final record is queued but not yet durable: readers find it
-    // here until it is, then in the store.
-    struct Ending {
-        JobRecord record;
-        uint64_t ticket = 0;
-    };
     // The scheduler's lock. Jobs ended while it is held have their final record queued, not
     // durable; on release it waits for those writes with the lock released, so no fsync is ever
-    // waited for under it, then moves the jobs from `ending_` to the store's care.
+    // waited for under it, then leaves the jobs to the store's care.
     class Locked {
       public:
         explicit Locked(Scheduler& scheduler);
@@ -257,11 +252,8 @@ class Scheduler {
     // ticket to wait for.
     std::optional<std::pair<std::string, uint64_t>> FindRequestInMemory(
         const std::string& request_id) const;
-    // The record of a job that ended and is not (or not yet) in the store.
-    const JobRecord* EndedRecord(const std::string& job_id) const;
     std::optional<TaskAssignment> TryLease(const std::string& worker,
                                            const WorkerDescription* about);
-    void MoveJob(Job& job, JobState to);
     // Drops a job's tasks once its time limit has passed; true if dropping them completed the
     // job (so that it is reported once, here or by Complete).
     bool EnforceTimeLimit(Job& job, absl::Time now);
@@ -287,7 +279,7 @@ class Scheduler {
     void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
     void FailJob(Job& job, const std::string& error);
     // Ends the live state of a job moved to a final state: its final record is queued and the
-    // job waits in `ending_` until Locked's release finds it durable. Returns that record.
+    // job waits in `ended_` until Locked's release finds it durable. Returns that record.
     JobRecord EndJob(Job& job);
     uint64_t Save(Job& job);  // queues the record's write and wakes watchers; a store ticket
 
@@ -301,9 +293,7 @@ class Scheduler {
     bool shutdown_ = false;
     uint64_t next_seq_ = 1;
     std::map<std::string, std::unique_ptr<Job>> active_;
-    std::map<std::string, Ending> ending_;
-    std::vector<std::string> to_settle_;           // in `ending_`, not yet waited for
-    std::map<std::string, JobRecord> unrecorded_;  // ended while the store could not write
+    EndedJobs ended_;
     // Ended jobs' tasks, for tasks_ended_ once the lock is released.
     std::vector<std::pair<std::string, std::vector<TaskStatus>>> ended_tasks_;
     TasksEnded tasks_ended_;
