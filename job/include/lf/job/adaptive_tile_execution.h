@@ -27,6 +27,8 @@ class AdaptiveTileExecution : public TileExecution {
     std::optional<std::vector<int>> EnforceTimeLimit(absl::Time started, absl::Time now) override;
     std::optional<absl::Duration> time_limit() const override;
     std::optional<AdaptiveReport> TileReport() const override { return plan().TileReport(); }
+    size_t tile_count() const { return plan().tile_count(); }
+    size_t tiles_finished() const { return plan().tiles_finished(); }
     // The report with the image's estimated error (reads the store).
     absl::StatusOr<AdaptiveReport> Report() const { return plan().Report(); }
 
