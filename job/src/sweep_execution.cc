@@ -7,10 +7,7 @@ namespace lf {
 absl::StatusOr<std::unique_ptr<SweepExecution>> SweepExecution::Make(
     const RenderPlanSettings& plan, const RadiositySettings& radiosity,
     const TileStoreFactory& tile_stores, uint32_t aovs) {
-    absl::StatusOr<std::vector<RenderTask>> tasks = PlanRender(plan);
-    if (!tasks.ok()) return tasks.status();
-    absl::StatusOr<std::unique_ptr<RenderMerger>> merger =
-        RenderMerger::Make(plan.width, plan.height, std::move(*tasks), tile_stores, aovs);
+    absl::StatusOr<std::unique_ptr<TileMerger>> merger = PlanTiles(plan, tile_stores, aovs);
     if (!merger.ok()) return merger.status();
     return std::unique_ptr<SweepExecution>(
         new SweepExecution(std::move(*merger), plan.spp, radiosity));

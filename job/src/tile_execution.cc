@@ -5,12 +5,19 @@
 
 namespace lf {
 
-absl::StatusOr<std::unique_ptr<TileExecution>> TileExecution::Make(
+absl::StatusOr<std::unique_ptr<TileMerger>> TileExecution::PlanTiles(
     const RenderPlanSettings& plan, const TileStoreFactory& tile_stores, uint32_t aovs) {
     absl::StatusOr<std::vector<RenderTask>> tasks = PlanRender(plan);
     if (!tasks.ok()) return tasks.status();
     absl::StatusOr<std::unique_ptr<RenderMerger>> merger =
         RenderMerger::Make(plan.width, plan.height, std::move(*tasks), tile_stores, aovs);
+    if (!merger.ok()) return merger.status();
+    return std::unique_ptr<TileMerger>(std::move(*merger));
+}
+
+absl::StatusOr<std::unique_ptr<TileExecution>> TileExecution::Make(
+    const RenderPlanSettings& plan, const TileStoreFactory& tile_stores, uint32_t aovs) {
+    absl::StatusOr<std::unique_ptr<TileMerger>> merger = PlanTiles(plan, tile_stores, aovs);
     if (!merger.ok()) return merger.status();
     return std::unique_ptr<TileExecution>(new TileExecution(std::move(*merger), plan.spp));
 }

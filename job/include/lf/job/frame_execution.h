@@ -34,7 +34,6 @@ class FrameExecution : public JobExecution {
     ImageReader SnapshotReader() const override;
 
     const FrameTask& task(int index) const { return merger_->tasks()[size_t(index)]; }
-    const FramePlanSettings& plan() const { return plan_; }
 
   private:
     FrameExecution(const FramePlanSettings& plan, std::unique_ptr<FrameMerger> merger)

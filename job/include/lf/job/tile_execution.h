@@ -36,6 +36,9 @@ class TileExecution : public JobExecution {
 
   protected:
     TileExecution(std::unique_ptr<TileMerger> merger, uint64_t spp);
+    // The fixed plan's merger.
+    static absl::StatusOr<std::unique_ptr<TileMerger>> PlanTiles(
+        const RenderPlanSettings& plan, const TileStoreFactory& tile_stores, uint32_t aovs);
     TileMerger& merger() const { return *merger_; }
     // Merges a tile's sums; the indices of the tasks the merger appended.
     absl::StatusOr<std::vector<int>> MergeSums(int task, const TileSums& sums);
