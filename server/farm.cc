@@ -7,7 +7,6 @@
 #include <set>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_split.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/radiosity_codec.h"
@@ -170,11 +169,11 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
 absl::Status Farm::RefuseUndecodable(const std::string& lease_id, const std::string& worker,
                                      const absl::Status& why) {
     const std::string reason = absl::StrCat("undecodable result: ", why.message());
-    scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
-    // The scheduler's lease ids are "job/task/attempt": named as its own refusals name them.
-    const std::vector<std::string> parts = absl::StrSplit(lease_id, '/');
+    // Named as the scheduler's own refusals name them, before the failure may end the job.
+    const std::optional<Scheduler::LeaseHolder> holder = scheduler_.HolderOf(lease_id, worker);
     const std::string task =
-        parts.size() == 3 ? absl::StrCat("job=", parts[0], " task=", parts[1], " ") : "";
+        holder ? absl::StrCat("job=", holder->job_id, " task=", holder->task, " ") : "";
+    scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
     return absl::InvalidArgumentError(
         absl::StrCat(task, "lease ", lease_id, " from ", worker, ": ", reason));
 }
@@ -207,16 +206,16 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
                                  std::string_view sweep_result) {
     absl::StatusOr<SweepChunkResult> result = DecodeSweepResult(sweep_result);
     if (!result.ok()) return RefuseUndecodable(lease_id, worker, result.status());
-    absl::StatusOr<Scheduler::SweepCompletion> done =
+    absl::StatusOr<Scheduler::Completion> done =
         scheduler_.CompleteSweep(lease_id, worker, *result);
     if (!done.ok()) return done.status();
-    if (done->outcome && done->outcome->converged) {
+    if (done->sweep && done->sweep->converged) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
-        sweep_solves_[done->job_id] = {done->outcome->iterations, done->outcome->residual};
+        sweep_solves_[done->job_id] = {done->sweep->iterations, done->sweep->residual};
     }
-    if (done->outcome) {
-        scheduler_.Publish(done->job_id, done->outcome->converged,
-                           blobs_->Put(EncodeRadiosity(done->outcome->radiosity)));
+    if (done->sweep) {
+        scheduler_.Publish(done->job_id, done->sweep->converged,
+                           blobs_->Put(EncodeRadiosity(done->sweep->radiosity)));
     }
     return absl::OkStatus();
 }

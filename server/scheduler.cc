@@ -1,32 +1,16 @@
 #include "server/scheduler.h"
 
 #include <cstdlib>
-#include <random>
 
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_split.h"
 #include "lf/core/image_error.h"
 #include "lf/core/log.h"
-#include "lf/core/tile_codec.h"
-#include "lf/job/frame_settings.h"
-#include "server/frame_result_codec.h"
-#include "server/time_limit.h"
 
 namespace lf {
 
 namespace {
 
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("scheduler"); }
-
-std::string RandomHex(int digits) {
-    static std::mt19937_64 rng{std::random_device{}()};
-    static const char kHex[] = "0123456789abcdef";
-    std::string hex;
-    uint64_t bits = rng();
-    for (int i = 0; i < digits; ++i, bits >>= 4) hex.push_back(kHex[bits & 15]);
-    return hex;
-}
 
 std::string NewJobId() { return "job-" + RandomHex(10); }
 
@@ -38,17 +22,13 @@ absl::Status AlreadyEnded(const JobRecord& record) {
 }  // namespace
 
 Scheduler::Scheduler(SchedulerOptions options, JobStore& store, Clock clock)
-    : options_(options),
-      store_(store),
-      clock_(std::move(clock)),
-      boot_(RandomHex(6)),
-      workers_(options.lease) {}
+    : options_(options), store_(store), clock_(std::move(clock)), workers_(options.lease) {}
 
 Scheduler::Locked::Locked(Scheduler& scheduler) : lock(scheduler.mutex_), scheduler_(scheduler) {}
 
 Scheduler::Locked::~Locked() {
     if (!lock.owns_lock()) lock.lock();
-    if (scheduler_.to_settle_.empty()) return;
+    if (!scheduler_.ended_.has_unsettled()) return;
     // Taken with the jobs SettleEnded waits for: their tasks are handed on once they are durable
     // (or logged as not recorded), with the lock released for the callback to write.
     std::vector<std::pair<std::string, std::vector<TaskStatus>>> tasks;
@@ -60,119 +40,23 @@ Scheduler::Locked::~Locked() {
 }
 
 void Scheduler::Locked::SettleEnded() {
-    std::vector<std::pair<std::string, uint64_t>> ended;
-    for (const std::string& id : scheduler_.to_settle_) {
-        ended.emplace_back(id, scheduler_.ending_.at(id).ticket);
-    }
-    scheduler_.to_settle_.clear();
+    const std::vector<std::pair<std::string, uint64_t>> ended = scheduler_.ended_.TakeUnsettled();
     lock.unlock();
     std::vector<absl::Status> durable;
     for (const auto& [id, ticket] : ended) durable.push_back(scheduler_.store_.WaitDurable(ticket));
     lock.lock();
-    for (size_t i = 0; i < ended.size(); ++i) {
-        auto it = scheduler_.ending_.find(ended[i].first);
-        if (!durable[i].ok()) {
-            Log()->error("job={} ended ({}) but not recorded: {}", it->first,
-                         JobStateName(it->second.record.state), std::string(durable[i].message()));
-            // Readers and watchers still learn how it ended; the store, which says it runs, has
-            // it run again after a restart.
-            scheduler_.unrecorded_[it->first] = std::move(it->second.record);
-        }
-        scheduler_.ending_.erase(it);
-    }
-}
-
-void Scheduler::MoveTask(Job& job, int t, TaskState to) {
-    if (absl::Status s = job.states.Transition(t, to); !s.ok()) {
-        Log()->critical("job={} {}", job.record.id, std::string(s.message()));
-        std::abort();
-    }
-}
-
-void Scheduler::MoveJob(Job& job, JobState to) {
-    if (absl::Status s = TransitionJob(job.record, to, clock_()); !s.ok()) {
-        Log()->critical("{}", std::string(s.message()));
-        std::abort();
-    }
-}
-
-size_t Scheduler::TaskCount(const Job& job) {
-    return job.frame ? job.frame->tasks().size() : job.merger->tasks().size();
-}
-
-uint64_t Scheduler::TaskSamples(const Job& job, int task) {
-    if (SweepChunkOf(job, task)) return 0;
-    const auto samples = [](const auto& t) {
-        return uint64_t(t.rect.width) * uint64_t(t.rect.height) * (t.sample_end - t.sample_begin);
-    };
-    return job.frame ? samples(job.frame->tasks()[size_t(task)])
-                     : samples(job.merger->tasks()[size_t(task)]);
-}
-
-size_t Scheduler::TasksDone(const Job& job) {
-    return job.frame ? job.frame->tasks_done() : job.merger->tasks_done();
-}
-
-bool Scheduler::Rendered(const Job& job) {
-    return job.frame ? job.frame->Complete() : job.merger->Complete();
-}
-
-const RenderStats& Scheduler::StatsOf(const Job& job) {
-    return job.frame ? job.frame->stats() : job.merger->stats();
-}
-
-void Scheduler::Grow(Job& job, size_t count) {
-    job.states.Resize(count);
-    job.tasks.resize(count);
-}
-
-absl::StatusOr<std::unique_ptr<Scheduler::Job>> Scheduler::NewJob(JobRecord record) const {
-    auto job = std::make_unique<Job>();
-    job->record = std::move(record);
-    // The job's own copy: `record` was moved from, its strings (the method) emptied.
-    const JobSpec& spec = job->record.spec;
-    job->speculation = SpeculationPolicy(options_.speculate_after);
-    if (UsesFramePlan(spec.method)) {
-        // The plan local mode makes of the same settings (lf::RenderFrameImage), so the merged
-        // sums are its bits; the merger's tiles in the same stores as a tile job's.
-        absl::StatusOr<FramePlanSettings> settings = FramePlanSettingsOf(spec.method, spec.plan);
-        if (!settings.ok()) return settings.status();
-        absl::StatusOr<std::vector<FrameTask>> plan = PlanFrameRender(*settings);
-        if (!plan.ok()) return plan.status();
-        absl::StatusOr<std::unique_ptr<FrameMerger>> merger =
-            FrameMerger::Make(settings->width, settings->height, settings->tile, settings->kind,
-                              std::move(*plan), options_.tile_stores);
-        if (!merger.ok()) return merger.status();
-        job->frame = std::move(*merger);
-    } else if (IsAdaptive(spec.adaptive)) {
-        absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> plan =
-            AdaptiveTilePlan::Make(spec.plan.width, spec.plan.height, spec.plan.spp, spec.plan.tile,
-                                   spec.adaptive, kMaxTaskSamples, options_.tile_stores, spec.aovs);
-        if (!plan.ok()) return plan.status();
-        job->adaptive = plan->get();
-        job->merger = std::move(*plan);
-    } else {
-        absl::StatusOr<std::vector<RenderTask>> plan = PlanRender(spec.plan);
-        if (!plan.ok()) return plan.status();
-        absl::StatusOr<std::unique_ptr<RenderMerger>> merger = RenderMerger::Make(
-            spec.plan.width, spec.plan.height, std::move(*plan), options_.tile_stores, spec.aovs);
-        if (!merger.ok()) return merger.status();
-        job->merger = std::move(*merger);
-    }
-    Grow(*job, TaskCount(*job));
-    return job;
+    for (size_t i = 0; i < ended.size(); ++i) scheduler_.ended_.Settle(ended[i].first, durable[i]);
 }
 
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     JobRecord record;
     record.spec = spec;
-    absl::StatusOr<std::unique_ptr<Job>> made = NewJob(std::move(record));
+    absl::StatusOr<std::unique_ptr<Job>> made =
+        Job::Make(std::move(record), options_.tile_stores, options_.speculate_after);
     if (!made.ok()) return made.status();
     std::unique_ptr<Job> job = std::move(*made);
-    QueueStart(*job);
+    job->Queue(job->execution->Start());
     job->record.submitted = clock_();
-    // The image's tasks: a radiosity solve's sweep tasks are not done the way tiles are.
-    job->record.tasks_total = int(TaskCount(*job));
     // The store is read before the lock is taken. An earlier submission it does not hold has not
     // been acknowledged yet, so it is still in memory.
     std::optional<std::string> stored;
@@ -200,12 +84,12 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
                          "(lightfarm-server --max-active-jobs); submit again once some end"));
     }
     // Ids are random: one the store lacks is taken in memory only by a freak.
-    while (active_.count(id) || EndedRecord(id)) id = NewJobId();
+    while (active_.count(id) || ended_.Find(id)) id = NewJobId();
     job->record.id = id;
     job->record.seq = next_seq_++;
     const uint64_t ticket = Save(*job);
     job->submit_ticket = ticket;
-    const size_t job_tasks = job->tasks.size();
+    const std::string summary = job->execution->Summary();
     active_[id] = std::move(job);
     locked.lock.unlock();
     // Acknowledged only once durable; waiting outside the lock lets submissions and results
@@ -216,16 +100,7 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
         active_.erase(id);
         return s;
     }
-    if (IsAdaptive(spec.adaptive)) {
-        Log()->info(
-            "job={} queued: {} tiles, {}x{}, first pass {} spp, adaptive up to {} spp, target "
-            "error {}, time limit {} s, priority {}",
-            id, job_tasks, spec.plan.width, spec.plan.height, spec.plan.spp, spec.adaptive.max_spp,
-            spec.adaptive.target_error, spec.adaptive.time_limit, spec.priority);
-    } else {
-        Log()->info("job={} queued: {} tasks, {}x{}, {} spp, priority {}", id, job_tasks,
-                    spec.plan.width, spec.plan.height, spec.plan.spp, spec.priority);
-    }
+    Log()->info("job={} queued: {}, priority {}", id, summary, spec.priority);
     return id;
 }
 
@@ -235,26 +110,14 @@ std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(
     for (const auto& [id, job] : active_) {
         if (job->record.spec.request_id == request_id) return std::pair{id, job->submit_ticket};
     }
-    for (const auto& [id, ending] : ending_) {
-        if (ending.record.spec.request_id == request_id) return std::pair{id, ending.ticket};
-    }
-    for (const auto& [id, record] : unrecorded_) {
-        if (record.spec.request_id == request_id) return std::pair{id, uint64_t(0)};
-    }
-    return std::nullopt;
-}
-
-const JobRecord* Scheduler::EndedRecord(const std::string& job_id) const {
-    if (auto it = ending_.find(job_id); it != ending_.end()) return &it->second.record;
-    if (auto it = unrecorded_.find(job_id); it != unrecorded_.end()) return &it->second;
-    return nullptr;
+    return ended_.FindRequest(request_id);
 }
 
 absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
     {
         std::lock_guard<std::mutex> lock(mutex_);
         if (auto it = active_.find(job_id); it != active_.end()) return it->second->record;
-        if (const JobRecord* ended = EndedRecord(job_id)) return *ended;
+        if (const JobRecord* ended = ended_.Find(job_id)) return *ended;
     }
     return store_.Get(job_id);
 }
@@ -265,26 +128,20 @@ absl::StatusOr<std::vector<JobRecord>> Scheduler::List(const JobQuery& query) co
     std::lock_guard<std::mutex> lock(mutex_);
     for (JobRecord& job : *jobs) {
         if (auto it = active_.find(job.id); it != active_.end()) job = it->second->record;
-        if (const JobRecord* ended = EndedRecord(job.id)) job = *ended;
+        if (const JobRecord* ended = ended_.Find(job.id)) job = *ended;
     }
     return jobs;
 }
 
 std::set<std::string> Scheduler::BlobsInUse() const {
     std::set<std::string> hashes;
-    auto add_spec = [&](const JobRecord& record) {
-        hashes.insert(record.spec.scene.hash);
-        for (const BlobRef& file : record.spec.files) hashes.insert(file.hash);
-    };
     std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& [id, job] : active_) {
-        add_spec(job->record);
-        for (const std::string* hash : {&job->sweep_input, &job->solution}) {
-            if (!hash->empty()) hashes.insert(*hash);
-        }
+        hashes.insert(job->record.spec.scene.hash);
+        for (const BlobRef& file : job->record.spec.files) hashes.insert(file.hash);
+        job->execution->AddBlobsInUse(hashes);
     }
-    for (const auto& [id, ending] : ending_) add_spec(ending.record);
-    for (const auto& [id, record] : unrecorded_) add_spec(record);
+    ended_.AddBlobsInUse(hashes);
     return hashes;
 }
 
@@ -292,83 +149,15 @@ std::optional<std::vector<TaskStatus>> Scheduler::Tasks(const std::string& job_i
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = active_.find(job_id);
     if (it == active_.end()) return std::nullopt;
-    return TaskStatuses(*it->second, clock_());
-}
-
-std::vector<TaskStatus> Scheduler::TaskStatuses(const Job& job, absl::Time now) const {
-    std::vector<TaskStatus> statuses(job.tasks.size());
-    for (int t = 0; t < int(job.tasks.size()); ++t) {
-        const Task& task = job.tasks[size_t(t)];
-        TaskStatus& status = statuses[size_t(t)];
-        status.index = t;
-        switch (job.states.state(t)) {
-            case TaskState::kWaiting:
-                status.state = TaskStatus::State::kWaiting;
-                break;
-            case TaskState::kQueued:
-                status.state = TaskStatus::State::kQueued;
-                break;
-            case TaskState::kLeased:
-                status.state = TaskStatus::State::kRunning;
-                break;
-            case TaskState::kDone:
-                status.state = TaskStatus::State::kDone;
-                break;
-            case TaskState::kDropped:
-                status.state = TaskStatus::State::kDropped;
-                break;
-        }
-        PixelRect rect;
-        if (job.frame) {
-            const FrameTask& frame = job.frame->tasks()[size_t(t)];
-            status.kind = TaskKind::kFrame;
-            // A light-path task has no camera part: it covers the frame.
-            rect = frame.rect.width > 0
-                       ? frame.rect
-                       : PixelRect{0, 0, job.record.spec.plan.width, job.record.spec.plan.height};
-            status.samples = frame.sample_end - frame.sample_begin;
-        } else if (SweepChunkOf(job, t)) {
-            status.kind = TaskKind::kRadiositySweep;
-        } else {
-            const RenderTask& tile = job.merger->tasks()[size_t(t)];
-            status.kind = TaskKind::kTile;
-            rect = tile.rect;
-            status.samples = tile.sample_end - tile.sample_begin;
-        }
-        status.x = rect.x0;
-        status.y = rect.y0;
-        status.width = rect.width;
-        status.height = rect.height;
-        status.attempts = task.attempts;
-        status.failures = task.failures;
-        status.last_error = task.last_error;
-        if (task.attempts == 0) continue;  // never leased: no holder, no times
-        status.worker = task.holders.back();
-        status.leased = task.leased_at;
-        status.finished = task.finished;
-        if (status.state == TaskStatus::State::kDone) {
-            status.duration = task.finished - task.leased_at;
-        } else if (status.state == TaskStatus::State::kRunning) {
-            status.duration = now - task.leased_at;
-        }
-    }
-    // An ended job's tasks that were not done never will be: its failing task included, whose
-    // last failure ended the job before it went back to the queue.
-    if (IsFinal(job.record.state)) {
-        for (TaskStatus& status : statuses) {
-            if (status.state != TaskStatus::State::kDone)
-                status.state = TaskStatus::State::kDropped;
-        }
-    }
-    return statuses;
+    return it->second->Statuses(leases_, clock_());
 }
 
 std::optional<Scheduler::LeaseHolder> Scheduler::HolderOf(const std::string& lease_id,
                                                           const std::string& worker) {
     std::lock_guard<std::mutex> lock(mutex_);
-    const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !HeldBy(*ref, worker)) return std::nullopt;
-    return LeaseHolder{ref->job->record.id, ref->task, ref->attempt, worker};
+    const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
+    if (!ref) return std::nullopt;
+    return LeaseHolder{ref->job->id(), ref->lease->task, ref->lease->attempt, worker};
 }
 
 size_t Scheduler::workers_tracked() const {
@@ -376,25 +165,11 @@ size_t Scheduler::workers_tracked() const {
     return workers_.size();
 }
 
-std::map<std::string, Scheduler::LeaseRef> Scheduler::LeasesByWorker() {
-    std::map<std::string, LeaseRef> held;
-    // The deadlines are kept for current leases only: fewer than the tasks of running jobs.
-    for (const std::string& lease_id : timeouts_.lease_ids()) {
-        const std::optional<LeaseRef> ref = Resolve(lease_id);
-        if (!ref || !IsCurrent(*ref)) continue;
-        const std::string& worker =
-            ref->job->tasks[size_t(ref->task)].holders[size_t(ref->attempt - 1)];
-        auto [it, added] = held.emplace(worker, *ref);
-        if (!added && it->second.attempt < ref->attempt) it->second = *ref;
-    }
-    return held;
-}
-
 std::vector<WorkerStatus> Scheduler::Workers() {
     std::lock_guard<std::mutex> lock(mutex_);
     const absl::Time now = clock_();
     workers_.ForgetSilent(now);
-    const std::map<std::string, LeaseRef> held = LeasesByWorker();
+    const std::map<std::string, const Lease*> held = leases_.CurrentByWorker();
     std::vector<WorkerStatus> workers;
     for (WorkerRegistry::Entry& entry : workers_.List()) {
         WorkerStatus& w = workers.emplace_back();
@@ -404,8 +179,8 @@ std::vector<WorkerStatus> Scheduler::Workers() {
         w.version = std::move(entry.about.version);
         w.since_seen = now - entry.last_seen;
         if (auto it = held.find(w.id); it != held.end()) {
-            w.job_id = it->second.job->record.id;
-            w.task = it->second.task;
+            w.job_id = it->second->job_id;
+            w.task = it->second->task;
         }
     }
     return workers;
@@ -422,7 +197,7 @@ SchedulerLoad Scheduler::Load() {
         load.tasks_running += job->states.running();
     }
     load.workers_live = int(workers_.size());
-    for (const auto& [worker, ref] : LeasesByWorker()) {
+    for (const auto& [worker, lease] : leases_.CurrentByWorker()) {
         load.workers_busy += workers_.IsLive(worker, now);
     }
     return load;
@@ -451,46 +226,32 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     std::vector<std::string> rendered;
     for (Stored& s : stored) {
         if (active_.count(s.record.id)) continue;
-        absl::StatusOr<std::unique_ptr<Job>> made = NewJob(std::move(s.record));
+        absl::StatusOr<std::unique_ptr<Job>> made =
+            Job::Make(std::move(s.record), options_.tile_stores, options_.speculate_after);
         if (!made.ok()) return made.status();
         std::unique_ptr<Job> job = std::move(*made);
         // In index order, an adaptive plan appends each pass before its result comes up: the
         // passes it planned depend only on the results before them.
         for (const auto& [t, bytes] : s.results) {
-            absl::Status merged;
-            if (job->frame) {
-                absl::StatusOr<FrameResult> result = DecodeFrameResult(bytes);
-                merged = result.ok() ? job->frame->Add(t, result->camera, result->splats)
-                                     : result.status();
-            } else {
-                absl::StatusOr<TileSums> sums = DecodeTileSums(bytes);
-                absl::StatusOr<std::vector<RenderTask>> pass =
-                    sums.ok() ? job->merger->Merge(t, *sums)
-                              : absl::StatusOr<std::vector<RenderTask>>(sums.status());
-                merged = pass.status();
-            }
             // The store wrote what merged before, so this cannot fail unless the file was
             // damaged; the task is then simply rendered again.
-            if (!merged.ok()) {
+            if (!job->execution->MergeRecorded(t, bytes).ok()) {
                 Log()->warn("job={} task={}: the recorded result is unusable, rendering it again",
-                            job->record.id, t);
+                            job->id(), t);
                 continue;
             }
-            MoveTask(*job, t, TaskState::kDone);
-            Grow(*job, TaskCount(*job));
+            job->Move(t, TaskState::kDone);
+            job->Queue({});
         }
-        QueueStart(*job);
-        job->record.tasks_done = int(TasksDone(*job));
-        job->record.tasks_total = int(TaskCount(*job));
-        job->record.stats = StatsOf(*job);
-        Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before",
-                    job->record.id, job->record.tasks_done, job->record.tasks_total,
-                    job->record.tasks_leased);
-        if (EnforceTimeLimit(*job, clock_()) || Rendered(*job)) {
-            rendered.push_back(job->record.id);
+        job->Queue(job->execution->Start());
+        job->Sync();
+        Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before", job->id(),
+                    job->record.tasks_done, job->record.tasks_total, job->record.tasks_leased);
+        if (EnforceTimeLimit(*job, clock_()) || job->execution->Complete()) {
+            rendered.push_back(job->id());
         }
         Save(*job);
-        active_[job->record.id] = std::move(job);
+        active_[job->id()] = std::move(job);
     }
     return rendered;
 }
@@ -544,117 +305,54 @@ int Scheduler::StragglerFor(const Job& job, const std::string& worker, absl::Tim
     if (!job.states.queued().empty()) return -1;
     int oldest = -1;
     for (int t = 0; t < int(job.tasks.size()); ++t) {
-        const Task& task = job.tasks[size_t(t)];
-        if (job.states.state(t) != TaskState::kLeased || task.live.size() != 1 ||
-            task.failed_on.count(worker) ||
-            task.holders[size_t(*task.live.begin() - 1)] == worker ||
+        const ScheduledJob::Task& task = job.tasks[size_t(t)];
+        if (job.states.state(t) != TaskState::kLeased || task.failed_on.count(worker) ||
             !job.speculation.IsStraggler(now - task.leased_at)) {
             continue;
         }
+        const std::vector<const Lease*> current = leases_.Current(job.id(), t);
+        if (current.size() != 1 || current[0]->worker == worker) continue;
         if (oldest < 0 || task.leased_at < job.tasks[size_t(oldest)].leased_at) oldest = t;
     }
     return oldest;
 }
 
-std::string Scheduler::LeaseId(const Job& job, int task, int attempt) const {
-    return absl::StrCat(job.record.id, "/", task, "/", boot_, "-", attempt);
-}
-
 TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time now) {
-    Task& task = job.tasks[size_t(t)];
+    ScheduledJob::Task& task = job.tasks[size_t(t)];
     if (job.states.state(t) == TaskState::kQueued) {
-        MoveTask(job, t, TaskState::kLeased);
+        job.Move(t, TaskState::kLeased);
         task.leased_at = now;
     }
     ++task.attempts;
-    task.holders.push_back(worker);
-    task.live.insert(task.attempts);
     ++job.record.tasks_leased;
     metrics_.leases.Add();
-    const std::string lease_id = LeaseId(job, t, task.attempts);
-    timeouts_.Set(lease_id, now + options_.lease);
-    if (job.record.state == JobState::kQueued) MoveJob(job, JobState::kRunning);
-    Save(job);
-    Log()->debug("job={} task={} leased to {} (attempt {})", job.record.id, t, LogSafe(worker),
-                 task.attempts);
     TaskAssignment lease;
-    lease.lease_id = lease_id;
-    lease.job_id = job.record.id;
+    lease.lease_id = leases_.Grant(job.id(), t, task.attempts, worker, now + options_.lease);
+    if (job.record.state == JobState::kQueued) job.MoveTo(clock_(), JobState::kRunning);
+    Save(job);
+    Log()->debug("job={} task={} leased to {} (attempt {})", job.id(), t, LogSafe(worker),
+                 task.attempts);
+    lease.job_id = job.id();
     lease.spec = job.record.spec;
     lease.lease = options_.lease;
     lease.heartbeat_interval = options_.heartbeat_interval;
-    const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(job, t);
-    if (job.frame) {
-        const FrameTask& frame = job.frame->tasks()[size_t(t)];
-        lease.task = RenderTask{frame.index, frame.rect, frame.sample_begin, frame.sample_end};
-        lease.path_begin = frame.path_begin;
-        lease.path_end = frame.path_end;
-        return lease;
-    }
-    if (!at) {
-        lease.task = job.merger->tasks()[size_t(t)];
-        lease.radiosity_hash = job.solution;
-        return lease;
-    }
-    job.chunk_owner[at->chunk] = worker;
-    lease.task.index = t;
-    lease.sweep = at->sweep;
-    lease.chunk = at->chunk;
-    lease.radiosity_hash = job.sweep_input;
+    job.execution->Lease(t, worker, lease);
     return lease;
 }
 
-void Scheduler::QueueStart(Job& job) {
-    if (SolvedInSweeps(job.record.spec) && job.solution.empty() && !job.merger->Complete()) {
-        // The solve is not recorded: after a restart it runs again, to the same bits, and the
-        // tiles already done stay done.
-        const RadiositySettings& r = job.record.spec.radiosity;
-        job.solve = std::make_unique<RadiositySolve>(r.sweep_tasks, r.tolerance, r.max_iterations);
-        job.sweeps = SweepTaskNumbering{int(job.merger->tasks().size()), job.solve->chunks()};
-        job.sweep_input.clear();
-        QueueSweep(job);
-        return;
-    }
-    for (int t = 0; t < int(TaskCount(job)); ++t) {
-        if (job.states.state(t) != TaskState::kWaiting) continue;
-        if (job.adaptive && !job.adaptive->IsPending(t)) continue;
-        MoveTask(job, t, TaskState::kQueued);
-    }
-}
-
-void Scheduler::QueueSweep(Job& job) {
-    const int sweep = job.solve->sweep();
-    Grow(job, size_t(job.sweeps->ToIndex({sweep + 1, 0})));
-    for (int c = 0; c < job.sweeps->chunks; ++c) {
-        MoveTask(job, job.sweeps->ToIndex({sweep, c}), TaskState::kQueued);
-    }
-}
-
-void Scheduler::QueuePass(Job& job, const RenderTask& pass) {
-    Grow(job, size_t(pass.index) + 1);
-    MoveTask(job, pass.index, TaskState::kQueued);
-    job.record.tasks_total = int(job.tasks.size());
-}
-
 bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
-    if (!job.adaptive || job.adaptive->stopped() ||
-        !TimeLimitReached(job.record.spec.adaptive, job.record.started, now)) {
-        return false;
+    const std::optional<std::vector<int>> dropped =
+        job.execution->EnforceTimeLimit(job.record.started, now);
+    if (!dropped) return false;
+    for (int t : *dropped) {
+        leases_.EndTask(job.id(), t);
+        job.Move(t, TaskState::kDropped);
     }
-    const std::vector<int> dropped = job.adaptive->Stop();
-    for (int t : dropped) {
-        Task& task = job.tasks[size_t(t)];
-        for (int attempt : task.live) timeouts_.Remove(LeaseId(job, t, attempt));
-        task.live.clear();
-        MoveTask(job, t, TaskState::kDropped);
-    }
-    job.record.tasks_total -= int(dropped.size());
-    Log()->info("job={} time limit of {} s reached: {} passes dropped, {} tasks merged",
-                job.record.id, job.record.spec.adaptive.time_limit, dropped.size(),
-                job.merger->tasks_done());
+    Log()->info("job={} time limit of {} s reached: {} tasks dropped, {} tasks merged", job.id(),
+                job.record.spec.adaptive.time_limit, dropped->size(), job.execution->tasks_done());
     Save(job);
     // When nothing was dropped, the last result completed the job and Complete said so.
-    return !dropped.empty() && job.merger->Complete();
+    return !dropped->empty() && job.execution->Complete();
 }
 
 std::vector<std::string> Scheduler::EnforceTimeLimits() {
@@ -667,19 +365,10 @@ std::vector<std::string> Scheduler::EnforceTimeLimits() {
     return rendered;
 }
 
-std::optional<SweepTaskNumbering::SweepChunk> Scheduler::SweepChunkOf(const Job& job, int t) {
-    return job.sweeps ? job.sweeps->FromIndex(t) : std::nullopt;
-}
-
 bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::Time now) const {
-    if (const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(job, t)) {
-        const auto owner = job.chunk_owner.find(at->chunk);
-        if (owner != job.chunk_owner.end() && owner->second != worker &&
-            workers_.IsLive(owner->second, now)) {
-            return false;
-        }
-    }
-    const Task& task = job.tasks[size_t(t)];
+    const std::string preferred = job.execution->PreferredWorker(t);
+    if (!preferred.empty() && preferred != worker && workers_.IsLive(preferred, now)) return false;
+    const ScheduledJob::Task& task = job.tasks[size_t(t)];
     if (!task.failed_on.count(worker)) return true;
     // It failed here: it waits for a live worker it has not failed on. Once it has failed on
     // every live worker it is tried again anywhere, so its failures end the job. `failed_on`
@@ -689,84 +378,63 @@ bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::
     return workers_.size() <= live_failed;
 }
 
-std::optional<Scheduler::LeaseRef> Scheduler::Resolve(const std::string& lease_id) {
-    const std::vector<std::string> parts = absl::StrSplit(lease_id, '/');
-    int task = 0, attempt = 0;
-    if (parts.size() != 3 || !absl::SimpleAtoi(parts[1], &task)) return std::nullopt;
-    const std::string prefix = boot_ + "-";
-    if (parts[2].rfind(prefix, 0) != 0 ||
-        !absl::SimpleAtoi(parts[2].substr(prefix.size()), &attempt)) {
-        return std::nullopt;
-    }
-    auto it = active_.find(parts[0]);
-    if (it == active_.end() || task < 0 || size_t(task) >= it->second->tasks.size() ||
-        attempt < 1 || attempt > it->second->tasks[size_t(task)].attempts) {
-        return std::nullopt;
-    }
-    return LeaseRef{it->second.get(), task, attempt};
-}
-
-bool Scheduler::HeldBy(const LeaseRef& ref, const std::string& worker) {
-    return ref.job->tasks[size_t(ref.task)].holders[size_t(ref.attempt - 1)] == worker;
-}
-
-bool Scheduler::IsCurrent(const LeaseRef& ref) {
-    const Task& task = ref.job->tasks[size_t(ref.task)];
-    return ref.job->states.state(ref.task) == TaskState::kLeased && task.live.count(ref.attempt);
+std::optional<Scheduler::LeaseRef> Scheduler::Resolve(const std::string& lease_id,
+                                                      const std::string& worker) {
+    const Lease* lease = leases_.Find(lease_id);
+    if (!lease || lease->worker != worker) return std::nullopt;
+    auto it = active_.find(lease->job_id);
+    if (it == active_.end()) return std::nullopt;
+    return LeaseRef{it->second.get(), lease, lease_id};
 }
 
 bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker) {
     Locked locked(*this);
     const absl::Time now = clock_();
-    const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !HeldBy(*ref, worker)) return false;  // a made-up id is not kept
+    if (!Resolve(lease_id, worker)) return false;  // a made-up id is not kept
     workers_.Seen(worker, now);
-    if (!IsCurrent(*ref)) return false;
-    timeouts_.Set(lease_id, now + options_.lease);
-    return true;
+    return leases_.Extend(lease_id, now + options_.lease);
 }
 
 absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lease_id,
                                                           const std::string& worker,
-                                                          const TileSums& sums, SplatList* splats) {
+                                                          const TaskResult& result) {
     Locked locked(*this);
     const absl::Time now = clock_();
     const absl::StatusOr<LeaseRef> ref = ResultLease(lease_id, worker, now);
     if (!ref.ok()) return ref.status();
     Job& job = *ref->job;
-    const TaskState state = job.states.state(ref->task);
-    if (state == TaskState::kDone || state == TaskState::kDropped) {
-        return Completion{job.record.id, false};
+    const int t = ref->lease->task;
+    Completion completion{job.id(), false, std::nullopt};
+    const TaskState state = job.states.state(t);
+    if (state == TaskState::kDone || state == TaskState::kDropped) return completion;
+    absl::StatusOr<JobExecution::Merged> merged = job.execution->Merge(t, result);
+    if (!merged.ok()) return Refuse(*ref, worker, merged.status());
+    MarkDone(job, t, now);
+    job.Queue(merged->appended);
+    if (!merged->job_error.ok()) {
+        FailJob(job, std::string(merged->job_error.message()));
+        return completion;
     }
-    absl::StatusOr<std::vector<RenderTask>> merged = std::vector<RenderTask>{};
-    if (SweepChunkOf(job, ref->task)) {
-        merged = absl::InvalidArgumentError("a tile result for a sweep task");
-    } else if (job.frame) {
-        // Frame plans are fixed: a merge appends no task.
-        const absl::Status added =
-            !splats ? absl::InvalidArgumentError("a frame task's result without its splats")
-                    : job.frame->Add(ref->task, sums, *splats);
-        if (!added.ok()) merged = added;
-    } else if (splats) {
-        merged = absl::InvalidArgumentError("splats in the result of a tile task");
-    } else {
-        merged = job.merger->Merge(ref->task, sums);
+    if (merged->sweep) {
+        Log()->info("job={} radiosity sweep {}: relative residual {:.3g}{}", job.id(),
+                    merged->sweep->iterations, merged->sweep->residual,
+                    merged->sweep->converged ? ", solved" : "");
+        completion.sweep = std::move(merged->sweep);
     }
-    if (!merged.ok()) return Refuse(*ref, lease_id, worker, merged.status());
-    MarkDone(job, ref->task, now);
-    for (const RenderTask& pass : *merged) QueuePass(job, pass);
     EnforceTimeLimit(job, now);
-    job.record.tasks_done = int(TasksDone(job));
-    job.record.stats = StatsOf(job);
-    job.record.tasks_running = job.states.running();
-    // A frame task's record holds its splats too, so that a restart merges the same sums.
-    const uint64_t ticket = store_.QueueTaskDone(
-        job.record, ref->task, job.frame ? EncodeFrameResult(sums, *splats) : EncodeTileSums(sums));
+    const std::optional<std::string> record = job.execution->RecordOf(result);
+    if (!record) {  // soft state, not recorded
+        Save(job);
+        return completion;
+    }
+    job.Sync();
+    // The record holds what the execution needs to merge the result again after a restart.
+    const uint64_t ticket = store_.QueueTaskDone(job.record, t, *record);
     ++version_;
     changed_.notify_all();
-    Log()->debug("job={} task={} done by {} ({}/{})", job.record.id, ref->task, LogSafe(worker),
+    Log()->debug("job={} task={} done by {} ({}/{})", job.id(), t, LogSafe(worker),
                  job.record.tasks_done, job.record.tasks_total);
-    const Completion completion{job.record.id, Rendered(job)};
+    completion.job_rendered = job.execution->Complete();
     locked.lock.unlock();
     // The worker hears "done" only once the result is durable.
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
@@ -775,7 +443,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
         locked.lock.lock();
         if (auto it = active_.find(completion.job_id); it != active_.end()) {
             FailJob(*it->second,
-                    absl::StrCat("recording the result of task ", ref->task, ": ", s.message()));
+                    absl::StrCat("recording the result of task ", t, ": ", s.message()));
         }
         return absl::Status(s.code(), absl::StrCat("job=", completion.job_id, ": ", s.message()));
     }
@@ -785,8 +453,8 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
 absl::StatusOr<Scheduler::LeaseRef> Scheduler::ResultLease(const std::string& lease_id,
                                                            const std::string& worker,
                                                            absl::Time now) {
-    const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !HeldBy(*ref, worker)) {
+    const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
+    if (!ref) {
         Log()->warn("result for lease {} from {} refused: not a lease it holds", LogSafe(lease_id),
                     LogSafe(worker));
         return absl::FailedPreconditionError(absl::StrCat(
@@ -796,65 +464,27 @@ absl::StatusOr<Scheduler::LeaseRef> Scheduler::ResultLease(const std::string& le
     return *ref;
 }
 
-absl::Status Scheduler::Refuse(const LeaseRef& ref, const std::string& lease_id,
-                               const std::string& worker, const absl::Status& why) {
-    const std::string error = absl::StrCat("job=", ref.job->record.id, " task=", ref.task, " from ",
-                                           worker, ": ", why.message());
-    if (IsCurrent(ref)) {
-        timeouts_.Remove(lease_id);
-        Requeue(ref, absl::StrCat("result refused: ", why.message()), true);
-    }
+absl::Status Scheduler::Refuse(const LeaseRef& ref, const std::string& worker,
+                               const absl::Status& why) {
+    const std::string error = absl::StrCat("job=", ref.job->id(), " task=", ref.lease->task,
+                                           " from ", worker, ": ", why.message());
+    if (ref.lease->current) Requeue(ref, absl::StrCat("result refused: ", why.message()), true);
     return absl::InvalidArgumentError(error);
 }
 
 void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
-    Task& task = job.tasks[size_t(t)];
+    ScheduledJob::Task& task = job.tasks[size_t(t)];
     task.finished = now;
     if (job.states.state(t) == TaskState::kLeased) {
         // Whoever else holds a lease of it (a retry or a speculative copy) learns at its next
         // heartbeat.
-        for (int attempt : task.live) timeouts_.Remove(LeaseId(job, t, attempt));
-        task.live.clear();
+        leases_.EndTask(job.id(), t);
         job.speculation.TaskDone(now - task.leased_at);
         metrics_.task_seconds.Observe(absl::ToDoubleSeconds(now - task.leased_at));
     }
-    MoveTask(job, t, TaskState::kDone);
+    job.Move(t, TaskState::kDone);
     metrics_.tasks_done.Add(now, 1);
-    metrics_.samples_done.Add(now, TaskSamples(job, t));
-}
-
-absl::StatusOr<Scheduler::SweepCompletion> Scheduler::CompleteSweep(
-    const std::string& lease_id, const std::string& worker, const SweepChunkResult& result) {
-    Locked locked(*this);
-    const absl::Time now = clock_();
-    const absl::StatusOr<LeaseRef> ref = ResultLease(lease_id, worker, now);
-    if (!ref.ok()) return ref.status();
-    Job& job = *ref->job;
-    if (job.states.state(ref->task) == TaskState::kDone) {
-        return SweepCompletion{job.record.id, std::nullopt};
-    }
-    const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(job, ref->task);
-    const SweepTaskNumbering::SweepChunk got{result.sweep, result.chunk};
-    absl::Status added = !at ? absl::InvalidArgumentError("a sweep result for a tile")
-                         : *at != got
-                             ? absl::InvalidArgumentError(absl::StrCat(
-                                   "a result of sweep ", result.sweep, " chunk ", result.chunk))
-                             : job.solve->Add(result);
-    if (!added.ok()) return Refuse(*ref, lease_id, worker, added);
-    MarkDone(job, ref->task, now);
-    SweepCompletion completion{job.record.id, std::nullopt};
-    if (job.solve->SweepComplete()) {
-        absl::StatusOr<RadiositySolve::Outcome> outcome = job.solve->FinishSweep();
-        if (!outcome.ok()) {
-            FailJob(job, std::string(outcome.status().message()));
-            return completion;
-        }
-        Log()->info("job={} radiosity sweep {}: relative residual {:.3g}{}", job.record.id,
-                    outcome->iterations, outcome->residual, outcome->converged ? ", solved" : "");
-        completion.outcome = std::move(*outcome);
-    }
-    Save(job);
-    return completion;
+    metrics_.samples_done.Add(now, job.execution->TaskSamples(t));
 }
 
 void Scheduler::Publish(const std::string& job_id, bool converged,
@@ -867,70 +497,65 @@ void Scheduler::Publish(const std::string& job_id, bool converged,
         FailJob(job, absl::StrCat("storing the radiosity: ", hash.status().message()));
         return;
     }
-    if (converged) {
-        job.solution = *hash;
-        job.solve.reset();
-        QueueStart(job);
-    } else {
-        job.sweep_input = *hash;
-        QueueSweep(job);
+    absl::StatusOr<std::vector<int>> ready = job.execution->Publish(converged, *hash);
+    if (!ready.ok()) {
+        FailJob(job, std::string(ready.status().message()));
+        return;
     }
+    job.Queue(*ready);
     Save(job);
 }
 
 absl::Status Scheduler::Fail(const std::string& lease_id, const std::string& worker,
                              const std::string& reason, FailureKind kind) {
     Locked locked(*this);
-    const std::optional<LeaseRef> ref = Resolve(lease_id);
-    if (!ref || !HeldBy(*ref, worker) || !IsCurrent(*ref)) return absl::OkStatus();
-    timeouts_.Remove(lease_id);
+    const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
+    if (!ref || !ref->lease->current) return absl::OkStatus();
     Requeue(*ref, absl::StrCat(reason, " (worker ", worker, ")"), kind == FailureKind::kTaskError);
     return absl::OkStatus();
 }
 
 void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool counted) {
     Job& job = *ref.job;
-    const int t = ref.task;
-    Task& task = job.tasks[size_t(t)];
-    task.live.erase(ref.attempt);
+    const int t = ref.lease->task;
+    const int attempt = ref.lease->attempt;
+    ScheduledJob::Task& task = job.tasks[size_t(t)];
+    leases_.End(ref.id);
     if (counted) {
         metrics_.task_failures.Add();
         ++task.failures;
-        task.failed_on.insert(task.holders[size_t(ref.attempt - 1)]);
+        task.failed_on.insert(ref.lease->worker);
         task.last_error = reason;
         job.record.last_error = absl::StrCat("task ", t, ": ", reason);
     }
-    Log()->warn("job={} task={} attempt {} failed: {}{}", job.record.id, t, ref.attempt,
-                LogSafe(reason), counted ? "" : " (not counted)");
+    Log()->warn("job={} task={} attempt {} failed: {}{}", job.id(), t, attempt, LogSafe(reason),
+                counted ? "" : " (not counted)");
     if (task.failures >= options_.max_failures) {
         FailJob(job, absl::StrCat("task ", t, " failed ", task.failures, " times; last: ", reason));
         return;
     }
-    if (task.live.empty()) {  // otherwise another lease of it is still rendering
-        MoveTask(job, t, TaskState::kQueued);
+    if (leases_.Current(job.id(), t).empty()) {  // otherwise another lease of it still renders
+        job.Move(t, TaskState::kQueued);
         ++job.record.retries;
     }
     Save(job);
 }
 
 void Scheduler::FailJob(Job& job, const std::string& error) {
-    MoveJob(job, JobState::kFailed);
+    job.MoveTo(clock_(), JobState::kFailed);
     job.record.error = error;
     Log()->error("job={} failed: {}", job.record.id, LogSafe(error));
     EndJob(job);
 }
 
 JobRecord Scheduler::EndJob(Job& job) {
-    for (int t = 0; t < int(job.tasks.size()); ++t) {
-        for (int attempt : job.tasks[size_t(t)].live) timeouts_.Remove(LeaseId(job, t, attempt));
-    }
     const std::string id = job.record.id;
-    ended_tasks_.emplace_back(id, TaskStatuses(job, clock_()));
+    ended_tasks_.emplace_back(id, job.Statuses(leases_, clock_()));
+    leases_.ForgetJob(id);
     const uint64_t ticket = Save(job);
-    ending_[id] = Ending{job.record, ticket};
-    to_settle_.push_back(id);
+    JobRecord record = job.record;
     active_.erase(id);  // destroys `job`
-    return ending_[id].record;
+    return ended_.Add(std::move(record), ticket);
 }
 
 absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
@@ -938,10 +563,10 @@ absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
     {
         Locked locked(*this);
         if (auto it = active_.find(job_id); it != active_.end()) {
-            MoveJob(*it->second, JobState::kCancelled);
+            it->second->MoveTo(clock_(), JobState::kCancelled);
             cancelled = EndJob(*it->second);
             Log()->info("job={} cancelled", job_id);
-        } else if (const JobRecord* ended = EndedRecord(job_id)) {
+        } else if (const JobRecord* ended = ended_.Find(job_id)) {
             return AlreadyEnded(*ended);
         }
     }  // the cancellation is durable here, or logged as not recorded
@@ -958,7 +583,7 @@ absl::StatusOr<JobRecord> Scheduler::SetPriority(const std::string& job_id, int 
         Locked locked(*this);
         auto it = active_.find(job_id);
         if (it == active_.end()) {
-            if (const JobRecord* ended = EndedRecord(job_id)) return AlreadyEnded(*ended);
+            if (const JobRecord* ended = ended_.Find(job_id)) return AlreadyEnded(*ended);
             locked.lock.unlock();  // the store is never read under the lock
             absl::StatusOr<JobRecord> stored = store_.Get(job_id);
             if (!stored.ok()) return stored.status();
@@ -978,14 +603,13 @@ int Scheduler::ExpireLeases() {
     Locked locked(*this);
     const absl::Time now = clock_();
     workers_.ForgetSilent(now);
-    const std::vector<std::string> expired = timeouts_.TakeExpired(now);
+    const std::vector<std::string> expired = leases_.TakeExpired(now);
     for (const std::string& lease_id : expired) {
-        const std::optional<LeaseRef> ref = Resolve(lease_id);
-        if (!ref || !IsCurrent(*ref)) continue;
-        const std::string& worker =
-            ref->job->tasks[size_t(ref->task)].holders[size_t(ref->attempt - 1)];
+        const Lease* lease = leases_.Find(lease_id);  // unknown once an earlier one failed its job
+        const std::optional<LeaseRef> ref = lease ? Resolve(lease_id, lease->worker) : std::nullopt;
+        if (!ref) continue;
         Requeue(*ref,
-                absl::StrCat("lease expired: worker ", worker, " sent no heartbeat for ",
+                absl::StrCat("lease expired: worker ", lease->worker, " sent no heartbeat for ",
                              absl::FormatDuration(options_.lease)),
                 true);
     }
@@ -994,8 +618,7 @@ int Scheduler::ExpireLeases() {
 
 absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_id) const {
     JobImage snapshot;
-    std::shared_ptr<const TileStore> tiles;            // outlives the job if it ends meanwhile
-    std::optional<FrameMerger::SnapshotSource> frame;  // a frame job's stores, the same
+    JobExecution::ImageReader read;  // shares the stores: outlives the job if it ends meanwhile
     {
         std::lock_guard<std::mutex> lock(mutex_);
         auto it = active_.find(job_id);
@@ -1004,18 +627,10 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_i
         }
         const Job& job = *it->second;
         snapshot.record = job.record;
-        if (job.frame) {
-            // Read after the lock is released, as a tile job's store: a preview may show a tile
-            // merged meanwhile with the normalisation before it; a complete job's is exact.
-            frame = job.frame->snapshot_source();
-        } else {
-            tiles = job.merger->store();
-        }
-        if (job.adaptive) snapshot.adaptive = job.adaptive->TileReport();
+        read = job.execution->SnapshotReader();
+        snapshot.adaptive = job.execution->TileReport();
     }
-    const RenderPlanSettings& plan = snapshot.record.spec.plan;
-    absl::StatusOr<Image> image =
-        frame ? frame->Read() : RenderImageOf(*tiles, plan.width, plan.height);
+    absl::StatusOr<Image> image = read();
     if (!image.ok()) return image.status();
     snapshot.image = std::move(*image);
     if (snapshot.adaptive) {
@@ -1035,7 +650,7 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
         FailJob(job, absl::StrCat("writing the result: ", result_path.status().message()));
         return;
     }
-    MoveJob(job, JobState::kSucceeded);
+    job.MoveTo(clock_(), JobState::kSucceeded);
     job.record.result_path = *result_path;
     Log()->info("job={} succeeded: {} samples -> {}", job_id, job.record.stats.samples,
                 *result_path);
@@ -1043,8 +658,8 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
 }
 
 uint64_t Scheduler::Save(Job& job) {
-    // Derived, so that the record cannot disagree with the task states.
-    job.record.tasks_running = IsFinal(job.record.state) ? 0 : job.states.running();
+    // Derived, so that the record cannot disagree with the execution and the task states.
+    job.Sync();
     const uint64_t ticket = store_.QueuePut(job.record);
     ++version_;
     changed_.notify_all();

@@ -1,12 +1,12 @@
-// The farm's scheduler, without I/O or gRPC: jobs are planned into tasks, tasks are leased to
-// workers by job priority then age, leases live while heartbeats extend them, and results merge
-// into the job's image. Tile jobs merge through a TileMerger, frame-method jobs (light, bdpt, ppm)
-// through a FrameMerger (lf/job/frame_merge.h), whose results carry splats. It composes small
-// units, each tested alone: task states change only through TaskStateMachine, job states through
-// TransitionJob; LeaseTimeouts keeps the lease deadlines, WorkerRegistry the live workers,
-// SpeculationPolicy and TimeLimitReached decide second leases and time limits, SweepTaskNumbering
-// places a solve's tasks; the timeout checker (TimeoutChecker) calls ExpireLeases and
-// EnforceTimeLimits. The store is never read, nor waited for, under the scheduler's lock.
+// The farm's scheduler, without I/O or gRPC: what spans jobs. Jobs are queued by priority then
+// age, their tasks leased to workers, leases live while heartbeats extend them, results go to
+// the job, and the store keeps it all durable. Everything a kind of job does its own way (its
+// plan, merge, task order, time limit: lf/job/job_execution.h) is its execution's to say. It
+// composes small units, each tested alone: task states change only through TaskStateMachine,
+// job states through TransitionJob; LeaseTable owns the leases, WorkerRegistry the live
+// workers, SpeculationPolicy decides second leases; the timeout checker (TimeoutChecker) calls
+// ExpireLeases and EnforceTimeLimits. The store is never read, nor waited for, under the
+// scheduler's lock.
 //
 // A lease that expires or a failure puts the task back in the queue, where workers it has not
 // failed on take it first; the third counted failure fails the job. Cancelling a job drops all its
@@ -27,19 +27,16 @@
 #include "lf/core/image.h"
 #include "lf/core/splat_list.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/frame_merge.h"
-#include "lf/job/merge.h"
+#include "lf/job/job_execution.h"
 #include "lf/job/task_assignment.h"
 #include "lf/job/task_status.h"
 #include "lf/job/worker_status.h"
+#include "server/ended_jobs.h"
 #include "server/job_state_machine.h"
 #include "server/job_store.h"
-#include "server/lease_timeouts.h"
+#include "server/lease_table.h"
 #include "server/metrics.h"
-#include "server/radiosity_solve.h"
-#include "server/speculation.h"
-#include "server/sweep_task_numbering.h"
-#include "server/task_state_machine.h"
+#include "server/scheduled_job.h"
 #include "server/worker_registry.h"
 
 namespace lf {
@@ -116,33 +113,33 @@ class Scheduler {
     // Extends the lease. False means stop: the job was cancelled or the lease is gone.
     bool Heartbeat(const std::string& lease_id, const std::string& worker);
 
-    // Merges a task's result and records it in the store before returning. The result is
-    // accepted even from an expired lease as long as the task is not done (it is the same bits
-    // whoever renders it); a duplicate is ignored. Refused: a lease this server never handed to
-    // `worker` (FailedPrecondition), and a result of the wrong rectangle or sample count
-    // (InvalidArgument; a current lease's task is then queued again as a counted failure).
+    // Merges a task's result (lf::TaskResult: what the task's kind returns), and records it in
+    // the store before returning when the job's execution keeps it. The result is accepted even
+    // from an expired lease as long as the task is not done (it is the same bits whoever renders
+    // it); a duplicate is ignored. Refused: a lease this server never handed to `worker`
+    // (FailedPrecondition), and a result that is not the task's (InvalidArgument, from the
+    // execution; a current lease's task is then queued again as a counted failure).
     // `job_rendered` says the job is now fully rendered: the caller writes the result and calls
-    // Finish. A frame method's task (lf/job/frame_plan.h) comes with `splats`, its splat list
-    // (coalesced here), and `sums` its camera part (a 0x0 tile with the stats when it has none);
-    // InvalidArgument for splats of a tile task, a frame task's result without them, another
-    // frame's splats or the wrong camera part.
+    // Finish. When a patch-group task completes its sweep, `sweep` holds the next sweep's input
+    // or the solution: the caller stores it as a blob and calls Publish. A solve that runs out of
+    // iterations fails the job.
     struct Completion {
         std::string job_id;
         bool job_rendered = false;
+        std::optional<RadiositySolve::Outcome> sweep;
     };
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
-                                        const TileSums& sums, SplatList* splats = nullptr);
-
-    // A patch-group task's result, taken as Complete takes a tile's. When it completes its
-    // sweep, `outcome` holds the next sweep's input or the solution: the caller stores it as a
-    // blob and calls Publish. A solve that runs out of iterations fails the job.
-    struct SweepCompletion {
-        std::string job_id;
-        std::optional<RadiositySolve::Outcome> outcome;
-    };
-    absl::StatusOr<SweepCompletion> CompleteSweep(const std::string& lease_id,
-                                                  const std::string& worker,
-                                                  const SweepChunkResult& result);
+                                        const TaskResult& result);
+    // A tile's result, or a frame task's (`sums` its camera part, a 0x0 tile with the stats when
+    // it has none, and `splats` its splat list).
+    absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
+                                        const TileSums& sums, SplatList* splats = nullptr) {
+        return Complete(lease_id, worker, TaskResult{.sums = &sums, .splats = splats});
+    }
+    absl::StatusOr<Completion> CompleteSweep(const std::string& lease_id, const std::string& worker,
+                                             const SweepChunkResult& result) {
+        return Complete(lease_id, worker, TaskResult{.sweep = &result});
+    }
     // Queues the sweep that reads blob `hash`, or the display tiles when `converged`; fails the
     // job when the blob could not be stored.
     void Publish(const std::string& job_id, bool converged,
@@ -229,54 +226,16 @@ class Scheduler {
     const SchedulerMetrics& metrics() const { return metrics_; }
 
   private:
-    // What a task's leases left behind; its state is in Job::states.
-    struct Task {
-        int attempts = 0;                  // leases handed out
-        int failures = 0;                  // counted failures
-        std::vector<std::string> holders;  // the worker of each lease, by attempt - 1
-        std::set<int> live;    // attempts whose lease is current: two when one is speculative
-        absl::Time leased_at;  // when it last left the queue
-        absl::Time finished = absl::InfinitePast();  // its first result merged
-        std::string last_error;                      // of its last counted failure
-        std::set<std::string> failed_on;
-    };
-    struct Job {
-        JobRecord record;
-        // The tiles' tasks and their results: a fixed plan, or an adaptive one (`adaptive`, the
-        // same object) whose passes are appended to the tasks as results ask for them.
-        std::unique_ptr<TileMerger> merger;
-        AdaptiveTilePlan* adaptive = nullptr;
-        // Frame methods (UsesFramePlan): their frame passes and merged sums, instead of `merger`
-        // (then null). The Task* helpers below answer for either.
-        std::unique_ptr<FrameMerger> frame{};
-        TaskStateMachine states{};
-        std::vector<Task> tasks{};   // by index, as many as `states`
-        uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
-        SpeculationPolicy speculation{absl::ZeroDuration()};
-        // Radiosity solved in sweeps: while `solve` is set, its patch-group tasks follow the
-        // tiles (numbered by `sweeps`, set once the job solves in sweeps) and the tiles wait. A
-        // chunk goes back to the worker that did it before, which keeps its form-factor rows; that
-        // is soft state, so any worker may take a chunk whose owner is gone.
-        std::unique_ptr<RadiositySolve> solve{};
-        std::optional<SweepTaskNumbering> sweeps{};
-        std::string sweep_input{};  // blob of the current sweep's input; "" in sweep 0
-        std::string solution{};     // blob of the solution, once solved
-        std::map<int, std::string> chunk_owner{};
-    };
+    using Job = ScheduledJob;
+    // A lease this server handed out, and its job, while that job is queued or running.
     struct LeaseRef {
         Job* job;
-        int task;
-        int attempt;
-    };
-    // A job that ended, while its final record is queued but not yet durable: readers find it
-    // here until it is, then in the store.
-    struct Ending {
-        JobRecord record;
-        uint64_t ticket = 0;
+        const Lease* lease;
+        std::string id;
     };
     // The scheduler's lock. Jobs ended while it is held have their final record queued, not
     // durable; on release it waits for those writes with the lock released, so no fsync is ever
-    // waited for under it, then moves the jobs from `ending_` to the store's care.
+    // waited for under it, then leaves the jobs to the store's care.
     class Locked {
       public:
         explicit Locked(Scheduler& scheduler);
@@ -293,68 +252,34 @@ class Scheduler {
     // ticket to wait for.
     std::optional<std::pair<std::string, uint64_t>> FindRequestInMemory(
         const std::string& request_id) const;
-    // The record of a job that ended and is not (or not yet) in the store.
-    const JobRecord* EndedRecord(const std::string& job_id) const;
     std::optional<TaskAssignment> TryLease(const std::string& worker,
                                            const WorkerDescription* about);
-    // The current lease each worker holds (the newest, should one hold two).
-    std::map<std::string, LeaseRef> LeasesByWorker();
-    // The sweep and chunk of a patch-group task; nullopt for a tile's.
-    static std::optional<SweepTaskNumbering::SweepChunk> SweepChunkOf(const Job& job, int task);
-    // The one way the scheduler moves a task or a job; an illegal move is a broken invariant.
-    void MoveTask(Job& job, int task, TaskState to);
-    void MoveJob(Job& job, JobState to);
-    // The job's planned tasks, those merged, whether all are, and their stats: the tile merger's
-    // or the frame merger's.
-    static size_t TaskCount(const Job& job);
-    static size_t TasksDone(const Job& job);
-    static bool Rendered(const Job& job);
-    static const RenderStats& StatsOf(const Job& job);
-    // Pixels times samples per pixel of a task's camera part; 0 for a radiosity sweep's.
-    static uint64_t TaskSamples(const Job& job, int task);
-    // Grows the job to `count` tasks, the new ones waiting.
-    static void Grow(Job& job, size_t count);
-    // Queues what a job starts with: its tiles not yet done, or its solve's first sweep.
-    void QueueStart(Job& job);
-    void QueueSweep(Job& job);
-    // A job with its tasks planned as its spec says: tiles (fixed or adaptive), or for a frame
-    // method the frame passes local mode plans (lf::FramePlanSettingsOf); InvalidArgument when
-    // they cannot be.
-    absl::StatusOr<std::unique_ptr<Job>> NewJob(JobRecord record) const;
-    // Queues a task the adaptive plan appended.
-    void QueuePass(Job& job, const RenderTask& pass);
-    // Drops an adaptive job's passes once its time limit has passed; true if dropping them
-    // completed the job (so that it is reported once, here or by Complete).
+    // Drops a job's tasks once its time limit has passed; true if dropping them completed the
+    // job (so that it is reported once, here or by Complete).
     bool EnforceTimeLimit(Job& job, absl::Time now);
-    // Whether `worker` may take queued task `task` now: a sweep task goes to its chunk's owner
-    // while that worker lives, and a task that failed on `worker` waits for a live worker it has
+    // Whether `worker` may take queued task `task` now: a task the execution prefers for another
+    // live worker waits for it, and a task that failed on `worker` waits for a live worker it has
     // not failed on, while there is one.
     bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;
     // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).
     absl::StatusOr<LeaseRef> ResultLease(const std::string& lease_id, const std::string& worker,
                                          absl::Time now);
     // Refuses a result: the task goes back to the queue as a counted failure.
-    absl::Status Refuse(const LeaseRef& ref, const std::string& lease_id, const std::string& worker,
-                        const absl::Status& why);
+    absl::Status Refuse(const LeaseRef& ref, const std::string& worker, const absl::Status& why);
     // The bookkeeping of a task's first accepted result.
     void MarkDone(Job& job, int task, absl::Time now);
     // A second lease of a task running too long in the job, or -1 (see SpeculationPolicy).
     int StragglerFor(const Job& job, const std::string& worker, absl::Time now) const;
     TaskAssignment Grant(Job& job, int task, const std::string& worker, absl::Time now);
-    std::string LeaseId(const Job& job, int task, int attempt) const;
-    // Where a lease id of this server points, whether or not the lease is still current; nullopt
-    // for ids it never handed out (forged, or from before a restart).
-    std::optional<LeaseRef> Resolve(const std::string& lease_id);
-    static bool HeldBy(const LeaseRef& ref, const std::string& worker);
-    static bool IsCurrent(const LeaseRef& ref);
-    // Ends the lease; when no other lease of the task is live, puts the task back in the queue.
-    // Counts a failure unless `counted` is false; fails the job at max_failures.
+    // The lease and its job when `worker` holds it, current or not; nullopt otherwise (a
+    // made-up id, another worker's lease, one from before a restart, or of a job that ended).
+    std::optional<LeaseRef> Resolve(const std::string& lease_id, const std::string& worker);
+    // Ends the lease; when no other lease of the task is current, puts the task back in the
+    // queue. Counts a failure unless `counted` is false; fails the job at max_failures.
     void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
     void FailJob(Job& job, const std::string& error);
-    // The job's tasks as Tasks() reports them.
-    std::vector<TaskStatus> TaskStatuses(const Job& job, absl::Time now) const;
     // Ends the live state of a job moved to a final state: its final record is queued and the
-    // job waits in `ending_` until Locked's release finds it durable. Returns that record.
+    // job waits in `ended_` until Locked's release finds it durable. Returns that record.
     JobRecord EndJob(Job& job);
     uint64_t Save(Job& job);  // queues the record's write and wakes watchers; a store ticket
 
@@ -367,17 +292,12 @@ class Scheduler {
     uint64_t version_ = 0;
     bool shutdown_ = false;
     uint64_t next_seq_ = 1;
-    // In lease ids, so that a lease of an earlier run of the server is never taken for a current
-    // one: attempts are counted from zero again after a restart.
-    const std::string boot_;
     std::map<std::string, std::unique_ptr<Job>> active_;
-    std::map<std::string, Ending> ending_;
-    std::vector<std::string> to_settle_;           // in `ending_`, not yet waited for
-    std::map<std::string, JobRecord> unrecorded_;  // ended while the store could not write
+    EndedJobs ended_;
     // Ended jobs' tasks, for tasks_ended_ once the lock is released.
     std::vector<std::pair<std::string, std::vector<TaskStatus>>> ended_tasks_;
     TasksEnded tasks_ended_;
-    LeaseTimeouts timeouts_;
+    LeaseTable leases_;
     WorkerRegistry workers_;
     SchedulerMetrics metrics_;
 };

@@ -1,26 +1,13 @@
 #include "lf/local/local_executor.h"
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
-#include <algorithm>
-#include <atomic>
-#include <chrono>
-#include <cmath>
-#include <condition_variable>
 #include <filesystem>
-#include <mutex>
-#include <queue>
-#include <thread>
-#include <tuple>
 
 #include "absl/strings/str_cat.h"
-#include "lf/core/image_error.h"
-#include "lf/job/adaptive_plan.h"
-#include "lf/job/frame_merge.h"
-#include "lf/job/merge.h"
-#include "lf/job/plan.h"
+#include "lf/job/adaptive_tile_execution.h"
+#include "lf/job/frame_execution.h"
+#include "lf/job/tile_execution.h"
 #include "lf/kernels/tile_renderer.h"
+#include "lf/local/execution_runner.h"
 
 namespace lf {
 
@@ -43,38 +30,35 @@ SampleOptions SampleOptionsOf(const RenderSettings& settings) {
     return {settings.clamp, settings.aovs, settings.sampler};
 }
 
-// Runs tasks 0..count-1 on `threads` threads (0: all cores), each task once: render(i) makes
-// its result in parallel, merge(i, result) adds it under one lock (mergers are not
-// thread-safe); the first merge error is returned. Exact sums make the order irrelevant.
-template <class Render, class Merge>
-absl::Status RunTasks(int threads, size_t count, const Render& render, const Merge& merge) {
-    std::mutex mutex;
-    absl::Status status;
-    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
-    arena.execute([&] {
-        tbb::parallel_for(
-            tbb::blocked_range<size_t>(0, count, 1),
-            [&](const tbb::blocked_range<size_t>& range) {
-                for (size_t i = range.begin(); i != range.end(); ++i) {
-                    auto result = render(i);
-                    std::lock_guard<std::mutex> lock(mutex);
-                    status.Update(merge(i, result));
-                }
-            },
-            tbb::simple_partitioner());
-    });
-    return status;
+// Runs a tile execution's tasks with lf::RenderTile.
+absl::Status RunTiles(TileExecution& execution, const Camera& camera,
+                      const RadianceEstimator& estimator, const RenderSettings& settings,
+                      RunOptions options, absl::Time started) {
+    options.threads = settings.threads;
+    return RunExecution(
+        execution,
+        [&](const TaskAssignment& lease, const std::atomic<bool>& cancel, const auto& merge) {
+            const RenderTask& task = lease.task;
+            const TileSums sums =
+                RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
+                           task.sample_end, SampleOptionsOf(settings), &cancel);
+            return merge(TaskResult{.sums = &sums});
+        },
+        options, started);
 }
 
-// The image the merger holds once every task is in, and the time since `start`.
-template <class Merger>
-absl::StatusOr<RenderOutput> Finish(const Merger& merger,
-                                    std::chrono::steady_clock::time_point start) {
-    absl::StatusOr<Image> image = merger.Snapshot();
+// The image of a complete execution, its stats, and the seconds since `started`.
+absl::StatusOr<RenderOutput> Output(const JobExecution& execution, const RunClock& clock,
+                                    absl::Time started) {
+    absl::StatusOr<Image> image = execution.SnapshotReader()();
     if (!image.ok()) return image.status();
-    RenderOutput out{std::move(*image), merger.stats(), 0, {}};
-    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    RenderOutput out{std::move(*image), execution.stats(), 0, {}};
+    out.seconds = absl::ToDoubleSeconds(clock() - started);
     return out;
+}
+
+RunClock ClockOr(const RunClock& clock) {
+    return clock ? clock : [] { return absl::Now(); };
 }
 
 }  // namespace
@@ -82,158 +66,85 @@ absl::StatusOr<RenderOutput> Finish(const Merger& merger,
 absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEstimator& estimator,
                                          const RenderSettings& settings,
                                          const ProgressFn& progress) {
-    const auto start = std::chrono::steady_clock::now();
-    absl::StatusOr<std::vector<RenderTask>> tasks =
-        PlanRender({camera.width(), camera.height(), settings.spp, settings.tile, settings.passes});
-    if (!tasks.ok()) return tasks.status();
-    absl::StatusOr<std::unique_ptr<RenderMerger>> made =
-        RenderMerger::Make(camera.width(), camera.height(), *tasks,
-                           TileStoreFor(camera, settings.aovs), settings.aovs);
+    const RunClock clock = ClockOr({});
+    const absl::Time started = clock();
+    absl::StatusOr<std::unique_ptr<TileExecution>> made = TileExecution::Make(
+        {camera.width(), camera.height(), settings.spp, settings.tile, settings.passes},
+        TileStoreFor(camera, settings.aovs), settings.aovs);
     if (!made.ok()) return made.status();
-    RenderMerger& merger = **made;
-    const absl::Status status = RunTasks(
-        settings.threads, tasks->size(),
-        [&](size_t i) {
-            const RenderTask& task = (*tasks)[i];
-            return RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
-                              task.sample_end, SampleOptionsOf(settings));
-        },
-        [&](size_t i, const TileSums& sums) {
-            const absl::Status added = merger.Add((*tasks)[i].index, sums);
-            if (progress) progress(merger.tasks_done(), merger.task_count());
-            return added;
-        });
-    if (!status.ok()) return status;
-    return Finish(merger, start);
+    TileExecution& execution = **made;
+    RunOptions options;
+    options.merged = [&] {
+        if (progress) progress(execution.tasks_done(), execution.task_count());
+    };
+    if (absl::Status s = RunTiles(execution, camera, estimator, settings, options, started);
+        !s.ok()) {
+        return s;
+    }
+    return Output(execution, clock, started);
 }
 
 absl::StatusOr<RenderOutput> RenderFrameImage(const Camera& camera, const FrameRenderer& renderer,
                                               const FramePlanSettings& plan,
                                               const RenderSettings& settings,
                                               const ProgressFn& progress) {
-    const auto start = std::chrono::steady_clock::now();
+    const RunClock clock = ClockOr({});
+    const absl::Time started = clock();
     if (plan.width != camera.width() || plan.height != camera.height()) {
         return absl::InvalidArgumentError(absl::StrCat("frame plan ", plan.width, "x", plan.height,
                                                        " is not the camera's ", camera.width(), "x",
                                                        camera.height()));
     }
-    absl::StatusOr<std::vector<FrameTask>> tasks = PlanFrameRender(plan);
-    if (!tasks.ok()) return tasks.status();
     // Two stores (camera sums, splat sums), each as a tile render's, in a file above 2048x2048.
-    absl::StatusOr<std::unique_ptr<FrameMerger>> made = FrameMerger::Make(
-        plan.width, plan.height, plan.tile, plan.kind, *tasks, TileStoreFor(camera, 0));
+    absl::StatusOr<std::unique_ptr<FrameExecution>> made =
+        FrameExecution::Make(plan, TileStoreFor(camera, 0));
     if (!made.ok()) return made.status();
-    FrameMerger& merger = **made;
-    struct Result {
-        TileSums camera;
-        SplatList splats;
+    FrameExecution& execution = **made;
+    RunOptions options;
+    options.threads = settings.threads;
+    options.merged = [&] {
+        if (progress) progress(execution.tasks_done(), execution.task_count());
     };
-    const absl::Status status = RunTasks(
-        settings.threads, tasks->size(),
-        [&](size_t i) {
-            const FrameTask& task = (*tasks)[i];
-            Result result{TileSums(task.rect, 0), SplatList(plan.width, plan.height)};
+    const absl::Status status = RunExecution(
+        execution,
+        [&](const TaskAssignment& lease, const std::atomic<bool>&, const auto& merge) {
+            const RenderTask& task = lease.task;
+            TileSums camera_sums(task.rect, 0);
+            SplatList splats(plan.width, plan.height);
             renderer.Render(
-                {task.rect, task.sample_begin, task.sample_end, task.path_begin, task.path_end},
-                result.camera, result.splats);
-            return result;
+                {task.rect, task.sample_begin, task.sample_end, lease.path_begin, lease.path_end},
+                camera_sums, splats);
+            return merge(TaskResult{.sums = &camera_sums, .splats = &splats});
         },
-        [&](size_t i, Result& result) {
-            const absl::Status added = merger.Add((*tasks)[i].index, result.camera, result.splats);
-            if (progress) progress(merger.tasks_done(), merger.tasks().size());
-            return added;
-        });
+        options, started);
     if (!status.ok()) return status;
-    return Finish(merger, start);
+    return Output(execution, clock, started);
 }
 
-absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
-                                                 const RadianceEstimator& estimator,
-                                                 const RenderSettings& settings,
-                                                 const AdaptiveSettings& adaptive,
-                                                 const ProgressFn& progress) {
-    using Clock = std::chrono::steady_clock;
-    const auto start = Clock::now();
-    absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made = AdaptiveTilePlan::Make(
+absl::StatusOr<RenderOutput> RenderImageAdaptive(
+    const Camera& camera, const RadianceEstimator& estimator, const RenderSettings& settings,
+    const AdaptiveSettings& adaptive, const ProgressFn& progress, const RunClock& run_clock) {
+    const RunClock clock = ClockOr(run_clock);
+    const absl::Time started = clock();
+    absl::StatusOr<std::unique_ptr<AdaptiveTileExecution>> made = AdaptiveTileExecution::Make(
         camera.width(), camera.height(), settings.spp, settings.tile, adaptive, kMaxTaskSamples,
         TileStoreFor(camera, settings.aovs), settings.aovs);
     if (!made.ok()) return made.status();
-    AdaptiveTilePlan& plan = **made;
-    const size_t tiles = plan.tile_count();
-
-    // Passes wait by their first sample, then plan order, as on the farm: every tile's first
-    // pass before any second one, and the least sampled tiles first, so a time limit leaves
-    // the tiles evenly sampled. No rounds: a tile's next pass starts as soon as its last ends.
-    auto later = [](const RenderTask& a, const RenderTask& b) {
-        return std::tie(a.sample_begin, a.index) > std::tie(b.sample_begin, b.index);
+    AdaptiveTileExecution& execution = **made;
+    RunOptions options;
+    options.clock = clock;
+    options.merged = [&] {
+        if (progress) progress(execution.tiles_finished(), execution.tile_count());
     };
-    std::priority_queue<RenderTask, std::vector<RenderTask>, decltype(later)> queue(later,
-                                                                                    plan.tasks());
-    std::mutex mutex;
-    std::condition_variable changed;
-    int running = 0;
-    bool finished = false;
-    absl::Status status;
-    std::atomic<bool> out_of_time{false};  // cancels the passes the time limit drops
-
-    auto work = [&] {
-        std::unique_lock<std::mutex> lock(mutex);
-        while (true) {
-            changed.wait(lock, [&] { return !queue.empty() || running == 0; });
-            if (queue.empty() || !status.ok()) break;
-            const RenderTask task = queue.top();
-            queue.pop();
-            if (!plan.IsPending(task.index)) continue;  // dropped by the time limit
-            ++running;
-            lock.unlock();
-            // First passes are never dropped, so never cancelled.
-            const bool first = task.sample_end <= plan.first_spp();
-            const TileSums sums = RenderTile(
-                camera, estimator, task.rect, settings.seed, task.sample_begin, task.sample_end,
-                SampleOptionsOf(settings), first ? nullptr : &out_of_time);
-            lock.lock();
-            --running;
-            if (plan.IsPending(task.index)) {  // else cut short: the time limit dropped it
-                absl::StatusOr<std::vector<RenderTask>> next = plan.Merge(task.index, sums);
-                if (!next.ok()) {
-                    status.Update(next.status());
-                } else {
-                    for (const RenderTask& pass : *next) queue.push(pass);
-                    if (progress) progress(plan.tiles_finished(), tiles);
-                }
-            }
-            changed.notify_all();
-        }
-        finished = true;
-        changed.notify_all();
-    };
-    const int threads = settings.threads > 0
-                            ? settings.threads
-                            : int(std::max(1u, std::thread::hardware_concurrency()));
-    std::vector<std::thread> pool;
-    for (int i = 0; i < threads; ++i) pool.emplace_back(work);
-    if (adaptive.time_limit > 0) {
-        std::unique_lock<std::mutex> lock(mutex);
-        const auto deadline = start + std::chrono::duration_cast<Clock::duration>(
-                                          std::chrono::duration<double>(adaptive.time_limit));
-        if (!changed.wait_until(lock, deadline, [&] { return finished; })) {
-            plan.Stop();
-            out_of_time = true;
-            changed.notify_all();
-        }
+    if (absl::Status s = RunTiles(execution, camera, estimator, settings, options, started);
+        !s.ok()) {
+        return s;
     }
-    for (std::thread& t : pool) t.join();
-    if (!status.ok()) return status;
-
-    RenderOutput out;
-    out.stats = plan.stats();
-    absl::StatusOr<Image> image = plan.Snapshot();
-    if (!image.ok()) return image.status();
-    out.image = std::move(*image);
-    absl::StatusOr<AdaptiveReport> report = plan.Report();
+    absl::StatusOr<RenderOutput> out = Output(execution, clock, started);
+    if (!out.ok()) return out.status();
+    absl::StatusOr<AdaptiveReport> report = execution.Report();
     if (!report.ok()) return report.status();
-    out.adaptive = std::move(*report);
-    out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    out->adaptive = std::move(*report);
     return out;
 }
 

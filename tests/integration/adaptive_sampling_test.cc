@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -48,16 +49,28 @@ class AdaptiveSampling : public ::testing::Test {
         tracer_ = std::make_unique<PathTracer>(*embree_, -1);
     }
 
-    RenderOutput Adaptive(const AdaptiveSettings& adaptive, int threads = 2) {
+    // `clock` empty: the real one.
+    RenderOutput Adaptive(const AdaptiveSettings& adaptive, int threads = 2,
+                          const RunClock& clock = {}, const ProgressFn& progress = {}) {
         RenderSettings settings;
         settings.spp = 8;
         settings.seed = 11;
         settings.threads = threads;
         settings.tile = 16;
         absl::StatusOr<RenderOutput> out =
-            RenderImageAdaptive(*camera_, *tracer_, settings, adaptive);
+            RenderImageAdaptive(*camera_, *tracer_, settings, adaptive, progress, clock);
         EXPECT_TRUE(out.ok()) << out.status();
         return *std::move(out);
+    }
+
+    // With a clock that stands still until `merges` passes have merged, then reads the limit
+    // (0.3 s) passed: the time limit comes after that much work whatever the machine's load.
+    RenderOutput TimeLimited(const AdaptiveSettings& adaptive, int merges) {
+        const absl::Time t0 = absl::FromUnixSeconds(1000);
+        std::atomic<int> merged{0};
+        return Adaptive(
+            adaptive, 2, [&] { return merged >= merges ? t0 + absl::Seconds(0.3) : t0; },
+            [&](size_t, size_t) { ++merged; });
     }
 
     Scene scene_;  // the Embree scene refers to it
@@ -187,14 +200,14 @@ TEST_F(AdaptiveSampling, IsDeterministicForAnyThreadCount) {
 }
 
 TEST_F(AdaptiveSampling, TimeLimitStopsSampling) {
-    const RenderOutput out = Adaptive({.target_error = 1e-4, .time_limit = 0.3});
+    const RenderOutput out = TimeLimited({.target_error = 1e-4, .time_limit = 0.3}, 24);
     EXPECT_TRUE(out.adaptive.timed_out);
     EXPECT_GT(out.adaptive.tiles_above_target, 0);
     // The first passes, then passes cut at the limit: well under a few times the limit.
     EXPECT_LT(out.seconds, 3.0);
 
     // Without a target, tiles double their samples, least sampled first, until the time is up.
-    const RenderOutput timed = Adaptive({.time_limit = 0.3});
+    const RenderOutput timed = TimeLimited({.time_limit = 0.3}, 40);
     EXPECT_TRUE(timed.adaptive.timed_out);
     EXPECT_GE(timed.adaptive.min_spp, 16u);
     EXPECT_LT(timed.seconds, 3.0);

@@ -10,9 +10,10 @@
 
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
+#include "lf/job/frame_merge.h"
+#include "lf/job/frame_result_codec.h"
 #include "lf/job/frame_settings.h"
 #include "server/farm.h"
-#include "server/frame_result_codec.h"
 #include "server/scheduler.h"
 #include "server/sqlite_job_store.h"
 #include "test_dir.h"

@@ -380,21 +380,16 @@ TEST_F(SchedulerTest, WaitForChangeWakesOnAnyChange) {
 
 TEST_F(SchedulerTest, IdleWorkerWaitsForWorkAndGetsItAtOnce) {
     EXPECT_FALSE(scheduler_.LeaseTask("w", absl::Now() + absl::Milliseconds(20)).has_value());
-    // The delay only lets the worker start waiting first.
-    absl::Time submitted;
+    // The delay only lets the worker start waiting first. The wait outlasts any test: only the
+    // submission's wake-up ends it in time, whatever the machine's load.
     std::thread submitter([&] {
         absl::SleepFor(absl::Milliseconds(50));
         Submit(0);
-        submitted = absl::Now();
     });
     const std::optional<TaskAssignment> lease =
-        scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20));
-    const absl::Time leased = absl::Now();
+        scheduler_.LeaseTask("w", absl::Now() + absl::Hours(1));
     submitter.join();
     EXPECT_TRUE(lease.has_value());
-    // Woken by the submission, not by a poll: well under the 20 s it would otherwise wait (a
-    // wake-up takes microseconds; the bound leaves room for a loaded machine).
-    EXPECT_LT(leased - submitted, absl::Milliseconds(500));
 }
 
 TEST_F(SchedulerTest, ShutdownEndsTheWait) {
@@ -402,10 +397,9 @@ TEST_F(SchedulerTest, ShutdownEndsTheWait) {
         absl::SleepFor(absl::Milliseconds(50));
         scheduler_.Shutdown();
     });
-    const absl::Time start = absl::Now();
-    EXPECT_FALSE(scheduler_.LeaseTask("w", absl::Now() + absl::Seconds(20)).has_value());
+    // A wait that outlasts any test: only Shutdown ends it in time.
+    EXPECT_FALSE(scheduler_.LeaseTask("w", absl::Now() + absl::Hours(1)).has_value());
     stopper.join();
-    EXPECT_LT(absl::Now() - start, absl::Seconds(5));
 }
 
 TEST_F(SchedulerTest, ListIsNewestFirst) {

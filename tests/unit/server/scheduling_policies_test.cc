@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "server/speculation.h"
-#include "server/sweep_task_numbering.h"
-#include "server/time_limit.h"
+#include "lf/job/sweep_task_numbering.h"
+#include "lf/job/time_limit.h"
 
 namespace lf {
 namespace {

@@ -35,7 +35,7 @@ struct RadiositySettings {
     double tolerance = defaults::kRadiosityTolerance;
     int max_iterations = defaults::kRadiosityMaxIterations;
     std::string display = defaults::kRadiosityDisplay;
-    // On the farm, with solver "jacobi": patch-group tasks per sweep (server/radiosity_solve.h).
+    // On the farm, with solver "jacobi": patch-group tasks per sweep (lf/job/radiosity_solve.h).
     int sweep_tasks = defaults::kRadiositySweepTasks;
     // Most patches mesh refinement may reach (RadiosityOptions::max_patches); 0: 16 times the
     // coarse mesh's.

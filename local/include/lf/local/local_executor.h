@@ -1,7 +1,7 @@
-// The in-process executor of local mode: the farm's planner (lf/job/plan.h) cuts the render into
-// tasks, TBB threads run them with lf::RenderTile as a worker would, and the farm's merger
-// (lf/job/merge.h) assembles the image. So `lightfarm render` and a farm render of the same job
-// are the same code and the same bits.
+// The in-process executor of local mode: the farm's job executions (lf/job/job_execution.h: its
+// plans and mergers) run on TBB threads (lf/local/execution_runner.h), each task rendered with
+// lf::RenderTile or the frame renderer as a worker would. So `lightfarm render` and a farm render
+// of the same job are the same code and the same bits.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +16,7 @@
 #include "lf/job/settings.h"
 #include "lf/kernels/frame_renderer.h"
 #include "lf/kernels/radiance.h"
+#include "lf/local/execution_runner.h"
 
 namespace lf {
 
@@ -49,16 +50,14 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
                                          const RenderSettings& settings,
                                          const ProgressFn& progress = {});
 
-// Adaptive sampling (AdaptiveTilePlan) on settings.threads threads, each taking the least
-// sampled tile's pass next; at the time limit the passes under way are cut and dropped, as on
-// the farm. settings.spp is the first pass of every tile
-// (rounded up to even, so A and B are equal halves); settings.passes is ignored. Progress counts
-// finished tiles.
-absl::StatusOr<RenderOutput> RenderImageAdaptive(const Camera& camera,
-                                                 const RadianceEstimator& estimator,
-                                                 const RenderSettings& settings,
-                                                 const AdaptiveSettings& adaptive,
-                                                 const ProgressFn& progress = {});
+// Adaptive sampling (lf::AdaptiveTileExecution) on settings.threads threads, each taking the
+// least sampled tile's pass next; at the time limit, read from `clock` (empty: absl::Now), the
+// passes under way are cut and dropped, as on the farm. settings.spp is the first pass of every
+// tile (rounded up to even, so A and B are equal halves); settings.passes is ignored. Progress
+// counts finished tiles.
+absl::StatusOr<RenderOutput> RenderImageAdaptive(
+    const Camera& camera, const RadianceEstimator& estimator, const RenderSettings& settings,
+    const AdaptiveSettings& adaptive, const ProgressFn& progress = {}, const RunClock& clock = {});
 
 // A frame method's render (light tracing, BDPT, photon mapping): PlanFrameRender cuts it into
 // frame tasks, settings.threads threads run them with `renderer` as a worker would (each task in

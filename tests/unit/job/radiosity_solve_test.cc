@@ -1,6 +1,6 @@
 // The farm's sweep bookkeeping against a local Jacobi iteration of a small system written out
 // by hand: b_{k+1} = E + ρ F b_k.
-#include "server/radiosity_solve.h"
+#include "lf/job/radiosity_solve.h"
 
 #include <gtest/gtest.h>
 

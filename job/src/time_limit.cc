@@ -1,4 +1,4 @@
-#include "server/time_limit.h"
+#include "lf/job/time_limit.h"
 
 namespace lf {
 

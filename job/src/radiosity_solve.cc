@@ -1,4 +1,4 @@
-#include "server/radiosity_solve.h"
+#include "lf/job/radiosity_solve.h"
 
 #include "absl/strings/str_format.h"
 

@@ -1,4 +1,4 @@
-#include "server/frame_result_codec.h"
+#include "lf/job/frame_result_codec.h"
 
 #include <cstdint>
 #include <cstring>

@@ -1,0 +1,56 @@
+// Radiosity solved in sweeps: the solve's patch-group tasks (lf::RadiositySolve, numbered by
+// SweepTaskNumbering after the tiles) come first, a sweep at a time, each sweep's result stored
+// by the caller as a blob (Publish); once solved, the display tiles, which read the solution.
+// A chunk goes back to the worker that did it before, which keeps its form-factor rows; that is
+// soft state, so any worker may take a chunk whose owner is gone.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "lf/job/radiosity_solve.h"
+#include "lf/job/sweep_task_numbering.h"
+#include "lf/job/tile_execution.h"
+
+namespace lf {
+
+class SweepExecution : public TileExecution {
+  public:
+    static absl::StatusOr<std::unique_ptr<SweepExecution>> Make(const RenderPlanSettings& plan,
+                                                                const RadiositySettings& radiosity,
+                                                                const TileStoreFactory& tile_stores,
+                                                                uint32_t aovs = 0);
+
+    size_t task_count() const override { return tasks_; }
+    // Not solved yet (after a restart too: the solve is not recorded, and runs again to the same
+    // bits): the first sweep; else the tiles.
+    std::vector<int> Start() override;
+    void Lease(int task, const std::string& worker, TaskAssignment& lease) override;
+    std::string PreferredWorker(int task) const override;
+    void Describe(int task, TaskStatus& status) const override;
+    uint64_t TaskSamples(int task) const override;
+    absl::StatusOr<Merged> Merge(int task, const TaskResult& result) override;
+    std::optional<std::string> RecordOf(const TaskResult& result) const override;
+    absl::StatusOr<std::vector<int>> Publish(bool converged, const std::string& hash) override;
+    void AddBlobsInUse(std::set<std::string>& hashes) const override;
+
+  private:
+    SweepExecution(std::unique_ptr<TileMerger> merger, uint64_t spp,
+                   const RadiositySettings& radiosity);
+    // The sweep and chunk of a patch-group task; nullopt for a tile's.
+    std::optional<SweepTaskNumbering::SweepChunk> SweepChunkOf(int task) const;
+    // Grows the tasks by the current sweep's, and returns them.
+    std::vector<int> QueueSweep();
+
+    RadiositySettings radiosity_;
+    size_t tasks_;                           // the tiles, then the sweeps' tasks planned so far
+    std::unique_ptr<RadiositySolve> solve_;  // while solving
+    std::optional<SweepTaskNumbering> sweeps_;
+    std::string sweep_input_;  // blob of the current sweep's input; "" in sweep 0
+    std::string solution_;     // blob of the solution, once solved
+    std::map<int, std::string> chunk_owner_;
+};
+
+}  // namespace lf

@@ -1,0 +1,46 @@
+#include "lf/job/job_execution.h"
+
+#include "lf/job/adaptive_tile_execution.h"
+#include "lf/job/frame_execution.h"
+#include "lf/job/frame_settings.h"
+#include "lf/job/sweep_execution.h"
+#include "lf/job/tile_execution.h"
+
+namespace lf {
+
+absl::StatusOr<std::vector<int>> JobExecution::Publish(bool converged, const std::string& hash) {
+    return absl::FailedPreconditionError("not a job solved in sweeps");
+}
+
+namespace {
+
+template <class Kind>
+absl::StatusOr<std::unique_ptr<JobExecution>> Upcast(absl::StatusOr<std::unique_ptr<Kind>> made) {
+    if (!made.ok()) return made.status();
+    return std::unique_ptr<JobExecution>(std::move(*made));
+}
+
+}  // namespace
+
+// The one place that tells the kinds of job apart.
+absl::StatusOr<std::unique_ptr<JobExecution>> MakeJobExecution(
+    const JobSpec& spec, const TileStoreFactory& tile_stores) {
+    if (UsesFramePlan(spec.method)) {
+        // The plan local mode makes of the same settings (lf::RenderFrameImage), so the merged
+        // sums are its bits.
+        absl::StatusOr<FramePlanSettings> plan = FramePlanSettingsOf(spec.method, spec.plan);
+        if (!plan.ok()) return plan.status();
+        return Upcast(FrameExecution::Make(*plan, tile_stores));
+    }
+    if (IsAdaptive(spec.adaptive)) {
+        return Upcast(AdaptiveTileExecution::Make(spec.plan.width, spec.plan.height, spec.plan.spp,
+                                                  spec.plan.tile, spec.adaptive, kMaxTaskSamples,
+                                                  tile_stores, spec.aovs));
+    }
+    if (SolvedInSweeps(spec)) {
+        return Upcast(SweepExecution::Make(spec.plan, spec.radiosity, tile_stores, spec.aovs));
+    }
+    return Upcast(TileExecution::Make(spec.plan, tile_stores, spec.aovs));
+}
+
+}  // namespace lf

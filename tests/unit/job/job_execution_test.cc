@@ -1,0 +1,249 @@
+// Each kind of job execution alone, with made-up results: which tasks start it, what a result
+// appends or unlocks, which results it refuses, what it records for a restart, and its time
+// limit. MakeJobExecution picks the kind from the spec.
+#include "lf/job/job_execution.h"
+
+#include <gtest/gtest.h>
+
+#include <typeindex>
+
+#include "lf/job/adaptive_tile_execution.h"
+#include "lf/job/frame_execution.h"
+#include "lf/job/sweep_execution.h"
+#include "lf/job/tile_execution.h"
+
+namespace lf {
+namespace {
+
+// A result of every sample of `task` at `value`, the odd samples at `odd` (A/B halves).
+TileSums Flat(const RenderTask& task, float value, float odd) {
+    TileSums sums(task.rect);
+    for (PixelSums& p : sums.pixels) {
+        for (uint64_t s = task.sample_begin; s < task.sample_end; ++s) {
+            p.Add(s, Rgb(s % 2 ? odd : value));
+        }
+    }
+    sums.stats.samples =
+        uint64_t(task.rect.width) * task.rect.height * (task.sample_end - task.sample_begin);
+    return sums;
+}
+
+RenderTask TaskOf(JobExecution& execution, int t) {
+    TaskAssignment lease;
+    execution.Lease(t, "w", lease);
+    return lease.task;
+}
+
+TEST(TileExecution, StartsWithEveryTileAndRefusesOtherKindsOfResult) {
+    auto made = TileExecution::Make({16, 16, 4, 8, 2}, MakeMemoryTileStore);
+    ASSERT_TRUE(made.ok()) << made.status();
+    TileExecution& e = **made;
+    EXPECT_EQ(e.Start(), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7}));
+    EXPECT_EQ(e.tasks_total(), 8);
+    const TileSums sums = Flat(TaskOf(e, 0), 0.5f, 0.5f);
+    SplatList splats(16, 16);
+    const SweepChunkResult sweep;
+    EXPECT_EQ(e.Merge(0, {.sums = &sums, .splats = &splats}).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(e.Merge(0, {.sweep = &sweep}).status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(e.Merge(1, {.sums = &sums}).status().code(), absl::StatusCode::kInvalidArgument)
+        << "another task's rectangle or samples";
+    absl::StatusOr<JobExecution::Merged> merged = e.Merge(0, {.sums = &sums});
+    ASSERT_TRUE(merged.ok()) << merged.status();
+    EXPECT_TRUE(merged->appended.empty());
+    EXPECT_EQ(e.tasks_done(), 1u);
+    EXPECT_FALSE(e.Complete());
+    TaskStatus status;
+    e.Describe(0, status);
+    EXPECT_EQ(status.kind, TaskKind::kTile);
+    EXPECT_EQ(e.TaskSamples(0), 8u * 8u * 2u);
+}
+
+TEST(TileExecution, RecordedResultsMergeToTheSameImage) {
+    auto live = TileExecution::Make({16, 8, 4, 8, 1}, MakeMemoryTileStore);
+    auto restarted = TileExecution::Make({16, 8, 4, 8, 1}, MakeMemoryTileStore);
+    ASSERT_TRUE(live.ok() && restarted.ok());
+    for (int t = 0; t < 2; ++t) {
+        const TileSums sums = Flat(TaskOf(**live, t), 0.25f * float(t + 1), 0.5f);
+        ASSERT_TRUE((*live)->Merge(t, {.sums = &sums}).ok());
+        const std::optional<std::string> record = (*live)->RecordOf({.sums = &sums});
+        ASSERT_TRUE(record.has_value());
+        ASSERT_TRUE((*restarted)->MergeRecorded(t, *record).ok());
+    }
+    EXPECT_TRUE((*live)->Complete());
+    EXPECT_TRUE((*restarted)->Complete());
+    const absl::StatusOr<Image> a = (*live)->SnapshotReader()();
+    const absl::StatusOr<Image> b = (*restarted)->SnapshotReader()();
+    ASSERT_TRUE(a.ok() && b.ok());
+    for (const char* c : {"R", "A.G", "B.B", "spp"}) {
+        EXPECT_EQ(*a->FindChannel(c), *b->FindChannel(c)) << c;
+    }
+}
+
+// 16x16 in 8x8 tiles, first pass 4 spp; tile (8, 8) is noisy (A 0.4, B 0.6), the others flat.
+std::unique_ptr<AdaptiveTileExecution> Adaptive(const AdaptiveSettings& settings) {
+    auto made =
+        AdaptiveTileExecution::Make(16, 16, 4, 8, settings, kMaxTaskSamples, MakeMemoryTileStore);
+    EXPECT_TRUE(made.ok()) << made.status();
+    return std::move(*made);
+}
+
+TileSums Halves(const RenderTask& task) {
+    const bool noisy = task.rect.x0 == 8 && task.rect.y0 == 8;
+    return Flat(task, noisy ? 0.4f : 0.5f, noisy ? 0.6f : 0.5f);
+}
+
+TEST(AdaptiveTileExecution, AppendsPassesForTheNoisyTileOnly) {
+    std::unique_ptr<AdaptiveTileExecution> e = Adaptive({.target_error = 0.1, .max_spp = 64});
+    std::vector<int> queue = e->Start();
+    EXPECT_EQ(queue, (std::vector<int>{0, 1, 2, 3}));
+    std::vector<uint64_t> ranks;
+    while (!queue.empty()) {
+        const int t = queue.front();
+        queue.erase(queue.begin());
+        ranks.push_back(e->QueueRank(t));
+        const TileSums sums = Halves(TaskOf(*e, t));
+        absl::StatusOr<JobExecution::Merged> merged = e->Merge(t, {.sums = &sums});
+        ASSERT_TRUE(merged.ok()) << merged.status();
+        for (int next : merged->appended) {
+            EXPECT_EQ(TaskOf(*e, next).rect.x0, 8);
+            queue.push_back(next);
+        }
+    }
+    EXPECT_EQ(ranks,
+              (std::vector<uint64_t>{0, 0, 0, 0, 4, 18}));  // a pass ranks by its first sample
+    EXPECT_TRUE(e->Complete());
+    EXPECT_EQ(e->tasks_total(), 6);
+    EXPECT_EQ(e->TileReport()->max_spp, 64u);
+    EXPECT_FALSE(e->EnforceTimeLimit(absl::InfinitePast(), absl::Now()).has_value());
+}
+
+TEST(AdaptiveTileExecution, TimeLimitDropsPassesOnce) {
+    std::unique_ptr<AdaptiveTileExecution> e = Adaptive({.time_limit = 5, .max_spp = 1 << 10});
+    EXPECT_EQ(e->time_limit(), absl::Seconds(5));
+    std::vector<int> second;
+    for (int t : e->Start()) {
+        const TileSums sums = Halves(TaskOf(*e, t));
+        absl::StatusOr<JobExecution::Merged> merged = e->Merge(t, {.sums = &sums});
+        ASSERT_TRUE(merged.ok());
+        second.insert(second.end(), merged->appended.begin(), merged->appended.end());
+    }
+    EXPECT_EQ(second.size(), 4u);
+    const absl::Time t0 = absl::FromUnixSeconds(1000);
+    EXPECT_FALSE(e->EnforceTimeLimit(t0, t0 + absl::Seconds(4)).has_value());
+    const std::optional<std::vector<int>> dropped = e->EnforceTimeLimit(t0, t0 + absl::Seconds(5));
+    ASSERT_TRUE(dropped.has_value());
+    EXPECT_EQ(*dropped, second);
+    EXPECT_FALSE(e->EnforceTimeLimit(t0, t0 + absl::Seconds(6)).has_value()) << "once";
+    EXPECT_EQ(e->tasks_total(), 4);
+    EXPECT_TRUE(e->Complete());
+    EXPECT_TRUE(e->TileReport()->timed_out);
+}
+
+TEST(FrameExecution, MergesCameraPartsAndSplatsAndRecordsBoth) {
+    FramePlanSettings plan;
+    plan.width = 8;
+    plan.height = 4;
+    plan.kind = FramePlanKind::kLightPaths;
+    plan.light_paths = 64;
+    plan.max_paths_per_task = 16;
+    auto made = FrameExecution::Make(plan, MakeMemoryTileStore);
+    ASSERT_TRUE(made.ok()) << made.status();
+    FrameExecution& e = **made;
+    ASSERT_EQ(e.Start().size(), 4u);
+    TaskAssignment lease;
+    e.Lease(1, "w", lease);
+    EXPECT_EQ(lease.path_begin, 16u);
+    EXPECT_EQ(lease.path_end, 32u);
+    TaskStatus status;
+    e.Describe(1, status);
+    EXPECT_EQ(status.kind, TaskKind::kFrame);
+    EXPECT_EQ(status.width, 8);  // a light-path task covers the frame
+    const TileSums camera{PixelRect{}};
+    EXPECT_EQ(e.Merge(0, {.sums = &camera}).status().code(), absl::StatusCode::kInvalidArgument);
+    for (int t = 0; t < 4; ++t) {
+        SplatList splats(8, 4);
+        ASSERT_TRUE(e.Merge(t, {.sums = &camera, .splats = &splats}).ok());
+        EXPECT_TRUE(e.RecordOf({.sums = &camera, .splats = &splats}).has_value());
+    }
+    EXPECT_TRUE(e.Complete());
+    EXPECT_TRUE(e.SnapshotReader()().ok());
+}
+
+// A system of one unknown and no power: the first sweep solves it.
+SweepChunkResult DarkChunk(int sweep) {
+    SweepChunkResult r;
+    r.sweep = sweep;
+    r.sides = 1;
+    r.change = {0};
+    r.power = {0};
+    r.input = {Rgb(0)};
+    r.output = {Rgb(0)};
+    return r;
+}
+
+TEST(SweepExecution, SolvesBeforeTheTilesAndHandsTheSolutionOn) {
+    RadiositySettings radiosity;
+    radiosity.sweep_tasks = 1;
+    auto made = SweepExecution::Make({16, 8, 4, 8, 1}, radiosity, MakeMemoryTileStore);
+    ASSERT_TRUE(made.ok()) << made.status();
+    SweepExecution& e = **made;
+    EXPECT_EQ(e.Start(), std::vector<int>{2});  // sweep 0's chunk, after the two tiles
+    EXPECT_EQ(e.task_count(), 3u);
+    EXPECT_EQ(e.tasks_total(), 2);
+    TaskAssignment lease;
+    e.Lease(2, "w", lease);
+    EXPECT_EQ(lease.sweep, 0);
+    EXPECT_EQ(e.PreferredWorker(2), "w");
+    EXPECT_EQ(e.TaskSamples(2), 0u);
+    const TileSums sums = Flat(TaskOf(e, 0), 0.5f, 0.5f);
+    EXPECT_EQ(e.Merge(2, {.sums = &sums}).status().code(), absl::StatusCode::kInvalidArgument);
+    const SweepChunkResult wrong = DarkChunk(1);
+    EXPECT_EQ(e.Merge(2, {.sweep = &wrong}).status().code(), absl::StatusCode::kInvalidArgument);
+    const SweepChunkResult chunk = DarkChunk(0);
+    EXPECT_EQ(e.Merge(0, {.sweep = &chunk}).status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_FALSE(e.RecordOf({.sweep = &chunk}).has_value()) << "soft state";
+    absl::StatusOr<JobExecution::Merged> merged = e.Merge(2, {.sweep = &chunk});
+    ASSERT_TRUE(merged.ok()) << merged.status();
+    ASSERT_TRUE(merged->sweep.has_value());
+    EXPECT_TRUE(merged->sweep->converged);
+    absl::StatusOr<std::vector<int>> tiles = e.Publish(true, "solution-hash");
+    ASSERT_TRUE(tiles.ok());
+    EXPECT_EQ(*tiles, (std::vector<int>{0, 1}));
+    e.Lease(0, "w", lease);
+    EXPECT_EQ(lease.radiosity_hash, "solution-hash");
+    std::set<std::string> blobs;
+    e.AddBlobsInUse(blobs);
+    EXPECT_EQ(blobs, std::set<std::string>{"solution-hash"});
+}
+
+TEST(MakeJobExecution, ChoosesTheKindFromTheSpec) {
+    JobSpec spec;
+    spec.plan = {16, 16, 4, 8, 1};
+    spec.method = "path";
+    auto kind = [&] {
+        absl::StatusOr<std::unique_ptr<JobExecution>> made =
+            MakeJobExecution(spec, MakeMemoryTileStore);
+        EXPECT_TRUE(made.ok()) << made.status();
+        const JobExecution& execution = **made;
+        return std::type_index(typeid(execution));
+    };
+    EXPECT_EQ(kind(), std::type_index(typeid(TileExecution)));
+    spec.adaptive.target_error = 0.1;
+    EXPECT_EQ(kind(), std::type_index(typeid(AdaptiveTileExecution)));
+    spec.adaptive.target_error = 0;
+    spec.method = "radiosity";
+    spec.radiosity.solver = "jacobi";
+    EXPECT_EQ(kind(), std::type_index(typeid(SweepExecution)));
+    spec.radiosity.solver = "shooting";
+    EXPECT_EQ(kind(), std::type_index(typeid(TileExecution)));
+    spec.method = "light";
+    EXPECT_EQ(kind(), std::type_index(typeid(FrameExecution)));
+    absl::StatusOr<std::unique_ptr<JobExecution>> light =
+        MakeJobExecution(spec, MakeMemoryTileStore);
+    ASSERT_TRUE(light.ok());
+    EXPECT_EQ((*light)->Publish(true, "x").status().code(), absl::StatusCode::kFailedPrecondition);
+}
+
+}  // namespace
+}  // namespace lf
