@@ -256,6 +256,41 @@ class Farm : public ::testing::Test {
         return false;
     }
 
+    // Kills `worker` while it holds a lease, so that its task must be leased again: stopped
+    // (SIGSTOP) at a moment when its log shows a task leased and not yet ended, then killed.
+    // Whatever the machine's load does to the spacing of its tasks, the kill is mid-task.
+    bool KillMidTask(Child* worker, const std::string& log) {
+        const auto count = [](const std::string& text, const std::string& what) {
+            int n = 0;
+            for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+                ++n;
+            return n;
+        };
+        const auto deadline = Clock::now() + milliseconds(20000);
+        while (Clock::now() < deadline) {
+            worker->Signal(SIGSTOP);
+            while (!IsStopped(worker->pid())) std::this_thread::sleep_for(milliseconds(1));
+            const std::string text = ReadText(dir_ / log);
+            const int ended = count(text, " rendered in ") + count(text, " failed after ") +
+                              count(text, " dropped: ") + count(text, " handed back: ");
+            if (count(text, " leased: ") > ended) {
+                worker->Signal(SIGKILL);
+                return true;
+            }
+            worker->Signal(SIGCONT);
+            std::this_thread::sleep_for(milliseconds(5));
+        }
+        return false;
+    }
+    // Not running, nor able to run: /proc/PID/stat is "PID (NAME) STATE ...", and STATE is T
+    // once a SIGSTOP took effect (Z or no file: it is gone).
+    static bool IsStopped(pid_t pid) {
+        const std::string stat = ReadText("/proc/" + std::to_string(pid) + "/stat");
+        const size_t paren = stat.rfind(')');
+        if (paren == std::string::npos || paren + 2 >= stat.size()) return true;
+        return std::string_view("RSD").find(stat[paren + 2]) == std::string_view::npos;
+    }
+
     // Polls the file at `path` until `text` shows up, for at most `timeout`.
     bool WaitForText(const fs::path& path, const std::string& text, milliseconds timeout) {
         const auto deadline = Clock::now() + timeout;
@@ -595,9 +630,7 @@ TEST_F(Farm, KilledWorkerDoesNotChangeTheImage) {
     Child* doomed = StartWorker("doomed");
     StartWorker("survivor");
     const std::string job = Submit(scene_, "--spp 512 --seed 9 --tile 32 --passes 2");
-    ASSERT_TRUE(WaitForStatus(job, "running", milliseconds(20000)));
-    std::this_thread::sleep_for(milliseconds(150));  // mid-task
-    doomed->Signal(SIGKILL);
+    ASSERT_TRUE(KillMidTask(doomed, "doomed.log"));
     ExpectSameAsLocal(job, scene_, 512, 9);
     // Its task went to the survivor: retried after the lease expired, or leased again
     // speculatively before that.
@@ -1413,14 +1446,9 @@ TEST_P(FarmFrame, KilledWorkerDoesNotChangeTheImage) {
     StartServer(/*lease_seconds=*/1);
     Child* doomed = StartWorker("doomed");
     StartWorker("survivor");
-    // ppm's tasks of 16 passes of 4096 photons took a tenth of a second: the kill at 150 ms
-    // could fall between two tasks and leave nothing to lease again.
-    const std::string split = Split(/*photons=*/65536);
-    const std::string job = Submit(scene_, Flags(256, 9, split));
-    ASSERT_TRUE(WaitForStatus(job, "running", milliseconds(20000)));
-    std::this_thread::sleep_for(milliseconds(150));  // mid-task
-    doomed->Signal(SIGKILL);
-    ExpectSameAsLocal(job, scene_, 256, 9, LocalFlags(split));
+    const std::string job = Submit(scene_, Flags(256, 9, Split()));
+    ASSERT_TRUE(KillMidTask(doomed, "doomed.log"));
+    ExpectSameAsLocal(job, scene_, 256, 9, LocalFlags(Split()));
     const TaskCounts c = Tasks(job);
     EXPECT_EQ(c.done, 16);
     EXPECT_GT(c.leased, c.total) << "no task was leased again";
