@@ -1,0 +1,116 @@
+// GltfImporter: one glTF file, as tinygltf parsed it, into the scene model. Its members are
+// defined by concept: gltf_nodes.cc (the node tree, cameras and lights), gltf_meshes.cc
+// (accessors and primitives) and gltf_materials.cc (materials, textures and images); AppendGltf
+// (gltf_scene.cc) loads the file and runs it. Private to core.
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/str_cat.h"
+#include "lf/core/affine.h"
+#include "lf/core/gltf_scene.h"
+#include "lf/core/scene.h"
+#include "lf/core/texture.h"
+
+namespace lf::gltf_internal {
+
+inline std::string Quoted(const std::string& name) {
+    return name.empty() ? std::string() : absl::StrCat(" \"", name, "\"");
+}
+
+// An error unwinds to AppendGltf as this, which adds the file name.
+struct GltfError {
+    std::string message;
+};
+
+[[noreturn]] inline void Fail(const std::string& where, const std::string& message) {
+    throw GltfError{absl::StrCat(where, ": ", message)};
+}
+
+// One accessor's elements, checked to lie inside their buffer view and buffer.
+struct AccessorData {
+    const unsigned char* data = nullptr;
+    size_t stride = 0, count = 0;
+    int components = 0, component_type = 0, component_size = 0;
+    bool normalized = false;
+};
+
+// Per-file state of one import.
+class GltfImporter {
+  public:
+    GltfImporter(const tinygltf::Model& model, const std::string& name, const GltfImport& options,
+                 Scene& scene, std::vector<GltfCamera>& cameras, std::vector<std::string>& warnings,
+                 const std::map<int, absl::StatusOr<std::shared_ptr<const TextureImage>>>& images,
+                 const std::map<std::string, absl::Status>& read_errors)
+        : model_(model),
+          name_(name),
+          options_(options),
+          scene_(scene),
+          cameras_(cameras),
+          warnings_(warnings),
+          images_(images),
+          read_errors_(read_errors) {}
+
+    // The default scene: its nodes' meshes, cameras and lights (gltf_nodes.cc).
+    void Import();
+
+  private:
+    void Warn(const std::string& message) { warnings_.push_back(message); }
+
+    void CheckExtensions();
+    void VisitNode(int index, const Affine& parent, const std::string& ref);
+    void AddCamera(const tinygltf::Node& node, const Affine& world, const std::string& where);
+    void AddLight(const tinygltf::Value& light_index, const Affine& world,
+                  const std::string& where);
+
+    // Meshes (gltf_meshes.cc).
+    AccessorData Accessor(int index, const std::string& where);
+    // An attribute's elements as floats, `components` per element: FLOAT, or the normalized
+    // integer types glTF allows for texture coordinates and colours.
+    std::vector<float> Floats(int index, int components, const std::string& where);
+    std::vector<uint32_t> Indices(int index, size_t vertices, const std::string& where);
+    void AddMesh(int index, const Affine& world, const std::string& node_where);
+
+    // Materials, textures and images (gltf_materials.cc).
+    // The scene material for glTF material `index` (-1: glTF's default material).
+    int Material(int index, const std::string& where);
+    // glTF's default: white, fully metallic and rough, opaque, single-sided.
+    lf::Material DefaultMaterial() const;
+    static double Number(const tinygltf::Value& object, const char* key, double fallback, double lo,
+                         double hi, const std::string& where);
+    static std::vector<double> Numbers(const tinygltf::Value& object, const char* key,
+                                       std::vector<double> fallback, const std::string& where);
+    static Rgb Color(const std::vector<double>& v, const std::string& where, const char* key);
+    static const tinygltf::Value* Extension(const tinygltf::ExtensionMap& map, const char* key);
+    lf::Material ConvertMaterial(int index);
+    // The TextureRef of a material's texture slot; `srgb` for colour textures.
+    TextureRef Texture(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
+                       bool srgb, const std::string& where);
+    static TextureRef::Wrap Wrap(int mode, const std::string& where);
+    // The Scene::textures index of glTF image `index`, decoded once however many textures
+    // use it.
+    int Image(int index);
+
+    const tinygltf::Model& model_;
+    const std::string& name_;
+    const GltfImport& options_;
+    Scene& scene_;
+    std::vector<GltfCamera>& cameras_;
+    std::vector<std::string>& warnings_;
+    const std::map<int, absl::StatusOr<std::shared_ptr<const TextureImage>>>& images_;
+    const std::map<std::string, absl::Status>& read_errors_;
+    std::vector<bool> visited_;
+    std::map<int, int> material_of_, texture_of_;
+    bool range_ignored_ = false;
+};
+
+}  // namespace lf::gltf_internal

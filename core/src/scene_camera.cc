@@ -1,0 +1,71 @@
+#include <optional>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "lf/core/pixel_filter.h"
+#include "scene_parser.h"
+
+namespace lf::scene_internal {
+
+CameraSpec SceneParser::ParseCamera(const Node& n) {
+    n.ExpectObject({"position", "look_at", "up", "fov_y_deg", "resolution", "aperture_radius",
+                    "focus_distance", "filter"});
+    CameraSpec camera;
+    camera.position = n.Get("position").Vector();
+    const Node look_at = n.Get("look_at");
+    camera.look_at = look_at.Vector();
+    const Vec3d view = camera.look_at - camera.position;
+    if (LengthSquared(view) == 0) look_at.Fail("equals camera.position");
+    if (const std::optional<Node> up = n.Find("up")) {
+        camera.up = up->Vector();
+        if (LengthSquared(camera.up) == 0 ||
+            Length(Cross(Normalize(view), Normalize(camera.up))) < 1e-6) {
+            up->Fail("is zero or parallel to the view direction");
+        }
+    } else if (Length(Cross(Normalize(view), camera.up)) < 1e-6) {
+        n.Fail("the default up [0, 1, 0] is parallel to the view direction; give `up`");
+    }
+    const Node fov = n.Get("fov_y_deg");
+    camera.fov_y_deg = fov.Number();
+    if (!(camera.fov_y_deg > 0 && camera.fov_y_deg < 180)) {
+        fov.Fail(absl::StrCat("must be in (0, 180) degrees, got ", camera.fov_y_deg));
+    }
+    const Node resolution = n.Get("resolution");
+    const std::vector<Node> size = resolution.Elements(2);
+    camera.width = size[0].Integer(1, kMaxResolution);
+    camera.height = size[1].Integer(1, kMaxResolution);
+    if (int64_t(camera.width) * camera.height > kMaxPixels) {
+        resolution.Fail(
+            absl::StrCat(camera.width, " x ", camera.height, " is more than 2^28 pixels"));
+    }
+    if (const std::optional<Node> aperture = n.Find("aperture_radius")) {
+        camera.aperture_radius = aperture->NumberIn(0, kMaxCoordinate, "≥ 0 (scene units)");
+    }
+    // By default the camera focuses on what it looks at.
+    camera.focus_distance = Length(view);
+    if (const std::optional<Node> focus = n.Find("focus_distance")) {
+        camera.focus_distance = focus->NumberIn(0, kMaxCoordinate, "above 0 (scene units)");
+        if (camera.focus_distance == 0) focus->Fail("must be above 0 (scene units)");
+    }
+    if (const std::optional<Node> filter = n.Find("filter")) camera.filter = ParseFilter(*filter);
+    return camera;
+}
+
+PixelFilter SceneParser::ParseFilter(const Node& n) {
+    n.ExpectObject({"type", "width"});
+    const Node type = n.Get("type");
+    const std::optional<PixelFilter::Type> found = PixelFilterTypeFromName(type.String());
+    if (!found) {
+        type.Fail(absl::StrCat("unknown filter type \"", type.String(),
+                               "\"; expected box, gaussian or blackman-harris"));
+    }
+    PixelFilter filter{*found, *found == PixelFilter::Type::kBox ? 1.0 : 3.0};
+    const std::optional<Node> width = n.Find("width");
+    if (width) filter.width = width->Number();
+    if (const absl::Status status = CheckPixelFilter(filter); !status.ok()) {
+        (width ? *width : n).Fail(std::string(status.message()));
+    }
+    return filter;
+}
+
+}  // namespace lf::scene_internal
