@@ -8,6 +8,7 @@
 #include <map>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/cancel.h"
 
 namespace lf {
 
@@ -220,9 +221,7 @@ absl::Status RadiosityRefusal(const Scene& scene) {
 }
 
 absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOptions& options) {
-    auto cancelled = [&] {
-        return options.cancel && options.cancel->load(std::memory_order_relaxed);
-    };
+    auto cancelled = [&] { return CancelRequested(options.cancel); };
     if (absl::Status refused = RadiosityRefusal(scene); !refused.ok()) return refused;
     if (!(options.patch_size >= 0) || (options.patch_size == 0 && options.patches <= 0)) {
         return absl::InvalidArgumentError(

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "lf/core/cancel.h"
 #include "lf/core/log.h"
 
 namespace lf {
@@ -580,9 +581,7 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
     std::vector<std::pair<int32_t, int32_t>> tasks;
     std::vector<bool> evaluated(groups.size() * groups.size(), false);
     int64_t total_work = 0;
-    auto cancelled = [&] {
-        return options.cancel && options.cancel->load(std::memory_order_relaxed);
-    };
+    auto cancelled = [&] { return CancelRequested(options.cancel); };
     for (int32_t i = 0; i < int32_t(groups.size()) && !cancelled(); ++i) {
         for (int32_t j = i; j < int32_t(groups.size()); ++j) {
             if (!wanted(i) && !wanted(j)) continue;

@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "lf/core/cancel.h"
 #include "lf/core/log.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/kernels/form_factors.h"
@@ -46,7 +47,6 @@ absl::Status CheckReflectance(const Scene& scene) {
     return absl::OkStatus();
 }
 
-bool IsCancelled(const std::atomic<bool>* cancel) { return cancel && cancel->load(); }
 absl::Status FormFactorsCancelled() {
     return absl::CancelledError("radiosity: form factors cancelled");
 }
@@ -62,7 +62,7 @@ absl::StatusOr<FormFactors> FormFactorsOf(const EmbreeScene& scene, const PatchM
     options.previous = previous;
     options.cancel = cancel;
     FormFactors form_factors = ComputeFormFactors(scene, mesh, options);
-    if (IsCancelled(cancel)) return FormFactorsCancelled();
+    if (CancelRequested(cancel)) return FormFactorsCancelled();
     const double seconds = SecondsSince(start);
     const FormFactorWork& work = form_factors.work();
     report.form_factor_seconds += seconds;
@@ -288,7 +288,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     ff_options.chunks = chunks;
     ff_options.cancel = cancel;
     out->form_factors_ = ComputeFormFactors(scene, *mesh, ff_options);
-    if (IsCancelled(cancel)) return FormFactorsCancelled();
+    if (CancelRequested(cancel)) return FormFactorsCancelled();
     out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
     out->system_ = MakeRadiositySystem(scene, *mesh, out->form_factors_);
     return out;

@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "lf/core/cancel.h"
 #include "lf/core/log.h"
 
 namespace lf {
@@ -75,10 +76,6 @@ class SolveLog {
         std::chrono::steady_clock::now() + std::chrono::seconds(5);
 };
 
-bool IsCancelled(const std::atomic<bool>* cancel) {
-    return cancel && cancel->load(std::memory_order_relaxed);
-}
-
 absl::Status SolveCancelled() { return absl::CancelledError("radiosity: solve cancelled"); }
 
 // b_next = E + ρ F b for every group at once, and the sweep's residual sums. Once `cancel` is
@@ -88,7 +85,7 @@ GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, st
     const auto& groups = system.form_factors->groups();
     std::vector<GroupSweep> parts(groups.size());
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
-        if (IsCancelled(cancel)) return;
+        if (CancelRequested(cancel)) return;
         const PatchGroup& group = groups[g];
         parts[g] = JacobiGroup(system, int32_t(g), b,
                                next.subspan(size_t(group.begin), size_t(group.size())));
@@ -108,7 +105,7 @@ absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
     SolveLog log;
     for (;;) {
         const GroupSweep sweep = JacobiSweep(system, b, next, options.cancel);
-        if (IsCancelled(options.cancel)) return SolveCancelled();
+        if (CancelRequested(options.cancel)) return SolveCancelled();
         const double residual = sweep.change / sweep.power;
         ++result.iterations;
         if (residual <= options.tolerance) {
@@ -137,7 +134,7 @@ absl::StatusOr<SolveResult> SolveGaussSeidel(const RadiositySystem& system,
     for (;;) {
         double change = 0;
         for (size_t g = 0; g < groups.size(); ++g) {
-            if (IsCancelled(options.cancel)) return SolveCancelled();
+            if (CancelRequested(options.cancel)) return SolveCancelled();
             const PatchGroup& group = groups[g];
             updated.resize(size_t(group.size()));
             GatherGroup(system, int32_t(g), b, updated);
@@ -173,7 +170,7 @@ absl::StatusOr<SolveResult> SolveShooting(const RadiositySystem& system,
     SolveResult result;
     int exact_checks = 0;
     for (;;) {
-        if (IsCancelled(options.cancel)) return SolveCancelled();
+        if (CancelRequested(options.cancel)) return SolveCancelled();
         if (shooter.residual() <= options.tolerance) {
             result.radiosity = shooter.Radiosity();
             result.residual = RelativeResidual(system, result.radiosity);

@@ -1,13 +1,20 @@
-// A worker stops a radiosity task within a second of a cancel (or SIGTERM) in every phase:
-// meshing, form factors and the solve each return Cancelled soon after the flag is set from
-// another thread. Each call here would run for many seconds, or without end, if it ignored it.
+// A worker stops a radiosity task soon after a cancel (or SIGTERM) in every phase: meshing, form
+// factors and the solve each return Cancelled once the flag is set from another thread. "Soon" is
+// counted in units of work (polls of the flag, pairs of patches), not seconds: the flag is set
+// at a given poll, so it falls mid-phase however loaded the machine is. Each call here would run
+// for many seconds, or without end, if it ignored it.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <atomic>
 #include <chrono>
 #include <climits>
+#include <cstdio>
+#include <cstdlib>
+#include <future>
 #include <thread>
 
+#include "lf/core/cancel.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/radiosity.h"
@@ -16,24 +23,41 @@
 namespace lf {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+// Counts the polls of cancel flags while it lives and sets `cancel` at poll number `at`.
+class CancelAtPoll {
+  public:
+    CancelAtPoll(std::atomic<bool>& cancel, int64_t at) : at_(at) {
+        SetCancelPollObserverForTesting([this, &cancel] {
+            if (++polls_ == at_) cancel = true;
+        });
+    }
+    ~CancelAtPoll() { SetCancelPollObserverForTesting(nullptr); }
 
-// Runs `call`, sets `cancel` from another thread once it has been running a little while (the
-// delay only puts the cancel in the middle of the phase), and returns the call's status and the
-// seconds from the cancel to the call's return.
+    bool reached() const { return polls_ >= at_; }
+    int64_t polls_after() const { return polls_ - at_; }  // those after the one that set it
+
+  private:
+    const int64_t at_;
+    std::atomic<int64_t> polls_{0};
+};
+
+// Runs `call` on one thread of a TBB arena of its own (so polls come in a fixed order) and
+// returns its result. A call that ignored the cancel would run for minutes or without end: past
+// a deadline far above the milliseconds a cancelled call takes, the test fails instead of hanging.
 template <typename Call>
-std::pair<absl::Status, double> CancelDuring(std::atomic<bool>& cancel, Call call) {
-    std::atomic<int64_t> cancelled_at{0};
-    std::thread canceller([&] {
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        cancelled_at = Clock::now().time_since_epoch().count();
-        cancel = true;
+auto OnOneThread(Call call) -> decltype(call()) {
+    std::packaged_task<decltype(call())()> task([&] {
+        tbb::task_arena arena(1);
+        return arena.execute(call);
     });
-    const absl::Status status = call();
-    const Clock::time_point returned = Clock::now();
-    canceller.join();
-    const Clock::time_point set{Clock::duration(cancelled_at.load())};
-    return {status, std::chrono::duration<double>(returned - set).count()};
+    auto result = task.get_future();
+    std::thread thread(std::move(task));
+    if (result.wait_for(std::chrono::seconds(120)) == std::future_status::timeout) {
+        std::fprintf(stderr, "still running two minutes after the cancel: it was ignored\n");
+        std::abort();
+    }
+    thread.join();
+    return result.get();
 }
 
 class RadiosityCancelTest : public ::testing::Test {
@@ -50,33 +74,62 @@ class RadiosityCancelTest : public ::testing::Test {
     std::unique_ptr<EmbreeScene> embree_;
 };
 
-TEST_F(RadiosityCancelTest, MeshingReturnsCancelledWithinASecond) {
+// Meshing polls once per row of a triangle's grid (a thousand rows are a few triangles' worth
+// of the 34k rows here) and returns at the poll that sees the flag.
+TEST_F(RadiosityCancelTest, MeshingReturnsCancelledAtThePollThatSeesTheCancel) {
     std::atomic<bool> cancel{false};
     PatchMeshOptions options;
     options.patches = int64_t(1) << 24;  // the most a job may ask: seconds of meshing
     options.cancel = &cancel;
-    const auto [status, seconds] =
-        CancelDuring(cancel, [&] { return PatchMesh::Build(*scene_, options).status(); });
+    const CancelAtPoll cancel_at(cancel, 1000);
+    const absl::Status status =
+        OnOneThread([&] { return PatchMesh::Build(*scene_, options).status(); });
     EXPECT_TRUE(absl::IsCancelled(status)) << status;
-    EXPECT_LT(seconds, 1.0);
-    std::printf("meshing: returned %.3f s after the cancel\n", seconds);
+    EXPECT_TRUE(cancel_at.reached());
+    EXPECT_EQ(cancel_at.polls_after(), 0);
 }
 
-TEST_F(RadiosityCancelTest, FormFactorsReturnCancelledWithinASecond) {
+// Form factors poll before each row of a block of two patch groups: each poll before the cancel
+// lets at most one row of pairs through (a group's size), none after it.
+TEST_F(RadiosityCancelTest, FormFactorsStopWithinARowOfTheCancel) {
+    absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(*scene_, {0, 12000});
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    std::atomic<bool> cancel{false};
+    FormFactorOptions options;
+    options.cancel = &cancel;
+    constexpr int64_t kCancelAt = 5000;
+    const CancelAtPoll cancel_at(cancel, kCancelAt);
+    // All the pairs: half a minute of one core.
+    const FormFactors form_factors =
+        OnOneThread([&] { return ComputeFormFactors(*embree_, *mesh, options); });
+    EXPECT_TRUE(cancel_at.reached());
+    EXPECT_GT(form_factors.work().pairs, 0);
+    EXPECT_LE(form_factors.work().pairs, kCancelAt * options.group_size);
+    std::printf("form factors: %lld pairs evaluated, %lld polls after the cancel\n",
+                static_cast<long long>(form_factors.work().pairs),
+                static_cast<long long>(cancel_at.polls_after()));
+}
+
+// PrepareRadiosity meshes (under a thousand polls for 12k patches), then computes the form
+// factors (over a million polls): the cancel at poll 20k ends it there, with the phase named.
+TEST_F(RadiosityCancelTest, PrepareReturnsCancelledDuringTheFormFactors) {
     std::atomic<bool> cancel{false};
     RadiosityOptions options;
     options.patches = 12000;  // form factors: half a minute of one core
     options.threads = 1;
     options.cancel = &cancel;
-    const auto [status, seconds] =
-        CancelDuring(cancel, [&] { return PrepareRadiosity(*embree_, options).status(); });
+    const CancelAtPoll cancel_at(cancel, 20000);
+    const absl::Status status =
+        OnOneThread([&] { return PrepareRadiosity(*embree_, options).status(); });
     EXPECT_TRUE(absl::IsCancelled(status)) << status;
     EXPECT_NE(status.message().find("form factors"), std::string_view::npos) << status;
-    EXPECT_LT(seconds, 1.0);
-    std::printf("form factors: returned %.3f s after the cancel\n", seconds);
+    EXPECT_TRUE(cancel_at.reached());
 }
 
-TEST_F(RadiosityCancelTest, SolveReturnsCancelledWithinASecondForEverySolver) {
+// The solvers poll before each patch group's gather (Jacobi: also once after each sweep; shooting:
+// before each shot). Gauss-Seidel and shooting return at the poll that sees the flag; Jacobi's
+// sweep skips its remaining groups, one poll each, and returns before the next sweep.
+TEST_F(RadiosityCancelTest, SolveReturnsCancelledMidSweepForEverySolver) {
     // A closed furnace whose walls reflect nearly all light: each sweep shrinks the error by
     // about 1 - 1e-6, so no solve reaches a fixed point for many minutes.
     const Scene furnace = testing::MakeFurnace(1.0, Vec3d(0, 0, 0), 0.999999f, 1.0f, 4);
@@ -86,29 +139,33 @@ TEST_F(RadiosityCancelTest, SolveReturnsCancelledWithinASecondForEverySolver) {
     ASSERT_TRUE(mesh.ok()) << mesh.status();
     const FormFactors form_factors = ComputeFormFactors(**embree, *mesh);
     const RadiositySystem system = MakeRadiositySystem(**embree, *mesh, form_factors);
+    const int64_t groups = int64_t(form_factors.groups().size());
     for (RadiositySolver solver :
          {RadiositySolver::kJacobi, RadiositySolver::kGaussSeidel, RadiositySolver::kShooting}) {
         std::atomic<bool> cancel{false};
         // A tolerance no solve reaches and no iteration limit: it ends only when cancelled.
         const SolveOptions options{solver, 1e-300, INT_MAX, &cancel};
-        const auto [status, seconds] =
-            CancelDuring(cancel, [&] { return SolveRadiosity(system, options).status(); });
+        // Ten sweeps (or shots) and half of the eleventh in.
+        const CancelAtPoll cancel_at(cancel, 10 * (groups + 1) + groups / 2);
+        const absl::Status status =
+            OnOneThread([&] { return SolveRadiosity(system, options).status(); });
         EXPECT_TRUE(absl::IsCancelled(status)) << RadiositySolverName(solver) << ": " << status;
-        EXPECT_LT(seconds, 1.0) << RadiositySolverName(solver);
-        std::printf("%s solve: returned %.3f s after the cancel\n", RadiositySolverName(solver),
-                    seconds);
+        EXPECT_TRUE(cancel_at.reached()) << RadiositySolverName(solver);
+        EXPECT_LE(cancel_at.polls_after(), solver == RadiositySolver::kJacobi ? groups : 0)
+            << RadiositySolverName(solver);
     }
 }
 
-TEST_F(RadiosityCancelTest, SweepChunkFormFactorsReturnCancelledWithinASecond) {
+TEST_F(RadiosityCancelTest, SweepChunkReturnsCancelledDuringTheFormFactors) {
     std::atomic<bool> cancel{false};
     RadiosityOptions options;
     options.patches = 12000;
-    const auto [status, seconds] = CancelDuring(cancel, [&] {
-        return RadiositySweepChunk::Build(*embree_, options, 0, 1, &cancel).status();
-    });
+    const CancelAtPoll cancel_at(cancel, 20000);
+    const absl::Status status = OnOneThread(
+        [&] { return RadiositySweepChunk::Build(*embree_, options, 0, 1, &cancel).status(); });
     EXPECT_TRUE(absl::IsCancelled(status)) << status;
-    EXPECT_LT(seconds, 1.0);
+    EXPECT_NE(status.message().find("form factors"), std::string_view::npos) << status;
+    EXPECT_TRUE(cancel_at.reached());
 }
 
 }  // namespace
