@@ -367,17 +367,25 @@ TEST_F(Farm, EveryMethodGivesTheBitsRecordedBeforeTheRefactor) {
     const std::string cornell = WriteScene("cornell32.json", 32);
     struct Case {
         std::string scene, flags, digest;
+        std::string farm_flags = "";  // submit's own (render has no --sweep-tasks)
     };
     const std::vector<Case> cases = {
         {cornell, "--method path --spp 8 --seed 3 --tile 16 --passes 2 --aov all --filter gaussian",
-         ""},
-        {cornell, "--method path --spp 4 --target-error 0.2 --max-spp 64 --tile 16", ""},
-        {cornell, "--method radiosity --patches 200 --spp 2 --tile 16 --sweep-tasks 3", ""},
-        {cornell, "--method radiosity --patches 200 --solver shooting --spp 2 --tile 16", ""},
-        {cornell, "--method whitted --spp 4 --tile 16", ""},
-        {cornell, "--method light --spp 4 --passes 2", ""},
-        {caustic, "--method bdpt --spp 4 --resolution 32x32 --tile 16", ""},
-        {caustic, "--method ppm --spp 4 --photons 20000 --resolution 32x32", ""},
+         "0cdd35f91da8a27b258bd27f320112c6cde01520e18d7a43763b1c7d2ba836f7"},
+        {cornell, "--method path --spp 4 --target-error 0.2 --max-spp 64 --tile 16",
+         "1b9f5e1b58b6ca8fb0058cc8464fbd8bd8fb4969553aee6c8fa8de9965eb2ca2"},
+        {cornell, "--method radiosity --patches 200 --spp 2 --tile 16",
+         "4c89fda9ae2faf5b29c6e5cf2bfbb432c5fb6bdd8d449cd3ead069095a82f192", "--sweep-tasks 3"},
+        {cornell, "--method radiosity --patches 200 --solver shooting --spp 2 --tile 16",
+         "0453d09587479dcc7b242cc640d5b6cee89d83a69e6df9b8c73b4b95035ae229"},
+        {cornell, "--method whitted --spp 4 --tile 16",
+         "8d41ca72c8071fd1c54bca65274083aefa9959b5adb9237a4eac54cc4d4afe61"},
+        {cornell, "--method light --spp 4 --passes 2",
+         "446d97a036ea50cb0979b5a1195c5ab13fb128cd5e19edebe300c6dbb8d1345a"},
+        {caustic, "--method bdpt --spp 4 --resolution 32x32 --tile 16",
+         "4392aa62079d150fabf9a50bbed203aa068a876ca3229ba2435cbdf5cfec22e9"},
+        {caustic, "--method ppm --spp 4 --photons 20000 --resolution 32x32",
+         "7573e4c9d81a7750f1c8b2e1f6e4265ac3c6491999c79fdfbd5ee320b39b697f"},
     };
     const bool print = std::getenv("LF_PRINT_DIGESTS") != nullptr;
     StartServer();
@@ -390,7 +398,7 @@ TEST_F(Farm, EveryMethodGivesTheBitsRecordedBeforeTheRefactor) {
         const CliRun r =
             Lightfarm("render " + c.scene + " -o " + local + " " + c.flags + " --no-progress");
         ASSERT_EQ(r.status, 0) << c.flags << r.out << r.err;
-        const std::string job = Submit(c.scene, c.flags);
+        const std::string job = Submit(c.scene, c.flags + " " + c.farm_flags);
         ASSERT_EQ(Farmctl("watch " + job, 120).status, 0) << c.flags;
         ASSERT_EQ(Farmctl("fetch " + job + " -o " + farm).status, 0) << c.flags;
         absl::StatusOr<ExrFile> a = ReadExr(local), b = ReadExr(farm);
