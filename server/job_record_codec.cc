@@ -1,234 +1,38 @@
 #include "server/job_record_codec.h"
 
-#include <nlohmann/json.hpp>
+#include <google/protobuf/util/json_util.h>
 
 #include "absl/strings/str_cat.h"
-#include "lf/core/pixel_filter.h"
+#include "lf/wire/stored_job.h"
 
 namespace lf {
 
-namespace {
-
-using nlohmann::json;
-
-// Times as Unix microseconds; absl::InfinitePast (not yet) as null.
-json TimeToJson(absl::Time t) {
-    return t == absl::InfinitePast() ? json(nullptr) : json(absl::ToUnixMicros(t));
-}
-absl::Time TimeFromJson(const json& j) {
-    return j.is_null() ? absl::InfinitePast() : absl::FromUnixMicros(j.get<int64_t>());
-}
-
-json BlobToJson(const BlobRef& b) { return {{"path", b.path}, {"hash", b.hash}, {"size", b.size}}; }
-BlobRef BlobFromJson(const json& j) {
-    return {j.at("path").get<std::string>(), j.at("hash").get<std::string>(),
-            j.at("size").get<uint64_t>()};
-}
-
-// `--filter` as {"type": name, "width": pixels}, or null for the scene's own.
-json FilterToJson(const std::optional<PixelFilter>& f) {
-    if (!f) return nullptr;
-    return {{"type", PixelFilterTypeName(f->type)}, {"width", f->width}};
-}
-absl::StatusOr<std::optional<PixelFilter>> FilterFromJson(const json& j) {
-    if (j.is_null()) return std::nullopt;
-    const std::string name = j.at("type").get<std::string>();
-    const std::optional<PixelFilter::Type> type = PixelFilterTypeFromName(name);
-    if (!type) {
-        return absl::DataLossError(
-            absl::StrCat("the stored record's filter \"", name, "\" is not a pixel filter"));
-    }
-    return PixelFilter{*type, j.at("width").get<double>()};
-}
-
-// A name; or, in records written before states were stored by name, the enum's position then.
-absl::StatusOr<JobState> StateFromJson(const json& j) {
-    if (j.is_string()) return JobStateFromName(j.get<std::string>());
-    const int legacy = j.get<int>();
-    if (legacy < int(JobState::kQueued) || legacy > int(JobState::kCancelled)) {
-        return absl::InvalidArgumentError(absl::StrCat("unknown job state ", legacy));
-    }
-    return JobState(legacy);
-}
-
-}  // namespace
-
-absl::StatusOr<JobState> JobStateFromName(std::string_view name) {
-    for (JobState s : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
-                       JobState::kFailed, JobState::kCancelled}) {
-        if (name == JobStateName(s)) return s;
-    }
-    return absl::InvalidArgumentError(
-        absl::StrCat("unknown job state \"", std::string(name),
-                     "\": expected queued, running, succeeded, failed or cancelled"));
-}
-
-std::string EncodeJobRecord(const JobRecord& r) {
-    json files = json::array();
-    for (const BlobRef& f : r.spec.files) files.push_back(BlobToJson(f));
-    const JobSpec& s = r.spec;
-    return json{
-        {"id", r.id},
-        {"seq", r.seq},
-        {"spec",
-         {{"name", s.name},
-          {"scene", BlobToJson(s.scene)},
-          {"files", files},
-          {"width", s.plan.width},
-          {"height", s.plan.height},
-          {"spp", s.plan.spp},
-          {"tile", s.plan.tile},
-          {"passes", s.plan.passes},
-          {"seed", s.seed},
-          {"max_depth", s.max_depth},
-          {"method", s.method},
-          {"radiosity",
-           {{"patches", s.radiosity.patches},
-            {"patch_size", s.radiosity.patch_size},
-            {"solver", s.radiosity.solver},
-            {"tolerance", s.radiosity.tolerance},
-            {"max_iterations", s.radiosity.max_iterations},
-            {"display", s.radiosity.display},
-            {"sweep_tasks", s.radiosity.sweep_tasks},
-            {"max_patches", s.radiosity.max_patches}}},
-          {"adaptive",
-           {{"target_error", s.adaptive.target_error},
-            {"time_limit", s.adaptive.time_limit},
-            {"max_spp", s.adaptive.max_spp}}},
-          {"camera", s.scene_options.camera},
-          {"resolution", {s.scene_options.width, s.scene_options.height}},
-          {"filter", FilterToJson(s.scene_options.filter)},
-          {"clamp", s.clamp},
-          {"aovs", s.aovs},
-          {"sampler", SamplerTypeName(s.sampler)},
-          {"light_strategy", LightStrategyName(s.light_strategy)},
-          {"ppm",
-           {{"photons_per_pass", s.ppm.photons_per_pass},
-            {"initial_radius", s.ppm.initial_radius},
-            {"alpha", s.ppm.alpha}}},
-          {"priority", s.priority},
-          {"scene_hash", s.scene_hash},
-          {"request_id", s.request_id},
-          {"owner", s.owner}}},
-        {"state", JobStateName(r.state)},
-        {"error", r.error},
-        {"last_error", r.last_error},
-        {"submitted", TimeToJson(r.submitted)},
-        {"started", TimeToJson(r.started)},
-        {"finished", TimeToJson(r.finished)},
-        {"tasks_total", r.tasks_total},
-        {"tasks_done", r.tasks_done},
-        {"tasks_running", r.tasks_running},
-        {"retries", r.retries},
-        {"tasks_leased", r.tasks_leased},
-        {"samples", r.stats.samples},
-        {"rays", r.stats.rays},
-        {"invalid_samples", r.stats.invalid_samples},
-        {"result_path", r.result_path},
-    }
-        .dump();
+std::string EncodeJobRecord(const JobRecord& record) {
+    lightfarm::v1::StoredJob stored;
+    ToProto(record, &stored);
+    google::protobuf::util::JsonPrintOptions options;
+    // Every field, also those at their zero value, by the names the store's queries use.
+    options.always_print_primitive_fields = true;
+    options.preserve_proto_field_names = true;
+    std::string text;
+    // Printing a message without Any fields cannot fail.
+    (void)google::protobuf::util::MessageToJsonString(stored, &text, options);
+    return text;
 }
 
 absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {
-    try {
-        const json j = json::parse(text);
-        JobRecord r;
-        r.id = j.at("id").get<std::string>();
-        r.seq = j.at("seq").get<uint64_t>();
-        const json& s = j.at("spec");
-        r.spec.name = s.at("name").get<std::string>();
-        r.spec.scene = BlobFromJson(s.at("scene"));
-        for (const json& f : s.at("files")) r.spec.files.push_back(BlobFromJson(f));
-        r.spec.plan.width = s.at("width").get<int>();
-        r.spec.plan.height = s.at("height").get<int>();
-        r.spec.plan.spp = s.at("spp").get<uint64_t>();
-        r.spec.plan.tile = s.at("tile").get<int>();
-        r.spec.plan.passes = s.at("passes").get<int>();
-        r.spec.seed = s.at("seed").get<uint64_t>();
-        r.spec.max_depth = s.at("max_depth").get<int>();
-        r.spec.method = s.value("method", "path");
-        if (s.contains("radiosity")) {
-            const auto& rad = s.at("radiosity");
-            r.spec.radiosity = {rad.at("patches").get<int64_t>(),
-                                rad.at("patch_size").get<double>(),
-                                rad.at("solver").get<std::string>(),
-                                rad.at("tolerance").get<double>(),
-                                rad.at("max_iterations").get<int>(),
-                                rad.at("display").get<std::string>(),
-                                rad.value("sweep_tasks", RadiositySettings().sweep_tasks),
-                                rad.value("max_patches", int64_t(0))};
-        }
-        if (s.contains("adaptive")) {
-            const auto& a = s.at("adaptive");
-            r.spec.adaptive = {a.at("target_error").get<double>(), a.at("time_limit").get<double>(),
-                               a.at("max_spp").get<uint64_t>()};
-        }
-        // Records before --camera and --resolution have neither: the scene's own view.
-        r.spec.scene_options.camera = s.value("camera", std::string());
-        if (s.contains("resolution")) {
-            r.spec.scene_options.width = s.at("resolution").at(0).get<int>();
-            r.spec.scene_options.height = s.at("resolution").at(1).get<int>();
-        }
-        // Records before --filter, --clamp and --aov have none of them: off.
-        if (s.contains("filter")) {
-            absl::StatusOr<std::optional<PixelFilter>> filter = FilterFromJson(s.at("filter"));
-            if (!filter.ok()) return filter.status();
-            r.spec.scene_options.filter = *filter;
-        }
-        // Records before --method ppm have no photon settings: the defaults.
-        if (s.contains("ppm")) {
-            const auto& p = s.at("ppm");
-            r.spec.ppm = {p.at("photons_per_pass").get<uint64_t>(),
-                          p.at("initial_radius").get<double>(), p.at("alpha").get<double>()};
-        }
-        r.spec.clamp = s.value("clamp", 0.0);
-        r.spec.aovs = s.value("aovs", uint32_t(0));
-        // Records before --sampler were rendered with independent numbers; a job resumed from
-        // one must keep them, or its remaining tiles would not match those already merged.
-        const std::string sampler = s.value("sampler", "independent");
-        if (const std::optional<SamplerType> type = SamplerTypeFromName(sampler)) {
-            r.spec.sampler = *type;
-        } else {
-            return absl::DataLossError(
-                absl::StrCat("the stored record's sampler \"", sampler, "\" is not a sampler"));
-        }
-        // Records before --light-sampling were rendered picking lights by power; resumed, they must
-        // keep it, or their remaining tiles would not match those already merged.
-        const std::string light = s.value("light_strategy", "power");
-        if (const std::optional<LightStrategy> strategy = LightStrategyFromName(light)) {
-            r.spec.light_strategy = *strategy;
-        } else {
-            return absl::DataLossError(absl::StrCat("the stored record's light_strategy \"", light,
-                                                    "\" is not power or bvh"));
-        }
-        r.spec.priority = s.at("priority").get<int>();
-        r.spec.scene_hash = s.at("scene_hash").get<std::string>();
-        r.spec.request_id = s.value("request_id", "");
-        r.spec.owner = s.value("owner", "");
-        if (absl::StatusOr<JobState> state = StateFromJson(j.at("state")); state.ok()) {
-            r.state = *state;
-        } else {
-            return absl::DataLossError(
-                absl::StrCat("the stored record's state: ", state.status().message()));
-        }
-        r.error = j.at("error").get<std::string>();
-        r.last_error = j.value("last_error", std::string());  // records before it had none
-        r.submitted = TimeFromJson(j.at("submitted"));
-        r.started = TimeFromJson(j.at("started"));
-        r.finished = TimeFromJson(j.at("finished"));
-        r.tasks_total = j.at("tasks_total").get<int>();
-        r.tasks_done = j.at("tasks_done").get<int>();
-        r.tasks_running = j.at("tasks_running").get<int>();
-        r.retries = j.at("retries").get<int>();
-        r.tasks_leased = j.value("tasks_leased", 0);
-        r.stats.samples = j.at("samples").get<uint64_t>();
-        r.stats.rays = j.at("rays").get<uint64_t>();
-        r.stats.invalid_samples = j.at("invalid_samples").get<uint64_t>();
-        r.result_path = j.at("result_path").get<std::string>();
-        return r;
-    } catch (const json::exception& e) {
-        return absl::DataLossError(absl::StrCat("the stored record is unreadable: ", e.what()));
+    lightfarm::v1::StoredJob stored;
+    if (const auto parsed = google::protobuf::util::JsonStringToMessage(text, &stored);
+        !parsed.ok()) {
+        return absl::DataLossError(
+            absl::StrCat("the stored record is unreadable: ", parsed.message().as_string()));
     }
+    absl::StatusOr<JobRecord> record = FromProto(stored);
+    if (!record.ok()) {
+        return absl::DataLossError(
+            absl::StrCat("the stored record's state: ", record.status().message()));
+    }
+    return record;
 }
 
 }  // namespace lf

@@ -10,6 +10,7 @@
 #include "absl/strings/str_join.h"
 #include "lf/core/log.h"
 #include "server/job_record_codec.h"
+#include "server/legacy_job_record.h"
 #include "server/sqlite_statement.h"
 
 namespace lf {
@@ -17,16 +18,22 @@ namespace lf {
 namespace {
 
 // A stored record, its errors naming the job.
-absl::StatusOr<JobRecord> Decode(std::string_view id, std::string_view record) {
-    absl::StatusOr<JobRecord> job = DecodeJobRecord(record);
+absl::StatusOr<JobRecord> NamingTheJob(std::string_view id, absl::StatusOr<JobRecord> job) {
     if (job.ok()) return job;
     return absl::Status(job.status().code(), absl::StrCat("job store: job ", std::string(id), ": ",
                                                           job.status().message()));
 }
+absl::StatusOr<JobRecord> Decode(std::string_view id, std::string_view record) {
+    return NamingTheJob(id, DecodeJobRecord(record));
+}
+absl::StatusOr<JobRecord> DecodeLegacy(std::string_view id, std::string_view record) {
+    return NamingTheJob(id, DecodeLegacyJobRecord(record));
+}
 
 // Schema versions (PRAGMA user_version): 0, records only, states by enum position, request ids
-// found inside the JSON; 1, the columns List and FindRequest select on, states by name.
-constexpr int kSchemaVersion = 1;
+// found inside the JSON; 1, the columns List and FindRequest select on, states by name; 2,
+// records in the StoredJob form (server/job_record_codec.h), those before in the legacy form.
+constexpr int kSchemaVersion = 2;
 
 }  // namespace
 
@@ -60,7 +67,7 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
             "job store version ", found_version, " is newer than this server's (", kSchemaVersion,
             "): run a lightfarm-server as new as the one that wrote it"));
     }
-    if (s.ok() && old) s = Migrate(db);
+    if (s.ok() && old) s = Migrate(db, found_version);
     if (s.ok()) {
         s = Exec(db,
                  "CREATE TABLE IF NOT EXISTS jobs (id TEXT PRIMARY KEY,"
@@ -221,19 +228,23 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
     return status;
 }
 
-absl::Status SqliteJobStore::Migrate(sqlite3* db) {
-    // Version 0 to 1: the columns, filled from the records, which are rewritten with states by
-    // name. In one transaction, so that a failure leaves version 0 to try again.
+absl::Status SqliteJobStore::Migrate(sqlite3* db, int64_t version) {
+    // Version 0 to 1: the columns, filled from the records. Either to 2: the records rewritten
+    // in the StoredJob form. In one transaction, so that a failure leaves the old version to try
+    // again.
     if (absl::Status s = Exec(db, "BEGIN IMMEDIATE"); !s.ok()) return s;
-    absl::Status status = Exec(db,
-                               "DROP INDEX IF EXISTS jobs_by_request;"
-                               "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';"
-                               "ALTER TABLE jobs ADD COLUMN finished INTEGER;");
+    absl::Status status;
+    if (version == 0) {
+        status = Exec(db,
+                      "DROP INDEX IF EXISTS jobs_by_request;"
+                      "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';"
+                      "ALTER TABLE jobs ADD COLUMN finished INTEGER;");
+    }
     std::vector<Write> rewrites;
     if (status.ok()) {
         Statement all(db, "SELECT id, record FROM jobs");
         while (status.ok() && all.Step()) {
-            absl::StatusOr<JobRecord> job = Decode(all.Column(0), all.Column(1));
+            absl::StatusOr<JobRecord> job = DecodeLegacy(all.Column(0), all.Column(1));
             if (job.ok()) rewrites.push_back(PutOf(*job));
             status = job.status();
         }

@@ -59,8 +59,8 @@ class SqliteJobStore : public JobStore {
         std::string result = {};
     };
     static Write PutOf(const JobRecord& job);
-    // Brings a database of an earlier version to this one's schema (see Open).
-    static absl::Status Migrate(sqlite3* db);
+    // Brings a database of an earlier `version` to this one's schema (see Open).
+    static absl::Status Migrate(sqlite3* db, int64_t version);
 
     explicit SqliteJobStore(sqlite3* db);
     uint64_t Queue(Write write);

@@ -1,5 +1,7 @@
 #include "lf/job/job_record.h"
 
+#include "absl/strings/str_cat.h"
+
 namespace lf {
 
 const char* JobStateName(JobState state) {
@@ -16,6 +18,16 @@ const char* JobStateName(JobState state) {
             return "cancelled";
     }
     return "unknown";
+}
+
+absl::StatusOr<JobState> JobStateFromName(std::string_view name) {
+    for (JobState s : {JobState::kQueued, JobState::kRunning, JobState::kSucceeded,
+                       JobState::kFailed, JobState::kCancelled}) {
+        if (name == JobStateName(s)) return s;
+    }
+    return absl::InvalidArgumentError(
+        absl::StrCat("unknown job state \"", std::string(name),
+                     "\": expected queued, running, succeeded, failed or cancelled"));
 }
 
 }  // namespace lf

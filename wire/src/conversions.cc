@@ -87,6 +87,12 @@ RadiositySettings FromProto(const pb::RadiosityParams& p) {
     return s;
 }
 
+void ToProto(const PhotonSettings& s, pb::PhotonParams* out) {
+    out->set_photons_per_pass(s.photons_per_pass);
+    out->set_initial_radius(s.initial_radius);
+    out->set_alpha(s.alpha);
+}
+
 void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_spp(spec.plan.spp);
     out->set_seed(spec.seed);
@@ -101,10 +107,7 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
         ToProto(spec.radiosity, out->mutable_radiosity());
     }
     if (info && info->frame_plan == FramePlanKind::kPhotonPasses) {
-        pb::PhotonParams* ppm = out->mutable_ppm();
-        ppm->set_photons_per_pass(spec.ppm.photons_per_pass);
-        ppm->set_initial_radius(spec.ppm.initial_radius);
-        ppm->set_alpha(spec.ppm.alpha);
+        ToProto(spec.ppm, out->mutable_ppm());
     }
     out->set_target_error(spec.adaptive.target_error);
     out->set_time_limit_seconds(spec.adaptive.time_limit);

@@ -4,11 +4,13 @@
 // coordinator restart.
 #include <gtest/gtest.h>
 
+#include "legacy_job_records.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/task_assignment.h"
 #include "lf/wire/conversions.h"
 #include "nlohmann/json.hpp"
 #include "server/job_record_codec.h"
+#include "server/legacy_job_record.h"
 
 namespace lf {
 namespace {
@@ -82,8 +84,9 @@ TEST(FrameWire, PhotonSettingsSurviveTheJobRecordAndOldRecordsHaveTheDefaults) {
     EXPECT_EQ(back->spec.ppm.photons_per_pass, 999u);
     EXPECT_EQ(back->spec.ppm.initial_radius, 0.5);
     EXPECT_EQ(back->spec.ppm.alpha, 0.6);
+    stored = nlohmann::json::parse(testing::kLegacyRepresentativeRecords[3]);  // ppm, 500000
     stored["spec"].erase("ppm");
-    back = DecodeJobRecord(stored.dump());
+    back = DecodeLegacyJobRecord(stored.dump());
     ASSERT_TRUE(back.ok()) << back.status();
     EXPECT_EQ(back->spec.ppm.photons_per_pass, defaults::kPpmPhotonsPerPass);
 }

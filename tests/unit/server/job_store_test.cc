@@ -1,8 +1,8 @@
 // The JobStore contract, which every store satisfies (in memory and SQLite alike): pages newest
 // first, the retention query, request ids unique, deletes; and the stored record format, which
-// belongs to the interface: states by name, the integer states of old records still read, an
-// unknown name a clear error. Then what only SQLite has: a database of the first schema is
-// upgraded in place.
+// belongs to the interface: states by name, the integer states of old records (the first form,
+// legacy_job_records.h) still read, an unknown name a clear error. Then what only SQLite has: a
+// database of the first schema is upgraded in place.
 #include "server/job_store.h"
 
 #include <gtest/gtest.h>
@@ -15,8 +15,10 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "legacy_job_records.h"
 #include "lf/core/aov.h"
 #include "server/job_record_codec.h"
+#include "server/legacy_job_record.h"
 #include "server/sqlite_job_store.h"
 #include "test_dir.h"
 
@@ -137,9 +139,9 @@ TEST(JobRecordCodec, StatesAreStoredByName) {
 }
 
 TEST(JobRecordCodec, IntegerStatesOfOldRecordsStillRead) {
-    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
+    nlohmann::json stored = nlohmann::json::parse(testing::kLegacyRecordA);
     stored["state"] = 3;  // kFailed's position when states were stored so
-    EXPECT_EQ(DecodeJobRecord(stored.dump())->state, JobState::kFailed);
+    EXPECT_EQ(DecodeLegacyJobRecord(stored.dump())->state, JobState::kFailed);
 }
 
 TEST(JobRecordCodec, CameraAndResolutionSurviveAndOldRecordsHaveNone) {
@@ -151,9 +153,11 @@ TEST(JobRecordCodec, CameraAndResolutionSurviveAndOldRecordsHaveNone) {
     EXPECT_EQ(back->spec.scene_options.camera, "Side");
     EXPECT_EQ(back->spec.scene_options.width, 640);
     EXPECT_EQ(back->spec.scene_options.height, 360);
+    // The first form, of a job with camera "Side" at 640 x 360.
+    stored = nlohmann::json::parse(testing::kLegacyRepresentativeRecords[0]);
     stored["spec"].erase("camera");
     stored["spec"].erase("resolution");
-    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
+    const absl::StatusOr<JobRecord> old = DecodeLegacyJobRecord(stored.dump());
     ASSERT_TRUE(old.ok()) << old.status();
     EXPECT_EQ(old->spec.scene_options.camera, "");
     EXPECT_EQ(old->spec.scene_options.width, 0);
@@ -172,10 +176,14 @@ TEST(JobRecordCodec, FilterClampAndAovsSurviveAndOldRecordsHaveNone) {
     EXPECT_EQ(back->spec.scene_options.filter->width, 2.5);
     EXPECT_EQ(back->spec.clamp, 12.5);
     EXPECT_EQ(back->spec.aovs, uint32_t(kAovAlbedo | kAovDepth));
-    stored["spec"]["filter"]["type"] = "lanczos";
+    stored["spec"]["params"]["filter_type"] = "FILTER_LANCZOS";
     EXPECT_EQ(DecodeJobRecord(stored.dump()).status().code(), absl::StatusCode::kDataLoss);
+    // The first form, of a job with a filter, a clamp and AOVs.
+    stored = nlohmann::json::parse(testing::kLegacyRepresentativeRecords[0]);
+    stored["spec"]["filter"]["type"] = "lanczos";
+    EXPECT_EQ(DecodeLegacyJobRecord(stored.dump()).status().code(), absl::StatusCode::kDataLoss);
     for (const char* key : {"filter", "clamp", "aovs"}) stored["spec"].erase(key);
-    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
+    const absl::StatusOr<JobRecord> old = DecodeLegacyJobRecord(stored.dump());
     ASSERT_TRUE(old.ok()) << old.status();
     EXPECT_FALSE(old->spec.scene_options.filter.has_value());
     EXPECT_EQ(old->spec.clamp, 0);
@@ -183,8 +191,9 @@ TEST(JobRecordCodec, FilterClampAndAovsSurviveAndOldRecordsHaveNone) {
 }
 
 // A setting the record stores by name (`key`): each of `values` survives, the default is stored
-// as `default_name`, a name no build knows is data loss naming it, and a record without the key
-// reads as `before`, what jobs rendered with before the setting existed.
+// by name (the first form: as `default_name`), a name no build knows is data loss (the first
+// form's naming it), and a record without the key reads as `before`, what jobs rendered with
+// before the setting existed.
 template <typename T>
 void ExpectNamedSettingSurvives(const std::string& key, T JobSpec::*field,
                                 std::initializer_list<T> values, const std::string& default_name,
@@ -196,15 +205,25 @@ void ExpectNamedSettingSurvives(const std::string& key, T JobSpec::*field,
         ASSERT_TRUE(back.ok()) << back.status();
         EXPECT_EQ(back->spec.*field, value) << key;
     }
-    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
+    nlohmann::json params = nlohmann::json::parse(EncodeJobRecord(Record("a", 1)));
+    nlohmann::json& param = params["spec"]["params"][key];
+    EXPECT_TRUE(param.is_string()) << param;
+    param = "halton";
+    EXPECT_EQ(DecodeJobRecord(params.dump()).status().code(), absl::StatusCode::kDataLoss);
+    params["spec"]["params"].erase(key);
+    const absl::StatusOr<JobRecord> unset = DecodeJobRecord(params.dump());
+    ASSERT_TRUE(unset.ok()) << unset.status();
+    EXPECT_EQ(unset->spec.*field, before) << key;
+
+    nlohmann::json stored = nlohmann::json::parse(testing::kLegacyRecordA);
     EXPECT_EQ(stored.at("spec").at(key), default_name);
     stored["spec"][key] = "halton";
-    const absl::StatusOr<JobRecord> unknown = DecodeJobRecord(stored.dump());
+    const absl::StatusOr<JobRecord> unknown = DecodeLegacyJobRecord(stored.dump());
     EXPECT_EQ(unknown.status().code(), absl::StatusCode::kDataLoss);
     EXPECT_NE(unknown.status().message().find(key + " \"halton\""), std::string_view::npos)
         << unknown.status();
     stored["spec"].erase(key);
-    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
+    const absl::StatusOr<JobRecord> old = DecodeLegacyJobRecord(stored.dump());
     ASSERT_TRUE(old.ok()) << old.status();
     EXPECT_EQ(old->spec.*field, before) << key;
 }
@@ -235,9 +254,9 @@ TEST(JobRecordCodec, UnknownStateNameIsAClearError) {
     EXPECT_EQ(DecodeJobRecord(stored.dump()).status().code(), absl::StatusCode::kDataLoss);
 }
 
-// A database as the first schema made it: records only, states by position, the request id
-// inside the JSON.
-void WriteVersion0Database(const fs::path& path, const std::vector<JobRecord>& jobs) {
+// A database as the first schema made it: records (of the first form) only, states by position,
+// the request id inside the JSON.
+void WriteVersion0Database(const fs::path& path, const std::vector<std::string_view>& records) {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
     ASSERT_EQ(sqlite3_exec(db,
@@ -249,12 +268,13 @@ void WriteVersion0Database(const fs::path& path, const std::vector<JobRecord>& j
                            "  json_extract(record, '$.spec.request_id'));",
                            nullptr, nullptr, nullptr),
               SQLITE_OK);
-    for (const JobRecord& job : jobs) {
-        nlohmann::json record = nlohmann::json::parse(EncodeJobRecord(job));
-        record["state"] = int(job.state);
-        const std::string sql =
-            "INSERT INTO jobs VALUES ('" + job.id + "', " + std::to_string(job.seq) + ", " +
-            std::to_string(int(IsFinal(job.state))) + ", '" + record.dump() + "')";
+    for (const std::string_view text : records) {
+        nlohmann::json record = nlohmann::json::parse(text);
+        const JobState state = *JobStateFromName(record.at("state").get<std::string>());
+        record["state"] = int(state);
+        const std::string sql = "INSERT INTO jobs VALUES ('" + record.at("id").get<std::string>() +
+                                "', " + std::to_string(record.at("seq").get<uint64_t>()) + ", " +
+                                std::to_string(int(IsFinal(state))) + ", '" + record.dump() + "')";
         ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
     }
     sqlite3_close(db);
@@ -262,9 +282,9 @@ void WriteVersion0Database(const fs::path& path, const std::vector<JobRecord>& j
 
 TEST(SqliteJobStoreUpgrade, FirstSchemaDatabaseIsUpgradedAndReadsAsBefore) {
     const fs::path dir = TestDir();
-    JobRecord done = Record("done", 1, JobState::kSucceeded), running = Record("running", 2);
-    running.spec.request_id = "req-2";
-    WriteVersion0Database(dir / "jobs.db", {done, running});
+    // Record("done", 1, JobState::kSucceeded), and Record("running", 2) with request id "req-2"
+    WriteVersion0Database(dir / "jobs.db",
+                          {testing::kLegacyRecordDone, testing::kLegacyRecordRunning});
     {
         absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
             SqliteJobStore::Open((dir / "jobs.db").string());

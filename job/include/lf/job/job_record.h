@@ -3,7 +3,9 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
+#include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "lf/core/film.h"
 #include "lf/job/job_spec.h"
@@ -12,6 +14,8 @@ namespace lf {
 
 enum class JobState { kQueued, kRunning, kSucceeded, kFailed, kCancelled };
 const char* JobStateName(JobState state);
+// The state named `name` (JobStateName's inverse); InvalidArgument for any other name.
+absl::StatusOr<JobState> JobStateFromName(std::string_view name);
 inline bool IsFinal(JobState s) { return s != JobState::kQueued && s != JobState::kRunning; }
 
 struct JobRecord {

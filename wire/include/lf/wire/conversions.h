@@ -20,6 +20,8 @@ BlobRef FromProto(const lightfarm::v1::SceneFile& file);
 void ToProto(const RadiositySettings& settings, lightfarm::v1::RadiosityParams* out);
 RadiositySettings FromProto(const lightfarm::v1::RadiosityParams& params);
 
+void ToProto(const PhotonSettings& settings, lightfarm::v1::PhotonParams* out);
+
 // The render settings of a spec (not its scene, name or priority).
 void ToProto(const JobSpec& spec, lightfarm::v1::RenderParams* out);
 // Fills the render settings of `spec` from `params`.

@@ -1,0 +1,105 @@
+#include "lf/wire/stored_job.h"
+
+#include <optional>
+
+#include "lf/wire/conversions.h"
+
+namespace lf {
+
+namespace pb = lightfarm::v1;
+
+namespace {
+
+using lf::FromProto;  // the conversions of lf/wire/conversions.h, beside the two below
+using lf::ToProto;
+
+// Unix microseconds; absl::InfinitePast (not yet) as unset.
+std::optional<int64_t> UnixMicros(absl::Time t) {
+    if (t == absl::InfinitePast()) return std::nullopt;
+    return absl::ToUnixMicros(t);
+}
+
+void ToProto(const JobSpec& spec, pb::StoredJobSpec* out) {
+    out->set_name(spec.name);
+    ToProto(spec.scene, out->mutable_scene());
+    for (const BlobRef& f : spec.files) ToProto(f, out->add_files());
+    pb::RenderParams* params = out->mutable_params();
+    ToProto(spec, params);
+    // The wire carries a method's own settings only; the spec keeps the others too.
+    ToProto(spec.radiosity, params->mutable_radiosity());
+    ToProto(spec.ppm, params->mutable_ppm());
+    out->set_width(spec.plan.width);
+    out->set_height(spec.plan.height);
+    out->set_priority(spec.priority);
+    out->set_scene_hash(spec.scene_hash);
+    out->set_request_id(spec.request_id);
+    out->set_owner(spec.owner);
+}
+
+JobSpec FromProto(const pb::StoredJobSpec& s) {
+    JobSpec spec;
+    spec.name = s.name();
+    spec.scene = FromProto(s.scene());
+    for (const pb::SceneFile& f : s.files()) spec.files.push_back(FromProto(f));
+    FromProto(s.params(), &spec);
+    spec.plan.width = s.width();
+    spec.plan.height = s.height();
+    spec.priority = s.priority();
+    spec.scene_hash = s.scene_hash();
+    spec.request_id = s.request_id();
+    spec.owner = s.owner();
+    return spec;
+}
+
+}  // namespace
+
+void ToProto(const JobRecord& job, pb::StoredJob* out) {
+    out->set_id(job.id);
+    out->set_seq(job.seq);
+    ToProto(job.spec, out->mutable_spec());
+    out->set_state(JobStateName(job.state));
+    out->set_error(job.error);
+    out->set_last_error(job.last_error);
+    if (auto us = UnixMicros(job.submitted)) out->set_submitted_unix_us(*us);
+    if (auto us = UnixMicros(job.started)) out->set_started_unix_us(*us);
+    if (auto us = UnixMicros(job.finished)) out->set_finished_unix_us(*us);
+    out->set_tasks_total(job.tasks_total);
+    out->set_tasks_done(job.tasks_done);
+    out->set_tasks_running(job.tasks_running);
+    out->set_retries(job.retries);
+    out->set_tasks_leased(job.tasks_leased);
+    out->set_samples(job.stats.samples);
+    out->set_rays(job.stats.rays);
+    out->set_invalid_samples(job.stats.invalid_samples);
+    out->set_result_path(job.result_path);
+}
+
+absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
+    const absl::StatusOr<JobState> state = JobStateFromName(s.state());
+    if (!state.ok()) return state.status();
+    const auto time = [](bool has, int64_t us) {
+        return has ? absl::FromUnixMicros(us) : absl::InfinitePast();
+    };
+    JobRecord job;
+    job.id = s.id();
+    job.seq = s.seq();
+    job.spec = FromProto(s.spec());
+    job.state = *state;
+    job.error = s.error();
+    job.last_error = s.last_error();
+    job.submitted = time(s.has_submitted_unix_us(), s.submitted_unix_us());
+    job.started = time(s.has_started_unix_us(), s.started_unix_us());
+    job.finished = time(s.has_finished_unix_us(), s.finished_unix_us());
+    job.tasks_total = s.tasks_total();
+    job.tasks_done = s.tasks_done();
+    job.tasks_running = s.tasks_running();
+    job.retries = s.retries();
+    job.tasks_leased = s.tasks_leased();
+    job.stats.samples = s.samples();
+    job.stats.rays = s.rays();
+    job.stats.invalid_samples = s.invalid_samples();
+    job.result_path = s.result_path();
+    return job;
+}
+
+}  // namespace lf
