@@ -241,18 +241,25 @@ class ClientTest(unittest.TestCase):
         stub = self.alice._stub
         md = self.alice._metadata
 
+        def held():
+            return stub.BlobUploadOffset(pb.BlobUploadOffsetRequest(hash=digest, size=len(mesh)),
+                                         timeout=10, metadata=md).offset
+
+        def wait_until_held(what):
+            deadline = time.monotonic() + 30
+            while held() != 1 << 20:
+                self.assertLess(time.monotonic(), deadline, what)
+                time.sleep(0.05)
+
         def broken():
             yield pb.UploadBlobRequest(hash=digest, size=len(mesh), data=mesh[:1 << 20])
-            time.sleep(0.5)  # the server takes the chunk before the stream breaks
+            # The stream breaks once the server has written the chunk, however slowly it runs.
+            wait_until_held("the server never wrote the first MiB")
             raise RuntimeError("the link breaks")
 
         with self.assertRaises(grpc.RpcError):
-            stub.UploadBlob(broken(), timeout=10, metadata=md)
-        deadline = time.monotonic() + 10
-        while stub.BlobUploadOffset(pb.BlobUploadOffsetRequest(hash=digest, size=len(mesh)),
-                                    timeout=10, metadata=md).offset != 1 << 20:
-            self.assertLess(time.monotonic(), deadline, "the server kept the first MiB")
-            time.sleep(0.05)
+            stub.UploadBlob(broken(), timeout=60, metadata=md)
+        wait_until_held("the server did not keep the first MiB")
 
         offsets = []
         real = stub.UploadBlob

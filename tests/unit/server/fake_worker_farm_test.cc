@@ -272,12 +272,16 @@ TEST_F(FakeWorkerFarm, CorruptAndWrongSizedResultsAreRefusedAndTheTaskRequeued) 
     ExpectSameAsHonest(job);
 }
 
+// A bound on the wait for a task to be leased again (after a 500 ms lease, or 300 ms of
+// straggling): far above that, so that a loaded machine does not fail the tests.
+constexpr std::chrono::seconds kLeasedAgainWithin{30};
+
 TEST_F(FakeWorkerFarm, SilentWorkerLosesItsLeaseAndTheTaskIsLeasedAgain) {
     const std::string job = Submit();
     const pb::Task silent = *Lease("silent");
     const auto start = std::chrono::steady_clock::now();
     std::optional<pb::Task> again;
-    while (!again && std::chrono::steady_clock::now() - start < std::chrono::seconds(5)) {
+    while (!again && std::chrono::steady_clock::now() - start < kLeasedAgainWithin) {
         std::optional<pb::Task> task = Lease("honest", 200);
         if (!task) continue;
         if (task->task_index() == silent.task_index()) again = task;
@@ -300,7 +304,7 @@ TEST_F(StragglerTest, StragglersTaskIsLeasedAgainAndTheFirstResultWins) {
     const pb::Task slow = *Lease("slow");
     std::optional<pb::Task> copy;
     const auto start = std::chrono::steady_clock::now();
-    while (!copy && std::chrono::steady_clock::now() - start < std::chrono::seconds(5)) {
+    while (!copy && std::chrono::steady_clock::now() - start < kLeasedAgainWithin) {
         EXPECT_TRUE(Heartbeat(slow, "slow"));  // alive, just slow
         std::optional<pb::Task> task = Lease("fast", 100);
         if (!task) continue;
