@@ -23,7 +23,7 @@ Command AddBenchCommand(CLI::App& app);
 Command AddConvergeCommand(CLI::App& app);
 Command AddPlanCommand(CLI::App& app);
 
-// The farm (farm_commands.cc): jobs on a lightfarm-server.
+// The farm (submit_command.cc, farm_commands.cc): jobs on a lightfarm-server.
 Command AddSubmitCommand(CLI::App& app);
 Command AddListCommand(CLI::App& app);
 Command AddStatusCommand(CLI::App& app);

@@ -1,44 +1,30 @@
-// The farm subcommands of `lightfarm`: submit, list, status, watch, fetch, cancel, priority,
-// delete, workers, tasks and logs, each a call to lightfarm-server's JobService. All protobuf
-// handling of the client is in this file.
+// The farm subcommands of `lightfarm` that ask lightfarm-server's JobService about jobs and act
+// on them: list, status, watch, fetch, cancel, priority, delete, workers, tasks and logs, each
+// through a FarmClient (`submit` is submit_command.cc).
 #include <google/protobuf/util/json_util.h>
-#include <grpcpp/grpcpp.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <map>
-#include <optional>
-#include <sstream>
+#include <memory>
+#include <string>
 
 #include "absl/strings/ascii.h"
-#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
-#include "adaptive_flags.h"
 #include "command.h"
+#include "farm_client.h"
+#include "farm_flags.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
-#include "lf/core/scene_loader.h"
-#include "lf/job/digest.h"
+#include "lf/job/job_record.h"
 #include "lf/job/job_spec.h"
-#include "lf/job/plan.h"
-#include "lf/job/scene_files.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "method_flags.h"
 #include "output_flags.h"
-#include "photon_flags.h"
 #include "progress_bar.h"
-#include "proto/channel.h"
-#include "proto/channel_flags.h"
-#include "proto/grpc_status.h"
-#include "radiosity_flags.h"
-#include "sample_flags.h"
-#include "scene_flags.h"
 
 namespace lf {
 
@@ -46,98 +32,6 @@ namespace fs = std::filesystem;
 namespace pb = lightfarm::v1;
 
 namespace {
-
-constexpr size_t kChunkBytes = 1 << 20;
-
-struct FarmFlags {
-    ChannelOptions channel{.address = "127.0.0.1:7070"};
-    double retry_seconds = 60;  // how long submit and watch ride out an unreachable server
-};
-
-// --server and the TLS and token flags; files they name are checked once the command line is
-// parsed, so that a wrong path is said before any work.
-void AddServerOption(CLI::App* cmd, FarmFlags& flags) {
-    cmd->add_option("--server", flags.channel.address, "HOST:PORT of lightfarm-server")
-        ->envname("LIGHTFARM_SERVER")
-        ->capture_default_str();
-    AddChannelFlags(cmd, &flags.channel);
-    cmd->parse_complete_callback([&flags] {
-        if (absl::StatusOr<std::shared_ptr<grpc::Channel>> channel = OpenChannel(flags.channel);
-            !channel.ok()) {
-            throw CLI::ValidationError(std::string(channel.status().message()));
-        }
-    });
-}
-
-void AddRetryOption(CLI::App* cmd, FarmFlags& flags) {
-    cmd->add_option("--retry-seconds", flags.retry_seconds,
-                    "while the server is unreachable (restarting, say), retry for this long "
-                    "before giving up; 0: do not retry")
-        ->capture_default_str()
-        ->check(CLI::Range(0.0, 86400.0));
-}
-
-// Waits between attempts to reach a server that is down: 0.25 s, doubling up to 5 s, until the
-// budget is spent, saying on stderr what it waits for.
-class Backoff {
-  public:
-    explicit Backoff(const FarmFlags& flags) : budget_(absl::Seconds(flags.retry_seconds)) {}
-
-    // False when the budget is spent: give up with `why`.
-    bool Wait(const std::string& what, const absl::Status& why) {
-        if (waited_ + delay_ > budget_) return false;
-        std::fprintf(stderr, "lightfarm: %s: %s; retrying in %.2g s\n", what.c_str(),
-                     std::string(why.message()).c_str(), absl::ToDoubleSeconds(delay_));
-        absl::SleepFor(delay_);
-        waited_ += delay_;
-        delay_ = std::min(2 * delay_, kMaxDelay);
-        return true;
-    }
-    // The server answered: a later outage gets the whole budget again.
-    void Reset() {
-        waited_ = absl::ZeroDuration();
-        delay_ = kFirstDelay;
-    }
-
-  private:
-    static constexpr absl::Duration kFirstDelay = absl::Milliseconds(250);
-    static constexpr absl::Duration kMaxDelay = absl::Seconds(5);
-    absl::Duration budget_;
-    absl::Duration waited_ = absl::ZeroDuration();
-    absl::Duration delay_ = kFirstDelay;
-};
-
-// A new channel: after an outage, retries take a new one, as a channel that failed to connect
-// fails calls fast for a while after the server is back.
-std::unique_ptr<pb::JobService::Stub> Connect(const FarmFlags& flags) {
-    absl::StatusOr<std::shared_ptr<grpc::Channel>> channel = OpenChannel(flags.channel);
-    if (!channel.ok()) {
-        // The files were readable when the command line was parsed (AddServerOption): one
-        // removed since leaves nothing to retry with.
-        std::fprintf(stderr, "lightfarm: error: %s\n",
-                     std::string(channel.status().message()).c_str());
-        std::exit(2);
-    }
-    return pb::JobService::NewStub(*channel);
-}
-
-// The server's own words, with where it was asked when it could not be reached.
-absl::Status CallStatus(const grpc::Status& s, const FarmFlags& flags) {
-    // gRPC reports a TLS handshake that failed on a certificate or on a plain-text peer as
-    // UNAVAILABLE, like a server that is down; retrying cannot help, so it is said at once.
-    if (s.error_code() == grpc::StatusCode::UNAVAILABLE &&
-        absl::StrContains(s.error_message(), "SSL_ERROR_SSL")) {
-        return absl::FailedPreconditionError(absl::StrCat(
-            "TLS handshake with server ", flags.channel.address, " failed (", s.error_message(),
-            "): check --tls-ca, the server's certificate names, and --tls-cert/--tls-key if the "
-            "server asks for client certificates"));
-    }
-    if (s.error_code() == grpc::StatusCode::UNAVAILABLE) {
-        return absl::UnavailableError(
-            absl::StrCat("server ", flags.channel.address, " not reachable: ", s.error_message()));
-    }
-    return FromGrpcStatus(s);
-}
 
 void AddJsonFlag(CLI::App* cmd, bool& json) {
     cmd->add_flag("--json", json,
@@ -158,203 +52,6 @@ void PrintJson(const google::protobuf::Message& message) {
 }
 
 std::string StateName(pb::Job::State s) { return absl::AsciiStrToLower(pb::Job::State_Name(s)); }
-
-bool IsFinal(pb::Job::State s) {
-    return s == pb::Job::SUCCEEDED || s == pb::Job::FAILED || s == pb::Job::CANCELLED;
-}
-
-absl::StatusOr<std::string> ReadFile(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return absl::NotFoundError(path.string() + ": cannot be read");
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
-
-// Loads the scene here, as `render` would, through a reader that records every file the loader
-// reads by the name it asks for (the name the server and workers look it up by): exactly the
-// files the farm needs (meshes, MTL files, included glTFs, their buffers and images), whatever
-// the format. A scene that does not load is refused here, with the loader's message, before
-// anything is uploaded. Returns the files' contents by name.
-absl::StatusOr<std::map<std::string, std::string>> ReadSceneFiles(const fs::path& scene_path,
-                                                                  const std::string& scene_text,
-                                                                  const SceneOptions& options) {
-    std::map<std::string, std::string> read;
-    const fs::path parent = scene_path.parent_path();
-    const SceneFileReader beside = ReadBeside(parent.empty() ? "." : parent.string());
-    const SceneFileReader recording = [&](const std::string& name) {
-        absl::StatusOr<std::string> bytes = beside(name);
-        if (bytes.ok()) read[name] = *bytes;
-        return bytes;
-    };
-    absl::StatusOr<Scene> scene = ParseScene(scene_text, scene_path.string(), recording, options);
-    if (!scene.ok()) return scene.status();
-    return read;
-}
-
-struct LocalFile {
-    pb::SceneFile ref;
-};
-
-// Uploads whose bytes add up to this show a progress bar (on a terminal).
-constexpr uint64_t kProgressBarBytes = uint64_t(16) << 20;
-
-// Sends what the server lacks of one blob: from where its bytes end (BlobUploadOffset), so an
-// upload that broke resumes instead of starting over. `sent` counts the bytes the server holds
-// of the blobs uploaded so far, of `total`, for `bar` (null: no bar).
-absl::Status Upload(pb::JobService::Stub& stub, const LocalFile& file, const std::string& content,
-                    const FarmFlags& flags, uint64_t& sent, uint64_t total, ProgressBar* bar) {
-    auto failed = [&](const absl::Status& s) {
-        return absl::Status(s.code(), absl::StrCat(file.ref.path(), ": upload: ", s.message()));
-    };
-    pb::BlobUploadOffsetRequest where;
-    where.set_hash(file.ref.hash());
-    where.set_size(file.ref.size());
-    pb::BlobUploadOffsetResponse held;
-    const grpc::Status asked =
-        stub.BlobUploadOffset(ContextWithDeadline(absl::Seconds(10)).get(), where, &held);
-    // A server of an earlier version, without the call, takes whole uploads only.
-    if (!asked.ok() && asked.error_code() != grpc::StatusCode::UNIMPLEMENTED) {
-        return failed(CallStatus(asked, flags));
-    }
-    const size_t offset = std::min<uint64_t>(held.offset(), content.size());
-    if (offset > 0 && offset < content.size()) {
-        std::fprintf(stderr, "lightfarm: %s: the server holds %zu of %zu bytes; sending the rest\n",
-                     file.ref.path().c_str(), offset, content.size());
-    }
-    sent += offset;
-    if (offset == content.size()) return absl::OkStatus();
-
-    const auto context = ContextWithDeadline(absl::Minutes(10));
-    pb::UploadBlobResponse response;
-    std::unique_ptr<grpc::ClientWriter<pb::UploadBlobRequest>> writer =
-        stub.UploadBlob(context.get(), &response);
-    pb::UploadBlobRequest chunk;
-    chunk.set_hash(file.ref.hash());
-    chunk.set_size(file.ref.size());
-    chunk.set_offset(offset);
-    size_t at = offset;
-    do {
-        const size_t n = std::min(kChunkBytes, content.size() - at);
-        chunk.set_data(content.data() + at, n);
-        if (!writer->Write(chunk)) break;
-        at += n;
-        sent += n;
-        if (bar) bar->Update(sent, total);
-        chunk.clear_hash();
-        chunk.clear_size();
-        chunk.clear_offset();
-    } while (at < content.size());
-    writer->WritesDone();
-    if (absl::Status s = CallStatus(writer->Finish(), flags); !s.ok()) return failed(s);
-    return absl::OkStatus();
-}
-
-// Uploads the blobs the server lacks and submits the job: one attempt.
-absl::StatusOr<std::string> SubmitOnce(pb::JobService::Stub& stub, const FarmFlags& flags,
-                                       const std::vector<LocalFile>& files,
-                                       const std::map<std::string, std::string>& contents,
-                                       const pb::SubmitJobRequest& req) {
-    pb::MissingBlobsRequest missing_req;
-    for (const auto& [hash, content] : contents) missing_req.add_hashes(hash);
-    pb::MissingBlobsResponse missing;
-    if (absl::Status s = CallStatus(
-            stub.MissingBlobs(ContextWithDeadline(absl::Seconds(10)).get(), missing_req, &missing),
-            flags);
-        !s.ok()) {
-        return s;
-    }
-    std::vector<const LocalFile*> uploads;
-    uint64_t total = 0, sent = 0;
-    for (const std::string& hash : missing.hashes()) {
-        for (const LocalFile& f : files) {
-            if (f.ref.hash() != hash) continue;
-            uploads.push_back(&f);
-            total += f.ref.size();
-            break;
-        }
-    }
-    std::optional<ProgressBar> bar;
-    if (total >= kProgressBarBytes) bar.emplace("upload");
-    for (const LocalFile* f : uploads) {
-        const absl::Status s =
-            Upload(stub, *f, contents.at(f->ref.hash()), flags, sent, total, bar ? &*bar : nullptr);
-        if (!s.ok()) {
-            if (bar) bar->Finish();  // the bar's line ends before the error's
-            return s;
-        }
-    }
-    if (bar) bar->Finish();
-
-    pb::SubmitJobResponse resp;
-    // The server loads the scene to check it, which takes a while for large meshes.
-    if (absl::Status s = CallStatus(
-            stub.SubmitJob(ContextWithDeadline(absl::Minutes(2)).get(), req, &resp), flags);
-        !s.ok()) {
-        return s;
-    }
-    return resp.job_id();
-}
-
-struct SubmitOptions {
-    FarmFlags farm;
-    std::string scene_path;
-    JobSpec spec;  // the scene and files are filled in by Submit
-};
-
-absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
-    const fs::path scene_path(o.scene_path);
-    absl::StatusOr<std::string> scene_text = ReadFile(scene_path);
-    if (!scene_text.ok()) return scene_text.status();
-    absl::StatusOr<std::map<std::string, std::string>> read =
-        ReadSceneFiles(scene_path, *scene_text, o.spec.scene_options);
-    if (!read.ok()) return read.status();
-
-    std::vector<LocalFile> files;
-    std::map<std::string, std::string> contents;  // by hash
-    auto add = [&](const std::string& name, std::string content) -> absl::Status {
-        if (absl::Status s = CheckScenePath(name); !s.ok()) {
-            return absl::InvalidArgumentError(absl::StrCat(o.scene_path, ": ", s.message()));
-        }
-        LocalFile f;
-        f.ref.set_path(name);
-        f.ref.set_hash(Sha256Hex(content));
-        f.ref.set_size(content.size());
-        contents[f.ref.hash()] = std::move(content);
-        files.push_back(std::move(f));
-        return absl::OkStatus();
-    };
-    if (absl::Status s = add(scene_path.filename().string(), *scene_text); !s.ok()) {
-        return s;
-    }
-    for (auto& [name, content] : *read) {
-        if (absl::Status s = add(name, std::move(content)); !s.ok()) return s;
-    }
-
-    JobSpec spec = o.spec;
-    std::vector<BlobRef> refs;
-    for (const LocalFile& f : files) refs.push_back(FromProto(f.ref));
-    spec.scene = refs[0];
-    spec.files.assign(refs.begin() + 1, refs.end());
-    if (spec.name.empty()) spec.name = scene_path.filename().string();
-    // The same id on every attempt: a retry after a lost answer (the server restarting, say)
-    // gets the job of the first attempt.
-    spec.request_id = Sha256Hex(
-        absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string()));
-    pb::SubmitJobRequest req;
-    ToProto(spec, &req);
-
-    Backoff backoff(o.farm);
-    while (true) {
-        absl::StatusOr<std::string> id = SubmitOnce(*Connect(o.farm), o.farm, files, contents, req);
-        // Aborted: another client was uploading one of the blobs; the retry resumes from its
-        // bytes, or finds the blob stored.
-        const bool transient = absl::IsUnavailable(id.status()) || absl::IsAborted(id.status());
-        if (!transient || !backoff.Wait("submit", id.status())) {
-            return id;
-        }
-    }
-}
 
 // "2026-11-26 23:41:07" in the machine's time zone, as a user reads a clock.
 std::string LocalTime(int64_t unix_ms) {
@@ -424,75 +121,11 @@ void PrintJob(const pb::Job& job) {
     }
     std::printf("%s\n", when.c_str());
     // A failed job's error names the failing task; its last error says what that one did.
-    if ((!IsFinal(job.state()) || job.state() == pb::Job::FAILED) && !job.last_error().empty()) {
+    if ((!IsFinal(FromProto(job.state())) || job.state() == pb::Job::FAILED) &&
+        !job.last_error().empty()) {
         std::printf("  last error  %s\n", job.last_error().c_str());
     }
     if (!job.error().empty()) std::printf("  error     %s\n", job.error().c_str());
-}
-
-absl::StatusOr<pb::Job> GetJob(const FarmFlags& flags, const std::string& id) {
-    pb::GetJobRequest req;
-    req.set_job_id(id);
-    pb::Job job;
-    absl::Status s = CallStatus(
-        Connect(flags)->GetJob(ContextWithDeadline(absl::Seconds(10)).get(), req, &job), flags);
-    if (!s.ok()) return s;
-    return job;
-}
-
-// Follows the job until it ends. Each call has a deadline; the watch goes on across them and
-// across a server outage of up to --retry-seconds.
-absl::StatusOr<pb::Job> Watch(const FarmFlags& flags, const std::string& id, ProgressBar& bar) {
-    std::unique_ptr<pb::JobService::Stub> stub = Connect(flags);
-    pb::WatchJobRequest req;
-    req.set_job_id(id);
-    pb::Job job;
-    Backoff backoff(flags);
-    while (true) {
-        const auto context = ContextWithDeadline(absl::Minutes(1));
-        std::unique_ptr<grpc::ClientReader<pb::Job>> reader = stub->WatchJob(context.get(), req);
-        while (reader->Read(&job)) {
-            backoff.Reset();
-            bar.Update(size_t(job.tasks_done()), size_t(std::max(1, job.tasks_total())));
-            if (IsFinal(job.state())) return job;
-        }
-        const grpc::Status s = reader->Finish();
-        if (s.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED) continue;
-        if (const absl::Status status = CallStatus(s, flags);
-            absl::IsUnavailable(status) && backoff.Wait("watch " + id, status)) {
-            stub = Connect(flags);
-            continue;
-        }
-        if (!s.ok()) return CallStatus(s, flags);
-        if (IsFinal(job.state())) return job;
-    }
-}
-
-absl::Status Fetch(const FarmFlags& flags, const std::string& id, const std::string& out,
-                   bool preview) {
-    pb::FetchResultRequest req;
-    req.set_job_id(id);
-    req.set_preview(preview);
-    const auto context = ContextWithDeadline(absl::Minutes(30));
-    std::unique_ptr<grpc::ClientReader<pb::Chunk>> reader =
-        Connect(flags)->FetchResult(context.get(), req);
-    // Written beside the target and renamed, so a failed fetch leaves no half file.
-    const std::string temp = out + ".part";
-    std::ofstream file(temp, std::ios::binary);
-    if (!file) return absl::PermissionDeniedError(out + ": cannot write here");
-    pb::Chunk chunk;
-    while (reader->Read(&chunk)) {
-        file.write(chunk.data().data(), std::streamsize(chunk.data().size()));
-    }
-    file.close();
-    std::error_code ec;
-    if (absl::Status s = CallStatus(reader->Finish(), flags); !s.ok() || !file) {
-        fs::remove(temp, ec);
-        return s.ok() ? absl::InternalError(out + ": write failed") : s;
-    }
-    fs::rename(temp, out, ec);
-    if (ec) return absl::InternalError(out + ": " + ec.message());
-    return absl::OkStatus();
 }
 
 // The job's EXR at paths.exr, and its preview at paths.png, made here from the EXR (fetched into
@@ -501,7 +134,7 @@ absl::Status FetchOutputs(const FarmFlags& flags, const std::string& id, const O
                           const PngOptions& preview_options, bool preview) {
     if (absl::Status s = CheckWritable(paths.png); !s.ok()) return s;
     const std::string exr = paths.exr.empty() ? paths.png + ".exr.part" : paths.exr;
-    if (absl::Status s = Fetch(flags, id, exr, preview); !s.ok()) return s;
+    if (absl::Status s = FarmClient(flags).FetchResult(id, exr, preview); !s.ok()) return s;
     if (paths.png.empty()) return absl::OkStatus();
     absl::StatusOr<ExrFile> file = ReadExr(exr);
     absl::Status written =
@@ -512,74 +145,6 @@ absl::Status FetchOutputs(const FarmFlags& flags, const std::string& id, const O
 }
 
 }  // namespace
-
-Command AddSubmitCommand(CLI::App& app) {
-    auto o = std::make_shared<SubmitOptions>();
-    CLI::App* cmd = app.add_subcommand(
-        "submit",
-        "Send a scene to a lightfarm-server as a job and print its id (the last line).\n"
-        "The scene file and every file it names (meshes; wherever `render` would find them)\n"
-        "are uploaded, and the farm reads only those; files the\n"
-        "server already has are not sent again. Same settings give the same bits as\n"
-        "`lightfarm render`, whatever the tile size, passes or workers.");
-    cmd->add_option("scene", o->scene_path, "scene file (JSON, .gltf or .glb)")
-        ->required()
-        ->check(CLI::ExistingFile);
-    AddSceneFlags(cmd, o->spec.scene_options);
-    AddServerOption(cmd, o->farm);
-    AddRetryOption(cmd, o->farm);
-    cmd->add_option("--spp", o->spec.plan.spp, "samples per pixel")
-        ->capture_default_str()
-        ->check(CLI::Range(uint64_t(1), kMaxSpp));
-    cmd->add_option("--seed", o->spec.seed, "random seed")->capture_default_str();
-    cmd->add_option("--max-depth", o->spec.max_depth,
-                    "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
-        ->capture_default_str()
-        ->check(CLI::Range(-1, kMaxDepthLimit));
-    cmd->add_option("--tile", o->spec.plan.tile, "tile side in pixels")
-        ->capture_default_str()
-        ->check(CLI::Range(1, kMaxFarmTile));
-    cmd->add_option("--passes", o->spec.plan.passes,
-                    "sample passes per tile; each pass of each tile is one task")
-        ->capture_default_str()
-        ->check(CLI::Range(1, kMaxPasses));
-    AddSampleFlags(cmd, o->spec.sampler, o->spec.light_strategy, o->spec.clamp, o->spec.aovs);
-    AddAdaptiveFlags(cmd, o->spec.adaptive);
-    cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
-        ->capture_default_str();
-    cmd->add_option("--name", o->spec.name, "job name (default: the scene file's name)");
-    cmd->add_option("--method", o->spec.method,
-                    "path, radiosity (Lambertian scenes; same bits as `lightfarm render "
-                    "--method radiosity` with the same options), whitted (direct light and "
-                    "specular chains only, a preview), or a frame method: light (light tracing), "
-                    "bdpt (bidirectional path tracing), ppm (progressive photon mapping). Every "
-                    "method gives the bits of `lightfarm render` with the same options; the "
-                    "frame methods take no --aov nor adaptive sampling")
-        ->capture_default_str()
-        ->check([](const std::string& m) { return MethodFlagError(m, false); });
-    AddPhotonFlags(cmd, o->spec.ppm);
-    AddRadiosityFlags(cmd, o->spec.radiosity);
-    cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
-                    "--solver jacobi: patch-group tasks per sweep; each worker computes the "
-                    "form-factor rows of its groups once and keeps them. Gauss-Seidel and "
-                    "shooting update one group after another, so with them every worker "
-                    "solves the whole system before rendering display tiles")
-        ->group("Radiosity")
-        ->capture_default_str()
-        ->check(CLI::Range(1, kMaxSweepTasks));
-    return {cmd, [cmd, o] {
-                if (absl::Status s = CheckRadiosityFlagsApply(*cmd, o->spec.method); !s.ok()) {
-                    return ReportError(s);
-                }
-                if (absl::Status s = CheckPhotonFlagsApply(*cmd, o->spec.method); !s.ok()) {
-                    return ReportError(s);
-                }
-                absl::StatusOr<std::string> id = Submit(*o);
-                if (!id.ok()) return ReportError(id.status());
-                std::printf("%s\n", id->c_str());
-                return 0;
-            }};
-}
 
 Command AddListCommand(CLI::App& app) {
     auto flags = std::make_shared<FarmFlags>();
@@ -594,7 +159,7 @@ Command AddListCommand(CLI::App& app) {
     return {cmd, [flags, limit, json] {
                 // A page per call, so that no answer grows with the number of jobs.
                 constexpr int kPage = 500;
-                const std::unique_ptr<pb::JobService::Stub> stub = Connect(*flags);
+                FarmClient client(*flags);
                 pb::ListJobsRequest req;
                 int listed = 0;
                 if (!*json) {
@@ -605,9 +170,7 @@ Command AddListCommand(CLI::App& app) {
                 do {
                     req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
                     pb::ListJobsResponse resp;
-                    absl::Status s = CallStatus(
-                        stub->ListJobs(ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
-                        *flags);
+                    absl::Status s = client.Call(&pb::JobService::Stub::ListJobs, req, &resp);
                     if (!s.ok()) return ReportError(s);
                     for (const pb::Job& job : resp.jobs()) {
                         if (*json) {
@@ -640,12 +203,16 @@ Command AddStatusCommand(CLI::App& app) {
     AddJsonFlag(cmd, *json);
     AddServerOption(cmd, *flags);
     return {cmd, [flags, id, json] {
-                absl::StatusOr<pb::Job> job = GetJob(*flags, *id);
-                if (!job.ok()) return ReportError(job.status());
+                pb::GetJobRequest req;
+                req.set_job_id(*id);
+                pb::Job job;
+                const absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::GetJob, req, &job);
+                if (!s.ok()) return ReportError(s);
                 if (*json) {
-                    PrintJson(*job);
+                    PrintJson(job);
                 } else {
-                    PrintJob(*job);
+                    PrintJob(job);
                 }
                 return 0;
             }};
@@ -663,7 +230,7 @@ Command AddWatchCommand(CLI::App& app) {
     AddRetryOption(cmd, *flags);
     return {cmd, [flags, id] {
                 ProgressBar bar(*id);
-                absl::StatusOr<pb::Job> job = Watch(*flags, *id, bar);
+                absl::StatusOr<pb::Job> job = FarmClient(*flags).Watch(*id, bar);
                 bar.Finish();
                 if (!job.ok()) return ReportError(job.status());
                 std::printf("job %s %s (%s tasks, %d retried)%s%s\n", job->id().c_str(),
@@ -707,18 +274,16 @@ Command AddCancelCommand(CLI::App& app) {
         "cancel", "Cancel a queued or running job; workers drop its tasks within a second.");
     cmd->add_option("job", *id, "job id")->required();
     AddServerOption(cmd, *flags);
-    return {
-        cmd, [flags, id] {
-            pb::CancelJobRequest req;
-            req.set_job_id(*id);
-            pb::Job job;
-            absl::Status s = CallStatus(
-                Connect(*flags)->CancelJob(ContextWithDeadline(absl::Seconds(10)).get(), req, &job),
-                *flags);
-            if (!s.ok()) return ReportError(s);
-            std::printf("job %s %s\n", job.id().c_str(), StateName(job.state()).c_str());
-            return 0;
-        }};
+    return {cmd, [flags, id] {
+                pb::CancelJobRequest req;
+                req.set_job_id(*id);
+                pb::Job job;
+                absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::CancelJob, req, &job);
+                if (!s.ok()) return ReportError(s);
+                std::printf("job %s %s\n", job.id().c_str(), StateName(job.state()).c_str());
+                return 0;
+            }};
 }
 
 Command AddPriorityCommand(CLI::App& app) {
@@ -737,9 +302,7 @@ Command AddPriorityCommand(CLI::App& app) {
                 req.set_priority(*priority);
                 pb::Job job;
                 absl::Status s =
-                    CallStatus(Connect(*flags)->SetJobPriority(
-                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &job),
-                               *flags);
+                    FarmClient(*flags).Call(&pb::JobService::Stub::SetJobPriority, req, &job);
                 if (!s.ok()) return ReportError(s);
                 std::printf("job %s priority %d\n", job.id().c_str(), job.priority());
                 return 0;
@@ -759,9 +322,7 @@ Command AddDeleteCommand(CLI::App& app) {
                 req.set_job_id(*id);
                 pb::DeleteJobResponse resp;
                 absl::Status s =
-                    CallStatus(Connect(*flags)->DeleteJob(
-                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
-                               *flags);
+                    FarmClient(*flags).Call(&pb::JobService::Stub::DeleteJob, req, &resp);
                 if (!s.ok()) return ReportError(s);
                 std::printf("job %s deleted\n", id->c_str());
                 return 0;
@@ -781,9 +342,7 @@ Command AddWorkersCommand(CLI::App& app) {
                 pb::ListWorkersRequest req;
                 pb::ListWorkersResponse resp;
                 absl::Status s =
-                    CallStatus(Connect(*flags)->ListWorkers(
-                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
-                               *flags);
+                    FarmClient(*flags).Call(&pb::JobService::Stub::ListWorkers, req, &resp);
                 if (!s.ok()) return ReportError(s);
                 if (*json) {
                     for (const pb::WorkerInfo& w : resp.workers()) PrintJson(w);
@@ -839,36 +398,33 @@ Command AddTasksCommand(CLI::App& app) {
     cmd->add_option("job", *id, "job id")->required();
     AddJsonFlag(cmd, *json);
     AddServerOption(cmd, *flags);
-    return {cmd, [flags, id, json] {
-                pb::ListTasksRequest req;
-                req.set_job_id(*id);
-                pb::ListTasksResponse resp;
-                absl::Status s =
-                    CallStatus(Connect(*flags)->ListTasks(
-                                   ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
-                               *flags);
-                if (!s.ok()) return ReportError(s);
-                if (*json) {
-                    for (const pb::TaskInfo& t : resp.tasks()) PrintJson(t);
-                    return 0;
-                }
-                std::printf("%5s %-8s %-15s %-17s %8s %-20s %9s  %s\n", "TASK", "STATE", "KIND",
-                            "PIXELS", "ATTEMPTS", "WORKER", "DURATION", "LAST-ERROR");
-                for (const pb::TaskInfo& t : resp.tasks()) {
-                    const std::string pixels =
-                        t.width() > 0
-                            ? absl::StrCat(t.x(), ",", t.y(), " ", t.width(), "x", t.height())
-                            : "-";
-                    const std::string duration =
-                        t.leased_unix_ms() > 0 ? absl::StrFormat("%.2f s", t.seconds()) : "-";
-                    std::printf("%5d %-8s %-15s %-17s %8d %-20s %9s  %s\n", t.index(),
-                                TaskStateName(t.state()).c_str(), TaskKindName(t.kind()).c_str(),
-                                pixels.c_str(), t.attempts(),
-                                t.worker().empty() ? "-" : LogSafe(t.worker(), 20).c_str(),
-                                duration.c_str(), LogSafe(t.last_error(), 200).c_str());
-                }
+    return {
+        cmd, [flags, id, json] {
+            pb::ListTasksRequest req;
+            req.set_job_id(*id);
+            pb::ListTasksResponse resp;
+            absl::Status s = FarmClient(*flags).Call(&pb::JobService::Stub::ListTasks, req, &resp);
+            if (!s.ok()) return ReportError(s);
+            if (*json) {
+                for (const pb::TaskInfo& t : resp.tasks()) PrintJson(t);
                 return 0;
-            }};
+            }
+            std::printf("%5s %-8s %-15s %-17s %8s %-20s %9s  %s\n", "TASK", "STATE", "KIND",
+                        "PIXELS", "ATTEMPTS", "WORKER", "DURATION", "LAST-ERROR");
+            for (const pb::TaskInfo& t : resp.tasks()) {
+                const std::string pixels =
+                    t.width() > 0 ? absl::StrCat(t.x(), ",", t.y(), " ", t.width(), "x", t.height())
+                                  : "-";
+                const std::string duration =
+                    t.leased_unix_ms() > 0 ? absl::StrFormat("%.2f s", t.seconds()) : "-";
+                std::printf("%5d %-8s %-15s %-17s %8d %-20s %9s  %s\n", t.index(),
+                            TaskStateName(t.state()).c_str(), TaskKindName(t.kind()).c_str(),
+                            pixels.c_str(), t.attempts(),
+                            t.worker().empty() ? "-" : LogSafe(t.worker(), 20).c_str(),
+                            duration.c_str(), LogSafe(t.last_error(), 200).c_str());
+            }
+            return 0;
+        }};
 }
 
 Command AddLogsCommand(CLI::App& app) {
@@ -891,22 +447,15 @@ Command AddLogsCommand(CLI::App& app) {
     AddServerOption(cmd, *flags);
     AddRetryOption(cmd, *flags);
     return {cmd, [flags, id, task, follow, json] {
-                std::unique_ptr<pb::JobService::Stub> stub = Connect(*flags);
+                FarmClient client(*flags);
                 pb::GetTaskLogsRequest req;
                 req.set_job_id(*id);
                 if (*task >= 0) req.set_task_index(*task);
-                Backoff backoff(*flags);
                 while (true) {
                     pb::GetTaskLogsResponse resp;
-                    const absl::Status s = CallStatus(
-                        stub->GetTaskLogs(ContextWithDeadline(absl::Seconds(10)).get(), req, &resp),
-                        *flags);
-                    if (absl::IsUnavailable(s) && backoff.Wait("logs " + *id, s)) {
-                        stub = Connect(*flags);
-                        continue;
-                    }
+                    const absl::Status s = client.CallRetrying(
+                        "logs " + *id, &pb::JobService::Stub::GetTaskLogs, req, &resp);
                     if (!s.ok()) return ReportError(s);
-                    backoff.Reset();
                     for (const pb::TaskLogLine& line : resp.lines()) {
                         if (*json) {
                             PrintJson(line);

@@ -185,6 +185,21 @@ pb::Job::State ToProto(JobState s) {
     return pb::Job::STATE_UNSPECIFIED;
 }
 
+JobState FromProto(pb::Job::State s) {
+    switch (s) {
+        case pb::Job::RUNNING:
+            return JobState::kRunning;
+        case pb::Job::SUCCEEDED:
+            return JobState::kSucceeded;
+        case pb::Job::FAILED:
+            return JobState::kFailed;
+        case pb::Job::CANCELLED:
+            return JobState::kCancelled;
+        default:
+            return JobState::kQueued;
+    }
+}
+
 void ToProto(const JobRecord& job, pb::Job* out) {
     out->set_id(job.id);
     out->set_name(job.spec.name);

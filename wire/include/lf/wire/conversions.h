@@ -31,6 +31,8 @@ void ToProto(const JobSpec& spec, lightfarm::v1::SubmitJobRequest* out);
 JobSpec FromProto(const lightfarm::v1::SubmitJobRequest& request);
 
 lightfarm::v1::Job::State ToProto(JobState state);
+// STATE_UNSPECIFIED, and a state of a newer server, are kQueued, the model's default: not final.
+JobState FromProto(lightfarm::v1::Job::State state);
 void ToProto(const JobRecord& job, lightfarm::v1::Job* out);
 
 void ToProto(const TaskAssignment& task, lightfarm::v1::Task* out);
