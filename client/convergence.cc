@@ -20,7 +20,7 @@
 #include "lf/core/log.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/job/render_metadata.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/radiosity.h"
@@ -33,7 +33,7 @@ extern char** environ;
 namespace lf {
 
 bool IsLadderMethod(Method method) {
-    return method == Method::kPath || Info(method).work == WorkKind::kFramePasses;
+    return method == Method::kPath || Info(method).work == WorkKind::kSplatPasses;
 }
 
 std::string ConfigName(const RenderConfig& config) {

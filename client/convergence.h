@@ -20,13 +20,13 @@
 #include "lf/core/light_strategy.h"
 #include "lf/core/sampler.h"
 #include "lf/core/scene_loader.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/job/method_registry.h"
 #include "lf/job/settings.h"
 
 namespace lf {
 
-// What a ladder varies: the method (the path tracer or a frame method: light, bdpt, ppm), where
+// What a ladder varies: the method (the path tracer or a splatting method: light, bdpt, ppm), where
 // the random numbers come from and how next-event estimation picks lights.
 struct RenderConfig {
     Method method = Method::kPath;

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "absl/status/status.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 
 namespace lf {
 

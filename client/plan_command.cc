@@ -15,7 +15,7 @@
 #include "lf/core/image_error.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
@@ -371,8 +371,8 @@ absl::Status RunPlan(const PlanOptions& options) {
     }
 
     const Camera camera(scene->camera, (*embree)->origin());
-    // The frame methods are not adaptive: the comparison of methods is their cost.
-    if (Info(method).work == WorkKind::kFramePasses) {
+    // The splatting methods are not adaptive: the comparison of methods is their cost.
+    if (Info(method).work == WorkKind::kSplatPasses) {
         return PrintMethodCosts(*scene, **embree, camera, options, method);
     }
 

@@ -137,10 +137,10 @@ Command AddSubmitCommand(CLI::App& app) {
     cmd->add_option("--method", o->spec.method,
                     "path, radiosity (Lambertian scenes; same bits as `lightfarm render "
                     "--method radiosity` with the same options), whitted (direct light and "
-                    "specular chains only, a preview), or a frame method: light (light tracing), "
+                    "specular chains only, a preview), or a splatting method: light (light tracing), "
                     "bdpt (bidirectional path tracing), ppm (progressive photon mapping). Every "
                     "method gives the bits of `lightfarm render` with the same options; the "
-                    "frame methods take no --aov nor adaptive sampling")
+                    "splatting methods take no --aov nor adaptive sampling")
         ->capture_default_str()
         ->check([](const std::string& m) { return MethodFlagError(m, false); });
     AddPhotonFlags(cmd, o->spec.ppm);

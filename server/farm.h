@@ -74,7 +74,7 @@ class Farm {
 
     // Decodes and merges a task's result; writes the job's EXR when it was the last one.
     // `radiosity`: what the worker's radiosity solve reported, for that EXR's header. `splats`:
-    // a frame task's splat list (lf::EncodeSplatList), with `tile_sums` its camera part. A
+    // a splat task's splat list (lf::EncodeSplatList), with `tile_sums` its camera part. A
     // result that does not decode, or does not fit its task, is refused naming the job, the
     // task and the worker, and the task goes back to the queue as a counted failure.
     absl::Status Complete(const std::string& lease_id, const std::string& worker,

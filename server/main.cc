@@ -8,7 +8,7 @@
 #include <cstdio>
 
 #include "lf/core/stop_signals.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "proto/channel.h"
 #include "server/farm.h"
 #include "server/grpc_service.h"
@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
     builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,
                                int(lf::kKeepaliveInterval / absl::Milliseconds(2)));
     builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PING_STRIKES, 0);
-    // A frame task's result (camera sums and splats) may be far above gRPC's 4 MiB default; the
+    // A splat task's result (camera sums and splats) may be far above gRPC's 4 MiB default; the
     // bound is the largest one the plans make (lf::kMaxTaskResultBytes, docs/farm.md).
     builder.SetMaxReceiveMessageSize(lf::kMaxTaskResultBytes);
     builder.AddListeningPort(listen, *credentials, &port);

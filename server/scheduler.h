@@ -130,7 +130,7 @@ class Scheduler {
     };
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
                                         const TaskResult& result);
-    // A tile's result, or a frame task's (`sums` its camera part, a 0x0 tile with the stats when
+    // A tile's result, or a splat task's (`sums` its camera part, a 0x0 tile with the stats when
     // it has none, and `splats` its splat list).
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
                                         const TileSums& sums, SplatList* splats = nullptr) {

@@ -4,7 +4,7 @@
 
 #include <fstream>
 
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/version.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/worker_service.grpc.pb.h"
@@ -29,7 +29,7 @@ absl::StatusOr<std::unique_ptr<ServerConnection>> ServerConnection::Open(
     args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
     args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
     args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
-    // The coordinator takes results up to this (frame tasks' splats: docs/farm.md).
+    // The coordinator takes results up to this (splat tasks' splats: docs/farm.md).
     args.SetMaxSendMessageSize(kMaxTaskResultBytes);
     absl::StatusOr<std::shared_ptr<grpc::Channel>> channel = OpenChannel(options, args);
     if (!channel.ok()) return channel.status();

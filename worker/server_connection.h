@@ -38,7 +38,7 @@ class ServerConnection {
         std::string bytes;
         bool sweep = false;
         std::optional<RadiosityFigures> radiosity;  // a radiosity job's tile: for the EXR header
-        // A frame task's splat list (lf::EncodeSplatList); `bytes` is then its camera part.
+        // A splat task's splat list (lf::EncodeSplatList); `bytes` is then its camera part.
         std::optional<std::string> splats;
         std::vector<TaskLogLine> log;  // the task's lines no heartbeat took
     };

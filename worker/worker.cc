@@ -13,7 +13,7 @@
 #include "lf/core/radiosity_codec.h"
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/tile_renderer.h"
 #include "lf/local/method_factory.h"
@@ -189,7 +189,7 @@ absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>
         result = {std::move(*swept), true, std::nullopt};
         return absl::OkStatus();
     }
-    if (UsesFramePlan(task.spec.method)) return RenderFrame(task, cancel, result, stats);
+    if (UsesSplatPlan(task.spec.method)) return RenderSplat(task, cancel, result, stats);
     if (absl::Status s = PrepareTracer(task, cancel); !s.ok()) return s;
     const TileSums sums = Render(task, cancel);
     stats = sums.stats;
@@ -368,24 +368,24 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
     return tile;
 }
 
-absl::Status Worker::RenderFrame(const TaskAssignment& task, const std::atomic<bool>& cancel,
+absl::Status Worker::RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
                                  ServerConnection::TaskResult& result, RenderStats& stats) {
     if (!loaded_.frame) {
         // Cached per job (loaded_.job_id), through the conversions local mode uses, so one job's
         // settings give local mode's kernel.
         const JobSpec& spec = task.spec;
-        absl::StatusOr<std::unique_ptr<FrameRenderer>> made = MakeFrameRenderer(
-            MethodOf(spec), *loaded_.embree, *loaded_.camera, FrameRenderSettingsOf(spec));
+        absl::StatusOr<std::unique_ptr<SplatRenderer>> made = MakeSplatRenderer(
+            MethodOf(spec), *loaded_.embree, *loaded_.camera, SplatRenderSettingsOf(spec));
         if (!made.ok()) return made.status();
         loaded_.frame = std::move(*made);
     }
-    const FrameWork work{task.task.rect, task.task.sample_begin, task.task.sample_end,
+    const SplatWork work{task.task.rect, task.task.sample_begin, task.task.sample_end,
                          task.path_begin, task.path_end};
     TileSums camera(task.task.rect, 0);
     SplatList splats(loaded_.camera->width(), loaded_.camera->height());
     // The renderer runs tbb inside: in this worker's arena, so --threads bounds it.
     arena_.execute([&] { loaded_.frame->Render(work, camera, splats, &cancel); });
-    if (cancel) return absl::CancelledError("frame task cancelled");
+    if (cancel) return absl::CancelledError("splat task cancelled");
     stats = camera.stats;
     result.bytes = EncodeTileSums(camera);
     result.splats = EncodeSplatList(splats);

@@ -18,7 +18,7 @@
 #include "absl/status/status.h"
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/frame_renderer.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiance.h"
 #include "lf/kernels/radiosity.h"
@@ -56,7 +56,7 @@ class Worker {
         std::unique_ptr<EmbreeScene> embree;
         std::unique_ptr<Camera> camera;
         std::unique_ptr<RadianceEstimator> tracer;  // path or Whitted tracer, radiosity display
-        std::unique_ptr<FrameRenderer> frame;       // a frame method's (light, bdpt, ppm)
+        std::unique_ptr<SplatRenderer> frame;       // a splatting method's (light, bdpt, ppm)
         // Radiosity solved in sweeps: the form-factor rows of the chunks this worker swept
         // (the server gives a chunk back to the worker that has its rows), and the last input.
         std::map<int, std::unique_ptr<RadiositySweepChunk>> chunks;
@@ -71,13 +71,13 @@ class Worker {
     // The job's path tracer or radiosity display, built once per job.
     absl::Status PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel);
     TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
-    // A tile or frame task's camera sums, or a sweep's result: `result` and its stats.
+    // A tile or splat task's camera sums, or a sweep's result: `result` and its stats.
     absl::Status RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
                          ServerConnection::TaskResult& result, RenderStats& stats);
-    // A frame method's task (lf::FrameTask): its camera sums and its splat list, encoded; the
+    // A splatting method's task (lf::SplatTask): its camera sums and its splat list, encoded; the
     // renderer is built once per job. FailedPrecondition when the result is above what the
     // coordinator takes (lf::kMaxTaskResultBytes).
-    absl::Status RenderFrame(const TaskAssignment& task, const std::atomic<bool>& cancel,
+    absl::Status RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
                              ServerConnection::TaskResult& result, RenderStats& stats);
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A radiosity vector the server stored as a blob.

@@ -95,8 +95,8 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
     rect.y0 = in.I32();
     rect.width = in.I32();
     rect.height = in.I32();
-    // 0x0 at 0,0: no pixels, only the stats (a frame task without a camera part, whose rays
-    // still count: lf/kernels/frame_renderer.h).
+    // 0x0 at 0,0: no pixels, only the stats (a splat task without a camera part, whose rays
+    // still count: lf/kernels/splat_renderer.h).
     const bool no_pixels = rect.x0 == 0 && rect.y0 == 0 && rect.width == 0 && rect.height == 0;
     if (!no_pixels && (rect.x0 < 0 || rect.y0 < 0 || rect.width <= 0 || rect.height <= 0 ||
                        rect.Area() > kMaxPixels)) {

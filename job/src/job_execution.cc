@@ -1,8 +1,8 @@
 #include "lf/job/job_execution.h"
 
 #include "lf/job/adaptive_tile_execution.h"
-#include "lf/job/frame_execution.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_execution.h"
+#include "lf/job/splat_settings.h"
 #include "lf/job/sweep_execution.h"
 #include "lf/job/tile_execution.h"
 
@@ -25,12 +25,12 @@ absl::StatusOr<std::unique_ptr<JobExecution>> Upcast(absl::StatusOr<std::unique_
 // The one place that tells the kinds of job apart.
 absl::StatusOr<std::unique_ptr<JobExecution>> MakeJobExecution(
     const JobSpec& spec, const TileStoreFactory& tile_stores) {
-    if (UsesFramePlan(spec.method)) {
-        // The plan local mode makes of the same settings (lf::RenderFrameImage), so the merged
+    if (UsesSplatPlan(spec.method)) {
+        // The plan local mode makes of the same settings (lf::RenderSplatImage), so the merged
         // sums are its bits.
-        absl::StatusOr<FramePlanSettings> plan = FramePlanSettingsOf(spec.method, spec.plan);
+        absl::StatusOr<SplatPlanSettings> plan = SplatPlanSettingsOf(spec.method, spec.plan);
         if (!plan.ok()) return plan.status();
-        return Upcast(FrameExecution::Make(*plan, tile_stores));
+        return Upcast(SplatExecution::Make(*plan, tile_stores));
     }
     if (IsAdaptive(spec.adaptive)) {
         return Upcast(AdaptiveTileExecution::Make(spec.plan.width, spec.plan.height, spec.plan.spp,

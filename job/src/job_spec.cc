@@ -39,7 +39,7 @@ absl::Status OneOf(const char* field, const std::string& value,
         absl::StrCat(field, " \"", value, "\": expected one of ", expected));
 }
 
-// The methods' own limits (MethodInfo): the frame methods make no AOVs and sample no
+// The methods' own limits (MethodInfo): the splatting methods make no AOVs and sample no
 // adaptive passes. Ok for an unknown method, which CheckJobSettings refuses first.
 absl::Status CheckMethodSettings(const JobSpec& spec) {
     const std::optional<Method> method = FindMethod(spec.method);

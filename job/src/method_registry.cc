@@ -19,11 +19,11 @@ constexpr std::array<MethodInfo, 6> kMethods = {{
     {Method::kRadiosity, "radiosity", WorkKind::kRadiosity, std::nullopt, false, false, true, true,
      RadiosityRefusal},
     {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, true, nullptr},
-    {Method::kLight, "light", WorkKind::kFramePasses, FramePlanKind::kLightPaths, true, false,
+    {Method::kLight, "light", WorkKind::kSplatPasses, SplatPlanKind::kLightPaths, true, false,
      false, false, nullptr},
-    {Method::kBdpt, "bdpt", WorkKind::kFramePasses, FramePlanKind::kCameraAndLight, true, true,
+    {Method::kBdpt, "bdpt", WorkKind::kSplatPasses, SplatPlanKind::kCameraAndLight, true, true,
      false, false, nullptr},
-    {Method::kPpm, "ppm", WorkKind::kFramePasses, FramePlanKind::kPhotonPasses, false, true, false,
+    {Method::kPpm, "ppm", WorkKind::kSplatPasses, SplatPlanKind::kPhotonPasses, false, true, false,
      false, nullptr},
 }};
 

@@ -174,7 +174,7 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     if (!info) return d;
     if (info->work == WorkKind::kRadiosity) AddRadiosityAttributes(m, d.attributes);
     if (info->splats_light_paths) AddLightPathAttributes(m, image, d.attributes);
-    if (info->frame_plan == FramePlanKind::kPhotonPasses) AddPhotonAttributes(m, d.attributes);
+    if (info->splat_plan == SplatPlanKind::kPhotonPasses) AddPhotonAttributes(m, d.attributes);
     return d;
 }
 

@@ -31,7 +31,7 @@ const char* TaskKindName(TaskKind kind) {
     switch (kind) {
         case TaskKind::kTile:
             return "tile";
-        case TaskKind::kFrame:
+        case TaskKind::kSplat:
             return "frame";
         case TaskKind::kRadiositySweep:
             return "sweep";

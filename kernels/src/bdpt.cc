@@ -89,7 +89,7 @@ struct BdptRenderer::Scratch {
 };
 
 BdptRenderer::BdptRenderer(const EmbreeScene& scene, const Camera& camera,
-                           const FrameRenderSettings& settings)
+                           const SplatRenderSettings& settings)
     : scene_(scene),
       camera_(camera),
       settings_(settings),
@@ -569,7 +569,7 @@ Rgb BdptRenderer::Sample(int x, int y, uint64_t sample_index, SplatList& splats,
     return L;
 }
 
-void BdptRenderer::Render(const FrameWork& work, TileSums& camera, SplatList& splats,
+void BdptRenderer::Render(const SplatWork& work, TileSums& camera, SplatList& splats,
                           const std::atomic<bool>* cancel) const {
     const PixelRect& rect = work.rect;
     if (rect.Area() <= 0 || work.sample_end <= work.sample_begin) return;

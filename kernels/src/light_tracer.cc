@@ -20,7 +20,7 @@ constexpr int kRouletteStartDepth = 1;
 }  // namespace
 
 LightTracer::LightTracer(const EmbreeScene& scene, const Camera& camera,
-                         const FrameRenderSettings& settings)
+                         const SplatRenderSettings& settings)
     : scene_(scene), camera_(camera), settings_(settings), emission_(scene) {}
 
 void LightTracer::Splat(const Vec2& raster, int half, Rgb value, SplatList& splats,
@@ -163,7 +163,7 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
     }
 }
 
-void LightTracer::Render(const FrameWork& work, TileSums& camera, SplatList& splats,
+void LightTracer::Render(const SplatWork& work, TileSums& camera, SplatList& splats,
                          const std::atomic<bool>* cancel) const {
     if (work.path_end <= work.path_begin) return;
     const uint64_t paths = work.path_end - work.path_begin;

@@ -81,7 +81,7 @@ double PpmDefaultRadius(const EmbreeScene& scene, const Camera& camera) {
 }
 
 absl::StatusOr<std::unique_ptr<PpmRenderer>> PpmRenderer::Create(
-    const EmbreeScene& scene, const Camera& camera, const FrameRenderSettings& settings) {
+    const EmbreeScene& scene, const Camera& camera, const SplatRenderSettings& settings) {
     if (!(settings.alpha > 0 && settings.alpha < 1)) {
         return absl::InvalidArgumentError(
             absl::StrCat("ppm: alpha ", settings.alpha, " is not in (0, 1)"));
@@ -94,7 +94,7 @@ absl::StatusOr<std::unique_ptr<PpmRenderer>> PpmRenderer::Create(
 }
 
 PpmRenderer::PpmRenderer(const EmbreeScene& scene, const Camera& camera,
-                         const FrameRenderSettings& settings)
+                         const SplatRenderSettings& settings)
     : scene_(scene),
       camera_(camera),
       settings_(settings),
@@ -320,7 +320,7 @@ Rgb PpmRenderer::DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec
     return L;
 }
 
-void PpmRenderer::Render(const FrameWork& work, TileSums& camera, SplatList& /*splats*/,
+void PpmRenderer::Render(const SplatWork& work, TileSums& camera, SplatList& /*splats*/,
                          const std::atomic<bool>* cancel) const {
     const PixelRect& rect = work.rect;
     if (rect.Area() == 0) return;

@@ -4,7 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/job/adaptive_tile_execution.h"
-#include "lf/job/frame_execution.h"
+#include "lf/job/splat_execution.h"
 #include "lf/job/tile_execution.h"
 #include "lf/kernels/tile_renderer.h"
 #include "lf/local/execution_runner.h"
@@ -84,22 +84,22 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
     return Output(execution, clock, started);
 }
 
-absl::StatusOr<RenderOutput> RenderFrameImage(const Camera& camera, const FrameRenderer& renderer,
-                                              const FramePlanSettings& plan,
+absl::StatusOr<RenderOutput> RenderSplatImage(const Camera& camera, const SplatRenderer& renderer,
+                                              const SplatPlanSettings& plan,
                                               const RenderSettings& settings,
                                               const ProgressFn& progress) {
     const RunClock clock = ClockOr({});
     const absl::Time started = clock();
     if (plan.width != camera.width() || plan.height != camera.height()) {
-        return absl::InvalidArgumentError(absl::StrCat("frame plan ", plan.width, "x", plan.height,
+        return absl::InvalidArgumentError(absl::StrCat("splat plan ", plan.width, "x", plan.height,
                                                        " is not the camera's ", camera.width(), "x",
                                                        camera.height()));
     }
     // Two stores (camera sums, splat sums), each as a tile render's, in a file above 2048x2048.
-    absl::StatusOr<std::unique_ptr<FrameExecution>> made =
-        FrameExecution::Make(plan, TileStoreFor(camera, 0));
+    absl::StatusOr<std::unique_ptr<SplatExecution>> made =
+        SplatExecution::Make(plan, TileStoreFor(camera, 0));
     if (!made.ok()) return made.status();
-    FrameExecution& execution = **made;
+    SplatExecution& execution = **made;
     RunOptions options;
     options.threads = settings.threads;
     options.merged = [&] {

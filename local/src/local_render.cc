@@ -41,8 +41,8 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     summary.load_seconds = absl::ToDoubleSeconds(absl::Now() - start);
 
     std::unique_ptr<RadianceEstimator> estimator;
-    std::unique_ptr<FrameRenderer> frame_renderer;  // light, bdpt, ppm
-    std::optional<FramePlanSettings> frame_plan;
+    std::unique_ptr<SplatRenderer> splat_renderer;  // light, bdpt, ppm
+    std::optional<SplatPlanSettings> splat_plan;
     const RadiosityRenderer* radiosity = nullptr;
     const bool adaptive = options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
     // The job this render is, as the farm would run it: its kernels' settings and its header.
@@ -62,7 +62,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     job.ppm = options.ppm;
     job.adaptive = options.adaptive;
     job.scene_hash = scene->content_hash;
-    if (info.work == WorkKind::kFramePasses) {
+    if (info.work == WorkKind::kSplatPasses) {
         // The job model's checks, so local mode refuses what the coordinator refuses.
         if (options.render.aovs != 0 || adaptive) {
             JobSpec spec;
@@ -72,13 +72,13 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
             if (absl::Status s = CheckJobSettings(spec); !s.ok()) return s;
         }
         if (absl::Status s = CheckPhotonSettings(options.ppm); !s.ok()) return s;
-        absl::StatusOr<FramePlanSettings> plan = FramePlanSettingsOf(job.method, job.plan);
+        absl::StatusOr<SplatPlanSettings> plan = SplatPlanSettingsOf(job.method, job.plan);
         if (!plan.ok()) return plan.status();
-        frame_plan = *plan;
-        absl::StatusOr<std::unique_ptr<FrameRenderer>> made =
-            MakeFrameRenderer(method, **embree, camera, FrameRenderSettingsOf(job));
+        splat_plan = *plan;
+        absl::StatusOr<std::unique_ptr<SplatRenderer>> made =
+            MakeSplatRenderer(method, **embree, camera, SplatRenderSettingsOf(job));
         if (!made.ok()) return made.status();
-        frame_renderer = std::move(*made);
+        splat_renderer = std::move(*made);
     } else if (info.work == WorkKind::kRadiosity) {
         // The one --target-error bounds both errors: the mesh's and the display's sampling.
         absl::StatusOr<RadiosityOptions> parsed =
@@ -150,19 +150,19 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         options.render.clamp > 0 ? absl::StrCat(", clamp ", options.render.clamp, " (biased)")
                                  : std::string(),
         options.render.aovs != 0 ? ", AOVs " + AovListName(options.render.aovs) : std::string());
-    if (frame_plan) {
+    if (splat_plan) {
         log->info(
             "job={} {}", job_id,
-            frame_plan->kind == FramePlanKind::kLightPaths
-                ? absl::StrCat(frame_plan->light_paths, " light paths in ranges of ",
-                               frame_plan->max_paths_per_task)
-            : frame_plan->kind == FramePlanKind::kPhotonPasses
-                ? absl::StrCat(frame_plan->spp, " photon passes of ", options.ppm.photons_per_pass,
+            splat_plan->kind == SplatPlanKind::kLightPaths
+                ? absl::StrCat(splat_plan->light_paths, " light paths in ranges of ",
+                               splat_plan->max_paths_per_task)
+            : splat_plan->kind == SplatPlanKind::kPhotonPasses
+                ? absl::StrCat(splat_plan->spp, " photon passes of ", options.ppm.photons_per_pass,
                                " photons, alpha ", options.ppm.alpha, ", first radius ",
                                options.ppm.initial_radius > 0
                                    ? absl::StrCat(options.ppm.initial_radius)
                                    : std::string("the kernel's choice"),
-                               ", tile ", frame_plan->tile)
+                               ", tile ", splat_plan->tile)
                 : std::string("a light subpath per camera sample"));
     }
     if (adaptive) {
@@ -177,8 +177,8 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         if (options.progress) options.progress->Update(done, n);
     };
     absl::StatusOr<RenderOutput> out =
-        frame_renderer
-            ? RenderFrameImage(camera, *frame_renderer, *frame_plan, options.render, progress)
+        splat_renderer
+            ? RenderSplatImage(camera, *splat_renderer, *splat_plan, options.render, progress)
         : adaptive
             ? RenderImageAdaptive(camera, *estimator, options.render, options.adaptive, progress)
             : RenderImage(camera, *estimator, options.render, progress);

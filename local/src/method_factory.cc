@@ -24,9 +24,9 @@ absl::StatusOr<std::unique_ptr<RadianceEstimator>> MakeRayTracer(Method method,
     }
 }
 
-absl::StatusOr<std::unique_ptr<FrameRenderer>> MakeFrameRenderer(
+absl::StatusOr<std::unique_ptr<SplatRenderer>> MakeSplatRenderer(
     Method method, const EmbreeScene& scene, const Camera& camera,
-    const FrameRenderSettings& settings) {
+    const SplatRenderSettings& settings) {
     if (absl::Status s = CheckMethodTakesFilter(method, camera.filter()); !s.ok()) return s;
     switch (method) {
         case Method::kLight:
@@ -37,17 +37,17 @@ absl::StatusOr<std::unique_ptr<FrameRenderer>> MakeFrameRenderer(
             absl::StatusOr<std::unique_ptr<PpmRenderer>> ppm =
                 PpmRenderer::Create(scene, camera, settings);
             if (!ppm.ok()) return ppm.status();
-            return std::unique_ptr<FrameRenderer>(std::move(*ppm));
+            return std::unique_ptr<SplatRenderer>(std::move(*ppm));
         }
         default:
             return absl::InvalidArgumentError(
                 absl::StrCat("method ", MethodName(method),
-                             ": no frame renderer (frame methods: light, bdpt, ppm)"));
+                             ": no frame renderer (splatting methods: light, bdpt, ppm)"));
     }
 }
 
-FrameRenderSettings FrameRenderSettingsOf(const JobSpec& spec) {
-    return FrameRenderSettingsOf<FrameRenderSettings>(spec.max_depth, spec.seed, spec.sampler,
+SplatRenderSettings SplatRenderSettingsOf(const JobSpec& spec) {
+    return SplatRenderSettingsOf<SplatRenderSettings>(spec.max_depth, spec.seed, spec.sampler,
                                                       spec.clamp, spec.light_strategy, spec.ppm);
 }
 

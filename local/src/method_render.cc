@@ -21,16 +21,16 @@ absl::StatusOr<RenderOutput> RenderWithMethod(Method method, const EmbreeScene& 
         if (!tracer.ok()) return tracer.status();
         return RenderImage(camera, **tracer, render);
     }
-    absl::StatusOr<FramePlanSettings> plan = FramePlanSettingsOf(
+    absl::StatusOr<SplatPlanSettings> plan = SplatPlanSettingsOf(
         MethodName(method), {camera.width(), camera.height(), spp, render.tile, render.passes});
     if (!plan.ok()) return plan.status();
-    absl::StatusOr<std::unique_ptr<FrameRenderer>> renderer =
-        MakeFrameRenderer(method, scene, camera,
-                          FrameRenderSettingsOf<FrameRenderSettings>(
+    absl::StatusOr<std::unique_ptr<SplatRenderer>> renderer =
+        MakeSplatRenderer(method, scene, camera,
+                          SplatRenderSettingsOf<SplatRenderSettings>(
                               settings.max_depth, settings.seed, settings.sampler, settings.clamp,
                               settings.light_strategy, settings.ppm));
     if (!renderer.ok()) return renderer.status();
-    return RenderFrameImage(camera, **renderer, *plan, render);
+    return RenderSplatImage(camera, **renderer, *plan, render);
 }
 
 }  // namespace lf

@@ -922,10 +922,10 @@ TEST_F(Cli, WhittedRendersAndUnknownMethodsAreRefused) {
     }
 }
 
-// `render --method light` goes through the frame plan and merger: any --threads, --passes
+// `render --method light` goes through the splat plan and merger: any --threads, --passes
 // (light-path ranges) and --tile (splat tiles) give the same bits, and the header names the
 // method and its light paths. Photon flags with another method, and AOVs and adaptive sampling
-// with a frame method, are refused, saying why.
+// with a splatting method, are refused, saying why.
 TEST_F(Cli, LightTracingRendersTheSameBitsForAnySplit) {
     const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
     const std::string base = "render " + scene + " --method light --spp 2 --resolution 24x24 " +

@@ -1399,11 +1399,11 @@ TEST_F(Farm, BadGltfIsRefusedAtSubmissionWithTheLoadersMessage) {
         << missing.err;
 }
 
-// The frame methods (light paths or photon passes over the whole frame, splats merged exactly):
+// The splatting methods (light paths or photon passes over the whole frame, splats merged exactly):
 // on the farm, the bits and header of `lightfarm render` with the same flags, whichever worker
 // renders which task, a worker killed mid-task, or the coordinator killed mid-job. bdpt and ppm
 // join the list below when their kernels land (a one-line change).
-class FarmFrame : public Farm, public ::testing::WithParamInterface<std::string> {
+class FarmSplat : public Farm, public ::testing::WithParamInterface<std::string> {
   protected:
     std::string Flags(uint64_t spp, uint64_t seed, const std::string& more = "") const {
         return "--method " + GetParam() + " --spp " + std::to_string(spp) + " --seed " +
@@ -1429,13 +1429,13 @@ class FarmFrame : public Farm, public ::testing::WithParamInterface<std::string>
     }
 };
 
-INSTANTIATE_TEST_SUITE_P(Methods, FarmFrame, ::testing::Values("light", "bdpt", "ppm"),
+INSTANTIATE_TEST_SUITE_P(Methods, FarmSplat, ::testing::Values("light", "bdpt", "ppm"),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                              return info.param;
                          });
 
 // Split(): 16 tasks, whose splats land all over the frame, from both workers.
-TEST_P(FarmFrame, TwoWorkersGiveTheLocalBitsAndHeader) {
+TEST_P(FarmSplat, TwoWorkersGiveTheLocalBitsAndHeader) {
     StartServer();
     StartWorker("w1");
     StartWorker("w2");
@@ -1450,7 +1450,7 @@ TEST_P(FarmFrame, TwoWorkersGiveTheLocalBitsAndHeader) {
     EXPECT_NE(list.out.find(GetParam()), std::string::npos) << list.out;
 }
 
-TEST_P(FarmFrame, KilledWorkerDoesNotChangeTheImage) {
+TEST_P(FarmSplat, KilledWorkerDoesNotChangeTheImage) {
     StartServer(/*lease_seconds=*/1);
     Child* doomed = StartWorker("doomed");
     StartWorker("survivor");
@@ -1464,7 +1464,7 @@ TEST_P(FarmFrame, KilledWorkerDoesNotChangeTheImage) {
 
 // Results merged before the kill are recorded with their splats and merged once on restart; a
 // result merged twice, or lost, would change the bits.
-TEST_P(FarmFrame, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
+TEST_P(FarmSplat, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
     StartServer();
     StartWorker("w1");
     StartWorker("w2");
@@ -1480,7 +1480,7 @@ TEST_P(FarmFrame, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
 
 // A running frame job's preview is the image of the light paths merged so far (normalised by
 // them, so not darker than the final image would be); a cancel stops the kernel mid-task.
-TEST_P(FarmFrame, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
+TEST_P(FarmSplat, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
     StartServer();
     StartWorker("w1");
     const std::string job = Submit(scene_, Flags(1024, 3, Split()));
@@ -1506,7 +1506,7 @@ TEST_P(FarmFrame, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
 // the method and the filter, rather than failing on every worker.
 // Light tracing and bdpt splat with the box filter only and are refused other filters at
 // submission; ppm gathers at filter-sampled camera samples and renders them as locally.
-TEST_P(FarmFrame, NonBoxFilterIsRefusedAtSubmissionWhereTheKernelSplats) {
+TEST_P(FarmSplat, NonBoxFilterIsRefusedAtSubmissionWhereTheKernelSplats) {
     StartServer();
     const std::string filter = "--filter gaussian:2 " + Split();
     if (GetParam() == "ppm") {
@@ -1521,7 +1521,7 @@ TEST_P(FarmFrame, NonBoxFilterIsRefusedAtSubmissionWhereTheKernelSplats) {
     EXPECT_NE(r.err.find("gaussian"), std::string::npos) << r.err;
 }
 
-TEST(FarmFrameFlags, PhotonFlagsAreRefusedForOtherMethodsOnSubmit) {
+TEST(FarmSplatFlags, PhotonFlagsAreRefusedForOtherMethodsOnSubmit) {
     const std::string cmd = std::string(LF_BIN_DIR) + "/lightfarm submit " + LF_TEST_SCENES +
                             "/cornell_box.json --method light --photons 1000 "
                             "--server 127.0.0.1:1 2>&1";

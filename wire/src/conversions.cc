@@ -106,7 +106,7 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     if (info && info->work == WorkKind::kRadiosity) {
         ToProto(spec.radiosity, out->mutable_radiosity());
     }
-    if (info && info->frame_plan == FramePlanKind::kPhotonPasses) {
+    if (info && info->splat_plan == SplatPlanKind::kPhotonPasses) {
         ToProto(spec.ppm, out->mutable_ppm());
     }
     out->set_target_error(spec.adaptive.target_error);
@@ -242,7 +242,7 @@ void ToProto(const TaskAssignment& task, pb::Task* out) {
         out->set_kind(pb::Task::RADIOSITY_SWEEP);
         out->set_sweep(task.sweep);
         out->set_chunk(task.chunk);
-    } else if (UsesFramePlan(task.spec.method)) {
+    } else if (UsesSplatPlan(task.spec.method)) {
         out->set_kind(pb::Task::FRAME);
         out->set_path_begin(task.path_begin);
         out->set_path_end(task.path_end);
@@ -315,7 +315,7 @@ pb::TaskInfo::Kind ToProto(TaskKind kind) {
     switch (kind) {
         case TaskKind::kTile:
             return pb::TaskInfo::TILE;
-        case TaskKind::kFrame:
+        case TaskKind::kSplat:
             return pb::TaskInfo::FRAME;
         case TaskKind::kRadiositySweep:
             return pb::TaskInfo::RADIOSITY_SWEEP;

@@ -8,7 +8,7 @@
 #include <typeindex>
 
 #include "lf/job/adaptive_tile_execution.h"
-#include "lf/job/frame_execution.h"
+#include "lf/job/splat_execution.h"
 #include "lf/job/sweep_execution.h"
 #include "lf/job/tile_execution.h"
 
@@ -140,16 +140,16 @@ TEST(AdaptiveTileExecution, TimeLimitDropsPassesOnce) {
     EXPECT_TRUE(e->TileReport()->timed_out);
 }
 
-TEST(FrameExecution, MergesCameraPartsAndSplatsAndRecordsBoth) {
-    FramePlanSettings plan;
+TEST(SplatExecution, MergesCameraPartsAndSplatsAndRecordsBoth) {
+    SplatPlanSettings plan;
     plan.width = 8;
     plan.height = 4;
-    plan.kind = FramePlanKind::kLightPaths;
+    plan.kind = SplatPlanKind::kLightPaths;
     plan.light_paths = 64;
     plan.max_paths_per_task = 16;
-    auto made = FrameExecution::Make(plan, MakeMemoryTileStore);
+    auto made = SplatExecution::Make(plan, MakeMemoryTileStore);
     ASSERT_TRUE(made.ok()) << made.status();
-    FrameExecution& e = **made;
+    SplatExecution& e = **made;
     ASSERT_EQ(e.Start().size(), 4u);
     TaskAssignment lease;
     e.Lease(1, "w", lease);
@@ -157,7 +157,7 @@ TEST(FrameExecution, MergesCameraPartsAndSplatsAndRecordsBoth) {
     EXPECT_EQ(lease.path_end, 32u);
     TaskStatus status;
     e.Describe(1, status);
-    EXPECT_EQ(status.kind, TaskKind::kFrame);
+    EXPECT_EQ(status.kind, TaskKind::kSplat);
     EXPECT_EQ(status.width, 8);  // a light-path task covers the frame
     const TileSums camera{PixelRect{}};
     EXPECT_EQ(e.Merge(0, {.sums = &camera}).status().code(), absl::StatusCode::kInvalidArgument);
@@ -238,7 +238,7 @@ TEST(MakeJobExecution, ChoosesTheKindFromTheSpec) {
     spec.radiosity.solver = "shooting";
     EXPECT_EQ(kind(), std::type_index(typeid(TileExecution)));
     spec.method = "light";
-    EXPECT_EQ(kind(), std::type_index(typeid(FrameExecution)));
+    EXPECT_EQ(kind(), std::type_index(typeid(SplatExecution)));
     absl::StatusOr<std::unique_ptr<JobExecution>> light =
         MakeJobExecution(spec, MakeMemoryTileStore);
     ASSERT_TRUE(light.ok());

@@ -26,7 +26,7 @@ namespace {
 
 // A frame of BDPT estimates: per pixel the two half estimates (A: even camera samples and their
 // light subpaths, B: odd ones), each its camera mean plus its splat sum x W H / N_h, N_h the
-// camera samples of that half over the frame (lf/job/frame_merge.h's normalisation).
+// camera samples of that half over the frame (lf/job/splat_merge.h's normalisation).
 struct BdptFrame {
     int width = 0, height = 0;
     std::vector<Rgb> half[2];
@@ -41,16 +41,16 @@ BdptFrame RenderBdpt(const Scene& scene, uint64_t spp, int max_depth, uint64_t s
     auto es = EmbreeScene::Build(scene);
     EXPECT_TRUE(es.ok()) << es.status();
     const Camera camera(scene.camera, (*es)->origin());
-    FrameRenderSettings settings;
+    SplatRenderSettings settings;
     settings.max_depth = max_depth;
     settings.seed = seed;
-    auto renderer = MakeFrameRenderer(Method::kBdpt, **es, camera, settings);
+    auto renderer = MakeSplatRenderer(Method::kBdpt, **es, camera, settings);
     EXPECT_TRUE(renderer.ok()) << renderer.status();
     const int w = camera.width(), h = camera.height();
     const PixelRect rect{0, 0, w, h};
     TileSums sums(rect);
     SplatList splats(w, h);
-    (*renderer)->Render(FrameWork{rect, 0, spp, 0, 0}, sums, splats);
+    (*renderer)->Render(SplatWork{rect, 0, spp, 0, 0}, sums, splats);
     TileSums splat_tile(rect);
     splats.AddTo(splat_tile);
     BdptFrame frame;
@@ -79,7 +79,7 @@ BdptFrame RenderBdpt(const Scene& scene, uint64_t spp, int max_depth, uint64_t s
 struct Mean {
     double value = 0, error = 0;
 };
-Mean FrameMean(const BdptFrame& f) {
+Mean SplatMean(const BdptFrame& f) {
     double sum = 0, var = 0;
     const double n = double(f.width) * f.height;
     for (int y = 0; y < f.height; ++y) {
@@ -164,7 +164,7 @@ TEST(Bdpt, FurnaceSphereWithAPointLightHasMeanRadianceOne) {
     // 0.5 / (1 - 0.5) = 1 over all bounces.
     scene.point_lights.push_back({{0, 0, 0}, Rgb(std::numbers::pi_v<float>)});
     const BdptFrame f = RenderBdpt(scene, 64, -1);
-    const Mean m = FrameMean(f);
+    const Mean m = SplatMean(f);
     std::printf("[bdpt] point-lit furnace: %.5f +- %.5f\n", m.value, m.error);
     EXPECT_NEAR(m.value, 1.0, 5 * m.error);
     EXPECT_LT(m.error, 0.01);
@@ -175,7 +175,7 @@ TEST(Bdpt, FurnaceSphereWithAPointLightHasMeanRadianceOne) {
 TEST(Bdpt, FurnaceSphereWithAnEmissiveInteriorHasMeanRadianceOne) {
     const Scene scene = FurnaceSphere(0.5f);
     const BdptFrame f = RenderBdpt(scene, 64, -1);
-    const Mean m = FrameMean(f);
+    const Mean m = SplatMean(f);
     std::printf("[bdpt] emissive furnace: %.5f +- %.5f\n", m.value, m.error);
     EXPECT_NEAR(m.value, 1.0, 5 * m.error);
     EXPECT_LT(m.error, 0.01);
@@ -184,7 +184,7 @@ TEST(Bdpt, FurnaceSphereWithAnEmissiveInteriorHasMeanRadianceOne) {
 TEST(Bdpt, FurnaceWithAMaxDepthSumsItsBounces) {
     // max_depth 2: emission plus two bounces, 0.5 (1 + 0.5 + 0.25).
     const Scene scene = FurnaceSphere(0.5f);
-    const Mean m = FrameMean(RenderBdpt(scene, 64, 2));
+    const Mean m = SplatMean(RenderBdpt(scene, 64, 2));
     std::printf("[bdpt] emissive furnace, max depth 2: %.5f +- %.5f\n", m.value, m.error);
     EXPECT_NEAR(m.value, 0.875, 5 * m.error);
 }
@@ -200,7 +200,7 @@ TEST(Bdpt, WhiteFurnaceWithUnlimitedDepthStopsAtTheCap) {
     const BdptFrame f = RenderBdpt(scene, 2, -1);  // one sample in each half
     EXPECT_GT(f.stats.truncated_paths, 0u);
     EXPECT_EQ(f.stats.invalid_samples, 0u);
-    const Mean m = FrameMean(f);
+    const Mean m = SplatMean(f);
     EXPECT_GT(m.value, 0.5);
     EXPECT_LE(m.value, 0.5 * (1 + 2 * kBdptUnlimitedDepth));
 }
@@ -437,14 +437,14 @@ TEST(Bdpt, AnySplitOfTheWorkGivesTheSameBits) {
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
     const Camera camera(scene.camera, (*es)->origin());
-    FrameRenderSettings settings;
+    SplatRenderSettings settings;
     settings.max_depth = 6;
     settings.seed = 11;
     const BdptRenderer renderer(**es, camera, settings);
     const PixelRect rect{0, 0, 16, 16};
     TileSums whole(rect);
     SplatList whole_splats(16, 16);
-    renderer.Render(FrameWork{rect, 0, 6, 0, 0}, whole, whole_splats);
+    renderer.Render(SplatWork{rect, 0, 6, 0, 0}, whole, whole_splats);
 
     // The same samples as two sample ranges over two halves of the rect, merged.
     TileSums merged(rect);
@@ -453,7 +453,7 @@ TEST(Bdpt, AnySplitOfTheWorkGivesTheSameBits) {
         for (const auto& [begin, end] : {std::pair<uint64_t, uint64_t>{0, 4}, {4, 6}}) {
             TileSums sums(part);
             SplatList splats(16, 16);
-            renderer.Render(FrameWork{part, begin, end, 0, 0}, sums, splats);
+            renderer.Render(SplatWork{part, begin, end, 0, 0}, sums, splats);
             for (int y = part.y0; y < part.y0 + part.height; ++y) {
                 for (int x = 0; x < 16; ++x) merged.at(x, y) += sums.at(x, y);
             }
@@ -484,7 +484,7 @@ TEST(Bdpt, RefusesPixelFiltersOtherThanTheBox) {
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
     const Camera camera(scene.camera, (*es)->origin());
-    auto renderer = MakeFrameRenderer(Method::kBdpt, **es, camera, FrameRenderSettings{});
+    auto renderer = MakeSplatRenderer(Method::kBdpt, **es, camera, SplatRenderSettings{});
     ASSERT_FALSE(renderer.ok());
     EXPECT_EQ(renderer.status().code(), absl::StatusCode::kFailedPrecondition);
     EXPECT_NE(renderer.status().message().find("bdpt"), std::string::npos);

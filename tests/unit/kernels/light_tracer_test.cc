@@ -1,5 +1,5 @@
 // Light tracing (lf/kernels/light_tracer.h): pbrt-v4's furnace spheres, agreement with the path
-// tracer region by region, split invariance, and the frame-method factory.
+// tracer region by region, split invariance, and the splatting-method factory.
 #include "lf/kernels/light_tracer.h"
 
 #include <gtest/gtest.h>
@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "frame_render.h"
-#include "frame_scenes.h"
+#include "splat_render.h"
+#include "splat_scenes.h"
 #include "lf/core/scene_loader.h"
 #include "lf/local/method_factory.h"
 #include "render_path.h"
@@ -19,14 +19,14 @@ namespace {
 
 // The image mean of R, G, B averaged, over K independent batches of light paths, with its
 // standard error from the spread of the batch means.
-testing::MeanAndError BatchedFrameMean(const Scene& scene, const FrameRenderSettings& settings,
+testing::MeanAndError BatchedSplatMean(const Scene& scene, const SplatRenderSettings& settings,
                                        int batches, uint64_t paths_per_batch) {
-    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", settings);
+    const testing::SplatSetup s = testing::MakeSplatSetup(scene, "light", settings);
     std::vector<double> means;
     for (int b = 0; b < batches; ++b) {
         const uint64_t begin = uint64_t(b) * paths_per_batch;
         const Image image =
-            testing::RenderFramePaths(*s.renderer, *s.camera, begin, begin + paths_per_batch).image;
+            testing::RenderSplatPaths(*s.renderer, *s.camera, begin, begin + paths_per_batch).image;
         double sum = 0;
         for (const char* c : {"R", "G", "B"}) {
             for (float v : *image.FindChannel(c)) sum += v;
@@ -39,8 +39,8 @@ testing::MeanAndError BatchedFrameMean(const Scene& scene, const FrameRenderSett
     return {mean, std::sqrt(var / batches)};
 }
 
-FrameRenderSettings Unlimited() {
-    FrameRenderSettings settings;
+SplatRenderSettings Unlimited() {
+    SplatRenderSettings settings;
     settings.max_depth = -1;
     settings.seed = 7;
     return settings;
@@ -49,7 +49,7 @@ FrameRenderSettings Unlimited() {
 // The furnace sphere's image mean is 1 within 4.5 standard errors, which are small enough for
 // that to mean something.
 void ExpectFurnaceIsOne(const Scene& scene, const char* what) {
-    const testing::MeanAndError m = BatchedFrameMean(scene, Unlimited(), 32, 1 << 15);
+    const testing::MeanAndError m = BatchedSplatMean(scene, Unlimited(), 32, 1 << 15);
     std::printf("[light] %s: %.5f +- %.5f (expected 1)\n", what, m.mean, m.standard_error);
     EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, 4.5 * m.standard_error) << what;
     EXPECT_LT(m.standard_error, 0.01) << what << ": too few paths for the test to mean anything";
@@ -71,9 +71,9 @@ TEST(LightTracer, EmissiveFurnaceSphereIsOne) {
 // estimator's (each pixel's value is Le for a box filter, up to the splat count).
 TEST(LightTracer, DepthZeroIsTheEmitterSeenDirectly) {
     const Scene scene = testing::EmissiveFurnaceSphere(16);
-    FrameRenderSettings settings = Unlimited();
+    SplatRenderSettings settings = Unlimited();
     settings.max_depth = 0;
-    const testing::MeanAndError m = BatchedFrameMean(scene, settings, 16, 1 << 14);
+    const testing::MeanAndError m = BatchedSplatMean(scene, settings, 16, 1 << 14);
     EXPECT_NEAR(m.mean, 0.5, 4.5 * m.standard_error + 1e-6);
 }
 
@@ -82,10 +82,10 @@ TEST(LightTracer, DepthZeroIsTheEmitterSeenDirectly) {
 // paths, so the limit is the clamp itself. A clamp far above the furnace's splats (a few units)
 // leaves the mean at 1; dividing the limit by W H (as the tracer once did) darkened it tenfold.
 TEST(LightTracer, ClampFarAboveTheSplatsLeavesTheFurnaceAtOne) {
-    FrameRenderSettings settings = Unlimited();
+    SplatRenderSettings settings = Unlimited();
     settings.clamp = 100;
     const testing::MeanAndError m =
-        BatchedFrameMean(testing::PointLitFurnaceSphere(16), settings, 32, 1 << 15);
+        BatchedSplatMean(testing::PointLitFurnaceSphere(16), settings, 32, 1 << 15);
     std::printf("[light] clamp 100: %.5f +- %.5f (expected 1)\n", m.mean, m.standard_error);
     EXPECT_NEAR(m.mean, testing::kFurnaceSphereRadiance, 4.5 * m.standard_error);
 }
@@ -101,7 +101,7 @@ Scene LoadTestScene(const char* name, int size) {
 // same splat list, entry for entry, and the same counts.
 TEST(LightTracer, AnySplitGivesTheSameSplats) {
     const Scene scene = LoadTestScene("materials.json", 24);
-    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", Unlimited());
+    const testing::SplatSetup s = testing::MakeSplatSetup(scene, "light", Unlimited());
     const int w = s.camera->width(), h = s.camera->height();
     constexpr uint64_t kPaths = 20000;
     SplatList whole(w, h);
@@ -128,7 +128,7 @@ TEST(LightTracer, AnySplitGivesTheSameSplats) {
 
 TEST(LightTracer, CancelledRenderStopsEarly) {
     const Scene scene = LoadTestScene("cornell_box.json", 16);
-    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", Unlimited());
+    const testing::SplatSetup s = testing::MakeSplatSetup(scene, "light", Unlimited());
     std::atomic<bool> cancel{true};
     SplatList splats(16, 16);
     TileSums sums(PixelRect{});
@@ -164,14 +164,14 @@ std::vector<BlockEstimate> PathBlocks(const Image& image) {
 
 // The light tracer's blocks from `batches` independent ranges of light paths: a light path
 // splats into several pixels of a block, so pixels are not independent; the batch means are.
-std::vector<BlockEstimate> LightBlocks(const testing::FrameSetup& s, int batches,
+std::vector<BlockEstimate> LightBlocks(const testing::SplatSetup& s, int batches,
                                        uint64_t paths_per_batch) {
     const int bw = s.camera->width() / kBlock, bh = s.camera->height() / kBlock;
     std::vector<std::vector<double>> per_batch(size_t(bw * bh));
     for (int k = 0; k < batches; ++k) {
         const uint64_t begin = uint64_t(k) * paths_per_batch;
         const Image image =
-            testing::RenderFramePaths(*s.renderer, *s.camera, begin, begin + paths_per_batch).image;
+            testing::RenderSplatPaths(*s.renderer, *s.camera, begin, begin + paths_per_batch).image;
         std::vector<double> sums(per_batch.size(), 0.0);
         for (int y = 0; y < bh * kBlock; ++y) {
             for (int x = 0; x < bw * kBlock; ++x) {
@@ -230,10 +230,10 @@ double BonferroniZ(double alpha, int n) {
 // (a bias common to all blocks) within its own.
 void ExpectLightMatchesPath(const Scene& scene, const char* scene_name, int max_depth, uint64_t spp,
                             int batches, uint64_t paths_per_batch) {
-    FrameRenderSettings settings;
+    SplatRenderSettings settings;
     settings.max_depth = max_depth;
     settings.seed = 3;
-    const testing::FrameSetup s = testing::MakeFrameSetup(scene, "light", settings);
+    const testing::SplatSetup s = testing::MakeSplatSetup(scene, "light", settings);
     const std::vector<BlockEstimate> light = LightBlocks(s, batches, paths_per_batch);
     const std::vector<BlockEstimate> path =
         PathBlocks(testing::RenderPath(scene, spp, max_depth, 5).out.image);
@@ -308,35 +308,35 @@ TEST(LightTracer, MatchesPathTracerForALightInsideGlass) {
     ExpectLightMatchesPath(scene, "lamp in glass", 4, 256, 64, 32 * 32 * 256 / 64);
 }
 
-TEST(FrameRendererFactory, BuildsLightAndRefusesWhatItCannot) {
-    auto is_frame_method = [](Method m) { return Info(m).work == WorkKind::kFramePasses; };
-    EXPECT_TRUE(is_frame_method(Method::kLight));
-    EXPECT_TRUE(is_frame_method(Method::kBdpt));
-    EXPECT_TRUE(is_frame_method(Method::kPpm));
-    EXPECT_FALSE(is_frame_method(Method::kPath));
-    EXPECT_FALSE(is_frame_method(Method::kWhitted));
+TEST(SplatRendererFactory, BuildsLightAndRefusesWhatItCannot) {
+    auto is_splat_method = [](Method m) { return Info(m).work == WorkKind::kSplatPasses; };
+    EXPECT_TRUE(is_splat_method(Method::kLight));
+    EXPECT_TRUE(is_splat_method(Method::kBdpt));
+    EXPECT_TRUE(is_splat_method(Method::kPpm));
+    EXPECT_FALSE(is_splat_method(Method::kPath));
+    EXPECT_FALSE(is_splat_method(Method::kWhitted));
     Scene scene = testing::PointLitFurnaceSphere(8);
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
     const Camera camera(scene.camera, (*es)->origin());
-    EXPECT_TRUE(MakeFrameRenderer(Method::kLight, **es, camera, {}).ok());
-    EXPECT_TRUE(MakeFrameRenderer(Method::kPpm, **es, camera, {}).ok());
-    FrameRenderSettings bad_alpha;
+    EXPECT_TRUE(MakeSplatRenderer(Method::kLight, **es, camera, {}).ok());
+    EXPECT_TRUE(MakeSplatRenderer(Method::kPpm, **es, camera, {}).ok());
+    SplatRenderSettings bad_alpha;
     bad_alpha.alpha = 1;
-    EXPECT_EQ(MakeFrameRenderer(Method::kPpm, **es, camera, bad_alpha).status().code(),
+    EXPECT_EQ(MakeSplatRenderer(Method::kPpm, **es, camera, bad_alpha).status().code(),
               absl::StatusCode::kInvalidArgument);
-    const auto path = MakeFrameRenderer(Method::kPath, **es, camera, {});
+    const auto path = MakeSplatRenderer(Method::kPath, **es, camera, {});
     EXPECT_EQ(path.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(path.status().message().find("path"), std::string::npos);
 
     scene.camera.filter = {PixelFilter::Type::kGaussian, 2};
     const Camera gaussian(scene.camera, (*es)->origin());
-    const auto refused = MakeFrameRenderer(Method::kLight, **es, gaussian, {});
+    const auto refused = MakeSplatRenderer(Method::kLight, **es, gaussian, {});
     EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
     EXPECT_NE(refused.status().message().find("light"), std::string::npos);
     EXPECT_NE(refused.status().message().find("gaussian"), std::string::npos);
     // Photons are gathered at filter-importance-sampled camera samples: any filter.
-    EXPECT_TRUE(MakeFrameRenderer(Method::kPpm, **es, gaussian, {}).ok());
+    EXPECT_TRUE(MakeSplatRenderer(Method::kPpm, **es, gaussian, {}).ok());
 }
 
 }  // namespace

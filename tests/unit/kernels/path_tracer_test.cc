@@ -6,7 +6,7 @@
 
 #include <numbers>
 
-#include "frame_scenes.h"
+#include "splat_scenes.h"
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
@@ -69,7 +69,7 @@ INSTANTIATE_TEST_SUITE_P(Albedos, Furnace,
                                     std::to_string(info.index);
                          });
 
-// pbrt-v4's integrator tests, as every method has them (frame_scenes.h): inside a sphere of
+// pbrt-v4's integrator tests, as every method has them (splat_scenes.h): inside a sphere of
 // albedo 0.5 lit by a point light of intensity pi at its centre, and inside the same sphere
 // emitting 0.5, the radiance is 1 everywhere; under both light strategies (the BVH's sphere
 // sampling from a point on the emitter itself lost light once).

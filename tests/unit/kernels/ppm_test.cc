@@ -37,7 +37,7 @@ std::unique_ptr<EmbreeScene> Build(const Scene& scene) {
 using testing::AddQuad;
 
 std::unique_ptr<PpmRenderer> MakePpm(const EmbreeScene& es, const Camera& camera,
-                                     const FrameRenderSettings& settings) {
+                                     const SplatRenderSettings& settings) {
     auto ppm = PpmRenderer::Create(es, camera, settings);
     EXPECT_TRUE(ppm.ok()) << ppm.status();
     return std::move(*ppm);
@@ -167,7 +167,7 @@ void ExpectFurnaceIsOne(const Scene& scene, SamplerType sampler_type,
                         LightStrategy strategy = LightStrategy::kBvh) {
     const auto es = Build(scene);
     const Camera camera(scene.camera, es->origin());
-    FrameRenderSettings settings;
+    SplatRenderSettings settings;
     settings.max_depth = -1;
     settings.photons_per_pass = 20'000;
     settings.initial_radius = 0.15;
@@ -220,7 +220,7 @@ TEST(Ppm, CausticBiasShrinksWithPassesAsPredicted) {
     scene.camera = testing::SquareCamera({0, 1.5, 0}, {0, 0, 0}, {0, 0, 1}, 2, 8);
     const auto es = Build(scene);
     const Camera camera(scene.camera, es->origin());
-    FrameRenderSettings settings;
+    SplatRenderSettings settings;
     settings.max_depth = 2;
     settings.photons_per_pass = 50'000;
     settings.initial_radius = 1.5;
@@ -268,7 +268,7 @@ TEST(Ppm, SplitsOverPassesAndTilesGiveTheSameBits) {
     scene->camera.width = scene->camera.height = 12;
     const auto es = Build(*scene);
     const Camera camera(scene->camera, es->origin());
-    FrameRenderSettings settings;
+    SplatRenderSettings settings;
     settings.photons_per_pass = 3000;
     settings.max_depth = -1;
     const auto ppm = MakePpm(*es, camera, settings);
@@ -315,7 +315,7 @@ TEST(Ppm, RejectsAlphaOutsideTheUnitInterval) {
     Scene scene = FurnaceSphere(0, true);
     const auto es = Build(scene);
     const Camera camera(scene.camera, es->origin());
-    FrameRenderSettings settings;
+    SplatRenderSettings settings;
     settings.alpha = 1;
     const auto ppm = PpmRenderer::Create(*es, camera, settings);
     ASSERT_FALSE(ppm.ok());
@@ -363,7 +363,7 @@ TEST(Ppm, ApproachesThePathTracerOnTheCornellBoxAsPassesGrow) {
         for (int x = 0; x < 16; ++x)
             expected[size_t(y / 4 * 4 + x / 4)] += reference.at(x, y).Mean().g / 16;
     }
-    FrameRenderSettings settings;
+    SplatRenderSettings settings;
     settings.max_depth = -1;
     settings.photons_per_pass = 16'384;
     const auto ppm = MakePpm(*es, camera, settings);

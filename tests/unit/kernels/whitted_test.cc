@@ -11,7 +11,7 @@
 #include <numbers>
 #include <optional>
 
-#include "frame_scenes.h"
+#include "splat_scenes.h"
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
@@ -109,7 +109,7 @@ TEST(Whitted, SumsEveryDeltaLightWithoutNoise) {
     }
 }
 
-// pbrt's furnace spheres (frame_scenes.h) have radiance 1 from their interreflection; Whitted
+// pbrt's furnace spheres (splat_scenes.h) have radiance 1 from their interreflection; Whitted
 // keeps the emission and the direct light only: with the point light albedo x E / pi = 0.5,
 // exactly and without noise; the emissive sphere 0.5 + 0.5 x 0.5 = 0.75 (the sphere is its own
 // area light), within the noise of sampling it.

@@ -1,11 +1,11 @@
 // The largest task result the wire takes (lf::kMaxTaskResultBytes) must also be one the job store
-// can record: a frame task's result is stored whole (its LFFR record: header, camera sums,
+// can record: a splat task's result is stored whole (its LFFR record: header, camera sums,
 // splats) as one SQLite blob, and a blob above SQLite's length limit fails the write after the
 // merge, which fails the job (Scheduler::Complete) instead of refusing the task on the worker.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 
 namespace lf {
 namespace {
@@ -17,7 +17,7 @@ TEST(ResultSizeLimitTest, LargestResultFitsInOneSqliteBlob) {
     const int64_t limit = sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1);
     sqlite3_close(db);
     // The worker sends up to kMaxTaskResultBytes - 4096 bytes of sums and splats; the LFFR
-    // header adds 16 (server/frame_result_codec.cc).
+    // header adds 16 (server/splat_result_codec.cc).
     EXPECT_LE(int64_t(kMaxTaskResultBytes) + 16, limit);
 }
 

@@ -143,7 +143,7 @@ TEST_F(TaskLogStoreTest, LinesAndTaskListsSurviveAReopenAndGoWithTheirJob) {
     TaskStatus task;
     task.index = 1;
     task.state = TaskStatus::State::kDone;
-    task.kind = TaskKind::kFrame;
+    task.kind = TaskKind::kSplat;
     task.x = 8;
     task.width = 8;
     task.height = 4;
@@ -173,7 +173,7 @@ TEST_F(TaskLogStoreTest, LinesAndTaskListsSurviveAReopenAndGoWithTheirJob) {
     const TaskStatus& read = (*tasks)[1];
     EXPECT_EQ(read.index, 1);
     EXPECT_EQ(read.state, TaskStatus::State::kDone);
-    EXPECT_EQ(read.kind, TaskKind::kFrame);
+    EXPECT_EQ(read.kind, TaskKind::kSplat);
     EXPECT_EQ(read.x, 8);
     EXPECT_EQ(read.width, 8);
     EXPECT_EQ(read.height, 4);

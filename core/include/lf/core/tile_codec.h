@@ -26,7 +26,7 @@ std::string EncodeTileSums(const TileSums& tile);
 
 // InvalidArgument, saying what is wrong, for anything that is not a whole encoded tile (unknown
 // AOV flags included). Decodes version 1 tiles too, with no truncated paths. A 0x0 rectangle at
-// 0,0 is a tile of no pixels carrying only its stats (a frame task with no camera part).
+// 0,0 is a tile of no pixels carrying only its stats (a splat task with no camera part).
 absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes);
 
 }  // namespace lf

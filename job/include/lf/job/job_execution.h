@@ -4,8 +4,8 @@
 // kind-specific, and local mode (lf/local/local_executor.h) runs the same objects on threads.
 //
 // The kinds: fixed tiles (lf/job/tile_execution.h), adaptive tiles
-// (lf/job/adaptive_tile_execution.h), frame passes of the splatting methods
-// (lf/job/frame_execution.h), and radiosity solved in sweeps (lf/job/sweep_execution.h).
+// (lf/job/adaptive_tile_execution.h), splat passes of the splatting methods
+// (lf/job/splat_execution.h), and radiosity solved in sweeps (lf/job/sweep_execution.h).
 // MakeJobExecution chooses one from a job spec, in one place.
 //
 // Not thread-safe: the caller serialises every call.
@@ -37,7 +37,7 @@
 namespace lf {
 
 // A task's result as a worker (or a local thread) made it; which parts are set depends on the
-// task: a tile's sums, a frame task's camera sums and splats, a patch-group task's sweep chunk.
+// task: a tile's sums, a splat task's camera sums and splats, a patch-group task's sweep chunk.
 struct TaskResult {
     const TileSums* sums = nullptr;
     SplatList* splats = nullptr;  // coalesced by the merge

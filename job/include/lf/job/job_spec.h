@@ -12,7 +12,7 @@
 #include "absl/status/status.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/job/method_registry.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
@@ -36,7 +36,7 @@ struct JobSpec {
     LightStrategy light_strategy = defaults::kLightStrategy;
     std::string method = defaults::kMethod;  // a name of lf/job/method_registry.h
     RadiositySettings radiosity;
-    PhotonSettings ppm;         // method "ppm" (lf/job/frame_settings.h)
+    PhotonSettings ppm;         // method "ppm" (lf/job/splat_settings.h)
     AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused
     int priority = 0;           // higher first
     std::string scene_hash;     // the loader's content hash, for the EXR header

@@ -12,7 +12,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/core/scene.h"
-#include "lf/job/frame_plan.h"
+#include "lf/job/splat_plan.h"
 
 namespace lf {
 
@@ -22,7 +22,7 @@ enum class Method { kPath, kRadiosity, kWhitted, kLight, kBdpt, kPpm };
 
 enum class WorkKind {
     kTiles,        // samples of pixel tiles (lf/job/plan.h): path, whitted
-    kFramePasses,  // frame passes whose results splat or gather anywhere (lf/job/frame_plan.h)
+    kSplatPasses,  // splat passes whose results splat or gather anywhere (lf/job/splat_plan.h)
     kRadiosity,    // a radiosity solve, then tiles of its display
 };
 
@@ -30,13 +30,13 @@ struct MethodInfo {
     Method method;
     const char* name;
     WorkKind work;
-    std::optional<FramePlanKind> frame_plan;  // kFramePasses only
+    std::optional<SplatPlanKind> splat_plan;  // kSplatPasses only
     // A splat lands in the one pixel that holds its raster position: the box filter's footprint,
     // so these take the box filter only (CheckMethodTakesScene).
     bool splats_light_paths;
     // Samples lights at camera-path vertices (lightfarm.light_sampling names the strategy).
     bool samples_lights;
-    // Frame passes have no per-pixel first hits to make AOVs of, and no tile whose error alone
+    // Splat passes have no per-pixel first hits to make AOVs of, and no tile whose error alone
     // decides its next pass.
     bool aovs;
     bool adaptive;  // --target-error, --time-limit

@@ -14,7 +14,7 @@
 #include "lf/core/image_io.h"
 #include "lf/core/scene.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"

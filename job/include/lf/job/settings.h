@@ -34,7 +34,7 @@ inline constexpr int kRadiosityMaxIterations = 10000;
 inline constexpr const char* kRadiosityDisplay = "smooth";
 inline constexpr int kRadiositySweepTasks = 8;
 
-// Progressive photon mapping (`ppm`, lf/job/frame_settings.h): photons traced per pass, the
+// Progressive photon mapping (`ppm`, lf/job/splat_settings.h): photons traced per pass, the
 // radius of pass 0 (0: the kernel chooses it from the scene's size and the frame) and alpha of
 // Knaus & Zwicker's radius schedule r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1), so r_i^2 falls as
 // i^(alpha - 1): after N passes the average's variance falls as N^-alpha and its bias as

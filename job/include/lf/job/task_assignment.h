@@ -20,8 +20,8 @@ struct TaskAssignment {
     // compute); a display tile (sweep -1) reads the solution from it.
     int sweep = -1, chunk = 0;
     std::string radiosity_hash;
-    // Frame methods (UsesFramePlan(spec.method)): the task's light paths or photon passes
-    // [path_begin, path_end) over the whole frame (lf::FrameTask); `task` holds its camera part.
+    // Splatting methods (UsesSplatPlan(spec.method)): the task's light paths or photon passes
+    // [path_begin, path_end) over the whole frame (lf::SplatTask); `task` holds its camera part.
     uint64_t path_begin = 0, path_end = 0;
     absl::Duration heartbeat_interval = absl::Milliseconds(300);
     absl::Duration lease = absl::Seconds(10);

@@ -12,14 +12,14 @@
 
 namespace lf {
 
-enum class TaskKind { kTile, kFrame, kRadiositySweep };
+enum class TaskKind { kTile, kSplat, kRadiositySweep };
 
 struct TaskStatus {
     enum class State { kWaiting, kQueued, kRunning, kDone, kDropped };
     int index = 0;
     State state = State::kQueued;
     TaskKind kind = TaskKind::kTile;
-    int x = 0, y = 0, width = 0, height = 0;  // a tile's pixels; the whole frame for kFrame
+    int x = 0, y = 0, width = 0, height = 0;  // a tile's pixels; the whole frame for kSplat
     uint64_t samples = 0;                     // per pixel, for a tile
     int attempts = 0, failures = 0;
     std::string worker;                          // of the current or last lease
@@ -35,7 +35,8 @@ struct TaskStatus {
 const char* TaskStatusName(TaskStatus::State state);
 // The state a TaskStatusName names; nullopt for any other string.
 std::optional<TaskStatus::State> TaskStatusFromName(std::string_view name);
-// "tile", "frame", "sweep".
+// "tile", "frame" (kSplat: the name the dashboard, the task log store and the wire's FRAME
+// already use), "sweep".
 const char* TaskKindName(TaskKind kind);
 
 // One line a worker logged while running a task.

@@ -53,8 +53,8 @@
 // (PixelSums::Add with the sample's index); each t = 1 contribution is splatted into the
 // SplatList at the pixel holding its raster position, half = the camera sample's parity, with
 // pbrt's film-normalised importance: a pixel is its camera mean plus its splat sum times
-// W H / N, N the camera samples of the frame (lf/job/frame_merge.h). Only the box filter is
-// supported (lf::MakeFrameRenderer refuses the others): a splat goes to one pixel.
+// W H / N, N the camera samples of the frame (lf/job/splat_merge.h). Only the box filter is
+// supported (lf::MakeSplatRenderer refuses the others): a splat goes to one pixel.
 #pragma once
 
 #include <atomic>
@@ -62,7 +62,7 @@
 
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/frame_renderer.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/light_emission.h"
 #include "lf/kernels/lights.h"
 
@@ -73,18 +73,18 @@ inline constexpr int kBdptUnlimitedDepth = 128;
 
 struct BdptVertex;
 
-class BdptRenderer : public FrameRenderer {
+class BdptRenderer : public SplatRenderer {
   public:
     // scene and camera must outlive the renderer. The camera's pixel filter is taken as box
-    // (lf::MakeFrameRenderer refuses others).
+    // (lf::MakeSplatRenderer refuses others).
     BdptRenderer(const EmbreeScene& scene, const Camera& camera,
-                 const FrameRenderSettings& settings);
+                 const SplatRenderSettings& settings);
     ~BdptRenderer() override;
 
     // Camera samples [work.sample_begin, work.sample_end) of every pixel of work.rect; the path
     // range is unused (a sample's light subpath is its own). Rows run in parallel (tbb), each
     // into its own sums, which are then added exactly.
-    void Render(const FrameWork& work, TileSums& camera, SplatList& splats,
+    void Render(const SplatWork& work, TileSums& camera, SplatList& splats,
                 const std::atomic<bool>* cancel = nullptr) const override;
 
     // One camera sample of pixel (x, y): its t >= 2 strategies' sum (unclamped) is returned,
@@ -126,7 +126,7 @@ class BdptRenderer : public FrameRenderer {
 
     const EmbreeScene& scene_;
     const Camera& camera_;
-    FrameRenderSettings settings_;
+    SplatRenderSettings settings_;
     LightSampler lights_;
     EmissionSampler emission_;
     float infinite_pdf_pos_;  // 1 / (pi R^2): the density of the disk lights at infinity use

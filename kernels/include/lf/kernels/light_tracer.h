@@ -7,9 +7,9 @@
 // background).
 //
 // Light path i of a job is a pure function of i and the settings: its sampler is keyed as
-// lf::FrameTask says (pixel-equivalent q = (i >> 1) mod W H, sample 2 ((i >> 1) / W H) + (i & 1))
+// lf::SplatTask says (pixel-equivalent q = (i >> 1) mod W H, sample 2 ((i >> 1) / W H) + (i & 1))
 // and it splats into half i & 1, so any split of [0, N) over tasks and threads gives the same
-// splat sums. Splats are in lf/job/frame_merge.h's normalisation: the image is W H / N times
+// splat sums. Splats are in lf/job/splat_merge.h's normalisation: the image is W H / N times
 // the splat sum.
 //
 // The path, vertex by vertex:
@@ -45,31 +45,31 @@
 // and counted in RenderStats::invalid_samples; samples counts light paths, rays every ray
 // (light rays and shadow rays to the camera).
 //
-// Only the box pixel filter: lf::MakeFrameRenderer refuses others (a splat goes to the one pixel
+// Only the box pixel filter: lf::MakeSplatRenderer refuses others (a splat goes to the one pixel
 // that holds its raster position). Thin-lens cameras are handled (a lens point per vertex).
 #pragma once
 
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/frame_renderer.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/light_emission.h"
 
 namespace lf {
 
-class LightTracer : public FrameRenderer {
+class LightTracer : public SplatRenderer {
   public:
     // Light paths per unit of parallel work: each chunk makes its own splat list, and the
     // chunks' lists are added in order.
     static constexpr uint64_t kChunkPaths = 1024;
 
     // scene and camera must outlive the tracer. The camera's pixel filter is taken as box (see
-    // the file comment: MakeFrameRenderer checks).
+    // the file comment: MakeSplatRenderer checks).
     LightTracer(const EmbreeScene& scene, const Camera& camera,
-                const FrameRenderSettings& settings);
+                const SplatRenderSettings& settings);
 
     // Traces light paths [work.path_begin, work.path_end); the camera part of `work` (rect,
     // samples) must be empty. camera.stats gets the rays and light paths.
-    void Render(const FrameWork& work, TileSums& camera, SplatList& splats,
+    void Render(const SplatWork& work, TileSums& camera, SplatList& splats,
                 const std::atomic<bool>* cancel = nullptr) const override;
 
     // Traces light path `index` alone, adding its splats to `splats` and its rays to `stats`
@@ -84,7 +84,7 @@ class LightTracer : public FrameRenderer {
 
     const EmbreeScene& scene_;
     const Camera& camera_;
-    FrameRenderSettings settings_;
+    SplatRenderSettings settings_;
     EmissionSampler emission_;
 };
 

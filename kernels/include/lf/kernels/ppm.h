@@ -2,7 +2,7 @@
 // photon map with radius r_p from the global schedule r_{p+1}^2 = r_p^2 (p + alpha) / (p + 1),
 // and estimates each pixel with that pixel's camera sample p; the image is the average of the
 // passes. Every pass is independent of the others, so passes split over tasks and machines
-// freely (lf/job/frame_plan.h, FramePlanKind::kPhotonPasses); the A/B halves of a pixel are
+// freely (lf/job/splat_plan.h, SplatPlanKind::kPhotonPasses); the A/B halves of a pixel are
 // its even and odd passes. Bias after N passes falls as r_N^2 ~ r_0^2 N^(alpha - 1)
 // (docs/rendering.md, "Progressive photon mapping").
 //
@@ -39,7 +39,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/frame_renderer.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/light_emission.h"
 #include "lf/kernels/lights.h"
 #include "lf/kernels/photon_map.h"
@@ -72,18 +72,18 @@ double PpmRadiusRatioSquared(double alpha, uint64_t pass);
 // should resolve it once at planning time and pass it as initial_radius.
 double PpmDefaultRadius(const EmbreeScene& scene, const Camera& camera);
 
-class PpmRenderer : public FrameRenderer {
+class PpmRenderer : public SplatRenderer {
   public:
     // InvalidArgument naming "ppm" for alpha outside (0, 1) or a negative or non-finite
     // initial_radius. photons_per_pass 0 means width x height of the camera's image (pbrt-v4's
     // default); initial_radius 0 means PpmDefaultRadius.
     static absl::StatusOr<std::unique_ptr<PpmRenderer>> Create(const EmbreeScene& scene,
                                                                const Camera& camera,
-                                                               const FrameRenderSettings& settings);
+                                                               const SplatRenderSettings& settings);
 
     // Passes [sample_begin, sample_end) for every pixel of work.rect (the path range, which the
     // plan makes equal, is not read). No splats.
-    void Render(const FrameWork& work, TileSums& camera, SplatList& splats,
+    void Render(const SplatWork& work, TileSums& camera, SplatList& splats,
                 const std::atomic<bool>* cancel = nullptr) const override;
 
     // Pass `pass`'s photon map (radius Radius(pass)); traced in parallel chunks whose photons
@@ -99,7 +99,7 @@ class PpmRenderer : public FrameRenderer {
 
   private:
     PpmRenderer(const EmbreeScene& scene, const Camera& camera,
-                const FrameRenderSettings& settings);
+                const SplatRenderSettings& settings);
     // Photons [begin, end) of pass `pass`, appended to `out`.
     void TraceRange(uint64_t pass, uint64_t begin, uint64_t end, std::vector<Photon>& out,
                     RenderStats& stats) const;
@@ -112,7 +112,7 @@ class PpmRenderer : public FrameRenderer {
 
     const EmbreeScene& scene_;
     const Camera& camera_;
-    FrameRenderSettings settings_;
+    SplatRenderSettings settings_;
     EmissionSampler emission_;
     LightSampler lights_;
     double initial_radius_;

@@ -12,9 +12,9 @@
 #include "lf/core/camera.h"
 #include "lf/core/image.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/frame_plan.h"
+#include "lf/job/splat_plan.h"
 #include "lf/job/settings.h"
-#include "lf/kernels/frame_renderer.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/radiance.h"
 #include "lf/local/execution_runner.h"
 
@@ -59,14 +59,14 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(
     const Camera& camera, const RadianceEstimator& estimator, const RenderSettings& settings,
     const AdaptiveSettings& adaptive, const ProgressFn& progress = {}, const RunClock& clock = {});
 
-// A frame method's render (light tracing, BDPT, photon mapping): PlanFrameRender cuts it into
-// frame tasks, settings.threads threads run them with `renderer` as a worker would (each task in
-// the same arena, the renderer free to parallel_for inside it), and FrameMerger adds their
+// A splatting method's render (light tracing, BDPT, photon mapping): PlanSplatRender cuts it into
+// splat tasks, settings.threads threads run them with `renderer` as a worker would (each task in
+// the same arena, the renderer free to parallel_for inside it), and SplatMerger adds their
 // camera sums and splat lists into the image, so the bits are the farm's for the same plan.
-// `plan` comes from FramePlanSettingsOf (lf/job/frame_settings.h); of `settings` only threads is
+// `plan` comes from SplatPlanSettingsOf (lf/job/splat_settings.h); of `settings` only threads is
 // used (the rest is the renderer's). Progress counts tasks.
-absl::StatusOr<RenderOutput> RenderFrameImage(const Camera& camera, const FrameRenderer& renderer,
-                                              const FramePlanSettings& plan,
+absl::StatusOr<RenderOutput> RenderSplatImage(const Camera& camera, const SplatRenderer& renderer,
+                                              const SplatPlanSettings& plan,
                                               const RenderSettings& settings,
                                               const ProgressFn& progress = {});
 

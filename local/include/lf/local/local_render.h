@@ -1,5 +1,5 @@
 // `lightfarm render` without its flags and output: a scene file to an EXR (and PNG preview) in
-// this process, by any method (path tracing, radiosity, Whitted, and the frame methods light,
+// this process, by any method (path tracing, radiosity, Whitted, and the splatting methods light,
 // bdpt, ppm), through the farm's planners and mergers (local_executor.h). The CLI prints the
 // summary.
 #pragma once
@@ -10,7 +10,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/image_io.h"
 #include "lf/core/scene_loader.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/job/method_registry.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/settings.h"

@@ -11,7 +11,7 @@
 #include "lf/job/job_spec.h"
 #include "lf/job/method_registry.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/frame_renderer.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/radiance.h"
 #include "lf/kernels/radiosity.h"
 
@@ -25,15 +25,15 @@ absl::StatusOr<std::unique_ptr<RadianceEstimator>> MakeRayTracer(Method method,
                                                                  int max_depth,
                                                                  LightStrategy strategy);
 
-// The renderer of a frame method (light, bdpt, ppm) over `scene` seen through `camera` (both
+// The renderer of a splatting method (light, bdpt, ppm) over `scene` seen through `camera` (both
 // must outlive it). InvalidArgument naming the method for any other; FailedPrecondition when
 // the method does not take the camera's pixel filter (CheckMethodTakesFilter) or the settings.
-absl::StatusOr<std::unique_ptr<FrameRenderer>> MakeFrameRenderer(
+absl::StatusOr<std::unique_ptr<SplatRenderer>> MakeSplatRenderer(
     Method method, const EmbreeScene& scene, const Camera& camera,
-    const FrameRenderSettings& settings);
+    const SplatRenderSettings& settings);
 
-// The frame kernels' settings of `spec` (FrameRenderSettingsOf).
-FrameRenderSettings FrameRenderSettingsOf(const JobSpec& spec);
+// The splat kernel' settings of `spec` (SplatRenderSettingsOf).
+SplatRenderSettings SplatRenderSettingsOf(const JobSpec& spec);
 
 // The radiosity kernel's options for `settings`, refining the mesh to target_error (0: none).
 // InvalidArgument for an unknown solver or display. Files, threads and cancellation are the

@@ -1,4 +1,4 @@
-#include "lf/job/frame_plan.h"
+#include "lf/job/splat_plan.h"
 
 #include <algorithm>
 
@@ -9,7 +9,7 @@ namespace lf {
 
 namespace {
 
-constexpr uint64_t kMaxFrameTasks = uint64_t(1) << 22;
+constexpr uint64_t kMaxSplatTasks = uint64_t(1) << 22;
 
 // Even and odd integers in [begin, end).
 std::array<uint64_t, 2> Parities(uint64_t begin, uint64_t end) {
@@ -20,21 +20,21 @@ std::array<uint64_t, 2> Parities(uint64_t begin, uint64_t end) {
 }
 
 // A plan is a vector in memory (and rows in the job store): refuse one of more than
-// kMaxFrameTasks before making it.
+// kMaxSplatTasks before making it.
 absl::Status CheckTaskCount(uint64_t units, uint64_t per_task, size_t tiles = 1) {
     const uint64_t ranges = units / per_task + (units % per_task != 0);
-    if (ranges > kMaxFrameTasks / tiles) {
+    if (ranges > kMaxSplatTasks / tiles) {
         return absl::InvalidArgumentError(
             absl::StrCat(units, " in ranges of ", per_task,
                          (tiles > 1 ? absl::StrCat(" on ", tiles, " tiles") : ""),
-                         " make more than ", kMaxFrameTasks, " tasks: raise the range per task"));
+                         " make more than ", kMaxSplatTasks, " tasks: raise the range per task"));
     }
     return absl::OkStatus();
 }
 
 }  // namespace
 
-std::vector<PixelRect> FrameTiles(int width, int height, int tile) {
+std::vector<PixelRect> SplatTiles(int width, int height, int tile) {
     std::vector<PixelRect> rects;
     for (int y = 0; y < height; y += tile) {
         for (int x = 0; x < width; x += tile) {
@@ -44,16 +44,16 @@ std::vector<PixelRect> FrameTiles(int width, int height, int tile) {
     return rects;
 }
 
-absl::StatusOr<std::vector<FrameTask>> PlanFrameRender(const FramePlanSettings& s) {
+absl::StatusOr<std::vector<SplatTask>> PlanSplatRender(const SplatPlanSettings& s) {
     if (s.width <= 0 || s.height <= 0 || int64_t(s.width) * s.height >= (int64_t(1) << 31)) {
         return absl::InvalidArgumentError(absl::StrCat("image size ", s.width, "x", s.height,
                                                        " is empty or has 2^31 pixels or more"));
     }
     if (s.tile < 1) return absl::InvalidArgumentError(absl::StrCat("tile ", s.tile, " is below 1"));
     const uint64_t pixels = uint64_t(s.width) * uint64_t(s.height);
-    std::vector<FrameTask> tasks;
+    std::vector<SplatTask> tasks;
     switch (s.kind) {
-        case FramePlanKind::kLightPaths: {
+        case SplatPlanKind::kLightPaths: {
             // At most kMaxSpp per pixel-equivalent, like camera samples: the exact sums of a
             // pixel then stay as far from overflow as a path-traced pixel's.
             if (s.light_paths < 1 || s.light_paths / pixels > kMaxSpp) {
@@ -68,7 +68,7 @@ absl::StatusOr<std::vector<FrameTask>> PlanFrameRender(const FramePlanSettings& 
                 return st;
             }
             for (uint64_t a = 0; a < s.light_paths; a += s.max_paths_per_task) {
-                FrameTask t;
+                SplatTask t;
                 t.index = int(tasks.size());
                 t.path_begin = a;
                 t.path_end = a + std::min(s.max_paths_per_task, s.light_paths - a);
@@ -76,7 +76,7 @@ absl::StatusOr<std::vector<FrameTask>> PlanFrameRender(const FramePlanSettings& 
             }
             break;
         }
-        case FramePlanKind::kCameraAndLight: {
+        case SplatPlanKind::kCameraAndLight: {
             absl::StatusOr<std::vector<RenderTask>> tiles =
                 PlanRender({s.width, s.height, s.spp, s.tile, s.passes});
             if (!tiles.ok()) return tiles.status();
@@ -85,7 +85,7 @@ absl::StatusOr<std::vector<FrameTask>> PlanFrameRender(const FramePlanSettings& 
             }
             break;
         }
-        case FramePlanKind::kPhotonPasses: {
+        case SplatPlanKind::kPhotonPasses: {
             if (s.spp < 1 || s.spp > kMaxSpp) {
                 return absl::InvalidArgumentError(
                     absl::StrCat("photon passes ", s.spp, " is outside 1..", kMaxSpp));
@@ -93,7 +93,7 @@ absl::StatusOr<std::vector<FrameTask>> PlanFrameRender(const FramePlanSettings& 
             if (s.max_paths_per_task < 1) {
                 return absl::InvalidArgumentError("photon passes per task is 0");
             }
-            const std::vector<PixelRect> rects = FrameTiles(s.width, s.height, s.tile);
+            const std::vector<PixelRect> rects = SplatTiles(s.width, s.height, s.tile);
             if (absl::Status st = CheckTaskCount(s.spp, s.max_paths_per_task, rects.size());
                 !st.ok()) {
                 return st;
@@ -113,16 +113,16 @@ absl::StatusOr<std::vector<FrameTask>> PlanFrameRender(const FramePlanSettings& 
     return tasks;
 }
 
-std::array<uint64_t, 2> SplatPaths(FramePlanKind kind, const FrameTask& task) {
+std::array<uint64_t, 2> SplatPaths(SplatPlanKind kind, const SplatTask& task) {
     switch (kind) {
-        case FramePlanKind::kLightPaths:
+        case SplatPlanKind::kLightPaths:
             return Parities(task.path_begin, task.path_end);
-        case FramePlanKind::kCameraAndLight: {
+        case SplatPlanKind::kCameraAndLight: {
             const std::array<uint64_t, 2> per_pixel = Parities(task.sample_begin, task.sample_end);
             const uint64_t area = uint64_t(task.rect.Area());
             return {per_pixel[0] * area, per_pixel[1] * area};
         }
-        case FramePlanKind::kPhotonPasses:
+        case SplatPlanKind::kPhotonPasses:
             break;
     }
     return {0, 0};

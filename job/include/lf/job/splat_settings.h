@@ -1,4 +1,4 @@
-// The job settings of the frame methods (light tracing, BDPT, photon mapping: lf/job/frame_plan.h)
+// The job settings of the splatting methods (light tracing, BDPT, photon mapping: lf/job/splat_plan.h)
 // and how a job's plain settings become their plan and their kernel's settings. Local mode
 // (`lightfarm render`), the coordinator and the workers all map through here, so one command line
 // gives one plan and one kernel configuration everywhere, hence the same bits.
@@ -12,7 +12,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/light_strategy.h"
 #include "lf/core/sampler.h"
-#include "lf/job/frame_plan.h"
+#include "lf/job/splat_plan.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
 
@@ -32,10 +32,10 @@ inline constexpr uint64_t kMaxPhotonsPerPass = uint64_t(1) << 28;
 // "ppm.alpha 1: expected above 0 and below 1".
 absl::Status CheckPhotonSettings(const PhotonSettings& ppm);
 
-// The plan kind of a frame method (MethodInfo::frame_plan); nullopt for the others and for
+// The plan kind of a splatting method (MethodInfo::splat_plan); nullopt for the others and for
 // unknown names.
-std::optional<FramePlanKind> FramePlanKindOf(std::string_view method);
-inline bool UsesFramePlan(std::string_view method) { return FramePlanKindOf(method).has_value(); }
+std::optional<SplatPlanKind> SplatPlanKindOf(std::string_view method);
+inline bool UsesSplatPlan(std::string_view method) { return SplatPlanKindOf(method).has_value(); }
 
 // `ppm`'s tile: the whole frame up to this side. Each task of a tile rebuilds the photon maps of
 // its passes (a pass's map is a pure function of the pass), so every extra tile repeats the
@@ -47,7 +47,7 @@ inline constexpr int kPpmMaxTile = 1024;
 inline constexpr uint64_t kMaxLightPathsPerTask = kDefaultPathsPerTask;
 
 // The largest task result a worker sends and the coordinator takes (CompleteTaskRequest), on
-// both ends of the wire in place of gRPC's 4 MiB default: a frame task's result is its camera
+// both ends of the wire in place of gRPC's 4 MiB default: a splat task's result is its camera
 // sums (104 bytes a pixel, at most kPpmMaxTile^2 pixels: 104 MiB) and its splat list (53 bytes
 // an entry after coalescing, at most 2 entries a pixel of the frame: 879 MB on a 3840x2160
 // frame whatever the task's paths or depth). So any task of a frame up to 4K, or of any frame
@@ -57,7 +57,7 @@ inline constexpr uint64_t kMaxLightPathsPerTask = kDefaultPathsPerTask;
 // blob, and a result it took but could not record would fail the job after the merge.
 inline constexpr int kMaxTaskResultBytes = 960'000'000;
 
-// The frame plan of `method` (a frame method) for a render of plan.width x plan.height:
+// The splat plan of `method` (a splatting method) for a render of plan.width x plan.height:
 // - light: spp x W x H light paths (spp light paths per pixel-equivalent, so `--spp` means the
 //   same effort per pixel as for the path tracer), in consecutive ranges of
 //   min(kMaxLightPathsPerTask, ceil(N / plan.passes)) paths (`--passes` splits them as it splits
@@ -65,14 +65,14 @@ inline constexpr int kMaxTaskResultBytes = 960'000'000;
 // - bdpt: plan's tiles x sample passes, as the path tracer's.
 // - ppm: spp photon passes (one camera sample per pixel each) in ranges of ceil(spp / passes) on
 //   tiles of the whole frame up to kPpmMaxTile a side (or plan.tile if larger).
-// InvalidArgument when `method` is not a frame method or the sizes are out of range.
-absl::StatusOr<FramePlanSettings> FramePlanSettingsOf(std::string_view method,
+// InvalidArgument when `method` is not a splatting method or the sizes are out of range.
+absl::StatusOr<SplatPlanSettings> SplatPlanSettingsOf(std::string_view method,
                                                       const RenderPlanSettings& plan);
 
-// The kernel's settings (lf::FrameRenderSettings) of a job's values. A template so that the job
+// The kernel's settings (lf::SplatRenderSettings) of a job's values. A template so that the job
 // model need not depend on the kernels; local mode and the worker both convert through it.
 template <class Settings>
-Settings FrameRenderSettingsOf(int max_depth, uint64_t seed, SamplerType sampler, double clamp,
+Settings SplatRenderSettingsOf(int max_depth, uint64_t seed, SamplerType sampler, double clamp,
                                LightStrategy light_strategy, const PhotonSettings& ppm) {
     Settings s;
     s.max_depth = max_depth;

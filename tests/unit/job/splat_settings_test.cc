@@ -1,7 +1,7 @@
-// The frame methods' job settings (lf/job/frame_settings.h): which plan each method gets from the
+// The splatting methods' job settings (lf/job/splat_settings.h): which plan each method gets from the
 // job's spp, tile and passes; what a job may ask of them (photon settings, no AOVs, no adaptive
 // sampling); the kernel settings they map to; and what their EXR header says.
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 
 #include <gtest/gtest.h>
 
@@ -14,42 +14,42 @@
 namespace lf {
 namespace {
 
-TEST(FrameSettings, MethodsMapToTheirPlanKinds) {
-    EXPECT_EQ(FramePlanKindOf("light"), FramePlanKind::kLightPaths);
-    EXPECT_EQ(FramePlanKindOf("bdpt"), FramePlanKind::kCameraAndLight);
-    EXPECT_EQ(FramePlanKindOf("ppm"), FramePlanKind::kPhotonPasses);
+TEST(SplatSettings, MethodsMapToTheirPlanKinds) {
+    EXPECT_EQ(SplatPlanKindOf("light"), SplatPlanKind::kLightPaths);
+    EXPECT_EQ(SplatPlanKindOf("bdpt"), SplatPlanKind::kCameraAndLight);
+    EXPECT_EQ(SplatPlanKindOf("ppm"), SplatPlanKind::kPhotonPasses);
     for (const char* tile_method : {"path", "radiosity", "whitted", "auto", ""}) {
-        EXPECT_FALSE(UsesFramePlan(tile_method)) << tile_method;
-        EXPECT_EQ(FramePlanSettingsOf(tile_method, {8, 8}).status().code(),
+        EXPECT_FALSE(UsesSplatPlan(tile_method)) << tile_method;
+        EXPECT_EQ(SplatPlanSettingsOf(tile_method, {8, 8}).status().code(),
                   absl::StatusCode::kInvalidArgument);
     }
 }
 
 // spp light paths per pixel-equivalent, in ranges --passes splits, at most 2^18 a task.
-TEST(FrameSettings, LightTracingTracesSppPathsPerPixelInPassRanges) {
-    absl::StatusOr<FramePlanSettings> s = FramePlanSettingsOf("light", {30, 20, 16, 8, 3});
+TEST(SplatSettings, LightTracingTracesSppPathsPerPixelInPassRanges) {
+    absl::StatusOr<SplatPlanSettings> s = SplatPlanSettingsOf("light", {30, 20, 16, 8, 3});
     ASSERT_TRUE(s.ok()) << s.status();
     EXPECT_EQ(s->light_paths, 16u * 30 * 20);
     EXPECT_EQ(s->max_paths_per_task, 3200u);  // ceil(9600 / 3)
     EXPECT_EQ(s->tile, 8);
-    absl::StatusOr<std::vector<FrameTask>> tasks = PlanFrameRender(*s);
+    absl::StatusOr<std::vector<SplatTask>> tasks = PlanSplatRender(*s);
     ASSERT_TRUE(tasks.ok());
     ASSERT_EQ(tasks->size(), 3u);
     EXPECT_EQ(tasks->back().path_end, 9600u);
 
-    s = FramePlanSettingsOf("light", {1920, 1080, 16, 32, 1});
+    s = SplatPlanSettingsOf("light", {1920, 1080, 16, 32, 1});
     ASSERT_TRUE(s.ok());
     EXPECT_EQ(s->max_paths_per_task, kMaxLightPathsPerTask);
-    tasks = PlanFrameRender(*s);
+    tasks = PlanSplatRender(*s);
     ASSERT_TRUE(tasks.ok());
     EXPECT_EQ(tasks->size(),
               (16u * 1920 * 1080 + kMaxLightPathsPerTask - 1) / kMaxLightPathsPerTask);
 }
 
-TEST(FrameSettings, BdptIsPlannedAsThePathTracer) {
-    absl::StatusOr<FramePlanSettings> s = FramePlanSettingsOf("bdpt", {30, 20, 16, 8, 4});
+TEST(SplatSettings, BdptIsPlannedAsThePathTracer) {
+    absl::StatusOr<SplatPlanSettings> s = SplatPlanSettingsOf("bdpt", {30, 20, 16, 8, 4});
     ASSERT_TRUE(s.ok());
-    absl::StatusOr<std::vector<FrameTask>> tasks = PlanFrameRender(*s);
+    absl::StatusOr<std::vector<SplatTask>> tasks = PlanSplatRender(*s);
     absl::StatusOr<std::vector<RenderTask>> tiles = PlanRender({30, 20, 16, 8, 4});
     ASSERT_TRUE(tasks.ok() && tiles.ok());
     ASSERT_EQ(tasks->size(), tiles->size());
@@ -60,30 +60,30 @@ TEST(FrameSettings, BdptIsPlannedAsThePathTracer) {
 }
 
 // Photon passes on whole-frame tiles (up to kPpmMaxTile a side), split by --passes.
-TEST(FrameSettings, PhotonPassesUseWholeFrameTiles) {
-    absl::StatusOr<FramePlanSettings> s = FramePlanSettingsOf("ppm", {300, 200, 10, 32, 4});
+TEST(SplatSettings, PhotonPassesUseWholeFrameTiles) {
+    absl::StatusOr<SplatPlanSettings> s = SplatPlanSettingsOf("ppm", {300, 200, 10, 32, 4});
     ASSERT_TRUE(s.ok());
     EXPECT_EQ(s->tile, 300);
     EXPECT_EQ(s->max_paths_per_task, 3u);  // ceil(10 / 4)
-    absl::StatusOr<std::vector<FrameTask>> tasks = PlanFrameRender(*s);
+    absl::StatusOr<std::vector<SplatTask>> tasks = PlanSplatRender(*s);
     ASSERT_TRUE(tasks.ok());
     ASSERT_EQ(tasks->size(), 4u);  // passes 0-2, 3-5, 6-8, 9
     EXPECT_EQ((*tasks)[0].rect.Area(), 300 * 200);
     EXPECT_EQ((*tasks)[3].path_begin, 9u);
 
-    s = FramePlanSettingsOf("ppm", {3000, 500, 10, 32, 1});
+    s = SplatPlanSettingsOf("ppm", {3000, 500, 10, 32, 1});
     ASSERT_TRUE(s.ok());
     EXPECT_EQ(s->tile, kPpmMaxTile);
 }
 
-TEST(FrameSettings, OutOfRangeSizesAreRefused) {
-    EXPECT_FALSE(FramePlanSettingsOf("light", {0, 8, 1}).ok());
-    EXPECT_FALSE(FramePlanSettingsOf("light", {8, 8, 0}).ok());
-    EXPECT_FALSE(FramePlanSettingsOf("ppm", {8, 8, kMaxSpp + 1}).ok());
-    EXPECT_FALSE(FramePlanSettingsOf("bdpt", {8, 8, 4, 8, 0}).ok());
+TEST(SplatSettings, OutOfRangeSizesAreRefused) {
+    EXPECT_FALSE(SplatPlanSettingsOf("light", {0, 8, 1}).ok());
+    EXPECT_FALSE(SplatPlanSettingsOf("light", {8, 8, 0}).ok());
+    EXPECT_FALSE(SplatPlanSettingsOf("ppm", {8, 8, kMaxSpp + 1}).ok());
+    EXPECT_FALSE(SplatPlanSettingsOf("bdpt", {8, 8, 4, 8, 0}).ok());
 }
 
-TEST(FrameSettings, PhotonSettingsOutsideTheirRangesAreRefusedByName) {
+TEST(SplatSettings, PhotonSettingsOutsideTheirRangesAreRefusedByName) {
     const struct {
         PhotonSettings ppm;
         const char* field;
@@ -107,7 +107,7 @@ TEST(FrameSettings, PhotonSettingsOutsideTheirRangesAreRefusedByName) {
     EXPECT_TRUE(CheckPhotonSettings({1, 0.25, 0.9}).ok());
 }
 
-TEST(FrameSettings, FrameMethodsRefuseAovsAndAdaptiveSampling) {
+TEST(SplatSettings, SplatMethodsRefuseAovsAndAdaptiveSampling) {
     for (const char* method : {"light", "bdpt", "ppm"}) {
         JobSpec spec;
         spec.method = method;
@@ -123,7 +123,7 @@ TEST(FrameSettings, FrameMethodsRefuseAovsAndAdaptiveSampling) {
     }
 }
 
-// A stand-in for lf::FrameRenderSettings with the same members.
+// A stand-in for lf::SplatRenderSettings with the same members.
 struct KernelSettings {
     int max_depth = 5;
     uint64_t seed = 0;
@@ -135,8 +135,8 @@ struct KernelSettings {
     double alpha = 0;
 };
 
-TEST(FrameSettings, KernelSettingsCarryEveryJobValue) {
-    const KernelSettings k = FrameRenderSettingsOf<KernelSettings>(
+TEST(SplatSettings, KernelSettingsCarryEveryJobValue) {
+    const KernelSettings k = SplatRenderSettingsOf<KernelSettings>(
         7, 42, SamplerType::kIndependent, 3.5, LightStrategy::kPower, {1000, 0.125, 0.75});
     EXPECT_EQ(k.max_depth, 7);
     EXPECT_EQ(k.seed, 42u);
@@ -153,7 +153,7 @@ std::string Text(const ExrAttributes& a, const std::string& name) {
     return it == a.end() ? "" : std::get<std::string>(it->second);
 }
 
-TEST(FrameSettings, HeaderNamesTheMethodAndItsParameters) {
+TEST(SplatSettings, HeaderNamesTheMethodAndItsParameters) {
     RenderMetadata m;
     m.scene_hash = "abc";
     m.spp = 4;

@@ -1,6 +1,6 @@
 // Rendering methods whose samples land anywhere on the image: light tracing ("light"),
 // bidirectional path tracing ("bdpt") and progressive photon mapping ("ppm"). Their unit of work
-// is a "frame pass" (lf/job/frame_plan.h plans them; lf/job/frame_merge.h merges them): a range
+// is a "splat pass" (lf/job/splat_plan.h plans them; lf/job/splat_merge.h merges them): a range
 // of camera samples over a rectangle, and/or a range of light paths or photon passes over the
 // whole frame. Its result is the rectangle's camera sums (TileSums) and a splat list
 // (SplatList) of exact sums, so any split of a render over tasks, threads and machines adds up
@@ -19,8 +19,8 @@
 
 namespace lf {
 
-// The settings of a frame method; the job model's defaults (lf/job/settings.h) fill them.
-struct FrameRenderSettings {
+// The settings of a splatting method; the job model's defaults (lf/job/settings.h) fill them.
+struct SplatRenderSettings {
     int max_depth = 5;  // the most bounces of a path; negative: unlimited (roulette ends them)
     uint64_t seed = 0;
     SamplerType sampler = SamplerType::kSobol;
@@ -37,26 +37,26 @@ struct FrameRenderSettings {
     double alpha = 2.0 / 3.0;
 };
 
-// One task's work (the kernel's view of lf::FrameTask; the job model is not a kernel
+// One task's work (the kernel's view of lf::SplatTask; the job model is not a kernel
 // dependency). Camera part: samples [sample_begin, sample_end) of every pixel of rect (none when
 // rect is empty). Whole-frame part: light paths [path_begin, path_end) for "light"; for "ppm"
 // the photon passes [path_begin, path_end), which equal the sample range; unused by "bdpt",
 // whose light subpaths are those of its camera samples.
-struct FrameWork {
+struct SplatWork {
     PixelRect rect;
     uint64_t sample_begin = 0, sample_end = 0;
     uint64_t path_begin = 0, path_end = 0;
 };
 
-class FrameRenderer {
+class SplatRenderer {
   public:
-    virtual ~FrameRenderer() = default;
+    virtual ~SplatRenderer() = default;
     // Adds the work's camera samples into `camera` (whose rect is work.rect) and its light paths'
     // contributions into `splats` (a list of the camera's frame), and the rays cast and samples
     // taken into camera.stats. The result is a pure function of the work and the settings: any
     // split of a render gives the same sums. May run tbb::parallel_for inside (callers run it in
     // their task arena); stops early, leaving partial sums the caller discards, once `cancel`.
-    virtual void Render(const FrameWork& work, TileSums& camera, SplatList& splats,
+    virtual void Render(const SplatWork& work, TileSums& camera, SplatList& splats,
                         const std::atomic<bool>* cancel = nullptr) const = 0;
 };
 

@@ -1,4 +1,4 @@
-#include "lf/job/frame_result_codec.h"
+#include "lf/job/splat_result_codec.h"
 
 #include <cstdint>
 #include <cstring>
@@ -27,7 +27,7 @@ uint64_t GetLe(std::string_view in, size_t at, int bytes) {
 
 }  // namespace
 
-std::string EncodeFrameResult(const TileSums& camera, SplatList& splats) {
+std::string EncodeSplatResult(const TileSums& camera, SplatList& splats) {
     const std::string tile = EncodeTileSums(camera);
     std::string out(kMagic, 4);
     PutLe(out, kVersion, 4);
@@ -37,25 +37,25 @@ std::string EncodeFrameResult(const TileSums& camera, SplatList& splats) {
     return out;
 }
 
-absl::StatusOr<FrameResult> DecodeFrameResult(std::string_view bytes) {
+absl::StatusOr<SplatResult> DecodeSplatResult(std::string_view bytes) {
     if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, 4) != 0) {
-        return absl::InvalidArgumentError(absl::StrCat("frame result: not an encoded result (",
+        return absl::InvalidArgumentError(absl::StrCat("splat result: not an encoded result (",
                                                        bytes.size(), " bytes, no LFFR header)"));
     }
     if (const uint64_t version = GetLe(bytes, 4, 4); version != kVersion) {
         return absl::InvalidArgumentError(
-            absl::StrCat("frame result: version ", version, ", expected ", kVersion));
+            absl::StrCat("splat result: version ", version, ", expected ", kVersion));
     }
     const uint64_t tile_bytes = GetLe(bytes, 8, 8);
     if (tile_bytes > bytes.size() - kHeaderBytes) {
-        return absl::InvalidArgumentError(absl::StrCat("frame result: camera sums of ", tile_bytes,
+        return absl::InvalidArgumentError(absl::StrCat("splat result: camera sums of ", tile_bytes,
                                                        " bytes in a record of ", bytes.size()));
     }
     absl::StatusOr<TileSums> camera = DecodeTileSums(bytes.substr(kHeaderBytes, tile_bytes));
     if (!camera.ok()) return camera.status();
     absl::StatusOr<SplatList> splats = DecodeSplatList(bytes.substr(kHeaderBytes + tile_bytes));
     if (!splats.ok()) return splats.status();
-    return FrameResult{std::move(*camera), std::move(*splats)};
+    return SplatResult{std::move(*camera), std::move(*splats)};
 }
 
 }  // namespace lf

@@ -1,4 +1,4 @@
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 
 #include <algorithm>
 #include <cmath>
@@ -28,17 +28,17 @@ absl::Status CheckPhotonSettings(const PhotonSettings& ppm) {
     return absl::OkStatus();
 }
 
-std::optional<FramePlanKind> FramePlanKindOf(std::string_view method) {
+std::optional<SplatPlanKind> SplatPlanKindOf(std::string_view method) {
     const std::optional<Method> m = FindMethod(method);
-    return m ? Info(*m).frame_plan : std::nullopt;
+    return m ? Info(*m).splat_plan : std::nullopt;
 }
 
-absl::StatusOr<FramePlanSettings> FramePlanSettingsOf(std::string_view method,
+absl::StatusOr<SplatPlanSettings> SplatPlanSettingsOf(std::string_view method,
                                                       const RenderPlanSettings& plan) {
-    const std::optional<FramePlanKind> kind = FramePlanKindOf(method);
+    const std::optional<SplatPlanKind> kind = SplatPlanKindOf(method);
     if (!kind) {
         return absl::InvalidArgumentError(absl::StrCat(
-            "method \"", std::string(method), "\" is not a frame method (light, bdpt, ppm)"));
+            "method \"", std::string(method), "\" is not a splatting method (light, bdpt, ppm)"));
     }
     if (plan.width <= 0 || plan.height <= 0) {
         return absl::InvalidArgumentError(
@@ -51,7 +51,7 @@ absl::StatusOr<FramePlanSettings> FramePlanSettingsOf(std::string_view method,
     if (plan.passes < 1) {
         return absl::InvalidArgumentError(absl::StrCat("passes ", plan.passes, " is below 1"));
     }
-    FramePlanSettings s;
+    SplatPlanSettings s;
     s.width = plan.width;
     s.height = plan.height;
     s.kind = *kind;
@@ -59,7 +59,7 @@ absl::StatusOr<FramePlanSettings> FramePlanSettingsOf(std::string_view method,
     s.tile = plan.tile;
     s.passes = plan.passes;
     switch (*kind) {
-        case FramePlanKind::kLightPaths: {
+        case SplatPlanKind::kLightPaths: {
             // Below 2^31 pixels x 2^24 spp: no overflow.
             s.light_paths = plan.spp * uint64_t(plan.width) * uint64_t(plan.height);
             const uint64_t passes = uint64_t(plan.passes);
@@ -67,9 +67,9 @@ absl::StatusOr<FramePlanSettings> FramePlanSettingsOf(std::string_view method,
                                             s.light_paths / passes + (s.light_paths % passes != 0));
             break;
         }
-        case FramePlanKind::kCameraAndLight:
+        case SplatPlanKind::kCameraAndLight:
             break;
-        case FramePlanKind::kPhotonPasses: {
+        case SplatPlanKind::kPhotonPasses: {
             const uint64_t passes = uint64_t(plan.passes);
             s.max_paths_per_task = plan.spp / passes + (plan.spp % passes != 0);
             s.tile = std::max(plan.tile, std::min(kPpmMaxTile, std::max(plan.width, plan.height)));

@@ -1,6 +1,6 @@
-// Local mode's frame renders (lf::RenderFrameImage): the frame plan's tasks, run on any number of
+// Local mode's frame renders (lf::RenderSplatImage): the splat plan's tasks, run on any number of
 // threads and split by any --passes and --tile, merge into the same bits, normalised as
-// lf/job/frame_merge.h says. The renderer here is a made-up one, a pure function of each light
+// lf/job/splat_merge.h says. The renderer here is a made-up one, a pure function of each light
 // path's index and each camera sample, as the contract asks of the real kernels.
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 
 #include "lf/core/camera.h"
 #include "lf/core/sampler.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/local/local_executor.h"
 
 namespace lf {
@@ -20,12 +20,12 @@ constexpr int kWidth = 23, kHeight = 17;
 // Light path i splats 0 to 3 values anywhere, over many orders of magnitude (half = i's parity);
 // a camera sample adds its own value and, for BDPT, splats its own light subpath. Photon passes
 // add one camera value per (pixel, pass) and splat nothing.
-class FakeFrameRenderer : public FrameRenderer {
+class FakeSplatRenderer : public SplatRenderer {
   public:
-    explicit FakeFrameRenderer(FramePlanKind kind) : kind_(kind) {}
-    void Render(const FrameWork& work, TileSums& camera, SplatList& splats,
+    explicit FakeSplatRenderer(SplatPlanKind kind) : kind_(kind) {}
+    void Render(const SplatWork& work, TileSums& camera, SplatList& splats,
                 const std::atomic<bool>*) const override {
-        for (uint64_t i = work.path_begin; i < work.path_end && kind_ == FramePlanKind::kLightPaths;
+        for (uint64_t i = work.path_begin; i < work.path_end && kind_ == SplatPlanKind::kLightPaths;
              ++i) {
             Path(i, int(i & 1), splats);
         }
@@ -35,7 +35,7 @@ class FakeFrameRenderer : public FrameRenderer {
                     Sampler u(5, x, y, s);
                     camera.at(x, y).Add(s, Rgb(std::exp(20 * u.Get1D() - 10), 1, float(x)));
                     ++camera.stats.samples;
-                    if (kind_ == FramePlanKind::kCameraAndLight) {
+                    if (kind_ == SplatPlanKind::kCameraAndLight) {
                         Path((uint64_t(y * kWidth + x) << 32) + s, int(s & 1), splats);
                     }
                 }
@@ -53,7 +53,7 @@ class FakeFrameRenderer : public FrameRenderer {
             out.Add(int(p.x * kWidth), int(p.y * kHeight), half, Rgb(std::exp(30 * u - 15), u, 1));
         }
     }
-    FramePlanKind kind_;
+    SplatPlanKind kind_;
 };
 
 Camera TestCamera() {
@@ -80,18 +80,18 @@ bool SameBits(const Image& a, const Image& b) {
 
 Image Render(const char* method, uint64_t spp, int tile, int passes, int threads) {
     const Camera camera = TestCamera();
-    absl::StatusOr<FramePlanSettings> plan =
-        FramePlanSettingsOf(method, {kWidth, kHeight, spp, tile, passes});
+    absl::StatusOr<SplatPlanSettings> plan =
+        SplatPlanSettingsOf(method, {kWidth, kHeight, spp, tile, passes});
     EXPECT_TRUE(plan.ok()) << plan.status();
-    const FakeFrameRenderer renderer(plan->kind);
+    const FakeSplatRenderer renderer(plan->kind);
     RenderSettings settings;
     settings.threads = threads;
-    absl::StatusOr<RenderOutput> out = RenderFrameImage(camera, renderer, *plan, settings);
+    absl::StatusOr<RenderOutput> out = RenderSplatImage(camera, renderer, *plan, settings);
     EXPECT_TRUE(out.ok()) << out.status();
     return out.ok() ? std::move(out->image) : Image();
 }
 
-TEST(RenderFrameImage, AnySplitAndThreadCountGivesTheSameBits) {
+TEST(RenderSplatImage, AnySplitAndThreadCountGivesTheSameBits) {
     for (const char* method : {"light", "bdpt", "ppm"}) {
         const Image one = Render(method, 6, 8, 1, 1);
         ASSERT_GT(one.width(), 0) << method;
@@ -103,10 +103,10 @@ TEST(RenderFrameImage, AnySplitAndThreadCountGivesTheSameBits) {
 
 // Light path i splats 1 onto pixel i mod P, so every pixel gets spp splats of 1 from spp x P
 // light paths: splat sum x P / N = 1 exactly, each half alike.
-TEST(RenderFrameImage, SplatsAreNormalisedByLightPathsPerPixel) {
-    class Uniform : public FrameRenderer {
+TEST(RenderSplatImage, SplatsAreNormalisedByLightPathsPerPixel) {
+    class Uniform : public SplatRenderer {
       public:
-        void Render(const FrameWork& work, TileSums&, SplatList& splats,
+        void Render(const SplatWork& work, TileSums&, SplatList& splats,
                     const std::atomic<bool>*) const override {
             for (uint64_t i = work.path_begin; i < work.path_end; ++i) {
                 const uint64_t q = i % (kWidth * kHeight);
@@ -115,10 +115,10 @@ TEST(RenderFrameImage, SplatsAreNormalisedByLightPathsPerPixel) {
         }
     };
     const Camera camera = TestCamera();
-    absl::StatusOr<FramePlanSettings> plan =
-        FramePlanSettingsOf("light", {kWidth, kHeight, 4, 8, 3});
+    absl::StatusOr<SplatPlanSettings> plan =
+        SplatPlanSettingsOf("light", {kWidth, kHeight, 4, 8, 3});
     ASSERT_TRUE(plan.ok()) << plan.status();
-    absl::StatusOr<RenderOutput> out = RenderFrameImage(camera, Uniform(), *plan, RenderSettings());
+    absl::StatusOr<RenderOutput> out = RenderSplatImage(camera, Uniform(), *plan, RenderSettings());
     ASSERT_TRUE(out.ok()) << out.status();
     const struct {
         const char* name;
@@ -131,12 +131,12 @@ TEST(RenderFrameImage, SplatsAreNormalisedByLightPathsPerPixel) {
     }
 }
 
-TEST(RenderFrameImage, RefusesAPlanOfAnotherSize) {
-    absl::StatusOr<FramePlanSettings> plan = FramePlanSettingsOf("light", {kWidth + 1, kHeight, 1});
+TEST(RenderSplatImage, RefusesAPlanOfAnotherSize) {
+    absl::StatusOr<SplatPlanSettings> plan = SplatPlanSettingsOf("light", {kWidth + 1, kHeight, 1});
     ASSERT_TRUE(plan.ok());
-    const FakeFrameRenderer renderer(plan->kind);
+    const FakeSplatRenderer renderer(plan->kind);
     absl::StatusOr<RenderOutput> out =
-        RenderFrameImage(TestCamera(), renderer, *plan, RenderSettings());
+        RenderSplatImage(TestCamera(), renderer, *plan, RenderSettings());
     EXPECT_EQ(out.status().code(), absl::StatusCode::kInvalidArgument);
 }
 

@@ -1,4 +1,4 @@
-#include "lf/job/frame_merge.h"
+#include "lf/job/splat_merge.h"
 
 #include <functional>
 
@@ -12,7 +12,7 @@ double SplatNormalization::Scale(int half) const {
     return n == 0 ? 0.0 : double(frame_pixels) / double(n);
 }
 
-void SetFrameTile(Image& image, const TileSums& camera, const TileSums& splats,
+void SetSplatTile(Image& image, const TileSums& camera, const TileSums& splats,
                   const SplatNormalization& norm) {
     static const char* kRgb[3] = {"R", "G", "B"};
     std::vector<float>* mean[3];
@@ -48,22 +48,22 @@ void SetFrameTile(Image& image, const TileSums& camera, const TileSums& splats,
     }
 }
 
-absl::StatusOr<std::unique_ptr<FrameMerger>> FrameMerger::Make(int width, int height, int tile,
-                                                               FramePlanKind kind,
-                                                               std::vector<FrameTask> tasks) {
+absl::StatusOr<std::unique_ptr<SplatMerger>> SplatMerger::Make(int width, int height, int tile,
+                                                               SplatPlanKind kind,
+                                                               std::vector<SplatTask> tasks) {
     return Make(width, height, tile, kind, std::move(tasks), MakeMemoryTileStore);
 }
 
-absl::StatusOr<std::unique_ptr<FrameMerger>> FrameMerger::Make(int width, int height, int tile,
-                                                               FramePlanKind kind,
-                                                               std::vector<FrameTask> tasks,
+absl::StatusOr<std::unique_ptr<SplatMerger>> SplatMerger::Make(int width, int height, int tile,
+                                                               SplatPlanKind kind,
+                                                               std::vector<SplatTask> tasks,
                                                                const TileStoreFactory& make_store) {
     if (width <= 0 || height <= 0 || tile < 1) {
         return absl::InvalidArgumentError(
             absl::StrCat("frame ", width, "x", height, " in tiles of ", tile, ": empty"));
     }
-    const std::vector<PixelRect> tiles = FrameTiles(width, height, tile);
-    for (const FrameTask& t : tasks) {
+    const std::vector<PixelRect> tiles = SplatTiles(width, height, tile);
+    for (const SplatTask& t : tasks) {
         // Camera parts must be tiles of the grid, so a task adds into exactly one store tile.
         if (t.rect.Area() == 0) continue;
         const bool on_grid =
@@ -82,12 +82,12 @@ absl::StatusOr<std::unique_ptr<FrameMerger>> FrameMerger::Make(int width, int he
     if (!camera.ok()) return camera.status();
     absl::StatusOr<std::unique_ptr<TileStore>> splats = make_store(tiles, 0);
     if (!splats.ok()) return splats.status();
-    return std::unique_ptr<FrameMerger>(new FrameMerger(width, height, tile, kind, std::move(tasks),
+    return std::unique_ptr<SplatMerger>(new SplatMerger(width, height, tile, kind, std::move(tasks),
                                                         std::move(*camera), std::move(*splats)));
 }
 
-FrameMerger::FrameMerger(int width, int height, int tile, FramePlanKind kind,
-                         std::vector<FrameTask> tasks, std::unique_ptr<TileStore> camera,
+SplatMerger::SplatMerger(int width, int height, int tile, SplatPlanKind kind,
+                         std::vector<SplatTask> tasks, std::unique_ptr<TileStore> camera,
                          std::unique_ptr<TileStore> splats)
     : width_(width),
       height_(height),
@@ -101,7 +101,7 @@ FrameMerger::FrameMerger(int width, int height, int tile, FramePlanKind kind,
     norm_.frame_pixels = uint64_t(width) * uint64_t(height);
 }
 
-absl::Status FrameMerger::AddOnce(int task, TileStore& store, int tile, int slot,
+absl::Status SplatMerger::AddOnce(int task, TileStore& store, int tile, int slot,
                                   const std::function<void(TileSums&)>& add) {
     std::vector<bool>& added = partial_[task];
     if (added.empty()) added.resize(2 * camera_->tiles().size(), false);
@@ -114,14 +114,14 @@ absl::Status FrameMerger::AddOnce(int task, TileStore& store, int tile, int slot
     return absl::OkStatus();
 }
 
-absl::Status FrameMerger::Add(int task_index, const TileSums& camera, SplatList& splats) {
+absl::Status SplatMerger::Add(int task_index, const TileSums& camera, SplatList& splats) {
     if (task_index < 0 || size_t(task_index) >= tasks_.size()) {
         return absl::InvalidArgumentError(absl::StrCat("no task ", task_index, " in the plan"));
     }
     if (done_[size_t(task_index)]) {
         return absl::AlreadyExistsError(absl::StrCat("task ", task_index, " is already merged"));
     }
-    const FrameTask& task = tasks_[size_t(task_index)];
+    const SplatTask& task = tasks_[size_t(task_index)];
     // Everything is checked before the first tile is touched.
     if (task.rect.Area() == 0) {
         if (camera.rect.Area() != 0) {
@@ -134,7 +134,7 @@ absl::Status FrameMerger::Add(int task_index, const TileSums& camera, SplatList&
         if (absl::Status s = CheckTaskResult(as_tile, camera); !s.ok()) return s;
         if (camera.aovs != 0) {
             return absl::InvalidArgumentError(
-                absl::StrCat("task ", task_index, ": camera sums with AOVs, which frame passes ",
+                absl::StrCat("task ", task_index, ": camera sums with AOVs, which splat passes ",
                              "do not carry"));
         }
     }
@@ -144,7 +144,7 @@ absl::Status FrameMerger::Add(int task_index, const TileSums& camera, SplatList&
                                                        " frame, the job's ", width_, "x", height_));
     }
     const std::vector<SplatEntry>& entries = splats.entries();
-    if (kind_ == FramePlanKind::kPhotonPasses && !entries.empty()) {
+    if (kind_ == SplatPlanKind::kPhotonPasses && !entries.empty()) {
         return absl::InvalidArgumentError(
             absl::StrCat("task ", task_index, ": ", entries.size(),
                          " splats from a photon pass, which has none"));
@@ -184,16 +184,16 @@ absl::Status FrameMerger::Add(int task_index, const TileSums& camera, SplatList&
     return absl::OkStatus();
 }
 
-absl::StatusOr<Image> FrameMerger::Snapshot() const { return snapshot_source().Read(); }
+absl::StatusOr<Image> SplatMerger::Snapshot() const { return snapshot_source().Read(); }
 
-absl::StatusOr<Image> FrameMerger::SnapshotSource::Read() const {
+absl::StatusOr<Image> SplatMerger::SnapshotSource::Read() const {
     Image image = EmptyRenderImage(width, height);
     for (int t = 0; t < int(camera->tiles().size()); ++t) {
         absl::StatusOr<TileSums> camera_sums = camera->Get(t);
         if (!camera_sums.ok()) return camera_sums.status();
         absl::StatusOr<TileSums> splat_sums = splats->Get(t);
         if (!splat_sums.ok()) return splat_sums.status();
-        SetFrameTile(image, *camera_sums, *splat_sums, norm);
+        SetSplatTile(image, *camera_sums, *splat_sums, norm);
     }
     return image;
 }

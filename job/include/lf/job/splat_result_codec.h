@@ -1,4 +1,4 @@
-// A frame task's result (lf/job/frame_plan.h) as the job store records it, so that a restarted
+// A splat task's result (lf/job/splat_plan.h) as the job store records it, so that a restarted
 // coordinator merges it again to the same bits: its camera sums (lf::EncodeTileSums; a 0x0 tile
 // carrying only the stats when the task has no camera part) and its splat list
 // (lf::EncodeSplatList), in one record.
@@ -16,15 +16,15 @@
 
 namespace lf {
 
-struct FrameResult {
+struct SplatResult {
     TileSums camera{PixelRect{}};
     SplatList splats;
 };
 
 // Coalesces the splats (equal sums give equal bytes).
-std::string EncodeFrameResult(const TileSums& camera, SplatList& splats);
+std::string EncodeSplatResult(const TileSums& camera, SplatList& splats);
 
 // InvalidArgument, saying which part is wrong, for anything that is not a whole encoded result.
-absl::StatusOr<FrameResult> DecodeFrameResult(std::string_view bytes);
+absl::StatusOr<SplatResult> DecodeSplatResult(std::string_view bytes);
 
 }  // namespace lf

@@ -1,6 +1,6 @@
-// The coordinator's glue for the frame methods (lf/job/frame_plan.h): a light job is planned
+// The coordinator's glue for the splatting methods (lf/job/splat_plan.h): a light job is planned
 // into light-path ranges, its results (camera part + splats) merge exactly once into the bits a
-// FrameMerger makes of the same results, a restarted scheduler merges the recorded results
+// SplatMerger makes of the same results, a restarted scheduler merges the recorded results
 // (splats included) to the same bits, and results that do not fit their task, or do not decode,
 // are refused naming the job, the task and the worker, the task going back to the queue.
 #include <gtest/gtest.h>
@@ -10,9 +10,9 @@
 
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
-#include "lf/job/frame_merge.h"
-#include "lf/job/frame_result_codec.h"
-#include "lf/job/frame_settings.h"
+#include "lf/job/splat_merge.h"
+#include "lf/job/splat_result_codec.h"
+#include "lf/job/splat_settings.h"
 #include "server/farm.h"
 #include "server/scheduler.h"
 #include "server/sqlite_job_store.h"
@@ -65,10 +65,10 @@ bool SameBits(const Image& a, const Image& b) {
     return true;
 }
 
-class FrameSchedulerTest : public ::testing::Test {
+class SplatSchedulerTest : public ::testing::Test {
   protected:
     void SetUp() override {
-        dir_ = lf::testing::FreshTestDir("lf_frame_sched");
+        dir_ = lf::testing::FreshTestDir("lf_splat_sched");
         fs::create_directories(dir_ / "tiles");
     }
     void TearDown() override { fs::remove_all(dir_); }
@@ -82,13 +82,13 @@ class FrameSchedulerTest : public ::testing::Test {
         return options;
     }
 
-    // The image a FrameMerger makes of every task's fake result: what the job must give.
+    // The image a SplatMerger makes of every task's fake result: what the job must give.
     static Image Expected() {
-        absl::StatusOr<FramePlanSettings> plan = FramePlanSettingsOf("light", LightSpec().plan);
-        absl::StatusOr<std::vector<FrameTask>> tasks = PlanFrameRender(*plan);
-        absl::StatusOr<std::unique_ptr<FrameMerger>> merger =
-            FrameMerger::Make(kWidth, kHeight, plan->tile, plan->kind, *tasks);
-        for (const FrameTask& t : *tasks) {
+        absl::StatusOr<SplatPlanSettings> plan = SplatPlanSettingsOf("light", LightSpec().plan);
+        absl::StatusOr<std::vector<SplatTask>> tasks = PlanSplatRender(*plan);
+        absl::StatusOr<std::unique_ptr<SplatMerger>> merger =
+            SplatMerger::Make(kWidth, kHeight, plan->tile, plan->kind, *tasks);
+        for (const SplatTask& t : *tasks) {
             TaskAssignment lease;
             lease.task = {t.index, t.rect, t.sample_begin, t.sample_end};
             lease.path_begin = t.path_begin;
@@ -102,7 +102,7 @@ class FrameSchedulerTest : public ::testing::Test {
     fs::path dir_;
 };
 
-TEST_F(FrameSchedulerTest, LightJobIsPlannedInPathRangesAndMergesEachResultOnce) {
+TEST_F(SplatSchedulerTest, LightJobIsPlannedInPathRangesAndMergesEachResultOnce) {
     InMemoryJobStore store;
     Scheduler scheduler(InFiles(), store);
     const std::string id = *scheduler.Submit(LightSpec());
@@ -132,7 +132,7 @@ TEST_F(FrameSchedulerTest, LightJobIsPlannedInPathRangesAndMergesEachResultOnce)
     EXPECT_TRUE(SameBits(scheduler.Snapshot(id)->image, Expected()));
 }
 
-TEST_F(FrameSchedulerTest, RestartMergesTheRecordedSplatsToTheSameBits) {
+TEST_F(SplatSchedulerTest, RestartMergesTheRecordedSplatsToTheSameBits) {
     std::string id;
     {
         std::unique_ptr<SqliteJobStore> store = lf::testing::OpenJobStore(dir_);
@@ -164,7 +164,7 @@ TEST_F(FrameSchedulerTest, RestartMergesTheRecordedSplatsToTheSameBits) {
     EXPECT_TRUE(SameBits(scheduler.Snapshot(id)->image, Expected()));
 }
 
-TEST_F(FrameSchedulerTest, ResultsThatDoNotFitTheirTaskAreRefusedNamingJobTaskAndWorker) {
+TEST_F(SplatSchedulerTest, ResultsThatDoNotFitTheirTaskAreRefusedNamingJobTaskAndWorker) {
     InMemoryJobStore store;
     Scheduler scheduler(InFiles(), store);
     const std::string id = *scheduler.Submit(LightSpec());
@@ -196,7 +196,7 @@ TEST_F(FrameSchedulerTest, ResultsThatDoNotFitTheirTaskAreRefusedNamingJobTaskAn
     EXPECT_EQ(record.state, JobState::kRunning);
 }
 
-TEST_F(FrameSchedulerTest, SplatsInATileJobsResultAreRefused) {
+TEST_F(SplatSchedulerTest, SplatsInATileJobsResultAreRefused) {
     InMemoryJobStore store;
     Scheduler scheduler(InFiles(), store);
     JobSpec spec = LightSpec();
@@ -214,7 +214,7 @@ TEST_F(FrameSchedulerTest, SplatsInATileJobsResultAreRefused) {
 }
 
 // Through the farm's decoding: hostile splat bytes fail the task, naming job, task and worker.
-TEST_F(FrameSchedulerTest, UndecodableSplatsFailTheTaskNamingJobTaskAndWorker) {
+TEST_F(SplatSchedulerTest, UndecodableSplatsFailTheTaskNamingJobTaskAndWorker) {
     FarmOptions options;
     options.data_dir = (dir_ / "farm").string();
     absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
@@ -248,21 +248,21 @@ TEST_F(FrameSchedulerTest, UndecodableSplatsFailTheTaskNamingJobTaskAndWorker) {
     (*farm)->scheduler().Shutdown();
 }
 
-TEST(FrameResultCodec, RoundTripsAndRefusesWhatIsNotOne) {
+TEST(SplatResultCodec, RoundTripsAndRefusesWhatIsNotOne) {
     TileSums camera(PixelRect{2, 3, 4, 2});
     camera.pixels[5].Add(1, Rgb(0.25f, 1, 2));
     camera.stats.rays = 77;
     SplatList splats(kWidth, kHeight);
     splats.Add(3, 4, 1, Rgb(1, 2, 3));
-    const std::string bytes = EncodeFrameResult(camera, splats);
-    absl::StatusOr<FrameResult> back = DecodeFrameResult(bytes);
+    const std::string bytes = EncodeSplatResult(camera, splats);
+    absl::StatusOr<SplatResult> back = DecodeSplatResult(bytes);
     ASSERT_TRUE(back.ok()) << back.status();
     EXPECT_EQ(EncodeTileSums(back->camera), EncodeTileSums(camera));
     EXPECT_EQ(back->splats.entries(), splats.entries());
     // No camera part: a 0x0 tile with the stats only.
     TileSums none{PixelRect{}};
     none.stats.rays = 5;
-    absl::StatusOr<FrameResult> stats_only = DecodeFrameResult(EncodeFrameResult(none, splats));
+    absl::StatusOr<SplatResult> stats_only = DecodeSplatResult(EncodeSplatResult(none, splats));
     ASSERT_TRUE(stats_only.ok()) << stats_only.status();
     EXPECT_EQ(stats_only->camera.rect.Area(), 0);
     EXPECT_EQ(stats_only->camera.stats.rays, 5u);
@@ -270,7 +270,7 @@ TEST(FrameResultCodec, RoundTripsAndRefusesWhatIsNotOne) {
          {std::string(), bytes.substr(0, 10), std::string("LFFX") + bytes.substr(4),
           bytes.substr(0, 8) + std::string(8, '\x7f') + bytes.substr(16),
           bytes.substr(0, bytes.size() - 3)}) {
-        EXPECT_EQ(DecodeFrameResult(bad).status().code(), absl::StatusCode::kInvalidArgument);
+        EXPECT_EQ(DecodeSplatResult(bad).status().code(), absl::StatusCode::kInvalidArgument);
     }
 }
 

@@ -1,5 +1,5 @@
-// Rendering light paths of a frame method (lf/kernels/frame_renderer.h) into an image in
-// frame_merge.h's normalisation, for kernel tests: what local mode and the coordinator do,
+// Rendering light paths of a splatting method (lf/kernels/splat_renderer.h) into an image in
+// splat_merge.h's normalisation, for kernel tests: what local mode and the coordinator do,
 // without the plan.
 #pragma once
 
@@ -10,9 +10,9 @@
 #include "lf/core/camera.h"
 #include "lf/core/image.h"
 #include "lf/core/splat_list.h"
-#include "lf/job/frame_merge.h"
+#include "lf/job/splat_merge.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/frame_renderer.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/local/method_factory.h"
 
 namespace lf::testing {
@@ -22,18 +22,18 @@ inline std::array<uint64_t, 2> PathsByHalf(uint64_t begin, uint64_t end) {
     return {(end + 1) / 2 - (begin + 1) / 2, end / 2 - begin / 2};
 }
 
-struct FrameRender {
-    Image image;  // R, G, B, A.*, B.*: SetFrameTile of the whole frame
+struct SplatRender {
+    Image image;  // R, G, B, A.*, B.*: SetSplatTile of the whole frame
     RenderStats stats;
 };
 
 // The image of light paths [begin, end) of `renderer` (no camera part).
-inline FrameRender RenderFramePaths(const FrameRenderer& renderer, const Camera& camera,
+inline SplatRender RenderSplatPaths(const SplatRenderer& renderer, const Camera& camera,
                                     uint64_t begin, uint64_t end) {
     const PixelRect frame{0, 0, camera.width(), camera.height()};
     TileSums camera_sums(PixelRect{0, 0, 0, 0});
     SplatList splats(camera.width(), camera.height());
-    FrameWork work;
+    SplatWork work;
     work.path_begin = begin;
     work.path_end = end;
     renderer.Render(work, camera_sums, splats);
@@ -42,26 +42,26 @@ inline FrameRender RenderFramePaths(const FrameRenderer& renderer, const Camera&
     SplatNormalization norm;
     norm.frame_pixels = uint64_t(camera.width()) * uint64_t(camera.height());
     norm.paths = PathsByHalf(begin, end);
-    FrameRender out{Image(camera.width(), camera.height()), camera_sums.stats};
-    SetFrameTile(out.image, empty, splat_tile, norm);
+    SplatRender out{Image(camera.width(), camera.height()), camera_sums.stats};
+    SetSplatTile(out.image, empty, splat_tile, norm);
     return out;
 }
 
-// A frame method's renderer over `scene`, which must build; keeps the scene and camera alive.
-struct FrameSetup {
+// A splatting method's renderer over `scene`, which must build; keeps the scene and camera alive.
+struct SplatSetup {
     std::unique_ptr<EmbreeScene> embree;
     std::unique_ptr<Camera> camera;
-    std::unique_ptr<FrameRenderer> renderer;
+    std::unique_ptr<SplatRenderer> renderer;
 };
 
-inline FrameSetup MakeFrameSetup(const Scene& scene, std::string_view method,
-                                 const FrameRenderSettings& settings) {
-    FrameSetup s;
+inline SplatSetup MakeSplatSetup(const Scene& scene, std::string_view method,
+                                 const SplatRenderSettings& settings) {
+    SplatSetup s;
     auto es = EmbreeScene::Build(scene);
     EXPECT_TRUE(es.ok()) << es.status();
     s.embree = std::move(*es);
     s.camera = std::make_unique<Camera>(scene.camera, s.embree->origin());
-    auto r = MakeFrameRenderer(*FindMethod(method), *s.embree, *s.camera, settings);
+    auto r = MakeSplatRenderer(*FindMethod(method), *s.embree, *s.camera, settings);
     EXPECT_TRUE(r.ok()) << r.status();
     s.renderer = std::move(*r);
     return s;

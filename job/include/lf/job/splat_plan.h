@@ -1,11 +1,11 @@
 // Planning renders whose samples land anywhere on the image (light tracing, BDPT, photon
-// mapping) into "frame pass" tasks. Tiles of camera samples (lf/job/plan.h) no longer suffice:
+// mapping) into "splat pass" tasks. Tiles of camera samples (lf/job/plan.h) no longer suffice:
 // a light path splats onto any pixel, and a photon pass needs a whole-frame photon map. A task
 // is a range of light paths (or photon passes) over the whole frame, plus optionally a tile of
 // camera samples; its result is the camera tile's sums (TileSums, possibly empty) and a splat
 // list (lf/core/splat_list.h). Like tile tasks, a task's result depends on nothing but its
 // ranges, so tasks may run anywhere, in any order, and merge into the same bits
-// (lf/job/frame_merge.h).
+// (lf/job/splat_merge.h).
 #pragma once
 
 #include <array>
@@ -18,7 +18,7 @@
 
 namespace lf {
 
-enum class FramePlanKind {
+enum class SplatPlanKind {
     // Light tracing (`light`): light paths [0, light_paths) over the whole frame, split into
     // consecutive ranges of at most max_paths_per_task; no camera part. Every light path splats.
     kLightPaths,
@@ -35,9 +35,9 @@ enum class FramePlanKind {
 
 inline constexpr uint64_t kDefaultPathsPerTask = uint64_t(1) << 18;
 
-struct FramePlanSettings {
+struct SplatPlanSettings {
     int width = 0, height = 0;
-    FramePlanKind kind = FramePlanKind::kLightPaths;
+    SplatPlanKind kind = SplatPlanKind::kLightPaths;
     // kLightPaths: light paths in all, at most kMaxSpp per pixel-equivalent (width x height).
     uint64_t light_paths = 0;
     // kLightPaths: light paths per task; kPhotonPasses: passes per task.
@@ -49,7 +49,7 @@ struct FramePlanSettings {
     int passes = defaults::kPasses;  // kCameraAndLight: sample passes per tile, 1..spp
 };
 
-struct FrameTask {
+struct SplatTask {
     int index = 0;  // position in the plan
     // Camera part: samples [sample_begin, sample_end) of every pixel of rect; none when rect is
     // empty (kLightPaths).
@@ -67,15 +67,15 @@ struct FrameTask {
 
 // kLightPaths: the ranges in order. kCameraAndLight: as PlanRender. kPhotonPasses: tile by tile,
 // row by row, each tile's pass ranges consecutive. InvalidArgument for sizes out of range.
-absl::StatusOr<std::vector<FrameTask>> PlanFrameRender(const FramePlanSettings& settings);
+absl::StatusOr<std::vector<SplatTask>> PlanSplatRender(const SplatPlanSettings& settings);
 
 // The light paths whose splats task `task` makes, by half (the parity of the light path's index
 // for kLightPaths, of the camera sample's for kCameraAndLight); {0, 0} for kPhotonPasses. What
 // the splats of merged tasks are divided by (lf::SplatNormalization).
-std::array<uint64_t, 2> SplatPaths(FramePlanKind kind, const FrameTask& task);
+std::array<uint64_t, 2> SplatPaths(SplatPlanKind kind, const SplatTask& task);
 
 // The tile rectangles of a width x height frame in tiles of side `tile`, row by row: the camera
-// rectangles of PlanFrameRender's tasks and the tiles splats are grouped by.
-std::vector<PixelRect> FrameTiles(int width, int height, int tile);
+// rectangles of PlanSplatRender's tasks and the tiles splats are grouped by.
+std::vector<PixelRect> SplatTiles(int width, int height, int tile);
 
 }  // namespace lf

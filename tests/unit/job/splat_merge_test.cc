@@ -1,7 +1,7 @@
 // Frame-pass results (camera tiles + splat lists) merged in any order, retried, or interrupted by
 // a failing store give the bits of one process adding everything at once, normalised by the
 // light paths per pixel-equivalent.
-#include "lf/job/frame_merge.h"
+#include "lf/job/splat_merge.h"
 
 #include <gtest/gtest.h>
 
@@ -45,7 +45,7 @@ struct Result {
 // What a worker returns for `task`: light paths [path_begin, path_end) splat (half = the path's
 // parity); camera samples of the rect add to the tile, each with its own light subpath (index
 // (pixel, sample), half = the sample's parity) that splats anywhere.
-Result RunFake(const FrameTask& task) {
+Result RunFake(const SplatTask& task) {
     Result r;
     r.camera = TileSums(task.rect);
     for (uint64_t i = task.path_begin; i < task.path_end; ++i)
@@ -65,13 +65,13 @@ Result RunFake(const FrameTask& task) {
 
 // One process adding every task's samples into one frame-sized tile and one list: what local
 // mode does, with the same composition.
-Image OneProcess(FramePlanKind kind, const std::vector<FrameTask>& plan) {
+Image OneProcess(SplatPlanKind kind, const std::vector<SplatTask>& plan) {
     const PixelRect frame{0, 0, kWidth, kHeight};
     TileSums camera(frame), splat_sums(frame);
     SplatList splats(kWidth, kHeight);
     SplatNormalization norm;
     norm.frame_pixels = kWidth * kHeight;
-    for (const FrameTask& t : plan) {
+    for (const SplatTask& t : plan) {
         Result r = RunFake(t);
         if (t.rect.Area() != 0) {
             for (int y = t.rect.y0; y < t.rect.y0 + t.rect.height; ++y) {
@@ -88,7 +88,7 @@ Image OneProcess(FramePlanKind kind, const std::vector<FrameTask>& plan) {
     splats.Coalesce();
     splats.AddTo(splat_sums);
     Image image = EmptyRenderImage(kWidth, kHeight);
-    SetFrameTile(image, camera, splat_sums, norm);
+    SetSplatTile(image, camera, splat_sums, norm);
     return image;
 }
 
@@ -101,8 +101,8 @@ void ExpectSameBits(const Image& a, const Image& b) {
     }
 }
 
-FramePlanSettings Settings(FramePlanKind kind) {
-    FramePlanSettings s;
+SplatPlanSettings Settings(SplatPlanKind kind) {
+    SplatPlanSettings s;
     s.width = kWidth;
     s.height = kHeight;
     s.kind = kind;
@@ -114,16 +114,16 @@ FramePlanSettings Settings(FramePlanKind kind) {
     return s;
 }
 
-TEST(FrameMerger, AnyOrderGivesTheBitsOfOneProcess) {
-    for (FramePlanKind kind : {FramePlanKind::kLightPaths, FramePlanKind::kCameraAndLight}) {
-        const std::vector<FrameTask> plan = *PlanFrameRender(Settings(kind));
+TEST(SplatMerger, AnyOrderGivesTheBitsOfOneProcess) {
+    for (SplatPlanKind kind : {SplatPlanKind::kLightPaths, SplatPlanKind::kCameraAndLight}) {
+        const std::vector<SplatTask> plan = *PlanSplatRender(Settings(kind));
         const Image reference = OneProcess(kind, plan);
         for (unsigned seed : {1u, 2u, 3u}) {
-            std::vector<FrameTask> order = plan;
+            std::vector<SplatTask> order = plan;
             std::shuffle(order.begin(), order.end(), std::mt19937(seed));
-            std::unique_ptr<FrameMerger> merger =
-                *FrameMerger::Make(kWidth, kHeight, kTile, kind, plan);
-            for (const FrameTask& t : order) {
+            std::unique_ptr<SplatMerger> merger =
+                *SplatMerger::Make(kWidth, kHeight, kTile, kind, plan);
+            for (const SplatTask& t : order) {
                 ASSERT_FALSE(merger->Complete());
                 Result r = RunFake(t);
                 ASSERT_TRUE(merger->Add(t.index, r.camera, r.splats).ok());
@@ -134,12 +134,12 @@ TEST(FrameMerger, AnyOrderGivesTheBitsOfOneProcess) {
     }
 }
 
-TEST(FrameMerger, ARetriedTaskIsNotCountedTwice) {
-    const std::vector<FrameTask> plan = *PlanFrameRender(Settings(FramePlanKind::kCameraAndLight));
-    const Image reference = OneProcess(FramePlanKind::kCameraAndLight, plan);
-    std::unique_ptr<FrameMerger> merger =
-        *FrameMerger::Make(kWidth, kHeight, kTile, FramePlanKind::kCameraAndLight, plan);
-    for (const FrameTask& t : plan) {
+TEST(SplatMerger, ARetriedTaskIsNotCountedTwice) {
+    const std::vector<SplatTask> plan = *PlanSplatRender(Settings(SplatPlanKind::kCameraAndLight));
+    const Image reference = OneProcess(SplatPlanKind::kCameraAndLight, plan);
+    std::unique_ptr<SplatMerger> merger =
+        *SplatMerger::Make(kWidth, kHeight, kTile, SplatPlanKind::kCameraAndLight, plan);
+    for (const SplatTask& t : plan) {
         Result r = RunFake(t);
         ASSERT_TRUE(merger->Add(t.index, r.camera, r.splats).ok());
         // A second worker's copy of the same task (a retry after a lost lease) changes nothing.
@@ -168,17 +168,17 @@ class FlakyStore : public TileStore {
     std::shared_ptr<int> budget_;  // Puts left before failing; -1: never fails
 };
 
-TEST(FrameMerger, AStoreFailureMidTaskThenARetryAddsEachTileOnce) {
-    const FramePlanKind kind = FramePlanKind::kLightPaths;
-    const std::vector<FrameTask> plan = *PlanFrameRender(Settings(kind));
+TEST(SplatMerger, AStoreFailureMidTaskThenARetryAddsEachTileOnce) {
+    const SplatPlanKind kind = SplatPlanKind::kLightPaths;
+    const std::vector<SplatTask> plan = *PlanSplatRender(Settings(kind));
     const Image reference = OneProcess(kind, plan);
     auto budget = std::make_shared<int>(-1);
-    std::unique_ptr<FrameMerger> merger = *FrameMerger::Make(
+    std::unique_ptr<SplatMerger> merger = *SplatMerger::Make(
         kWidth, kHeight, kTile, kind, plan,
         [&](std::vector<PixelRect> tiles, uint32_t) -> absl::StatusOr<std::unique_ptr<TileStore>> {
             return std::make_unique<FlakyStore>(std::move(tiles), budget);
         });
-    for (const FrameTask& t : plan) {
+    for (const SplatTask& t : plan) {
         // Each task's splats span several tiles: let a few land, then fail the rest.
         *budget = 3;
         Result r = RunFake(t);
@@ -194,16 +194,16 @@ TEST(FrameMerger, AStoreFailureMidTaskThenARetryAddsEachTileOnce) {
 // k gives pixel j one path of parity k + j, so after any even number of tasks every pixel has as
 // many splats per half as each half has paths per pixel: each half and their mean are exactly
 // (1, 2, 0.5), mid-render (divided by the paths merged so far) as at the end.
-TEST(FrameMerger, SplatsAreDividedByTheLightPathsPerPixel) {
-    FramePlanSettings s = Settings(FramePlanKind::kLightPaths);
+TEST(SplatMerger, SplatsAreDividedByTheLightPathsPerPixel) {
+    SplatPlanSettings s = Settings(SplatPlanKind::kLightPaths);
     s.light_paths = 4 * kWidth * kHeight;
     s.max_paths_per_task = kWidth * kHeight;
-    const std::vector<FrameTask> plan = *PlanFrameRender(s);
+    const std::vector<SplatTask> plan = *PlanSplatRender(s);
     ASSERT_EQ(plan.size(), 4u);
-    std::unique_ptr<FrameMerger> merger =
-        *FrameMerger::Make(kWidth, kHeight, kTile, FramePlanKind::kLightPaths, plan);
+    std::unique_ptr<SplatMerger> merger =
+        *SplatMerger::Make(kWidth, kHeight, kTile, SplatPlanKind::kLightPaths, plan);
     for (int k : {3, 0, 2, 1}) {
-        const FrameTask& t = plan[size_t(k)];
+        const SplatTask& t = plan[size_t(k)];
         SplatList splats(kWidth, kHeight);
         for (uint64_t i = t.path_begin; i < t.path_end; ++i) {
             const int pixel = int(i % uint64_t(kWidth * kHeight));
@@ -227,10 +227,10 @@ TEST(FrameMerger, SplatsAreDividedByTheLightPathsPerPixel) {
     }
 }
 
-TEST(FrameMerger, RefusesResultsThatAreNotTheTasks) {
-    const std::vector<FrameTask> light = *PlanFrameRender(Settings(FramePlanKind::kLightPaths));
-    std::unique_ptr<FrameMerger> merger =
-        *FrameMerger::Make(kWidth, kHeight, kTile, FramePlanKind::kLightPaths, light);
+TEST(SplatMerger, RefusesResultsThatAreNotTheTasks) {
+    const std::vector<SplatTask> light = *PlanSplatRender(Settings(SplatPlanKind::kLightPaths));
+    std::unique_ptr<SplatMerger> merger =
+        *SplatMerger::Make(kWidth, kHeight, kTile, SplatPlanKind::kLightPaths, light);
     SplatList other_frame(kWidth + 1, kHeight);
     EXPECT_EQ(merger->Add(0, TileSums(PixelRect{}), other_frame).code(),
               absl::StatusCode::kInvalidArgument);
@@ -241,25 +241,25 @@ TEST(FrameMerger, RefusesResultsThatAreNotTheTasks) {
               absl::StatusCode::kInvalidArgument);
     EXPECT_EQ(merger->tasks_done(), 0u);
 
-    const std::vector<FrameTask> bdpt = *PlanFrameRender(Settings(FramePlanKind::kCameraAndLight));
-    merger = *FrameMerger::Make(kWidth, kHeight, kTile, FramePlanKind::kCameraAndLight, bdpt);
+    const std::vector<SplatTask> bdpt = *PlanSplatRender(Settings(SplatPlanKind::kCameraAndLight));
+    merger = *SplatMerger::Make(kWidth, kHeight, kTile, SplatPlanKind::kCameraAndLight, bdpt);
     Result r = RunFake(bdpt[0]);
     r.camera.at(0, 0).count[0] += 1;  // a pixel with one sample too many
     EXPECT_EQ(merger->Add(0, r.camera, r.splats).code(), absl::StatusCode::kInvalidArgument);
 
-    FramePlanSettings ppm = Settings(FramePlanKind::kPhotonPasses);
+    SplatPlanSettings ppm = Settings(SplatPlanKind::kPhotonPasses);
     ppm.max_paths_per_task = 2;
-    const std::vector<FrameTask> passes = *PlanFrameRender(ppm);
-    merger = *FrameMerger::Make(kWidth, kHeight, kTile, FramePlanKind::kPhotonPasses, passes);
+    const std::vector<SplatTask> passes = *PlanSplatRender(ppm);
+    merger = *SplatMerger::Make(kWidth, kHeight, kTile, SplatPlanKind::kPhotonPasses, passes);
     Result p = RunFake(passes[0]);
     p.splats.Add(1, 1, 0, Rgb(1));
     EXPECT_EQ(merger->Add(0, p.camera, p.splats).code(), absl::StatusCode::kInvalidArgument);
 
     // Camera rectangles off the merger's tile grid cannot be merged into one store tile.
-    std::vector<FrameTask> off_grid = bdpt;
+    std::vector<SplatTask> off_grid = bdpt;
     off_grid[0].rect.x0 += 1;
     EXPECT_FALSE(
-        FrameMerger::Make(kWidth, kHeight, kTile, FramePlanKind::kCameraAndLight, off_grid).ok());
+        SplatMerger::Make(kWidth, kHeight, kTile, SplatPlanKind::kCameraAndLight, off_grid).ok());
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Merging frame-pass task results (lf/job/frame_plan.h): each task's camera sums go into a tile
+// Merging frame-pass task results (lf/job/splat_plan.h): each task's camera sums go into a tile
 // store as tile results do (lf/job/merge.h), and its splat list is split by tile and added into a
 // second store of the same tiles, so a job holds one tile in memory at a time, never a dense
 // full-frame layer. All sums are exact: any order of tasks gives the same bits.
@@ -26,7 +26,7 @@
 #include "lf/core/film.h"
 #include "lf/core/image.h"
 #include "lf/core/splat_list.h"
-#include "lf/job/frame_plan.h"
+#include "lf/job/splat_plan.h"
 #include "lf/job/tile_store.h"
 
 namespace lf {
@@ -43,19 +43,19 @@ struct SplatNormalization {
 // Writes R,G,B, A.*, B.* and spp of a tile from its camera sums and splat sums (same rect; the
 // splat tile's counts are ignored), normalised as the file comment says: local mode and the
 // coordinator both call this, so their images have the same bits. spp is the camera samples.
-void SetFrameTile(Image& image, const TileSums& camera, const TileSums& splats,
+void SetSplatTile(Image& image, const TileSums& camera, const TileSums& splats,
                   const SplatNormalization& norm);
 
-class FrameMerger {
+class SplatMerger {
   public:
     // Tiles of side `tile` in memory (the tile of the plan's settings).
-    static absl::StatusOr<std::unique_ptr<FrameMerger>> Make(int width, int height, int tile,
-                                                             FramePlanKind kind,
-                                                             std::vector<FrameTask> tasks);
+    static absl::StatusOr<std::unique_ptr<SplatMerger>> Make(int width, int height, int tile,
+                                                             SplatPlanKind kind,
+                                                             std::vector<SplatTask> tasks);
     // Tiles where `make_store` says (two stores: camera sums, splat sums).
-    static absl::StatusOr<std::unique_ptr<FrameMerger>> Make(int width, int height, int tile,
-                                                             FramePlanKind kind,
-                                                             std::vector<FrameTask> tasks,
+    static absl::StatusOr<std::unique_ptr<SplatMerger>> Make(int width, int height, int tile,
+                                                             SplatPlanKind kind,
+                                                             std::vector<SplatTask> tasks,
                                                              const TileStoreFactory& make_store);
 
     // Adds task `task_index`'s result: `camera` its camera tile (an empty rect when the task has
@@ -67,13 +67,13 @@ class FrameMerger {
     // any tile twice.
     absl::Status Add(int task_index, const TileSums& camera, SplatList& splats);
 
-    const std::vector<FrameTask>& tasks() const { return tasks_; }
+    const std::vector<SplatTask>& tasks() const { return tasks_; }
     size_t tasks_done() const { return tasks_done_; }
     bool Complete() const { return tasks_done_ == tasks_.size(); }
     const RenderStats& stats() const { return stats_; }
     const SplatNormalization& normalization() const { return norm_; }
 
-    // The image of everything merged so far (SetFrameTile of every tile). Once Complete(), the
+    // The image of everything merged so far (SetSplatTile of every tile). Once Complete(), the
     // bits local mode makes of the same render.
     absl::StatusOr<Image> Snapshot() const;
 
@@ -91,7 +91,7 @@ class FrameMerger {
     SnapshotSource snapshot_source() const { return {width_, height_, camera_, splats_, norm_}; }
 
   private:
-    FrameMerger(int width, int height, int tile, FramePlanKind kind, std::vector<FrameTask> tasks,
+    SplatMerger(int width, int height, int tile, SplatPlanKind kind, std::vector<SplatTask> tasks,
                 std::unique_ptr<TileStore> camera, std::unique_ptr<TileStore> splats);
     int TileOf(int x, int y) const { return (y / tile_) * columns_ + x / tile_; }
     // Adds `add` to tile `tile` of `store` unless task `task` did so before.
@@ -99,8 +99,8 @@ class FrameMerger {
                          const std::function<void(TileSums&)>& add);
 
     int width_, height_, tile_, columns_;
-    FramePlanKind kind_;
-    std::vector<FrameTask> tasks_;
+    SplatPlanKind kind_;
+    std::vector<SplatTask> tasks_;
     std::shared_ptr<TileStore> camera_, splats_;  // shared with snapshot sources
     std::vector<bool> done_;
     // Tasks partly merged when a store failed: slots (splat tile t, camera tile T + t) added.

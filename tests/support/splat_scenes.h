@@ -1,4 +1,4 @@
-// Scenes for the frame methods (light tracing, BDPT, photon mapping), after pbrt-v4's
+// Scenes for the splatting methods (light tracing, BDPT, photon mapping), after pbrt-v4's
 // integrator tests: a camera inside a diffuse sphere whose radiance is known in closed form.
 #pragma once
 

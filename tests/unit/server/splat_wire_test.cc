@@ -1,4 +1,4 @@
-// The frame methods on the wire: a ppm job's photon settings, and a frame task's camera part and
+// The splatting methods on the wire: a ppm job's photon settings, and a splat task's camera part and
 // light-path range, reach the worker as the client and the coordinator gave them; a params
 // message without photon settings means the defaults; a job record keeps them across a
 // coordinator restart.
@@ -17,7 +17,7 @@ namespace {
 
 namespace pb = lightfarm::v1;
 
-TEST(FrameWire, PhotonSettingsSurviveTheWire) {
+TEST(SplatWire, PhotonSettingsSurviveTheWire) {
     JobSpec spec;
     spec.method = "ppm";
     spec.ppm = {12345, 0.25, 0.8};
@@ -31,7 +31,7 @@ TEST(FrameWire, PhotonSettingsSurviveTheWire) {
     EXPECT_EQ(back.ppm.alpha, 0.8);
 }
 
-TEST(FrameWire, MissingPhotonSettingsMeanTheDefaults) {
+TEST(SplatWire, MissingPhotonSettingsMeanTheDefaults) {
     pb::RenderParams params;
     params.set_method("ppm");
     params.mutable_ppm();  // present, every field zero
@@ -43,7 +43,7 @@ TEST(FrameWire, MissingPhotonSettingsMeanTheDefaults) {
     EXPECT_TRUE(CheckPhotonSettings(back.ppm).ok());
 }
 
-TEST(FrameWire, FrameTaskRangesSurviveTheWire) {
+TEST(SplatWire, SplatTaskRangesSurviveTheWire) {
     for (const char* method : {"light", "bdpt", "ppm"}) {
         TaskAssignment a;
         a.lease_id = "l";
@@ -72,7 +72,7 @@ TEST(FrameWire, FrameTaskRangesSurviveTheWire) {
     EXPECT_EQ(t.kind(), pb::Task::TILE);
 }
 
-TEST(FrameWire, PhotonSettingsSurviveTheJobRecordAndOldRecordsHaveTheDefaults) {
+TEST(SplatWire, PhotonSettingsSurviveTheJobRecordAndOldRecordsHaveTheDefaults) {
     JobRecord job;
     job.id = "a";
     job.seq = 1;
