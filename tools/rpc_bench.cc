@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "lightfarm/v1/job_service.grpc.pb.h"
-#include "proto/channel.h"
-#include "proto/channel_flags.h"
-#include "proto/grpc_status.h"
+#include "lf/proto/channel.h"
+#include "lf/proto/channel_flags.h"
+#include "lf/proto/grpc_status.h"
 
 namespace pb = lightfarm::v1;
 

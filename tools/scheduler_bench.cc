@@ -15,8 +15,8 @@
 #include <filesystem>
 #include <thread>
 
-#include "server/scheduler.h"
-#include "server/sqlite_job_store.h"
+#include "lf/server/scheduler.h"
+#include "lf/server/sqlite_job_store.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <memory>
 
-#include "server/sqlite_job_store.h"
+#include "lf/server/sqlite_job_store.h"
 
 namespace lf::testing {
 

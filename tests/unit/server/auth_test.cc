@@ -1,6 +1,6 @@
 // Who may do what: every role against every action, the visibility of jobs, and the
 // authenticator's answers to missing, malformed, unknown and revoked tokens.
-#include "server/auth.h"
+#include "lf/server/auth.h"
 
 #include <gtest/gtest.h>
 

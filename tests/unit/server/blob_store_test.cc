@@ -2,7 +2,7 @@
 // refused before the excess reaches the disk), keeps the bytes of a broken upload so that it
 // resumes where they end, hashes the whole blob whatever the resumes, lets one upload of a hash
 // run at a time, bounds the partial uploads it keeps, and removes what no one uses.
-#include "server/blob_store.h"
+#include "lf/server/blob_store.h"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 // job), the JSON of jobs, tasks, workers and the farm, cancel and priority, the preview PNG
 // (decoded, and changed by a merged task), the CSRF checks of POSTs, bounds on what a request
 // names, anonymous admins only on loopback, and the embedded pages with their headers.
-#include "server/dashboard.h"
+#include "lf/server/dashboard.h"
 
 #include <gtest/gtest.h>
 #include <stb_image.h>
@@ -14,7 +14,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_split.h"
 #include "lf/core/tile_codec.h"
-#include "server/web_assets.h"
+#include "lf/server/web_assets.h"
 #include "test_dir.h"
 
 namespace lf {

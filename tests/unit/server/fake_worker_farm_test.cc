@@ -25,7 +25,7 @@
 #include "lf/core/tile_codec.h"
 #include "lf/job/digest.h"
 #include "lf/version.h"
-#include "server/grpc_service.h"
+#include "lf/server/grpc_service.h"
 #include "test_dir.h"
 
 namespace lf {

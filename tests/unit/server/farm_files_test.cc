@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "lf/job/digest.h"
-#include "server/farm.h"
-#include "server/sqlite_job_store.h"
+#include "lf/server/farm.h"
+#include "lf/server/sqlite_job_store.h"
 #include "test_dir.h"
 
 namespace lf {

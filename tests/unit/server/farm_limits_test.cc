@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "server/farm.h"
+#include "lf/server/farm.h"
 
 namespace lf {
 namespace {

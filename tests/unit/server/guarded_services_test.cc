@@ -12,9 +12,9 @@
 #include "lf/version.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "lightfarm/v1/worker_service.grpc.pb.h"
-#include "proto/channel.h"
-#include "server/grpc_service.h"
-#include "server/server_credentials.h"
+#include "lf/proto/channel.h"
+#include "lf/server/grpc_service.h"
+#include "lf/server/server_credentials.h"
 #include "test_dir.h"
 
 namespace lf {

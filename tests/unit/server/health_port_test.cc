@@ -1,6 +1,6 @@
 // --grpc-health: a plain-text port that answers grpc.health.v1.Health/Check as a probe asks
 // (an empty service name), SERVING until shutdown begins, then NOT_SERVING.
-#include "server/health_port.h"
+#include "lf/server/health_port.h"
 
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>

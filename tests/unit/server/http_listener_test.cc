@@ -1,7 +1,7 @@
 // lightfarm-server --http: the /metrics and /healthz handlers against a real Farm in a temporary
 // data folder (the counts follow a submission, a lease and a result), and the listener itself on
 // a port the OS picks, refusing a port in use, and over HTTPS with the dashboard.
-#include "server/http_listener.h"
+#include "lf/server/http_listener.h"
 
 #include <gtest/gtest.h>
 #include <httplib.h>

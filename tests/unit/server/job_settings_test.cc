@@ -13,7 +13,7 @@
 #include "lf/core/patch_mesh.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/job/job_spec.h"
-#include "server/farm.h"
+#include "lf/server/farm.h"
 
 namespace lf {
 namespace {

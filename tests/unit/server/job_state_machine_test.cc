@@ -1,5 +1,5 @@
 // The job state machine: final states have no way out, and the times it stamps.
-#include "server/job_state_machine.h"
+#include "lf/server/job_state_machine.h"
 
 #include <gtest/gtest.h>
 

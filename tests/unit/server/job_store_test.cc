@@ -3,7 +3,7 @@
 // belongs to the interface: states by name, the integer states of old records (the first form,
 // legacy_job_records.h) still read, an unknown name a clear error. Then what only SQLite has: a
 // database of the first schema is upgraded in place.
-#include "server/job_store.h"
+#include "lf/server/job_store.h"
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -17,9 +17,9 @@
 #include "absl/strings/str_cat.h"
 #include "legacy_job_records.h"
 #include "lf/core/aov.h"
-#include "server/job_record_codec.h"
-#include "server/legacy_job_record.h"
-#include "server/sqlite_job_store.h"
+#include "lf/server/job_record_codec.h"
+#include "lf/server/legacy_job_record.h"
+#include "lf/server/sqlite_job_store.h"
 #include "test_dir.h"
 
 namespace lf {

@@ -1,7 +1,7 @@
 // The lease table alone, with made-up times: leases come out once their deadline has passed,
 // earliest first, a moved or ended lease never comes out early, ids are unguessable and only
 // ever looked up, and a job's leases are forgotten with it.
-#include "server/lease_table.h"
+#include "lf/server/lease_table.h"
 
 #include <gtest/gtest.h>
 

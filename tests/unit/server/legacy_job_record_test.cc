@@ -2,7 +2,7 @@
 // the StoredJob form replaced it (legacy_job_records.h): they decode to the jobs they were
 // written from, and a store of that form opened by this server is upgraded, lists them, finds
 // them by request id and owner, and recovers the jobs that had not ended.
-#include "server/legacy_job_record.h"
+#include "lf/server/legacy_job_record.h"
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -12,9 +12,9 @@
 
 #include "legacy_job_records.h"
 #include "lf/core/aov.h"
-#include "server/job_record_codec.h"
-#include "server/scheduler.h"
-#include "server/sqlite_job_store.h"
+#include "lf/server/job_record_codec.h"
+#include "lf/server/scheduler.h"
+#include "lf/server/sqlite_job_store.h"
 #include "test_dir.h"
 
 namespace lf {

@@ -1,4 +1,4 @@
-#include "server/listen_policy.h"
+#include "lf/server/listen_policy.h"
 
 #include <gtest/gtest.h>
 

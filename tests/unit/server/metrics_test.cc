@@ -1,7 +1,7 @@
 // The metric types and their Prometheus text: the exact exposition of known values, bucket
 // edges (a value equal to a bound counts in that bound's bucket), and no update lost when many
 // threads count at once.
-#include "server/metrics.h"
+#include "lf/server/metrics.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // --retention takes days, which absl::ParseDuration does not, and refuses what is not a
 // duration rather than guessing a unit.
-#include "server/retention_flag.h"
+#include "lf/server/retention_flag.h"
 
 #include <gtest/gtest.h>
 

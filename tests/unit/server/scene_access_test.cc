@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "lf/job/digest.h"
-#include "server/farm.h"
+#include "lf/server/farm.h"
 
 namespace lf {
 namespace {

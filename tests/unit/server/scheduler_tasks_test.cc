@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "lease_results.h"
-#include "server/scheduler.h"
+#include "lf/server/scheduler.h"
 
 namespace lf {
 namespace {

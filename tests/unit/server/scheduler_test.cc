@@ -1,7 +1,7 @@
 // The task state machine with a fake clock: priority then age, leases that heartbeats keep
 // alive and that expire otherwise, retries on other workers, three strikes, cancel, and
 // results that arrive late or twice.
-#include "server/scheduler.h"
+#include "lf/server/scheduler.h"
 
 #include <gtest/gtest.h>
 

@@ -7,8 +7,8 @@
 #include <cstring>
 #include <filesystem>
 
-#include "server/scheduler.h"
-#include "server/sqlite_job_store.h"
+#include "lf/server/scheduler.h"
+#include "lf/server/sqlite_job_store.h"
 #include "test_dir.h"
 #include "test_job_store.h"
 

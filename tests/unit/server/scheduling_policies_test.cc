@@ -2,7 +2,7 @@
 // when an adaptive job's time limit is reached; and where sweep tasks are numbered.
 #include <gtest/gtest.h>
 
-#include "server/speculation.h"
+#include "lf/server/speculation.h"
 #include "lf/job/sweep_task_numbering.h"
 #include "lf/job/time_limit.h"
 

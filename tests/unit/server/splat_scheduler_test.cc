@@ -13,9 +13,9 @@
 #include "lf/job/splat_merge.h"
 #include "lf/job/splat_result_codec.h"
 #include "lf/job/splat_settings.h"
-#include "server/farm.h"
-#include "server/scheduler.h"
-#include "server/sqlite_job_store.h"
+#include "lf/server/farm.h"
+#include "lf/server/scheduler.h"
+#include "lf/server/sqlite_job_store.h"
 #include "test_dir.h"
 #include "test_job_store.h"
 

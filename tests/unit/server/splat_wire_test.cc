@@ -9,8 +9,8 @@
 #include "lf/job/task_assignment.h"
 #include "lf/wire/conversions.h"
 #include "nlohmann/json.hpp"
-#include "server/job_record_codec.h"
-#include "server/legacy_job_record.h"
+#include "lf/server/job_record_codec.h"
+#include "lf/server/legacy_job_record.h"
 
 namespace lf {
 namespace {

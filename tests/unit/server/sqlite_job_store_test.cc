@@ -2,7 +2,7 @@
 // trip, done tasks come back merged and are not leased again, leases of the dead server are
 // queued again, a job rendered but not written is handed back for its result, and a store that
 // cannot write refuses the submission instead of losing it.
-#include "server/sqlite_job_store.h"
+#include "lf/server/sqlite_job_store.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -12,8 +12,8 @@
 #include <fstream>
 
 #include "lease_results.h"
-#include "server/farm.h"
-#include "server/scheduler.h"
+#include "lf/server/farm.h"
+#include "lf/server/scheduler.h"
 #include "test_dir.h"
 #include "test_job_store.h"
 

@@ -1,7 +1,7 @@
 // The task log store: lines kept in order per job, bounded per task with a counted "dropped"
 // line, sanitised as wire input, paged by seq, kept across a reopen, deleted with their job; and
 // ended jobs' task lists.
-#include "server/task_log_store.h"
+#include "lf/server/task_log_store.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The task state machine: every move the diagram allows, none it does not, and the queue and
 // the running count that follow from the states.
-#include "server/task_state_machine.h"
+#include "lf/server/task_state_machine.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // The timeout checker ticks again and again until stopped, and no tick starts after Stop.
-#include "server/timeout_checker.h"
+#include "lf/server/timeout_checker.h"
 
 #include <gtest/gtest.h>
 

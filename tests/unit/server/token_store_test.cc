@@ -1,6 +1,6 @@
 // The token store: tokens are shown once and stored hashed, names are unique for good,
 // revocation keeps the record, and the file is usable by a second process while a server reads.
-#include "server/token_store.h"
+#include "lf/server/token_store.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The worker registry keeps only the workers heard from within a lease, and forgetting the
 // silent ones leaves the live ones.
-#include "server/worker_registry.h"
+#include "lf/server/worker_registry.h"
 
 #include <gtest/gtest.h>
 

@@ -11,8 +11,8 @@
 #include <thread>
 
 #include "lf/version.h"
-#include "server/grpc_service.h"
-#include "worker/worker.h"
+#include "lf/server/grpc_service.h"
+#include "lf/worker/worker.h"
 
 namespace lf {
 namespace {

@@ -1,6 +1,6 @@
 // The worker's blob cache: a blob is fetched once, checked against its hash, kept across
 // restarts, and the least recently used go first when the budget is exceeded.
-#include "worker/blob_cache.h"
+#include "lf/worker/blob_cache.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

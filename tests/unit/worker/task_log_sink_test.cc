@@ -1,7 +1,7 @@
 // The worker's task log capture: lines go to the task running when they are logged, from any
 // thread but an ignored one; each task's pending lines are bounded, the oldest dropped and
 // counted.
-#include "worker/task_log_sink.h"
+#include "lf/worker/task_log_sink.h"
 
 #include <gtest/gtest.h>
 #include <spdlog/spdlog.h>

@@ -1,0 +1,476 @@
+// The farm subcommands of `lightfarm` that ask lightfarm-server's JobService about jobs and act
+// on them: list, status, watch, fetch, cancel, priority, delete, workers, tasks and logs, each
+// through a FarmClient (`submit` is submit_command.cc).
+#include <google/protobuf/util/json_util.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
+#include "lf/client/command.h"
+#include "lf/client/farm_client.h"
+#include "lf/client/farm_flags.h"
+#include "lf/core/image_io.h"
+#include "lf/core/log.h"
+#include "lf/job/job_record.h"
+#include "lf/job/job_spec.h"
+#include "lf/wire/conversions.h"
+#include "lightfarm/v1/job_service.grpc.pb.h"
+#include "lf/client/method_flags.h"
+#include "lf/client/output_flags.h"
+#include "lf/client/progress_bar.h"
+
+namespace lf {
+
+namespace fs = std::filesystem;
+namespace pb = lightfarm::v1;
+
+namespace {
+
+void AddJsonFlag(CLI::App* cmd, bool& json) {
+    cmd->add_flag("--json", json,
+                  "one JSON object a line instead of the table: the wire message's fields "
+                  "(lightfarm.v1, proto field names, every field present)");
+}
+
+// The message as one line of JSON, as protobuf's own mapping writes it (strings escaped, so no
+// name a worker or submitter chose can move the terminal).
+void PrintJson(const google::protobuf::Message& message) {
+    google::protobuf::util::JsonPrintOptions options;
+    options.always_print_primitive_fields = true;
+    options.preserve_proto_field_names = true;
+    std::string line;
+    if (google::protobuf::util::MessageToJsonString(message, &line, options).ok()) {
+        std::printf("%s\n", line.c_str());
+    }
+}
+
+std::string StateName(pb::Job::State s) { return absl::AsciiStrToLower(pb::Job::State_Name(s)); }
+
+// "2026-11-26 23:41:07" in the machine's time zone, as a user reads a clock.
+std::string LocalTime(int64_t unix_ms) {
+    return absl::FormatTime("%Y-%m-%d %H:%M:%S", absl::FromUnixMillis(unix_ms),
+                            absl::LocalTimeZone());
+}
+
+// How long the job has rendered (from its first lease to its end, or to now), or "-" before
+// its first lease: "42s", "3m07s", "2h05m".
+std::string ElapsedText(const pb::Job& job) {
+    if (job.started_unix_ms() <= 0) return "-";
+    const int64_t end =
+        job.finished_unix_ms() > 0 ? job.finished_unix_ms() : absl::ToUnixMillis(absl::Now());
+    const int64_t s = std::max<int64_t>(0, (end - job.started_unix_ms()) / 1000);
+    if (s < 60) return absl::StrCat(s, "s");
+    if (s < 3600) return absl::StrFormat("%dm%02ds", s / 60, s % 60);
+    return absl::StrFormat("%dh%02dm", s / 3600, s / 60 % 60);
+}
+
+std::string Progress(const pb::Job& job) {
+    return absl::StrCat(job.tasks_done(), "/", job.tasks_total());
+}
+
+void PrintJob(const pb::Job& job) {
+    const int64_t now = absl::ToUnixMillis(absl::Now());
+    auto seconds = [](int64_t from, int64_t to) { return double(to - from) / 1000.0; };
+    std::printf("job %s: %s\n", job.id().c_str(), StateName(job.state()).c_str());
+    std::printf("  name      %s\n", job.name().c_str());
+    if (!job.owner().empty()) std::printf("  owner     %s\n", job.owner().c_str());
+    std::printf("  method    %s\n",
+                job.params().method().empty() ? "path" : job.params().method().c_str());
+    std::printf("  image     %dx%d, %llu spp, seed %llu, max depth %d, tile %d, %d passes\n",
+                job.width(), job.height(), (unsigned long long)job.params().spp(),
+                (unsigned long long)job.params().seed(), job.params().max_depth(),
+                job.params().tile(), job.params().passes());
+    JobSpec spec;
+    FromProto(job.params(), &spec);
+    // Radiosity samples no lights: its light strategy would say nothing.
+    std::printf("  sampling  %s sampler%s\n", SamplerTypeName(spec.sampler),
+                FindMethod(spec.method) == Method::kRadiosity
+                    ? ""
+                    : absl::StrCat(", ", LightStrategyName(spec.light_strategy), " light sampling")
+                          .c_str());
+    if (job.params().target_error() > 0 || job.params().time_limit_seconds() > 0) {
+        std::printf("  adaptive  target error %g, time limit %g s, at most %llu spp\n",
+                    job.params().target_error(), job.params().time_limit_seconds(),
+                    (unsigned long long)job.params().max_spp());
+    }
+    std::printf("  priority  %d\n", job.priority());
+    std::printf("  tasks     %s done, %d running, %d retried, %d leased\n", Progress(job).c_str(),
+                job.tasks_running(), job.retries(), job.tasks_leased());
+    std::printf("  samples   %llu (%llu rays, %llu NaN/Inf)\n", (unsigned long long)job.samples(),
+                (unsigned long long)job.rays(), (unsigned long long)job.invalid_samples());
+    if (job.started_unix_ms() > 0) {
+        const int64_t end = job.finished_unix_ms() > 0 ? job.finished_unix_ms() : now;
+        std::printf("  time      %.1f s queued, %.1f s rendering\n",
+                    seconds(job.submitted_unix_ms(), job.started_unix_ms()),
+                    seconds(job.started_unix_ms(), end));
+    } else {
+        std::printf("  time      %.1f s queued\n", seconds(job.submitted_unix_ms(), now));
+    }
+    std::string when = absl::StrCat("  submitted ", LocalTime(job.submitted_unix_ms()));
+    if (job.started_unix_ms() > 0)
+        absl::StrAppend(&when, ", started ", LocalTime(job.started_unix_ms()));
+    if (job.finished_unix_ms() > 0) {
+        absl::StrAppend(&when, ", ended ", LocalTime(job.finished_unix_ms()));
+    }
+    std::printf("%s\n", when.c_str());
+    // A failed job's error names the failing task; its last error says what that one did.
+    if ((!IsFinal(FromProto(job.state())) || job.state() == pb::Job::FAILED) &&
+        !job.last_error().empty()) {
+        std::printf("  last error  %s\n", job.last_error().c_str());
+    }
+    if (!job.error().empty()) std::printf("  error     %s\n", job.error().c_str());
+}
+
+// The job's EXR at paths.exr, and its preview at paths.png, made here from the EXR (fetched into
+// a temporary file when -o names only the PNG).
+absl::Status FetchOutputs(const FarmFlags& flags, const std::string& id, const OutputPaths& paths,
+                          const PngOptions& preview_options, bool preview) {
+    if (absl::Status s = CheckWritable(paths.png); !s.ok()) return s;
+    const std::string exr = paths.exr.empty() ? paths.png + ".exr.part" : paths.exr;
+    if (absl::Status s = FarmClient(flags).FetchResult(id, exr, preview); !s.ok()) return s;
+    if (paths.png.empty()) return absl::OkStatus();
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    absl::Status written =
+        file.ok() ? WritePng(paths.png, file->image, preview_options) : file.status();
+    std::error_code ignored;  // a temporary file left behind is harmless
+    if (paths.exr.empty()) fs::remove(exr, ignored);
+    return written;
+}
+
+}  // namespace
+
+Command AddListCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto limit = std::make_shared<int>(0);
+    auto json = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand("list", "List the server's jobs, newest first.");
+    cmd->add_option("--limit", *limit, "at most this many jobs; 0 lists them all")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    AddJsonFlag(cmd, *json);
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, limit, json] {
+                // A page per call, so that no answer grows with the number of jobs.
+                constexpr int kPage = 500;
+                FarmClient client(*flags);
+                pb::ListJobsRequest req;
+                int listed = 0;
+                if (!*json) {
+                    std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s %-19s %8s  %s\n", "JOB",
+                                "STATE", "OWNER", "METHOD", "PRIORITY", "TASKS", "SPP", "SUBMITTED",
+                                "TIME", "NAME");
+                }
+                do {
+                    req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
+                    pb::ListJobsResponse resp;
+                    absl::Status s = client.Call(&pb::JobService::Stub::ListJobs, req, &resp);
+                    if (!s.ok()) return ReportError(s);
+                    for (const pb::Job& job : resp.jobs()) {
+                        if (*json) {
+                            PrintJson(job);
+                            continue;
+                        }
+                        std::printf(
+                            "%-16s %-10s %-12s %-9s %8d %11s %9llu %-19s %8s  %s\n",
+                            job.id().c_str(), StateName(job.state()).c_str(),
+                            job.owner().empty() ? "-" : job.owner().c_str(),
+                            job.params().method().empty() ? "path" : job.params().method().c_str(),
+                            job.priority(), Progress(job).c_str(),
+                            (unsigned long long)job.params().spp(),
+                            LocalTime(job.submitted_unix_ms()).c_str(), ElapsedText(job).c_str(),
+                            job.name().c_str());
+                    }
+                    listed += resp.jobs_size();
+                    req.set_page_token(resp.next_page_token());
+                } while (!req.page_token().empty() && (*limit == 0 || listed < *limit));
+                return 0;
+            }};
+}
+
+Command AddStatusCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand("status", "Show one job: state, progress, error.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddJsonFlag(cmd, *json);
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id, json] {
+                pb::GetJobRequest req;
+                req.set_job_id(*id);
+                pb::Job job;
+                const absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::GetJob, req, &job);
+                if (!s.ok()) return ReportError(s);
+                if (*json) {
+                    PrintJson(job);
+                } else {
+                    PrintJob(job);
+                }
+                return 0;
+            }};
+}
+
+Command AddWatchCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "watch",
+        "Follow a job until it ends (progress bar on a terminal). Exit status 0 only when it\n"
+        "succeeded.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    AddRetryOption(cmd, *flags);
+    return {cmd, [flags, id] {
+                ProgressBar bar(*id);
+                absl::StatusOr<pb::Job> job = FarmClient(*flags).Watch(*id, bar);
+                bar.Finish();
+                if (!job.ok()) return ReportError(job.status());
+                std::printf("job %s %s (%s tasks, %d retried)%s%s\n", job->id().c_str(),
+                            StateName(job->state()).c_str(), Progress(*job).c_str(), job->retries(),
+                            job->error().empty() ? "" : ": ", job->error().c_str());
+                return job->state() == pb::Job::SUCCEEDED ? 0 : 1;
+            }};
+}
+
+Command AddFetchCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto output = std::make_shared<OutputFlags>();
+    auto preview = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand(
+        "fetch",
+        "Download a job's OpenEXR result (the same channels and header as `lightfarm render`),\n"
+        "or its PNG preview (-o out.png, or --png beside the EXR), made here as `render` makes\n"
+        "it.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddOutputFlags(cmd, *output);
+    cmd->add_flag("--preview", *preview,
+                  "a running job's tiles merged so far (unfinished tiles have fewer samples)");
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id, output, preview] {
+                absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
+                if (!paths.ok()) return ReportError(paths.status());
+                if (absl::Status s = FetchOutputs(*flags, *id, *paths, output->preview, *preview);
+                    !s.ok()) {
+                    return ReportError(s);
+                }
+                std::printf("job %s -> %s\n", id->c_str(), OutputNames(*paths).c_str());
+                return 0;
+            }};
+}
+
+Command AddCancelCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "cancel", "Cancel a queued or running job; workers drop its tasks within a second.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id] {
+                pb::CancelJobRequest req;
+                req.set_job_id(*id);
+                pb::Job job;
+                absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::CancelJob, req, &job);
+                if (!s.ok()) return ReportError(s);
+                std::printf("job %s %s\n", job.id().c_str(), StateName(job.state()).c_str());
+                return 0;
+            }};
+}
+
+Command AddPriorityCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto priority = std::make_shared<int>(0);
+    CLI::App* cmd = app.add_subcommand(
+        "priority",
+        "Change a queued or running job's priority: higher runs first, from the next task on.");
+    cmd->add_option("job", *id, "job id")->required();
+    cmd->add_option("priority", *priority, "the new priority (submit's --priority)")->required();
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id, priority] {
+                pb::SetJobPriorityRequest req;
+                req.set_job_id(*id);
+                req.set_priority(*priority);
+                pb::Job job;
+                absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::SetJobPriority, req, &job);
+                if (!s.ok()) return ReportError(s);
+                std::printf("job %s priority %d\n", job.id().c_str(), job.priority());
+                return 0;
+            }};
+}
+
+Command AddDeleteCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "delete",
+        "Delete an ended job and its result from the server (cancel a running one first).");
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id] {
+                pb::DeleteJobRequest req;
+                req.set_job_id(*id);
+                pb::DeleteJobResponse resp;
+                absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::DeleteJob, req, &resp);
+                if (!s.ok()) return ReportError(s);
+                std::printf("job %s deleted\n", id->c_str());
+                return 0;
+            }};
+}
+
+Command AddWorkersCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    CLI::App* cmd = app.add_subcommand(
+        "workers",
+        "List the workers the server heard from within a lease: name, address, version, state,\n"
+        "task and seconds since each was last heard from.");
+    auto json = std::make_shared<bool>(false);
+    AddJsonFlag(cmd, *json);
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, json] {
+                pb::ListWorkersRequest req;
+                pb::ListWorkersResponse resp;
+                absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::ListWorkers, req, &resp);
+                if (!s.ok()) return ReportError(s);
+                if (*json) {
+                    for (const pb::WorkerInfo& w : resp.workers()) PrintJson(w);
+                    return 0;
+                }
+                std::printf("%-20s %-24s %-30s %-5s %-22s %s\n", "NAME", "ADDRESS", "VERSION",
+                            "STATE", "TASK", "LAST-HEARTBEAT");
+                for (const pb::WorkerInfo& w : resp.workers()) {
+                    const bool busy = w.state() == pb::WorkerInfo::BUSY;
+                    // Names and versions come from the workers: escaped, so none can move the
+                    // terminal.
+                    std::printf("%-20s %-24s %-30s %-5s %-22s %.1f s ago\n",
+                                LogSafe(w.name().empty() ? w.id() : w.name(), 64).c_str(),
+                                LogSafe(w.address(), 64).c_str(), LogSafe(w.version(), 64).c_str(),
+                                busy ? "busy" : "idle",
+                                busy ? absl::StrCat(w.job_id(), "/", w.task_index()).c_str() : "-",
+                                w.seconds_since_seen());
+                }
+                return 0;
+            }};
+}
+
+namespace {
+
+std::string TaskStateName(pb::TaskInfo::State s) {
+    return absl::AsciiStrToLower(pb::TaskInfo::State_Name(s));
+}
+
+std::string TaskKindName(pb::TaskInfo::Kind k) {
+    return absl::AsciiStrToLower(pb::TaskInfo::Kind_Name(k));
+}
+
+// "2026-11-26 23:40:01.123 task 3 #1 worker-a info     text", in the local time zone. The text
+// was made safe by the server; the worker's id is escaped here.
+void PrintLogLine(const pb::TaskLogLine& line) {
+    const std::string time = absl::FormatTime(
+        "%Y-%m-%d %H:%M:%E3S", absl::FromUnixMillis(line.unix_ms()), absl::LocalTimeZone());
+    std::printf("%s task %d #%d %s %-8s %s\n", time.c_str(), line.task_index(), line.attempt(),
+                LogSafe(line.worker(), 64).c_str(), line.level().c_str(), line.text().c_str());
+}
+
+}  // namespace
+
+Command AddTasksCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand(
+        "tasks",
+        "List a job's tasks: state, kind, pixels, leases handed out, the worker of the last one,\n"
+        "how long it ran (or runs so far) and its last error. An ended job's as the server\n"
+        "recorded them when it ended.");
+    cmd->add_option("job", *id, "job id")->required();
+    AddJsonFlag(cmd, *json);
+    AddServerOption(cmd, *flags);
+    return {
+        cmd, [flags, id, json] {
+            pb::ListTasksRequest req;
+            req.set_job_id(*id);
+            pb::ListTasksResponse resp;
+            absl::Status s = FarmClient(*flags).Call(&pb::JobService::Stub::ListTasks, req, &resp);
+            if (!s.ok()) return ReportError(s);
+            if (*json) {
+                for (const pb::TaskInfo& t : resp.tasks()) PrintJson(t);
+                return 0;
+            }
+            std::printf("%5s %-8s %-15s %-17s %8s %-20s %9s  %s\n", "TASK", "STATE", "KIND",
+                        "PIXELS", "ATTEMPTS", "WORKER", "DURATION", "LAST-ERROR");
+            for (const pb::TaskInfo& t : resp.tasks()) {
+                const std::string pixels =
+                    t.width() > 0 ? absl::StrCat(t.x(), ",", t.y(), " ", t.width(), "x", t.height())
+                                  : "-";
+                const std::string duration =
+                    t.leased_unix_ms() > 0 ? absl::StrFormat("%.2f s", t.seconds()) : "-";
+                std::printf("%5d %-8s %-15s %-17s %8d %-20s %9s  %s\n", t.index(),
+                            TaskStateName(t.state()).c_str(), TaskKindName(t.kind()).c_str(),
+                            pixels.c_str(), t.attempts(),
+                            t.worker().empty() ? "-" : LogSafe(t.worker(), 20).c_str(),
+                            duration.c_str(), LogSafe(t.last_error(), 200).c_str());
+            }
+            return 0;
+        }};
+}
+
+Command AddLogsCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto task = std::make_shared<int>(-1);
+    auto follow = std::make_shared<bool>(false);
+    auto json = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand(
+        "logs",
+        "Print what workers logged while running a job's tasks, in the order the server took\n"
+        "the lines: time, task, attempt (#1 is the first lease), worker, level, text. The server\n"
+        "keeps each task's most recent lines (docs/farm.md, Tasks and logs).");
+    cmd->add_option("job", *id, "job id")->required();
+    cmd->add_option("--task", *task, "only this task's lines (its index, as `lightfarm tasks`)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--follow,-f", *follow,
+                  "keep printing new lines (polling twice a second) until the job ends; exit 0");
+    AddJsonFlag(cmd, *json);
+    AddServerOption(cmd, *flags);
+    AddRetryOption(cmd, *flags);
+    return {cmd, [flags, id, task, follow, json] {
+                FarmClient client(*flags);
+                pb::GetTaskLogsRequest req;
+                req.set_job_id(*id);
+                if (*task >= 0) req.set_task_index(*task);
+                while (true) {
+                    pb::GetTaskLogsResponse resp;
+                    const absl::Status s = client.CallRetrying(
+                        "logs " + *id, &pb::JobService::Stub::GetTaskLogs, req, &resp);
+                    if (!s.ok()) return ReportError(s);
+                    for (const pb::TaskLogLine& line : resp.lines()) {
+                        if (*json) {
+                            PrintJson(line);
+                        } else {
+                            PrintLogLine(line);
+                        }
+                    }
+                    std::fflush(stdout);
+                    req.set_after_seq(resp.next_seq());
+                    if (resp.job_ended()) return 0;
+                    if (!resp.lines().empty()) continue;  // more may be kept: the next page
+                    if (!*follow) return 0;
+                    absl::SleepFor(absl::Milliseconds(500));
+                }
+            }};
+}
+
+}  // namespace lf

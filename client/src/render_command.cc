@@ -1,0 +1,176 @@
+#include <cstdio>
+#include <optional>
+
+#include "lf/client/adaptive_flags.h"
+#include "lf/client/command.h"
+#include "lf/job/job_spec.h"
+#include "lf/local/local_render.h"
+#include "lf/client/method_flags.h"
+#include "lf/client/output_flags.h"
+#include "lf/client/photon_flags.h"
+#include "lf/client/progress_bar.h"
+#include "lf/client/radiosity_flags.h"
+#include "lf/client/sample_flags.h"
+#include "lf/client/scene_flags.h"
+
+namespace lf {
+
+int ReportError(const absl::Status& status) {
+    std::fprintf(stderr, "lightfarm: error: %s\n", std::string(status.message()).c_str());
+    return 1;
+}
+
+namespace {
+
+// The bar starts with the sampling, as its elapsed time and estimate are the sampling's.
+class BarProgress : public RenderProgress {
+  public:
+    void Start() override { bar_.emplace("render"); }
+    void Update(size_t done, size_t total) override { bar_->Update(done, total); }
+    void Finish() override { bar_->Finish(); }
+
+  private:
+    std::optional<ProgressBar> bar_;
+};
+
+}  // namespace
+
+Command AddRenderCommand(CLI::App& app) {
+    auto options = std::make_shared<LocalRenderOptions>();
+    auto output = std::make_shared<OutputFlags>();
+    auto no_progress = std::make_shared<bool>(false);
+    auto method = std::make_shared<std::string>(defaults::kMethod);
+    CLI::App* cmd = app.add_subcommand(
+        "render",
+        "Render a scene in this process to an OpenEXR image and/or a PNG preview, by path\n"
+        "tracing, radiosity, Whitted ray tracing, light tracing, bidirectional path tracing or\n"
+        "progressive photon mapping, through the same planner and merger as the farm.\n"
+        "The EXR holds float32 R,G,B (mean radiance per pixel, W m^-2 sr^-1, linear Rec.709,\n"
+        "through the pixel filter), the two half-sample estimates A.R,A.G,A.B and B.R,B.G,B.B\n"
+        "(even and odd samples; their difference estimates the error), spp, and the --aov\n"
+        "channels, with header attributes lightfarm.* saying how the image was made. Same seed\n"
+        "and settings give the same bits for any --tile and --threads.");
+    cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    AddSceneFlags(cmd, options->scene);
+    AddOutputFlags(cmd, *output);
+    cmd->add_option("--spp", options->render.spp, "samples per pixel")
+        ->capture_default_str()
+        ->check(CLI::Range(uint64_t(1), kMaxSpp));
+    cmd->add_option("--seed", options->render.seed, "random seed")->capture_default_str();
+    cmd->add_option("--max-depth", options->max_depth,
+                    "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
+        ->capture_default_str()
+        ->check(CLI::Range(-1, kMaxDepthLimit));
+    cmd->add_option("--threads", options->render.threads, "worker threads; 0 = all cores")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1024));
+    cmd->add_option("--tile", options->render.tile, "tile side in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 65536));
+    cmd->add_option("--passes", options->render.passes,
+                    "sample passes per tile, as a farm job would split them (same bits)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxPasses));
+    AddSampleFlags(cmd, options->render.sampler, options->render.light_strategy,
+                   options->render.clamp, options->render.aovs);
+    AddAdaptiveFlags(cmd, options->adaptive);
+    cmd->add_flag("--no-progress", *no_progress, "no progress bar");
+    cmd->add_option("--method", *method,
+                    "path (path tracing, any material), radiosity (finite elements, Lambertian "
+                    "quads and triangles only, view-independent), whitted (direct light and "
+                    "mirror/glass reflection and refraction only: a fast preview without "
+                    "interreflection or caustics), light (light tracing: --spp light paths per "
+                    "pixel from the lights, each connected to the camera and splatted anywhere on "
+                    "the image), bdpt (bidirectional path tracing: every connection of a camera "
+                    "and a light subpath, weighted by MIS), ppm (progressive photon mapping: --spp "
+                    "passes of --photons photons each, a shrinking gather radius; consistent, "
+                    "biased at any finite pass count) or auto (whitted where it is exact: no "
+                    "interreflection nor caustics; else radiosity where it is exact: Lambertian "
+                    "quads and triangles; else bdpt for caustics of small emitters through "
+                    "specular surfaces; else path; the log says why). light, bdpt and ppm take no "
+                    "--aov nor adaptive sampling")
+        ->capture_default_str()
+        ->check([](const std::string& m) { return MethodFlagError(m, true); });
+
+    AddPhotonFlags(cmd, options->ppm);
+
+    const std::string r = "Radiosity";
+    AddRadiosityFlags(cmd, options->radiosity);
+    cmd->add_option("--save-solution", options->save_solution,
+                    "write the solved radiosity, to render other cameras without solving")
+        ->group(r);
+    cmd->add_option("--load-solution", options->load_solution,
+                    "reuse a saved solution (must match the scene and mesh)")
+        ->group(r)
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--export-ply", options->export_ply,
+                    "write the solution as a PLY mesh with per-vertex sRGB colours")
+        ->group(r);
+
+    return {
+        cmd, [cmd, options, output, no_progress, method] {
+            absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
+            if (!paths.ok()) return ReportError(paths.status());
+            options->exr_path = paths->exr;
+            options->png_path = paths->png;
+            options->preview = output->preview;
+            if (absl::Status s = CheckRadiosityFlagsApply(*cmd, *method); !s.ok()) {
+                return ReportError(s);
+            }
+            if (absl::Status s = CheckPhotonFlagsApply(*cmd, *method); !s.ok()) {
+                return ReportError(s);
+            }
+            for (const std::string* path : {&options->exr_path, &options->png_path}) {
+                if (absl::Status s = CheckWritable(*path); !s.ok()) return ReportError(s);
+            }
+            options->method = MethodOfFlag(*method);
+            BarProgress bar;
+            options->progress = *no_progress ? nullptr : &bar;
+            absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
+            if (!summary.ok()) return ReportError(summary.status());
+            const double s = summary->render_seconds;
+            std::printf(
+                "job %s: %s, %dx%d, %llu samples in %.2f s: %.3f M samples/s, %.3f M rays/s, "
+                "%llu NaN/Inf samples -> %s\n",
+                summary->job_id.c_str(), std::string(MethodName(summary->method)).c_str(),
+                summary->width, summary->height, (unsigned long long)summary->stats.samples, s,
+                summary->stats.samples / s * 1e-6, summary->stats.rays / s * 1e-6,
+                (unsigned long long)summary->stats.invalid_samples, OutputNames(*paths).c_str());
+            std::printf("time: load %.2f s, ", summary->load_seconds);
+            if (const std::optional<RadiosityFigures>& r = summary->radiosity) {
+                std::printf("radiosity %.2f s (mesh %.2f s, form factors %.2f s, solve %.2f s), ",
+                            summary->radiosity_seconds, summary->mesh_seconds,
+                            r->form_factor_seconds, r->solve_seconds);
+            }
+            std::printf("render %.2f s, total %.2f s\n", summary->render_seconds, summary->seconds);
+            if (summary->estimated_error >= 0) {
+                std::printf("estimated relative error %.4f%s%s\n", summary->estimated_error,
+                            summary->high_variance ? " (high variance)" : "",
+                            options->render.clamp > 0
+                                ? " (noise only: --clamp biases the image, and this error does "
+                                  "not include that bias)"
+                                : "");
+            } else if (options->render.clamp > 0) {
+                std::printf("--clamp %g: the image is biased\n", options->render.clamp);
+            }
+            if (summary->adaptive) {
+                const AdaptiveReport& a = summary->adaptive_report;
+                double samples = 0, pixels = 0;  // the mean spp, what `plan` predicts
+                for (const AdaptiveReport::Tile& t : a.per_tile) {
+                    samples += double(t.spp) * t.rect.Area();
+                    pixels += double(t.rect.Area());
+                }
+                std::printf(
+                    "adaptive: %llu..%llu spp per pixel (mean %.0f), worst tile %.4f, %d of %d "
+                    "tiles above the target%s\n",
+                    (unsigned long long)a.min_spp, (unsigned long long)a.max_spp,
+                    pixels > 0 ? samples / pixels : 0, a.worst_tile_error, a.tiles_above_target,
+                    a.tiles, a.timed_out ? ", time limit reached" : "");
+            }
+            return 0;
+        }};
+}
+
+}  // namespace lf

@@ -1,0 +1,103 @@
+#include "lf/client/scene_flags.h"
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "lf/core/pixel_filter.h"
+
+namespace lf {
+namespace {
+
+// "WxH" ("1920x1080") into *width and *height; a bare "N" too when `single` is not null (then
+// *single = N and the size is left alone). InvalidArgument otherwise.
+absl::Status ParseResolution(const std::string& text, int* width, int* height, int* single) {
+    const size_t x = text.find_first_of("xX");
+    int w = 0, h = 0;
+    if (x == std::string::npos && single && absl::SimpleAtoi(text, &w) && w >= 0) {
+        *single = w;
+        return absl::OkStatus();
+    }
+    if (x == std::string::npos || !absl::SimpleAtoi(text.substr(0, x), &w) ||
+        !absl::SimpleAtoi(text.substr(x + 1), &h) || w < 1 || h < 1) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "--resolution \"", text, "\": expected WxH, e.g. 1920x1080", single ? ", or N" : ""));
+    }
+    *width = w;
+    *height = h;
+    return absl::OkStatus();
+}
+
+// "TYPE" or "TYPE:WIDTH" (width in pixels; default 1 for box, kDefaultFilterWidth otherwise).
+absl::StatusOr<PixelFilter> ParseFilter(const std::string& text) {
+    const size_t colon = text.find(':');
+    const std::string name = text.substr(0, colon);
+    const std::optional<PixelFilter::Type> type = PixelFilterTypeFromName(name);
+    if (!type) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "--filter ", text, ": unknown filter \"", name,
+            "\"; expected box, gaussian or blackman-harris, optionally :WIDTH in pixels"));
+    }
+    PixelFilter filter{*type, *type == PixelFilter::Type::kBox ? 1.0 : kDefaultFilterWidth};
+    if (colon != std::string::npos && !absl::SimpleAtod(text.substr(colon + 1), &filter.width)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--filter ", text, ": the width after ':' must be a number of pixels"));
+    }
+    if (absl::Status s = CheckPixelFilter(filter); !s.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("--filter ", text, ": ", s.message()));
+    }
+    return filter;
+}
+
+}  // namespace
+
+void AddFilterFlag(CLI::App* cmd, SceneOptions& options) {
+    cmd->add_option_function<std::string>(
+           "--filter",
+           [&options](const std::string& text) {
+               absl::StatusOr<PixelFilter> filter = ParseFilter(text);
+               if (!filter.ok()) throw CLI::ValidationError(std::string(filter.status().message()));
+               options.filter = *filter;
+           },
+           absl::StrCat("pixel filter, in place of the scene camera's (default: the scene's, "
+                        "else box): box (each sample uniform in its pixel), gaussian (sigma = "
+                        "width/6) or blackman-harris, with an optional :WIDTH, the filter's full "
+                        "support in pixels (",
+                        kMinFilterWidth, " to ", kMaxFilterWidth, ", default ", kDefaultFilterWidth,
+                        "; box is 1). Samples are placed by the filter, keeping equal weights"))
+        ->type_name("TYPE[:WIDTH]");
+}
+
+void AddCameraFlag(CLI::App* cmd, SceneOptions& options) {
+    cmd->add_option("--camera", options.camera,
+                    "render from the glTF camera of this name (its node's name, or the "
+                    "camera's); default: the JSON scene's camera, else the first glTF camera");
+}
+
+void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, int* single, int max_single,
+                       const std::string& help) {
+    cmd->add_option_function<std::string>(
+           "--resolution",
+           [&options, single, max_single](const std::string& text) {
+               absl::Status s = ParseResolution(text, &options.width, &options.height, single);
+               if (s.ok() && single && *single > max_single) {
+                   s = absl::InvalidArgumentError(
+                       absl::StrCat("--resolution ", *single, ": at most ", max_single));
+               }
+               if (!s.ok()) throw CLI::ValidationError(std::string(s.message()));
+               // WxH given: the bare N no longer applies.
+               if (single && options.width > 0) *single = 0;
+           },
+           help)
+        ->type_name(single ? "WxH|N" : "WxH");
+}
+
+void AddSceneFlags(CLI::App* cmd, SceneOptions& options) {
+    AddCameraFlag(cmd, options);
+    AddResolutionFlag(
+        cmd, options, nullptr, 0,
+        "image size WxH in pixels, instead of the scene's (JSON resolution or glTF camera)");
+    AddFilterFlag(cmd, options);
+}
+
+}  // namespace lf

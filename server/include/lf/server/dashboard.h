@@ -1,0 +1,93 @@
+// The web dashboard of lightfarm-server's --http listener: its pages (server/web/, embedded at
+// build time) and the JSON API they poll, a thin adapter over Farm as the gRPC services are. A
+// caller is who its token says (an `lf_token` cookie set by signing in, or Authorization:
+// Bearer) and sees what the gRPC API would show that token: a submitter its own jobs (another's
+// answers 404 exactly as a job that does not exist), workers without other owners' job ids;
+// worker tokens may not use it. With authentication off (no tokens, gRPC on loopback) everyone
+// is an anonymous admin, as on the gRPC port, but only from this machine and through a loopback
+// Host (against DNS rebinding). Plain logic over HttpRequest and HttpAnswer, tested without HTTP.
+//
+//   GET  /, /web/NAME                 the pages
+//   GET  /api/session                 who is signed in (401 when no one is and tokens are on)
+//   POST /api/session {"token": T}    signs in: an HttpOnly, SameSite=Strict cookie
+//   POST /api/session/end             signs out
+//   GET  /api/jobs?limit=N&before=SEQ newest first
+//   GET  /api/jobs/ID                 one job, with its ETA
+//   GET  /api/jobs/ID/tasks           its tasks
+//   GET  /api/jobs/ID/logs?task=N&after=SEQ&max=N
+//   GET  /api/jobs/ID/preview.png     the image merged so far, 8-bit sRGB
+//   GET  /api/jobs/ID/metadata        the EXR header attributes of that image
+//   POST /api/jobs/ID/cancel
+//   POST /api/jobs/ID/priority {"priority": N}
+//   GET  /api/workers
+//   GET  /api/farm                    queue depth, workers, throughput per minute of the last hour
+//
+// POSTs must come as application/json from the page's own origin (CSRF), unless they carry
+// Authorization: Bearer, which a browser never adds by itself.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "lf/core/image_io.h"
+#include "lf/server/auth.h"
+#include "lf/server/farm.h"
+#include "lf/server/http_exchange.h"
+
+namespace lf {
+
+struct DashboardOptions {
+    bool tls = false;  // served over HTTPS: the cookie is Secure, the page's origin https://
+    // A running job's preview is made again (its EXR written and read, its PNG encoded) at most
+    // this often, however many tabs watch it and however fast its tasks merge.
+    absl::Duration preview_min_age = absl::Seconds(2);
+};
+
+class Dashboard {
+  public:
+    Dashboard(Farm& farm, Authenticator& auth, DashboardOptions options);
+
+    // Answers any request for / , /web/... or /api/...; 404 for other paths.
+    HttpAnswer Serve(const HttpRequest& request);
+
+    // The name of the session cookie.
+    static constexpr char kCookie[] = "lf_token";
+    // Previews kept encoded, the most recently asked for.
+    static constexpr size_t kMaxPreviews = 16;
+
+  private:
+    struct Preview {
+        int tasks_done = 0;
+        JobState state = JobState::kQueued;
+        std::string png;
+        ExrAttributes attributes;
+        absl::Time made;
+        uint64_t used = 0;  // the cache's clock when last asked for
+    };
+
+    HttpAnswer Api(const HttpRequest& request, const std::string& route);
+    HttpAnswer SignIn(const HttpRequest& request);
+    HttpAnswer JobApi(const HttpRequest& request, const Caller& caller, const std::string& route);
+    absl::StatusOr<Caller> CallerOf(const HttpRequest& request);
+    // CSRF: a POST's content type and origin.
+    absl::Status CheckPost(const HttpRequest& request) const;
+    // The job when `caller` may see it; NotFound alike for another's job and for none.
+    absl::StatusOr<JobRecord> VisibleJob(const Caller& caller, const std::string& job_id);
+    // The job's image as merged so far (or its result), encoded again only when a task was
+    // merged since, and not more often than preview_min_age while the job runs.
+    absl::StatusOr<std::shared_ptr<const Preview>> PreviewOf(const JobRecord& job);
+
+    Farm& farm_;
+    Authenticator& auth_;
+    const DashboardOptions options_;
+    std::mutex previews_mutex_;
+    std::map<std::string, std::shared_ptr<Preview>> previews_;  // by job id
+    uint64_t preview_clock_ = 0;
+};
+
+}  // namespace lf

@@ -1,0 +1,305 @@
+// The farm's scheduler, without I/O or gRPC: what spans jobs. Jobs are queued by priority then
+// age, their tasks leased to workers, leases live while heartbeats extend them, results go to
+// the job, and the store keeps it all durable. Everything a kind of job does its own way (its
+// plan, merge, task order, time limit: lf/job/job_execution.h) is its execution's to say. It
+// composes small units, each tested alone: task states change only through TaskStateMachine,
+// job states through TransitionJob; LeaseTable owns the leases, WorkerRegistry the live
+// workers, SpeculationPolicy decides second leases; the timeout checker (TimeoutChecker) calls
+// ExpireLeases and EnforceTimeLimits. The store is never read, nor waited for, under the
+// scheduler's lock.
+//
+// A lease that expires or a failure puts the task back in the queue, where workers it has not
+// failed on take it first; the third counted failure fails the job. Cancelling a job drops all its
+// tasks at once: their heartbeats answer "stop".
+#pragma once
+
+#include <condition_variable>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "lf/core/image.h"
+#include "lf/core/splat_list.h"
+#include "lf/job/adaptive_plan.h"
+#include "lf/job/job_execution.h"
+#include "lf/job/task_assignment.h"
+#include "lf/job/task_status.h"
+#include "lf/job/worker_status.h"
+#include "lf/server/ended_jobs.h"
+#include "lf/server/job_state_machine.h"
+#include "lf/server/job_store.h"
+#include "lf/server/lease_table.h"
+#include "lf/server/metrics.h"
+#include "lf/server/scheduled_job.h"
+#include "lf/server/worker_registry.h"
+
+namespace lf {
+
+struct SchedulerOptions {
+    absl::Duration lease = absl::Seconds(10);  // a lease lasts this long past the last heartbeat
+    int max_failures = 3;                      // counted failures of one task that fail its job
+    // Near the end of a job (no task of it queued), an idle worker gets a second lease of a task
+    // running longer than this and longer than twice the job's mean task time; the first result
+    // wins (both are the same bits), so one slow worker does not hold the job.
+    absl::Duration speculate_after = absl::Seconds(1);
+    // How often workers heartbeat, told to them with each lease.
+    absl::Duration heartbeat_interval = absl::Milliseconds(300);
+    // Where each job's merged tiles are kept (lf/job/tile_store.h): the coordinator keeps them
+    // in files, so that a job's memory does not grow with its image.
+    TileStoreFactory tile_stores = MakeMemoryTileStore;
+    // Jobs queued or running at once; a submission beyond is refused (ResourceExhausted).
+    size_t max_active_jobs = 1000;
+};
+
+// Counted as the scheduler works; read by /metrics at any time, without the scheduler's lock.
+struct SchedulerMetrics {
+    Counter leases;         // leases handed out, second leases of stragglers included
+    Counter task_failures;  // counted failures: expired leases, task errors, refused results
+    // Per task done while leased: seconds from its lease to its accepted result (the render
+    // and the result's transfer), as the server's clock measures them.
+    Histogram task_seconds{{0.1, 0.25, 0.5, 1, 2.5, 5, 10, 30, 60, 120, 300, 600, 1800, 3600}};
+    // Tasks merged, and the samples they brought (pixels times samples per pixel of their camera
+    // part), per minute of the last hour: the dashboard's throughput.
+    MinuteCounts tasks_done;
+    MinuteCounts samples_done;
+};
+
+// What is queued and running now, for /metrics.
+struct SchedulerLoad {
+    int jobs_queued = 0, jobs_running = 0;
+    int64_t tasks_queued = 0, tasks_running = 0;  // across active jobs
+    int workers_live = 0;                         // seen within a lease
+    int workers_busy = 0;                         // live and holding a current lease
+};
+
+enum class FailureKind {
+    kTaskError,       // counts toward max_failures
+    kWorkerShutdown,  // the worker was told to stop: not the task's fault
+};
+
+class Scheduler {
+  public:
+    using Clock = std::function<absl::Time()>;
+    Scheduler(
+        SchedulerOptions options, JobStore& store, Clock clock = [] { return absl::Now(); });
+
+    // Plans and queues the job; `spec` must be validated. Returns the job id once the job is in
+    // the store (an error, and nothing queued, when the store cannot take it). A request id
+    // seen before returns that submission's job. ResourceExhausted when max_active_jobs jobs are
+    // queued or running.
+    absl::StatusOr<std::string> Submit(const JobSpec& spec);
+
+    // Takes up the jobs the store holds that have not ended, as a server restarting does: their
+    // recorded task results are merged again and every other task is queued (leases do not
+    // outlive the server; their workers' late results are still taken). Returns the jobs that
+    // are fully rendered, whose result the caller writes and Finishes.
+    absl::StatusOr<std::vector<std::string>> Recover();
+
+    // The first queued task of the highest-priority, oldest job that this worker may take (a
+    // task that failed here goes to a live worker it has not failed on, while there is one); when
+    // none is queued, a straggler's task (see speculate_after). Waits until `wait_until` for one to
+    // be queued (a long poll: an idle worker starts on a new job at once); nullopt when there is
+    // nothing to do. `about`: what the worker says of itself, for Workers().
+    std::optional<TaskAssignment> LeaseTask(const std::string& worker,
+                                            absl::Time wait_until = absl::InfinitePast(),
+                                            const WorkerDescription* about = nullptr);
+
+    // Extends the lease. False means stop: the job was cancelled or the lease is gone.
+    bool Heartbeat(const std::string& lease_id, const std::string& worker);
+
+    // Merges a task's result (lf::TaskResult: what the task's kind returns), and records it in
+    // the store before returning when the job's execution keeps it. The result is accepted even
+    // from an expired lease as long as the task is not done (it is the same bits whoever renders
+    // it); a duplicate is ignored. Refused: a lease this server never handed to `worker`
+    // (FailedPrecondition), and a result that is not the task's (InvalidArgument, from the
+    // execution; a current lease's task is then queued again as a counted failure).
+    // `job_rendered` says the job is now fully rendered: the caller writes the result and calls
+    // Finish. When a patch-group task completes its sweep, `sweep` holds the next sweep's input
+    // or the solution: the caller stores it as a blob and calls Publish. A solve that runs out of
+    // iterations fails the job.
+    struct Completion {
+        std::string job_id;
+        bool job_rendered = false;
+        std::optional<RadiositySolve::Outcome> sweep;
+    };
+    absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
+                                        const TaskResult& result);
+    // A tile's result, or a splat task's (`sums` its camera part, a 0x0 tile with the stats when
+    // it has none, and `splats` its splat list).
+    absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
+                                        const TileSums& sums, SplatList* splats = nullptr) {
+        return Complete(lease_id, worker, TaskResult{.sums = &sums, .splats = splats});
+    }
+    absl::StatusOr<Completion> CompleteSweep(const std::string& lease_id, const std::string& worker,
+                                             const SweepChunkResult& result) {
+        return Complete(lease_id, worker, TaskResult{.sweep = &result});
+    }
+    // Queues the sweep that reads blob `hash`, or the display tiles when `converged`; fails the
+    // job when the blob could not be stored.
+    void Publish(const std::string& job_id, bool converged,
+                 const absl::StatusOr<std::string>& hash);
+
+    // Gives a leased task back. Ignored when the lease is no longer current.
+    absl::Status Fail(const std::string& lease_id, const std::string& worker,
+                      const std::string& reason, FailureKind kind);
+
+    absl::StatusOr<JobRecord> Cancel(const std::string& job_id);
+
+    // A queued or running job's new priority: its queued tasks are leased in the new order from
+    // the next lease on. Returns the record once it is durable; FailedPrecondition for a job that
+    // has ended, NotFound for one the store does not hold.
+    absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
+
+    // Re-queues the tasks whose lease ran out (each counts as a failure of the task), and
+    // forgets the workers silent for a lease. Returns how many leases expired.
+    int ExpireLeases();
+
+    // Ends the sampling of adaptive jobs whose time limit has passed since they started: passes
+    // not yet merged are dropped (leases of them hear "stop"), tiles keep their first pass.
+    // Returns the jobs that are now fully rendered, whose result the caller writes and Finishes.
+    std::vector<std::string> EnforceTimeLimits();
+
+    // A rendered job's record and image, to write as its result, and for an adaptive job how its
+    // sampling ended. The image is read from the job's tile store one tile at a time after the
+    // lock is released: a preview of a running job may show one tile's newer result beside
+    // another's older one, never half a tile.
+    struct JobImage {
+        JobRecord record;
+        Image image;
+        std::optional<AdaptiveReport> adaptive;
+    };
+    absl::StatusOr<JobImage> Snapshot(const std::string& job_id) const;
+
+    // Ends a fully rendered job: succeeded with the result file, or failed with the error.
+    void Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path);
+
+    // Running jobs as they are now, ended ones from the store.
+    absl::StatusOr<JobRecord> Get(const std::string& job_id) const;
+    // The jobs the query selects from the store, running ones as they are now.
+    absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const;
+
+    // The blobs the jobs held in memory read (queued, running, or ended and not yet recorded):
+    // their scenes' files and the radiosity sweeps' inputs and solutions.
+    std::set<std::string> BlobsInUse() const;
+
+    // Blocks until some job changed after `version` was current, or `deadline`, or Shutdown.
+    // Returns the version now.
+    uint64_t WaitForChange(uint64_t version, absl::Time deadline);
+    void Shutdown();  // wakes every WaitForChange for good
+
+    // A queued or running job's tasks as they are now (TaskStatus::log_lines left 0: the logs
+    // are not the scheduler's); nullopt for a job that is not queued or running.
+    std::optional<std::vector<TaskStatus>> Tasks(const std::string& job_id) const;
+
+    // Whom a lease belongs to, for the log lines that come with its heartbeats and results.
+    struct LeaseHolder {
+        std::string job_id;
+        int task = 0;
+        int attempt = 0;  // 1 for the task's first lease
+        std::string worker;
+    };
+    // Where a lease id of this server points when `worker` holds it, current or not, while its
+    // job is queued or running; nullopt otherwise (a made-up id, another worker's lease, a lease
+    // from before a restart, or a job that has ended).
+    std::optional<LeaseHolder> HolderOf(const std::string& lease_id, const std::string& worker);
+
+    // Called with an ended job's tasks as they were when it ended, after the scheduler's lock is
+    // released and the job's final record is durable (or logged as not recorded), so that they
+    // can be kept once the job leaves memory. Set before the first job is submitted or recovered.
+    using TasksEnded = std::function<void(const std::string& job_id, std::vector<TaskStatus>)>;
+    void OnTasksEnded(TasksEnded callback) { tasks_ended_ = std::move(callback); }
+
+    // Workers the scheduler keeps track of: the live ones, and silent ones not yet forgotten
+    // (the timeout checker forgets them within a tick of a lease's silence).
+    size_t workers_tracked() const;
+
+    // The live workers by id (a worker silent for a lease is forgotten), each with the task it
+    // holds a current lease of.
+    std::vector<WorkerStatus> Workers();
+    SchedulerLoad Load();
+    const SchedulerMetrics& metrics() const { return metrics_; }
+
+  private:
+    using Job = ScheduledJob;
+    // A lease this server handed out, and its job, while that job is queued or running.
+    struct LeaseRef {
+        Job* job;
+        const Lease* lease;
+        std::string id;
+    };
+    // The scheduler's lock. Jobs ended while it is held have their final record queued, not
+    // durable; on release it waits for those writes with the lock released, so no fsync is ever
+    // waited for under it, then leaves the jobs to the store's care.
+    class Locked {
+      public:
+        explicit Locked(Scheduler& scheduler);
+        ~Locked();
+        std::unique_lock<std::mutex> lock;
+
+      private:
+        // Waits for the ended jobs' records with the lock released.
+        void SettleEnded();
+        Scheduler& scheduler_;
+    };
+
+    // The job of an earlier submission with this request id held in memory, and the store
+    // ticket to wait for.
+    std::optional<std::pair<std::string, uint64_t>> FindRequestInMemory(
+        const std::string& request_id) const;
+    std::optional<TaskAssignment> TryLease(const std::string& worker,
+                                           const WorkerDescription* about);
+    // Drops a job's tasks once its time limit has passed; true if dropping them completed the
+    // job (so that it is reported once, here or by Complete).
+    bool EnforceTimeLimit(Job& job, absl::Time now);
+    // Whether `worker` may take queued task `task` now: a task the execution prefers for another
+    // live worker waits for it, and a task that failed on `worker` waits for a live worker it has
+    // not failed on, while there is one.
+    bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;
+    // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).
+    absl::StatusOr<LeaseRef> ResultLease(const std::string& lease_id, const std::string& worker,
+                                         absl::Time now);
+    // Refuses a result: the task goes back to the queue as a counted failure.
+    absl::Status Refuse(const LeaseRef& ref, const std::string& worker, const absl::Status& why);
+    // The bookkeeping of a task's first accepted result.
+    void MarkDone(Job& job, int task, absl::Time now);
+    // A second lease of a task running too long in the job, or -1 (see SpeculationPolicy).
+    int StragglerFor(const Job& job, const std::string& worker, absl::Time now) const;
+    TaskAssignment Grant(Job& job, int task, const std::string& worker, absl::Time now);
+    // The lease and its job when `worker` holds it, current or not; nullopt otherwise (a
+    // made-up id, another worker's lease, one from before a restart, or of a job that ended).
+    std::optional<LeaseRef> Resolve(const std::string& lease_id, const std::string& worker);
+    // Ends the lease; when no other lease of the task is current, puts the task back in the
+    // queue. Counts a failure unless `counted` is false; fails the job at max_failures.
+    void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
+    void FailJob(Job& job, const std::string& error);
+    // Ends the live state of a job moved to a final state: its final record is queued and the
+    // job waits in `ended_` until Locked's release finds it durable. Returns that record.
+    JobRecord EndJob(Job& job);
+    uint64_t Save(Job& job);  // queues the record's write and wakes watchers; a store ticket
+
+    const SchedulerOptions options_;
+    JobStore& store_;
+    const Clock clock_;
+
+    mutable std::mutex mutex_;
+    std::condition_variable changed_;
+    uint64_t version_ = 0;
+    bool shutdown_ = false;
+    uint64_t next_seq_ = 1;
+    std::map<std::string, std::unique_ptr<Job>> active_;
+    EndedJobs ended_;
+    // Ended jobs' tasks, for tasks_ended_ once the lock is released.
+    std::vector<std::pair<std::string, std::vector<TaskStatus>>> ended_tasks_;
+    TasksEnded tasks_ended_;
+    LeaseTable leases_;
+    WorkerRegistry workers_;
+    SchedulerMetrics metrics_;
+};
+
+}  // namespace lf

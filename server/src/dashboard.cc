@@ -1,0 +1,527 @@
+#include "lf/server/dashboard.h"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/time/clock.h"
+#include "lf/core/log.h"
+#include "lf/server/listen_policy.h"
+#include "lf/server/web_assets.h"
+
+namespace lf {
+
+namespace {
+
+using Json = nlohmann::json;
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("dashboard"); }
+
+constexpr char kJsonType[] = "application/json";
+constexpr int kDefaultJobs = 50, kMaxJobs = 200;
+constexpr int kDefaultLogLines = 200, kMaxLogLines = 1000;
+constexpr size_t kMaxJobIdBytes = 64;
+
+// Nothing but the server's own files, and no page may frame the dashboard.
+const std::vector<std::pair<std::string, std::string>>& SecurityHeaders() {
+    static const std::vector<std::pair<std::string, std::string>> headers = {
+        {"Content-Security-Policy",
+         "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self'; "
+         "connect-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'"},
+        {"X-Content-Type-Options", "nosniff"},
+        {"Referrer-Policy", "no-referrer"},
+    };
+    return headers;
+}
+
+HttpAnswer JsonAnswer(int status, const Json& body) {
+    HttpAnswer a{status, kJsonType, body.dump(), {{"Cache-Control", "no-store"}}};
+    return a;
+}
+
+int HttpStatusOf(const absl::Status& s) {
+    switch (s.code()) {
+        case absl::StatusCode::kInvalidArgument:
+        case absl::StatusCode::kOutOfRange:
+            return 400;
+        case absl::StatusCode::kUnauthenticated:
+            return 401;
+        case absl::StatusCode::kPermissionDenied:
+            return 403;
+        case absl::StatusCode::kNotFound:
+            return 404;
+        case absl::StatusCode::kFailedPrecondition:
+        case absl::StatusCode::kAlreadyExists:
+            return 409;
+        case absl::StatusCode::kResourceExhausted:
+            return 429;
+        case absl::StatusCode::kUnavailable:
+            return 503;
+        default:
+            return 500;
+    }
+}
+
+HttpAnswer ErrorAnswer(const absl::Status& s) {
+    return JsonAnswer(HttpStatusOf(s), {{"error", std::string(s.message())}});
+}
+
+HttpAnswer NotFoundAnswer() { return ErrorAnswer(absl::NotFoundError("not found")); }
+
+// Milliseconds since the Unix epoch; null for a time that has not come (InfinitePast).
+Json UnixMs(absl::Time t) {
+    return t == absl::InfinitePast() ? Json(nullptr) : Json(absl::ToUnixMillis(t));
+}
+
+// Seconds left at the pace of the tasks merged so far; null before the first one.
+Json EtaSeconds(const JobRecord& job, absl::Time now) {
+    if (IsFinal(job.state) || job.tasks_done == 0 || job.started == absl::InfinitePast()) {
+        return nullptr;
+    }
+    const double elapsed = absl::ToDoubleSeconds(now - job.started);
+    return elapsed * (job.tasks_total - job.tasks_done) / job.tasks_done;
+}
+
+Json JobJson(const JobRecord& job, absl::Time now) {
+    return {
+        {"id", job.id},
+        {"seq", job.seq},
+        {"name", job.spec.name},
+        {"owner", job.spec.owner},
+        {"method", job.spec.method},
+        {"state", JobStateName(job.state)},
+        {"priority", job.spec.priority},
+        {"width", job.spec.plan.width},
+        {"height", job.spec.plan.height},
+        {"spp", job.spec.plan.spp},
+        {"tasks_total", job.tasks_total},
+        {"tasks_done", job.tasks_done},
+        {"tasks_running", job.tasks_running},
+        {"retries", job.retries},
+        {"submitted_ms", UnixMs(job.submitted)},
+        {"started_ms", UnixMs(job.started)},
+        {"finished_ms", UnixMs(job.finished)},
+        {"eta_s", EtaSeconds(job, now)},
+        {"error", job.error},
+        {"last_error", job.last_error},
+    };
+}
+
+Json TaskJson(const TaskStatus& t) {
+    return {
+        {"index", t.index},
+        {"state", TaskStatusName(t.state)},
+        {"kind", TaskKindName(t.kind)},
+        {"x", t.x},
+        {"y", t.y},
+        {"width", t.width},
+        {"height", t.height},
+        {"samples", t.samples},
+        {"attempts", t.attempts},
+        {"failures", t.failures},
+        {"worker", t.worker},
+        {"leased_ms", UnixMs(t.leased)},
+        {"finished_ms", UnixMs(t.finished)},
+        {"duration_ms", absl::ToInt64Milliseconds(t.duration)},
+        {"last_error", t.last_error},
+        {"log_lines", t.log_lines},
+    };
+}
+
+Json AttributeJson(const ExrAttribute& value) {
+    return std::visit(
+        [](const auto& v) -> Json {
+            using T = std::decay_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, ExrChromaticities>) {
+                return {{"red", {v.red_x, v.red_y}},
+                        {"green", {v.green_x, v.green_y}},
+                        {"blue", {v.blue_x, v.blue_y}},
+                        {"white", {v.white_x, v.white_y}}};
+            } else {
+                return v;
+            }
+        },
+        value);
+}
+
+// A job id as the scheduler makes them ("job-" and hex); anything else names no job.
+bool PlausibleJobId(const std::string& id) {
+    return !id.empty() && id.size() <= kMaxJobIdBytes &&
+           std::all_of(id.begin(), id.end(), [](char c) {
+               return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_';
+           });
+}
+
+// An integer query parameter within [lo, hi]; `fallback` when absent.
+absl::StatusOr<int64_t> IntParam(const HttpRequest& request, const std::string& name,
+                                 int64_t fallback, int64_t lo, int64_t hi) {
+    std::optional<std::string> text = request.Query(name);
+    if (!text) return fallback;
+    int64_t value = 0;
+    if (!absl::SimpleAtoi(*text, &value) || value < lo || value > hi) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(name, ": expected an integer in ", lo, "..", hi));
+    }
+    return value;
+}
+
+std::string ContentTypeOf(const std::string& name) {
+    const std::string ext = name.substr(name.rfind('.') + 1);
+    if (ext == "html") return "text/html; charset=utf-8";
+    if (ext == "js") return "text/javascript; charset=utf-8";
+    if (ext == "css") return "text/css; charset=utf-8";
+    if (ext == "svg") return "image/svg+xml";
+    return "application/octet-stream";
+}
+
+// A strong validator of an embedded file: FNV-1a of its bytes.
+std::string EtagOf(std::string_view bytes) {
+    uint64_t h = 14695981039346656037ull;
+    for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
+    return absl::StrCat("\"", absl::Hex(h), "\"");
+}
+
+// 304 when the client holds this version already.
+bool NotModified(const HttpRequest& request, const std::string& etag) {
+    std::optional<std::string> held = request.Header("if-none-match");
+    return held && *held == etag;
+}
+
+HttpAnswer AssetAnswer(const HttpRequest& request, const std::string& name) {
+    for (const WebAsset& asset : WebAssets()) {
+        if (asset.name != name) continue;
+        const std::string etag = EtagOf(asset.content);
+        // Revalidated on every load (a new server build may change them); 304 is cheap.
+        std::vector<std::pair<std::string, std::string>> headers = {{"Cache-Control", "no-cache"},
+                                                                    {"ETag", etag}};
+        if (NotModified(request, etag)) return {304, "", "", std::move(headers)};
+        return {200, ContentTypeOf(name), std::string(asset.content), std::move(headers)};
+    }
+    return NotFoundAnswer();
+}
+
+// The value of cookie `name` in a Cookie header.
+std::optional<std::string> CookieValue(const std::string& header, const std::string& name) {
+    for (absl::string_view part : absl::StrSplit(header, ';')) {
+        part = absl::StripAsciiWhitespace(part);
+        if (absl::StartsWith(part, name + "=")) return std::string(part.substr(name.size() + 1));
+    }
+    return std::nullopt;
+}
+
+std::string SessionCookie(const std::string& value, bool tls, bool clear) {
+    return absl::StrCat(Dashboard::kCookie, "=", value, "; Path=/; HttpOnly; SameSite=Strict",
+                        tls ? "; Secure" : "", clear ? "; Max-Age=0" : "");
+}
+
+Json CallerJson(const Caller& caller, bool auth) {
+    return {{"name", caller.name}, {"role", RoleName(caller.role)}, {"auth", auth}};
+}
+
+}  // namespace
+
+Dashboard::Dashboard(Farm& farm, Authenticator& auth, DashboardOptions options)
+    : farm_(farm), auth_(auth), options_(options) {}
+
+HttpAnswer Dashboard::Serve(const HttpRequest& request) {
+    HttpAnswer answer;
+    if (absl::StartsWith(request.path, "/api/")) {
+        answer = Api(request, request.path.substr(5));
+    } else if (request.method != "GET") {
+        answer = ErrorAnswer(absl::InvalidArgumentError("the pages are only read (GET)"));
+        answer.status = 405;
+    } else if (request.path == "/") {
+        answer = AssetAnswer(request, "index.html");
+    } else if (absl::StartsWith(request.path, "/web/")) {
+        answer = AssetAnswer(request, request.path.substr(5));
+    } else {
+        answer = NotFoundAnswer();
+    }
+    const auto& security = SecurityHeaders();
+    answer.headers.insert(answer.headers.end(), security.begin(), security.end());
+    return answer;
+}
+
+absl::StatusOr<Caller> Dashboard::CallerOf(const HttpRequest& request) {
+    if (!auth_.enabled() && !(IsLoopbackHost(request.remote_addr) &&
+                              IsLoopbackHost(ListenHost(request.Header("host").value_or(""))))) {
+        // Without tokens everyone is an admin: only this machine may be, through an address
+        // that names it (a page of another site renamed to 127.0.0.1 names itself).
+        return absl::PermissionDeniedError(
+            "authentication is off (no tokens): the dashboard answers only this machine at "
+            "localhost or 127.0.0.1; make a token (lightfarm-server token create) to open it to "
+            "others");
+    }
+    std::optional<std::string> header = request.Header("authorization");
+    if (!header) {
+        if (std::optional<std::string> cookies = request.Header("cookie")) {
+            if (std::optional<std::string> token = CookieValue(*cookies, kCookie)) {
+                header = "Bearer " + *token;
+            }
+        }
+    }
+    absl::StatusOr<Caller> caller = auth_.Authenticate(header);
+    if (!caller.ok()) return caller.status();
+    // Every page shows jobs: a worker's token has no business here.
+    if (absl::Status s = Permit(*caller, Action::kReadJobs); !s.ok()) return s;
+    return caller;
+}
+
+absl::Status Dashboard::CheckPost(const HttpRequest& request) const {
+    // A browser adds no Authorization header by itself: such a request is not forged.
+    if (request.Header("authorization")) return absl::OkStatus();
+    const std::string type = request.Header("content-type").value_or("");
+    if (!absl::StartsWith(type, kJsonType)) {
+        // A cross-site form can post only form types without a CORS preflight, which this
+        // server never grants.
+        return absl::PermissionDeniedError("expected Content-Type: application/json");
+    }
+    const std::optional<std::string> origin = request.Header("origin");
+    const std::string expected =
+        absl::StrCat(options_.tls ? "https://" : "http://", request.Header("host").value_or(""));
+    if (!origin || *origin != expected) {
+        return absl::PermissionDeniedError("cross-origin request refused");
+    }
+    return absl::OkStatus();
+}
+
+HttpAnswer Dashboard::Api(const HttpRequest& request, const std::string& route) {
+    const bool post = request.method == "POST";
+    if (!post && request.method != "GET") {
+        HttpAnswer a = ErrorAnswer(absl::InvalidArgumentError("only GET and POST"));
+        a.status = 405;
+        return a;
+    }
+    if (post) {
+        if (absl::Status s = CheckPost(request); !s.ok()) {
+            Log()->warn("{} {} refused: {}", request.method, LogSafe(request.path),
+                        std::string(s.message()));
+            return ErrorAnswer(s);
+        }
+    }
+    if (route == "session" && post) return SignIn(request);
+    if (route == "session/end" && post) {
+        HttpAnswer a = JsonAnswer(200, {{"signed_out", true}});
+        a.headers.emplace_back("Set-Cookie", SessionCookie("", options_.tls, true));
+        return a;
+    }
+    absl::StatusOr<Caller> caller = CallerOf(request);
+    if (!caller.ok()) return ErrorAnswer(caller.status());
+    if (route == "session" && !post) return JsonAnswer(200, CallerJson(*caller, auth_.enabled()));
+    if (absl::StartsWith(route, "jobs")) return JobApi(request, *caller, route);
+    if (post) return NotFoundAnswer();
+    if (route == "workers") {
+        if (absl::Status s = Permit(*caller, Action::kListWorkers); !s.ok()) return ErrorAnswer(s);
+        Json workers = Json::array();
+        for (WorkerStatus& w : farm_.scheduler().Workers()) {
+            // A submitter sees that a worker is busy, not with whose job.
+            if (w.busy() && !VisibleJob(*caller, w.job_id).ok()) w.job_id = "(other)";
+            workers.push_back({{"id", w.id},
+                               {"name", w.name},
+                               {"version", w.version},
+                               {"address", w.address},
+                               {"state", w.busy() ? "busy" : "idle"},
+                               {"job_id", w.job_id},
+                               {"task", w.task},
+                               {"since_seen_ms", absl::ToInt64Milliseconds(w.since_seen)}});
+        }
+        return JsonAnswer(200, {{"workers", workers}});
+    }
+    if (route == "farm") {
+        const SchedulerLoad load = farm_.scheduler().Load();
+        const SchedulerMetrics& metrics = farm_.scheduler().metrics();
+        const absl::Time now = absl::Now();
+        return JsonAnswer(200, {{"queue_depth", load.tasks_queued},
+                                {"tasks_running", load.tasks_running},
+                                {"jobs_queued", load.jobs_queued},
+                                {"jobs_running", load.jobs_running},
+                                {"workers_live", load.workers_live},
+                                {"workers_busy", load.workers_busy},
+                                {"tasks_per_minute", metrics.tasks_done.LastHour(now)},
+                                {"samples_per_minute", metrics.samples_done.LastHour(now)},
+                                {"now_ms", absl::ToUnixMillis(now)}});
+    }
+    return NotFoundAnswer();
+}
+
+HttpAnswer Dashboard::SignIn(const HttpRequest& request) {
+    const Json body = Json::parse(request.body, nullptr, false);
+    if (!body.is_object() || !body.contains("token") || !body["token"].is_string()) {
+        return ErrorAnswer(absl::InvalidArgumentError("expected {\"token\": \"lf1_...\"}"));
+    }
+    const std::string token = body["token"].get<std::string>();
+    absl::StatusOr<Caller> caller = auth_.Authenticate("Bearer " + token);
+    if (caller.ok()) {
+        if (absl::Status s = Permit(*caller, Action::kReadJobs); !s.ok()) caller = s;
+    }
+    if (!caller.ok()) {
+        Log()->warn("sign-in refused: {}", LogSafe(std::string(caller.status().message())));
+        return ErrorAnswer(caller.status());
+    }
+    Log()->info("signed in: token {}", caller->name);
+    HttpAnswer a = JsonAnswer(200, CallerJson(*caller, auth_.enabled()));
+    // Only a token the store knows comes back in the header: nothing else of the body does.
+    a.headers.emplace_back("Set-Cookie", SessionCookie(token, options_.tls, false));
+    return a;
+}
+
+absl::StatusOr<JobRecord> Dashboard::VisibleJob(const Caller& caller, const std::string& job_id) {
+    const absl::Status none = absl::NotFoundError(absl::StrCat("no job ", job_id));
+    if (!PlausibleJobId(job_id)) return absl::NotFoundError("no such job");
+    absl::StatusOr<JobRecord> job = farm_.scheduler().Get(job_id);
+    if (absl::IsNotFound(job.status()) || (job.ok() && !MaySee(caller, job->spec.owner))) {
+        return none;
+    }
+    return job;
+}
+
+HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
+                             const std::string& route) {
+    const bool post = request.method == "POST";
+    const absl::Time now = absl::Now();
+    if (route == "jobs") {
+        if (post) return NotFoundAnswer();
+        absl::StatusOr<int64_t> limit = IntParam(request, "limit", kDefaultJobs, 1, kMaxJobs);
+        absl::StatusOr<int64_t> before =
+            IntParam(request, "before", 0, 0, std::numeric_limits<int64_t>::max());
+        if (!limit.ok()) return ErrorAnswer(limit.status());
+        if (!before.ok()) return ErrorAnswer(before.status());
+        JobQuery query{.before_seq = uint64_t(*before), .limit = size_t(*limit)};
+        if (caller.role != Role::kAdmin) query.owner = caller.name;
+        absl::StatusOr<std::vector<JobRecord>> jobs = farm_.scheduler().List(query);
+        if (!jobs.ok()) return ErrorAnswer(jobs.status());
+        Json list = Json::array();
+        for (const JobRecord& job : *jobs) list.push_back(JobJson(job, now));
+        return JsonAnswer(200, {{"jobs", list}, {"now_ms", absl::ToUnixMillis(now)}});
+    }
+    // jobs/ID[/what]
+    const std::vector<std::string> parts = absl::StrSplit(route, '/');
+    if (parts.size() < 2 || parts.size() > 3) return NotFoundAnswer();
+    const std::string& id = parts[1];
+    const std::string what = parts.size() == 3 ? parts[2] : "";
+    absl::StatusOr<JobRecord> job = VisibleJob(caller, id);
+    if (!job.ok()) return ErrorAnswer(job.status());
+
+    if (post) {
+        if (what == "cancel") {
+            if (absl::Status s = Permit(caller, Action::kCancelJob); !s.ok()) return ErrorAnswer(s);
+            absl::StatusOr<JobRecord> cancelled = farm_.scheduler().Cancel(id);
+            if (!cancelled.ok()) return ErrorAnswer(cancelled.status());
+            Log()->info("job={} cancelled by {} from the dashboard", id, caller.name);
+            return JsonAnswer(200, JobJson(*cancelled, now));
+        }
+        if (what == "priority") {
+            if (absl::Status s = Permit(caller, Action::kSetPriority); !s.ok()) {
+                return ErrorAnswer(s);
+            }
+            const Json body = Json::parse(request.body, nullptr, false);
+            if (!body.is_object() || !body.contains("priority") ||
+                !body["priority"].is_number_integer() ||
+                body["priority"].get<int64_t>() < std::numeric_limits<int32_t>::min() ||
+                body["priority"].get<int64_t>() > std::numeric_limits<int32_t>::max()) {
+                return ErrorAnswer(
+                    absl::InvalidArgumentError("expected {\"priority\": N}, N a 32-bit integer"));
+            }
+            absl::StatusOr<JobRecord> changed =
+                farm_.SetPriority(id, int(body["priority"].get<int64_t>()));
+            if (!changed.ok()) return ErrorAnswer(changed.status());
+            Log()->info("job={} priority set to {} by {} from the dashboard", id,
+                        changed->spec.priority, caller.name);
+            return JsonAnswer(200, JobJson(*changed, now));
+        }
+        return NotFoundAnswer();
+    }
+    if (what.empty()) return JsonAnswer(200, JobJson(*job, now));
+    if (what == "tasks") {
+        absl::StatusOr<std::vector<TaskStatus>> tasks = farm_.Tasks(id);
+        if (!tasks.ok()) return ErrorAnswer(tasks.status());
+        Json list = Json::array();
+        for (const TaskStatus& t : *tasks) list.push_back(TaskJson(t));
+        return JsonAnswer(200, {{"tasks", list}});
+    }
+    if (what == "logs") {
+        absl::StatusOr<int64_t> task = IntParam(request, "task", -1, 0, 1 << 30);
+        absl::StatusOr<int64_t> after =
+            IntParam(request, "after", 0, 0, std::numeric_limits<int64_t>::max());
+        absl::StatusOr<int64_t> max = IntParam(request, "max", kDefaultLogLines, 1, kMaxLogLines);
+        for (const auto* p : {&task, &after, &max}) {
+            if (!p->ok()) return ErrorAnswer(p->status());
+        }
+        absl::StatusOr<TaskLogPage> page = farm_.TaskLogs(
+            id, *task < 0 ? std::nullopt : std::optional<int>(int(*task)), *after, int(*max));
+        if (!page.ok()) return ErrorAnswer(page.status());
+        Json lines = Json::array();
+        for (const TaskLogLine& l : page->lines) {
+            lines.push_back({{"seq", l.seq},
+                             {"task", l.task},
+                             {"attempt", l.attempt},
+                             {"worker", l.worker},
+                             {"time_ms", absl::ToUnixMillis(l.time)},
+                             {"level", l.level},
+                             {"text", l.text}});
+        }
+        return JsonAnswer(
+            200, {{"lines", lines}, {"next_seq", page->next_seq}, {"ended", page->job_ended}});
+    }
+    if (what == "preview.png" || what == "metadata") {
+        absl::StatusOr<std::shared_ptr<const Preview>> preview = PreviewOf(*job);
+        if (!preview.ok()) return ErrorAnswer(preview.status());
+        const std::string etag =
+            absl::StrCat("\"", (*preview)->tasks_done, "-", int((*preview)->state), "\"");
+        std::vector<std::pair<std::string, std::string>> headers = {
+            {"Cache-Control", "private, no-cache"}, {"ETag", etag}};
+        if (what == "metadata") {
+            Json attributes = Json::object();
+            for (const auto& [name, value] : (*preview)->attributes) {
+                attributes[name] = AttributeJson(value);
+            }
+            return JsonAnswer(200, {{"attributes", attributes}});
+        }
+        if (NotModified(request, etag)) return {304, "", "", std::move(headers)};
+        return {200, "image/png", (*preview)->png, std::move(headers)};
+    }
+    return NotFoundAnswer();
+}
+
+absl::StatusOr<std::shared_ptr<const Dashboard::Preview>> Dashboard::PreviewOf(
+    const JobRecord& job) {
+    {
+        std::lock_guard<std::mutex> lock(previews_mutex_);
+        auto it = previews_.find(job.id);
+        // A job that failed or was cancelled keeps the last preview shown of it.
+        if (it != previews_.end() &&
+            ((it->second->tasks_done == job.tasks_done && it->second->state == job.state) ||
+             (!IsFinal(job.state) && absl::Now() - it->second->made < options_.preview_min_age) ||
+             (IsFinal(job.state) && job.state != JobState::kSucceeded))) {
+            it->second->used = ++preview_clock_;
+            return it->second;
+        }
+    }
+    absl::StatusOr<std::string> path = farm_.ResultFile(job.id, true);
+    if (!path.ok()) return path.status();
+    absl::StatusOr<ExrFile> exr = ReadExr(*path);
+    if (!exr.ok()) {
+        Log()->error("job={}: preview: {}", job.id, std::string(exr.status().message()));
+        return absl::UnavailableError("the preview cannot be read on the server");
+    }
+    // Filmic: highlights roll off instead of clipping, as a look at a render in progress wants.
+    absl::StatusOr<std::string> png = EncodePng(exr->image, {.tone = ToneCurve::kFilmic});
+    if (!png.ok()) return png.status();
+    auto preview = std::make_shared<Preview>(Preview{job.tasks_done, job.state, std::move(*png),
+                                                     std::move(exr->attributes), absl::Now(), 0});
+    std::lock_guard<std::mutex> lock(previews_mutex_);
+    preview->used = ++preview_clock_;
+    previews_[job.id] = preview;
+    if (previews_.size() > kMaxPreviews) {
+        auto oldest = std::min_element(previews_.begin(), previews_.end(), [](auto& a, auto& b) {
+            return a.second->used < b.second->used;
+        });
+        previews_.erase(oldest);
+    }
+    return preview;
+}
+
+}  // namespace lf

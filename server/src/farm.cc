@@ -1,0 +1,467 @@
+#include "lf/server/farm.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <set>
+
+#include "absl/strings/str_cat.h"
+#include "lf/core/image_io.h"
+#include "lf/core/log.h"
+#include "lf/core/radiosity_codec.h"
+#include "lf/core/splat_codec.h"
+#include "lf/core/tile_codec.h"
+#include "lf/job/method_registry.h"
+#include "lf/job/render_metadata.h"
+
+namespace lf {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("farm"); }
+
+// A name no other writer in this process uses at the same time.
+std::string UniqueSuffix() {
+    static std::atomic<uint64_t> counter{0};
+    return absl::StrCat(::getpid(), "-", ++counter);
+}
+
+// The scheduler's options with each job's tiles in a file under the data folder's scratch/.
+SchedulerOptions WithTileFiles(SchedulerOptions options, const std::string& data_dir) {
+    options.tile_stores = [dir = data_dir + "/scratch"](std::vector<PixelRect> tiles,
+                                                        uint32_t aovs) {
+        return MakeFileTileStore(dir, std::move(tiles), aovs);
+    };
+    return options;
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
+    std::error_code ec;
+    for (const char* sub : {"results", "previews", "scratch"}) {
+        fs::create_directories(fs::path(options.data_dir) / sub, ec);
+        if (ec) return absl::InternalError(options.data_dir + "/" + sub + ": " + ec.message());
+    }
+    absl::StatusOr<std::unique_ptr<DataDirLock>> lock = DataDirLock::Acquire(options.data_dir);
+    if (!lock.ok()) return lock.status();
+    absl::StatusOr<std::unique_ptr<BlobStore>> blobs = BlobStore::Open(options.data_dir + "/blobs");
+    if (!blobs.ok()) return blobs.status();
+    absl::StatusOr<std::unique_ptr<SqliteJobStore>> store =
+        SqliteJobStore::Open(options.data_dir + "/jobs.db");
+    if (!store.ok()) return store.status();
+    absl::StatusOr<std::unique_ptr<TaskLogStore>> logs =
+        TaskLogStore::Open(options.data_dir + "/logs.db", options.task_logs);
+    if (!logs.ok()) return logs.status();
+    std::unique_ptr<Farm> farm(
+        new Farm(options, std::move(*blobs), std::move(*store), std::move(*logs)));
+    farm->lock_ = std::move(*lock);
+    farm->SweepTemporaryFiles();
+    absl::StatusOr<std::vector<std::string>> rendered = farm->scheduler_.Recover();
+    if (!rendered.ok()) return rendered.status();
+    for (const std::string& job_id : *rendered) farm->FinishJob(job_id);
+    if (absl::StatusOr<int> expired = farm->DeleteExpired(absl::Now()); !expired.ok()) {
+        return expired.status();
+    }
+    return farm;
+}
+
+Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
+           std::unique_ptr<SqliteJobStore> store, std::unique_ptr<TaskLogStore> logs)
+    : options_(options),
+      blobs_(std::move(blobs)),
+      store_(std::move(store)),
+      logs_(std::move(logs)),
+      scheduler_(WithTileFiles(options.scheduler, options.data_dir), *store_) {
+    scheduler_.OnTasksEnded([this](const std::string& job_id, std::vector<TaskStatus> tasks) {
+        // The job has ended either way: `lightfarm tasks` then lists none of its tasks.
+        if (absl::Status s = logs_->RecordTasks(job_id, tasks); !s.ok()) {
+            Log()->error("job={} tasks not recorded: {}", job_id, std::string(s.message()));
+        }
+    });
+}
+
+absl::Status Farm::CheckSceneSize(uint64_t bytes) const {
+    if (bytes <= options_.limits.max_scene_bytes) return absl::OkStatus();
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the scene and its files are ", bytes, " bytes, above this server's limit of ",
+                     options_.limits.max_scene_bytes, " (lightfarm-server --max-scene-mb)"));
+}
+
+absl::StatusOr<std::unique_ptr<BlobStore::Upload>> Farm::StartUpload(const std::string& hash,
+                                                                     uint64_t size,
+                                                                     uint64_t offset) {
+    if (absl::Status s = CheckSceneSize(size); !s.ok()) return s;
+    return blobs_->StartUpload(hash, size, offset);
+}
+
+absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
+    // The CLI's limits (lf/job/job_spec.h): a bad job is refused here rather than failing, or
+    // running without end, on every worker.
+    if (absl::Status s = CheckJobSettings(spec); !s.ok()) return s;
+    if (spec.name.size() > kMaxJobNameBytes) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "job name of ", spec.name.size(), " bytes is above the limit of ", kMaxJobNameBytes));
+    }
+    if (spec.request_id.size() > kMaxRequestIdBytes) {
+        return absl::InvalidArgumentError(absl::StrCat("request id of ", spec.request_id.size(),
+                                                       " bytes is above the limit of ",
+                                                       kMaxRequestIdBytes));
+    }
+    std::vector<const BlobRef*> refs = {&spec.scene};
+    for (const BlobRef& f : spec.files) refs.push_back(&f);
+    uint64_t scene_bytes = 0;
+    for (const BlobRef* ref : refs) scene_bytes += ref->size;
+    if (absl::Status s = CheckSceneSize(scene_bytes); !s.ok()) return s;
+    if (spec.plan.spp > options_.limits.max_spp) {
+        return absl::ResourceExhaustedError(
+            absl::StrCat(spec.plan.spp, " samples per pixel is above this server's limit of ",
+                         options_.limits.max_spp, " (lightfarm-server --max-spp)"));
+    }
+    std::shared_lock<std::shared_mutex> blobs_in_use(blob_users_);
+    for (const BlobRef* ref : refs) {
+        if (absl::Status s = CheckScenePath(ref->path); !s.ok()) return s;
+        if (!blobs_->Has(ref->hash)) {
+            return absl::FailedPreconditionError(
+                absl::StrCat(ref->path, ": blob ", ref->hash, " was not uploaded"));
+        }
+        // The size limit above was checked on the declared sizes.
+        if (absl::StatusOr<uint64_t> size = blobs_->SizeOf(ref->hash); !size.ok()) {
+            return size.status();
+        } else if (*size != ref->size) {
+            return absl::InvalidArgumentError(absl::StrCat(ref->path, ": declared as ", ref->size,
+                                                           " bytes, its blob holds ", *size));
+        }
+    }
+    if (IsAdaptive(spec.adaptive) && spec.adaptive.max_spp > options_.limits.max_spp) {
+        return absl::ResourceExhaustedError(absl::StrCat(
+            "adaptive sampling up to ", spec.adaptive.max_spp,
+            " samples per pixel is above this server's limit of ", options_.limits.max_spp,
+            " (lightfarm-server --max-spp); lower --max-spp"));
+    }
+    absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
+        spec.scene, spec.files, [&](const std::string& hash) { return blobs_->PathOf(hash); },
+        nullptr, spec.scene_options);
+    // The service logs the refusal with its caller.
+    if (!scene.ok()) return absl::InvalidArgumentError(scene.status().message());
+    // Refused here, once, rather than failing on every worker.
+    if (absl::Status s = CheckMethodTakesScene(MethodOf(spec), *scene); !s.ok()) return s;
+    const int side = options_.limits.max_resolution;
+    if (scene->camera.width > side || scene->camera.height > side) {
+        return absl::ResourceExhaustedError(absl::StrCat("resolution ", scene->camera.width, "x",
+                                                         scene->camera.height,
+                                                         " is above this server's limit of ", side,
+                                                         " pixels per side "
+                                                         "(lightfarm-server --max-resolution)"));
+    }
+    spec.plan.width = scene->camera.width;
+    spec.plan.height = scene->camera.height;
+    spec.scene_hash = scene->content_hash;
+    // The filter the scene resolves to (its camera's, or --filter's), kept with the job for the
+    // EXR header, which is written without loading the scene again.
+    spec.scene_options.filter = scene->camera.filter;
+    return scheduler_.Submit(spec);
+}
+
+absl::Status Farm::RefuseUndecodable(const std::string& lease_id, const std::string& worker,
+                                     const absl::Status& why) {
+    const std::string reason = absl::StrCat("undecodable result: ", why.message());
+    // Named as the scheduler's own refusals name them, before the failure may end the job.
+    const std::optional<Scheduler::LeaseHolder> holder = scheduler_.HolderOf(lease_id, worker);
+    const std::string task =
+        holder ? absl::StrCat("job=", holder->job_id, " task=", holder->task, " ") : "";
+    scheduler_.Fail(lease_id, worker, reason, FailureKind::kTaskError).IgnoreError();
+    return absl::InvalidArgumentError(
+        absl::StrCat(task, "lease ", lease_id, " from ", worker, ": ", reason));
+}
+
+absl::Status Farm::Complete(const std::string& lease_id, const std::string& worker,
+                            std::string_view tile_sums, std::optional<RadiosityFigures> radiosity,
+                            std::optional<std::string_view> splats) {
+    absl::StatusOr<TileSums> sums = DecodeTileSums(tile_sums);
+    if (!sums.ok()) return RefuseUndecodable(lease_id, worker, sums.status());
+    // Checked whole before anything is allocated (lf::DecodeSplatList); its frame and the
+    // camera part are the scheduler's to check against the task.
+    std::optional<SplatList> list;
+    if (splats) {
+        absl::StatusOr<SplatList> decoded = DecodeSplatList(*splats);
+        if (!decoded.ok()) return RefuseUndecodable(lease_id, worker, decoded.status());
+        list = std::move(*decoded);
+    }
+    absl::StatusOr<Scheduler::Completion> done =
+        scheduler_.Complete(lease_id, worker, *sums, list ? &*list : nullptr);
+    if (!done.ok()) return done.status();
+    if (radiosity) {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        radiosity_[done->job_id] = *radiosity;
+    }
+    if (done->job_rendered) FinishJob(done->job_id);
+    return absl::OkStatus();
+}
+
+absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
+                                 std::string_view sweep_result) {
+    absl::StatusOr<SweepChunkResult> result = DecodeSweepResult(sweep_result);
+    if (!result.ok()) return RefuseUndecodable(lease_id, worker, result.status());
+    absl::StatusOr<Scheduler::Completion> done =
+        scheduler_.CompleteSweep(lease_id, worker, *result);
+    if (!done.ok()) return done.status();
+    if (done->sweep && done->sweep->converged) {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        sweep_solves_[done->job_id] = {done->sweep->iterations, done->sweep->residual};
+    }
+    if (done->sweep) {
+        scheduler_.Publish(done->job_id, done->sweep->converged,
+                           blobs_->Put(EncodeRadiosity(done->sweep->radiosity)));
+    }
+    return absl::OkStatus();
+}
+
+absl::Status Farm::WriteSnapshot(const std::string& job_id, bool complete,
+                                 const std::string& path) {
+    std::lock_guard<std::mutex> lock(image_mutex_);
+    absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.Snapshot(job_id);
+    if (!snapshot.ok()) return snapshot.status();
+    return WriteImage(*snapshot, complete, path);
+}
+
+void Farm::FinishJob(const std::string& job_id) {
+    const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
+    const absl::Status written = WriteSnapshot(job_id, true, path);
+    {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        radiosity_.erase(job_id);
+        sweep_solves_.erase(job_id);
+    }
+    if (absl::IsFailedPrecondition(written)) return;  // cancelled meanwhile
+    scheduler_.Finish(job_id, written.ok() ? absl::StatusOr<std::string>(path)
+                                           : absl::StatusOr<std::string>(written));
+}
+
+void Farm::CheckTimers() {
+    scheduler_.ExpireLeases();
+    for (const std::string& job_id : scheduler_.EnforceTimeLimits()) FinishJob(job_id);
+}
+
+absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete,
+                              const std::string& path) {
+    const JobRecord& job = snapshot.record;
+    RenderOutcome outcome;
+    outcome.seconds = job.started == absl::InfinitePast()
+                          ? 0.0
+                          : absl::ToDoubleSeconds(absl::Now() - job.started);
+    outcome.stats = job.stats;
+    outcome.adaptive = snapshot.adaptive;
+    {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        if (auto it = radiosity_.find(job.id); it != radiosity_.end()) {
+            outcome.radiosity = it->second;
+            // The display tiles' workers read the farm's solution: the solve's figures are ours.
+            if (auto solve = sweep_solves_.find(job.id); solve != sweep_solves_.end()) {
+                outcome.radiosity->iterations = solve->second.iterations;
+                outcome.radiosity->residual = solve->second.residual;
+            }
+        }
+    }
+    absl::StatusOr<RenderDescription> description =
+        DescribeRender(MetadataOf(job.spec, outcome), snapshot.image, complete);
+    if (!description.ok()) return description.status();
+    const ExrAttributes& attributes = description->attributes;
+    // Renamed into place so a reader never sees half a file, and durable before the job is
+    // recorded as succeeded.
+    const std::string temp = path + ".tmp-" + UniqueSuffix();
+    if (absl::Status s = WriteExr(temp, snapshot.image, attributes); !s.ok()) return s;
+    return RenameDurably(temp, path);
+}
+
+absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool preview) {
+    absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+    if (!job.ok()) return job.status();
+    if (IsFinal(job->state)) {
+        std::lock_guard<std::mutex> lock(image_mutex_);
+        previewed_.erase(job_id);
+    }
+    if (job->state == JobState::kSucceeded) return job->result_path;
+    if (!preview || IsFinal(job->state)) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "job ", job_id, " is ", JobStateName(job->state), " (", job->tasks_done, "/",
+            job->tasks_total, " tasks done): no result",
+            IsFinal(job->state) ? "" : " yet; --preview fetches what is merged so far"));
+    }
+    const std::string path = options_.data_dir + "/previews/" + job_id + ".exr";
+    {
+        std::lock_guard<std::mutex> lock(image_mutex_);
+        auto it = previewed_.find(job_id);
+        if (it != previewed_.end() && it->second == job->tasks_done) return path;
+    }
+    if (absl::Status s = WriteSnapshot(job_id, false, path); !s.ok()) {
+        // The job ended since it was read: its last task merged meanwhile. Its result, once
+        // written, is the preview asked for.
+        absl::StatusOr<JobRecord> now = scheduler_.Get(job_id);
+        if (absl::IsFailedPrecondition(s) && now.ok() && IsFinal(now->state)) {
+            return ResultFile(job_id, preview);
+        }
+        return s;
+    }
+    std::lock_guard<std::mutex> lock(image_mutex_);
+    previewed_[job_id] = job->tasks_done;
+    return path;
+}
+
+}  // namespace lf
+
+namespace lf {
+
+void Farm::RemoveJobFiles(const std::string& job_id) {
+    for (const char* sub : {"results", "previews"}) {
+        std::error_code ignored;  // a job without such a file
+        fs::remove(fs::path(options_.data_dir) / sub / (job_id + ".exr"), ignored);
+    }
+}
+
+absl::Status Farm::DeleteJob(const std::string& job_id) {
+    absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+    if (!job.ok()) return job.status();
+    if (!IsFinal(job->state)) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "job ", job_id, " is ", JobStateName(job->state), ": cancel it before deleting it"));
+    }
+    if (absl::Status s = store_->Delete(job_id); !s.ok()) return s;
+    RemoveJobFiles(job_id);
+    RemoveJobLogs({job_id});
+    // The job is gone either way: a blob left now goes at the next hourly sweep.
+    if (absl::StatusOr<BlobStore::Removed> removed = RemoveUnusedBlobs(absl::Now());
+        !removed.ok()) {
+        Log()->error("job={} deleted; its blobs stay: {}", job_id,
+                     std::string(removed.status().message()));
+    }
+    return absl::OkStatus();
+}
+
+absl::StatusOr<BlobStore::Removed> Farm::RemoveUnusedBlobs(absl::Time now) {
+    std::unique_lock<std::shared_mutex> no_submission(blob_users_);
+    std::set<std::string> used = scheduler_.BlobsInUse();
+    absl::StatusOr<std::vector<JobRecord>> stored = store_->List();
+    if (!stored.ok()) return stored.status();
+    for (const JobRecord& job : *stored) {
+        used.insert(job.spec.scene.hash);
+        for (const BlobRef& file : job.spec.files) used.insert(file.hash);
+    }
+    const BlobStore::Removed removed =
+        blobs_->RemoveUnused(used, now - kUnusedBlobGrace, now - kPartialUploadLifetime);
+    if (removed.blobs > 0 || removed.partials > 0) {
+        Log()->info("removed {} blobs no job uses ({} bytes) and {} stale partial uploads",
+                    removed.blobs, removed.blob_bytes, removed.partials);
+    }
+    return removed;
+}
+
+absl::StatusOr<int> Farm::DeleteExpired(absl::Time now) {
+    // In pages, so that a long-idle server does not load every expired job at once.
+    constexpr size_t kPage = 1000;
+    int deleted = 0;
+    while (options_.retention > absl::ZeroDuration()) {
+        absl::StatusOr<std::vector<JobRecord>> expired =
+            store_->List({.limit = kPage, .ended_before = now - options_.retention});
+        if (!expired.ok()) return expired.status();
+        if (expired->empty()) break;
+        uint64_t ticket = 0;
+        for (const JobRecord& job : *expired) ticket = store_->QueueDelete(job.id);
+        if (absl::Status s = store_->WaitDurable(ticket); !s.ok()) return s;
+        std::vector<std::string> ids;
+        for (const JobRecord& job : *expired) {
+            RemoveJobFiles(job.id);
+            ids.push_back(job.id);
+        }
+        RemoveJobLogs(ids);
+        deleted += int(expired->size());
+    }
+    if (deleted > 0) {
+        Log()->info("deleted {} jobs that ended more than {} ago", deleted,
+                    absl::FormatDuration(options_.retention));
+    }
+    if (absl::StatusOr<BlobStore::Removed> removed = RemoveUnusedBlobs(now); !removed.ok()) {
+        return removed.status();
+    }
+    return deleted;
+}
+
+void Farm::RemoveJobLogs(const std::vector<std::string>& job_ids) {
+    // The jobs are gone either way; lines left behind are found by no one.
+    if (absl::Status s = logs_->Delete(job_ids); !s.ok()) {
+        Log()->error("the task logs of {} deleted jobs stay in logs.db: {}", job_ids.size(),
+                     std::string(s.message()));
+    }
+}
+
+absl::StatusOr<std::vector<TaskStatus>> Farm::Tasks(const std::string& job_id) {
+    std::optional<std::vector<TaskStatus>> tasks = scheduler_.Tasks(job_id);
+    if (!tasks) {
+        absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+        if (!job.ok()) return job.status();
+        // Ended: as recorded when it ended (a job ended just now may not be yet).
+        absl::StatusOr<std::vector<TaskStatus>> recorded = logs_->Tasks(job_id);
+        if (!recorded.ok()) return recorded.status();
+        tasks = std::move(*recorded);
+    }
+    absl::StatusOr<std::map<int, int>> counts = logs_->LineCounts(job_id);
+    if (!counts.ok()) return counts.status();
+    for (TaskStatus& task : *tasks) {
+        if (auto it = counts->find(task.index); it != counts->end()) task.log_lines = it->second;
+    }
+    return *tasks;
+}
+
+absl::StatusOr<TaskLogPage> Farm::TaskLogs(const std::string& job_id, std::optional<int> task,
+                                           int64_t after_seq, int max_lines) {
+    // Whether the job has ended is read before its lines: the last lines of its tasks are kept
+    // before their results are taken (TakeTaskLog), so none follow an ended job's page.
+    absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+    if (!job.ok()) return job.status();
+    const int page_size = max_lines <= 0 ? kMaxTaskLogPage : std::min(max_lines, kMaxTaskLogPage);
+    absl::StatusOr<TaskLogPage> page = logs_->Read(job_id, task, after_seq, page_size);
+    if (!page.ok()) return page.status();
+    page->job_ended = IsFinal(job->state) && int(page->lines.size()) < page_size;
+    return page;
+}
+
+absl::Status Farm::TakeTaskLog(const std::string& lease_id, const std::string& worker,
+                               std::vector<TaskLogLine> lines) {
+    if (lines.empty()) return absl::OkStatus();
+    const std::optional<Scheduler::LeaseHolder> holder = scheduler_.HolderOf(lease_id, worker);
+    if (!holder) return absl::OkStatus();
+    return logs_->Append(holder->job_id, holder->task, holder->attempt, holder->worker,
+                         std::move(lines));
+}
+
+void Farm::SweepTemporaryFiles() {
+    // Nothing in scratch/ or previews/ outlives the request that wrote it, and a result's
+    // temporary file is renamed or removed before its job is recorded.
+    int removed = blobs_->SweepUnfinishedUploads();
+    for (const char* sub : {"scratch", "previews", "results"}) {
+        std::error_code ec;
+        for (const fs::directory_entry& entry :
+             fs::directory_iterator(fs::path(options_.data_dir) / sub, ec)) {
+            if (sub == std::string_view("results") &&
+                entry.path().filename().string().find(".tmp-") == std::string::npos) {
+                continue;
+            }
+            std::error_code ignored;
+            removed += fs::remove_all(entry.path(), ignored) > 0;
+        }
+    }
+    if (removed > 0) Log()->info("removed {} temporary files left by an earlier run", removed);
+}
+
+}  // namespace lf
+
+namespace lf {
+
+absl::StatusOr<JobRecord> Farm::SetPriority(const std::string& job_id, int priority) {
+    return scheduler_.SetPriority(job_id, priority);
+}
+
+}  // namespace lf

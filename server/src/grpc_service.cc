@@ -1,0 +1,488 @@
+#include "lf/server/grpc_service.h"
+
+#include <algorithm>
+#include <fstream>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "lf/core/log.h"
+#include "lf/version.h"
+#include "lf/wire/conversions.h"
+#include "lf/proto/grpc_status.h"
+
+namespace lf {
+
+namespace pb = lightfarm::v1;
+
+namespace {
+
+constexpr size_t kChunkBytes = 1 << 20;
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("rpc"); }
+
+// Who called, for the log: the peer's address as gRPC reports it.
+std::string Peer(const grpc::ServerContext* context) { return LogSafe(context->peer()); }
+
+// The token's name, or "anonymous" with authentication off.
+std::string Who(const Caller& caller) {
+    return caller.name.empty() ? "anonymous" : absl::StrCat("token ", caller.name);
+}
+
+// Streams a file in chunks; stops early when the client goes away. The client hears `what` could
+// not be read, never where the file is: paths of the data folder stay in the server's log.
+grpc::Status StreamFile(grpc::ServerContext* context, const std::string& path,
+                        const std::string& what, grpc::ServerWriter<pb::Chunk>* writer) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        Log()->error("{}: {} cannot be read", what, path);
+        return grpc::Status(grpc::StatusCode::NOT_FOUND, what + " cannot be read on the server");
+    }
+    std::string buffer(kChunkBytes, '\0');
+    pb::Chunk chunk;
+    while (in) {
+        in.read(buffer.data(), std::streamsize(buffer.size()));
+        if (in.gcount() == 0) break;
+        chunk.set_data(buffer.data(), size_t(in.gcount()));
+        if (context->IsCancelled() || !writer->Write(chunk)) {
+            return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
+        }
+    }
+    return grpc::Status::OK;
+}
+
+// The bearer token of the call, as its `authorization` metadata carries it.
+std::optional<std::string_view> AuthorizationOf(const grpc::ServerContext* context) {
+    const auto& metadata = context->client_metadata();
+    auto it = metadata.find("authorization");
+    if (it == metadata.end()) return std::nullopt;
+    return std::string_view(it->second.data(), it->second.size());
+}
+
+// Keeps the task log lines that came with a worker's heartbeat or result: before the message is
+// acted on, since its job may end with it. A store that cannot write costs the lines, not the
+// result.
+template <typename Request>
+void TakeTaskLog(Farm& farm, const Request& req) {
+    if (req.log().empty()) return;
+    std::vector<TaskLogLine> lines;
+    lines.reserve(size_t(req.log_size()));
+    for (const pb::WorkerLogLine& line : req.log()) lines.push_back(FromProto(line));
+    if (absl::Status s = farm.TakeTaskLog(req.lease_id(), req.worker_id(), std::move(lines));
+        !s.ok()) {
+        Log()->error("lease={} worker={}: task log lines lost: {}", LogSafe(req.lease_id()),
+                     LogSafe(req.worker_id()), std::string(s.message()));
+    }
+}
+
+}  // namespace
+
+absl::StatusOr<Caller> CallGuard::Check(grpc::ServerContext* context, const char* rpc,
+                                        Action action) const {
+    absl::StatusOr<Caller> caller = auth.Authenticate(AuthorizationOf(context));
+    absl::Status s = caller.ok() ? Permit(*caller, action) : caller.status();
+    if (s.ok() && action == Action::kWork && worker_certificates &&
+        !context->auth_context()->IsPeerAuthenticated()) {
+        s = absl::UnauthenticatedError(
+            "workers must present a client certificate signed by the server's --tls-client-ca "
+            "(lightfarm-worker --tls-cert FILE --tls-key FILE)");
+    }
+    if (!s.ok()) {
+        Log()->warn("{} from {} refused: {}", rpc, Peer(context),
+                    LogSafe(std::string(s.message())));
+        return s;
+    }
+    return caller;
+}
+
+absl::StatusOr<JobRecord> JobServiceImpl::VisibleJob(const Caller& caller,
+                                                     const std::string& job_id) const {
+    absl::StatusOr<JobRecord> job = farm_.scheduler().Get(job_id);
+    if (job.ok() && !MaySee(caller, job->spec.owner))
+        return absl::NotFoundError("no job " + job_id);
+    return job;
+}
+
+grpc::Status JobServiceImpl::MissingBlobs(grpc::ServerContext* context,
+                                          const pb::MissingBlobsRequest* req,
+                                          pb::MissingBlobsResponse* resp) {
+    if (auto c = guard_.Check(context, "MissingBlobs", Action::kUploadBlobs); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    for (const std::string& hash : req->hashes()) {
+        // Touched: the client will not upload it, and may submit a job naming it.
+        if (!farm_.blobs().Touch(hash)) resp->add_hashes(hash);
+    }
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::BlobUploadOffset(grpc::ServerContext* context,
+                                              const pb::BlobUploadOffsetRequest* req,
+                                              pb::BlobUploadOffsetResponse* resp) {
+    if (auto c = guard_.Check(context, "BlobUploadOffset", Action::kUploadBlobs); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    absl::StatusOr<uint64_t> offset = farm_.blobs().UploadOffset(req->hash(), req->size());
+    if (!offset.ok()) return ToGrpcStatus(offset.status());
+    resp->set_offset(*offset);
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext* context,
+                                        grpc::ServerReader<pb::UploadBlobRequest>* reader,
+                                        pb::UploadBlobResponse*) {
+    if (auto c = guard_.Check(context, "UploadBlob", Action::kUploadBlobs); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    pb::UploadBlobRequest chunk;
+    if (!reader->Read(&chunk)) {
+        return ToGrpcStatus(absl::InvalidArgumentError("UploadBlob: empty stream"));
+    }
+    const std::string hash = LogSafe(chunk.hash());
+    absl::StatusOr<std::unique_ptr<BlobStore::Upload>> upload =
+        farm_.StartUpload(chunk.hash(), chunk.size(), chunk.offset());
+    // Another stream stored it meanwhile: what this one brings is not needed.
+    if (absl::IsAlreadyExists(upload.status())) return grpc::Status::OK;
+    if (!upload.ok()) {
+        Log()->warn("blob {}: upload from {} refused: {}", hash, Peer(context),
+                    LogSafe(std::string(upload.status().message())));
+        return ToGrpcStatus(upload.status());
+    }
+    BlobStore::Upload& up = **upload;
+    if (up.offset() > 0) {
+        Log()->info("blob {}: upload from {} resumes at byte {} of {}", hash, Peer(context),
+                    up.offset(), chunk.size());
+    }
+    absl::Status s;
+    do {
+        s = up.Append(chunk.data());
+    } while (s.ok() && reader->Read(&chunk));
+    if (s.ok()) s = up.Finish();
+    if (s.ok()) {
+        Log()->info("blob {}: stored, {} bytes, {} of them received from {} in this upload", hash,
+                    up.offset() + up.received(), up.received(), Peer(context));
+    } else {
+        Log()->warn("blob {}: upload from {} ended after {} bytes received (from byte {}): {}",
+                    hash, Peer(context), up.received(), up.offset(),
+                    LogSafe(std::string(s.message())));
+    }
+    return ToGrpcStatus(s);
+}
+
+grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
+                                       const pb::SubmitJobRequest* req,
+                                       pb::SubmitJobResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "SubmitJob", Action::kSubmit);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    // Proto3 keeps enum values this build does not know; JobSpec cannot hold them, so they are
+    // refused here rather than rendered as something the client did not ask for.
+    if (!pb::PixelFilterType_IsValid(req->params().filter_type())) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("params.filter_type ", req->params().filter_type(),
+                         ": unknown pixel filter; expected box, gaussian or blackman-harris")));
+    }
+    if (!pb::SamplerType_IsValid(req->params().sampler())) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("params.sampler ", req->params().sampler(),
+                         ": unknown sampler; expected independent or sobol")));
+    }
+    if (!pb::LightStrategy_IsValid(req->params().light_strategy())) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("params.light_strategy ", req->params().light_strategy(),
+                         ": unknown light sampling strategy; expected power or bvh")));
+    }
+    JobSpec spec = FromProto(*req);
+    spec.owner = caller->name;
+    absl::StatusOr<std::string> id = farm_.Submit(std::move(spec));
+    if (!id.ok()) {
+        Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()), Peer(context),
+                    LogSafe(std::string(id.status().message())));
+        return ToGrpcStatus(id.status());
+    }
+    Log()->info("job={} submitted by {} from {}: \"{}\"", *id, Who(*caller), Peer(context),
+                LogSafe(req->name()));
+    resp->set_job_id(*id);
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::GetJob(grpc::ServerContext* context, const pb::GetJobRequest* req,
+                                    pb::Job* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "GetJob", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id());
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    ToProto(*job, resp);
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext* context, const pb::ListJobsRequest* req,
+                                      pb::ListJobsResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "ListJobs", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (req->page_size() < 0) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("ListJobs: page_size ", req->page_size(), " is negative")));
+    }
+    const int page_size =
+        req->page_size() == 0 ? kDefaultPageSize : std::min(req->page_size(), kMaxPageSize);
+    // The token is the seq of the page's last job: the next page starts below it.
+    JobQuery query{.limit = size_t(page_size) + 1};
+    if (caller->role != Role::kAdmin) query.owner = caller->name;
+    if (!req->page_token().empty() &&
+        (!absl::SimpleAtoi(req->page_token(), &query.before_seq) || query.before_seq == 0)) {
+        return ToGrpcStatus(
+            absl::InvalidArgumentError("ListJobs: page_token is not one this server gave out"));
+    }
+    absl::StatusOr<std::vector<JobRecord>> jobs = farm_.scheduler().List(query);
+    if (!jobs.ok()) return ToGrpcStatus(jobs.status());
+    if (jobs->size() > size_t(page_size)) {
+        jobs->resize(size_t(page_size));
+        resp->set_next_page_token(absl::StrCat(jobs->back().seq));
+    }
+    for (const JobRecord& job : *jobs) ToProto(job, resp->add_jobs());
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::WatchJobRequest* req,
+                                      grpc::ServerWriter<pb::Job>* writer) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "WatchJob", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    // Checked once: a job's owner never changes.
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
+    // Each stream holds a server thread until its job ends: bounded, so that watchers cannot
+    // take every thread (or the memory of thousands).
+    struct Slot {
+        std::atomic<int>& count;
+        ~Slot() { --count; }
+    } slot{watchers_};
+    if (++watchers_ > options_.max_watchers) {
+        Log()->warn("watch of job={} from {} refused: {} watchers already", LogSafe(req->job_id()),
+                    Peer(context), options_.max_watchers);
+        return ToGrpcStatus(absl::ResourceExhaustedError(absl::StrCat(
+            "this server already serves its most watchers, ", options_.max_watchers,
+            " (lightfarm-server --max-watchers): try again later, or poll with `lightfarm "
+            "status`")));
+    }
+    // At most five messages a second, and one at least every few seconds so a dead client is
+    // noticed.
+    constexpr absl::Duration kMinGap = absl::Milliseconds(200), kMaxGap = absl::Seconds(5);
+    Scheduler& scheduler = farm_.scheduler();
+    std::string last_sent;
+    absl::Time last_time = absl::InfinitePast();
+    // Taken before each read, so a change during the read or the pause is never missed.
+    uint64_t version = scheduler.WaitForChange(0, absl::InfinitePast());
+    while (!context->IsCancelled()) {
+        absl::StatusOr<JobRecord> job = scheduler.Get(req->job_id());
+        if (!job.ok()) return ToGrpcStatus(job.status());
+        pb::Job message;
+        ToProto(*job, &message);
+        std::string bytes = message.SerializeAsString();
+        if (bytes != last_sent || absl::Now() - last_time > kMaxGap) {
+            if (!writer->Write(message)) break;
+            last_sent = std::move(bytes);
+            last_time = absl::Now();
+        }
+        if (IsFinal(job->state)) break;
+        absl::SleepFor(kMinGap);
+        version = scheduler.WaitForChange(version, absl::Now() + absl::Seconds(1));
+    }
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
+                                       const pb::CancelJobRequest* req, pb::Job* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "CancelJob", Action::kCancelJob);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(*caller, req->job_id()); !seen.ok()) {
+        return ToGrpcStatus(seen.status());
+    }
+    absl::StatusOr<JobRecord> job = farm_.scheduler().Cancel(req->job_id());
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    Log()->info("job={} cancelled by {} from {}", job->id, Who(*caller), Peer(context));
+    ToProto(*job, resp);
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::SetJobPriority(grpc::ServerContext* context,
+                                            const pb::SetJobPriorityRequest* req, pb::Job* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "SetJobPriority", Action::kSetPriority);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(*caller, req->job_id()); !seen.ok()) {
+        return ToGrpcStatus(seen.status());
+    }
+    absl::StatusOr<JobRecord> job = farm_.SetPriority(req->job_id(), req->priority());
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    Log()->info("job={} priority set to {} by {} from {}", job->id, req->priority(), Who(*caller),
+                Peer(context));
+    ToProto(*job, resp);
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context,
+                                         const pb::FetchResultRequest* req,
+                                         grpc::ServerWriter<pb::Chunk>* writer) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "FetchResult", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
+    absl::StatusOr<std::string> path = farm_.ResultFile(req->job_id(), req->preview());
+    if (!path.ok()) return ToGrpcStatus(path.status());
+    return StreamFile(context, *path, "the result of job " + req->job_id(), writer);
+}
+
+grpc::Status JobServiceImpl::DeleteJob(grpc::ServerContext* context,
+                                       const pb::DeleteJobRequest* req, pb::DeleteJobResponse*) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "DeleteJob", Action::kDeleteJob);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
+    if (absl::Status s = farm_.DeleteJob(req->job_id()); !s.ok()) return ToGrpcStatus(s);
+    Log()->info("job={} deleted by {} from {}", LogSafe(req->job_id()), Who(*caller),
+                Peer(context));
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context,
+                                         const pb::ListWorkersRequest*,
+                                         pb::ListWorkersResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "ListWorkers", Action::kListWorkers);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    for (WorkerStatus& worker : farm_.scheduler().Workers()) {
+        // A submitter sees that a worker is busy, not with whose job.
+        if (worker.busy() && !VisibleJob(*caller, worker.job_id).ok()) worker.job_id = "(other)";
+        ToProto(worker, resp->add_workers());
+    }
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::ListTasks(grpc::ServerContext* context,
+                                       const pb::ListTasksRequest* req,
+                                       pb::ListTasksResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "ListTasks", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
+    absl::StatusOr<std::vector<TaskStatus>> tasks = farm_.Tasks(req->job_id());
+    if (!tasks.ok()) return ToGrpcStatus(tasks.status());
+    for (const TaskStatus& task : *tasks) ToProto(task, resp->add_tasks());
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::GetTaskLogs(grpc::ServerContext* context,
+                                         const pb::GetTaskLogsRequest* req,
+                                         pb::GetTaskLogsResponse* resp) {
+    absl::StatusOr<Caller> caller = guard_.Check(context, "GetTaskLogs", Action::kReadJobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+        return ToGrpcStatus(job.status());
+    }
+    absl::StatusOr<TaskLogPage> page = farm_.TaskLogs(
+        req->job_id(), req->has_task_index() ? std::optional<int>(req->task_index()) : std::nullopt,
+        req->after_seq(), req->max_lines());
+    if (!page.ok()) return ToGrpcStatus(page.status());
+    for (const TaskLogLine& line : page->lines) ToProto(line, resp->add_lines());
+    resp->set_next_seq(page->next_seq);
+    resp->set_job_ended(page->job_ended);
+    return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context,
+                                          const pb::LeaseTaskRequest* req,
+                                          pb::LeaseTaskResponse* resp) {
+    if (auto c = guard_.Check(context, "LeaseTask", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    if (req->worker_id().empty()) {
+        return ToGrpcStatus(absl::InvalidArgumentError("LeaseTask: worker_id is empty"));
+    }
+    if (req->version() != kBuildVersion) {
+        return ToGrpcStatus(absl::FailedPreconditionError(absl::StrCat(
+            "worker version ", req->version().empty() ? "(none)" : req->version(),
+            ", server version ", kBuildVersion, ": run workers of the server's build")));
+    }
+    if (req->name().size() > kMaxWorkerNameBytes) {
+        return ToGrpcStatus(absl::InvalidArgumentError(
+            absl::StrCat("LeaseTask: worker name of ", req->name().size(),
+                         " bytes is above the limit of ", kMaxWorkerNameBytes)));
+    }
+    const WorkerDescription about{req->name(), context->peer(), req->version()};
+    const absl::Duration wait = absl::Milliseconds(std::clamp(req->wait_ms(), 0, 10000));
+    if (std::optional<TaskAssignment> lease =
+            farm_.scheduler().LeaseTask(req->worker_id(), absl::Now() + wait, &about)) {
+        ToProto(*lease, resp->mutable_task());
+    }
+    return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* context,
+                                          const pb::HeartbeatRequest* req,
+                                          pb::HeartbeatResponse* resp) {
+    if (auto c = guard_.Check(context, "Heartbeat", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    TakeTaskLog(farm_, *req);
+    resp->set_cancelled(!farm_.scheduler().Heartbeat(req->lease_id(), req->worker_id()));
+    return grpc::Status::OK;
+}
+
+grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context,
+                                             const pb::CompleteTaskRequest* req,
+                                             pb::CompleteTaskResponse*) {
+    if (auto c = guard_.Check(context, "CompleteTask", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    TakeTaskLog(farm_, *req);
+    const absl::Status s =
+        req->radiosity_sweep().empty()
+            ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums(),
+                             req->has_radiosity()
+                                 ? std::optional<RadiosityFigures>(FromProto(req->radiosity()))
+                                 : std::nullopt,
+                             // An encoded list is never empty: empty means a tile's result.
+                             req->splats().empty() ? std::nullopt
+                                                   : std::optional<std::string_view>(req->splats()))
+            : farm_.CompleteSweep(req->lease_id(), req->worker_id(), req->radiosity_sweep());
+    if (!s.ok()) {
+        Log()->warn("{}", RefusedResultLine(req->lease_id(), req->worker_id(), context->peer(),
+                                            std::string(s.message())));
+    }
+    return ToGrpcStatus(s);
+}
+
+std::string RefusedResultLine(std::string_view lease_id, std::string_view worker_id,
+                              std::string_view peer, std::string_view why) {
+    // Every part came from the wire: the ids and the peer, and the reason, which quotes them.
+    return absl::StrCat("lease=", LogSafe(lease_id), " worker=", LogSafe(worker_id), " from ",
+                        LogSafe(peer), ": CompleteTask refused: ", LogSafe(why, 1024));
+}
+
+grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext* context,
+                                         const pb::FailTaskRequest* req, pb::FailTaskResponse*) {
+    if (auto c = guard_.Check(context, "FailTask", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    TakeTaskLog(farm_, *req);
+    const FailureKind kind = req->kind() == pb::FailTaskRequest::WORKER_SHUTDOWN
+                                 ? FailureKind::kWorkerShutdown
+                                 : FailureKind::kTaskError;
+    return ToGrpcStatus(
+        farm_.scheduler().Fail(req->lease_id(), req->worker_id(), req->reason(), kind));
+}
+
+grpc::Status WorkerServiceImpl::FetchBlob(grpc::ServerContext* context,
+                                          const pb::FetchBlobRequest* req,
+                                          grpc::ServerWriter<pb::Chunk>* writer) {
+    if (auto c = guard_.Check(context, "FetchBlob", Action::kWork); !c.ok()) {
+        return ToGrpcStatus(c.status());
+    }
+    if (!farm_.blobs().Has(req->hash())) {
+        return ToGrpcStatus(absl::NotFoundError("no blob " + req->hash()));
+    }
+    return StreamFile(context, farm_.blobs().PathOf(req->hash()), "blob " + req->hash(), writer);
+}
+
+}  // namespace lf

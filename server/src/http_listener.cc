@@ -1,0 +1,184 @@
+#include "lf/server/http_listener.h"
+
+#include <httplib.h>
+#include <sys/socket.h>
+
+#include <cctype>
+#include <thread>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "lf/core/log.h"
+#include "lf/server/dashboard.h"
+#include "lf/server/metrics.h"
+
+namespace lf {
+
+namespace {
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("http"); }
+
+constexpr char kText[] = "text/plain; charset=utf-8";
+// The exposition format's content type, version 0.0.4.
+constexpr char kMetricsType[] = "text/plain; version=0.0.4; charset=utf-8";
+
+// Each connection holds one of these threads while it is open: enough for probes, scrapes and a
+// few browsers' connections, which keep-alive holds no longer than kKeepAliveSeconds when idle.
+constexpr int kThreads = 16;
+constexpr time_t kKeepAliveSeconds = 1;
+// The dashboard's requests are small: a token, a priority.
+constexpr size_t kMaxBodyBytes = 64 << 10;
+
+HttpRequest FromHttplib(const httplib::Request& r) {
+    HttpRequest request{r.method, r.path, {}, {}, r.body, r.remote_addr};
+    for (const auto& [name, value] : r.params) request.query.emplace(name, value);
+    for (const auto& [name, value] : r.headers) {
+        std::string lower = name;
+        for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+        request.headers.emplace(std::move(lower), value);
+    }
+    return request;
+}
+
+void Reply(HttpAnswer a, httplib::Response& response) {
+    response.status = a.status;
+    for (auto& [name, value] : a.headers) response.set_header(name, value);
+    if (a.status != 304) response.set_content(std::move(a.body), a.content_type.c_str());
+}
+
+HttpAnswer Unavailable(const absl::Status& why) {
+    return {503, kText, absl::StrCat("not ok: ", why.message(), "\n")};
+}
+
+}  // namespace
+
+HttpAnswer HealthzAnswer(Farm& farm) {
+    if (absl::Status s = farm.store().Health(); !s.ok()) return Unavailable(s);
+    return {200, kText, "ok\n"};
+}
+
+HttpAnswer MetricsAnswer(Farm& farm) {
+    const absl::StatusOr<std::map<JobState, int64_t>> ended = farm.store().CountEnded();
+    if (!ended.ok()) return Unavailable(ended.status());
+    const SchedulerLoad load = farm.scheduler().Load();
+    const SchedulerMetrics& counted = farm.scheduler().metrics();
+    auto ended_in = [&](JobState state) {
+        auto it = ended->find(state);
+        return double(it == ended->end() ? 0 : it->second);
+    };
+    MetricsText text;
+    text.AddGauge("lightfarm_jobs", "Jobs by state: queued and running now, ended ones kept.",
+                  "state",
+                  {{"queued", load.jobs_queued},
+                   {"running", load.jobs_running},
+                   {"succeeded", ended_in(JobState::kSucceeded)},
+                   {"failed", ended_in(JobState::kFailed)},
+                   {"cancelled", ended_in(JobState::kCancelled)}});
+    text.AddGauge("lightfarm_tasks", "Tasks of queued and running jobs, queued or leased now.",
+                  "state",
+                  {{"queued", double(load.tasks_queued)}, {"running", double(load.tasks_running)}});
+    text.AddGauge("lightfarm_workers",
+                  "Workers heard from within a lease (live), holding a lease (busy) or not (idle).",
+                  "state",
+                  {{"live", load.workers_live},
+                   {"busy", load.workers_busy},
+                   {"idle", load.workers_live - load.workers_busy}});
+    text.AddGauge("lightfarm_queue_depth", "Tasks queued and waiting for a worker.",
+                  double(load.tasks_queued));
+    text.AddHistogram("lightfarm_task_duration_seconds",
+                      "Seconds from a task's lease to its accepted result, per completed task.",
+                      counted.task_seconds.snapshot());
+    text.AddCounter("lightfarm_task_failures_total",
+                    "Counted task failures: expired leases, task errors, refused results.",
+                    counted.task_failures.value());
+    text.AddCounter("lightfarm_leases_total", "Task leases handed out to workers.",
+                    counted.leases.value());
+    text.AddHistogram("lightfarm_store_write_seconds",
+                      "Seconds of each job store commit (one transaction and its sync).",
+                      farm.store().write_seconds().snapshot());
+    return {200, kMetricsType, text.text()};
+}
+
+struct HttpListener::Server {
+    std::unique_ptr<httplib::Server> http;  // an httplib::SSLServer under TLS
+    std::unique_ptr<Dashboard> dashboard;
+    std::thread thread;
+};
+
+HttpListener::HttpListener(std::unique_ptr<Server> server, int port)
+    : server_(std::move(server)), port_(port) {}
+
+absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(
+    const std::string& host_port, Farm& farm, const HttpListenerOptions& options) {
+    const size_t colon = host_port.rfind(':');
+    int port = 0;
+    if (colon == std::string::npos || colon == 0 ||
+        !absl::SimpleAtoi(host_port.substr(colon + 1), &port) || port < 0 || port > 65535) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--http ", host_port, ": expected HOST:PORT, as 127.0.0.1:9090"));
+    }
+    std::string host = host_port.substr(0, colon);
+    if (host.size() > 2 && host.front() == '[' && host.back() == ']') {
+        host = host.substr(1, host.size() - 2);  // [::1]:9090
+    }
+    auto server = std::make_unique<Server>();
+    const bool tls = !options.tls_cert.empty() && !options.tls_key.empty();
+    if (tls) {
+        server->http =
+            std::make_unique<httplib::SSLServer>(options.tls_cert.c_str(), options.tls_key.c_str());
+        if (!server->http->is_valid()) {
+            return absl::FailedPreconditionError(
+                absl::StrCat("--http ", host_port, ": cannot use --tls-cert ", options.tls_cert,
+                             " and --tls-key ", options.tls_key, " for HTTPS"));
+        }
+    } else {
+        server->http = std::make_unique<httplib::Server>();
+    }
+    httplib::Server& http = *server->http;
+    // httplib sets SO_REUSEPORT, with which a second server would share the port and answer
+    // scrapes at random: only SO_REUSEADDR, so that a port in use is an error.
+    http.set_socket_options([](socket_t sock) {
+        int yes = 1;
+        setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
+    http.new_task_queue = [] { return new httplib::ThreadPool(kThreads); };
+    http.set_keep_alive_timeout(kKeepAliveSeconds);
+    http.set_payload_max_length(kMaxBodyBytes);
+    auto answer = [&farm](HttpAnswer (*handler)(Farm&)) {
+        return [&farm, handler](const httplib::Request&, httplib::Response& response) {
+            Reply(handler(farm), response);
+        };
+    };
+    http.Get("/healthz", answer(&HealthzAnswer));
+    http.Get("/metrics", answer(&MetricsAnswer));
+    if (options.dashboard_auth) {
+        server->dashboard =
+            std::make_unique<Dashboard>(farm, *options.dashboard_auth, DashboardOptions{tls});
+        Dashboard* dashboard = server->dashboard.get();
+        auto serve = [dashboard](const httplib::Request& request, httplib::Response& response) {
+            Reply(dashboard->Serve(FromHttplib(request)), response);
+        };
+        http.Get("/|/web/.*|/api/.*", serve);
+        http.Post("/api/.*", serve);
+    }
+    const bool bound =
+        port == 0 ? (port = http.bind_to_any_port(host)) > 0 : http.bind_to_port(host, port);
+    if (!bound) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "cannot listen on ", host_port, " for --http (is another process using the port?)"));
+    }
+    server->thread = std::thread([&http] { http.listen_after_bind(); });
+    // stop() does nothing until the loop runs: wait for it, so the destructor can end it.
+    while (!http.is_running()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    Log()->info("serving /healthz, /metrics{} on {}://{}:{}",
+                options.dashboard_auth ? " and the dashboard" : "", tls ? "https" : "http", host,
+                port);
+    return std::unique_ptr<HttpListener>(new HttpListener(std::move(server), port));
+}
+
+HttpListener::~HttpListener() {
+    server_->http->stop();
+    server_->thread.join();
+}
+
+}  // namespace lf

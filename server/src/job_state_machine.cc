@@ -1,0 +1,30 @@
+#include "lf/server/job_state_machine.h"
+
+#include "absl/strings/str_cat.h"
+
+namespace lf {
+
+bool IsLegalJobTransition(JobState from, JobState to) {
+    switch (from) {
+        case JobState::kQueued:
+            return to != JobState::kQueued && to != JobState::kSucceeded;
+        case JobState::kRunning:
+            return IsFinal(to);
+        default:
+            return false;
+    }
+}
+
+absl::Status TransitionJob(JobRecord& job, JobState to, absl::Time now) {
+    if (!IsLegalJobTransition(job.state, to)) {
+        return absl::FailedPreconditionError(absl::StrCat("job ", job.id, ": no transition from ",
+                                                          JobStateName(job.state), " to ",
+                                                          JobStateName(to)));
+    }
+    if (to == JobState::kRunning) job.started = now;
+    if (IsFinal(to)) job.finished = now;
+    job.state = to;
+    return absl::OkStatus();
+}
+
+}  // namespace lf

@@ -1,0 +1,100 @@
+#include "lf/server/scheduled_job.h"
+
+#include <cstdlib>
+
+#include "lf/core/log.h"
+#include "lf/server/job_state_machine.h"
+
+namespace lf {
+
+absl::StatusOr<std::unique_ptr<ScheduledJob>> ScheduledJob::Make(
+    JobRecord record, const TileStoreFactory& tile_stores, absl::Duration speculate_after) {
+    auto job = std::make_unique<ScheduledJob>();
+    job->record = std::move(record);
+    absl::StatusOr<std::unique_ptr<JobExecution>> execution =
+        MakeJobExecution(job->record.spec, tile_stores);
+    if (!execution.ok()) return execution.status();
+    job->execution = std::move(*execution);
+    job->speculation = SpeculationPolicy(speculate_after);
+    job->Queue({});
+    return job;
+}
+
+void ScheduledJob::Move(int t, TaskState to) {
+    if (absl::Status s = states.Transition(t, to); !s.ok()) {
+        NamedLogger("scheduler")->critical("job={} {}", record.id, std::string(s.message()));
+        std::abort();
+    }
+}
+
+void ScheduledJob::MoveTo(absl::Time now, JobState to) {
+    if (absl::Status s = TransitionJob(record, to, now); !s.ok()) {
+        NamedLogger("scheduler")->critical("{}", std::string(s.message()));
+        std::abort();
+    }
+}
+
+void ScheduledJob::Queue(const std::vector<int>& ready) {
+    states.Resize(execution->task_count());
+    tasks.resize(execution->task_count());
+    for (int t : ready) {
+        if (states.state(t) == TaskState::kWaiting) Move(t, TaskState::kQueued);
+    }
+}
+
+void ScheduledJob::Sync() {
+    record.tasks_done = int(execution->tasks_done());
+    record.tasks_total = execution->tasks_total();
+    record.stats = execution->stats();
+    record.tasks_running = IsFinal(record.state) ? 0 : states.running();
+}
+
+std::vector<TaskStatus> ScheduledJob::Statuses(const LeaseTable& leases, absl::Time now) const {
+    std::vector<TaskStatus> statuses(tasks.size());
+    for (int t = 0; t < int(tasks.size()); ++t) {
+        const Task& task = tasks[size_t(t)];
+        TaskStatus& status = statuses[size_t(t)];
+        status.index = t;
+        switch (states.state(t)) {
+            case TaskState::kWaiting:
+                status.state = TaskStatus::State::kWaiting;
+                break;
+            case TaskState::kQueued:
+                status.state = TaskStatus::State::kQueued;
+                break;
+            case TaskState::kLeased:
+                status.state = TaskStatus::State::kRunning;
+                break;
+            case TaskState::kDone:
+                status.state = TaskStatus::State::kDone;
+                break;
+            case TaskState::kDropped:
+                status.state = TaskStatus::State::kDropped;
+                break;
+        }
+        execution->Describe(t, status);
+        status.attempts = task.attempts;
+        status.failures = task.failures;
+        status.last_error = task.last_error;
+        if (task.attempts == 0) continue;  // never leased: no holder, no times
+        status.worker = leases.LastHolder(record.id, t);
+        status.leased = task.leased_at;
+        status.finished = task.finished;
+        if (status.state == TaskStatus::State::kDone) {
+            status.duration = task.finished - task.leased_at;
+        } else if (status.state == TaskStatus::State::kRunning) {
+            status.duration = now - task.leased_at;
+        }
+    }
+    // An ended job's tasks that were not done never will be: its failing task included, whose
+    // last failure ended the job before it went back to the queue.
+    if (IsFinal(record.state)) {
+        for (TaskStatus& status : statuses) {
+            if (status.state != TaskStatus::State::kDone)
+                status.state = TaskStatus::State::kDropped;
+        }
+    }
+    return statuses;
+}
+
+}  // namespace lf

@@ -1,0 +1,682 @@
+#include "lf/server/scheduler.h"
+
+#include <cstdlib>
+
+#include "absl/strings/str_cat.h"
+#include "lf/core/image_error.h"
+#include "lf/core/log.h"
+
+namespace lf {
+
+namespace {
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("scheduler"); }
+
+std::string NewJobId() { return "job-" + RandomHex(10); }
+
+absl::Status AlreadyEnded(const JobRecord& record) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("job ", record.id, " has already ended (", JobStateName(record.state), ")"));
+}
+
+}  // namespace
+
+Scheduler::Scheduler(SchedulerOptions options, JobStore& store, Clock clock)
+    : options_(options), store_(store), clock_(std::move(clock)), workers_(options.lease) {}
+
+Scheduler::Locked::Locked(Scheduler& scheduler) : lock(scheduler.mutex_), scheduler_(scheduler) {}
+
+Scheduler::Locked::~Locked() {
+    if (!lock.owns_lock()) lock.lock();
+    if (!scheduler_.ended_.has_unsettled()) return;
+    // Taken with the jobs SettleEnded waits for: their tasks are handed on once they are durable
+    // (or logged as not recorded), with the lock released for the callback to write.
+    std::vector<std::pair<std::string, std::vector<TaskStatus>>> tasks;
+    tasks.swap(scheduler_.ended_tasks_);
+    SettleEnded();
+    lock.unlock();
+    if (!scheduler_.tasks_ended_) return;
+    for (auto& [id, statuses] : tasks) scheduler_.tasks_ended_(id, std::move(statuses));
+}
+
+void Scheduler::Locked::SettleEnded() {
+    const std::vector<std::pair<std::string, uint64_t>> ended = scheduler_.ended_.TakeUnsettled();
+    lock.unlock();
+    std::vector<absl::Status> durable;
+    for (const auto& [id, ticket] : ended) durable.push_back(scheduler_.store_.WaitDurable(ticket));
+    lock.lock();
+    for (size_t i = 0; i < ended.size(); ++i) scheduler_.ended_.Settle(ended[i].first, durable[i]);
+}
+
+absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
+    JobRecord record;
+    record.spec = spec;
+    absl::StatusOr<std::unique_ptr<Job>> made =
+        Job::Make(std::move(record), options_.tile_stores, options_.speculate_after);
+    if (!made.ok()) return made.status();
+    std::unique_ptr<Job> job = std::move(*made);
+    job->Queue(job->execution->Start());
+    job->record.submitted = clock_();
+    // The store is read before the lock is taken. An earlier submission it does not hold has not
+    // been acknowledged yet, so it is still in memory.
+    std::optional<std::string> stored;
+    if (!spec.request_id.empty()) {
+        absl::StatusOr<std::optional<std::string>> found = store_.FindRequest(spec.request_id);
+        if (!found.ok()) return found.status();
+        stored = *found;
+    }
+    std::string id = NewJobId();
+    while (store_.Get(id).ok()) id = NewJobId();
+    Locked locked(*this);
+    std::optional<std::pair<std::string, uint64_t>> earlier =
+        stored ? std::pair{*stored, uint64_t(0)} : FindRequestInMemory(spec.request_id);
+    if (earlier) {
+        locked.lock.unlock();
+        if (absl::Status s = store_.WaitDurable(earlier->second); !s.ok()) return s;
+        Log()->info("job={} submitted again (request {})", earlier->first,
+                    LogSafe(spec.request_id));
+        return earlier->first;
+    }
+    if (active_.size() >= options_.max_active_jobs) {
+        return absl::ResourceExhaustedError(
+            absl::StrCat(active_.size(),
+                         " jobs are queued or running, this server's limit "
+                         "(lightfarm-server --max-active-jobs); submit again once some end"));
+    }
+    // Ids are random: one the store lacks is taken in memory only by a freak.
+    while (active_.count(id) || ended_.Find(id)) id = NewJobId();
+    job->record.id = id;
+    job->record.seq = next_seq_++;
+    const uint64_t ticket = Save(*job);
+    job->submit_ticket = ticket;
+    const std::string summary = job->execution->Summary();
+    active_[id] = std::move(job);
+    locked.lock.unlock();
+    // Acknowledged only once durable; waiting outside the lock lets submissions and results
+    // share one sync.
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
+        Log()->error("job={} refused: {}", id, std::string(s.message()));
+        locked.lock.lock();
+        active_.erase(id);
+        return s;
+    }
+    Log()->info("job={} queued: {}, priority {}", id, summary, spec.priority);
+    return id;
+}
+
+std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(
+    const std::string& request_id) const {
+    if (request_id.empty()) return std::nullopt;
+    for (const auto& [id, job] : active_) {
+        if (job->record.spec.request_id == request_id) return std::pair{id, job->submit_ticket};
+    }
+    return ended_.FindRequest(request_id);
+}
+
+absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (auto it = active_.find(job_id); it != active_.end()) return it->second->record;
+        if (const JobRecord* ended = ended_.Find(job_id)) return *ended;
+    }
+    return store_.Get(job_id);
+}
+
+absl::StatusOr<std::vector<JobRecord>> Scheduler::List(const JobQuery& query) const {
+    absl::StatusOr<std::vector<JobRecord>> jobs = store_.List(query);
+    if (!jobs.ok()) return jobs.status();
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (JobRecord& job : *jobs) {
+        if (auto it = active_.find(job.id); it != active_.end()) job = it->second->record;
+        if (const JobRecord* ended = ended_.Find(job.id)) job = *ended;
+    }
+    return jobs;
+}
+
+std::set<std::string> Scheduler::BlobsInUse() const {
+    std::set<std::string> hashes;
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [id, job] : active_) {
+        hashes.insert(job->record.spec.scene.hash);
+        for (const BlobRef& file : job->record.spec.files) hashes.insert(file.hash);
+        job->execution->AddBlobsInUse(hashes);
+    }
+    ended_.AddBlobsInUse(hashes);
+    return hashes;
+}
+
+std::optional<std::vector<TaskStatus>> Scheduler::Tasks(const std::string& job_id) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = active_.find(job_id);
+    if (it == active_.end()) return std::nullopt;
+    return it->second->Statuses(leases_, clock_());
+}
+
+std::optional<Scheduler::LeaseHolder> Scheduler::HolderOf(const std::string& lease_id,
+                                                          const std::string& worker) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
+    if (!ref) return std::nullopt;
+    return LeaseHolder{ref->job->id(), ref->lease->task, ref->lease->attempt, worker};
+}
+
+size_t Scheduler::workers_tracked() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return workers_.size();
+}
+
+std::vector<WorkerStatus> Scheduler::Workers() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const absl::Time now = clock_();
+    workers_.ForgetSilent(now);
+    const std::map<std::string, const Lease*> held = leases_.CurrentByWorker();
+    std::vector<WorkerStatus> workers;
+    for (WorkerRegistry::Entry& entry : workers_.List()) {
+        WorkerStatus& w = workers.emplace_back();
+        w.id = std::move(entry.id);
+        w.name = std::move(entry.about.name);
+        w.address = std::move(entry.about.address);
+        w.version = std::move(entry.about.version);
+        w.since_seen = now - entry.last_seen;
+        if (auto it = held.find(w.id); it != held.end()) {
+            w.job_id = it->second->job_id;
+            w.task = it->second->task;
+        }
+    }
+    return workers;
+}
+
+SchedulerLoad Scheduler::Load() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const absl::Time now = clock_();
+    workers_.ForgetSilent(now);
+    SchedulerLoad load;
+    for (const auto& [id, job] : active_) {
+        ++(job->record.state == JobState::kQueued ? load.jobs_queued : load.jobs_running);
+        load.tasks_queued += job->states.count(TaskState::kQueued);
+        load.tasks_running += job->states.running();
+    }
+    load.workers_live = int(workers_.size());
+    for (const auto& [worker, lease] : leases_.CurrentByWorker()) {
+        load.workers_busy += workers_.IsLive(worker, now);
+    }
+    return load;
+}
+
+absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
+    // The store is read before the lock is taken.
+    struct Stored {
+        JobRecord record;
+        std::map<int, std::string> results;
+    };
+    std::vector<Stored> stored;
+    uint64_t last_seq = 0;
+    // A store that cannot list must not start an empty server.
+    absl::StatusOr<std::vector<JobRecord>> recorded = store_.List();
+    if (!recorded.ok()) return recorded.status();
+    for (JobRecord& record : *recorded) {
+        last_seq = std::max(last_seq, record.seq);
+        if (IsFinal(record.state)) continue;
+        absl::StatusOr<std::map<int, std::string>> results = store_.TaskResults(record.id);
+        if (!results.ok()) return results.status();
+        stored.push_back({std::move(record), std::move(*results)});
+    }
+    Locked locked(*this);
+    next_seq_ = std::max(next_seq_, last_seq + 1);
+    std::vector<std::string> rendered;
+    for (Stored& s : stored) {
+        if (active_.count(s.record.id)) continue;
+        absl::StatusOr<std::unique_ptr<Job>> made =
+            Job::Make(std::move(s.record), options_.tile_stores, options_.speculate_after);
+        if (!made.ok()) return made.status();
+        std::unique_ptr<Job> job = std::move(*made);
+        // In index order, an adaptive plan appends each pass before its result comes up: the
+        // passes it planned depend only on the results before them.
+        for (const auto& [t, bytes] : s.results) {
+            // The store wrote what merged before, so this cannot fail unless the file was
+            // damaged; the task is then simply rendered again.
+            if (!job->execution->MergeRecorded(t, bytes).ok()) {
+                Log()->warn("job={} task={}: the recorded result is unusable, rendering it again",
+                            job->id(), t);
+                continue;
+            }
+            job->Move(t, TaskState::kDone);
+            job->Queue({});
+        }
+        job->Queue(job->execution->Start());
+        job->Sync();
+        Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before", job->id(),
+                    job->record.tasks_done, job->record.tasks_total, job->record.tasks_leased);
+        if (EnforceTimeLimit(*job, clock_()) || job->execution->Complete()) {
+            rendered.push_back(job->id());
+        }
+        Save(*job);
+        active_[job->id()] = std::move(job);
+    }
+    return rendered;
+}
+
+std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker, absl::Time wait_until,
+                                                   const WorkerDescription* about) {
+    Locked locked(*this);
+    while (true) {
+        if (std::optional<TaskAssignment> lease = TryLease(worker, about)) return lease;
+        const uint64_t version = version_;
+        if (shutdown_ || !changed_.wait_until(locked.lock, absl::ToChronoTime(wait_until),
+                                              [&] { return version_ != version || shutdown_; })) {
+            return std::nullopt;
+        }
+    }
+}
+
+std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
+                                                  const WorkerDescription* about) {
+    const absl::Time now = clock_();
+    workers_.Seen(worker, now, about);
+    workers_.ForgetSilent(now);  // so that the workers kept are the live ones
+    Job* best = nullptr;
+    int best_task = -1;
+    for (auto& [id, job] : active_) {
+        if (best && (job->record.spec.priority < best->record.spec.priority ||
+                     (job->record.spec.priority == best->record.spec.priority &&
+                      job->record.seq > best->record.seq))) {
+            continue;
+        }
+        for (int t : job->states.queued()) {
+            if (!MayTake(*job, t, worker, now)) continue;
+            best = job.get();
+            best_task = t;
+            break;
+        }
+    }
+    if (best) return Grant(*best, best_task, worker, now);
+    for (auto& [id, job] : active_) {
+        if (const int t = StragglerFor(*job, worker, now); t >= 0) {
+            Log()->info("job={} task={} running for {}: leased again to {}", id, t,
+                        absl::FormatDuration(now - job->tasks[size_t(t)].leased_at),
+                        LogSafe(worker));
+            return Grant(*job, t, worker, now);
+        }
+    }
+    return std::nullopt;
+}
+
+int Scheduler::StragglerFor(const Job& job, const std::string& worker, absl::Time now) const {
+    if (!job.states.queued().empty()) return -1;
+    int oldest = -1;
+    for (int t = 0; t < int(job.tasks.size()); ++t) {
+        const ScheduledJob::Task& task = job.tasks[size_t(t)];
+        if (job.states.state(t) != TaskState::kLeased || task.failed_on.count(worker) ||
+            !job.speculation.IsStraggler(now - task.leased_at)) {
+            continue;
+        }
+        const std::vector<const Lease*> current = leases_.Current(job.id(), t);
+        if (current.size() != 1 || current[0]->worker == worker) continue;
+        if (oldest < 0 || task.leased_at < job.tasks[size_t(oldest)].leased_at) oldest = t;
+    }
+    return oldest;
+}
+
+TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl::Time now) {
+    ScheduledJob::Task& task = job.tasks[size_t(t)];
+    if (job.states.state(t) == TaskState::kQueued) {
+        job.Move(t, TaskState::kLeased);
+        task.leased_at = now;
+    }
+    ++task.attempts;
+    ++job.record.tasks_leased;
+    metrics_.leases.Add();
+    TaskAssignment lease;
+    lease.lease_id = leases_.Grant(job.id(), t, task.attempts, worker, now + options_.lease);
+    if (job.record.state == JobState::kQueued) job.MoveTo(clock_(), JobState::kRunning);
+    Save(job);
+    Log()->debug("job={} task={} leased to {} (attempt {})", job.id(), t, LogSafe(worker),
+                 task.attempts);
+    lease.job_id = job.id();
+    lease.spec = job.record.spec;
+    lease.lease = options_.lease;
+    lease.heartbeat_interval = options_.heartbeat_interval;
+    job.execution->Lease(t, worker, lease);
+    return lease;
+}
+
+bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
+    const std::optional<std::vector<int>> dropped =
+        job.execution->EnforceTimeLimit(job.record.started, now);
+    if (!dropped) return false;
+    for (int t : *dropped) {
+        leases_.EndTask(job.id(), t);
+        job.Move(t, TaskState::kDropped);
+    }
+    Log()->info("job={} time limit of {} s reached: {} tasks dropped, {} tasks merged", job.id(),
+                job.record.spec.adaptive.time_limit, dropped->size(), job.execution->tasks_done());
+    Save(job);
+    // When nothing was dropped, the last result completed the job and Complete said so.
+    return !dropped->empty() && job.execution->Complete();
+}
+
+std::vector<std::string> Scheduler::EnforceTimeLimits() {
+    Locked locked(*this);
+    std::vector<std::string> rendered;
+    const absl::Time now = clock_();
+    for (auto& [id, job] : active_) {
+        if (EnforceTimeLimit(*job, now)) rendered.push_back(id);
+    }
+    return rendered;
+}
+
+bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::Time now) const {
+    const std::string preferred = job.execution->PreferredWorker(t);
+    if (!preferred.empty() && preferred != worker && workers_.IsLive(preferred, now)) return false;
+    const ScheduledJob::Task& task = job.tasks[size_t(t)];
+    if (!task.failed_on.count(worker)) return true;
+    // It failed here: it waits for a live worker it has not failed on. Once it has failed on
+    // every live worker it is tried again anywhere, so its failures end the job. `failed_on`
+    // holds fewer than max_failures workers, and the workers kept are the live ones.
+    size_t live_failed = 0;
+    for (const std::string& w : task.failed_on) live_failed += workers_.IsLive(w, now);
+    return workers_.size() <= live_failed;
+}
+
+std::optional<Scheduler::LeaseRef> Scheduler::Resolve(const std::string& lease_id,
+                                                      const std::string& worker) {
+    const Lease* lease = leases_.Find(lease_id);
+    if (!lease || lease->worker != worker) return std::nullopt;
+    auto it = active_.find(lease->job_id);
+    if (it == active_.end()) return std::nullopt;
+    return LeaseRef{it->second.get(), lease, lease_id};
+}
+
+bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker) {
+    Locked locked(*this);
+    const absl::Time now = clock_();
+    if (!Resolve(lease_id, worker)) return false;  // a made-up id is not kept
+    workers_.Seen(worker, now);
+    return leases_.Extend(lease_id, now + options_.lease);
+}
+
+absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lease_id,
+                                                          const std::string& worker,
+                                                          const TaskResult& result) {
+    Locked locked(*this);
+    const absl::Time now = clock_();
+    const absl::StatusOr<LeaseRef> ref = ResultLease(lease_id, worker, now);
+    if (!ref.ok()) return ref.status();
+    Job& job = *ref->job;
+    const int t = ref->lease->task;
+    Completion completion{job.id(), false, std::nullopt};
+    const TaskState state = job.states.state(t);
+    if (state == TaskState::kDone || state == TaskState::kDropped) return completion;
+    absl::StatusOr<JobExecution::Merged> merged = job.execution->Merge(t, result);
+    if (!merged.ok()) return Refuse(*ref, worker, merged.status());
+    MarkDone(job, t, now);
+    job.Queue(merged->appended);
+    if (!merged->job_error.ok()) {
+        FailJob(job, std::string(merged->job_error.message()));
+        return completion;
+    }
+    if (merged->sweep) {
+        Log()->info("job={} radiosity sweep {}: relative residual {:.3g}{}", job.id(),
+                    merged->sweep->iterations, merged->sweep->residual,
+                    merged->sweep->converged ? ", solved" : "");
+        completion.sweep = std::move(merged->sweep);
+    }
+    EnforceTimeLimit(job, now);
+    const std::optional<std::string> record = job.execution->RecordOf(result);
+    if (!record) {  // soft state, not recorded
+        Save(job);
+        return completion;
+    }
+    job.Sync();
+    // The record holds what the execution needs to merge the result again after a restart.
+    const uint64_t ticket = store_.QueueTaskDone(job.record, t, *record);
+    ++version_;
+    changed_.notify_all();
+    Log()->debug("job={} task={} done by {} ({}/{})", job.id(), t, LogSafe(worker),
+                 job.record.tasks_done, job.record.tasks_total);
+    completion.job_rendered = job.execution->Complete();
+    locked.lock.unlock();
+    // The worker hears "done" only once the result is durable.
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
+        // The merge cannot be taken back, and a job whose results are not all recorded would not
+        // survive a restart: it fails here, and the worker hears why.
+        locked.lock.lock();
+        if (auto it = active_.find(completion.job_id); it != active_.end()) {
+            FailJob(*it->second,
+                    absl::StrCat("recording the result of task ", t, ": ", s.message()));
+        }
+        return absl::Status(s.code(), absl::StrCat("job=", completion.job_id, ": ", s.message()));
+    }
+    return completion;
+}
+
+absl::StatusOr<Scheduler::LeaseRef> Scheduler::ResultLease(const std::string& lease_id,
+                                                           const std::string& worker,
+                                                           absl::Time now) {
+    const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
+    if (!ref) {
+        Log()->warn("result for lease {} from {} refused: not a lease it holds", LogSafe(lease_id),
+                    LogSafe(worker));
+        return absl::FailedPreconditionError(absl::StrCat(
+            "lease ", lease_id, " is not one of worker ", worker, " in a running job"));
+    }
+    workers_.Seen(worker, now);
+    return *ref;
+}
+
+absl::Status Scheduler::Refuse(const LeaseRef& ref, const std::string& worker,
+                               const absl::Status& why) {
+    const std::string error = absl::StrCat("job=", ref.job->id(), " task=", ref.lease->task,
+                                           " from ", worker, ": ", why.message());
+    if (ref.lease->current) Requeue(ref, absl::StrCat("result refused: ", why.message()), true);
+    return absl::InvalidArgumentError(error);
+}
+
+void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
+    ScheduledJob::Task& task = job.tasks[size_t(t)];
+    task.finished = now;
+    if (job.states.state(t) == TaskState::kLeased) {
+        // Whoever else holds a lease of it (a retry or a speculative copy) learns at its next
+        // heartbeat.
+        leases_.EndTask(job.id(), t);
+        job.speculation.TaskDone(now - task.leased_at);
+        metrics_.task_seconds.Observe(absl::ToDoubleSeconds(now - task.leased_at));
+    }
+    job.Move(t, TaskState::kDone);
+    metrics_.tasks_done.Add(now, 1);
+    metrics_.samples_done.Add(now, job.execution->TaskSamples(t));
+}
+
+void Scheduler::Publish(const std::string& job_id, bool converged,
+                        const absl::StatusOr<std::string>& hash) {
+    Locked locked(*this);
+    auto it = active_.find(job_id);
+    if (it == active_.end()) return;  // cancelled meanwhile
+    Job& job = *it->second;
+    if (!hash.ok()) {
+        FailJob(job, absl::StrCat("storing the radiosity: ", hash.status().message()));
+        return;
+    }
+    absl::StatusOr<std::vector<int>> ready = job.execution->Publish(converged, *hash);
+    if (!ready.ok()) {
+        FailJob(job, std::string(ready.status().message()));
+        return;
+    }
+    job.Queue(*ready);
+    Save(job);
+}
+
+absl::Status Scheduler::Fail(const std::string& lease_id, const std::string& worker,
+                             const std::string& reason, FailureKind kind) {
+    Locked locked(*this);
+    const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
+    if (!ref || !ref->lease->current) return absl::OkStatus();
+    Requeue(*ref, absl::StrCat(reason, " (worker ", worker, ")"), kind == FailureKind::kTaskError);
+    return absl::OkStatus();
+}
+
+void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool counted) {
+    Job& job = *ref.job;
+    const int t = ref.lease->task;
+    const int attempt = ref.lease->attempt;
+    ScheduledJob::Task& task = job.tasks[size_t(t)];
+    leases_.End(ref.id);
+    if (counted) {
+        metrics_.task_failures.Add();
+        ++task.failures;
+        task.failed_on.insert(ref.lease->worker);
+        task.last_error = reason;
+        job.record.last_error = absl::StrCat("task ", t, ": ", reason);
+    }
+    Log()->warn("job={} task={} attempt {} failed: {}{}", job.id(), t, attempt, LogSafe(reason),
+                counted ? "" : " (not counted)");
+    if (task.failures >= options_.max_failures) {
+        FailJob(job, absl::StrCat("task ", t, " failed ", task.failures, " times; last: ", reason));
+        return;
+    }
+    if (leases_.Current(job.id(), t).empty()) {  // otherwise another lease of it still renders
+        job.Move(t, TaskState::kQueued);
+        ++job.record.retries;
+    }
+    Save(job);
+}
+
+void Scheduler::FailJob(Job& job, const std::string& error) {
+    job.MoveTo(clock_(), JobState::kFailed);
+    job.record.error = error;
+    Log()->error("job={} failed: {}", job.record.id, LogSafe(error));
+    EndJob(job);
+}
+
+JobRecord Scheduler::EndJob(Job& job) {
+    const std::string id = job.record.id;
+    ended_tasks_.emplace_back(id, job.Statuses(leases_, clock_()));
+    leases_.ForgetJob(id);
+    const uint64_t ticket = Save(job);
+    JobRecord record = job.record;
+    active_.erase(id);  // destroys `job`
+    return ended_.Add(std::move(record), ticket);
+}
+
+absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
+    std::optional<JobRecord> cancelled;
+    {
+        Locked locked(*this);
+        if (auto it = active_.find(job_id); it != active_.end()) {
+            it->second->MoveTo(clock_(), JobState::kCancelled);
+            cancelled = EndJob(*it->second);
+            Log()->info("job={} cancelled", job_id);
+        } else if (const JobRecord* ended = ended_.Find(job_id)) {
+            return AlreadyEnded(*ended);
+        }
+    }  // the cancellation is durable here, or logged as not recorded
+    if (cancelled) return *cancelled;
+    absl::StatusOr<JobRecord> record = store_.Get(job_id);
+    if (!record.ok()) return record.status();
+    return AlreadyEnded(*record);
+}
+
+absl::StatusOr<JobRecord> Scheduler::SetPriority(const std::string& job_id, int priority) {
+    JobRecord record;
+    uint64_t ticket = 0;
+    {
+        Locked locked(*this);
+        auto it = active_.find(job_id);
+        if (it == active_.end()) {
+            if (const JobRecord* ended = ended_.Find(job_id)) return AlreadyEnded(*ended);
+            locked.lock.unlock();  // the store is never read under the lock
+            absl::StatusOr<JobRecord> stored = store_.Get(job_id);
+            if (!stored.ok()) return stored.status();
+            return AlreadyEnded(*stored);
+        }
+        Job& job = *it->second;
+        Log()->info("job={} priority {} -> {}", job_id, job.record.spec.priority, priority);
+        job.record.spec.priority = priority;
+        ticket = Save(job);
+        record = job.record;
+    }
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
+    return record;
+}
+
+int Scheduler::ExpireLeases() {
+    Locked locked(*this);
+    const absl::Time now = clock_();
+    workers_.ForgetSilent(now);
+    const std::vector<std::string> expired = leases_.TakeExpired(now);
+    for (const std::string& lease_id : expired) {
+        const Lease* lease = leases_.Find(lease_id);  // unknown once an earlier one failed its job
+        const std::optional<LeaseRef> ref = lease ? Resolve(lease_id, lease->worker) : std::nullopt;
+        if (!ref) continue;
+        Requeue(*ref,
+                absl::StrCat("lease expired: worker ", lease->worker, " sent no heartbeat for ",
+                             absl::FormatDuration(options_.lease)),
+                true);
+    }
+    return int(expired.size());
+}
+
+absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_id) const {
+    JobImage snapshot;
+    JobExecution::ImageReader read;  // shares the stores: outlives the job if it ends meanwhile
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        auto it = active_.find(job_id);
+        if (it == active_.end()) {
+            return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " is not running"));
+        }
+        const Job& job = *it->second;
+        snapshot.record = job.record;
+        read = job.execution->SnapshotReader();
+        snapshot.adaptive = job.execution->TileReport();
+    }
+    absl::StatusOr<Image> image = read();
+    if (!image.ok()) return image.status();
+    snapshot.image = std::move(*image);
+    if (snapshot.adaptive) {
+        absl::StatusOr<double> estimated = EstimatedRelativeError(snapshot.image);
+        if (!estimated.ok()) return estimated.status();
+        snapshot.adaptive->estimated_error = *estimated;
+    }
+    return snapshot;
+}
+
+void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path) {
+    Locked locked(*this);
+    auto it = active_.find(job_id);
+    if (it == active_.end()) return;  // cancelled meanwhile
+    Job& job = *it->second;
+    if (!result_path.ok()) {
+        FailJob(job, absl::StrCat("writing the result: ", result_path.status().message()));
+        return;
+    }
+    job.MoveTo(clock_(), JobState::kSucceeded);
+    job.record.result_path = *result_path;
+    Log()->info("job={} succeeded: {} samples -> {}", job_id, job.record.stats.samples,
+                *result_path);
+    EndJob(job);
+}
+
+uint64_t Scheduler::Save(Job& job) {
+    // Derived, so that the record cannot disagree with the execution and the task states.
+    job.Sync();
+    const uint64_t ticket = store_.QueuePut(job.record);
+    ++version_;
+    changed_.notify_all();
+    return ticket;
+}
+
+uint64_t Scheduler::WaitForChange(uint64_t version, absl::Time deadline) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait_until(lock, absl::ToChronoTime(deadline),
+                        [&] { return version_ != version || shutdown_; });
+    return version_;
+}
+
+void Scheduler::Shutdown() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    shutdown_ = true;
+    changed_.notify_all();
+}
+
+}  // namespace lf

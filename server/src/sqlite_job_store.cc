@@ -1,0 +1,368 @@
+#include "lf/server/sqlite_job_store.h"
+
+#include <sqlite3.h>
+
+#include <limits>
+#include <map>
+#include <set>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "lf/core/log.h"
+#include "lf/server/job_record_codec.h"
+#include "lf/server/legacy_job_record.h"
+#include "lf/server/sqlite_statement.h"
+
+namespace lf {
+
+namespace {
+
+// A stored record, its errors naming the job.
+absl::StatusOr<JobRecord> NamingTheJob(std::string_view id, absl::StatusOr<JobRecord> job) {
+    if (job.ok()) return job;
+    return absl::Status(job.status().code(), absl::StrCat("job store: job ", std::string(id), ": ",
+                                                          job.status().message()));
+}
+absl::StatusOr<JobRecord> Decode(std::string_view id, std::string_view record) {
+    return NamingTheJob(id, DecodeJobRecord(record));
+}
+absl::StatusOr<JobRecord> DecodeLegacy(std::string_view id, std::string_view record) {
+    return NamingTheJob(id, DecodeLegacyJobRecord(record));
+}
+
+// Schema versions (PRAGMA user_version): 0, records only, states by enum position, request ids
+// found inside the JSON; 1, the columns List and FindRequest select on, states by name; 2,
+// records in the StoredJob form (server/job_record_codec.h), those before in the legacy form.
+constexpr int kSchemaVersion = 2;
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::string& path) {
+    sqlite3* db = nullptr;
+    if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr) !=
+        SQLITE_OK) {
+        absl::Status s = absl::UnavailableError(
+            absl::StrCat(path, ": cannot open the job store: ", db ? sqlite3_errmsg(db) : "?"));
+        sqlite3_close(db);
+        return s;
+    }
+    std::unique_ptr<SqliteJobStore> store(new SqliteJobStore(db));
+    // synchronous=FULL: a commit is on disk when it returns, so what was acknowledged survives
+    // a crash of the process or of the machine. The busy timeout only matters for a second
+    // process (the sqlite3 shell) reading at the same time.
+    absl::Status s = Exec(db,
+                          "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
+                          "PRAGMA busy_timeout=5000;");
+    int64_t found_version = 0;
+    bool old = false;
+    if (s.ok()) {
+        Statement version(db, "PRAGMA user_version");
+        if (version.Step()) found_version = version.ColumnInt(0);
+        Statement tables(db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'jobs'");
+        old = tables.Step() && found_version < kSchemaVersion;
+        s = version.status().ok() ? tables.status() : version.status();
+    }
+    if (s.ok() && found_version > kSchemaVersion) {
+        s = absl::FailedPreconditionError(absl::StrCat(
+            "job store version ", found_version, " is newer than this server's (", kSchemaVersion,
+            "): run a lightfarm-server as new as the one that wrote it"));
+    }
+    if (s.ok() && old) s = Migrate(db, found_version);
+    if (s.ok()) {
+        s = Exec(db,
+                 "CREATE TABLE IF NOT EXISTS jobs (id TEXT PRIMARY KEY,"
+                 "  seq INTEGER NOT NULL, final INTEGER NOT NULL, record TEXT NOT NULL,"
+                 "  request_id TEXT NOT NULL DEFAULT '', finished INTEGER);"
+                 "CREATE TABLE IF NOT EXISTS task_results (job TEXT NOT NULL,"
+                 "  task INTEGER NOT NULL, sums BLOB NOT NULL,"
+                 "  PRIMARY KEY (job, task));"
+                 "CREATE UNIQUE INDEX IF NOT EXISTS jobs_by_request_id ON jobs (request_id)"
+                 "  WHERE request_id != '';"
+                 "CREATE INDEX IF NOT EXISTS jobs_by_seq ON jobs (seq);"
+                 "CREATE INDEX IF NOT EXISTS ended_jobs ON jobs (finished) WHERE final = 1;");
+    }
+    if (s.ok()) {
+        s = Exec(db, absl::StrCat("PRAGMA user_version = ", kSchemaVersion).c_str());
+    }
+    if (s.ok() && sqlite3_open_v2(path.c_str(), &store->read_db_, SQLITE_OPEN_READWRITE, nullptr) !=
+                      SQLITE_OK) {
+        s = absl::UnavailableError(
+            absl::StrCat("cannot open a reading connection: ",
+                         store->read_db_ ? sqlite3_errmsg(store->read_db_) : "?"));
+    }
+    // A reader of a WAL database waits only while another connection recovers or checkpoints
+    // it, briefly; the timeout keeps that from being an error.
+    if (s.ok()) s = Exec(store->read_db_, "PRAGMA busy_timeout=5000;");
+    if (!s.ok()) return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
+    return store;
+}
+
+SqliteJobStore::SqliteJobStore(sqlite3* db) : db_(db), writer_([this] { WriterLoop(); }) {}
+
+SqliteJobStore::~SqliteJobStore() {
+    {
+        std::lock_guard<std::mutex> lock(queue_mutex_);
+        stop_ = true;
+    }
+    queued_cv_.notify_all();
+    writer_.join();
+    sqlite3_close(read_db_);
+    sqlite3_close(db_);
+}
+
+SqliteJobStore::Write SqliteJobStore::PutOf(const JobRecord& job) {
+    Write w{job.id};
+    w.seq = job.seq;
+    w.final = IsFinal(job.state);
+    w.request_id = job.spec.request_id;
+    if (w.final && job.finished != absl::InfinitePast()) {
+        w.finished_us = absl::ToUnixMicros(job.finished);
+    }
+    w.record = EncodeJobRecord(job);
+    return w;
+}
+
+uint64_t SqliteJobStore::QueuePut(const JobRecord& job) { return Queue(PutOf(job)); }
+
+uint64_t SqliteJobStore::QueueTaskDone(const JobRecord& job, int task, std::string result) {
+    Write w = PutOf(job);
+    w.task = task;
+    w.result = std::move(result);
+    return Queue(std::move(w));
+}
+
+uint64_t SqliteJobStore::QueueDelete(const std::string& id) {
+    Write w{id};
+    w.remove = true;
+    return Queue(std::move(w));
+}
+
+uint64_t SqliteJobStore::Queue(Write write) {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queue_.push_back(std::move(write));
+    queued_cv_.notify_one();
+    return ++last_ticket_;
+}
+
+absl::Status SqliteJobStore::WaitDurable(uint64_t ticket) {
+    std::unique_lock<std::mutex> lock(queue_mutex_);
+    durable_cv_.wait(lock, [&] { return durable_ >= ticket; });
+    for (const auto& [first, last, error] : failed_) {
+        if (first <= ticket && ticket <= last) return error;
+    }
+    return absl::OkStatus();
+}
+
+void SqliteJobStore::WriterLoop() {
+    std::unique_lock<std::mutex> lock(queue_mutex_);
+    while (true) {
+        queued_cv_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+        if (queue_.empty()) return;  // stopping, and everything is committed
+        std::deque<Write> batch;
+        batch.swap(queue_);
+        const uint64_t last = last_ticket_, first = last - batch.size() + 1;
+        lock.unlock();
+        const absl::Time start = absl::Now();
+        const absl::Status status = Commit(batch);
+        write_seconds_.Observe(absl::ToDoubleSeconds(absl::Now() - start));
+        if (!status.ok()) {
+            // Writes nobody waits for (leases) are lost here but for this line; the next write
+            // of their job carries the state again.
+            std::set<std::string> jobs;
+            for (const Write& w : batch) jobs.insert(w.job_id);
+            NamedLogger("store")->error("job={} commit of {} writes failed: {}",
+                                        absl::StrJoin(jobs, ","), batch.size(),
+                                        std::string(status.message()));
+        }
+        lock.lock();
+        if (!status.ok()) failed_.emplace_back(first, last, status);
+        last_commit_ = status;
+        durable_ = last;
+        durable_cv_.notify_all();
+    }
+}
+
+absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
+    // Only the newest record of a job in the batch is written: the earlier ones would be
+    // replaced, or deleted, within the same transaction anyway.
+    std::map<std::string_view, size_t> newest;
+    for (size_t i = 0; i < batch.size(); ++i) newest[batch[i].job_id] = i;
+    std::lock_guard<std::mutex> lock(db_mutex_);
+    if (absl::Status s = Exec(db_, "BEGIN IMMEDIATE"); !s.ok()) return s;
+    absl::Status status;
+    for (size_t i = 0; i < batch.size() && status.ok(); ++i) {
+        const Write& w = batch[i];
+        if (w.remove) {
+            Statement drop(db_, "DELETE FROM jobs WHERE id = ?1");
+            drop.Bind(1, w.job_id).Step();
+            Statement drop_results(db_, "DELETE FROM task_results WHERE job = ?1");
+            if (drop.status().ok()) drop_results.Bind(1, w.job_id).Step();
+            status = drop.status().ok() ? drop_results.status() : drop.status();
+            continue;
+        }
+        if (w.task >= 0) {
+            Statement put(
+                db_, "INSERT OR REPLACE INTO task_results (job, task, sums) VALUES (?1, ?2, ?3)");
+            put.Bind(1, w.job_id).Bind(2, int64_t(w.task)).BindBlob(3, w.result).Step();
+            status = put.status();
+        }
+        if (!status.ok() || newest[w.job_id] != i) continue;
+        // An upsert by id, not INSERT OR REPLACE: a clash of request ids must fail, not delete
+        // the other job.
+        Statement put(db_,
+                      "INSERT INTO jobs (id, seq, final, record, request_id, finished)"
+                      " VALUES (?1, ?2, ?3, ?4, ?5, ?6) ON CONFLICT (id) DO UPDATE SET"
+                      " seq = excluded.seq, final = excluded.final, record = excluded.record,"
+                      " request_id = excluded.request_id, finished = excluded.finished");
+        put.Bind(1, w.job_id).Bind(2, int64_t(w.seq)).Bind(3, int64_t(w.final));
+        put.Bind(4, w.record).Bind(5, w.request_id).Bind(6, w.finished_us).Step();
+        status = put.status();
+        if (status.ok() && w.final) {
+            Statement drop(db_, "DELETE FROM task_results WHERE job = ?1");
+            drop.Bind(1, w.job_id).Step();
+            status = drop.status();
+        }
+    }
+    if (status.ok()) status = Exec(db_, "COMMIT");
+    if (!status.ok()) Exec(db_, "ROLLBACK").IgnoreError();
+    return status;
+}
+
+absl::Status SqliteJobStore::Migrate(sqlite3* db, int64_t version) {
+    // Version 0 to 1: the columns, filled from the records. Either to 2: the records rewritten
+    // in the StoredJob form. In one transaction, so that a failure leaves the old version to try
+    // again.
+    if (absl::Status s = Exec(db, "BEGIN IMMEDIATE"); !s.ok()) return s;
+    absl::Status status;
+    if (version == 0) {
+        status = Exec(db,
+                      "DROP INDEX IF EXISTS jobs_by_request;"
+                      "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';"
+                      "ALTER TABLE jobs ADD COLUMN finished INTEGER;");
+    }
+    std::vector<Write> rewrites;
+    if (status.ok()) {
+        Statement all(db, "SELECT id, record FROM jobs");
+        while (status.ok() && all.Step()) {
+            absl::StatusOr<JobRecord> job = DecodeLegacy(all.Column(0), all.Column(1));
+            if (job.ok()) rewrites.push_back(PutOf(*job));
+            status = job.status();
+        }
+        if (status.ok()) status = all.status();
+    }
+    for (size_t i = 0; i < rewrites.size() && status.ok(); ++i) {
+        const Write& w = rewrites[i];
+        Statement update(
+            db, "UPDATE jobs SET record = ?2, request_id = ?3, finished = ?4 WHERE id = ?1");
+        update.Bind(1, w.job_id).Bind(2, w.record).Bind(3, w.request_id).Bind(4, w.finished_us);
+        update.Step();
+        status = update.status();
+    }
+    if (status.ok()) status = Exec(db, "COMMIT");
+    if (!status.ok()) {
+        Exec(db, "ROLLBACK").IgnoreError();
+        return absl::Status(status.code(),
+                            absl::StrCat("upgrading the job store: ", status.message()));
+    }
+    NamedLogger("store")->info("job store upgraded to version {}: {} jobs", kSchemaVersion,
+                               rewrites.size());
+    return absl::OkStatus();
+}
+
+absl::Status SqliteJobStore::Health() const {
+    {
+        std::lock_guard<std::mutex> lock(queue_mutex_);
+        if (!last_commit_.ok()) return last_commit_;
+    }
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    Statement read(read_db_, "SELECT COUNT(*) FROM jobs WHERE seq < 0");
+    read.Step();
+    return read.status();
+}
+
+absl::StatusOr<std::map<JobState, int64_t>> SqliteJobStore::CountEnded() const {
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    Statement count(read_db_,
+                    "SELECT json_extract(record, '$.state'), COUNT(*) FROM jobs WHERE final = 1"
+                    " GROUP BY 1");
+    std::map<JobState, int64_t> counts;
+    while (count.Step()) {
+        absl::StatusOr<JobState> state = JobStateFromName(count.Column(0));
+        if (!state.ok()) return state.status();
+        counts[*state] = count.ColumnInt(1);
+    }
+    if (!count.status().ok()) return count.status();
+    return counts;
+}
+
+absl::StatusOr<JobRecord> SqliteJobStore::DecodeCached(std::string_view id,
+                                                       std::string_view record) const {
+    const size_t hash = std::hash<std::string_view>{}(record);
+    if (auto it = decoded_.find(std::string(id));
+        it != decoded_.end() && it->second.first == hash) {
+        return it->second.second;
+    }
+    absl::StatusOr<JobRecord> job = Decode(id, record);
+    if (!job.ok()) return job;
+    if (decoded_.size() >= kDecodedCacheSize) decoded_.clear();
+    decoded_.insert_or_assign(std::string(id), std::make_pair(hash, *job));
+    return job;
+}
+
+absl::StatusOr<JobRecord> SqliteJobStore::Get(const std::string& id) const {
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    Statement get(read_db_, "SELECT record FROM jobs WHERE id = ?1");
+    if (get.Bind(1, id).Step()) return DecodeCached(id, get.Column(0));
+    if (!get.status().ok()) return get.status();
+    return absl::NotFoundError("no job " + id);
+}
+
+absl::StatusOr<std::vector<JobRecord>> SqliteJobStore::List(const JobQuery& query) const {
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    std::vector<JobRecord> jobs;
+    Statement list(read_db_,
+                   "SELECT id, record FROM jobs WHERE seq < ?1"
+                   " AND (?2 IS NULL OR (final = 1 AND finished < ?2))"
+                   // The owner is read from the record rather than a column of its own: a
+                   // submitter's list scans the newest jobs until its page is full, and old
+                   // stores need no migration.
+                   " AND (?4 IS NULL OR json_extract(record, '$.spec.owner') = ?4)"
+                   " ORDER BY seq DESC LIMIT ?3");
+    list.Bind(
+        1, query.before_seq == 0 ? std::numeric_limits<int64_t>::max() : int64_t(query.before_seq));
+    list.Bind(2, query.ended_before == absl::InfinitePast()
+                     ? std::nullopt
+                     : std::optional<int64_t>(absl::ToUnixMicros(query.ended_before)));
+    list.Bind(3, query.limit == 0 ? int64_t(-1) : int64_t(query.limit));
+    if (query.owner) list.Bind(4, *query.owner);
+    while (list.Step()) {
+        absl::StatusOr<JobRecord> job = DecodeCached(list.Column(0), list.Column(1));
+        if (!job.ok()) return job.status();
+        jobs.push_back(std::move(*job));
+    }
+    if (!list.status().ok()) return list.status();
+    return jobs;
+}
+
+absl::StatusOr<std::optional<std::string>> SqliteJobStore::FindRequest(
+    const std::string& request_id) const {
+    if (request_id.empty()) return std::nullopt;
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    Statement find(read_db_, "SELECT id FROM jobs WHERE request_id = ?1");
+    if (find.Bind(1, request_id).Step()) return std::string(find.Column(0));
+    if (!find.status().ok()) return find.status();
+    return std::nullopt;
+}
+
+absl::StatusOr<std::map<int, std::string>> SqliteJobStore::TaskResults(
+    const std::string& id) const {
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    std::map<int, std::string> results;
+    Statement get(read_db_, "SELECT task, sums FROM task_results WHERE job = ?1");
+    get.Bind(1, id);
+    while (get.Step()) results[int(get.ColumnInt(0))] = std::string(get.Column(1));
+    if (!get.status().ok()) return get.status();
+    return results;
+}
+
+}  // namespace lf

@@ -1,0 +1,121 @@
+// A stateless farm worker: leases a task, renders its tile and sample range (or sweeps its
+// patch groups of a radiosity solve), hands back the result, and again. The only state kept
+// between tasks is a cache: scene blobs on disk, and the last job's built scene, radiosity
+// form-factor rows and solution in memory.
+#pragma once
+
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "absl/status/status.h"
+#include "lf/core/camera.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/splat_renderer.h"
+#include "lf/kernels/path_tracer.h"
+#include "lf/kernels/radiance.h"
+#include "lf/kernels/radiosity.h"
+#include "lf/worker/blob_cache.h"
+#include "lf/worker/server_connection.h"
+#include "lf/worker/task_log_sink.h"
+
+namespace lf {
+
+struct WorkerOptions {
+    int threads = 1;
+    // An idle worker long-polls the server for this long per call...
+    absl::Duration lease_wait = absl::Seconds(1);
+    // ...and backs off from this to that while the server cannot be reached.
+    absl::Duration min_idle = absl::Milliseconds(50), max_idle = absl::Seconds(1);
+};
+
+class Worker {
+  public:
+    // `logs`: the sink that captures each task's lines (TaskLogSink::Install), sent with the
+    // task's heartbeats and its result.
+    Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache, TaskLogSink& logs);
+    // Sends the result handed over last, then returns.
+    ~Worker();
+
+    // Leases and renders tasks until Stop.
+    void Run();
+    // Thread-safe: stops the current task, hands it back, and makes Run return.
+    void Stop();
+
+  private:
+    struct LoadedScene {
+        std::string job_id;
+        std::unique_ptr<Scene> scene;  // EmbreeScene keeps a reference
+        std::unique_ptr<EmbreeScene> embree;
+        std::unique_ptr<Camera> camera;
+        std::unique_ptr<RadianceEstimator> tracer;  // path or Whitted tracer, radiosity display
+        std::unique_ptr<SplatRenderer> frame;       // a splatting method's (light, bdpt, ppm)
+        // Radiosity solved in sweeps: the form-factor rows of the chunks this worker swept
+        // (the server gives a chunk back to the worker that has its rows), and the last input.
+        std::map<int, std::unique_ptr<RadiositySweepChunk>> chunks;
+        std::string input_hash;
+        std::vector<Rgb> input;
+    };
+
+    void Execute(const TaskAssignment& task);
+    // The job's scene, built once for consecutive tasks of the same job.
+    // Each returns Cancelled soon after `cancel` is set.
+    absl::Status PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel);
+    // The job's path tracer or radiosity display, built once per job.
+    absl::Status PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel);
+    TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
+    // A tile or splat task's camera sums, or a sweep's result: `result` and its stats.
+    absl::Status RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                         ServerConnection::TaskResult& result, RenderStats& stats);
+    // A splatting method's task (lf::SplatTask): its camera sums and its splat list, encoded; the
+    // renderer is built once per job. FailedPrecondition when the result is above what the
+    // coordinator takes (lf::kMaxTaskResultBytes).
+    absl::Status RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                             ServerConnection::TaskResult& result, RenderStats& stats);
+    absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
+    // A radiosity vector the server stored as a blob.
+    absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
+    // Hands the result to the sender thread, after the previous one was sent: the upload of a
+    // result overlaps the lease and render of the next task (over a slow link, a 64x64 tile's
+    // 400 kB take a few hundred milliseconds), and at most one result waits in memory.
+    void SendResult(const TaskAssignment& task, ServerConnection::TaskResult result,
+                    double seconds);
+    void SenderLoop();
+    // Waits until the result handed over last is sent.
+    void FlushSends();
+    bool stopping() const { return stopping_.load(); }
+    void WaitIdle(absl::Duration d);
+
+    const WorkerOptions options_;
+    ServerConnection& server_;
+    BlobCache& cache_;
+    TaskLogSink& logs_;
+    LoadedScene loaded_;
+    tbb::task_arena arena_;
+
+    std::atomic<bool> stopping_{false};
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::atomic<bool>* current_cancel_ = nullptr;  // guarded by mutex_
+
+    struct PendingResult {
+        TaskAssignment task;
+        ServerConnection::TaskResult result;
+        double seconds = 0;
+    };
+    std::mutex send_mutex_;
+    std::condition_variable send_cv_;
+    std::optional<PendingResult> pending_;  // guarded by send_mutex_: handed over, not yet sent
+    bool sending_ = false;                  // guarded by send_mutex_
+    bool sender_stop_ = false;              // guarded by send_mutex_
+    std::thread sender_;                    // last: starts once the rest is built
+};
+
+}  // namespace lf

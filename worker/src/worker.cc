@@ -1,0 +1,443 @@
+#include "lf/worker/worker.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <map>
+#include <thread>
+
+#include "absl/strings/str_cat.h"
+#include "lf/core/file_util.h"
+#include "lf/core/log.h"
+#include "lf/core/radiosity_codec.h"
+#include "lf/core/splat_codec.h"
+#include "lf/core/tile_codec.h"
+#include "lf/job/splat_settings.h"
+#include "lf/kernels/radiosity.h"
+#include "lf/kernels/tile_renderer.h"
+#include "lf/local/method_factory.h"
+
+namespace lf {
+
+namespace {
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("worker"); }
+
+// What a lease asks for, for its first log line.
+std::string DescribeTask(const TaskAssignment& task) {
+    if (task.sweep >= 0) {
+        return absl::StrCat("radiosity sweep ", task.sweep, " patch group ", task.chunk, " of ",
+                            task.spec.radiosity.sweep_tasks);
+    }
+    const PixelRect& r = task.task.rect;
+    std::string what =
+        absl::StrCat(task.spec.method, ", pixels ", r.x0, ",", r.y0, " ", r.width, "x", r.height,
+                     ", samples ", task.task.sample_begin, "-", task.task.sample_end, " (",
+                     task.task.sample_end - task.task.sample_begin, " spp)");
+    if (task.path_end > task.path_begin) {
+        absl::StrAppend(&what, ", light paths ", task.path_begin, "-", task.path_end);
+    }
+    return what;
+}
+
+}  // namespace
+
+Worker::Worker(WorkerOptions options, ServerConnection& server, BlobCache& cache, TaskLogSink& logs)
+    : options_(std::move(options)),
+      server_(server),
+      cache_(cache),
+      logs_(logs),
+      arena_(options_.threads),
+      sender_([this] { SenderLoop(); }) {}
+
+Worker::~Worker() {
+    {
+        std::lock_guard<std::mutex> lock(send_mutex_);
+        sender_stop_ = true;
+    }
+    send_cv_.notify_all();
+    sender_.join();  // sends what was handed over first
+}
+
+void Worker::Stop() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+    if (current_cancel_) current_cancel_->store(true);
+    wake_.notify_all();
+}
+
+void Worker::WaitIdle(absl::Duration d) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait_for(lock, absl::ToChronoNanoseconds(d), [&] { return stopping(); });
+}
+
+void Worker::Run() {
+    absl::Duration idle = options_.min_idle;
+    absl::StatusCode last = absl::StatusCode::kOk;  // logged when it changes, not every retry
+    while (!stopping()) {
+        absl::StatusOr<std::optional<TaskAssignment>> task = server_.Lease(options_.lease_wait);
+        if (task.status().code() != last) {
+            last = task.status().code();
+            const std::string why(task.status().message());
+            if (task.ok()) {
+                Log()->info("worker={} server reachable again", server_.worker_id());
+            } else if (last == absl::StatusCode::kFailedPrecondition) {
+                // Another build (LeaseTask's version check). Retried rather than exiting, so a
+                // server brought to this build gets its workers back without restarting them.
+                Log()->error(
+                    "worker={} refused by the server, retrying until it accepts this "
+                    "build: {}",
+                    server_.worker_id(), why);
+            } else if (last == absl::StatusCode::kUnauthenticated ||
+                       last == absl::StatusCode::kPermissionDenied) {
+                // A token or certificate the server does not take (yet): retried, so that
+                // creating the token or fixing the server's CA needs no worker restart.
+                Log()->error("worker={} refused by the server, retrying: {}", server_.worker_id(),
+                             why);
+            } else {
+                Log()->warn("worker={} server unreachable, retrying: {}", server_.worker_id(), why);
+            }
+        }
+        if (!task.ok()) {
+            WaitIdle(idle);
+            idle = std::min(idle * 2, options_.max_idle);
+            continue;
+        }
+        idle = options_.min_idle;
+        if (!*task) continue;  // the server already waited
+        Execute(**task);
+    }
+    FlushSends();  // a result finished before the stop is still worth its upload
+    Log()->info("worker={} stopped", server_.worker_id());
+}
+
+void Worker::Execute(const TaskAssignment& task) {
+    // Everything logged from here until End, the kernels' lines included, is the task's.
+    const std::shared_ptr<TaskLog> log = logs_.Begin();
+    const std::string ids = "job=" + task.job_id + " task=" + std::to_string(task.task.index);
+    Log()->info("{} leased: {}", ids, DescribeTask(task));
+    std::atomic<bool> cancel{false};
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        current_cancel_ = &cancel;
+        if (stopping()) cancel = true;
+    }
+    // Heartbeats from their own thread, so a long tile keeps its lease and hears of a cancel.
+    std::mutex hb_mutex;
+    std::condition_variable hb_wake;
+    bool task_over = false;
+    std::atomic<bool> dropped{false};
+    std::thread heartbeat([&] {
+        std::unique_lock<std::mutex> lock(hb_mutex);
+        while (!hb_wake.wait_for(lock, absl::ToChronoNanoseconds(task.heartbeat_interval),
+                                 [&] { return task_over; })) {
+            lock.unlock();
+            // Lines of a heartbeat that does not arrive are lost: the next one carries newer.
+            const absl::StatusOr<bool> keep = server_.Heartbeat(task.lease_id, log->Take());
+            lock.lock();
+            if (keep.ok() && !*keep) {
+                dropped = true;
+                cancel = true;
+            }
+        }
+    });
+
+    const absl::Time start = absl::Now();
+    ServerConnection::TaskResult result;
+    RenderStats stats;
+    absl::Status status = PrepareScene(task, cancel);
+    if (status.ok()) status = RunTask(task, cancel, result, stats);
+    {
+        std::lock_guard<std::mutex> lock(hb_mutex);
+        task_over = true;
+    }
+    hb_wake.notify_all();
+    heartbeat.join();
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        current_cancel_ = nullptr;
+    }
+
+    const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
+    // A result that was finished before a stop was asked for is still worth sending.
+    if (dropped) {
+        Log()->info("{} dropped: the job was cancelled or the lease lost", ids);
+        logs_.End();
+    } else if (status.ok() && !cancel) {
+        Log()->info("{} rendered in {:.2f} s: {} samples, {} rays, {} NaN/Inf samples", ids,
+                    seconds, stats.samples, stats.rays, stats.invalid_samples);
+        logs_.End();
+        result.log = log->Take();
+        SendResult(task, std::move(result), seconds);
+    } else if (stopping()) {
+        Log()->info("{} handed back: worker shutting down", ids);
+        logs_.End();
+        (void)server_.Fail(task.lease_id, "worker shutting down", true, log->Take());
+    } else {
+        Log()->error("{} failed after {:.2f} s: {}", ids, seconds, std::string(status.message()));
+        logs_.End();
+        (void)server_.Fail(task.lease_id, std::string(status.message()), false, log->Take());
+    }
+}
+
+absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                             ServerConnection::TaskResult& result, RenderStats& stats) {
+    if (task.sweep >= 0) {
+        absl::StatusOr<std::string> swept = Sweep(task, cancel);
+        if (!swept.ok()) return swept.status();
+        result = {std::move(*swept), true, std::nullopt};
+        return absl::OkStatus();
+    }
+    if (UsesSplatPlan(task.spec.method)) return RenderSplat(task, cancel, result, stats);
+    if (absl::Status s = PrepareTracer(task, cancel); !s.ok()) return s;
+    const TileSums sums = Render(task, cancel);
+    stats = sums.stats;
+    result.bytes = EncodeTileSums(sums);
+    if (const auto* r = dynamic_cast<const RadiosityRenderer*>(loaded_.tracer.get())) {
+        result.radiosity = RadiosityFiguresOf(r->report());
+    }
+    return absl::OkStatus();
+}
+
+absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel) {
+    if (loaded_.job_id == task.job_id) {
+        Log()->info("job={} task={} scene {} already loaded", task.job_id, task.task.index,
+                    task.spec.scene.path);
+        return absl::OkStatus();
+    }
+    // The previous job's geometry and BVH go now, its decoded textures only after this load:
+    // a texture the next job uses too (the next frame of a shot, say) is then shared, not
+    // decoded again (DecodeTexture keeps each file content once while anything holds it).
+    const std::vector<std::shared_ptr<const TextureImage>> previous_textures =
+        loaded_.scene ? loaded_.scene->textures
+                      : std::vector<std::shared_ptr<const TextureImage>>{};
+    loaded_ = {};
+    int fetched = 0;  // the others were in the cache
+    auto fetch = [&](const std::string& hash, const std::string& path) {
+        ++fetched;
+        return server_.FetchBlob(hash, path);
+    };
+    std::vector<const BlobRef*> refs = {&task.spec.scene};
+    for (const BlobRef& ref : task.spec.files) refs.push_back(&ref);
+    std::map<std::string, std::string> files;  // hash -> cached file
+    auto cancelled = [&] { return absl::CancelledError("scene loading cancelled"); };
+    for (const BlobRef* ref : refs) {
+        if (cancel) return cancelled();
+        absl::StatusOr<std::string> path = cache_.Get(ref->hash, fetch);
+        if (!path.ok()) return path.status();
+        files[ref->hash] = *path;
+    }
+    absl::StatusOr<Scene> scene = LoadSceneFromBlobs(
+        task.spec.scene, task.spec.files, [&](const std::string& hash) { return files[hash]; },
+        &cancel, task.spec.scene_options);
+    cache_.Trim();
+    if (!scene.ok()) return scene.status();
+    if (cancel) return cancelled();
+    LoadedScene loaded;
+    loaded.scene = std::make_unique<Scene>(std::move(*scene));
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree =
+        EmbreeScene::Build(*loaded.scene, &cancel);
+    if (!embree.ok()) return embree.status();
+    loaded.embree = std::move(*embree);
+    loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
+    loaded.job_id = task.job_id;
+    loaded_ = std::move(loaded);
+    Log()->info("job={} task={} scene {} loaded: {} files, {} fetched from the server, {} cached",
+                task.job_id, task.task.index, task.spec.scene.path, refs.size(), fetched,
+                int(refs.size()) - fetched);
+    return absl::OkStatus();
+}
+
+absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel) {
+    if (loaded_.tracer) return absl::OkStatus();
+    const Method method = MethodOf(task.spec);
+    if (Info(method).work != WorkKind::kRadiosity) {
+        // Cached per job (loaded_.job_id), so the job's one light strategy is the tracer's.
+        absl::StatusOr<std::unique_ptr<RadianceEstimator>> tracer =
+            MakeRayTracer(method, *loaded_.embree, task.spec.max_depth, task.spec.light_strategy);
+        if (!tracer.ok()) return tracer.status();
+        loaded_.tracer = std::move(*tracer);
+        return absl::OkStatus();
+    }
+    absl::StatusOr<RadiosityOptions> options =
+        RadiosityOptionsOf(task.spec.radiosity, task.spec.adaptive.target_error);
+    if (!options.ok()) return options.status();
+    options->threads = options_.threads;
+    options->cancel = &cancel;  // meshing, form factors and the solve stop on a cancel
+    absl::StatusOr<std::unique_ptr<RadiosityRenderer>> renderer;
+    if (!task.radiosity_hash.empty()) {  // solved by the farm's sweeps
+        absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task.radiosity_hash);
+        if (!solution.ok()) return solution.status();
+        renderer = RadiosityRendererFor(*loaded_.embree, *options, std::move(*solution));
+    } else {
+        // Every worker of the job solves the same system to the same bits (the solver is
+        // deterministic for any thread count), so its tiles match `lightfarm render`.
+        renderer = PrepareRadiosity(*loaded_.embree, *options);
+    }
+    if (!renderer.ok()) return renderer.status();
+    loaded_.tracer = std::move(*renderer);
+    // The sweeps are over: their form-factor rows are not needed again.
+    loaded_.chunks.clear();
+    loaded_.input.clear();
+    loaded_.input_hash.clear();
+    return absl::OkStatus();
+}
+
+absl::StatusOr<std::vector<Rgb>> Worker::ReadRadiosity(const std::string& hash) {
+    absl::StatusOr<std::string> path = cache_.Get(
+        hash, [&](const std::string& h, const std::string& p) { return server_.FetchBlob(h, p); });
+    if (!path.ok()) return path.status();
+    absl::StatusOr<std::string> bytes = ReadFile(*path);
+    if (!bytes.ok()) return bytes.status();
+    return DecodeRadiosity(*bytes);
+}
+
+absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
+                                          const std::atomic<bool>& cancel) {
+    const RadiositySettings& r = task.spec.radiosity;
+    std::unique_ptr<RadiositySweepChunk>& chunk = loaded_.chunks[task.chunk];
+    if (!chunk) {
+        absl::StatusOr<RadiosityOptions> options =
+            RadiosityOptionsOf(task.spec.radiosity, task.spec.adaptive.target_error);
+        if (!options.ok()) return options.status();
+        const absl::Time start = absl::Now();
+        absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> built;
+        arena_.execute([&] {
+            built = RadiositySweepChunk::Build(*loaded_.embree, *options, task.chunk, r.sweep_tasks,
+                                               &cancel);
+        });
+        if (!built.ok()) {
+            loaded_.chunks.erase(task.chunk);
+            return built.status();
+        }
+        chunk = std::move(*built);
+        Log()->info("job={} task={} form factors of chunk {}/{} in {:.2f} s", task.job_id,
+                    task.task.index, task.chunk, r.sweep_tasks,
+                    absl::ToDoubleSeconds(absl::Now() - start));
+    }
+    std::span<const Rgb> input = chunk->emission();
+    if (!task.radiosity_hash.empty()) {
+        if (loaded_.input_hash != task.radiosity_hash) {
+            absl::StatusOr<std::vector<Rgb>> read = ReadRadiosity(task.radiosity_hash);
+            if (!read.ok()) return read.status();
+            loaded_.input = std::move(*read);
+            loaded_.input_hash = task.radiosity_hash;
+        }
+        input = loaded_.input;
+    }
+    absl::StatusOr<SweepChunkResult> result;
+    arena_.execute([&] { result = chunk->Sweep(task.sweep, input); });
+    if (!result.ok()) return result.status();
+    return EncodeSweepResult(*result);
+}
+
+TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& cancel) {
+    // Pieces of one row and a few tens of thousands of samples: small enough that a cancel
+    // stops the work within a fraction of a second (RenderTile checks between rows), and exact
+    // sums make any split of the tile give the same bits.
+    constexpr uint64_t kSamplesPerPiece = 1 << 16;
+    const PixelRect& rect = task.task.rect;
+    const uint64_t step = std::max<uint64_t>(1, kSamplesPerPiece / uint64_t(rect.width));
+    const SampleOptions options{task.spec.clamp, task.spec.aovs, task.spec.sampler};
+    TileSums tile(rect, options.aovs);
+    std::mutex stats_mutex;
+    arena_.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<int>(rect.y0, rect.y0 + rect.height, 1),
+            [&](const tbb::blocked_range<int>& rows) {
+                for (int y = rows.begin(); y != rows.end(); ++y) {
+                    const PixelRect row_rect{rect.x0, y, rect.width, 1};
+                    TileSums row(row_rect, options.aovs);
+                    for (uint64_t s = task.task.sample_begin; s < task.task.sample_end && !cancel;
+                         s += step) {
+                        row += RenderTile(
+                            *loaded_.camera, *loaded_.tracer, row_rect, task.spec.seed, s,
+                            std::min(s + step, task.task.sample_end), options, &cancel);
+                    }
+                    std::copy(row.pixels.begin(), row.pixels.end(), &tile.at(rect.x0, y));
+                    if (options.aovs != 0) {
+                        std::copy(row.aov_pixels.begin(), row.aov_pixels.end(),
+                                  tile.aov_pixels.begin() + ptrdiff_t(tile.Index(rect.x0, y)));
+                    }
+                    std::lock_guard<std::mutex> lock(stats_mutex);
+                    tile.stats += row.stats;
+                }
+            });
+    });
+    return tile;
+}
+
+absl::Status Worker::RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                                 ServerConnection::TaskResult& result, RenderStats& stats) {
+    if (!loaded_.frame) {
+        // Cached per job (loaded_.job_id), through the conversions local mode uses, so one job's
+        // settings give local mode's kernel.
+        const JobSpec& spec = task.spec;
+        absl::StatusOr<std::unique_ptr<SplatRenderer>> made = MakeSplatRenderer(
+            MethodOf(spec), *loaded_.embree, *loaded_.camera, SplatRenderSettingsOf(spec));
+        if (!made.ok()) return made.status();
+        loaded_.frame = std::move(*made);
+    }
+    const SplatWork work{task.task.rect, task.task.sample_begin, task.task.sample_end,
+                         task.path_begin, task.path_end};
+    TileSums camera(task.task.rect, 0);
+    SplatList splats(loaded_.camera->width(), loaded_.camera->height());
+    // The renderer runs tbb inside: in this worker's arena, so --threads bounds it.
+    arena_.execute([&] { loaded_.frame->Render(work, camera, splats, &cancel); });
+    if (cancel) return absl::CancelledError("splat task cancelled");
+    stats = camera.stats;
+    result.bytes = EncodeTileSums(camera);
+    result.splats = EncodeSplatList(splats);
+    const size_t bytes = result.bytes.size() + result.splats->size();
+    // Above the bound the coordinator would refuse the message: said here, in its terms.
+    if (bytes > size_t(kMaxTaskResultBytes) - 4096) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "the result of job ", task.job_id, " task ", task.task.index, " is ", bytes,
+            " bytes, above the coordinator's bound of ", kMaxTaskResultBytes,
+            " (lf::kMaxTaskResultBytes): render with more --passes (fewer light paths a task) "
+            "or a finite --max-depth"));
+    }
+    return absl::OkStatus();
+}
+
+void Worker::SendResult(const TaskAssignment& task, ServerConnection::TaskResult result,
+                        double seconds) {
+    std::unique_lock<std::mutex> lock(send_mutex_);
+    send_cv_.wait(lock, [&] { return !pending_ && !sending_; });
+    pending_ = PendingResult{task, std::move(result), seconds};
+    send_cv_.notify_all();
+}
+
+void Worker::FlushSends() {
+    std::unique_lock<std::mutex> lock(send_mutex_);
+    send_cv_.wait(lock, [&] { return !pending_ && !sending_; });
+}
+
+void Worker::SenderLoop() {
+    // It sends one task's result while the next task runs: its lines are neither's log.
+    TaskLogSink::IgnoreThisThread();
+    std::unique_lock<std::mutex> lock(send_mutex_);
+    while (true) {
+        send_cv_.wait(lock, [&] { return pending_ || sender_stop_; });
+        if (!pending_) return;  // stopping, and everything handed over is sent
+        const PendingResult sending = std::move(*pending_);
+        pending_.reset();
+        sending_ = true;
+        lock.unlock();
+        const TaskAssignment& task = sending.task;
+        const absl::Status sent = server_.Complete(task.lease_id, sending.result, sending.seconds);
+        if (sent.ok()) {
+            Log()->debug("job={} task={} done in {:.2f} s", task.job_id, task.task.index,
+                         sending.seconds);
+        } else {
+            Log()->warn("job={} task={} result not taken: {}", task.job_id, task.task.index,
+                        std::string(sent.message()));
+        }
+        lock.lock();
+        sending_ = false;
+        send_cv_.notify_all();
+    }
+}
+
+}  // namespace lf
