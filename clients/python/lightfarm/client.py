@@ -29,7 +29,7 @@ UPLOAD_SECONDS = 600.0
 FETCH_SECONDS = 1800.0
 WATCH_STREAM_SECONDS = 60.0  # one WatchJob stream; the watch goes on across them
 
-# Keepalive as proto/channel.cc: a dead link is found within 15 s.
+# Keepalive as proto/src/channel.cc: a dead link is found within 15 s.
 _CHANNEL_OPTIONS = [
     ("grpc.keepalive_time_ms", 10000),
     ("grpc.keepalive_timeout_ms", 5000),
