@@ -53,7 +53,6 @@ class TileMerger {
   protected:
     TileMerger(int width, int height, std::shared_ptr<TileStore> store)
         : width_(width), height_(height), store_(std::move(store)) {}
-    TileStore& mutable_store() { return *store_; }
     // Adds `sums` to tile `tile`'s in the store; the tile's sums after, or the store's error (and
     // nothing added). InvalidArgument when `sums` carries other AOVs than the store.
     absl::StatusOr<TileSums> AddToTile(int tile, const TileSums& sums);
