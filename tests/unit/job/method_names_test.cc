@@ -1,5 +1,5 @@
 // Method names are compared in one place: the registry (lf/job/method_registry.h) and the CLI's
-// flag parsing (client/*_flags.cc). Anywhere else a comparison with a method's name is a second
+// flag parsing (client/src/*_flags.cc). Anywhere else a comparison with a method's name is a second
 // registry that drifts; this test greps the source tree for them and lists each.
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 bool Allowed(const fs::path& relative) {
     const std::string name = relative.filename().string();
     return relative == fs::path("job/src/method_registry.cc") ||
-           (relative.parent_path() == fs::path("client") && name.ends_with("_flags.cc"));
+           (relative.parent_path() == fs::path("client/src") && name.ends_with("_flags.cc"));
 }
 
 TEST(MethodNames, AreComparedOnlyInTheRegistryAndTheFlagParsers) {
