@@ -38,13 +38,6 @@ std::pair<Vec3d, Vec3d> Scene::Bounds() const {
     return {lo, hi};
 }
 
-bool Scene::AllLambertian() const {
-    for (const Material& m : materials) {
-        if (m.type != Material::Type::kLambert) return false;
-    }
-    return true;
-}
-
 bool Scene::HasLights() const {
     if (!point_lights.empty() || !spot_lights.empty() || !directional_lights.empty() ||
         environment) {

@@ -217,7 +217,6 @@ struct Scene {
 
     // Axis-aligned bounds of all geometry.
     std::pair<Vec3d, Vec3d> Bounds() const;
-    bool AllLambertian() const;
     bool HasLights() const;  // any emitter: emissive material or a light of any kind
 };
 
