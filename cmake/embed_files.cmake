@@ -1,5 +1,5 @@
 # cmake -DOUTPUT=file.cc -DBASE=dir -DFILES=a,b -P embed_files.cmake
-# Writes a C++ file that defines lf::WebAssets() (server/web_assets.h): each file's bytes as an
+# Writes a C++ file that defines lf::WebAssets() (lf/server/web_assets.h): each file's bytes as an
 # array, named by its path under BASE.
 string(REPLACE "," ";" FILES "${FILES}")
 set(arrays "")

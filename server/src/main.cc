@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
     // port and answering clients at random.
     builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
-    // Clients and workers ping every lf::kKeepaliveInterval to find dead links (proto/channel.h);
+    // Clients and workers ping every lf::kKeepaliveInterval to find dead links (lf/proto/channel.h);
     // gRPC's default would answer pings that often with GOAWAY.
     builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
     builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,

@@ -32,7 +32,7 @@ absl::StatusOr<JobRecord> DecodeLegacy(std::string_view id, std::string_view rec
 
 // Schema versions (PRAGMA user_version): 0, records only, states by enum position, request ids
 // found inside the JSON; 1, the columns List and FindRequest select on, states by name; 2,
-// records in the StoredJob form (server/job_record_codec.h), those before in the legacy form.
+// records in the StoredJob form (lf/server/job_record_codec.h), those before in the legacy form.
 constexpr int kSchemaVersion = 2;
 
 }  // namespace

@@ -853,7 +853,7 @@ class Farm:
 
 def unauthenticated(text):
     """The CLI prints the server's message, not the status code's name: these are the
-    UNAUTHENTICATED messages of server/auth.cc."""
+    UNAUTHENTICATED messages of server/src/auth.cc."""
     return any(m in text for m in ("UNAUTHENTICATED", "not one of this server's",
                                    "requires a token", "was revoked"))
 

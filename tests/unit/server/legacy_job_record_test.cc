@@ -1,4 +1,4 @@
-// Records of the first stored form (server/legacy_job_record.h), printed by its encoder before
+// Records of the first stored form (lf/server/legacy_job_record.h), printed by its encoder before
 // the StoredJob form replaced it (legacy_job_records.h): they decode to the jobs they were
 // written from, and a store of that form opened by this server is upgraded, lists them, finds
 // them by request id and owner, and recovers the jobs that had not ended.

@@ -1,4 +1,4 @@
-// Job records in the first stored form (server/legacy_job_record.h), as its encoder printed them
+// Job records in the first stored form (lf/server/legacy_job_record.h), as its encoder printed them
 // before the StoredJob form replaced it: what the databases of earlier servers hold.
 #pragma once
 

@@ -17,7 +17,7 @@ TEST(ResultSizeLimitTest, LargestResultFitsInOneSqliteBlob) {
     const int64_t limit = sqlite3_limit(db, SQLITE_LIMIT_LENGTH, -1);
     sqlite3_close(db);
     // The worker sends up to kMaxTaskResultBytes - 4096 bytes of sums and splats; the LFFR
-    // header adds 16 (server/splat_result_codec.cc).
+    // header adds 16 (job/src/splat_result_codec.cc).
     EXPECT_LE(int64_t(kMaxTaskResultBytes) + 16, limit);
 }
 
