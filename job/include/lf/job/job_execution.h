@@ -1,6 +1,6 @@
 // How one kind of job runs, apart from whoever runs it: its plan, its merger, which tasks start
 // it and which a result appends or unlocks, its time limit, and what a task's result means. The
-// coordinator's scheduler (server/scheduler.h) asks a job's JobExecution for everything
+// coordinator's scheduler (lf/server/scheduler.h) asks a job's JobExecution for everything
 // kind-specific, and local mode (lf/local/local_executor.h) runs the same objects on threads.
 //
 // The kinds: fixed tiles (lf/job/tile_execution.h), adaptive tiles

@@ -108,7 +108,7 @@ class RadiosityRenderer : public RadianceEstimator {
     RadiosityReport report_;
 };
 
-// One patch-group task of the farm's Jacobi solve (server/radiosity_solve.h): the form-factor
+// One patch-group task of the farm's Jacobi solve (lf/job/radiosity_solve.h): the form-factor
 // rows of chunk `chunk` of `chunks` of the patch groups, computed once, then swept against the
 // radiosity of each sweep in turn. The sweep's sums are those SolveRadiosity's Jacobi solver
 // makes, so the farm's solution has its bits.

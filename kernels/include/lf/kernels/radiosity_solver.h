@@ -67,7 +67,7 @@ void GatherGroup(const RadiositySystem& system, int32_t group, std::span<const R
 
 // GatherGroup, and the group's share of a Jacobi sweep's residual: change = ||out - b|| and
 // power = ||b|| over the group's sides. A sweep sums these in group order, locally and on the
-// farm alike (server/radiosity_solve.h), so both stop after the same sweep with the same bits.
+// farm alike (lf/job/radiosity_solve.h), so both stop after the same sweep with the same bits.
 struct GroupSweep {
     double change = 0, power = 0;
 };
