@@ -97,6 +97,7 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
         Log()->error("job={} refused: {}", id, std::string(s.message()));
         locked.lock.lock();
+        leases_.ForgetJob(id);  // a worker may have leased one of its tasks meanwhile
         active_.erase(id);
         return s;
     }
@@ -534,7 +535,9 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
         FailJob(job, absl::StrCat("task ", t, " failed ", task.failures, " times; last: ", reason));
         return;
     }
-    if (leases_.Current(job.id(), t).empty()) {  // otherwise another lease of it still renders
+    // Otherwise another lease of it still renders; or, when several of its leases expired in
+    // one tick (TakeExpired ends them all first), an earlier one's requeue queued it already.
+    if (leases_.Current(job.id(), t).empty() && job.states.state(t) == TaskState::kLeased) {
         job.Move(t, TaskState::kQueued);
         ++job.record.retries;
     }

@@ -341,6 +341,30 @@ TEST_F(SchedulerTest, StragglersTaskIsLeasedAgainNearTheEndAndTheFirstResultWins
     EXPECT_EQ(Job(id).tasks_running, 0);
 }
 
+// A task's original lease and its speculative copy expiring in the same tick of the timeout
+// checker (both workers gone at once, or the checker late): each counts as a failure, the task
+// is queued again once, and the job goes on (it used to move the task from queued to queued, a
+// broken invariant that aborted the coordinator).
+TEST_F(SchedulerTest, OriginalAndSpeculativeCopyExpiringInOneTickQueueTheTaskOnce) {
+    const std::string id = Submit(0, 16);  // two tasks
+    const TaskAssignment slow = *scheduler_.LeaseTask("slow");
+    const TaskAssignment fast = *scheduler_.LeaseTask("fast");
+    ASSERT_TRUE(scheduler_.Complete(fast.lease_id, "fast", Result(fast)).ok());
+    now_ += absl::Seconds(2);
+    const TaskAssignment copy = *scheduler_.LeaseTask("fast");
+    ASSERT_EQ(copy.task.index, slow.task.index);
+    now_ += absl::Seconds(30);  // past both leases
+    EXPECT_EQ(scheduler_.ExpireLeases(), 2);
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+    EXPECT_EQ(Job(id).tasks_running, 0);
+    EXPECT_EQ(Job(id).retries, 1);
+    const std::optional<TaskAssignment> again = scheduler_.LeaseTask("third");
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->task.index, slow.task.index);
+    ASSERT_TRUE(scheduler_.Complete(again->lease_id, "third", Result(*again)).ok());
+    EXPECT_EQ(Job(id).tasks_done, 2);
+}
+
 TEST_F(SchedulerTest, FailedSpeculativeCopyLeavesTheOriginalRunning) {
     const std::string id = Submit(0, 16);
     const TaskAssignment slow = *scheduler_.LeaseTask("slow");
