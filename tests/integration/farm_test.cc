@@ -1404,7 +1404,9 @@ TEST_P(FarmSplat, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
 TEST_P(FarmSplat, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
     StartServer();
     StartWorker("w1");
-    const std::string job = Submit(scene_, Flags(1024, 3, Split()));
+    // ppm's passes of 65536 photons make tasks of seconds, so that the cancel lands mid-task:
+    // with 4096 an idle machine often finished the task before its next heartbeat.
+    const std::string job = Submit(scene_, Flags(1024, 3, Split(/*photons=*/65536)));
     ASSERT_TRUE(WaitForTasksDone(job, 2, milliseconds(60000)));
     const std::string preview = (dir_ / "preview.exr").string();
     const CliRun fetch = Farmctl("fetch --preview " + job + " -o " + preview);
