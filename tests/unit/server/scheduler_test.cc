@@ -295,7 +295,8 @@ TEST_F(SchedulerTest, ResultForALeaseTheWorkerDoesNotHoldIsRefused) {
     EXPECT_FALSE(scheduler_.Heartbeat(lease.lease_id, "b"));
     ASSERT_TRUE(scheduler_.Fail(lease.lease_id, "b", "?", FailureKind::kTaskError).ok());
     std::string forged = lease.lease_id;
-    forged.back() = '7';  // an attempt never handed out
+    // An id never handed out: one hex digit changed (ids are random, so it may already be 7).
+    forged.back() = forged.back() == '7' ? '8' : '7';
     EXPECT_EQ(scheduler_.Complete(forged, "a", Result(lease)).status().code(),
               absl::StatusCode::kFailedPrecondition);
     EXPECT_EQ(Job(id).tasks_done, 0);
