@@ -84,10 +84,11 @@ try {
     start('lightfarm-worker', ['--server', grpcAddress, '--token-file', workerToken, '--name', name, '--threads', '1', '--cache-dir', join(dir, `cache-${name}`)]);
   }
 
-  // Enough small tasks to watch for some 20 s: 16 tiles of 64x64 in passes of 256 samples.
+  // Enough tasks to watch for some 30 s even on a fast idle machine (a pass of 256 samples on a
+  // 16x16 tile takes 0.05 s there): 16 tiles of 64x64 in passes of 2048 samples.
   const scene = join(scenesDir, 'cornell_box.json');
   const submit = (extra) => cli(['submit', scene, '--resolution', '64x64', '--tile', '16', ...extra], aliceToken).split('\n').pop().trim();
-  const job = submit(['--spp', '2048', '--passes', '8', '--name', 'watched']);
+  const job = submit(['--spp', '16384', '--passes', '8', '--name', 'watched']);
   console.log(`job ${job} submitted`);
 
   browser = await chromium.launch({
