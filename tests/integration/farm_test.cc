@@ -1405,9 +1405,11 @@ TEST_P(FarmSplat, CoordinatorKilledMidJobCompletesWithTheLocalBits) {
 TEST_P(FarmSplat, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
     StartServer();
     StartWorker("w1");
-    // ppm's passes of 65536 photons make tasks of seconds, so that the cancel lands mid-task:
-    // with 4096 an idle machine often finished the task before its next heartbeat.
-    const std::string job = Submit(scene_, Flags(1024, 3, Split(/*photons=*/65536)));
+    // Tasks of a second or more, so that the cancel lands mid-task: ppm's passes of 65536
+    // photons, light's 1024 paths a pixel a task (with 4096 photons, or 64 light paths a pixel,
+    // an idle machine often finished the task before its next heartbeat).
+    const uint64_t spp = GetParam() == "light" ? 16384 : 1024;
+    const std::string job = Submit(scene_, Flags(spp, 3, Split(/*photons=*/65536)));
     ASSERT_TRUE(WaitForTasksDone(job, 2, milliseconds(60000)));
     const std::string preview = (dir_ / "preview.exr").string();
     const CliRun fetch = Farmctl("fetch --preview " + job + " -o " + preview);
