@@ -2,13 +2,14 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "lf/core/log.h"
+#include "lf/proto/grpc_status.h"
 #include "lf/version.h"
 #include "lf/wire/conversions.h"
-#include "lf/proto/grpc_status.h"
 
 namespace lf {
 
@@ -31,7 +32,8 @@ std::string Who(const Caller& caller) {
 // Streams a file in chunks; stops early when the client goes away. The client hears `what` could
 // not be read, never where the file is: paths of the data folder stay in the server's log.
 grpc::Status StreamFile(grpc::ServerContext* context, const std::string& path,
-                        const std::string& what, grpc::ServerWriter<pb::Chunk>* writer) {
+                        const std::string& what,
+                        const std::function<bool(const pb::Chunk&)>& write) {
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         Log()->error("{}: {} cannot be read", what, path);
@@ -43,7 +45,7 @@ grpc::Status StreamFile(grpc::ServerContext* context, const std::string& path,
         in.read(buffer.data(), std::streamsize(buffer.size()));
         if (in.gcount() == 0) break;
         chunk.set_data(buffer.data(), size_t(in.gcount()));
-        if (context->IsCancelled() || !writer->Write(chunk)) {
+        if (context->IsCancelled() || !write(chunk)) {
             return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
         }
     }
@@ -94,6 +96,73 @@ absl::StatusOr<Caller> CallGuard::Check(grpc::ServerContext* context, const char
     return caller;
 }
 
+absl::Status CheckRequestSize(const char* rpc, size_t bytes, size_t max_bytes) {
+    if (bytes <= max_bytes) return absl::OkStatus();
+    return absl::ResourceExhaustedError(absl::StrCat(rpc, ": a request of ", bytes,
+                                                     " bytes is above this call's bound of ",
+                                                     max_bytes, " bytes"));
+}
+
+JobServiceImpl::JobServiceImpl(Farm& farm, CallGuard guard, JobServiceOptions options)
+    : ReadAfterAuth("lightfarm.v1.JobService", guard), farm_(farm), options_(options) {
+    using std::bind_front;
+    Unary<pb::MissingBlobsRequest, pb::MissingBlobsResponse>(
+        "MissingBlobs", Action::kUploadBlobs, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::MissingBlobs, this));
+    Unary<pb::BlobUploadOffsetRequest, pb::BlobUploadOffsetResponse>(
+        "BlobUploadOffset", Action::kUploadBlobs, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::BlobUploadOffset, this));
+    Unary<pb::SubmitJobRequest, pb::SubmitJobResponse>(
+        "SubmitJob", Action::kSubmit, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::SubmitJob, this));
+    Unary<pb::GetJobRequest, pb::Job>("GetJob", Action::kReadJobs, kMaxRequestBytes,
+                                      bind_front(&JobServiceImpl::GetJob, this));
+    Unary<pb::ListJobsRequest, pb::ListJobsResponse>("ListJobs", Action::kReadJobs,
+                                                     kMaxRequestBytes,
+                                                     bind_front(&JobServiceImpl::ListJobs, this));
+    ServerStreaming<pb::WatchJobRequest, pb::Job>("WatchJob", Action::kReadJobs,
+                                                  bind_front(&JobServiceImpl::WatchJob, this));
+    Unary<pb::CancelJobRequest, pb::Job>("CancelJob", Action::kCancelJob, kMaxRequestBytes,
+                                         bind_front(&JobServiceImpl::CancelJob, this));
+    Unary<pb::SetJobPriorityRequest, pb::Job>("SetJobPriority", Action::kSetPriority,
+                                              kMaxRequestBytes,
+                                              bind_front(&JobServiceImpl::SetJobPriority, this));
+    ServerStreaming<pb::FetchResultRequest, pb::Chunk>(
+        "FetchResult", Action::kReadJobs, bind_front(&JobServiceImpl::FetchResult, this));
+    Unary<pb::DeleteJobRequest, pb::DeleteJobResponse>(
+        "DeleteJob", Action::kDeleteJob, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::DeleteJob, this));
+    Unary<pb::ListWorkersRequest, pb::ListWorkersResponse>(
+        "ListWorkers", Action::kListWorkers, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::ListWorkers, this));
+    Unary<pb::ListTasksRequest, pb::ListTasksResponse>(
+        "ListTasks", Action::kReadJobs, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::ListTasks, this));
+    Unary<pb::GetTaskLogsRequest, pb::GetTaskLogsResponse>(
+        "GetTaskLogs", Action::kReadJobs, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::GetTaskLogs, this));
+}
+
+WorkerServiceImpl::WorkerServiceImpl(Farm& farm, CallGuard guard)
+    : ReadAfterAuth("lightfarm.v1.WorkerService", guard), farm_(farm) {
+    using std::bind_front;
+    Unary<pb::LeaseTaskRequest, pb::LeaseTaskResponse>(
+        "LeaseTask", Action::kWork, kMaxRequestBytes,
+        bind_front(&WorkerServiceImpl::LeaseTask, this));
+    Unary<pb::HeartbeatRequest, pb::HeartbeatResponse>(
+        "Heartbeat", Action::kWork, kMaxRequestBytes,
+        bind_front(&WorkerServiceImpl::Heartbeat, this));
+    // The one large message: a task's result, from a worker whose token was checked first.
+    Unary<pb::CompleteTaskRequest, pb::CompleteTaskResponse>(
+        "CompleteTask", Action::kWork, size_t(kMaxTaskResultBytes),
+        bind_front(&WorkerServiceImpl::CompleteTask, this));
+    Unary<pb::FailTaskRequest, pb::FailTaskResponse>(
+        "FailTask", Action::kWork, kMaxRequestBytes,
+        bind_front(&WorkerServiceImpl::FailTask, this));
+    ServerStreaming<pb::FetchBlobRequest, pb::Chunk>(
+        "FetchBlob", Action::kWork, bind_front(&WorkerServiceImpl::FetchBlob, this));
+}
+
 absl::StatusOr<JobRecord> JobServiceImpl::VisibleJob(const Caller& caller,
                                                      const std::string& job_id) const {
     absl::StatusOr<JobRecord> job = farm_.scheduler().Get(job_id);
@@ -102,26 +171,20 @@ absl::StatusOr<JobRecord> JobServiceImpl::VisibleJob(const Caller& caller,
     return job;
 }
 
-grpc::Status JobServiceImpl::MissingBlobs(grpc::ServerContext* context,
-                                          const pb::MissingBlobsRequest* req,
+grpc::Status JobServiceImpl::MissingBlobs(grpc::ServerContext* context, const Caller& caller,
+                                          const pb::MissingBlobsRequest& req,
                                           pb::MissingBlobsResponse* resp) {
-    if (auto c = guard_.Check(context, "MissingBlobs", Action::kUploadBlobs); !c.ok()) {
-        return ToGrpcStatus(c.status());
-    }
-    for (const std::string& hash : req->hashes()) {
+    for (const std::string& hash : req.hashes()) {
         // Touched: the client will not upload it, and may submit a job naming it.
         if (!farm_.blobs().Touch(hash)) resp->add_hashes(hash);
     }
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::BlobUploadOffset(grpc::ServerContext* context,
-                                              const pb::BlobUploadOffsetRequest* req,
+grpc::Status JobServiceImpl::BlobUploadOffset(grpc::ServerContext* context, const Caller& caller,
+                                              const pb::BlobUploadOffsetRequest& req,
                                               pb::BlobUploadOffsetResponse* resp) {
-    if (auto c = guard_.Check(context, "BlobUploadOffset", Action::kUploadBlobs); !c.ok()) {
-        return ToGrpcStatus(c.status());
-    }
-    absl::StatusOr<uint64_t> offset = farm_.blobs().UploadOffset(req->hash(), req->size());
+    absl::StatusOr<uint64_t> offset = farm_.blobs().UploadOffset(req.hash(), req.size());
     if (!offset.ok()) return ToGrpcStatus(offset.status());
     resp->set_offset(*offset);
     return grpc::Status::OK;
@@ -168,67 +231,61 @@ grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext* context,
     return ToGrpcStatus(s);
 }
 
-grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context,
-                                       const pb::SubmitJobRequest* req,
+grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context, const Caller& caller,
+                                       const pb::SubmitJobRequest& req,
                                        pb::SubmitJobResponse* resp) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "SubmitJob", Action::kSubmit);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
     // Proto3 keeps enum values this build does not know; JobSpec cannot hold them, so they are
     // refused here rather than rendered as something the client did not ask for.
-    if (!pb::PixelFilterType_IsValid(req->params().filter_type())) {
+    if (!pb::PixelFilterType_IsValid(req.params().filter_type())) {
         return ToGrpcStatus(absl::InvalidArgumentError(
-            absl::StrCat("params.filter_type ", req->params().filter_type(),
+            absl::StrCat("params.filter_type ", req.params().filter_type(),
                          ": unknown pixel filter; expected box, gaussian or blackman-harris")));
     }
-    if (!pb::SamplerType_IsValid(req->params().sampler())) {
+    if (!pb::SamplerType_IsValid(req.params().sampler())) {
         return ToGrpcStatus(absl::InvalidArgumentError(
-            absl::StrCat("params.sampler ", req->params().sampler(),
+            absl::StrCat("params.sampler ", req.params().sampler(),
                          ": unknown sampler; expected independent or sobol")));
     }
-    if (!pb::LightStrategy_IsValid(req->params().light_strategy())) {
+    if (!pb::LightStrategy_IsValid(req.params().light_strategy())) {
         return ToGrpcStatus(absl::InvalidArgumentError(
-            absl::StrCat("params.light_strategy ", req->params().light_strategy(),
+            absl::StrCat("params.light_strategy ", req.params().light_strategy(),
                          ": unknown light sampling strategy; expected power or bvh")));
     }
-    JobSpec spec = FromProto(*req);
-    spec.owner = caller->name;
+    JobSpec spec = FromProto(req);
+    spec.owner = caller.name;
     absl::StatusOr<std::string> id = farm_.Submit(std::move(spec));
     if (!id.ok()) {
-        Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req->name()), Peer(context),
+        Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req.name()), Peer(context),
                     LogSafe(std::string(id.status().message())));
         return ToGrpcStatus(id.status());
     }
-    Log()->info("job={} submitted by {} from {}: \"{}\"", *id, Who(*caller), Peer(context),
-                LogSafe(req->name()));
+    Log()->info("job={} submitted by {} from {}: \"{}\"", *id, Who(caller), Peer(context),
+                LogSafe(req.name()));
     resp->set_job_id(*id);
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::GetJob(grpc::ServerContext* context, const pb::GetJobRequest* req,
-                                    pb::Job* resp) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "GetJob", Action::kReadJobs);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
-    absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id());
+grpc::Status JobServiceImpl::GetJob(grpc::ServerContext* context, const Caller& caller,
+                                    const pb::GetJobRequest& req, pb::Job* resp) {
+    absl::StatusOr<JobRecord> job = VisibleJob(caller, req.job_id());
     if (!job.ok()) return ToGrpcStatus(job.status());
     ToProto(*job, resp);
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext* context, const pb::ListJobsRequest* req,
-                                      pb::ListJobsResponse* resp) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "ListJobs", Action::kReadJobs);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
-    if (req->page_size() < 0) {
+grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext* context, const Caller& caller,
+                                      const pb::ListJobsRequest& req, pb::ListJobsResponse* resp) {
+    if (req.page_size() < 0) {
         return ToGrpcStatus(absl::InvalidArgumentError(
-            absl::StrCat("ListJobs: page_size ", req->page_size(), " is negative")));
+            absl::StrCat("ListJobs: page_size ", req.page_size(), " is negative")));
     }
     const int page_size =
-        req->page_size() == 0 ? kDefaultPageSize : std::min(req->page_size(), kMaxPageSize);
+        req.page_size() == 0 ? kDefaultPageSize : std::min(req.page_size(), kMaxPageSize);
     // The token is the seq of the page's last job: the next page starts below it.
     JobQuery query{.limit = size_t(page_size) + 1};
-    if (caller->role != Role::kAdmin) query.owner = caller->name;
-    if (!req->page_token().empty() &&
-        (!absl::SimpleAtoi(req->page_token(), &query.before_seq) || query.before_seq == 0)) {
+    if (caller.role != Role::kAdmin) query.owner = caller.name;
+    if (!req.page_token().empty() &&
+        (!absl::SimpleAtoi(req.page_token(), &query.before_seq) || query.before_seq == 0)) {
         return ToGrpcStatus(
             absl::InvalidArgumentError("ListJobs: page_token is not one this server gave out"));
     }
@@ -242,12 +299,11 @@ grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext* context, const pb::Li
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::WatchJobRequest* req,
-                                      grpc::ServerWriter<pb::Job>* writer) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "WatchJob", Action::kReadJobs);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
+grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const Caller& caller,
+                                      const pb::WatchJobRequest& req,
+                                      const std::function<bool(const pb::Job&)>& write) {
     // Checked once: a job's owner never changes.
-    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+    if (absl::StatusOr<JobRecord> job = VisibleJob(caller, req.job_id()); !job.ok()) {
         return ToGrpcStatus(job.status());
     }
     // Each stream holds a server thread until its job ends: bounded, so that watchers cannot
@@ -257,7 +313,7 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::Wa
         ~Slot() { --count; }
     } slot{watchers_};
     if (++watchers_ > options_.max_watchers) {
-        Log()->warn("watch of job={} from {} refused: {} watchers already", LogSafe(req->job_id()),
+        Log()->warn("watch of job={} from {} refused: {} watchers already", LogSafe(req.job_id()),
                     Peer(context), options_.max_watchers);
         return ToGrpcStatus(absl::ResourceExhaustedError(absl::StrCat(
             "this server already serves its most watchers, ", options_.max_watchers,
@@ -273,13 +329,13 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::Wa
     // Taken before each read, so a change during the read or the pause is never missed.
     uint64_t version = scheduler.WaitForChange(0, absl::InfinitePast());
     while (!context->IsCancelled()) {
-        absl::StatusOr<JobRecord> job = scheduler.Get(req->job_id());
+        absl::StatusOr<JobRecord> job = scheduler.Get(req.job_id());
         if (!job.ok()) return ToGrpcStatus(job.status());
         pb::Job message;
         ToProto(*job, &message);
         std::string bytes = message.SerializeAsString();
         if (bytes != last_sent || absl::Now() - last_time > kMaxGap) {
-            if (!writer->Write(message)) break;
+            if (!write(message)) break;
             last_sent = std::move(bytes);
             last_time = absl::Now();
         }
@@ -290,99 +346,84 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const pb::Wa
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context,
-                                       const pb::CancelJobRequest* req, pb::Job* resp) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "CancelJob", Action::kCancelJob);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
-    if (absl::StatusOr<JobRecord> seen = VisibleJob(*caller, req->job_id()); !seen.ok()) {
+grpc::Status JobServiceImpl::CancelJob(grpc::ServerContext* context, const Caller& caller,
+                                       const pb::CancelJobRequest& req, pb::Job* resp) {
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(caller, req.job_id()); !seen.ok()) {
         return ToGrpcStatus(seen.status());
     }
-    absl::StatusOr<JobRecord> job = farm_.scheduler().Cancel(req->job_id());
+    absl::StatusOr<JobRecord> job = farm_.scheduler().Cancel(req.job_id());
     if (!job.ok()) return ToGrpcStatus(job.status());
-    Log()->info("job={} cancelled by {} from {}", job->id, Who(*caller), Peer(context));
+    Log()->info("job={} cancelled by {} from {}", job->id, Who(caller), Peer(context));
     ToProto(*job, resp);
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::SetJobPriority(grpc::ServerContext* context,
-                                            const pb::SetJobPriorityRequest* req, pb::Job* resp) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "SetJobPriority", Action::kSetPriority);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
-    if (absl::StatusOr<JobRecord> seen = VisibleJob(*caller, req->job_id()); !seen.ok()) {
+grpc::Status JobServiceImpl::SetJobPriority(grpc::ServerContext* context, const Caller& caller,
+                                            const pb::SetJobPriorityRequest& req, pb::Job* resp) {
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(caller, req.job_id()); !seen.ok()) {
         return ToGrpcStatus(seen.status());
     }
-    absl::StatusOr<JobRecord> job = farm_.SetPriority(req->job_id(), req->priority());
+    absl::StatusOr<JobRecord> job = farm_.SetPriority(req.job_id(), req.priority());
     if (!job.ok()) return ToGrpcStatus(job.status());
-    Log()->info("job={} priority set to {} by {} from {}", job->id, req->priority(), Who(*caller),
+    Log()->info("job={} priority set to {} by {} from {}", job->id, req.priority(), Who(caller),
                 Peer(context));
     ToProto(*job, resp);
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context,
-                                         const pb::FetchResultRequest* req,
-                                         grpc::ServerWriter<pb::Chunk>* writer) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "FetchResult", Action::kReadJobs);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
-    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context, const Caller& caller,
+                                         const pb::FetchResultRequest& req,
+                                         const std::function<bool(const pb::Chunk&)>& write) {
+    if (absl::StatusOr<JobRecord> job = VisibleJob(caller, req.job_id()); !job.ok()) {
         return ToGrpcStatus(job.status());
     }
-    absl::StatusOr<std::string> path = farm_.ResultFile(req->job_id(), req->preview());
+    absl::StatusOr<std::string> path = farm_.ResultFile(req.job_id(), req.preview());
     if (!path.ok()) return ToGrpcStatus(path.status());
-    return StreamFile(context, *path, "the result of job " + req->job_id(), writer);
+    return StreamFile(context, *path, "the result of job " + req.job_id(), write);
 }
 
-grpc::Status JobServiceImpl::DeleteJob(grpc::ServerContext* context,
-                                       const pb::DeleteJobRequest* req, pb::DeleteJobResponse*) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "DeleteJob", Action::kDeleteJob);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
-    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+grpc::Status JobServiceImpl::DeleteJob(grpc::ServerContext* context, const Caller& caller,
+                                       const pb::DeleteJobRequest& req, pb::DeleteJobResponse*) {
+    if (absl::StatusOr<JobRecord> job = VisibleJob(caller, req.job_id()); !job.ok()) {
         return ToGrpcStatus(job.status());
     }
-    if (absl::Status s = farm_.DeleteJob(req->job_id()); !s.ok()) return ToGrpcStatus(s);
-    Log()->info("job={} deleted by {} from {}", LogSafe(req->job_id()), Who(*caller),
-                Peer(context));
+    if (absl::Status s = farm_.DeleteJob(req.job_id()); !s.ok()) return ToGrpcStatus(s);
+    Log()->info("job={} deleted by {} from {}", LogSafe(req.job_id()), Who(caller), Peer(context));
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context,
-                                         const pb::ListWorkersRequest*,
+grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context, const Caller& caller,
+                                         const pb::ListWorkersRequest& req,
                                          pb::ListWorkersResponse* resp) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "ListWorkers", Action::kListWorkers);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
     for (WorkerStatus& worker : farm_.scheduler().Workers()) {
         // A submitter sees that a worker is busy, not with whose job.
-        if (worker.busy() && !VisibleJob(*caller, worker.job_id).ok()) worker.job_id = "(other)";
+        if (worker.busy() && !VisibleJob(caller, worker.job_id).ok()) worker.job_id = "(other)";
         ToProto(worker, resp->add_workers());
     }
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::ListTasks(grpc::ServerContext* context,
-                                       const pb::ListTasksRequest* req,
+grpc::Status JobServiceImpl::ListTasks(grpc::ServerContext* context, const Caller& caller,
+                                       const pb::ListTasksRequest& req,
                                        pb::ListTasksResponse* resp) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "ListTasks", Action::kReadJobs);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
-    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+    if (absl::StatusOr<JobRecord> job = VisibleJob(caller, req.job_id()); !job.ok()) {
         return ToGrpcStatus(job.status());
     }
-    absl::StatusOr<std::vector<TaskStatus>> tasks = farm_.Tasks(req->job_id());
+    absl::StatusOr<std::vector<TaskStatus>> tasks = farm_.Tasks(req.job_id());
     if (!tasks.ok()) return ToGrpcStatus(tasks.status());
     for (const TaskStatus& task : *tasks) ToProto(task, resp->add_tasks());
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::GetTaskLogs(grpc::ServerContext* context,
-                                         const pb::GetTaskLogsRequest* req,
+grpc::Status JobServiceImpl::GetTaskLogs(grpc::ServerContext* context, const Caller& caller,
+                                         const pb::GetTaskLogsRequest& req,
                                          pb::GetTaskLogsResponse* resp) {
-    absl::StatusOr<Caller> caller = guard_.Check(context, "GetTaskLogs", Action::kReadJobs);
-    if (!caller.ok()) return ToGrpcStatus(caller.status());
-    if (absl::StatusOr<JobRecord> job = VisibleJob(*caller, req->job_id()); !job.ok()) {
+    if (absl::StatusOr<JobRecord> job = VisibleJob(caller, req.job_id()); !job.ok()) {
         return ToGrpcStatus(job.status());
     }
     absl::StatusOr<TaskLogPage> page = farm_.TaskLogs(
-        req->job_id(), req->has_task_index() ? std::optional<int>(req->task_index()) : std::nullopt,
-        req->after_seq(), req->max_lines());
+        req.job_id(), req.has_task_index() ? std::optional<int>(req.task_index()) : std::nullopt,
+        req.after_seq(), req.max_lines());
     if (!page.ok()) return ToGrpcStatus(page.status());
     for (const TaskLogLine& line : page->lines) ToProto(line, resp->add_lines());
     resp->set_next_seq(page->next_seq);
@@ -390,64 +431,55 @@ grpc::Status JobServiceImpl::GetTaskLogs(grpc::ServerContext* context,
     return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context,
-                                          const pb::LeaseTaskRequest* req,
+grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context, const Caller& caller,
+                                          const pb::LeaseTaskRequest& req,
                                           pb::LeaseTaskResponse* resp) {
-    if (auto c = guard_.Check(context, "LeaseTask", Action::kWork); !c.ok()) {
-        return ToGrpcStatus(c.status());
-    }
-    if (req->worker_id().empty()) {
+    if (req.worker_id().empty()) {
         return ToGrpcStatus(absl::InvalidArgumentError("LeaseTask: worker_id is empty"));
     }
-    if (req->version() != kBuildVersion) {
+    if (req.version() != kBuildVersion) {
         return ToGrpcStatus(absl::FailedPreconditionError(absl::StrCat(
-            "worker version ", req->version().empty() ? "(none)" : req->version(),
+            "worker version ", req.version().empty() ? "(none)" : req.version(),
             ", server version ", kBuildVersion, ": run workers of the server's build")));
     }
-    if (req->name().size() > kMaxWorkerNameBytes) {
+    if (req.name().size() > kMaxWorkerNameBytes) {
         return ToGrpcStatus(absl::InvalidArgumentError(
-            absl::StrCat("LeaseTask: worker name of ", req->name().size(),
+            absl::StrCat("LeaseTask: worker name of ", req.name().size(),
                          " bytes is above the limit of ", kMaxWorkerNameBytes)));
     }
-    const WorkerDescription about{req->name(), context->peer(), req->version()};
-    const absl::Duration wait = absl::Milliseconds(std::clamp(req->wait_ms(), 0, 10000));
+    const WorkerDescription about{req.name(), context->peer(), req.version()};
+    const absl::Duration wait = absl::Milliseconds(std::clamp(req.wait_ms(), 0, 10000));
     if (std::optional<TaskAssignment> lease =
-            farm_.scheduler().LeaseTask(req->worker_id(), absl::Now() + wait, &about)) {
+            farm_.scheduler().LeaseTask(req.worker_id(), absl::Now() + wait, &about)) {
         ToProto(*lease, resp->mutable_task());
     }
     return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* context,
-                                          const pb::HeartbeatRequest* req,
+grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* context, const Caller& caller,
+                                          const pb::HeartbeatRequest& req,
                                           pb::HeartbeatResponse* resp) {
-    if (auto c = guard_.Check(context, "Heartbeat", Action::kWork); !c.ok()) {
-        return ToGrpcStatus(c.status());
-    }
-    TakeTaskLog(farm_, *req);
-    resp->set_cancelled(!farm_.scheduler().Heartbeat(req->lease_id(), req->worker_id()));
+    TakeTaskLog(farm_, req);
+    resp->set_cancelled(!farm_.scheduler().Heartbeat(req.lease_id(), req.worker_id()));
     return grpc::Status::OK;
 }
 
-grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context,
-                                             const pb::CompleteTaskRequest* req,
+grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context, const Caller& caller,
+                                             const pb::CompleteTaskRequest& req,
                                              pb::CompleteTaskResponse*) {
-    if (auto c = guard_.Check(context, "CompleteTask", Action::kWork); !c.ok()) {
-        return ToGrpcStatus(c.status());
-    }
-    TakeTaskLog(farm_, *req);
+    TakeTaskLog(farm_, req);
     const absl::Status s =
-        req->radiosity_sweep().empty()
-            ? farm_.Complete(req->lease_id(), req->worker_id(), req->tile_sums(),
-                             req->has_radiosity()
-                                 ? std::optional<RadiosityFigures>(FromProto(req->radiosity()))
+        req.radiosity_sweep().empty()
+            ? farm_.Complete(req.lease_id(), req.worker_id(), req.tile_sums(),
+                             req.has_radiosity()
+                                 ? std::optional<RadiosityFigures>(FromProto(req.radiosity()))
                                  : std::nullopt,
                              // An encoded list is never empty: empty means a tile's result.
-                             req->splats().empty() ? std::nullopt
-                                                   : std::optional<std::string_view>(req->splats()))
-            : farm_.CompleteSweep(req->lease_id(), req->worker_id(), req->radiosity_sweep());
+                             req.splats().empty() ? std::nullopt
+                                                  : std::optional<std::string_view>(req.splats()))
+            : farm_.CompleteSweep(req.lease_id(), req.worker_id(), req.radiosity_sweep());
     if (!s.ok()) {
-        Log()->warn("{}", RefusedResultLine(req->lease_id(), req->worker_id(), context->peer(),
+        Log()->warn("{}", RefusedResultLine(req.lease_id(), req.worker_id(), context->peer(),
                                             std::string(s.message())));
     }
     return ToGrpcStatus(s);
@@ -460,29 +492,23 @@ std::string RefusedResultLine(std::string_view lease_id, std::string_view worker
                         LogSafe(peer), ": CompleteTask refused: ", LogSafe(why, 1024));
 }
 
-grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext* context,
-                                         const pb::FailTaskRequest* req, pb::FailTaskResponse*) {
-    if (auto c = guard_.Check(context, "FailTask", Action::kWork); !c.ok()) {
-        return ToGrpcStatus(c.status());
-    }
-    TakeTaskLog(farm_, *req);
-    const FailureKind kind = req->kind() == pb::FailTaskRequest::WORKER_SHUTDOWN
+grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext* context, const Caller& caller,
+                                         const pb::FailTaskRequest& req, pb::FailTaskResponse*) {
+    TakeTaskLog(farm_, req);
+    const FailureKind kind = req.kind() == pb::FailTaskRequest::WORKER_SHUTDOWN
                                  ? FailureKind::kWorkerShutdown
                                  : FailureKind::kTaskError;
     return ToGrpcStatus(
-        farm_.scheduler().Fail(req->lease_id(), req->worker_id(), req->reason(), kind));
+        farm_.scheduler().Fail(req.lease_id(), req.worker_id(), req.reason(), kind));
 }
 
-grpc::Status WorkerServiceImpl::FetchBlob(grpc::ServerContext* context,
-                                          const pb::FetchBlobRequest* req,
-                                          grpc::ServerWriter<pb::Chunk>* writer) {
-    if (auto c = guard_.Check(context, "FetchBlob", Action::kWork); !c.ok()) {
-        return ToGrpcStatus(c.status());
+grpc::Status WorkerServiceImpl::FetchBlob(grpc::ServerContext* context, const Caller& caller,
+                                          const pb::FetchBlobRequest& req,
+                                          const std::function<bool(const pb::Chunk&)>& write) {
+    if (!farm_.blobs().Has(req.hash())) {
+        return ToGrpcStatus(absl::NotFoundError("no blob " + req.hash()));
     }
-    if (!farm_.blobs().Has(req->hash())) {
-        return ToGrpcStatus(absl::NotFoundError("no blob " + req->hash()));
-    }
-    return StreamFile(context, farm_.blobs().PathOf(req->hash()), "blob " + req->hash(), writer);
+    return StreamFile(context, farm_.blobs().PathOf(req.hash()), "blob " + req.hash(), write);
 }
 
 }  // namespace lf

@@ -13,6 +13,7 @@
 #include "lf/server/farm.h"
 #include "lf/server/grpc_service.h"
 #include "lf/server/health_port.h"
+#include "lf/server/health_service.h"
 #include "lf/server/http_listener.h"
 #include "lf/server/listen_policy.h"
 #include "lf/server/retention_flag.h"
@@ -148,9 +149,9 @@ int main(int argc, char** argv) {
     const lf::CallGuard guard{auth, !tls.client_ca.empty()};
     lf::JobServiceImpl job_service(**farm, guard, service_options);
     lf::WorkerServiceImpl worker_service(**farm, guard);
-    // grpc.health.v1.Health: SERVING for "" while the server runs, NOT_SERVING from shutdown on.
-    // It answers without a token, as Kubernetes' gRPC probes and load balancers ask.
-    grpc::EnableDefaultHealthCheckService(true);
+    // grpc.health.v1.Health: SERVING while the server runs, NOT_SERVING from shutdown on. It
+    // answers without a token, as Kubernetes' gRPC probes and load balancers ask.
+    lf::HealthService health_service;
     grpc::ServerBuilder builder;
     int port = 0;
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
@@ -168,6 +169,7 @@ int main(int argc, char** argv) {
     builder.AddListeningPort(listen, *credentials, &port);
     builder.RegisterService(&job_service);
     builder.RegisterService(&worker_service);
+    builder.RegisterCallbackGenericService(&health_service);
     std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
     if (!server || port == 0) {
         std::fprintf(stderr,
@@ -240,8 +242,8 @@ int main(int argc, char** argv) {
     });
 
     spdlog::info("signal {}: shutting down", stop_signals.Wait());
-    server->GetHealthCheckService()->SetServingStatus(false);
-    if (health_port) health_port->server->GetHealthCheckService()->SetServingStatus(false);
+    health_service.SetServing(false);
+    if (health_port) health_port->health->SetServing(false);
     (*farm)->scheduler().Shutdown();
     server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
     if (health_port) health_port->server->Shutdown(std::chrono::system_clock::now());

@@ -47,7 +47,7 @@ TEST(HealthPort, ServingUntilShutdownBeginsThenNotServing) {
     ASSERT_TRUE(health.ok()) << health.status();
     const std::string address = "127.0.0.1:" + std::to_string(health->port);
     EXPECT_EQ(CheckStatus(address), 1);
-    health->server->GetHealthCheckService()->SetServingStatus(false);
+    health->health->SetServing(false);
     EXPECT_EQ(CheckStatus(address), 2);
     health->server->Shutdown(std::chrono::system_clock::now());
 }

@@ -1,0 +1,28 @@
+// grpc.health.v1.Health without reading requests: Check answers the server's state, SERVING
+// until SetServing(false), then NOT_SERVING; Watch answers it once and ends; every other method
+// not registered on the server answers UNIMPLEMENTED.
+//
+// gRPC's default health service reads each request whole before it answers, and health needs no
+// token, so one probe announcing 200 MB made the server hold them (gRPC 1.51 buffers a message
+// before its size limit applies, grpc/grpc#43012). This one never reads: the service name a
+// request may carry is not looked at, and every name answers the server's state, as "" does.
+#pragma once
+
+#include <grpcpp/generic/async_generic_service.h>
+
+#include <atomic>
+
+namespace lf {
+
+class HealthService final : public grpc::CallbackGenericService {
+  public:
+    grpc::ServerGenericBidiReactor* CreateReactor(grpc::GenericCallbackServerContext*) override;
+
+    void SetServing(bool serving) { serving_ = serving; }
+    bool serving() const { return serving_; }
+
+  private:
+    std::atomic<bool> serving_{true};
+};
+
+}  // namespace lf

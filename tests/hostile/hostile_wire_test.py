@@ -1,0 +1,140 @@
+"""Hostile calls on the coordinator's gRPC port: no call without a valid token may make the server
+hold more than a few MB, and only CompleteTask takes messages above lf::kMaxRequestBytes.
+
+gRPC 1.51 buffers a whole request before its size limit applies (grpc/grpc#43012): before the
+server read requests only after checking the caller (lf/server/read_after_auth.h), three
+unauthenticated ListJobs of 300 MB took it from 23 MB to 1.9 GB of resident memory.
+
+Environment (set by ctest): LF_BIN_DIR, the build's bin folder.
+"""
+
+import os
+import shutil
+import subprocess
+import tempfile
+import threading
+import unittest
+
+import grpc
+
+BIN = os.environ.get("LF_BIN_DIR", "")
+MB = 1 << 20
+MAX_REQUEST_BYTES = 4 * MB  # lf::kMaxRequestBytes
+# What the server may hold beyond its start while refusing the calls below: HTTP/2 windows and
+# the calls' bookkeeping, not their messages (each is far larger).
+HEADROOM_KB = 64 * 1024
+
+
+def string_field(size):
+    """A message whose field 2 is a string of `size` bytes: ListJobsRequest's page_token, and an
+    unknown field to the other requests."""
+    out = bytearray(b"\x12")  # field 2, length-delimited
+    v = size
+    while True:
+        b, v = v & 0x7F, v >> 7
+        out.append(b | (0x80 if v else 0))
+        if not v:
+            break
+    return bytes(out) + b"x" * size
+
+
+def vm_hwm_kb(pid):
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1])
+    raise AssertionError("no VmHWM")
+
+
+class HostileWire(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp(prefix="lightfarm-hostile-")
+        data = os.path.join(cls.dir, "data")
+        cls.tokens = {}
+        for name, role in (("alice", "submitter"), ("node", "worker")):
+            r = subprocess.run([os.path.join(BIN, "lightfarm-server"), "token", "create",
+                                "--data-dir", data, "--name", name, "--role", role],
+                               capture_output=True, text=True, check=True)
+            cls.tokens[name] = r.stdout.strip().splitlines()[-1]
+        cls.server = subprocess.Popen(
+            [os.path.join(BIN, "lightfarm-server"), "--listen", "127.0.0.1:0", "--data-dir", data,
+             "--log-level", "warn"], stdout=subprocess.PIPE, text=True)
+        line = cls.server.stdout.readline().strip()
+        assert line.startswith("listening on "), line
+        cls.address = line.split()[-1]
+        cls.channel = grpc.insecure_channel(
+            cls.address, options=[("grpc.max_send_message_length", -1),
+                                  ("grpc.max_receive_message_length", -1)])
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.channel.close()
+        cls.server.terminate()
+        cls.server.wait(timeout=10)
+        shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def call(self, method, body, token=None):
+        """(status code, details, response bytes) of a unary call with raw bytes."""
+        stub = self.channel.unary_unary(method, request_serializer=lambda b: b,
+                                        response_deserializer=lambda b: b)
+        metadata = [("authorization", "Bearer " + self.tokens[token])] if token else None
+        try:
+            return grpc.StatusCode.OK, "", stub(body, metadata=metadata, timeout=120)
+        except grpc.RpcError as e:
+            return e.code(), e.details() or "", None
+
+    def concurrently(self, n, method, body, token=None):
+        results = [None] * n
+
+        def one(i):
+            results[i] = self.call(method, body, token)
+        threads = [threading.Thread(target=one, args=(i,)) for i in range(n)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        return results
+
+    def assert_memory_bounded(self, before_kb, what):
+        grown = vm_hwm_kb(self.server.pid) - before_kb
+        print(f"{what}: peak resident memory grew by {grown // 1024} MB")
+        self.assertLess(grown, HEADROOM_KB, f"{what} made the server hold {grown // 1024} MB")
+
+    def test_unauthenticated_huge_requests_are_refused_unread(self):
+        before = vm_hwm_kb(self.server.pid)
+        body = string_field(200 * MB)
+        for method in ("/lightfarm.v1.JobService/ListJobs",
+                       "/lightfarm.v1.JobService/WatchJob",
+                       "/lightfarm.v1.WorkerService/CompleteTask"):
+            for code, details, _ in self.concurrently(3, method, body):
+                self.assertEqual(code, grpc.StatusCode.UNAUTHENTICATED, f"{method}: {details}")
+        self.assert_memory_bounded(before, "9 calls of 200 MB without a token")
+
+    def test_health_answers_without_reading_the_request(self):
+        before = vm_hwm_kb(self.server.pid)
+        for code, details, answer in self.concurrently(
+                3, "/grpc.health.v1.Health/Check", string_field(200 * MB)):
+            self.assertEqual(code, grpc.StatusCode.OK, details)
+            self.assertEqual(answer, b"\x08\x01", "SERVING")
+        self.assert_memory_bounded(before, "3 health checks of 200 MB")
+
+    def test_a_submitter_may_not_send_a_task_result(self):
+        before = vm_hwm_kb(self.server.pid)
+        code, details, _ = self.call("/lightfarm.v1.WorkerService/CompleteTask",
+                                     string_field(200 * MB), "alice")
+        self.assertEqual(code, grpc.StatusCode.PERMISSION_DENIED, details)
+        self.assert_memory_bounded(before, "a submitter's result of 200 MB")
+
+    def test_requests_above_the_bound_are_refused_naming_it(self):
+        code, details, _ = self.call("/lightfarm.v1.JobService/ListJobs",
+                                     string_field(MAX_REQUEST_BYTES + 1), "alice")
+        self.assertEqual(code, grpc.StatusCode.RESOURCE_EXHAUSTED, details)
+        self.assertIn("ListJobs", details)
+        self.assertIn(str(MAX_REQUEST_BYTES), details)
+        code, details, _ = self.call("/lightfarm.v1.JobService/ListJobs", string_field(10), "alice")
+        self.assertEqual(code, grpc.StatusCode.INVALID_ARGUMENT, details)  # not a page token
+
+
+if __name__ == "__main__":
+    unittest.main()
