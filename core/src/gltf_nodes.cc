@@ -161,6 +161,12 @@ void GltfImporter::VisitNode(int index, const Affine& parent, const std::string&
     const Affine world = LocalTransform(node, where).Then(parent);
     // Each node's numbers are finite, but a chain of large scales can overflow.
     if (!world.IsFinite()) Fail(where, "its world transform overflows double range");
+    const Vec3d origin = world.Apply(Vec3d(0, 0, 0));
+    if (!(std::abs(origin.x) <= kMaxCoordinate && std::abs(origin.y) <= kMaxCoordinate &&
+          std::abs(origin.z) <= kMaxCoordinate)) {
+        Fail(where, absl::StrCat("its world translation (", origin.x, ", ", origin.y, ", ",
+                                 origin.z, ") is beyond ±", kMaxCoordinate));
+    }
     if (node.mesh >= 0) AddMesh(node.mesh, world, where);
     if (node.camera >= 0) AddCamera(node, world, where);
     if (const auto light = node.extensions.find("KHR_lights_punctual");

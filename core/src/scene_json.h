@@ -18,6 +18,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "lf/core/rgb.h"
+#include "lf/core/scene.h"
 #include "lf/core/vec.h"
 
 namespace lf::scene_internal {
@@ -25,9 +26,6 @@ namespace lf::scene_internal {
 // Keeps the materials object in file order, which is the order of Scene::materials.
 using Json = nlohmann::ordered_json;
 
-// Beyond this a coordinate is a unit mistake or garbage, and the float kernels would have no
-// precision left for the geometry's detail.
-inline constexpr double kMaxCoordinate = 1e15;
 inline constexpr int kMaxResolution = 65536;
 inline constexpr int64_t kMaxPixels = int64_t(1) << 28;
 inline constexpr float kMaxFloat = std::numeric_limits<float>::max();

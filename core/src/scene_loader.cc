@@ -150,6 +150,7 @@ absl::StatusOr<Scene> ParseScene(const std::string& json_text, const std::string
     try {
         scene = gltf ? parser.ParseGltf(json_text, source) : parser.Parse(root, json_text);
         scene->source = source;
+        if (absl::Status s = CheckCoordinates(*scene); !s.ok()) throw LoadError{s};
         // After every transform: tangents are not transformed with the meshes.
         ComputeMissingTangents(*scene);
     } catch (const LoadError& e) {

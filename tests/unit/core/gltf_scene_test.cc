@@ -550,6 +550,34 @@ TEST_F(GltfSceneTest, ATransformChainThatOverflowsIsRefused) {
     ExpectError(Load(b), {"nodes[0] \"Quad\"", "overflows"});
 }
 
+// Finite doubles beyond float range reached Embree as infinite rays (`Assertion ray.valid()`:
+// SIGABRT in `render` and in every worker that leased the job): refused at the node, as JSON
+// scenes refuse coordinates beyond ±1e15.
+TEST_F(GltfSceneTest, ANodeTranslatedBeyondTheCoordinateRangeIsRefused) {
+    GltfBuilder camera = testing::TexturedTestScene();
+    camera.json()["nodes"][3]["translation"] = {1e308, 0, 0};
+    ExpectError(Load(camera), {"nodes[3] \"Front\"", "world translation (1e+308, 0, 0)", "1e+15"});
+    GltfBuilder lamp = testing::TexturedTestScene();
+    lamp.json()["nodes"][4]["matrix"] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -2e15, 0, 1};
+    ExpectError(Load(lamp), {"nodes[4] \"Lamp\"", "world translation"});
+}
+
+// A scale that keeps every node's origin in range can still throw vertices and light axes out
+// of it: the scene-wide check every loader ends with names them.
+TEST_F(GltfSceneTest, VerticesOrLightAxesScaledOutOfRangeAreRefused) {
+    GltfBuilder mesh = testing::TexturedTestScene();
+    mesh.json()["nodes"][0]["scale"] = {1e20, 1e20, 1e20};  // "Quad"
+    ExpectError(Load(mesh), {"mesh \"quad[0]\"", "vertex beyond"});
+    GltfBuilder sun = testing::TexturedTestScene();
+    Json& j = sun.json();
+    j["extensions"]["KHR_lights_punctual"]["lights"].push_back(
+        {{"type", "directional"}, {"intensity", 1}});
+    j["scenes"][0]["nodes"].push_back(
+        sun.AddNode({{"scale", {1e308, 1e308, 1e308}},
+                     {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}}));
+    ExpectError(Load(sun), {"directional light 0 direction"});
+}
+
 // A node scaled flat along its axis (a hidden light) leaves a spot or sun no direction: it is
 // skipped with a warning instead of lighting everything with NaN.
 TEST_F(GltfSceneTest, ALightFlattenedAlongItsAxisIsSkippedWithAWarning) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "lf/core/rgb.h"
 #include "lf/core/vec.h"
 
@@ -199,6 +200,11 @@ struct CameraSpec {
     PixelFilter filter;
 };
 
+// Beyond this a coordinate is a unit mistake or garbage, and the float kernels would have no
+// precision left for the geometry's detail (and above 3.4e38 none at all: Embree aborts on an
+// infinite ray).
+inline constexpr double kMaxCoordinate = 1e15;
+
 struct Scene {
     CameraSpec camera;
     std::vector<Material> materials;
@@ -219,5 +225,11 @@ struct Scene {
     std::pair<Vec3d, Vec3d> Bounds() const;
     bool HasLights() const;  // any emitter: emissive material or a light of any kind
 };
+
+// InvalidArgument naming the first position (vertex, sphere, light, camera) beyond
+// ±kMaxCoordinate or not finite, or direction not finite. Every loader ends with it, so whoever
+// loads a scene (a worker included) never hands such numbers to the kernels, whoever checked it
+// before.
+absl::Status CheckCoordinates(const Scene& scene);
 
 }  // namespace lf
