@@ -111,6 +111,10 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
                                                        " bytes is above the limit of ",
                                                        kMaxRequestIdBytes));
     }
+    // A request id is its submitter's: another owner's same id is another request, never a way
+    // to learn that owner's job id or to have one's own submission dropped. Token names hold
+    // no '/'.
+    if (!spec.request_id.empty()) spec.request_id = absl::StrCat(spec.owner, "/", spec.request_id);
     std::vector<const BlobRef*> refs = {&spec.scene};
     for (const BlobRef& f : spec.files) refs.push_back(&f);
     uint64_t scene_bytes = 0;

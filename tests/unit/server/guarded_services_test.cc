@@ -9,12 +9,12 @@
 
 #include "lf/core/file_util.h"
 #include "lf/job/digest.h"
-#include "lf/version.h"
-#include "lightfarm/v1/job_service.grpc.pb.h"
-#include "lightfarm/v1/worker_service.grpc.pb.h"
 #include "lf/proto/channel.h"
 #include "lf/server/grpc_service.h"
 #include "lf/server/server_credentials.h"
+#include "lf/version.h"
+#include "lightfarm/v1/job_service.grpc.pb.h"
+#include "lightfarm/v1/worker_service.grpc.pb.h"
 #include "test_dir.h"
 
 namespace lf {
@@ -114,8 +114,10 @@ class GuardedServices : public ::testing::Test {
         return context;
     }
 
-    grpc::Status Submit(pb::JobService::Stub& stub, std::string* id) {
+    grpc::Status Submit(pb::JobService::Stub& stub, std::string* id,
+                        const std::string& request_id = "") {
         pb::SubmitJobRequest request;
+        request.set_request_id(request_id);
         request.mutable_scene()->set_path(scene_.path);
         request.mutable_scene()->set_hash(scene_.hash);
         request.mutable_scene()->set_size(scene_.size);
@@ -224,6 +226,19 @@ TEST_F(GuardedServices, SubmitterSeesOnlyItsOwnJobsAdminSeesAll) {
     pb::CancelJobRequest cancel_bob;
     cancel_bob.set_job_id(bob_job);
     EXPECT_TRUE(Jobs("root")->CancelJob(Context().get(), cancel_bob, &job).ok());
+}
+
+// A request id is its submitter's: Bob sending Alice's gets a job of his own, not hers (he got
+// her job id back, his submission was dropped and the id answered NOT_FOUND to him).
+TEST_F(GuardedServices, ARequestIdIsScopedToItsOwner) {
+    std::string alice_job, alice_again, bob_job;
+    ASSERT_TRUE(Submit(*Jobs("alice"), &alice_job, "req-1").ok());
+    ASSERT_TRUE(Submit(*Jobs("bob"), &bob_job, "req-1").ok());
+    ASSERT_TRUE(Submit(*Jobs("alice"), &alice_again, "req-1").ok());
+    EXPECT_NE(bob_job, alice_job);
+    EXPECT_EQ(alice_again, alice_job) << "a retry of alice's own request is her job";
+    EXPECT_EQ(ListedIds("bob"), std::vector<std::string>{bob_job});
+    EXPECT_EQ(ListedIds("alice"), std::vector<std::string>{alice_job});
 }
 
 TEST_F(GuardedServices, RolesAreKeptApart) {
