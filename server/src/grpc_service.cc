@@ -63,16 +63,22 @@ std::optional<std::string_view> AuthorizationOf(const grpc::ServerContext* conte
 // Keeps the task log lines that came with a worker's heartbeat or result: before the message is
 // acted on, since its job may end with it. A store that cannot write costs the lines, not the
 // result.
+// A worker's identity: its token's name before the id it claims, so that one token's workers can
+// never name another's leases (lf::PrincipalOf reads the name back). The claimed id alone with
+// authentication off.
+std::string WorkerIdentity(const Caller& caller, const std::string& claimed) {
+    return caller.name.empty() ? claimed : absl::StrCat(caller.name, "/", claimed);
+}
+
 template <typename Request>
-void TakeTaskLog(Farm& farm, const Request& req) {
+void TakeTaskLog(Farm& farm, const Request& req, const std::string& worker) {
     if (req.log().empty()) return;
     std::vector<TaskLogLine> lines;
     lines.reserve(size_t(req.log_size()));
     for (const pb::WorkerLogLine& line : req.log()) lines.push_back(FromProto(line));
-    if (absl::Status s = farm.TakeTaskLog(req.lease_id(), req.worker_id(), std::move(lines));
-        !s.ok()) {
+    if (absl::Status s = farm.TakeTaskLog(req.lease_id(), worker, std::move(lines)); !s.ok()) {
         Log()->error("lease={} worker={}: task log lines lost: {}", LogSafe(req.lease_id()),
-                     LogSafe(req.worker_id()), std::string(s.message()));
+                     LogSafe(worker), std::string(s.message()));
     }
 }
 
@@ -449,8 +455,8 @@ grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context, const Ca
     }
     const WorkerDescription about{req.name(), context->peer(), req.version()};
     const absl::Duration wait = absl::Milliseconds(std::clamp(req.wait_ms(), 0, 10000));
-    if (std::optional<TaskAssignment> lease =
-            farm_.scheduler().LeaseTask(req.worker_id(), absl::Now() + wait, &about)) {
+    if (std::optional<TaskAssignment> lease = farm_.scheduler().LeaseTask(
+            WorkerIdentity(caller, req.worker_id()), absl::Now() + wait, &about)) {
         ToProto(*lease, resp->mutable_task());
     }
     return grpc::Status::OK;
@@ -459,27 +465,29 @@ grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context, const Ca
 grpc::Status WorkerServiceImpl::Heartbeat(grpc::ServerContext* context, const Caller& caller,
                                           const pb::HeartbeatRequest& req,
                                           pb::HeartbeatResponse* resp) {
-    TakeTaskLog(farm_, req);
-    resp->set_cancelled(!farm_.scheduler().Heartbeat(req.lease_id(), req.worker_id()));
+    const std::string worker = WorkerIdentity(caller, req.worker_id());
+    TakeTaskLog(farm_, req, worker);
+    resp->set_cancelled(!farm_.scheduler().Heartbeat(req.lease_id(), worker));
     return grpc::Status::OK;
 }
 
 grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context, const Caller& caller,
                                              const pb::CompleteTaskRequest& req,
                                              pb::CompleteTaskResponse*) {
-    TakeTaskLog(farm_, req);
+    const std::string worker = WorkerIdentity(caller, req.worker_id());
+    TakeTaskLog(farm_, req, worker);
     const absl::Status s =
         req.radiosity_sweep().empty()
-            ? farm_.Complete(req.lease_id(), req.worker_id(), req.tile_sums(),
+            ? farm_.Complete(req.lease_id(), worker, req.tile_sums(),
                              req.has_radiosity()
                                  ? std::optional<RadiosityFigures>(FromProto(req.radiosity()))
                                  : std::nullopt,
                              // An encoded list is never empty: empty means a tile's result.
                              req.splats().empty() ? std::nullopt
                                                   : std::optional<std::string_view>(req.splats()))
-            : farm_.CompleteSweep(req.lease_id(), req.worker_id(), req.radiosity_sweep());
+            : farm_.CompleteSweep(req.lease_id(), worker, req.radiosity_sweep());
     if (!s.ok()) {
-        Log()->warn("{}", RefusedResultLine(req.lease_id(), req.worker_id(), context->peer(),
+        Log()->warn("{}", RefusedResultLine(req.lease_id(), worker, context->peer(),
                                             std::string(s.message())));
     }
     return ToGrpcStatus(s);
@@ -494,12 +502,12 @@ std::string RefusedResultLine(std::string_view lease_id, std::string_view worker
 
 grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext* context, const Caller& caller,
                                          const pb::FailTaskRequest& req, pb::FailTaskResponse*) {
-    TakeTaskLog(farm_, req);
+    const std::string worker = WorkerIdentity(caller, req.worker_id());
+    TakeTaskLog(farm_, req, worker);
     const FailureKind kind = req.kind() == pb::FailTaskRequest::WORKER_SHUTDOWN
                                  ? FailureKind::kWorkerShutdown
                                  : FailureKind::kTaskError;
-    return ToGrpcStatus(
-        farm_.scheduler().Fail(req.lease_id(), req.worker_id(), req.reason(), kind));
+    return ToGrpcStatus(farm_.scheduler().Fail(req.lease_id(), worker, req.reason(), kind));
 }
 
 grpc::Status WorkerServiceImpl::FetchBlob(grpc::ServerContext* context, const Caller& caller,

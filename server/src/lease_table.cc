@@ -39,8 +39,21 @@ bool LeaseTable::Extend(const std::string& lease_id, absl::Time deadline) {
     Entry& entry = it->second;
     deadlines_.erase(entry.deadline);
     entry.lease.deadline = deadline;
+    entry.lease.heard = true;
     entry.deadline = deadlines_.emplace(deadline, lease_id);
     return true;
+}
+
+std::string PrincipalOf(const std::string& worker) {
+    const size_t slash = worker.find('/');
+    return slash == std::string::npos ? "" : worker.substr(0, slash);
+}
+
+int LeaseTable::CurrentOf(const std::string& principal) const {
+    int n = 0;
+    for (const auto& [deadline, id] : deadlines_)
+        n += PrincipalOf(by_id_.at(id).lease.worker) == principal;
+    return n;
 }
 
 void LeaseTable::EndEntry(Entry& entry) {

@@ -96,6 +96,12 @@ int main(int argc, char** argv) {
                    "most jobs queued or running at once")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    app.add_option("--max-leases-per-token", options.scheduler.max_leases_per_token,
+                   "most tasks the workers of one worker token hold at once (whatever worker ids "
+                   "they claim); a worker whose leases expire unheard 3 times in a row gets none "
+                   "for 10 leases' time")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     std::string http;
     std::string grpc_health;
     app.add_option("--grpc-health", grpc_health,
@@ -157,8 +163,8 @@ int main(int argc, char** argv) {
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
     // port and answering clients at random.
     builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
-    // Clients and workers ping every lf::kKeepaliveInterval to find dead links (lf/proto/channel.h);
-    // gRPC's default would answer pings that often with GOAWAY.
+    // Clients and workers ping every lf::kKeepaliveInterval to find dead links
+    // (lf/proto/channel.h); gRPC's default would answer pings that often with GOAWAY.
     builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
     builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,
                                int(lf::kKeepaliveInterval / absl::Milliseconds(2)));

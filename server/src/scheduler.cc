@@ -275,6 +275,11 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
     const absl::Time now = clock_();
     workers_.Seen(worker, now, about);
     workers_.ForgetSilent(now);  // so that the workers kept are the live ones
+    if (workers_.IsQuarantined(worker, now)) return std::nullopt;
+    if (const std::string principal = PrincipalOf(worker);
+        !principal.empty() && leases_.CurrentOf(principal) >= options_.max_leases_per_token) {
+        return std::nullopt;
+    }
     Job* best = nullptr;
     int best_task = -1;
     for (auto& [id, job] : active_) {
@@ -393,6 +398,7 @@ bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker
     const absl::Time now = clock_();
     if (!Resolve(lease_id, worker)) return false;  // a made-up id is not kept
     workers_.Seen(worker, now);
+    workers_.Worked(worker);
     return leases_.Extend(lease_id, now + options_.lease);
 }
 
@@ -410,6 +416,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     if (state == TaskState::kDone || state == TaskState::kDropped) return completion;
     absl::StatusOr<JobExecution::Merged> merged = job.execution->Merge(t, result);
     if (!merged.ok()) return Refuse(*ref, worker, merged.status());
+    workers_.Worked(worker);
     MarkDone(job, t, now);
     job.Queue(merged->appended);
     if (!merged->job_error.ok()) {
@@ -611,10 +618,25 @@ int Scheduler::ExpireLeases() {
         const Lease* lease = leases_.Find(lease_id);  // unknown once an earlier one failed its job
         const std::optional<LeaseRef> ref = lease ? Resolve(lease_id, lease->worker) : std::nullopt;
         if (!ref) continue;
-        Requeue(*ref,
-                absl::StrCat("lease expired: worker ", lease->worker, " sent no heartbeat for ",
-                             absl::FormatDuration(options_.lease)),
-                true);
+        if (lease->heard) {
+            Requeue(*ref,
+                    absl::StrCat("lease expired: worker ", lease->worker, " sent no heartbeat for ",
+                                 absl::FormatDuration(options_.lease)),
+                    true);
+            continue;
+        }
+        // Workers heartbeat as soon as they take a task: one that never did abandoned it, or
+        // never got it. Counting that against the task would let one token that leases and
+        // never answers fail every queued job; it counts against the worker instead.
+        const std::string worker = lease->worker;
+        Requeue(*ref, absl::StrCat("lease abandoned: worker ", worker, " never heartbeated"),
+                false);
+        if (workers_.Abandoned(worker, now, options_.lease * options_.quarantine_leases)) {
+            Log()->warn("worker {} quarantined for {}: {} leases in a row expired unheard",
+                        LogSafe(worker),
+                        absl::FormatDuration(options_.lease * options_.quarantine_leases),
+                        WorkerRegistry::kAbandonedInARow);
+        }
     }
     return int(expired.size());
 }

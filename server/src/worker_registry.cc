@@ -1,12 +1,14 @@
 #include "lf/server/worker_registry.h"
 
+#include <algorithm>
+
 namespace lf {
 
 void WorkerRegistry::Seen(const std::string& worker, absl::Time now,
                           const WorkerDescription* about) {
     auto it = by_worker_.find(worker);
     if (it == by_worker_.end()) {
-        it = by_worker_.emplace(worker, Kept{by_seen_.emplace(now, worker), {}}).first;
+        it = by_worker_.emplace(worker, Kept{by_seen_.emplace(now, worker)}).first;
     } else {
         by_seen_.erase(it->second.seen);
         it->second.seen = by_seen_.emplace(now, worker);
@@ -21,6 +23,7 @@ int WorkerRegistry::ForgetSilent(absl::Time now) {
         by_seen_.erase(by_seen_.begin());
         ++forgotten;
     }
+    std::erase_if(strikes_, [now](const auto& entry) { return now >= entry.second.forget_at; });
     return forgotten;
 }
 
@@ -29,11 +32,31 @@ bool WorkerRegistry::IsLive(const std::string& worker, absl::Time now) const {
     return it != by_worker_.end() && now - it->second.seen->first < alive_for_;
 }
 
+bool WorkerRegistry::Abandoned(const std::string& worker, absl::Time now,
+                               absl::Duration quarantine) {
+    Strikes& s = strikes_[worker];
+    s.forget_at = std::max(s.quarantined_until, now + quarantine);
+    if (++s.in_a_row < kAbandonedInARow) return false;
+    s.in_a_row = 0;
+    s.quarantined_until = s.forget_at = now + quarantine;
+    return true;
+}
+
+void WorkerRegistry::Worked(const std::string& worker) { strikes_.erase(worker); }
+
+bool WorkerRegistry::IsQuarantined(const std::string& worker, absl::Time now) const {
+    auto it = strikes_.find(worker);
+    return it != strikes_.end() && now < it->second.quarantined_until;
+}
+
 std::vector<WorkerRegistry::Entry> WorkerRegistry::List() const {
     std::vector<Entry> entries;
     entries.reserve(by_worker_.size());
     for (const auto& [id, kept] : by_worker_) {
-        entries.push_back({id, kept.about, kept.seen->first});
+        auto strikes = strikes_.find(id);
+        entries.push_back(
+            {id, kept.about, kept.seen->first,
+             strikes == strikes_.end() ? absl::InfinitePast() : strikes->second.quarantined_until});
     }
     return entries;
 }

@@ -124,14 +124,15 @@ void Worker::Execute(const TaskAssignment& task) {
         if (stopping()) cancel = true;
     }
     // Heartbeats from their own thread, so a long tile keeps its lease and hears of a cancel.
+    // The first goes at once: it tells the coordinator the task was taken (a lease that expires
+    // before any heartbeat is held against the worker, not the task).
     std::mutex hb_mutex;
     std::condition_variable hb_wake;
     bool task_over = false;
     std::atomic<bool> dropped{false};
     std::thread heartbeat([&] {
         std::unique_lock<std::mutex> lock(hb_mutex);
-        while (!hb_wake.wait_for(lock, absl::ToChronoNanoseconds(task.heartbeat_interval),
-                                 [&] { return task_over; })) {
+        while (!task_over) {
             lock.unlock();
             // Lines of a heartbeat that does not arrive are lost: the next one carries newer.
             const absl::StatusOr<bool> keep = server_.Heartbeat(task.lease_id, log->Take());
@@ -139,6 +140,10 @@ void Worker::Execute(const TaskAssignment& task) {
             if (keep.ok() && !*keep) {
                 dropped = true;
                 cancel = true;
+            }
+            if (hb_wake.wait_for(lock, absl::ToChronoNanoseconds(task.heartbeat_interval),
+                                 [&] { return task_over; })) {
+                break;
             }
         }
     });

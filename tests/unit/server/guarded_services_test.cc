@@ -241,6 +241,42 @@ TEST_F(GuardedServices, ARequestIdIsScopedToItsOwner) {
     EXPECT_EQ(ListedIds("alice"), std::vector<std::string>{alice_job});
 }
 
+// A worker's identity is its token's and the id it claims: another token claiming the same id
+// cannot keep, complete or fail that worker's lease (a token holding node1 heartbeated and
+// completed node2's lease with forged pixels by claiming node2's worker_id).
+TEST_F(GuardedServices, AnotherTokenCannotActForAWorkerByClaimingItsId) {
+    std::string job;
+    ASSERT_TRUE(Submit(*Jobs("alice"), &job).ok());
+    pb::LeaseTaskRequest lease_request;
+    lease_request.set_worker_id("w");
+    lease_request.set_version(kBuildVersion);
+    pb::LeaseTaskResponse lease;
+    ASSERT_TRUE(pb::WorkerService::NewStub(Channel("node", "worker"))
+                    ->LeaseTask(Context().get(), lease_request, &lease)
+                    .ok());
+    ASSERT_TRUE(lease.has_task());
+    auto heartbeat = [&](const std::string& who) {
+        pb::HeartbeatRequest request;
+        request.set_lease_id(lease.task().lease_id());
+        request.set_worker_id("w");
+        pb::HeartbeatResponse response;
+        EXPECT_TRUE(pb::WorkerService::NewStub(Channel(who, "worker"))
+                        ->Heartbeat(Context().get(), request, &response)
+                        .ok());
+        return !response.cancelled();
+    };
+    EXPECT_FALSE(heartbeat("root")) << "the lease is not root's worker's";
+    EXPECT_TRUE(heartbeat("node"));
+    pb::CompleteTaskRequest forged;
+    forged.set_lease_id(lease.task().lease_id());
+    forged.set_worker_id("w");
+    pb::CompleteTaskResponse done;
+    const grpc::Status s = pb::WorkerService::NewStub(Channel("root", "worker"))
+                               ->CompleteTask(Context().get(), forged, &done);
+    EXPECT_FALSE(s.ok());
+    EXPECT_TRUE(heartbeat("node")) << "the forged result did not end node's lease";
+}
+
 TEST_F(GuardedServices, RolesAreKeptApart) {
     std::string id;
     const grpc::Status worker_submit = Submit(*Jobs("node"), &id);

@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lease_results.h"
+#include "lf/server/worker_registry.h"
 
 namespace lf {
 namespace {
@@ -251,13 +252,66 @@ TEST_F(SchedulerTest, ExpiriesCountAsFailuresButShutdownsDoNot) {
                 .ok());
     }
     EXPECT_EQ(Job(id).state, JobState::kRunning);
+    // Leases their worker took (it heartbeated) and then lost.
     for (int i = 0; i < 3; ++i) {
-        ASSERT_TRUE(scheduler_.LeaseTask("w").has_value());
+        const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w");
+        ASSERT_TRUE(lease.has_value());
+        ASSERT_TRUE(scheduler_.Heartbeat(lease->lease_id, "w"));
         now_ += absl::Seconds(11);
         scheduler_.ExpireLeases();
     }
     EXPECT_EQ(Job(id).state, JobState::kFailed);
     EXPECT_NE(Job(id).error.find("lease expired"), std::string::npos) << Job(id).error;
+}
+
+// One worker token leasing under ever new ids and never answering failed 197 of 200 jobs in
+// 10 s: a lease that expires before any heartbeat is not the task's failure.
+TEST_F(SchedulerTest, LeasesAbandonedUnderFreshIdsFailNoJob) {
+    const std::string id = Submit(0, 16, 1);  // one task
+    for (int i = 0; i < 20; ++i) {
+        ASSERT_TRUE(scheduler_.LeaseTask("evil/" + std::to_string(i)).has_value());
+        now_ += absl::Seconds(11);
+        scheduler_.ExpireLeases();
+    }
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+    const std::optional<TaskAssignment> honest = scheduler_.LeaseTask("node/w");
+    ASSERT_TRUE(honest.has_value());
+    ASSERT_TRUE(scheduler_.Complete(honest->lease_id, "node/w", Result(*honest)).ok());
+    EXPECT_EQ(Job(id).tasks_done, 1);
+    EXPECT_NE(Job(id).state, JobState::kFailed);
+}
+
+// A worker whose leases keep expiring unheard gets none for a while; the others still do.
+TEST_F(SchedulerTest, AWorkerThatKeepsAbandoningLeasesIsQuarantined) {
+    Submit(0, 16);
+    for (int i = 0; i < WorkerRegistry::kAbandonedInARow; ++i) {
+        ASSERT_TRUE(scheduler_.LeaseTask("flaky").has_value()) << i;
+        now_ += absl::Seconds(11);
+        scheduler_.ExpireLeases();
+    }
+    EXPECT_FALSE(scheduler_.LeaseTask("flaky").has_value()) << "quarantined";
+    const std::optional<TaskAssignment> other = scheduler_.LeaseTask("steady");
+    ASSERT_TRUE(other.has_value());
+    ASSERT_TRUE(
+        scheduler_.Fail(other->lease_id, "steady", "stop", FailureKind::kWorkerShutdown).ok());
+    now_ += absl::Seconds(10 * 10);  // quarantine_leases leases
+    EXPECT_TRUE(scheduler_.LeaseTask("flaky").has_value()) << "quarantine over";
+}
+
+// However many worker ids one token claims, its workers hold at most max_leases_per_token tasks.
+TEST(SchedulerLeaseCap, OneTokensWorkersHoldAtMostTheCap) {
+    SchedulerOptions options;
+    options.max_leases_per_token = 2;
+    InMemoryJobStore store;
+    Scheduler scheduler(options, store);
+    JobSpec spec;
+    spec.name = "capped";
+    spec.plan = {16, 16, 4, 8, 2};  // 8 tasks
+    ASSERT_TRUE(scheduler.Submit(spec).ok());
+    EXPECT_TRUE(scheduler.LeaseTask("evil/a").has_value());
+    EXPECT_TRUE(scheduler.LeaseTask("evil/b").has_value());
+    EXPECT_FALSE(scheduler.LeaseTask("evil/c").has_value());
+    EXPECT_TRUE(scheduler.LeaseTask("node/a").has_value()) << "another token's worker";
 }
 
 TEST_F(SchedulerTest, LateResultOfAnExpiredLeaseIsMergedOnce) {

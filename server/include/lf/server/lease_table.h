@@ -25,7 +25,14 @@ struct Lease {
     std::string worker;
     absl::Time deadline;
     bool current = true;
+    // A heartbeat extended it: the worker took the task. A lease that expires unheard was
+    // abandoned (or never reached its worker): the task is not to blame.
+    bool heard = false;
 };
+
+// The principal a worker id belongs to: its token's name, which lf::WorkerIdentity puts before a
+// '/'; "" for an id without one (authentication off).
+std::string PrincipalOf(const std::string& worker);
 
 // `digits` hex digits from std::random_device: unguessable ids.
 std::string RandomHex(int digits);
@@ -59,6 +66,8 @@ class LeaseTable {
     // The current lease each worker holds (of two, the one with the later deadline).
     std::map<std::string, const Lease*> CurrentByWorker() const;
     size_t current_count() const { return deadlines_.size(); }
+    // Current leases held by workers of `principal` (PrincipalOf their id).
+    int CurrentOf(const std::string& principal) const;
 
   private:
     using Deadlines = std::multimap<absl::Time, std::string>;

@@ -10,13 +10,13 @@
 // dropped with the stream, never buffered beyond HTTP/2's window). A request read is refused above
 // its method's bound, which is kMaxRequestBytes for all but CompleteTask.
 
-#include <cstddef>
-#include <functional>
-#include <string>
-
 #include <google/protobuf/descriptor.h>
 #include <grpcpp/impl/codegen/method_handler.h>
 #include <grpcpp/support/sync_stream.h>
+
+#include <cstddef>
+#include <functional>
+#include <string>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
@@ -89,8 +89,9 @@ class ReadAfterAuth : public Generated {
                     absl::StatusOr<Caller> caller =
                         ReadChecked(guard, context, rpc, action, kMaxRequestBytes, stream, req);
                     if (!caller.ok()) return ToGrpcStatus(caller.status());
-                    return handler(context, *caller, req,
-                                   [stream](const Resp& message) { return stream->Write(message); });
+                    return handler(context, *caller, req, [stream](const Resp& message) {
+                        return stream->Write(message);
+                    });
                 }));
     }
 
@@ -98,10 +99,9 @@ class ReadAfterAuth : public Generated {
 
   private:
     template <class Stream, class Req>
-    static absl::StatusOr<Caller> ReadChecked(const CallGuard& guard,
-                                              grpc::ServerContext* context, const char* rpc,
-                                              Action action, size_t max_request_bytes,
-                                              Stream* stream, Req& req) {
+    static absl::StatusOr<Caller> ReadChecked(const CallGuard& guard, grpc::ServerContext* context,
+                                              const char* rpc, Action action,
+                                              size_t max_request_bytes, Stream* stream, Req& req) {
         absl::StatusOr<Caller> caller = guard.Check(context, rpc, action);
         if (!caller.ok()) return caller.status();
         if (!stream->Read(&req)) {

@@ -55,6 +55,12 @@ struct SchedulerOptions {
     TileStoreFactory tile_stores = MakeMemoryTileStore;
     // Jobs queued or running at once; a submission beyond is refused (ResourceExhausted).
     size_t max_active_jobs = 1000;
+    // Current leases of all the workers of one token (lf::PrincipalOf their ids) at once: a token
+    // leasing under ever new worker ids holds no more of the farm's tasks than this.
+    int max_leases_per_token = 256;
+    // A worker whose leases expire unheard WorkerRegistry::kAbandonedInARow times in a row gets
+    // no lease for this many leases' time.
+    int quarantine_leases = 10;
 };
 
 // Counted as the scheduler works; read by /metrics at any time, without the scheduler's lock.

@@ -29,6 +29,15 @@ class WorkerRegistry {
     int ForgetSilent(absl::Time now);
 
     bool IsLive(const std::string& worker, absl::Time now) const;
+
+    // A lease of the worker expired before any heartbeat for it: after kAbandonedInARow such in a
+    // row the worker is quarantined (it gets no lease) until `now + quarantine`. Returns whether
+    // this one quarantined it.
+    bool Abandoned(const std::string& worker, absl::Time now, absl::Duration quarantine);
+    // The worker heartbeated or sent a result: its abandoned leases in a row start again at 0.
+    void Worked(const std::string& worker);
+    bool IsQuarantined(const std::string& worker, absl::Time now) const;
+    static constexpr int kAbandonedInARow = 3;
     // The workers kept: after ForgetSilent(now), the ones live at `now`.
     size_t size() const { return by_worker_.size(); }
 
@@ -36,6 +45,7 @@ class WorkerRegistry {
         std::string id;
         WorkerDescription about;
         absl::Time last_seen;
+        absl::Time quarantined_until = absl::InfinitePast();
     };
     // The workers kept, by id.
     std::vector<Entry> List() const;
@@ -46,6 +56,14 @@ class WorkerRegistry {
         BySeen::iterator seen;
         WorkerDescription about;
     };
+    // Kept apart from by_worker_: a worker is silent, so forgotten there, by the time its lease
+    // expires. Each entry is dropped once its quarantine ended and its last strike is as old.
+    struct Strikes {
+        int in_a_row = 0;
+        absl::Time quarantined_until = absl::InfinitePast();
+        absl::Time forget_at;
+    };
+    std::map<std::string, Strikes> strikes_;
     const absl::Duration alive_for_;
     BySeen by_seen_;
     std::map<std::string, Kept> by_worker_;
