@@ -11,6 +11,7 @@ packages=(
   libcpp-httplib-dev
   iproute2 openssl python3 python3-yaml
   python3-grpcio python3-protobuf
+  clang libclang-rt-14-dev
   chromium
 )
 missing=()

@@ -162,16 +162,18 @@ Command AddListCommand(CLI::App& app) {
                 FarmClient client(*flags);
                 pb::ListJobsRequest req;
                 int listed = 0;
-                if (!*json) {
-                    std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s %-19s %8s  %s\n", "JOB",
-                                "STATE", "OWNER", "METHOD", "PRIORITY", "TASKS", "SPP", "SUBMITTED",
-                                "TIME", "NAME");
-                }
                 do {
                     req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
                     pb::ListJobsResponse resp;
                     absl::Status s = client.Call(&pb::JobService::Stub::ListJobs, req, &resp);
                     if (!s.ok()) return ReportError(s);
+                    // After the first answer: a failed call prints nothing on stdout for
+                    // scripts to take as a (empty) table.
+                    if (!*json && req.page_token().empty()) {
+                        std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s %-19s %8s  %s\n", "JOB",
+                                    "STATE", "OWNER", "METHOD", "PRIORITY", "TASKS", "SPP",
+                                    "SUBMITTED", "TIME", "NAME");
+                    }
                     for (const pb::Job& job : resp.jobs()) {
                         if (*json) {
                             PrintJson(job);

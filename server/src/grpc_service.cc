@@ -171,6 +171,13 @@ WorkerServiceImpl::WorkerServiceImpl(Farm& farm, CallGuard guard)
 
 absl::StatusOr<JobRecord> JobServiceImpl::VisibleJob(const Caller& caller,
                                                      const std::string& job_id) const {
+    // Job ids are "job-" and 10 hex digits: a longer one is nobody's, and is not echoed back
+    // (a megabyte-long id came back whole in GetJob's error).
+    constexpr size_t kMaxJobIdBytes = 64;
+    if (job_id.size() > kMaxJobIdBytes) {
+        return absl::NotFoundError(absl::StrCat("no job ", LogSafe(job_id, kMaxJobIdBytes), " (",
+                                                job_id.size(), " bytes)"));
+    }
     absl::StatusOr<JobRecord> job = farm_.scheduler().Get(job_id);
     if (job.ok() && !MaySee(caller, job->spec.owner))
         return absl::NotFoundError("no job " + job_id);

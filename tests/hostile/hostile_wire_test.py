@@ -136,5 +136,14 @@ class HostileWire(unittest.TestCase):
         self.assertEqual(code, grpc.StatusCode.INVALID_ARGUMENT, details)  # not a page token
 
 
+    def test_a_long_job_id_is_not_echoed(self):
+        # GetJobRequest: job_id is field 1.
+        body = b"\x0a" + bytes([0x80, 0x80, 0x40]) + b"j" * (1 << 20)
+        code, details, _ = self.call("/lightfarm.v1.JobService/GetJob", body, "alice")
+        self.assertEqual(code, grpc.StatusCode.NOT_FOUND, details[:200])
+        self.assertLess(len(details), 200, "the id came back whole")
+        self.assertIn("1048576 bytes", details)
+
+
 if __name__ == "__main__":
     unittest.main()

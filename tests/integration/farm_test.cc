@@ -666,6 +666,14 @@ TEST_F(Farm, MalformedSceneIsRefusedAndTheServerStaysUp) {
     EXPECT_NE(Farmctl("status job-doesnotexist").err.find("job-doesnotexist"), std::string::npos);
 }
 
+// Scripts read stdout: a list that fails prints no table header there (it did, then rc 1).
+TEST_F(Farm, AFailedListPrintsNothingOnStdout) {
+    const CliRun r = Lightfarm("list --server 127.0.0.1:1");
+    EXPECT_NE(r.status, 0);
+    EXPECT_EQ(r.out, "");
+    EXPECT_NE(r.err, "");
+}
+
 TEST_F(Farm, TerminatedWorkerHandsItsTaskBack) {
     StartServer();
     Child* worker = StartWorker("w1");

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# CI's sanitizer and fuzz runs (README, Tests), after the normal suite:
+#  1. a clang build (build-san/) of lf_core and lf_job with AddressSanitizer, UndefinedBehavior-
+#     Sanitizer (any report aborts) and libFuzzer's coverage;
+#  2. the core and job unit tests under those sanitizers;
+#  3. each fuzz target of tests/fuzz for FUZZ_SECONDS (default 60) from its seed corpus. A crash
+#     fails the run and is kept as build-san/fuzz-crashes/TARGET-*: add it to
+#     tests/fuzz/regressions/TARGET/, which every build's ctest replays.
+# Prints how long each part took.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+fuzz_seconds=${FUZZ_SECONDS:-60}
+fuzzers=(scene_json_fuzz gltf_fuzz mesh_fuzz texture_fuzz codec_fuzz)
+mapfile -t unit_tests < <(ls tests/unit/core/*_test.cc tests/unit/job/*_test.cc | xargs -n1 basename | sed 's/\.cc$//')
+t0=$(date +%s)
+cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+  -DCMAKE_CXX_COMPILER=clang++ \
+  -DLF_SANITIZE=address,undefined -DLF_FUZZ=ON >/dev/null
+cmake --build build-san -j"${JOBS:-2}" --target "${unit_tests[@]}" "${fuzzers[@]}" >/dev/null
+t1=$(date +%s)
+echo "sanitize: build of ${#unit_tests[@]} unit test programs and ${#fuzzers[@]} fuzz targets with address,undefined: $((t1 - t0)) s"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+for t in "${unit_tests[@]}"; do
+  (cd build-san && LF_TEST_QUIET=1 "bin/$t" --gtest_brief=1 >"$t.log" 2>&1) || {
+    echo "sanitize: $t failed under address,undefined:"; tail -60 "build-san/$t.log"; exit 1; }
+done
+t2=$(date +%s)
+echo "sanitize: ${#unit_tests[@]} unit test programs passed under address,undefined: $((t2 - t1)) s"
+mkdir -p build-san/fuzz-crashes
+for f in "${fuzzers[@]}"; do
+  rm -rf "build-san/corpus/$f" && mkdir -p "build-san/corpus/$f"
+  # New inputs go to build-san/corpus; the seeds in the source tree are only read.
+  if ! build-san/bin/$f -max_total_time="$fuzz_seconds" -print_final_stats=1 \
+      -artifact_prefix="build-san/fuzz-crashes/$f-" "build-san/corpus/$f" "tests/fuzz/corpus/$f" \
+      >"build-san/$f.log" 2>&1; then
+    echo "sanitize: $f found a crash:"; tail -60 "build-san/$f.log"; ls build-san/fuzz-crashes; exit 1
+  fi
+  echo "sanitize: $f: $(grep -o 'stat::number_of_executed_units: *[0-9]*' "build-san/$f.log" | grep -o '[0-9]*$') runs in ${fuzz_seconds} s, no crash"
+done
+t3=$(date +%s)
+echo "sanitize: fuzzing: $((t3 - t2)) s; all: $((t3 - t0)) s"
