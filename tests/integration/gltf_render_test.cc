@@ -117,5 +117,23 @@ TEST_F(GltfRender, RenderCommandTakesGltfCameraAndResolution) {
     EXPECT_NE(size_out.find("expected WxH"), std::string::npos) << size_out;
 }
 
+// A camera at 1e308 hit Embree's `ray.valid()` assertion: render died of SIGABRT (rc 134). The
+// loader refuses it, so render fails with the message and the ordinary exit code.
+TEST_F(GltfRender, RenderRefusesACameraBeyondTheCoordinateBoundInsteadOfAborting) {
+    testing::GltfBuilder b = testing::TexturedTestScene();
+    b.json()["nodes"][3]["translation"] = {1e308, 1, 6};  // "Front"
+    Write("far.gltf", b.Gltf("far.bin"));
+    Write("far.bin", b.bin());
+    const auto [status, out] = Lightfarm("render " + (dir_ / "far.gltf").string() + " -o " +
+                                         (dir_ / "far.exr").string() + " --spp 1 --no-progress");
+    EXPECT_EQ(status, 1) << out;
+    EXPECT_NE(
+        out.find(
+            "far.gltf: nodes[3] \"Front\": its world translation (1e+308, 1, 6) is beyond ±1e+15"),
+        std::string::npos)
+        << out;
+    EXPECT_FALSE(fs::exists(dir_ / "far.exr"));
+}
+
 }  // namespace
 }  // namespace lf
