@@ -6,11 +6,13 @@
 #  3. each fuzz target of tests/fuzz for FUZZ_SECONDS (default 60) from its seed corpus. A crash
 #     fails the run and is kept as build-san/fuzz-crashes/TARGET-*: add it to
 #     tests/fuzz/regressions/TARGET/, which every build's ctest replays.
+#  4. a ThreadSanitizer build (build-tsan/) of the coordinator's scheduler, lease, store, timeout
+#     and in-process farm tests (TSAN_TESTS), run there.
 # Prints how long each part took.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 fuzz_seconds=${FUZZ_SECONDS:-60}
-fuzzers=(scene_json_fuzz gltf_fuzz mesh_fuzz texture_fuzz codec_fuzz)
+fuzzers=(scene_json_fuzz gltf_fuzz mesh_fuzz texture_fuzz codec_fuzz job_record_fuzz)
 mapfile -t unit_tests < <(ls tests/unit/core/*_test.cc tests/unit/job/*_test.cc | xargs -n1 basename | sed 's/\.cc$//')
 t0=$(date +%s)
 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
@@ -39,4 +41,19 @@ for f in "${fuzzers[@]}"; do
   echo "sanitize: $f: $(grep -o 'stat::number_of_executed_units: *[0-9]*' "build-san/$f.log" | grep -o '[0-9]*$') runs in ${fuzz_seconds} s, no crash"
 done
 t3=$(date +%s)
-echo "sanitize: fuzzing: $((t3 - t2)) s; all: $((t3 - t0)) s"
+echo "sanitize: fuzzing: $((t3 - t2)) s"
+tsan_tests=(${TSAN_TESTS:-scheduler_test scheduler_tasks_test scheduling_policies_test splat_scheduler_test
+  lease_table_test worker_registry_test job_store_test sqlite_job_store_test timeout_checker_test
+  task_log_store_test fake_worker_farm_test})
+cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+  -DLF_SANITIZE=thread >/dev/null
+cmake --build build-tsan -j"${JOBS:-2}" --target "${tsan_tests[@]}" >/dev/null
+t4=$(date +%s)
+echo "sanitize: build of ${#tsan_tests[@]} coordinator test programs with thread: $((t4 - t3)) s"
+export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
+for t in "${tsan_tests[@]}"; do
+  (cd build-tsan && LF_TEST_QUIET=1 "bin/$t" --gtest_brief=1 >"$t.log" 2>&1) || {
+    echo "sanitize: $t failed under thread:"; tail -80 "build-tsan/$t.log"; exit 1; }
+done
+t5=$(date +%s)
+echo "sanitize: ${#tsan_tests[@]} coordinator test programs passed under thread: $((t5 - t4)) s; all: $((t5 - t0)) s"

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "image_files.h"
 #include "lf/core/file_util.h"
@@ -180,6 +181,28 @@ TEST(TextureIo, RefusesAnAbsurdSizeFromTheHeaderAlone) {
     EXPECT_EQ(decoded.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(decoded.status().message().find("huge.png"), std::string::npos);
     EXPECT_NE(decoded.status().message().find("100000 x 100000"), std::string::npos)
+        << decoded.status();
+}
+
+// A 1.5 KB EXR whose header declared a 1.4 GB attribute of a type OpenEXR does not know made it
+// allocate 1.4 GB (found by tests/fuzz/texture_fuzz; its input is
+// tests/fuzz/regressions/texture/): refused from the header, naming the attribute.
+TEST(TextureIo, AnExrHeaderDeclaringMoreThanTheFileHoldsIsRefusedBeforeAllocating) {
+    Image exr(2, 1);
+    for (const char* channel : {"R", "G", "B"}) exr.Channel(channel) = {0.5f, 1.0f};
+    const std::string path = (testing::FreshTestDir("texture_exr_header") / "a.exr").string();
+    ASSERT_TRUE(WriteExr(path, exr, {}).ok());
+    const std::string good = *ReadFile(path);
+    // An attribute of a type OpenEXR does not know, declaring 1.4 GB, first in the header.
+    const uint32_t size = 0x5200006e;
+    std::string huge = good.substr(0, 8) + std::string("bomb\0blob\0", 10) +
+                       std::string(reinterpret_cast<const char*>(&size), 4) + good.substr(8);
+    const auto decoded = DecodeTexture(huge, "huge.exr");
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_NE(decoded.status().message().find(
+                  "huge.exr: not a readable OpenEXR image: header attribute \"bomb\" declares "
+                  "1375731822 bytes"),
+              std::string::npos)
         << decoded.status();
 }
 
