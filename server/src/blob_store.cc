@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/log.h"
 
 namespace lf {
 
@@ -42,7 +43,8 @@ absl::Time ModifiedAt(const std::string& path) {
 }
 
 absl::Status MalformedHash(const std::string& hash) {
-    return absl::InvalidArgumentError("blob hash '" + hash + "' is not a SHA-256 hex digest");
+    return absl::InvalidArgumentError("blob hash '" + LogSafe(hash, 64) +
+                                      "' is not a SHA-256 hex digest");
 }
 
 }  // namespace
@@ -182,6 +184,11 @@ absl::Status BlobStore::ClaimPartial(const std::string& hash, uint64_t size, uin
         return refuse(absl::InvalidArgumentError(absl::StrCat(
             "blob ", hash, ": upload at offset ", offset, " of a blob of ", size, " bytes")));
     }
+    if (!found.empty() && found != path) {
+        return refuse(absl::InvalidArgumentError(
+            absl::StrCat("blob ", hash, ": upload of ", size, " bytes at offset ", offset,
+                         ", the bytes held are of an upload declared with another size; removed")));
+    }
     if (offset == 0) {
         if (!found.empty()) {
             fs::remove(found, ec);
@@ -192,14 +199,9 @@ absl::Status BlobStore::ClaimPartial(const std::string& hash, uint64_t size, uin
         if (!std::ofstream(path, std::ios::binary)) {
             return absl::InternalError(path + ": cannot be created");
         }
-    } else if (found != path) {
-        if (found.empty()) {
-            return absl::OutOfRangeError(absl::StrCat("blob ", hash, ": upload at offset ", offset,
-                                                      ", the server holds none of it; start at 0"));
-        }
-        return refuse(absl::InvalidArgumentError(
-            absl::StrCat("blob ", hash, ": upload of ", size, " bytes at offset ", offset,
-                         ", the bytes held are of an upload declared with another size; removed")));
+    } else if (found.empty()) {
+        return absl::OutOfRangeError(absl::StrCat("blob ", hash, ": upload at offset ", offset,
+                                                  ", the server holds none of it; start at 0"));
     } else {
         const uint64_t held = fs::file_size(path, ec);
         if (ec) return absl::InternalError(path + ": " + ec.message());

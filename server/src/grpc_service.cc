@@ -18,6 +18,8 @@ namespace pb = lightfarm::v1;
 namespace {
 
 constexpr size_t kChunkBytes = 1 << 20;
+// How much of an id from the wire an error quotes.
+constexpr size_t kIdBytesInErrors = 64;
 
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("rpc"); }
 
@@ -173,14 +175,13 @@ absl::StatusOr<JobRecord> JobServiceImpl::VisibleJob(const Caller& caller,
                                                      const std::string& job_id) const {
     // Job ids are "job-" and 10 hex digits: a longer one is nobody's, and is not echoed back
     // (a megabyte-long id came back whole in GetJob's error).
-    constexpr size_t kMaxJobIdBytes = 64;
-    if (job_id.size() > kMaxJobIdBytes) {
-        return absl::NotFoundError(absl::StrCat("no job ", LogSafe(job_id, kMaxJobIdBytes), " (",
+    if (job_id.size() > kIdBytesInErrors) {
+        return absl::NotFoundError(absl::StrCat("no job ", LogSafe(job_id, kIdBytesInErrors), " (",
                                                 job_id.size(), " bytes)"));
     }
     absl::StatusOr<JobRecord> job = farm_.scheduler().Get(job_id);
     if (job.ok() && !MaySee(caller, job->spec.owner))
-        return absl::NotFoundError("no job " + job_id);
+        return absl::NotFoundError("no job " + LogSafe(job_id, kIdBytesInErrors));
     return job;
 }
 
@@ -521,7 +522,8 @@ grpc::Status WorkerServiceImpl::FetchBlob(grpc::ServerContext* context, const Ca
                                           const pb::FetchBlobRequest& req,
                                           const std::function<bool(const pb::Chunk&)>& write) {
     if (!farm_.blobs().Has(req.hash())) {
-        return ToGrpcStatus(absl::NotFoundError("no blob " + req.hash()));
+        return ToGrpcStatus(
+            absl::NotFoundError("no blob " + LogSafe(req.hash(), kIdBytesInErrors)));
     }
     return StreamFile(context, farm_.blobs().PathOf(req.hash()), "blob " + req.hash(), write);
 }

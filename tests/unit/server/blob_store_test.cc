@@ -206,6 +206,23 @@ TEST_F(BlobStoreTest, OffsetsAndSizesThatDoNotFitTheBytesHeldAreRefused) {
               absl::StatusCode::kInvalidArgument);
 }
 
+TEST_F(BlobStoreTest, ASecondDeclaredSizeFromTheStartIsRefusedAndThePartialRemoved) {
+    const std::string content = RandomBytes(10000, 6);
+    const std::string hash = Sha256Hex(content);
+    ASSERT_TRUE(Send(content, 0, 4000).ok());
+    const absl::Status other_size = blobs_->StartUpload(hash, 20000, 0).status();
+    EXPECT_EQ(other_size.code(), absl::StatusCode::kInvalidArgument) << other_size;
+    EXPECT_NE(other_size.message().find("another size"), std::string_view::npos) << other_size;
+    EXPECT_EQ(Partials(), 0) << "neither upload's bytes are kept";
+    EXPECT_TRUE(Send(content, 0, content.size(), /*finish=*/true).ok()) << "then starts afresh";
+}
+
+TEST_F(BlobStoreTest, AMalformedHashIsQuotedCut) {
+    const absl::Status s = blobs_->StartUpload(std::string(1 << 20, 'z'), 1).status();
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_LT(s.message().size(), 200u) << s;
+}
+
 TEST_F(BlobStoreTest, OneUploadOfAHashAtATimeAndTheOtherFindsItStored) {
     const std::string content = RandomBytes(100000, 6);
     const std::string hash = Sha256Hex(content);

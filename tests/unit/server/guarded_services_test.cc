@@ -277,6 +277,15 @@ TEST_F(GuardedServices, AnotherTokenCannotActForAWorkerByClaimingItsId) {
     EXPECT_TRUE(heartbeat("node")) << "the forged result did not end node's lease";
 }
 
+TEST_F(GuardedServices, AMegabyteLongJobIdIsNotEchoedBack) {
+    pb::GetJobRequest request;
+    request.set_job_id(std::string(1 << 20, 'j'));
+    pb::Job job;
+    const grpc::Status s = Jobs("alice")->GetJob(Context().get(), request, &job);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_LT(s.error_message().size(), 200u) << s.error_message().substr(0, 200);
+}
+
 TEST_F(GuardedServices, RolesAreKeptApart) {
     std::string id;
     const grpc::Status worker_submit = Submit(*Jobs("node"), &id);
