@@ -349,6 +349,10 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const Caller
         ToProto(*job, &message);
         std::string bytes = message.SerializeAsString();
         if (bytes != last_sent || absl::Now() - last_time > kMaxGap) {
+            // A token revoked meanwhile ends the stream (within the Authenticator's cache time).
+            if (auto c = guard_.Check(context, "WatchJob", Action::kReadJobs); !c.ok()) {
+                return ToGrpcStatus(c.status());
+            }
             if (!write(message)) break;
             last_sent = std::move(bytes);
             last_time = absl::Now();

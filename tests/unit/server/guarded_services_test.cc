@@ -277,6 +277,26 @@ TEST_F(GuardedServices, AnotherTokenCannotActForAWorkerByClaimingItsId) {
     EXPECT_TRUE(heartbeat("node")) << "the forged result did not end node's lease";
 }
 
+TEST_F(GuardedServices, ARevokedTokensWatchStopsWithUnauthenticated) {
+    std::string id;
+    auto alice = Jobs("alice");
+    ASSERT_TRUE(Submit(*alice, &id).ok());
+    pb::WatchJobRequest watch;
+    watch.set_job_id(id);
+    auto context = Context();
+    auto reader = alice->WatchJob(context.get(), watch);
+    pb::Job update;
+    ASSERT_TRUE(reader->Read(&update));
+    auto tokens = TokenStore::Open((dir_ / "data").string());
+    ASSERT_TRUE(tokens.ok());
+    ASSERT_TRUE((*tokens)->Revoke("alice").ok());
+    while (reader->Read(&update)) {
+    }
+    const grpc::Status s = reader->Finish();
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAUTHENTICATED) << s.error_message();
+    EXPECT_NE(s.error_message().find("revoked"), std::string::npos) << s.error_message();
+}
+
 TEST_F(GuardedServices, AMegabyteLongJobIdIsNotEchoedBack) {
     pb::GetJobRequest request;
     request.set_job_id(std::string(1 << 20, 'j'));
