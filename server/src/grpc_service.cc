@@ -41,12 +41,15 @@ grpc::Status StreamFile(grpc::ServerContext* context, const std::string& path,
         Log()->error("{}: {} cannot be read", what, path);
         return grpc::Status(grpc::StatusCode::NOT_FOUND, what + " cannot be read on the server");
     }
-    std::string buffer(kChunkBytes, '\0');
+    // One chunk at a time, read into the message itself: a reader that stalls holds this chunk
+    // and what gRPC's flow control lets through, whatever the file's size.
     pb::Chunk chunk;
+    std::string& data = *chunk.mutable_data();
     while (in) {
-        in.read(buffer.data(), std::streamsize(buffer.size()));
-        if (in.gcount() == 0) break;
-        chunk.set_data(buffer.data(), size_t(in.gcount()));
+        data.resize(kChunkBytes);
+        in.read(data.data(), std::streamsize(data.size()));
+        data.resize(size_t(in.gcount()));
+        if (data.empty()) break;
         if (context->IsCancelled() || !write(chunk)) {
             return grpc::Status(grpc::StatusCode::CANCELLED, "the client went away");
         }
@@ -112,7 +115,21 @@ absl::Status CheckRequestSize(const char* rpc, size_t bytes, size_t max_bytes) {
 }
 
 JobServiceImpl::JobServiceImpl(Farm& farm, CallGuard guard, JobServiceOptions options)
-    : ReadAfterAuth("lightfarm.v1.JobService", guard), farm_(farm), options_(options) {
+    : ReadAfterAuth("lightfarm.v1.JobService", guard),
+      farm_(farm),
+      watchers_({.what = "WatchJob streams",
+                 .max = options.max_watchers,
+                 .max_flag = "--max-watchers",
+                 .max_per_token = options.max_watchers_per_token,
+                 .per_token_flag = "--max-watchers-per-token",
+                 .hint = "or poll with `lightfarm status`"}),
+      // Farm-wide, uploads are bounded by the partial uploads the blob store keeps.
+      uploads_({.what = "UploadBlob streams",
+                .max_per_token = options.max_uploads_per_token,
+                .per_token_flag = "--max-uploads-per-token"}),
+      fetches_({.what = "FetchResult streams",
+                .max_per_token = options.max_fetches_per_token,
+                .per_token_flag = "--max-fetches-per-token"}) {
     using std::bind_front;
     Unary<pb::MissingBlobsRequest, pb::MissingBlobsResponse>(
         "MissingBlobs", Action::kUploadBlobs, kMaxRequestBytes,
@@ -207,8 +224,13 @@ grpc::Status JobServiceImpl::BlobUploadOffset(grpc::ServerContext* context, cons
 grpc::Status JobServiceImpl::UploadBlob(grpc::ServerContext* context,
                                         grpc::ServerReader<pb::UploadBlobRequest>* reader,
                                         pb::UploadBlobResponse*) {
-    if (auto c = guard_.Check(context, "UploadBlob", Action::kUploadBlobs); !c.ok()) {
-        return ToGrpcStatus(c.status());
+    absl::StatusOr<Caller> caller = guard_.Check(context, "UploadBlob", Action::kUploadBlobs);
+    if (!caller.ok()) return ToGrpcStatus(caller.status());
+    absl::StatusOr<StreamSlots::Slot> slot = uploads_.Take(caller->name);
+    if (!slot.ok()) {
+        Log()->warn("upload from {} refused: {}", Peer(context),
+                    std::string(slot.status().message()));
+        return ToGrpcStatus(slot.status());
     }
     pb::UploadBlobRequest chunk;
     if (!reader->Read(&chunk)) {
@@ -322,17 +344,11 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const Caller
     }
     // Each stream holds a server thread until its job ends: bounded, so that watchers cannot
     // take every thread (or the memory of thousands).
-    struct Slot {
-        std::atomic<int>& count;
-        ~Slot() { --count; }
-    } slot{watchers_};
-    if (++watchers_ > options_.max_watchers) {
-        Log()->warn("watch of job={} from {} refused: {} watchers already", LogSafe(req.job_id()),
-                    Peer(context), options_.max_watchers);
-        return ToGrpcStatus(absl::ResourceExhaustedError(absl::StrCat(
-            "this server already serves its most watchers, ", options_.max_watchers,
-            " (lightfarm-server --max-watchers): try again later, or poll with `lightfarm "
-            "status`")));
+    absl::StatusOr<StreamSlots::Slot> slot = watchers_.Take(caller.name);
+    if (!slot.ok()) {
+        Log()->warn("watch of job={} from {} refused: {}", LogSafe(req.job_id()), Peer(context),
+                    std::string(slot.status().message()));
+        return ToGrpcStatus(slot.status());
     }
     // At most five messages a second, and one at least every few seconds so a dead client is
     // noticed.
@@ -397,6 +413,12 @@ grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context, const Cal
     }
     absl::StatusOr<std::string> path = farm_.ResultFile(req.job_id(), req.preview());
     if (!path.ok()) return ToGrpcStatus(path.status());
+    absl::StatusOr<StreamSlots::Slot> slot = fetches_.Take(caller.name);
+    if (!slot.ok()) {
+        Log()->warn("fetch of job={} from {} refused: {}", LogSafe(req.job_id()), Peer(context),
+                    std::string(slot.status().message()));
+        return ToGrpcStatus(slot.status());
+    }
     return StreamFile(context, *path, "the result of job " + req.job_id(), write);
 }
 

@@ -92,6 +92,19 @@ int main(int argc, char** argv) {
                    "most WatchJob streams open at once (each holds a thread); more are refused")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    app.add_option("--max-watchers-per-token", service_options.max_watchers_per_token,
+                   "most WatchJob streams one token may hold open at once")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    app.add_option("--max-uploads-per-token", service_options.max_uploads_per_token,
+                   "most UploadBlob streams one token may hold open at once (the farm keeps at "
+                   "most 16 partial uploads)")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    app.add_option("--max-fetches-per-token", service_options.max_fetches_per_token,
+                   "most FetchResult streams one token may hold open at once")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     app.add_option("--max-active-jobs", options.scheduler.max_active_jobs,
                    "most jobs queued or running at once")
         ->capture_default_str()

@@ -6,6 +6,9 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <mutex>
+#include <optional>
+#include <thread>
 
 #include "lf/core/file_util.h"
 #include "lf/job/digest.h"
@@ -64,7 +67,7 @@ class GuardedServices : public ::testing::Test {
             std::ofstream(dir_ / (std::string(name) + ".token")) << *token << "\n";
         }
         auth_ = std::make_unique<Authenticator>(std::move(*tokens), true);
-        jobs_ = std::make_unique<JobServiceImpl>(*farm_, CallGuard{*auth_, true});
+        jobs_ = std::make_unique<JobServiceImpl>(*farm_, CallGuard{*auth_, true}, service_options_);
         workers_ = std::make_unique<WorkerServiceImpl>(*farm_, CallGuard{*auth_, true});
         auto credentials = MakeServerCredentials({.cert = (dir_ / "server.crt").string(),
                                                   .key = (dir_ / "server.key").string(),
@@ -147,6 +150,7 @@ class GuardedServices : public ::testing::Test {
     }
 
     fs::path dir_;
+    JobServiceOptions service_options_;
     std::unique_ptr<Farm> farm_;
     std::unique_ptr<Authenticator> auth_;
     std::unique_ptr<JobServiceImpl> jobs_;
@@ -295,6 +299,191 @@ TEST_F(GuardedServices, ARevokedTokensWatchStopsWithUnauthenticated) {
     const grpc::Status s = reader->Finish();
     EXPECT_EQ(s.error_code(), grpc::StatusCode::UNAUTHENTICATED) << s.error_message();
     EXPECT_NE(s.error_message().find("revoked"), std::string::npos) << s.error_message();
+}
+
+// A stream held open by `who`, its first message read or its refusal kept.
+template <class Message>
+struct HeldStream {
+    std::unique_ptr<grpc::ClientContext> context;
+    std::unique_ptr<grpc::ClientReader<Message>> reader;
+    bool open = false;
+    grpc::Status refusal;
+
+    ~HeldStream() {
+        if (!open) return;
+        context->TryCancel();
+        reader->Finish();
+    }
+};
+
+TEST_F(GuardedServices, OneTokensWatchesLeaveRoomForAnothers) {
+    std::string alice_job, bob_job;
+    ASSERT_TRUE(Submit(*Jobs("alice"), &alice_job).ok());
+    ASSERT_TRUE(Submit(*Jobs("bob"), &bob_job).ok());
+    const auto watch = [&](pb::JobService::Stub& stub, const std::string& id) {
+        auto held = std::make_unique<HeldStream<pb::Job>>();
+        held->context = Context();
+        pb::WatchJobRequest request;
+        request.set_job_id(id);
+        held->reader = stub.WatchJob(held->context.get(), request);
+        pb::Job first;
+        // The first message comes once the server holds the stream's slot.
+        held->open = held->reader->Read(&first);
+        if (!held->open) held->refusal = held->reader->Finish();
+        return held;
+    };
+    // Alice opens watches until she is refused, or as many as the farm serves (256).
+    auto alice = Jobs("alice");
+    std::vector<std::unique_ptr<HeldStream<pb::Job>>> held;
+    while (held.size() < 256) {
+        held.push_back(watch(*alice, alice_job));
+        if (!held.back()->open) break;
+    }
+    ASSERT_FALSE(held.back()->open);
+    EXPECT_EQ(held.back()->refusal.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+    EXPECT_NE(held.back()->refusal.error_message().find("--max-watchers-per-token"),
+              std::string::npos)
+        << held.back()->refusal.error_message();
+    EXPECT_NE(held.back()->refusal.error_message().find("\"alice\""), std::string::npos)
+        << held.back()->refusal.error_message();
+    EXPECT_EQ(held.size(), 33u);
+    auto bob = watch(*Jobs("bob"), bob_job);
+    EXPECT_TRUE(bob->open) << bob->refusal.error_message();
+}
+
+TEST_F(GuardedServices, OneTokensStalledUploadsLeaveRoomForAnothers) {
+    // Alice opens as many uploads as the blob store keeps partial uploads (16), each sending its
+    // first 64 KiB of 1 MiB and then nothing; each ends refused or holding its partial.
+    auto alice = Jobs("alice");
+    struct Upload {
+        grpc::ClientContext context;
+        pb::UploadBlobResponse response;
+        std::unique_ptr<grpc::ClientWriter<pb::UploadBlobRequest>> writer;
+        std::string hash;
+        std::optional<grpc::Status> refusal;
+        std::thread finish;
+    };
+    std::vector<std::unique_ptr<Upload>> uploads;
+    std::mutex mutex;
+    for (int i = 0; i < kMaxPartialUploads; ++i) {
+        auto up = std::make_unique<Upload>();
+        up->context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+        up->hash = Sha256Hex("blob " + std::to_string(i));
+        up->writer = alice->UploadBlob(&up->context, &up->response);
+        pb::UploadBlobRequest chunk;
+        chunk.set_hash(up->hash);
+        chunk.set_size(1 << 20);
+        chunk.set_data(std::string(64 << 10, 'x'));
+        up->writer->Write(chunk);
+        up->finish = std::thread([&mutex, u = up.get()] {
+            grpc::Status s = u->writer->Finish();
+            std::lock_guard<std::mutex> lock(mutex);
+            u->refusal = s;
+        });
+        uploads.push_back(std::move(up));
+    }
+    const auto settled = [&](const Upload& up) {
+        std::lock_guard<std::mutex> lock(mutex);
+        return up.refusal.has_value() || *farm_->blobs().UploadOffset(up.hash, 1 << 20) > 0;
+    };
+    for (const auto& up : uploads) {
+        while (!settled(*up)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    int refused = 0;
+    {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const auto& up : uploads) {
+            if (!up->refusal) continue;
+            ++refused;
+            EXPECT_EQ(up->refusal->error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+            EXPECT_NE(up->refusal->error_message().find("--max-uploads-per-token"),
+                      std::string::npos)
+                << up->refusal->error_message();
+        }
+    }
+    EXPECT_EQ(refused, kMaxPartialUploads - 4);
+
+    // Bob's upload goes through while Alice's stall.
+    const std::string data = "bob's texture";
+    pb::UploadBlobRequest chunk;
+    chunk.set_hash(Sha256Hex(data));
+    chunk.set_size(data.size());
+    chunk.set_data(data);
+    grpc::ClientContext context;
+    pb::UploadBlobResponse response;
+    auto writer = Jobs("bob")->UploadBlob(&context, &response);
+    writer->Write(chunk);
+    writer->WritesDone();
+    const grpc::Status bob = writer->Finish();
+    EXPECT_TRUE(bob.ok()) << bob.error_message();
+    EXPECT_TRUE(farm_->blobs().Has(Sha256Hex(data)));
+
+    for (auto& up : uploads) {
+        up->context.TryCancel();
+        up->finish.join();
+    }
+}
+
+// The resident memory of this process in KiB.
+long ResidentKib() {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+    }
+    return -1;
+}
+
+TEST_F(GuardedServices, StalledResultReadersAreCappedPerTokenAndHoldNoWholeResult) {
+    std::string alice_job, bob_job;
+    ASSERT_TRUE(Submit(*Jobs("alice"), &alice_job).ok());
+    ASSERT_TRUE(Submit(*Jobs("bob"), &bob_job).ok());
+    // A queued job's preview is kept while no task ends: made 64 MiB here, as a large result.
+    ASSERT_TRUE(farm_->ResultFile(alice_job, true).ok());
+    constexpr size_t kResultBytes = size_t(64) << 20;
+    std::ofstream(dir_ / "data" / "previews" / (alice_job + ".exr"), std::ios::binary)
+        << std::string(kResultBytes, 'r');
+    const auto fetch = [&](pb::JobService::Stub& stub, const std::string& id) {
+        auto held = std::make_unique<HeldStream<pb::Chunk>>();
+        held->context = Context();
+        pb::FetchResultRequest request;
+        request.set_job_id(id);
+        request.set_preview(true);
+        held->reader = stub.FetchResult(held->context.get(), request);
+        pb::Chunk first;
+        held->open = held->reader->Read(&first);
+        if (!held->open) held->refusal = held->reader->Finish();
+        return held;
+    };
+    auto alice = Jobs("alice");
+    const long before = ResidentKib();
+    // Readers that take one chunk and stop.
+    std::vector<std::unique_ptr<HeldStream<pb::Chunk>>> held;
+    for (int i = 0; i < 4; ++i) {
+        held.push_back(fetch(*alice, alice_job));
+        ASSERT_TRUE(held.back()->open) << held.back()->refusal.error_message();
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the server run ahead
+    const long after = ResidentKib();
+    // Each reader costs its chunk and what flow control lets through on both ends of the
+    // connection (this process is server and client: about 17 MB a reader measured), not the
+    // 64 MiB result: four whole results would be 256 MiB.
+    EXPECT_LT(after - before, long(4 * kResultBytes / 2 / 1024))
+        << before << " KiB before, " << after << " after";
+    const auto refused = fetch(*alice, alice_job);
+    ASSERT_FALSE(refused->open);
+    EXPECT_EQ(refused->refusal.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+    EXPECT_NE(refused->refusal.error_message().find("--max-fetches-per-token"), std::string::npos)
+        << refused->refusal.error_message();
+    // Bob's fetch goes through while Alice's readers stall.
+    auto bob = fetch(*Jobs("bob"), bob_job);
+    ASSERT_TRUE(bob->open) << bob->refusal.error_message();
+    pb::Chunk chunk;
+    while (bob->reader->Read(&chunk)) {
+    }
+    bob->open = false;
+    const grpc::Status done = bob->reader->Finish();
+    EXPECT_TRUE(done.ok()) << done.error_message();
 }
 
 TEST_F(GuardedServices, AMegabyteLongJobIdIsNotEchoedBack) {

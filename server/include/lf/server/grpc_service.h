@@ -2,7 +2,6 @@
 // and the plain types of Farm and Scheduler. All protobuf conversion of the server is here.
 #pragma once
 
-#include <atomic>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -10,6 +9,7 @@
 #include "lf/server/auth.h"
 #include "lf/server/farm.h"
 #include "lf/server/read_after_auth.h"
+#include "lf/server/stream_slots.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
 #include "lightfarm/v1/worker_service.grpc.pb.h"
 
@@ -20,6 +20,13 @@ namespace lf {
 struct JobServiceOptions {
     // WatchJob streams open at once; each holds one of the server's threads while it lasts.
     int max_watchers = 256;
+    // Streams one token may hold open at once, below the farm-wide bounds (the watchers above,
+    // the blob store's kMaxPartialUploads), so that one token's stalled streams leave room for
+    // other tokens'. Not applied with authentication off (every caller is the same anonymous
+    // admin).
+    int max_watchers_per_token = 32;
+    int max_uploads_per_token = 4;
+    int max_fetches_per_token = 4;
 };
 
 // ListJobs pages: the size when the request names none, and the largest.
@@ -78,8 +85,7 @@ class JobServiceImpl final : public ReadAfterAuth<lightfarm::v1::JobService::Ser
     absl::StatusOr<JobRecord> VisibleJob(const Caller& caller, const std::string& job_id) const;
 
     Farm& farm_;
-    const JobServiceOptions options_;
-    std::atomic<int> watchers_{0};
+    StreamSlots watchers_, uploads_, fetches_;
 };
 
 // The log line of a refused result, every value from the wire escaped (lf::LogSafe).
