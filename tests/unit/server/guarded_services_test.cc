@@ -301,9 +301,23 @@ TEST_F(GuardedServices, ARevokedTokensWatchStopsWithUnauthenticated) {
     EXPECT_NE(s.error_message().find("revoked"), std::string::npos) << s.error_message();
 }
 
-// A stream held open by `who`, its first message read or its refusal kept.
+// A server stream held open, its first message read, or its refusal kept.
 template <class Message>
 struct HeldStream {
+    // Opens the stream `call` (ClientContext*) starts and reads its first message, which comes
+    // once the server holds the stream's slot.
+    template <class Call>
+    static std::unique_ptr<HeldStream> Open(Call call) {
+        auto held = std::make_unique<HeldStream>();
+        held->context = std::make_unique<grpc::ClientContext>();
+        held->context->set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+        held->reader = call(held->context.get());
+        Message first;
+        held->open = held->reader->Read(&first);
+        if (!held->open) held->refusal = held->reader->Finish();
+        return held;
+    }
+
     std::unique_ptr<grpc::ClientContext> context;
     std::unique_ptr<grpc::ClientReader<Message>> reader;
     bool open = false;
@@ -320,17 +334,11 @@ TEST_F(GuardedServices, OneTokensWatchesLeaveRoomForAnothers) {
     std::string alice_job, bob_job;
     ASSERT_TRUE(Submit(*Jobs("alice"), &alice_job).ok());
     ASSERT_TRUE(Submit(*Jobs("bob"), &bob_job).ok());
-    const auto watch = [&](pb::JobService::Stub& stub, const std::string& id) {
-        auto held = std::make_unique<HeldStream<pb::Job>>();
-        held->context = Context();
+    const auto watch = [](pb::JobService::Stub& stub, const std::string& id) {
         pb::WatchJobRequest request;
         request.set_job_id(id);
-        held->reader = stub.WatchJob(held->context.get(), request);
-        pb::Job first;
-        // The first message comes once the server holds the stream's slot.
-        held->open = held->reader->Read(&first);
-        if (!held->open) held->refusal = held->reader->Finish();
-        return held;
+        return HeldStream<pb::Job>::Open(
+            [&](grpc::ClientContext* context) { return stub.WatchJob(context, request); });
     };
     // Alice opens watches until she is refused, or as many as the farm serves (256).
     auto alice = Jobs("alice");
@@ -443,17 +451,12 @@ TEST_F(GuardedServices, StalledResultReadersAreCappedPerTokenAndHoldNoWholeResul
     constexpr size_t kResultBytes = size_t(64) << 20;
     std::ofstream(dir_ / "data" / "previews" / (alice_job + ".exr"), std::ios::binary)
         << std::string(kResultBytes, 'r');
-    const auto fetch = [&](pb::JobService::Stub& stub, const std::string& id) {
-        auto held = std::make_unique<HeldStream<pb::Chunk>>();
-        held->context = Context();
+    const auto fetch = [](pb::JobService::Stub& stub, const std::string& id) {
         pb::FetchResultRequest request;
         request.set_job_id(id);
         request.set_preview(true);
-        held->reader = stub.FetchResult(held->context.get(), request);
-        pb::Chunk first;
-        held->open = held->reader->Read(&first);
-        if (!held->open) held->refusal = held->reader->Finish();
-        return held;
+        return HeldStream<pb::Chunk>::Open(
+            [&](grpc::ClientContext* context) { return stub.FetchResult(context, request); });
     };
     auto alice = Jobs("alice");
     const long before = ResidentKib();
