@@ -17,6 +17,8 @@
 #include <unordered_set>
 #include <vector>
 
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "lf/core/log.h"
@@ -221,14 +223,18 @@ size_t HeadEnd(const std::string& text, size_t from) {
     return at == std::string::npos ? at : at + 4;
 }
 
-// GET or HEAD /healthz, with or without a query.
+// GET or HEAD /healthz, with or without a query, and without a body: one sent slowly would hold
+// the health thread.
 bool IsHealthProbe(std::string_view head) {
     const size_t space = head.find(' ');
     if (space == std::string_view::npos) return false;
     const std::string_view method = head.substr(0, space);
     std::string_view target = head.substr(space + 1);
     target = target.substr(0, std::min(target.find(' '), target.find('?')));
-    return (method == "GET" || method == "HEAD") && target == "/healthz";
+    const std::string lower = absl::AsciiStrToLower(std::string(head));
+    return (method == "GET" || method == "HEAD") && target == "/healthz" &&
+           !absl::StrContains(lower, "\ncontent-length:") &&
+           !absl::StrContains(lower, "\ntransfer-encoding:");
 }
 
 }  // namespace
