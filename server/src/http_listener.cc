@@ -8,6 +8,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "http_gate.h"
 #include "lf/core/log.h"
 #include "lf/server/dashboard.h"
 #include "lf/server/metrics.h"
@@ -22,10 +23,6 @@ constexpr char kText[] = "text/plain; charset=utf-8";
 // The exposition format's content type, version 0.0.4.
 constexpr char kMetricsType[] = "text/plain; version=0.0.4; charset=utf-8";
 
-// Each connection holds one of these threads while it is open: enough for probes, scrapes and a
-// few browsers' connections, which keep-alive holds no longer than kKeepAliveSeconds when idle.
-constexpr int kThreads = 16;
-constexpr time_t kKeepAliveSeconds = 1;
 // The dashboard's requests are small: a token, a priority.
 constexpr size_t kMaxBodyBytes = 64 << 10;
 
@@ -48,6 +45,24 @@ void Reply(HttpAnswer a, httplib::Response& response) {
 
 HttpAnswer Unavailable(const absl::Status& why) {
     return {503, kText, absl::StrCat("not ok: ", why.message(), "\n")};
+}
+
+HttpAnswer BodyTooLarge() {
+    return {413, kText, absl::StrCat("request body over ", kMaxBodyBytes, " bytes\n")};
+}
+
+// 413 and 408 for the requests the gate cut off; httplib would answer 400.
+httplib::Server::HandlerResponse CutOff(const httplib::Request&, httplib::Response& response) {
+    if (HttpGate::BodyOverLimit()) {
+        Reply(BodyTooLarge(), response);
+    } else if (HttpGate::ReadTimedOut()) {
+        response.status = 408;
+        response.set_content("request not received in time\n", kText);
+    } else {
+        return httplib::Server::HandlerResponse::Unhandled;
+    }
+    response.set_header("Connection", "close");
+    return httplib::Server::HandlerResponse::Handled;
 }
 
 }  // namespace
@@ -100,7 +115,8 @@ HttpAnswer MetricsAnswer(Farm& farm) {
 }
 
 struct HttpListener::Server {
-    std::unique_ptr<httplib::Server> http;  // an httplib::SSLServer under TLS
+    std::unique_ptr<httplib::Server> http;  // a GatedServer, of httplib::SSLServer under TLS
+    HttpGate* gate = nullptr;
     std::unique_ptr<Dashboard> dashboard;
     std::thread thread;
 };
@@ -123,16 +139,23 @@ absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(
     }
     auto server = std::make_unique<Server>();
     const bool tls = !options.tls_cert.empty() && !options.tls_key.empty();
+    HttpGateLimits limits;
+    limits.max_body_bytes = kMaxBodyBytes;
+    limits.request_read_time = options.request_read_time;
     if (tls) {
-        server->http =
-            std::make_unique<httplib::SSLServer>(options.tls_cert.c_str(), options.tls_key.c_str());
+        auto https = std::make_unique<GatedServer<httplib::SSLServer>>(
+            limits, options.tls_cert.c_str(), options.tls_key.c_str());
+        server->gate = &https->gate();
+        server->http = std::move(https);
         if (!server->http->is_valid()) {
             return absl::FailedPreconditionError(
                 absl::StrCat("--http ", host_port, ": cannot use --tls-cert ", options.tls_cert,
                              " and --tls-key ", options.tls_key, " for HTTPS"));
         }
     } else {
-        server->http = std::make_unique<httplib::Server>();
+        auto plain = std::make_unique<GatedServer<httplib::Server>>(limits);
+        server->gate = &plain->gate();
+        server->http = std::move(plain);
     }
     httplib::Server& http = *server->http;
     // httplib sets SO_REUSEPORT, with which a second server would share the port and answer
@@ -141,27 +164,11 @@ absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(
         int yes = 1;
         setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
     });
-    http.new_task_queue = [] { return new httplib::ThreadPool(kThreads); };
-    http.set_keep_alive_timeout(kKeepAliveSeconds);
+    // For the Keep-Alive header; the gate keeps the time.
+    http.set_keep_alive_timeout(absl::ToInt64Seconds(limits.keep_alive));
+    http.set_keep_alive_max_count(size_t(limits.max_requests_per_connection));
     http.set_payload_max_length(kMaxBodyBytes);
-    // httplib 0.11 bounds a body by its Content-Length only, and reads a chunked one whole
-    // before any handler (400 MB of chunks to /api/session took the server from 46 to 889 MB).
-    // The dashboard's requests all carry a Content-Length, so a chunked body is refused here,
-    // before it is read, and the connection closed with it unread.
-    http.set_pre_routing_handler([](const httplib::Request& request, httplib::Response& response) {
-        if (!request.has_header("Transfer-Encoding"))
-            return httplib::Server::HandlerResponse::Unhandled;
-        response.status = 411;
-        response.set_header("Connection", "close");
-        response.set_content(
-            absl::StrCat("a request body must come with a Content-Length of at most ",
-                         kMaxBodyBytes, " bytes, not Transfer-Encoding\n"),
-            kText);
-        Log()->warn("{} {} from {} refused: Transfer-Encoding {}", LogSafe(request.method),
-                    LogSafe(request.path), LogSafe(request.remote_addr),
-                    LogSafe(request.get_header_value("Transfer-Encoding")));
-        return httplib::Server::HandlerResponse::Handled;
-    });
+    http.set_error_handler(httplib::Server::HandlerWithResponse(CutOff));
     auto answer = [&farm](HttpAnswer (*handler)(Farm&)) {
         return [&farm, handler](const httplib::Request&, httplib::Response& response) {
             Reply(handler(farm), response);
@@ -174,7 +181,10 @@ absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(
             std::make_unique<Dashboard>(farm, *options.dashboard_auth, DashboardOptions{tls});
         Dashboard* dashboard = server->dashboard.get();
         auto serve = [dashboard](const httplib::Request& request, httplib::Response& response) {
-            Reply(dashboard->Serve(FromHttplib(request)), response);
+            // A chunked body may pass the gate's byte limit by its chunks' framing.
+            Reply(request.body.size() > kMaxBodyBytes ? BodyTooLarge()
+                                                      : dashboard->Serve(FromHttplib(request)),
+                  response);
         };
         http.Get("/|/web/.*|/api/.*", serve);
         http.Post("/api/.*", serve);
@@ -197,6 +207,7 @@ absl::StatusOr<std::unique_ptr<HttpListener>> HttpListener::Start(
 HttpListener::~HttpListener() {
     server_->http->stop();
     server_->thread.join();
+    server_->gate->Stop();
 }
 
 }  // namespace lf

@@ -122,7 +122,9 @@ int main(int argc, char** argv) {
                    "for probes that cannot speak TLS (Kubernetes' grpc probe); off if unset");
     app.add_option("--http", http,
                    "HOST:PORT to serve GET /healthz, /metrics (Prometheus) and the web dashboard "
-                   "on, over HTTPS with --tls-cert and --tls-key; off if unset");
+                   "on, over HTTPS with --tls-cert and --tls-key; off if unset. A request must "
+                   "arrive whole within 10 s (bodies at most 64 KiB); /healthz has a thread of "
+                   "its own");
     app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
         ->capture_default_str();
     lf::TokenCommand token_command(app);

@@ -20,12 +20,35 @@ int Fail(const absl::Status& s) {
 int TokenCommand::Create() {
     absl::StatusOr<Role> role = RoleFromName(role_);
     if (!role.ok()) return Fail(role.status());
+    absl::StatusOr<bool> any = store_->Any();
+    if (!any.ok()) return Fail(any.status());
     absl::StatusOr<std::string> token = store_->Create(name_, *role);
     if (!token.ok()) return Fail(token.status());
     std::fprintf(stderr,
                  "token \"%s\" (%s) created; it is shown once, here: keep it in a file only its "
                  "user reads (--token-file) or in LIGHTFARM_TOKEN\n",
                  name_.c_str(), RoleName(*role));
+    if (!*any) {
+        std::fprintf(stderr,
+                     "warning: this is the farm's first token: within a second, a server on %s "
+                     "refuses every call without a valid token, workers included. Running "
+                     "workers are refused until each has a worker token: make one per worker with "
+                     "`lightfarm-server token create --data-dir %s --name NODE --role worker` "
+                     "and restart the worker with --token-file FILE (or LIGHTFARM_TOKEN); "
+                     "clients need one too (a submitter or admin token)\n",
+                     data_dir_.c_str(), data_dir_.c_str());
+    }
+    std::printf("%s\n", token->c_str());
+    return 0;
+}
+
+int TokenCommand::Rotate() {
+    absl::StatusOr<std::string> token = store_->Rotate(name_);
+    if (!token.ok()) return Fail(token.status());
+    std::fprintf(stderr,
+                 "token \"%s\" rotated: its previous token is refused within a second; this "
+                 "one, shown once, sees and manages the same jobs\n",
+                 name_.c_str());
     std::printf("%s\n", token->c_str());
     return 0;
 }
@@ -63,7 +86,11 @@ TokenCommand::TokenCommand(CLI::App& app) {
         "create", "make a token and print it as the last line (it is stored only hashed)");
     list_ = token_->add_subcommand("list", "list tokens: name, role, created, revoked");
     CLI::App* revoke = token_->add_subcommand("revoke", "revoke a token by name (kept, refused)");
-    for (CLI::App* cmd : {create_, list_, revoke}) {
+    rotate_ = token_->add_subcommand(
+        "rotate",
+        "give a name a new token, revoked or not, and print it as the last line: its previous "
+        "token is refused, its jobs stay its own (for a token that leaked)");
+    for (CLI::App* cmd : {create_, list_, revoke, rotate_}) {
         cmd->add_option("--data-dir", data_dir_, "the server's data folder")->required();
     }
     create_->add_option("--name", name_, "who the token is for: 1-64 of A-Z a-z 0-9 . _ - @")
@@ -74,7 +101,9 @@ TokenCommand::TokenCommand(CLI::App& app) {
                      "admin: everything, every job; worker: lease, heartbeat, complete tasks")
         ->required()
         ->check(CLI::IsMember({"submitter", "admin", "worker"}));
-    revoke->add_option("--name", name_, "the token's name")->required();
+    for (CLI::App* cmd : {revoke, rotate_}) {
+        cmd->add_option("--name", name_, "the token's name")->required();
+    }
 }
 
 std::optional<int> TokenCommand::Run() {
@@ -84,6 +113,7 @@ std::optional<int> TokenCommand::Run() {
     store_ = std::move(*store);
     if (create_->parsed()) return Create();
     if (list_->parsed()) return List();
+    if (rotate_->parsed()) return Rotate();
     return Revoke();
 }
 

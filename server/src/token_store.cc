@@ -25,6 +25,22 @@ constexpr std::array<Role, 3> kRoles = {Role::kSubmitter, Role::kAdmin, Role::kW
 constexpr size_t kTokenBytes = 32;
 constexpr char kTokenPrefix[] = "lf1_";
 
+absl::StatusOr<std::string> NewToken() {
+    std::array<unsigned char, kTokenBytes> bytes;
+    if (RAND_bytes(bytes.data(), int(bytes.size())) != 1) {
+        return absl::InternalError("no random bytes from OpenSSL for a token");
+    }
+    return absl::StrCat(
+        kTokenPrefix, absl::BytesToHexString(
+                          std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size())));
+}
+
+int64_t NowMicros() { return absl::ToUnixMicros(absl::Now()); }
+
+absl::Status NoSuchName(const std::string& name) {
+    return absl::NotFoundError(absl::StrCat("no token named \"", absl::CHexEscape(name), "\""));
+}
+
 }  // namespace
 
 const char* RoleName(Role role) {
@@ -81,7 +97,11 @@ absl::StatusOr<std::unique_ptr<TokenStore>> TokenStore::Open(const std::string& 
                           "PRAGMA busy_timeout=5000;"
                           "CREATE TABLE IF NOT EXISTS tokens (name TEXT PRIMARY KEY,"
                           "  role TEXT NOT NULL, hash TEXT NOT NULL UNIQUE,"
-                          "  created INTEGER NOT NULL, revoked INTEGER);");
+                          "  created INTEGER NOT NULL, revoked INTEGER);"
+                          // Added with `token rotate`: a name's earlier tokens, refused as
+                          // revoked. Files made before it gain it here; their tokens stay.
+                          "CREATE TABLE IF NOT EXISTS retired_tokens (hash TEXT PRIMARY KEY,"
+                          "  name TEXT NOT NULL, retired INTEGER NOT NULL);");
     if (!s.ok()) return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
     return store;
 }
@@ -90,34 +110,52 @@ TokenStore::~TokenStore() { sqlite3_close(db_); }
 
 absl::StatusOr<std::string> TokenStore::Create(const std::string& name, Role role) {
     if (absl::Status s = CheckTokenName(name); !s.ok()) return s;
-    std::array<unsigned char, kTokenBytes> bytes;
-    if (RAND_bytes(bytes.data(), int(bytes.size())) != 1) {
-        return absl::InternalError("no random bytes from OpenSSL for a token");
-    }
-    const std::string token =
-        absl::StrCat(kTokenPrefix, absl::BytesToHexString(std::string(
-                                       reinterpret_cast<const char*>(bytes.data()), bytes.size())));
+    absl::StatusOr<std::string> token = NewToken();
+    if (!token.ok()) return token.status();
     Statement insert(db_, "INSERT INTO tokens (name, role, hash, created) VALUES (?1, ?2, ?3, ?4)");
-    insert.Bind(1, name).Bind(2, RoleName(role)).Bind(3, Sha256Hex(token));
-    insert.Bind(4, int64_t(absl::ToUnixMicros(absl::Now()))).Step();
+    insert.Bind(1, name).Bind(2, RoleName(role)).Bind(3, Sha256Hex(*token));
+    insert.Bind(4, NowMicros()).Step();
     if (absl::Status s = insert.status(); !s.ok()) {
         if (absl::IsAlreadyExists(s)) {
             return absl::AlreadyExistsError(
                 absl::StrCat("a token named \"", name,
-                             "\" exists (revoked ones keep their names): choose another name"));
+                             "\" exists (revoked ones keep their names, which own their jobs): "
+                             "`token rotate --name ",
+                             name, "` gives it a new token, or choose another name"));
         }
         return s;
     }
     return token;
 }
 
+absl::StatusOr<std::string> TokenStore::Rotate(const std::string& name) {
+    absl::StatusOr<std::string> token = NewToken();
+    if (!token.ok()) return token.status();
+    if (absl::Status s = Exec(db_, "BEGIN IMMEDIATE"); !s.ok()) return s;
+    Statement retire(db_,
+                     "INSERT INTO retired_tokens (hash, name, retired) "
+                     "SELECT hash, name, ?2 FROM tokens WHERE name = ?1");
+    retire.Bind(1, name).Bind(2, NowMicros()).Step();
+    absl::Status s = retire.status();
+    if (s.ok() && sqlite3_changes(db_) == 0) s = NoSuchName(name);
+    if (s.ok()) {
+        Statement replace(db_, "UPDATE tokens SET hash = ?2, revoked = NULL WHERE name = ?1");
+        replace.Bind(1, name).Bind(2, Sha256Hex(*token)).Step();
+        s = replace.status();
+    }
+    if (!s.ok()) {
+        Exec(db_, "ROLLBACK").IgnoreError();
+        return s;
+    }
+    if (absl::Status c = Exec(db_, "COMMIT"); !c.ok()) return c;
+    return token;
+}
+
 absl::Status TokenStore::Revoke(const std::string& name) {
     Statement revoke(db_, "UPDATE tokens SET revoked = coalesce(revoked, ?2) WHERE name = ?1");
-    revoke.Bind(1, name).Bind(2, int64_t(absl::ToUnixMicros(absl::Now()))).Step();
+    revoke.Bind(1, name).Bind(2, NowMicros()).Step();
     if (absl::Status s = revoke.status(); !s.ok()) return s;
-    if (sqlite3_changes(db_) == 0) {
-        return absl::NotFoundError(absl::StrCat("no token named \"", absl::CHexEscape(name), "\""));
-    }
+    if (sqlite3_changes(db_) == 0) return NoSuchName(name);
     return absl::OkStatus();
 }
 
@@ -152,7 +190,11 @@ absl::StatusOr<std::vector<TokenInfo>> TokenStore::List() const {
 }
 
 absl::StatusOr<std::optional<TokenInfo>> TokenStore::Find(std::string_view token) const {
-    Statement find(db_, "SELECT name, role, created, revoked FROM tokens WHERE hash = ?1");
+    // A rotated-away token is its name's, revoked when it was replaced.
+    Statement find(db_,
+                   "SELECT name, role, created, revoked FROM tokens WHERE hash = ?1 "
+                   "UNION ALL SELECT t.name, t.role, t.created, r.retired "
+                   "FROM retired_tokens r JOIN tokens t ON t.name = r.name WHERE r.hash = ?1");
     if (find.Bind(1, Sha256Hex(token)).Step()) return InfoOf(find);
     if (absl::Status s = find.status(); !s.ok()) return s;
     return std::nullopt;

@@ -117,5 +117,22 @@ TEST_F(AuthenticatorTest, MissingMalformedUnknownAndRevokedTokensAreUnauthentica
     EXPECT_TRUE(absl::StrContains(message("Bearer " + token), "\"bob\" was revoked"));
 }
 
+TEST_F(AuthenticatorTest, RotatedTokenIsRefusedAndItsSuccessorSeesTheSameJobs) {
+    const std::string old = *admin_->Create("dave", Role::kSubmitter);
+    absl::StatusOr<Caller> before = auth_->Authenticate("Bearer " + old);
+    ASSERT_TRUE(before.ok()) << before.status();
+    const std::string rotated = *admin_->Rotate("dave");
+    absl::SleepFor(absl::Milliseconds(1100));  // the cache's second
+    absl::Status refused = auth_->Authenticate("Bearer " + old).status();
+    EXPECT_TRUE(absl::IsUnauthenticated(refused)) << refused;
+    EXPECT_TRUE(absl::StrContains(refused.message(), "\"dave\" was revoked")) << refused;
+    absl::StatusOr<Caller> after = auth_->Authenticate("Bearer " + rotated);
+    ASSERT_TRUE(after.ok()) << after.status();
+    EXPECT_EQ(after->name, before->name);
+    EXPECT_EQ(after->role, Role::kSubmitter);
+    // Jobs are owned by the name: those submitted with the old token are the new one's.
+    EXPECT_TRUE(MaySee(*after, before->name));
+}
+
 }  // namespace
 }  // namespace lf

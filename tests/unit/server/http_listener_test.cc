@@ -1,6 +1,7 @@
 // lightfarm-server --http: the /metrics and /healthz handlers against a real Farm in a temporary
 // data folder (the counts follow a submission, a lease and a result), and the listener itself on
-// a port the OS picks, refusing a port in use, and over HTTPS with the dashboard.
+// a port the OS picks, refusing a port in use, and over HTTPS with the dashboard; hostile
+// clients (a chunked body without end, slow request heads) on raw sockets.
 #include "lf/server/http_listener.h"
 
 #include <arpa/inet.h>
@@ -11,7 +12,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
+#include <thread>
 
 #include "lf/core/film.h"
 
@@ -152,33 +155,6 @@ TEST_F(HttpListenerTest, ListensOnAPortTheSystemPicksAndRefusesATakenOne) {
         << second.status();
 }
 
-// httplib reads a chunked body whole before any handler (400 MB of chunks took the server from
-// 46 to 889 MB): such a request is answered 411 as soon as its head arrived, before any chunk.
-TEST_F(HttpListenerTest, AChunkedBodyIsRefusedBeforeItIsRead) {
-    absl::StatusOr<std::unique_ptr<HttpListener>> listener =
-        HttpListener::Start("127.0.0.1:0", *farm_);
-    ASSERT_TRUE(listener.ok()) << listener.status();
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    ASSERT_GE(fd, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_port = htons(uint16_t((*listener)->port()));
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
-    const std::string head =
-        "POST /api/session HTTP/1.1\r\nHost: lightfarm\r\nContent-Type: application/json\r\n"
-        "Transfer-Encoding: chunked\r\n\r\n";
-    ASSERT_EQ(::send(fd, head.data(), head.size(), MSG_NOSIGNAL), ssize_t(head.size()));
-    pollfd readable{fd, POLLIN, 0};
-    ASSERT_EQ(::poll(&readable, 1, 10000), 1) << "no answer before the body: it waits to read it";
-    char answer[512] = {};
-    const ssize_t n = ::recv(fd, answer, sizeof answer - 1, 0);
-    ::close(fd);
-    ASSERT_GT(n, 0);
-    EXPECT_EQ(std::string(answer).substr(0, 12), "HTTP/1.1 411") << answer;
-    EXPECT_NE(std::string(answer).find("Content-Length"), std::string::npos) << answer;
-}
-
 // A certificate of its own for 127.0.0.1, made by the openssl command (deploy/install-deps.sh
 // installs it): HTTPS with the dashboard, which plain HTTP cannot reach.
 TEST_F(HttpListenerTest, ServesHttpsAndTheDashboardWithTheServersCertificate) {
@@ -218,6 +194,127 @@ TEST_F(HttpListenerTest, ServesHttpsAndTheDashboardWithTheServersCertificate) {
     absl::StatusOr<std::unique_ptr<HttpListener>> bad = HttpListener::Start(
         "127.0.0.1:0", *farm_, {.tls_cert = cert, .tls_key = (dir_ / "none.key").string()});
     EXPECT_EQ(bad.status().code(), absl::StatusCode::kFailedPrecondition) << bad.status();
+}
+
+// A blocking socket connected to 127.0.0.1:`port`, whose reads give up after 10 s.
+int Connect(int port) {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(uint16_t(port));
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    EXPECT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&to), sizeof to), 0) << strerror(errno);
+    timeval ten{10, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &ten, sizeof ten);
+    return fd;
+}
+
+bool Send(int fd, const std::string& bytes) {
+    return send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL) == ssize_t(bytes.size());
+}
+
+bool Readable(int fd) {
+    pollfd p{fd, POLLIN, 0};
+    return poll(&p, 1, 0) > 0;
+}
+
+// What the server sent until it closed or paused for 10 s.
+std::string Answer(int fd) {
+    std::string answer;
+    char buffer[4096];
+    for (ssize_t n; (n = recv(fd, buffer, sizeof buffer, 0)) > 0;) answer.append(buffer, n);
+    return answer;
+}
+
+// The 64 KiB limit held only with Content-Length: chunks were read without end (400 MB took the
+// server from 46 MB to 889 MB). Now the answer comes while the client is still sending.
+TEST_F(HttpListenerTest, ChunkedBodyOverTheLimitIsRefusedBeforeItIsAllSent) {
+    std::unique_ptr<Authenticator> auth = Authenticator::Off();
+    absl::StatusOr<std::unique_ptr<HttpListener>> listener =
+        HttpListener::Start("127.0.0.1:0", *farm_, {.dashboard_auth = auth.get()});
+    ASSERT_TRUE(listener.ok()) << listener.status();
+    const int port = (*listener)->port();
+
+    const int fd = Connect(port);
+    ASSERT_TRUE(Send(fd,
+                     "POST /api/session HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: "
+                     "application/json\r\nTransfer-Encoding: chunked\r\n\r\n"));
+    const std::string chunk = "10000\r\n" + std::string(1 << 16, 'a') + "\r\n";
+    constexpr int kChunks = 512;  // 32 MB
+    int sent = 0;
+    while (sent < kChunks && !Readable(fd) && Send(fd, chunk)) ++sent;
+    const std::string answer = Answer(fd);
+    close(fd);
+    EXPECT_LT(sent, kChunks) << "the server read all " << kChunks << " chunks";
+    EXPECT_EQ(answer.substr(0, 12), "HTTP/1.1 413") << answer;
+
+    // A small chunked body is read as before.
+    httplib::Client client("127.0.0.1", port);
+    client.set_read_timeout(10);
+    httplib::Result small = client.Post(
+        "/api/session",
+        [](size_t, httplib::DataSink& sink) {
+            sink.write("{\"token\": \"x\"}", 14);
+            sink.done();
+            return true;
+        },
+        "application/json");
+    ASSERT_TRUE(small) << httplib::to_string(small.error());
+    EXPECT_NE(small->status, 413);
+}
+
+// Slowloris: 17 connections sending a header line every 3 s held the 16 handler threads, and
+// /healthz went unanswered. Now heads are read apart from the handler threads, and /healthz
+// has a thread of its own.
+TEST_F(HttpListenerTest, HealthzAnswersWhileMoreSlowClientsThanThreadsSendHeads) {
+    absl::StatusOr<std::unique_ptr<HttpListener>> listener =
+        HttpListener::Start("127.0.0.1:0", *farm_);
+    ASSERT_TRUE(listener.ok()) << listener.status();
+    const int port = (*listener)->port();
+
+    std::vector<int> slow;
+    for (int i = 0; i < 40; ++i) {
+        slow.push_back(Connect(port));
+        Send(slow.back(), "GET /metrics HTTP/1.1\r\n");
+    }
+    std::atomic<bool> done = false;
+    std::thread sender([&] {
+        for (int line = 0; !done; ++line) {
+            for (int fd : slow) Send(fd, "X-Slow-" + std::to_string(line) + ": 1\r\n");
+            std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        }
+    });
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+
+    httplib::Client client("127.0.0.1", port);
+    client.set_connection_timeout(5);
+    client.set_read_timeout(5);
+    httplib::Result healthz = client.Get("/healthz");
+    done = true;
+    sender.join();
+    for (int fd : slow) close(fd);
+    ASSERT_TRUE(healthz) << httplib::to_string(healthz.error());
+    EXPECT_EQ(healthz->status, 200);
+    EXPECT_EQ(healthz->body, "ok\n");
+}
+
+// The read timeout was renewed by every line: a head sent a line at a time never ended. Now the
+// whole request has a deadline: 408, and the connection closed, while the client still sends.
+TEST_F(HttpListenerTest, ARequestHeadThatNeverEndsIsCutOff) {
+    absl::StatusOr<std::unique_ptr<HttpListener>> listener =
+        HttpListener::Start("127.0.0.1:0", *farm_, {.request_read_time = absl::Seconds(2)});
+    ASSERT_TRUE(listener.ok()) << listener.status();
+
+    const int fd = Connect((*listener)->port());
+    bool cut_off = !Send(fd, "GET /healthz HTTP/1.1\r\n");
+    for (int line = 0; line < 120 && !cut_off; ++line) {  // 30 s of lines
+        std::this_thread::sleep_for(std::chrono::milliseconds(250));
+        cut_off = Readable(fd) || !Send(fd, "X-Slow: " + std::to_string(line) + "\r\n");
+    }
+    const std::string answer = Answer(fd);
+    close(fd);
+    EXPECT_TRUE(cut_off);
+    EXPECT_EQ(answer.substr(0, 12), "HTTP/1.1 408") << answer;
 }
 
 TEST_F(HttpListenerTest, RefusesAnAddressWithoutAPort) {

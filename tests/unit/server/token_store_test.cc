@@ -75,6 +75,38 @@ TEST(TokenStore, RevokedTokenIsFoundAsRevokedAndListed) {
     EXPECT_TRUE(*(*store)->Any());  // a revoked token keeps authentication on
 }
 
+// A leaked token is replaced under the same name, so its owner keeps its jobs; the old one is
+// found as revoked. Before `rotate`, a revoked name could never have a token again.
+TEST(TokenStore, RotateGivesTheSameNameANewTokenAndRevokesTheOld) {
+    const auto dir = testing::FreshTestDir("lf_tokens");
+    auto store = TokenStore::Open(dir.string());
+    ASSERT_TRUE(store.ok());
+    const std::string first = *(*store)->Create("carol", Role::kSubmitter);
+    absl::StatusOr<std::string> second = (*store)->Rotate("carol");
+    ASSERT_TRUE(second.ok()) << second.status();
+    EXPECT_NE(*second, first);
+    EXPECT_FALSE((*(*store)->Find(first))->valid());
+    EXPECT_EQ((*(*store)->Find(first))->name, "carol");
+    auto now = *(*store)->Find(*second);
+    ASSERT_TRUE(now.has_value());
+    EXPECT_TRUE(now->valid());
+    EXPECT_EQ(now->name, "carol");
+    EXPECT_EQ(now->role, Role::kSubmitter);
+
+    // After a revocation (the usual first step with a leak) too.
+    ASSERT_TRUE((*store)->Revoke("carol").ok());
+    const std::string third = *(*store)->Rotate("carol");
+    EXPECT_TRUE((*(*store)->Find(third))->valid());
+    EXPECT_FALSE((*(*store)->Find(*second))->valid());
+    EXPECT_FALSE((*(*store)->Find(first))->valid());
+    ASSERT_EQ((*store)->List()->size(), 1u);
+    EXPECT_TRUE((*(*store)->List())[0].valid());
+
+    EXPECT_TRUE(absl::IsNotFound((*store)->Rotate("nobody").status()));
+    EXPECT_TRUE(absl::StrContains((*store)->Create("carol", Role::kAdmin).status().message(),
+                                  "token rotate --name carol"));
+}
+
 TEST(TokenStore, SecondConnectionSeesTokensAtOnce) {
     // `lightfarm-server token create` while a server holds the file open.
     const auto dir = testing::FreshTestDir("lf_tokens");

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "absl/time/time.h"
 #include "lf/server/auth.h"
 #include "lf/server/farm.h"
 #include "lf/server/http_exchange.h"
@@ -24,6 +25,9 @@ struct HttpListenerOptions {
     Authenticator* dashboard_auth = nullptr;
     // PEM files: HTTPS with them when both are set (the gRPC port's --tls-cert and --tls-key).
     std::string tls_cert, tls_key;
+    // From a request's first byte to the end of its body: a client slower than this is cut off
+    // (408), however steadily it sends.
+    absl::Duration request_read_time = absl::Seconds(10);
 };
 
 class HttpListener {

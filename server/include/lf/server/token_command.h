@@ -1,4 +1,4 @@
-// `lightfarm-server token create|list|revoke`: the farm's tokens, managed on the data folder
+// `lightfarm-server token create|list|revoke|rotate`: the farm's tokens, managed on the data folder
 // (while a server runs on it or not).
 #pragma once
 
@@ -24,11 +24,13 @@ class TokenCommand {
     int Create();
     int List();
     int Revoke();
+    int Rotate();
 
     std::string data_dir_, name_, role_;
     CLI::App* token_;
     CLI::App* create_;
     CLI::App* list_;
+    CLI::App* rotate_;
     std::unique_ptr<TokenStore> store_;
 };
 

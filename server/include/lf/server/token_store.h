@@ -1,7 +1,9 @@
-// The farm's bearer tokens: who may call the server and in which role. Kept in their own SQLite
-// file in the data folder (tokens.db), apart from the job store, so that `lightfarm-server token`
-// can add and revoke tokens while a server runs on the folder (the server reads the file, never
-// holds it). Only each token's SHA-256 is stored: the file does not let anyone call the farm.
+// The farm's bearer tokens: who may call the server and in which role. A name is a principal
+// (jobs are owned by it) whose token can be replaced (rotated) without losing them. Kept in their
+// own SQLite file in the data folder (tokens.db), apart from the job store, so that
+// `lightfarm-server token` can add and revoke tokens while a server runs on the folder (the server
+// reads the file, never holds it). Only each token's SHA-256 is stored: the file does not let
+// anyone call the farm.
 #pragma once
 
 #include <memory>
@@ -50,6 +52,9 @@ class TokenStore {
     // A new token for `name`, returned once and never stored. AlreadyExists when the name is
     // taken, even by a revoked token: a name stays one identity in the job records.
     absl::StatusOr<std::string> Create(const std::string& name, Role role);
+    // A new token for the existing `name` (revoked or not), same role: the name's jobs stay its
+    // own, its earlier tokens are found as revoked from now on. NotFound for an unknown name.
+    absl::StatusOr<std::string> Rotate(const std::string& name);
     // NotFound for an unknown name; revoking twice is fine.
     absl::Status Revoke(const std::string& name);
     absl::StatusOr<std::vector<TokenInfo>> List() const;
