@@ -20,11 +20,13 @@
 #include "lf/server/timeout_checker.h"
 #include "lf/server/token_command.h"
 #include "lf/server/token_store.h"
+#include "lf/version.h"
 
 int main(int argc, char** argv) {
     const lf::StopSignals stop_signals;  // before any thread starts
 
     CLI::App app{"lightfarm-server: the render farm's coordinator (see docs/farm.md)."};
+    app.set_version_flag("--version", std::string(lf::kVersion));
     std::string listen = "127.0.0.1:7070";
     lf::FarmOptions options;
     double lease_seconds = 10;
@@ -156,8 +158,8 @@ int main(int argc, char** argv) {
     // Without SO_REUSEPORT a second server on this port fails here, instead of sharing the
     // port and answering clients at random.
     builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
-    // Clients and workers ping every lf::kKeepaliveInterval to find dead links (lf/proto/channel.h);
-    // gRPC's default would answer pings that often with GOAWAY.
+    // Clients and workers ping every lf::kKeepaliveInterval to find dead links
+    // (lf/proto/channel.h); gRPC's default would answer pings that often with GOAWAY.
     builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
     builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,
                                int(lf::kKeepaliveInterval / absl::Milliseconds(2)));
