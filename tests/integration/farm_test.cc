@@ -126,6 +126,15 @@ struct CliRun {
     }
 };
 
+// `BINARY ARGS` of the build's bin folder: its exit status and stdout.
+std::pair<int, std::string> RunBinary(const std::string& command) {
+    FILE* pipe = popen((std::string(LF_BIN_DIR) + "/" + command).c_str(), "r");
+    std::string out;
+    char buf[4096];
+    while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+    return {WEXITSTATUS(pclose(pipe)), out};
+}
+
 std::string ReadText(const fs::path& path) {
     std::ifstream in(path);
     std::stringstream s;
@@ -377,12 +386,8 @@ TEST_F(Farm, HelpExplainsEveryFarmCommand) {
     }
     for (auto [binary, option] : {std::pair{"lightfarm-server", "--data-dir"},
                                   std::pair{"lightfarm-worker", "--cache-dir"}}) {
-        const std::string cmd = std::string(LF_BIN_DIR) + "/" + binary + " --help";
-        FILE* pipe = popen(cmd.c_str(), "r");
-        std::string out;
-        char buf[4096];
-        while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-        EXPECT_EQ(WEXITSTATUS(pclose(pipe)), 0) << binary;
+        const auto [status, out] = RunBinary(std::string(binary) + " --help");
+        EXPECT_EQ(status, 0) << binary;
         EXPECT_NE(out.find(option), std::string::npos) << out;
     }
 }
@@ -1148,12 +1153,8 @@ TEST_F(Farm, OperatorMistakesGetClearAnswers) {
     const std::string version = Lightfarm("--version").out;
     ASSERT_FALSE(version.empty());
     for (const char* binary : {"lightfarm-server", "lightfarm-worker"}) {
-        const std::string cmd = std::string(LF_BIN_DIR) + "/" + binary + " --version";
-        FILE* pipe = popen(cmd.c_str(), "r");
-        std::string out;
-        char buf[4096];
-        while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-        EXPECT_EQ(WEXITSTATUS(pclose(pipe)), 0) << binary;
+        const auto [status, out] = RunBinary(std::string(binary) + " --version");
+        EXPECT_EQ(status, 0) << binary;
         EXPECT_EQ(out, version) << binary;
     }
 
