@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "lf/core/camera.h"
+#include "lf/core/plural.h"
 #include "lf/core/sampler.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
@@ -55,9 +56,6 @@ double RawRaysPerSecond(const EmbreeScene& scene, uint64_t count, int threads) {
 absl::Status RunBench(const BenchOptions& options) {
     absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
-    if (options.resolution > 0) {
-        scene->camera.width = scene->camera.height = options.resolution;
-    }
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
     const Camera camera(scene->camera, (*embree)->origin());
@@ -77,12 +75,12 @@ absl::Status RunBench(const BenchOptions& options) {
     const double sps = double(out.stats.samples) / out.seconds;
     const double rps = double(out.stats.rays) / out.seconds;
     std::printf(
-        "scene            %s (%dx%d, %llu spp, max depth %s, %d threads, %s sampler, %s light "
+        "scene            %s (%dx%d, %llu spp, max depth %s, %s, %s sampler, %s light "
         "sampling)\n",
         options.scene_path.c_str(), camera.width(), camera.height(),
         (unsigned long long)options.spp,
         options.max_depth < 0 ? "unlimited" : std::to_string(options.max_depth).c_str(),
-        options.threads, SamplerTypeName(options.sampler),
+        Plural(options.threads, "thread").c_str(), SamplerTypeName(options.sampler),
         LightStrategyName(options.light_strategy));
     std::printf("path tracing     %.3f M samples/s, %.3f M rays/s, %.2f rays/sample, %.2f s\n",
                 sps * 1e-6, rps * 1e-6, double(out.stats.rays) / double(out.stats.samples),

@@ -20,8 +20,7 @@ Command AddBenchCommand(CLI::App& app) {
         ->check(CLI::Range(1, 1024));
     AddCameraFlag(cmd, options->scene);
     AddFilterFlag(cmd, options->scene);
-    AddResolutionFlag(cmd, options->scene, &options->resolution, 65536,
-                      "image size WxH, or N for a square N x N (0 = the scene's; default 256)");
+    AddResolutionFlag(cmd, options->scene, "image size WxH, or N for N x N (default 256 x 256)");
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str();
     AddSamplerFlag(cmd, options->sampler);

@@ -7,9 +7,9 @@
 #include "absl/strings/str_format.h"
 #include "lf/client/command.h"
 #include "lf/client/convergence.h"
-#include "lf/job/job_spec.h"
 #include "lf/client/photon_flags.h"
 #include "lf/client/scene_flags.h"
+#include "lf/job/job_spec.h"
 
 namespace lf {
 
@@ -109,8 +109,8 @@ Command AddConvergeCommand(CLI::App& app) {
     AddPhotonFlags(cmd, options->ppm);
     AddCameraFlag(cmd, options->scene);
     AddFilterFlag(cmd, options->scene);
-    AddResolutionFlag(cmd, options->scene, &options->resolution, 16384,
-                      "image size WxH, or N for width N with the scene's aspect (0 = the scene's)");
+    AddResolutionFlag(cmd, options->scene,
+                      "image size WxH, or N for N x N, instead of the scene's");
     cmd->add_option("--max-spp", options->max_spp, "largest spp of the path ladder")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(2), uint64_t(1) << 20));

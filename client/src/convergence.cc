@@ -20,8 +20,8 @@
 #include "lf/core/log.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
-#include "lf/job/splat_settings.h"
 #include "lf/job/render_metadata.h"
+#include "lf/job/splat_settings.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/local/local_executor.h"
@@ -485,11 +485,6 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
 
     absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
-    if (options.resolution > 0) {
-        CameraSpec& c = scene->camera;
-        c.height = std::max(1, int(std::lround(double(c.height) * options.resolution / c.width)));
-        c.width = options.resolution;
-    }
     if (with_radiosity) {
         if (const std::string why = RadiosityLimitation(*scene); !why.empty()) {
             return absl::InvalidArgumentError(absl::StrCat(

@@ -6,12 +6,12 @@
 #include <fstream>
 #include <optional>
 
-#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
-#include "lf/wire/conversions.h"
 #include "lf/proto/channel.h"
+#include "lf/proto/connection_status.h"
+#include "lf/wire/conversions.h"
 
 namespace lf {
 
@@ -77,20 +77,7 @@ void FarmClient::Connect() {
 
 // The server's own words, with where it was asked when it could not be reached.
 absl::Status FarmClient::CallStatus(const grpc::Status& s) const {
-    // gRPC reports a TLS handshake that failed on a certificate or on a plain-text peer as
-    // UNAVAILABLE, like a server that is down; retrying cannot help, so it is said at once.
-    if (s.error_code() == grpc::StatusCode::UNAVAILABLE &&
-        absl::StrContains(s.error_message(), "SSL_ERROR_SSL")) {
-        return absl::FailedPreconditionError(absl::StrCat(
-            "TLS handshake with server ", flags_.channel.address, " failed (", s.error_message(),
-            "): check --tls-ca, the server's certificate names, and --tls-cert/--tls-key if the "
-            "server asks for client certificates"));
-    }
-    if (s.error_code() == grpc::StatusCode::UNAVAILABLE) {
-        return absl::UnavailableError(
-            absl::StrCat("server ", flags_.channel.address, " not reachable: ", s.error_message()));
-    }
-    return FromGrpcStatus(s);
+    return ConnectionStatus(s, flags_.channel);
 }
 
 absl::Status FarmClient::Retrying(const std::string& what,

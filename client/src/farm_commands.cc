@@ -16,15 +16,16 @@
 #include "lf/client/command.h"
 #include "lf/client/farm_client.h"
 #include "lf/client/farm_flags.h"
+#include "lf/client/method_flags.h"
+#include "lf/client/output_flags.h"
+#include "lf/client/progress_bar.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
+#include "lf/core/plural.h"
 #include "lf/job/job_record.h"
 #include "lf/job/job_spec.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
-#include "lf/client/method_flags.h"
-#include "lf/client/output_flags.h"
-#include "lf/client/progress_bar.h"
 
 namespace lf {
 
@@ -41,14 +42,17 @@ void AddJsonFlag(CLI::App* cmd, bool& json) {
 
 // The message as one line of JSON, as protobuf's own mapping writes it (strings escaped, so no
 // name a worker or submitter chose can move the terminal).
-void PrintJson(const google::protobuf::Message& message) {
+std::string JsonLine(const google::protobuf::Message& message) {
     google::protobuf::util::JsonPrintOptions options;
     options.always_print_primitive_fields = true;
     options.preserve_proto_field_names = true;
     std::string line;
-    if (google::protobuf::util::MessageToJsonString(message, &line, options).ok()) {
-        std::printf("%s\n", line.c_str());
-    }
+    if (!google::protobuf::util::MessageToJsonString(message, &line, options).ok()) return "";
+    return line + "\n";
+}
+
+void PrintJson(const google::protobuf::Message& message) {
+    std::fputs(JsonLine(message).c_str(), stdout);
 }
 
 std::string StateName(pb::Job::State s) { return absl::AsciiStrToLower(pb::Job::State_Name(s)); }
@@ -83,10 +87,10 @@ void PrintJob(const pb::Job& job) {
     if (!job.owner().empty()) std::printf("  owner     %s\n", job.owner().c_str());
     std::printf("  method    %s\n",
                 job.params().method().empty() ? "path" : job.params().method().c_str());
-    std::printf("  image     %dx%d, %llu spp, seed %llu, max depth %d, tile %d, %d passes\n",
-                job.width(), job.height(), (unsigned long long)job.params().spp(),
+    std::printf("  image     %dx%d, %llu spp, seed %llu, max depth %d, tile %d, %s\n", job.width(),
+                job.height(), (unsigned long long)job.params().spp(),
                 (unsigned long long)job.params().seed(), job.params().max_depth(),
-                job.params().tile(), job.params().passes());
+                job.params().tile(), Plural(job.params().passes(), "pass").c_str());
     JobSpec spec;
     FromProto(job.params(), &spec);
     // Radiosity samples no lights: its light strategy would say nothing.
@@ -162,25 +166,24 @@ Command AddListCommand(CLI::App& app) {
                 FarmClient client(*flags);
                 pb::ListJobsRequest req;
                 int listed = 0;
+                // Printed only once every page has come: a failed call prints nothing to stdout.
+                std::string out =
+                    *json ? ""
+                          : absl::StrFormat("%-16s %-10s %-12s %-9s %8s %11s %9s %-19s %8s  %s\n",
+                                            "JOB", "STATE", "OWNER", "METHOD", "PRIORITY", "TASKS",
+                                            "SPP", "SUBMITTED", "TIME", "NAME");
                 do {
                     req.set_page_size(*limit > 0 ? std::min(kPage, *limit - listed) : kPage);
                     pb::ListJobsResponse resp;
                     absl::Status s = client.Call(&pb::JobService::Stub::ListJobs, req, &resp);
                     if (!s.ok()) return ReportError(s);
-                    // After the first answer: a failed call prints nothing on stdout for
-                    // scripts to take as a (empty) table.
-                    if (!*json && req.page_token().empty()) {
-                        std::printf("%-16s %-10s %-12s %-9s %8s %11s %9s %-19s %8s  %s\n", "JOB",
-                                    "STATE", "OWNER", "METHOD", "PRIORITY", "TASKS", "SPP",
-                                    "SUBMITTED", "TIME", "NAME");
-                    }
                     for (const pb::Job& job : resp.jobs()) {
                         if (*json) {
-                            PrintJson(job);
+                            absl::StrAppend(&out, JsonLine(job));
                             continue;
                         }
-                        std::printf(
-                            "%-16s %-10s %-12s %-9s %8d %11s %9llu %-19s %8s  %s\n",
+                        absl::StrAppendFormat(
+                            &out, "%-16s %-10s %-12s %-9s %8d %11s %9llu %-19s %8s  %s\n",
                             job.id().c_str(), StateName(job.state()).c_str(),
                             job.owner().empty() ? "-" : job.owner().c_str(),
                             job.params().method().empty() ? "path" : job.params().method().c_str(),
@@ -192,6 +195,7 @@ Command AddListCommand(CLI::App& app) {
                     listed += resp.jobs_size();
                     req.set_page_token(resp.next_page_token());
                 } while (!req.page_token().empty() && (*limit == 0 || listed < *limit));
+                std::fputs(out.c_str(), stdout);
                 return 0;
             }};
 }

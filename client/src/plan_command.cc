@@ -11,14 +11,20 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "lf/client/command.h"
+#include "lf/client/method_flags.h"
+#include "lf/client/photon_flags.h"
+#include "lf/client/radiosity_flags.h"
+#include "lf/client/sample_flags.h"
+#include "lf/client/scene_flags.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_error.h"
 #include "lf/core/patch_mesh.h"
+#include "lf/core/plural.h"
 #include "lf/core/scene_loader.h"
-#include "lf/job/splat_settings.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
@@ -28,11 +34,6 @@
 #include "lf/local/method_factory.h"
 #include "lf/local/method_render.h"
 #include "lf/local/render_prediction.h"
-#include "lf/client/method_flags.h"
-#include "lf/client/photon_flags.h"
-#include "lf/client/radiosity_flags.h"
-#include "lf/client/sample_flags.h"
-#include "lf/client/scene_flags.h"
 
 namespace lf {
 
@@ -165,11 +166,11 @@ absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& op
         const RadiosityReport& r = pilots.back();
         std::printf(
             "radiosity pilot: %lld patches, %lld unknowns: form factors %.3f s (%.2f MiB), "
-            "solve %.3f s (%d iterations), estimated discretisation error %.3g (worst patch "
+            "solve %.3f s (%s), estimated discretisation error %.3g (worst patch "
             "share %.3g)\n",
             (long long)r.patches, (long long)r.sides, r.form_factor_seconds,
-            double(r.form_factor_bytes) / (1 << 20), r.solve_seconds, r.iterations,
-            r.mean_estimated_error, r.estimated_error);
+            double(r.form_factor_bytes) / (1 << 20), r.solve_seconds,
+            Plural(r.iterations, "iteration").c_str(), r.mean_estimated_error, r.estimated_error);
         if (settings.patches == options.patches) break;  // the target itself
     }
     const RadiosityReport& large = pilots.back();

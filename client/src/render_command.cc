@@ -1,10 +1,10 @@
 #include <cstdio>
 #include <optional>
+#include <string>
 
+#include "absl/strings/str_format.h"
 #include "lf/client/adaptive_flags.h"
 #include "lf/client/command.h"
-#include "lf/job/job_spec.h"
-#include "lf/local/local_render.h"
 #include "lf/client/method_flags.h"
 #include "lf/client/output_flags.h"
 #include "lf/client/photon_flags.h"
@@ -12,6 +12,9 @@
 #include "lf/client/radiosity_flags.h"
 #include "lf/client/sample_flags.h"
 #include "lf/client/scene_flags.h"
+#include "lf/core/plural.h"
+#include "lf/job/job_spec.h"
+#include "lf/local/local_render.h"
 
 namespace lf {
 
@@ -146,7 +149,8 @@ Command AddRenderCommand(CLI::App& app) {
             }
             std::printf("render %.2f s, total %.2f s\n", summary->render_seconds, summary->seconds);
             if (summary->estimated_error >= 0) {
-                std::printf("estimated relative error %.4f%s%s\n", summary->estimated_error,
+                std::printf("estimated relative error of the whole image %.4f%s%s\n",
+                            summary->estimated_error,
                             summary->high_variance ? " (high variance)" : "",
                             options->render.clamp > 0
                                 ? " (noise only: --clamp biases the image, and this error does "
@@ -162,12 +166,19 @@ Command AddRenderCommand(CLI::App& app) {
                     samples += double(t.spp) * t.rect.Area();
                     pixels += double(t.rect.Area());
                 }
-                std::printf(
-                    "adaptive: %llu..%llu spp per pixel (mean %.0f), worst tile %.4f, %d of %d "
-                    "tiles above the target%s\n",
-                    (unsigned long long)a.min_spp, (unsigned long long)a.max_spp,
-                    pixels > 0 ? samples / pixels : 0, a.worst_tile_error, a.tiles_above_target,
-                    a.tiles, a.timed_out ? ", time limit reached" : "");
+                // The target bounds each tile's error, not the whole image's above.
+                const double target = options->adaptive.target_error;
+                const std::string tiles =
+                    target > 0 ? absl::StrFormat(
+                                     "--target-error %g bounds each tile's error: worst tile "
+                                     "%.4f, %d of %s above it",
+                                     target, a.worst_tile_error, a.tiles_above_target,
+                                     Plural(a.tiles, "tile"))
+                               : absl::StrFormat("worst tile error %.4f", a.worst_tile_error);
+                std::printf("adaptive: %llu..%llu spp per pixel (mean %.0f); %s%s\n",
+                            (unsigned long long)a.min_spp, (unsigned long long)a.max_spp,
+                            pixels > 0 ? samples / pixels : 0, tiles.c_str(),
+                            a.timed_out ? ", time limit reached" : "");
             }
             return 0;
         }};

@@ -9,19 +9,17 @@
 namespace lf {
 namespace {
 
-// "WxH" ("1920x1080") into *width and *height; a bare "N" too when `single` is not null (then
-// *single = N and the size is left alone). InvalidArgument otherwise.
-absl::Status ParseResolution(const std::string& text, int* width, int* height, int* single) {
+// "WxH" ("1920x1080") or "N" (N x N) into *width and *height; InvalidArgument otherwise.
+absl::Status ParseResolution(const std::string& text, int* width, int* height) {
     const size_t x = text.find_first_of("xX");
     int w = 0, h = 0;
-    if (x == std::string::npos && single && absl::SimpleAtoi(text, &w) && w >= 0) {
-        *single = w;
-        return absl::OkStatus();
-    }
-    if (x == std::string::npos || !absl::SimpleAtoi(text.substr(0, x), &w) ||
-        !absl::SimpleAtoi(text.substr(x + 1), &h) || w < 1 || h < 1) {
+    const bool parsed =
+        x == std::string::npos
+            ? absl::SimpleAtoi(text, &w) && absl::SimpleAtoi(text, &h)
+            : absl::SimpleAtoi(text.substr(0, x), &w) && absl::SimpleAtoi(text.substr(x + 1), &h);
+    if (!parsed || w < 1 || h < 1) {
         return absl::InvalidArgumentError(absl::StrCat(
-            "--resolution \"", text, "\": expected WxH, e.g. 1920x1080", single ? ", or N" : ""));
+            "--resolution \"", text, "\": expected WxH, e.g. 1920x1080, or N for N x N"));
     }
     *width = w;
     *height = h;
@@ -74,29 +72,22 @@ void AddCameraFlag(CLI::App* cmd, SceneOptions& options) {
                     "camera's); default: the JSON scene's camera, else the first glTF camera");
 }
 
-void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, int* single, int max_single,
-                       const std::string& help) {
+void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, const std::string& help) {
     cmd->add_option_function<std::string>(
            "--resolution",
-           [&options, single, max_single](const std::string& text) {
-               absl::Status s = ParseResolution(text, &options.width, &options.height, single);
-               if (s.ok() && single && *single > max_single) {
-                   s = absl::InvalidArgumentError(
-                       absl::StrCat("--resolution ", *single, ": at most ", max_single));
-               }
+           [&options](const std::string& text) {
+               absl::Status s = ParseResolution(text, &options.width, &options.height);
                if (!s.ok()) throw CLI::ValidationError(std::string(s.message()));
-               // WxH given: the bare N no longer applies.
-               if (single && options.width > 0) *single = 0;
            },
            help)
-        ->type_name(single ? "WxH|N" : "WxH");
+        ->type_name("WxH|N");
 }
 
 void AddSceneFlags(CLI::App* cmd, SceneOptions& options) {
     AddCameraFlag(cmd, options);
-    AddResolutionFlag(
-        cmd, options, nullptr, 0,
-        "image size WxH in pixels, instead of the scene's (JSON resolution or glTF camera)");
+    AddResolutionFlag(cmd, options,
+                      "image size WxH in pixels, or N for N x N, instead of the scene's (JSON "
+                      "resolution or glTF camera)");
     AddFilterFlag(cmd, options);
 }
 

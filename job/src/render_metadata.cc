@@ -160,7 +160,7 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     const std::optional<Method> method = FindMethod(m.method);
     const MethodInfo* info = method ? &Info(*method) : nullptr;
     if (info && info->samples_lights) {
-        d.attributes["lightfarm.light_sampling"] = std::string(LightStrategyName(m.light_strategy));
+        d.attributes["lightfarm.lightSampling"] = std::string(LightStrategyName(m.light_strategy));
     }
     if (m.clamp > 0) AddClampAttributes(m.clamp, d.attributes);
     // An adaptive render's first pass gives every pixel at least 2 samples (it is even).

@@ -11,6 +11,7 @@
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/pixel_filter.h"
+#include "lf/core/plural.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/render_metadata.h"
@@ -99,10 +100,10 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         summary.radiosity = RadiosityFiguresOf(rep);
         summary.mesh_seconds = rep.mesh_seconds;
         log->info(
-            "job={} radiosity: {} patches, {} unknowns, {} iterations, residual {:.2e}, form "
+            "job={} radiosity: {} patches, {} unknowns, {}, residual {:.2e}, form "
             "factors {:.2f} s ({} MiB), solve {:.2f} s",
-            job_id, rep.patches, rep.sides, rep.iterations, rep.residual, rep.form_factor_seconds,
-            rep.form_factor_bytes >> 20, rep.solve_seconds);
+            job_id, rep.patches, rep.sides, Plural(rep.iterations, "iteration"), rep.residual,
+            rep.form_factor_seconds, rep.form_factor_bytes >> 20, rep.solve_seconds);
         for (size_t pass = 0; pass < rep.refinement.size(); ++pass) {
             const RadiosityRefinementPass& p = rep.refinement[pass];
             log->info(

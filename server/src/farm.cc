@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
+#include "lf/core/plural.h"
 #include "lf/core/radiosity_codec.h"
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
@@ -357,8 +358,8 @@ absl::StatusOr<BlobStore::Removed> Farm::RemoveUnusedBlobs(absl::Time now) {
     const BlobStore::Removed removed =
         blobs_->RemoveUnused(used, now - kUnusedBlobGrace, now - kPartialUploadLifetime);
     if (removed.blobs > 0 || removed.partials > 0) {
-        Log()->info("removed {} blobs no job uses ({} bytes) and {} stale partial uploads",
-                    removed.blobs, removed.blob_bytes, removed.partials);
+        Log()->info("removed {} no job uses ({} bytes) and {}", Plural(removed.blobs, "blob"),
+                    removed.blob_bytes, Plural(removed.partials, "stale partial upload"));
     }
     return removed;
 }
@@ -384,7 +385,7 @@ absl::StatusOr<int> Farm::DeleteExpired(absl::Time now) {
         deleted += int(expired->size());
     }
     if (deleted > 0) {
-        Log()->info("deleted {} jobs that ended more than {} ago", deleted,
+        Log()->info("deleted {} that ended more than {} ago", Plural(deleted, "job"),
                     absl::FormatDuration(options_.retention));
     }
     if (absl::StatusOr<BlobStore::Removed> removed = RemoveUnusedBlobs(now); !removed.ok()) {
@@ -425,6 +426,11 @@ absl::StatusOr<TaskLogPage> Farm::TaskLogs(const std::string& job_id, std::optio
     // before their results are taken (TakeTaskLog), so none follow an ended job's page.
     absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
     if (!job.ok()) return job.status();
+    if (task && (*task < 0 || *task >= job->tasks_total)) {
+        return absl::NotFoundError(absl::StrCat(
+            "job ", job_id, " has no task ", *task, ": it has ", Plural(job->tasks_total, "task"),
+            job->tasks_total > 0 ? absl::StrCat(", 0 to ", job->tasks_total - 1) : ""));
+    }
     const int page_size = max_lines <= 0 ? kMaxTaskLogPage : std::min(max_lines, kMaxTaskLogPage);
     absl::StatusOr<TaskLogPage> page = logs_->Read(job_id, task, after_seq, page_size);
     if (!page.ok()) return page.status();

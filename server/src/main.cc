@@ -21,11 +21,13 @@
 #include "lf/server/timeout_checker.h"
 #include "lf/server/token_command.h"
 #include "lf/server/token_store.h"
+#include "lf/version.h"
 
 int main(int argc, char** argv) {
     const lf::StopSignals stop_signals;  // before any thread starts
 
     CLI::App app{"lightfarm-server: the render farm's coordinator (see docs/farm.md)."};
+    app.set_version_flag("--version", std::string(lf::kVersion));
     std::string listen = "127.0.0.1:7070";
     lf::FarmOptions options;
     double lease_seconds = 10;

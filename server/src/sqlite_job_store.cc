@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "lf/core/log.h"
+#include "lf/core/plural.h"
 #include "lf/server/job_record_codec.h"
 #include "lf/server/legacy_job_record.h"
 #include "lf/server/sqlite_statement.h"
@@ -264,8 +265,8 @@ absl::Status SqliteJobStore::Migrate(sqlite3* db, int64_t version) {
         return absl::Status(status.code(),
                             absl::StrCat("upgrading the job store: ", status.message()));
     }
-    NamedLogger("store")->info("job store upgraded to version {}: {} jobs", kSchemaVersion,
-                               rewrites.size());
+    NamedLogger("store")->info("job store upgraded to version {}: {}", kSchemaVersion,
+                               Plural(int64_t(rewrites.size()), "job"));
     return absl::OkStatus();
 }
 

@@ -403,7 +403,7 @@ TEST_F(Cli, ConvergeComparesEveryPairOfSamplerAndLightStrategyAgainstOneReferenc
     ASSERT_TRUE(reference.ok()) << reference.status();
     const auto& a = reference->attributes;
     const std::string config = std::get<std::string>(a.at("lightfarm.sampler")) + "/" +
-                               std::get<std::string>(a.at("lightfarm.light_sampling"));
+                               std::get<std::string>(a.at("lightfarm.lightSampling"));
     EXPECT_EQ(r.output.substr(named + prefix.size(), config.size()), config) << r.output;
     EXPECT_EQ(std::get<int>(a.at("lightfarm.spp")), 64);
     EXPECT_EQ(std::get<std::string>(a.at("lightfarm.seed")), "1");  // the ladders' seed 0, plus 1
@@ -479,8 +479,13 @@ TEST_F(Cli, TargetErrorRecordsTheEstimateInTheHeader) {
                   " --spp 4 --target-error 0.3 --time-limit 60 --threads 2 "
                   "--no-progress");
     ASSERT_EQ(r.status, 0) << r.output;
-    EXPECT_NE(r.output.find("estimated relative error"), std::string::npos) << r.output;
-    EXPECT_NE(r.output.find("0 of 64 tiles above the target"), std::string::npos) << r.output;
+    // Two measures, each named: the image's, and the per-tile one the target bounds.
+    EXPECT_NE(r.output.find("estimated relative error of the whole image "), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("--target-error 0.3 bounds each tile's error: worst tile "),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find(", 0 of 64 tiles above it"), std::string::npos) << r.output;
     absl::StatusOr<ExrFile> file = ReadExr(exr);
     ASSERT_TRUE(file.ok()) << file.status();
     EXPECT_EQ(std::get<double>(file->attributes.at("lightfarm.targetError")), 0.3);
@@ -862,7 +867,7 @@ TEST_F(Cli, LightSamplingReachesThePathTracerAndKeepsTheMean) {
         EXPECT_NE(r.output.find(strategy + " light sampling"), std::string::npos) << r.output;
         absl::StatusOr<ExrFile> file = ReadExr(exr);
         if (file.ok()) {
-            EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.light_sampling")),
+            EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.lightSampling")),
                       strategy);
         }
         return file;
@@ -911,7 +916,7 @@ TEST_F(Cli, WhittedRendersAndUnknownMethodsAreRefused) {
     absl::StatusOr<ExrFile> file = ReadExr(exr);
     ASSERT_TRUE(file.ok()) << file.status();
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.method")), "whitted");
-    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.light_sampling")), "bvh");
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.lightSampling")), "bvh");
 
     for (const std::string command :
          {"render " + scene + " -o " + exr, "submit " + scene, "plan " + scene}) {

@@ -126,6 +126,15 @@ struct CliRun {
     }
 };
 
+// `BINARY ARGS` of the build's bin folder: its exit status and stdout.
+std::pair<int, std::string> RunBinary(const std::string& command) {
+    FILE* pipe = popen((std::string(LF_BIN_DIR) + "/" + command).c_str(), "r");
+    std::string out;
+    char buf[4096];
+    while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+    return {WEXITSTATUS(pclose(pipe)), out};
+}
+
 std::string ReadText(const fs::path& path) {
     std::ifstream in(path);
     std::stringstream s;
@@ -377,12 +386,8 @@ TEST_F(Farm, HelpExplainsEveryFarmCommand) {
     }
     for (auto [binary, option] : {std::pair{"lightfarm-server", "--data-dir"},
                                   std::pair{"lightfarm-worker", "--cache-dir"}}) {
-        const std::string cmd = std::string(LF_BIN_DIR) + "/" + binary + " --help";
-        FILE* pipe = popen(cmd.c_str(), "r");
-        std::string out;
-        char buf[4096];
-        while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-        EXPECT_EQ(WEXITSTATUS(pclose(pipe)), 0) << binary;
+        const auto [status, out] = RunBinary(std::string(binary) + " --help");
+        EXPECT_EQ(status, 0) << binary;
         EXPECT_NE(out.find(option), std::string::npos) << out;
     }
 }
@@ -895,7 +900,7 @@ TEST_F(Farm, ClampAovsFilterSamplerAndLightSamplingGiveTheSameImageAndHeaderLoca
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.filter")),
               "blackman-harris 2 px");
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.sampler")), "independent");
-    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.light_sampling")), "power");
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.lightSampling")), "power");
     EXPECT_NE(file->image.FindChannel("depth.Z"), nullptr);
 }
 
@@ -1142,6 +1147,40 @@ TEST_F(Farm, ListFollowsItsLimitAndDeleteRemovesOnlyEndedJobs) {
     EXPECT_EQ(deleted.status, 0) << deleted.err;
     EXPECT_EQ(Farmctl("list").out.find(jobs[0]), std::string::npos);
     EXPECT_NE(Farmctl("status " + jobs[0]).status, 0);
+}
+
+// What an operator trips on: a failed `list` prints no table header for a script to read;
+// `logs --task` of a task the job lacks is an error; every binary answers --version alike;
+// counts of one are singular.
+TEST_F(Farm, OperatorMistakesGetClearAnswers) {
+    const CliRun down = Lightfarm("list --server 127.0.0.1:1");
+    EXPECT_NE(down.status, 0);
+    EXPECT_EQ(down.out, "") << "a failed list prints nothing to stdout";
+    EXPECT_NE(down.err.find("127.0.0.1:1"), std::string::npos) << down.err;
+
+    const std::string version = Lightfarm("--version").out;
+    ASSERT_FALSE(version.empty());
+    for (const char* binary : {"lightfarm-server", "lightfarm-worker"}) {
+        const auto [status, out] = RunBinary(std::string(binary) + " --version");
+        EXPECT_EQ(status, 0) << binary;
+        EXPECT_EQ(out, version) << binary;
+    }
+
+    StartServer();
+    StartWorker("w1", 1);
+    const std::string job = Submit(WriteScene("cornell16.json", 16), "--spp 2 --tile 8 --passes 1");
+    ASSERT_EQ(Farmctl("watch " + job).status, 0);
+    const CliRun missing = Farmctl("logs " + job + " --task 999");
+    EXPECT_NE(missing.status, 0);
+    EXPECT_EQ(missing.out, "");
+    EXPECT_NE(missing.err.find("job " + job + " has no task 999: it has 4 tasks"),
+              std::string::npos)
+        << missing.err;
+    EXPECT_EQ(Farmctl("logs " + job + " --task 3").status, 0) << "the last task is there";
+
+    const std::string status = Farmctl("status " + job).out;
+    EXPECT_NE(status.find("tile 8, 1 pass\n"), std::string::npos) << status;
+    EXPECT_NE(ReadText(dir_ / "w1.log").find(" with 1 thread ("), std::string::npos);
 }
 
 // `submit` uploads every file the scene names as `render` finds it, `../` and absolute names

@@ -111,10 +111,21 @@ TEST_F(GltfRender, RenderCommandTakesGltfCameraAndResolution) {
     EXPECT_NE(bad_out.find("scene.gltf: no camera named \"Top\"; the cameras are \"Front\""),
               std::string::npos)
         << bad_out;
+    // A bare N is N x N, as for bench and converge.
+    const auto [square_status, square_out] =
+        Lightfarm("render " + (dir_ / "scene.gltf").string() + " -o " + exr +
+                  " --spp 2 --camera Front --resolution 24 --no-progress");
+    ASSERT_EQ(square_status, 0) << square_out;
+    absl::StatusOr<ExrFile> square = ReadExr(exr);
+    ASSERT_TRUE(square.ok()) << square.status();
+    EXPECT_EQ(square->image.width(), 24);
+    EXPECT_EQ(square->image.height(), 24);
     const auto [size_status, size_out] =
-        Lightfarm("render " + (dir_ / "scene.gltf").string() + " -o " + exr + " --resolution 40");
+        Lightfarm("render " + (dir_ / "scene.gltf").string() + " -o " + exr + " --resolution 40y");
     EXPECT_NE(size_status, 0);
-    EXPECT_NE(size_out.find("expected WxH"), std::string::npos) << size_out;
+    EXPECT_NE(size_out.find("--resolution \"40y\": expected WxH, e.g. 1920x1080, or N for N x N"),
+              std::string::npos)
+        << size_out;
 }
 
 // A camera at 1e308 hit Embree's `ray.valid()` assertion: render died of SIGABRT (rc 134). The

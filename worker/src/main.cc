@@ -10,15 +10,18 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/log.h"
+#include "lf/core/plural.h"
 #include "lf/core/stop_signals.h"
 #include "lf/job/worker_status.h"
 #include "lf/proto/channel_flags.h"
+#include "lf/version.h"
 #include "lf/worker/worker.h"
 
 int main(int argc, char** argv) {
     const lf::StopSignals stop_signals;  // before any thread starts
 
     CLI::App app{"lightfarm-worker: renders tasks of a lightfarm-server (see docs/farm.md)."};
+    app.set_version_flag("--version", std::string(lf::kVersion));
     lf::ChannelOptions channel;
     lf::WorkerOptions options;
     options.threads = int(std::max(1u, std::thread::hardware_concurrency()));
@@ -79,8 +82,8 @@ int main(int argc, char** argv) {
         return 0;
     }
     lf::Worker worker(options, **connection, **cache, *task_logs);
-    spdlog::info("worker={} ({}) serving {} with {} threads ({})", id, lf::LogSafe(name),
-                 channel.address, options.threads, channel.tls_ca.empty() ? "no TLS" : "TLS");
+    spdlog::info("worker={} ({}) serving {} with {} ({})", id, lf::LogSafe(name), channel.address,
+                 lf::Plural(options.threads, "thread"), channel.tls_ca.empty() ? "no TLS" : "TLS");
 
     std::thread signal_waiter([&] {
         const int signal = stop_signals.Wait();

@@ -5,16 +5,19 @@
 #include <fstream>
 
 #include "lf/job/splat_settings.h"
+#include "lf/proto/connection_status.h"
+#include "lf/proto/grpc_status.h"
 #include "lf/version.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/worker_service.grpc.pb.h"
-#include "lf/proto/grpc_status.h"
 
 namespace lf {
 
 namespace pb = lightfarm::v1;
 
 struct ServerConnection::Stub {
+    ChannelOptions options;  // for messages: the address, and whether TLS is on
+    std::shared_ptr<grpc::Channel> channel;
     std::unique_ptr<pb::WorkerService::Stub> stub;
 };
 
@@ -35,6 +38,8 @@ absl::StatusOr<std::unique_ptr<ServerConnection>> ServerConnection::Open(
     if (!channel.ok()) return channel.status();
     std::unique_ptr<ServerConnection> connection(
         new ServerConnection(std::move(worker_id), std::move(name)));
+    connection->stub_->options = options;
+    connection->stub_->channel = *channel;
     connection->stub_->stub = pb::WorkerService::NewStub(*channel);
     return connection;
 }
@@ -52,8 +57,15 @@ absl::StatusOr<std::optional<TaskAssignment>> ServerConnection::Lease(absl::Dura
     // backoff) is what makes the channel reconnect as soon as a restarted server listens.
     const auto context = ContextWithDeadline(wait + absl::Seconds(1));
     context->set_wait_for_ready(true);
-    const grpc::Status s = stub_->stub->LeaseTask(context.get(), req, &resp);
-    if (!s.ok()) return FromGrpcStatus(s);
+    grpc::Status s = stub_->stub->LeaseTask(context.get(), req, &resp);
+    // Waiting hides why the connection fails ("Deadline Exceeded"); a call that does not wait
+    // says it (TLS on one side only, say).
+    if (s.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED &&
+        stub_->channel->GetState(false) != GRPC_CHANNEL_READY) {
+        req.set_wait_ms(0);
+        s = stub_->stub->LeaseTask(ContextWithDeadline(absl::Seconds(1)).get(), req, &resp);
+    }
+    if (!s.ok()) return ConnectionStatus(s, stub_->options);
     if (!resp.has_task()) return std::nullopt;
     return FromProto(resp.task());
 }

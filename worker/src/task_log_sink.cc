@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/plural.h"
 
 namespace lf {
 
@@ -36,7 +37,7 @@ std::vector<TaskLogLine> TaskLog::Take() {
         TaskLogLine& note = taken.emplace_back();
         note.time = last_dropped_;
         note.level = "warning";
-        note.text = absl::StrCat("... ", dropped_, " lines dropped");
+        note.text = absl::StrCat("... ", Plural(dropped_, "line"), " dropped");
         dropped_ = 0;
     }
     for (TaskLogLine& line : lines_) taken.push_back(std::move(line));

@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/file_util.h"
 #include "lf/core/log.h"
+#include "lf/core/plural.h"
 #include "lf/core/radiosity_codec.h"
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
@@ -83,12 +84,10 @@ void Worker::Run() {
             if (task.ok()) {
                 Log()->info("worker={} server reachable again", server_.worker_id());
             } else if (last == absl::StatusCode::kFailedPrecondition) {
-                // Another build (LeaseTask's version check). Retried rather than exiting, so a
-                // server brought to this build gets its workers back without restarting them.
-                Log()->error(
-                    "worker={} refused by the server, retrying until it accepts this "
-                    "build: {}",
-                    server_.worker_id(), why);
+                // Another build (LeaseTask's version check) or TLS on one side only. Retried
+                // rather than exiting, so a server fixed gets its workers back without restarts.
+                Log()->error("worker={} cannot work with the server, retrying until it can: {}",
+                             server_.worker_id(), why);
             } else if (last == absl::StatusCode::kUnauthenticated ||
                        last == absl::StatusCode::kPermissionDenied) {
                 // A token or certificate the server does not take (yet): retried, so that
@@ -248,9 +247,9 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
     loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
     loaded.job_id = task.job_id;
     loaded_ = std::move(loaded);
-    Log()->info("job={} task={} scene {} loaded: {} files, {} fetched from the server, {} cached",
-                task.job_id, task.task.index, task.spec.scene.path, refs.size(), fetched,
-                int(refs.size()) - fetched);
+    Log()->info("job={} task={} scene {} loaded: {}, {} fetched from the server, {} cached",
+                task.job_id, task.task.index, task.spec.scene.path,
+                Plural(int64_t(refs.size()), "file"), fetched, int(refs.size()) - fetched);
     return absl::OkStatus();
 }
 

@@ -18,11 +18,12 @@ from .errors import (Aborted, AlreadyExists, Cancelled, DeadlineExceeded, Failed
                      Internal, InvalidArgument, LightfarmError, NotFound, OutOfRange,
                      PermissionDenied, ResourceExhausted, TlsError, Unauthenticated, Unavailable,
                      Unimplemented)
+from .preview import exr_to_png
 from .scene import scene_files
 
 __all__ = [
     "Client", "Job", "JobState", "LogLine", "Progress", "Task", "Worker", "DEFAULT_SERVER",
-    "METHODS", "load_token", "scene_files", "LightfarmError", "Aborted", "AlreadyExists",
+    "METHODS", "load_token", "scene_files", "exr_to_png", "LightfarmError", "Aborted", "AlreadyExists",
     "Cancelled", "DeadlineExceeded", "FailedPrecondition", "Internal", "InvalidArgument",
     "NotFound", "OutOfRange", "PermissionDenied", "ResourceExhausted", "TlsError",
     "Unauthenticated", "Unavailable", "Unimplemented",

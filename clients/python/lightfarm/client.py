@@ -14,6 +14,7 @@ import grpc
 
 from . import errors
 from .errors import InvalidArgument, LightfarmError
+from .preview import TONEMAPS, exr_to_png
 from .scene import check_scene_path, scene_files
 from .v1 import common_pb2, job_service_pb2, job_service_pb2_grpc
 
@@ -317,7 +318,7 @@ class Client:
         self.close()
 
     def _error(self, e: grpc.RpcError, call: str = "") -> LightfarmError:
-        return errors.from_rpc_error(e, self.server, call)
+        return errors.from_rpc_error(e, self.server, call, tls=self._credentials is not None)
 
     def _unary(self, method: str, request, timeout: float = UNARY_SECONDS):
         try:
@@ -435,12 +436,21 @@ class Client:
         return last.job
 
     # --- results ---
-    def fetch(self, job_id: str, path: Union[str, os.PathLike], *, preview: bool = False) -> str:
+    def fetch(self, job_id: str, path: Union[str, os.PathLike], *, preview: bool = False,
+              exposure: float = 0.0, tonemap: str = "clamp") -> str:
         """Writes the job's OpenEXR result to ``path`` (through ``path``.part, renamed when
-        complete, so a failed fetch leaves no half file) and returns the path.
+        complete, so a failed fetch leaves no half file) and returns the path. A ``path`` ending
+        in .png gets the 8-bit sRGB preview instead, as ``lightfarm fetch -o out.png`` makes it:
+        radiance times 2^``exposure``, then the ``tonemap`` curve ("clamp" or "filmic").
         FailedPrecondition until the job has succeeded, unless ``preview`` asks for the tiles
         merged so far."""
         path = os.fspath(path)
+        png = path.lower().endswith(".png")
+        if not png and (exposure != 0.0 or tonemap != "clamp"):
+            raise InvalidArgument(f"{path}: exposure and tonemap make the PNG preview; give a "
+                                  "path ending in .png")
+        if png and tonemap not in TONEMAPS:
+            raise InvalidArgument(f"tonemap {tonemap!r}: expected clamp or filmic")
         temp = path + ".part"
         try:
             with open(temp, "wb") as f:
@@ -448,6 +458,12 @@ class Client:
                         pb.FetchResultRequest(job_id=job_id, preview=preview),
                         timeout=FETCH_SECONDS, metadata=self._metadata):
                     f.write(chunk.data)
+            if png:
+                with open(temp, "rb") as f:
+                    image = exr_to_png(f.read(), exposure=exposure, tonemap=tonemap,
+                                       what=f"job {job_id}")
+                with open(temp, "wb") as f:
+                    f.write(image)
         except grpc.RpcError as e:
             _remove(temp)
             raise self._error(e, "FetchResult") from None

@@ -111,9 +111,11 @@ _BY_CODE = {cls.default_code: cls for cls in (
     DeadlineExceeded, Cancelled, Internal)}
 
 
-def from_rpc_error(error: grpc.RpcError, server: str = "", call: str = "") -> LightfarmError:
+def from_rpc_error(error: grpc.RpcError, server: str = "", call: str = "",
+                   tls: bool = False) -> LightfarmError:
     """The :class:`LightfarmError` for a failed gRPC call (``call``, a JobService method, for
-    a message when the server gives none), with the server's message."""
+    a message when the server gives none; ``tls``, whether the client speaks TLS), with the
+    server's message."""
     code = error.code() if hasattr(error, "code") else grpc.StatusCode.UNKNOWN
     details = error.details() if hasattr(error, "details") else None
     if not details:
@@ -121,11 +123,24 @@ def from_rpc_error(error: grpc.RpcError, server: str = "", call: str = "") -> Li
             details = f"{call or 'the call'}: not implemented by server {server}"
         else:
             details = f"{call or 'the call'}: {code.name} without a message"
+    if code == grpc.StatusCode.UNAVAILABLE and tls and ("wrong version number" in details or
+                                                        "WRONG_VERSION_NUMBER" in details):
+        return TlsError(f"server {server} does not speak TLS (it answered the TLS handshake in "
+                        f"plain text): leave out tls_ca, or start the server with --tls-cert "
+                        f"and --tls-key ({details})", code)
+    if code == grpc.StatusCode.UNAVAILABLE and tls and "ALPN" in details:
+        return TlsError(f"server {server} speaks TLS but not gRPC (is it the server's --http "
+                        f"port?) ({details})", code)
     if code == grpc.StatusCode.UNAVAILABLE and ("SSL_ERROR_SSL" in details or
                                                 "Ssl handshake failed" in details):
         return TlsError(f"TLS handshake with server {server} failed ({details}): check tls_ca, "
                         "the server's certificate names, and tls_cert/tls_key if the server asks "
                         "for client certificates", code)
+    if code == grpc.StatusCode.UNAVAILABLE and not tls and "Socket closed" in details:
+        # Unavailable still: a server going down closes connections too, and that is retried.
+        return Unavailable(f"server {server} closed the connection before answering: it speaks "
+                           "TLS, most likely (a TLS server closes plain-text connections so); "
+                           f"give the CA of its certificate as tls_ca ({details})", code)
     if code == grpc.StatusCode.UNAVAILABLE:
         return Unavailable(f"server {server} not reachable: {details}", code)
     return _BY_CODE.get(code, LightfarmError)(details, code)

@@ -12,11 +12,13 @@ import os
 import secrets
 import shutil
 import socket
+import struct
 import subprocess
 import sys
 import tempfile
 import time
 import unittest
+import zlib
 
 import grpc
 
@@ -28,12 +30,50 @@ SCENES = os.environ.get("LF_TEST_SCENES", "")
 DOCS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "docs",
                     "python.md")
 EXR_MAGIC = bytes([0x76, 0x2F, 0x31, 0x01])
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 SMALL = dict(spp=4, resolution=(32, 32), tile=8, passes=2)  # 32 tasks, well under a second
 WATCHED = dict(spp=512, resolution=(64, 64), tile=16, passes=2)  # 32 tasks, a few seconds
 
 
 def cornell():
     return os.path.join(SCENES, "cornell_box.json")
+
+
+def png_pixels(data):
+    """Width, height and the RGB bytes of an 8-bit RGB PNG, whatever its row filters."""
+    assert data[:8] == PNG_MAGIC, data[:8]
+    at, idat = 8, b""
+    while at < len(data):
+        n, kind = struct.unpack_from(">I4s", data, at)
+        body = data[at + 8:at + 8 + n]
+        at += 12 + n
+        if kind == b"IHDR":
+            width, height, depth, color = struct.unpack_from(">IIBB", body)
+            assert (depth, color) == (8, 2), (depth, color)
+        elif kind == b"IDAT":
+            idat += body
+    raw = zlib.decompress(idat)
+    stride = width * 3
+    prev, out, p = bytearray(stride), bytearray(), 0
+    for _ in range(height):
+        kind, line = raw[p], bytearray(raw[p + 1:p + 1 + stride])
+        p += 1 + stride
+        for i in range(stride):
+            a = line[i - 3] if i >= 3 else 0
+            b = prev[i]
+            c = prev[i - 3] if i >= 3 else 0
+            if kind == 1:
+                line[i] = (line[i] + a) & 0xFF
+            elif kind == 2:
+                line[i] = (line[i] + b) & 0xFF
+            elif kind == 3:
+                line[i] = (line[i] + (a + b) // 2) & 0xFF
+            elif kind == 4:
+                pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 0xFF
+        out += line
+        prev = line
+    return width, height, bytes(out)
 
 
 class Farm:
@@ -356,6 +396,83 @@ class ClientTest(unittest.TestCase):
         with self.assertRaises(lightfarm.InvalidArgument):
             lightfarm.Client(self.farm.address, tls_cert=self.farm.path("server.crt"),
                              tls_key=self.farm.path("server.key"))  # no CA
+
+    def test_fetch_png_is_the_clis_preview(self):
+        """fetch(job, "x.png") writes the PNG `lightfarm fetch -o x.png` writes, pixel for pixel,
+        with the same exposure and tone curve."""
+        job_id = self.alice.submit(cornell(), **SMALL)
+        self.assertEqual(self.alice.wait(job_id).state, lightfarm.JobState.SUCCEEDED)
+        for flags, kwargs in (([], {}), (["--exposure", "1.5", "--tonemap", "filmic"],
+                                         dict(exposure=1.5, tonemap="filmic"))):
+            mine, theirs = self.farm.path("python.png"), self.farm.path("cli.png")
+            self.assertEqual(self.alice.fetch(job_id, mine, **kwargs), mine)
+            r = self.farm.cli("fetch", job_id, "-o", theirs, *flags)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            with open(mine, "rb") as f:
+                ours = png_pixels(f.read())
+            with open(theirs, "rb") as f:
+                cli = png_pixels(f.read())
+            self.assertEqual(ours[:2], (32, 32))
+            self.assertEqual(ours, cli, flags)
+            self.assertGreater(max(ours[2]), 0, "not black")
+            self.assertFalse(os.path.exists(mine + ".part"))
+        with self.assertRaises(lightfarm.InvalidArgument):
+            self.alice.fetch(job_id, self.farm.path("x.exr"), exposure=1.0)
+        with self.assertRaises(lightfarm.InvalidArgument):
+            self.alice.fetch(job_id, self.farm.path("x.png"), tonemap="aces")
+
+    def test_tls_on_one_side_only(self):
+        """A plain-text client or worker of the TLS server is told that the server speaks TLS
+        and to give --tls-ca (tls_ca); one with a CA whose server speaks plain text is told
+        that it does not."""
+        def wait_for_log(name, text):
+            deadline = time.monotonic() + 30
+            while text not in self.farm.log(name):
+                self.assertLess(time.monotonic(), deadline, self.farm.log(name))
+                time.sleep(0.1)
+
+        with lightfarm.Client(self.farm.address, token_file=self.farm.path("alice.token"),
+                              tls_ca="", retry_seconds=0) as c:
+            with self.assertRaises(lightfarm.Unavailable) as caught:
+                c.workers()
+        self.assertIn("speaks TLS", caught.exception.message)
+        self.assertIn("tls_ca", caught.exception.message)
+        r = subprocess.run([self.farm.bin("lightfarm"), "list", "--server", self.farm.address,
+                            "--token-file", self.farm.path("alice.token")],
+                           capture_output=True, text=True, timeout=60)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertEqual(r.stdout, "", "no table header from a failed list")
+        self.assertIn("speaks TLS", r.stderr)
+        self.assertIn("--tls-ca", r.stderr)
+        worker = self.farm.spawn("plain-worker", [
+            self.farm.bin("lightfarm-worker"), "--server", self.farm.address, "--token-file",
+            self.farm.path("node.token"), "--cache-dir", self.farm.path("cache-plain")])
+        wait_for_log("plain-worker", "speaks TLS, most likely")
+        worker.terminate()
+        worker.wait(timeout=10)
+        self.assertIn("--tls-ca", self.farm.log("plain-worker"))
+
+        plain = self.farm.spawn("plain-server", [
+            self.farm.bin("lightfarm-server"), "--listen", "127.0.0.1:0", "--data-dir",
+            self.farm.path("plain-data"), "--log-level", "warn"], stdout=subprocess.PIPE)
+        address = plain.stdout.readline().strip()[len("listening on "):]
+        with lightfarm.Client(address, token="x", tls_ca=self.farm.path("ca.crt"),
+                              retry_seconds=0) as c:
+            with self.assertRaises(lightfarm.TlsError) as caught:
+                c.workers()
+        self.assertIn("does not speak TLS", caught.exception.message)
+        r = subprocess.run([self.farm.bin("lightfarm"), "list", "--server", address, "--tls-ca",
+                            self.farm.path("ca.crt")], capture_output=True, text=True, timeout=60)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("does not speak TLS", r.stderr)
+        worker = self.farm.spawn("tls-worker", [
+            self.farm.bin("lightfarm-worker"), "--server", address, "--tls-ca",
+            self.farm.path("ca.crt"), "--cache-dir", self.farm.path("cache-tls")])
+        wait_for_log("tls-worker", "does not speak TLS")
+        worker.terminate()
+        worker.wait(timeout=10)
+        plain.terminate()
+        plain.wait(timeout=10)
 
     def test_malformed_scene(self):
         bad = self.farm.path("bad.json")

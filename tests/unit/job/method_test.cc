@@ -44,7 +44,7 @@ TEST(Method, WhittedHeaderNamesItsMethodAndLightSampling) {
     absl::StatusOr<RenderDescription> d = DescribeRender(m, EmptyRenderImage(4, 4), true);
     ASSERT_TRUE(d.ok()) << d.status();
     EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.method")), "whitted");
-    EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.light_sampling")), "power");
+    EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.lightSampling")), "power");
     for (const auto& [name, value] : d->attributes) {
         EXPECT_NE(name.rfind("lightfarm.radiosity.", 0), 0u) << name;
     }

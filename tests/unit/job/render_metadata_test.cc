@@ -121,13 +121,26 @@ TEST(RenderMetadata, LightSamplingIsNamedForPathTracingOnly) {
         m.light_strategy = strategy;
         absl::StatusOr<RenderDescription> d = DescribeRender(m, EmptyRenderImage(4, 4), true);
         ASSERT_TRUE(d.ok()) << d.status();
-        EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.light_sampling")),
+        EXPECT_EQ(std::get<std::string>(d->attributes.at("lightfarm.lightSampling")),
                   LightStrategyName(strategy));
     }
     m.method = "radiosity";
     absl::StatusOr<RenderDescription> radiosity = DescribeRender(m, EmptyRenderImage(4, 4), true);
     ASSERT_TRUE(radiosity.ok()) << radiosity.status();
-    EXPECT_FALSE(radiosity->attributes.count("lightfarm.light_sampling"));
+    EXPECT_FALSE(radiosity->attributes.count("lightfarm.lightSampling"));
+}
+
+// lightfarm.* names are camelCase, as OpenEXR's own: no snake_case name among them.
+TEST(RenderMetadata, AttributeNamesAreCamelCase) {
+    for (const char* method : {"path", "radiosity", "light", "bdpt", "ppm", "whitted"}) {
+        RenderMetadata m = PathMetadata();
+        m.method = method;
+        absl::StatusOr<RenderDescription> d = DescribeRender(m, EmptyRenderImage(4, 4), true);
+        ASSERT_TRUE(d.ok()) << d.status();
+        for (const auto& [name, value] : d->attributes) {
+            EXPECT_EQ(name.find('_'), std::string::npos) << method << ": " << name;
+        }
+    }
 }
 
 TEST(RenderMetadata, RadiosityFiguresAndSettingsGoIntoTheHeader) {

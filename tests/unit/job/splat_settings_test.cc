@@ -1,5 +1,5 @@
-// The splatting methods' job settings (lf/job/splat_settings.h): which plan each method gets from the
-// job's spp, tile and passes; what a job may ask of them (photon settings, no AOVs, no adaptive
+// The splatting methods' job settings (lf/job/splat_settings.h): which plan each method gets from
+// the job's spp, tile and passes; what a job may ask of them (photon settings, no AOVs, no adaptive
 // sampling); the kernel settings they map to; and what their EXR header says.
 #include "lf/job/splat_settings.h"
 
@@ -165,14 +165,14 @@ TEST(SplatSettings, HeaderNamesTheMethodAndItsParameters) {
     EXPECT_EQ(Text(d->attributes, "lightfarm.lightPaths"), "120");
     EXPECT_EQ(Text(d->attributes, "lightfarm.lightPathsPerPixel"), "4");
     EXPECT_EQ(std::get<int>(d->attributes.at("lightfarm.maxDepth")), 6);
-    EXPECT_EQ(d->attributes.count("lightfarm.light_sampling"), 0u) << "light tracing samples none";
+    EXPECT_EQ(d->attributes.count("lightfarm.lightSampling"), 0u) << "light tracing samples none";
     EXPECT_EQ(d->attributes.count("lightfarm.bias"), 0u);
 
     m.method = "bdpt";
     d = DescribeRender(m, EmptyRenderImage(10, 3), true);
     ASSERT_TRUE(d.ok());
     EXPECT_EQ(Text(d->attributes, "lightfarm.lightPaths"), "120");
-    EXPECT_EQ(Text(d->attributes, "lightfarm.light_sampling"), "bvh");
+    EXPECT_EQ(Text(d->attributes, "lightfarm.lightSampling"), "bvh");
 
     m.method = "ppm";
     m.ppm = {5000, 0, 0.75};

@@ -14,8 +14,7 @@ struct BenchOptions {
     std::string scene_path;
     uint64_t spp = defaults::kSpp;
     int threads = 2;
-    int resolution = 256;  // square side, 0: the scene's; unused when scene gives WxH
-    SceneOptions scene;
+    SceneOptions scene{.width = 256, .height = 256};
     int max_depth = defaults::kMaxDepth;
     SamplerType sampler = defaults::kSampler;
     LightStrategy light_strategy = defaults::kLightStrategy;

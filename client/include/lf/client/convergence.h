@@ -20,9 +20,9 @@
 #include "lf/core/light_strategy.h"
 #include "lf/core/sampler.h"
 #include "lf/core/scene_loader.h"
-#include "lf/job/splat_settings.h"
 #include "lf/job/method_registry.h"
 #include "lf/job/settings.h"
+#include "lf/job/splat_settings.h"
 
 namespace lf {
 
@@ -67,8 +67,7 @@ struct ConvergenceOptions {
     // ladder methods (path, light, bdpt, ppm), each laddered in every configuration of `configs`
     std::string method = "both";
     PhotonSettings ppm;      // the ppm ladders' --photons, --ppm-radius, --ppm-alpha
-    int resolution = 0;      // image width, height keeps the aspect; 0: the scene's
-    SceneOptions scene;      // --camera; --resolution WxH (then `resolution` is 0)
+    SceneOptions scene;      // --camera, --resolution
     uint64_t max_spp = 256;  // path ladder 1, 2, 4, ... up to this
     uint64_t reference_spp = 4096;
     int64_t min_patches = 250;  // radiosity ladder, doubling

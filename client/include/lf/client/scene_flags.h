@@ -12,16 +12,15 @@ namespace lf {
 // --camera NAME, filling options.camera.
 void AddCameraFlag(CLI::App* cmd, SceneOptions& options);
 
-// --resolution WxH into options.width and height; with `single`, also a bare N (at most
-// `max_single`) into *single, for the commands whose --resolution N came first.
-void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, int* single, int max_single,
-                       const std::string& help);
+// --resolution WxH, or N for N x N, into options.width and height (every command alike; the
+// scene loader bounds them).
+void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, const std::string& help);
 
 // --filter TYPE[:WIDTH] into options.filter: the pixel filter, in place of the scene camera's.
 inline constexpr double kDefaultFilterWidth = 3;  // pixels, gaussian and blackman-harris
 void AddFilterFlag(CLI::App* cmd, SceneOptions& options);
 
-// --camera, --resolution WxH and --filter, filling `options`.
+// --camera, --resolution and --filter, filling `options`.
 void AddSceneFlags(CLI::App* cmd, SceneOptions& options);
 
 }  // namespace lf

@@ -34,7 +34,7 @@ struct MethodInfo {
     // A splat lands in the one pixel that holds its raster position: the box filter's footprint,
     // so these take the box filter only (CheckMethodTakesScene).
     bool splats_light_paths;
-    // Samples lights at camera-path vertices (lightfarm.light_sampling names the strategy).
+    // Samples lights at camera-path vertices (lightfarm.lightSampling names the strategy).
     bool samples_lights;
     // Splat passes have no per-pixel first hits to make AOVs of, and no tile whose error alone
     // decides its next pass.

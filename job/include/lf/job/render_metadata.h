@@ -14,10 +14,10 @@
 #include "lf/core/image_io.h"
 #include "lf/core/scene.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/splat_settings.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
+#include "lf/job/splat_settings.h"
 
 namespace lf {
 
@@ -73,7 +73,7 @@ struct RenderMetadata {
     uint32_t aovs = 0;   // lf/core/aov.h flags of the AOV channels the image has
     PixelFilter filter;  // the camera's, after --filter
     SamplerType sampler = defaults::kSampler;  // lightfarm.sampler
-    // lightfarm.light_sampling, for the methods that sample lights at camera-path vertices (path,
+    // lightfarm.lightSampling, for the methods that sample lights at camera-path vertices (path,
     // whitted, bdpt, ppm; not radiosity nor light tracing)
     LightStrategy light_strategy = defaults::kLightStrategy;
     double seconds = 0;  // the whole render: loading, meshing, solving and sampling
@@ -110,7 +110,7 @@ struct RenderDescription {
 
 // Every attribute of a render's header: how it was made (lightfarm.version, scene hash, camera
 // when picked by name, method, settings with lightfarm.sampler and, for path tracing,
-// lightfarm.light_sampling, timing, ray and sample counts, truncated paths), what
+// lightfarm.lightSampling, timing, ray and sample counts, truncated paths), what
 // the channels hold (lightfarm.channels, lightfarm.aovs when there are AOVs, lightfarm.filter),
 // their units (lightfarm.units and OpenEXR's standard chromaticities, Rec.709 with D65, and
 // whiteLuminance = 683 cd/m^2 for RGB (1, 1, 1)), the bias of --clamp (lightfarm.clamp and

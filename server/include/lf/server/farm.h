@@ -111,7 +111,7 @@ class Farm {
     absl::StatusOr<std::vector<TaskStatus>> Tasks(const std::string& job_id);
     // The job's captured task log lines after `after_seq` (one task's when `task` is set), at
     // most `max_lines` of them (kMaxTaskLogPage when 0 or more). NotFound for a job the farm
-    // does not know.
+    // does not know, or a `task` the job does not have.
     absl::StatusOr<TaskLogPage> TaskLogs(const std::string& job_id, std::optional<int> task,
                                          int64_t after_seq, int max_lines);
     // Keeps the log lines a worker sent with a heartbeat or a result of lease `lease_id`, under
