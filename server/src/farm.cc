@@ -47,7 +47,8 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
         fs::create_directories(fs::path(options.data_dir) / sub, ec);
         if (ec) return absl::InternalError(options.data_dir + "/" + sub + ": " + ec.message());
     }
-    absl::StatusOr<std::unique_ptr<DataDirLock>> lock = DataDirLock::Acquire(options.data_dir);
+    absl::StatusOr<std::unique_ptr<DirLock>> lock =
+        DirLock::Acquire(options.data_dir, {"data folder", "lightfarm-server", "--data-dir"});
     if (!lock.ok()) return lock.status();
     absl::StatusOr<std::unique_ptr<BlobStore>> blobs = BlobStore::Open(options.data_dir + "/blobs");
     if (!blobs.ok()) return blobs.status();

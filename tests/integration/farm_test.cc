@@ -1123,9 +1123,33 @@ TEST_F(Farm, SecondServerOnADataDirInUseRefusesToStart) {
                           "second-server.log");
     EXPECT_EQ(second->Wait(milliseconds(10000)), std::optional<int>(1));
     const std::string log = ReadText(dir_ / "second-server.log");
-    EXPECT_NE(log.find((dir_ / "data").string() + " is in use by another lightfarm-server"),
+    EXPECT_NE(log.find((dir_ / "data").string() + " is in use by another lightfarm-server (pid " +
+                       std::to_string(server_->pid()) + ","),
               std::string::npos)
         << log;
+}
+
+// Issue 27: two workers on one --cache-dir evicted each other's blobs and nothing said so; the
+// second now refuses to start, naming the folder and the first worker's pid.
+TEST_F(Farm, SecondWorkerOnACacheDirInUseRefusesToStart) {
+    StartServer();
+    Child* first = StartWorker("shared");
+    const fs::path lock = dir_ / "cache-shared" / "lock";
+    const std::string pid = std::to_string(first->pid());
+    for (int i = 0; i < 1000 && ReadText(lock) != pid + "\n"; ++i) {
+        std::this_thread::sleep_for(milliseconds(10));
+    }
+    ASSERT_EQ(ReadText(lock), pid + "\n") << "the first worker holds the folder";
+    Child* second = Spawn({std::string(LF_BIN_DIR) + "/lightfarm-worker", "--server", address_,
+                           "--cache-dir", (dir_ / "cache-shared").string()},
+                          "second-worker.log");
+    EXPECT_EQ(second->Wait(milliseconds(10000)), std::optional<int>(1));
+    const std::string log = ReadText(dir_ / "second-worker.log");
+    EXPECT_NE(log.find("cache folder " + (dir_ / "cache-shared").string() +
+                       " is in use by another lightfarm-worker (pid " + pid + ","),
+              std::string::npos)
+        << log;
+    EXPECT_FALSE(first->Wait(milliseconds(0)).has_value()) << "the first worker goes on";
 }
 
 TEST_F(Farm, ListFollowsItsLimitAndDeleteRemovesOnlyEndedJobs) {

@@ -6,9 +6,11 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/dir_lock.h"
 #include "lf/core/log.h"
 #include "lf/core/plural.h"
 #include "lf/core/stop_signals.h"
@@ -49,7 +51,9 @@ int main(int argc, char** argv) {
     app.add_option("--threads", options.threads, "render threads")
         ->capture_default_str()
         ->check(CLI::Range(1, 1024));
-    app.add_option("--cache-dir", cache_dir, "scene blob cache, one per worker (kept across runs)")
+    app.add_option("--cache-dir", cache_dir,
+                   "scene blob cache (kept across runs), one per worker: a worker refuses a folder "
+                   "another running worker holds (its lock file names the holder's pid)")
         ->capture_default_str();
     app.add_option("--cache-mb", cache_mb, "cache budget in MiB")->capture_default_str();
     app.add_option("--log-level", log_level,
@@ -70,6 +74,13 @@ int main(int argc, char** argv) {
     spdlog::set_level(std::min(level, spdlog::level::info));
     // Before any other logger is made: each clones the default logger's sinks.
     const std::shared_ptr<lf::TaskLogSink> task_logs = lf::TaskLogSink::Install();
+    // One worker per cache: two would evict each other's blobs mid-fetch.
+    std::error_code made;
+    std::filesystem::create_directories(cache_dir, made);
+    if (made) return fail(absl::InternalError(cache_dir + ": " + made.message()));
+    absl::StatusOr<std::unique_ptr<lf::DirLock>> cache_lock =
+        lf::DirLock::Acquire(cache_dir, {"cache folder", "lightfarm-worker", "--cache-dir"});
+    if (!cache_lock.ok()) return fail(cache_lock.status());
     absl::StatusOr<std::unique_ptr<lf::BlobCache>> cache =
         lf::BlobCache::Open(cache_dir + "/blobs", cache_mb << 20);
     if (!cache.ok()) return fail(cache.status());

@@ -13,10 +13,10 @@
 #include <string_view>
 
 #include "absl/status/statusor.h"
+#include "lf/core/dir_lock.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/task_status.h"
 #include "lf/server/blob_store.h"
-#include "lf/server/data_dir_lock.h"
 #include "lf/server/job_store.h"
 #include "lf/server/scheduler.h"
 #include "lf/server/sqlite_job_store.h"
@@ -148,7 +148,7 @@ class Farm {
     absl::Status WriteSnapshot(const std::string& job_id, bool complete, const std::string& path);
 
     const FarmOptions options_;
-    std::unique_ptr<DataDirLock> lock_;
+    std::unique_ptr<DirLock> lock_;
     // Radiosity figures of running jobs, for their EXR headers: the workers' reports, and of
     // jobs solved in sweeps, the iterations and residual of the farm's own solve. Kept in
     // memory: after a restart a header lacks what the workers reported before it.
