@@ -54,8 +54,9 @@ from lightfarm.v1 import job_service_pb2_grpc as jgrpc
 from lightfarm.v1 import worker_service_pb2 as wpb
 from lightfarm.v1 import worker_service_pb2_grpc as wgrpc
 
-MB = 1 << 20
-PEAK_LIMIT = 1_000_000_000  # bytes: "the server stays below 1 GB"
+MIB = 1 << 20  # payload sizes
+MB = 1_000_000  # what is reported and checked
+PEAK_LIMIT = 1000 * MB  # "the server stays below 1 GB"
 # What one attack may add to the server's resident memory: the issue asks that no call without
 # a valid token make it hold more than a few MB; a cap with bounded buffering keeps stalled
 # readers to a few MB each for a few streams.
@@ -279,9 +280,13 @@ class HonestRun:
     """Alice submits HONEST_JOBS jobs (each scene a new upload), waits for each with WatchJob
     (polling GetJob when a watch is refused) and fetches each result."""
 
-    def __init__(self, farm, token, base_text, first_tag, request_id=None):
+    def __init__(self, farm, token, base_text, first_tag, request_id=None, held=None):
         self.farm, self.token, self.base_text, self.first_tag = farm, token, base_text, first_tag
         self.request_id = request_id
+        # Set when mallory lets go of her uploads (6): was alice's first upload in before?
+        self.held = held
+        self.first_in_while_held = None
+        self.first_seconds = None
         self.submitted = threading.Event()
         self.job_ids, self.outcomes = [], {}
         self.upload_refusals, self.watch_refusals, self.fetch_errors = [], [], []
@@ -298,6 +303,10 @@ class HonestRun:
                     try:
                         self.job_ids.append(client.submit(path, name=f"honest-{self.first_tag + i}",
                                                           request_id=rid, **HONEST_PARAMS))
+                        if self.first_seconds is None:
+                            self.first_seconds = time.time() - start
+                            if self.held is not None:
+                                self.first_in_while_held = not self.held.is_set()
                         break
                     except lightfarm.ResourceExhausted as e:
                         self.upload_refusals.append(str(e))
@@ -374,7 +383,7 @@ def attack_huge_unauthenticated(farm, sampler, out):
     def one():
         ch = channel(farm.grpc_addr)
         try:
-            jgrpc.JobServiceStub(ch).ListJobs(jpb.ListJobsRequest(page_token="x" * (300 * MB)),
+            jgrpc.JobServiceStub(ch).ListJobs(jpb.ListJobsRequest(page_token="x" * (300 * MIB)),
                                               timeout=ATTACK_SECONDS)
             codes.append("OK")
         except grpc.RpcError as e:
@@ -396,7 +405,7 @@ def attack_chunked_session(farm, sampler, out):
     ATTACK_SECONDS."""
     before = sampler.reset_hwm()
     answers = []
-    chunk = b"a" * MB
+    chunk = b"a" * MIB
     frame = b"%x\r\n" % len(chunk) + chunk + b"\r\n"
 
     def one():
@@ -612,7 +621,7 @@ def attack_slots(farm, mallory_token, out, ready):
     futures = []
 
     def stalled_upload():
-        data = secrets.token_bytes(10 * MB)
+        data = secrets.token_bytes(10 * MIB)
         digest = hashlib.sha256(data).hexdigest()
         yield jpb.UploadBlobRequest(hash=digest, size=len(data), offset=0, data=data[:64 << 10])
         release.wait()
@@ -656,29 +665,44 @@ def attack_slots(farm, mallory_token, out, ready):
 
 
 def attack_stalled_readers(farm, sampler, mallory_token, job_id, out):
-    """(7) 400 FetchResult streams of mallory's 512x512 result that read one chunk and stop."""
+    """(7) 400 FetchResult streams of mallory's 512x512 result that read one chunk and stop
+    (each waits at most ATTACK_SECONDS for its first chunk), held for 4 s more."""
     before = sampler.reset_hwm()
     channels = [channel(farm.grpc_addr) for _ in range(8)]
     stubs = [jgrpc.JobServiceStub(c) for c in channels]
-    streams, codes, reading = [], {}, 0
-    for i in range(400):
-        streams.append(stubs[i % 8].FetchResult(jpb.FetchResultRequest(job_id=job_id),
-                                                timeout=60, metadata=bearer(mallory_token)))
-    for s in streams:
-        try:
-            next(s)
-            reading += 1
-        except grpc.RpcError as e:
-            codes[e.code().name] = codes.get(e.code().name, 0) + 1
-        except StopIteration:
-            pass
+    codes, reading = {}, []
+    lock = threading.Lock()
+    streams = [stubs[i % 8].FetchResult(jpb.FetchResultRequest(job_id=job_id),
+                                        timeout=ATTACK_SECONDS + 10,
+                                        metadata=bearer(mallory_token)) for i in range(400)]
+    end = time.time() + ATTACK_SECONDS
+
+    def first_chunks(part):
+        for s in part:
+            if time.time() > end:
+                s.cancel()
+            try:
+                next(s)
+                with lock:
+                    reading.append(s)
+            except grpc.RpcError as e:
+                with lock:
+                    codes[e.code().name] = codes.get(e.code().name, 0) + 1
+            except StopIteration:
+                pass
+
+    threads = [threading.Thread(target=first_chunks, args=(streams[i::8],)) for i in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
     time.sleep(4)  # the stalled readers hold what they hold
     rise = sampler.hwm() - before
     for s in streams:
         s.cancel()
     for c in channels:
         c.close()
-    out.update(reading=reading, refused=codes, rise=rise, before=before)
+    out.update(reading=len(reading), refused=codes, rise=rise, before=before)
 
 
 def attack_request_id(farm, mallory_token, alice_token, honest, out):
@@ -798,7 +822,8 @@ def run(farm, checks):
     slots_ready.wait(30)
     log(f"attack 6 holds {outcomes[6].get('uploads_held')} uploads, "
         f"{outcomes[6].get('watching')} watches")
-    attacked = HonestRun(farm, alice_token, base_text, 100, request_id=secrets.token_hex(16))
+    attacked = HonestRun(farm, alice_token, base_text, 100, request_id=secrets.token_hex(16),
+                         held=outcomes[6]["release"])
     honest_thread = threading.Thread(target=attacked.run,
                                      args=(time.time() + HONEST_DEADLINE,))
     honest_thread.start()
@@ -856,7 +881,8 @@ def run(farm, checks):
     print(f"(6) mallory: {o[6].get('uploads_held')} stalled uploads held (refused "
           f"{o[6].get('uploads_refused')}), {o[6].get('watching')} watches open (refused "
           f"{o[6].get('watches_refused')}); alice's uploads refused {len(attacked.upload_refusals)}"
-          f" times, watches refused {len(attacked.watch_refusals)} "
+          f" times, watches refused {len(attacked.watch_refusals)}, her first submission took "
+          f"{attacked.first_seconds or -1:.1f} s (quiet: {quiet.first_seconds or -1:.1f} s) "
           f"{attacked.upload_refusals[:1] + attacked.watch_refusals[:1]}")
     print(f"(7) 400 stalled FetchResult readers: {o[7]['reading']} reading, refused "
           f"{o[7]['refused']}, RSS {o[7]['before'] / MB:.0f} MB before, +{o[7]['rise'] / MB:.0f} "
@@ -874,7 +900,7 @@ def run(farm, checks):
     print(f"/healthz at the end: {healthz_end}\n")
 
     checks.check(sampler.peak_rss < PEAK_LIMIT,
-                 f"peak resident memory {sampler.peak_rss / MB:.0f} MB is below 1 GB")
+                 f"peak resident memory {sampler.peak_rss / MB:.0f} MB is below 1 GB (10^9 bytes)")
     checks.check(not quiet.failed() and len(quiet.outcomes) == HONEST_JOBS,
                  f"every honest job of the quiet phase succeeded: {quiet.outcomes}")
     checks.check(not attacked.failed() and len(attacked.outcomes) == HONEST_JOBS,
@@ -910,9 +936,11 @@ def run(farm, checks):
     checks.check(o[5].get("probes", 0) > 0 and o[5].get("answered") == o[5].get("probes"),
                  f"(5) /healthz answered every probe within 2 s during slowloris "
                  f"({o[5].get('answered')} of {o[5].get('probes')})")
-    checks.check(not attacked.upload_refusals,
-                 f"(6) alice's uploads are not refused while mallory stalls "
-                 f"{o[6].get('uploads_held')} ({attacked.upload_refusals[:1]})")
+    checks.check(not attacked.upload_refusals and attacked.first_in_while_held,
+                 f"(6) alice's uploads are neither refused nor held back while mallory stalls "
+                 f"{o[6].get('uploads_held')} (refusals {attacked.upload_refusals[:1]}; her first "
+                 f"submission went through before mallory let go {SLOTS_SECONDS} s later: "
+                 f"{attacked.first_in_while_held})")
     checks.check(not attacked.watch_refusals,
                  f"(6) alice's watches are not refused while mallory holds {o[6].get('watching')} "
                  f"({attacked.watch_refusals[:1]})")
