@@ -221,6 +221,18 @@ class Sampler:
         while not self.stopped.wait(0.05):
             self.sample()
 
+    def settle(self, seconds=10):
+        """Waits, at most `seconds`, until the resident memory stops falling: what an earlier
+        window left is given back before the next one starts."""
+        end = time.time() + seconds
+        last = self.status()["VmRSS"]
+        while time.time() < end:
+            time.sleep(0.5)
+            now = self.status()["VmRSS"]
+            if now > last - 2 * MB:
+                return
+            last = now
+
     def reset_hwm(self):
         """Takes the peak so far into peak_rss, resets VmHWM and returns VmRSS now."""
         with self.lock:
@@ -376,6 +388,7 @@ def task_failures(admin, job_ids, exclude=()):
 def attack_huge_unauthenticated(farm, sampler, out):
     """(1) Three ListJobs calls with no token and a 300 MB page_token each, at once, for at
     most ATTACK_SECONDS (a loaded machine sends them slowly)."""
+    sampler.settle()
     before = sampler.reset_hwm()
     start = time.time()
     codes = []
@@ -403,6 +416,7 @@ def attack_huge_unauthenticated(farm, sampler, out):
 def attack_chunked_session(farm, sampler, out):
     """(2) Two chunked POST /api/session bodies of 300 MB each, at once, each sent for at most
     ATTACK_SECONDS."""
+    sampler.settle()
     before = sampler.reset_hwm()
     answers = []
     chunk = b"a" * MIB
@@ -667,6 +681,7 @@ def attack_slots(farm, mallory_token, out, ready):
 def attack_stalled_readers(farm, sampler, mallory_token, job_id, out):
     """(7) 400 FetchResult streams of mallory's 512x512 result that read one chunk and stop
     (each waits at most ATTACK_SECONDS for its first chunk), held for 4 s more."""
+    sampler.settle()
     before = sampler.reset_hwm()
     channels = [channel(farm.grpc_addr) for _ in range(8)]
     stubs = [jgrpc.JobServiceStub(c) for c in channels]
