@@ -10,6 +10,13 @@ namespace lf {
 
 namespace {
 
+// The key of a token's strikes as a whole (WorkerRegistry::Abandoned), apart from its workers'
+// (TOKEN/claimed-id, which always hold a '/'); empty for workers without a token.
+std::string TokenStrikes(const std::string& worker) {
+    const std::string principal = PrincipalOf(worker);
+    return principal.empty() ? "" : "token " + principal;
+}
+
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("scheduler"); }
 
 std::string NewJobId() { return "job-" + RandomHex(10); }
@@ -275,7 +282,8 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
     const absl::Time now = clock_();
     workers_.Seen(worker, now, about);
     workers_.ForgetSilent(now);  // so that the workers kept are the live ones
-    if (workers_.IsQuarantined(worker, now)) return std::nullopt;
+    if (workers_.IsQuarantined(worker, now) || workers_.IsQuarantined(TokenStrikes(worker), now))
+        return std::nullopt;
     if (const std::string principal = PrincipalOf(worker);
         !principal.empty() && leases_.CurrentOf(principal) >= options_.max_leases_per_token) {
         return std::nullopt;
@@ -399,6 +407,7 @@ bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker
     if (!Resolve(lease_id, worker)) return false;  // a made-up id is not kept
     workers_.Seen(worker, now);
     workers_.Worked(worker);
+    workers_.Worked(TokenStrikes(worker));
     return leases_.Extend(lease_id, now + options_.lease);
 }
 
@@ -417,6 +426,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     absl::StatusOr<JobExecution::Merged> merged = job.execution->Merge(t, result);
     if (!merged.ok()) return Refuse(*ref, worker, merged.status());
     workers_.Worked(worker);
+    workers_.Worked(TokenStrikes(worker));
     MarkDone(job, t, now);
     job.Queue(merged->appended);
     if (!merged->job_error.ok()) {
@@ -631,11 +641,16 @@ int Scheduler::ExpireLeases() {
         const std::string worker = lease->worker;
         Requeue(*ref, absl::StrCat("lease abandoned: worker ", worker, " never heartbeated"),
                 false);
-        if (workers_.Abandoned(worker, now, options_.lease * options_.quarantine_leases)) {
-            Log()->warn("worker {} quarantined for {}: {} leases in a row expired unheard",
-                        LogSafe(worker),
-                        absl::FormatDuration(options_.lease * options_.quarantine_leases),
-                        WorkerRegistry::kAbandonedInARow);
+        // Strikes against the worker, and against its token as a whole: one that leases under
+        // a fresh id each time would never be quarantined as a worker.
+        for (const std::string& who : {worker, TokenStrikes(worker)}) {
+            if (!who.empty() &&
+                workers_.Abandoned(who, now, options_.lease * options_.quarantine_leases)) {
+                Log()->warn("{} quarantined for {}: {} leases in a row expired unheard",
+                            who == worker ? "worker " + LogSafe(worker) : LogSafe(who),
+                            absl::FormatDuration(options_.lease * options_.quarantine_leases),
+                            WorkerRegistry::kAbandonedInARow);
+            }
         }
     }
     return int(expired.size());

@@ -268,17 +268,47 @@ TEST_F(SchedulerTest, ExpiriesCountAsFailuresButShutdownsDoNot) {
 // 10 s: a lease that expires before any heartbeat is not the task's failure.
 TEST_F(SchedulerTest, LeasesAbandonedUnderFreshIdsFailNoJob) {
     const std::string id = Submit(0, 16, 1);  // one task
+    int abandoned = 0;  // the token's quarantine refuses some of the 20
     for (int i = 0; i < 20; ++i) {
-        ASSERT_TRUE(scheduler_.LeaseTask("evil/" + std::to_string(i)).has_value());
+        abandoned += scheduler_.LeaseTask("evil/" + std::to_string(i)).has_value();
         now_ += absl::Seconds(11);
         scheduler_.ExpireLeases();
     }
+    EXPECT_GT(abandoned, 3);
     EXPECT_EQ(Job(id).state, JobState::kRunning);
     const std::optional<TaskAssignment> honest = scheduler_.LeaseTask("node/w");
     ASSERT_TRUE(honest.has_value());
     ASSERT_TRUE(scheduler_.Complete(honest->lease_id, "node/w", Result(*honest)).ok());
     EXPECT_EQ(Job(id).tasks_done, 1);
     EXPECT_NE(Job(id).state, JobState::kFailed);
+}
+
+// A token whose workers' leases keep expiring unheard, under a fresh id each time, is
+// quarantined as a whole (as a worker, each id had one strike only); other tokens still lease,
+// and a lease its worker answers clears the token's strikes.
+TEST_F(SchedulerTest, ATokenLeasingUnderFreshIdsAndNeverAnsweringIsQuarantined) {
+    Submit(0, 16);
+    for (int i = 0; i < WorkerRegistry::kAbandonedInARow; ++i) {
+        ASSERT_TRUE(scheduler_.LeaseTask("evil/" + std::to_string(i)).has_value()) << i;
+        now_ += absl::Seconds(11);
+        scheduler_.ExpireLeases();
+    }
+    EXPECT_FALSE(scheduler_.LeaseTask("evil/fresh").has_value()) << "the token is quarantined";
+    const std::optional<TaskAssignment> other = scheduler_.LeaseTask("node/w");
+    ASSERT_TRUE(other.has_value());
+    ASSERT_TRUE(
+        scheduler_.Fail(other->lease_id, "node/w", "stop", FailureKind::kWorkerShutdown).ok());
+    now_ += absl::Seconds(10 * 10);  // quarantine_leases leases
+    const std::optional<TaskAssignment> again = scheduler_.LeaseTask("evil/later");
+    ASSERT_TRUE(again.has_value()) << "quarantine over";
+    ASSERT_TRUE(scheduler_.Heartbeat(again->lease_id, "evil/later"));
+    // Two strikes, then an answered lease: the count starts again.
+    for (int i = 0; i < WorkerRegistry::kAbandonedInARow - 1; ++i) {
+        now_ += absl::Seconds(11);
+        scheduler_.ExpireLeases();
+        ASSERT_TRUE(scheduler_.LeaseTask("evil/again" + std::to_string(i)).has_value()) << i;
+    }
+    EXPECT_TRUE(scheduler_.LeaseTask("evil/one-more").has_value());
 }
 
 // A worker whose leases keep expiring unheard gets none for a while; the others still do.
