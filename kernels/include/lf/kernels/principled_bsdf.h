@@ -11,7 +11,7 @@
 // Without k that is the specification's fresnel_mix exactly, which is single scattering: it
 // loses what the layer scatters more than once (a white base reflects 0.972 at normal incidence
 // and roughness 1). But its diffuse weight 1 - F(wo.h) at the half vector can also let base and
-// layer reflect more than arrives (white base, IOR 1.5, roughness 0.3: 1.06 at 80 degrees; 1.88
+// layer reflect more than arrives (white base, IOR 1.5, roughness 0.3: 1.24 at 84 degrees; 1.88
 // at grazing incidence on a smooth surface). k(w) = min(1, (1 - s E(w)) / A(w)), E the layer's
 // directional albedo (lf/kernels/ggx_albedo.h; Schlick's F for a smooth layer) and A the base
 // weight's (lf/kernels/fresnel_mix_albedo.h), is 1 wherever the specification's mix conserves
