@@ -28,6 +28,7 @@ Bsdf::Bsdf(const Material& material, const SurfaceParams& params)
 }
 
 bool Bsdf::IsDelta() const {
+    if (principled_) return principled_->IsDelta();
     return type_ == Material::Type::kMirror || type_ == Material::Type::kDielectric;
 }
 

@@ -7,6 +7,7 @@
 #include "lf/kernels/bsdf.h"
 #include "lf/kernels/bsdf_sampling.h"
 #include "lf/kernels/fresnel.h"
+#include "lf/kernels/fresnel_mix_albedo.h"
 
 namespace lf {
 namespace {
@@ -46,13 +47,11 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
                     Clamp01(params.roughness) * Clamp01(params.roughness)),
       // Lambert's limit (no layer, no metal) needs no table: it is not built for it.
       albedo_(specular_ > 0 || metallic_ > 0 ? &GgxAlbedo::Get() : nullptr),
-      albedo_roughness_(GgxAlbedo::At(Clamp01(params.roughness))) {
-    const float layer_average =
-        specular_ > 0 ? specular_ * albedo_->Average(albedo_roughness_, f0_) : 0;
-    const float remaining = 1 - layer_average;
-    diffuse_scale_ =
-        remaining > 1e-6f ? (1 - metallic_) * (1 - transmission_) * kInvPi / remaining : 0;
-}
+      albedo_roughness_(GgxAlbedo::At(Clamp01(params.roughness))),
+      mix_(specular_ > 0 ? &FresnelMixAlbedo::Get() : nullptr),
+      smooth_(Clamp01(params.roughness) * Clamp01(params.roughness) <
+              MicrofacetDistribution::kMinAlpha),
+      diffuse_scale_((1 - metallic_) * (1 - transmission_) * kInvPi) {}
 
 float PrincipledBsdf::LayerFresnel(float cos_om, bool outside) const {
     if (outside) return specular_ * SchlickScalar(f0_, cos_om);
@@ -101,14 +100,16 @@ PrincipledBsdf::LobePick PrincipledBsdf::Pick(const Vec3& wo) const {
     return p;
 }
 
+Rgb PrincipledBsdf::ReflectionFresnel(float cos_om, bool outside) const {
+    return FrSchlick(base_, cos_om) * metallic_ +
+           Rgb((1 - metallic_) * LayerFresnel(cos_om, outside));
+}
+
 Rgb PrincipledBsdf::ReflectionEval(const Vec3& wo, const Vec3& wi, bool outside) const {
     const Vec3 wm = Normalize(wo + wi);
-    const float cos_om = Dot(wo, wm);
     // D G / (4 cos_o cos_i), as in the glossy BSDF.
     const float dg = distribution_.D(wm) * distribution_.GOverCosines(wo, wi) / 4;
-    const Rgb conductor = FrSchlick(base_, cos_om) * metallic_;
-    const float layer = (1 - metallic_) * LayerFresnel(cos_om, outside);
-    return (conductor + Rgb(layer)) * dg;
+    return ReflectionFresnel(Dot(wo, wm), outside) * dg;
 }
 
 float PrincipledBsdf::ReflectionPdf(const Vec3& wo, const Vec3& wi) const {
@@ -118,12 +119,19 @@ float PrincipledBsdf::ReflectionPdf(const Vec3& wo, const Vec3& wi) const {
     return distribution_.PdfWm(wo, wm) / (4 * cos_om);
 }
 
+float PrincipledBsdf::BaseKeep(float mu) const {
+    const float layer =
+        smooth_ ? LayerFresnel(mu, true) : specular_ * albedo_->E(mu, albedo_roughness_, f0_);
+    const float base = mix_->Albedo(mu, specular_, f0_);
+    return base > 1 - layer ? (1 - layer) / base : 1;
+}
+
 Rgb PrincipledBsdf::DiffuseEval(const Vec3& wo, const Vec3& wi) const {
     if (diffuse_scale_ == 0) return {};
     if (specular_ == 0) return base_ * diffuse_scale_;
-    const float keep_o = 1 - specular_ * albedo_->E(wo.z, albedo_roughness_, f0_);
-    const float keep_i = 1 - specular_ * albedo_->E(wi.z, albedo_roughness_, f0_);
-    return base_ * (diffuse_scale_ * keep_o * keep_i);
+    const float cos_oh = Dot(wo, Normalize(wo + wi));
+    return base_ *
+           (diffuse_scale_ * (1 - LayerFresnel(cos_oh, true)) * BaseKeep(wo.z) * BaseKeep(wi.z));
 }
 
 Rgb PrincipledBsdf::ThinTransmissionEval(const Vec3& wo, const Vec3& wi) const {
@@ -177,6 +185,9 @@ float PrincipledBsdf::RefractionPdf(const Vec3& wo, const Vec3& wi) const {
 Rgb PrincipledBsdf::Eval(const Vec3& wo, const Vec3& wi) const {
     if (std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return {};
     const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+    if (smooth_) {
+        return SameHemisphere(wo, wi) && Outside(wo) ? DiffuseEval(wo_up, wi_up) : Rgb();
+    }
     if (SameHemisphere(wo, wi)) {
         const bool outside = Outside(wo);
         Rgb f = ReflectionEval(wo_up, wi_up, outside);
@@ -190,6 +201,7 @@ float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
     if (std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return 0;
     const LobePick pick = Pick(wo);
     const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+    if (smooth_) return SameHemisphere(wo, wi) ? pick.diffuse * wi_up.z * kInvPi : 0;
     if (SameHemisphere(wo, wi)) {
         float pdf = pick.diffuse * wi_up.z * kInvPi;
         if (pick.reflect > 0) pdf += pick.reflect * ReflectionPdf(wo_up, wi_up);
@@ -202,6 +214,8 @@ float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
 std::optional<BsdfSample> PrincipledBsdf::Sample(const Vec3& wo, float uc, const Vec2& u) const {
     if (!(std::abs(wo.z) >= kMinCos)) return std::nullopt;
     const LobePick pick = Pick(wo);
+    const bool diffuse = uc >= pick.reflect && uc < pick.reflect + pick.diffuse;
+    if (smooth_ && !diffuse) return SampleSmooth(wo, uc, pick);
     const Vec3 wo_up = ToUpper(wo);
     const float side = wo.z > 0 ? 1.0f : -1.0f;
     Vec3 wi_up;  // in the frame mirrored so that wo_up.z > 0
@@ -234,6 +248,33 @@ std::optional<BsdfSample> PrincipledBsdf::Sample(const Vec3& wo, float uc, const
     const float pdf = Pdf(wo, wi);
     if (!(pdf > 0)) return std::nullopt;
     return BsdfSample{Eval(wo, wi), wi, pdf, false, eta};
+}
+
+std::optional<BsdfSample> PrincipledBsdf::SampleSmooth(const Vec3& wo, float uc,
+                                                       const LobePick& pick) const {
+    const Vec3 wo_up = ToUpper(wo);
+    const float side = wo.z > 0 ? 1.0f : -1.0f;
+    const bool outside = Outside(wo);
+    if (uc < pick.reflect) {
+        const Vec3 wi(-wo.x, -wo.y, wo.z);
+        const Rgb f = ReflectionFresnel(wo_up.z, outside) / wo_up.z;
+        return BsdfSample{f, wi, pick.reflect, true};
+    }
+    if (!(pick.transmit > 0)) return std::nullopt;
+    const float weight = (1 - metallic_) * transmission_;
+    if (!refracts_) {
+        // A thin wall: straight through.
+        const float f = weight * (1 - LayerFresnel(wo_up.z, true)) / wo_up.z;
+        return BsdfSample{Rgb(f), -wo, pick.transmit, true};
+    }
+    const float eta = RelativeEta(wo);
+    const std::optional<Vec3> refracted = Refract(wo_up, Vec3(0, 0, 1), eta);
+    if (!refracted || -refracted->z < kMinCos) return std::nullopt;  // total internal reflection
+    const Vec3 wi(refracted->x, refracted->y, side * refracted->z);
+    // Fresnel at the outside direction's cosine, as RefractionEval takes it.
+    const float fresnel = LayerFresnel(outside ? wo_up.z : -refracted->z, true);
+    const float f = weight * (1 - fresnel) / (-refracted->z * eta * eta);
+    return BsdfSample{Rgb(f), wi, pick.transmit, true, eta};
 }
 
 }  // namespace lf

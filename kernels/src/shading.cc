@@ -57,6 +57,25 @@ Vec3 NormalMapped(const EmbreeScene& es, const Material& m, const SurfaceHit& hi
 
 }  // namespace
 
+Vec3 ValidReflectionNormal(const Vec3& ns, const Vec3& n, const Vec3& wo) {
+    const Vec3 ng = Dot(wo, n) < 0 ? -n : n;  // the geometric normal on wo's side
+    const float cos_o = Dot(wo, ng);
+    // How far above the surface the mirror direction must stay: a little, and never above wo.
+    const float lift = std::min(0.9f * cos_o, 0.01f);
+    const Vec3 r = ns * (2 * Dot(wo, ns)) - wo;
+    const float cos_r = Dot(r, ng);
+    if (cos_r >= lift) return ns;
+    // Keep the mirror direction's azimuth about ng, raise it to `lift`: r' = lift ng + sin t,
+    // and the normal that mirrors wo into r' is their half vector.
+    Vec3 t = r - ng * cos_r;
+    if (!(LengthSquared(t) > 1e-12f)) t = ng * cos_o - wo;  // r straight down: away from wo
+    if (!(LengthSquared(t) > 1e-12f)) t = ns - ng * Dot(ns, ng);
+    if (!(LengthSquared(t) > 1e-12f)) return ng;
+    const Vec3 r_valid = ng * lift + Normalize(t) * std::sqrt(1 - lift * lift);
+    const Vec3 h = wo + r_valid;
+    return LengthSquared(h) > 0 ? Normalize(h) : ng;
+}
+
 SurfacePoint Shading::Leaving(const Vec3& w) const {
     // Only rays that dip below the facet need P'. Above it the flat facet is the better origin:
     // on a convex mesh nothing can shadow it there, while P' lies outside the mesh, where
@@ -159,14 +178,7 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
         }
     }
     if (m.normal_texture.valid()) s.ns = NormalMapped(es, m, hit, s.uv, s.ns);
-    // A view from the geometric front below the shading hemisphere (grazing, at the silhouette
-    // of a coarse smooth mesh or under a steep normal map) would make every reflection
-    // inconsistent, a black rim: bend ns until wo is just on its side, as Cycles'
-    // ensure_valid_reflection does.
-    constexpr float kMinCosView = 0.01f;
-    const float side = Dot(wo, hit.n) < 0 ? -1.0f : 1.0f;
-    const float cos_o = Dot(wo, s.ns);
-    if (side * cos_o < kMinCosView) s.ns = Normalize(s.ns + wo * (side * kMinCosView - cos_o));
+    s.ns = ValidReflectionNormal(s.ns, hit.n, wo);
 
     s.params = SurfaceParams::Of(m);
     if (m.base_color_texture.valid()) {

@@ -173,11 +173,10 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
     // A delta BSDF: every lobe is followed, weighted by its value times the cosine (what
     // Bsdf::Sample's f |cos| / pdf is before the division by the lobe's choice probability).
     // uc = 0 picks the reflection (when Fresnel reflects anything), uc = 1 the refraction
-    // (none under total internal reflection); a mirror has one lobe.
-    const bool dielectric = material.type == Material::Type::kDielectric;
+    // (none under total internal reflection); a mirror and a smooth metal have one lobe.
     const std::optional<BsdfSample> lobes[2] = {
         bsdf.Sample(wo, 0, Vec2()),
-        dielectric ? bsdf.Sample(wo, 1, Vec2()) : std::nullopt,
+        Transmits(material) ? bsdf.Sample(wo, 1, Vec2()) : std::nullopt,
     };
     bool reflected = false, refracted = false;
     for (const std::optional<BsdfSample>& lobe : lobes) {

@@ -397,5 +397,46 @@ TEST(SmoothShading, NoLightLeaksFromBelowTheSurface) {
     }
 }
 
+// A bent shading normal never makes a reflection vanish (issue 28): a large quad whose vertex
+// normals all lean 70 degrees towards +x, seen from the -x side at 45 degrees, where wo mirrored
+// about the bent normal points below the surface. Under a uniform sky of radiance 1 a mirror of
+// reflectance 0.9 and a smooth principled metal of base 0.9 show 0.9 (Schlick's F at least F0)
+// in every pixel; before, every pixel was black.
+TEST(SmoothShading, BentNormalMirrorsStillReflect) {
+    for (const bool principled : {false, true}) {
+        Scene scene;
+        Material m;
+        if (principled) {
+            m.type = Material::Type::kPrincipled;
+            m.metallic = 1;
+            m.roughness = 0;
+        } else {
+            m.type = Material::Type::kMirror;
+        }
+        m.reflectance = Rgb(0.9f);
+        scene.materials.push_back(m);
+        TriangleMesh quad;
+        quad.positions = {{-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}};
+        const Vec3 lean = Normalize(Vec3(std::sin(70 * kPi / 180), std::cos(70 * kPi / 180), 0));
+        quad.normals = {lean, lean, lean, lean};
+        quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+        scene.meshes.push_back(quad);
+        scene.environment = EnvironmentLight{};
+        scene.camera = testing::SquareCamera({-2, 2, 0}, {0, 0, 0}, {0, 1, 0}, 20, 8);
+        const RenderOutput out = testing::RenderPath(scene, 4).out;
+        for (int y = 0; y < 8; ++y) {
+            for (int x = 0; x < 8; ++x) {
+                const float g = out.image.Pixel(x, y).g;
+                if (principled) {
+                    EXPECT_GE(g, 0.9f - 1e-4f) << x << "," << y;
+                    EXPECT_LE(g, 1.0f) << x << "," << y;
+                } else {
+                    EXPECT_NEAR(g, 0.9f, 1e-4f) << x << "," << y;
+                }
+            }
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lf

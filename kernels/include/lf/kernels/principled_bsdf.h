@@ -6,15 +6,20 @@
 //   conductor  = F_schlick(base, wo.wm) D G / (4 cos_o cos_i), GGX with alpha = r^2
 //   dielectric = s F D G / (4 cos_o cos_i)                     specular layer, s = `specular`,
 //              + t (1 - s F) BTDF                              F = Schlick with F0 from the IOR
-//              + (1 - t) base/pi (1 - s E(wo)) (1 - s E(wi)) / (1 - s E_avg)
+//              + (1 - t) base/pi (1 - s F(wo.h)) k(wo) k(wi)   h = normalize(wo + wi)
 //
-// The last line is where this departs from the specification: its diffuse weight 1 - F(wo.wm)
-// taken at the half vector lets base and layer reflect more than arrives (white base, IOR 1.5:
-// albedo 1.15 at 73 degrees, 1.88 at grazing incidence on a smooth surface). Scaling the base by 1
-// - E, the layer's directional albedo (lf/kernels/ggx_albedo.h), on both sides and renormalising by
-// the cosine-weighted average (Kelemen and Szirmay-Kalos 2001; Kulla and Conty 2017) keeps the BRDF
-// reciprocal and makes the albedo exactly s E(wo) + (1 - s E(wo)) base for an opaque dielectric:
-// never above one.
+// Without k that is the specification's fresnel_mix exactly, which is single scattering: it
+// loses what the layer scatters more than once (a white base reflects 0.972 at normal incidence
+// and roughness 1). But its diffuse weight 1 - F(wo.h) at the half vector can also let base and
+// layer reflect more than arrives (white base, IOR 1.5, roughness 0.3: 1.24 at 84 degrees; 1.88
+// at grazing incidence on a smooth surface). k(w) = min(1, (1 - s E(w)) / A(w)), E the layer's
+// directional albedo (lf/kernels/ggx_albedo.h; Schlick's F for a smooth layer) and A the base
+// weight's (lf/kernels/fresnel_mix_albedo.h), is 1 wherever the specification's mix conserves
+// energy and scales the base down just enough elsewhere: reciprocal, and the albedo of an opaque
+// dielectric never exceeds s E(wo) + (1 - s E(wo)) base.
+//
+// Below roughness sqrt(MicrofacetDistribution::kMinAlpha) the surface is smooth: reflection and
+// transmission are Dirac deltas (BsdfSample::delta); Eval and Pdf hold the diffuse base alone.
 //
 // The BTDF: with `thickness` 0 the surface is a thin wall, and transmission is the specular
 // lobe mirrored to the other side (light passes through without bending, blurred by the
@@ -31,6 +36,7 @@
 #include "lf/core/scene.h"
 #include "lf/core/vec.h"
 #include "lf/kernels/bsdf_sample.h"
+#include "lf/kernels/fresnel_mix_albedo.h"
 #include "lf/kernels/ggx_albedo.h"
 #include "lf/kernels/microfacet.h"
 
@@ -47,6 +53,8 @@ class PrincipledBsdf {
     Rgb Eval(const Vec3& wo, const Vec3& wi) const;
     float Pdf(const Vec3& wo, const Vec3& wi) const;
     std::optional<BsdfSample> Sample(const Vec3& wo, float uc, const Vec2& u) const;
+    // Every lobe is a Dirac delta: a smooth surface without a diffuse base.
+    bool IsDelta() const { return smooth_ && diffuse_scale_ == 0; }
     // Bsdf::RefractionEta: RelativeEta(wo) for a pair across a solid's interface, else 1.
     float RefractionEta(const Vec3& wo, const Vec3& wi) const {
         return refracts_ && wo.z * wi.z < 0 ? RelativeEta(wo) : 1.0f;
@@ -62,11 +70,15 @@ class PrincipledBsdf {
 
     // wo on the outside of the surface: always for thin walls and opaque surfaces.
     bool Outside(const Vec3& wo) const { return !refracts_ || wo.z > 0; }
+    // The base's weight k(mu) on one side (see the top).
+    float BaseKeep(float mu) const;
     // The specular layer's Fresnel term s F for a microfacet seen at cos_om from one side.
     float LayerFresnel(float cos_om, bool outside) const;
     // IOR on the far side of the interface over the IOR on wo's side.
     float RelativeEta(const Vec3& wo) const { return wo.z > 0 ? ior_ : 1 / ior_; }
 
+    // The conductor's and the specular layer's Fresnel terms together.
+    Rgb ReflectionFresnel(float cos_om, bool outside) const;
     // Lobes, for directions already mirrored to wo.z > 0 (reflection, thin transmission).
     Rgb ReflectionEval(const Vec3& wo, const Vec3& wi, bool outside) const;
     float ReflectionPdf(const Vec3& wo, const Vec3& wi) const;
@@ -77,6 +89,8 @@ class PrincipledBsdf {
     float RefractionPdf(const Vec3& wo, const Vec3& wi) const;
     // The microfacet normal of a refraction pair, on wo's side; empty for back-facing pairs.
     std::optional<Vec3> RefractionNormal(const Vec3& wo, const Vec3& wi) const;
+    // A smooth surface's delta reflection (uc < pick.reflect) or transmission (past the diffuse).
+    std::optional<BsdfSample> SampleSmooth(const Vec3& wo, float uc, const LobePick& pick) const;
 
     Rgb base_;
     float metallic_, specular_, transmission_, ior_, f0_;
@@ -84,7 +98,12 @@ class PrincipledBsdf {
     MicrofacetDistribution distribution_;
     const GgxAlbedo* albedo_;
     GgxAlbedo::Roughness albedo_roughness_;
-    float diffuse_scale_;  // (1 - metallic) (1 - transmission) / (pi (1 - s E_avg))
+    const FresnelMixAlbedo* mix_;  // for specular > 0
+    // alpha below MicrofacetDistribution::kMinAlpha: reflection and transmission are Dirac deltas,
+    // as glTF's roughness 0 is a perfect mirror. As a GGX lobe that narrow, a delta light seen
+    // through it by next-event estimation gave single samples 1e5 times the light's irradiance.
+    bool smooth_;
+    float diffuse_scale_;  // (1 - metallic) (1 - transmission) / pi
 };
 
 }  // namespace lf

@@ -13,7 +13,8 @@ namespace lf {
 struct Shading {
     SurfacePoint point;  // the hit: p, its error bound, the geometric normal n
     // Unit shading normal on the geometric normal's side; equals point.n on flat geometry.
-    // Bent, where needed, so that wo is on the same side of it as of the geometric normal.
+    // Bent, where needed, so that wo mirrored about it stays above the surface
+    // (ValidReflectionNormal), which also keeps wo on its side.
     Vec3 ns;
     Vec2 uv;
     SurfaceParams params;
@@ -39,6 +40,13 @@ struct Shading {
     // reflection just below a smooth mesh's facet near the terminator that clears it.
     bool SidesAgree(const Vec3& wo, const Vec3& wi, bool reflect) const;
 };
+
+// The shading normal ns (unit, interpolated or normal-mapped) adjusted so that wo mirrored
+// about it stays above the geometric surface (n, either side; wo unit, away from the surface),
+// as Cycles' ensure_valid_reflection does: a bent normal must not make a reflection vanish.
+// Where the mirror direction falls below min(0.01, 0.9 wo.n) the normal becomes the half vector
+// of wo and that direction raised to it, keeping its azimuth; else ns unchanged.
+Vec3 ValidReflectionNormal(const Vec3& ns, const Vec3& n, const Vec3& wo);
 
 // The interaction at `hit` seen from direction wo (unit, away from the surface).
 Shading Shade(const EmbreeScene& scene, const SurfaceHit& hit, const Vec3& wo);
