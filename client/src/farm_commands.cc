@@ -34,6 +34,10 @@ namespace pb = lightfarm::v1;
 
 namespace {
 
+// How much of a worker's identity `workers`, `tasks` and `logs` show: the same in each, so that
+// one table's worker is found in the other.
+constexpr size_t kWorkerIdShown = 64;
+
 void AddJsonFlag(CLI::App* cmd, bool& json) {
     cmd->add_flag("--json", json,
                   "one JSON object a line instead of the table: the wire message's fields "
@@ -339,8 +343,9 @@ Command AddWorkersCommand(CLI::App& app) {
     auto flags = std::make_shared<FarmFlags>();
     CLI::App* cmd = app.add_subcommand(
         "workers",
-        "List the workers the server heard from within a lease: name, address, version, state,\n"
-        "task and seconds since each was last heard from.");
+        "List the workers the server heard from within a lease: worker (the identity `tasks` and\n"
+        "`logs` show), name (its --name, by default its host's), address, version, state, task\n"
+        "and seconds since each was last heard from.");
     auto json = std::make_shared<bool>(false);
     AddJsonFlag(cmd, *json);
     AddServerOption(cmd, *flags);
@@ -354,14 +359,16 @@ Command AddWorkersCommand(CLI::App& app) {
                     for (const pb::WorkerInfo& w : resp.workers()) PrintJson(w);
                     return 0;
                 }
-                std::printf("%-20s %-24s %-30s %-5s %-22s %s\n", "NAME", "ADDRESS", "VERSION",
-                            "STATE", "TASK", "LAST-HEARTBEAT");
+                std::printf("%-28s %-20s %-24s %-30s %-5s %-22s %s\n", "WORKER", "NAME", "ADDRESS",
+                            "VERSION", "STATE", "TASK", "LAST-HEARTBEAT");
                 for (const pb::WorkerInfo& w : resp.workers()) {
                     const bool busy = w.state() == pb::WorkerInfo::BUSY;
-                    // Names and versions come from the workers: escaped, so none can move the
-                    // terminal.
-                    std::printf("%-20s %-24s %-30s %-5s %-22s %.1f s ago\n",
-                                LogSafe(w.name().empty() ? w.id() : w.name(), 64).c_str(),
+                    // Ids, names and versions come from the workers: escaped, so none can move
+                    // the terminal. The id first, as `tasks` names the worker: two workers of
+                    // one host share their name.
+                    std::printf("%-28s %-20s %-24s %-30s %-5s %-22s %.1f s ago\n",
+                                LogSafe(w.id(), kWorkerIdShown).c_str(),
+                                w.name().empty() ? "-" : LogSafe(w.name(), 64).c_str(),
                                 LogSafe(w.address(), 64).c_str(), LogSafe(w.version(), 64).c_str(),
                                 busy ? "busy" : "idle",
                                 busy ? absl::StrCat(w.job_id(), "/", w.task_index()).c_str() : "-",
@@ -387,7 +394,8 @@ void PrintLogLine(const pb::TaskLogLine& line) {
     const std::string time = absl::FormatTime(
         "%Y-%m-%d %H:%M:%E3S", absl::FromUnixMillis(line.unix_ms()), absl::LocalTimeZone());
     std::printf("%s task %d #%d %s %-8s %s\n", time.c_str(), line.task_index(), line.attempt(),
-                LogSafe(line.worker(), 64).c_str(), line.level().c_str(), line.text().c_str());
+                LogSafe(line.worker(), kWorkerIdShown).c_str(), line.level().c_str(),
+                line.text().c_str());
 }
 
 }  // namespace
@@ -415,7 +423,7 @@ Command AddTasksCommand(CLI::App& app) {
                 for (const pb::TaskInfo& t : resp.tasks()) PrintJson(t);
                 return 0;
             }
-            std::printf("%5s %-8s %-15s %-17s %8s %-20s %9s  %s\n", "TASK", "STATE", "KIND",
+            std::printf("%5s %-8s %-15s %-17s %8s %-28s %9s  %s\n", "TASK", "STATE", "KIND",
                         "PIXELS", "ATTEMPTS", "WORKER", "DURATION", "LAST-ERROR");
             for (const pb::TaskInfo& t : resp.tasks()) {
                 const std::string pixels =
@@ -423,10 +431,10 @@ Command AddTasksCommand(CLI::App& app) {
                                   : "-";
                 const std::string duration =
                     t.leased_unix_ms() > 0 ? absl::StrFormat("%.2f s", t.seconds()) : "-";
-                std::printf("%5d %-8s %-15s %-17s %8d %-20s %9s  %s\n", t.index(),
+                std::printf("%5d %-8s %-15s %-17s %8d %-28s %9s  %s\n", t.index(),
                             TaskStateName(t.state()).c_str(), TaskKindName(t.kind()).c_str(),
                             pixels.c_str(), t.attempts(),
-                            t.worker().empty() ? "-" : LogSafe(t.worker(), 20).c_str(),
+                            t.worker().empty() ? "-" : LogSafe(t.worker(), kWorkerIdShown).c_str(),
                             duration.c_str(), LogSafe(t.last_error(), 200).c_str());
             }
             return 0;

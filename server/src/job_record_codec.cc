@@ -7,9 +7,9 @@
 
 namespace lf {
 
-std::string EncodeJobRecord(const JobRecord& record) {
-    lightfarm::v1::StoredJob stored;
-    ToProto(record, &stored);
+namespace {
+
+std::string ToJson(const google::protobuf::Message& stored) {
     google::protobuf::util::JsonPrintOptions options;
     // Every field, also those at their zero value, by the names the store's queries use.
     options.always_print_primitive_fields = true;
@@ -18,6 +18,31 @@ std::string EncodeJobRecord(const JobRecord& record) {
     // Printing a message without Any fields cannot fail.
     (void)google::protobuf::util::MessageToJsonString(stored, &text, options);
     return text;
+}
+
+}  // namespace
+
+std::string EncodeJobRecord(const JobRecord& record) {
+    lightfarm::v1::StoredJob stored;
+    ToProto(record, &stored);
+    return ToJson(stored);
+}
+
+std::string EncodeTaskHistory(const TaskHistory& history) {
+    lightfarm::v1::StoredTaskHistory stored;
+    ToProto(history, &stored);
+    return ToJson(stored);
+}
+
+absl::StatusOr<TaskHistory> DecodeTaskHistory(std::string_view text) {
+    if (text.empty()) return TaskHistory{};
+    lightfarm::v1::StoredTaskHistory stored;
+    if (const auto parsed = google::protobuf::util::JsonStringToMessage(text, &stored);
+        !parsed.ok()) {
+        return absl::DataLossError(
+            absl::StrCat("the stored task history is unreadable: ", parsed.message().as_string()));
+    }
+    return FromProto(stored);
 }
 
 absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view text) {

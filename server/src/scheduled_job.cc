@@ -49,6 +49,25 @@ void ScheduledJob::Sync() {
     record.tasks_running = IsFinal(record.state) ? 0 : states.running();
 }
 
+std::string ScheduledJob::WorkerOf(int t, const LeaseTable& leases) const {
+    std::string worker = leases.LastHolder(record.id, t);
+    return worker.empty() ? tasks[size_t(t)].recorded_worker : worker;
+}
+
+TaskHistory ScheduledJob::History(int t, const LeaseTable& leases) const {
+    const Task& task = tasks[size_t(t)];
+    return {task.attempts, task.failures, WorkerOf(t, leases), task.leased_at, task.finished};
+}
+
+void ScheduledJob::Restore(int t, const TaskHistory& history) {
+    Task& task = tasks[size_t(t)];
+    task.attempts = history.attempts;
+    task.failures = history.failures;
+    task.recorded_worker = history.worker;
+    task.leased_at = history.leased;
+    task.finished = history.finished;
+}
+
 std::vector<TaskStatus> ScheduledJob::Statuses(const LeaseTable& leases, absl::Time now) const {
     std::vector<TaskStatus> statuses(tasks.size());
     for (int t = 0; t < int(tasks.size()); ++t) {
@@ -77,7 +96,7 @@ std::vector<TaskStatus> ScheduledJob::Statuses(const LeaseTable& leases, absl::T
         status.failures = task.failures;
         status.last_error = task.last_error;
         if (task.attempts == 0) continue;  // never leased: no holder, no times
-        status.worker = leases.LastHolder(record.id, t);
+        status.worker = WorkerOf(t, leases);
         status.leased = task.leased_at;
         status.finished = task.finished;
         if (status.state == TaskStatus::State::kDone) {

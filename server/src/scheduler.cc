@@ -215,7 +215,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     // The store is read before the lock is taken.
     struct Stored {
         JobRecord record;
-        std::map<int, std::string> results;
+        std::map<int, JobStore::RecordedTask> results;
     };
     std::vector<Stored> stored;
     uint64_t last_seq = 0;
@@ -225,7 +225,8 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     for (JobRecord& record : *recorded) {
         last_seq = std::max(last_seq, record.seq);
         if (IsFinal(record.state)) continue;
-        absl::StatusOr<std::map<int, std::string>> results = store_.TaskResults(record.id);
+        absl::StatusOr<std::map<int, JobStore::RecordedTask>> results =
+            store_.TaskResults(record.id);
         if (!results.ok()) return results.status();
         stored.push_back({std::move(record), std::move(*results)});
     }
@@ -240,16 +241,17 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
         std::unique_ptr<Job> job = std::move(*made);
         // In index order, an adaptive plan appends each pass before its result comes up: the
         // passes it planned depend only on the results before them.
-        for (const auto& [t, bytes] : s.results) {
+        for (const auto& [t, recorded] : s.results) {
             // The store wrote what merged before, so this cannot fail unless the file was
             // damaged; the task is then simply rendered again.
-            if (!job->execution->MergeRecorded(t, bytes).ok()) {
+            if (!job->execution->MergeRecorded(t, recorded.result).ok()) {
                 Log()->warn("job={} task={}: the recorded result is unusable, rendering it again",
                             job->id(), t);
                 continue;
             }
             job->Move(t, TaskState::kDone);
             job->Queue({});
+            job->Restore(t, recorded.history);
         }
         job->Queue(job->execution->Start());
         job->Sync();
@@ -447,7 +449,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     }
     job.Sync();
     // The record holds what the execution needs to merge the result again after a restart.
-    const uint64_t ticket = store_.QueueTaskDone(job.record, t, *record);
+    const uint64_t ticket = store_.QueueTaskDone(job.record, t, *record, job.History(t, leases_));
     ++version_;
     changed_.notify_all();
     Log()->debug("job={} task={} done by {} ({}/{})", job.id(), t, LogSafe(worker),

@@ -33,8 +33,9 @@ absl::StatusOr<JobRecord> DecodeLegacy(std::string_view id, std::string_view rec
 
 // Schema versions (PRAGMA user_version): 0, records only, states by enum position, request ids
 // found inside the JSON; 1, the columns List and FindRequest select on, states by name; 2,
-// records in the StoredJob form (lf/server/job_record_codec.h), those before in the legacy form.
-constexpr int kSchemaVersion = 2;
+// records in the StoredJob form (lf/server/job_record_codec.h), those before in the legacy form;
+// 3, task_results' history column (EncodeTaskHistory; '' for results recorded before).
+constexpr int kSchemaVersion = 3;
 
 }  // namespace
 
@@ -75,7 +76,7 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
                  "  seq INTEGER NOT NULL, final INTEGER NOT NULL, record TEXT NOT NULL,"
                  "  request_id TEXT NOT NULL DEFAULT '', finished INTEGER);"
                  "CREATE TABLE IF NOT EXISTS task_results (job TEXT NOT NULL,"
-                 "  task INTEGER NOT NULL, sums BLOB NOT NULL,"
+                 "  task INTEGER NOT NULL, sums BLOB NOT NULL, history TEXT NOT NULL DEFAULT '',"
                  "  PRIMARY KEY (job, task));"
                  "CREATE UNIQUE INDEX IF NOT EXISTS jobs_by_request_id ON jobs (request_id)"
                  "  WHERE request_id != '';"
@@ -125,10 +126,12 @@ SqliteJobStore::Write SqliteJobStore::PutOf(const JobRecord& job) {
 
 uint64_t SqliteJobStore::QueuePut(const JobRecord& job) { return Queue(PutOf(job)); }
 
-uint64_t SqliteJobStore::QueueTaskDone(const JobRecord& job, int task, std::string result) {
+uint64_t SqliteJobStore::QueueTaskDone(const JobRecord& job, int task, std::string result,
+                                       const TaskHistory& history) {
     Write w = PutOf(job);
     w.task = task;
     w.result = std::move(result);
+    w.history = EncodeTaskHistory(history);
     return Queue(std::move(w));
 }
 
@@ -202,9 +205,11 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
             continue;
         }
         if (w.task >= 0) {
-            Statement put(
-                db_, "INSERT OR REPLACE INTO task_results (job, task, sums) VALUES (?1, ?2, ?3)");
-            put.Bind(1, w.job_id).Bind(2, int64_t(w.task)).BindBlob(3, w.result).Step();
+            Statement put(db_,
+                          "INSERT OR REPLACE INTO task_results (job, task, sums, history)"
+                          " VALUES (?1, ?2, ?3, ?4)");
+            put.Bind(1, w.job_id).Bind(2, int64_t(w.task)).BindBlob(3, w.result);
+            put.Bind(4, w.history).Step();
             status = put.status();
         }
         if (!status.ok() || newest[w.job_id] != i) continue;
@@ -231,18 +236,29 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
 
 absl::Status SqliteJobStore::Migrate(sqlite3* db, int64_t version) {
     // Version 0 to 1: the columns, filled from the records. Either to 2: the records rewritten
-    // in the StoredJob form. In one transaction, so that a failure leaves the old version to try
-    // again.
+    // in the StoredJob form. Any to 3: task_results gains its history column (when an earlier
+    // version made the table). In one transaction, so that a failure leaves the old version to
+    // try again.
     if (absl::Status s = Exec(db, "BEGIN IMMEDIATE"); !s.ok()) return s;
     absl::Status status;
-    if (version == 0) {
+    bool has_results = false;
+    {
+        Statement results(
+            db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'task_results'");
+        has_results = results.Step();
+        status = results.status();
+    }
+    if (status.ok() && has_results) {
+        status = Exec(db, "ALTER TABLE task_results ADD COLUMN history TEXT NOT NULL DEFAULT ''");
+    }
+    if (status.ok() && version == 0) {
         status = Exec(db,
                       "DROP INDEX IF EXISTS jobs_by_request;"
                       "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';"
                       "ALTER TABLE jobs ADD COLUMN finished INTEGER;");
     }
     std::vector<Write> rewrites;
-    if (status.ok()) {
+    if (status.ok() && version < 2) {
         Statement all(db, "SELECT id, record FROM jobs");
         while (status.ok() && all.Step()) {
             absl::StatusOr<JobRecord> job = DecodeLegacy(all.Column(0), all.Column(1));
@@ -265,8 +281,8 @@ absl::Status SqliteJobStore::Migrate(sqlite3* db, int64_t version) {
         return absl::Status(status.code(),
                             absl::StrCat("upgrading the job store: ", status.message()));
     }
-    NamedLogger("store")->info("job store upgraded to version {}: {}", kSchemaVersion,
-                               Plural(int64_t(rewrites.size()), "job"));
+    NamedLogger("store")->info("job store upgraded from version {} to {}: {} rewritten", version,
+                               kSchemaVersion, Plural(int64_t(rewrites.size()), "job"));
     return absl::OkStatus();
 }
 
@@ -355,13 +371,26 @@ absl::StatusOr<std::optional<std::string>> SqliteJobStore::FindRequest(
     return std::nullopt;
 }
 
-absl::StatusOr<std::map<int, std::string>> SqliteJobStore::TaskResults(
+absl::StatusOr<std::map<int, JobStore::RecordedTask>> SqliteJobStore::TaskResults(
     const std::string& id) const {
     std::lock_guard<std::mutex> lock(read_mutex_);
-    std::map<int, std::string> results;
-    Statement get(read_db_, "SELECT task, sums FROM task_results WHERE job = ?1");
+    std::map<int, RecordedTask> results;
+    Statement get(read_db_, "SELECT task, sums, history FROM task_results WHERE job = ?1");
     get.Bind(1, id);
-    while (get.Step()) results[int(get.ColumnInt(0))] = std::string(get.Column(1));
+    while (get.Step()) {
+        const int task = int(get.ColumnInt(0));
+        RecordedTask& recorded = results[task];
+        recorded.result = std::string(get.Column(1));
+        // The history is only shown (`lightfarm tasks`): a damaged one costs the display, not
+        // the result.
+        absl::StatusOr<TaskHistory> history = DecodeTaskHistory(get.Column(2));
+        if (history.ok()) {
+            recorded.history = std::move(*history);
+        } else {
+            NamedLogger("store")->warn("job={} task={}: {}", id, task,
+                                       std::string(history.status().message()));
+        }
+    }
     if (!get.status().ok()) return get.status();
     return results;
 }

@@ -1,4 +1,5 @@
-// Workers heard from within a lease: name, version, state, current task, last heartbeat.
+// Workers heard from within a lease: id (as a job's tasks and logs name the worker), name (its
+// --name, by default its host's), version, state, current task, last heartbeat.
 import { get } from './api.js';
 import { h, table } from './format.js';
 
@@ -15,10 +16,11 @@ export function mount(root) {
         return h('a', { href: `#/job/${encodeURIComponent(w.job_id)}` }, `${w.job_id} task ${w.task}`);
       };
       const rows = workers.map((w) => h('tr', { class: 'worker' },
-        h('td', {}, w.name), h('td', {}, w.version), h('td', { class: 'state' }, w.state),
+        h('td', {}, w.id), h('td', {}, w.name), h('td', {}, w.version),
+        h('td', { class: 'state' }, w.state),
         h('td', {}, task(w)), h('td', {}, `${(w.since_seen_ms / 1000).toFixed(1)} s ago`)));
       body.replaceChildren(workers.length === 0 ? h('p', {}, 'No live workers.')
-        : table(['Name', 'Version', 'State', 'Task', 'Last heard'], rows));
+        : table(['Worker', 'Name', 'Version', 'State', 'Task', 'Last heard'], rows));
     },
   };
 }

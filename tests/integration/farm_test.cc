@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -436,6 +437,52 @@ std::vector<nlohmann::json> JsonLines(const std::string& out) {
         objects.push_back(nlohmann::json::parse(line));
     }
     return objects;
+}
+
+// The first column of each line of a table after its header.
+std::vector<std::string> FirstColumn(const std::string& table) {
+    std::vector<std::string> column;
+    std::istringstream lines(table);
+    std::string line;
+    std::getline(lines, line);
+    while (std::getline(lines, line)) column.push_back(line.substr(0, line.find(' ')));
+    return column;
+}
+
+// Issue 27: two workers on one host both showed as the host name in `workers`, while `tasks`
+// named them by id. Both tables name a worker by the one identity the server knows it by.
+TEST_F(Farm, WorkersAndTasksNameTwoWorkersOfOneHostAlike) {
+    StartServer();
+    StartWorker("w1");  // no --name: both are named after this host
+    StartWorker("w2");
+    const std::string job = Submit(scene_, "--spp 2 --tile 16");
+    ASSERT_EQ(Farmctl("watch " + job).status, 0);
+    std::vector<nlohmann::json> listed;
+    for (int i = 0; i < 500 && listed.size() < 2; ++i) {
+        listed = JsonLines(Farmctl("workers --json").out);
+        std::this_thread::sleep_for(milliseconds(20));
+    }
+    ASSERT_EQ(listed.size(), 2u);
+    EXPECT_EQ(listed[0]["name"], listed[1]["name"]);
+    EXPECT_NE(listed[0]["id"], listed[1]["id"]);
+
+    const CliRun workers = Farmctl("workers");
+    ASSERT_EQ(workers.status, 0) << workers.err;
+    std::vector<std::string> shown = FirstColumn(workers.out);
+    std::sort(shown.begin(), shown.end());
+    std::vector<std::string> ids = {listed[0]["id"], listed[1]["id"]};
+    std::sort(ids.begin(), ids.end());
+    EXPECT_EQ(shown, ids) << workers.out;
+
+    const CliRun table = Farmctl("tasks " + job);
+    ASSERT_EQ(table.status, 0) << table.err;
+    const std::vector<nlohmann::json> tasks = JsonLines(Farmctl("tasks --json " + job).out);
+    ASSERT_FALSE(tasks.empty());
+    for (const nlohmann::json& task : tasks) {
+        const std::string worker = task["worker"];
+        EXPECT_NE(std::find(ids.begin(), ids.end(), worker), ids.end()) << worker;
+        EXPECT_NE(table.out.find(" " + worker + " "), std::string::npos) << table.out;
+    }
 }
 
 // `lightfarm logs` prints what the worker logged during each task, one task's with --task, as

@@ -102,4 +102,22 @@ absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
     return job;
 }
 
+void ToProto(const TaskHistory& history, pb::StoredTaskHistory* out) {
+    out->set_attempts(history.attempts);
+    out->set_failures(history.failures);
+    out->set_worker(history.worker);
+    if (auto us = UnixMicros(history.leased)) out->set_leased_unix_us(*us);
+    if (auto us = UnixMicros(history.finished)) out->set_finished_unix_us(*us);
+}
+
+TaskHistory FromProto(const pb::StoredTaskHistory& s) {
+    TaskHistory history;
+    history.attempts = s.attempts();
+    history.failures = s.failures();
+    history.worker = s.worker();
+    if (s.has_leased_unix_us()) history.leased = absl::FromUnixMicros(s.leased_unix_us());
+    if (s.has_finished_unix_us()) history.finished = absl::FromUnixMicros(s.finished_unix_us());
+    return history;
+}
+
 }  // namespace lf

@@ -1,8 +1,8 @@
 // The JobStore contract, which every store satisfies (in memory and SQLite alike): pages newest
 // first, the retention query, request ids unique, deletes; and the stored record format, which
 // belongs to the interface: states by name, the integer states of old records (the first form,
-// legacy_job_records.h) still read, an unknown name a clear error. Then what only SQLite has: a
-// database of the first schema is upgraded in place.
+// legacy_job_records.h) still read, an unknown name a clear error. Then what only SQLite has:
+// databases of the first and the second schema are upgraded in place.
 #include "lf/server/job_store.h"
 
 #include <gtest/gtest.h>
@@ -120,7 +120,7 @@ TYPED_TEST(JobStoreContract, RequestIdsAreUnique) {
 
 TYPED_TEST(JobStoreContract, DeleteRemovesTheRecordAndTaskResults) {
     ASSERT_TRUE(
-        this->store_->WaitDurable(this->store_->QueueTaskDone(Record("a", 1), 0, "sums")).ok());
+        this->store_->WaitDurable(this->store_->QueueTaskDone(Record("a", 1), 0, "sums", {})).ok());
     ASSERT_TRUE(this->store_->Put(Record("b", 2)).ok());
     ASSERT_TRUE(this->store_->Delete("a").ok());
     EXPECT_EQ(this->store_->Get("a").status().code(), absl::StatusCode::kNotFound);
@@ -309,6 +309,67 @@ TEST(SqliteJobStoreUpgrade, FirstSchemaDatabaseIsUpgradedAndReadsAsBefore) {
     sqlite3_finalize(stmt);
     sqlite3_close(db);
     EXPECT_TRUE(SqliteJobStore::Open((dir / "jobs.db").string()).ok());
+    fs::remove_all(dir);
+}
+
+// A database as version 2 of the store left it: task results without their history.
+void WriteVersion2Database(const fs::path& path, const JobRecord& job) {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+    const std::string sql = absl::StrCat(
+        "CREATE TABLE jobs (id TEXT PRIMARY KEY,"
+        "  seq INTEGER NOT NULL, final INTEGER NOT NULL, record TEXT NOT NULL,"
+        "  request_id TEXT NOT NULL DEFAULT '', finished INTEGER);"
+        "CREATE TABLE task_results (job TEXT NOT NULL,"
+        "  task INTEGER NOT NULL, sums BLOB NOT NULL,"
+        "  PRIMARY KEY (job, task));"
+        "CREATE UNIQUE INDEX jobs_by_request_id ON jobs (request_id) WHERE request_id != '';"
+        "CREATE INDEX jobs_by_seq ON jobs (seq);"
+        "CREATE INDEX ended_jobs ON jobs (finished) WHERE final = 1;"
+        "INSERT INTO jobs (id, seq, final, record) VALUES ('",
+        job.id, "', ", job.seq, ", 0, '", EncodeJobRecord(job),
+        "');"
+        "INSERT INTO task_results VALUES ('",
+        job.id, "', 0, 'sums');PRAGMA user_version = 2;");
+    ASSERT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK)
+        << sqlite3_errmsg(db);
+    sqlite3_close(db);
+}
+
+TEST(SqliteJobStoreUpgrade, SecondSchemaDatabaseKeepsItsResultsAndRecordsTaskHistories) {
+    const fs::path dir = TestDir();
+    const fs::path path = dir / "jobs.db";
+    WriteVersion2Database(path, Record("running", 1));
+    const TaskHistory history{2, 1, "node1/host-12", absl::FromUnixSeconds(10),
+                              absl::FromUnixSeconds(13)};
+    {
+        absl::StatusOr<std::unique_ptr<SqliteJobStore>> store = SqliteJobStore::Open(path.string());
+        ASSERT_TRUE(store.ok()) << store.status();
+        absl::StatusOr<std::map<int, JobStore::RecordedTask>> results =
+            (*store)->TaskResults("running");
+        ASSERT_TRUE(results.ok()) << results.status();
+        ASSERT_EQ(results->size(), 1u);
+        EXPECT_EQ(results->at(0).result, "sums");
+        EXPECT_EQ(results->at(0).history.attempts, 0) << "recorded before histories were";
+        EXPECT_EQ(results->at(0).history.worker, "");
+        ASSERT_TRUE((*store)
+                        ->WaitDurable(
+                            (*store)->QueueTaskDone(*(*store)->Get("running"), 1, "more", history))
+                        .ok());
+    }
+    absl::StatusOr<std::unique_ptr<SqliteJobStore>> store = SqliteJobStore::Open(path.string());
+    ASSERT_TRUE(store.ok()) << store.status();
+    absl::StatusOr<std::map<int, JobStore::RecordedTask>> results =
+        (*store)->TaskResults("running");
+    ASSERT_TRUE(results.ok()) << results.status();
+    ASSERT_EQ(results->size(), 2u);
+    EXPECT_EQ(results->at(0).result, "sums");
+    const TaskHistory& back = results->at(1).history;
+    EXPECT_EQ(back.attempts, 2);
+    EXPECT_EQ(back.failures, 1);
+    EXPECT_EQ(back.worker, "node1/host-12");
+    EXPECT_EQ(back.leased, history.leased);
+    EXPECT_EQ(back.finished, history.finished);
     fs::remove_all(dir);
 }
 

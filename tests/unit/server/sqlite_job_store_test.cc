@@ -157,6 +157,60 @@ TEST_F(SqliteJobStoreTest, RestartKeepsDoneTasksAndQueuesTheRest) {
     EXPECT_NE(newest, id);
 }
 
+// Issue 27: a restart showed the tasks done before it with 0 attempts, no worker and no duration.
+TEST_F(SqliteJobStoreTest, RestartKeepsTheDoneTasksAttemptsWorkerAndDuration) {
+    absl::Time now = absl::FromUnixSeconds(1'000'000);
+    const Scheduler::Clock clock = [&now] { return now; };
+    std::string id;
+    std::vector<TaskStatus> before_restart;
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        Scheduler before({}, *store, clock);
+        id = *before.Submit(Spec());
+        // One task fails on the first worker, and is done by the second.
+        std::optional<TaskAssignment> failed = before.LeaseTask("node1/host-11");
+        ASSERT_TRUE(failed);
+        now += absl::Seconds(1);
+        ASSERT_TRUE(
+            before.Fail(failed->lease_id, "node1/host-11", "flaky", FailureKind::kTaskError).ok());
+        for (int i = 0; i < 4; ++i) {
+            std::optional<TaskAssignment> lease = before.LeaseTask("node1/host-12");
+            ASSERT_TRUE(lease);
+            now += absl::Seconds(2 + i);
+            ASSERT_TRUE(before.Complete(lease->lease_id, "node1/host-12", Result(*lease)).ok());
+        }
+        before_restart = *before.Tasks(id);
+    }
+    int done = 0, retried = 0;
+    for (const TaskStatus& task : before_restart) {
+        if (task.state != TaskStatus::State::kDone) continue;
+        ++done;
+        retried += task.attempts == 2;
+    }
+    ASSERT_EQ(done, 4);
+
+    std::unique_ptr<SqliteJobStore> store = OpenStore();
+    now += absl::Minutes(1);
+    Scheduler after({}, *store, clock);
+    ASSERT_TRUE(after.Recover().ok());
+    const std::vector<TaskStatus> tasks = *after.Tasks(id);
+    ASSERT_EQ(tasks.size(), before_restart.size());
+    for (const TaskStatus& was : before_restart) {
+        if (was.state != TaskStatus::State::kDone) continue;
+        SCOPED_TRACE(was.index);
+        const TaskStatus& is = tasks[size_t(was.index)];
+        EXPECT_EQ(is.state, TaskStatus::State::kDone);
+        EXPECT_EQ(is.attempts, was.attempts);
+        EXPECT_EQ(is.failures, was.failures);
+        EXPECT_EQ(is.worker, "node1/host-12");
+        EXPECT_EQ(is.leased, was.leased);
+        EXPECT_EQ(is.finished, was.finished);
+        EXPECT_GE(is.duration, absl::Seconds(2));
+        EXPECT_EQ(is.duration, was.duration);
+    }
+    EXPECT_EQ(retried, 1) << "the failed task's second lease is counted";
+}
+
 TEST_F(SqliteJobStoreTest, JobRenderedButNotWrittenIsHandedBackAfterARestart) {
     std::string id;
     {
@@ -203,7 +257,7 @@ class FailingStore : public InMemoryJobStore {
     uint64_t QueuePut(const JobRecord& job) override {
         return fail ? kFailed : InMemoryJobStore::QueuePut(job);
     }
-    uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) override {
+    uint64_t QueueTaskDone(const JobRecord& job, int, std::string, const TaskHistory&) override {
         return QueuePut(job);
     }
     absl::Status WaitDurable(uint64_t ticket) override {

@@ -32,4 +32,14 @@ struct JobRecord {
     std::string result_path;  // the EXR, once succeeded
 };
 
+// What a done task's leases left behind, recorded with its result so that `lightfarm tasks`
+// still shows it after the coordinator restarts.
+struct TaskHistory {
+    int attempts = 0;                          // leases handed out
+    int failures = 0;                          // counted failures
+    std::string worker;                        // the holder of its last lease (TaskStatus::worker)
+    absl::Time leased = absl::InfinitePast();  // when it last left the queue
+    absl::Time finished = absl::InfinitePast();  // its result merged
+};
+
 }  // namespace lf

@@ -17,4 +17,9 @@ std::string EncodeJobRecord(const JobRecord& record);
 // DataLoss, naming the field, for a record that does not parse or names an unknown state.
 absl::StatusOr<JobRecord> DecodeJobRecord(std::string_view stored);
 
+// A done task's history (lightfarm.v1.StoredTaskHistory), in the same JSON form.
+std::string EncodeTaskHistory(const TaskHistory& history);
+// DataLoss for one that does not parse; "" (a result recorded before histories were) is none.
+absl::StatusOr<TaskHistory> DecodeTaskHistory(std::string_view stored);
+
 }  // namespace lf

@@ -36,9 +36,10 @@ class JobStore {
     // their locks. Each returns a ticket for WaitDurable. A record whose request id another
     // job holds is refused (AlreadyExists from WaitDurable).
     virtual uint64_t QueuePut(const JobRecord& job) = 0;  // insert or replace, by id
-    // The job's record together with the encoded TileSums of its task `task`, in one write. A
-    // record in a final state drops the job's task results.
-    virtual uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) = 0;
+    // The job's record together with the encoded TileSums of its task `task` and the task's
+    // history, in one write. A record in a final state drops the job's task results.
+    virtual uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result,
+                                   const TaskHistory& history) = 0;
     // Removes the job's record and task results; nothing to remove is not an error.
     virtual uint64_t QueueDelete(const std::string& id) = 0;
     // Blocks until the write of `ticket`, and every one before it, is durable; or its error.
@@ -52,8 +53,13 @@ class JobStore {
     // The job submitted with this client request id, if any.
     virtual absl::StatusOr<std::optional<std::string>> FindRequest(
         const std::string& request_id) const = 0;
-    // The results QueueTaskDone recorded for a job that has not ended, by task index.
-    virtual absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const = 0;
+    // What QueueTaskDone recorded for a job that has not ended, by task index.
+    struct RecordedTask {
+        std::string result;
+        TaskHistory history;  // empty for a result recorded before histories were
+    };
+    virtual absl::StatusOr<std::map<int, RecordedTask>> TaskResults(
+        const std::string& id) const = 0;
 };
 
 // Nothing outlives the process, so there is nothing to recover: task results are not kept, and
@@ -61,7 +67,7 @@ class JobStore {
 class InMemoryJobStore : public JobStore {
   public:
     uint64_t QueuePut(const JobRecord& job) override;
-    uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) override {
+    uint64_t QueueTaskDone(const JobRecord& job, int, std::string, const TaskHistory&) override {
         return QueuePut(job);
     }
     uint64_t QueueDelete(const std::string& id) override;
@@ -70,8 +76,8 @@ class InMemoryJobStore : public JobStore {
     absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const override;
     absl::StatusOr<std::optional<std::string>> FindRequest(
         const std::string& request_id) const override;
-    absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const override {
-        return std::map<int, std::string>{};
+    absl::StatusOr<std::map<int, RecordedTask>> TaskResults(const std::string&) const override {
+        return std::map<int, RecordedTask>{};
     }
 
   private:

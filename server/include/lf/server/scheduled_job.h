@@ -30,6 +30,9 @@ struct ScheduledJob {
         absl::Time finished = absl::InfinitePast();  // its first result merged
         std::string last_error;                      // of its last counted failure
         std::set<std::string> failed_on;
+        // The holder of its last lease as recorded before a restart: the lease table, which
+        // knows the holders of this run's leases, starts empty.
+        std::string recorded_worker;
     };
 
     // The job with its tasks planned as its spec says (MakeJobExecution); InvalidArgument when
@@ -47,6 +50,9 @@ struct ScheduledJob {
     void Sync();
     // The job's tasks as Scheduler::Tasks reports them.
     std::vector<TaskStatus> Statuses(const LeaseTable& leases, absl::Time now) const;
+    // A done task's history, recorded with its result; Restore takes it back after a restart.
+    TaskHistory History(int task, const LeaseTable& leases) const;
+    void Restore(int task, const TaskHistory& history);
     const std::string& id() const { return record.id; }
 
     JobRecord record;
@@ -55,6 +61,10 @@ struct ScheduledJob {
     std::vector<Task> tasks;     // by index, as many as `states`
     uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
     SpeculationPolicy speculation{absl::ZeroDuration()};
+
+  private:
+    // The holder of the task's last lease, of this run or recorded before.
+    std::string WorkerOf(int task, const LeaseTable& leases) const;
 };
 
 }  // namespace lf

@@ -29,14 +29,15 @@ class SqliteJobStore : public JobStore {
     ~SqliteJobStore() override;  // commits what is queued
 
     uint64_t QueuePut(const JobRecord& job) override;
-    uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result) override;
+    uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result,
+                           const TaskHistory& history) override;
     uint64_t QueueDelete(const std::string& id) override;
     absl::Status WaitDurable(uint64_t ticket) override;
     absl::StatusOr<JobRecord> Get(const std::string& id) const override;
     absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const override;
     absl::StatusOr<std::optional<std::string>> FindRequest(
         const std::string& request_id) const override;
-    absl::StatusOr<std::map<int, std::string>> TaskResults(const std::string& id) const override;
+    absl::StatusOr<std::map<int, RecordedTask>> TaskResults(const std::string& id) const override;
 
     // For /healthz: Ok while the database answers a read and the last commit succeeded.
     absl::Status Health() const;
@@ -57,6 +58,7 @@ class SqliteJobStore : public JobStore {
         std::string record = {};                  // EncodeJobRecord
         int task = -1;                            // with a task result when >= 0
         std::string result = {};
+        std::string history = {};  // EncodeTaskHistory, with the result
     };
     static Write PutOf(const JobRecord& job);
     // Brings a database of an earlier `version` to this one's schema (see Open).

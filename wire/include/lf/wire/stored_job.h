@@ -12,4 +12,7 @@ void ToProto(const JobRecord& job, lightfarm::v1::StoredJob* out);
 // InvalidArgument for a state no build names.
 absl::StatusOr<JobRecord> FromProto(const lightfarm::v1::StoredJob& stored);
 
+void ToProto(const TaskHistory& history, lightfarm::v1::StoredTaskHistory* out);
+TaskHistory FromProto(const lightfarm::v1::StoredTaskHistory& stored);
+
 }  // namespace lf
