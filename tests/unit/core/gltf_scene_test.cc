@@ -514,18 +514,12 @@ TEST_F(GltfSceneTest, AbsurdlyLargeImageIsRefusedNamingIt) {
     ExpectError(Load(testing::TexturedTestScene()), {"scene.gltf", "images[0] \"checker\""});
 }
 
-TEST_F(GltfSceneTest, RequiredUnsupportedExtensionsOrthographicAndMissingCamerasAreRefused) {
+TEST_F(GltfSceneTest, RequiredUnsupportedExtensionsAndMissingCamerasAreRefused) {
     GltfBuilder b = testing::TexturedTestScene();
     b.json()["extensionsRequired"] = {"KHR_lights_punctual", "KHR_draco_mesh_compression",
                                       "EXT_meshopt_compression"};
     ExpectError(Load(b), {"extensionsRequired",
                           "does not support KHR_draco_mesh_compression, EXT_meshopt_compression"});
-
-    GltfBuilder ortho = testing::TexturedTestScene();
-    ortho.json()["cameras"][0] = {
-        {"type", "orthographic"},
-        {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0}, {"zfar", 10}}}};
-    ExpectError(Load(ortho), {"cameras[0]", "orthographic", "perspective cameras only"});
 
     GltfBuilder none = testing::TexturedTestScene();
     none.json()["scenes"][0]["nodes"] = {2, 4};
@@ -594,6 +588,56 @@ TEST_F(GltfSceneTest, ALightFlattenedAlongItsAxisIsSkippedWithAWarning) {
     EXPECT_NE(CapturedLog().str().find("spot light under a transform that flattens its axis"),
               std::string::npos)
         << CapturedLog().str();
+}
+
+// glTF's orthographic camera: ymag is the film's half height, xmag / ymag its aspect; it looks
+// down its node's -Z like a perspective one.
+TEST_F(GltfSceneTest, OrthographicCamerasKeepTheirMagnificationAndAspect) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["cameras"][0] = {
+        {"type", "orthographic"},
+        {"orthographic", {{"xmag", 3}, {"ymag", 1.5}, {"znear", 0.01}, {"zfar", 10}}}};
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_EQ(scene->camera.projection, CameraSpec::Projection::kOrthographic);
+    EXPECT_DOUBLE_EQ(scene->camera.half_height, 1.5);
+    EXPECT_EQ(scene->camera.width, kGltfLongerSide);
+    EXPECT_EQ(scene->camera.height, kGltfLongerSide / 2);
+}
+
+// A file is refused for a camera only when that camera is the one rendered; unnamed cameras are
+// picked by their order.
+TEST_F(GltfSceneTest, ACameraThatIsNotRenderedNeverRefusesTheFile) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Json& j = b.json();
+    j["cameras"].push_back({{"type", "perspective"}, {"perspective", {{"yfov", 0}, {"znear", 1}}}});
+    j["cameras"].push_back(
+        {{"type", "orthographic"},
+         {"orthographic", {{"xmag", 0}, {"ymag", 1}, {"znear", 0}, {"zfar", 1}}}});
+    j["scenes"][0]["nodes"].push_back(b.AddNode({{"camera", 1}}));
+    j["scenes"][0]["nodes"].push_back(b.AddNode({{"camera", 2}}));
+    const absl::StatusOr<Scene> first = Load(b);
+    ASSERT_TRUE(first.ok()) << first.status();
+    EXPECT_EQ(first->camera.projection, CameraSpec::Projection::kPerspective);
+    ExpectError(Load(b, "scene.gltf", {.camera = "1"}), {"scene.gltf", "cameras[1]", "yfov 0"});
+    ExpectError(Load(b, "scene.gltf", {.camera = "2"}),
+                {"cameras[2]", "xmag 0 and ymag 1 must be non-zero"});
+    ExpectError(Load(b, "scene.gltf", {.camera = "3"}), {"no camera named \"3\"", "0 to 2"});
+}
+
+// Khronos' Cameras asset (tests/scenes/khronos/Cameras, CC0): one perspective and one
+// orthographic camera, both unnamed.
+TEST(GltfCamerasAsset, LoadsWithEitherCamera) {
+    const std::string path = std::string(LF_TEST_SCENES) + "/khronos/Cameras/Cameras.gltf";
+    const absl::StatusOr<Scene> perspective = LoadScene(path);
+    ASSERT_TRUE(perspective.ok()) << perspective.status();
+    EXPECT_EQ(perspective->camera.projection, CameraSpec::Projection::kPerspective);
+    EXPECT_NEAR(perspective->camera.fov_y_deg, 0.7 * 180 / std::numbers::pi, 1e-9);
+    const absl::StatusOr<Scene> ortho = LoadScene(path, {.camera = "1"});
+    ASSERT_TRUE(ortho.ok()) << ortho.status();
+    EXPECT_EQ(ortho->camera.projection, CameraSpec::Projection::kOrthographic);
+    EXPECT_DOUBLE_EQ(ortho->camera.half_height, 1);
+    ExpectNear(ortho->camera.position, Vec3d(0.5, 0.5, 3));
 }
 
 }  // namespace

@@ -186,10 +186,16 @@ struct PixelFilter {
 };
 
 struct CameraSpec {
+    // Perspective: rays leave `position` through a film of vertical angle fov_y_deg.
+    // Orthographic (glTF's xmag/ymag): parallel rays along the view axis from a film
+    // 2 half_height tall (scene units) centred on `position`, as wide as the image's aspect.
+    enum class Projection { kPerspective, kOrthographic };
+    Projection projection = Projection::kPerspective;
     Vec3d position{0, 0, 0};
     Vec3d look_at{0, 0, 1};
     Vec3d up{0, 1, 0};
     double fov_y_deg = 45;
+    double half_height = 1;  // orthographic only
     int width = 256;
     int height = 256;
     // Thin lens (distributed ray tracing): rays leave a disk of this radius around `position`,
