@@ -130,8 +130,8 @@ absl::StatusOr<CameraSpec> ChooseGltfCamera(const std::vector<GltfCamera>& camer
                                             const std::string& name) {
     if (cameras.empty()) {
         return absl::NotFoundError(
-            "no camera; add one to the glTF, or include the file from a JSON scene that gives "
-            "a camera");
+            "no camera; render with --camera auto (frames the whole scene), add one to the "
+            "glTF, or include the file from a JSON scene that gives a camera");
     }
     const auto usable = [](const GltfCamera& camera) -> absl::StatusOr<CameraSpec> {
         if (!camera.error.empty()) return absl::InvalidArgumentError(camera.error);

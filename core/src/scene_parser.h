@@ -61,7 +61,10 @@ class SceneParser {
     Scene Finish(Scene& scene);
     static bool IncludesGltf(const Node& root);
     // The JSON's camera unless --camera names a glTF one; the first glTF camera without either.
+    // `--camera auto`, or the scene's camera of that name.
     void ResolveCamera(const Node& root, bool json_camera, Scene& scene);
+    // `--camera auto` and no glTF camera of that name: FrameScene.
+    bool FramesTheScene() const;
 
     // Camera (scene_camera.cc).
     CameraSpec ParseCamera(const Node& n);

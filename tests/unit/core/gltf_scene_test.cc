@@ -640,5 +640,57 @@ TEST(GltfCamerasAsset, LoadsWithEitherCamera) {
     ExpectNear(ortho->camera.position, Vec3d(0.5, 0.5, 3));
 }
 
+// COLOR_0 as normalized unsigned bytes (VEC3, alpha 1) or floats (VEC4) becomes the mesh's
+// linear RGBA vertex colours.
+TEST_F(GltfSceneTest, VertexColoursAreImportedAsLinearRgba) {
+    GltfBuilder b = testing::TexturedTestScene();
+    const uint8_t bytes[9] = {255, 0, 0, 0, 51, 0, 0, 0, 255};
+    const int tri_colours = b.AddAccessor(bytes, sizeof bytes, 5121, "VEC3", 3);
+    b.json()["accessors"][size_t(tri_colours)]["normalized"] = true;
+    b.json()["meshes"][1]["primitives"][0]["attributes"]["COLOR_0"] = tri_colours;
+    b.json()["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = b.AddFloats<4>(
+        {{{1, 1, 1, 0.25f}}, {{0.5f, 0.5f, 0.5f, 1}}, {{0, 0, 0, 1}}, {{1, 0, 1, 0.5f}}});
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const TriangleMesh* quad = nullptr;
+    const TriangleMesh* tri = nullptr;
+    for (const TriangleMesh& m : scene->meshes) (m.name.starts_with("quad") ? quad : tri) = &m;
+    ASSERT_TRUE(quad && tri);
+    ASSERT_EQ(tri->colors.size(), 3u);
+    EXPECT_EQ(tri->colors[0], (std::array<float, 4>{1, 0, 0, 1}));
+    EXPECT_EQ(tri->colors[1], (std::array<float, 4>{0, 0.2f, 0, 1}));
+    ASSERT_EQ(quad->colors.size(), 4u);
+    EXPECT_EQ(quad->colors[3], (std::array<float, 4>{1, 0, 1, 0.5f}));
+
+    GltfBuilder bad = testing::TexturedTestScene();
+    bad.json()["meshes"][1]["primitives"][0]["attributes"]["COLOR_0"] =
+        bad.AddFloats<2>({{{1, 1}}, {{1, 1}}, {{1, 1}}});
+    ExpectError(Load(bad), {"COLOR_0", "2 components per element, expected 3 or 4"});
+}
+
+// Khronos' VertexColorTest (tests/scenes/khronos, CC-BY 4.0, Analytical Graphics): its test
+// row's checks carry red, green and blue vertex colours that zero the fail marks' channels.
+TEST(GltfVertexColorAsset, TheTestRowGetsItsVertexColours) {
+    const std::string path =
+        std::string(LF_TEST_SCENES) + "/khronos/VertexColorTest/VertexColorTest.gltf";
+    CapturedLog().str("");
+    const absl::StatusOr<Scene> scene = LoadScene(path, {.camera = "auto"});
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    size_t coloured = 0, pure[3] = {0, 0, 0};
+    for (const TriangleMesh& m : scene->meshes) {
+        if (m.colors.empty()) continue;
+        coloured += m.colors.size();
+        for (const auto& c : m.colors) {
+            for (int k = 0; k < 3; ++k) {
+                pure[k] +=
+                    c[size_t(k)] == 1 && c[size_t((k + 1) % 3)] == 0 && c[size_t((k + 2) % 3)] == 0;
+            }
+        }
+    }
+    EXPECT_GT(coloured, 0u);
+    for (const size_t n : pure) EXPECT_GT(n, 0u);
+    EXPECT_EQ(CapturedLog().str().find("COLOR_0"), std::string::npos) << CapturedLog().str();
+}
+
 }  // namespace
 }  // namespace lf

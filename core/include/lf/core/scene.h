@@ -119,6 +119,8 @@ struct TriangleMesh {
     std::vector<Vec3> normals;  // unit, in the same space as positions
     std::vector<Vec2> uvs;      // TEXCOORD_0: v = 0 is the top of the image
     std::vector<std::array<float, 4>> tangents;
+    // COLOR_0, linear RGBA: multiplies the base colour and its alpha the opacity (glTF).
+    std::vector<std::array<float, 4>> colors;
     // True when the mesh came from a `quad` shape: (v0,v1,v2),(v0,v2,v3). Radiosity meshes
     // such shapes as a grid of quads rather than triangles.
     bool is_quad = false;
