@@ -210,7 +210,7 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
             Fail(where, absl::StrCat("mode ", prim.mode, " (", ModeName(prim.mode),
                                      ") is not supported; only triangles (mode 4)"));
         }
-        if (!prim.targets.empty()) Warn(absl::StrCat(where, ": morph targets ignored"));
+        if (!prim.targets.empty()) Tally("morph targets ignored", "primitive", where);
         const auto attribute = [&](const char* key) {
             const auto found = prim.attributes.find(key);
             return found == prim.attributes.end() ? -1 : found->second;
@@ -302,7 +302,7 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
                         : std::array{indices[3 * i], indices[3 * i + 1], indices[3 * i + 2]};
         }
         if (out.triangles.empty()) {
-            Warn(absl::StrCat(where, ": no triangles, skipped"));
+            Tally("no triangles, skipped", "primitive", where);
             continue;
         }
         scene_.meshes.push_back(std::move(out));

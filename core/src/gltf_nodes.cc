@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -129,6 +130,18 @@ void GltfImporter::Import() {
                   absl::StrCat("scenes[", index, "].nodes[", i, "]"));
     }
     if (range_ignored_) Warn("KHR_lights_punctual range ignored: lights fall off as 1/r^2");
+    WarnTallies();
+}
+
+void GltfImporter::WarnTallies() {
+    constexpr size_t kNamed = 3;
+    for (const auto& [what, t] : tallies_) {
+        const size_t n = t.wheres.size();
+        const std::vector<std::string> named(t.wheres.begin(),
+                                             t.wheres.begin() + ptrdiff_t(std::min(n, kNamed)));
+        Warn(absl::StrCat(what, " in ", n, " ", t.noun, n == 1 ? "" : "s", ": ",
+                          absl::StrJoin(named, ", "), n > kNamed ? ", ..." : ""));
+    }
 }
 
 void GltfImporter::CheckExtensions() {
@@ -263,8 +276,8 @@ void GltfImporter::AddLight(const tinygltf::Value& light_index, const Affine& wo
     // A node scaled to zero (a common way to hide one) leaves spot and directional lights
     // no direction: they light nothing.
     if (light.type != "point" && !(Length(axis) > 0)) {
-        Warn(absl::StrCat(where, ": ", light.type,
-                          " light under a transform that flattens its axis, skipped"));
+        Tally(absl::StrCat(light.type, " light under a transform that flattens its axis, skipped"),
+              "node", where);
         return;
     }
     if (light.type == "point") {

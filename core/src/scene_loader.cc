@@ -62,8 +62,9 @@ Scene SceneParser::ParseGltf(const std::string& bytes, const std::string& source
     hash_.Update(bytes);
     Scene scene;
     // The reader resolves names beside the scene file already.
-    ImportGltf(bytes, std::filesystem::path(source).filename().string(), "", Affine(), scene,
-               [](const absl::Status& s) { throw LoadError{s}; });
+    ImportGltf(
+        bytes, std::filesystem::path(source).filename().string(), "", Affine(), scene,
+        [](const absl::Status& s) { throw LoadError{s}; }, false);
     if (FramesTheScene()) {
         scene.camera = FrameScene(scene);
         return Finish(scene);

@@ -101,10 +101,11 @@ class SceneParser {
     // material indices become the scene's.
     CachedMeshFile AddFileMaterials(MeshFile file, const std::string& where, Scene& scene);
     // Appends glTF `name` (read as `bytes`) to `scene`, every file it reads hashed, its meshes
-    // checked as a JSON mesh's are. `fail` throws the error with the caller's context.
+    // checked as a JSON mesh's are. `fail` throws the error with the caller's context. Warnings
+    // name the glTF when it is included (the log line names the scene file already).
     void ImportGltf(const std::string& bytes, const std::string& name, const std::string& base_dir,
                     const Affine& transform, Scene& scene,
-                    const std::function<void(const absl::Status&)>& fail);
+                    const std::function<void(const absl::Status&)>& fail, bool included);
     // {"type": "gltf", "file": ..., "transform": ...}: a glTF file's meshes, materials, lights
     // and cameras in a JSON scene.
     void ParseGltfShape(const Node& n, Scene& scene);

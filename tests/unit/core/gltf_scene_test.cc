@@ -692,5 +692,27 @@ TEST(GltfVertexColorAsset, TheTestRowGetsItsVertexColours) {
     EXPECT_EQ(CapturedLog().str().find("COLOR_0"), std::string::npos) << CapturedLog().str();
 }
 
+// A loss many objects share is one warning with a count, and a glTF rendered directly names its
+// file once in it (the log line's prefix), not once per material.
+TEST_F(GltfSceneTest, WarningsComeOncePerKindWithACountNamingTheFileOnce) {
+    GltfBuilder b = testing::TexturedTestScene();
+    for (Json& m : b.json()["materials"]) m["occlusionTexture"] = {{"index", 0}};
+    const size_t materials = b.json()["materials"].size();
+    ASSERT_GE(materials, 2u);
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const std::string log = CapturedLog().str();
+    const std::string kind = "occlusionTexture ignored";
+    const size_t at = log.find(kind);
+    ASSERT_NE(at, std::string::npos) << log;
+    EXPECT_EQ(log.find(kind, at + 1), std::string::npos) << log;
+    const size_t begin = log.rfind('\n', at) + 1, end = log.find('\n', at);
+    const std::string line = log.substr(begin, end - begin);
+    EXPECT_NE(line.find(absl::StrCat("in ", materials, " materials: materials[0]")),
+              std::string::npos)
+        << line;
+    EXPECT_EQ(line.find("scene.gltf"), line.rfind("scene.gltf")) << line;
+}
+
 }  // namespace
 }  // namespace lf
