@@ -308,23 +308,42 @@ absl::Status RunPlan(const PlanOptions& options) {
         }
     }
 
+    // An emission texture with no lit texel (glTF files give every material emissiveFactor 1
+    // and a black texture) emits nothing.
+    const auto emits = [&](const Material& m) {
+        if (!m.IsEmissive() || !m.emission_texture.valid()) return m.IsEmissive();
+        const TextureImage& t = *scene->textures[size_t(m.emission_texture.image)];
+        const int colour = std::min(t.channels, 3) == 3 ? 3 : 1;
+        for (size_t i = 0; i < size_t(t.width) * size_t(t.height); ++i) {
+            for (int c = 0; c < colour; ++c) {
+                const size_t k = i * size_t(t.channels) + size_t(c);
+                if (t.texels8.empty() ? t.texels32[k] > 0 : t.texels8[k] > 0) return true;
+            }
+        }
+        return false;
+    };
     int emissive_triangles = 0, emissive_spheres = 0;
     double emitting_area = 0;
     for (const TriangleMesh& m : scene->meshes) {
-        if (!scene->materials[size_t(m.material)].IsEmissive()) continue;
+        if (!emits(scene->materials[size_t(m.material)])) continue;
         for (const auto& t : m.triangles) {
             ++emissive_triangles;
             emitting_area += TriangleArea(m, t);
         }
     }
     for (const Sphere& s : scene->spheres) {
-        if (scene->materials[size_t(s.material)].IsEmissive()) ++emissive_spheres;
+        if (emits(scene->materials[size_t(s.material)])) ++emissive_spheres;
     }
+    const std::optional<EnvironmentLight>& sky = scene->environment;
+    const std::string environment =
+        !sky       ? "no environment"
+        : sky->map ? absl::StrCat("an environment map (", sky->map->name, ")")
+                   : absl::StrCat("a uniform environment ", Color(sky->radiance));
     std::printf(
         "lights: %d emissive triangles (%.4g m^2), %d emissive spheres, %zu point lights, %zu "
-        "spot lights, %zu directional lights\n",
+        "spot lights, %zu directional lights, %s\n",
         emissive_triangles, emitting_area, emissive_spheres, scene->point_lights.size(),
-        scene->spot_lights.size(), scene->directional_lights.size());
+        scene->spot_lights.size(), scene->directional_lights.size(), environment.c_str());
 
     const MethodChoice choice = ChooseMethod(*scene, MethodOfFlag(options.method));
     const Method method = choice.method;

@@ -69,7 +69,10 @@ void AddFilterFlag(CLI::App* cmd, SceneOptions& options) {
 void AddCameraFlag(CLI::App* cmd, SceneOptions& options) {
     cmd->add_option("--camera", options.camera,
                     "render from the glTF camera of this name (its node's name, or the "
-                    "camera's); default: the JSON scene's camera, else the first glTF camera");
+                    "camera's), or the N-th glTF camera in node order (from 0) when none is "
+                    "named N; `auto` frames the whole scene from the front (-Z, glTF's +Y up, 20 "
+                    "degrees above), unless a camera is named so; default: the JSON scene's "
+                    "camera, else the first glTF camera");
 }
 
 void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, const std::string& help) {

@@ -17,9 +17,11 @@ Camera::Camera(const CameraSpec& spec, const Vec3d& origin)
     forward_ = Vec3(f);
     right_ = Vec3(r);
     up_ = Vec3(u);
-    tan_half_fov_ = float(std::tan(spec.fov_y_deg * std::numbers::pi / 360.0));
+    orthographic_ = spec.projection == CameraSpec::Projection::kOrthographic;
+    tan_half_fov_ = orthographic_ ? float(spec.half_height)
+                                  : float(std::tan(spec.fov_y_deg * std::numbers::pi / 360.0));
     aspect_ = float(width_) / float(height_);
-    lens_radius_ = float(spec.aperture_radius);
+    lens_radius_ = orthographic_ ? 0 : float(spec.aperture_radius);
     focus_distance_ = float(spec.focus_distance);
     film_area_ = 4 * tan_half_fov_ * tan_half_fov_ * aspect_;
     lens_area_ = lens_radius_ > 0 ? std::numbers::pi_v<float> * lens_radius_ * lens_radius_ : 1;
@@ -28,6 +30,7 @@ Camera::Camera(const CameraSpec& spec, const Vec3d& origin)
 Ray Camera::GenerateRay(int px, int py, float u, float v, const Vec2& lens) const {
     const float x = (2 * (px + u) / width_ - 1) * tan_half_fov_ * aspect_;
     const float y = (1 - 2 * (py + v) / height_) * tan_half_fov_;
+    if (orthographic_) return Ray{position_ + right_ * x + up_ * y, forward_};
     const Vec3 through = forward_ + right_ * x + up_ * y;  // forward component 1
     if (lens_radius_ == 0) return Ray{position_, Normalize(through)};
     // Every ray through this film point meets the pinhole ray on the focal plane.
@@ -39,7 +42,8 @@ Ray Camera::GenerateRay(int px, int py, float u, float v, const Vec2& lens) cons
 
 std::optional<Vec2> Camera::Raster(const Ray& ray, float* cos_theta) const {
     const float cos = Dot(ray.d, forward_);
-    if (!(cos > 0)) return std::nullopt;
+    // A delta in direction: see IsOrthographic.
+    if (orthographic_ || !(cos > 0)) return std::nullopt;
     // The film point at distance 1 along the view axis that GenerateRay would have aimed at: the
     // pinhole's own direction, or for a lens the pinhole ray through the point where this ray
     // crosses the focal plane.

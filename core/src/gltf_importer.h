@@ -65,6 +65,14 @@ class GltfImporter {
 
   private:
     void Warn(const std::string& message) { warnings_.push_back(message); }
+    // A loss that many objects may share, warned once at the end with their count:
+    // "occlusionTexture ignored (...) in 12 materials: materials[0] \"a\", ...".
+    void Tally(const std::string& what, const std::string& noun, const std::string& where) {
+        Tallied& t = tallies_[what];
+        t.noun = noun;
+        t.wheres.push_back(where);
+    }
+    void WarnTallies();
 
     void CheckExtensions();
     void VisitNode(int index, const Affine& parent, const std::string& ref);
@@ -108,6 +116,11 @@ class GltfImporter {
     std::vector<std::string>& warnings_;
     const std::map<int, absl::StatusOr<std::shared_ptr<const TextureImage>>>& images_;
     const std::map<std::string, absl::Status>& read_errors_;
+    struct Tallied {
+        std::string noun;
+        std::vector<std::string> wheres;
+    };
+    std::map<std::string, Tallied> tallies_;
     std::vector<bool> visited_;
     std::map<int, int> material_of_, texture_of_;
     bool range_ignored_ = false;

@@ -104,9 +104,8 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
     m.normal_scale = float(g.normalTexture.scale);
     if (!std::isfinite(m.normal_scale)) Fail(where, "normalTexture.scale is not finite");
     if (g.occlusionTexture.index >= 0) {
-        Warn(absl::StrCat(where,
-                          ": occlusionTexture ignored (a path tracer computes "
-                          "occlusion itself)"));
+        Tally("occlusionTexture ignored (a path tracer computes occlusion itself)", "material",
+              where);
     }
     m.emission_texture = Texture(g.emissiveTexture.index, g.emissiveTexture.texCoord,
                                  g.emissiveTexture.extensions, true, where + ".emissiveTexture");

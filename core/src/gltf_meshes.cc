@@ -210,7 +210,7 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
             Fail(where, absl::StrCat("mode ", prim.mode, " (", ModeName(prim.mode),
                                      ") is not supported; only triangles (mode 4)"));
         }
-        if (!prim.targets.empty()) Warn(absl::StrCat(where, ": morph targets ignored"));
+        if (!prim.targets.empty()) Tally("morph targets ignored", "primitive", where);
         const auto attribute = [&](const char* key) {
             const auto found = prim.attributes.find(key);
             return found == prim.attributes.end() ? -1 : found->second;
@@ -263,6 +263,25 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
                                    (t[4 * i + 3] < 0 ? -1.0f : 1.0f) * (det < 0 ? -1 : 1)};
             }
         }
+        if (const int color = attribute("COLOR_0"); color >= 0) {
+            // VEC3 or VEC4 of FLOAT or normalized UNSIGNED_BYTE/SHORT, linear.
+            const int components = Accessor(color, at + "COLOR_0").components;
+            if (components != 3 && components != 4) {
+                Fail(at + "COLOR_0", absl::StrCat("accessors[", color, "] has ", components,
+                                                  " components per element, expected 3 or 4"));
+            }
+            const std::vector<float> c = Floats(color, components, at + "COLOR_0");
+            if (c.size() / size_t(components) != n) {
+                Fail(at + "COLOR_0", "count differs from POSITION");
+            }
+            out.colors.resize(n);
+            for (size_t i = 0; i < n; ++i) {
+                const float* e = &c[i * size_t(components)];
+                out.colors[i] = {std::clamp(e[0], 0.0f, 1.0f), std::clamp(e[1], 0.0f, 1.0f),
+                                 std::clamp(e[2], 0.0f, 1.0f),
+                                 components == 4 ? std::clamp(e[3], 0.0f, 1.0f) : 1.0f};
+            }
+        }
         std::vector<uint32_t> indices;
         if (prim.indices >= 0) {
             indices = Indices(prim.indices, n, at.substr(0, at.size() - 11) + "indices");
@@ -283,7 +302,7 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
                         : std::array{indices[3 * i], indices[3 * i + 1], indices[3 * i + 2]};
         }
         if (out.triangles.empty()) {
-            Warn(absl::StrCat(where, ": no triangles, skipped"));
+            Tally("no triangles, skipped", "primitive", where);
             continue;
         }
         scene_.meshes.push_back(std::move(out));

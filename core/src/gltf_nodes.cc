@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -129,6 +130,18 @@ void GltfImporter::Import() {
                   absl::StrCat("scenes[", index, "].nodes[", i, "]"));
     }
     if (range_ignored_) Warn("KHR_lights_punctual range ignored: lights fall off as 1/r^2");
+    WarnTallies();
+}
+
+void GltfImporter::WarnTallies() {
+    constexpr size_t kNamed = 3;
+    for (const auto& [what, t] : tallies_) {
+        const size_t n = t.wheres.size();
+        const std::vector<std::string> named(t.wheres.begin(),
+                                             t.wheres.begin() + ptrdiff_t(std::min(n, kNamed)));
+        Warn(absl::StrCat(what, " in ", n, " ", t.noun, n == 1 ? "" : "s", ": ",
+                          absl::StrJoin(named, ", "), n > kNamed ? ", ..." : ""));
+    }
 }
 
 void GltfImporter::CheckExtensions() {
@@ -185,28 +198,45 @@ void GltfImporter::AddCamera(const tinygltf::Node& node, const Affine& world,
     }
     const tinygltf::Camera& camera = model_.cameras[size_t(node.camera)];
     const std::string at = absl::StrCat("cameras[", node.camera, "]", Quoted(camera.name));
-    if (camera.type != "perspective") {
-        Fail(at, absl::StrCat("type \"", camera.type,
-                              "\" is not supported; lightfarm renders "
-                              "perspective cameras only"));
-    }
-    const tinygltf::PerspectiveCamera& p = camera.perspective;
-    if (!(p.yfov > 0 && p.yfov < std::numbers::pi)) {
-        Fail(at, absl::StrCat("yfov ", p.yfov, " must be in (0, pi) radians"));
-    }
     GltfCamera out;
     out.name = node.name.empty() ? camera.name : node.name;
+    // A camera that is not rendered must not refuse the file: its faults wait for ChooseGltfCamera.
+    const auto refuse = [&](const std::string& object, const std::string& message) {
+        out.error = absl::StrCat(object, ": ", message);
+        cameras_.push_back(std::move(out));
+    };
     CameraSpec& spec = out.spec;
     // The camera looks down its node's -Z with +Y up.
     spec.position = world.Apply(Vec3d(0, 0, 0));
     const Vec3d forward = world.ApplyLinear(Vec3d(0, 0, -1));
     spec.up = world.ApplyLinear(Vec3d(0, 1, 0));
-    if (!(Length(Cross(forward, spec.up)) > 0)) Fail(where, "its transform is singular");
+    if (!(Length(Cross(forward, spec.up)) > 0)) return refuse(where, "its transform is singular");
     spec.look_at = spec.position + Normalize(forward);
-    spec.fov_y_deg = p.yfov * 180 / std::numbers::pi;
-    const double aspect = p.aspectRatio > 0 ? p.aspectRatio : 1;
+    double aspect = 1;
+    if (camera.type == "perspective") {
+        const tinygltf::PerspectiveCamera& p = camera.perspective;
+        if (!(p.yfov > 0 && p.yfov < std::numbers::pi)) {
+            return refuse(at, absl::StrCat("yfov ", p.yfov, " must be in (0, pi) radians"));
+        }
+        spec.fov_y_deg = p.yfov * 180 / std::numbers::pi;
+        if (p.aspectRatio > 0) aspect = p.aspectRatio;
+    } else if (camera.type == "orthographic") {
+        const tinygltf::OrthographicCamera& o = camera.orthographic;
+        if (!(std::abs(o.xmag) > 0 && std::abs(o.ymag) > 0 && std::abs(o.ymag) <= kMaxCoordinate &&
+              std::abs(o.xmag) <= kMaxCoordinate)) {
+            return refuse(at, absl::StrCat("xmag ", o.xmag, " and ymag ", o.ymag,
+                                           " must be non-zero and finite"));
+        }
+        // The rays start on the film plane itself: znear and zfar clip nothing here.
+        spec.projection = CameraSpec::Projection::kOrthographic;
+        spec.half_height = std::abs(o.ymag);
+        aspect = std::abs(o.xmag) / std::abs(o.ymag);
+    } else {
+        return refuse(at, absl::StrCat("type \"", camera.type,
+                                       "\" is unknown; expected perspective or orthographic"));
+    }
     if (!(aspect >= 1e-3 && aspect <= 1e3)) {
-        Fail(at, absl::StrCat("aspectRatio ", p.aspectRatio, " is not within [0.001, 1000]"));
+        return refuse(at, absl::StrCat("aspect ratio ", aspect, " is not within [0.001, 1000]"));
     }
     spec.width =
         aspect >= 1 ? kGltfLongerSide : std::max(1, int(std::lround(kGltfLongerSide * aspect)));
@@ -246,8 +276,8 @@ void GltfImporter::AddLight(const tinygltf::Value& light_index, const Affine& wo
     // A node scaled to zero (a common way to hide one) leaves spot and directional lights
     // no direction: they light nothing.
     if (light.type != "point" && !(Length(axis) > 0)) {
-        Warn(absl::StrCat(where, ": ", light.type,
-                          " light under a transform that flattens its axis, skipped"));
+        Tally(absl::StrCat(light.type, " light under a transform that flattens its axis, skipped"),
+              "node", where);
         return;
     }
     if (light.type == "point") {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "gltf_importer.h"
@@ -129,17 +130,26 @@ absl::StatusOr<CameraSpec> ChooseGltfCamera(const std::vector<GltfCamera>& camer
                                             const std::string& name) {
     if (cameras.empty()) {
         return absl::NotFoundError(
-            "no camera; add one to the glTF, or include the file from a JSON scene that gives "
-            "a camera");
+            "no camera; render with --camera auto (frames the whole scene), add one to the "
+            "glTF, or include the file from a JSON scene that gives a camera");
     }
-    if (name.empty()) return cameras.front().spec;
+    const auto usable = [](const GltfCamera& camera) -> absl::StatusOr<CameraSpec> {
+        if (!camera.error.empty()) return absl::InvalidArgumentError(camera.error);
+        return camera.spec;
+    };
+    if (name.empty()) return usable(cameras.front());
     std::vector<std::string> names;
     for (const GltfCamera& camera : cameras) {
-        if (camera.name == name) return camera.spec;
+        if (camera.name == name) return usable(camera);
         names.push_back(absl::StrCat("\"", camera.name, "\""));
     }
+    // Unnamed cameras (most sample assets) by their place in node order.
+    if (size_t index = 0; absl::SimpleAtoi(name, &index) && index < cameras.size()) {
+        return usable(cameras[index]);
+    }
     return absl::NotFoundError(absl::StrCat("no camera named \"", name, "\"; the cameras are ",
-                                            absl::StrJoin(names, ", ")));
+                                            absl::StrJoin(names, ", "), " (or 0 to ",
+                                            cameras.size() - 1, " by their order)"));
 }
 
 }  // namespace lf

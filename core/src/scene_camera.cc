@@ -8,9 +8,18 @@
 namespace lf::scene_internal {
 
 CameraSpec SceneParser::ParseCamera(const Node& n) {
-    n.ExpectObject({"position", "look_at", "up", "fov_y_deg", "resolution", "aperture_radius",
-                    "focus_distance", "filter"});
+    n.ExpectObject({"type", "position", "look_at", "up", "fov_y_deg", "half_height", "resolution",
+                    "aperture_radius", "focus_distance", "filter"});
     CameraSpec camera;
+    if (const std::optional<Node> type = n.Find("type")) {
+        if (type->String() == "orthographic") {
+            camera.projection = CameraSpec::Projection::kOrthographic;
+        } else if (type->String() != "perspective") {
+            type->Fail(absl::StrCat("unknown camera type \"", type->String(),
+                                    "\"; expected perspective or orthographic"));
+        }
+    }
+    const bool orthographic = camera.projection == CameraSpec::Projection::kOrthographic;
     camera.position = n.Get("position").Vector();
     const Node look_at = n.Get("look_at");
     camera.look_at = look_at.Vector();
@@ -25,10 +34,24 @@ CameraSpec SceneParser::ParseCamera(const Node& n) {
     } else if (Length(Cross(Normalize(view), camera.up)) < 1e-6) {
         n.Fail("the default up [0, 1, 0] is parallel to the view direction; give `up`");
     }
-    const Node fov = n.Get("fov_y_deg");
-    camera.fov_y_deg = fov.Number();
-    if (!(camera.fov_y_deg > 0 && camera.fov_y_deg < 180)) {
-        fov.Fail(absl::StrCat("must be in (0, 180) degrees, got ", camera.fov_y_deg));
+    if (orthographic) {
+        const Node half = n.Get("half_height");
+        camera.half_height = half.NumberIn(0, kMaxCoordinate, "above 0 (scene units)");
+        if (camera.half_height == 0) half.Fail("must be above 0 (scene units)");
+        for (const char* key : {"fov_y_deg", "aperture_radius", "focus_distance"}) {
+            if (const std::optional<Node> k = n.Find(key)) {
+                k->Fail("has no meaning for an orthographic camera");
+            }
+        }
+    } else {
+        if (const std::optional<Node> half = n.Find("half_height")) {
+            half->Fail("is for orthographic cameras (\"type\": \"orthographic\")");
+        }
+        const Node fov = n.Get("fov_y_deg");
+        camera.fov_y_deg = fov.Number();
+        if (!(camera.fov_y_deg > 0 && camera.fov_y_deg < 180)) {
+            fov.Fail(absl::StrCat("must be in (0, 180) degrees, got ", camera.fov_y_deg));
+        }
     }
     const Node resolution = n.Get("resolution");
     const std::vector<Node> size = resolution.Elements(2);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/auto_camera.h"
 #include "lf/core/file_util.h"
 #include "lf/core/gltf_scene.h"
 #include "lf/core/log.h"
@@ -29,9 +30,11 @@ Scene SceneParser::Parse(const Json& json, const std::string& text) {
     }
     Scene scene;
     textures_ = &scene.textures;
-    // Optional when an included glTF may bring a camera (ResolveCamera).
-    const std::optional<Node> camera =
-        IncludesGltf(root) ? root.Find("camera") : std::optional(root.Get("camera"));
+    // Optional when an included glTF may bring a camera, or --camera auto frames the scene
+    // (ResolveCamera).
+    const std::optional<Node> camera = IncludesGltf(root) || options_.camera == kAutoCameraName
+                                           ? root.Find("camera")
+                                           : std::optional(root.Get("camera"));
     if (camera) scene.camera = ParseCamera(*camera);
 
     const Node materials = root.Get("materials");
@@ -59,8 +62,13 @@ Scene SceneParser::ParseGltf(const std::string& bytes, const std::string& source
     hash_.Update(bytes);
     Scene scene;
     // The reader resolves names beside the scene file already.
-    ImportGltf(bytes, std::filesystem::path(source).filename().string(), "", Affine(), scene,
-               [](const absl::Status& s) { throw LoadError{s}; });
+    ImportGltf(
+        bytes, std::filesystem::path(source).filename().string(), "", Affine(), scene,
+        [](const absl::Status& s) { throw LoadError{s}; }, false);
+    if (FramesTheScene()) {
+        scene.camera = FrameScene(scene);
+        return Finish(scene);
+    }
     absl::StatusOr<CameraSpec> camera = ChooseGltfCamera(gltf_cameras_, options_.camera);
     if (!camera.ok()) throw LoadError{camera.status()};
     scene.camera = *camera;
@@ -101,7 +109,17 @@ bool SceneParser::IncludesGltf(const Node& root) {
            });
 }
 
+bool SceneParser::FramesTheScene() const {
+    return options_.camera == kAutoCameraName &&
+           std::none_of(gltf_cameras_.begin(), gltf_cameras_.end(),
+                        [](const GltfCamera& c) { return c.name == kAutoCameraName; });
+}
+
 void SceneParser::ResolveCamera(const Node& root, bool json_camera, Scene& scene) {
+    if (FramesTheScene()) {
+        scene.camera = FrameScene(scene);
+        return;
+    }
     if (json_camera && options_.camera.empty()) return;
     if (!json_camera && gltf_cameras_.empty()) {
         root.Fail("missing required key \"camera\" (no included glTF has a camera)");

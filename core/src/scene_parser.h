@@ -61,7 +61,10 @@ class SceneParser {
     Scene Finish(Scene& scene);
     static bool IncludesGltf(const Node& root);
     // The JSON's camera unless --camera names a glTF one; the first glTF camera without either.
+    // `--camera auto`, or the scene's camera of that name.
     void ResolveCamera(const Node& root, bool json_camera, Scene& scene);
+    // `--camera auto` and no glTF camera of that name: FrameScene.
+    bool FramesTheScene() const;
 
     // Camera (scene_camera.cc).
     CameraSpec ParseCamera(const Node& n);
@@ -98,10 +101,11 @@ class SceneParser {
     // material indices become the scene's.
     CachedMeshFile AddFileMaterials(MeshFile file, const std::string& where, Scene& scene);
     // Appends glTF `name` (read as `bytes`) to `scene`, every file it reads hashed, its meshes
-    // checked as a JSON mesh's are. `fail` throws the error with the caller's context.
+    // checked as a JSON mesh's are. `fail` throws the error with the caller's context. Warnings
+    // name the glTF when it is included (the log line names the scene file already).
     void ImportGltf(const std::string& bytes, const std::string& name, const std::string& base_dir,
                     const Affine& transform, Scene& scene,
-                    const std::function<void(const absl::Status&)>& fail);
+                    const std::function<void(const absl::Status&)>& fail, bool included);
     // {"type": "gltf", "file": ..., "transform": ...}: a glTF file's meshes, materials, lights
     // and cameras in a JSON scene.
     void ParseGltfShape(const Node& n, Scene& scene);

@@ -251,7 +251,7 @@ CachedMeshFile SceneParser::AddFileMaterials(MeshFile file, const std::string& w
 
 void SceneParser::ImportGltf(const std::string& bytes, const std::string& name,
                              const std::string& base_dir, const Affine& transform, Scene& scene,
-                             const std::function<void(const absl::Status&)>& fail) {
+                             const std::function<void(const absl::Status&)>& fail, bool included) {
     const SceneFileReader hashing_reader =
         [&](const std::string& file) -> absl::StatusOr<std::string> {
         absl::StatusOr<std::string> read = read_file_(file);
@@ -262,7 +262,9 @@ void SceneParser::ImportGltf(const std::string& bytes, const std::string& name,
     std::vector<std::string> warnings;
     const absl::Status status = AppendGltf(bytes, name, hashing_reader, {base_dir, transform},
                                            scene, gltf_cameras_, warnings);
-    for (const std::string& w : warnings) warnings_.push_back(absl::StrCat(name, ": ", w));
+    for (const std::string& w : warnings) {
+        warnings_.push_back(included ? absl::StrCat(name, ": ", w) : w);
+    }
     if (!status.ok()) fail(status);
     for (size_t i = first_mesh; i < scene.meshes.size(); ++i) {
         dropped_degenerate_ += DropDegenerate(scene.meshes[i]);
@@ -290,7 +292,7 @@ void SceneParser::ParseGltfShape(const Node& n, Scene& scene) {
     hash_.Update(*bytes);
     const std::optional<Node> transform = n.Find("transform");
     ImportGltf(*bytes, name, std::filesystem::path(name).parent_path().string(),
-               transform ? ParseTransform(*transform) : Affine(), scene, fail);
+               transform ? ParseTransform(*transform) : Affine(), scene, fail, true);
 }
 
 }  // namespace lf::scene_internal

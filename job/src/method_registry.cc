@@ -78,6 +78,13 @@ absl::Status CheckMethodTakesFilter(Method method, const PixelFilter& filter) {
 
 absl::Status CheckMethodTakesScene(Method method, const Scene& scene) {
     if (absl::Status s = CheckMethodTakesFilter(method, scene.camera.filter); !s.ok()) return s;
+    if (Info(method).splats_light_paths &&
+        scene.camera.projection == CameraSpec::Projection::kOrthographic) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "method ", MethodName(method),
+            ": orthographic cameras are not supported (light paths cannot reach a camera that "
+            "sees along one direction); use path, whitted or ppm"));
+    }
     const auto refusal = Info(method).scene_refusal;
     return refusal ? refusal(scene) : absl::OkStatus();
 }

@@ -59,6 +59,7 @@ absl::Status CheckMesh(const Scene& scene, const TriangleMesh& mesh) {
     };
     if (absl::Status s = check(mesh.normals.size(), "normals"); !s.ok()) return s;
     if (absl::Status s = check(mesh.uvs.size(), "texture coordinates"); !s.ok()) return s;
+    if (absl::Status s = check(mesh.colors.size(), "vertex colours"); !s.ok()) return s;
     return check(mesh.tangents.size(), "tangents");
 }
 
@@ -95,9 +96,12 @@ void FilterHits(const RTCFilterFunctionNArguments* args) {
             }
         }
         if (f.alpha_mask) {
-            const Vec2 uv = TriangleUv(mesh, prim, RTCHitN_u(args->hit, args->N, i),
-                                       RTCHitN_v(args->hit, args->N, i));
-            if (IsCutOut(scene, material, uv)) args->valid[i] = 0;
+            const float b1 = RTCHitN_u(args->hit, args->N, i),
+                        b2 = RTCHitN_v(args->hit, args->N, i);
+            if (IsCutOut(scene, material, TriangleUv(mesh, prim, b1, b2),
+                         VertexColor(mesh, prim, b1, b2).a)) {
+                args->valid[i] = 0;
+            }
         }
     }
 }

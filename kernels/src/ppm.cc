@@ -67,7 +67,8 @@ double PpmDefaultRadius(const EmbreeScene& scene, const Camera& camera) {
             const std::optional<SurfaceHit> hit = scene.Intersect(ray);
             if (!hit) continue;
             const double angle = Length(Normalize(ray.d) - Normalize(next.d));
-            footprints.push_back(double(hit->t) * Length(ray.d) * angle);
+            // Orthographic rays are parallel: their footprint is the origins' spacing.
+            footprints.push_back(double(hit->t) * Length(ray.d) * angle + Length(next.o - ray.o));
         }
     }
     if (footprints.empty()) {

@@ -115,15 +115,26 @@ Vec2 TriangleUv(const TriangleMesh& mesh, int primitive, float b1, float b2) {
     return {b0 * uv0.x + b1 * uv1.x + b2 * uv2.x, b0 * uv0.y + b1 * uv1.y + b2 * uv2.y};
 }
 
-float Opacity(const Scene& scene, const Material& material, const Vec2& uv) {
-    float a = material.opacity;
+Rgba VertexColor(const TriangleMesh& mesh, int primitive, float b1, float b2) {
+    if (mesh.colors.empty()) return {Rgb(1.0f), 1};
+    const auto& tri = mesh.triangles[size_t(primitive)];
+    const float b[3] = {1 - b1 - b2, b1, b2};
+    float sum[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        for (int c = 0; c < 4; ++c) sum[c] += b[i] * mesh.colors[tri[size_t(i)]][size_t(c)];
+    }
+    return {Rgb(sum[0], sum[1], sum[2]), sum[3]};
+}
+
+float Opacity(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha) {
+    float a = material.opacity * vertex_alpha;
     if (material.base_color_texture.valid()) a *= Sample(scene, material.base_color_texture, uv).a;
     return a;
 }
 
-bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv) {
+bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha) {
     return material.alpha_mode == Material::AlphaMode::kMask &&
-           Opacity(scene, material, uv) < material.alpha_cutoff;
+           Opacity(scene, material, uv, vertex_alpha) < material.alpha_cutoff;
 }
 
 bool Transmits(const Material& material) {
@@ -156,12 +167,14 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
     const Scene& scene = es.scene();
     const Material& m = scene.materials[size_t(hit.material)];
     Shading s;
+    Rgb vertex_color(1.0f);
     s.point = {hit.p, hit.p_error, hit.n};
     s.ns = hit.n;
     s.p_outer = hit.p;
     if (hit.mesh >= 0) {
         const TriangleMesh& mesh = scene.meshes[size_t(hit.mesh)];
         s.uv = TriangleUv(mesh, hit.primitive, hit.b1, hit.b2);
+        vertex_color = VertexColor(mesh, hit.primitive, hit.b1, hit.b2).rgb;
         if (!mesh.normals.empty()) {
             const auto& tri = mesh.triangles[size_t(hit.primitive)];
             const float b[3] = {1 - hit.b1 - hit.b2, hit.b1, hit.b2};
@@ -181,6 +194,7 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
     s.ns = ValidReflectionNormal(s.ns, hit.n, wo);
 
     s.params = SurfaceParams::Of(m);
+    s.params.base_color *= vertex_color;
     if (m.base_color_texture.valid()) {
         // An HDR or EXR colour texture can exceed 1, which no albedo may.
         const Rgb texel = Sample(scene, m.base_color_texture, s.uv).rgb;
@@ -207,7 +221,10 @@ Rgb EmissionAt(const EmbreeScene& es, const SurfacePoint& light_point, const Rgb
         return radiance;
     }
     const Vec2 uv = TriangleUv(mesh, light_point.primitive, light_point.b1, light_point.b2);
-    if (IsCutOut(scene, m, uv)) return Rgb(0);
+    if (IsCutOut(scene, m, uv,
+                 VertexColor(mesh, light_point.primitive, light_point.b1, light_point.b2).a)) {
+        return Rgb(0);
+    }
     if (!m.emission_texture.valid()) return radiance;
     return radiance * Sample(scene, m.emission_texture, uv).rgb;
 }

@@ -497,6 +497,27 @@ TEST_F(Cli, TargetErrorRecordsTheEstimateInTheHeader) {
               std::get<int>(file->attributes.at("lightfarm.spp")));
 }
 
+// `plan` lists the environment among the lights, and a material whose emission texture has no
+// lit texel (glTF exports give emissiveFactor 1 and a black texture) is not an emitter.
+TEST_F(Cli, PlanListsTheEnvironmentAndSkipsEmissionTexturesWithoutLight) {
+    std::ofstream(dir_ / "black.png", std::ios::binary)
+        << testing::PngBytes(2, 2, 3, std::vector<uint8_t>(12, 0));
+    const std::string scene = Write("sky.json", R"({
+      "camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 40,
+                 "resolution": [8, 8]},
+      "materials": {"dark": {"type": "principled", "base_color": [0.5, 0.5, 0.5],
+                             "emission": [1, 1, 1], "emission_texture": {"file": "black.png"}}},
+      "shapes": [{"type": "quad", "material": "dark",
+                  "vertices": [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]]}],
+      "lights": [{"type": "environment", "radiance": [0.5, 0.5, 0.5]}]})");
+    const RunResult r = Lightfarm("plan " + scene + " --pilot-spp 2 --threads 2");
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* text :
+         {"lights: 0 emissive triangles", "a uniform environment (0.5, 0.5, 0.5)"}) {
+        EXPECT_NE(r.output.find(text), std::string::npos) << text << "\n" << r.output;
+    }
+}
+
 TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
     const RunResult r = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
                                   "/cornell_box.json --pilot-spp 2 --target-error 0.5 --threads 2");

@@ -146,5 +146,33 @@ TEST_F(GltfRender, RenderRefusesACameraBeyondTheCoordinateBoundInsteadOfAborting
     EXPECT_FALSE(fs::exists(dir_ / "far.exr"));
 }
 
+// Khronos' Cameras asset (CC0) through its orthographic camera, under a sun along the view
+// axis: the square (x, y in [0, 1], turned 45 degrees about x) covers cos 45 of a unit square of
+// the 2 x 2 film, so 17.7% of the pixels. The perspective camera (yfov 0.7, 3 away) sees it as
+// a trapezoid: near edge y = -0.5 / (3 tan 0.35), half width 0.5 / (3 tan 0.35); far edge at
+// depth 3 + cos 45, y = (sin 45 - 0.5) / depth, half width 0.5 / depth: 12.6% of the film.
+TEST(GltfCamerasAsset, RendersWithEitherCamera) {
+    const std::string path = std::string(LF_TEST_SCENES) + "/khronos/Cameras/Cameras.gltf";
+    double covered[2] = {0, 0};
+    for (int camera = 0; camera < 2; ++camera) {
+        const SceneOptions options{.camera = std::to_string(camera), .width = 64, .height = 64};
+        absl::StatusOr<Scene> scene = LoadScene(path, options);
+        ASSERT_TRUE(scene.ok()) << scene.status();
+        scene->directional_lights.push_back({Vec3d(0, 0, -1), Rgb(1.0f)});
+        const testing::PathRender render = testing::RenderPath(*scene, 4, 2, 1);
+        const std::vector<float>& r = *render.out.image.FindChannel("R");
+        for (const float v : r) {
+            ASSERT_TRUE(std::isfinite(v));
+            covered[camera] += v > 0;
+        }
+        covered[camera] /= double(r.size());
+    }
+    // A pixel on the square's rim may be partly covered: 2 * (32 + 23) rim pixels of 4096.
+    EXPECT_NEAR(covered[1], std::sqrt(0.5) / 4, 110.0 / 4096);
+    const double t = std::tan(0.35), near = 3 * t, far = (3 + std::sqrt(0.5)) * t;
+    const double trapezoid = (1 / near + 1 / far) / 2 * ((std::sqrt(0.5) - 0.5) / far + 0.5 / near);
+    EXPECT_NEAR(covered[0], trapezoid / 4, 100.0 / 4096);
+}
+
 }  // namespace
 }  // namespace lf

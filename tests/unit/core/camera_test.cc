@@ -95,5 +95,35 @@ TEST(Camera, ThinLensBlurCircleHasTheThinLensDiameter) {
     }
 }
 
+// Orthographic (glTF xmag/ymag): a point's pixel is its offset from the view axis over the film's
+// half extents, x = <p - o, r> / (h W/H), y = <p - o, u'> / h, raster ((x + 1) W/2, (1 - y) H/2);
+// the ray through that raster position runs parallel to the view axis through the point, from
+// the film plane, whatever the point's depth.
+TEST(Camera, OrthographicRayThroughAPointsClosedFormPixelMeetsIt) {
+    CameraSpec spec = Spec();
+    spec.projection = CameraSpec::Projection::kOrthographic;
+    spec.half_height = 2;        // half width 4 at 200 x 100
+    spec.aperture_radius = 0.5;  // no meaning for an orthographic camera: ignored
+    const Camera cam(spec, Vec3d(0, 0, 0));
+    EXPECT_TRUE(cam.IsOrthographic());
+    EXPECT_FALSE(cam.HasLens());
+    // right = f x up = (-1, 0, 0), up' = (0, 1, 0), from (1, 2, 3).
+    for (const Vec3d p : {Vec3d(2, 3, 7), Vec3d(-2.5, 0.5, 40), Vec3d(4.9, 3.9, 3.5)}) {
+        const double x = -(p.x - 1) / 4, y = (p.y - 2) / 2;
+        const double rx = (x + 1) * 100, ry = (1 - y) * 50;
+        const int px = int(std::floor(rx)), py = int(std::floor(ry));
+        const Ray r = cam.GenerateRay(px, py, float(rx - px), float(ry - py));
+        EXPECT_NEAR(r.d.x, 0, 1e-7);
+        EXPECT_NEAR(r.d.y, 0, 1e-7);
+        EXPECT_NEAR(r.d.z, 1, 1e-7);
+        EXPECT_NEAR(r.o.z, 3, 1e-6);
+        EXPECT_NEAR(r.o.x, p.x, 1e-5) << p.x;
+        EXPECT_NEAR(r.o.y, p.y, 1e-5) << p.y;
+    }
+    // Light paths cannot reach it by chance: no importance.
+    EXPECT_FALSE(cam.SampleWi(Vec3(2, 3, 7)).has_value());
+    EXPECT_EQ(cam.We(Ray{Vec3(2, 3, 3), Vec3(0, 0, 1)}), 0);
+}
+
 }  // namespace
 }  // namespace lf

@@ -514,18 +514,12 @@ TEST_F(GltfSceneTest, AbsurdlyLargeImageIsRefusedNamingIt) {
     ExpectError(Load(testing::TexturedTestScene()), {"scene.gltf", "images[0] \"checker\""});
 }
 
-TEST_F(GltfSceneTest, RequiredUnsupportedExtensionsOrthographicAndMissingCamerasAreRefused) {
+TEST_F(GltfSceneTest, RequiredUnsupportedExtensionsAndMissingCamerasAreRefused) {
     GltfBuilder b = testing::TexturedTestScene();
     b.json()["extensionsRequired"] = {"KHR_lights_punctual", "KHR_draco_mesh_compression",
                                       "EXT_meshopt_compression"};
     ExpectError(Load(b), {"extensionsRequired",
                           "does not support KHR_draco_mesh_compression, EXT_meshopt_compression"});
-
-    GltfBuilder ortho = testing::TexturedTestScene();
-    ortho.json()["cameras"][0] = {
-        {"type", "orthographic"},
-        {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0}, {"zfar", 10}}}};
-    ExpectError(Load(ortho), {"cameras[0]", "orthographic", "perspective cameras only"});
 
     GltfBuilder none = testing::TexturedTestScene();
     none.json()["scenes"][0]["nodes"] = {2, 4};
@@ -594,6 +588,130 @@ TEST_F(GltfSceneTest, ALightFlattenedAlongItsAxisIsSkippedWithAWarning) {
     EXPECT_NE(CapturedLog().str().find("spot light under a transform that flattens its axis"),
               std::string::npos)
         << CapturedLog().str();
+}
+
+// glTF's orthographic camera: ymag is the film's half height, xmag / ymag its aspect; it looks
+// down its node's -Z like a perspective one.
+TEST_F(GltfSceneTest, OrthographicCamerasKeepTheirMagnificationAndAspect) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["cameras"][0] = {
+        {"type", "orthographic"},
+        {"orthographic", {{"xmag", 3}, {"ymag", 1.5}, {"znear", 0.01}, {"zfar", 10}}}};
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_EQ(scene->camera.projection, CameraSpec::Projection::kOrthographic);
+    EXPECT_DOUBLE_EQ(scene->camera.half_height, 1.5);
+    EXPECT_EQ(scene->camera.width, kGltfLongerSide);
+    EXPECT_EQ(scene->camera.height, kGltfLongerSide / 2);
+}
+
+// A file is refused for a camera only when that camera is the one rendered; unnamed cameras are
+// picked by their order.
+TEST_F(GltfSceneTest, ACameraThatIsNotRenderedNeverRefusesTheFile) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Json& j = b.json();
+    j["cameras"].push_back({{"type", "perspective"}, {"perspective", {{"yfov", 0}, {"znear", 1}}}});
+    j["cameras"].push_back(
+        {{"type", "orthographic"},
+         {"orthographic", {{"xmag", 0}, {"ymag", 1}, {"znear", 0}, {"zfar", 1}}}});
+    j["scenes"][0]["nodes"].push_back(b.AddNode({{"camera", 1}}));
+    j["scenes"][0]["nodes"].push_back(b.AddNode({{"camera", 2}}));
+    const absl::StatusOr<Scene> first = Load(b);
+    ASSERT_TRUE(first.ok()) << first.status();
+    EXPECT_EQ(first->camera.projection, CameraSpec::Projection::kPerspective);
+    ExpectError(Load(b, "scene.gltf", {.camera = "1"}), {"scene.gltf", "cameras[1]", "yfov 0"});
+    ExpectError(Load(b, "scene.gltf", {.camera = "2"}),
+                {"cameras[2]", "xmag 0 and ymag 1 must be non-zero"});
+    ExpectError(Load(b, "scene.gltf", {.camera = "3"}), {"no camera named \"3\"", "0 to 2"});
+}
+
+// Khronos' Cameras asset (tests/scenes/khronos/Cameras, CC0): one perspective and one
+// orthographic camera, both unnamed.
+TEST(GltfCamerasAsset, LoadsWithEitherCamera) {
+    const std::string path = std::string(LF_TEST_SCENES) + "/khronos/Cameras/Cameras.gltf";
+    const absl::StatusOr<Scene> perspective = LoadScene(path);
+    ASSERT_TRUE(perspective.ok()) << perspective.status();
+    EXPECT_EQ(perspective->camera.projection, CameraSpec::Projection::kPerspective);
+    EXPECT_NEAR(perspective->camera.fov_y_deg, 0.7 * 180 / std::numbers::pi, 1e-9);
+    const absl::StatusOr<Scene> ortho = LoadScene(path, {.camera = "1"});
+    ASSERT_TRUE(ortho.ok()) << ortho.status();
+    EXPECT_EQ(ortho->camera.projection, CameraSpec::Projection::kOrthographic);
+    EXPECT_DOUBLE_EQ(ortho->camera.half_height, 1);
+    ExpectNear(ortho->camera.position, Vec3d(0.5, 0.5, 3));
+}
+
+// COLOR_0 as normalized unsigned bytes (VEC3, alpha 1) or floats (VEC4) becomes the mesh's
+// linear RGBA vertex colours.
+TEST_F(GltfSceneTest, VertexColoursAreImportedAsLinearRgba) {
+    GltfBuilder b = testing::TexturedTestScene();
+    const uint8_t bytes[9] = {255, 0, 0, 0, 51, 0, 0, 0, 255};
+    const int tri_colours = b.AddAccessor(bytes, sizeof bytes, 5121, "VEC3", 3);
+    b.json()["accessors"][size_t(tri_colours)]["normalized"] = true;
+    b.json()["meshes"][1]["primitives"][0]["attributes"]["COLOR_0"] = tri_colours;
+    b.json()["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = b.AddFloats<4>(
+        {{{1, 1, 1, 0.25f}}, {{0.5f, 0.5f, 0.5f, 1}}, {{0, 0, 0, 1}}, {{1, 0, 1, 0.5f}}});
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const TriangleMesh* quad = nullptr;
+    const TriangleMesh* tri = nullptr;
+    for (const TriangleMesh& m : scene->meshes) (m.name.starts_with("quad") ? quad : tri) = &m;
+    ASSERT_TRUE(quad && tri);
+    ASSERT_EQ(tri->colors.size(), 3u);
+    EXPECT_EQ(tri->colors[0], (std::array<float, 4>{1, 0, 0, 1}));
+    EXPECT_EQ(tri->colors[1], (std::array<float, 4>{0, 0.2f, 0, 1}));
+    ASSERT_EQ(quad->colors.size(), 4u);
+    EXPECT_EQ(quad->colors[3], (std::array<float, 4>{1, 0, 1, 0.5f}));
+
+    GltfBuilder bad = testing::TexturedTestScene();
+    bad.json()["meshes"][1]["primitives"][0]["attributes"]["COLOR_0"] =
+        bad.AddFloats<2>({{{1, 1}}, {{1, 1}}, {{1, 1}}});
+    ExpectError(Load(bad), {"COLOR_0", "2 components per element, expected 3 or 4"});
+}
+
+// Khronos' VertexColorTest (tests/scenes/khronos, CC-BY 4.0, Analytical Graphics): its test
+// row's checks carry red, green and blue vertex colours that zero the fail marks' channels.
+TEST(GltfVertexColorAsset, TheTestRowGetsItsVertexColours) {
+    const std::string path =
+        std::string(LF_TEST_SCENES) + "/khronos/VertexColorTest/VertexColorTest.gltf";
+    CapturedLog().str("");
+    const absl::StatusOr<Scene> scene = LoadScene(path, {.camera = "auto"});
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    size_t coloured = 0, pure[3] = {0, 0, 0};
+    for (const TriangleMesh& m : scene->meshes) {
+        if (m.colors.empty()) continue;
+        coloured += m.colors.size();
+        for (const auto& c : m.colors) {
+            for (int k = 0; k < 3; ++k) {
+                pure[k] +=
+                    c[size_t(k)] == 1 && c[size_t((k + 1) % 3)] == 0 && c[size_t((k + 2) % 3)] == 0;
+            }
+        }
+    }
+    EXPECT_GT(coloured, 0u);
+    for (const size_t n : pure) EXPECT_GT(n, 0u);
+    EXPECT_EQ(CapturedLog().str().find("COLOR_0"), std::string::npos) << CapturedLog().str();
+}
+
+// A loss many objects share is one warning with a count, and a glTF rendered directly names its
+// file once in it (the log line's prefix), not once per material.
+TEST_F(GltfSceneTest, WarningsComeOncePerKindWithACountNamingTheFileOnce) {
+    GltfBuilder b = testing::TexturedTestScene();
+    for (Json& m : b.json()["materials"]) m["occlusionTexture"] = {{"index", 0}};
+    const size_t materials = b.json()["materials"].size();
+    ASSERT_GE(materials, 2u);
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const std::string log = CapturedLog().str();
+    const std::string kind = "occlusionTexture ignored";
+    const size_t at = log.find(kind);
+    ASSERT_NE(at, std::string::npos) << log;
+    EXPECT_EQ(log.find(kind, at + 1), std::string::npos) << log;
+    const size_t begin = log.rfind('\n', at) + 1, end = log.find('\n', at);
+    const std::string line = log.substr(begin, end - begin);
+    EXPECT_NE(line.find(absl::StrCat("in ", materials, " materials: materials[0]")),
+              std::string::npos)
+        << line;
+    EXPECT_EQ(line.find("scene.gltf"), line.rfind("scene.gltf")) << line;
 }
 
 }  // namespace

@@ -388,6 +388,30 @@ TEST_F(SceneLoaderTest, MaterialErrorsNameThePath) {
     ExpectError(WithMaterial("[]"), "scene.json: materials.m: expected an object, got array");
 }
 
+// "type": "orthographic" takes the film's half height in place of a field of view.
+TEST_F(SceneLoaderTest, OrthographicCameraTakesAHalfHeight) {
+    auto with_camera = [](const std::string& fields) {
+        return SceneJson(
+            kQuad, kMaterials,
+            R"({"position": [0, 0, -5], "look_at": [0, 0, 0], "resolution": [8, 4], )" + fields +
+                "}");
+    };
+    const absl::StatusOr<Scene> scene =
+        Parse(with_camera(R"("type": "orthographic", "half_height": 2.5)"));
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_EQ(scene->camera.projection, CameraSpec::Projection::kOrthographic);
+    EXPECT_DOUBLE_EQ(scene->camera.half_height, 2.5);
+    ExpectError(with_camera(R"("type": "orthographic")"),
+                "scene.json: camera: missing required key \"half_height\"");
+    ExpectError(with_camera(R"("type": "orthographic", "half_height": 1, "fov_y_deg": 40)"),
+                "scene.json: camera.fov_y_deg: has no meaning for an orthographic camera");
+    ExpectError(with_camera(R"("type": "fisheye", "fov_y_deg": 40)"),
+                "scene.json: camera.type: unknown camera type \"fisheye\"; expected perspective "
+                "or orthographic");
+    ExpectError(with_camera(R"("half_height": 1, "fov_y_deg": 40)"),
+                "scene.json: camera.half_height: is for orthographic cameras");
+}
+
 TEST_F(SceneLoaderTest, CameraErrorsNameThePath) {
     auto with_camera = [](const std::string& fields) {
         return SceneJson(kQuad, kMaterials, "{" + fields + "}");

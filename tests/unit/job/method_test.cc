@@ -50,5 +50,23 @@ TEST(Method, WhittedHeaderNamesItsMethodAndLightSampling) {
     }
 }
 
+// Light tracing and bdpt reach the camera through its importance, which an orthographic camera
+// (one direction) does not have: they refuse it by name; the others render it.
+TEST(Method, OnlyMethodsThatTraceFromTheCameraTakeAnOrthographicCamera) {
+    Scene scene;
+    scene.camera.projection = CameraSpec::Projection::kOrthographic;
+    for (const MethodInfo& info : AllMethods()) {
+        if (info.method == Method::kRadiosity) continue;  // refuses this empty scene
+        const absl::Status s = CheckMethodTakesScene(info.method, scene);
+        if (info.splats_light_paths) {
+            EXPECT_EQ(s.code(), absl::StatusCode::kFailedPrecondition) << info.name;
+            EXPECT_NE(s.message().find("orthographic cameras are not supported"), std::string::npos)
+                << s;
+        } else {
+            EXPECT_TRUE(s.ok()) << info.name << ": " << s;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lf

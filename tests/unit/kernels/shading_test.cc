@@ -124,6 +124,67 @@ TEST(TextureOrientation, BaseColourTextureScalesLambertAlbedo) {
     }
 }
 
+// COLOR_0 multiplies the base colour, interpolated barycentrically: on the quad (-1,1) red,
+// (-1,-1) green, (1,-1) blue, (1,1) white, a pixel centre (x, y) of triangle (0, 1, 2) has
+// weights b1 = (1 - y) / 2 - b2, b2 = (1 + x) / 2; of (0, 2, 3) b1 = (1 - y) / 2, b2 = (x + y) / 2
+// (world x, y of the point), so the lambert render is the uncoloured one times that colour, per
+// pixel, to float rounding (same seed, same paths).
+TEST(VertexColours, MultiplyTheBaseColourAtTheHitsBarycentrics) {
+    Scene white;
+    Material m;
+    m.reflectance = Rgb(0.5f);
+    white.materials.push_back(m);
+    white.meshes.push_back(UvQuad(1, 0, 0));
+    white.point_lights.push_back({{0.2, -0.1, 0.8}, Rgb(1)});
+    white.camera = FrontCamera(16);
+    Scene coloured = white;
+    coloured.meshes[0].colors = {{1, 0, 0, 1}, {0, 1, 0, 1}, {0, 0, 1, 1}, {1, 1, 1, 1}};
+    const Rgb vertex[4] = {Rgb(1, 0, 0), Rgb(0, 1, 0), Rgb(0, 0, 1), Rgb(1, 1, 1)};
+    const RenderOutput a = testing::RenderPath(white, 4).out;
+    const RenderOutput b = testing::RenderPath(coloured, 4).out;
+    for (int py = 0; py < 16; ++py) {
+        for (int px = 0; px < 16; ++px) {
+            // Both renders draw the same film points; the colour is linear over each triangle
+            // (pixels the diagonal x = -y crosses are left out), so the ratio is the colour at
+            // the pixel centre within its change over half a pixel (1/32 per weight).
+            const double x = (px + 0.5) / 8 - 1, y = 1 - (py + 0.5) / 8;
+            if (std::abs(x + y) < 0.2) continue;
+            const bool first = x < -y;  // triangle (0, 1, 2) holds the bottom-left half
+            const double b2 = first ? (1 + x) / 2 : (x + y) / 2;
+            const double b1 = first ? (1 - y) / 2 - b2 : (1 - y) / 2;
+            const double b0 = 1 - b1 - b2;
+            const Rgb& v1 = first ? vertex[1] : vertex[2];
+            const Rgb& v2 = first ? vertex[2] : vertex[3];
+            const Rgb colour = vertex[0] * float(b0) + v1 * float(b1) + v2 * float(b2);
+            for (int c = 0; c < 3; ++c) {
+                const float lit = a.image.Pixel(px, py)[c];
+                ASSERT_GT(lit, 0) << px << "," << py << " ch " << c;
+                EXPECT_NEAR(b.image.Pixel(px, py)[c], lit * colour[c], 0.07 * lit)
+                    << px << "," << py << " ch " << c;
+            }
+        }
+    }
+}
+
+// COLOR_0's alpha multiplies the opacity an alpha mask cuts at.
+TEST(VertexColours, AlphaMultipliesTheOpacity) {
+    Scene scene;
+    Material m;
+    m.alpha_mode = Material::AlphaMode::kMask;
+    m.alpha_cutoff = 0.5f;
+    scene.materials.push_back(m);
+    scene.meshes.push_back(UvQuad(1, 0, 0));
+    // Alpha 0 on the left edge, 1 on the right: the cut at alpha 0.5 is x = 0.
+    scene.meshes[0].colors = {{1, 1, 1, 0}, {1, 1, 1, 0}, {1, 1, 1, 1}, {1, 1, 1, 1}};
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    const Vec3 down(0, 0, -1);
+    EXPECT_FALSE((*es)->Intersect(Ray{Vec3(-0.3f, 0.5f, 1), down}).has_value());
+    EXPECT_FALSE((*es)->Intersect(Ray{Vec3(-0.1f, -0.5f, 1), down}).has_value());
+    EXPECT_TRUE((*es)->Intersect(Ray{Vec3(0.1f, 0.5f, 1), down}).has_value());
+    EXPECT_TRUE((*es)->Intersect(Ray{Vec3(0.3f, -0.5f, 1), down}).has_value());
+}
+
 // The metallic-roughness texture's G channel scales roughness and its B channel metallic (its
 // R, occlusion in some exports, is ignored); the base colour texture scales the base colour.
 TEST(TexturedParams, FactorsTimesTexels) {

@@ -1,4 +1,5 @@
-// Pinhole or thin-lens camera exactly as docs/scene-format.md defines it, with its pixel filter.
+// Pinhole, thin-lens or orthographic camera exactly as docs/scene-format.md defines it, with its
+// pixel filter.
 #pragma once
 
 #include <optional>
@@ -26,6 +27,11 @@ class Camera {
 
     // Whether rays need a lens sample: a pinhole takes none, so its renders keep their bits.
     bool HasLens() const { return lens_radius_ > 0; }
+
+    // Orthographic cameras see along one direction only: no light path reaches them by
+    // chance, so the importance functions below are for perspective cameras (methods that
+    // connect light paths to the camera refuse orthographic ones).
+    bool IsOrthographic() const { return orthographic_; }
 
     // Importance: the camera's end of a light path (pbrt-v4's PerspectiveCamera::We, PDF_We,
     // SampleWi), normalised as pbrt does: We cos integrated over the film's directions and the
@@ -77,7 +83,9 @@ class Camera {
     std::optional<Vec2> Raster(const Ray& ray, float* cos_theta) const;
 
     Vec3 position_, forward_, right_, up_;
-    float tan_half_fov_ = 0, aspect_ = 1;
+    bool orthographic_ = false;
+    float tan_half_fov_ = 0, aspect_ = 1;  // tan_half_fov_: the film's half height at distance 1
+                                           // (orthographic: the film's half height)
     float lens_radius_ = 0, focus_distance_ = 1;
     float film_area_ = 1;  // of the film at distance 1 from the pinhole
     float lens_area_ = 1;  // pi r^2, or 1 for a pinhole

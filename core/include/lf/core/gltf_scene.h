@@ -20,6 +20,9 @@ namespace lf {
 struct GltfCamera {
     std::string name;  // the node's name, or the camera's when the node has none
     CameraSpec spec;
+    // Why the camera cannot render ("cameras[1]: yfov 0 ..."): an error only when
+    // it is chosen, so a file is never refused for a camera it does not render from.
+    std::string error;
 };
 
 // The image side a glTF camera gets for its longer side (the other from its aspectRatio; square
@@ -49,7 +52,8 @@ absl::Status AppendGltf(const std::string& bytes, const std::string& name,
                         std::vector<GltfCamera>& cameras, std::vector<std::string>& warnings);
 
 // The camera named `name` among `cameras` (empty name: the first). NotFound listing the names
-// when there is no such camera, or when there is none at all.
+// when there is no such camera, or when there is none at all; InvalidArgument with its error for
+// a camera that cannot render.
 absl::StatusOr<CameraSpec> ChooseGltfCamera(const std::vector<GltfCamera>& cameras,
                                             const std::string& name);
 

@@ -119,6 +119,8 @@ struct TriangleMesh {
     std::vector<Vec3> normals;  // unit, in the same space as positions
     std::vector<Vec2> uvs;      // TEXCOORD_0: v = 0 is the top of the image
     std::vector<std::array<float, 4>> tangents;
+    // COLOR_0, linear RGBA: multiplies the base colour and its alpha the opacity (glTF).
+    std::vector<std::array<float, 4>> colors;
     // True when the mesh came from a `quad` shape: (v0,v1,v2),(v0,v2,v3). Radiosity meshes
     // such shapes as a grid of quads rather than triangles.
     bool is_quad = false;
@@ -186,10 +188,16 @@ struct PixelFilter {
 };
 
 struct CameraSpec {
+    // Perspective: rays leave `position` through a film of vertical angle fov_y_deg.
+    // Orthographic (glTF's xmag/ymag): parallel rays along the view axis from a film
+    // 2 half_height tall (scene units) centred on `position`, as wide as the image's aspect.
+    enum class Projection { kPerspective, kOrthographic };
+    Projection projection = Projection::kPerspective;
     Vec3d position{0, 0, 0};
     Vec3d look_at{0, 0, 1};
     Vec3d up{0, 1, 0};
     double fov_y_deg = 45;
+    double half_height = 1;  // orthographic only
     int width = 256;
     int height = 256;
     // Thin lens (distributed ray tracing): rays leave a disk of this radius around `position`,

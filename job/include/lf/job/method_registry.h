@@ -59,8 +59,8 @@ absl::StatusOr<Method> ParseMethod(std::string_view name);
 Method MethodOf(const JobSpec& spec);
 
 // Ok when `method` can render `scene` as its camera sees it: FailedPrecondition naming the
-// method and the pixel filter for a splatting method and a filter other than the box; the
-// method's scene_refusal otherwise.
+// method and the pixel filter for a splatting method and a filter other than the box, or for a
+// splatting method and an orthographic camera; the method's scene_refusal otherwise.
 absl::Status CheckMethodTakesScene(Method method, const Scene& scene);
 // The pixel filter part of CheckMethodTakesScene, for a camera already built.
 absl::Status CheckMethodTakesFilter(Method method, const PixelFilter& filter);

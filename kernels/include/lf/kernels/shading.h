@@ -5,6 +5,7 @@
 #pragma once
 
 #include "lf/core/scene.h"
+#include "lf/core/texture.h"
 #include "lf/kernels/bsdf.h"
 #include "lf/kernels/embree_scene.h"
 
@@ -59,11 +60,15 @@ Rgb EmissionAt(const EmbreeScene& scene, const SurfacePoint& light_point, const 
 // TEXCOORD_0 of a triangle's point; (0, 0) on meshes without uvs.
 Vec2 TriangleUv(const TriangleMesh& mesh, int primitive, float b1, float b2);
 
-// The material's opacity at uv: its factor times the base colour texture's alpha.
-float Opacity(const Scene& scene, const Material& material, const Vec2& uv);
+// COLOR_0 of a triangle's point; white and opaque on meshes without vertex colours.
+Rgba VertexColor(const TriangleMesh& mesh, int primitive, float b1, float b2);
+
+// The material's opacity at uv: its factor times the base colour texture's alpha times the
+// vertex colour's alpha there.
+float Opacity(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha = 1);
 
 // True when rays pass through the material at uv (an alpha-mask hole).
-bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv);
+bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha = 1);
 
 // Materials whose back faces let light out: single-sided culling spares them.
 bool Transmits(const Material& material);
