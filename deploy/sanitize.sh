@@ -6,8 +6,12 @@
 #  3. each fuzz target of tests/fuzz for FUZZ_SECONDS (default 60) from its seed corpus. A crash
 #     fails the run and is kept as build-san/fuzz-crashes/TARGET-*: add it to
 #     tests/fuzz/regressions/TARGET/, which every build's ctest replays.
-#  4. a ThreadSanitizer build (build-tsan/) of the coordinator's scheduler, lease, store, timeout
-#     and in-process farm tests (TSAN_TESTS), run there.
+#  4. a ThreadSanitizer build (build-tsan/) of the coordinator's scheduler, lease, store and
+#     timeout tests and farm_concurrency_test (a Farm driven from many threads without gRPC)
+#     (TSAN_TESTS), run there with tests/sanitizers/tsan.supp. The gRPC tests are not run under
+#     it: Debian's gRPC and Abseil are not built with ThreadSanitizer, so it cannot see their
+#     locks and reports their hand-offs between threads as races (fake_worker_farm_test: 1429
+#     false reports with the suppressions, in gRPC's metadata maps and Abseil's Status and Cord).
 # Prints how long each part took.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -44,13 +48,13 @@ t3=$(date +%s)
 echo "sanitize: fuzzing: $((t3 - t2)) s"
 tsan_tests=(${TSAN_TESTS:-scheduler_test scheduler_tasks_test scheduling_policies_test splat_scheduler_test
   lease_table_test worker_registry_test job_store_test sqlite_job_store_test timeout_checker_test
-  task_log_store_test fake_worker_farm_test})
+  task_log_store_test farm_concurrency_test})
 cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DLF_SANITIZE=thread >/dev/null
 cmake --build build-tsan -j"${JOBS:-2}" --target "${tsan_tests[@]}" >/dev/null
 t4=$(date +%s)
 echo "sanitize: build of ${#tsan_tests[@]} coordinator test programs with thread: $((t4 - t3)) s"
-export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
+export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/sanitizers/tsan.supp
 for t in "${tsan_tests[@]}"; do
   (cd build-tsan && LF_TEST_QUIET=1 "bin/$t" --gtest_brief=1 >"$t.log" 2>&1) || {
     echo "sanitize: $t failed under thread:"; tail -80 "build-tsan/$t.log"; exit 1; }

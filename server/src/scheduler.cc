@@ -53,6 +53,7 @@ void Scheduler::Locked::SettleEnded() {
     for (const auto& [id, ticket] : ended) durable.push_back(scheduler_.store_.WaitDurable(ticket));
     lock.lock();
     for (size_t i = 0; i < ended.size(); ++i) scheduler_.ended_.Settle(ended[i].first, durable[i]);
+    scheduler_.left_memory_ += ended.size();
 }
 
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
@@ -64,25 +65,18 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     std::unique_ptr<Job> job = std::move(*made);
     job->Queue(job->execution->Start());
     job->record.submitted = clock_();
-    // The store is read before the lock is taken. An earlier submission it does not hold has not
-    // been acknowledged yet, so it is still in memory.
-    std::optional<std::string> stored;
-    if (!spec.request_id.empty()) {
-        absl::StatusOr<std::optional<std::string>> found = store_.FindRequest(spec.request_id);
-        if (!found.ok()) return found.status();
-        stored = *found;
-    }
     std::string id = NewJobId();
     while (store_.Get(id).ok()) id = NewJobId();
     Locked locked(*this);
-    std::optional<std::pair<std::string, uint64_t>> earlier =
-        stored ? std::pair{*stored, uint64_t(0)} : FindRequestInMemory(spec.request_id);
-    if (earlier) {
+    absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> earlier =
+        FindRequest(spec.request_id, locked);
+    if (!earlier.ok()) return earlier.status();
+    if (*earlier) {
         locked.lock.unlock();
-        if (absl::Status s = store_.WaitDurable(earlier->second); !s.ok()) return s;
-        Log()->info("job={} submitted again (request {})", earlier->first,
+        if (absl::Status s = store_.WaitDurable((*earlier)->second); !s.ok()) return s;
+        Log()->info("job={} submitted again (request {})", (*earlier)->first,
                     LogSafe(spec.request_id));
-        return earlier->first;
+        return (*earlier)->first;
     }
     if (active_.size() >= options_.max_active_jobs) {
         return absl::ResourceExhaustedError(
@@ -110,6 +104,24 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     }
     Log()->info("job={} queued: {}, priority {}", id, summary, spec.priority);
     return id;
+}
+
+absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> Scheduler::FindRequest(
+    const std::string& request_id, Locked& locked) {
+    if (request_id.empty()) return std::nullopt;
+    while (true) {
+        // The store is read without the lock. An earlier submission it does not hold has not
+        // been acknowledged yet, so it is in memory after the read, unless it ended and left
+        // memory for the store during the read: then the store is read again.
+        const uint64_t left_before = left_memory_;
+        locked.lock.unlock();
+        absl::StatusOr<std::optional<std::string>> stored = store_.FindRequest(request_id);
+        locked.lock.lock();
+        if (!stored.ok()) return stored.status();
+        if (*stored) return std::pair{**stored, uint64_t(0)};
+        if (auto in_memory = FindRequestInMemory(request_id)) return in_memory;
+        if (left_memory_ == left_before) return std::nullopt;
+    }
 }
 
 std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(

@@ -703,5 +703,63 @@ TEST(SchedulerLockTest, SubmitLooksUpItsRequestWithoutTheLock) {
     submit.join();
 }
 
+// A store whose next request lookup, once told to, answers and then waits: the submission that
+// made it goes on only after the job it missed has ended and left the scheduler's memory.
+class LateLookupStore : public InMemoryJobStore {
+  public:
+    absl::StatusOr<std::optional<std::string>> FindRequest(
+        const std::string& request_id) const override {
+        absl::StatusOr<std::optional<std::string>> found =
+            InMemoryJobStore::FindRequest(request_id);
+        std::unique_lock<std::mutex> lock(mutex_);
+        if (hold_next_) {
+            hold_next_ = false;
+            looked_up_ = true;
+            cv_.notify_all();
+            cv_.wait(lock, [this] { return released_; });
+        }
+        return found;
+    }
+    void HoldNextLookup() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        hold_next_ = true;
+    }
+    void AwaitLookedUp() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [this] { return looked_up_; });
+    }
+    void Release() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        released_ = true;
+        cv_.notify_all();
+    }
+
+  private:
+    mutable std::mutex mutex_;
+    mutable std::condition_variable cv_;
+    mutable bool hold_next_ = false, looked_up_ = false;
+    bool released_ = false;
+};
+
+// A retried submission whose store lookup came before its first attempt was recorded, and whose
+// first attempt's job ended meanwhile, still gets that job (it got AlreadyExists before).
+TEST(SchedulerLockTest, RetryGetsTheFirstJobThatEndedDuringItsLookup) {
+    LateLookupStore store;
+    Scheduler scheduler({}, store);
+    store.HoldNextLookup();
+    std::future<absl::StatusOr<std::string>> retry =
+        std::async(std::launch::async, [&] { return scheduler.Submit(SmallSpec("req-1")); });
+    store.AwaitLookedUp();
+    const absl::StatusOr<std::string> first = scheduler.Submit(SmallSpec("req-1"));
+    ASSERT_TRUE(first.ok()) << first.status();
+    ASSERT_TRUE(scheduler.Cancel(*first).ok());  // recorded, and gone from memory
+    store.Release();
+    const absl::StatusOr<std::string> again = retry.get();
+    ASSERT_TRUE(again.ok()) << again.status();
+    EXPECT_EQ(*again, *first);
+    EXPECT_EQ(scheduler.List()->size(), 1u);
+    EXPECT_FALSE(scheduler.LeaseTask("w").has_value());  // nothing of a second job queued
+}
+
 }  // namespace
 }  // namespace lf

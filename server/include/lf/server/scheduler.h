@@ -254,6 +254,10 @@ class Scheduler {
         Scheduler& scheduler_;
     };
 
+    // The job of an earlier submission with this request id, in the store or in memory, and the
+    // store ticket to wait for. Called and returns with `locked` held; reads the store without.
+    absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> FindRequest(
+        const std::string& request_id, Locked& locked);
     // The job of an earlier submission with this request id held in memory, and the store
     // ticket to wait for.
     std::optional<std::pair<std::string, uint64_t>> FindRequestInMemory(
@@ -300,6 +304,7 @@ class Scheduler {
     uint64_t next_seq_ = 1;
     std::map<std::string, std::unique_ptr<Job>> active_;
     EndedJobs ended_;
+    uint64_t left_memory_ = 0;  // ended jobs settled out of `ended_`, for FindRequest
     // Ended jobs' tasks, for tasks_ended_ once the lock is released.
     std::vector<std::pair<std::string, std::vector<TaskStatus>>> ended_tasks_;
     TasksEnded tasks_ended_;
