@@ -130,8 +130,8 @@ Rgb PrincipledBsdf::ThinTransmissionEval(const Vec3& wo, const Vec3& wi) const {
     const float weight = (1 - metallic_) * transmission_;
     if (!(weight > 0)) return {};
     const Vec3 wm = Normalize(wo + wi);
-    return Rgb(weight * (1 - LayerFresnel(Dot(wo, wm), true)) * distribution_.D(wm) *
-               distribution_.GOverCosines(wo, wi) / 4);
+    return base_ * (weight * (1 - LayerFresnel(Dot(wo, wm), true)) * distribution_.D(wm) *
+                    distribution_.GOverCosines(wo, wi) / 4);
 }
 
 std::optional<Vec3> PrincipledBsdf::RefractionNormal(const Vec3& wo, const Vec3& wi) const {
@@ -161,7 +161,7 @@ Rgb PrincipledBsdf::RefractionEval(const Vec3& wo, const Vec3& wi) const {
     const float value = weight * (1 - fresnel) * distribution_.D(*wm) *
                         distribution_.GOverCosines(wo, wi) * -cos_im * cos_om /
                         (half * half * eta * eta);
-    return Rgb(std::max(0.0f, value));
+    return base_ * std::max(0.0f, value);
 }
 
 float PrincipledBsdf::RefractionPdf(const Vec3& wo, const Vec3& wi) const {

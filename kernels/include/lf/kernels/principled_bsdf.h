@@ -5,7 +5,7 @@
 //   f = metallic * conductor + (1 - metallic) * dielectric
 //   conductor  = F_schlick(base, wo.wm) D G / (4 cos_o cos_i), GGX with alpha = r^2
 //   dielectric = s F D G / (4 cos_o cos_i)                     specular layer, s = `specular`,
-//              + t (1 - s F) BTDF                              F = Schlick with F0 from the IOR
+//              + t (1 - s F) base BTDF                         F = Schlick with F0 from the IOR
 //              + (1 - t) base/pi (1 - s E(wo)) (1 - s E(wi)) / (1 - s E_avg)
 //
 // The last line is where this departs from the specification: its diffuse weight 1 - F(wo.wm)
@@ -16,7 +16,9 @@
 // reciprocal and makes the albedo exactly s E(wo) + (1 - s E(wo)) base for an opaque dielectric:
 // never above one.
 //
-// The BTDF: with `thickness` 0 the surface is a thin wall, and transmission is the specular
+// The BTDF is tinted by the base colour at every crossing (KHR_materials_transmission), so solid
+// glass tints twice, on entry and exit, besides Beer's law inside (lf/kernels/shading.h). With
+// `thickness` 0 the surface is a thin wall, and transmission is the specular
 // lobe mirrored to the other side (light passes through without bending, blurred by the
 // roughness). Above 0 the mesh is the boundary of a solid of relative IOR `ior` and the BTDF is
 // Walter et al.'s rough dielectric (2007), F then taken at the cosine on the outside of the
