@@ -155,14 +155,12 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         }
     }
     m.double_sided = g.doubleSided;
-    if (g.alphaMode == "MASK" || g.alphaMode == "BLEND") {
+    if (g.alphaMode == "MASK") {
         m.alpha_mode = lf::Material::AlphaMode::kMask;
         m.alpha_cutoff = float(g.alphaCutoff);
-        if (g.alphaMode == "BLEND") {
-            Warn(where + ": alphaMode BLEND rendered as MASK with alphaCutoff 0.5");
-            m.alpha_cutoff = 0.5f;
-        }
         if (!(m.alpha_cutoff >= 0)) Fail(where, "alphaCutoff must be at least 0");
+    } else if (g.alphaMode == "BLEND") {
+        m.alpha_mode = lf::Material::AlphaMode::kBlend;
     } else if (g.alphaMode != "OPAQUE") {
         Fail(where, absl::StrCat("alphaMode \"", g.alphaMode,
                                  "\" is unknown; expected OPAQUE, MASK or BLEND"));

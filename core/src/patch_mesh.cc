@@ -190,6 +190,9 @@ std::string RadiosityLimitation(const Scene& scene) {
         if (m.alpha_mode == Material::AlphaMode::kMask) {
             return what + "has an alpha mask, which radiosity does not model";
         }
+        if (m.alpha_mode == Material::AlphaMode::kBlend) {
+            return what + "is alpha-blended, which radiosity does not model";
+        }
         if (!m.double_sided) return what + "is single-sided, which radiosity does not model";
     }
     if (!scene.spheres.empty()) {

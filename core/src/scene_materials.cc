@@ -178,9 +178,10 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
         m.emission_texture = ParseTexture(*texture, true);
     }
     if (const std::optional<Node> mode = n.Find("alpha_mode")) {
-        m.alpha_mode = mode->OneOf<Material::AlphaMode>(
-            "alpha mode",
-            {{"opaque", Material::AlphaMode::kOpaque}, {"mask", Material::AlphaMode::kMask}});
+        m.alpha_mode = mode->OneOf<Material::AlphaMode>("alpha mode",
+                                                        {{"opaque", Material::AlphaMode::kOpaque},
+                                                         {"mask", Material::AlphaMode::kMask},
+                                                         {"blend", Material::AlphaMode::kBlend}});
     }
     if (const std::optional<Node> sided = n.Find("double_sided")) m.double_sided = sided->Bool();
 }

@@ -1,8 +1,10 @@
 #include "lf/kernels/shading.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
+#include "lf/core/sampler.h"
 #include "lf/core/texture.h"
 #include "lf/kernels/float_util.h"
 
@@ -107,6 +109,27 @@ bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv) {
            Opacity(scene, material, uv) < material.alpha_cutoff;
 }
 
+bool PassesThrough(const Scene& scene, const Material& material, const Vec2& uv, float u) {
+    switch (material.alpha_mode) {
+        case Material::AlphaMode::kOpaque:
+            return false;
+        case Material::AlphaMode::kMask:
+            return IsCutOut(scene, material, uv);
+        case Material::AlphaMode::kBlend:
+            return u >= Opacity(scene, material, uv);
+    }
+    return false;
+}
+
+float AlphaHash(const Vec3& origin, const Vec3& direction, unsigned geometry, unsigned primitive) {
+    uint64_t h = MixBits((uint64_t(geometry) << 32) | primitive);
+    for (int i = 0; i < 3; ++i) {
+        h = MixBits(h ^ ((uint64_t(std::bit_cast<uint32_t>(origin[i])) << 32) |
+                         std::bit_cast<uint32_t>(direction[i])));
+    }
+    return float(h >> 40) * 0x1p-24f;
+}
+
 bool Transmits(const Material& material) {
     return material.type == Material::Type::kDielectric ||
            (material.type == Material::Type::kPrincipled && material.transmission > 0);
@@ -191,13 +214,15 @@ Rgb EmissionAt(const EmbreeScene& es, const SurfacePoint& light_point, const Rgb
     const Scene& scene = es.scene();
     const TriangleMesh& mesh = scene.meshes[size_t(light_point.mesh)];
     const Material& m = scene.materials[size_t(mesh.material)];
-    if (!m.emission_texture.valid() && m.alpha_mode != Material::AlphaMode::kMask) {
+    if (!m.emission_texture.valid() && m.alpha_mode == Material::AlphaMode::kOpaque) {
         return radiance;
     }
     const Vec2 uv = TriangleUv(mesh, light_point.primitive, light_point.b1, light_point.b2);
     if (IsCutOut(scene, m, uv)) return Rgb(0);
-    if (!m.emission_texture.valid()) return radiance;
-    return radiance * Sample(scene, m.emission_texture, uv).rgb;
+    Rgb le = radiance;
+    if (m.alpha_mode == Material::AlphaMode::kBlend) le *= Opacity(scene, m, uv);
+    if (m.emission_texture.valid()) le *= Sample(scene, m.emission_texture, uv).rgb;
+    return le;
 }
 
 }  // namespace lf

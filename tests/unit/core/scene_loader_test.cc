@@ -663,7 +663,8 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
                 "metallic_roughness_texture": "mr.png",
                 "normal_texture": {"file": "mr.png", "wrap": "clamp"}, "normal_scale": 0.5,
                 "emission_texture": "wood.png"},
-            "glow": {"type": "principled", "emission_texture": "wood.png"}})"));
+            "glow": {"type": "principled", "emission_texture": "wood.png",
+                "alpha_mode": "blend"}})"));
     ASSERT_TRUE(scene.ok()) << scene.status();
     EXPECT_TRUE(CapturedLog().str().empty()) << CapturedLog().str();
     ASSERT_EQ(scene->textures.size(), 2u);
@@ -714,6 +715,7 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
     // An emission texture alone is the radiance: its factor defaults to 1.
     EXPECT_EQ(scene->materials[3].emission, Rgb(1));
     EXPECT_EQ(scene->materials[3].reflectance, Rgb(0.8f));
+    EXPECT_EQ(scene->materials[3].alpha_mode, Material::AlphaMode::kBlend);
 }
 
 TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
@@ -735,9 +737,9 @@ TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
                 "scene.json: materials.m.base_color[2]: must be in [0, 1], got 2");
     ExpectError(WithMaterial(p + R"("base_color": [1, 1, 1], "reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m: give either base_color or reflectance");
-    ExpectError(WithMaterial(p + R"("alpha_mode": "blend"})"),
-                "scene.json: materials.m.alpha_mode: unknown alpha mode \"blend\"; expected "
-                "opaque or mask");
+    ExpectError(WithMaterial(p + R"("alpha_mode": "add"})"),
+                "scene.json: materials.m.alpha_mode: unknown alpha mode \"add\"; expected "
+                "opaque, mask or blend");
     ExpectError(WithMaterial(p + R"("double_sided": "yes"})"),
                 "scene.json: materials.m.double_sided: expected true or false, got string");
     ExpectError(

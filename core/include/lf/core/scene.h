@@ -51,7 +51,7 @@ struct TextureRef {
 struct Material {
     enum class Type { kLambert, kMirror, kGlossy, kDielectric, kPrincipled };
     enum class Distribution { kGgx, kBeckmann };
-    enum class AlphaMode { kOpaque, kMask };
+    enum class AlphaMode { kOpaque, kMask, kBlend };
 
     std::string name;
     Type type = Type::kLambert;
@@ -86,6 +86,8 @@ struct Material {
     TextureRef base_color_texture, metallic_roughness_texture, normal_texture, emission_texture;
     float normal_scale = 1;  // scales the normal map's x and y (glTF normalTexture.scale)
     float opacity = 1;       // base colour alpha factor; with the texture's alpha, for kMask
+    // kBlend (glTF BLEND): stochastic transparency, rays pass through with probability
+    // 1 - opacity, so the image converges to opacity * surface + (1 - opacity) * behind.
     AlphaMode alpha_mode = AlphaMode::kOpaque;
     float alpha_cutoff = 0.5f;  // kMask: opacity below this is a hole
     // Single-sided surfaces (glTF doubleSided false) are invisible from behind, as in glTF
