@@ -92,6 +92,8 @@ class GltfImporter {
     static Rgb Color(const std::vector<double>& v, const std::string& where, const char* key);
     static const tinygltf::Value* Extension(const tinygltf::ExtensionMap& map, const char* key);
     lf::Material ConvertMaterial(int index);
+    // KHR_materials_unlit: `m` emits its base colour (factor times texture) and reflects nothing.
+    static void MakeUnlit(lf::Material& m);
     // The TextureRef of a material's texture slot; `srgb` for colour textures.
     TextureRef Texture(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
                        bool srgb, const std::string& where);

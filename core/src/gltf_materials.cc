@@ -155,6 +155,7 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         }
     }
     m.double_sided = g.doubleSided;
+    if (Extension(g.extensions, "KHR_materials_unlit")) MakeUnlit(m);
     if (g.alphaMode == "MASK") {
         m.alpha_mode = lf::Material::AlphaMode::kMask;
         m.alpha_cutoff = float(g.alphaCutoff);
@@ -166,6 +167,16 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
                                  "\" is unknown; expected OPAQUE, MASK or BLEND"));
     }
     return m;
+}
+
+void GltfImporter::MakeUnlit(lf::Material& m) {
+    // KHR_materials_unlit: the base colour is the radiance the surface shows, and nothing is
+    // reflected. The base colour texture stays for its alpha (cut-outs, blending).
+    m.type = lf::Material::Type::kLambert;
+    m.emission = m.reflectance;
+    m.emission_texture = m.base_color_texture;
+    m.two_sided_emission = m.double_sided;
+    m.reflectance = Rgb(0.0f);
 }
 
 TextureRef GltfImporter::Texture(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,

@@ -392,6 +392,36 @@ TEST_F(GltfSceneTest, AnIncludingTransformScalesTheAttenuationDistance) {
     EXPECT_FLOAT_EQ(included->materials[0].attenuation_distance, 0.02f);
 }
 
+// KHR_materials_unlit: the surface shows its base colour (factor times texture) as emitted
+// radiance, on both faces when double-sided, and reflects nothing; required, it still loads.
+TEST_F(GltfSceneTest, UnlitMaterialsEmitTheirBaseColourAndReflectNothing) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Json& j = b.json();
+    for (Json& m : j["materials"]) {
+        m["extensions"]["KHR_materials_unlit"] = Json::object();
+        m["emissiveFactor"] = {0.5, 0.5, 0.5};  // ignored: unlit shows the base colour only
+    }
+    j["extensionsUsed"].push_back("KHR_materials_unlit");
+    j["extensionsRequired"].push_back("KHR_materials_unlit");
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_EQ(scene->materials.size(), 2u);
+    const Material& textured = scene->materials[0];
+    EXPECT_EQ(textured.type, Material::Type::kLambert);
+    EXPECT_EQ(textured.reflectance, Rgb(0.0f));
+    EXPECT_EQ(textured.emission, Rgb(1.0f));
+    EXPECT_EQ(textured.emission_texture.image, textured.base_color_texture.image);
+    EXPECT_TRUE(textured.emission_texture.srgb);
+    EXPECT_FALSE(textured.two_sided_emission);
+    const Material& red = scene->materials[1];
+    EXPECT_EQ(red.type, Material::Type::kLambert);
+    EXPECT_EQ(red.reflectance, Rgb(0.0f));
+    EXPECT_EQ(red.emission, Rgb(0.8f, 0.1f, 0.1f));
+    EXPECT_FALSE(red.emission_texture.valid());
+    EXPECT_TRUE(red.two_sided_emission);
+    EXPECT_EQ(CapturedLog().str().find("unlit"), std::string::npos) << CapturedLog().str();
+}
+
 TEST_F(GltfSceneTest, JsonSceneIncludesAGltfWithItsCameraOrItsOwn) {
     const GltfBuilder b = testing::TexturedTestScene();
     Write("models/car.gltf", b.Gltf("car.bin"));
