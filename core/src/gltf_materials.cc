@@ -145,6 +145,24 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
             Warn(at + ": thicknessTexture ignored; only whether thickness is 0 matters");
         }
     }
+    if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_clearcoat")) {
+        const std::string at = where + ".KHR_materials_clearcoat";
+        m.clearcoat = float(Number(*e, "clearcoatFactor", 0, 0, 1, at));
+        m.clearcoat_roughness = float(Number(*e, "clearcoatRoughnessFactor", 0, 0, 1, at));
+        if (e->Has("clearcoatTexture") || e->Has("clearcoatRoughnessTexture") ||
+            e->Has("clearcoatNormalTexture")) {
+            Warn(at + ": clearcoat textures ignored; the factors apply everywhere");
+        }
+    }
+    if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_sheen")) {
+        const std::string at = where + ".KHR_materials_sheen";
+        m.sheen_color =
+            Color(Numbers(*e, "sheenColorFactor", {0, 0, 0}, at), at, "sheenColorFactor");
+        m.sheen_roughness = float(Number(*e, "sheenRoughnessFactor", 0, 0, 1, at));
+        if (e->Has("sheenColorTexture") || e->Has("sheenRoughnessTexture")) {
+            Warn(at + ": sheen textures ignored; the factors apply everywhere");
+        }
+    }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_specular")) {
         const std::string at = where + ".KHR_materials_specular";
         m.specular = float(Number(*e, "specularFactor", 1, 0, 1, at));

@@ -131,6 +131,10 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
                        "thickness",
                        "attenuation_color",
                        "attenuation_distance",
+                       "clearcoat",
+                       "clearcoat_roughness",
+                       "sheen_color",
+                       "sheen_roughness",
                        "normal_texture",
                        "normal_scale",
                        "emission_texture",
@@ -153,6 +157,10 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
     m.roughness = fraction("roughness", 0.5f);
     m.specular = fraction("specular", 1);
     m.transmission = fraction("transmission", 0);
+    m.clearcoat = fraction("clearcoat", 0);
+    m.clearcoat_roughness = fraction("clearcoat_roughness", 0);
+    m.sheen_roughness = fraction("sheen_roughness", 0);
+    if (const std::optional<Node> color = n.Find("sheen_color")) m.sheen_color = color->Color(1);
     m.opacity = fraction("opacity", 1);
     m.alpha_cutoff = fraction("alpha_cutoff", 0.5f);
     if (const std::optional<Node> ior = n.Find("ior")) m.ior = ior->PositiveFloat();

@@ -46,7 +46,9 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
                     Clamp01(params.roughness) * Clamp01(params.roughness)),
       // Lambert's limit (no layer, no metal) needs no table: it is not built for it.
       albedo_(specular_ > 0 || metallic_ > 0 ? &GgxAlbedo::Get() : nullptr),
-      albedo_roughness_(GgxAlbedo::At(Clamp01(params.roughness))) {
+      albedo_roughness_(GgxAlbedo::At(Clamp01(params.roughness))),
+      coat_(params.clearcoat, params.clearcoat_roughness),
+      sheen_(params.sheen_color, params.sheen_roughness) {
     const float layer_average =
         specular_ > 0 ? specular_ * albedo_->Average(albedo_roughness_, f0_) : 0;
     const float remaining = 1 - layer_average;
@@ -174,7 +176,56 @@ float PrincipledBsdf::RefractionPdf(const Vec3& wo, const Vec3& wi) const {
     return distribution_.PdfWm(ToUpper(wo), ToUpper(*wm)) * -cos_im / (half * half);
 }
 
+PrincipledBsdf::LayerPick PrincipledBsdf::PickLayers(const Vec3& wo) const {
+    if (!layered() || !Outside(wo)) return {};
+    // Each layer in proportion to what it reflects, within bounds that keep every lobe sampled.
+    const Vec3 wo_up = ToUpper(wo);
+    LayerPick p;
+    if (coat_.active()) p.coat = std::clamp(coat_.Albedo(wo_up), kPickFloor, 0.5f);
+    if (sheen_.active())
+        p.sheen = std::clamp(sheen_.Albedo(wo_up), kPickFloor, 0.5f) * (1 - p.coat);
+    p.rest = 1 - p.coat - p.sheen;
+    return p;
+}
+
+float PrincipledBsdf::LayerKeep(const Vec3& wo, const Vec3& wi) const {
+    float keep = 1;
+    if (coat_.active()) keep *= coat_.Keep(wo, wi);
+    if (sheen_.active()) keep *= sheen_.Keep(wo, wi);
+    return keep;
+}
+
 Rgb PrincipledBsdf::Eval(const Vec3& wo, const Vec3& wi) const {
+    const Rgb f = BaseEval(wo, wi);
+    if (!layered() || std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return f;
+    const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+    if (SameHemisphere(wo, wi)) {
+        if (!Outside(wo)) return f;
+        Rgb below = f;
+        if (sheen_.active()) below = sheen_.Eval(wo_up, wi_up) + below * sheen_.Keep(wo_up, wi_up);
+        if (!coat_.active()) return below;
+        return Rgb(coat_.Eval(wo_up, wi_up)) + below * coat_.Keep(wo_up, wi_up);
+    }
+    if (!refracts_) return f * LayerKeep(wo_up, wi_up);
+    // Refraction passes the layers once, on the outside.
+    const Vec3 outside = wo.z > 0 ? wo : wi;
+    return f * LayerKeep(outside, outside);
+}
+
+float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
+    const float base = BasePdf(wo, wi);
+    const LayerPick pick = PickLayers(wo);
+    if (pick.rest == 1 || std::abs(wi.z) < kMinCos) return base;
+    float pdf = pick.rest * base;
+    if (SameHemisphere(wo, wi)) {
+        const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+        if (pick.coat > 0) pdf += pick.coat * coat_.Pdf(wo_up, wi_up);
+        if (pick.sheen > 0) pdf += pick.sheen * SheenLobe::Pdf(wi_up);
+    }
+    return pdf;
+}
+
+Rgb PrincipledBsdf::BaseEval(const Vec3& wo, const Vec3& wi) const {
     if (std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return {};
     const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
     if (SameHemisphere(wo, wi)) {
@@ -186,7 +237,7 @@ Rgb PrincipledBsdf::Eval(const Vec3& wo, const Vec3& wi) const {
     return refracts_ ? RefractionEval(wo, wi) : ThinTransmissionEval(wo_up, wi_up);
 }
 
-float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
+float PrincipledBsdf::BasePdf(const Vec3& wo, const Vec3& wi) const {
     if (std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return 0;
     const LobePick pick = Pick(wo);
     const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
@@ -202,11 +253,16 @@ float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
 std::optional<BsdfSample> PrincipledBsdf::Sample(const Vec3& wo, float uc, const Vec2& u) const {
     if (!(std::abs(wo.z) >= kMinCos)) return std::nullopt;
     const LobePick pick = Pick(wo);
+    const LayerPick layers = PickLayers(wo);
     const Vec3 wo_up = ToUpper(wo);
     const float side = wo.z > 0 ? 1.0f : -1.0f;
     Vec3 wi_up;  // in the frame mirrored so that wo_up.z > 0
     float eta = 1;
-    if (uc < pick.reflect + pick.diffuse) {
+    if (uc < layers.coat + layers.sheen) {
+        wi_up = uc < layers.coat ? coat_.Sample(wo_up, u) : SheenLobe::Sample(u);
+        if (wi_up.z < kMinCos) return std::nullopt;
+    } else if (uc = std::min((uc - layers.coat - layers.sheen) / layers.rest, 0x1.fffffep-1f);
+               uc < pick.reflect + pick.diffuse) {
         if (uc < pick.reflect) {
             const Vec3 wm = distribution_.SampleWm(wo_up, u);
             wi_up = wm * (2 * Dot(wo_up, wm)) - wo_up;

@@ -227,6 +227,10 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
            {"KHR_materials_transmission", {{"transmissionFactor", 0.75}}},
            {"KHR_materials_ior", {{"ior", 1.33}}},
+           {"KHR_materials_clearcoat",
+            {{"clearcoatFactor", 0.7}, {"clearcoatRoughnessFactor", 0.2}}},
+           {"KHR_materials_sheen",
+            {{"sheenColorFactor", {0.9, 0.5, 0.1}}, {"sheenRoughnessFactor", 0.4}}},
            {"KHR_materials_volume",
             {{"thicknessFactor", 0.1},
              {"attenuationDistance", 2},
@@ -236,7 +240,8 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
     j["meshes"][0]["primitives"].push_back(j["meshes"][1]["primitives"][0]);
     j["meshes"][0]["primitives"][1]["material"] = 3;
     j["extensionsUsed"] = {"KHR_lights_punctual", "KHR_texture_transform",
-                           "KHR_materials_clearcoat"};
+                           "KHR_materials_iridescence", "KHR_materials_clearcoat",
+                           "KHR_materials_sheen"};
     const absl::StatusOr<Scene> scene = Load(b);
     ASSERT_TRUE(scene.ok()) << scene.status();
 
@@ -294,9 +299,15 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
     const std::string log = CapturedLog().str();
     EXPECT_NE(log.find("occlusionTexture ignored"), std::string::npos) << log;
     EXPECT_EQ(log.find("BLEND"), std::string::npos) << log;
-    EXPECT_NE(log.find("extension KHR_materials_clearcoat not supported: the clear coat layer"),
+    EXPECT_NE(log.find("extension KHR_materials_iridescence not supported: thin-film iridescence"),
               std::string::npos)
         << log;
+    EXPECT_EQ(log.find("KHR_materials_clearcoat"), std::string::npos) << log;
+    EXPECT_EQ(log.find("KHR_materials_sheen"), std::string::npos) << log;
+    EXPECT_FLOAT_EQ(glass.clearcoat, 0.7f);
+    EXPECT_FLOAT_EQ(glass.clearcoat_roughness, 0.2f);
+    EXPECT_FLOAT_EQ(glass.sheen_color.g, 0.5f);
+    EXPECT_FLOAT_EQ(glass.sheen_roughness, 0.4f);
 }
 
 TEST_F(GltfSceneTest, SpotAndDirectionalLightsPointDownTheirNodesMinusZ) {

@@ -657,6 +657,8 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
                 "thickness": 0.01, "attenuation_color": [0.9, 0.8, 0.7],
                 "attenuation_distance": 0.5, "opacity": 0.6, "alpha_mode": "mask",
                 "alpha_cutoff": 0.3, "double_sided": false, "emission": [0.1, 0.2, 0.3],
+                "clearcoat": 0.5, "clearcoat_roughness": 0.1, "sheen_color": [0.2, 0.3, 0.4],
+                "sheen_roughness": 0.6,
                 "base_color_texture": {"file": "wood.png", "wrap": "mirror", "filter": "nearest",
                     "transform": {"offset": [0.5, 0.25], "rotation_deg": 90,
                                   "scale": [2, -1]}},
@@ -679,6 +681,10 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
     EXPECT_FALSE(plain.IsEmissive());
 
     const Material& m = scene->materials[2];
+    EXPECT_FLOAT_EQ(m.clearcoat, 0.5f);
+    EXPECT_FLOAT_EQ(m.clearcoat_roughness, 0.1f);
+    EXPECT_EQ(m.sheen_color, Rgb(0.2f, 0.3f, 0.4f));
+    EXPECT_FLOAT_EQ(m.sheen_roughness, 0.6f);
     EXPECT_EQ(m.reflectance, Rgb(0.5f, 0.1f, 0.1f));
     EXPECT_FLOAT_EQ(m.metallic, 0.3f);
     EXPECT_FLOAT_EQ(m.roughness, 0.2f);

@@ -83,6 +83,14 @@ struct Material {
     float thickness = 0;
     Rgb attenuation_color{1.0f};  // the colour white light takes after attenuation_distance
     float attenuation_distance = std::numeric_limits<float>::infinity();  // metres
+    // KHR_materials_clearcoat: a GGX dielectric layer (IOR 1.5) of this weight and perceptual
+    // roughness on top of everything else.
+    float clearcoat = 0;
+    float clearcoat_roughness = 0;
+    // KHR_materials_sheen: a cloth-like Charlie lobe of this colour and perceptual roughness
+    // between the clear coat and the base; black is none.
+    Rgb sheen_color{0.0f};
+    float sheen_roughness = 0;
     TextureRef base_color_texture, metallic_roughness_texture, normal_texture, emission_texture;
     float normal_scale = 1;  // scales the normal map's x and y (glTF normalTexture.scale)
     float opacity = 1;       // base colour alpha factor; with the texture's alpha, for kMask

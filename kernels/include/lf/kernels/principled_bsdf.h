@@ -1,5 +1,6 @@
 // The principled material: glTF 2.0's metallic-roughness BRDF (its Appendix B) with
 // KHR_materials_specular's weight, KHR_materials_ior and KHR_materials_transmission/_volume,
+// under KHR_materials_sheen and KHR_materials_clearcoat layers (see LayerPick below),
 // in the local shading frame of lf/kernels/bsdf.h (+z the front face's normal, the outside).
 //
 //   f = metallic * conductor + (1 - metallic) * dielectric
@@ -33,8 +34,10 @@
 #include "lf/core/scene.h"
 #include "lf/core/vec.h"
 #include "lf/kernels/bsdf_sample.h"
+#include "lf/kernels/clearcoat_lobe.h"
 #include "lf/kernels/ggx_albedo.h"
 #include "lf/kernels/microfacet.h"
+#include "lf/kernels/sheen_lobe.h"
 
 namespace lf {
 
@@ -55,6 +58,21 @@ class PrincipledBsdf {
     }
 
   private:
+    // The layers over the outside face (KHR_materials_clearcoat over KHR_materials_sheen over
+    // the rest): f = coat + Keep_coat (sheen + Keep_sheen base), each Keep symmetric in (wo, wi)
+    // (lf/kernels/clearcoat_lobe.h, sheen_lobe.h). Light crossing the surface passes both layers
+    // on its outside side and is scaled by their Keep there. Inside a solid there are none.
+    // Probabilities of sampling the coat and the sheen for wo; the base lobes get `rest`.
+    struct LayerPick {
+        float coat = 0, sheen = 0, rest = 1;
+    };
+    LayerPick PickLayers(const Vec3& wo) const;
+    bool layered() const { return coat_.active() || sheen_.active(); }
+    // What the layers let through to and from the base for the pair.
+    float LayerKeep(const Vec3& wo, const Vec3& wi) const;
+    Rgb BaseEval(const Vec3& wo, const Vec3& wi) const;
+    float BasePdf(const Vec3& wo, const Vec3& wi) const;
+
     // Probabilities of sampling the reflection (conductor and specular layer share GGX visible
     // normals), diffuse and transmission lobes for wo; they sum to one, or all are zero.
     struct LobePick {
@@ -87,6 +105,8 @@ class PrincipledBsdf {
     const GgxAlbedo* albedo_;
     GgxAlbedo::Roughness albedo_roughness_;
     float diffuse_scale_;  // (1 - metallic) (1 - transmission) / (pi (1 - s E_avg))
+    ClearcoatLobe coat_;
+    SheenLobe sheen_;
 };
 
 }  // namespace lf
