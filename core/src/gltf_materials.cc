@@ -124,9 +124,7 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_transmission")) {
         const std::string at = where + ".KHR_materials_transmission";
         m.transmission = float(Number(*e, "transmissionFactor", 0, 0, 1, at));
-        if (e->Has("transmissionTexture")) {
-            Warn(at + ": transmissionTexture ignored; the factor applies everywhere");
-        }
+        m.transmission_texture = TextureInfo(*e, "transmissionTexture", false, at);
     }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_volume")) {
         const std::string at = where + ".KHR_materials_volume";
@@ -236,6 +234,22 @@ TextureRef GltfImporter::Texture(int index, int tex_coord, const tinygltf::Exten
                           "; lightfarm reads TEXCOORD_0 only and uses that"));
     }
     return ref;
+}
+
+TextureRef GltfImporter::TextureInfo(const tinygltf::Value& extension, const char* key, bool srgb,
+                                     const std::string& where) {
+    if (!extension.Has(key)) return {};
+    const std::string at = absl::StrCat(where, ".", key);
+    const tinygltf::Value& info = extension.Get(key);
+    if (!info.IsObject()) Fail(at, "is not an object");
+    if (!info.Has("index")) Fail(at, "has no index");
+    tinygltf::ExtensionMap extensions;
+    if (info.Has("extensions")) {
+        const tinygltf::Value& e = info.Get("extensions");
+        for (const std::string& name : e.Keys()) extensions[name] = e.Get(name);
+    }
+    return Texture(int(Number(info, "index", 0, 0, 1e9, at)),
+                   int(Number(info, "texCoord", 0, 0, 1e6, at)), extensions, srgb, at);
 }
 
 TextureRef::Wrap GltfImporter::Wrap(int mode, const std::string& where) {

@@ -181,6 +181,7 @@ std::string RadiosityLimitation(const Scene& scene) {
              {std::pair{&m.base_color_texture, "base_color_texture"},
               {&m.emission_texture, "emission_texture"},
               {&m.normal_texture, "normal_texture"},
+              {&m.transmission_texture, "transmission_texture"},
               {&m.metallic_roughness_texture, "metallic_roughness_texture"}}) {
             if (!ref->valid()) continue;
             return absl::StrCat(what, "has a texture (", key, " \"",

@@ -136,6 +136,7 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
                        "sheen_color",
                        "sheen_roughness",
                        "normal_texture",
+                       "transmission_texture",
                        "normal_scale",
                        "emission_texture",
                        "opacity",
@@ -178,6 +179,9 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
     }
     if (const std::optional<Node> texture = n.Find("normal_texture")) {
         m.normal_texture = ParseTexture(*texture, false);
+    }
+    if (const std::optional<Node> texture = n.Find("transmission_texture")) {
+        m.transmission_texture = ParseTexture(*texture, false);
     }
     if (const std::optional<Node> scale = n.Find("normal_scale")) {
         m.normal_scale = float(scale->NumberIn(-kMaxFloat, kMaxFloat, "a finite float"));

@@ -63,8 +63,9 @@ absl::Status CheckMesh(const Scene& scene, const TriangleMesh& mesh) {
 }
 
 absl::Status CheckTextures(const Scene& scene, const Material& m) {
-    for (const TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture,
-                                  &m.normal_texture, &m.emission_texture}) {
+    for (const TextureRef* ref :
+         {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
+          &m.emission_texture, &m.transmission_texture}) {
         if (!ref->valid()) continue;
         if (size_t(ref->image) >= scene.textures.size() || !scene.textures[size_t(ref->image)]) {
             return absl::InvalidArgumentError(absl::StrCat(scene.source, ": material '", m.name,

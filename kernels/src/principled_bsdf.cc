@@ -37,10 +37,10 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
             Clamp01(params.base_color.b)),
       metallic_(Clamp01(params.metallic)),
       specular_(Clamp01(material.specular)),
-      transmission_(Clamp01(material.transmission)),
+      transmission_(Clamp01(params.transmission)),
       ior_(material.ior),
       f0_(((material.ior - 1) / (material.ior + 1)) * ((material.ior - 1) / (material.ior + 1))),
-      refracts_(transmission_ > 0 && material.thickness > 0 &&
+      refracts_(material.transmission > 0 && material.thickness > 0 &&
                 std::abs(material.ior - 1) > kMinIorContrast),
       distribution_(Material::Distribution::kGgx,
                     Clamp01(params.roughness) * Clamp01(params.roughness)),

@@ -202,6 +202,9 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
         s.params.roughness *= mr.g;
         s.params.metallic *= mr.b;
     }
+    if (m.transmission_texture.valid()) {
+        s.params.transmission *= Sample(scene, m.transmission_texture, s.uv).rgb.r;
+    }
     s.emission = m.emission;
     if (m.IsEmissive() && m.emission_texture.valid()) {
         s.emission *= Sample(scene, m.emission_texture, s.uv).rgb;

@@ -225,7 +225,8 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
          {"alphaCutoff", 0.3},
          {"extensions",
           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
-           {"KHR_materials_transmission", {{"transmissionFactor", 0.75}}},
+           {"KHR_materials_transmission",
+            {{"transmissionFactor", 0.75}, {"transmissionTexture", {{"index", 0}}}}},
            {"KHR_materials_ior", {{"ior", 1.33}}},
            {"KHR_materials_clearcoat",
             {{"clearcoatFactor", 0.7}, {"clearcoatRoughnessFactor", 0.2}}},
@@ -277,6 +278,8 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
     EXPECT_FLOAT_EQ(glass.emission.r, 4);
     EXPECT_FLOAT_EQ(glass.emission.g, 2);
     EXPECT_FLOAT_EQ(glass.transmission, 0.75f);
+    EXPECT_TRUE(glass.transmission_texture.valid());
+    EXPECT_FALSE(glass.transmission_texture.srgb);
     EXPECT_FLOAT_EQ(glass.ior, 1.33f);
     EXPECT_FLOAT_EQ(glass.thickness, 0.1f);
     EXPECT_FLOAT_EQ(glass.attenuation_distance, 2);

@@ -92,8 +92,9 @@ struct Material {
     Rgb sheen_color{0.0f};
     float sheen_roughness = 0;
     TextureRef base_color_texture, metallic_roughness_texture, normal_texture, emission_texture;
-    float normal_scale = 1;  // scales the normal map's x and y (glTF normalTexture.scale)
-    float opacity = 1;       // base colour alpha factor; with the texture's alpha, for kMask
+    TextureRef transmission_texture;  // its R channel multiplies `transmission` (linear)
+    float normal_scale = 1;           // scales the normal map's x and y (glTF normalTexture.scale)
+    float opacity = 1;  // base colour alpha factor; with the texture's alpha, for kMask
     // kBlend (glTF BLEND): stochastic transparency, rays pass through with probability
     // 1 - opacity, so the image converges to opacity * surface + (1 - opacity) * behind.
     AlphaMode alpha_mode = AlphaMode::kOpaque;
@@ -111,7 +112,7 @@ struct Material {
     }
     bool IsTextured() const {
         return base_color_texture.valid() || metallic_roughness_texture.valid() ||
-               normal_texture.valid() || emission_texture.valid();
+               normal_texture.valid() || emission_texture.valid() || transmission_texture.valid();
     }
 };
 
