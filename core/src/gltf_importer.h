@@ -100,9 +100,15 @@ class GltfImporter {
     static Rgb Color(const std::vector<double>& v, const std::string& where, const char* key);
     static const tinygltf::Value* Extension(const tinygltf::ExtensionMap& map, const char* key);
     lf::Material ConvertMaterial(int index);
+    // KHR_materials_unlit: `m` emits its base colour (factor times texture) and reflects nothing.
+    static void MakeUnlit(lf::Material& m);
     // The TextureRef of a material's texture slot; `srgb` for colour textures.
     TextureRef Texture(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
                        bool srgb, const std::string& where);
+    // The TextureRef of an extension's textureInfo `key` (e.g. transmissionTexture); none when
+    // absent.
+    TextureRef TextureInfo(const tinygltf::Value& extension, const char* key, bool srgb,
+                           const std::string& where);
     static TextureRef::Wrap Wrap(int mode, const std::string& where);
     // The Scene::textures index of glTF image `index`, decoded once however many textures
     // use it.

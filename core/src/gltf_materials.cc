@@ -123,9 +123,7 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_transmission")) {
         const std::string at = where + ".KHR_materials_transmission";
         m.transmission = float(Number(*e, "transmissionFactor", 0, 0, 1, at));
-        if (e->Has("transmissionTexture")) {
-            Warn(at + ": transmissionTexture ignored; the factor applies everywhere");
-        }
+        m.transmission_texture = TextureInfo(*e, "transmissionTexture", false, at);
     }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_volume")) {
         const std::string at = where + ".KHR_materials_volume";
@@ -144,6 +142,24 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
             Warn(at + ": thicknessTexture ignored; only whether thickness is 0 matters");
         }
     }
+    if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_clearcoat")) {
+        const std::string at = where + ".KHR_materials_clearcoat";
+        m.clearcoat = float(Number(*e, "clearcoatFactor", 0, 0, 1, at));
+        m.clearcoat_roughness = float(Number(*e, "clearcoatRoughnessFactor", 0, 0, 1, at));
+        if (e->Has("clearcoatTexture") || e->Has("clearcoatRoughnessTexture") ||
+            e->Has("clearcoatNormalTexture")) {
+            Warn(at + ": clearcoat textures ignored; the factors apply everywhere");
+        }
+    }
+    if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_sheen")) {
+        const std::string at = where + ".KHR_materials_sheen";
+        m.sheen_color =
+            Color(Numbers(*e, "sheenColorFactor", {0, 0, 0}, at), at, "sheenColorFactor");
+        m.sheen_roughness = float(Number(*e, "sheenRoughnessFactor", 0, 0, 1, at));
+        if (e->Has("sheenColorTexture") || e->Has("sheenRoughnessTexture")) {
+            Warn(at + ": sheen textures ignored; the factors apply everywhere");
+        }
+    }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_specular")) {
         const std::string at = where + ".KHR_materials_specular";
         m.specular = float(Number(*e, "specularFactor", 1, 0, 1, at));
@@ -154,19 +170,28 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         }
     }
     m.double_sided = g.doubleSided;
-    if (g.alphaMode == "MASK" || g.alphaMode == "BLEND") {
+    if (Extension(g.extensions, "KHR_materials_unlit")) MakeUnlit(m);
+    if (g.alphaMode == "MASK") {
         m.alpha_mode = lf::Material::AlphaMode::kMask;
         m.alpha_cutoff = float(g.alphaCutoff);
-        if (g.alphaMode == "BLEND") {
-            Warn(where + ": alphaMode BLEND rendered as MASK with alphaCutoff 0.5");
-            m.alpha_cutoff = 0.5f;
-        }
         if (!(m.alpha_cutoff >= 0)) Fail(where, "alphaCutoff must be at least 0");
+    } else if (g.alphaMode == "BLEND") {
+        m.alpha_mode = lf::Material::AlphaMode::kBlend;
     } else if (g.alphaMode != "OPAQUE") {
         Fail(where, absl::StrCat("alphaMode \"", g.alphaMode,
                                  "\" is unknown; expected OPAQUE, MASK or BLEND"));
     }
     return m;
+}
+
+void GltfImporter::MakeUnlit(lf::Material& m) {
+    // KHR_materials_unlit: the base colour is the radiance the surface shows, and nothing is
+    // reflected. The base colour texture stays for its alpha (cut-outs, blending).
+    m.type = lf::Material::Type::kLambert;
+    m.emission = m.reflectance;
+    m.emission_texture = m.base_color_texture;
+    m.two_sided_emission = m.double_sided;
+    m.reflectance = Rgb(0.0f);
 }
 
 TextureRef GltfImporter::Texture(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
@@ -208,6 +233,22 @@ TextureRef GltfImporter::Texture(int index, int tex_coord, const tinygltf::Exten
                           "; lightfarm reads TEXCOORD_0 only and uses that"));
     }
     return ref;
+}
+
+TextureRef GltfImporter::TextureInfo(const tinygltf::Value& extension, const char* key, bool srgb,
+                                     const std::string& where) {
+    if (!extension.Has(key)) return {};
+    const std::string at = absl::StrCat(where, ".", key);
+    const tinygltf::Value& info = extension.Get(key);
+    if (!info.IsObject()) Fail(at, "is not an object");
+    if (!info.Has("index")) Fail(at, "has no index");
+    tinygltf::ExtensionMap extensions;
+    if (info.Has("extensions")) {
+        const tinygltf::Value& e = info.Get("extensions");
+        for (const std::string& name : e.Keys()) extensions[name] = e.Get(name);
+    }
+    return Texture(int(Number(info, "index", 0, 0, 1e9, at)),
+                   int(Number(info, "texCoord", 0, 0, 1e6, at)), extensions, srgb, at);
 }
 
 TextureRef::Wrap GltfImporter::Wrap(int mode, const std::string& where) {

@@ -18,10 +18,11 @@ namespace {
 // (a warning); in extensionsRequired it is an error.
 const std::set<std::string>& SupportedExtensions() {
     static const std::set<std::string> kSupported = {
-        "KHR_lights_punctual",   "KHR_materials_emissive_strength",
-        "KHR_materials_ior",     "KHR_materials_transmission",
-        "KHR_materials_volume",  "KHR_materials_specular",
-        "KHR_texture_transform",
+        "KHR_lights_punctual",  "KHR_materials_emissive_strength",
+        "KHR_materials_ior",    "KHR_materials_transmission",
+        "KHR_materials_volume", "KHR_materials_specular",
+        "KHR_materials_unlit",  "KHR_materials_clearcoat",
+        "KHR_materials_sheen",  "KHR_texture_transform",
     };
     return kSupported;
 }
@@ -29,12 +30,9 @@ const std::set<std::string>& SupportedExtensions() {
 // What a render loses when it ignores an extension, for the warning.
 std::string WhatIsLost(const std::string& extension) {
     static const std::map<std::string, std::string> kLost = {
-        {"KHR_materials_clearcoat", "the clear coat layer"},
-        {"KHR_materials_sheen", "the sheen (cloth) lobe"},
         {"KHR_materials_iridescence", "thin-film iridescence"},
         {"KHR_materials_anisotropy", "anisotropic roughness; rendered isotropic"},
         {"KHR_materials_dispersion", "dispersion; one IOR for all wavelengths"},
-        {"KHR_materials_unlit", "unlit shading; the material is lit as a PBR one"},
         {"KHR_materials_pbrSpecularGlossiness",
          "the specular-glossiness material; the "
          "metallic-roughness fallback is used"},

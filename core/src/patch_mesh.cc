@@ -181,6 +181,7 @@ std::string RadiosityLimitation(const Scene& scene) {
              {std::pair{&m.base_color_texture, "base_color_texture"},
               {&m.emission_texture, "emission_texture"},
               {&m.normal_texture, "normal_texture"},
+              {&m.transmission_texture, "transmission_texture"},
               {&m.metallic_roughness_texture, "metallic_roughness_texture"}}) {
             if (!ref->valid()) continue;
             return absl::StrCat(what, "has a texture (", key, " \"",
@@ -189,6 +190,9 @@ std::string RadiosityLimitation(const Scene& scene) {
         }
         if (m.alpha_mode == Material::AlphaMode::kMask) {
             return what + "has an alpha mask, which radiosity does not model";
+        }
+        if (m.alpha_mode == Material::AlphaMode::kBlend) {
+            return what + "is alpha-blended, which radiosity does not model";
         }
         if (!m.double_sided) return what + "is single-sided, which radiosity does not model";
     }

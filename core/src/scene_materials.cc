@@ -131,7 +131,12 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
                        "thickness",
                        "attenuation_color",
                        "attenuation_distance",
+                       "clearcoat",
+                       "clearcoat_roughness",
+                       "sheen_color",
+                       "sheen_roughness",
                        "normal_texture",
+                       "transmission_texture",
                        "normal_scale",
                        "emission_texture",
                        "opacity",
@@ -153,6 +158,10 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
     m.roughness = fraction("roughness", 0.5f);
     m.specular = fraction("specular", 1);
     m.transmission = fraction("transmission", 0);
+    m.clearcoat = fraction("clearcoat", 0);
+    m.clearcoat_roughness = fraction("clearcoat_roughness", 0);
+    m.sheen_roughness = fraction("sheen_roughness", 0);
+    if (const std::optional<Node> color = n.Find("sheen_color")) m.sheen_color = color->Color(1);
     m.opacity = fraction("opacity", 1);
     m.alpha_cutoff = fraction("alpha_cutoff", 0.5f);
     if (const std::optional<Node> ior = n.Find("ior")) m.ior = ior->PositiveFloat();
@@ -171,6 +180,9 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
     if (const std::optional<Node> texture = n.Find("normal_texture")) {
         m.normal_texture = ParseTexture(*texture, false);
     }
+    if (const std::optional<Node> texture = n.Find("transmission_texture")) {
+        m.transmission_texture = ParseTexture(*texture, false);
+    }
     if (const std::optional<Node> scale = n.Find("normal_scale")) {
         m.normal_scale = float(scale->NumberIn(-kMaxFloat, kMaxFloat, "a finite float"));
     }
@@ -178,9 +190,10 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
         m.emission_texture = ParseTexture(*texture, true);
     }
     if (const std::optional<Node> mode = n.Find("alpha_mode")) {
-        m.alpha_mode = mode->OneOf<Material::AlphaMode>(
-            "alpha mode",
-            {{"opaque", Material::AlphaMode::kOpaque}, {"mask", Material::AlphaMode::kMask}});
+        m.alpha_mode = mode->OneOf<Material::AlphaMode>("alpha mode",
+                                                        {{"opaque", Material::AlphaMode::kOpaque},
+                                                         {"mask", Material::AlphaMode::kMask},
+                                                         {"blend", Material::AlphaMode::kBlend}});
     }
     if (const std::optional<Node> sided = n.Find("double_sided")) m.double_sided = sided->Bool();
 }

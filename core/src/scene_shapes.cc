@@ -238,7 +238,7 @@ CachedMeshFile SceneParser::AddFileMaterials(MeshFile file, const std::string& w
     const int first = int(scene.materials.size());
     for (Material& m : file.materials) {
         for (TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture,
-                                &m.normal_texture, &m.emission_texture}) {
+                                &m.normal_texture, &m.emission_texture, &m.transmission_texture}) {
             if (ref->valid()) ref->image = image_of[size_t(ref->image)];
         }
         scene.materials.push_back(std::move(m));

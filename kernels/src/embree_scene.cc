@@ -19,7 +19,7 @@ namespace {
 struct MeshFilter {
     const EmbreeScene* scene;
     int mesh;
-    bool alpha_mask;    // rays pass through holes of the base colour's alpha
+    bool alpha_test;    // rays pass through holes (or blend) of the base colour's alpha
     bool single_sided;  // rays pass through back faces
 };
 
@@ -64,8 +64,9 @@ absl::Status CheckMesh(const Scene& scene, const TriangleMesh& mesh) {
 }
 
 absl::Status CheckTextures(const Scene& scene, const Material& m) {
-    for (const TextureRef* ref : {&m.base_color_texture, &m.metallic_roughness_texture,
-                                  &m.normal_texture, &m.emission_texture}) {
+    for (const TextureRef* ref :
+         {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
+          &m.emission_texture, &m.transmission_texture}) {
         if (!ref->valid()) continue;
         if (size_t(ref->image) >= scene.textures.size() || !scene.textures[size_t(ref->image)]) {
             return absl::InvalidArgumentError(absl::StrCat(scene.source, ": material '", m.name,
@@ -74,6 +75,16 @@ absl::Status CheckTextures(const Scene& scene, const Material& m) {
         }
     }
     return absl::OkStatus();
+}
+
+Vec3 RayOrigin(const RTCFilterFunctionNArguments* args, unsigned i) {
+    return {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+            RTCRayN_org_z(args->ray, args->N, i)};
+}
+
+Vec3 RayDirection(const RTCFilterFunctionNArguments* args, unsigned i) {
+    return {RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+            RTCRayN_dir_z(args->ray, args->N, i)};
 }
 
 // Embree calls this for every candidate hit on a filtered mesh, before accepting it.
@@ -86,8 +97,7 @@ void FilterHits(const RTCFilterFunctionNArguments* args) {
         if (args->valid[i] == 0) continue;
         const int prim = int(RTCHitN_primID(args->hit, args->N, i));
         if (f.single_sided) {
-            const Vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
-                         RTCRayN_dir_z(args->ray, args->N, i));
+            const Vec3 d = RayDirection(args, i);
             Vec3 p0, p1, p2;
             f.scene->Triangle(f.mesh, prim, &p0, &p1, &p2);
             if (Dot(d, Cross(p1 - p0, p2 - p0)) > 0) {
@@ -95,11 +105,15 @@ void FilterHits(const RTCFilterFunctionNArguments* args) {
                 continue;
             }
         }
-        if (f.alpha_mask) {
+        if (f.alpha_test) {
             const float b1 = RTCHitN_u(args->hit, args->N, i),
                         b2 = RTCHitN_v(args->hit, args->N, i);
-            if (IsCutOut(scene, material, TriangleUv(mesh, prim, b1, b2),
-                         VertexColor(mesh, prim, b1, b2).a)) {
+            const float u = material.alpha_mode == Material::AlphaMode::kBlend
+                                ? AlphaHash(RayOrigin(args, i), RayDirection(args, i),
+                                            unsigned(f.mesh), unsigned(prim))
+                                : 0;
+            if (PassesThrough(scene, material, TriangleUv(mesh, prim, b1, b2),
+                              VertexColor(mesh, prim, b1, b2).a, u)) {
                 args->valid[i] = 0;
             }
         }
@@ -181,11 +195,11 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
                                    mesh.triangles.data(), 0, 3 * sizeof(uint32_t),
                                    mesh.triangles.size());
         const Material& material = scene.materials[size_t(mesh.material)];
-        const bool alpha_mask = material.alpha_mode == Material::AlphaMode::kMask;
+        const bool alpha_test = material.alpha_mode != Material::AlphaMode::kOpaque;
         const bool single_sided = !material.double_sided && !Transmits(material);
         // Ordinary meshes keep Embree's fast path: no callback per candidate hit.
-        if (alpha_mask || single_sided) {
-            h.filters.push_back({es.get(), int(m), alpha_mask, single_sided});
+        if (alpha_test || single_sided) {
+            h.filters.push_back({es.get(), int(m), alpha_test, single_sided});
             rtcSetGeometryUserData(geom, &h.filters.back());
             rtcSetGeometryIntersectFilterFunction(geom, FilterHits);
             rtcSetGeometryOccludedFilterFunction(geom, FilterHits);

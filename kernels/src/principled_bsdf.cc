@@ -38,10 +38,10 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
             Clamp01(params.base_color.b)),
       metallic_(Clamp01(params.metallic)),
       specular_(Clamp01(material.specular)),
-      transmission_(Clamp01(material.transmission)),
+      transmission_(Clamp01(params.transmission)),
       ior_(material.ior),
       f0_(((material.ior - 1) / (material.ior + 1)) * ((material.ior - 1) / (material.ior + 1))),
-      refracts_(transmission_ > 0 && material.thickness > 0 &&
+      refracts_(material.transmission > 0 && material.thickness > 0 &&
                 std::abs(material.ior - 1) > kMinIorContrast),
       distribution_(Material::Distribution::kGgx,
                     Clamp01(params.roughness) * Clamp01(params.roughness)),
@@ -51,7 +51,9 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
       mix_(specular_ > 0 ? &FresnelMixAlbedo::Get() : nullptr),
       smooth_(Clamp01(params.roughness) * Clamp01(params.roughness) <
               MicrofacetDistribution::kMinAlpha),
-      diffuse_scale_((1 - metallic_) * (1 - transmission_) * kInvPi) {}
+      diffuse_scale_((1 - metallic_) * (1 - transmission_) * kInvPi),
+      coat_(params.clearcoat, params.clearcoat_roughness),
+      sheen_(params.sheen_color, params.sheen_roughness) {}
 
 float PrincipledBsdf::LayerFresnel(float cos_om, bool outside) const {
     if (outside) return specular_ * SchlickScalar(f0_, cos_om);
@@ -138,8 +140,8 @@ Rgb PrincipledBsdf::ThinTransmissionEval(const Vec3& wo, const Vec3& wi) const {
     const float weight = (1 - metallic_) * transmission_;
     if (!(weight > 0)) return {};
     const Vec3 wm = Normalize(wo + wi);
-    return Rgb(weight * (1 - LayerFresnel(Dot(wo, wm), true)) * distribution_.D(wm) *
-               distribution_.GOverCosines(wo, wi) / 4);
+    return base_ * (weight * (1 - LayerFresnel(Dot(wo, wm), true)) * distribution_.D(wm) *
+                    distribution_.GOverCosines(wo, wi) / 4);
 }
 
 std::optional<Vec3> PrincipledBsdf::RefractionNormal(const Vec3& wo, const Vec3& wi) const {
@@ -169,7 +171,7 @@ Rgb PrincipledBsdf::RefractionEval(const Vec3& wo, const Vec3& wi) const {
     const float value = weight * (1 - fresnel) * distribution_.D(*wm) *
                         distribution_.GOverCosines(wo, wi) * -cos_im * cos_om /
                         (half * half * eta * eta);
-    return Rgb(std::max(0.0f, value));
+    return base_ * std::max(0.0f, value);
 }
 
 float PrincipledBsdf::RefractionPdf(const Vec3& wo, const Vec3& wi) const {
@@ -182,7 +184,56 @@ float PrincipledBsdf::RefractionPdf(const Vec3& wo, const Vec3& wi) const {
     return distribution_.PdfWm(ToUpper(wo), ToUpper(*wm)) * -cos_im / (half * half);
 }
 
+PrincipledBsdf::LayerPick PrincipledBsdf::PickLayers(const Vec3& wo) const {
+    if (!layered() || !Outside(wo)) return {};
+    // Each layer in proportion to what it reflects, within bounds that keep every lobe sampled.
+    const Vec3 wo_up = ToUpper(wo);
+    LayerPick p;
+    if (coat_.active()) p.coat = std::clamp(coat_.Albedo(wo_up), kPickFloor, 0.5f);
+    if (sheen_.active())
+        p.sheen = std::clamp(sheen_.Albedo(wo_up), kPickFloor, 0.5f) * (1 - p.coat);
+    p.rest = 1 - p.coat - p.sheen;
+    return p;
+}
+
+float PrincipledBsdf::LayerKeep(const Vec3& wo, const Vec3& wi) const {
+    float keep = 1;
+    if (coat_.active()) keep *= coat_.Keep(wo, wi);
+    if (sheen_.active()) keep *= sheen_.Keep(wo, wi);
+    return keep;
+}
+
 Rgb PrincipledBsdf::Eval(const Vec3& wo, const Vec3& wi) const {
+    const Rgb f = BaseEval(wo, wi);
+    if (!layered() || std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return f;
+    const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+    if (SameHemisphere(wo, wi)) {
+        if (!Outside(wo)) return f;
+        Rgb below = f;
+        if (sheen_.active()) below = sheen_.Eval(wo_up, wi_up) + below * sheen_.Keep(wo_up, wi_up);
+        if (!coat_.active()) return below;
+        return Rgb(coat_.Eval(wo_up, wi_up)) + below * coat_.Keep(wo_up, wi_up);
+    }
+    if (!refracts_) return f * LayerKeep(wo_up, wi_up);
+    // Refraction passes the layers once, on the outside.
+    const Vec3 outside = wo.z > 0 ? wo : wi;
+    return f * LayerKeep(outside, outside);
+}
+
+float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
+    const float base = BasePdf(wo, wi);
+    const LayerPick pick = PickLayers(wo);
+    if (pick.rest == 1 || std::abs(wi.z) < kMinCos) return base;
+    float pdf = pick.rest * base;
+    if (SameHemisphere(wo, wi)) {
+        const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+        if (pick.coat > 0) pdf += pick.coat * coat_.Pdf(wo_up, wi_up);
+        if (pick.sheen > 0) pdf += pick.sheen * SheenLobe::Pdf(wi_up);
+    }
+    return pdf;
+}
+
+Rgb PrincipledBsdf::BaseEval(const Vec3& wo, const Vec3& wi) const {
     if (std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return {};
     const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
     if (smooth_) {
@@ -197,7 +248,7 @@ Rgb PrincipledBsdf::Eval(const Vec3& wo, const Vec3& wi) const {
     return refracts_ ? RefractionEval(wo, wi) : ThinTransmissionEval(wo_up, wi_up);
 }
 
-float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
+float PrincipledBsdf::BasePdf(const Vec3& wo, const Vec3& wi) const {
     if (std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return 0;
     const LobePick pick = Pick(wo);
     const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
@@ -214,13 +265,36 @@ float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
 std::optional<BsdfSample> PrincipledBsdf::Sample(const Vec3& wo, float uc, const Vec2& u) const {
     if (!(std::abs(wo.z) >= kMinCos)) return std::nullopt;
     const LobePick pick = Pick(wo);
-    const bool diffuse = uc >= pick.reflect && uc < pick.reflect + pick.diffuse;
-    if (smooth_ && !diffuse) return SampleSmooth(wo, uc, pick);
+    const LayerPick layers = PickLayers(wo);
+    if (smooth_ && uc >= layers.coat + layers.sheen) {
+        // The base's delta lobes, chosen as Sample chooses below; the layers above pass them
+        // as Eval lets them through.
+        const float ub = std::min((uc - layers.coat - layers.sheen) / layers.rest, 0x1.fffffep-1f);
+        if (ub < pick.reflect || ub >= pick.reflect + pick.diffuse) {
+            std::optional<BsdfSample> s = SampleSmooth(wo, ub, pick);
+            if (s && layered()) {
+                s->pdf *= layers.rest;
+                if (SameHemisphere(wo, s->wi)) {
+                    if (Outside(wo)) s->f *= LayerKeep(ToUpper(wo), ToUpper(s->wi));
+                } else if (!refracts_) {
+                    s->f *= LayerKeep(ToUpper(wo), ToUpper(s->wi));
+                } else {
+                    const Vec3 outside = wo.z > 0 ? wo : s->wi;
+                    s->f *= LayerKeep(outside, outside);
+                }
+            }
+            return s;
+        }
+    }
     const Vec3 wo_up = ToUpper(wo);
     const float side = wo.z > 0 ? 1.0f : -1.0f;
     Vec3 wi_up;  // in the frame mirrored so that wo_up.z > 0
     float eta = 1;
-    if (uc < pick.reflect + pick.diffuse) {
+    if (uc < layers.coat + layers.sheen) {
+        wi_up = uc < layers.coat ? coat_.Sample(wo_up, u) : SheenLobe::Sample(u);
+        if (wi_up.z < kMinCos) return std::nullopt;
+    } else if (uc = std::min((uc - layers.coat - layers.sheen) / layers.rest, 0x1.fffffep-1f);
+               uc < pick.reflect + pick.diffuse) {
         if (uc < pick.reflect) {
             const Vec3 wm = distribution_.SampleWm(wo_up, u);
             wi_up = wm * (2 * Dot(wo_up, wm)) - wo_up;
@@ -265,7 +339,7 @@ std::optional<BsdfSample> PrincipledBsdf::SampleSmooth(const Vec3& wo, float uc,
     if (!refracts_) {
         // A thin wall: straight through.
         const float f = weight * (1 - LayerFresnel(wo_up.z, true)) / wo_up.z;
-        return BsdfSample{Rgb(f), -wo, pick.transmit, true};
+        return BsdfSample{base_ * f, -wo, pick.transmit, true};
     }
     const float eta = RelativeEta(wo);
     const std::optional<Vec3> refracted = Refract(wo_up, Vec3(0, 0, 1), eta);
@@ -274,7 +348,7 @@ std::optional<BsdfSample> PrincipledBsdf::SampleSmooth(const Vec3& wo, float uc,
     // Fresnel at the outside direction's cosine, as RefractionEval takes it.
     const float fresnel = LayerFresnel(outside ? wo_up.z : -refracted->z, true);
     const float f = weight * (1 - fresnel) / (-refracted->z * eta * eta);
-    return BsdfSample{Rgb(f), wi, pick.transmit, true, eta};
+    return BsdfSample{base_ * f, wi, pick.transmit, true, eta};
 }
 
 }  // namespace lf

@@ -1,8 +1,10 @@
 #include "lf/kernels/shading.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
+#include "lf/core/sampler.h"
 #include "lf/core/texture.h"
 #include "lf/kernels/float_util.h"
 
@@ -137,6 +139,28 @@ bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv, floa
            Opacity(scene, material, uv, vertex_alpha) < material.alpha_cutoff;
 }
 
+bool PassesThrough(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha,
+                   float u) {
+    switch (material.alpha_mode) {
+        case Material::AlphaMode::kOpaque:
+            return false;
+        case Material::AlphaMode::kMask:
+            return IsCutOut(scene, material, uv, vertex_alpha);
+        case Material::AlphaMode::kBlend:
+            return u >= Opacity(scene, material, uv, vertex_alpha);
+    }
+    return false;
+}
+
+float AlphaHash(const Vec3& origin, const Vec3& direction, unsigned geometry, unsigned primitive) {
+    uint64_t h = MixBits((uint64_t(geometry) << 32) | primitive);
+    for (int i = 0; i < 3; ++i) {
+        h = MixBits(h ^ ((uint64_t(std::bit_cast<uint32_t>(origin[i])) << 32) |
+                         std::bit_cast<uint32_t>(direction[i])));
+    }
+    return float(h >> 40) * 0x1p-24f;
+}
+
 bool Transmits(const Material& material) {
     return material.type == Material::Type::kDielectric ||
            (material.type == Material::Type::kPrincipled && material.transmission > 0);
@@ -205,6 +229,9 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
         s.params.roughness *= mr.g;
         s.params.metallic *= mr.b;
     }
+    if (m.transmission_texture.valid()) {
+        s.params.transmission *= Sample(scene, m.transmission_texture, s.uv).rgb.r;
+    }
     s.emission = m.emission;
     if (m.IsEmissive() && m.emission_texture.valid()) {
         s.emission *= Sample(scene, m.emission_texture, s.uv).rgb;
@@ -217,16 +244,17 @@ Rgb EmissionAt(const EmbreeScene& es, const SurfacePoint& light_point, const Rgb
     const Scene& scene = es.scene();
     const TriangleMesh& mesh = scene.meshes[size_t(light_point.mesh)];
     const Material& m = scene.materials[size_t(mesh.material)];
-    if (!m.emission_texture.valid() && m.alpha_mode != Material::AlphaMode::kMask) {
+    if (!m.emission_texture.valid() && m.alpha_mode == Material::AlphaMode::kOpaque) {
         return radiance;
     }
     const Vec2 uv = TriangleUv(mesh, light_point.primitive, light_point.b1, light_point.b2);
-    if (IsCutOut(scene, m, uv,
-                 VertexColor(mesh, light_point.primitive, light_point.b1, light_point.b2).a)) {
-        return Rgb(0);
-    }
-    if (!m.emission_texture.valid()) return radiance;
-    return radiance * Sample(scene, m.emission_texture, uv).rgb;
+    const float vertex_alpha =
+        VertexColor(mesh, light_point.primitive, light_point.b1, light_point.b2).a;
+    if (IsCutOut(scene, m, uv, vertex_alpha)) return Rgb(0);
+    Rgb le = radiance;
+    if (m.alpha_mode == Material::AlphaMode::kBlend) le *= Opacity(scene, m, uv, vertex_alpha);
+    if (m.emission_texture.valid()) le *= Sample(scene, m.emission_texture, uv).rgb;
+    return le;
 }
 
 }  // namespace lf

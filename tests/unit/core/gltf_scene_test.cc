@@ -225,8 +225,13 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
          {"alphaCutoff", 0.3},
          {"extensions",
           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
-           {"KHR_materials_transmission", {{"transmissionFactor", 0.75}}},
+           {"KHR_materials_transmission",
+            {{"transmissionFactor", 0.75}, {"transmissionTexture", {{"index", 0}}}}},
            {"KHR_materials_ior", {{"ior", 1.33}}},
+           {"KHR_materials_clearcoat",
+            {{"clearcoatFactor", 0.7}, {"clearcoatRoughnessFactor", 0.2}}},
+           {"KHR_materials_sheen",
+            {{"sheenColorFactor", {0.9, 0.5, 0.1}}, {"sheenRoughnessFactor", 0.4}}},
            {"KHR_materials_volume",
             {{"thicknessFactor", 0.1},
              {"attenuationDistance", 2},
@@ -236,7 +241,8 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
     j["meshes"][0]["primitives"].push_back(j["meshes"][1]["primitives"][0]);
     j["meshes"][0]["primitives"][1]["material"] = 3;
     j["extensionsUsed"] = {"KHR_lights_punctual", "KHR_texture_transform",
-                           "KHR_materials_clearcoat"};
+                           "KHR_materials_iridescence", "KHR_materials_clearcoat",
+                           "KHR_materials_sheen"};
     const absl::StatusOr<Scene> scene = Load(b);
     ASSERT_TRUE(scene.ok()) << scene.status();
 
@@ -272,6 +278,8 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
     EXPECT_FLOAT_EQ(glass.emission.r, 4);
     EXPECT_FLOAT_EQ(glass.emission.g, 2);
     EXPECT_FLOAT_EQ(glass.transmission, 0.75f);
+    EXPECT_TRUE(glass.transmission_texture.valid());
+    EXPECT_FALSE(glass.transmission_texture.srgb);
     EXPECT_FLOAT_EQ(glass.ior, 1.33f);
     EXPECT_FLOAT_EQ(glass.thickness, 0.1f);
     EXPECT_FLOAT_EQ(glass.attenuation_distance, 2);
@@ -279,8 +287,7 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
     EXPECT_EQ(glass.alpha_mode, Material::AlphaMode::kMask);
     EXPECT_FLOAT_EQ(glass.alpha_cutoff, 0.3f);
     const Material& blend = scene->materials[3];
-    EXPECT_EQ(blend.alpha_mode, Material::AlphaMode::kMask);
-    EXPECT_FLOAT_EQ(blend.alpha_cutoff, 0.5f);
+    EXPECT_EQ(blend.alpha_mode, Material::AlphaMode::kBlend);
 
     // One image, decoded once, shared by every ref to it, texels top row first.
     ASSERT_EQ(scene->textures.size(), 1u);
@@ -294,10 +301,16 @@ TEST_F(GltfSceneTest, MaterialsAndTexturesBecomePrincipledParametersAndSharedIma
 
     const std::string log = CapturedLog().str();
     EXPECT_NE(log.find("occlusionTexture ignored"), std::string::npos) << log;
-    EXPECT_NE(log.find("BLEND rendered as MASK"), std::string::npos) << log;
-    EXPECT_NE(log.find("extension KHR_materials_clearcoat not supported: the clear coat layer"),
+    EXPECT_EQ(log.find("BLEND"), std::string::npos) << log;
+    EXPECT_NE(log.find("extension KHR_materials_iridescence not supported: thin-film iridescence"),
               std::string::npos)
         << log;
+    EXPECT_EQ(log.find("KHR_materials_clearcoat"), std::string::npos) << log;
+    EXPECT_EQ(log.find("KHR_materials_sheen"), std::string::npos) << log;
+    EXPECT_FLOAT_EQ(glass.clearcoat, 0.7f);
+    EXPECT_FLOAT_EQ(glass.clearcoat_roughness, 0.2f);
+    EXPECT_FLOAT_EQ(glass.sheen_color.g, 0.5f);
+    EXPECT_FLOAT_EQ(glass.sheen_roughness, 0.4f);
 }
 
 TEST_F(GltfSceneTest, SpotAndDirectionalLightsPointDownTheirNodesMinusZ) {
@@ -391,6 +404,36 @@ TEST_F(GltfSceneTest, AnIncludingTransformScalesTheAttenuationDistance) {
         "scene.json", ReadBeside(dir_.string()));
     ASSERT_TRUE(included.ok()) << included.status();
     EXPECT_FLOAT_EQ(included->materials[0].attenuation_distance, 0.02f);
+}
+
+// KHR_materials_unlit: the surface shows its base colour (factor times texture) as emitted
+// radiance, on both faces when double-sided, and reflects nothing; required, it still loads.
+TEST_F(GltfSceneTest, UnlitMaterialsEmitTheirBaseColourAndReflectNothing) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Json& j = b.json();
+    for (Json& m : j["materials"]) {
+        m["extensions"]["KHR_materials_unlit"] = Json::object();
+        m["emissiveFactor"] = {0.5, 0.5, 0.5};  // ignored: unlit shows the base colour only
+    }
+    j["extensionsUsed"].push_back("KHR_materials_unlit");
+    j["extensionsRequired"].push_back("KHR_materials_unlit");
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_EQ(scene->materials.size(), 2u);
+    const Material& textured = scene->materials[0];
+    EXPECT_EQ(textured.type, Material::Type::kLambert);
+    EXPECT_EQ(textured.reflectance, Rgb(0.0f));
+    EXPECT_EQ(textured.emission, Rgb(1.0f));
+    EXPECT_EQ(textured.emission_texture.image, textured.base_color_texture.image);
+    EXPECT_TRUE(textured.emission_texture.srgb);
+    EXPECT_FALSE(textured.two_sided_emission);
+    const Material& red = scene->materials[1];
+    EXPECT_EQ(red.type, Material::Type::kLambert);
+    EXPECT_EQ(red.reflectance, Rgb(0.0f));
+    EXPECT_EQ(red.emission, Rgb(0.8f, 0.1f, 0.1f));
+    EXPECT_FALSE(red.emission_texture.valid());
+    EXPECT_TRUE(red.two_sided_emission);
+    EXPECT_EQ(CapturedLog().str().find("unlit"), std::string::npos) << CapturedLog().str();
 }
 
 TEST_F(GltfSceneTest, JsonSceneIncludesAGltfWithItsCameraOrItsOwn) {

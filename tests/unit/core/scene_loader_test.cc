@@ -681,13 +681,16 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
                 "thickness": 0.01, "attenuation_color": [0.9, 0.8, 0.7],
                 "attenuation_distance": 0.5, "opacity": 0.6, "alpha_mode": "mask",
                 "alpha_cutoff": 0.3, "double_sided": false, "emission": [0.1, 0.2, 0.3],
+                "clearcoat": 0.5, "clearcoat_roughness": 0.1, "sheen_color": [0.2, 0.3, 0.4],
+                "sheen_roughness": 0.6,
                 "base_color_texture": {"file": "wood.png", "wrap": "mirror", "filter": "nearest",
                     "transform": {"offset": [0.5, 0.25], "rotation_deg": 90,
                                   "scale": [2, -1]}},
                 "metallic_roughness_texture": "mr.png",
                 "normal_texture": {"file": "mr.png", "wrap": "clamp"}, "normal_scale": 0.5,
                 "emission_texture": "wood.png"},
-            "glow": {"type": "principled", "emission_texture": "wood.png"}})"));
+            "glow": {"type": "principled", "emission_texture": "wood.png",
+                "alpha_mode": "blend"}})"));
     ASSERT_TRUE(scene.ok()) << scene.status();
     EXPECT_TRUE(CapturedLog().str().empty()) << CapturedLog().str();
     ASSERT_EQ(scene->textures.size(), 2u);
@@ -702,6 +705,10 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
     EXPECT_FALSE(plain.IsEmissive());
 
     const Material& m = scene->materials[2];
+    EXPECT_FLOAT_EQ(m.clearcoat, 0.5f);
+    EXPECT_FLOAT_EQ(m.clearcoat_roughness, 0.1f);
+    EXPECT_EQ(m.sheen_color, Rgb(0.2f, 0.3f, 0.4f));
+    EXPECT_FLOAT_EQ(m.sheen_roughness, 0.6f);
     EXPECT_EQ(m.reflectance, Rgb(0.5f, 0.1f, 0.1f));
     EXPECT_FLOAT_EQ(m.metallic, 0.3f);
     EXPECT_FLOAT_EQ(m.roughness, 0.2f);
@@ -738,6 +745,7 @@ TEST_F(SceneLoaderTest, PrincipledMaterialAndTextures) {
     // An emission texture alone is the radiance: its factor defaults to 1.
     EXPECT_EQ(scene->materials[3].emission, Rgb(1));
     EXPECT_EQ(scene->materials[3].reflectance, Rgb(0.8f));
+    EXPECT_EQ(scene->materials[3].alpha_mode, Material::AlphaMode::kBlend);
 }
 
 TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
@@ -759,9 +767,9 @@ TEST_F(SceneLoaderTest, PrincipledErrorsNameThePath) {
                 "scene.json: materials.m.base_color[2]: must be in [0, 1], got 2");
     ExpectError(WithMaterial(p + R"("base_color": [1, 1, 1], "reflectance": [1, 1, 1]})"),
                 "scene.json: materials.m: give either base_color or reflectance");
-    ExpectError(WithMaterial(p + R"("alpha_mode": "blend"})"),
-                "scene.json: materials.m.alpha_mode: unknown alpha mode \"blend\"; expected "
-                "opaque or mask");
+    ExpectError(WithMaterial(p + R"("alpha_mode": "add"})"),
+                "scene.json: materials.m.alpha_mode: unknown alpha mode \"add\"; expected "
+                "opaque, mask or blend");
     ExpectError(WithMaterial(p + R"("double_sided": "yes"})"),
                 "scene.json: materials.m.double_sided: expected true or false, got string");
     ExpectError(

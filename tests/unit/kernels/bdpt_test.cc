@@ -432,6 +432,26 @@ TEST(Bdpt, MatchesThePathTracerThroughAThinLensAndAbsorbingGlass) {
     CompareWithPathTracer("thin lens, absorbing glass", scene, 256, 512, 8);
 }
 
+TEST(Bdpt, MatchesThePathTracerThroughTintedPrincipledGlass) {
+    // The principled BTDF's base colour tint (per crossing) and Beer's law in a solid sphere, a
+    // thin-walled one beside it; both subpaths and the connections cross them.
+    Scene scene = OpenScene();
+    scene.environment = EnvironmentLight{};
+    scene.environment->radiance = Rgb(0.3f, 0.4f, 0.6f);
+    scene.directional_lights.push_back({Normalize(Vec3d(0.3, -1, 0.4)), Rgb(2, 1.8f, 1.5f), 0});
+    for (int i : {1, 2}) {
+        Material& m = scene.materials[size_t(i)];
+        m.type = Material::Type::kPrincipled;
+        m.reflectance = i == 1 ? Rgb(0.9f, 0.4f, 0.2f) : Rgb(0.3f, 0.8f, 0.5f);
+        m.roughness = 0.3f;
+        m.transmission = 1;
+        m.thickness = i == 1 ? 0.5f : 0;
+        m.attenuation_color = Rgb(0.9f, 0.7f, 0.5f);
+        m.attenuation_distance = 0.5f;
+    }
+    CompareWithPathTracer("tinted principled glass", scene, 256, 512, 8);
+}
+
 TEST(Bdpt, AnySplitOfTheWorkGivesTheSameBits) {
     const Scene scene = LoadSmall("materials.json", 16);
     auto es = EmbreeScene::Build(scene);

@@ -2,8 +2,13 @@
 // faces of single-sided meshes, except where the material transmits.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+#include <utility>
+
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/shading.h"
+#include "plane_render.h"
 #include "render_path.h"
 #include "test_scenes.h"
 
@@ -91,6 +96,90 @@ TEST(AlphaMask, LightSamplesInHolesEmitNothing) {
     const SurfacePoint right = (*es)->TrianglePoint(0, 1, 0.1f, 0.8f);  // near (1, 1)
     EXPECT_EQ(EmissionAt(**es, left, Rgb(3)), Rgb(0));
     EXPECT_EQ(EmissionAt(**es, right, Rgb(3)), Rgb(3));
+}
+
+// The mean of channel c over an image whose pixels all have the same expectation, and its
+// standard error from the pixels' spread.
+std::pair<double, double> ImageMean(const Image& image, int c) {
+    double sum = 0, sum2 = 0;
+    const int n = image.width() * image.height();
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const double v = image.Pixel(x, y)[c];
+            sum += v;
+            sum2 += v * v;
+        }
+    }
+    const double mean = sum / n;
+    return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / (n - 1))};
+}
+
+// glTF's BLEND by stochastic transparency: a quad of opacity a emitting red 2 in front of an
+// emitter of green 1 renders (2 a, 1 - a, 0), the alpha-blended value, in expectation. (As a
+// cut-out at 0.5, which BLEND was before, it rendered (0, 1, 0).)
+TEST(AlphaBlend, CameraRaysConvergeToTheBlendedValue) {
+    Scene scene = MaskedQuadOverEmitter();
+    Material& blend = scene.materials[0];
+    blend.base_color_texture = {};
+    blend.alpha_mode = Material::AlphaMode::kBlend;
+    blend.opacity = 0.3f;
+    blend.emission = Rgb(2, 0, 0);
+    scene.materials[1].emission = Rgb(0, 1, 0);
+    // Inside the front quad only: every pixel has the same expectation.
+    scene.camera = testing::SquareCamera({0, 0, 1}, {0, 0, 0}, {0, 1, 0}, 60, 16);
+    const RenderOutput out = testing::RenderPath(scene, 64).out;
+    const float a = blend.opacity;
+    const double expected[3] = {2 * a, 1 - a, 0};
+    for (int c = 0; c < 3; ++c) {
+        const auto [mean, standard_error] = ImageMean(out.image, c);
+        if (c < 2) {
+            EXPECT_GT(standard_error, 0) << "stochastic, not a fixed cut-out";
+        }
+        EXPECT_NEAR(mean, expected[c], 5 * standard_error + 1e-6) << "channel " << c;
+    }
+}
+
+// Shadow rays blend too: a plane of albedo rho under a directional light of irradiance E,
+// through a black blended sheet of opacity a that the camera also looks through, renders
+// (1 - a)^2 rho E / pi: the light passes the sheet with probability 1 - a, the view too.
+TEST(AlphaBlend, ShadowRaysPassWithProbabilityOneMinusOpacity) {
+    const Rgb rho(0.5f);
+    Scene scene = testing::PlaneUnderCamera(rho);
+    Material sheet;
+    sheet.reflectance = Rgb(0);
+    sheet.alpha_mode = Material::AlphaMode::kBlend;
+    sheet.opacity = 0.4f;
+    scene.materials.push_back(sheet);
+    TriangleMesh m;
+    m.material = 1;
+    m.positions = {{-5, 1, -5}, {-5, 1, 5}, {5, 1, 5}, {5, 1, -5}};
+    m.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(m);
+    const Rgb irradiance(3.0f, 2.0f, 1.0f);
+    scene.directional_lights.push_back({Vec3d(0, -1, 0), irradiance});
+    const RenderOutput out = testing::RenderPath(scene, 64).out;
+    const double pass = 1 - sheet.opacity;
+    for (int c = 0; c < 3; ++c) {
+        const double expected = pass * pass * rho[c] * irradiance[c] / std::numbers::pi;
+        const auto [mean, standard_error] = ImageMean(out.image, c);
+        EXPECT_GT(standard_error, 0);
+        EXPECT_NEAR(mean, expected, 5 * standard_error + 1e-6) << "channel " << c;
+    }
+}
+
+// A light sample on a blended emitter carries its radiance times the opacity: what a ray that
+// may pass through it sees on average.
+TEST(AlphaBlend, LightSamplesCarryTheOpacity) {
+    Scene scene = MaskedQuadOverEmitter();
+    scene.materials[0].alpha_mode = Material::AlphaMode::kBlend;
+    scene.materials[0].opacity = 0.5f;
+    scene.materials[0].emission = Rgb(3);
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    const SurfacePoint left = (*es)->TrianglePoint(0, 0, 0.1f, 0.1f);   // texture alpha 0
+    const SurfacePoint right = (*es)->TrianglePoint(0, 1, 0.1f, 0.8f);  // texture alpha 1
+    EXPECT_EQ(EmissionAt(**es, left, Rgb(3)), Rgb(0));
+    EXPECT_EQ(EmissionAt(**es, right, Rgb(3)), Rgb(1.5f));
 }
 
 struct SidedCase {

@@ -40,6 +40,7 @@ TEST_P(Interior, TransmittedRadianceFollowsBeersLaw) {
     Material glass;
     glass.type = GetParam();
     glass.ior = 1;
+    glass.reflectance = Rgb(1);  // the principled base colour tints each crossing: untinted here
     glass.attenuation_color = Rgb(1, 0.5f, 0.25f);
     glass.attenuation_distance = 0.5f;
     // The principled material is solid glass when it transmits and has a thickness (glTF's

@@ -35,6 +35,9 @@ struct Params {
     float transmission = 0;
     float thickness = 0;
     float ior = 1.5f;
+    float clearcoat = 0, clearcoat_roughness = 0;
+    Rgb sheen_color{0.0f};
+    float sheen_roughness = 0;
 };
 
 Material Principled(const Params& p) {
@@ -47,20 +50,45 @@ Material Principled(const Params& p) {
     m.transmission = p.transmission;
     m.thickness = p.thickness;
     m.ior = p.ior;
+    m.clearcoat = p.clearcoat;
+    m.clearcoat_roughness = p.clearcoat_roughness;
+    m.sheen_color = p.sheen_color;
+    m.sheen_roughness = p.sheen_roughness;
     return m;
 }
 
 std::string Describe(const Params& p) {
     char text[160];
-    std::snprintf(text, sizeof text, "r %.2f metallic %.2f specular %.2f transmission %.2f %s",
+    std::snprintf(text, sizeof text,
+                  "r %.2f metallic %.2f specular %.2f transmission %.2f %s coat %.2f (r %.2f) "
+                  "sheen %.2f (r %.2f)",
                   p.roughness, p.metallic, p.specular, p.transmission,
-                  p.transmission > 0 ? (p.thickness > 0 ? "solid" : "thin") : "opaque");
+                  p.transmission > 0 ? (p.thickness > 0 ? "solid" : "thin") : "opaque", p.clearcoat,
+                  p.clearcoat_roughness, p.sheen_color.Average(), p.sheen_roughness);
     return text;
 }
 
-// A spread of materials: opaque, metallic, thin and solid transmission, tinted.
+Params Layered(Params p, float clearcoat, float clearcoat_roughness, const Rgb& sheen_color,
+               float sheen_roughness) {
+    p.clearcoat = clearcoat;
+    p.clearcoat_roughness = clearcoat_roughness;
+    p.sheen_color = sheen_color;
+    p.sheen_roughness = sheen_roughness;
+    return p;
+}
+
+// A spread of materials: opaque, metallic, thin and solid transmission, tinted, and the same
+// under a clear coat, a sheen or both.
 std::vector<Params> Spread() {
+    const Params plastic{Rgb(0.8f, 0.4f, 0.2f), 0.5f};
+    const Params thin{Rgb(0.7f, 0.8f, 0.9f), 0.4f, 0, 1, 1, 0};
+    const Params solid{Rgb(1.0f), 0.3f, 0, 1, 1, 1};
     return {
+        Layered(plastic, 1, 0.1f, Rgb(0.0f), 0),
+        Layered(plastic, 0, 0, Rgb(0.9f, 0.7f, 0.5f), 0.5f),
+        Layered(Params{Rgb(0.95f, 0.7f, 0.4f), 0.6f, 1}, 0.7f, 0.4f, Rgb(0.3f), 0.2f),
+        Layered(thin, 1, 0.3f, Rgb(0.5f, 0.6f, 0.7f), 0.8f),
+        Layered(solid, 0.8f, 0.05f, Rgb(0.0f), 0),
         {Rgb(0.8f, 0.4f, 0.2f), 0.5f},
         {Rgb(0.9f, 0.6f, 0.3f), 0.3f, 0.5f},
         {Rgb(0.95f, 0.7f, 0.4f), 0.6f, 1},
@@ -185,11 +213,13 @@ struct Chi2Case {
 };
 
 std::vector<Chi2Case> Chi2Cases() {
-    const std::vector<std::pair<std::string, Params>> materials = {
-        {"Plastic", Spread()[0]},   {"HalfMetal", Spread()[1]}, {"Metal", Spread()[2]},
-        {"ThinGlass", Spread()[3]}, {"ThinMix", Spread()[4]},   {"SolidGlass", Spread()[5]},
-        {"SolidMix", Spread()[6]},
+    const std::vector<std::string> names = {
+        "CoatedPlastic", "Sheen",   "CoatedSheenMetal", "CoatedSheenThinGlass",
+        "CoatedSolid",   "Plastic", "HalfMetal",        "Metal",
+        "ThinGlass",     "ThinMix", "SolidGlass",       "SolidMix",
     };
+    std::vector<std::pair<std::string, Params>> materials;
+    for (size_t i = 0; i < names.size(); ++i) materials.push_back({names[i], Spread()[i]});
     std::vector<Chi2Case> cases;
     for (const auto& [m_name, params] : materials) {
         // Back130 starts inside the solids.

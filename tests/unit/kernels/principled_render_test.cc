@@ -23,6 +23,13 @@ TEST(PrincipledRender, PlaneUnderDirectionalLightMatchesEval) {
         m.type = Material::Type::kPrincipled;
         m.roughness = roughness;
         m.metallic = 0.3f;
+        // The rougher plane wears a clear coat and a sheen: the renderer hands them to the BSDF.
+        if (roughness > 0.5f) {
+            m.clearcoat = 0.8f;
+            m.clearcoat_roughness = 0.3f;
+            m.sheen_color = Rgb(0.6f, 0.7f, 0.9f);
+            m.sheen_roughness = 0.5f;
+        }
         const DirectionalLight sun{Normalize(Vec3d(0.4, -1, 0.3)), Rgb(2.0f, 1.5f, 1.0f)};
         scene.directional_lights.push_back(sun);
         const uint64_t spp = 64;

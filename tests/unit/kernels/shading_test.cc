@@ -186,7 +186,8 @@ TEST(VertexColours, AlphaMultipliesTheOpacity) {
 }
 
 // The metallic-roughness texture's G channel scales roughness and its B channel metallic (its
-// R, occlusion in some exports, is ignored); the base colour texture scales the base colour.
+// R, occlusion in some exports, is ignored); the base colour texture scales the base colour; the
+// transmission texture's R channel scales transmission.
 TEST(TexturedParams, FactorsTimesTexels) {
     Scene scene;
     auto mr = std::make_shared<TextureImage>();
@@ -201,6 +202,8 @@ TEST(TexturedParams, FactorsTimesTexels) {
     m.roughness = 0.8f;
     m.metallic = 0.6f;
     m.metallic_roughness_texture.image = 0;
+    m.transmission = 0.8f;
+    m.transmission_texture.image = 0;
     m.base_color_texture.image = 1;
     m.base_color_texture.srgb = true;
     m.base_color_texture.nearest = true;
@@ -217,6 +220,7 @@ TEST(TexturedParams, FactorsTimesTexels) {
     const SurfaceParams b = Shade(**es, *white, -down).params;
     EXPECT_FLOAT_EQ(a.roughness, 0.4f);
     EXPECT_FLOAT_EQ(a.metallic, 0.15f);
+    EXPECT_FLOAT_EQ(a.transmission, 0.08f);
     EXPECT_EQ(a.base_color, Rgb(0.5f, 0, 0));
     EXPECT_EQ(b.base_color, Rgb(0.5f));
 }

@@ -51,7 +51,7 @@ struct TextureRef {
 struct Material {
     enum class Type { kLambert, kMirror, kGlossy, kDielectric, kPrincipled };
     enum class Distribution { kGgx, kBeckmann };
-    enum class AlphaMode { kOpaque, kMask };
+    enum class AlphaMode { kOpaque, kMask, kBlend };
 
     std::string name;
     Type type = Type::kLambert;
@@ -83,9 +83,20 @@ struct Material {
     float thickness = 0;
     Rgb attenuation_color{1.0f};  // the colour white light takes after attenuation_distance
     float attenuation_distance = std::numeric_limits<float>::infinity();  // metres
+    // KHR_materials_clearcoat: a GGX dielectric layer (IOR 1.5) of this weight and perceptual
+    // roughness on top of everything else.
+    float clearcoat = 0;
+    float clearcoat_roughness = 0;
+    // KHR_materials_sheen: a cloth-like Charlie lobe of this colour and perceptual roughness
+    // between the clear coat and the base; black is none.
+    Rgb sheen_color{0.0f};
+    float sheen_roughness = 0;
     TextureRef base_color_texture, metallic_roughness_texture, normal_texture, emission_texture;
-    float normal_scale = 1;  // scales the normal map's x and y (glTF normalTexture.scale)
-    float opacity = 1;       // base colour alpha factor; with the texture's alpha, for kMask
+    TextureRef transmission_texture;  // its R channel multiplies `transmission` (linear)
+    float normal_scale = 1;           // scales the normal map's x and y (glTF normalTexture.scale)
+    float opacity = 1;  // base colour alpha factor; with the texture's alpha, for kMask
+    // kBlend (glTF BLEND): stochastic transparency, rays pass through with probability
+    // 1 - opacity, so the image converges to opacity * surface + (1 - opacity) * behind.
     AlphaMode alpha_mode = AlphaMode::kOpaque;
     float alpha_cutoff = 0.5f;  // kMask: opacity below this is a hole
     // Single-sided surfaces (glTF doubleSided false) are invisible from behind, as in glTF
@@ -101,7 +112,7 @@ struct Material {
     }
     bool IsTextured() const {
         return base_color_texture.valid() || metallic_roughness_texture.valid() ||
-               normal_texture.valid() || emission_texture.valid();
+               normal_texture.valid() || emission_texture.valid() || transmission_texture.valid();
     }
 };
 

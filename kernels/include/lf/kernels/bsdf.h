@@ -22,8 +22,15 @@ struct SurfaceParams {
     Rgb base_color;  // lambert albedo, principled base colour
     float metallic = 0;
     float roughness = 0;  // principled: perceptual roughness r
+    float clearcoat = 0, clearcoat_roughness = 0;
+    Rgb sheen_color;
+    float sheen_roughness = 0;
+    float transmission = 0;  // principled; whether the material is a solid stays the Material's
 
-    static SurfaceParams Of(const Material& m) { return {m.reflectance, m.metallic, m.roughness}; }
+    static SurfaceParams Of(const Material& m) {
+        return {m.reflectance,         m.metallic,    m.roughness,       m.clearcoat,
+                m.clearcoat_roughness, m.sheen_color, m.sheen_roughness, m.transmission};
+    }
 };
 
 class Bsdf {

@@ -1,11 +1,12 @@
 // The principled material: glTF 2.0's metallic-roughness BRDF (its Appendix B) with
 // KHR_materials_specular's weight, KHR_materials_ior and KHR_materials_transmission/_volume,
+// under KHR_materials_sheen and KHR_materials_clearcoat layers (see LayerPick below),
 // in the local shading frame of lf/kernels/bsdf.h (+z the front face's normal, the outside).
 //
 //   f = metallic * conductor + (1 - metallic) * dielectric
 //   conductor  = F_schlick(base, wo.wm) D G / (4 cos_o cos_i), GGX with alpha = r^2
 //   dielectric = s F D G / (4 cos_o cos_i)                     specular layer, s = `specular`,
-//              + t (1 - s F) BTDF                              F = Schlick with F0 from the IOR
+//              + t (1 - s F) base BTDF                         F = Schlick with F0 from the IOR
 //              + (1 - t) base/pi (1 - s F(wo.h)) k(wo) k(wi)   h = normalize(wo + wi)
 //
 // Without k that is the specification's fresnel_mix exactly, which is single scattering: it
@@ -21,7 +22,9 @@
 // Below roughness sqrt(MicrofacetDistribution::kMinAlpha) the surface is smooth: reflection and
 // transmission are Dirac deltas (BsdfSample::delta); Eval and Pdf hold the diffuse base alone.
 //
-// The BTDF: with `thickness` 0 the surface is a thin wall, and transmission is the specular
+// The BTDF is tinted by the base colour at every crossing (KHR_materials_transmission), so solid
+// glass tints twice, on entry and exit, besides Beer's law inside (lf/kernels/shading.h). With
+// `thickness` 0 the surface is a thin wall, and transmission is the specular
 // lobe mirrored to the other side (light passes through without bending, blurred by the
 // roughness). Above 0 the mesh is the boundary of a solid of relative IOR `ior` and the BTDF is
 // Walter et al.'s rough dielectric (2007), F then taken at the cosine on the outside of the
@@ -36,9 +39,11 @@
 #include "lf/core/scene.h"
 #include "lf/core/vec.h"
 #include "lf/kernels/bsdf_sample.h"
+#include "lf/kernels/clearcoat_lobe.h"
 #include "lf/kernels/fresnel_mix_albedo.h"
 #include "lf/kernels/ggx_albedo.h"
 #include "lf/kernels/microfacet.h"
+#include "lf/kernels/sheen_lobe.h"
 
 namespace lf {
 
@@ -54,13 +59,28 @@ class PrincipledBsdf {
     float Pdf(const Vec3& wo, const Vec3& wi) const;
     std::optional<BsdfSample> Sample(const Vec3& wo, float uc, const Vec2& u) const;
     // Every lobe is a Dirac delta: a smooth surface without a diffuse base.
-    bool IsDelta() const { return smooth_ && diffuse_scale_ == 0; }
+    bool IsDelta() const { return smooth_ && diffuse_scale_ == 0 && !layered(); }
     // Bsdf::RefractionEta: RelativeEta(wo) for a pair across a solid's interface, else 1.
     float RefractionEta(const Vec3& wo, const Vec3& wi) const {
         return refracts_ && wo.z * wi.z < 0 ? RelativeEta(wo) : 1.0f;
     }
 
   private:
+    // The layers over the outside face (KHR_materials_clearcoat over KHR_materials_sheen over
+    // the rest): f = coat + Keep_coat (sheen + Keep_sheen base), each Keep symmetric in (wo, wi)
+    // (lf/kernels/clearcoat_lobe.h, sheen_lobe.h). Light crossing the surface passes both layers
+    // on its outside side and is scaled by their Keep there. Inside a solid there are none.
+    // Probabilities of sampling the coat and the sheen for wo; the base lobes get `rest`.
+    struct LayerPick {
+        float coat = 0, sheen = 0, rest = 1;
+    };
+    LayerPick PickLayers(const Vec3& wo) const;
+    bool layered() const { return coat_.active() || sheen_.active(); }
+    // What the layers let through to and from the base for the pair.
+    float LayerKeep(const Vec3& wo, const Vec3& wi) const;
+    Rgb BaseEval(const Vec3& wo, const Vec3& wi) const;
+    float BasePdf(const Vec3& wo, const Vec3& wi) const;
+
     // Probabilities of sampling the reflection (conductor and specular layer share GGX visible
     // normals), diffuse and transmission lobes for wo; they sum to one, or all are zero.
     struct LobePick {
@@ -104,6 +124,8 @@ class PrincipledBsdf {
     // through it by next-event estimation gave single samples 1e5 times the light's irradiance.
     bool smooth_;
     float diffuse_scale_;  // (1 - metallic) (1 - transmission) / pi
+    ClearcoatLobe coat_;
+    SheenLobe sheen_;
 };
 
 }  // namespace lf

@@ -54,7 +54,8 @@ Shading Shade(const EmbreeScene& scene, const SurfaceHit& hit, const Vec3& wo);
 
 // The radiance a light sample on an emitter carries: `radiance` (the material's emission
 // factor, as LightSampler gives it) times the emission texture at the sample; black in an
-// alpha-mask hole, which emits nothing because rays pass through it.
+// alpha-mask hole, which emits nothing because rays pass through it, and times the opacity on a
+// blended surface (what rays that stop there see, on average).
 Rgb EmissionAt(const EmbreeScene& scene, const SurfacePoint& light_point, const Rgb& radiance);
 
 // TEXCOORD_0 of a triangle's point; (0, 0) on meshes without uvs.
@@ -69,6 +70,17 @@ float Opacity(const Scene& scene, const Material& material, const Vec2& uv, floa
 
 // True when rays pass through the material at uv (an alpha-mask hole).
 bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha = 1);
+
+// Whether a ray passes through the material at uv, u uniform in [0, 1): through an alpha-mask
+// hole always, through a blended surface when u >= its opacity.
+bool PassesThrough(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha,
+                   float u);
+
+// A uniform number in [0, 1) for the candidate hit of a ray (origin, direction) on primitive
+// `primitive` of geometry `geometry`: the blend test's, so a ray and its retraces agree, while
+// rays of different samples (other origins or directions) draw independently (pbrt-v4's
+// stochastic alpha test does the same).
+float AlphaHash(const Vec3& origin, const Vec3& direction, unsigned geometry, unsigned primitive);
 
 // Materials whose back faces let light out: single-sided culling spares them.
 bool Transmits(const Material& material);

@@ -1,0 +1,36 @@
+// KHR_materials_clearcoat's layer: a smooth-to-rough GGX dielectric of IOR 1.5 (Schlick, F0 =
+// 0.04) with weight `factor`, over whatever lies beneath (lf/kernels/principled_bsdf.h scales
+// that by Keep). Directions in the upper hemisphere of the shading frame.
+#pragma once
+
+#include "lf/core/vec.h"
+#include "lf/kernels/ggx_albedo.h"
+#include "lf/kernels/microfacet.h"
+
+namespace lf {
+
+class ClearcoatLobe {
+  public:
+    // factor in [0, 1]; roughness is glTF's perceptual clearcoatRoughness (alpha = r^2).
+    ClearcoatLobe(float factor, float roughness);
+
+    bool active() const { return factor_ > 0; }
+    float Eval(const Vec3& wo, const Vec3& wi) const;
+    float Pdf(const Vec3& wo, const Vec3& wi) const;
+    // Reflects wo about a visible GGX normal; wi may fall below the horizon (the caller drops it).
+    Vec3 Sample(const Vec3& wo, const Vec2& u) const;
+    // What the coat reflects of light arriving from w: factor E(cos theta_w).
+    float Albedo(const Vec3& w) const;
+    // The share of light the layer leaves to what lies beneath for the pair (wo, wi): 1 minus the
+    // larger of their albedos, symmetric so that the layered BSDF stays reciprocal, and at most
+    // 1 - Albedo(wo) so that coat and base never reflect more than arrives.
+    float Keep(const Vec3& wo, const Vec3& wi) const;
+
+  private:
+    float factor_;
+    MicrofacetDistribution distribution_;
+    const GgxAlbedo* albedo_;
+    GgxAlbedo::Roughness albedo_roughness_;
+};
+
+}  // namespace lf
