@@ -443,7 +443,8 @@ absl::Status Farm::TakeTaskLog(const std::string& lease_id, const std::string& w
                                std::vector<TaskLogLine> lines) {
     if (lines.empty()) return absl::OkStatus();
     const std::optional<Scheduler::LeaseHolder> holder = scheduler_.HolderOf(lease_id, worker);
-    if (!holder) return absl::OkStatus();
+    // A late heartbeat's lines for a lease that ended are not kept: the attempt is over.
+    if (!holder || !holder->current) return absl::OkStatus();
     return logs_->Append(holder->job_id, holder->task, holder->attempt, holder->worker,
                          std::move(lines));
 }

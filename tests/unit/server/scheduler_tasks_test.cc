@@ -99,8 +99,11 @@ TEST_F(SchedulerTasksTest, HolderOfNamesTheJobTaskAndAttemptOnlyForTheWorkerHold
     EXPECT_EQ(holder->task, lease.task.index);
     EXPECT_EQ(holder->attempt, 2);
     EXPECT_EQ(holder->worker, "a");
-    // An earlier attempt still resolves (its late lines are its own), another worker's never.
+    EXPECT_TRUE(holder->current);
+    // An earlier attempt still resolves, as ended (Farm::TakeTaskLog drops lines for it: a late
+    // heartbeat's were stored), another worker's never.
     EXPECT_EQ(scheduler_.HolderOf(lease.lease_id, "a")->attempt, 1);
+    EXPECT_FALSE(scheduler_.HolderOf(lease.lease_id, "a")->current);
     EXPECT_FALSE(scheduler_.HolderOf(again.lease_id, "b").has_value());
     EXPECT_FALSE(scheduler_.HolderOf(id + "/0/forged-1", "a").has_value());
     ASSERT_TRUE(scheduler_.Cancel(id).ok());
