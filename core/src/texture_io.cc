@@ -14,6 +14,7 @@
 #include <string_view>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/log.h"
 
 namespace lf {
 namespace {
@@ -96,7 +97,7 @@ absl::Status CheckExrHeaders(const std::string& bytes, const std::string& name) 
             if (size < 0 || size_t(size) > bytes.size() - at) {
                 return absl::InvalidArgumentError(
                     absl::StrCat(name, ": not a readable OpenEXR image: header attribute \"",
-                                 std::string(*attribute), "\" declares ", size,
+                                 LogSafe(std::string(*attribute), 64), "\" declares ", size,
                                  " bytes, the file has ", bytes.size() - at, " left"));
             }
             at += size_t(size);

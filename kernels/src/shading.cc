@@ -59,7 +59,10 @@ Vec3 NormalMapped(const EmbreeScene& es, const Material& m, const SurfaceHit& hi
 
 }  // namespace
 
-Vec3 ValidReflectionNormal(const Vec3& ns, const Vec3& n, const Vec3& wo) {
+namespace {
+
+// ValidReflectionNormal on wo's side of the surface: the result may face wo's side.
+Vec3 ValidReflectionNormalTowardsView(const Vec3& ns, const Vec3& n, const Vec3& wo) {
     const Vec3 ng = Dot(wo, n) < 0 ? -n : n;  // the geometric normal on wo's side
     const float cos_o = Dot(wo, ng);
     // How far above the surface the mirror direction must stay: a little, and never above wo.
@@ -76,6 +79,15 @@ Vec3 ValidReflectionNormal(const Vec3& ns, const Vec3& n, const Vec3& wo) {
     const Vec3 r_valid = ng * lift + Normalize(t) * std::sqrt(1 - lift * lift);
     const Vec3 h = wo + r_valid;
     return LengthSquared(h) > 0 ? Normalize(h) : ng;
+}
+
+}  // namespace
+
+Vec3 ValidReflectionNormal(const Vec3& ns, const Vec3& n, const Vec3& wo) {
+    // Mirroring about -h is mirroring about h: the normal keeps ns's side of the surface, which
+    // tells a solid's inside from its outside (a view from inside got an outward-facing normal).
+    const Vec3 valid = ValidReflectionNormalTowardsView(ns, n, wo);
+    return Dot(valid, n) * Dot(ns, n) < 0 ? -valid : valid;
 }
 
 SurfacePoint Shading::Leaving(const Vec3& w) const {

@@ -421,9 +421,12 @@ bool Scheduler::Heartbeat(const std::string& lease_id, const std::string& worker
     const absl::Time now = clock_();
     if (!Resolve(lease_id, worker)) return false;  // a made-up id is not kept
     workers_.Seen(worker, now);
+    // Only a lease still held clears strikes: a heartbeat on an expired one would otherwise
+    // lift its token's quarantine.
+    if (!leases_.Extend(lease_id, now + options_.lease)) return false;
     workers_.Worked(worker);
     workers_.Worked(TokenStrikes(worker));
-    return leases_.Extend(lease_id, now + options_.lease);
+    return true;
 }
 
 absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lease_id,

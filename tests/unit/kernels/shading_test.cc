@@ -462,6 +462,19 @@ TEST(SmoothShading, NoLightLeaksFromBelowTheSurface) {
     }
 }
 
+// The normal keeps the side of the shading normal it was given, which tells a solid's inside
+// from its outside: seen from behind, a bent normal came back facing the view (outward).
+TEST(SmoothShading, AValidReflectionNormalKeepsItsSideSeenFromBehind) {
+    const Vec3 n(0, 0, 1);
+    const Vec3 ns = Normalize(Vec3(0.95f, 0, 0.1f));   // leaning far from n
+    const Vec3 wo = Normalize(Vec3(-0.3f, 0, -0.2f));  // from behind: ns mirrors it through
+    const Vec3 valid = ValidReflectionNormal(ns, n, wo);
+    EXPECT_GT(Dot(valid, n), 0) << "the normal flipped to the view's side";
+    const Vec3 r = valid * (2 * Dot(wo, valid)) - wo;
+    EXPECT_LT(Dot(r, n), 0) << "the mirrored view must stay on the view's side";
+    EXPECT_NEAR(Length(valid), 1, 1e-5);
+}
+
 // A bent shading normal never makes a reflection vanish (issue 28): a large quad whose vertex
 // normals all lean 70 degrees towards +x, seen from the -x side at 45 degrees, where wo mirrored
 // about the bent normal points below the surface. Under a uniform sky of radiance 1 a mirror of

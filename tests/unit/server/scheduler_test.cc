@@ -268,7 +268,7 @@ TEST_F(SchedulerTest, ExpiriesCountAsFailuresButShutdownsDoNot) {
 // 10 s: a lease that expires before any heartbeat is not the task's failure.
 TEST_F(SchedulerTest, LeasesAbandonedUnderFreshIdsFailNoJob) {
     const std::string id = Submit(0, 16, 1);  // one task
-    int abandoned = 0;  // the token's quarantine refuses some of the 20
+    int abandoned = 0;                        // the token's quarantine refuses some of the 20
     for (int i = 0; i < 20; ++i) {
         abandoned += scheduler_.LeaseTask("evil/" + std::to_string(i)).has_value();
         now_ += absl::Seconds(11);
@@ -288,12 +288,19 @@ TEST_F(SchedulerTest, LeasesAbandonedUnderFreshIdsFailNoJob) {
 // and a lease its worker answers clears the token's strikes.
 TEST_F(SchedulerTest, ATokenLeasingUnderFreshIdsAndNeverAnsweringIsQuarantined) {
     Submit(0, 16);
+    std::string expired;
     for (int i = 0; i < WorkerRegistry::kAbandonedInARow; ++i) {
-        ASSERT_TRUE(scheduler_.LeaseTask("evil/" + std::to_string(i)).has_value()) << i;
+        const std::optional<TaskAssignment> lease =
+            scheduler_.LeaseTask("evil/" + std::to_string(i));
+        ASSERT_TRUE(lease.has_value()) << i;
+        expired = lease->lease_id;
         now_ += absl::Seconds(11);
         scheduler_.ExpireLeases();
     }
     EXPECT_FALSE(scheduler_.LeaseTask("evil/fresh").has_value()) << "the token is quarantined";
+    // A heartbeat on a lease that expired is refused, and lifts no quarantine.
+    EXPECT_FALSE(scheduler_.Heartbeat(expired, "evil/2"));
+    EXPECT_FALSE(scheduler_.LeaseTask("evil/fresh").has_value()) << "still quarantined";
     const std::optional<TaskAssignment> other = scheduler_.LeaseTask("node/w");
     ASSERT_TRUE(other.has_value());
     ASSERT_TRUE(
