@@ -18,6 +18,16 @@ cd "$(dirname "$0")/.."
 fuzz_seconds=${FUZZ_SECONDS:-60}
 fuzzers=(scene_json_fuzz gltf_fuzz mesh_fuzz texture_fuzz codec_fuzz job_record_fuzz)
 mapfile -t unit_tests < <(ls tests/unit/core/*_test.cc tests/unit/job/*_test.cc | xargs -n1 basename | sed 's/\.cc$//')
+# run_tests DIR SANITIZERS PROGRAM...: each test program built in DIR; the first failure ends
+# the run with the end of its log.
+run_tests() {
+  local dir=$1 sanitizers=$2 t
+  shift 2
+  for t in "$@"; do
+    (cd "$dir" && LF_TEST_QUIET=1 "bin/$t" --gtest_brief=1 >"$t.log" 2>&1) || {
+      echo "sanitize: $t failed under $sanitizers:"; tail -80 "$dir/$t.log"; exit 1; }
+  done
+}
 t0=$(date +%s)
 cmake -S . -B build-san -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DCMAKE_CXX_COMPILER=clang++ \
@@ -27,10 +37,7 @@ t1=$(date +%s)
 echo "sanitize: build of ${#unit_tests[@]} unit test programs and ${#fuzzers[@]} fuzz targets with address,undefined: $((t1 - t0)) s"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-for t in "${unit_tests[@]}"; do
-  (cd build-san && LF_TEST_QUIET=1 "bin/$t" --gtest_brief=1 >"$t.log" 2>&1) || {
-    echo "sanitize: $t failed under address,undefined:"; tail -60 "build-san/$t.log"; exit 1; }
-done
+run_tests build-san address,undefined "${unit_tests[@]}"
 t2=$(date +%s)
 echo "sanitize: ${#unit_tests[@]} unit test programs passed under address,undefined: $((t2 - t1)) s"
 mkdir -p build-san/fuzz-crashes
@@ -55,9 +62,6 @@ cmake --build build-tsan -j"${JOBS:-2}" --target "${tsan_tests[@]}" >/dev/null
 t4=$(date +%s)
 echo "sanitize: build of ${#tsan_tests[@]} coordinator test programs with thread: $((t4 - t3)) s"
 export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/sanitizers/tsan.supp
-for t in "${tsan_tests[@]}"; do
-  (cd build-tsan && LF_TEST_QUIET=1 "bin/$t" --gtest_brief=1 >"$t.log" 2>&1) || {
-    echo "sanitize: $t failed under thread:"; tail -80 "build-tsan/$t.log"; exit 1; }
-done
+run_tests build-tsan thread "${tsan_tests[@]}"
 t5=$(date +%s)
 echo "sanitize: ${#tsan_tests[@]} coordinator test programs passed under thread: $((t5 - t4)) s; all: $((t5 - t0)) s"
