@@ -32,6 +32,11 @@ bool Bsdf::IsDelta() const {
     return type_ == Material::Type::kMirror || type_ == Material::Type::kDielectric;
 }
 
+bool Bsdf::HasDeltaLobe() const {
+    if (principled_) return principled_->HasDeltaLobe();
+    return IsDelta();
+}
+
 float Bsdf::RefractionEta(const Vec3& wo, const Vec3& wi) const {
     if (principled_) return principled_->RefractionEta(wo, wi);
     if (type_ != Material::Type::kDielectric || !(wo.z * wi.z < 0)) return 1;

@@ -240,10 +240,13 @@ Rgb PpmRenderer::Li(const Ray& camera_ray, const PhotonMap& map, Sampler& sample
         const Vec3 wo = frame.ToLocal(wo_world);
         const Bsdf bsdf(material, sh.params);
 
+        // One BSDF sample: at a delta vertex the lobe to follow; elsewhere direct light's
+        // MIS sample, or one of the delta lobes of a smooth surface over a diffuse base.
+        const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
         if (!bsdf.IsDelta()) {
             // Direct light: the photons hold none (they are stored from their second hit on).
             L += beta *
-                 DirectLight(*hit, sh, wo_world, bsdf, medium, u_choice, u_light, u_bsdf, stats);
+                 DirectLight(*hit, sh, wo_world, bsdf, bs, medium, u_choice.x, u_light, stats);
             // Indirect light: the density estimate, over photons whose path fits in max_depth.
             const int max_photon_depth = max_depth < 0 ? kMaxPathDepth : max_depth - 1 - depth;
             Rgb sum(0);
@@ -254,11 +257,13 @@ Rgb PpmRenderer::Li(const Ray& camera_ray, const PhotonMap& map, Sampler& sample
                 sum += bsdf.Eval(wo, wi) * photon.power;
             });
             L += beta * sum * density_scale;
-            break;
+            // The density estimate and direct light cover the lobes that are not deltas; the
+            // path goes on only along a delta lobe that was picked (weight over its
+            // probability), whose next hit counts the emission it sees.
+            if (!bs || !bs->delta) break;
         }
 
-        // A delta vertex: follow the sampled lobe, as the path tracer.
-        const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
+        // A delta lobe: follow it, as the path tracer.
         if (!bs || !(bs->pdf > 0)) break;
         const Vec3 wi = frame.FromLocal(bs->wi);
         if (!sh.SidesAgree(wo_world, wi, bs->wi.z * wo.z > 0)) break;
@@ -281,21 +286,21 @@ Rgb PpmRenderer::Li(const Ray& camera_ray, const PhotonMap& map, Sampler& sample
 // there, e.g. a sphere light seen from a point on that sphere), and glossy lobes are sampled
 // better by the BSDF.
 Rgb PpmRenderer::DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec3& wo_world,
-                             const Bsdf& bsdf, int medium, const Vec2& u_choice,
-                             const Vec2& u_light, const Vec2& u_bsdf, RenderStats& stats) const {
+                             const Bsdf& bsdf, const std::optional<BsdfSample>& bs, int medium,
+                             float u_pick, const Vec2& u_light, RenderStats& stats) const {
     const std::vector<Material>& materials = scene_.scene().materials;
     const Frame frame = Frame::FromNormal(sh.ns);
     const Vec3 wo = frame.ToLocal(wo_world);
-    Rgb L = NextEventEstimate(scene_, lights_, hit, sh, wo_world, bsdf, medium, Rgb(1.0f),
-                              u_choice.x, u_light, stats);
+    Rgb L = NextEventEstimate(scene_, lights_, hit, sh, wo_world, bsdf, medium, Rgb(1.0f), u_pick,
+                              u_light, stats);
     // Beer's law when the BSDF sample reaches an emitter through a solid's interior.
     auto transmittance = [&](const Vec3& w, bool transmitted, float distance) {
         const int through = InteriorAfter(medium, hit.material, materials[size_t(hit.material)],
                                           Dot(w, hit.n), transmitted);
         return through >= 0 ? Transmittance(materials[size_t(through)], distance) : Rgb(1.0f);
     };
-    const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
-    if (!bs || !(bs->pdf > 0)) return L;
+    // A delta lobe's sample is the path's next segment (Li), which counts what it hits.
+    if (!bs || bs->delta || !(bs->pdf > 0)) return L;
     const Vec3 wi = frame.FromLocal(bs->wi);
     if (!sh.SidesAgree(wo_world, wi, bs->wi.z * wo.z > 0)) return L;
     const Rgb weight = bs->f * (std::abs(bs->wi.z) / bs->pdf);
@@ -306,7 +311,7 @@ Rgb PpmRenderer::DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec
     if (!light_hit) {
         const Rgb le = lights_.EscapedRadiance(wi);
         if (!le.IsBlack()) {
-            L += weight * le * (bs->delta ? 1.0f : PowerHeuristic(bs->pdf, lights_.EscapedPdf(wi)));
+            L += weight * le * PowerHeuristic(bs->pdf, lights_.EscapedPdf(wi));
         }
         return L;
     }
@@ -314,8 +319,7 @@ Rgb PpmRenderer::DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec
     if (!(Dot(wi, light_hit->n) < 0 || EmitsFromBack(light_material))) return L;
     const Shading light_sh = Shade(scene_, *light_hit, -wi);
     if (light_sh.emission.IsBlack()) return L;
-    const float w =
-        bs->delta ? 1.0f : PowerHeuristic(bs->pdf, lights_.Pdf(hit.p, sh.ns, *light_hit));
+    const float w = PowerHeuristic(bs->pdf, lights_.Pdf(hit.p, sh.ns, *light_hit));
     L += weight * light_sh.emission * w *
          transmittance(wi, bs->wi.z * wo.z < 0, light_hit->t * Length(ray.d));
     return L;

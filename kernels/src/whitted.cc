@@ -19,13 +19,13 @@ int MediumAfter(int medium, int index, const Material& material, float cos_i_ng,
     return cos_i_ng < 0 ? index : -1;
 }
 
-bool IsSpecular(const Material& m) {
-    return m.type == Material::Type::kMirror || m.type == Material::Type::kDielectric;
-}
+// Has a delta lobe everywhere: a texture only scales the factors, so a smooth principled
+// material's constant parameters decide it for every point.
+bool IsSpecular(const Material& m) { return Bsdf(m).HasDeltaLobe(); }
 
-// Reflects light, but not as a delta BSDF: a vertex Whitted ends a ray tree at.
+// Reflects light, but not only as a delta BSDF: a vertex Whitted ends a ray tree at.
 bool ReflectsDiffusely(const Material& m) {
-    if (IsSpecular(m)) return false;
+    if (Bsdf(m).IsDelta()) return false;
     return m.type != Material::Type::kLambert || !m.reflectance.IsBlack();
 }
 
@@ -167,6 +167,19 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
             const std::optional<LightSample> ls = lights_.Sample(hit->p, sh.ns, u_pick, u_light);
             if (ls && !ls->delta) L += direct(*ls);
         }
+        // A smooth surface over a diffuse base also reflects (or refracts) as a mirror: one of
+        // its delta lobes, picked as Sample picks it, is followed with its weight over the
+        // pick's probability. The draws come after the light's, and only for such surfaces,
+        // so other scenes keep their sample streams.
+        if (bsdf.HasDeltaLobe()) {
+            const float uc = sampler.Get1D();
+            const Vec2 u = sampler.Get2D();
+            const std::optional<BsdfSample> bs = bsdf.Sample(wo, uc, u);
+            if (bs && bs->delta && bs->pdf > 0) {
+                L += Follow(ray, *hit, sh, material, wo, *bs,
+                            bs->f * (std::abs(bs->wi.z) / bs->pdf), depth, medium, sampler, stats);
+            }
+        }
         return beta * L;
     }
 
@@ -186,15 +199,21 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
         bool& done = transmitted ? refracted : reflected;
         if (done) continue;
         done = true;
-        const Vec3 wi = frame.FromLocal(lobe->wi);
-        if (!sh.SidesAgree(-ray.d, wi, lobe->wi.z * wo.z > 0)) continue;
-        const Rgb weight = lobe->f * std::abs(lobe->wi.z);
-        if (weight.IsBlack()) continue;
-        const int next_medium =
-            MediumAfter(medium, hit->material, material, Dot(wi, ng), transmitted);
-        L += weight * Trace(SpawnRay(sh.Leaving(wi), wi), depth + 1, next_medium, sampler, stats);
+        L += Follow(ray, *hit, sh, material, wo, *lobe, lobe->f * std::abs(lobe->wi.z), depth,
+                    medium, sampler, stats);
     }
     return beta * L;
+}
+
+Rgb WhittedTracer::Follow(const Ray& ray, const SurfaceHit& hit, const Shading& sh,
+                          const Material& material, const Vec3& wo, const BsdfSample& lobe,
+                          const Rgb& weight, int depth, int medium, Sampler& sampler,
+                          RenderStats& stats) const {
+    const Vec3 wi = Frame::FromNormal(sh.ns).FromLocal(lobe.wi);
+    if (!sh.SidesAgree(-ray.d, wi, lobe.wi.z * wo.z > 0) || weight.IsBlack()) return {};
+    const int next_medium =
+        MediumAfter(medium, hit.material, material, Dot(wi, hit.n), lobe.wi.z * wo.z < 0);
+    return weight * Trace(SpawnRay(sh.Leaving(wi), wi), depth + 1, next_medium, sampler, stats);
 }
 
 }  // namespace lf

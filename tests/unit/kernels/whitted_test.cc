@@ -11,13 +11,13 @@
 #include <numbers>
 #include <optional>
 
-#include "splat_scenes.h"
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/local/local_executor.h"
 #include "plane_render.h"
 #include "point_estimate.h"
+#include "splat_scenes.h"
 #include "test_scenes.h"
 
 namespace lf {
@@ -164,16 +164,19 @@ TEST(Whitted, EqualsPathTracerAtDepthOne) {
     }
 }
 
-// A diffuse floor, a mirror sphere on it and a point light: no diffuse surface sees another,
+// A diffuse floor, a specular sphere on it and a point light: no diffuse surface sees another,
 // so at max depth 2 the path tracer's only terms are direct light at the floor, seen directly
-// or in the mirror, which is all Whitted computes: the two agree, shadow and reflection
-// included.
-TEST(Whitted, EqualsPathTracerThroughMirror) {
+// or in the sphere, which is all Whitted computes: the two agree, shadow and reflection
+// included. The sphere is a mirror, or a smooth principled dielectric over a black base: a
+// BSDF with a delta lobe and a (black) diffuse one, whose reflection Whitted used to drop
+// because the surface was not all delta.
+void ExpectEqualsPathTracerThroughSpecularSphere(const Material& sphere_material) {
     Scene scene;
     const int floor = AddMaterial(scene, Material::Type::kLambert, Rgb(0.7f, 0.6f, 0.3f));
-    const int mirror = AddMaterial(scene, Material::Type::kMirror, Rgb(0.95f, 0.9f, 0.8f));
+    scene.materials.push_back(sphere_material);
+    const int sphere = int(scene.materials.size()) - 1;
     AddQuad(scene, floor, {-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20});  // normal +y
-    scene.spheres.push_back({"mirror", mirror, Vec3d(0, 1, 0), 1});
+    scene.spheres.push_back({"sphere", sphere, Vec3d(0, 1, 0), 1});
     scene.point_lights.push_back({Vec3d(1.5, 3, 1), Rgb(20.0f, 18.0f, 15.0f)});
     scene.camera = testing::SquareCamera({0, 1.5, 5}, {0, 1, 0}, {0, 1, 0}, 40, 8);
     const auto es = Build(scene);
@@ -185,13 +188,29 @@ TEST(Whitted, EqualsPathTracerThroughMirror) {
         const char* what;
     } targets[] = {{{0.8, 0, 2}, "floor, lit"},
                    {{-0.9, 0, -1.5}, "floor, in the sphere's shadow"},
-                   {{0.3, 0.4, 0.9}, "mirror, showing the floor"},
-                   {{-0.6, 0.3, 0.75}, "mirror, showing the floor at an angle"},
-                   {{0.2, 1.6, 0.95}, "mirror, showing the sky"}};
+                   {{0.3, 0.4, 0.9}, "sphere, showing the floor"},
+                   {{-0.6, 0.3, 0.75}, "sphere, showing the floor at an angle"},
+                   {{0.2, 1.6, 0.95}, "sphere, showing the sky"}};
     for (const auto& t : targets) {
         ExpectSameRadiance(whitted, path, testing::RayBetween(from, t.to, es->origin()), 4096,
                            t.what);
     }
+}
+
+TEST(Whitted, EqualsPathTracerThroughMirror) {
+    Material mirror;
+    mirror.type = Material::Type::kMirror;
+    mirror.reflectance = Rgb(0.95f, 0.9f, 0.8f);
+    ExpectEqualsPathTracerThroughSpecularSphere(mirror);
+}
+
+TEST(Whitted, EqualsPathTracerThroughSmoothPrincipledOverABlackBase) {
+    Material plastic;
+    plastic.type = Material::Type::kPrincipled;
+    plastic.reflectance = Rgb(0.0f);
+    plastic.roughness = 0;
+    plastic.ior = 2.5f;  // F0 = 0.18: a reflection well above the noise
+    ExpectEqualsPathTracerThroughSpecularSphere(plastic);
 }
 
 // Unpolarised Fresnel reflectance from the definition, for light arriving at cos_i > 0 from
@@ -348,6 +367,18 @@ TEST(Whitted, MissingTermsFollowTheSceneRule) {
     const std::vector<std::string> all = WhittedMissingTerms(both);
     EXPECT_TRUE(has(all, "interreflection"));
     EXPECT_TRUE(has(all, "caustics"));
+
+    // A smooth principled sphere reflects the light as a mirror does (its delta lobe), over a
+    // diffuse base that sees the plane: caustics and interreflection.
+    Scene plastic = plane;
+    Material smooth;
+    smooth.type = Material::Type::kPrincipled;
+    smooth.roughness = 0;
+    plastic.materials.push_back(smooth);
+    plastic.spheres.push_back({"plastic", int(plastic.materials.size()) - 1, Vec3d(0, 1, 0), 0.5});
+    const std::vector<std::string> smooth_terms = WhittedMissingTerms(plastic);
+    EXPECT_TRUE(has(smooth_terms, "caustics"));
+    EXPECT_TRUE(has(smooth_terms, "interreflection"));
 }
 
 }  // namespace

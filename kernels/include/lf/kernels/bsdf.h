@@ -46,6 +46,10 @@ class Bsdf {
 
     // True when every lobe is a Dirac delta: light sampling is useless there.
     bool IsDelta() const;
+    // True when some lobe is a Dirac delta (Sample may return BsdfSample::delta): a smooth
+    // principled surface over a diffuse base has both kinds, and estimators that gather light
+    // at non-delta vertices (Whitted, photon mapping) must still follow its delta lobes.
+    bool HasDeltaLobe() const;
 
     // For a pair that crosses a refracting interface (a dielectric, a principled solid), the IOR
     // on wi's side over the IOR on wo's side, as BsdfSample::eta reports it; else 1. Eval

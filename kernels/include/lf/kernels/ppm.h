@@ -38,12 +38,13 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/camera.h"
+#include "lf/kernels/bsdf_sample.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/light_emission.h"
 #include "lf/kernels/lights.h"
 #include "lf/kernels/photon_map.h"
 #include "lf/kernels/shading.h"
+#include "lf/kernels/splat_renderer.h"
 
 namespace lf {
 
@@ -105,10 +106,11 @@ class PpmRenderer : public SplatRenderer {
                     RenderStats& stats) const;
 
     // Direct light at a camera vertex (non-delta BSDF, outgoing direction wo_world, inside
-    // `medium`), by multiple importance sampling of the lights and the BSDF.
+    // `medium`), by multiple importance sampling of the lights and the BSDF sample `bs`; a
+    // delta lobe's sample adds nothing here (the path follows it).
     Rgb DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec3& wo_world,
-                    const Bsdf& bsdf, int medium, const Vec2& u_choice, const Vec2& u_light,
-                    const Vec2& u_bsdf, RenderStats& stats) const;
+                    const Bsdf& bsdf, const std::optional<BsdfSample>& bs, int medium, float u_pick,
+                    const Vec2& u_light, RenderStats& stats) const;
 
     const EmbreeScene& scene_;
     const Camera& camera_;

@@ -60,6 +60,8 @@ class PrincipledBsdf {
     std::optional<BsdfSample> Sample(const Vec3& wo, float uc, const Vec2& u) const;
     // Every lobe is a Dirac delta: a smooth surface without a diffuse base.
     bool IsDelta() const { return smooth_ && diffuse_scale_ == 0 && !layered(); }
+    // Some lobe is a Dirac delta: the smooth base's reflection or transmission.
+    bool HasDeltaLobe() const { return smooth_; }
     // Bsdf::RefractionEta: RelativeEta(wo) for a pair across a solid's interface, else 1.
     float RefractionEta(const Vec3& wo, const Vec3& wi) const {
         return refracts_ && wo.z * wi.z < 0 ? RelativeEta(wo) : 1.0f;

@@ -5,8 +5,10 @@
 // the others (area lights, sun disks and the environment: a shadow ray to a sampled point,
 // weight 1 / pdf, no MIS since no BSDF-sampled ray competes). At a mirror or dielectric (a delta
 // BSDF) it follows every lobe with its weight instead of choosing one: the reflection and, for
-// dielectrics, the refraction, weighted by Fresnel, up to max_depth. Emitters seen directly or
-// through specular chains and the lights at infinity that camera and specular rays escape to add
+// dielectrics, the refraction, weighted by Fresnel, up to max_depth. A smooth principled surface
+// over a diffuse base has both kinds: it takes direct light for its base and follows one of its
+// delta lobes, picked at random with its weight over the pick's probability. Emitters seen directly
+// or through specular chains and the lights at infinity that camera and specular rays escape to add
 // their radiance.
 //
 // What it misses, by Heckbert's notation: every path with a diffuse or glossy vertex that is not
@@ -20,9 +22,11 @@
 #include <vector>
 
 #include "lf/core/scene.h"
+#include "lf/kernels/bsdf_sample.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/lights.h"
 #include "lf/kernels/radiance.h"
+#include "lf/kernels/shading.h"
 
 namespace lf {
 
@@ -46,6 +50,11 @@ class WhittedTracer : public RadianceEstimator {
     // The radiance along `ray`, the ray tree's level `depth`, travelling inside solid transmitter
     // `medium` (a material index) or -1.
     Rgb Trace(const Ray& ray, int depth, int medium, Sampler& sampler, RenderStats& stats) const;
+    // Traces the delta lobe `lobe` of the BSDF at `hit` (wo in its shading frame) and returns
+    // its radiance times `weight`.
+    Rgb Follow(const Ray& ray, const SurfaceHit& hit, const Shading& sh, const Material& material,
+               const Vec3& wo, const BsdfSample& lobe, const Rgb& weight, int depth, int medium,
+               Sampler& sampler, RenderStats& stats) const;
 
     const EmbreeScene& scene_;
     LightSampler lights_;
