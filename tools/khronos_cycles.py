@@ -11,6 +11,11 @@ plus the file's own KHR_lights_punctual lights (the importer's default, physical
 sees the asset; RGB is linear, Standard view transform (no Filmic), unclamped, no denoising, a box
 pixel filter, bounces up to 64 (lightfarm's are unlimited with Russian roulette).
 
+Where Blender's import departs from glTF, the script puts glTF back: punctual lights get radius 0
+(the importer gives them 0.25 m), a primitive without a material gets glTF's default material
+(white, metallic 1, roughness 1; Blender's default is a grey diffuse), and a single-sided material
+(backface culling, which Cycles ignores) becomes transparent from behind.
+
 Also prints "AUTO PX PY PZ TX TY TZ FOV" : lightfarm's --camera auto framing (auto_camera.cc)
 computed here from the imported meshes' bounds, for the script to check against lightfarm's.
 """
@@ -51,6 +56,44 @@ def auto_framing():
     distance = radius / math.sin(math.radians(20))
     position = centre + mathutils.Vector((0, math.sin(elevation), math.cos(elevation))) * distance
     return position, centre
+
+
+def follow_gltf():
+    for light in bpy.data.lights:
+        light.shadow_soft_size = 0
+        if light.type == "SUN":
+            light.angle = 0
+    default = None
+    for obj in bpy.context.scene.objects:
+        if obj.type == "MESH" and not any(slot.material for slot in obj.material_slots):
+            if default is None:
+                default = bpy.data.materials.new("gltf default")
+                default.use_nodes = True
+                bsdf = default.node_tree.nodes["Principled BSDF"]
+                bsdf.inputs["Base Color"].default_value = (1, 1, 1, 1)
+                bsdf.inputs["Metallic"].default_value = 1
+                bsdf.inputs["Roughness"].default_value = 1
+                default.use_backface_culling = True
+            obj.data.materials.clear()
+            obj.data.materials.append(default)
+    for material in bpy.data.materials:
+        if material.use_backface_culling and material.use_nodes:
+            hide_back(material.node_tree)
+
+
+def hide_back(tree):
+    """Cycles renders backface-culled faces: a transparent shader from behind hides them."""
+    output = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL" and n.is_active_output)
+    link = output.inputs["Surface"].links[0]
+    shader = link.from_socket
+    tree.links.remove(link)
+    geometry = tree.nodes.new("ShaderNodeNewGeometry")
+    clear = tree.nodes.new("ShaderNodeBsdfTransparent")
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    tree.links.new(geometry.outputs["Backfacing"], mix.inputs["Fac"])
+    tree.links.new(shader, mix.inputs[1])
+    tree.links.new(clear.outputs["BSDF"], mix.inputs[2])
+    tree.links.new(mix.outputs["Shader"], output.inputs["Surface"])
 
 
 def set_camera(scene, kind, numbers, size):
@@ -128,6 +171,7 @@ def main():
         numpy.bool = bool
     bpy.ops.import_scene.gltf(filepath=gltf)
     scene = bpy.context.scene
+    follow_gltf()
     position, target = auto_framing()
     print("AUTO %.6g %.6g %.6g %.6g %.6g %.6g 40" % (*position, *target))
     set_camera(scene, kind, numbers, size)
