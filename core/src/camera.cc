@@ -4,9 +4,26 @@
 #include <numbers>
 #include <optional>
 
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "lf/core/disk_sampling.h"
 
 namespace lf {
+
+namespace {
+
+std::string Point(const Vec3d& p) { return absl::StrFormat("(%.6g, %.6g, %.6g)", p.x, p.y, p.z); }
+
+}  // namespace
+
+std::string DescribeCamera(const CameraSpec& spec) {
+    const bool ortho = spec.projection == CameraSpec::Projection::kOrthographic;
+    return absl::StrCat(
+        ortho ? "orthographic" : "perspective", " from ", Point(spec.position), " towards ",
+        Point(spec.look_at), ", up ", Point(spec.up),
+        ortho ? absl::StrFormat(", half height %.6g", spec.half_height)
+              : absl::StrFormat(", vertical field of view %.6g degrees", spec.fov_y_deg));
+}
 
 Camera::Camera(const CameraSpec& spec, const Vec3d& origin)
     : width_(spec.width), height_(spec.height), filter_spec_(spec.filter), filter_(spec.filter) {

@@ -151,6 +151,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
         options.render.clamp > 0 ? absl::StrCat(", clamp ", options.render.clamp, " (biased)")
                                  : std::string(),
         options.render.aovs != 0 ? ", AOVs " + AovListName(options.render.aovs) : std::string());
+    log->info("job={} camera: {}", job_id, DescribeCamera(scene->camera));
     if (splat_plan) {
         log->info(
             "job={} {}", job_id,

@@ -125,5 +125,19 @@ TEST(Camera, OrthographicRayThroughAPointsClosedFormPixelMeetsIt) {
     EXPECT_EQ(cam.We(Ray{Vec3(2, 3, 3), Vec3(0, 0, 1)}), 0);
 }
 
+// The render log's camera line: enough to set up the same view in another renderer.
+TEST(Camera, DescribesItsViewInOneLine) {
+    EXPECT_EQ(DescribeCamera(Spec()),
+              "perspective from (1, 2, 3) towards (1, 2, 10), up (0, 1, 0), vertical field of "
+              "view 60 degrees");
+    CameraSpec ortho = Spec();
+    ortho.projection = CameraSpec::Projection::kOrthographic;
+    ortho.half_height = 0.25;
+    ortho.position = {0.5, -1e-7, 1234567};
+    EXPECT_EQ(DescribeCamera(ortho),
+              "orthographic from (0.5, -1e-07, 1.23457e+06) towards (1, 2, 10), up (0, 1, 0), "
+              "half height 0.25");
+}
+
 }  // namespace
 }  // namespace lf

@@ -3,12 +3,18 @@
 #pragma once
 
 #include <optional>
+#include <string>
 
 #include "lf/core/pixel_filter.h"
 #include "lf/core/ray.h"
 #include "lf/core/scene.h"
 
 namespace lf {
+
+// One line for the render log, e.g. "perspective from (0, 1, 5) towards (0, 1, 0), up (0, 1, 0),
+// vertical field of view 40 degrees": what `--camera auto` chose, to set up the same view
+// elsewhere (tools/khronos_vs_cycles.sh does in Blender). Positions to 6 significant digits.
+std::string DescribeCamera(const CameraSpec& spec);
 
 class Camera {
   public:
