@@ -57,6 +57,7 @@ Command AddRenderCommand(CLI::App& app) {
         ->required()
         ->check(CLI::ExistingFile);
     AddSceneFlags(cmd, options->scene);
+    AddSkyFlag(cmd, options->scene);
     AddOutputFlags(cmd, *output);
     cmd->add_option("--spp", options->render.spp, "samples per pixel")
         ->capture_default_str()
@@ -116,6 +117,9 @@ Command AddRenderCommand(CLI::App& app) {
         cmd, [cmd, options, output, no_progress, method] {
             absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
             if (!paths.ok()) return ReportError(paths.status());
+            if (absl::Status s = ResolveSkyFile(options->scene_path, options->scene); !s.ok()) {
+                return ReportError(s);
+            }
             options->exr_path = paths->exr;
             options->png_path = paths->png;
             options->preview = output->preview;

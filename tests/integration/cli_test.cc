@@ -874,6 +874,65 @@ ImageMean MeanOfImage(const Image& image) {
     return m;
 }
 
+// --sky, without JSON: a Lambertian plane seen from above under a uniform sky of radiance L
+// reflects rho / pi * pi L = rho L (the plane, open, sees only sky above it), so the image's mean
+// over R, G and B is sum(rho) L. With a map lit (2) above the horizon and black below, read from
+// outside the scene's folder, the same plane sees a uniform hemisphere of 2. Bad values are
+// refused naming the flag and the value.
+TEST_F(Cli, SkyFlagLightsTheSceneWithoutJson) {
+    fs::create_directories(dir_ / "scene");
+    fs::create_directories(dir_ / "maps");
+    const std::string scene = Write("scene/plane.json", R"({
+      "camera": {"position": [0, 2, 0.5], "look_at": [0, 0, 0], "fov_y_deg": 20,
+                 "resolution": [8, 8]},
+      "materials": {"m": {"type": "lambert", "reflectance": [0.5, 0.25, 0.75]}},
+      "shapes": [{"type": "quad", "material": "m",
+                  "vertices": [[-1000, 0, 1000], [1000, 0, 1000], [1000, 0, -1000],
+                               [-1000, 0, -1000]]}]})");
+    std::ofstream(dir_ / "maps" / "half.hdr", std::ios::binary)
+        << testing::HdrBytes(2, 2, {2, 2, 2, 2, 2, 2, 0, 0, 0, 0, 0, 0});
+    for (const auto& [sky, expected] : {std::pair<std::string, double>{"white", 1.5},
+                                        {"2,2,2", 3.0},
+                                        {(dir_ / "maps" / "half.hdr").string(), 3.0}}) {
+        SCOPED_TRACE(sky);
+        const std::string exr = (dir_ / "sky.exr").string();
+        const RunResult r = Lightfarm("render " + scene + " -o " + exr + " --sky " + sky +
+                                      " --spp 64 --seed 1 --no-progress");
+        ASSERT_EQ(r.status, 0) << r.output;
+        absl::StatusOr<ExrFile> file = ReadExr(exr);
+        ASSERT_TRUE(file.ok()) << file.status();
+        const ImageMean m = MeanOfImage(file->image);
+        ASSERT_GT(m.variance, 0);
+        EXPECT_LT(std::abs(m.mean - expected), 4 * std::sqrt(m.variance))
+            << m.mean << " +- " << std::sqrt(m.variance);
+        const std::string recorded = std::get<std::string>(file->attributes.at("lightfarm.sky"));
+        EXPECT_EQ(recorded, sky.find('/') == std::string::npos ? sky : "../maps/half.hdr");
+    }
+    for (const auto& [sky, message] :
+         {std::pair<std::string, std::string>{
+              "1,2", "--sky \"1,2\": 2 numbers; expected white, R,G,B or a number"},
+          {"-1", "--sky \"-1\": \"-1\" is not a radiance"},
+          {"missing.hdr", "--sky missing.hdr: no such file"}}) {
+        const RunResult r = Lightfarm("render " + scene + " -o " + (dir_ / "x.exr").string() +
+                                      " --sky " + sky + " --no-progress");
+        EXPECT_NE(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+    }
+    // Replacing the scene's own sky is said.
+    const std::string lit = Write("scene/lit.json", R"({
+      "camera": {"position": [0, 2, 0.5], "look_at": [0, 0, 0], "fov_y_deg": 20,
+                 "resolution": [4, 4]},
+      "materials": {"m": {"type": "lambert", "reflectance": [0.5, 0.5, 0.5]}},
+      "shapes": [{"type": "quad", "material": "m",
+                  "vertices": [[-1, 0, 1], [1, 0, 1], [1, 0, -1], [-1, 0, -1]]}],
+      "lights": [{"type": "environment", "radiance": 3}]})");
+    const RunResult r = Lightfarm("render " + lit + " -o " + (dir_ / "lit.exr").string() +
+                                  " --sky white --spp 2 --no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("--sky replaces the scene's environment light"), std::string::npos)
+        << r.output;
+}
+
 // --light-sampling reaches the path tracer: with the same seed, power and bvh give different
 // bits, and the header and the log name each; both are unbiased, so bvh's mean with another
 // seed (independent of power's) is power's within 4 standard errors of their difference.

@@ -65,6 +65,7 @@ RadiosityFigures RadiosityFiguresOf(const Report& r) {
 struct RenderMetadata {
     std::string scene_hash;
     std::string camera;  // the glTF camera --camera picked; "" for the scene's own
+    std::string sky;     // --sky as given to the scene loader; "" for the scene's own
     std::string method;  // a name of lf/job/method_registry.h
     uint64_t spp = 0;    // adaptive: the most any pixel got
     uint64_t seed = 0;
@@ -109,10 +110,10 @@ struct RenderDescription {
 };
 
 // Every attribute of a render's header: how it was made (lightfarm.version, scene hash, camera
-// when picked by name, method, settings with lightfarm.sampler and, for path tracing,
-// lightfarm.lightSampling, timing, ray and sample counts, truncated paths), what
-// the channels hold (lightfarm.channels, lightfarm.aovs when there are AOVs, lightfarm.filter),
-// their units (lightfarm.units and OpenEXR's standard chromaticities, Rec.709 with D65, and
+// when picked by name, lightfarm.sky with --sky, method, settings with lightfarm.sampler and, for
+// path tracing, lightfarm.lightSampling, timing, ray and sample counts, truncated paths), what the
+// channels hold (lightfarm.channels, lightfarm.aovs when there are AOVs, lightfarm.filter), their
+// units (lightfarm.units and OpenEXR's standard chromaticities, Rec.709 with D65, and
 // whiteLuminance = 683 cd/m^2 for RGB (1, 1, 1)), the bias of --clamp (lightfarm.clamp and
 // lightfarm.bias, only when clamping), the image's own error estimates
 // (lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance: noise only,
