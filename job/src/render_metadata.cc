@@ -157,6 +157,7 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     d.attributes = DescribeMethod(m);
     if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
     if (!m.sky.empty()) d.attributes["lightfarm.sky"] = m.sky;
+    if (!m.partial.empty()) d.attributes["lightfarm.partial"] = m.partial;
     if (m.aovs != 0) d.attributes["lightfarm.aovs"] = AovListName(m.aovs);
     const std::optional<Method> method = FindMethod(m.method);
     const MethodInfo* info = method ? &Info(*method) : nullptr;
@@ -200,6 +201,7 @@ RenderMetadata MetadataOf(const JobSpec& spec, const RenderOutcome& outcome) {
     m.radiosity_settings = spec.radiosity;
     m.radiosity = outcome.radiosity;
     m.ppm = spec.ppm;
+    m.partial = outcome.partial;
     return m;
 }
 
