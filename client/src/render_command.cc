@@ -1,3 +1,4 @@
+#include <csignal>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -36,6 +37,22 @@ class BarProgress : public RenderProgress {
     std::optional<ProgressBar> bar_;
 };
 
+RenderInterrupt render_interrupt;
+
+// The first Ctrl-C while sampling can stop with a partial image asks for it; a second one, or
+// one at any other time, ends the process at once (the default action).
+extern "C" void OnInterrupt(int) {
+    std::signal(SIGINT, SIG_DFL);
+    if (!render_interrupt.honoured.load()) {
+        std::raise(SIGINT);
+        return;
+    }
+    render_interrupt.requested = true;
+}
+
+// The shell's status for a process ended by SIGINT.
+constexpr int kInterruptedStatus = 128 + SIGINT;
+
 }  // namespace
 
 Command AddRenderCommand(CLI::App& app) {
@@ -52,11 +69,16 @@ Command AddRenderCommand(CLI::App& app) {
         "through the pixel filter), the two half-sample estimates A.R,A.G,A.B and B.R,B.G,B.B\n"
         "(even and odd samples; their difference estimates the error), spp, and the --aov\n"
         "channels, with header attributes lightfarm.* saying how the image was made. Same seed\n"
-        "and settings give the same bits for any --tile and --threads.");
+        "and settings give the same bits for any --tile and --threads.\n"
+        "Ctrl-C while path, whitted or radiosity's display sample stops them: the files get the\n"
+        "whole passes done so far (each pixel the mean of its own samples, in spp), the header\n"
+        "says lightfarm.partial, and the exit status is 130. A second Ctrl-C, or one during\n"
+        "loading, solving or a splatting method, ends it at once.");
     cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
     AddSceneFlags(cmd, options->scene);
+    AddSkyFlag(cmd, options->scene);
     AddOutputFlags(cmd, *output);
     cmd->add_option("--spp", options->render.spp, "samples per pixel")
         ->capture_default_str()
@@ -116,6 +138,9 @@ Command AddRenderCommand(CLI::App& app) {
         cmd, [cmd, options, output, no_progress, method] {
             absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
             if (!paths.ok()) return ReportError(paths.status());
+            if (absl::Status s = ResolveSkyFile(options->scene_path, options->scene); !s.ok()) {
+                return ReportError(s);
+            }
             options->exr_path = paths->exr;
             options->png_path = paths->png;
             options->preview = output->preview;
@@ -131,7 +156,10 @@ Command AddRenderCommand(CLI::App& app) {
             options->method = MethodOfFlag(*method);
             BarProgress bar;
             options->progress = *no_progress ? nullptr : &bar;
+            options->interrupt = &render_interrupt;
+            std::signal(SIGINT, OnInterrupt);
             absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
+            std::signal(SIGINT, SIG_DFL);
             if (!summary.ok()) return ReportError(summary.status());
             const double s = summary->render_seconds;
             std::printf(
@@ -179,6 +207,11 @@ Command AddRenderCommand(CLI::App& app) {
                             (unsigned long long)a.min_spp, (unsigned long long)a.max_spp,
                             pixels > 0 ? samples / pixels : 0, tiles.c_str(),
                             a.timed_out ? ", time limit reached" : "");
+            }
+            if (!summary->partial.empty()) {
+                std::fprintf(stderr, "lightfarm: %s; wrote it to %s\n", summary->partial.c_str(),
+                             OutputNames(*paths).c_str());
+                return kInterruptedStatus;
             }
             return 0;
         }};

@@ -1,10 +1,13 @@
 #include "lf/client/scene_flags.h"
 
+#include <filesystem>
+
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "lf/core/pixel_filter.h"
+#include "lf/core/sky_option.h"
 
 namespace lf {
 namespace {
@@ -84,6 +87,41 @@ void AddResolutionFlag(CLI::App* cmd, SceneOptions& options, const std::string& 
            },
            help)
         ->type_name("WxH|N");
+}
+
+void AddSkyFlag(CLI::App* cmd, SceneOptions& options) {
+    cmd->add_option_function<std::string>(
+           "--sky",
+           [&options](const std::string& text) {
+               absl::StatusOr<SkyOption> sky = ParseSkyOption(text);
+               if (!sky.ok()) throw CLI::ValidationError(std::string(sky.status().message()));
+               options.sky = text;
+           },
+           "an environment light in place of the scene's (with a warning when it has one), "
+           "without writing JSON: white (radiance 1 W m^-2 sr^-1 from every direction), R,G,B "
+           "or a number (a uniform radiance), or a lat-long map FILE.hdr or FILE.exr, oriented "
+           "as Blender shows it (docs/scene-format.md, environment); `submit` uploads the file "
+           "with the scene's")
+        ->type_name("white|R,G,B|FILE");
+}
+
+absl::Status ResolveSkyFile(const std::string& scene_path, SceneOptions& options) {
+    if (options.sky.empty()) return absl::OkStatus();
+    absl::StatusOr<SkyOption> sky = ParseSkyOption(options.sky);
+    if (!sky.ok()) return sky.status();
+    if (sky->file.empty()) return absl::OkStatus();
+    namespace fs = std::filesystem;
+    std::error_code error;
+    if (!fs::is_regular_file(sky->file, error)) {
+        return absl::NotFoundError(
+            absl::StrCat("--sky ", sky->file, ": no such file (nor white, R,G,B or a number)"));
+    }
+    // The loader reads files by their names beside the scene, the farm by the names they were
+    // uploaded as: one name, relative to the scene's folder, serves both.
+    const fs::path folder = fs::absolute(fs::path(scene_path)).parent_path();
+    const fs::path name = fs::absolute(fs::path(sky->file)).lexically_relative(folder);
+    options.sky = name.empty() ? fs::absolute(fs::path(sky->file)).string() : name.string();
+    return absl::OkStatus();
 }
 
 void AddSceneFlags(CLI::App* cmd, SceneOptions& options) {

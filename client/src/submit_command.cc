@@ -15,17 +15,17 @@
 #include "lf/client/command.h"
 #include "lf/client/farm_client.h"
 #include "lf/client/farm_flags.h"
+#include "lf/client/method_flags.h"
+#include "lf/client/photon_flags.h"
+#include "lf/client/radiosity_flags.h"
+#include "lf/client/sample_flags.h"
+#include "lf/client/scene_flags.h"
 #include "lf/core/file_util.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
-#include "lf/client/method_flags.h"
-#include "lf/client/photon_flags.h"
-#include "lf/client/radiosity_flags.h"
-#include "lf/client/sample_flags.h"
-#include "lf/client/scene_flags.h"
 
 namespace lf {
 namespace {
@@ -112,6 +112,7 @@ Command AddSubmitCommand(CLI::App& app) {
         ->required()
         ->check(CLI::ExistingFile);
     AddSceneFlags(cmd, o->spec.scene_options);
+    AddSkyFlag(cmd, o->spec.scene_options);
     AddServerOption(cmd, o->farm);
     AddRetryOption(cmd, o->farm);
     cmd->add_option("--spp", o->spec.plan.spp, "samples per pixel")
@@ -134,13 +135,14 @@ Command AddSubmitCommand(CLI::App& app) {
     cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
     cmd->add_option("--name", o->spec.name, "job name (default: the scene file's name)");
-    cmd->add_option("--method", o->spec.method,
-                    "path, radiosity (Lambertian scenes; same bits as `lightfarm render "
-                    "--method radiosity` with the same options), whitted (direct light and "
-                    "specular chains only, a preview), or a splatting method: light (light tracing), "
-                    "bdpt (bidirectional path tracing), ppm (progressive photon mapping). Every "
-                    "method gives the bits of `lightfarm render` with the same options; the "
-                    "splatting methods take no --aov nor adaptive sampling")
+    cmd->add_option(
+           "--method", o->spec.method,
+           "path, radiosity (Lambertian scenes; same bits as `lightfarm render "
+           "--method radiosity` with the same options), whitted (direct light and "
+           "specular chains only, a preview), or a splatting method: light (light tracing), "
+           "bdpt (bidirectional path tracing), ppm (progressive photon mapping). Every "
+           "method gives the bits of `lightfarm render` with the same options; the "
+           "splatting methods take no --aov nor adaptive sampling")
         ->capture_default_str()
         ->check([](const std::string& m) { return MethodFlagError(m, false); });
     AddPhotonFlags(cmd, o->spec.ppm);
@@ -158,6 +160,10 @@ Command AddSubmitCommand(CLI::App& app) {
                     return ReportError(s);
                 }
                 if (absl::Status s = CheckPhotonFlagsApply(*cmd, o->spec.method); !s.ok()) {
+                    return ReportError(s);
+                }
+                if (absl::Status s = ResolveSkyFile(o->scene_path, o->spec.scene_options);
+                    !s.ok()) {
                     return ReportError(s);
                 }
                 absl::StatusOr<std::string> id = Submit(*o);

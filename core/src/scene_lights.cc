@@ -7,6 +7,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/blackbody.h"
 #include "lf/core/photometry.h"
+#include "lf/core/sky_option.h"
 #include "lf/core/texture.h"
 #include "scene_parser.h"
 
@@ -132,12 +133,7 @@ EnvironmentLight SceneParser::ParseEnvironment(const Node& n) {
             "color or temperature_k multiply them)");
     }
     const std::string name = file->String();
-    light.map = DecodeFile(name, file->path());
-    if (!light.map->hdr) {
-        file->Fail(absl::StrCat("\"", name,
-                                "\" is an 8- or 16-bit image of display values, not radiance; "
-                                "give a Radiance HDR or OpenEXR map"));
-    }
+    light.map = DecodeSkyMap(name, file->path());
     const Rgb tint = LightColor(n, photometric);
     if (!photometric) {
         light.radiance = tint * float(scale);
@@ -151,6 +147,30 @@ EnvironmentLight SceneParser::ParseEnvironment(const Node& n) {
         light.radiance = tint * float(nits / (kLumensPerWatt * mean));
     }
     return checked();
+}
+
+std::shared_ptr<const TextureImage> SceneParser::DecodeSkyMap(const std::string& name,
+                                                              const std::string& where) {
+    std::shared_ptr<const TextureImage> map = DecodeFile(name, where);
+    if (!map->hdr) {
+        throw LoadError{absl::InvalidArgumentError(
+            absl::StrCat(where, ": \"", name,
+                         "\" is an 8- or 16-bit image of display values, not radiance; give a "
+                         "Radiance HDR or OpenEXR map"))};
+    }
+    return map;
+}
+
+void SceneParser::ApplySky(Scene& scene) {
+    absl::StatusOr<SkyOption> sky = ParseSkyOption(options_.sky);
+    if (!sky.ok()) throw LoadError{sky.status()};
+    // The flag changes the render as a scene file would: it counts in the content hash.
+    hash_.Update(absl::StrCat("--sky ", options_.sky));
+    if (scene.environment) warnings_.push_back("--sky replaces the scene's environment light");
+    EnvironmentLight light;
+    light.radiance = sky->radiance;
+    if (!sky->file.empty()) light.map = DecodeSkyMap(sky->file, "--sky");
+    scene.environment = light;
 }
 
 double SceneParser::MeanLuminance(const TextureImage& map, const Rgb& tint) {

@@ -94,6 +94,7 @@ Scene SceneParser::Finish(Scene& scene) {
         }
         scene.camera.filter = *options_.filter;
     }
+    if (!options_.sky.empty()) ApplySky(scene);
     if (!scene.HasLights()) {
         warnings_.push_back("no emissive shape and no light: the image will be black");
     }

@@ -114,6 +114,11 @@ class SceneParser {
     void ParseLight(const Node& n, Scene& scene);
     SpotLight ParseSpot(const Node& n);
     EnvironmentLight ParseEnvironment(const Node& n);
+    // A lat-long map for the sky: an HDR or EXR file (an 8- or 16-bit image is refused).
+    std::shared_ptr<const TextureImage> DecodeSkyMap(const std::string& name,
+                                                     const std::string& where);
+    // options_.sky as the scene's environment light, replacing its own with a warning.
+    void ApplySky(Scene& scene);
     // The luminance (Rec.709 Y) of a lat-long map times `tint`, averaged over the sphere of
     // directions: each texel weighs its solid angle, (cos theta_top - cos theta_bottom) of its
     // row times 2 pi / width, its radiance taken as constant over it.

@@ -97,6 +97,12 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
             return absl::InvalidArgumentError(absl::StrCat("camera: ", s.message()));
         }
     }
+    // Like the camera name, the sky's text (or its file's name) appears in messages and logs.
+    if (!spec.scene_options.sky.empty()) {
+        if (absl::Status s = CheckScenePath(spec.scene_options.sky); !s.ok()) {
+            return absl::InvalidArgumentError(absl::StrCat("sky: ", s.message()));
+        }
+    }
     // A cast from the wire or a record could hold any value; SampleOptions takes only these.
     if (spec.sampler != SamplerType::kIndependent && spec.sampler != SamplerType::kSobol) {
         return absl::InvalidArgumentError(

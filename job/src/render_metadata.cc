@@ -156,6 +156,8 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     RenderDescription d;
     d.attributes = DescribeMethod(m);
     if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
+    if (!m.sky.empty()) d.attributes["lightfarm.sky"] = m.sky;
+    if (!m.partial.empty()) d.attributes["lightfarm.partial"] = m.partial;
     if (m.aovs != 0) d.attributes["lightfarm.aovs"] = AovListName(m.aovs);
     const std::optional<Method> method = FindMethod(m.method);
     const MethodInfo* info = method ? &Info(*method) : nullptr;
@@ -182,6 +184,7 @@ RenderMetadata MetadataOf(const JobSpec& spec, const RenderOutcome& outcome) {
     RenderMetadata m;
     m.scene_hash = spec.scene_hash;
     m.camera = spec.scene_options.camera;
+    m.sky = spec.scene_options.sky;
     m.method = spec.method;
     m.spp = outcome.adaptive ? outcome.adaptive->max_spp : spec.plan.spp;
     m.seed = spec.seed;
@@ -198,6 +201,7 @@ RenderMetadata MetadataOf(const JobSpec& spec, const RenderOutcome& outcome) {
     m.radiosity_settings = spec.radiosity;
     m.radiosity = outcome.radiosity;
     m.ppm = spec.ppm;
+    m.partial = outcome.partial;
     return m;
 }
 

@@ -53,10 +53,11 @@ Rgb EnvironmentEmitter::MapValue(const Vec2& uv) const {
 }
 
 Vec2 EnvironmentEmitter::MapUv(const Vec3& w) const {
-    // Turned by -rotate_y about +y (right-handed).
-    const float x = cos_rotation_ * w.x - sin_rotation_ * w.z;
-    const float z = sin_rotation_ * w.x + cos_rotation_ * w.z;
-    const float u = 0.5f + std::atan2(x, -z) / (2 * kPi);
+    // Read along w turned by +rotate_y about +y (right-handed), as Blender's Mapping node (Point)
+    // turns the direction its Environment Texture reads; u = 0.5 looks along +x as in Blender.
+    const float x = cos_rotation_ * w.x + sin_rotation_ * w.z;
+    const float z = -sin_rotation_ * w.x + cos_rotation_ * w.z;
+    const float u = 0.5f + std::atan2(z, x) / (2 * kPi);
     const float v = std::acos(std::clamp(w.y, -1.0f, 1.0f)) / kPi;
     return {std::clamp(u, 0.0f, 1.0f), std::clamp(v, 0.0f, 1.0f)};
 }
@@ -79,10 +80,10 @@ std::optional<EnvironmentEmitter::DirectionSample> EnvironmentEmitter::Sample(co
     const float theta = uv.y * kPi, phi = 2 * kPi * (uv.x - 0.5f);
     const float sin_theta = std::sin(theta);
     if (!(sin_theta > 0)) return std::nullopt;
-    // The inverse of MapUv: u = 0.5 + atan2(x, -z) / (2 pi), v = acos(y) / pi, then turned back
-    // by +rotate_y.
-    const float x = sin_theta * std::sin(phi), y = std::cos(theta), z = -sin_theta * std::cos(phi);
-    const Vec3 wi(cos_rotation_ * x + sin_rotation_ * z, y, -sin_rotation_ * x + cos_rotation_ * z);
+    // The inverse of MapUv: u = 0.5 + atan2(z, x) / (2 pi), v = acos(y) / pi, then turned back
+    // by -rotate_y.
+    const float x = sin_theta * std::cos(phi), y = std::cos(theta), z = sin_theta * std::sin(phi);
+    const Vec3 wi(cos_rotation_ * x - sin_rotation_ * z, y, sin_rotation_ * x + cos_rotation_ * z);
     return DirectionSample{wi, MapValue(uv), map_pdf / (2 * kPi * kPi * sin_theta)};
 }
 

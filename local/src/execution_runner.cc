@@ -28,10 +28,11 @@ class Runner {
           threads_(threads) {}
 
     absl::Status Run(tbb::task_arena& arena) {
-        std::thread timer;
+        std::thread timer, interrupt;
         if (const std::optional<absl::Duration> limit = execution_.time_limit()) {
             timer = std::thread([this, limit] { WatchTimeLimit(*limit); });
         }
+        if (options_.interrupt) interrupt = std::thread([this] { WatchInterrupt(); });
         arena.execute([&] {
             {
                 std::lock_guard<std::mutex> lock(mutex_);
@@ -46,6 +47,7 @@ class Runner {
             changed_.notify_all();
         }
         if (timer.joinable()) timer.join();
+        if (interrupt.joinable()) interrupt.join();
         return status_;
     }
 
@@ -59,7 +61,7 @@ class Runner {
     // Starts workers while fewer than `threads_` run and queued tasks wait for one. Under the
     // lock.
     void Pump() {
-        while (running_ < threads_ && queue_.size() > starting_ && status_.ok()) {
+        while (running_ < threads_ && queue_.size() > starting_ && status_.ok() && !interrupted_) {
             ++running_;
             ++starting_;
             group_.run([this] { RunNext(); });
@@ -72,16 +74,18 @@ class Runner {
         std::unique_lock<std::mutex> lock(mutex_);
         --starting_;
         while (!queue_.empty() && dropped_.count(queue_.top().second)) queue_.pop();
-        if (!queue_.empty() && status_.ok()) {
+        if (!queue_.empty() && status_.ok() && !interrupted_) {
             const int t = queue_.top().second;
             queue_.pop();
             TaskAssignment lease;
             execution_.Lease(t, "", lease);
             const std::atomic<bool>& cancel = cancel_[size_t(t)];
+            under_way_.insert(t);
             lock.unlock();
             const absl::Status status =
                 run_(lease, cancel, [&](const TaskResult& result) { return Merge(t, result); });
             lock.lock();
+            under_way_.erase(t);
             status_.Update(status);
         }
         --running_;
@@ -110,6 +114,23 @@ class Runner {
             cancel_[size_t(t)] = true;
         }
         return true;
+    }
+
+    // Until the run ends or *options_.interrupt is set: then the tasks under way are cut and
+    // dropped, as the time limit drops them, and nothing starts any more.
+    void WatchInterrupt() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        while (!finished_) {
+            if (options_.interrupt->load()) {
+                interrupted_ = true;
+                for (int t : under_way_) {
+                    dropped_.insert(t);
+                    cancel_[size_t(t)] = true;
+                }
+                return;
+            }
+            changed_.wait_for(lock, std::chrono::milliseconds(50));
+        }
     }
 
     // Until the run ends or the limit passes, by the clock; merges wake it to look again.
@@ -141,6 +162,8 @@ class Runner {
         queue_;
     std::deque<std::atomic<bool>> cancel_;  // by task; a deque keeps them in place as it grows
     std::set<int> dropped_;
+    std::set<int> under_way_;  // leased and not returned
+    bool interrupted_ = false;
     int running_ = 0;      // workers spawned and not done
     size_t starting_ = 0;  // of them, those that have not taken a task yet
     bool finished_ = false;

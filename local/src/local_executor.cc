@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/cancel.h"
 #include "lf/job/adaptive_tile_execution.h"
 #include "lf/job/splat_execution.h"
 #include "lf/job/tile_execution.h"
@@ -47,13 +48,17 @@ absl::Status RunTiles(TileExecution& execution, const Camera& camera,
         options, started);
 }
 
-// The image of a complete execution, its stats, and the seconds since `started`.
+// The image of an execution, complete or interrupted, its stats, and the seconds since
+// `started`.
 absl::StatusOr<RenderOutput> Output(const JobExecution& execution, const RunClock& clock,
-                                    absl::Time started) {
+                                    absl::Time started, const std::atomic<bool>* interrupt) {
     absl::StatusOr<Image> image = execution.SnapshotReader()();
     if (!image.ok()) return image.status();
     RenderOutput out{std::move(*image), execution.stats(), 0, {}};
     out.seconds = absl::ToDoubleSeconds(clock() - started);
+    out.tasks_done = execution.tasks_done();
+    out.task_count = execution.task_count();
+    out.interrupted = CancelRequested(interrupt) && out.tasks_done < out.task_count;
     return out;
 }
 
@@ -64,8 +69,8 @@ RunClock ClockOr(const RunClock& clock) {
 }  // namespace
 
 absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEstimator& estimator,
-                                         const RenderSettings& settings,
-                                         const ProgressFn& progress) {
+                                         const RenderSettings& settings, const ProgressFn& progress,
+                                         const std::atomic<bool>* interrupt) {
     const RunClock clock = ClockOr({});
     const absl::Time started = clock();
     absl::StatusOr<std::unique_ptr<TileExecution>> made = TileExecution::Make(
@@ -77,11 +82,12 @@ absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEst
     options.merged = [&] {
         if (progress) progress(execution.tasks_done(), execution.task_count());
     };
+    options.interrupt = interrupt;
     if (absl::Status s = RunTiles(execution, camera, estimator, settings, options, started);
         !s.ok()) {
         return s;
     }
-    return Output(execution, clock, started);
+    return Output(execution, clock, started, interrupt);
 }
 
 absl::StatusOr<RenderOutput> RenderSplatImage(const Camera& camera, const SplatRenderer& renderer,
@@ -118,12 +124,13 @@ absl::StatusOr<RenderOutput> RenderSplatImage(const Camera& camera, const SplatR
         },
         options, started);
     if (!status.ok()) return status;
-    return Output(execution, clock, started);
+    return Output(execution, clock, started, nullptr);
 }
 
 absl::StatusOr<RenderOutput> RenderImageAdaptive(
     const Camera& camera, const RadianceEstimator& estimator, const RenderSettings& settings,
-    const AdaptiveSettings& adaptive, const ProgressFn& progress, const RunClock& run_clock) {
+    const AdaptiveSettings& adaptive, const ProgressFn& progress, const RunClock& run_clock,
+    const std::atomic<bool>* interrupt) {
     const RunClock clock = ClockOr(run_clock);
     const absl::Time started = clock();
     absl::StatusOr<std::unique_ptr<AdaptiveTileExecution>> made = AdaptiveTileExecution::Make(
@@ -136,11 +143,12 @@ absl::StatusOr<RenderOutput> RenderImageAdaptive(
     options.merged = [&] {
         if (progress) progress(execution.tiles_finished(), execution.tile_count());
     };
+    options.interrupt = interrupt;
     if (absl::Status s = RunTiles(execution, camera, estimator, settings, options, started);
         !s.ok()) {
         return s;
     }
-    absl::StatusOr<RenderOutput> out = Output(execution, clock, started);
+    absl::StatusOr<RenderOutput> out = Output(execution, clock, started, interrupt);
     if (!out.ok()) return out.status();
     absl::StatusOr<AdaptiveReport> report = execution.Report();
     if (!report.ok()) return report.status();

@@ -178,14 +178,25 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     const ProgressFn progress = [&](size_t done, size_t n) {
         if (options.progress) options.progress->Update(done, n);
     };
+    const std::atomic<bool>* interrupt =
+        options.interrupt && !splat_renderer ? &options.interrupt->requested : nullptr;
+    if (interrupt) options.interrupt->honoured = true;
     absl::StatusOr<RenderOutput> out =
         splat_renderer
             ? RenderSplatImage(camera, *splat_renderer, *splat_plan, options.render, progress)
-        : adaptive
-            ? RenderImageAdaptive(camera, *estimator, options.render, options.adaptive, progress)
-            : RenderImage(camera, *estimator, options.render, progress);
+        : adaptive ? RenderImageAdaptive(camera, *estimator, options.render, options.adaptive,
+                                         progress, {}, interrupt)
+                   : RenderImage(camera, *estimator, options.render, progress, interrupt);
+    if (interrupt) options.interrupt->honoured = false;
     if (options.progress) options.progress->Finish();
     if (!out.ok()) return out.status();
+    if (out->interrupted) {
+        summary.partial = absl::StrCat(
+            "interrupted after ", out->tasks_done, " of ", out->task_count,
+            " tasks (whole passes of tiles): each pixel is the mean of its own samples, the spp "
+            "channel (0 where none ran)");
+        log->warn("job={} {}", job_id, summary.partial);
+    }
     if (out->stats.invalid_samples > 0) {
         log->warn("job={} {} NaN or infinite samples were discarded (counted as zero)", job_id,
                   out->stats.invalid_samples);
@@ -218,8 +229,10 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     outcome.stats = out->stats;
     if (adaptive) outcome.adaptive = out->adaptive;
     outcome.radiosity = summary.radiosity;
+    outcome.partial = summary.partial;
+    // A partial image's A/B halves are not a whole render's: no error estimate.
     absl::StatusOr<RenderDescription> description =
-        DescribeRender(MetadataOf(job, outcome), out->image, true);
+        DescribeRender(MetadataOf(job, outcome), out->image, !out->interrupted);
     if (!description.ok()) return description.status();
     if (description->estimates) {
         const VarianceAssessment& variance = description->estimates->variance;

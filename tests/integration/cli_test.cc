@@ -1,7 +1,11 @@
 // The `lightfarm` binary end to end: a render writes an EXR whose header says how it was
 // made, and bad input fails with a message naming what and where.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <stb_image.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -872,6 +876,123 @@ ImageMean MeanOfImage(const Image& image) {
         }
     }
     return m;
+}
+
+// --sky, without JSON: a Lambertian plane seen from above under a uniform sky of radiance L
+// reflects rho / pi * pi L = rho L (the plane, open, sees only sky above it), so the image's mean
+// over R, G and B is sum(rho) L. With a map lit (2) above the horizon and black below, read from
+// outside the scene's folder, the same plane sees a uniform hemisphere of 2. Bad values are
+// refused naming the flag and the value.
+TEST_F(Cli, SkyFlagLightsTheSceneWithoutJson) {
+    fs::create_directories(dir_ / "scene");
+    fs::create_directories(dir_ / "maps");
+    const std::string scene = Write("scene/plane.json", R"({
+      "camera": {"position": [0, 2, 0.5], "look_at": [0, 0, 0], "fov_y_deg": 20,
+                 "resolution": [8, 8]},
+      "materials": {"m": {"type": "lambert", "reflectance": [0.5, 0.25, 0.75]}},
+      "shapes": [{"type": "quad", "material": "m",
+                  "vertices": [[-1000, 0, 1000], [1000, 0, 1000], [1000, 0, -1000],
+                               [-1000, 0, -1000]]}]})");
+    std::ofstream(dir_ / "maps" / "half.hdr", std::ios::binary)
+        << testing::HdrBytes(2, 2, {2, 2, 2, 2, 2, 2, 0, 0, 0, 0, 0, 0});
+    for (const auto& [sky, expected] : {std::pair<std::string, double>{"white", 1.5},
+                                        {"2,2,2", 3.0},
+                                        {(dir_ / "maps" / "half.hdr").string(), 3.0}}) {
+        SCOPED_TRACE(sky);
+        const std::string exr = (dir_ / "sky.exr").string();
+        const RunResult r = Lightfarm("render " + scene + " -o " + exr + " --sky " + sky +
+                                      " --spp 64 --seed 1 --no-progress");
+        ASSERT_EQ(r.status, 0) << r.output;
+        absl::StatusOr<ExrFile> file = ReadExr(exr);
+        ASSERT_TRUE(file.ok()) << file.status();
+        const ImageMean m = MeanOfImage(file->image);
+        ASSERT_GT(m.variance, 0);
+        EXPECT_LT(std::abs(m.mean - expected), 4 * std::sqrt(m.variance))
+            << m.mean << " +- " << std::sqrt(m.variance);
+        const std::string recorded = std::get<std::string>(file->attributes.at("lightfarm.sky"));
+        EXPECT_EQ(recorded, sky.find('/') == std::string::npos ? sky : "../maps/half.hdr");
+    }
+    for (const auto& [sky, message] :
+         {std::pair<std::string, std::string>{
+              "1,2", "--sky \"1,2\": 2 numbers; expected white, R,G,B or a number"},
+          {"-1", "--sky \"-1\": \"-1\" is not a radiance"},
+          {"missing.hdr", "--sky missing.hdr: no such file"}}) {
+        const RunResult r = Lightfarm("render " + scene + " -o " + (dir_ / "x.exr").string() +
+                                      " --sky " + sky + " --no-progress");
+        EXPECT_NE(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+    }
+    // Replacing the scene's own sky is said.
+    const std::string lit = Write("scene/lit.json", R"({
+      "camera": {"position": [0, 2, 0.5], "look_at": [0, 0, 0], "fov_y_deg": 20,
+                 "resolution": [4, 4]},
+      "materials": {"m": {"type": "lambert", "reflectance": [0.5, 0.5, 0.5]}},
+      "shapes": [{"type": "quad", "material": "m",
+                  "vertices": [[-1, 0, 1], [1, 0, 1], [1, 0, -1], [-1, 0, -1]]}],
+      "lights": [{"type": "environment", "radiance": 3}]})");
+    const RunResult r = Lightfarm("render " + lit + " -o " + (dir_ / "lit.exr").string() +
+                                  " --sky white --spp 2 --no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("--sky replaces the scene's environment light"), std::string::npos)
+        << r.output;
+}
+
+// Ctrl-C during `render`: the process stops sampling, writes the whole passes done so far (each
+// pixel the mean of its own samples, a whole number of 4-sample passes of its tile), says so in
+// the header and on stderr, and exits with 130. The render would take minutes; SIGINT is sent
+// once it logs that it samples (and again while it has not stopped: a Ctrl-C during loading ends
+// it at once, which the status would show).
+TEST_F(Cli, CtrlCWritesThePassesDoneSoFar) {
+    const std::string exr = (dir_ / "partial.exr").string();
+    const std::string log = (dir_ / "render.log").string();
+    const std::string cmd = std::string(LF_BIN_DIR) + "/lightfarm render " +
+                            std::string(LF_TEST_SCENES) + "/cornell_box.json -o " + exr +
+                            " --resolution 32x32 --tile 16 --spp 262144 --passes 65536 "
+                            "--threads 2 --no-progress";
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(fd, 1);
+        dup2(fd, 2);
+        execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), nullptr);
+        _exit(127);
+    }
+    const auto read_log = [&] {
+        std::ifstream in(log);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    int status = 0;
+    bool sampling = false;
+    for (int i = 0; i < 1200 && !sampling; ++i) {  // up to 2 minutes
+        usleep(100'000);
+        sampling = read_log().find(" rendering ") != std::string::npos;
+    }
+    ASSERT_TRUE(sampling) << read_log();
+    usleep(500'000);  // past the log line, into the sampling
+    kill(pid, SIGINT);
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    const std::string output = read_log();
+    ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << WTERMSIG(status) << "\n" << output;
+    EXPECT_EQ(WEXITSTATUS(status), 130) << output;
+    EXPECT_NE(output.find("lightfarm: interrupted after "), std::string::npos) << output;
+    EXPECT_NE(output.find("wrote it to " + exr), std::string::npos) << output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    const std::string partial = std::get<std::string>(file->attributes.at("lightfarm.partial"));
+    EXPECT_EQ(partial.rfind("interrupted after ", 0), 0u) << partial;
+    EXPECT_EQ(file->attributes.count("lightfarm.estimatedError"), 0u);
+    const std::vector<float>& spp = *file->image.FindChannel("spp");
+    double samples = 0;
+    for (float n : spp) {
+        EXPECT_EQ(std::fmod(n, 4.0f), 0.0f);
+        samples += n;
+    }
+    EXPECT_GT(samples, 0);
+    EXPECT_LT(samples, 262144.0 * 32 * 32);
+    for (const char* c : {"R", "G", "B"}) {
+        for (float v : *file->image.FindChannel(c)) ASSERT_TRUE(std::isfinite(v)) << c;
+    }
 }
 
 // --light-sampling reaches the path tracer: with the same seed, power and bvh give different

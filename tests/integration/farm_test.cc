@@ -1104,6 +1104,33 @@ TEST_F(Farm, RadiosityJobForAGlossySceneIsRefusedAtSubmission) {
     EXPECT_NE(r.err.find("radiosity models lambert only"), std::string::npos) << r.err;
 }
 
+// A --sky map outside the scene's folder travels with the scene's files (by its name relative to
+// that folder, which the header records) and gives the local bits.
+TEST_F(Farm, SkyMapIsUploadedAndGivesTheLocalBits) {
+    StartServer();
+    StartWorker("w1");
+    fs::create_directories(dir_ / "maps");
+    std::ofstream(dir_ / "maps" / "sky.hdr", std::ios::binary)
+        << lf::testing::HdrBytes(4, 2, {1, 2, 3, 4, 4, 4, 0, 1, 0, 9, 9, 9,  //
+                                        0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 1});
+    fs::create_directories(dir_ / "scene");
+    const std::string scene = (dir_ / "scene" / "cornell.json").string();
+    fs::copy_file(scene_, scene);
+    const std::string flags =
+        "--spp 4 --seed 2 --tile 16 --sky " + (dir_ / "maps" / "sky.hdr").string();
+    const std::string job = Submit(scene, flags);
+    const CliRun watch = Farmctl("watch " + job);
+    ASSERT_EQ(watch.status, 0) << watch.out << watch.err;
+    const std::string farm = (dir_ / "farm.exr").string(), local = (dir_ / "local.exr").string();
+    ASSERT_EQ(Farmctl("fetch " + job + " -o " + farm).status, 0);
+    const CliRun r = Lightfarm("render " + scene + " -o " + local + " " + flags + " --no-progress");
+    ASSERT_EQ(r.status, 0) << r.out << r.err;
+    ExpectSameImageAndHeader(farm, local);
+    absl::StatusOr<ExrFile> file = ReadExr(farm);
+    ASSERT_TRUE(file.ok()) << file.status();
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.sky")), "../maps/sky.hdr");
+}
+
 // Files named inside files (an OBJ's MTL, the MTL's texture) are uploaded with the scene: the
 // server finds them and refuses radiosity for the texture, not for a missing file.
 TEST_F(Farm, FilesAnObjNamesAreUploadedWithTheScene) {

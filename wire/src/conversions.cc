@@ -115,6 +115,7 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_camera(spec.scene_options.camera);
     out->set_width(spec.scene_options.width);
     out->set_height(spec.scene_options.height);
+    out->set_sky(spec.scene_options.sky);
     out->set_clamp(spec.clamp);
     out->set_aovs(spec.aovs);
     out->set_sampler(ToProto(spec.sampler));
@@ -142,7 +143,7 @@ void FromProto(const pb::RenderParams& p, JobSpec* spec) {
     spec->adaptive.target_error = p.target_error();
     spec->adaptive.time_limit = p.time_limit_seconds();
     if (p.max_spp() != 0) spec->adaptive.max_spp = p.max_spp();
-    spec->scene_options = {p.camera(), p.width(), p.height(), FilterFromProto(p)};
+    spec->scene_options = {p.camera(), p.width(), p.height(), FilterFromProto(p), p.sky()};
     spec->clamp = p.clamp();
     spec->aovs = p.aovs();
     spec->sampler = FromProto(p.sampler());

@@ -9,6 +9,8 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "gltf_files.h"
 #include "image_files.h"
@@ -1069,6 +1071,66 @@ TEST_F(SceneLoaderTest, PhotometricSkyIgnoresTexelsThatEmitNothing) {
     ASSERT_TRUE(scene.ok()) << scene.status();
     ASSERT_TRUE(scene->environment);
     EXPECT_EQ(scene->environment->radiance, Rgb(2));
+}
+
+// --sky (SceneOptions::sky): white, a colour, a grey or a map file read beside the scene, in
+// place of the scene's environment with a warning; it counts in the content hash.
+TEST_F(SceneLoaderTest, SkyOptionAddsOrReplacesTheEnvironment) {
+    Write("sky.hdr", lf::testing::HdrBytes(2, 1, {4, 4, 4, 0, 0, 0}));
+    Write("sky.png", lf::testing::PngBytes(2, 1, 3, {255, 255, 255, 0, 0, 0}));
+    const auto with_sky = [&](const std::string& json, const std::string& sky) {
+        return ParseScene(json, "scene.json", ReadBeside(dir_.string()), {.sky = sky});
+    };
+    const std::string bare = WithLights("");
+    const absl::StatusOr<Scene> none = Parse(bare);
+    ASSERT_TRUE(none.ok()) << none.status();
+    EXPECT_FALSE(none->environment);
+    for (const auto& [text, radiance] : {std::pair<std::string, Rgb>{"white", Rgb(1)},
+                                         {"0.5", Rgb(0.5f)},
+                                         {"1,2.5,0", Rgb(1, 2.5f, 0)}}) {
+        CapturedLog().str("");
+        const absl::StatusOr<Scene> scene = with_sky(bare, text);
+        ASSERT_TRUE(scene.ok()) << text << ": " << scene.status();
+        ASSERT_TRUE(scene->environment) << text;
+        EXPECT_EQ(scene->environment->radiance, radiance) << text;
+        EXPECT_EQ(scene->environment->map, nullptr) << text;
+        EXPECT_NE(scene->content_hash, none->content_hash) << text;
+        EXPECT_EQ(CapturedLog().str().find("--sky"), std::string::npos) << CapturedLog().str();
+    }
+    EXPECT_NE(with_sky(bare, "white")->content_hash, with_sky(bare, "0.5")->content_hash);
+    const absl::StatusOr<Scene> map = with_sky(bare, "sky.hdr");
+    ASSERT_TRUE(map.ok()) << map.status();
+    ASSERT_TRUE(map->environment && map->environment->map);
+    EXPECT_EQ(map->environment->map->width, 2);
+    EXPECT_EQ(map->environment->radiance, Rgb(1));
+    // Replacing the scene's own sky says so.
+    CapturedLog().str("");
+    const absl::StatusOr<Scene> replaced =
+        with_sky(WithLights(R"({"type": "environment", "radiance": [3, 3, 3]})"), "white");
+    ASSERT_TRUE(replaced.ok()) << replaced.status();
+    EXPECT_EQ(replaced->environment->radiance, Rgb(1));
+    EXPECT_NE(CapturedLog().str().find("scene.json: --sky replaces the scene's environment light"),
+              std::string::npos)
+        << CapturedLog().str();
+    // Bad values name the flag and the value.
+    for (const auto& [text, expected, code] :
+         {std::tuple<std::string, std::string, absl::StatusCode>{
+              "1,2", "--sky \"1,2\": 2 numbers; expected white, R,G,B or a number",
+              absl::StatusCode::kInvalidArgument},
+          {"-1", "--sky \"-1\": \"-1\" is not a radiance", absl::StatusCode::kInvalidArgument},
+          {"1,1,1e11", "--sky \"1,1,1e11\": \"1e11\" is not a radiance",
+           absl::StatusCode::kInvalidArgument},
+          {"nope.hdr", "scene.json: --sky \"nope.hdr\": ", absl::StatusCode::kNotFound},
+          {"sky.png",
+           "scene.json: --sky: \"sky.png\" is an 8- or 16-bit image of display values, not "
+           "radiance",
+           absl::StatusCode::kInvalidArgument}}) {
+        const absl::StatusOr<Scene> scene = with_sky(bare, text);
+        ASSERT_FALSE(scene.ok()) << text;
+        EXPECT_EQ(scene.status().code(), code) << scene.status();
+        EXPECT_NE(scene.status().message().find(expected), std::string::npos)
+            << "message: " << scene.status().message() << "\nexpected: " << expected;
+    }
 }
 
 TEST_F(SceneLoaderTest, EnvironmentErrorsNameThePath) {

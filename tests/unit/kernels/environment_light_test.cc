@@ -1,13 +1,15 @@
 // The environment light against closed forms: a uniform sky and a half-lit map over an open
 // Lambertian plane, a sun-in-sky map whose irradiance is a sum over its texels, a single bright
-// column that must light from where rotate_y turns it; and the map sampler's directions against
-// its own density by chi-square.
+// column that must light from where rotate_y turns it, a texel that must light where Blender shows
+// it; and the map sampler's directions against its own density by chi-square.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <memory>
 #include <numbers>
+#include <utility>
 
 #include "chi_square.h"
 #include "lf/kernels/embree_scene.h"
@@ -112,9 +114,9 @@ TEST(EnvironmentLight, EightBitMapIsDecodedFromSrgb) {
     map->channels = 3;
     map->texels8 = {255, 255, 255, 128, 64, 0};  // u < 1/2: white; u > 1/2: (128, 64, 0)
     const EnvironmentEmitter sky(EnvironmentLight{Rgb(2.0f), map, 0});
-    // u = 0.5 + atan2(x, -z) / (2 pi): x < 0 reads the left half, x > 0 the right.
-    EXPECT_EQ(sky.Le(Vec3(-1, 0, 0)), Rgb(2.0f));
-    const Rgb right = sky.Le(Vec3(1, 0, 0));
+    // u = 0.5 + atan2(z, x) / (2 pi): z < 0 reads the left half, z > 0 the right.
+    EXPECT_EQ(sky.Le(Vec3(0, 0, -1)), Rgb(2.0f));
+    const Rgb right = sky.Le(Vec3(0, 0, 1));
     EXPECT_NEAR(right.r, 2 * 0.2158605f, 1e-6f);
     EXPECT_NEAR(right.g, 2 * 0.0512695f, 1e-6f);
     EXPECT_EQ(right.b, 0);
@@ -130,10 +132,11 @@ TEST(EnvironmentLight, NonFiniteTexelsEmitNothing) {
         const auto ds = sky.Sample(sampler.Get2D());
         ASSERT_TRUE(ds);
         ASSERT_EQ(ds->radiance, Rgb(2.0f));
-        ASSERT_GT(ds->wi.x, 0);  // u in [3/4, 1): atan2(x, -z) in [pi/2, pi)
+        ASSERT_GT(ds->wi.z, 0);  // u in [3/4, 1): atan2(z, x) in [pi/2, pi)
+        ASSERT_LT(ds->wi.x, 0);
     }
-    // u = 0.125, 0.375 and 0.625: atan2(x, -z) = -3 pi / 4, -pi / 4, pi / 4.
-    for (const Vec3& w : {Vec3(-1, 0, 1), Vec3(-1, 0, -1), Vec3(1, 0, -1)}) {
+    // u = 0.125, 0.375 and 0.625: atan2(z, x) = -3 pi / 4, -pi / 4, pi / 4.
+    for (const Vec3& w : {Vec3(-1, 0, -1), Vec3(1, 0, -1), Vec3(1, 0, 1)}) {
         EXPECT_EQ(sky.Le(Normalize(w)), Rgb(0.0f));
         EXPECT_EQ(sky.Pdf(Normalize(w)), 0);
     }
@@ -208,19 +211,19 @@ TEST(EnvironmentLight, MapSamplingMatchesItsPdf) {
             const auto ds = sky.Sample(sampler.Get2D());
             ASSERT_TRUE(ds);
             const double v = std::acos(std::clamp(double(ds->wi.y), -1.0, 1.0)) / kPi;
-            const double u = 0.5 + std::atan2(double(ds->wi.x), -double(ds->wi.z)) / (2 * kPi);
+            const double u = 0.5 + std::atan2(double(ds->wi.z), double(ds->wi.x)) / (2 * kPi);
             const int row = std::clamp(int(v * kH), 0, kH - 1);
             const int column = std::clamp(int(u * kW), 0, kW - 1);
             ++observed[size_t(row * kW + column)];
         }
         // The quadrature's pole is +z and its azimuth phi; the map's pole is +y and its
-        // u = 0.5 + atan2(x, -z) / (2 pi). World (-d.y, d.z, d.x) has y = cos(theta) and
-        // atan2(x, -z) = phi - pi: cell (theta, phi) is the map's (v, u) = (theta, phi) / pi, 2 pi.
+        // u = 0.5 + atan2(z, x) / (2 pi). World (-d.x, d.z, -d.y) has y = cos(theta) and
+        // atan2(z, x) = phi - pi: cell (theta, phi) is the map's (v, u) = (theta, phi) / pi, 2 pi.
         double integral = 0;
         for (int row = 0; row < kH; ++row) {
             for (int column = 0; column < kW; ++column) {
                 const double p = testing::IntegrateSolidAngle(
-                    [&](const Vec3& d) { return double(sky.Pdf(Vec3(-d.y, d.z, d.x))); },
+                    [&](const Vec3& d) { return double(sky.Pdf(Vec3(-d.x, d.z, -d.y))); },
                     row * kPi / kH, (row + 1) * kPi / kH, column * 2 * kPi / kW,
                     (column + 1) * 2 * kPi / kW, 2, 1e-7);
                 expected[size_t(row * kW + column)] = p * kSamples;
@@ -234,22 +237,22 @@ TEST(EnvironmentLight, MapSamplingMatchesItsPdf) {
 }
 
 // One bright column of texels (u in [5/32, 6/32]), turned by rotate_y = 2: the map's azimuth
-// phi = 2 pi (u - 0.5) = atan2(x, -z) of the direction before the turn by -rotate_y, so after it
-// the column lies at world azimuth phi - rotate_y (counter-clockwise seen from above). A vertical
+// phi = 2 pi (u - 0.5) = atan2(z, x) of the direction after the turn by +rotate_y, so the column
+// lies at world azimuth atan2(z, x) = phi + rotate_y (clockwise seen from above). A vertical
 // plane facing that azimuth psi receives E = L integral of sin^2(theta) dtheta (= pi / 2) times
 // integral of cos(phi - psi) dphi over the column (= 2 sin(dphi / 2)); one facing away, or
 // facing where the opposite turn would put the column, receives nothing.
-TEST(EnvironmentLight, RotateYTurnsTheSkyCounterClockwise) {
+TEST(EnvironmentLight, RotateYTurnsTheSkyClockwiseSeenFromAbove) {
     constexpr int kW = 32, kH = 16, kColumn = 5;
     const double rotate = 2.0;
     const double phi = 2 * kPi * ((kColumn + 0.5) / kW - 0.5);
     const double dphi = 2 * kPi / kW;
     const Rgb rho(0.5f);
     for (const auto& [psi, irradiance] :
-         {std::pair{phi - rotate, kPi / 2 * 2 * std::sin(dphi / 2)},
-          std::pair{phi - rotate + kPi, 0.0}, std::pair{phi + rotate, 0.0}}) {
-        const Vec3d n(std::sin(psi), 0, -std::cos(psi));   // atan2(n.x, -n.z) = psi
-        const Vec3d t(-std::cos(psi), 0, -std::sin(psi));  // horizontal, along the plane
+         {std::pair{phi + rotate, kPi / 2 * 2 * std::sin(dphi / 2)},
+          std::pair{phi + rotate + kPi, 0.0}, std::pair{phi - rotate, 0.0}}) {
+        const Vec3d n(std::cos(psi), 0, std::sin(psi));   // atan2(n.z, n.x) = psi
+        const Vec3d t(std::sin(psi), 0, -std::cos(psi));  // horizontal, along the plane
         Scene scene;
         Material plane;
         plane.reflectance = rho;
@@ -276,6 +279,62 @@ TEST(EnvironmentLight, RotateYTurnsTheSkyCounterClockwise) {
         const testing::PointEstimate sky = testing::EstimateRadiance(
             *tr.tracer, testing::RayBetween(n * 2.0, n * 3.0, tr.embree->origin()), 1);
         EXPECT_EQ(sky.mean[1], irradiance > 0 ? 1 : 0) << "psi " << psi;
+    }
+}
+
+// Where Blender shows a texel of a lat-long map, worked out from Cycles: its world shader's
+// Environment Texture (equirectangular) reads direction D (Blender's frame, +z up) at
+//   u = (atan2(D.y, D.x) - pi) / (-2 pi),   v = (acos(D.z) - pi) / (-pi)
+// (direction_to_equirectangular: range (-2 pi, pi, -pi, pi)), v = 0 the image's bottom row
+// (Blender stores images bottom-up). A Mapping node of type Point (its default) rotating about Z
+// by alpha between Texture Coordinate and the texture reads D = Rz(alpha) d for ray direction d.
+// glTF's frame is Blender's turned: glTF (x, y, z) = Blender (x, z, -y). So for a glTF
+// direction g: d = (g.x, -g.z, g.y). Returns the texel (column, row from the top) Blender reads.
+std::pair<int, int> BlenderTexel(const Vec3& g, double alpha, int w, int h) {
+    const double dx = g.x, dy = -double(g.z), dz = g.y;
+    const double x = std::cos(alpha) * dx - std::sin(alpha) * dy;  // Rz(alpha) d
+    const double y = std::sin(alpha) * dx + std::cos(alpha) * dy;
+    const double u = (std::atan2(y, x) - kPi) / (-2 * kPi);
+    const double v = (std::acos(std::clamp(dz, -1.0, 1.0)) - kPi) / -kPi;
+    const int column = std::clamp(int(u * w), 0, w - 1);
+    const int row_from_bottom = std::clamp(int(v * h), 0, h - 1);
+    return {column, h - 1 - row_from_bottom};
+}
+
+// One bright texel (column 12, row 2 of 16 x 8) must light exactly the directions where Blender
+// shows it (BlenderTexel), with rotate_y_deg playing the Mapping node's Z rotation, and the
+// sampler must draw only those directions. Before, the map's centre looked down -z (Blender's +y,
+// a quarter turn off) and rotate_y turned the other way.
+TEST(EnvironmentLight, BrightTexelLightsWhereBlenderShowsIt) {
+    constexpr int kW = 16, kH = 8, kX = 12, kY = 2;
+    const auto map = Map(kW, kH, [](int x, int y) { return x == kX && y == kY ? 100.0f : 0.0f; });
+    for (const double alpha : {0.0, kPi / 2, 0.5}) {
+        const EnvironmentEmitter sky(EnvironmentLight{Rgb(1.0f), map, alpha});
+        int lit = 0;
+        for (int i = 0; i < 20000; ++i) {
+            Sampler sampler(5, 0, 0, uint64_t(i));
+            const Vec2 r = sampler.Get2D();
+            const float z = 1 - 2 * r.x, s = std::sqrt(std::max(0.0f, 1 - z * z));
+            const float phi = 2 * float(kPi) * r.y;
+            const Vec3 g(s * std::cos(phi), z, s * std::sin(phi));
+            const bool blender_lit = BlenderTexel(g, alpha, kW, kH) == std::pair{kX, kY};
+            // Texel borders are measure zero; a float direction within 1e-4 of one may round
+            // either way.
+            const auto [bx, by] = BlenderTexel(g, alpha + 1e-4, kW, kH);
+            const auto [cx, cy] = BlenderTexel(g, alpha - 1e-4, kW, kH);
+            if ((bx == kX && by == kY) != (cx == kX && cy == kY)) continue;
+            lit += blender_lit;
+            ASSERT_EQ(sky.Le(g).g, blender_lit ? 100.0f : 0.0f)
+                << "rotate_y " << alpha << " direction " << g.x << " " << g.y << " " << g.z;
+        }
+        EXPECT_GT(lit, 0);
+        for (int i = 0; i < 2000; ++i) {
+            Sampler sampler(6, 0, 0, uint64_t(i));
+            const auto ds = sky.Sample(sampler.Get2D());
+            ASSERT_TRUE(ds);
+            EXPECT_EQ(BlenderTexel(ds->wi, alpha, kW, kH), (std::pair{kX, kY}))
+                << "rotate_y " << alpha;
+        }
     }
 }
 

@@ -163,6 +163,15 @@ TEST(JobRecordCodec, CameraAndResolutionSurviveAndOldRecordsHaveNone) {
     EXPECT_EQ(old->spec.scene_options.width, 0);
 }
 
+// --sky travels in the record as in RenderParams (a server restart keeps it).
+TEST(JobRecordCodec, SkySurvives) {
+    JobRecord job = Record("a", 1);
+    job.spec.scene_options.sky = "../maps/sky.hdr";
+    const absl::StatusOr<JobRecord> back = DecodeJobRecord(EncodeJobRecord(job));
+    ASSERT_TRUE(back.ok()) << back.status();
+    EXPECT_EQ(back->spec.scene_options.sky, "../maps/sky.hdr");
+}
+
 TEST(JobRecordCodec, FilterClampAndAovsSurviveAndOldRecordsHaveNone) {
     JobRecord job = Record("a", 1);
     job.spec.scene_options.filter = PixelFilter{PixelFilter::Type::kBlackmanHarris, 2.5};

@@ -177,10 +177,11 @@ struct DirectionalLight {
 
 // Light arriving from every direction at infinity (a sky). Without a map its radiance is
 // `radiance` everywhere; with one, the map's texel times `radiance` (which carries the scene's
-// `scale` or photometric normalisation). The map is latitude-longitude with +y up: world
-// direction d is first turned by -rotate_y about +y (so a positive rotate_y turns the sky
-// counter-clockwise seen from above, as Blender's and pbrt's rotations do), then read at
-// u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, texel row 0 at the top (v = 0).
+// `scale` or photometric normalisation). The map is latitude-longitude with +y up, oriented as
+// Blender's Environment Texture in a glTF export: world direction d is first turned by
+// +rotate_y about +y (as Blender's Mapping node, type Point, turns the direction it reads by
+// its Z rotation, so the sky turns clockwise seen from above), then read at
+// u = 0.5 + atan2(d.z, d.x) / (2 pi), v = acos(d.y) / pi, texel row 0 at the top (v = 0).
 struct EnvironmentLight {
     Rgb radiance{1.0f};                       // W m^-2 sr^-1 per channel (times the map's texel)
     std::shared_ptr<const TextureImage> map;  // HDR/EXR texels, linear; null: uniform

@@ -28,6 +28,9 @@ struct SceneOptions {
     int width = 0, height = 0;  // above 0: the image size, whatever the scene says
     // `--filter`: the pixel filter, whatever the scene's camera says (glTF cameras have none).
     std::optional<PixelFilter> filter;
+    // `--sky` (lf/core/sky_option.h): an environment light replacing the scene's; a map file by
+    // the name the scene's reader reads it by. Empty: the scene's own.
+    std::string sky;
 };
 
 // Files beside the scene file (ReadBeside of its folder).

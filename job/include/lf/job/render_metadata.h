@@ -65,6 +65,7 @@ RadiosityFigures RadiosityFiguresOf(const Report& r) {
 struct RenderMetadata {
     std::string scene_hash;
     std::string camera;  // the glTF camera --camera picked; "" for the scene's own
+    std::string sky;     // --sky as given to the scene loader; "" for the scene's own
     std::string method;  // a name of lf/job/method_registry.h
     uint64_t spp = 0;    // adaptive: the most any pixel got
     uint64_t seed = 0;
@@ -83,6 +84,7 @@ struct RenderMetadata {
     RadiositySettings radiosity_settings;       // method "radiosity"
     std::optional<RadiosityFigures> radiosity;  // when known
     PhotonSettings ppm;                         // method "ppm"
+    std::string partial;  // lightfarm.partial: why and where the render stopped; "" complete
 };
 
 // What a render of a job measured, for its header.
@@ -91,6 +93,7 @@ struct RenderOutcome {
     RenderStats stats;
     std::optional<AdaptiveReport> adaptive;  // set for an adaptive render
     std::optional<RadiosityFigures> radiosity;
+    std::string partial;  // an interrupted render: what it holds (RenderMetadata::partial)
 };
 
 // The metadata of `spec` rendered with `outcome`, local mode's and the farm's alike (so their
@@ -109,18 +112,18 @@ struct RenderDescription {
 };
 
 // Every attribute of a render's header: how it was made (lightfarm.version, scene hash, camera
-// when picked by name, method, settings with lightfarm.sampler and, for path tracing,
-// lightfarm.lightSampling, timing, ray and sample counts, truncated paths), what
-// the channels hold (lightfarm.channels, lightfarm.aovs when there are AOVs, lightfarm.filter),
-// their units (lightfarm.units and OpenEXR's standard chromaticities, Rec.709 with D65, and
-// whiteLuminance = 683 cd/m^2 for RGB (1, 1, 1)), the bias of --clamp (lightfarm.clamp and
-// lightfarm.bias, only when clamping), the image's own error estimates
-// (lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance: noise only,
-// never the clamp's bias) when `complete` and every pixel has at least 2 samples, how an
-// adaptive render ended (lightfarm.targetError, .timeLimit, lightfarm.adaptive.*), the
-// radiosity solve (lightfarm.radiosity.*), the light paths of light tracing and BDPT
-// (lightfarm.lightPaths, lightfarm.lightPathsPerPixel) and photon mapping's passes, photons and
-// radius schedule with the bias it leaves (lightfarm.ppm.*, lightfarm.bias).
+// when picked by name, lightfarm.sky with --sky, lightfarm.partial for an interrupted render,
+// method, settings with lightfarm.sampler and, for path tracing, lightfarm.lightSampling, timing,
+// ray and sample counts, truncated paths), what the channels hold (lightfarm.channels,
+// lightfarm.aovs when there are AOVs, lightfarm.filter), their units (lightfarm.units and OpenEXR's
+// standard chromaticities, Rec.709 with D65, and whiteLuminance = 683 cd/m^2 for RGB (1, 1, 1)),
+// the bias of --clamp (lightfarm.clamp and lightfarm.bias, only when clamping), the image's own
+// error estimates (lightfarm.estimatedError, .estimatedRelMse, .estimatedMeanError, .highVariance:
+// noise only, never the clamp's bias) when `complete` and every pixel has at least 2 samples, how
+// an adaptive render ended (lightfarm.targetError, .timeLimit, lightfarm.adaptive.*), the radiosity
+// solve (lightfarm.radiosity.*), the light paths of light tracing and BDPT (lightfarm.lightPaths,
+// lightfarm.lightPathsPerPixel) and photon mapping's passes, photons and radius schedule with the
+// bias it leaves (lightfarm.ppm.*, lightfarm.bias).
 absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& metadata, const Image& image,
                                                  bool complete);
 

@@ -35,7 +35,7 @@ class EnvironmentEmitter {
   private:
     // The map's texel at (u, v) times the light's radiance; `radiance` alone without a map.
     Rgb MapValue(const Vec2& uv) const;
-    // The map's (u, v) for a world direction, after turning it by -rotate_y about +y.
+    // The map's (u, v) for a world direction, after turning it by +rotate_y about +y.
     Vec2 MapUv(const Vec3& w) const;
 
     EnvironmentLight light_;

@@ -29,10 +29,14 @@ struct RunOptions {
     RunClock clock;   // empty: absl::Now
     // Called under the lock after every merge.
     std::function<void()> merged;
+    // Set from anywhere (a signal handler: Ctrl-C) to stop: no task starts any more, those under
+    // way are cancelled and their results dropped, so the execution keeps whole tasks only.
+    // Polled every 50 ms. Null: never.
+    const std::atomic<bool>* interrupt = nullptr;
 };
 
-// Runs until the execution is complete, or the first error; `started` is when its time limit
-// counts from.
+// Runs until the execution is complete, interrupted (OK, with what was merged), or the first
+// error; `started` is when its time limit counts from.
 absl::Status RunExecution(JobExecution& execution, const RunTask& run, const RunOptions& options,
                           absl::Time started);
 

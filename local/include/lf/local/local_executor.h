@@ -4,6 +4,7 @@
 // of the same job are the same code and the same bits.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -12,10 +13,10 @@
 #include "lf/core/camera.h"
 #include "lf/core/image.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/splat_plan.h"
 #include "lf/job/settings.h"
-#include "lf/kernels/splat_renderer.h"
+#include "lf/job/splat_plan.h"
 #include "lf/kernels/radiance.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/local/execution_runner.h"
 
 namespace lf {
@@ -41,23 +42,30 @@ struct RenderOutput {
     RenderStats stats;
     double seconds = 0;
     AdaptiveReport adaptive;  // RenderImageAdaptive only
+    // Stopped by `interrupt`: the image holds the tasks (whole passes of tiles) merged before,
+    // tasks_done of task_count, each pixel the mean of its own samples (spp; 0 where none ran).
+    bool interrupted = false;
+    size_t tasks_done = 0, task_count = 0;
 };
 
 // Called from worker threads with (tasks done, tasks in all); must be thread-safe.
 using ProgressFn = std::function<void(size_t, size_t)>;
 
+// `interrupt` (RunOptions::interrupt) stops it with the passes merged so far.
 absl::StatusOr<RenderOutput> RenderImage(const Camera& camera, const RadianceEstimator& estimator,
                                          const RenderSettings& settings,
-                                         const ProgressFn& progress = {});
+                                         const ProgressFn& progress = {},
+                                         const std::atomic<bool>* interrupt = nullptr);
 
 // Adaptive sampling (lf::AdaptiveTileExecution) on settings.threads threads, each taking the
 // least sampled tile's pass next; at the time limit, read from `clock` (empty: absl::Now), the
 // passes under way are cut and dropped, as on the farm. settings.spp is the first pass of every
 // tile (rounded up to even, so A and B are equal halves); settings.passes is ignored. Progress
-// counts finished tiles.
+// counts finished tiles. `interrupt` stops it as RenderImage's does.
 absl::StatusOr<RenderOutput> RenderImageAdaptive(
     const Camera& camera, const RadianceEstimator& estimator, const RenderSettings& settings,
-    const AdaptiveSettings& adaptive, const ProgressFn& progress = {}, const RunClock& clock = {});
+    const AdaptiveSettings& adaptive, const ProgressFn& progress = {}, const RunClock& clock = {},
+    const std::atomic<bool>* interrupt = nullptr);
 
 // A splatting method's render (light tracing, BDPT, photon mapping): PlanSplatRender cuts it into
 // splat tasks, settings.threads threads run them with `renderer` as a worker would (each task in

@@ -4,16 +4,17 @@
 // summary.
 #pragma once
 
+#include <atomic>
 #include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
 #include "lf/core/image_io.h"
 #include "lf/core/scene_loader.h"
-#include "lf/job/splat_settings.h"
 #include "lf/job/method_registry.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/settings.h"
+#include "lf/job/splat_settings.h"
 #include "lf/local/local_executor.h"
 
 namespace lf {
@@ -26,6 +27,15 @@ class RenderProgress {
     virtual void Start() = 0;
     virtual void Update(size_t done, size_t total) = 0;
     virtual void Finish() = 0;
+};
+
+// Ctrl-C during a render. A signal handler sets `requested`; RunLocalRender sets `honoured`
+// while it samples by a method that can stop with an unbiased partial image (the tile methods:
+// path, whitted, radiosity's display, adaptive), so that a handler may exit at once otherwise.
+// Lock-free atomics, safe in a signal handler.
+struct RenderInterrupt {
+    std::atomic<bool> requested{false};
+    std::atomic<bool> honoured{false};
 };
 
 struct LocalRenderOptions {
@@ -42,7 +52,8 @@ struct LocalRenderOptions {
     PhotonSettings ppm;  // --photons, --ppm-radius, --ppm-alpha
     // Radiosity's files (RadiosityOptions): a solution to save or load, a PLY to export.
     std::string save_solution, load_solution, export_ply;
-    RenderProgress* progress = nullptr;  // none when null
+    RenderProgress* progress = nullptr;    // none when null
+    RenderInterrupt* interrupt = nullptr;  // none when null
 };
 
 struct LocalRenderSummary {
@@ -60,6 +71,8 @@ struct LocalRenderSummary {
     bool high_variance = false;
     bool adaptive = false;
     AdaptiveReport adaptive_report;
+    // Interrupted: the files hold the passes done so far; `partial` says so, as the header does.
+    std::string partial;
 };
 
 // Renders and writes the files; logs as the farm's jobs do (job=local-<scene hash>).

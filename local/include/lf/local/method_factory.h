@@ -11,9 +11,9 @@
 #include "lf/job/job_spec.h"
 #include "lf/job/method_registry.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/radiance.h"
 #include "lf/kernels/radiosity.h"
+#include "lf/kernels/splat_renderer.h"
 
 namespace lf {
 

@@ -7,8 +7,8 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/camera.h"
-#include "lf/job/splat_settings.h"
 #include "lf/job/method_registry.h"
+#include "lf/job/splat_settings.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/local/local_executor.h"
 
