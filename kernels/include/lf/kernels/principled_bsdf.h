@@ -21,6 +21,7 @@
 //
 // Below roughness sqrt(MicrofacetDistribution::kMinAlpha) the surface is smooth: reflection and
 // transmission are Dirac deltas (BsdfSample::delta); Eval and Pdf hold the diffuse base alone.
+// A clear coat that smooth is a delta mirror too (lf/kernels/clearcoat_lobe.h).
 //
 // The BTDF is tinted by the base colour at every crossing (KHR_materials_transmission), so solid
 // glass tints twice, on entry and exit, besides Beer's law inside (lf/kernels/shading.h). With
@@ -58,8 +59,12 @@ class PrincipledBsdf {
     Rgb Eval(const Vec3& wo, const Vec3& wi) const;
     float Pdf(const Vec3& wo, const Vec3& wi) const;
     std::optional<BsdfSample> Sample(const Vec3& wo, float uc, const Vec2& u) const;
-    // Every lobe is a Dirac delta: a smooth surface without a diffuse base.
-    bool IsDelta() const { return smooth_ && diffuse_scale_ == 0 && !layered(); }
+    // Every lobe is a Dirac delta: a smooth surface without a diffuse base, under no sheen and
+    // no coat or a smooth one.
+    bool IsDelta() const {
+        return smooth_ && diffuse_scale_ == 0 && !sheen_.active() &&
+               (!coat_.active() || coat_.smooth());
+    }
     // Bsdf::RefractionEta: RelativeEta(wo) for a pair across a solid's interface, else 1.
     float RefractionEta(const Vec3& wo, const Vec3& wi) const {
         return refracts_ && wo.z * wi.z < 0 ? RelativeEta(wo) : 1.0f;
