@@ -163,11 +163,17 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_specular")) {
         const std::string at = where + ".KHR_materials_specular";
         m.specular = float(Number(*e, "specularFactor", 1, 0, 1, at));
+        m.specular_texture = TextureInfo(*e, "specularTexture", false, at);
+        // Unbounded above: min(F0 colour, 1) applies per channel when rendering.
         const std::vector<double> tint = Numbers(*e, "specularColorFactor", {1, 1, 1}, at);
-        if (tint != std::vector<double>{1, 1, 1} || e->Has("specularTexture") ||
-            e->Has("specularColorTexture")) {
-            Warn(at + ": specular colour and textures ignored; only specularFactor is used");
+        for (size_t c = 0; c < 3; ++c) {
+            if (!(tint[c] >= 0 && tint[c] <= 1e10)) {
+                Fail(at, absl::StrCat("specularColorFactor[", c, "] ", tint[c],
+                                      " is outside [0, 1e10]"));
+            }
         }
+        m.specular_color = Rgb(float(tint[0]), float(tint[1]), float(tint[2]));
+        m.specular_color_texture = TextureInfo(*e, "specularColorTexture", true, at);
     }
     m.double_sided = g.doubleSided;
     if (Extension(g.extensions, "KHR_materials_unlit")) MakeUnlit(m);
@@ -186,11 +192,13 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
 
 void GltfImporter::MakeUnlit(lf::Material& m) {
     // KHR_materials_unlit: the base colour is the radiance the surface shows, and nothing is
-    // reflected. The base colour texture stays for its alpha (cut-outs, blending).
+    // reflected; vertex colours multiply it as they did the base colour. The base colour
+    // texture stays for its alpha (cut-outs, blending).
     m.type = lf::Material::Type::kLambert;
     m.emission = m.reflectance;
     m.emission_texture = m.base_color_texture;
     m.two_sided_emission = m.double_sided;
+    m.emission_by_vertex_color = true;
     m.reflectance = Rgb(0.0f);
 }
 

@@ -31,9 +31,12 @@ float Clamp01(float x) { return x > 0 ? std::min(x, 1.0f) : 0.0f; }  // NaN -> 0
 // are isotropic, so both agree for them.
 Vec3 Upright(const Vec3& w) { return w.z < 0 ? -w : w; }
 
-float SchlickScalar(float f0, float cos) {
-    const float m = std::clamp(1 - cos, 0.0f, 1.0f);
-    return f0 + (1 - f0) * ((m * m) * (m * m) * m);
+// KHR_materials_specular: ((ior - 1) / (ior + 1))^2 times the specular colour, at most 1.
+Rgb DielectricF0(float ior, const Rgb& color) {
+    const float f0 = ((ior - 1) / (ior + 1)) * ((ior - 1) / (ior + 1));
+    Rgb c;
+    for (int i = 0; i < 3; ++i) c[i] = color[i] > 0 ? std::min(f0 * color[i], 1.0f) : 0.0f;
+    return c;
 }
 
 }  // namespace
@@ -42,10 +45,11 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
     : base_(Clamp01(params.base_color.r), Clamp01(params.base_color.g),
             Clamp01(params.base_color.b)),
       metallic_(Clamp01(params.metallic)),
-      specular_(Clamp01(material.specular)),
+      specular_(Clamp01(params.specular)),
       transmission_(Clamp01(params.transmission)),
       ior_(material.ior),
-      f0_(((material.ior - 1) / (material.ior + 1)) * ((material.ior - 1) / (material.ior + 1))),
+      f0_color_(DielectricF0(material.ior, params.specular_color)),
+      f0_(f0_color_.MaxComponent()),
       refracts_(material.transmission > 0 && material.thickness > 0 &&
                 std::abs(material.ior - 1) > kMinIorContrast),
       distribution_(Material::Distribution::kGgx,
@@ -60,13 +64,13 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
       coat_(params.clearcoat, params.clearcoat_roughness, params.coat_normal),
       sheen_(params.sheen_color, params.sheen_roughness) {}
 
-float PrincipledBsdf::LayerFresnel(float cos_om, bool outside) const {
-    if (outside) return specular_ * SchlickScalar(f0_, cos_om);
+Rgb PrincipledBsdf::LayerFresnelColor(float cos_om, bool outside) const {
+    if (outside) return FrSchlick(f0_color_, cos_om) * specular_;
     // From inside a solid: Schlick at the cosine the refracted direction would have outside;
     // 1 under total internal reflection.
     const float sin2_t = (1 - cos_om * cos_om) * ior_ * ior_;
-    if (sin2_t >= 1) return specular_;
-    return specular_ * SchlickScalar(f0_, std::sqrt(1 - sin2_t));
+    if (sin2_t >= 1) return Rgb(specular_);
+    return FrSchlick(f0_color_, std::sqrt(1 - sin2_t)) * specular_;
 }
 
 PrincipledBsdf::LobePick PrincipledBsdf::Pick(const Vec3& wo) const {
@@ -109,7 +113,7 @@ PrincipledBsdf::LobePick PrincipledBsdf::Pick(const Vec3& wo) const {
 
 Rgb PrincipledBsdf::ReflectionFresnel(float cos_om, bool outside) const {
     return FrSchlick(base_, cos_om) * metallic_ +
-           Rgb((1 - metallic_) * LayerFresnel(cos_om, outside));
+           LayerFresnelColor(cos_om, outside) * (1 - metallic_);
 }
 
 Rgb PrincipledBsdf::ReflectionEval(const Vec3& wo, const Vec3& wi, bool outside) const {

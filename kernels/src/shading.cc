@@ -241,10 +241,17 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
         s.params.roughness *= mr.g;
         s.params.metallic *= mr.b;
     }
+    if (m.specular_texture.valid()) {
+        s.params.specular *= Sample(scene, m.specular_texture, s.uv).a;
+    }
+    if (m.specular_color_texture.valid()) {
+        s.params.specular_color *= Sample(scene, m.specular_color_texture, s.uv).rgb;
+    }
     if (m.transmission_texture.valid()) {
         s.params.transmission *= Sample(scene, m.transmission_texture, s.uv).rgb.r;
     }
     s.emission = m.emission;
+    if (m.emission_by_vertex_color) s.emission *= vertex_color;
     if (m.IsEmissive() && m.emission_texture.valid()) {
         s.emission *= Sample(scene, m.emission_texture, s.uv).rgb;
     }
@@ -256,15 +263,16 @@ Rgb EmissionAt(const EmbreeScene& es, const SurfacePoint& light_point, const Rgb
     const Scene& scene = es.scene();
     const TriangleMesh& mesh = scene.meshes[size_t(light_point.mesh)];
     const Material& m = scene.materials[size_t(mesh.material)];
-    if (!m.emission_texture.valid() && m.alpha_mode == Material::AlphaMode::kOpaque) {
+    if (!m.emission_texture.valid() && m.alpha_mode == Material::AlphaMode::kOpaque &&
+        !m.emission_by_vertex_color) {
         return radiance;
     }
     const Vec2 uv = TriangleUv(mesh, light_point.primitive, light_point.b1, light_point.b2);
-    const float vertex_alpha =
-        VertexColor(mesh, light_point.primitive, light_point.b1, light_point.b2).a;
-    if (IsCutOut(scene, m, uv, vertex_alpha)) return Rgb(0);
+    const Rgba vertex = VertexColor(mesh, light_point.primitive, light_point.b1, light_point.b2);
+    if (IsCutOut(scene, m, uv, vertex.a)) return Rgb(0);
     Rgb le = radiance;
-    if (m.alpha_mode == Material::AlphaMode::kBlend) le *= Opacity(scene, m, uv, vertex_alpha);
+    if (m.emission_by_vertex_color) le *= vertex.rgb;
+    if (m.alpha_mode == Material::AlphaMode::kBlend) le *= Opacity(scene, m, uv, vertex.a);
     if (m.emission_texture.valid()) le *= Sample(scene, m.emission_texture, uv).rgb;
     return le;
 }

@@ -166,6 +166,37 @@ TEST(VertexColours, MultiplyTheBaseColourAtTheHitsBarycentrics) {
     }
 }
 
+// An unlit surface (KHR_materials_unlit) emits its base colour, which COLOR_0 multiplies: seen
+// by a camera ray (Shade) and by a light sample (EmissionAt) alike.
+TEST(VertexColours, MultiplyAnUnlitSurfacesEmission) {
+    Scene scene;
+    Material m;
+    m.reflectance = Rgb(0.0f);
+    m.emission = Rgb(0.8f);
+    m.emission_by_vertex_color = true;
+    scene.materials.push_back(m);
+    scene.meshes.push_back(UvQuad(1, 0, 0));
+    // Red on the left edge, blue on the right.
+    scene.meshes[0].colors = {{1, 0, 0, 1}, {1, 0, 0, 1}, {0, 0, 1, 1}, {0, 0, 1, 1}};
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    const Vec3 down(0, 0, -1);
+    for (float x : {-0.5f, 0.5f}) {
+        const std::optional<SurfaceHit> hit = (*es)->Intersect(Ray{Vec3(x, 0.2f, 1), down});
+        ASSERT_TRUE(hit);
+        const float right = (x + 1) / 2;  // the blue share
+        const Rgb expected(0.8f * (1 - right), 0, 0.8f * right);
+        const Rgb seen = Shade(**es, *hit, -down).emission;
+        SurfacePoint light{hit->p,         hit->p_error, hit->n, hit->mesh,
+                           hit->primitive, hit->b1,      hit->b2};
+        const Rgb sampled = EmissionAt(**es, light, m.emission);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(seen[c], expected[c], 1e-5f) << x << " ch " << c;
+            EXPECT_NEAR(sampled[c], expected[c], 1e-5f) << x << " ch " << c;
+        }
+    }
+}
+
 // COLOR_0's alpha multiplies the opacity an alpha mask cuts at.
 TEST(VertexColours, AlphaMultipliesTheOpacity) {
     Scene scene;

@@ -22,6 +22,8 @@ struct SurfaceParams {
     Rgb base_color;  // lambert albedo, principled base colour
     float metallic = 0;
     float roughness = 0;  // principled: perceptual roughness r
+    float specular = 1;   // principled: the specular layer's weight and F0 tint
+    Rgb specular_color{1.0f};
     float clearcoat = 0, clearcoat_roughness = 0;
     // The coat's own normal (clearcoatNormalTexture) in the shading frame of lf/core/vec.h's
     // Frame::FromNormal(ns), which every estimator builds; +z is the shading normal itself.
@@ -35,6 +37,8 @@ struct SurfaceParams {
         p.base_color = m.reflectance;
         p.metallic = m.metallic;
         p.roughness = m.roughness;
+        p.specular = m.specular;
+        p.specular_color = m.specular_color;
         p.clearcoat = m.clearcoat;
         p.clearcoat_roughness = m.clearcoat_roughness;
         p.sheen_color = m.sheen_color;

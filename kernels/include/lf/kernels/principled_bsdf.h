@@ -1,7 +1,8 @@
 // The principled material: glTF 2.0's metallic-roughness BRDF (its Appendix B) with
-// KHR_materials_specular's weight, KHR_materials_ior and KHR_materials_transmission/_volume,
-// under KHR_materials_sheen and KHR_materials_clearcoat layers (see LayerPick below),
-// in the local shading frame of lf/kernels/bsdf.h (+z the front face's normal, the outside).
+// KHR_materials_specular's weight and colour, KHR_materials_ior and
+// KHR_materials_transmission/_volume, under KHR_materials_sheen and KHR_materials_clearcoat layers
+// (see LayerPick below), in the local shading frame of lf/kernels/bsdf.h (+z the front face's
+// normal, the outside).
 //
 //   f = metallic * conductor + (1 - metallic) * dielectric
 //   conductor  = F_schlick(base, wo.wm) D G / (4 cos_o cos_i), GGX with alpha = r^2
@@ -97,8 +98,14 @@ class PrincipledBsdf {
     bool Outside(const Vec3& wo) const { return !refracts_ || wo.z > 0; }
     // The base's weight k(mu) on one side (see the top).
     float BaseKeep(float mu) const;
-    // The specular layer's Fresnel term s F for a microfacet seen at cos_om from one side.
-    float LayerFresnel(float cos_om, bool outside) const;
+    // The specular layer's Fresnel term s F for a microfacet seen at cos_om from one side, per
+    // channel (F0 tinted by the specular colour), and its largest channel, which weights what
+    // lies beneath (KHR_materials_specular's max_value(F); Schlick is monotone in F0, so it is
+    // the Fresnel term of the largest F0).
+    Rgb LayerFresnelColor(float cos_om, bool outside) const;
+    float LayerFresnel(float cos_om, bool outside) const {
+        return LayerFresnelColor(cos_om, outside).MaxComponent();
+    }
     // IOR on the far side of the interface over the IOR on wo's side.
     float RelativeEta(const Vec3& wo) const { return wo.z > 0 ? ior_ : 1 / ior_; }
 
@@ -118,7 +125,9 @@ class PrincipledBsdf {
     std::optional<BsdfSample> SampleSmooth(const Vec3& wo, float uc, const LobePick& pick) const;
 
     Rgb base_;
-    float metallic_, specular_, transmission_, ior_, f0_;
+    float metallic_, specular_, transmission_, ior_;
+    Rgb f0_color_;   // min(F0(ior) specular colour, 1)
+    float f0_;       // its largest channel
     bool refracts_;  // a solid's interface (thickness > 0) with transmission
     MicrofacetDistribution distribution_;
     const GgxAlbedo* albedo_;
