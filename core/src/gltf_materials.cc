@@ -146,9 +146,12 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         const std::string at = where + ".KHR_materials_clearcoat";
         m.clearcoat = float(Number(*e, "clearcoatFactor", 0, 0, 1, at));
         m.clearcoat_roughness = float(Number(*e, "clearcoatRoughnessFactor", 0, 0, 1, at));
-        if (e->Has("clearcoatTexture") || e->Has("clearcoatRoughnessTexture") ||
-            e->Has("clearcoatNormalTexture")) {
-            Warn(at + ": clearcoat textures ignored; the factors apply everywhere");
+        m.clearcoat_texture = TextureInfo(*e, "clearcoatTexture", false, at);
+        m.clearcoat_roughness_texture = TextureInfo(*e, "clearcoatRoughnessTexture", false, at);
+        m.clearcoat_normal_texture = TextureInfo(*e, "clearcoatNormalTexture", false, at);
+        if (e->Has("clearcoatNormalTexture")) {
+            m.clearcoat_normal_scale = float(Number(e->Get("clearcoatNormalTexture"), "scale", 1,
+                                                    -1e6, 1e6, at + ".clearcoatNormalTexture"));
         }
     }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_sheen")) {
@@ -156,9 +159,8 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         m.sheen_color =
             Color(Numbers(*e, "sheenColorFactor", {0, 0, 0}, at), at, "sheenColorFactor");
         m.sheen_roughness = float(Number(*e, "sheenRoughnessFactor", 0, 0, 1, at));
-        if (e->Has("sheenColorTexture") || e->Has("sheenRoughnessTexture")) {
-            Warn(at + ": sheen textures ignored; the factors apply everywhere");
-        }
+        m.sheen_color_texture = TextureInfo(*e, "sheenColorTexture", true, at);
+        m.sheen_roughness_texture = TextureInfo(*e, "sheenRoughnessTexture", false, at);
     }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_specular")) {
         const std::string at = where + ".KHR_materials_specular";

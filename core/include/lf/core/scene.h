@@ -100,6 +100,13 @@ struct Material {
     TextureRef transmission_texture;    // its R channel multiplies `transmission` (linear)
     TextureRef specular_texture;        // its A channel multiplies `specular` (linear)
     TextureRef specular_color_texture;  // its RGB multiplies `specular_color` (sRGB)
+    // KHR_materials_clearcoat's and _sheen's textures (linear but the sheen colour): R times
+    // `clearcoat`, G times `clearcoat_roughness`, RGB times `sheen_color`, A times
+    // `sheen_roughness`; the coat's own normal map (without one the coat follows the
+    // interpolated normal, not `normal_texture`, as the extension says).
+    TextureRef clearcoat_texture, clearcoat_roughness_texture, clearcoat_normal_texture;
+    float clearcoat_normal_scale = 1;
+    TextureRef sheen_color_texture, sheen_roughness_texture;
     float normal_scale = 1;  // scales the normal map's x and y (glTF normalTexture.scale)
     float opacity = 1;       // base colour alpha factor; with the texture's alpha, for kMask
     // kBlend (glTF BLEND): stochastic transparency, rays pass through with probability
@@ -120,7 +127,10 @@ struct Material {
     bool IsTextured() const {
         return base_color_texture.valid() || metallic_roughness_texture.valid() ||
                normal_texture.valid() || emission_texture.valid() || transmission_texture.valid() ||
-               specular_texture.valid() || specular_color_texture.valid();
+               specular_texture.valid() || specular_color_texture.valid() ||
+               clearcoat_texture.valid() || clearcoat_roughness_texture.valid() ||
+               clearcoat_normal_texture.valid() || sheen_color_texture.valid() ||
+               sheen_roughness_texture.valid();
     }
 };
 
