@@ -146,9 +146,12 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         const std::string at = where + ".KHR_materials_clearcoat";
         m.clearcoat = float(Number(*e, "clearcoatFactor", 0, 0, 1, at));
         m.clearcoat_roughness = float(Number(*e, "clearcoatRoughnessFactor", 0, 0, 1, at));
-        if (e->Has("clearcoatTexture") || e->Has("clearcoatRoughnessTexture") ||
-            e->Has("clearcoatNormalTexture")) {
-            Warn(at + ": clearcoat textures ignored; the factors apply everywhere");
+        m.clearcoat_texture = TextureInfo(*e, "clearcoatTexture", false, at);
+        m.clearcoat_roughness_texture = TextureInfo(*e, "clearcoatRoughnessTexture", false, at);
+        m.clearcoat_normal_texture = TextureInfo(*e, "clearcoatNormalTexture", false, at);
+        if (e->Has("clearcoatNormalTexture")) {
+            m.clearcoat_normal_scale = float(Number(e->Get("clearcoatNormalTexture"), "scale", 1,
+                                                    -1e6, 1e6, at + ".clearcoatNormalTexture"));
         }
     }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_sheen")) {
@@ -156,18 +159,23 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         m.sheen_color =
             Color(Numbers(*e, "sheenColorFactor", {0, 0, 0}, at), at, "sheenColorFactor");
         m.sheen_roughness = float(Number(*e, "sheenRoughnessFactor", 0, 0, 1, at));
-        if (e->Has("sheenColorTexture") || e->Has("sheenRoughnessTexture")) {
-            Warn(at + ": sheen textures ignored; the factors apply everywhere");
-        }
+        m.sheen_color_texture = TextureInfo(*e, "sheenColorTexture", true, at);
+        m.sheen_roughness_texture = TextureInfo(*e, "sheenRoughnessTexture", false, at);
     }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_specular")) {
         const std::string at = where + ".KHR_materials_specular";
         m.specular = float(Number(*e, "specularFactor", 1, 0, 1, at));
+        m.specular_texture = TextureInfo(*e, "specularTexture", false, at);
+        // Unbounded above: min(F0 colour, 1) applies per channel when rendering.
         const std::vector<double> tint = Numbers(*e, "specularColorFactor", {1, 1, 1}, at);
-        if (tint != std::vector<double>{1, 1, 1} || e->Has("specularTexture") ||
-            e->Has("specularColorTexture")) {
-            Warn(at + ": specular colour and textures ignored; only specularFactor is used");
+        for (size_t c = 0; c < 3; ++c) {
+            if (!(tint[c] >= 0 && tint[c] <= 1e10)) {
+                Fail(at, absl::StrCat("specularColorFactor[", c, "] ", tint[c],
+                                      " is outside [0, 1e10]"));
+            }
         }
+        m.specular_color = Rgb(float(tint[0]), float(tint[1]), float(tint[2]));
+        m.specular_color_texture = TextureInfo(*e, "specularColorTexture", true, at);
     }
     m.double_sided = g.doubleSided;
     if (Extension(g.extensions, "KHR_materials_unlit")) MakeUnlit(m);
@@ -186,11 +194,13 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
 
 void GltfImporter::MakeUnlit(lf::Material& m) {
     // KHR_materials_unlit: the base colour is the radiance the surface shows, and nothing is
-    // reflected. The base colour texture stays for its alpha (cut-outs, blending).
+    // reflected; vertex colours multiply it as they did the base colour. The base colour
+    // texture stays for its alpha (cut-outs, blending).
     m.type = lf::Material::Type::kLambert;
     m.emission = m.reflectance;
     m.emission_texture = m.base_color_texture;
     m.two_sided_emission = m.double_sided;
+    m.emission_by_vertex_color = true;
     m.reflectance = Rgb(0.0f);
 }
 

@@ -126,6 +126,7 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
                        "roughness",
                        "metallic_roughness_texture",
                        "specular",
+                       "specular_color",
                        "ior",
                        "transmission",
                        "thickness",
@@ -157,6 +158,9 @@ void SceneParser::ParsePrincipled(const Node& n, Material& m) {
     m.metallic = fraction("metallic", 0);
     m.roughness = fraction("roughness", 0.5f);
     m.specular = fraction("specular", 1);
+    if (const std::optional<Node> color = n.Find("specular_color")) {
+        m.specular_color = color->Color(kMaxFloat);
+    }
     m.transmission = fraction("transmission", 0);
     m.clearcoat = fraction("clearcoat", 0);
     m.clearcoat_roughness = fraction("clearcoat_roughness", 0);

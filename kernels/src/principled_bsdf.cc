@@ -26,9 +26,17 @@ constexpr float kMinIorContrast = 1e-3f;
 
 float Clamp01(float x) { return x > 0 ? std::min(x, 1.0f) : 0.0f; }  // NaN -> 0
 
-float SchlickScalar(float f0, float cos) {
-    const float m = std::clamp(1 - cos, 0.0f, 1.0f);
-    return f0 + (1 - f0) * ((m * m) * (m * m) * m);
+// The layers' frame for a back-side direction: the whole configuration turned over (w -> -w)
+// rather than mirrored (ToUpper), which keeps a tilted coat normal's azimuth; the base's lobes
+// are isotropic, so both agree for them.
+Vec3 Upright(const Vec3& w) { return w.z < 0 ? -w : w; }
+
+// KHR_materials_specular: ((ior - 1) / (ior + 1))^2 times the specular colour, at most 1.
+Rgb DielectricF0(float ior, const Rgb& color) {
+    const float f0 = ((ior - 1) / (ior + 1)) * ((ior - 1) / (ior + 1));
+    Rgb c;
+    for (int i = 0; i < 3; ++i) c[i] = color[i] > 0 ? std::min(f0 * color[i], 1.0f) : 0.0f;
+    return c;
 }
 
 }  // namespace
@@ -37,10 +45,11 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
     : base_(Clamp01(params.base_color.r), Clamp01(params.base_color.g),
             Clamp01(params.base_color.b)),
       metallic_(Clamp01(params.metallic)),
-      specular_(Clamp01(material.specular)),
+      specular_(Clamp01(params.specular)),
       transmission_(Clamp01(params.transmission)),
       ior_(material.ior),
-      f0_(((material.ior - 1) / (material.ior + 1)) * ((material.ior - 1) / (material.ior + 1))),
+      f0_color_(DielectricF0(material.ior, params.specular_color)),
+      f0_(f0_color_.MaxComponent()),
       refracts_(material.transmission > 0 && material.thickness > 0 &&
                 std::abs(material.ior - 1) > kMinIorContrast),
       distribution_(Material::Distribution::kGgx,
@@ -52,16 +61,16 @@ PrincipledBsdf::PrincipledBsdf(const Material& material, const SurfaceParams& pa
       smooth_(Clamp01(params.roughness) * Clamp01(params.roughness) <
               MicrofacetDistribution::kMinAlpha),
       diffuse_scale_((1 - metallic_) * (1 - transmission_) * kInvPi),
-      coat_(params.clearcoat, params.clearcoat_roughness),
+      coat_(params.clearcoat, params.clearcoat_roughness, params.coat_normal),
       sheen_(params.sheen_color, params.sheen_roughness) {}
 
-float PrincipledBsdf::LayerFresnel(float cos_om, bool outside) const {
-    if (outside) return specular_ * SchlickScalar(f0_, cos_om);
+Rgb PrincipledBsdf::LayerFresnelColor(float cos_om, bool outside) const {
+    if (outside) return FrSchlick(f0_color_, cos_om) * specular_;
     // From inside a solid: Schlick at the cosine the refracted direction would have outside;
     // 1 under total internal reflection.
     const float sin2_t = (1 - cos_om * cos_om) * ior_ * ior_;
-    if (sin2_t >= 1) return specular_;
-    return specular_ * SchlickScalar(f0_, std::sqrt(1 - sin2_t));
+    if (sin2_t >= 1) return Rgb(specular_);
+    return FrSchlick(f0_color_, std::sqrt(1 - sin2_t)) * specular_;
 }
 
 PrincipledBsdf::LobePick PrincipledBsdf::Pick(const Vec3& wo) const {
@@ -104,7 +113,7 @@ PrincipledBsdf::LobePick PrincipledBsdf::Pick(const Vec3& wo) const {
 
 Rgb PrincipledBsdf::ReflectionFresnel(float cos_om, bool outside) const {
     return FrSchlick(base_, cos_om) * metallic_ +
-           Rgb((1 - metallic_) * LayerFresnel(cos_om, outside));
+           LayerFresnelColor(cos_om, outside) * (1 - metallic_);
 }
 
 Rgb PrincipledBsdf::ReflectionEval(const Vec3& wo, const Vec3& wi, bool outside) const {
@@ -187,7 +196,7 @@ float PrincipledBsdf::RefractionPdf(const Vec3& wo, const Vec3& wi) const {
 PrincipledBsdf::LayerPick PrincipledBsdf::PickLayers(const Vec3& wo) const {
     if (!layered() || !Outside(wo)) return {};
     // Each layer in proportion to what it reflects, within bounds that keep every lobe sampled.
-    const Vec3 wo_up = ToUpper(wo);
+    const Vec3 wo_up = Upright(wo);
     LayerPick p;
     if (coat_.active()) p.coat = std::clamp(coat_.Albedo(wo_up), kPickFloor, 0.5f);
     if (sheen_.active())
@@ -206,7 +215,7 @@ float PrincipledBsdf::LayerKeep(const Vec3& wo, const Vec3& wi) const {
 Rgb PrincipledBsdf::Eval(const Vec3& wo, const Vec3& wi) const {
     const Rgb f = BaseEval(wo, wi);
     if (!layered() || std::abs(wo.z) < kMinCos || std::abs(wi.z) < kMinCos) return f;
-    const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+    const Vec3 wo_up = Upright(wo), wi_up = Upright(wi);
     if (SameHemisphere(wo, wi)) {
         if (!Outside(wo)) return f;
         Rgb below = f;
@@ -226,7 +235,7 @@ float PrincipledBsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
     if (pick.rest == 1 || std::abs(wi.z) < kMinCos) return base;
     float pdf = pick.rest * base;
     if (SameHemisphere(wo, wi)) {
-        const Vec3 wo_up = ToUpper(wo), wi_up = ToUpper(wi);
+        const Vec3 wo_up = Upright(wo), wi_up = Upright(wi);
         if (pick.coat > 0) pdf += pick.coat * coat_.Pdf(wo_up, wi_up);
         if (pick.sheen > 0) pdf += pick.sheen * SheenLobe::Pdf(wi_up);
     }
@@ -275,9 +284,9 @@ std::optional<BsdfSample> PrincipledBsdf::Sample(const Vec3& wo, float uc, const
             if (s && layered()) {
                 s->pdf *= layers.rest;
                 if (SameHemisphere(wo, s->wi)) {
-                    if (Outside(wo)) s->f *= LayerKeep(ToUpper(wo), ToUpper(s->wi));
+                    if (Outside(wo)) s->f *= LayerKeep(Upright(wo), Upright(s->wi));
                 } else if (!refracts_) {
-                    s->f *= LayerKeep(ToUpper(wo), ToUpper(s->wi));
+                    s->f *= LayerKeep(Upright(wo), Upright(s->wi));
                 } else {
                     const Vec3 outside = wo.z > 0 ? wo : s->wi;
                     s->f *= LayerKeep(outside, outside);
@@ -286,15 +295,24 @@ std::optional<BsdfSample> PrincipledBsdf::Sample(const Vec3& wo, float uc, const
             return s;
         }
     }
+    if (uc < layers.coat + layers.sheen) {
+        const Vec3 wo_r = Upright(wo);
+        const Vec3 wi_r = uc < layers.coat ? coat_.Sample(wo_r, u) : SheenLobe::Sample(u);
+        if (wi_r.z < kMinCos) return std::nullopt;
+        const Vec3 wi = wo.z > 0 ? wi_r : -wi_r;
+        if (uc < layers.coat && coat_.smooth()) {
+            return BsdfSample{Rgb(coat_.MirrorReflectance(wo_r) / wi_r.z), wi, layers.coat, true};
+        }
+        const float pdf = Pdf(wo, wi);
+        if (!(pdf > 0)) return std::nullopt;
+        return BsdfSample{Eval(wo, wi), wi, pdf, false, 1};
+    }
     const Vec3 wo_up = ToUpper(wo);
     const float side = wo.z > 0 ? 1.0f : -1.0f;
     Vec3 wi_up;  // in the frame mirrored so that wo_up.z > 0
     float eta = 1;
-    if (uc < layers.coat + layers.sheen) {
-        wi_up = uc < layers.coat ? coat_.Sample(wo_up, u) : SheenLobe::Sample(u);
-        if (wi_up.z < kMinCos) return std::nullopt;
-    } else if (uc = std::min((uc - layers.coat - layers.sheen) / layers.rest, 0x1.fffffep-1f);
-               uc < pick.reflect + pick.diffuse) {
+    uc = std::min((uc - layers.coat - layers.sheen) / layers.rest, 0x1.fffffep-1f);
+    if (uc < pick.reflect + pick.diffuse) {
         if (uc < pick.reflect) {
             const Vec3 wm = distribution_.SampleWm(wo_up, u);
             wi_up = wm * (2 * Dot(wo_up, wm)) - wo_up;

@@ -36,8 +36,8 @@ bool TangentAt(const TriangleMesh& mesh, const SurfaceHit& hit, Vec3* tangent, f
 
 // The normal map's normal at the hit, or `n` where the map cannot apply (no uvs or tangent,
 // or a texel that points below the geometric surface).
-Vec3 NormalMapped(const EmbreeScene& es, const Material& m, const SurfaceHit& hit, const Vec2& uv,
-                  const Vec3& n) {
+Vec3 NormalMapped(const EmbreeScene& es, const TextureRef& map, float scale, const SurfaceHit& hit,
+                  const Vec2& uv, const Vec3& n) {
     if (hit.mesh < 0) return n;
     const TriangleMesh& mesh = es.scene().meshes[size_t(hit.mesh)];
     if (mesh.uvs.empty()) return n;
@@ -49,8 +49,8 @@ Vec3 NormalMapped(const EmbreeScene& es, const Material& m, const SurfaceHit& hi
     t = Normalize(t);
     const Vec3 b = Cross(n, t) * sign;
     // Texels hold (n + 1) / 2 as linear data; the scale applies to x and y (glTF).
-    const Rgb c = Sample(es.scene(), m.normal_texture, uv).rgb;
-    const float x = (2 * c.r - 1) * m.normal_scale, y = (2 * c.g - 1) * m.normal_scale;
+    const Rgb c = Sample(es.scene(), map, uv).rgb;
+    const float x = (2 * c.r - 1) * scale, y = (2 * c.g - 1) * scale;
     const float z = 2 * c.b - 1;
     const Vec3 mapped = t * x + b * y + n * z;
     if (!(LengthSquared(mapped) > 0) || !(Dot(mapped, hit.n) > 0)) return n;
@@ -199,6 +199,32 @@ Rgb Transmittance(const Material& material, float distance) {
     return t;
 }
 
+namespace {
+
+// The clear coat's factor and roughness times their textures, and its own normal: its normal
+// map's, or the interpolated normal where the base's is mapped, in s.ns's shading frame.
+void ShadeCoat(const EmbreeScene& es, const Material& m, const SurfaceHit& hit, const Vec3& wo,
+               const Vec3& interpolated, Shading& s) {
+    const Scene& scene = es.scene();
+    if (m.clearcoat_texture.valid()) {
+        s.params.clearcoat *= Sample(scene, m.clearcoat_texture, s.uv).rgb.r;
+    }
+    if (m.clearcoat_roughness_texture.valid()) {
+        s.params.clearcoat_roughness *= Sample(scene, m.clearcoat_roughness_texture, s.uv).rgb.g;
+    }
+    if (!m.clearcoat_normal_texture.valid() && !m.normal_texture.valid()) return;
+    Vec3 coat = interpolated;
+    if (m.clearcoat_normal_texture.valid()) {
+        coat = NormalMapped(es, m.clearcoat_normal_texture, m.clearcoat_normal_scale, hit, s.uv,
+                            interpolated);
+    }
+    coat = ValidReflectionNormal(coat, hit.n, wo);
+    const Vec3 local = Frame::FromNormal(s.ns).ToLocal(coat);
+    if (local.z > 0) s.params.coat_normal = local;
+}
+
+}  // namespace
+
 Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
     const Scene& scene = es.scene();
     const Material& m = scene.materials[size_t(hit.material)];
@@ -226,7 +252,10 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
             s.p_outer = hit.p + lift;
         }
     }
-    if (m.normal_texture.valid()) s.ns = NormalMapped(es, m, hit, s.uv, s.ns);
+    const Vec3 interpolated = s.ns;
+    if (m.normal_texture.valid()) {
+        s.ns = NormalMapped(es, m.normal_texture, m.normal_scale, hit, s.uv, s.ns);
+    }
     s.ns = ValidReflectionNormal(s.ns, hit.n, wo);
 
     s.params = SurfaceParams::Of(m);
@@ -241,10 +270,24 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
         s.params.roughness *= mr.g;
         s.params.metallic *= mr.b;
     }
+    if (m.specular_texture.valid()) {
+        s.params.specular *= Sample(scene, m.specular_texture, s.uv).a;
+    }
+    if (m.specular_color_texture.valid()) {
+        s.params.specular_color *= Sample(scene, m.specular_color_texture, s.uv).rgb;
+    }
+    if (m.clearcoat > 0) ShadeCoat(es, m, hit, wo, interpolated, s);
+    if (m.sheen_color_texture.valid()) {
+        s.params.sheen_color *= Sample(scene, m.sheen_color_texture, s.uv).rgb;
+    }
+    if (m.sheen_roughness_texture.valid()) {
+        s.params.sheen_roughness *= Sample(scene, m.sheen_roughness_texture, s.uv).a;
+    }
     if (m.transmission_texture.valid()) {
         s.params.transmission *= Sample(scene, m.transmission_texture, s.uv).rgb.r;
     }
     s.emission = m.emission;
+    if (m.emission_by_vertex_color) s.emission *= vertex_color;
     if (m.IsEmissive() && m.emission_texture.valid()) {
         s.emission *= Sample(scene, m.emission_texture, s.uv).rgb;
     }
@@ -256,15 +299,16 @@ Rgb EmissionAt(const EmbreeScene& es, const SurfacePoint& light_point, const Rgb
     const Scene& scene = es.scene();
     const TriangleMesh& mesh = scene.meshes[size_t(light_point.mesh)];
     const Material& m = scene.materials[size_t(mesh.material)];
-    if (!m.emission_texture.valid() && m.alpha_mode == Material::AlphaMode::kOpaque) {
+    if (!m.emission_texture.valid() && m.alpha_mode == Material::AlphaMode::kOpaque &&
+        !m.emission_by_vertex_color) {
         return radiance;
     }
     const Vec2 uv = TriangleUv(mesh, light_point.primitive, light_point.b1, light_point.b2);
-    const float vertex_alpha =
-        VertexColor(mesh, light_point.primitive, light_point.b1, light_point.b2).a;
-    if (IsCutOut(scene, m, uv, vertex_alpha)) return Rgb(0);
+    const Rgba vertex = VertexColor(mesh, light_point.primitive, light_point.b1, light_point.b2);
+    if (IsCutOut(scene, m, uv, vertex.a)) return Rgb(0);
     Rgb le = radiance;
-    if (m.alpha_mode == Material::AlphaMode::kBlend) le *= Opacity(scene, m, uv, vertex_alpha);
+    if (m.emission_by_vertex_color) le *= vertex.rgb;
+    if (m.alpha_mode == Material::AlphaMode::kBlend) le *= Opacity(scene, m, uv, vertex.a);
     if (m.emission_texture.valid()) le *= Sample(scene, m.emission_texture, uv).rgb;
     return le;
 }

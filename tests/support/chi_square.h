@@ -122,12 +122,15 @@ inline void ExpectCountsMatch(const std::vector<double>& observed,
     EXPECT_GT(p_value, level) << name;
 }
 
-// Chi-square goodness of fit of bsdf.Sample(wo, ...) against bsdf.Pdf(wo, .) over the sphere,
-// for a BSDF without delta lobes; `name` seeds the sampler and labels the printed line, and
-// `num_tests` (the size of the family of such tests) sets the Sidak-corrected level.
+// Chi-square goodness of fit of bsdf.Sample(wo, ...) against bsdf.Pdf(wo, .) over the sphere;
+// `name` seeds the sampler and labels the printed line, and `num_tests` (the size of the family
+// of such tests) sets the Sidak-corrected level. A BSDF with delta lobes beside rough ones
+// (`with_delta`): Pdf leaves out the delta lobes' pick probabilities, so their samples count as
+// mass Pdf does not cover, as failed samples do; without it a delta sample fails the test.
 inline void ExpectSamplingMatchesPdf(const Bsdf& bsdf, const Vec3& wo, const std::string& name,
-                                     int num_tests) {
-    // Observed: histogram of sampled directions; the extra last cell counts failed samples.
+                                     int num_tests, bool with_delta = false) {
+    // Observed: histogram of sampled directions; the extra last cell counts failed samples (and
+    // delta ones, with_delta).
     constexpr int kCells = kThetaRes * kPhiRes;
     std::vector<double> observed(kCells + 1, 0.0);
     const uint64_t seed = std::hash<std::string>{}(name);
@@ -137,6 +140,10 @@ inline void ExpectSamplingMatchesPdf(const Bsdf& bsdf, const Vec3& wo, const std
         const Vec2 u = sampler.Get2D();
         const std::optional<BsdfSample> bs = bsdf.Sample(wo, uc, u);
         if (!bs) {
+            ++observed[kCells];
+            continue;
+        }
+        if (with_delta && bs->delta) {
             ++observed[kCells];
             continue;
         }
@@ -162,7 +169,7 @@ inline void ExpectSamplingMatchesPdf(const Bsdf& bsdf, const Vec3& wo, const std
             integral += p;
         }
     }
-    // Samples that Sample rejects are exactly the mass Pdf does not cover.
+    // Samples that Sample rejects (or gives a delta lobe) are exactly the mass Pdf does not cover.
     expected[kCells] = std::max(0.0, 1 - integral) * kChi2Samples;
 
     const double fail_fraction = observed[kCells] / kChi2Samples;

@@ -2,7 +2,9 @@
 """Writes firefly_room.json and uv_sphere.obj: issue 28's Blender room in small.
 
 A floor, smooth-shaded low-poly UV spheres (16 x 8 segments, per-vertex normals) of every
-material kind, a small emissive panel of radiance 8, and point, spot and directional lights.
+material kind (a clear-coated one among them, and a board of the same clear-coated paint
+tilted to show the camera the sun's glint), a small emissive panel of radiance 8, and point,
+spot and directional lights.
 Run from anywhere; the files land beside this script.
 """
 import json
@@ -10,6 +12,8 @@ import math
 import os
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+CAMERA_POSITION = [0, 1.6, 4.2]
+SUN = [-1, -2, -0.5]  # the way the directional light travels
 
 
 def uv_sphere(segments=16, rings=8):
@@ -46,6 +50,31 @@ def sphere(name, material, center, radius):
             "transform": {"scale": radius, "translate": center}}
 
 
+def normalize(v):
+    n = math.sqrt(sum(c * c for c in v))
+    return [c / n for c in v]
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def mirror_board(center, half, camera, light_direction):
+    """A square quad at `center` tilted so that the camera sees light arriving along
+    `light_direction` reflected at its centre: a glint of the sun, which a smooth lobe must not
+    show (a delta light meets a delta lobe with probability 0) but a near-delta one shows at
+    thousands of times the light's radiance."""
+    to_camera = normalize([c - p for c, p in zip(camera, center)])
+    to_light = normalize([-c for c in light_direction])
+    n = normalize([a + b for a, b in zip(to_camera, to_light)])
+    u = normalize(cross(n, [0, 1, 0]))
+    v = cross(n, u)
+    corner = lambda su, sv: [round(p + half * (su * a + sv * b), 6)
+                             for p, a, b in zip(center, u, v)]
+    # Counter-clockwise seen from the camera, so the front face looks at it.
+    return [corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)]
+
+
 def scene():
     materials = {
         "floor": {"type": "principled", "base_color": [0.6, 0.55, 0.5], "roughness": 0.5},
@@ -61,6 +90,9 @@ def scene():
         "mirror": {"type": "mirror", "reflectance": [0.9, 0.9, 0.9]},
         "dielectric": {"type": "dielectric", "ior": 1.5},
         "glossy": {"type": "glossy", "roughness": 0.3, "reflectance": [0.9, 0.6, 0.3]},
+        # Car paint: a mirror-smooth clear coat over a rough base.
+        "car_paint": {"type": "principled", "base_color": [0.7, 0.05, 0.05], "roughness": 0.5,
+                      "clearcoat": 1, "clearcoat_roughness": 0},
         "panel": {"type": "lambert", "reflectance": [0, 0, 0], "emission": [8, 8, 8]},
     }
     shapes = [
@@ -70,18 +102,20 @@ def scene():
          "vertices": [[-0.3, 2.5, -0.3], [0.3, 2.5, -0.3], [0.3, 2.5, 0.3], [-0.3, 2.5, 0.3]]},
     ]
     names = ["gold", "glass", "thin_glass", "plastic", "chrome", "lambert", "mirror",
-             "dielectric", "glossy"]
+             "dielectric", "glossy", "car_paint"]
     for k, name in enumerate(names):
         x = -2.0 + 1.0 * (k % 5)
         z = -0.6 + 1.2 * (k // 5)
         shapes.append(sphere(name, name, [x, 0.45, z], 0.45))
+    shapes.append({"type": "quad", "name": "lacquered_board", "material": "car_paint",
+                   "vertices": mirror_board([1.0, 0.6, 2.0], 0.3, CAMERA_POSITION, SUN)})
     lights = [
         {"type": "point", "position": [1.5, 2.0, 1.5], "intensity": 4},
         {"type": "spot", "position": [-1.5, 2.2, 1.8], "direction": [0.5, -1, -0.8],
          "intensity": 6, "outer_angle_deg": 40, "inner_angle_deg": 30},
-        {"type": "directional", "direction": [-1, -2, -0.5], "irradiance": 2},
+        {"type": "directional", "direction": SUN, "irradiance": 2},
     ]
-    camera = {"position": [0, 1.6, 4.2], "look_at": [0, 0.4, 0], "up": [0, 1, 0],
+    camera = {"position": CAMERA_POSITION, "look_at": [0, 0.4, 0], "up": [0, 1, 0],
               "fov_y_deg": 45, "resolution": [96, 64]}
     return {"camera": camera, "materials": materials, "shapes": shapes, "lights": lights}
 

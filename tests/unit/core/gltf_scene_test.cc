@@ -406,6 +406,30 @@ TEST_F(GltfSceneTest, AnIncludingTransformScalesTheAttenuationDistance) {
     EXPECT_FLOAT_EQ(included->materials[0].attenuation_distance, 0.02f);
 }
 
+// KHR_materials_specular: the factor, the colour (unbounded above: F0 is clamped when
+// rendering) and both textures are read, with no warning; a negative colour is refused.
+TEST_F(GltfSceneTest, SpecularColourAndTexturesAreRead) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["materials"][0]["extensions"]["KHR_materials_specular"] = {
+        {"specularFactor", 0.5},
+        {"specularColorFactor", {2, 1, 0.5}},
+        {"specularTexture", {{"index", 0}}},
+        {"specularColorTexture", {{"index", 0}}}};
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const Material& m = scene->materials[0];
+    EXPECT_EQ(m.specular, 0.5f);
+    EXPECT_EQ(m.specular_color, Rgb(2, 1, 0.5f));
+    EXPECT_EQ(m.specular_texture.image, m.base_color_texture.image);
+    EXPECT_FALSE(m.specular_texture.srgb);
+    EXPECT_EQ(m.specular_color_texture.image, m.base_color_texture.image);
+    EXPECT_TRUE(m.specular_color_texture.srgb);
+    EXPECT_EQ(CapturedLog().str().find("specular"), std::string::npos) << CapturedLog().str();
+    b.json()["materials"][0]["extensions"]["KHR_materials_specular"]["specularColorFactor"] = {
+        1, -1, 1};
+    ExpectError(Load(b), {"materials[0]", "KHR_materials_specular", "specularColorFactor[1] -1"});
+}
+
 // KHR_materials_unlit: the surface shows its base colour (factor times texture) as emitted
 // radiance, on both faces when double-sided, and reflects nothing; required, it still loads.
 TEST_F(GltfSceneTest, UnlitMaterialsEmitTheirBaseColourAndReflectNothing) {
@@ -433,6 +457,7 @@ TEST_F(GltfSceneTest, UnlitMaterialsEmitTheirBaseColourAndReflectNothing) {
     EXPECT_EQ(red.emission, Rgb(0.8f, 0.1f, 0.1f));
     EXPECT_FALSE(red.emission_texture.valid());
     EXPECT_TRUE(red.two_sided_emission);
+    EXPECT_TRUE(red.emission_by_vertex_color);  // COLOR_0 multiplies what it shows
     EXPECT_EQ(CapturedLog().str().find("unlit"), std::string::npos) << CapturedLog().str();
 }
 

@@ -115,7 +115,9 @@ std::vector<LayerCase> LayerCases() {
     Material sheen_only = Layered(none, 0.5f, 0, 0, 0, 0, 0, white, 0.4f);
     sheen_only.specular = 0;
     cases.push_back({"SheenOnly", sheen_only});
-    for (float cr : {0.03f, 0.3f, 1.0f}) {
+    // 0.04: the sharpest coat that is still a GGX lobe (alpha 1.6e-3; below sqrt(1e-3) it is a
+    // mirror, the cases after the grid).
+    for (float cr : {0.04f, 0.3f, 1.0f}) {
         for (float sr : {0.1f, 0.5f, 1.0f}) {
             const std::string tag =
                 "_cr" + std::to_string(int(cr * 100)) + "_sr" + std::to_string(int(sr * 10));
@@ -126,7 +128,54 @@ std::vector<LayerCase> LayerCases() {
             cases.push_back({"SolidGlass" + tag, Layered(white, 0.2f, 0, 1, 1, 1, cr, white, sr)});
         }
     }
+    // Mirror-smooth coats (roughness 0): a delta lobe over every kind of base.
+    cases.push_back({"SmoothCoatPlastic", Layered(white, 0.5f, 0, 0, 0, 1, 0, white, 0.5f)});
+    cases.push_back({"SmoothCoatMetal", Layered(white, 0.3f, 1, 0, 0, 1, 0, none, 0)});
+    cases.push_back({"SmoothCoatThinGlass", Layered(white, 0.1f, 0, 1, 0, 1, 0, white, 0.5f)});
+    cases.push_back({"SmoothCoatSolidGlass", Layered(white, 0, 0, 1, 1, 1, 0, none, 0)});
     return cases;
+}
+
+LayerCase Find(const std::string& name) {
+    for (LayerCase& c : LayerCases()) {
+        if (c.name == name) return c;
+    }
+    ADD_FAILURE() << name;
+    return {};
+}
+
+// A coat of roughness 0 is a mirror (issue 28): delta samples in the mirror direction carrying
+// the coat's Fresnel F = 0.04 + 0.96 (1 - cos)^5 over their pick probability, no value of its
+// own off them (Eval is the base beneath, a black Lambertian here, times Keep = 1 - F), and,
+// over a smooth base with no diffuse part or sheen, a delta BSDF.
+TEST(Clearcoat, SmoothCoatIsAMirror) {
+    Material coat = Layered(Rgb(0.0f), 0.5f, 0, 0, 0, 1, 0, Rgb(0.0f), 0);
+    coat.specular = 0;
+    const Bsdf bsdf(coat);
+    for (float cos : {0.1f, 0.5f, 0.9f}) {
+        const Vec3 wo(std::sqrt(1 - cos * cos), 0, cos);
+        const Vec3 mirror(-wo.x, -wo.y, wo.z);
+        EXPECT_EQ(bsdf.Eval(wo, mirror).g, 0) << cos;
+        int deltas = 0;
+        for (int i = 0; i < 256; ++i) {
+            Sampler sampler(17, 0, 0, uint64_t(i));
+            const float uc = sampler.Get1D();
+            const std::optional<BsdfSample> s = bsdf.Sample(wo, uc, sampler.Get2D());
+            if (!s || !s->delta) continue;
+            ++deltas;
+            EXPECT_NEAR(s->wi.x, mirror.x, 1e-6f);
+            EXPECT_NEAR(s->wi.z, mirror.z, 1e-6f);
+            const float fresnel = 0.04f + 0.96f * std::pow(1 - cos, 5.0f);
+            EXPECT_NEAR(s->f.g * s->wi.z, fresnel, 1e-6f) << cos;
+            // The delta sample's pick probability is the mass Pdf leaves out.
+            EXPECT_GT(s->pdf, 0.04f) << cos;
+        }
+        EXPECT_GT(deltas, 10) << cos;
+    }
+    const Rgb white(1.0f), none(0.0f);
+    EXPECT_TRUE(Bsdf(Layered(white, 0, 1, 0, 0, 1, 0, none, 0)).IsDelta());  // coated chrome
+    EXPECT_FALSE(Bsdf(Layered(white, 0, 1, 0, 0, 1, 0.5f, none, 0)).IsDelta());
+    EXPECT_FALSE(Bsdf(Layered(white, 0.5f, 0, 0, 0, 1, 0, none, 0)).IsDelta());
 }
 
 // White furnace: base, sheen and coat all white, never above one.
@@ -169,6 +218,22 @@ TEST_P(LayerChi2, SampleMatchesPdf) {
         testing::ExpectSamplingMatchesPdf(Bsdf(c.material), wo, c.name + "_" + wo_name, cases);
     }
 }
+
+class SmoothCoatChi2 : public ::testing::TestWithParam<LayerCase> {};
+
+// The rough lobes beneath a mirror coat: the coat's delta samples are the mass Pdf leaves out.
+TEST_P(SmoothCoatChi2, SampleMatchesPdf) {
+    const LayerCase& c = GetParam();
+    const int cases = 2 * int(testing::Chi2IncidentDirections().size());
+    for (const auto& [wo_name, wo] : testing::Chi2IncidentDirections()) {
+        testing::ExpectSamplingMatchesPdf(Bsdf(c.material), wo, c.name + "_" + wo_name, cases,
+                                          true);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Lobes, SmoothCoatChi2,
+                         ::testing::Values(Find("SmoothCoatPlastic"), Find("SmoothCoatThinGlass")),
+                         [](const auto& info) { return info.param.name; });
 
 INSTANTIATE_TEST_SUITE_P(Lobes, LayerChi2,
                          ::testing::Values(LayerCases()[0], LayerCases()[1], LayerCases()[6],

@@ -38,6 +38,7 @@ struct Params {
     float clearcoat = 0, clearcoat_roughness = 0;
     Rgb sheen_color{0.0f};
     float sheen_roughness = 0;
+    Rgb specular_color{1.0f};
 };
 
 Material Principled(const Params& p) {
@@ -47,6 +48,7 @@ Material Principled(const Params& p) {
     m.roughness = p.roughness;
     m.metallic = p.metallic;
     m.specular = p.specular;
+    m.specular_color = p.specular_color;
     m.transmission = p.transmission;
     m.thickness = p.thickness;
     m.ior = p.ior;
@@ -96,6 +98,9 @@ std::vector<Params> Spread() {
         {Rgb(0.5f), 0.7f, 0.2f, 0.6f, 0.5f, 0},
         {Rgb(1.0f), 0.3f, 0, 1, 1, 1},
         {Rgb(0.6f, 0.9f, 0.6f), 0.5f, 0.2f, 1, 0.6f, 2, 1.33f},
+        // KHR_materials_specular's colour, one channel's F0 clamped at 1.
+        {Rgb(0.8f, 0.4f, 0.2f), 0.4f, 0, 0.8f, 0, 0, 2.5f, 0, 0, Rgb(0.0f), 0, Rgb(6, 1, 0.3f)},
+        {Rgb(0.7f, 0.8f, 0.9f), 0.3f, 0, 1, 1, 1, 1.5f, 0, 0, Rgb(0.0f), 0, Rgb(2, 0.5f, 1)},
     };
 }
 
@@ -371,6 +376,66 @@ TEST(PrincipledBsdf, DielectricIsAppendixBFresnelMix) {
         }
     }
     EXPECT_EQ(compared, 81);
+}
+
+// KHR_materials_specular's colour: per channel c, F_c = F0_c + (1 - F0_c)(1 - V.H)^5 with
+// F0_c = min(F0(ior) colour_c, 1), and f_c = s F_c D Vis + (1 - s max_c F_c) base / pi, at
+// angles, roughnesses and colours (one clamped at F0 = 1) where the mix conserves energy.
+TEST(PrincipledBsdf, SpecularColorIsTheExtensionsFresnelMix) {
+    constexpr double kDeg = std::numbers::pi / 180;
+    const float base = 0.5f;
+    struct Tint {
+        float ior, specular;
+        Rgb color;
+    };
+    int compared = 0;
+    for (const Tint& tint :
+         {Tint{1.5f, 1.0f, Rgb(1.0f, 0.5f, 0.2f)}, Tint{1.5f, 0.6f, Rgb(2.0f, 0.0f, 1.0f)},
+          Tint{2.5f, 0.5f, Rgb(6.0f, 1.0f, 0.3f)}}) {
+        const float f0 = ((tint.ior - 1) / (tint.ior + 1)) * ((tint.ior - 1) / (tint.ior + 1));
+        for (float r : {0.7f, 1.0f}) {
+            Params p;
+            p.base = Rgb(base);
+            p.roughness = r;
+            p.ior = tint.ior;
+            p.specular = tint.specular;
+            p.specular_color = tint.color;
+            const Bsdf bsdf(Principled(p));
+            const float a2 = r * r * r * r;
+            for (float theta_o : {0.0f, 30.0f, 50.0f}) {
+                for (float theta_i : {10.0f, 40.0f}) {
+                    for (float phi : {0.0f, 180.0f}) {
+                        const Vec3 v = Spherical(theta_o * kDeg, 0.0);
+                        const Vec3 l = Spherical(theta_i * kDeg, phi * kDeg);
+                        const Vec3 h = Normalize(v + l);
+                        const float vh = Dot(v, h), nh = h.z, nl = l.z, nv = v.z;
+                        const float dd = nh * nh * (a2 - 1) + 1;
+                        const float d = a2 / (std::numbers::pi_v<float> * dd * dd);
+                        const float vis = 0.5f / (nl * std::sqrt(nv * nv * (1 - a2) + a2) +
+                                                  nv * std::sqrt(nl * nl * (1 - a2) + a2));
+                        float fresnel[3], max_fresnel = 0;
+                        for (int c = 0; c < 3; ++c) {
+                            const float f0c = std::min(f0 * tint.color[c], 1.0f);
+                            fresnel[c] = f0c + (1 - f0c) * std::pow(1 - vh, 5.0f);
+                            max_fresnel = std::max(max_fresnel, fresnel[c]);
+                        }
+                        const Rgb got = bsdf.Eval(v, l);
+                        for (int c = 0; c < 3; ++c) {
+                            const float expected = tint.specular * fresnel[c] * d * vis +
+                                                   (1 - tint.specular * max_fresnel) * base *
+                                                       std::numbers::inv_pi_v<float>;
+                            EXPECT_NEAR(got[c], expected, 2e-6f * expected)
+                                << "ior " << tint.ior << " channel " << c << " r " << r
+                                << " theta_o " << theta_o << " theta_i " << theta_i << " phi "
+                                << phi;
+                        }
+                        ++compared;
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_EQ(compared, 72);
 }
 
 // Issue 28's plane: base 0.5, roughness 1, irradiance pi at normal incidence, seen head on:

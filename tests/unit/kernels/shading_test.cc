@@ -166,6 +166,37 @@ TEST(VertexColours, MultiplyTheBaseColourAtTheHitsBarycentrics) {
     }
 }
 
+// An unlit surface (KHR_materials_unlit) emits its base colour, which COLOR_0 multiplies: seen
+// by a camera ray (Shade) and by a light sample (EmissionAt) alike.
+TEST(VertexColours, MultiplyAnUnlitSurfacesEmission) {
+    Scene scene;
+    Material m;
+    m.reflectance = Rgb(0.0f);
+    m.emission = Rgb(0.8f);
+    m.emission_by_vertex_color = true;
+    scene.materials.push_back(m);
+    scene.meshes.push_back(UvQuad(1, 0, 0));
+    // Red on the left edge, blue on the right.
+    scene.meshes[0].colors = {{1, 0, 0, 1}, {1, 0, 0, 1}, {0, 0, 1, 1}, {0, 0, 1, 1}};
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    const Vec3 down(0, 0, -1);
+    for (float x : {-0.5f, 0.5f}) {
+        const std::optional<SurfaceHit> hit = (*es)->Intersect(Ray{Vec3(x, 0.2f, 1), down});
+        ASSERT_TRUE(hit);
+        const float right = (x + 1) / 2;  // the blue share
+        const Rgb expected(0.8f * (1 - right), 0, 0.8f * right);
+        const Rgb seen = Shade(**es, *hit, -down).emission;
+        SurfacePoint light{hit->p,         hit->p_error, hit->n, hit->mesh,
+                           hit->primitive, hit->b1,      hit->b2};
+        const Rgb sampled = EmissionAt(**es, light, m.emission);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(seen[c], expected[c], 1e-5f) << x << " ch " << c;
+            EXPECT_NEAR(sampled[c], expected[c], 1e-5f) << x << " ch " << c;
+        }
+    }
+}
+
 // COLOR_0's alpha multiplies the opacity an alpha mask cuts at.
 TEST(VertexColours, AlphaMultipliesTheOpacity) {
     Scene scene;
@@ -223,6 +254,56 @@ TEST(TexturedParams, FactorsTimesTexels) {
     EXPECT_FLOAT_EQ(a.transmission, 0.08f);
     EXPECT_EQ(a.base_color, Rgb(0.5f, 0, 0));
     EXPECT_EQ(b.base_color, Rgb(0.5f));
+}
+
+// KHR_materials_clearcoat's and _sheen's textures: a coat texture whose R is 1 on the left half
+// of the top row and 0 on the right switches the coat on and off there; its G scales the coat's
+// roughness, the sheen colour texture (sRGB) the sheen colour. The coat's own normal map tilts
+// the coat's normal alone: the base's shading normal stays the surface's.
+TEST(TexturedParams, ClearcoatAndSheenTextures) {
+    Scene scene;
+    scene.textures.push_back(Quadrants());
+    auto tilt = std::make_shared<TextureImage>();
+    tilt->width = tilt->height = 1;
+    tilt->channels = 3;
+    tilt->texels32 = {0.8f, 0.5f, 0.9f};  // (0.6, 0, 0.8) in tangent space
+    scene.textures.push_back(tilt);
+    Material m;
+    m.type = Material::Type::kPrincipled;
+    m.clearcoat = 0.8f;
+    m.clearcoat_roughness = 0.5f;
+    m.sheen_color = Rgb(0.5f);
+    m.sheen_roughness = 0.6f;
+    for (TextureRef* t : {&m.clearcoat_texture, &m.clearcoat_roughness_texture,
+                          &m.sheen_color_texture, &m.sheen_roughness_texture}) {
+        t->image = 0;
+        t->nearest = true;
+    }
+    m.sheen_color_texture.srgb = true;
+    m.clearcoat_normal_texture.image = 1;
+    scene.materials.push_back(m);
+    scene.meshes.push_back(UvQuad(1, 0, 0));
+    scene.meshes[0].tangents.assign(4, {1, 0, 0, 1});
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    const Vec3 down(0, 0, -1);
+    const std::optional<SurfaceHit> red = (*es)->Intersect(Ray{Vec3(-0.5f, 0.5f, 1), down});
+    const std::optional<SurfaceHit> green = (*es)->Intersect(Ray{Vec3(0.5f, 0.5f, 1), down});
+    ASSERT_TRUE(red && green);
+    const Shading coated = Shade(**es, *red, -down);
+    const Shading bare = Shade(**es, *green, -down);
+    EXPECT_FLOAT_EQ(coated.params.clearcoat, 0.8f);
+    EXPECT_FLOAT_EQ(bare.params.clearcoat, 0);
+    EXPECT_FLOAT_EQ(coated.params.clearcoat_roughness, 0);
+    EXPECT_FLOAT_EQ(bare.params.clearcoat_roughness, 0.5f);
+    EXPECT_EQ(coated.params.sheen_color, Rgb(0.5f, 0, 0));
+    EXPECT_EQ(bare.params.sheen_color, Rgb(0, 0.5f, 0));
+    EXPECT_FLOAT_EQ(coated.params.sheen_roughness, 0.6f);  // RGB: alpha 1
+    // The coat's normal in the shading frame; the base's is the flat quad's.
+    EXPECT_NEAR(coated.params.coat_normal.x, 0.6f, 1e-5f);
+    EXPECT_NEAR(coated.params.coat_normal.y, 0, 1e-5f);
+    EXPECT_NEAR(coated.params.coat_normal.z, 0.8f, 1e-5f);
+    EXPECT_EQ(coated.ns, Vec3(0, 0, 1));
 }
 
 // Checks every pixel of a render against the mean over its footprint of `radiance` along each

@@ -67,6 +67,9 @@ struct Material {
     // Emission leaves both faces (JSON "two_sided"), each with radiance `emission`: a panel
     // that glows on both sides emits twice the power of a one-sided one.
     bool two_sided_emission = false;
+    // COLOR_0 multiplies the emission too: a KHR_materials_unlit surface emits its base colour,
+    // which vertex colours multiply (glTF).
+    bool emission_by_vertex_color = false;
 
     // The principled material: the glTF 2.0 metallic-roughness BRDF (its Appendix B) with
     // KHR_materials_transmission, _ior and _volume. Textures multiply their factors:
@@ -75,8 +78,10 @@ struct Material {
     // emission by `emission_texture`.
     float metallic = 0;
     // Weight of the dielectric specular layer (KHR_materials_specular's factor): 0 leaves the
-    // Lambertian base alone.
+    // Lambertian base alone. Its colour (specularColorFactor, any value >= 0) tints the
+    // layer's F0: min(F0(ior) specular_color, 1) per channel.
     float specular = 1;
+    Rgb specular_color{1.0f};
     float transmission = 0;  // fraction of the dielectric base that is transmitted, not diffuse
     // KHR_materials_volume: above 0 the mesh is closed solid glass that refracts on entry and
     // exit; 0 is a thin wall that transmits without bending.
@@ -92,9 +97,18 @@ struct Material {
     Rgb sheen_color{0.0f};
     float sheen_roughness = 0;
     TextureRef base_color_texture, metallic_roughness_texture, normal_texture, emission_texture;
-    TextureRef transmission_texture;  // its R channel multiplies `transmission` (linear)
-    float normal_scale = 1;           // scales the normal map's x and y (glTF normalTexture.scale)
-    float opacity = 1;  // base colour alpha factor; with the texture's alpha, for kMask
+    TextureRef transmission_texture;    // its R channel multiplies `transmission` (linear)
+    TextureRef specular_texture;        // its A channel multiplies `specular` (linear)
+    TextureRef specular_color_texture;  // its RGB multiplies `specular_color` (sRGB)
+    // KHR_materials_clearcoat's and _sheen's textures (linear but the sheen colour): R times
+    // `clearcoat`, G times `clearcoat_roughness`, RGB times `sheen_color`, A times
+    // `sheen_roughness`; the coat's own normal map (without one the coat follows the
+    // interpolated normal, not `normal_texture`, as the extension says).
+    TextureRef clearcoat_texture, clearcoat_roughness_texture, clearcoat_normal_texture;
+    float clearcoat_normal_scale = 1;
+    TextureRef sheen_color_texture, sheen_roughness_texture;
+    float normal_scale = 1;  // scales the normal map's x and y (glTF normalTexture.scale)
+    float opacity = 1;       // base colour alpha factor; with the texture's alpha, for kMask
     // kBlend (glTF BLEND): stochastic transparency, rays pass through with probability
     // 1 - opacity, so the image converges to opacity * surface + (1 - opacity) * behind.
     AlphaMode alpha_mode = AlphaMode::kOpaque;
@@ -112,7 +126,11 @@ struct Material {
     }
     bool IsTextured() const {
         return base_color_texture.valid() || metallic_roughness_texture.valid() ||
-               normal_texture.valid() || emission_texture.valid() || transmission_texture.valid();
+               normal_texture.valid() || emission_texture.valid() || transmission_texture.valid() ||
+               specular_texture.valid() || specular_color_texture.valid() ||
+               clearcoat_texture.valid() || clearcoat_roughness_texture.valid() ||
+               clearcoat_normal_texture.valid() || sheen_color_texture.valid() ||
+               sheen_roughness_texture.valid();
     }
 };
 

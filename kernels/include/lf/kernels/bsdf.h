@@ -22,14 +22,29 @@ struct SurfaceParams {
     Rgb base_color;  // lambert albedo, principled base colour
     float metallic = 0;
     float roughness = 0;  // principled: perceptual roughness r
+    float specular = 1;   // principled: the specular layer's weight and F0 tint
+    Rgb specular_color{1.0f};
     float clearcoat = 0, clearcoat_roughness = 0;
+    // The coat's own normal (clearcoatNormalTexture) in the shading frame of lf/core/vec.h's
+    // Frame::FromNormal(ns), which every estimator builds; +z is the shading normal itself.
+    Vec3 coat_normal{0, 0, 1};
     Rgb sheen_color;
     float sheen_roughness = 0;
     float transmission = 0;  // principled; whether the material is a solid stays the Material's
 
     static SurfaceParams Of(const Material& m) {
-        return {m.reflectance,         m.metallic,    m.roughness,       m.clearcoat,
-                m.clearcoat_roughness, m.sheen_color, m.sheen_roughness, m.transmission};
+        SurfaceParams p;
+        p.base_color = m.reflectance;
+        p.metallic = m.metallic;
+        p.roughness = m.roughness;
+        p.specular = m.specular;
+        p.specular_color = m.specular_color;
+        p.clearcoat = m.clearcoat;
+        p.clearcoat_roughness = m.clearcoat_roughness;
+        p.sheen_color = m.sheen_color;
+        p.sheen_roughness = m.sheen_roughness;
+        p.transmission = m.transmission;
+        return p;
     }
 };
 

@@ -1,7 +1,8 @@
 // The principled material: glTF 2.0's metallic-roughness BRDF (its Appendix B) with
-// KHR_materials_specular's weight, KHR_materials_ior and KHR_materials_transmission/_volume,
-// under KHR_materials_sheen and KHR_materials_clearcoat layers (see LayerPick below),
-// in the local shading frame of lf/kernels/bsdf.h (+z the front face's normal, the outside).
+// KHR_materials_specular's weight and colour, KHR_materials_ior and
+// KHR_materials_transmission/_volume, under KHR_materials_sheen and KHR_materials_clearcoat layers
+// (see LayerPick below), in the local shading frame of lf/kernels/bsdf.h (+z the front face's
+// normal, the outside).
 //
 //   f = metallic * conductor + (1 - metallic) * dielectric
 //   conductor  = F_schlick(base, wo.wm) D G / (4 cos_o cos_i), GGX with alpha = r^2
@@ -21,6 +22,7 @@
 //
 // Below roughness sqrt(MicrofacetDistribution::kMinAlpha) the surface is smooth: reflection and
 // transmission are Dirac deltas (BsdfSample::delta); Eval and Pdf hold the diffuse base alone.
+// A clear coat that smooth is a delta mirror too (lf/kernels/clearcoat_lobe.h).
 //
 // The BTDF is tinted by the base colour at every crossing (KHR_materials_transmission), so solid
 // glass tints twice, on entry and exit, besides Beer's law inside (lf/kernels/shading.h). With
@@ -58,10 +60,14 @@ class PrincipledBsdf {
     Rgb Eval(const Vec3& wo, const Vec3& wi) const;
     float Pdf(const Vec3& wo, const Vec3& wi) const;
     std::optional<BsdfSample> Sample(const Vec3& wo, float uc, const Vec2& u) const;
-    // Every lobe is a Dirac delta: a smooth surface without a diffuse base.
-    bool IsDelta() const { return smooth_ && diffuse_scale_ == 0 && !layered(); }
-    // Some lobe is a Dirac delta: the smooth base's reflection or transmission.
-    bool HasDeltaLobe() const { return smooth_; }
+    // Every lobe is a Dirac delta: a smooth surface without a diffuse base, under no sheen and
+    // no coat or a smooth one.
+    bool IsDelta() const {
+        return smooth_ && diffuse_scale_ == 0 && !sheen_.active() &&
+               (!coat_.active() || coat_.smooth());
+    }
+    // Some lobe is a Dirac delta: the smooth base's reflection or transmission, or a smooth coat.
+    bool HasDeltaLobe() const { return smooth_ || (coat_.active() && coat_.smooth()); }
     // Bsdf::RefractionEta: RelativeEta(wo) for a pair across a solid's interface, else 1.
     float RefractionEta(const Vec3& wo, const Vec3& wi) const {
         return refracts_ && wo.z * wi.z < 0 ? RelativeEta(wo) : 1.0f;
@@ -94,8 +100,14 @@ class PrincipledBsdf {
     bool Outside(const Vec3& wo) const { return !refracts_ || wo.z > 0; }
     // The base's weight k(mu) on one side (see the top).
     float BaseKeep(float mu) const;
-    // The specular layer's Fresnel term s F for a microfacet seen at cos_om from one side.
-    float LayerFresnel(float cos_om, bool outside) const;
+    // The specular layer's Fresnel term s F for a microfacet seen at cos_om from one side, per
+    // channel (F0 tinted by the specular colour), and its largest channel, which weights what
+    // lies beneath (KHR_materials_specular's max_value(F); Schlick is monotone in F0, so it is
+    // the Fresnel term of the largest F0).
+    Rgb LayerFresnelColor(float cos_om, bool outside) const;
+    float LayerFresnel(float cos_om, bool outside) const {
+        return LayerFresnelColor(cos_om, outside).MaxComponent();
+    }
     // IOR on the far side of the interface over the IOR on wo's side.
     float RelativeEta(const Vec3& wo) const { return wo.z > 0 ? ior_ : 1 / ior_; }
 
@@ -115,7 +127,9 @@ class PrincipledBsdf {
     std::optional<BsdfSample> SampleSmooth(const Vec3& wo, float uc, const LobePick& pick) const;
 
     Rgb base_;
-    float metallic_, specular_, transmission_, ior_, f0_;
+    float metallic_, specular_, transmission_, ior_;
+    Rgb f0_color_;   // min(F0(ior) specular colour, 1)
+    float f0_;       // its largest channel
     bool refracts_;  // a solid's interface (thickness > 0) with transmission
     MicrofacetDistribution distribution_;
     const GgxAlbedo* albedo_;

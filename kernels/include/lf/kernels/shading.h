@@ -53,7 +53,8 @@ Vec3 ValidReflectionNormal(const Vec3& ns, const Vec3& n, const Vec3& wo);
 Shading Shade(const EmbreeScene& scene, const SurfaceHit& hit, const Vec3& wo);
 
 // The radiance a light sample on an emitter carries: `radiance` (the material's emission
-// factor, as LightSampler gives it) times the emission texture at the sample; black in an
+// factor, as LightSampler gives it) times the emission texture at the sample (and the vertex
+// colour, Material::emission_by_vertex_color); black in an
 // alpha-mask hole, which emits nothing because rays pass through it, and times the opacity on a
 // blended surface (what rays that stop there see, on average).
 Rgb EmissionAt(const EmbreeScene& scene, const SurfacePoint& light_point, const Rgb& radiance);
