@@ -130,42 +130,47 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
     const Vec3 wo = frame.ToLocal(-ray.d);
     const Bsdf bsdf(material, sh.params);
 
-    if (!bsdf.IsDelta()) {
-        // Direct light only, and the ray tree ends: every delta light, as Whitted's shadow rays
-        // (no noise from picking among them), plus one sample of the LightSampler for the
-        // others, whose delta picks are dropped (the non-delta picks alone estimate the rest
-        // without bias, each weighted by its own pick probability). No MIS: nothing else
-        // reaches the lights from here.
-        const auto direct = [&](const LightSample& ls) -> Rgb {
-            if (!(ls.pdf > 0)) return {};
-            const Vec3 wi = frame.ToLocal(ls.wi);
-            const Rgb f = sh.SidesAgree(-ray.d, ls.wi, wi.z * wo.z > 0)
-                              ? bsdf.Eval(wo, wi) * std::abs(wi.z)
-                              : Rgb();
-            if (f.IsBlack()) return {};
-            const Rgb radiance = EmissionAt(scene_, ls.point, ls.radiance);
-            if (radiance.IsBlack()) return {};
-            ++stats.rays;
-            if (scene_.Occluded(SpawnRayTo(sh.Leaving(ls.wi), ls.point))) return {};
-            Rgb contribution = f * radiance / ls.pdf;
-            const int through =
-                MediumAfter(medium, hit->material, material, Dot(ls.wi, ng), wi.z * wo.z < 0);
-            if (through >= 0) {
-                contribution *=
-                    Transmittance(materials[size_t(through)], Length(ls.point.p - hit->p));
+    // A smooth coat over a smooth base reflects by two delta lobes in one direction, which the
+    // deterministic split below cannot tell apart: such a surface takes the random pick too.
+    if (!bsdf.IsDelta() || sh.params.clearcoat > 0) {
+        if (!bsdf.IsDelta()) {
+            // Direct light only, and the ray tree ends: every delta light, as Whitted's shadow rays
+            // (no noise from picking among them), plus one sample of the LightSampler for the
+            // others, whose delta picks are dropped (the non-delta picks alone estimate the rest
+            // without bias, each weighted by its own pick probability). No MIS: nothing else
+            // reaches the lights from here.
+            const auto direct = [&](const LightSample& ls) -> Rgb {
+                if (!(ls.pdf > 0)) return {};
+                const Vec3 wi = frame.ToLocal(ls.wi);
+                const Rgb f = sh.SidesAgree(-ray.d, ls.wi, wi.z * wo.z > 0)
+                                  ? bsdf.Eval(wo, wi) * std::abs(wi.z)
+                                  : Rgb();
+                if (f.IsBlack()) return {};
+                const Rgb radiance = EmissionAt(scene_, ls.point, ls.radiance);
+                if (radiance.IsBlack()) return {};
+                ++stats.rays;
+                if (scene_.Occluded(SpawnRayTo(sh.Leaving(ls.wi), ls.point))) return {};
+                Rgb contribution = f * radiance / ls.pdf;
+                const int through =
+                    MediumAfter(medium, hit->material, material, Dot(ls.wi, ng), wi.z * wo.z < 0);
+                if (through >= 0) {
+                    contribution *=
+                        Transmittance(materials[size_t(through)], Length(ls.point.p - hit->p));
+                }
+                return contribution;
+            };
+            for (const size_t i : delta_lights_) {
+                if (const std::optional<LightSample> ls = lights_.SampleDeltaLight(i, hit->p)) {
+                    L += direct(*ls);
+                }
             }
-            return contribution;
-        };
-        for (const size_t i : delta_lights_) {
-            if (const std::optional<LightSample> ls = lights_.SampleDeltaLight(i, hit->p)) {
-                L += direct(*ls);
+            if (delta_lights_.size() < lights_.size()) {
+                const float u_pick = sampler.Get1D();
+                const Vec2 u_light = sampler.Get2D();
+                const std::optional<LightSample> ls =
+                    lights_.Sample(hit->p, sh.ns, u_pick, u_light);
+                if (ls && !ls->delta) L += direct(*ls);
             }
-        }
-        if (delta_lights_.size() < lights_.size()) {
-            const float u_pick = sampler.Get1D();
-            const Vec2 u_light = sampler.Get2D();
-            const std::optional<LightSample> ls = lights_.Sample(hit->p, sh.ns, u_pick, u_light);
-            if (ls && !ls->delta) L += direct(*ls);
         }
         // A smooth surface over a diffuse base also reflects (or refracts) as a mirror: one of
         // its delta lobes, picked as Sample picks it, is followed with its weight over the

@@ -213,6 +213,19 @@ TEST(Whitted, EqualsPathTracerThroughSmoothPrincipledOverABlackBase) {
     ExpectEqualsPathTracerThroughSpecularSphere(plastic);
 }
 
+// A smooth clear coat over a smooth metal: all delta, its coat and base reflecting in one
+// direction; the deterministic split used to follow the coat's lobe alone.
+TEST(Whitted, EqualsPathTracerThroughSmoothCoatedMetal) {
+    Material paint;
+    paint.type = Material::Type::kPrincipled;
+    paint.reflectance = Rgb(0.9f, 0.6f, 0.3f);
+    paint.metallic = 1;
+    paint.roughness = 0;
+    paint.clearcoat = 1;
+    paint.clearcoat_roughness = 0;
+    ExpectEqualsPathTracerThroughSpecularSphere(paint);
+}
+
 // Unpolarised Fresnel reflectance from the definition, for light arriving at cos_i > 0 from
 // the side of index n1 onto index n2; 1 under total internal reflection.
 double Fresnel(double cos_i, double n1, double n2) {
