@@ -139,6 +139,41 @@ TEST(SceneAnimation, FilesWithoutAnimationsSkinsOrMorphsHaveNone) {
     EXPECT_EQ(scene->animation, nullptr);
 }
 
+TEST(SceneAnimation, AGltfInAJsonSceneMovesUnderItsTransform) {
+    // A JSON triangle comes first, so the glTF's meshes are not the scene's first, and a
+    // primitive before the animated one has only a degenerate triangle (dropped with its mesh):
+    // the animation still poses the right mesh.
+    GltfBuilder b = MovingParent();
+    const int degenerate = b.AddIndices({0, 0, 1});
+    b.json()["meshes"][0]["primitives"].insert(
+        b.json()["meshes"][0]["primitives"].begin(),
+        {{"attributes", {{"POSITION", 0}}}, {"indices", degenerate}});
+    const std::string gltf = b.GltfEmbedded();
+    const Json json = {
+        {"materials", {{"grey", {{"type", "lambert"}, {"reflectance", {0.5, 0.5, 0.5}}}}}},
+        {"shapes",
+         {{{"type", "triangle"},
+           {"material", "grey"},
+           {"vertices", {{0, 0, -9}, {1, 0, -9}, {0, 1, -9}}}},
+          {{"type", "gltf"},
+           {"file", "moving.gltf"},
+           {"transform", {{"translate", {10, 0, 0}}}}}}}};
+    absl::StatusOr<Scene> scene = ParseScene(
+        json.dump(), "shot.json", [&](const std::string& name) -> absl::StatusOr<std::string> {
+            if (name == "moving.gltf") return gltf;
+            return absl::NotFoundError(name);
+        });
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_NE(scene->animation, nullptr);
+    ASSERT_EQ(scene->animation->meshes.size(), 1u);
+    EXPECT_EQ(scene->animation->meshes[0].mesh, 1);
+    ASSERT_TRUE(scene->animation->PoseAt(2, *scene).ok());
+    // At 2 s: translated (4, 0, 0) and turned a quarter about +y, then the JSON's (10, 0, 0).
+    ExpectNear(scene->meshes[1].positions[1], Vec3d(14, 0, 0) + RotateY(Vec3d(2, 0, 0), kPi / 2));
+    ExpectNear(scene->camera.position, Vec3d(14, 0, 0) + RotateY(Vec3d(0, 0, 5), kPi / 2));
+    ExpectNear(scene->meshes[0].positions[0], Vec3d(0, 0, -9));
+}
+
 // Two joints: a root at the origin and a child at (0, 1, 0) that turns a quarter about +z
 // over 1 s. A quad from (0, 0) to (1, 2): its bottom follows the root, (0, 2) the child, (1, 2)
 // half each. The mesh's node is moved to (5, 5, 5), which skinning ignores.
