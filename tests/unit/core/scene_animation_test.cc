@@ -272,6 +272,29 @@ TEST(SceneAnimation, AMorphTargetAtWeightHalfIsHalfway) {
     ExpectNear(still->meshes[0].positions[2], Vec3d(0, 1, 0.5));
 }
 
+TEST(SceneAnimation, KhronosSimpleMorphFollowsItsWeights) {
+    // Two targets move vertex 2 (rest (0.5, 0.5, 0)) by (-1, 1, 0) and (1, 1, 0); the weights
+    // run (0, 0), (0, 1), (1, 1), (1, 0), (0, 0) at t = 0 to 4.
+    SceneOptions options;
+    options.camera = "auto";
+    absl::StatusOr<Scene> scene =
+        LoadScene(std::string(LF_TEST_SCENES) + "/khronos/SimpleMorph/SimpleMorph.gltf", options);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_NE(scene->animation, nullptr);
+    EXPECT_EQ(scene->animation->End(), 4);
+    const auto vertex2 = [&](double t) {
+        EXPECT_TRUE(scene->animation->PoseAt(t, *scene).ok());
+        return scene->meshes[0].positions[2];
+    };
+    const auto expected = [](double w0, double w1) {
+        return Vec3d(0.5, 0.5, 0) + w0 * Vec3d(-1, 1, 0) + w1 * Vec3d(1, 1, 0);
+    };
+    ExpectNear(vertex2(1.5), expected(0.5, 1));
+    ExpectNear(vertex2(3.25), expected(0.75, 0));
+    ExpectNear(vertex2(-1), expected(0, 0));
+    ExpectNear(scene->meshes[0].positions[1], Vec3d(1, 0, 0));
+}
+
 std::string LoadError(const GltfBuilder& b) {
     absl::StatusOr<Scene> scene = Load(b, "auto");
     EXPECT_FALSE(scene.ok());
