@@ -178,7 +178,7 @@ void GltfImporter::AnimateNode(int index, const Counts& before, const std::strin
     }
     added_primitives_.clear();
     if (cameras_.size() > before.cameras) cameras_.back().node = node;
-    if (!animation.NodeMoves(node)) return;
+    if (!moving_[size_t(node)]) return;
     const auto light = [&](AnimatedLight::Kind kind, size_t was, size_t now) {
         if (now > was) animation.lights.push_back({kind, int(was), node, true});
     };
@@ -202,7 +202,7 @@ void GltfImporter::AnimateMesh(int index, int scene_mesh, int primitive,
     AnimatedMesh out;
     out.mesh = scene_mesh;
     out.node = node_index;
-    out.moves = animation.NodeMoves(node_index) || weights_animated;
+    out.moves = moving_[size_t(node_index)] || weights_animated;
     if (node.skin < 0 && prim.targets.empty() && !out.moves) return;
     const std::string where =
         absl::StrCat("meshes[", node.mesh, "]", Quoted(mesh.name), ".primitives[", primitive, "]");
@@ -293,7 +293,7 @@ void GltfImporter::AnimateMesh(int index, int scene_mesh, int primitive,
         const AnimationSkin& skin = animation.skins[size_t(out.skin)];
         out.moves =
             weights_animated || std::any_of(skin.joints.begin(), skin.joints.end(),
-                                            [&](int joint) { return animation.NodeMoves(joint); });
+                                            [&](int joint) { return moving_[size_t(joint)]; });
     }
     animation.meshes.push_back(std::move(out));
 }

@@ -158,6 +158,7 @@ class GltfImporter {
     // Animation: each glTF node's and skin's index in options_.animation (-1: none).
     std::vector<int> node_of_;
     std::map<int, int> skin_of_;
+    std::vector<bool> moving_;  // SceneAnimation::MovingNodes once the channels are read
     std::map<int, int> material_of_, texture_of_;
     bool range_ignored_ = false;
 };

@@ -124,6 +124,7 @@ void GltfImporter::Import() {
     if (options_.animation && Animates()) {
         ReadNodeTree();
         ReadAnimations();
+        moving_ = options_.animation->MovingNodes();
     }
     visited_.assign(model_.nodes.size(), false);
     const tinygltf::Scene& gltf_scene = model_.scenes[size_t(index)];

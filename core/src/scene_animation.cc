@@ -17,6 +17,16 @@ void AddScaled(const Affine& a, double weight, Affine& sum) {
     }
 }
 
+// Within the coordinate range every loader checks (and finite).
+bool InRange(const Vec3d& p) {
+    return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate &&
+           std::abs(p.z) <= kMaxCoordinate;
+}
+
+std::string Beyond(const Vec3d& p) {
+    return absl::StrCat("(", p.x, ", ", p.y, ", ", p.z, ") is beyond ±", kMaxCoordinate);
+}
+
 Affine Zero() {
     Affine z;
     for (auto& row : z.m) row.fill(0);
@@ -35,7 +45,8 @@ std::span<const double> MorphWeights(const AnimatedMesh& mesh, const AnimationNo
 
 absl::Status PoseMesh(const AnimatedMesh& a, const SceneAnimation& animation,
                       const std::vector<Affine>& world,
-                      const std::vector<std::vector<double>>& weights, Scene& scene) {
+                      const std::vector<std::vector<double>>& weights, double seconds,
+                      Scene& scene) {
     TriangleMesh& mesh = scene.meshes[size_t(a.mesh)];
     const std::string& where = animation.nodes[size_t(a.node)].where;
     const size_t n = a.positions.size();
@@ -80,6 +91,11 @@ absl::Status PoseMesh(const AnimatedMesh& a, const SceneAnimation& animation,
             }
         }
         mesh.positions[v] = m.Apply(p);
+        if (!InRange(mesh.positions[v])) {
+            return absl::InvalidArgumentError(absl::StrCat(where, " at ", seconds, " s: mesh \"",
+                                                           mesh.name, "\" vertex ", v, " at ",
+                                                           Beyond(mesh.positions[v])));
+        }
         if (!a.normals.empty()) {
             const Vec3d moved =
                 (a.skin >= 0 ? m.NormalMatrix() : rigid_normals).ApplyLinear(normal);
@@ -173,7 +189,7 @@ absl::Status SceneAnimation::PoseAt(double seconds, Scene& scene) const {
         }
     }
     for (const AnimatedMesh& mesh : meshes) {
-        if (absl::Status s = PoseMesh(mesh, *this, world, weights, scene); !s.ok()) {
+        if (absl::Status s = PoseMesh(mesh, *this, world, weights, seconds, scene); !s.ok()) {
             return s;
         }
     }
@@ -181,6 +197,10 @@ absl::Status SceneAnimation::PoseAt(double seconds, Scene& scene) const {
         const Affine& w = world[size_t(light.node)];
         const Vec3d position = w.Apply(Vec3d(0, 0, 0));
         const Vec3d axis = w.ApplyLinear(Vec3d(0, 0, -1));
+        if (!InRange(position)) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(at(light.node), ": its light at ", Beyond(position)));
+        }
         if (light.kind != AnimatedLight::Kind::kPoint && !(Length(axis) > 0)) {
             return absl::InvalidArgumentError(
                 absl::StrCat(at(light.node), ": its transform flattens the light's axis"));
@@ -198,27 +218,33 @@ absl::Status SceneAnimation::PoseAt(double seconds, Scene& scene) const {
                 break;
         }
     }
-    if (camera_node >= 0 && !PlaceGltfCamera(world[size_t(camera_node)], scene.camera)) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(at(camera_node), ": its transform flattens the camera's view"));
-    }
-    if (absl::Status s = CheckCoordinates(scene); !s.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("at ", seconds, " s: ", s.message()));
+    if (camera_node >= 0) {
+        if (!PlaceGltfCamera(world[size_t(camera_node)], scene.camera)) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(at(camera_node), ": its transform flattens the camera's view"));
+        }
+        if (!InRange(scene.camera.position)) {
+            return absl::InvalidArgumentError(
+                absl::StrCat(at(camera_node), ": its camera at ", Beyond(scene.camera.position)));
+        }
     }
     return absl::OkStatus();
 }
 
-bool SceneAnimation::NodeMoves(int node) const {
-    for (; node >= 0; node = nodes[size_t(node)].parent) {
-        for (const AnimationChannel& c : channels) {
-            if (c.node == node && c.path != AnimationChannel::Path::kWeights) return true;
-        }
+std::vector<bool> SceneAnimation::MovingNodes() const {
+    std::vector<bool> moving(nodes.size(), false);
+    for (const AnimationChannel& c : channels) {
+        if (c.path != AnimationChannel::Path::kWeights) moving[size_t(c.node)] = true;
     }
-    return false;
+    // Parents come first, so one pass carries motion down the tree.
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        if (nodes[i].parent >= 0 && moving[size_t(nodes[i].parent)]) moving[i] = true;
+    }
+    return moving;
 }
 
 bool SceneAnimation::Moves() const {
-    return (camera_node >= 0 && NodeMoves(camera_node)) ||
+    return (camera_node >= 0 && MovingNodes()[size_t(camera_node)]) ||
            std::any_of(meshes.begin(), meshes.end(),
                        [](const AnimatedMesh& m) { return m.moves; }) ||
            std::any_of(lights.begin(), lights.end(),

@@ -295,6 +295,23 @@ TEST(SceneAnimation, KhronosSimpleMorphFollowsItsWeights) {
     ExpectNear(scene->meshes[0].positions[1], Vec3d(1, 0, 0));
 }
 
+TEST(SceneAnimation, APoseBeyondTheCoordinateRangeIsRefusedNamingNodeAndTime) {
+    GltfBuilder b = MovingParent();
+    const int times = b.AddFloats<1>({{{0}}, {{1}}});
+    const int far = b.AddFloats<3>({{{0, 0, 0}}, {{0, 4e15f, 0}}});
+    // Node 0 holds the triangle: its translation (1, 0, 0) becomes (0, 4e15, 0), under the
+    // parent at (2, 0, 0) at 1 s.
+    Animate(b, {{0, "translation", times, far}});
+    absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_TRUE(scene->animation->PoseAt(0.1, *scene).ok());
+    const absl::Status status = scene->animation->PoseAt(1, *scene);
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(std::string(status.message()),
+                HasSubstr("anim.gltf: nodes[0] \"Tri\" at 1 s: mesh \"tri[0]\" "
+                          "vertex 0 at (2, 4e+15, 0) is beyond ±1e+15"));
+}
+
 std::string LoadError(const GltfBuilder& b) {
     absl::StatusOr<Scene> scene = Load(b, "auto");
     EXPECT_FALSE(scene.ok());

@@ -92,14 +92,16 @@ struct SceneAnimation {
     // Writes the world-space geometry, camera and lights of time `seconds` into `scene`, the
     // Scene this animation was loaded with (or a copy of it). Only what a node drives is
     // written; the camera keeps its lens, resolution and filter. InvalidArgument naming the
-    // node and the time when a pose flattens a transform or leaves the coordinate range.
+    // node and the time when a pose flattens a transform or leaves the coordinate range
+    // (±kMaxCoordinate).
     absl::Status PoseAt(double seconds, Scene& scene) const;
 
     // Each node's world transform at `seconds`.
     std::vector<Affine> WorldTransforms(double seconds) const;
 
-    // Whether a translation, rotation or scale channel moves `node` or one of its ancestors.
-    bool NodeMoves(int node) const;
+    // For each node, whether a translation, rotation or scale channel moves it or one of its
+    // ancestors.
+    std::vector<bool> MovingNodes() const;
     // Whether anything in the scene changes over time; false: every time gives one image.
     bool Moves() const;
     // The first and last keyframe times of all channels (0, 0 without channels).
