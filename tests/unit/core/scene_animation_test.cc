@@ -131,6 +131,29 @@ TEST(SceneAnimation, ChildrenOfAnAnimatedNodeMoveWithIt) {
     }
 }
 
+TEST(SceneAnimation, StepAndCubicSplineChannelsReachTheNodes) {
+    // The triangle's node: its translation steps from (1, 0, 0) to (1, 5, 0) at 1 s; its scale
+    // goes from 1 to 3 over [0, 1] on a cubic spline with zero tangents, which at s = 1/2 is
+    // the Hermite (2s^3 - 3s^2 + 1) 1 + (-2s^3 + 3s^2) 3 = 2; the parent's channels are gone.
+    GltfBuilder b = MovingParent();
+    b.json().erase("animations");
+    const int times = b.AddFloats<1>({{{0}}, {{1}}});
+    const int steps = b.AddFloats<3>({{{1, 0, 0}}, {{1, 5, 0}}});
+    const int scales = b.AddFloats<3>(
+        {{{0, 0, 0}}, {{1, 1, 1}}, {{0, 0, 0}}, {{0, 0, 0}}, {{3, 3, 3}}, {{0, 0, 0}}});
+    Animate(b,
+            {{0, "translation", times, steps, "STEP"}, {0, "scale", times, scales, "CUBICSPLINE"}});
+    absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_TRUE(scene->animation->PoseAt(0.5, *scene).ok());
+    ExpectNear(scene->meshes[0].positions[2], Vec3d(1, 2, 0));
+    ExpectNear(scene->meshes[0].positions[1], Vec3d(3, 0, 0));
+    ASSERT_TRUE(scene->animation->PoseAt(1, *scene).ok());
+    ExpectNear(scene->meshes[0].positions[2], Vec3d(1, 8, 0));
+    // Nothing moves the camera now.
+    EXPECT_EQ(scene->animation->MovingNodes()[size_t(scene->animation->camera_node)], false);
+}
+
 TEST(SceneAnimation, FilesWithoutAnimationsSkinsOrMorphsHaveNone) {
     GltfBuilder b = MovingParent();
     b.json().erase("animations");
