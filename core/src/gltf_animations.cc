@@ -3,6 +3,7 @@
 // default scene renders, what it drives.
 #include <algorithm>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,15 @@ std::vector<Vec3d> Vec3s(const std::vector<float>& floats) {
         out[i] = {floats[3 * i], floats[3 * i + 1], floats[3 * i + 2]};
     }
     return out;
+}
+
+// A channel's target.path, or none for paths this importer does not animate (an extension's).
+std::optional<AnimationChannel::Path> ChannelPath(const std::string& path) {
+    if (path == "translation") return AnimationChannel::Path::kTranslation;
+    if (path == "rotation") return AnimationChannel::Path::kRotation;
+    if (path == "scale") return AnimationChannel::Path::kScale;
+    if (path == "weights") return AnimationChannel::Path::kWeights;
+    return std::nullopt;
 }
 
 int Attribute(const std::map<std::string, int>& attributes, const char* key) {
@@ -88,22 +98,15 @@ void GltfImporter::ReadAnimations() {
         for (size_t c = 0; c < anim.channels.size(); ++c) {
             const tinygltf::AnimationChannel& channel = anim.channels[c];
             const std::string where = absl::StrCat(at, ".channels[", c, "]");
-            const std::string& path = channel.target_path;
-            AnimationChannel::Path path_kind;
-            int width = path == "rotation" ? 4 : 3;
-            if (path == "translation") {
-                path_kind = AnimationChannel::Path::kTranslation;
-            } else if (path == "rotation") {
-                path_kind = AnimationChannel::Path::kRotation;
-            } else if (path == "scale") {
-                path_kind = AnimationChannel::Path::kScale;
-            } else if (path == "weights") {
-                path_kind = AnimationChannel::Path::kWeights;
-            } else {
-                Tally(absl::StrCat("target.path \"", path, "\" not supported, channel ignored"),
+            const std::optional<AnimationChannel::Path> path = ChannelPath(channel.target_path);
+            if (!path) {
+                Tally(absl::StrCat("target.path \"", channel.target_path,
+                                   "\" not supported, channel ignored"),
                       "channel", where);
                 continue;
             }
+            const AnimationChannel::Path path_kind = *path;
+            int width = path_kind == AnimationChannel::Path::kRotation ? 4 : 3;
             if (channel.target_node < 0) {
                 // Only extensions target something other than a node.
                 Tally("channel without a target node ignored", "channel", where);
@@ -172,6 +175,8 @@ GltfImporter::Counts GltfImporter::CountObjects() const {
 void GltfImporter::AnimateNode(int index, const Counts& before, const std::string& where) {
     SceneAnimation& animation = *options_.animation;
     const int node = node_of_[size_t(index)];
+    // A node on a cycle of children is not in the tree; the traversal refuses it next.
+    if (node < 0) return;
     for (size_t i = 0; i < added_primitives_.size() && before.meshes + i < scene_.meshes.size();
          ++i) {
         AnimateMesh(index, int(before.meshes + i), added_primitives_[i], where);

@@ -376,6 +376,14 @@ TEST(SceneAnimation, BadAnimationsAreRefusedNamingWhere) {
                   "anim.gltf: animations[1] \"Action\".channels[0]: animates the morph weights "
                   "of nodes[0] \"Tri\", whose mesh has no morph targets");
     }
+    {
+        // A scene root ("Still") on a cycle of children: the animation's tree has no place for
+        // it, and the traversal refuses the file.
+        GltfBuilder b = MovingParent();
+        const int loop = b.AddNode({{"name", "Loop"}, {"children", {5}}});
+        b.json()["nodes"][5]["children"] = {loop};
+        EXPECT_THAT(LoadError(b), HasSubstr("reached twice: the node hierarchy is not a tree"));
+    }
     EXPECT_EQ(LoadError(SkinnedQuad(7)),
               "anim.gltf: meshes[0] \"skinned\".primitives[0].attributes.JOINTS_0: vertex 3 "
               "names joint 7, but skins[0] has 2 joints");
