@@ -36,4 +36,19 @@ bool Affine::IsFinite() const {
     return true;
 }
 
+Affine Affine::FromTrs(const Vec3d& translation, const std::array<double, 4>& rotation,
+                       const Vec3d& scale) {
+    const auto [x, y, z, w] = rotation;
+    Affine a;
+    a.m = {{{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w), translation.x},
+            {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w), translation.y},
+            {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y), translation.z}}};
+    for (int r = 0; r < 3; ++r) {
+        a.m[r][0] *= scale.x;
+        a.m[r][1] *= scale.y;
+        a.m[r][2] *= scale.z;
+    }
+    return a;
+}
+
 }  // namespace lf

@@ -6,6 +6,7 @@
 
 #include <tiny_gltf.h>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -53,6 +54,13 @@ inline constexpr size_t kMaxDracoPoints = size_t(1) << 26, kMaxDracoFaces = size
 // moved into its extension object, where DecodeDraco reads it. Other files come back as they are.
 std::string PrepareDraco(const std::string& bytes, bool binary);
 
+// A node's rest translation, rotation (normalised; Fail naming `where` for the zero
+// quaternion) and scale, and its whole local transform (its matrix, checked) (gltf_nodes.cc).
+Vec3d NodeTranslation(const tinygltf::Node& node);
+std::array<double, 4> NodeRotation(const tinygltf::Node& node, const std::string& where);
+Vec3d NodeScale(const tinygltf::Node& node);
+Affine LocalTransform(const tinygltf::Node& node, const std::string& where);
+
 // Per-file state of one import.
 class GltfImporter {
   public:
@@ -88,6 +96,23 @@ class GltfImporter {
     void AddCamera(const tinygltf::Node& node, const Affine& world, const std::string& where);
     void AddLight(const tinygltf::Value& light_index, const Affine& world,
                   const std::string& where);
+
+    // Animations, skins and morph targets into options_.animation (gltf_animations.cc).
+    // Whether the file has any (else the import collects nothing).
+    bool Animates() const;
+    // Every node into the animation's tree, parents first, and every channel.
+    void ReadNodeTree();
+    void ReadAnimations();
+    // How many scene objects there were before node `index` added its own.
+    struct Counts {
+        size_t meshes, cameras, point_lights, spot_lights, directional_lights;
+    };
+    Counts CountObjects() const;
+    // Records what node `index` added since `before`: its meshes' rest geometry, skins and
+    // morph targets, its camera's node, its lights when they move.
+    void AnimateNode(int index, const Counts& before, const std::string& where);
+    void AnimateMesh(int node, int scene_mesh, int primitive, const std::string& node_where);
+    int Skin(int index, const std::string& node_where);
 
     // Meshes (gltf_meshes.cc).
     // A buffer view's bytes, checked to lie inside their buffer.
@@ -146,6 +171,12 @@ class GltfImporter {
     };
     std::map<std::string, Tallied> tallies_;
     std::vector<bool> visited_;
+    // The primitives AddMesh made scene meshes of, in order.
+    std::vector<int> added_primitives_;
+    // Animation: each glTF node's and skin's index in options_.animation (-1: none).
+    std::vector<int> node_of_;
+    std::map<int, int> skin_of_;
+    std::vector<bool> moving_;  // SceneAnimation::MovingNodes once the channels are read
     std::map<int, int> material_of_, texture_of_;
     // The current primitive's Draco-decoded accessors, by accessor index.
     struct Decoded {

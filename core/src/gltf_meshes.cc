@@ -218,6 +218,7 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
     const tinygltf::Mesh& mesh = model_.meshes[size_t(index)];
     const Affine normal_matrix = world.NormalMatrix();
     const double det = world.Determinant();
+    added_primitives_.clear();
     if (!(std::abs(det) > 0)) Fail(node_where, "its transform is singular (flattens the mesh)");
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
         const tinygltf::Primitive& prim = mesh.primitives[p];
@@ -330,6 +331,7 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
             continue;
         }
         scene_.meshes.push_back(std::move(out));
+        added_primitives_.push_back(int(p));
     }
 }
 

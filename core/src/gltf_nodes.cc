@@ -48,6 +48,26 @@ std::string WhatIsLost(const std::string& extension) {
     return found == kLost.end() ? "whatever it describes is ignored" : found->second;
 }
 
+}  // namespace
+
+Vec3d NodeTranslation(const tinygltf::Node& node) {
+    const std::vector<double>& t = node.translation;
+    return t.empty() ? Vec3d(0, 0, 0) : Vec3d(t[0], t[1], t[2]);
+}
+
+std::array<double, 4> NodeRotation(const tinygltf::Node& node, const std::string& where) {
+    if (node.rotation.empty()) return {0, 0, 0, 1};
+    const std::vector<double>& q = node.rotation;
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!(norm > 0)) Fail(where, "rotation is the zero quaternion");
+    return {q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm};
+}
+
+Vec3d NodeScale(const tinygltf::Node& node) {
+    const std::vector<double>& s = node.scale;
+    return s.empty() ? Vec3d(1, 1, 1) : Vec3d(s[0], s[1], s[2]);
+}
+
 // The node's own transform: its matrix (column-major) or translation * rotation * scale.
 Affine LocalTransform(const tinygltf::Node& node, const std::string& where) {
     Affine local;
@@ -74,28 +94,8 @@ Affine LocalTransform(const tinygltf::Node& node, const std::string& where) {
         }
         return local;
     }
-    if (!node.rotation.empty()) {
-        double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2],
-               w = node.rotation[3];
-        const double norm = std::sqrt(x * x + y * y + z * z + w * w);
-        if (!(norm > 0)) Fail(where, "rotation is the zero quaternion");
-        x /= norm, y /= norm, z /= norm, w /= norm;
-        m = {{{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w), 0},
-              {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w), 0},
-              {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y), 0}}};
-    }
-    if (!node.scale.empty()) {
-        for (int r = 0; r < 3; ++r) {
-            for (int c = 0; c < 3; ++c) m[r][c] *= node.scale[c];
-        }
-    }
-    if (!node.translation.empty()) {
-        for (int r = 0; r < 3; ++r) m[r][3] = node.translation[r];
-    }
-    return local;
+    return Affine::FromTrs(NodeTranslation(node), NodeRotation(node, where), NodeScale(node));
 }
-
-}  // namespace
 
 void GltfImporter::Import() {
     CheckExtensions();
@@ -119,6 +119,11 @@ void GltfImporter::Import() {
     // Every material, in file order, so scene material i is glTF material i (after those
     // already in the scene); the default material only when a primitive needs it.
     for (int i = 0; i < int(model_.materials.size()); ++i) Material(i, "materials");
+    if (options_.animation && Animates()) {
+        ReadNodeTree();
+        ReadAnimations();
+        moving_ = options_.animation->MovingNodes();
+    }
     visited_.assign(model_.nodes.size(), false);
     const tinygltf::Scene& gltf_scene = model_.scenes[size_t(index)];
     for (size_t i = 0; i < gltf_scene.nodes.size(); ++i) {
@@ -176,12 +181,14 @@ void GltfImporter::VisitNode(int index, const Affine& parent, const std::string&
         Fail(where, absl::StrCat("its world translation (", origin.x, ", ", origin.y, ", ",
                                  origin.z, ") is beyond ±", kMaxCoordinate));
     }
+    const Counts before = CountObjects();
     if (node.mesh >= 0) AddMesh(node.mesh, world, where);
     if (node.camera >= 0) AddCamera(node, world, where);
     if (const auto light = node.extensions.find("KHR_lights_punctual");
         light != node.extensions.end()) {
         AddLight(light->second.Get("light"), world, where);
     }
+    if (options_.animation && !node_of_.empty()) AnimateNode(index, before, where);
     for (size_t i = 0; i < node.children.size(); ++i) {
         VisitNode(node.children[i], world, absl::StrCat(where, ".children[", i, "]"));
     }
@@ -202,12 +209,7 @@ void GltfImporter::AddCamera(const tinygltf::Node& node, const Affine& world,
         cameras_.push_back(std::move(out));
     };
     CameraSpec& spec = out.spec;
-    // The camera looks down its node's -Z with +Y up.
-    spec.position = world.Apply(Vec3d(0, 0, 0));
-    const Vec3d forward = world.ApplyLinear(Vec3d(0, 0, -1));
-    spec.up = world.ApplyLinear(Vec3d(0, 1, 0));
-    if (!(Length(Cross(forward, spec.up)) > 0)) return refuse(where, "its transform is singular");
-    spec.look_at = spec.position + Normalize(forward);
+    if (!PlaceGltfCamera(world, spec)) return refuse(where, "its transform is singular");
     double aspect = 1;
     if (camera.type == "perspective") {
         const tinygltf::PerspectiveCamera& p = camera.perspective;

@@ -127,16 +127,16 @@ absl::Status AppendGltf(const std::string& bytes, const std::string& name,
     return absl::OkStatus();
 }
 
-absl::StatusOr<CameraSpec> ChooseGltfCamera(const std::vector<GltfCamera>& cameras,
-                                            const std::string& name) {
+absl::StatusOr<const GltfCamera*> ChooseGltfCamera(const std::vector<GltfCamera>& cameras,
+                                                   const std::string& name) {
     if (cameras.empty()) {
         return absl::NotFoundError(
             "no camera; render with --camera auto (frames the whole scene), add one to the "
             "glTF, or include the file from a JSON scene that gives a camera");
     }
-    const auto usable = [](const GltfCamera& camera) -> absl::StatusOr<CameraSpec> {
+    const auto usable = [](const GltfCamera& camera) -> absl::StatusOr<const GltfCamera*> {
         if (!camera.error.empty()) return absl::InvalidArgumentError(camera.error);
-        return camera.spec;
+        return &camera;
     };
     if (name.empty()) return usable(cameras.front());
     std::vector<std::string> names;

@@ -15,6 +15,7 @@
 #include "lf/core/log.h"
 #include "lf/core/mesh_tangents.h"
 #include "lf/core/pixel_filter.h"
+#include "lf/core/scene_animation.h"
 #include "scene_json.h"
 #include "scene_parser.h"
 
@@ -69,9 +70,7 @@ Scene SceneParser::ParseGltf(const std::string& bytes, const std::string& source
         scene.camera = FrameScene(scene);
         return Finish(scene);
     }
-    absl::StatusOr<CameraSpec> camera = ChooseGltfCamera(gltf_cameras_, options_.camera);
-    if (!camera.ok()) throw LoadError{camera.status()};
-    scene.camera = *camera;
+    UseGltfCamera("", scene);
     return Finish(scene);
 }
 
@@ -99,6 +98,7 @@ Scene SceneParser::Finish(Scene& scene) {
         warnings_.push_back("no emissive shape and no light: the image will be black");
     }
     scene.dropped_degenerate = dropped_degenerate_;
+    if (!animation_.Empty()) scene.animation = std::make_shared<const SceneAnimation>(animation_);
     scene.content_hash = hash_.Hex();
     return std::move(scene);
 }
@@ -130,12 +130,17 @@ void SceneParser::ResolveCamera(const Node& root, bool json_camera, Scene& scene
                                "\": the scene has no named cameras (only glTF cameras have "
                                "names)"));
     }
-    absl::StatusOr<CameraSpec> camera = ChooseGltfCamera(gltf_cameras_, options_.camera);
+    UseGltfCamera("--camera: ", scene);
+}
+
+void SceneParser::UseGltfCamera(const std::string& prefix, Scene& scene) {
+    absl::StatusOr<const GltfCamera*> camera = ChooseGltfCamera(gltf_cameras_, options_.camera);
     if (!camera.ok()) {
-        throw LoadError{absl::Status(camera.status().code(),
-                                     absl::StrCat("--camera: ", camera.status().message()))};
+        throw LoadError{
+            absl::Status(camera.status().code(), absl::StrCat(prefix, camera.status().message()))};
     }
-    scene.camera = *camera;
+    scene.camera = (*camera)->spec;
+    animation_.camera_node = (*camera)->node;
 }
 
 }  // namespace scene_internal

@@ -65,6 +65,9 @@ class SceneParser {
     void ResolveCamera(const Node& root, bool json_camera, Scene& scene);
     // `--camera auto` and no glTF camera of that name: FrameScene.
     bool FramesTheScene() const;
+    // The glTF camera options_.camera names (the first without a name) as the scene's camera,
+    // its node the one the animation poses; LoadError as ChooseGltfCamera says, after `prefix`.
+    void UseGltfCamera(const std::string& prefix, Scene& scene);
 
     // Camera (scene_camera.cc).
     CameraSpec ParseCamera(const Node& n);
@@ -148,6 +151,8 @@ class SceneParser {
     const SceneFileReader& read_file_;
     const SceneOptions& options_;
     std::vector<GltfCamera> gltf_cameras_;
+    // Every included glTF's animations, skins and morphs; the Scene gets it unless it is empty.
+    SceneAnimation animation_;
     std::vector<std::string> warnings_;
     std::map<std::string, int> material_index_;
     // power_lm emitters, resolved once every shape is loaded.

@@ -260,8 +260,9 @@ void SceneParser::ImportGltf(const std::string& bytes, const std::string& name,
     };
     const size_t first_mesh = scene.meshes.size();
     std::vector<std::string> warnings;
-    const absl::Status status = AppendGltf(bytes, name, hashing_reader, {base_dir, transform},
-                                           scene, gltf_cameras_, warnings);
+    const absl::Status status =
+        AppendGltf(bytes, name, hashing_reader, {base_dir, transform, &animation_}, scene,
+                   gltf_cameras_, warnings);
     for (const std::string& w : warnings) {
         warnings_.push_back(included ? absl::StrCat(name, ": ", w) : w);
     }
@@ -275,7 +276,15 @@ void SceneParser::ImportGltf(const std::string& bytes, const std::string& name,
             }
         }
     }
+    // Meshes left without triangles go; the animation's mesh indices follow the rest.
+    std::vector<int> index_after(scene.meshes.size(), -1);
+    for (int i = 0, kept = 0; i < int(scene.meshes.size()); ++i) {
+        if (!scene.meshes[size_t(i)].triangles.empty()) index_after[size_t(i)] = kept++;
+    }
     std::erase_if(scene.meshes, [](const TriangleMesh& m) { return m.triangles.empty(); });
+    std::erase_if(animation_.meshes,
+                  [&](const AnimatedMesh& m) { return index_after[size_t(m.mesh)] < 0; });
+    for (AnimatedMesh& m : animation_.meshes) m.mesh = index_after[size_t(m.mesh)];
 }
 
 void SceneParser::ParseGltfShape(const Node& n, Scene& scene) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace lf {
 namespace {
 
@@ -40,6 +42,19 @@ TEST(Affine, ThenAppliesThisFirst) {
     EXPECT_TRUE(scale.IsFinite());
     scale.m[1][1] = 1e300 * 1e300;
     EXPECT_FALSE(scale.IsFinite());
+}
+
+TEST(Affine, FromTrsScalesThenRotatesThenTranslates) {
+    // A quarter turn about +z (x -> y, y -> -x), scale (2, 3, 4), then translate (1, 2, 3);
+    // sqrt(0.5) squared is 0.5 within a few ulps.
+    const double s = std::sqrt(0.5);
+    const Affine a = Affine::FromTrs(Vec3d(1, 2, 3), {0, 0, s, s}, Vec3d(2, 3, 4));
+    const Vec3d q = a.Apply(Vec3d(1, 1, 1));
+    // Scaled (2, 3, 4), turned (-3, 2, 4), moved (-2, 4, 7).
+    EXPECT_NEAR(q.x, -2, 1e-14);
+    EXPECT_NEAR(q.y, 4, 1e-14);
+    EXPECT_NEAR(q.z, 7, 1e-14);
+    EXPECT_NEAR(a.Determinant(), 24, 1e-13);
 }
 
 }  // namespace

@@ -24,6 +24,11 @@ struct Affine {
     // front face.
     Affine NormalMatrix() const;
     bool IsFinite() const;
+
+    // translation * rotation * scale, glTF's node transform; `rotation` a unit quaternion
+    // (x, y, z, w).
+    static Affine FromTrs(const Vec3d& translation, const std::array<double, 4>& rotation,
+                          const Vec3d& scale);
 };
 
 }  // namespace lf

@@ -12,6 +12,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/affine.h"
 #include "lf/core/scene.h"
+#include "lf/core/scene_animation.h"
 #include "lf/core/scene_loader.h"
 
 namespace lf {
@@ -23,6 +24,8 @@ struct GltfCamera {
     // Why the camera cannot render ("cameras[1]: yfov 0 ..."): an error only when
     // it is chosen, so a file is never refused for a camera it does not render from.
     std::string error;
+    // Its node in GltfImport::animation, when the import collects one; -1 otherwise.
+    int node = -1;
 };
 
 // The image side a glTF camera gets for its longer side (the other from its aspectRatio; square
@@ -37,6 +40,10 @@ struct GltfImport {
     // Applied after the file's own node transforms: a JSON scene's "transform" of the included
     // file.
     Affine transform;
+    // Where the file's animations, skins and morph targets go (lf/core/scene_animation.h),
+    // with the node tree and what each node drives, when the file has any of them; null:
+    // ignored, the rest pose only.
+    SceneAnimation* animation = nullptr;
 };
 
 // Appends the default scene of glTF file `name` (its bytes `bytes`, JSON or binary) to `scene`:
@@ -54,8 +61,8 @@ absl::Status AppendGltf(const std::string& bytes, const std::string& name,
 // The camera named `name` among `cameras` (empty name: the first). NotFound listing the names
 // when there is no such camera, or when there is none at all; InvalidArgument with its error for
 // a camera that cannot render.
-absl::StatusOr<CameraSpec> ChooseGltfCamera(const std::vector<GltfCamera>& cameras,
-                                            const std::string& name);
+absl::StatusOr<const GltfCamera*> ChooseGltfCamera(const std::vector<GltfCamera>& cameras,
+                                                   const std::string& name);
 
 // True for names ending in .gltf or .glb, in any case.
 bool IsGltfName(const std::string& name);

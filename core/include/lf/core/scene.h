@@ -243,6 +243,8 @@ struct CameraSpec {
 // infinite ray).
 inline constexpr double kMaxCoordinate = 1e15;
 
+struct SceneAnimation;  // lf/core/scene_animation.h
+
 struct Scene {
     CameraSpec camera;
     std::vector<Material> materials;
@@ -258,6 +260,9 @@ struct Scene {
     std::string source;        // path of the scene file, for messages
     std::string content_hash;  // hex digest of the scene file and every mesh file it names
     int dropped_degenerate = 0;
+    // What glTF animations, skins and morph targets do to this scene over time (PoseAt); null
+    // when the scene has none. The geometry above is the files' rest pose until posed.
+    std::shared_ptr<const SceneAnimation> animation;
 
     // Axis-aligned bounds of all geometry.
     std::pair<Vec3d, Vec3d> Bounds() const;
