@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -43,6 +44,14 @@ struct AccessorData {
     int components = 0, component_type = 0, component_size = 0;
     bool normalized = false;
 };
+
+// What one Draco primitive may decode to (a few GB at most), refused beyond.
+inline constexpr size_t kMaxDracoPoints = size_t(1) << 26, kMaxDracoFaces = size_t(1) << 26;
+
+// tinygltf 2.7 refuses a primitive whose indices accessor has no bufferView, which a Draco
+// primitive's need not have: the glTF (`binary`: .glb) with each Draco primitive's "indices"
+// moved into its extension object, where DecodeDraco reads it. Other files come back as they are.
+std::string PrepareDraco(const std::string& bytes, bool binary);
 
 // Per-file state of one import.
 class GltfImporter {
@@ -81,12 +90,21 @@ class GltfImporter {
                   const std::string& where);
 
     // Meshes (gltf_meshes.cc).
+    // A buffer view's bytes, checked to lie inside their buffer.
+    std::string_view BufferView(int index, const std::string& where);
+    // What accessor `index` declares (type, count), without its data.
+    AccessorData Declaration(int index, const std::string& where);
+    // Accessor `index`'s elements: decoded_'s when the primitive is Draco's, else the buffer's.
     AccessorData Accessor(int index, const std::string& where);
     // An attribute's elements as floats, `components` per element: FLOAT, or the normalized
     // integer types glTF allows for texture coordinates and colours.
     std::vector<float> Floats(int index, int components, const std::string& where);
     std::vector<uint32_t> Indices(int index, size_t vertices, const std::string& where);
     void AddMesh(int index, const Affine& world, const std::string& node_where);
+    // Decodes a KHR_draco_mesh_compression primitive into decoded_ (gltf_draco.cc); returns
+    // its indices accessor.
+    int DecodeDraco(const tinygltf::Primitive& primitive, const tinygltf::Value& draco,
+                    const std::string& where);
 
     // Materials, textures and images (gltf_materials.cc).
     // The scene material for glTF material `index` (-1: glTF's default material).
@@ -129,6 +147,12 @@ class GltfImporter {
     std::map<std::string, Tallied> tallies_;
     std::vector<bool> visited_;
     std::map<int, int> material_of_, texture_of_;
+    // The current primitive's Draco-decoded accessors, by accessor index.
+    struct Decoded {
+        std::vector<unsigned char> bytes;
+        AccessorData data;
+    };
+    std::map<int, Decoded> decoded_;
     bool range_ignored_ = false;
 };
 

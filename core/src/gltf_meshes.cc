@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -55,19 +56,12 @@ const char* ModeName(int mode) {
 
 }  // namespace
 
-AccessorData GltfImporter::Accessor(int index, const std::string& where) {
-    if (index < 0 || index >= int(model_.accessors.size())) {
-        Fail(where, absl::StrCat("accessor ", index, " does not exist (the file has ",
-                                 model_.accessors.size(), ")"));
+std::string_view GltfImporter::BufferView(int index, const std::string& where) {
+    if (index < 0 || index >= int(model_.bufferViews.size())) {
+        Fail(where, absl::StrCat("bufferView ", index, " does not exist"));
     }
-    const tinygltf::Accessor& a = model_.accessors[size_t(index)];
-    const std::string at = absl::StrCat(where, ": accessors[", index, "]", Quoted(a.name));
-    if (a.sparse.isSparse) Fail(at, "sparse accessors are not supported");
-    if (a.bufferView < 0 || a.bufferView >= int(model_.bufferViews.size())) {
-        Fail(at, absl::StrCat("bufferView ", a.bufferView, " does not exist"));
-    }
-    const tinygltf::BufferView& view = model_.bufferViews[size_t(a.bufferView)];
-    const std::string view_at = absl::StrCat(at, ": bufferViews[", a.bufferView, "]");
+    const tinygltf::BufferView& view = model_.bufferViews[size_t(index)];
+    const std::string view_at = absl::StrCat(where, ": bufferViews[", index, "]");
     if (view.buffer < 0 || view.buffer >= int(model_.buffers.size())) {
         Fail(view_at, absl::StrCat("buffer ", view.buffer, " does not exist"));
     }
@@ -78,6 +72,17 @@ AccessorData GltfImporter::Accessor(int index, const std::string& where) {
                                    view.byteOffset + view.byteLength, " are beyond buffer ",
                                    view.buffer, " of ", buffer.data.size(), " bytes"));
     }
+    return {reinterpret_cast<const char*>(buffer.data.data()) + view.byteOffset, view.byteLength};
+}
+
+AccessorData GltfImporter::Declaration(int index, const std::string& where) {
+    if (index < 0 || index >= int(model_.accessors.size())) {
+        Fail(where, absl::StrCat("accessor ", index, " does not exist (the file has ",
+                                 model_.accessors.size(), ")"));
+    }
+    const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+    const std::string at = absl::StrCat(where, ": accessors[", index, "]", Quoted(a.name));
+    if (a.sparse.isSparse) Fail(at, "sparse accessors are not supported");
     AccessorData d;
     d.component_type = a.componentType;
     d.component_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
@@ -87,22 +92,34 @@ AccessorData GltfImporter::Accessor(int index, const std::string& where) {
     }
     d.normalized = a.normalized;
     d.count = a.count;
+    return d;
+}
+
+AccessorData GltfImporter::Accessor(int index, const std::string& where) {
+    if (const auto decoded = decoded_.find(index); decoded != decoded_.end()) {
+        return decoded->second.data;
+    }
+    AccessorData d = Declaration(index, where);
+    const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+    const std::string at = absl::StrCat(where, ": accessors[", index, "]", Quoted(a.name));
+    const std::string_view view = BufferView(a.bufferView, at);
     const size_t element = size_t(d.component_size) * size_t(d.components);
-    d.stride = view.byteStride > 0 ? view.byteStride : element;
+    const size_t byte_stride = model_.bufferViews[size_t(a.bufferView)].byteStride;
+    d.stride = byte_stride > 0 ? byte_stride : element;
     if (d.stride < element) {
-        Fail(view_at,
+        Fail(absl::StrCat(at, ": bufferViews[", a.bufferView, "]"),
              absl::StrCat("byteStride ", d.stride, " is below the element size ", element));
     }
     if (d.count > 0) {
         const size_t end = a.byteOffset + d.stride * (d.count - 1) + element;
-        if (a.byteOffset > view.byteLength || d.count - 1 > (view.byteLength) / d.stride ||
-            end > view.byteLength) {
+        if (a.byteOffset > view.size() || d.count - 1 > view.size() / d.stride ||
+            end > view.size()) {
             Fail(at, absl::StrCat(d.count, " elements from byte ", a.byteOffset,
-                                  " run beyond bufferViews[", a.bufferView, "] of ",
-                                  view.byteLength, " bytes"));
+                                  " run beyond bufferViews[", a.bufferView, "] of ", view.size(),
+                                  " bytes"));
         }
     }
-    d.data = buffer.data.data() + view.byteOffset + a.byteOffset;
+    d.data = reinterpret_cast<const unsigned char*>(view.data()) + a.byteOffset;
     return d;
 }
 
@@ -217,6 +234,13 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
         };
         const int position = attribute("POSITION");
         if (position < 0) Fail(where, "has no POSITION attribute");
+        // A Draco primitive's accessors read what its bitstream decodes to.
+        int indices_accessor = prim.indices;
+        decoded_.clear();
+        if (const tinygltf::Value* draco =
+                Extension(prim.extensions, "KHR_draco_mesh_compression")) {
+            indices_accessor = DecodeDraco(prim, *draco, where);
+        }
         TriangleMesh out;
         out.name = mesh.name.empty() ? absl::StrCat(name_, "#", where)
                                      : absl::StrCat(mesh.name, "[", p, "]");
@@ -283,8 +307,8 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
             }
         }
         std::vector<uint32_t> indices;
-        if (prim.indices >= 0) {
-            indices = Indices(prim.indices, n, at.substr(0, at.size() - 11) + "indices");
+        if (indices_accessor >= 0) {
+            indices = Indices(indices_accessor, n, at.substr(0, at.size() - 11) + "indices");
         } else {
             indices.resize(n);
             for (size_t i = 0; i < n; ++i) indices[i] = uint32_t(i);

@@ -18,11 +18,12 @@ namespace {
 // (a warning); in extensionsRequired it is an error.
 const std::set<std::string>& SupportedExtensions() {
     static const std::set<std::string> kSupported = {
-        "KHR_lights_punctual",  "KHR_materials_emissive_strength",
-        "KHR_materials_ior",    "KHR_materials_transmission",
-        "KHR_materials_volume", "KHR_materials_specular",
-        "KHR_materials_unlit",  "KHR_materials_clearcoat",
-        "KHR_materials_sheen",  "KHR_texture_transform",
+        "KHR_lights_punctual",        "KHR_materials_emissive_strength",
+        "KHR_materials_ior",          "KHR_materials_transmission",
+        "KHR_materials_volume",       "KHR_materials_specular",
+        "KHR_materials_unlit",        "KHR_materials_clearcoat",
+        "KHR_materials_sheen",        "KHR_texture_transform",
+        "KHR_draco_mesh_compression",
     };
     return kSupported;
 }
@@ -39,9 +40,6 @@ std::string WhatIsLost(const std::string& extension) {
         {"KHR_materials_variants", "material variants; the default materials are used"},
         {"KHR_texture_basisu", "Basis Universal textures; the fallback images are used"},
         {"EXT_texture_webp", "WebP textures; the fallback images are used"},
-        {"KHR_draco_mesh_compression",
-         "Draco-compressed geometry; the uncompressed fallback is "
-         "used"},
         {"EXT_meshopt_compression", "meshopt-compressed geometry; the fallback is used"},
         {"KHR_mesh_quantization", "nothing if the quantized attributes are floats"},
         {"EXT_mesh_gpu_instancing", "the instances; each mesh is rendered once"},

@@ -99,12 +99,13 @@ absl::Status AppendGltf(const std::string& bytes, const std::string& name,
                 bytes.size() < 12 ? "alone needs 12" : absl::StrCat("declares ", declared)));
         }
     }
+    const std::string prepared = gltf_internal::PrepareDraco(bytes, binary);
     const bool ok =
-        binary ? loader.LoadBinaryFromMemory(&model, &err, &warn,
-                                             reinterpret_cast<const unsigned char*>(bytes.data()),
-                                             unsigned(bytes.size()), "")
-               : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
-                                            unsigned(bytes.size()), "");
+        binary ? loader.LoadBinaryFromMemory(
+                     &model, &err, &warn, reinterpret_cast<const unsigned char*>(prepared.data()),
+                     unsigned(prepared.size()), "")
+               : loader.LoadASCIIFromString(&model, &err, &warn, prepared.data(),
+                                            unsigned(prepared.size()), "");
     if (!ok) {
         // A file the reader could not give is the cause the user can act on.
         for (const auto& [uri, status] : context.read_errors) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -584,10 +585,10 @@ TEST_F(GltfSceneTest, AbsurdlyLargeImageIsRefusedNamingIt) {
 
 TEST_F(GltfSceneTest, RequiredUnsupportedExtensionsAndMissingCamerasAreRefused) {
     GltfBuilder b = testing::TexturedTestScene();
-    b.json()["extensionsRequired"] = {"KHR_lights_punctual", "KHR_draco_mesh_compression",
+    b.json()["extensionsRequired"] = {"KHR_lights_punctual", "KHR_texture_basisu",
                                       "EXT_meshopt_compression"};
     ExpectError(Load(b), {"extensionsRequired",
-                          "does not support KHR_draco_mesh_compression, EXT_meshopt_compression"});
+                          "does not support KHR_texture_basisu, EXT_meshopt_compression"});
 
     GltfBuilder none = testing::TexturedTestScene();
     none.json()["scenes"][0]["nodes"] = {2, 4};
@@ -758,6 +759,135 @@ TEST(GltfVertexColorAsset, TheTestRowGetsItsVertexColours) {
     EXPECT_GT(coloured, 0u);
     for (const size_t n : pure) EXPECT_GT(n, 0u);
     EXPECT_EQ(CapturedLog().str().find("COLOR_0"), std::string::npos) << CapturedLog().str();
+}
+
+// KHR_draco_mesh_compression (tests/scenes/draco, made by make_draco_twins.py): a UV sphere
+// as plain glTF and compressed by draco_encoder, edgebreaker (.gltf) and sequential (.glb).
+std::string DracoScene(const std::string& name) {
+    return std::string(LF_TEST_SCENES) + "/draco/" + name;
+}
+
+std::string FileBytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Each Draco triangle has a twin triangle (the encoder reorders faces and may start a face at
+// another corner) whose corners agree within the quantisation: positions at 14 bits over the
+// sphere's extent 2 round by at most 2/(2^14-1)/2 = 6.1e-5 per component, uvs at 12 bits over 1
+// by 1.2e-4; normals at 10 bits of octahedral coordinates (spacing 2/1022) move by at most
+// about one spacing, 2.0e-3, per component. Each bound is given twice its size.
+void ExpectDracoTwin(const TriangleMesh& draco, const TriangleMesh& plain) {
+    ASSERT_EQ(draco.triangles.size(), plain.triangles.size());
+    ASSERT_EQ(draco.normals.size(), draco.positions.size());
+    ASSERT_EQ(draco.uvs.size(), draco.positions.size());
+    constexpr double kPosition = 2 * 6.1e-5, kUv = 2 * 1.2e-4, kNormal = 2 * 2.0e-3;
+    const auto close = [&](uint32_t a, uint32_t b) {
+        for (int k = 0; k < 3; ++k) {
+            if (std::abs(draco.positions[a][k] - plain.positions[b][k]) > kPosition) return false;
+            if (std::abs(draco.normals[a][k] - plain.normals[b][k]) > kNormal) return false;
+        }
+        return std::abs(draco.uvs[a].x - plain.uvs[b].x) <= kUv &&
+               std::abs(draco.uvs[a].y - plain.uvs[b].y) <= kUv;
+    };
+    std::vector<bool> used(plain.triangles.size(), false);
+    for (const auto& t : draco.triangles) {
+        bool found = false;
+        for (size_t j = 0; j < plain.triangles.size() && !found; ++j) {
+            const auto& u = plain.triangles[j];
+            for (int r = 0; r < 3 && !found && !used[j]; ++r) {
+                found = close(t[0], u[size_t(r)]) && close(t[1], u[size_t((r + 1) % 3)]) &&
+                        close(t[2], u[size_t((r + 2) % 3)]);
+                if (found) used[j] = true;
+            }
+        }
+        EXPECT_TRUE(found) << "no twin for the triangle at " << draco.positions[t[0]].x << " "
+                           << draco.positions[t[0]].y << " " << draco.positions[t[0]].z;
+    }
+}
+
+TEST(GltfDraco, EdgebreakerAndSequentialFilesEqualTheirUncompressedTwin) {
+    CapturedLog().str("");
+    const absl::StatusOr<Scene> plain = LoadScene(DracoScene("sphere.gltf"));
+    ASSERT_TRUE(plain.ok()) << plain.status();
+    ASSERT_EQ(plain->meshes.size(), 1u);
+    EXPECT_EQ(plain->meshes[0].triangles.size(), 288u);
+    for (const char* name : {"sphere_draco.gltf", "sphere_draco_sequential.glb"}) {
+        SCOPED_TRACE(name);
+        const absl::StatusOr<Scene> draco = LoadScene(DracoScene(name));
+        ASSERT_TRUE(draco.ok()) << draco.status();
+        ASSERT_EQ(draco->meshes.size(), 1u);
+        ExpectDracoTwin(draco->meshes[0], plain->meshes[0]);
+        EXPECT_EQ(draco->meshes[0].material, 0);
+        EXPECT_EQ(draco->textures.size(), plain->textures.size());
+    }
+    EXPECT_EQ(CapturedLog().str().find("KHR_draco"), std::string::npos) << CapturedLog().str();
+}
+
+TEST_F(GltfSceneTest, CorruptOrInconsistentDracoPrimitivesAreRefusedNamingThem) {
+    const std::string stream = FileBytes(DracoScene("sphere_draco.bin"));
+    const Json gltf = Json::parse(FileBytes(DracoScene("sphere_draco.gltf")));
+    Write("checker.png", FileBytes(DracoScene("checker.png")));
+    const auto load = [&](const Json& j, const std::string& bin) {
+        Write("d.gltf", j.dump());
+        Write("sphere_draco.bin", bin);
+        return LoadScene((dir_ / "d.gltf").string());
+    };
+    ASSERT_TRUE(load(gltf, stream).ok());
+    const std::string at =
+        "meshes[0] \"sphere\".primitives[0].extensions.KHR_draco_mesh_compression";
+
+    // The bitstream cut in half, or its middle overwritten.
+    Json half = gltf;
+    half["bufferViews"][0]["byteLength"] = stream.size() / 2;
+    half["buffers"][0]["byteLength"] = stream.size() / 2;
+    ExpectError(load(half, stream.substr(0, stream.size() / 2)),
+                {"d.gltf", at, "cannot be decoded"});
+    std::string garbled = stream;
+    for (size_t i = 20; i < garbled.size(); i += 3) garbled[i] = char(0xff);
+    ExpectError(load(gltf, garbled), {"d.gltf", at});
+    std::string not_draco = stream;
+    not_draco[0] = 'X';
+    ExpectError(load(gltf, not_draco), {at, "is not a Draco triangle mesh"});
+
+    // An attribute id the bitstream lacks, or a semantic the primitive lacks.
+    Json missing = gltf;
+    missing["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["attributes"]
+           ["NORMAL"] = 7;
+    ExpectError(load(missing, stream),
+                {at + ".attributes.NORMAL", "attribute id 7 is not in the bitstream"});
+    Json extra = gltf;
+    extra["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["attributes"]
+         ["TEXCOORD_1"] = 1;
+    ExpectError(load(extra, stream),
+                {at + ".attributes.TEXCOORD_1", "not among the primitive's attributes"});
+
+    // Counts that differ from the accessors': the faces the header declares, the points it
+    // decodes to, and an attribute's.
+    Json faces = gltf;
+    faces["accessors"][3]["count"] = 3 * 287;
+    ExpectError(load(faces, stream),
+                {at, "the bitstream declares 288 faces", "the accessors say 287 faces"});
+    Json points = gltf;
+    for (int a : {0, 1, 2}) points["accessors"][a]["count"] = 184;
+    ExpectError(load(points, stream), {at, "decoded 288 faces and 185 points", "184 points"});
+    Json uvs = gltf;
+    uvs["accessors"][2]["count"] = 184;
+    ExpectError(load(uvs, stream),
+                {at + ".attributes.TEXCOORD_0", "184 elements; the bitstream has 185 points"});
+    Json components = gltf;
+    components["accessors"][2]["type"] = "VEC3";
+    ExpectError(load(components, stream),
+                {at + ".attributes.TEXCOORD_0", "has 2 components; accessors[2] has 3"});
+
+    // Absurd sizes are refused before anything is decoded.
+    Json huge = gltf;
+    huge["accessors"][3]["count"] = 3 * (size_t(1) << 27);
+    ExpectError(load(huge, stream), {at, "more than lightfarm decodes"});
+    Json no_indices = gltf;
+    no_indices["meshes"][0]["primitives"][0].erase("indices");
+    ExpectError(load(no_indices, stream),
+                {"meshes[0] \"sphere\".primitives[0]", "has no indices accessor"});
 }
 
 // A loss many objects share is one warning with a count, and a glTF rendered directly names its
