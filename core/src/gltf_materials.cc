@@ -238,9 +238,11 @@ TextureRef GltfImporter::Texture(int index, int tex_coord, const tinygltf::Exten
             tex_coord = int(Number(*t, "texCoord", 0, 0, 1e6, t_at));
         }
     }
-    if (tex_coord != 0) {
+    if (tex_coord > 1) {
         Warn(absl::StrCat(where, ": uses TEXCOORD_", tex_coord,
-                          "; lightfarm reads TEXCOORD_0 only and uses that"));
+                          "; lightfarm reads TEXCOORD_0 and TEXCOORD_1 only and uses TEXCOORD_0"));
+    } else {
+        ref.tex_coord = tex_coord;
     }
     return ref;
 }

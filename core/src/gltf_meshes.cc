@@ -268,11 +268,21 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
                 out.normals[i] = Vec3(v / length);
             }
         }
-        if (const int uv = attribute("TEXCOORD_0"); uv >= 0) {
-            const std::vector<float> uvs = Floats(uv, 2, at + "TEXCOORD_0");
-            if (uvs.size() / 2 != n) Fail(at + "TEXCOORD_0", "count differs from POSITION");
-            out.uvs.resize(n);
-            for (size_t i = 0; i < n; ++i) out.uvs[i] = {uvs[2 * i], uvs[2 * i + 1]};
+        const auto read_uvs = [&](const char* key, std::vector<Vec2>& out_uvs) {
+            const int uv = attribute(key);
+            if (uv < 0) return false;
+            const std::vector<float> uvs = Floats(uv, 2, at + key);
+            if (uvs.size() / 2 != n) Fail(at + key, "count differs from POSITION");
+            out_uvs.resize(n);
+            for (size_t i = 0; i < n; ++i) out_uvs[i] = {uvs[2 * i], uvs[2 * i + 1]};
+            return true;
+        };
+        read_uvs("TEXCOORD_0", out.uvs);
+        // The second set costs memory only where a texture reads it.
+        if (scene_.materials[size_t(out.material)].ReadsUvs1() &&
+            !read_uvs("TEXCOORD_1", out.uvs1)) {
+            Tally("material reads TEXCOORD_1 the primitive lacks (uv (0, 0) used)", "primitive",
+                  where);
         }
         if (const int tangent = attribute("TANGENT"); tangent >= 0) {
             const std::vector<float> t = Floats(tangent, 4, at + "TANGENT");

@@ -2,13 +2,14 @@
 
 namespace lf {
 
-void ComputeTangents(TriangleMesh& mesh) {
+void ComputeTangents(TriangleMesh& mesh, int tex_coord) {
+    const std::vector<Vec2>& uvs = mesh.Uvs(tex_coord);
     const size_t n = mesh.positions.size();
     std::vector<Vec3d> tangent(n), bitangent(n), normal(n);
     for (const auto& t : mesh.triangles) {
         const Vec3d e1 = mesh.positions[t[1]] - mesh.positions[t[0]];
         const Vec3d e2 = mesh.positions[t[2]] - mesh.positions[t[0]];
-        const Vec2 &uv0 = mesh.uvs[t[0]], &uv1 = mesh.uvs[t[1]], &uv2 = mesh.uvs[t[2]];
+        const Vec2 &uv0 = uvs[t[0]], &uv1 = uvs[t[1]], &uv2 = uvs[t[2]];
         const double du1 = uv1.x - uv0.x, dv1 = uv1.y - uv0.y;
         const double du2 = uv2.x - uv0.x, dv2 = uv2.y - uv0.y;
         const double r = du1 * dv2 - du2 * dv1;
@@ -35,10 +36,9 @@ void ComputeTangents(TriangleMesh& mesh) {
 
 void ComputeMissingTangents(Scene& scene) {
     for (TriangleMesh& mesh : scene.meshes) {
-        if (mesh.tangents.empty() && !mesh.uvs.empty() &&
-            scene.materials[size_t(mesh.material)].normal_texture.valid()) {
-            ComputeTangents(mesh);
-        }
+        const TextureRef& map = scene.materials[size_t(mesh.material)].normal_texture;
+        if (!map.valid() || !mesh.tangents.empty()) continue;
+        if (!mesh.Uvs(map.tex_coord).empty()) ComputeTangents(mesh, map.tex_coord);
     }
 }
 

@@ -59,6 +59,7 @@ absl::Status CheckMesh(const Scene& scene, const TriangleMesh& mesh) {
     };
     if (absl::Status s = check(mesh.normals.size(), "normals"); !s.ok()) return s;
     if (absl::Status s = check(mesh.uvs.size(), "texture coordinates"); !s.ok()) return s;
+    if (absl::Status s = check(mesh.uvs1.size(), "second texture coordinates"); !s.ok()) return s;
     if (absl::Status s = check(mesh.colors.size(), "vertex colours"); !s.ok()) return s;
     return check(mesh.tangents.size(), "tangents");
 }
@@ -112,7 +113,7 @@ void FilterHits(const RTCFilterFunctionNArguments* args) {
                                 ? AlphaHash(RayOrigin(args, i), RayDirection(args, i),
                                             unsigned(f.mesh), unsigned(prim))
                                 : 0;
-            if (PassesThrough(scene, material, TriangleUv(mesh, prim, b1, b2),
+            if (PassesThrough(scene, material, TriangleUvs(mesh, prim, b1, b2),
                               VertexColor(mesh, prim, b1, b2).a, u)) {
                 args->valid[i] = 0;
             }

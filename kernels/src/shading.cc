@@ -11,8 +11,8 @@
 namespace lf {
 namespace {
 
-Rgba Sample(const Scene& scene, const TextureRef& ref, const Vec2& uv) {
-    return Lookup(*scene.textures[size_t(ref.image)], ref, uv);
+Rgba Sample(const Scene& scene, const TextureRef& ref, const TexCoords& uv) {
+    return Lookup(*scene.textures[size_t(ref.image)], ref, uv[size_t(ref.tex_coord)]);
 }
 
 // The tangent and the bitangent's sign (glTF: bitangent = sign * cross(normal, tangent)) at the
@@ -37,10 +37,10 @@ bool TangentAt(const TriangleMesh& mesh, const SurfaceHit& hit, Vec3* tangent, f
 // The normal map's normal at the hit, or `n` where the map cannot apply (no uvs or tangent,
 // or a texel that points below the geometric surface).
 Vec3 NormalMapped(const EmbreeScene& es, const TextureRef& map, float scale, const SurfaceHit& hit,
-                  const Vec2& uv, const Vec3& n) {
+                  const TexCoords& uv, const Vec3& n) {
     if (hit.mesh < 0) return n;
     const TriangleMesh& mesh = es.scene().meshes[size_t(hit.mesh)];
-    if (mesh.uvs.empty()) return n;
+    if (mesh.Uvs(map.tex_coord).empty()) return n;
     Vec3 t;
     float sign;
     if (!TangentAt(mesh, hit, &t, &sign)) return n;
@@ -121,12 +121,18 @@ bool Shading::ClearsFacet(const Vec3& w) const {
     return false;
 }
 
-Vec2 TriangleUv(const TriangleMesh& mesh, int primitive, float b1, float b2) {
-    if (mesh.uvs.empty()) return {0, 0};
+TexCoords TriangleUvs(const TriangleMesh& mesh, int primitive, float b1, float b2) {
+    TexCoords out{};
     const auto& tri = mesh.triangles[size_t(primitive)];
-    const Vec2 uv0 = mesh.uvs[tri[0]], uv1 = mesh.uvs[tri[1]], uv2 = mesh.uvs[tri[2]];
     const float b0 = 1 - b1 - b2;
-    return {b0 * uv0.x + b1 * uv1.x + b2 * uv2.x, b0 * uv0.y + b1 * uv1.y + b2 * uv2.y};
+    for (int set = 0; set < 2; ++set) {
+        const std::vector<Vec2>& uvs = mesh.Uvs(set);
+        if (uvs.empty()) continue;
+        const Vec2 uv0 = uvs[tri[0]], uv1 = uvs[tri[1]], uv2 = uvs[tri[2]];
+        out[size_t(set)] = {b0 * uv0.x + b1 * uv1.x + b2 * uv2.x,
+                            b0 * uv0.y + b1 * uv1.y + b2 * uv2.y};
+    }
+    return out;
 }
 
 Rgba VertexColor(const TriangleMesh& mesh, int primitive, float b1, float b2) {
@@ -140,19 +146,21 @@ Rgba VertexColor(const TriangleMesh& mesh, int primitive, float b1, float b2) {
     return {Rgb(sum[0], sum[1], sum[2]), sum[3]};
 }
 
-float Opacity(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha) {
+float Opacity(const Scene& scene, const Material& material, const TexCoords& uv,
+              float vertex_alpha) {
     float a = material.opacity * vertex_alpha;
     if (material.base_color_texture.valid()) a *= Sample(scene, material.base_color_texture, uv).a;
     return a;
 }
 
-bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha) {
+bool IsCutOut(const Scene& scene, const Material& material, const TexCoords& uv,
+              float vertex_alpha) {
     return material.alpha_mode == Material::AlphaMode::kMask &&
            Opacity(scene, material, uv, vertex_alpha) < material.alpha_cutoff;
 }
 
-bool PassesThrough(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha,
-                   float u) {
+bool PassesThrough(const Scene& scene, const Material& material, const TexCoords& uv,
+                   float vertex_alpha, float u) {
     switch (material.alpha_mode) {
         case Material::AlphaMode::kOpaque:
             return false;
@@ -235,7 +243,7 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
     s.p_outer = hit.p;
     if (hit.mesh >= 0) {
         const TriangleMesh& mesh = scene.meshes[size_t(hit.mesh)];
-        s.uv = TriangleUv(mesh, hit.primitive, hit.b1, hit.b2);
+        s.uv = TriangleUvs(mesh, hit.primitive, hit.b1, hit.b2);
         vertex_color = VertexColor(mesh, hit.primitive, hit.b1, hit.b2).rgb;
         if (!mesh.normals.empty()) {
             const auto& tri = mesh.triangles[size_t(hit.primitive)];
@@ -303,7 +311,7 @@ Rgb EmissionAt(const EmbreeScene& es, const SurfacePoint& light_point, const Rgb
         !m.emission_by_vertex_color) {
         return radiance;
     }
-    const Vec2 uv = TriangleUv(mesh, light_point.primitive, light_point.b1, light_point.b2);
+    const TexCoords uv = TriangleUvs(mesh, light_point.primitive, light_point.b1, light_point.b2);
     const Rgba vertex = VertexColor(mesh, light_point.primitive, light_point.b1, light_point.b2);
     if (IsCutOut(scene, m, uv, vertex.a)) return Rgb(0);
     Rgb le = radiance;

@@ -892,6 +892,31 @@ TEST_F(GltfSceneTest, CorruptOrInconsistentDracoPrimitivesAreRefusedNamingThem) 
 
 // A loss many objects share is one warning with a count, and a glTF rendered directly names its
 // file once in it (the log line's prefix), not once per material.
+// texCoord 0 and 1 choose the uv set (KHR_texture_transform's texCoord overrides it); a
+// primitive without the TEXCOORD_1 its material reads, and TEXCOORD_2 and beyond, warn.
+TEST_F(GltfSceneTest, TexCoordPicksTheUvSetAndUnreadSetsWarn) {
+    GltfBuilder b = testing::TexturedTestScene();
+    Json& pbr = b.json()["materials"][0]["pbrMetallicRoughness"];
+    pbr["baseColorTexture"]["texCoord"] = 1;
+    pbr["metallicRoughnessTexture"] = {{"index", 0}, {"texCoord", 2}};
+    b.json()["materials"][0]["emissiveFactor"] = {1, 1, 1};
+    b.json()["materials"][0]["emissiveTexture"] = {
+        {"index", 0}, {"extensions", {{"KHR_texture_transform", {{"texCoord", 1}}}}}};
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    const Material& m = scene->materials[0];
+    EXPECT_EQ(m.base_color_texture.tex_coord, 1);
+    EXPECT_EQ(m.metallic_roughness_texture.tex_coord, 0);
+    EXPECT_EQ(m.emission_texture.tex_coord, 1);
+    EXPECT_TRUE(scene->meshes[0].uvs1.empty());
+    const std::string log = CapturedLog().str();
+    EXPECT_NE(log.find("material reads TEXCOORD_1 the primitive lacks (uv (0, 0) used) in 1 "
+                       "primitive: meshes[0]"),
+              std::string::npos)
+        << log;
+    EXPECT_NE(log.find("metallicRoughnessTexture: uses TEXCOORD_2"), std::string::npos) << log;
+}
+
 TEST_F(GltfSceneTest, WarningsComeOncePerKindWithACountNamingTheFileOnce) {
     GltfBuilder b = testing::TexturedTestScene();
     for (Json& m : b.json()["materials"]) m["occlusionTexture"] = {{"index", 0}};

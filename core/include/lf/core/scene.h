@@ -44,6 +44,7 @@ struct TextureRef {
     Vec2 offset{0, 0};
     float rotation = 0;  // radians, counter-clockwise in uv
     Vec2 scale{1, 1};
+    int tex_coord = 0;  // the uv set it reads: 0 TriangleMesh::uvs, 1 TriangleMesh::uvs1
 
     bool valid() const { return image >= 0; }
 };
@@ -124,13 +125,25 @@ struct Material {
         return double_sided || type == Type::kDielectric ||
                (type == Type::kPrincipled && transmission > 0);
     }
+    std::array<const TextureRef*, 12> Textures() const {
+        return {
+            &base_color_texture,       &metallic_roughness_texture, &normal_texture,
+            &emission_texture,         &transmission_texture,       &specular_texture,
+            &specular_color_texture,   &clearcoat_texture,          &clearcoat_roughness_texture,
+            &clearcoat_normal_texture, &sheen_color_texture,        &sheen_roughness_texture};
+    }
     bool IsTextured() const {
-        return base_color_texture.valid() || metallic_roughness_texture.valid() ||
-               normal_texture.valid() || emission_texture.valid() || transmission_texture.valid() ||
-               specular_texture.valid() || specular_color_texture.valid() ||
-               clearcoat_texture.valid() || clearcoat_roughness_texture.valid() ||
-               clearcoat_normal_texture.valid() || sheen_color_texture.valid() ||
-               sheen_roughness_texture.valid();
+        for (const TextureRef* t : Textures()) {
+            if (t->valid()) return true;
+        }
+        return false;
+    }
+    // Whether a texture reads the second uv set (TriangleMesh::uvs1).
+    bool ReadsUvs1() const {
+        for (const TextureRef* t : Textures()) {
+            if (t->valid() && t->tex_coord == 1) return true;
+        }
+        return false;
     }
 };
 
@@ -147,12 +160,17 @@ struct TriangleMesh {
     // flat-shaded; tangents (xyz, and w = ±1 the bitangent's sign) serve normal maps.
     std::vector<Vec3> normals;  // unit, in the same space as positions
     std::vector<Vec2> uvs;      // TEXCOORD_0: v = 0 is the top of the image
+    // TEXCOORD_1, for textures with tex_coord 1; loaders keep it only when the material reads it.
+    std::vector<Vec2> uvs1;
     std::vector<std::array<float, 4>> tangents;
     // COLOR_0, linear RGBA: multiplies the base colour and its alpha the opacity (glTF).
     std::vector<std::array<float, 4>> colors;
     // True when the mesh came from a `quad` shape: (v0,v1,v2),(v0,v2,v3). Radiosity meshes
     // such shapes as a grid of quads rather than triangles.
     bool is_quad = false;
+
+    // The uv set a texture with this tex_coord reads.
+    const std::vector<Vec2>& Uvs(int tex_coord) const { return tex_coord == 1 ? uvs1 : uvs; }
 };
 
 struct Sphere {

@@ -4,6 +4,8 @@
 // offset on smooth meshes). The geometric normal stays in SurfaceHit::n: it decides sides.
 #pragma once
 
+#include <array>
+
 #include "lf/core/scene.h"
 #include "lf/core/texture.h"
 #include "lf/kernels/bsdf.h"
@@ -11,13 +13,16 @@
 
 namespace lf {
 
+// A point's uvs in each set a texture may read (TextureRef::tex_coord): TEXCOORD_0, TEXCOORD_1.
+using TexCoords = std::array<Vec2, 2>;
+
 struct Shading {
     SurfacePoint point;  // the hit: p, its error bound, the geometric normal n
     // Unit shading normal on the geometric normal's side; equals point.n on flat geometry.
     // Bent, where needed, so that wo mirrored about it stays above the surface
     // (ValidReflectionNormal), which also keeps wo on its side.
     Vec3 ns;
-    Vec2 uv;
+    TexCoords uv;
     SurfaceParams params;
     Rgb emission;  // radiance leaving the front (both, if two-sided): factor times texture
     // Hanika's P' (Ray Tracing Gems II, ch. 4): the hit lifted towards the smooth surface the
@@ -59,23 +64,25 @@ Shading Shade(const EmbreeScene& scene, const SurfaceHit& hit, const Vec3& wo);
 // blended surface (what rays that stop there see, on average).
 Rgb EmissionAt(const EmbreeScene& scene, const SurfacePoint& light_point, const Rgb& radiance);
 
-// TEXCOORD_0 of a triangle's point; (0, 0) on meshes without uvs.
-Vec2 TriangleUv(const TriangleMesh& mesh, int primitive, float b1, float b2);
+// Both uv sets of a triangle's point; (0, 0) for a set the mesh lacks.
+TexCoords TriangleUvs(const TriangleMesh& mesh, int primitive, float b1, float b2);
 
 // COLOR_0 of a triangle's point; white and opaque on meshes without vertex colours.
 Rgba VertexColor(const TriangleMesh& mesh, int primitive, float b1, float b2);
 
 // The material's opacity at uv: its factor times the base colour texture's alpha times the
 // vertex colour's alpha there.
-float Opacity(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha = 1);
+float Opacity(const Scene& scene, const Material& material, const TexCoords& uv,
+              float vertex_alpha = 1);
 
 // True when rays pass through the material at uv (an alpha-mask hole).
-bool IsCutOut(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha = 1);
+bool IsCutOut(const Scene& scene, const Material& material, const TexCoords& uv,
+              float vertex_alpha = 1);
 
 // Whether a ray passes through the material at uv, u uniform in [0, 1): through an alpha-mask
 // hole always, through a blended surface when u >= its opacity.
-bool PassesThrough(const Scene& scene, const Material& material, const Vec2& uv, float vertex_alpha,
-                   float u);
+bool PassesThrough(const Scene& scene, const Material& material, const TexCoords& uv,
+                   float vertex_alpha, float u);
 
 // A uniform number in [0, 1) for the candidate hit of a ray (origin, direction) on primitive
 // `primitive` of geometry `geometry`: the blend test's, so a ray and its retraces agree, while
