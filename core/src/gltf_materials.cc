@@ -139,7 +139,11 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         m.attenuation_color =
             Color(Numbers(*e, "attenuationColor", {1, 1, 1}, at), at, "attenuationColor");
         if (e->Has("thicknessTexture")) {
-            Warn(at + ": thicknessTexture ignored; only whether thickness is 0 matters");
+            // The extension's thickness stands in for the geometry in rasterisers; a ray
+            // tracer measures the path inside, so only thin (0) against solid matters here.
+            Tally("KHR_materials_volume thicknessTexture unused (paths inside are measured on "
+                  "the geometry)",
+                  "material", where);
         }
     }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_clearcoat")) {
