@@ -141,9 +141,10 @@ lf::Material GltfImporter::ConvertMaterial(int index) {
         if (e->Has("thicknessTexture")) {
             // The extension's thickness stands in for the geometry in rasterisers; a ray
             // tracer measures the path inside, so only thin (0) against solid matters here.
-            Tally("KHR_materials_volume thicknessTexture unused (paths inside are measured on "
-                  "the geometry)",
-                  "material", where);
+            Tally(
+                "KHR_materials_volume thicknessTexture unused (paths inside are measured on "
+                "the geometry)",
+                "material", where);
         }
     }
     if (const tinygltf::Value* e = Extension(g.extensions, "KHR_materials_clearcoat")) {
@@ -242,6 +243,7 @@ TextureRef GltfImporter::Texture(int index, int tex_coord, const tinygltf::Exten
             tex_coord = int(Number(*t, "texCoord", 0, 0, 1e6, t_at));
         }
     }
+    if (tex_coord < 0) Fail(where, absl::StrCat("texCoord ", tex_coord, " is negative"));
     if (tex_coord > 1) {
         Warn(absl::StrCat(where, ": uses TEXCOORD_", tex_coord,
                           "; lightfarm reads TEXCOORD_0 and TEXCOORD_1 only and uses TEXCOORD_0"));

@@ -917,6 +917,17 @@ TEST_F(GltfSceneTest, TexCoordPicksTheUvSetAndUnreadSetsWarn) {
     EXPECT_NE(log.find("metallicRoughnessTexture: uses TEXCOORD_2"), std::string::npos) << log;
 }
 
+// A negative texCoord would index the uv sets from before their start: refused, naming it.
+TEST_F(GltfSceneTest, ANegativeTexCoordIsRefusedNamingTheTexture) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["texCoord"] = -1;
+    const absl::StatusOr<Scene> scene = Load(b);
+    ASSERT_FALSE(scene.ok());
+    EXPECT_NE(std::string(scene.status().message()).find("texCoord -1 is negative"),
+              std::string::npos)
+        << scene.status();
+}
+
 TEST_F(GltfSceneTest, WarningsComeOncePerKindWithACountNamingTheFileOnce) {
     GltfBuilder b = testing::TexturedTestScene();
     for (Json& m : b.json()["materials"]) m["occlusionTexture"] = {{"index", 0}};
