@@ -446,11 +446,16 @@ TEST_F(GuardedServices, StalledResultReadersAreCappedPerTokenAndHoldNoWholeResul
     std::string alice_job, bob_job;
     ASSERT_TRUE(Submit(*Jobs("alice"), &alice_job).ok());
     ASSERT_TRUE(Submit(*Jobs("bob"), &bob_job).ok());
-    // A queued job's preview is kept while no task ends: made 64 MiB here, as a large result.
+    // A queued job's preview is kept while no task ends: made 192 MiB here, as a large result.
+    // Large beside what the transport may buffer per stream on both ends (its windows grow with
+    // the measured bandwidth-delay product; 37 MB a reader was seen on a loaded machine).
     ASSERT_TRUE(farm_->ResultFile(alice_job, true).ok());
-    constexpr size_t kResultBytes = size_t(64) << 20;
-    std::ofstream(dir_ / "data" / "previews" / (alice_job + ".exr"), std::ios::binary)
-        << std::string(kResultBytes, 'r');
+    constexpr size_t kResultBytes = size_t(192) << 20;
+    {
+        std::ofstream out(dir_ / "data" / "previews" / (alice_job + ".exr"), std::ios::binary);
+        const std::string mebibyte(size_t(1) << 20, 'r');
+        for (size_t i = 0; i < kResultBytes >> 20; ++i) out << mebibyte;
+    }
     const auto fetch = [](pb::JobService::Stub& stub, const std::string& id) {
         pb::FetchResultRequest request;
         request.set_job_id(id);
@@ -469,8 +474,8 @@ TEST_F(GuardedServices, StalledResultReadersAreCappedPerTokenAndHoldNoWholeResul
     std::this_thread::sleep_for(std::chrono::milliseconds(500));  // let the server run ahead
     const long after = ResidentKib();
     // Each reader costs its chunk and what flow control lets through on both ends of the
-    // connection (this process is server and client: about 17 MB a reader measured), not the
-    // 64 MiB result: four whole results would be 256 MiB.
+    // connection (this process is server and client: 17 to 37 MB a reader measured), not the
+    // 192 MiB result: four whole results would be 768 MiB.
     EXPECT_LT(after - before, long(4 * kResultBytes / 2 / 1024))
         << before << " KiB before, " << after << " after";
     const auto refused = fetch(*alice, alice_job);
