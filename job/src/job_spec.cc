@@ -53,6 +53,11 @@ absl::Status CheckMethodSettings(const JobSpec& spec) {
             "adaptive: method \"", spec.method,
             "\" has no adaptive sampling (no target error or time limit); set spp instead"));
     }
+    if (spec.shot.shutter > 0 && !Info(*method).motion_blur) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "shutter: method \"", spec.method,
+            "\" solves one instant per frame and renders no motion blur; set shutter 0"));
+    }
     return absl::OkStatus();
 }
 
@@ -86,6 +91,7 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         InRange("radiosity.sweep_tasks", r.sweep_tasks, 1, kMaxSweepTasks),
         InRange("radiosity.max_patches", r.max_patches, int64_t(0), kMaxRefinedPatches),
         CheckPhotonSettings(spec.ppm),
+        CheckShotSettings(spec.shot),
         CheckMethodSettings(spec),
     };
     for (const absl::Status& s : checks) {
@@ -119,6 +125,13 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         }
     }
     return absl::OkStatus();
+}
+
+JobSpec FrameSpec(const JobSpec& spec, int frame) {
+    JobSpec still = spec;
+    still.shot.frames = FrameRange{frame, frame, 1};
+    still.shot.chunk = 1;
+    return still;
 }
 
 }  // namespace lf

@@ -15,16 +15,17 @@ namespace {
 
 // Indexed by Method.
 constexpr std::array<MethodInfo, 6> kMethods = {{
-    {Method::kPath, "path", WorkKind::kTiles, std::nullopt, false, true, true, true, nullptr},
+    {Method::kPath, "path", WorkKind::kTiles, std::nullopt, false, true, true, true, true, nullptr},
     {Method::kRadiosity, "radiosity", WorkKind::kRadiosity, std::nullopt, false, false, true, true,
-     RadiosityRefusal},
-    {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, true, nullptr},
+     false, RadiosityRefusal},
+    {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, true, true,
+     nullptr},
     {Method::kLight, "light", WorkKind::kSplatPasses, SplatPlanKind::kLightPaths, true, false,
-     false, false, nullptr},
+     false, false, true, nullptr},
     {Method::kBdpt, "bdpt", WorkKind::kSplatPasses, SplatPlanKind::kCameraAndLight, true, true,
-     false, false, nullptr},
+     false, false, true, nullptr},
     {Method::kPpm, "ppm", WorkKind::kSplatPasses, SplatPlanKind::kPhotonPasses, false, true, false,
-     false, nullptr},
+     false, true, nullptr},
 }};
 
 constexpr bool IndexedByMethod() {

@@ -158,6 +158,12 @@ absl::StatusOr<RenderDescription> DescribeRender(const RenderMetadata& m, const 
     if (!m.camera.empty()) d.attributes["lightfarm.camera"] = m.camera;
     if (!m.sky.empty()) d.attributes["lightfarm.sky"] = m.sky;
     if (!m.partial.empty()) d.attributes["lightfarm.partial"] = m.partial;
+    if (m.frame) {
+        d.attributes["lightfarm.frame"] = *m.frame;
+        d.attributes["lightfarm.time"] = FrameSeconds(*m.frame, m.fps);
+        d.attributes["lightfarm.fps"] = m.fps;
+        d.attributes["lightfarm.shutter"] = m.shutter;
+    }
     if (m.aovs != 0) d.attributes["lightfarm.aovs"] = AovListName(m.aovs);
     const std::optional<Method> method = FindMethod(m.method);
     const MethodInfo* info = method ? &Info(*method) : nullptr;
@@ -202,6 +208,12 @@ RenderMetadata MetadataOf(const JobSpec& spec, const RenderOutcome& outcome) {
     m.radiosity = outcome.radiosity;
     m.ppm = spec.ppm;
     m.partial = outcome.partial;
+    // A shot's per-frame spec (FrameSpec) names one frame.
+    if (spec.shot.frames && spec.shot.frames->count() == 1) {
+        m.frame = spec.shot.frames->first;
+        m.fps = spec.shot.fps;
+        m.shutter = spec.shot.shutter;
+    }
     return m;
 }
 

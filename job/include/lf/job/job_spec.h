@@ -17,6 +17,7 @@
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
 #include "lf/job/settings.h"
+#include "lf/job/shot.h"
 
 namespace lf {
 
@@ -38,6 +39,7 @@ struct JobSpec {
     RadiositySettings radiosity;
     PhotonSettings ppm;         // method "ppm" (lf/job/splat_settings.h)
     AdaptiveSettings adaptive;  // IsAdaptive: plan.spp is the first pass, plan.passes unused
+    ShotSettings shot;          // frames, fps, shutter, chunk (lf/job/shot.h); a still by default
     int priority = 0;           // higher first
     std::string scene_hash;     // the loader's content hash, for the EXR header
     std::string request_id;     // the client's, for idempotent retries; "" for none
@@ -67,6 +69,11 @@ inline constexpr std::array<std::string_view, 2> kRadiosityDisplays = {"flat", "
 // where they are loaded); otherwise InvalidArgument naming the field and its allowed range, e.g.
 // "radiosity.patches 1099511627776: expected 1 to 16777216".
 absl::Status CheckJobSettings(const JobSpec& spec);
+
+// The still that renders frame `frame` of `spec`'s shot: its frames are {frame, frame, 1}, one
+// frame a task. Every frame of a shot renders as the still of that frame renders alone, locally
+// or on the farm, so each gives the same bits.
+JobSpec FrameSpec(const JobSpec& spec, int frame);
 
 // Radiosity jobs the farm solves in patch-group tasks per sweep, rather than on every worker.
 // Not adaptive ones: their passes are appended to the tasks where the sweeps would go.

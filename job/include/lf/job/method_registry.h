@@ -40,6 +40,8 @@ struct MethodInfo {
     // decides its next pass.
     bool aovs;
     bool adaptive;  // --target-error, --time-limit
+    // Renders a shutter interval (--shutter): radiosity solves one instant per frame.
+    bool motion_blur;
     // The scenes the method cannot represent: why, as a status; nullptr when it takes any.
     // Whitted's omissions (lf::WhittedMissingTerms) are logged, not refused.
     absl::Status (*scene_refusal)(const Scene& scene);

@@ -85,6 +85,10 @@ struct RenderMetadata {
     std::optional<RadiosityFigures> radiosity;  // when known
     PhotonSettings ppm;                         // method "ppm"
     std::string partial;  // lightfarm.partial: why and where the render stopped; "" complete
+    // The frame of a shot (or `--frame N`): lightfarm.frame, .time, .fps, .shutter; nullopt
+    // for a still.
+    std::optional<int> frame;
+    double fps = 0, shutter = 0;
 };
 
 // What a render of a job measured, for its header.
