@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/scene_animation.h"
 
 namespace lf {
 
@@ -116,6 +117,15 @@ ShutterInterval ShutterOf(int frame, const ShotSettings& shot) {
     const double centre = FrameSeconds(frame, shot.fps);
     const double half = 0.5 * shot.shutter / shot.fps;
     return {centre - half, centre + half};
+}
+
+absl::Status PoseSceneAtFrame(int frame, const ShotSettings& shot, Scene& scene) {
+    const double seconds = FrameSeconds(frame, shot.fps);
+    absl::Status s = scene.animation_error;
+    if (s.ok() && scene.animation) s = scene.animation->PoseAt(seconds, scene);
+    if (s.ok()) return s;
+    return absl::Status(s.code(), absl::StrCat("frame ", frame, " (", seconds, " s) of ",
+                                               scene.source, ": ", s.message()));
 }
 
 std::string FramePath(std::string_view pattern, int frame) {

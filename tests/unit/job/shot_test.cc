@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lf/core/scene.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/render_metadata.h"
 
@@ -139,6 +140,18 @@ TEST(ShotSettingsTest, AFramesHeaderNamesItsFrameTimeAndShutter) {
         DescribeRender(MetadataOf(JobSpec{}, {}), image, false);
     ASSERT_TRUE(still.ok());
     EXPECT_FALSE(still->attributes.contains("lightfarm.frame"));
+}
+
+TEST(PoseSceneAtFrameTest, AStaticSceneStaysAndMalformedAnimationNamesTheFrame) {
+    Scene scene;
+    scene.source = "shot.json";
+    scene.spheres.push_back({});
+    ShotSettings shot;
+    EXPECT_TRUE(PoseSceneAtFrame(12, shot, scene).ok());
+    scene.animation_error = absl::InvalidArgumentError("animations[0].channels[1]: no node 9");
+    const absl::Status s = PoseSceneAtFrame(12, shot, scene);
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(s.message(), "frame 12 (0.5 s) of shot.json: animations[0].channels[1]: no node 9");
 }
 
 }  // namespace

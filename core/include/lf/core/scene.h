@@ -281,6 +281,9 @@ struct Scene {
     // What glTF animations, skins and morph targets do to this scene over time (PoseAt); null
     // when the scene has none. The geometry above is the files' rest pose until posed.
     std::shared_ptr<const SceneAnimation> animation;
+    // Not ok when the files' animation data is malformed: a still loads (with a warning) and
+    // renders the rest pose; whoever needs the scene in time (frames, a shutter) refuses with it.
+    absl::Status animation_error;
 
     // Axis-aligned bounds of all geometry.
     std::pair<Vec3d, Vec3d> Bounds() const;

@@ -12,6 +12,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "lf/core/scene.h"
 
 namespace lf {
 
@@ -67,6 +68,12 @@ struct ShutterInterval {
     double open = 0, close = 0;
 };
 ShutterInterval ShutterOf(int frame, const ShotSettings& shot);
+
+// Poses `scene` (as loaded, or posed at another frame before) at frame `frame`'s time, the one
+// way local mode and the workers move a scene to a frame. A scene without animation stays as it
+// is; malformed animation data is the loader's Scene::animation_error, returned with the frame
+// named, as is a pose PoseAt refuses.
+absl::Status PoseSceneAtFrame(int frame, const ShotSettings& shot, Scene& scene);
 
 // The file of frame `frame` from `pattern`: its one run of '#' becomes the frame number,
 // zero-padded to as many digits as there are '#' (Blender's convention; a negative frame keeps
