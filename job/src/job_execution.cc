@@ -1,6 +1,7 @@
 #include "lf/job/job_execution.h"
 
 #include "lf/job/adaptive_tile_execution.h"
+#include "lf/job/shot_execution.h"
 #include "lf/job/splat_execution.h"
 #include "lf/job/splat_settings.h"
 #include "lf/job/sweep_execution.h"
@@ -22,8 +23,14 @@ absl::StatusOr<std::unique_ptr<JobExecution>> Upcast(absl::StatusOr<std::unique_
 
 }  // namespace
 
-// The one place that tells the kinds of job apart.
 absl::StatusOr<std::unique_ptr<JobExecution>> MakeJobExecution(
+    const JobSpec& spec, const TileStoreFactory& tile_stores) {
+    if (spec.shot.frames) return Upcast(ShotExecution::Make(spec, tile_stores));
+    return MakeFrameExecution(spec, tile_stores);
+}
+
+// The one place that tells the kinds of image apart.
+absl::StatusOr<std::unique_ptr<JobExecution>> MakeFrameExecution(
     const JobSpec& spec, const TileStoreFactory& tile_stores) {
     if (UsesSplatPlan(spec.method)) {
         // The plan local mode makes of the same settings (lf::RenderSplatImage), so the merged

@@ -42,6 +42,10 @@ struct TaskResult {
     const TileSums* sums = nullptr;
     SplatList* splats = nullptr;  // coalesced by the merge
     const SweepChunkResult* sweep = nullptr;
+    // A shot's: the frame the worker rendered (its lease's); a chunk's: one result a part of its
+    // lease, in that order.
+    std::optional<int> frame;
+    std::vector<TaskResult> parts;
 };
 
 class JobExecution {
@@ -80,7 +84,8 @@ class JobExecution {
     struct Merged {
         std::vector<int> appended;  // tasks the result added to the plan, to queue
         std::optional<RadiositySolve::Outcome> sweep;  // the sweep this result completed
-        absl::Status job_error;  // not ok: the job fails (a solve out of iterations)
+        absl::Status job_error;             // not ok: the job fails (a solve out of iterations)
+        std::vector<int> frames_completed;  // a shot's frames this result completed
     };
     // Validates and merges task `task`'s result. InvalidArgument (nothing merged) for a result
     // that is not the task's: another kind, another rectangle or sample count, another frame.
@@ -114,8 +119,13 @@ class JobExecution {
 };
 
 // The kind of execution `spec` runs as, planned as its settings say; InvalidArgument when they
-// cannot be. `spec` must be validated.
+// cannot be. `spec` must be validated. A shot (spec.shot.frames set, even one frame) is a
+// ShotExecution (lf/job/shot_execution.h) of the frames' own executions.
 absl::StatusOr<std::unique_ptr<JobExecution>> MakeJobExecution(const JobSpec& spec,
                                                                const TileStoreFactory& tile_stores);
+// The kind one image of `spec` runs as: the still, or a shot's frame (FrameSpec), whose
+// shot settings it does not read.
+absl::StatusOr<std::unique_ptr<JobExecution>> MakeFrameExecution(
+    const JobSpec& spec, const TileStoreFactory& tile_stores);
 
 }  // namespace lf

@@ -2,7 +2,9 @@
 // pixels and samples (or which patch-group chunk of a radiosity sweep), and the job's settings.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/time/time.h"
 #include "lf/job/job_spec.h"
@@ -23,6 +25,17 @@ struct TaskAssignment {
     // Splatting methods (UsesSplatPlan(spec.method)): the task's light paths or photon passes
     // [path_begin, path_end) over the whole frame (lf::SplatTask); `task` holds its camera part.
     uint64_t path_begin = 0, path_end = 0;
+    // A shot's task (JobSpec::shot.frames, lf/job/shot_execution.h): the frame it renders, the
+    // scene posed at its time; nullopt for a still.
+    std::optional<int> frame;
+    // A chunk of a shot (shot.chunk > 1): every task of several frames, run in this order by one
+    // worker; `task`, `frame` and the path range above are then unused.
+    struct Part {
+        int frame = 0;
+        RenderTask task;
+        uint64_t path_begin = 0, path_end = 0;
+    };
+    std::vector<Part> parts;
     absl::Duration heartbeat_interval = absl::Milliseconds(300);
     absl::Duration lease = absl::Seconds(10);
 };

@@ -21,6 +21,7 @@ struct TaskStatus {
     TaskKind kind = TaskKind::kTile;
     int x = 0, y = 0, width = 0, height = 0;  // a tile's pixels; the whole frame for kSplat
     uint64_t samples = 0;                     // per pixel, for a tile
+    std::vector<int> frames;                  // a shot's task: the frames it renders
     int attempts = 0, failures = 0;
     std::string worker;                          // of the current or last lease
     absl::Time leased = absl::InfinitePast();    // the current or last lease

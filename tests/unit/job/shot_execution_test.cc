@@ -1,0 +1,298 @@
+// A shot as one job: its task indices over the frames' own plans, chunks of whole frames, each
+// frame completing on its own, results refused for another frame, and a restart that merges the
+// recorded results again frame by frame.
+#include "lf/job/shot_execution.h"
+
+#include <gtest/gtest.h>
+
+namespace lf {
+namespace {
+
+// Every sample of `task` at `value`.
+TileSums Flat(const RenderTask& task, float value) {
+    TileSums sums(task.rect);
+    for (PixelSums& p : sums.pixels) {
+        for (uint64_t s = task.sample_begin; s < task.sample_end; ++s) p.Add(s, Rgb(value));
+    }
+    sums.stats.samples =
+        uint64_t(task.rect.width) * task.rect.height * (task.sample_end - task.sample_begin);
+    return sums;
+}
+
+// Frames `frames` of a 16x16 image in 8x8 tiles at 4 spp: 4 tasks a frame.
+JobSpec Shot(FrameRange frames, int chunk = 1) {
+    JobSpec spec;
+    spec.plan = {16, 16, 4, 8, 1};
+    spec.shot.frames = frames;
+    spec.shot.chunk = chunk;
+    return spec;
+}
+
+std::unique_ptr<ShotExecution> Make(const JobSpec& spec) {
+    auto made = ShotExecution::Make(spec, MakeMemoryTileStore);
+    EXPECT_TRUE(made.ok()) << made.status();
+    return made.ok() ? std::move(*made) : nullptr;
+}
+
+TaskAssignment LeaseOf(JobExecution& e, int task) {
+    TaskAssignment lease;
+    e.Lease(task, "w", lease);
+    return lease;
+}
+
+// The result a worker sends for shot task `task`, frame f's pixels at f / 10.
+struct Result {
+    std::vector<TileSums> sums;
+    TaskResult result;
+};
+Result Render(JobExecution& e, int task) {
+    const TaskAssignment lease = LeaseOf(e, task);
+    Result r;
+    if (lease.parts.empty()) {
+        r.sums.push_back(Flat(lease.task, float(*lease.frame) / 10));
+        r.result = {.sums = &r.sums[0], .frame = lease.frame};
+        return r;
+    }
+    r.sums.reserve(lease.parts.size());
+    for (const TaskAssignment::Part& part : lease.parts) {
+        r.sums.push_back(Flat(part.task, float(part.frame) / 10));
+        r.result.parts.push_back({.sums = &r.sums.back(), .frame = part.frame});
+    }
+    return r;
+}
+
+TEST(ShotExecution, MakeJobExecutionMakesOneForAShotEvenOfOneFrame) {
+    auto shot = MakeJobExecution(Shot({7, 7, 1}), MakeMemoryTileStore);
+    ASSERT_TRUE(shot.ok()) << shot.status();
+    EXPECT_NE(dynamic_cast<ShotExecution*>(shot->get()), nullptr);
+    EXPECT_EQ(LeaseOf(**shot, 0).frame, 7);
+    JobSpec still = Shot({1, 1, 1});
+    still.shot.frames.reset();
+    auto made = MakeJobExecution(still, MakeMemoryTileStore);
+    ASSERT_TRUE(made.ok()) << made.status();
+    EXPECT_EQ(dynamic_cast<ShotExecution*>(made->get()), nullptr);
+    EXPECT_FALSE(LeaseOf(**made, 0).frame.has_value()) << "a still's lease names no frame";
+}
+
+TEST(ShotExecution, TaskIndicesRunFrameAfterFrame) {
+    std::unique_ptr<ShotExecution> e = Make(Shot({10, 14, 2}));  // frames 10, 12, 14
+    ASSERT_NE(e, nullptr);
+    EXPECT_EQ(e->task_count(), 12u);
+    EXPECT_EQ(e->tasks_total(), 12);
+    std::vector<int> all(12);
+    for (int t = 0; t < 12; ++t) all[size_t(t)] = t;
+    EXPECT_EQ(e->Start(), all);
+    EXPECT_EQ(e->Locate(5), std::make_pair(1, 1));
+    const TaskAssignment lease = LeaseOf(*e, 5);
+    EXPECT_EQ(lease.frame, 12);
+    EXPECT_EQ(lease.task.rect.x0, 8) << "the frame's second tile";
+    EXPECT_EQ(lease.task.rect.y0, 0);
+    TaskStatus status;
+    e->Describe(9, status);
+    EXPECT_EQ(status.frames, std::vector<int>{14});
+    EXPECT_EQ(status.width, 8);
+    EXPECT_LT(e->QueueRank(3), e->QueueRank(4)) << "frames finish in order";
+}
+
+TEST(ShotExecution, EachFrameCompletesOnItsOwn) {
+    std::unique_ptr<ShotExecution> e = Make(Shot({1, 3, 1}));
+    ASSERT_NE(e, nullptr);
+    e->Start();
+    std::vector<int> completed;
+    for (int t : {4, 5, 6, 0, 7}) {  // frame 2 whole, frame 1 begun
+        Result r = Render(*e, t);
+        absl::StatusOr<JobExecution::Merged> merged = e->Merge(t, r.result);
+        ASSERT_TRUE(merged.ok()) << merged.status();
+        completed.insert(completed.end(), merged->frames_completed.begin(),
+                         merged->frames_completed.end());
+    }
+    EXPECT_EQ(completed, std::vector<int>{2}) << "reported by the result that completed it";
+    EXPECT_EQ(e->frames_done(), 1);
+    EXPECT_TRUE(e->frame(1).Complete());
+    EXPECT_FALSE(e->frame(0).Complete());
+    EXPECT_EQ(e->frame(0).tasks_done(), 1u);
+    EXPECT_EQ(e->tasks_done(), 5u);
+    EXPECT_FALSE(e->Complete());
+    EXPECT_EQ(e->stats().samples, 5u * 8 * 8 * 4);
+    // The preview is the first frame not complete: frame 1, one tile merged.
+    const absl::StatusOr<Image> preview = e->SnapshotReader()();
+    ASSERT_TRUE(preview.ok()) << preview.status();
+    EXPECT_FLOAT_EQ(preview->FindChannel("R")->at(0), 0.1f);
+}
+
+TEST(ShotExecution, RefusesAResultOfAnotherFrameOrWithoutOne) {
+    std::unique_ptr<ShotExecution> e = Make(Shot({1, 2, 1}));
+    ASSERT_NE(e, nullptr);
+    e->Start();
+    Result r = Render(*e, 0);  // frame 1, tile 0
+    TaskResult other = r.result;
+    other.frame = 2;
+    absl::StatusOr<JobExecution::Merged> merged = e->Merge(0, other);
+    ASSERT_FALSE(merged.ok());
+    EXPECT_EQ(merged.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(merged.status().message().find("frame 2 for a task of frame 1"), std::string::npos)
+        << merged.status();
+    other.frame.reset();
+    EXPECT_EQ(e->Merge(0, other).status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(e->Merge(4, r.result).status().code(), absl::StatusCode::kInvalidArgument)
+        << "frame 1's tile for frame 2's task";
+    EXPECT_EQ(e->tasks_done(), 0u);
+    EXPECT_TRUE(e->Merge(0, r.result).ok());
+}
+
+TEST(ShotExecution, AChunkIsEveryTaskOfItsFrames) {
+    std::unique_ptr<ShotExecution> e = Make(Shot({1, 5, 1}, 2));  // {1, 2}, {3, 4}, {5}
+    ASSERT_NE(e, nullptr);
+    EXPECT_EQ(e->Start(), (std::vector<int>{0, 1, 2}));
+    EXPECT_EQ(e->task_count(), 3u);
+    EXPECT_EQ(e->tasks_total(), 3);
+    EXPECT_EQ(e->FramesOf(1), (std::vector<int>{3, 4}));
+    EXPECT_EQ(e->FramesOf(2), (std::vector<int>{5}));
+    const TaskAssignment lease = LeaseOf(*e, 1);
+    ASSERT_EQ(lease.parts.size(), 8u);
+    EXPECT_EQ(lease.parts[0].frame, 3);
+    EXPECT_EQ(lease.parts[7].frame, 4);
+    EXPECT_EQ(lease.parts[7].task.rect.x0, 8);
+    EXPECT_EQ(lease.parts[7].task.rect.y0, 8);
+    EXPECT_EQ(e->TaskSamples(1), 2u * 16 * 16 * 4);
+    TaskStatus status;
+    e->Describe(1, status);
+    EXPECT_EQ(status.frames, (std::vector<int>{3, 4}));
+    EXPECT_EQ(status.width, 16) << "whole frames";
+
+    Result r = Render(*e, 1);
+    TaskResult short_result = r.result;
+    short_result.parts.pop_back();
+    EXPECT_EQ(e->Merge(1, short_result).status().code(), absl::StatusCode::kInvalidArgument);
+    // A part of the wrong rectangle stops the merge there; the parts before stay merged and the
+    // retry merges the rest.
+    TaskResult damaged = r.result;
+    damaged.parts[5].sums = &r.sums[0];
+    EXPECT_EQ(e->Merge(1, damaged).status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_TRUE(e->frame(2).Complete());
+    EXPECT_FALSE(e->frame(3).Complete());
+    EXPECT_EQ(e->tasks_done(), 0u);
+    absl::StatusOr<JobExecution::Merged> merged = e->Merge(1, r.result);
+    ASSERT_TRUE(merged.ok()) << merged.status();
+    EXPECT_EQ(merged->frames_completed, std::vector<int>{4});
+    EXPECT_EQ(e->tasks_done(), 1u);
+    EXPECT_EQ(e->frames_done(), 2);
+}
+
+TEST(ShotExecution, ChunksRefuseKindsThatGrowAsTheyMerge) {
+    JobSpec adaptive = Shot({1, 4, 1}, 2);
+    adaptive.adaptive.target_error = 0.05;
+    absl::StatusOr<std::unique_ptr<ShotExecution>> made =
+        ShotExecution::Make(adaptive, MakeMemoryTileStore);
+    ASSERT_FALSE(made.ok());
+    EXPECT_NE(made.status().message().find("chunk 2"), std::string::npos) << made.status();
+    EXPECT_NE(made.status().message().find("--chunk 1"), std::string::npos) << made.status();
+    EXPECT_EQ(CheckShotChunk(adaptive).code(), absl::StatusCode::kInvalidArgument);
+    adaptive.shot.chunk = 1;
+    EXPECT_TRUE(ShotExecution::Make(adaptive, MakeMemoryTileStore).ok());
+
+    JobSpec sweeps = Shot({1, 4, 1});
+    sweeps.method = "radiosity";
+    sweeps.radiosity.solver = "jacobi";
+    made = ShotExecution::Make(sweeps, MakeMemoryTileStore);
+    ASSERT_FALSE(made.ok());
+    EXPECT_NE(made.status().message().find("--solver gauss-seidel"), std::string::npos)
+        << made.status();
+    sweeps.radiosity.solver = "gauss-seidel";  // each worker solves: fixed tiles, chunks too
+    sweeps.shot.chunk = 2;
+    EXPECT_TRUE(ShotExecution::Make(sweeps, MakeMemoryTileStore).ok());
+}
+
+TEST(ShotExecution, AdaptiveFramesAppendPassesUnderNewShotIndices) {
+    JobSpec spec = Shot({1, 2, 1});
+    spec.adaptive = {.target_error = 0.01, .max_spp = 16};
+    std::unique_ptr<ShotExecution> e = Make(spec);
+    ASSERT_NE(e, nullptr);
+    std::vector<int> queue = e->Start();
+    ASSERT_EQ(queue.size(), 8u);
+    // Noisy A/B halves everywhere: every tile asks for another pass until max_spp.
+    while (!queue.empty()) {
+        const int t = queue.front();
+        queue.erase(queue.begin());
+        const TaskAssignment lease = LeaseOf(*e, t);
+        TileSums sums(lease.task.rect);
+        for (PixelSums& p : sums.pixels) {
+            for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
+                p.Add(s, Rgb(s % 2 ? 0.2f : 0.8f));
+            }
+        }
+        absl::StatusOr<JobExecution::Merged> merged =
+            e->Merge(t, {.sums = &sums, .frame = lease.frame});
+        ASSERT_TRUE(merged.ok()) << merged.status();
+        for (int next : merged->appended) {
+            EXPECT_GE(next, 8);
+            EXPECT_EQ(LeaseOf(*e, next).frame, lease.frame) << "a pass of the same frame";
+            queue.push_back(next);
+        }
+    }
+    EXPECT_TRUE(e->Complete());
+    EXPECT_GT(e->task_count(), 8u);
+    EXPECT_EQ(e->frames_done(), 2);
+}
+
+// The coordinator restarted: the recorded results merged again give every frame's bits, in a
+// plain shot and in chunks.
+void ExpectRestartGivesTheSameFrames(const JobSpec& spec, const std::vector<int>& done) {
+    std::unique_ptr<ShotExecution> live = Make(spec);
+    std::unique_ptr<ShotExecution> restarted = Make(spec);
+    ASSERT_TRUE(live && restarted);
+    live->Start();
+    std::map<int, std::string> records;
+    for (int t : done) {
+        Result r = Render(*live, t);
+        ASSERT_TRUE(live->Merge(t, r.result).ok());
+        const std::optional<std::string> record = live->RecordOf(r.result);
+        ASSERT_TRUE(record.has_value());
+        records[t] = *record;
+    }
+    for (const auto& [t, record] : records) {  // the store replays in index order
+        ASSERT_TRUE(restarted->MergeRecorded(t, record).ok()) << t;
+    }
+    restarted->Start();
+    EXPECT_EQ(restarted->tasks_done(), live->tasks_done());
+    EXPECT_EQ(restarted->frames_done(), live->frames_done());
+    for (int i = 0; i < spec.shot.frames->count(); ++i) {
+        EXPECT_EQ(restarted->frame(i).Complete(), live->frame(i).Complete()) << i;
+        const absl::StatusOr<Image> a = live->frame(i).SnapshotReader()();
+        const absl::StatusOr<Image> b = restarted->frame(i).SnapshotReader()();
+        ASSERT_TRUE(a.ok() && b.ok());
+        for (const char* c : {"R", "A.G", "spp"}) {
+            EXPECT_EQ(*a->FindChannel(c), *b->FindChannel(c)) << "frame position " << i << " " << c;
+        }
+    }
+    // A record is merged only for its own task.
+    const auto& [t, record] = *records.begin();
+    EXPECT_FALSE(restarted->MergeRecorded(int(restarted->task_count()) - 1, record).ok());
+}
+
+TEST(ShotExecution, ARestartMergesTheRecordedResultsFrameByFrame) {
+    ExpectRestartGivesTheSameFrames(Shot({1, 3, 1}), {7, 0, 4, 5, 6});
+}
+
+TEST(ShotExecution, ARestartMergesTheRecordedChunks) {
+    ExpectRestartGivesTheSameFrames(Shot({1, 5, 1}, 2), {2, 0});
+}
+
+TEST(ShotExecution, ADamagedRecordIsRefused) {
+    std::unique_ptr<ShotExecution> e = Make(Shot({1, 2, 1}));
+    ASSERT_NE(e, nullptr);
+    Result r = Render(*e, 0);
+    const std::string record = *e->RecordOf(r.result);
+    for (size_t cut : {size_t(0), size_t(5), size_t(9), size_t(14), record.size() - 1}) {
+        EXPECT_FALSE(e->MergeRecorded(0, record.substr(0, cut)).ok()) << cut;
+    }
+    std::string huge = record;
+    huge[7] = '\xff';  // the part count
+    EXPECT_FALSE(e->MergeRecorded(0, huge).ok());
+    EXPECT_FALSE(e->MergeRecorded(0, record + "x").ok());
+    EXPECT_EQ(e->tasks_done(), 0u);
+    EXPECT_TRUE(e->MergeRecorded(0, record).ok());
+}
+
+}  // namespace
+}  // namespace lf
