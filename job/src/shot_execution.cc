@@ -89,6 +89,18 @@ absl::Status CheckShotChunk(const JobSpec& spec) {
             "adaptive sampling (--target-error, --time-limit) adds passes as results merge");
     }
     if (SolvedInSweeps(spec)) return refuse("radiosity solved in sweeps adds a sweep at a time");
+    // A chunk's result is one message and one record: every frame's sums (tile_codec.h: 104
+    // bytes a pixel, 220 with AOVs) and, for splatting methods, up to 2 splats of 53 bytes a pixel.
+    const uint64_t pixel_bytes = (spec.aovs ? 220 : 104) + (UsesSplatPlan(spec.method) ? 106 : 0);
+    const uint64_t bytes = uint64_t(spec.shot.chunk) * uint64_t(spec.plan.width) *
+                           uint64_t(spec.plan.height) * pixel_bytes;
+    if (bytes > uint64_t(kMaxTaskResultBytes)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("chunk ", spec.shot.chunk, ": a task's result would take up to ", bytes,
+                         " bytes (", spec.shot.chunk, " frames of ", spec.plan.width, "x",
+                         spec.plan.height, "), above the coordinator's bound of ",
+                         kMaxTaskResultBytes, " (lf::kMaxTaskResultBytes); use a smaller --chunk"));
+    }
     return absl::OkStatus();
 }
 

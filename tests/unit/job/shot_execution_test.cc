@@ -201,6 +201,28 @@ TEST(ShotExecution, ChunksRefuseKindsThatGrowAsTheyMerge) {
     sweeps.radiosity.solver = "gauss-seidel";  // each worker solves: fixed tiles, chunks too
     sweeps.shot.chunk = 2;
     EXPECT_TRUE(ShotExecution::Make(sweeps, MakeMemoryTileStore).ok());
+
+    JobSpec big = Shot({1, 100, 1}, 50);  // 50 frames of 4K: 43 GB in one result
+    big.plan.width = 3840;
+    big.plan.height = 2160;
+    const absl::Status too_big = CheckShotChunk(big);
+    EXPECT_NE(too_big.message().find("use a smaller --chunk"), std::string::npos) << too_big;
+    big.shot.chunk = 1;
+    EXPECT_TRUE(CheckShotChunk(big).ok());
+}
+
+TEST(ShotExecution, AChunkOfASplattingMethodLeasesEveryPassOfItsFrames) {
+    JobSpec light = Shot({1, 3, 1}, 3);
+    light.method = "light";
+    std::unique_ptr<ShotExecution> e = Make(light);
+    ASSERT_NE(e, nullptr);
+    const size_t passes = e->frame(0).task_count();
+    const TaskAssignment lease = LeaseOf(*e, 0);
+    ASSERT_EQ(lease.parts.size(), 3 * passes);
+    EXPECT_EQ(lease.parts.back().frame, 3);
+    EXPECT_GT(lease.parts.back().path_end, lease.parts.back().path_begin);
+    EXPECT_EQ(lease.parts[passes].path_begin, lease.parts[0].path_begin) << "each frame's plan";
+    EXPECT_EQ(lease.parts[passes].frame, 2);
 }
 
 TEST(ShotExecution, AdaptiveFramesAppendPassesUnderNewShotIndices) {

@@ -86,7 +86,9 @@ class ShotExecution : public JobExecution {
 };
 
 // Whether a task of `spec` (a shot with shot.chunk > 1) may hold several frames: the kinds
-// whose plan is fixed when the job starts. InvalidArgument naming the setting otherwise.
+// whose plan is fixed when the job starts, and a chunk whose result (one message and one record
+// of every frame's sums) stays under kMaxTaskResultBytes. InvalidArgument naming the setting
+// otherwise.
 absl::Status CheckShotChunk(const JobSpec& spec);
 
 }  // namespace lf
