@@ -30,4 +30,10 @@ absl::StatusOr<JobState> JobStateFromName(std::string_view name) {
                      "\": expected queued, running, succeeded, failed or cancelled"));
 }
 
+int JobRecord::frames_done() const {
+    int done = 0;
+    for (const FrameProgress& frame : frames) done += frame.done;
+    return done;
+}
+
 }  // namespace lf

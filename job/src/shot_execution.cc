@@ -428,4 +428,24 @@ JobExecution::ImageReader ShotExecution::SnapshotReader() const {
     return frames_exec_.back()->SnapshotReader();
 }
 
+std::vector<FrameProgress> ShotExecution::Frames() const {
+    std::vector<FrameProgress> frames;
+    for (int i = 0; i < int(frames_exec_.size()); ++i) {
+        const JobExecution& frame = *frames_exec_[size_t(i)];
+        frames.push_back({.frame = frames_.at(i),
+                          .tasks_done = int(frame.tasks_done()),
+                          .tasks_total = frame.tasks_total(),
+                          .done = frame.Complete()});
+    }
+    return frames;
+}
+
+absl::StatusOr<JobExecution::ImageReader> ShotExecution::FrameReader(int frame) const {
+    if (!frames_.Contains(frame)) {
+        return absl::NotFoundError(absl::StrCat("frame ", frame, " is not one of the shot's (",
+                                                FrameRangeText(frames_), ")"));
+    }
+    return frames_exec_[size_t(frames_.IndexOf(frame))]->SnapshotReader();
+}
+
 }  // namespace lf

@@ -124,6 +124,15 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
         out->set_filter_type(ToProto(filter->type));
         out->set_filter_width(filter->width);
     }
+    if (const std::optional<FrameRange>& frames = spec.shot.frames) {
+        pb::ShotParams* shot = out->mutable_shot();
+        shot->set_first(frames->first);
+        shot->set_last(frames->last);
+        shot->set_step(frames->step);
+        shot->set_fps(spec.shot.fps);
+        shot->set_shutter(spec.shot.shutter);
+        shot->set_chunk(spec.shot.chunk);
+    }
 }
 
 void FromProto(const pb::RenderParams& p, JobSpec* spec) {
@@ -148,6 +157,14 @@ void FromProto(const pb::RenderParams& p, JobSpec* spec) {
     spec->aovs = p.aovs();
     spec->sampler = FromProto(p.sampler());
     spec->light_strategy = FromProto(p.light_strategy());
+    spec->shot = {};
+    if (p.has_shot()) {  // zero fields keep the defaults; CheckJobSettings refuses the rest
+        const pb::ShotParams& shot = p.shot();
+        spec->shot.frames = FrameRange{shot.first(), shot.last(), shot.step() ? shot.step() : 1};
+        if (shot.fps() != 0) spec->shot.fps = shot.fps();
+        spec->shot.shutter = shot.shutter();
+        if (shot.chunk() != 0) spec->shot.chunk = shot.chunk();
+    }
 }
 
 void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {
@@ -224,6 +241,17 @@ void ToProto(const JobRecord& job, pb::Job* out) {
     out->set_tasks_leased(job.tasks_leased);
     out->set_last_error(job.last_error);
     out->set_owner(job.spec.owner);
+    if (job.spec.shot.frames) {
+        out->set_frames_done(job.frames_done());
+        out->set_frames_total(job.spec.shot.frames->count());
+    }
+    for (const FrameProgress& frame : job.frames) {
+        pb::FrameProgress* f = out->add_frames();
+        f->set_frame(frame.frame);
+        f->set_tasks_done(frame.tasks_done);
+        f->set_tasks_total(frame.tasks_total);
+        f->set_done(frame.done);
+    }
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {
@@ -249,6 +277,19 @@ void ToProto(const TaskAssignment& task, pb::Task* out) {
         out->set_path_end(task.path_end);
     }
     out->set_radiosity_hash(task.radiosity_hash);
+    if (task.frame) out->set_frame(*task.frame);
+    for (const TaskAssignment::Part& part : task.parts) {
+        pb::TaskPart* p = out->add_parts();
+        p->set_frame(part.frame);
+        p->set_x0(part.task.rect.x0);
+        p->set_y0(part.task.rect.y0);
+        p->set_width(part.task.rect.width);
+        p->set_height(part.task.rect.height);
+        p->set_sample_begin(part.task.sample_begin);
+        p->set_sample_end(part.task.sample_end);
+        p->set_path_begin(part.path_begin);
+        p->set_path_end(part.path_end);
+    }
     out->set_heartbeat_interval_ms(int(absl::ToInt64Milliseconds(task.heartbeat_interval)));
     out->set_lease_ms(int(absl::ToInt64Milliseconds(task.lease)));
 }
@@ -273,6 +314,16 @@ TaskAssignment FromProto(const pb::Task& t) {
     task.task.rect = {t.x0(), t.y0(), t.width(), t.height()};
     task.task.sample_begin = t.sample_begin();
     task.task.sample_end = t.sample_end();
+    if (t.has_frame()) task.frame = t.frame();
+    for (const pb::TaskPart& p : t.parts()) {
+        TaskAssignment::Part part{
+            .frame = p.frame(), .path_begin = p.path_begin(), .path_end = p.path_end()};
+        part.task.index = t.task_index();
+        part.task.rect = {p.x0(), p.y0(), p.width(), p.height()};
+        part.task.sample_begin = p.sample_begin();
+        part.task.sample_end = p.sample_end();
+        task.parts.push_back(part);
+    }
     if (t.heartbeat_interval_ms() > 0) {
         task.heartbeat_interval = absl::Milliseconds(t.heartbeat_interval_ms());
     }
@@ -343,6 +394,7 @@ void ToProto(const TaskStatus& task, pb::TaskInfo* out) {
     out->set_seconds(absl::ToDoubleSeconds(task.duration));
     out->set_last_error(task.last_error);
     out->set_log_lines(task.log_lines);
+    for (int frame : task.frames) out->add_frames(frame);
 }
 
 void ToProto(const TaskLogLine& line, pb::TaskLogLine* out) {

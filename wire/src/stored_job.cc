@@ -72,6 +72,14 @@ void ToProto(const JobRecord& job, pb::StoredJob* out) {
     out->set_rays(job.stats.rays);
     out->set_invalid_samples(job.stats.invalid_samples);
     out->set_result_path(job.result_path);
+    for (const FrameProgress& frame : job.frames) {
+        pb::StoredFrame* f = out->add_frames();
+        f->set_frame(frame.frame);
+        f->set_tasks_done(frame.tasks_done);
+        f->set_tasks_total(frame.tasks_total);
+        f->set_done(frame.done);
+        f->set_result_path(frame.result_path);
+    }
 }
 
 absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
@@ -99,6 +107,10 @@ absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
     job.stats.rays = s.rays();
     job.stats.invalid_samples = s.invalid_samples();
     job.result_path = s.result_path();
+    for (const pb::StoredFrame& f : s.frames()) {
+        job.frames.push_back(
+            {f.frame(), f.tasks_done(), f.tasks_total(), f.done(), f.result_path()});
+    }
     return job;
 }
 

@@ -116,6 +116,14 @@ class JobExecution {
     virtual ImageReader SnapshotReader() const = 0;
     // An adaptive job's report, without estimated_error (measured on the snapshot).
     virtual std::optional<AdaptiveReport> TileReport() const { return std::nullopt; }
+
+    // A shot's frames in frame order, without result paths (the coordinator's); none for a still.
+    virtual std::vector<FrameProgress> Frames() const { return {}; }
+    // Reads frame `frame`'s image merged so far, as SnapshotReader; NotFound for a frame the job
+    // does not render.
+    virtual absl::StatusOr<ImageReader> FrameReader(int frame) const {
+        return absl::NotFoundError("not a shot: it renders no frames");
+    }
 };
 
 // The kind of execution `spec` runs as, planned as its settings say; InvalidArgument when they

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
@@ -30,6 +31,10 @@ struct JobRecord {
     int tasks_leased = 0;  // leases ever handed out, across server restarts: renders started
     RenderStats stats;
     std::string result_path;  // the EXR, once succeeded
+    // A shot's frames in frame order (none for a still); a frame's EXR stays fetchable whatever
+    // the job ends as.
+    std::vector<FrameProgress> frames;
+    int frames_done() const;
 };
 
 // What a done task's leases left behind, recorded with its result so that `lightfarm tasks`

@@ -49,6 +49,15 @@ struct ShotSettings {
     int chunk = 1;
 };
 
+// A shot's frame as the coordinator reports and records it (JobRecord::frames).
+struct FrameProgress {
+    int frame = 0;
+    int tasks_done = 0, tasks_total = 0;
+    bool done = false;        // every task merged
+    std::string result_path;  // its EXR once the coordinator wrote it; "" before
+    friend bool operator==(const FrameProgress&, const FrameProgress&) = default;
+};
+
 // "A-B", "A-B:STEP" or "N" (one frame); frames may be negative ("-10--1"). InvalidArgument
 // naming the text for anything else, an empty or reversed range, a step below 1, a frame beyond
 // ±kMaxFrameNumber or more than kMaxShotFrames frames.

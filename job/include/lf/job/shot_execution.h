@@ -50,6 +50,8 @@ class ShotExecution : public JobExecution {
     void AddBlobsInUse(std::set<std::string>& hashes) const override;
     // The first frame not complete, or the last frame once every one is.
     ImageReader SnapshotReader() const override;
+    std::vector<FrameProgress> Frames() const override;
+    absl::StatusOr<ImageReader> FrameReader(int frame) const override;
 
     const FrameRange& frames() const { return frames_; }
     int chunk() const { return chunk_; }
