@@ -440,12 +440,9 @@ std::vector<FrameProgress> ShotExecution::Frames() const {
     return frames;
 }
 
-absl::StatusOr<JobExecution::ImageReader> ShotExecution::FrameReader(int frame) const {
-    if (!frames_.Contains(frame)) {
-        return absl::NotFoundError(absl::StrCat("frame ", frame, " is not one of the shot's (",
-                                                FrameRangeText(frames_), ")"));
-    }
-    return frames_exec_[size_t(frames_.IndexOf(frame))]->SnapshotReader();
+const JobExecution* ShotExecution::FrameExecution(int frame) const {
+    if (!frames_.Contains(frame)) return nullptr;
+    return frames_exec_[size_t(frames_.IndexOf(frame))].get();
 }
 
 }  // namespace lf

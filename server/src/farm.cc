@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <set>
@@ -64,6 +65,12 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
     farm->SweepTemporaryFiles();
     absl::StatusOr<std::vector<std::string>> rendered = farm->scheduler_.Recover();
     if (!rendered.ok()) return rendered.status();
+    // Frames complete before the restart whose EXR was not recorded, of shots still running.
+    for (const auto& [job_id, frame] : farm->scheduler_.UnwrittenFrames()) {
+        if (std::find(rendered->begin(), rendered->end(), job_id) == rendered->end()) {
+            farm->WriteFrame(job_id, frame);
+        }
+    }
     for (const std::string& job_id : *rendered) farm->FinishJob(job_id);
     if (absl::StatusOr<int> expired = farm->DeleteExpired(absl::Now()); !expired.ok()) {
         return expired.status();
@@ -155,6 +162,13 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     if (!scene.ok()) return absl::InvalidArgumentError(scene.status().message());
     // Refused here, once, rather than failing on every worker.
     if (absl::Status s = CheckMethodTakesScene(MethodOf(spec), *scene); !s.ok()) return s;
+    // A shot's scene must pose: malformed animation is refused as `render --frames` refuses it.
+    if (spec.shot.frames) {
+        if (absl::Status s = PoseSceneAtFrame(spec.shot.frames->first, spec.shot, *scene);
+            !s.ok()) {
+            return absl::InvalidArgumentError(s.message());
+        }
+    }
     const int side = options_.limits.max_resolution;
     if (scene->camera.width > side || scene->camera.height > side) {
         return absl::ResourceExhaustedError(absl::StrCat("resolution ", scene->camera.width, "x",
@@ -186,26 +200,63 @@ absl::Status Farm::RefuseUndecodable(const std::string& lease_id, const std::str
 
 absl::Status Farm::Complete(const std::string& lease_id, const std::string& worker,
                             std::string_view tile_sums, std::optional<RadiosityFigures> radiosity,
-                            std::optional<std::string_view> splats) {
-    absl::StatusOr<TileSums> sums = DecodeTileSums(tile_sums);
-    if (!sums.ok()) return RefuseUndecodable(lease_id, worker, sums.status());
-    // Checked whole before anything is allocated (lf::DecodeSplatList); its frame and the
-    // camera part are the scheduler's to check against the task.
-    std::optional<SplatList> list;
-    if (splats) {
-        absl::StatusOr<SplatList> decoded = DecodeSplatList(*splats);
+                            std::optional<std::string_view> splats, std::optional<int> frame,
+                            const std::vector<ResultPart>& parts) {
+    // A chunk's parts, or the one result; kept in place while the result points at them.
+    std::vector<ResultPart> wire = parts;
+    if (parts.empty()) wire.push_back({frame.value_or(0), tile_sums, splats});
+    std::vector<TileSums> sums;
+    std::vector<std::optional<SplatList>> lists;
+    sums.reserve(wire.size());
+    lists.reserve(wire.size());
+    for (const ResultPart& part : wire) {
+        absl::StatusOr<TileSums> decoded = DecodeTileSums(part.tile_sums);
         if (!decoded.ok()) return RefuseUndecodable(lease_id, worker, decoded.status());
-        list = std::move(*decoded);
+        sums.push_back(std::move(*decoded));
+        // Checked whole before anything is allocated (lf::DecodeSplatList); its frame and the
+        // camera part are the scheduler's to check against the task.
+        lists.emplace_back();
+        if (part.splats) {
+            absl::StatusOr<SplatList> list = DecodeSplatList(*part.splats);
+            if (!list.ok()) return RefuseUndecodable(lease_id, worker, list.status());
+            lists.back() = std::move(*list);
+        }
     }
-    absl::StatusOr<Scheduler::Completion> done =
-        scheduler_.Complete(lease_id, worker, *sums, list ? &*list : nullptr);
+    std::vector<TaskResult> results;
+    for (size_t i = 0; i < wire.size(); ++i) {
+        results.push_back({.sums = &sums[i],
+                           .splats = lists[i] ? &*lists[i] : nullptr,
+                           .frame = parts.empty() ? frame : std::optional<int>(wire[i].frame)});
+    }
+    TaskResult chunk{.parts = std::move(results)};
+    const TaskResult& result = parts.empty() ? chunk.parts.front() : chunk;
+    absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, result);
     if (!done.ok()) return done.status();
     if (radiosity) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         radiosity_[done->job_id] = *radiosity;
     }
+    for (int f : done->frames_completed) WriteFrame(done->job_id, f);
     if (done->job_rendered) FinishJob(done->job_id);
     return absl::OkStatus();
+}
+
+std::string Farm::FramePathOf(const std::string& dir, const std::string& job_id, int frame) const {
+    return absl::StrCat(options_.data_dir, "/", dir, "/", job_id, ".frame", frame, ".exr");
+}
+
+void Farm::WriteFrame(const std::string& job_id, int frame) {
+    const std::string path = FramePathOf("results", job_id, frame);
+    absl::Status written;
+    {
+        std::lock_guard<std::mutex> lock(image_mutex_);
+        absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.FrameSnapshot(job_id, frame);
+        written = snapshot.ok() ? WriteImage(*snapshot, true, path) : snapshot.status();
+    }
+    if (absl::IsFailedPrecondition(written)) return;  // cancelled meanwhile
+    scheduler_.FrameWritten(
+        job_id, frame,
+        written.ok() ? absl::StatusOr<std::string>(path) : absl::StatusOr<std::string>(written));
 }
 
 absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
@@ -235,6 +286,20 @@ absl::Status Farm::WriteSnapshot(const std::string& job_id, bool complete,
 }
 
 void Farm::FinishJob(const std::string& job_id) {
+    absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
+    if (job.ok() && job->spec.shot.frames) {
+        // Its frames are its result, each written as it completed; those a restart or a time
+        // limit completed since are written now.
+        for (const auto& [id, frame] : scheduler_.UnwrittenFrames()) {
+            if (id == job_id) WriteFrame(job_id, frame);
+        }
+        job = scheduler_.Get(job_id);
+        if (job.ok() && IsFinal(job->state)) return;  // a frame's write failed it
+        scheduler_.Finish(job_id, job.ok() && !job->frames.empty()
+                                      ? absl::StatusOr<std::string>(job->frames.back().result_path)
+                                      : absl::StatusOr<std::string>(job.status()));
+        return;
+    }
     const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
     const absl::Status written = WriteSnapshot(job_id, true, path);
     {
@@ -283,9 +348,40 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
     return RenameDurably(temp, path);
 }
 
-absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool preview) {
+absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool preview,
+                                             std::optional<int> frame) {
     absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
     if (!job.ok()) return job.status();
+    if (frame) {
+        if (!job->spec.shot.frames || !job->spec.shot.frames->Contains(*frame)) {
+            return absl::NotFoundError(absl::StrCat(
+                "job ", job_id, " renders no frame ", *frame,
+                job->spec.shot.frames
+                    ? absl::StrCat(" (its frames: ", FrameRangeText(*job->spec.shot.frames), ")")
+                    : std::string(" (a still)")));
+        }
+        for (const FrameProgress& f : job->frames) {
+            if (f.frame == *frame && !f.result_path.empty()) return f.result_path;
+        }
+        if (!preview || IsFinal(job->state)) {
+            return absl::FailedPreconditionError(absl::StrCat(
+                "job ", job_id, " frame ", *frame, " is not finished (job ",
+                JobStateName(job->state), ", ", job->frames_done(), "/",
+                job->spec.shot.frames->count(), " frames done): no result",
+                IsFinal(job->state) ? "" : " yet; --preview fetches what is merged so far"));
+        }
+        const std::string path = FramePathOf("previews", job_id, *frame);
+        std::lock_guard<std::mutex> lock(image_mutex_);
+        absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.FrameSnapshot(job_id, *frame);
+        if (!snapshot.ok()) return snapshot.status();
+        if (absl::Status s = WriteImage(*snapshot, false, path); !s.ok()) return s;
+        return path;
+    }
+    if (job->spec.shot.frames && !preview) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "job ", job_id, " is a shot of frames ", FrameRangeText(*job->spec.shot.frames), " (",
+            job->frames_done(), " done): fetch its frames (lightfarm fetch JOB -o out_####.exr)"));
+    }
     if (IsFinal(job->state)) {
         std::lock_guard<std::mutex> lock(image_mutex_);
         previewed_.erase(job_id);
@@ -325,6 +421,14 @@ void Farm::RemoveJobFiles(const std::string& job_id) {
     for (const char* sub : {"results", "previews"}) {
         std::error_code ignored;  // a job without such a file
         fs::remove(fs::path(options_.data_dir) / sub / (job_id + ".exr"), ignored);
+        // A shot's frames: JOB.frame<N>.exr (job ids are random hex, no prefix of another's).
+        const std::string prefix = job_id + ".frame";
+        std::vector<fs::path> frames;
+        for (fs::directory_iterator it(fs::path(options_.data_dir) / sub, ignored), end;
+             !ignored && it != end; it.increment(ignored)) {
+            if (it->path().filename().string().rfind(prefix, 0) == 0) frames.push_back(it->path());
+        }
+        for (const fs::path& frame : frames) fs::remove(frame, ignored);
     }
 }
 

@@ -411,7 +411,9 @@ grpc::Status JobServiceImpl::FetchResult(grpc::ServerContext* context, const Cal
     if (absl::StatusOr<JobRecord> job = VisibleJob(caller, req.job_id()); !job.ok()) {
         return ToGrpcStatus(job.status());
     }
-    absl::StatusOr<std::string> path = farm_.ResultFile(req.job_id(), req.preview());
+    absl::StatusOr<std::string> path =
+        farm_.ResultFile(req.job_id(), req.preview(),
+                         req.has_frame() ? std::optional<int>(req.frame()) : std::nullopt);
     if (!path.ok()) return ToGrpcStatus(path.status());
     absl::StatusOr<StreamSlots::Slot> slot = fetches_.Take(caller.name);
     if (!slot.ok()) {
@@ -510,15 +512,22 @@ grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context, const
                                              pb::CompleteTaskResponse*) {
     const std::string worker = WorkerIdentity(caller, req.worker_id());
     TakeTaskLog(farm_, req, worker);
+    std::vector<Farm::ResultPart> parts;
+    for (const pb::TaskPartResult& part : req.parts()) {
+        parts.push_back({part.frame(), part.tile_sums(),
+                         part.splats().empty() ? std::nullopt
+                                               : std::optional<std::string_view>(part.splats())});
+    }
     const absl::Status s =
         req.radiosity_sweep().empty()
-            ? farm_.Complete(req.lease_id(), worker, req.tile_sums(),
-                             req.has_radiosity()
-                                 ? std::optional<RadiosityFigures>(FromProto(req.radiosity()))
-                                 : std::nullopt,
-                             // An encoded list is never empty: empty means a tile's result.
-                             req.splats().empty() ? std::nullopt
-                                                  : std::optional<std::string_view>(req.splats()))
+            ? farm_.Complete(
+                  req.lease_id(), worker, req.tile_sums(),
+                  req.has_radiosity() ? std::optional<RadiosityFigures>(FromProto(req.radiosity()))
+                                      : std::nullopt,
+                  // An encoded list is never empty: empty means a tile's result.
+                  req.splats().empty() ? std::nullopt
+                                       : std::optional<std::string_view>(req.splats()),
+                  req.has_frame() ? std::optional<int>(req.frame()) : std::nullopt, parts)
             : farm_.CompleteSweep(req.lease_id(), worker, req.radiosity_sweep());
     if (!s.ok()) {
         Log()->warn("{}", RefusedResultLine(req.lease_id(), worker, context->peer(),

@@ -46,6 +46,15 @@ void ScheduledJob::Sync() {
     record.tasks_done = int(execution->tasks_done());
     record.tasks_total = execution->tasks_total();
     record.stats = execution->stats();
+    // A shot's progress from its execution; the paths of the frames written are the record's.
+    // Both in frame order; a record from before the job's first Sync has none.
+    std::vector<FrameProgress> frames = execution->Frames();
+    if (record.frames.size() == frames.size()) {
+        for (size_t i = 0; i < frames.size(); ++i) {
+            frames[i].result_path = std::move(record.frames[i].result_path);
+        }
+    }
+    record.frames = std::move(frames);
     record.tasks_running = IsFinal(record.state) ? 0 : states.running();
 }
 

@@ -1,5 +1,6 @@
 #include "lf/server/scheduler.h"
 
+#include <algorithm>
 #include <cstdlib>
 
 #include "absl/strings/str_cat.h"
@@ -457,6 +458,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
                     merged->sweep->converged ? ", solved" : "");
         completion.sweep = std::move(merged->sweep);
     }
+    completion.frames_completed = std::move(merged->frames_completed);
     EnforceTimeLimit(job, now);
     const std::optional<std::string> record = job.execution->RecordOf(result);
     if (!record) {  // soft state, not recorded
@@ -697,6 +699,76 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_i
         snapshot.adaptive->estimated_error = *estimated;
     }
     return snapshot;
+}
+
+absl::StatusOr<Scheduler::JobImage> Scheduler::FrameSnapshot(const std::string& job_id,
+                                                             int frame) const {
+    JobImage snapshot;
+    JobExecution::ImageReader read;  // shares the frame's stores, as Snapshot's
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        auto it = active_.find(job_id);
+        if (it == active_.end()) {
+            return absl::FailedPreconditionError(absl::StrCat("job ", job_id, " is not running"));
+        }
+        const Job& job = *it->second;
+        const JobExecution* execution = job.execution->FrameExecution(frame);
+        if (!execution) {
+            return absl::NotFoundError(absl::StrCat("job ", job_id, " renders no frame ", frame));
+        }
+        snapshot.record = job.record;
+        snapshot.record.spec = FrameSpec(job.record.spec, frame);
+        snapshot.record.stats = execution->stats();
+        read = execution->SnapshotReader();
+        snapshot.adaptive = execution->TileReport();
+    }
+    absl::StatusOr<Image> image = read();
+    if (!image.ok()) return image.status();
+    snapshot.image = std::move(*image);
+    if (snapshot.adaptive) {
+        absl::StatusOr<double> estimated = EstimatedRelativeError(snapshot.image);
+        if (!estimated.ok()) return estimated.status();
+        snapshot.adaptive->estimated_error = *estimated;
+    }
+    return snapshot;
+}
+
+void Scheduler::FrameWritten(const std::string& job_id, int frame,
+                             const absl::StatusOr<std::string>& path) {
+    Locked locked(*this);
+    auto it = active_.find(job_id);
+    if (it == active_.end()) return;  // cancelled meanwhile: it keeps the frames recorded before
+    Job& job = *it->second;
+    if (!path.ok()) {
+        FailJob(job, absl::StrCat("writing frame ", frame, ": ", path.status().message()));
+        return;
+    }
+    job.Sync();
+    for (FrameProgress& f : job.record.frames) {
+        if (f.frame == frame) f.result_path = *path;
+    }
+    Log()->info("job={} frame {} written ({}/{} frames) -> {}", job_id, frame,
+                job.record.frames_done(), job.record.frames.size(), *path);
+    const uint64_t ticket = Save(job);
+    locked.lock.unlock();
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
+        Log()->error("job={} frame {}: its path is not recorded: {}", job_id, frame,
+                     std::string(s.message()));
+    }
+}
+
+std::vector<std::pair<std::string, int>> Scheduler::UnwrittenFrames() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::pair<std::string, int>> frames;
+    for (const auto& [id, job] : active_) {
+        const std::vector<FrameProgress>& recorded = job->record.frames;  // in frame order
+        const std::vector<FrameProgress> now = job->execution->Frames();
+        for (size_t i = 0; i < now.size(); ++i) {
+            const bool written = i < recorded.size() && !recorded[i].result_path.empty();
+            if (now[i].done && !written) frames.emplace_back(id, now[i].frame);
+        }
+    }
+    return frames;
 }
 
 void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path) {

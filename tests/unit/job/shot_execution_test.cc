@@ -111,6 +111,13 @@ TEST(ShotExecution, EachFrameCompletesOnItsOwn) {
     EXPECT_TRUE(e->frame(1).Complete());
     EXPECT_FALSE(e->frame(0).Complete());
     EXPECT_EQ(e->frame(0).tasks_done(), 1u);
+    EXPECT_EQ(e->FrameExecution(2), &e->frame(1));
+    EXPECT_EQ(e->FrameExecution(4), nullptr);
+    const std::vector<FrameProgress> frames = e->Frames();
+    ASSERT_EQ(frames.size(), 3u);
+    EXPECT_EQ(frames[0], (FrameProgress{.frame = 1, .tasks_done = 1, .tasks_total = 4}));
+    EXPECT_EQ(frames[1],
+              (FrameProgress{.frame = 2, .tasks_done = 4, .tasks_total = 4, .done = true}));
     EXPECT_EQ(e->tasks_done(), 5u);
     EXPECT_FALSE(e->Complete());
     EXPECT_EQ(e->stats().samples, 5u * 8 * 8 * 4);

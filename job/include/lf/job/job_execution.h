@@ -119,11 +119,9 @@ class JobExecution {
 
     // A shot's frames in frame order, without result paths (the coordinator's); none for a still.
     virtual std::vector<FrameProgress> Frames() const { return {}; }
-    // Reads frame `frame`'s image merged so far, as SnapshotReader; NotFound for a frame the job
-    // does not render.
-    virtual absl::StatusOr<ImageReader> FrameReader(int frame) const {
-        return absl::NotFoundError("not a shot: it renders no frames");
-    }
+    // A shot's frame `frame` (its number) as its own execution: its image, stats and report;
+    // nullptr for a frame the job does not render.
+    virtual const JobExecution* FrameExecution(int frame) const { return nullptr; }
 };
 
 // The kind of execution `spec` runs as, planned as its settings say; InvalidArgument when they

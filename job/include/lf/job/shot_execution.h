@@ -51,7 +51,7 @@ class ShotExecution : public JobExecution {
     // The first frame not complete, or the last frame once every one is.
     ImageReader SnapshotReader() const override;
     std::vector<FrameProgress> Frames() const override;
-    absl::StatusOr<ImageReader> FrameReader(int frame) const override;
+    const JobExecution* FrameExecution(int frame) const override;
 
     const FrameRange& frames() const { return frames_; }
     int chunk() const { return chunk_; }

@@ -77,18 +77,31 @@ class Farm {
     // a splat task's splat list (lf::EncodeSplatList), with `tile_sums` its camera part. A
     // result that does not decode, or does not fit its task, is refused naming the job, the
     // task and the worker, and the task goes back to the queue as a counted failure.
+    // A shot's task names its `frame`; a chunk of a shot sends one part a frame's task, in its
+    // lease's order, instead of `tile_sums` and `splats`. Each frame the result completes is
+    // written as its own EXR at once (fetchable whatever the job ends as).
+    struct ResultPart {
+        int frame = 0;
+        std::string_view tile_sums;
+        std::optional<std::string_view> splats;
+    };
     absl::Status Complete(const std::string& lease_id, const std::string& worker,
                           std::string_view tile_sums,
                           std::optional<RadiosityFigures> radiosity = std::nullopt,
-                          std::optional<std::string_view> splats = std::nullopt);
+                          std::optional<std::string_view> splats = std::nullopt,
+                          std::optional<int> frame = std::nullopt,
+                          const std::vector<ResultPart>& parts = {});
     // A radiosity patch-group task's result (lf::EncodeSweepResult); when it ends a sweep,
     // stores the next sweep's input or the solution as a blob for the workers.
     absl::Status CompleteSweep(const std::string& lease_id, const std::string& worker,
                                std::string_view sweep_result);
 
     // The EXR of a succeeded job; with `preview`, also of a running one (what is merged so far).
-    // A preview is written again only when a task was merged since the last one.
-    absl::StatusOr<std::string> ResultFile(const std::string& job_id, bool preview);
+    // A preview is written again only when a task was merged since the last one. A shot's
+    // `frame`: its EXR once the frame is complete, whatever the job's state (a cancelled or
+    // failed shot keeps its finished frames); with `preview`, what is merged of it so far.
+    absl::StatusOr<std::string> ResultFile(const std::string& job_id, bool preview,
+                                           std::optional<int> frame = std::nullopt);
 
     // What the server's timer thread runs every tenth of a second: expired leases go back to the
     // queue, and adaptive jobs past their time limit stop sampling (and are written if that
@@ -139,6 +152,10 @@ class Farm {
     absl::Status WriteImage(const Scheduler::JobImage& snapshot, bool complete,
                             const std::string& path);
     void FinishJob(const std::string& job_id);
+    // Writes a shot's complete frame `frame` as results/JOB.frame<N>.exr, its header the frame's
+    // (MetadataOf(FrameSpec)), and records it; a failed write fails the job.
+    void WriteFrame(const std::string& job_id, int frame);
+    std::string FramePathOf(const std::string& dir, const std::string& job_id, int frame) const;
     void RemoveJobFiles(const std::string& job_id);
     void RemoveJobLogs(const std::vector<std::string>& job_ids);
     // The temporary files of writes a killed server did not finish.

@@ -129,10 +129,13 @@ class Scheduler {
     // Finish. When a patch-group task completes its sweep, `sweep` holds the next sweep's input
     // or the solution: the caller stores it as a blob and calls Publish. A solve that runs out of
     // iterations fails the job.
+    // `frames_completed`: a shot's frames the result completed, whose EXR the caller writes
+    // (WriteFrame) before it learns the job is rendered.
     struct Completion {
         std::string job_id;
         bool job_rendered = false;
         std::optional<RadiositySolve::Outcome> sweep;
+        std::vector<int> frames_completed;
     };
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
                                         const TaskResult& result);
@@ -181,6 +184,16 @@ class Scheduler {
         std::optional<AdaptiveReport> adaptive;
     };
     absl::StatusOr<JobImage> Snapshot(const std::string& job_id) const;
+    // A running shot's frame `frame` as Snapshot reads a job: the record's spec is the frame's
+    // (FrameSpec), its stats the frame's. NotFound for a frame the job does not render.
+    absl::StatusOr<JobImage> FrameSnapshot(const std::string& job_id, int frame) const;
+    // Records frame `frame`'s EXR as written (fetchable from now on, whatever the job ends as), or
+    // fails the job with the error.
+    void FrameWritten(const std::string& job_id, int frame,
+                      const absl::StatusOr<std::string>& path);
+    // The frames of running shots that are complete but whose EXR is not recorded (the
+    // coordinator stopped between the merge and the write): (job id, frame).
+    std::vector<std::pair<std::string, int>> UnwrittenFrames() const;
 
     // Ends a fully rendered job: succeeded with the result file, or failed with the error.
     void Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path);

@@ -1,0 +1,194 @@
+// A shot through the coordinator's Farm, with made-up results (no renderer): each frame's EXR is
+// written as soon as its last task merges, with the frame's header; a cancelled shot keeps its
+// finished frames fetchable; a restarted coordinator replays the recorded results frame by frame
+// and finishes the shot; deleting it removes every frame.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "lf/core/image_io.h"
+#include "lf/core/tile_codec.h"
+#include "lf/job/digest.h"
+#include "lf/server/farm.h"
+#include "test_dir.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ShotFarmTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = lf::testing::FreshTestDir("lf_shotfarm");
+        options_.data_dir = dir_.string();
+        Open();
+        std::ifstream in(fs::path(LF_TEST_SCENES) / "cornell_box.json");
+        std::stringstream text;
+        text << in.rdbuf();
+        scene_ = text.str();
+        auto upload = farm_->blobs().StartUpload(Sha256Hex(scene_), scene_.size());
+        ASSERT_TRUE(upload.ok()) << upload.status();
+        ASSERT_TRUE((*upload)->Append(scene_).ok());
+        ASSERT_TRUE((*upload)->Finish().ok());
+    }
+    void TearDown() override {
+        farm_.reset();
+        fs::remove_all(dir_);
+    }
+
+    void Open() {
+        farm_.reset();
+        absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options_);
+        ASSERT_TRUE(farm.ok()) << farm.status();
+        farm_ = std::move(*farm);
+    }
+
+    JobSpec Shot(int chunk = 1) {
+        JobSpec spec;
+        spec.scene = {"scene.json", Sha256Hex(scene_), scene_.size()};
+        spec.scene_options.width = 16;  // 4 tiles of 8x8 a frame
+        spec.scene_options.height = 16;
+        spec.plan.spp = 2;
+        spec.plan.tile = 8;
+        spec.plan.passes = 1;
+        spec.shot.frames = FrameRange{1, 3, 1};
+        spec.shot.chunk = chunk;
+        return spec;
+    }
+
+    // Leases one task and answers it with every sample at the frame's number / 10.
+    void RenderOne() {
+        std::optional<TaskAssignment> lease =
+            farm_->scheduler().LeaseTask("w1", absl::Now() + absl::Seconds(5));
+        ASSERT_TRUE(lease.has_value());
+        const auto sums = [](const RenderTask& task, int frame) {
+            TileSums s(task.rect);
+            for (PixelSums& p : s.pixels) {
+                for (uint64_t i = task.sample_begin; i < task.sample_end; ++i) {
+                    p.Add(i, Rgb(float(frame) / 10));
+                }
+            }
+            return EncodeTileSums(s);
+        };
+        if (lease->parts.empty()) {
+            ASSERT_TRUE(lease->frame.has_value());
+            const absl::Status s =
+                farm_->Complete(lease->lease_id, "w1", sums(lease->task, *lease->frame),
+                                std::nullopt, std::nullopt, lease->frame);
+            ASSERT_TRUE(s.ok()) << s;
+            return;
+        }
+        std::vector<std::string> encoded;
+        for (const TaskAssignment::Part& part : lease->parts) {
+            encoded.push_back(sums(part.task, part.frame));
+        }
+        std::vector<Farm::ResultPart> parts;
+        for (size_t i = 0; i < encoded.size(); ++i) {
+            parts.push_back({lease->parts[i].frame, encoded[i], std::nullopt});
+        }
+        const absl::Status s = farm_->Complete(lease->lease_id, "w1", "", std::nullopt,
+                                               std::nullopt, std::nullopt, parts);
+        ASSERT_TRUE(s.ok()) << s;
+    }
+
+    // The frame's EXR: its R at (0, 0) and its lightfarm.frame attribute.
+    void ExpectFrame(const std::string& job, int frame) {
+        absl::StatusOr<std::string> path = farm_->ResultFile(job, false, frame);
+        ASSERT_TRUE(path.ok()) << path.status();
+        absl::StatusOr<ExrFile> exr = ReadExr(*path);
+        ASSERT_TRUE(exr.ok()) << exr.status();
+        EXPECT_FLOAT_EQ(exr->image.FindChannel("R")->at(0), float(frame) / 10) << frame;
+        ASSERT_TRUE(exr->attributes.count("lightfarm.frame")) << frame;
+    }
+
+    fs::path dir_;
+    FarmOptions options_;
+    std::string scene_;
+    std::unique_ptr<Farm> farm_;
+};
+
+TEST_F(ShotFarmTest, EachFrameIsWrittenWhenItCompletesAndACancelledShotKeepsThem) {
+    absl::StatusOr<std::string> job = farm_->Submit(Shot());
+    ASSERT_TRUE(job.ok()) << job.status();
+    for (int t = 0; t < 4; ++t) RenderOne();  // frame 1
+    absl::StatusOr<JobRecord> record = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(record.ok());
+    EXPECT_EQ(record->frames_done(), 1);
+    ASSERT_EQ(record->frames.size(), 3u);
+    EXPECT_FALSE(record->frames[0].result_path.empty());
+    ExpectFrame(*job, 1);
+    RenderOne();  // a tile of frame 2
+    EXPECT_EQ(farm_->ResultFile(*job, false, 2).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(farm_->ResultFile(*job, false).status().code(), absl::StatusCode::kFailedPrecondition)
+        << "a shot is fetched frame by frame";
+    EXPECT_EQ(farm_->ResultFile(*job, false, 7).status().code(), absl::StatusCode::kNotFound);
+    absl::StatusOr<std::string> preview = farm_->ResultFile(*job, true, 2);
+    ASSERT_TRUE(preview.ok()) << preview.status();
+
+    ASSERT_TRUE(farm_->scheduler().Cancel(*job).ok());
+    ExpectFrame(*job, 1);
+    EXPECT_EQ(farm_->ResultFile(*job, false, 2).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    Open();  // and from the store, once the coordinator restarted
+    ExpectFrame(*job, 1);
+
+    const std::string frame_file = *farm_->ResultFile(*job, false, 1);
+    ASSERT_TRUE(farm_->DeleteJob(*job).ok());
+    EXPECT_FALSE(fs::exists(frame_file));
+}
+
+TEST_F(ShotFarmTest, ARestartedCoordinatorReplaysTheFramesAndFinishesTheShot) {
+    absl::StatusOr<std::string> job = farm_->Submit(Shot());
+    ASSERT_TRUE(job.ok()) << job.status();
+    for (int t = 0; t < 6; ++t) RenderOne();  // frame 1, half of frame 2
+    Open();
+    absl::StatusOr<JobRecord> record = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(record.ok()) << record.status();
+    EXPECT_EQ(record->tasks_done, 6);
+    ASSERT_EQ(record->frames.size(), 3u);
+    EXPECT_EQ(record->frames[1].tasks_done, 2);
+    ExpectFrame(*job, 1);
+    for (int t = 0; t < 6; ++t) RenderOne();
+    record = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(record.ok());
+    EXPECT_EQ(record->state, JobState::kSucceeded) << record->error;
+    EXPECT_EQ(record->frames_done(), 3);
+    for (int f : {1, 2, 3}) ExpectFrame(*job, f);
+}
+
+TEST_F(ShotFarmTest, ChunksOfWholeFramesAcrossARestart) {
+    absl::StatusOr<std::string> job = farm_->Submit(Shot(2));  // {1, 2}, {3}
+    ASSERT_TRUE(job.ok()) << job.status();
+    RenderOne();
+    absl::StatusOr<JobRecord> record = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(record.ok());
+    EXPECT_EQ(record->tasks_total, 2);
+    EXPECT_EQ(record->frames_done(), 2);
+    Open();
+    ExpectFrame(*job, 2);
+    RenderOne();
+    record = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(record.ok());
+    EXPECT_EQ(record->state, JobState::kSucceeded) << record->error;
+    for (int f : {1, 2, 3}) ExpectFrame(*job, f);
+}
+
+TEST_F(ShotFarmTest, BadShotSettingsAreRefusedAtSubmissionWithRendersMessage) {
+    JobSpec spec = Shot();
+    spec.shot.fps = -1;
+    absl::StatusOr<std::string> job = farm_->Submit(spec);
+    ASSERT_FALSE(job.ok());
+    EXPECT_EQ(job.status(), CheckJobSettings(spec));
+    spec = Shot(2);
+    spec.adaptive.target_error = 0.05;
+    job = farm_->Submit(spec);
+    ASSERT_FALSE(job.ok());
+    EXPECT_NE(job.status().message().find("--chunk 1"), std::string::npos) << job.status();
+}
+
+}  // namespace
+}  // namespace lf
