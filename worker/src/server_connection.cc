@@ -92,6 +92,13 @@ absl::Status ServerConnection::Complete(const std::string& lease_id, const TaskR
     req.set_seconds(seconds);
     if (result.radiosity) ToProto(*result.radiosity, req.mutable_radiosity());
     if (result.splats) req.set_splats(*result.splats);
+    if (result.frame) req.set_frame(*result.frame);
+    for (const TaskResult::Part& part : result.parts) {
+        pb::TaskPartResult* p = req.add_parts();
+        p->set_frame(part.frame);
+        p->set_tile_sums(part.bytes);
+        if (part.splats) p->set_splats(*part.splats);
+    }
     for (const TaskLogLine& line : result.log) ToProto(line, req.add_log());
     pb::CompleteTaskResponse resp;
     // Rides out a server restart: the result stays valid after its lease.

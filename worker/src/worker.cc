@@ -12,8 +12,10 @@
 #include "lf/core/log.h"
 #include "lf/core/plural.h"
 #include "lf/core/radiosity_codec.h"
+#include "lf/core/scene_animation.h"
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
+#include "lf/job/shot.h"
 #include "lf/job/splat_settings.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/tile_renderer.h"
@@ -38,6 +40,11 @@ std::string DescribeTask(const TaskAssignment& task) {
                      task.task.sample_end - task.task.sample_begin, " spp)");
     if (task.path_end > task.path_begin) {
         absl::StrAppend(&what, ", light paths ", task.path_begin, "-", task.path_end);
+    }
+    if (task.frame) absl::StrAppend(&what, ", frame ", *task.frame);
+    if (!task.parts.empty()) {
+        what = absl::StrCat(task.spec.method, ", frames ", task.parts.front().frame, "-",
+                            task.parts.back().frame, " whole (", task.parts.size(), " parts)");
     }
     return what;
 }
@@ -187,6 +194,11 @@ void Worker::Execute(const TaskAssignment& task) {
 
 absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
                              ServerConnection::TaskResult& result, RenderStats& stats) {
+    if (!task.parts.empty()) return RunChunk(task, cancel, result, stats);
+    if (task.frame) {
+        if (absl::Status s = PoseFrame(task, *task.frame, cancel); !s.ok()) return s;
+        result.frame = task.frame;
+    }
     if (task.sweep >= 0) {
         absl::StatusOr<std::string> swept = Sweep(task, cancel);
         if (!swept.ok()) return swept.status();
@@ -201,6 +213,64 @@ absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>
     if (const auto* r = dynamic_cast<const RadiosityRenderer*>(loaded_.tracer.get())) {
         result.radiosity = RadiosityFiguresOf(r->report());
     }
+    return absl::OkStatus();
+}
+
+absl::Status Worker::RunChunk(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                              ServerConnection::TaskResult& result, RenderStats& stats) {
+    TaskAssignment one = task;
+    one.parts.clear();
+    for (const TaskAssignment::Part& part : task.parts) {
+        if (cancel) return absl::CancelledError("chunk cancelled");
+        one.task.rect = part.task.rect;
+        one.task.sample_begin = part.task.sample_begin;
+        one.task.sample_end = part.task.sample_end;
+        one.path_begin = part.path_begin;
+        one.path_end = part.path_end;
+        one.frame = part.frame;
+        ServerConnection::TaskResult rendered;
+        RenderStats part_stats;
+        if (absl::Status s = RunTask(one, cancel, rendered, part_stats); !s.ok()) return s;
+        stats += part_stats;
+        if (rendered.radiosity) result.radiosity = rendered.radiosity;
+        result.parts.push_back({part.frame, std::move(rendered.bytes), std::move(rendered.splats)});
+    }
+    return absl::OkStatus();
+}
+
+absl::Status Worker::PoseFrame(const TaskAssignment& task, int frame,
+                               const std::atomic<bool>& cancel) {
+    if (loaded_.posed_frame == frame) return absl::OkStatus();
+    const SceneAnimation* animation = loaded_.scene->animation.get();
+    // Without motion every time gives the image of the first pose: the BVH built for it stays,
+    // and so do the kernels (a radiosity solve included).
+    const bool moves = animation && animation->Moves();
+    if (loaded_.embree && !moves) {
+        loaded_.posed_frame = frame;
+        Log()->info("job={} task={} frame {}: nothing moves, the scene and BVH are kept",
+                    task.job_id, task.task.index, frame);
+        return absl::OkStatus();
+    }
+    const absl::Time start = absl::Now();
+    if (absl::Status s = PoseSceneAtFrame(frame, task.spec.shot, *loaded_.scene); !s.ok()) {
+        loaded_ = {};  // perhaps half posed: loaded again for the next task
+        return s;
+    }
+    const absl::Time posed = absl::Now();
+    loaded_.tracer.reset();
+    loaded_.frame.reset();
+    loaded_.camera.reset();
+    loaded_.embree.reset();
+    loaded_.posed_frame.reset();
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree =
+        EmbreeScene::Build(*loaded_.scene, &cancel);
+    if (!embree.ok()) return embree.status();
+    loaded_.embree = std::move(*embree);
+    loaded_.camera = std::make_unique<Camera>(loaded_.scene->camera, loaded_.embree->origin());
+    loaded_.posed_frame = frame;
+    Log()->info("job={} task={} frame {} posed in {:.1f} ms, BVH built in {:.1f} ms", task.job_id,
+                task.task.index, frame, absl::ToDoubleMilliseconds(posed - start),
+                absl::ToDoubleMilliseconds(absl::Now() - posed));
     return absl::OkStatus();
 }
 
@@ -240,11 +310,14 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
     if (cancel) return cancelled();
     LoadedScene loaded;
     loaded.scene = std::make_unique<Scene>(std::move(*scene));
-    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree =
-        EmbreeScene::Build(*loaded.scene, &cancel);
-    if (!embree.ok()) return embree.status();
-    loaded.embree = std::move(*embree);
-    loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
+    // A shot's BVH is built for its first frame's pose (PoseFrame), a still's for the rest pose.
+    if (!task.spec.shot.frames) {
+        absl::StatusOr<std::unique_ptr<EmbreeScene>> embree =
+            EmbreeScene::Build(*loaded.scene, &cancel);
+        if (!embree.ok()) return embree.status();
+        loaded.embree = std::move(*embree);
+        loaded.camera = std::make_unique<Camera>(loaded.scene->camera, loaded.embree->origin());
+    }
     loaded.job_id = task.job_id;
     loaded_ = std::move(loaded);
     Log()->info("job={} task={} scene {} loaded: {}, {} fetched from the server, {} cached",

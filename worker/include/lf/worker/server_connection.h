@@ -41,6 +41,14 @@ class ServerConnection {
         // A splat task's splat list (lf::EncodeSplatList); `bytes` is then its camera part.
         std::optional<std::string> splats;
         std::vector<TaskLogLine> log;  // the task's lines no heartbeat took
+        std::optional<int> frame;      // a shot's task: the frame rendered
+        // A chunk of a shot: one result a part of the lease, in its order, instead of `bytes`.
+        struct Part {
+            int frame = 0;
+            std::string bytes;
+            std::optional<std::string> splats;
+        };
+        std::vector<Part> parts;
     };
     absl::Status Complete(const std::string& lease_id, const TaskResult& result, double seconds);
     // `shutdown`: the worker is stopping, which does not count against the task.

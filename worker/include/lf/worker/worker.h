@@ -18,10 +18,10 @@
 #include "absl/status/status.h"
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiance.h"
 #include "lf/kernels/radiosity.h"
+#include "lf/kernels/splat_renderer.h"
 #include "lf/worker/blob_cache.h"
 #include "lf/worker/server_connection.h"
 #include "lf/worker/task_log_sink.h"
@@ -62,6 +62,8 @@ class Worker {
         std::map<int, std::unique_ptr<RadiositySweepChunk>> chunks;
         std::string input_hash;
         std::vector<Rgb> input;
+        // A shot's: the frame the scene is posed at (the BVH, camera and kernels are of it).
+        std::optional<int> posed_frame;
     };
 
     void Execute(const TaskAssignment& task);
@@ -70,6 +72,12 @@ class Worker {
     absl::Status PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // The job's path tracer or radiosity display, built once per job.
     absl::Status PrepareTracer(const TaskAssignment& task, const std::atomic<bool>& cancel);
+    // Poses the job's scene at `frame` (lf::PoseSceneAtFrame) and rebuilds its BVH, camera and
+    // kernels when the animation moves something; nothing when it is posed there already.
+    absl::Status PoseFrame(const TaskAssignment& task, int frame, const std::atomic<bool>& cancel);
+    // A chunk of a shot: each part in order, posed at its frame, one result a part.
+    absl::Status RunChunk(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                          ServerConnection::TaskResult& result, RenderStats& stats);
     TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A tile or splat task's camera sums, or a sweep's result: `result` and its stats.
     absl::Status RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
