@@ -226,10 +226,12 @@ absl::StatusOr<pb::Job> FarmClient::Watch(const std::string& id, ProgressBar& ba
     }
 }
 
-absl::Status FarmClient::FetchResult(const std::string& id, const std::string& path, bool preview) {
+absl::Status FarmClient::FetchResult(const std::string& id, const std::string& path, bool preview,
+                                     std::optional<int> frame) {
     pb::FetchResultRequest req;
     req.set_job_id(id);
     req.set_preview(preview);
+    if (frame) req.set_frame(*frame);
     const auto context = ContextWithDeadline(absl::Minutes(30));
     std::unique_ptr<grpc::ClientReader<pb::Chunk>> reader = stub_->FetchResult(context.get(), req);
     // Written beside the target and renamed, so a failed fetch leaves no half file.

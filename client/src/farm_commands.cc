@@ -79,8 +79,25 @@ std::string ElapsedText(const pb::Job& job) {
     return absl::StrFormat("%dh%02dm", s / 3600, s / 60 % 60);
 }
 
+// A shot's ", 1/3 frames" done; "" for a still.
+std::string FramesDone(const pb::Job& job) {
+    if (job.frames_total() == 0) return "";
+    return absl::StrCat(", ", job.frames_done(), "/", job.frames_total(), " frames");
+}
+
+// "5/12" tasks; a shot's "5/12, 1/3 frames".
 std::string Progress(const pb::Job& job) {
-    return absl::StrCat(job.tasks_done(), "/", job.tasks_total());
+    return absl::StrCat(job.tasks_done(), "/", job.tasks_total(), FramesDone(job));
+}
+
+// A shot's frames and each one's progress: "1 done, 2 3/4, 3 0/4".
+std::string FramesText(const pb::Job& job) {
+    std::string text;
+    for (const pb::FrameProgress& f : job.frames()) {
+        absl::StrAppend(&text, text.empty() ? "" : ", ", f.frame(), " ",
+                        f.done() ? "done" : absl::StrCat(f.tasks_done(), "/", f.tasks_total()));
+    }
+    return text;
 }
 
 void PrintJob(const pb::Job& job) {
@@ -108,9 +125,17 @@ void PrintJob(const pb::Job& job) {
                     job.params().target_error(), job.params().time_limit_seconds(),
                     (unsigned long long)job.params().max_spp());
     }
+    if (spec.shot.frames) {
+        std::printf(
+            "  frames    %s at %g fps, %d done of %d%s\n",
+            FrameRangeText(*spec.shot.frames).c_str(), spec.shot.fps, job.frames_done(),
+            job.frames_total(),
+            spec.shot.chunk > 1 ? absl::StrCat(", ", spec.shot.chunk, " a task").c_str() : "");
+        std::printf("            %s\n", FramesText(job).c_str());
+    }
     std::printf("  priority  %d\n", job.priority());
-    std::printf("  tasks     %s done, %d running, %d retried, %d leased\n", Progress(job).c_str(),
-                job.tasks_running(), job.retries(), job.tasks_leased());
+    std::printf("  tasks     %d/%d done, %d running, %d retried, %d leased\n", job.tasks_done(),
+                job.tasks_total(), job.tasks_running(), job.retries(), job.tasks_leased());
     std::printf("  samples   %llu (%llu rays, %llu NaN/Inf)\n", (unsigned long long)job.samples(),
                 (unsigned long long)job.rays(), (unsigned long long)job.invalid_samples());
     if (job.started_unix_ms() > 0) {
@@ -137,12 +162,13 @@ void PrintJob(const pb::Job& job) {
 }
 
 // The job's EXR at paths.exr, and its preview at paths.png, made here from the EXR (fetched into
-// a temporary file when -o names only the PNG).
+// a temporary file when -o names only the PNG). A shot's `frame` is that frame's.
 absl::Status FetchOutputs(const FarmFlags& flags, const std::string& id, const OutputPaths& paths,
-                          const PngOptions& preview_options, bool preview) {
+                          const PngOptions& preview_options, bool preview,
+                          std::optional<int> frame = std::nullopt) {
     if (absl::Status s = CheckWritable(paths.png); !s.ok()) return s;
     const std::string exr = paths.exr.empty() ? paths.png + ".exr.part" : paths.exr;
-    if (absl::Status s = FarmClient(flags).FetchResult(id, exr, preview); !s.ok()) return s;
+    if (absl::Status s = FarmClient(flags).FetchResult(id, exr, preview, frame); !s.ok()) return s;
     if (paths.png.empty()) return absl::OkStatus();
     absl::StatusOr<ExrFile> file = ReadExr(exr);
     absl::Status written =
@@ -150,6 +176,56 @@ absl::Status FetchOutputs(const FarmFlags& flags, const std::string& id, const O
     std::error_code ignored;  // a temporary file left behind is harmless
     if (paths.exr.empty()) fs::remove(exr, ignored);
     return written;
+}
+
+absl::StatusOr<pb::Job> GetJob(const FarmFlags& flags, const std::string& id) {
+    pb::GetJobRequest req;
+    req.set_job_id(id);
+    pb::Job job;
+    if (absl::Status s = FarmClient(flags).Call(&pb::JobService::Stub::GetJob, req, &job);
+        !s.ok()) {
+        return s;
+    }
+    return job;
+}
+
+// The frames `fetch` writes: those --frames names (each must be the shot's), or every finished
+// one (every one with --preview); -o and --png must number them (lf::CheckFramePattern).
+absl::StatusOr<std::vector<int>> FramesToFetch(const pb::Job& job, const std::string& flag,
+                                               const OutputPaths& paths, bool preview) {
+    JobSpec spec;
+    FromProto(job.params(), &spec);
+    const FrameRange& shot = *spec.shot.frames;
+    std::vector<int> frames;
+    FrameRange named = shot;
+    if (!flag.empty()) {
+        absl::StatusOr<FrameRange> range = ParseFrameRange(flag);
+        if (!range.ok()) return range.status();
+        named = *range;
+        for (int i = 0; i < named.count(); ++i) {
+            if (!shot.Contains(named.at(i))) {
+                return absl::InvalidArgumentError(
+                    absl::StrCat("--frames ", flag, ": frame ", named.at(i), " is not one of job ",
+                                 job.id(), "'s (", FrameRangeText(shot), ")"));
+            }
+            frames.push_back(named.at(i));
+        }
+    } else {
+        for (const pb::FrameProgress& f : job.frames()) {
+            if (f.done() || preview) frames.push_back(f.frame());
+        }
+        if (frames.empty()) {
+            return absl::FailedPreconditionError(
+                absl::StrCat("job ", job.id(), " has no finished frame yet (0/", job.frames_total(),
+                             "); --preview fetches what is merged so far"));
+        }
+        if (frames.size() == 1) named = {frames[0], frames[0], 1};
+    }
+    for (const auto& [name, pattern] : {std::pair{"-o", paths.exr}, {"--png", paths.png}}) {
+        if (pattern.empty()) continue;
+        if (absl::Status s = CheckFramePattern(name, pattern, named); !s.ok()) return s;
+    }
+    return frames;
 }
 
 }  // namespace
@@ -243,8 +319,9 @@ Command AddWatchCommand(CLI::App& app) {
                 absl::StatusOr<pb::Job> job = FarmClient(*flags).Watch(*id, bar);
                 bar.Finish();
                 if (!job.ok()) return ReportError(job.status());
-                std::printf("job %s %s (%s tasks, %d retried)%s%s\n", job->id().c_str(),
-                            StateName(job->state()).c_str(), Progress(*job).c_str(), job->retries(),
+                std::printf("job %s %s (%d/%d tasks%s, %d retried)%s%s\n", job->id().c_str(),
+                            StateName(job->state()).c_str(), job->tasks_done(), job->tasks_total(),
+                            FramesDone(*job).c_str(), job->retries(),
                             job->error().empty() ? "" : ": ", job->error().c_str());
                 return job->state() == pb::Job::SUCCEEDED ? 0 : 1;
             }};
@@ -264,17 +341,46 @@ Command AddFetchCommand(CLI::App& app) {
     AddOutputFlags(cmd, *output);
     cmd->add_flag("--preview", *preview,
                   "a running job's tiles merged so far (unfinished tiles have fewer samples)");
+    auto frames = std::make_shared<std::string>();
+    cmd->add_option("--frames", *frames,
+                    "a shot's frames to fetch, A-B[:STEP] or N (default: every finished one); "
+                    "-o and --png then name each frame's file with a run of # for its number, "
+                    "e.g. -o out_####.exr");
     AddServerOption(cmd, *flags);
-    return {cmd, [flags, id, output, preview] {
-                absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
-                if (!paths.ok()) return ReportError(paths.status());
+    return {
+        cmd, [flags, id, output, preview, frames] {
+            absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
+            if (!paths.ok()) return ReportError(paths.status());
+            absl::StatusOr<pb::Job> job = GetJob(*flags, *id);
+            if (!job.ok()) return ReportError(job.status());
+            if (job->frames_total() == 0) {
+                if (!frames->empty()) {
+                    return ReportError(absl::InvalidArgumentError(absl::StrCat(
+                        "--frames: job ", *id, " is a still, not a shot; fetch it without")));
+                }
                 if (absl::Status s = FetchOutputs(*flags, *id, *paths, output->preview, *preview);
                     !s.ok()) {
                     return ReportError(s);
                 }
                 std::printf("job %s -> %s\n", id->c_str(), OutputNames(*paths).c_str());
                 return 0;
-            }};
+            }
+            absl::StatusOr<std::vector<int>> wanted =
+                FramesToFetch(*job, *frames, *paths, *preview);
+            if (!wanted.ok()) return ReportError(wanted.status());
+            for (int f : *wanted) {
+                const OutputPaths frame_paths{paths->exr.empty() ? "" : FramePath(paths->exr, f),
+                                              paths->png.empty() ? "" : FramePath(paths->png, f)};
+                if (absl::Status s =
+                        FetchOutputs(*flags, *id, frame_paths, output->preview, *preview, f);
+                    !s.ok()) {
+                    return ReportError(s);
+                }
+                std::printf("job %s frame %d -> %s\n", id->c_str(), f,
+                            OutputNames(frame_paths).c_str());
+            }
+            return 0;
+        }};
 }
 
 Command AddCancelCommand(CLI::App& app) {
@@ -423,17 +529,23 @@ Command AddTasksCommand(CLI::App& app) {
                 for (const pb::TaskInfo& t : resp.tasks()) PrintJson(t);
                 return 0;
             }
-            std::printf("%5s %-8s %-15s %-17s %8s %-28s %9s  %s\n", "TASK", "STATE", "KIND",
-                        "PIXELS", "ATTEMPTS", "WORKER", "DURATION", "LAST-ERROR");
+            std::printf("%5s %-8s %-15s %-17s %-11s %8s %-28s %9s  %s\n", "TASK", "STATE", "KIND",
+                        "PIXELS", "FRAMES", "ATTEMPTS", "WORKER", "DURATION", "LAST-ERROR");
             for (const pb::TaskInfo& t : resp.tasks()) {
                 const std::string pixels =
                     t.width() > 0 ? absl::StrCat(t.x(), ",", t.y(), " ", t.width(), "x", t.height())
                                   : "-";
                 const std::string duration =
                     t.leased_unix_ms() > 0 ? absl::StrFormat("%.2f s", t.seconds()) : "-";
-                std::printf("%5d %-8s %-15s %-17s %8d %-28s %9s  %s\n", t.index(),
+                // A task's frames: one, or a chunk's first-last; "-" for a still's.
+                const std::string frames =
+                    t.frames().empty() ? "-"
+                    : t.frames_size() == 1
+                        ? absl::StrCat(t.frames(0))
+                        : absl::StrCat(t.frames(0), "-", t.frames(t.frames_size() - 1));
+                std::printf("%5d %-8s %-15s %-17s %-11s %8d %-28s %9s  %s\n", t.index(),
                             TaskStateName(t.state()).c_str(), TaskKindName(t.kind()).c_str(),
-                            pixels.c_str(), t.attempts(),
+                            pixels.c_str(), frames.c_str(), t.attempts(),
                             t.worker().empty() ? "-" : LogSafe(t.worker(), kWorkerIdShown).c_str(),
                             duration.c_str(), LogSafe(t.last_error(), 200).c_str());
             }

@@ -145,6 +145,13 @@ Command AddSubmitCommand(CLI::App& app) {
            "splatting methods take no --aov nor adaptive sampling")
         ->capture_default_str()
         ->check([](const std::string& m) { return MethodFlagError(m, false); });
+    CLI::Option* chunk =
+        cmd->add_option("--chunk", o->spec.shot.chunk,
+                        "a shot's whole frames a task, each task rendering every tile of its "
+                        "frames on one worker (fixed plans only: not with adaptive sampling "
+                        "or --solver jacobi); 1: each frame's tiles spread over the workers")
+            ->capture_default_str()
+            ->check(CLI::Range(1, kMaxChunk));
     AddPhotonFlags(cmd, o->spec.ppm);
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
@@ -155,7 +162,12 @@ Command AddSubmitCommand(CLI::App& app) {
         ->group("Radiosity")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxSweepTasks));
-    return {cmd, [cmd, o] {
+    return {cmd, [cmd, o, chunk] {
+                if (chunk->count() > 0 && !o->spec.shot.frames) {
+                    return ReportError(absl::InvalidArgumentError(
+                        absl::StrCat("--chunk ", o->spec.shot.chunk,
+                                     ": whole frames a task needs a shot (--frames A-B)")));
+                }
                 if (absl::Status s = CheckRadiosityFlagsApply(*cmd, o->spec.method); !s.ok()) {
                     return ReportError(s);
                 }

@@ -14,10 +14,10 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "lf/client/farm_flags.h"
-#include "lf/job/job_spec.h"
-#include "lightfarm/v1/job_service.grpc.pb.h"
 #include "lf/client/progress_bar.h"
+#include "lf/job/job_spec.h"
 #include "lf/proto/grpc_status.h"
+#include "lightfarm/v1/job_service.grpc.pb.h"
 
 namespace lf {
 
@@ -60,7 +60,9 @@ class FarmClient {
     absl::StatusOr<lightfarm::v1::Job> Watch(const std::string& id, ProgressBar& bar);
 
     // The job's OpenEXR result (with `preview`, a running job's tiles merged so far) into `path`.
-    absl::Status FetchResult(const std::string& id, const std::string& path, bool preview);
+    // A shot's `frame`: that frame's EXR (with `preview`, what is merged of it so far).
+    absl::Status FetchResult(const std::string& id, const std::string& path, bool preview,
+                             std::optional<int> frame = std::nullopt);
 
   private:
     void Connect();
