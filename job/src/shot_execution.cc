@@ -250,10 +250,12 @@ void ShotExecution::Lease(int task, const std::string& worker, TaskAssignment& l
     if (chunk_ <= 1) {
         const auto [index, t] = Locate(task);
         frames_exec_[size_t(index)]->Lease(t, worker, lease);
+        lease.task.index = task;  // the shot's index, not the frame's own
         lease.frame = frames_.at(index);
         return;
     }
     lease.parts.clear();
+    lease.task.index = task;
     for (const auto& [index, t] : PartsOf(task)) {
         TaskAssignment part;
         frames_exec_[size_t(index)]->Lease(t, worker, part);

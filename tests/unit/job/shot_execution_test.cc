@@ -85,6 +85,8 @@ TEST(ShotExecution, TaskIndicesRunFrameAfterFrame) {
     EXPECT_EQ(e->Locate(5), std::make_pair(1, 1));
     const TaskAssignment lease = LeaseOf(*e, 5);
     EXPECT_EQ(lease.frame, 12);
+    EXPECT_EQ(lease.task.index, 5) << "the shot's index, which the worker and its logs name";
+    EXPECT_EQ(LeaseOf(*e, 9).task.index, 9);
     EXPECT_EQ(lease.task.rect.x0, 8) << "the frame's second tile";
     EXPECT_EQ(lease.task.rect.y0, 0);
     TaskStatus status;
@@ -157,6 +159,7 @@ TEST(ShotExecution, AChunkIsEveryTaskOfItsFrames) {
     EXPECT_EQ(e->FramesOf(2), (std::vector<int>{5}));
     const TaskAssignment lease = LeaseOf(*e, 1);
     ASSERT_EQ(lease.parts.size(), 8u);
+    EXPECT_EQ(lease.task.index, 1);
     EXPECT_EQ(lease.parts[0].frame, 3);
     EXPECT_EQ(lease.parts[7].frame, 4);
     EXPECT_EQ(lease.parts[7].task.rect.x0, 8);
