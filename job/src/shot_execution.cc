@@ -107,6 +107,9 @@ absl::Status CheckShotChunk(const JobSpec& spec) {
 absl::StatusOr<std::unique_ptr<ShotExecution>> ShotExecution::Make(
     const JobSpec& spec, const TileStoreFactory& tile_stores) {
     if (!spec.shot.frames) return absl::InvalidArgumentError("a shot without frames");
+    // Checked again: a spec read back from a damaged store has not been through CheckJobSettings,
+    // and an empty range would leave no frame to plan.
+    if (absl::Status s = CheckShotSettings(spec.shot); !s.ok()) return s;
     if (SolvedInSweeps(spec)) {
         // The coordinator stores and publishes one sweep's solution a job at a time.
         return absl::InvalidArgumentError(

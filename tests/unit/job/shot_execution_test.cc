@@ -235,6 +235,15 @@ TEST(ShotExecution, AChunkOfASplattingMethodLeasesEveryPassOfItsFrames) {
     EXPECT_EQ(lease.parts[passes].frame, 2);
 }
 
+TEST(ShotExecution, ARangeNoSubmissionWouldTakeIsRefused) {
+    // As a damaged job store could hand one back: never checked by CheckJobSettings.
+    for (const FrameRange& bad : {FrameRange{5, 1, 1}, FrameRange{1, 5, 0}}) {
+        absl::StatusOr<std::unique_ptr<ShotExecution>> made =
+            ShotExecution::Make(Shot(bad), MakeMemoryTileStore);
+        EXPECT_EQ(made.status().code(), absl::StatusCode::kInvalidArgument) << FrameRangeText(bad);
+    }
+}
+
 TEST(ShotExecution, AdaptiveFramesAppendPassesUnderNewShotIndices) {
     JobSpec spec = Shot({1, 2, 1});
     spec.adaptive = {.target_error = 0.01, .max_spp = 16};
