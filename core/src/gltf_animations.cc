@@ -168,20 +168,15 @@ void GltfImporter::ReadAnimations() {
 }
 
 GltfImporter::Counts GltfImporter::CountObjects() const {
-    return {scene_.meshes.size(), cameras_.size(), scene_.point_lights.size(),
-            scene_.spot_lights.size(), scene_.directional_lights.size()};
+    return {cameras_.size(), scene_.point_lights.size(), scene_.spot_lights.size(),
+            scene_.directional_lights.size()};
 }
 
-void GltfImporter::AnimateNode(int index, const Counts& before, const std::string& where) {
+void GltfImporter::AnimateNode(int index, const Counts& before) {
     SceneAnimation& animation = *options_.animation;
     const int node = node_of_[size_t(index)];
     // A node on a cycle of children is not in the tree; the traversal refuses it next.
     if (node < 0) return;
-    for (size_t i = 0; i < added_primitives_.size() && before.meshes + i < scene_.meshes.size();
-         ++i) {
-        AnimateMesh(index, int(before.meshes + i), added_primitives_[i], where);
-    }
-    added_primitives_.clear();
     if (cameras_.size() > before.cameras) cameras_.back().node = node;
     if (!moving_[size_t(node)]) return;
     const auto light = [&](AnimatedLight::Kind kind, size_t was, size_t now) {

@@ -211,14 +211,16 @@ std::vector<uint32_t> GltfImporter::Indices(int index, size_t vertices, const st
     return out;
 }
 
-void GltfImporter::AddMesh(int index, const Affine& world, const std::string& node_where) {
+void GltfImporter::AddMesh(int node, const Affine& world, const std::string& node_where) {
+    const int index = model_.nodes[size_t(node)].mesh;
+    // A node on a cycle of children is not in the animation's tree; the traversal refuses it.
+    const bool animated = options_.animation && !node_of_.empty() && node_of_[size_t(node)] >= 0;
     if (index >= int(model_.meshes.size())) {
         Fail(node_where, absl::StrCat("mesh ", index, " does not exist"));
     }
     const tinygltf::Mesh& mesh = model_.meshes[size_t(index)];
     const Affine normal_matrix = world.NormalMatrix();
     const double det = world.Determinant();
-    added_primitives_.clear();
     if (!(std::abs(det) > 0)) Fail(node_where, "its transform is singular (flattens the mesh)");
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
         const tinygltf::Primitive& prim = mesh.primitives[p];
@@ -341,7 +343,7 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
             continue;
         }
         scene_.meshes.push_back(std::move(out));
-        added_primitives_.push_back(int(p));
+        if (animated) AnimateMesh(node, int(scene_.meshes.size()) - 1, int(p), node_where);
     }
 }
 

@@ -182,13 +182,13 @@ void GltfImporter::VisitNode(int index, const Affine& parent, const std::string&
                                  origin.z, ") is beyond ±", kMaxCoordinate));
     }
     const Counts before = CountObjects();
-    if (node.mesh >= 0) AddMesh(node.mesh, world, where);
+    if (node.mesh >= 0) AddMesh(index, world, where);
     if (node.camera >= 0) AddCamera(node, world, where);
     if (const auto light = node.extensions.find("KHR_lights_punctual");
         light != node.extensions.end()) {
         AddLight(light->second.Get("light"), world, where);
     }
-    if (options_.animation && !node_of_.empty()) AnimateNode(index, before, where);
+    if (options_.animation && !node_of_.empty()) AnimateNode(index, before);
     for (size_t i = 0; i < node.children.size(); ++i) {
         VisitNode(node.children[i], world, absl::StrCat(where, ".children[", i, "]"));
     }

@@ -318,6 +318,32 @@ TEST(SceneAnimation, KhronosSimpleMorphFollowsItsWeights) {
     ExpectNear(scene->meshes[0].positions[1], Vec3d(1, 0, 0));
 }
 
+TEST(SceneAnimation, DracoPrimitivesAreSkinnedMorphedAndAnimatedEachWithItsOwnPoints) {
+    // tests/scenes/draco/animated_draco.glb (make_draco_animated.py): one mesh of two Draco
+    // primitives (185 and 61 points) under a skinned, a rigidly moving and a morphed node; over
+    // 1 s the bone rises by 2, the rigid node moves 3 along +x, the morph lifts by 1 in z.
+    SceneOptions options;
+    options.camera = "auto";
+    absl::StatusOr<Scene> scene =
+        LoadScene(std::string(LF_TEST_SCENES) + "/draco/animated_draco.glb", options);
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    ASSERT_NE(scene->animation, nullptr);
+    ASSERT_EQ(scene->meshes.size(), 6u);
+    EXPECT_EQ(scene->meshes[0].positions.size(), 185u);
+    EXPECT_EQ(scene->meshes[1].positions.size(), 61u);
+    const std::vector<TriangleMesh> rest = scene->meshes;
+    ASSERT_TRUE(scene->animation->PoseAt(0.5, *scene).ok());
+    const Vec3d motion[] = {{0, 1, 0},   {0, 1, 0},   {1.5, 0, 0},
+                            {1.5, 0, 0}, {0, 0, 0.5}, {0, 0, 0.5}};
+    for (size_t m = 0; m < 6; ++m) {
+        SCOPED_TRACE(scene->meshes[m].name);
+        ASSERT_EQ(scene->meshes[m].positions.size(), rest[m].positions.size());
+        for (size_t v = 0; v < rest[m].positions.size(); ++v) {
+            ExpectNear(scene->meshes[m].positions[v], rest[m].positions[v] + motion[m], 1e-5);
+        }
+    }
+}
+
 TEST(SceneAnimation, APoseBeyondTheCoordinateRangeIsRefusedNamingNodeAndTime) {
     GltfBuilder b = MovingParent();
     const int times = b.AddFloats<1>({{{0}}, {{1}}});
