@@ -47,6 +47,21 @@ bool GltfImporter::Animates() const {
     });
 }
 
+void GltfImporter::AnimationStep(const std::function<void()>& step) {
+    if (!animating_) return;
+    try {
+        step();
+    } catch (const GltfError& e) {
+        animating_ = false;
+        Warn(absl::StrCat("animation ignored: ", e.message));
+        // The first fault of a scene's files is the one its frames are refused with.
+        if (options_.animation_error->ok()) {
+            *options_.animation_error =
+                absl::InvalidArgumentError(absl::StrCat(name_, ": ", e.message));
+        }
+    }
+}
+
 void GltfImporter::ReadNodeTree() {
     SceneAnimation& animation = *options_.animation;
     const int n = int(model_.nodes.size());
@@ -138,10 +153,12 @@ void GltfImporter::ReadAnimations() {
             const absl::StatusOr<Interpolation> interpolation =
                 ParseInterpolation(sampler.interpolation, sampler_at);
             if (!interpolation.ok()) throw GltfError{std::string(interpolation.status().message())};
-            const std::vector<float> input = Floats(sampler.input, 1, sampler_at + ".input");
+            // Keyframes::Create checks the numbers, naming the key and its time.
+            const std::vector<float> input =
+                Floats(sampler.input, 1, sampler_at + ".input", /*any_value=*/true);
             std::vector<float> output;
             if (path_kind == AnimationChannel::Path::kWeights) {
-                output = Floats(sampler.output, 1, sampler_at + ".output");
+                output = Floats(sampler.output, 1, sampler_at + ".output", true);
                 const int targets =
                     node.mesh >= 0 && node.mesh < int(model_.meshes.size()) &&
                             !model_.meshes[size_t(node.mesh)].primitives.empty()
@@ -153,7 +170,7 @@ void GltfImporter::ReadAnimations() {
                 }
                 width = targets;
             } else {
-                output = Floats(sampler.output, width, sampler_at + ".output");
+                output = Floats(sampler.output, width, sampler_at + ".output", true);
             }
             absl::StatusOr<Keyframes> keys = Keyframes::Create(
                 *interpolation,

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -100,6 +101,10 @@ class GltfImporter {
     // Animations, skins and morph targets into options_.animation (gltf_animations.cc).
     // Whether the file has any (else the import collects nothing).
     bool Animates() const;
+    // Runs `step` of reading the animation while animating_. A fault in it (a GltfError) drops
+    // the file's animation but not the file: one warning ("animation ignored: ..."), the error
+    // in options_.animation_error, and no further steps.
+    void AnimationStep(const std::function<void()>& step);
     // Every node into the animation's tree, parents first, and every channel.
     void ReadNodeTree();
     void ReadAnimations();
@@ -124,8 +129,10 @@ class GltfImporter {
     // Accessor `index`'s elements: decoded_'s when the primitive is Draco's, else the buffer's.
     AccessorData Accessor(int index, const std::string& where);
     // An attribute's elements as floats, `components` per element: FLOAT, or the normalized
-    // integer types glTF allows for texture coordinates and colours.
-    std::vector<float> Floats(int index, int components, const std::string& where);
+    // integer types glTF allows for texture coordinates and colours. Not finite values are
+    // refused unless `any_value` (animation samplers: Keyframes::Create names their key).
+    std::vector<float> Floats(int index, int components, const std::string& where,
+                              bool any_value = false);
     std::vector<uint32_t> Indices(int index, size_t vertices, const std::string& where);
     // Node `node`'s mesh, one scene mesh per triangle primitive, each recorded for the
     // animation when the import collects one.
@@ -175,6 +182,8 @@ class GltfImporter {
     };
     std::map<std::string, Tallied> tallies_;
     std::vector<bool> visited_;
+    // Whether the import collects the file's animation (it has one and nothing failed yet).
+    bool animating_ = false;
     // Animation: each glTF node's and skin's index in options_.animation (-1: none).
     std::vector<int> node_of_;
     std::map<int, int> skin_of_;

@@ -123,7 +123,8 @@ AccessorData GltfImporter::Accessor(int index, const std::string& where) {
     return d;
 }
 
-std::vector<float> GltfImporter::Floats(int index, int components, const std::string& where) {
+std::vector<float> GltfImporter::Floats(int index, int components, const std::string& where,
+                                        bool any_value) {
     const AccessorData d = Accessor(index, where);
     if (d.components != components) {
         Fail(where, absl::StrCat("accessors[", index, "] has ", d.components,
@@ -168,7 +169,7 @@ std::vector<float> GltfImporter::Floats(int index, int components, const std::st
                                              ComponentTypeName(d.component_type),
                                              ", which glTF does not allow here"));
             }
-            if (!std::isfinite(v)) {
+            if (!any_value && !std::isfinite(v)) {
                 Fail(where, absl::StrCat("accessors[", index, "] element ", i, " component ", c,
                                          " is ", v));
             }
@@ -214,7 +215,7 @@ std::vector<uint32_t> GltfImporter::Indices(int index, size_t vertices, const st
 void GltfImporter::AddMesh(int node, const Affine& world, const std::string& node_where) {
     const int index = model_.nodes[size_t(node)].mesh;
     // A node on a cycle of children is not in the animation's tree; the traversal refuses it.
-    const bool animated = options_.animation && !node_of_.empty() && node_of_[size_t(node)] >= 0;
+    const bool in_tree = animating_ && node_of_[size_t(node)] >= 0;
     if (index >= int(model_.meshes.size())) {
         Fail(node_where, absl::StrCat("mesh ", index, " does not exist"));
     }
@@ -230,7 +231,6 @@ void GltfImporter::AddMesh(int node, const Affine& world, const std::string& nod
             Fail(where, absl::StrCat("mode ", prim.mode, " (", ModeName(prim.mode),
                                      ") is not supported; only triangles (mode 4)"));
         }
-        if (!prim.targets.empty()) Tally("morph targets ignored", "primitive", where);
         const auto attribute = [&](const char* key) {
             const auto found = prim.attributes.find(key);
             return found == prim.attributes.end() ? -1 : found->second;
@@ -343,7 +343,10 @@ void GltfImporter::AddMesh(int node, const Affine& world, const std::string& nod
             continue;
         }
         scene_.meshes.push_back(std::move(out));
-        if (animated) AnimateMesh(node, int(scene_.meshes.size()) - 1, int(p), node_where);
+        if (in_tree) {
+            AnimationStep(
+                [&] { AnimateMesh(node, int(scene_.meshes.size()) - 1, int(p), node_where); });
+        }
     }
 }
 

@@ -98,7 +98,10 @@ Scene SceneParser::Finish(Scene& scene) {
         warnings_.push_back("no emissive shape and no light: the image will be black");
     }
     scene.dropped_degenerate = dropped_degenerate_;
-    if (!animation_.Empty()) scene.animation = std::make_shared<const SceneAnimation>(animation_);
+    scene.animation_error = animation_error_;
+    if (animation_error_.ok() && !animation_.Empty()) {
+        scene.animation = std::make_shared<const SceneAnimation>(animation_);
+    }
     scene.content_hash = hash_.Hex();
     return std::move(scene);
 }

@@ -151,8 +151,10 @@ class SceneParser {
     const SceneFileReader& read_file_;
     const SceneOptions& options_;
     std::vector<GltfCamera> gltf_cameras_;
-    // Every included glTF's animations, skins and morphs; the Scene gets it unless it is empty.
+    // Every included glTF's animations, skins and morphs; the Scene gets it unless it is empty
+    // or a file's animation data is malformed (animation_error_, the first such fault).
     SceneAnimation animation_;
+    absl::Status animation_error_;
     std::vector<std::string> warnings_;
     std::map<std::string, int> material_index_;
     // power_lm emitters, resolved once every shape is loaded.

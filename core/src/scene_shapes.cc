@@ -260,9 +260,9 @@ void SceneParser::ImportGltf(const std::string& bytes, const std::string& name,
     };
     const size_t first_mesh = scene.meshes.size();
     std::vector<std::string> warnings;
-    const absl::Status status =
-        AppendGltf(bytes, name, hashing_reader, {base_dir, transform, &animation_}, scene,
-                   gltf_cameras_, warnings);
+    const absl::Status status = AppendGltf(bytes, name, hashing_reader,
+                                           {base_dir, transform, &animation_, &animation_error_},
+                                           scene, gltf_cameras_, warnings);
     for (const std::string& w : warnings) {
         warnings_.push_back(included ? absl::StrCat(name, ": ", w) : w);
     }
