@@ -124,7 +124,10 @@ void SceneParser::ResolveCamera(const Node& root, bool json_camera, Scene& scene
         scene.camera = FrameScene(scene);
         return;
     }
-    if (json_camera && options_.camera.empty()) return;
+    if (json_camera && options_.camera.empty()) {
+        animation_.camera_node = json_camera_node_;
+        return;
+    }
     if (!json_camera && gltf_cameras_.empty()) {
         root.Fail("missing required key \"camera\" (no included glTF has a camera)");
     }

@@ -97,9 +97,27 @@ class SceneParser {
 
     // Shapes and included files (scene_shapes.cc).
     void ParseShape(const Node& n, Scene& scene);
-    // A mesh file's meshes: with `material_index` (>= 0) one mesh of that material, otherwise
-    // one per material of the file (an OBJ's MTL files), those materials added to the scene.
+    // A fixed `transform`: {"scale", "rotate", "translate"} or {"matrix"}.
+    static Affine ParseTransform(const Node& n);
+    // A mesh file's meshes, in the file's coordinates: with `material_index` (>= 0) one mesh
+    // of that material, otherwise one per material of the file (an OBJ's MTL files), those
+    // materials added to the scene.
     std::vector<TriangleMesh> LoadMeshShape(const Node& n, int material_index, Scene& scene);
+
+    // Keyframed transforms (scene_keyframes.cc).
+    // What a transform may do to the object it places: spheres stay spheres, cameras keep
+    // their lens.
+    enum class Scaling { kAny, kUniform, kNone };
+    // A `transform`, fixed or keyframed ({"keyframes": [...], "interpolation": ...}): where
+    // the object is in a still (`rest`: a keyframed transform's first keyframe) and, when
+    // keyframed, the animation node it became (`node`, else -1), named `where` in messages.
+    struct PlacedTransform {
+        Affine rest;
+        int node = -1;
+    };
+    PlacedTransform ParseAnyTransform(const Node& n, Scaling scaling, const std::string& where);
+    // The node of a keyframed transform `n`, its channels, and its first keyframe's transform.
+    PlacedTransform ParseKeyframes(const Node& n, Scaling scaling, const std::string& where);
     // A mesh file's materials join the scene's, their textures its textures; the meshes'
     // material indices become the scene's.
     CachedMeshFile AddFileMaterials(MeshFile file, const std::string& where, Scene& scene);
@@ -151,6 +169,8 @@ class SceneParser {
     const SceneFileReader& read_file_;
     const SceneOptions& options_;
     std::vector<GltfCamera> gltf_cameras_;
+    // The node placing the JSON camera when it has keyframes; -1: it stays.
+    int json_camera_node_ = -1;
     // Every included glTF's animations, skins and morphs; the Scene gets it unless it is empty
     // or a file's animation data is malformed (animation_error_, the first such fault).
     SceneAnimation animation_;
