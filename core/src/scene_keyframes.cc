@@ -3,7 +3,6 @@
 // moves it like a glTF node.
 #include <array>
 #include <cmath>
-#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,19 +25,6 @@ bool ScalesUniformly(const Affine& a) {
         if (std::abs(Dot(r[i], r[(i + 1) % 3])) > kTolerance * s) return false;
     }
     return true;
-}
-
-// {"axis": [x, y, z], "angle_deg": a} as a unit quaternion (x, y, z, w): counter-clockwise
-// looking down the axis at the origin, as a fixed transform's `rotate`.
-std::array<double, 4> Quaternion(const Node& rotate) {
-    rotate.ExpectObject({"axis", "angle_deg"});
-    const Node axis_node = rotate.Get("axis");
-    const Vec3d axis = axis_node.Vector();
-    if (LengthSquared(axis) == 0) axis_node.Fail("must not be zero");
-    const Vec3d a = Normalize(axis);
-    const double half = rotate.Get("angle_deg").Number() * std::numbers::pi / 360;
-    const double s = std::sin(half);
-    return {a.x * s, a.y * s, a.z * s, std::cos(half)};
 }
 
 }  // namespace
@@ -93,7 +79,7 @@ SceneParser::PlacedTransform SceneParser::ParseKeyframes(const Node& n, Scaling 
         Vec3d translation(0, 0, 0), scale(1, 1, 1);
         std::array<double, 4> rotation{0, 0, 0, 1};
         if (const std::optional<Node> t = key.Find("translate")) translation = t->Vector();
-        if (const std::optional<Node> r = key.Find("rotate")) rotation = Quaternion(*r);
+        if (const std::optional<Node> r = key.Find("rotate")) rotation = ParseRotation(*r);
         if (const std::optional<Node> s = key.Find("scale")) {
             if (scaling == Scaling::kNone) {
                 s->Fail("a camera's keyframes may only rotate and translate");

@@ -3,6 +3,7 @@
 // scene_shapes.cc and scene_lights.cc (lights and photometric units). Private to core.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <initializer_list>
 #include <map>
@@ -99,6 +100,9 @@ class SceneParser {
     void ParseShape(const Node& n, Scene& scene);
     // A fixed `transform`: {"scale", "rotate", "translate"} or {"matrix"}.
     static Affine ParseTransform(const Node& n);
+    // `rotate`, {"axis": [x, y, z], "angle_deg": a}, as a unit quaternion (x, y, z, w):
+    // counter-clockwise looking down the axis at the origin (right-hand rule).
+    static std::array<double, 4> ParseRotation(const Node& rotate);
     // A mesh file's meshes, in the file's coordinates: with `material_index` (>= 0) one mesh
     // of that material, otherwise one per material of the file (an OBJ's MTL files), those
     // materials added to the scene.

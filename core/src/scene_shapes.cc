@@ -24,6 +24,17 @@ bool WithinCoordinateRange(const Vec3d& p) {
 
 }  // namespace
 
+std::array<double, 4> SceneParser::ParseRotation(const Node& rotate) {
+    rotate.ExpectObject({"axis", "angle_deg"});
+    const Node axis_node = rotate.Get("axis");
+    const Vec3d axis = axis_node.Vector();
+    if (LengthSquared(axis) == 0) axis_node.Fail("must not be zero");
+    const Vec3d a = Normalize(axis);
+    const double half = rotate.Get("angle_deg").Number() * std::numbers::pi / 360;
+    const double s = std::sin(half);
+    return {a.x * s, a.y * s, a.z * s, std::cos(half)};
+}
+
 Affine SceneParser::ParseTransform(const Node& n) {
     n.ExpectObject({"scale", "rotate", "translate", "matrix"});
     Affine transform;
@@ -45,18 +56,8 @@ Affine SceneParser::ParseTransform(const Node& n) {
         for (int a = 0; a < 3; ++a) transform.m[a][a] = s[a];
     }
     if (const std::optional<Node> rotate = n.Find("rotate")) {
-        rotate->ExpectObject({"axis", "angle_deg"});
-        const Node axis_node = rotate->Get("axis");
-        const Vec3d axis = axis_node.Vector();
-        if (LengthSquared(axis) == 0) axis_node.Fail("must not be zero");
-        const Vec3d a = Normalize(axis);
-        const double angle = rotate->Get("angle_deg").Number() * std::numbers::pi / 180;
-        const double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
-        Affine rotation;  // Rodrigues: counter-clockwise looking down the axis at the origin
-        rotation.m = {{{t * a.x * a.x + c, t * a.x * a.y - s * a.z, t * a.x * a.z + s * a.y, 0},
-                       {t * a.x * a.y + s * a.z, t * a.y * a.y + c, t * a.y * a.z - s * a.x, 0},
-                       {t * a.x * a.z - s * a.y, t * a.y * a.z + s * a.x, t * a.z * a.z + c, 0}}};
-        transform = transform.Then(rotation);
+        transform =
+            transform.Then(Affine::FromTrs(Vec3d(0, 0, 0), ParseRotation(*rotate), Vec3d(1, 1, 1)));
     }
     if (const std::optional<Node> translate = n.Find("translate")) {
         const Vec3d t = translate->Vector();
