@@ -144,6 +144,24 @@ TEST(SceneKeyframes, AQuadAndTheCameraMoveAndStillShapesStay) {
     ExpectNear(scene->meshes[0].positions[2], Vec3d(1, 1, 0));
 }
 
+TEST(SceneKeyframes, TheShotScenesMoveTheBallAndTheCamera) {
+    // tests/scenes/shot (README.md there): the ball at x = -2 + 4 t, the camera at x = t.
+    for (const char* name : {"moving_ball.json", "moving_ball_camera.json"}) {
+        SCOPED_TRACE(name);
+        absl::StatusOr<Scene> scene = LoadScene(std::string(LF_TEST_SCENES) + "/shot/" + name);
+        ASSERT_TRUE(scene.ok()) << scene.status();
+        ASSERT_NE(scene->animation, nullptr);
+        const bool camera_moves = std::string(name) == "moving_ball_camera.json";
+        for (const int frame : {1, 12, 24}) {
+            const double t = frame / 24.0;
+            ASSERT_TRUE(scene->animation->PoseAt(t, *scene).ok());
+            ExpectNear(scene->spheres[0].center, Vec3d(-2 + 4 * t, 0, 0));
+            ExpectNear(scene->camera.position, Vec3d(camera_moves ? t : 0, 0, 10));
+            ExpectNear(Normalize(scene->camera.look_at - scene->camera.position), Vec3d(0, 0, -1));
+        }
+    }
+}
+
 TEST(SceneKeyframes, BadKeyframesAreRefusedNamingTheirPath) {
     const auto ball = [](const Json& transform) {
         Json b = Ball("LINEAR");
