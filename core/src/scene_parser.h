@@ -1,6 +1,7 @@
 // SceneParser: a JSON scene, or a glTF file as a whole scene, into the scene model. Its members
 // are defined by concept: scene_loader.cc (the whole scene), scene_camera.cc, scene_materials.cc,
-// scene_shapes.cc and scene_lights.cc (lights and photometric units). Private to core.
+// scene_shapes.cc, scene_keyframes.cc (keyframed transforms) and scene_lights.cc (lights and
+// photometric units). Private to core.
 #pragma once
 
 #include <array>
