@@ -468,6 +468,41 @@ TEST(SceneAnimation, BadAnimationsAreIgnoredInAStillNamingWhere) {
     }
 }
 
+TEST(SceneAnimation, ABadIncludedGltfDropsTheWholeAnimationNamingTheFile) {
+    // A JSON scene with a keyframed sphere includes a glTF whose channel targets node 42: the
+    // still loads, and the scene has no animation at all (frames are refused with the error).
+    GltfBuilder b = MovingParent();
+    b.json()["animations"][0]["channels"][1]["target"]["node"] = 42;
+    const std::string gltf = b.GltfEmbedded();
+    const Json json = {
+        {"materials",
+         {{"glow", {{"type", "lambert"}, {"emission", {1, 1, 1}}, {"reflectance", {0, 0, 0}}}}}},
+        {"shapes",
+         {{{"type", "sphere"},
+           {"material", "glow"},
+           {"center", {0, 0, 0}},
+           {"radius", 1},
+           {"transform",
+            {{"keyframes",
+              {{{"time", 0}, {"translate", {0, 0, 0}}},
+               {{"time", 1}, {"translate", {1, 0, 0}}}}}}}},
+          {{"type", "gltf"}, {"file", "models/bad.gltf"}}}}};
+    testing::CapturedSceneLog().str("");
+    absl::StatusOr<Scene> scene = ParseScene(
+        json.dump(), "shot.json", [&](const std::string& name) -> absl::StatusOr<std::string> {
+            if (name == "models/bad.gltf") return gltf;
+            return absl::NotFoundError(name);
+        });
+    ASSERT_TRUE(scene.ok()) << scene.status();
+    EXPECT_EQ(scene->animation, nullptr);
+    const std::string what =
+        "animations[0] \"Action\".channels[1]: target node 42 does not exist (the file has 6 "
+        "nodes)";
+    EXPECT_EQ(scene->animation_error.message(), "models/bad.gltf: " + what);
+    EXPECT_THAT(testing::CapturedSceneLog().str(),
+                HasSubstr("shot.json: models/bad.gltf: animation ignored: " + what));
+}
+
 TEST(SceneAnimation, AHierarchyThatIsNotATreeIsStillRefused) {
     // A scene root ("Still") on a cycle of children: the animation's tree has no place for it,
     // and the traversal refuses the file.
