@@ -6,13 +6,24 @@ namespace lf {
 
 void AddFrameFlags(CLI::App* cmd, FrameFlags& flags) {
     const std::string g = "Animation";
-    cmd->add_option("--frames", flags.frames,
-                    "render frames A to B (every STEP-th): frame f shows the scene at f / fps "
-                    "seconds; -o and --png then need a run of # for the frame number "
-                    "(out_####.exr)")
+    // Functions, not plain options, so that an empty value counts as given.
+    cmd->add_option_function<std::string>(
+           "--frames",
+           [&flags](const std::string& text) {
+               flags.frames = text;
+               flags.frames_given = true;
+           },
+           "render frames A to B (every STEP-th): frame f shows the scene at f / fps seconds; -o "
+           "and --png then need a run of # for the frame number (out_####.exr)")
         ->type_name("A-B[:STEP]")
         ->group(g);
-    cmd->add_option("--frame", flags.frame, "render frame N alone (the scene at N / fps seconds)")
+    cmd->add_option_function<std::string>(
+           "--frame",
+           [&flags](const std::string& text) {
+               flags.frame = text;
+               flags.frame_given = true;
+           },
+           "render frame N alone (the scene at N / fps seconds)")
         ->type_name("N")
         ->group(g);
     cmd->add_option_function<double>(
@@ -29,14 +40,14 @@ void AddFrameFlags(CLI::App* cmd, FrameFlags& flags) {
 absl::StatusOr<ShotSettings> ShotOfFrameFlags(const FrameFlags& flags) {
     ShotSettings shot;
     shot.fps = flags.fps;
-    if (!flags.frames.empty() && !flags.frame.empty()) {
+    if (flags.frames_given && flags.frame_given) {
         return absl::InvalidArgumentError(absl::StrCat("--frame ", flags.frame, " with --frames ",
                                                        flags.frames,
                                                        ": give one frame or a range, not both"));
     }
-    const std::string& text = flags.frames.empty() ? flags.frame : flags.frames;
-    const char* flag = flags.frames.empty() ? "--frame" : "--frames";
-    if (text.empty()) {
+    const std::string& text = flags.frames_given ? flags.frames : flags.frame;
+    const char* flag = flags.frames_given ? "--frames" : "--frame";
+    if (!flags.frames_given && !flags.frame_given) {
         if (flags.fps_given) {
             return absl::InvalidArgumentError(absl::StrCat(
                 "--fps ", flags.fps, ": applies to --frames or --frame; a still has no time"));
@@ -46,7 +57,7 @@ absl::StatusOr<ShotSettings> ShotOfFrameFlags(const FrameFlags& flags) {
     absl::StatusOr<FrameRange> range = ParseFrameRange(text);
     if (!range.ok())
         return absl::InvalidArgumentError(absl::StrCat(flag, ": ", range.status().message()));
-    if (!flags.frame.empty() && range->count() != 1) {
+    if (flags.frame_given && range->count() != 1) {
         return absl::InvalidArgumentError(
             absl::StrCat("--frame ", flags.frame, ": expected one frame N; --frames takes ranges"));
     }

@@ -14,6 +14,7 @@
 
 #include "lf/core/camera.h"
 #include "lf/core/image_io.h"
+#include "lf/core/scene_animation.h"
 #include "lf/core/scene_loader.h"
 #include "lf/local/local_render.h"
 
@@ -150,12 +151,12 @@ TEST_F(ShotRender, AStaticSceneGivesTheStillsPixelsEveryFrame) {
 }
 
 // The `lightfarm` binary's status and output.
-struct Run {
+struct RunResult {
     int status;
     std::string output;
 };
 
-Run Lightfarm(const std::string& args) {
+RunResult Lightfarm(const std::string& args) {
     const std::string cmd = std::string(LF_BIN_DIR) + "/lightfarm " + args + " 2>&1";
     FILE* pipe = popen(cmd.c_str(), "r");
     std::string out;
@@ -171,7 +172,7 @@ TEST_F(ShotRender, BadFramesFailNamingWhatAndWriteNothing) {
         std::string args, expected;
     } cases[] = {
         {"--frames 5-1 -o " + Path("a_#.exr"), "--frames: frames \"5-1\""},
-        {"--frames '' -o " + Path("a_#.exr"), "--frames"},
+        {"--frames '' -o " + Path("a_#.exr"), "the range is empty"},
         {"--frames 1-3 -o " + Path("a.exr"), "-o"},
         {"--frames 1-3 -o " + Path("a_#.exr") + " --png " + Path("a.png"), "--png"},
         {"--frame 2 --frames 1-3 -o " + Path("a_#.exr"), "--frame 2 with --frames 1-3"},
@@ -180,7 +181,7 @@ TEST_F(ShotRender, BadFramesFailNamingWhatAndWriteNothing) {
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.args);
-        const Run run = Lightfarm("render " + ball + small + c.args);
+        const RunResult run = Lightfarm("render " + ball + small + c.args);
         EXPECT_NE(run.status, 0);
         EXPECT_NE(run.output.find(c.expected), std::string::npos) << run.output;
         EXPECT_EQ(Files(), 0u);
@@ -194,7 +195,7 @@ TEST_F(ShotRender, AMalformedAnimationRefusesFramesNamingTheFile) {
     gltf["accessors"][output]["type"] = "SCALAR";
     const std::string scene = Path("broken.gltf");
     std::ofstream(scene) << gltf.dump();
-    const Run run =
+    const RunResult run =
         Lightfarm("render " + scene + " --resolution 16x12 --spp 1 --no-progress --frames 1-3 -o " +
                   Path("b_#.exr"));
     EXPECT_NE(run.status, 0);

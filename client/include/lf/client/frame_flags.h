@@ -14,7 +14,7 @@ struct FrameFlags {
     std::string frames;  // --frames A-B[:STEP]
     std::string frame;   // --frame N
     double fps = defaults::kFps;
-    bool fps_given = false;
+    bool frames_given = false, frame_given = false, fps_given = false;
 };
 
 void AddFrameFlags(CLI::App* cmd, FrameFlags& flags);
