@@ -74,7 +74,7 @@ int RunShot(const LocalRenderOptions& options, const ShotSettings& shot) {
     for (const LocalFrameSummary& f : summary->frames) {
         const LocalRenderSummary& r = f.render;
         std::printf(
-            "frame %d (%.4f s): pose %.1f ms, BVH %s, render %.2f s, %.3f M samples/s -> %s\n",
+            "frame %d (%.4f s): pose %.3f ms, BVH %s, render %.2f s, %.3f M samples/s -> %s\n",
             f.frame, f.time, 1e3 * f.pose_seconds,
             f.bvh_seconds > 0 ? absl::StrFormat("%.1f ms", 1e3 * f.bvh_seconds).c_str() : "reused",
             r.render_seconds, r.stats.samples / r.render_seconds * 1e-6,
@@ -85,8 +85,8 @@ int RunShot(const LocalRenderOptions& options, const ShotSettings& shot) {
     }
     const size_t n = summary->frames.size();
     std::printf(
-        "job %s: %s in %.2f s: %.2f frames per minute; mean per frame: pose %.1f ms, BVH %.1f "
-        "ms%s, render %.2f s\n",
+        "job %s: %s in %.2f s: %.2f frames per minute; mean per frame: pose %.3f ms, BVH %.1f "
+        "ms%s, render %.3f s\n",
         summary->job_id.c_str(), Plural(int64_t(n), "frame").c_str(), summary->seconds,
         60.0 * double(n) / summary->seconds, 1e3 * pose / double(n), 1e3 * bvh / double(n),
         summary->moves ? "" : " (nothing moves: built once)", render / double(n));

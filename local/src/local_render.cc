@@ -417,7 +417,7 @@ absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
             return s;
         }
         log->info(
-            "job={} frame {} ({:.4f} s): pose {:.1f} ms, BVH {}, render {:.2f} s, total {:.2f} "
+            "job={} frame {} ({:.4f} s): pose {:.3f} ms, BVH {}, render {:.2f} s, total {:.2f} "
             "s{}",
             r->job_id, frame, f.time, 1e3 * f.pose_seconds,
             f.bvh_seconds > 0 ? absl::StrFormat("%.1f ms", 1e3 * f.bvh_seconds)
