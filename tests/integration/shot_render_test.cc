@@ -2,11 +2,8 @@
 // camera model projects it at each frame's time, a scene that does not move gives the still's
 // bits every frame, and bad input fails before anything is written.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -17,6 +14,8 @@
 #include "lf/core/scene_animation.h"
 #include "lf/core/scene_loader.h"
 #include "lf/local/local_render.h"
+#include "lightfarm_process.h"
+#include "test_dir.h"
 
 namespace lf {
 namespace {
@@ -37,10 +36,7 @@ Vec3d Lerp(const Vec3d& a, const Vec3d& b, double t) { return a + (b - a) * t; }
 
 class ShotRender : public ::testing::Test {
   protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("lf_shot_" + std::to_string(::getpid()));
-        fs::create_directories(dir_);
-    }
+    void SetUp() override { dir_ = testing::FreshTestDir("lf_shot"); }
     void TearDown() override { fs::remove_all(dir_); }
     std::string Path(const std::string& name) const { return (dir_ / name).string(); }
     LocalRenderOptions Options(const std::string& scene, int spp) const {
@@ -150,20 +146,27 @@ TEST_F(ShotRender, AStaticSceneGivesTheStillsPixelsEveryFrame) {
     }
 }
 
-// The `lightfarm` binary's status and output.
-struct RunResult {
-    int status;
-    std::string output;
-};
-
-RunResult Lightfarm(const std::string& args) {
-    const std::string cmd = std::string(LF_BIN_DIR) + "/lightfarm " + args + " 2>&1";
-    FILE* pipe = popen(cmd.c_str(), "r");
-    std::string out;
-    char buf[4096];
-    while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-    return {WEXITSTATUS(pclose(pipe)), out};
+// Ctrl-C (asked before the first frame samples): that frame is written partial, none after it.
+TEST_F(ShotRender, AnInterruptWritesTheFramePartialAndEndsTheShot) {
+    LocalRenderOptions o = Options(Shots("moving_ball.gltf"), 4);
+    o.exr_path = Path("i_#.exr");
+    RenderInterrupt interrupt;
+    interrupt.requested = true;
+    o.interrupt = &interrupt;
+    ShotSettings shot;
+    shot.frames = FrameRange{1, 3, 1};
+    absl::StatusOr<LocalShotSummary> summary = RunLocalShot(o, shot);
+    ASSERT_TRUE(summary.ok()) << summary.status();
+    ASSERT_EQ(summary->frames.size(), 1u);
+    EXPECT_NE(summary->partial.find("frame 1 interrupted"), std::string::npos) << summary->partial;
+    EXPECT_NE(summary->partial.find("1 frame of 3"), std::string::npos) << summary->partial;
+    absl::StatusOr<ExrFile> exr = ReadExr(Path("i_1.exr"));
+    ASSERT_TRUE(exr.ok()) << exr.status();
+    EXPECT_TRUE(exr->attributes.count("lightfarm.partial"));
+    EXPECT_EQ(Files(), 1u);
 }
+
+using testing::RunLightfarm;
 
 TEST_F(ShotRender, BadFramesFailNamingWhatAndWriteNothing) {
     const std::string ball = Shots("moving_ball.gltf");
@@ -181,7 +184,7 @@ TEST_F(ShotRender, BadFramesFailNamingWhatAndWriteNothing) {
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.args);
-        const RunResult run = Lightfarm("render " + ball + small + c.args);
+        const testing::LightfarmRun run = RunLightfarm("render " + ball + small + c.args);
         EXPECT_NE(run.status, 0);
         EXPECT_NE(run.output.find(c.expected), std::string::npos) << run.output;
         EXPECT_EQ(Files(), 0u);
@@ -195,9 +198,9 @@ TEST_F(ShotRender, AMalformedAnimationRefusesFramesNamingTheFile) {
     gltf["accessors"][output]["type"] = "SCALAR";
     const std::string scene = Path("broken.gltf");
     std::ofstream(scene) << gltf.dump();
-    const RunResult run =
-        Lightfarm("render " + scene + " --resolution 16x12 --spp 1 --no-progress --frames 1-3 -o " +
-                  Path("b_#.exr"));
+    const testing::LightfarmRun run = RunLightfarm(
+        "render " + scene + " --resolution 16x12 --spp 1 --no-progress --frames 1-3 -o " +
+        Path("b_#.exr"));
     EXPECT_NE(run.status, 0);
     EXPECT_NE(run.output.find("broken.gltf"), std::string::npos) << run.output;
     EXPECT_NE(run.output.find("animations[0]"), std::string::npos) << run.output;
