@@ -34,9 +34,14 @@ echo "machine: $(nproc) cores; before: $(uptime)"
     --method "$method" -o "$out/frame_####.exr" --no-progress >"$out/shot.log" 2>"$out/render.log"
 echo "after:  $(uptime)"
 tail -n 1 "$out/shot.log"
-# Per-frame lines: "frame F (T s): pose P ms, BVH B ms|reused, render R s, ..."
-awk '/^frame / {
-        n++; pose = $6; bvh = ($9 == "reused,") ? 0 : $9; render = $12 + 0
+# Per-frame lines: "frame F (T s): pose P ms, BVH B ms|reused[, radiosity S s], render R s, ..."
+awk 'function after(label,    rest) {
+        if (!match($0, label " [0-9.]+")) return 0
+        rest = substr($0, RSTART + length(label) + 1, RLENGTH - length(label) - 1)
+        return rest + 0
+    }
+    /^frame / {
+        n++; pose = after("pose"); bvh = after("BVH"); render = after("render")
         ps += pose; bs += bvh; rs += render
         if (pose > pmax) pmax = pose; if (bvh > bmax) bmax = bvh
     }

@@ -73,11 +73,16 @@ int RunShot(const LocalRenderOptions& options, const ShotSettings& shot) {
     double pose = 0, bvh = 0, render = 0;
     for (const LocalFrameSummary& f : summary->frames) {
         const LocalRenderSummary& r = f.render;
+        // Radiosity solves with each BVH it builds.
+        const std::string built = f.bvh_seconds == 0 ? "reused"
+                                  : r.radiosity
+                                      ? absl::StrFormat("%.1f ms, radiosity %.2f s",
+                                                        1e3 * f.bvh_seconds, r.radiosity_seconds)
+                                      : absl::StrFormat("%.1f ms", 1e3 * f.bvh_seconds);
         std::printf(
             "frame %d (%.4f s): pose %.3f ms, BVH %s, render %.2f s, %.3f M samples/s -> %s\n",
-            f.frame, f.time, 1e3 * f.pose_seconds,
-            f.bvh_seconds > 0 ? absl::StrFormat("%.1f ms", 1e3 * f.bvh_seconds).c_str() : "reused",
-            r.render_seconds, r.stats.samples / r.render_seconds * 1e-6,
+            f.frame, f.time, 1e3 * f.pose_seconds, built.c_str(), r.render_seconds,
+            r.stats.samples / r.render_seconds * 1e-6,
             OutputNames({f.exr_path, f.png_path}).c_str());
         pose += f.pose_seconds;
         bvh += f.bvh_seconds;
