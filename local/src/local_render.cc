@@ -397,6 +397,7 @@ absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
         f.pose_seconds = absl::ToDoubleSeconds(absl::Now() - frame_start);
         // A scene that does not move renders every frame on the first frame's kernels.
         if (!kernels || moves) {
+            kernels.reset();  // one BVH in memory at a time
             absl::StatusOr<std::unique_ptr<PosedKernels>> k =
                 BuildKernels(r->scene, options, r->method, r->job, r->job_id);
             if (!k.ok()) return k.status();
