@@ -1,0 +1,211 @@
+// `render --frames` (RunLocalShot and the CLI): a ball moving at a known speed sits where the
+// camera model projects it at each frame's time, a scene that does not move gives the still's
+// bits every frame, and bad input fails before anything is written.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "lf/core/camera.h"
+#include "lf/core/image_io.h"
+#include "lf/core/scene_animation.h"
+#include "lf/core/scene_loader.h"
+#include "lf/local/local_render.h"
+#include "lightfarm_process.h"
+#include "test_dir.h"
+
+namespace lf {
+namespace {
+
+namespace fs = std::filesystem;
+
+// tests/scenes/shots/make_shots.py's numbers: the ball's centre and the camera move linearly
+// over 0..1 s.
+constexpr Vec3d kBallFrom{-1.5, -0.5, 0}, kBallTo{1.5, 0.5, 0};
+constexpr Vec3d kCameraFrom{0, 0, 5}, kCameraTo{0.5, 0.3, 5};
+constexpr int kWidth = 64, kHeight = 48;
+
+std::string Shots(const std::string& name) {
+    return std::string(LF_TEST_SCENES) + "/shots/" + name;
+}
+
+Vec3d Lerp(const Vec3d& a, const Vec3d& b, double t) { return a + (b - a) * t; }
+
+class ShotRender : public ::testing::Test {
+  protected:
+    void SetUp() override { dir_ = testing::FreshTestDir("lf_shot"); }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+    LocalRenderOptions Options(const std::string& scene, int spp) const {
+        LocalRenderOptions o;
+        o.scene_path = scene;
+        o.scene.width = kWidth;
+        o.scene.height = kHeight;
+        o.render.spp = spp;
+        return o;
+    }
+    size_t Files() const { return size_t(std::distance(fs::directory_iterator(dir_), {})); }
+    fs::path dir_;
+};
+
+// The radiance-weighted mean raster position (x from the left, y from the top, in pixels).
+Vec2 Centroid(const Image& image) {
+    const std::vector<float>& r = *image.FindChannel("R");
+    double sum = 0, sx = 0, sy = 0;
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const double v = r[size_t(y) * size_t(image.width()) + size_t(x)];
+            sum += v;
+            sx += v * (x + 0.5);
+            sy += v * (y + 0.5);
+        }
+    }
+    return {float(sx / sum), float(sy / sum)};
+}
+
+// An emissive ball seen by a pinhole images as a uniform ellipse whose centroid is the
+// projection of the ball's centre, off by f tan(angle off axis) (r / d)^2 at most: 0.07 pixels
+// here. Pixel filters are symmetric and keep the centroid; the noise is the silhouette's
+// coverage at 64 spp, a few hundredths of a pixel.
+void ExpectBallWhereTheCameraProjectsIt(const std::string& scene_file, bool camera_moves,
+                                        const std::string& dir) {
+    SceneOptions scene_options;
+    scene_options.width = kWidth;
+    scene_options.height = kHeight;
+    absl::StatusOr<Scene> rest = LoadScene(scene_file, scene_options);
+    ASSERT_TRUE(rest.ok()) << rest.status();
+    ASSERT_TRUE(rest->animation && rest->animation->Moves());
+
+    LocalRenderOptions o;
+    o.scene_path = scene_file;
+    o.scene = scene_options;
+    o.render.spp = 64;
+    o.exr_path = dir + "/ball_####.exr";
+    ShotSettings shot;
+    shot.frames = FrameRange{1, 24, 1};
+    absl::StatusOr<LocalShotSummary> summary = RunLocalShot(o, shot);
+    ASSERT_TRUE(summary.ok()) << summary.status();
+    ASSERT_EQ(summary->frames.size(), 24u);
+    EXPECT_TRUE(summary->moves);
+    for (int frame : {1, 12, 24}) {
+        SCOPED_TRACE(frame);
+        const double t = frame / 24.0;
+        // The rest pose's camera, moved by the analytic translation of its node.
+        CameraSpec spec = rest->camera;
+        const Vec3d shift =
+            camera_moves ? Lerp(kCameraFrom, kCameraTo, t) - kCameraFrom : Vec3d{0, 0, 0};
+        spec.position = spec.position + shift;
+        spec.look_at = spec.look_at + shift;
+        const Camera camera(spec, Vec3d{0, 0, 0});
+        const Vec3d ball = Lerp(kBallFrom, kBallTo, t);
+        const std::optional<Camera::ImportanceSample> at =
+            camera.SampleWi(Vec3(float(ball.x), float(ball.y), float(ball.z)));
+        ASSERT_TRUE(at.has_value());
+
+        absl::StatusOr<ExrFile> exr = ReadExr(summary->frames[size_t(frame - 1)].exr_path);
+        ASSERT_TRUE(exr.ok()) << exr.status();
+        EXPECT_EQ(std::get<int>(exr->attributes.at("lightfarm.frame")), frame);
+        EXPECT_DOUBLE_EQ(std::get<double>(exr->attributes.at("lightfarm.time")), t);
+        const Vec2 centroid = Centroid(exr->image);
+        EXPECT_NEAR(centroid.x, at->raster.x, 0.5);
+        EXPECT_NEAR(centroid.y, at->raster.y, 0.5);
+    }
+}
+
+TEST_F(ShotRender, AMovingBallSitsWhereTheCameraProjectsIt) {
+    ExpectBallWhereTheCameraProjectsIt(Shots("moving_ball.gltf"), false, dir_.string());
+}
+
+TEST_F(ShotRender, AMovingBallSitsWhereAMovingCameraProjectsIt) {
+    ExpectBallWhereTheCameraProjectsIt(Shots("moving_ball_camera.gltf"), true, dir_.string());
+}
+
+TEST_F(ShotRender, AStaticSceneGivesTheStillsPixelsEveryFrame) {
+    LocalRenderOptions still = Options(std::string(LF_TEST_SCENES) + "/cornell_box.json", 4);
+    still.exr_path = Path("still.exr");
+    ASSERT_TRUE(RunLocalRender(still).ok());
+    LocalRenderOptions frames = still;
+    frames.exr_path = Path("frame_##.exr");
+    ShotSettings shot;
+    shot.frames = FrameRange{1, 3, 1};
+    absl::StatusOr<LocalShotSummary> summary = RunLocalShot(frames, shot);
+    ASSERT_TRUE(summary.ok()) << summary.status();
+    EXPECT_FALSE(summary->moves);
+    absl::StatusOr<ExrFile> want = ReadExr(Path("still.exr"));
+    ASSERT_TRUE(want.ok()) << want.status();
+    for (const char* name : {"frame_01.exr", "frame_02.exr", "frame_03.exr"}) {
+        SCOPED_TRACE(name);
+        absl::StatusOr<ExrFile> got = ReadExr(Path(name));
+        ASSERT_TRUE(got.ok()) << got.status();
+        EXPECT_EQ(got->image.channels(), want->image.channels());
+        EXPECT_EQ(want->attributes.count("lightfarm.frame"), 0u);
+        EXPECT_TRUE(got->attributes.count("lightfarm.frame"));
+    }
+}
+
+// Ctrl-C (asked before the first frame samples): that frame is written partial, none after it.
+TEST_F(ShotRender, AnInterruptWritesTheFramePartialAndEndsTheShot) {
+    LocalRenderOptions o = Options(Shots("moving_ball.gltf"), 4);
+    o.exr_path = Path("i_#.exr");
+    RenderInterrupt interrupt;
+    interrupt.requested = true;
+    o.interrupt = &interrupt;
+    ShotSettings shot;
+    shot.frames = FrameRange{1, 3, 1};
+    absl::StatusOr<LocalShotSummary> summary = RunLocalShot(o, shot);
+    ASSERT_TRUE(summary.ok()) << summary.status();
+    ASSERT_EQ(summary->frames.size(), 1u);
+    EXPECT_NE(summary->partial.find("frame 1 interrupted"), std::string::npos) << summary->partial;
+    EXPECT_NE(summary->partial.find("1 frame of 3"), std::string::npos) << summary->partial;
+    absl::StatusOr<ExrFile> exr = ReadExr(Path("i_1.exr"));
+    ASSERT_TRUE(exr.ok()) << exr.status();
+    EXPECT_TRUE(exr->attributes.count("lightfarm.partial"));
+    EXPECT_EQ(Files(), 1u);
+}
+
+using testing::RunLightfarm;
+
+TEST_F(ShotRender, BadFramesFailNamingWhatAndWriteNothing) {
+    const std::string ball = Shots("moving_ball.gltf");
+    const std::string small = " --resolution 16x12 --spp 1 --no-progress ";
+    struct Case {
+        std::string args, expected;
+    } cases[] = {
+        {"--frames 5-1 -o " + Path("a_#.exr"), "--frames: frames \"5-1\""},
+        {"--frames '' -o " + Path("a_#.exr"), "the range is empty"},
+        {"--frames 1-3 -o " + Path("a.exr"), "-o"},
+        {"--frames 1-3 -o " + Path("a_#.exr") + " --png " + Path("a.png"), "--png"},
+        {"--frame 2 --frames 1-3 -o " + Path("a_#.exr"), "--frame 2 with --frames 1-3"},
+        {"--fps 0 --frames 1-3 -o " + Path("a_#.exr"), "--fps 0"},
+        {"--fps 30 -o " + Path("a.exr"), "--fps 30"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const testing::LightfarmRun run = RunLightfarm("render " + ball + small + c.args);
+        EXPECT_NE(run.status, 0);
+        EXPECT_NE(run.output.find(c.expected), std::string::npos) << run.output;
+        EXPECT_EQ(Files(), 0u);
+    }
+}
+
+TEST_F(ShotRender, AMalformedAnimationRefusesFramesNamingTheFile) {
+    // The ball's translation channel samples an accessor of the wrong type (SCALAR).
+    nlohmann::json gltf = nlohmann::json::parse(std::ifstream(Shots("moving_ball.gltf")));
+    const int output = gltf["animations"][0]["samplers"][0]["output"];
+    gltf["accessors"][output]["type"] = "SCALAR";
+    const std::string scene = Path("broken.gltf");
+    std::ofstream(scene) << gltf.dump();
+    const testing::LightfarmRun run = RunLightfarm(
+        "render " + scene + " --resolution 16x12 --spp 1 --no-progress --frames 1-3 -o " +
+        Path("b_#.exr"));
+    EXPECT_NE(run.status, 0);
+    EXPECT_NE(run.output.find("broken.gltf"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("animations[0]"), std::string::npos) << run.output;
+    EXPECT_EQ(Files(), 1u);  // the scene alone
+}
+
+}  // namespace
+}  // namespace lf
