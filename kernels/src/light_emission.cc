@@ -93,16 +93,16 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
     picks_ = LightPickTable::FromWeights(weights);
 }
 
-SurfacePoint EmissionSampler::AreaPoint(const Light& light, const Vec2& u) const {
+SurfacePoint EmissionSampler::AreaPoint(const Light& light, const Vec2& u, float time) const {
     if (light.kind == Kind::kTriangle) {
         // Uniform on the triangle (Osada et al.'s square-root parameterisation).
         const float su = std::sqrt(u.x);
-        return scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y);
+        return scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y, time);
     }
     const float z = 1 - 2 * u.x;
     const float r = std::sqrt(std::max(0.0f, 1 - z * z));
     const float phi = 2 * kPi * u.y;
-    return scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z));
+    return scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z), time);
 }
 
 Rgb EmissionSampler::AreaEmission(const Light& light, const SurfacePoint& point) const {
@@ -114,7 +114,7 @@ Rgb EmissionSampler::AreaEmission(const Light& light, const SurfacePoint& point)
 }
 
 std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& u_pos,
-                                                      const Vec2& u_dir) const {
+                                                      const Vec2& u_dir, float time) const {
     if (lights_.empty()) return std::nullopt;
     const int li = picks_.Pick(u_pick);
     EmissionSample es;
@@ -127,7 +127,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
     switch (light.kind) {
         case Kind::kTriangle:
         case Kind::kSphere: {
-            es.point = AreaPoint(light, u_pos);
+            es.point = AreaPoint(light, u_pos, time);
             es.on_surface = true;
             if (light.kind == Kind::kSphere) es.sphere = light.index;
             es.pdf_pos = 1 / light.area;
@@ -213,6 +213,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
         }
     }
     if (!(es.pdf_pos > 0 && es.pdf_dir > 0) || es.le.IsBlack()) return std::nullopt;
+    es.point.time = time;
     return es;
 }
 

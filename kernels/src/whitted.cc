@@ -168,7 +168,7 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
                 const float u_pick = sampler.Get1D();
                 const Vec2 u_light = sampler.Get2D();
                 const std::optional<LightSample> ls =
-                    lights_.Sample(hit->p, sh.ns, u_pick, u_light);
+                    lights_.Sample(hit->p, sh.ns, u_pick, u_light, hit->time);
                 if (ls && !ls->delta) L += direct(*ls);
             }
         }

@@ -202,7 +202,7 @@ TEST_P(EmissionFluxTest, FluxMatchesPowerAndPdfLeMatchesSample) {
         Sampler sampler(std::hash<std::string>{}(GetParam().name), 0, 0, uint64_t(i));
         const float u_pick = sampler.Get1D();
         const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, 0);
         if (!s) continue;
         ASSERT_NEAR(Length(s->w), 1, 1e-5);
         ASSERT_EQ(s->pick, emission.Pmf(s->light));
@@ -238,7 +238,7 @@ TEST(EmissionSamplerTest, HitsMapToTheirLight) {
         Sampler sampler(3, 0, 0, uint64_t(i));
         const float u_pick = sampler.Get1D();
         const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, 0);
         ASSERT_TRUE(s);
         // Aim back at the sampled point from outside along its normal's side it emitted on.
         const Vec3 side = Dot(s->w, s->point.n) > 0 ? s->point.n : -s->point.n;
@@ -327,7 +327,7 @@ TEST_P(EmissionDirectionTest, DirectionsFollowPdfDir) {
         Sampler sampler(std::hash<std::string>{}(GetParam().name), 0, 0, uint64_t(i));
         const float u_pick = sampler.Get1D();
         const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, 0);
         ASSERT_TRUE(s);
         if (!first) first = s;
         const double theta = std::acos(std::clamp(double(s->w.z), -1.0, 1.0));
@@ -378,7 +378,7 @@ TEST(LightTracingConnectionTest, PointLightOverPlaneMatchesClosedFormAndPathTrac
         Sampler sampler(5, 0, 0, uint64_t(i));
         const float u_pick = sampler.Get1D();
         const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, 0);
         if (!s) continue;
         const std::optional<SurfaceHit> hit = (*es)->Intersect(s->ray());
         if (!hit) continue;

@@ -79,7 +79,9 @@ class EmissionSampler {
     // An emitted ray: u_pick picks the light, u_pos the point on it (lights at infinity: on the
     // disk), u_dir the direction (two-sided emitters: u_dir.x also picks the side). nullopt when
     // the sample carries no light (a cut-out of a textured emitter, outside a spot's cone, ...).
-    std::optional<EmissionSample> Sample(float u_pick, const Vec2& u_pos, const Vec2& u_dir) const;
+    // The ray leaves at `time` in the shutter (Ray::time), from where a moving emitter is then.
+    std::optional<EmissionSample> Sample(float u_pick, const Vec2& u_pos, const Vec2& u_dir,
+                                         float time) const;
 
     // The light a surface hit is on (an emissive triangle or sphere), or -1.
     int LightOf(const SurfaceHit& hit) const;
@@ -120,7 +122,7 @@ class EmissionSampler {
     };
 
     // An area light's point for u, with its normal and Le there (Le before the side test).
-    SurfacePoint AreaPoint(const Light& light, const Vec2& u) const;
+    SurfacePoint AreaPoint(const Light& light, const Vec2& u, float time) const;
     Rgb AreaEmission(const Light& light, const SurfacePoint& point) const;
     // Direction density of a light at infinity for a ray travelling along w.
     float InfiniteDirPdf(const Light& light, const Vec3& w) const;

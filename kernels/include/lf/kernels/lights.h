@@ -62,9 +62,9 @@ class LightSampler {
     LightStrategy strategy() const { return strategy_; }
 
     // A light sample for the reference point `ref` with (shading) normal `n`, unit, or zero in a
-    // volume; kPower ignores n.
-    std::optional<LightSample> Sample(const Vec3& ref, const Vec3& n, float u_pick,
-                                      const Vec2& u) const;
+    // volume; kPower ignores n. Moving emitters are where they are at `time` (Ray::time).
+    std::optional<LightSample> Sample(const Vec3& ref, const Vec3& n, float u_pick, const Vec2& u,
+                                      float time) const;
 
     // Light i (of size()) when it is a delta light (point, spot, directional without a
     // diameter), as Sample gives it at `ref` but with pdf 1; nullopt for the others: for
@@ -73,7 +73,8 @@ class LightSampler {
     std::optional<LightSample> SampleDeltaLight(size_t i, const Vec3& ref) const;
 
     // Density, per solid angle at `ref`, with which Sample(ref, n, ...) would have produced
-    // `hit` (an emitter hit by a BSDF-sampled ray); used for multiple importance sampling.
+    // `hit` (an emitter hit by a BSDF-sampled ray, at its time); used for multiple importance
+    // sampling.
     float Pdf(const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;
 
     // Radiance of the lights at infinity (sun disks, environment) arriving along a ray that
@@ -127,7 +128,7 @@ class LightSampler {
     // angle at ref (normal n, for the cosine warp of large triangles), not yet times the pick
     // probability.
     std::optional<LightSample> SampleArea(const Light& light, const Vec3& ref, const Vec3& n,
-                                          const Vec2& u) const;
+                                          const Vec2& u, float time) const;
     // The density with which SampleArea yields `hit` on area light `light` from ref.
     float AreaPdf(const Light& light, const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;
     // The point at (s, t) of rectangle light `light`, on whichever of its triangles holds it.

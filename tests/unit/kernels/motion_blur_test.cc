@@ -1,0 +1,279 @@
+// Motion blur (issue 29): a sample's time in the shutter (Sampler::GetTime) places moving
+// meshes (Embree's time steps), the camera and emitters sampled for next-event estimation.
+// Streaks are measured against the projection of the distance travelled, energy against the
+// still, methods against each other, and scenes where nothing moves keep their bits.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "lf/core/camera.h"
+#include "lf/core/scene_animation.h"
+#include "lf/job/splat_settings.h"
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/path_tracer.h"
+#include "lf/kernels/scene_motion.h"
+#include "lf/local/local_executor.h"
+#include "lf/local/method_factory.h"
+
+namespace lf {
+namespace {
+
+constexpr int kSize = 64;                       // pixels a side
+constexpr double kPixelsPerUnit = kSize / 2.0;  // orthographic, half height 1
+constexpr double kSide = 0.25;                  // the square's side: 8 pixels
+constexpr double kTravel = 0.5;                 // during the shutter [0, 1] s: 16 pixels
+
+// One node moving from x = -travel/2 to +travel/2 over [0, 1] s (linear keys), else still.
+SceneAnimation OneMovingNode(double travel, double z) {
+    SceneAnimation a;
+    AnimationNode node;
+    node.where = "nodes[0] \"mover\"";
+    node.translation = {0, 0, z};
+    a.nodes.push_back(node);
+    if (travel != 0) {
+        a.channels.push_back(
+            {0, AnimationChannel::Path::kTranslation,
+             Keyframes::Create(Interpolation::kLinear, KeyframeKind::kVector, 3, {0, 1},
+                               {-travel / 2, 0, z, travel / 2, 0, z}, "test channel")
+                 .value()});
+    }
+    return a;
+}
+
+// An emissive square (radiance 1, both faces) of side kSide in the plane z = 0 about its
+// centre, seen by an orthographic camera looking down -z; `square_moves` or the camera moves.
+struct MovingScene {
+    Scene scene;
+    SceneAnimation animation;
+};
+
+MovingScene SquareScene(bool square_moves, bool camera_moves) {
+    MovingScene m;
+    Material lamp;
+    lamp.name = "lamp";
+    lamp.emission = Rgb(1.0f);
+    lamp.double_sided = true;
+    lamp.two_sided_emission = true;
+    lamp.reflectance = Rgb(0.0f);
+    m.scene.materials.push_back(lamp);
+    const double h = kSide / 2;
+    TriangleMesh square;
+    square.name = "square";
+    square.positions = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}};
+    square.triangles = {{0, 1, 2}, {0, 2, 3}};
+    m.scene.meshes.push_back(square);
+    m.scene.camera.projection = CameraSpec::Projection::kOrthographic;
+    m.scene.camera.position = {0, 0, 5};
+    m.scene.camera.look_at = {0, 0, 0};
+    m.scene.camera.half_height = 1;
+    m.scene.camera.width = m.scene.camera.height = kSize;
+    if (square_moves) {
+        m.animation = OneMovingNode(kTravel, 0);
+        AnimatedMesh am;
+        am.mesh = 0;
+        am.node = 0;
+        am.positions = square.positions;
+        am.moves = true;
+        m.animation.meshes.push_back(am);
+    } else if (camera_moves) {
+        m.animation = OneMovingNode(kTravel, 5);
+        m.animation.camera_node = 0;
+    }
+    // The frame's instant is the middle of the shutter.
+    EXPECT_TRUE(m.animation.PoseAt(0.5, m.scene).ok());
+    return m;
+}
+
+struct Rendered {
+    RenderOutput out;
+    std::unique_ptr<EmbreeScene> embree;
+};
+
+Rendered RenderPathWithMotion(const Scene& scene, const SceneMotion& motion, uint64_t spp,
+                              SamplerType sampler = SamplerType::kSobol) {
+    auto es = EmbreeScene::Build(scene, nullptr, motion);
+    EXPECT_TRUE(es.ok()) << es.status();
+    const Camera camera(scene.camera, (*es)->origin(), (*es)->camera_motion());
+    const PathTracer tracer(**es, 4);
+    RenderSettings settings;
+    settings.spp = spp;
+    settings.seed = 3;
+    settings.tile = 16;
+    settings.sampler = sampler;
+    return {RenderImage(camera, tracer, settings).value(), std::move(*es)};
+}
+
+Image RenderSplatWithMotion(const Scene& scene, const SceneMotion& motion, const char* method,
+                            uint64_t spp, int max_depth = 4) {
+    auto es = EmbreeScene::Build(scene, nullptr, motion);
+    EXPECT_TRUE(es.ok()) << es.status();
+    const Camera camera(scene.camera, (*es)->origin(), (*es)->camera_motion());
+    SplatRenderSettings settings;
+    settings.max_depth = max_depth;
+    settings.seed = 5;
+    auto renderer = MakeSplatRenderer(*FindMethod(method), **es, camera, settings);
+    EXPECT_TRUE(renderer.ok()) << renderer.status();
+    const SplatPlanSettings plan =
+        SplatPlanSettingsOf(method, {scene.camera.width, scene.camera.height, spp, 16, 2}).value();
+    RenderSettings local;
+    local.threads = 2;
+    return RenderSplatImage(camera, **renderer, plan, local).value().image;
+}
+
+// Mean and variance of the image's columns weighted by their brightness (channel average).
+struct Spread {
+    double sum = 0, mean = 0, variance = 0;
+};
+Spread HorizontalSpread(const Image& image) {
+    Spread s;
+    double sx = 0, sxx = 0;
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const double v = image.Pixel(x, y).Average();
+            const double cx = x + 0.5;
+            s.sum += v;
+            sx += v * cx;
+            sxx += v * cx * cx;
+        }
+    }
+    s.mean = sx / s.sum;
+    s.variance = sxx / s.sum - s.mean * s.mean;
+    return s;
+}
+
+// The image's sum and its standard error from the per-pixel A/B halves (Var of a pixel's
+// mean = E[(A - B)^2] / 4).
+struct Sum {
+    double value = 0, error = 0;
+};
+Sum ImageSum(const Image& image) {
+    Sum s;
+    double var = 0;
+    for (int y = 0; y < image.height(); ++y) {
+        for (int x = 0; x < image.width(); ++x) {
+            const double a = image.Pixel(x, y, "A.").Average();
+            const double b = image.Pixel(x, y, "B.").Average();
+            s.value += (a + b) / 2;
+            var += (a - b) * (a - b) / 4;
+        }
+    }
+    s.error = std::sqrt(var);
+    return s;
+}
+
+bool SameBits(const Image& a, const Image& b) {
+    if (a.channels().size() != b.channels().size()) return false;
+    for (const auto& [name, ca] : a.channels()) {
+        const std::vector<float>* cb = b.FindChannel(name);
+        if (cb == nullptr || ca.size() != cb->size() ||
+            std::memcmp(ca.data(), cb->data(), ca.size() * sizeof(float)) != 0) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// A streak of L pixels is the still image convolved with a box L wide: its variance grows by
+// L^2 / 12 (variances of independent offsets add).
+void ExpectStreak(const Image& still, const Image& blurred, const char* what) {
+    const Spread s = HorizontalSpread(still), b = HorizontalSpread(blurred);
+    const double length = kTravel * kPixelsPerUnit;
+    const double expected = length * length / 12;
+    std::printf("[motion] %s: still variance %.3f, blurred %.3f, added %.3f (L^2/12 = %.3f)\n",
+                what, s.variance, b.variance, b.variance - s.variance, expected);
+    EXPECT_NEAR(b.variance - s.variance, expected, 0.1 * expected) << what;
+    // Centred where the still is: the shutter is centred on the frame's instant.
+    EXPECT_NEAR(b.mean, s.mean, 0.25) << what;
+}
+
+TEST(MotionBlur, AMovingEmitterStreaksByTheProjectedDistance) {
+    const MovingScene m = SquareScene(true, false);
+    const Rendered still = RenderPathWithMotion(m.scene, {}, 64);
+    const Rendered blurred = RenderPathWithMotion(m.scene, {&m.animation, 0, 1}, 64);
+    EXPECT_EQ(blurred.embree->steps(), 2);  // straight-line motion
+    EXPECT_TRUE(blurred.embree->Moves(0));
+    ExpectStreak(still.out.image, blurred.out.image, "moving square");
+}
+
+TEST(MotionBlur, AMovingCameraStreaksAStillScene) {
+    const MovingScene m = SquareScene(false, true);
+    const Rendered still = RenderPathWithMotion(m.scene, {}, 64);
+    const Rendered blurred = RenderPathWithMotion(m.scene, {&m.animation, 0, 1}, 64);
+    EXPECT_EQ(blurred.embree->camera_motion().size(), 2u);
+    EXPECT_FALSE(blurred.embree->Moves(0));
+    ExpectStreak(still.out.image, blurred.out.image, "moving camera");
+}
+
+TEST(MotionBlur, AUniformlyMovingEmitterKeepsItsBrightness) {
+    const MovingScene m = SquareScene(true, false);
+    const Rendered still = RenderPathWithMotion(m.scene, {}, 32, SamplerType::kIndependent);
+    const Rendered blurred =
+        RenderPathWithMotion(m.scene, {&m.animation, 0, 1}, 32, SamplerType::kIndependent);
+    const Sum s = ImageSum(still.out.image), b = ImageSum(blurred.out.image);
+    const double se = std::hypot(s.error, b.error);
+    std::printf("[motion] image sum: still %.3f +- %.3f, blurred %.3f +- %.3f\n", s.value, s.error,
+                b.value, b.error);
+    // The square covers 8 x 8 pixels of radiance 1.
+    EXPECT_NEAR(s.value, 64, 1e-3);
+    EXPECT_GT(se, 0);
+    EXPECT_NEAR(b.value, s.value, 4 * se);
+}
+
+// The instant the scene was posed at: a closed shutter, or an open one over which nothing
+// moves, renders the still's bits, by the path tracer and a splatting method.
+TEST(MotionBlur, WhenNothingMovesTheShutterKeepsTheStillsBits) {
+    MovingScene m = SquareScene(true, false);
+    // A diffuse floor behind the square, so that paths bounce.
+    Material floor;
+    floor.name = "floor";
+    floor.reflectance = Rgb(0.6f);
+    m.scene.materials.push_back(floor);
+    TriangleMesh back;
+    back.name = "back";
+    back.material = 1;
+    back.positions = {{-2, -2, -1}, {2, -2, -1}, {2, 2, -1}, {-2, 2, -1}};
+    back.triangles = {{0, 1, 2}, {0, 2, 3}};
+    m.scene.meshes.push_back(back);
+    m.scene.camera.projection = CameraSpec::Projection::kPerspective;
+    m.scene.camera.fov_y_deg = 40;
+    m.scene.camera.width = m.scene.camera.height = 24;
+    SceneAnimation still_animation = OneMovingNode(0, 0);  // no channel
+    still_animation.meshes = m.animation.meshes;
+    still_animation.meshes[0].moves = false;
+    ASSERT_FALSE(still_animation.Moves());
+    const SceneMotion instant{&m.animation, 0.5, 0.5}, nothing_moves{&still_animation, 0, 1};
+    const Image path = RenderPathWithMotion(m.scene, {}, 8).out.image;
+    const Image bdpt = RenderSplatWithMotion(m.scene, {}, "bdpt", 8);
+    for (const SceneMotion& motion : {instant, nothing_moves}) {
+        EXPECT_FALSE(motion.Blurs());
+        EXPECT_TRUE(SameBits(path, RenderPathWithMotion(m.scene, motion, 8).out.image));
+        EXPECT_TRUE(SameBits(bdpt, RenderSplatWithMotion(m.scene, motion, "bdpt", 8)));
+    }
+}
+
+TEST(MotionBlur, TheTimeIsADimensionOfItsOwn) {
+    for (const SamplerType type : {SamplerType::kIndependent, SamplerType::kSobol}) {
+        Sampler a(7, 3, 4, 5, type), b(7, 3, 4, 5, type);
+        const float time = b.GetTime();
+        EXPECT_GE(time, 0.0f);
+        EXPECT_LT(time, 1.0f);
+        for (int i = 0; i < 8; ++i) {
+            const Vec2 ua = a.Get2D(), ub = b.Get2D();
+            EXPECT_EQ(ua.x, ub.x);
+            EXPECT_EQ(ua.y, ub.y);
+        }
+    }
+    // Sobol stratifies the times of a pixel's samples: each of 16 strata of [0, 1) gets one of
+    // the first 16 even (half A) samples.
+    int hits[16] = {};
+    for (uint64_t s = 0; s < 32; s += 2) {
+        ++hits[int(Sampler(9, 1, 2, s, SamplerType::kSobol).GetTime() * 16)];
+    }
+    for (int h : hits) EXPECT_EQ(h, 1);
+}
+
+}  // namespace
+}  // namespace lf
