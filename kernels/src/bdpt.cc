@@ -130,7 +130,7 @@ float BdptRenderer::PdfLight(const BdptVertex& v, const BdptVertex& next) const 
     const float dist2 = LengthSquared(d);
     if (!(dist2 > 0)) return 0;
     const Vec3 w = d / std::sqrt(dist2);
-    float pdf = emission_.PdfLe(v.light, v.p, v.ng, w).dir / dist2;
+    float pdf = emission_.PdfLe(v.light, v.p, v.ng, w, v.point.time).dir / dist2;
     if (next.on_surface) pdf *= std::abs(Dot(next.ng, w));
     return pdf;
 }
@@ -143,7 +143,7 @@ float BdptRenderer::PdfLightOrigin(const BdptVertex& v, const BdptVertex& next) 
     }
     if (v.light < 0) return 0;
     const Vec3 w = DirectionTo(v, next);
-    return emission_.Pmf(v.light) * emission_.PdfLe(v.light, v.p, v.ng, w).pos;
+    return emission_.Pmf(v.light) * emission_.PdfLe(v.light, v.p, v.ng, w, v.point.time).pos;
 }
 
 float BdptRenderer::NeeRatio(const BdptVertex& v, const BdptVertex& ref) const {

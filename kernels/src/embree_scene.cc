@@ -140,10 +140,26 @@ T Lerp(const T& a, const T& b, float f) {
     return a * (1 - f) + b * f;
 }
 
-// The poses of the meshes (and camera) that move at MotionSteps(motion) times over the shutter.
+// The places of the point and spot lights in `scene`, render space.
+Vec3 PointPlace(const Scene& scene, size_t i, const Vec3d& origin) {
+    return Vec3(scene.point_lights[i].position - origin);
+}
+EmbreeScene::SpotPlace SpotPlaceOf(const Scene& scene, size_t i, const Vec3d& origin) {
+    const SpotLight& spot = scene.spot_lights[i];
+    return {Vec3(spot.position - origin), Vec3(Normalize(spot.direction))};
+}
+
+// What moves over the shutter, posed at MotionSteps(motion) times: meshes, camera, lights.
+struct PosedSteps {
+    std::vector<std::vector<EmbreeScene::MeshStep>>& meshes;
+    std::vector<CameraSpec>& camera;
+    std::vector<std::vector<Vec3>>& points;
+    std::vector<std::vector<EmbreeScene::SpotPlace>>& spots;
+};
 absl::Status PoseSteps(const Scene& scene, const SceneMotion& motion, int steps,
-                       const Vec3d& origin, std::vector<std::vector<EmbreeScene::MeshStep>>& meshes,
-                       std::vector<CameraSpec>& camera) {
+                       const Vec3d& origin, const PosedSteps& out) {
+    std::vector<std::vector<EmbreeScene::MeshStep>>& meshes = out.meshes;
+    std::vector<CameraSpec>& camera = out.camera;
     const SceneAnimation& animation = *motion.animation;
     const std::vector<bool> moving_nodes = animation.MovingNodes();
     const bool camera_moves =
@@ -166,6 +182,15 @@ absl::Status PoseSteps(const Scene& scene, const SceneMotion& motion, int steps,
             meshes[size_t(am.mesh)].push_back(std::move(step));
         }
         if (camera_moves) camera.push_back(posed.camera);
+        for (const AnimatedLight& light : animation.lights) {
+            if (!light.moves) continue;
+            const size_t i = size_t(light.index);
+            if (light.kind == AnimatedLight::Kind::kPoint) {
+                out.points[i].push_back(PointPlace(posed, i, origin));
+            } else if (light.kind == AnimatedLight::Kind::kSpot) {
+                out.spots[i].push_back(SpotPlaceOf(posed, i, origin));
+            }
+        }
     }
     return absl::OkStatus();
 }
@@ -234,9 +259,12 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
     es->positions_.resize(scene.meshes.size());
     es->steps_ = MotionSteps(motion);
     es->steps_of_.resize(scene.meshes.size());
+    es->point_steps_.resize(scene.point_lights.size());
+    es->spot_steps_.resize(scene.spot_lights.size());
     if (es->steps_ > 1) {
         if (absl::Status s =
-                PoseSteps(scene, motion, es->steps_, origin, es->steps_of_, es->camera_motion_);
+                PoseSteps(scene, motion, es->steps_, origin,
+                          {es->steps_of_, es->camera_motion_, es->point_steps_, es->spot_steps_});
             !s.ok()) {
             return s;
         }
@@ -334,6 +362,21 @@ std::array<float, 4> EmbreeScene::Tangent(int mesh, uint32_t v, float time) cons
     const StepPosition at = StepAt(time, steps.size());
     const std::array<float, 4>&a = steps[at.i].tangents[v], &b = steps[at.i + 1].tangents[v];
     return {Lerp(a[0], b[0], at.f), Lerp(a[1], b[1], at.f), Lerp(a[2], b[2], at.f), a[3]};
+}
+
+Vec3 EmbreeScene::PointLightPosition(int i, float time) const {
+    const std::vector<Vec3>& steps = point_steps_[size_t(i)];
+    if (steps.empty()) return PointPlace(scene_, size_t(i), origin_);
+    const StepPosition at = StepAt(time, steps.size());
+    return Lerp(steps[at.i], steps[at.i + 1], at.f);
+}
+
+EmbreeScene::SpotPlace EmbreeScene::SpotLightAt(int i, float time) const {
+    const std::vector<SpotPlace>& steps = spot_steps_[size_t(i)];
+    if (steps.empty()) return SpotPlaceOf(scene_, size_t(i), origin_);
+    const StepPosition at = StepAt(time, steps.size());
+    const SpotPlace &a = steps[at.i], &b = steps[at.i + 1];
+    return {Lerp(a.position, b.position, at.f), Normalize(Lerp(a.direction, b.direction, at.f))};
 }
 
 SurfacePoint EmbreeScene::TrianglePoint(int mesh, int primitive, float b1, float b2,

@@ -71,7 +71,7 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
     if (es->on_surface) {
         if (const auto cs = camera_.SampleWi(es->point.p, u_lens0, time);
             cs && cs->pdf > 0 && cs->we > 0 &&
-            emission_.PdfLe(es->light, es->point.p, es->point.n, cs->wi).dir > 0) {
+            emission_.PdfLe(es->light, es->point.p, es->point.n, cs->wi, time).dir > 0) {
             const Rgb value = es->le * (std::abs(Dot(cs->wi, es->point.n)) * cs->we /
                                         (es->pick * es->pdf_pos * cs->pdf));
             ++stats.rays;

@@ -17,6 +17,9 @@
 namespace lf {
 
 namespace {
+
+// The time (Ray::time) of step `step` of the scene's moving geometry and lights.
+float StepTime(const EmbreeScene& es, int step) { return float(step) / float(es.steps() - 1); }
 constexpr float kPi = std::numbers::pi_v<float>;
 
 // Triangles and rectangles subtending less than this many steradians are sampled by area.
@@ -154,7 +157,7 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
         // A moving triangle's bounds hold it at every step (and so between them).
         for (int step = 1; es.Moves(m) && step < es.steps(); ++step) {
             Vec3 p0, p1, p2;
-            es.Triangle(m, t, float(step) / float(es.steps() - 1), &p0, &p1, &p2);
+            es.Triangle(m, t, StepTime(es, step), &p0, &p1, &p2);
             b = Union(b, TriangleLightBounds(p0, p1, p2, radiance, two_sided));
         }
         if (rectangle) {
@@ -190,14 +193,19 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
         const PointLight& point = scene.point_lights[i];
         lights_.push_back({Kind::kPoint, int(i), 0, 0, false});
         weights.push_back(4 * std::numbers::pi * LightPowerWeight(point.intensity));
-        bounds.push_back(PointLightBounds(Vec3(point.position - es.origin()),
+        LightBounds b =
+            PointLightBounds(es.PointLightPosition(int(i), 0), LightPowerWeight(point.intensity));
+        // A moving light's bounds hold it at every step (and so between them).
+        for (int step = 1; step < es.steps(); ++step) {
+            b = Union(b, PointLightBounds(es.PointLightPosition(int(i), StepTime(es, step)),
                                           LightPowerWeight(point.intensity)));
+        }
+        bounds.push_back(b);
     }
     for (size_t i = 0; i < scene.spot_lights.size(); ++i) {
         const SpotLight& spot = scene.spot_lights[i];
         const SpotBand band = SpotBandOf(spot);
-        spot_cones_.push_back({Vec3(Normalize(spot.direction)), float(band.outer),
-                               float(1 / band.width),
+        spot_cones_.push_back({float(band.outer), float(1 / band.width),
                                spot.falloff == SpotLight::Falloff::kSmoothstep});
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
         weights.push_back(SpotFalloffSolidAngle(spot) * LightPowerWeight(spot.intensity));
@@ -205,9 +213,15 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
         // to 1 in float keeps a positive pick probability wherever it shines.
         const float cos_outer = std::nextafter(float(1 - band.outer), -1.0f);
         const float cos_inner = std::max(float(1 - (band.outer - band.width)), cos_outer);
-        bounds.push_back(SpotLightBounds(Vec3(spot.position - es.origin()),
-                                         spot_cones_.back().direction,
+        const EmbreeScene::SpotPlace place = es.SpotLightAt(int(i), 0);
+        LightBounds b = SpotLightBounds(place.position, place.direction,
+                                        LightPowerWeight(spot.intensity), cos_inner, cos_outer);
+        for (int step = 1; step < es.steps(); ++step) {
+            const EmbreeScene::SpotPlace at = es.SpotLightAt(int(i), StepTime(es, step));
+            b = Union(b, SpotLightBounds(at.position, at.direction,
                                          LightPowerWeight(spot.intensity), cos_inner, cos_outer));
+        }
+        bounds.push_back(b);
     }
     finite_count_ = lights_.size();
     const auto [lo, hi] = scene.Bounds();
@@ -275,7 +289,7 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, const Vec3& n, 
 
     if (light.kind == Kind::kPoint || light.kind == Kind::kSpot ||
         light.kind == Kind::kDirectional) {
-        std::optional<LightSample> ls = SampleDelta(light, ref);
+        std::optional<LightSample> ls = SampleDelta(light, ref, time);
         if (ls) ls->pdf = pick;
         return ls;
     }
@@ -305,9 +319,10 @@ bool LightSampler::IsDeltaLight(size_t i) const {
     return kind == Kind::kPoint || kind == Kind::kSpot || kind == Kind::kDirectional;
 }
 
-std::optional<LightSample> LightSampler::SampleDeltaLight(size_t i, const Vec3& ref) const {
+std::optional<LightSample> LightSampler::SampleDeltaLight(size_t i, const Vec3& ref,
+                                                          float time) const {
     if (!IsDeltaLight(i)) return std::nullopt;
-    std::optional<LightSample> ls = SampleDelta(lights_[i], ref);
+    std::optional<LightSample> ls = SampleDelta(lights_[i], ref, time);
     if (ls) ls->pdf = 1;
     return ls;
 }
@@ -450,7 +465,8 @@ Vec3 LightSampler::InfinitePoint(const Vec3& ref, const Vec3& wi) const {
     return ref + wi * (2 * scene_radius_ + Length(ref) + 1);
 }
 
-std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const Vec3& ref) const {
+std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const Vec3& ref,
+                                                     float time) const {
     const Scene& scene = scene_.scene();
     LightSample ls;
     ls.delta = true;
@@ -464,10 +480,12 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
         return ls;
     }
     const bool spot = light.kind == Kind::kSpot;
-    const Vec3d position = spot ? scene.spot_lights[size_t(light.index)].position
-                                : scene.point_lights[size_t(light.index)].position;
+    const EmbreeScene::SpotPlace place =
+        spot ? scene_.SpotLightAt(light.index, time)
+             : EmbreeScene::SpotPlace{scene_.PointLightPosition(light.index, time), Vec3()};
     (spot ? ls.spot_light : ls.point_light) = light.index;
-    ls.point.p = Vec3(position - scene_.origin());
+    ls.point.p = place.position;
+    ls.point.time = time;
     const Vec3 d = ls.point.p - ref;
     const float dist2 = LengthSquared(d);
     if (!(dist2 > 0)) return std::nullopt;
@@ -480,7 +498,7 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
     const SpotCone& cone = spot_cones_[size_t(light.index)];
     // 1 - cos of the angle to the axis as |d - axis|^2 / 2 (d = -wi, from the light): exact for
     // narrow cones, where cos itself rounds to 1 in float.
-    const float one_minus_cos = 0.5f * LengthSquared(ls.wi + cone.direction);
+    const float one_minus_cos = 0.5f * LengthSquared(ls.wi + place.direction);
     const float t =
         std::clamp((cone.one_minus_cos_outer - one_minus_cos) * cone.inv_width, 0.0f, 1.0f);
     if (t == 0) return std::nullopt;  // outside the outer cone: no shadow ray needed

@@ -160,7 +160,8 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
                 return contribution;
             };
             for (const size_t i : delta_lights_) {
-                if (const std::optional<LightSample> ls = lights_.SampleDeltaLight(i, hit->p)) {
+                if (const std::optional<LightSample> ls =
+                        lights_.SampleDeltaLight(i, hit->p, hit->time)) {
                     L += direct(*ls);
                 }
             }

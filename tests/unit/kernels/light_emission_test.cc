@@ -211,7 +211,7 @@ TEST_P(EmissionFluxTest, FluxMatchesPowerAndPdfLeMatchesSample) {
         const double f = s->le.Average() * cos / (s->pick * s->pdf_pos * s->pdf_dir);
         sum += f;
         sum2 += f * f;
-        const EmissionPdf pdf = emission.PdfLe(s->light, s->point.p, s->point.n, s->w);
+        const EmissionPdf pdf = emission.PdfLe(s->light, s->point.p, s->point.n, s->w, 0);
         ASSERT_NEAR(pdf.pos, s->pdf_pos, 1e-5f * s->pdf_pos);
         ASSERT_NEAR(pdf.dir, s->pdf_dir, 1e-3f * s->pdf_dir) << "sample " << i;
     }
@@ -249,7 +249,7 @@ TEST(EmissionSamplerTest, HitsMapToTheirLight) {
         EXPECT_LT(Length(hit->p - s->point.p), 1e-4f);
         const int light = emission.LightOf(*hit);
         EXPECT_EQ(light, s->light);
-        const EmissionPdf pdf = emission.PdfLe(light, hit->p, hit->n, s->w);
+        const EmissionPdf pdf = emission.PdfLe(light, hit->p, hit->n, s->w, 0);
         EXPECT_NEAR(pdf.pos, s->pdf_pos, 1e-5f * s->pdf_pos);
         EXPECT_NEAR(pdf.dir, s->pdf_dir, 1e-3f * s->pdf_dir);
     }
@@ -344,7 +344,7 @@ TEST_P(EmissionDirectionTest, DirectionsFollowPdfDir) {
             const double p = IntegrateSolidAngle(
                 [&](const Vec3& w) {
                     return double(
-                        emission.PdfLe(first->light, first->point.p, first->point.n, w).dir);
+                        emission.PdfLe(first->light, first->point.p, first->point.n, w, 0).dir);
                 },
                 ti * kPi / kThetaRes, (ti + 1) * kPi / kThetaRes, pi * 2 * kPi / kPhiRes,
                 (pi + 1) * 2 * kPi / kPhiRes, 4, 1e-7);

@@ -4,6 +4,7 @@
 // still, methods against each other, and scenes where nothing moves keep their bits.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -222,24 +223,105 @@ TEST(MotionBlur, AUniformlyMovingEmitterKeepsItsBrightness) {
     EXPECT_NEAR(b.value, s.value, 4 * se);
 }
 
+// The z threshold of a two-sided test at family-wise level alpha over m tests (Bonferroni).
+double BonferroniZ(int m, double alpha = 1e-3) {
+    double lo = 0, hi = 20;
+    for (int i = 0; i < 100; ++i) {
+        const double z = (lo + hi) / 2;
+        (std::erfc(z / std::sqrt(2.0)) > alpha / m ? lo : hi) = z;
+    }
+    return hi;
+}
+
+// Block means (channel average) of two renders agree within their A/B standard errors.
+void ExpectSameBlocks(const Image& a, const Image& b, const char* what, int block = 8) {
+    const int bw = a.width() / block, bh = a.height() / block;
+    const double threshold = BonferroniZ(bw * bh);
+    double worst = 0;
+    for (int by = 0; by < bh; ++by) {
+        for (int bx = 0; bx < bw; ++bx) {
+            double m[2] = {}, v[2] = {};
+            for (int y = by * block; y < (by + 1) * block; ++y) {
+                for (int x = bx * block; x < (bx + 1) * block; ++x) {
+                    for (int i = 0; i < 2; ++i) {
+                        const Image& image = i == 0 ? a : b;
+                        const double pa = image.Pixel(x, y, "A.").Average();
+                        const double pb = image.Pixel(x, y, "B.").Average();
+                        m[i] += (pa + pb) / 2;
+                        v[i] += (pa - pb) * (pa - pb) / 4;
+                    }
+                }
+            }
+            const double se = std::sqrt(v[0] + v[1]);
+            const double z = se > 0 ? (m[0] - m[1]) / se : (m[0] == m[1] ? 0 : 1e9);
+            worst = std::max(worst, std::abs(z));
+            EXPECT_LT(std::abs(z), threshold) << what << ": block " << bx << ", " << by << ": "
+                                              << m[0] << " vs " << m[1] << " +- " << se;
+        }
+    }
+    std::printf("[motion] %s: largest |z| %.2f of %d blocks (threshold %.2f)\n", what, worst,
+                bw * bh, threshold);
+}
+
+// A diffuse wall behind the square (z = -0.3) and a perspective camera (light paths cannot
+// reach an orthographic one) of `size` pixels a side.
+void AddWallInPerspective(Scene& scene, int size) {
+    Material wall;
+    wall.name = "wall";
+    wall.reflectance = Rgb(0.7f);
+    scene.materials.push_back(wall);
+    TriangleMesh back;
+    back.name = "back";
+    back.material = int(scene.materials.size()) - 1;
+    back.positions = {{-2, -2, -0.3}, {2, -2, -0.3}, {2, 2, -0.3}, {-2, 2, -0.3}};
+    back.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(back);
+    scene.camera.projection = CameraSpec::Projection::kPerspective;
+    scene.camera.position = {0, 0.3, 2};
+    scene.camera.fov_y_deg = 40;
+    scene.camera.width = scene.camera.height = size;
+}
+
+// A moving emissive square lighting a diffuse wall, seen in perspective: the path tracer, BDPT
+// and the light tracer give one blurred image (the square's streak and the light it casts,
+// both at the sample's time).
+TEST(MotionBlur, MethodsAgreeOnABlurredScene) {
+    MovingScene m = SquareScene(true, false);
+    AddWallInPerspective(m.scene, 32);
+    const SceneMotion motion{&m.animation, 0, 1};
+    const Image path = RenderPathWithMotion(m.scene, motion, 256).out.image;
+    ExpectSameBlocks(path, RenderSplatWithMotion(m.scene, motion, "bdpt", 128), "bdpt vs path");
+    ExpectSameBlocks(path, RenderSplatWithMotion(m.scene, motion, "light", 128), "light vs path");
+    // Not the still: the blur is there to see.
+    const Image still = RenderPathWithMotion(m.scene, {}, 256).out.image;
+    const double lit = HorizontalSpread(path).variance, sharp = HorizontalSpread(still).variance;
+    EXPECT_GT(lit, sharp + 1);
+}
+
+// A point light moving over the wall (no emitter in view): the path tracer's next-event
+// estimation (LightSampler) and the light tracer's emission (EmissionSampler) place it alike
+// at each sample's time, and BDPT, which uses both, agrees with them.
+TEST(MotionBlur, AMovingPointLightLightsTheSameForEveryMethod) {
+    Scene scene;
+    AddWallInPerspective(scene, 32);
+    scene.point_lights.push_back({{0, 0, 0.2}, Rgb(2.0f)});
+    SceneAnimation animation = OneMovingNode(1.0, 0.2);
+    animation.lights.push_back({AnimatedLight::Kind::kPoint, 0, 0, true});
+    ASSERT_TRUE(animation.PoseAt(0.5, scene).ok());
+    const SceneMotion motion{&animation, 0, 1};
+    const Image path = RenderPathWithMotion(scene, motion, 128).out.image;
+    ExpectSameBlocks(path, RenderSplatWithMotion(scene, motion, "light", 64), "point: light");
+    ExpectSameBlocks(path, RenderSplatWithMotion(scene, motion, "bdpt", 64), "point: bdpt");
+    // The light spreads: its pool on the wall is wider than the still's.
+    const Image still = RenderPathWithMotion(scene, {}, 128).out.image;
+    EXPECT_GT(HorizontalSpread(path).variance, HorizontalSpread(still).variance + 1);
+}
+
 // The instant the scene was posed at: a closed shutter, or an open one over which nothing
 // moves, renders the still's bits, by the path tracer and a splatting method.
 TEST(MotionBlur, WhenNothingMovesTheShutterKeepsTheStillsBits) {
     MovingScene m = SquareScene(true, false);
-    // A diffuse floor behind the square, so that paths bounce.
-    Material floor;
-    floor.name = "floor";
-    floor.reflectance = Rgb(0.6f);
-    m.scene.materials.push_back(floor);
-    TriangleMesh back;
-    back.name = "back";
-    back.material = 1;
-    back.positions = {{-2, -2, -1}, {2, -2, -1}, {2, 2, -1}, {-2, 2, -1}};
-    back.triangles = {{0, 1, 2}, {0, 2, 3}};
-    m.scene.meshes.push_back(back);
-    m.scene.camera.projection = CameraSpec::Projection::kPerspective;
-    m.scene.camera.fov_y_deg = 40;
-    m.scene.camera.width = m.scene.camera.height = 24;
+    AddWallInPerspective(m.scene, 24);
     SceneAnimation still_animation = OneMovingNode(0, 0);  // no channel
     still_animation.meshes = m.animation.meshes;
     still_animation.meshes[0].moves = false;

@@ -83,6 +83,14 @@ class EmbreeScene {
     bool Moves(int mesh) const { return !steps_of_[size_t(mesh)].empty(); }
     Vec3 Normal(int mesh, uint32_t v, float time) const;
     std::array<float, 4> Tangent(int mesh, uint32_t v, float time) const;
+    // Point light i's position and spot light i's position and unit axis (render space) at
+    // `time`: the Scene's when no node moves them, else linear between steps (the axis
+    // renormalised).
+    Vec3 PointLightPosition(int i, float time) const;
+    struct SpotPlace {
+        Vec3 position, direction;
+    };
+    SpotPlace SpotLightAt(int i, float time) const;
     // The camera's poses over the shutter when it moves (for Camera's motion), else empty.
     const std::vector<CameraSpec>& camera_motion() const { return camera_motion_; }
     // How many poses moving meshes have (1: nothing moves).
@@ -108,6 +116,9 @@ class EmbreeScene {
     std::vector<std::vector<Vec3>> positions_;
     // Per mesh: empty when it stands still, else its poses, one per step.
     std::vector<std::vector<MeshStep>> steps_of_;
+    // Per point and spot light: empty when it stands still, else its places, one per step.
+    std::vector<std::vector<Vec3>> point_steps_;
+    std::vector<std::vector<SpotPlace>> spot_steps_;
     int steps_ = 1;
     std::vector<CameraSpec> camera_motion_;
     std::vector<Vec3> sphere_centers_;

@@ -95,7 +95,8 @@ class EmissionSampler {
     // otherwise) in direction w (unit, away from the light). For a light at infinity p and n are
     // ignored and pos is 1 / (pi R^2); w must then be the direction of travel. Deltas: the
     // densities of the delta parts are 1 when w is the light's own direction, else 0.
-    EmissionPdf PdfLe(int light, const Vec3& p, const Vec3& n, const Vec3& w) const;
+    // A moving spot light's cone is the one of `time`.
+    EmissionPdf PdfLe(int light, const Vec3& p, const Vec3& n, const Vec3& w, float time) const;
 
     // For a path vertex that escaped the scene travelling along -w (w unit, towards the sky):
     // pos = 1 / (pi R^2) and dir = the sum over the lights at infinity (not directional delta
@@ -113,9 +114,9 @@ class EmissionSampler {
         bool two_sided;
     };
     // A spot light's cone (SpotBandOf, as LightSampler's): with c = 1 - cos(angle to the axis),
-    // the falloff is SpotBandFalloff(clamp((one_minus_cos_outer - c) * inv_width, 0, 1)).
+    // the falloff is SpotBandFalloff(clamp((one_minus_cos_outer - c) * inv_width, 0, 1)). Its
+    // position and axis at a time are EmbreeScene::SpotLightAt's.
     struct SpotCone {
-        Vec3 position, direction;
         float one_minus_cos_outer, inv_width;
         bool smooth;
         Rgb intensity;

@@ -70,7 +70,7 @@ class LightSampler {
     // diameter), as Sample gives it at `ref` but with pdf 1; nullopt for the others: for
     // estimators that sum every delta light instead of picking one (lf/kernels/whitted.h).
     bool IsDeltaLight(size_t i) const;
-    std::optional<LightSample> SampleDeltaLight(size_t i, const Vec3& ref) const;
+    std::optional<LightSample> SampleDeltaLight(size_t i, const Vec3& ref, float time) const;
 
     // Density, per solid angle at `ref`, with which Sample(ref, n, ...) would have produced
     // `hit` (an emitter hit by a BSDF-sampled ray, at its time); used for multiple importance
@@ -113,11 +113,10 @@ class LightSampler {
         };
         Half halves[2];
     };
-    // A spot light's cone in render space: with c = 1 - cos(angle to the axis) and
-    // t = clamp((one_minus_cos_outer - c) * inv_width, 0, 1) its falloff is t^2
-    // (KHR_lights_punctual) or t^2 (3 - 2 t) (smoothstep).
+    // A spot light's cone (its axis at a time: EmbreeScene::SpotLightAt): with c = 1 - cos(angle
+    // to the axis) and t = clamp((one_minus_cos_outer - c) * inv_width, 0, 1) its falloff is
+    // t^2 (KHR_lights_punctual) or t^2 (3 - 2 t) (smoothstep).
     struct SpotCone {
-        Vec3 direction;
         float one_minus_cos_outer, inv_width;
         bool smooth;
     };
@@ -133,7 +132,7 @@ class LightSampler {
     float AreaPdf(const Light& light, const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;
     // The point at (s, t) of rectangle light `light`, on whichever of its triangles holds it.
     SurfacePoint RectanglePoint(const Light& light, const Vec2& st) const;
-    std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref) const;
+    std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref, float time) const;
     // A direction towards a sun disk (uniform in its cone) or the environment (by its map).
     std::optional<Vec3> SampleInfiniteDirection(const Light& light, const Vec2& u) const;
     // Where a shadow ray from ref towards a light at infinity in direction wi ends.
