@@ -8,12 +8,16 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
+#include <numbers>
+#include <optional>
 
 #include "lf/core/camera.h"
 #include "lf/core/scene_animation.h"
 #include "lf/job/splat_settings.h"
 #include "lf/kernels/embree_scene.h"
+#include "lf/kernels/lights.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/scene_motion.h"
 #include "lf/local/local_executor.h"
@@ -315,6 +319,95 @@ TEST(MotionBlur, AMovingPointLightLightsTheSameForEveryMethod) {
     // The light spreads: its pool on the wall is wider than the still's.
     const Image still = RenderPathWithMotion(scene, {}, 128).out.image;
     EXPECT_GT(HorizontalSpread(path).variance, HorizontalSpread(still).variance + 1);
+}
+
+// A square turning a quarter turn about +y over the shutter (rotation keys, so 9 steps) and
+// emitting: a ray at time t hits it where its pose at t is, to within the steps' chord error,
+// and a light sample of it at time t lies on the surface a ray of that time hits.
+TEST(MotionBlur, ARotatingEmitterIsWhereItsPoseIsAndItsLightSamplesAgree) {
+    MovingScene m = SquareScene(false, false);
+    m.animation = OneMovingNode(0, 0);
+    const double s = std::sqrt(0.5);
+    m.animation.channels.push_back(
+        {0, AnimationChannel::Path::kRotation,
+         Keyframes::Create(Interpolation::kLinear, KeyframeKind::kRotation, 4, {0, 1},
+                           {0, 0, 0, 1, 0, s, 0, s}, "test rotation")
+             .value()});
+    AnimatedMesh am;
+    am.mesh = 0;
+    am.node = 0;
+    am.positions = m.scene.meshes[0].positions;
+    am.moves = true;
+    m.animation.meshes.push_back(am);
+    ASSERT_TRUE(m.animation.PoseAt(0.5, m.scene).ok());
+    const SceneMotion motion{&m.animation, 0, 1};
+    EXPECT_EQ(MotionSteps(motion), kCurvedMotionSteps);
+    auto es = EmbreeScene::Build(m.scene, nullptr, motion);
+    ASSERT_TRUE(es.ok()) << es.status();
+    ASSERT_TRUE((*es)->Moves(0));
+    const LightSampler lights(**es);
+    for (const float t : {0.0f, 0.1f, 0.3f, 0.5f, 0.77f}) {
+        // The square's plane at t: through the origin, normal (sin a, 0, cos a), a = t pi/2.
+        const double a = t * std::numbers::pi / 2;
+        const Vec3 normal(float(std::sin(a)), 0, float(std::cos(a)));
+        const Vec3 o = Vec3(Vec3d(0.02, 0.01, 5) - (*es)->origin());
+        const Ray ray{o, Vec3(0, 0, -1), std::numeric_limits<float>::infinity(), t};
+        const std::optional<SurfaceHit> hit = (*es)->Intersect(ray);
+        ASSERT_TRUE(hit) << t;
+        EXPECT_EQ(hit->time, t);
+        const Vec3 world = hit->p + Vec3((*es)->origin());
+        // 9 steps: the chord of an eighth of the quarter turn at radius 0.02 is far below 1e-4.
+        EXPECT_NEAR(Dot(world, normal), 0, 1e-4) << t;
+        // A light sample seen from in front of the square at time t, and the ray of that time
+        // towards it: it hits the sampled point on the emitter.
+        const Vec3 ref = Vec3(Vec3d(0.3 * std::sin(a), 0.05, 0.3 * std::cos(a)) - (*es)->origin());
+        for (const float u : {0.2f, 0.6f}) {
+            const std::optional<LightSample> ls =
+                lights.Sample(ref, Vec3(0, 0, 0), 0.5f, {u, 0.4f}, t);
+            ASSERT_TRUE(ls) << t;
+            EXPECT_EQ(ls->point.time, t);
+            const Vec3 sampled = ls->point.p + Vec3((*es)->origin());
+            EXPECT_NEAR(Dot(sampled, normal), 0, 1e-4) << t;
+            const std::optional<SurfaceHit> towards =
+                (*es)->Intersect(Ray{ref, ls->wi, std::numeric_limits<float>::infinity(), t});
+            ASSERT_TRUE(towards) << t;
+            EXPECT_LT(Length(towards->p - ls->point.p), 1e-4f) << t;
+            EXPECT_NEAR(lights.Pdf(ref, Vec3(0, 0, 0), *towards), ls->pdf, 1e-3f * ls->pdf) << t;
+        }
+    }
+}
+
+// A morph target (a weights channel: deformation, so 9 steps) lifting one corner of the
+// square: a ray at time t hits the surface of that time's pose. The lift is linear in the
+// weight, so the steps' interpolation is exact.
+TEST(MotionBlur, AMorphedMeshIsHitWhereItsPoseIs) {
+    MovingScene m = SquareScene(false, false);
+    m.animation = OneMovingNode(0, 0);
+    m.animation.channels.push_back({0, AnimationChannel::Path::kWeights,
+                                    Keyframes::Create(Interpolation::kLinear, KeyframeKind::kVector,
+                                                      1, {0, 1}, {0, 1}, "test weights")
+                                        .value()});
+    AnimatedMesh am;
+    am.mesh = 0;
+    am.node = 0;
+    am.positions = m.scene.meshes[0].positions;
+    am.targets.push_back({{{0, 0, 0}, {0, 0, 0}, {0, 0, 0.5}, {0, 0, 0}}, {}, {}});
+    am.weights = {0};
+    am.moves = true;
+    m.animation.meshes.push_back(am);
+    ASSERT_TRUE(m.animation.PoseAt(0.5, m.scene).ok());
+    const SceneMotion motion{&m.animation, 0, 1};
+    EXPECT_EQ(MotionSteps(motion), kCurvedMotionSteps);
+    auto es = EmbreeScene::Build(m.scene, nullptr, motion);
+    ASSERT_TRUE(es.ok()) << es.status();
+    for (const float t : {0.0f, 0.2f, 0.55f, 1.0f}) {
+        // (0.1, 0.05) has barycentric 0.7 on the lifted corner of triangle 0.
+        const Vec3 o = Vec3(Vec3d(0.1, 0.05, 5) - (*es)->origin());
+        const std::optional<SurfaceHit> hit =
+            (*es)->Intersect(Ray{o, Vec3(0, 0, -1), std::numeric_limits<float>::infinity(), t});
+        ASSERT_TRUE(hit) << t;
+        EXPECT_NEAR(hit->p.z + (*es)->origin().z, 0.35 * t, 1e-5) << t;
+    }
 }
 
 // The instant the scene was posed at: a closed shutter, or an open one over which nothing
