@@ -308,6 +308,13 @@ TEST(MotionBlur, MethodsAgreeOnABlurredScene) {
 TEST(MotionBlur, AMovingPointLightLightsTheSameForEveryMethod) {
     Scene scene;
     AddWallInPerspective(scene, 32);
+    // A floor, so that light also arrives after a bounce (photons, light subpaths).
+    TriangleMesh floor;
+    floor.name = "floor";
+    floor.material = 0;
+    floor.positions = {{-2, -0.4, -0.3}, {2, -0.4, -0.3}, {2, -0.4, 2}, {-2, -0.4, 2}};
+    floor.triangles = {{0, 2, 1}, {0, 3, 2}};
+    scene.meshes.push_back(floor);
     scene.point_lights.push_back({{0, 0, 0.2}, Rgb(2.0f)});
     SceneAnimation animation = OneMovingNode(1.0, 0.2);
     animation.lights.push_back({AnimatedLight::Kind::kPoint, 0, 0, true});
@@ -316,6 +323,8 @@ TEST(MotionBlur, AMovingPointLightLightsTheSameForEveryMethod) {
     const Image path = RenderPathWithMotion(scene, motion, 128).out.image;
     ExpectSameBlocks(path, RenderSplatWithMotion(scene, motion, "light", 64), "point: light");
     ExpectSameBlocks(path, RenderSplatWithMotion(scene, motion, "bdpt", 64), "point: bdpt");
+    // Photon mapping: its direct light is next-event estimation at each pass's time.
+    ExpectSameBlocks(path, RenderSplatWithMotion(scene, motion, "ppm", 64), "point: ppm");
     // The light spreads: its pool on the wall is wider than the still's.
     const Image still = RenderPathWithMotion(scene, {}, 128).out.image;
     EXPECT_GT(HorizontalSpread(path).variance, HorizontalSpread(still).variance + 1);
