@@ -158,8 +158,6 @@ struct PosedSteps {
 };
 absl::Status PoseSteps(const Scene& scene, const SceneMotion& motion, int steps,
                        const Vec3d& origin, const PosedSteps& out) {
-    std::vector<std::vector<EmbreeScene::MeshStep>>& meshes = out.meshes;
-    std::vector<CameraSpec>& camera = out.camera;
     const SceneAnimation& animation = *motion.animation;
     const std::vector<bool> moving_nodes = animation.MovingNodes();
     const bool camera_moves =
@@ -179,9 +177,9 @@ absl::Status PoseSteps(const Scene& scene, const SceneMotion& motion, int steps,
             step.positions.push_back(Vec3());  // Embree may read 16 bytes from the last vertex
             step.normals = mesh.normals;
             step.tangents = mesh.tangents;
-            meshes[size_t(am.mesh)].push_back(std::move(step));
+            out.meshes[size_t(am.mesh)].push_back(std::move(step));
         }
-        if (camera_moves) camera.push_back(posed.camera);
+        if (camera_moves) out.camera.push_back(posed.camera);
         for (const AnimatedLight& light : animation.lights) {
             if (!light.moves) continue;
             const size_t i = size_t(light.index);
