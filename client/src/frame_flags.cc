@@ -35,11 +35,19 @@ void AddFrameFlags(CLI::App* cmd, FrameFlags& flags) {
            absl::StrCat("frames per second of --frames/--frame (default ", defaults::kFps, ")"))
         ->type_name("F")
         ->group(g);
+    cmd->add_option("--shutter", flags.shutter,
+                    absl::StrCat("motion blur: the shutter stays open S frames, centred on each "
+                                 "frame's time (Blender's default); each camera sample draws a "
+                                 "time in it. 0 (the default): the instant. Up to ",
+                                 kMaxShutter, "; radiosity refuses it"))
+        ->type_name("S")
+        ->group(g);
 }
 
 absl::StatusOr<ShotSettings> ShotOfFrameFlags(const FrameFlags& flags) {
     ShotSettings shot;
     shot.fps = flags.fps;
+    shot.shutter = flags.shutter;
     if (flags.frames_given && flags.frame_given) {
         return absl::InvalidArgumentError(absl::StrCat("--frame ", flags.frame, " with --frames ",
                                                        flags.frames,
@@ -51,6 +59,11 @@ absl::StatusOr<ShotSettings> ShotOfFrameFlags(const FrameFlags& flags) {
         if (flags.fps_given) {
             return absl::InvalidArgumentError(absl::StrCat(
                 "--fps ", flags.fps, ": applies to --frames or --frame; a still has no time"));
+        }
+        if (flags.shutter != 0) {
+            return absl::InvalidArgumentError(
+                absl::StrCat("--shutter ", flags.shutter,
+                             ": motion blur needs --frames or --frame; a still has no time"));
         }
         return shot;
     }

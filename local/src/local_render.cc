@@ -20,6 +20,7 @@
 #include "lf/job/shot.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
+#include "lf/kernels/scene_motion.h"
 #include "lf/kernels/whitted.h"
 #include "lf/local/method_choice.h"
 #include "lf/local/method_factory.h"
@@ -85,19 +86,22 @@ absl::StatusOr<std::optional<SplatPlanSettings>> SplatPlanOf(const LocalRenderOp
     return *plan;
 }
 
-// Builds the BVH of `scene` as it is posed now and the kernels of `method` on it.
+// Builds the BVH of `scene` as it is posed now (and over the shutter of `motion`, when it
+// blurs) and the kernels of `method` on it.
 absl::StatusOr<std::unique_ptr<PosedKernels>> BuildKernels(const Scene& scene,
                                                            const LocalRenderOptions& options,
                                                            Method method, const JobSpec& job,
-                                                           const std::string& job_id) {
+                                                           const std::string& job_id,
+                                                           const SceneMotion& motion = {}) {
     auto log = NamedLogger("render");
     auto k = std::make_unique<PosedKernels>();
     const absl::Time bvh_start = absl::Now();
-    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(scene);
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree =
+        EmbreeScene::Build(scene, nullptr, motion);
     if (!embree.ok()) return embree.status();
     k->embree = std::move(*embree);
     k->bvh_seconds = absl::ToDoubleSeconds(absl::Now() - bvh_start);
-    k->camera.emplace(scene.camera, k->embree->origin());
+    k->camera.emplace(scene.camera, k->embree->origin(), k->embree->camera_motion());
     const MethodInfo& info = Info(method);
     if (info.work == WorkKind::kSplatPasses) {
         absl::StatusOr<std::unique_ptr<SplatRenderer>> made =
@@ -379,6 +383,7 @@ absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
     absl::StatusOr<LoadedRender> r = LoadRender(options);
     if (!r.ok()) return r.status();
     r->job.shot = shot;
+    if (absl::Status s = CheckShutterOfMethod(r->method, shot.shutter); !s.ok()) return s;
     // A malformed animation fails the first frame's pose, before any file is written.
     const bool moves = r->scene.animation && r->scene.animation->Moves();
     LocalShotSummary shot_summary;
@@ -398,8 +403,10 @@ absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
         // A scene that does not move renders every frame on the first frame's kernels.
         if (!kernels || moves) {
             kernels.reset();  // one BVH in memory at a time
+            const ShutterInterval shutter = ShutterOf(frame, shot);
             absl::StatusOr<std::unique_ptr<PosedKernels>> k =
-                BuildKernels(r->scene, options, r->method, r->job, r->job_id);
+                BuildKernels(r->scene, options, r->method, r->job, r->job_id,
+                             {r->scene.animation.get(), shutter.open, shutter.close});
             if (!k.ok()) return k.status();
             kernels = std::move(*k);
             f.bvh_seconds = kernels->bvh_seconds;

@@ -3,6 +3,7 @@
 // bits every frame, and bad input fails before anything is written.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -205,6 +206,91 @@ TEST_F(ShotRender, AMalformedAnimationRefusesFramesNamingTheFile) {
     EXPECT_NE(run.output.find("broken.gltf"), std::string::npos) << run.output;
     EXPECT_NE(run.output.find("animations[0]"), std::string::npos) << run.output;
     EXPECT_EQ(Files(), 1u);  // the scene alone
+}
+
+// Image sum, and its standard error when each pixel averages `spp` samples of 0 or `peak` (a
+// directly seen emitter on black: a pixel's variance is v (peak - v) / spp for its mean v;
+// stratified samples only do better, so the bound is conservative).
+struct ImageSum {
+    double sum = 0, variance = 0;
+};
+ImageSum SumOf(const Image& image, uint64_t spp) {
+    const std::vector<float>& r = *image.FindChannel("R");
+    const double peak = *std::max_element(r.begin(), r.end());
+    ImageSum s;
+    for (float v : r) {
+        s.sum += v;
+        s.variance += std::max(0.0, double(v) * (peak - v)) / double(spp);
+    }
+    return s;
+}
+
+// `--shutter 1` on the ball moving at constant speed: the streak's centroid is the still's at the
+// frame's time (the shutter is centred on it), and the light it sends is the still's (the
+// emitter's brightness is conserved), each within its noise.
+TEST_F(ShotRender, AShutterCentredOnTheFrameKeepsTheBallsCentroidAndBrightness) {
+    constexpr uint64_t kSpp = 256;
+    Image images[2];
+    for (int blur = 0; blur < 2; ++blur) {
+        LocalRenderOptions o = Options(Shots("moving_ball.gltf"), kSpp);
+        o.exr_path = Path(blur ? "blur_#.exr" : "still_#.exr");
+        ShotSettings shot;
+        shot.frames = FrameRange{12, 12, 1};
+        shot.shutter = blur ? 1.0 : 0.0;
+        absl::StatusOr<LocalShotSummary> summary = RunLocalShot(o, shot);
+        ASSERT_TRUE(summary.ok()) << summary.status();
+        absl::StatusOr<ExrFile> exr = ReadExr(summary->frames.at(0).exr_path);
+        ASSERT_TRUE(exr.ok()) << exr.status();
+        EXPECT_DOUBLE_EQ(std::get<double>(exr->attributes.at("lightfarm.shutter")), shot.shutter);
+        images[blur] = std::move(exr->image);
+    }
+    EXPECT_NE(*images[0].FindChannel("R"), *images[1].FindChannel("R"));  // it did blur
+    const Vec2 still = Centroid(images[0]), blurred = Centroid(images[1]);
+    EXPECT_NEAR(blurred.x, still.x, 0.25);
+    EXPECT_NEAR(blurred.y, still.y, 0.25);
+    const ImageSum a = SumOf(images[0], kSpp), b = SumOf(images[1], kSpp);
+    EXPECT_NEAR(b.sum, a.sum, 4 * std::sqrt(a.variance + b.variance))
+        << "still " << a.sum << ", blurred " << b.sum;
+}
+
+// Nothing moves in the Cornell box: an open shutter changes no bit.
+TEST_F(ShotRender, AStaticSceneRendersTheSameBitsWithAndWithoutAShutter) {
+    std::vector<float> pixels[2];
+    for (int blur = 0; blur < 2; ++blur) {
+        LocalRenderOptions o = Options(std::string(LF_TEST_SCENES) + "/cornell_box.json", 4);
+        o.exr_path = Path(blur ? "blur.exr" : "still.exr");
+        ShotSettings shot;
+        shot.frames = FrameRange{3, 3, 1};
+        shot.shutter = blur ? 1.0 : 0.0;
+        ASSERT_TRUE(RunLocalShot(o, shot).ok());
+        absl::StatusOr<ExrFile> exr = ReadExr(o.exr_path);
+        ASSERT_TRUE(exr.ok()) << exr.status();
+        pixels[blur] = *exr->image.FindChannel("R");
+    }
+    EXPECT_EQ(pixels[0], pixels[1]);
+}
+
+TEST_F(ShotRender, AShutterWithoutFramesOrByRadiosityIsRefused) {
+    const std::string small = " --resolution 16x12 --spp 1 --no-progress ";
+    struct Case {
+        std::string args, expected;
+    } cases[] = {
+        {"render " + Shots("moving_ball.gltf") + small + "--shutter 0.5 -o " + Path("a.exr"),
+         "--shutter 0.5: motion blur needs --frames or --frame"},
+        {"render " + Shots("moving_ball.gltf") + small + "--frame 2 --shutter 11 -o " +
+             Path("a.exr"),
+         "shutter 11"},
+        {"render " + std::string(LF_TEST_SCENES) + "/cornell_box.json" + small +
+             "--method radiosity --frame 2 --shutter 0.5 -o " + Path("a.exr"),
+         "method \"radiosity\" solves one instant per frame"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const testing::LightfarmRun run = RunLightfarm(c.args);
+        EXPECT_NE(run.status, 0);
+        EXPECT_NE(run.output.find(c.expected), std::string::npos) << run.output;
+        EXPECT_EQ(Files(), 0u);
+    }
 }
 
 }  // namespace

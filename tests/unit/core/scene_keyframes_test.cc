@@ -148,7 +148,7 @@ TEST(SceneKeyframes, TheShotScenesMoveTheBallAndTheCamera) {
     // tests/scenes/shot (README.md there): the ball at x = -2 + 4 t, the camera at x = t.
     for (const char* name : {"moving_ball.json", "moving_ball_camera.json"}) {
         SCOPED_TRACE(name);
-        absl::StatusOr<Scene> scene = LoadScene(std::string(LF_TEST_SCENES) + "/shot/" + name);
+        absl::StatusOr<Scene> scene = LoadScene(std::string(LF_TEST_SCENES) + "/shots/" + name);
         ASSERT_TRUE(scene.ok()) << scene.status();
         ASSERT_NE(scene->animation, nullptr);
         const bool camera_moves = std::string(name) == "moving_ball_camera.json";
