@@ -231,6 +231,30 @@ EmbreeScene::~EmbreeScene() {
     if (handles_->device) rtcReleaseDevice(handles_->device);
 }
 
+namespace {
+
+// What the time steps do not move yet (analytic spheres, directional lights) must not sit still
+// silently while the rest blurs: refused, naming the object.
+absl::Status CheckMotionIsRepresented(const SceneAnimation& animation) {
+    for (const AnimatedSphere& s : animation.spheres) {
+        if (!s.moves) continue;
+        return absl::UnimplementedError(absl::StrCat(
+            "spheres[", s.sphere, "] (", animation.nodes[size_t(s.node)].where,
+            ") moves during the shutter, and motion blur of analytic spheres is not implemented "
+            "yet: make it a mesh (a UV sphere) or render without --shutter"));
+    }
+    for (const AnimatedLight& l : animation.lights) {
+        if (!l.moves || l.kind != AnimatedLight::Kind::kDirectional) continue;
+        return absl::UnimplementedError(
+            absl::StrCat("directional light ", l.index, " (", animation.nodes[size_t(l.node)].where,
+                         ") turns during the shutter, and motion blur of directional lights is not "
+                         "implemented yet: render without --shutter"));
+    }
+    return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& scene,
                                                                 const std::atomic<bool>* cancel,
                                                                 const SceneMotion& motion) {
@@ -256,6 +280,9 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
     static_assert(sizeof(Vec3) == 3 * sizeof(float), "Embree reads positions_ as FLOAT3");
     es->positions_.resize(scene.meshes.size());
     es->steps_ = MotionSteps(motion);
+    if (es->steps_ > 1) {
+        if (absl::Status s = CheckMotionIsRepresented(*motion.animation); !s.ok()) return s;
+    }
     es->steps_of_.resize(scene.meshes.size());
     es->point_steps_.resize(scene.point_lights.size());
     es->spot_steps_.resize(scene.spot_lights.size());

@@ -342,6 +342,29 @@ void TakeKernelFigures(const PosedKernels& k, LocalRenderSummary& summary) {
 
 }  // namespace
 
+namespace {
+
+// Radiosity's files name one solve. Frames of a scene that moves solve anew each, so one file
+// would be overwritten (--save-solution, --export-ply) or applied to geometry it does not fit
+// (--load-solution: its check compares counts and the scene's hash, which motion keeps).
+absl::Status CheckSolutionFilesOfShot(const LocalRenderOptions& options, const Scene& scene,
+                                      const FrameRange& frames) {
+    if (frames.count() == 1 || !scene.animation || !scene.animation->Moves()) {
+        return absl::OkStatus();
+    }
+    for (const auto& [flag, path] : {std::pair{"--save-solution", &options.save_solution},
+                                     std::pair{"--load-solution", &options.load_solution},
+                                     std::pair{"--export-ply", &options.export_ply}}) {
+        if (path->empty()) continue;
+        return absl::InvalidArgumentError(absl::StrCat(
+            flag, " ", *path, " with --frames ", FrameRangeText(frames), ": ", scene.source,
+            " moves, so each frame solves anew and one file cannot hold them; use --frame N"));
+    }
+    return absl::OkStatus();
+}
+
+}  // namespace
+
 absl::Status CheckShotOutputs(const LocalRenderOptions& options, const FrameRange& frames) {
     // -o names the EXR, or the PNG when there is no EXR; --png the PNG beside an EXR.
     if (!options.exr_path.empty()) {
@@ -384,6 +407,7 @@ absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
     if (!r.ok()) return r.status();
     r->job.shot = shot;
     if (absl::Status s = CheckShutterOfMethod(r->method, shot.shutter); !s.ok()) return s;
+    if (absl::Status s = CheckSolutionFilesOfShot(options, r->scene, frames); !s.ok()) return s;
     // A malformed animation fails the first frame's pose, before any file is written.
     const bool moves = r->scene.animation && r->scene.animation->Moves();
     LocalShotSummary shot_summary;

@@ -293,5 +293,39 @@ TEST_F(ShotRender, AShutterWithoutFramesOrByRadiosityIsRefused) {
     }
 }
 
+// moving_ball.json's ball is an analytic sphere, which the shutter's steps do not move yet.
+TEST_F(ShotRender, AShutterOverAMovingAnalyticSphereIsRefusedNamingIt) {
+    const testing::LightfarmRun run = RunLightfarm(
+        "render " + Shots("moving_ball.json") +
+        " --resolution 16x12 --spp 1 --no-progress --frame 12 --shutter 1 -o " + Path("s.exr"));
+    EXPECT_NE(run.status, 0);
+    EXPECT_NE(run.output.find("spheres[0]"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("motion blur of analytic spheres"), std::string::npos) << run.output;
+    EXPECT_EQ(Files(), 0u);
+}
+
+// A Cornell box whose tall block slides: radiosity solves each frame anew, so one solution file
+// cannot serve the shot.
+TEST_F(ShotRender, RadiositySolutionFilesAreRefusedForAMovingShot) {
+    nlohmann::json scene =
+        nlohmann::json::parse(std::ifstream(std::string(LF_TEST_SCENES) + "/cornell_box.json"));
+    scene["shapes"].back()["transform"] = {
+        {"keyframes",
+         {{{"time", 0}, {"translate", {0, 0, 0}}}, {{"time", 1}, {"translate", {0.05, 0, 0}}}}}};
+    const std::string file = Path("sliding.json");
+    std::ofstream(file) << scene.dump();
+    std::ofstream(Path("solution.bin")) << "a solution";  // --load-solution wants a file
+    for (const char* flag : {"--save-solution", "--load-solution", "--export-ply"}) {
+        SCOPED_TRACE(flag);
+        const testing::LightfarmRun run = RunLightfarm(
+            "render " + file + " --method radiosity --resolution 16x12 --spp 1 --no-progress " +
+            "--frames 1-2 -o " + Path("r_#.exr") + " " + flag + " " + Path("solution.bin"));
+        EXPECT_NE(run.status, 0);
+        EXPECT_NE(run.output.find(std::string(flag) + " "), std::string::npos) << run.output;
+        EXPECT_NE(run.output.find("each frame solves anew"), std::string::npos) << run.output;
+        EXPECT_EQ(Files(), 2u);  // the scene and the solution alone
+    }
+}
+
 }  // namespace
 }  // namespace lf

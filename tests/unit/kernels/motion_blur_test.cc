@@ -13,6 +13,7 @@
 #include <numbers>
 #include <optional>
 
+#include "bonferroni.h"
 #include "lf/core/camera.h"
 #include "lf/core/scene_animation.h"
 #include "lf/job/splat_settings.h"
@@ -25,6 +26,8 @@
 
 namespace lf {
 namespace {
+
+using testing::BonferroniZ;
 
 constexpr int kSize = 64;                       // pixels a side
 constexpr double kPixelsPerUnit = kSize / 2.0;  // orthographic, half height 1
@@ -46,6 +49,16 @@ SceneAnimation OneMovingNode(double travel, double z) {
                  .value()});
     }
     return a;
+}
+
+// The square (mesh 0) driven by node 0, in the mesh's own space.
+AnimatedMesh DrivenSquare(const TriangleMesh& square) {
+    AnimatedMesh am;
+    am.mesh = 0;
+    am.node = 0;
+    am.positions = square.positions;
+    am.moves = true;
+    return am;
 }
 
 // An emissive square (radiance 1, both faces) of side kSide in the plane z = 0 about its
@@ -77,12 +90,7 @@ MovingScene SquareScene(bool square_moves, bool camera_moves) {
     m.scene.camera.width = m.scene.camera.height = kSize;
     if (square_moves) {
         m.animation = OneMovingNode(kTravel, 0);
-        AnimatedMesh am;
-        am.mesh = 0;
-        am.node = 0;
-        am.positions = square.positions;
-        am.moves = true;
-        m.animation.meshes.push_back(am);
+        m.animation.meshes.push_back(DrivenSquare(square));
     } else if (camera_moves) {
         m.animation = OneMovingNode(kTravel, 5);
         m.animation.camera_node = 0;
@@ -227,16 +235,6 @@ TEST(MotionBlur, AUniformlyMovingEmitterKeepsItsBrightness) {
     EXPECT_NEAR(b.value, s.value, 4 * se);
 }
 
-// The z threshold of a two-sided test at family-wise level alpha over m tests (Bonferroni).
-double BonferroniZ(int m, double alpha = 1e-3) {
-    double lo = 0, hi = 20;
-    for (int i = 0; i < 100; ++i) {
-        const double z = (lo + hi) / 2;
-        (std::erfc(z / std::sqrt(2.0)) > alpha / m ? lo : hi) = z;
-    }
-    return hi;
-}
-
 // Block means (channel average) of two renders agree within their A/B standard errors.
 void ExpectSameBlocks(const Image& a, const Image& b, const char* what, int block = 8) {
     const int bw = a.width() / block, bh = a.height() / block;
@@ -342,12 +340,7 @@ TEST(MotionBlur, ARotatingEmitterIsWhereItsPoseIsAndItsLightSamplesAgree) {
          Keyframes::Create(Interpolation::kLinear, KeyframeKind::kRotation, 4, {0, 1},
                            {0, 0, 0, 1, 0, s, 0, s}, "test rotation")
              .value()});
-    AnimatedMesh am;
-    am.mesh = 0;
-    am.node = 0;
-    am.positions = m.scene.meshes[0].positions;
-    am.moves = true;
-    m.animation.meshes.push_back(am);
+    m.animation.meshes.push_back(DrivenSquare(m.scene.meshes[0]));
     ASSERT_TRUE(m.animation.PoseAt(0.5, m.scene).ok());
     const SceneMotion motion{&m.animation, 0, 1};
     EXPECT_EQ(MotionSteps(motion), kCurvedMotionSteps);
@@ -396,13 +389,9 @@ TEST(MotionBlur, AMorphedMeshIsHitWhereItsPoseIs) {
                                     Keyframes::Create(Interpolation::kLinear, KeyframeKind::kVector,
                                                       1, {0, 1}, {0, 1}, "test weights")
                                         .value()});
-    AnimatedMesh am;
-    am.mesh = 0;
-    am.node = 0;
-    am.positions = m.scene.meshes[0].positions;
+    AnimatedMesh am = DrivenSquare(m.scene.meshes[0]);
     am.targets.push_back({{{0, 0, 0}, {0, 0, 0}, {0, 0, 0.5}, {0, 0, 0}}, {}, {}});
     am.weights = {0};
-    am.moves = true;
     m.animation.meshes.push_back(am);
     ASSERT_TRUE(m.animation.PoseAt(0.5, m.scene).ok());
     const SceneMotion motion{&m.animation, 0, 1};
@@ -457,6 +446,55 @@ TEST(MotionBlur, TheTimeIsADimensionOfItsOwn) {
         ++hits[int(Sampler(9, 1, 2, s, SamplerType::kSobol).GetTime() * 16)];
     }
     for (int h : hits) EXPECT_EQ(h, 1);
+}
+
+// Two poses are exact only for a straight path at constant speed over the shutter: a key inside
+// it (a bounce) or a CUBICSPLINE path takes the curved rule's steps.
+TEST(MotionBlur, TwoStepsOnlyForAStraightPathOverTheShutter) {
+    const auto steps = [](Interpolation interpolation, std::vector<double> times,
+                          std::vector<double> values, double open, double close) {
+        SceneAnimation a = OneMovingNode(0, 0);
+        a.channels.push_back({0, AnimationChannel::Path::kTranslation,
+                              Keyframes::Create(interpolation, KeyframeKind::kVector, 3,
+                                                std::move(times), std::move(values), "test")
+                                  .value()});
+        TriangleMesh square;
+        square.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+        a.meshes.push_back(DrivenSquare(square));
+        return MotionSteps(SceneMotion{&a, open, close});
+    };
+    const std::vector<double> bounce = {0, 0, 0, 0, 1, 0, 0, 0, 0};  // up and down again
+    EXPECT_EQ(steps(Interpolation::kLinear, {0, 0.5, 1}, bounce, 0.1, 0.4), 2);
+    EXPECT_EQ(steps(Interpolation::kLinear, {0, 0.5, 1}, bounce, 0.4, 0.6), kCurvedMotionSteps);
+    EXPECT_EQ(steps(Interpolation::kStep, {0, 0.5, 1}, bounce, 0.6, 0.9), 2);
+    EXPECT_EQ(steps(Interpolation::kStep, {0, 0.5, 1}, bounce, 0.4, 0.6), kCurvedMotionSteps);
+    // CUBICSPLINE: in-tangent, value, out-tangent per key.
+    EXPECT_EQ(steps(Interpolation::kCubicSpline, {0, 1},
+                    {0, 1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1, 0, 0, 0, -1, 0}, 0.1, 0.4),
+              kCurvedMotionSteps);
+}
+
+// What the steps do not move yet is refused, not rendered sharp beside blurred meshes.
+TEST(MotionBlur, AMovingSphereOrDirectionalLightUnderAShutterIsRefusedNamingIt) {
+    MovingScene m = SquareScene(true, false);
+    m.scene.spheres.push_back({});
+    m.animation.spheres.push_back({.sphere = 0, .node = 0, .moves = true});
+    auto refused = EmbreeScene::Build(m.scene, nullptr, SceneMotion{&m.animation, 0, 1});
+    ASSERT_FALSE(refused.ok());
+    EXPECT_EQ(refused.status().code(), absl::StatusCode::kUnimplemented);
+    EXPECT_NE(refused.status().message().find("spheres[0] (nodes[0] \"mover\") moves"),
+              std::string_view::npos)
+        << refused.status();
+    // The instant (a still of that frame) renders it.
+    EXPECT_TRUE(EmbreeScene::Build(m.scene, nullptr, SceneMotion{&m.animation, 0.5, 0.5}).ok());
+    m.animation.spheres.clear();
+    m.scene.directional_lights.push_back({.direction = {0, -1, 0}, .irradiance = Rgb(1.0f)});
+    m.animation.lights.push_back(
+        {.kind = AnimatedLight::Kind::kDirectional, .index = 0, .node = 0, .moves = true});
+    refused = EmbreeScene::Build(m.scene, nullptr, SceneMotion{&m.animation, 0, 1});
+    ASSERT_FALSE(refused.ok());
+    EXPECT_NE(refused.status().message().find("directional light 0"), std::string_view::npos)
+        << refused.status();
 }
 
 }  // namespace

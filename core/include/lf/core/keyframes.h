@@ -34,6 +34,8 @@ class Keyframes {
     std::vector<double> At(double seconds) const;
 
     int width() const { return width_; }
+    Interpolation interpolation() const { return interpolation_; }
+    const std::vector<double>& times() const { return times_; }
     double start() const { return times_.front(); }
     double end() const { return times_.back(); }
 

@@ -72,7 +72,7 @@ class EmbreeScene {
     const Scene& scene() const { return scene_; }
     const Vec3d& origin() const { return origin_; }
 
-    // Spheres do not move (SceneAnimation does not animate them).
+    // Spheres do not move during a shutter: Build refuses a blur that would move one.
     Vec3 SphereCenter(int sphere) const { return sphere_centers_[size_t(sphere)]; }
     // Vertices of triangle `primitive` of `mesh` in render space at `time` (Ray::time).
     void Triangle(int mesh, int primitive, float time, Vec3* p0, Vec3* p1, Vec3* p2) const;

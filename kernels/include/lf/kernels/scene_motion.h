@@ -18,10 +18,12 @@ struct SceneMotion {
     bool Blurs() const { return animation && close > open && animation->Moves(); }
 };
 
-// Embree interpolates linearly between poses. 2 when every channel translates (a straight
-// line between keys is exact), else kCurvedMotionSteps, enough for rotations and deformations:
-// an object turning a quarter turn in the shutter strays from its arc by r (1 - cos(pi / 32)),
-// 0.5% of its radius. motion.steps when given. 1 when motion does not blur.
+// Embree interpolates linearly between poses. 2 when every channel is a translation on a
+// straight line at constant speed over the shutter (LINEAR or STEP keys, none inside it), so the
+// two poses are exact; else kCurvedMotionSteps, enough for rotations, deformations, keys inside
+// the shutter and CUBICSPLINE paths: an object turning a quarter turn in the shutter strays from
+// its arc by r (1 - cos(pi / 32)), 0.5% of its radius. motion.steps when given. 1 when motion
+// does not blur.
 inline constexpr int kCurvedMotionSteps = 9;
 int MotionSteps(const SceneMotion& motion);
 
