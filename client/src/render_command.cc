@@ -6,6 +6,7 @@
 #include "absl/strings/str_format.h"
 #include "lf/client/adaptive_flags.h"
 #include "lf/client/command.h"
+#include "lf/client/frame_flags.h"
 #include "lf/client/method_flags.h"
 #include "lf/client/output_flags.h"
 #include "lf/client/photon_flags.h"
@@ -26,15 +27,25 @@ int ReportError(const absl::Status& status) {
 
 namespace {
 
-// The bar starts with the sampling, as its elapsed time and estimate are the sampling's.
+// The bar starts with the sampling, as its elapsed time and estimate are the sampling's. A
+// shot has one such bar a frame and, below each, the shot's own.
 class BarProgress : public RenderProgress {
   public:
-    void Start() override { bar_.emplace("render"); }
+    void Start() override { bar_.emplace(label_); }
     void Update(size_t done, size_t total) override { bar_->Update(done, total); }
     void Finish() override { bar_->Finish(); }
+    void StartFrame(int index, int count, int frame) override {
+        if (!shot_) shot_.emplace("shot  ");
+        label_ = absl::StrFormat("frame %d", frame);
+    }
+    void FinishFrame(int done, int count) override {
+        shot_->Update(done, count);
+        shot_->Finish();
+    }
 
   private:
-    std::optional<ProgressBar> bar_;
+    std::string label_ = "render";
+    std::optional<ProgressBar> bar_, shot_;
 };
 
 RenderInterrupt render_interrupt;
@@ -53,6 +64,44 @@ extern "C" void OnInterrupt(int) {
 // The shell's status for a process ended by SIGINT.
 constexpr int kInterruptedStatus = 128 + SIGINT;
 
+// `render --frames`/`--frame`: a line a frame, then the shot's rate.
+int RunShot(const LocalRenderOptions& options, const ShotSettings& shot) {
+    std::signal(SIGINT, OnInterrupt);
+    absl::StatusOr<LocalShotSummary> summary = RunLocalShot(options, shot);
+    std::signal(SIGINT, SIG_DFL);
+    if (!summary.ok()) return ReportError(summary.status());
+    double pose = 0, bvh = 0, render = 0;
+    for (const LocalFrameSummary& f : summary->frames) {
+        const LocalRenderSummary& r = f.render;
+        // Radiosity solves with each BVH it builds.
+        const std::string built = f.bvh_seconds == 0 ? "reused"
+                                  : r.radiosity
+                                      ? absl::StrFormat("%.1f ms, radiosity %.2f s",
+                                                        1e3 * f.bvh_seconds, r.radiosity_seconds)
+                                      : absl::StrFormat("%.1f ms", 1e3 * f.bvh_seconds);
+        std::printf(
+            "frame %d (%.4f s): pose %.3f ms, BVH %s, render %.2f s, %.3f M samples/s -> %s\n",
+            f.frame, f.time, 1e3 * f.pose_seconds, built.c_str(), r.render_seconds,
+            r.stats.samples / r.render_seconds * 1e-6,
+            OutputNames({f.exr_path, f.png_path}).c_str());
+        pose += f.pose_seconds;
+        bvh += f.bvh_seconds;
+        render += r.render_seconds;
+    }
+    const size_t n = summary->frames.size();
+    std::printf(
+        "job %s: %s in %.2f s: %.2f frames per minute; mean per frame: pose %.3f ms, BVH %.1f "
+        "ms%s, render %.3f s\n",
+        summary->job_id.c_str(), Plural(int64_t(n), "frame").c_str(), summary->seconds,
+        60.0 * double(n) / summary->seconds, 1e3 * pose / double(n), 1e3 * bvh / double(n),
+        summary->moves ? "" : " (nothing moves: built once)", render / double(n));
+    if (!summary->partial.empty()) {
+        std::fprintf(stderr, "lightfarm: %s\n", summary->partial.c_str());
+        return kInterruptedStatus;
+    }
+    return 0;
+}
+
 }  // namespace
 
 Command AddRenderCommand(CLI::App& app) {
@@ -60,6 +109,7 @@ Command AddRenderCommand(CLI::App& app) {
     auto output = std::make_shared<OutputFlags>();
     auto no_progress = std::make_shared<bool>(false);
     auto method = std::make_shared<std::string>(defaults::kMethod);
+    auto frame_flags = std::make_shared<FrameFlags>();
     CLI::App* cmd = app.add_subcommand(
         "render",
         "Render a scene in this process to an OpenEXR image and/or a PNG preview, by path\n"
@@ -73,13 +123,22 @@ Command AddRenderCommand(CLI::App& app) {
         "Ctrl-C while path, whitted or radiosity's display sample stops them: the files get the\n"
         "whole passes done so far (each pixel the mean of its own samples, in spp), the header\n"
         "says lightfarm.partial, and the exit status is 130. A second Ctrl-C, or one during\n"
-        "loading, solving or a splatting method, ends it at once.");
+        "loading, solving or a splatting method, ends it at once.\n"
+        "--frames A-B[:STEP] renders an animated scene's frames (glTF animations, skins and\n"
+        "morph targets), frame f at f / --fps seconds, each to -o and --png with the frame number\n"
+        "in place of their run of # (out_####.exr -> out_0012.exr); --frame N renders one. The\n"
+        "scene loads once; the BVH and the method's kernel are built again only for frames where\n"
+        "something moved (radiosity solves each such frame). Each frame is the still that frame\n"
+        "gives alone (same seed, same bits), its header adds lightfarm.frame, .time, .fps and\n"
+        ".shutter. Ctrl-C while a frame samples writes that frame partial and ends the shot\n"
+        "(status 130).");
     cmd->add_option("scene", options->scene_path, "scene file (JSON, .gltf or .glb)")
         ->required()
         ->check(CLI::ExistingFile);
     AddSceneFlags(cmd, options->scene);
     AddSkyFlag(cmd, options->scene);
     AddOutputFlags(cmd, *output);
+    AddFrameFlags(cmd, *frame_flags);
     cmd->add_option("--spp", options->render.spp, "samples per pixel")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(1), kMaxSpp));
@@ -135,9 +194,11 @@ Command AddRenderCommand(CLI::App& app) {
         ->group(r);
 
     return {
-        cmd, [cmd, options, output, no_progress, method] {
+        cmd, [cmd, options, output, no_progress, method, frame_flags] {
             absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
             if (!paths.ok()) return ReportError(paths.status());
+            absl::StatusOr<ShotSettings> shot = ShotOfFrameFlags(*frame_flags);
+            if (!shot.ok()) return ReportError(shot.status());
             if (absl::Status s = ResolveSkyFile(options->scene_path, options->scene); !s.ok()) {
                 return ReportError(s);
             }
@@ -150,13 +211,21 @@ Command AddRenderCommand(CLI::App& app) {
             if (absl::Status s = CheckPhotonFlagsApply(*cmd, *method); !s.ok()) {
                 return ReportError(s);
             }
+            if (shot->frames) {
+                if (absl::Status s = CheckShotOutputs(*options, *shot->frames); !s.ok()) {
+                    return ReportError(s);
+                }
+            }
             for (const std::string* path : {&options->exr_path, &options->png_path}) {
-                if (absl::Status s = CheckWritable(*path); !s.ok()) return ReportError(s);
+                const std::string first =
+                    shot->frames ? FramePath(*path, shot->frames->first) : *path;
+                if (absl::Status s = CheckWritable(first); !s.ok()) return ReportError(s);
             }
             options->method = MethodOfFlag(*method);
             BarProgress bar;
             options->progress = *no_progress ? nullptr : &bar;
             options->interrupt = &render_interrupt;
+            if (shot->frames) return RunShot(*options, *shot);
             std::signal(SIGINT, OnInterrupt);
             absl::StatusOr<LocalRenderSummary> summary = RunLocalRender(*options);
             std::signal(SIGINT, SIG_DFL);

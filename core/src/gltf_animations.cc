@@ -47,6 +47,21 @@ bool GltfImporter::Animates() const {
     });
 }
 
+void GltfImporter::AnimationStep(const std::function<void()>& step) {
+    if (!animating_) return;
+    try {
+        step();
+    } catch (const GltfError& e) {
+        animating_ = false;
+        Warn(absl::StrCat("animation ignored: ", e.message));
+        // The first fault of a scene's files is the one its frames are refused with.
+        if (options_.animation_error->ok()) {
+            *options_.animation_error =
+                absl::InvalidArgumentError(absl::StrCat(name_, ": ", e.message));
+        }
+    }
+}
+
 void GltfImporter::ReadNodeTree() {
     SceneAnimation& animation = *options_.animation;
     const int n = int(model_.nodes.size());
@@ -138,10 +153,12 @@ void GltfImporter::ReadAnimations() {
             const absl::StatusOr<Interpolation> interpolation =
                 ParseInterpolation(sampler.interpolation, sampler_at);
             if (!interpolation.ok()) throw GltfError{std::string(interpolation.status().message())};
-            const std::vector<float> input = Floats(sampler.input, 1, sampler_at + ".input");
+            // Keyframes::Create checks the numbers, naming the key and its time.
+            const std::vector<float> input =
+                Floats(sampler.input, 1, sampler_at + ".input", /*any_value=*/true);
             std::vector<float> output;
             if (path_kind == AnimationChannel::Path::kWeights) {
-                output = Floats(sampler.output, 1, sampler_at + ".output");
+                output = Floats(sampler.output, 1, sampler_at + ".output", true);
                 const int targets =
                     node.mesh >= 0 && node.mesh < int(model_.meshes.size()) &&
                             !model_.meshes[size_t(node.mesh)].primitives.empty()
@@ -153,7 +170,7 @@ void GltfImporter::ReadAnimations() {
                 }
                 width = targets;
             } else {
-                output = Floats(sampler.output, width, sampler_at + ".output");
+                output = Floats(sampler.output, width, sampler_at + ".output", true);
             }
             absl::StatusOr<Keyframes> keys = Keyframes::Create(
                 *interpolation,
@@ -168,20 +185,15 @@ void GltfImporter::ReadAnimations() {
 }
 
 GltfImporter::Counts GltfImporter::CountObjects() const {
-    return {scene_.meshes.size(), cameras_.size(), scene_.point_lights.size(),
-            scene_.spot_lights.size(), scene_.directional_lights.size()};
+    return {cameras_.size(), scene_.point_lights.size(), scene_.spot_lights.size(),
+            scene_.directional_lights.size()};
 }
 
-void GltfImporter::AnimateNode(int index, const Counts& before, const std::string& where) {
+void GltfImporter::AnimateNode(int index, const Counts& before) {
     SceneAnimation& animation = *options_.animation;
     const int node = node_of_[size_t(index)];
     // A node on a cycle of children is not in the tree; the traversal refuses it next.
     if (node < 0) return;
-    for (size_t i = 0; i < added_primitives_.size() && before.meshes + i < scene_.meshes.size();
-         ++i) {
-        AnimateMesh(index, int(before.meshes + i), added_primitives_[i], where);
-    }
-    added_primitives_.clear();
     if (cameras_.size() > before.cameras) cameras_.back().node = node;
     if (!moving_[size_t(node)]) return;
     const auto light = [&](AnimatedLight::Kind kind, size_t was, size_t now) {

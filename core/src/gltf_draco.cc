@@ -61,8 +61,9 @@ bool MoveIndices(nlohmann::json& gltf) {
 }
 
 // The faces (and, for sequential connectivity, points) a Draco mesh bitstream declares, read
-// from its connectivity header before anything is decoded or allocated. Only for the bitstream
-// version every encoder since Draco 1.0 writes (2.2) without metadata; nullopt otherwise.
+// from its connectivity header before anything is decoded or allocated. Only for bitstream
+// version 2.2 (what current encoders write) without metadata; nullopt otherwise, and the counts
+// are compared once decoded.
 struct DeclaredCounts {
     uint32_t faces = 0;
     std::optional<uint32_t> points;  // edgebreaker meshes find theirs while decoding

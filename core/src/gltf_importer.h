@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -100,17 +101,23 @@ class GltfImporter {
     // Animations, skins and morph targets into options_.animation (gltf_animations.cc).
     // Whether the file has any (else the import collects nothing).
     bool Animates() const;
+    // Runs `step` of reading the animation while animating_. A fault in it (a GltfError) drops
+    // the file's animation but not the file: one warning ("animation ignored: ..."), the error
+    // in options_.animation_error, and no further steps.
+    void AnimationStep(const std::function<void()>& step);
     // Every node into the animation's tree, parents first, and every channel.
     void ReadNodeTree();
     void ReadAnimations();
     // How many scene objects there were before node `index` added its own.
     struct Counts {
-        size_t meshes, cameras, point_lights, spot_lights, directional_lights;
+        size_t cameras, point_lights, spot_lights, directional_lights;
     };
     Counts CountObjects() const;
-    // Records what node `index` added since `before`: its meshes' rest geometry, skins and
-    // morph targets, its camera's node, its lights when they move.
-    void AnimateNode(int index, const Counts& before, const std::string& where);
+    // Records what node `index` added since `before`: its camera's node, its lights when they
+    // move.
+    void AnimateNode(int index, const Counts& before);
+    // Records scene mesh `scene_mesh`, primitive `primitive` of node `node`'s mesh: its rest
+    // geometry, skin and morph targets. Called while decoded_ holds the primitive's Draco data.
     void AnimateMesh(int node, int scene_mesh, int primitive, const std::string& node_where);
     int Skin(int index, const std::string& node_where);
 
@@ -122,10 +129,14 @@ class GltfImporter {
     // Accessor `index`'s elements: decoded_'s when the primitive is Draco's, else the buffer's.
     AccessorData Accessor(int index, const std::string& where);
     // An attribute's elements as floats, `components` per element: FLOAT, or the normalized
-    // integer types glTF allows for texture coordinates and colours.
-    std::vector<float> Floats(int index, int components, const std::string& where);
+    // integer types glTF allows for texture coordinates and colours. Not finite values are
+    // refused unless `any_value` (animation samplers: Keyframes::Create names their key).
+    std::vector<float> Floats(int index, int components, const std::string& where,
+                              bool any_value = false);
     std::vector<uint32_t> Indices(int index, size_t vertices, const std::string& where);
-    void AddMesh(int index, const Affine& world, const std::string& node_where);
+    // Node `node`'s mesh, one scene mesh per triangle primitive, each recorded for the
+    // animation when the import collects one.
+    void AddMesh(int node, const Affine& world, const std::string& node_where);
     // Decodes a KHR_draco_mesh_compression primitive into decoded_ (gltf_draco.cc); returns
     // its indices accessor.
     int DecodeDraco(const tinygltf::Primitive& primitive, const tinygltf::Value& draco,
@@ -171,14 +182,15 @@ class GltfImporter {
     };
     std::map<std::string, Tallied> tallies_;
     std::vector<bool> visited_;
-    // The primitives AddMesh made scene meshes of, in order.
-    std::vector<int> added_primitives_;
+    // Whether the import collects the file's animation (it has one and nothing failed yet).
+    bool animating_ = false;
     // Animation: each glTF node's and skin's index in options_.animation (-1: none).
     std::vector<int> node_of_;
     std::map<int, int> skin_of_;
     std::vector<bool> moving_;  // SceneAnimation::MovingNodes once the channels are read
     std::map<int, int> material_of_, texture_of_;
-    // The current primitive's Draco-decoded accessors, by accessor index.
+    // The current primitive's Draco-decoded accessors, by accessor index: AddMesh records each
+    // primitive for the animation (AnimateMesh) before it decodes the next.
     struct Decoded {
         std::vector<unsigned char> bytes;
         AccessorData data;

@@ -123,7 +123,8 @@ AccessorData GltfImporter::Accessor(int index, const std::string& where) {
     return d;
 }
 
-std::vector<float> GltfImporter::Floats(int index, int components, const std::string& where) {
+std::vector<float> GltfImporter::Floats(int index, int components, const std::string& where,
+                                        bool any_value) {
     const AccessorData d = Accessor(index, where);
     if (d.components != components) {
         Fail(where, absl::StrCat("accessors[", index, "] has ", d.components,
@@ -168,7 +169,7 @@ std::vector<float> GltfImporter::Floats(int index, int components, const std::st
                                              ComponentTypeName(d.component_type),
                                              ", which glTF does not allow here"));
             }
-            if (!std::isfinite(v)) {
+            if (!any_value && !std::isfinite(v)) {
                 Fail(where, absl::StrCat("accessors[", index, "] element ", i, " component ", c,
                                          " is ", v));
             }
@@ -211,14 +212,16 @@ std::vector<uint32_t> GltfImporter::Indices(int index, size_t vertices, const st
     return out;
 }
 
-void GltfImporter::AddMesh(int index, const Affine& world, const std::string& node_where) {
+void GltfImporter::AddMesh(int node, const Affine& world, const std::string& node_where) {
+    const int index = model_.nodes[size_t(node)].mesh;
+    // A node on a cycle of children is not in the animation's tree; the traversal refuses it.
+    const bool in_tree = animating_ && node_of_[size_t(node)] >= 0;
     if (index >= int(model_.meshes.size())) {
         Fail(node_where, absl::StrCat("mesh ", index, " does not exist"));
     }
     const tinygltf::Mesh& mesh = model_.meshes[size_t(index)];
     const Affine normal_matrix = world.NormalMatrix();
     const double det = world.Determinant();
-    added_primitives_.clear();
     if (!(std::abs(det) > 0)) Fail(node_where, "its transform is singular (flattens the mesh)");
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
         const tinygltf::Primitive& prim = mesh.primitives[p];
@@ -228,7 +231,6 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
             Fail(where, absl::StrCat("mode ", prim.mode, " (", ModeName(prim.mode),
                                      ") is not supported; only triangles (mode 4)"));
         }
-        if (!prim.targets.empty()) Tally("morph targets ignored", "primitive", where);
         const auto attribute = [&](const char* key) {
             const auto found = prim.attributes.find(key);
             return found == prim.attributes.end() ? -1 : found->second;
@@ -341,7 +343,10 @@ void GltfImporter::AddMesh(int index, const Affine& world, const std::string& no
             continue;
         }
         scene_.meshes.push_back(std::move(out));
-        added_primitives_.push_back(int(p));
+        if (in_tree) {
+            AnimationStep(
+                [&] { AnimateMesh(node, int(scene_.meshes.size()) - 1, int(p), node_where); });
+        }
     }
 }
 

@@ -99,12 +99,6 @@ Affine LocalTransform(const tinygltf::Node& node, const std::string& where) {
 
 void GltfImporter::Import() {
     CheckExtensions();
-    if (!model_.animations.empty()) {
-        Warn(absl::StrCat(model_.animations.size(),
-                          " animations ignored: the rest pose is "
-                          "rendered"));
-    }
-    if (!model_.skins.empty()) Warn("skins ignored: meshes are rendered unskinned");
     if (model_.scenes.empty()) Fail("scenes", "the file has no scene");
     int index = model_.defaultScene;
     if (index < 0) index = 0;
@@ -119,11 +113,12 @@ void GltfImporter::Import() {
     // Every material, in file order, so scene material i is glTF material i (after those
     // already in the scene); the default material only when a primitive needs it.
     for (int i = 0; i < int(model_.materials.size()); ++i) Material(i, "materials");
-    if (options_.animation && Animates()) {
+    animating_ = options_.animation && Animates();
+    AnimationStep([&] {
         ReadNodeTree();
         ReadAnimations();
         moving_ = options_.animation->MovingNodes();
-    }
+    });
     visited_.assign(model_.nodes.size(), false);
     const tinygltf::Scene& gltf_scene = model_.scenes[size_t(index)];
     for (size_t i = 0; i < gltf_scene.nodes.size(); ++i) {
@@ -182,13 +177,13 @@ void GltfImporter::VisitNode(int index, const Affine& parent, const std::string&
                                  origin.z, ") is beyond ±", kMaxCoordinate));
     }
     const Counts before = CountObjects();
-    if (node.mesh >= 0) AddMesh(node.mesh, world, where);
+    if (node.mesh >= 0) AddMesh(index, world, where);
     if (node.camera >= 0) AddCamera(node, world, where);
     if (const auto light = node.extensions.find("KHR_lights_punctual");
         light != node.extensions.end()) {
         AddLight(light->second.Get("light"), world, where);
     }
-    if (options_.animation && !node_of_.empty()) AnimateNode(index, before, where);
+    if (animating_) AnimateNode(index, before);
     for (size_t i = 0; i < node.children.size(); ++i) {
         VisitNode(node.children[i], world, absl::StrCat(where, ".children[", i, "]"));
     }

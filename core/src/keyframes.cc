@@ -67,8 +67,8 @@ absl::StatusOr<Keyframes> Keyframes::Create(Interpolation interpolation, Keyfram
     }
     for (size_t i = 0; i < values.size(); ++i) {
         if (!std::isfinite(values[i])) {
-            return fail(absl::StrCat("output keyframe ", i / per_key, " number ", i % per_key,
-                                     " is ", values[i]));
+            return fail(absl::StrCat("output keyframe ", i / per_key, " (at ", times[i / per_key],
+                                     " s) number ", i % per_key, " is ", values[i]));
         }
     }
     Keyframes out;
@@ -82,7 +82,8 @@ absl::StatusOr<Keyframes> Keyframes::Create(Interpolation interpolation, Keyfram
         for (size_t k = 0; k < out.times_.size(); ++k) {
             const double* q = out.Value(k);
             if (!(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] > 0)) {
-                return fail(absl::StrCat("output keyframe ", k, " is the zero quaternion"));
+                return fail(absl::StrCat("output keyframe ", k, " (at ", out.times_[k],
+                                         " s) is the zero quaternion"));
             }
         }
     }

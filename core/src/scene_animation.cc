@@ -193,6 +193,21 @@ absl::Status SceneAnimation::PoseAt(double seconds, Scene& scene) const {
             return s;
         }
     }
+    for (const AnimatedSphere& s : spheres) {
+        const Affine& w = world[size_t(s.node)];
+        Sphere& sphere = scene.spheres[size_t(s.sphere)];
+        sphere.center = w.Apply(s.center);
+        sphere.radius = s.radius * std::cbrt(std::abs(w.Determinant()));
+        if (!InRange(sphere.center)) {
+            return absl::InvalidArgumentError(absl::StrCat(at(s.node), ": sphere \"", sphere.name,
+                                                           "\" centre ", Beyond(sphere.center)));
+        }
+        if (!(sphere.radius > 0 && sphere.radius <= kMaxCoordinate)) {
+            return absl::InvalidArgumentError(absl::StrCat(at(s.node), ": sphere \"", sphere.name,
+                                                           "\" radius ", sphere.radius,
+                                                           " is not in (0, 1e15]"));
+        }
+    }
     for (const AnimatedLight& light : lights) {
         const Affine& w = world[size_t(light.node)];
         const Vec3d position = w.Apply(Vec3d(0, 0, 0));
@@ -247,6 +262,8 @@ bool SceneAnimation::Moves() const {
     return (camera_node >= 0 && MovingNodes()[size_t(camera_node)]) ||
            std::any_of(meshes.begin(), meshes.end(),
                        [](const AnimatedMesh& m) { return m.moves; }) ||
+           std::any_of(spheres.begin(), spheres.end(),
+                       [](const AnimatedSphere& s) { return s.moves; }) ||
            std::any_of(lights.begin(), lights.end(),
                        [](const AnimatedLight& l) { return l.moves; });
 }

@@ -9,7 +9,7 @@ namespace lf::scene_internal {
 
 CameraSpec SceneParser::ParseCamera(const Node& n) {
     n.ExpectObject({"type", "position", "look_at", "up", "fov_y_deg", "half_height", "resolution",
-                    "aperture_radius", "focus_distance", "filter"});
+                    "aperture_radius", "focus_distance", "filter", "transform"});
     CameraSpec camera;
     if (const std::optional<Node> type = n.Find("type")) {
         if (type->String() == "orthographic") {
@@ -71,6 +71,25 @@ CameraSpec SceneParser::ParseCamera(const Node& n) {
         if (camera.focus_distance == 0) focus->Fail("must be above 0 (scene units)");
     }
     if (const std::optional<Node> filter = n.Find("filter")) camera.filter = ParseFilter(*filter);
+    if (const std::optional<Node> transform = n.Find("transform")) {
+        const PlacedTransform placed = ParseAnyTransform(*transform, Scaling::kNone, "camera");
+        if (placed.node >= 0) {
+            // A child node holds the camera as glTF places one (looking down its -Z, +Y up),
+            // so PoseAt moves it as it moves a glTF camera.
+            const Vec3d f = Normalize(camera.look_at - camera.position);
+            const Vec3d r = Normalize(Cross(f, camera.up)), u = Cross(r, f);
+            AnimationNode node;
+            node.where = "camera";
+            node.parent = placed.node;
+            node.has_matrix = true;
+            for (int i = 0; i < 3; ++i) node.matrix.m[i] = {r[i], u[i], -f[i], camera.position[i]};
+            json_camera_node_ = int(animation_.nodes.size());
+            animation_.nodes.push_back(node);
+        }
+        camera.position = placed.rest.Apply(camera.position);
+        camera.look_at = placed.rest.Apply(camera.look_at);
+        camera.up = placed.rest.ApplyLinear(camera.up);
+    }
     return camera;
 }
 

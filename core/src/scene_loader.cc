@@ -98,7 +98,10 @@ Scene SceneParser::Finish(Scene& scene) {
         warnings_.push_back("no emissive shape and no light: the image will be black");
     }
     scene.dropped_degenerate = dropped_degenerate_;
-    if (!animation_.Empty()) scene.animation = std::make_shared<const SceneAnimation>(animation_);
+    scene.animation_error = animation_error_;
+    if (animation_error_.ok() && !animation_.Empty()) {
+        scene.animation = std::make_shared<const SceneAnimation>(animation_);
+    }
     scene.content_hash = hash_.Hex();
     return std::move(scene);
 }
@@ -121,7 +124,10 @@ void SceneParser::ResolveCamera(const Node& root, bool json_camera, Scene& scene
         scene.camera = FrameScene(scene);
         return;
     }
-    if (json_camera && options_.camera.empty()) return;
+    if (json_camera && options_.camera.empty()) {
+        animation_.camera_node = json_camera_node_;
+        return;
+    }
     if (!json_camera && gltf_cameras_.empty()) {
         root.Fail("missing required key \"camera\" (no included glTF has a camera)");
     }

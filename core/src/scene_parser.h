@@ -1,8 +1,10 @@
 // SceneParser: a JSON scene, or a glTF file as a whole scene, into the scene model. Its members
 // are defined by concept: scene_loader.cc (the whole scene), scene_camera.cc, scene_materials.cc,
-// scene_shapes.cc and scene_lights.cc (lights and photometric units). Private to core.
+// scene_shapes.cc, scene_keyframes.cc (keyframed transforms) and scene_lights.cc (lights and
+// photometric units). Private to core.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <initializer_list>
 #include <map>
@@ -97,9 +99,30 @@ class SceneParser {
 
     // Shapes and included files (scene_shapes.cc).
     void ParseShape(const Node& n, Scene& scene);
-    // A mesh file's meshes: with `material_index` (>= 0) one mesh of that material, otherwise
-    // one per material of the file (an OBJ's MTL files), those materials added to the scene.
+    // A fixed `transform`: {"scale", "rotate", "translate"} or {"matrix"}.
+    static Affine ParseTransform(const Node& n);
+    // `rotate`, {"axis": [x, y, z], "angle_deg": a}, as a unit quaternion (x, y, z, w):
+    // counter-clockwise looking down the axis at the origin (right-hand rule).
+    static std::array<double, 4> ParseRotation(const Node& rotate);
+    // A mesh file's meshes, in the file's coordinates: with `material_index` (>= 0) one mesh
+    // of that material, otherwise one per material of the file (an OBJ's MTL files), those
+    // materials added to the scene.
     std::vector<TriangleMesh> LoadMeshShape(const Node& n, int material_index, Scene& scene);
+
+    // Keyframed transforms (scene_keyframes.cc).
+    // What a transform may do to the object it places: spheres stay spheres, cameras keep
+    // their lens.
+    enum class Scaling { kAny, kUniform, kNone };
+    // A `transform`, fixed or keyframed ({"keyframes": [...], "interpolation": ...}): where
+    // the object is in a still (`rest`: a keyframed transform's first keyframe) and, when
+    // keyframed, the animation node it became (`node`, else -1), named `where` in messages.
+    struct PlacedTransform {
+        Affine rest;
+        int node = -1;
+    };
+    PlacedTransform ParseAnyTransform(const Node& n, Scaling scaling, const std::string& where);
+    // The node of a keyframed transform `n`, its channels, and its first keyframe's transform.
+    PlacedTransform ParseKeyframes(const Node& n, Scaling scaling, const std::string& where);
     // A mesh file's materials join the scene's, their textures its textures; the meshes'
     // material indices become the scene's.
     CachedMeshFile AddFileMaterials(MeshFile file, const std::string& where, Scene& scene);
@@ -151,8 +174,12 @@ class SceneParser {
     const SceneFileReader& read_file_;
     const SceneOptions& options_;
     std::vector<GltfCamera> gltf_cameras_;
-    // Every included glTF's animations, skins and morphs; the Scene gets it unless it is empty.
+    // The node placing the JSON camera when it has keyframes; -1: it stays.
+    int json_camera_node_ = -1;
+    // Every included glTF's animations, skins and morphs; the Scene gets it unless it is empty
+    // or a file's animation data is malformed (animation_error_, the first such fault).
     SceneAnimation animation_;
+    absl::Status animation_error_;
     std::vector<std::string> warnings_;
     std::map<std::string, int> material_index_;
     // power_lm emitters, resolved once every shape is loaded.

@@ -22,7 +22,20 @@ bool WithinCoordinateRange(const Vec3d& p) {
            std::abs(p.z) <= kMaxCoordinate;
 }
 
-Affine ParseTransform(const Node& n) {
+}  // namespace
+
+std::array<double, 4> SceneParser::ParseRotation(const Node& rotate) {
+    rotate.ExpectObject({"axis", "angle_deg"});
+    const Node axis_node = rotate.Get("axis");
+    const Vec3d axis = axis_node.Vector();
+    if (LengthSquared(axis) == 0) axis_node.Fail("must not be zero");
+    const Vec3d a = Normalize(axis);
+    const double half = rotate.Get("angle_deg").Number() * std::numbers::pi / 360;
+    const double s = std::sin(half);
+    return {a.x * s, a.y * s, a.z * s, std::cos(half)};
+}
+
+Affine SceneParser::ParseTransform(const Node& n) {
     n.ExpectObject({"scale", "rotate", "translate", "matrix"});
     Affine transform;
     if (const std::optional<Node> matrix = n.Find("matrix")) {
@@ -43,18 +56,8 @@ Affine ParseTransform(const Node& n) {
         for (int a = 0; a < 3; ++a) transform.m[a][a] = s[a];
     }
     if (const std::optional<Node> rotate = n.Find("rotate")) {
-        rotate->ExpectObject({"axis", "angle_deg"});
-        const Node axis_node = rotate->Get("axis");
-        const Vec3d axis = axis_node.Vector();
-        if (LengthSquared(axis) == 0) axis_node.Fail("must not be zero");
-        const Vec3d a = Normalize(axis);
-        const double angle = rotate->Get("angle_deg").Number() * std::numbers::pi / 180;
-        const double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
-        Affine rotation;  // Rodrigues: counter-clockwise looking down the axis at the origin
-        rotation.m = {{{t * a.x * a.x + c, t * a.x * a.y - s * a.z, t * a.x * a.z + s * a.y, 0},
-                       {t * a.x * a.y + s * a.z, t * a.y * a.y + c, t * a.y * a.z - s * a.x, 0},
-                       {t * a.x * a.z - s * a.y, t * a.y * a.z + s * a.x, t * a.z * a.z + c, 0}}};
-        transform = transform.Then(rotation);
+        transform =
+            transform.Then(Affine::FromTrs(Vec3d(0, 0, 0), ParseRotation(*rotate), Vec3d(1, 1, 1)));
     }
     if (const std::optional<Node> translate = n.Find("translate")) {
         const Vec3d t = translate->Vector();
@@ -67,6 +70,8 @@ Affine ParseTransform(const Node& n) {
     }
     return transform;
 }
+
+namespace {
 
 // Drops triangles with repeated vertices or (near) zero area; returns how many.
 int DropDegenerate(TriangleMesh& mesh) {
@@ -111,14 +116,36 @@ void SceneParser::ParseShape(const Node& n, Scene& scene) {
         material_index = found->second;
     }
     const std::string name = n.Has("name") ? n.Get("name").String() : n.path();
+    // Keyframed, the shape is a node of the animation, its geometry kept in its own space.
+    const std::optional<Node> transform_node = n.Find("transform");
+    const PlacedTransform placed =
+        transform_node
+            ? ParseAnyTransform(
+                  *transform_node, type_name == "sphere" ? Scaling::kUniform : Scaling::kAny,
+                  n.Has("name") ? absl::StrCat(n.path(), " \"", name, "\"") : n.path())
+            : PlacedTransform{};
+    const bool moves =
+        std::any_of(animation_.channels.begin(), animation_.channels.end(),
+                    [&](const AnimationChannel& c) { return c.node == placed.node; });
 
     if (type_name == "sphere") {
-        n.WarnUnknownKeys({"type", "material", "name", "center", "radius"});
+        n.WarnUnknownKeys({"type", "material", "name", "center", "radius", "transform"});
         Sphere sphere{name, material_index, n.Get("center").Vector(), 0};
         const Node radius = n.Get("radius");
         sphere.radius = radius.Number();
         if (!(sphere.radius > 0 && sphere.radius <= kMaxCoordinate)) {
             radius.Fail(absl::StrCat("must be in (0, 1e15], got ", sphere.radius));
+        }
+        if (placed.node >= 0) {
+            animation_.spheres.push_back(
+                {int(scene.spheres.size()), placed.node, sphere.center, sphere.radius, moves});
+        }
+        sphere.center = placed.rest.Apply(sphere.center);
+        sphere.radius *= std::cbrt(std::abs(placed.rest.Determinant()));
+        if (!WithinCoordinateRange(sphere.center) || !(sphere.radius <= kMaxCoordinate)) {
+            n.Fail(absl::StrCat("after the transform the centre (", sphere.center.x, ", ",
+                                sphere.center.y, ", ", sphere.center.z, ") or the radius ",
+                                sphere.radius, " lies beyond 1e15"));
         }
         scene.spheres.push_back(sphere);
         return;
@@ -126,7 +153,7 @@ void SceneParser::ParseShape(const Node& n, Scene& scene) {
 
     std::vector<TriangleMesh> meshes;
     if (type_name == "quad" || type_name == "triangle") {
-        n.WarnUnknownKeys({"type", "material", "name", "vertices"});
+        n.WarnUnknownKeys({"type", "material", "name", "vertices", "transform"});
         const bool quad = type_name == "quad";
         TriangleMesh& mesh = meshes.emplace_back();
         for (const Node& v : n.Get("vertices").Elements(quad ? 4 : 3)) {
@@ -150,12 +177,31 @@ void SceneParser::ParseShape(const Node& n, Scene& scene) {
         mesh.name = meshes.size() == 1
                         ? name
                         : absl::StrCat(name, " (", scene.materials[mesh.material].name, ")");
+        AnimatedMesh own;  // the geometry in the shape's space, for a keyframed transform
+        if (placed.node >= 0) {
+            own.positions = mesh.positions;
+            for (const Vec3& normal : mesh.normals) own.normals.emplace_back(normal);
+        }
+        if (transform_node) TransformMesh(placed.rest, mesh);
+        for (const Vec3d& p : mesh.positions) {
+            if (!WithinCoordinateRange(p)) {
+                n.Fail(absl::StrCat("a vertex of \"", mesh.name, "\" lies beyond ±1e15",
+                                    transform_node ? " after the transform" : "", ": (", p.x, ", ",
+                                    p.y, ", ", p.z, ")"));
+            }
+        }
         const int dropped = DropDegenerate(mesh);
         dropped_degenerate_ += dropped;
         if (mesh.triangles.empty()) continue;
         // Radiosity grids an is_quad mesh between its four corners, which no longer holds
         // once a triangle is gone.
         if (dropped > 0) mesh.is_quad = false;
+        if (placed.node >= 0) {
+            own.mesh = int(scene.meshes.size());
+            own.node = placed.node;
+            own.moves = moves;
+            animation_.meshes.push_back(std::move(own));
+        }
         scene.meshes.push_back(std::move(mesh));
         kept = true;
     }
@@ -213,19 +259,6 @@ std::vector<TriangleMesh> SceneParser::LoadMeshShape(const Node& n, int material
     }
     std::vector<TriangleMesh> meshes = cached->second.meshes;
     if (!own_materials) meshes[0].material = material_index;
-
-    const std::optional<Node> transform_node = n.Find("transform");
-    const Affine transform = transform_node ? ParseTransform(*transform_node) : Affine();
-    for (TriangleMesh& mesh : meshes) {
-        if (transform_node) TransformMesh(transform, mesh);
-        for (const Vec3d& p : mesh.positions) {
-            if (!WithinCoordinateRange(p)) {
-                n.Fail(absl::StrCat("a vertex of ", name, " lies beyond ±1e15",
-                                    n.Has("transform") ? " after the transform" : "", ": (", p.x,
-                                    ", ", p.y, ", ", p.z, ")"));
-            }
-        }
-    }
     return meshes;
 }
 
@@ -260,9 +293,9 @@ void SceneParser::ImportGltf(const std::string& bytes, const std::string& name,
     };
     const size_t first_mesh = scene.meshes.size();
     std::vector<std::string> warnings;
-    const absl::Status status =
-        AppendGltf(bytes, name, hashing_reader, {base_dir, transform, &animation_}, scene,
-                   gltf_cameras_, warnings);
+    const absl::Status status = AppendGltf(bytes, name, hashing_reader,
+                                           {base_dir, transform, &animation_, &animation_error_},
+                                           scene, gltf_cameras_, warnings);
     for (const std::string& w : warnings) {
         warnings_.push_back(included ? absl::StrCat(name, ": ", w) : w);
     }
@@ -292,6 +325,10 @@ void SceneParser::ParseGltfShape(const Node& n, Scene& scene) {
     const Node file = n.Get("file");
     const std::string name = file.String();
     if (name.empty()) file.Fail("empty file name");
+    const std::optional<Node> transform = n.Find("transform");
+    if (transform && transform->Has("keyframes")) {
+        transform->Fail("a glTF's transform is fixed; animate its nodes in the glTF itself");
+    }
     auto fail = [&](const absl::Status& status) {
         throw LoadError{absl::Status(
             status.code(), absl::StrCat(file.path(), " \"", name, "\": ", status.message()))};
@@ -299,7 +336,6 @@ void SceneParser::ParseGltfShape(const Node& n, Scene& scene) {
     absl::StatusOr<std::string> bytes = read_file_(name);
     if (!bytes.ok()) fail(bytes.status());
     hash_.Update(*bytes);
-    const std::optional<Node> transform = n.Find("transform");
     ImportGltf(*bytes, name, std::filesystem::path(name).parent_path().string(),
                transform ? ParseTransform(*transform) : Affine(), scene, fail, true);
 }

@@ -53,12 +53,7 @@ absl::Status CheckMethodSettings(const JobSpec& spec) {
             "adaptive: method \"", spec.method,
             "\" has no adaptive sampling (no target error or time limit); set spp instead"));
     }
-    if (spec.shot.shutter > 0 && !Info(*method).motion_blur) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "shutter: method \"", spec.method,
-            "\" solves one instant per frame and renders no motion blur; set shutter 0"));
-    }
-    return absl::OkStatus();
+    return CheckShutterOfMethod(*method, spec.shot.shutter);
 }
 
 }  // namespace
@@ -125,6 +120,13 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         }
     }
     return absl::OkStatus();
+}
+
+absl::Status CheckShutterOfMethod(Method method, double shutter) {
+    if (shutter <= 0 || Info(method).motion_blur) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat("shutter: method \"", MethodName(method),
+                     "\" solves one instant per frame and renders no motion blur; set shutter 0"));
 }
 
 JobSpec FrameSpec(const JobSpec& spec, int frame) {

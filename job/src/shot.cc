@@ -91,9 +91,9 @@ absl::Status CheckShotSettings(const ShotSettings& shot) {
             return s;
         }
     }
-    if (!(shot.fps > 0 && shot.fps <= kMaxFps)) {
+    if (!(shot.fps >= kMinFps && shot.fps <= kMaxFps)) {
         return absl::InvalidArgumentError(
-            absl::StrCat("fps ", shot.fps, ": expected above 0, at most ", kMaxFps));
+            absl::StrCat("fps ", shot.fps, ": expected ", kMinFps, " to ", kMaxFps));
     }
     if (!(shot.shutter >= 0 && shot.shutter <= kMaxShutter)) {
         return absl::InvalidArgumentError(absl::StrCat(

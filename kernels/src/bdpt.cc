@@ -64,6 +64,8 @@ struct BdptVertex {
 
 namespace {
 
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
 // pbrt's remap of zero densities in the MIS recursion (those that no strategy samples, such as
 // a camera or light endpoint's reverse density; delta lobes have their own, see Walk).
 float Remap0(float f) { return f != 0 ? f : 1; }
@@ -128,7 +130,7 @@ float BdptRenderer::PdfLight(const BdptVertex& v, const BdptVertex& next) const 
     const float dist2 = LengthSquared(d);
     if (!(dist2 > 0)) return 0;
     const Vec3 w = d / std::sqrt(dist2);
-    float pdf = emission_.PdfLe(v.light, v.p, v.ng, w).dir / dist2;
+    float pdf = emission_.PdfLe(v.light, v.p, v.ng, w, v.point.time).dir / dist2;
     if (next.on_surface) pdf *= std::abs(Dot(next.ng, w));
     return pdf;
 }
@@ -141,7 +143,7 @@ float BdptRenderer::PdfLightOrigin(const BdptVertex& v, const BdptVertex& next) 
     }
     if (v.light < 0) return 0;
     const Vec3 w = DirectionTo(v, next);
-    return emission_.Pmf(v.light) * emission_.PdfLe(v.light, v.p, v.ng, w).pos;
+    return emission_.Pmf(v.light) * emission_.PdfLe(v.light, v.p, v.ng, w, v.point.time).pos;
 }
 
 float BdptRenderer::NeeRatio(const BdptVertex& v, const BdptVertex& ref) const {
@@ -156,6 +158,7 @@ float BdptRenderer::NeeRatio(const BdptVertex& v, const BdptVertex& ref) const {
     hit.mesh = v.mesh;
     hit.primitive = v.primitive;
     hit.sphere = v.sphere;
+    hit.time = v.point.time;
     if (hit.mesh < 0 && hit.sphere < 0) return 1;
     const Vec3 d = v.p - ref.p;
     const float dist2 = LengthSquared(d);
@@ -170,7 +173,7 @@ float BdptRenderer::PdfTo(const BdptVertex& v, const BdptVertex* prev,
     const Vec3 wn = DirectionTo(v, next);
     float pdf = 0;
     if (v.type == BdptVertex::Type::kCamera) {
-        pdf = camera_.PdfWe(Ray{v.p, wn}).dir;
+        pdf = camera_.PdfWe(Ray{v.p, wn, kInfinity, v.point.time}).dir;
     } else {
         if (prev == nullptr) return 0;
         const Vec3 wp = DirectionTo(v, *prev);
@@ -332,9 +335,9 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
     }
 }
 
-void BdptRenderer::LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_dir,
+void BdptRenderer::LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_dir, float time,
                                 Sampler& sampler, Path& path, RenderStats& stats) const {
-    const std::optional<EmissionSample> es = emission_.Sample(u_pick, u_pos, u_dir);
+    const std::optional<EmissionSample> es = emission_.Sample(u_pick, u_pos, u_dir, time);
     if (!es) return;
     BdptVertex v;
     v.type = BdptVertex::Type::kLight;
@@ -451,12 +454,13 @@ Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
         BdptVertex& qs = light[size_t(s - 1)];
         if (qs.type != Type::kSurface || !qs.IsConnectible()) return Rgb(0);
         const std::optional<Camera::ImportanceSample> cs =
-            camera_.SampleWi(qs.p, camera_.HasLens() ? qs.u_conn : Vec2{});
+            camera_.SampleWi(qs.p, camera_.HasLens() ? qs.u_conn : Vec2{}, qs.point.time);
         if (!cs || !(cs->pdf > 0)) return Rgb(0);
         BdptVertex sampled;
         sampled.type = Type::kCamera;
         sampled.p = cs->lens_point;
         sampled.point.p = cs->lens_point;
+        sampled.point.time = qs.point.time;
         sampled.beta = Rgb(cs->we / cs->pdf);
         L = qs.beta * FCos(qs, cs->wi, true) * sampled.beta;
         if (L.IsBlack()) return L;
@@ -470,7 +474,8 @@ Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
     }
     if (s == 1) {
         if (pt.type != Type::kSurface || !pt.IsConnectible()) return Rgb(0);
-        const std::optional<LightSample> ls = lights_.Sample(pt.p, pt.ns, pt.u_pick, pt.u_conn);
+        const std::optional<LightSample> ls =
+            lights_.Sample(pt.p, pt.ns, pt.u_pick, pt.u_conn, pt.point.time);
         if (!ls || !(ls->pdf > 0)) return Rgb(0);
         BdptVertex sampled;
         sampled.type = Type::kLight;
@@ -527,18 +532,21 @@ Rgb BdptRenderer::Sample(int x, int y, uint64_t sample_index, SplatList& splats,
     const Vec2 lens = camera_.HasLens() ? sampler.Get2D() : Vec2{};
     const float u_pick = sampler.Get1D();
     const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
+    // Both subpaths at one time in the shutter: every connection joins the same instant.
+    const float time = sampler.GetTime();
 
-    const Ray ray = camera_.GenerateRay(x, y, film.x, film.y, lens);
+    const Ray ray = camera_.GenerateRay(x, y, film.x, film.y, lens, time);
     BdptVertex cv;
     cv.type = BdptVertex::Type::kCamera;
     cv.p = ray.o;
     cv.point.p = ray.o;
+    cv.point.time = time;
     cv.beta = Rgb(1);
     camera.push_back(cv);
-    const Camera::ImportancePdf pdf = camera_.PdfWe(Ray{ray.o, Normalize(ray.d)});
+    const Camera::ImportancePdf pdf = camera_.PdfWe(Ray{ray.o, Normalize(ray.d), kInfinity, time});
     const int max_depth = settings_.max_depth < 0 ? kBdptUnlimitedDepth : settings_.max_depth;
     Walk(ray, Rgb(1), pdf.dir, max_depth + 1, false, sampler, camera, stats);
-    LightSubpath(u_pick, u_pos, u_dir, sampler, light, stats);
+    LightSubpath(u_pick, u_pos, u_dir, time, sampler, light, stats);
 
     const int nc = int(camera.size()), nl = int(light.size());
     if (nl >= 2) light[0].nee_ratio = NeeRatio(light[0], light[1]);

@@ -156,7 +156,7 @@ SurfacePoint RayPointOf(const EmbreeScene& scene, const PatchMesh& mesh, const S
                         const std::array<double, 3>& w) {
     const PatchMesh::Patch& patch = mesh.patches()[size_t(g.patch)];
     const auto [b1, b2] = mesh.TriangleBarycentrics(g.patch, w);
-    return scene.TrianglePoint(patch.mesh, patch.primitive, float(b1), float(b2));
+    return scene.TrianglePoint(patch.mesh, patch.primitive, float(b1), float(b2), 0);
 }
 
 std::vector<SideGeometry> SideGeometries(const EmbreeScene& scene, const PatchMesh& mesh) {

@@ -57,8 +57,7 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
         const SpotLight& spot = scene.spot_lights[i];
         // The cone sizes as LightSampler clamps them, so both see one falloff.
         const SpotBand band = SpotBandOf(spot);
-        spots_.push_back({Vec3(spot.position - es.origin()), Vec3(Normalize(spot.direction)),
-                          float(band.outer), float(1 / band.width),
+        spots_.push_back({float(band.outer), float(1 / band.width),
                           spot.falloff == SpotLight::Falloff::kSmoothstep, spot.intensity});
         spot_light_.push_back(int(lights_.size()));
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
@@ -93,16 +92,16 @@ EmissionSampler::EmissionSampler(const EmbreeScene& es) : scene_(es) {
     picks_ = LightPickTable::FromWeights(weights);
 }
 
-SurfacePoint EmissionSampler::AreaPoint(const Light& light, const Vec2& u) const {
+SurfacePoint EmissionSampler::AreaPoint(const Light& light, const Vec2& u, float time) const {
     if (light.kind == Kind::kTriangle) {
         // Uniform on the triangle (Osada et al.'s square-root parameterisation).
         const float su = std::sqrt(u.x);
-        return scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y);
+        return scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y, time);
     }
     const float z = 1 - 2 * u.x;
     const float r = std::sqrt(std::max(0.0f, 1 - z * z));
     const float phi = 2 * kPi * u.y;
-    return scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z));
+    return scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z), time);
 }
 
 Rgb EmissionSampler::AreaEmission(const Light& light, const SurfacePoint& point) const {
@@ -114,7 +113,7 @@ Rgb EmissionSampler::AreaEmission(const Light& light, const SurfacePoint& point)
 }
 
 std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& u_pos,
-                                                      const Vec2& u_dir) const {
+                                                      const Vec2& u_dir, float time) const {
     if (lights_.empty()) return std::nullopt;
     const int li = picks_.Pick(u_pick);
     EmissionSample es;
@@ -127,7 +126,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
     switch (light.kind) {
         case Kind::kTriangle:
         case Kind::kSphere: {
-            es.point = AreaPoint(light, u_pos);
+            es.point = AreaPoint(light, u_pos, time);
             es.on_surface = true;
             if (light.kind == Kind::kSphere) es.sphere = light.index;
             es.pdf_pos = 1 / light.area;
@@ -152,7 +151,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
             break;
         }
         case Kind::kPoint: {
-            es.point.p = Vec3(scene.point_lights[size_t(light.index)].position - scene_.origin());
+            es.point.p = scene_.PointLightPosition(light.index, time);
             es.delta_pos = true;
             es.pdf_pos = 1;
             const float z = 1 - 2 * u_dir.x;
@@ -166,12 +165,13 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
         }
         case Kind::kSpot: {
             const SpotCone& cone = spots_[size_t(light.index)];
-            es.point.p = cone.position;
+            const EmbreeScene::SpotPlace place = scene_.SpotLightAt(light.index, time);
+            es.point.p = place.position;
             es.delta_pos = true;
             es.pdf_pos = 1;
             // Uniform in the outer cone: 1 - cos(theta) uniform in [0, 1 - cos outer].
             const float omc = u_dir.x * cone.one_minus_cos_outer;
-            es.w = ConeDirection(cone.direction, omc, u_dir.y);
+            es.w = ConeDirection(place.direction, omc, u_dir.y);
             es.point.n = es.w;
             es.pdf_dir = 1 / (2 * kPi * cone.one_minus_cos_outer);
             const float t =
@@ -213,6 +213,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
         }
     }
     if (!(es.pdf_pos > 0 && es.pdf_dir > 0) || es.le.IsBlack()) return std::nullopt;
+    es.point.time = time;
     return es;
 }
 
@@ -249,7 +250,8 @@ float EmissionSampler::InfiniteDirPdf(const Light& light, const Vec3& w) const {
     }
 }
 
-EmissionPdf EmissionSampler::PdfLe(int li, const Vec3& p, const Vec3& n, const Vec3& w) const {
+EmissionPdf EmissionSampler::PdfLe(int li, const Vec3& p, const Vec3& n, const Vec3& w,
+                                   float time) const {
     (void)p;  // uniform by area: the density does not depend on where on the light
     const Light& light = lights_[size_t(li)];
     switch (light.kind) {
@@ -263,7 +265,9 @@ EmissionPdf EmissionSampler::PdfLe(int li, const Vec3& p, const Vec3& n, const V
             return {1, 1 / (4 * kPi)};
         case Kind::kSpot: {
             const SpotCone& cone = spots_[size_t(light.index)];
-            const bool inside = OneMinusCosBetween(w, cone.direction) <= cone.one_minus_cos_outer;
+            const bool inside =
+                OneMinusCosBetween(w, scene_.SpotLightAt(light.index, time).direction) <=
+                cone.one_minus_cos_outer;
             return {1, inside ? 1 / (2 * kPi * cone.one_minus_cos_outer) : 0.0f};
         }
         default:

@@ -53,10 +53,12 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
                     int(q / uint64_t(camera_.width())), 2 * (j / frame) + uint64_t(half),
                     settings_.sampler);
     const bool lens = camera_.HasLens();
+    // The whole path, and the camera it reaches, at one time in the shutter.
+    const float time = sampler.GetTime();
 
     const float u_pick = sampler.Get1D();
     const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-    const std::optional<EmissionSample> es = emission_.Sample(u_pick, u_pos, u_dir);
+    const std::optional<EmissionSample> es = emission_.Sample(u_pick, u_pos, u_dir, time);
     if (!es) return;
     // Power leaving y0 per path: Le |cos| / (pick pdf_pos pdf_dir). Point, spot and the lights
     // at infinity have point.n = w, so their cosine is 1.
@@ -67,9 +69,9 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
     // pdf_camera), when the light emits that way (its front, or either side if two-sided).
     const Vec2 u_lens0 = lens ? sampler.Get2D() : Vec2{};
     if (es->on_surface) {
-        if (const auto cs = camera_.SampleWi(es->point.p, u_lens0);
+        if (const auto cs = camera_.SampleWi(es->point.p, u_lens0, time);
             cs && cs->pdf > 0 && cs->we > 0 &&
-            emission_.PdfLe(es->light, es->point.p, es->point.n, cs->wi).dir > 0) {
+            emission_.PdfLe(es->light, es->point.p, es->point.n, cs->wi, time).dir > 0) {
             const Rgb value = es->le * (std::abs(Dot(cs->wi, es->point.n)) * cs->we /
                                         (es->pick * es->pdf_pos * cs->pdf));
             ++stats.rays;
@@ -109,7 +111,8 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
 
         // y_{bounce + 1} to the camera.
         if (!bsdf.IsDelta()) {
-            if (const auto cs = camera_.SampleWi(hit->p, u_lens); cs && cs->pdf > 0 && cs->we > 0) {
+            if (const auto cs = camera_.SampleWi(hit->p, u_lens, time);
+                cs && cs->pdf > 0 && cs->we > 0) {
                 const Vec3 wi = frame.ToLocal(cs->wi);
                 const bool reflect = wi.z * wo.z > 0;
                 if (sh.SidesAgree(wo_world, cs->wi, reflect)) {

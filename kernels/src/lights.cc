@@ -17,6 +17,9 @@
 namespace lf {
 
 namespace {
+
+// The time (Ray::time) of step `step` of the scene's moving geometry and lights.
+float StepTime(const EmbreeScene& es, int step) { return float(step) / float(es.steps() - 1); }
 constexpr float kPi = std::numbers::pi_v<float>;
 
 // Triangles and rectangles subtending less than this many steradians are sampled by area.
@@ -100,9 +103,11 @@ void DualEdges(const Vec3& p0, const Vec3& p1, const Vec3& p2, Vec3* dual1, Vec3
 // than a rectangle.
 std::optional<LightSampler::Rectangle> LightSampler::FormRectangle(const EmbreeScene& es, int m,
                                                                    int t) {
+    // A moving mesh's rectangle need not stay one: its triangles are lit one by one.
+    if (es.Moves(m)) return std::nullopt;
     std::array<Vec3, 3> a, b;
-    es.Triangle(m, t, &a[0], &a[1], &a[2]);
-    es.Triangle(m, t + 1, &b[0], &b[1], &b[2]);
+    es.Triangle(m, t, 0, &a[0], &a[1], &a[2]);
+    es.Triangle(m, t + 1, 0, &b[0], &b[1], &b[2]);
     // The vertex of each triangle that the other lacks.
     int a_only = -1, b_only = -1, shared = 0;
     for (int i = 0; i < 3; ++i) {
@@ -149,9 +154,15 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
             rectangle = FormRectangle(es, m, t);
         }
         LightBounds b = TriangleLightBounds(tri.p[0], tri.p[1], tri.p[2], radiance, two_sided);
+        // A moving triangle's bounds hold it at every step (and so between them).
+        for (int step = 1; es.Moves(m) && step < es.steps(); ++step) {
+            Vec3 p0, p1, p2;
+            es.Triangle(m, t, StepTime(es, step), &p0, &p1, &p2);
+            b = Union(b, TriangleLightBounds(p0, p1, p2, radiance, two_sided));
+        }
         if (rectangle) {
             Vec3 q0, q1, q2;
-            es.Triangle(m, t + 1, &q0, &q1, &q2);
+            es.Triangle(m, t + 1, 0, &q0, &q1, &q2);
             b = Union(b, TriangleLightBounds(q0, q1, q2, radiance, two_sided));
             const float rectangle_area = Length(Cross(rectangle->frame.ex, rectangle->frame.ey));
             lights_.push_back(
@@ -182,14 +193,19 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
         const PointLight& point = scene.point_lights[i];
         lights_.push_back({Kind::kPoint, int(i), 0, 0, false});
         weights.push_back(4 * std::numbers::pi * LightPowerWeight(point.intensity));
-        bounds.push_back(PointLightBounds(Vec3(point.position - es.origin()),
+        LightBounds b =
+            PointLightBounds(es.PointLightPosition(int(i), 0), LightPowerWeight(point.intensity));
+        // A moving light's bounds hold it at every step (and so between them).
+        for (int step = 1; step < es.steps(); ++step) {
+            b = Union(b, PointLightBounds(es.PointLightPosition(int(i), StepTime(es, step)),
                                           LightPowerWeight(point.intensity)));
+        }
+        bounds.push_back(b);
     }
     for (size_t i = 0; i < scene.spot_lights.size(); ++i) {
         const SpotLight& spot = scene.spot_lights[i];
         const SpotBand band = SpotBandOf(spot);
-        spot_cones_.push_back({Vec3(Normalize(spot.direction)), float(band.outer),
-                               float(1 / band.width),
+        spot_cones_.push_back({float(band.outer), float(1 / band.width),
                                spot.falloff == SpotLight::Falloff::kSmoothstep});
         lights_.push_back({Kind::kSpot, int(i), 0, 0, false});
         weights.push_back(SpotFalloffSolidAngle(spot) * LightPowerWeight(spot.intensity));
@@ -197,9 +213,15 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
         // to 1 in float keeps a positive pick probability wherever it shines.
         const float cos_outer = std::nextafter(float(1 - band.outer), -1.0f);
         const float cos_inner = std::max(float(1 - (band.outer - band.width)), cos_outer);
-        bounds.push_back(SpotLightBounds(Vec3(spot.position - es.origin()),
-                                         spot_cones_.back().direction,
+        const EmbreeScene::SpotPlace place = es.SpotLightAt(int(i), 0);
+        LightBounds b = SpotLightBounds(place.position, place.direction,
+                                        LightPowerWeight(spot.intensity), cos_inner, cos_outer);
+        for (int step = 1; step < es.steps(); ++step) {
+            const EmbreeScene::SpotPlace at = es.SpotLightAt(int(i), StepTime(es, step));
+            b = Union(b, SpotLightBounds(at.position, at.direction,
                                          LightPowerWeight(spot.intensity), cos_inner, cos_outer));
+        }
+        bounds.push_back(b);
     }
     finite_count_ = lights_.size();
     const auto [lo, hi] = scene.Bounds();
@@ -247,7 +269,7 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
 }
 
 std::optional<LightSample> LightSampler::Sample(const Vec3& ref, const Vec3& n, float u_pick,
-                                                const Vec2& u) const {
+                                                const Vec2& u, float time) const {
     if (lights_.empty()) return std::nullopt;
     int li = 0;
     float pick = 0;
@@ -267,7 +289,7 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, const Vec3& n, 
 
     if (light.kind == Kind::kPoint || light.kind == Kind::kSpot ||
         light.kind == Kind::kDirectional) {
-        std::optional<LightSample> ls = SampleDelta(light, ref);
+        std::optional<LightSample> ls = SampleDelta(light, ref, time);
         if (ls) ls->pdf = pick;
         return ls;
     }
@@ -287,7 +309,7 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, const Vec3& n, 
         ls.point.n = -ls.wi;
         return ls;
     }
-    std::optional<LightSample> ls = SampleArea(light, ref, n, u);
+    std::optional<LightSample> ls = SampleArea(light, ref, n, u, time);
     if (ls) ls->pdf *= pick;
     return ls;
 }
@@ -297,17 +319,20 @@ bool LightSampler::IsDeltaLight(size_t i) const {
     return kind == Kind::kPoint || kind == Kind::kSpot || kind == Kind::kDirectional;
 }
 
-std::optional<LightSample> LightSampler::SampleDeltaLight(size_t i, const Vec3& ref) const {
+std::optional<LightSample> LightSampler::SampleDeltaLight(size_t i, const Vec3& ref,
+                                                          float time) const {
     if (!IsDeltaLight(i)) return std::nullopt;
-    std::optional<LightSample> ls = SampleDelta(lights_[i], ref);
+    std::optional<LightSample> ls = SampleDelta(lights_[i], ref, time);
     if (ls) ls->pdf = 1;
     return ls;
 }
 
 std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Vec3& ref,
-                                                    const Vec3& n, const Vec2& u) const {
+                                                    const Vec3& n, const Vec2& u,
+                                                    float time) const {
     const Scene& scene = scene_.scene();
     const bool bvh = strategy_ == LightStrategy::kBvh;
+    float area = light.area;
     LightSample ls;
     Rgb emission;
     float solid_angle_pdf = 0;  // set when the point was sampled by solid angle
@@ -321,16 +346,19 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
     };
     if (light.kind == Kind::kTriangle) {
         Vec3 p0, p1, p2;
-        scene_.Triangle(light.index, light.primitive, &p0, &p1, &p2);
+        scene_.Triangle(light.index, light.primitive, time, &p0, &p1, &p2);
+        // A deforming triangle's area changes with time (ForEachEmissiveTriangle's formula).
+        area = 0.5f * Length(Cross(p1 - p0, p2 - p0));
         const SphericalTriangle st(ref, p0, p1, p2, kMinSampledSolidAngle);
         if (bvh && st.samplable()) {
             solid_angle_pdf = st.Pdf();
             const Vec2 b = st.Sample(warped(CosineWarp::ForTriangle(ref, n, p0, p1, p2))).b;
-            ls.point = scene_.TrianglePoint(light.index, light.primitive, b.x, b.y);
+            ls.point = scene_.TrianglePoint(light.index, light.primitive, b.x, b.y, time);
         } else {
             // Uniform on the triangle (Osada et al. square-root parameterisation).
             const float su = std::sqrt(u.x);
-            ls.point = scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y);
+            ls.point =
+                scene_.TrianglePoint(light.index, light.primitive, su * (1 - u.y), su * u.y, time);
         }
         emission = scene.materials[size_t(scene.meshes[size_t(light.index)].material)].emission;
     } else if (light.kind == Kind::kRectangle) {
@@ -351,14 +379,14 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
                 SampleSphereCone(ref, scene_.SphereCenter(light.index),
                                  float(scene.spheres[size_t(light.index)].radius), u);
             if (!s) return std::nullopt;
-            ls.point = scene_.SpherePoint(light.index, s->normal);
+            ls.point = scene_.SpherePoint(light.index, s->normal, time);
             solid_angle_pdf = s->pdf;
         } else {
             const float z = 1 - 2 * u.x;
             const float r = std::sqrt(std::max(0.0f, 1 - z * z));
             const float phi = 2 * kPi * u.y;
-            ls.point =
-                scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z));
+            ls.point = scene_.SpherePoint(light.index,
+                                          Vec3(r * std::cos(phi), r * std::sin(phi), z), time);
         }
         ls.sphere = light.index;
         emission = scene.materials[size_t(scene.spheres[size_t(light.index)].material)].emission;
@@ -371,7 +399,7 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
     const float cos_light = light.two_sided ? std::abs(cos_front) : cos_front;
     if (!(cos_light > 0)) return std::nullopt;  // a one-sided emitter seen from behind
     ls.radiance = emission;
-    ls.pdf = solid_angle_pdf > 0 ? solid_angle_pdf : dist2 / (cos_light * light.area);
+    ls.pdf = solid_angle_pdf > 0 ? solid_angle_pdf : dist2 / (cos_light * area);
     return ls;
 }
 
@@ -393,7 +421,7 @@ float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const Vec3& n,
             }
         } else {
             Vec3 p0, p1, p2;
-            scene_.Triangle(light.index, light.primitive, &p0, &p1, &p2);
+            scene_.Triangle(light.index, light.primitive, hit.time, &p0, &p1, &p2);
             const SphericalTriangle st(ref, p0, p1, p2, kMinSampledSolidAngle);
             if (st.samplable()) {
                 if (!warp) return st.Pdf();
@@ -402,11 +430,17 @@ float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const Vec3& n,
             }
         }
     }
+    float area = light.area;
+    if (light.kind == Kind::kTriangle) {
+        Vec3 p0, p1, p2;
+        scene_.Triangle(light.index, light.primitive, hit.time, &p0, &p1, &p2);
+        area = 0.5f * Length(Cross(p1 - p0, p2 - p0));
+    }
     const Vec3 d = hit.p - ref;
     const float dist2 = LengthSquared(d);
     const float cos_light = std::abs(Dot(hit.n, d)) / std::sqrt(dist2);
     if (!(cos_light > 0)) return 0;
-    return dist2 / (cos_light * light.area);
+    return dist2 / (cos_light * area);
 }
 
 std::optional<Vec3> LightSampler::SampleInfiniteDirection(const Light& light, const Vec2& u) const {
@@ -431,7 +465,8 @@ Vec3 LightSampler::InfinitePoint(const Vec3& ref, const Vec3& wi) const {
     return ref + wi * (2 * scene_radius_ + Length(ref) + 1);
 }
 
-std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const Vec3& ref) const {
+std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const Vec3& ref,
+                                                     float time) const {
     const Scene& scene = scene_.scene();
     LightSample ls;
     ls.delta = true;
@@ -445,10 +480,12 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
         return ls;
     }
     const bool spot = light.kind == Kind::kSpot;
-    const Vec3d position = spot ? scene.spot_lights[size_t(light.index)].position
-                                : scene.point_lights[size_t(light.index)].position;
+    const EmbreeScene::SpotPlace place =
+        spot ? scene_.SpotLightAt(light.index, time)
+             : EmbreeScene::SpotPlace{scene_.PointLightPosition(light.index, time), Vec3()};
     (spot ? ls.spot_light : ls.point_light) = light.index;
-    ls.point.p = Vec3(position - scene_.origin());
+    ls.point.p = place.position;
+    ls.point.time = time;
     const Vec3 d = ls.point.p - ref;
     const float dist2 = LengthSquared(d);
     if (!(dist2 > 0)) return std::nullopt;
@@ -461,7 +498,7 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
     const SpotCone& cone = spot_cones_[size_t(light.index)];
     // 1 - cos of the angle to the axis as |d - axis|^2 / 2 (d = -wi, from the light): exact for
     // narrow cones, where cos itself rounds to 1 in float.
-    const float one_minus_cos = 0.5f * LengthSquared(ls.wi + cone.direction);
+    const float one_minus_cos = 0.5f * LengthSquared(ls.wi + place.direction);
     const float t =
         std::clamp((cone.one_minus_cos_outer - one_minus_cos) * cone.inv_width, 0.0f, 1.0f);
     if (t == 0) return std::nullopt;  // outside the outer cone: no shadow ray needed
@@ -488,7 +525,7 @@ SurfacePoint LightSampler::RectanglePoint(const Light& light, const Vec2& st) co
             b2 /= sum;
         }
     }
-    return scene_.TrianglePoint(light.index, h->primitive, b1, b2);
+    return scene_.TrianglePoint(light.index, h->primitive, b1, b2, 0);  // never moves
 }
 
 int LightSampler::LightIndex(const SurfaceHit& hit) const {

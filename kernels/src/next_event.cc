@@ -5,7 +5,7 @@ namespace lf {
 Rgb NextEventEstimate(const EmbreeScene& scene, const LightSampler& lights, const SurfaceHit& hit,
                       const Shading& sh, const Vec3& wo_world, const Bsdf& bsdf, int medium,
                       const Rgb& beta, float u_pick, const Vec2& u_light, RenderStats& stats) {
-    const std::optional<LightSample> ls = lights.Sample(hit.p, sh.ns, u_pick, u_light);
+    const std::optional<LightSample> ls = lights.Sample(hit.p, sh.ns, u_pick, u_light, hit.time);
     if (!ls) return Rgb();
     const std::vector<Material>& materials = scene.scene().materials;
     const Frame frame = Frame::FromNormal(sh.ns);

@@ -34,11 +34,12 @@ double RoundTo4Bits(double x) {
 
 }  // namespace
 
-std::optional<EmittedPhoton> EmitPhoton(const EmissionSampler& emission, Sampler& sampler) {
+std::optional<EmittedPhoton> EmitPhoton(const EmissionSampler& emission, Sampler& sampler,
+                                        float time) {
     const float u_pick = sampler.Get1D();
     const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
     if (emission.empty()) return std::nullopt;
-    const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+    const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, time);
     if (!s) return std::nullopt;
     const float pdf = s->pick * s->pdf_pos * s->pdf_dir;
     if (!(pdf > 0)) return std::nullopt;
@@ -107,6 +108,12 @@ PpmRenderer::PpmRenderer(const EmbreeScene& scene, const Camera& camera,
                             ? settings.photons_per_pass
                             : uint64_t(camera.width()) * uint64_t(camera.height())) {}
 
+float PpmRenderer::PassTime(uint64_t pass) const {
+    // The pass is the sample index of one shared pixel: Sobol stratifies the passes' times.
+    return Sampler(MixBits(settings_.seed ^ kPassTimeSalt), 0, 0, pass, settings_.sampler)
+        .GetTime();
+}
+
 float PpmRenderer::Radius(uint64_t pass) const {
     return float(initial_radius_ * std::sqrt(PpmRadiusRatioSquared(settings_.alpha, pass)));
 }
@@ -116,9 +123,10 @@ void PpmRenderer::TraceRange(uint64_t pass, uint64_t begin, uint64_t end, std::v
     const std::vector<Material>& materials = scene_.scene().materials;
     const int max_depth = settings_.max_depth;
     const uint64_t photon_seed = MixBits(settings_.seed ^ kPhotonSeedSalt);
+    const float time = PassTime(pass);
     for (uint64_t i = begin; i < end; ++i) {
         Sampler sampler(photon_seed, int(i & 0xffff), int(i >> 16), pass, settings_.sampler);
-        const std::optional<EmittedPhoton> emitted = EmitPhoton(emission_, sampler);
+        const std::optional<EmittedPhoton> emitted = EmitPhoton(emission_, sampler, time);
         if (!emitted) continue;
         Ray ray = emitted->ray;
         Rgb beta = emitted->power;
@@ -332,6 +340,7 @@ void PpmRenderer::Render(const SplatWork& work, TileSums& camera, SplatList& /*s
     for (uint64_t pass = work.sample_begin; pass < work.sample_end; ++pass) {
         if (cancel && cancel->load(std::memory_order_relaxed)) return;
         const PhotonMap map = TracePhotons(pass, camera.stats, cancel);
+        const float time = PassTime(pass);
         std::vector<RenderStats> row_stats(size_t(rect.height));
         tbb::parallel_for(0, rect.height, [&](int row) {
             if (cancel && cancel->load(std::memory_order_relaxed)) return;
@@ -341,7 +350,7 @@ void PpmRenderer::Render(const SplatWork& work, TileSums& camera, SplatList& /*s
                 Sampler sampler(settings_.seed, x, y, pass, settings_.sampler);
                 const Vec2 film = camera_.SampleFilm(sampler.Get2D());
                 const Vec2 lens = camera_.HasLens() ? sampler.Get2D() : Vec2{};
-                const Ray ray = camera_.GenerateRay(x, y, film.x, film.y, lens);
+                const Ray ray = camera_.GenerateRay(x, y, film.x, film.y, lens, time);
                 Rgb L = Li(ray, map, sampler, stats);
                 if (!L.IsFinite()) {
                     ++stats.invalid_samples;

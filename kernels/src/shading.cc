@@ -18,14 +18,15 @@ Rgba Sample(const Scene& scene, const TextureRef& ref, const TexCoords& uv) {
 // The tangent and the bitangent's sign (glTF: bitangent = sign * cross(normal, tangent)) at the
 // hit: the mesh's tangents (from its file, or lf::ComputeTangents when the scene loaded)
 // interpolated; false for a mesh without them.
-bool TangentAt(const TriangleMesh& mesh, const SurfaceHit& hit, Vec3* tangent, float* sign) {
+bool TangentAt(const EmbreeScene& es, const TriangleMesh& mesh, const SurfaceHit& hit,
+               Vec3* tangent, float* sign) {
     if (mesh.tangents.empty()) return false;
     const auto& tri = mesh.triangles[size_t(hit.primitive)];
     const float b[3] = {1 - hit.b1 - hit.b2, hit.b1, hit.b2};
     Vec3 t;
     float w = 0;
     for (int i = 0; i < 3; ++i) {
-        const auto& ti = mesh.tangents[tri[size_t(i)]];
+        const std::array<float, 4> ti = es.Tangent(hit.mesh, tri[size_t(i)], hit.time);
         t += Vec3(ti[0], ti[1], ti[2]) * b[i];
         w += ti[3] * b[i];
     }
@@ -43,7 +44,7 @@ Vec3 NormalMapped(const EmbreeScene& es, const TextureRef& map, float scale, con
     if (mesh.Uvs(map.tex_coord).empty()) return n;
     Vec3 t;
     float sign;
-    if (!TangentAt(mesh, hit, &t, &sign)) return n;
+    if (!TangentAt(es, mesh, hit, &t, &sign)) return n;
     t = t - n * Dot(n, t);  // Gram-Schmidt against the shading normal
     if (!(LengthSquared(t) > 0)) return n;
     t = Normalize(t);
@@ -97,7 +98,10 @@ SurfacePoint Shading::Leaving(const Vec3& w) const {
     // lit radiance that way).
     if (!(Dot(w, ns) > 0) || !(Dot(w, point.n) < 0) || p_outer == point.p) return point;
     // P' is P plus a vector with a non-negative component along n; only the final sum rounds.
-    return {p_outer, point.p_error + Abs(p_outer) * Gamma(2), point.n};
+    SurfacePoint outer = point;
+    outer.p = p_outer;
+    outer.p_error = point.p_error + Abs(p_outer) * Gamma(2);
+    return outer;
 }
 
 bool Shading::SidesAgree(const Vec3& wo, const Vec3& wi, bool reflect) const {
@@ -239,6 +243,7 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
     Shading s;
     Rgb vertex_color(1.0f);
     s.point = {hit.p, hit.p_error, hit.n};
+    s.point.time = hit.time;
     s.ns = hit.n;
     s.p_outer = hit.p;
     if (hit.mesh >= 0) {
@@ -248,10 +253,10 @@ Shading Shade(const EmbreeScene& es, const SurfaceHit& hit, const Vec3& wo) {
         if (!mesh.normals.empty()) {
             const auto& tri = mesh.triangles[size_t(hit.primitive)];
             const float b[3] = {1 - hit.b1 - hit.b2, hit.b1, hit.b2};
-            es.Triangle(hit.mesh, hit.primitive, &s.v[0], &s.v[1], &s.v[2]);
+            es.Triangle(hit.mesh, hit.primitive, hit.time, &s.v[0], &s.v[1], &s.v[2]);
             Vec3 n_sum, lift;
             for (int i = 0; i < 3; ++i) {
-                const Vec3 ni = FaceForward(mesh.normals[tri[size_t(i)]], hit.n);
+                const Vec3 ni = FaceForward(es.Normal(hit.mesh, tri[size_t(i)], hit.time), hit.n);
                 n_sum += ni * b[i];
                 // Hanika: project P onto each vertex's tangent plane where P lies below it.
                 lift -= ni * (b[i] * std::min(0.0f, Dot(hit.p - s.v[i], ni)));

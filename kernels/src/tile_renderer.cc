@@ -16,7 +16,7 @@ TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, co
                 Sampler sampler(seed, x, y, s, options.sampler);
                 const Vec2 film = camera.SampleFilm(sampler.Get2D());
                 const Vec2 lens = camera.HasLens() ? sampler.Get2D() : Vec2{};
-                const Ray ray = camera.GenerateRay(x, y, film.x, film.y, lens);
+                const Ray ray = camera.GenerateRay(x, y, film.x, film.y, lens, sampler.GetTime());
                 Rgb L = estimator.Li(ray, sampler, tile.stats);
                 if (!L.IsFinite()) {
                     ++tile.stats.invalid_samples;

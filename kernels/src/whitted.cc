@@ -160,7 +160,8 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
                 return contribution;
             };
             for (const size_t i : delta_lights_) {
-                if (const std::optional<LightSample> ls = lights_.SampleDeltaLight(i, hit->p)) {
+                if (const std::optional<LightSample> ls =
+                        lights_.SampleDeltaLight(i, hit->p, hit->time)) {
                     L += direct(*ls);
                 }
             }
@@ -168,7 +169,7 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
                 const float u_pick = sampler.Get1D();
                 const Vec2 u_light = sampler.Get2D();
                 const std::optional<LightSample> ls =
-                    lights_.Sample(hit->p, sh.ns, u_pick, u_light);
+                    lights_.Sample(hit->p, sh.ns, u_pick, u_light, hit->time);
                 if (ls && !ls->delta) L += direct(*ls);
             }
         }

@@ -11,6 +11,7 @@
 #include "image_files.h"
 #include "lf/core/image_io.h"
 #include "lf/core/scene_loader.h"
+#include "lightfarm_process.h"
 #include "render_path.h"
 #include "test_dir.h"
 #include "test_scenes.h"
@@ -39,12 +40,8 @@ class GltfRender : public ::testing::Test {
 
     // `lightfarm ARGS` with stdout and stderr.
     std::pair<int, std::string> Lightfarm(const std::string& args) {
-        const std::string cmd = std::string(LF_BIN_DIR) + "/lightfarm " + args + " 2>&1";
-        FILE* pipe = popen(cmd.c_str(), "r");
-        std::string out;
-        char buf[4096];
-        while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-        return {WEXITSTATUS(pclose(pipe)), out};
+        testing::LightfarmRun run = testing::RunLightfarm(args);
+        return {run.status, std::move(run.output)};
     }
 
     fs::path dir_;

@@ -23,28 +23,28 @@ SEGMENTS, RINGS = 16, 10
 QUANTISATION = ["-qp", "14", "-qt", "12", "-qn", "10"]
 
 
-def sphere():
+def sphere(segments=SEGMENTS, rings=RINGS):
     """Vertices (position, normal, uv) and triangles; every vertex used, no degenerate face."""
     vertices, index = [], {}
 
     def vertex(ring, seg, u):
-        theta, phi = math.pi * ring / RINGS, 2 * math.pi * u
+        theta, phi = math.pi * ring / rings, 2 * math.pi * u
         n = (math.sin(theta) * math.cos(phi), math.cos(theta), -math.sin(theta) * math.sin(phi))
         key = (ring, seg)
         if key not in index:
             index[key] = len(vertices)
-            vertices.append((n, n, (u, ring / RINGS)))
+            vertices.append((n, n, (u, ring / rings)))
         return index[key]
 
     triangles = []
-    for ring in range(RINGS):
-        for seg in range(SEGMENTS):
-            u0, u1 = seg / SEGMENTS, (seg + 1) / SEGMENTS
+    for ring in range(rings):
+        for seg in range(segments):
+            u0, u1 = seg / segments, (seg + 1) / segments
             if ring == 0:  # the north pole: one vertex per segment, at its middle's u
                 triangles.append((vertex(0, seg, (u0 + u1) / 2), vertex(1, seg, u0),
                                   vertex(1, seg + 1, u1)))
-            elif ring == RINGS - 1:
-                triangles.append((vertex(ring, seg, u0), vertex(RINGS, seg, (u0 + u1) / 2),
+            elif ring == rings - 1:
+                triangles.append((vertex(ring, seg, u0), vertex(rings, seg, (u0 + u1) / 2),
                                   vertex(ring, seg + 1, u1)))
             else:
                 a, b = vertex(ring, seg, u0), vertex(ring, seg + 1, u1)

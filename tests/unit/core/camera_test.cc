@@ -139,5 +139,32 @@ TEST(Camera, DescribesItsViewInOneLine) {
               "half height 0.25");
 }
 
+// A moving camera (motion blur): at time t it is between its two nearest poses, its position
+// linear and its orientation slerped, so a camera panning a quarter turn looks 45 degrees
+// round at the middle of the shutter; the ray carries its time.
+TEST(Camera, AMovingCameraIsBetweenItsPosesAtTheRaysTime) {
+    CameraSpec open = Spec(), close = Spec();
+    close.position = {3, 2, 3};
+    close.look_at = {10, 2, 3};  // from +z to +x: a quarter turn about +y
+    const CameraSpec motion[] = {open, close};
+    const Camera cam(Spec(), Vec3d(0, 0, 0), motion);
+    EXPECT_TRUE(cam.Moves());
+    for (const float t : {0.0f, 0.25f, 0.5f, 1.0f}) {
+        const Ray r = cam.GenerateRay(100, 50, 0.0f, 0.0f, {}, t);
+        const double angle = t * std::numbers::pi / 2;
+        EXPECT_NEAR(r.d.x, std::sin(angle), 1e-5) << t;
+        EXPECT_NEAR(r.d.z, std::cos(angle), 1e-5) << t;
+        EXPECT_NEAR(r.d.y, 0, 1e-5) << t;
+        EXPECT_NEAR(r.o.x, 1 + 2 * t, 1e-5) << t;
+        EXPECT_EQ(r.time, t);
+        // The importance of that ray finds it at the film's centre at the same time only.
+        Vec2 raster;
+        ASSERT_GT(cam.We(r, &raster), 0) << t;
+        EXPECT_NEAR(raster.x, 100, 1e-2) << t;
+        EXPECT_NEAR(raster.y, 50, 1e-2) << t;
+    }
+    EXPECT_FALSE(Camera(Spec(), Vec3d(0, 0, 0)).Moves());
+}
+
 }  // namespace
 }  // namespace lf

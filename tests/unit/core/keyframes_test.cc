@@ -149,9 +149,9 @@ TEST(Keyframes, BadSamplersAreRefusedNamingWhere) {
     EXPECT_EQ(error(Interpolation::kLinear, {0, NAN}, {0, 1}),
               "animations[2].samplers[1]: input time 1 is nan");
     EXPECT_EQ(error(Interpolation::kLinear, {0, 1}, {0, NAN}),
-              "animations[2].samplers[1]: output keyframe 1 number 0 is nan");
+              "animations[2].samplers[1]: output keyframe 1 (at 1 s) number 0 is nan");
     EXPECT_EQ(error(Interpolation::kLinear, {0, 1}, {0, INFINITY}),
-              "animations[2].samplers[1]: output keyframe 1 number 0 is inf");
+              "animations[2].samplers[1]: output keyframe 1 (at 1 s) number 0 is inf");
     EXPECT_EQ(error(Interpolation::kCubicSpline, {0, 1}, {0, 1}),
               "animations[2].samplers[1]: output has 2 numbers for 2 keyframes; expected 6 "
               "(CUBICSPLINE: in-tangent, value, out-tangent)");
@@ -160,7 +160,7 @@ TEST(Keyframes, BadSamplersAreRefusedNamingWhere) {
     EXPECT_EQ(error(Interpolation::kLinear, {}, {}),
               "animations[2].samplers[1]: input has no keyframes");
     EXPECT_EQ(error(Interpolation::kLinear, {0}, {0, 0, 0, 0}, KeyframeKind::kRotation),
-              "animations[2].samplers[1]: output keyframe 0 is the zero quaternion");
+              "animations[2].samplers[1]: output keyframe 0 (at 0 s) is the zero quaternion");
     EXPECT_EQ(
         std::string(ParseInterpolation("SMOOTH", "animations[0].samplers[3]").status().message()),
         "animations[0].samplers[3]: interpolation \"SMOOTH\" is unknown; expected LINEAR, "

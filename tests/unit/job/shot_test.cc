@@ -92,6 +92,7 @@ TEST(ShotSettingsTest, OutOfRangeSettingsAreRefusedNamingTheField) {
     const FrameRange frames{1, 2, 1};
     for (const Case& c :
          {Case{{frames, 0.0, 0, 1}, "fps 0"}, Case{{frames, std::nan(""), 0, 1}, "fps nan"},
+          Case{{frames, 1e-310, 0, 1}, "expected 0.001 to 1000"},
           Case{{frames, 24, -1, 1}, "shutter -1"}, Case{{frames, 24, 11, 1}, "shutter 11"},
           Case{{frames, 24, 0, 0}, "chunk 0"},
           Case{{std::nullopt, 24, 0.5, 1}, "motion blur needs a frame"},

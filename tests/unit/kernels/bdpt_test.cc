@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bonferroni.h"
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
@@ -23,6 +24,8 @@
 
 namespace lf {
 namespace {
+
+using testing::BonferroniZ;
 
 // A frame of BDPT estimates: per pixel the two half estimates (A: even camera samples and their
 // light subpaths, B: odd ones), each its camera mean plus its splat sum x W H / N_h, N_h the
@@ -91,16 +94,6 @@ Mean SplatMean(const BdptFrame& f) {
         }
     }
     return {sum / n, std::sqrt(var) / n};
-}
-
-// The z threshold of a two-sided test at family-wise level alpha over m tests (Bonferroni).
-double BonferroniZ(int m, double alpha = 1e-3) {
-    double lo = 0, hi = 20;
-    for (int i = 0; i < 100; ++i) {
-        const double z = (lo + hi) / 2;
-        (std::erfc(z / std::sqrt(2.0)) > alpha / m ? lo : hi) = z;
-    }
-    return hi;
 }
 
 // Compares BDPT with the path tracer block by block (blocks of side `block`, channel

@@ -92,8 +92,8 @@ TEST(AlphaMask, LightSamplesInHolesEmitNothing) {
     scene.materials[0].emission = Rgb(3);
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok()) << es.status();
-    const SurfacePoint left = (*es)->TrianglePoint(0, 0, 0.1f, 0.1f);   // near (-1, 1)
-    const SurfacePoint right = (*es)->TrianglePoint(0, 1, 0.1f, 0.8f);  // near (1, 1)
+    const SurfacePoint left = (*es)->TrianglePoint(0, 0, 0.1f, 0.1f, 0);   // near (-1, 1)
+    const SurfacePoint right = (*es)->TrianglePoint(0, 1, 0.1f, 0.8f, 0);  // near (1, 1)
     EXPECT_EQ(EmissionAt(**es, left, Rgb(3)), Rgb(0));
     EXPECT_EQ(EmissionAt(**es, right, Rgb(3)), Rgb(3));
 }
@@ -176,8 +176,8 @@ TEST(AlphaBlend, LightSamplesCarryTheOpacity) {
     scene.materials[0].emission = Rgb(3);
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok()) << es.status();
-    const SurfacePoint left = (*es)->TrianglePoint(0, 0, 0.1f, 0.1f);   // texture alpha 0
-    const SurfacePoint right = (*es)->TrianglePoint(0, 1, 0.1f, 0.8f);  // texture alpha 1
+    const SurfacePoint left = (*es)->TrianglePoint(0, 0, 0.1f, 0.1f, 0);   // texture alpha 0
+    const SurfacePoint right = (*es)->TrianglePoint(0, 1, 0.1f, 0.8f, 0);  // texture alpha 1
     EXPECT_EQ(EmissionAt(**es, left, Rgb(3)), Rgb(0));
     EXPECT_EQ(EmissionAt(**es, right, Rgb(3)), Rgb(1.5f));
 }

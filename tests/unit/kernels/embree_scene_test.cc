@@ -53,7 +53,7 @@ TEST(EmbreeScene, TriangleHitReportsFrontNormalAndBarycentrics) {
     ASSERT_TRUE(hit);
     EXPECT_NEAR(hit->t, 1.3f, 1e-5f);
     EXPECT_NEAR(hit->n.y, 1.0f, 1e-6f);  // the floor faces into the box
-    const SurfacePoint sp = (*es)->TrianglePoint(hit->mesh, hit->primitive, hit->b1, hit->b2);
+    const SurfacePoint sp = (*es)->TrianglePoint(hit->mesh, hit->primitive, hit->b1, hit->b2, 0);
     EXPECT_NEAR(sp.p.x, 0.2f, 1e-5f);
     EXPECT_NEAR(sp.p.z, 0.0f, 1e-5f);
 }

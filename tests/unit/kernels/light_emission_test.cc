@@ -202,7 +202,7 @@ TEST_P(EmissionFluxTest, FluxMatchesPowerAndPdfLeMatchesSample) {
         Sampler sampler(std::hash<std::string>{}(GetParam().name), 0, 0, uint64_t(i));
         const float u_pick = sampler.Get1D();
         const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, 0);
         if (!s) continue;
         ASSERT_NEAR(Length(s->w), 1, 1e-5);
         ASSERT_EQ(s->pick, emission.Pmf(s->light));
@@ -211,7 +211,7 @@ TEST_P(EmissionFluxTest, FluxMatchesPowerAndPdfLeMatchesSample) {
         const double f = s->le.Average() * cos / (s->pick * s->pdf_pos * s->pdf_dir);
         sum += f;
         sum2 += f * f;
-        const EmissionPdf pdf = emission.PdfLe(s->light, s->point.p, s->point.n, s->w);
+        const EmissionPdf pdf = emission.PdfLe(s->light, s->point.p, s->point.n, s->w, 0);
         ASSERT_NEAR(pdf.pos, s->pdf_pos, 1e-5f * s->pdf_pos);
         ASSERT_NEAR(pdf.dir, s->pdf_dir, 1e-3f * s->pdf_dir) << "sample " << i;
     }
@@ -238,7 +238,7 @@ TEST(EmissionSamplerTest, HitsMapToTheirLight) {
         Sampler sampler(3, 0, 0, uint64_t(i));
         const float u_pick = sampler.Get1D();
         const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, 0);
         ASSERT_TRUE(s);
         // Aim back at the sampled point from outside along its normal's side it emitted on.
         const Vec3 side = Dot(s->w, s->point.n) > 0 ? s->point.n : -s->point.n;
@@ -249,7 +249,7 @@ TEST(EmissionSamplerTest, HitsMapToTheirLight) {
         EXPECT_LT(Length(hit->p - s->point.p), 1e-4f);
         const int light = emission.LightOf(*hit);
         EXPECT_EQ(light, s->light);
-        const EmissionPdf pdf = emission.PdfLe(light, hit->p, hit->n, s->w);
+        const EmissionPdf pdf = emission.PdfLe(light, hit->p, hit->n, s->w, 0);
         EXPECT_NEAR(pdf.pos, s->pdf_pos, 1e-5f * s->pdf_pos);
         EXPECT_NEAR(pdf.dir, s->pdf_dir, 1e-3f * s->pdf_dir);
     }
@@ -327,7 +327,7 @@ TEST_P(EmissionDirectionTest, DirectionsFollowPdfDir) {
         Sampler sampler(std::hash<std::string>{}(GetParam().name), 0, 0, uint64_t(i));
         const float u_pick = sampler.Get1D();
         const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, 0);
         ASSERT_TRUE(s);
         if (!first) first = s;
         const double theta = std::acos(std::clamp(double(s->w.z), -1.0, 1.0));
@@ -344,7 +344,7 @@ TEST_P(EmissionDirectionTest, DirectionsFollowPdfDir) {
             const double p = IntegrateSolidAngle(
                 [&](const Vec3& w) {
                     return double(
-                        emission.PdfLe(first->light, first->point.p, first->point.n, w).dir);
+                        emission.PdfLe(first->light, first->point.p, first->point.n, w, 0).dir);
                 },
                 ti * kPi / kThetaRes, (ti + 1) * kPi / kThetaRes, pi * 2 * kPi / kPhiRes,
                 (pi + 1) * 2 * kPi / kPhiRes, 4, 1e-7);
@@ -378,7 +378,7 @@ TEST(LightTracingConnectionTest, PointLightOverPlaneMatchesClosedFormAndPathTrac
         Sampler sampler(5, 0, 0, uint64_t(i));
         const float u_pick = sampler.Get1D();
         const Vec2 u_pos = sampler.Get2D(), u_dir = sampler.Get2D();
-        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir);
+        const std::optional<EmissionSample> s = emission.Sample(u_pick, u_pos, u_dir, 0);
         if (!s) continue;
         const std::optional<SurfaceHit> hit = (*es)->Intersect(s->ray());
         if (!hit) continue;

@@ -71,7 +71,7 @@ std::map<int, int> ExpectPdfMatchesSample(const EmbreeScene& es, const LightSamp
             for (int j = 0; j < kGrid; ++j) {
                 const float u_pick = (k + 0.5f) / kPicks;
                 const Vec2 u((i + 0.37f) / kGrid, (j + 0.71f) / kGrid);
-                const std::optional<LightSample> ls = sampler.Sample(ref, n, u_pick, u);
+                const std::optional<LightSample> ls = sampler.Sample(ref, n, u_pick, u, 0);
                 if (!ls || ls->delta) continue;
                 const std::optional<SurfaceHit> hit = es.Intersect(Ray{ref, ls->wi});
                 if (!hit) continue;
@@ -117,7 +117,7 @@ TEST(LightStrategy, PdfMatchesSampleNearFarInsideAndOutside) {
     std::optional<float> first;
     for (int i = 0; i < 64; ++i) {
         const auto ls =
-            sampler.Sample(below, Vec3(0, 0, 0), (i + 0.5f) / 64, {(i % 8 + 0.5f) / 8, 0.3f});
+            sampler.Sample(below, Vec3(0, 0, 0), (i + 0.5f) / 64, {(i % 8 + 0.5f) / 8, 0.3f}, 0);
         if (!ls) continue;
         const auto hit = (*es)->Intersect(Ray{below, ls->wi});
         ASSERT_TRUE(hit);

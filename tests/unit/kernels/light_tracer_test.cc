@@ -8,14 +8,17 @@
 #include <cstdio>
 #include <vector>
 
-#include "splat_render.h"
-#include "splat_scenes.h"
+#include "bonferroni.h"
 #include "lf/core/scene_loader.h"
 #include "lf/local/method_factory.h"
 #include "render_path.h"
+#include "splat_render.h"
+#include "splat_scenes.h"
 
 namespace lf {
 namespace {
+
+using testing::BonferroniZ;
 
 // The image mean of R, G, B averaged, over K independent batches of light paths, with its
 // standard error from the spread of the batch means.
@@ -214,17 +217,6 @@ std::vector<bool> SpecularBlocks(const EmbreeScene& es, const Camera& camera) {
     return specular;
 }
 
-// The two-sided normal quantile for a family-wise error of alpha over n tests (Bonferroni).
-double BonferroniZ(double alpha, int n) {
-    const double p = alpha / n;
-    double lo = 0, hi = 40;
-    for (int i = 0; i < 200; ++i) {
-        const double mid = (lo + hi) / 2;
-        (std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
-    }
-    return hi;
-}
-
 // Light tracing and path tracing at the same max_depth agree block by block (8x8 pixels) within
 // their variances: each block's z with a Bonferroni threshold over the blocks, and the mean z
 // (a bias common to all blocks) within its own.
@@ -241,7 +233,7 @@ void ExpectLightMatchesPath(const Scene& scene, const char* scene_name, int max_
     int compared = 0;
     for (bool b : specular) compared += b ? 0 : 1;
     ASSERT_GT(compared, int(specular.size()) / 2);
-    const double threshold = BonferroniZ(1e-3, compared);
+    const double threshold = BonferroniZ(compared);
     double z_sum = 0, worst = 0;
     for (size_t b = 0; b < light.size(); ++b) {
         if (specular[b]) continue;
@@ -266,7 +258,7 @@ void ExpectLightMatchesPath(const Scene& scene, const char* scene_name, int max_
         "[light] %s: %d blocks of %zu compared, largest |z| %.2f (threshold %.2f), "
         "sum z / sqrt(n) %.2f\n",
         scene_name, compared, light.size(), worst, threshold, mean_z);
-    EXPECT_LT(std::abs(mean_z), BonferroniZ(1e-3, 1));
+    EXPECT_LT(std::abs(mean_z), BonferroniZ(1));
 }
 
 TEST(LightTracer, MatchesPathTracerOnCornellBox) {

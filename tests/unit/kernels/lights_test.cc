@@ -106,7 +106,7 @@ SpotProbe ProbeSpot(const LightSampler& sampler, const Vec3& light, const SpotLi
                     double degrees, float u_pick) {
     const double a = Radians(degrees);
     const Vec3 ref = light + Vec3(float(1.5 * std::sin(a)), -float(1.5 * std::cos(a)), 0);
-    return {ref, sampler.Sample(ref, Vec3(0, 1, 0), u_pick, {0.5f, 0.5f}),
+    return {ref, sampler.Sample(ref, Vec3(0, 1, 0), u_pick, {0.5f, 0.5f}, 0),
             spot.intensity.g *
                 SpotFalloff(std::cos(a), spot.inner_cone, spot.outer_cone, spot.falloff) /
                 (1.5 * 1.5)};
@@ -159,7 +159,7 @@ TEST_P(SpotFalloffTest, NarrowConesKeepTheirFalloffAndTheirShareOfThePower) {
         const double spot_pmf = spot_weight / (spot_weight + point_weight);
         // The point light comes first in the sampler's order, the spot last.
         const std::optional<LightSample> on_axis =
-            sampler.Sample(light - Vec3(0, 1.5f, 0), Vec3(0, 1, 0), 0.9999f, {0.5f, 0.5f});
+            sampler.Sample(light - Vec3(0, 1.5f, 0), Vec3(0, 1, 0), 0.9999f, {0.5f, 0.5f}, 0);
         ASSERT_TRUE(on_axis) << inner << ".." << outer;
         EXPECT_NEAR(on_axis->pdf, spot_pmf, 1e-5 * spot_pmf) << inner << ".." << outer;
         EXPECT_NEAR(on_axis->radiance.g, 3 / (1.5 * 1.5), 1e-5) << inner << ".." << outer;
@@ -246,7 +246,7 @@ TEST(DirectionalLight, ShadowRayReachesBeyondTheScene) {
     for (const Vec3d& world : {Vec3d(0, 0, 0), Vec3d(40, 0, -30), Vec3d(-45, 0, 45)}) {
         const SurfacePoint here{Vec3(world - (*es)->origin()), Vec3(1e-4f, 1e-4f, 1e-4f),
                                 Vec3(0, 1, 0)};
-        const std::optional<LightSample> ls = sampler.Sample(here.p, here.n, 0.5f, {0.5f, 0.5f});
+        const std::optional<LightSample> ls = sampler.Sample(here.p, here.n, 0.5f, {0.5f, 0.5f}, 0);
         ASSERT_TRUE(ls);
         EXPECT_TRUE(ls->delta);
         EXPECT_EQ(ls->radiance, Rgb(1.0f));
@@ -287,7 +287,7 @@ TEST(LightSampler, PicksDeltaLightsByPower) {
     const Vec3 ref = Vec3(Vec3d(0.5, 0.1, 0) - (*es)->origin());
     int seen = 0;
     for (int i = 0; i < 1000; ++i) {
-        const auto ls = sampler.Sample(ref, Vec3(0, 1, 0), (i + 0.5f) / 1000, {0.5f, 0.5f});
+        const auto ls = sampler.Sample(ref, Vec3(0, 1, 0), (i + 0.5f) / 1000, {0.5f, 0.5f}, 0);
         ASSERT_TRUE(ls);
         ++seen;
         const bool is_sun = ls->wi.y > 0.999f && ls->radiance == Rgb(0.001f);
@@ -355,7 +355,7 @@ TEST(SunDisk, VanishingDiskIsTheDeltaLight) {
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok());
     const LightSampler sampler(**es);
-    const auto ls = sampler.Sample(Vec3(0, 0, 0), Vec3(0, 1, 0), 0.5f, {0.5f, 0.5f});
+    const auto ls = sampler.Sample(Vec3(0, 0, 0), Vec3(0, 1, 0), 0.5f, {0.5f, 0.5f}, 0);
     ASSERT_TRUE(ls);
     EXPECT_TRUE(ls->delta);
     EXPECT_EQ(ls->radiance, Rgb(1.0f));
@@ -501,7 +501,7 @@ TEST(LightSampler, PicksSunSkyAndTwoSidedEmittersByPower) {
     int seen[3] = {};
     constexpr int kN = 3000;
     for (int i = 0; i < kN; ++i) {
-        const auto ls = sampler.Sample(ref, Vec3(0, 1, 0), (i + 0.5f) / kN, {0.3f, 0.6f});
+        const auto ls = sampler.Sample(ref, Vec3(0, 1, 0), (i + 0.5f) / kN, {0.3f, 0.6f}, 0);
         if (!ls) continue;  // the sky below the horizon is not refused: it is all directions
         EXPECT_FALSE(ls->delta);
         if (ls->radiance == Rgb(1.0f)) {  // the triangle, from behind

@@ -2,8 +2,11 @@
 // pixel filter.
 #pragma once
 
+#include <array>
 #include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "lf/core/pixel_filter.h"
 #include "lf/core/ray.h"
@@ -20,11 +23,20 @@ class Camera {
   public:
     // `origin` is subtracted from world positions: kernels render in a frame centred on the
     // scene so float precision is spent where the geometry is (see EmbreeScene).
-    Camera(const CameraSpec& spec, const Vec3d& origin);
+    // A moving camera (motion blur) gives `motion`: where it is at evenly spaced times over the
+    // shutter, the first at its opening (time 0), the last at its closing (time 1), as
+    // EmbreeScene::camera_motion() holds them; at time t it is between the two nearest, its
+    // position linear and its orientation slerped. Lens, film and filter are `spec`'s. Empty:
+    // the camera stands still at `spec`.
+    Camera(const CameraSpec& spec, const Vec3d& origin, std::span<const CameraSpec> motion = {});
 
     // Ray through film point (px + u, py + v); px counts from the left, py from the top. With a
-    // lens, `lens` (uniform in [0, 1)^2) picks the point on the aperture it leaves from.
-    Ray GenerateRay(int px, int py, float u, float v, const Vec2& lens = {}) const;
+    // lens, `lens` (uniform in [0, 1)^2) picks the point on the aperture it leaves from. The ray
+    // leaves at `time` in the shutter (Ray::time) from where the camera is then.
+    Ray GenerateRay(int px, int py, float u, float v, const Vec2& lens = {}, float time = 0) const;
+
+    // Whether the camera moves during the shutter.
+    bool Moves() const { return !motion_.empty(); }
 
     // Where in its pixel a sample with film numbers u (uniform in [0, 1)^2) lands, for
     // GenerateRay: distributed like the camera's pixel filter (FilterSampler); u itself for the
@@ -76,7 +88,8 @@ class Camera {
         float pdf = 0;
         float we = 0;
     };
-    std::optional<ImportanceSample> SampleWi(const Vec3& ref, const Vec2& u_lens = {}) const;
+    std::optional<ImportanceSample> SampleWi(const Vec3& ref, const Vec2& u_lens = {},
+                                             float time = 0) const;
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -84,11 +97,24 @@ class Camera {
     const PixelFilter& filter() const { return filter_spec_; }
 
   private:
+    // Where the camera is and which way it looks (render space, unit axes).
+    struct Pose {
+        Vec3 position, forward, right, up;
+    };
+    // A step of a moving camera: its position and its orientation as a unit quaternion
+    // (x, y, z, w) of the rotation taking (right, up, -forward) to the axes.
+    struct MotionKey {
+        Vec3d position;
+        std::array<double, 4> rotation;
+    };
+    Pose PoseAt(float time) const;
+
     // Where ray's film point falls (raster coordinates) and the cosine of ray.d with the view
     // axis; nullopt when behind the camera or off the film.
-    std::optional<Vec2> Raster(const Ray& ray, float* cos_theta) const;
+    std::optional<Vec2> Raster(const Ray& ray, const Pose& pose, float* cos_theta) const;
 
-    Vec3 position_, forward_, right_, up_;
+    Pose pose_;                      // the still camera's
+    std::vector<MotionKey> motion_;  // a moving camera's steps; empty: still
     bool orthographic_ = false;
     float tan_half_fov_ = 0, aspect_ = 1;  // tan_half_fov_: the film's half height at distance 1
                                            // (orthographic: the film's half height)

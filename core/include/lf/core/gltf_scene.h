@@ -44,6 +44,10 @@ struct GltfImport {
     // with the node tree and what each node drives, when the file has any of them; null:
     // ignored, the rest pose only.
     SceneAnimation* animation = nullptr;
+    // Required with `animation`: where a fault in that data goes (InvalidArgument naming the
+    // file and the glTF object: "car.gltf: animations[0].channels[2]: ..."). Such a file still
+    // loads in its rest pose, with a warning, and what went into `animation` is incomplete.
+    absl::Status* animation_error = nullptr;
 };
 
 // Appends the default scene of glTF file `name` (its bytes `bytes`, JSON or binary) to `scene`:

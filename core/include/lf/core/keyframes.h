@@ -21,8 +21,9 @@ class Keyframes {
   public:
     // `values` holds `width` numbers per key; CUBICSPLINE 3 * width, in glTF's order: in-tangent,
     // value, out-tangent. InvalidArgument starting with `where` ("animations[0].samplers[1]")
-    // when the times are empty, not finite or not strictly increasing, the counts do not
-    // match, a value is not finite, or a rotation key is the zero quaternion.
+    // and naming the key (its index, and its time once the times are valid) when the times are
+    // empty, not finite or not strictly increasing, the counts do not match, a value is not
+    // finite, or a rotation key is the zero quaternion.
     static absl::StatusOr<Keyframes> Create(Interpolation interpolation, KeyframeKind kind,
                                             int width, std::vector<double> times,
                                             std::vector<double> values, const std::string& where);
@@ -33,6 +34,8 @@ class Keyframes {
     std::vector<double> At(double seconds) const;
 
     int width() const { return width_; }
+    Interpolation interpolation() const { return interpolation_; }
+    const std::vector<double>& times() const { return times_; }
     double start() const { return times_.front(); }
     double end() const { return times_.back(); }
 

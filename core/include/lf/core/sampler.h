@@ -77,7 +77,20 @@ class Sampler {
         return {float(bits >> 40) * 0x1p-24f, float((bits >> 8) & 0xffffff) * 0x1p-24f};
     }
 
+    // The sample's time in the shutter, uniform in [0, 1): a dimension of its own, outside the
+    // sequence of Get1D/Get2D draws, so a render that takes it draws every other number as
+    // one that does not (a static scene keeps its bits with a shutter). Stratified over the
+    // pixel's samples like every other dimension (Sobol).
+    float GetTime() const {
+        const uint64_t h = MixBits(key_ ^ kTimeKey);
+        if (type_ == SamplerType::kSobol) {
+            return ToFloat(ScrambledDimension0(ShuffledReversedIndex(h), h));
+        }
+        return float(h >> 40) * 0x1p-24f;
+    }
+
   private:
+    static constexpr uint64_t kTimeKey = 0x5851f42d4c957f2dULL;
     static constexpr uint64_t kGolden = 0x9e3779b97f4a7c15ULL;
 
     static uint64_t PixelKey(uint64_t seed, int px, int py) {

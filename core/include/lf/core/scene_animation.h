@@ -80,20 +80,33 @@ struct AnimatedLight {
     bool moves = false;
 };
 
+// A Scene sphere a node places (a JSON sphere with keyframes): its centre moved by the node's
+// world transform, its radius scaled by the transform's scale, which the loader keeps uniform.
+struct AnimatedSphere {
+    int sphere = 0;  // index in Scene::spheres
+    int node = 0;    // index in SceneAnimation::nodes
+    Vec3d center;    // in the node's space
+    double radius = 1;
+    bool moves = false;
+};
+
 struct SceneAnimation {
     std::vector<AnimationNode> nodes;
-    std::vector<AnimationChannel> channels;  // every animation of every file, all at once
+    // Every animation of every file, and every JSON keyframed transform, all at once.
+    std::vector<AnimationChannel> channels;
     std::vector<AnimationSkin> skins;
     std::vector<AnimatedMesh> meshes;
+    std::vector<AnimatedSphere> spheres;
     std::vector<AnimatedLight> lights;
-    // The node of the Scene's camera when it is a glTF camera; -1: the camera stays.
+    // The node of the Scene's camera when it is a glTF camera or a JSON camera with keyframes
+    // (a child node placing it as a glTF camera: looking down -Z, +Y up); -1: it stays.
     int camera_node = -1;
 
-    // Writes the world-space geometry, camera and lights of time `seconds` into `scene`, the
-    // Scene this animation was loaded with (or a copy of it). Only what a node drives is
-    // written; the camera keeps its lens, resolution and filter. InvalidArgument naming the
-    // node and the time when a pose flattens a transform or leaves the coordinate range
-    // (±kMaxCoordinate).
+    // Writes the world-space geometry (meshes and spheres), camera and lights of time
+    // `seconds` into `scene`, the Scene this animation was loaded with (or a copy of it). Only
+    // what a node drives is written; the camera keeps its lens, resolution and filter.
+    // InvalidArgument naming the node and the time when a pose flattens a transform or leaves
+    // the coordinate range (±kMaxCoordinate).
     absl::Status PoseAt(double seconds, Scene& scene) const;
 
     // Each node's world transform at `seconds`.
@@ -109,7 +122,9 @@ struct SceneAnimation {
     double End() const;
     // Whether the animation drives anything at all (skins and morph weights pose a mesh even
     // without channels).
-    bool Empty() const { return meshes.empty() && lights.empty() && camera_node < 0; }
+    bool Empty() const {
+        return meshes.empty() && spheres.empty() && lights.empty() && camera_node < 0;
+    }
 };
 
 // Places `spec` (position, look_at, up) where a glTF camera node with world transform `world`

@@ -70,6 +70,10 @@ inline constexpr std::array<std::string_view, 2> kRadiosityDisplays = {"flat", "
 // "radiosity.patches 1099511627776: expected 1 to 16777216".
 absl::Status CheckJobSettings(const JobSpec& spec);
 
+// Ok unless `shutter` opens (> 0) for a method that renders no motion blur
+// (MethodInfo::motion_blur): then InvalidArgument naming the method.
+absl::Status CheckShutterOfMethod(Method method, double shutter);
+
 // The still that renders frame `frame` of `spec`'s shot: its frames are {frame, frame, 1}, one
 // frame a task. Every frame of a shot renders as the still of that frame renders alone, locally
 // or on the farm, so each gives the same bits.

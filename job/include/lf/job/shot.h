@@ -30,7 +30,8 @@ struct FrameRange {
 
 inline constexpr int kMaxFrameNumber = 1'000'000;  // |frame| at most this
 inline constexpr int kMaxShotFrames = 100'000;     // frames in one job
-inline constexpr double kMaxFps = 1000;
+// Frame times stay finite and distinct: |frame| / fps at most 10^9 seconds.
+inline constexpr double kMinFps = 1e-3, kMaxFps = 1000;
 inline constexpr double kMaxShutter = 10;  // frames
 inline constexpr int kMaxChunk = 1000;
 
@@ -66,8 +67,8 @@ absl::StatusOr<FrameRange> ParseFrameRange(std::string_view text);
 std::string FrameRangeText(const FrameRange& range);
 
 // Ok when the settings are within their limits (the frames as ParseFrameRange checks them, fps in
-// (0, kMaxFps], shutter in [0, kMaxShutter], chunk in 1..kMaxChunk); otherwise InvalidArgument
-// naming the field, as CheckJobSettings reports the others.
+// [kMinFps, kMaxFps], shutter in [0, kMaxShutter], chunk in 1..kMaxChunk); otherwise
+// InvalidArgument naming the field, as CheckJobSettings reports the others.
 absl::Status CheckShotSettings(const ShotSettings& shot);
 
 // Seconds of frame `frame`: frame / fps.

@@ -62,9 +62,9 @@
 
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/light_emission.h"
 #include "lf/kernels/lights.h"
+#include "lf/kernels/splat_renderer.h"
 
 namespace lf {
 
@@ -99,9 +99,10 @@ class BdptRenderer : public SplatRenderer {
     // Extends `path` (whose last vertex is where `ray` starts) by up to `max_vertices` vertices.
     void Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool importance, Sampler& sampler,
               Path& path, RenderStats& stats) const;
-    // The light subpath of the emission numbers; empty when the sample carries no light.
-    void LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_dir, Sampler& sampler,
-                      Path& path, RenderStats& stats) const;
+    // The light subpath of the emission numbers at `time` in the shutter; empty when the sample
+    // carries no light.
+    void LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_dir, float time,
+                      Sampler& sampler, Path& path, RenderStats& stats) const;
     // Strategy (s, t) for t >= 2 (camera sum) or t = 1 (then *raster is set when it
     // contributes); 0 when it does not apply or is occluded. Weighted.
     Rgb Connect(Path& light, Path& camera, int s, int t, Vec2* raster, RenderStats& stats) const;

@@ -3,8 +3,13 @@
 // that subtraction, so a scene 10^5 units from the world origin keeps full float precision.
 // Hit points carry pbrt-v4 style floating-point error bounds; rays leaving a surface start
 // beyond them (SpawnRay), so there is no self-intersection at any scale.
+// With motion (SceneMotion) the meshes that move have one pose per step over the shutter
+// (Embree's time steps, interpolated linearly); everything that reads a position, normal or
+// tangent at a time (a ray's, a hit's) interpolates the same way, so a light sample on a moving
+// emitter and a ray's hit on it agree. Meshes that stay still keep one pose and cost nothing.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -13,6 +18,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/ray.h"
 #include "lf/core/scene.h"
+#include "lf/kernels/scene_motion.h"
 
 namespace lf {
 
@@ -26,6 +32,7 @@ struct SurfaceHit {
     int sphere = -1;       // index in Scene::spheres, or -1 for a triangle
     int primitive = 0;     // triangle index within the mesh
     float b1 = 0, b2 = 0;  // barycentrics of vertices 1 and 2 of the triangle
+    float time = 0;        // the ray's (Ray::time): where moving geometry was hit
 };
 
 // A point on a surface with its error bound and normal: where rays start and end.
@@ -35,6 +42,7 @@ struct SurfacePoint {
     // tracer read the emitter's textures there. mesh -1 otherwise.
     int mesh = -1, primitive = 0;
     float b1 = 0, b2 = 0;
+    float time = 0;  // in the shutter (Ray::time): rays spawned from it leave then
 };
 
 // A ray origin just outside p's error box on the side of w.
@@ -46,8 +54,12 @@ Ray SpawnRayTo(const SurfacePoint& from, const SurfacePoint& to);
 class EmbreeScene {
   public:
     // Cancelled once `cancel` is set: Embree's BVH build asks its progress monitor often.
+    // `scene` is posed at the frame's time; with `motion` that blurs, copies of it posed at
+    // MotionSteps(motion) times over the shutter (SceneAnimation::PoseAt) give the moving
+    // meshes' steps and the camera's (camera_motion()). A pose PoseAt refuses is the error.
     static absl::StatusOr<std::unique_ptr<EmbreeScene>> Build(
-        const Scene& scene, const std::atomic<bool>* cancel = nullptr);
+        const Scene& scene, const std::atomic<bool>* cancel = nullptr,
+        const SceneMotion& motion = {});
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -60,11 +72,36 @@ class EmbreeScene {
     const Scene& scene() const { return scene_; }
     const Vec3d& origin() const { return origin_; }
 
+    // Spheres do not move during a shutter: Build refuses a blur that would move one.
     Vec3 SphereCenter(int sphere) const { return sphere_centers_[size_t(sphere)]; }
-    // Vertices of triangle `primitive` of `mesh` in render space.
-    void Triangle(int mesh, int primitive, Vec3* p0, Vec3* p1, Vec3* p2) const;
-    SurfacePoint TrianglePoint(int mesh, int primitive, float b1, float b2) const;
-    SurfacePoint SpherePoint(int sphere, const Vec3& direction_from_center) const;
+    // Vertices of triangle `primitive` of `mesh` in render space at `time` (Ray::time).
+    void Triangle(int mesh, int primitive, float time, Vec3* p0, Vec3* p1, Vec3* p2) const;
+    SurfacePoint TrianglePoint(int mesh, int primitive, float b1, float b2, float time) const;
+    SurfacePoint SpherePoint(int sphere, const Vec3& direction_from_center, float time) const;
+    // Whether mesh m moves during the shutter; its vertex `v`'s normal and tangent at `time`
+    // (the Scene's when it does not move; interpolated, not normalised, when it does).
+    bool Moves(int mesh) const { return !steps_of_[size_t(mesh)].empty(); }
+    Vec3 Normal(int mesh, uint32_t v, float time) const;
+    std::array<float, 4> Tangent(int mesh, uint32_t v, float time) const;
+    // Point light i's position and spot light i's position and unit axis (render space) at
+    // `time`: the Scene's when no node moves them, else linear between steps (the axis
+    // renormalised).
+    Vec3 PointLightPosition(int i, float time) const;
+    struct SpotPlace {
+        Vec3 position, direction;
+    };
+    SpotPlace SpotLightAt(int i, float time) const;
+    // The camera's poses over the shutter when it moves (for Camera's motion), else empty.
+    const std::vector<CameraSpec>& camera_motion() const { return camera_motion_; }
+    // How many poses moving meshes have (1: nothing moves).
+    int steps() const { return steps_; }
+
+    // A moving mesh's pose at one step: render-space positions with the padding vertex,
+    // normals and tangents as the posed Scene gives them.
+    struct MeshStep {
+        std::vector<Vec3> positions, normals;
+        std::vector<std::array<float, 4>> tangents;
+    };
 
   private:
     EmbreeScene(const Scene& scene, const Vec3d& origin);
@@ -77,6 +114,13 @@ class EmbreeScene {
     // buffer (shared, not copied). Normals, uvs and tangents are read from the Scene itself:
     // translation to render space leaves them unchanged.
     std::vector<std::vector<Vec3>> positions_;
+    // Per mesh: empty when it stands still, else its poses, one per step.
+    std::vector<std::vector<MeshStep>> steps_of_;
+    // Per point and spot light: empty when it stands still, else its places, one per step.
+    std::vector<std::vector<Vec3>> point_steps_;
+    std::vector<std::vector<SpotPlace>> spot_steps_;
+    int steps_ = 1;
+    std::vector<CameraSpec> camera_motion_;
     std::vector<Vec3> sphere_centers_;
     unsigned sphere_geometry_ = ~0u;
 };

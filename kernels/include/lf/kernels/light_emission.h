@@ -79,7 +79,9 @@ class EmissionSampler {
     // An emitted ray: u_pick picks the light, u_pos the point on it (lights at infinity: on the
     // disk), u_dir the direction (two-sided emitters: u_dir.x also picks the side). nullopt when
     // the sample carries no light (a cut-out of a textured emitter, outside a spot's cone, ...).
-    std::optional<EmissionSample> Sample(float u_pick, const Vec2& u_pos, const Vec2& u_dir) const;
+    // The ray leaves at `time` in the shutter (Ray::time), from where a moving emitter is then.
+    std::optional<EmissionSample> Sample(float u_pick, const Vec2& u_pos, const Vec2& u_dir,
+                                         float time) const;
 
     // The light a surface hit is on (an emissive triangle or sphere), or -1.
     int LightOf(const SurfaceHit& hit) const;
@@ -93,7 +95,8 @@ class EmissionSampler {
     // otherwise) in direction w (unit, away from the light). For a light at infinity p and n are
     // ignored and pos is 1 / (pi R^2); w must then be the direction of travel. Deltas: the
     // densities of the delta parts are 1 when w is the light's own direction, else 0.
-    EmissionPdf PdfLe(int light, const Vec3& p, const Vec3& n, const Vec3& w) const;
+    // A moving spot light's cone is the one of `time`.
+    EmissionPdf PdfLe(int light, const Vec3& p, const Vec3& n, const Vec3& w, float time) const;
 
     // For a path vertex that escaped the scene travelling along -w (w unit, towards the sky):
     // pos = 1 / (pi R^2) and dir = the sum over the lights at infinity (not directional delta
@@ -111,16 +114,16 @@ class EmissionSampler {
         bool two_sided;
     };
     // A spot light's cone (SpotBandOf, as LightSampler's): with c = 1 - cos(angle to the axis),
-    // the falloff is SpotBandFalloff(clamp((one_minus_cos_outer - c) * inv_width, 0, 1)).
+    // the falloff is SpotBandFalloff(clamp((one_minus_cos_outer - c) * inv_width, 0, 1)). Its
+    // position and axis at a time are EmbreeScene::SpotLightAt's.
     struct SpotCone {
-        Vec3 position, direction;
         float one_minus_cos_outer, inv_width;
         bool smooth;
         Rgb intensity;
     };
 
     // An area light's point for u, with its normal and Le there (Le before the side test).
-    SurfacePoint AreaPoint(const Light& light, const Vec2& u) const;
+    SurfacePoint AreaPoint(const Light& light, const Vec2& u, float time) const;
     Rgb AreaEmission(const Light& light, const SurfacePoint& point) const;
     // Direction density of a light at infinity for a ray travelling along w.
     float InfiniteDirPdf(const Light& light, const Vec3& w) const;

@@ -39,9 +39,10 @@ struct EmissiveTriangle {
     bool two_sided;  // emits from its back too (EmitsFromBack)
 };
 
-// Calls visit(const EmissiveTriangle&) for every triangle of positive area of every emissive
-// mesh, mesh by mesh, in order. visit returns how many triangles it took: 1, or 2 when it made
-// one light of this triangle and the next (a rectangle), which is then skipped.
+// Calls visit(const EmissiveTriangle&) for every triangle of positive area (at the shutter's
+// opening, for a moving mesh) of every emissive mesh, mesh by mesh, in order. visit returns how
+// many triangles it took: 1, or 2 when it made one light of this triangle and the next (a
+// rectangle), which is then skipped.
 template <typename Visit>
 void ForEachEmissiveTriangle(const EmbreeScene& es, Visit&& visit) {
     const Scene& scene = es.scene();
@@ -51,7 +52,7 @@ void ForEachEmissiveTriangle(const EmbreeScene& es, Visit&& visit) {
         const size_t triangles = scene.meshes[m].triangles.size();
         for (size_t t = 0; t < triangles; ++t) {
             EmissiveTriangle tri{int(m), int(t), {}, 0, &material, EmitsFromBack(material)};
-            es.Triangle(int(m), int(t), &tri.p[0], &tri.p[1], &tri.p[2]);
+            es.Triangle(int(m), int(t), 0, &tri.p[0], &tri.p[1], &tri.p[2]);
             tri.area = 0.5f * Length(Cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
             if (!(tri.area > 0)) continue;
             t += size_t(visit(static_cast<const EmissiveTriangle&>(tri)) - 1);

@@ -62,18 +62,19 @@ class LightSampler {
     LightStrategy strategy() const { return strategy_; }
 
     // A light sample for the reference point `ref` with (shading) normal `n`, unit, or zero in a
-    // volume; kPower ignores n.
-    std::optional<LightSample> Sample(const Vec3& ref, const Vec3& n, float u_pick,
-                                      const Vec2& u) const;
+    // volume; kPower ignores n. Moving emitters are where they are at `time` (Ray::time).
+    std::optional<LightSample> Sample(const Vec3& ref, const Vec3& n, float u_pick, const Vec2& u,
+                                      float time) const;
 
     // Light i (of size()) when it is a delta light (point, spot, directional without a
     // diameter), as Sample gives it at `ref` but with pdf 1; nullopt for the others: for
     // estimators that sum every delta light instead of picking one (lf/kernels/whitted.h).
     bool IsDeltaLight(size_t i) const;
-    std::optional<LightSample> SampleDeltaLight(size_t i, const Vec3& ref) const;
+    std::optional<LightSample> SampleDeltaLight(size_t i, const Vec3& ref, float time) const;
 
     // Density, per solid angle at `ref`, with which Sample(ref, n, ...) would have produced
-    // `hit` (an emitter hit by a BSDF-sampled ray); used for multiple importance sampling.
+    // `hit` (an emitter hit by a BSDF-sampled ray, at its time); used for multiple importance
+    // sampling.
     float Pdf(const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;
 
     // Radiance of the lights at infinity (sun disks, environment) arriving along a ray that
@@ -112,11 +113,10 @@ class LightSampler {
         };
         Half halves[2];
     };
-    // A spot light's cone in render space: with c = 1 - cos(angle to the axis) and
-    // t = clamp((one_minus_cos_outer - c) * inv_width, 0, 1) its falloff is t^2
-    // (KHR_lights_punctual) or t^2 (3 - 2 t) (smoothstep).
+    // A spot light's cone (its axis at a time: EmbreeScene::SpotLightAt): with c = 1 - cos(angle
+    // to the axis) and t = clamp((one_minus_cos_outer - c) * inv_width, 0, 1) its falloff is
+    // t^2 (KHR_lights_punctual) or t^2 (3 - 2 t) (smoothstep).
     struct SpotCone {
-        Vec3 direction;
         float one_minus_cos_outer, inv_width;
         bool smooth;
     };
@@ -127,12 +127,12 @@ class LightSampler {
     // angle at ref (normal n, for the cosine warp of large triangles), not yet times the pick
     // probability.
     std::optional<LightSample> SampleArea(const Light& light, const Vec3& ref, const Vec3& n,
-                                          const Vec2& u) const;
+                                          const Vec2& u, float time) const;
     // The density with which SampleArea yields `hit` on area light `light` from ref.
     float AreaPdf(const Light& light, const Vec3& ref, const Vec3& n, const SurfaceHit& hit) const;
     // The point at (s, t) of rectangle light `light`, on whichever of its triangles holds it.
     SurfacePoint RectanglePoint(const Light& light, const Vec2& st) const;
-    std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref) const;
+    std::optional<LightSample> SampleDelta(const Light& light, const Vec3& ref, float time) const;
     // A direction towards a sun disk (uniform in its cone) or the environment (by its map).
     std::optional<Vec3> SampleInfiniteDirection(const Light& light, const Vec2& u) const;
     // Where a shadow ray from ref towards a light at infinity in direction wi ends.

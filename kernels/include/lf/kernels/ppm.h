@@ -49,6 +49,8 @@
 namespace lf {
 
 inline constexpr uint64_t kPhotonSeedSalt = 0x70686f746f6e73ULL;  // "photons"
+// Pass p's time in the shutter: Sampler(MixBits(seed ^ kPassTimeSalt), 0, 0, p).GetTime().
+inline constexpr uint64_t kPassTimeSalt = 0x73687574746572ULL;  // "shutter"
 // The default r_0 in pixel footprints at the scene's typical depth (see PpmDefaultRadius).
 inline constexpr double kDefaultRadiusPixels = 3;
 
@@ -59,8 +61,9 @@ struct EmittedPhoton {
     Rgb power;
 };
 // Draws u_pick, u_pos, u_dir from `sampler`, in that order; nullopt when the sample carries no
-// light.
-std::optional<EmittedPhoton> EmitPhoton(const EmissionSampler& emission, Sampler& sampler);
+// light. The photon leaves at `time` in the shutter.
+std::optional<EmittedPhoton> EmitPhoton(const EmissionSampler& emission, Sampler& sampler,
+                                        float time = 0);
 
 // r_p^2 / r_0^2 = prod_{i < p} (i + alpha) / (i + 1), by that product in double.
 double PpmRadiusRatioSquared(double alpha, uint64_t pass);
@@ -88,7 +91,10 @@ class PpmRenderer : public SplatRenderer {
                 const std::atomic<bool>* cancel = nullptr) const override;
 
     // Pass `pass`'s photon map (radius Radius(pass)); traced in parallel chunks whose photons
-    // are concatenated in photon order. Its rays are added to stats.rays.
+    // are concatenated in photon order. Its rays are added to stats.rays. A pass's photons and
+    // camera rays share one time in the shutter, PassTime(pass), so that every photon a camera
+    // vertex gathers was where that vertex is (motion blur); the passes spread it over the
+    // shutter.
     PhotonMap TracePhotons(uint64_t pass, RenderStats& stats,
                            const std::atomic<bool>* cancel = nullptr) const;
     // Pass `pass`'s estimate along camera ray `ray` with `map` (TracePhotons(pass)).
@@ -97,6 +103,7 @@ class PpmRenderer : public SplatRenderer {
     double initial_radius() const { return initial_radius_; }
     uint64_t photons_per_pass() const { return photons_per_pass_; }
     float Radius(uint64_t pass) const;
+    float PassTime(uint64_t pass) const;
 
   private:
     PpmRenderer(const EmbreeScene& scene, const Camera& camera,

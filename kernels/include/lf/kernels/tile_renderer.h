@@ -28,6 +28,8 @@ struct SampleOptions {
 // Sampler(seed, x, y, s, options.sampler); its first two numbers place it in the pixel through the
 // camera's pixel filter (Camera::SampleFilm), and it adds to pixel (x, y) alone with weight 1, so
 // the result depends on nothing else: not the tiling, not the thread. AOVs draw no random numbers.
+// Its time in the shutter (motion blur: Ray::time) is Sampler::GetTime, which shifts no other
+// number, so scenes where nothing moves render the same bits with a shutter as without.
 TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, const PixelRect& rect,
                     uint64_t seed, uint64_t sample_begin, uint64_t sample_end,
                     const SampleOptions& options = {}, const std::atomic<bool>* cancel = nullptr);

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "lf/core/image_io.h"
@@ -14,6 +15,7 @@
 #include "lf/job/method_registry.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/settings.h"
+#include "lf/job/shot.h"
 #include "lf/job/splat_settings.h"
 #include "lf/local/local_executor.h"
 
@@ -27,6 +29,10 @@ class RenderProgress {
     virtual void Start() = 0;
     virtual void Update(size_t done, size_t total) = 0;
     virtual void Finish() = 0;
+    // A shot (RunLocalShot): frame `frame`, the index-th of `count`, starts; `done` of `count`
+    // are written.
+    virtual void StartFrame(int index, int count, int frame) {}
+    virtual void FinishFrame(int done, int count) {}
 };
 
 // Ctrl-C during a render. A signal handler sets `requested`; RunLocalRender sets `honoured`
@@ -77,5 +83,37 @@ struct LocalRenderSummary {
 
 // Renders and writes the files; logs as the farm's jobs do (job=local-<scene hash>).
 absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& options);
+
+// One frame of a shot: its files, and what posing the scene and building its BVH (and the
+// method's kernel) took; bvh_seconds 0 when the frame reused the previous frame's.
+struct LocalFrameSummary {
+    int frame = 0;
+    double time = 0;  // seconds: frame / fps
+    double pose_seconds = 0, bvh_seconds = 0;
+    std::string exr_path, png_path;
+    LocalRenderSummary render;  // load_seconds: pose and BVH
+};
+
+struct LocalShotSummary {
+    std::string job_id;
+    bool moves = false;  // false: every frame rendered on the first frame's BVH and kernel
+    std::vector<LocalFrameSummary> frames;  // those written, in order
+    double seconds = 0;                     // the whole shot, loading included
+    // Ctrl-C: the last frame written is partial and the shot stopped there.
+    std::string partial;
+};
+
+// Ok when options.exr_path and options.png_path (patterns: out_####.exr) name every frame of
+// `frames` (CheckFramePattern), naming -o or --png otherwise.
+absl::Status CheckShotOutputs(const LocalRenderOptions& options, const FrameRange& frames);
+
+// `render --frames`: loads the scene once, then for each frame of `shot.frames` poses it
+// (PoseSceneAtFrame), rebuilds the BVH and the method's kernel when the animation moves
+// anything (radiosity solves again: one instant per frame), and renders and writes the frame
+// as RunLocalRender renders the still of FrameSpec (same bits; its header names the frame).
+// options.exr_path and png_path are patterns (FramePath). An interrupt writes the current
+// frame partial and ends the shot.
+absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
+                                              const ShotSettings& shot);
 
 }  // namespace lf
