@@ -15,6 +15,7 @@
 #include "lf/client/command.h"
 #include "lf/client/farm_client.h"
 #include "lf/client/farm_flags.h"
+#include "lf/client/frame_flags.h"
 #include "lf/client/method_flags.h"
 #include "lf/client/photon_flags.h"
 #include "lf/client/radiosity_flags.h"
@@ -115,6 +116,8 @@ Command AddSubmitCommand(CLI::App& app) {
     AddSkyFlag(cmd, o->spec.scene_options);
     AddServerOption(cmd, o->farm);
     AddRetryOption(cmd, o->farm);
+    auto frame_flags = std::make_shared<FrameFlags>();
+    AddFrameFlags(cmd, *frame_flags);
     cmd->add_option("--spp", o->spec.plan.spp, "samples per pixel")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(1), kMaxSpp));
@@ -151,7 +154,8 @@ Command AddSubmitCommand(CLI::App& app) {
                         "frames on one worker (fixed plans only: not with adaptive sampling "
                         "or --solver jacobi); 1: each frame's tiles spread over the workers")
             ->capture_default_str()
-            ->check(CLI::Range(1, kMaxChunk));
+            ->check(CLI::Range(1, kMaxChunk))
+            ->group("Animation");
     AddPhotonFlags(cmd, o->spec.ppm);
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
@@ -162,7 +166,11 @@ Command AddSubmitCommand(CLI::App& app) {
         ->group("Radiosity")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxSweepTasks));
-    return {cmd, [cmd, o, chunk] {
+    return {cmd, [cmd, o, chunk, frame_flags] {
+                absl::StatusOr<ShotSettings> shot = ShotOfFrameFlags(*frame_flags);
+                if (!shot.ok()) return ReportError(shot.status());
+                shot->chunk = o->spec.shot.chunk;
+                o->spec.shot = *shot;
                 if (chunk->count() > 0 && !o->spec.shot.frames) {
                     return ReportError(absl::InvalidArgumentError(
                         absl::StrCat("--chunk ", o->spec.shot.chunk,

@@ -262,11 +262,14 @@ absl::Status Worker::PoseFrame(const TaskAssignment& task, int frame,
     loaded_.camera.reset();
     loaded_.embree.reset();
     loaded_.posed_frame.reset();
-    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree =
-        EmbreeScene::Build(*loaded_.scene, &cancel);
+    // Under an open shutter the BVH holds the poses over it, as `render --shutter` builds them.
+    const ShutterInterval shutter = ShutterOf(frame, task.spec.shot);
+    absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(
+        *loaded_.scene, &cancel, {loaded_.scene->animation.get(), shutter.open, shutter.close});
     if (!embree.ok()) return embree.status();
     loaded_.embree = std::move(*embree);
-    loaded_.camera = std::make_unique<Camera>(loaded_.scene->camera, loaded_.embree->origin());
+    loaded_.camera = std::make_unique<Camera>(loaded_.scene->camera, loaded_.embree->origin(),
+                                              loaded_.embree->camera_motion());
     loaded_.posed_frame = frame;
     Log()->info("job={} task={} frame {} posed in {:.1f} ms, BVH built in {:.1f} ms", task.job_id,
                 task.task.index, frame, absl::ToDoubleMilliseconds(posed - start),
