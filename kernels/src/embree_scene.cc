@@ -403,6 +403,12 @@ void EmbreeScene::Triangle(int mesh, int primitive, float time, Vec3* p0, Vec3* 
     *p2 = Lerp(a[tri[2]], b[tri[2]], at.f);
 }
 
+float EmbreeScene::TriangleArea(int mesh, int primitive, float time) const {
+    Vec3 p0, p1, p2;
+    Triangle(mesh, primitive, time, &p0, &p1, &p2);
+    return 0.5f * Length(Cross(p1 - p0, p2 - p0));
+}
+
 Vec3 EmbreeScene::Normal(int mesh, uint32_t v, float time) const {
     const std::vector<MeshStep>& steps = steps_of_[size_t(mesh)];
     if (steps.empty()) return scene_.meshes[size_t(mesh)].normals[v];

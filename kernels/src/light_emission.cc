@@ -104,6 +104,14 @@ SurfacePoint EmissionSampler::AreaPoint(const Light& light, const Vec2& u, float
     return scene_.SpherePoint(light.index, Vec3(r * std::cos(phi), r * std::sin(phi), z), time);
 }
 
+float EmissionSampler::AreaAt(const Light& light, float time) const {
+    // A deforming triangle's area changes with time; a still one's is the one of the list.
+    if (light.kind == Kind::kTriangle && scene_.Moves(light.index)) {
+        return scene_.TriangleArea(light.index, light.primitive, time);
+    }
+    return light.area;
+}
+
 Rgb EmissionSampler::AreaEmission(const Light& light, const SurfacePoint& point) const {
     const Scene& scene = scene_.scene();
     const int material = light.kind == Kind::kTriangle
@@ -129,7 +137,7 @@ std::optional<EmissionSample> EmissionSampler::Sample(float u_pick, const Vec2& 
             es.point = AreaPoint(light, u_pos, time);
             es.on_surface = true;
             if (light.kind == Kind::kSphere) es.sphere = light.index;
-            es.pdf_pos = 1 / light.area;
+            es.pdf_pos = 1 / AreaAt(light, time);
             Vec2 u = u_dir;
             Vec3 n = es.point.n;
             float side = 1;
@@ -258,8 +266,9 @@ EmissionPdf EmissionSampler::PdfLe(int li, const Vec3& p, const Vec3& n, const V
         case Kind::kTriangle:
         case Kind::kSphere: {
             const float cos = Dot(n, w);
-            if (!light.two_sided && !(cos > 0)) return {1 / light.area, 0};
-            return {1 / light.area, std::abs(cos) / kPi * (light.two_sided ? 0.5f : 1.0f)};
+            const float pdf_pos = 1 / AreaAt(light, time);
+            if (!light.two_sided && !(cos > 0)) return {pdf_pos, 0};
+            return {pdf_pos, std::abs(cos) / kPi * (light.two_sided ? 0.5f : 1.0f)};
         }
         case Kind::kPoint:
             return {1, 1 / (4 * kPi)};

@@ -353,8 +353,7 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
     if (light.kind == Kind::kTriangle) {
         Vec3 p0, p1, p2;
         scene_.Triangle(light.index, light.primitive, time, &p0, &p1, &p2);
-        // A deforming triangle's area changes with time (ForEachEmissiveTriangle's formula).
-        area = 0.5f * Length(Cross(p1 - p0, p2 - p0));
+        area = scene_.TriangleArea(light.index, light.primitive, time);
         const SphericalTriangle st(ref, p0, p1, p2, kMinSampledSolidAngle);
         if (bvh && st.samplable()) {
             solid_angle_pdf = st.Pdf();
@@ -438,9 +437,7 @@ float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const Vec3& n,
     }
     float area = light.area;
     if (light.kind == Kind::kTriangle) {
-        Vec3 p0, p1, p2;
-        scene_.Triangle(light.index, light.primitive, hit.time, &p0, &p1, &p2);
-        area = 0.5f * Length(Cross(p1 - p0, p2 - p0));
+        area = scene_.TriangleArea(light.index, light.primitive, hit.time);
     }
     const Vec3 d = hit.p - ref;
     const float dist2 = LengthSquared(d);

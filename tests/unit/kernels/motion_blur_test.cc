@@ -475,6 +475,34 @@ TEST(MotionBlur, TwoStepsOnlyForAStraightPathOverTheShutter) {
 }
 
 // What the steps do not move yet is refused, not rendered sharp beside blurred meshes.
+// The emissive square growing from `from` to 1.5 times its side over the shutter, lighting a
+// wall: its area, so the light tracer's density by area, changes with time, and a square of no
+// area at the opening still emits once it grows.
+void ExpectGrowingSquareLightsAlike(double from) {
+    MovingScene m = SquareScene(false, false);
+    m.animation = OneMovingNode(0, 0);
+    m.animation.channels.push_back(
+        {0, AnimationChannel::Path::kScale,
+         Keyframes::Create(Interpolation::kLinear, KeyframeKind::kVector, 3, {0, 1},
+                           {from, from, 1, 1.5, 1.5, 1}, "test scale")
+             .value()});
+    m.animation.meshes.push_back(DrivenSquare(m.scene.meshes[0]));
+    ASSERT_TRUE(m.animation.PoseAt(0.5, m.scene).ok());
+    AddWallInPerspective(m.scene, 32);
+    const SceneMotion motion{&m.animation, 0, 1};
+    const Image path = RenderPathWithMotion(m.scene, motion, 256).out.image;
+    ExpectSameBlocks(path, RenderSplatWithMotion(m.scene, motion, "light", 128),
+                     "growing square: light");
+    ExpectSameBlocks(path, RenderSplatWithMotion(m.scene, motion, "bdpt", 128),
+                     "growing square: bdpt");
+}
+
+TEST(MotionBlur, AGrowingEmitterLightsAlikeForEveryMethod) { ExpectGrowingSquareLightsAlike(0.5); }
+
+TEST(MotionBlur, AnEmitterOfNoAreaAtTheOpeningStillEmitsOnceItGrows) {
+    ExpectGrowingSquareLightsAlike(0);
+}
+
 // An emissive analytic sphere (radius 1 at unit radiance, in the plane z = 0) of kSide diameter
 // driven by node 0, as SquareScene's square.
 MovingScene SphereScene() {

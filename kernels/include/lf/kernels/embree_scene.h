@@ -79,6 +79,8 @@ class EmbreeScene {
     // Vertices of triangle `primitive` of `mesh` in render space at `time` (Ray::time).
     void Triangle(int mesh, int primitive, float time, Vec3* p0, Vec3* p1, Vec3* p2) const;
     SurfacePoint TrianglePoint(int mesh, int primitive, float b1, float b2, float time) const;
+    // Its area at `time`: a deforming triangle's changes with time.
+    float TriangleArea(int mesh, int primitive, float time) const;
     SurfacePoint SpherePoint(int sphere, const Vec3& direction_from_center, float time) const;
     // Whether mesh m moves during the shutter; its vertex `v`'s normal and tangent at `time`
     // (the Scene's when it does not move; interpolated, not normalised, when it does).

@@ -125,6 +125,8 @@ class EmissionSampler {
     // An area light's point for u, with its normal and Le there (Le before the side test).
     SurfacePoint AreaPoint(const Light& light, const Vec2& u, float time) const;
     Rgb AreaEmission(const Light& light, const SurfacePoint& point) const;
+    // 1 / the density by area of a point on `light` at `time`.
+    float AreaAt(const Light& light, float time) const;
     // Direction density of a light at infinity for a ray travelling along w.
     float InfiniteDirPdf(const Light& light, const Vec3& w) const;
 

@@ -39,9 +39,11 @@ struct EmissiveTriangle {
     bool two_sided;  // emits from its back too (EmitsFromBack)
 };
 
-// Calls visit(const EmissiveTriangle&) for every triangle of positive area (at the shutter's
-// opening, for a moving mesh) of every emissive mesh, mesh by mesh, in order. visit returns how
-// many triangles it took: 1, or 2 when it made one light of this triangle and the next (a
+// Calls visit(const EmissiveTriangle&) for every triangle of positive area of every emissive
+// mesh, mesh by mesh, in order; p is where it is at the shutter's opening, and a moving mesh's
+// triangle's area is its largest at any step, so that one of no area at the opening that grows
+// is still a light (its density at a time comes from EmbreeScene::TriangleArea). visit returns
+// how many triangles it took: 1, or 2 when it made one light of this triangle and the next (a
 // rectangle), which is then skipped.
 template <typename Visit>
 void ForEachEmissiveTriangle(const EmbreeScene& es, Visit&& visit) {
@@ -54,6 +56,12 @@ void ForEachEmissiveTriangle(const EmbreeScene& es, Visit&& visit) {
             EmissiveTriangle tri{int(m), int(t), {}, 0, &material, EmitsFromBack(material)};
             es.Triangle(int(m), int(t), 0, &tri.p[0], &tri.p[1], &tri.p[2]);
             tri.area = 0.5f * Length(Cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
+            if (es.Moves(int(m))) {
+                for (int step = 1; step < es.steps(); ++step) {
+                    const float time = float(step) / float(es.steps() - 1);
+                    tri.area = std::max(tri.area, es.TriangleArea(int(m), int(t), time));
+                }
+            }
             if (!(tri.area > 0)) continue;
             t += size_t(visit(static_cast<const EmissiveTriangle&>(tri)) - 1);
         }

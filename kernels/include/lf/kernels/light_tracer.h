@@ -51,8 +51,8 @@
 
 #include "lf/core/camera.h"
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/splat_renderer.h"
 #include "lf/kernels/light_emission.h"
+#include "lf/kernels/splat_renderer.h"
 
 namespace lf {
 
