@@ -213,6 +213,7 @@ Json TaskJson(const TaskStatus& t) {
         {"duration_ms", absl::ToInt64Milliseconds(t.duration)},
         {"last_error", t.last_error},
         {"log_lines", t.log_lines},
+        {"frames", t.frames},
     };
 }
 

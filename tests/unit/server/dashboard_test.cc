@@ -524,7 +524,10 @@ TEST_F(DashboardTest, AFramesPreviewIsAPngOfTheFramesSizeAndAnUnknownFrameIsName
     const Json tasks = Call(Get("/api/jobs/" + job + "/tasks?frame=12", alice_), 200)["tasks"];
     ASSERT_EQ(tasks.size(), 4u);
     int merged = 0;
-    for (const Json& t : tasks) merged += t["state"] == "done";
+    for (const Json& t : tasks) {
+        merged += t["state"] == "done";
+        EXPECT_EQ(t["frames"], Json::array({12}));
+    }
     EXPECT_EQ(merged, 1);
 
     for (const std::string what : {"/frames/11/preview.png", "/frames/16/metadata"}) {
