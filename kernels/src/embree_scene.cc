@@ -155,6 +155,7 @@ struct PosedSteps {
     std::vector<CameraSpec>& camera;
     std::vector<std::vector<Vec3>>& points;
     std::vector<std::vector<EmbreeScene::SpotPlace>>& spots;
+    std::vector<std::vector<float>>& spheres;  // per step, x y z r per sphere; empty: none moves
 };
 absl::Status PoseSteps(const Scene& scene, const SceneMotion& motion, int steps,
                        const Vec3d& origin, const PosedSteps& out) {
@@ -162,6 +163,8 @@ absl::Status PoseSteps(const Scene& scene, const SceneMotion& motion, int steps,
     const std::vector<bool> moving_nodes = animation.MovingNodes();
     const bool camera_moves =
         animation.camera_node >= 0 && moving_nodes[size_t(animation.camera_node)];
+    const bool spheres_move = std::any_of(animation.spheres.begin(), animation.spheres.end(),
+                                          [](const AnimatedSphere& s) { return s.moves; });
     Scene posed = scene;
     for (int i = 0; i < steps; ++i) {
         const double t = i + 1 == steps
@@ -180,6 +183,14 @@ absl::Status PoseSteps(const Scene& scene, const SceneMotion& motion, int steps,
             out.meshes[size_t(am.mesh)].push_back(std::move(step));
         }
         if (camera_moves) out.camera.push_back(posed.camera);
+        if (spheres_move) {
+            std::vector<float>& step = out.spheres.emplace_back();
+            step.reserve(4 * posed.spheres.size());
+            for (const Sphere& s : posed.spheres) {
+                const Vec3 c(s.center - origin);
+                step.insert(step.end(), {c.x, c.y, c.z, float(s.radius)});
+            }
+        }
         for (const AnimatedLight& light : animation.lights) {
             if (!light.moves) continue;
             const size_t i = size_t(light.index);
@@ -233,15 +244,23 @@ EmbreeScene::~EmbreeScene() {
 
 namespace {
 
-// What the time steps do not move yet (analytic spheres, directional lights) must not sit still
-// silently while the rest blurs: refused, naming the object.
-absl::Status CheckMotionIsRepresented(const SceneAnimation& animation) {
+// What the time steps do not move yet (a sphere's radius, directional lights) must not sit still
+// silently while the rest blurs: refused, naming the object. `sphere_steps` are PoseSteps'.
+absl::Status CheckMotionIsRepresented(const SceneAnimation& animation,
+                                      const std::vector<std::vector<float>>& sphere_steps) {
     for (const AnimatedSphere& s : animation.spheres) {
         if (!s.moves) continue;
-        return absl::UnimplementedError(absl::StrCat(
-            "spheres[", s.sphere, "] (", animation.nodes[size_t(s.node)].where,
-            ") moves during the shutter, and motion blur of analytic spheres is not implemented "
-            "yet: make it a mesh (a UV sphere) or render without --shutter"));
+        const size_t r = 4 * size_t(s.sphere) + 3;
+        for (const std::vector<float>& step : sphere_steps) {
+            // A rotating node may round its scale differently step to step.
+            if (std::abs(step[r] - sphere_steps.front()[r]) <= 1e-5f * step[r]) continue;
+            return absl::UnimplementedError(
+                absl::StrCat("spheres[", s.sphere, "] (", animation.nodes[size_t(s.node)].where,
+                             ") changes size during the shutter (radius ", sphere_steps.front()[r],
+                             " to ", step[r],
+                             "), and motion blur of a scaling analytic sphere is not implemented: "
+                             "make it a mesh (a UV sphere) or render without --shutter"));
+        }
     }
     for (const AnimatedLight& l : animation.lights) {
         if (!l.moves || l.kind != AnimatedLight::Kind::kDirectional) continue;
@@ -280,16 +299,17 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
     static_assert(sizeof(Vec3) == 3 * sizeof(float), "Embree reads positions_ as FLOAT3");
     es->positions_.resize(scene.meshes.size());
     es->steps_ = MotionSteps(motion);
-    if (es->steps_ > 1) {
-        if (absl::Status s = CheckMotionIsRepresented(*motion.animation); !s.ok()) return s;
-    }
     es->steps_of_.resize(scene.meshes.size());
     es->point_steps_.resize(scene.point_lights.size());
     es->spot_steps_.resize(scene.spot_lights.size());
     if (es->steps_ > 1) {
-        if (absl::Status s =
-                PoseSteps(scene, motion, es->steps_, origin,
-                          {es->steps_of_, es->camera_motion_, es->point_steps_, es->spot_steps_});
+        if (absl::Status s = PoseSteps(scene, motion, es->steps_, origin,
+                                       {es->steps_of_, es->camera_motion_, es->point_steps_,
+                                        es->spot_steps_, es->sphere_steps_});
+            !s.ok()) {
+            return s;
+        }
+        if (absl::Status s = CheckMotionIsRepresented(*motion.animation, es->sphere_steps_);
             !s.ok()) {
             return s;
         }
@@ -341,9 +361,18 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
             h.sphere_buffer.insert(h.sphere_buffer.end(), {c.x, c.y, c.z, float(s.radius)});
         }
         RTCGeometry geom = rtcNewGeometry(h.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-        rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                   h.sphere_buffer.data(), 0, 4 * sizeof(float),
-                                   scene.spheres.size());
+        if (es->sphere_steps_.empty()) {
+            rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                       h.sphere_buffer.data(), 0, 4 * sizeof(float),
+                                       scene.spheres.size());
+        } else {
+            rtcSetGeometryTimeStepCount(geom, unsigned(es->sphere_steps_.size()));
+            for (size_t i = 0; i < es->sphere_steps_.size(); ++i) {
+                rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, unsigned(i),
+                                           RTC_FORMAT_FLOAT4, es->sphere_steps_[i].data(), 0,
+                                           4 * sizeof(float), scene.spheres.size());
+            }
+        }
         rtcCommitGeometry(geom);
         es->sphere_geometry_ = rtcAttachGeometry(h.scene, geom);
         rtcReleaseGeometry(geom);
@@ -389,6 +418,14 @@ std::array<float, 4> EmbreeScene::Tangent(int mesh, uint32_t v, float time) cons
     return {Lerp(a[0], b[0], at.f), Lerp(a[1], b[1], at.f), Lerp(a[2], b[2], at.f), a[3]};
 }
 
+Vec3 EmbreeScene::SphereCenter(int sphere, float time) const {
+    if (sphere_steps_.empty()) return sphere_centers_[size_t(sphere)];
+    const StepPosition at = StepAt(time, sphere_steps_.size());
+    const float *a = &sphere_steps_[at.i][4 * size_t(sphere)],
+                *b = &sphere_steps_[at.i + 1][4 * size_t(sphere)];
+    return Lerp(Vec3(a[0], a[1], a[2]), Vec3(b[0], b[1], b[2]), at.f);
+}
+
 Vec3 EmbreeScene::PointLightPosition(int i, float time) const {
     const std::vector<Vec3>& steps = point_steps_[size_t(i)];
     if (steps.empty()) return PointPlace(scene_, size_t(i), origin_);
@@ -426,7 +463,7 @@ SurfacePoint EmbreeScene::TrianglePoint(int mesh, int primitive, float b1, float
 
 SurfacePoint EmbreeScene::SpherePoint(int sphere, const Vec3& direction_from_center,
                                       float time) const {
-    const Vec3 c = sphere_centers_[size_t(sphere)];
+    const Vec3 c = SphereCenter(sphere, time);
     const float r = float(scene_.spheres[size_t(sphere)].radius);
     SurfacePoint sp;
     sp.n = Normalize(direction_from_center);
@@ -466,7 +503,7 @@ std::optional<SurfaceHit> EmbreeScene::Intersect(const Ray& ray) const {
         hit.sphere = int(rh.hit.primID);
         hit.material = scene_.spheres[rh.hit.primID].material;
         const Vec3 p = ray.o + ray.d * hit.t;
-        sp = SpherePoint(hit.sphere, p - sphere_centers_[rh.hit.primID], ray.time);
+        sp = SpherePoint(hit.sphere, p - SphereCenter(hit.sphere, ray.time), ray.time);
     } else {
         hit.mesh = int(rh.hit.geomID);
         hit.primitive = int(rh.hit.primID);

@@ -185,9 +185,15 @@ LightSampler::LightSampler(const EmbreeScene& es, LightStrategy strategy)
         lights_.push_back({Kind::kSphere, int(s), 0, sphere->area, sphere->two_sided});
         weights.push_back(AreaLightWeight(sphere->area, emission, sphere->two_sided));
         // Seen from inside, a two-sided sphere's normals still cover every direction.
-        bounds.push_back(
-            SphereLightBounds(es.SphereCenter(int(s)), float(scene.spheres[s].radius),
-                              LightPowerWeight(emission) * (sphere->two_sided ? 2 : 1)));
+        const float power = LightPowerWeight(emission) * (sphere->two_sided ? 2 : 1);
+        const float radius = float(scene.spheres[s].radius);
+        LightBounds b = SphereLightBounds(es.SphereCenter(int(s), 0), radius, power);
+        // A moving sphere's bounds hold it at every step (and so between them).
+        for (int step = 1; step < es.steps(); ++step) {
+            b = Union(
+                b, SphereLightBounds(es.SphereCenter(int(s), StepTime(es, step)), radius, power));
+        }
+        bounds.push_back(b);
     }
     for (size_t i = 0; i < scene.point_lights.size(); ++i) {
         const PointLight& point = scene.point_lights[i];
@@ -376,7 +382,7 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
     } else {
         if (bvh) {
             const std::optional<SphereConeSample> s =
-                SampleSphereCone(ref, scene_.SphereCenter(light.index),
+                SampleSphereCone(ref, scene_.SphereCenter(light.index, time),
                                  float(scene.spheres[size_t(light.index)].radius), u);
             if (!s) return std::nullopt;
             ls.point = scene_.SpherePoint(light.index, s->normal, time);
@@ -407,7 +413,7 @@ float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const Vec3& n,
                             const SurfaceHit& hit) const {
     if (strategy_ == LightStrategy::kBvh) {
         if (light.kind == Kind::kSphere) {
-            return SphereConePdf(ref, scene_.SphereCenter(light.index),
+            return SphereConePdf(ref, scene_.SphereCenter(light.index, hit.time),
                                  float(scene_.scene().spheres[size_t(light.index)].radius), hit.p);
         }
         const bool warp = n != Vec3(0, 0, 0);

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <array>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "lf/core/log.h"
 #include "lf/server/sqlite_statement.h"
 
@@ -81,8 +84,26 @@ absl::StatusOr<std::unique_ptr<TaskLogStore>> TaskLogStore::Open(const std::stri
              "  samples INTEGER NOT NULL, attempts INTEGER NOT NULL, failures INTEGER NOT NULL,"
              "  worker TEXT NOT NULL, leased_ms INTEGER NOT NULL, finished_ms INTEGER NOT NULL,"
              "  duration_ms INTEGER NOT NULL, last_error TEXT NOT NULL,"
+             "  frames TEXT NOT NULL DEFAULT '',"
              "  PRIMARY KEY (job, task));");
     if (!s.ok()) return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
+    // A store written before shots has no frames column: its tasks are stills' ("").
+    bool migrated = false;
+    {
+        Statement has_frames(db, "SELECT 1 FROM pragma_table_info('tasks') WHERE name = 'frames'");
+        migrated = has_frames.Step();
+        if (!has_frames.status().ok()) {
+            return absl::Status(has_frames.status().code(),
+                                absl::StrCat(path, ": ", has_frames.status().message()));
+        }
+    }  // finalized before the table changes
+    if (!migrated) {
+        if (absl::Status a =
+                Exec(db, "ALTER TABLE tasks ADD COLUMN frames TEXT NOT NULL DEFAULT ''");
+            !a.ok()) {
+            return absl::Status(a.code(), absl::StrCat(path, ": ", a.message()));
+        }
+    }
     return store;
 }
 
@@ -254,8 +275,8 @@ absl::Status TaskLogStore::RecordTasks(const std::string& job_id,
     Statement insert(db_,
                      "INSERT OR REPLACE INTO tasks (job, task, state, kind, x, y, width, height,"
                      " samples, attempts, failures, worker, leased_ms, finished_ms, duration_ms,"
-                     " last_error) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12,"
-                     " ?13, ?14, ?15, ?16)");
+                     " last_error, frames) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11,"
+                     " ?12, ?13, ?14, ?15, ?16, ?17)");
     for (const TaskStatus& t : tasks) {
         insert.Bind(1, job_id)
             .Bind(2, int64_t(t.index))
@@ -272,7 +293,8 @@ absl::Status TaskLogStore::RecordTasks(const std::string& job_id,
             .Bind(13, UnixMs(t.leased))
             .Bind(14, UnixMs(t.finished))
             .Bind(15, absl::ToInt64Milliseconds(t.duration))
-            .Bind(16, t.last_error);
+            .Bind(16, t.last_error)
+            .Bind(17, absl::StrJoin(t.frames, ","));
         insert.Step();
         if (!insert.status().ok()) return insert.status();
         insert.Reset();
@@ -284,7 +306,7 @@ absl::StatusOr<std::vector<TaskStatus>> TaskLogStore::Tasks(const std::string& j
     std::lock_guard<std::mutex> lock(mutex_);
     Statement select(db_,
                      "SELECT task, state, kind, x, y, width, height, samples, attempts, failures,"
-                     " worker, leased_ms, finished_ms, duration_ms, last_error FROM tasks"
+                     " worker, leased_ms, finished_ms, duration_ms, last_error, frames FROM tasks"
                      " WHERE job = ?1 ORDER BY task");
     select.Bind(1, job_id);
     std::vector<TaskStatus> tasks;
@@ -308,6 +330,12 @@ absl::StatusOr<std::vector<TaskStatus>> TaskLogStore::Tasks(const std::string& j
         t.finished = FromUnixMs(select.ColumnInt(12));
         t.duration = absl::Milliseconds(select.ColumnInt(13));
         t.last_error = std::string(select.Column(14));
+        // Written by RecordTasks: a part that is not a number is a damaged row, skipped.
+        for (absl::string_view part :
+             absl::StrSplit(std::string(select.Column(15)), ',', absl::SkipEmpty())) {
+            int frame = 0;
+            if (absl::SimpleAtoi(part, &frame)) t.frames.push_back(frame);
+        }
     }
     if (!select.status().ok()) return select.status();
     return tasks;

@@ -143,6 +143,12 @@ std::string ReadText(const fs::path& path) {
     return s.str();
 }
 
+// A shot of the moving ball under a moving camera, blurred, in small frames.
+std::string ShotScene() {
+    return (fs::path(LF_TEST_SCENES) / "shots" / "moving_ball_camera.gltf").string();
+}
+constexpr const char* kShotFlags = "--resolution 96x54 --shutter 0.5 --seed 3 --method path";
+
 class Farm : public ::testing::Test {
   protected:
     void SetUp() override {
@@ -368,6 +374,27 @@ class Farm : public ::testing::Test {
             EXPECT_EQ(a->attributes.at(name), b->attributes.at(name)) << name;
         }
         EXPECT_TRUE(a->attributes.count("lightfarm.seconds"));
+    }
+
+    // Every frame of `frames` fetched from the farm equals `lightfarm render --frames RANGE
+    // FLAGS`, bit for bit and header for header (lightfarm.frame, .time, .fps, .shutter
+    // included).
+    void ExpectFramesAsRendered(const std::string& job, const std::vector<int>& frames,
+                                const std::string& range, const std::string& flags) {
+        const std::string farm = (dir_ / "farm_####.exr").string();
+        const CliRun fetch = Farmctl("fetch " + job + " --frames " + range + " -o " + farm);
+        ASSERT_EQ(fetch.status, 0) << fetch.out << fetch.err;
+        const std::string local = (dir_ / "local_####.exr").string();
+        const CliRun r = Lightfarm("render " + ShotScene() + " --frames " + range + " " + flags +
+                                   " -o " + local + " --threads 2 --no-progress");
+        ASSERT_EQ(r.status, 0) << r.out << r.err;
+        for (int f : frames) {
+            char name[32];
+            std::snprintf(name, sizeof name, "_%04d.exr", f);
+            SCOPED_TRACE(::testing::Message() << "frame " << f);
+            ExpectSameImageAndHeader((dir_ / ("farm" + std::string(name))).string(),
+                                     (dir_ / ("local" + std::string(name))).string());
+        }
     }
 
     fs::path dir_;
@@ -1470,6 +1497,71 @@ TEST_F(Farm, BadGltfIsRefusedAtSubmissionWithTheLoadersMessage) {
 // on the farm, the bits and header of `lightfarm render` with the same flags, whichever worker
 // renders which task, a worker killed mid-task, or the coordinator killed mid-job. bdpt and ppm
 // join the list below when their kernels land (a one-line change).
+TEST_F(Farm, AShotInChunksSurvivesAKilledWorkerAndARestartAndGivesRendersBits) {
+    StartServer(/*lease_seconds=*/1);
+    Child* doomed = StartWorker("doomed");
+    StartWorker("survivor");
+    // 8 frames, two a task: 4 tasks of about a second each.
+    const std::string flags = std::string(kShotFlags) + " --spp 1024 --tile 32";
+    const std::string job = Submit(ShotScene(), "--frames 1-8 --chunk 2 " + flags);
+    ASSERT_TRUE(KillMidTask(doomed, "doomed.log"));
+    ASSERT_TRUE(WaitForTasksDone(job, 1, milliseconds(60000)));
+    CrashAndRestartServer();
+    const CliRun watch = Farmctl("watch " + job, 120);
+    ASSERT_EQ(watch.status, 0) << watch.out << watch.err;
+    EXPECT_NE(watch.out.find("8/8 frames"), std::string::npos) << watch.out;
+    const CliRun tasks = Farmctl("tasks " + job);
+    for (const char* chunk : {" 1-2 ", " 3-4 ", " 5-6 ", " 7-8 "}) {
+        EXPECT_NE(tasks.out.find(chunk), std::string::npos) << chunk << " in\n" << tasks.out;
+    }
+    EXPECT_GT(Tasks(job).leased, Tasks(job).total) << "the killed worker's chunk ran once";
+    ExpectFramesAsRendered(job, {1, 2, 3, 4, 5, 6, 7, 8}, "1-8", flags);
+}
+
+TEST_F(Farm, ACancelledShotKeepsItsFinishedFramesFetchable) {
+    StartServer();
+    StartWorker("w1");
+    // Frame 1 is quick, frame 2 would take minutes: the cancel lands in frame 2.
+    const std::string flags = std::string(kShotFlags) + " --spp 4096 --tile 96";
+    const std::string job = Submit(ShotScene(), "--frames 1-3 " + flags);
+    ASSERT_TRUE(WaitForStatus(job, "1 done", milliseconds(60000)));
+    ASSERT_EQ(Farmctl("cancel " + job).status, 0);
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_NE(status.out.find("cancelled"), std::string::npos) << status.out;
+    // Without --frames, fetch writes every finished frame: frame 1 alone.
+    const CliRun all = Farmctl("fetch " + job + " -o " + (dir_ / "all_####.exr").string());
+    ASSERT_EQ(all.status, 0) << all.out << all.err;
+    EXPECT_TRUE(fs::exists(dir_ / "all_0001.exr"));
+    EXPECT_FALSE(fs::exists(dir_ / "all_0002.exr"));
+    // An unfinished frame asked by name is a clear error naming it.
+    const CliRun unfinished =
+        Farmctl("fetch " + job + " --frames 3 -o " + (dir_ / "u_####.exr").string());
+    EXPECT_NE(unfinished.status, 0);
+    EXPECT_NE(unfinished.err.find("frame 3"), std::string::npos) << unfinished.err;
+    ExpectFramesAsRendered(job, {1}, "1", flags);
+}
+
+// The client checks a shot's flags with the code `render` uses: the same words either way.
+TEST_F(Farm, AShotsBadFlagsAreRefusedAtSubmissionWithRendersMessage) {
+    StartServer();
+    for (const std::string bad : {"--frames 5-1", "--frames 1-0:0", "--frame 1-3", "--shutter 0.5",
+                                  "--frames 1-2 --shutter 11"}) {
+        SCOPED_TRACE(bad);
+        const CliRun submit = Farmctl("submit " + ShotScene() + " " + bad);
+        const CliRun render = Lightfarm("render " + ShotScene() + " " + bad + " -o " +
+                                        (dir_ / "x_####.exr").string());
+        EXPECT_NE(submit.status, 0);
+        EXPECT_NE(render.status, 0);
+        EXPECT_FALSE(submit.err.empty());
+        EXPECT_EQ(submit.err, render.err);
+    }
+    const CliRun chunk = Farmctl("submit " + ShotScene() + " --chunk 2");
+    EXPECT_NE(chunk.status, 0);
+    EXPECT_NE(chunk.err.find("--chunk 2: whole frames a task needs a shot"), std::string::npos)
+        << chunk.err;
+    EXPECT_EQ(Farmctl("list").out.find("moving_ball"), std::string::npos) << "a job was made";
+}
+
 class FarmSplat : public Farm, public ::testing::WithParamInterface<std::string> {
   protected:
     std::string Flags(uint64_t spp, uint64_t seed, const std::string& more = "") const {

@@ -228,29 +228,34 @@ ImageSum SumOf(const Image& image, uint64_t spp) {
 // `--shutter 1` on the ball moving at constant speed: the streak's centroid is the still's at the
 // frame's time (the shutter is centred on it), and the light it sends is the still's (the
 // emitter's brightness is conserved), each within its noise.
+// The ball as a mesh (glTF) and as an analytic sphere (JSON): both blur about the frame's place.
 TEST_F(ShotRender, AShutterCentredOnTheFrameKeepsTheBallsCentroidAndBrightness) {
     constexpr uint64_t kSpp = 256;
-    Image images[2];
-    for (int blur = 0; blur < 2; ++blur) {
-        LocalRenderOptions o = Options(Shots("moving_ball.gltf"), kSpp);
-        o.exr_path = Path(blur ? "blur_#.exr" : "still_#.exr");
-        ShotSettings shot;
-        shot.frames = FrameRange{12, 12, 1};
-        shot.shutter = blur ? 1.0 : 0.0;
-        absl::StatusOr<LocalShotSummary> summary = RunLocalShot(o, shot);
-        ASSERT_TRUE(summary.ok()) << summary.status();
-        absl::StatusOr<ExrFile> exr = ReadExr(summary->frames.at(0).exr_path);
-        ASSERT_TRUE(exr.ok()) << exr.status();
-        EXPECT_DOUBLE_EQ(std::get<double>(exr->attributes.at("lightfarm.shutter")), shot.shutter);
-        images[blur] = std::move(exr->image);
+    for (const std::string scene : {"moving_ball.gltf", "moving_ball.json"}) {
+        SCOPED_TRACE(scene);
+        Image images[2];
+        for (int blur = 0; blur < 2; ++blur) {
+            LocalRenderOptions o = Options(Shots(scene), kSpp);
+            o.exr_path = Path(scene + (blur ? "_blur_#.exr" : "_still_#.exr"));
+            ShotSettings shot;
+            shot.frames = FrameRange{12, 12, 1};
+            shot.shutter = blur ? 1.0 : 0.0;
+            absl::StatusOr<LocalShotSummary> summary = RunLocalShot(o, shot);
+            ASSERT_TRUE(summary.ok()) << summary.status();
+            absl::StatusOr<ExrFile> exr = ReadExr(summary->frames.at(0).exr_path);
+            ASSERT_TRUE(exr.ok()) << exr.status();
+            EXPECT_DOUBLE_EQ(std::get<double>(exr->attributes.at("lightfarm.shutter")),
+                             shot.shutter);
+            images[blur] = std::move(exr->image);
+        }
+        EXPECT_NE(*images[0].FindChannel("R"), *images[1].FindChannel("R"));  // it did blur
+        const Vec2 still = Centroid(images[0]), blurred = Centroid(images[1]);
+        EXPECT_NEAR(blurred.x, still.x, 0.25);
+        EXPECT_NEAR(blurred.y, still.y, 0.25);
+        const ImageSum a = SumOf(images[0], kSpp), b = SumOf(images[1], kSpp);
+        EXPECT_NEAR(b.sum, a.sum, 4 * std::sqrt(a.variance + b.variance))
+            << "still " << a.sum << ", blurred " << b.sum;
     }
-    EXPECT_NE(*images[0].FindChannel("R"), *images[1].FindChannel("R"));  // it did blur
-    const Vec2 still = Centroid(images[0]), blurred = Centroid(images[1]);
-    EXPECT_NEAR(blurred.x, still.x, 0.25);
-    EXPECT_NEAR(blurred.y, still.y, 0.25);
-    const ImageSum a = SumOf(images[0], kSpp), b = SumOf(images[1], kSpp);
-    EXPECT_NEAR(b.sum, a.sum, 4 * std::sqrt(a.variance + b.variance))
-        << "still " << a.sum << ", blurred " << b.sum;
 }
 
 // Nothing moves in the Cornell box: an open shutter changes no bit.
@@ -294,14 +299,20 @@ TEST_F(ShotRender, AShutterWithoutFramesOrByRadiosityIsRefused) {
 }
 
 // moving_ball.json's ball is an analytic sphere, which the shutter's steps do not move yet.
-TEST_F(ShotRender, AShutterOverAMovingAnalyticSphereIsRefusedNamingIt) {
+// A ball whose node also grows: its radius would change in the shutter, which is refused.
+TEST_F(ShotRender, AShutterOverAGrowingAnalyticSphereIsRefusedNamingIt) {
+    nlohmann::json scene = nlohmann::json::parse(std::ifstream(Shots("moving_ball.json")));
+    scene["shapes"][0]["transform"]["keyframes"][0]["scale"] = 1;
+    scene["shapes"][0]["transform"]["keyframes"][1]["scale"] = 2;
+    const std::string file = Path("growing.json");
+    std::ofstream(file) << scene.dump();
     const testing::LightfarmRun run = RunLightfarm(
-        "render " + Shots("moving_ball.json") +
-        " --resolution 16x12 --spp 1 --no-progress --frame 12 --shutter 1 -o " + Path("s.exr"));
+        "render " + file + " --resolution 16x12 --spp 1 --no-progress --frame 12 --shutter 1 -o " +
+        Path("s.exr"));
     EXPECT_NE(run.status, 0);
     EXPECT_NE(run.output.find("spheres[0]"), std::string::npos) << run.output;
-    EXPECT_NE(run.output.find("motion blur of analytic spheres"), std::string::npos) << run.output;
-    EXPECT_EQ(Files(), 0u);
+    EXPECT_NE(run.output.find("changes size during the shutter"), std::string::npos) << run.output;
+    EXPECT_EQ(Files(), 1u);  // the scene alone
 }
 
 // A Cornell box whose tall block slides: radiosity solves each frame anew, so one solution file

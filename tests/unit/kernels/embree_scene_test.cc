@@ -22,7 +22,7 @@ TEST(EmbreeScene, SphereHitFromOutsideAndInside) {
     const Scene scene = SphereScene(Vec3d(1, 2, 3), 0.5);
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok()) << es.status();
-    const Vec3 c((*es)->SphereCenter(0));
+    const Vec3 c((*es)->SphereCenter(0, 0));
     auto outside = (*es)->Intersect(Ray{c + Vec3(0, 0, -2), Vec3(0, 0, 1)});
     ASSERT_TRUE(outside);
     EXPECT_NEAR(outside->t, 1.5f, 1e-5f);

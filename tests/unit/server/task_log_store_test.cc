@@ -4,6 +4,7 @@
 #include "lf/server/task_log_store.h"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <filesystem>
 
@@ -191,6 +192,60 @@ TEST_F(TaskLogStoreTest, LinesAndTaskListsSurviveAReopenAndGoWithTheirJob) {
     EXPECT_TRUE(store->Tasks("gone")->empty());
     EXPECT_EQ(store->Read("job", std::nullopt, 0, 100)->lines.size(), 2u);
     EXPECT_EQ(store->Tasks("job")->size(), 2u);
+}
+
+// A shot's task names its frames, and an ended shot's `tasks` are read from here: they keep them.
+TEST_F(TaskLogStoreTest, AnEndedShotsTasksKeepTheirFrames) {
+    TaskStatus chunk;
+    chunk.index = 0;
+    chunk.frames = {1, 2};
+    TaskStatus still;
+    still.index = 1;
+    {
+        auto store = Open();
+        ASSERT_TRUE(store->RecordTasks("shot", {chunk, still}).ok());
+    }
+    absl::StatusOr<std::vector<TaskStatus>> tasks = Open()->Tasks("shot");
+    ASSERT_TRUE(tasks.ok()) << tasks.status();
+    ASSERT_EQ(tasks->size(), 2u);
+    EXPECT_EQ((*tasks)[0].frames, (std::vector<int>{1, 2}));
+    EXPECT_TRUE((*tasks)[1].frames.empty());
+}
+
+// A store written before shots had no frames column: it opens, its rows read as stills', and a
+// shot's tasks record into it.
+TEST_F(TaskLogStoreTest, AStoreFromBeforeShotsGainsTheFramesColumn) {
+    {
+        sqlite3* db = nullptr;
+        ASSERT_EQ(sqlite3_open((dir_ / "logs.db").c_str(), &db), SQLITE_OK);
+        ASSERT_EQ(
+            sqlite3_exec(db,
+                         "CREATE TABLE tasks (job TEXT NOT NULL, task INTEGER NOT NULL,"
+                         "  state TEXT NOT NULL, kind INTEGER NOT NULL, x INTEGER NOT NULL,"
+                         "  y INTEGER NOT NULL, width INTEGER NOT NULL, height INTEGER NOT NULL,"
+                         "  samples INTEGER NOT NULL, attempts INTEGER NOT NULL,"
+                         "  failures INTEGER NOT NULL, worker TEXT NOT NULL,"
+                         "  leased_ms INTEGER NOT NULL, finished_ms INTEGER NOT NULL,"
+                         "  duration_ms INTEGER NOT NULL, last_error TEXT NOT NULL,"
+                         "  PRIMARY KEY (job, task));"
+                         "INSERT INTO tasks VALUES ('old', 0, 'done', 0, 0, 0, 8, 8, 4, 1, 0, 'w',"
+                         "  0, 0, 0, '');",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+        sqlite3_close(db);
+    }
+    auto store = Open();
+    ASSERT_TRUE(store);
+    absl::StatusOr<std::vector<TaskStatus>> old = store->Tasks("old");
+    ASSERT_TRUE(old.ok()) << old.status();
+    ASSERT_EQ(old->size(), 1u);
+    EXPECT_EQ((*old)[0].width, 8);
+    EXPECT_TRUE((*old)[0].frames.empty());
+    TaskStatus chunk;
+    chunk.frames = {3, 4};
+    ASSERT_TRUE(store->RecordTasks("shot", {chunk}).ok());
+    EXPECT_EQ(store->Tasks("shot")->at(0).frames, (std::vector<int>{3, 4}));
+    EXPECT_TRUE(Open());  // and opens again, migrated
 }
 
 }  // namespace

@@ -72,8 +72,10 @@ class EmbreeScene {
     const Scene& scene() const { return scene_; }
     const Vec3d& origin() const { return origin_; }
 
-    // Spheres do not move during a shutter: Build refuses a blur that would move one.
-    Vec3 SphereCenter(int sphere) const { return sphere_centers_[size_t(sphere)]; }
+    // Sphere `sphere`'s centre (render space) at `time` (Ray::time): the Scene's when no sphere
+    // moves, else linear between steps, as Embree moves it. Its radius stays the Scene's: Build
+    // refuses a blur that would scale one.
+    Vec3 SphereCenter(int sphere, float time) const;
     // Vertices of triangle `primitive` of `mesh` in render space at `time` (Ray::time).
     void Triangle(int mesh, int primitive, float time, Vec3* p0, Vec3* p1, Vec3* p2) const;
     SurfacePoint TrianglePoint(int mesh, int primitive, float b1, float b2, float time) const;
@@ -122,6 +124,8 @@ class EmbreeScene {
     int steps_ = 1;
     std::vector<CameraSpec> camera_motion_;
     std::vector<Vec3> sphere_centers_;
+    // Empty when no sphere moves, else per step every sphere's x, y, z, r (Embree's buffers).
+    std::vector<std::vector<float>> sphere_steps_;
     unsigned sphere_geometry_ = ~0u;
 };
 
