@@ -473,6 +473,10 @@ TEST_F(DashboardTest, AShotsJobListsItsFramesWithTheirStates) {
     const HttpAnswer kept =
         dashboard_->Serve(Get("/api/jobs/" + job + "/frames/1/preview.png", alice_));
     EXPECT_EQ(kept.status, 200) << kept.body;
+    // An ended shot's tasks, as recorded when it ended, still name their frames.
+    const Json tasks = Call(Get("/api/jobs/" + job + "/tasks?frame=1", alice_), 200)["tasks"];
+    ASSERT_EQ(tasks.size(), 4u);
+    for (const Json& t : tasks) EXPECT_EQ(t["state"], "done");
 }
 
 TEST_F(DashboardTest, AStillHasNoFrames) {
