@@ -136,13 +136,12 @@ Json JobJson(const JobRecord& job, absl::Time now) {
     };
 }
 
-// The frame `frame` of a shot's record; nullptr for one its record does not list (a record not
-// yet synced with its execution lists none).
+// The frame `frame` of a shot's record (in frame order: at its position in the range); nullptr
+// for one its record does not list (a record not yet synced with its execution lists none).
 const FrameProgress* FrameOf(const JobRecord& job, int frame) {
-    for (const FrameProgress& f : job.frames) {
-        if (f.frame == frame) return &f;
-    }
-    return nullptr;
+    if (!job.spec.shot.frames || !job.spec.shot.frames->Contains(frame)) return nullptr;
+    const size_t i = size_t(job.spec.shot.frames->IndexOf(frame));
+    return i < job.frames.size() && job.frames[i].frame == frame ? &job.frames[i] : nullptr;
 }
 
 // NotFound naming the frame and the job when `job` does not render `frame`.
