@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
@@ -9,6 +10,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
 #include "lf/core/log.h"
+#include "lf/job/shot.h"
 #include "lf/server/listen_policy.h"
 #include "lf/server/web_assets.h"
 
@@ -85,6 +87,29 @@ Json EtaSeconds(const JobRecord& job, absl::Time now) {
     return elapsed * (job.tasks_total - job.tasks_done) / job.tasks_done;
 }
 
+// A shot's range and how far it is; null for a still. `current`: the first frame not done.
+Json ShotJson(const JobRecord& job) {
+    if (!job.spec.shot.frames) return nullptr;
+    const FrameRange& range = *job.spec.shot.frames;
+    int current = range.last;
+    for (const FrameProgress& f : job.frames) {
+        if (!f.done) {
+            current = f.frame;
+            break;
+        }
+    }
+    if (job.frames.empty()) current = range.first;
+    return {{"first", range.first},
+            {"last", range.last},
+            {"step", range.step},
+            {"fps", job.spec.shot.fps},
+            {"shutter", job.spec.shot.shutter},
+            {"chunk", job.spec.shot.chunk},
+            {"frames_total", range.count()},
+            {"frames_done", job.frames_done()},
+            {"current", current}};
+}
+
 Json JobJson(const JobRecord& job, absl::Time now) {
     return {
         {"id", job.id},
@@ -107,7 +132,66 @@ Json JobJson(const JobRecord& job, absl::Time now) {
         {"eta_s", EtaSeconds(job, now)},
         {"error", job.error},
         {"last_error", job.last_error},
+        {"shot", ShotJson(job)},
     };
+}
+
+// The frame `frame` of a shot's record (in frame order: at its position in the range); nullptr
+// for one its record does not list (a record not yet synced with its execution lists none).
+const FrameProgress* FrameOf(const JobRecord& job, int frame) {
+    if (!job.spec.shot.frames || !job.spec.shot.frames->Contains(frame)) return nullptr;
+    const size_t i = size_t(job.spec.shot.frames->IndexOf(frame));
+    return i < job.frames.size() && job.frames[i].frame == frame ? &job.frames[i] : nullptr;
+}
+
+// NotFound naming the frame and the job when `job` does not render `frame`.
+absl::Status CheckRendersFrame(const JobRecord& job, int frame) {
+    if (job.spec.shot.frames && job.spec.shot.frames->Contains(frame)) return absl::OkStatus();
+    return absl::NotFoundError(absl::StrCat(
+        "job ", job.id, " renders no frame ", frame,
+        job.spec.shot.frames
+            ? absl::StrCat(" (its frames: ", FrameRangeText(*job.spec.shot.frames), ")")
+            : std::string(" (a still)")));
+}
+
+// A frame as the strip shows it: done, rendering (a task of it runs or has merged), queued, or
+// the state of a shot that ended without it.
+const char* FrameStateName(const FrameProgress& f, JobState job, bool running) {
+    if (f.done) return "done";
+    if (IsFinal(job)) return JobStateName(job);
+    return running || f.tasks_done > 0 ? "rendering" : "queued";
+}
+
+// The frame's preview, its version in the query so that an image reloads only when it changed;
+// null when there is none to show (nothing merged yet, or an unfinished frame of an ended shot).
+Json FramePreviewUrl(const JobRecord& job, const FrameProgress& f) {
+    if (f.result_path.empty() && (IsFinal(job.state) || (!f.done && f.tasks_done == 0))) {
+        return nullptr;
+    }
+    return absl::StrCat("/api/jobs/", job.id, "/frames/", f.frame, "/preview.png?v=", f.tasks_done,
+                        f.done ? "-done" : "");
+}
+
+// The version of a frame's preview: its merged tasks, and whether they are all.
+std::string FramePreviewEtag(int tasks_done, bool done) {
+    return absl::StrCat("\"frame-", tasks_done, done ? "-done" : "", "\"");
+}
+
+// A shot's frames from position `from` of its range, at most Dashboard::kFramesListed of them;
+// `running`: the frames a running task renders.
+Json FramesJson(const JobRecord& job, int from, const std::set<int>& running) {
+    const FrameRange& range = *job.spec.shot.frames;
+    Json frames = Json::array();
+    for (int i = from; i < std::min(range.count(), from + Dashboard::kFramesListed); ++i) {
+        FrameProgress f{.frame = range.at(i)};
+        if (const FrameProgress* listed = FrameOf(job, f.frame)) f = *listed;
+        frames.push_back({{"frame", f.frame},
+                          {"state", FrameStateName(f, job.state, running.count(f.frame) > 0)},
+                          {"tasks_done", f.tasks_done},
+                          {"tasks_total", f.tasks_total},
+                          {"preview", FramePreviewUrl(job, f)}});
+    }
+    return frames;
 }
 
 Json TaskJson(const TaskStatus& t) {
@@ -128,6 +212,7 @@ Json TaskJson(const TaskStatus& t) {
         {"duration_ms", absl::ToInt64Milliseconds(t.duration)},
         {"last_error", t.last_error},
         {"log_lines", t.log_lines},
+        {"frames", t.frames},
     };
 }
 
@@ -397,13 +482,36 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
         for (const JobRecord& job : *jobs) list.push_back(JobJson(job, now));
         return JsonAnswer(200, {{"jobs", list}, {"now_ms", absl::ToUnixMillis(now)}});
     }
-    // jobs/ID[/what]
+    // jobs/ID[/what] or jobs/ID/frames/N/what
     const std::vector<std::string> parts = absl::StrSplit(route, '/');
-    if (parts.size() < 2 || parts.size() > 3) return NotFoundAnswer();
+    if (parts.size() < 2 || parts.size() == 4 || parts.size() > 5) return NotFoundAnswer();
     const std::string& id = parts[1];
-    const std::string what = parts.size() == 3 ? parts[2] : "";
+    std::string what = parts.size() >= 3 ? parts[2] : "";
+    std::optional<int> frame;
+    if (parts.size() == 5) {
+        int n = 0;
+        if (post || parts[2] != "frames" || !absl::SimpleAtoi(parts[3], &n)) {
+            return NotFoundAnswer();
+        }
+        frame = n;
+        what = parts[4];
+    }
     absl::StatusOr<JobRecord> job = VisibleJob(caller, id);
     if (!job.ok()) return ErrorAnswer(job.status());
+    if (frame) {
+        if (absl::Status s = CheckRendersFrame(*job, *frame); !s.ok()) return ErrorAnswer(s);
+        if (what != "preview.png" && what != "metadata") return NotFoundAnswer();
+        // A finished frame's image never changes: a browser holding it needs no new encoding.
+        const FrameProgress* f = FrameOf(*job, *frame);
+        if (what == "preview.png" && f && f->done &&
+            NotModified(request, FramePreviewEtag(f->tasks_done, true))) {
+            return {304,
+                    "",
+                    "",
+                    {{"Cache-Control", "private, no-cache"},
+                     {"ETag", FramePreviewEtag(f->tasks_done, true)}}};
+        }
+    }
 
     if (post) {
         if (what == "cancel") {
@@ -434,12 +542,29 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
         }
         return NotFoundAnswer();
     }
-    if (what.empty()) return JsonAnswer(200, JobJson(*job, now));
+    if (what.empty()) {
+        absl::StatusOr<Json> body = JobWithFramesJson(request, *job, now);
+        if (!body.ok()) return ErrorAnswer(body.status());
+        return JsonAnswer(200, *body);
+    }
     if (what == "tasks") {
+        std::optional<int> only;  // ?frame=N: a shot's frame's tasks
+        if (request.Query("frame")) {
+            absl::StatusOr<int64_t> n =
+                IntParam(request, "frame", 0, -kMaxFrameNumber, kMaxFrameNumber);
+            if (!n.ok()) return ErrorAnswer(n.status());
+            if (absl::Status s = CheckRendersFrame(*job, int(*n)); !s.ok()) return ErrorAnswer(s);
+            only = int(*n);
+        }
         absl::StatusOr<std::vector<TaskStatus>> tasks = farm_.Tasks(id);
         if (!tasks.ok()) return ErrorAnswer(tasks.status());
         Json list = Json::array();
-        for (const TaskStatus& t : *tasks) list.push_back(TaskJson(t));
+        for (const TaskStatus& t : *tasks) {
+            if (only && std::find(t.frames.begin(), t.frames.end(), *only) == t.frames.end()) {
+                continue;
+            }
+            list.push_back(TaskJson(t));
+        }
         return JsonAnswer(200, {{"tasks", list}});
     }
     if (what == "logs") {
@@ -467,40 +592,82 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
             200, {{"lines", lines}, {"next_seq", page->next_seq}, {"ended", page->job_ended}});
     }
     if (what == "preview.png" || what == "metadata") {
-        absl::StatusOr<std::shared_ptr<const Preview>> preview = PreviewOf(*job);
+        absl::StatusOr<std::shared_ptr<const Preview>> preview = PreviewOf(*job, frame);
         if (!preview.ok()) return ErrorAnswer(preview.status());
-        const std::string etag =
-            absl::StrCat("\"", (*preview)->tasks_done, "-", int((*preview)->state), "\"");
-        std::vector<std::pair<std::string, std::string>> headers = {
-            {"Cache-Control", "private, no-cache"}, {"ETag", etag}};
-        if (what == "metadata") {
-            Json attributes = Json::object();
-            for (const auto& [name, value] : (*preview)->attributes) {
-                attributes[name] = AttributeJson(value);
-            }
-            return JsonAnswer(200, {{"attributes", attributes}});
-        }
-        if (NotModified(request, etag)) return {304, "", "", std::move(headers)};
-        return {200, "image/png", (*preview)->png, std::move(headers)};
+        return PreviewAnswer(request, **preview, what);
     }
     return NotFoundAnswer();
 }
 
+absl::StatusOr<Json> Dashboard::JobWithFramesJson(const HttpRequest& request, const JobRecord& job,
+                                                  absl::Time now) {
+    Json body = JobJson(job, now);
+    if (!job.spec.shot.frames) return body;
+    const FrameRange& range = *job.spec.shot.frames;
+    // The page of the current frame unless another is asked for.
+    const int current = range.IndexOf(body["shot"]["current"].get<int>());
+    absl::StatusOr<int64_t> from = IntParam(
+        request, "frames_from", current / kFramesListed * kFramesListed, 0, range.count() - 1);
+    if (!from.ok()) return from.status();
+    std::set<int> running;
+    if (job.tasks_running > 0) {
+        // The scheduler's own view of the tasks: no log line counts read for it.
+        for (const TaskStatus& t :
+             farm_.scheduler().Tasks(job.id).value_or(std::vector<TaskStatus>{})) {
+            if (t.state == TaskStatus::State::kRunning) {
+                running.insert(t.frames.begin(), t.frames.end());
+            }
+        }
+    }
+    body["shot"]["frames_from"] = *from;
+    body["shot"]["frames_per_page"] = kFramesListed;
+    body["frames"] = FramesJson(job, int(*from), running);
+    return body;
+}
+
+HttpAnswer Dashboard::PreviewAnswer(const HttpRequest& request, const Preview& preview,
+                                    const std::string& what) {
+    std::vector<std::pair<std::string, std::string>> headers = {
+        {"Cache-Control", "private, no-cache"}, {"ETag", preview.etag}};
+    if (what == "metadata") {
+        Json attributes = Json::object();
+        for (const auto& [name, value] : preview.attributes) {
+            attributes[name] = AttributeJson(value);
+        }
+        return JsonAnswer(200, {{"attributes", attributes}});
+    }
+    if (NotModified(request, preview.etag)) return {304, "", "", std::move(headers)};
+    return {200, "image/png", preview.png, std::move(headers)};
+}
+
 absl::StatusOr<std::shared_ptr<const Dashboard::Preview>> Dashboard::PreviewOf(
-    const JobRecord& job) {
+    const JobRecord& job, std::optional<int> frame) {
+    // What the image shows: the job's merged tasks, or the frame's.
+    int tasks_done = job.tasks_done;
+    bool frame_done = false;
+    if (frame) {
+        if (const FrameProgress* f = FrameOf(job, *frame)) {
+            tasks_done = f->tasks_done;
+            frame_done = f->done;
+        }
+    }
+    const std::string key = frame ? absl::StrCat(job.id, "/", *frame) : job.id;
     {
         std::lock_guard<std::mutex> lock(previews_mutex_);
-        auto it = previews_.find(job.id);
-        // A job that failed or was cancelled keeps the last preview shown of it.
+        auto it = previews_.find(key);
+        // A job that failed or was cancelled keeps the last preview shown of it (of a frame,
+        // unless the frame was finished since).
         if (it != previews_.end() &&
-            ((it->second->tasks_done == job.tasks_done && it->second->state == job.state) ||
+            ((it->second->tasks_done == tasks_done && it->second->frame_done == frame_done &&
+              (frame || it->second->state == job.state)) ||
              (!IsFinal(job.state) && absl::Now() - it->second->made < options_.preview_min_age) ||
-             (IsFinal(job.state) && job.state != JobState::kSucceeded))) {
+             (IsFinal(job.state) && job.state != JobState::kSucceeded &&
+              it->second->frame_done == frame_done))) {
             it->second->used = ++preview_clock_;
             return it->second;
         }
     }
-    absl::StatusOr<std::string> path = farm_.ResultFile(job.id, true);
+    absl::StatusOr<std::string> path = farm_.ResultFile(job.id, true, frame);
     if (!path.ok()) return path.status();
     absl::StatusOr<ExrFile> exr = ReadExr(*path);
     if (!exr.ok()) {
@@ -510,11 +677,18 @@ absl::StatusOr<std::shared_ptr<const Dashboard::Preview>> Dashboard::PreviewOf(
     // Filmic: highlights roll off instead of clipping, as a look at a render in progress wants.
     absl::StatusOr<std::string> png = EncodePng(exr->image, {.tone = ToneCurve::kFilmic});
     if (!png.ok()) return png.status();
-    auto preview = std::make_shared<Preview>(Preview{job.tasks_done, job.state, std::move(*png),
-                                                     std::move(exr->attributes), absl::Now(), 0});
+    auto preview = std::make_shared<Preview>(
+        Preview{.tasks_done = tasks_done,
+                .state = job.state,
+                .frame_done = frame_done,
+                .etag = frame ? FramePreviewEtag(tasks_done, frame_done)
+                              : absl::StrCat("\"", tasks_done, "-", int(job.state), "\""),
+                .png = std::move(*png),
+                .attributes = std::move(exr->attributes),
+                .made = absl::Now()});
     std::lock_guard<std::mutex> lock(previews_mutex_);
     preview->used = ++preview_clock_;
-    previews_[job.id] = preview;
+    previews_[key] = preview;
     if (previews_.size() > kMaxPreviews) {
         auto oldest = std::min_element(previews_.begin(), previews_.end(), [](auto& a, auto& b) {
             return a.second->used < b.second->used;

@@ -1,5 +1,6 @@
 // The dashboard's shell: hash routes to pages, and one polling loop for the page on screen.
-// Each page module exports mount(root, argument) returning { refresh, every } where refresh()
+// Each page module exports mount(root, argument, who, detail) returning { refresh, every }
+// (#/NAME/ARGUMENT/DETAIL: #/frame/JOB/N is job.js on a shot's frame N) where refresh()
 // fetches and draws and `every` is its polling period in ms. Polling stops while the tab is
 // hidden and resumes at once when it is shown again.
 import { ApiError, get, post } from './api.js';
@@ -9,7 +10,7 @@ import * as jobs from './jobs.js';
 import * as signin from './signin.js';
 import * as workers from './workers.js';
 
-const pages = { jobs, job, workers, farm, signin };
+const pages = { jobs, job, frame: job, workers, farm, signin };
 const root = document.getElementById('page');
 const problem = document.getElementById('problem');
 let current = null;  // { page, timer }
@@ -51,14 +52,15 @@ async function who() {
 
 function route() {
   if (current) clearTimeout(current.timer);
-  const [name, argument] = location.hash.replace(/^#\/?/, '').split('/');
+  const [name, argument, detail] = location.hash.replace(/^#\/?/, '').split('/');
   const module = pages[name] || jobs;
   for (const link of document.querySelectorAll('nav a')) {
     link.classList.toggle('current', link.dataset.page === (pages[name] ? name : 'jobs'));
   }
   root.replaceChildren();
   showProblem('');
-  current = { page: module.mount(root, argument && decodeURIComponent(argument), who), timer: 0 };
+  const decoded = (text) => text && decodeURIComponent(text);
+  current = { page: module.mount(root, decoded(argument), who, decoded(detail)), timer: 0 };
   tick(current);
 }
 

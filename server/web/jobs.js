@@ -1,4 +1,5 @@
-// Jobs, newest first: state, owner, method, progress, priority, times and ETA.
+// Jobs, newest first: state, owner, method, progress (a shot's frames too), priority, times
+// and ETA.
 import { get } from './api.js';
 import { duration, h, progress, table, time } from './format.js';
 
@@ -14,7 +15,8 @@ export function mount(root) {
         h('td', { class: 'state' }, j.state),
         h('td', {}, j.owner || '—'),
         h('td', {}, j.method),
-        h('td', {}, progress(j.tasks_done, j.tasks_total)),
+        h('td', {}, progress(j.tasks_done, j.tasks_total),
+          j.shot ? h('span', { class: 'frames' }, ` ${j.shot.frames_done}/${j.shot.frames_total} frames`) : ''),
         h('td', { class: 'number' }, String(j.priority)),
         h('td', {}, time(j.submitted_ms)),
         h('td', {}, time(j.started_ms)),

@@ -1,7 +1,8 @@
 // The dashboard end to end: a real lightfarm-server with tokens, two lightfarm-workers and the
 // lightfarm CLI from the build, and Debian's headless Chromium driven by playwright-core.
 // Checks: a wrong token is refused; signed in, a job submitted from the CLI appears and its
-// progress rises; the preview loads and changes while tiles land; a task's log opens; a job
+// progress rises; the preview loads and changes while tiles land; a task's log opens; a shot's
+// page shows its frames' thumbnails and states, and a click opens a frame's page; a job
 // cancelled from the page (after its priority was raised there) is so for the CLI too. Screenshots of every page go to
 // SCREENSHOTS (the build's web-screenshots/).
 //
@@ -156,6 +157,35 @@ try {
   await until('tasks in the chart', () => page.$$eval('svg.chart rect', (r) => r.some((e) => Number(e.getAttribute('height')) > 0)));
   check(true, `the farm page shows the queue depth (${await page.textContent('#queue-depth .value')}) and throughput`);
   await page.screenshot({ path: join(shotsDir, 'farm.png'), fullPage: true });
+
+  // A shot (4 frames of the moving ball, tiny): its page shows a strip of 4 frame thumbnails
+  // with their states and no one image; a click on a thumbnail opens the frame's page, with the
+  // frame's preview, its tasks only and its EXR header.
+  const shotScene = join(scenesDir, 'shots', 'moving_ball.json');
+  const shotJob = cli(['submit', shotScene, '--frames', '1-4', '--resolution', '32x18', '--spp', '4', '--tile', '16',
+    '--priority', '10', '--name', 'shot'], aliceToken).split('\n').pop().trim();
+  await page.goto(`${base}/#/job/${shotJob}`);
+  await until('4 frame thumbnails', async () => (await page.$$('#frames a.thumb')).length === 4);
+  const numbers = await page.$$eval('#frames a.thumb .number', (e) => e.map((n) => n.textContent));
+  check(numbers.join(',') === '1,2,3,4', `the shot's page shows a thumbnail a frame, numbered ${numbers.join(', ')}`);
+  check(await page.isHidden('#preview'), "the shot's own page shows its frames instead of one image");
+  const states = () => page.$$eval('#frames a.thumb .frame-state', (e) => e.map((n) => n.textContent));
+  const seen = new Set();
+  await until('every frame done', async () => { (await states()).forEach((s) => seen.add(s)); return (await states()).every((s) => s === 'done'); }, 60);
+  await until('the thumbnails loaded', () => page.$$eval('#frames a.thumb img', (imgs) => imgs.length === 4 && imgs.every((i) => i.complete && i.naturalWidth === 32)));
+  check(true, `each thumbnail shows its frame's state (seen: ${[...seen].join(', ')}) and its 32x18 preview`);
+  await page.screenshot({ path: join(shotsDir, 'shot.png'), fullPage: true });
+  await page.click('#frames a.thumb[data-frame="3"]');
+  await until("the frame's page", () => page.url().endsWith(`#/frame/${shotJob}/3`));
+  await page.waitForSelector('#frame-state');
+  await until("the frame's preview", () => page.evaluate(() => document.getElementById('preview').naturalWidth === 32));
+  check((await page.textContent('h1')).includes('frame 3') && (await page.textContent('#frame-state')) === 'done',
+    `a click opens frame 3's page: "${await page.textContent('h1')}", ${await page.textContent('#frame-state')}, its preview loaded`);
+  const frameTasks = await page.$$eval('tr.task td:first-child', (e) => e.map((n) => n.textContent));
+  check(frameTasks.length === 4 && frameTasks.every((t) => t.includes('frame 3,')), `the frame's page lists its 4 tasks only (${frameTasks[0]}, ...)`);
+  await until("the frame's EXR header", () => page.$$eval('#metadata tr', (rows) => rows.some((r) => r.textContent === 'lightfarm.frame3')));
+  check(await page.isVisible('#frames a.thumb.open[data-frame="3"]'), "the frame's thumbnail is marked open in the strip");
+  await page.screenshot({ path: join(shotsDir, 'frame.png'), fullPage: true });
 
   // Raise a job's priority and cancel it from its page; the CLI agrees.
   const doomed = submit(['--spp', '65536', '--passes', '64', '--name', 'doomed']);

@@ -2,7 +2,8 @@
 // a socket: signing in and being refused, what each token sees (another's job answers as no
 // job), the JSON of jobs, tasks, workers and the farm, cancel and priority, the preview PNG
 // (decoded, and changed by a merged task), the CSRF checks of POSTs, bounds on what a request
-// names, anonymous admins only on loopback, and the embedded pages with their headers.
+// names, anonymous admins only on loopback, and the embedded pages with their headers; a shot's
+// frames with their states, paged, and each frame's preview and tasks.
 #include "lf/server/dashboard.h"
 
 #include <gtest/gtest.h>
@@ -69,18 +70,35 @@ class DashboardTest : public ::testing::Test {
         return *id;
     }
 
+    // A shot of `frames` at 16x16, one 8x8 tile a task in one pass of 2 spp: 4 tasks a frame,
+    // `tile` 16 for one.
+    std::string SubmitShot(const std::string& owner, FrameRange frames, int tile = 8) {
+        JobSpec spec;
+        spec.name = "shot of " + owner;
+        spec.owner = owner;
+        spec.plan = {16, 16, 2, tile, 1};
+        spec.shot.frames = frames;
+        absl::StatusOr<std::string> id = farm_->scheduler().Submit(spec);
+        EXPECT_TRUE(id.ok()) << id.status();
+        return *id;
+    }
+
     // Leases a task and merges a result of `value` in every pixel through the Farm; false when
     // no task is queued.
     bool RenderOne(const std::string& worker, float value) {
         std::optional<TaskAssignment> lease = farm_->scheduler().LeaseTask(worker);
-        if (!lease) return false;
-        TileSums sums(lease->task.rect);
+        return lease && Merge(*lease, worker, value);
+    }
+    bool Merge(const TaskAssignment& lease, const std::string& worker, float value) {
+        TileSums sums(lease.task.rect);
         for (PixelSums& p : sums.pixels) {
-            for (uint64_t s = lease->task.sample_begin; s < lease->task.sample_end; ++s) {
+            for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
                 p.Add(s, Rgb(value));
             }
         }
-        const absl::Status merged = farm_->Complete(lease->lease_id, worker, EncodeTileSums(sums));
+        // A shot's task names its frame (a still's none).
+        const absl::Status merged = farm_->Complete(lease.lease_id, worker, EncodeTileSums(sums),
+                                                    std::nullopt, std::nullopt, lease.frame);
         EXPECT_TRUE(merged.ok()) << merged;
         return merged.ok();
     }
@@ -384,6 +402,185 @@ TEST_F(DashboardTest, ARunningJobsPreviewIsMadeAtMostOncePerMinimumAge) {
     const HttpAnswer final = dashboard_->Serve(Get(path, alice_));
     ASSERT_EQ(final.status, 200);
     EXPECT_NE(final.body, first.body);
+}
+
+// The PNG's size and RGB bytes.
+struct Decoded {
+    int width = 0, height = 0;
+    std::vector<unsigned char> rgb;
+};
+Decoded DecodePng(const std::string& png) {
+    Decoded d;
+    int channels = 0;
+    unsigned char* data = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(png.data()),
+                                                int(png.size()), &d.width, &d.height, &channels, 3);
+    EXPECT_NE(data, nullptr);
+    if (data) d.rgb.assign(data, data + size_t(d.width) * d.height * 3);
+    stbi_image_free(data);
+    return d;
+}
+
+TEST_F(DashboardTest, AShotsJobListsItsFramesWithTheirStates) {
+    const std::string job = SubmitShot("alice", {1, 3, 1});
+    Json j = Call(Get("/api/jobs/" + job, alice_), 200);
+    EXPECT_EQ(j["shot"]["frames_total"], 3);
+    EXPECT_EQ(j["shot"]["frames_done"], 0);
+    EXPECT_EQ(j["shot"]["current"], 1);
+    EXPECT_EQ(j["shot"]["fps"], 24.0);
+    ASSERT_EQ(j["frames"].size(), 3u);
+    for (int i = 0; i < 3; ++i) {
+        EXPECT_EQ(j["frames"][i]["frame"], i + 1);
+        EXPECT_EQ(j["frames"][i]["state"], "queued");
+        EXPECT_TRUE(j["frames"][i]["preview"].is_null());
+    }
+
+    // Frame 1's first task leased: rendering, though nothing of it merged yet.
+    std::optional<TaskAssignment> lease = farm_->scheduler().LeaseTask("w1");
+    ASSERT_TRUE(lease && lease->frame == 1);
+    j = Call(Get("/api/jobs/" + job, alice_), 200);
+    EXPECT_EQ(j["frames"][0]["state"], "rendering");
+    EXPECT_TRUE(j["frames"][0]["preview"].is_null());
+    EXPECT_EQ(j["frames"][1]["state"], "queued");
+    ASSERT_TRUE(Merge(*lease, "w1", 0.5f));
+
+    for (int t = 0; t < 4; ++t) ASSERT_TRUE(RenderOne("w1", 0.5f));  // frame 1 and a task of 2
+    j = Call(Get("/api/jobs/" + job, alice_), 200);
+    EXPECT_EQ(j["shot"]["frames_done"], 1);
+    EXPECT_EQ(j["shot"]["current"], 2);
+    EXPECT_EQ(j["frames"][0]["state"], "done");
+    EXPECT_EQ(j["frames"][0]["tasks_done"], 4);
+    EXPECT_EQ(j["frames"][0]["tasks_total"], 4);
+    EXPECT_EQ(j["frames"][0]["preview"], "/api/jobs/" + job + "/frames/1/preview.png?v=4-done");
+    EXPECT_EQ(j["frames"][1]["state"], "rendering");
+    EXPECT_EQ(j["frames"][1]["tasks_done"], 1);
+    EXPECT_EQ(j["frames"][1]["preview"], "/api/jobs/" + job + "/frames/2/preview.png?v=1");
+    EXPECT_EQ(j["frames"][2]["state"], "queued");
+
+    // The list shows how far the shot is, not its frames.
+    const Json listed = Call(Get("/api/jobs", alice_), 200)["jobs"][0];
+    EXPECT_EQ(listed["shot"]["frames_done"], 1);
+    EXPECT_FALSE(listed.contains("frames"));
+
+    // Cancelled: the finished frame stays done with its preview, the others say why they never
+    // will be.
+    Call(Post("/api/jobs/" + job + "/cancel", Json::object(), alice_), 200);
+    j = Call(Get("/api/jobs/" + job, alice_), 200);
+    EXPECT_EQ(j["frames"][0]["state"], "done");
+    EXPECT_FALSE(j["frames"][0]["preview"].is_null());
+    EXPECT_EQ(j["frames"][1]["state"], "cancelled");
+    EXPECT_TRUE(j["frames"][1]["preview"].is_null());
+    EXPECT_EQ(j["frames"][2]["state"], "cancelled");
+    const HttpAnswer kept =
+        dashboard_->Serve(Get("/api/jobs/" + job + "/frames/1/preview.png", alice_));
+    EXPECT_EQ(kept.status, 200) << kept.body;
+    // An ended shot's tasks, as recorded when it ended, still name their frames.
+    const Json tasks = Call(Get("/api/jobs/" + job + "/tasks?frame=1", alice_), 200)["tasks"];
+    ASSERT_EQ(tasks.size(), 4u);
+    for (const Json& t : tasks) EXPECT_EQ(t["state"], "done");
+}
+
+TEST_F(DashboardTest, AStillHasNoFrames) {
+    const std::string job = Submit("alice");
+    const Json j = Call(Get("/api/jobs/" + job, alice_), 200);
+    EXPECT_TRUE(j["shot"].is_null());
+    EXPECT_FALSE(j.contains("frames"));
+    const Json refused = Call(Get("/api/jobs/" + job + "/frames/1/preview.png", alice_), 404);
+    EXPECT_EQ(refused["error"], "job " + job + " renders no frame 1 (a still)");
+    Call(Get("/api/jobs/" + job + "/tasks?frame=1", alice_), 404);
+}
+
+TEST_F(DashboardTest, AFramesPreviewIsAPngOfTheFramesSizeAndAnUnknownFrameIsNamed) {
+    dashboard_ = std::make_unique<Dashboard>(
+        *farm_, *auth_, DashboardOptions{.preview_min_age = absl::ZeroDuration()});
+    const std::string job = SubmitShot("alice", {10, 14, 2});        // frames 10, 12, 14
+    for (int t = 0; t < 4; ++t) ASSERT_TRUE(RenderOne("w1", 0.2f));  // frame 10
+    ASSERT_TRUE(RenderOne("w1", 0.8f));                              // a tile of frame 12
+    const std::string ten = "/api/jobs/" + job + "/frames/10/preview.png";
+    const std::string twelve = "/api/jobs/" + job + "/frames/12/preview.png";
+    const HttpAnswer done = dashboard_->Serve(Get(ten, alice_));
+    ASSERT_EQ(done.status, 200) << done.body;
+    EXPECT_EQ(done.content_type, "image/png");
+    const Decoded d = DecodePng(done.body);
+    EXPECT_EQ(d.width, 16);
+    EXPECT_EQ(d.height, 16);
+    // Every pixel of the finished frame alike, and lit.
+    ASSERT_FALSE(d.rgb.empty());
+    EXPECT_GT(d.rgb[0], 0);
+    EXPECT_EQ(std::count(d.rgb.begin(), d.rgb.end(), d.rgb[0]), std::ptrdiff_t(d.rgb.size()));
+    // A finished frame held by the browser is not encoded again.
+    HttpRequest again = Get(ten, alice_);
+    again.headers["if-none-match"] = HeaderOf(done, "ETag");
+    EXPECT_EQ(dashboard_->Serve(again).status, 304);
+
+    // The rendering frame: its one merged tile (brighter than frame 10), the rest black.
+    const HttpAnswer rendering = dashboard_->Serve(Get(twelve, alice_));
+    ASSERT_EQ(rendering.status, 200) << rendering.body;
+    const Decoded r = DecodePng(rendering.body);
+    EXPECT_EQ(r.width, 16);
+    EXPECT_EQ(r.height, 16);
+    EXPECT_EQ(std::count(r.rgb.begin(), r.rgb.end(), 0), std::ptrdiff_t(3 * 8 * 8 * 3));
+    EXPECT_EQ(*std::max_element(r.rgb.begin(), r.rgb.end()) > d.rgb[0], true);
+    EXPECT_NE(HeaderOf(rendering, "ETag"), HeaderOf(done, "ETag"));
+
+    const Json metadata = Call(Get("/api/jobs/" + job + "/frames/10/metadata", alice_), 200);
+    EXPECT_EQ(metadata["attributes"]["lightfarm.frame"], 10);
+
+    const Json tasks = Call(Get("/api/jobs/" + job + "/tasks?frame=12", alice_), 200)["tasks"];
+    ASSERT_EQ(tasks.size(), 4u);
+    int merged = 0;
+    for (const Json& t : tasks) {
+        merged += t["state"] == "done";
+        EXPECT_EQ(t["frames"], Json::array({12}));
+    }
+    EXPECT_EQ(merged, 1);
+
+    for (const std::string what : {"/frames/11/preview.png", "/frames/16/metadata"}) {
+        const Json unknown = Call(Get("/api/jobs/" + job + what, alice_), 404);
+        const std::string error = unknown["error"];
+        EXPECT_TRUE(absl::StrContains(error, "no frame 1")) << error;
+        EXPECT_TRUE(absl::StrContains(error, job)) << error;
+        EXPECT_TRUE(absl::StrContains(error, "(its frames: 10-14:2)")) << error;
+    }
+    EXPECT_EQ(Call(Get("/api/jobs/" + job + "/tasks?frame=13", alice_), 404)["error"],
+              "job " + job + " renders no frame 13 (its frames: 10-14:2)");
+    Call(Get("/api/jobs/" + job + "/frames/ten/preview.png", alice_), 404);
+    Call(Get("/api/jobs/" + job + "/frames/10/tasks", alice_), 404);
+    // Another's shot's frame answers as no job.
+    EXPECT_EQ(Call(Get(ten, bob_), 404)["error"], "no job " + job);
+}
+
+// 10000 frames: one answer lists kFramesListed of them, from the current frame's page or the
+// one asked for, and says how many there are.
+TEST_F(DashboardTest, ALongShotsFramesComeInPages) {
+    const std::string job = SubmitShot("alice", {1, 10000, 1}, 16);
+    const std::string path = "/api/jobs/" + job;
+    Json j = Call(Get(path, alice_), 200);
+    EXPECT_EQ(j["shot"]["frames_total"], 10000);
+    EXPECT_EQ(j["shot"]["frames_from"], 0);
+    EXPECT_EQ(j["shot"]["frames_per_page"], Dashboard::kFramesListed);
+    ASSERT_EQ(j["frames"].size(), size_t(Dashboard::kFramesListed));
+    EXPECT_EQ(j["frames"][0]["frame"], 1);
+    j = Call(Get(path + "?frames_from=9950", alice_), 200);
+    EXPECT_EQ(j["shot"]["frames_from"], 9950);
+    ASSERT_EQ(j["frames"].size(), 50u);
+    EXPECT_EQ(j["frames"][49]["frame"], 10000);
+    Call(Get(path + "?frames_from=10000", alice_), 400);
+    Call(Get(path + "?frames_from=-1", alice_), 400);
+    // The whole answer stays small: 100 frames, not 10000.
+    EXPECT_LT(dashboard_->Serve(Get(path, alice_)).body.size(), 20000u);
+
+    // Unasked, the page is the current frame's (frames merge slowly in so long a record: a
+    // shorter shot past its first page shows it).
+    Call(Post(path + "/cancel", Json::object(), alice_), 200);
+    const std::string shorter = SubmitShot("alice", {1, 150, 1}, 16);
+    for (int t = 0; t < Dashboard::kFramesListed + 5; ++t) ASSERT_TRUE(RenderOne("w1", 0.5f));
+    j = Call(Get("/api/jobs/" + shorter, alice_), 200);
+    EXPECT_EQ(j["shot"]["current"], Dashboard::kFramesListed + 6);
+    EXPECT_EQ(j["shot"]["frames_from"], Dashboard::kFramesListed);
+    ASSERT_EQ(j["frames"].size(), size_t(150 - Dashboard::kFramesListed));
+    EXPECT_EQ(j["frames"][0]["frame"], Dashboard::kFramesListed + 1);
+    EXPECT_EQ(j["frames"][4]["state"], "done");
+    EXPECT_EQ(j["frames"][5]["state"], "queued");
 }
 
 TEST_F(DashboardTest, WhatARequestNamesIsBounded) {

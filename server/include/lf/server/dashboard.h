@@ -12,11 +12,14 @@
 //   POST /api/session {"token": T}    signs in: an HttpOnly, SameSite=Strict cookie
 //   POST /api/session/end             signs out
 //   GET  /api/jobs?limit=N&before=SEQ newest first
-//   GET  /api/jobs/ID                 one job, with its ETA
-//   GET  /api/jobs/ID/tasks           its tasks
+//   GET  /api/jobs/ID?frames_from=I   one job, with its ETA; a shot's with its frames: at most
+//                                     kFramesListed of them from position I of its range
+//                                     (default: the page of its current frame)
+//   GET  /api/jobs/ID/tasks?frame=N   its tasks (a shot's frame N's only)
 //   GET  /api/jobs/ID/logs?task=N&after=SEQ&max=N
 //   GET  /api/jobs/ID/preview.png     the image merged so far, 8-bit sRGB
 //   GET  /api/jobs/ID/metadata        the EXR header attributes of that image
+//   GET  /api/jobs/ID/frames/N/preview.png, .../metadata   the same of a shot's frame N
 //   POST /api/jobs/ID/cancel
 //   POST /api/jobs/ID/priority {"priority": N}
 //   GET  /api/workers
@@ -30,6 +33,8 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -59,11 +64,15 @@ class Dashboard {
     static constexpr char kCookie[] = "lf_token";
     // Previews kept encoded, the most recently asked for.
     static constexpr size_t kMaxPreviews = 16;
+    // Frames of a shot one job answer lists: the page's strip pages through longer shots.
+    static constexpr int kFramesListed = 100;
 
   private:
     struct Preview {
-        int tasks_done = 0;
+        int tasks_done = 0;  // the job's, or the frame's
         JobState state = JobState::kQueued;
+        bool frame_done = false;
+        std::string etag;  // its version
         std::string png;
         ExrAttributes attributes;
         absl::Time made;
@@ -79,14 +88,22 @@ class Dashboard {
     // The job when `caller` may see it; NotFound alike for another's job and for none.
     absl::StatusOr<JobRecord> VisibleJob(const Caller& caller, const std::string& job_id);
     // The job's image as merged so far (or its result), encoded again only when a task was
-    // merged since, and not more often than preview_min_age while the job runs.
-    absl::StatusOr<std::shared_ptr<const Preview>> PreviewOf(const JobRecord& job);
+    // merged since, and not more often than preview_min_age while the job runs; a shot's
+    // `frame`'s likewise (NotFound naming the frame and the job for one it does not render).
+    absl::StatusOr<std::shared_ptr<const Preview>> PreviewOf(const JobRecord& job,
+                                                             std::optional<int> frame);
+    // One job's JSON; a shot's with the page of its frames `frames_from` asks for.
+    absl::StatusOr<nlohmann::json> JobWithFramesJson(const HttpRequest& request,
+                                                     const JobRecord& job, absl::Time now);
+    // preview.png and metadata of `preview`, whose ETag names its version.
+    HttpAnswer PreviewAnswer(const HttpRequest& request, const Preview& preview,
+                             const std::string& what);
 
     Farm& farm_;
     Authenticator& auth_;
     const DashboardOptions options_;
     std::mutex previews_mutex_;
-    std::map<std::string, std::shared_ptr<Preview>> previews_;  // by job id
+    std::map<std::string, std::shared_ptr<Preview>> previews_;  // by job id (and frame)
     uint64_t preview_clock_ = 0;
 };
 
