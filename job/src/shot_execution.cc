@@ -376,6 +376,11 @@ std::optional<std::string> ShotExecution::RecordOf(const TaskResult& result) con
 }
 
 absl::StatusOr<std::vector<int>> ShotExecution::MergeRecorded(int task, std::string_view record) {
+    // A store's index the plan has not made (yet): damage, or results replayed out of order.
+    if (task < 0 || size_t(task) >= task_count()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("a record of task ", task, " of a shot planned with ", task_count()));
+    }
     absl::StatusOr<std::vector<RecordedPart>> recorded = DecodeParts(record);
     if (!recorded.ok()) return recorded.status();
     const std::vector<std::pair<int, int>> parts =

@@ -253,9 +253,16 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
             Job::Make(std::move(s.record), options_.tile_stores, options_.speculate_after);
         if (!made.ok()) return made.status();
         std::unique_ptr<Job> job = std::move(*made);
-        // In index order, an adaptive plan appends each pass before its result comes up: the
-        // passes it planned depend only on the results before them.
-        for (const auto& [t, recorded] : s.results) {
+        // In the order they merged, so an adaptive plan appends each pass before its result
+        // comes up, and a shot gives each appended pass the index it had (its frames append
+        // in the order their results merged, not in index order).
+        std::vector<std::pair<int, const JobStore::RecordedTask*>> in_order;
+        for (const auto& [t, recorded] : s.results) in_order.emplace_back(t, &recorded);
+        std::stable_sort(in_order.begin(), in_order.end(), [](const auto& a, const auto& b) {
+            return a.second->order < b.second->order;
+        });
+        for (const auto& [t, stored_result] : in_order) {
+            const JobStore::RecordedTask& recorded = *stored_result;
             // The store wrote what merged before, so this cannot fail unless the file was
             // damaged; the task is then simply rendered again.
             if (!job->execution->MergeRecorded(t, recorded.result).ok()) {
@@ -676,6 +683,24 @@ int Scheduler::ExpireLeases() {
     return int(expired.size());
 }
 
+namespace {
+
+// The image of a snapshot taken under the lock, read outside it, and its estimated error.
+absl::StatusOr<Scheduler::JobImage> ReadSnapshot(Scheduler::JobImage snapshot,
+                                                 const JobExecution::ImageReader& read) {
+    absl::StatusOr<Image> image = read();
+    if (!image.ok()) return image.status();
+    snapshot.image = std::move(*image);
+    if (snapshot.adaptive) {
+        absl::StatusOr<double> estimated = EstimatedRelativeError(snapshot.image);
+        if (!estimated.ok()) return estimated.status();
+        snapshot.adaptive->estimated_error = *estimated;
+    }
+    return snapshot;
+}
+
+}  // namespace
+
 absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_id) const {
     JobImage snapshot;
     JobExecution::ImageReader read;  // shares the stores: outlives the job if it ends meanwhile
@@ -690,15 +715,7 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_i
         read = job.execution->SnapshotReader();
         snapshot.adaptive = job.execution->TileReport();
     }
-    absl::StatusOr<Image> image = read();
-    if (!image.ok()) return image.status();
-    snapshot.image = std::move(*image);
-    if (snapshot.adaptive) {
-        absl::StatusOr<double> estimated = EstimatedRelativeError(snapshot.image);
-        if (!estimated.ok()) return estimated.status();
-        snapshot.adaptive->estimated_error = *estimated;
-    }
-    return snapshot;
+    return ReadSnapshot(std::move(snapshot), read);
 }
 
 absl::StatusOr<Scheduler::JobImage> Scheduler::FrameSnapshot(const std::string& job_id,
@@ -722,15 +739,7 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::FrameSnapshot(const std::string& 
         read = execution->SnapshotReader();
         snapshot.adaptive = execution->TileReport();
     }
-    absl::StatusOr<Image> image = read();
-    if (!image.ok()) return image.status();
-    snapshot.image = std::move(*image);
-    if (snapshot.adaptive) {
-        absl::StatusOr<double> estimated = EstimatedRelativeError(snapshot.image);
-        if (!estimated.ok()) return estimated.status();
-        snapshot.adaptive->estimated_error = *estimated;
-    }
-    return snapshot;
+    return ReadSnapshot(std::move(snapshot), read);
 }
 
 void Scheduler::FrameWritten(const std::string& job_id, int frame,

@@ -375,12 +375,14 @@ absl::StatusOr<std::map<int, JobStore::RecordedTask>> SqliteJobStore::TaskResult
     const std::string& id) const {
     std::lock_guard<std::mutex> lock(read_mutex_);
     std::map<int, RecordedTask> results;
-    Statement get(read_db_, "SELECT task, sums, history FROM task_results WHERE job = ?1");
+    // rowid grows with each write (INSERT OR REPLACE gives a replaced row a new one).
+    Statement get(read_db_, "SELECT task, sums, history, rowid FROM task_results WHERE job = ?1");
     get.Bind(1, id);
     while (get.Step()) {
         const int task = int(get.ColumnInt(0));
         RecordedTask& recorded = results[task];
         recorded.result = std::string(get.Column(1));
+        recorded.order = get.ColumnInt(3);
         // The history is only shown (`lightfarm tasks`): a damaged one costs the display, not
         // the result.
         absl::StatusOr<TaskHistory> history = DecodeTaskHistory(get.Column(2));

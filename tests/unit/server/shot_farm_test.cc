@@ -4,6 +4,7 @@
 // and finishes the shot; deleting it removes every frame.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -64,11 +65,18 @@ class ShotFarmTest : public ::testing::Test {
         std::optional<TaskAssignment> lease =
             farm_->scheduler().LeaseTask("w1", absl::Now() + absl::Seconds(5));
         ASSERT_TRUE(lease.has_value());
-        const auto sums = [](const RenderTask& task, int frame) {
+        Answer(*lease);
+    }
+    // The frame's number / 10 at every sample; with `noise`, plus or minus 0.05 sample by sample
+    // (the mean the same), so that an adaptive plan wants more passes.
+    void Answer(const TaskAssignment& assignment, bool noise = false) {
+        const TaskAssignment* lease = &assignment;
+        const auto sums = [noise](const RenderTask& task, int frame) {
             TileSums s(task.rect);
             for (PixelSums& p : s.pixels) {
                 for (uint64_t i = task.sample_begin; i < task.sample_end; ++i) {
-                    p.Add(i, Rgb(float(frame) / 10));
+                    const float wobble = noise ? (i % 2 ? 0.05f : -0.05f) : 0.0f;
+                    p.Add(i, Rgb(float(frame) / 10 + wobble));
                 }
             }
             return EncodeTileSums(s);
@@ -158,6 +166,63 @@ TEST_F(ShotFarmTest, ARestartedCoordinatorReplaysTheFramesAndFinishesTheShot) {
     EXPECT_EQ(record->state, JobState::kSucceeded) << record->error;
     EXPECT_EQ(record->frames_done(), 3);
     for (int f : {1, 2, 3}) ExpectFrame(*job, f);
+}
+
+// An adaptive shot appends each frame's next passes as the frame's results merge; here frame 2's
+// first passes merge before frame 1's, so frame 2's next pass takes a shot task index before
+// frame 1's. A restarted coordinator replays the results in the order they merged, so every
+// recorded index means the frame's task it meant, and the shot finishes with each frame's value.
+TEST_F(ShotFarmTest, AnAdaptiveShotReplaysItsPassesAsTheyMergedAcrossFrames) {
+    JobSpec spec = Shot();
+    spec.shot.frames = FrameRange{1, 2, 1};
+    spec.plan.spp = 4;
+    spec.adaptive.target_error = 1e-4;  // far below the noise: passes up to max_spp
+    spec.adaptive.max_spp = 16;
+    absl::StatusOr<std::string> job = farm_->Submit(spec);
+    ASSERT_TRUE(job.ok()) << job.status();
+    std::vector<TaskAssignment> first;  // every first pass: 4 tiles a frame
+    while (std::optional<TaskAssignment> lease =
+               farm_->scheduler().LeaseTask("w1", absl::Now() + absl::Milliseconds(100))) {
+        first.push_back(*lease);
+    }
+    ASSERT_EQ(first.size(), 8u);
+    std::stable_sort(first.begin(), first.end(),
+                     [](const TaskAssignment& a, const TaskAssignment& b) {
+                         return *a.frame > *b.frame;  // frame 2 first
+                     });
+    for (const TaskAssignment& lease : first) Answer(lease, true);
+    absl::StatusOr<JobRecord> before = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(before.ok());
+    ASSERT_GT(before->tasks_total, 8) << "no pass appended";
+    std::vector<TaskAssignment> second;  // a few of the appended passes
+    for (int i = 0; i < 3; ++i) {
+        std::optional<TaskAssignment> lease =
+            farm_->scheduler().LeaseTask("w1", absl::Now() + absl::Seconds(5));
+        ASSERT_TRUE(lease.has_value());
+        Answer(*lease, true);
+    }
+    before = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(before.ok());
+    Open();
+    absl::StatusOr<JobRecord> after = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(after.ok()) << after.status();
+    EXPECT_EQ(after->tasks_done, before->tasks_done) << "recorded results were refused";
+    EXPECT_EQ(after->tasks_total, before->tasks_total);
+    while (std::optional<TaskAssignment> lease =
+               farm_->scheduler().LeaseTask("w1", absl::Now() + absl::Milliseconds(200))) {
+        Answer(*lease, true);
+    }
+    after = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(after.ok());
+    EXPECT_EQ(after->state, JobState::kSucceeded) << after->error;
+    for (int f : {1, 2}) {
+        absl::StatusOr<std::string> path = farm_->ResultFile(*job, false, f);
+        ASSERT_TRUE(path.ok()) << path.status();
+        absl::StatusOr<ExrFile> exr = ReadExr(*path);
+        ASSERT_TRUE(exr.ok()) << exr.status();
+        // An even number of samples a pixel: the wobble cancels.
+        EXPECT_NEAR(exr->image.FindChannel("R")->at(0), float(f) / 10, 1e-5) << f;
+    }
 }
 
 TEST_F(ShotFarmTest, ChunksOfWholeFramesAcrossARestart) {

@@ -57,6 +57,9 @@ class JobStore {
     struct RecordedTask {
         std::string result;
         TaskHistory history;  // empty for a result recorded before histories were
+        // The order it was written in, among the job's results: a restart merges them again
+        // in that order, the order they merged in (a shot's passes take indices as they merge).
+        int64_t order = 0;
     };
     virtual absl::StatusOr<std::map<int, RecordedTask>> TaskResults(
         const std::string& id) const = 0;
