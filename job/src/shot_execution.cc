@@ -295,6 +295,8 @@ uint64_t ShotExecution::TaskSamples(int task) const {
     return samples;
 }
 
+size_t ShotExecution::ResultParts(int task) const { return chunk_ > 1 ? PartsOf(task).size() : 0; }
+
 absl::StatusOr<std::vector<int>> ShotExecution::MergePart(int index, int task,
                                                           const TaskResult& part) {
     absl::StatusOr<Merged> merged = frames_exec_[size_t(index)]->Merge(task, part);
@@ -332,13 +334,21 @@ absl::StatusOr<JobExecution::Merged> ShotExecution::Merge(int task, const TaskRe
                 result.parts.size(), " parts in the result of a chunk of ", parts.size()));
         }
         std::vector<bool>& done = parts_merged_[size_t(task)];
+        // Whole before any part merges: a part merged before (a result refused half way) is
+        // not merged again, but recorded with the rest (RecordOf), so it must be whole too.
+        for (size_t k = 0; k < parts.size(); ++k) {
+            const int want = frames_.at(parts[k].first);
+            const TaskResult& part = result.parts[k];
+            if (part.frame != want) return WrongFrame(part.frame.value_or(0), want);
+            if (done[k] && !frames_exec_.front()->RecordOf(part)) {
+                return absl::InvalidArgumentError(absl::StrCat(
+                    "part ", k, " (frame ", want, ") of a chunk's result without its sums"));
+            }
+        }
         for (size_t k = 0; k < parts.size(); ++k) {
             if (done[k]) continue;
             const auto [index, t] = parts[k];
             const TaskResult& part = result.parts[k];
-            if (part.frame != frames_.at(index)) {
-                return WrongFrame(part.frame.value_or(0), frames_.at(index));
-            }
             absl::StatusOr<std::vector<int>> appended = MergePart(index, t, part);
             if (!appended.ok()) {
                 return absl::Status(

@@ -64,6 +64,7 @@ absl::StatusOr<JobExecution::Merged> SplatExecution::Merge(int index, const Task
 }
 
 std::optional<std::string> SplatExecution::RecordOf(const TaskResult& result) const {
+    if (!result.sums || !result.splats) return std::nullopt;  // not a splat task's result
     return EncodeSplatResult(*result.sums, *result.splats);
 }
 

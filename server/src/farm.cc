@@ -202,6 +202,15 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
                             std::string_view tile_sums, std::optional<RadiosityFigures> radiosity,
                             std::optional<std::string_view> splats, std::optional<int> frame,
                             const std::vector<ResultPart>& parts) {
+    // As many parts as the task has, checked before any is decoded: a worker's message of
+    // millions of empty parts costs no decoding.
+    const std::optional<Scheduler::LeaseHolder> holder = scheduler_.HolderOf(lease_id, worker);
+    if (const size_t want = holder ? holder->parts : 0; parts.size() != want) {
+        return RefuseUndecodable(lease_id, worker,
+                                 absl::InvalidArgumentError(absl::StrCat(
+                                     parts.size(), " parts in the result of a task of ", want,
+                                     want == 1 ? " part" : " parts")));
+    }
     // A chunk's parts, or the one result; kept in place while the result points at them.
     std::vector<ResultPart> wire = parts;
     if (parts.empty()) wire.push_back({frame.value_or(0), tile_sums, splats});
@@ -231,7 +240,16 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     TaskResult chunk{.parts = std::move(results)};
     const TaskResult& result = parts.empty() ? chunk.parts.front() : chunk;
     absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, result);
-    if (!done.ok()) return done.status();
+    if (!done.ok()) {
+        // A chunk refused half way keeps the parts merged before the refusal: the frames they
+        // completed are written now, so that a shot cancelled before the retry still has them.
+        if (holder && !parts.empty()) {
+            for (const auto& [id, f] : scheduler_.UnwrittenFrames()) {
+                if (id == holder->job_id) WriteFrame(id, f);
+            }
+        }
+        return done.status();
+    }
     if (radiosity) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         radiosity_[done->job_id] = *radiosity;

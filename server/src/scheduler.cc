@@ -178,8 +178,9 @@ std::optional<Scheduler::LeaseHolder> Scheduler::HolderOf(const std::string& lea
     std::lock_guard<std::mutex> lock(mutex_);
     const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
     if (!ref) return std::nullopt;
-    return LeaseHolder{ref->job->id(), ref->lease->task, ref->lease->attempt, worker,
-                       ref->lease->current};
+    return LeaseHolder{ref->job->id(),      ref->lease->task,
+                       ref->lease->attempt, worker,
+                       ref->lease->current, ref->job->execution->ResultParts(ref->lease->task)};
 }
 
 size_t Scheduler::workers_tracked() const {

@@ -182,9 +182,21 @@ TEST(ShotExecution, AChunkIsEveryTaskOfItsFrames) {
     EXPECT_TRUE(e->frame(2).Complete());
     EXPECT_FALSE(e->frame(3).Complete());
     EXPECT_EQ(e->tasks_done(), 0u);
+    // The retry's parts merged before are not merged again, but they are recorded with the
+    // rest: one without its sums is refused, not recorded from a null pointer.
+    EXPECT_EQ(e->ResultParts(1), 8u);
+    EXPECT_EQ(e->ResultParts(2), 4u);
+    TaskResult hollow = r.result;
+    hollow.parts[0].sums = nullptr;
+    absl::StatusOr<JobExecution::Merged> refused = e->Merge(1, hollow);
+    EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(refused.status().message().find("part 0 (frame 3)"), std::string_view::npos)
+        << refused.status();
+    EXPECT_FALSE(e->frame(3).Complete()) << "nothing merged";
     absl::StatusOr<JobExecution::Merged> merged = e->Merge(1, r.result);
     ASSERT_TRUE(merged.ok()) << merged.status();
     EXPECT_EQ(merged->frames_completed, std::vector<int>{4});
+    EXPECT_TRUE(e->RecordOf(r.result).has_value());
     EXPECT_EQ(e->tasks_done(), 1u);
     EXPECT_EQ(e->frames_done(), 2);
 }

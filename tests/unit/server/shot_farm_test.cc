@@ -242,6 +242,48 @@ TEST_F(ShotFarmTest, ChunksOfWholeFramesAcrossARestart) {
     for (int f : {1, 2, 3}) ExpectFrame(*job, f);
 }
 
+// A chunk's result must hold its task's parts, counted before any is decoded; one refused half
+// way keeps the parts merged before the refusal, and the frames they complete are written at
+// once, so a shot cancelled before the retry keeps them.
+TEST_F(ShotFarmTest, AChunkRefusedHalfWayWritesTheFramesItCompleted) {
+    absl::StatusOr<std::string> job = farm_->Submit(Shot(2));  // {1, 2}, {3}
+    ASSERT_TRUE(job.ok()) << job.status();
+    std::optional<TaskAssignment> lease =
+        farm_->scheduler().LeaseTask("w1", absl::Now() + absl::Seconds(5));
+    ASSERT_TRUE(lease.has_value());
+    ASSERT_EQ(lease->parts.size(), 8u);  // 4 tiles of frame 1, then of frame 2
+    std::vector<std::string> encoded;
+    for (const TaskAssignment::Part& part : lease->parts) {
+        TileSums sums(part.task.rect);
+        for (PixelSums& p : sums.pixels) {
+            for (uint64_t i = part.task.sample_begin; i < part.task.sample_end; ++i) {
+                p.Add(i, Rgb(float(part.frame) / 10));
+            }
+        }
+        encoded.push_back(EncodeTileSums(sums));
+    }
+    std::vector<Farm::ResultPart> parts;
+    for (size_t i = 0; i < encoded.size(); ++i) {
+        parts.push_back({lease->parts[i].frame, encoded[i], std::nullopt});
+    }
+    const std::vector<Farm::ResultPart> three(parts.begin(), parts.begin() + 3);
+    absl::Status s =
+        farm_->Complete(lease->lease_id, "w1", "", std::nullopt, std::nullopt, std::nullopt, three);
+    EXPECT_NE(s.message().find("3 parts in the result of a task of 8 parts"),
+              std::string_view::npos)
+        << s;
+    lease = farm_->scheduler().LeaseTask("w1", absl::Now() + absl::Seconds(5));
+    ASSERT_TRUE(lease.has_value());
+    std::vector<Farm::ResultPart> damaged = parts;
+    damaged[5].tile_sums = encoded[0];  // frame 2's second tile with another rectangle
+    s = farm_->Complete(lease->lease_id, "w1", "", std::nullopt, std::nullopt, std::nullopt,
+                        damaged);
+    EXPECT_FALSE(s.ok());
+    ASSERT_TRUE(farm_->scheduler().Cancel(*job).ok());
+    ExpectFrame(*job, 1);
+    EXPECT_FALSE(farm_->ResultFile(*job, false, 2).ok());
+}
+
 TEST_F(ShotFarmTest, BadShotSettingsAreRefusedAtSubmissionWithRendersMessage) {
     JobSpec spec = Shot();
     spec.shot.fps = -1;

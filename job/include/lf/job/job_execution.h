@@ -80,6 +80,9 @@ class JobExecution {
     virtual void Describe(int task, TaskStatus& status) const = 0;
     // Pixels times samples per pixel of a task's camera part (0 for a sweep's), for throughput.
     virtual uint64_t TaskSamples(int task) const = 0;
+    // How many parts a task's result must hold (TaskResult::parts): a chunk's frames' tasks;
+    // 0 for a task answered by one result. Checked before a result is decoded.
+    virtual size_t ResultParts(int task) const { return 0; }
 
     struct Merged {
         std::vector<int> appended;  // tasks the result added to the plan, to queue

@@ -39,6 +39,7 @@ class ShotExecution : public JobExecution {
     std::string PreferredWorker(int task) const override;
     void Describe(int task, TaskStatus& status) const override;
     uint64_t TaskSamples(int task) const override;
+    size_t ResultParts(int task) const override;
     // The result must name the task's frame (TaskResult::frame), or for a chunk hold one part per
     // part of the lease, in its order. A chunk's parts merged before (a result refused half way)
     // are not merged again.

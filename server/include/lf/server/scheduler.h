@@ -223,6 +223,7 @@ class Scheduler {
         int attempt = 0;  // 1 for the task's first lease
         std::string worker;
         bool current = false;  // false once the lease ended (failed, expired, done, cancelled)
+        size_t parts = 0;      // parts its result must hold (JobExecution::ResultParts)
     };
     // Where a lease id of this server points when `worker` holds it, current or not, while its
     // job is queued or running; nullopt otherwise (a made-up id, another worker's lease, a lease
