@@ -91,7 +91,9 @@ absl::Status CheckShotChunk(const JobSpec& spec) {
     if (SolvedInSweeps(spec)) return refuse("radiosity solved in sweeps adds a sweep at a time");
     // A chunk's result is one message and one record: every frame's sums (tile_codec.h: 104
     // bytes a pixel, 220 with AOVs) and, for splatting methods, up to 2 splats of 53 bytes a pixel.
-    const uint64_t pixel_bytes = (spec.aovs ? 220 : 104) + (UsesSplatPlan(spec.method) ? 106 : 0);
+    // Each pass of a tile is a part with the tile's sums.
+    const uint64_t pixel_bytes = (spec.aovs ? 220 : 104) * uint64_t(std::max(spec.plan.passes, 1)) +
+                                 (UsesSplatPlan(spec.method) ? 106 : 0);
     const uint64_t bytes = uint64_t(spec.shot.chunk) * uint64_t(spec.plan.width) *
                            uint64_t(spec.plan.height) * pixel_bytes;
     if (bytes > uint64_t(kMaxTaskResultBytes)) {
@@ -126,6 +128,15 @@ absl::StatusOr<std::unique_ptr<ShotExecution>> ShotExecution::Make(
             MakeFrameExecution(FrameSpec(spec, range.at(i)), tile_stores);
         if (!frame.ok()) return frame.status();
         frames.push_back(std::move(*frame));
+        // Every frame plans as the first: bounded before the others are made.
+        const int64_t tasks = int64_t(frames.front()->task_count()) * range.count();
+        if (i == 0 && tasks > kMaxShotTasks) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                "frames ", FrameRangeText(range), ": ", range.count(), " frames of ",
+                frames.front()->task_count(), " tasks each is ", tasks,
+                " tasks, above the coordinator's bound of ", kMaxShotTasks,
+                " (lf::kMaxShotTasks); use a larger --tile, fewer --passes or fewer frames a job"));
+        }
     }
     return std::unique_ptr<ShotExecution>(new ShotExecution(spec, std::move(frames)));
 }

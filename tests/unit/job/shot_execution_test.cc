@@ -231,6 +231,32 @@ TEST(ShotExecution, ChunksRefuseKindsThatGrowAsTheyMerge) {
     EXPECT_NE(too_big.message().find("use a smaller --chunk"), std::string::npos) << too_big;
     big.shot.chunk = 1;
     EXPECT_TRUE(CheckShotChunk(big).ok());
+    // Each pass of a tile is a part with the tile's sums: 4 frames of 1080p in 1 pass fit
+    // (862 MB), in 2 they do not (1.7 GB).
+    JobSpec passes = Shot({1, 8, 1}, 4);
+    passes.plan.width = 1920;
+    passes.plan.height = 1080;
+    EXPECT_TRUE(CheckShotChunk(passes).ok());
+    passes.plan.passes = 2;
+    EXPECT_NE(CheckShotChunk(passes).message().find("use a smaller --chunk"), std::string::npos);
+}
+
+// Every frame's plan is held while the shot runs: the frames' tasks together are bounded, and
+// the bound is checked on the first frame's plan, before the others are made.
+TEST(ShotExecution, AShotOfTooManyTasksIsRefusedNamingTheBound) {
+    JobSpec spec = Shot({1, 10000, 1});  // 10000 frames of 1080p in 8x8 tiles: 324M tasks
+    spec.plan.width = 1920;
+    spec.plan.height = 1080;
+    absl::StatusOr<std::unique_ptr<ShotExecution>> made =
+        ShotExecution::Make(spec, MakeMemoryTileStore);
+    ASSERT_FALSE(made.ok());
+    EXPECT_NE(made.status().message().find("10000 frames of 32400 tasks each"), std::string::npos)
+        << made.status();
+    EXPECT_NE(made.status().message().find("lf::kMaxShotTasks"), std::string::npos);
+    spec.plan.tile = 64;  // 510 tasks a frame: 5.1M, still too many
+    EXPECT_FALSE(ShotExecution::Make(spec, MakeMemoryTileStore).ok());
+    spec.shot.frames = FrameRange{1, 2, 1};  // 1020 tasks
+    EXPECT_TRUE(ShotExecution::Make(spec, MakeMemoryTileStore).ok());
 }
 
 TEST(ShotExecution, AChunkOfASplattingMethodLeasesEveryPassOfItsFrames) {

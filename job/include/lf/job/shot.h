@@ -29,7 +29,12 @@ struct FrameRange {
 };
 
 inline constexpr int kMaxFrameNumber = 1'000'000;  // |frame| at most this
-inline constexpr int kMaxShotFrames = 100'000;     // frames in one job
+// Frames in one job: each frame's merger holds its tile file open while the shot runs, and the
+// job's record lists every frame (a longer sequence is several shots, as studios split them).
+inline constexpr int kMaxShotFrames = 10'000;
+// Tasks a shot may plan over all its frames (lf::ShotExecution::Make): a task costs the
+// coordinator a few hundred bytes while the shot runs.
+inline constexpr int64_t kMaxShotTasks = 1'000'000;
 // Frame times stay finite and distinct: |frame| / fps at most 10^9 seconds.
 inline constexpr double kMinFps = 1e-3, kMaxFps = 1000;
 inline constexpr double kMaxShutter = 10;  // frames
