@@ -331,7 +331,13 @@ grpc::Status JobServiceImpl::ListJobs(grpc::ServerContext* context, const Caller
         jobs->resize(size_t(page_size));
         resp->set_next_page_token(absl::StrCat(jobs->back().seq));
     }
-    for (const JobRecord& job : *jobs) ToProto(job, resp->add_jobs());
+    for (const JobRecord& job : *jobs) {
+        pb::Job* listed = resp->add_jobs();
+        ToProto(job, listed);
+        // A list shows frames done/total; each frame's progress is GetJob's (a page of long
+        // shots would pass a client's 4 MiB message limit).
+        listed->clear_frames();
+    }
     return grpc::Status::OK;
 }
 
