@@ -826,12 +826,14 @@ TEST_F(Cli, RadiositySummaryReportsEveryPhaseAndTheTotal) {
                           &load, &radiosity, &mesh, &ff, &solve, &render, &total),
               7)
         << r.output;
-    EXPECT_GE(radiosity, ff + solve - 0.01) << r.output;
-    EXPECT_GE(total, load + radiosity + render - 0.01) << r.output;
+    // Each printed figure is its value rounded to 0.01 s, so within 0.005 of it: a sum of n
+    // rounded parts against a rounded total may be off by 0.005 (n + 1).
+    EXPECT_GE(radiosity, ff + solve - 0.015) << r.output;
+    EXPECT_GE(total, load + radiosity + render - 0.02) << r.output;
     absl::StatusOr<ExrFile> file = ReadExr(exr);
     ASSERT_TRUE(file.ok()) << file.status();
     const double seconds = std::get<double>(file->attributes.at("lightfarm.seconds"));
-    EXPECT_GE(seconds, load + radiosity + render - 0.01) << r.output;
+    EXPECT_GE(seconds, load + radiosity + render - 0.015) << r.output;  // exact vs 3 rounded
     EXPECT_GE(seconds + 0.01,
               std::get<double>(file->attributes.at("lightfarm.radiosity.formFactorSeconds")) +
                   std::get<double>(file->attributes.at("lightfarm.radiosity.solveSeconds")));
