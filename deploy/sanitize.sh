@@ -3,7 +3,7 @@
 #  1. a clang build (build-san/) of lf_core and lf_job with AddressSanitizer, UndefinedBehavior-
 #     Sanitizer (any report aborts) and libFuzzer's coverage;
 #  2. the core and job unit tests under those sanitizers;
-#  3. each fuzz target of tests/fuzz for FUZZ_SECONDS (default 20) from its seed corpus. A crash
+#  3. each fuzz target of tests/fuzz for FUZZ_SECONDS (default 15) from its seed corpus. A crash
 #     fails the run and is kept as build-san/fuzz-crashes/TARGET-*: add it to
 #     tests/fuzz/regressions/TARGET/, which every build's ctest replays.
 #  4. a ThreadSanitizer build (build-tsan/) of the coordinator's scheduler, lease, store and
@@ -15,7 +15,7 @@
 # Prints how long each part took.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-fuzz_seconds=${FUZZ_SECONDS:-20}
+fuzz_seconds=${FUZZ_SECONDS:-15}
 fuzzers=(scene_json_fuzz gltf_fuzz mesh_fuzz texture_fuzz codec_fuzz job_record_fuzz)
 mapfile -t unit_tests < <(ls tests/unit/core/*_test.cc tests/unit/job/*_test.cc | xargs -n1 basename | sed 's/\.cc$//')
 # run_tests DIR SANITIZERS PROGRAM...: each test program built in DIR; the first failure ends

@@ -1501,8 +1501,8 @@ TEST_F(Farm, AShotInChunksSurvivesAKilledWorkerAndARestartAndGivesRendersBits) {
     StartServer(/*lease_seconds=*/1);
     Child* doomed = StartWorker("doomed");
     StartWorker("survivor");
-    // 8 frames, two a task: 4 tasks of about a second each.
-    const std::string flags = std::string(kShotFlags) + " --spp 1024 --tile 32";
+    // 8 frames, two a task: 4 tasks of over a second each on one thread.
+    const std::string flags = std::string(kShotFlags) + " --spp 512 --tile 32";
     const std::string job = Submit(ShotScene(), "--frames 1-8 --chunk 2 " + flags);
     ASSERT_TRUE(KillMidTask(doomed, "doomed.log"));
     ASSERT_TRUE(WaitForTasksDone(job, 1, milliseconds(60000)));
