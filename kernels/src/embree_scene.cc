@@ -406,7 +406,7 @@ void EmbreeScene::Triangle(int mesh, int primitive, float time, Vec3* p0, Vec3* 
 float EmbreeScene::TriangleArea(int mesh, int primitive, float time) const {
     Vec3 p0, p1, p2;
     Triangle(mesh, primitive, time, &p0, &p1, &p2);
-    return 0.5f * Length(Cross(p1 - p0, p2 - p0));
+    return TriangleAreaOf(p0, p1, p2);
 }
 
 Vec3 EmbreeScene::Normal(int mesh, uint32_t v, float time) const {

@@ -353,7 +353,7 @@ std::optional<LightSample> LightSampler::SampleArea(const Light& light, const Ve
     if (light.kind == Kind::kTriangle) {
         Vec3 p0, p1, p2;
         scene_.Triangle(light.index, light.primitive, time, &p0, &p1, &p2);
-        area = scene_.TriangleArea(light.index, light.primitive, time);
+        area = TriangleAreaOf(p0, p1, p2);  // a deforming triangle's, at `time`
         const SphericalTriangle st(ref, p0, p1, p2, kMinSampledSolidAngle);
         if (bvh && st.samplable()) {
             solid_angle_pdf = st.Pdf();
@@ -436,7 +436,8 @@ float LightSampler::AreaPdf(const Light& light, const Vec3& ref, const Vec3& n,
         }
     }
     float area = light.area;
-    if (light.kind == Kind::kTriangle) {
+    // A still triangle's area is the list's (the same formula at the same points).
+    if (light.kind == Kind::kTriangle && scene_.Moves(light.index)) {
         area = scene_.TriangleArea(light.index, light.primitive, hit.time);
     }
     const Vec3 d = hit.p - ref;

@@ -46,6 +46,11 @@ struct SurfacePoint {
 };
 
 // A ray origin just outside p's error box on the side of w.
+// The area of the triangle p0 p1 p2: the one formula of the light lists and their densities.
+inline float TriangleAreaOf(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+    return 0.5f * Length(Cross(p1 - p0, p2 - p0));
+}
+
 Vec3 OffsetRayOrigin(const SurfacePoint& sp, const Vec3& w);
 Ray SpawnRay(const SurfacePoint& from, const Vec3& direction);
 // A ray from `from` that stops just short of `to`: t in (0, 1 - epsilon) over d = to' - from'.
@@ -79,7 +84,7 @@ class EmbreeScene {
     // Vertices of triangle `primitive` of `mesh` in render space at `time` (Ray::time).
     void Triangle(int mesh, int primitive, float time, Vec3* p0, Vec3* p1, Vec3* p2) const;
     SurfacePoint TrianglePoint(int mesh, int primitive, float b1, float b2, float time) const;
-    // Its area at `time`: a deforming triangle's changes with time.
+    // Its area at `time`: a deforming triangle's changes with time (TriangleAreaOf).
     float TriangleArea(int mesh, int primitive, float time) const;
     SurfacePoint SpherePoint(int sphere, const Vec3& direction_from_center, float time) const;
     // Whether mesh m moves during the shutter; its vertex `v`'s normal and tangent at `time`

@@ -55,7 +55,7 @@ void ForEachEmissiveTriangle(const EmbreeScene& es, Visit&& visit) {
         for (size_t t = 0; t < triangles; ++t) {
             EmissiveTriangle tri{int(m), int(t), {}, 0, &material, EmitsFromBack(material)};
             es.Triangle(int(m), int(t), 0, &tri.p[0], &tri.p[1], &tri.p[2]);
-            tri.area = 0.5f * Length(Cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
+            tri.area = TriangleAreaOf(tri.p[0], tri.p[1], tri.p[2]);
             if (es.Moves(int(m))) {
                 for (int step = 1; step < es.steps(); ++step) {
                     const float time = float(step) / float(es.steps() - 1);
