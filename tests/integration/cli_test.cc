@@ -524,7 +524,8 @@ TEST_F(Cli, PlanListsTheEnvironmentAndSkipsEmissionTexturesWithoutLight) {
 
 TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
     const RunResult r = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
-                                  "/cornell_box.json --pilot-spp 2 --target-error 0.5 --threads 2");
+                                  "/cornell_box.json --pilot-spp 2 --target-error 0.5 --threads 2 "
+                                  "--resolution 64x64");
     ASSERT_EQ(r.status, 0) << r.output;
     for (const char* text :
          {"light: lambert, reflectance (0, 0, 0), emits (17, 12, 4)", "2 emissive triangles",
@@ -536,7 +537,7 @@ TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
     // radiosity cannot model the scene.
     const RunResult radiosity = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
                                           "/cornell_box.json --method radiosity --patches 1000 "
-                                          "--pilot-spp 2 --threads 2");
+                                          "--pilot-spp 2 --threads 2 --resolution 64x64");
     ASSERT_EQ(radiosity.status, 0) << radiosity.output;
     for (const char* text :
          {"method (--method radiosity): radiosity, because requested",
@@ -569,7 +570,8 @@ TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
 // Cornell box) was printed "spp^--0.81": the exponent is printed with its own sign.
 TEST_F(Cli, PlanPrintsTheMeasuredExponentWithItsSign) {
     const RunResult r = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
-                                  "/cornell_box.json --method path --resolution 4x4 --threads 2");
+                                  "/cornell_box.json --method path --resolution 4x4 --threads 2 "
+                                  "--photons 4096");
     ASSERT_EQ(r.status, 0) << r.output;
     // At 4x4 the estimate rises between the stages: a positive exponent, printed as such.
     const size_t at = r.output.find("error goes as spp^");
@@ -1118,8 +1120,9 @@ TEST_F(Cli, LightTracingRendersTheSameBitsForAnySplit) {
 // scene's light is interreflected or focused (one lit plane), a preview with its missing terms
 // named in the Cornell box; with --method whitted its pilot traces Whitted's rays.
 TEST_F(Cli, PlanRecommendsWhittedOnlyAsAPreviewNamingWhatItLeavesOut) {
-    const RunResult box = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
-                                    "/cornell_box.json --pilot-spp 2 --threads 2");
+    const RunResult box =
+        Lightfarm("plan " + std::string(LF_TEST_SCENES) +
+                  "/cornell_box.json --pilot-spp 2 --threads 2 --resolution 64x64");
     ASSERT_EQ(box.status, 0) << box.output;
     for (const char* text : {"method (--method auto): radiosity",
                              "whitted: recommended only as a preview", "interreflection"}) {
