@@ -230,7 +230,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     // The store is read before the lock is taken.
     struct Stored {
         JobRecord record;
-        std::map<int, JobStore::RecordedTask> results;
+        absl::StatusOr<std::map<int, JobStore::RecordedTask>> results;
     };
     std::vector<Stored> stored;
     uint64_t last_seq = 0;
@@ -240,25 +240,29 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     for (JobRecord& record : *recorded) {
         last_seq = std::max(last_seq, record.seq);
         if (IsFinal(record.state)) continue;
-        absl::StatusOr<std::map<int, JobStore::RecordedTask>> results =
-            store_.TaskResults(record.id);
-        if (!results.ok()) return results.status();
-        stored.push_back({std::move(record), std::move(*results)});
+        const std::string id = record.id;
+        stored.push_back({std::move(record), store_.TaskResults(id)});
     }
     Locked locked(*this);
     next_seq_ = std::max(next_seq_, last_seq + 1);
     std::vector<std::string> rendered;
     for (Stored& s : stored) {
         if (active_.count(s.record.id)) continue;
+        // One job that cannot be taken up (its task results unreadable, or a spec this build
+        // refuses, such as a shot over a newer limit) fails alone; the farm starts with the rest.
         absl::StatusOr<std::unique_ptr<Job>> made =
-            Job::Make(std::move(s.record), options_.tile_stores, options_.speculate_after);
-        if (!made.ok()) return made.status();
+            s.results.ok() ? Job::Make(s.record, options_.tile_stores, options_.speculate_after)
+                           : absl::StatusOr<std::unique_ptr<Job>>(s.results.status());
+        if (!made.ok()) {
+            FailUnrecoverable(std::move(s.record), made.status());
+            continue;
+        }
         std::unique_ptr<Job> job = std::move(*made);
         // In the order they merged, so an adaptive plan appends each pass before its result
         // comes up, and a shot gives each appended pass the index it had (its frames append
         // in the order their results merged, not in index order).
         std::vector<std::pair<int, const JobStore::RecordedTask*>> in_order;
-        for (const auto& [t, recorded] : s.results) in_order.emplace_back(t, &recorded);
+        for (const auto& [t, recorded] : *s.results) in_order.emplace_back(t, &recorded);
         std::stable_sort(in_order.begin(), in_order.end(), [](const auto& a, const auto& b) {
             return a.second->order < b.second->order;
         });
@@ -587,6 +591,16 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
         ++job.record.retries;
     }
     Save(job);
+}
+
+void Scheduler::FailUnrecoverable(JobRecord record, const absl::Status& why) {
+    const absl::Status moved = TransitionJob(record, JobState::kFailed, clock_());
+    if (!moved.ok()) Log()->error("job={}: {}", record.id, std::string(moved.message()));
+    record.error =
+        absl::StrCat("cannot be taken up after the coordinator restarted: ", why.message());
+    Log()->error("job={} failed: {}", record.id, LogSafe(record.error));
+    const uint64_t ticket = store_.QueuePut(record);
+    ended_.Add(std::move(record), ticket);
 }
 
 void Scheduler::FailJob(Job& job, const std::string& error) {

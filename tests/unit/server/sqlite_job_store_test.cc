@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "lease_results.h"
+#include "lf/job/shot.h"
 #include "lf/server/farm.h"
 #include "lf/server/scheduler.h"
 #include "test_dir.h"
@@ -282,6 +283,34 @@ TEST_F(SqliteJobStoreTest, StoreThatCannotListFailsRecoveryInsteadOfStartingEmpt
     EXPECT_EQ(rendered.status().code(), absl::StatusCode::kDataLoss);
     EXPECT_NE(rendered.status().message().find("malformed"), std::string_view::npos);
     EXPECT_EQ(after.List().status().code(), absl::StatusCode::kDataLoss) << "nor lists nothing";
+}
+
+// A stored job this build cannot take up (here a shot over the frame limit, as a store written by
+// an older build could hold) fails alone, naming why; the server starts with the other jobs.
+TEST_F(SqliteJobStoreTest, StoredJobThatCannotBeTakenUpFailsAloneAndTheRestRecover) {
+    std::string good, bad;
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        Scheduler before({}, *store);
+        good = *before.Submit(Spec());
+        bad = *before.Submit(Spec());
+        JobRecord record = *store->Get(bad);
+        record.spec.shot.frames = FrameRange{1, kMaxShotFrames + 1, 1};
+        ASSERT_TRUE(store->Put(record).ok());
+    }
+    std::unique_ptr<SqliteJobStore> store = OpenStore();
+    Scheduler after({}, *store);
+    const absl::StatusOr<std::vector<std::string>> rendered = after.Recover();
+    ASSERT_TRUE(rendered.ok()) << rendered.status();
+    const JobRecord failed = *after.Get(bad);
+    EXPECT_EQ(failed.state, JobState::kFailed);
+    EXPECT_NE(failed.error.find("cannot be taken up after the coordinator restarted"),
+              std::string::npos)
+        << failed.error;
+    EXPECT_NE(failed.error.find(std::to_string(kMaxShotFrames)), std::string::npos) << failed.error;
+    EXPECT_EQ(store->Get(bad)->state, JobState::kFailed) << "the failure is stored";
+    CompleteAll(after, "w");
+    EXPECT_EQ(after.Get(good)->tasks_done, 8);
 }
 
 TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs) {

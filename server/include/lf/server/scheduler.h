@@ -303,6 +303,8 @@ class Scheduler {
     // queue. Counts a failure unless `counted` is false; fails the job at max_failures.
     void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
     void FailJob(Job& job, const std::string& error);
+    // A stored job Recover cannot take up, ended as failed with `why`; the lock is held.
+    void FailUnrecoverable(JobRecord record, const absl::Status& why);
     // Ends the live state of a job moved to a final state: its final record is queued and the
     // job waits in `ended_` until Locked's release finds it durable. Returns that record.
     JobRecord EndJob(Job& job);
