@@ -1,6 +1,7 @@
 #include "lf/job/job_record.h"
 
 #include "absl/strings/str_cat.h"
+#include "lf/job/shot.h"
 
 namespace lf {
 
@@ -34,6 +35,21 @@ int JobRecord::frames_done() const {
     int done = 0;
     for (const FrameProgress& frame : frames) done += frame.done;
     return done;
+}
+
+const FrameProgress* FrameOf(const JobRecord& job, int frame) {
+    if (!job.spec.shot.frames || !job.spec.shot.frames->Contains(frame)) return nullptr;
+    const size_t i = size_t(job.spec.shot.frames->IndexOf(frame));
+    return i < job.frames.size() && job.frames[i].frame == frame ? &job.frames[i] : nullptr;
+}
+
+absl::Status CheckRendersFrame(const JobRecord& job, int frame) {
+    if (job.spec.shot.frames && job.spec.shot.frames->Contains(frame)) return absl::OkStatus();
+    return absl::NotFoundError(absl::StrCat(
+        "job ", job.id, " renders no frame ", frame,
+        job.spec.shot.frames
+            ? absl::StrCat(" (its frames: ", FrameRangeText(*job.spec.shot.frames), ")")
+            : std::string(" (a still)")));
 }
 
 }  // namespace lf

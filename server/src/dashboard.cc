@@ -136,24 +136,6 @@ Json JobJson(const JobRecord& job, absl::Time now) {
     };
 }
 
-// The frame `frame` of a shot's record (in frame order: at its position in the range); nullptr
-// for one its record does not list (a record not yet synced with its execution lists none).
-const FrameProgress* FrameOf(const JobRecord& job, int frame) {
-    if (!job.spec.shot.frames || !job.spec.shot.frames->Contains(frame)) return nullptr;
-    const size_t i = size_t(job.spec.shot.frames->IndexOf(frame));
-    return i < job.frames.size() && job.frames[i].frame == frame ? &job.frames[i] : nullptr;
-}
-
-// NotFound naming the frame and the job when `job` does not render `frame`.
-absl::Status CheckRendersFrame(const JobRecord& job, int frame) {
-    if (job.spec.shot.frames && job.spec.shot.frames->Contains(frame)) return absl::OkStatus();
-    return absl::NotFoundError(absl::StrCat(
-        "job ", job.id, " renders no frame ", frame,
-        job.spec.shot.frames
-            ? absl::StrCat(" (its frames: ", FrameRangeText(*job.spec.shot.frames), ")")
-            : std::string(" (a still)")));
-}
-
 // A frame as the strip shows it: done, rendering (a task of it runs or has merged), queued, or
 // the state of a shot that ended without it.
 const char* FrameStateName(const FrameProgress& f, JobState job, bool running) {

@@ -371,15 +371,9 @@ absl::StatusOr<std::string> Farm::ResultFile(const std::string& job_id, bool pre
     absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
     if (!job.ok()) return job.status();
     if (frame) {
-        if (!job->spec.shot.frames || !job->spec.shot.frames->Contains(*frame)) {
-            return absl::NotFoundError(absl::StrCat(
-                "job ", job_id, " renders no frame ", *frame,
-                job->spec.shot.frames
-                    ? absl::StrCat(" (its frames: ", FrameRangeText(*job->spec.shot.frames), ")")
-                    : std::string(" (a still)")));
-        }
-        for (const FrameProgress& f : job->frames) {
-            if (f.frame == *frame && !f.result_path.empty()) return f.result_path;
+        if (absl::Status s = CheckRendersFrame(*job, *frame); !s.ok()) return s;
+        if (const FrameProgress* f = FrameOf(*job, *frame); f && !f->result_path.empty()) {
+            return f->result_path;
         }
         if (!preview || IsFinal(job->state)) {
             return absl::FailedPreconditionError(absl::StrCat(

@@ -193,7 +193,8 @@ void Worker::Execute(const TaskAssignment& task) {
 }
 
 absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
-                             ServerConnection::TaskResult& result, RenderStats& stats) {
+                             ServerConnection::TaskResult& result, RenderStats& stats,
+                             SplatList* frame_splats) {
     if (!task.parts.empty()) return RunChunk(task, cancel, result, stats);
     if (task.frame) {
         if (absl::Status s = PoseFrame(task, *task.frame, cancel); !s.ok()) return s;
@@ -205,7 +206,9 @@ absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>
         result = {std::move(*swept), true, std::nullopt};
         return absl::OkStatus();
     }
-    if (UsesSplatPlan(task.spec.method)) return RenderSplat(task, cancel, result, stats);
+    if (UsesSplatPlan(task.spec.method)) {
+        return RenderSplat(task, cancel, result, stats, frame_splats);
+    }
     if (absl::Status s = PrepareTracer(task, cancel); !s.ok()) return s;
     const TileSums sums = Render(task, cancel);
     stats = sums.stats;
@@ -220,6 +223,13 @@ absl::Status Worker::RunChunk(const TaskAssignment& task, const std::atomic<bool
                               ServerConnection::TaskResult& result, RenderStats& stats) {
     TaskAssignment one = task;
     one.parts.clear();
+    // A splatting method's parts add their splats to one list a frame: its exact sums are the
+    // same whichever task added what, and it holds at most 2 entries a pixel however many tasks
+    // the frame has, so a chunk's result is bounded by its frames (lf::CheckShotChunk). The
+    // frame's first part carries the list, its others an empty one.
+    const bool splatting = UsesSplatPlan(task.spec.method);
+    std::map<int, SplatList> frame_splats;
+    std::map<int, size_t> first_part;
     for (const TaskAssignment::Part& part : task.parts) {
         if (cancel) return absl::CancelledError("chunk cancelled");
         one.task.rect = part.task.rect;
@@ -230,10 +240,30 @@ absl::Status Worker::RunChunk(const TaskAssignment& task, const std::atomic<bool
         one.frame = part.frame;
         ServerConnection::TaskResult rendered;
         RenderStats part_stats;
-        if (absl::Status s = RunTask(one, cancel, rendered, part_stats); !s.ok()) return s;
+        SplatList* splats = nullptr;
+        if (splatting) {
+            splats = &frame_splats[part.frame];
+            first_part.try_emplace(part.frame, result.parts.size());
+        }
+        if (absl::Status s = RunTask(one, cancel, rendered, part_stats, splats); !s.ok()) return s;
         stats += part_stats;
         if (rendered.radiosity) result.radiosity = rendered.radiosity;
         result.parts.push_back({part.frame, std::move(rendered.bytes), std::move(rendered.splats)});
+    }
+    if (!splatting) return absl::OkStatus();
+    size_t bytes = 0;
+    for (size_t i = 0; i < result.parts.size(); ++i) {
+        ServerConnection::TaskResult::Part& part = result.parts[i];
+        SplatList& list = frame_splats[part.frame];
+        SplatList none(list.width(), list.height());
+        part.splats = EncodeSplatList(first_part[part.frame] == i ? list : none);
+        bytes += part.bytes.size() + part.splats->size();
+    }
+    if (bytes > size_t(kMaxTaskResultBytes) - 4096) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "the result of job ", task.job_id, " task ", task.task.index, " (", task.parts.size(),
+            " parts) is ", bytes, " bytes, above the coordinator's bound of ", kMaxTaskResultBytes,
+            " (lf::kMaxTaskResultBytes): submit with a smaller --chunk"));
     }
     return absl::OkStatus();
 }
@@ -449,7 +479,8 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
 }
 
 absl::Status Worker::RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
-                                 ServerConnection::TaskResult& result, RenderStats& stats) {
+                                 ServerConnection::TaskResult& result, RenderStats& stats,
+                                 SplatList* frame_splats) {
     if (!loaded_.frame) {
         // Cached per job (loaded_.job_id), through the conversions local mode uses, so one job's
         // settings give local mode's kernel.
@@ -462,12 +493,15 @@ absl::Status Worker::RenderSplat(const TaskAssignment& task, const std::atomic<b
     const SplatWork work{task.task.rect, task.task.sample_begin, task.task.sample_end,
                          task.path_begin, task.path_end};
     TileSums camera(task.task.rect, 0);
-    SplatList splats(loaded_.camera->width(), loaded_.camera->height());
+    SplatList own(loaded_.camera->width(), loaded_.camera->height());
+    if (frame_splats && frame_splats->width() == 0) *frame_splats = own;
+    SplatList& splats = frame_splats ? *frame_splats : own;
     // The renderer runs tbb inside: in this worker's arena, so --threads bounds it.
     arena_.execute([&] { loaded_.frame->Render(work, camera, splats, &cancel); });
     if (cancel) return absl::CancelledError("splat task cancelled");
     stats = camera.stats;
     result.bytes = EncodeTileSums(camera);
+    if (frame_splats) return absl::OkStatus();
     result.splats = EncodeSplatList(splats);
     const size_t bytes = result.bytes.size() + result.splats->size();
     // Above the bound the coordinator would refuse the message: said here, in its terms.

@@ -175,6 +175,34 @@ TEST_F(ShotWorkerTest, AMovingTriangleGivesFramesThatDifferAndChunksGiveTheSameB
     for (int f = 1; f < 4; ++f) EXPECT_NE(red[size_t(f)], red[0]) << "frame " << f << " moved";
 }
 
+// Splatting methods' chunks: a frame's tasks add their splats to one list on the worker (so a
+// chunk's result holds at most one list a frame); the frames are the bits of one task a lease.
+TEST_F(ShotWorkerTest, SplattingChunksSumTheirFramesSplatsToTheSameBits) {
+    const BlobRef scene = Put("moving.gltf", MovingTriangleGltf());
+    for (const char* method : {"light", "bdpt"}) {
+        SCOPED_TRACE(method);
+        JobSpec spec = Spec(scene, FrameRange{0, 1, 1});
+        spec.method = method;
+        spec.plan.passes = 2;
+        const JobRecord tasks = Render(spec);
+        ASSERT_EQ(tasks.state, JobState::kSucceeded) << tasks.error;
+        ASSERT_GT(tasks.tasks_total, 2) << "several tasks a frame, so a chunk sums their splats";
+        spec.shot.chunk = 2;
+        const JobRecord chunk = Render(spec);
+        ASSERT_EQ(chunk.state, JobState::kSucceeded) << chunk.error;
+        EXPECT_EQ(chunk.tasks_total, 1) << "one task renders both frames";
+        for (int f = 0; f < 2; ++f) {
+            const Image a = FrameOf(tasks, f), b = FrameOf(chunk, f);
+            ASSERT_TRUE(a.FindChannel("R") && b.FindChannel("R")) << f;
+            EXPECT_EQ(*a.FindChannel("R"), *b.FindChannel("R")) << "frame " << f;
+            EXPECT_EQ(*a.FindChannel("B.G"), *b.FindChannel("B.G")) << "frame " << f;
+            float lit = 0;
+            for (float v : *a.FindChannel("R")) lit += v;
+            EXPECT_GT(lit, 0) << "frame " << f << ": the light reaches the camera";
+        }
+    }
+}
+
 TEST_F(ShotWorkerTest, WithoutAnimationEveryFrameIsTheStill) {
     const BlobRef scene =
         Put("cornell_box.json", ReadText(fs::path(LF_TEST_SCENES) / "cornell_box.json"));

@@ -47,4 +47,11 @@ struct TaskHistory {
     absl::Time finished = absl::InfinitePast();  // its result merged
 };
 
+// A shot's progress of `frame` (in frame order: at its position in the range); null when the job
+// does not render it or its record does not list it yet (not synced with its execution).
+const FrameProgress* FrameOf(const JobRecord& job, int frame);
+// NotFound naming the frame and the job (and the frames it renders) when `job` does not render
+// `frame`: what a fetch or the dashboard answers for it.
+absl::Status CheckRendersFrame(const JobRecord& job, int frame);
+
 }  // namespace lf

@@ -17,6 +17,7 @@
 
 #include "absl/status/status.h"
 #include "lf/core/camera.h"
+#include "lf/core/splat_list.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiance.h"
@@ -80,13 +81,17 @@ class Worker {
                           ServerConnection::TaskResult& result, RenderStats& stats);
     TileSums Render(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A tile or splat task's camera sums, or a sweep's result: `result` and its stats.
+    // `frame_splats`: see RenderSplat.
     absl::Status RunTask(const TaskAssignment& task, const std::atomic<bool>& cancel,
-                         ServerConnection::TaskResult& result, RenderStats& stats);
+                         ServerConnection::TaskResult& result, RenderStats& stats,
+                         SplatList* frame_splats = nullptr);
     // A splatting method's task (lf::SplatTask): its camera sums and its splat list, encoded; the
     // renderer is built once per job. FailedPrecondition when the result is above what the
-    // coordinator takes (lf::kMaxTaskResultBytes).
+    // coordinator takes (lf::kMaxTaskResultBytes). With `frame_splats` (a chunk's list of the
+    // task's frame) the splats are added to it instead, and `result.splats` stays unset.
     absl::Status RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
-                             ServerConnection::TaskResult& result, RenderStats& stats);
+                             ServerConnection::TaskResult& result, RenderStats& stats,
+                             SplatList* frame_splats);
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
     // A radiosity vector the server stored as a blob.
     absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
