@@ -205,7 +205,9 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     // As many parts as the task has, checked before any is decoded: a worker's message of
     // millions of empty parts costs no decoding.
     const std::optional<Scheduler::LeaseHolder> holder = scheduler_.HolderOf(lease_id, worker);
-    if (const size_t want = holder ? holder->parts : 0; parts.size() != want) {
+    // Not a lease of a running job (it ended, or the id is made up): the scheduler says so.
+    if (!holder) return scheduler_.Complete(lease_id, worker, TaskResult{}).status();
+    if (const size_t want = holder->parts; parts.size() != want) {
         return RefuseUndecodable(lease_id, worker,
                                  absl::InvalidArgumentError(absl::StrCat(
                                      parts.size(), " parts in the result of a task of ", want,
@@ -243,7 +245,7 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     if (!done.ok()) {
         // A chunk refused half way keeps the parts merged before the refusal: the frames they
         // completed are written now, so that a shot cancelled before the retry still has them.
-        if (holder && !parts.empty()) {
+        if (!parts.empty()) {
             for (const auto& [id, f] : scheduler_.UnwrittenFrames()) {
                 if (id == holder->job_id) WriteFrame(id, f);
             }

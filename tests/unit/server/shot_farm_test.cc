@@ -282,6 +282,12 @@ TEST_F(ShotFarmTest, AChunkRefusedHalfWayWritesTheFramesItCompleted) {
     ASSERT_TRUE(farm_->scheduler().Cancel(*job).ok());
     ExpectFrame(*job, 1);
     EXPECT_FALSE(farm_->ResultFile(*job, false, 2).ok());
+    // A chunk's result after its job ended is refused as the lease it no longer is, not for
+    // its parts (the ended job's task has none).
+    s = farm_->Complete(lease->lease_id, "w1", "", std::nullopt, std::nullopt, std::nullopt, parts);
+    EXPECT_EQ(s.code(), absl::StatusCode::kFailedPrecondition) << s;
+    EXPECT_NE(s.message().find("is not one of worker w1 in a running job"), std::string_view::npos)
+        << s;
 }
 
 TEST_F(ShotFarmTest, BadShotSettingsAreRefusedAtSubmissionWithRendersMessage) {
