@@ -632,7 +632,6 @@ TEST_F(DashboardTest, PagesAreEmbeddedWithTheirTypesAndAStrictPolicy) {
     }
 }
 
-
 std::vector<std::string> IdsOf(const Json& answer) {
     std::vector<std::string> ids;
     for (const Json& j : answer["jobs"]) ids.push_back(j["id"]);
