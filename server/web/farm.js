@@ -44,7 +44,7 @@ function chart(counts, title, unit) {
     picture.append(rect);
   });
   // The x axis: minutes ago, every quarter of the hour.
-  for (let ago = counts.length - 1; ago >= 0; ago -= 15) {
+  for (let ago = 0; ago < counts.length; ago += 15) {
     const x = left + (counts.length - 1 - ago) * bar + bar / 2;
     picture.append(svg('line', { x1: x, x2: x, y1: top + height, y2: top + height + 4, class: 'axis' }),
       text({ x, y: top + height + 15, 'text-anchor': 'middle', class: 'tick' }, ago === 0 ? 'now' : `${ago}`));

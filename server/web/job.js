@@ -127,7 +127,7 @@ export function mount(root, id, who, frameText) {
     drag = null;
   });
 
-  taskState.append(h('option', { value: '' }, 'all'), kTaskStates.map((s) => h('option', { value: s }, s)));
+  taskState.append(h('option', { value: '' }, 'all'), ...kTaskStates.map((s) => h('option', { value: s }, s)));
   taskState.addEventListener('change', () => { taskOffset = 0; return act(() => {}); });
   function turnTasks(step) {
     taskOffset = Math.max(0, Math.min(taskOffset + step * kTaskRows, Math.max(0, taskTotal - 1)));
