@@ -97,7 +97,7 @@ export function mount(root) {
       h('td', { class: 'number priority' }, String(j.priority)),
       h('td', {}, time(j.submitted_ms)),
       h('td', {}, duration(j.eta_s)),
-      h('td', { class: 'actions' }, actions(j))));
+      h('td', { class: 'row-actions' }, actions(j))));
     body.replaceChildren(jobs.length === 0 ? h('p', {}, pages.length > 1 ? 'No more jobs.' : 'No jobs match.')
       : table(['ID', 'Name', 'Owner', 'State', 'Progress', 'Priority', 'Submitted', 'ETA', 'Actions'], rows));
     pageLabel.textContent = `page ${pages.length}`;
