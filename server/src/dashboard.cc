@@ -4,14 +4,17 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
 #include "lf/core/log.h"
 #include "lf/job/shot.h"
 #include "lf/server/listen_policy.h"
+#include "lf/server/preview_channels.h"
 #include "lf/server/web_assets.h"
 
 namespace lf {
@@ -24,6 +27,11 @@ std::shared_ptr<spdlog::logger> Log() { return NamedLogger("dashboard"); }
 
 constexpr char kJsonType[] = "application/json";
 constexpr int kDefaultJobs = 50, kMaxJobs = 200;
+// Jobs one list request reads at most to fill a filtered page; it goes on from there when asked.
+constexpr size_t kJobsReadAtOnce = 200, kMaxJobsScanned = 5000;
+constexpr size_t kMaxFilterBytes = 256;
+constexpr int kDefaultTasks = 1000, kMaxTasks = 10000;
+constexpr double kMaxExposure = 8;  // stops either way
 constexpr int kDefaultLogLines = 200, kMaxLogLines = 1000;
 constexpr size_t kMaxJobIdBytes = 64;
 
@@ -233,6 +241,51 @@ absl::StatusOr<int64_t> IntParam(const HttpRequest& request, const std::string& 
             absl::StrCat(name, ": expected an integer in ", lo, "..", hi));
     }
     return value;
+}
+
+// A number query parameter within [lo, hi]; `fallback` when absent.
+absl::StatusOr<double> DoubleParam(const HttpRequest& request, const std::string& name,
+                                   double fallback, double lo, double hi) {
+    std::optional<std::string> text = request.Query(name);
+    if (!text) return fallback;
+    double value = 0;
+    if (!absl::SimpleAtod(*text, &value) || !(value >= lo && value <= hi)) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(name, ": expected a number in ", lo, "..", hi));
+    }
+    return value;
+}
+
+// A text filter parameter: "" when absent; InvalidArgument naming it when too long.
+absl::StatusOr<std::string> FilterParam(const HttpRequest& request, const std::string& name) {
+    std::string text = request.Query(name).value_or("");
+    if (text.size() > kMaxFilterBytes) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(name, ": at most ", kMaxFilterBytes, " bytes"));
+    }
+    return text;
+}
+
+// ?state=NAME of a task: one of TaskStatusName's; nullopt when absent or empty.
+absl::StatusOr<std::optional<TaskStatus::State>> TaskStateParam(const HttpRequest& request) {
+    const std::string text = request.Query("state").value_or("");
+    if (text.empty()) return std::nullopt;
+    std::vector<std::string> names;
+    for (int i = 0; i <= int(TaskStatus::State::kDropped); ++i) {
+        const auto state = TaskStatus::State(i);
+        if (text == TaskStatusName(state)) return state;
+        names.push_back(TaskStatusName(state));
+    }
+    return absl::InvalidArgumentError(absl::StrCat("state: no task state \"", LogSafe(text),
+                                                   "\"; expected one of ",
+                                                   absl::StrJoin(names, ", ")));
+}
+
+// A downloaded file's name: the job's id (a plausible one: no quotes), a shot's frame, `ext`.
+std::string AttachmentHeader(const std::string& job_id, std::optional<int> frame,
+                             const std::string& ext) {
+    return absl::StrCat("attachment; filename=\"", job_id,
+                        frame ? absl::StrCat("-frame", *frame) : "", ".", ext, "\"");
 }
 
 std::string ContentTypeOf(const std::string& name) {
@@ -449,21 +502,7 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
                              const std::string& route) {
     const bool post = request.method == "POST";
     const absl::Time now = absl::Now();
-    if (route == "jobs") {
-        if (post) return NotFoundAnswer();
-        absl::StatusOr<int64_t> limit = IntParam(request, "limit", kDefaultJobs, 1, kMaxJobs);
-        absl::StatusOr<int64_t> before =
-            IntParam(request, "before", 0, 0, std::numeric_limits<int64_t>::max());
-        if (!limit.ok()) return ErrorAnswer(limit.status());
-        if (!before.ok()) return ErrorAnswer(before.status());
-        JobQuery query{.before_seq = uint64_t(*before), .limit = size_t(*limit)};
-        if (caller.role != Role::kAdmin) query.owner = caller.name;
-        absl::StatusOr<std::vector<JobRecord>> jobs = farm_.scheduler().List(query);
-        if (!jobs.ok()) return ErrorAnswer(jobs.status());
-        Json list = Json::array();
-        for (const JobRecord& job : *jobs) list.push_back(JobJson(job, now));
-        return JsonAnswer(200, {{"jobs", list}, {"now_ms", absl::ToUnixMillis(now)}});
-    }
+    if (route == "jobs") return post ? NotFoundAnswer() : ListJobs(request, caller, now);
     // jobs/ID[/what] or jobs/ID/frames/N/what
     const std::vector<std::string> parts = absl::StrSplit(route, '/');
     if (parts.size() < 2 || parts.size() == 4 || parts.size() > 5) return NotFoundAnswer();
@@ -482,7 +521,9 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
     if (!job.ok()) return ErrorAnswer(job.status());
     if (frame) {
         if (absl::Status s = CheckRendersFrame(*job, *frame); !s.ok()) return ErrorAnswer(s);
-        if (what != "preview.png" && what != "metadata") return NotFoundAnswer();
+        if (what != "preview.png" && what != "metadata" && what != "result.exr") {
+            return NotFoundAnswer();
+        }
         // A finished frame's image never changes: a browser holding it needs no new encoding.
         const FrameProgress* f = FrameOf(*job, *frame);
         if (what == "preview.png" && f && f->done &&
@@ -522,6 +563,13 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
                         changed->spec.priority, caller.name);
             return JsonAnswer(200, JobJson(*changed, now));
         }
+        if (what == "delete") {
+            if (absl::Status s = Permit(caller, Action::kDeleteJob); !s.ok()) return ErrorAnswer(s);
+            if (absl::Status s = farm_.DeleteJob(id); !s.ok()) return ErrorAnswer(s);
+            ForgetPreviews(id);
+            Log()->info("job={} deleted by {} from the dashboard", id, caller.name);
+            return JsonAnswer(200, {{"deleted", id}});
+        }
         return NotFoundAnswer();
     }
     if (what.empty()) {
@@ -529,26 +577,7 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
         if (!body.ok()) return ErrorAnswer(body.status());
         return JsonAnswer(200, *body);
     }
-    if (what == "tasks") {
-        std::optional<int> only;  // ?frame=N: a shot's frame's tasks
-        if (request.Query("frame")) {
-            absl::StatusOr<int64_t> n =
-                IntParam(request, "frame", 0, -kMaxFrameNumber, kMaxFrameNumber);
-            if (!n.ok()) return ErrorAnswer(n.status());
-            if (absl::Status s = CheckRendersFrame(*job, int(*n)); !s.ok()) return ErrorAnswer(s);
-            only = int(*n);
-        }
-        absl::StatusOr<std::vector<TaskStatus>> tasks = farm_.Tasks(id);
-        if (!tasks.ok()) return ErrorAnswer(tasks.status());
-        Json list = Json::array();
-        for (const TaskStatus& t : *tasks) {
-            if (only && std::find(t.frames.begin(), t.frames.end(), *only) == t.frames.end()) {
-                continue;
-            }
-            list.push_back(TaskJson(t));
-        }
-        return JsonAnswer(200, {{"tasks", list}});
-    }
+    if (what == "tasks") return ListTasks(request, *job);
     if (what == "logs") {
         absl::StatusOr<int64_t> task = IntParam(request, "task", -1, 0, 1 << 30);
         absl::StatusOr<int64_t> after =
@@ -573,12 +602,155 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
         return JsonAnswer(
             200, {{"lines", lines}, {"next_seq", page->next_seq}, {"ended", page->job_ended}});
     }
+    if (what == "result.exr") {
+        absl::StatusOr<std::string> path = farm_.ResultFile(id, false, frame);
+        if (!path.ok()) return ErrorAnswer(path.status());
+        HttpAnswer a{200, "image/x-exr", "", {{"Cache-Control", "private, no-cache"}}, *path};
+        a.headers.emplace_back("Content-Disposition", AttachmentHeader(id, frame, "exr"));
+        Log()->info("job={} result downloaded by {} from the dashboard", id, caller.name);
+        return a;
+    }
     if (what == "preview.png" || what == "metadata") {
-        absl::StatusOr<std::shared_ptr<const Preview>> preview = PreviewOf(*job, frame);
-        if (!preview.ok()) return ErrorAnswer(preview.status());
-        return PreviewAnswer(request, **preview, what);
+        HttpAnswer a;
+        if (what == "preview.png" && (request.Query("exposure") || request.Query("channel"))) {
+            a = GradedPreviewAnswer(request, *job, frame);
+        } else {
+            absl::StatusOr<std::shared_ptr<const Preview>> preview = PreviewOf(*job, frame);
+            if (!preview.ok()) return ErrorAnswer(preview.status());
+            a = PreviewAnswer(request, **preview, what);
+        }
+        if (a.status == 200 && what == "preview.png" && request.Query("download")) {
+            a.headers.emplace_back("Content-Disposition", AttachmentHeader(id, frame, "png"));
+        }
+        return a;
     }
     return NotFoundAnswer();
+}
+
+HttpAnswer Dashboard::ListJobs(const HttpRequest& request, const Caller& caller, absl::Time now) {
+    absl::StatusOr<int64_t> limit = IntParam(request, "limit", kDefaultJobs, 1, kMaxJobs);
+    absl::StatusOr<int64_t> before =
+        IntParam(request, "before", 0, 0, std::numeric_limits<int64_t>::max());
+    absl::StatusOr<std::string> state_name = FilterParam(request, "state");
+    absl::StatusOr<std::string> owner = FilterParam(request, "owner");
+    absl::StatusOr<std::string> name = FilterParam(request, "name");
+    if (!limit.ok()) return ErrorAnswer(limit.status());
+    if (!before.ok()) return ErrorAnswer(before.status());
+    for (const auto* p : {&state_name, &owner, &name}) {
+        if (!p->ok()) return ErrorAnswer(p->status());
+    }
+    std::optional<JobState> state;
+    if (!state_name->empty()) {
+        absl::StatusOr<JobState> s = JobStateFromName(*state_name);
+        if (!s.ok()) {
+            return ErrorAnswer(absl::InvalidArgumentError(
+                absl::StrCat("state: ", LogSafe(std::string(s.status().message())))));
+        }
+        state = *s;
+    }
+    JobQuery query{.before_seq = uint64_t(*before), .limit = kJobsReadAtOnce};
+    if (!owner->empty()) query.owner = *owner;
+    Json list = Json::array();
+    Json next = nullptr;  // `before` of the next page; null when no job is left
+    // A submitter lists its own jobs: another owner's are none.
+    const bool others = caller.role != Role::kAdmin && query.owner && *query.owner != caller.name;
+    if (caller.role != Role::kAdmin) query.owner = caller.name;
+    const std::string needle = absl::AsciiStrToLower(*name);
+    for (size_t scanned = 0; !others;) {
+        absl::StatusOr<std::vector<JobRecord>> jobs = farm_.scheduler().List(query);
+        if (!jobs.ok()) return ErrorAnswer(jobs.status());
+        for (const JobRecord& job : *jobs) {
+            ++scanned;
+            query.before_seq = job.seq;
+            if (state && job.state != *state) continue;
+            if (!needle.empty() &&
+                !absl::StrContains(absl::AsciiStrToLower(job.spec.name), needle) &&
+                !absl::StrContains(job.id, needle)) {
+                continue;
+            }
+            list.push_back(JobJson(job, now));
+            if (list.size() == size_t(*limit)) break;
+        }
+        // A full page, or as many jobs read as one request may: the next page goes on from here.
+        if (list.size() == size_t(*limit) ||
+            (jobs->size() == kJobsReadAtOnce && scanned >= kMaxJobsScanned)) {
+            next = query.before_seq;
+            break;
+        }
+        if (jobs->size() < kJobsReadAtOnce) break;
+    }
+    return JsonAnswer(200,
+                      {{"jobs", list}, {"next_before", next}, {"now_ms", absl::ToUnixMillis(now)}});
+}
+
+HttpAnswer Dashboard::ListTasks(const HttpRequest& request, const JobRecord& job) {
+    std::optional<int> only;  // ?frame=N: a shot's frame's tasks
+    if (request.Query("frame")) {
+        absl::StatusOr<int64_t> n =
+            IntParam(request, "frame", 0, -kMaxFrameNumber, kMaxFrameNumber);
+        if (!n.ok()) return ErrorAnswer(n.status());
+        if (absl::Status s = CheckRendersFrame(job, int(*n)); !s.ok()) return ErrorAnswer(s);
+        only = int(*n);
+    }
+    absl::StatusOr<std::optional<TaskStatus::State>> state = TaskStateParam(request);
+    absl::StatusOr<int64_t> offset = IntParam(request, "offset", 0, 0, 1 << 30);
+    absl::StatusOr<int64_t> limit = IntParam(request, "limit", kDefaultTasks, 1, kMaxTasks);
+    if (!state.ok()) return ErrorAnswer(state.status());
+    if (!offset.ok()) return ErrorAnswer(offset.status());
+    if (!limit.ok()) return ErrorAnswer(limit.status());
+    absl::StatusOr<std::vector<TaskStatus>> tasks = farm_.Tasks(job.id);
+    if (!tasks.ok()) return ErrorAnswer(tasks.status());
+    Json list = Json::array();
+    Json counts = Json::object();  // the job's (or the frame's) tasks by state, unfiltered
+    int64_t matching = 0;
+    for (const TaskStatus& t : *tasks) {
+        if (only && std::find(t.frames.begin(), t.frames.end(), *only) == t.frames.end()) {
+            continue;
+        }
+        const std::string name = TaskStatusName(t.state);
+        counts[name] = counts.value(name, 0) + 1;
+        if (*state && t.state != **state) continue;
+        if (matching >= *offset && matching < *offset + *limit) list.push_back(TaskJson(t));
+        ++matching;
+    }
+    return JsonAnswer(
+        200, {{"tasks", list}, {"total", matching}, {"offset", *offset}, {"counts", counts}});
+}
+
+HttpAnswer Dashboard::GradedPreviewAnswer(const HttpRequest& request, const JobRecord& job,
+                                          std::optional<int> frame) {
+    absl::StatusOr<double> exposure =
+        DoubleParam(request, "exposure", 0, -kMaxExposure, kMaxExposure);
+    if (!exposure.ok()) return ErrorAnswer(exposure.status());
+    absl::StatusOr<std::string> channel = FilterParam(request, "channel");
+    if (!channel.ok()) return ErrorAnswer(channel.status());
+    absl::StatusOr<ExrFile> exr = ReadResult(job, frame);
+    if (!exr.ok()) return ErrorAnswer(exr.status());
+    absl::StatusOr<ChannelView> view =
+        ViewChannel(exr->image, channel->empty() ? "beauty" : *channel);
+    if (!view.ok()) return ErrorAnswer(view.status());
+    absl::StatusOr<std::string> png =
+        EncodePng(view->rgb, {.exposure = *exposure, .tone = view->tone});
+    if (!png.ok()) return ErrorAnswer(png.status());
+    return {200, "image/png", std::move(*png), {{"Cache-Control", "private, no-cache"}}};
+}
+
+absl::StatusOr<ExrFile> Dashboard::ReadResult(const JobRecord& job, std::optional<int> frame) {
+    absl::StatusOr<std::string> path = farm_.ResultFile(job.id, true, frame);
+    if (!path.ok()) return path.status();
+    absl::StatusOr<ExrFile> exr = ReadExr(*path);
+    if (!exr.ok()) {
+        Log()->error("job={}: preview: {}", job.id, std::string(exr.status().message()));
+        return absl::UnavailableError("the preview cannot be read on the server");
+    }
+    return exr;
+}
+
+void Dashboard::ForgetPreviews(const std::string& job_id) {
+    std::lock_guard<std::mutex> lock(previews_mutex_);
+    std::erase_if(previews_, [&](const auto& entry) {
+        return entry.first == job_id || absl::StartsWith(entry.first, job_id + "/");
+    });
 }
 
 absl::StatusOr<Json> Dashboard::JobWithFramesJson(const HttpRequest& request, const JobRecord& job,
@@ -616,7 +788,7 @@ HttpAnswer Dashboard::PreviewAnswer(const HttpRequest& request, const Preview& p
         for (const auto& [name, value] : preview.attributes) {
             attributes[name] = AttributeJson(value);
         }
-        return JsonAnswer(200, {{"attributes", attributes}});
+        return JsonAnswer(200, {{"attributes", attributes}, {"channels", preview.channels}});
     }
     if (NotModified(request, preview.etag)) return {304, "", "", std::move(headers)};
     return {200, "image/png", preview.png, std::move(headers)};
@@ -649,13 +821,8 @@ absl::StatusOr<std::shared_ptr<const Dashboard::Preview>> Dashboard::PreviewOf(
             return it->second;
         }
     }
-    absl::StatusOr<std::string> path = farm_.ResultFile(job.id, true, frame);
-    if (!path.ok()) return path.status();
-    absl::StatusOr<ExrFile> exr = ReadExr(*path);
-    if (!exr.ok()) {
-        Log()->error("job={}: preview: {}", job.id, std::string(exr.status().message()));
-        return absl::UnavailableError("the preview cannot be read on the server");
-    }
+    absl::StatusOr<ExrFile> exr = ReadResult(job, frame);
+    if (!exr.ok()) return exr.status();
     // Filmic: highlights roll off instead of clipping, as a look at a render in progress wants.
     absl::StatusOr<std::string> png = EncodePng(exr->image, {.tone = ToneCurve::kFilmic});
     if (!png.ok()) return png.status();
@@ -666,6 +833,7 @@ absl::StatusOr<std::shared_ptr<const Dashboard::Preview>> Dashboard::PreviewOf(
                 .etag = frame ? FramePreviewEtag(tasks_done, frame_done)
                               : absl::StrCat("\"", tasks_done, "-", int(job.state), "\""),
                 .png = std::move(*png),
+                .channels = PreviewChannels(exr->image),
                 .attributes = std::move(exr->attributes),
                 .made = absl::Now()});
     std::lock_guard<std::mutex> lock(previews_mutex_);

@@ -3,8 +3,12 @@
 #include <httplib.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cctype>
+#include <fstream>
+#include <memory>
 #include <thread>
+#include <vector>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -25,6 +29,8 @@ constexpr char kMetricsType[] = "text/plain; version=0.0.4; charset=utf-8";
 
 // The dashboard's requests are small: a token, a priority.
 constexpr size_t kMaxBodyBytes = 64 << 10;
+// A downloaded file goes out in pieces of this size.
+constexpr size_t kFileChunkBytes = 256 << 10;
 
 HttpRequest FromHttplib(const httplib::Request& r) {
     HttpRequest request{r.method, r.path, {}, {}, r.body, r.remote_addr};
@@ -37,10 +43,33 @@ HttpRequest FromHttplib(const httplib::Request& r) {
     return request;
 }
 
+// A file answer: opened now (a file replaced or removed later is still read whole), sent in
+// pieces of kFileChunkBytes.
+void ReplyWithFile(const HttpAnswer& a, httplib::Response& response) {
+    auto in = std::make_shared<std::ifstream>(a.file, std::ios::binary | std::ios::ate);
+    if (!*in) {
+        Log()->error("cannot open {} to send it", a.file);
+        response.status = 500;
+        response.set_content("the file cannot be read on the server\n", kText);
+        return;
+    }
+    const size_t size = size_t(in->tellg());
+    in->seekg(0);
+    response.set_content_provider(
+        size, a.content_type, [in](size_t offset, size_t length, httplib::DataSink& sink) {
+            std::vector<char> piece(std::min(length, kFileChunkBytes));
+            in->seekg(std::streamoff(offset));
+            in->read(piece.data(), std::streamsize(piece.size()));
+            return in->gcount() > 0 && sink.write(piece.data(), size_t(in->gcount()));
+        });
+}
+
 void Reply(HttpAnswer a, httplib::Response& response) {
     response.status = a.status;
     for (auto& [name, value] : a.headers) response.set_header(name, value);
-    if (a.status != 304) response.set_content(std::move(a.body), a.content_type.c_str());
+    if (a.status == 304) return;
+    if (!a.file.empty()) return ReplyWithFile(a, response);
+    response.set_content(std::move(a.body), a.content_type.c_str());
 }
 
 HttpAnswer Unavailable(const absl::Status& why) {

@@ -1,5 +1,7 @@
-// One job: its state and actions, the image merged so far with its tiles shaded by state, its
-// tasks (click one for its log) and the EXR header of the image. A shot's page shows instead a
+// One job: its state and actions, the image merged so far with its tiles shaded by state (a
+// click toggles fit and 1:1, a drag pans at 1:1; the exposure and the channel shown are the
+// server's tone mapping of the linear image), downloads, its tasks filtered by state and paged
+// (click one for its log) and the EXR header of the image. A shot's page shows instead a
 // strip of its frames (lazy-loaded previews, each with its number and state, paged as the API
 // lists them); a frame's page (#/frame/JOB/N) shows that frame as a still's page shows the
 // still: its tiles, tasks, preview and header, with the strip to go on to another frame.
@@ -7,22 +9,42 @@ import { get, post } from './api.js';
 import { duration, h, progress, svg, table, time } from './format.js';
 
 const ended = (state) => ['succeeded', 'failed', 'cancelled'].includes(state);
-// Rows of the tasks table: a job may have thousands of tasks; those worth a look come first.
-const kMaxTaskRows = 200;
-const rank = (t) => (t.state === 'running' ? 0 : t.failures > 0 ? 1 : t.state === 'done' ? 2 : 3);
+// Rows of a page of the tasks table; the tile overlay reads up to the API's bound of tasks.
+const kTaskRows = 50, kOverlayTasks = 10000;
+const kTaskStates = ['waiting', 'queued', 'running', 'done', 'dropped'];
 
 export function mount(root, id, who, frameText) {
   const path = `jobs/${encodeURIComponent(id)}`;
   const frame = frameText === undefined ? null : Number(frameText);
   // What the preview, tiles, tasks and header are of: the job, or its frame.
   const imagePath = frame === null ? path : `${path}/frames/${frame}`;
-  const tasksPath = frame === null ? `${path}/tasks` : `${path}/tasks?frame=${frame}`;
+  const tasksPath = (params) => {
+    const q = new URLSearchParams(params);
+    if (frame !== null) q.set('frame', frame);
+    return `${path}/tasks?${q}`;
+  };
   const summary = h('div', { id: 'summary' });
   const frameSummary = h('p', { id: 'frame-summary' });
   const image = h('img', { id: 'preview', alt: 'the image merged so far' });
   const overlay = svg('svg', { id: 'tiles', preserveAspectRatio: 'none' });
-  const preview = h('div', { class: 'preview' }, image, overlay);
+  const preview = h('div', { class: 'preview', id: 'preview-box', title: 'click: fit or 1:1; drag: pan at 1:1' },
+    h('div', { class: 'preview-inner' }, image, overlay));
+  const exposure = h('input', { type: 'range', id: 'exposure', min: -8, max: 8, step: 0.5, value: 0 });
+  const exposureLabel = h('output', { id: 'exposure-value', for: 'exposure' }, '+0 EV');
+  const channel = h('select', { id: 'channel' }, h('option', { value: 'beauty' }, 'beauty'));
+  const downloadExr = h('a', { id: 'download-exr', download: '', hidden: true }, 'Download EXR');
+  const downloadPng = h('a', { id: 'download-png', download: '', hidden: true }, 'Download PNG (as shown)');
+  const viewer = h('div', { class: 'viewer' },
+    h('div', { class: 'actions' }, h('label', { for: 'exposure' }, 'Exposure'), exposure, exposureLabel,
+      h('label', { for: 'channel' }, 'Channel'), channel, downloadPng, downloadExr), preview);
+  const taskState = h('select', { id: 'task-state' });
+  const taskPageLabel = h('span', { id: 'tasks-page' });
+  const taskEarlier = h('button', { id: 'tasks-earlier', onclick: () => turnTasks(-1) }, '◀');
+  const taskLater = h('button', { id: 'tasks-later', onclick: () => turnTasks(1) }, '▶');
   const tasks = h('div', { id: 'tasks' });
+  // Dependencies: drawn only once the job's JSON names them (`depends_on`, which the job
+  // management API adds); nothing is shown before.
+  const dependsOn = h('p', { id: 'depends-on', hidden: true });
   const log = h('pre', { id: 'log' });
   const logTitle = h('h2', { id: 'log-title' });
   const metadata = h('div', { id: 'metadata' });
@@ -31,6 +53,11 @@ export function mount(root, id, who, frameText) {
   const cancel = h('button', { id: 'cancel', onclick: async () => {
     if (confirm(`Cancel job ${id}?`)) await act(() => post(`${path}/cancel`));
   } }, 'Cancel job');
+  const remove = h('button', { id: 'delete', onclick: async () => {
+    if (confirm(`Delete job ${id} and its files?`)) {
+      await act(async () => { await post(`${path}/delete`); location.hash = '#/jobs'; });
+    }
+  } }, 'Delete job');
   const setPriority = h('button', { id: 'set-priority', onclick: () => act(() => post(`${path}/priority`, { priority: Number(priority.value) })) }, 'Set priority');
   const problem = h('p', { class: 'error' });
   const strip = h('div', { id: 'frames', class: 'strip' });
@@ -41,10 +68,11 @@ export function mount(root, id, who, frameText) {
     h('h2', {}, 'Frames'), h('div', { class: 'pager' }, earlier, pageLabel, later), strip);
   const title = frame === null ? h('h1', {}, `Job ${id}`)
     : h('h1', {}, h('a', { href: `#/job/${encodeURIComponent(id)}` }, `Job ${id}`), `, frame ${frame}`);
-  root.append(title, summary, frameSummary,
-    h('div', { class: 'actions' }, cancel, h('label', { for: 'priority' }, 'Priority'), priority, setPriority, problem),
-    shot, preview,
-    h('h2', {}, 'Tasks'), tasks, logTitle, log, metadataTitle, metadata);
+  root.append(title, summary, frameSummary, dependsOn,
+    h('div', { class: 'actions' }, cancel, remove, h('label', { for: 'priority' }, 'Priority'), priority, setPriority, problem),
+    shot, viewer,
+    h('h2', {}, 'Tasks'), h('div', { class: 'pager' }, h('label', { for: 'task-state' }, 'State'), taskState,
+      taskEarlier, taskPageLabel, taskLater), tasks, logTitle, log, metadataTitle, metadata);
 
   let shown = '';        // the preview's version on screen
   let metadataOf = '';   // the version whose metadata is on screen
@@ -54,8 +82,57 @@ export function mount(root, id, who, frameText) {
   let framesFrom = null; // the strip's page: its first frame's position; null: the server's choice
   let listed = null;     // the shot's page as last drawn
   const thumbs = new Map();  // frame number -> { element, img, state }
+  let base = null;       // the preview's URL at exposure 0 of the beauty, as the server caches it
+  let taskOffset = 0;    // the tasks table's page: its first row among the tasks in the state
+  let taskTotal = 0;
   priority.addEventListener('focus', () => { editing = true; });
   priority.addEventListener('blur', () => { editing = false; });
+
+  // The image as graded: the cached preview at exposure 0 of the beauty, else the server tone
+  // maps the linear EXR again (it knows the channels; a browser's canvas would have only the PNG).
+  function previewUrl() {
+    const ev = Number(exposure.value);
+    if (ev === 0 && channel.value === 'beauty') return base;
+    return `${base}&${new URLSearchParams({ exposure: ev, channel: channel.value })}`;
+  }
+  function showPreview() {
+    if (!base) return;
+    image.src = previewUrl();
+    downloadPng.href = `${previewUrl()}&download=1`;
+    downloadPng.hidden = false;
+  }
+  exposure.addEventListener('input', () => {
+    exposureLabel.textContent = `${exposure.value > 0 ? '+' : ''}${exposure.value} EV`;
+  });
+  exposure.addEventListener('change', showPreview);
+  channel.addEventListener('change', showPreview);
+
+  // Fit or 1:1 on a click; at 1:1 a drag pans (and is no click).
+  let drag = null;
+  preview.addEventListener('mousedown', (e) => {
+    drag = { x: e.clientX, y: e.clientY, left: preview.scrollLeft, top: preview.scrollTop, moved: false };
+    e.preventDefault();
+  });
+  window.addEventListener('mousemove', (e) => {
+    if (!drag) return;
+    const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+    drag.moved = drag.moved || Math.abs(dx) + Math.abs(dy) > 3;
+    if (preview.classList.contains('actual')) {
+      preview.scrollLeft = drag.left - dx;
+      preview.scrollTop = drag.top - dy;
+    }
+  });
+  window.addEventListener('mouseup', () => {
+    if (drag && !drag.moved) preview.classList.toggle('actual');
+    drag = null;
+  });
+
+  taskState.append(h('option', { value: '' }, 'all'), ...kTaskStates.map((s) => h('option', { value: s }, s)));
+  taskState.addEventListener('change', () => { taskOffset = 0; return act(() => {}); });
+  function turnTasks(step) {
+    taskOffset = Math.max(0, Math.min(taskOffset + step * kTaskRows, Math.max(0, taskTotal - 1)));
+    return act(() => {});
+  }
 
   async function act(action) {
     problem.textContent = '';
@@ -146,8 +223,11 @@ export function mount(root, id, who, frameText) {
   }
 
   async function refresh() {
-    // Both asked at once, drawn together: the summary and the tasks agree.
-    let [job, { tasks: list }] = await Promise.all([get(jobPath()), get(tasksPath)]);
+    // All asked at once, drawn together: the summary, the tiles and the tasks agree.
+    const page = { offset: taskOffset, limit: kTaskRows };
+    if (taskState.value) page.state = taskState.value;
+    let [job, { tasks: list }, rows] = await Promise.all([get(jobPath()),
+      get(tasksPath({ limit: kOverlayTasks })), get(tasksPath(page))]);
     if (frame !== null && framesFrom === null && job.shot) {
       // A frame's page lists the strip's page holding the frame.
       const per = job.shot.frames_per_page;
@@ -163,12 +243,17 @@ export function mount(root, id, who, frameText) {
         h('td', {}, duration(job.eta_s)))]),
     h('p', { class: 'error' }, job.error));
     cancel.disabled = ended(job.state);
+    remove.disabled = !ended(job.state);
+    if (Array.isArray(job.depends_on)) {
+      dependsOn.hidden = false;
+      dependsOn.replaceChildren('Depends on: ', ...job.depends_on.map((d) => h('a', { href: `#/job/${encodeURIComponent(d)}` }, d, ' ')));
+    }
     setPriority.disabled = ended(job.state);
     if (!editing) priority.value = job.priority;
     if (job.shot) drawStrip(job);
     // A shot's own page has no one image: its frames have theirs.
     const image_shown = !job.shot || frame !== null;
-    for (const element of [preview, metadataTitle, metadata]) element.hidden = !image_shown;
+    for (const element of [viewer, metadataTitle, metadata]) element.hidden = !image_shown;
 
     // The frame's or the job's image, its version, and whether it is final.
     let version = null;
@@ -184,23 +269,34 @@ export function mount(root, id, who, frameText) {
     }
 
     drawTiles(job, list);
-    const rows = [...list].sort((a, b) => rank(a) - rank(b) || a.index - b.index).slice(0, kMaxTaskRows);
+    const complete = frame === null ? job.state === 'succeeded' : mine && mine.state === 'done';
+    downloadExr.hidden = !complete;
+    if (complete) downloadExr.href = `/api/${imagePath}/result.exr`;
+    taskTotal = rows.total;
+    const counts = Object.entries(rows.counts).map(([s, n]) => `${n} ${s}`).join(', ');
+    taskPageLabel.textContent = rows.total === 0 ? `none (${counts || 'no tasks'})`
+      : `${rows.offset + 1}–${rows.offset + rows.tasks.length} of ${rows.total} (${counts})`;
+    taskEarlier.disabled = rows.offset === 0;
+    taskLater.disabled = rows.offset + rows.tasks.length >= rows.total;
     const frames = (t) => (t.frames && t.frames.length ? `frame ${t.frames.join(', ')}, ` : '');
-    tasks.replaceChildren(table(['Task', 'State', 'Worker', 'Attempts', 'Duration', 'Log lines'], rows.map((t) =>
+    tasks.replaceChildren(table(['Task', 'State', 'Worker', 'Attempts', 'Duration', 'Log lines'], rows.tasks.map((t) =>
       h('tr', { class: `task ${t.state}${t.index === logTask ? ' open' : ''}`, 'data-task': t.index, onclick: () => openLog(t.index) },
         h('td', {}, `${t.index} (${frames(t)}${t.kind} ${t.x},${t.y} ${t.width}×${t.height})`), h('td', {}, t.state),
         h('td', {}, t.worker || '—'), h('td', { class: 'number' }, String(t.attempts)),
-        h('td', {}, t.attempts ? `${(t.duration_ms / 1000).toFixed(1)} s` : '—'), h('td', { class: 'number' }, String(t.log_lines))))),
-    list.length > rows.length ? h('p', {}, `${list.length - rows.length} more tasks not listed (running, failed and done ones first).`) : '');
+        h('td', {}, t.attempts ? `${(t.duration_ms / 1000).toFixed(1)} s` : '—'), h('td', { class: 'number' }, String(t.log_lines))))));
 
     // The preview is fetched again only when a task was merged since (or the job ended).
     if (image_shown && version && version !== shown) {
       shown = version;
-      image.src = frame === null ? `/api/${path}/preview.png?v=${encodeURIComponent(version)}` : version;
+      base = frame === null ? `/api/${path}/preview.png?v=${encodeURIComponent(version)}` : version;
+      showPreview();
     }
     if (shown && metadataOf !== shown && (final || !metadataOf)) {
       metadataOf = shown;
-      const { attributes } = await get(`${imagePath}/metadata`);
+      const { attributes, channels } = await get(`${imagePath}/metadata`);
+      const picked = channel.value;
+      channel.replaceChildren(...channels.map((c) => h('option', { value: c }, c)));
+      channel.value = channels.includes(picked) ? picked : 'beauty';
       metadata.replaceChildren(table(['Attribute', 'Value'], Object.entries(attributes).map(([name, value]) =>
         h('tr', {}, h('td', {}, name), h('td', {}, typeof value === 'object' ? JSON.stringify(value) : String(value))))));
     }

@@ -3,8 +3,11 @@
 // Checks: a wrong token is refused; signed in, a job submitted from the CLI appears and its
 // progress rises; the preview loads and changes while tiles land; a task's log opens; a shot's
 // page shows its frames' thumbnails and states, and a click opens a frame's page; a job
-// cancelled from the page (after its priority was raised there) is so for the CLI too. Screenshots of every page go to
-// SCREENSHOTS (the build's web-screenshots/).
+// cancelled from the page (after its priority was raised there) is so for the CLI too; the jobs
+// page filtered by state and by name, paged, and its row actions (cancel, delete, EXR and PNG
+// downloads); a job's preview zoomed to 1:1 and graded by the exposure slider and the channel
+// picker (a job rendered with AOVs); tasks filtered by state; the farm's charts' axes and units.
+// Screenshots of every page go to SCREENSHOTS (the build's web-screenshots/).
 //
 //   node dashboard_e2e.mjs BIN_DIR SCENES_DIR SCREENSHOTS_DIR
 import { spawn, execFileSync } from 'node:child_process';
@@ -156,6 +159,14 @@ try {
   await page.waitForSelector('#queue-depth .value');
   await until('tasks in the chart', () => page.$$eval('svg.chart rect', (r) => r.some((e) => Number(e.getAttribute('height')) > 0)));
   check(true, `the farm page shows the queue depth (${await page.textContent('#queue-depth .value')}) and throughput`);
+  const axes = await page.$$eval('svg.chart', (charts) => charts.map((c) => ({
+    title: c.querySelector('text.title').textContent,
+    units: [...c.querySelectorAll('text.unit')].map((t) => t.textContent),
+    ticks: [...c.querySelectorAll('text.tick')].map((t) => t.textContent),
+  })));
+  check(axes.length === 2 && axes[0].units.join('|') === 'tasks/min|minutes ago' && axes[1].units.join('|') === 'samples/min|minutes ago'
+    && axes.every((a) => a.ticks.includes('0') && a.ticks.includes('now') && a.ticks.includes('30')),
+  `the charts have titles, axes with units and ticks: ${axes.map((a) => `${a.title} [${a.units.join(', ')}; ${a.ticks.join(' ')}]`).join('; ')}`);
   await page.screenshot({ path: join(shotsDir, 'farm.png'), fullPage: true });
 
   // A shot (4 frames of the moving ball, tiny): its page shows a strip of 4 frame thumbnails
@@ -212,6 +223,88 @@ try {
   const adminJob = cli(['submit', scene, '--resolution', '16x16', '--spp', '1', '--name', 'admins'], adminToken).split('\n').pop().trim();
   const hidden = await context.request.get(`${base}/api/jobs/${adminJob}`);
   check(hidden.status() === 404, "another owner's job is not found for alice");
+
+  // The jobs page as a tool: 3 tiny stills (one with AOVs) and one long job to act on.
+  const tiny = (name, extra = []) => cli(['submit', scene, '--resolution', '32x32', '--spp', '4', '--tile', '16', '--passes', '1', '--priority', '20', '--name', name, ...extra], aliceToken).split('\n').pop().trim();
+  const tinies = [tiny('tiny-one'), tiny('tiny-two'), tiny('tiny-aov', ['--aov', 'albedo,normal'])];
+  const victim = submit(['--spp', '65536', '--passes', '64', '--name', 'victim']);
+  await until('the tiny jobs done', () => tinies.every((t) => /succeeded/.test(cli(['status', t], aliceToken))), 60);
+  await page.goto(`${base}/#/jobs`);
+  await page.waitForSelector(`tr.job[data-id="${victim}"]`);
+  const listed = () => page.$$eval('tr.job', (rows) => rows.map((r) => ({ id: r.dataset.id, name: r.querySelector('td.name').textContent, state: r.querySelector('td.state').textContent })));
+  const all = await listed();
+  await page.selectOption('#filter-state', 'cancelled');
+  await until('only cancelled jobs', async () => { const l = await listed(); return l.length > 0 && l.length < all.length && l.every((j) => j.state === 'cancelled'); });
+  check((await listed()).some((j) => j.id === doomed), `filtered by state: ${(await listed()).length} cancelled of ${all.length} jobs`);
+  await page.selectOption('#filter-state', '');
+  await page.fill('#filter-name', 'TINY');
+  await page.press('#filter-name', 'Enter');
+  await until('only the tiny jobs', async () => { const l = await listed(); return l.length === 3 && l.every((j) => j.name.startsWith('tiny-')); });
+  check(true, `filtered by name: ${(await listed()).map((j) => j.name).join(', ')}`);
+  await page.fill('#filter-name', '');
+  await page.press('#filter-name', 'Enter');
+  await page.selectOption('#page-size', '5');
+  await until('a page of 5', async () => (await listed()).length === 5);
+  const firstPage = (await listed()).map((j) => j.id);
+  await page.click('#jobs-next');
+  await until('the second page', async () => (await page.textContent('#jobs-page')) === 'page 2');
+  const secondPage = (await listed()).map((j) => j.id);
+  check(secondPage.length === all.length - 5 && secondPage.every((id) => !firstPage.includes(id)),
+    `paging: page 1 lists ${firstPage.length} jobs, page 2 the other ${secondPage.length}`);
+  await page.click('#jobs-previous');
+  await until('the first page again', async () => (await listed())[0].id === firstPage[0]);
+  await page.screenshot({ path: join(shotsDir, 'jobs-paged.png'), fullPage: true });
+
+  // Row actions: cancel and delete the victim; the CLI and the API agree.
+  const victimRow = `tr.job[data-id="${victim}"]`;
+  page.once('dialog', (d) => d.accept());
+  await page.click(`${victimRow} button.action.cancel`);
+  await until('the victim cancelled on the page', async () => (await page.textContent(`${victimRow} td.state`)) === 'cancelled');
+  check(/cancelled/i.test(cli(['status', victim], aliceToken)), 'cancel from the jobs page: the CLI says cancelled');
+  page.once('dialog', (d) => d.accept());
+  await page.click(`${victimRow} button.action.delete`);
+  await until('the victim gone from the page', async () => (await page.$(victimRow)) === null);
+  check((await context.request.get(`${base}/api/jobs/${victim}`)).status() === 404, 'delete from the jobs page: the API no longer knows the job');
+
+  // Downloads: the EXR and the PNG of a succeeded job, as attachments.
+  const exrLink = await page.getAttribute(`tr.job[data-id="${tinies[0]}"] a.action.exr`, 'href');
+  const exr = await context.request.get(`${base}${exrLink}`);
+  const exrBytes = await exr.body();
+  check(exr.status() === 200 && exrBytes.subarray(0, 4).equals(Buffer.from([0x76, 0x2f, 0x31, 0x01])) && /attachment/.test(exr.headers()['content-disposition']),
+    `the EXR link serves an OpenEXR file (${exrBytes.length} bytes, ${exr.headers()['content-disposition']})`);
+  const png = await context.request.get(`${base}${await page.getAttribute(`tr.job[data-id="${tinies[0]}"] a.action.png`, 'href')}`);
+  check(png.status() === 200 && (await png.body()).subarray(1, 4).toString() === 'PNG' && /attachment/.test(png.headers()['content-disposition']), 'the PNG link serves a PNG attachment');
+
+  // The preview: a click shows it at 1:1, the exposure slider and the channel picker change it.
+  await page.goto(`${base}/#/job/${tinies[2]}`);
+  const sizes = () => page.evaluate(() => { const i = document.getElementById('preview'); return i.complete ? [i.naturalWidth, i.clientWidth] : [0, 0]; });
+  await until('the preview', async () => (await sizes())[0] === 32);
+  const fitted = await sizes();
+  await page.click('#preview-box');
+  await until('1:1', async () => { const [n, c] = await sizes(); return n === 32 && c === 32; });
+  check(fitted[1] !== 32, `a click shows the preview at 1:1 (displayed ${fitted[1]} px wide, then 32, its natural width)`);
+  const shown = async () => { const src = await page.getAttribute('#preview', 'src'); return (await context.request.get(`${base}${src}`)).body(); };
+  const plain = await shown();
+  await page.$eval('#exposure', (e) => { e.value = '3'; e.dispatchEvent(new Event('input')); e.dispatchEvent(new Event('change')); });
+  await until('the brighter preview', async () => (await page.getAttribute('#preview', 'src')).includes('exposure=3'));
+  const brighter = await shown();
+  check(!brighter.equals(plain) && (await page.textContent('#exposure-value')) === '+3 EV', `the exposure slider changes the image (${plain.length} then ${brighter.length} bytes at +3 EV)`);
+  await until('the channels', async () => (await page.$$eval('#channel option', (o) => o.map((e) => e.value))).includes('normal'));
+  const channels = await page.$$eval('#channel option', (o) => o.map((e) => e.value));
+  check(['beauty', 'A', 'B', 'albedo', 'normal'].every((c) => channels.includes(c)), `the channel picker lists the job's AOVs: ${channels.join(', ')}`);
+  await page.selectOption('#channel', 'normal');
+  await until('the normals', async () => (await page.getAttribute('#preview', 'src')).includes('channel=normal'));
+  const normals = await shown();
+  check(!normals.equals(brighter), 'switching the channel to normal changes the image');
+  await page.screenshot({ path: join(shotsDir, 'job-aov.png'), fullPage: true });
+
+  // Tasks filtered by state: the tiny job's 4 tasks are done, none runs.
+  await page.selectOption('#task-state', 'done');
+  await until('the done tasks', async () => (await page.textContent('#tasks-page')).startsWith('1–4 of 4'));
+  check((await page.$$('tr.task.done')).length === 4, `tasks filtered by done: ${await page.textContent('#tasks-page')}`);
+  await page.selectOption('#task-state', 'running');
+  await until('no running tasks', async () => (await page.$$('tr.task')).length === 0);
+  check((await page.textContent('#tasks-page')).startsWith('none'), `tasks filtered by running: ${await page.textContent('#tasks-page')}`);
 
   check(errors.length === 0, `no errors on the pages${errors.length ? ': ' + errors.join('; ') : ''}`);
   console.log('dashboard e2e: all checks passed');

@@ -3,13 +3,15 @@
 // job), the JSON of jobs, tasks, workers and the farm, cancel and priority, the preview PNG
 // (decoded, and changed by a merged task), the CSRF checks of POSTs, bounds on what a request
 // names, anonymous admins only on loopback, and the embedded pages with their headers; a shot's
-// frames with their states, paged, and each frame's preview and tasks.
+// frames with their states, paged, and each frame's preview and tasks; the jobs list filtered
+// and paged, tasks by state and paged, delete, the EXR download, the graded preview.
 #include "lf/server/dashboard.h"
 
 #include <gtest/gtest.h>
 #include <stb_image.h>
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "absl/strings/match.h"
@@ -60,9 +62,9 @@ class DashboardTest : public ::testing::Test {
     }
 
     // A 16x16 image in 8x8 tiles, 4 spp in 2 passes: 8 tasks.
-    std::string Submit(const std::string& owner) {
+    std::string Submit(const std::string& owner, const std::string& name = "") {
         JobSpec spec;
-        spec.name = "of " + owner;
+        spec.name = name.empty() ? "of " + owner : name;
         spec.owner = owner;
         spec.plan = {16, 16, 4, 8, 2};
         absl::StatusOr<std::string> id = farm_->scheduler().Submit(spec);
@@ -628,6 +630,156 @@ TEST_F(DashboardTest, PagesAreEmbeddedWithTheirTypesAndAStrictPolicy) {
         EXPECT_FALSE(absl::StrContains(content, "https://")) << asset.name;
         EXPECT_FALSE(absl::StrContains(content, "//cdn")) << asset.name;
     }
+}
+
+std::vector<std::string> IdsOf(const Json& answer) {
+    std::vector<std::string> ids;
+    for (const Json& j : answer["jobs"]) ids.push_back(j["id"]);
+    return ids;
+}
+
+TEST_F(DashboardTest, JobsFilterByStateOwnerAndNameAndComeInPages) {
+    const std::string a1 = Submit("alice", "Alpha one"), a2 = Submit("alice", "beta two");
+    const std::string a3 = Submit("alice", "alpha three"), b1 = Submit("bob", "alpha of bob");
+    ASSERT_TRUE(farm_->scheduler().Cancel(a2).ok());
+
+    EXPECT_EQ(IdsOf(Call(Get("/api/jobs?state=cancelled", alice_), 200)),
+              std::vector<std::string>{a2});
+    EXPECT_EQ(IdsOf(Call(Get("/api/jobs?state=queued", alice_), 200)),
+              (std::vector<std::string>{a3, a1}));
+    // The name's substring, whatever its case; an id's too.
+    EXPECT_EQ(IdsOf(Call(Get("/api/jobs?name=ALPHA", alice_), 200)),
+              (std::vector<std::string>{a3, a1}));
+    EXPECT_EQ(IdsOf(Call(Get("/api/jobs?name=" + a2, alice_), 200)), std::vector<std::string>{a2});
+    EXPECT_EQ(IdsOf(Call(Get("/api/jobs?name=alpha", root_), 200)),
+              (std::vector<std::string>{b1, a3, a1}));
+    EXPECT_EQ(IdsOf(Call(Get("/api/jobs?owner=bob", root_), 200)), std::vector<std::string>{b1});
+    // A submitter asking for another owner's jobs sees none.
+    EXPECT_TRUE(Call(Get("/api/jobs?owner=bob", alice_), 200)["jobs"].empty());
+    EXPECT_EQ(IdsOf(Call(Get("/api/jobs?owner=alice", alice_), 200)).size(), 3u);
+
+    // Pages of 2 of the 3 queued: the second goes on from `next_before`, and is the last.
+    const Json first = Call(Get("/api/jobs?state=queued&limit=1", root_), 200);
+    EXPECT_EQ(IdsOf(first), std::vector<std::string>{b1});
+    ASSERT_TRUE(first["next_before"].is_number());
+    const Json second = Call(
+        Get("/api/jobs?state=queued&limit=2&before=" + first["next_before"].dump(), root_), 200);
+    EXPECT_EQ(IdsOf(second), (std::vector<std::string>{a3, a1}));
+    const Json last = Call(
+        Get("/api/jobs?state=queued&limit=2&before=" + second["next_before"].dump(), root_), 200);
+    EXPECT_TRUE(last["jobs"].empty());
+    EXPECT_TRUE(last["next_before"].is_null());
+    EXPECT_TRUE(Call(Get("/api/jobs?limit=50", root_), 200)["next_before"].is_null());
+
+    const Json bad_state = Call(Get("/api/jobs?state=sleeping", alice_), 400);
+    EXPECT_TRUE(absl::StartsWith(bad_state["error"].get<std::string>(), "state: ")) << bad_state;
+    const Json long_name = Call(Get("/api/jobs?name=" + std::string(300, 'x'), alice_), 400);
+    EXPECT_TRUE(absl::StartsWith(long_name["error"].get<std::string>(), "name: ")) << long_name;
+}
+
+TEST_F(DashboardTest, TasksFilterByStateAndComeInPages) {
+    const std::string job = Submit("alice");  // 8 tasks
+    ASSERT_TRUE(RenderOne("w1", 0.5f));
+    ASSERT_TRUE(farm_->scheduler().LeaseTask("w2"));
+    const std::string path = "/api/jobs/" + job + "/tasks";
+    const Json running = Call(Get(path + "?state=running", alice_), 200);
+    ASSERT_EQ(running["tasks"].size(), 1u);
+    EXPECT_EQ(running["tasks"][0]["worker"], "w2");
+    EXPECT_EQ(running["total"], 1);
+    EXPECT_EQ(Call(Get(path + "?state=done", alice_), 200)["tasks"][0]["worker"], "w1");
+    const Json all = Call(Get(path, alice_), 200);
+    EXPECT_EQ(all["tasks"].size(), 8u);
+    EXPECT_EQ(all["counts"]["queued"], 6);
+    EXPECT_EQ(all["counts"]["running"], 1);
+    EXPECT_EQ(all["counts"]["done"], 1);
+
+    const Json page = Call(Get(path + "?offset=3&limit=3", alice_), 200);
+    ASSERT_EQ(page["tasks"].size(), 3u);
+    EXPECT_EQ(page["tasks"][0]["index"], all["tasks"][3]["index"]);
+    EXPECT_EQ(page["total"], 8);
+    EXPECT_EQ(Call(Get(path + "?offset=6&limit=3", alice_), 200)["tasks"].size(), 2u);
+
+    const Json bad = Call(Get(path + "?state=sleeping", alice_), 400);
+    EXPECT_TRUE(absl::StrContains(bad["error"].get<std::string>(), "state: "));
+    EXPECT_TRUE(absl::StrContains(bad["error"].get<std::string>(), "queued")) << bad;
+    EXPECT_TRUE(absl::StartsWith(
+        Call(Get(path + "?limit=0", alice_), 400)["error"].get<std::string>(), "limit: "));
+    Call(Get(path + "?limit=100000", alice_), 400);
+    EXPECT_TRUE(absl::StartsWith(
+        Call(Get(path + "?offset=-1", alice_), 400)["error"].get<std::string>(), "offset: "));
+}
+
+TEST_F(DashboardTest, DeleteRemovesAnEndedJobOfItsOwnerOrForAnAdmin) {
+    const std::string mine = Submit("alice"), theirs = Submit("bob");
+    Call(Post("/api/jobs/" + mine + "/delete", Json::object(), alice_), 409);  // not ended
+    ASSERT_TRUE(farm_->scheduler().Cancel(mine).ok());
+    ASSERT_TRUE(farm_->scheduler().Cancel(theirs).ok());
+    Call(Post("/api/jobs/" + theirs + "/delete", Json::object(), alice_), 404);
+    EXPECT_TRUE(farm_->scheduler().Get(theirs).ok());
+    EXPECT_EQ(Call(Post("/api/jobs/" + mine + "/delete", Json::object(), alice_), 200)["deleted"],
+              mine);
+    EXPECT_TRUE(absl::IsNotFound(farm_->scheduler().Get(mine).status()));
+    Call(Get("/api/jobs/" + mine, alice_), 404);
+    Call(Post("/api/jobs/" + theirs + "/delete", Json::object(), root_), 200);
+    EXPECT_TRUE(absl::IsNotFound(farm_->scheduler().Get(theirs).status()));
+    // The page's GET cannot delete.
+    Call(Get("/api/jobs/" + mine + "/delete", alice_), 404);
+}
+
+TEST_F(DashboardTest, TheResultExrIsAnAttachmentStreamedFromItsFile) {
+    const std::string job = Submit("alice");
+    Call(Get("/api/jobs/" + job + "/result.exr", alice_), 409);  // not rendered yet
+    while (RenderOne("w1", 0.5f)) {
+    }
+    ASSERT_EQ(farm_->scheduler().Get(job)->state, JobState::kSucceeded);
+    Call(Get("/api/jobs/" + job + "/result.exr", bob_), 404);
+    const HttpAnswer a = dashboard_->Serve(Get("/api/jobs/" + job + "/result.exr", alice_));
+    ASSERT_EQ(a.status, 200) << a.body;
+    EXPECT_EQ(a.content_type, "image/x-exr");
+    EXPECT_EQ(HeaderOf(a, "Content-Disposition"), "attachment; filename=\"" + job + ".exr\"");
+    EXPECT_TRUE(a.body.empty()) << "the file is streamed, not copied into the answer";
+    std::ifstream in(a.file, std::ios::binary);
+    char magic[4] = {};
+    ASSERT_TRUE(in.read(magic, 4)) << a.file;
+    EXPECT_EQ(std::string(magic, 4), std::string("\x76\x2f\x31\x01", 4));
+}
+
+TEST_F(DashboardTest, ThePreviewIsGradedByExposureAndChannelFromTheLinearImage) {
+    const std::string job = Submit("alice");
+    ASSERT_TRUE(RenderOne("w1", 0.1f));
+    const std::string path = "/api/jobs/" + job + "/preview.png";
+    auto first_pixel = [&](const std::string& query) {
+        const HttpAnswer a = dashboard_->Serve(Get(path + query, alice_));
+        EXPECT_EQ(a.status, 200) << query << ": " << a.body;
+        int w = 0, h = 0, n = 0;
+        unsigned char* data =
+            stbi_load_from_memory(reinterpret_cast<const unsigned char*>(a.body.data()),
+                                  int(a.body.size()), &w, &h, &n, 3);
+        EXPECT_NE(data, nullptr) << query;
+        const int red = data ? data[0] : -1;
+        stbi_image_free(data);
+        return red;
+    };
+    const int plain = first_pixel("?exposure=0");
+    EXPECT_GT(plain, 0);
+    EXPECT_GT(first_pixel("?exposure=2"), plain);
+    EXPECT_LT(first_pixel("?exposure=-2.5"), plain);
+    EXPECT_EQ(first_pixel("?channel=A&exposure=0"), plain);  // both halves saw 0.1
+
+    const Json metadata = Call(Get("/api/jobs/" + job + "/metadata", alice_), 200);
+    EXPECT_EQ(metadata["channels"], (Json{"beauty", "A", "B"}));
+    const Json no_albedo = Call(Get(path + "?channel=albedo", alice_), 400);
+    EXPECT_TRUE(absl::StartsWith(no_albedo["error"].get<std::string>(), "channel: "));
+    EXPECT_TRUE(absl::StrContains(no_albedo["error"].get<std::string>(), "beauty, A, B"));
+    EXPECT_TRUE(absl::StartsWith(
+        Call(Get(path + "?exposure=9", alice_), 400)["error"].get<std::string>(), "exposure: "));
+    Call(Get(path + "?exposure=nan", alice_), 400);
+    Call(Get(path + "?exposure=1", bob_), 404);
+
+    const HttpAnswer download = dashboard_->Serve(Get(path + "?download=1", alice_));
+    ASSERT_EQ(download.status, 200);
+    EXPECT_EQ(HeaderOf(download, "Content-Disposition"),
+              "attachment; filename=\"" + job + ".png\"");
 }
 
 }  // namespace

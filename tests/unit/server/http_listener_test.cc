@@ -1,7 +1,8 @@
 // lightfarm-server --http: the /metrics and /healthz handlers against a real Farm in a temporary
 // data folder (the counts follow a submission, a lease and a result), and the listener itself on
 // a port the OS picks, refusing a port in use, and over HTTPS with the dashboard; hostile
-// clients (a chunked body without end, slow request heads) on raw sockets.
+// clients (a chunked body without end, slow request heads) on raw sockets; a result EXR larger
+// than one piece downloaded whole from the dashboard.
 #include "lf/server/http_listener.h"
 
 #include <arpa/inet.h>
@@ -14,9 +15,12 @@
 
 #include <atomic>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "lf/core/film.h"
+#include "lf/core/tile_codec.h"
 
 namespace lf {
 namespace {
@@ -194,6 +198,44 @@ TEST_F(HttpListenerTest, ServesHttpsAndTheDashboardWithTheServersCertificate) {
     absl::StatusOr<std::unique_ptr<HttpListener>> bad = HttpListener::Start(
         "127.0.0.1:0", *farm_, {.tls_cert = cert, .tls_key = (dir_ / "none.key").string()});
     EXPECT_EQ(bad.status().code(), absl::StatusCode::kFailedPrecondition) << bad.status();
+}
+
+// The dashboard's EXR download is sent from the file in pieces: a result of several pieces
+// arrives whole, byte for byte.
+TEST_F(HttpListenerTest, AResultExrOfManyPiecesIsDownloadedWhole) {
+    JobSpec spec;
+    spec.name = "download";
+    spec.plan = {512, 512, 1, 512, 1};  // one task
+    absl::StatusOr<std::string> job = farm_->scheduler().Submit(spec);
+    ASSERT_TRUE(job.ok()) << job.status();
+    std::optional<TaskAssignment> lease = farm_->scheduler().LeaseTask("w1");
+    ASSERT_TRUE(lease);
+    TileSums sums(lease->task.rect);
+    // Values that do not compress: the file stays larger than a piece.
+    uint32_t state = 1;
+    for (PixelSums& p : sums.pixels) {
+        state = state * 1664525u + 1013904223u;
+        p.Add(0, Rgb(float(state >> 8) / float(1 << 24)));
+    }
+    ASSERT_TRUE(farm_->Complete(lease->lease_id, "w1", EncodeTileSums(sums)).ok());
+    absl::StatusOr<std::string> path = farm_->ResultFile(*job, false);
+    ASSERT_TRUE(path.ok()) << path.status();
+    std::ifstream in(*path, std::ios::binary);
+    std::stringstream file;
+    file << in.rdbuf();
+    ASSERT_GT(file.str().size(), size_t(256 << 10) * 2) << "fewer than three pieces";
+
+    std::unique_ptr<Authenticator> auth = Authenticator::Off();
+    absl::StatusOr<std::unique_ptr<HttpListener>> listener =
+        HttpListener::Start("127.0.0.1:0", *farm_, {.dashboard_auth = auth.get()});
+    ASSERT_TRUE(listener.ok()) << listener.status();
+    httplib::Client client("127.0.0.1", (*listener)->port());
+    httplib::Result got = client.Get("/api/jobs/" + *job + "/result.exr");
+    ASSERT_TRUE(got) << httplib::to_string(got.error());
+    EXPECT_EQ(got->status, 200);
+    EXPECT_EQ(got->get_header_value("Content-Type"), "image/x-exr");
+    EXPECT_EQ(got->get_header_value("Content-Length"), std::to_string(file.str().size()));
+    EXPECT_TRUE(got->body == file.str()) << got->body.size() << " bytes of " << file.str().size();
 }
 
 // A blocking socket connected to 127.0.0.1:`port`, whose reads give up after 10 s.

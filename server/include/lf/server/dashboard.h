@@ -11,16 +11,25 @@
 //   GET  /api/session                 who is signed in (401 when no one is and tokens are on)
 //   POST /api/session {"token": T}    signs in: an HttpOnly, SameSite=Strict cookie
 //   POST /api/session/end             signs out
-//   GET  /api/jobs?limit=N&before=SEQ newest first
+//   GET  /api/jobs?limit=N&before=SEQ&state=S&owner=O&name=TEXT
+//                                     newest first, filtered (state exactly, owner exactly, TEXT
+//                                     a case-blind substring of the name or id); next_before: the
+//                                     `before` of the next page (null at the end)
 //   GET  /api/jobs/ID?frames_from=I   one job, with its ETA; a shot's with its frames: at most
 //                                     kFramesListed of them from position I of its range
 //                                     (default: the page of its current frame)
-//   GET  /api/jobs/ID/tasks?frame=N   its tasks (a shot's frame N's only)
+//   GET  /api/jobs/ID/tasks?frame=N&state=S&offset=I&limit=N
+//                                     its tasks (a shot's frame N's only) in state S, a page of
+//                                     them, their total and counts by state
 //   GET  /api/jobs/ID/logs?task=N&after=SEQ&max=N
-//   GET  /api/jobs/ID/preview.png     the image merged so far, 8-bit sRGB
-//   GET  /api/jobs/ID/metadata        the EXR header attributes of that image
-//   GET  /api/jobs/ID/frames/N/preview.png, .../metadata   the same of a shot's frame N
+//   GET  /api/jobs/ID/preview.png     the image merged so far, 8-bit sRGB; ?exposure=EV (-8..8)
+//                                     and ?channel=beauty|A|B|albedo|normal|depth tone-map it from
+//                                     the linear EXR; ?download=1 as an attachment
+//   GET  /api/jobs/ID/metadata        the EXR header attributes of that image, its channels
+//   GET  /api/jobs/ID/result.exr      a succeeded job's EXR as an attachment, streamed
+//   GET  /api/jobs/ID/frames/N/preview.png, .../metadata, .../result.exr   a shot's frame N's
 //   POST /api/jobs/ID/cancel
+//   POST /api/jobs/ID/delete          an ended job (the roles of the gRPC DeleteJob)
 //   POST /api/jobs/ID/priority {"priority": N}
 //   GET  /api/workers
 //   GET  /api/farm                    queue depth, workers, throughput per minute of the last hour
@@ -36,6 +45,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
@@ -74,6 +84,7 @@ class Dashboard {
         bool frame_done = false;
         std::string etag;  // its version
         std::string png;
+        std::vector<std::string> channels;  // the views the image has (PreviewChannels)
         ExrAttributes attributes;
         absl::Time made;
         uint64_t used = 0;  // the cache's clock when last asked for
@@ -92,6 +103,17 @@ class Dashboard {
     // `frame`'s likewise (NotFound naming the frame and the job for one it does not render).
     absl::StatusOr<std::shared_ptr<const Preview>> PreviewOf(const JobRecord& job,
                                                              std::optional<int> frame);
+    // GET /api/jobs: newest first, filtered by state, owner and a name's (or id's) substring.
+    HttpAnswer ListJobs(const HttpRequest& request, const Caller& caller, absl::Time now);
+    // GET /api/jobs/ID/tasks: a page of the tasks in a state (a shot's frame's), with counts.
+    HttpAnswer ListTasks(const HttpRequest& request, const JobRecord& job);
+    // preview.png?exposure=EV&channel=NAME: made from the linear image at each request.
+    HttpAnswer GradedPreviewAnswer(const HttpRequest& request, const JobRecord& job,
+                                   std::optional<int> frame);
+    // The job's (or frame's) image as merged so far, read from its EXR.
+    absl::StatusOr<ExrFile> ReadResult(const JobRecord& job, std::optional<int> frame);
+    // Drops a deleted job's cached previews.
+    void ForgetPreviews(const std::string& job_id);
     // One job's JSON; a shot's with the page of its frames `frames_from` asks for.
     absl::StatusOr<nlohmann::json> JobWithFramesJson(const HttpRequest& request,
                                                      const JobRecord& job, absl::Time now);

@@ -34,6 +34,9 @@ struct HttpAnswer {
     std::string content_type;
     std::string body;
     std::vector<std::pair<std::string, std::string>> headers;  // beyond Content-Type
+    // When set, the body is this file, streamed in pieces as the peer reads (`body` unused): a
+    // result may be larger than an answer should hold in memory.
+    std::string file;
 };
 
 }  // namespace lf
