@@ -322,19 +322,14 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
     workers_.ForgetSilent(now);  // so that the workers kept are the live ones
     if (workers_.IsQuarantined(worker, now) || workers_.IsQuarantined(TokenStrikes(worker), now))
         return std::nullopt;
-    if (!controls_.empty()) {
-        const std::vector<WorkerRegistry::Entry> known = workers_.List();
-        const auto self = std::find_if(known.begin(), known.end(),
-                                       [&](const auto& entry) { return entry.id == worker; });
-        if (self != known.end() && ControlOf(worker, self->about) != WorkerControl::kEnabled) {
-            return std::nullopt;
-        }
-    }
+    // Seen just now: the registry keeps it.
+    const WorkerDescription& self = *workers_.AboutOf(worker);
+    if (ControlOf(worker, self) != WorkerControl::kEnabled) return std::nullopt;
     if (const std::string principal = PrincipalOf(worker);
         !principal.empty() && leases_.CurrentOf(principal) >= options_.max_leases_per_token) {
         return std::nullopt;
     }
-    const std::vector<std::string> tags = workers_.TagsOf(worker);
+    const std::vector<std::string>& tags = self.tags;
     Job* best = nullptr;
     int best_task = -1;
     for (auto& [id, job] : active_) {

@@ -17,7 +17,8 @@ void WorkerRegistry::Seen(const std::string& worker, absl::Time now,
     }
     if (about) it->second.about = *about;
     if (auto gone = offline_.find(worker); gone != offline_.end()) {
-        if (!about) it->second.about = std::move(gone->second.first);
+        if (!about) it->second.about = std::move(gone->second.about);
+        offline_by_seen_.erase(gone->second.seen);
         offline_.erase(gone);
     }
 }
@@ -26,17 +27,16 @@ int WorkerRegistry::ForgetSilent(absl::Time now) {
     int forgotten = 0;
     while (!by_seen_.empty() && now - by_seen_.begin()->first >= alive_for_) {
         auto it = by_worker_.find(by_seen_.begin()->second);
-        offline_[it->first] = {std::move(it->second.about), by_seen_.begin()->first};
+        offline_[it->first] = {std::move(it->second.about),
+                               offline_by_seen_.emplace(by_seen_.begin()->first, it->first)};
         by_worker_.erase(it);
         by_seen_.erase(by_seen_.begin());
         ++forgotten;
     }
-    std::erase_if(offline_,
-                  [&](const auto& entry) { return now - entry.second.second >= forget_after_; });
-    while (offline_.size() > kMaxOffline) {
-        offline_.erase(std::min_element(
-            offline_.begin(), offline_.end(),
-            [](const auto& a, const auto& b) { return a.second.second < b.second.second; }));
+    while (!offline_by_seen_.empty() && (offline_.size() > kMaxOffline ||
+                                         now - offline_by_seen_.begin()->first >= forget_after_)) {
+        offline_.erase(offline_by_seen_.begin()->second);
+        offline_by_seen_.erase(offline_by_seen_.begin());
     }
     std::erase_if(strikes_, [now](const auto& entry) { return now >= entry.second.forget_at; });
     return forgotten;
@@ -47,9 +47,9 @@ bool WorkerRegistry::IsLive(const std::string& worker, absl::Time now) const {
     return it != by_worker_.end() && now - it->second.seen->first < alive_for_;
 }
 
-std::vector<std::string> WorkerRegistry::TagsOf(const std::string& worker) const {
+const WorkerDescription* WorkerRegistry::AboutOf(const std::string& worker) const {
     auto it = by_worker_.find(worker);
-    return it == by_worker_.end() ? std::vector<std::string>{} : it->second.about.tags;
+    return it == by_worker_.end() ? nullptr : &it->second.about;
 }
 
 bool WorkerRegistry::AnyLiveHas(const std::vector<std::string>& tags, absl::Time now) const {
@@ -91,7 +91,7 @@ std::vector<WorkerRegistry::Entry> WorkerRegistry::List() const {
 std::vector<WorkerRegistry::Entry> WorkerRegistry::Offline() const {
     std::vector<Entry> entries;
     entries.reserve(offline_.size());
-    for (const auto& [id, gone] : offline_) entries.push_back({id, gone.first, gone.second});
+    for (const auto& [id, gone] : offline_) entries.push_back({id, gone.about, gone.seen->first});
     return entries;
 }
 

@@ -11,7 +11,7 @@ export function mount(root) {
     refresh: async () => {
       const { workers } = await get('workers');
       const task = (w) => {
-        if (w.state !== 'busy') return '—';
+        if (!w.job_id) return '—';
         if (w.job_id === '(other)') return "another owner's job";
         return h('a', { href: `#/job/${encodeURIComponent(w.job_id)}` }, `${w.job_id} task ${w.task}`);
       };

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <set>
 
 #include "lease_results.h"
 #include "lf/server/farm.h"
@@ -111,6 +112,20 @@ TEST_F(WorkerControlTest, SilentWorkerIsListedOfflineThenForgotten) {
     EXPECT_EQ(StateOf("box-1"), "idle");
     now_ += absl::Minutes(31);
     EXPECT_EQ(StateOf("box-1"), "");
+}
+
+TEST(WorkerRegistryOffline, MadeUpIdsKeepAtMostTheCapOldestDroppedFirst) {
+    const absl::Time t0 = absl::FromUnixSeconds(1'000'000);
+    WorkerRegistry r(absl::Seconds(10), absl::Hours(1));
+    const int n = int(WorkerRegistry::kMaxOffline) + 100;
+    for (int i = 0; i < n; ++i) r.Seen("made-up-" + std::to_string(i), t0 + absl::Microseconds(i));
+    EXPECT_EQ(r.ForgetSilent(t0 + absl::Seconds(11)), n);
+    EXPECT_EQ(r.size(), 0u);
+    std::set<std::string> offline;
+    for (const WorkerRegistry::Entry& e : r.Offline()) offline.insert(e.id);
+    EXPECT_EQ(offline.size(), WorkerRegistry::kMaxOffline);
+    EXPECT_FALSE(offline.count("made-up-99"));
+    EXPECT_TRUE(offline.count("made-up-100"));
 }
 
 TEST(WorkerStateStore, ControlsSurviveAReopenAndEnableRemovesThem) {

@@ -34,8 +34,8 @@ class WorkerRegistry {
     int ForgetSilent(absl::Time now);
 
     bool IsLive(const std::string& worker, absl::Time now) const;
-    // The tags the worker said it has at its last lease request; none for one not kept.
-    std::vector<std::string> TagsOf(const std::string& worker) const;
+    // What the worker said of itself at its last lease request; nullptr for one not kept.
+    const WorkerDescription* AboutOf(const std::string& worker) const;
     // Whether some live worker has every one of `tags`.
     bool AnyLiveHas(const std::vector<std::string>& tags, absl::Time now) const;
 
@@ -81,7 +81,13 @@ class WorkerRegistry {
     const absl::Duration alive_for_;
     const absl::Duration forget_after_;
     BySeen by_seen_;
-    std::map<std::string, std::pair<WorkerDescription, absl::Time>> offline_;
+    // The offline workers, by id and by when each was last seen (the oldest go first).
+    struct Gone {
+        WorkerDescription about;
+        BySeen::iterator seen;
+    };
+    BySeen offline_by_seen_;
+    std::map<std::string, Gone> offline_;
     std::map<std::string, Kept> by_worker_;
 };
 
