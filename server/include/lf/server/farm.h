@@ -47,7 +47,7 @@ constexpr absl::Duration kPartialUploadLifetime = absl::Hours(24);
 constexpr int kMaxTaskLogPage = 1000;
 
 struct FarmOptions {
-    std::string data_dir;  // jobs.db, logs.db, blobs/, results/, previews/, scratch/ go here
+    std::string data_dir;  // jobs.db, logs.db, workers.db, blobs/, results/, previews/, scratch/
     SchedulerOptions scheduler;
     TaskLogLimits task_logs;
     JobLimits limits;
