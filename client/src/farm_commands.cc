@@ -11,6 +11,7 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "lf/client/command.h"
@@ -134,6 +135,16 @@ void PrintJob(const pb::Job& job) {
         std::printf("            %s\n", FramesText(job).c_str());
     }
     std::printf("  priority  %d\n", job.priority());
+    if (job.tags_size() > 0 || job.max_workers() > 0) {
+        std::printf(
+            "  workers   %s%s\n",
+            job.tags_size() > 0 ? absl::StrCat("tags ", absl::StrJoin(job.tags(), ",")).c_str()
+                                : "any",
+            job.max_workers() > 0 ? absl::StrCat(", at most ", job.max_workers()).c_str() : "");
+    }
+    if (!job.waiting_reason().empty()) {
+        std::printf("  waiting   %s\n", LogSafe(job.waiting_reason()).c_str());
+    }
     std::printf("  tasks     %d/%d done, %d running, %d retried, %d leased\n", job.tasks_done(),
                 job.tasks_total(), job.tasks_running(), job.retries(), job.tasks_leased());
     std::printf("  samples   %llu (%llu rays, %llu NaN/Inf)\n", (unsigned long long)job.samples(),
@@ -445,41 +456,80 @@ Command AddDeleteCommand(CLI::App& app) {
             }};
 }
 
+namespace {
+
+// The workers table (or JSON lines) of `workers`.
+void PrintWorkers(const pb::ListWorkersResponse& resp, bool json) {
+    if (json) {
+        for (const pb::WorkerInfo& w : resp.workers()) PrintJson(w);
+        return;
+    }
+    std::printf("%-28s %-20s %-24s %-30s %-8s %-22s %-20s %s\n", "WORKER", "NAME", "ADDRESS",
+                "VERSION", "STATE", "TASK", "TAGS", "LAST-HEARTBEAT");
+    for (const pb::WorkerInfo& w : resp.workers()) {
+        const bool busy = !w.job_id().empty();
+        const std::string tags =
+            w.tags_size() > 0 ? LogSafe(absl::StrJoin(w.tags(), ","), 64) : "-";
+        // Ids, names and versions come from the workers: escaped, so none can move the
+        // terminal. The id first, as `tasks` names the worker: two workers of one host share
+        // their name.
+        std::printf("%-28s %-20s %-24s %-30s %-8s %-22s %-20s %.1f s ago\n",
+                    LogSafe(w.id(), kWorkerIdShown).c_str(),
+                    w.name().empty() ? "-" : LogSafe(w.name(), 64).c_str(),
+                    LogSafe(w.address(), 64).c_str(), LogSafe(w.version(), 64).c_str(),
+                    absl::AsciiStrToLower(pb::WorkerInfo::State_Name(w.state())).c_str(),
+                    busy ? absl::StrCat(w.job_id(), "/", w.task_index()).c_str() : "-",
+                    tags.c_str(), w.seconds_since_seen());
+    }
+}
+
+}  // namespace
+
 Command AddWorkersCommand(CLI::App& app) {
     auto flags = std::make_shared<FarmFlags>();
     CLI::App* cmd = app.add_subcommand(
         "workers",
-        "List the workers the server heard from within a lease: worker (the identity `tasks` and\n"
-        "`logs` show), name (its --name, by default its host's), address, version, state, task\n"
-        "and seconds since each was last heard from.");
+        "List the workers the server knows: worker (the identity `tasks` and `logs` show), name\n"
+        "(its --name, by default its host's), address, version, state (idle, busy, disabled,\n"
+        "draining, drained, or offline: silent for a lease, listed until the server's\n"
+        "--forget-workers-after), task, tags and seconds since each was last heard from.\n"
+        "`workers disable|enable|drain NAME` (admins): a disabled worker takes no new task, its\n"
+        "current one goes on; a drained one finishes its task, then takes none. NAME is a\n"
+        "worker's name (every worker of that name) or id; the state survives server restarts.");
     auto json = std::make_shared<bool>(false);
+    auto action = std::make_shared<std::string>();
+    auto worker = std::make_shared<std::string>();
+    cmd->add_option("action", *action, "disable, enable or drain")
+        ->check(CLI::IsMember({"disable", "enable", "drain"}));
+    cmd->add_option("worker", *worker, "the worker's name or id, with an action");
     AddJsonFlag(cmd, *json);
     AddServerOption(cmd, *flags);
-    return {cmd, [flags, json] {
-                pb::ListWorkersRequest req;
-                pb::ListWorkersResponse resp;
-                absl::Status s =
-                    FarmClient(*flags).Call(&pb::JobService::Stub::ListWorkers, req, &resp);
-                if (!s.ok()) return ReportError(s);
-                if (*json) {
-                    for (const pb::WorkerInfo& w : resp.workers()) PrintJson(w);
+    return {cmd, [flags, json, action, worker] {
+                if (!action->empty() && worker->empty()) {
+                    return ReportError(absl::InvalidArgumentError(
+                        absl::StrCat("workers ", *action, ": name the worker (its name or id)")));
+                }
+                if (action->empty()) {
+                    pb::ListWorkersRequest req;
+                    pb::ListWorkersResponse resp;
+                    absl::Status s =
+                        FarmClient(*flags).Call(&pb::JobService::Stub::ListWorkers, req, &resp);
+                    if (!s.ok()) return ReportError(s);
+                    PrintWorkers(resp, *json);
                     return 0;
                 }
-                std::printf("%-28s %-20s %-24s %-30s %-5s %-22s %s\n", "WORKER", "NAME", "ADDRESS",
-                            "VERSION", "STATE", "TASK", "LAST-HEARTBEAT");
-                for (const pb::WorkerInfo& w : resp.workers()) {
-                    const bool busy = w.state() == pb::WorkerInfo::BUSY;
-                    // Ids, names and versions come from the workers: escaped, so none can move
-                    // the terminal. The id first, as `tasks` names the worker: two workers of
-                    // one host share their name.
-                    std::printf("%-28s %-20s %-24s %-30s %-5s %-22s %.1f s ago\n",
-                                LogSafe(w.id(), kWorkerIdShown).c_str(),
-                                w.name().empty() ? "-" : LogSafe(w.name(), 64).c_str(),
-                                LogSafe(w.address(), 64).c_str(), LogSafe(w.version(), 64).c_str(),
-                                busy ? "busy" : "idle",
-                                busy ? absl::StrCat(w.job_id(), "/", w.task_index()).c_str() : "-",
-                                w.seconds_since_seen());
-                }
+                pb::SetWorkerStateRequest req;
+                req.set_worker(*worker);
+                req.set_control(*action == "disable" ? pb::SetWorkerStateRequest::DISABLE
+                                : *action == "drain" ? pb::SetWorkerStateRequest::DRAIN
+                                                     : pb::SetWorkerStateRequest::ENABLE);
+                pb::SetWorkerStateResponse resp;
+                absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::SetWorkerState, req, &resp);
+                if (!s.ok()) return ReportError(s);
+                pb::ListWorkersResponse shown;
+                *shown.mutable_workers() = resp.workers();
+                PrintWorkers(shown, *json);
                 return 0;
             }};
 }

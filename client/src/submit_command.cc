@@ -27,6 +27,7 @@
 #include "lf/job/job_spec.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
+#include "lf/job/worker_tags.h"
 
 namespace lf {
 namespace {
@@ -57,7 +58,8 @@ absl::StatusOr<std::map<std::string, std::string>> ReadSceneFiles(const fs::path
 struct SubmitOptions {
     FarmFlags farm;
     std::string scene_path;
-    JobSpec spec;  // the scene and files are filled in by Submit
+    JobSpec spec;      // the scene and files are filled in by Submit
+    std::string tags;  // --tags, into spec.tags
 };
 
 absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
@@ -138,6 +140,17 @@ Command AddSubmitCommand(CLI::App& app) {
     cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
     cmd->add_option("--name", o->spec.name, "job name (default: the scene file's name)");
+    cmd->add_option("--tags", o->tags,
+                    "comma-separated tags (gpu,big-memory): only workers having every one take "
+                    "the job (lightfarm-worker --tags); none: any worker")
+        ->check([](const std::string& list) {
+            const absl::StatusOr<std::vector<std::string>> parsed = ParseTags(list, "--tags");
+            return parsed.ok() ? std::string() : std::string(parsed.status().message());
+        });
+    cmd->add_option("--max-workers", o->spec.max_workers,
+                    "at most this many workers render the job at once; 0: no cap")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     cmd->add_option(
            "--method", o->spec.method,
            "path, radiosity (Lambertian scenes; same bits as `lightfarm render "
@@ -186,6 +199,7 @@ Command AddSubmitCommand(CLI::App& app) {
                     !s.ok()) {
                     return ReportError(s);
                 }
+                o->spec.tags = *ParseTags(o->tags, "--tags");  // checked by the flag
                 absl::StatusOr<std::string> id = Submit(*o);
                 if (!id.ok()) return ReportError(id.status());
                 std::printf("%s\n", id->c_str());

@@ -8,6 +8,7 @@
 #include "lf/core/aov.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/pixel_filter.h"
+#include "lf/job/worker_tags.h"
 
 namespace lf {
 
@@ -88,6 +89,8 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         CheckPhotonSettings(spec.ppm),
         CheckShotSettings(spec.shot),
         CheckMethodSettings(spec),
+        CheckTags(spec.tags, "tags"),
+        InRange("max_workers", spec.max_workers, 0, std::numeric_limits<int>::max()),
     };
     for (const absl::Status& s : checks) {
         if (!s.ok()) return s;

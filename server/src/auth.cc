@@ -20,7 +20,7 @@ bool RoleMay(Role role, Action action) {
         case Role::kWorker:
             return action == Action::kWork;
         case Role::kSubmitter:
-            return action != Action::kWork;
+            return action != Action::kWork && action != Action::kManageWorkers;
     }
     return false;
 }
@@ -45,6 +45,8 @@ const char* ActionName(Action action) {
             return "list workers";
         case Action::kWork:
             return "lease and render tasks";
+        case Action::kManageWorkers:
+            return "disable, enable or drain workers";
     }
     return "?";
 }

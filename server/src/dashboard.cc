@@ -443,7 +443,8 @@ HttpAnswer Dashboard::Api(const HttpRequest& request, const std::string& route) 
                                {"name", w.name},
                                {"version", w.version},
                                {"address", w.address},
-                               {"state", w.busy() ? "busy" : "idle"},
+                               {"state", WorkerStateName(StateOf(w))},
+                               {"tags", w.tags},
                                {"job_id", w.job_id},
                                {"task", w.task},
                                {"since_seen_ms", absl::ToInt64Milliseconds(w.since_seen)}});

@@ -62,6 +62,19 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
     std::unique_ptr<Farm> farm(
         new Farm(options, std::move(*blobs), std::move(*store), std::move(*logs)));
     farm->lock_ = std::move(*lock);
+    if (!options.notify_url.empty()) {
+        absl::StatusOr<std::unique_ptr<JobNotifier>> notifier =
+            JobNotifier::Start(options.notify_url, options.notify);
+        if (!notifier.ok()) return notifier.status();
+        farm->notifier_ = std::move(*notifier);
+    }
+    absl::StatusOr<std::unique_ptr<WorkerStateStore>> worker_states =
+        WorkerStateStore::Open(options.data_dir + "/workers.db");
+    if (!worker_states.ok()) return worker_states.status();
+    farm->worker_states_ = std::move(*worker_states);
+    absl::StatusOr<std::map<std::string, WorkerControl>> controls = farm->worker_states_->List();
+    if (!controls.ok()) return controls.status();
+    for (const auto& [name, control] : *controls) farm->scheduler_.SetWorkerControl(name, control);
     farm->SweepTemporaryFiles();
     absl::StatusOr<std::vector<std::string>> rendered = farm->scheduler_.Recover();
     if (!rendered.ok()) return rendered.status();
@@ -89,6 +102,13 @@ Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
         // The job has ended either way: `lightfarm tasks` then lists none of its tasks.
         if (absl::Status s = logs_->RecordTasks(job_id, tasks); !s.ok()) {
             Log()->error("job={} tasks not recorded: {}", job_id, std::string(s.message()));
+        }
+        if (!notifier_) return;
+        // The final record is durable by now: read from the store, outside the scheduler's lock.
+        if (absl::StatusOr<JobRecord> job = scheduler_.Get(job_id); job.ok()) {
+            notifier_->JobEnded(*job);
+        } else {
+            Log()->error("job={} not notified: {}", job_id, std::string(job.status().message()));
         }
     });
 }
@@ -589,6 +609,22 @@ void Farm::SweepTemporaryFiles() {
 }  // namespace lf
 
 namespace lf {
+
+absl::StatusOr<std::vector<WorkerStatus>> Farm::SetWorkerState(const std::string& name_or_id,
+                                                               WorkerControl control) {
+    const std::optional<std::string> key = scheduler_.WorkerKey(name_or_id);
+    if (!key) {
+        return absl::NotFoundError(
+            absl::StrCat("no worker named ", LogSafe(name_or_id, 128),
+                         " nor with that id (lightfarm workers lists them)"));
+    }
+    if (absl::Status s = worker_states_->Put(*key, control); !s.ok()) return s;
+    scheduler_.SetWorkerControl(*key, control);
+    std::vector<WorkerStatus> named = scheduler_.Workers();
+    std::erase_if(named,
+                  [&](const WorkerStatus& w) { return (w.name.empty() ? w.id : w.name) != *key; });
+    return named;
+}
 
 absl::StatusOr<JobRecord> Farm::SetPriority(const std::string& job_id, int priority) {
     return scheduler_.SetPriority(job_id, priority);

@@ -7,6 +7,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "lf/core/log.h"
+#include "lf/job/worker_tags.h"
 #include "lf/proto/grpc_status.h"
 #include "lf/version.h"
 #include "lf/wire/conversions.h"
@@ -166,6 +167,10 @@ JobServiceImpl::JobServiceImpl(Farm& farm, CallGuard guard, JobServiceOptions op
     Unary<pb::GetTaskLogsRequest, pb::GetTaskLogsResponse>(
         "GetTaskLogs", Action::kReadJobs, kMaxRequestBytes,
         bind_front(&JobServiceImpl::GetTaskLogs, this));
+    // Worker management and stats (issue 30)
+    Unary<pb::SetWorkerStateRequest, pb::SetWorkerStateResponse>(
+        "SetWorkerState", Action::kManageWorkers, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::SetWorkerState, this));
 }
 
 WorkerServiceImpl::WorkerServiceImpl(Farm& farm, CallGuard guard)
@@ -451,6 +456,33 @@ grpc::Status JobServiceImpl::ListWorkers(grpc::ServerContext* context, const Cal
     return grpc::Status::OK;
 }
 
+grpc::Status JobServiceImpl::SetWorkerState(grpc::ServerContext* context, const Caller& caller,
+                                            const pb::SetWorkerStateRequest& req,
+                                            pb::SetWorkerStateResponse* resp) {
+    WorkerControl control;
+    switch (req.control()) {
+        case pb::SetWorkerStateRequest::ENABLE:
+            control = WorkerControl::kEnabled;
+            break;
+        case pb::SetWorkerStateRequest::DISABLE:
+            control = WorkerControl::kDisabled;
+            break;
+        case pb::SetWorkerStateRequest::DRAIN:
+            control = WorkerControl::kDrain;
+            break;
+        default:
+            return ToGrpcStatus(absl::InvalidArgumentError(
+                absl::StrCat("SetWorkerState of ", LogSafe(req.worker(), 128), ": control ",
+                             int(req.control()), " is none of enable, disable, drain")));
+    }
+    absl::StatusOr<std::vector<WorkerStatus>> workers = farm_.SetWorkerState(req.worker(), control);
+    if (!workers.ok()) return ToGrpcStatus(workers.status());
+    Log()->info("worker {} set to {} by {} from {}", LogSafe(req.worker(), 128),
+                WorkerControlName(control), Who(caller), Peer(context));
+    for (const WorkerStatus& worker : *workers) ToProto(worker, resp->add_workers());
+    return grpc::Status::OK;
+}
+
 grpc::Status JobServiceImpl::ListTasks(grpc::ServerContext* context, const Caller& caller,
                                        const pb::ListTasksRequest& req,
                                        pb::ListTasksResponse* resp) {
@@ -495,7 +527,12 @@ grpc::Status WorkerServiceImpl::LeaseTask(grpc::ServerContext* context, const Ca
             absl::StrCat("LeaseTask: worker name of ", req.name().size(),
                          " bytes is above the limit of ", kMaxWorkerNameBytes)));
     }
-    const WorkerDescription about{req.name(), context->peer(), req.version()};
+    const std::vector<std::string> tags(req.tags().begin(), req.tags().end());
+    if (absl::Status s = CheckTags(tags, "LeaseTask: worker tags"); !s.ok()) {
+        return ToGrpcStatus(absl::InvalidArgumentError(absl::StrCat(
+            LogSafe(std::string(s.message())), " (worker ", LogSafe(req.worker_id()), ")")));
+    }
+    const WorkerDescription about{req.name(), context->peer(), req.version(), tags};
     const absl::Duration wait = absl::Milliseconds(std::clamp(req.wait_ms(), 0, 10000));
     if (std::optional<TaskAssignment> lease = farm_.scheduler().LeaseTask(
             WorkerIdentity(caller, req.worker_id()), absl::Now() + wait, &about)) {

@@ -56,6 +56,15 @@ int LeaseTable::CurrentOf(const std::string& principal) const {
     return n;
 }
 
+std::set<std::string> LeaseTable::WorkersOf(const std::string& job_id) const {
+    std::set<std::string> workers;
+    for (const auto& [deadline, id] : deadlines_) {
+        const Lease& lease = by_id_.at(id).lease;
+        if (lease.job_id == job_id) workers.insert(lease.worker);
+    }
+    return workers;
+}
+
 void LeaseTable::EndEntry(Entry& entry) {
     if (!entry.lease.current) return;
     deadlines_.erase(entry.deadline);

@@ -72,6 +72,13 @@ int main(int argc, char** argv) {
     app.add_option("--max-spp", options.limits.max_spp, "most samples per pixel per job")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    // A duration flag's check: 7d, 12h, 30m, 1d12h or 0 (lf::ParseRetention).
+    const CLI::Validator duration(
+        [](std::string& text) {
+            absl::StatusOr<absl::Duration> d = lf::ParseRetention(text);
+            return d.ok() ? std::string() : std::string(d.status().message());
+        },
+        "DURATION");
     double retention_days = 30;
     CLI::Option* days_option =
         app.add_option("--retention-days", retention_days,
@@ -83,12 +90,17 @@ int main(int argc, char** argv) {
     app.add_option("--retention", retention_text,
                    "as --retention-days, as a duration: 7d, 12h, 30m, 1d12h; 0 keeps them forever")
         ->excludes(days_option)
-        ->check(CLI::Validator(
-            [](std::string& text) {
-                absl::StatusOr<absl::Duration> d = lf::ParseRetention(text);
-                return d.ok() ? std::string() : std::string(d.status().message());
-            },
-            "DURATION"));
+        ->check(duration);
+    std::string forget_workers_after = "1h";
+    app.add_option("--forget-workers-after", forget_workers_after,
+                   "a worker silent for a lease is listed as offline, with its last-seen time, "
+                   "until this long after it was last seen (1h, 30m, 2d); 0 forgets it at once")
+        ->capture_default_str()
+        ->check(duration);
+    app.add_option("--notify-url", options.notify_url,
+                   "POST a JSON object ({job_id, name, owner, state, error, submitted, started, "
+                   "finished}) to this http:// or https:// URL when a job succeeds, fails or is "
+                   "cancelled; sent from its own thread, 3 attempts of 5 s at most each");
     lf::JobServiceOptions service_options;
     app.add_option("--max-watchers", service_options.max_watchers,
                    "most WatchJob streams open at once (each holds a thread); more are refused")
@@ -159,6 +171,7 @@ int main(int argc, char** argv) {
     options.scheduler.lease = absl::Seconds(lease_seconds);
     options.scheduler.speculate_after = absl::Seconds(speculate_seconds);
     options.limits.max_scene_bytes = max_scene_mb << 20;
+    options.scheduler.forget_workers_after = *lf::ParseRetention(forget_workers_after);
     options.retention = retention_text.empty() ? absl::Hours(24 * retention_days)
                                                : *lf::ParseRetention(retention_text);
     // Often enough that a cancel reaches workers within about a second, and several times per

@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_error.h"
 #include "lf/core/log.h"
+#include "lf/job/worker_tags.h"
 
 namespace lf {
 
@@ -30,7 +31,10 @@ absl::Status AlreadyEnded(const JobRecord& record) {
 }  // namespace
 
 Scheduler::Scheduler(SchedulerOptions options, JobStore& store, Clock clock)
-    : options_(options), store_(store), clock_(std::move(clock)), workers_(options.lease) {}
+    : options_(options),
+      store_(store),
+      clock_(std::move(clock)),
+      workers_(options.lease, options.forget_workers_after) {}
 
 Scheduler::Locked::Locked(Scheduler& scheduler) : lock(scheduler.mutex_), scheduler_(scheduler) {}
 
@@ -137,7 +141,9 @@ std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(
 absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
     {
         std::lock_guard<std::mutex> lock(mutex_);
-        if (auto it = active_.find(job_id); it != active_.end()) return it->second->record;
+        if (auto it = active_.find(job_id); it != active_.end()) {
+            return ReadRecord(*it->second, clock_());
+        }
         if (const JobRecord* ended = ended_.Find(job_id)) return *ended;
     }
     return store_.Get(job_id);
@@ -147,8 +153,9 @@ absl::StatusOr<std::vector<JobRecord>> Scheduler::List(const JobQuery& query) co
     absl::StatusOr<std::vector<JobRecord>> jobs = store_.List(query);
     if (!jobs.ok()) return jobs.status();
     std::lock_guard<std::mutex> lock(mutex_);
+    const absl::Time now = clock_();
     for (JobRecord& job : *jobs) {
-        if (auto it = active_.find(job.id); it != active_.end()) job = it->second->record;
+        if (auto it = active_.find(job.id); it != active_.end()) job = ReadRecord(*it->second, now);
         if (const JobRecord* ended = ended_.Find(job.id)) job = *ended;
     }
     return jobs;
@@ -194,13 +201,20 @@ std::vector<WorkerStatus> Scheduler::Workers() {
     workers_.ForgetSilent(now);
     const std::map<std::string, const Lease*> held = leases_.CurrentByWorker();
     std::vector<WorkerStatus> workers;
-    for (WorkerRegistry::Entry& entry : workers_.List()) {
+    std::vector<WorkerRegistry::Entry> entries = workers_.List();
+    const size_t live = entries.size();
+    for (WorkerRegistry::Entry& entry : workers_.Offline()) entries.push_back(std::move(entry));
+    for (WorkerRegistry::Entry& entry : entries) {
         WorkerStatus& w = workers.emplace_back();
+        w.offline = workers.size() > live;
+        w.control = ControlOf(entry.id, entry.about);
+        w.last_seen = entry.last_seen;
         w.id = std::move(entry.id);
         w.name = std::move(entry.about.name);
         w.address = std::move(entry.about.address);
         w.version = std::move(entry.about.version);
         w.since_seen = now - entry.last_seen;
+        w.tags = std::move(entry.about.tags);
         if (auto it = held.find(w.id); it != held.end()) {
             w.job_id = it->second->job_id;
             w.task = it->second->task;
@@ -312,10 +326,14 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
     workers_.ForgetSilent(now);  // so that the workers kept are the live ones
     if (workers_.IsQuarantined(worker, now) || workers_.IsQuarantined(TokenStrikes(worker), now))
         return std::nullopt;
+    // Seen just now: the registry keeps it.
+    const WorkerDescription& self = *workers_.AboutOf(worker);
+    if (ControlOf(worker, self) != WorkerControl::kEnabled) return std::nullopt;
     if (const std::string principal = PrincipalOf(worker);
         !principal.empty() && leases_.CurrentOf(principal) >= options_.max_leases_per_token) {
         return std::nullopt;
     }
+    const std::vector<std::string>& tags = self.tags;
     Job* best = nullptr;
     int best_task = -1;
     for (auto& [id, job] : active_) {
@@ -324,6 +342,7 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
                       job->record.seq > best->record.seq))) {
             continue;
         }
+        if (!Admits(*job, worker, tags)) continue;
         for (int t : job->states.queued()) {
             if (!MayTake(*job, t, worker, now)) continue;
             best = job.get();
@@ -333,6 +352,7 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
     }
     if (best) return Grant(*best, best_task, worker, now);
     for (auto& [id, job] : active_) {
+        if (!Admits(*job, worker, tags)) continue;
         if (const int t = StragglerFor(*job, worker, now); t >= 0) {
             Log()->info("job={} task={} running for {}: leased again to {}", id, t,
                         absl::FormatDuration(now - job->tasks[size_t(t)].leased_at),
@@ -418,6 +438,55 @@ bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::
     size_t live_failed = 0;
     for (const std::string& w : task.failed_on) live_failed += workers_.IsLive(w, now);
     return workers_.size() <= live_failed;
+}
+
+WorkerControl Scheduler::ControlOf(const std::string& id, const WorkerDescription& about) const {
+    auto it = controls_.find(about.name.empty() ? id : about.name);
+    return it == controls_.end() ? WorkerControl::kEnabled : it->second;
+}
+
+std::optional<std::string> Scheduler::WorkerKey(const std::string& name_or_id) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<WorkerRegistry::Entry> entries = workers_.List();
+    for (WorkerRegistry::Entry& entry : workers_.Offline()) entries.push_back(std::move(entry));
+    for (const WorkerRegistry::Entry& entry : entries) {
+        if (entry.id == name_or_id) return entry.about.name.empty() ? entry.id : entry.about.name;
+    }
+    for (const WorkerRegistry::Entry& entry : entries) {
+        if (entry.about.name == name_or_id) return name_or_id;
+    }
+    if (controls_.count(name_or_id)) return name_or_id;
+    return std::nullopt;
+}
+
+void Scheduler::SetWorkerControl(const std::string& key, WorkerControl control) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (control == WorkerControl::kEnabled) {
+        controls_.erase(key);
+    } else {
+        controls_[key] = control;
+    }
+    // A re-enabled worker waiting in LeaseTask looks for work again.
+    ++version_;
+    changed_.notify_all();
+}
+
+bool Scheduler::Admits(const Job& job, const std::string& worker,
+                       const std::vector<std::string>& tags) const {
+    const JobSpec& spec = job.record.spec;
+    if (!HasAllTags(tags, spec.tags)) return false;
+    if (spec.max_workers <= 0) return true;
+    const std::set<std::string> holders = leases_.WorkersOf(job.id());
+    return holders.count(worker) || int(holders.size()) < spec.max_workers;
+}
+
+JobRecord Scheduler::ReadRecord(const Job& job, absl::Time now) const {
+    JobRecord record = job.record;
+    if (!record.spec.tags.empty() && !job.states.queued().empty() &&
+        !workers_.AnyLiveHas(record.spec.tags, now)) {
+        record.waiting_reason = WaitingForTags(record.spec.tags);
+    }
+    return record;
 }
 
 std::optional<Scheduler::LeaseRef> Scheduler::Resolve(const std::string& lease_id,

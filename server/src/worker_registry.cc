@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "lf/job/worker_tags.h"
+
 namespace lf {
 
 void WorkerRegistry::Seen(const std::string& worker, absl::Time now,
@@ -14,14 +16,27 @@ void WorkerRegistry::Seen(const std::string& worker, absl::Time now,
         it->second.seen = by_seen_.emplace(now, worker);
     }
     if (about) it->second.about = *about;
+    if (auto gone = offline_.find(worker); gone != offline_.end()) {
+        if (!about) it->second.about = std::move(gone->second.about);
+        offline_by_seen_.erase(gone->second.seen);
+        offline_.erase(gone);
+    }
 }
 
 int WorkerRegistry::ForgetSilent(absl::Time now) {
     int forgotten = 0;
     while (!by_seen_.empty() && now - by_seen_.begin()->first >= alive_for_) {
-        by_worker_.erase(by_seen_.begin()->second);
+        auto it = by_worker_.find(by_seen_.begin()->second);
+        offline_[it->first] = {std::move(it->second.about),
+                               offline_by_seen_.emplace(by_seen_.begin()->first, it->first)};
+        by_worker_.erase(it);
         by_seen_.erase(by_seen_.begin());
         ++forgotten;
+    }
+    while (!offline_by_seen_.empty() && (offline_.size() > kMaxOffline ||
+                                         now - offline_by_seen_.begin()->first >= forget_after_)) {
+        offline_.erase(offline_by_seen_.begin()->second);
+        offline_by_seen_.erase(offline_by_seen_.begin());
     }
     std::erase_if(strikes_, [now](const auto& entry) { return now >= entry.second.forget_at; });
     return forgotten;
@@ -30,6 +45,18 @@ int WorkerRegistry::ForgetSilent(absl::Time now) {
 bool WorkerRegistry::IsLive(const std::string& worker, absl::Time now) const {
     auto it = by_worker_.find(worker);
     return it != by_worker_.end() && now - it->second.seen->first < alive_for_;
+}
+
+const WorkerDescription* WorkerRegistry::AboutOf(const std::string& worker) const {
+    auto it = by_worker_.find(worker);
+    return it == by_worker_.end() ? nullptr : &it->second.about;
+}
+
+bool WorkerRegistry::AnyLiveHas(const std::vector<std::string>& tags, absl::Time now) const {
+    return std::any_of(by_worker_.begin(), by_worker_.end(), [&](const auto& entry) {
+        return now - entry.second.seen->first < alive_for_ &&
+               HasAllTags(entry.second.about.tags, tags);
+    });
 }
 
 bool WorkerRegistry::Abandoned(const std::string& worker, absl::Time now,
@@ -58,6 +85,13 @@ std::vector<WorkerRegistry::Entry> WorkerRegistry::List() const {
             {id, kept.about, kept.seen->first,
              strikes == strikes_.end() ? absl::InfinitePast() : strikes->second.quarantined_until});
     }
+    return entries;
+}
+
+std::vector<WorkerRegistry::Entry> WorkerRegistry::Offline() const {
+    std::vector<Entry> entries;
+    entries.reserve(offline_.size());
+    for (const auto& [id, gone] : offline_) entries.push_back({id, gone.about, gone.seen->first});
     return entries;
 }
 

@@ -1,22 +1,24 @@
-// Workers heard from within a lease: id (as a job's tasks and logs name the worker), name (its
-// --name, by default its host's), address, version, state, current job and task, last heartbeat.
-// The table is a list of columns (kColumns): a column, such as one of actions, is one entry.
+// The farm's workers: id (as a job's tasks and logs name the worker), name (its --name, by default
+// its host's), address, version, tags, state (idle, busy, disabled, draining, drained, offline),
+// current job and task, last heard. The table is a list of columns (kColumns): a column, such as
+// one of actions, is one entry.
 import { get } from './api.js';
 import { h, table, time } from './format.js';
 
+// A draining worker still holds its task: shown whatever the state says.
 const task = (w) => {
-  if (w.state !== 'busy') return '—';
+  if (!w.job_id) return '—';
   if (w.job_id === '(other)') return "another owner's job";
   return h('a', { href: `#/job/${encodeURIComponent(w.job_id)}` }, `${w.job_id} task ${w.task}`);
 };
 
-// Listed workers are live (heard within a lease): busy with a task or idle.
 const kColumns = [
   { title: 'Worker', cell: (w) => w.id },
   { title: 'Name', cell: (w) => w.name },
   { title: 'Address', cell: (w) => w.address || '—' },
   { title: 'Version', cell: (w) => w.version },
-  { title: 'State', cell: (w) => `live, ${w.state}`, class: 'state' },
+  { title: 'Tags', cell: (w) => (w.tags && w.tags.length ? w.tags.join(', ') : '—') },
+  { title: 'State', cell: (w) => w.state, class: 'state' },
   { title: 'Current task', cell: task },
   { title: 'Last seen', cell: (w, now) => h('span', { title: time(now - w.since_seen_ms) }, `${(w.since_seen_ms / 1000).toFixed(1)} s ago`) },
 ];
@@ -31,7 +33,7 @@ export function mount(root) {
       const now = Date.now();
       const rows = workers.map((w) => h('tr', { class: `worker ${w.state}`, 'data-id': w.id },
         kColumns.map((c) => h('td', { class: c.class }, c.cell(w, now)))));
-      body.replaceChildren(workers.length === 0 ? h('p', {}, 'No live workers.')
+      body.replaceChildren(workers.length === 0 ? h('p', {}, 'No workers.')
         : table(kColumns.map((c) => c.title), rows));
     },
   };

@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
@@ -195,11 +196,17 @@ class Farm : public ::testing::Test {
         address_ = line.substr(std::strlen("listening on "));
     }
 
-    Child* StartWorker(const std::string& name, int threads = 1) {
-        return Spawn(
-            {std::string(LF_BIN_DIR) + "/lightfarm-worker", "--server", address_, "--threads",
-             std::to_string(threads), "--cache-dir", (dir_ / ("cache-" + name)).string()},
-            name + ".log");
+    Child* StartWorker(const std::string& name, int threads = 1,
+                       const std::vector<std::string>& more_args = {}) {
+        std::vector<std::string> argv = {std::string(LF_BIN_DIR) + "/lightfarm-worker",
+                                         "--server",
+                                         address_,
+                                         "--threads",
+                                         std::to_string(threads),
+                                         "--cache-dir",
+                                         (dir_ / ("cache-" + name)).string()};
+        argv.insert(argv.end(), more_args.begin(), more_args.end());
+        return Spawn(argv, name + ".log");
     }
 
     Child* Spawn(const std::vector<std::string>& argv, const std::string& log) {
@@ -516,6 +523,60 @@ TEST_F(Farm, WorkersAndTasksNameTwoWorkersOfOneHostAlike) {
 // JSON with --json; `lightfarm tasks` lists them. A task failing on its worker (its scene's
 // blob gone from the server) fails the job naming the task and its error, and --follow prints
 // the error lines until the job ends.
+// Pools and worker control (issue 30): a job tagged gpu renders on the gpu worker alone; a
+// disabled worker stays disabled across a server restart, and the other renders everything.
+TEST_F(Farm, TaggedJobGoesToTheTaggedWorkerAndDisableSurvivesARestart) {
+    StartServer();
+    StartWorker("cpu", 1, {"--name", "cpu"});
+    StartWorker("gpu", 1, {"--name", "gpu", "--tags", "gpu,linux"});
+    // The worker of each name, once both are listed.
+    const auto ids = [&] {
+        std::map<std::string, std::string> by_name;
+        for (int i = 0; i < 500 && by_name.size() < 2; ++i) {
+            by_name.clear();
+            for (const nlohmann::json& w : JsonLines(Farmctl("workers --json").out)) {
+                if (w.value("state", "") != "OFFLINE") by_name[w["name"]] = w["id"];
+            }
+            std::this_thread::sleep_for(milliseconds(20));
+        }
+        return by_name;
+    };
+    std::map<std::string, std::string> workers = ids();
+    ASSERT_EQ(workers.size(), 2u);
+    const CliRun table = Farmctl("workers");
+    EXPECT_NE(table.out.find(" gpu,linux "), std::string::npos) << table.out;
+
+    const std::string tagged = Submit(scene_, "--spp 2 --tile 16 --tags gpu --max-workers 1");
+    ASSERT_EQ(Farmctl("watch " + tagged).status, 0);
+    for (const nlohmann::json& task : JsonLines(Farmctl("tasks --json " + tagged).out)) {
+        EXPECT_EQ(task["worker"], workers["gpu"]);
+    }
+    const CliRun status = Farmctl("status " + tagged);
+    EXPECT_NE(status.out.find("workers   tags gpu, at most 1"), std::string::npos) << status.out;
+
+    const CliRun disable = Farmctl("workers disable gpu");
+    ASSERT_EQ(disable.status, 0) << disable.err;
+    EXPECT_NE(disable.out.find("disabled"), std::string::npos) << disable.out;
+    server_->Signal(SIGTERM);
+    ASSERT_EQ(server_->Wait(milliseconds(5000)), std::optional<int>(0));
+    const std::string address = address_;
+    StartServer(10, address);
+    ASSERT_EQ(address_, address);
+    workers = ids();
+    ASSERT_EQ(workers.size(), 2u);
+    for (const nlohmann::json& w : JsonLines(Farmctl("workers --json").out)) {
+        if (w["name"] == "gpu") EXPECT_EQ(w["state"], "DISABLED") << w.dump();
+    }
+    const std::string plain = Submit(scene_, "--spp 2 --tile 16");
+    ASSERT_EQ(Farmctl("watch " + plain).status, 0);
+    for (const nlohmann::json& task : JsonLines(Farmctl("tasks --json " + plain).out)) {
+        EXPECT_EQ(task["worker"], workers["cpu"]) << "the disabled worker takes nothing";
+    }
+    EXPECT_EQ(Farmctl("workers enable gpu").status, 0);
+    EXPECT_NE(Farmctl("workers disable nobody").err.find("no worker named nobody"),
+              std::string::npos);
+}
+
 TEST_F(Farm, LogsAndTasksShowWhatEachTaskDidAndWhyOneFailed) {
     StartServer();
     Child* worker = StartWorker("w1");

@@ -174,6 +174,8 @@ void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {
     out->set_priority(spec.priority);
     out->set_name(spec.name);
     out->set_request_id(spec.request_id);
+    for (const std::string& tag : spec.tags) out->add_tags(tag);
+    out->set_max_workers(spec.max_workers);
 }
 
 JobSpec FromProto(const pb::SubmitJobRequest& r) {
@@ -184,6 +186,8 @@ JobSpec FromProto(const pb::SubmitJobRequest& r) {
     for (const pb::SceneFile& f : r.files()) spec.files.push_back(FromProto(f));
     FromProto(r.params(), &spec);
     spec.priority = r.priority();
+    spec.tags.assign(r.tags().begin(), r.tags().end());
+    spec.max_workers = r.max_workers();
     return spec;
 }
 
@@ -252,6 +256,9 @@ void ToProto(const JobRecord& job, pb::Job* out) {
         f->set_tasks_total(frame.tasks_total);
         f->set_done(frame.done);
     }
+    for (const std::string& tag : job.spec.tags) out->add_tags(tag);
+    out->set_max_workers(job.spec.max_workers);
+    out->set_waiting_reason(job.waiting_reason);
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {
@@ -331,15 +338,35 @@ TaskAssignment FromProto(const pb::Task& t) {
     return task;
 }
 
+pb::WorkerInfo::State ToProto(WorkerState state) {
+    switch (state) {
+        case WorkerState::kIdle:
+            return pb::WorkerInfo::IDLE;
+        case WorkerState::kBusy:
+            return pb::WorkerInfo::BUSY;
+        case WorkerState::kDisabled:
+            return pb::WorkerInfo::DISABLED;
+        case WorkerState::kDraining:
+            return pb::WorkerInfo::DRAINING;
+        case WorkerState::kDrained:
+            return pb::WorkerInfo::DRAINED;
+        case WorkerState::kOffline:
+            return pb::WorkerInfo::OFFLINE;
+    }
+    return pb::WorkerInfo::STATE_UNSPECIFIED;
+}
+
 void ToProto(const WorkerStatus& worker, pb::WorkerInfo* out) {
     out->set_id(worker.id);
     out->set_name(worker.name);
     out->set_address(worker.address);
     out->set_version(worker.version);
-    out->set_state(worker.busy() ? pb::WorkerInfo::BUSY : pb::WorkerInfo::IDLE);
+    out->set_state(ToProto(StateOf(worker)));
     out->set_job_id(worker.job_id);
     out->set_task_index(worker.task);
     out->set_seconds_since_seen(absl::ToDoubleSeconds(worker.since_seen));
+    for (const std::string& tag : worker.tags) out->add_tags(tag);
+    out->set_last_seen_unix_ms(absl::ToUnixMillis(worker.last_seen));
 }
 
 namespace {

@@ -34,6 +34,8 @@ void ToProto(const JobSpec& spec, pb::StoredJobSpec* out) {
     out->set_scene_hash(spec.scene_hash);
     out->set_request_id(spec.request_id);
     out->set_owner(spec.owner);
+    for (const std::string& tag : spec.tags) out->add_tags(tag);
+    out->set_max_workers(spec.max_workers);
 }
 
 JobSpec FromProto(const pb::StoredJobSpec& s) {
@@ -48,6 +50,8 @@ JobSpec FromProto(const pb::StoredJobSpec& s) {
     spec.scene_hash = s.scene_hash();
     spec.request_id = s.request_id();
     spec.owner = s.owner();
+    spec.tags.assign(s.tags().begin(), s.tags().end());
+    spec.max_workers = s.max_workers();
     return spec;
 }
 

@@ -15,6 +15,7 @@
 #include "lf/core/plural.h"
 #include "lf/core/stop_signals.h"
 #include "lf/job/worker_status.h"
+#include "lf/job/worker_tags.h"
 #include "lf/proto/channel_flags.h"
 #include "lf/version.h"
 #include "lf/worker/worker.h"
@@ -43,6 +44,14 @@ int main(int argc, char** argv) {
             return n.size() <= lf::kMaxWorkerNameBytes
                        ? std::string()
                        : absl::StrCat("at most ", lf::kMaxWorkerNameBytes, " bytes");
+        });
+    std::string tags;
+    app.add_option("--tags", tags,
+                   "comma-separated tags of this worker (gpu,big-memory: each [a-z0-9_-]{1,32}, at "
+                   "most 32); it takes only jobs whose every tag it has (submit --tags)")
+        ->check([](const std::string& list) {
+            const absl::StatusOr<std::vector<std::string>> parsed = lf::ParseTags(list, "--tags");
+            return parsed.ok() ? std::string() : std::string(parsed.status().message());
         });
     bool check_config = false;
     app.add_flag("--check-config", check_config,
@@ -88,6 +97,7 @@ int main(int argc, char** argv) {
     absl::StatusOr<std::unique_ptr<lf::ServerConnection>> connection =
         lf::ServerConnection::Open(channel, id, name);
     if (!connection.ok()) return fail(connection.status());
+    (*connection)->set_tags(*lf::ParseTags(tags, "--tags"));  // checked by the flag
     if (check_config) {
         std::printf("config ok\n");
         return 0;

@@ -52,6 +52,7 @@ absl::StatusOr<std::optional<TaskAssignment>> ServerConnection::Lease(absl::Dura
     req.set_wait_ms(int(absl::ToInt64Milliseconds(wait)));
     req.set_version(kBuildVersion);
     req.set_name(name_);
+    for (const std::string& tag : tags_) req.add_tags(tag);
     pb::LeaseTaskResponse resp;
     // Waiting for the connection (rather than failing at once while the channel is in
     // backoff) is what makes the channel reconnect as soon as a restarted server listens.

@@ -85,6 +85,9 @@ class Job:
     tasks_leased: int
     last_error: str
     owner: str
+    tags: Tuple[str, ...]  # only workers having every one take it; () any worker
+    max_workers: int       # at most this many workers at once; 0 no cap
+    waiting_reason: str    # why no worker takes it, e.g. "waiting for a worker with tags gpu"
     proto: pb.Job = dataclasses.field(repr=False, compare=False)
 
     @property
@@ -106,8 +109,8 @@ class Job:
     @classmethod
     def from_proto(cls, m: pb.Job) -> "Job":
         values = {f.name: getattr(m, f.name) for f in dataclasses.fields(cls)
-                  if f.name not in ("state", "proto")}
-        return cls(state=JobState(m.state), proto=m, **values)
+                  if f.name not in ("state", "proto", "tags")}
+        return cls(state=JobState(m.state), proto=m, tags=tuple(m.tags), **values)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -136,7 +139,8 @@ class Progress:
 
 @dataclasses.dataclass(frozen=True)
 class Worker:
-    """A worker the server heard from within a lease (lightfarm.v1.WorkerInfo)."""
+    """A worker the server knows (lightfarm.v1.WorkerInfo): heard from within a lease, or
+    offline (silent, listed until the server's --forget-workers-after)."""
     id: str
     name: str
     address: str
@@ -145,11 +149,17 @@ class Worker:
     job_id: str
     task_index: int
     seconds_since_seen: float
+    tags: Tuple[str, ...]  # lightfarm-worker --tags
+    # "idle", "busy", "disabled", "draining", "drained" or "offline"
+    state: str
+    last_seen_unix_ms: int
 
     @classmethod
     def from_proto(cls, m: pb.WorkerInfo) -> "Worker":
-        return cls(m.id, m.name, m.address, m.version, m.state == pb.WorkerInfo.BUSY, m.job_id,
-                   m.task_index, m.seconds_since_seen)
+        # Busy: holds a task, whatever else it is (a disabled or draining worker's task goes on).
+        return cls(m.id, m.name, m.address, m.version, bool(m.job_id), m.job_id, m.task_index,
+                   m.seconds_since_seen, tuple(m.tags),
+                   pb.WorkerInfo.State.Name(m.state).lower(), m.last_seen_unix_ms)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -369,6 +379,19 @@ class Client:
         resp = self._unary("ListWorkers", pb.ListWorkersRequest())
         return [Worker.from_proto(w) for w in resp.workers]
 
+    def set_worker_state(self, name: str, state: str) -> List[Worker]:
+        """Admins: ``state`` "disable" (no new task; the current one goes on), "drain" (finish
+        the current task, then none) or "enable" the workers named ``name`` (or the one whose id
+        it is). Kept by name across server restarts. Returns those workers in their new state."""
+        controls = {"enable": pb.SetWorkerStateRequest.ENABLE,
+                    "disable": pb.SetWorkerStateRequest.DISABLE,
+                    "drain": pb.SetWorkerStateRequest.DRAIN}
+        if state not in controls:
+            raise InvalidArgument(f"state {state!r}: expected one of enable, disable, drain")
+        resp = self._unary("SetWorkerState",
+                           pb.SetWorkerStateRequest(worker=name, control=controls[state]))
+        return [Worker.from_proto(w) for w in resp.workers]
+
     def tasks(self, job_id: str) -> List[Task]:
         """The job's tasks: as the scheduler holds them now, or as recorded for an ended job."""
         resp = self._unary("ListTasks", pb.ListTasksRequest(job_id=job_id))
@@ -486,7 +509,8 @@ class Client:
                tolerance: float = 1e-4, max_iterations: int = 10000, display: str = "smooth",
                sweep_tasks: int = 8, max_patches: int = 0,
                photons_per_pass: int = 1 << 18, initial_radius: float = 0.0,
-               alpha: float = 2.0 / 3.0, request_id: Optional[str] = None) -> str:
+               alpha: float = 2.0 / 3.0, request_id: Optional[str] = None,
+               tags: Sequence[str] = (), max_workers: int = 0) -> str:
         """Uploads the scene and every file it names (those the server lacks, resuming a broken
         upload) and queues it as a job; returns the job id.
 
@@ -500,7 +524,9 @@ class Client:
         ``target_error``, ``time_limit`` (seconds) and ``max_spp``; radiosity's ``patches``,
         ``patch_size``, ``solver``, ``tolerance``, ``max_iterations``, ``display``,
         ``sweep_tasks``, ``max_patches``; photon mapping's ``photons_per_pass``,
-        ``initial_radius``, ``alpha``. The server checks them all and the scene (InvalidArgument
+        ``initial_radius``, ``alpha``; ``tags`` (only workers having every one take the job)
+        and ``max_workers`` (at most this many workers at once, 0 no cap). The server checks
+        them all and the scene (InvalidArgument
         with the loader's message). ``request_id`` makes retries idempotent (default: 128
         random bits, the same on every retry of this call).
         """
@@ -540,7 +566,8 @@ class Client:
         req = pb.SubmitJobRequest(
             scene=ref(scene_name, text), files=[ref(n, d) for n, d in named], params=params,
             priority=priority, name=name or scene_name,
-            request_id=request_id or secrets.token_hex(16))
+            request_id=request_id or secrets.token_hex(16), tags=list(tags),
+            max_workers=max_workers)
         files = [req.scene] + list(req.files)
 
         backoff = _Backoff(self.retry_seconds)

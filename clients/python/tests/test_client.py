@@ -101,12 +101,13 @@ class Farm:
         if not line.startswith("listening on "):
             raise RuntimeError(f"server did not start: {line!r} {self.log('server')}")
         self.address = line[len("listening on "):]
-        for name in ("w1", "w2"):
+        # w2 alone has the tag "gpu" (test_tags).
+        for name, tags in (("w1", ""), ("w2", "gpu")):
             self.spawn(name, [
                 self.bin("lightfarm-worker"), "--server", self.address, "--tls-ca",
                 self.path("ca.crt"), "--token-file", self.path("node.token"), "--name", name,
                 "--threads", "1", "--cache-dir", self.path("cache-" + name), "--log-level",
-                "warn"])
+                "warn", "--tags", tags])
 
     def path(self, *names):
         return os.path.join(self.dir, *names)
@@ -544,6 +545,42 @@ class ClientTest(unittest.TestCase):
     def test_workers(self):
         names = sorted(w.name for w in self.alice.workers())
         self.assertEqual(names, ["w1", "w2"])
+
+    def test_tags(self):
+        """A job tagged gpu goes to w2 alone; one tagged with what no worker has says so."""
+        self.assertEqual({w.name: w.tags for w in self.alice.workers()},
+                         {"w1": (), "w2": ("gpu",)})
+        job_id = self.alice.submit(cornell(), tags=["gpu"], max_workers=1, **SMALL)
+        job = self.alice.wait(job_id)
+        self.assertEqual(job.state, lightfarm.JobState.SUCCEEDED, job.error)
+        self.assertEqual((job.tags, job.max_workers), (("gpu",), 1))
+        self.assertEqual({t.worker for t in self.alice.tasks(job_id)},
+                         {w.id for w in self.alice.workers() if w.name == "w2"})
+        stuck = self.alice.submit(cornell(), tags=["tpu"], **SMALL)
+        try:
+            self.assertEqual(self.alice.get(stuck).waiting_reason,
+                             "waiting for a worker with tags tpu")
+        finally:
+            self.alice.cancel(stuck)
+        with self.assertRaises(lightfarm.InvalidArgument):
+            self.alice.submit(cornell(), tags=["No Spaces"], **SMALL)
+
+    def test_set_worker_state(self):
+        """An admin disables w1 (it then takes nothing) and enables it again; a submitter may not."""
+        with self.assertRaises(lightfarm.PermissionDenied):
+            self.alice.set_worker_state("w1", "disable")
+        with self.farm.client("root") as root:
+            try:
+                (w1,) = root.set_worker_state("w1", "disable")
+                self.assertEqual((w1.name, w1.state), ("w1", "disabled"))
+                job = self.alice.wait(self.alice.submit(cornell(), **SMALL))
+                self.assertEqual(job.state, lightfarm.JobState.SUCCEEDED, job.error)
+                self.assertNotIn(w1.id, {t.worker for t in self.alice.tasks(job.id)})
+            finally:
+                (w1,) = root.set_worker_state("w1", "enable")
+            self.assertIn(w1.state, ("idle", "busy"))
+            with self.assertRaises(lightfarm.NotFound):
+                root.set_worker_state("nobody", "drain")
 
     def test_tasks_logs_priority(self):
         """SetJobPriority on a running job, then ListTasks and GetTaskLogs of the ended job."""

@@ -11,9 +11,10 @@
 namespace lf {
 namespace {
 
-constexpr Action kAllActions[] = {Action::kUploadBlobs, Action::kSubmit,      Action::kReadJobs,
-                                  Action::kCancelJob,   Action::kSetPriority, Action::kDeleteJob,
-                                  Action::kListWorkers, Action::kWork};
+constexpr Action kAllActions[] = {
+    Action::kUploadBlobs, Action::kSubmit,      Action::kReadJobs,
+    Action::kCancelJob,   Action::kSetPriority, Action::kDeleteJob,
+    Action::kListWorkers, Action::kWork,        Action::kManageWorkers};
 
 TEST(Permit, AdminMayDoEverything) {
     for (Action a : kAllActions) EXPECT_TRUE(Permit({"root", Role::kAdmin}, a).ok());
@@ -32,10 +33,14 @@ TEST(Permit, WorkerMayOnlyWork) {
     }
 }
 
-TEST(Permit, SubmitterMayDoAllButWork) {
+TEST(Permit, SubmitterMayDoAllButWorkAndManageWorkers) {
     const Caller alice{"alice", Role::kSubmitter};
-    for (Action a : kAllActions) EXPECT_EQ(Permit(alice, a).ok(), a != Action::kWork);
+    for (Action a : kAllActions) {
+        EXPECT_EQ(Permit(alice, a).ok(), a != Action::kWork && a != Action::kManageWorkers);
+    }
     EXPECT_TRUE(absl::StrContains(Permit(alice, Action::kWork).message(), "lease and render"));
+    EXPECT_TRUE(absl::StrContains(Permit(alice, Action::kManageWorkers).message(),
+                                  "disable, enable or drain workers"));
 }
 
 TEST(MaySee, SubmittersSeeTheirOwnJobsAdminsAllWorkersNone) {

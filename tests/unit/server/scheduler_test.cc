@@ -146,9 +146,15 @@ TEST_F(SchedulerTest, WorkersShowTheirTaskWhileLeasedAndGoWhenSilent) {
     EXPECT_EQ(scheduler_.Load().workers_busy, 0);
     EXPECT_EQ(scheduler_.Load().workers_live, 1);
 
-    now_ += absl::Seconds(10);  // silent for a lease: forgotten
-    EXPECT_TRUE(scheduler_.Workers().empty());
+    // Silent for a lease: no longer live, listed as offline (issue 30) until
+    // forget_workers_after, then forgotten.
+    now_ += absl::Seconds(10);
+    workers = scheduler_.Workers();
+    ASSERT_EQ(workers.size(), 1u);
+    EXPECT_TRUE(workers[0].offline);
     EXPECT_EQ(scheduler_.Load().workers_live, 0);
+    now_ += SchedulerOptions{}.forget_workers_after;
+    EXPECT_TRUE(scheduler_.Workers().empty());
 }
 
 TEST_F(SchedulerTest, RetriedTaskGoesToAnotherWorkerWhenThereIsOne) {

@@ -34,6 +34,9 @@ struct JobRecord {
     // A shot's frames in frame order (none for a still); a frame's EXR stays fetchable whatever
     // the job ends as.
     std::vector<FrameProgress> frames;
+    // Why a queued or running job has tasks no worker takes, when the scheduler knows ("waiting
+    // for a worker with tags gpu"); set as the job is read, never stored.
+    std::string waiting_reason;
     int frames_done() const;
 };
 

@@ -12,12 +12,12 @@
 #include "absl/status/status.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/splat_settings.h"
 #include "lf/job/method_registry.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
 #include "lf/job/settings.h"
 #include "lf/job/shot.h"
+#include "lf/job/splat_settings.h"
 
 namespace lf {
 
@@ -46,6 +46,9 @@ struct JobSpec {
     // The name of the token that submitted it (the server sets it, never the client); "" when
     // the server ran without authentication. A submitter token sees only its own jobs.
     std::string owner;
+    // Leased only to workers having every one of these tags (lf/job/worker_tags.h); none: any.
+    std::vector<std::string> tags;
+    int max_workers = 0;  // distinct workers holding its leases at once; 0: no cap
 };
 
 // The limits of a job's settings, one list for the CLI's flags (`render`, `submit`) and the

@@ -23,12 +23,13 @@ namespace lf {
 enum class Action {
     kUploadBlobs,  // MissingBlobs, UploadBlob
     kSubmit,
-    kReadJobs,     // GetJob, ListJobs, WatchJob, FetchResult: own jobs, or all for an admin
-    kCancelJob,    // own jobs, or all for an admin
-    kSetPriority,  // own jobs, or all for an admin
-    kDeleteJob,    // own jobs, or all for an admin
-    kListWorkers,  // the farm's workers: admins and submitters
-    kWork,         // LeaseTask, Heartbeat, CompleteTask, FailTask, FetchBlob
+    kReadJobs,       // GetJob, ListJobs, WatchJob, FetchResult: own jobs, or all for an admin
+    kCancelJob,      // own jobs, or all for an admin
+    kSetPriority,    // own jobs, or all for an admin
+    kDeleteJob,      // own jobs, or all for an admin
+    kListWorkers,    // the farm's workers: admins and submitters
+    kWork,           // LeaseTask, Heartbeat, CompleteTask, FailTask, FetchBlob
+    kManageWorkers,  // SetWorkerState: admins only
 };
 const char* ActionName(Action action);
 

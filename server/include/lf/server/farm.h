@@ -17,10 +17,12 @@
 #include "lf/job/render_metadata.h"
 #include "lf/job/task_status.h"
 #include "lf/server/blob_store.h"
+#include "lf/server/job_notifier.h"
 #include "lf/server/job_store.h"
 #include "lf/server/scheduler.h"
 #include "lf/server/sqlite_job_store.h"
 #include "lf/server/task_log_store.h"
+#include "lf/server/worker_state_store.h"
 
 namespace lf {
 
@@ -45,12 +47,16 @@ constexpr absl::Duration kPartialUploadLifetime = absl::Hours(24);
 constexpr int kMaxTaskLogPage = 1000;
 
 struct FarmOptions {
-    std::string data_dir;  // jobs.db, logs.db, blobs/, results/, previews/, scratch/ go here
+    std::string data_dir;  // jobs.db, logs.db, workers.db, blobs/, results/, previews/, scratch/
     SchedulerOptions scheduler;
     TaskLogLimits task_logs;
     JobLimits limits;
     // Ended jobs older than this are deleted (see DeleteExpired); zero keeps them forever.
     absl::Duration retention = absl::ZeroDuration();
+    // lightfarm-server --notify-url: where each ended job is POSTed (lf/server/job_notifier.h);
+    // "" for nowhere.
+    std::string notify_url;
+    JobNotifierOptions notify;
 };
 
 class Farm {
@@ -135,6 +141,12 @@ class Farm {
     // A queued or running job's new priority; FailedPrecondition once it has ended.
     absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
 
+    // Worker control (issue 30): disables, enables or drains the workers of a name, or the one of
+    // an id (Scheduler::WorkerKey), durably (workers.db) before it takes effect. Returns the
+    // workers of that name known now; NotFound naming `name_or_id` for a worker never heard of.
+    absl::StatusOr<std::vector<WorkerStatus>> SetWorkerState(const std::string& name_or_id,
+                                                             WorkerControl control);
+
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }
     const SqliteJobStore& store() const { return *store_; }
@@ -182,6 +194,8 @@ class Farm {
     std::shared_mutex blob_users_;
     std::unique_ptr<SqliteJobStore> store_;
     std::unique_ptr<TaskLogStore> logs_;
+    std::unique_ptr<WorkerStateStore> worker_states_;  // set by Open
+    std::unique_ptr<JobNotifier> notifier_;            // set by Open, with a notify_url
     Scheduler scheduler_;
     std::mutex image_mutex_;
     std::map<std::string, int> previewed_;  // tasks done at each running job's last preview

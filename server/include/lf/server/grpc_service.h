@@ -64,6 +64,10 @@ class JobServiceImpl final : public ReadAfterAuth<lightfarm::v1::JobService::Ser
                            const lightfarm::v1::CancelJobRequest&, lightfarm::v1::Job*);
     grpc::Status SetJobPriority(grpc::ServerContext*, const Caller&,
                                 const lightfarm::v1::SetJobPriorityRequest&, lightfarm::v1::Job*);
+    // Worker management and stats (issue 30)
+    grpc::Status SetWorkerState(grpc::ServerContext*, const Caller&,
+                                const lightfarm::v1::SetWorkerStateRequest&,
+                                lightfarm::v1::SetWorkerStateResponse*);
     grpc::Status FetchResult(grpc::ServerContext*, const Caller&,
                              const lightfarm::v1::FetchResultRequest&,
                              const std::function<bool(const lightfarm::v1::Chunk&)>&);

@@ -9,6 +9,7 @@
 
 #include <functional>
 #include <map>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -68,6 +69,8 @@ class LeaseTable {
     size_t current_count() const { return deadlines_.size(); }
     // Current leases held by workers of `principal` (PrincipalOf their id).
     int CurrentOf(const std::string& principal) const;
+    // The workers holding current leases of the job (its max_workers cap counts them).
+    std::set<std::string> WorkersOf(const std::string& job_id) const;
 
   private:
     using Deadlines = std::multimap<absl::Time, std::string>;

@@ -61,6 +61,9 @@ struct SchedulerOptions {
     // A worker whose leases expire unheard WorkerRegistry::kAbandonedInARow times in a row gets
     // no lease for this many leases' time.
     int quarantine_leases = 10;
+    // A worker silent for a lease is listed as offline (Workers) until this long after it was
+    // last seen (lightfarm-server --forget-workers-after).
+    absl::Duration forget_workers_after = absl::Hours(1);
 };
 
 // Counted as the scheduler works; read by /metrics at any time, without the scheduler's lock.
@@ -244,6 +247,14 @@ class Scheduler {
     // holds a current lease of.
     std::vector<WorkerStatus> Workers();
     SchedulerLoad Load();
+
+    // Worker control (lightfarm workers enable|disable|drain), kept by worker name: the name a
+    // worker known now (live or offline) goes by when `name_or_id` is its id or its name, or a
+    // name with a control set before; nullopt otherwise. A worker without a name is kept by id.
+    std::optional<std::string> WorkerKey(const std::string& name_or_id);
+    // Sets the control of the workers named `key` (a WorkerKey): those disabled or draining
+    // lease nothing new from now on; a task they hold runs to its end.
+    void SetWorkerControl(const std::string& key, WorkerControl control);
     const SchedulerMetrics& metrics() const { return metrics_; }
 
   private:
@@ -286,6 +297,12 @@ class Scheduler {
     // live worker waits for it, and a task that failed on `worker` waits for a live worker it has
     // not failed on, while there is one.
     bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;
+    // Whether the job goes to `worker`, which has `tags`: the worker has every tag of the job,
+    // and the job's max_workers cap leaves it room (or the worker already holds a lease of it).
+    bool Admits(const Job& job, const std::string& worker,
+                const std::vector<std::string>& tags) const;
+    // The job's record as a reader sees it: with its waiting_reason.
+    JobRecord ReadRecord(const Job& job, absl::Time now) const;
     // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).
     absl::StatusOr<LeaseRef> ResultLease(const std::string& lease_id, const std::string& worker,
                                          absl::Time now);
@@ -327,6 +344,9 @@ class Scheduler {
     TasksEnded tasks_ended_;
     LeaseTable leases_;
     WorkerRegistry workers_;
+    std::map<std::string, WorkerControl> controls_;  // by WorkerKey; none: enabled
+    // The control of the worker `id` described as `about`.
+    WorkerControl ControlOf(const std::string& id, const WorkerDescription& about) const;
     SchedulerMetrics metrics_;
 };
 

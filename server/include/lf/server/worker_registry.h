@@ -13,22 +13,31 @@
 namespace lf {
 
 struct WorkerDescription {
-    std::string name;     // lightfarm-worker --name, by default its host name
-    std::string address;  // the peer of its last lease request, as gRPC names it
-    std::string version;  // its build (lf::kBuildVersion)
+    std::string name;               // lightfarm-worker --name, by default its host name
+    std::string address;            // the peer of its last lease request, as gRPC names it
+    std::string version;            // its build (lf::kBuildVersion)
+    std::vector<std::string> tags;  // lightfarm-worker --tags (lf/job/worker_tags.h)
 };
 
 class WorkerRegistry {
   public:
-    // A worker is live while it was seen less than `alive_for` ago (the lease).
-    explicit WorkerRegistry(absl::Duration alive_for) : alive_for_(alive_for) {}
+    // A worker is live while it was seen less than `alive_for` ago (the lease); a silent one is
+    // kept as offline (Offline) until `forget_after` since it was last seen.
+    explicit WorkerRegistry(absl::Duration alive_for,
+                            absl::Duration forget_after = absl::ZeroDuration())
+        : alive_for_(alive_for), forget_after_(forget_after) {}
 
     // `about`, when given, replaces what the worker said of itself before.
     void Seen(const std::string& worker, absl::Time now, const WorkerDescription* about = nullptr);
-    // Forgets the workers not seen for `alive_for` by `now`; returns how many.
+    // Moves the workers not seen for `alive_for` by `now` to the offline ones, and forgets the
+    // offline ones not seen for `forget_after`; returns how many fell silent.
     int ForgetSilent(absl::Time now);
 
     bool IsLive(const std::string& worker, absl::Time now) const;
+    // What the worker said of itself at its last lease request; nullptr for one not kept.
+    const WorkerDescription* AboutOf(const std::string& worker) const;
+    // Whether some live worker has every one of `tags`.
+    bool AnyLiveHas(const std::vector<std::string>& tags, absl::Time now) const;
 
     // A lease of the worker expired before any heartbeat for it: after kAbandonedInARow such in a
     // row the worker is quarantined (it gets no lease) until `now + quarantine`. Returns whether
@@ -49,6 +58,11 @@ class WorkerRegistry {
     };
     // The workers kept, by id.
     std::vector<Entry> List() const;
+    // The silent workers not yet forgotten, by id (quarantined_until unset).
+    std::vector<Entry> Offline() const;
+    // Past this many offline workers the longest silent is forgotten first: ids a client makes
+    // up cost bounded memory.
+    static constexpr size_t kMaxOffline = 4096;
 
   private:
     using BySeen = std::multimap<absl::Time, std::string>;
@@ -65,7 +79,15 @@ class WorkerRegistry {
     };
     std::map<std::string, Strikes> strikes_;
     const absl::Duration alive_for_;
+    const absl::Duration forget_after_;
     BySeen by_seen_;
+    // The offline workers, by id and by when each was last seen (the oldest go first).
+    struct Gone {
+        WorkerDescription about;
+        BySeen::iterator seen;
+    };
+    BySeen offline_by_seen_;
+    std::map<std::string, Gone> offline_;
     std::map<std::string, Kept> by_worker_;
 };
 

@@ -38,6 +38,7 @@ void ToProto(const JobRecord& job, lightfarm::v1::Job* out);
 void ToProto(const TaskAssignment& task, lightfarm::v1::Task* out);
 TaskAssignment FromProto(const lightfarm::v1::Task& task);
 
+lightfarm::v1::WorkerInfo::State ToProto(WorkerState state);
 void ToProto(const WorkerStatus& worker, lightfarm::v1::WorkerInfo* out);
 
 void ToProto(const TaskStatus& task, lightfarm::v1::TaskInfo* out);

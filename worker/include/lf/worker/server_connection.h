@@ -27,6 +27,9 @@ class ServerConnection {
     ~ServerConnection();
 
     const std::string& worker_id() const { return worker_id_; }
+    // Sent with every lease request: the server leases only jobs whose tags the worker all has
+    // (lightfarm-worker --tags, checked by lf::CheckTags).
+    void set_tags(std::vector<std::string> tags) { tags_ = std::move(tags); }
 
     // Waits up to `wait` for work; nullopt: none.
     absl::StatusOr<std::optional<TaskAssignment>> Lease(absl::Duration wait);
@@ -61,6 +64,7 @@ class ServerConnection {
     ServerConnection(std::string worker_id, std::string name);
     std::string worker_id_;
     std::string name_;
+    std::vector<std::string> tags_;
     struct Stub;  // keeps gRPC headers out of the worker's other files
     std::unique_ptr<Stub> stub_;
 };

@@ -1,0 +1,119 @@
+#include "lf/server/job_notifier.h"
+
+#include <httplib.h>
+
+#include <nlohmann/json.hpp>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "lf/core/log.h"
+
+namespace lf {
+
+namespace {
+
+std::shared_ptr<spdlog::logger> Log() { return NamedLogger("notify"); }
+
+std::string Rfc3339(absl::Time t) {
+    if (t == absl::InfinitePast()) return "";
+    return absl::FormatTime("%Y-%m-%dT%H:%M:%SZ", t, absl::UTCTimeZone());
+}
+
+}  // namespace
+
+std::string JobEndedJson(const JobRecord& job) {
+    return nlohmann::json{{"job_id", job.id},
+                          {"name", job.spec.name},
+                          {"owner", job.spec.owner},
+                          {"state", JobStateName(job.state)},
+                          {"error", job.error},
+                          {"submitted", Rfc3339(job.submitted)},
+                          {"started", Rfc3339(job.started)},
+                          {"finished", Rfc3339(job.finished)}}
+        .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+absl::StatusOr<std::unique_ptr<JobNotifier>> JobNotifier::Start(const std::string& url,
+                                                                JobNotifierOptions options) {
+    const bool http = absl::StartsWith(url, "http://"), https = absl::StartsWith(url, "https://");
+    const size_t host_at = http ? 7 : 8;
+    const size_t path_at = url.find('/', host_at);
+    if ((!http && !https) || url.size() == host_at || path_at == host_at ||
+        url.find_first_of(" \t\r\n") != std::string::npos) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--notify-url ", LogSafe(url, 256),
+                         ": expected http://HOST[:PORT][/PATH] or https://"));
+    }
+    std::string origin = url.substr(0, path_at);
+    std::string path = path_at == std::string::npos ? "/" : url.substr(path_at);
+    return std::unique_ptr<JobNotifier>(
+        new JobNotifier(std::move(origin), std::move(path), options));
+}
+
+JobNotifier::JobNotifier(std::string origin, std::string path, JobNotifierOptions options)
+    : origin_(std::move(origin)), path_(std::move(path)), options_(options) {
+    thread_ = std::thread([this] { Run(); });
+}
+
+JobNotifier::~JobNotifier() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        stopping_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+}
+
+void JobNotifier::JobEnded(const JobRecord& job) {
+    std::string body = JobEndedJson(job);
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (queue_.size() >= options_.max_queued) {
+            Log()->warn("notify: {} notifications queued for {}: job={}'s dropped",
+                        options_.max_queued, origin_, queue_.front().first);
+            queue_.pop_front();
+        }
+        queue_.emplace_back(job.id, std::move(body));
+    }
+    wake_.notify_all();
+}
+
+void JobNotifier::Run() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (true) {
+        wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+        if (stopping_) return;
+        auto [job_id, body] = std::move(queue_.front());
+        queue_.pop_front();
+        lock.unlock();
+        const bool going_on = Post(job_id, body);
+        lock.lock();
+        if (!going_on) return;
+    }
+}
+
+bool JobNotifier::Post(const std::string& job_id, const std::string& body) {
+    httplib::Client client(origin_);
+    const int64_t timeout_us = absl::ToInt64Microseconds(options_.timeout);
+    client.set_connection_timeout(0, timeout_us);
+    client.set_read_timeout(0, timeout_us);
+    client.set_write_timeout(0, timeout_us);
+    absl::Duration wait = options_.first_retry;
+    std::string why;
+    for (int attempt = 1; attempt <= options_.attempts; ++attempt) {
+        const httplib::Result answer = client.Post(path_, body, "application/json");
+        if (answer && answer->status >= 200 && answer->status < 300) return true;
+        why = answer ? absl::StrCat("HTTP ", answer->status) : httplib::to_string(answer.error());
+        if (attempt == options_.attempts) break;
+        std::unique_lock<std::mutex> lock(mutex_);
+        if (wake_.wait_for(lock, absl::ToChronoMilliseconds(wait), [&] { return stopping_; })) {
+            return false;
+        }
+        wait *= 2;
+    }
+    Log()->warn("notify: job={} not notified to {}{} after {} attempts: {}", job_id, origin_,
+                LogSafe(path_, 256), options_.attempts, why);
+    return true;
+}
+
+}  // namespace lf
