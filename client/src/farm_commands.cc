@@ -159,6 +159,13 @@ void PrintJob(const pb::Job& job) {
         std::printf("  last error  %s\n", job.last_error().c_str());
     }
     if (!job.error().empty()) std::printf("  error     %s\n", job.error().c_str());
+    // Job management (issue 30).
+    std::printf("  attempts  %d a task; blocklist after %d failures\n", job.max_attempts(),
+                job.blocklist_after());
+    for (const pb::BlockedWorker& w : job.blocklist()) {
+        std::printf("  blocklisted: %s (%s, last: %s)\n", w.worker().c_str(),
+                    Plural(w.failures(), "failure").c_str(), w.last_error().c_str());
+    }
 }
 
 // The job's EXR at paths.exr, and its preview at paths.png, made here from the EXR (fetched into

@@ -138,6 +138,16 @@ Command AddSubmitCommand(CLI::App& app) {
     cmd->add_option("--priority", o->spec.priority, "higher runs first; equal: oldest first")
         ->capture_default_str();
     cmd->add_option("--name", o->spec.name, "job name (default: the scene file's name)");
+    // Job management (issue 30).
+    cmd->add_option("--max-attempts", o->spec.max_attempts,
+                    "failures of one task that fail the job (docs/farm.md, Managing jobs)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxAttemptsLimit));
+    cmd->add_option("--blocklist-after", o->spec.blocklist_after,
+                    "a worker that fails this many of the job's tasks gets none of them any "
+                    "more; the job fails when every live worker is blocklisted")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxAttemptsLimit));
     cmd->add_option(
            "--method", o->spec.method,
            "path, radiosity (Lambertian scenes; same bits as `lightfarm render "

@@ -36,4 +36,12 @@ int JobRecord::frames_done() const {
     return done;
 }
 
+std::vector<WorkerFailures> JobRecord::Blocklisted() const {
+    std::vector<WorkerFailures> blocked;
+    for (const WorkerFailures& w : worker_failures) {
+        if (w.failures >= spec.blocklist_after) blocked.push_back(w);
+    }
+    return blocked;
+}
+
 }  // namespace lf

@@ -88,6 +88,8 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         CheckPhotonSettings(spec.ppm),
         CheckShotSettings(spec.shot),
         CheckMethodSettings(spec),
+        InRange("max_attempts", spec.max_attempts, 1, kMaxAttemptsLimit),
+        InRange("blocklist_after", spec.blocklist_after, 1, kMaxAttemptsLimit),
     };
     for (const absl::Status& s : checks) {
         if (!s.ok()) return s;

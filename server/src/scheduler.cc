@@ -6,6 +6,8 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_error.h"
 #include "lf/core/log.h"
+#include "lf/core/plural.h"
+#include "lf/server/blocklist.h"
 
 namespace lf {
 
@@ -314,7 +316,12 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
     }
     Job* best = nullptr;
     int best_task = -1;
+    std::vector<std::string> stranded;  // jobs with queued tasks this blocklisted worker asks for
     for (auto& [id, job] : active_) {
+        if (IsBlocklisted(job->record, worker)) {
+            if (!job->states.queued().empty()) stranded.push_back(id);
+            continue;
+        }
         if (best && (job->record.spec.priority < best->record.spec.priority ||
                      (job->record.spec.priority == best->record.spec.priority &&
                       job->record.seq > best->record.seq))) {
@@ -327,6 +334,7 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
             break;
         }
     }
+    for (const std::string& id : stranded) FailIfStranded(*active_.at(id));
     if (best) return Grant(*best, best_task, worker, now);
     for (auto& [id, job] : active_) {
         if (const int t = StragglerFor(*job, worker, now); t >= 0) {
@@ -340,7 +348,7 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
 }
 
 int Scheduler::StragglerFor(const Job& job, const std::string& worker, absl::Time now) const {
-    if (!job.states.queued().empty()) return -1;
+    if (!job.states.queued().empty() || IsBlocklisted(job.record, worker)) return -1;
     int oldest = -1;
     for (int t = 0; t < int(job.tasks.size()); ++t) {
         const ScheduledJob::Task& task = job.tasks[size_t(t)];
@@ -410,7 +418,7 @@ bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::
     if (!task.failed_on.count(worker)) return true;
     // It failed here: it waits for a live worker it has not failed on. Once it has failed on
     // every live worker it is tried again anywhere, so its failures end the job. `failed_on`
-    // holds fewer than max_failures workers, and the workers kept are the live ones.
+    // holds fewer than max_attempts workers, and the workers kept are the live ones.
     size_t live_failed = 0;
     for (const std::string& w : task.failed_on) live_failed += workers_.IsLive(w, now);
     return workers_.size() <= live_failed;
@@ -514,7 +522,7 @@ absl::Status Scheduler::Refuse(const LeaseRef& ref, const std::string& worker,
                                const absl::Status& why) {
     const std::string error = absl::StrCat("job=", ref.job->id(), " task=", ref.lease->task,
                                            " from ", worker, ": ", why.message());
-    if (ref.lease->current) Requeue(ref, absl::StrCat("result refused: ", why.message()), true);
+    if (ref.lease->current) RequeueReported(ref, absl::StrCat("result refused: ", why.message()));
     return absl::InvalidArgumentError(error);
 }
 
@@ -557,8 +565,31 @@ absl::Status Scheduler::Fail(const std::string& lease_id, const std::string& wor
     Locked locked(*this);
     const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
     if (!ref || !ref->lease->current) return absl::OkStatus();
-    Requeue(*ref, absl::StrCat(reason, " (worker ", worker, ")"), kind == FailureKind::kTaskError);
+    const std::string why = absl::StrCat(reason, " (worker ", worker, ")");
+    if (kind == FailureKind::kTaskError) {
+        RequeueReported(*ref, why);
+    } else {
+        Requeue(*ref, why, false);
+    }
     return absl::OkStatus();
+}
+
+void Scheduler::RequeueReported(const LeaseRef& ref, const std::string& reason) {
+    const std::string job_id = ref.job->id(), worker = ref.lease->worker;
+    const bool blocked = CountWorkerFailure(ref.job->record, worker, reason);
+    Requeue(ref, reason, true);  // may end the job
+    auto it = active_.find(job_id);
+    if (!blocked || it == active_.end()) return;
+    Log()->warn("job={} worker {} blocklisted: it failed {} of the job's tasks", job_id,
+                LogSafe(worker), it->second->record.spec.blocklist_after);
+    FailIfStranded(*it->second);
+}
+
+void Scheduler::FailIfStranded(Job& job) {
+    workers_.ForgetSilent(clock_());
+    std::vector<std::string> live;
+    for (const WorkerRegistry::Entry& entry : workers_.List()) live.push_back(entry.id);
+    if (std::optional<std::string> error = StrandedError(job.record, live)) FailJob(job, *error);
 }
 
 void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool counted) {
@@ -576,8 +607,9 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
     }
     Log()->warn("job={} task={} attempt {} failed: {}{}", job.id(), t, attempt, LogSafe(reason),
                 counted ? "" : " (not counted)");
-    if (task.failures >= options_.max_failures) {
-        FailJob(job, absl::StrCat("task ", t, " failed ", task.failures, " times; last: ", reason));
+    if (task.failures >= job.record.spec.max_attempts) {
+        FailJob(job, absl::StrCat("task ", t, " failed ", Plural(task.failures, "time"),
+                                  "; last: ", reason));
         return;
     }
     // Otherwise another lease of it still renders; or, when several of its leases expired in

@@ -161,7 +161,8 @@ export function mount(root, id, who, frameText) {
         h('td', {}, progress(job.tasks_done, job.tasks_total), job.shot ? ` ${job.shot.frames_done}/${job.shot.frames_total} frames` : ''),
         h('td', {}, time(job.submitted_ms)), h('td', {}, time(job.started_ms)), h('td', {}, time(job.finished_ms)),
         h('td', {}, duration(job.eta_s)))]),
-    h('p', { class: 'error' }, job.error));
+    h('p', { class: 'error' }, job.error),
+    h('p', { class: 'blocklist' }, job.blocklist.map((b) => `blocklisted: ${b.worker} (${b.failures} failures, last: ${b.last_error})`).join('; ')));
     cancel.disabled = ended(job.state);
     setPriority.disabled = ended(job.state);
     if (!editing) priority.value = job.priority;

@@ -149,6 +149,8 @@ std::string ShotScene() {
 }
 constexpr const char* kShotFlags = "--resolution 96x54 --shutter 0.5 --seed 3 --method path";
 
+std::vector<nlohmann::json> JsonLines(const std::string& out);
+
 class Farm : public ::testing::Test {
   protected:
     void SetUp() override {
@@ -195,11 +197,25 @@ class Farm : public ::testing::Test {
         address_ = line.substr(std::strlen("listening on "));
     }
 
-    Child* StartWorker(const std::string& name, int threads = 1) {
-        return Spawn(
-            {std::string(LF_BIN_DIR) + "/lightfarm-worker", "--server", address_, "--threads",
-             std::to_string(threads), "--cache-dir", (dir_ / ("cache-" + name)).string()},
-            name + ".log");
+    Child* StartWorker(const std::string& name, int threads = 1,
+                       const std::vector<std::string>& more_args = {}) {
+        std::vector<std::string> argv = {std::string(LF_BIN_DIR) + "/lightfarm-worker",
+                                         "--server",
+                                         address_,
+                                         "--threads",
+                                         std::to_string(threads),
+                                         "--cache-dir",
+                                         (dir_ / ("cache-" + name)).string()};
+        argv.insert(argv.end(), more_args.begin(), more_args.end());
+        return Spawn(argv, name + ".log");
+    }
+    // Polls `workers` until it lists `count` workers, for at most 10 s.
+    bool WaitForWorkers(size_t count) {
+        for (int i = 0; i < 500; ++i) {
+            if (JsonLines(Farmctl("workers --json").out).size() >= count) return true;
+            std::this_thread::sleep_for(milliseconds(20));
+        }
+        return false;
     }
 
     Child* Spawn(const std::vector<std::string>& argv, const std::string& log) {
@@ -1694,6 +1710,46 @@ TEST(FarmSplatFlags, PhotonFlagsAreRefusedForOtherMethodsOnSubmit) {
     while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
     EXPECT_NE(WEXITSTATUS(pclose(pipe)), 0);
     EXPECT_NE(out.find("--photons"), std::string::npos) << out;
+}
+
+// Job management (issue 30): a worker that fails every task is blocklisted from the job after
+// --blocklist-after of its failures (it cannot fail any one task 3 times: a task it failed waits
+// for the good worker), and the job succeeds on the good worker with the bits of a local render.
+// The blocklist is in the job's record, so it outlives a restart.
+TEST_F(Farm, BrokenWorkerIsBlocklistedAndTheJobSucceedsOnTheGoodOne) {
+    StartServer();
+    StartWorker("good");
+    StartWorker("bad", 1, {"--fail-tasks-for-test"});
+    ASSERT_TRUE(WaitForWorkers(2));
+    const std::string job = Submit(scene_, "--spp 64 --tile 16 --seed 5 --blocklist-after 3");
+    ExpectSameAsLocal(job, scene_, 64, 5);
+    const std::string blocklisted =
+        "(3 failures, last: failing every task (--fail-tasks-for-test) (worker ";
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_NE(status.out.find("  blocklisted: "), std::string::npos) << status.out;
+    EXPECT_NE(status.out.find(blocklisted), std::string::npos) << status.out;
+    EXPECT_NE(status.out.find("attempts  3 a task; blocklist after 3 failures"), std::string::npos)
+        << status.out;
+    EXPECT_EQ(ReadText(dir_ / "good.log").find("failing every task"), std::string::npos);
+    CrashAndRestartServer();
+    EXPECT_NE(Farmctl("status " + job).out.find(blocklisted), std::string::npos);
+}
+
+// With only a broken worker, the job does not wait for ever: once the worker is blocklisted,
+// no live worker may take its tasks and it fails naming the worker.
+TEST_F(Farm, JobFailsWhenItsOnlyWorkerIsBlocklisted) {
+    StartServer();
+    StartWorker("bad", 1, {"--fail-tasks-for-test"});
+    ASSERT_TRUE(WaitForWorkers(1));
+    const std::string job =
+        Submit(scene_, "--spp 1 --tile 16 --max-attempts 10 --blocklist-after 2");
+    EXPECT_NE(Farmctl("watch " + job).status, 0);
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_NE(status.out.find("error     every live worker is blocklisted from the job: "),
+              std::string::npos)
+        << status.out;
+    EXPECT_NE(status.out.find(" (2 failures, last: failing every task"), std::string::npos)
+        << status.out;
 }
 
 }  // namespace

@@ -174,6 +174,8 @@ void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {
     out->set_priority(spec.priority);
     out->set_name(spec.name);
     out->set_request_id(spec.request_id);
+    out->set_max_attempts(spec.max_attempts);
+    out->set_blocklist_after(spec.blocklist_after);
 }
 
 JobSpec FromProto(const pb::SubmitJobRequest& r) {
@@ -184,6 +186,8 @@ JobSpec FromProto(const pb::SubmitJobRequest& r) {
     for (const pb::SceneFile& f : r.files()) spec.files.push_back(FromProto(f));
     FromProto(r.params(), &spec);
     spec.priority = r.priority();
+    if (r.max_attempts() != 0) spec.max_attempts = r.max_attempts();
+    if (r.blocklist_after() != 0) spec.blocklist_after = r.blocklist_after();
     return spec;
 }
 
@@ -252,6 +256,14 @@ void ToProto(const JobRecord& job, pb::Job* out) {
         f->set_tasks_total(frame.tasks_total);
         f->set_done(frame.done);
     }
+    for (const WorkerFailures& w : job.Blocklisted()) {
+        pb::BlockedWorker* b = out->add_blocklist();
+        b->set_worker(w.worker);
+        b->set_failures(w.failures);
+        b->set_last_error(w.last_error);
+    }
+    out->set_max_attempts(job.spec.max_attempts);
+    out->set_blocklist_after(job.spec.blocklist_after);
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {

@@ -34,6 +34,8 @@ void ToProto(const JobSpec& spec, pb::StoredJobSpec* out) {
     out->set_scene_hash(spec.scene_hash);
     out->set_request_id(spec.request_id);
     out->set_owner(spec.owner);
+    out->set_max_attempts(spec.max_attempts);
+    out->set_blocklist_after(spec.blocklist_after);
 }
 
 JobSpec FromProto(const pb::StoredJobSpec& s) {
@@ -48,6 +50,8 @@ JobSpec FromProto(const pb::StoredJobSpec& s) {
     spec.scene_hash = s.scene_hash();
     spec.request_id = s.request_id();
     spec.owner = s.owner();
+    if (s.max_attempts() != 0) spec.max_attempts = s.max_attempts();
+    if (s.blocklist_after() != 0) spec.blocklist_after = s.blocklist_after();
     return spec;
 }
 
@@ -80,6 +84,12 @@ void ToProto(const JobRecord& job, pb::StoredJob* out) {
         f->set_done(frame.done);
         f->set_result_path(frame.result_path);
     }
+    for (const WorkerFailures& w : job.worker_failures) {
+        pb::StoredWorkerFailures* f = out->add_worker_failures();
+        f->set_worker(w.worker);
+        f->set_failures(w.failures);
+        f->set_last_error(w.last_error);
+    }
 }
 
 absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
@@ -110,6 +120,9 @@ absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
     for (const pb::StoredFrame& f : s.frames()) {
         job.frames.push_back(
             {f.frame(), f.tasks_done(), f.tasks_total(), f.done(), f.result_path()});
+    }
+    for (const pb::StoredWorkerFailures& w : s.worker_failures()) {
+        job.worker_failures.push_back({w.worker(), w.failures(), w.last_error()});
     }
     return job;
 }

@@ -62,6 +62,14 @@ class JobState(enum.Enum):
 
 
 @dataclasses.dataclass(frozen=True)
+class BlockedWorker:
+    """A worker blocklisted from a job (lightfarm.v1.BlockedWorker): its failures there."""
+    worker: str
+    failures: int
+    last_error: str
+
+
+@dataclasses.dataclass(frozen=True)
 class Job:
     """A job as the server reports it (lightfarm.v1.Job; ``proto`` is the message itself)."""
     id: str
@@ -86,6 +94,20 @@ class Job:
     last_error: str
     owner: str
     proto: pb.Job = dataclasses.field(repr=False, compare=False)
+
+    # Job management (issue 30).
+    @property
+    def blocklist(self) -> List["BlockedWorker"]:
+        """The workers blocklisted from the job: they get none of its tasks any more."""
+        return [BlockedWorker(b.worker, b.failures, b.last_error) for b in self.proto.blocklist]
+
+    @property
+    def max_attempts(self) -> int:
+        return self.proto.max_attempts
+
+    @property
+    def blocklist_after(self) -> int:
+        return self.proto.blocklist_after
 
     @property
     def params(self) -> common_pb2.RenderParams:
@@ -486,7 +508,8 @@ class Client:
                tolerance: float = 1e-4, max_iterations: int = 10000, display: str = "smooth",
                sweep_tasks: int = 8, max_patches: int = 0,
                photons_per_pass: int = 1 << 18, initial_radius: float = 0.0,
-               alpha: float = 2.0 / 3.0, request_id: Optional[str] = None) -> str:
+               alpha: float = 2.0 / 3.0, request_id: Optional[str] = None,
+               max_attempts: int = 3, blocklist_after: int = 3) -> str:
         """Uploads the scene and every file it names (those the server lacks, resuming a broken
         upload) and queues it as a job; returns the job id.
 
@@ -500,7 +523,9 @@ class Client:
         ``target_error``, ``time_limit`` (seconds) and ``max_spp``; radiosity's ``patches``,
         ``patch_size``, ``solver``, ``tolerance``, ``max_iterations``, ``display``,
         ``sweep_tasks``, ``max_patches``; photon mapping's ``photons_per_pass``,
-        ``initial_radius``, ``alpha``. The server checks them all and the scene (InvalidArgument
+        ``initial_radius``, ``alpha``; ``max_attempts`` (failures of one task that fail the
+        job) and ``blocklist_after`` (a worker's failures in the job after which it gets none of
+        its tasks), 1 to 100. The server checks them all and the scene (InvalidArgument
         with the loader's message). ``request_id`` makes retries idempotent (default: 128
         random bits, the same on every retry of this call).
         """
@@ -540,7 +565,8 @@ class Client:
         req = pb.SubmitJobRequest(
             scene=ref(scene_name, text), files=[ref(n, d) for n, d in named], params=params,
             priority=priority, name=name or scene_name,
-            request_id=request_id or secrets.token_hex(16))
+            request_id=request_id or secrets.token_hex(16), max_attempts=max_attempts,
+            blocklist_after=blocklist_after)
         files = [req.scene] + list(req.files)
 
         backoff = _Backoff(self.retry_seconds)

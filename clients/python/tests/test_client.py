@@ -562,5 +562,15 @@ class ClientTest(unittest.TestCase):
         one = builtins.list(self.alice.logs(job_id, task=0))
         self.assertTrue(one and all(l.task_index == 0 for l in one), one)
 
+    def test_max_attempts_and_blocklist_after(self):
+        """Job management (issue 30): submit's limits reach the job; out of range is refused."""
+        job = self.alice.wait(self.alice.submit(cornell(), max_attempts=7, blocklist_after=2,
+                                                **SMALL))
+        self.assertEqual((job.max_attempts, job.blocklist_after), (7, 2))
+        self.assertEqual(job.blocklist, [])
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.submit(cornell(), max_attempts=101, **SMALL)
+        self.assertIn("max_attempts 101: expected 1 to 100", caught.exception.message)
+
 if __name__ == "__main__":
     unittest.main()

@@ -19,6 +19,14 @@ const char* JobStateName(JobState state);
 absl::StatusOr<JobState> JobStateFromName(std::string_view name);
 inline bool IsFinal(JobState s) { return s != JobState::kQueued && s != JobState::kRunning; }
 
+// A worker's counted task failures in one job (issue 30's blocklist): those it reported itself
+// (task errors and refused results), not leases that expired.
+struct WorkerFailures {
+    std::string worker;
+    int failures = 0;
+    std::string last_error;
+};
+
 struct JobRecord {
     std::string id;
     uint64_t seq = 0;  // submission order
@@ -34,7 +42,12 @@ struct JobRecord {
     // A shot's frames in frame order (none for a still); a frame's EXR stays fetchable whatever
     // the job ends as.
     std::vector<FrameProgress> frames;
+    // Every worker that failed a task of this job, in the order of their first failure.
+    std::vector<WorkerFailures> worker_failures;
     int frames_done() const;
+    // The workers of worker_failures with spec.blocklist_after failures or more: they get no
+    // more tasks of this job.
+    std::vector<WorkerFailures> Blocklisted() const;
 };
 
 // What a done task's leases left behind, recorded with its result so that `lightfarm tasks`

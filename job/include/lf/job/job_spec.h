@@ -12,14 +12,18 @@
 #include "absl/status/status.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/adaptive_plan.h"
-#include "lf/job/splat_settings.h"
 #include "lf/job/method_registry.h"
 #include "lf/job/plan.h"
 #include "lf/job/scene_files.h"
 #include "lf/job/settings.h"
 #include "lf/job/shot.h"
+#include "lf/job/splat_settings.h"
 
 namespace lf {
+
+// `submit --max-attempts` and `--blocklist-after`: their defaults, and the limit of both.
+inline constexpr int kDefaultMaxAttempts = 3, kDefaultBlocklistAfter = 3;
+inline constexpr int kMaxAttemptsLimit = 100;
 
 struct JobSpec {
     std::string name;
@@ -46,6 +50,11 @@ struct JobSpec {
     // The name of the token that submitted it (the server sets it, never the client); "" when
     // the server ran without authentication. A submitter token sees only its own jobs.
     std::string owner;
+    // Job management (issue 30): counted failures of one task that fail the job, and the
+    // counted failures of one worker in this job after which it gets none of the job's tasks
+    // (the blocklist, JobRecord::Blocklisted).
+    int max_attempts = kDefaultMaxAttempts;
+    int blocklist_after = kDefaultBlocklistAfter;
 };
 
 // The limits of a job's settings, one list for the CLI's flags (`render`, `submit`) and the

@@ -9,8 +9,9 @@
 // scheduler's lock.
 //
 // A lease that expires or a failure puts the task back in the queue, where workers it has not
-// failed on take it first; the third counted failure fails the job. Cancelling a job drops all its
-// tasks at once: their heartbeats answer "stop".
+// failed on take it first; the job's max_attempts-th counted failure of a task fails the job. A
+// worker that failed blocklist_after of a job's tasks gets none of them (lf/server/blocklist.h).
+// Cancelling a job drops all its tasks at once: their heartbeats answer "stop".
 #pragma once
 
 #include <condition_variable>
@@ -43,7 +44,6 @@ namespace lf {
 
 struct SchedulerOptions {
     absl::Duration lease = absl::Seconds(10);  // a lease lasts this long past the last heartbeat
-    int max_failures = 3;                      // counted failures of one task that fail its job
     // Near the end of a job (no task of it queued), an idle worker gets a second lease of a task
     // running longer than this and longer than twice the job's mean task time; the first result
     // wins (both are the same bits), so one slow worker does not hold the job.
@@ -85,7 +85,7 @@ struct SchedulerLoad {
 };
 
 enum class FailureKind {
-    kTaskError,       // counts toward max_failures
+    kTaskError,       // counts toward the job's max_attempts and the worker's blocklist
     kWorkerShutdown,  // the worker was told to stop: not the task's fault
 };
 
@@ -300,8 +300,13 @@ class Scheduler {
     // made-up id, another worker's lease, one from before a restart, or of a job that ended).
     std::optional<LeaseRef> Resolve(const std::string& lease_id, const std::string& worker);
     // Ends the lease; when no other lease of the task is current, puts the task back in the
-    // queue. Counts a failure unless `counted` is false; fails the job at max_failures.
+    // queue. Counts a failure unless `counted` is false; fails the job at its max_attempts.
     void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
+    // Requeue for a failure the worker itself reported (an error, a refused result): it also
+    // counts toward the worker's blocklist, and fails the job when that leaves it no live worker.
+    void RequeueReported(const LeaseRef& ref, const std::string& reason);
+    // Fails the job when every live worker is blocklisted from it (StrandedError).
+    void FailIfStranded(Job& job);
     void FailJob(Job& job, const std::string& error);
     // Ends the live state of a job moved to a final state: its final record is queued and the
     // job waits in `ended_` until Locked's release finds it durable. Returns that record.
