@@ -45,6 +45,8 @@ const char* ActionName(Action action) {
             return "list workers";
         case Action::kWork:
             return "lease and render tasks";
+        case Action::kManageJobs:
+            return "requeue, pause or resume jobs";
     }
     return "?";
 }

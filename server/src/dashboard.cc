@@ -147,6 +147,7 @@ Json JobJson(const JobRecord& job, absl::Time now) {
         {"max_attempts", job.spec.max_attempts},
         {"blocklist_after", job.spec.blocklist_after},
         {"blocklist", BlocklistJson(job)},
+        {"paused", job.paused},
     };
 }
 

@@ -156,7 +156,7 @@ export function mount(root, id, who, frameText) {
       if (framesFrom !== job.shot.frames_from) job = await get(jobPath());
     }
     summary.replaceChildren(table(['State', 'Owner', 'Method', 'Size', 'Progress', 'Submitted', 'Started', 'Finished', 'ETA'], [
-      h('tr', {}, h('td', { class: 'state', id: 'state' }, job.state), h('td', {}, job.owner || '—'), h('td', {}, job.method),
+      h('tr', {}, h('td', { class: 'state', id: 'state' }, job.paused && !ended(job.state) ? 'paused' : job.state), h('td', {}, job.owner || '—'), h('td', {}, job.method),
         h('td', {}, `${job.width}×${job.height}, ${job.spp} spp`),
         h('td', {}, progress(job.tasks_done, job.tasks_total), job.shot ? ` ${job.shot.frames_done}/${job.shot.frames_total} frames` : ''),
         h('td', {}, time(job.submitted_ms)), h('td', {}, time(job.started_ms)), h('td', {}, time(job.finished_ms)),

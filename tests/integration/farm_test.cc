@@ -1752,5 +1752,63 @@ TEST_F(Farm, JobFailsWhenItsOnlyWorkerIsBlocklisted) {
         << status.out;
 }
 
+// Job management (issue 30): a job failed by its max attempts (a broken worker beside a good
+// one; --max-attempts 1) keeps the results of the tasks done, across a coordinator restart:
+// `requeue` queues it again with those tasks done, and it renders the rest on the good worker to
+// the bits of a local render.
+TEST_F(Farm, RequeuedFailedJobRendersOnAfterARestartToTheBitsOfALocalRender) {
+    StartServer();
+    StartWorker("good");
+    Child* bad = StartWorker("bad", 1, {"--fail-tasks-for-test"});
+    ASSERT_TRUE(WaitForWorkers(2));
+    const std::string job = Submit(scene_, "--spp 16 --tile 16 --seed 7 --max-attempts 1");
+    EXPECT_NE(Farmctl("watch " + job).status, 0);
+    bad->Signal(SIGKILL);
+    ASSERT_TRUE(bad->Wait(milliseconds(5000)));
+    const CliRun failed = Farmctl("status " + job);
+    EXPECT_NE(failed.out.find("error     task "), std::string::npos) << failed.out;
+    EXPECT_NE(failed.out.find("failed 1 time; last: failing every task"), std::string::npos)
+        << failed.out;
+    const TaskCounts before = Tasks(job);
+    CrashAndRestartServer();
+    EXPECT_NE(Farmctl("status " + job).out.find(": failed"), std::string::npos);
+    const CliRun requeued = Farmctl("requeue " + job);
+    ASSERT_EQ(requeued.status, 0) << requeued.err;
+    EXPECT_EQ(requeued.out,
+              "job " + job + " queued (" + std::to_string(before.done) + "/16 tasks done)\n");
+    ExpectSameAsLocal(job, scene_, 16, 7);
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_EQ(status.out.find("error "), std::string::npos) << status.out;
+    // A succeeded job has nothing to requeue.
+    const CliRun again = Farmctl("requeue " + job);
+    EXPECT_NE(again.status, 0);
+    EXPECT_NE(again.err.find("only a failed or cancelled job is queued again"), std::string::npos)
+        << again.err;
+}
+
+// Job management (issue 30): a paused job leases nothing, and stays paused across a restart;
+// resumed, it renders to the bits of a local render. A worker is listed once its first lease
+// request was answered under the scheduler's lock, so "nothing leased" is checked after one.
+TEST_F(Farm, PausedJobStaysPausedAcrossARestartAndRendersOnceResumed) {
+    StartServer();
+    const std::string job = Submit(scene_, "--spp 4 --tile 32 --seed 9");
+    const CliRun paused = Farmctl("pause " + job);
+    ASSERT_EQ(paused.status, 0) << paused.err;
+    EXPECT_EQ(paused.out, "job " + job + " paused\n");
+    StartWorker("w1");
+    ASSERT_TRUE(WaitForWorkers(1));
+    EXPECT_EQ(Tasks(job).leased, 0);
+    EXPECT_NE(Farmctl("status " + job).out.find("job " + job + ": paused"), std::string::npos);
+    CrashAndRestartServer();
+    ASSERT_TRUE(WaitForWorkers(1));
+    EXPECT_EQ(Tasks(job).leased, 0);
+    EXPECT_NE(Farmctl("list").out.find("paused"), std::string::npos);
+    const CliRun resumed = Farmctl("resume " + job);
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(resumed.out, "job " + job + " resumed\n");
+    ExpectSameAsLocal(job, scene_, 4, 9);
+    EXPECT_NE(Farmctl("pause " + job).status, 0);  // it has ended
+}
+
 }  // namespace
 }  // namespace lf

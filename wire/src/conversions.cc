@@ -264,6 +264,7 @@ void ToProto(const JobRecord& job, pb::Job* out) {
     }
     out->set_max_attempts(job.spec.max_attempts);
     out->set_blocklist_after(job.spec.blocklist_after);
+    out->set_paused(job.paused);
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {

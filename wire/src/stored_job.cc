@@ -90,6 +90,7 @@ void ToProto(const JobRecord& job, pb::StoredJob* out) {
         f->set_failures(w.failures);
         f->set_last_error(w.last_error);
     }
+    out->set_paused(job.paused);
 }
 
 absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
@@ -124,6 +125,7 @@ absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
     for (const pb::StoredWorkerFailures& w : s.worker_failures()) {
         job.worker_failures.push_back({w.worker(), w.failures(), w.last_error()});
     }
+    job.paused = s.paused();
     return job;
 }
 

@@ -102,6 +102,11 @@ class Job:
         return [BlockedWorker(b.worker, b.failures, b.last_error) for b in self.proto.blocklist]
 
     @property
+    def paused(self) -> bool:
+        """Paused (``Client.pause``): a queued or running job that leases nothing new."""
+        return self.proto.paused
+
+    @property
     def max_attempts(self) -> int:
         return self.proto.max_attempts
 
@@ -385,6 +390,22 @@ class Client:
         admin. FailedPrecondition for a job that has ended."""
         return Job.from_proto(self._unary(
             "SetJobPriority", pb.SetJobPriorityRequest(job_id=job_id, priority=priority)))
+
+    # Job management (issue 30).
+    def requeue(self, job_id: str) -> Job:
+        """Puts the job's failed tasks back in the queue with their failures reset and clears
+        its blocklist; a failed or cancelled job is queued again and renders on from the tasks it
+        had done (``lightfarm requeue``). FailedPrecondition for a succeeded job."""
+        return Job.from_proto(self._unary("RequeueJob", pb.RequeueJobRequest(job_id=job_id)))
+
+    def pause(self, job_id: str) -> Job:
+        """Pauses a queued or running job: it leases nothing new, its running tasks finish
+        (``lightfarm pause``); it stays paused across a restart. FailedPrecondition once ended."""
+        return Job.from_proto(self._unary("PauseJob", pb.PauseJobRequest(job_id=job_id)))
+
+    def resume(self, job_id: str) -> Job:
+        """Resumes a paused job (``lightfarm resume``)."""
+        return Job.from_proto(self._unary("ResumeJob", pb.ResumeJobRequest(job_id=job_id)))
 
     def workers(self) -> List[Worker]:
         """The workers the server heard from within a lease."""

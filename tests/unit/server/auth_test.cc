@@ -13,7 +13,7 @@ namespace {
 
 constexpr Action kAllActions[] = {Action::kUploadBlobs, Action::kSubmit,      Action::kReadJobs,
                                   Action::kCancelJob,   Action::kSetPriority, Action::kDeleteJob,
-                                  Action::kListWorkers, Action::kWork};
+                                  Action::kListWorkers, Action::kWork,        Action::kManageJobs};
 
 TEST(Permit, AdminMayDoEverything) {
     for (Action a : kAllActions) EXPECT_TRUE(Permit({"root", Role::kAdmin}, a).ok());

@@ -280,6 +280,66 @@ TEST_F(JobManagementTest, BlocklistedWorkerGetsNoMoreTasksOfTheJob) {
     EXPECT_FALSE(scheduler_.LeaseTask("bad").has_value());
 }
 
+TEST_F(JobManagementTest, RequeueOfARunningJobResetsItsFailuresAndBlocklist) {
+    const std::string id = SubmitWith(2, 2);
+    scheduler_.LeaseTask("good");  // alive, holding task 0
+    FailNext("bad", "no GPU");     // task 1
+    FailNext("bad", "no GPU");     // task 2: blocklisted
+    ASSERT_EQ(Job(id).Blocklisted().size(), 1u);
+    absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(id);
+    ASSERT_TRUE(requeued.ok()) << requeued.status();
+    EXPECT_TRUE(requeued->record.Blocklisted().empty());
+    EXPECT_EQ(requeued->record.last_error, "");
+    EXPECT_TRUE(store_.Get(id)->worker_failures.empty());
+    // The bad worker may take the tasks again, even those it failed, and each has its two
+    // attempts again: one more failure of task 1 does not fail the job.
+    const std::vector<TaskStatus> before = *scheduler_.Tasks(id);
+    EXPECT_EQ(before[1].failures, 0);
+    FailNext("bad", "no GPU");
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+}
+
+TEST_F(JobManagementTest, RequeuedFailedJobIsQueuedAgainAndRenders) {
+    const std::string id = SubmitWith(1, 3);
+    FailNext("w", "out of memory");
+    ASSERT_EQ(Job(id).state, JobState::kFailed);
+    absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(id);
+    ASSERT_TRUE(requeued.ok()) << requeued.status();
+    EXPECT_EQ(Job(id).state, JobState::kQueued);
+    EXPECT_EQ(Job(id).error, "");
+    EXPECT_EQ(Job(id).finished, absl::InfinitePast());
+    bool rendered = false;
+    while (std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w")) {
+        absl::StatusOr<Scheduler::Completion> done =
+            scheduler_.Complete(lease->lease_id, "w", Result(*lease));
+        ASSERT_TRUE(done.ok()) << done.status();
+        rendered = done->job_rendered;
+    }
+    EXPECT_TRUE(rendered);
+    scheduler_.Finish(id, std::string("/results/x.exr"));
+    EXPECT_EQ(Job(id).state, JobState::kSucceeded);
+}
+
+TEST_F(JobManagementTest, PausedJobLeasesNothingNewButItsRunningTasksMerge) {
+    const std::string id = SubmitWith(3, 3);
+    const TaskAssignment running = *scheduler_.LeaseTask("w");
+    absl::StatusOr<JobRecord> paused = scheduler_.SetPaused(id, true);
+    ASSERT_TRUE(paused.ok()) << paused.status();
+    EXPECT_TRUE(paused->paused);
+    EXPECT_TRUE(store_.Get(id)->paused);  // durable
+    EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
+    EXPECT_FALSE(scheduler_.LeaseTask("idle").has_value());  // nor a second lease of a straggler
+    ASSERT_TRUE(scheduler_.Complete(running.lease_id, "w", Result(running)).ok());
+    EXPECT_EQ(Job(id).tasks_done, 1);
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+    ASSERT_TRUE(scheduler_.SetPaused(id, false).ok());
+    EXPECT_TRUE(scheduler_.LeaseTask("w").has_value());
+    ASSERT_TRUE(scheduler_.Cancel(id).ok());
+    EXPECT_EQ(scheduler_.SetPaused(id, true).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(scheduler_.SetPaused("job-none", true).status().code(), absl::StatusCode::kNotFound);
+}
+
 TEST_F(JobManagementTest, JobFailsWhenEveryLiveWorkerIsBlocklisted) {
     const std::string id = SubmitWith(5, 2);
     FailNext("bad", "no GPU");

@@ -44,6 +44,9 @@ struct JobRecord {
     std::vector<FrameProgress> frames;
     // Every worker that failed a task of this job, in the order of their first failure.
     std::vector<WorkerFailures> worker_failures;
+    // `lightfarm pause`: a queued or running job that leases nothing new (its running tasks
+    // finish and merge) until resumed. A flag, not a state: the job is still queued or running.
+    bool paused = false;
     int frames_done() const;
     // The workers of worker_failures with spec.blocklist_after failures or more: they get no
     // more tasks of this job.

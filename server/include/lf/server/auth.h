@@ -29,6 +29,8 @@ enum class Action {
     kDeleteJob,    // own jobs, or all for an admin
     kListWorkers,  // the farm's workers: admins and submitters
     kWork,         // LeaseTask, Heartbeat, CompleteTask, FailTask, FetchBlob
+    // Job management (issue 30): RequeueJob, PauseJob, ResumeJob; own jobs, or all for an admin.
+    kManageJobs,
 };
 const char* ActionName(Action action);
 

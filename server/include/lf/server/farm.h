@@ -135,6 +135,10 @@ class Farm {
     // A queued or running job's new priority; FailedPrecondition once it has ended.
     absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
 
+    // Job management (issue 30): Scheduler::RequeueJob, and a job it finds fully rendered
+    // written and finished.
+    absl::StatusOr<JobRecord> Requeue(const std::string& job_id);
+
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }
     const SqliteJobStore& store() const { return *store_; }

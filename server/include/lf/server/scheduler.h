@@ -165,6 +165,23 @@ class Scheduler {
     // has ended, NotFound for one the store does not hold.
     absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
 
+    // Job management (issue 30).
+    // `lightfarm requeue`: the job's failed tasks go back in the queue with their failures
+    // reset (their lease counts stay, as the attempt numbers of their logs), and its blocklist
+    // is cleared. A failed or cancelled job is queued again (ReopenJob): its recorded task
+    // results merge as after a restart (Recover) and it renders on from there. `rendered`: the
+    // job is fully rendered already; the caller writes the result and Finishes. NotFound for a
+    // job the store does not hold, FailedPrecondition for a succeeded one, Unavailable for one
+    // ending right now (its final record not yet durable).
+    struct Requeued {
+        JobRecord record;
+        bool rendered = false;
+    };
+    absl::StatusOr<Requeued> RequeueJob(const std::string& job_id);
+    // `lightfarm pause` and `resume` (JobRecord::paused): returns the record once durable;
+    // FailedPrecondition for a job that has ended, NotFound for one the store does not hold.
+    absl::StatusOr<JobRecord> SetPaused(const std::string& job_id, bool paused);
+
     // Re-queues the tasks whose lease ran out (each counts as a failure of the task), and
     // forgets the workers silent for a lease. Returns how many leases expired.
     int ExpireLeases();
@@ -277,6 +294,11 @@ class Scheduler {
     // ticket to wait for.
     std::optional<std::pair<std::string, uint64_t>> FindRequestInMemory(
         const std::string& request_id) const;
+    // Takes up a job of the store that has not ended, as Recover does: its recorded results
+    // merge again in the order they merged, every other task is queued. In active_ after;
+    // returns whether it is fully rendered.
+    absl::StatusOr<bool> TakeUp(JobRecord record,
+                                const std::map<int, JobStore::RecordedTask>& results);
     std::optional<TaskAssignment> TryLease(const std::string& worker,
                                            const WorkerDescription* about);
     // Drops a job's tasks once its time limit has passed; true if dropping them completed the
@@ -305,6 +327,9 @@ class Scheduler {
     // Requeue for a failure the worker itself reported (an error, a refused result): it also
     // counts toward the worker's blocklist, and fails the job when that leaves it no live worker.
     void RequeueReported(const LeaseRef& ref, const std::string& reason);
+    // The queued or running job `job_id` to change, with `locked` held; for any other, the
+    // status to answer (read from the store with the lock released, as SetPriority does).
+    absl::StatusOr<Job*> ActiveJob(const std::string& job_id, Locked& locked);
     // Fails the job when every live worker is blocklisted from it (StrandedError).
     void FailIfStranded(Job& job);
     void FailJob(Job& job, const std::string& error);
