@@ -61,6 +61,10 @@ void PrintJson(const google::protobuf::Message& message) {
 }
 
 std::string StateName(pb::Job::State s) { return absl::AsciiStrToLower(pb::Job::State_Name(s)); }
+// What list and status show: a paused job (issue 30) as "paused", else its state.
+std::string ShownState(const pb::Job& job) {
+    return job.paused() && !IsFinal(FromProto(job.state())) ? "paused" : StateName(job.state());
+}
 
 // "2026-11-26 23:41:07" in the machine's time zone, as a user reads a clock.
 std::string LocalTime(int64_t unix_ms) {
@@ -104,7 +108,7 @@ std::string FramesText(const pb::Job& job) {
 void PrintJob(const pb::Job& job) {
     const int64_t now = absl::ToUnixMillis(absl::Now());
     auto seconds = [](int64_t from, int64_t to) { return double(to - from) / 1000.0; };
-    std::printf("job %s: %s\n", job.id().c_str(), StateName(job.state()).c_str());
+    std::printf("job %s: %s\n", job.id().c_str(), ShownState(job).c_str());
     std::printf("  name      %s\n", job.name().c_str());
     if (!job.owner().empty()) std::printf("  owner     %s\n", job.owner().c_str());
     std::printf("  method    %s\n",
@@ -170,6 +174,13 @@ void PrintJob(const pb::Job& job) {
         std::printf("  last error  %s\n", job.last_error().c_str());
     }
     if (!job.error().empty()) std::printf("  error     %s\n", job.error().c_str());
+    // Job management (issue 30).
+    std::printf("  attempts  %d a task; blocklist after %d failures\n", job.max_attempts(),
+                job.blocklist_after());
+    for (const pb::BlockedWorker& w : job.blocklist()) {
+        std::printf("  blocklisted: %s (%s, last: %s)\n", w.worker().c_str(),
+                    Plural(w.failures(), "failure").c_str(), w.last_error().c_str());
+    }
 }
 
 // The job's EXR at paths.exr, and its preview at paths.png, made here from the EXR (fetched into
@@ -275,7 +286,7 @@ Command AddListCommand(CLI::App& app) {
                         }
                         absl::StrAppendFormat(
                             &out, "%-16s %-10s %-12s %-9s %8d %11s %9llu %-19s %8s  %s\n",
-                            job.id().c_str(), StateName(job.state()).c_str(),
+                            job.id().c_str(), ShownState(job).c_str(),
                             job.owner().empty() ? "-" : job.owner().c_str(),
                             job.params().method().empty() ? "path" : job.params().method().c_str(),
                             job.priority(), Progress(job).c_str(),

@@ -151,6 +151,16 @@ Command AddSubmitCommand(CLI::App& app) {
                     "at most this many workers render the job at once; 0: no cap")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
+    // Job management (issue 30).
+    cmd->add_option("--max-attempts", o->spec.max_attempts,
+                    "failures of one task that fail the job (docs/farm.md, Managing jobs)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxAttemptsLimit));
+    cmd->add_option("--blocklist-after", o->spec.blocklist_after,
+                    "a worker that fails this many of the job's tasks gets none of them any "
+                    "more; the job fails when every live worker is blocklisted")
+        ->capture_default_str()
+        ->check(CLI::Range(1, kMaxAttemptsLimit));
     cmd->add_option(
            "--method", o->spec.method,
            "path, radiosity (Lambertian scenes; same bits as `lightfarm render "

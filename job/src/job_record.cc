@@ -52,4 +52,12 @@ absl::Status CheckRendersFrame(const JobRecord& job, int frame) {
             : std::string(" (a still)")));
 }
 
+std::vector<WorkerFailures> JobRecord::Blocklisted() const {
+    std::vector<WorkerFailures> blocked;
+    for (const WorkerFailures& w : worker_failures) {
+        if (w.failures >= spec.blocklist_after) blocked.push_back(w);
+    }
+    return blocked;
+}
+
 }  // namespace lf

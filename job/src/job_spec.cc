@@ -91,6 +91,8 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         CheckMethodSettings(spec),
         CheckTags(spec.tags, "tags"),
         InRange("max_workers", spec.max_workers, 0, std::numeric_limits<int>::max()),
+        InRange("max_attempts", spec.max_attempts, 1, kMaxAttemptsLimit),
+        InRange("blocklist_after", spec.blocklist_after, 1, kMaxAttemptsLimit),
     };
     for (const absl::Status& s : checks) {
         if (!s.ok()) return s;

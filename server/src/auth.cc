@@ -47,6 +47,8 @@ const char* ActionName(Action action) {
             return "lease and render tasks";
         case Action::kManageWorkers:
             return "disable, enable or drain workers";
+        case Action::kManageJobs:
+            return "requeue, pause or resume jobs";
     }
     return "?";
 }

@@ -118,6 +118,16 @@ Json ShotJson(const JobRecord& job) {
             {"current", current}};
 }
 
+// The workers blocklisted from the job (lf/server/blocklist.h).
+Json BlocklistJson(const JobRecord& job) {
+    Json list = Json::array();
+    for (const WorkerFailures& w : job.Blocklisted()) {
+        list.push_back(
+            {{"worker", w.worker}, {"failures", w.failures}, {"last_error", w.last_error}});
+    }
+    return list;
+}
+
 Json JobJson(const JobRecord& job, absl::Time now) {
     return {
         {"id", job.id},
@@ -141,6 +151,11 @@ Json JobJson(const JobRecord& job, absl::Time now) {
         {"error", job.error},
         {"last_error", job.last_error},
         {"shot", ShotJson(job)},
+        // Job management (issue 30).
+        {"max_attempts", job.spec.max_attempts},
+        {"blocklist_after", job.spec.blocklist_after},
+        {"blocklist", BlocklistJson(job)},
+        {"paused", job.paused},
     };
 }
 

@@ -631,3 +631,14 @@ absl::StatusOr<JobRecord> Farm::SetPriority(const std::string& job_id, int prior
 }
 
 }  // namespace lf
+
+namespace lf {
+
+absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id) {
+    absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(job_id);
+    if (!requeued.ok()) return requeued.status();
+    if (requeued->rendered) FinishJob(job_id);
+    return requeued->record;
+}
+
+}  // namespace lf

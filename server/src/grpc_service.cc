@@ -171,6 +171,13 @@ JobServiceImpl::JobServiceImpl(Farm& farm, CallGuard guard, JobServiceOptions op
     Unary<pb::SetWorkerStateRequest, pb::SetWorkerStateResponse>(
         "SetWorkerState", Action::kManageWorkers, kMaxRequestBytes,
         bind_front(&JobServiceImpl::SetWorkerState, this));
+    // Job management (issue 30).
+    Unary<pb::RequeueJobRequest, pb::Job>("RequeueJob", Action::kManageJobs, kMaxRequestBytes,
+                                          bind_front(&JobServiceImpl::RequeueJob, this));
+    Unary<pb::PauseJobRequest, pb::Job>("PauseJob", Action::kManageJobs, kMaxRequestBytes,
+                                        bind_front(&JobServiceImpl::PauseJob, this));
+    Unary<pb::ResumeJobRequest, pb::Job>("ResumeJob", Action::kManageJobs, kMaxRequestBytes,
+                                         bind_front(&JobServiceImpl::ResumeJob, this));
 }
 
 WorkerServiceImpl::WorkerServiceImpl(Farm& farm, CallGuard guard)
@@ -411,6 +418,41 @@ grpc::Status JobServiceImpl::SetJobPriority(grpc::ServerContext* context, const 
     absl::StatusOr<JobRecord> job = farm_.SetPriority(req.job_id(), req.priority());
     if (!job.ok()) return ToGrpcStatus(job.status());
     Log()->info("job={} priority set to {} by {} from {}", job->id, req.priority(), Who(caller),
+                Peer(context));
+    ToProto(*job, resp);
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::RequeueJob(grpc::ServerContext* context, const Caller& caller,
+                                        const pb::RequeueJobRequest& req, pb::Job* resp) {
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(caller, req.job_id()); !seen.ok()) {
+        return ToGrpcStatus(seen.status());
+    }
+    absl::StatusOr<JobRecord> job = farm_.Requeue(req.job_id());
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    Log()->info("job={} requeued by {} from {}", job->id, Who(caller), Peer(context));
+    ToProto(*job, resp);
+    return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::PauseJob(grpc::ServerContext* context, const Caller& caller,
+                                      const pb::PauseJobRequest& req, pb::Job* resp) {
+    return SetPaused(context, caller, req.job_id(), true, resp);
+}
+
+grpc::Status JobServiceImpl::ResumeJob(grpc::ServerContext* context, const Caller& caller,
+                                       const pb::ResumeJobRequest& req, pb::Job* resp) {
+    return SetPaused(context, caller, req.job_id(), false, resp);
+}
+
+grpc::Status JobServiceImpl::SetPaused(grpc::ServerContext* context, const Caller& caller,
+                                       const std::string& job_id, bool paused, pb::Job* resp) {
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(caller, job_id); !seen.ok()) {
+        return ToGrpcStatus(seen.status());
+    }
+    absl::StatusOr<JobRecord> job = farm_.scheduler().SetPaused(job_id, paused);
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    Log()->info("job={} {} by {} from {}", job->id, paused ? "paused" : "resumed", Who(caller),
                 Peer(context));
     ToProto(*job, resp);
     return grpc::Status::OK;

@@ -27,4 +27,18 @@ absl::Status TransitionJob(JobRecord& job, JobState to, absl::Time now) {
     return absl::OkStatus();
 }
 
+absl::Status ReopenJob(JobRecord& job) {
+    if (job.state != JobState::kFailed && job.state != JobState::kCancelled) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            "job ", job.id, " is ", JobStateName(job.state),
+            ": only a failed or cancelled job is queued again (a queued or running one has its "
+            "failed tasks requeued)"));
+    }
+    job.state = JobState::kQueued;
+    job.error.clear();
+    // It starts again at its next lease: an adaptive job's time limit counts from there.
+    job.started = job.finished = absl::InfinitePast();
+    return absl::OkStatus();
+}
+
 }  // namespace lf

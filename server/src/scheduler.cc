@@ -6,7 +6,9 @@
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_error.h"
 #include "lf/core/log.h"
+#include "lf/core/plural.h"
 #include "lf/job/worker_tags.h"
+#include "lf/server/blocklist.h"
 
 namespace lf {
 
@@ -264,46 +266,105 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
         if (active_.count(s.record.id)) continue;
         // One job that cannot be taken up (its task results unreadable, or a spec this build
         // refuses, such as a shot over a newer limit) fails alone; the farm starts with the rest.
-        absl::StatusOr<std::unique_ptr<Job>> made =
-            s.results.ok() ? Job::Make(s.record, options_.tile_stores, options_.speculate_after)
-                           : absl::StatusOr<std::unique_ptr<Job>>(s.results.status());
-        if (!made.ok()) {
-            FailUnrecoverable(std::move(s.record), made.status());
+        const std::string id = s.record.id;
+        absl::StatusOr<bool> done = s.results.ok() ? TakeUp(s.record, *s.results)
+                                                   : absl::StatusOr<bool>(s.results.status());
+        if (!done.ok()) {
+            FailUnrecoverable(std::move(s.record), done.status());
             continue;
         }
-        std::unique_ptr<Job> job = std::move(*made);
-        // In the order they merged, so an adaptive plan appends each pass before its result
-        // comes up, and a shot gives each appended pass the index it had (its frames append
-        // in the order their results merged, not in index order).
-        std::vector<std::pair<int, const JobStore::RecordedTask*>> in_order;
-        for (const auto& [t, recorded] : *s.results) in_order.emplace_back(t, &recorded);
-        std::stable_sort(in_order.begin(), in_order.end(), [](const auto& a, const auto& b) {
-            return a.second->order < b.second->order;
-        });
-        for (const auto& [t, stored_result] : in_order) {
-            const JobStore::RecordedTask& recorded = *stored_result;
-            // The store wrote what merged before, so this cannot fail unless the file was
-            // damaged; the task is then simply rendered again.
-            if (!job->execution->MergeRecorded(t, recorded.result).ok()) {
-                Log()->warn("job={} task={}: the recorded result is unusable, rendering it again",
-                            job->id(), t);
-                continue;
-            }
-            job->Move(t, TaskState::kDone);
-            job->Queue({});
-            job->Restore(t, recorded.history);
-        }
-        job->Queue(job->execution->Start());
-        job->Sync();
-        Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before", job->id(),
-                    job->record.tasks_done, job->record.tasks_total, job->record.tasks_leased);
-        if (EnforceTimeLimit(*job, clock_()) || job->execution->Complete()) {
-            rendered.push_back(job->id());
-        }
-        Save(*job);
-        active_[job->id()] = std::move(job);
+        if (*done) rendered.push_back(id);
     }
     return rendered;
+}
+
+absl::StatusOr<bool> Scheduler::TakeUp(JobRecord record,
+                                       const std::map<int, JobStore::RecordedTask>& results) {
+    absl::StatusOr<std::unique_ptr<Job>> made =
+        Job::Make(std::move(record), options_.tile_stores, options_.speculate_after);
+    if (!made.ok()) return made.status();
+    std::unique_ptr<Job> job = std::move(*made);
+    // In the order they merged, so an adaptive plan appends each pass before its result
+    // comes up, and a shot gives each appended pass the index it had (its frames append
+    // in the order their results merged, not in index order).
+    std::vector<std::pair<int, const JobStore::RecordedTask*>> in_order;
+    for (const auto& [t, recorded] : results) in_order.emplace_back(t, &recorded);
+    std::stable_sort(in_order.begin(), in_order.end(), [](const auto& a, const auto& b) {
+        return a.second->order < b.second->order;
+    });
+    for (const auto& [t, stored_result] : in_order) {
+        const JobStore::RecordedTask& recorded = *stored_result;
+        // The store wrote what merged before, so this cannot fail unless the file was
+        // damaged; the task is then simply rendered again.
+        if (!job->execution->MergeRecorded(t, recorded.result).ok()) {
+            Log()->warn("job={} task={}: the recorded result is unusable, rendering it again",
+                        job->id(), t);
+            continue;
+        }
+        job->Move(t, TaskState::kDone);
+        job->Queue({});
+        job->Restore(t, recorded.history);
+    }
+    job->Queue(job->execution->Start());
+    job->Sync();
+    Log()->info("job={} recovered: {}/{} tasks done, {} leases handed out before", job->id(),
+                job->record.tasks_done, job->record.tasks_total, job->record.tasks_leased);
+    const bool rendered = EnforceTimeLimit(*job, clock_()) || job->execution->Complete();
+    Save(*job);
+    active_[job->id()] = std::move(job);
+    return rendered;
+}
+
+absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job_id) {
+    {
+        Locked locked(*this);
+        if (auto it = active_.find(job_id); it != active_.end()) {
+            Job& job = *it->second;
+            int reset = 0;
+            for (ScheduledJob::Task& task : job.tasks) {
+                reset += task.failures > 0;
+                task.failures = 0;
+                task.failed_on.clear();
+            }
+            job.record.worker_failures.clear();
+            job.record.last_error.clear();
+            Log()->info("job={} requeued: {} failed tasks reset, blocklist cleared", job_id, reset);
+            const uint64_t ticket = Save(job);
+            Requeued requeued{job.record, false};
+            locked.lock.unlock();
+            if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
+            return requeued;
+        }
+        if (ended_.Find(job_id)) {
+            return absl::UnavailableError(
+                absl::StrCat("job ", job_id,
+                             " has just ended and its record is not in the store yet; requeue "
+                             "it again in a moment"));
+        }
+    }
+    // The store is read without the lock.
+    absl::StatusOr<JobRecord> stored = store_.Get(job_id);
+    if (!stored.ok()) return stored.status();
+    if (absl::Status s = ReopenJob(*stored); !s.ok()) return s;
+    absl::StatusOr<std::map<int, JobStore::RecordedTask>> results = store_.TaskResults(job_id);
+    if (!results.ok()) return results.status();
+    stored->worker_failures.clear();
+    stored->last_error.clear();
+    Locked locked(*this);
+    if (active_.count(job_id) || ended_.Find(job_id)) {
+        return absl::AbortedError(
+            absl::StrCat("job ", job_id, " was requeued by another call meanwhile"));
+    }
+    absl::StatusOr<bool> rendered = TakeUp(std::move(*stored), *results);
+    if (!rendered.ok()) return rendered.status();
+    Job& job = *active_.at(job_id);
+    Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued", job_id,
+                job.record.tasks_done, job.record.tasks_total);
+    const uint64_t ticket = Save(job);
+    Requeued requeued{job.record, *rendered};
+    locked.lock.unlock();
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
+    return requeued;
 }
 
 std::optional<TaskAssignment> Scheduler::LeaseTask(const std::string& worker, absl::Time wait_until,
@@ -336,7 +397,13 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
     const std::vector<std::string>& tags = self.tags;
     Job* best = nullptr;
     int best_task = -1;
+    std::vector<std::string> stranded;  // jobs with queued tasks this blocklisted worker asks for
     for (auto& [id, job] : active_) {
+        if (job->record.paused) continue;
+        if (IsBlocklisted(job->record, worker)) {
+            if (!job->states.queued().empty()) stranded.push_back(id);
+            continue;
+        }
         if (best && (job->record.spec.priority < best->record.spec.priority ||
                      (job->record.spec.priority == best->record.spec.priority &&
                       job->record.seq > best->record.seq))) {
@@ -350,6 +417,7 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
             break;
         }
     }
+    for (const std::string& id : stranded) FailIfStranded(*active_.at(id));
     if (best) return Grant(*best, best_task, worker, now);
     for (auto& [id, job] : active_) {
         if (!Admits(*job, worker, tags)) continue;
@@ -364,7 +432,9 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
 }
 
 int Scheduler::StragglerFor(const Job& job, const std::string& worker, absl::Time now) const {
-    if (!job.states.queued().empty()) return -1;
+    if (!job.states.queued().empty() || job.record.paused || IsBlocklisted(job.record, worker)) {
+        return -1;
+    }
     int oldest = -1;
     for (int t = 0; t < int(job.tasks.size()); ++t) {
         const ScheduledJob::Task& task = job.tasks[size_t(t)];
@@ -434,7 +504,7 @@ bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::
     if (!task.failed_on.count(worker)) return true;
     // It failed here: it waits for a live worker it has not failed on. Once it has failed on
     // every live worker it is tried again anywhere, so its failures end the job. `failed_on`
-    // holds fewer than max_failures workers, and the workers kept are the live ones.
+    // holds fewer than max_attempts workers, and the workers kept are the live ones.
     size_t live_failed = 0;
     for (const std::string& w : task.failed_on) live_failed += workers_.IsLive(w, now);
     return workers_.size() <= live_failed;
@@ -587,7 +657,7 @@ absl::Status Scheduler::Refuse(const LeaseRef& ref, const std::string& worker,
                                const absl::Status& why) {
     const std::string error = absl::StrCat("job=", ref.job->id(), " task=", ref.lease->task,
                                            " from ", worker, ": ", why.message());
-    if (ref.lease->current) Requeue(ref, absl::StrCat("result refused: ", why.message()), true);
+    if (ref.lease->current) RequeueReported(ref, absl::StrCat("result refused: ", why.message()));
     return absl::InvalidArgumentError(error);
 }
 
@@ -630,8 +700,31 @@ absl::Status Scheduler::Fail(const std::string& lease_id, const std::string& wor
     Locked locked(*this);
     const std::optional<LeaseRef> ref = Resolve(lease_id, worker);
     if (!ref || !ref->lease->current) return absl::OkStatus();
-    Requeue(*ref, absl::StrCat(reason, " (worker ", worker, ")"), kind == FailureKind::kTaskError);
+    const std::string why = absl::StrCat(reason, " (worker ", worker, ")");
+    if (kind == FailureKind::kTaskError) {
+        RequeueReported(*ref, why);
+    } else {
+        Requeue(*ref, why, false);
+    }
     return absl::OkStatus();
+}
+
+void Scheduler::RequeueReported(const LeaseRef& ref, const std::string& reason) {
+    const std::string job_id = ref.job->id(), worker = ref.lease->worker;
+    const bool blocked = CountWorkerFailure(ref.job->record, worker, reason);
+    Requeue(ref, reason, true);  // may end the job
+    auto it = active_.find(job_id);
+    if (!blocked || it == active_.end()) return;
+    Log()->warn("job={} worker {} blocklisted: it failed {} of the job's tasks", job_id,
+                LogSafe(worker), it->second->record.spec.blocklist_after);
+    FailIfStranded(*it->second);
+}
+
+void Scheduler::FailIfStranded(Job& job) {
+    workers_.ForgetSilent(clock_());
+    std::vector<std::string> live;
+    for (const WorkerRegistry::Entry& entry : workers_.List()) live.push_back(entry.id);
+    if (std::optional<std::string> error = StrandedError(job.record, live)) FailJob(job, *error);
 }
 
 void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool counted) {
@@ -649,8 +742,9 @@ void Scheduler::Requeue(const LeaseRef& ref, const std::string& reason, bool cou
     }
     Log()->warn("job={} task={} attempt {} failed: {}{}", job.id(), t, attempt, LogSafe(reason),
                 counted ? "" : " (not counted)");
-    if (task.failures >= options_.max_failures) {
-        FailJob(job, absl::StrCat("task ", t, " failed ", task.failures, " times; last: ", reason));
+    if (task.failures >= job.record.spec.max_attempts) {
+        FailJob(job, absl::StrCat("task ", t, " failed ", Plural(task.failures, "time"),
+                                  "; last: ", reason));
         return;
     }
     // Otherwise another lease of it still renders; or, when several of its leases expired in
@@ -707,20 +801,40 @@ absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
     return AlreadyEnded(*record);
 }
 
+absl::StatusOr<Scheduler::Job*> Scheduler::ActiveJob(const std::string& job_id, Locked& locked) {
+    auto it = active_.find(job_id);
+    if (it != active_.end()) return it->second.get();
+    if (const JobRecord* ended = ended_.Find(job_id)) return AlreadyEnded(*ended);
+    locked.lock.unlock();  // the store is never read under the lock
+    absl::StatusOr<JobRecord> stored = store_.Get(job_id);
+    if (!stored.ok()) return stored.status();
+    return AlreadyEnded(*stored);
+}
+
+absl::StatusOr<JobRecord> Scheduler::SetPaused(const std::string& job_id, bool paused) {
+    JobRecord record;
+    uint64_t ticket = 0;
+    {
+        Locked locked(*this);
+        absl::StatusOr<Job*> job = ActiveJob(job_id, locked);
+        if (!job.ok()) return job.status();
+        Log()->info("job={} {}", job_id, paused ? "paused" : "resumed");
+        (*job)->record.paused = paused;
+        ticket = Save(**job);
+        record = (*job)->record;
+    }
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
+    return record;
+}
+
 absl::StatusOr<JobRecord> Scheduler::SetPriority(const std::string& job_id, int priority) {
     JobRecord record;
     uint64_t ticket = 0;
     {
         Locked locked(*this);
-        auto it = active_.find(job_id);
-        if (it == active_.end()) {
-            if (const JobRecord* ended = ended_.Find(job_id)) return AlreadyEnded(*ended);
-            locked.lock.unlock();  // the store is never read under the lock
-            absl::StatusOr<JobRecord> stored = store_.Get(job_id);
-            if (!stored.ok()) return stored.status();
-            return AlreadyEnded(*stored);
-        }
-        Job& job = *it->second;
+        absl::StatusOr<Job*> active = ActiveJob(job_id, locked);
+        if (!active.ok()) return active.status();
+        Job& job = **active;
         Log()->info("job={} priority {} -> {}", job_id, job.record.spec.priority, priority);
         job.record.spec.priority = priority;
         ticket = Save(job);

@@ -116,6 +116,7 @@ SqliteJobStore::Write SqliteJobStore::PutOf(const JobRecord& job) {
     Write w{job.id};
     w.seq = job.seq;
     w.final = IsFinal(job.state);
+    w.drop_results = job.state == JobState::kSucceeded;
     w.request_id = job.spec.request_id;
     if (w.final && job.finished != absl::InfinitePast()) {
         w.finished_us = absl::ToUnixMicros(job.finished);
@@ -223,7 +224,7 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
         put.Bind(1, w.job_id).Bind(2, int64_t(w.seq)).Bind(3, int64_t(w.final));
         put.Bind(4, w.record).Bind(5, w.request_id).Bind(6, w.finished_us).Step();
         status = put.status();
-        if (status.ok() && w.final) {
+        if (status.ok() && w.drop_results) {
             Statement drop(db_, "DELETE FROM task_results WHERE job = ?1");
             drop.Bind(1, w.job_id).Step();
             status = drop.status();

@@ -236,12 +236,13 @@ export function mount(root, id, who, frameText) {
       if (framesFrom !== job.shot.frames_from) job = await get(jobPath());
     }
     summary.replaceChildren(table(['State', 'Owner', 'Method', 'Size', 'Progress', 'Submitted', 'Started', 'Finished', 'ETA'], [
-      h('tr', {}, h('td', { class: 'state', id: 'state' }, job.state), h('td', {}, job.owner || '—'), h('td', {}, job.method),
+      h('tr', {}, h('td', { class: 'state', id: 'state' }, job.paused && !ended(job.state) ? 'paused' : job.state), h('td', {}, job.owner || '—'), h('td', {}, job.method),
         h('td', {}, `${job.width}×${job.height}, ${job.spp} spp`),
         h('td', {}, progress(job.tasks_done, job.tasks_total), job.shot ? ` ${job.shot.frames_done}/${job.shot.frames_total} frames` : ''),
         h('td', {}, time(job.submitted_ms)), h('td', {}, time(job.started_ms)), h('td', {}, time(job.finished_ms)),
         h('td', {}, duration(job.eta_s)))]),
-    h('p', { class: 'error' }, job.error));
+    h('p', { class: 'error' }, job.error),
+    h('p', { class: 'blocklist' }, job.blocklist.map((b) => `blocklisted: ${b.worker} (${b.failures} failures, last: ${b.last_error})`).join('; ')));
     cancel.disabled = ended(job.state);
     remove.disabled = !ended(job.state);
     if (Array.isArray(job.depends_on)) {

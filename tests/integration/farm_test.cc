@@ -150,6 +150,8 @@ std::string ShotScene() {
 }
 constexpr const char* kShotFlags = "--resolution 96x54 --shutter 0.5 --seed 3 --method path";
 
+std::vector<nlohmann::json> JsonLines(const std::string& out);
+
 class Farm : public ::testing::Test {
   protected:
     void SetUp() override {
@@ -207,6 +209,14 @@ class Farm : public ::testing::Test {
                                          (dir_ / ("cache-" + name)).string()};
         argv.insert(argv.end(), more_args.begin(), more_args.end());
         return Spawn(argv, name + ".log");
+    }
+    // Polls `workers` until it lists `count` workers, for at most 10 s.
+    bool WaitForWorkers(size_t count) {
+        for (int i = 0; i < 500; ++i) {
+            if (JsonLines(Farmctl("workers --json").out).size() >= count) return true;
+            std::this_thread::sleep_for(milliseconds(20));
+        }
+        return false;
     }
 
     Child* Spawn(const std::vector<std::string>& argv, const std::string& log) {
@@ -1755,6 +1765,104 @@ TEST(FarmSplatFlags, PhotonFlagsAreRefusedForOtherMethodsOnSubmit) {
     while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
     EXPECT_NE(WEXITSTATUS(pclose(pipe)), 0);
     EXPECT_NE(out.find("--photons"), std::string::npos) << out;
+}
+
+// Job management (issue 30): a worker that fails every task is blocklisted from the job after
+// --blocklist-after of its failures (it cannot fail any one task 3 times: a task it failed waits
+// for the good worker), and the job succeeds on the good worker with the bits of a local render.
+// The blocklist is in the job's record, so it outlives a restart.
+TEST_F(Farm, BrokenWorkerIsBlocklistedAndTheJobSucceedsOnTheGoodOne) {
+    StartServer();
+    StartWorker("good");
+    StartWorker("bad", 1, {"--fail-tasks-for-test"});
+    ASSERT_TRUE(WaitForWorkers(2));
+    const std::string job = Submit(scene_, "--spp 64 --tile 16 --seed 5 --blocklist-after 3");
+    ExpectSameAsLocal(job, scene_, 64, 5);
+    const std::string blocklisted =
+        "(3 failures, last: failing every task (--fail-tasks-for-test) (worker ";
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_NE(status.out.find("  blocklisted: "), std::string::npos) << status.out;
+    EXPECT_NE(status.out.find(blocklisted), std::string::npos) << status.out;
+    EXPECT_NE(status.out.find("attempts  3 a task; blocklist after 3 failures"), std::string::npos)
+        << status.out;
+    EXPECT_EQ(ReadText(dir_ / "good.log").find("failing every task"), std::string::npos);
+    CrashAndRestartServer();
+    EXPECT_NE(Farmctl("status " + job).out.find(blocklisted), std::string::npos);
+}
+
+// With only a broken worker, the job does not wait for ever: once the worker is blocklisted,
+// no live worker may take its tasks and it fails naming the worker.
+TEST_F(Farm, JobFailsWhenItsOnlyWorkerIsBlocklisted) {
+    StartServer();
+    StartWorker("bad", 1, {"--fail-tasks-for-test"});
+    ASSERT_TRUE(WaitForWorkers(1));
+    const std::string job =
+        Submit(scene_, "--spp 1 --tile 16 --max-attempts 10 --blocklist-after 2");
+    EXPECT_NE(Farmctl("watch " + job).status, 0);
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_NE(status.out.find("error     every live worker is blocklisted from the job: "),
+              std::string::npos)
+        << status.out;
+    EXPECT_NE(status.out.find(" (2 failures, last: failing every task"), std::string::npos)
+        << status.out;
+}
+
+// Job management (issue 30): a job failed by its max attempts (a broken worker beside a good
+// one; --max-attempts 1) keeps the results of the tasks done, across a coordinator restart:
+// `requeue` queues it again with those tasks done, and it renders the rest on the good worker to
+// the bits of a local render.
+TEST_F(Farm, RequeuedFailedJobRendersOnAfterARestartToTheBitsOfALocalRender) {
+    StartServer();
+    StartWorker("good");
+    Child* bad = StartWorker("bad", 1, {"--fail-tasks-for-test"});
+    ASSERT_TRUE(WaitForWorkers(2));
+    const std::string job = Submit(scene_, "--spp 16 --tile 16 --seed 7 --max-attempts 1");
+    EXPECT_NE(Farmctl("watch " + job).status, 0);
+    bad->Signal(SIGKILL);
+    ASSERT_TRUE(bad->Wait(milliseconds(5000)));
+    const CliRun failed = Farmctl("status " + job);
+    EXPECT_NE(failed.out.find("error     task "), std::string::npos) << failed.out;
+    EXPECT_NE(failed.out.find("failed 1 time; last: failing every task"), std::string::npos)
+        << failed.out;
+    const TaskCounts before = Tasks(job);
+    CrashAndRestartServer();
+    EXPECT_NE(Farmctl("status " + job).out.find(": failed"), std::string::npos);
+    const CliRun requeued = Farmctl("requeue " + job);
+    ASSERT_EQ(requeued.status, 0) << requeued.err;
+    EXPECT_EQ(requeued.out,
+              "job " + job + " queued (" + std::to_string(before.done) + "/16 tasks done)\n");
+    ExpectSameAsLocal(job, scene_, 16, 7);
+    const CliRun status = Farmctl("status " + job);
+    EXPECT_EQ(status.out.find("error "), std::string::npos) << status.out;
+    // A succeeded job has nothing to requeue.
+    const CliRun again = Farmctl("requeue " + job);
+    EXPECT_NE(again.status, 0);
+    EXPECT_NE(again.err.find("only a failed or cancelled job is queued again"), std::string::npos)
+        << again.err;
+}
+
+// Job management (issue 30): a paused job leases nothing, and stays paused across a restart;
+// resumed, it renders to the bits of a local render. A worker is listed once its first lease
+// request was answered under the scheduler's lock, so "nothing leased" is checked after one.
+TEST_F(Farm, PausedJobStaysPausedAcrossARestartAndRendersOnceResumed) {
+    StartServer();
+    const std::string job = Submit(scene_, "--spp 4 --tile 32 --seed 9");
+    const CliRun paused = Farmctl("pause " + job);
+    ASSERT_EQ(paused.status, 0) << paused.err;
+    EXPECT_EQ(paused.out, "job " + job + " paused\n");
+    StartWorker("w1");
+    ASSERT_TRUE(WaitForWorkers(1));
+    EXPECT_EQ(Tasks(job).leased, 0);
+    EXPECT_NE(Farmctl("status " + job).out.find("job " + job + ": paused"), std::string::npos);
+    CrashAndRestartServer();
+    ASSERT_TRUE(WaitForWorkers(1));
+    EXPECT_EQ(Tasks(job).leased, 0);
+    EXPECT_NE(Farmctl("list").out.find("paused"), std::string::npos);
+    const CliRun resumed = Farmctl("resume " + job);
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(resumed.out, "job " + job + " resumed\n");
+    ExpectSameAsLocal(job, scene_, 4, 9);
+    EXPECT_NE(Farmctl("pause " + job).status, 0);  // it has ended
 }
 
 }  // namespace

@@ -176,6 +176,8 @@ void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {
     out->set_request_id(spec.request_id);
     for (const std::string& tag : spec.tags) out->add_tags(tag);
     out->set_max_workers(spec.max_workers);
+    out->set_max_attempts(spec.max_attempts);
+    out->set_blocklist_after(spec.blocklist_after);
 }
 
 JobSpec FromProto(const pb::SubmitJobRequest& r) {
@@ -188,6 +190,8 @@ JobSpec FromProto(const pb::SubmitJobRequest& r) {
     spec.priority = r.priority();
     spec.tags.assign(r.tags().begin(), r.tags().end());
     spec.max_workers = r.max_workers();
+    if (r.max_attempts() != 0) spec.max_attempts = r.max_attempts();
+    if (r.blocklist_after() != 0) spec.blocklist_after = r.blocklist_after();
     return spec;
 }
 
@@ -259,6 +263,15 @@ void ToProto(const JobRecord& job, pb::Job* out) {
     for (const std::string& tag : job.spec.tags) out->add_tags(tag);
     out->set_max_workers(job.spec.max_workers);
     out->set_waiting_reason(job.waiting_reason);
+    for (const WorkerFailures& w : job.Blocklisted()) {
+        pb::BlockedWorker* b = out->add_blocklist();
+        b->set_worker(w.worker);
+        b->set_failures(w.failures);
+        b->set_last_error(w.last_error);
+    }
+    out->set_max_attempts(job.spec.max_attempts);
+    out->set_blocklist_after(job.spec.blocklist_after);
+    out->set_paused(job.paused);
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {

@@ -36,6 +36,8 @@ void ToProto(const JobSpec& spec, pb::StoredJobSpec* out) {
     out->set_owner(spec.owner);
     for (const std::string& tag : spec.tags) out->add_tags(tag);
     out->set_max_workers(spec.max_workers);
+    out->set_max_attempts(spec.max_attempts);
+    out->set_blocklist_after(spec.blocklist_after);
 }
 
 JobSpec FromProto(const pb::StoredJobSpec& s) {
@@ -52,6 +54,8 @@ JobSpec FromProto(const pb::StoredJobSpec& s) {
     spec.owner = s.owner();
     spec.tags.assign(s.tags().begin(), s.tags().end());
     spec.max_workers = s.max_workers();
+    if (s.max_attempts() != 0) spec.max_attempts = s.max_attempts();
+    if (s.blocklist_after() != 0) spec.blocklist_after = s.blocklist_after();
     return spec;
 }
 
@@ -84,6 +88,13 @@ void ToProto(const JobRecord& job, pb::StoredJob* out) {
         f->set_done(frame.done);
         f->set_result_path(frame.result_path);
     }
+    for (const WorkerFailures& w : job.worker_failures) {
+        pb::StoredWorkerFailures* f = out->add_worker_failures();
+        f->set_worker(w.worker);
+        f->set_failures(w.failures);
+        f->set_last_error(w.last_error);
+    }
+    out->set_paused(job.paused);
 }
 
 absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
@@ -115,6 +126,10 @@ absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
         job.frames.push_back(
             {f.frame(), f.tasks_done(), f.tasks_total(), f.done(), f.result_path()});
     }
+    for (const pb::StoredWorkerFailures& w : s.worker_failures()) {
+        job.worker_failures.push_back({w.worker(), w.failures(), w.last_error()});
+    }
+    job.paused = s.paused();
     return job;
 }
 

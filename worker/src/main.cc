@@ -69,6 +69,10 @@ int main(int argc, char** argv) {
                    "what stderr shows: trace, debug, info, warn, error or off (each task's log "
                    "for the server keeps info and above in any case)")
         ->capture_default_str();
+    // Hidden (no group): for the farm's tests of retries and the blocklist only.
+    app.add_flag("--fail-tasks-for-test", options.fail_tasks_for_test,
+                 "tests only: fail every task at once")
+        ->group("");
     CLI11_PARSE(app, argc, argv);
 
     const auto fail = [](const absl::Status& s) {

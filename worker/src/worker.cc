@@ -157,7 +157,9 @@ void Worker::Execute(const TaskAssignment& task) {
     const absl::Time start = absl::Now();
     ServerConnection::TaskResult result;
     RenderStats stats;
-    absl::Status status = PrepareScene(task, cancel);
+    absl::Status status = options_.fail_tasks_for_test
+                              ? absl::InternalError("failing every task (--fail-tasks-for-test)")
+                              : PrepareScene(task, cancel);
     if (status.ok()) status = RunTask(task, cancel, result, stats);
     {
         std::lock_guard<std::mutex> lock(hb_mutex);

@@ -12,8 +12,8 @@ The gRPC stubs (lightfarm.v1) are generated from proto/ when the repository is b
 importable package is build/python/lightfarm.
 """
 
-from .client import (DEFAULT_SERVER, METHODS, Client, Job, JobState, LogLine, Progress, Task,
-                     Worker, load_token)
+from .client import (DEFAULT_SERVER, METHODS, BlockedWorker, Client, Job, JobState, LogLine,
+                     Progress, Task, Worker, load_token)
 from .errors import (Aborted, AlreadyExists, Cancelled, DeadlineExceeded, FailedPrecondition,
                      Internal, InvalidArgument, LightfarmError, NotFound, OutOfRange,
                      PermissionDenied, ResourceExhausted, TlsError, Unauthenticated, Unavailable,
@@ -22,7 +22,7 @@ from .preview import exr_to_png
 from .scene import scene_files
 
 __all__ = [
-    "Client", "Job", "JobState", "LogLine", "Progress", "Task", "Worker", "DEFAULT_SERVER",
+    "BlockedWorker", "Client", "Job", "JobState", "LogLine", "Progress", "Task", "Worker", "DEFAULT_SERVER",
     "METHODS", "load_token", "scene_files", "exr_to_png", "LightfarmError", "Aborted", "AlreadyExists",
     "Cancelled", "DeadlineExceeded", "FailedPrecondition", "Internal", "InvalidArgument",
     "NotFound", "OutOfRange", "PermissionDenied", "ResourceExhausted", "TlsError",

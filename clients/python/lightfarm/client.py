@@ -62,6 +62,14 @@ class JobState(enum.Enum):
 
 
 @dataclasses.dataclass(frozen=True)
+class BlockedWorker:
+    """A worker blocklisted from a job (lightfarm.v1.BlockedWorker): its failures there."""
+    worker: str
+    failures: int
+    last_error: str
+
+
+@dataclasses.dataclass(frozen=True)
 class Job:
     """A job as the server reports it (lightfarm.v1.Job; ``proto`` is the message itself)."""
     id: str
@@ -89,6 +97,25 @@ class Job:
     max_workers: int       # at most this many workers at once; 0 no cap
     waiting_reason: str    # why no worker takes it, e.g. "waiting for a worker with tags gpu"
     proto: pb.Job = dataclasses.field(repr=False, compare=False)
+
+    # Job management (issue 30).
+    @property
+    def blocklist(self) -> List["BlockedWorker"]:
+        """The workers blocklisted from the job: they get none of its tasks any more."""
+        return [BlockedWorker(b.worker, b.failures, b.last_error) for b in self.proto.blocklist]
+
+    @property
+    def paused(self) -> bool:
+        """Paused (``Client.pause``): a queued or running job that leases nothing new."""
+        return self.proto.paused
+
+    @property
+    def max_attempts(self) -> int:
+        return self.proto.max_attempts
+
+    @property
+    def blocklist_after(self) -> int:
+        return self.proto.blocklist_after
 
     @property
     def params(self) -> common_pb2.RenderParams:
@@ -374,6 +401,22 @@ class Client:
         return Job.from_proto(self._unary(
             "SetJobPriority", pb.SetJobPriorityRequest(job_id=job_id, priority=priority)))
 
+    # Job management (issue 30).
+    def requeue(self, job_id: str) -> Job:
+        """Puts the job's failed tasks back in the queue with their failures reset and clears
+        its blocklist; a failed or cancelled job is queued again and renders on from the tasks it
+        had done (``lightfarm requeue``). FailedPrecondition for a succeeded job."""
+        return Job.from_proto(self._unary("RequeueJob", pb.RequeueJobRequest(job_id=job_id)))
+
+    def pause(self, job_id: str) -> Job:
+        """Pauses a queued or running job: it leases nothing new, its running tasks finish
+        (``lightfarm pause``); it stays paused across a restart. FailedPrecondition once ended."""
+        return Job.from_proto(self._unary("PauseJob", pb.PauseJobRequest(job_id=job_id)))
+
+    def resume(self, job_id: str) -> Job:
+        """Resumes a paused job (``lightfarm resume``)."""
+        return Job.from_proto(self._unary("ResumeJob", pb.ResumeJobRequest(job_id=job_id)))
+
     def workers(self) -> List[Worker]:
         """The workers the server heard from within a lease."""
         resp = self._unary("ListWorkers", pb.ListWorkersRequest())
@@ -510,7 +553,8 @@ class Client:
                sweep_tasks: int = 8, max_patches: int = 0,
                photons_per_pass: int = 1 << 18, initial_radius: float = 0.0,
                alpha: float = 2.0 / 3.0, request_id: Optional[str] = None,
-               tags: Sequence[str] = (), max_workers: int = 0) -> str:
+               tags: Sequence[str] = (), max_workers: int = 0,
+               max_attempts: int = 3, blocklist_after: int = 3) -> str:
         """Uploads the scene and every file it names (those the server lacks, resuming a broken
         upload) and queues it as a job; returns the job id.
 
@@ -525,8 +569,10 @@ class Client:
         ``patch_size``, ``solver``, ``tolerance``, ``max_iterations``, ``display``,
         ``sweep_tasks``, ``max_patches``; photon mapping's ``photons_per_pass``,
         ``initial_radius``, ``alpha``; ``tags`` (only workers having every one take the job)
-        and ``max_workers`` (at most this many workers at once, 0 no cap). The server checks
-        them all and the scene (InvalidArgument
+        and ``max_workers`` (at most this many workers at once, 0 no cap); ``max_attempts``
+        (failures of one task that fail the job) and ``blocklist_after`` (a worker's failures in
+        the job after which it gets none of its tasks), 1 to 100. The server checks them all
+        and the scene (InvalidArgument
         with the loader's message). ``request_id`` makes retries idempotent (default: 128
         random bits, the same on every retry of this call).
         """
@@ -567,7 +613,7 @@ class Client:
             scene=ref(scene_name, text), files=[ref(n, d) for n, d in named], params=params,
             priority=priority, name=name or scene_name,
             request_id=request_id or secrets.token_hex(16), tags=list(tags),
-            max_workers=max_workers)
+            max_workers=max_workers, max_attempts=max_attempts, blocklist_after=blocklist_after)
         files = [req.scene] + list(req.files)
 
         backoff = _Backoff(self.retry_seconds)

@@ -599,5 +599,34 @@ class ClientTest(unittest.TestCase):
         one = builtins.list(self.alice.logs(job_id, task=0))
         self.assertTrue(one and all(l.task_index == 0 for l in one), one)
 
+    def test_max_attempts_and_blocklist_after(self):
+        """Job management (issue 30): submit's limits reach the job; out of range is refused."""
+        job = self.alice.wait(self.alice.submit(cornell(), max_attempts=7, blocklist_after=2,
+                                                **SMALL))
+        self.assertEqual((job.max_attempts, job.blocklist_after), (7, 2))
+        self.assertEqual(job.blocklist, [])
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.submit(cornell(), max_attempts=101, **SMALL)
+        self.assertIn("max_attempts 101: expected 1 to 100", caught.exception.message)
+
+    def test_requeue(self):
+        """Job management (issue 30): a cancelled job is queued again; a succeeded one is not."""
+        job_id = self.alice.submit(cornell(), spp=4096, resolution=(128, 128), tile=32,
+                                   name="long")
+        self.assertEqual(self.alice.cancel(job_id).state, lightfarm.JobState.CANCELLED)
+        job = self.alice.requeue(job_id)
+        self.assertEqual(job.state, lightfarm.JobState.QUEUED)
+        self.assertEqual(job.error, "")
+        # Paused and resumed while it runs; cancelled, it cannot be paused.
+        self.assertTrue(self.alice.pause(job_id).paused)
+        self.assertTrue(self.alice.get(job_id).paused)
+        self.assertFalse(self.alice.resume(job_id).paused)
+        self.assertEqual(self.alice.cancel(job_id).state, lightfarm.JobState.CANCELLED)
+        with self.assertRaises(lightfarm.FailedPrecondition):
+            self.alice.pause(job_id)
+        done = self.alice.wait(self.alice.submit(cornell(), **SMALL))
+        with self.assertRaises(lightfarm.FailedPrecondition):
+            self.alice.requeue(done.id)
+
 if __name__ == "__main__":
     unittest.main()

@@ -12,9 +12,9 @@ namespace lf {
 namespace {
 
 constexpr Action kAllActions[] = {
-    Action::kUploadBlobs, Action::kSubmit,      Action::kReadJobs,
-    Action::kCancelJob,   Action::kSetPriority, Action::kDeleteJob,
-    Action::kListWorkers, Action::kWork,        Action::kManageWorkers};
+    Action::kUploadBlobs,   Action::kSubmit,    Action::kReadJobs,    Action::kCancelJob,
+    Action::kSetPriority,   Action::kDeleteJob, Action::kListWorkers, Action::kWork,
+    Action::kManageWorkers, Action::kManageJobs};
 
 TEST(Permit, AdminMayDoEverything) {
     for (Action a : kAllActions) EXPECT_TRUE(Permit({"root", Role::kAdmin}, a).ok());

@@ -77,7 +77,6 @@ class FarmConcurrencyTest : public ::testing::Test {
         options.data_dir = dir_.string();
         options.scheduler.lease = absl::Milliseconds(500);
         options.scheduler.speculate_after = absl::Milliseconds(20);  // second leases happen
-        options.scheduler.max_failures = 1000;  // failures here are chance, not the job's fault
         absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
         ASSERT_TRUE(farm.ok()) << farm.status();
         farm_ = std::move(*farm);
@@ -113,6 +112,8 @@ class FarmConcurrencyTest : public ::testing::Test {
         spec.priority = n % 3;
         spec.request_id = request_id;
         spec.owner = owner;
+        // Failures here are chance, not the job's fault, nor a worker's.
+        spec.max_attempts = spec.blocklist_after = kMaxAttemptsLimit;
         return spec;
     }
 

@@ -225,6 +225,22 @@ TEST_F(GuardedServices, SubmitterSeesOnlyItsOwnJobsAdminSeesAll) {
     ASSERT_TRUE(Jobs("alice")->ListTasks(Context().get(), list_tasks, &tasks).ok());
     EXPECT_GT(tasks.tasks_size(), 0);
     EXPECT_TRUE(Jobs("alice")->GetTaskLogs(Context().get(), get_logs, &logs).ok());
+    // Job management (issue 30): Bob can neither pause, resume nor requeue Alice's job; she
+    // and the admin can.
+    pb::PauseJobRequest pause;
+    pause.set_job_id(alice_job);
+    pb::ResumeJobRequest resume;
+    resume.set_job_id(alice_job);
+    pb::RequeueJobRequest requeue;
+    requeue.set_job_id(alice_job);
+    expect_hidden(bob->PauseJob(Context().get(), pause, &job));
+    expect_hidden(bob->ResumeJob(Context().get(), resume, &job));
+    expect_hidden(bob->RequeueJob(Context().get(), requeue, &job));
+    ASSERT_TRUE(Jobs("alice")->PauseJob(Context().get(), pause, &job).ok());
+    EXPECT_TRUE(job.paused());
+    ASSERT_TRUE(Jobs("root")->ResumeJob(Context().get(), resume, &job).ok());
+    EXPECT_FALSE(job.paused());
+    EXPECT_TRUE(Jobs("alice")->RequeueJob(Context().get(), requeue, &job).ok());
     // Alice's own calls work, and the admin may cancel anyone's job.
     EXPECT_TRUE(Jobs("alice")->CancelJob(Context().get(), cancel, &job).ok());
     pb::CancelJobRequest cancel_bob;

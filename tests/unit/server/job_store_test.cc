@@ -164,6 +164,35 @@ TEST(JobRecordCodec, CameraAndResolutionSurviveAndOldRecordsHaveNone) {
 }
 
 // --sky travels in the record as in RenderParams (a server restart keeps it).
+// Job management (issue 30): the job's limits, its workers' failures and its pause survive;
+// a record from before them reads with the defaults.
+TEST(JobRecordCodec, JobManagementSurvivesAndOldRecordsHaveTheDefaults) {
+    JobRecord job = Record("a", 1);
+    job.spec.max_attempts = 7;
+    job.spec.blocklist_after = 2;
+    job.worker_failures = {{"w1", 2, "no GPU"}, {"w2", 1, "disk full"}};
+    job.paused = true;
+    nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(job));
+    const absl::StatusOr<JobRecord> back = DecodeJobRecord(stored.dump());
+    ASSERT_TRUE(back.ok()) << back.status();
+    EXPECT_EQ(back->spec.max_attempts, 7);
+    EXPECT_EQ(back->spec.blocklist_after, 2);
+    ASSERT_EQ(back->worker_failures.size(), 2u);
+    EXPECT_EQ(back->worker_failures[0].worker, "w1");
+    EXPECT_EQ(back->worker_failures[0].failures, 2);
+    EXPECT_EQ(back->worker_failures[0].last_error, "no GPU");
+    EXPECT_EQ(back->Blocklisted().size(), 1u);
+    EXPECT_TRUE(back->paused);
+    for (const char* field : {"worker_failures", "paused"}) stored.erase(field);
+    for (const char* field : {"max_attempts", "blocklist_after"}) stored["spec"].erase(field);
+    const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
+    ASSERT_TRUE(old.ok()) << old.status();
+    EXPECT_EQ(old->spec.max_attempts, kDefaultMaxAttempts);
+    EXPECT_EQ(old->spec.blocklist_after, kDefaultBlocklistAfter);
+    EXPECT_TRUE(old->worker_failures.empty());
+    EXPECT_FALSE(old->paused);
+}
+
 TEST(JobRecordCodec, SkySurvives) {
     JobRecord job = Record("a", 1);
     job.spec.scene_options.sky = "../maps/sky.hdr";

@@ -22,7 +22,6 @@ class SchedulerTest : public ::testing::Test {
     static SchedulerOptions Options() {
         SchedulerOptions o;
         o.lease = absl::Seconds(10);
-        o.max_failures = 3;
         return o;
     }
 
@@ -203,7 +202,8 @@ TEST_F(SchedulerTest, LastErrorShowsWhileTheTaskIsRetried) {
 }
 
 // With any number of workers, a task that fails on every attempt fails its job after
-// max_failures counted failures: once it failed on every live worker it is leased again.
+// max_attempts (3 by default) counted failures: once it failed on every live worker it is leased
+// again.
 class AlwaysFailingTaskTest : public SchedulerTest, public ::testing::WithParamInterface<int> {};
 
 TEST_P(AlwaysFailingTaskTest, FailsTheJobAfterMaxFailuresNamingTheTaskAndTheLastReason) {
@@ -232,6 +232,130 @@ TEST_P(AlwaysFailingTaskTest, FailsTheJobAfterMaxFailuresNamingTheTaskAndTheLast
 }
 
 INSTANTIATE_TEST_SUITE_P(Workers, AlwaysFailingTaskTest, ::testing::Values(1, 2, 3));
+
+// Job management (issue 30): the job's own max attempts, and the blocklist.
+class JobManagementTest : public SchedulerTest {
+  protected:
+    // A 16x16 image in 8x8 tiles, one pass: 4 tasks.
+    std::string SubmitWith(int max_attempts, int blocklist_after) {
+        JobSpec spec;
+        spec.name = "managed";
+        spec.plan = {16, 16, 1, 8, 1};
+        spec.max_attempts = max_attempts;
+        spec.blocklist_after = blocklist_after;
+        absl::StatusOr<std::string> id = scheduler_.Submit(spec);
+        EXPECT_TRUE(id.ok()) << id.status();
+        return *id;
+    }
+    void FailNext(const std::string& worker, const std::string& reason) {
+        const std::optional<TaskAssignment> lease = scheduler_.LeaseTask(worker);
+        ASSERT_TRUE(lease.has_value()) << worker;
+        ASSERT_TRUE(scheduler_.Fail(lease->lease_id, worker, reason, FailureKind::kTaskError).ok());
+    }
+};
+
+TEST_F(JobManagementTest, MaxAttemptsOfTheJobFailIt) {
+    const std::string id = SubmitWith(1, 3);
+    FailNext("w", "out of memory");
+    EXPECT_EQ(Job(id).state, JobState::kFailed);
+    EXPECT_EQ(Job(id).error, "task 0 failed 1 time; last: out of memory (worker w)");
+}
+
+TEST_F(JobManagementTest, BlocklistedWorkerGetsNoMoreTasksOfTheJob) {
+    const std::string id = SubmitWith(3, 2);
+    scheduler_.LeaseTask("good");     // alive, holding task 0
+    FailNext("bad", "no GPU");        // task 1
+    FailNext("bad", "no GPU again");  // task 2: blocklisted
+    EXPECT_FALSE(scheduler_.LeaseTask("bad").has_value());
+    const JobRecord job = Job(id);
+    EXPECT_EQ(job.state, JobState::kRunning);
+    ASSERT_EQ(job.Blocklisted().size(), 1u);
+    EXPECT_EQ(job.Blocklisted()[0].worker, "bad");
+    EXPECT_EQ(job.Blocklisted()[0].failures, 2);
+    EXPECT_EQ(job.Blocklisted()[0].last_error, "no GPU again (worker bad)");
+    // Saved with the record, so it outlives a restart.
+    ASSERT_EQ(store_.Get(id)->worker_failures.size(), 1u);
+    EXPECT_EQ(store_.Get(id)->worker_failures[0].failures, 2);
+    // The good worker renders the rest, the failed tasks included.
+    for (int i = 0; i < 3; ++i) {
+        const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("good");
+        ASSERT_TRUE(lease.has_value());
+        ASSERT_TRUE(scheduler_.Complete(lease->lease_id, "good", Result(*lease)).ok());
+    }
+    EXPECT_EQ(Job(id).tasks_done, 3);
+    EXPECT_FALSE(scheduler_.LeaseTask("bad").has_value());
+}
+
+TEST_F(JobManagementTest, RequeueOfARunningJobResetsItsFailuresAndBlocklist) {
+    const std::string id = SubmitWith(2, 2);
+    scheduler_.LeaseTask("good");  // alive, holding task 0
+    FailNext("bad", "no GPU");     // task 1
+    FailNext("bad", "no GPU");     // task 2: blocklisted
+    ASSERT_EQ(Job(id).Blocklisted().size(), 1u);
+    absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(id);
+    ASSERT_TRUE(requeued.ok()) << requeued.status();
+    EXPECT_TRUE(requeued->record.Blocklisted().empty());
+    EXPECT_EQ(requeued->record.last_error, "");
+    EXPECT_TRUE(store_.Get(id)->worker_failures.empty());
+    // The bad worker may take the tasks again, even those it failed, and each has its two
+    // attempts again: one more failure of task 1 does not fail the job.
+    const std::vector<TaskStatus> before = *scheduler_.Tasks(id);
+    EXPECT_EQ(before[1].failures, 0);
+    FailNext("bad", "no GPU");
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+}
+
+TEST_F(JobManagementTest, RequeuedFailedJobIsQueuedAgainAndRenders) {
+    const std::string id = SubmitWith(1, 3);
+    FailNext("w", "out of memory");
+    ASSERT_EQ(Job(id).state, JobState::kFailed);
+    absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(id);
+    ASSERT_TRUE(requeued.ok()) << requeued.status();
+    EXPECT_EQ(Job(id).state, JobState::kQueued);
+    EXPECT_EQ(Job(id).error, "");
+    EXPECT_EQ(Job(id).finished, absl::InfinitePast());
+    bool rendered = false;
+    while (std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w")) {
+        absl::StatusOr<Scheduler::Completion> done =
+            scheduler_.Complete(lease->lease_id, "w", Result(*lease));
+        ASSERT_TRUE(done.ok()) << done.status();
+        rendered = done->job_rendered;
+    }
+    EXPECT_TRUE(rendered);
+    scheduler_.Finish(id, std::string("/results/x.exr"));
+    EXPECT_EQ(Job(id).state, JobState::kSucceeded);
+}
+
+TEST_F(JobManagementTest, PausedJobLeasesNothingNewButItsRunningTasksMerge) {
+    const std::string id = SubmitWith(3, 3);
+    const TaskAssignment running = *scheduler_.LeaseTask("w");
+    absl::StatusOr<JobRecord> paused = scheduler_.SetPaused(id, true);
+    ASSERT_TRUE(paused.ok()) << paused.status();
+    EXPECT_TRUE(paused->paused);
+    EXPECT_TRUE(store_.Get(id)->paused);  // durable
+    EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
+    EXPECT_FALSE(scheduler_.LeaseTask("idle").has_value());  // nor a second lease of a straggler
+    ASSERT_TRUE(scheduler_.Complete(running.lease_id, "w", Result(running)).ok());
+    EXPECT_EQ(Job(id).tasks_done, 1);
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+    ASSERT_TRUE(scheduler_.SetPaused(id, false).ok());
+    EXPECT_TRUE(scheduler_.LeaseTask("w").has_value());
+    ASSERT_TRUE(scheduler_.Cancel(id).ok());
+    EXPECT_EQ(scheduler_.SetPaused(id, true).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(scheduler_.SetPaused("job-none", true).status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST_F(JobManagementTest, JobFailsWhenEveryLiveWorkerIsBlocklisted) {
+    const std::string id = SubmitWith(5, 2);
+    FailNext("bad", "no GPU");
+    EXPECT_EQ(Job(id).state, JobState::kRunning);
+    FailNext("bad", "no GPU");
+    EXPECT_EQ(Job(id).state, JobState::kFailed);
+    EXPECT_EQ(Job(id).error,
+              "every live worker is blocklisted from the job: bad (2 failures, last: no GPU "
+              "(worker bad))");
+}
 
 TEST_F(SchedulerTest, MadeUpWorkerIdsAreForgottenAfterALease) {
     for (int i = 0; i < 100'000; ++i) {

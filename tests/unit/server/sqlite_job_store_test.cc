@@ -231,6 +231,55 @@ TEST_F(SqliteJobStoreTest, JobRenderedButNotWrittenIsHandedBackAfterARestart) {
     EXPECT_TRUE(store->TaskResults(id)->empty()) << "an ended job keeps no task results";
 }
 
+// Job management (issue 30): a failed job keeps its task results, so that a requeue after a
+// restart merges them again (the Recover path) and renders only the rest, to the image of a
+// job that never failed.
+TEST_F(SqliteJobStoreTest, RequeuedFailedJobRendersOnFromItsRecordedResultsAfterARestart) {
+    JobSpec spec = Spec();  // 8 tasks
+    spec.max_attempts = 1;
+    std::string id, whole;
+    std::vector<float> expected;
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        Scheduler before({}, *store);
+        whole = *before.Submit(Spec());
+        CompleteAll(before, "w");
+        expected = Pixels(before, whole);
+        id = *before.Submit(spec);
+        for (int i = 0; i < 3; ++i) {
+            const TaskAssignment lease = *before.LeaseTask("w");
+            ASSERT_TRUE(before.Complete(lease.lease_id, "w", Result(lease)).ok());
+        }
+        const TaskAssignment failing = *before.LeaseTask("w");
+        ASSERT_TRUE(before.Fail(failing.lease_id, "w", "no GPU", FailureKind::kTaskError).ok());
+        ASSERT_EQ(before.Get(id)->state, JobState::kFailed);
+        EXPECT_EQ(store->TaskResults(id)->size(), 3u) << "a failed job keeps its task results";
+    }
+    std::unique_ptr<SqliteJobStore> store = OpenStore();
+    Scheduler after({}, *store);
+    ASSERT_TRUE(after.Recover().ok());
+    EXPECT_EQ(after.Get(id)->state, JobState::kFailed);  // stays failed until requeued
+    absl::StatusOr<Scheduler::Requeued> requeued = after.RequeueJob(id);
+    ASSERT_TRUE(requeued.ok()) << requeued.status();
+    EXPECT_EQ(requeued->record.state, JobState::kQueued);
+    EXPECT_EQ(requeued->record.error, "");
+    EXPECT_EQ(requeued->record.tasks_done, 3);
+    EXPECT_FALSE(requeued->rendered);
+    EXPECT_EQ(store->Get(id)->state, JobState::kQueued);  // durable
+    int leased = 0;
+    while (std::optional<TaskAssignment> lease = after.LeaseTask("w")) {
+        ++leased;
+        ASSERT_TRUE(after.Complete(lease->lease_id, "w", Result(*lease)).ok());
+    }
+    EXPECT_EQ(leased, 5);
+    EXPECT_EQ(Pixels(after, id), expected);
+    after.Finish(id, std::string("/results/x.exr"));
+    EXPECT_EQ(after.Get(id)->state, JobState::kSucceeded);
+    EXPECT_TRUE(store->TaskResults(id)->empty()) << "a succeeded job keeps no task results";
+    EXPECT_EQ(after.RequeueJob(id).status().code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(after.RequeueJob("job-none").status().code(), absl::StatusCode::kNotFound);
+}
+
 TEST_F(SqliteJobStoreTest, SubmissionRetriedWithItsRequestIdGetsTheSameJob) {
     JobSpec spec = Spec();
     spec.request_id = "req-1";

@@ -35,5 +35,9 @@ Command AddDeleteCommand(CLI::App& app);
 Command AddWorkersCommand(CLI::App& app);
 Command AddTasksCommand(CLI::App& app);
 Command AddLogsCommand(CLI::App& app);
+// Job management (issue 30; job_management_commands.cc).
+Command AddRequeueCommand(CLI::App& app);
+Command AddPauseCommand(CLI::App& app);
+Command AddResumeCommand(CLI::App& app);
 
 }  // namespace lf

@@ -19,6 +19,14 @@ const char* JobStateName(JobState state);
 absl::StatusOr<JobState> JobStateFromName(std::string_view name);
 inline bool IsFinal(JobState s) { return s != JobState::kQueued && s != JobState::kRunning; }
 
+// A worker's counted task failures in one job (issue 30's blocklist): those it reported itself
+// (task errors and refused results), not leases that expired.
+struct WorkerFailures {
+    std::string worker;
+    int failures = 0;
+    std::string last_error;
+};
+
 struct JobRecord {
     std::string id;
     uint64_t seq = 0;  // submission order
@@ -37,7 +45,15 @@ struct JobRecord {
     // Why a queued or running job has tasks no worker takes, when the scheduler knows ("waiting
     // for a worker with tags gpu"); set as the job is read, never stored.
     std::string waiting_reason;
+    // Every worker that failed a task of this job, in the order of their first failure.
+    std::vector<WorkerFailures> worker_failures;
+    // `lightfarm pause`: a queued or running job that leases nothing new (its running tasks
+    // finish and merge) until resumed. A flag, not a state: the job is still queued or running.
+    bool paused = false;
     int frames_done() const;
+    // The workers of worker_failures with spec.blocklist_after failures or more: they get no
+    // more tasks of this job.
+    std::vector<WorkerFailures> Blocklisted() const;
 };
 
 // What a done task's leases left behind, recorded with its result so that `lightfarm tasks`

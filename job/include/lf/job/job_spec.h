@@ -21,6 +21,10 @@
 
 namespace lf {
 
+// `submit --max-attempts` and `--blocklist-after`: their defaults, and the limit of both.
+inline constexpr int kDefaultMaxAttempts = 3, kDefaultBlocklistAfter = 3;
+inline constexpr int kMaxAttemptsLimit = 100;
+
 struct JobSpec {
     std::string name;
     BlobRef scene;               // the scene JSON
@@ -49,6 +53,11 @@ struct JobSpec {
     // Leased only to workers having every one of these tags (lf/job/worker_tags.h); none: any.
     std::vector<std::string> tags;
     int max_workers = 0;  // distinct workers holding its leases at once; 0: no cap
+    // Job management (issue 30): counted failures of one task that fail the job, and the
+    // counted failures of one worker in this job after which it gets none of the job's tasks
+    // (the blocklist, JobRecord::Blocklisted).
+    int max_attempts = kDefaultMaxAttempts;
+    int blocklist_after = kDefaultBlocklistAfter;
 };
 
 // The limits of a job's settings, one list for the CLI's flags (`render`, `submit`) and the

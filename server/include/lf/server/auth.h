@@ -30,6 +30,8 @@ enum class Action {
     kListWorkers,    // the farm's workers: admins and submitters
     kWork,           // LeaseTask, Heartbeat, CompleteTask, FailTask, FetchBlob
     kManageWorkers,  // SetWorkerState: admins only
+    // Job management (issue 30): RequeueJob, PauseJob, ResumeJob; own jobs, or all for an admin.
+    kManageJobs,
 };
 const char* ActionName(Action action);
 

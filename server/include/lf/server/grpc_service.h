@@ -68,6 +68,16 @@ class JobServiceImpl final : public ReadAfterAuth<lightfarm::v1::JobService::Ser
     grpc::Status SetWorkerState(grpc::ServerContext*, const Caller&,
                                 const lightfarm::v1::SetWorkerStateRequest&,
                                 lightfarm::v1::SetWorkerStateResponse*);
+    // Job management (issue 30).
+    grpc::Status RequeueJob(grpc::ServerContext*, const Caller&,
+                            const lightfarm::v1::RequeueJobRequest&, lightfarm::v1::Job*);
+    grpc::Status PauseJob(grpc::ServerContext*, const Caller&,
+                          const lightfarm::v1::PauseJobRequest&, lightfarm::v1::Job*);
+    grpc::Status ResumeJob(grpc::ServerContext*, const Caller&,
+                           const lightfarm::v1::ResumeJobRequest&, lightfarm::v1::Job*);
+    // PauseJob and ResumeJob.
+    grpc::Status SetPaused(grpc::ServerContext* context, const Caller& caller,
+                           const std::string& job_id, bool paused, lightfarm::v1::Job* resp);
     grpc::Status FetchResult(grpc::ServerContext*, const Caller&,
                              const lightfarm::v1::FetchResultRequest&,
                              const std::function<bool(const lightfarm::v1::Chunk&)>&);

@@ -37,7 +37,8 @@ class JobStore {
     // job holds is refused (AlreadyExists from WaitDurable).
     virtual uint64_t QueuePut(const JobRecord& job) = 0;  // insert or replace, by id
     // The job's record together with the encoded TileSums of its task `task` and the task's
-    // history, in one write. A record in a final state drops the job's task results.
+    // history, in one write. A succeeded record drops the job's task results; a failed or
+    // cancelled one keeps them for `lightfarm requeue` (Scheduler::RequeueJob) until deleted.
     virtual uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result,
                                    const TaskHistory& history) = 0;
     // Removes the job's record and task results; nothing to remove is not an error.

@@ -9,8 +9,9 @@
 // scheduler's lock.
 //
 // A lease that expires or a failure puts the task back in the queue, where workers it has not
-// failed on take it first; the third counted failure fails the job. Cancelling a job drops all its
-// tasks at once: their heartbeats answer "stop".
+// failed on take it first; the job's max_attempts-th counted failure of a task fails the job. A
+// worker that failed blocklist_after of a job's tasks gets none of them (lf/server/blocklist.h).
+// Cancelling a job drops all its tasks at once: their heartbeats answer "stop".
 #pragma once
 
 #include <condition_variable>
@@ -43,7 +44,6 @@ namespace lf {
 
 struct SchedulerOptions {
     absl::Duration lease = absl::Seconds(10);  // a lease lasts this long past the last heartbeat
-    int max_failures = 3;                      // counted failures of one task that fail its job
     // Near the end of a job (no task of it queued), an idle worker gets a second lease of a task
     // running longer than this and longer than twice the job's mean task time; the first result
     // wins (both are the same bits), so one slow worker does not hold the job.
@@ -88,7 +88,7 @@ struct SchedulerLoad {
 };
 
 enum class FailureKind {
-    kTaskError,       // counts toward max_failures
+    kTaskError,       // counts toward the job's max_attempts and the worker's blocklist
     kWorkerShutdown,  // the worker was told to stop: not the task's fault
 };
 
@@ -167,6 +167,23 @@ class Scheduler {
     // the next lease on. Returns the record once it is durable; FailedPrecondition for a job that
     // has ended, NotFound for one the store does not hold.
     absl::StatusOr<JobRecord> SetPriority(const std::string& job_id, int priority);
+
+    // Job management (issue 30).
+    // `lightfarm requeue`: the job's failed tasks go back in the queue with their failures
+    // reset (their lease counts stay, as the attempt numbers of their logs), and its blocklist
+    // is cleared. A failed or cancelled job is queued again (ReopenJob): its recorded task
+    // results merge as after a restart (Recover) and it renders on from there. `rendered`: the
+    // job is fully rendered already; the caller writes the result and Finishes. NotFound for a
+    // job the store does not hold, FailedPrecondition for a succeeded one, Unavailable for one
+    // ending right now (its final record not yet durable).
+    struct Requeued {
+        JobRecord record;
+        bool rendered = false;
+    };
+    absl::StatusOr<Requeued> RequeueJob(const std::string& job_id);
+    // `lightfarm pause` and `resume` (JobRecord::paused): returns the record once durable;
+    // FailedPrecondition for a job that has ended, NotFound for one the store does not hold.
+    absl::StatusOr<JobRecord> SetPaused(const std::string& job_id, bool paused);
 
     // Re-queues the tasks whose lease ran out (each counts as a failure of the task), and
     // forgets the workers silent for a lease. Returns how many leases expired.
@@ -288,6 +305,11 @@ class Scheduler {
     // ticket to wait for.
     std::optional<std::pair<std::string, uint64_t>> FindRequestInMemory(
         const std::string& request_id) const;
+    // Takes up a job of the store that has not ended, as Recover does: its recorded results
+    // merge again in the order they merged, every other task is queued. In active_ after;
+    // returns whether it is fully rendered.
+    absl::StatusOr<bool> TakeUp(JobRecord record,
+                                const std::map<int, JobStore::RecordedTask>& results);
     std::optional<TaskAssignment> TryLease(const std::string& worker,
                                            const WorkerDescription* about);
     // Drops a job's tasks once its time limit has passed; true if dropping them completed the
@@ -317,8 +339,16 @@ class Scheduler {
     // made-up id, another worker's lease, one from before a restart, or of a job that ended).
     std::optional<LeaseRef> Resolve(const std::string& lease_id, const std::string& worker);
     // Ends the lease; when no other lease of the task is current, puts the task back in the
-    // queue. Counts a failure unless `counted` is false; fails the job at max_failures.
+    // queue. Counts a failure unless `counted` is false; fails the job at its max_attempts.
     void Requeue(const LeaseRef& ref, const std::string& reason, bool counted);
+    // Requeue for a failure the worker itself reported (an error, a refused result): it also
+    // counts toward the worker's blocklist, and fails the job when that leaves it no live worker.
+    void RequeueReported(const LeaseRef& ref, const std::string& reason);
+    // The queued or running job `job_id` to change, with `locked` held; for any other, the
+    // status to answer (read from the store with the lock released, as SetPriority does).
+    absl::StatusOr<Job*> ActiveJob(const std::string& job_id, Locked& locked);
+    // Fails the job when every live worker is blocklisted from it (StrandedError).
+    void FailIfStranded(Job& job);
     void FailJob(Job& job, const std::string& error);
     // A stored job Recover cannot take up, ended as failed with `why`; the lock is held.
     void FailUnrecoverable(JobRecord record, const absl::Status& why);

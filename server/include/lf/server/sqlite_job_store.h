@@ -53,6 +53,8 @@ class SqliteJobStore : public JobStore {
         bool remove = false;
         uint64_t seq = 0;
         bool final = false;
+        // Succeeded: its task results go. A failed or cancelled job keeps them (requeue).
+        bool drop_results = false;
         std::string request_id = {};
         std::optional<int64_t> finished_us = {};  // ended jobs only
         std::string record = {};                  // EncodeJobRecord

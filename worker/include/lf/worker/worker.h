@@ -35,6 +35,9 @@ struct WorkerOptions {
     absl::Duration lease_wait = absl::Seconds(1);
     // ...and backs off from this to that while the server cannot be reached.
     absl::Duration min_idle = absl::Milliseconds(50), max_idle = absl::Seconds(1);
+    // Tests only (lightfarm-worker --fail-tasks-for-test): every task fails at once, as on a
+    // broken machine, for the farm tests of retries and the blocklist.
+    bool fail_tasks_for_test = false;
 };
 
 class Worker {

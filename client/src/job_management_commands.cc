@@ -1,0 +1,80 @@
+// Job management (issue 30): `lightfarm requeue`, `pause` and `resume`. See docs/farm.md,
+// Managing jobs.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "lf/client/command.h"
+#include "lf/client/farm_client.h"
+#include "lf/client/farm_flags.h"
+#include "lf/job/job_record.h"
+#include "lf/wire/conversions.h"
+#include "lightfarm/v1/job_service.grpc.pb.h"
+
+namespace lf {
+
+namespace pb = lightfarm::v1;
+
+Command AddRequeueCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(
+        "requeue",
+        "Put a job's failed tasks back in the queue with their failures reset, and clear its\n"
+        "blocklist. A failed or cancelled job is queued again and renders on from the tasks it\n"
+        "had done (the job's owner or an admin).");
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    return {
+        cmd, [flags, id] {
+            pb::RequeueJobRequest req;
+            req.set_job_id(*id);
+            pb::Job job;
+            absl::Status s = FarmClient(*flags).Call(&pb::JobService::Stub::RequeueJob, req, &job);
+            if (!s.ok()) return ReportError(s);
+            std::printf("job %s %s (%d/%d tasks done)\n", job.id().c_str(),
+                        JobStateName(FromProto(job.state())), job.tasks_done(), job.tasks_total());
+            return 0;
+        }};
+}
+
+namespace {
+
+// `pause` or `resume`.
+template <typename Request>
+Command AddPausingCommand(CLI::App& app, const char* name, const char* help,
+                          FarmClient::Rpc<Request, pb::Job> rpc) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    CLI::App* cmd = app.add_subcommand(name, help);
+    cmd->add_option("job", *id, "job id")->required();
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id, rpc] {
+                Request req;
+                req.set_job_id(*id);
+                pb::Job job;
+                if (absl::Status s = FarmClient(*flags).Call(rpc, req, &job); !s.ok()) {
+                    return ReportError(s);
+                }
+                std::printf("job %s %s\n", job.id().c_str(), job.paused() ? "paused" : "resumed");
+                return 0;
+            }};
+}
+
+}  // namespace
+
+Command AddPauseCommand(CLI::App& app) {
+    return AddPausingCommand<pb::PauseJobRequest>(
+        app, "pause",
+        "Pause a queued or running job: it leases nothing new, its running tasks finish and\n"
+        "merge; it stays paused across a server restart until `resume` (owner or admin).",
+        &pb::JobService::Stub::PauseJob);
+}
+
+Command AddResumeCommand(CLI::App& app) {
+    return AddPausingCommand<pb::ResumeJobRequest>(
+        app, "resume", "Resume a paused job: its tasks are leased again.",
+        &pb::JobService::Stub::ResumeJob);
+}
+
+}  // namespace lf
