@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
 from typing import Any, Dict, List, Optional
 
 # Cycles' default, for a scene whose Cycles settings are missing (the add-on disabled).
@@ -85,23 +86,27 @@ def submit_settings(r: BlendRender) -> Dict[str, Any]:
 
 
 def output_pattern(r: BlendRender) -> str:
-    """Where Fetch writes the frames: the output path made absolute ("//" is the .blend's
-    folder, as bpy.path.abspath reads it), with Blender's rules: a path without '#' gets
-    "####" appended (a folder's frames are 0001.exr, ...), and the name ends in .exr in place
-    of another image extension."""
+    """Where Fetch writes the frames, named as Blender names an OpenEXR frame
+    (RenderSettings.frame_path): the output path made absolute ("//" is the .blend's folder),
+    "####" appended when it has no '#' (a folder's frames are 0001.exr, ...), and .exr in place
+    of an image extension or after the name. One run of '#' only: lightfarm numbers one."""
     path = r.filepath or "//"
     if path.startswith("//"):
         if not r.blend_path:
             raise ValueError(f"output path {path}: relative to the .blend, which is not saved "
                              "yet; save it first")
         path = os.path.join(os.path.dirname(r.blend_path), path[2:])
-    path = os.path.normpath(path) + (os.sep if path.endswith(("/", os.sep)) else "")
-    base, ext = os.path.splitext(path)
-    if ext.lower() in _IMAGE_EXTENSIONS and not base.endswith(os.sep):
-        path = base
-    if "#" not in os.path.basename(path):
-        path += "####"
-    return path + ".exr"
+    folder, name = os.path.split(path)
+    runs = re.findall("#+", name)
+    if len(runs) > 1:
+        raise ValueError(f"output path {r.filepath}: more than one run of '#'; lightfarm puts "
+                         "the frame number in one")
+    if not runs:
+        name += "####"
+    base, ext = os.path.splitext(name)
+    if ext.lower() in _IMAGE_EXTENSIONS:
+        name = base
+    return os.path.join(os.path.normpath(folder), name + ".exr")
 
 
 def cli_flags(settings: Dict[str, Any]) -> List[str]:
