@@ -67,6 +67,10 @@ s.server = args.server
 s.token_file = "//alice.token"
 s.export_dir = "//export"
 
+from lightfarm_blender import panel  # noqa: E402
+
+summary = panel._summary(scene)
+assert summary == "32x24, frames 2-6:2 at 24 fps, 4 spp, shutter 0.5 frames", summary
 assert bpy.ops.lightfarm.check() == {"FINISHED"}
 issues = [i.text for i in s.issues]
 for expected in ("Area: an area light", "Plane: particle system", "world World: its lighting"):
@@ -85,7 +89,7 @@ assert s.output_pattern == os.path.join(args.dir, "frames", "shot_####.exr"), s.
 assert bpy.ops.lightfarm.fetch() == {"FINISHED"}
 fetching = operators.task(scene, "fetch")
 assert fetching.join(60), "the fetch did not end within a minute"
-operators.sync(scene)
+assert operators._poll() is None, "the timer stops once every task has ended"
 assert not fetching.status["error"], fetching.status
 paths = fetching.status["paths"]
 assert paths == [os.path.join(args.dir, "frames", f"shot_{f:04d}.exr") for f in (2, 4, 6)], paths

@@ -7,7 +7,7 @@ import types
 import unittest
 
 import lightfarm
-from lightfarm_blender import mapping, scene_check
+from lightfarm_blender import farm_jobs, mapping, scene_check
 
 NS = types.SimpleNamespace
 
@@ -152,6 +152,23 @@ class SceneCheckTest(unittest.TestCase):
                             f"{who}: {what} in {issues}")
         self.assertFalse(any("Hidden" in i or "Sub" in i for i in issues), issues)
         self.assertEqual(len(issues), 12, issues)
+
+
+class FarmJobsTest(unittest.TestCase):
+    def test_a_failure_reaches_the_panel_and_removes_the_export(self):
+        """A background task's error is its status (the panel's line), and a temporary export
+        goes even when the submission fails."""
+        import os
+        import tempfile
+        folder = tempfile.mkdtemp()
+        conn = farm_jobs.Connection("127.0.0.1:1", "/nonexistent/alice.token", None)
+        task = farm_jobs.submit(conn, os.path.join(folder, "x.glb"), {}, folder)
+        self.assertTrue(task.join(30))
+        status = task.status
+        self.assertTrue(status["done"])
+        self.assertIn("submit: INVALID_ARGUMENT: token_file /nonexistent/alice.token",
+                      status["error"])
+        self.assertFalse(os.path.exists(folder))
 
 
 if __name__ == "__main__":

@@ -42,8 +42,8 @@ class FarmTask:
             work(self)
         except lightfarm.LightfarmError as e:
             self.update(error=f"{self.what}: {e.code.name}: {e.message}")
-        except (OSError, ValueError) as e:
-            self.update(error=f"{self.what}: {e}")
+        except Exception as e:  # the panel shows it: a thread's traceback reaches no one
+            self.update(error=f"{self.what}: {type(e).__name__}: {e}")
         finally:
             self.update(done=True)
 
@@ -68,12 +68,20 @@ def submit(conn: Connection, scene_file: str, settings: Dict[str, Any],
     follows the job until it ends; ``remove_dir`` (the temporary export) goes once uploaded."""
 
     def work(task: FarmTask) -> None:
-        with conn.client() as farm:
+        def remove_export() -> None:
+            if remove_dir:
+                shutil.rmtree(remove_dir, ignore_errors=True)
+
+        try:
+            farm = conn.client()  # a token file that cannot be read fails here
+        except BaseException:
+            remove_export()
+            raise
+        with farm:
             try:
                 job_id = farm.submit(scene_file, **settings)
             finally:
-                if remove_dir:
-                    shutil.rmtree(remove_dir, ignore_errors=True)
+                remove_export()
             task.update(job_id=job_id, message=f"job {job_id} submitted")
             for p in farm.watch(job_id):
                 frames = p.job.proto
