@@ -8,7 +8,6 @@ bl_info = {
     "blender": (3, 4, 0),
     "location": "Properties > Render > lightfarm",
     "description": "Render the scene's frames on a lightfarm render farm",
-    "doc_url": "https://github.com/lightfarm/lightfarm/blob/main/docs/blender.md",
     "category": "Render",
 }
 
