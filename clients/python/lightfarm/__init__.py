@@ -20,10 +20,12 @@ from .errors import (Aborted, AlreadyExists, Cancelled, DeadlineExceeded, Failed
                      Unimplemented)
 from .preview import exr_to_png
 from .scene import scene_files
+from .shot import FrameRange, frame_path, parse_frames
 
 __all__ = [
-    "BlockedWorker", "Client", "Job", "JobState", "LogLine", "Progress", "Task", "Worker", "DEFAULT_SERVER",
-    "METHODS", "load_token", "scene_files", "exr_to_png", "LightfarmError", "Aborted", "AlreadyExists",
+    "BlockedWorker", "Client", "Job", "JobState", "LogLine", "Progress", "Task", "Worker",
+    "DEFAULT_SERVER", "METHODS", "load_token", "scene_files", "exr_to_png", "FrameRange",
+    "frame_path", "parse_frames", "LightfarmError", "Aborted", "AlreadyExists",
     "Cancelled", "DeadlineExceeded", "FailedPrecondition", "Internal", "InvalidArgument",
     "NotFound", "OutOfRange", "PermissionDenied", "ResourceExhausted", "TlsError",
     "Unauthenticated", "Unavailable", "Unimplemented",

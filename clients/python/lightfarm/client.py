@@ -16,6 +16,8 @@ from . import errors
 from .errors import InvalidArgument, LightfarmError
 from .preview import TONEMAPS, exr_to_png
 from .scene import check_scene_path, scene_files
+from .shot import (DEFAULT_FPS, MAX_CHUNK, MAX_FPS, MAX_SHUTTER, MIN_FPS, FrameRange,
+                   check_frame_pattern, check_range, frame_path, parse_frames)
 from .v1 import common_pb2, job_service_pb2, job_service_pb2_grpc
 
 pb = job_service_pb2
@@ -511,23 +513,67 @@ class Client:
         FailedPrecondition until the job has succeeded, unless ``preview`` asks for the tiles
         merged so far."""
         path = os.fspath(path)
+        self._check_preview(path, exposure, tonemap)
+        return self._fetch_one(pb.FetchResultRequest(job_id=job_id, preview=preview), path,
+                               exposure, tonemap, f"job {job_id}")
+
+    def fetch_frames(self, job_id: str, pattern: Union[str, os.PathLike], *,
+                     frames: Union[None, str, Iterable[int]] = None, exposure: float = 0.0,
+                     tonemap: str = "clamp") -> List[str]:
+        """Writes a shot's finished frames as ``lightfarm fetch JOB -o out_####.exr`` does: each
+        to ``pattern`` with its run of '#' replaced by the frame number (zero-padded to as many
+        digits), an OpenEXR, or the PNG preview for a pattern ending in .png. ``frames`` ("A-B",
+        "A-B:STEP", "N" or frame numbers) picks some, each one of the shot's; without it, every
+        frame done so far (FailedPrecondition when there is none yet). Returns the paths written,
+        in frame order. InvalidArgument for a still (use :meth:`fetch`), a frame not in the shot
+        or a pattern that cannot number the frames."""
+        pattern = os.fspath(pattern)
+        self._check_preview(pattern, exposure, tonemap)
+        job = self.get(job_id)
+        if not job.params.HasField("shot"):
+            raise InvalidArgument(f"job {job_id} is a still, not a shot: fetch() writes its image")
+        s = job.params.shot
+        shot = FrameRange(s.first, s.last, s.step or 1)
+        if frames is None:
+            wanted = [f.frame for f in job.proto.frames if f.done]
+            if not wanted:
+                raise errors.FailedPrecondition(
+                    f"job {job_id} has no finished frame yet (0/{job.proto.frames_total})")
+        else:
+            wanted = list(parse_frames(frames) if isinstance(frames, str) else frames)
+            for frame in wanted:
+                if frame not in shot:
+                    raise InvalidArgument(f"frames: frame {frame} is not one of job {job_id}'s "
+                                          f"({shot})")
+        named = (FrameRange(wanted[0], wanted[0]) if len(wanted) == 1
+                 else FrameRange(min(wanted), max(wanted)))
+        check_frame_pattern("pattern", pattern, named)
+        return [self._fetch_one(pb.FetchResultRequest(job_id=job_id, frame=frame),
+                                frame_path(pattern, frame), exposure, tonemap,
+                                f"job {job_id} frame {frame}")
+                for frame in sorted(set(wanted))]
+
+    @staticmethod
+    def _check_preview(path: str, exposure: float, tonemap: str) -> None:
         png = path.lower().endswith(".png")
         if not png and (exposure != 0.0 or tonemap != "clamp"):
             raise InvalidArgument(f"{path}: exposure and tonemap make the PNG preview; give a "
                                   "path ending in .png")
         if png and tonemap not in TONEMAPS:
             raise InvalidArgument(f"tonemap {tonemap!r}: expected clamp or filmic")
+
+    def _fetch_one(self, req: pb.FetchResultRequest, path: str, exposure: float, tonemap: str,
+                   what: str) -> str:
+        """Streams one result to ``path``.part, made a PNG for a .png path, then renamed."""
         temp = path + ".part"
         try:
             with open(temp, "wb") as f:
-                for chunk in self._stub.FetchResult(
-                        pb.FetchResultRequest(job_id=job_id, preview=preview),
-                        timeout=FETCH_SECONDS, metadata=self._metadata):
+                for chunk in self._stub.FetchResult(req, timeout=FETCH_SECONDS,
+                                                    metadata=self._metadata):
                     f.write(chunk.data)
-            if png:
+            if path.lower().endswith(".png"):
                 with open(temp, "rb") as f:
-                    image = exr_to_png(f.read(), exposure=exposure, tonemap=tonemap,
-                                       what=f"job {job_id}")
+                    image = exr_to_png(f.read(), exposure=exposure, tonemap=tonemap, what=what)
                 with open(temp, "wb") as f:
                     f.write(image)
         except grpc.RpcError as e:
@@ -552,7 +598,9 @@ class Client:
                tolerance: float = 1e-4, max_iterations: int = 10000, display: str = "smooth",
                sweep_tasks: int = 8, max_patches: int = 0,
                photons_per_pass: int = 1 << 18, initial_radius: float = 0.0,
-               alpha: float = 2.0 / 3.0, request_id: Optional[str] = None,
+               alpha: float = 2.0 / 3.0, frames: Optional[str] = None,
+               frame: Optional[int] = None, fps: Optional[float] = None, shutter: float = 0.0,
+               chunk: Optional[int] = None, request_id: Optional[str] = None,
                tags: Sequence[str] = (), max_workers: int = 0,
                max_attempts: int = 3, blocklist_after: int = 3) -> str:
         """Uploads the scene and every file it names (those the server lacks, resuming a broken
@@ -568,11 +616,14 @@ class Client:
         ``target_error``, ``time_limit`` (seconds) and ``max_spp``; radiosity's ``patches``,
         ``patch_size``, ``solver``, ``tolerance``, ``max_iterations``, ``display``,
         ``sweep_tasks``, ``max_patches``; photon mapping's ``photons_per_pass``,
-        ``initial_radius``, ``alpha``; ``tags`` (only workers having every one take the job)
-        and ``max_workers`` (at most this many workers at once, 0 no cap); ``max_attempts``
-        (failures of one task that fail the job) and ``blocklist_after`` (a worker's failures in
-        the job after which it gets none of its tasks), 1 to 100. The server checks them all
-        and the scene (InvalidArgument
+        ``initial_radius``, ``alpha``. A shot of an animated scene: ``frames`` ("A-B",
+        "A-B:STEP") or ``frame`` (N alone), frame f showing the scene at f / ``fps`` seconds
+        (default 24), ``shutter`` (motion blur: frames the shutter stays open, centred on each
+        frame; 0 the instant) and ``chunk`` (whole frames a task, default 1). ``tags`` (only
+        workers having every one take the job) and ``max_workers`` (at most this many workers
+        at once, 0 no cap); ``max_attempts`` (failures of one task that fail the job) and
+        ``blocklist_after`` (a worker's failures in the job after which it gets none of its
+        tasks), 1 to 100. The server checks them all and the scene (InvalidArgument
         with the loader's message). ``request_id`` makes retries idempotent (default: 128
         random bits, the same on every retry of this call).
         """
@@ -606,6 +657,9 @@ class Client:
                 patches=patches, patch_size=patch_size, solver=solver, tolerance=tolerance,
                 max_iterations=max_iterations, display=display, sweep_tasks=sweep_tasks,
                 max_patches=max_patches))
+        shot = _shot_params(frames, frame, fps, shutter, chunk)
+        if shot is not None:
+            params.shot.CopyFrom(shot)
         if method == "ppm":
             params.ppm.CopyFrom(common_pb2.PhotonParams(
                 photons_per_pass=photons_per_pass, initial_radius=initial_radius, alpha=alpha))
@@ -679,6 +733,43 @@ def _remove(path: str) -> None:
         os.remove(path)
     except OSError:
         pass
+
+
+def _shot_params(frames: Optional[str], frame: Optional[int], fps: Optional[float],
+                 shutter: float, chunk: Optional[int]) -> Optional[common_pb2.ShotParams]:
+    """The shot of submit's arguments, checked as ``lightfarm submit --frames`` checks them;
+    None for a still."""
+    if frames is not None and frame is not None:
+        raise InvalidArgument(f"frame {frame} with frames {frames!r}: give one frame or a range, "
+                              "not both")
+    if frames is None and frame is None:
+        for what, value in (("fps", fps), ("chunk", chunk)):
+            if value is not None:
+                raise InvalidArgument(f"{what} {value}: applies to frames or frame; a still has "
+                                      "no time")
+        if shutter != 0:
+            raise InvalidArgument(f"shutter {shutter}: motion blur needs frames or frame; a still "
+                                  "has no time")
+        return None
+    if frames is not None:
+        if not isinstance(frames, str):
+            raise InvalidArgument(f"frames {frames!r}: expected a string A-B[:STEP]")
+        span = parse_frames(frames)
+    else:
+        if isinstance(frame, bool) or not isinstance(frame, int):
+            raise InvalidArgument(f"frame {frame!r}: expected a whole frame number")
+        span = check_range(FrameRange(frame, frame))
+    fps = DEFAULT_FPS if fps is None else float(fps)
+    chunk = 1 if chunk is None else chunk
+    if not MIN_FPS <= fps <= MAX_FPS:
+        raise InvalidArgument(f"fps {fps}: expected {MIN_FPS} to {MAX_FPS:g}")
+    if not 0 <= shutter <= MAX_SHUTTER:
+        raise InvalidArgument(f"shutter {shutter}: expected 0 (the instant) to {MAX_SHUTTER:g} "
+                              "frames")
+    if isinstance(chunk, bool) or not isinstance(chunk, int) or not 1 <= chunk <= MAX_CHUNK:
+        raise InvalidArgument(f"chunk {chunk}: expected 1 to {MAX_CHUNK} frames a task")
+    return common_pb2.ShotParams(first=span.first, last=span.last, step=span.step, fps=fps,
+                                 shutter=shutter, chunk=chunk)
 
 
 def _choice(what: str, value: str, choices: Dict[str, int]) -> int:

@@ -628,5 +628,70 @@ class ClientTest(unittest.TestCase):
         with self.assertRaises(lightfarm.FailedPrecondition):
             self.alice.requeue(done.id)
 
+    def test_shot_submit_and_fetch_frames(self):
+        """A shot submitted with frames, fps and shutter; fetch_frames writes each finished
+        frame as `lightfarm fetch -o out_####.exr` does, byte for byte."""
+        ball = os.path.join(SCENES, "shots", "moving_ball.json")
+        job_id = self.alice.submit(ball, frames="2-6:2", fps=12.0, shutter=0.5, spp=2,
+                                   resolution=(32, 18), tile=16)
+        job = self.alice.wait(job_id)
+        self.assertEqual(job.state, lightfarm.JobState.SUCCEEDED, job.error)
+        shot = job.params.shot
+        self.assertEqual((shot.first, shot.last, shot.step, shot.fps, shot.shutter, shot.chunk),
+                         (2, 6, 2, 12.0, 0.5, 1))
+        self.assertEqual([f.frame for f in job.proto.frames], [2, 4, 6])
+        pattern = self.farm.path("shot", "py_###.exr")
+        os.makedirs(os.path.dirname(pattern))
+        written = self.alice.fetch_frames(job_id, pattern)
+        self.assertEqual(written, [self.farm.path("shot", f"py_00{f}.exr") for f in (2, 4, 6)])
+        r = self.farm.cli("fetch", job_id, "-o", self.farm.path("shot", "cli_###.exr"))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        images = []
+        for f in (2, 4, 6):
+            with open(self.farm.path("shot", f"py_00{f}.exr"), "rb") as mine, \
+                    open(self.farm.path("shot", f"cli_00{f}.exr"), "rb") as cli:
+                images.append(mine.read())
+                self.assertEqual(images[-1], cli.read(), f"frame {f}: the CLI's bytes")
+            self.assertEqual(images[-1][:4], EXR_MAGIC)
+        self.assertNotEqual(images[0], images[1], "the ball moves between frames")
+        self.assertEqual(self.alice.fetch_frames(job_id, self.farm.path("shot", "one.exr"),
+                                                 frames="4"), [self.farm.path("shot", "one.exr")])
+        with open(self.farm.path("shot", "one.exr"), "rb") as f:
+            self.assertEqual(f.read(), images[1])
+        self.assertEqual(self.alice.fetch_frames(job_id, self.farm.path("shot", "s_#.png"),
+                                                 frames=[6]), [self.farm.path("shot", "s_6.png")])
+
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.fetch_frames(job_id, pattern, frames="3")
+        self.assertIn("frame 3 is not one of", caught.exception.message)
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.fetch_frames(job_id, self.farm.path("shot", "all.exr"))
+        self.assertIn("has no '#'", caught.exception.message)
+        still = self.alice.submit(cornell(), **SMALL)
+        self.alice.wait(still)
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.fetch_frames(still, pattern)
+        self.assertIn("is a still", caught.exception.message)
+
+    def test_shot_arguments_checked(self):
+        ball = os.path.join(SCENES, "shots", "moving_ball.json")
+        for kwargs, text in ((dict(frames="6-2"), "reversed"),
+                             (dict(frames="1-4", frame=2), "not both"),
+                             (dict(fps=30.0), "a still has no time"),
+                             (dict(shutter=0.5), "motion blur needs frames"),
+                             (dict(frames="1-4", shutter=11.0), "shutter 11"),
+                             (dict(frames="1-4", fps=0.0), "fps 0"),
+                             (dict(frames="1-4", chunk=0), "chunk 0"),
+                             (dict(frames="1-4:0"), "step 0")):
+            with self.assertRaises(lightfarm.InvalidArgument, msg=kwargs) as caught:
+                self.alice.submit(ball, **kwargs)
+            self.assertIn(text, caught.exception.message)
+        # One frame: the scene at that frame's time, fetched as that frame.
+        job_id = self.alice.submit(ball, frame=12, spp=1, resolution=(16, 9), tile=16, chunk=1)
+        self.assertEqual(self.alice.wait(job_id).state, lightfarm.JobState.SUCCEEDED)
+        self.assertEqual(self.alice.fetch_frames(job_id, self.farm.path("frame12.exr")),
+                         [self.farm.path("frame12.exr")])
+
+
 if __name__ == "__main__":
     unittest.main()
