@@ -447,6 +447,7 @@ HttpAnswer Dashboard::Api(const HttpRequest& request, const std::string& route) 
     if (!caller.ok()) return ErrorAnswer(caller.status());
     if (route == "session" && !post) return JsonAnswer(200, CallerJson(*caller, auth_.enabled()));
     if (absl::StartsWith(route, "jobs")) return JobApi(request, *caller, route);
+    if (post && absl::StartsWith(route, "workers/")) return WorkerAction(*caller, route);
     if (post) return NotFoundAnswer();
     if (route == "workers") {
         if (absl::Status s = Permit(*caller, Action::kListWorkers); !s.ok()) return ErrorAnswer(s);
@@ -481,6 +482,31 @@ HttpAnswer Dashboard::Api(const HttpRequest& request, const std::string& route) 
                                 {"now_ms", absl::ToUnixMillis(now)}});
     }
     return NotFoundAnswer();
+}
+
+// POST workers/NAME/{disable,enable,drain}: as JobService's SetWorkerState, admins only; NAME a
+// worker's name or id.
+HttpAnswer Dashboard::WorkerAction(const Caller& caller, std::string_view route) {
+    constexpr std::string_view kPrefix = "workers/";
+    const size_t slash = route.rfind('/');
+    if (slash <= kPrefix.size()) return NotFoundAnswer();  // no name
+    const std::string name(route.substr(kPrefix.size(), slash - kPrefix.size()));
+    const std::string_view what = route.substr(slash + 1);
+    std::optional<WorkerControl> control;
+    if (what == "disable") control = WorkerControl::kDisabled;
+    if (what == "enable") control = WorkerControl::kEnabled;
+    if (what == "drain") control = WorkerControl::kDrain;
+    if (!control) return NotFoundAnswer();
+    if (absl::Status s = Permit(caller, Action::kManageWorkers); !s.ok()) return ErrorAnswer(s);
+    absl::StatusOr<std::vector<WorkerStatus>> workers = farm_.SetWorkerState(name, *control);
+    if (!workers.ok()) return ErrorAnswer(workers.status());
+    Log()->info("worker {} set to {} by {} from the dashboard", LogSafe(name),
+                WorkerControlName(*control), caller.name);
+    Json listed = Json::array();
+    for (const WorkerStatus& w : *workers) {
+        listed.push_back({{"id", w.id}, {"name", w.name}, {"state", WorkerStateName(StateOf(w))}});
+    }
+    return JsonAnswer(200, {{"workers", listed}});
 }
 
 HttpAnswer Dashboard::SignIn(const HttpRequest& request) {
@@ -577,6 +603,21 @@ HttpAnswer Dashboard::JobApi(const HttpRequest& request, const Caller& caller,
             if (!changed.ok()) return ErrorAnswer(changed.status());
             Log()->info("job={} priority set to {} by {} from the dashboard", id,
                         changed->spec.priority, caller.name);
+            return JsonAnswer(200, JobJson(*changed, now));
+        }
+        if (what == "requeue" || what == "pause" || what == "resume") {
+            // As JobService's RequeueJob, PauseJob and ResumeJob: the job's owner or an admin.
+            if (absl::Status s = Permit(caller, Action::kManageJobs); !s.ok())
+                return ErrorAnswer(s);
+            absl::StatusOr<JobRecord> changed =
+                what == "requeue" ? farm_.Requeue(id)
+                                  : farm_.scheduler().SetPaused(id, what == "pause");
+            if (!changed.ok()) return ErrorAnswer(changed.status());
+            Log()->info("job={} {} by {} from the dashboard", id,
+                        what == "requeue" ? "requeued"
+                        : what == "pause" ? "paused"
+                                          : "resumed",
+                        caller.name);
             return JsonAnswer(200, JobJson(*changed, now));
         }
         if (what == "delete") {

@@ -635,7 +635,10 @@ grpc::Status WorkerServiceImpl::FailTask(grpc::ServerContext* context, const Cal
     const FailureKind kind = req.kind() == pb::FailTaskRequest::WORKER_SHUTDOWN
                                  ? FailureKind::kWorkerShutdown
                                  : FailureKind::kTaskError;
-    return ToGrpcStatus(farm_.scheduler().Fail(req.lease_id(), worker, req.reason(), kind));
+    // Kept with the task, the job's last error and the blocklist, all saved with every record
+    // write and printed by the CLI: one bounded line, its control characters escaped.
+    return ToGrpcStatus(
+        farm_.scheduler().Fail(req.lease_id(), worker, LogSafe(req.reason(), 1024), kind));
 }
 
 grpc::Status WorkerServiceImpl::FetchBlob(grpc::ServerContext* context, const Caller& caller,

@@ -502,12 +502,21 @@ bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::
     if (!preferred.empty() && preferred != worker && workers_.IsLive(preferred, now)) return false;
     const ScheduledJob::Task& task = job.tasks[size_t(t)];
     if (!task.failed_on.count(worker)) return true;
-    // It failed here: it waits for a live worker it has not failed on. Once it has failed on
-    // every live worker it is tried again anywhere, so its failures end the job. `failed_on`
-    // holds fewer than max_attempts workers, and the workers kept are the live ones.
-    size_t live_failed = 0;
-    for (const std::string& w : task.failed_on) live_failed += workers_.IsLive(w, now);
-    return workers_.size() <= live_failed;
+    // It failed here: it waits for a live worker it has not failed on that may take the job
+    // (enabled, not blocklisted from it, with its tags: a worker that may not would hold it
+    // forever). Once it has failed on every such worker it is tried again anywhere, so its
+    // failures end the job. The workers kept are the live ones.
+    size_t eligible = 0, eligible_failed = 0;
+    for (const WorkerRegistry::Entry& entry : workers_.List()) {
+        if (ControlOf(entry.id, entry.about) != WorkerControl::kEnabled ||
+            IsBlocklisted(job.record, entry.id) ||
+            !HasAllTags(entry.about.tags, job.record.spec.tags)) {
+            continue;
+        }
+        ++eligible;
+        eligible_failed += task.failed_on.count(entry.id);
+    }
+    return eligible <= eligible_failed;
 }
 
 WorkerControl Scheduler::ControlOf(const std::string& id, const WorkerDescription& about) const {

@@ -19,6 +19,11 @@ const kActions = [
     const value = prompt(`Priority of job ${j.id} (higher runs first)`, j.priority);
     return value === null ? null : post(`${jobPath(j)}/priority`, { priority: Number(value) });
   } },
+  { name: 'pause', label: 'Pause', when: (j) => !ended(j.state) && !j.paused, run: (j) => post(`${jobPath(j)}/pause`) },
+  { name: 'resume', label: 'Resume', when: (j) => !ended(j.state) && j.paused, run: (j) => post(`${jobPath(j)}/resume`) },
+  // A failed or cancelled job renders on from the tasks it had done.
+  { name: 'requeue', label: 'Requeue', when: (j) => j.state === 'failed' || j.state === 'cancelled',
+    run: (j) => post(`${jobPath(j)}/requeue`) },
   { name: 'delete', label: 'Delete', when: (j) => ended(j.state),
     confirm: (j) => `Delete job ${j.id} and its files?`, run: (j) => post(`${jobPath(j)}/delete`) },
   // A still's image; a shot's frames are downloaded from their own pages.
@@ -91,7 +96,7 @@ export function mount(root) {
       h('td', { class: 'id' }, link(j, j.id)),
       h('td', { class: 'name' }, link(j, j.name || '—')),
       h('td', { class: 'owner' }, j.owner || '—'),
-      h('td', { class: 'state' }, j.state),
+      h('td', { class: 'state' }, j.paused && !ended(j.state) ? 'paused' : j.state),
       h('td', {}, progress(j.tasks_done, j.tasks_total),
         j.shot ? h('span', { class: 'frames' }, ` ${j.shot.frames_done}/${j.shot.frames_total} frames`) : ''),
       h('td', { class: 'number priority' }, String(j.priority)),

@@ -103,7 +103,7 @@ try {
   const page = await context.newPage();
   const errors = [];
   page.on('pageerror', (e) => errors.push(e.message));
-  page.on('console', (m) => { if (m.type() === 'error' && !/401|404|409/.test(m.text())) errors.push(m.text()); });
+  page.on('console', (m) => { if (m.type() === 'error' && !/401|403|404|409/.test(m.text())) errors.push(m.text()); });
 
   // Not signed in: the sign-in page; a wrong token is refused.
   await page.goto(base);
@@ -255,12 +255,27 @@ try {
   await until('the first page again', async () => (await listed())[0].id === firstPage[0]);
   await page.screenshot({ path: join(shotsDir, 'jobs-paged.png'), fullPage: true });
 
-  // Row actions: cancel and delete the victim; the CLI and the API agree.
+  // Row actions: pause and resume the victim, cancel it, requeue it, cancel it again and delete
+  // it; the CLI and the API agree.
   const victimRow = `tr.job[data-id="${victim}"]`;
-  page.once('dialog', (d) => d.accept());
-  await page.click(`${victimRow} button.action.cancel`);
-  await until('the victim cancelled on the page', async () => (await page.textContent(`${victimRow} td.state`)) === 'cancelled');
+  const victimApi = async () => (await context.request.get(`${base}/api/jobs/${victim}`)).json();
+  await page.click(`${victimRow} button.action.pause`);
+  await until('the victim paused on the page', async () => (await page.textContent(`${victimRow} td.state`)) === 'paused');
+  check((await victimApi()).paused === true && /paused/i.test(cli(['status', victim], aliceToken)), 'pause from the jobs page: the API and the CLI say paused');
+  await page.click(`${victimRow} button.action.resume`);
+  await until('the victim resumed on the page', async () => ['queued', 'running'].includes(await page.textContent(`${victimRow} td.state`)));
+  check((await victimApi()).paused === false, 'resume from the jobs page: the API says not paused');
+  const cancelVictim = async () => {
+    page.once('dialog', (d) => d.accept());
+    await page.click(`${victimRow} button.action.cancel`);
+    await until('the victim cancelled on the page', async () => (await page.textContent(`${victimRow} td.state`)) === 'cancelled');
+  };
+  await cancelVictim();
   check(/cancelled/i.test(cli(['status', victim], aliceToken)), 'cancel from the jobs page: the CLI says cancelled');
+  await page.click(`${victimRow} button.action.requeue`);
+  await until('the victim queued again', async () => ['queued', 'running'].includes(await page.textContent(`${victimRow} td.state`)));
+  check(['QUEUED', 'RUNNING', 'queued', 'running'].includes((await victimApi()).state), `requeue from the jobs page: the cancelled job is ${(await victimApi()).state} again`);
+  await cancelVictim();
   page.once('dialog', (d) => d.accept());
   await page.click(`${victimRow} button.action.delete`);
   await until('the victim gone from the page', async () => (await page.$(victimRow)) === null);
@@ -305,6 +320,37 @@ try {
   await page.selectOption('#task-state', 'running');
   await until('no running tasks', async () => (await page.$$('tr.task')).length === 0);
   check((await page.textContent('#tasks-page')).startsWith('none'), `tasks filtered by running: ${await page.textContent('#tasks-page')}`);
+
+  // Workers as an admin: alice's page has the buttons but the server refuses her; the admin
+  // disables, drains and enables a worker from the workers page, and the CLI agrees.
+  await page.goto(`${base}/#/workers`);
+  await page.click('tr.worker[data-name="w2"] button.action.disable');
+  await until('the refusal', async () => (await page.textContent('#workers-problem')).length > 0);
+  check(/may not disable/.test(await page.textContent('#workers-problem')), `a submitter may not disable a worker: "${await page.textContent('#workers-problem')}"`);
+  const admin = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  const adminPage = await admin.newPage();
+  adminPage.on('pageerror', (e) => errors.push(e.message));
+  await adminPage.goto(base);
+  await adminPage.waitForSelector('form#signin');
+  await adminPage.fill('#token', readFileSync(adminToken, 'utf8').trim());
+  await adminPage.click('form#signin button');
+  await adminPage.waitForSelector('tr.job', { timeout: 15000 });
+  await adminPage.goto(`${base}/#/workers`);
+  const w2 = 'tr.worker[data-name="w2"]';
+  const w2State = () => adminPage.textContent(`${w2} td.state`);
+  await adminPage.waitForSelector(`${w2} button.action.disable`);
+  await adminPage.click(`${w2} button.action.disable`);
+  await until('w2 disabled', async () => (await w2State()) === 'disabled');
+  check(/w2.*disabled/.test(cli(['workers'], adminToken)), 'disable from the workers page: the CLI lists w2 as disabled');
+  await adminPage.click(`${w2} button.action.enable`);
+  await until('w2 enabled', async () => ['idle', 'busy'].includes(await w2State()));
+  await adminPage.click(`${w2} button.action.drain`);
+  await until('w2 drained', async () => (await w2State()) === 'drained');
+  check(true, 'drain from the workers page: the idle w2 is drained');
+  await adminPage.click(`${w2} button.action.enable`);
+  await until('w2 enabled again', async () => ['idle', 'busy'].includes(await w2State()));
+  check(true, `enable from the workers page: w2 is ${await w2State()}`);
+  await adminPage.screenshot({ path: join(shotsDir, 'workers-admin.png'), fullPage: true });
 
   check(errors.length === 0, `no errors on the pages${errors.length ? ': ' + errors.join('; ') : ''}`);
   console.log('dashboard e2e: all checks passed');

@@ -628,6 +628,8 @@ class Client:
         random bits, the same on every retry of this call).
         """
         scene_path = os.fspath(scene_path)
+        if isinstance(tags, str):  # a str is a sequence of one-letter tags
+            raise InvalidArgument(f"tags {tags!r}: a list of tags, e.g. [{tags!r}]")
         if method not in METHODS:
             raise InvalidArgument(f"method {method!r}: expected one of {', '.join(METHODS)}")
         text, named = scene_files(scene_path)

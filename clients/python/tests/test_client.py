@@ -550,6 +550,9 @@ class ClientTest(unittest.TestCase):
         """A job tagged gpu goes to w2 alone; one tagged with what no worker has says so."""
         self.assertEqual({w.name: w.tags for w in self.alice.workers()},
                          {"w1": (), "w2": ("gpu",)})
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.submit(cornell(), tags="gpu", **SMALL)  # not the tags g, p and u
+        self.assertIn("a list of tags", caught.exception.message)
         job_id = self.alice.submit(cornell(), tags=["gpu"], max_workers=1, **SMALL)
         job = self.alice.wait(job_id)
         self.assertEqual(job.state, lightfarm.JobState.SUCCEEDED, job.error)

@@ -726,6 +726,38 @@ TEST_F(DashboardTest, DeleteRemovesAnEndedJobOfItsOwnerOrForAnAdmin) {
     Call(Get("/api/jobs/" + mine + "/delete", alice_), 404);
 }
 
+// The jobs page's pause, resume and requeue, as JobService's: the owner or an admin; the
+// workers page's disable, enable and drain, as SetWorkerState: admins only.
+TEST_F(DashboardTest, JobAndWorkerActionsFollowTheRoles) {
+    const std::string mine = Submit("alice");
+    Call(Post("/api/jobs/" + mine + "/pause", Json::object(), bob_), 404);
+    EXPECT_EQ(Call(Post("/api/jobs/" + mine + "/pause", Json::object(), alice_), 200)["paused"],
+              true);
+    EXPECT_TRUE(farm_->scheduler().Get(mine)->paused);
+    EXPECT_FALSE(RenderOne("w1", 0.5f)) << "a paused job leases nothing";
+    EXPECT_EQ(Call(Post("/api/jobs/" + mine + "/resume", Json::object(), root_), 200)["paused"],
+              false);
+    ASSERT_TRUE(farm_->scheduler().Cancel(mine).ok());
+    Call(Post("/api/jobs/" + mine + "/pause", Json::object(), alice_), 409);  // ended
+    EXPECT_EQ(Call(Post("/api/jobs/" + mine + "/requeue", Json::object(), alice_), 200)["state"],
+              "queued");
+    EXPECT_EQ(farm_->scheduler().Get(mine)->state, JobState::kQueued);
+
+    ASSERT_TRUE(RenderOne("w1", 0.5f));  // w1 is known to the farm now
+    Call(Post("/api/workers/w1/disable", Json::object(), alice_), 403);
+    Call(Post("/api/workers/nobody/disable", Json::object(), root_), 404);
+    Call(Post("/api/workers/w1/sleep", Json::object(), root_), 404);
+    Call(Post("/api/workers//disable", Json::object(), root_), 404);
+    const Json disabled = Call(Post("/api/workers/w1/disable", Json::object(), root_), 200);
+    ASSERT_EQ(disabled["workers"].size(), 1u) << disabled;
+    EXPECT_EQ(disabled["workers"][0]["state"], "disabled");
+    EXPECT_FALSE(RenderOne("w1", 0.5f)) << "a disabled worker leases nothing";
+    EXPECT_EQ(
+        Call(Post("/api/workers/w1/enable", Json::object(), root_), 200)["workers"][0]["state"],
+        "idle");
+    EXPECT_TRUE(RenderOne("w1", 0.5f));
+}
+
 TEST_F(DashboardTest, TheResultExrIsAnAttachmentStreamedFromItsFile) {
     const std::string job = Submit("alice");
     Call(Get("/api/jobs/" + job + "/result.exr", alice_), 409);  // not rendered yet

@@ -68,6 +68,9 @@ class JobNotifierTest : public ::testing::Test {
         FarmOptions options;
         options.data_dir = dir_.string();
         options.notify_url = endpoint_.url();
+        // Longer than any hang here (each test releases the endpoint itself): a post timed out
+        // under a slow sanitizer run would be sent again and posted twice.
+        options.notify.timeout = absl::Minutes(5);
         absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
         ASSERT_TRUE(farm.ok()) << farm.status();
         farm_ = std::move(*farm);

@@ -286,6 +286,26 @@ TEST_F(JobManagementTest, BlocklistedWorkerGetsNoMoreTasksOfTheJob) {
     EXPECT_FALSE(scheduler_.LeaseTask("bad").has_value());
 }
 
+// A task that failed on the good worker waits for another live worker only while one may
+// take it: a blocklisted (or disabled, or tag-lacking) one never will, so the good worker takes it
+// again rather than the job stalling.
+TEST_F(JobManagementTest, ATaskFailedOnTheOnlyEligibleWorkerIsNotHeldForABlocklistedOne) {
+    const std::string id = SubmitWith(3, 2);
+    const std::optional<TaskAssignment> held = scheduler_.LeaseTask("good");  // task 0
+    ASSERT_TRUE(held.has_value());
+    FailNext("bad", "no GPU");  // task 1
+    FailNext("bad", "no GPU");  // task 2: blocklisted, still live
+    ASSERT_EQ(Job(id).Blocklisted().size(), 1u);
+    ASSERT_TRUE(scheduler_.Fail(held->lease_id, "good", "flaky", FailureKind::kTaskError).ok());
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_FALSE(scheduler_.LeaseTask("bad").has_value());  // the blocklisted one polls on
+        const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("good");
+        ASSERT_TRUE(lease.has_value()) << "task " << i << " of 4 held back";
+        ASSERT_TRUE(scheduler_.Complete(lease->lease_id, "good", Result(*lease)).ok());
+    }
+    EXPECT_EQ(Job(id).tasks_done, 4);
+}
+
 TEST_F(JobManagementTest, RequeueOfARunningJobResetsItsFailuresAndBlocklist) {
     const std::string id = SubmitWith(2, 2);
     scheduler_.LeaseTask("good");  // alive, holding task 0

@@ -167,8 +167,11 @@ TEST_F(SplatSchedulerTest, RestartMergesTheRecordedSplatsToTheSameBits) {
 TEST_F(SplatSchedulerTest, ResultsThatDoNotFitTheirTaskAreRefusedNamingJobTaskAndWorker) {
     InMemoryJobStore store;
     Scheduler scheduler(InFiles(), store);
-    const std::string id = *scheduler.Submit(LightSpec());
-    // Three tasks, one refusal each (three on one task would fail the job).
+    // Three tasks, one refusal each (three on one task would fail the job); w1 is not
+    // blocklisted by its three (issue 30's blocklist would fail the job of its only worker).
+    JobSpec spec = LightSpec();
+    spec.blocklist_after = 4;
+    const std::string id = *scheduler.Submit(spec);
     std::vector<TaskAssignment> leases;
     for (int i = 0; i < 3; ++i) leases.push_back(*scheduler.LeaseTask("w1"));
     auto expect_refused = [&](const TileSums& camera, SplatList* splats, const std::string& why) {

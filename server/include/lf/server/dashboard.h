@@ -45,6 +45,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -92,6 +93,7 @@ class Dashboard {
 
     HttpAnswer Api(const HttpRequest& request, const std::string& route);
     HttpAnswer SignIn(const HttpRequest& request);
+    HttpAnswer WorkerAction(const Caller& caller, std::string_view route);
     HttpAnswer JobApi(const HttpRequest& request, const Caller& caller, const std::string& route);
     absl::StatusOr<Caller> CallerOf(const HttpRequest& request);
     // CSRF: a POST's content type and origin.
