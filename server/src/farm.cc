@@ -467,6 +467,7 @@ void Farm::RemoveJobFiles(const std::string& job_id) {
 }
 
 absl::Status Farm::DeleteJob(const std::string& job_id) {
+    std::lock_guard<std::mutex> one_change(ended_job_changes_);
     absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
     if (!job.ok()) return job.status();
     if (!IsFinal(job->state)) {
@@ -508,6 +509,7 @@ absl::StatusOr<int> Farm::DeleteExpired(absl::Time now) {
     constexpr size_t kPage = 1000;
     int deleted = 0;
     while (options_.retention > absl::ZeroDuration()) {
+        std::lock_guard<std::mutex> one_change(ended_job_changes_);
         absl::StatusOr<std::vector<JobRecord>> expired =
             store_->List({.limit = kPage, .ended_before = now - options_.retention});
         if (!expired.ok()) return expired.status();
@@ -635,6 +637,7 @@ absl::StatusOr<JobRecord> Farm::SetPriority(const std::string& job_id, int prior
 namespace lf {
 
 absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id) {
+    std::lock_guard<std::mutex> one_change(ended_job_changes_);
     absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(job_id);
     if (!requeued.ok()) return requeued.status();
     if (requeued->rendered) FinishJob(job_id);

@@ -354,7 +354,6 @@ TEST_F(JobManagementTest, PausedJobLeasesNothingNewButItsRunningTasksMerge) {
     EXPECT_TRUE(paused->paused);
     EXPECT_TRUE(store_.Get(id)->paused);  // durable
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
-    EXPECT_FALSE(scheduler_.LeaseTask("idle").has_value());  // nor a second lease of a straggler
     ASSERT_TRUE(scheduler_.Complete(running.lease_id, "w", Result(running)).ok());
     EXPECT_EQ(Job(id).tasks_done, 1);
     EXPECT_EQ(Job(id).state, JobState::kRunning);
@@ -363,6 +362,19 @@ TEST_F(JobManagementTest, PausedJobLeasesNothingNewButItsRunningTasksMerge) {
     ASSERT_TRUE(scheduler_.Cancel(id).ok());
     EXPECT_EQ(scheduler_.SetPaused(id, true).status().code(),
               absl::StatusCode::kFailedPrecondition);
+
+    // Near its end (nothing queued, one slow task running), a paused job gives an idle worker
+    // no second lease of its straggler either.
+    const std::string two = Submit(0, 16);  // two tasks
+    const TaskAssignment slow = *scheduler_.LeaseTask("slow");
+    const TaskAssignment fast = *scheduler_.LeaseTask("fast");
+    now_ += absl::Milliseconds(500);
+    ASSERT_TRUE(scheduler_.Complete(fast.lease_id, "fast", Result(fast)).ok());
+    now_ += absl::Seconds(1);  // slow now: a straggler (StragglersTaskIsLeasedAgain...)
+    ASSERT_TRUE(scheduler_.SetPaused(two, true).ok());
+    EXPECT_FALSE(scheduler_.LeaseTask("fast").has_value()) << "a second lease of a paused job";
+    ASSERT_TRUE(scheduler_.SetPaused(two, false).ok());
+    EXPECT_TRUE(scheduler_.LeaseTask("fast").has_value()) << "the straggler, once resumed";
     EXPECT_EQ(scheduler_.SetPaused("job-none", true).status().code(), absl::StatusCode::kNotFound);
 }
 

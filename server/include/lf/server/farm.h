@@ -195,6 +195,11 @@ class Farm {
     // Shared by a submission from its blob checks until its job is held by the scheduler, and
     // taken alone by RemoveUnusedBlobs, so that no blob goes between the two.
     std::shared_mutex blob_users_;
+    // Taken by Requeue, DeleteJob and each page of DeleteExpired: an ended job is requeued or
+    // deleted, never both at once (a requeue's record written after the delete would bring the
+    // job back without its results, logs or blobs; a delete after the requeue would drop a
+    // running job's record).
+    std::mutex ended_job_changes_;
     std::unique_ptr<SqliteJobStore> store_;
     std::unique_ptr<TaskLogStore> logs_;
     std::unique_ptr<WorkerStateStore> worker_states_;  // set by Open
