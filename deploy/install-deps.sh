@@ -15,7 +15,8 @@ packages=(
   chromium
   # The Blender add-on's headless test (docs/blender.md): on top of the rest, 166 packages,
   # 171 MB to download, 620 MB installed (Debian 12, --no-install-recommends).
-  blender
+  # Blender's own glTF exporter imports numpy, which Debian's blender package does not pull in.
+  blender python3-numpy
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -139,6 +139,15 @@ absl::StatusOr<TextureImage> DecodeExr(const std::string& bytes, const std::stri
     }
 }
 
+constexpr int64_t kMaxTexelsPerFileByte = 16384;
+
+// PNG, JPEG and Radiance HDR, by their magic numbers (stb_image's own tests for them).
+bool IsStbFormat(const std::string& bytes) {
+    const std::string_view b(bytes);
+    return b.starts_with("\x89PNG\r\n\x1a\n") || b.starts_with("\xff\xd8") ||
+           b.starts_with("#?RADIANCE\n") || b.starts_with("#?RGBE\n");
+}
+
 // A PNG's size from its IHDR chunk. stb_image refuses very large images itself, with a message
 // about the format rather than the size; this keeps the size the reason given.
 std::optional<std::pair<int64_t, int64_t>> PngSize(const std::string& bytes) {
@@ -165,12 +174,26 @@ absl::StatusOr<TextureImage> DecodeStb(const std::string& bytes, const std::stri
     }
     const int length = int(bytes.size());
     int width = 0, height = 0, channels = 0;
-    if (!stbi_info_from_memory(data, length, &width, &height, &channels)) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            name, ": not a PNG, JPEG, HDR or EXR image (", stbi_failure_reason(), ")"));
+    // Debian's stb_image is built with every format; TGA, BMP, PSD, GIF, PIC and PNM (TGA has no
+    // magic number, so almost any bytes parse as one) are not ours to accept.
+    const bool header =
+        IsStbFormat(bytes) && stbi_info_from_memory(data, length, &width, &height, &channels);
+    if (!header) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(name, ": not a PNG, JPEG, HDR or EXR image (",
+                         IsStbFormat(bytes) ? stbi_failure_reason() : "unknown signature", ")"));
     }
     // From the header alone, before a byte of texels is allocated.
     if (absl::Status s = CheckSize(name, width, height); !s.ok()) return s;
+    // A truncated JPEG decodes in full (stb_image reads zeros past the end), so a few hundred
+    // bytes could claim gigabytes of texels. No valid file of these formats packs more than
+    // about 8,300 texels into a byte (a 1-bit PNG at deflate's limit of 1032:1; JPEG at most
+    // about 460, Radiance's run lengths 16), so twice that is refused as truncated or hostile.
+    if (int64_t(width) * height > kMaxTexelsPerFileByte * int64_t(bytes.size())) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            name, ": image of ", width, " x ", height, " texels in a file of ", bytes.size(),
+            " bytes: more than a PNG, JPEG or HDR file can hold (truncated?)"));
+    }
     TextureImage image;
     const size_t count = size_t(width) * size_t(height);
     auto fail = [&] {

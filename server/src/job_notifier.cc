@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "lf/core/log.h"
@@ -57,10 +58,17 @@ JobNotifier::JobNotifier(std::string origin, std::string path, JobNotifierOption
 
 JobNotifier::~JobNotifier() {
     {
-        std::lock_guard<std::mutex> lock(mutex_);
+        std::unique_lock<std::mutex> lock(mutex_);
         stopping_ = true;
+        wake_.notify_all();
+        // An endpoint that trickles its answer would otherwise hold the shutdown for as long as
+        // it likes: stop() shuts the socket under the attempt (httplib's cross-thread abort).
+        // Again until the attempt returns: one stopped before its socket opened goes on.
+        while (posting_) {
+            posting_->stop();
+            wake_.wait_for(lock, std::chrono::milliseconds(50));
+        }
     }
-    wake_.notify_all();
     thread_.join();
 }
 
@@ -98,14 +106,39 @@ bool JobNotifier::Post(const std::string& job_id, const std::string& body) {
     client.set_connection_timeout(0, timeout_us);
     client.set_read_timeout(0, timeout_us);
     client.set_write_timeout(0, timeout_us);
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (stopping_) return false;
+        posting_ = &client;
+    }
+    absl::Cleanup done = [&] {
+        std::lock_guard<std::mutex> lock(mutex_);
+        posting_ = nullptr;
+        wake_.notify_all();
+    };
+    httplib::Request request;
+    request.method = "POST";
+    request.path = path_;
+    request.body = body;
+    request.set_header("Content-Type", "application/json");
+    // The status is all we need: an answer's body is never read, however long or slow (httplib
+    // calls the handler only for an answer with a body; a 204 comes back whole).
+    int status = 0;
+    request.response_handler = [&](const httplib::Response& answer) {
+        status = answer.status;
+        return false;
+    };
     absl::Duration wait = options_.first_retry;
     std::string why;
     for (int attempt = 1; attempt <= options_.attempts; ++attempt) {
-        const httplib::Result answer = client.Post(path_, body, "application/json");
-        if (answer && answer->status >= 200 && answer->status < 300) return true;
-        why = answer ? absl::StrCat("HTTP ", answer->status) : httplib::to_string(answer.error());
-        if (attempt == options_.attempts) break;
+        status = 0;
+        const httplib::Result answer = client.send(request);
+        if (answer) status = answer->status;
+        if (status >= 200 && status < 300) return true;
+        why = status ? absl::StrCat("HTTP ", status) : httplib::to_string(answer.error());
         std::unique_lock<std::mutex> lock(mutex_);
+        if (stopping_) return false;
+        if (attempt == options_.attempts) break;
         if (wake_.wait_for(lock, absl::ToChronoMilliseconds(wait), [&] { return stopping_; })) {
             return false;
         }

@@ -16,6 +16,8 @@ import subprocess
 import sys
 import tempfile
 import time
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'support'))
+from processes import stop_all  # noqa: E402  (tests/support)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SKIP = 77
@@ -124,13 +126,8 @@ def main():
         print("frames 2, 4, 6: the farm's bits are lightfarm render's")
         return 0
     finally:
-        for p in reversed(procs):
-            p.terminate()
+        stop_all(procs)
         for p in procs:
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
             if p.stdout:
                 p.stdout.close()
         if os.environ.get("LF_KEEP_TEST_DIR"):

@@ -28,6 +28,8 @@ import time
 import urllib.request
 
 import yaml
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'support'))
+from processes import stop_all  # noqa: E402  (tests/support)
 
 BIN_DIR, SRC = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
 DEPLOY = os.path.join(SRC, "deploy")
@@ -943,13 +945,7 @@ def check_live(pki, compose_found, k8s_found, systemd_found):
             errors.append(f"{rel(DOCS)}: a worker with the docs' client certificate and a worker "
                           f"token never appears in `lightfarm workers` ({listed.strip()[-400:]})")
     finally:
-        for p in procs:
-            p.terminate()
-        for p in procs:
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
+        stop_all(procs)
 
 
 def main():

@@ -53,6 +53,8 @@ from lightfarm.v1 import job_service_pb2 as jpb
 from lightfarm.v1 import job_service_pb2_grpc as jgrpc
 from lightfarm.v1 import worker_service_pb2 as wpb
 from lightfarm.v1 import worker_service_pb2_grpc as wgrpc
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'support'))
+from processes import stop_all  # noqa: E402  (tests/support)
 
 MIB = 1 << 20  # payload sizes
 MB = 1_000_000  # what is reported and checked
@@ -172,14 +174,7 @@ class Farm:
         self.stopping = True
         with self.lock:
             procs = [p for p, _ in self.workers.values()] + ([self.server] if self.server else [])
-        for p in procs:
-            if p.poll() is None:
-                p.terminate()
-        for p in procs:
-            try:
-                p.wait(10)
-            except subprocess.TimeoutExpired:
-                p.kill()
+        stop_all(procs)
 
 
 class Sampler:

@@ -24,6 +24,9 @@ import grpc
 
 import lightfarm
 from lightfarm.v1 import job_service_pb2 as pb
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', '..',
+                                'tests', 'support'))
+from processes import stop_all  # noqa: E402  (tests/support)
 
 BIN = os.environ.get("LF_BIN_DIR", "")
 SCENES = os.environ.get("LF_TEST_SCENES", "")
@@ -157,14 +160,8 @@ class Farm:
                 self.path(token + ".token")], capture_output=True, text=True, timeout=120)
 
     def stop(self):
-        for p in reversed(self.procs):
-            p.terminate()
+        stop_all(self.procs)
         for p in self.procs:
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait()
             if p.stdout:
                 p.stdout.close()
         shutil.rmtree(self.dir, ignore_errors=True)

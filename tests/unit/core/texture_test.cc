@@ -1,6 +1,7 @@
 #include "lf/core/texture.h"
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <cstring>
@@ -216,6 +217,74 @@ TEST(TextureIo, GarbageAndTruncatedFilesAreClearErrors) {
         EXPECT_EQ(decoded.status().code(), absl::StatusCode::kInvalidArgument);
         EXPECT_EQ(decoded.status().message().substr(0, 9), "bad.png: ") << decoded.status();
     }
+}
+
+// The bytes tests/fuzz/texture_fuzz found: a 44-byte TGA (a format without a magic number) whose
+// header claimed 4071 x 65295 texels, which stb_image allocated and copied (2 GB).
+TEST(TextureIo, FormatsBeyondPngJpegHdrAndExrAreRefusedThoughStbKnowsThem) {
+    std::string tga("\xa8\x00\x03\x00\x02\x00\xe7\x0fitten by stb_im", 23);
+    tga += std::string(21, '\x0f');
+    const std::string bmp = std::string("BM") + std::string(60, '\0');
+    for (const std::string& bytes : {tga, bmp}) {
+        const auto decoded = DecodeTexture(bytes, "odd.png");
+        ASSERT_FALSE(decoded.ok());
+        EXPECT_EQ(decoded.status().message(),
+                  "odd.png: not a PNG, JPEG, HDR or EXR image (unknown signature)");
+    }
+}
+
+// A JPEG cut after its headers decodes in full with stb_image (it reads zeros past the end): one
+// claiming 16384 x 16384 texels in a few hundred bytes is refused before a texel is allocated.
+TEST(TextureIo, ATruncatedJpegClaimingFarMoreTexelsThanItsBytesIsRefused) {
+    std::string jpeg;
+    const std::vector<uint8_t> texels(8 * 8 * 3, 128);
+    ASSERT_TRUE(stbi_write_jpg_to_func(testing::AppendToString, &jpeg, 8, 8, 3, texels.data(), 90));
+    const size_t sof = jpeg.find("\xff\xc0");
+    const size_t sos = jpeg.find("\xff\xda");
+    ASSERT_NE(sof, std::string::npos);
+    ASSERT_NE(sos, std::string::npos);
+    for (size_t at : {sof + 5, sof + 7}) jpeg.replace(at, 2, "\x40\x00", 2);  // height, width
+    jpeg.resize(sos + 14);  // the scan header and nothing of the scan
+    const auto decoded = DecodeTexture(jpeg, "cut.jpg");
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_EQ(decoded.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(
+        decoded.status().message().find("cut.jpg: image of 16384 x 16384 texels in a file of"),
+        std::string::npos)
+        << decoded.status();
+}
+
+// The densest valid file of the formats: a 1-bit PNG of one colour, deflated at zlib's best (near
+// deflate's limit of 1032:1). The bound on texels a byte must let it through.
+TEST(TextureIo, AOneBitPngAtDeflatesLimitIsAccepted) {
+    const uint32_t side = 4096;
+    // Each row: its filter byte (0, none) and side / 8 bytes of zero bits.
+    const std::string raw(size_t(side) * (side / 8 + 1), '\0');
+    uLongf packed_size = compressBound(uLong(raw.size()));
+    std::string packed(packed_size, '\0');
+    ASSERT_EQ(compress2(reinterpret_cast<Bytef*>(packed.data()), &packed_size,
+                        reinterpret_cast<const Bytef*>(raw.data()), uLong(raw.size()), 9),
+              Z_OK);
+    packed.resize(packed_size);
+    auto be32 = [](uint32_t v) {
+        return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+    };
+    auto chunk = [&](const std::string& type, const std::string& data) {
+        const std::string body = type + data;
+        return be32(uint32_t(data.size())) + body +
+               be32(uint32_t(
+                   crc32(0, reinterpret_cast<const Bytef*>(body.data()), uInt(body.size()))));
+    };
+    // IHDR: width, height, bit depth 1, colour type 0 (grey), deflate, filter 0, no interlace.
+    const std::string png =
+        std::string("\x89PNG\r\n\x1a\n", 8) +
+        chunk("IHDR", be32(side) + be32(side) + std::string("\x01\0\0\0\0", 5)) +
+        chunk("IDAT", packed) + chunk("IEND", "");
+    EXPECT_GT(double(side) * side / double(png.size()), 7000.0) << png.size() << " bytes";
+    const auto decoded = DecodeTexture(png, "dense.png");
+    ASSERT_TRUE(decoded.ok()) << decoded.status();
+    EXPECT_EQ((*decoded)->width, int(side));
+    EXPECT_EQ((*decoded)->texels8.size(), size_t(side) * side);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <future>
 #include <nlohmann/json.hpp>
 
 #include "lease_results.h"
@@ -168,6 +169,24 @@ TEST(JobNotifier, QueueIsBoundedDroppingTheOldest) {
     std::vector<std::string> ids;
     for (const nlohmann::json& body : endpoint.Await(3)) ids.push_back(body["job_id"]);
     EXPECT_EQ(ids, (std::vector<std::string>{"a", "d", "e"}));
+}
+
+// An endpoint that never answers, with an attempt's timeout of an hour: stopping the notifier
+// (the coordinator's shutdown) aborts the attempt instead of waiting it out.
+TEST(JobNotifier, StoppingAbortsTheAttemptUnderWay) {
+    Endpoint endpoint;
+    endpoint.Hang(true);
+    absl::StatusOr<std::unique_ptr<JobNotifier>> notifier =
+        JobNotifier::Start(endpoint.url(), JobNotifierOptions{.timeout = absl::Hours(1)});
+    ASSERT_TRUE(notifier.ok()) << notifier.status();
+    JobRecord job;
+    job.id = "a";
+    (*notifier)->JobEnded(job);
+    endpoint.Await(1);  // the post is under way, its answer held
+    std::future<void> stopped = std::async(std::launch::async, [&] { notifier->reset(); });
+    // A bound for a broken test, not a timing: without the abort this waits an hour.
+    EXPECT_EQ(stopped.wait_for(std::chrono::minutes(1)), std::future_status::ready);
+    endpoint.Hang(false);
 }
 
 TEST(JobNotifier, BadUrlIsRefusedNamingTheFlag) {

@@ -14,6 +14,10 @@
 #include "absl/time/time.h"
 #include "lf/job/job_record.h"
 
+namespace httplib {
+class Client;
+}
+
 namespace lf {
 
 struct JobNotifierOptions {
@@ -33,7 +37,7 @@ class JobNotifier {
     // --notify-url otherwise.
     static absl::StatusOr<std::unique_ptr<JobNotifier>> Start(const std::string& url,
                                                               JobNotifierOptions options = {});
-    ~JobNotifier();  // waits for the attempt under way, drops the rest
+    ~JobNotifier();  // aborts the attempt under way, drops the rest
     JobNotifier(const JobNotifier&) = delete;
     JobNotifier& operator=(const JobNotifier&) = delete;
 
@@ -53,6 +57,7 @@ class JobNotifier {
     std::condition_variable wake_;
     std::deque<std::pair<std::string, std::string>> queue_;  // (job id, body)
     bool stopping_ = false;
+    httplib::Client* posting_ = nullptr;  // the attempt under way, for the destructor to stop
     std::thread thread_;
 };
 
