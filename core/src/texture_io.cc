@@ -139,13 +139,24 @@ absl::StatusOr<TextureImage> DecodeExr(const std::string& bytes, const std::stri
     }
 }
 
-constexpr int64_t kMaxTexelsPerFileByte = 16384;
+// The formats stb_image decodes for us, by their magic numbers (stb_image's own tests for
+// them), each with the most texels a byte of a file of it may claim. A truncated JPEG or HDR
+// decodes in full (stb_image reads zeros past the end), so a few hundred bytes could claim
+// gigabytes of texels. No valid file packs more than about 8,300 texels into a byte of PNG (1 bit
+// a texel at deflate's limit of 1032:1), 460 of JPEG (one 1-bit DC code a block, 4x4 chroma
+// subsampling) or 16 of Radiance HDR (runs of 127 in 8 bytes): about twice those are the bounds.
+struct StbFormat {
+    std::string_view magic;
+    int64_t texels_per_byte;
+};
+constexpr StbFormat kStbFormats[] = {
+    {"\x89PNG\r\n\x1a\n", 16384}, {"\xff\xd8", 1024}, {"#?RADIANCE\n", 32}, {"#?RGBE\n", 32}};
 
-// PNG, JPEG and Radiance HDR, by their magic numbers (stb_image's own tests for them).
-bool IsStbFormat(const std::string& bytes) {
-    const std::string_view b(bytes);
-    return b.starts_with("\x89PNG\r\n\x1a\n") || b.starts_with("\xff\xd8") ||
-           b.starts_with("#?RADIANCE\n") || b.starts_with("#?RGBE\n");
+const StbFormat* FindStbFormat(const std::string& bytes) {
+    for (const StbFormat& format : kStbFormats) {
+        if (std::string_view(bytes).starts_with(format.magic)) return &format;
+    }
+    return nullptr;
 }
 
 // A PNG's size from its IHDR chunk. stb_image refuses very large images itself, with a message
@@ -176,23 +187,18 @@ absl::StatusOr<TextureImage> DecodeStb(const std::string& bytes, const std::stri
     int width = 0, height = 0, channels = 0;
     // Debian's stb_image is built with every format; TGA, BMP, PSD, GIF, PIC and PNM (TGA has no
     // magic number, so almost any bytes parse as one) are not ours to accept.
-    const bool header =
-        IsStbFormat(bytes) && stbi_info_from_memory(data, length, &width, &height, &channels);
-    if (!header) {
+    const StbFormat* format = FindStbFormat(bytes);
+    if (!format || !stbi_info_from_memory(data, length, &width, &height, &channels)) {
         return absl::InvalidArgumentError(
             absl::StrCat(name, ": not a PNG, JPEG, HDR or EXR image (",
-                         IsStbFormat(bytes) ? stbi_failure_reason() : "unknown signature", ")"));
+                         format ? stbi_failure_reason() : "unknown signature", ")"));
     }
     // From the header alone, before a byte of texels is allocated.
     if (absl::Status s = CheckSize(name, width, height); !s.ok()) return s;
-    // A truncated JPEG decodes in full (stb_image reads zeros past the end), so a few hundred
-    // bytes could claim gigabytes of texels. No valid file of these formats packs more than
-    // about 8,300 texels into a byte (a 1-bit PNG at deflate's limit of 1032:1; JPEG at most
-    // about 460, Radiance's run lengths 16), so twice that is refused as truncated or hostile.
-    if (int64_t(width) * height > kMaxTexelsPerFileByte * int64_t(bytes.size())) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            name, ": image of ", width, " x ", height, " texels in a file of ", bytes.size(),
-            " bytes: more than a PNG, JPEG or HDR file can hold (truncated?)"));
+    if (int64_t(width) * height > format->texels_per_byte * int64_t(bytes.size())) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(name, ": image of ", width, " x ", height, " texels in a file of ",
+                         bytes.size(), " bytes: more than a valid file can hold (truncated?)"));
     }
     TextureImage image;
     const size_t count = size_t(width) * size_t(height);

@@ -254,6 +254,19 @@ TEST(TextureIo, ATruncatedJpegClaimingFarMoreTexelsThanItsBytesIsRefused) {
         << decoded.status();
 }
 
+// The same for Radiance HDR, whose bound is far lower (at most 16 texels a byte in valid runs).
+TEST(TextureIo, ATruncatedHdrClaimingFarMoreTexelsThanItsBytesIsRefused) {
+    std::string hdr = testing::HdrBytes(2, 1, {1, 1, 1, 1, 1, 1});
+    const size_t size_line = hdr.find("-Y 1 +X 2\n");
+    ASSERT_NE(size_line, std::string::npos);
+    hdr = hdr.substr(0, size_line) + "-Y 512 +X 512\n";
+    const auto decoded = DecodeTexture(hdr, "cut.hdr");
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_NE(decoded.status().message().find("cut.hdr: image of 512 x 512 texels in a file of"),
+              std::string::npos)
+        << decoded.status();
+}
+
 // The densest valid file of the formats: a 1-bit PNG of one colour, deflated at zlib's best (near
 // deflate's limit of 1032:1). The bound on texels a byte must let it through.
 TEST(TextureIo, AOneBitPngAtDeflatesLimitIsAccepted) {
