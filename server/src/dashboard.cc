@@ -4,12 +4,14 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
 #include "absl/time/clock.h"
 #include "lf/core/log.h"
 #include "lf/job/shot.h"
@@ -781,15 +783,52 @@ HttpAnswer Dashboard::GradedPreviewAnswer(const HttpRequest& request, const JobR
     if (!exposure.ok()) return ErrorAnswer(exposure.status());
     absl::StatusOr<std::string> channel = FilterParam(request, "channel");
     if (!channel.ok()) return ErrorAnswer(channel.status());
-    absl::StatusOr<ExrFile> exr = ReadResult(job, frame);
-    if (!exr.ok()) return ErrorAnswer(exr.status());
-    absl::StatusOr<ChannelView> view =
-        ViewChannel(exr->image, channel->empty() ? "beauty" : *channel);
+    absl::StatusOr<std::shared_ptr<const Preview>> preview = PreviewOf(job, frame);
+    if (!preview.ok()) return ErrorAnswer(preview.status());
+    const std::string etag =
+        absl::StrCat("\"", absl::StripSuffix(absl::StripPrefix((*preview)->etag, "\""), "\""), "/",
+                     *exposure, "/", channel->empty() ? "beauty" : *channel, "\"");
+    std::vector<std::pair<std::string, std::string>> headers = {
+        {"Cache-Control", "private, no-cache"}, {"ETag", etag}};
+    if (NotModified(request, etag)) return {304, "", "", std::move(headers)};
+    {
+        std::unique_lock<std::mutex> lock(graded_mutex_);
+        if (!graded_turn_.wait_for(lock, std::chrono::seconds(30),
+                                   [&] { return graded_running_ < kGradedAtOnce; })) {
+            return ErrorAnswer(absl::UnavailableError("graded previews are busy; try again"));
+        }
+        ++graded_running_;
+    }
+    absl::Cleanup turn_done = [&] {
+        std::lock_guard<std::mutex> lock(graded_mutex_);
+        --graded_running_;
+        graded_turn_.notify_one();
+    };
+    absl::StatusOr<std::shared_ptr<const Image>> image = GradedSource(job, frame, **preview);
+    if (!image.ok()) return ErrorAnswer(image.status());
+    absl::StatusOr<ChannelView> view = ViewChannel(**image, channel->empty() ? "beauty" : *channel);
     if (!view.ok()) return ErrorAnswer(view.status());
     absl::StatusOr<std::string> png =
         EncodePng(view->rgb, {.exposure = *exposure, .tone = view->tone});
     if (!png.ok()) return ErrorAnswer(png.status());
-    return {200, "image/png", std::move(*png), {{"Cache-Control", "private, no-cache"}}};
+    return {200, "image/png", std::move(*png), std::move(headers)};
+}
+
+absl::StatusOr<std::shared_ptr<const Image>> Dashboard::GradedSource(const JobRecord& job,
+                                                                     std::optional<int> frame,
+                                                                     const Preview& preview) {
+    const std::string key =
+        absl::StrCat(frame ? absl::StrCat(job.id, "/", *frame) : job.id, " ", preview.etag);
+    {
+        std::lock_guard<std::mutex> lock(previews_mutex_);
+        if (graded_.key == key) return graded_.image;
+    }
+    absl::StatusOr<ExrFile> exr = ReadResult(job, frame);
+    if (!exr.ok()) return exr.status();
+    auto image = std::make_shared<const Image>(std::move(exr->image));
+    std::lock_guard<std::mutex> lock(previews_mutex_);
+    graded_ = {key, image};
+    return image;
 }
 
 absl::StatusOr<ExrFile> Dashboard::ReadResult(const JobRecord& job, std::optional<int> frame) {
@@ -805,6 +844,10 @@ absl::StatusOr<ExrFile> Dashboard::ReadResult(const JobRecord& job, std::optiona
 
 void Dashboard::ForgetPreviews(const std::string& job_id) {
     std::lock_guard<std::mutex> lock(previews_mutex_);
+    if (absl::StartsWith(graded_.key, job_id + " ") ||
+        absl::StartsWith(graded_.key, job_id + "/")) {
+        graded_ = {};
+    }
     std::erase_if(previews_, [&](const auto& entry) {
         return entry.first == job_id || absl::StartsWith(entry.first, job_id + "/");
     });

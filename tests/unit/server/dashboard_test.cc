@@ -808,6 +808,18 @@ TEST_F(DashboardTest, ThePreviewIsGradedByExposureAndChannelFromTheLinearImage) 
     Call(Get(path + "?exposure=nan", alice_), 400);
     Call(Get(path + "?exposure=1", bob_), 404);
 
+    // A graded image is named by the preview's version, the exposure and the channel: the
+    // browser asks again with it and is answered 304 without an image read or encoded.
+    const HttpAnswer graded = dashboard_->Serve(Get(path + "?exposure=1", alice_));
+    const std::string etag = HeaderOf(graded, "ETag");
+    ASSERT_FALSE(etag.empty());
+    HttpRequest again = Get(path + "?exposure=1", alice_);
+    again.headers["if-none-match"] = etag;
+    EXPECT_EQ(dashboard_->Serve(again).status, 304);
+    for (const char* other : {"?exposure=1.5", "?exposure=1&channel=A"}) {
+        EXPECT_NE(HeaderOf(dashboard_->Serve(Get(path + other, alice_)), "ETag"), etag) << other;
+    }
+
     const HttpAnswer download = dashboard_->Serve(Get(path + "?download=1", alice_));
     ASSERT_EQ(download.status, 200);
     EXPECT_EQ(HeaderOf(download, "Content-Disposition"),

@@ -38,6 +38,7 @@
 // Authorization: Bearer, which a browser never adds by itself.
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -75,6 +76,8 @@ class Dashboard {
     static constexpr char kCookie[] = "lf_token";
     // Previews kept encoded, the most recently asked for.
     static constexpr size_t kMaxPreviews = 16;
+    // Graded previews (exposure, channel) made at once: each costs a full-size image's memory.
+    static constexpr int kGradedAtOnce = 2;
     // Frames of a shot one job answer lists: the page's strip pages through longer shots.
     static constexpr int kFramesListed = 100;
 
@@ -109,9 +112,15 @@ class Dashboard {
     HttpAnswer ListJobs(const HttpRequest& request, const Caller& caller, absl::Time now);
     // GET /api/jobs/ID/tasks: a page of the tasks in a state (a shot's frame's), with counts.
     HttpAnswer ListTasks(const HttpRequest& request, const JobRecord& job);
-    // preview.png?exposure=EV&channel=NAME: made from the linear image at each request.
+    // preview.png?exposure=EV&channel=NAME: made from the linear image of the preview's version
+    // (PreviewOf), which is kept for the last image graded; its ETag names the version, the
+    // exposure and the channel. At most kGradedAtOnce are made at once; others wait for a turn.
     HttpAnswer GradedPreviewAnswer(const HttpRequest& request, const JobRecord& job,
                                    std::optional<int> frame);
+    // The linear image of `preview`'s version of the job's (frame's) result, read once a version.
+    absl::StatusOr<std::shared_ptr<const Image>> GradedSource(const JobRecord& job,
+                                                              std::optional<int> frame,
+                                                              const Preview& preview);
     // The job's (or frame's) image as merged so far, read from its EXR.
     absl::StatusOr<ExrFile> ReadResult(const JobRecord& job, std::optional<int> frame);
     // Drops a deleted job's cached previews.
@@ -129,6 +138,16 @@ class Dashboard {
     std::mutex previews_mutex_;
     std::map<std::string, std::shared_ptr<Preview>> previews_;  // by job id (and frame)
     uint64_t preview_clock_ = 0;
+    // The image last graded: a user dragging the exposure slider asks for one image many times.
+    struct GradedImage {
+        std::string key;  // job id (and frame) and the preview's ETag
+        std::shared_ptr<const Image> image;
+    };
+    GradedImage graded_;  // under previews_mutex_
+    // Graded previews being made now (each holds an image and its encoding), under graded_mutex_.
+    std::mutex graded_mutex_;
+    std::condition_variable graded_turn_;
+    int graded_running_ = 0;
 };
 
 }  // namespace lf
