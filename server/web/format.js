@@ -28,6 +28,12 @@ export function duration(seconds) {
   return `${Math.floor(s / 3600)} h ${Math.floor((s % 3600) / 60)} min`;
 }
 
+// A task's or a frame's time on its workers: tenths of a second below a minute.
+export function seconds(s) {
+  if (s === null || s === undefined) return '—';
+  return s < 60 ? `${s.toFixed(1)} s` : duration(s);
+}
+
 export function progress(done, total) {
   const fraction = total > 0 ? done / total : 0;
   const bar = h('span', { class: 'bar' });
