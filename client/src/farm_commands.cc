@@ -170,7 +170,7 @@ void PrintJob(const pb::Job& job) {
         std::printf("  time      %.1f s queued\n", seconds(job.submitted_unix_ms(), now));
     }
     if (job.render_seconds() > 0) {
-        std::printf("  worked    %.1f s rendering, %.1f s CPU, on workers (merged tasks)\n",
+        std::printf("  worked    %.2f s rendering, %.2f s CPU, on workers (merged tasks)\n",
                     job.render_seconds(), job.cpu_seconds());
     }
     std::string when = absl::StrCat("  submitted ", LocalTime(job.submitted_unix_ms()));
