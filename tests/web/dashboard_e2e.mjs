@@ -148,6 +148,11 @@ try {
   await page.click('tr.task.done');
   await until('log lines', async () => (await page.$$('#log .line')).length > 0, 20);
   check(true, `a task's log opens: "${(await page.textContent('#log .line')).slice(0, 100)}"`);
+  // History (issue 30): the job's CPU time on its workers, and each done task's.
+  const cpu = await page.textContent('#cpu-time');
+  const taskCpu = await page.$$eval('tr.task.done', (rows) => rows.map((r) => r.children[5].textContent));
+  check(/^\d+\.\d\d s$/.test(cpu) && taskCpu.length > 0 && taskCpu.every((t) => /^\d+\.\d\d s$/.test(t)),
+    `the job page shows the CPU time (${cpu}) and each done task's (${taskCpu.slice(0, 3).join(', ')})`);
   await page.screenshot({ path: join(shotsDir, 'job.png'), fullPage: true });
 
   // Workers and the farm.
