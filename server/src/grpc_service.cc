@@ -444,7 +444,8 @@ grpc::Status JobServiceImpl::GetStats(grpc::ServerContext* context, const Caller
     StatsQuery query;
     if (req.since_unix_ms() != 0) {
         query.since = absl::FromUnixMillis(req.since_unix_ms());
-        if (query.since > absl::Now()) {
+        // A minute's leeway: the client's clock, which made `since`, may run a little ahead.
+        if (query.since > absl::Now() + absl::Minutes(1)) {
             return ToGrpcStatus(absl::InvalidArgumentError(absl::StrCat(
                 "GetStats: since ", absl::FormatTime(query.since), " is in the future")));
         }
