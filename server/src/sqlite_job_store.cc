@@ -320,8 +320,10 @@ absl::StatusOr<FarmStats> SqliteJobStore::Stats(const StatsQuery& query) const {
         return rows.status();
     };
     absl::Status status = read(
+        // A job requeued since it ended counts as active, not by its earlier end.
         "SELECT owner, state, COUNT(*) FROM job_stats WHERE ended >= ?1"
-        " AND (?2 IS NULL OR owner = ?2) GROUP BY owner, state",
+        " AND (?2 IS NULL OR owner = ?2)"
+        " AND job NOT IN (SELECT id FROM jobs WHERE final = 0) GROUP BY owner, state",
         [&](const Statement& row) {
             // A state this server does not know (a newer one's) is not counted.
             if (absl::StatusOr<JobState> state = JobStateFromName(row.Column(1)); state.ok()) {

@@ -501,6 +501,10 @@ TEST_F(SqliteJobStoreStatsTest, TasksAndEndedJobsAddUpPerOwnerAndWorkerAndOutliv
         // Written again as it is (a later write of an ended record): counted once.
         ASSERT_TRUE(store->Put(failed).ok());
         ASSERT_TRUE(store->Put(Job("job-c", "alice", JobState::kQueued)).ok());
+        // Requeued after it was cancelled: active, not cancelled.
+        ASSERT_TRUE(
+            store->Put(Job("job-d", "alice", JobState::kCancelled, t0_ + absl::Seconds(45))).ok());
+        ASSERT_TRUE(store->Put(Job("job-d", "alice", JobState::kQueued)).ok());
         ASSERT_TRUE(store->Delete("job-a").ok());
         ASSERT_TRUE(store->Delete("job-b").ok());
     }
@@ -510,7 +514,7 @@ TEST_F(SqliteJobStoreStatsTest, TasksAndEndedJobsAddUpPerOwnerAndWorkerAndOutliv
     ASSERT_TRUE(all.ok()) << all.status();
     EXPECT_EQ(all->since, absl::InfinitePast());
     ASSERT_EQ(all->owners.size(), 2u);
-    EXPECT_EQ(all->owners[0], (OwnerStats{"alice", 1, 0, 0, 1, 2, 150, {4, 6}}));
+    EXPECT_EQ(all->owners[0], (OwnerStats{"alice", 1, 0, 0, 2, 2, 150, {4, 6}}));
     EXPECT_EQ(all->owners[1], (OwnerStats{"bob", 0, 1, 0, 0, 1, 10, {5, 6}}));
     ASSERT_EQ(all->workers.size(), 2u);
     EXPECT_EQ(all->workers[0], (WorkerStats{"w1", 2, 0, {6, 8}}));
@@ -521,7 +525,7 @@ TEST_F(SqliteJobStoreStatsTest, TasksAndEndedJobsAddUpPerOwnerAndWorkerAndOutliv
     ASSERT_TRUE(recent.ok()) << recent.status();
     EXPECT_EQ(recent->since, since);
     ASSERT_EQ(recent->owners.size(), 2u);
-    EXPECT_EQ(recent->owners[0], (OwnerStats{"alice", 1, 0, 0, 1, 0, 0, {}}));
+    EXPECT_EQ(recent->owners[0], (OwnerStats{"alice", 1, 0, 0, 2, 0, 0, {}}));
     EXPECT_EQ(recent->owners[1], (OwnerStats{"bob", 0, 1, 0, 0, 1, 10, {5, 6}}));
     ASSERT_EQ(recent->workers.size(), 2u);
     EXPECT_EQ(recent->workers[0], (WorkerStats{"w1", 1, 0, {5, 6}}));
