@@ -120,6 +120,15 @@ class Job:
     def blocklist_after(self) -> int:
         return self.proto.blocklist_after
 
+    # History (issue 30): summed over its merged tasks, as their workers measured them.
+    @property
+    def cpu_seconds(self) -> float:
+        return self.proto.cpu_seconds
+
+    @property
+    def render_seconds(self) -> float:
+        return self.proto.render_seconds
+
     @property
     def params(self) -> common_pb2.RenderParams:
         """The render settings (lightfarm.v1.RenderParams)."""

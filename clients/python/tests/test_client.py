@@ -635,6 +635,8 @@ class ClientTest(unittest.TestCase):
     def test_stats(self):
         """History (issue 30): a submitter's own rows, an admin's everyone's, as plain dicts."""
         job = self.alice.wait(self.alice.submit(cornell(), **SMALL))
+        self.assertGreater(job.cpu_seconds, 0)
+        self.assertGreater(job.render_seconds, 0)
         mine = self.alice.stats(since=datetime.timedelta(hours=1))
         self.assertIsNotNone(mine["since"])
         self.assertEqual([o["owner"] for o in mine["owners"]], ["alice"])
