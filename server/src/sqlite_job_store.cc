@@ -35,7 +35,8 @@ absl::StatusOr<JobRecord> DecodeLegacy(std::string_view id, std::string_view rec
 // found inside the JSON; 1, the columns List and FindRequest select on, states by name; 2,
 // records in the StoredJob form (lf/server/job_record_codec.h), those before in the legacy form;
 // 3, task_results' history column (EncodeTaskHistory; '' for results recorded before); 4, the
-// history tables task_stats, job_stats and worker_failure_stats (empty in a store upgraded).
+// history tables task_stats, job_stats and worker_failure_stats (a store upgraded gains its
+// ended jobs in job_stats).
 constexpr int kSchemaVersion = 4;
 
 // Removes the history older than SqliteJobStore::kStatsKeptFor.
@@ -112,6 +113,14 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
                  "  failures INTEGER NOT NULL, PRIMARY KEY (job, ended, worker));"
                  "CREATE INDEX IF NOT EXISTS worker_failure_stats_by_ended"
                  "  ON worker_failure_stats (ended);");
+    }
+    if (s.ok() && old && found_version < 4) {
+        // The jobs that ended before the history: counted by state, without their tasks.
+        s = Exec(
+            db,
+            "INSERT OR IGNORE INTO job_stats (job, owner, state, ended)"
+            " SELECT id, json_extract(record, '$.spec.owner'), json_extract(record, '$.state'),"
+            " finished FROM jobs WHERE final = 1 AND finished IS NOT NULL");
     }
     if (s.ok()) s = PruneStats(db);
     if (s.ok()) {

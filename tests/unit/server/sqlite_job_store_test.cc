@@ -541,9 +541,13 @@ TEST_F(SqliteJobStoreStatsTest, TasksAndEndedJobsAddUpPerOwnerAndWorkerAndOutliv
     EXPECT_EQ(alice->workers[1], (WorkerStats{"w2", 1, 0, {3, 4}}));
 }
 
-TEST_F(SqliteJobStoreStatsTest, AVersion3StoreOpensAndGainsTheHistoryTables) {
+TEST_F(SqliteJobStoreStatsTest, AVersion3StoreOpensAndGainsTheHistoryTablesWithItsEndedJobs) {
     const std::string path = (dir_ / "jobs.db").string();
-    ASSERT_TRUE(OpenStore()->Put(Job("job-a", "alice", JobState::kRunning)).ok());
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        ASSERT_TRUE(store->Put(Job("job-a", "alice", JobState::kRunning)).ok());
+        ASSERT_TRUE(store->Put(Job("job-b", "bob", JobState::kFailed, t0_)).ok());
+    }
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
     ASSERT_EQ(sqlite3_exec(db,
@@ -559,8 +563,10 @@ TEST_F(SqliteJobStoreStatsTest, AVersion3StoreOpensAndGainsTheHistoryTables) {
     TaskDone(*store, *store->Get("job-a"), 0, Done("w1", t0_, {1, 2}, 3));
     absl::StatusOr<FarmStats> stats = store->Stats({});
     ASSERT_TRUE(stats.ok()) << stats.status();
-    ASSERT_EQ(stats->owners.size(), 1u);
+    ASSERT_EQ(stats->owners.size(), 2u);
     EXPECT_EQ(stats->owners[0], (OwnerStats{"alice", 0, 0, 0, 1, 1, 3, {1, 2}}));
+    // Ended before the upgrade: counted by its state, without tasks.
+    EXPECT_EQ(stats->owners[1], (OwnerStats{"bob", 0, 1, 0, 0, 0, 0, {}}));
 }
 
 }  // namespace
