@@ -1,12 +1,14 @@
 // The farm subcommands of `lightfarm` that ask lightfarm-server's JobService about jobs and act
-// on them: list, status, watch, fetch, cancel, priority, delete, workers, tasks and logs, each
-// through a FarmClient (`submit` is submit_command.cc).
+// on them: list, status, watch, fetch, cancel, priority, delete, workers, tasks, logs and stats,
+// each through a FarmClient (`submit` is submit_command.cc).
 #include <google/protobuf/util/json_util.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
@@ -23,6 +25,7 @@
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
 #include "lf/core/plural.h"
+#include "lf/job/farm_stats.h"
 #include "lf/job/job_record.h"
 #include "lf/job/job_spec.h"
 #include "lf/wire/conversions.h"
@@ -101,6 +104,11 @@ std::string FramesText(const pb::Job& job) {
     for (const pb::FrameProgress& f : job.frames()) {
         absl::StrAppend(&text, text.empty() ? "" : ", ", f.frame(), " ",
                         f.done() ? "done" : absl::StrCat(f.tasks_done(), "/", f.tasks_total()));
+        // What its merged tasks took on their workers (issue 30's per-frame times).
+        if (f.render_seconds() > 0) {
+            absl::StrAppend(&text, absl::StrFormat(" (%.1f s, %.1f s CPU)", f.render_seconds(),
+                                                   f.cpu_seconds()));
+        }
     }
     return text;
 }
@@ -160,6 +168,10 @@ void PrintJob(const pb::Job& job) {
                     seconds(job.started_unix_ms(), end));
     } else {
         std::printf("  time      %.1f s queued\n", seconds(job.submitted_unix_ms(), now));
+    }
+    if (job.render_seconds() > 0) {
+        std::printf("  worked    %.2f s rendering, %.2f s CPU, on workers (merged tasks)\n",
+                    job.render_seconds(), job.cpu_seconds());
     }
     std::string when = absl::StrCat("  submitted ", LocalTime(job.submitted_unix_ms()));
     if (job.started_unix_ms() > 0)
@@ -574,8 +586,8 @@ Command AddTasksCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "tasks",
         "List a job's tasks: state, kind, pixels, leases handed out, the worker of the last one,\n"
-        "how long it ran (or runs so far) and its last error. An ended job's as the server\n"
-        "recorded them when it ended.");
+        "how long it ran (or runs so far), a done task's CPU seconds on its worker and its last\n"
+        "error. An ended job's as the server recorded them when it ended.");
     cmd->add_option("job", *id, "job id")->required();
     AddJsonFlag(cmd, *json);
     AddServerOption(cmd, *flags);
@@ -590,8 +602,9 @@ Command AddTasksCommand(CLI::App& app) {
                 for (const pb::TaskInfo& t : resp.tasks()) PrintJson(t);
                 return 0;
             }
-            std::printf("%5s %-8s %-15s %-17s %-11s %8s %-28s %9s  %s\n", "TASK", "STATE", "KIND",
-                        "PIXELS", "FRAMES", "ATTEMPTS", "WORKER", "DURATION", "LAST-ERROR");
+            std::printf("%5s %-8s %-15s %-17s %-11s %8s %-28s %9s %9s  %s\n", "TASK", "STATE",
+                        "KIND", "PIXELS", "FRAMES", "ATTEMPTS", "WORKER", "DURATION", "CPU",
+                        "LAST-ERROR");
             for (const pb::TaskInfo& t : resp.tasks()) {
                 const std::string pixels =
                     t.width() > 0 ? absl::StrCat(t.x(), ",", t.y(), " ", t.width(), "x", t.height())
@@ -604,11 +617,15 @@ Command AddTasksCommand(CLI::App& app) {
                     : t.frames_size() == 1
                         ? absl::StrCat(t.frames(0))
                         : absl::StrCat(t.frames(0), "-", t.frames(t.frames_size() - 1));
-                std::printf("%5d %-8s %-15s %-17s %-11s %8d %-28s %9s  %s\n", t.index(),
+                // The worker's CPU seconds over a done task's render (issue 30's history).
+                const std::string cpu = t.state() == pb::TaskInfo::DONE && t.render_seconds() > 0
+                                            ? absl::StrFormat("%.2f s", t.cpu_seconds())
+                                            : "-";
+                std::printf("%5d %-8s %-15s %-17s %-11s %8d %-28s %9s %9s  %s\n", t.index(),
                             TaskStateName(t.state()).c_str(), TaskKindName(t.kind()).c_str(),
                             pixels.c_str(), frames.c_str(), t.attempts(),
                             t.worker().empty() ? "-" : LogSafe(t.worker(), kWorkerIdShown).c_str(),
-                            duration.c_str(), LogSafe(t.last_error(), 200).c_str());
+                            duration.c_str(), cpu.c_str(), LogSafe(t.last_error(), 200).c_str());
             }
             return 0;
         }};
@@ -657,6 +674,92 @@ Command AddLogsCommand(CLI::App& app) {
                     if (!*follow) return 0;
                     absl::SleepFor(absl::Milliseconds(500));
                 }
+            }};
+}
+
+namespace {
+
+// The stats tables (issue 30), each column as wide as its widest cell.
+void PrintStats(const pb::GetStatsResponse& stats, const std::string& since) {
+    std::printf("since %s\n",
+                stats.since_unix_ms() > 0
+                    ? absl::StrCat(LocalTime(stats.since_unix_ms()), " (", since, ")").c_str()
+                    : "the start of the history kept");
+    const auto hours = [](double seconds) { return absl::StrFormat("%.3f", seconds / 3600); };
+    const auto print = [](const std::vector<std::vector<std::string>>& rows) {
+        std::vector<size_t> widths(rows.front().size(), 0);
+        for (const auto& row : rows) {
+            for (size_t i = 0; i < row.size(); ++i) widths[i] = std::max(widths[i], row[i].size());
+        }
+        for (const auto& row : rows) {
+            std::string line = absl::StrFormat("%-*s", int(widths[0]), row[0]);
+            for (size_t i = 1; i < row.size(); ++i) {
+                absl::StrAppend(&line, absl::StrFormat("  %*s", int(widths[i]), row[i]));
+            }
+            std::printf("%s\n", line.c_str());
+        }
+    };
+    std::vector<std::vector<std::string>> owners = {{"OWNER", "SUCCEEDED", "FAILED", "CANCELLED",
+                                                     "ACTIVE", "TASKS", "SAMPLES", "CPU-HOURS",
+                                                     "RENDER-HOURS"}};
+    for (const pb::OwnerStats& o : stats.owners()) {
+        owners.push_back({o.owner().empty() ? "-" : LogSafe(o.owner(), kWorkerIdShown),
+                          absl::StrCat(o.jobs_succeeded()), absl::StrCat(o.jobs_failed()),
+                          absl::StrCat(o.jobs_cancelled()), absl::StrCat(o.jobs_active()),
+                          absl::StrCat(o.tasks()), absl::StrCat(o.samples()),
+                          hours(o.cpu_seconds()), hours(o.render_seconds())});
+    }
+    print(owners);
+    std::printf("\n");
+    std::vector<std::vector<std::string>> workers = {
+        {"WORKER", "TASKS", "FAILURES", "CPU-HOURS", "RENDER-HOURS"}};
+    for (const pb::WorkerStats& w : stats.workers()) {
+        workers.push_back({LogSafe(w.worker(), kWorkerIdShown), absl::StrCat(w.tasks()),
+                           absl::StrCat(w.failures()), hours(w.cpu_seconds()),
+                           hours(w.render_seconds())});
+    }
+    print(workers);
+}
+
+}  // namespace
+
+Command AddStatsCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto since = std::make_shared<std::string>();
+    auto owner = std::make_shared<std::string>();
+    auto json = std::make_shared<bool>(false);
+    CLI::App* cmd = app.add_subcommand(
+        "stats",
+        "The farm's history (kept across restarts and job deletions, for 400 days): per owner,\n"
+        "jobs that ended by final state and those active now, tasks, samples, CPU and render\n"
+        "hours; per worker, tasks, failures, CPU and render hours. An admin sees everyone's, a\n"
+        "submitter their own jobs' (docs/farm.md, History).");
+    cmd->add_option("--since", *since,
+                    "only work that ended since: 7d, 24h, 30m, 45s ago, a date 2026-11-01 (UTC) "
+                    "or a time 2026-11-01T08:00:00Z; default: all the history kept");
+    cmd->add_option("--owner", *owner, "only this owner's jobs (an admin's choice)");
+    cmd->add_flag("--json", *json,
+                  "one JSON object instead of the tables: lightfarm.v1.GetStatsResponse with "
+                  "proto field names (docs/farm.md, History)");
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, since, owner, json] {
+                pb::GetStatsRequest req;
+                if (!since->empty()) {
+                    absl::StatusOr<absl::Time> start = ParseSince(*since, absl::Now());
+                    if (!start.ok()) return ReportError(start.status());
+                    req.set_since_unix_ms(absl::ToUnixMillis(*start));
+                }
+                req.set_owner(*owner);
+                pb::GetStatsResponse resp;
+                absl::Status s =
+                    FarmClient(*flags).Call(&pb::JobService::Stub::GetStats, req, &resp);
+                if (!s.ok()) return ReportError(s);
+                if (*json) {
+                    PrintJson(resp);
+                } else {
+                    PrintStats(resp, *since);
+                }
+                return 0;
             }};
 }
 

@@ -158,6 +158,9 @@ Json JobJson(const JobRecord& job, absl::Time now) {
         {"blocklist_after", job.spec.blocklist_after},
         {"blocklist", BlocklistJson(job)},
         {"paused", job.paused},
+        // History (issue 30): summed over the merged tasks, as their workers measured them.
+        {"render_s", job.times.render_seconds},
+        {"cpu_s", job.times.cpu_seconds},
     };
 }
 
@@ -196,6 +199,8 @@ Json FramesJson(const JobRecord& job, int from, const std::set<int>& running) {
                           {"state", FrameStateName(f, job.state, running.count(f.frame) > 0)},
                           {"tasks_done", f.tasks_done},
                           {"tasks_total", f.tasks_total},
+                          {"render_s", f.times.render_seconds},
+                          {"cpu_s", f.times.cpu_seconds},
                           {"preview", FramePreviewUrl(job, f)}});
     }
     return frames;
@@ -220,6 +225,8 @@ Json TaskJson(const TaskStatus& t) {
         {"last_error", t.last_error},
         {"log_lines", t.log_lines},
         {"frames", t.frames},
+        {"render_s", t.times.render_seconds},
+        {"cpu_s", t.times.cpu_seconds},
     };
 }
 

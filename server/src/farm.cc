@@ -221,7 +221,7 @@ absl::Status Farm::RefuseUndecodable(const std::string& lease_id, const std::str
 absl::Status Farm::Complete(const std::string& lease_id, const std::string& worker,
                             std::string_view tile_sums, std::optional<RadiosityFigures> radiosity,
                             std::optional<std::string_view> splats, std::optional<int> frame,
-                            const std::vector<ResultPart>& parts) {
+                            const std::vector<ResultPart>& parts, const TaskTimes& times) {
     // As many parts as the task has, checked before any is decoded: a worker's message of
     // millions of empty parts costs no decoding.
     const std::optional<Scheduler::LeaseHolder> holder = scheduler_.HolderOf(lease_id, worker);
@@ -235,7 +235,7 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     }
     // A chunk's parts, or the one result; kept in place while the result points at them.
     std::vector<ResultPart> wire = parts;
-    if (parts.empty()) wire.push_back({frame.value_or(0), tile_sums, splats});
+    if (parts.empty()) wire.push_back({frame.value_or(0), tile_sums, splats, times});
     std::vector<TileSums> sums;
     std::vector<std::optional<SplatList>> lists;
     sums.reserve(wire.size());
@@ -257,9 +257,10 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     for (size_t i = 0; i < wire.size(); ++i) {
         results.push_back({.sums = &sums[i],
                            .splats = lists[i] ? &*lists[i] : nullptr,
-                           .frame = parts.empty() ? frame : std::optional<int>(wire[i].frame)});
+                           .frame = parts.empty() ? frame : std::optional<int>(wire[i].frame),
+                           .times = wire[i].times});
     }
-    TaskResult chunk{.parts = std::move(results)};
+    TaskResult chunk{.parts = std::move(results), .times = times};
     const TaskResult& result = parts.empty() ? chunk.parts.front() : chunk;
     absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(lease_id, worker, result);
     if (!done.ok()) {
@@ -300,11 +301,11 @@ void Farm::WriteFrame(const std::string& job_id, int frame) {
 }
 
 absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
-                                 std::string_view sweep_result) {
+                                 std::string_view sweep_result, const TaskTimes& times) {
     absl::StatusOr<SweepChunkResult> result = DecodeSweepResult(sweep_result);
     if (!result.ok()) return RefuseUndecodable(lease_id, worker, result.status());
     absl::StatusOr<Scheduler::Completion> done =
-        scheduler_.CompleteSweep(lease_id, worker, *result);
+        scheduler_.Complete(lease_id, worker, TaskResult{.sweep = &*result, .times = times});
     if (!done.ok()) return done.status();
     if (done->sweep && done->sweep->converged) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);

@@ -178,6 +178,10 @@ JobServiceImpl::JobServiceImpl(Farm& farm, CallGuard guard, JobServiceOptions op
                                         bind_front(&JobServiceImpl::PauseJob, this));
     Unary<pb::ResumeJobRequest, pb::Job>("ResumeJob", Action::kManageJobs, kMaxRequestBytes,
                                          bind_front(&JobServiceImpl::ResumeJob, this));
+    // History (issue 30): read as jobs are, everyone's for an admin, a submitter's own.
+    Unary<pb::GetStatsRequest, pb::GetStatsResponse>("GetStats", Action::kReadJobs,
+                                                     kMaxRequestBytes,
+                                                     bind_front(&JobServiceImpl::GetStats, this));
 }
 
 WorkerServiceImpl::WorkerServiceImpl(Farm& farm, CallGuard guard)
@@ -435,6 +439,31 @@ grpc::Status JobServiceImpl::RequeueJob(grpc::ServerContext* context, const Call
     return grpc::Status::OK;
 }
 
+grpc::Status JobServiceImpl::GetStats(grpc::ServerContext* context, const Caller& caller,
+                                      const pb::GetStatsRequest& req, pb::GetStatsResponse* resp) {
+    StatsQuery query;
+    if (req.since_unix_ms() != 0) {
+        query.since = absl::FromUnixMillis(req.since_unix_ms());
+        // A minute's leeway: the client's clock, which made `since`, may run a little ahead.
+        if (query.since > absl::Now() + absl::Minutes(1)) {
+            return ToGrpcStatus(absl::InvalidArgumentError(absl::StrCat(
+                "GetStats: since ", absl::FormatTime(query.since), " is in the future")));
+        }
+    }
+    if (!req.owner().empty()) query.owner = req.owner();
+    if (!MaySee(caller, req.owner().empty() ? caller.name : req.owner())) {
+        return ToGrpcStatus(absl::PermissionDeniedError(
+            absl::StrCat("token \"", caller.name, "\" may see only its own jobs' stats, not ",
+                         LogSafe(req.owner(), kIdBytesInErrors), "'s")));
+    }
+    // A submitter's own jobs only, and the workers' rows of their tasks only.
+    if (caller.role != Role::kAdmin) query.owner = caller.name;
+    absl::StatusOr<FarmStats> stats = farm_.store().Stats(query);
+    if (!stats.ok()) return ToGrpcStatus(stats.status());
+    ToProto(*stats, resp);
+    return grpc::Status::OK;
+}
+
 grpc::Status JobServiceImpl::PauseJob(grpc::ServerContext* context, const Caller& caller,
                                       const pb::PauseJobRequest& req, pb::Job* resp) {
     return SetPaused(context, caller, req.job_id(), true, resp);
@@ -599,10 +628,14 @@ grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context, const
     TakeTaskLog(farm_, req, worker);
     std::vector<Farm::ResultPart> parts;
     for (const pb::TaskPartResult& part : req.parts()) {
-        parts.push_back({part.frame(), part.tile_sums(),
-                         part.splats().empty() ? std::nullopt
-                                               : std::optional<std::string_view>(part.splats())});
+        parts.push_back(
+            {part.frame(),
+             part.tile_sums(),
+             part.splats().empty() ? std::nullopt : std::optional<std::string_view>(part.splats()),
+             {part.render_seconds(), part.cpu_seconds()}});
     }
+    // As the worker measured them: shown and summed, never trusted for anything else.
+    const TaskTimes times{req.seconds(), req.cpu_seconds()};
     const absl::Status s =
         req.radiosity_sweep().empty()
             ? farm_.Complete(
@@ -612,8 +645,8 @@ grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context, const
                   // An encoded list is never empty: empty means a tile's result.
                   req.splats().empty() ? std::nullopt
                                        : std::optional<std::string_view>(req.splats()),
-                  req.has_frame() ? std::optional<int>(req.frame()) : std::nullopt, parts)
-            : farm_.CompleteSweep(req.lease_id(), worker, req.radiosity_sweep());
+                  req.has_frame() ? std::optional<int>(req.frame()) : std::nullopt, parts, times)
+            : farm_.CompleteSweep(req.lease_id(), worker, req.radiosity_sweep(), times);
     if (!s.ok()) {
         Log()->warn("{}", RefusedResultLine(req.lease_id(), worker, context->peer(),
                                             std::string(s.message())));

@@ -52,6 +52,7 @@ void ScheduledJob::Sync() {
     if (record.frames.size() == frames.size()) {
         for (size_t i = 0; i < frames.size(); ++i) {
             frames[i].result_path = std::move(record.frames[i].result_path);
+            frames[i].times = record.frames[i].times;
         }
     }
     record.frames = std::move(frames);
@@ -65,7 +66,14 @@ std::string ScheduledJob::WorkerOf(int t, const LeaseTable& leases) const {
 
 TaskHistory ScheduledJob::History(int t, const LeaseTable& leases) const {
     const Task& task = tasks[size_t(t)];
-    return {task.attempts, task.failures, WorkerOf(t, leases), task.leased_at, task.finished};
+    return {.attempts = task.attempts,
+            .failures = task.failures,
+            .worker = WorkerOf(t, leases),
+            .leased = task.leased_at,
+            .finished = task.finished,
+            .times = task.times,
+            .samples = execution->TaskSamples(t),
+            .frame = task.frame};
 }
 
 void ScheduledJob::Restore(int t, const TaskHistory& history) {
@@ -75,6 +83,23 @@ void ScheduledJob::Restore(int t, const TaskHistory& history) {
     task.recorded_worker = history.worker;
     task.leased_at = history.leased;
     task.finished = history.finished;
+    task.times = history.times;
+    task.frame = history.frame;
+}
+
+void ScheduledJob::AddTimes(int t, const TaskResult& result) {
+    Task& task = tasks[size_t(t)];
+    task.times = result.times;
+    if (result.parts.empty()) task.frame = result.frame;
+    record.times += result.times;
+    Sync();  // the record lists the frames
+    const auto add_to_frame = [&](const TaskResult& part) {
+        for (FrameProgress& frame : record.frames) {
+            if (part.frame && frame.frame == *part.frame) frame.times += part.times;
+        }
+    };
+    if (result.parts.empty()) add_to_frame(result);
+    for (const TaskResult& part : result.parts) add_to_frame(part);
 }
 
 std::vector<TaskStatus> ScheduledJob::Statuses(const LeaseTable& leases, absl::Time now) const {
@@ -108,6 +133,7 @@ std::vector<TaskStatus> ScheduledJob::Statuses(const LeaseTable& leases, absl::T
         status.worker = WorkerOf(t, leases);
         status.leased = task.leased_at;
         status.finished = task.finished;
+        status.times = task.times;
         if (status.state == TaskStatus::State::kDone) {
             status.duration = task.finished - task.leased_at;
         } else if (status.state == TaskStatus::State::kRunning) {

@@ -607,6 +607,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     workers_.Worked(worker);
     workers_.Worked(TokenStrikes(worker));
     MarkDone(job, t, now);
+    job.AddTimes(t, result);
     job.Queue(merged->appended);
     if (!merged->job_error.ok()) {
         FailJob(job, std::string(merged->job_error.message()));

@@ -34,8 +34,23 @@ absl::StatusOr<JobRecord> DecodeLegacy(std::string_view id, std::string_view rec
 // Schema versions (PRAGMA user_version): 0, records only, states by enum position, request ids
 // found inside the JSON; 1, the columns List and FindRequest select on, states by name; 2,
 // records in the StoredJob form (lf/server/job_record_codec.h), those before in the legacy form;
-// 3, task_results' history column (EncodeTaskHistory; '' for results recorded before).
-constexpr int kSchemaVersion = 3;
+// 3, task_results' history column (EncodeTaskHistory; '' for results recorded before); 4, the
+// history tables task_stats, job_stats and worker_failure_stats (a store upgraded gains its
+// ended jobs in job_stats).
+constexpr int kSchemaVersion = 4;
+
+// Removes the history older than SqliteJobStore::kStatsKeptFor.
+absl::Status PruneStats(sqlite3* db) {
+    const int64_t before = absl::ToUnixMicros(absl::Now() - SqliteJobStore::kStatsKeptFor);
+    for (const char* sql :
+         {"DELETE FROM task_stats WHERE finished < ?1", "DELETE FROM job_stats WHERE ended < ?1",
+          "DELETE FROM worker_failure_stats WHERE ended < ?1"}) {
+        Statement prune(db, sql);
+        prune.Bind(1, before).Step();
+        if (!prune.status().ok()) return prune.status();
+    }
+    return absl::OkStatus();
+}
 
 }  // namespace
 
@@ -81,8 +96,33 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
                  "CREATE UNIQUE INDEX IF NOT EXISTS jobs_by_request_id ON jobs (request_id)"
                  "  WHERE request_id != '';"
                  "CREATE INDEX IF NOT EXISTS jobs_by_seq ON jobs (seq);"
-                 "CREATE INDEX IF NOT EXISTS ended_jobs ON jobs (finished) WHERE final = 1;");
+                 "CREATE INDEX IF NOT EXISTS ended_jobs ON jobs (finished) WHERE final = 1;"
+                 // The history (issue 30): times in Unix microseconds; a task's frame is NULL but
+                 // for a shot's task of one frame. A task rendered again after a requeue adds a
+                 // row; a job keeps only its last end.
+                 "CREATE TABLE IF NOT EXISTS task_stats (job TEXT NOT NULL, task INTEGER NOT NULL,"
+                 "  finished INTEGER NOT NULL, owner TEXT NOT NULL, worker TEXT NOT NULL,"
+                 "  frame INTEGER, cpu_seconds REAL NOT NULL, render_seconds REAL NOT NULL,"
+                 "  samples INTEGER NOT NULL, PRIMARY KEY (job, task, finished));"
+                 "CREATE INDEX IF NOT EXISTS task_stats_by_finished ON task_stats (finished);"
+                 "CREATE TABLE IF NOT EXISTS job_stats (job TEXT PRIMARY KEY, owner TEXT NOT NULL,"
+                 "  state TEXT NOT NULL, ended INTEGER NOT NULL);"
+                 "CREATE INDEX IF NOT EXISTS job_stats_by_ended ON job_stats (ended);"
+                 "CREATE TABLE IF NOT EXISTS worker_failure_stats (job TEXT NOT NULL,"
+                 "  ended INTEGER NOT NULL, worker TEXT NOT NULL, owner TEXT NOT NULL,"
+                 "  failures INTEGER NOT NULL, PRIMARY KEY (job, ended, worker));"
+                 "CREATE INDEX IF NOT EXISTS worker_failure_stats_by_ended"
+                 "  ON worker_failure_stats (ended);");
     }
+    if (s.ok() && old && found_version < 4) {
+        // The jobs that ended before the history: counted by state, without their tasks.
+        s = Exec(
+            db,
+            "INSERT OR IGNORE INTO job_stats (job, owner, state, ended)"
+            " SELECT id, json_extract(record, '$.spec.owner'), json_extract(record, '$.state'),"
+            " finished FROM jobs WHERE final = 1 AND finished IS NOT NULL");
+    }
+    if (s.ok()) s = PruneStats(db);
     if (s.ok()) {
         s = Exec(db, absl::StrCat("PRAGMA user_version = ", kSchemaVersion).c_str());
     }
@@ -122,6 +162,9 @@ SqliteJobStore::Write SqliteJobStore::PutOf(const JobRecord& job) {
         w.finished_us = absl::ToUnixMicros(job.finished);
     }
     w.record = EncodeJobRecord(job);
+    w.owner = job.spec.owner;
+    w.state = job.state;
+    if (w.finished_us) w.worker_failures = job.worker_failures;
     return w;
 }
 
@@ -133,6 +176,7 @@ uint64_t SqliteJobStore::QueueTaskDone(const JobRecord& job, int task, std::stri
     w.task = task;
     w.result = std::move(result);
     w.history = EncodeTaskHistory(history);
+    w.done = history;
     return Queue(std::move(w));
 }
 
@@ -212,6 +256,7 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
             put.Bind(1, w.job_id).Bind(2, int64_t(w.task)).BindBlob(3, w.result);
             put.Bind(4, w.history).Step();
             status = put.status();
+            if (status.ok()) status = RecordTaskStats(w);
         }
         if (!status.ok() || newest[w.job_id] != i) continue;
         // An upsert by id, not INSERT OR REPLACE: a clash of request ids must fail, not delete
@@ -224,6 +269,7 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
         put.Bind(1, w.job_id).Bind(2, int64_t(w.seq)).Bind(3, int64_t(w.final));
         put.Bind(4, w.record).Bind(5, w.request_id).Bind(6, w.finished_us).Step();
         status = put.status();
+        if (status.ok() && w.finished_us) status = RecordJobEnd(w);
         if (status.ok() && w.drop_results) {
             Statement drop(db_, "DELETE FROM task_results WHERE job = ?1");
             drop.Bind(1, w.job_id).Step();
@@ -235,11 +281,100 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
     return status;
 }
 
+absl::Status SqliteJobStore::RecordTaskStats(const Write& w) {
+    const absl::Time finished =
+        w.done.finished == absl::InfinitePast() ? absl::Now() : w.done.finished;
+    Statement put(db_,
+                  "INSERT OR REPLACE INTO task_stats (job, task, finished, owner, worker, frame,"
+                  " cpu_seconds, render_seconds, samples)"
+                  " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)");
+    put.Bind(1, w.job_id).Bind(2, int64_t(w.task)).Bind(3, absl::ToUnixMicros(finished));
+    put.Bind(4, w.owner).Bind(5, w.done.worker);
+    put.Bind(6, w.done.frame ? std::optional<int64_t>(*w.done.frame) : std::nullopt);
+    put.BindDouble(7, w.done.times.cpu_seconds).BindDouble(8, w.done.times.render_seconds);
+    put.Bind(9, int64_t(w.done.samples)).Step();
+    return put.status();
+}
+
+absl::Status SqliteJobStore::RecordJobEnd(const Write& w) {
+    // An ended job's record, written again (a requeued job that ends again) or not: its last
+    // end replaces the row, and its failures are those since its requeue cleared them.
+    Statement job(db_,
+                  "INSERT OR REPLACE INTO job_stats (job, owner, state, ended)"
+                  " VALUES (?1, ?2, ?3, ?4)");
+    job.Bind(1, w.job_id).Bind(2, w.owner).Bind(3, JobStateName(w.state));
+    job.Bind(4, w.finished_us).Step();
+    if (!job.status().ok()) return job.status();
+    for (const WorkerFailures& f : w.worker_failures) {
+        Statement put(db_,
+                      "INSERT OR REPLACE INTO worker_failure_stats (job, ended, worker, owner,"
+                      " failures) VALUES (?1, ?2, ?3, ?4, ?5)");
+        put.Bind(1, w.job_id).Bind(2, w.finished_us).Bind(3, f.worker).Bind(4, w.owner);
+        put.Bind(5, int64_t(f.failures)).Step();
+        if (!put.status().ok()) return put.status();
+    }
+    return PruneStats(db_);
+}
+
+absl::StatusOr<FarmStats> SqliteJobStore::Stats(const StatsQuery& query) const {
+    const int64_t since = query.since == absl::InfinitePast() ? std::numeric_limits<int64_t>::min()
+                                                              : absl::ToUnixMicros(query.since);
+    StatsAccumulator stats;
+    std::lock_guard<std::mutex> lock(read_mutex_);
+    const auto read = [&](const char* sql, const auto& add) {
+        Statement rows(read_db_, sql);
+        rows.Bind(1, since);
+        if (query.owner) rows.Bind(2, *query.owner);
+        while (rows.Step()) add(rows);
+        return rows.status();
+    };
+    absl::Status status = read(
+        // A job requeued since it ended counts as active, not by its earlier end.
+        "SELECT owner, state, COUNT(*) FROM job_stats WHERE ended >= ?1"
+        " AND (?2 IS NULL OR owner = ?2)"
+        " AND job NOT IN (SELECT id FROM jobs WHERE final = 0) GROUP BY owner, state",
+        [&](const Statement& row) {
+            // A state this server does not know (a newer one's) is not counted.
+            if (absl::StatusOr<JobState> state = JobStateFromName(row.Column(1)); state.ok()) {
+                stats.AddJobs(row.Column(0), *state, row.ColumnInt(2));
+            }
+        });
+    if (status.ok()) {
+        // Active now, whatever the window (?1 is unused: the count of parameters is the
+        // highest index, so binding it is no error).
+        status = read(
+            "SELECT json_extract(record, '$.spec.owner') AS o, COUNT(*) FROM jobs"
+            " WHERE final = 0 AND (?2 IS NULL OR o = ?2) GROUP BY o",
+            [&](const Statement& row) {
+                stats.AddJobs(row.Column(0), JobState::kRunning, row.ColumnInt(1));
+            });
+    }
+    if (status.ok()) {
+        status = read(
+            "SELECT owner, worker, COUNT(*), SUM(samples), SUM(cpu_seconds),"
+            " SUM(render_seconds) FROM task_stats WHERE finished >= ?1"
+            " AND (?2 IS NULL OR owner = ?2) GROUP BY owner, worker",
+            [&](const Statement& row) {
+                stats.AddTasks(row.Column(0), row.Column(1), row.ColumnInt(2),
+                               uint64_t(row.ColumnInt(3)),
+                               {row.ColumnDouble(5), row.ColumnDouble(4)});
+            });
+    }
+    if (status.ok()) {
+        status = read(
+            "SELECT worker, SUM(failures) FROM worker_failure_stats WHERE ended >= ?1"
+            " AND (?2 IS NULL OR owner = ?2) GROUP BY worker",
+            [&](const Statement& row) { stats.AddFailures(row.Column(0), row.ColumnInt(1)); });
+    }
+    if (!status.ok()) return status;
+    return std::move(stats).Take(query.since);
+}
+
 absl::Status SqliteJobStore::Migrate(sqlite3* db, int64_t version) {
     // Version 0 to 1: the columns, filled from the records. Either to 2: the records rewritten
     // in the StoredJob form. Any to 3: task_results gains its history column (when an earlier
     // version made the table). In one transaction, so that a failure leaves the old version to
-    // try again.
+    // try again. To 4: the history tables, made by Open as in a new store.
     if (absl::Status s = Exec(db, "BEGIN IMMEDIATE"); !s.ok()) return s;
     absl::Status status;
     bool has_results = false;
@@ -249,7 +384,7 @@ absl::Status SqliteJobStore::Migrate(sqlite3* db, int64_t version) {
         has_results = results.Step();
         status = results.status();
     }
-    if (status.ok() && has_results) {
+    if (status.ok() && has_results && version < 3) {
         status = Exec(db, "ALTER TABLE task_results ADD COLUMN history TEXT NOT NULL DEFAULT ''");
     }
     if (status.ok() && version == 0) {

@@ -85,21 +85,27 @@ absl::StatusOr<std::unique_ptr<TaskLogStore>> TaskLogStore::Open(const std::stri
              "  worker TEXT NOT NULL, leased_ms INTEGER NOT NULL, finished_ms INTEGER NOT NULL,"
              "  duration_ms INTEGER NOT NULL, last_error TEXT NOT NULL,"
              "  frames TEXT NOT NULL DEFAULT '',"
+             "  render_seconds REAL NOT NULL DEFAULT 0, cpu_seconds REAL NOT NULL DEFAULT 0,"
              "  PRIMARY KEY (job, task));");
     if (!s.ok()) return absl::Status(s.code(), absl::StrCat(path, ": ", s.message()));
-    // A store written before shots has no frames column: its tasks are stills' ("").
-    bool migrated = false;
-    {
-        Statement has_frames(db, "SELECT 1 FROM pragma_table_info('tasks') WHERE name = 'frames'");
-        migrated = has_frames.Step();
-        if (!has_frames.status().ok()) {
-            return absl::Status(has_frames.status().code(),
-                                absl::StrCat(path, ": ", has_frames.status().message()));
-        }
-    }  // finalized before the table changes
-    if (!migrated) {
+    // A store written before shots has no frames column (its tasks are stills': ""), one
+    // written before the history (issue 30) no times (0: not measured).
+    for (const auto& [column, definition] :
+         {std::pair{"frames", "frames TEXT NOT NULL DEFAULT ''"},
+          std::pair{"render_seconds", "render_seconds REAL NOT NULL DEFAULT 0"},
+          std::pair{"cpu_seconds", "cpu_seconds REAL NOT NULL DEFAULT 0"}}) {
+        bool present = false;
+        {
+            Statement has(db, "SELECT 1 FROM pragma_table_info('tasks') WHERE name = ?1");
+            present = has.Bind(1, column).Step();
+            if (!has.status().ok()) {
+                return absl::Status(has.status().code(),
+                                    absl::StrCat(path, ": ", has.status().message()));
+            }
+        }  // finalized before the table changes
+        if (present) continue;
         if (absl::Status a =
-                Exec(db, "ALTER TABLE tasks ADD COLUMN frames TEXT NOT NULL DEFAULT ''");
+                Exec(db, absl::StrCat("ALTER TABLE tasks ADD COLUMN ", definition).c_str());
             !a.ok()) {
             return absl::Status(a.code(), absl::StrCat(path, ": ", a.message()));
         }
@@ -275,8 +281,8 @@ absl::Status TaskLogStore::RecordTasks(const std::string& job_id,
     Statement insert(db_,
                      "INSERT OR REPLACE INTO tasks (job, task, state, kind, x, y, width, height,"
                      " samples, attempts, failures, worker, leased_ms, finished_ms, duration_ms,"
-                     " last_error, frames) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11,"
-                     " ?12, ?13, ?14, ?15, ?16, ?17)");
+                     " last_error, frames, render_seconds, cpu_seconds) VALUES (?1, ?2, ?3, ?4,"
+                     " ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, ?18, ?19)");
     for (const TaskStatus& t : tasks) {
         insert.Bind(1, job_id)
             .Bind(2, int64_t(t.index))
@@ -294,7 +300,9 @@ absl::Status TaskLogStore::RecordTasks(const std::string& job_id,
             .Bind(14, UnixMs(t.finished))
             .Bind(15, absl::ToInt64Milliseconds(t.duration))
             .Bind(16, t.last_error)
-            .Bind(17, absl::StrJoin(t.frames, ","));
+            .Bind(17, absl::StrJoin(t.frames, ","))
+            .BindDouble(18, t.times.render_seconds)
+            .BindDouble(19, t.times.cpu_seconds);
         insert.Step();
         if (!insert.status().ok()) return insert.status();
         insert.Reset();
@@ -306,8 +314,8 @@ absl::StatusOr<std::vector<TaskStatus>> TaskLogStore::Tasks(const std::string& j
     std::lock_guard<std::mutex> lock(mutex_);
     Statement select(db_,
                      "SELECT task, state, kind, x, y, width, height, samples, attempts, failures,"
-                     " worker, leased_ms, finished_ms, duration_ms, last_error, frames FROM tasks"
-                     " WHERE job = ?1 ORDER BY task");
+                     " worker, leased_ms, finished_ms, duration_ms, last_error, frames,"
+                     " render_seconds, cpu_seconds FROM tasks WHERE job = ?1 ORDER BY task");
     select.Bind(1, job_id);
     std::vector<TaskStatus> tasks;
     while (select.Step()) {
@@ -336,6 +344,7 @@ absl::StatusOr<std::vector<TaskStatus>> TaskLogStore::Tasks(const std::string& j
             int frame = 0;
             if (absl::SimpleAtoi(part, &frame)) t.frames.push_back(frame);
         }
+        t.times = {select.ColumnDouble(16), select.ColumnDouble(17)};
     }
     if (!select.status().ok()) return select.status();
     return tasks;

@@ -28,6 +28,14 @@ export function duration(seconds) {
   return `${Math.floor(s / 3600)} h ${Math.floor((s % 3600) / 60)} min`;
 }
 
+// A task's or a frame's time on its workers: hundredths of a second below 10 s, tenths below a
+// minute.
+export function seconds(s) {
+  if (s === null || s === undefined) return '—';
+  if (s < 10) return `${s.toFixed(2)} s`;
+  return s < 60 ? `${s.toFixed(1)} s` : duration(s);
+}
+
 export function progress(done, total) {
   const fraction = total > 0 ? done / total : 0;
   const bar = h('span', { class: 'bar' });

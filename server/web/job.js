@@ -6,7 +6,7 @@
 // lists them); a frame's page (#/frame/JOB/N) shows that frame as a still's page shows the
 // still: its tiles, tasks, preview and header, with the strip to go on to another frame.
 import { get, post } from './api.js';
-import { duration, h, progress, svg, table, time } from './format.js';
+import { duration, h, progress, seconds, svg, table, time } from './format.js';
 
 const ended = (state) => ['succeeded', 'failed', 'cancelled'].includes(state);
 // Rows of a page of the tasks table; the tile overlay reads up to the API's bound of tasks.
@@ -193,7 +193,7 @@ export function mount(root, id, who, frameText) {
     for (const f of job.frames) {
       const thumb = thumbs.get(f.frame);
       thumb.element.className = `thumb ${f.state}${f.frame === frame ? ' open' : ''}`;
-      thumb.element.title = `frame ${f.frame}: ${f.state}, ${f.tasks_done}/${f.tasks_total} tasks`;
+      thumb.element.title = `frame ${f.frame}: ${f.state}, ${f.tasks_done}/${f.tasks_total} tasks, ${seconds(f.render_s)} render, ${seconds(f.cpu_s)} CPU`;
       thumb.state.textContent = f.state;
       thumb.img.hidden = !f.preview;
       if (f.preview && thumb.img.getAttribute('src') !== f.preview) thumb.img.src = f.preview;
@@ -235,12 +235,12 @@ export function mount(root, id, who, frameText) {
       framesFrom = Math.min(Math.max(0, Math.floor(position / per) * per), job.shot.frames_total - 1);
       if (framesFrom !== job.shot.frames_from) job = await get(jobPath());
     }
-    summary.replaceChildren(table(['State', 'Owner', 'Method', 'Size', 'Progress', 'Submitted', 'Started', 'Finished', 'ETA'], [
+    summary.replaceChildren(table(['State', 'Owner', 'Method', 'Size', 'Progress', 'Submitted', 'Started', 'Finished', 'ETA', 'CPU time'], [
       h('tr', {}, h('td', { class: 'state', id: 'state' }, job.paused && !ended(job.state) ? 'paused' : job.state), h('td', {}, job.owner || '—'), h('td', {}, job.method),
         h('td', {}, `${job.width}×${job.height}, ${job.spp} spp`),
         h('td', {}, progress(job.tasks_done, job.tasks_total), job.shot ? ` ${job.shot.frames_done}/${job.shot.frames_total} frames` : ''),
         h('td', {}, time(job.submitted_ms)), h('td', {}, time(job.started_ms)), h('td', {}, time(job.finished_ms)),
-        h('td', {}, duration(job.eta_s)))]),
+        h('td', {}, duration(job.eta_s)), h('td', { id: 'cpu-time', title: `${seconds(job.render_s)} rendering on workers` }, seconds(job.cpu_s)))]),
     h('p', { class: 'error' }, job.error),
     h('p', { class: 'blocklist' }, job.blocklist.map((b) => `blocklisted: ${b.worker} (${b.failures} failures, last: ${b.last_error})`).join('; ')));
     cancel.disabled = ended(job.state);
@@ -264,7 +264,7 @@ export function mount(root, id, who, frameText) {
       if (job.tasks_done > 0 || job.state === 'succeeded') version = `${job.tasks_done}-${job.state}`;
     } else if (mine) {
       frameSummary.replaceChildren(`Frame ${frame}: `, h('span', { class: 'state', id: 'frame-state' }, mine.state), ' ',
-        progress(mine.tasks_done, mine.tasks_total));
+        progress(mine.tasks_done, mine.tasks_total), h('span', { id: 'frame-times' }, ` ${seconds(mine.render_s)} render, ${seconds(mine.cpu_s)} CPU`));
       version = mine.preview;
       final = final || mine.state === 'done';
     }
@@ -280,11 +280,12 @@ export function mount(root, id, who, frameText) {
     taskEarlier.disabled = rows.offset === 0;
     taskLater.disabled = rows.offset + rows.tasks.length >= rows.total;
     const frames = (t) => (t.frames && t.frames.length ? `frame ${t.frames.join(', ')}, ` : '');
-    tasks.replaceChildren(table(['Task', 'State', 'Worker', 'Attempts', 'Duration', 'Log lines'], rows.tasks.map((t) =>
+    tasks.replaceChildren(table(['Task', 'State', 'Worker', 'Attempts', 'Duration', 'CPU', 'Log lines'], rows.tasks.map((t) =>
       h('tr', { class: `task ${t.state}${t.index === logTask ? ' open' : ''}`, 'data-task': t.index, onclick: () => openLog(t.index) },
         h('td', {}, `${t.index} (${frames(t)}${t.kind} ${t.x},${t.y} ${t.width}×${t.height})`), h('td', {}, t.state),
         h('td', {}, t.worker || '—'), h('td', { class: 'number' }, String(t.attempts)),
-        h('td', {}, t.attempts ? `${(t.duration_ms / 1000).toFixed(1)} s` : '—'), h('td', { class: 'number' }, String(t.log_lines))))));
+        h('td', {}, t.attempts ? `${(t.duration_ms / 1000).toFixed(1)} s` : '—'),
+        h('td', { class: 'number' }, t.state === 'done' ? seconds(t.cpu_s) : '—'), h('td', { class: 'number' }, String(t.log_lines))))));
 
     // The preview is fetched again only when a task was merged since (or the job ended).
     if (image_shown && version && version !== shown) {

@@ -423,8 +423,8 @@ class Farm : public ::testing::Test {
 };
 
 TEST_F(Farm, HelpExplainsEveryFarmCommand) {
-    for (const char* cmd :
-         {"submit", "list", "status", "watch", "fetch", "cancel", "delete", "tasks", "logs"}) {
+    for (const char* cmd : {"submit", "list", "status", "watch", "fetch", "cancel", "delete",
+                            "tasks", "logs", "stats"}) {
         const CliRun r = Lightfarm(std::string(cmd) + " --help");
         EXPECT_EQ(r.status, 0) << cmd;
         EXPECT_NE(r.out.find("--server"), std::string::npos) << cmd << r.out;
@@ -585,6 +585,71 @@ TEST_F(Farm, TaggedJobGoesToTheTaggedWorkerAndDisableSurvivesARestart) {
     EXPECT_EQ(Farmctl("workers enable gpu").status, 0);
     EXPECT_NE(Farmctl("workers disable nobody").err.find("no worker named nobody"),
               std::string::npos);
+}
+
+// History (issue 30): a real worker's CPU and render seconds per task, summed in `stats` per
+// owner and per worker, the same after a coordinator restart and after the job is deleted.
+TEST_F(Farm, StatsCountARealWorkersTimesAcrossARestartAndADeletion) {
+    StartServer();
+    StartWorker("w1", 2);
+    const auto start = Clock::now();
+    const std::string job = Submit(scene_, "--spp 4 --tile 32");  // 4 tasks
+    ASSERT_EQ(Farmctl("watch " + job).status, 0);
+    const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+
+    const std::vector<nlohmann::json> tasks = JsonLines(Farmctl("tasks --json " + job).out);
+    ASSERT_EQ(tasks.size(), 4u);
+    const double cores = std::max(1u, std::thread::hardware_concurrency());
+    double cpu = 0, render = 0;
+    for (const nlohmann::json& t : tasks) {
+        const double task_cpu = t["cpu_seconds"], task_render = t["render_seconds"];
+        EXPECT_GT(task_cpu, 0) << t;
+        EXPECT_GT(task_render, 0) << t;
+        // The process' CPU time over the task: at most every core for its whole render.
+        EXPECT_LE(task_cpu, cores * task_render + 0.05) << t;
+        cpu += task_cpu;
+        render += task_render;
+    }
+    EXPECT_LE(render, wall);
+    EXPECT_NE(Farmctl("status " + job).out.find("  worked    "), std::string::npos);
+
+    const auto stats = [&] {
+        const CliRun r = Farmctl("stats --json");
+        EXPECT_EQ(r.status, 0) << r.err;
+        const std::vector<nlohmann::json> lines = JsonLines(r.out);
+        return lines.size() == 1 ? lines[0] : nlohmann::json();
+    };
+    const nlohmann::json before = stats();
+    ASSERT_EQ(before["owners"].size(), 1u) << before;
+    const nlohmann::json& owner = before["owners"][0];
+    EXPECT_EQ(owner["owner"], "");            // authentication off
+    EXPECT_EQ(owner["jobs_succeeded"], "1");  // int64s are strings in protobuf's JSON
+    EXPECT_EQ(owner["jobs_active"], "0");
+    EXPECT_EQ(owner["tasks"], "4");
+    EXPECT_EQ(owner["samples"], std::to_string(64 * 64 * 4));
+    EXPECT_NEAR(owner["cpu_seconds"].get<double>(), cpu, 1e-6 * cpu);
+    EXPECT_NEAR(owner["render_seconds"].get<double>(), render, 1e-6 * render);
+    ASSERT_EQ(before["workers"].size(), 1u) << before;
+    EXPECT_EQ(before["workers"][0]["tasks"], "4");
+    EXPECT_EQ(before["workers"][0]["worker"], tasks[0]["worker"]);
+
+    CrashAndRestartServer();
+    EXPECT_EQ(stats(), before);
+    ASSERT_EQ(Farmctl("delete " + job).status, 0);
+    EXPECT_EQ(stats(), before);
+
+    const CliRun table = Farmctl("stats --since 1h");
+    ASSERT_EQ(table.status, 0) << table.err;
+    EXPECT_NE(table.out.find("OWNER  SUCCEEDED  FAILED  CANCELLED  ACTIVE  TASKS"),
+              std::string::npos)
+        << table.out;
+    EXPECT_NE(table.out.find("WORKER"), std::string::npos) << table.out;
+    for (const char* bad : {"--since 2999-01-01", "--since soon", "--since 0d"}) {
+        const CliRun r = Farmctl(std::string("stats ") + bad);
+        EXPECT_NE(r.status, 0) << bad;
+        EXPECT_NE(r.err.find("--since "), std::string::npos) << r.err;
+        EXPECT_TRUE(r.out.empty()) << r.out;
+    }
 }
 
 TEST_F(Farm, LogsAndTasksShowWhatEachTaskDidAndWhyOneFailed) {

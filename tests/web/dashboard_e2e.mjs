@@ -148,6 +148,11 @@ try {
   await page.click('tr.task.done');
   await until('log lines', async () => (await page.$$('#log .line')).length > 0, 20);
   check(true, `a task's log opens: "${(await page.textContent('#log .line')).slice(0, 100)}"`);
+  // History (issue 30): the job's CPU time on its workers, and each done task's.
+  const cpu = await page.textContent('#cpu-time');
+  const taskCpu = await page.$$eval('tr.task.done', (rows) => rows.map((r) => r.children[5].textContent));
+  check(/^\d+\.\d\d s$/.test(cpu) && taskCpu.length > 0 && taskCpu.every((t) => /^\d+\.\d\d s$/.test(t)),
+    `the job page shows the CPU time (${cpu}) and each done task's (${taskCpu.slice(0, 3).join(', ')})`);
   await page.screenshot({ path: join(shotsDir, 'job.png'), fullPage: true });
 
   // Workers and the farm.
@@ -192,6 +197,9 @@ try {
   await until("the frame's preview", () => page.evaluate(() => document.getElementById('preview').naturalWidth === 32));
   check((await page.textContent('h1')).includes('frame 3') && (await page.textContent('#frame-state')) === 'done',
     `a click opens frame 3's page: "${await page.textContent('h1')}", ${await page.textContent('#frame-state')}, its preview loaded`);
+  const frameTimes = await page.textContent('#frame-times');
+  check(/^ \d+\.\d\d s render, \d+\.\d\d s CPU$/.test(frameTimes),
+    `the frame's page shows its tasks' times on their workers:${frameTimes}`);
   const frameTasks = await page.$$eval('tr.task td:first-child', (e) => e.map((n) => n.textContent));
   check(frameTasks.length === 4 && frameTasks.every((t) => t.includes('frame 3,')), `the frame's page lists its 4 tasks only (${frameTasks[0]}, ...)`);
   await until("the frame's EXR header", () => page.$$eval('#metadata tr', (rows) => rows.some((r) => r.textContent === 'lightfarm.frame3')));

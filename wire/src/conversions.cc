@@ -259,6 +259,8 @@ void ToProto(const JobRecord& job, pb::Job* out) {
         f->set_tasks_done(frame.tasks_done);
         f->set_tasks_total(frame.tasks_total);
         f->set_done(frame.done);
+        f->set_render_seconds(frame.times.render_seconds);
+        f->set_cpu_seconds(frame.times.cpu_seconds);
     }
     for (const std::string& tag : job.spec.tags) out->add_tags(tag);
     out->set_max_workers(job.spec.max_workers);
@@ -272,6 +274,8 @@ void ToProto(const JobRecord& job, pb::Job* out) {
     out->set_max_attempts(job.spec.max_attempts);
     out->set_blocklist_after(job.spec.blocklist_after);
     out->set_paused(job.paused);
+    out->set_render_seconds(job.times.render_seconds);
+    out->set_cpu_seconds(job.times.cpu_seconds);
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {
@@ -435,6 +439,33 @@ void ToProto(const TaskStatus& task, pb::TaskInfo* out) {
     out->set_last_error(task.last_error);
     out->set_log_lines(task.log_lines);
     for (int frame : task.frames) out->add_frames(frame);
+    out->set_render_seconds(task.times.render_seconds);
+    out->set_cpu_seconds(task.times.cpu_seconds);
+}
+
+void ToProto(const FarmStats& stats, pb::GetStatsResponse* out) {
+    if (stats.since != absl::InfinitePast())
+        out->set_since_unix_ms(absl::ToUnixMillis(stats.since));
+    for (const OwnerStats& o : stats.owners) {
+        pb::OwnerStats* p = out->add_owners();
+        p->set_owner(o.owner);
+        p->set_jobs_succeeded(o.succeeded);
+        p->set_jobs_failed(o.failed);
+        p->set_jobs_cancelled(o.cancelled);
+        p->set_jobs_active(o.active);
+        p->set_tasks(o.tasks);
+        p->set_samples(o.samples);
+        p->set_cpu_seconds(o.times.cpu_seconds);
+        p->set_render_seconds(o.times.render_seconds);
+    }
+    for (const WorkerStats& w : stats.workers) {
+        pb::WorkerStats* p = out->add_workers();
+        p->set_worker(w.worker);
+        p->set_tasks(w.tasks);
+        p->set_failures(w.failures);
+        p->set_cpu_seconds(w.times.cpu_seconds);
+        p->set_render_seconds(w.times.render_seconds);
+    }
 }
 
 void ToProto(const TaskLogLine& line, pb::TaskLogLine* out) {

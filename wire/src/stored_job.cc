@@ -87,6 +87,8 @@ void ToProto(const JobRecord& job, pb::StoredJob* out) {
         f->set_tasks_total(frame.tasks_total);
         f->set_done(frame.done);
         f->set_result_path(frame.result_path);
+        f->set_render_seconds(frame.times.render_seconds);
+        f->set_cpu_seconds(frame.times.cpu_seconds);
     }
     for (const WorkerFailures& w : job.worker_failures) {
         pb::StoredWorkerFailures* f = out->add_worker_failures();
@@ -95,6 +97,8 @@ void ToProto(const JobRecord& job, pb::StoredJob* out) {
         f->set_last_error(w.last_error);
     }
     out->set_paused(job.paused);
+    out->set_render_seconds(job.times.render_seconds);
+    out->set_cpu_seconds(job.times.cpu_seconds);
 }
 
 absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
@@ -123,13 +127,18 @@ absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
     job.stats.invalid_samples = s.invalid_samples();
     job.result_path = s.result_path();
     for (const pb::StoredFrame& f : s.frames()) {
-        job.frames.push_back(
-            {f.frame(), f.tasks_done(), f.tasks_total(), f.done(), f.result_path()});
+        job.frames.push_back({f.frame(),
+                              f.tasks_done(),
+                              f.tasks_total(),
+                              f.done(),
+                              f.result_path(),
+                              {f.render_seconds(), f.cpu_seconds()}});
     }
     for (const pb::StoredWorkerFailures& w : s.worker_failures()) {
         job.worker_failures.push_back({w.worker(), w.failures(), w.last_error()});
     }
     job.paused = s.paused();
+    job.times = {s.render_seconds(), s.cpu_seconds()};
     return job;
 }
 
@@ -139,6 +148,10 @@ void ToProto(const TaskHistory& history, pb::StoredTaskHistory* out) {
     out->set_worker(history.worker);
     if (auto us = UnixMicros(history.leased)) out->set_leased_unix_us(*us);
     if (auto us = UnixMicros(history.finished)) out->set_finished_unix_us(*us);
+    out->set_render_seconds(history.times.render_seconds);
+    out->set_cpu_seconds(history.times.cpu_seconds);
+    out->set_samples(history.samples);
+    if (history.frame) out->set_frame(*history.frame);
 }
 
 TaskHistory FromProto(const pb::StoredTaskHistory& s) {
@@ -148,6 +161,9 @@ TaskHistory FromProto(const pb::StoredTaskHistory& s) {
     history.worker = s.worker();
     if (s.has_leased_unix_us()) history.leased = absl::FromUnixMicros(s.leased_unix_us());
     if (s.has_finished_unix_us()) history.finished = absl::FromUnixMicros(s.finished_unix_us());
+    history.times = {s.render_seconds(), s.cpu_seconds()};
+    history.samples = s.samples();
+    if (s.has_frame()) history.frame = s.frame();
     return history;
 }
 

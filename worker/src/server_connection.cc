@@ -91,6 +91,7 @@ absl::Status ServerConnection::Complete(const std::string& lease_id, const TaskR
     req.set_worker_id(worker_id_);
     (result.sweep ? req.mutable_radiosity_sweep() : req.mutable_tile_sums())->assign(result.bytes);
     req.set_seconds(seconds);
+    req.set_cpu_seconds(result.times.cpu_seconds);
     if (result.radiosity) ToProto(*result.radiosity, req.mutable_radiosity());
     if (result.splats) req.set_splats(*result.splats);
     if (result.frame) req.set_frame(*result.frame);
@@ -99,6 +100,8 @@ absl::Status ServerConnection::Complete(const std::string& lease_id, const TaskR
         p->set_frame(part.frame);
         p->set_tile_sums(part.bytes);
         if (part.splats) p->set_splats(*part.splats);
+        p->set_render_seconds(part.times.render_seconds);
+        p->set_cpu_seconds(part.times.cpu_seconds);
     }
     for (const TaskLogLine& line : result.log) ToProto(line, req.add_log());
     pb::CompleteTaskResponse resp;

@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <time.h>
 
 #include <algorithm>
 #include <map>
@@ -26,6 +27,26 @@ namespace lf {
 namespace {
 
 std::shared_ptr<spdlog::logger> Log() { return NamedLogger("worker"); }
+
+// A task's wall and CPU time since it was made. The CPU time is the whole process': a worker
+// runs one task at a time, and besides it only the heartbeats and the upload of the previous
+// result, which cost little.
+class TaskClock {
+  public:
+    TaskClock() : wall_(absl::Now()), cpu_(ProcessCpuSeconds()) {}
+    TaskTimes Elapsed() const {
+        return {absl::ToDoubleSeconds(absl::Now() - wall_), ProcessCpuSeconds() - cpu_};
+    }
+
+  private:
+    static double ProcessCpuSeconds() {
+        timespec t{};
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+        return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
+    }
+    absl::Time wall_;
+    double cpu_;
+};
 
 // What a lease asks for, for its first log line.
 std::string DescribeTask(const TaskAssignment& task) {
@@ -154,7 +175,7 @@ void Worker::Execute(const TaskAssignment& task) {
         }
     });
 
-    const absl::Time start = absl::Now();
+    const TaskClock clock;
     ServerConnection::TaskResult result;
     RenderStats stats;
     absl::Status status = options_.fail_tasks_for_test
@@ -172,7 +193,8 @@ void Worker::Execute(const TaskAssignment& task) {
         current_cancel_ = nullptr;
     }
 
-    const double seconds = absl::ToDoubleSeconds(absl::Now() - start);
+    result.times = clock.Elapsed();
+    const double seconds = result.times.render_seconds;
     // A result that was finished before a stop was asked for is still worth sending.
     if (dropped) {
         Log()->info("{} dropped: the job was cancelled or the lease lost", ids);
@@ -247,10 +269,12 @@ absl::Status Worker::RunChunk(const TaskAssignment& task, const std::atomic<bool
             splats = &frame_splats[part.frame];
             first_part.try_emplace(part.frame, result.parts.size());
         }
+        const TaskClock clock;
         if (absl::Status s = RunTask(one, cancel, rendered, part_stats, splats); !s.ok()) return s;
         stats += part_stats;
         if (rendered.radiosity) result.radiosity = rendered.radiosity;
-        result.parts.push_back({part.frame, std::move(rendered.bytes), std::move(rendered.splats)});
+        result.parts.push_back(
+            {part.frame, std::move(rendered.bytes), std::move(rendered.splats), clock.Elapsed()});
     }
     if (!splatting) return absl::OkStatus();
     size_t bytes = 0;

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import enum
 import hashlib
 import os
@@ -118,6 +119,15 @@ class Job:
     @property
     def blocklist_after(self) -> int:
         return self.proto.blocklist_after
+
+    # History (issue 30): summed over its merged tasks, as their workers measured them.
+    @property
+    def cpu_seconds(self) -> float:
+        return self.proto.cpu_seconds
+
+    @property
+    def render_seconds(self) -> float:
+        return self.proto.render_seconds
 
     @property
     def params(self) -> common_pb2.RenderParams:
@@ -418,6 +428,35 @@ class Client:
     def resume(self, job_id: str) -> Job:
         """Resumes a paused job (``lightfarm resume``)."""
         return Job.from_proto(self._unary("ResumeJob", pb.ResumeJobRequest(job_id=job_id)))
+
+    # History (issue 30).
+    def stats(self, *, since: Union[None, datetime.datetime, datetime.timedelta] = None,
+              owner: str = "") -> Dict[str, object]:
+        """The farm's history as ``lightfarm stats`` prints it: work that ended ``since`` (a
+        time, naive ones read as UTC, or a span before now; None: all the history kept), only
+        ``owner``'s jobs when given. An admin sees everyone's, a submitter their own jobs (asking
+        for another owner's is PermissionDenied). Returns plain dicts: ``{"since": datetime or
+        None, "owners": [...], "workers": [...]}``, each row with the keys of the wire's
+        OwnerStats and WorkerStats (docs/farm.md, History)."""
+        if isinstance(since, datetime.timedelta):
+            since = datetime.datetime.now(datetime.timezone.utc) - since
+        if since is not None and since.tzinfo is None:
+            since = since.replace(tzinfo=datetime.timezone.utc)
+        req = pb.GetStatsRequest(owner=owner)
+        if since is not None:
+            req.since_unix_ms = int(since.timestamp() * 1000)
+        resp = self._unary("GetStats", req)
+
+        def row(m) -> Dict[str, object]:
+            return {f.name: getattr(m, f.name) for f in m.DESCRIPTOR.fields}
+
+        return {
+            "since": (datetime.datetime.fromtimestamp(resp.since_unix_ms / 1000,
+                                                      datetime.timezone.utc)
+                      if resp.since_unix_ms else None),
+            "owners": [row(o) for o in resp.owners],
+            "workers": [row(w) for w in resp.workers],
+        }
 
     def workers(self) -> List[Worker]:
         """The workers the server heard from within a lease."""

@@ -6,6 +6,7 @@ LF_BIN_DIR (the build's bin folder) and LF_TEST_SCENES (tests/scenes). Needs ope
 """
 
 import builtins
+import datetime
 import hashlib
 import json
 import os
@@ -627,6 +628,33 @@ class ClientTest(unittest.TestCase):
         done = self.alice.wait(self.alice.submit(cornell(), **SMALL))
         with self.assertRaises(lightfarm.FailedPrecondition):
             self.alice.requeue(done.id)
+
+    def test_stats(self):
+        """History (issue 30): a submitter's own rows, an admin's everyone's, as plain dicts."""
+        job = self.alice.wait(self.alice.submit(cornell(), **SMALL))
+        self.assertGreater(job.cpu_seconds, 0)
+        self.assertGreater(job.render_seconds, 0)
+        mine = self.alice.stats(since=datetime.timedelta(hours=1))
+        self.assertIsNotNone(mine["since"])
+        self.assertEqual([o["owner"] for o in mine["owners"]], ["alice"])
+        alice = mine["owners"][0]
+        self.assertGreaterEqual(alice["jobs_succeeded"], 1)
+        self.assertGreaterEqual(alice["tasks"], job.tasks_total)
+        self.assertGreater(alice["cpu_seconds"], 0)
+        self.assertGreater(alice["render_seconds"], 0)
+        # The workers' rows are of alice's tasks only: they add up to hers.
+        self.assertEqual(sum(w["tasks"] for w in mine["workers"]), alice["tasks"])
+        with self.farm.client("root") as root:
+            everyone = root.stats()
+            self.assertIsNone(everyone["since"])
+            self.assertIn(alice["owner"], [o["owner"] for o in everyone["owners"]])
+            self.assertGreaterEqual(root.stats(owner="alice")["owners"][0]["tasks"],
+                                    alice["tasks"])
+        with self.farm.client("bob") as bob:
+            with self.assertRaises(lightfarm.PermissionDenied):
+                bob.stats(owner="alice")
+        with self.assertRaises(lightfarm.InvalidArgument):
+            self.alice.stats(since=datetime.datetime(2999, 1, 1))
 
     def test_shot_submit_and_fetch_frames(self):
         """A shot submitted with frames, fps and shutter; fetch_frames writes each finished

@@ -91,7 +91,8 @@ class DashboardTest : public ::testing::Test {
         std::optional<TaskAssignment> lease = farm_->scheduler().LeaseTask(worker);
         return lease && Merge(*lease, worker, value);
     }
-    bool Merge(const TaskAssignment& lease, const std::string& worker, float value) {
+    bool Merge(const TaskAssignment& lease, const std::string& worker, float value,
+               const TaskTimes& times = {}) {
         TileSums sums(lease.task.rect);
         for (PixelSums& p : sums.pixels) {
             for (uint64_t s = lease.task.sample_begin; s < lease.task.sample_end; ++s) {
@@ -99,8 +100,9 @@ class DashboardTest : public ::testing::Test {
             }
         }
         // A shot's task names its frame (a still's none).
-        const absl::Status merged = farm_->Complete(lease.lease_id, worker, EncodeTileSums(sums),
-                                                    std::nullopt, std::nullopt, lease.frame);
+        const absl::Status merged =
+            farm_->Complete(lease.lease_id, worker, EncodeTileSums(sums), std::nullopt,
+                            std::nullopt, lease.frame, {}, times);
         EXPECT_TRUE(merged.ok()) << merged;
         return merged.ok();
     }
@@ -479,6 +481,51 @@ TEST_F(DashboardTest, AShotsJobListsItsFramesWithTheirStates) {
     const Json tasks = Call(Get("/api/jobs/" + job + "/tasks?frame=1", alice_), 200)["tasks"];
     ASSERT_EQ(tasks.size(), 4u);
     for (const Json& t : tasks) EXPECT_EQ(t["state"], "done");
+}
+
+// History (issue 30): the workers' times of a job, its frames and its tasks, kept by the store
+// across a coordinator restart, and its history (lf::FarmStats) after the job is deleted.
+TEST_F(DashboardTest, JobFramesAndTasksShowTheirWorkersTimesAcrossARestart) {
+    const std::string job = SubmitShot("alice", {1, 2, 1}, 16);  // one task a frame
+    for (const TaskTimes& times : {TaskTimes{2, 3}, TaskTimes{4, 7}}) {
+        std::optional<TaskAssignment> lease = farm_->scheduler().LeaseTask("w1");
+        ASSERT_TRUE(lease);
+        ASSERT_TRUE(Merge(*lease, "w1", 0.5f, times));
+    }
+    const auto expect_times = [&](const std::string& token) {
+        const Json j = Call(Get("/api/jobs/" + job, token), 200);
+        EXPECT_EQ(j["state"], "succeeded");
+        EXPECT_EQ(j["render_s"], 6.0);
+        EXPECT_EQ(j["cpu_s"], 10.0);
+        ASSERT_EQ(j["frames"].size(), 2u);
+        EXPECT_EQ(j["frames"][0]["render_s"], 2.0);
+        EXPECT_EQ(j["frames"][0]["cpu_s"], 3.0);
+        EXPECT_EQ(j["frames"][1]["render_s"], 4.0);
+        EXPECT_EQ(j["frames"][1]["cpu_s"], 7.0);
+        const Json tasks = Call(Get("/api/jobs/" + job + "/tasks", token), 200)["tasks"];
+        ASSERT_EQ(tasks.size(), 2u);
+        EXPECT_EQ(tasks[0]["cpu_s"], 3.0);
+        EXPECT_EQ(tasks[1]["cpu_s"], 7.0);
+    };
+    expect_times(alice_);
+
+    dashboard_.reset();
+    farm_.reset();
+    FarmOptions options;
+    options.data_dir = dir_.string();
+    absl::StatusOr<std::unique_ptr<Farm>> again = Farm::Open(options);
+    ASSERT_TRUE(again.ok()) << again.status();
+    farm_ = std::move(*again);
+    dashboard_ = std::make_unique<Dashboard>(*farm_, *auth_, DashboardOptions{});
+    expect_times(alice_);
+
+    ASSERT_TRUE(farm_->DeleteJob(job).ok());
+    const absl::StatusOr<FarmStats> stats = farm_->store().Stats({});
+    ASSERT_TRUE(stats.ok()) << stats.status();
+    ASSERT_EQ(stats->owners.size(), 1u);
+    EXPECT_EQ(stats->owners[0], (OwnerStats{"alice", 1, 0, 0, 0, 2, 2 * 16 * 16 * 2, {6, 10}}));
+    ASSERT_EQ(stats->workers.size(), 1u);
+    EXPECT_EQ(stats->workers[0], (WorkerStats{"w1", 2, 0, {6, 10}}));
 }
 
 TEST_F(DashboardTest, AStillHasNoFrames) {

@@ -519,6 +519,46 @@ TEST_F(GuardedServices, AMegabyteLongJobIdIsNotEchoedBack) {
     EXPECT_LT(s.error_message().size(), 200u) << s.error_message().substr(0, 200);
 }
 
+// History (issue 30): GetStats reads as jobs do. The jobs' ends are all that is counted here
+// (no worker renders): each submitter's cancelled job.
+TEST_F(GuardedServices, StatsShowASubmitterItsOwnJobsAnAdminEveryonesAWorkerNone) {
+    std::string alice_job, bob_job;
+    ASSERT_TRUE(Submit(*Jobs("alice"), &alice_job).ok());
+    ASSERT_TRUE(Submit(*Jobs("bob"), &bob_job).ok());
+    pb::Job job;
+    for (const std::string& id : {alice_job, bob_job}) {
+        pb::CancelJobRequest cancel;
+        cancel.set_job_id(id);
+        ASSERT_TRUE(Jobs("root")->CancelJob(Context().get(), cancel, &job).ok());
+    }
+    const auto owners = [&](const std::string& who, const std::string& owner = "") {
+        pb::GetStatsRequest request;
+        request.set_owner(owner);
+        pb::GetStatsResponse response;
+        const grpc::Status s = Jobs(who)->GetStats(Context().get(), request, &response);
+        std::vector<std::string> names;
+        for (const pb::OwnerStats& o : response.owners()) {
+            EXPECT_EQ(o.jobs_cancelled(), 1) << o.owner();
+            names.push_back(o.owner());
+        }
+        return std::make_pair(s.error_code(), names);
+    };
+    using Names = std::vector<std::string>;
+    EXPECT_EQ(owners("alice"), std::make_pair(grpc::StatusCode::OK, Names{"alice"}));
+    EXPECT_EQ(owners("alice", "alice"), std::make_pair(grpc::StatusCode::OK, Names{"alice"}));
+    EXPECT_EQ(owners("bob"), std::make_pair(grpc::StatusCode::OK, Names{"bob"}));
+    EXPECT_EQ(owners("root"), std::make_pair(grpc::StatusCode::OK, Names{"alice", "bob"}));
+    EXPECT_EQ(owners("root", "bob"), std::make_pair(grpc::StatusCode::OK, Names{"bob"}));
+    EXPECT_EQ(owners("bob", "alice").first, grpc::StatusCode::PERMISSION_DENIED);
+    EXPECT_EQ(owners("node").first, grpc::StatusCode::PERMISSION_DENIED);
+
+    pb::GetStatsRequest future;
+    future.set_since_unix_ms(absl::ToUnixMillis(absl::Now() + absl::Hours(1)));
+    pb::GetStatsResponse response;
+    EXPECT_EQ(Jobs("root")->GetStats(Context().get(), future, &response).error_code(),
+              grpc::StatusCode::INVALID_ARGUMENT);
+}
+
 TEST_F(GuardedServices, RolesAreKeptApart) {
     std::string id;
     const grpc::Status worker_submit = Submit(*Jobs("node"), &id);

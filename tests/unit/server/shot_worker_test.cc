@@ -161,6 +161,16 @@ TEST_F(ShotWorkerTest, AMovingTriangleGivesFramesThatDifferAndChunksGiveTheSameB
     const JobRecord chunks = Render(Spec(scene, FrameRange{0, 3, 1}, 3));
     ASSERT_EQ(chunks.state, JobState::kSucceeded) << chunks.error;
     EXPECT_EQ(chunks.tasks_total, 2);
+    // History (issue 30): each frame of a chunk has its part's own times, within its lease's.
+    ASSERT_EQ(chunks.frames.size(), 4u);
+    double frames_render = 0;
+    for (const FrameProgress& f : chunks.frames) {
+        EXPECT_GT(f.times.render_seconds, 0) << "frame " << f.frame;
+        EXPECT_GE(f.times.cpu_seconds, 0) << "frame " << f.frame;
+        frames_render += f.times.render_seconds;
+    }
+    EXPECT_LE(frames_render, chunks.times.render_seconds);
+    EXPECT_GT(chunks.times.cpu_seconds, 0);
     std::vector<std::vector<float>> red;
     for (int f = 0; f < 4; ++f) {
         const Image a = FrameOf(tiles, f), b = FrameOf(chunks, f);

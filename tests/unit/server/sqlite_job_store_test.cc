@@ -5,6 +5,7 @@
 #include "lf/server/sqlite_job_store.h"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -453,6 +454,119 @@ TEST_F(SqliteJobStoreTest, RestartReplaysAnAdaptiveJobsPasses) {
     EXPECT_TRUE(rendered);
     EXPECT_EQ(leased, 6);
     EXPECT_EQ(Pixels(after, id), expected);
+}
+
+// History (issue 30): a row a merged task and an ended job, summed per owner and per worker,
+// filtered by time and owner, kept when the jobs are deleted, pruned when too old.
+class SqliteJobStoreStatsTest : public SqliteJobStoreTest {
+  protected:
+    static JobRecord Job(const std::string& id, const std::string& owner, JobState state,
+                         absl::Time finished = absl::InfinitePast()) {
+        JobRecord job{.id = id, .seq = uint64_t(id.back()), .spec = Spec()};
+        job.spec.owner = owner;
+        job.state = state;
+        job.finished = finished;
+        return job;
+    }
+    static TaskHistory Done(const std::string& worker, absl::Time finished, TaskTimes times,
+                            uint64_t samples) {
+        TaskHistory h{.attempts = 1, .worker = worker, .finished = finished};
+        h.times = times;
+        h.samples = samples;
+        return h;
+    }
+    static void TaskDone(SqliteJobStore& store, const JobRecord& job, int task,
+                         const TaskHistory& h) {
+        ASSERT_TRUE(store.WaitDurable(store.QueueTaskDone(job, task, "sums", h)).ok());
+    }
+
+    const absl::Time t0_ = absl::Now() - absl::Hours(1);
+};
+
+TEST_F(SqliteJobStoreStatsTest, TasksAndEndedJobsAddUpPerOwnerAndWorkerAndOutliveDeletion) {
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        const JobRecord a = Job("job-a", "alice", JobState::kRunning);
+        const JobRecord b = Job("job-b", "bob", JobState::kRunning);
+        TaskDone(*store, a, 0, Done("w1", t0_ + absl::Seconds(10), {1, 2}, 100));
+        TaskDone(*store, a, 1, Done("w2", t0_ + absl::Seconds(20), {3, 4}, 50));
+        TaskDone(*store, b, 0, Done("w1", t0_ + absl::Seconds(30), {5, 6}, 10));
+        // Older than kept: pruned when a job ends.
+        TaskDone(*store, b, 1, Done("w1", absl::Now() - absl::Hours(401 * 24), {100, 100}, 1));
+        ASSERT_TRUE(
+            store->Put(Job("job-a", "alice", JobState::kSucceeded, t0_ + absl::Seconds(40))).ok());
+        JobRecord failed = Job("job-b", "bob", JobState::kFailed, t0_ + absl::Seconds(50));
+        failed.worker_failures = {{"w2", 2, "boom"}};
+        ASSERT_TRUE(store->Put(failed).ok());
+        // Written again as it is (a later write of an ended record): counted once.
+        ASSERT_TRUE(store->Put(failed).ok());
+        ASSERT_TRUE(store->Put(Job("job-c", "alice", JobState::kQueued)).ok());
+        // Requeued after it was cancelled: active, not cancelled.
+        ASSERT_TRUE(
+            store->Put(Job("job-d", "alice", JobState::kCancelled, t0_ + absl::Seconds(45))).ok());
+        ASSERT_TRUE(store->Put(Job("job-d", "alice", JobState::kQueued)).ok());
+        ASSERT_TRUE(store->Delete("job-a").ok());
+        ASSERT_TRUE(store->Delete("job-b").ok());
+    }
+    std::unique_ptr<SqliteJobStore> store = OpenStore();  // across a restart
+
+    absl::StatusOr<FarmStats> all = store->Stats({});
+    ASSERT_TRUE(all.ok()) << all.status();
+    EXPECT_EQ(all->since, absl::InfinitePast());
+    ASSERT_EQ(all->owners.size(), 2u);
+    EXPECT_EQ(all->owners[0], (OwnerStats{"alice", 1, 0, 0, 2, 2, 150, {4, 6}}));
+    EXPECT_EQ(all->owners[1], (OwnerStats{"bob", 0, 1, 0, 0, 1, 10, {5, 6}}));
+    ASSERT_EQ(all->workers.size(), 2u);
+    EXPECT_EQ(all->workers[0], (WorkerStats{"w1", 2, 0, {6, 8}}));
+    EXPECT_EQ(all->workers[1], (WorkerStats{"w2", 1, 2, {3, 4}}));
+
+    const absl::Time since = t0_ + absl::Seconds(25);
+    absl::StatusOr<FarmStats> recent = store->Stats({.since = since});
+    ASSERT_TRUE(recent.ok()) << recent.status();
+    EXPECT_EQ(recent->since, since);
+    ASSERT_EQ(recent->owners.size(), 2u);
+    EXPECT_EQ(recent->owners[0], (OwnerStats{"alice", 1, 0, 0, 2, 0, 0, {}}));
+    EXPECT_EQ(recent->owners[1], (OwnerStats{"bob", 0, 1, 0, 0, 1, 10, {5, 6}}));
+    ASSERT_EQ(recent->workers.size(), 2u);
+    EXPECT_EQ(recent->workers[0], (WorkerStats{"w1", 1, 0, {5, 6}}));
+    EXPECT_EQ(recent->workers[1], (WorkerStats{"w2", 0, 2, {}}));
+
+    // One owner's: the workers' rows of their tasks only (w2's failures were in bob's job).
+    absl::StatusOr<FarmStats> alice = store->Stats({.owner = "alice"});
+    ASSERT_TRUE(alice.ok()) << alice.status();
+    ASSERT_EQ(alice->owners.size(), 1u);
+    EXPECT_EQ(alice->owners[0].owner, "alice");
+    ASSERT_EQ(alice->workers.size(), 2u);
+    EXPECT_EQ(alice->workers[0], (WorkerStats{"w1", 1, 0, {1, 2}}));
+    EXPECT_EQ(alice->workers[1], (WorkerStats{"w2", 1, 0, {3, 4}}));
+}
+
+TEST_F(SqliteJobStoreStatsTest, AVersion3StoreOpensAndGainsTheHistoryTablesWithItsEndedJobs) {
+    const std::string path = (dir_ / "jobs.db").string();
+    {
+        std::unique_ptr<SqliteJobStore> store = OpenStore();
+        ASSERT_TRUE(store->Put(Job("job-a", "alice", JobState::kRunning)).ok());
+        ASSERT_TRUE(store->Put(Job("job-b", "bob", JobState::kFailed, t0_)).ok());
+    }
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db,
+                           "DROP TABLE task_stats; DROP TABLE job_stats;"
+                           " DROP TABLE worker_failure_stats; PRAGMA user_version = 3;",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK)
+        << sqlite3_errmsg(db);
+    sqlite3_close(db);
+
+    std::unique_ptr<SqliteJobStore> store = OpenStore();
+    ASSERT_TRUE(store->Get("job-a").ok());
+    TaskDone(*store, *store->Get("job-a"), 0, Done("w1", t0_, {1, 2}, 3));
+    absl::StatusOr<FarmStats> stats = store->Stats({});
+    ASSERT_TRUE(stats.ok()) << stats.status();
+    ASSERT_EQ(stats->owners.size(), 2u);
+    EXPECT_EQ(stats->owners[0], (OwnerStats{"alice", 0, 0, 0, 1, 1, 3, {1, 2}}));
+    // Ended before the upgrade: counted by its state, without tasks.
+    EXPECT_EQ(stats->owners[1], (OwnerStats{"bob", 0, 1, 0, 0, 0, 0, {}}));
 }
 
 }  // namespace

@@ -194,11 +194,13 @@ TEST_F(TaskLogStoreTest, LinesAndTaskListsSurviveAReopenAndGoWithTheirJob) {
     EXPECT_EQ(store->Tasks("job")->size(), 2u);
 }
 
-// A shot's task names its frames, and an ended shot's `tasks` are read from here: they keep them.
+// A shot's task names its frames, and an ended shot's `tasks` are read from here: they keep them,
+// and their workers' times (issue 30's history).
 TEST_F(TaskLogStoreTest, AnEndedShotsTasksKeepTheirFrames) {
     TaskStatus chunk;
     chunk.index = 0;
     chunk.frames = {1, 2};
+    chunk.times = {1.5, 2.25};
     TaskStatus still;
     still.index = 1;
     {
@@ -209,7 +211,9 @@ TEST_F(TaskLogStoreTest, AnEndedShotsTasksKeepTheirFrames) {
     ASSERT_TRUE(tasks.ok()) << tasks.status();
     ASSERT_EQ(tasks->size(), 2u);
     EXPECT_EQ((*tasks)[0].frames, (std::vector<int>{1, 2}));
+    EXPECT_EQ((*tasks)[0].times, (TaskTimes{1.5, 2.25}));
     EXPECT_TRUE((*tasks)[1].frames.empty());
+    EXPECT_EQ((*tasks)[1].times, TaskTimes{});
 }
 
 // A store written before shots had no frames column: it opens, its rows read as stills', and a
@@ -241,10 +245,13 @@ TEST_F(TaskLogStoreTest, AStoreFromBeforeShotsGainsTheFramesColumn) {
     ASSERT_EQ(old->size(), 1u);
     EXPECT_EQ((*old)[0].width, 8);
     EXPECT_TRUE((*old)[0].frames.empty());
+    EXPECT_EQ((*old)[0].times, TaskTimes{});  // nor the history's times
     TaskStatus chunk;
     chunk.frames = {3, 4};
+    chunk.times = {1, 2};
     ASSERT_TRUE(store->RecordTasks("shot", {chunk}).ok());
     EXPECT_EQ(store->Tasks("shot")->at(0).frames, (std::vector<int>{3, 4}));
+    EXPECT_EQ(store->Tasks("shot")->at(0).times, (TaskTimes{1, 2}));
     EXPECT_TRUE(Open());  // and opens again, migrated
 }
 

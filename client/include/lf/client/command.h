@@ -39,5 +39,7 @@ Command AddLogsCommand(CLI::App& app);
 Command AddRequeueCommand(CLI::App& app);
 Command AddPauseCommand(CLI::App& app);
 Command AddResumeCommand(CLI::App& app);
+// History (issue 30; farm_commands.cc).
+Command AddStatsCommand(CLI::App& app);
 
 }  // namespace lf

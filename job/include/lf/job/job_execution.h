@@ -46,6 +46,8 @@ struct TaskResult {
     // lease, in that order.
     std::optional<int> frame;
     std::vector<TaskResult> parts;
+    // What it cost on the worker: a chunk's whole lease, and each part its own.
+    TaskTimes times;
 };
 
 class JobExecution {

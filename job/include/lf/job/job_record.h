@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "absl/time/time.h"
 #include "lf/core/film.h"
 #include "lf/job/job_spec.h"
+#include "lf/job/task_status.h"
 
 namespace lf {
 
@@ -50,6 +52,7 @@ struct JobRecord {
     // `lightfarm pause`: a queued or running job that leases nothing new (its running tasks
     // finish and merge) until resumed. A flag, not a state: the job is still queued or running.
     bool paused = false;
+    TaskTimes times;  // summed over its merged tasks (issue 30's history)
     int frames_done() const;
     // The workers of worker_failures with spec.blocklist_after failures or more: they get no
     // more tasks of this job.
@@ -64,6 +67,9 @@ struct TaskHistory {
     std::string worker;                        // the holder of its last lease (TaskStatus::worker)
     absl::Time leased = absl::InfinitePast();  // when it last left the queue
     absl::Time finished = absl::InfinitePast();  // its result merged
+    TaskTimes times;                             // as its worker measured them
+    uint64_t samples = 0;                        // lf::JobExecution::TaskSamples
+    std::optional<int> frame;                    // a shot's task of one frame (not a chunk)
 };
 
 // A shot's progress of `frame` (in frame order: at its position in the range); null when the job

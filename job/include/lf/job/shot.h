@@ -13,6 +13,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "lf/core/scene.h"
+#include "lf/job/task_status.h"
 
 namespace lf {
 
@@ -61,6 +62,7 @@ struct FrameProgress {
     int tasks_done = 0, tasks_total = 0;
     bool done = false;        // every task merged
     std::string result_path;  // its EXR once the coordinator wrote it; "" before
+    TaskTimes times;          // summed over its merged tasks (a chunk's parts count their own)
     friend bool operator==(const FrameProgress&, const FrameProgress&) = default;
 };
 

@@ -14,6 +14,19 @@ namespace lf {
 
 enum class TaskKind { kTile, kSplat, kRadiositySweep };
 
+// What a task cost on its worker (issue 30's history): the wall seconds of its render and the
+// worker process' CPU seconds over them (CLOCK_PROCESS_CPUTIME_ID: a worker runs one task at a
+// time, so they are the task's).
+struct TaskTimes {
+    double render_seconds = 0, cpu_seconds = 0;
+    TaskTimes& operator+=(const TaskTimes& o) {
+        render_seconds += o.render_seconds;
+        cpu_seconds += o.cpu_seconds;
+        return *this;
+    }
+    friend bool operator==(const TaskTimes&, const TaskTimes&) = default;
+};
+
 struct TaskStatus {
     enum class State { kWaiting, kQueued, kRunning, kDone, kDropped };
     int index = 0;
@@ -29,6 +42,7 @@ struct TaskStatus {
     absl::Duration duration;                     // lease to merged result, or running so far
     std::string last_error;
     int log_lines = 0;
+    TaskTimes times;  // a done task's, as its worker measured them
 };
 
 // "waiting", "queued", "running", "done", "dropped": as the dashboard shows a state and the

@@ -85,22 +85,24 @@ class Farm {
     // task and the worker, and the task goes back to the queue as a counted failure.
     // A shot's task names its `frame`; a chunk of a shot sends one part a frame's task, in its
     // lease's order, instead of `tile_sums` and `splats`. Each frame the result completes is
-    // written as its own EXR at once (fetchable whatever the job ends as).
+    // written as its own EXR at once (fetchable whatever the job ends as). `times`: what the
+    // task (and each part) cost on the worker, for the job's history.
     struct ResultPart {
         int frame = 0;
         std::string_view tile_sums;
         std::optional<std::string_view> splats;
+        TaskTimes times;
     };
     absl::Status Complete(const std::string& lease_id, const std::string& worker,
                           std::string_view tile_sums,
                           std::optional<RadiosityFigures> radiosity = std::nullopt,
                           std::optional<std::string_view> splats = std::nullopt,
                           std::optional<int> frame = std::nullopt,
-                          const std::vector<ResultPart>& parts = {});
+                          const std::vector<ResultPart>& parts = {}, const TaskTimes& times = {});
     // A radiosity patch-group task's result (lf::EncodeSweepResult); when it ends a sweep,
     // stores the next sweep's input or the solution as a blob for the workers.
     absl::Status CompleteSweep(const std::string& lease_id, const std::string& worker,
-                               std::string_view sweep_result);
+                               std::string_view sweep_result, const TaskTimes& times = {});
 
     // The EXR of a succeeded job; with `preview`, also of a running one (what is merged so far).
     // A preview is written again only when a task was merged since the last one. A shot's

@@ -75,6 +75,9 @@ class JobServiceImpl final : public ReadAfterAuth<lightfarm::v1::JobService::Ser
                           const lightfarm::v1::PauseJobRequest&, lightfarm::v1::Job*);
     grpc::Status ResumeJob(grpc::ServerContext*, const Caller&,
                            const lightfarm::v1::ResumeJobRequest&, lightfarm::v1::Job*);
+    // History (issue 30).
+    grpc::Status GetStats(grpc::ServerContext*, const Caller&,
+                          const lightfarm::v1::GetStatsRequest&, lightfarm::v1::GetStatsResponse*);
     // PauseJob and ResumeJob.
     grpc::Status SetPaused(grpc::ServerContext* context, const Caller& caller,
                            const std::string& job_id, bool paused, lightfarm::v1::Job* resp);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -33,6 +34,8 @@ struct ScheduledJob {
         // The holder of its last lease as recorded before a restart: the lease table, which
         // knows the holders of this run's leases, starts empty.
         std::string recorded_worker;
+        TaskTimes times;           // of its merged result
+        std::optional<int> frame;  // of a shot's task of one frame
     };
 
     // The job with its tasks planned as its spec says (MakeJobExecution); InvalidArgument when
@@ -53,6 +56,8 @@ struct ScheduledJob {
     // A done task's history, recorded with its result; Restore takes it back after a restart.
     TaskHistory History(int task, const LeaseTable& leases) const;
     void Restore(int task, const TaskHistory& history);
+    // Adds a merged result's times (lf::TaskResult::times) to the task, the job and its frames.
+    void AddTimes(int task, const TaskResult& result);
     const std::string& id() const { return record.id; }
 
     JobRecord record;

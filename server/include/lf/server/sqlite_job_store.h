@@ -3,6 +3,11 @@
 // synchronous=FULL, and callers acknowledge only after WaitDurable. One writer thread commits
 // the queued writes in batches (group commit): one transaction and one sync for all the writes
 // that queued while the previous batch was being synced.
+//
+// Beside the jobs, an append-only history of ended work (issue 30, `lightfarm stats`): a row a
+// merged task (task_stats) and a row an ended job (job_stats) with its workers' failures
+// (worker_failure_stats), written in the same transactions as the records, kept when a job is
+// deleted, and pruned after kStatsKeptFor.
 #pragma once
 
 #include <condition_variable>
@@ -15,6 +20,7 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "lf/job/farm_stats.h"
 #include "lf/server/job_store.h"
 #include "lf/server/metrics.h"
 
@@ -43,6 +49,10 @@ class SqliteJobStore : public JobStore {
     absl::Status Health() const;
     // Ended jobs kept (see retention), by final state.
     absl::StatusOr<std::map<JobState, int64_t>> CountEnded() const;
+    // The history since query.since, summed in SQL (however long the history, the rows read are
+    // one per owner, state and worker).
+    absl::StatusOr<FarmStats> Stats(const StatsQuery& query) const;
+    static constexpr absl::Duration kStatsKeptFor = absl::Hours(400 * 24);
     // Seconds of each commit of the writer thread: a transaction of queued writes and its sync.
     const Histogram& write_seconds() const { return write_seconds_; }
 
@@ -61,7 +71,17 @@ class SqliteJobStore : public JobStore {
         int task = -1;                            // with a task result when >= 0
         std::string result = {};
         std::string history = {};  // EncodeTaskHistory, with the result
+        // For the history tables: the job's owner, a done task's history, an ended job's state
+        // and its workers' failures.
+        std::string owner = {};
+        TaskHistory done = {};
+        JobState state = JobState::kQueued;
+        std::vector<WorkerFailures> worker_failures = {};
     };
+    // The history rows of a task's result, and of an ended job's record (in Commit's
+    // transaction; a job's end also prunes the history).
+    absl::Status RecordTaskStats(const Write& w);
+    absl::Status RecordJobEnd(const Write& w);
     static Write PutOf(const JobRecord& job);
     // Brings a database of an earlier `version` to this one's schema (see Open).
     static absl::Status Migrate(sqlite3* db, int64_t version);

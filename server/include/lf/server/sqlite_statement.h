@@ -51,6 +51,10 @@ class Statement {
         if (rc_ == SQLITE_OK) rc_ = sqlite3_bind_null(stmt_, i);
         return *this;
     }
+    Statement& BindDouble(int i, double value) {
+        if (rc_ == SQLITE_OK) rc_ = sqlite3_bind_double(stmt_, i, value);
+        return *this;
+    }
     // True while there is a row; check status() after false.
     bool Step() {
         if (rc_ != SQLITE_OK && rc_ != SQLITE_ROW) return false;
@@ -70,6 +74,7 @@ class Statement {
         return {static_cast<const char*>(data), size_t(sqlite3_column_bytes(stmt_, i))};
     }
     int64_t ColumnInt(int i) const { return sqlite3_column_int64(stmt_, i); }
+    double ColumnDouble(int i) const { return sqlite3_column_double(stmt_, i); }
     bool IsNull(int i) const { return sqlite3_column_type(stmt_, i) == SQLITE_NULL; }
 
   private:

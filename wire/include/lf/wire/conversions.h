@@ -3,6 +3,7 @@
 // other's types. Unset fields of older peers keep the job model's defaults.
 #pragma once
 
+#include "lf/job/farm_stats.h"
 #include "lf/job/job_record.h"
 #include "lf/job/job_spec.h"
 #include "lf/job/render_metadata.h"
@@ -42,6 +43,7 @@ lightfarm::v1::WorkerInfo::State ToProto(WorkerState state);
 void ToProto(const WorkerStatus& worker, lightfarm::v1::WorkerInfo* out);
 
 void ToProto(const TaskStatus& task, lightfarm::v1::TaskInfo* out);
+void ToProto(const FarmStats& stats, lightfarm::v1::GetStatsResponse* out);
 void ToProto(const TaskLogLine& line, lightfarm::v1::TaskLogLine* out);
 // A line as the worker captured it: its time, level and text; the server knows the rest.
 void ToProto(const TaskLogLine& line, lightfarm::v1::WorkerLogLine* out);

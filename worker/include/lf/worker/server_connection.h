@@ -50,8 +50,10 @@ class ServerConnection {
             int frame = 0;
             std::string bytes;
             std::optional<std::string> splats;
+            TaskTimes times;  // the part's own
         };
         std::vector<Part> parts;
+        TaskTimes times;  // the whole lease's (issue 30's history)
     };
     absl::Status Complete(const std::string& lease_id, const TaskResult& result, double seconds);
     // `shutdown`: the worker is stopping, which does not count against the task.
