@@ -575,7 +575,9 @@ TEST_F(Farm, TaggedJobGoesToTheTaggedWorkerAndDisableSurvivesARestart) {
     workers = ids();
     ASSERT_EQ(workers.size(), 2u);
     for (const nlohmann::json& w : JsonLines(Farmctl("workers --json").out)) {
-        if (w["name"] == "gpu") EXPECT_EQ(w["state"], "DISABLED") << w.dump();
+        if (w["name"] == "gpu") {
+            EXPECT_EQ(w["state"], "DISABLED") << w.dump();
+        }
     }
     const std::string plain = Submit(scene_, "--spp 2 --tile 16");
     ASSERT_EQ(Farmctl("watch " + plain).status, 0);
