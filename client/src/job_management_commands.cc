@@ -1,8 +1,12 @@
-// Job management (issue 30): `lightfarm requeue`, `pause` and `resume`. See docs/farm.md,
+// Job management (issue 30): `lightfarm requeue`, `pause`, `resume` and `depend`. See docs/farm.md,
 // Managing jobs.
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 
 #include "lf/client/command.h"
 #include "lf/client/farm_client.h"
@@ -75,6 +79,39 @@ Command AddResumeCommand(CLI::App& app) {
     return AddPausingCommand<pb::ResumeJobRequest>(
         app, "resume", "Resume a paused job: its tasks are leased again.",
         &pb::JobService::Stub::ResumeJob);
+}
+
+Command AddDependCommand(CLI::App& app) {
+    auto flags = std::make_shared<FarmFlags>();
+    auto id = std::make_shared<std::string>();
+    auto after = std::make_shared<std::vector<std::string>>();
+    CLI::App* cmd = app.add_subcommand(
+        "depend",
+        "Make a queued job also wait for other jobs: it leases nothing until each has\n"
+        "succeeded, and fails when one fails, is cancelled or deleted (the job's owner or an\n"
+        "admin). A cycle is refused.");
+    cmd->add_option("job", *id, "job id")->required();
+    cmd->add_option("--after", *after, "job ids, comma-separated or repeated")
+        ->required()
+        ->delimiter(',');
+    AddServerOption(cmd, *flags);
+    return {cmd, [flags, id, after] {
+                pb::AddJobDependenciesRequest req;
+                req.set_job_id(*id);
+                for (const std::string& dep : *after) req.add_after(dep);
+                pb::Job job;
+                if (absl::Status s = FarmClient(*flags).Call(
+                        &pb::JobService::Stub::AddJobDependencies, req, &job);
+                    !s.ok()) {
+                    return ReportError(s);
+                }
+                std::printf("job %s runs after %s%s\n", job.id().c_str(),
+                            absl::StrJoin(job.after(), ", ").c_str(),
+                            job.waiting_reason().empty()
+                                ? ""
+                                : absl::StrCat("; ", job.waiting_reason()).c_str());
+                return 0;
+            }};
 }
 
 }  // namespace lf

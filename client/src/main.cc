@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
         lf::AddCancelCommand(app),  lf::AddPriorityCommand(app), lf::AddDeleteCommand(app),
         lf::AddWorkersCommand(app), lf::AddTasksCommand(app),    lf::AddLogsCommand(app),
         lf::AddRequeueCommand(app), lf::AddPauseCommand(app),    lf::AddResumeCommand(app),
+        lf::AddDependCommand(app),
     };
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::from_str(log_level));

@@ -6,8 +6,10 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "lf/core/log.h"
 #include "lf/job/worker_tags.h"
+#include "lf/server/job_dependencies.h"
 #include "lf/proto/grpc_status.h"
 #include "lf/version.h"
 #include "lf/wire/conversions.h"
@@ -178,6 +180,10 @@ JobServiceImpl::JobServiceImpl(Farm& farm, CallGuard guard, JobServiceOptions op
                                         bind_front(&JobServiceImpl::PauseJob, this));
     Unary<pb::ResumeJobRequest, pb::Job>("ResumeJob", Action::kManageJobs, kMaxRequestBytes,
                                          bind_front(&JobServiceImpl::ResumeJob, this));
+    // Dependencies (issue 30).
+    Unary<pb::AddJobDependenciesRequest, pb::Job>(
+        "AddJobDependencies", Action::kManageJobs, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::AddJobDependencies, this));
 }
 
 WorkerServiceImpl::WorkerServiceImpl(Farm& farm, CallGuard guard)
@@ -301,6 +307,9 @@ grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context, const Calle
     }
     JobSpec spec = FromProto(req);
     spec.owner = caller.name;
+    if (absl::Status s = CheckVisibleDependencies(caller, spec.after); !s.ok()) {
+        return ToGrpcStatus(s);
+    }
     absl::StatusOr<std::string> id = farm_.Submit(std::move(spec));
     if (!id.ok()) {
         Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req.name()), Peer(context),
@@ -433,6 +442,37 @@ grpc::Status JobServiceImpl::RequeueJob(grpc::ServerContext* context, const Call
     Log()->info("job={} requeued by {} from {}", job->id, Who(caller), Peer(context));
     ToProto(*job, resp);
     return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::AddJobDependencies(grpc::ServerContext* context,
+                                                const Caller& caller,
+                                                const pb::AddJobDependenciesRequest& req,
+                                                pb::Job* resp) {
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(caller, req.job_id()); !seen.ok()) {
+        return ToGrpcStatus(seen.status());
+    }
+    const std::vector<std::string> after(req.after().begin(), req.after().end());
+    if (absl::Status s = CheckVisibleDependencies(caller, after); !s.ok()) return ToGrpcStatus(s);
+    absl::StatusOr<JobRecord> job = farm_.scheduler().AddDependencies(req.job_id(), after);
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    Log()->info("job={} runs after {} by {} from {}", job->id, absl::StrJoin(job->spec.after, ","),
+                Who(caller), Peer(context));
+    ToProto(*job, resp);
+    return grpc::Status::OK;
+}
+
+absl::Status JobServiceImpl::CheckVisibleDependencies(const Caller& caller,
+                                                      const std::vector<std::string>& after) const {
+    absl::StatusOr<std::vector<std::string>> ids = CheckDependencyIds(after, "after");
+    if (!ids.ok()) return ids.status();
+    for (const std::string& id : *ids) {
+        // Another owner's job is as unknown to the caller as one never submitted.
+        if (absl::StatusOr<JobRecord> job = VisibleJob(caller, id); !job.ok()) {
+            return absl::Status(job.status().code(),
+                                absl::StrCat("dependency ", id, ": ", job.status().message()));
+        }
+    }
+    return absl::OkStatus();
 }
 
 grpc::Status JobServiceImpl::PauseJob(grpc::ServerContext* context, const Caller& caller,

@@ -39,5 +39,7 @@ Command AddLogsCommand(CLI::App& app);
 Command AddRequeueCommand(CLI::App& app);
 Command AddPauseCommand(CLI::App& app);
 Command AddResumeCommand(CLI::App& app);
+// Dependencies (issue 30; job_management_commands.cc).
+Command AddDependCommand(CLI::App& app);
 
 }  // namespace lf
