@@ -7,7 +7,6 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
-
 #include "lf/client/command.h"
 #include "lf/client/farm_client.h"
 #include "lf/client/farm_flags.h"

@@ -9,8 +9,8 @@
 #include "absl/strings/str_join.h"
 #include "lf/core/log.h"
 #include "lf/job/worker_tags.h"
-#include "lf/server/job_dependencies.h"
 #include "lf/proto/grpc_status.h"
+#include "lf/server/job_dependencies.h"
 #include "lf/version.h"
 #include "lf/wire/conversions.h"
 
@@ -444,8 +444,7 @@ grpc::Status JobServiceImpl::RequeueJob(grpc::ServerContext* context, const Call
     return grpc::Status::OK;
 }
 
-grpc::Status JobServiceImpl::AddJobDependencies(grpc::ServerContext* context,
-                                                const Caller& caller,
+grpc::Status JobServiceImpl::AddJobDependencies(grpc::ServerContext* context, const Caller& caller,
                                                 const pb::AddJobDependenciesRequest& req,
                                                 pb::Job* resp) {
     if (absl::StatusOr<JobRecord> seen = VisibleJob(caller, req.job_id()); !seen.ok()) {

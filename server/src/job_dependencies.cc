@@ -23,9 +23,8 @@ absl::StatusOr<std::vector<std::string>> CheckDependencyIds(
         if (seen.insert(id).second) added.push_back(id);
     }
     if (seen.size() > kMaxDependencies) {
-        return absl::InvalidArgumentError(absl::StrCat(what, ": ", seen.size(),
-                                                       " jobs to run after, above the limit of ",
-                                                       kMaxDependencies));
+        return absl::InvalidArgumentError(absl::StrCat(
+            what, ": ", seen.size(), " jobs to run after, above the limit of ", kMaxDependencies));
     }
     return added;
 }
@@ -58,8 +57,8 @@ std::optional<std::string> DependencyFailure(const DependencyState& dependency) 
 std::string WaitingForDependencies(const std::vector<DependencyState>& waiting) {
     std::vector<std::string> parts;
     for (const DependencyState& d : waiting) {
-        parts.push_back(absl::StrCat(d.id, " (", d.state ? JobStateName(*d.state) : "unknown",
-                                     ")"));
+        parts.push_back(
+            absl::StrCat(d.id, " (", d.state ? JobStateName(*d.state) : "unknown", ")"));
     }
     return "waiting for " + absl::StrJoin(parts, ", ");
 }

@@ -299,7 +299,8 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     for (const auto& [id, job] : active_) ids.push_back(id);
     for (const std::string& id : ids) {
         // A job failed as the dependent of one failed here has left.
-        if (auto it = active_.find(id); it != active_.end()) FailIfDependencyEnded(*it->second, ended);
+        if (auto it = active_.find(id); it != active_.end())
+            FailIfDependencyEnded(*it->second, ended);
     }
     return rendered;
 }
@@ -609,7 +610,7 @@ JobRecord Scheduler::ReadRecord(const Job& job, absl::Time now) const {
     if (!waiting.empty()) {
         record.waiting_reason = WaitingForDependencies(waiting);
     } else if (!record.spec.tags.empty() && !job.states.queued().empty() &&
-        !workers_.AnyLiveHas(record.spec.tags, now)) {
+               !workers_.AnyLiveHas(record.spec.tags, now)) {
         record.waiting_reason = WaitingForTags(record.spec.tags);
     }
     return record;

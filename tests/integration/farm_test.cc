@@ -423,8 +423,8 @@ class Farm : public ::testing::Test {
 };
 
 TEST_F(Farm, HelpExplainsEveryFarmCommand) {
-    for (const char* cmd :
-         {"submit", "list", "status", "watch", "fetch", "cancel", "delete", "tasks", "logs", "depend"}) {
+    for (const char* cmd : {"submit", "list", "status", "watch", "fetch", "cancel", "delete",
+                            "tasks", "logs", "depend"}) {
         const CliRun r = Lightfarm(std::string(cmd) + " --help");
         EXPECT_EQ(r.status, 0) << cmd;
         EXPECT_NE(r.out.find("--server"), std::string::npos) << cmd << r.out;
@@ -1894,8 +1894,7 @@ TEST_F(Farm, DependentWaitsForItsDependencyAndTheCliSaysWhy) {
     const std::string c = Submit(scene_, "--spp 4 --tile 32 --seed 9");
     const CliRun depend = Farmctl("depend " + c + " --after " + b);
     ASSERT_EQ(depend.status, 0) << depend.err;
-    EXPECT_EQ(depend.out,
-              "job " + c + " runs after " + b + "; waiting for " + b + " (queued)\n");
+    EXPECT_EQ(depend.out, "job " + c + " runs after " + b + "; waiting for " + b + " (queued)\n");
     StartWorker("w1");
     ASSERT_TRUE(WaitForStatus(c, ": succeeded", milliseconds(60000)));
     // `status --json`: each ended before the next one's first lease.

@@ -33,8 +33,8 @@ TEST(JobDependencies, IdsCollapseAndAreBounded) {
     const absl::Status over = CheckDependencyIds(many, "after").status();
     EXPECT_TRUE(absl::IsInvalidArgument(over)) << over;
     EXPECT_NE(over.message().find("65"), std::string::npos) << over;
-    EXPECT_FALSE(CheckDependencyIds({"job-extra"}, "after", std::vector<std::string>(
-                                                               many.begin(), many.begin() + 64))
+    EXPECT_FALSE(CheckDependencyIds({"job-extra"}, "after",
+                                    std::vector<std::string>(many.begin(), many.begin() + 64))
                      .ok())
         << "counted with those the job has";
 }

@@ -15,9 +15,8 @@ namespace {
 class SchedulerDependencies : public ::testing::Test {
   protected:
     SchedulerDependencies() : scheduler_(SchedulerOptions{}, store_, [this] { return now_; }) {
-        scheduler_.OnTasksEnded([this](const std::string& id, std::vector<TaskStatus>) {
-            ended_.push_back(id);
-        });
+        scheduler_.OnTasksEnded(
+            [this](const std::string& id, std::vector<TaskStatus>) { ended_.push_back(id); });
     }
 
     // One task (16x16 in one tile), running after `after`.
@@ -45,8 +44,8 @@ class SchedulerDependencies : public ::testing::Test {
         std::optional<TaskAssignment> lease = Lease();
         ASSERT_TRUE(lease.has_value()) << "nothing to lease; " << id << " expected";
         ASSERT_EQ(lease->job_id, id);
-        absl::StatusOr<Scheduler::Completion> done = scheduler_.Complete(
-            lease->lease_id, "w-1", testing::UniformResult(*lease, Rgb(0.5f)));
+        absl::StatusOr<Scheduler::Completion> done =
+            scheduler_.Complete(lease->lease_id, "w-1", testing::UniformResult(*lease, Rgb(0.5f)));
         ASSERT_TRUE(done.ok()) << done.status();
         ASSERT_TRUE(done->job_rendered);
         scheduler_.Finish(id, "/results/" + id + ".exr");
@@ -77,9 +76,9 @@ TEST_F(SchedulerDependencies, ChainRunsInOrderAndSaysWhatItWaitsFor) {
     EXPECT_FALSE(Lease().has_value()) << "B and C wait while A runs";
     EXPECT_EQ(Get(b).waiting_reason, "waiting for " + a + " (running)");
     EXPECT_EQ(Get(b).state, JobState::kQueued);
-    ASSERT_TRUE(scheduler_
-                    .Complete(first->lease_id, "w-1", testing::UniformResult(*first, Rgb(0.5f)))
-                    .ok());
+    ASSERT_TRUE(
+        scheduler_.Complete(first->lease_id, "w-1", testing::UniformResult(*first, Rgb(0.5f)))
+            .ok());
     EXPECT_FALSE(Lease().has_value()) << "A rendered is not A succeeded";
     now_ += absl::Seconds(1);
     scheduler_.Finish(a, "/results/a.exr");
@@ -126,8 +125,7 @@ TEST_F(SchedulerDependencies, FailureFailsTheChainBelow) {
     EXPECT_EQ(Get(b).error, "dependency " + a + " failed: " + Get(a).error);
     EXPECT_EQ(Get(c).state, JobState::kFailed);
     EXPECT_EQ(Get(c).error, "dependency " + b + " failed: " + Get(b).error);
-    EXPECT_EQ(std::set<std::string>(ended_.begin(), ended_.end()),
-              (std::set<std::string>{a, b, c}))
+    EXPECT_EQ(std::set<std::string>(ended_.begin(), ended_.end()), (std::set<std::string>{a, b, c}))
         << "each dependent is notified as an ended job";
     EXPECT_EQ(Get(other).state, JobState::kQueued) << "a job not depending on A goes on";
 }
@@ -205,9 +203,8 @@ TEST_F(SchedulerDependencies, RecoverStillWaitsAndSeesWhatEndedMeanwhile) {
     ASSERT_TRUE(lease.has_value());
     EXPECT_EQ(lease->job_id, a);
     EXPECT_FALSE(restarted.LeaseTask("w-1", absl::InfinitePast()).has_value());
-    ASSERT_TRUE(restarted
-                    .Complete(lease->lease_id, "w-1", testing::UniformResult(*lease, Rgb(0.5f)))
-                    .ok());
+    ASSERT_TRUE(
+        restarted.Complete(lease->lease_id, "w-1", testing::UniformResult(*lease, Rgb(0.5f))).ok());
     restarted.Finish(a, "/results/a.exr");
     lease = restarted.LeaseTask("w-1", absl::InfinitePast());
     ASSERT_TRUE(lease.has_value());
