@@ -18,16 +18,30 @@ namespace lf {
 
 namespace pb = lightfarm::v1;
 
+namespace {
+
+// A subcommand acting on one job: its `job` argument and --server.
+struct JobSubcommand {
+    CLI::App* cmd;
+    std::shared_ptr<FarmFlags> flags = std::make_shared<FarmFlags>();
+    std::shared_ptr<std::string> id = std::make_shared<std::string>();
+};
+
+JobSubcommand AddJobSubcommand(CLI::App& app, const char* name, const char* help) {
+    JobSubcommand sub{app.add_subcommand(name, help)};
+    sub.cmd->add_option("job", *sub.id, "job id")->required();
+    AddServerOption(sub.cmd, *sub.flags);
+    return sub;
+}
+
+}  // namespace
+
 Command AddRequeueCommand(CLI::App& app) {
-    auto flags = std::make_shared<FarmFlags>();
-    auto id = std::make_shared<std::string>();
-    CLI::App* cmd = app.add_subcommand(
-        "requeue",
+    auto [cmd, flags, id] = AddJobSubcommand(
+        app, "requeue",
         "Put a job's failed tasks back in the queue with their failures reset, and clear its\n"
         "blocklist. A failed or cancelled job is queued again and renders on from the tasks it\n"
         "had done (the job's owner or an admin).");
-    cmd->add_option("job", *id, "job id")->required();
-    AddServerOption(cmd, *flags);
     return {
         cmd, [flags, id] {
             pb::RequeueJobRequest req;
@@ -47,11 +61,7 @@ namespace {
 template <typename Request>
 Command AddPausingCommand(CLI::App& app, const char* name, const char* help,
                           FarmClient::Rpc<Request, pb::Job> rpc) {
-    auto flags = std::make_shared<FarmFlags>();
-    auto id = std::make_shared<std::string>();
-    CLI::App* cmd = app.add_subcommand(name, help);
-    cmd->add_option("job", *id, "job id")->required();
-    AddServerOption(cmd, *flags);
+    auto [cmd, flags, id] = AddJobSubcommand(app, name, help);
     return {cmd, [flags, id, rpc] {
                 Request req;
                 req.set_job_id(*id);
@@ -81,19 +91,15 @@ Command AddResumeCommand(CLI::App& app) {
 }
 
 Command AddDependCommand(CLI::App& app) {
-    auto flags = std::make_shared<FarmFlags>();
-    auto id = std::make_shared<std::string>();
-    auto after = std::make_shared<std::vector<std::string>>();
-    CLI::App* cmd = app.add_subcommand(
-        "depend",
+    auto [cmd, flags, id] = AddJobSubcommand(
+        app, "depend",
         "Make a queued job also wait for other jobs: it leases nothing until each has\n"
         "succeeded, and fails when one fails, is cancelled or deleted (the job's owner or an\n"
         "admin). A cycle is refused.");
-    cmd->add_option("job", *id, "job id")->required();
+    auto after = std::make_shared<std::vector<std::string>>();
     cmd->add_option("--after", *after, "job ids, comma-separated or repeated")
         ->required()
         ->delimiter(',');
-    AddServerOption(cmd, *flags);
     return {cmd, [flags, id, after] {
                 pb::AddJobDependenciesRequest req;
                 req.set_job_id(*id);

@@ -957,8 +957,8 @@ absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
         Locked locked(*this);
         if (auto it = active_.find(job_id); it != active_.end()) {
             it->second->MoveTo(clock_(), JobState::kCancelled);
+            Log()->info("job={} cancelled", job_id);  // before its dependents fail
             cancelled = EndJob(*it->second);
-            Log()->info("job={} cancelled", job_id);
         } else if (const JobRecord* ended = ended_.Find(job_id)) {
             return AlreadyEnded(*ended);
         }

@@ -4,13 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <nlohmann/json.hpp>
-#include <sstream>
 
+#include "farm_scene.h"
 #include "lease_results.h"
 #include "lf/core/tile_codec.h"
-#include "lf/job/digest.h"
 #include "lf/server/farm.h"
 #include "test_dir.h"
 
@@ -24,18 +21,9 @@ class FarmDependencies : public ::testing::Test {
     void SetUp() override {
         dir_ = lf::testing::FreshTestDir("lf_farm_deps");
         Open();
-        std::ifstream in(fs::path(LF_TEST_SCENES) / "cornell_box.json");
-        std::stringstream text;
-        text << in.rdbuf();
-        nlohmann::json scene = nlohmann::json::parse(text.str());
-        scene["camera"]["resolution"] = {16, 16};
-        const std::string json = scene.dump();
-        scene_ = {"scene.json", Sha256Hex(json), json.size()};
-        absl::StatusOr<std::unique_ptr<BlobStore::Upload>> upload =
-            farm_->blobs().StartUpload(scene_.hash, scene_.size);
-        ASSERT_TRUE(upload.ok()) << upload.status();
-        ASSERT_TRUE((*upload)->Append(json).ok());
-        ASSERT_TRUE((*upload)->Finish().ok());
+        absl::StatusOr<BlobRef> scene = lf::testing::StoreCornellBox(*farm_, 16);
+        ASSERT_TRUE(scene.ok()) << scene.status();
+        scene_ = *scene;
     }
 
     void TearDown() override {
