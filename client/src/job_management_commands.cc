@@ -94,8 +94,8 @@ Command AddDependCommand(CLI::App& app) {
     auto [cmd, flags, id] = AddJobSubcommand(
         app, "depend",
         "Make a queued job also wait for other jobs: it leases nothing until each has\n"
-        "succeeded, and fails when one fails, is cancelled or deleted (the job's owner or an\n"
-        "admin). A cycle is refused.");
+        "succeeded, and fails when one fails or is cancelled (the job's owner or an admin). A\n"
+        "cycle is refused.");
     auto after = std::make_shared<std::vector<std::string>>();
     cmd->add_option("--after", *after, "job ids, comma-separated or repeated")
         ->required()

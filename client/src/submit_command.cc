@@ -153,7 +153,7 @@ Command AddSubmitCommand(CLI::App& app) {
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--after", o->spec.after,
                     "job ids, comma-separated or repeated: the job leases nothing until each has "
-                    "succeeded, and fails when one fails, is cancelled or deleted")
+                    "succeeded, and fails when one fails or is cancelled")
         ->delimiter(',');
     // Job management (issue 30).
     cmd->add_option("--max-attempts", o->spec.max_attempts,

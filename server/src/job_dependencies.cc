@@ -43,7 +43,7 @@ absl::Status CheckNewDependency(const DependencyState& dependency) {
 
 std::optional<std::string> DependencyFailure(const DependencyState& dependency) {
     const std::string prefix = "dependency " + dependency.id;
-    if (!dependency.state) return prefix + " was deleted";
+    if (!dependency.state) return std::nullopt;
     switch (*dependency.state) {
         case JobState::kFailed:
             return absl::StrCat(prefix, " failed: ", dependency.error);

@@ -294,7 +294,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
         }
         if (*done) rendered.push_back(id);
     }
-    // A dependency that ended unsucceeded before the restart, its dependents not failed yet.
+    // A dependency whose failure was recorded before the restart, its dependents' not yet.
     std::vector<std::string> ids;
     for (const auto& [id, job] : active_) ids.push_back(id);
     for (const std::string& id : ids) {
@@ -390,7 +390,7 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
     Job& job = *active_.at(job_id);
     Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued", job_id,
                 job.record.tasks_done, job.record.tasks_total);
-    // A dependency still failed, cancelled or deleted fails it again: requeue that one first.
+    // A dependency still failed or cancelled fails it again: requeue that one first.
     if (FailIfDependencyEnded(job, *after)) {
         const JobRecord* failed = ended_.Find(job_id);
         return Requeued{*failed, false};

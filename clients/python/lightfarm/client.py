@@ -644,7 +644,7 @@ class Client:
         at once, 0 no cap); ``max_attempts`` (failures of one task that fail the job) and
         ``blocklist_after`` (a worker's failures in the job after which it gets none of its
         tasks), 1 to 100. ``after``: job ids; the job leases nothing until each has succeeded,
-        and fails when one fails, is cancelled or deleted (NotFound for an unknown id,
+        and fails when one fails or is cancelled (NotFound for an unknown id,
         FailedPrecondition for one that failed or was cancelled). The server checks them all and the scene (InvalidArgument
         with the loader's message). ``request_id`` makes retries idempotent (default: 128
         random bits, the same on every retry of this call).

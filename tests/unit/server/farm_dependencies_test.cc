@@ -95,16 +95,24 @@ TEST_F(FarmDependencies, ChainFinishesInOrderAcrossARestart) {
     EXPECT_LT(rb.finished, rc.started);
 }
 
-TEST_F(FarmDependencies, DeletingTheDependencyFailsARequeuedDependent) {
+// Deleting a dependency that ended: a dependent it failed stays failed with the reason, and one
+// it released renders, across a restart too (the delete is no failure).
+TEST_F(FarmDependencies, DeletingAnEndedDependencyFailsNothing) {
     const std::string a = Submit();
     const std::string b = Submit({a});
     ASSERT_TRUE(farm_->scheduler().Cancel(a).ok());
-    EXPECT_EQ(Get(b).error, "dependency " + a + " was cancelled");
     ASSERT_TRUE(farm_->DeleteJob(a).ok());
-    absl::StatusOr<JobRecord> requeued = farm_->Requeue(b);
-    ASSERT_TRUE(requeued.ok()) << requeued.status();
-    EXPECT_EQ(requeued->state, JobState::kFailed);
-    EXPECT_EQ(Get(b).error, "dependency " + a + " was deleted");
+    EXPECT_EQ(Get(b).state, JobState::kFailed);
+    EXPECT_EQ(Get(b).error, "dependency " + a + " was cancelled");
+
+    const std::string c = Submit();
+    EXPECT_EQ(Work(), c);
+    const std::string d = Submit({c});
+    ASSERT_TRUE(farm_->DeleteJob(c).ok());
+    Open();
+    EXPECT_EQ(Get(d).state, JobState::kQueued);
+    EXPECT_EQ(Work(), d);
+    EXPECT_EQ(Get(d).state, JobState::kSucceeded);
 }
 
 }  // namespace

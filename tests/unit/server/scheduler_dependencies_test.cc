@@ -1,7 +1,7 @@
 // Job dependencies in the scheduler (issue 30): a job leases nothing while a job it runs after
 // is queued or running, says so in its waiting reason, and fails (down a chain, each notified
-// as an ended job) when a dependency fails, is cancelled or is deleted; `depend` refuses a
-// cycle; a dependency that ended before a restart is seen by Recover.
+// as an ended job) when a dependency fails or is cancelled, not when an ended one is deleted;
+// `depend` refuses a cycle; a dependency that ended before a restart is seen by Recover.
 #include <gtest/gtest.h>
 
 #include <set>
@@ -138,17 +138,26 @@ TEST_F(SchedulerDependencies, CancelFailsTheDependents) {
     EXPECT_EQ(Get(b).error, "dependency " + a + " was cancelled");
 }
 
-TEST_F(SchedulerDependencies, RequeueAfterTheDependencyWasDeletedFailsAgain) {
+// A job is deleted only once ended, its dependents settled then: deleting it afterwards leaves a
+// failed dependent failed with its reason, and a requeue of that dependent (the user's call)
+// finds nothing left to wait for; a dependent released by a success is not failed by a delete.
+TEST_F(SchedulerDependencies, DeletingAnEndedDependencyChangesNothing) {
     const std::string a = MustSubmit();
     const std::string b = MustSubmit({a});
     ASSERT_TRUE(scheduler_.Cancel(a).ok());
     ASSERT_EQ(Get(b).state, JobState::kFailed);
     ASSERT_TRUE(store_.Delete(a).ok());
+    EXPECT_EQ(Get(b).error, "dependency " + a + " was cancelled");
     absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(b);
     ASSERT_TRUE(requeued.ok()) << requeued.status();
-    EXPECT_EQ(requeued->record.state, JobState::kFailed);
-    EXPECT_EQ(Get(b).error, "dependency " + a + " was deleted");
-    EXPECT_FALSE(Lease().has_value());
+    EXPECT_EQ(requeued->record.state, JobState::kQueued);
+    Run(b);
+
+    const std::string c = MustSubmit();
+    const std::string d = MustSubmit({c});
+    Run(c);
+    ASSERT_TRUE(store_.Delete(c).ok());  // as retention would
+    Run(d);
 }
 
 TEST_F(SchedulerDependencies, DependRefusesCyclesAndAddsToQueuedJobsOnly) {
@@ -176,12 +185,13 @@ TEST_F(SchedulerDependencies, DependRefusesCyclesAndAddsToQueuedJobsOnly) {
 }
 
 TEST_F(SchedulerDependencies, RecoverStillWaitsAndSeesWhatEndedMeanwhile) {
+    // What a restart may find: C's dependency succeeded and then deleted (by retention, say)
+    // before C was leased, and a job whose dependency's failure was recorded, its own not yet.
+    const std::string gone = MustSubmit();
+    Run(gone);
     const std::string a = MustSubmit();
     const std::string b = MustSubmit({a});
-    const std::string gone = MustSubmit();
     const std::string c = MustSubmit({gone});
-    // What a restart may find: C's dependency deleted (its own failure not recorded yet), and a
-    // job whose dependency failed before the coordinator went down.
     ASSERT_TRUE(store_.Delete(gone).ok());
     JobRecord failed = Get(a);
     failed.id = "job-failedbefore";
@@ -196,9 +206,11 @@ TEST_F(SchedulerDependencies, RecoverStillWaitsAndSeesWhatEndedMeanwhile) {
 
     Scheduler restarted(SchedulerOptions{}, store_, [this] { return now_; });
     ASSERT_TRUE(restarted.Recover().ok());
-    EXPECT_EQ(restarted.Get(c)->error, "dependency " + gone + " was deleted");
+    EXPECT_EQ(restarted.Get(c)->state, JobState::kQueued) << "released before the restart";
+    EXPECT_TRUE(restarted.Get(c)->waiting_for.empty());
     EXPECT_EQ(restarted.Get(orphan.id)->error, "dependency job-failedbefore failed: it broke");
     EXPECT_EQ(restarted.Get(b)->waiting_for, std::vector<std::string>{a});
+    ASSERT_TRUE(restarted.Cancel(c).ok());
     std::optional<TaskAssignment> lease = restarted.LeaseTask("w-1", absl::InfinitePast());
     ASSERT_TRUE(lease.has_value());
     EXPECT_EQ(lease->job_id, a);

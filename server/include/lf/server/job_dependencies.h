@@ -1,7 +1,10 @@
 // Job dependencies (issue 30, `lightfarm submit --after`, `lightfarm depend`): the plain rules,
 // without the scheduler. A job waits while a job it runs after is queued or running, runs once
-// every one has succeeded, and fails when one fails, is cancelled or is deleted; the scheduler
-// applies these to the jobs it holds (lf/server/scheduler.h).
+// every one has succeeded, and fails when one fails or is cancelled; the scheduler applies these
+// to the jobs it holds (lf/server/scheduler.h). A job is deleted (or expires) only once ended,
+// when its dependents were settled already (failed with it, or released by its success, durably
+// before the delete: the store writes in order), so a dependency gone from the store fails
+// nothing: it counts as ended and settled.
 #pragma once
 
 #include <functional>
@@ -19,7 +22,7 @@ inline constexpr size_t kMaxDependencies = 64;
 inline constexpr size_t kMaxDependencyIdBytes = 64;
 
 // A dependency as the farm knows it now: nullopt `state` for a job the farm does not hold
-// (never submitted, or deleted).
+// (never submitted, or deleted once ended).
 struct DependencyState {
     std::string id;
     std::optional<JobState> state;
@@ -38,9 +41,9 @@ absl::StatusOr<std::vector<std::string>> CheckDependencyIds(
 // one.
 absl::Status CheckNewDependency(const DependencyState& dependency);
 
-// Why a job running after `dependency` fails, when that ended without succeeding or is gone:
-// "dependency job-1 failed: <its error>", "... was cancelled", "... was deleted"; nullopt while
-// it is queued or running, or once it succeeded.
+// Why a job running after `dependency` fails, when that ended without succeeding:
+// "dependency job-1 failed: <its error>", "dependency job-1 was cancelled"; nullopt while it is
+// queued or running, once it succeeded, and once it is gone (see above).
 std::optional<std::string> DependencyFailure(const DependencyState& dependency);
 
 // The waiting reason of a job whose dependencies `waiting` are not ended:

@@ -190,10 +190,10 @@ class Scheduler {
 
     // Dependencies (issue 30, lf/server/job_dependencies.h). A job leases nothing while a job of
     // its spec.after is queued or running, and fails when one ends without succeeding (and so
-    // on down a chain). `lightfarm depend`: the queued job also runs after `after` (ids
-    // checked by CheckDependencyIds); returns the record once durable. NotFound for an unknown
-    // job or dependency, FailedPrecondition for a job that is not queued, a dependency that
-    // failed or was cancelled, or a cycle (its CycleText).
+    // on down a chain); a dependency deleted since counts as settled. `lightfarm depend`: the
+    // queued job also runs after `after` (ids checked by CheckDependencyIds); returns the record
+    // once durable. NotFound for an unknown job or dependency, FailedPrecondition for a job that is
+    // not queued, a dependency that failed or was cancelled, or a cycle (its CycleText).
     absl::StatusOr<JobRecord> AddDependencies(const std::string& job_id,
                                               const std::vector<std::string>& after);
 
@@ -342,8 +342,8 @@ class Scheduler {
     // NotFound is returned.
     absl::StatusOr<std::map<std::string, DependencyState>> DependencyStates(
         const std::vector<std::string>& ids, Locked& locked);
-    // Fails the job when a job it runs after, not held in memory, ended without succeeding or
-    // is gone by `known` (Recover's and RequeueJob's view of the store); true if it did.
+    // Fails the job when a job it runs after, not held in memory, ended without succeeding by
+    // `known` (Recover's and RequeueJob's view of the store); true if it did.
     bool FailIfDependencyEnded(Job& job, const std::map<std::string, DependencyState>& known);
     // The job's record as a reader sees it: with its waiting_reason.
     JobRecord ReadRecord(const Job& job, absl::Time now) const;
