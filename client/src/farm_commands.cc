@@ -64,9 +64,12 @@ void PrintJson(const google::protobuf::Message& message) {
 }
 
 std::string StateName(pb::Job::State s) { return absl::AsciiStrToLower(pb::Job::State_Name(s)); }
-// What list and status show: a paused job (issue 30) as "paused", else its state.
+// What list and status show: a paused job (issue 30) as "paused", a queued one waiting for its
+// dependencies as "waiting", else its state.
 std::string ShownState(const pb::Job& job) {
-    return job.paused() && !IsFinal(FromProto(job.state())) ? "paused" : StateName(job.state());
+    if (IsFinal(FromProto(job.state()))) return StateName(job.state());
+    if (job.paused()) return "paused";
+    return job.waiting_for_size() > 0 ? "waiting" : StateName(job.state());
 }
 
 // "2026-11-26 23:41:07" in the machine's time zone, as a user reads a clock.
@@ -153,6 +156,9 @@ void PrintJob(const pb::Job& job) {
             job.tags_size() > 0 ? absl::StrCat("tags ", absl::StrJoin(job.tags(), ",")).c_str()
                                 : "any",
             job.max_workers() > 0 ? absl::StrCat(", at most ", job.max_workers()).c_str() : "");
+    }
+    if (job.after_size() > 0) {
+        std::printf("  after     %s\n", LogSafe(absl::StrJoin(job.after(), ", ")).c_str());
     }
     if (!job.waiting_reason().empty()) {
         std::printf("  waiting   %s\n", LogSafe(job.waiting_reason()).c_str());

@@ -1,9 +1,12 @@
-// Job management (issue 30): `lightfarm requeue`, `pause` and `resume`. See docs/farm.md,
+// Job management (issue 30): `lightfarm requeue`, `pause`, `resume` and `depend`. See docs/farm.md,
 // Managing jobs.
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "lf/client/command.h"
 #include "lf/client/farm_client.h"
 #include "lf/client/farm_flags.h"
@@ -15,16 +18,30 @@ namespace lf {
 
 namespace pb = lightfarm::v1;
 
+namespace {
+
+// A subcommand acting on one job: its `job` argument and --server.
+struct JobSubcommand {
+    CLI::App* cmd;
+    std::shared_ptr<FarmFlags> flags = std::make_shared<FarmFlags>();
+    std::shared_ptr<std::string> id = std::make_shared<std::string>();
+};
+
+JobSubcommand AddJobSubcommand(CLI::App& app, const char* name, const char* help) {
+    JobSubcommand sub{app.add_subcommand(name, help)};
+    sub.cmd->add_option("job", *sub.id, "job id")->required();
+    AddServerOption(sub.cmd, *sub.flags);
+    return sub;
+}
+
+}  // namespace
+
 Command AddRequeueCommand(CLI::App& app) {
-    auto flags = std::make_shared<FarmFlags>();
-    auto id = std::make_shared<std::string>();
-    CLI::App* cmd = app.add_subcommand(
-        "requeue",
+    auto [cmd, flags, id] = AddJobSubcommand(
+        app, "requeue",
         "Put a job's failed tasks back in the queue with their failures reset, and clear its\n"
         "blocklist. A failed or cancelled job is queued again and renders on from the tasks it\n"
         "had done (the job's owner or an admin).");
-    cmd->add_option("job", *id, "job id")->required();
-    AddServerOption(cmd, *flags);
     return {
         cmd, [flags, id] {
             pb::RequeueJobRequest req;
@@ -44,11 +61,7 @@ namespace {
 template <typename Request>
 Command AddPausingCommand(CLI::App& app, const char* name, const char* help,
                           FarmClient::Rpc<Request, pb::Job> rpc) {
-    auto flags = std::make_shared<FarmFlags>();
-    auto id = std::make_shared<std::string>();
-    CLI::App* cmd = app.add_subcommand(name, help);
-    cmd->add_option("job", *id, "job id")->required();
-    AddServerOption(cmd, *flags);
+    auto [cmd, flags, id] = AddJobSubcommand(app, name, help);
     return {cmd, [flags, id, rpc] {
                 Request req;
                 req.set_job_id(*id);
@@ -75,6 +88,35 @@ Command AddResumeCommand(CLI::App& app) {
     return AddPausingCommand<pb::ResumeJobRequest>(
         app, "resume", "Resume a paused job: its tasks are leased again.",
         &pb::JobService::Stub::ResumeJob);
+}
+
+Command AddDependCommand(CLI::App& app) {
+    auto [cmd, flags, id] = AddJobSubcommand(
+        app, "depend",
+        "Make a queued job also wait for other jobs: it leases nothing until each has\n"
+        "succeeded, and fails when one fails or is cancelled (the job's owner or an admin). A\n"
+        "cycle is refused.");
+    auto after = std::make_shared<std::vector<std::string>>();
+    cmd->add_option("--after", *after, "job ids, comma-separated or repeated")
+        ->required()
+        ->delimiter(',');
+    return {cmd, [flags, id, after] {
+                pb::AddJobDependenciesRequest req;
+                req.set_job_id(*id);
+                for (const std::string& dep : *after) req.add_after(dep);
+                pb::Job job;
+                if (absl::Status s = FarmClient(*flags).Call(
+                        &pb::JobService::Stub::AddJobDependencies, req, &job);
+                    !s.ok()) {
+                    return ReportError(s);
+                }
+                std::printf("job %s runs after %s%s\n", job.id().c_str(),
+                            absl::StrJoin(job.after(), ", ").c_str(),
+                            job.waiting_reason().empty()
+                                ? ""
+                                : absl::StrCat("; ", job.waiting_reason()).c_str());
+                return 0;
+            }};
 }
 
 }  // namespace lf

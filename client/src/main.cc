@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
         lf::AddWorkersCommand(app), lf::AddTasksCommand(app),    lf::AddLogsCommand(app),
         lf::AddRequeueCommand(app), lf::AddPauseCommand(app),    lf::AddResumeCommand(app),
         lf::AddStatsCommand(app),
+        lf::AddDependCommand(app),
     };
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::from_str(log_level));

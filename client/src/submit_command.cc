@@ -151,6 +151,10 @@ Command AddSubmitCommand(CLI::App& app) {
                     "at most this many workers render the job at once; 0: no cap")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--after", o->spec.after,
+                    "job ids, comma-separated or repeated: the job leases nothing until each has "
+                    "succeeded, and fails when one fails or is cancelled")
+        ->delimiter(',');
     // Job management (issue 30).
     cmd->add_option("--max-attempts", o->spec.max_attempts,
                     "failures of one task that fail the job (docs/farm.md, Managing jobs)")

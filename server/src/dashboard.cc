@@ -863,6 +863,15 @@ void Dashboard::ForgetPreviews(const std::string& job_id) {
 absl::StatusOr<Json> Dashboard::JobWithFramesJson(const HttpRequest& request, const JobRecord& job,
                                                   absl::Time now) {
     Json body = JobJson(job, now);
+    // Dependencies (issue 30): the jobs it runs after, each in its state now.
+    if (!job.spec.after.empty()) {
+        Json after = Json::array();
+        for (const std::string& dep : job.spec.after) {
+            const absl::StatusOr<JobRecord> d = farm_.scheduler().Get(dep);
+            after.push_back({{"id", dep}, {"state", d.ok() ? JobStateName(d->state) : "deleted"}});
+        }
+        body["depends_on"] = std::move(after);
+    }
     if (!job.spec.shot.frames) return body;
     const FrameRange& range = *job.spec.shot.frames;
     // The page of the current frame unless another is asked for.

@@ -6,9 +6,11 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "lf/core/log.h"
 #include "lf/job/worker_tags.h"
 #include "lf/proto/grpc_status.h"
+#include "lf/server/job_dependencies.h"
 #include "lf/version.h"
 #include "lf/wire/conversions.h"
 
@@ -182,6 +184,10 @@ JobServiceImpl::JobServiceImpl(Farm& farm, CallGuard guard, JobServiceOptions op
     Unary<pb::GetStatsRequest, pb::GetStatsResponse>("GetStats", Action::kReadJobs,
                                                      kMaxRequestBytes,
                                                      bind_front(&JobServiceImpl::GetStats, this));
+    // Dependencies (issue 30).
+    Unary<pb::AddJobDependenciesRequest, pb::Job>(
+        "AddJobDependencies", Action::kManageJobs, kMaxRequestBytes,
+        bind_front(&JobServiceImpl::AddJobDependencies, this));
 }
 
 WorkerServiceImpl::WorkerServiceImpl(Farm& farm, CallGuard guard)
@@ -305,6 +311,9 @@ grpc::Status JobServiceImpl::SubmitJob(grpc::ServerContext* context, const Calle
     }
     JobSpec spec = FromProto(req);
     spec.owner = caller.name;
+    if (absl::Status s = CheckVisibleDependencies(caller, spec.after); !s.ok()) {
+        return ToGrpcStatus(s);
+    }
     absl::StatusOr<std::string> id = farm_.Submit(std::move(spec));
     if (!id.ok()) {
         Log()->warn("submission of \"{}\" from {} refused: {}", LogSafe(req.name()), Peer(context),
@@ -462,6 +471,36 @@ grpc::Status JobServiceImpl::GetStats(grpc::ServerContext* context, const Caller
     if (!stats.ok()) return ToGrpcStatus(stats.status());
     ToProto(*stats, resp);
     return grpc::Status::OK;
+}
+
+grpc::Status JobServiceImpl::AddJobDependencies(grpc::ServerContext* context, const Caller& caller,
+                                                const pb::AddJobDependenciesRequest& req,
+                                                pb::Job* resp) {
+    if (absl::StatusOr<JobRecord> seen = VisibleJob(caller, req.job_id()); !seen.ok()) {
+        return ToGrpcStatus(seen.status());
+    }
+    const std::vector<std::string> after(req.after().begin(), req.after().end());
+    if (absl::Status s = CheckVisibleDependencies(caller, after); !s.ok()) return ToGrpcStatus(s);
+    absl::StatusOr<JobRecord> job = farm_.scheduler().AddDependencies(req.job_id(), after);
+    if (!job.ok()) return ToGrpcStatus(job.status());
+    Log()->info("job={} runs after {} by {} from {}", job->id, absl::StrJoin(job->spec.after, ","),
+                Who(caller), Peer(context));
+    ToProto(*job, resp);
+    return grpc::Status::OK;
+}
+
+absl::Status JobServiceImpl::CheckVisibleDependencies(const Caller& caller,
+                                                      const std::vector<std::string>& after) const {
+    absl::StatusOr<std::vector<std::string>> ids = CheckDependencyIds(after, "after");
+    if (!ids.ok()) return ids.status();
+    for (const std::string& id : *ids) {
+        // Another owner's job is as unknown to the caller as one never submitted.
+        if (absl::StatusOr<JobRecord> job = VisibleJob(caller, id); !job.ok()) {
+            return absl::Status(job.status().code(),
+                                absl::StrCat("dependency ", id, ": ", job.status().message()));
+        }
+    }
+    return absl::OkStatus();
 }
 
 grpc::Status JobServiceImpl::PauseJob(grpc::ServerContext* context, const Caller& caller,

@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "lf/core/image_error.h"
 #include "lf/core/log.h"
 #include "lf/core/plural.h"
@@ -66,6 +67,9 @@ void Scheduler::Locked::SettleEnded() {
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     JobRecord record;
     record.spec = spec;
+    absl::StatusOr<std::vector<std::string>> after = CheckDependencyIds(spec.after, "after");
+    if (!after.ok()) return after.status();
+    record.spec.after = std::move(*after);
     absl::StatusOr<std::unique_ptr<Job>> made =
         Job::Make(std::move(record), options_.tile_stores, options_.speculate_after);
     if (!made.ok()) return made.status();
@@ -78,6 +82,17 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> earlier =
         FindRequest(spec.request_id, locked);
     if (!earlier.ok()) return earlier.status();
+    // Read after the request: no dependency of a retried submission is checked again.
+    if (!*earlier && !job->record.spec.after.empty()) {
+        absl::StatusOr<std::map<std::string, DependencyState>> states =
+            DependencyStates(job->record.spec.after, locked);
+        if (!states.ok()) return states.status();
+        for (const auto& [dep, state] : *states) {
+            if (absl::Status s = CheckNewDependency(state); !s.ok()) return s;
+        }
+        // The store was read without the lock: the same request may have come in meanwhile.
+        *earlier = FindRequestInMemory(spec.request_id);
+    }
     if (*earlier) {
         locked.lock.unlock();
         if (absl::Status s = store_.WaitDurable((*earlier)->second); !s.ok()) return s;
@@ -249,13 +264,17 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
         absl::StatusOr<std::map<int, JobStore::RecordedTask>> results;
     };
     std::vector<Stored> stored;
+    std::map<std::string, DependencyState> ended;  // the jobs a recovered job may run after
     uint64_t last_seq = 0;
     // A store that cannot list must not start an empty server.
     absl::StatusOr<std::vector<JobRecord>> recorded = store_.List();
     if (!recorded.ok()) return recorded.status();
     for (JobRecord& record : *recorded) {
         last_seq = std::max(last_seq, record.seq);
-        if (IsFinal(record.state)) continue;
+        if (IsFinal(record.state)) {
+            ended[record.id] = {record.id, record.state, record.error};
+            continue;
+        }
         const std::string id = record.id;
         stored.push_back({std::move(record), store_.TaskResults(id)});
     }
@@ -274,6 +293,14 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
             continue;
         }
         if (*done) rendered.push_back(id);
+    }
+    // A dependency whose failure was recorded before the restart, its dependents' not yet.
+    std::vector<std::string> ids;
+    for (const auto& [id, job] : active_) ids.push_back(id);
+    for (const std::string& id : ids) {
+        // A job failed as the dependent of one failed here has left.
+        if (auto it = active_.find(id); it != active_.end())
+            FailIfDependencyEnded(*it->second, ended);
     }
     return rendered;
 }
@@ -351,6 +378,9 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
     stored->worker_failures.clear();
     stored->last_error.clear();
     Locked locked(*this);
+    absl::StatusOr<std::map<std::string, DependencyState>> after =
+        DependencyStates(stored->spec.after, locked);
+    if (!after.ok()) return after.status();
     if (active_.count(job_id) || ended_.Find(job_id)) {
         return absl::AbortedError(
             absl::StrCat("job ", job_id, " was requeued by another call meanwhile"));
@@ -360,6 +390,11 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
     Job& job = *active_.at(job_id);
     Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued", job_id,
                 job.record.tasks_done, job.record.tasks_total);
+    // A dependency still failed or cancelled fails it again: requeue that one first.
+    if (FailIfDependencyEnded(job, *after)) {
+        const JobRecord* failed = ended_.Find(job_id);
+        return Requeued{*failed, false};
+    }
     const uint64_t ticket = Save(job);
     Requeued requeued{job.record, *rendered};
     locked.lock.unlock();
@@ -399,7 +434,7 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
     int best_task = -1;
     std::vector<std::string> stranded;  // jobs with queued tasks this blocklisted worker asks for
     for (auto& [id, job] : active_) {
-        if (job->record.paused) continue;
+        if (job->record.paused || WaitsForDependency(*job)) continue;
         if (IsBlocklisted(job->record, worker)) {
             if (!job->states.queued().empty()) stranded.push_back(id);
             continue;
@@ -417,7 +452,10 @@ std::optional<TaskAssignment> Scheduler::TryLease(const std::string& worker,
             break;
         }
     }
-    for (const std::string& id : stranded) FailIfStranded(*active_.at(id));
+    for (const std::string& id : stranded) {
+        // Failing one may fail the others as its dependents.
+        if (auto it = active_.find(id); it != active_.end()) FailIfStranded(*it->second);
+    }
     if (best) return Grant(*best, best_task, worker, now);
     for (auto& [id, job] : active_) {
         if (!Admits(*job, worker, tags)) continue;
@@ -561,8 +599,18 @@ bool Scheduler::Admits(const Job& job, const std::string& worker,
 
 JobRecord Scheduler::ReadRecord(const Job& job, absl::Time now) const {
     JobRecord record = job.record;
-    if (!record.spec.tags.empty() && !job.states.queued().empty() &&
-        !workers_.AnyLiveHas(record.spec.tags, now)) {
+    record.waiting_for.clear();  // a reader's view, never the job's own
+    std::vector<DependencyState> waiting;
+    for (const std::string& dep : record.spec.after) {
+        if (auto it = active_.find(dep); it != active_.end()) {
+            waiting.push_back({dep, it->second->record.state});
+            record.waiting_for.push_back(dep);
+        }
+    }
+    if (!waiting.empty()) {
+        record.waiting_reason = WaitingForDependencies(waiting);
+    } else if (!record.spec.tags.empty() && !job.states.queued().empty() &&
+               !workers_.AnyLiveHas(record.spec.tags, now)) {
         record.waiting_reason = WaitingForTags(record.spec.tags);
     }
     return record;
@@ -790,7 +838,118 @@ JobRecord Scheduler::EndJob(Job& job) {
     const uint64_t ticket = Save(job);
     JobRecord record = job.record;
     active_.erase(id);  // destroys `job`
-    return ended_.Add(std::move(record), ticket);
+    const std::optional<std::string> why =
+        DependencyFailure({record.id, record.state, record.error});
+    JobRecord added = ended_.Add(std::move(record), ticket);
+    if (!why) return added;
+    // Its dependents fail, and theirs in turn (each FailJob ends here again).
+    std::vector<std::string> dependents;
+    for (const auto& [other, dependent] : active_) {
+        const std::vector<std::string>& after = dependent->record.spec.after;
+        if (std::find(after.begin(), after.end(), id) != after.end()) dependents.push_back(other);
+    }
+    for (const std::string& other : dependents) {
+        if (auto it = active_.find(other); it != active_.end()) FailJob(*it->second, *why);
+    }
+    return added;
+}
+
+bool Scheduler::WaitsForDependency(const Job& job) const {
+    for (const std::string& dep : job.record.spec.after) {
+        if (active_.count(dep)) return true;
+    }
+    return false;
+}
+
+absl::StatusOr<std::map<std::string, DependencyState>> Scheduler::DependencyStates(
+    const std::vector<std::string>& ids, Locked& locked) {
+    std::map<std::string, DependencyState> states;
+    if (ids.empty()) return states;
+    while (true) {
+        // A job queued or running when the store was read and not in memory after it ended and
+        // left memory meanwhile: the store is read again.
+        const uint64_t left_before = left_memory_;
+        locked.lock.unlock();
+        std::map<std::string, absl::StatusOr<JobRecord>> stored;
+        for (const std::string& id : ids) stored.emplace(id, store_.Get(id));
+        locked.lock.lock();
+        bool stale = false;
+        for (const auto& [id, record] : stored) {
+            DependencyState& state = states[id];
+            state = {id};
+            if (auto it = active_.find(id); it != active_.end()) {
+                state.state = it->second->record.state;
+            } else if (const JobRecord* ended = ended_.Find(id)) {
+                state = {id, ended->state, ended->error};
+            } else if (record.ok()) {
+                state = {id, record->state, record->error};
+                stale |= !IsFinal(record->state);
+            } else if (!absl::IsNotFound(record.status())) {
+                return record.status();
+            }
+        }
+        if (!stale || left_memory_ == left_before) return states;
+    }
+}
+
+bool Scheduler::FailIfDependencyEnded(Job& job,
+                                      const std::map<std::string, DependencyState>& known) {
+    for (const std::string& dep : job.record.spec.after) {
+        if (active_.count(dep)) continue;
+        DependencyState state{dep};
+        if (const JobRecord* ended = ended_.Find(dep)) {
+            state = {dep, ended->state, ended->error};
+        } else if (auto it = known.find(dep); it != known.end()) {
+            state = it->second;
+        }
+        if (std::optional<std::string> why = DependencyFailure(state)) {
+            FailJob(job, *why);
+            return true;
+        }
+    }
+    return false;
+}
+
+absl::StatusOr<JobRecord> Scheduler::AddDependencies(const std::string& job_id,
+                                                     const std::vector<std::string>& after) {
+    JobRecord record;
+    uint64_t ticket = 0;
+    {
+        Locked locked(*this);
+        absl::StatusOr<std::map<std::string, DependencyState>> states =
+            DependencyStates(after, locked);
+        if (!states.ok()) return states.status();
+        absl::StatusOr<Job*> active = ActiveJob(job_id, locked);
+        if (!active.ok()) return active.status();
+        Job& job = **active;
+        if (job.record.state != JobState::kQueued) {
+            return absl::FailedPreconditionError(
+                absl::StrCat("job ", job_id, " is ", JobStateName(job.record.state),
+                             ": dependencies are added only to a queued job"));
+        }
+        absl::StatusOr<std::vector<std::string>> added =
+            CheckDependencyIds(after, "after", job.record.spec.after);
+        if (!added.ok()) return added.status();
+        for (const std::string& dep : *added) {
+            if (absl::Status s = CheckNewDependency(states->at(dep)); !s.ok()) return s;
+        }
+        // Only jobs still held can close a cycle: an ended one waits for nothing.
+        const std::optional<std::vector<std::string>> cycle =
+            FindCycle(job_id, *added, [&](const std::string& id) {
+                auto it = active_.find(id);
+                return it == active_.end() ? std::vector<std::string>{}
+                                           : it->second->record.spec.after;
+            });
+        if (cycle) return absl::FailedPreconditionError(CycleText(*cycle));
+        std::vector<std::string>& deps = job.record.spec.after;
+        deps.insert(deps.end(), added->begin(), added->end());
+        Log()->info("job={} runs after {} more: {}", job_id, added->size(),
+                    absl::StrJoin(*added, ","));
+        ticket = Save(job);
+        record = ReadRecord(job, clock_());
+    }
+    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
+    return record;
 }
 
 absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
@@ -799,8 +958,8 @@ absl::StatusOr<JobRecord> Scheduler::Cancel(const std::string& job_id) {
         Locked locked(*this);
         if (auto it = active_.find(job_id); it != active_.end()) {
             it->second->MoveTo(clock_(), JobState::kCancelled);
+            Log()->info("job={} cancelled", job_id);  // before its dependents fail
             cancelled = EndJob(*it->second);
-            Log()->info("job={} cancelled", job_id);
         } else if (const JobRecord* ended = ended_.Find(job_id)) {
             return AlreadyEnded(*ended);
         }

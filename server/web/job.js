@@ -42,8 +42,8 @@ export function mount(root, id, who, frameText) {
   const taskEarlier = h('button', { id: 'tasks-earlier', onclick: () => turnTasks(-1) }, '◀');
   const taskLater = h('button', { id: 'tasks-later', onclick: () => turnTasks(1) }, '▶');
   const tasks = h('div', { id: 'tasks' });
-  // Dependencies: drawn only once the job's JSON names them (`depends_on`, which the job
-  // management API adds); nothing is shown before.
+  // Dependencies (issue 30): drawn only for a job whose JSON names them (`depends_on`: each
+  // job's id and state), linked to their pages.
   const dependsOn = h('p', { id: 'depends-on', hidden: true });
   const log = h('pre', { id: 'log' });
   const logTitle = h('h2', { id: 'log-title' });
@@ -247,7 +247,8 @@ export function mount(root, id, who, frameText) {
     remove.disabled = !ended(job.state);
     if (Array.isArray(job.depends_on)) {
       dependsOn.hidden = false;
-      dependsOn.replaceChildren('Depends on: ', ...job.depends_on.map((d) => h('a', { href: `#/job/${encodeURIComponent(d)}` }, d, ' ')));
+      dependsOn.replaceChildren('Depends on: ', ...job.depends_on.map((d, i) => h('span', { class: 'dependency' },
+        i > 0 ? ', ' : '', h('a', { href: `#/job/${encodeURIComponent(d.id)}` }, d.id), ` (${d.state})`)));
     }
     setPriority.disabled = ended(job.state);
     if (!editing) priority.value = job.priority;

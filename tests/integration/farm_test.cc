@@ -424,7 +424,7 @@ class Farm : public ::testing::Test {
 
 TEST_F(Farm, HelpExplainsEveryFarmCommand) {
     for (const char* cmd : {"submit", "list", "status", "watch", "fetch", "cancel", "delete",
-                            "tasks", "logs", "stats"}) {
+                            "tasks", "logs", "stats", "depend"}) {
         const CliRun r = Lightfarm(std::string(cmd) + " --help");
         EXPECT_EQ(r.status, 0) << cmd;
         EXPECT_NE(r.out.find("--server"), std::string::npos) << cmd << r.out;
@@ -1930,6 +1930,51 @@ TEST_F(Farm, PausedJobStaysPausedAcrossARestartAndRendersOnceResumed) {
     EXPECT_EQ(resumed.out, "job " + job + " resumed\n");
     ExpectSameAsLocal(job, scene_, 4, 9);
     EXPECT_NE(Farmctl("pause " + job).status, 0);  // it has ended
+}
+
+}  // namespace
+}  // namespace lf
+
+namespace lf {
+namespace {
+
+// Dependencies (issue 30): `submit --after` and `depend` on the command line. The dependent
+// waits, status and list say so, a cycle and an unknown id are refused with their names, and
+// the chain renders in order once a worker comes (a waiting job leases nothing).
+TEST_F(Farm, DependentWaitsForItsDependencyAndTheCliSaysWhy) {
+    StartServer();
+    const std::string a = Submit(scene_, "--spp 4 --tile 32 --seed 9");
+    const std::string b = Submit(scene_, "--spp 4 --tile 32 --seed 9 --after " + a + "," + a);
+    const CliRun unknown = Farmctl("submit " + scene_ + " --after job-nonesuch");
+    EXPECT_NE(unknown.status, 0);
+    EXPECT_NE(unknown.err.find("job-nonesuch"), std::string::npos) << unknown.err;
+    const CliRun cycle = Farmctl("depend " + a + " --after " + b);
+    EXPECT_NE(cycle.status, 0);
+    EXPECT_NE(cycle.err.find("cycle: " + a + " -> " + b + " -> " + a), std::string::npos)
+        << cycle.err;
+    const std::string status = Farmctl("status " + b).out;
+    EXPECT_NE(status.find("  after     " + a + "\n"), std::string::npos) << status;
+    EXPECT_NE(status.find("  waiting   waiting for " + a + " (queued)\n"), std::string::npos)
+        << status;
+    const std::string list = Farmctl("list").out;
+    EXPECT_NE(list.find("waiting"), std::string::npos) << list;
+    const std::string c = Submit(scene_, "--spp 4 --tile 32 --seed 9");
+    const CliRun depend = Farmctl("depend " + c + " --after " + b);
+    ASSERT_EQ(depend.status, 0) << depend.err;
+    EXPECT_EQ(depend.out, "job " + c + " runs after " + b + "; waiting for " + b + " (queued)\n");
+    StartWorker("w1");
+    ASSERT_TRUE(WaitForStatus(c, ": succeeded", milliseconds(60000)));
+    // `status --json`: each ended before the next one's first lease.
+    const auto times = [&](const std::string& job) {
+        const nlohmann::json j = nlohmann::json::parse(Farmctl("status --json " + job).out);
+        return std::pair{std::stoll(j.at("started_unix_ms").get<std::string>()),
+                         std::stoll(j.at("finished_unix_ms").get<std::string>())};
+    };
+    const auto [a_started, a_finished] = times(a);
+    const auto [b_started, b_finished] = times(b);
+    const auto [c_started, c_finished] = times(c);
+    EXPECT_LE(a_finished, b_started);
+    EXPECT_LE(b_finished, c_started);
 }
 
 }  // namespace

@@ -208,6 +208,7 @@ try {
 
   // Raise a job's priority and cancel it from its page; the CLI agrees.
   const doomed = submit(['--spp', '65536', '--passes', '64', '--name', 'doomed']);
+  const waiter = submit(['--spp', '1', '--name', 'waiter', '--after', doomed]);
   await page.goto(`${base}/#/job/${doomed}`);
   await page.waitForSelector('#state');
   await page.fill('#priority', '5');
@@ -226,6 +227,11 @@ try {
   const status = cli(['status', doomed], aliceToken);
   check(/cancelled/i.test(status), `cancelled from the page, and the CLI agrees: ${status.split('\n')[0]}`);
   await page.screenshot({ path: join(shotsDir, 'job-cancelled.png'), fullPage: true });
+  // Dependencies (issue 30): the dependent's page links its dependency, in its state.
+  await page.goto(`${base}/#/job/${waiter}`);
+  await until('the dependency on the page', async () => (await page.textContent('#depends-on')) === `Depends on: ${doomed} (cancelled)`);
+  check(await page.isVisible(`#depends-on a[href="#/job/${doomed}"]`) && (await page.textContent('#state')) === 'failed',
+    'a dependent of a cancelled job shows it linked, cancelled, and has failed');
 
   // Alice may not see the admin's jobs: an admin's job answers 404.
   const adminJob = cli(['submit', scene, '--resolution', '16x16', '--spp', '1', '--name', 'admins'], adminToken).split('\n').pop().trim();

@@ -178,6 +178,7 @@ void ToProto(const JobSpec& spec, pb::SubmitJobRequest* out) {
     out->set_max_workers(spec.max_workers);
     out->set_max_attempts(spec.max_attempts);
     out->set_blocklist_after(spec.blocklist_after);
+    for (const std::string& id : spec.after) out->add_after(id);
 }
 
 JobSpec FromProto(const pb::SubmitJobRequest& r) {
@@ -192,6 +193,7 @@ JobSpec FromProto(const pb::SubmitJobRequest& r) {
     spec.max_workers = r.max_workers();
     if (r.max_attempts() != 0) spec.max_attempts = r.max_attempts();
     if (r.blocklist_after() != 0) spec.blocklist_after = r.blocklist_after();
+    spec.after.assign(r.after().begin(), r.after().end());
     return spec;
 }
 
@@ -276,6 +278,8 @@ void ToProto(const JobRecord& job, pb::Job* out) {
     out->set_paused(job.paused);
     out->set_render_seconds(job.times.render_seconds);
     out->set_cpu_seconds(job.times.cpu_seconds);
+    for (const std::string& id : job.spec.after) out->add_after(id);
+    for (const std::string& id : job.waiting_for) out->add_waiting_for(id);
 }
 
 void ToProto(const TaskAssignment& task, pb::Task* out) {

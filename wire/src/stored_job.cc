@@ -38,6 +38,7 @@ void ToProto(const JobSpec& spec, pb::StoredJobSpec* out) {
     out->set_max_workers(spec.max_workers);
     out->set_max_attempts(spec.max_attempts);
     out->set_blocklist_after(spec.blocklist_after);
+    for (const std::string& id : spec.after) out->add_after(id);
 }
 
 JobSpec FromProto(const pb::StoredJobSpec& s) {
@@ -56,6 +57,7 @@ JobSpec FromProto(const pb::StoredJobSpec& s) {
     spec.max_workers = s.max_workers();
     if (s.max_attempts() != 0) spec.max_attempts = s.max_attempts();
     if (s.blocklist_after() != 0) spec.blocklist_after = s.blocklist_after();
+    spec.after.assign(s.after().begin(), s.after().end());
     return spec;
 }
 

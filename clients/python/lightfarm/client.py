@@ -108,6 +108,16 @@ class Job:
         return [BlockedWorker(b.worker, b.failures, b.last_error) for b in self.proto.blocklist]
 
     @property
+    def after(self) -> Tuple[str, ...]:
+        """Dependencies: the jobs it runs after."""
+        return tuple(self.proto.after)
+
+    @property
+    def waiting_for(self) -> Tuple[str, ...]:
+        """Of ``after``, those not ended yet while the job is queued."""
+        return tuple(self.proto.waiting_for)
+
+    @property
     def paused(self) -> bool:
         """Paused (``Client.pause``): a queued or running job that leases nothing new."""
         return self.proto.paused
@@ -458,6 +468,15 @@ class Client:
             "workers": [row(w) for w in resp.workers],
         }
 
+    def depend(self, job_id: str, after: Sequence[str]) -> Job:
+        """Makes a queued job also run after the jobs ``after`` (``lightfarm depend``): the job's
+        owner or an admin. FailedPrecondition for a cycle (its message names it), a job not
+        queued, or a dependency that failed or was cancelled; NotFound for an unknown id."""
+        if isinstance(after, str):
+            raise InvalidArgument(f"after {after!r}: a list of job ids, e.g. [{after!r}]")
+        return Job.from_proto(self._unary(
+            "AddJobDependencies", pb.AddJobDependenciesRequest(job_id=job_id, after=list(after))))
+
     def workers(self) -> List[Worker]:
         """The workers the server heard from within a lease."""
         resp = self._unary("ListWorkers", pb.ListWorkersRequest())
@@ -641,7 +660,8 @@ class Client:
                frame: Optional[int] = None, fps: Optional[float] = None, shutter: float = 0.0,
                chunk: Optional[int] = None, request_id: Optional[str] = None,
                tags: Sequence[str] = (), max_workers: int = 0,
-               max_attempts: int = 3, blocklist_after: int = 3) -> str:
+               max_attempts: int = 3, blocklist_after: int = 3,
+               after: Sequence[str] = ()) -> str:
         """Uploads the scene and every file it names (those the server lacks, resuming a broken
         upload) and queues it as a job; returns the job id.
 
@@ -662,13 +682,17 @@ class Client:
         workers having every one take the job) and ``max_workers`` (at most this many workers
         at once, 0 no cap); ``max_attempts`` (failures of one task that fail the job) and
         ``blocklist_after`` (a worker's failures in the job after which it gets none of its
-        tasks), 1 to 100. The server checks them all and the scene (InvalidArgument
+        tasks), 1 to 100. ``after``: job ids; the job leases nothing until each has succeeded,
+        and fails when one fails or is cancelled (NotFound for an unknown id,
+        FailedPrecondition for one that failed or was cancelled). The server checks them all and the scene (InvalidArgument
         with the loader's message). ``request_id`` makes retries idempotent (default: 128
         random bits, the same on every retry of this call).
         """
         scene_path = os.fspath(scene_path)
         if isinstance(tags, str):  # a str is a sequence of one-letter tags
             raise InvalidArgument(f"tags {tags!r}: a list of tags, e.g. [{tags!r}]")
+        if isinstance(after, str):  # a str is a sequence of one-letter ids
+            raise InvalidArgument(f"after {after!r}: a list of job ids, e.g. [{after!r}]")
         if method not in METHODS:
             raise InvalidArgument(f"method {method!r}: expected one of {', '.join(METHODS)}")
         text, named = scene_files(scene_path)
@@ -708,7 +732,8 @@ class Client:
             scene=ref(scene_name, text), files=[ref(n, d) for n, d in named], params=params,
             priority=priority, name=name or scene_name,
             request_id=request_id or secrets.token_hex(16), tags=list(tags),
-            max_workers=max_workers, max_attempts=max_attempts, blocklist_after=blocklist_after)
+            max_workers=max_workers, max_attempts=max_attempts, blocklist_after=blocklist_after,
+            after=list(after))
         files = [req.scene] + list(req.files)
 
         backoff = _Backoff(self.retry_seconds)

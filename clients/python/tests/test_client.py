@@ -566,6 +566,33 @@ class ClientTest(unittest.TestCase):
         with self.assertRaises(lightfarm.InvalidArgument):
             self.alice.submit(cornell(), tags=["No Spaces"], **SMALL)
 
+    def test_after(self):
+        """A job submitted after another runs once that one succeeded; a bare str, an unknown id
+        and a cycle are refused."""
+        with self.assertRaises(lightfarm.InvalidArgument):
+            self.alice.submit(cornell(), after="job-1", **SMALL)
+        with self.assertRaises(lightfarm.NotFound) as caught:
+            self.alice.submit(cornell(), after=["job-nonesuch"], **SMALL)
+        self.assertIn("job-nonesuch", caught.exception.message)
+        first = self.alice.submit(cornell(), **SMALL)
+        second = self.alice.submit(cornell(), after=[first, first], **SMALL)
+        self.assertEqual(self.alice.get(second).after, (first,))
+        done = self.alice.wait(second)
+        self.assertEqual(done.state, lightfarm.JobState.SUCCEEDED, done.error)
+        self.assertLessEqual(self.alice.get(first).finished_unix_ms, done.started_unix_ms)
+        third = self.alice.submit(cornell(), tags=["tpu"], **SMALL)  # stays queued
+        fourth = self.alice.submit(cornell(), after=[third], **SMALL)
+        try:
+            with self.assertRaises(lightfarm.FailedPrecondition) as caught:
+                self.alice.depend(third, [fourth])
+            self.assertEqual(caught.exception.message, f"cycle: {third} -> {fourth} -> {third}")
+            self.assertEqual(self.alice.get(fourth).waiting_for, (third,))
+        finally:
+            self.alice.cancel(third)
+        failed = self.alice.get(fourth)
+        self.assertEqual((failed.state, failed.error),
+                         (lightfarm.JobState.FAILED, f"dependency {third} was cancelled"))
+
     def test_set_worker_state(self):
         """An admin disables w1 (it then takes nothing) and enables it again; a submitter may not."""
         with self.assertRaises(lightfarm.PermissionDenied):

@@ -319,6 +319,20 @@ TEST_F(DashboardTest, JobTasksAndFarmJsonFollowTheWork) {
               2 * 8 * 8 * 2);
 }
 
+// Dependencies (issue 30): the job page's JSON names each job it runs after with its state now.
+TEST_F(DashboardTest, AJobListsItsDependenciesWithTheirStates) {
+    const std::string first = Submit("alice"), second = Submit("alice");
+    EXPECT_FALSE(Call(Get("/api/jobs/" + second, alice_), 200).contains("depends_on"));
+    ASSERT_TRUE(farm_->scheduler().AddDependencies(second, {first}).ok());
+    Json j = Call(Get("/api/jobs/" + second, alice_), 200);
+    EXPECT_EQ(j["depends_on"], Json::parse(R"([{"id": ")" + first + R"(", "state": "queued"}])"));
+    ASSERT_TRUE(farm_->scheduler().Cancel(first).ok());
+    j = Call(Get("/api/jobs/" + second, alice_), 200);
+    EXPECT_EQ(j["depends_on"][0]["state"], "cancelled");
+    EXPECT_EQ(j["state"], "failed");
+    EXPECT_EQ(j["error"], "dependency " + first + " was cancelled");
+}
+
 TEST_F(DashboardTest, CancelAndPriorityChangeTheJob) {
     const std::string first = Submit("alice"), second = Submit("alice");
     Json j = Call(Post("/api/jobs/" + second + "/priority", {{"priority", 7}}, alice_), 200);

@@ -248,6 +248,37 @@ TEST_F(GuardedServices, SubmitterSeesOnlyItsOwnJobsAdminSeesAll) {
     EXPECT_TRUE(Jobs("root")->CancelJob(Context().get(), cancel_bob, &job).ok());
 }
 
+// Dependencies (issue 30): `depend` is the job's owner's or an admin's, a worker's role may not,
+// and another owner's job is as unknown as a dependency as it is to GetJob.
+TEST_F(GuardedServices, DependenciesAreTheOwnersOrAnAdmins) {
+    std::string alice_first, alice_second, bob_job;
+    ASSERT_TRUE(Submit(*Jobs("alice"), &alice_first).ok());
+    ASSERT_TRUE(Submit(*Jobs("alice"), &alice_second).ok());
+    ASSERT_TRUE(Submit(*Jobs("bob"), &bob_job).ok());
+    pb::AddJobDependenciesRequest depend;
+    depend.set_job_id(alice_second);
+    depend.add_after(alice_first);
+    pb::Job job;
+    const grpc::Status hidden = Jobs("bob")->AddJobDependencies(Context().get(), depend, &job);
+    EXPECT_EQ(hidden.error_code(), grpc::StatusCode::NOT_FOUND) << hidden.error_message();
+    EXPECT_EQ(hidden.error_message(), "no job " + alice_second);
+    EXPECT_EQ(Jobs("node")->AddJobDependencies(Context().get(), depend, &job).error_code(),
+              grpc::StatusCode::PERMISSION_DENIED);
+    ASSERT_TRUE(Jobs("alice")->AddJobDependencies(Context().get(), depend, &job).ok());
+    EXPECT_EQ(job.waiting_for_size(), 1);
+
+    pb::AddJobDependenciesRequest on_bob = depend;
+    on_bob.set_after(0, bob_job);
+    const grpc::Status foreign = Jobs("alice")->AddJobDependencies(Context().get(), on_bob, &job);
+    EXPECT_EQ(foreign.error_code(), grpc::StatusCode::NOT_FOUND) << foreign.error_message();
+    EXPECT_EQ(foreign.error_message(), "dependency " + bob_job + ": no job " + bob_job);
+    ASSERT_TRUE(Jobs("root")->AddJobDependencies(Context().get(), on_bob, &job).ok())
+        << "an admin sees every job";
+    EXPECT_EQ(job.after_size(), 2);
+    EXPECT_EQ(job.waiting_reason(),
+              "waiting for " + alice_first + " (queued), " + bob_job + " (queued)");
+}
+
 // A request id is its submitter's: Bob sending Alice's gets a job of his own, not hers (he got
 // her job id back, his submission was dropped and the id answered NOT_FOUND to him).
 TEST_F(GuardedServices, ARequestIdIsScopedToItsOwner) {

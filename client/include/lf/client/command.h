@@ -41,5 +41,7 @@ Command AddPauseCommand(CLI::App& app);
 Command AddResumeCommand(CLI::App& app);
 // History (issue 30; farm_commands.cc).
 Command AddStatsCommand(CLI::App& app);
+// Dependencies (issue 30; job_management_commands.cc).
+Command AddDependCommand(CLI::App& app);
 
 }  // namespace lf

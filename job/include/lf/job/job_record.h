@@ -53,6 +53,9 @@ struct JobRecord {
     // finish and merge) until resumed. A flag, not a state: the job is still queued or running.
     bool paused = false;
     TaskTimes times;  // summed over its merged tasks (issue 30's history)
+    // Dependencies (issue 30): of spec.after, those not ended yet while the job is queued; set
+    // as the job is read, never stored.
+    std::vector<std::string> waiting_for;
     int frames_done() const;
     // The workers of worker_failures with spec.blocklist_after failures or more: they get no
     // more tasks of this job.

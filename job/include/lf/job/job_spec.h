@@ -58,6 +58,9 @@ struct JobSpec {
     // (the blocklist, JobRecord::Blocklisted).
     int max_attempts = kDefaultMaxAttempts;
     int blocklist_after = kDefaultBlocklistAfter;
+    // Dependencies (issue 30): job ids, each distinct; the job leases nothing until every one
+    // has succeeded (lf/server/job_dependencies.h).
+    std::vector<std::string> after;
 };
 
 // The limits of a job's settings, one list for the CLI's flags (`render`, `submit`) and the

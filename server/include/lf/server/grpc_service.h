@@ -78,6 +78,14 @@ class JobServiceImpl final : public ReadAfterAuth<lightfarm::v1::JobService::Ser
     // History (issue 30).
     grpc::Status GetStats(grpc::ServerContext*, const Caller&,
                           const lightfarm::v1::GetStatsRequest&, lightfarm::v1::GetStatsResponse*);
+    // Dependencies (issue 30).
+    grpc::Status AddJobDependencies(grpc::ServerContext*, const Caller&,
+                                    const lightfarm::v1::AddJobDependenciesRequest&,
+                                    lightfarm::v1::Job*);
+    // NotFound, as VisibleJob answers, for a job of `after` the caller may not see; the ids
+    // checked by CheckDependencyIds first.
+    absl::Status CheckVisibleDependencies(const Caller& caller,
+                                          const std::vector<std::string>& after) const;
     // PauseJob and ResumeJob.
     grpc::Status SetPaused(grpc::ServerContext* context, const Caller& caller,
                            const std::string& job_id, bool paused, lightfarm::v1::Job* resp);

@@ -33,6 +33,7 @@
 #include "lf/job/task_status.h"
 #include "lf/job/worker_status.h"
 #include "lf/server/ended_jobs.h"
+#include "lf/server/job_dependencies.h"
 #include "lf/server/job_state_machine.h"
 #include "lf/server/job_store.h"
 #include "lf/server/lease_table.h"
@@ -98,7 +99,9 @@ class Scheduler {
     Scheduler(
         SchedulerOptions options, JobStore& store, Clock clock = [] { return absl::Now(); });
 
-    // Plans and queues the job; `spec` must be validated. Returns the job id once the job is in
+    // Plans and queues the job; `spec` must be validated, but for its dependencies (spec.after:
+    // their ids as CheckDependencyIds checks them, each known and not failed nor cancelled, see
+    // AddDependencies). Returns the job id once the job is in
     // the store (an error, and nothing queued, when the store cannot take it). A request id
     // seen before returns that submission's job. ResourceExhausted when max_active_jobs jobs are
     // queued or running.
@@ -184,6 +187,15 @@ class Scheduler {
     // `lightfarm pause` and `resume` (JobRecord::paused): returns the record once durable;
     // FailedPrecondition for a job that has ended, NotFound for one the store does not hold.
     absl::StatusOr<JobRecord> SetPaused(const std::string& job_id, bool paused);
+
+    // Dependencies (issue 30, lf/server/job_dependencies.h). A job leases nothing while a job of
+    // its spec.after is queued or running, and fails when one ends without succeeding (and so
+    // on down a chain); a dependency deleted since counts as settled. `lightfarm depend`: the
+    // queued job also runs after `after` (ids checked by CheckDependencyIds); returns the record
+    // once durable. NotFound for an unknown job or dependency, FailedPrecondition for a job that is
+    // not queued, a dependency that failed or was cancelled, or a cycle (its CycleText).
+    absl::StatusOr<JobRecord> AddDependencies(const std::string& job_id,
+                                              const std::vector<std::string>& after);
 
     // Re-queues the tasks whose lease ran out (each counts as a failure of the task), and
     // forgets the workers silent for a lease. Returns how many leases expired.
@@ -323,6 +335,16 @@ class Scheduler {
     // and the job's max_workers cap leaves it room (or the worker already holds a lease of it).
     bool Admits(const Job& job, const std::string& worker,
                 const std::vector<std::string>& tags) const;
+    // Whether a job of the job's spec.after is still queued or running.
+    bool WaitsForDependency(const Job& job) const;
+    // The states of jobs `ids`, from memory or the store (read with the lock released, as
+    // FindRequest does); Called and returns with `locked` held. A store error other than
+    // NotFound is returned.
+    absl::StatusOr<std::map<std::string, DependencyState>> DependencyStates(
+        const std::vector<std::string>& ids, Locked& locked);
+    // Fails the job when a job it runs after, not held in memory, ended without succeeding by
+    // `known` (Recover's and RequeueJob's view of the store); true if it did.
+    bool FailIfDependencyEnded(Job& job, const std::map<std::string, DependencyState>& known);
     // The job's record as a reader sees it: with its waiting_reason.
     JobRecord ReadRecord(const Job& job, absl::Time now) const;
     // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).
