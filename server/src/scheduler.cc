@@ -45,12 +45,12 @@ Scheduler::Locked::~Locked() {
     if (!scheduler_.ended_.has_unsettled()) return;
     // Taken with the jobs SettleEnded waits for: their tasks are handed on once they are durable
     // (or logged as not recorded), with the lock released for the callback to write.
-    std::vector<std::pair<std::string, std::vector<TaskStatus>>> tasks;
+    std::vector<std::pair<JobRecord, std::vector<TaskStatus>>> tasks;
     tasks.swap(scheduler_.ended_tasks_);
     SettleEnded();
     lock.unlock();
     if (!scheduler_.tasks_ended_) return;
-    for (auto& [id, statuses] : tasks) scheduler_.tasks_ended_(id, std::move(statuses));
+    for (auto& [record, statuses] : tasks) scheduler_.tasks_ended_(record, std::move(statuses));
 }
 
 void Scheduler::Locked::SettleEnded() {
@@ -85,12 +85,7 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
                     LogSafe(spec.request_id));
         return (*earlier)->first;
     }
-    if (active_.size() >= options_.max_active_jobs) {
-        return absl::ResourceExhaustedError(
-            absl::StrCat(active_.size(),
-                         " jobs are queued or running, this server's limit "
-                         "(lightfarm-server --max-active-jobs); submit again once some end"));
-    }
+    if (absl::Status s = CheckActiveJobLimit("submit"); !s.ok()) return s;
     // Ids are random: one the store lacks is taken in memory only by a freak.
     while (active_.count(id) || ended_.Find(id)) id = NewJobId();
     job->record.id = id;
@@ -111,6 +106,14 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     }
     Log()->info("job={} queued: {}, priority {}", id, summary, spec.priority);
     return id;
+}
+
+absl::Status Scheduler::CheckActiveJobLimit(const char* action) const {
+    if (active_.size() < options_.max_active_jobs) return absl::OkStatus();
+    return absl::ResourceExhaustedError(absl::StrCat(
+        active_.size(),
+        " jobs are queued or running, this server's limit (lightfarm-server --max-active-jobs); ",
+        action, " again once some end"));
 }
 
 absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> Scheduler::FindRequest(
@@ -284,6 +287,7 @@ absl::StatusOr<bool> Scheduler::TakeUp(JobRecord record,
         Job::Make(std::move(record), options_.tile_stores, options_.speculate_after);
     if (!made.ok()) return made.status();
     std::unique_ptr<Job> job = std::move(*made);
+    job->paused_since = clock_();  // a paused job's clock stays stopped from here
     // In the order they merged, so an adaptive plan appends each pass before its result
     // comes up, and a shot gives each appended pass the index it had (its frames append
     // in the order their results merged, not in index order).
@@ -355,6 +359,7 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
         return absl::AbortedError(
             absl::StrCat("job ", job_id, " was requeued by another call meanwhile"));
     }
+    if (absl::Status s = CheckActiveJobLimit("requeue"); !s.ok()) return s;
     absl::StatusOr<bool> rendered = TakeUp(std::move(*stored), *results);
     if (!rendered.ok()) return rendered.status();
     Job& job = *active_.at(job_id);
@@ -473,8 +478,9 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
 }
 
 bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
+    if (job.record.paused) return false;  // its clock is stopped
     const std::optional<std::vector<int>> dropped =
-        job.execution->EnforceTimeLimit(job.record.started, now);
+        job.execution->EnforceTimeLimit(job.record.started + job.paused_for, now);
     if (!dropped) return false;
     for (int t : *dropped) {
         leases_.EndTask(job.id(), t);
@@ -784,10 +790,12 @@ void Scheduler::FailJob(Job& job, const std::string& error) {
 
 JobRecord Scheduler::EndJob(Job& job) {
     const std::string id = job.record.id;
-    ended_tasks_.emplace_back(id, job.Statuses(leases_, clock_()));
+    job.record.paused = false;  // an ended job is cancelled, failed or succeeded, not paused
+    std::vector<TaskStatus> statuses = job.Statuses(leases_, clock_());
     leases_.ForgetJob(id);
     const uint64_t ticket = Save(job);
     JobRecord record = job.record;
+    ended_tasks_.emplace_back(record, std::move(statuses));
     active_.erase(id);  // destroys `job`
     return ended_.Add(std::move(record), ticket);
 }
@@ -828,6 +836,9 @@ absl::StatusOr<JobRecord> Scheduler::SetPaused(const std::string& job_id, bool p
         absl::StatusOr<Job*> job = ActiveJob(job_id, locked);
         if (!job.ok()) return job.status();
         Log()->info("job={} {}", job_id, paused ? "paused" : "resumed");
+        const absl::Time now = clock_();
+        if (paused && !(*job)->record.paused) (*job)->paused_since = now;
+        if (!paused && (*job)->record.paused) (*job)->paused_for += now - (*job)->paused_since;
         (*job)->record.paused = paused;
         ticket = Save(**job);
         record = (*job)->record;

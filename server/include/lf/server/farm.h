@@ -203,6 +203,7 @@ class Farm {
     std::unique_ptr<SqliteJobStore> store_;
     std::unique_ptr<TaskLogStore> logs_;
     std::unique_ptr<WorkerStateStore> worker_states_;  // set by Open
+    std::mutex worker_control_changes_;                // taken by SetWorkerState
     std::unique_ptr<JobNotifier> notifier_;            // set by Open, with a notify_url
     Scheduler scheduler_;
     std::mutex image_mutex_;

@@ -250,10 +250,12 @@ class Scheduler {
     // from before a restart, or a job that has ended).
     std::optional<LeaseHolder> HolderOf(const std::string& lease_id, const std::string& worker);
 
-    // Called with an ended job's tasks as they were when it ended, after the scheduler's lock is
-    // released and the job's final record is durable (or logged as not recorded), so that they
-    // can be kept once the job leaves memory. Set before the first job is submitted or recovered.
-    using TasksEnded = std::function<void(const std::string& job_id, std::vector<TaskStatus>)>;
+    // Called with an ended job's final record and its tasks as they were when it ended, after
+    // the scheduler's lock is released and that record is durable (or logged as not recorded),
+    // so that they can be kept once the job leaves memory. The record is the one the job ended
+    // with, even when the job was requeued meanwhile. Set before the first job is submitted or
+    // recovered.
+    using TasksEnded = std::function<void(const JobRecord& ended, std::vector<TaskStatus>)>;
     void OnTasksEnded(TasksEnded callback) { tasks_ended_ = std::move(callback); }
 
     // Workers the scheduler keeps track of: the live ones, and silent ones not yet forgotten
@@ -315,6 +317,9 @@ class Scheduler {
     // Drops a job's tasks once its time limit has passed; true if dropping them completed the
     // job (so that it is reported once, here or by Complete).
     bool EnforceTimeLimit(Job& job, absl::Time now);
+    // ResourceExhausted when max_active_jobs jobs are queued or running (`action`: what to try
+    // again). Called under the lock.
+    absl::Status CheckActiveJobLimit(const char* action) const;
     // Whether `worker` may take queued task `task` now: a task the execution prefers for another
     // live worker waits for it, and a task that failed on `worker` waits for a live worker it has
     // not failed on, while there is one.
@@ -370,7 +375,7 @@ class Scheduler {
     EndedJobs ended_;
     uint64_t left_memory_ = 0;  // ended jobs settled out of `ended_`, for FindRequest
     // Ended jobs' tasks, for tasks_ended_ once the lock is released.
-    std::vector<std::pair<std::string, std::vector<TaskStatus>>> ended_tasks_;
+    std::vector<std::pair<JobRecord, std::vector<TaskStatus>>> ended_tasks_;
     TasksEnded tasks_ended_;
     LeaseTable leases_;
     WorkerRegistry workers_;
