@@ -636,10 +636,17 @@ absl::StatusOr<JobRecord> Farm::SetPriority(const std::string& job_id, int prior
 
 namespace lf {
 
-absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id) {
+absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id,
+                                        const std::optional<FrameRange>& frames) {
     std::lock_guard<std::mutex> one_change(ended_job_changes_);
-    absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(job_id);
+    absl::StatusOr<Scheduler::Requeued> requeued =
+        frames ? scheduler_.RequeueFrames(job_id, *frames) : scheduler_.RequeueJob(job_id);
     if (!requeued.ok()) return requeued.status();
+    // No longer recorded: removed, so that nothing serves the old EXR under the frame's name.
+    for (int frame : requeued->frames) {
+        std::error_code ignored;  // a frame whose EXR was never written
+        fs::remove(FramePathOf("results", job_id, frame), ignored);
+    }
     if (requeued->rendered) FinishJob(job_id);
     return requeued->record;
 }

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <set>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "lf/core/image_error.h"
 #include "lf/core/log.h"
 #include "lf/core/plural.h"
@@ -28,6 +30,45 @@ std::string NewJobId() { return "job-" + RandomHex(10); }
 absl::Status AlreadyEnded(const JobRecord& record) {
     return absl::FailedPreconditionError(
         absl::StrCat("job ", record.id, " has already ended (", JobStateName(record.state), ")"));
+}
+
+// Unavailable for a job whose final record is not durable yet.
+absl::Status JustEnded(const std::string& job_id) {
+    return absl::UnavailableError(absl::StrCat(
+        "job ", job_id,
+        " has just ended and its record is not in the store yet; requeue it again in a moment"));
+}
+
+// `requeue --frames`: InvalidArgument for a still or frames outside the shot, naming them;
+// FailedPrecondition for an adaptive shot (its passes take task indices in the order they merged,
+// so some frames' results cannot be dropped and the rest merged again as recorded).
+absl::Status CheckRequeuedFrames(const JobRecord& job, const FrameRange& frames) {
+    const std::string what = absl::StrCat("--frames ", FrameRangeText(frames), ": ");
+    const std::optional<FrameRange>& shot = job.spec.shot.frames;
+    if (!shot) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            what, "job ", job.id, " is a still image; --frames applies to a shot's frames"));
+    }
+    std::vector<int> outside;
+    for (int i = 0; i < frames.count(); ++i) {
+        if (!shot->Contains(frames.at(i))) outside.push_back(frames.at(i));
+    }
+    if (!outside.empty()) {
+        constexpr size_t kNamed = 10;
+        const std::string named = outside.size() == 1 ? "frame " : "frames ";
+        const std::string more =
+            outside.size() > kNamed ? absl::StrCat(" and ", outside.size() - kNamed, " more") : "";
+        outside.resize(std::min(outside.size(), kNamed));
+        return absl::InvalidArgumentError(absl::StrCat(what, named, absl::StrJoin(outside, ", "),
+                                                       more, " not in job ", job.id, "'s shot (",
+                                                       FrameRangeText(*shot), ")"));
+    }
+    if (IsAdaptive(job.spec.adaptive)) {
+        return absl::FailedPreconditionError(
+            absl::StrCat(what, "job ", job.id,
+                         " samples adaptively: its frames cannot be rendered again alone"));
+    }
+    return absl::OkStatus();
 }
 
 }  // namespace
@@ -339,17 +380,35 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
             if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
             return requeued;
         }
-        if (ended_.Find(job_id)) {
-            return absl::UnavailableError(
-                absl::StrCat("job ", job_id,
-                             " has just ended and its record is not in the store yet; requeue "
-                             "it again in a moment"));
-        }
+        if (ended_.Find(job_id)) return JustEnded(job_id);
     }
+    return Reopen(job_id, std::nullopt);
+}
+
+absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueFrames(const std::string& job_id,
+                                                             const FrameRange& frames) {
+    {
+        Locked locked(*this);
+        if (active_.count(job_id)) {
+            return absl::FailedPreconditionError(absl::StrCat(
+                "job ", job_id,
+                " is queued or running: --frames renders frames of an ended job again (cancel "
+                "it first, or wait for it to end)"));
+        }
+        if (ended_.Find(job_id)) return JustEnded(job_id);
+    }
+    return Reopen(job_id, frames);
+}
+
+absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
+                                                      const std::optional<FrameRange>& frames) {
     // The store is read without the lock.
     absl::StatusOr<JobRecord> stored = store_.Get(job_id);
     if (!stored.ok()) return stored.status();
-    if (absl::Status s = ReopenJob(*stored); !s.ok()) return s;
+    if (frames) {
+        if (absl::Status s = CheckRequeuedFrames(*stored, *frames); !s.ok()) return s;
+    }
+    if (absl::Status s = ReopenJob(*stored, frames.has_value()); !s.ok()) return s;
     absl::StatusOr<std::map<int, JobStore::RecordedTask>> results = store_.TaskResults(job_id);
     if (!results.ok()) return results.status();
     stored->worker_failures.clear();
@@ -360,13 +419,40 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
             absl::StrCat("job ", job_id, " was requeued by another call meanwhile"));
     }
     if (absl::Status s = CheckActiveJobLimit("requeue"); !s.ok()) return s;
+    Requeued requeued;
+    std::vector<int> dropped;  // tasks of the frames rendered again, their results removed
+    if (frames) {
+        absl::StatusOr<std::unique_ptr<Job>> made =
+            Job::Make(*stored, options_.tile_stores, options_.speculate_after);
+        if (!made.ok()) return made.status();
+        std::set<int> again;
+        for (const auto& [t, result] : *results) {
+            TaskStatus task;
+            (*made)->execution->Describe(t, task);
+            if (std::none_of(task.frames.begin(), task.frames.end(),
+                             [&](int f) { return frames->Contains(f); })) {
+                continue;
+            }
+            dropped.push_back(t);
+            again.insert(task.frames.begin(), task.frames.end());  // a chunk's other frames too
+        }
+        for (int t : dropped) results->erase(t);
+        for (FrameProgress& frame : stored->frames) {
+            if (frames->Contains(frame.frame) || again.count(frame.frame)) {
+                frame.result_path.clear();
+                requeued.frames.push_back(frame.frame);
+            }
+        }
+    }
     absl::StatusOr<bool> rendered = TakeUp(std::move(*stored), *results);
     if (!rendered.ok()) return rendered.status();
     Job& job = *active_.at(job_id);
-    Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued", job_id,
-                job.record.tasks_done, job.record.tasks_total);
-    const uint64_t ticket = Save(job);
-    Requeued requeued{job.record, *rendered};
+    Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued{}", job_id,
+                job.record.tasks_done, job.record.tasks_total,
+                frames ? absl::StrCat(" (frames ", FrameRangeText(*frames), " again)") : "");
+    const uint64_t ticket = Save(job, dropped);
+    requeued.record = job.record;
+    requeued.rendered = *rendered;
     locked.lock.unlock();
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
     return requeued;
@@ -1014,10 +1100,12 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
     EndJob(job);
 }
 
-uint64_t Scheduler::Save(Job& job) {
+uint64_t Scheduler::Save(Job& job, const std::vector<int>& drop_results) {
     // Derived, so that the record cannot disagree with the execution and the task states.
     job.Sync();
-    const uint64_t ticket = store_.QueuePut(job.record);
+    const uint64_t ticket = drop_results.empty()
+                                ? store_.QueuePut(job.record)
+                                : store_.QueuePutDropping(job.record, drop_results);
     ++version_;
     changed_.notify_all();
     return ticket;

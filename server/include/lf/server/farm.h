@@ -146,9 +146,10 @@ class Farm {
     // workers of that name known now; NotFound naming `name_or_id` for a worker never heard of.
     absl::StatusOr<std::vector<WorkerStatus>> SetWorkerState(const std::string& name_or_id,
                                                              WorkerControl control);
-    // Job management (issue 30): Scheduler::RequeueJob, and a job it finds fully rendered
-    // written and finished.
-    absl::StatusOr<JobRecord> Requeue(const std::string& job_id);
+    // Job management (issue 30): Scheduler::RequeueJob, or with `frames` RequeueFrames (those
+    // frames' EXRs removed), and a job it finds fully rendered written and finished.
+    absl::StatusOr<JobRecord> Requeue(const std::string& job_id,
+                                      const std::optional<FrameRange>& frames = std::nullopt);
 
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }

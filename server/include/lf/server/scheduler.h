@@ -179,8 +179,16 @@ class Scheduler {
     struct Requeued {
         JobRecord record;
         bool rendered = false;
+        std::vector<int> frames;  // RequeueFrames: the frames whose EXRs are dropped
     };
     absl::StatusOr<Requeued> RequeueJob(const std::string& job_id);
+    // `lightfarm requeue --frames`: frames `frames` of an ended shot (a succeeded one too) are
+    // rendered again from scratch: the results of their tasks are removed from the store with
+    // the reopened record, and their EXRs are no longer recorded (Requeued::frames: those, and
+    // the other frames of a chunk that holds one); the rest merges as after a restart and the
+    // job is queued. InvalidArgument naming them for a still or frames outside the shot,
+    // FailedPrecondition for a job not ended, or an adaptive shot; else as RequeueJob.
+    absl::StatusOr<Requeued> RequeueFrames(const std::string& job_id, const FrameRange& frames);
     // `lightfarm pause` and `resume` (JobRecord::paused): returns the record once durable;
     // FailedPrecondition for a job that has ended, NotFound for one the store does not hold.
     absl::StatusOr<JobRecord> SetPaused(const std::string& job_id, bool paused);
@@ -320,6 +328,9 @@ class Scheduler {
     // ResourceExhausted when max_active_jobs jobs are queued or running (`action`: what to try
     // again). Called under the lock.
     absl::Status CheckActiveJobLimit(const char* action) const;
+    // An ended job taken up again from the store (RequeueJob; RequeueFrames with `frames`).
+    absl::StatusOr<Requeued> Reopen(const std::string& job_id,
+                                    const std::optional<FrameRange>& frames);
     // Whether `worker` may take queued task `task` now: a task the execution prefers for another
     // live worker waits for it, and a task that failed on `worker` waits for a live worker it has
     // not failed on, while there is one.
@@ -360,7 +371,9 @@ class Scheduler {
     // Ends the live state of a job moved to a final state: its final record is queued and the
     // job waits in `ended_` until Locked's release finds it durable. Returns that record.
     JobRecord EndJob(Job& job);
-    uint64_t Save(Job& job);  // queues the record's write and wakes watchers; a store ticket
+    // Queues the record's write (removing the results of tasks `drop_results` with it) and
+    // wakes watchers; returns a store ticket.
+    uint64_t Save(Job& job, const std::vector<int>& drop_results = {});
 
     const SchedulerOptions options_;
     JobStore& store_;
