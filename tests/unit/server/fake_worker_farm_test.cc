@@ -304,6 +304,31 @@ TEST_F(FakeWorkerFarm, AHugeFailureReasonIsKeptAsOneBoundedLine) {
     EXPECT_EQ(GetJob(job).last_error().size(), record->last_error.size());
 }
 
+// RequeueJob's frames: parsed as submit's --frames, each refusal naming what was wrong.
+TEST_F(FakeWorkerFarm, RequeueJobFramesAreCheckedAndNamedInTheError) {
+    const std::string job = Submit();
+    RenderHonestly(job);
+    const auto requeue = [&](const std::string& frames) {
+        pb::RequeueJobRequest request;
+        request.set_job_id(job);
+        request.set_frames(frames);
+        pb::Job response;
+        grpc::ClientContext context;
+        return job_stub_->RequeueJob(&context, request, &response);
+    };
+    const grpc::Status reversed = requeue("5-2");
+    EXPECT_EQ(reversed.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(reversed.error_message().rfind("frames: ", 0), 0u) << reversed.error_message();
+    const grpc::Status huge = requeue(std::string(1 << 20, '7'));
+    EXPECT_EQ(huge.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_LT(huge.error_message().size(), 200u);
+    const grpc::Status still = requeue("1-2");
+    EXPECT_EQ(still.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(still.error_message().find("still image"), std::string::npos)
+        << still.error_message();
+    EXPECT_EQ(GetJob(job).state(), pb::Job::SUCCEEDED);
+}
+
 // A bound on the wait for a task to be leased again (after a 500 ms lease, or 300 ms of
 // straggling): far above that, so that a loaded machine does not fail the tests.
 constexpr std::chrono::seconds kLeasedAgainWithin{30};
