@@ -774,13 +774,18 @@ TEST_F(SchedulerTest, AdaptiveJobQueuesPassesOnlyForTheTileAboveTheTarget) {
     EXPECT_EQ((*snapshot->image.FindChannel("spp"))[15 * 16 + 15], 64.0f);
 }
 
+// An adaptive job's four first passes (SubmitAdaptive) leased and merged with HalvesResult.
+void CompleteFirstPasses(Scheduler& scheduler) {
+    for (int i = 0; i < 4; ++i) {
+        const std::optional<TaskAssignment> lease = scheduler.LeaseTask("w");
+        ASSERT_TRUE(lease.has_value());
+        ASSERT_TRUE(scheduler.Complete(lease->lease_id, "w", HalvesResult(*lease)).ok());
+    }
+}
+
 TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     const std::string id = SubmitAdaptive(scheduler_, {.time_limit = 5, .max_spp = 1 << 10});
-    for (int i = 0; i < 4; ++i) {  // the first passes, each asking for a second
-        const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w");
-        ASSERT_TRUE(lease.has_value());
-        ASSERT_TRUE(scheduler_.Complete(lease->lease_id, "w", HalvesResult(*lease)).ok());
-    }
+    CompleteFirstPasses(scheduler_);  // each asking for a second
     const std::optional<TaskAssignment> running = scheduler_.LeaseTask("w");
     ASSERT_TRUE(running.has_value());
     EXPECT_EQ(running->task.sample_begin, 4u);
@@ -808,11 +813,7 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
 // from where it was on resume.
 TEST_F(SchedulerTest, TimeLimitClockStopsWhileTheJobIsPaused) {
     const std::string id = SubmitAdaptive(scheduler_, {.time_limit = 5, .max_spp = 1 << 10});
-    for (int i = 0; i < 4; ++i) {  // the first passes, each asking for a second
-        const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w");
-        ASSERT_TRUE(lease.has_value());
-        ASSERT_TRUE(scheduler_.Complete(lease->lease_id, "w", HalvesResult(*lease)).ok());
-    }
+    CompleteFirstPasses(scheduler_);                     // each asking for a second
     ASSERT_TRUE(scheduler_.LeaseTask("w").has_value());  // a second pass
     now_ += absl::Seconds(2);
     ASSERT_TRUE(scheduler_.SetPaused(id, true).ok());
