@@ -327,7 +327,11 @@ absl::StatusOr<bool> Scheduler::TakeUp(JobRecord record,
     absl::StatusOr<std::unique_ptr<Job>> made =
         Job::Make(std::move(record), options_.tile_stores, options_.speculate_after);
     if (!made.ok()) return made.status();
-    std::unique_ptr<Job> job = std::move(*made);
+    return TakeUp(std::move(*made), results);
+}
+
+absl::StatusOr<bool> Scheduler::TakeUp(std::unique_ptr<Job> job,
+                                       const std::map<int, JobStore::RecordedTask>& results) {
     job->paused_since = clock_();  // a paused job's clock stays stopped from here
     // In the order they merged, so an adaptive plan appends each pass before its result
     // comes up, and a shot gives each appended pass the index it had (its frames append
@@ -419,14 +423,16 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
             absl::StrCat("job ", job_id, " was requeued by another call meanwhile"));
     }
     if (absl::Status s = CheckActiveJobLimit("requeue"); !s.ok()) return s;
+    absl::StatusOr<std::unique_ptr<Job>> made =
+        Job::Make(std::move(*stored), options_.tile_stores, options_.speculate_after);
+    if (!made.ok()) return made.status();
     Requeued requeued;
     std::vector<int> dropped;  // tasks of the frames rendered again, their results removed
     if (frames) {
-        absl::StatusOr<std::unique_ptr<Job>> made =
-            Job::Make(*stored, options_.tile_stores, options_.speculate_after);
-        if (!made.ok()) return made.status();
         std::set<int> again;
         for (const auto& [t, result] : *results) {
+            // An index the plan lacks (a damaged store): TakeUp renders it again.
+            if (t < 0 || size_t(t) >= (*made)->execution->task_count()) continue;
             TaskStatus task;
             (*made)->execution->Describe(t, task);
             if (std::none_of(task.frames.begin(), task.frames.end(),
@@ -437,14 +443,14 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
             again.insert(task.frames.begin(), task.frames.end());  // a chunk's other frames too
         }
         for (int t : dropped) results->erase(t);
-        for (FrameProgress& frame : stored->frames) {
+        for (FrameProgress& frame : (*made)->record.frames) {
             if (frames->Contains(frame.frame) || again.count(frame.frame)) {
                 frame.result_path.clear();
                 requeued.frames.push_back(frame.frame);
             }
         }
     }
-    absl::StatusOr<bool> rendered = TakeUp(std::move(*stored), *results);
+    absl::StatusOr<bool> rendered = TakeUp(std::move(*made), *results);
     if (!rendered.ok()) return rendered.status();
     Job& job = *active_.at(job_id);
     Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued{}", job_id,

@@ -320,6 +320,9 @@ class Scheduler {
     // returns whether it is fully rendered.
     absl::StatusOr<bool> TakeUp(JobRecord record,
                                 const std::map<int, JobStore::RecordedTask>& results);
+    // The same with the job planned already (Job::Make).
+    absl::StatusOr<bool> TakeUp(std::unique_ptr<Job> job,
+                                const std::map<int, JobStore::RecordedTask>& results);
     std::optional<TaskAssignment> TryLease(const std::string& worker,
                                            const WorkerDescription* about);
     // Drops a job's tasks once its time limit has passed; true if dropping them completed the
