@@ -11,6 +11,7 @@
 #include "lf/client/farm_client.h"
 #include "lf/client/farm_flags.h"
 #include "lf/job/job_record.h"
+#include "lf/job/shot.h"
 #include "lf/wire/conversions.h"
 #include "lightfarm/v1/job_service.grpc.pb.h"
 
@@ -39,13 +40,34 @@ JobSubcommand AddJobSubcommand(CLI::App& app, const char* name, const char* help
 Command AddRequeueCommand(CLI::App& app) {
     auto [cmd, flags, id] = AddJobSubcommand(
         app, "requeue",
-        "Put a job's failed tasks back in the queue with their failures reset, and clear its\n"
-        "blocklist. A failed or cancelled job is queued again and renders on from the tasks it\n"
-        "had done (the job's owner or an admin).");
+        "Put a job's tasks back in the queue (the job's owner or an admin).\n"
+        "--failed (the default): its failed tasks, their failures reset, and its blocklist\n"
+        "cleared; a failed or cancelled job is queued again and renders on from the tasks it had\n"
+        "done. --frames A-B[:STEP]: those frames of an ended shot, a succeeded one too, are\n"
+        "rendered again from scratch (their EXRs dropped and written again), the job queued\n"
+        "until they are done.");
+    auto frames = std::make_shared<std::string>();
+    auto failed = std::make_shared<bool>(true);
+    // Names the default, and is captured below only to outlive the parse: the failed tasks are
+    // requeued whenever --frames is not given, and a job --frames takes up again has every
+    // task's failures reset too.
+    cmd->add_flag("--failed", *failed, "requeue the failed tasks (the default)");
+    cmd->add_option("--frames", *frames,
+                    "render these frames of an ended shot again (submit's --frames syntax; a "
+                    "chunk's other frames with them)")
+        ->type_name("A-B[:STEP]");
     return {
-        cmd, [flags, id] {
+        cmd, [flags, id, frames, failed] {
             pb::RequeueJobRequest req;
             req.set_job_id(*id);
+            if (!frames->empty()) {
+                absl::StatusOr<FrameRange> range = ParseFrameRange(*frames);
+                if (!range.ok()) {
+                    return ReportError(absl::InvalidArgumentError(
+                        absl::StrCat("--frames: ", range.status().message())));
+                }
+                req.set_frames(FrameRangeText(*range));
+            }
             pb::Job job;
             absl::Status s = FarmClient(*flags).Call(&pb::JobService::Stub::RequeueJob, req, &job);
             if (!s.ok()) return ReportError(s);

@@ -1,5 +1,6 @@
 #include "lf/core/log.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <mutex>
 
@@ -16,27 +17,24 @@ std::shared_ptr<spdlog::logger> NamedLogger(const std::string& name) {
 
 std::string LogSafe(std::string_view value, size_t max_bytes) {
     std::string out;
-    const std::string_view kept = value.substr(0, max_bytes);
-    out.reserve(kept.size());
-    for (const char c : kept) {
+    out.reserve(std::min(value.size(), max_bytes));
+    size_t used = 0;  // bytes of `value` escaped into `out`
+    for (; used < value.size(); ++used) {
+        const char c = value[used];
         const auto byte = static_cast<unsigned char>(c);
-        if (c == '\\') {
-            out += "\\\\";
-        } else if (c == '\n') {
-            out += "\\n";
-        } else if (c == '\r') {
-            out += "\\r";
-        } else if (c == '\t') {
-            out += "\\t";
+        char escaped[5] = {c, 0};
+        if (c == '\\' || c == '\n' || c == '\r' || c == '\t') {
+            escaped[0] = '\\';
+            escaped[1] = c == '\\' ? '\\' : c == '\n' ? 'n' : c == '\r' ? 'r' : 't';
         } else if (byte < 0x20 || byte >= 0x7f) {
-            char escaped[5];
             std::snprintf(escaped, sizeof(escaped), "\\x%02x", byte);
-            out += escaped;
-        } else {
-            out += c;
         }
+        const std::string_view piece(escaped);
+        // The bound is on the escaped text: a value of newlines stays as short as any other.
+        if (out.size() + piece.size() > max_bytes) break;
+        out += piece;
     }
-    if (kept.size() < value.size()) out += "...(" + std::to_string(value.size()) + " bytes)";
+    if (used < value.size()) out += "...(" + std::to_string(value.size()) + " bytes)";
     return out;
 }
 

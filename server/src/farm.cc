@@ -98,18 +98,13 @@ Farm::Farm(const FarmOptions& options, std::unique_ptr<BlobStore> blobs,
       store_(std::move(store)),
       logs_(std::move(logs)),
       scheduler_(WithTileFiles(options.scheduler, options.data_dir), *store_) {
-    scheduler_.OnTasksEnded([this](const std::string& job_id, std::vector<TaskStatus> tasks) {
+    scheduler_.OnTasksEnded([this](const JobRecord& ended, std::vector<TaskStatus> tasks) {
         // The job has ended either way: `lightfarm tasks` then lists none of its tasks.
-        if (absl::Status s = logs_->RecordTasks(job_id, tasks); !s.ok()) {
-            Log()->error("job={} tasks not recorded: {}", job_id, std::string(s.message()));
+        if (absl::Status s = logs_->RecordTasks(ended.id, tasks); !s.ok()) {
+            Log()->error("job={} tasks not recorded: {}", ended.id, std::string(s.message()));
         }
-        if (!notifier_) return;
-        // The final record is durable by now: read from the store, outside the scheduler's lock.
-        if (absl::StatusOr<JobRecord> job = scheduler_.Get(job_id); job.ok()) {
-            notifier_->JobEnded(*job);
-        } else {
-            Log()->error("job={} not notified: {}", job_id, std::string(job.status().message()));
-        }
+        // The record it ended with: read again, a job requeued meanwhile would be queued.
+        if (notifier_) notifier_->JobEnded(ended);
     });
 }
 
@@ -621,8 +616,13 @@ absl::StatusOr<std::vector<WorkerStatus>> Farm::SetWorkerState(const std::string
             absl::StrCat("no worker named ", LogSafe(name_or_id, 128),
                          " nor with that id (lightfarm workers lists them)"));
     }
-    if (absl::Status s = worker_states_->Put(*key, control); !s.ok()) return s;
-    scheduler_.SetWorkerControl(*key, control);
+    {
+        // The store and the scheduler in the same order for every caller: two concurrent
+        // changes of one worker leave both holding the later one.
+        std::lock_guard<std::mutex> one_change(worker_control_changes_);
+        if (absl::Status s = worker_states_->Put(*key, control); !s.ok()) return s;
+        scheduler_.SetWorkerControl(*key, control);
+    }
     std::vector<WorkerStatus> named = scheduler_.Workers();
     std::erase_if(named,
                   [&](const WorkerStatus& w) { return (w.name.empty() ? w.id : w.name) != *key; });
@@ -637,10 +637,17 @@ absl::StatusOr<JobRecord> Farm::SetPriority(const std::string& job_id, int prior
 
 namespace lf {
 
-absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id) {
+absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id,
+                                        const std::optional<FrameRange>& frames) {
     std::lock_guard<std::mutex> one_change(ended_job_changes_);
-    absl::StatusOr<Scheduler::Requeued> requeued = scheduler_.RequeueJob(job_id);
+    absl::StatusOr<Scheduler::Requeued> requeued =
+        frames ? scheduler_.RequeueFrames(job_id, *frames) : scheduler_.RequeueJob(job_id);
     if (!requeued.ok()) return requeued.status();
+    // No longer recorded: removed, so that nothing serves the old EXR under the frame's name.
+    for (int frame : requeued->frames) {
+        std::error_code ignored;  // a frame whose EXR was never written
+        fs::remove(FramePathOf("results", job_id, frame), ignored);
+    }
     if (requeued->rendered) FinishJob(job_id);
     return requeued->record;
 }

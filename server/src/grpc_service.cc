@@ -441,9 +441,26 @@ grpc::Status JobServiceImpl::RequeueJob(grpc::ServerContext* context, const Call
     if (absl::StatusOr<JobRecord> seen = VisibleJob(caller, req.job_id()); !seen.ok()) {
         return ToGrpcStatus(seen.status());
     }
-    absl::StatusOr<JobRecord> job = farm_.Requeue(req.job_id());
+    std::optional<FrameRange> frames;
+    if (!req.frames().empty()) {
+        // Echoed in the error: bounded first ("-1000000--1000000:1000000" is the longest range).
+        constexpr size_t kMaxRangeText = 64;
+        absl::StatusOr<FrameRange> range =
+            req.frames().size() > kMaxRangeText
+                ? absl::InvalidArgumentError(
+                      absl::StrCat(req.frames().size(), " bytes, not a range A-B[:STEP]"))
+                : ParseFrameRange(req.frames());
+        if (!range.ok()) {
+            return ToGrpcStatus(
+                absl::InvalidArgumentError(absl::StrCat("frames: ", range.status().message())));
+        }
+        frames = *range;
+    }
+    absl::StatusOr<JobRecord> job = farm_.Requeue(req.job_id(), frames);
     if (!job.ok()) return ToGrpcStatus(job.status());
-    Log()->info("job={} requeued by {} from {}", job->id, Who(caller), Peer(context));
+    Log()->info("job={} requeued{} by {} from {}", job->id,
+                frames ? " (frames " + FrameRangeText(*frames) + ")" : "", Who(caller),
+                Peer(context));
     ToProto(*job, resp);
     return grpc::Status::OK;
 }

@@ -27,15 +27,19 @@ absl::Status TransitionJob(JobRecord& job, JobState to, absl::Time now) {
     return absl::OkStatus();
 }
 
-absl::Status ReopenJob(JobRecord& job) {
-    if (job.state != JobState::kFailed && job.state != JobState::kCancelled) {
+absl::Status ReopenJob(JobRecord& job, bool succeeded_too) {
+    const bool succeeded = job.state == JobState::kSucceeded;
+    if (job.state != JobState::kFailed && job.state != JobState::kCancelled &&
+        !(succeeded && succeeded_too)) {
         return absl::FailedPreconditionError(absl::StrCat(
             "job ", job.id, " is ", JobStateName(job.state),
             ": only a failed or cancelled job is queued again (a queued or running one has its "
-            "failed tasks requeued)"));
+            "failed tasks requeued; a succeeded shot has chosen frames rendered again with "
+            "--frames)"));
     }
     job.state = JobState::kQueued;
     job.error.clear();
+    job.result_path.clear();
     // It starts again at its next lease: an adaptive job's time limit counts from there.
     job.started = job.finished = absl::InfinitePast();
     return absl::OkStatus();

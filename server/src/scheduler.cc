@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <set>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -31,6 +32,45 @@ absl::Status AlreadyEnded(const JobRecord& record) {
         absl::StrCat("job ", record.id, " has already ended (", JobStateName(record.state), ")"));
 }
 
+// Unavailable for a job whose final record is not durable yet.
+absl::Status JustEnded(const std::string& job_id) {
+    return absl::UnavailableError(absl::StrCat(
+        "job ", job_id,
+        " has just ended and its record is not in the store yet; requeue it again in a moment"));
+}
+
+// `requeue --frames`: InvalidArgument for a still or frames outside the shot, naming them;
+// FailedPrecondition for an adaptive shot (its passes take task indices in the order they merged,
+// so some frames' results cannot be dropped and the rest merged again as recorded).
+absl::Status CheckRequeuedFrames(const JobRecord& job, const FrameRange& frames) {
+    const std::string what = absl::StrCat("--frames ", FrameRangeText(frames), ": ");
+    const std::optional<FrameRange>& shot = job.spec.shot.frames;
+    if (!shot) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            what, "job ", job.id, " is a still image; --frames applies to a shot's frames"));
+    }
+    std::vector<int> outside;
+    for (int i = 0; i < frames.count(); ++i) {
+        if (!shot->Contains(frames.at(i))) outside.push_back(frames.at(i));
+    }
+    if (!outside.empty()) {
+        constexpr size_t kNamed = 10;
+        const std::string named = outside.size() == 1 ? "frame " : "frames ";
+        const std::string more =
+            outside.size() > kNamed ? absl::StrCat(" and ", outside.size() - kNamed, " more") : "";
+        outside.resize(std::min(outside.size(), kNamed));
+        return absl::InvalidArgumentError(absl::StrCat(what, named, absl::StrJoin(outside, ", "),
+                                                       more, " not in job ", job.id, "'s shot (",
+                                                       FrameRangeText(*shot), ")"));
+    }
+    if (IsAdaptive(job.spec.adaptive)) {
+        return absl::FailedPreconditionError(
+            absl::StrCat(what, "job ", job.id,
+                         " samples adaptively: its frames cannot be rendered again alone"));
+    }
+    return absl::OkStatus();
+}
+
 }  // namespace
 
 Scheduler::Scheduler(SchedulerOptions options, JobStore& store, Clock clock)
@@ -46,12 +86,12 @@ Scheduler::Locked::~Locked() {
     if (!scheduler_.ended_.has_unsettled()) return;
     // Taken with the jobs SettleEnded waits for: their tasks are handed on once they are durable
     // (or logged as not recorded), with the lock released for the callback to write.
-    std::vector<std::pair<std::string, std::vector<TaskStatus>>> tasks;
+    std::vector<std::pair<JobRecord, std::vector<TaskStatus>>> tasks;
     tasks.swap(scheduler_.ended_tasks_);
     SettleEnded();
     lock.unlock();
     if (!scheduler_.tasks_ended_) return;
-    for (auto& [id, statuses] : tasks) scheduler_.tasks_ended_(id, std::move(statuses));
+    for (auto& [record, statuses] : tasks) scheduler_.tasks_ended_(record, std::move(statuses));
 }
 
 void Scheduler::Locked::SettleEnded() {
@@ -100,12 +140,7 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
                     LogSafe(spec.request_id));
         return (*earlier)->first;
     }
-    if (active_.size() >= options_.max_active_jobs) {
-        return absl::ResourceExhaustedError(
-            absl::StrCat(active_.size(),
-                         " jobs are queued or running, this server's limit "
-                         "(lightfarm-server --max-active-jobs); submit again once some end"));
-    }
+    if (absl::Status s = CheckActiveJobLimit("submit"); !s.ok()) return s;
     // Ids are random: one the store lacks is taken in memory only by a freak.
     while (active_.count(id) || ended_.Find(id)) id = NewJobId();
     job->record.id = id;
@@ -126,6 +161,14 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     }
     Log()->info("job={} queued: {}, priority {}", id, summary, spec.priority);
     return id;
+}
+
+absl::Status Scheduler::CheckActiveJobLimit(const char* action) const {
+    if (active_.size() < options_.max_active_jobs) return absl::OkStatus();
+    return absl::ResourceExhaustedError(absl::StrCat(
+        active_.size(),
+        " jobs are queued or running, this server's limit (lightfarm-server --max-active-jobs); ",
+        action, " again once some end"));
 }
 
 absl::StatusOr<std::optional<std::pair<std::string, uint64_t>>> Scheduler::FindRequest(
@@ -310,7 +353,12 @@ absl::StatusOr<bool> Scheduler::TakeUp(JobRecord record,
     absl::StatusOr<std::unique_ptr<Job>> made =
         Job::Make(std::move(record), options_.tile_stores, options_.speculate_after);
     if (!made.ok()) return made.status();
-    std::unique_ptr<Job> job = std::move(*made);
+    return TakeUp(std::move(*made), results);
+}
+
+absl::StatusOr<bool> Scheduler::TakeUp(std::unique_ptr<Job> job,
+                                       const std::map<int, JobStore::RecordedTask>& results) {
+    job->paused_since = clock_();  // a paused job's clock stays stopped from here
     // In the order they merged, so an adaptive plan appends each pass before its result
     // comes up, and a shot gives each appended pass the index it had (its frames append
     // in the order their results merged, not in index order).
@@ -362,17 +410,35 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
             if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
             return requeued;
         }
-        if (ended_.Find(job_id)) {
-            return absl::UnavailableError(
-                absl::StrCat("job ", job_id,
-                             " has just ended and its record is not in the store yet; requeue "
-                             "it again in a moment"));
-        }
+        if (ended_.Find(job_id)) return JustEnded(job_id);
     }
+    return Reopen(job_id, std::nullopt);
+}
+
+absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueFrames(const std::string& job_id,
+                                                             const FrameRange& frames) {
+    {
+        Locked locked(*this);
+        if (active_.count(job_id)) {
+            return absl::FailedPreconditionError(absl::StrCat(
+                "job ", job_id,
+                " is queued or running: --frames renders frames of an ended job again (cancel "
+                "it first, or wait for it to end)"));
+        }
+        if (ended_.Find(job_id)) return JustEnded(job_id);
+    }
+    return Reopen(job_id, frames);
+}
+
+absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
+                                                      const std::optional<FrameRange>& frames) {
     // The store is read without the lock.
     absl::StatusOr<JobRecord> stored = store_.Get(job_id);
     if (!stored.ok()) return stored.status();
-    if (absl::Status s = ReopenJob(*stored); !s.ok()) return s;
+    if (frames) {
+        if (absl::Status s = CheckRequeuedFrames(*stored, *frames); !s.ok()) return s;
+    }
+    if (absl::Status s = ReopenJob(*stored, frames.has_value()); !s.ok()) return s;
     absl::StatusOr<std::map<int, JobStore::RecordedTask>> results = store_.TaskResults(job_id);
     if (!results.ok()) return results.status();
     stored->worker_failures.clear();
@@ -385,18 +451,48 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
         return absl::AbortedError(
             absl::StrCat("job ", job_id, " was requeued by another call meanwhile"));
     }
-    absl::StatusOr<bool> rendered = TakeUp(std::move(*stored), *results);
+    if (absl::Status s = CheckActiveJobLimit("requeue"); !s.ok()) return s;
+    absl::StatusOr<std::unique_ptr<Job>> made =
+        Job::Make(std::move(*stored), options_.tile_stores, options_.speculate_after);
+    if (!made.ok()) return made.status();
+    Requeued requeued;
+    std::vector<int> dropped;  // tasks of the frames rendered again, their results removed
+    if (frames) {
+        std::set<int> again;
+        for (const auto& [t, result] : *results) {
+            // An index the plan lacks (a damaged store): TakeUp renders it again.
+            if (t < 0 || size_t(t) >= (*made)->execution->task_count()) continue;
+            TaskStatus task;
+            (*made)->execution->Describe(t, task);
+            if (std::none_of(task.frames.begin(), task.frames.end(),
+                             [&](int f) { return frames->Contains(f); })) {
+                continue;
+            }
+            dropped.push_back(t);
+            again.insert(task.frames.begin(), task.frames.end());  // a chunk's other frames too
+        }
+        for (int t : dropped) results->erase(t);
+        for (FrameProgress& frame : (*made)->record.frames) {
+            if (frames->Contains(frame.frame) || again.count(frame.frame)) {
+                frame.result_path.clear();
+                requeued.frames.push_back(frame.frame);
+            }
+        }
+    }
+    absl::StatusOr<bool> rendered = TakeUp(std::move(*made), *results);
     if (!rendered.ok()) return rendered.status();
     Job& job = *active_.at(job_id);
-    Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued", job_id,
-                job.record.tasks_done, job.record.tasks_total);
+    Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued{}", job_id,
+                job.record.tasks_done, job.record.tasks_total,
+                frames ? absl::StrCat(" (frames ", FrameRangeText(*frames), " again)") : "");
     // A dependency still failed or cancelled fails it again: requeue that one first.
     if (FailIfDependencyEnded(job, *after)) {
-        const JobRecord* failed = ended_.Find(job_id);
-        return Requeued{*failed, false};
+        requeued.record = *ended_.Find(job_id);
+        return requeued;
     }
-    const uint64_t ticket = Save(job);
-    Requeued requeued{job.record, *rendered};
+    const uint64_t ticket = Save(job, dropped);
+    requeued.record = job.record;
+    requeued.rendered = *rendered;
     locked.lock.unlock();
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
     return requeued;
@@ -511,8 +607,9 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
 }
 
 bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
+    if (job.record.paused) return false;  // its clock is stopped
     const std::optional<std::vector<int>> dropped =
-        job.execution->EnforceTimeLimit(job.record.started, now);
+        job.execution->EnforceTimeLimit(job.record.started + job.paused_for, now);
     if (!dropped) return false;
     for (int t : *dropped) {
         leases_.EndTask(job.id(), t);
@@ -833,10 +930,12 @@ void Scheduler::FailJob(Job& job, const std::string& error) {
 
 JobRecord Scheduler::EndJob(Job& job) {
     const std::string id = job.record.id;
-    ended_tasks_.emplace_back(id, job.Statuses(leases_, clock_()));
+    job.record.paused = false;  // an ended job is cancelled, failed or succeeded, not paused
+    std::vector<TaskStatus> statuses = job.Statuses(leases_, clock_());
     leases_.ForgetJob(id);
     const uint64_t ticket = Save(job);
     JobRecord record = job.record;
+    ended_tasks_.emplace_back(record, std::move(statuses));
     active_.erase(id);  // destroys `job`
     const std::optional<std::string> why =
         DependencyFailure({record.id, record.state, record.error});
@@ -988,6 +1087,9 @@ absl::StatusOr<JobRecord> Scheduler::SetPaused(const std::string& job_id, bool p
         absl::StatusOr<Job*> job = ActiveJob(job_id, locked);
         if (!job.ok()) return job.status();
         Log()->info("job={} {}", job_id, paused ? "paused" : "resumed");
+        const absl::Time now = clock_();
+        if (paused && !(*job)->record.paused) (*job)->paused_since = now;
+        if (!paused && (*job)->record.paused) (*job)->paused_for += now - (*job)->paused_since;
         (*job)->record.paused = paused;
         ticket = Save(**job);
         record = (*job)->record;
@@ -1163,10 +1265,12 @@ void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::stri
     EndJob(job);
 }
 
-uint64_t Scheduler::Save(Job& job) {
+uint64_t Scheduler::Save(Job& job, const std::vector<int>& drop_results) {
     // Derived, so that the record cannot disagree with the execution and the task states.
     job.Sync();
-    const uint64_t ticket = store_.QueuePut(job.record);
+    const uint64_t ticket = drop_results.empty()
+                                ? store_.QueuePut(job.record)
+                                : store_.QueuePutDropping(job.record, drop_results);
     ++version_;
     changed_.notify_all();
     return ticket;

@@ -156,7 +156,7 @@ SqliteJobStore::Write SqliteJobStore::PutOf(const JobRecord& job) {
     Write w{job.id};
     w.seq = job.seq;
     w.final = IsFinal(job.state);
-    w.drop_results = job.state == JobState::kSucceeded;
+    w.drop_results = job.state == JobState::kSucceeded && !job.spec.shot.frames;
     w.request_id = job.spec.request_id;
     if (w.final && job.finished != absl::InfinitePast()) {
         w.finished_us = absl::ToUnixMicros(job.finished);
@@ -177,6 +177,12 @@ uint64_t SqliteJobStore::QueueTaskDone(const JobRecord& job, int task, std::stri
     w.result = std::move(result);
     w.history = EncodeTaskHistory(history);
     w.done = history;
+    return Queue(std::move(w));
+}
+
+uint64_t SqliteJobStore::QueuePutDropping(const JobRecord& job, const std::vector<int>& tasks) {
+    Write w = PutOf(job);
+    w.drop_tasks = tasks;
     return Queue(std::move(w));
 }
 
@@ -257,6 +263,11 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
             put.Bind(4, w.history).Step();
             status = put.status();
             if (status.ok()) status = RecordTaskStats(w);
+        }
+        for (size_t k = 0; k < w.drop_tasks.size() && status.ok(); ++k) {
+            Statement drop(db_, "DELETE FROM task_results WHERE job = ?1 AND task = ?2");
+            drop.Bind(1, w.job_id).Bind(2, int64_t(w.drop_tasks[k])).Step();
+            status = drop.status();
         }
         if (!status.ok() || newest[w.job_id] != i) continue;
         // An upsert by id, not INSERT OR REPLACE: a clash of request ids must fail, not delete

@@ -1656,6 +1656,33 @@ TEST_F(Farm, AShotInChunksSurvivesAKilledWorkerAndARestartAndGivesRendersBits) {
     ExpectFramesAsRendered(job, {1, 2, 3, 4, 5, 6, 7, 8}, "1-8", flags);
 }
 
+// `lightfarm requeue --frames`: a succeeded shot's frame is rendered again from scratch, the
+// requeue surviving a coordinator restart before any worker takes it, to the bits of a local
+// render; frames outside the shot are refused, naming them.
+TEST_F(Farm, RequeuedFrameOfASucceededShotRendersAgainAfterARestartToRendersBits) {
+    StartServer();
+    Child* first = StartWorker("first");
+    const std::string flags = std::string(kShotFlags) + " --spp 4 --tile 32";
+    const std::string job = Submit(ShotScene(), "--frames 1-3 " + flags);
+    const CliRun watch = Farmctl("watch " + job, 120);
+    ASSERT_EQ(watch.status, 0) << watch.out << watch.err;
+    first->Signal(SIGTERM);
+    ASSERT_TRUE(first->Wait(milliseconds(10000)));
+    const CliRun outside = Farmctl("requeue " + job + " --frames 3-5");
+    EXPECT_NE(outside.status, 0);
+    EXPECT_NE(outside.err.find("frames 4, 5 not in job"), std::string::npos) << outside.err;
+    const CliRun requeued = Farmctl("requeue " + job + " --failed --frames 2");
+    ASSERT_EQ(requeued.status, 0) << requeued.err;
+    EXPECT_EQ(requeued.out.rfind("job " + job + " queued (", 0), 0u) << requeued.out;
+    CrashAndRestartServer();
+    EXPECT_NE(Farmctl("status " + job).out.find(": queued"), std::string::npos);
+    StartWorker("second");
+    const CliRun again = Farmctl("watch " + job, 120);
+    ASSERT_EQ(again.status, 0) << again.out << again.err;
+    EXPECT_NE(again.out.find("3/3 frames"), std::string::npos) << again.out;
+    ExpectFramesAsRendered(job, {1, 2, 3}, "1-3", flags);
+}
+
 TEST_F(Farm, ACancelledShotKeepsItsFinishedFramesFetchable) {
     StartServer();
     StartWorker("w1");

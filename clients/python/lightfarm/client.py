@@ -424,11 +424,17 @@ class Client:
             "SetJobPriority", pb.SetJobPriorityRequest(job_id=job_id, priority=priority)))
 
     # Job management (issue 30).
-    def requeue(self, job_id: str) -> Job:
-        """Puts the job's failed tasks back in the queue with their failures reset and clears
-        its blocklist; a failed or cancelled job is queued again and renders on from the tasks it
-        had done (``lightfarm requeue``). FailedPrecondition for a succeeded job."""
-        return Job.from_proto(self._unary("RequeueJob", pb.RequeueJobRequest(job_id=job_id)))
+    def requeue(self, job_id: str, frames: Optional[str] = None, failed: bool = True) -> Job:
+        """``lightfarm requeue``. With ``failed`` (the default) and no ``frames``: puts the job's
+        failed tasks back in the queue with their failures reset and clears its blocklist; a
+        failed or cancelled job is queued again and renders on from the tasks it had done
+        (FailedPrecondition for a succeeded job). ``frames`` ("A-B[:STEP]", submit's --frames
+        syntax): those frames of an ended shot, a succeeded one too, are rendered again from
+        scratch; InvalidArgument for frames outside the shot or a still."""
+        if frames is None and not failed:
+            raise ValueError("requeue: nothing to requeue (failed=False and no frames)")
+        return Job.from_proto(self._unary(
+            "RequeueJob", pb.RequeueJobRequest(job_id=job_id, frames=frames or "")))
 
     def pause(self, job_id: str) -> Job:
         """Pauses a queued or running job: it leases nothing new, its running tasks finish

@@ -683,6 +683,21 @@ class ClientTest(unittest.TestCase):
         with self.assertRaises(lightfarm.InvalidArgument):
             self.alice.stats(since=datetime.datetime(2999, 1, 1))
 
+    def test_requeue_frames(self):
+        """requeue(frames=...): a succeeded shot's frame rendered again, and it succeeds again;
+        a frame outside the shot is refused, naming it; failed=False alone requeues nothing."""
+        ball = os.path.join(SCENES, "shots", "moving_ball.json")
+        job_id = self.alice.submit(ball, frames="2-6:2", spp=2, resolution=(32, 18), tile=16)
+        self.assertEqual(self.alice.wait(job_id).state, lightfarm.JobState.SUCCEEDED)
+        job = self.alice.requeue(job_id, frames="4")
+        self.assertEqual(job.state, lightfarm.JobState.QUEUED)
+        self.assertEqual(self.alice.wait(job_id).state, lightfarm.JobState.SUCCEEDED)
+        with self.assertRaises(lightfarm.InvalidArgument) as caught:
+            self.alice.requeue(job_id, frames="5")
+        self.assertIn("frame 5 not in job", caught.exception.message)
+        with self.assertRaises(ValueError):
+            self.alice.requeue(job_id, failed=False)
+
     def test_shot_submit_and_fetch_frames(self):
         """A shot submitted with frames, fps and shutter; fetch_frames writes each finished
         frame as `lightfarm fetch -o out_####.exr` does, byte for byte."""

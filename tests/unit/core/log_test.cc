@@ -21,6 +21,11 @@ TEST(LogSafeTest, LongValueIsCutAndSaysItsLength) {
     const std::string safe = LogSafe(huge, 16);
     EXPECT_EQ(safe, std::string(16, 'x') + "...(2097152 bytes)");
     EXPECT_EQ(LogSafe("short", 16), "short");
+    // The bound is on the escaped text, so escapes do not stretch it.
+    std::string eight_newlines;
+    for (int i = 0; i < 8; ++i) eight_newlines += "\\n";
+    EXPECT_EQ(LogSafe(std::string(100, '\n'), 16), eight_newlines + "...(100 bytes)");
+    EXPECT_EQ(LogSafe("ab\x01", 5), "ab...(3 bytes)") << "an escape is never cut in half";
 }
 
 }  // namespace

@@ -24,8 +24,8 @@
 #include "lf/core/log.h"
 #include "lf/core/tile_codec.h"
 #include "lf/job/digest.h"
-#include "lf/version.h"
 #include "lf/server/grpc_service.h"
+#include "lf/version.h"
 #include "test_dir.h"
 
 namespace lf {
@@ -270,6 +270,63 @@ TEST_F(FakeWorkerFarm, CorruptAndWrongSizedResultsAreRefusedAndTheTaskRequeued) 
     // The first honest lease above expires unheard; everything is rendered again honestly.
     RenderHonestly(job);
     ExpectSameAsHonest(job);
+}
+
+// A worker's failure reason is kept with the task, as the job's last error and in its
+// blocklist, saved with every record write and printed by the CLI: a reason near the request
+// limit, with newlines, is kept as one escaped line of at most 1 KiB in each.
+TEST_F(FakeWorkerFarm, AHugeFailureReasonIsKeptAsOneBoundedLine) {
+    const std::string job = Submit();
+    const pb::Task task = *Lease("flaky");
+    std::string reason;
+    while (reason.size() < (size_t(4) << 20) - 4096) reason += "out of memory\nat line 7\n";
+    pb::FailTaskRequest request;
+    request.set_lease_id(task.lease_id());
+    request.set_worker_id("flaky");
+    request.set_reason(reason);
+    pb::FailTaskResponse response;
+    grpc::ClientContext context;
+    ASSERT_TRUE(worker_stub_->FailTask(&context, request, &response).ok());
+
+    const absl::StatusOr<JobRecord> record = farm_->scheduler().Get(job);
+    ASSERT_TRUE(record.ok()) << record.status();
+    ASSERT_EQ(record->worker_failures.size(), 1u);
+    const std::optional<std::vector<TaskStatus>> tasks = farm_->scheduler().Tasks(job);
+    ASSERT_TRUE(tasks.has_value());
+    const std::string task_error = (*tasks)[size_t(task.task_index())].last_error;
+    // Each as the scheduler words it: the reason with a short prefix or suffix.
+    for (const std::string* kept :
+         {&task_error, &record->last_error, &record->worker_failures[0].last_error}) {
+        EXPECT_EQ(kept->find('\n'), std::string::npos) << *kept;
+        EXPECT_NE(kept->find("out of memory"), std::string::npos);
+        EXPECT_LE(kept->size(), 1024u + 64) << kept->substr(0, 80);
+    }
+    EXPECT_EQ(GetJob(job).last_error().size(), record->last_error.size());
+}
+
+// RequeueJob's frames: parsed as submit's --frames, each refusal naming what was wrong.
+TEST_F(FakeWorkerFarm, RequeueJobFramesAreCheckedAndNamedInTheError) {
+    const std::string job = Submit();
+    RenderHonestly(job);
+    const auto requeue = [&](const std::string& frames) {
+        pb::RequeueJobRequest request;
+        request.set_job_id(job);
+        request.set_frames(frames);
+        pb::Job response;
+        grpc::ClientContext context;
+        return job_stub_->RequeueJob(&context, request, &response);
+    };
+    const grpc::Status reversed = requeue("5-2");
+    EXPECT_EQ(reversed.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(reversed.error_message().rfind("frames: ", 0), 0u) << reversed.error_message();
+    const grpc::Status huge = requeue(std::string(1 << 20, '7'));
+    EXPECT_EQ(huge.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_LT(huge.error_message().size(), 200u);
+    const grpc::Status still = requeue("1-2");
+    EXPECT_EQ(still.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(still.error_message().find("still image"), std::string::npos)
+        << still.error_message();
+    EXPECT_EQ(GetJob(job).state(), pb::Job::SUCCEEDED);
 }
 
 // A bound on the wait for a task to be leased again (after a 500 ms lease, or 300 ms of

@@ -11,8 +11,10 @@ namespace {
 class SchedulerTasksTest : public ::testing::Test {
   protected:
     SchedulerTasksTest() : scheduler_(SchedulerOptions{}, store_, [this] { return now_; }) {
-        scheduler_.OnTasksEnded([this](const std::string& id, std::vector<TaskStatus> tasks) {
-            ended_[id] = std::move(tasks);
+        scheduler_.OnTasksEnded([this](const JobRecord& ended, std::vector<TaskStatus> tasks) {
+            ended_[ended.id] = std::move(tasks);
+            if (requeue_when_ended_) ASSERT_TRUE(scheduler_.RequeueJob(ended.id).ok());
+            ended_states_[ended.id] = ended.state;
         });
     }
 
@@ -40,6 +42,8 @@ class SchedulerTasksTest : public ::testing::Test {
     InMemoryJobStore store_;
     Scheduler scheduler_;
     std::map<std::string, std::vector<TaskStatus>> ended_;
+    std::map<std::string, JobState> ended_states_;  // of the record handed on
+    bool requeue_when_ended_ = false;
 };
 
 TEST_F(SchedulerTasksTest, ShowsEachTasksStateRectangleHolderTimesAndLastError) {
@@ -143,6 +147,17 @@ TEST_F(SchedulerTasksTest, AFailedJobsTasksKeepTheFailingTasksLastError) {
     EXPECT_EQ(ended_[id][0].failures, 3);
     EXPECT_EQ(ended_[id][0].attempts, 3);
     EXPECT_EQ(ended_[id][0].last_error, "bad scene (worker a)");
+}
+
+// The notifier's record (Farm passes it on): the one the job ended with, even when the job was
+// requeued before the callback looked at it.
+TEST_F(SchedulerTasksTest, TheEndedRecordIsTheOneTheJobEndedWithThoughRequeuedAtOnce) {
+    requeue_when_ended_ = true;
+    const std::string id = Submit();
+    ASSERT_TRUE(scheduler_.Cancel(id).ok());
+    ASSERT_EQ(ended_states_.count(id), 1u);
+    EXPECT_EQ(ended_states_[id], JobState::kCancelled);
+    EXPECT_EQ(scheduler_.Get(id)->state, JobState::kQueued);  // requeued meanwhile
 }
 
 }  // namespace

@@ -346,6 +346,44 @@ TEST_F(JobManagementTest, RequeuedFailedJobIsQueuedAgainAndRenders) {
     EXPECT_EQ(Job(id).state, JobState::kSucceeded);
 }
 
+TEST_F(JobManagementTest, RequeueOfAnEndedJobRespectsTheActiveJobLimit) {
+    SchedulerOptions options = Options();
+    options.max_active_jobs = 1;
+    InMemoryJobStore store;
+    Scheduler limited(options, store, [this] { return now_; });
+    JobSpec spec;
+    spec.name = "limited";
+    spec.plan = {16, 16, 1, 8, 1};
+    spec.max_attempts = 1;
+    const absl::StatusOr<std::string> failed = limited.Submit(spec);
+    ASSERT_TRUE(failed.ok()) << failed.status();
+    const std::optional<TaskAssignment> lease = limited.LeaseTask("w");
+    ASSERT_TRUE(lease.has_value());
+    ASSERT_TRUE(limited.Fail(lease->lease_id, "w", "out of memory", FailureKind::kTaskError).ok());
+    ASSERT_EQ(limited.Get(*failed)->state, JobState::kFailed);
+    const absl::StatusOr<std::string> other = limited.Submit(spec);  // the one job allowed
+    ASSERT_TRUE(other.ok()) << other.status();
+    const absl::StatusOr<Scheduler::Requeued> refused = limited.RequeueJob(*failed);
+    EXPECT_EQ(refused.status().code(), absl::StatusCode::kResourceExhausted) << refused.status();
+    EXPECT_NE(refused.status().message().find("--max-active-jobs"), std::string::npos);
+    EXPECT_EQ(limited.Get(*failed)->state, JobState::kFailed);
+    EXPECT_EQ(store.Get(*failed)->state, JobState::kFailed);
+    ASSERT_TRUE(limited.Cancel(*other).ok());
+    EXPECT_TRUE(limited.RequeueJob(*failed).ok());
+    EXPECT_EQ(limited.Get(*failed)->state, JobState::kQueued);
+}
+
+TEST_F(JobManagementTest, APausedJobThatIsCancelledIsCancelledNotPaused) {
+    const std::string id = SubmitWith(3, 3);
+    ASSERT_TRUE(scheduler_.SetPaused(id, true).ok());
+    absl::StatusOr<JobRecord> cancelled = scheduler_.Cancel(id);
+    ASSERT_TRUE(cancelled.ok()) << cancelled.status();
+    EXPECT_EQ(cancelled->state, JobState::kCancelled);
+    EXPECT_FALSE(cancelled->paused);
+    EXPECT_FALSE(Job(id).paused);
+    EXPECT_FALSE(store_.Get(id)->paused);
+}
+
 TEST_F(JobManagementTest, PausedJobLeasesNothingNewButItsRunningTasksMerge) {
     const std::string id = SubmitWith(3, 3);
     const TaskAssignment running = *scheduler_.LeaseTask("w");
@@ -736,13 +774,18 @@ TEST_F(SchedulerTest, AdaptiveJobQueuesPassesOnlyForTheTileAboveTheTarget) {
     EXPECT_EQ((*snapshot->image.FindChannel("spp"))[15 * 16 + 15], 64.0f);
 }
 
+// An adaptive job's four first passes (SubmitAdaptive) leased and merged with HalvesResult.
+void CompleteFirstPasses(Scheduler& scheduler) {
+    for (int i = 0; i < 4; ++i) {
+        const std::optional<TaskAssignment> lease = scheduler.LeaseTask("w");
+        ASSERT_TRUE(lease.has_value());
+        ASSERT_TRUE(scheduler.Complete(lease->lease_id, "w", HalvesResult(*lease)).ok());
+    }
+}
+
 TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     const std::string id = SubmitAdaptive(scheduler_, {.time_limit = 5, .max_spp = 1 << 10});
-    for (int i = 0; i < 4; ++i) {  // the first passes, each asking for a second
-        const std::optional<TaskAssignment> lease = scheduler_.LeaseTask("w");
-        ASSERT_TRUE(lease.has_value());
-        ASSERT_TRUE(scheduler_.Complete(lease->lease_id, "w", HalvesResult(*lease)).ok());
-    }
+    CompleteFirstPasses(scheduler_);  // each asking for a second
     const std::optional<TaskAssignment> running = scheduler_.LeaseTask("w");
     ASSERT_TRUE(running.has_value());
     EXPECT_EQ(running->task.sample_begin, 4u);
@@ -764,6 +807,23 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     ASSERT_TRUE(snapshot.ok());
     EXPECT_TRUE(snapshot->adaptive->timed_out);
     EXPECT_EQ(snapshot->adaptive->max_spp, 4u);
+}
+
+// A paused job's time limit does not run out while it is paused: the clock stops and goes on
+// from where it was on resume.
+TEST_F(SchedulerTest, TimeLimitClockStopsWhileTheJobIsPaused) {
+    const std::string id = SubmitAdaptive(scheduler_, {.time_limit = 5, .max_spp = 1 << 10});
+    CompleteFirstPasses(scheduler_);                     // each asking for a second
+    ASSERT_TRUE(scheduler_.LeaseTask("w").has_value());  // a second pass
+    now_ += absl::Seconds(2);
+    ASSERT_TRUE(scheduler_.SetPaused(id, true).ok());
+    now_ += absl::Seconds(10);
+    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty()) << "ran out while paused";
+    ASSERT_TRUE(scheduler_.SetPaused(id, false).ok());
+    now_ += absl::Seconds(2);  // 4 s of the 5 run
+    EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
+    now_ += absl::Seconds(1);
+    EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
 }
 
 // A job its last result completed is reported by Complete, and not again by the time limit.

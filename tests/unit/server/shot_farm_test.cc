@@ -303,5 +303,76 @@ TEST_F(ShotFarmTest, BadShotSettingsAreRefusedAtSubmissionWithRendersMessage) {
     EXPECT_NE(job.status().message().find("--chunk 1"), std::string::npos) << job.status();
 }
 
+// `lightfarm requeue --frames`: a succeeded shot's chosen frames are rendered again from scratch
+// (their EXRs dropped, the other frames kept), durably across a restart, and the shot succeeds
+// again; frames outside the shot, a still and a running job are refused.
+TEST_F(ShotFarmTest, RequeuedFramesOfASucceededShotAreRenderedAgainAcrossARestart) {
+    absl::StatusOr<std::string> job = farm_->Submit(Shot());
+    ASSERT_TRUE(job.ok()) << job.status();
+    EXPECT_EQ(farm_->Requeue(*job, FrameRange{2, 2, 1}).status().code(),
+              absl::StatusCode::kFailedPrecondition)
+        << "a queued job";
+    for (int t = 0; t < 12; ++t) RenderOne();
+    ASSERT_EQ(farm_->scheduler().Get(*job)->state, JobState::kSucceeded);
+    const std::string frame_2 = *farm_->ResultFile(*job, false, 2);
+
+    const absl::Status outside = farm_->Requeue(*job, FrameRange{2, 6, 2}).status();
+    EXPECT_EQ(outside.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(outside.message().find("frames 4, 6 not in job"), std::string::npos) << outside;
+    JobSpec still = Shot();
+    still.shot.frames.reset();
+    absl::StatusOr<std::string> image = farm_->Submit(still);
+    ASSERT_TRUE(image.ok()) << image.status();
+    ASSERT_TRUE(farm_->scheduler().Cancel(*image).ok());
+    const absl::Status of_still = farm_->Requeue(*image, FrameRange{1, 1, 1}).status();
+    EXPECT_EQ(of_still.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(of_still.message().find("still image"), std::string::npos) << of_still;
+    EXPECT_EQ(farm_->scheduler().Get(*job)->state, JobState::kSucceeded)
+        << "refusals change nothing";
+
+    absl::StatusOr<JobRecord> requeued = farm_->Requeue(*job, FrameRange{2, 2, 1});
+    ASSERT_TRUE(requeued.ok()) << requeued.status();
+    EXPECT_EQ(requeued->state, JobState::kQueued);
+    EXPECT_EQ(requeued->tasks_done, 8);
+    EXPECT_FALSE(fs::exists(frame_2));
+    EXPECT_EQ(farm_->ResultFile(*job, false, 2).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    Open();  // durable: the restarted coordinator renders frame 2 alone
+    absl::StatusOr<JobRecord> record = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(record.ok()) << record.status();
+    EXPECT_EQ(record->state, JobState::kQueued);
+    EXPECT_EQ(record->tasks_done, 8);
+    ExpectFrame(*job, 1);
+    ExpectFrame(*job, 3);
+    for (int t = 0; t < 4; ++t) {
+        std::optional<TaskAssignment> lease =
+            farm_->scheduler().LeaseTask("w1", absl::Now() + absl::Seconds(5));
+        ASSERT_TRUE(lease.has_value());
+        EXPECT_EQ(lease->frame, std::optional<int>(2));
+        Answer(*lease);
+    }
+    record = farm_->scheduler().Get(*job);
+    ASSERT_TRUE(record.ok());
+    EXPECT_EQ(record->state, JobState::kSucceeded) << record->error;
+    for (int f : {1, 2, 3}) ExpectFrame(*job, f);
+}
+
+// A chunk holds several frames: requeuing one renders its chunk again, and says which frames.
+TEST_F(ShotFarmTest, RequeuingAFrameOfAChunkRendersTheChunkAgain) {
+    absl::StatusOr<std::string> job = farm_->Submit(Shot(2));  // chunks {1, 2} and {3}
+    ASSERT_TRUE(job.ok()) << job.status();
+    for (int t = 0; t < 2; ++t) RenderOne();
+    ASSERT_EQ(farm_->scheduler().Get(*job)->state, JobState::kSucceeded);
+    absl::StatusOr<JobRecord> requeued = farm_->Requeue(*job, FrameRange{2, 2, 1});
+    ASSERT_TRUE(requeued.ok()) << requeued.status();
+    ASSERT_EQ(requeued->frames.size(), 3u);
+    EXPECT_TRUE(requeued->frames[0].result_path.empty());
+    EXPECT_TRUE(requeued->frames[1].result_path.empty());
+    EXPECT_FALSE(requeued->frames[2].result_path.empty());
+    RenderOne();
+    EXPECT_EQ(farm_->scheduler().Get(*job)->state, JobState::kSucceeded);
+    for (int f : {1, 2, 3}) ExpectFrame(*job, f);
+}
+
 }  // namespace
 }  // namespace lf

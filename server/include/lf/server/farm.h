@@ -148,9 +148,10 @@ class Farm {
     // workers of that name known now; NotFound naming `name_or_id` for a worker never heard of.
     absl::StatusOr<std::vector<WorkerStatus>> SetWorkerState(const std::string& name_or_id,
                                                              WorkerControl control);
-    // Job management (issue 30): Scheduler::RequeueJob, and a job it finds fully rendered
-    // written and finished.
-    absl::StatusOr<JobRecord> Requeue(const std::string& job_id);
+    // Job management (issue 30): Scheduler::RequeueJob, or with `frames` RequeueFrames (those
+    // frames' EXRs removed), and a job it finds fully rendered written and finished.
+    absl::StatusOr<JobRecord> Requeue(const std::string& job_id,
+                                      const std::optional<FrameRange>& frames = std::nullopt);
 
     Scheduler& scheduler() { return scheduler_; }
     BlobStore& blobs() { return *blobs_; }
@@ -205,6 +206,7 @@ class Farm {
     std::unique_ptr<SqliteJobStore> store_;
     std::unique_ptr<TaskLogStore> logs_;
     std::unique_ptr<WorkerStateStore> worker_states_;  // set by Open
+    std::mutex worker_control_changes_;                // taken by SetWorkerState
     std::unique_ptr<JobNotifier> notifier_;            // set by Open, with a notify_url
     Scheduler scheduler_;
     std::mutex image_mutex_;

@@ -4,8 +4,8 @@
 //      +-----------------------------^
 //
 // The final states have no way out but ReopenJob's (`lightfarm requeue`: failed or cancelled
-// back to queued); a job may end without ever running (cancelled while queued, or failed when
-// its store write or its plan fails).
+// back to queued, and with --frames a succeeded shot too); a job may end without ever running
+// (cancelled while queued, or failed when its store write or its plan fails).
 #pragma once
 
 #include "absl/status/status.h"
@@ -21,7 +21,8 @@ bool IsLegalJobTransition(JobState from, JobState to);
 absl::Status TransitionJob(JobRecord& job, JobState to, absl::Time now);
 
 // Job management (issue 30): a failed or cancelled job queued again (lightfarm requeue), its
-// error, start and end cleared; FailedPrecondition, and nothing changed, for any other state.
-absl::Status ReopenJob(JobRecord& job);
+// error, start and end cleared; with `succeeded_too` (requeue --frames) a succeeded one also,
+// its result path cleared. FailedPrecondition, and nothing changed, for any other state.
+absl::Status ReopenJob(JobRecord& job, bool succeeded_too = false);
 
 }  // namespace lf

@@ -37,10 +37,13 @@ class JobStore {
     // job holds is refused (AlreadyExists from WaitDurable).
     virtual uint64_t QueuePut(const JobRecord& job) = 0;  // insert or replace, by id
     // The job's record together with the encoded TileSums of its task `task` and the task's
-    // history, in one write. A succeeded record drops the job's task results; a failed or
-    // cancelled one keeps them for `lightfarm requeue` (Scheduler::RequeueJob) until deleted.
+    // history, in one write. A succeeded still's record drops the job's task results; a failed
+    // or cancelled job, or a succeeded shot, keeps them for `lightfarm requeue` (--frames of a
+    // shot: Scheduler::RequeueFrames) until deleted.
     virtual uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result,
                                    const TaskHistory& history) = 0;
+    // The job's record with the results of its tasks `tasks` removed, in one write.
+    virtual uint64_t QueuePutDropping(const JobRecord& job, const std::vector<int>& tasks) = 0;
     // Removes the job's record and task results; nothing to remove is not an error.
     virtual uint64_t QueueDelete(const std::string& id) = 0;
     // Blocks until the write of `ticket`, and every one before it, is durable; or its error.
@@ -72,6 +75,9 @@ class InMemoryJobStore : public JobStore {
   public:
     uint64_t QueuePut(const JobRecord& job) override;
     uint64_t QueueTaskDone(const JobRecord& job, int, std::string, const TaskHistory&) override {
+        return QueuePut(job);
+    }
+    uint64_t QueuePutDropping(const JobRecord& job, const std::vector<int>&) override {
         return QueuePut(job);
     }
     uint64_t QueueDelete(const std::string& id) override;

@@ -182,8 +182,16 @@ class Scheduler {
     struct Requeued {
         JobRecord record;
         bool rendered = false;
+        std::vector<int> frames;  // RequeueFrames: the frames whose EXRs are dropped
     };
     absl::StatusOr<Requeued> RequeueJob(const std::string& job_id);
+    // `lightfarm requeue --frames`: frames `frames` of an ended shot (a succeeded one too) are
+    // rendered again from scratch: the results of their tasks are removed from the store with
+    // the reopened record, and their EXRs are no longer recorded (Requeued::frames: those, and
+    // the other frames of a chunk that holds one); the rest merges as after a restart and the
+    // job is queued. InvalidArgument naming them for a still or frames outside the shot,
+    // FailedPrecondition for a job not ended, or an adaptive shot; else as RequeueJob.
+    absl::StatusOr<Requeued> RequeueFrames(const std::string& job_id, const FrameRange& frames);
     // `lightfarm pause` and `resume` (JobRecord::paused): returns the record once durable;
     // FailedPrecondition for a job that has ended, NotFound for one the store does not hold.
     absl::StatusOr<JobRecord> SetPaused(const std::string& job_id, bool paused);
@@ -262,10 +270,12 @@ class Scheduler {
     // from before a restart, or a job that has ended).
     std::optional<LeaseHolder> HolderOf(const std::string& lease_id, const std::string& worker);
 
-    // Called with an ended job's tasks as they were when it ended, after the scheduler's lock is
-    // released and the job's final record is durable (or logged as not recorded), so that they
-    // can be kept once the job leaves memory. Set before the first job is submitted or recovered.
-    using TasksEnded = std::function<void(const std::string& job_id, std::vector<TaskStatus>)>;
+    // Called with an ended job's final record and its tasks as they were when it ended, after
+    // the scheduler's lock is released and that record is durable (or logged as not recorded),
+    // so that they can be kept once the job leaves memory. The record is the one the job ended
+    // with, even when the job was requeued meanwhile. Set before the first job is submitted or
+    // recovered.
+    using TasksEnded = std::function<void(const JobRecord& ended, std::vector<TaskStatus>)>;
     void OnTasksEnded(TasksEnded callback) { tasks_ended_ = std::move(callback); }
 
     // Workers the scheduler keeps track of: the live ones, and silent ones not yet forgotten
@@ -322,11 +332,20 @@ class Scheduler {
     // returns whether it is fully rendered.
     absl::StatusOr<bool> TakeUp(JobRecord record,
                                 const std::map<int, JobStore::RecordedTask>& results);
+    // The same with the job planned already (Job::Make).
+    absl::StatusOr<bool> TakeUp(std::unique_ptr<Job> job,
+                                const std::map<int, JobStore::RecordedTask>& results);
     std::optional<TaskAssignment> TryLease(const std::string& worker,
                                            const WorkerDescription* about);
     // Drops a job's tasks once its time limit has passed; true if dropping them completed the
     // job (so that it is reported once, here or by Complete).
     bool EnforceTimeLimit(Job& job, absl::Time now);
+    // ResourceExhausted when max_active_jobs jobs are queued or running (`action`: what to try
+    // again). Called under the lock.
+    absl::Status CheckActiveJobLimit(const char* action) const;
+    // An ended job taken up again from the store (RequeueJob; RequeueFrames with `frames`).
+    absl::StatusOr<Requeued> Reopen(const std::string& job_id,
+                                    const std::optional<FrameRange>& frames);
     // Whether `worker` may take queued task `task` now: a task the execution prefers for another
     // live worker waits for it, and a task that failed on `worker` waits for a live worker it has
     // not failed on, while there is one.
@@ -377,7 +396,9 @@ class Scheduler {
     // Ends the live state of a job moved to a final state: its final record is queued and the
     // job waits in `ended_` until Locked's release finds it durable. Returns that record.
     JobRecord EndJob(Job& job);
-    uint64_t Save(Job& job);  // queues the record's write and wakes watchers; a store ticket
+    // Queues the record's write (removing the results of tasks `drop_results` with it) and
+    // wakes watchers; returns a store ticket.
+    uint64_t Save(Job& job, const std::vector<int>& drop_results = {});
 
     const SchedulerOptions options_;
     JobStore& store_;
@@ -392,7 +413,7 @@ class Scheduler {
     EndedJobs ended_;
     uint64_t left_memory_ = 0;  // ended jobs settled out of `ended_`, for FindRequest
     // Ended jobs' tasks, for tasks_ended_ once the lock is released.
-    std::vector<std::pair<std::string, std::vector<TaskStatus>>> ended_tasks_;
+    std::vector<std::pair<JobRecord, std::vector<TaskStatus>>> ended_tasks_;
     TasksEnded tasks_ended_;
     LeaseTable leases_;
     WorkerRegistry workers_;

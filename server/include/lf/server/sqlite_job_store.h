@@ -37,6 +37,7 @@ class SqliteJobStore : public JobStore {
     uint64_t QueuePut(const JobRecord& job) override;
     uint64_t QueueTaskDone(const JobRecord& job, int task, std::string result,
                            const TaskHistory& history) override;
+    uint64_t QueuePutDropping(const JobRecord& job, const std::vector<int>& tasks) override;
     uint64_t QueueDelete(const std::string& id) override;
     absl::Status WaitDurable(uint64_t ticket) override;
     absl::StatusOr<JobRecord> Get(const std::string& id) const override;
@@ -63,8 +64,10 @@ class SqliteJobStore : public JobStore {
         bool remove = false;
         uint64_t seq = 0;
         bool final = false;
-        // Succeeded: its task results go. A failed or cancelled job keeps them (requeue).
+        // A succeeded still: its task results go. A failed or cancelled job, or a succeeded
+        // shot, keeps them (requeue, requeue --frames).
         bool drop_results = false;
+        std::vector<int> drop_tasks = {};  // task results to remove with the record
         std::string request_id = {};
         std::optional<int64_t> finished_us = {};  // ended jobs only
         std::string record = {};                  // EncodeJobRecord
