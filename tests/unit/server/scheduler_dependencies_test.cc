@@ -16,7 +16,7 @@ class SchedulerDependencies : public ::testing::Test {
   protected:
     SchedulerDependencies() : scheduler_(SchedulerOptions{}, store_, [this] { return now_; }) {
         scheduler_.OnTasksEnded(
-            [this](const std::string& id, std::vector<TaskStatus>) { ended_.push_back(id); });
+            [this](const JobRecord& job, std::vector<TaskStatus>) { ended_.push_back(job.id); });
     }
 
     // One task (16x16 in one tile), running after `after`.
