@@ -1,6 +1,16 @@
 #include "lf/job/task_status.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace lf {
+
+TaskTimes ReportedTimes(double render_seconds, double cpu_seconds) {
+    const auto sane = [](double s) {
+        return std::isfinite(s) ? std::clamp(s, 0.0, kMaxTaskSeconds) : 0.0;
+    };
+    return {sane(render_seconds), sane(cpu_seconds)};
+}
 
 const char* TaskStatusName(TaskStatus::State state) {
     switch (state) {

@@ -685,13 +685,12 @@ grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context, const
     std::vector<Farm::ResultPart> parts;
     for (const pb::TaskPartResult& part : req.parts()) {
         parts.push_back(
-            {part.frame(),
-             part.tile_sums(),
+            {part.frame(), part.tile_sums(),
              part.splats().empty() ? std::nullopt : std::optional<std::string_view>(part.splats()),
-             {part.render_seconds(), part.cpu_seconds()}});
+             ReportedTimes(part.render_seconds(), part.cpu_seconds())});
     }
     // As the worker measured them: shown and summed, never trusted for anything else.
-    const TaskTimes times{req.seconds(), req.cpu_seconds()};
+    const TaskTimes times = ReportedTimes(req.seconds(), req.cpu_seconds());
     const absl::Status s =
         req.radiosity_sweep().empty()
             ? farm_.Complete(

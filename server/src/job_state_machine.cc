@@ -42,6 +42,7 @@ absl::Status ReopenJob(JobRecord& job, bool succeeded_too) {
     job.result_path.clear();
     // It starts again at its next lease: an adaptive job's time limit counts from there.
     job.started = job.finished = absl::InfinitePast();
+    job.paused_for = absl::ZeroDuration();
     return absl::OkStatus();
 }
 

@@ -358,7 +358,10 @@ absl::StatusOr<bool> Scheduler::TakeUp(JobRecord record,
 
 absl::StatusOr<bool> Scheduler::TakeUp(std::unique_ptr<Job> job,
                                        const std::map<int, JobStore::RecordedTask>& results) {
-    job->paused_since = clock_();  // a paused job's clock stays stopped from here
+    // A record stored paused before pauses were timed: its clock stays stopped from here.
+    if (job->record.paused && job->record.paused_at == absl::InfinitePast()) {
+        job->record.paused_at = clock_();
+    }
     // In the order they merged, so an adaptive plan appends each pass before its result
     // comes up, and a shot gives each appended pass the index it had (its frames append
     // in the order their results merged, not in index order).
@@ -609,7 +612,7 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
 bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
     if (job.record.paused) return false;  // its clock is stopped
     const std::optional<std::vector<int>> dropped =
-        job.execution->EnforceTimeLimit(job.record.started + job.paused_for, now);
+        job.execution->EnforceTimeLimit(job.record.started + job.record.paused_for, now);
     if (!dropped) return false;
     for (int t : *dropped) {
         leases_.EndTask(job.id(), t);
@@ -931,6 +934,7 @@ void Scheduler::FailJob(Job& job, const std::string& error) {
 JobRecord Scheduler::EndJob(Job& job) {
     const std::string id = job.record.id;
     job.record.paused = false;  // an ended job is cancelled, failed or succeeded, not paused
+    job.record.paused_at = absl::InfinitePast();
     std::vector<TaskStatus> statuses = job.Statuses(leases_, clock_());
     leases_.ForgetJob(id);
     const uint64_t ticket = Save(job);
@@ -1088,9 +1092,13 @@ absl::StatusOr<JobRecord> Scheduler::SetPaused(const std::string& job_id, bool p
         if (!job.ok()) return job.status();
         Log()->info("job={} {}", job_id, paused ? "paused" : "resumed");
         const absl::Time now = clock_();
-        if (paused && !(*job)->record.paused) (*job)->paused_since = now;
-        if (!paused && (*job)->record.paused) (*job)->paused_for += now - (*job)->paused_since;
-        (*job)->record.paused = paused;
+        JobRecord& r = (*job)->record;
+        if (paused && !r.paused) r.paused_at = now;
+        if (!paused && r.paused) {
+            r.paused_for += std::max(absl::ZeroDuration(), now - r.paused_at);
+            r.paused_at = absl::InfinitePast();
+        }
+        r.paused = paused;
         ticket = Save(**job);
         record = (*job)->record;
     }

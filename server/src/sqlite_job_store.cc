@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "lf/core/log.h"
@@ -105,6 +106,8 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
                  "  frame INTEGER, cpu_seconds REAL NOT NULL, render_seconds REAL NOT NULL,"
                  "  samples INTEGER NOT NULL, PRIMARY KEY (job, task, finished));"
                  "CREATE INDEX IF NOT EXISTS task_stats_by_finished ON task_stats (finished);"
+                 // A submitter's stats read their own rows only.
+                 "CREATE INDEX IF NOT EXISTS task_stats_by_owner ON task_stats (owner, finished);"
                  "CREATE TABLE IF NOT EXISTS job_stats (job TEXT PRIMARY KEY, owner TEXT NOT NULL,"
                  "  state TEXT NOT NULL, ended INTEGER NOT NULL);"
                  "CREATE INDEX IF NOT EXISTS job_stats_by_ended ON job_stats (ended);"
@@ -269,6 +272,9 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
             drop.Bind(1, w.job_id).Bind(2, int64_t(w.drop_tasks[k])).Step();
             status = drop.status();
         }
+        // Every end goes into the history, even one whose record a later write in the batch
+        // replaces or deletes (a job deleted as soon as it ended).
+        if (status.ok() && w.finished_us) status = RecordJobEnd(w);
         if (!status.ok() || newest[w.job_id] != i) continue;
         // An upsert by id, not INSERT OR REPLACE: a clash of request ids must fail, not delete
         // the other job.
@@ -280,7 +286,6 @@ absl::Status SqliteJobStore::Commit(const std::deque<Write>& batch) {
         put.Bind(1, w.job_id).Bind(2, int64_t(w.seq)).Bind(3, int64_t(w.final));
         put.Bind(4, w.record).Bind(5, w.request_id).Bind(6, w.finished_us).Step();
         status = put.status();
-        if (status.ok() && w.finished_us) status = RecordJobEnd(w);
         if (status.ok() && w.drop_results) {
             Statement drop(db_, "DELETE FROM task_results WHERE job = ?1");
             drop.Bind(1, w.job_id).Step();
@@ -332,6 +337,10 @@ absl::StatusOr<FarmStats> SqliteJobStore::Stats(const StatsQuery& query) const {
                                                               : absl::ToUnixMicros(query.since);
     StatsAccumulator stats;
     std::lock_guard<std::mutex> lock(read_mutex_);
+    // One snapshot for the four queries: a job requeued or ended between two of them would
+    // count twice or not at all.
+    if (absl::Status s = Exec(read_db_, "BEGIN"); !s.ok()) return s;
+    absl::Cleanup end_read = [&] { Exec(read_db_, "COMMIT").IgnoreError(); };
     const auto read = [&](const char* sql, const auto& add) {
         Statement rows(read_db_, sql);
         rows.Bind(1, since);

@@ -99,6 +99,9 @@ void ToProto(const JobRecord& job, pb::StoredJob* out) {
         f->set_last_error(w.last_error);
     }
     out->set_paused(job.paused);
+    out->set_paused_for_us(absl::ToInt64Microseconds(job.paused_for));
+    if (job.paused_at != absl::InfinitePast())
+        out->set_paused_at_unix_us(absl::ToUnixMicros(job.paused_at));
     out->set_render_seconds(job.times.render_seconds);
     out->set_cpu_seconds(job.times.cpu_seconds);
 }
@@ -140,6 +143,9 @@ absl::StatusOr<JobRecord> FromProto(const pb::StoredJob& s) {
         job.worker_failures.push_back({w.worker(), w.failures(), w.last_error()});
     }
     job.paused = s.paused();
+    // A hostile or damaged record's negative time would lengthen the limit: read as none.
+    job.paused_for = absl::Microseconds(std::max<int64_t>(0, s.paused_for_us()));
+    if (s.has_paused_at_unix_us()) job.paused_at = absl::FromUnixMicros(s.paused_at_unix_us());
     job.times = {s.render_seconds(), s.cpu_seconds()};
     return job;
 }

@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <chrono>
 #include <map>
 #include <thread>
 
@@ -33,9 +34,11 @@ std::shared_ptr<spdlog::logger> Log() { return NamedLogger("worker"); }
 // result, which cost little.
 class TaskClock {
   public:
-    TaskClock() : wall_(absl::Now()), cpu_(ProcessCpuSeconds()) {}
+    TaskClock() : wall_(std::chrono::steady_clock::now()), cpu_(ProcessCpuSeconds()) {}
+    // The steady clock: a step of the system clock during the task changes nothing.
     TaskTimes Elapsed() const {
-        return {absl::ToDoubleSeconds(absl::Now() - wall_), ProcessCpuSeconds() - cpu_};
+        return {std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_).count(),
+                ProcessCpuSeconds() - cpu_};
     }
 
   private:
@@ -44,7 +47,7 @@ class TaskClock {
         clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
         return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
     }
-    absl::Time wall_;
+    std::chrono::steady_clock::time_point wall_;
     double cpu_;
 };
 

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 
@@ -19,6 +21,18 @@ TEST(TaskStatusNames, EveryStateHasItsOwnNameAndReadsBack) {
     EXPECT_EQ(names.size(), 5u);
     EXPECT_EQ(TaskStatusFromName("Done"), std::nullopt);
     EXPECT_EQ(TaskStatusFromName(""), std::nullopt);
+}
+
+// What a worker reports is kept only within reason: a NaN or negative time reads as 0, and none
+// is above 30 days, so no worker can poison or swamp the sums.
+TEST(ReportedTimes, NonFiniteAndNegativeReadAsZeroAndHugeAreCapped) {
+    EXPECT_EQ(ReportedTimes(2.5, 4.75), (TaskTimes{2.5, 4.75}));
+    EXPECT_EQ(ReportedTimes(std::nan(""), -1), (TaskTimes{0, 0}));
+    EXPECT_EQ(ReportedTimes(-std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::infinity()),
+              (TaskTimes{0, 0}));
+    EXPECT_EQ(ReportedTimes(1e308, kMaxTaskSeconds + 1),
+              (TaskTimes{kMaxTaskSeconds, kMaxTaskSeconds}));
 }
 
 }  // namespace

@@ -172,6 +172,8 @@ TEST(JobRecordCodec, JobManagementSurvivesAndOldRecordsHaveTheDefaults) {
     job.spec.blocklist_after = 2;
     job.worker_failures = {{"w1", 2, "no GPU"}, {"w2", 1, "disk full"}};
     job.paused = true;
+    job.paused_for = absl::Seconds(90);
+    job.paused_at = absl::FromUnixSeconds(1'000'000);
     nlohmann::json stored = nlohmann::json::parse(EncodeJobRecord(job));
     const absl::StatusOr<JobRecord> back = DecodeJobRecord(stored.dump());
     ASSERT_TRUE(back.ok()) << back.status();
@@ -183,7 +185,11 @@ TEST(JobRecordCodec, JobManagementSurvivesAndOldRecordsHaveTheDefaults) {
     EXPECT_EQ(back->worker_failures[0].last_error, "no GPU");
     EXPECT_EQ(back->Blocklisted().size(), 1u);
     EXPECT_TRUE(back->paused);
-    for (const char* field : {"worker_failures", "paused"}) stored.erase(field);
+    EXPECT_EQ(back->paused_for, absl::Seconds(90));
+    EXPECT_EQ(back->paused_at, absl::FromUnixSeconds(1'000'000));
+    for (const char* field : {"worker_failures", "paused", "paused_for_us", "paused_at_unix_us"}) {
+        stored.erase(field);
+    }
     for (const char* field : {"max_attempts", "blocklist_after"}) stored["spec"].erase(field);
     const absl::StatusOr<JobRecord> old = DecodeJobRecord(stored.dump());
     ASSERT_TRUE(old.ok()) << old.status();
@@ -191,6 +197,8 @@ TEST(JobRecordCodec, JobManagementSurvivesAndOldRecordsHaveTheDefaults) {
     EXPECT_EQ(old->spec.blocklist_after, kDefaultBlocklistAfter);
     EXPECT_TRUE(old->worker_failures.empty());
     EXPECT_FALSE(old->paused);
+    EXPECT_EQ(old->paused_for, absl::ZeroDuration());
+    EXPECT_EQ(old->paused_at, absl::InfinitePast());
 }
 
 TEST(JobRecordCodec, SkySurvives) {

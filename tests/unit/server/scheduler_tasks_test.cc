@@ -13,7 +13,9 @@ class SchedulerTasksTest : public ::testing::Test {
     SchedulerTasksTest() : scheduler_(SchedulerOptions{}, store_, [this] { return now_; }) {
         scheduler_.OnTasksEnded([this](const JobRecord& ended, std::vector<TaskStatus> tasks) {
             ended_[ended.id] = std::move(tasks);
-            if (requeue_when_ended_) ASSERT_TRUE(scheduler_.RequeueJob(ended.id).ok());
+            if (requeue_when_ended_) {
+                ASSERT_TRUE(scheduler_.RequeueJob(ended.id).ok());
+            }
             ended_states_[ended.id] = ended.state;
         });
     }

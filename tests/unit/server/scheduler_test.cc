@@ -826,6 +826,28 @@ TEST_F(SchedulerTest, TimeLimitClockStopsWhileTheJobIsPaused) {
     EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
 }
 
+// The time paused is in the job's record: a coordinator restarted during a pause keeps the
+// clock stopped for it. (This test store keeps no task results: the restarted scheduler renders
+// the first passes again.)
+TEST_F(SchedulerTest, TimeLimitClockStaysStoppedForAPauseAcrossARestart) {
+    const std::string id = SubmitAdaptive(scheduler_, {.time_limit = 5, .max_spp = 1 << 10});
+    CompleteFirstPasses(scheduler_);
+    now_ += absl::Seconds(2);
+    ASSERT_TRUE(scheduler_.SetPaused(id, true).ok());
+    now_ += absl::Seconds(10);
+    Scheduler restarted(Options(), store_, [this] { return now_; });
+    ASSERT_TRUE(restarted.Recover().ok());
+    now_ += absl::Seconds(10);
+    EXPECT_TRUE(restarted.EnforceTimeLimits().empty()) << "ran out while paused";
+    ASSERT_TRUE(restarted.SetPaused(id, false).ok());
+    CompleteFirstPasses(restarted);
+    ASSERT_TRUE(restarted.LeaseTask("w").has_value());  // a second pass
+    now_ += absl::Seconds(2);                           // 4 s of the 5 run
+    EXPECT_TRUE(restarted.EnforceTimeLimits().empty());
+    now_ += absl::Seconds(1);
+    EXPECT_EQ(restarted.EnforceTimeLimits(), std::vector<std::string>{id});
+}
+
 // A job its last result completed is reported by Complete, and not again by the time limit.
 TEST_F(SchedulerTest, TimeLimitDoesNotReportAJobItsLastResultCompleted) {
     const std::string id = SubmitAdaptive(scheduler_, {.target_error = 0.5, .time_limit = 5});

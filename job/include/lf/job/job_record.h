@@ -52,6 +52,10 @@ struct JobRecord {
     // `lightfarm pause`: a queued or running job that leases nothing new (its running tasks
     // finish and merge) until resumed. A flag, not a state: the job is still queued or running.
     bool paused = false;
+    // The adaptive time limit's clock stops while the job is paused: the time paused since it
+    // started, besides the current pause, which began at paused_at (InfinitePast when running).
+    absl::Duration paused_for = absl::ZeroDuration();
+    absl::Time paused_at = absl::InfinitePast();
     TaskTimes times;  // summed over its merged tasks (issue 30's history)
     // Dependencies (issue 30): of spec.after, those not ended yet while the job is queued; set
     // as the job is read, never stored.

@@ -27,6 +27,12 @@ struct TaskTimes {
     friend bool operator==(const TaskTimes&, const TaskTimes&) = default;
 };
 
+// A worker's figures as the farm keeps them: what is not finite or below 0 (a NaN from a broken
+// or hostile worker would poison every sum, and fail the history's write) reads as 0, and each
+// is at most kMaxTaskSeconds (30 days; no task runs that long).
+inline constexpr double kMaxTaskSeconds = 30 * 86400.0;
+TaskTimes ReportedTimes(double render_seconds, double cpu_seconds);
+
 struct TaskStatus {
     enum class State { kWaiting, kQueued, kRunning, kDone, kDropped };
     int index = 0;

@@ -66,10 +66,6 @@ struct ScheduledJob {
     std::vector<Task> tasks;     // by index, as many as `states`
     uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
     SpeculationPolicy speculation{absl::ZeroDuration()};
-    // The adaptive time limit's clock stops while the job is paused: the time paused in this
-    // run before the current pause, and when that pause began.
-    absl::Duration paused_for = absl::ZeroDuration();
-    absl::Time paused_since;
 
   private:
     // The holder of the task's last lease, of this run or recorded before.
