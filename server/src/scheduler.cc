@@ -454,6 +454,24 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
         return absl::AbortedError(
             absl::StrCat("job ", job_id, " was requeued by another call meanwhile"));
     }
+    // Refused, not failed again: a requeue that could only fail changes nothing (a shot's
+    // frames dropped for it would be lost).
+    if (std::optional<std::string> why = EndedDependencyFailure(*stored, *after)) {
+        return absl::FailedPreconditionError(
+            absl::StrCat("job ", job_id, " cannot run: ", *why, "; requeue that one first"));
+    }
+    // Jobs its success released would wait for it again mid-render, and a cycle could close
+    // through them (their dependencies were checked against it as ended).
+    std::vector<std::string> dependents;
+    for (const auto& [id, other] : active_) {
+        const std::vector<std::string>& of = other->record.spec.after;
+        if (std::find(of.begin(), of.end(), job_id) != of.end()) dependents.push_back(id);
+    }
+    if (!dependents.empty()) {
+        return absl::FailedPreconditionError(
+            absl::StrCat("job ", job_id, " has jobs running after it (",
+                         absl::StrJoin(dependents, ", "), "): requeue it once they have ended"));
+    }
     if (absl::Status s = CheckActiveJobLimit("requeue"); !s.ok()) return s;
     absl::StatusOr<std::unique_ptr<Job>> made =
         Job::Make(std::move(*stored), options_.tile_stores, options_.speculate_after);
@@ -488,11 +506,6 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
     Log()->info("job={} requeued: {}/{} tasks done kept, the rest queued{}", job_id,
                 job.record.tasks_done, job.record.tasks_total,
                 frames ? absl::StrCat(" (frames ", FrameRangeText(*frames), " again)") : "");
-    // A dependency still failed or cancelled fails it again: requeue that one first.
-    if (FailIfDependencyEnded(job, *after)) {
-        requeued.record = *ended_.Find(job_id);
-        return requeued;
-    }
     const uint64_t ticket = Save(job, dropped);
     requeued.record = job.record;
     requeued.rendered = *rendered;
@@ -995,9 +1008,9 @@ absl::StatusOr<std::map<std::string, DependencyState>> Scheduler::DependencyStat
     }
 }
 
-bool Scheduler::FailIfDependencyEnded(Job& job,
-                                      const std::map<std::string, DependencyState>& known) {
-    for (const std::string& dep : job.record.spec.after) {
+std::optional<std::string> Scheduler::EndedDependencyFailure(
+    const JobRecord& job, const std::map<std::string, DependencyState>& known) const {
+    for (const std::string& dep : job.spec.after) {
         if (active_.count(dep)) continue;
         DependencyState state{dep};
         if (const JobRecord* ended = ended_.Find(dep)) {
@@ -1005,12 +1018,16 @@ bool Scheduler::FailIfDependencyEnded(Job& job,
         } else if (auto it = known.find(dep); it != known.end()) {
             state = it->second;
         }
-        if (std::optional<std::string> why = DependencyFailure(state)) {
-            FailJob(job, *why);
-            return true;
-        }
+        if (std::optional<std::string> why = DependencyFailure(state)) return why;
     }
-    return false;
+    return std::nullopt;
+}
+
+bool Scheduler::FailIfDependencyEnded(Job& job,
+                                      const std::map<std::string, DependencyState>& known) {
+    std::optional<std::string> why = EndedDependencyFailure(job.record, known);
+    if (why) FailJob(job, *why);
+    return why.has_value();
 }
 
 absl::StatusOr<JobRecord> Scheduler::AddDependencies(const std::string& job_id,

@@ -138,6 +138,27 @@ TEST_F(SchedulerDependencies, CancelFailsTheDependents) {
     EXPECT_EQ(Get(b).error, "dependency " + a + " was cancelled");
 }
 
+// A dependent failed with its dependency is refused a requeue while that dependency stays
+// failed (nothing changes: it would only fail again), and taken once the dependency runs again.
+TEST_F(SchedulerDependencies, RequeueOfADependentWaitsForItsDependencysRequeue) {
+    const std::string a = MustSubmit();
+    const std::string b = MustSubmit({a});
+    ASSERT_TRUE(scheduler_.Cancel(a).ok());
+    ASSERT_EQ(Get(b).state, JobState::kFailed);
+    const absl::StatusOr<Scheduler::Requeued> refused = scheduler_.RequeueJob(b);
+    ASSERT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(refused.status().message(), "job " + b + " cannot run: dependency " + a +
+                                              " was cancelled; requeue that one first");
+    EXPECT_EQ(Get(b).state, JobState::kFailed);
+    EXPECT_EQ(Get(b).error, "dependency " + a + " was cancelled") << "the refusal changed it";
+    ASSERT_TRUE(scheduler_.RequeueJob(a).ok());
+    ASSERT_TRUE(scheduler_.RequeueJob(b).ok());
+    EXPECT_EQ(Get(b).waiting_for, std::vector<std::string>{a});
+    Run(a);
+    Run(b);
+    EXPECT_EQ(Get(b).state, JobState::kSucceeded);
+}
+
 // A job is deleted only once ended, its dependents settled then: deleting it afterwards leaves a
 // failed dependent failed with its reason, and a requeue of that dependent (the user's call)
 // finds nothing left to wait for; a dependent released by a success is not failed by a delete.

@@ -358,6 +358,28 @@ TEST_F(ShotFarmTest, RequeuedFramesOfASucceededShotAreRenderedAgainAcrossARestar
 }
 
 // A chunk holds several frames: requeuing one renders its chunk again, and says which frames.
+// A job released by the shot's success would wait for it again mid-render (and a cycle could
+// close through it): the shot's frames are refused a requeue while such a job is queued or
+// running.
+TEST_F(ShotFarmTest, FramesOfAShotOthersRunAfterAreRefusedARequeueUntilTheyEnd) {
+    absl::StatusOr<std::string> shot = farm_->Submit(Shot());
+    ASSERT_TRUE(shot.ok()) << shot.status();
+    for (int t = 0; t < 12; ++t) RenderOne();
+    ASSERT_EQ(farm_->scheduler().Get(*shot)->state, JobState::kSucceeded);
+    JobSpec comp = Shot();
+    comp.after = {*shot};
+    absl::StatusOr<std::string> after = farm_->Submit(comp);
+    ASSERT_TRUE(after.ok()) << after.status();
+    const absl::Status refused = farm_->Requeue(*shot, FrameRange{2, 2, 1}).status();
+    EXPECT_EQ(refused.code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_NE(refused.message().find("has jobs running after it (" + *after + ")"),
+              std::string::npos)
+        << refused;
+    EXPECT_EQ(farm_->scheduler().Get(*shot)->state, JobState::kSucceeded);
+    ASSERT_TRUE(farm_->scheduler().Cancel(*after).ok());
+    EXPECT_TRUE(farm_->Requeue(*shot, FrameRange{2, 2, 1}).ok());
+}
+
 TEST_F(ShotFarmTest, RequeuingAFrameOfAChunkRendersTheChunkAgain) {
     absl::StatusOr<std::string> job = farm_->Submit(Shot(2));  // chunks {1, 2} and {3}
     ASSERT_TRUE(job.ok()) << job.status();

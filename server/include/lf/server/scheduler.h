@@ -364,6 +364,10 @@ class Scheduler {
     // Fails the job when a job it runs after, not held in memory, ended without succeeding by
     // `known` (Recover's and RequeueJob's view of the store); true if it did.
     bool FailIfDependencyEnded(Job& job, const std::map<std::string, DependencyState>& known);
+    // Why `job` cannot run, when a job it runs after, not held in memory, ended without
+    // succeeding by `known`; nullopt when none did.
+    std::optional<std::string> EndedDependencyFailure(
+        const JobRecord& job, const std::map<std::string, DependencyState>& known) const;
     // The job's record as a reader sees it: with its waiting_reason.
     JobRecord ReadRecord(const Job& job, absl::Time now) const;
     // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).
