@@ -640,14 +640,17 @@ namespace lf {
 absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id,
                                         const std::optional<FrameRange>& frames) {
     std::lock_guard<std::mutex> one_change(ended_job_changes_);
-    absl::StatusOr<Scheduler::Requeued> requeued =
-        frames ? scheduler_.RequeueFrames(job_id, *frames) : scheduler_.RequeueJob(job_id);
-    if (!requeued.ok()) return requeued.status();
     // No longer recorded: removed, so that nothing serves the old EXR under the frame's name.
-    for (int frame : requeued->frames) {
-        std::error_code ignored;  // a frame whose EXR was never written
-        fs::remove(FramePathOf("results", job_id, frame), ignored);
-    }
+    const auto remove_files = [&](const std::vector<int>& dropped) {
+        for (int frame : dropped) {
+            std::error_code ignored;  // a frame whose EXR was never written
+            fs::remove(FramePathOf("results", job_id, frame), ignored);
+        }
+    };
+    absl::StatusOr<Scheduler::Requeued> requeued =
+        frames ? scheduler_.RequeueFrames(job_id, *frames, remove_files)
+               : scheduler_.RequeueJob(job_id);
+    if (!requeued.ok()) return requeued.status();
     if (requeued->rendered) FinishJob(job_id);
     return requeued->record;
 }

@@ -415,11 +415,12 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
         }
         if (ended_.Find(job_id)) return JustEnded(job_id);
     }
-    return Reopen(job_id, std::nullopt);
+    return Reopen(job_id, nullptr, std::nullopt);
 }
 
 absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueFrames(const std::string& job_id,
-                                                             const FrameRange& frames) {
+                                                             const FrameRange& frames,
+                                                             const RemoveFrameFiles& remove_files) {
     {
         Locked locked(*this);
         if (active_.count(job_id)) {
@@ -430,10 +431,11 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueFrames(const std::string& 
         }
         if (ended_.Find(job_id)) return JustEnded(job_id);
     }
-    return Reopen(job_id, frames);
+    return Reopen(job_id, remove_files, frames);
 }
 
 absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
+                                                      const RemoveFrameFiles& remove_files,
                                                       const std::optional<FrameRange>& frames) {
     // The store is read without the lock.
     absl::StatusOr<JobRecord> stored = store_.Get(job_id);
@@ -509,6 +511,8 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
     const uint64_t ticket = Save(job, dropped);
     requeued.record = job.record;
     requeued.rendered = *rendered;
+    // Leases and merges wait for the lock: no frame of this run is written yet.
+    if (remove_files && !requeued.frames.empty()) remove_files(requeued.frames);
     locked.lock.unlock();
     if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
     return requeued;
@@ -958,15 +962,22 @@ JobRecord Scheduler::EndJob(Job& job) {
         DependencyFailure({record.id, record.state, record.error});
     JobRecord added = ended_.Add(std::move(record), ticket);
     if (!why) return added;
-    // Its dependents fail, and theirs in turn (each FailJob ends here again).
-    std::vector<std::string> dependents;
+    // Its dependents fail, and theirs in turn: each FailJob ends here again and adds its own to
+    // the list the outermost call works through (a chain of thousands recursing would not).
     for (const auto& [other, dependent] : active_) {
         const std::vector<std::string>& after = dependent->record.spec.after;
-        if (std::find(after.begin(), after.end(), id) != after.end()) dependents.push_back(other);
+        if (std::find(after.begin(), after.end(), id) != after.end()) {
+            failing_dependents_.emplace_back(other, *why);
+        }
     }
-    for (const std::string& other : dependents) {
-        if (auto it = active_.find(other); it != active_.end()) FailJob(*it->second, *why);
+    if (failing_dependents_busy_) return added;
+    failing_dependents_busy_ = true;
+    while (!failing_dependents_.empty()) {
+        auto [other, reason] = std::move(failing_dependents_.front());
+        failing_dependents_.pop_front();
+        if (auto it = active_.find(other); it != active_.end()) FailJob(*it->second, reason);
     }
+    failing_dependents_busy_ = false;
     return added;
 }
 

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <condition_variable>
+#include <deque>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -191,7 +192,11 @@ class Scheduler {
     // the other frames of a chunk that holds one); the rest merges as after a restart and the
     // job is queued. InvalidArgument naming them for a still or frames outside the shot,
     // FailedPrecondition for a job not ended, or an adaptive shot; else as RequeueJob.
-    absl::StatusOr<Requeued> RequeueFrames(const std::string& job_id, const FrameRange& frames);
+    // `remove_files(frames)` is called once the job is queued again, before a worker can lease
+    // it, so that a frame rendered again at once is never removed as the old one.
+    using RemoveFrameFiles = std::function<void(const std::vector<int>& frames)>;
+    absl::StatusOr<Requeued> RequeueFrames(const std::string& job_id, const FrameRange& frames,
+                                           const RemoveFrameFiles& remove_files);
     // `lightfarm pause` and `resume` (JobRecord::paused): returns the record once durable;
     // FailedPrecondition for a job that has ended, NotFound for one the store does not hold.
     absl::StatusOr<JobRecord> SetPaused(const std::string& job_id, bool paused);
@@ -344,7 +349,7 @@ class Scheduler {
     // again). Called under the lock.
     absl::Status CheckActiveJobLimit(const char* action) const;
     // An ended job taken up again from the store (RequeueJob; RequeueFrames with `frames`).
-    absl::StatusOr<Requeued> Reopen(const std::string& job_id,
+    absl::StatusOr<Requeued> Reopen(const std::string& job_id, const RemoveFrameFiles& remove_files,
                                     const std::optional<FrameRange>& frames);
     // Whether `worker` may take queued task `task` now: a task the execution prefers for another
     // live worker waits for it, and a task that failed on `worker` waits for a live worker it has
@@ -418,6 +423,9 @@ class Scheduler {
     uint64_t left_memory_ = 0;  // ended jobs settled out of `ended_`, for FindRequest
     // Ended jobs' tasks, for tasks_ended_ once the lock is released.
     std::vector<std::pair<JobRecord, std::vector<TaskStatus>>> ended_tasks_;
+    // Dependents to fail (job id, reason), worked through by the outermost EndJob.
+    std::deque<std::pair<std::string, std::string>> failing_dependents_;
+    bool failing_dependents_busy_ = false;
     TasksEnded tasks_ended_;
     LeaseTable leases_;
     WorkerRegistry workers_;
