@@ -45,7 +45,8 @@ Command AddRequeueCommand(CLI::App& app) {
         "cleared; a failed or cancelled job is queued again and renders on from the tasks it had\n"
         "done. --frames A-B[:STEP]: those frames of an ended shot, a succeeded one too, are\n"
         "rendered again from scratch (their EXRs dropped and written again), the job queued\n"
-        "until they are done.");
+        "until they are done. Refused while a job it runs after is failed or cancelled\n"
+        "(requeue that one first), and --frames while jobs that run after it are active.");
     auto frames = std::make_shared<std::string>();
     auto failed = std::make_shared<bool>(true);
     // Names the default, and is captured below only to outlive the parse: the failed tasks are
