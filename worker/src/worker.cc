@@ -17,6 +17,7 @@
 #include "lf/core/scene_animation.h"
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
+#include "lf/job/adaptive_plan.h"
 #include "lf/job/shot.h"
 #include "lf/job/splat_settings.h"
 #include "lf/kernels/radiosity.h"
@@ -236,6 +237,7 @@ absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>
     if (UsesSplatPlan(task.spec.method)) {
         return RenderSplat(task, cancel, result, stats, frame_splats);
     }
+    if (absl::Status s = CheckActivePixels(task.task, task.spec.adaptive); !s.ok()) return s;
     if (absl::Status s = PrepareTracer(task, cancel); !s.ok()) return s;
     const TileSums sums = Render(task, cancel);
     stats = sums.stats;
@@ -479,6 +481,7 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
     const PixelRect& rect = task.task.rect;
     const uint64_t step = std::max<uint64_t>(1, kSamplesPerPiece / uint64_t(rect.width));
     const SampleOptions options{task.spec.clamp, task.spec.aovs, task.spec.sampler};
+    const PixelMask active = task.task.active();
     TileSums tile(rect, options.aovs);
     std::mutex stats_mutex;
     arena_.execute([&] {
@@ -492,7 +495,7 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
                          s += step) {
                         row += RenderTile(
                             *loaded_.camera, *loaded_.tracer, row_rect, task.spec.seed, s,
-                            std::min(s + step, task.task.sample_end), options, &cancel);
+                            std::min(s + step, task.task.sample_end), options, &cancel, &active);
                     }
                     std::copy(row.pixels.begin(), row.pixels.end(), &tile.at(rect.x0, y));
                     if (options.aovs != 0) {
