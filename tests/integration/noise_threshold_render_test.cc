@@ -137,7 +137,7 @@ TEST_F(NoiseThreshold, LowerRelMseThanUniformAtEqualSamples) {
     const double total = std::accumulate(spp.begin(), spp.end(), 0.0);
     const uint64_t even = 2 * uint64_t(std::ceil(total / double(spp.size()) / 2));
     const RenderOutput uniform = Render(even, 32);
-    const RenderOutput reference = Render(2048, 33);
+    const RenderOutput reference = Render(1024, 33);
     const std::vector<double> a = RelMse(adaptive, reference), u = RelMse(uniform, reference);
     const double n = double(a.size());
     double mean_a = 0, mean_u = 0, sum = 0, sum2 = 0;

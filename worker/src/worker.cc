@@ -182,9 +182,11 @@ void Worker::Execute(const TaskAssignment& task) {
     const TaskClock clock;
     ServerConnection::TaskResult result;
     RenderStats stats;
+    // The task's own fields first: a malformed one fails before any download.
     absl::Status status = options_.fail_tasks_for_test
                               ? absl::InternalError("failing every task (--fail-tasks-for-test)")
-                              : PrepareScene(task, cancel);
+                              : CheckActivePixels(task.task, task.spec.adaptive);
+    if (status.ok()) status = PrepareScene(task, cancel);
     if (status.ok()) status = RunTask(task, cancel, result, stats);
     {
         std::lock_guard<std::mutex> lock(hb_mutex);
@@ -237,7 +239,6 @@ absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>
     if (UsesSplatPlan(task.spec.method)) {
         return RenderSplat(task, cancel, result, stats, frame_splats);
     }
-    if (absl::Status s = CheckActivePixels(task.task, task.spec.adaptive); !s.ok()) return s;
     if (absl::Status s = PrepareTracer(task, cancel); !s.ok()) return s;
     const TileSums sums = Render(task, cancel);
     stats = sums.stats;

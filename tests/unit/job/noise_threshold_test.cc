@@ -63,13 +63,13 @@ TileSums Pass(const RenderTask& task) {
     return sums;
 }
 
-struct Run {
+struct PlanRun {
     Image image;
     AdaptiveReport report;
     std::vector<RenderTask> tasks;
 };
 
-Run RunToEnd(int tile, const AdaptiveSettings& settings, uint64_t max_task_samples = 1 << 20) {
+PlanRun RunToEnd(int tile, const AdaptiveSettings& settings, uint64_t max_task_samples = 1 << 20) {
     absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made =
         AdaptiveTilePlan::Make(16, 8, 16, tile, settings, max_task_samples);
     EXPECT_TRUE(made.ok()) << made.status();
@@ -87,7 +87,7 @@ Run RunToEnd(int tile, const AdaptiveSettings& settings, uint64_t max_task_sampl
 const AdaptiveSettings kSettings{.max_spp = 4096, .noise_threshold = 0.01};
 
 TEST(NoiseThresholdPlan, SamplesOnlyUnconvergedPixelsAndEachStopsByItsOwnSamples) {
-    const Run run = RunToEnd(8, kSettings);
+    const PlanRun run = RunToEnd(8, kSettings);
     const std::vector<float>& spp = *run.image.FindChannel("spp");
     const std::vector<float>& r = *run.image.FindChannel("R");
     const std::vector<float>& a = *run.image.FindChannel("A.R");
@@ -125,7 +125,7 @@ TEST(NoiseThresholdPlan, SamplesOnlyUnconvergedPixelsAndEachStopsByItsOwnSamples
 }
 
 TEST(NoiseThresholdPlan, PixelsAreTheSameBitsForAnyTileSizeAndTaskSplit) {
-    const Run eight = RunToEnd(8, kSettings), four = RunToEnd(4, kSettings),
+    const PlanRun eight = RunToEnd(8, kSettings), four = RunToEnd(4, kSettings),
               split = RunToEnd(16, kSettings, 100);
     for (const char* c : {"R", "G", "A.B", "B.R", "spp"}) {
         EXPECT_EQ(*eight.image.FindChannel(c), *four.image.FindChannel(c)) << c;
@@ -135,7 +135,7 @@ TEST(NoiseThresholdPlan, PixelsAreTheSameBitsForAnyTileSizeAndTaskSplit) {
 }
 
 TEST(NoiseThresholdPlan, StopsAtMaxSppAndCountsWhatDidNotConverge) {
-    const Run run = RunToEnd(8, {.max_spp = 64, .noise_threshold = 0.001});
+    const PlanRun run = RunToEnd(8, {.max_spp = 64, .noise_threshold = 0.001});
     EXPECT_EQ(run.report.max_spp, 64u);
     EXPECT_GT(run.report.pixels_unconverged, 0);
     EXPECT_LE(run.report.pixels_unconverged, 64);  // the flat pixels converge
