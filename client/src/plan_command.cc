@@ -415,9 +415,10 @@ absl::Status RunPlan(const PlanOptions& options) {
         return PrintMethodCosts(*scene, **embree, camera, options, method);
     }
 
+    // The comparison of methods costs a target error, which a noise threshold is not.
     if (options.noise_threshold > 0) {
         PrintNoiseThresholdPlan(options);
-        return PrintMethodCosts(*scene, **embree, camera, options, method);
+        return absl::OkStatus();
     }
     // A pilot in two stages at the full resolution, each tile's error measured after both, so
     // that how fast it falls is measured rather than assumed (docs/convergence.md, "Error
@@ -495,8 +496,8 @@ Command AddPlanCommand(CLI::App& app) {
         ->check(CLI::Range(1e-6, 1.0));
     cmd->add_option("--noise-threshold", options->noise_threshold,
                     "explain render --noise-threshold (per-pixel, Cycles' rule) instead of "
-                    "costing a target error; give the render's --spp (default: Cycles' automatic "
-                    "minimum) and --max-spp")
+                    "costing a target error and comparing methods; give the render's --spp "
+                    "(default: Cycles' automatic minimum) and --max-spp")
         ->check(CLI::Range(kMinNoiseThreshold, 1.0));
     cmd->add_option("--pilot-spp", options->pilot_spp,
                     "samples per pixel of the pilot's first stage; the second takes 4x")
