@@ -126,7 +126,7 @@ TEST(NoiseThresholdPlan, SamplesOnlyUnconvergedPixelsAndEachStopsByItsOwnSamples
 
 TEST(NoiseThresholdPlan, PixelsAreTheSameBitsForAnyTileSizeAndTaskSplit) {
     const PlanRun eight = RunToEnd(8, kSettings), four = RunToEnd(4, kSettings),
-              split = RunToEnd(16, kSettings, 100);
+                  split = RunToEnd(16, kSettings, 100);
     for (const char* c : {"R", "G", "A.B", "B.R", "spp"}) {
         EXPECT_EQ(*eight.image.FindChannel(c), *four.image.FindChannel(c)) << c;
         EXPECT_EQ(*eight.image.FindChannel(c), *split.image.FindChannel(c)) << c;
