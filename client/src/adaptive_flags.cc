@@ -14,6 +14,14 @@ void AddAdaptiveFlags(CLI::App* cmd, AdaptiveSettings& settings) {
                     "discretisation error is at most this (docs/radiosity.md)")
         ->group(a)
         ->check(CLI::Range(kMinTargetError, kMaxTargetError));
+    cmd->add_option("--noise-threshold", settings.noise_threshold,
+                    "per-pixel adaptive sampling as Cycles' Noise Threshold (the same error "
+                    "measure and scale, e.g. 0.01): a pixel stops once Cycles' error of its "
+                    "A/B halves is below 5x this; --spp is its minimum samples (default: Cycles' "
+                    "automatic ceil(16 / T^0.3): 0.1 -> 32, 0.01 -> 64), --max-spp its most. Not "
+                    "with --target-error")
+        ->group(a)
+        ->check(CLI::Range(kMinNoiseThreshold, 1.0));
     cmd->add_option("--time-limit", settings.time_limit,
                     "stop sampling about this many seconds after the render starts (every tile "
                     "gets its first pass); alone, tiles double their samples until then")
@@ -23,6 +31,13 @@ void AddAdaptiveFlags(CLI::App* cmd, AdaptiveSettings& settings) {
         ->group(a)
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(2), kMaxSpp));
+}
+
+void ApplyNoiseThresholdMinSpp(const CLI::App& cmd, const AdaptiveSettings& settings,
+                               uint64_t& spp) {
+    if (settings.noise_threshold > 0 && cmd.count("--spp") == 0) {
+        spp = NoiseThresholdMinSpp(settings.noise_threshold);
+    }
 }
 
 }  // namespace lf

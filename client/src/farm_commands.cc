@@ -136,10 +136,13 @@ void PrintJob(const pb::Job& job) {
                     ? ""
                     : absl::StrCat(", ", LightStrategyName(spec.light_strategy), " light sampling")
                           .c_str());
-    if (job.params().target_error() > 0 || job.params().time_limit_seconds() > 0) {
-        std::printf("  adaptive  target error %g, time limit %g s, at most %llu spp\n",
-                    job.params().target_error(), job.params().time_limit_seconds(),
-                    (unsigned long long)job.params().max_spp());
+    if (IsAdaptive(spec.adaptive)) {
+        std::printf(
+            "  adaptive  %s %g, time limit %g s, at most %llu spp\n",
+            spec.adaptive.noise_threshold > 0 ? "noise threshold (per pixel)" : "target error",
+            spec.adaptive.noise_threshold > 0 ? spec.adaptive.noise_threshold
+                                              : spec.adaptive.target_error,
+            spec.adaptive.time_limit, (unsigned long long)spec.adaptive.max_spp);
     }
     if (spec.shot.frames) {
         std::printf(

@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
+#include "lf/client/adaptive_flags.h"
 #include "lf/client/command.h"
 #include "lf/client/method_flags.h"
 #include "lf/client/photon_flags.h"
@@ -44,6 +45,7 @@ struct PlanOptions {
     SceneOptions scene;
     std::string method = "auto";
     double target_error = 0.01;
+    double noise_threshold = 0;  // render --noise-threshold: explained, not costed
     uint64_t pilot_spp = 8;
     // The render's own settings, which decide its passes: --spp (its first pass), --tile,
     // --seed and --max-spp.
@@ -62,6 +64,23 @@ struct PlanOptions {
     PhotonSettings ppm;  // the ppm pilot's --photons, --ppm-radius, --ppm-alpha
     bool compare_methods = true;
 };
+
+// What render --noise-threshold will do; its cost depends on each pixel's noise, which plan
+// does not pilot per pixel.
+void PrintNoiseThresholdPlan(const PlanOptions& o) {
+    const double t = o.noise_threshold;
+    const uint64_t first =
+        std::min(o.max_spp, std::max<uint64_t>(2, o.first_spp + o.first_spp % 2));
+    std::printf(
+        "render --noise-threshold %g samples per pixel as Cycles' Noise Threshold %g: every pixel "
+        "takes --spp %llu samples (Cycles' automatic minimum for %g is %llu), then passes of 16 "
+        "more (a quarter more from 64 on) while its error, sum |I - A| / (1e-4 + sqrt(sum I)) "
+        "over R, G, B with I its mean and A its even samples' mean, is not below 5 x %g = %g, up "
+        "to --max-spp %llu; the EXR's spp channel holds each pixel's count "
+        "(docs/convergence.md)\n",
+        t, t, (unsigned long long)first, t, (unsigned long long)NoiseThresholdMinSpp(t), t, 5 * t,
+        (unsigned long long)o.max_spp);
+}
 
 std::string Color(const Rgb& c) { return absl::StrFormat("(%.3g, %.3g, %.3g)", c.r, c.g, c.b); }
 
@@ -396,6 +415,11 @@ absl::Status RunPlan(const PlanOptions& options) {
         return PrintMethodCosts(*scene, **embree, camera, options, method);
     }
 
+    // The comparison of methods costs a target error, which a noise threshold is not.
+    if (options.noise_threshold > 0) {
+        PrintNoiseThresholdPlan(options);
+        return absl::OkStatus();
+    }
     // A pilot in two stages at the full resolution, each tile's error measured after both, so
     // that how fast it falls is measured rather than assumed (docs/convergence.md, "Error
     // estimates and plan predictions").
@@ -470,6 +494,11 @@ Command AddPlanCommand(CLI::App& app) {
                     "relative error to estimate the cost for")
         ->capture_default_str()
         ->check(CLI::Range(1e-6, 1.0));
+    cmd->add_option("--noise-threshold", options->noise_threshold,
+                    "explain render --noise-threshold (per-pixel, Cycles' rule) instead of "
+                    "costing a target error and comparing methods; give the render's --spp "
+                    "(default: Cycles' automatic minimum) and --max-spp")
+        ->check(CLI::Range(kMinNoiseThreshold, 1.0));
     cmd->add_option("--pilot-spp", options->pilot_spp,
                     "samples per pixel of the pilot's first stage; the second takes 4x")
         ->capture_default_str()
@@ -497,7 +526,13 @@ Command AddPlanCommand(CLI::App& app) {
     AddLightSamplingFlag(cmd, options->light_strategy);
     AddClampFlag(cmd, options->clamp);
     AddPhotonFlags(cmd, options->ppm);
-    return {cmd, [options] {
+    return {cmd, [cmd, options] {
+                if (options->noise_threshold > 0 && cmd->count("--target-error") > 0) {
+                    return ReportError(absl::InvalidArgumentError(
+                        "--noise-threshold (per pixel) and --target-error (per tile): pick one"));
+                }
+                ApplyNoiseThresholdMinSpp(*cmd, {.noise_threshold = options->noise_threshold},
+                                          options->first_spp);
                 const absl::Status status = RunPlan(*options);
                 return status.ok() ? 0 : ReportError(status);
             }};

@@ -195,6 +195,7 @@ Command AddRenderCommand(CLI::App& app) {
 
     return {
         cmd, [cmd, options, output, no_progress, method, frame_flags] {
+            ApplyNoiseThresholdMinSpp(*cmd, options->adaptive, options->render.spp);
             absl::StatusOr<OutputPaths> paths = ResolveOutputPaths(*output);
             if (!paths.ok()) return ReportError(paths.status());
             absl::StatusOr<ShotSettings> shot = ShotOfFrameFlags(*frame_flags);
@@ -258,24 +259,23 @@ Command AddRenderCommand(CLI::App& app) {
             }
             if (summary->adaptive) {
                 const AdaptiveReport& a = summary->adaptive_report;
-                double samples = 0, pixels = 0;  // the mean spp, what `plan` predicts
-                for (const AdaptiveReport::Tile& t : a.per_tile) {
-                    samples += double(t.spp) * t.rect.Area();
-                    pixels += double(t.rect.Area());
-                }
                 // The target bounds each tile's error, not the whole image's above.
                 const double target = options->adaptive.target_error;
+                const double threshold = options->adaptive.noise_threshold;
                 const std::string tiles =
-                    target > 0 ? absl::StrFormat(
-                                     "--target-error %g bounds each tile's error: worst tile "
-                                     "%.4f, %d of %s above it",
-                                     target, a.worst_tile_error, a.tiles_above_target,
-                                     Plural(a.tiles, "tile"))
-                               : absl::StrFormat("worst tile error %.4f", a.worst_tile_error);
+                    threshold > 0
+                        ? absl::StrFormat("--noise-threshold %g: %lld of %lld pixels not converged",
+                                          threshold, (long long)a.pixels_unconverged,
+                                          (long long)a.pixels)
+                    : target > 0 ? absl::StrFormat(
+                                       "--target-error %g bounds each tile's error: worst tile "
+                                       "%.4f, %d of %s above it",
+                                       target, a.worst_tile_error, a.tiles_above_target,
+                                       Plural(a.tiles, "tile"))
+                                 : absl::StrFormat("worst tile error %.4f", a.worst_tile_error);
                 std::printf("adaptive: %llu..%llu spp per pixel (mean %.0f); %s%s\n",
                             (unsigned long long)a.min_spp, (unsigned long long)a.max_spp,
-                            pixels > 0 ? samples / pixels : 0, tiles.c_str(),
-                            a.timed_out ? ", time limit reached" : "");
+                            a.mean_spp, tiles.c_str(), a.timed_out ? ", time limit reached" : "");
             }
             if (!summary->partial.empty()) {
                 std::fprintf(stderr, "lightfarm: %s; wrote it to %s\n", summary->partial.c_str(),

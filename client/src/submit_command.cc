@@ -194,6 +194,7 @@ Command AddSubmitCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxSweepTasks));
     return {cmd, [cmd, o, chunk, frame_flags] {
+                ApplyNoiseThresholdMinSpp(*cmd, o->spec.adaptive, o->spec.plan.spp);
                 absl::StatusOr<ShotSettings> shot = ShotOfFrameFlags(*frame_flags);
                 if (!shot.ok()) return ReportError(shot.status());
                 shot->chunk = o->spec.shot.chunk;

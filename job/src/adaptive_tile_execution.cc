@@ -20,10 +20,12 @@ AdaptiveTileExecution::AdaptiveTileExecution(std::unique_ptr<AdaptiveTilePlan> p
     : TileExecution(std::move(plan), 0), settings_(settings) {}
 
 std::string AdaptiveTileExecution::Summary() const {
-    return absl::StrCat(plan().tile_count(), " tiles, ", plan().width(), "x", plan().height(),
-                        ", first pass ", plan().first_spp(), " spp, adaptive up to ",
-                        settings_.max_spp, " spp, target error ", settings_.target_error,
-                        ", time limit ", settings_.time_limit, " s");
+    return absl::StrCat(
+        plan().tile_count(), " tiles, ", plan().width(), "x", plan().height(), ", first pass ",
+        plan().first_spp(), " spp, adaptive up to ", settings_.max_spp, " spp, ",
+        settings_.noise_threshold > 0 ? absl::StrCat("noise threshold ", settings_.noise_threshold)
+                                      : absl::StrCat("target error ", settings_.target_error),
+        ", time limit ", settings_.time_limit, " s");
 }
 
 std::vector<int> AdaptiveTileExecution::Start() {

@@ -52,7 +52,14 @@ absl::Status CheckMethodSettings(const JobSpec& spec) {
     if (IsAdaptive(spec.adaptive) && !Info(*method).adaptive) {
         return absl::InvalidArgumentError(absl::StrCat(
             "adaptive: method \"", spec.method,
-            "\" has no adaptive sampling (no target error or time limit); set spp instead"));
+            "\" has no adaptive sampling (no target error, noise threshold or time limit); set "
+            "spp instead"));
+    }
+    // Radiosity's target error refines its mesh; its display samples are no noise to stop on.
+    if (spec.adaptive.noise_threshold > 0 && Info(*method).work != WorkKind::kTiles) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("adaptive.noise_threshold: method \"", spec.method,
+                         "\" has no per-pixel samples to stop; use method path or whitted"));
     }
     return CheckShutterOfMethod(*method, spec.shot.shutter);
 }
@@ -77,6 +84,9 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         NoneOrInRange("adaptive.time_limit", spec.adaptive.time_limit, kMinTimeLimit,
                       kMaxTimeLimit),
         InRange("adaptive.max_spp", spec.adaptive.max_spp, uint64_t(2), kMaxSpp),
+        NoneOrInRange("adaptive.noise_threshold", spec.adaptive.noise_threshold, kMinNoiseThreshold,
+                      1.0),
+        CheckAdaptiveSettings(spec.adaptive),
         InRange("radiosity.patches", r.patches, int64_t(1), kMaxPatchTarget),
         // Finite: an infinite size would mesh every triangle as one patch, which no flag can ask.
         InRange("radiosity.patch_size", r.patch_size, 0.0, std::numeric_limits<double>::max()),

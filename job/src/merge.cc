@@ -17,10 +17,13 @@ absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums) {
                          ",", task.rect.y0, " ", task.rect.width, "x", task.rect.height));
     }
     const uint64_t n = task.sample_end - task.sample_begin;
-    for (const PixelSums& p : sums.pixels) {
-        if (p.Count() != n) {
-            return absl::InvalidArgumentError(absl::StrCat("task ", task.index, ": a pixel has ",
-                                                           p.Count(), " samples, the task ", n));
+    const PixelMask active = task.active();
+    for (size_t i = 0; i < sums.pixels.size(); ++i) {
+        const uint64_t expected = active.Has(i) ? n : 0;
+        if (sums.pixels[i].Count() != expected) {
+            return absl::InvalidArgumentError(absl::StrCat("task ", task.index, ": pixel ", i,
+                                                           " has ", sums.pixels[i].Count(),
+                                                           " samples, the task ", expected));
         }
     }
     return absl::OkStatus();

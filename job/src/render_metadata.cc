@@ -86,6 +86,11 @@ void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveRepor
     attributes["lightfarm.adaptive.timedOut"] = YesNo(report.timed_out);
     attributes["lightfarm.adaptive.minSpp"] = int(report.min_spp);
     attributes["lightfarm.adaptive.maxSpp"] = int(report.max_spp);
+    if (settings.noise_threshold > 0) {
+        attributes["lightfarm.noiseThreshold"] = settings.noise_threshold;
+        attributes["lightfarm.adaptive.pixelsUnconverged"] =
+            std::to_string(report.pixels_unconverged);
+    }
 }
 
 void AddRadiosityAttributes(const RenderMetadata& m, ExrAttributes& attributes) {

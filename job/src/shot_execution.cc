@@ -86,7 +86,8 @@ absl::Status CheckShotChunk(const JobSpec& spec) {
     };
     if (IsAdaptive(spec.adaptive)) {
         return refuse(
-            "adaptive sampling (--target-error, --time-limit) adds passes as results merge");
+            "adaptive sampling (--target-error, --noise-threshold, --time-limit) adds passes as "
+            "results merge");
     }
     if (SolvedInSweeps(spec)) return refuse("radiosity solved in sweeps adds a sweep at a time");
     // A chunk's result is one message and one record: every frame's sums (tile_codec.h: 104

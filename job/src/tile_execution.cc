@@ -51,8 +51,7 @@ void TileExecution::Describe(int task, TaskStatus& status) const {
 }
 
 uint64_t TileExecution::TaskSamples(int task) const {
-    const RenderTask& t = merger_->tasks()[size_t(task)];
-    return uint64_t(t.rect.width) * uint64_t(t.rect.height) * (t.sample_end - t.sample_begin);
+    return merger_->tasks()[size_t(task)].Samples();
 }
 
 absl::StatusOr<std::vector<int>> TileExecution::MergeSums(int task, const TileSums& sums) {

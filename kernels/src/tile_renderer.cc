@@ -6,11 +6,15 @@ namespace lf {
 
 TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, const PixelRect& rect,
                     uint64_t seed, uint64_t sample_begin, uint64_t sample_end,
-                    const SampleOptions& options, const std::atomic<bool>* cancel) {
+                    const SampleOptions& options, const std::atomic<bool>* cancel,
+                    const PixelMask* active) {
     TileSums tile(rect, options.aovs);
     for (int y = rect.y0; y < rect.y0 + rect.height; ++y) {
         if (cancel && cancel->load(std::memory_order_relaxed)) break;
+        uint64_t pixels = 0;
         for (int x = rect.x0; x < rect.x0 + rect.width; ++x) {
+            if (active && !active->Has(x, y)) continue;
+            ++pixels;
             PixelSums& pixel = tile.at(x, y);
             for (uint64_t s = sample_begin; s < sample_end; ++s) {
                 Sampler sampler(seed, x, y, s, options.sampler);
@@ -35,7 +39,7 @@ TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, co
                 }
             }
         }
-        tile.stats.samples += uint64_t(rect.width) * (sample_end - sample_begin);
+        tile.stats.samples += pixels * (sample_end - sample_begin);
     }
     return tile;
 }

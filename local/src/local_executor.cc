@@ -40,9 +40,10 @@ absl::Status RunTiles(TileExecution& execution, const Camera& camera,
         execution,
         [&](const TaskAssignment& lease, const std::atomic<bool>& cancel, const auto& merge) {
             const RenderTask& task = lease.task;
+            const PixelMask active = task.active();
             const TileSums sums =
                 RenderTile(camera, estimator, task.rect, settings.seed, task.sample_begin,
-                           task.sample_end, SampleOptionsOf(settings), &cancel);
+                           task.sample_end, SampleOptionsOf(settings), &cancel, &active);
             return merge(TaskResult{.sums = &sums});
         },
         options, started);

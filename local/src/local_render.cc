@@ -42,9 +42,7 @@ struct PosedKernels {
     std::optional<RadiosityFigures> radiosity;
 };
 
-bool IsAdaptive(const LocalRenderOptions& options) {
-    return options.adaptive.target_error > 0 || options.adaptive.time_limit > 0;
-}
+bool IsAdaptive(const LocalRenderOptions& options) { return IsAdaptive(options.adaptive); }
 
 // The job a render of `scene` is, as the farm would run it: its kernels' settings and its header.
 JobSpec LocalJobOf(const LocalRenderOptions& options, const Scene& scene, const MethodInfo& info) {
@@ -68,11 +66,11 @@ JobSpec LocalJobOf(const LocalRenderOptions& options, const Scene& scene, const 
 }
 
 // The splatting methods' plan, after the job model's checks, so that local mode refuses what
-// the coordinator refuses; nullopt for the other methods.
+// the coordinator refuses (AOVs and adaptive sampling of methods without them, for every
+// method); nullopt for the other methods.
 absl::StatusOr<std::optional<SplatPlanSettings>> SplatPlanOf(const LocalRenderOptions& options,
                                                              const JobSpec& job,
                                                              const MethodInfo& info) {
-    if (info.work != WorkKind::kSplatPasses) return std::nullopt;
     if (options.render.aovs != 0 || IsAdaptive(options)) {
         JobSpec spec;
         spec.method = job.method;
@@ -80,6 +78,7 @@ absl::StatusOr<std::optional<SplatPlanSettings>> SplatPlanOf(const LocalRenderOp
         spec.adaptive = options.adaptive;
         if (absl::Status s = CheckJobSettings(spec); !s.ok()) return s;
     }
+    if (info.work != WorkKind::kSplatPasses) return std::nullopt;
     if (absl::Status s = CheckPhotonSettings(options.ppm); !s.ok()) return s;
     absl::StatusOr<SplatPlanSettings> plan = SplatPlanSettingsOf(job.method, job.plan);
     if (!plan.ok()) return plan.status();
@@ -205,9 +204,11 @@ void LogRenderSettings(const LocalRenderOptions& options, const Scene& scene, Me
     }
     if (IsAdaptive(options)) {
         log->info(
-            "job={} adaptive: first pass {} spp, target error {}, time limit {} s, at "
-            "most {} spp",
-            job_id, options.render.spp, options.adaptive.target_error, options.adaptive.time_limit,
+            "job={} adaptive: first pass {} spp, target error {}, noise threshold {}, time limit "
+            "{} "
+            "s, at most {} spp",
+            job_id, options.render.spp, options.adaptive.target_error,
+            options.adaptive.noise_threshold, options.adaptive.time_limit,
             options.adaptive.max_spp);
     }
 }

@@ -501,6 +501,48 @@ TEST_F(Cli, TargetErrorRecordsTheEstimateInTheHeader) {
               std::get<int>(file->attributes.at("lightfarm.spp")));
 }
 
+// --noise-threshold without --spp starts every pixel at Cycles' automatic minimum (0.1: 32), the
+// header names the threshold, `plan` explains it, and what cannot combine is refused by name.
+TEST_F(Cli, NoiseThresholdUsesCyclesMinimumAndRefusesWhatCannotCombine) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::string exr = (dir_ / "n.exr").string();
+    const RunResult r =
+        Lightfarm("render " + scene + " -o " + exr +
+                  " --resolution 32 --noise-threshold 0.1 --threads 2 --no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("--noise-threshold 0.1: 0 of 1024 pixels not converged"),
+              std::string::npos)
+        << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    EXPECT_EQ(std::get<double>(file->attributes.at("lightfarm.noiseThreshold")), 0.1);
+    EXPECT_EQ(std::get<int>(file->attributes.at("lightfarm.adaptive.minSpp")), 32);
+    const std::vector<float>& spp = *file->image.FindChannel("spp");
+    EXPECT_EQ(*std::min_element(spp.begin(), spp.end()), 32);
+
+    const RunResult both = Lightfarm("render " + scene + " -o " + exr +
+                                     " --noise-threshold 0.1 --target-error 0.1 --no-progress");
+    EXPECT_NE(both.status, 0);
+    EXPECT_NE(both.output.find("pick one"), std::string::npos) << both.output;
+    const RunResult bdpt = Lightfarm("render " + scene + " -o " + exr +
+                                     " --noise-threshold 0.1 --method bdpt --no-progress");
+    EXPECT_NE(bdpt.status, 0);
+    EXPECT_NE(bdpt.output.find("method \"bdpt\" has no adaptive sampling"), std::string::npos)
+        << bdpt.output;
+    const RunResult radiosity =
+        Lightfarm("render " + scene + " -o " + exr +
+                  " --noise-threshold 0.1 --method radiosity --no-progress");
+    EXPECT_NE(radiosity.status, 0);
+    EXPECT_NE(radiosity.output.find("no per-pixel samples to stop"), std::string::npos)
+        << radiosity.output;
+    const RunResult plan =
+        Lightfarm("plan " + scene + " --noise-threshold 0.01 --method path --resolution 32");
+    ASSERT_EQ(plan.status, 0) << plan.output;
+    EXPECT_NE(plan.output.find("takes --spp 64 samples (Cycles' automatic minimum for 0.01 is 64)"),
+              std::string::npos)
+        << plan.output;
+}
+
 // `plan` lists the environment among the lights, and a material whose emission texture has no
 // lit texel (glTF exports give emissiveFactor 1 and a black texture) is not an emitter.
 TEST_F(Cli, PlanListsTheEnvironmentAndSkipsEmissionTexturesWithoutLight) {

@@ -1221,6 +1221,30 @@ TEST_F(Farm, ServerKilledMidAdaptiveRenderReplansTheSamePasses) {
     EXPECT_NE(ReadText(dir_ / "server-2.log").find("recovered"), std::string::npos);
 }
 
+// Per-pixel adaptive sampling on the farm: passes carry the masks of the pixels not converged,
+// each pixel's stop decided by its own samples, so the local pixels; after a server restart the
+// recorded results replan the same masks.
+TEST_F(Farm, NoiseThresholdSamplesPixelsApartAndGivesTheLocalPixels) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string flags = "--method path --tile 16 --noise-threshold 0.05 --max-spp 512";
+    const std::string job = Submit(scene_, "--spp 8 --seed 5 " + flags);
+    ASSERT_TRUE(WaitForTasksDone(job, 24, milliseconds(30000)));
+    CrashAndRestartServer();
+    ExpectSameAsLocal(job, scene_, 8, 5, flags);
+    absl::StatusOr<ExrFile> exr = ReadExr((dir_ / (job + ".exr")).string());
+    ASSERT_TRUE(exr.ok()) << exr.status();
+    const ExrAttributes& a = exr->attributes;
+    EXPECT_EQ(std::get<double>(a.at("lightfarm.noiseThreshold")), 0.05);
+    EXPECT_EQ(std::get<int>(a.at("lightfarm.adaptive.minSpp")), 8);
+    // Pixels of one tile stopped apart: the spp channel holds more counts than tiles do passes.
+    const std::vector<float>& spp = *exr->image.FindChannel("spp");
+    const std::set<float> counts(spp.begin(), spp.end());
+    EXPECT_GE(counts.size(), 4u);
+    EXPECT_GT(Tasks(job).total, 16);
+}
+
 // The job ends because of its limit (the server says so, and so does the header), with fewer
 // samples than the job asked for at most.
 TEST_F(Farm, TimeLimitEndsAnAdaptiveJob) {

@@ -112,6 +112,7 @@ void ToProto(const JobSpec& spec, pb::RenderParams* out) {
     out->set_target_error(spec.adaptive.target_error);
     out->set_time_limit_seconds(spec.adaptive.time_limit);
     out->set_max_spp(spec.adaptive.max_spp);
+    out->set_noise_threshold(spec.adaptive.noise_threshold);
     out->set_camera(spec.scene_options.camera);
     out->set_width(spec.scene_options.width);
     out->set_height(spec.scene_options.height);
@@ -152,6 +153,7 @@ void FromProto(const pb::RenderParams& p, JobSpec* spec) {
     spec->adaptive.target_error = p.target_error();
     spec->adaptive.time_limit = p.time_limit_seconds();
     if (p.max_spp() != 0) spec->adaptive.max_spp = p.max_spp();
+    spec->adaptive.noise_threshold = p.noise_threshold();
     spec->scene_options = {p.camera(), p.width(), p.height(), FilterFromProto(p), p.sky()};
     spec->clamp = p.clamp();
     spec->aovs = p.aovs();
@@ -295,6 +297,7 @@ void ToProto(const TaskAssignment& task, pb::Task* out) {
     out->set_height(task.task.rect.height);
     out->set_sample_begin(task.task.sample_begin);
     out->set_sample_end(task.task.sample_end);
+    out->set_active_pixels(task.task.active_pixels);
     if (task.sweep >= 0) {
         out->set_kind(pb::Task::RADIOSITY_SWEEP);
         out->set_sweep(task.sweep);
@@ -342,6 +345,7 @@ TaskAssignment FromProto(const pb::Task& t) {
     task.task.rect = {t.x0(), t.y0(), t.width(), t.height()};
     task.task.sample_begin = t.sample_begin();
     task.task.sample_end = t.sample_end();
+    task.task.active_pixels = t.active_pixels();
     if (t.has_frame()) task.frame = t.frame();
     for (const pb::TaskPart& p : t.parts()) {
         TaskAssignment::Part part{

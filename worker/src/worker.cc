@@ -17,6 +17,7 @@
 #include "lf/core/scene_animation.h"
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
+#include "lf/job/adaptive_plan.h"
 #include "lf/job/shot.h"
 #include "lf/job/splat_settings.h"
 #include "lf/kernels/radiosity.h"
@@ -181,9 +182,11 @@ void Worker::Execute(const TaskAssignment& task) {
     const TaskClock clock;
     ServerConnection::TaskResult result;
     RenderStats stats;
+    // The task's own fields first: a malformed one fails before any download.
     absl::Status status = options_.fail_tasks_for_test
                               ? absl::InternalError("failing every task (--fail-tasks-for-test)")
-                              : PrepareScene(task, cancel);
+                              : CheckActivePixels(task.task, task.spec.adaptive);
+    if (status.ok()) status = PrepareScene(task, cancel);
     if (status.ok()) status = RunTask(task, cancel, result, stats);
     {
         std::lock_guard<std::mutex> lock(hb_mutex);
@@ -479,6 +482,7 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
     const PixelRect& rect = task.task.rect;
     const uint64_t step = std::max<uint64_t>(1, kSamplesPerPiece / uint64_t(rect.width));
     const SampleOptions options{task.spec.clamp, task.spec.aovs, task.spec.sampler};
+    const PixelMask active = task.task.active();
     TileSums tile(rect, options.aovs);
     std::mutex stats_mutex;
     arena_.execute([&] {
@@ -492,7 +496,7 @@ TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& can
                          s += step) {
                         row += RenderTile(
                             *loaded_.camera, *loaded_.tracer, row_rect, task.spec.seed, s,
-                            std::min(s + step, task.task.sample_end), options, &cancel);
+                            std::min(s + step, task.task.sample_end), options, &cancel, &active);
                     }
                     std::copy(row.pixels.begin(), row.pixels.end(), &tile.at(rect.x0, y));
                     if (options.aovs != 0) {

@@ -657,7 +657,7 @@ class Client:
                aovs: Union[int, Sequence[str]] = 0, filter: Optional[str] = None,
                filter_width: Optional[float] = None, sampler: str = "sobol",
                light_sampling: str = "bvh", target_error: float = 0.0,
-               time_limit: float = 0.0, max_spp: int = 1 << 16,
+               time_limit: float = 0.0, max_spp: int = 1 << 16, noise_threshold: float = 0.0,
                patches: int = 4000, patch_size: float = 0.0, solver: str = "jacobi",
                tolerance: float = 1e-4, max_iterations: int = 10000, display: str = "smooth",
                sweep_tasks: int = 8, max_patches: int = 0,
@@ -678,7 +678,9 @@ class Client:
         ``clamp``, ``aovs`` (flags or names: "albedo", "normal", "depth"), ``filter`` ("box",
         "gaussian", "blackman-harris") and ``filter_width``, ``sampler`` ("sobol",
         "independent"), ``light_sampling`` ("bvh", "power"); adaptive sampling with
-        ``target_error``, ``time_limit`` (seconds) and ``max_spp``; radiosity's ``patches``,
+        ``target_error``, ``time_limit`` (seconds) and ``max_spp``, or per pixel with
+        ``noise_threshold`` (Cycles' Noise Threshold; ``spp`` is then each pixel's minimum, as
+        given: the CLI's default is Cycles' automatic one); radiosity's ``patches``,
         ``patch_size``, ``solver``, ``tolerance``, ``max_iterations``, ``display``,
         ``sweep_tasks``, ``max_patches``; photon mapping's ``photons_per_pass``,
         ``initial_radius``, ``alpha``. A shot of an animated scene: ``frames`` ("A-B",
@@ -714,6 +716,7 @@ class Client:
         params = common_pb2.RenderParams(
             spp=spp, seed=seed, max_depth=max_depth, tile=tile, passes=passes, method=method,
             target_error=target_error, time_limit_seconds=time_limit, max_spp=max_spp,
+            noise_threshold=noise_threshold,
             camera=camera, clamp=clamp, aovs=_aov_flags(aovs), sampler=_choice(
                 "sampler", sampler, _SAMPLERS),
             light_strategy=_choice("light_sampling", light_sampling, _LIGHT_SAMPLING))

@@ -23,16 +23,21 @@ namespace lf {
 // Each tile gets passes of samples until its estimated relative error (EstimatedTileError, the
 // square root of its relMSE from the A/B halves) is at most target_error, it has max_spp
 // samples, or the time limit has passed. Every tile gets its first pass whatever the time limit.
+// With noise_threshold instead, each pixel gets passes until it converges by Cycles' rule
+// (PixelConverged); a tile's passes sample only its pixels not converged yet.
 struct AdaptiveSettings {
     double target_error = 0;  // relative; 0: none
     double time_limit = 0;    // seconds; 0: none
     uint64_t max_spp = defaults::kAdaptiveMaxSpp;
+    double noise_threshold = 0;  // Cycles' Noise Threshold, per pixel; 0: none
 };
 
-inline bool IsAdaptive(const AdaptiveSettings& a) { return a.target_error > 0 || a.time_limit > 0; }
+inline bool IsAdaptive(const AdaptiveSettings& a) {
+    return a.target_error > 0 || a.time_limit > 0 || a.noise_threshold > 0;
+}
 
-// InvalidArgument naming the setting that is out of range (a negative or non-finite target or
-// limit, max_spp below 2 or above kMaxSpp).
+// InvalidArgument naming the setting that is out of range (a negative or non-finite target,
+// threshold or limit, max_spp below 2 or above kMaxSpp, a target error with a noise threshold).
 absl::Status CheckAdaptiveSettings(const AdaptiveSettings& a);
 
 struct AdaptiveReport {
@@ -41,7 +46,10 @@ struct AdaptiveReport {
     int tiles = 0;
     int tiles_above_target = 0;  // stopped by max_spp or the time limit
     bool timed_out = false;
-    uint64_t min_spp = 0, max_spp = 0;
+    uint64_t min_spp = 0, max_spp = 0;  // per pixel
+    double mean_spp = 0;
+    // A noise threshold: the pixels, and those not converged (stopped by max_spp or the time).
+    int64_t pixels = 0, pixels_unconverged = 0;
     struct Tile {
         PixelRect rect;
         uint64_t spp = 0;
@@ -55,6 +63,26 @@ struct AdaptiveReport {
 // a little low does not cost a whole extra pass; at least 2 more, at most 8x per pass so one
 // noisy estimate cannot ask for far too much; even, so the A and B halves stay equal.
 uint64_t NextSampleCount(uint64_t n, double error, double target, uint64_t max_spp);
+
+// Cycles' per-pixel error (Blender 3.4, kernel/film/adaptive_sampling.h, after Dammertz et al.
+// 2009 section 2.1): with I the pixel's mean and A the mean of its even samples,
+// sum over channels |I - A| / (1e-4 + sqrt(sum over channels I)). Here I - A = (B - A) / 2.
+double PixelNoiseError(const PixelSums& pixel);
+// Cycles' test: converged when the error is below 5 threshold (Cycles scales the user's Noise
+// Threshold by 5 before comparing, "to make it more intuitive").
+bool PixelConverged(const PixelSums& pixel, double noise_threshold);
+// Cycles' automatic min samples for a threshold: ceil(16 / threshold^0.3), at least 4 (0.1: 32,
+// 0.01: 64, 0.001: 128), rounded up to even.
+uint64_t NoiseThresholdMinSpp(double noise_threshold);
+// The samples a pixel not converged after `n` gets next: Cycles checks every 16 samples; passes
+// grow by a quarter from 64 on, so a tile takes tens of passes, not thousands, and the check
+// points (a function of n alone) are the same for every pixel whatever its tile.
+uint64_t NextNoiseCheck(uint64_t n, uint64_t max_spp);
+
+// A task's mask of active pixels as a worker receives it: InvalidArgument unless it is empty or
+// one bit per pixel of the rectangle, no bit past it, at least one set, in a job with a noise
+// threshold, and the task ends at or below max_spp.
+absl::Status CheckActivePixels(const RenderTask& task, const AdaptiveSettings& settings);
 
 // The most pixel samples in one task: a longer pass is split into tasks of consecutive sample
 // ranges, so that one hard tile's last pass (up to 8x the one before) spreads over workers
@@ -105,14 +133,23 @@ class AdaptiveTilePlan : public TileMerger {
   private:
     struct Tile {
         PixelRect rect;
-        uint64_t spp = 0;  // samples merged in each pixel
+        uint64_t spp = 0;      // most samples merged in a pixel
+        uint64_t min_spp = 0;  // fewest (a noise threshold stops pixels apart)
+        uint64_t samples = 0;  // in all its pixels
         double error = 1;
+        int64_t unconverged = 0;   // pixels still sampled, with a noise threshold
         std::vector<int> pending;  // the tasks of the current pass not merged yet
     };
     AdaptiveTilePlan(int width, int height, const AdaptiveSettings& settings,
                      uint64_t max_task_samples, std::shared_ptr<TileStore> store);
-    // Appends the tasks of tile `tile`'s pass over samples [begin, end).
-    std::vector<RenderTask> AppendPass(int tile, uint64_t begin, uint64_t end);
+    // Appends the tasks of tile `tile`'s pass over samples [begin, end) of the pixels in
+    // `active` (PixelMask::bits; empty: all).
+    std::vector<RenderTask> AppendPass(int tile, uint64_t begin, uint64_t end,
+                                       const std::string& active = {});
+    // The pass after one that merged, or none: by the tile's error, or per pixel by the noise
+    // threshold.
+    std::vector<RenderTask> NextTilePass(int tile);
+    std::vector<RenderTask> NextNoisePass(int tile, const TileSums& merged);
 
     AdaptiveSettings settings_;
     uint64_t max_task_samples_;

@@ -75,6 +75,7 @@ inline constexpr int kMaxFarmAovTile = 128;
 inline constexpr int64_t kMaxPatchTarget = int64_t(1) << 24;
 inline constexpr double kMinTolerance = 1e-12, kMaxTolerance = 1.0;
 inline constexpr double kMinTargetError = 1e-6, kMaxTargetError = 1.0;  // or 0: none
+inline constexpr double kMinNoiseThreshold = 1e-6;                      // or 0: none
 inline constexpr double kMinTimeLimit = 1e-3, kMaxTimeLimit = 1e7;      // seconds, or 0: none
 inline constexpr std::array<std::string_view, 3> kRadiositySolvers = {"jacobi", "gauss-seidel",
                                                                       "shooting"};

@@ -9,6 +9,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/film.h"
+#include "lf/core/pixel_mask.h"
 #include "lf/job/settings.h"
 
 namespace lf {
@@ -47,6 +48,13 @@ struct RenderTask {
     int index = 0;  // position in the plan
     PixelRect rect;
     uint64_t sample_begin = 0, sample_end = 0;
+    // A noise-threshold pass: the pixels still sampled (PixelMask::bits of rect); empty: all.
+    std::string active_pixels;
+
+    PixelMask active() const { return {rect, active_pixels}; }
+    int64_t ActivePixels() const { return active().Count(); }
+    // Pixel samples the task renders.
+    uint64_t Samples() const { return uint64_t(ActivePixels()) * (sample_end - sample_begin); }
 };
 
 // Tile by tile, row by row, each tile's passes consecutive, so the tiles

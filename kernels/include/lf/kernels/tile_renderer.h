@@ -7,6 +7,7 @@
 
 #include "lf/core/camera.h"
 #include "lf/core/film.h"
+#include "lf/core/pixel_mask.h"
 #include "lf/core/sampler.h"
 #include "lf/kernels/radiance.h"
 
@@ -30,8 +31,10 @@ struct SampleOptions {
 // the result depends on nothing else: not the tiling, not the thread. AOVs draw no random numbers.
 // Its time in the shutter (motion blur: Ray::time) is Sampler::GetTime, which shifts no other
 // number, so scenes where nothing moves render the same bits with a shutter as without.
+// With `active`, only the pixels it has get samples (per-pixel adaptive sampling).
 TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, const PixelRect& rect,
                     uint64_t seed, uint64_t sample_begin, uint64_t sample_end,
-                    const SampleOptions& options = {}, const std::atomic<bool>* cancel = nullptr);
+                    const SampleOptions& options = {}, const std::atomic<bool>* cancel = nullptr,
+                    const PixelMask* active = nullptr);
 
 }  // namespace lf
