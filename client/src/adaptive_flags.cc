@@ -18,8 +18,10 @@ void AddAdaptiveFlags(CLI::App* cmd, AdaptiveSettings& settings) {
                     "per-pixel adaptive sampling as Cycles' Noise Threshold (the same error "
                     "measure and scale, e.g. 0.01): a pixel stops once Cycles' error of its "
                     "A/B halves is below 5x this; --spp is its minimum samples (default: Cycles' "
-                    "automatic ceil(16 / T^0.3): 0.1 -> 32, 0.01 -> 64), --max-spp its most. Not "
-                    "with --target-error")
+                    "automatic ceil(16 / T^0.3): 0.1 -> 32, 0.01 -> 64; at least 4), --max-spp its "
+                    "most (default 65536: pixels that never converge, such as caustic "
+                    "fireflies, go that far unless --max-spp or --time-limit says less; Cycles' "
+                    "Max Samples defaults to 4096). Not with --target-error")
         ->group(a)
         ->check(CLI::Range(kMinNoiseThreshold, 1.0));
     cmd->add_option("--time-limit", settings.time_limit,

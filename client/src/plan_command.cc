@@ -366,6 +366,9 @@ absl::Status RunPlan(const PlanOptions& options) {
 
     const MethodChoice choice = ChooseMethod(*scene, MethodOfFlag(options.method));
     const Method method = choice.method;
+    if (absl::Status s = CheckNoiseThresholdMethod(method, options.noise_threshold); !s.ok()) {
+        return s;
+    }
     std::printf("method (--method %s): %s, because %s\n", options.method.c_str(),
                 std::string(MethodName(method)).c_str(), choice.why.c_str());
     // What Whitted would give (lf/kernels/whitted.h), whether or not it is the method.

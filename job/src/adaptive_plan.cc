@@ -58,7 +58,7 @@ bool PixelConverged(const PixelSums& pixel, double noise_threshold) {
 
 uint64_t NoiseThresholdMinSpp(double noise_threshold) {
     const double cycles = std::ceil(16 / std::pow(noise_threshold, 0.3));
-    return RoundUpToEven(std::max<uint64_t>(4, uint64_t(cycles)));
+    return RoundUpToEven(std::max<uint64_t>(kMinNoiseThresholdSpp, uint64_t(cycles)));
 }
 
 uint64_t NextNoiseCheck(uint64_t n, uint64_t max_spp) {
@@ -84,7 +84,8 @@ absl::Status CheckActivePixels(const RenderTask& task, const AdaptiveSettings& s
     if (settings.noise_threshold <= 0) {
         return absl::InvalidArgumentError(absl::StrCat(where, "a job without a noise threshold"));
     }
-    if (task.sample_end > settings.max_spp) {
+    // The plan rounds max_spp up to even (the halves hold equally many), and so may the last pass.
+    if (task.sample_end > RoundUpToEven(settings.max_spp)) {
         return absl::InvalidArgumentError(absl::StrCat(where, "samples up to ", task.sample_end,
                                                        ", beyond the job's max_spp ",
                                                        settings.max_spp));
@@ -104,8 +105,11 @@ absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> AdaptiveTilePlan::Make(
     int width, int height, uint64_t first_spp, int tile, const AdaptiveSettings& settings,
     uint64_t max_task_samples, const TileStoreFactory& make_store, uint32_t aovs) {
     if (absl::Status s = CheckAdaptiveSettings(settings); !s.ok()) return s;
-    const uint64_t first =
-        std::min(RoundUpToEven(settings.max_spp), RoundUpToEven(std::max<uint64_t>(first_spp, 2)));
+    // Per pixel, at least 4 (Cycles' floor): with one sample a half, a dark pixel whose two
+    // samples are both 0 would stop at once.
+    const uint64_t floor = settings.noise_threshold > 0 ? kMinNoiseThresholdSpp : 2;
+    const uint64_t first = std::min(RoundUpToEven(settings.max_spp),
+                                    RoundUpToEven(std::max<uint64_t>(first_spp, floor)));
     absl::StatusOr<std::vector<RenderTask>> tiles = PlanRender({width, height, first, tile, 1});
     if (!tiles.ok()) return tiles.status();
     absl::StatusOr<std::unique_ptr<TileStore>> store = make_store(TileRects(*tiles), aovs);
@@ -114,7 +118,7 @@ absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> AdaptiveTilePlan::Make(
         new AdaptiveTilePlan(width, height, settings, max_task_samples, std::move(*store)));
     plan->first_ = first;
     for (const RenderTask& task : *tiles) {
-        plan->tiles_.push_back({task.rect, 0, 0, 1, task.rect.Area(), {}});
+        plan->tiles_.push_back({.rect = task.rect, .unconverged = task.rect.Area()});
     }
     for (int t = 0; t < int(plan->tiles_.size()); ++t) plan->AppendPass(t, 0, plan->first_);
     return plan;

@@ -55,16 +55,24 @@ absl::Status CheckMethodSettings(const JobSpec& spec) {
             "\" has no adaptive sampling (no target error, noise threshold or time limit); set "
             "spp instead"));
     }
-    // Radiosity's target error refines its mesh; its display samples are no noise to stop on.
-    if (spec.adaptive.noise_threshold > 0 && Info(*method).work != WorkKind::kTiles) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("adaptive.noise_threshold: method \"", spec.method,
-                         "\" has no per-pixel samples to stop; use method path or whitted"));
+    if (absl::Status s = CheckNoiseThresholdMethod(*method, spec.adaptive.noise_threshold);
+        !s.ok()) {
+        return s;
     }
     return CheckShutterOfMethod(*method, spec.shot.shutter);
 }
 
 }  // namespace
+
+absl::Status CheckNoiseThresholdMethod(Method method, double noise_threshold) {
+    // Radiosity's target error refines its mesh; its display samples are no noise to stop on.
+    if (noise_threshold > 0 && Info(method).work != WorkKind::kTiles) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("adaptive.noise_threshold: method \"", Info(method).name,
+                         "\" has no per-pixel samples to stop; use method path or whitted"));
+    }
+    return absl::OkStatus();
+}
 
 absl::Status CheckJobSettings(const JobSpec& spec) {
     const RadiositySettings& r = spec.radiosity;

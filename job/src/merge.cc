@@ -17,13 +17,34 @@ absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums) {
                          ",", task.rect.y0, " ", task.rect.width, "x", task.rect.height));
     }
     const uint64_t n = task.sample_end - task.sample_begin;
+    // Samples [begin, end) hold this many even ones (the A half); the rest are odd (B).
+    const uint64_t even = (task.sample_end + 1) / 2 - (task.sample_begin + 1) / 2;
     const PixelMask active = task.active();
+    const ExactSum zero;
     for (size_t i = 0; i < sums.pixels.size(); ++i) {
-        const uint64_t expected = active.Has(i) ? n : 0;
-        if (sums.pixels[i].Count() != expected) {
+        const PixelSums& p = sums.pixels[i];
+        const bool sampled = active.Has(i);
+        const uint64_t expected = sampled ? n : 0;
+        if (p.Count() != expected) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                "task ", task.index, ": pixel ", i, " has ", p.Count(), " samples, the task ",
+                expected));
+        }
+        if (sampled && p.count[0] != even) {
             return absl::InvalidArgumentError(absl::StrCat("task ", task.index, ": pixel ", i,
-                                                           " has ", sums.pixels[i].Count(),
-                                                           " samples, the task ", expected));
+                                                           " has ", p.count[0],
+                                                           " even samples, the task ", even));
+        }
+        // A pixel the task does not sample must come back untouched (a converged pixel of a
+        // noise-threshold pass keeps the sums it stopped with).
+        bool untouched =
+            sampled || i >= sums.aov_pixels.size() || sums.aov_pixels[i] == AovSums{};
+        for (int h = 0; h < 2; ++h) {
+            for (int c = 0; c < 3; ++c) untouched = untouched && (sampled || p.sum[h][c] == zero);
+        }
+        if (!untouched) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                "task ", task.index, ": pixel ", i, " is not sampled by the task but has sums"));
         }
     }
     return absl::OkStatus();

@@ -1,5 +1,8 @@
 #include "lf/job/render_metadata.h"
 
+#include <algorithm>
+#include <limits>
+
 #include "absl/strings/str_cat.h"
 #include "lf/core/aov.h"
 #include "lf/core/pixel_filter.h"
@@ -88,8 +91,9 @@ void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveRepor
     attributes["lightfarm.adaptive.maxSpp"] = int(report.max_spp);
     if (settings.noise_threshold > 0) {
         attributes["lightfarm.noiseThreshold"] = settings.noise_threshold;
-        attributes["lightfarm.adaptive.pixelsUnconverged"] =
-            std::to_string(report.pixels_unconverged);
+        // An int as minSpp; above 2^31 pixels, the most an int holds (images are smaller).
+        attributes["lightfarm.adaptive.pixelsUnconverged"] = int(std::min<int64_t>(
+            report.pixels_unconverged, std::numeric_limits<int>::max()));
     }
 }
 

@@ -541,6 +541,16 @@ TEST_F(Cli, NoiseThresholdUsesCyclesMinimumAndRefusesWhatCannotCombine) {
     EXPECT_NE(plan.output.find("takes --spp 64 samples (Cycles' automatic minimum for 0.01 is 64)"),
               std::string::npos)
         << plan.output;
+    // plan refuses what render refuses.
+    for (const char* method : {"radiosity", "bdpt"}) {
+        const RunResult refused = Lightfarm("plan " + scene + " --noise-threshold 0.01 --method " +
+                                            method + " --resolution 32");
+        EXPECT_NE(refused.status, 0) << method;
+        EXPECT_NE(refused.output.find(std::string("method \"") + method +
+                                      "\" has no per-pixel samples to stop"),
+                  std::string::npos)
+            << refused.output;
+    }
 }
 
 // `plan` lists the environment among the lights, and a material whose emission texture has no

@@ -6,6 +6,7 @@ import dataclasses
 import datetime
 import enum
 import hashlib
+import math
 import os
 import secrets
 import time
@@ -650,7 +651,8 @@ class Client:
         return path
 
     # --- submitting ---
-    def submit(self, scene_path: Union[str, os.PathLike], *, spp: int = 16, seed: int = 0,
+    def submit(self, scene_path: Union[str, os.PathLike], *, spp: Optional[int] = None,
+               seed: int = 0,
                max_depth: int = -1, tile: int = 32, passes: int = 1, method: str = "path",
                priority: int = 0, name: Optional[str] = None, camera: str = "",
                resolution: Optional[Tuple[int, int]] = None, clamp: float = 0.0,
@@ -679,8 +681,8 @@ class Client:
         "gaussian", "blackman-harris") and ``filter_width``, ``sampler`` ("sobol",
         "independent"), ``light_sampling`` ("bvh", "power"); adaptive sampling with
         ``target_error``, ``time_limit`` (seconds) and ``max_spp``, or per pixel with
-        ``noise_threshold`` (Cycles' Noise Threshold; ``spp`` is then each pixel's minimum, as
-        given: the CLI's default is Cycles' automatic one); radiosity's ``patches``,
+        ``noise_threshold`` (Cycles' Noise Threshold; ``spp`` is then each pixel's minimum,
+        by default Cycles' automatic one, ceil(16 / threshold^0.3), as the CLI's); radiosity's ``patches``,
         ``patch_size``, ``solver``, ``tolerance``, ``max_iterations``, ``display``,
         ``sweep_tasks``, ``max_patches``; photon mapping's ``photons_per_pass``,
         ``initial_radius``, ``alpha``. A shot of an animated scene: ``frames`` ("A-B",
@@ -697,6 +699,8 @@ class Client:
         random bits, the same on every retry of this call).
         """
         scene_path = os.fspath(scene_path)
+        if spp is None:
+            spp = _noise_threshold_min_spp(noise_threshold) if noise_threshold > 0 else 16
         if isinstance(tags, str):  # a str is a sequence of one-letter tags
             raise InvalidArgument(f"tags {tags!r}: a list of tags, e.g. [{tags!r}]")
         if isinstance(after, str):  # a str is a sequence of one-letter ids
@@ -801,6 +805,13 @@ class Client:
     def _upload_error(self, file: common_pb2.SceneFile, e: grpc.RpcError) -> LightfarmError:
         err = self._error(e, "UploadBlob")
         return type(err)(f"{file.path}: upload: {err.message}", err.code)
+
+
+def _noise_threshold_min_spp(threshold: float) -> int:
+    """Cycles' automatic minimum for a noise threshold, at least 4, even: as
+    lf::NoiseThresholdMinSpp (job/src/adaptive_plan.cc)."""
+    n = max(4, math.ceil(16 / threshold ** 0.3))
+    return n + (n & 1)
 
 
 def _remove(path: str) -> None:

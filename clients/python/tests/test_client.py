@@ -168,6 +168,16 @@ class Farm:
         shutil.rmtree(self.dir, ignore_errors=True)
 
 
+class NoiseThresholdMinSppTest(unittest.TestCase):
+    def test_is_cycles_automatic_minimum_as_the_cli(self):
+        from lightfarm.client import _noise_threshold_min_spp
+        # lf::NoiseThresholdMinSpp's values (noise_threshold_test): Cycles' ceil(16 / T^0.3).
+        self.assertEqual(_noise_threshold_min_spp(0.1), 32)
+        self.assertEqual(_noise_threshold_min_spp(0.01), 64)
+        self.assertEqual(_noise_threshold_min_spp(0.001), 128)
+        self.assertEqual(_noise_threshold_min_spp(1.0), 16)
+
+
 class ClientTest(unittest.TestCase):
     farm = None
 

@@ -134,6 +134,22 @@ TEST(NoiseThresholdPlan, PixelsAreTheSameBitsForAnyTileSizeAndTaskSplit) {
     EXPECT_GT(split.tasks.size(), eight.tasks.size());
 }
 
+TEST(NoiseThresholdPlan, EveryTaskOfAnOddMaxSppPassesTheWorkersCheck) {
+    const AdaptiveSettings odd{.max_spp = 101, .noise_threshold = 0.001};
+    const PlanRun run = RunToEnd(8, odd);
+    EXPECT_EQ(run.report.max_spp, 102u);
+    for (const RenderTask& task : run.tasks) {
+        EXPECT_TRUE(CheckActivePixels(task, odd).ok()) << CheckActivePixels(task, odd);
+    }
+}
+
+TEST(NoiseThresholdPlan, TakesAtLeastFourSamplesAPixel) {
+    absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made =
+        AdaptiveTilePlan::Make(16, 8, 2, 8, kSettings, 1 << 20);
+    ASSERT_TRUE(made.ok()) << made.status();
+    EXPECT_EQ((*made)->tasks()[0].sample_end, kMinNoiseThresholdSpp);
+}
+
 TEST(NoiseThresholdPlan, StopsAtMaxSppAndCountsWhatDidNotConverge) {
     const PlanRun run = RunToEnd(8, {.max_spp = 64, .noise_threshold = 0.001});
     EXPECT_EQ(run.report.max_spp, 64u);
@@ -157,6 +173,38 @@ TEST(NoiseThresholdPlan, RefusesAResultWithSamplesInAConvergedPixel) {
         << merged.status();
 }
 
+TEST(NoiseThresholdPlan, RefusesSumsOutsideTheMaskAndUnbalancedHalves) {
+    absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made =
+        AdaptiveTilePlan::Make(16, 8, 16, 16, kSettings);
+    ASSERT_TRUE(made.ok());
+    AdaptiveTilePlan& plan = **made;
+    ASSERT_TRUE(plan.Merge(0, Pass(plan.tasks()[0])).ok());
+    ASSERT_EQ(plan.tasks().size(), 2u);
+    const RenderTask next = plan.tasks()[1];
+    const PixelMask mask = next.active();
+    size_t outside = 0, inside = 0;
+    while (mask.Has(outside)) ++outside;
+    while (!mask.Has(inside)) ++inside;
+
+    TileSums touched = Pass(next);
+    touched.pixels[outside].sum[0][0].Add(1.0f);  // no samples, yet sums
+    absl::StatusOr<std::vector<RenderTask>> merged = plan.Merge(1, touched);
+    EXPECT_EQ(merged.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(merged.status().message().find("is not sampled by the task but has sums"),
+              std::string::npos)
+        << merged.status();
+
+    TileSums unbalanced = Pass(next);
+    PixelSums& p = unbalanced.pixels[inside];
+    ++p.count[0];  // as many samples, one more of them even
+    --p.count[1];
+    merged = plan.Merge(1, unbalanced);
+    EXPECT_EQ(merged.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(merged.status().message().find("even samples, the task"), std::string::npos)
+        << merged.status();
+    EXPECT_TRUE(plan.Merge(1, Pass(next)).ok());  // nothing of the refused results stuck
+}
+
 TEST(CheckActivePixels, RefusesMalformedMasks) {
     RenderTask task{7, {0, 0, 5, 2}, 16, 32, std::string("\x01\x02", 2)};
     EXPECT_TRUE(CheckActivePixels(task, kSettings).ok());
@@ -175,6 +223,9 @@ TEST(CheckActivePixels, RefusesMalformedMasks) {
     t.active_pixels = std::string("\x00\x00", 2);
     refused(t, kSettings, "none set");
     refused(task, {.max_spp = 24, .noise_threshold = 0.01}, "beyond the job's max_spp 24");
+    // An odd max_spp: the plan's last pass ends at the even count above it.
+    EXPECT_TRUE(CheckActivePixels(task, {.max_spp = 31, .noise_threshold = 0.01}).ok());
+    refused(task, {.max_spp = 29, .noise_threshold = 0.01}, "beyond the job's max_spp 29");
     refused(task, {.target_error = 0.1}, "without a noise threshold");
     task.active_pixels.clear();  // every pixel: any job
     EXPECT_TRUE(CheckActivePixels(task, {.target_error = 0.1}).ok());

@@ -71,6 +71,9 @@ double PixelNoiseError(const PixelSums& pixel);
 // Cycles' test: converged when the error is below 5 threshold (Cycles scales the user's Noise
 // Threshold by 5 before comparing, "to make it more intuitive").
 bool PixelConverged(const PixelSums& pixel, double noise_threshold);
+// The fewest samples a pixel of a noise-threshold render takes, whatever --spp says (Cycles'
+// floor too).
+inline constexpr uint64_t kMinNoiseThresholdSpp = 4;
 // Cycles' automatic min samples for a threshold: ceil(16 / threshold^0.3), at least 4 (0.1: 32,
 // 0.01: 64, 0.001: 128), rounded up to even.
 uint64_t NoiseThresholdMinSpp(double noise_threshold);

@@ -86,6 +86,11 @@ inline constexpr std::array<std::string_view, 2> kRadiosityDisplays = {"flat", "
 // "radiosity.patches 1099511627776: expected 1 to 16777216".
 absl::Status CheckJobSettings(const JobSpec& spec);
 
+// Ok unless `noise_threshold` is set (> 0) for a method without per-pixel samples (only the
+// tile methods have them): then InvalidArgument naming the method. `render`, `submit` and `plan`
+// refuse alike.
+absl::Status CheckNoiseThresholdMethod(Method method, double noise_threshold);
+
 // Ok unless `shutter` opens (> 0) for a method that renders no motion blur
 // (MethodInfo::motion_blur): then InvalidArgument naming the method.
 absl::Status CheckShutterOfMethod(Method method, double shutter);
