@@ -26,9 +26,9 @@ absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums) {
         const bool sampled = active.Has(i);
         const uint64_t expected = sampled ? n : 0;
         if (p.Count() != expected) {
-            return absl::InvalidArgumentError(absl::StrCat(
-                "task ", task.index, ": pixel ", i, " has ", p.Count(), " samples, the task ",
-                expected));
+            return absl::InvalidArgumentError(absl::StrCat("task ", task.index, ": pixel ", i,
+                                                           " has ", p.Count(),
+                                                           " samples, the task ", expected));
         }
         if (sampled && p.count[0] != even) {
             return absl::InvalidArgumentError(absl::StrCat("task ", task.index, ": pixel ", i,
@@ -37,8 +37,7 @@ absl::Status CheckTaskResult(const RenderTask& task, const TileSums& sums) {
         }
         // A pixel the task does not sample must come back untouched (a converged pixel of a
         // noise-threshold pass keeps the sums it stopped with).
-        bool untouched =
-            sampled || i >= sums.aov_pixels.size() || sums.aov_pixels[i] == AovSums{};
+        bool untouched = sampled || i >= sums.aov_pixels.size() || sums.aov_pixels[i] == AovSums{};
         for (int h = 0; h < 2; ++h) {
             for (int c = 0; c < 3; ++c) untouched = untouched && (sampled || p.sum[h][c] == zero);
         }

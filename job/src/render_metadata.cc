@@ -92,8 +92,8 @@ void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveRepor
     if (settings.noise_threshold > 0) {
         attributes["lightfarm.noiseThreshold"] = settings.noise_threshold;
         // An int as minSpp; above 2^31 pixels, the most an int holds (images are smaller).
-        attributes["lightfarm.adaptive.pixelsUnconverged"] = int(std::min<int64_t>(
-            report.pixels_unconverged, std::numeric_limits<int>::max()));
+        attributes["lightfarm.adaptive.pixelsUnconverged"] =
+            int(std::min<int64_t>(report.pixels_unconverged, std::numeric_limits<int>::max()));
     }
 }
 

@@ -157,13 +157,20 @@ TEST(NoiseThresholdPlan, StopsAtMaxSppAndCountsWhatDidNotConverge) {
     EXPECT_LE(run.report.pixels_unconverged, 64);  // the flat pixels converge
 }
 
-TEST(NoiseThresholdPlan, RefusesAResultWithSamplesInAConvergedPixel) {
+// One 16x8 tile whose first pass has merged, so that its second pass samples the noisy half.
+std::unique_ptr<AdaptiveTilePlan> AfterTheFirstPass() {
     absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made =
         AdaptiveTilePlan::Make(16, 8, 16, 16, kSettings);
-    ASSERT_TRUE(made.ok());
-    AdaptiveTilePlan& plan = **made;
-    ASSERT_TRUE(plan.Merge(0, Pass(plan.tasks()[0])).ok());
-    ASSERT_EQ(plan.tasks().size(), 2u);
+    EXPECT_TRUE(made.ok()) << made.status();
+    EXPECT_TRUE((*made)->Merge(0, Pass((*made)->tasks()[0])).ok());
+    EXPECT_EQ((*made)->tasks().size(), 2u);
+    return *std::move(made);
+}
+
+TEST(NoiseThresholdPlan, RefusesAResultWithSamplesInAConvergedPixel) {
+    const std::unique_ptr<AdaptiveTilePlan> made = AfterTheFirstPass();
+    ASSERT_EQ(made->tasks().size(), 2u);
+    AdaptiveTilePlan& plan = *made;
     RenderTask all = plan.tasks()[1];
     ASSERT_FALSE(all.active_pixels.empty());
     all.active_pixels.clear();  // a worker that sampled every pixel
@@ -174,12 +181,9 @@ TEST(NoiseThresholdPlan, RefusesAResultWithSamplesInAConvergedPixel) {
 }
 
 TEST(NoiseThresholdPlan, RefusesSumsOutsideTheMaskAndUnbalancedHalves) {
-    absl::StatusOr<std::unique_ptr<AdaptiveTilePlan>> made =
-        AdaptiveTilePlan::Make(16, 8, 16, 16, kSettings);
-    ASSERT_TRUE(made.ok());
-    AdaptiveTilePlan& plan = **made;
-    ASSERT_TRUE(plan.Merge(0, Pass(plan.tasks()[0])).ok());
-    ASSERT_EQ(plan.tasks().size(), 2u);
+    const std::unique_ptr<AdaptiveTilePlan> made = AfterTheFirstPass();
+    ASSERT_EQ(made->tasks().size(), 2u);
+    AdaptiveTilePlan& plan = *made;
     const RenderTask next = plan.tasks()[1];
     const PixelMask mask = next.active();
     size_t outside = 0, inside = 0;
