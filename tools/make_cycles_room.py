@@ -6,9 +6,10 @@ Cycles (which imports the glTF again) render one scene:
 
 A closed 4 x 4 x 2.8 m room: walls of a 64 x 64 brick texture repeated once a metre, a grey
 floor, a white ceiling with a 1 x 1 m emissive panel (one-sided, facing down, radiance 8, 7, 6
-W m^-2 sr^-1 through KHR_materials_emissive_strength) as the only light, a glass sphere (IOR
-1.5, smooth: KHR_materials_transmission and KHR_materials_ior), a rough gold metal sphere, and
-the camera. Deterministic: running it again writes the same files.
+W m^-2 sr^-1 through KHR_materials_emissive_strength) as the only light, a glass sphere
+(smooth, KHR_materials_transmission, IOR 1.5: glTF's default), a rough gold metal sphere, and
+the camera. Running it again writes the same scene (the spheres' smooth normals may differ in their
+last bits: Blender computes them in parallel).
 """
 
 import math
