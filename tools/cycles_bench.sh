@@ -206,16 +206,17 @@ for name in "${scene_names[@]}"; do
   targets+=("| $name | equal-time RMSE ratio <= $limit | $equal_time | $(awk -v x="${equal_time%\*}" -v l="$limit" 'BEGIN { print (x + 0 <= l ? "met" : "not met") }') |")
 
   if [ "$adaptive" = 1 ]; then
-    points=""
+    points="" shown=()
     for t in "${threshold_list[@]}"; do
       s=$(lf_render "$scene" "$dir/lf_adaptive_$t.exr" "$dir/lf_adaptive_$t.log" \
         --noise-threshold "$t" --max-spp "$top_spp" --seed 0)
       read -r e _ _ < <(rmse "$dir/lf_adaptive_$t.exr" "$lf_ref")
       points+="$s $e"$'\n'
+      shown+=("$t: $s s, $e")
     done
     read -r cy_adaptive_e _ _ < <(rmse "$dir/cy_adaptive.exr" "$dir/$cy_ref_name.exr")
     lf_adaptive_at=$(printf '%s' "$points" | at_time "$cy_adaptive_s")
-    adaptive_rows+=("| $name | $cy_adaptive_s | $cy_adaptive_e | $(printf '%s' "$points" | tr '\n' ';' | sed 's/;$//; s/;/; /g') | $lf_adaptive_at | $(ratio "$lf_adaptive_at" "$cy_adaptive_e") |")
+    adaptive_rows+=("| $name | $cy_adaptive_s | $cy_adaptive_e | $(printf '%s; ' "${shown[@]}" | sed 's/; $//') | $lf_adaptive_at | $(ratio "$lf_adaptive_at" "$cy_adaptive_e") |")
   fi
   unset lf_s lf_e cy_s cy_e
   echo
@@ -242,7 +243,7 @@ echo
 if [ "$adaptive" = 1 ]; then
   echo "Cycles at noise threshold 0.01 against lightfarm --noise-threshold $thresholds (--max-spp $top_spp)"
   echo
-  echo "| scene | Cycles s | Cycles RMSE | lightfarm (s RMSE) per threshold | lightfarm RMSE at Cycles' time | ratio |"
+  echo "| scene | Cycles s | Cycles RMSE | lightfarm per threshold (T: s, RMSE) | lightfarm RMSE at Cycles' time | ratio |"
   echo "| --- | ---: | ---: | --- | ---: | ---: |"
   printf '%s\n' "${adaptive_rows[@]}"
 else
