@@ -59,7 +59,8 @@ def build_json(path):
     order = list(materials)
     for i, shape in enumerate(scene.get("shapes", [])):
         if shape.get("type") != "quad":
-            sys.exit("%s: shapes[%d]: type %r: only quads are built here" % (path, i, shape.get("type")))
+            kind = shape.get("type")
+            sys.exit("%s: shapes[%d]: type %r: only quads are built here" % (path, i, kind))
         if shape.get("material") not in materials:
             sys.exit("%s: shapes[%d]: no material %r" % (path, i, shape.get("material")))
         faces.append(range(len(vertices), len(vertices) + 4))

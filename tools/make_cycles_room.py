@@ -98,7 +98,8 @@ def panel():
     lamp.use_backface_culling = True  # single-sided: emits downwards only, as in lightfarm
     mesh = bpy.data.meshes.new("Panel")
     z = HEIGHT - 0.01
-    mesh.from_pydata([(-0.5, -0.5, z), (-0.5, 0.5, z), (0.5, 0.5, z), (0.5, -0.5, z)], [], [range(4)])
+    corners = [(-0.5, -0.5, z), (-0.5, 0.5, z), (0.5, 0.5, z), (0.5, -0.5, z)]
+    mesh.from_pydata(corners, [], [range(4)])
     mesh.materials.append(lamp)
     mesh.update()
     assert mesh.polygons[0].normal.z < 0
@@ -132,7 +133,8 @@ def main():
     camera.data.sensor_fit = "VERTICAL"
     camera.data.angle_y = math.radians(60)
     camera.location = (0, -1.9, 1.3)
-    camera.rotation_euler = (mathutils.Vector((0, 0.6, 0.6)) - camera.location).to_track_quat("-Z", "Y").to_euler()
+    towards = mathutils.Vector((0, 0.6, 0.6)) - camera.location
+    camera.rotation_euler = towards.to_track_quat("-Z", "Y").to_euler()
     scene.collection.objects.link(camera)
     scene.camera = camera
     scene.render.resolution_x = scene.render.resolution_y = 256
