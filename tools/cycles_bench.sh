@@ -167,8 +167,8 @@ for name in "${scene_names[@]}"; do
   if [ "$fresh" = 1 ] || [ ! -f "$dir/$cy_ref_name.exr" ]; then renders+=("$cy_ref_name:$ref_spp:1"); fi
   if [ "$adaptive" = 1 ]; then renders+=("cy_adaptive:$top_spp:0:0.01"); fi
   # shellcheck disable=SC2086  # $view is the projection and ten numbers
-  if ! blender -b --factory-startup --python tools/cycles_bench.py -- "$PWD/$scene" "$dir" "$res" \
-      "$threads" $view "${renders[@]}" > "$dir/cycles.log" 2>&1; then
+  if ! blender -b --factory-startup --python-exit-code 1 --python tools/cycles_bench.py -- \
+      "$PWD/$scene" "$dir" "$res" "$threads" $view "${renders[@]}" > "$dir/cycles.log" 2>&1; then
     echo "$0: Cycles failed on $name, see $dir/cycles.log" >&2
     exit 1
   fi
