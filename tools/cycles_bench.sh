@@ -194,6 +194,13 @@ for name in "${scene_names[@]}"; do
   speed=$(ratio "$t_c" "${lf_s[$at_spp]}")
   equal_spp=$(ratio "${lf_e[$at_spp]}" "${cy_e[$at_spp]}")
   equal_time=$(ratio "$lf_at" "${cy_e[$at_spp]}")
+  # From $at_spp to $top_spp spp an RMSE should fall as 1/sqrt(spp); one that hardly falls is
+  # the reference's own error (fireflies in it), and the scene's ratios are then meaningless.
+  for who in lightfarm Cycles; do
+    if [ "$who" = lightfarm ]; then e_at=${lf_e[$at_spp]} e_top=${lf_e[$top_spp]}; else e_at=${cy_e[$at_spp]} e_top=${cy_e[$top_spp]}; fi
+    awk -v w="$who" -v a="$e_at" -v t="$e_top" -v n="$at_spp" -v m="$top_spp" 'BEGIN {
+      if (m > n && t > 0.8 * a) printf("\nWARNING: %s'"'"'s RMSE falls only from %s to %s between %d and %d spp (1/sqrt(spp): %.3g): its reference is probably dominated by its own outliers; this scene'"'"'s ratios are not valid.\n", w, a, t, n, m, a * sqrt(n / m)) }'
+  done
   echo
   echo "lightfarm's RMSE at Cycles' $at_spp-spp time ($t_c s): $lf_at; lightfarm reference's own estimated RMSE $ref_halves"
   summary+=("| $name | ${lf_s[$at_spp]} | $t_c | $speed | $equal_spp | $equal_time | $ref_ratio | $ref_halves |")
