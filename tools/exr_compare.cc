@@ -8,6 +8,12 @@
 // 1): its RGB is then composited over that sky, as A renders it, and the means are taken over
 // the pixels B covers fully (alpha >= 0.999), the asset rather than the sky around it.
 // Output, one line: "pixels N A r g b lum B r g b lum ratio r g b lum" (ratio nan where B's is 0).
+//
+//   exr_compare A.exr REFERENCE.exr --rmse      (tools/cycles_bench.sh)
+//
+// adds " rmse E halves H" to the line: E the root mean square difference A - B over all pixels
+// and R, G, B (B over the white sky as above), and H A's own error estimate from lightfarm's
+// half-sample channels, sqrt(mean(((A.R - B.R) / 2)^2)) over the same, nan without them.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
@@ -77,7 +83,21 @@ Image SideBySide(const Image& a, const Image& b) {
     return out;
 }
 
-int Run(const std::string& a_path, const std::string& b_path, const std::string& png) {
+// Root mean square of x - y over all pixels and R, G, B, where x and y name the channels.
+double Rmse(const Image& a, const char* const x[3], const Image& b, const char* const y[3]) {
+    double sum = 0;
+    size_t n = 0;
+    for (int c = 0; c < 3; ++c) {
+        const std::vector<float>* p = a.FindChannel(x[c]);
+        const std::vector<float>* q = b.FindChannel(y[c]);
+        if (p == nullptr || q == nullptr || p->size() != q->size()) return NAN;
+        for (size_t i = 0; i < p->size(); ++i) sum += std::pow(double((*p)[i]) - (*q)[i], 2);
+        n += p->size();
+    }
+    return std::sqrt(sum / double(n));
+}
+
+int Run(const std::string& a_path, const std::string& b_path, const std::string& png, bool rmse) {
     absl::StatusOr<ExrFile> a = ReadExr(a_path);
     absl::StatusOr<ExrFile> b = ReadExr(b_path);
     for (const absl::StatusOr<ExrFile>* f : {&a, &b}) {
@@ -104,6 +124,13 @@ int Run(const std::string& a_path, const std::string& b_path, const std::string&
     for (const double v : mb) std::printf(" %.5g", v);
     std::printf(" ratio");
     for (int c = 0; c < 4; ++c) std::printf(" %.4f", mb[c] > 0 ? ma[c] / mb[c] : NAN);
+    if (rmse) {
+        constexpr const char* kHalfA[3] = {"A.R", "A.G", "A.B"};
+        constexpr const char* kHalfB[3] = {"B.R", "B.G", "B.B"};
+        // (A - B) / 2 of the halves: the error of their mean when the halves are independent.
+        std::printf(" rmse %.6g halves %.6g", Rmse(a->image, kRgb, b->image, kRgb),
+                    Rmse(a->image, kHalfA, a->image, kHalfB) / 2);
+    }
     std::printf("\n");
     if (!png.empty()) {
         if (absl::Status s = WritePng(png, SideBySide(a->image, b->image)); !s.ok()) {
@@ -120,11 +147,15 @@ int Run(const std::string& a_path, const std::string& b_path, const std::string&
 int main(int argc, char** argv) {
     CLI::App app{
         "Mean R, G, B and luminance of two EXR renders, their ratios A/B, and a "
-        "side-by-side sRGB PNG"};
+        "side-by-side sRGB PNG; with --rmse, the RMSE of A against B"};
     std::string a, b, png;
+    bool rmse = false;
     app.add_option("a", a, "first image (.exr)")->required();
     app.add_option("b", b, "second image (.exr)")->required();
     app.add_option("--png", png, "write A and B side by side here (8-bit sRGB, clamped)");
+    app.add_flag("--rmse", rmse,
+                 "also print the RMSE of A against B over all pixels and R, G, B, and A's own "
+                 "estimate of it from lightfarm's half-sample channels A.* and B.* (nan without)");
     CLI11_PARSE(app, argc, argv);
-    return lf::Run(a, b, png);
+    return lf::Run(a, b, png, rmse);
 }
