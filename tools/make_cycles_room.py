@@ -8,10 +8,12 @@ A closed 4 x 4 x 2.8 m room: walls of a 64 x 64 brick texture repeated once a me
 floor, a white ceiling with a 1 x 1 m emissive panel (one-sided, facing down, radiance 8, 7, 6
 W m^-2 sr^-1 through KHR_materials_emissive_strength) as the only light, a glass sphere
 (smooth, KHR_materials_transmission, IOR 1.5: glTF's default), a rough gold metal sphere, and
-the camera. Running it again writes the same scene (the spheres' smooth normals may differ in their
-last bits: Blender computes them in parallel).
+the camera. The glass gets KHR_materials_volume after the export (make_glass_solid), so that
+lightfarm refracts through it as Cycles does. Running it again writes the same scene (the
+spheres' smooth normals may differ in their last bits: Blender computes them in parallel).
 """
 
+import json
 import math
 import os
 import sys
@@ -138,13 +140,33 @@ def main():
     scene.collection.objects.link(camera)
     scene.camera = camera
     scene.render.resolution_x = scene.render.resolution_y = 256
+    path = os.path.join(directory, "room.gltf")
     bpy.ops.export_scene.gltf(
-        filepath=os.path.join(directory, "room.gltf"),
+        filepath=path,
         export_format="GLTF_SEPARATE",
         export_cameras=True,
         export_lights=False,
         export_extras=False,
     )
+    make_glass_solid(path)
+
+
+def make_glass_solid(path):
+    """glTF's transmission without KHR_materials_volume is a thin wall (no refraction), which
+    lightfarm follows; Cycles refracts through the closed sphere whatever glTF says. Blender 3.4's
+    exporter writes no volume, so the Glass material gets one here (thickness: the diameter), and
+    both renderers see a solid glass ball."""
+    with open(path) as f:
+        gltf = json.load(f)
+    for m in gltf["materials"]:
+        if m["name"] == "Glass":
+            m.setdefault("extensions", {})["KHR_materials_volume"] = {"thicknessFactor": 1.0}
+    used = gltf.setdefault("extensionsUsed", [])
+    if "KHR_materials_volume" not in used:
+        used.append("KHR_materials_volume")
+    with open(path, "w") as f:
+        json.dump(gltf, f, indent=4)
+        f.write("\n")
 
 
 main()
