@@ -103,7 +103,9 @@ if ! "$bin/exr_compare" --help | grep -q -- --rmse; then
   exit 2
 fi
 adaptive=0
-if "$bin/lightfarm" render --help | grep -q -- --noise-threshold; then adaptive=1; fi
+# Not `--help | grep -q`: under pipefail, grep leaving early fails the pipeline (SIGPIPE).
+render_help=$("$bin/lightfarm" render --help)
+if grep -q -- --noise-threshold <<< "$render_help"; then adaptive=1; fi
 lf_sum=$(sha256sum "$bin/lightfarm" | cut -c1-12)
 blender_version=$(blender --version 2> /dev/null | sed -n '1s/Blender //p')
 mkdir -p "$out"
