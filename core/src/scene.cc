@@ -20,6 +20,8 @@ const char* MaterialTypeName(Material::Type type) {
             return "dielectric";
         case Material::Type::kPrincipled:
             return "principled";
+        case Material::Type::kInterface:
+            return "interface";
     }
     return "unknown";
 }

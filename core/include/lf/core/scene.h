@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "lf/core/medium.h"
 #include "lf/core/rgb.h"
 #include "lf/core/vec.h"
 
@@ -50,7 +51,9 @@ struct TextureRef {
 };
 
 struct Material {
-    enum class Type { kLambert, kMirror, kGlossy, kDielectric, kPrincipled };
+    // kInterface: a boundary between media that neither reflects nor refracts (rays pass
+    // straight through it into the medium on the other side).
+    enum class Type { kLambert, kMirror, kGlossy, kDielectric, kPrincipled, kInterface };
     enum class Distribution { kGgx, kBeckmann };
     enum class AlphaMode { kOpaque, kMask, kBlend };
 
@@ -168,6 +171,7 @@ struct TriangleMesh {
     // True when the mesh came from a `quad` shape: (v0,v1,v2),(v0,v2,v3). Radiosity meshes
     // such shapes as a grid of quads rather than triangles.
     bool is_quad = false;
+    MediumInterface media;  // JSON "interior" and "exterior"
 
     // The uv set a texture with this tex_coord reads.
     const std::vector<Vec2>& Uvs(int tex_coord) const { return tex_coord == 1 ? uvs1 : uvs; }
@@ -178,6 +182,7 @@ struct Sphere {
     int material = 0;
     Vec3d center;
     double radius = 1;
+    MediumInterface media;
 };
 
 struct PointLight {
@@ -274,6 +279,11 @@ struct Scene {
     std::optional<EnvironmentLight> environment;  // at most one sky
     // Images the materials' TextureRefs index; shared, so a copied scene costs no texels.
     std::vector<std::shared_ptr<const TextureImage>> textures;
+    // Participating media (JSON "media"), which shapes' MediumInterfaces and camera_medium
+    // index. Solid transmitters with KHR_materials_volume's attenuation get a homogeneous
+    // absorbing medium here as their interior.
+    std::vector<Medium> media;
+    int camera_medium = -1;  // the medium the camera sits in (JSON camera "medium"), -1 vacuum
 
     std::string source;        // path of the scene file, for messages
     std::string content_hash;  // hex digest of the scene file and every mesh file it names
