@@ -1,5 +1,6 @@
 #include "lf/core/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -24,6 +25,13 @@ const char* MaterialTypeName(Material::Type type) {
             return "interface";
     }
     return "unknown";
+}
+
+bool Scene::HasMedia() const {
+    if (!media.empty() || camera_medium >= 0) return true;
+    return std::any_of(materials.begin(), materials.end(), [](const Material& m) {
+        return m.type == Material::Type::kInterface;
+    });
 }
 
 std::pair<Vec3d, Vec3d> Scene::Bounds() const {

@@ -17,6 +17,7 @@ Rgb Albedo(const Material& material, const SurfaceParams& params) {
                                       : params.base_color;
         case Material::Type::kLambert:
         case Material::Type::kPrincipled:
+        case Material::Type::kInterface:  // never a first hit (TraceFirstHit passes it)
             return params.base_color;
     }
     return params.base_color;
@@ -24,12 +25,22 @@ Rgb Albedo(const Material& material, const SurfaceParams& params) {
 
 }  // namespace
 
-std::optional<FirstHit> TraceFirstHit(const EmbreeScene& scene, const Ray& ray) {
-    const std::optional<SurfaceHit> hit = scene.Intersect(ray);
-    if (!hit) return std::nullopt;
-    const Shading sh = Shade(scene, *hit, -ray.d);
-    const Material& material = scene.scene().materials[size_t(hit->material)];
-    return FirstHit{Albedo(material, sh.params), sh.ns, hit->t * Length(ray.d)};
+std::optional<FirstHit> TraceFirstHit(const EmbreeScene& scene, const Ray& camera_ray) {
+    Ray ray = camera_ray;
+    float distance = 0;
+    for (;;) {
+        const std::optional<SurfaceHit> hit = scene.Intersect(ray);
+        if (!hit) return std::nullopt;
+        distance += hit->t * Length(ray.d);
+        const Material& material = scene.scene().materials[size_t(hit->material)];
+        if (material.type == Material::Type::kInterface) {
+            // A boundary between media is not a surface: the first hit lies beyond it.
+            ray = SpawnRay(SurfacePoint{hit->p, hit->p_error, hit->n}, ray.d);
+            continue;
+        }
+        const Shading sh = Shade(scene, *hit, -ray.d);
+        return FirstHit{Albedo(material, sh.params), sh.ns, distance};
+    }
 }
 
 }  // namespace lf

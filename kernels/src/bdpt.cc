@@ -44,13 +44,15 @@ struct BdptVertex {
     Rgb beta;
     float pdf_fwd = 0, pdf_rev = 0;
     // Surfaces: the interaction, the BSDF and its frame, the direction back along the subpath,
-    // the material, the interior the subpath arrived through, the emission seen from wo
-    // (camera subpaths), and the connection numbers drawn at this vertex.
+    // the material, the medium the subpath arrived through and the media on either side of
+    // the surface, the emission seen from wo (camera subpaths), and the connection numbers
+    // drawn at this vertex.
     Shading sh;
     std::optional<Bsdf> bsdf;
     Frame frame;
     Vec3 wo;
     int material = -1, medium = -1;
+    MediumInterface media;
     Rgb le;
     float u_pick = 0;
     Vec2 u_conn;
@@ -204,8 +206,7 @@ Rgb BdptRenderer::FCos(const BdptVertex& v, const Vec3& dir, bool importance) co
 int BdptRenderer::MediumToward(const BdptVertex& v, const Vec3& dir) const {
     if (v.type != BdptVertex::Type::kSurface) return -1;
     const bool transmitted = v.frame.ToLocal(dir).z * v.frame.ToLocal(v.wo).z < 0;
-    return InteriorAfter(v.medium, v.material, scene_.scene().materials[size_t(v.material)],
-                         Dot(dir, v.ng), transmitted);
+    return transmitted ? MediumAfter(v.media, v.medium, v.ng, dir) : v.medium;
 }
 
 Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to,
@@ -213,9 +214,7 @@ Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to,
     const Vec3 dir = DirectionTo(from, to);
     ++stats.rays;
     if (scene_.Occluded(SpawnRayTo(from.sh.Leaving(dir), to.point))) return Rgb(0);
-    const int medium = MediumToward(from, dir);
-    if (medium < 0) return Rgb(1);
-    return Transmittance(scene_.scene().materials[size_t(medium)], Length(to.p - from.p));
+    return Attenuation(scene_, MediumToward(from, dir), Length(to.p - from.p));
 }
 
 void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool importance,
@@ -248,7 +247,7 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
             return;
         }
         if (medium >= 0) {
-            beta *= Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
+            beta *= Attenuation(scene_, medium, hit->t * Length(ray.d));
             if (beta.IsBlack()) return;
         }
         BdptVertex v;
@@ -261,6 +260,7 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
         v.on_surface = true;
         v.material = hit->material;
         v.medium = medium;
+        v.media = InterfaceAt(scene_.scene(), *hit);
         v.wo = -ray.d;
         v.frame = Frame::FromNormal(v.sh.ns);
         const Material& material = materials[size_t(hit->material)];
@@ -323,7 +323,7 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
             pdf_rev = std::abs(Dot(cur.wo, cur.ng));
         }
         prev.pdf_rev = ConvertDensity(cur, pdf_rev, prev);
-        medium = InteriorAfter(medium, cur.material, material, Dot(wi, cur.ng), transmitted);
+        if (transmitted) medium = MediumAfter(cur.media, medium, cur.ng, wi);
         ray = SpawnRay(cur.sh.Leaving(wi), wi);
         if (bounces >= kRouletteStartBounce) {
             const float relative =

@@ -69,6 +69,7 @@ Rgb Bsdf::Eval(const Vec3& wo, const Vec3& wi) const {
         case Material::Type::kMirror:
         case Material::Type::kDielectric:
         case Material::Type::kPrincipled:  // principled_
+        case Material::Type::kInterface:   // scatters nothing: integrators pass through it
             break;
     }
     return {};
@@ -86,6 +87,7 @@ float Bsdf::Pdf(const Vec3& wo, const Vec3& wi) const {
         case Material::Type::kMirror:
         case Material::Type::kDielectric:
         case Material::Type::kPrincipled:  // principled_
+        case Material::Type::kInterface:   // scatters nothing: integrators pass through it
             break;
     }
     return 0;
@@ -139,6 +141,7 @@ std::optional<BsdfSample> Bsdf::Sample(const Vec3& wo, float uc, const Vec2& u) 
             return BsdfSample{Rgb(f), *wi, transmit, true, eta};
         }
         case Material::Type::kPrincipled:  // principled_
+        case Material::Type::kInterface:   // scatters nothing: integrators pass through it
             break;
     }
     return std::nullopt;

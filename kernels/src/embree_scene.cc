@@ -280,6 +280,7 @@ absl::StatusOr<std::unique_ptr<EmbreeScene>> EmbreeScene::Build(const Scene& sce
     const auto [lo, hi] = scene.Bounds();
     const Vec3d origin = (lo + hi) * 0.5;
     std::unique_ptr<EmbreeScene> es(new EmbreeScene(scene, origin));
+    es->media_ = std::make_unique<SceneMedia>(scene, origin);
     Handles& h = *es->handles_;
     h.device = rtcNewDevice(nullptr);
     if (!h.device) return absl::InternalError("embree: cannot create a device");

@@ -96,7 +96,7 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
         if (!hit) break;
         if (medium >= 0) {
-            beta *= Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
+            beta *= Attenuation(scene_, medium, hit->t * Length(ray.d));
             if (beta.IsBlack()) break;
         }
         const Material& material = materials[size_t(hit->material)];
@@ -126,12 +126,10 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
                         ++stats.rays;
                         const SurfacePoint lens_point{cs->lens_point, Vec3(), Vec3()};
                         if (!scene_.Occluded(SpawnRayTo(sh.Leaving(cs->wi), lens_point))) {
-                            const int through = InteriorAfter(medium, hit->material, material,
-                                                              Dot(cs->wi, ng), !reflect);
-                            if (through >= 0) {
-                                value *= Transmittance(materials[size_t(through)],
-                                                       Length(cs->lens_point - hit->p));
-                            }
+                            const int through =
+                                reflect ? medium
+                                        : MediumAfter(scene_.scene(), medium, *hit, cs->wi);
+                            value *= Attenuation(scene_, through, Length(cs->lens_point - hit->p));
                             Splat(cs->raster, half, value, splats, stats);
                         }
                     }
@@ -155,7 +153,7 @@ void LightTracer::TracePath(uint64_t index, SplatList& splats, RenderStats& stat
         beta *= bs->f *
                 (bs->eta * bs->eta * std::abs(wo.z) * std::abs(cos_i_ng) / (cos_o_ng * bs->pdf));
         if (beta.IsBlack() || !beta.IsFinite()) break;
-        medium = InteriorAfter(medium, hit->material, material, cos_i_ng, transmitted);
+        if (transmitted) medium = MediumAfter(scene_.scene(), medium, *hit, wi_world);
         ray = SpawnRay(sh.Leaving(wi_world), wi_world);
 
         if (bounce >= kRouletteStartDepth) {

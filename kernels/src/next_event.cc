@@ -2,12 +2,20 @@
 
 namespace lf {
 
+const MediumInterface& InterfaceAt(const Scene& scene, const SurfaceHit& hit) {
+    return hit.mesh >= 0 ? scene.meshes[size_t(hit.mesh)].media
+                         : scene.spheres[size_t(hit.sphere)].media;
+}
+
+Rgb Attenuation(const EmbreeScene& scene, int medium, float distance) {
+    return medium < 0 ? Rgb(1.0f) : scene.media().HomogeneousTransmittance(medium, distance);
+}
+
 Rgb NextEventEstimate(const EmbreeScene& scene, const LightSampler& lights, const SurfaceHit& hit,
                       const Shading& sh, const Vec3& wo_world, const Bsdf& bsdf, int medium,
                       const Rgb& beta, float u_pick, const Vec2& u_light, RenderStats& stats) {
     const std::optional<LightSample> ls = lights.Sample(hit.p, sh.ns, u_pick, u_light, hit.time);
     if (!ls) return Rgb();
-    const std::vector<Material>& materials = scene.scene().materials;
     const Frame frame = Frame::FromNormal(sh.ns);
     const Vec3 wo = frame.ToLocal(wo_world);
     const Vec3 wi = frame.ToLocal(ls->wi);
@@ -19,13 +27,9 @@ Rgb NextEventEstimate(const EmbreeScene& scene, const LightSampler& lights, cons
     ++stats.rays;
     if (scene.Occluded(SpawnRayTo(sh.Leaving(ls->wi), ls->point))) return Rgb();
     const float w = ls->delta ? 1.0f : PowerHeuristic(ls->pdf, bsdf.Pdf(wo, wi));
-    Rgb contribution = beta * f * radiance * (w / ls->pdf);
-    const int through = InteriorAfter(medium, hit.material, materials[size_t(hit.material)],
-                                      Dot(ls->wi, hit.n), wi.z * wo.z < 0);
-    if (through >= 0) {
-        contribution *= Transmittance(materials[size_t(through)], Length(ls->point.p - hit.p));
-    }
-    return contribution;
+    const int through = wi.z * wo.z < 0 ? MediumAfter(scene.scene(), medium, hit, ls->wi) : medium;
+    return beta * f * radiance * (w / ls->pdf) *
+           Attenuation(scene, through, Length(ls->point.p - hit.p));
 }
 
 }  // namespace lf

@@ -21,6 +21,9 @@ PathTracer::PathTracer(const EmbreeScene& scene, int max_depth, LightStrategy st
 
 Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) const {
     const std::vector<Material>& materials = scene_.scene().materials;
+    // Scenes with media take VolPathTracer (lf/kernels/vol_path_tracer.h): every ray here
+    // travels through vacuum.
+    constexpr int kVacuum = -1;
     Rgb L(0), beta(1);
     Ray ray = camera_ray;
     bool delta_bounce = true;  // the camera ray sees emission with full weight
@@ -29,8 +32,6 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
     // BSDF-sampled ray hits must see what its Sample saw there.
     Vec3 prev_p, prev_n;
     float eta_scale = 1;
-    // The solid transmitter whose interior the ray travels through (a material index), or -1.
-    int medium = -1;
 
     for (int depth = 0;; ++depth) {
         // The bounce's random numbers, drawn before the ray is traced: a Sobol draw is a chain
@@ -51,10 +52,6 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
                      (delta_bounce ? 1.0f : PowerHeuristic(prev_pdf, lights_.EscapedPdf(w)));
             }
             break;
-        }
-        if (medium >= 0) {
-            beta *= Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
-            if (beta.IsBlack()) break;
         }
         const Material& material = materials[size_t(hit->material)];
         const Vec3& ng = hit->n;
@@ -81,7 +78,7 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         const Bsdf bsdf(material, sh.params);
 
         if (!bsdf.IsDelta()) {
-            L += NextEventEstimate(scene_, lights_, *hit, sh, -ray.d, bsdf, medium, beta,
+            L += NextEventEstimate(scene_, lights_, *hit, sh, -ray.d, bsdf, kVacuum, beta,
                                    u_choice.x, u_light, stats);
         }
 
@@ -91,12 +88,8 @@ Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) 
         if (!sh.SidesAgree(-ray.d, wi, bs->wi.z * wo.z > 0)) break;
         beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
         if (beta.IsBlack()) break;
-        const bool transmitted = bs->wi.z * wo.z < 0;
-        const int next_medium =
-            InteriorAfter(medium, hit->material, material, Dot(wi, ng), transmitted);
         // Radiance is scaled by 1/eta^2 across a refracting interface; roulette must not see it.
         eta_scale *= bs->eta * bs->eta;
-        medium = next_medium;
         delta_bounce = bs->delta;
         prev_pdf = bs->pdf;
         prev_p = hit->p;

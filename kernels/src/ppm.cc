@@ -142,7 +142,7 @@ void PpmRenderer::TraceRange(uint64_t pass, uint64_t begin, uint64_t end, std::v
             const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
             if (!hit) break;
             if (medium >= 0) {
-                beta *= Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
+                beta *= Attenuation(scene_, medium, hit->t * Length(ray.d));
                 if (beta.IsBlack()) break;
             }
             const Material& material = materials[size_t(hit->material)];
@@ -169,8 +169,7 @@ void PpmRenderer::TraceRange(uint64_t pass, uint64_t begin, uint64_t end, std::v
             if (!(cos_o_ng > 0)) break;
             beta *= bs->f * (std::abs(wo.z) * cos_i_ng / (cos_o_ng * bs->pdf) * bs->eta * bs->eta);
             if (beta.IsBlack() || !beta.IsFinite()) break;
-            medium = InteriorAfter(medium, hit->material, material, Dot(wi, hit->n),
-                                   bs->wi.z * wo.z < 0);
+            if (bs->wi.z * wo.z < 0) medium = MediumAfter(scene_.scene(), medium, *hit, wi);
             ray = SpawnRay(sh.Leaving(wi), wi);
             if (depth >= kRouletteStartDepth) {
                 const float q = std::max(0.0f, 1 - beta.MaxComponent() / emitted_max);
@@ -229,7 +228,7 @@ Rgb PpmRenderer::Li(const Ray& camera_ray, const PhotonMap& map, Sampler& sample
             break;
         }
         if (medium >= 0) {
-            beta *= Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
+            beta *= Attenuation(scene_, medium, hit->t * Length(ray.d));
             if (beta.IsBlack()) break;
         }
         const Material& material = materials[size_t(hit->material)];
@@ -277,7 +276,7 @@ Rgb PpmRenderer::Li(const Ray& camera_ray, const PhotonMap& map, Sampler& sample
         if (!sh.SidesAgree(wo_world, wi, bs->wi.z * wo.z > 0)) break;
         beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
         if (beta.IsBlack()) break;
-        medium = InteriorAfter(medium, hit->material, material, Dot(wi, ng), bs->wi.z * wo.z < 0);
+        if (bs->wi.z * wo.z < 0) medium = MediumAfter(scene_.scene(), medium, *hit, wi);
         eta_scale *= bs->eta * bs->eta;
         ray = SpawnRay(sh.Leaving(wi), wi);
         if (depth >= kRouletteStartDepth) {
@@ -303,9 +302,8 @@ Rgb PpmRenderer::DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec
                               u_light, stats);
     // Beer's law when the BSDF sample reaches an emitter through a solid's interior.
     auto transmittance = [&](const Vec3& w, bool transmitted, float distance) {
-        const int through = InteriorAfter(medium, hit.material, materials[size_t(hit.material)],
-                                          Dot(w, hit.n), transmitted);
-        return through >= 0 ? Transmittance(materials[size_t(through)], distance) : Rgb(1.0f);
+        return Attenuation(scene_, transmitted ? MediumAfter(scene_.scene(), medium, hit, w) : medium,
+                           distance);
     };
     // A delta lobe's sample is the path's next segment (Li), which counts what it hits.
     if (!bs || bs->delta || !(bs->pdf > 0)) return L;

@@ -200,16 +200,6 @@ bool HasInterior(const Material& material) {
             material.thickness > 0);
 }
 
-Rgb Transmittance(const Material& material, float distance) {
-    if (!std::isfinite(material.attenuation_distance) || !(distance > 0)) return Rgb(1);
-    Rgb t;
-    for (int c = 0; c < 3; ++c) {
-        // sigma = -ln(colour) / d, so exp(-sigma * distance) = colour^(distance / d).
-        t[c] = std::pow(std::max(0.0f, material.attenuation_color[c]),
-                        distance / material.attenuation_distance);
-    }
-    return t;
-}
 
 namespace {
 

@@ -5,19 +5,12 @@
 #include <optional>
 
 #include "lf/kernels/bsdf.h"
+#include "lf/kernels/next_event.h"
 #include "lf/kernels/shading.h"
 
 namespace lf {
 
 namespace {
-
-// The interior a ray is in after leaving a surface of material `index` in direction wi, as in
-// the path tracer: a transmission through a solid transmitter's surface enters it (against the
-// geometric normal) or leaves it (along it).
-int MediumAfter(int medium, int index, const Material& material, float cos_i_ng, bool transmitted) {
-    if (!transmitted || !HasInterior(material)) return medium;
-    return cos_i_ng < 0 ? index : -1;
-}
 
 // Has a delta lobe everywhere: a texture only scales the factors, so a smooth principled
 // material's constant parameters decide it for every point.
@@ -109,7 +102,7 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
     if (!hit) return lights_.EscapedRadiance(Normalize(ray.d));
     Rgb beta(1);
     if (medium >= 0) {
-        beta = Transmittance(materials[size_t(medium)], hit->t * Length(ray.d));
+        beta = Attenuation(scene_, medium, hit->t * Length(ray.d));
         if (beta.IsBlack()) return {};
     }
     const Material& material = materials[size_t(hit->material)];
@@ -150,14 +143,10 @@ Rgb WhittedTracer::Trace(const Ray& ray, int depth, int medium, Sampler& sampler
                 if (radiance.IsBlack()) return {};
                 ++stats.rays;
                 if (scene_.Occluded(SpawnRayTo(sh.Leaving(ls.wi), ls.point))) return {};
-                Rgb contribution = f * radiance / ls.pdf;
                 const int through =
-                    MediumAfter(medium, hit->material, material, Dot(ls.wi, ng), wi.z * wo.z < 0);
-                if (through >= 0) {
-                    contribution *=
-                        Transmittance(materials[size_t(through)], Length(ls.point.p - hit->p));
-                }
-                return contribution;
+                    wi.z * wo.z < 0 ? MediumAfter(scene_.scene(), medium, *hit, ls.wi) : medium;
+                return f * radiance / ls.pdf *
+                       Attenuation(scene_, through, Length(ls.point.p - hit->p));
             };
             for (const size_t i : delta_lights_) {
                 if (const std::optional<LightSample> ls =
@@ -218,7 +207,7 @@ Rgb WhittedTracer::Follow(const Ray& ray, const SurfaceHit& hit, const Shading& 
     const Vec3 wi = Frame::FromNormal(sh.ns).FromLocal(lobe.wi);
     if (!sh.SidesAgree(-ray.d, wi, lobe.wi.z * wo.z > 0) || weight.IsBlack()) return {};
     const int next_medium =
-        MediumAfter(medium, hit.material, material, Dot(wi, hit.n), lobe.wi.z * wo.z < 0);
+        lobe.wi.z * wo.z < 0 ? MediumAfter(scene_.scene(), medium, hit, wi) : medium;
     return weight * Trace(SpawnRay(sh.Leaving(wi), wi), depth + 1, next_medium, sampler, stats);
 }
 

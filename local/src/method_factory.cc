@@ -5,6 +5,7 @@
 #include "lf/kernels/light_tracer.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/ppm.h"
+#include "lf/kernels/vol_path_tracer.h"
 #include "lf/kernels/whitted.h"
 
 namespace lf {
@@ -15,6 +16,9 @@ absl::StatusOr<std::unique_ptr<RadianceEstimator>> MakeRayTracer(Method method,
                                                                  LightStrategy strategy) {
     switch (method) {
         case Method::kPath:
+            if (scene.scene().HasMedia()) {
+                return std::make_unique<VolPathTracer>(scene, max_depth, strategy);
+            }
             return std::make_unique<PathTracer>(scene, max_depth, strategy);
         case Method::kWhitted:
             return std::make_unique<WhittedTracer>(scene, max_depth, strategy);

@@ -298,6 +298,9 @@ struct Scene {
     // Axis-aligned bounds of all geometry.
     std::pair<Vec3d, Vec3d> Bounds() const;
     bool HasLights() const;  // any emitter: emissive material or a light of any kind
+    // Any medium, a camera inside one or an interface surface: what the volumetric path tracer
+    // renders and the other methods refuse (but Beer's-law absorbers, which they take).
+    bool HasMedia() const;
 };
 
 // InvalidArgument naming the first position (vertex, sphere, light, camera) beyond

@@ -18,6 +18,7 @@
 #include "absl/status/statusor.h"
 #include "lf/core/ray.h"
 #include "lf/core/scene.h"
+#include "lf/kernels/media.h"
 #include "lf/kernels/scene_motion.h"
 
 namespace lf {
@@ -76,6 +77,8 @@ class EmbreeScene {
 
     const Scene& scene() const { return scene_; }
     const Vec3d& origin() const { return origin_; }
+    // The scene's participating media in render space.
+    const SceneMedia& media() const { return *media_; }
 
     // Sphere `sphere`'s centre (render space) at `time` (Ray::time): the Scene's when no sphere
     // moves, else linear between steps, as Embree moves it. Its radius stays the Scene's: Build
@@ -119,6 +122,7 @@ class EmbreeScene {
     Vec3d origin_;
     struct Handles;
     std::unique_ptr<Handles> handles_;
+    std::unique_ptr<SceneMedia> media_;
     // Render-space float positions per mesh, one padding vertex at the end: also Embree's vertex
     // buffer (shared, not copied). Normals, uvs and tangents are read from the Scene itself:
     // translation to render space leaves them unchanged.

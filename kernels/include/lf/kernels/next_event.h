@@ -20,15 +20,25 @@ inline float PowerHeuristic(float pdf_a, float pdf_b) {
     return a + b > 0 ? a / (a + b) : 0;
 }
 
-// The interior a path is in (a material index, or -1 outside every solid) after leaving a
-// surface of material `index` in direction wi, having been in `medium`: a transmission through
-// a solid transmitter's surface enters it (against the geometric normal, cos_i_ng < 0) or
-// leaves it.
-inline int InteriorAfter(int medium, int index, const Material& material, float cos_i_ng,
-                         bool transmitted) {
-    if (!transmitted || !HasInterior(material)) return medium;
-    return cos_i_ng < 0 ? index : -1;
+// The media on either side of the surface `hit` lies on (its shape's).
+const MediumInterface& InterfaceAt(const Scene& scene, const SurfaceHit& hit);
+
+// The medium a path is in after crossing a surface of interface `mi` and geometric normal ng
+// into direction w (any length), having been in `medium`: the side w points into, or `medium`
+// unchanged when the shape has no interface. Only for paths that cross (transmit or pass an
+// interface surface); a reflection stays where it was.
+inline int MediumAfter(const MediumInterface& mi, int medium, const Vec3& ng, const Vec3& w) {
+    if (!mi.has_interface) return medium;
+    return Dot(w, ng) < 0 ? mi.interior : mi.exterior;
 }
+inline int MediumAfter(const Scene& scene, int medium, const SurfaceHit& hit, const Vec3& w) {
+    return MediumAfter(InterfaceAt(scene, hit), medium, hit.n, w);
+}
+
+// Beer's law over `distance` (render space) of `medium`, 1 in vacuum (-1): the homogeneous
+// absorbers (a solid's KHR_materials_volume attenuation) that the methods other than the path
+// tracer take (lf/job/method_registry.h refuses them any other medium).
+Rgb Attenuation(const EmbreeScene& scene, int medium, float distance);
 
 // One light sample at `hit` (shading `sh`, the BSDF in the frame of sh.ns, wo_world the unit
 // direction the path leaves towards) for a path of throughput `beta` inside `medium`: beta f

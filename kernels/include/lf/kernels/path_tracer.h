@@ -3,8 +3,8 @@
 // (environment, sun disks), which rays that leave the scene see; next-event estimation for
 // delta lights, BSDF sampling at every vertex and Russian roulette on the path throughput.
 // BSDFs are evaluated in the shading frame at each hit (lf/kernels/shading.h: vertex normals,
-// normal maps, textures) while the geometric normal decides sides; paths inside solid
-// transmitters are attenuated by Beer's law.
+// normal maps, textures) while the geometric normal decides sides. Scenes with participating
+// media (absorbing solids included) take VolPathTracer instead.
 #pragma once
 
 #include "lf/kernels/embree_scene.h"

@@ -101,7 +101,4 @@ bool EmitsFromBack(const Material& material);
 // surface against the geometric normal is inside until it crosses back.
 bool HasInterior(const Material& material);
 
-// Beer's law through `distance` of `material`'s interior.
-Rgb Transmittance(const Material& material, float distance);
-
 }  // namespace lf

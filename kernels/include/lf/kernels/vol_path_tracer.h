@@ -1,0 +1,50 @@
+// Volumetric path tracing: the path tracer for scenes with participating media (pbrt-v4's
+// VolPathIntegrator). Along each segment inside a medium, tentative collisions are drawn
+// against the medium's majorant (SceneMedia::SampleTMaj); each is absorbed, scattered or null
+// with the probabilities sigma_a, sigma_s and sigma_n over sigma_maj of one hero channel, drawn
+// uniformly per path. The other two channels follow with ratio weights, and the estimate is
+// the one-sample MIS (balance heuristic) over the three hero choices: every weight is carried as
+// the path's rescaled densities r_u (unidirectional) and r_l (light sampling) per channel,
+// divided out as their average. So chromatic media are unbiased in every channel. Next-event
+// estimation works from surface and medium vertices. Its shadow rays pass through surfaces of
+// the interface material and estimate the transmittance of each medium by ratio tracking,
+// and its light samples are MIS-weighted against BSDF or phase sampling.
+// `path` renders with it the scenes for which Scene::HasMedia, PathTracer the others.
+// Surfaces are shaded as in PathTracer. A path crosses a shape's MediumInterface when it
+// transmits or passes an interface surface.
+#pragma once
+
+#include "lf/kernels/embree_scene.h"
+#include "lf/kernels/lights.h"
+#include "lf/kernels/media.h"
+#include "lf/kernels/radiance.h"
+
+namespace lf {
+
+class VolPathTracer : public RadianceEstimator {
+  public:
+    // As PathTracer's: max_depth negative is unlimited (kMaxPathDepth).
+    VolPathTracer(const EmbreeScene& scene, int max_depth,
+                  LightStrategy strategy = LightStrategy::kBvh);
+
+    Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
+    const EmbreeScene& geometry() const override { return scene_; }
+
+  private:
+    struct PathState;
+    // Light sampled from a vertex at `from` (surface: `n` its shading normal; medium: n zero)
+    // whose scattering for the light direction wi is `f_of(wi)` (BSDF times |cos|, or the phase
+    // function) with density `pdf_of(wi)`, the shadow ray starting in medium `medium_of(wi)`;
+    // the path's throughput and r_u there in `state`.
+    template <typename MediumOf, typename F, typename Pdf>
+    Rgb SampleLight(const SurfacePoint& from, const Vec3& n, MediumOf&& medium_of,
+                    const PathState& state, float u_pick, const Vec2& u_light, MediumRng& rng,
+                    F&& f_of, Pdf&& pdf_of, RenderStats& stats) const;
+
+    const EmbreeScene& scene_;
+    const SceneMedia& media_;
+    LightSampler lights_;
+    int max_depth_;
+};
+
+}  // namespace lf
