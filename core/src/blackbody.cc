@@ -5,21 +5,36 @@
 
 namespace lf {
 
-Xyz BlackbodyXyz(double kelvin) {
-    // Planck's law, spectral radiance per metre of wavelength: 2 h c^2 / l^5 / (e^(h c / l k T) -
-    // 1). Constant factors cancel in the normalisation, so only the shape is computed.
+namespace {
+
+// Planck's law: spectral radiance in W m^-2 sr^-1 per metre of wavelength at wavelength
+// kCie1931FirstNm + i nm. expm1 keeps the Wien tail exact where e^x - 1 would round.
+double PlanckAtCieRow(int i, double kelvin) {
     constexpr double kH = 6.62607015e-34, kC = 299792458, kK = 1.380649e-23;  // SI, exact
+    const double l = (kCie1931FirstNm + i) * 1e-9;
+    return 2 * kH * kC * kC / (std::pow(l, 5) * std::expm1(kH * kC / (l * kK * kelvin)));
+}
+
+}  // namespace
+
+Xyz BlackbodyXyz(double kelvin) {
+    // The 1 nm table is summed as the CIE's own practice (CIE 15:2004 7.2), a sum over its rows;
+    // constant factors cancel in the normalisation.
     Xyz sum{0, 0, 0};
     for (int i = 0; i < kCie1931Count; ++i) {
-        const double l = (kCie1931FirstNm + i) * 1e-9;
-        // expm1 keeps the Wien tail exact where e^x - 1 would round; the 1 nm table is summed
-        // as the CIE's own practice (CIE 15:2004 7.2), a sum over its rows.
-        const double planck = 1 / (std::pow(l * 1e6, 5) * std::expm1(kH * kC / (l * kK * kelvin)));
+        const double planck = PlanckAtCieRow(i, kelvin);
         sum.x += planck * kCie1931[size_t(i)].x;
         sum.y += planck * kCie1931[size_t(i)].y;
         sum.z += planck * kCie1931[size_t(i)].z;
     }
     return {sum.x / sum.y, 1, sum.z / sum.y};
+}
+
+double BlackbodyLuminance(double kelvin) {
+    double sum = 0;
+    for (int i = 0; i < kCie1931Count; ++i)
+        sum += PlanckAtCieRow(i, kelvin) * kCie1931[size_t(i)].y;
+    return 683 * sum * 1e-9;  // 1 nm steps
 }
 
 Rgb BlackbodyRgb(double kelvin) {

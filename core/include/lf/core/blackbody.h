@@ -18,4 +18,10 @@ Xyz BlackbodyXyz(double kelvin);
 // (blue would be negative): a negative channel is clipped to 0 before normalising.
 Rgb BlackbodyRgb(double kelvin);
 
+// The luminance of a black body at `kelvin` (> 0) in cd/m^2: 683 lm/W times the integral of
+// Planck's spectral radiance against the photopic V = y-bar (1 nm steps, 380-780 nm). With
+// BlackbodyRgb, BlackbodyRgb(T) * BlackbodyLuminance(T) / 683 is its radiance in the renderer's
+// absolute units.
+double BlackbodyLuminance(double kelvin);
+
 }  // namespace lf

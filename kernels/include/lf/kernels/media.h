@@ -7,14 +7,15 @@
 // collision real. Grids bound their density by a coarse 16^3 majorant grid walked with a 3D DDA.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "lf/core/ray.h"
 #include "lf/core/rgb.h"
-#include "lf/core/scene.h"
 #include "lf/core/sampler.h"
+#include "lf/core/scene.h"
 
 namespace lf {
 
@@ -68,8 +69,77 @@ class SceneMedia {
                    Callback&& callback) const;
 
   private:
+    // A stretch [t0, t1) of a unit-direction ray over which sigma_maj bounds sigma_t.
+    struct MajorantSegment {
+        float t0, t1;
+        Rgb sigma_maj;
+    };
+    // The segments along a ray, in order (pbrt-v4's DDAMajorantIterator): a homogeneous medium's
+    // one segment; for a grid, its background before the density's box, the box's majorant cells
+    // by a 3D DDA, its background after. Segments of majorant 0 are skipped.
+    class MajorantIterator {
+      public:
+        bool Next(MajorantSegment& segment);
+
+      private:
+        friend class SceneMedia;
+        enum class Stage { kBefore, kInside, kAfter, kDone };
+        Stage stage_ = Stage::kBefore;
+        float t_ = 0, t_enter_ = 0, t_exit_ = 0, t_end_ = 0;
+        Rgb sigma_outside_;             // background density times sigma_t (sigma_t if homogeneous)
+        Rgb sigma_t_;                   // per unit density, inside the box
+        const float* cells_ = nullptr;  // the majorant grid, null when the box is not crossed
+        int voxel_[3] = {}, step_[3] = {}, voxel_limit_[3] = {};
+        float next_crossing_[3] = {}, delta_t_[3] = {};
+    };
+
+    // `ray.d` unit.
+    MajorantIterator Majorants(int medium, const Ray& ray, float t_max) const;
+    MediumPoint PointAt(int medium, const Vec3& p) const;
+    // exp(-sigma s) per channel, 1 where sigma is 0 (also for an infinite s).
+    static Rgb Attenuation(const Rgb& sigma, float s) {
+        Rgb a(1.0f);
+        for (int c = 0; c < 3; ++c) {
+            if (sigma[c] != 0) a[c] = std::exp(-sigma[c] * s);
+        }
+        return a;
+    }
+
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
+
+template <typename Callback>
+Rgb SceneMedia::SampleTMaj(int medium, const Ray& ray, float t_max, int hero, MediumRng& rng,
+                           Callback&& callback) const {
+    // Distances in scene units, so that sigma_maj is per metre.
+    const float length = Length(ray.d);
+    Ray unit = ray;
+    unit.d = ray.d / length;
+    MajorantIterator segments = Majorants(medium, unit, t_max * length);
+    Rgb t_maj(1.0f);
+    MajorantSegment s;
+    while (segments.Next(s)) {
+        const float sigma = s.sigma_maj[hero];
+        if (sigma == 0) {
+            t_maj *= Attenuation(s.sigma_maj, s.t1 - s.t0);
+            continue;
+        }
+        for (float t = s.t0;;) {
+            // Exponential with rate sigma; 1 - u is in (0, 1], so the step is finite.
+            const float dt = -std::log(1 - rng.Uniform()) / sigma;
+            if (t + dt >= s.t1) {
+                t_maj *= Attenuation(s.sigma_maj, s.t1 - t);
+                break;
+            }
+            t += dt;
+            t_maj *= Attenuation(s.sigma_maj, dt);
+            const Vec3 p = unit.o + unit.d * t;
+            if (!callback(p, PointAt(medium, p), s.sigma_maj, t_maj)) return Rgb(1.0f);
+            t_maj = Rgb(1.0f);
+        }
+    }
+    return t_maj;
+}
 
 }  // namespace lf
