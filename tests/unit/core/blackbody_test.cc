@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace lf {
 namespace {
 
@@ -61,6 +63,26 @@ TEST(Blackbody, WhiteNearD65AndRedderWhenCooler) {
         previous_x = x;
         previous_red = c.r / c.g;
     }
+}
+
+// 683 Int V B dlambda by a sum of its own: Planck's law in the CODATA 2018 radiation constants
+// (c1L = 2 h c^2, c2 = h c / k) at the observer's 1 nm rows.
+TEST(Blackbody, LuminanceIsTheLuminousIntegralOfPlanck) {
+    constexpr double kC1L = 1.191042972e-16, kC2 = 1.438776877e-2;
+    for (double kelvin : {1500.0, 3000.0, 6500.0}) {
+        double sum = 0;
+        for (int nm = kCie1931FirstNm; nm <= kCie1931LastNm; ++nm) {
+            const double l = nm * 1e-9;
+            sum += kC1L / std::pow(l, 5) / std::expm1(kC2 / (l * kelvin)) *
+                   kCie1931[size_t(nm - kCie1931FirstNm)].y * 1e-9;
+        }
+        EXPECT_NEAR(BlackbodyLuminance(kelvin), 683 * sum, 1e-6 * 683 * sum) << kelvin << " K";
+    }
+    // The candela of 1948-1979: a black body at the freezing point of platinum (2042 K on
+    // ITS-90) has 60 cd/cm^2.
+    EXPECT_NEAR(BlackbodyLuminance(2042), 6e5, 0.01 * 6e5);
+    // Hotter is brighter, by orders of magnitude.
+    EXPECT_GT(BlackbodyLuminance(3000), 1000 * BlackbodyLuminance(1500));
 }
 
 }  // namespace
