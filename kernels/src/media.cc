@@ -14,6 +14,7 @@ namespace {
 
 constexpr int kMajorantRes = 16;
 constexpr int kLeTableSize = 1024;
+constexpr float kMinMajorantFraction = 1e-2f;
 // Below this a black body's visible radiance is negligible (and Planck's law underflows far
 // below it): it emits 0.
 constexpr double kMinGlowK = 500;
@@ -95,6 +96,11 @@ std::vector<float> BuildMajorants(const VolumeGrid& grid, const Vec3d& lo, const
 struct RenderMedium {
     Medium::Type type;
     Rgb sigma_a, sigma_s, sigma_t, emission;
+    // kGrid: sigma_t per unit density with every channel at least kMinMajorantFraction of the
+    // largest. A majorant may be any bound above sigma_t; a channel of sigma_t 0 (but not all)
+    // would otherwise give its hero paths no collisions, and the others would then be attenuated
+    // by their majorant, not their density: biased. With the floor they see null collisions.
+    Rgb majorant_per_density;
     float g;
     bool emissive;
     // kGrid: each grid with its map from render space.
@@ -133,6 +139,10 @@ RenderMedium Build(const Medium& m, const Vec3d& origin) {
     r.g = m.g;
     r.emissive = !m.emission.IsBlack();
     if (m.type != Medium::Type::kGrid) return r;
+    const float largest = r.sigma_t.MaxComponent();
+    for (int c = 0; c < 3; ++c) {
+        r.majorant_per_density[c] = std::max(r.sigma_t[c], kMinMajorantFraction * largest);
+    }
 
     r.density = m.density;
     r.density_xf = RenderToIndex(*m.density, origin);
@@ -216,8 +226,8 @@ SceneMedia::MajorantIterator SceneMedia::Majorants(int medium, const Ray& ray, f
         it.sigma_outside_ = m.sigma_t;
         return it;
     }
-    it.sigma_outside_ = m.sigma_t * m.background;
-    it.sigma_t_ = m.sigma_t;
+    it.sigma_outside_ = m.majorant_per_density * m.background;
+    it.sigma_t_ = m.majorant_per_density;
     // The ray against the majorant grid's box [0, 16]^3 (slabs).
     const Vec3 o = m.majorant_xf.Apply(ray.o), d = m.majorant_xf.ApplyLinear(ray.d);
     float t0 = 0, t1 = t_max;

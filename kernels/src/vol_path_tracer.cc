@@ -33,7 +33,7 @@ uint64_t WalkSeed(const Vec2& u, int depth) {
     return MixBits(bits ^ (uint64_t(uint32_t(depth)) << 48));
 }
 
-SurfacePoint MediumPoint(const Vec3& p, float time) {
+SurfacePoint PointInMedium(const Vec3& p, float time) {
     SurfacePoint sp;
     sp.p = p;
     sp.time = time;
@@ -183,7 +183,7 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
                         }
                         const float g = media_.g(medium);
                         const Vec3 d = Normalize(ray.d);
-                        const SurfacePoint here = MediumPoint(p, ray.time);
+                        const SurfacePoint here = PointInMedium(p, ray.time);
                         L += SampleLight(
                             here, Vec3(), [&](const Vec3&) { return medium; }, state, u_choice.x, u_light, rng,
                             [&](const Vec3& wi) { return Rgb(HenyeyGreenstein(Dot(d, wi), g)); },

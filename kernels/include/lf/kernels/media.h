@@ -87,7 +87,7 @@ class SceneMedia {
         Stage stage_ = Stage::kBefore;
         float t_ = 0, t_enter_ = 0, t_exit_ = 0, t_end_ = 0;
         Rgb sigma_outside_;             // background density times sigma_t (sigma_t if homogeneous)
-        Rgb sigma_t_;                   // per unit density, inside the box
+        Rgb sigma_t_;  // the majorant per unit density inside the box (RenderMedium)
         const float* cells_ = nullptr;  // the majorant grid, null when the box is not crossed
         int voxel_[3] = {}, step_[3] = {}, voxel_limit_[3] = {};
         float next_crossing_[3] = {}, delta_t_[3] = {};
