@@ -2,7 +2,7 @@
 
     python3 tools/media_scenes.py tests [OUTDIR]        the small test scenes (default
                                                         tests/scenes/media): slab, furnace,
-                                                        cornell_fog, spot_sphere
+                                                        furnace_albedo, cornell_fog, spot_sphere
     python3 tools/media_scenes.py bench OUTDIR GRID.vdb  the benchmark's scenes around a 2 m grid
                                                         centred on the origin (tools/media_bench.sh)
 
@@ -58,12 +58,13 @@ def slab():
     }
 
 
-def furnace():
-    """A non-absorbing scattering sphere in a uniform environment of radiance 1."""
+def furnace(sigma_a):
+    """A scattering sphere (sigma_s 2) in a uniform environment of radiance 1: with sigma_a 0
+    every pixel is 1, with sigma_a 2 (albedo 0.5) tools/media_reference.py gives the image."""
     return {
         "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_y_deg": 40.0,
                    "resolution": [16, 16]},
-        "media": {"cloud": homogeneous([0, 0, 0], [2.0, 2.0, 2.0], g=0.5)},
+        "media": {"cloud": homogeneous([sigma_a] * 3, [2.0, 2.0, 2.0], g=0.5)},
         "materials": {"boundary": {"type": "interface"}},
         "shapes": [{"type": "sphere", "name": "cloud", "material": "boundary", "center": [0, 0, 0],
                     "radius": 1.0, "interior": "cloud"}],
@@ -139,9 +140,11 @@ def main():
     if len(args) in (1, 2) and args[0] == "tests":
         out = args[1] if len(args) == 2 else os.path.join(HERE, "..", "tests", "scenes", "media")
         os.makedirs(out, exist_ok=True)
-        for name, make in (("slab", slab), ("furnace", furnace), ("cornell_fog", cornell_fog),
-                           ("spot_sphere", spot_sphere)):
-            write(os.path.join(out, name + ".json"), make())
+        write(os.path.join(out, "slab.json"), slab())
+        write(os.path.join(out, "furnace.json"), furnace(0.0))
+        write(os.path.join(out, "furnace_albedo.json"), furnace(2.0))
+        write(os.path.join(out, "cornell_fog.json"), cornell_fog())
+        write(os.path.join(out, "spot_sphere.json"), spot_sphere())
     elif len(args) == 3 and args[0] == "bench":
         out, grid = args[1], os.path.abspath(args[2])
         os.makedirs(out, exist_ok=True)
