@@ -19,16 +19,15 @@ cd "$(dirname "$0")/.."
 bin="${LF_BIN_DIR:-build/bin}"
 grid_size=256 resolution=512 spp=8 threads=2 out=""
 usage="usage: $0 [--grid-size N] [--resolution N] [--spp N] [--threads N] [--out DIR]"
-while [ $# -gt 0 ]; do
+while [ $# -ge 2 ]; do
   case "$1" in
-    --grid-size) grid_size="$2"; shift 2 ;;
-    --resolution) resolution="$2"; shift 2 ;;
-    --spp) spp="$2"; shift 2 ;;
-    --threads) threads="$2"; shift 2 ;;
-    --out) out="$2"; shift 2 ;;
-    *) echo "$usage" >&2; exit 2 ;;
+    # --grid-size N sets grid_size, and so on.
+    --grid-size | --resolution | --spp | --threads | --out) name="${1#--}"; printf -v "${name//-/_}" '%s' "$2" ;;
+    *) break ;;
   esac
+  shift 2
 done
+[ $# -eq 0 ] || { echo "$usage" >&2; exit 2; }
 [ -n "$out" ] || out="$(mktemp -d /tmp/media_bench.XXXXXX)"
 mkdir -p "$out"
 [ -x "$bin/lightfarm" ] || { echo "media_bench: no $bin/lightfarm; build it first" >&2; exit 1; }
