@@ -1,7 +1,8 @@
 """Bakes a small Mantaflow fire in Blender (headless) and writes one frame of its OpenVDB cache
 with a lightfarm scene that renders it (tests/scenes/media/blender_fire.vdb and .json):
 
-    blender -b --factory-startup --python tools/make_blender_smoke.py -- [OUTDIR] [--resolution N] [--frame F]
+    blender -b --factory-startup --python tools/make_blender_smoke.py -- \
+        [OUTDIR] [--resolution N] [--frame F]
 
 OUTDIR defaults to tests/scenes/media, N to 32 (the domain's Resolution Divisions), F to 50. The
 scene is what Object > Quick Effects > Quick Smoke (style Fire) makes of a 0.5 m cube, with the

@@ -22,7 +22,10 @@ usage="usage: $0 [--grid-size N] [--resolution N] [--spp N] [--threads N] [--out
 while [ $# -ge 2 ]; do
   case "$1" in
     # --grid-size N sets grid_size, and so on.
-    --grid-size | --resolution | --spp | --threads | --out) name="${1#--}"; printf -v "${name//-/_}" '%s' "$2" ;;
+    --grid-size | --resolution | --spp | --threads | --out)
+      name="${1#--}"
+      printf -v "${name//-/_}" '%s' "$2"
+      ;;
     *) break ;;
   esac
   shift 2
@@ -69,7 +72,12 @@ render() {
     --resolution "$resolution" --spp "$spp" --threads "$threads" --seed 1 --no-progress \
     >"$out/$name.log" 2>&1; then
     awk '
-      /M samples\/s/ { for (i = 2; i <= NF; i++) { if ($i == "samples/s,") s = $(i - 2); if ($i == "rays/s,") r = $(i - 2) } }
+      /M samples\/s/ {
+        for (i = 2; i <= NF; i++) {
+          if ($i == "samples/s,") s = $(i - 2)
+          if ($i == "rays/s,") r = $(i - 2)
+        }
+      }
       /^time: load/ { load = $3 }
       END { print load, s, r }' "$out/$name.log"
   fi
@@ -85,7 +93,8 @@ for name in clear smoke_1x smoke_10x smoke_100x; do
   [ "$scale" = 0 ] || tau=$(awk -v c="$column" -v s="$scale" 'BEGIN { printf "%.3g", c * 4 * s }')
   result=$(render "$name")
   if [ -z "$result" ]; then
-    printf '%-12s %12s  failed: %s\n' "$name" "$tau" "$(grep -m1 -i error "$out/$name.log" || tail -1 "$out/$name.log")"
+    why=$(grep -m1 -i error "$out/$name.log" || tail -1 "$out/$name.log")
+    printf '%-12s %12s  failed: %s\n' "$name" "$tau" "$why"
     continue
   fi
   read -r load rate rays <<<"$result"
