@@ -130,7 +130,7 @@ int Smoke(const std::string& path, int n) {
                 // Billows: noise of 4 cells a metre, thresholded, faded towards the sphere.
                 const float noise = Fractal(4 * p.x() + 17.3, 4 * p.y() + 5.1, 4 * p.z() + 9.7);
                 const float fade = float(1 - r / 0.95);
-                const float d = std::fmin(1.0f, 2.5f * (noise - 0.45f) + fade - 0.3f);
+                const float d = std::fmin(1.0f, 6.0f * (noise - 0.5f) + 1.5f * fade - 0.2f);
                 if (d > 0) acc.setValue(openvdb::Coord(i, j, k), d);
             }
         }
