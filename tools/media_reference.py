@@ -2,6 +2,7 @@
 environment, computed by an analog random walk (numpy), not by lightfarm's code:
 
     python3 tools/media_reference.py tests/scenes/media/furnace_albedo.json [--walks 4000000]
+    python3 tools/media_reference.py --check     checks the walk against closed forms
 
 The scene must be one sphere whose interior is a homogeneous medium with grey sigma_a, sigma_s
 (m^-1, times its scale) and Henyey-Greenstein g, a uniform environment of radiance E and a
@@ -130,8 +131,36 @@ def estimate(s, n, rng, centre_only):
     return value.mean(), value.std() / math.sqrt(n)
 
 
+def self_check():
+    """Checks the walk against closed forms; exits non-zero if one fails."""
+    rng = np.random.default_rng(1)
+    camera = {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_y_deg": 0.01,
+              "resolution": [2, 2]}
+    sphere = {"center": np.zeros(3), "radius": 1.0, "g": 0.5, "radiance": 1.0, "camera": camera}
+    failed = []
+    # No scattering: the axial ray's transmittance exp(-sigma_a * 2R).
+    mean, error = estimate({**sphere, "sigma_a": 1.0, "sigma_s": 0.0}, 2_000_000, rng, False)
+    if abs(mean - math.exp(-2)) > 4 * error:
+        failed.append(f"absorber: {mean:.5f} +- {error:.5f}, expected {math.exp(-2):.5f}")
+    # No absorption: every walk leaves with its weight 1.
+    mean, error = estimate({**sphere, "sigma_a": 0.0, "sigma_s": 4.0}, 100_000, rng, False)
+    if mean != 1.0:
+        failed.append(f"furnace: {mean}, expected exactly 1")
+    # HG's mean cosine is g.
+    d = rng.normal(size=(400_000, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    for g in (-0.3, 0.0, 0.7):
+        cos = np.einsum("ij,ij->i", hg_turn(d, g, rng), d)
+        if abs(cos.mean() - g) > 4 * cos.std() / math.sqrt(len(cos)):
+            failed.append(f"HG g={g}: mean cosine {cos.mean():.5f}")
+    print("media_reference.py --check: " + ("; ".join(failed) if failed else "all passed"))
+    sys.exit(1 if failed else 0)
+
+
 def main():
     args = sys.argv[1:]
+    if args == ["--check"]:
+        self_check()
     walks = 4_000_000
     if "--walks" in args:
         i = args.index("--walks")
