@@ -1,5 +1,5 @@
 // The media benchmark's OpenVDB helper, built by hand against libopenvdb-dev (not part of the
-// product's build; tools/media_bench.sh and tools/make_blender_smoke.py build it):
+// product's build; tools/media_bench.sh builds it):
 //
 //   g++ -std=c++20 -O2 tools/media_grid.cc -o media_grid -lopenvdb -ltbb -lImath
 //
