@@ -8,7 +8,7 @@ OUTDIR defaults to tests/scenes/media, N to 32 (the domain's Resolution Division
 scene is what Object > Quick Effects > Quick Smoke (style Fire) makes of a 0.5 m cube, with the
 domain's cache settings left at Blender 3.4's defaults (OpenVDB, Blosc, Half precision, no
 noise) except its size: the domain is 2 x 2 x 4 m (Blender's x, y, z) with its floor at z = 0,
-so that N divides every side and the cells are cubes. The cache is baked into a temporary
+so that for an even N the cells are cubes that fill it exactly. The cache is baked into a temporary
 directory and frame F's data file (cache/data/fluid_data_00FF.vdb) is copied as it is.
 
 The medium's transform follows from the domain: the cache stores cell (i, j, k) of the domain
@@ -16,7 +16,8 @@ at OpenVDB index (i, j, k) with a plain voxel-size transform (no rotation, no tr
 domain's placement is not in the file), while Mantaflow's values sit at cell centres, so in
 Blender's world the value (i, j, k) is at domain_min + (i + 1/2, j + 1/2, k + 1/2) * dx. The
 scene turns Blender's z-up into lightfarm's y-up as Blender's glTF exporter does ((x, y, z) ->
-(x, z, -y)). Running it again bakes the same frame (Mantaflow is deterministic here).
+(x, z, -y)). Running it again bakes the same voxels (the files differ only in the random UUID
+OpenVDB writes into each).
 """
 
 import json
@@ -53,8 +54,8 @@ def parse_args():
             i += 1
     if positional:
         out = positional[0]
-    if resolution < 8 or frame < 1:
-        sys.exit("make_blender_smoke.py: --resolution must be at least 8 and --frame at least 1")
+    if resolution < 8 or resolution % 2 or frame < 1:
+        sys.exit("make_blender_smoke.py: --resolution must be even and at least 8, --frame at least 1")
     return os.path.abspath(out), resolution, frame
 
 
@@ -75,7 +76,6 @@ def build_fire(resolution, frame_end, cache_dir):
     with bpy.context.temp_override(active_object=domain, object=domain, selected_objects=[domain]):
         if bpy.ops.fluid.bake_all() != {"FINISHED"}:
             sys.exit("make_blender_smoke.py: the bake failed")
-    return domain, settings
 
 
 def to_y_up(p):
@@ -120,7 +120,7 @@ def main():
     cache_dir = tempfile.mkdtemp(prefix="lightfarm_fire_")
     os.chdir(cache_dir)  # Mantaflow writes waveletNoiseTile.bin into the working directory
     try:
-        domain, settings = build_fire(resolution, frame, cache_dir)
+        build_fire(resolution, frame, cache_dir)
         dx = max(DOMAIN_SIZE) / resolution
         cells = [round(s / dx) for s in DOMAIN_SIZE]
         source = os.path.join(cache_dir, "data", f"fluid_data_{frame:04d}.vdb")
