@@ -55,7 +55,8 @@ def parse_args():
     if positional:
         out = positional[0]
     if resolution < 8 or resolution % 2 or frame < 1:
-        sys.exit("make_blender_smoke.py: --resolution must be even and at least 8, --frame at least 1")
+        sys.exit("make_blender_smoke.py: --resolution must be even and at least 8, "
+                 "--frame at least 1")
     return os.path.abspath(out), resolution, frame
 
 
