@@ -1,0 +1,138 @@
+#include "lf/core/volume_grid.h"
+
+#include <openvdb/io/Stream.h>
+#include <openvdb/math/Maps.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+
+#include <cmath>
+#include <exception>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+
+namespace lf {
+namespace {
+
+// Lattice points in the box [lo, hi] (inclusive); 0 for an empty one.
+int64_t Points(const openvdb::Coord& lo, const openvdb::Coord& hi) {
+    int64_t points = 1;
+    for (int a = 0; a < 3; ++a) {
+        if (hi[a] < lo[a]) return 0;
+        points *= int64_t(hi[a]) - lo[a] + 1;  // each factor < 2^32: no overflow below 2^63
+        if (points > kMaxVolumeGridPoints) return points;
+    }
+    return points;
+}
+
+// The bounding box the writer recorded (Grid::addStatsMetadata), when it did.
+std::optional<int64_t> RecordedPoints(const openvdb::GridBase& grid) {
+    const auto lo = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+    const auto hi = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+    if (!lo || !hi) return std::nullopt;
+    return Points(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
+}
+
+// OpenVDB's maps act on row vectors (world = index * M): M's transpose is our M.
+Affine FromVdb(const openvdb::Mat4d& m) {
+    Affine a;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) a.m[r][c] = m(c, r);
+    }
+    return a;
+}
+
+}  // namespace
+
+absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::string& bytes,
+                                                                  const std::string& file_name,
+                                                                  const std::string& grid_name,
+                                                                  const Affine& medium_transform) {
+    // Thread-safe once: a static's initialisation.
+    [[maybe_unused]] static const bool initialized = (openvdb::initialize(), true);
+    const std::string where = absl::StrCat(file_name, " grid \"", grid_name, "\"");
+    auto invalid = [&](const std::string& why) {
+        return absl::InvalidArgumentError(absl::StrCat(where, ": ", why));
+    };
+    openvdb::GridBase::Ptr base;
+    try {
+        std::istringstream in(bytes);
+        // Delayed loading reads the tree's topology here and its voxel values only when the
+        // dense copy below asks for them, after the size checks.
+        openvdb::io::Stream stream(in, /*delayLoad=*/true);
+        const openvdb::GridPtrVecPtr grids = stream.getGrids();
+        std::vector<std::string> names;
+        for (const openvdb::GridBase::Ptr& g : *grids) {
+            if (g->getName() == grid_name && !base) base = g;
+            names.push_back(absl::StrCat("\"", g->getName(), "\" (", g->valueType(), ")"));
+        }
+        if (!base) {
+            return invalid(absl::StrCat("no such grid; the file has ",
+                                        names.empty() ? "none" : absl::StrJoin(names, ", ")));
+        }
+    } catch (const std::exception& e) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(file_name, ": not a readable OpenVDB file (", e.what(), ")"));
+    }
+    const openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+    if (!grid) {
+        return invalid(
+            absl::StrCat("a ", base->valueType(), " grid; media read float grids only"));
+    }
+    if (const std::optional<int64_t> recorded = RecordedPoints(*grid);
+        recorded && *recorded > kMaxVolumeGridPoints) {
+        return invalid(absl::StrCat("its metadata gives a bounding box of ", *recorded,
+                                    " voxels, above the limit of ", kMaxVolumeGridPoints));
+    }
+    if (!grid->transform().isLinear()) {
+        return invalid(absl::StrCat("a ", grid->transform().mapType(),
+                                    " transform; media read grids with affine transforms only"));
+    }
+
+    auto out = std::make_shared<VolumeGrid>();
+    out->name = absl::StrCat(file_name, "#", grid_name);
+    out->background = grid->background();
+    if (!(std::isfinite(out->background) && out->background >= 0)) {
+        return invalid(absl::StrCat("background ", out->background, ": expected a finite value >= 0"));
+    }
+    const openvdb::math::AffineMap::ConstPtr map = grid->transform().baseMap()->getAffineMap();
+    out->index_to_world = FromVdb(map->getMat4()).Then(medium_transform);
+    out->world_to_index = out->index_to_world.Inverse();
+    if (!out->world_to_index.IsFinite()) return invalid("its transform is singular");
+
+    try {
+        const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+        const int64_t points = Points(box.min(), box.max());
+        if (points > kMaxVolumeGridPoints) {
+            return invalid(absl::StrCat("its active voxels span a bounding box of ", points,
+                                        " voxels, above the limit of ", kMaxVolumeGridPoints));
+        }
+        if (points == 0) return std::shared_ptr<const VolumeGrid>(std::move(out));
+        for (int a = 0; a < 3; ++a) {
+            out->min[a] = box.min()[a];
+            out->size[a] = box.max()[a] - box.min()[a] + 1;
+        }
+        out->values.resize(size_t(points));
+        openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, out->values.data());
+        openvdb::tools::copyToDense(*grid, dense);
+    } catch (const std::exception& e) {
+        return invalid(absl::StrCat("its voxels cannot be read (", e.what(), ")"));
+    }
+    for (size_t i = 0; i < out->values.size(); ++i) {
+        const float v = out->values[i];
+        if (std::isfinite(v) && v >= 0) continue;
+        const int64_t x = int64_t(i % size_t(out->size[0])),
+                      y = int64_t(i / size_t(out->size[0]) % size_t(out->size[1])),
+                      z = int64_t(i / (size_t(out->size[0]) * size_t(out->size[1])));
+        return invalid(absl::StrCat("value ", v, " at voxel (", out->min[0] + x, ", ",
+                                    out->min[1] + y, ", ", out->min[2] + z,
+                                    "): expected a finite value >= 0 (negative density, emission "
+                                    "or temperature is unphysical)"));
+    }
+    return std::shared_ptr<const VolumeGrid>(std::move(out));
+}
+
+}  // namespace lf
