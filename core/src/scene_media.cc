@@ -24,19 +24,20 @@ Medium SceneParser::ParseMedium(const std::string& name, const Node& n) {
     Medium m;
     m.name = name;
     m.type = n.Get("type").OneOf<Medium::Type>(
-        "medium type", {{"homogeneous", Medium::Type::kHomogeneous}, {"grid", Medium::Type::kGrid}});
+        "medium type",
+        {{"homogeneous", Medium::Type::kHomogeneous}, {"grid", Medium::Type::kGrid}});
     // Unknown keys are errors: a misspelt coefficient would leave the medium silently empty.
     if (m.type == Medium::Type::kHomogeneous) {
         n.RejectUnknownKeys({"type", "sigma_a", "sigma_s", "scale", "g", "emission"},
                             "a homogeneous medium has type, sigma_a, sigma_s, scale, g and "
                             "emission");
     } else {
-        n.RejectUnknownKeys({"type", "file", "density_grid", "sigma_a", "sigma_s", "scale", "g",
-                             "emission", "emission_grid", "temperature_grid",
-                             "temperature_scale", "transform"},
-                            "a grid medium has type, file, density_grid, sigma_a, sigma_s, scale, "
-                            "g, emission, emission_grid, temperature_grid, temperature_scale and "
-                            "transform");
+        n.RejectUnknownKeys(
+            {"type", "file", "density_grid", "sigma_a", "sigma_s", "scale", "g", "emission",
+             "emission_grid", "temperature_grid", "temperature_scale", "transform"},
+            "a grid medium has type, file, density_grid, sigma_a, sigma_s, scale, "
+            "g, emission, emission_grid, temperature_grid, temperature_scale and "
+            "transform");
     }
     if (const std::optional<Node> a = n.Find("sigma_a")) m.sigma_a = a->Color(kMaxFloat);
     if (const std::optional<Node> s = n.Find("sigma_s")) m.sigma_s = s->Color(kMaxFloat);
@@ -60,8 +61,7 @@ Medium SceneParser::ParseMedium(const std::string& name, const Node& n) {
     if (m.type == Medium::Type::kHomogeneous) return m;
 
     const Node file = n.Get("file");
-    const Affine transform =
-        n.Has("transform") ? ParseTransform(n.Get("transform")) : Affine();
+    const Affine transform = n.Has("transform") ? ParseTransform(n.Get("transform")) : Affine();
     const std::optional<Node> density = n.Find("density_grid");
     m.density = LoadGrid(file, density ? *density : file, density ? density->String() : "density",
                          transform);
@@ -109,11 +109,12 @@ int SceneParser::MediumIndex(const Node& n) const {
     const auto found = medium_index_.find(name);
     if (found != medium_index_.end()) return found->second;
     std::vector<std::string> names;
-    for (const auto& [known, index] : medium_index_) names.push_back(absl::StrCat("\"", known, "\""));
+    for (const auto& [known, index] : medium_index_)
+        names.push_back(absl::StrCat("\"", known, "\""));
     n.Fail(absl::StrCat("unknown medium \"", name, "\"; ",
-                        names.empty() ? "the scene has no \"media\""
-                                      : absl::StrCat("the scene's media are ",
-                                                     absl::StrJoin(names, ", "))));
+                        names.empty()
+                            ? "the scene has no \"media\""
+                            : absl::StrCat("the scene's media are ", absl::StrJoin(names, ", "))));
 }
 
 MediumInterface SceneParser::ParseMediumInterface(const Node& shape) const {

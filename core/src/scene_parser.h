@@ -208,8 +208,8 @@ class SceneParser {
     std::string environment_path_;  // the first environment light's JSON path
     // By name and whether the file's own materials were read.
     std::map<std::pair<std::string, bool>, CachedMeshFile> mesh_cache_;
-    std::map<std::string, int> texture_index_;  // by file name, into *textures_
-    std::map<std::string, int> medium_index_;   // by name, into Scene::media
+    std::map<std::string, int> texture_index_;       // by file name, into *textures_
+    std::map<std::string, int> medium_index_;        // by name, into Scene::media
     std::map<std::string, std::string> grid_files_;  // .vdb bytes by normalised name
     std::vector<std::shared_ptr<const TextureImage>>* textures_ = nullptr;  // the scene's
     Fnv1a128 hash_;

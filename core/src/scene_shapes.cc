@@ -133,7 +133,8 @@ void SceneParser::ParseShape(const Node& n, Scene& scene) {
                     [&](const AnimationChannel& c) { return c.node == placed.node; });
 
     if (type_name == "sphere") {
-        n.WarnUnknownKeys({"type", "material", "name", "center", "radius", "transform"}, kMediaKeys);
+        n.WarnUnknownKeys({"type", "material", "name", "center", "radius", "transform"},
+                          kMediaKeys);
         Sphere sphere{name, material_index, n.Get("center").Vector(), 0, ParseMediumInterface(n)};
         const Node radius = n.Get("radius");
         sphere.radius = radius.Number();

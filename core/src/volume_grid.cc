@@ -48,9 +48,9 @@ Affine FromVdb(const openvdb::Mat4d& m) {
 }  // namespace
 
 absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::string& bytes,
-                                                                  const std::string& file_name,
-                                                                  const std::string& grid_name,
-                                                                  const Affine& medium_transform) {
+                                                                 const std::string& file_name,
+                                                                 const std::string& grid_name,
+                                                                 const Affine& medium_transform) {
     // Thread-safe once: a static's initialisation.
     [[maybe_unused]] static const bool initialized = (openvdb::initialize(), true);
     const std::string where = absl::StrCat(file_name, " grid \"", grid_name, "\"");
@@ -79,8 +79,7 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
     }
     const openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
     if (!grid) {
-        return invalid(
-            absl::StrCat("a ", base->valueType(), " grid; media read float grids only"));
+        return invalid(absl::StrCat("a ", base->valueType(), " grid; media read float grids only"));
     }
     if (const std::optional<int64_t> recorded = RecordedPoints(*grid);
         recorded && *recorded > kMaxVolumeGridPoints) {
@@ -96,7 +95,8 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
     out->name = absl::StrCat(file_name, "#", grid_name);
     out->background = grid->background();
     if (!(std::isfinite(out->background) && out->background >= 0)) {
-        return invalid(absl::StrCat("background ", out->background, ": expected a finite value >= 0"));
+        return invalid(
+            absl::StrCat("background ", out->background, ": expected a finite value >= 0"));
     }
     const openvdb::math::AffineMap::ConstPtr map = grid->transform().baseMap()->getAffineMap();
     out->index_to_world = FromVdb(map->getMat4()).Then(medium_transform);

@@ -22,8 +22,8 @@ inline constexpr int64_t kMaxVolumeGridPoints = int64_t(1) << 28;
 // another value type, a frustum transform, more than kMaxVolumeGridPoints lattice points, and
 // negative or non-finite values (density, emission and temperature are all >= 0).
 absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::string& bytes,
-                                                                  const std::string& file_name,
-                                                                  const std::string& grid_name,
-                                                                  const Affine& medium_transform);
+                                                                 const std::string& file_name,
+                                                                 const std::string& grid_name,
+                                                                 const Affine& medium_transform);
 
 }  // namespace lf
