@@ -343,13 +343,12 @@ void SceneParser::ParseGltfShape(const Node& n, Scene& scene) {
     absl::StatusOr<std::string> bytes = read_file_(name);
     if (!bytes.ok()) fail(bytes.status());
     hash_.Update(*bytes);
-    const size_t first_mesh = scene.meshes.size(), first_sphere = scene.spheres.size();
+    const size_t first_mesh = scene.meshes.size();
     ImportGltf(*bytes, name, std::filesystem::path(name).parent_path().string(),
                transform ? ParseTransform(*transform) : Affine(), scene, fail, true);
     // Every mesh of the file sits between the same media.
     const MediumInterface media = ParseMediumInterface(n);
     for (size_t i = first_mesh; i < scene.meshes.size(); ++i) scene.meshes[i].media = media;
-    for (size_t i = first_sphere; i < scene.spheres.size(); ++i) scene.spheres[i].media = media;
 }
 
 }  // namespace lf::scene_internal

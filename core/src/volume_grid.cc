@@ -6,6 +6,7 @@
 #include <openvdb/tools/Dense.h>
 
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <optional>
 #include <sstream>
@@ -57,6 +58,14 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
     auto invalid = [&](const std::string& why) {
         return absl::InvalidArgumentError(absl::StrCat(where, ": ", why));
     };
+    // Checked here: OpenVDB's delayed loading leaves its temporary copy behind when the header
+    // is not a .vdb's.
+    int32_t magic = 0;
+    if (bytes.size() >= sizeof(magic)) std::memcpy(&magic, bytes.data(), sizeof(magic));
+    if (magic != openvdb::OPENVDB_MAGIC) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(file_name, ": not a readable OpenVDB file (no .vdb header)"));
+    }
     openvdb::GridBase::Ptr base;
     try {
         std::istringstream in(bytes);

@@ -1,14 +1,14 @@
 #include "lf/core/volume_grid.h"
 
 #include <gtest/gtest.h>
-#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <string>
+
+#include "vdb_files.h"
 
 namespace lf {
 namespace {
@@ -37,15 +37,6 @@ class VolumeGridTest : public ::testing::Test {
         return grid;
     }
 
-    // The grids as the bytes of a .vdb file; `stats` writes the bounding box metadata.
-    static std::string Bytes(const openvdb::GridPtrVec& grids, bool stats = true) {
-        std::ostringstream out(std::ios::binary);
-        openvdb::io::Stream stream(out);
-        stream.setGridStatsMetadataEnabled(stats);
-        stream.write(grids);
-        return out.str();
-    }
-
     static absl::StatusOr<std::shared_ptr<const VolumeGrid>> Load(
         const std::string& bytes, const std::string& grid = "density",
         const Affine& transform = Affine()) {
@@ -63,7 +54,7 @@ class VolumeGridTest : public ::testing::Test {
 
 TEST_F(VolumeGridTest, CopiesTheActiveBoxAndTheBackground) {
     const openvdb::FloatGrid::Ptr block = Block();
-    absl::StatusOr<std::shared_ptr<const VolumeGrid>> grid = Load(Bytes({block}));
+    absl::StatusOr<std::shared_ptr<const VolumeGrid>> grid = Load(testing::VdbBytes({block}));
     ASSERT_TRUE(grid.ok()) << grid.status();
     const VolumeGrid& g = **grid;
     EXPECT_EQ(g.name, "smoke.vdb#density");
@@ -90,7 +81,7 @@ TEST_F(VolumeGridTest, CopiesTheActiveBoxAndTheBackground) {
 // the background beyond the box.
 TEST_F(VolumeGridTest, LookupMatchesOpenVdbsBoxSampler) {
     const openvdb::FloatGrid::Ptr block = Block();
-    absl::StatusOr<std::shared_ptr<const VolumeGrid>> grid = Load(Bytes({block}));
+    absl::StatusOr<std::shared_ptr<const VolumeGrid>> grid = Load(testing::VdbBytes({block}));
     ASSERT_TRUE(grid.ok()) << grid.status();
     const openvdb::FloatGrid::ConstAccessor acc = block->getConstAccessor();
     int between = 0;
@@ -116,7 +107,7 @@ TEST_F(VolumeGridTest, TransformIsTheFilesThenTheMediums) {
     Affine medium;
     medium.m = {{{0, -2, 0, 10}, {2, 0, 0, 0}, {0, 0, 2, -1}}};
     absl::StatusOr<std::shared_ptr<const VolumeGrid>> grid =
-        Load(Bytes({block}), "density", medium);
+        Load(testing::VdbBytes({block}), "density", medium);
     ASSERT_TRUE(grid.ok()) << grid.status();
     for (const Vec3d& ijk : {Vec3d(0, 0, 0), Vec3d(-1, 2, 5), Vec3d(3.5, -1, 7.25)}) {
         const openvdb::Vec3d file = block->indexToWorld(openvdb::Vec3d(ijk.x, ijk.y, ijk.z));
@@ -133,7 +124,7 @@ TEST_F(VolumeGridTest, TransformIsTheFilesThenTheMediums) {
 TEST_F(VolumeGridTest, EmptyGridIsAllBackground) {
     openvdb::FloatGrid::Ptr empty = openvdb::FloatGrid::create(0.5f);
     empty->setName("density");
-    absl::StatusOr<std::shared_ptr<const VolumeGrid>> grid = Load(Bytes({empty}));
+    absl::StatusOr<std::shared_ptr<const VolumeGrid>> grid = Load(testing::VdbBytes({empty}));
     ASSERT_TRUE(grid.ok()) << grid.status();
     EXPECT_TRUE((*grid)->values.empty());
     EXPECT_EQ((*grid)->Lookup(Vec3d(0.5, 0.5, 0.5)), 0.5f);
@@ -142,7 +133,7 @@ TEST_F(VolumeGridTest, EmptyGridIsAllBackground) {
 TEST_F(VolumeGridTest, MissingGridListsTheFilesGrids) {
     openvdb::Vec3SGrid::Ptr velocity = openvdb::Vec3SGrid::create();
     velocity->setName("velocity");
-    ExpectError(Load(Bytes({Block("flame"), velocity})),
+    ExpectError(Load(testing::VdbBytes({Block("flame"), velocity})),
                 "smoke.vdb grid \"density\": no such grid; the file has \"flame\" (float), "
                 "\"velocity\" (vec3s)");
 }
@@ -150,7 +141,7 @@ TEST_F(VolumeGridTest, MissingGridListsTheFilesGrids) {
 TEST_F(VolumeGridTest, NonFloatGridIsRefusedByName) {
     openvdb::Vec3SGrid::Ptr velocity = openvdb::Vec3SGrid::create();
     velocity->setName("velocity");
-    ExpectError(Load(Bytes({velocity}), "velocity"),
+    ExpectError(Load(testing::VdbBytes({velocity}), "velocity"),
                 "smoke.vdb grid \"velocity\": a vec3s grid; media read float grids only");
 }
 
@@ -161,10 +152,10 @@ TEST_F(VolumeGridTest, AbsurdBoundingBoxIsRefusedBeforeTheCopy) {
     sparse->setName("density");
     sparse->tree().setValue(openvdb::Coord(0, 0, 0), 1);
     sparse->tree().setValue(openvdb::Coord(1000, 1000, 1000), 1);
-    ExpectError(Load(Bytes({sparse})),
+    ExpectError(Load(testing::VdbBytes({sparse})),
                 "its metadata gives a bounding box of 1003003001 voxels, above the limit of "
                 "268435456");
-    ExpectError(Load(Bytes({sparse}, /*stats=*/false)),
+    ExpectError(Load(testing::VdbBytes({sparse}, /*stats=*/false)),
                 "its active voxels span a bounding box of 1003003001 voxels, above the limit");
 }
 
@@ -173,10 +164,11 @@ TEST_F(VolumeGridTest, NegativeOrNonFiniteValuesAreRefused) {
          {-0.5f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
         openvdb::FloatGrid::Ptr grid = Block();
         grid->tree().setValue(openvdb::Coord(1, 3, 6), bad);
-        ExpectError(Load(Bytes({grid})), "smoke.vdb grid \"density\": value ");
-        ExpectError(Load(Bytes({grid})), " at voxel (1, 3, 6): expected a finite value >= 0");
+        ExpectError(Load(testing::VdbBytes({grid})), "smoke.vdb grid \"density\": value ");
+        ExpectError(Load(testing::VdbBytes({grid})),
+                    " at voxel (1, 3, 6): expected a finite value >= 0");
     }
-    ExpectError(Load(Bytes({openvdb::FloatGrid::create(-1)->copyGrid()}), ""),
+    ExpectError(Load(testing::VdbBytes({openvdb::FloatGrid::create(-1)->copyGrid()}), ""),
                 "background -1: expected a finite value >= 0");
 }
 
@@ -184,13 +176,14 @@ TEST_F(VolumeGridTest, FrustumTransformIsRefused) {
     openvdb::FloatGrid::Ptr grid = Block();
     grid->setTransform(openvdb::math::Transform::createFrustumTransform(
         openvdb::BBoxd(openvdb::Vec3d(0, 0, 0), openvdb::Vec3d(10, 10, 10)), 0.5, 2, 1));
-    ExpectError(Load(Bytes({grid})), "transform; media read grids with affine transforms only");
+    ExpectError(Load(testing::VdbBytes({grid})),
+                "transform; media read grids with affine transforms only");
 }
 
 TEST_F(VolumeGridTest, GarbageAndTruncatedBytesAreClearErrors) {
     ExpectError(Load("not a vdb file at all"), "smoke.vdb: not a readable OpenVDB file");
     ExpectError(Load(""), "smoke.vdb: not a readable OpenVDB file");
-    const std::string bytes = Bytes({Block()});
+    const std::string bytes = testing::VdbBytes({Block()});
     for (const size_t length : {size_t(8), bytes.size() / 2, bytes.size() * 3 / 4}) {
         absl::StatusOr<std::shared_ptr<const VolumeGrid>> grid = Load(bytes.substr(0, length));
         ASSERT_FALSE(grid.ok()) << length;
