@@ -253,6 +253,8 @@ absl::Status PrintMethodCosts(const Scene& scene, const EmbreeScene& embree, con
     std::vector<Method> methods = {Method::kPath, Method::kBdpt, Method::kPpm};
     if (transport.specular.empty() && !scene.environment) methods.push_back(Method::kLight);
     if (transport.whitted_missing.empty()) methods.push_back(Method::kWhitted);
+    // Media only the path tracer renders, say: the others would be costed for another image.
+    std::erase_if(methods, [&](Method m) { return !CheckMethodTakesScene(m, scene).ok(); });
     const uint64_t stages[2] = {options.pilot_spp, 4 * options.pilot_spp};
     std::printf(
         "methods for --target-error %.4g: pilots of %llu then %llu spp over the whole image; "
@@ -404,6 +406,8 @@ absl::Status RunPlan(const PlanOptions& options) {
     if (absl::Status s = CheckNoiseThresholdMethod(method, options.noise_threshold); !s.ok()) {
         return s;
     }
+    // plan refuses what render and the farm refuse.
+    if (absl::Status s = CheckMethodTakesScene(method, *scene); !s.ok()) return s;
     std::printf("method (--method %s): %s, because %s\n", options.method.c_str(),
                 std::string(MethodName(method)).c_str(), choice.why.c_str());
     // What Whitted would give (lf/kernels/whitted.h), whether or not it is the method.
