@@ -815,9 +815,10 @@ TEST_F(Cli, HelpExplainsTheOutputFlags) {
                              "EXR is never scaled", ".png writes only"}) {
         EXPECT_NE(r.output.find(text), std::string::npos) << text;
     }
-    // --method auto's rule as ChooseAutomatically applies it (whitted, radiosity, bdpt, path),
-    // not the older radiosity-or-path rule.
-    for (const char* text : {"auto (whitted where it is exact", "else bdpt for caustics"}) {
+    // --method auto's rule as ChooseAutomatically applies it (path for media only it renders,
+    // whitted, radiosity, bdpt, path), not the older radiosity-or-path rule.
+    for (const char* text : {"auto (path for scattering, emitting or grid media",
+                             "whitted where it is exact", "else bdpt for caustics"}) {
         EXPECT_NE(r.output.find(text), std::string::npos) << text;
     }
     EXPECT_EQ(r.output.find("there are no spheres"), std::string::npos);
