@@ -3,12 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "lf/core/scene_loader.h"
-#include "test_dir.h"
+#include "scene_test.h"
 #include "vdb_files.h"
 
 namespace lf {
@@ -36,14 +34,8 @@ std::string MediaScene(const std::string& media, const std::string& shapes = "",
            (shapes.empty() ? "" : ", " + shapes) + "]}";
 }
 
-class SceneMediaTest : public ::testing::Test {
+class SceneMediaTest : public testing::SceneTest {
   protected:
-    void SetUp() override { dir_ = lf::testing::FreshTestDir("lf_scene_media"); }
-    void TearDown() override { std::filesystem::remove_all(dir_); }
-
-    void Write(const std::string& name, const std::string& bytes) {
-        std::ofstream(dir_ / name, std::ios::binary) << bytes;
-    }
     // smoke.vdb: "density" 0.5 and "temperature" 3 on [0, 4)^3 with 0.25 voxels, and a vec3s
     // "velocity".
     void WriteSmoke() {
@@ -53,21 +45,6 @@ class SceneMediaTest : public ::testing::Test {
               testing::VdbBytes({testing::ConstantGrid("density", 0.5f, 4, 0.25),
                                  testing::ConstantGrid("temperature", 3, 4, 0.25), velocity}));
     }
-
-    absl::StatusOr<Scene> Parse(const std::string& json) {
-        return ParseScene(json, "scene.json", ReadBeside(dir_.string()));
-    }
-
-    void ExpectError(const std::string& json, const std::string& expected,
-                     absl::StatusCode code = absl::StatusCode::kInvalidArgument) {
-        absl::StatusOr<Scene> scene = Parse(json);
-        ASSERT_FALSE(scene.ok()) << "expected an error containing: " << expected;
-        EXPECT_EQ(scene.status().code(), code) << scene.status();
-        EXPECT_NE(scene.status().message().find(expected), std::string::npos)
-            << "message: " << scene.status().message() << "\nexpected: " << expected;
-    }
-
-    std::filesystem::path dir_;
 };
 
 TEST_F(SceneMediaTest, HomogeneousMediumKeysAndDefaults) {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "lf/job/digest.h"
+#include "lf/job/settings.h"
 #include "lf/server/farm.h"
 
 namespace lf {
@@ -24,6 +25,19 @@ std::string ForgedScene(const std::string& file) {
            file + "\"}]}";
 }
 
+// Uploads `json` alone as scene.json and submits it for `method`.
+absl::StatusOr<std::string> SubmitScene(Farm& farm, const std::string& json,
+                                        const std::string& method = defaults::kMethod) {
+    JobSpec spec;
+    spec.method = method;
+    spec.scene = {"scene.json", Sha256Hex(json), json.size()};
+    auto upload = farm.StartUpload(spec.scene.hash, json.size());
+    if (!upload.ok()) return upload.status();
+    if (absl::Status s = (*upload)->Append(json); !s.ok()) return s;
+    if (absl::Status s = (*upload)->Finish(); !s.ok()) return s;
+    return farm.Submit(spec);
+}
+
 TEST(SceneAccessTest, ForgedSceneNamingAServerFileIsRefusedWithoutLeakingIt) {
     const fs::path dir = fs::temp_directory_path() / ("lf_access_" + std::to_string(::getpid()));
     fs::remove_all(dir);
@@ -37,19 +51,54 @@ TEST(SceneAccessTest, ForgedSceneNamingAServerFileIsRefusedWithoutLeakingIt) {
                                    "../secret.obj", "secret.obj", "/no/such/file.obj"};
     for (const std::string& target : targets) {
         const std::string json = ForgedScene(target);
-        JobSpec spec;
-        spec.scene = {"scene.json", Sha256Hex(json), json.size()};
-        auto upload = (*farm)->StartUpload(spec.scene.hash, json.size());
-        ASSERT_TRUE(upload.ok()) << upload.status();
-        ASSERT_TRUE((*upload)->Append(json).ok());
-        ASSERT_TRUE((*upload)->Finish().ok());
-
-        const absl::StatusOr<std::string> job = (*farm)->Submit(spec);
+        const absl::StatusOr<std::string> job = SubmitScene(**farm, json);
         ASSERT_FALSE(job.ok()) << target;
         EXPECT_EQ(job.status().code(), absl::StatusCode::kInvalidArgument);
         EXPECT_EQ(job.status().message(), "scene.json: shapes[0].file \"" + target +
                                               "\": not among the files uploaded with the scene");
     }
+    fs::remove_all(dir);
+}
+
+// Submission loads the scene with its media: a grid whose .vdb was not uploaded is refused
+// naming the field, and a method that does not render the media is refused naming both.
+TEST(SceneAccessTest, MediaAreCheckedAtSubmission) {
+    const fs::path dir = fs::temp_directory_path() / ("lf_media_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    FarmOptions options;
+    options.data_dir = (dir / "data").string();
+    absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
+    ASSERT_TRUE(farm.ok()) << farm.status();
+    const std::string scene =
+        R"({"camera": {"position": [0, 0, -1], "look_at": [0, 0, 0], "fov_y_deg": 40,
+                       "resolution": [4, 4]},
+            "materials": {"lamp": {"type": "lambert", "reflectance": [0.5, 0.5, 0.5],
+                                   "emission": [1, 1, 1]}},
+            "media": {MEDIA},
+            "shapes": [{"type": "quad", "material": "lamp", "exterior": "fog",
+                        "vertices": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]}]})";
+    const auto with = [&](const std::string& media) {
+        std::string json = scene;
+        return json.replace(json.find("MEDIA"), 5, media);
+    };
+
+    const absl::StatusOr<std::string> missing = SubmitScene(
+        **farm, with(R"("fog": {"type": "grid", "file": "fog.vdb", "sigma_s": [1, 1, 1]})"),
+        "path");
+    ASSERT_FALSE(missing.ok());
+    EXPECT_EQ(missing.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(
+        missing.status().message(),
+        "scene.json: media.fog.file \"fog.vdb\": not among the files uploaded with the scene");
+
+    const std::string fog = with(R"("fog": {"type": "homogeneous", "sigma_s": [1, 1, 1]})");
+    const absl::StatusOr<std::string> bdpt = SubmitScene(**farm, fog, "bdpt");
+    ASSERT_FALSE(bdpt.ok());
+    EXPECT_EQ(bdpt.status().code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_EQ(bdpt.status().message(),
+              "method bdpt: medium \"fog\" scatters light (sigma_s > 0): not yet supported by "
+              "bdpt; use --method path");
+    EXPECT_TRUE(SubmitScene(**farm, fog, "path").ok());
     fs::remove_all(dir);
 }
 
