@@ -11,6 +11,7 @@
 #include "lf/job/digest.h"
 #include "lf/job/settings.h"
 #include "lf/server/farm.h"
+#include "test_dir.h"
 
 namespace lf {
 namespace {
@@ -41,52 +42,57 @@ absl::StatusOr<std::string> SubmitScene(Farm& farm, const std::string& json,
     return farm.Submit(spec);
 }
 
-TEST(SceneAccessTest, ForgedSceneNamingAServerFileIsRefusedWithoutLeakingIt) {
-    const fs::path dir = fs::temp_directory_path() / ("lf_access_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    FarmOptions options;
-    options.data_dir = (dir / "data").string();
-    absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
-    ASSERT_TRUE(farm.ok()) << farm.status();
+// A farm whose data directory is in a fresh folder, dir_.
+class SceneAccessTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        dir_ = testing::FreshTestDir("lf_access");
+        FarmOptions options;
+        options.data_dir = (dir_ / "data").string();
+        absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
+        ASSERT_TRUE(farm.ok()) << farm.status();
+        farm_ = *std::move(farm);
+    }
+    void TearDown() override {
+        farm_.reset();
+        fs::remove_all(dir_);
+    }
+
+    fs::path dir_;
+    std::unique_ptr<Farm> farm_;
+};
+
+TEST_F(SceneAccessTest, ForgedSceneNamingAServerFileIsRefusedWithoutLeakingIt) {
+    const fs::path& dir = dir_;
     // A file of the server's own disk, in its data directory and outside.
     std::ofstream(dir / "data" / "secret.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     const std::string targets[] = {"/etc/hostname", (dir / "data" / "secret.obj").string(),
                                    "../secret.obj", "secret.obj", "/no/such/file.obj"};
     for (const std::string& target : targets) {
         const std::string json = ForgedScene(target);
-        const absl::StatusOr<std::string> job = SubmitScene(**farm, json);
+        const absl::StatusOr<std::string> job = SubmitScene(*farm_, json);
         ASSERT_FALSE(job.ok()) << target;
         EXPECT_EQ(job.status().code(), absl::StatusCode::kInvalidArgument);
         EXPECT_EQ(job.status().message(), "scene.json: shapes[0].file \"" + target +
                                               "\": not among the files uploaded with the scene");
     }
-    fs::remove_all(dir);
 }
 
 // Submission loads the scene with its media: a grid whose .vdb was not uploaded is refused
 // naming the field, and a method that does not render the media is refused naming both.
-TEST(SceneAccessTest, MediaAreCheckedAtSubmission) {
-    const fs::path dir = fs::temp_directory_path() / ("lf_media_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    FarmOptions options;
-    options.data_dir = (dir / "data").string();
-    absl::StatusOr<std::unique_ptr<Farm>> farm = Farm::Open(options);
-    ASSERT_TRUE(farm.ok()) << farm.status();
-    const std::string scene =
-        R"({"camera": {"position": [0, 0, -1], "look_at": [0, 0, 0], "fov_y_deg": 40,
-                       "resolution": [4, 4]},
-            "materials": {"lamp": {"type": "lambert", "reflectance": [0.5, 0.5, 0.5],
-                                   "emission": [1, 1, 1]}},
-            "media": {MEDIA},
-            "shapes": [{"type": "quad", "material": "lamp", "exterior": "fog",
-                        "vertices": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]}]})";
-    const auto with = [&](const std::string& media) {
-        std::string json = scene;
-        return json.replace(json.find("MEDIA"), 5, media);
+TEST_F(SceneAccessTest, MediaAreCheckedAtSubmission) {
+    // ForgedScene's lamp, its mesh a sphere inside `media`'s "fog".
+    const auto with = [](const std::string& media) {
+        std::string json = ForgedScene("");
+        const std::string mesh = R"({"type": "mesh", "material": "lamp", "file": ""})";
+        json.replace(json.find(mesh), mesh.size(),
+                     R"({"type": "sphere", "material": "lamp", "center": [0, 0, 1], )"
+                     R"("radius": 0.5, "exterior": "fog"})");
+        return json.insert(json.rfind('}'), R"(, "media": {)" + media + "}");
     };
 
     const absl::StatusOr<std::string> missing = SubmitScene(
-        **farm, with(R"("fog": {"type": "grid", "file": "fog.vdb", "sigma_s": [1, 1, 1]})"),
+        *farm_, with(R"("fog": {"type": "grid", "file": "fog.vdb", "sigma_s": [1, 1, 1]})"),
         "path");
     ASSERT_FALSE(missing.ok());
     EXPECT_EQ(missing.status().code(), absl::StatusCode::kInvalidArgument);
@@ -95,15 +101,14 @@ TEST(SceneAccessTest, MediaAreCheckedAtSubmission) {
         "scene.json: media.fog.file \"fog.vdb\": not among the files uploaded with the scene");
 
     const std::string fog = with(R"("fog": {"type": "homogeneous", "sigma_s": [1, 1, 1]})");
-    const absl::StatusOr<std::string> bdpt = SubmitScene(**farm, fog, "bdpt");
+    const absl::StatusOr<std::string> bdpt = SubmitScene(*farm_, fog, "bdpt");
     ASSERT_FALSE(bdpt.ok());
     EXPECT_EQ(bdpt.status().code(), absl::StatusCode::kFailedPrecondition);
     EXPECT_EQ(bdpt.status().message(),
               "method bdpt: medium \"fog\" scatters light (sigma_s > 0): not yet supported by "
               "bdpt; use --method path");
-    const absl::StatusOr<std::string> path = SubmitScene(**farm, fog, "path");
+    const absl::StatusOr<std::string> path = SubmitScene(*farm_, fog, "path");
     EXPECT_TRUE(path.ok()) << path.status();
-    fs::remove_all(dir);
 }
 
 }  // namespace
