@@ -10,6 +10,7 @@
 #include "scene_parser.h"
 
 namespace lf::scene_internal {
+
 void SceneParser::ParseMedia(const Node& media, Scene& scene) {
     media.RequireObject();
     for (const auto& [name, value] : media.json().items()) {
@@ -109,8 +110,9 @@ int SceneParser::MediumIndex(const Node& n) const {
     const auto found = medium_index_.find(name);
     if (found != medium_index_.end()) return found->second;
     std::vector<std::string> names;
-    for (const auto& [known, index] : medium_index_)
+    for (const auto& [known, index] : medium_index_) {
         names.push_back(absl::StrCat("\"", known, "\""));
+    }
     n.Fail(absl::StrCat("unknown medium \"", name, "\"; ",
                         names.empty()
                             ? "the scene has no \"media\""

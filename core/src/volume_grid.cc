@@ -5,10 +5,10 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <exception>
-#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -18,23 +18,24 @@
 namespace lf {
 namespace {
 
-// Lattice points in the box [lo, hi] (inclusive); 0 for an empty one.
-int64_t Points(const openvdb::Coord& lo, const openvdb::Coord& hi) {
-    int64_t points = 1;
-    for (int a = 0; a < 3; ++a) {
-        if (hi[a] < lo[a]) return 0;
-        points *= int64_t(hi[a]) - lo[a] + 1;  // each factor < 2^32: no overflow below 2^63
-        if (points > kMaxVolumeGridPoints) return points;
-    }
-    return points;
+// Why the box [lo, hi] (inclusive) holds too many lattice points for a dense copy, or "".
+// Each side is below 2^33, so the product in double is exact near the bound.
+std::string TooLarge(const openvdb::Coord& lo, const openvdb::Coord& hi) {
+    double points = 1;
+    for (int a = 0; a < 3; ++a) points *= std::max(0.0, double(hi[a]) - lo[a] + 1);
+    if (points <= double(kMaxVolumeGridPoints)) return "";
+    return absl::StrCat(int64_t(hi[0]) - lo[0] + 1, " x ", int64_t(hi[1]) - lo[1] + 1, " x ",
+                        int64_t(hi[2]) - lo[2] + 1, " voxels, above the limit of ",
+                        kMaxVolumeGridPoints, " (2^28)");
 }
 
-// The bounding box the writer recorded (Grid::addStatsMetadata), when it did.
-std::optional<int64_t> RecordedPoints(const openvdb::GridBase& grid) {
+// The bounding box the writer recorded (Grid::addStatsMetadata), when it did: TooLarge's
+// verdict on it.
+std::string RecordedTooLarge(const openvdb::GridBase& grid) {
     const auto lo = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
     const auto hi = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
-    if (!lo || !hi) return std::nullopt;
-    return Points(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
+    if (!lo || !hi) return "";
+    return TooLarge(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
 }
 
 // OpenVDB's maps act on row vectors (world = index * M): M's transpose is our M.
@@ -90,10 +91,8 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
     if (!grid) {
         return invalid(absl::StrCat("a ", base->valueType(), " grid; media read float grids only"));
     }
-    if (const std::optional<int64_t> recorded = RecordedPoints(*grid);
-        recorded && *recorded > kMaxVolumeGridPoints) {
-        return invalid(absl::StrCat("its metadata gives a bounding box of ", *recorded,
-                                    " voxels, above the limit of ", kMaxVolumeGridPoints));
+    if (const std::string why = RecordedTooLarge(*grid); !why.empty()) {
+        return invalid("its metadata gives a bounding box of " + why);
     }
     if (!grid->transform().isLinear()) {
         return invalid(absl::StrCat("a ", grid->transform().mapType(),
@@ -114,17 +113,16 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
 
     try {
         const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
-        const int64_t points = Points(box.min(), box.max());
-        if (points > kMaxVolumeGridPoints) {
-            return invalid(absl::StrCat("its active voxels span a bounding box of ", points,
-                                        " voxels, above the limit of ", kMaxVolumeGridPoints));
+        if (const std::string why = TooLarge(box.min(), box.max()); !why.empty()) {
+            return invalid("its active voxels span a bounding box of " + why);
         }
-        if (points == 0) return std::shared_ptr<const VolumeGrid>(std::move(out));
+        // No active voxel: everything reads the background.
+        if (box.empty()) return std::shared_ptr<const VolumeGrid>(std::move(out));
         for (int a = 0; a < 3; ++a) {
             out->min[a] = box.min()[a];
             out->size[a] = box.max()[a] - box.min()[a] + 1;
         }
-        out->values.resize(size_t(points));
+        out->values.resize(size_t(out->size[0]) * size_t(out->size[1]) * size_t(out->size[2]));
         openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, out->values.data());
         openvdb::tools::copyToDense(*grid, dense);
     } catch (const std::exception& e) {

@@ -153,10 +153,23 @@ TEST_F(VolumeGridTest, AbsurdBoundingBoxIsRefusedBeforeTheCopy) {
     sparse->tree().setValue(openvdb::Coord(0, 0, 0), 1);
     sparse->tree().setValue(openvdb::Coord(1000, 1000, 1000), 1);
     ExpectError(Load(testing::VdbBytes({sparse})),
-                "its metadata gives a bounding box of 1003003001 voxels, above the limit of "
-                "268435456");
+                "its metadata gives a bounding box of 1001 x 1001 x 1001 voxels, above the limit "
+                "of 268435456 (2^28)");
     ExpectError(Load(testing::VdbBytes({sparse}, /*stats=*/false)),
-                "its active voxels span a bounding box of 1003003001 voxels, above the limit");
+                "its active voxels span a bounding box of 1001 x 1001 x 1001 voxels, above the "
+                "limit");
+    // Sides whose product overflows 64 bits, and a box one plane beyond 2^10 x 2^10 x 2^8.
+    openvdb::FloatGrid::Ptr vast = openvdb::FloatGrid::create(0);
+    vast->setName("density");
+    vast->tree().setValue(openvdb::Coord(-2000000000, -2000000000, -2000000000), 1);
+    vast->tree().setValue(openvdb::Coord(2000000000, 2000000000, 2000000000), 1);
+    ExpectError(Load(testing::VdbBytes({vast}, false)),
+                "span a bounding box of 4000000001 x 4000000001 x 4000000001 voxels");
+    openvdb::FloatGrid::Ptr edge = openvdb::FloatGrid::create(0);
+    edge->setName("density");
+    edge->tree().setValue(openvdb::Coord(0, 0, 0), 1);
+    edge->tree().setValue(openvdb::Coord(1023, 1023, 256), 1);
+    ExpectError(Load(testing::VdbBytes({edge})), "1024 x 1024 x 257 voxels, above the limit");
 }
 
 TEST_F(VolumeGridTest, NegativeOrNonFiniteValuesAreRefused) {
