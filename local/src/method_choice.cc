@@ -27,13 +27,14 @@ bool FocusesLight(const Material& m) {
             return (m.transmission > 0 || m.metallic > 0.5f) &&
                    m.roughness * m.roughness < kCausticRoughness;
         case Material::Type::kLambert:
+        case Material::Type::kInterface:  // passes light straight on
             return false;
     }
     return false;
 }
 
 bool Scatters(const Material& m) {
-    if (FocusesLight(m)) return false;
+    if (FocusesLight(m) || m.type == Material::Type::kInterface) return false;
     return m.type != Material::Type::kLambert || !m.reflectance.IsBlack();
 }
 

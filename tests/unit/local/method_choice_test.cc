@@ -75,6 +75,14 @@ TEST(MethodChoice, AutoTakesThePathTracerForMediaOnlyItRenders) {
               R"(, "media": {"ink": {"type": "homogeneous", "sigma_a": [1, 1, 1]}})" + lit),
         std::nullopt);
     EXPECT_EQ(absorber.method, Method::kWhitted);
+
+    // An interface between media passes light straight on: it neither scatters nor focuses.
+    std::string boundary = kPlane;
+    boundary.replace(boundary.find(R"("type": "lambert")"), 17, R"("type": "interface")");
+    boundary.erase(boundary.find(R"(, "reflectance": [0.5, 0.5, 0.5])"), 32);
+    const SceneTransport t = AnalyzeTransport(Parse(boundary + "}"));
+    EXPECT_FALSE(t.diffuse);
+    EXPECT_TRUE(t.specular.empty());
 }
 
 TEST(MethodChoice, RequestedMethodIsTaken) {
