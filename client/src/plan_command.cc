@@ -19,6 +19,7 @@
 #include "lf/client/scene_flags.h"
 #include "lf/core/camera.h"
 #include "lf/core/image_error.h"
+#include "lf/core/medium.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/plural.h"
 #include "lf/core/scene_loader.h"
@@ -131,8 +132,31 @@ std::string DescribeSurface(const Material& m) {
                                    m.roughness);
         case Material::Type::kDielectric:
             return absl::StrFormat("index of refraction %.3g", m.ior);
+        case Material::Type::kInterface:
+            return "a boundary between media (neither reflects nor refracts)";
     }
     return "";
+}
+
+// A grid's lattice and what its dense copy holds in memory.
+std::string DescribeGrid(const VolumeGrid& g) {
+    return absl::StrFormat("%s %dx%dx%d (%.3g MiB)", g.name, g.size[0], g.size[1], g.size[2],
+                           double(g.values.size() * sizeof(float)) / (1 << 20));
+}
+
+// A medium's coefficients, and its grids with their sizes.
+std::string DescribeMedium(const Medium& m) {
+    std::string out =
+        absl::StrFormat("%s, sigma_a %s, sigma_s %s m^-1, g %.3g",
+                        m.type == Medium::Type::kGrid ? "grid (at density 1)" : "homogeneous",
+                        Color(m.sigma_a), Color(m.sigma_s), m.g);
+    if (!m.emission.IsBlack()) absl::StrAppend(&out, ", emits ", Color(m.emission));
+    for (const auto& [grid, what] : {std::pair{&m.density, "density"},
+                                     {&m.emission_grid, "emission"},
+                                     {&m.temperature, "temperature"}}) {
+        if (*grid) absl::StrAppend(&out, ", ", what, " ", DescribeGrid(**grid));
+    }
+    return out;
 }
 
 // Radiosity's cost comes from pilot solves of 1/8 and 1/4 of the target's patches (about 1/4
@@ -229,6 +253,8 @@ absl::Status PrintMethodCosts(const Scene& scene, const EmbreeScene& embree, con
     std::vector<Method> methods = {Method::kPath, Method::kBdpt, Method::kPpm};
     if (transport.specular.empty() && !scene.environment) methods.push_back(Method::kLight);
     if (transport.whitted_missing.empty()) methods.push_back(Method::kWhitted);
+    // Media only the path tracer renders, say: the others would be costed for another image.
+    std::erase_if(methods, [&](Method m) { return !CheckMethodTakesScene(m, scene).ok(); });
     const uint64_t stages[2] = {options.pilot_spp, 4 * options.pilot_spp};
     std::printf(
         "methods for --target-error %.4g: pilots of %llu then %llu spp over the whole image; "
@@ -364,11 +390,24 @@ absl::Status RunPlan(const PlanOptions& options) {
         emissive_triangles, emitting_area, emissive_spheres, scene->point_lights.size(),
         scene->spot_lights.size(), scene->directional_lights.size(), environment.c_str());
 
+    if (!scene->media.empty()) {
+        std::printf("media:\n");
+        for (const Medium& m : scene->media) {
+            std::printf("  %s: %s\n", m.name.c_str(), DescribeMedium(m).c_str());
+        }
+        if (scene->camera_medium >= 0) {
+            std::printf("the camera is in medium \"%s\"\n",
+                        scene->media[size_t(scene->camera_medium)].name.c_str());
+        }
+    }
+
     const MethodChoice choice = ChooseMethod(*scene, MethodOfFlag(options.method));
     const Method method = choice.method;
     if (absl::Status s = CheckNoiseThresholdMethod(method, options.noise_threshold); !s.ok()) {
         return s;
     }
+    // plan refuses what render and the farm refuse.
+    if (absl::Status s = CheckMethodTakesScene(method, *scene); !s.ok()) return s;
     std::printf("method (--method %s): %s, because %s\n", options.method.c_str(),
                 std::string(MethodName(method)).c_str(), choice.why.c_str());
     // What Whitted would give (lf/kernels/whitted.h), whether or not it is the method.
@@ -473,12 +512,13 @@ Command AddPlanCommand(CLI::App& app) {
     auto options = std::make_shared<PlanOptions>();
     CLI::App* cmd = app.add_subcommand(
         "plan",
-        "Say what a render of the scene will model and why: materials and lights in use, the\n"
-        "method --method picks, the path depth policy, for radiosity the patch count and the\n"
-        "time and memory of the form factors and the solve (from a pilot solve of fewer\n"
-        "patches), and the samples and time a target error needs (from a two-stage pilot\n"
-        "render's own error estimates, how fast they fall, and its speed; give the render's\n"
-        "--spp, --tile, --seed and --max-spp for its passes), then the same target's cost for\n"
+        "Say what a render of the scene will model and why: materials, lights and participating\n"
+        "media (with their grids' sizes and memory) in use, the method --method picks, the path\n"
+        "depth policy, for radiosity the patch count and the time and memory of the form\n"
+        "factors and the solve (from a pilot solve of fewer patches), and the samples and time\n"
+        "a target error needs (from a two-stage pilot render's own error estimates, how fast\n"
+        "they fall, and its speed; give the render's --spp, --tile, --seed and --max-spp for\n"
+        "its passes), then the same target's cost for\n"
         "each Monte Carlo method that renders the scene completely (path, bdpt, ppm; light\n"
         "where nothing specular or sky is seen; whitted where it is exact), each from a\n"
         "two-stage pilot of the whole image, and which is fastest.");

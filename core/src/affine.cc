@@ -27,6 +27,19 @@ Affine Affine::NormalMatrix() const {
     return n;
 }
 
+Affine Affine::Inverse() const {
+    // M^-1 is the transposed cofactor matrix over det(M); t goes to -M^-1 t.
+    const double det = Determinant();
+    const Vec3d cofactor[3] = {Cross(Row(1), Row(2)), Cross(Row(2), Row(0)), Cross(Row(0), Row(1))};
+    Affine inverse;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) inverse.m[r][c] = cofactor[c][r] / det;
+    }
+    const Vec3d t = inverse.ApplyLinear(Vec3d(m[0][3], m[1][3], m[2][3]));
+    for (int r = 0; r < 3; ++r) inverse.m[r][3] = -t[r];
+    return inverse;
+}
+
 bool Affine::IsFinite() const {
     for (const auto& row : m) {
         for (const double v : row) {

@@ -9,7 +9,7 @@ namespace lf::scene_internal {
 
 CameraSpec SceneParser::ParseCamera(const Node& n) {
     n.ExpectObject({"type", "position", "look_at", "up", "fov_y_deg", "half_height", "resolution",
-                    "aperture_radius", "focus_distance", "filter", "transform"});
+                    "medium", "aperture_radius", "focus_distance", "filter", "transform"});
     CameraSpec camera;
     if (const std::optional<Node> type = n.Find("type")) {
         if (type->String() == "orthographic") {

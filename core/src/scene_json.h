@@ -72,6 +72,18 @@ class Node {
         }
     }
 
+    // For objects where a misspelt key would silently change the result: an unknown key is an
+    // error, `what` saying what has which keys ("a homogeneous medium has type, sigma_a, ...").
+    void RejectUnknownKeys(std::initializer_list<std::string_view> known,
+                           const std::string& what) const {
+        RequireObject();
+        for (const auto& [key, value] : json_.items()) {
+            if (std::find(known.begin(), known.end(), key) == known.end()) {
+                Fail(absl::StrCat("unknown key \"", key, "\"; ", what));
+            }
+        }
+    }
+
     void ExpectObject(std::initializer_list<std::string_view> known) const {
         RequireObject();
         WarnUnknownKeys(known);

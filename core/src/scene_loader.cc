@@ -25,18 +25,25 @@ namespace scene_internal {
 Scene SceneParser::Parse(const Json& json, const std::string& text) {
     hash_.Update(text);
     const Node root(json, "", &warnings_);
-    root.ExpectObject({"version", "camera", "materials", "shapes", "lights"});
+    root.ExpectObject({"version", "camera", "materials", "shapes", "lights", "media"});
     if (const std::optional<Node> version = root.Find("version")) {
         if (version->Number() != 1) version->Fail("unsupported; this build reads version 1");
     }
     Scene scene;
     textures_ = &scene.textures;
+    // Before the camera and the shapes, which name media.
+    if (const std::optional<Node> media = root.Find("media")) ParseMedia(*media, scene);
     // Optional when an included glTF may bring a camera, or --camera auto frames the scene
     // (ResolveCamera).
     const std::optional<Node> camera = IncludesGltf(root) || options_.camera == kAutoCameraName
                                            ? root.Find("camera")
                                            : std::optional(root.Get("camera"));
-    if (camera) scene.camera = ParseCamera(*camera);
+    if (camera) {
+        scene.camera = ParseCamera(*camera);
+        if (const std::optional<Node> medium = camera->Find("medium")) {
+            scene.camera_medium = MediumIndex(*medium);
+        }
+    }
 
     const Node materials = root.Get("materials");
     materials.RequireObject();
@@ -94,6 +101,7 @@ Scene SceneParser::Finish(Scene& scene) {
         scene.camera.filter = *options_.filter;
     }
     if (!options_.sky.empty()) ApplySky(scene);
+    AddAttenuationMedia(scene);
     if (!scene.HasLights()) {
         warnings_.push_back("no emissive shape and no light: the image will be black");
     }

@@ -60,9 +60,16 @@ Material SceneParser::ParseMaterial(const std::string& name, const Node& n) {
         m.ior = n.Get("ior").PositiveFloat();
     } else if (type_name == "principled") {
         ParsePrincipled(n, m);
+    } else if (type_name == "interface") {
+        // Neither reflects nor emits: a colour or an emission here is a misunderstanding.
+        n.RejectUnknownKeys({"type", "name"},
+                            "an interface material (a boundary between media) has no other keys");
+        m.type = Material::Type::kInterface;
+        return m;
     } else {
-        type.Fail(absl::StrCat("unknown material type \"", type_name,
-                               "\"; expected lambert, mirror, glossy, dielectric or principled"));
+        type.Fail(absl::StrCat(
+            "unknown material type \"", type_name,
+            "\"; expected lambert, mirror, glossy, dielectric, principled or interface"));
     }
     ParseEmission(n, m);
     return m;

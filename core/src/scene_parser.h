@@ -1,7 +1,7 @@
 // SceneParser: a JSON scene, or a glTF file as a whole scene, into the scene model. Its members
 // are defined by concept: scene_loader.cc (the whole scene), scene_camera.cc, scene_materials.cc,
-// scene_shapes.cc, scene_keyframes.cc (keyframed transforms) and scene_lights.cc (lights and
-// photometric units). Private to core.
+// scene_shapes.cc, scene_keyframes.cc (keyframed transforms), scene_lights.cc (lights and
+// photometric units) and scene_media.cc (participating media). Private to core.
 #pragma once
 
 #include <array>
@@ -171,6 +171,23 @@ class SceneParser {
     // of one face (pi L A) or both (2 pi L A).
     void ResolveEmittedPower(Scene& scene);
 
+    // Participating media (scene_media.cc).
+    // The top-level "media" object into Scene::media.
+    void ParseMedia(const Node& media, Scene& scene);
+    Medium ParseMedium(const std::string& name, const Node& n);
+    // Grid `grid_name` (named at `key`) of a grid medium's `file`, the file read and hashed once.
+    std::shared_ptr<const VolumeGrid> LoadGrid(const Node& file, const Node& key,
+                                               const std::string& grid_name,
+                                               const Affine& transform);
+    // A shape's "interior" and "exterior": either makes an interface, the other side vacuum.
+    MediumInterface ParseMediumInterface(const Node& shape) const;
+    // The index in Scene::media of the medium named at `n`.
+    int MediumIndex(const Node& n) const;
+    // Beer's law as a medium: each solid transmitter (Material::HasInterior) with a finite
+    // attenuation_distance and no interface of its own gets a homogeneous absorber inside,
+    // sigma_a = -ln(attenuation_color) / attenuation_distance, one per material.
+    static void AddAttenuationMedia(Scene& scene);
+
     const SceneFileReader& read_file_;
     const SceneOptions& options_;
     std::vector<GltfCamera> gltf_cameras_;
@@ -191,7 +208,9 @@ class SceneParser {
     std::string environment_path_;  // the first environment light's JSON path
     // By name and whether the file's own materials were read.
     std::map<std::pair<std::string, bool>, CachedMeshFile> mesh_cache_;
-    std::map<std::string, int> texture_index_;  // by file name, into *textures_
+    std::map<std::string, int> texture_index_;       // by file name, into *textures_
+    std::map<std::string, int> medium_index_;        // by name, into Scene::media
+    std::map<std::string, std::string> grid_files_;  // .vdb bytes by normalised name
     std::vector<std::shared_ptr<const TextureImage>>* textures_ = nullptr;  // the scene's
     Fnv1a128 hash_;
     int dropped_degenerate_ = 0;

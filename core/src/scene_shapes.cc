@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <numbers>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -15,6 +16,9 @@ namespace {
 // Twice a triangle's area below this fraction of its longest edge squared is within double
 // rounding of zero: the triangle has no reliable normal and no area to sample.
 constexpr double kDegenerateRatio = 1e-12;
+
+// The medium on either side of a shape's surface (scene_media.cc).
+constexpr std::array<std::string_view, 2> kMediaKeys = {"interior", "exterior"};
 
 // False for NaN too, which a comparison of the largest component would let through.
 bool WithinCoordinateRange(const Vec3d& p) {
@@ -129,8 +133,9 @@ void SceneParser::ParseShape(const Node& n, Scene& scene) {
                     [&](const AnimationChannel& c) { return c.node == placed.node; });
 
     if (type_name == "sphere") {
-        n.WarnUnknownKeys({"type", "material", "name", "center", "radius", "transform"});
-        Sphere sphere{name, material_index, n.Get("center").Vector(), 0};
+        n.WarnUnknownKeys({"type", "material", "name", "center", "radius", "transform"},
+                          kMediaKeys);
+        Sphere sphere{name, material_index, n.Get("center").Vector(), 0, ParseMediumInterface(n)};
         const Node radius = n.Get("radius");
         sphere.radius = radius.Number();
         if (!(sphere.radius > 0 && sphere.radius <= kMaxCoordinate)) {
@@ -153,7 +158,7 @@ void SceneParser::ParseShape(const Node& n, Scene& scene) {
 
     std::vector<TriangleMesh> meshes;
     if (type_name == "quad" || type_name == "triangle") {
-        n.WarnUnknownKeys({"type", "material", "name", "vertices", "transform"});
+        n.WarnUnknownKeys({"type", "material", "name", "vertices", "transform"}, kMediaKeys);
         const bool quad = type_name == "quad";
         TriangleMesh& mesh = meshes.emplace_back();
         for (const Node& v : n.Get("vertices").Elements(quad ? 4 : 3)) {
@@ -164,15 +169,17 @@ void SceneParser::ParseShape(const Node& n, Scene& scene) {
         mesh.is_quad = quad;
         mesh.material = material_index;
     } else if (type_name == "mesh") {
-        n.WarnUnknownKeys({"type", "material", "name", "file", "transform"});
+        n.WarnUnknownKeys({"type", "material", "name", "file", "transform"}, kMediaKeys);
         meshes = LoadMeshShape(n, material_index, scene);
     } else {
         type.Fail(absl::StrCat("unknown shape type \"", type_name,
                                "\"; expected quad, triangle, mesh or sphere"));
     }
 
+    const MediumInterface media = ParseMediumInterface(n);
     bool kept = false;
     for (TriangleMesh& mesh : meshes) {
+        mesh.media = media;
         // One mesh per material of the file: each named for its material.
         mesh.name = meshes.size() == 1
                         ? name
@@ -321,7 +328,7 @@ void SceneParser::ImportGltf(const std::string& bytes, const std::string& name,
 }
 
 void SceneParser::ParseGltfShape(const Node& n, Scene& scene) {
-    n.WarnUnknownKeys({"type", "file", "transform"});
+    n.WarnUnknownKeys({"type", "file", "transform"}, kMediaKeys);
     const Node file = n.Get("file");
     const std::string name = file.String();
     if (name.empty()) file.Fail("empty file name");
@@ -336,8 +343,12 @@ void SceneParser::ParseGltfShape(const Node& n, Scene& scene) {
     absl::StatusOr<std::string> bytes = read_file_(name);
     if (!bytes.ok()) fail(bytes.status());
     hash_.Update(*bytes);
+    const size_t first_mesh = scene.meshes.size();
     ImportGltf(*bytes, name, std::filesystem::path(name).parent_path().string(),
                transform ? ParseTransform(*transform) : Affine(), scene, fail, true);
+    // Every mesh of the file sits between the same media.
+    const MediumInterface media = ParseMediumInterface(n);
+    for (size_t i = first_mesh; i < scene.meshes.size(); ++i) scene.meshes[i].media = media;
 }
 
 }  // namespace lf::scene_internal

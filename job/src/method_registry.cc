@@ -13,19 +13,41 @@ namespace lf {
 
 namespace {
 
+// Every method but the path tracer renders homogeneous absorbers only.
+absl::Status MediaRefusal(Method method, const Scene& scene) {
+    const std::string why = MediaLimitation(scene);
+    if (why.empty()) return absl::OkStatus();
+    const bool lacks_model = method == Method::kWhitted || method == Method::kRadiosity;
+    return absl::FailedPreconditionError(
+        absl::StrCat("method ", MethodName(method), ": ", why,
+                     lacks_model ? absl::StrCat(", which ", MethodName(method), " does not model")
+                                 : absl::StrCat(": not yet supported by ", MethodName(method)),
+                     "; use --method path"));
+}
+
+template <Method kMethod>
+absl::Status MediaOnlyRefusal(const Scene& scene) {
+    return MediaRefusal(kMethod, scene);
+}
+
+absl::Status RadiosityAndMediaRefusal(const Scene& scene) {
+    if (absl::Status s = MediaRefusal(Method::kRadiosity, scene); !s.ok()) return s;
+    return RadiosityRefusal(scene);
+}
+
 // Indexed by Method.
 constexpr std::array<MethodInfo, 6> kMethods = {{
     {Method::kPath, "path", WorkKind::kTiles, std::nullopt, false, true, true, true, true, nullptr},
     {Method::kRadiosity, "radiosity", WorkKind::kRadiosity, std::nullopt, false, false, true, true,
-     false, RadiosityRefusal},
+     false, RadiosityAndMediaRefusal},
     {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, true, true,
-     nullptr},
+     MediaOnlyRefusal<Method::kWhitted>},
     {Method::kLight, "light", WorkKind::kSplatPasses, SplatPlanKind::kLightPaths, true, false,
-     false, false, true, nullptr},
+     false, false, true, MediaOnlyRefusal<Method::kLight>},
     {Method::kBdpt, "bdpt", WorkKind::kSplatPasses, SplatPlanKind::kCameraAndLight, true, true,
-     false, false, true, nullptr},
+     false, false, true, MediaOnlyRefusal<Method::kBdpt>},
     {Method::kPpm, "ppm", WorkKind::kSplatPasses, SplatPlanKind::kPhotonPasses, false, true, false,
-     false, true, nullptr},
+     false, true, MediaOnlyRefusal<Method::kPpm>},
 }};
 
 constexpr bool IndexedByMethod() {
@@ -65,6 +87,20 @@ Method MethodOf(const JobSpec& spec) {
     if (std::optional<Method> method = FindMethod(spec.method)) return *method;
     std::fprintf(stderr, "MethodOf: unchecked job spec with method \"%s\"\n", spec.method.c_str());
     std::abort();
+}
+
+std::string MediaLimitation(const Scene& scene) {
+    if (scene.camera_medium >= 0) {
+        return absl::StrCat("the camera is in medium \"",
+                            scene.media[size_t(scene.camera_medium)].name, "\"");
+    }
+    for (const Medium& m : scene.media) {
+        const std::string what = absl::StrCat("medium \"", m.name, "\"");
+        if (m.type == Medium::Type::kGrid) return what + " is a grid (heterogeneous)";
+        if (!m.sigma_s.IsBlack()) return what + " scatters light (sigma_s > 0)";
+        if (m.IsEmissive()) return what + " emits light";
+    }
+    return "";
 }
 
 absl::Status CheckMethodTakesFilter(Method method, const PixelFilter& filter) {

@@ -326,6 +326,8 @@ absl::StatusOr<LoadedRender> LoadRender(const LocalRenderOptions& options) {
     r.job_id = "local-" + r.scene.content_hash.substr(0, 8);
     const MethodChoice choice = ChooseMethod(r.scene, options.method);
     r.method = choice.method;
+    // What the farm refuses at submission (media a method does not render, say) is refused here.
+    if (absl::Status s = CheckMethodTakesScene(r.method, r.scene); !s.ok()) return s;
     const MethodInfo& info = Info(r.method);
     log->info("job={} method {} ({})", r.job_id, info.name, choice.why);
     r.job = LocalJobOf(options, r.scene, info);

@@ -27,13 +27,14 @@ bool FocusesLight(const Material& m) {
             return (m.transmission > 0 || m.metallic > 0.5f) &&
                    m.roughness * m.roughness < kCausticRoughness;
         case Material::Type::kLambert:
+        case Material::Type::kInterface:  // passes light straight on
             return false;
     }
     return false;
 }
 
 bool Scatters(const Material& m) {
-    if (FocusesLight(m)) return false;
+    if (FocusesLight(m) || m.type == Material::Type::kInterface) return false;
     return m.type != Material::Type::kLambert || !m.reflectance.IsBlack();
 }
 
@@ -118,6 +119,10 @@ MethodChoice ChooseAutomatically(const Scene& scene) {
     // No light: every method renders black; no form factors or pilots to spend on it.
     if (!scene.HasLights()) {
         return {Method::kPath, "the scene has no lights: the image is black whatever the method"};
+    }
+    // Scattering, emitting or grid media: every other method refuses them (MediaLimitation).
+    if (const std::string media = MediaLimitation(scene); !media.empty()) {
+        return {Method::kPath, absl::StrCat(media, ": only the path tracer renders it")};
     }
     // Whitted before radiosity: where it is exact it has no meshing error either.
     if (t.whitted_missing.empty() && scene.HasLights()) {

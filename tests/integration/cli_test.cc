@@ -21,6 +21,7 @@
 #include "absl/strings/str_split.h"
 #include "image_files.h"
 #include "lf/core/image_io.h"
+#include "vdb_files.h"
 
 namespace lf {
 namespace {
@@ -574,6 +575,47 @@ TEST_F(Cli, PlanListsTheEnvironmentAndSkipsEmissionTexturesWithoutLight) {
     }
 }
 
+// `plan` lists the media with their grids, auto takes the path tracer for scattering media,
+// and plan and render refuse a method that does not render them, naming both.
+TEST_F(Cli, PlanListsMediaAndMethodsRefuseWhatTheyDoNotRender) {
+    std::ofstream(dir_ / "smoke.vdb", std::ios::binary)
+        << testing::VdbBytes({testing::ConstantGrid("density", 0.5f, 4, 0.25)});
+    const std::string scene = Write("fog.json", R"({
+      "camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 40,
+                 "resolution": [8, 8]},
+      "materials": {"lamp": {"type": "lambert", "reflectance": [0.5, 0.5, 0.5],
+                             "emission": [1, 1, 1]},
+                    "boundary": {"type": "interface"}},
+      "media": {"fog": {"type": "homogeneous", "sigma_s": [0.5, 0.5, 0.5], "g": 0.3},
+                "smoke": {"type": "grid", "file": "smoke.vdb", "sigma_a": [1, 1, 1]}},
+      "shapes": [{"type": "quad", "material": "lamp",
+                  "vertices": [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]]},
+                 {"type": "sphere", "material": "boundary", "center": [0, 0, 1],
+                  "radius": 0.5, "interior": "smoke", "exterior": "fog"}]})");
+    const RunResult r = Lightfarm("plan " + scene + " --pilot-spp 2 --threads 2");
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* text :
+         {"media:\n  fog: homogeneous, sigma_a (0, 0, 0), sigma_s (0.5, 0.5, 0.5) m^-1, g 0.3\n",
+          "  smoke: grid (at density 1), sigma_a (1, 1, 1), sigma_s (0, 0, 0) m^-1, g 0, density "
+          "smoke.vdb#density 4x4x4 (0.000244 MiB)\n",
+          "method (--method auto): path, because medium \"fog\" scatters light (sigma_s > 0): "
+          "only the path tracer renders it"}) {
+        EXPECT_NE(r.output.find(text), std::string::npos) << text << "\n" << r.output;
+    }
+    EXPECT_EQ(r.output.find("  bdpt "), std::string::npos) << "bdpt costed:\n" << r.output;
+    for (const std::string& command :
+         {"plan " + scene + " --method bdpt --pilot-spp 2",
+          "render " + scene + " -o " + (dir_ / "x.exr").string() + " --method bdpt --spp 1"}) {
+        const RunResult refused = Lightfarm(command);
+        EXPECT_NE(refused.status, 0) << command;
+        EXPECT_NE(refused.output.find("method bdpt: medium \"fog\" scatters light (sigma_s > 0): "
+                                      "not yet supported by bdpt; use --method path"),
+                  std::string::npos)
+            << command << "\n"
+            << refused.output;
+    }
+}
+
 TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
     const RunResult r = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
                                   "/cornell_box.json --pilot-spp 2 --target-error 0.5 --threads 2 "
@@ -773,9 +815,10 @@ TEST_F(Cli, HelpExplainsTheOutputFlags) {
                              "EXR is never scaled", ".png writes only"}) {
         EXPECT_NE(r.output.find(text), std::string::npos) << text;
     }
-    // --method auto's rule as ChooseAutomatically applies it (whitted, radiosity, bdpt, path),
-    // not the older radiosity-or-path rule.
-    for (const char* text : {"auto (whitted where it is exact", "else bdpt for caustics"}) {
+    // --method auto's rule as ChooseAutomatically applies it (path for media only it renders,
+    // whitted, radiosity, bdpt, path), not the older radiosity-or-path rule.
+    for (const char* text : {"auto (path for scattering, emitting or grid media",
+                             "whitted where it is exact", "else bdpt for caustics"}) {
         EXPECT_NE(r.output.find(text), std::string::npos) << text;
     }
     EXPECT_EQ(r.output.find("there are no spheres"), std::string::npos);

@@ -34,6 +34,7 @@
 #include "lf/core/image_io.h"
 #include "lf/job/digest.h"
 #include "test_dir.h"
+#include "vdb_files.h"
 
 namespace lf {
 namespace {
@@ -1318,6 +1319,34 @@ TEST_F(Farm, SkyMapIsUploadedAndGivesTheLocalBits) {
     absl::StatusOr<ExrFile> file = ReadExr(farm);
     ASSERT_TRUE(file.ok()) << file.status();
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.sky")), "../maps/sky.hdr");
+}
+
+// A grid medium's .vdb travels as a blob like a mesh (submit uploads what the loader reads) and
+// the farm's render has the local bits; a method that does not render the medium is refused at
+// submission naming both.
+TEST_F(Farm, GridMediumFileIsUploadedAndGivesTheLocalBits) {
+    StartServer();
+    StartWorker("w1");
+    fs::create_directories(dir_ / "scene" / "cache");
+    std::ofstream(dir_ / "scene" / "cache" / "smoke.vdb", std::ios::binary)
+        << lf::testing::VdbBytes({lf::testing::ConstantGrid("density", 0.5f, 8, 0.05)});
+    nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
+    scene["media"] = {{"smoke",
+                       {{"type", "grid"},
+                        {"file", "cache/smoke.vdb"},
+                        {"sigma_s", {2, 2, 2}},
+                        {"transform", {{"translate", {0.1, 0.1, 0.1}}}}}}};
+    scene["camera"]["medium"] = "smoke";
+    const std::string smoky = (dir_ / "scene" / "smoke.json").string();
+    std::ofstream(smoky) << scene.dump();
+    const std::string job = Submit(smoky, "--spp 4 --seed 2 --tile 16");
+    ExpectSameAsLocal(job, smoky, 4, 2);
+    const CliRun bdpt = Farmctl("submit " + smoky + " --method bdpt --spp 4");
+    EXPECT_NE(bdpt.status, 0);
+    EXPECT_NE(bdpt.err.find("method bdpt: the camera is in medium \"smoke\": not yet supported "
+                            "by bdpt; use --method path"),
+              std::string::npos)
+        << bdpt.err;
 }
 
 // Files named inside files (an OBJ's MTL, the MTL's texture) are uploaded with the scene: the

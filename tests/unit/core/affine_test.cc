@@ -57,5 +57,24 @@ TEST(Affine, FromTrsScalesThenRotatesThenTranslates) {
     EXPECT_NEAR(a.Determinant(), 24, 1e-13);
 }
 
+// Inverse undoes the map on both sides, mirrored or not, translation included.
+TEST(Affine, InverseUndoesTheMap) {
+    for (const double mirror : {1.0, -1.0}) {
+        const Affine a = Skewed(mirror);
+        const Affine inverse = a.Inverse();
+        for (const Vec3d& p : {Vec3d(0, 0, 0), Vec3d(1, -2, 3), Vec3d(-7.5, 0.25, 100)}) {
+            const Vec3d there = inverse.Apply(a.Apply(p)), back = a.Apply(inverse.Apply(p));
+            for (int i = 0; i < 3; ++i) {
+                EXPECT_NEAR(there[i], p[i], 1e-12);
+                EXPECT_NEAR(back[i], p[i], 1e-12);
+            }
+        }
+        EXPECT_NEAR(a.Determinant() * inverse.Determinant(), 1, 1e-12);
+    }
+    Affine flat;
+    flat.m[2][2] = 0;
+    EXPECT_FALSE(flat.Inverse().IsFinite());
+}
+
 }  // namespace
 }  // namespace lf

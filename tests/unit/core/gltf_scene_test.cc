@@ -407,6 +407,33 @@ TEST_F(GltfSceneTest, AnIncludingTransformScalesTheAttenuationDistance) {
     EXPECT_FLOAT_EQ(included->materials[0].attenuation_distance, 0.02f);
 }
 
+// A transmitting glTF solid's attenuation becomes its interior medium, as a JSON scene's does;
+// a JSON "interior" on the included file puts every mesh of it between the named media.
+TEST_F(GltfSceneTest, AttenuationIsAMediumAndAnIncludedFileTakesInterfaces) {
+    GltfBuilder b = testing::TexturedTestScene();
+    b.json()["materials"][0]["extensions"]["KHR_materials_transmission"] = {
+        {"transmissionFactor", 1}};
+    b.json()["materials"][0]["extensions"]["KHR_materials_volume"] = {
+        {"thicknessFactor", 0.1}, {"attenuationDistance", 2}, {"attenuationColor", {0.5, 1, 1}}};
+    const absl::StatusOr<Scene> direct = Load(b, "glass.gltf");
+    ASSERT_TRUE(direct.ok()) << direct.status();
+    ASSERT_EQ(direct->media.size(), 1u);
+    EXPECT_FLOAT_EQ(direct->media[0].sigma_a.r, float(std::log(2.0) / 2));
+    EXPECT_EQ(direct->media[0].sigma_a.g, 0);
+    EXPECT_EQ(direct->meshes[0].media.interior, 0);
+    const absl::StatusOr<Scene> included = ParseScene(
+        R"({"materials": {}, "media": {"fog": {"type": "homogeneous", "sigma_s": [1, 1, 1]}},
+            "shapes": [{"type": "gltf", "file": "glass.gltf", "exterior": "fog"}]})",
+        "scene.json", ReadBeside(dir_.string()));
+    ASSERT_TRUE(included.ok()) << included.status();
+    EXPECT_EQ(included->media.size(), 1u);  // the explicit interface wins over the attenuation
+    for (const TriangleMesh& mesh : included->meshes) {
+        EXPECT_TRUE(mesh.media.has_interface);
+        EXPECT_EQ(mesh.media.interior, -1);
+        EXPECT_EQ(mesh.media.exterior, 0);
+    }
+}
+
 // KHR_materials_specular: the factor, the colour (unbounded above: F0 is clamped when
 // rendering) and both textures are read, with no warning; a negative colour is refused.
 TEST_F(GltfSceneTest, SpecularColourAndTexturesAreRead) {

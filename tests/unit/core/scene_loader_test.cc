@@ -17,6 +17,7 @@
 #include "lf/core/blackbody.h"
 #include "lf/core/image_io.h"
 #include "scene_log.h"
+#include "scene_test.h"
 #include "test_dir.h"
 
 namespace lf {
@@ -75,33 +76,12 @@ std::string WithLights(const std::string& lights) {
     return SceneJson(kQuad, kMaterials, kCamera, R"(, "lights": [)" + lights + "]");
 }
 
-class SceneLoaderTest : public ::testing::Test {
+class SceneLoaderTest : public testing::SceneTest {
   protected:
     void SetUp() override {
-        dir_ = lf::testing::FreshTestDir("lf_scene_loader");
+        SceneTest::SetUp();
         CapturedLog().str("");
     }
-    void TearDown() override { std::filesystem::remove_all(dir_); }
-
-    void Write(const std::string& name, const std::string& bytes) {
-        std::ofstream(dir_ / name, std::ios::binary) << bytes;
-    }
-
-    absl::StatusOr<Scene> Parse(const std::string& json) {
-        return ParseScene(json, "scene.json", ReadBeside(dir_.string()));
-    }
-
-    // Parsing must fail with a message containing `expected`.
-    void ExpectError(const std::string& json, const std::string& expected,
-                     absl::StatusCode code = absl::StatusCode::kInvalidArgument) {
-        absl::StatusOr<Scene> scene = Parse(json);
-        ASSERT_FALSE(scene.ok()) << "expected an error containing: " << expected;
-        EXPECT_EQ(scene.status().code(), code) << scene.status();
-        EXPECT_NE(scene.status().message().find(expected), std::string::npos)
-            << "message: " << scene.status().message() << "\nexpected: " << expected;
-    }
-
-    std::filesystem::path dir_;
 };
 
 TEST_F(SceneLoaderTest, CornellBox) {

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lf/job/job_spec.h"
 #include "lf/job/merge.h"
@@ -65,6 +67,57 @@ TEST(Method, OnlyMethodsThatTraceFromTheCameraTakeAnOrthographicCamera) {
         } else {
             EXPECT_TRUE(s.ok()) << info.name << ": " << s;
         }
+    }
+}
+
+// Only the path tracer renders scattering, emitting and grid media and a camera in a medium;
+// the others refuse them naming themselves and the medium. A homogeneous absorber (Beer's
+// law) every method takes.
+TEST(Method, OnlyThePathTracerTakesMediaBeyondAbsorbers) {
+    Medium absorber;
+    absorber.name = "ink";
+    absorber.sigma_a = Rgb(1, 2, 3);
+    Medium fog = absorber, glow = absorber, smoke = absorber;
+    fog.name = "fog";
+    fog.sigma_s = Rgb(0.5f);
+    glow.name = "glow";
+    glow.emission = Rgb(1);
+    smoke.name = "smoke";
+    smoke.type = Medium::Type::kGrid;
+    const auto with = [](std::vector<Medium> media, int camera_medium = -1) {
+        Scene scene;
+        scene.media = std::move(media);
+        scene.camera_medium = camera_medium;
+        return scene;
+    };
+    const std::pair<Scene, std::string> refused[] = {
+        {with({absorber, fog}), "medium \"fog\" scatters light (sigma_s > 0)"},
+        {with({glow}), "medium \"glow\" emits light"},
+        {with({smoke}), "medium \"smoke\" is a grid (heterogeneous)"},
+        {with({absorber}, 0), "the camera is in medium \"ink\""},
+    };
+    for (const auto& [scene, why] : refused) {
+        EXPECT_EQ(MediaLimitation(scene), why);
+        EXPECT_TRUE(CheckMethodTakesScene(Method::kPath, scene).ok());
+        for (const MethodInfo& info : AllMethods()) {
+            if (info.method == Method::kPath) continue;
+            const absl::Status s = CheckMethodTakesScene(info.method, scene);
+            EXPECT_EQ(s.code(), absl::StatusCode::kFailedPrecondition) << info.name << ": " << s;
+            const std::string name = info.name;
+            const std::string expected =
+                "method " + name + ": " + why +
+                (info.method == Method::kWhitted || info.method == Method::kRadiosity
+                     ? ", which " + name + " does not model"
+                     : ": not yet supported by " + name) +
+                "; use --method path";
+            EXPECT_EQ(s.message(), expected);
+        }
+    }
+    const Scene absorbing = with({absorber});
+    EXPECT_EQ(MediaLimitation(absorbing), "");
+    for (const Method m :
+         {Method::kPath, Method::kWhitted, Method::kLight, Method::kBdpt, Method::kPpm}) {
+        EXPECT_TRUE(CheckMethodTakesScene(m, absorbing).ok()) << MethodName(m);
     }
 }
 

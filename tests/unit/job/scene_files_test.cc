@@ -16,6 +16,7 @@
 #include "lf/core/scene_loader.h"
 #include "lf/job/digest.h"
 #include "test_dir.h"
+#include "vdb_files.h"
 
 namespace lf {
 namespace {
@@ -200,6 +201,50 @@ TEST_F(SceneFilesTest, SkyFileLoadsFromItsBlob) {
     const absl::StatusOr<Scene> missing = Load(Put("s.json", json), {Put("up.obj", kTriangle)});
     EXPECT_EQ(missing.status().message(),
               "s.json: lights[0].file \"sky.hdr\": not among the files uploaded with the scene");
+}
+
+// A grid medium's .vdb is a file of the scene like a mesh: `submit` uploads what the loader
+// reads, and the farm's loader finds it among the uploads or names the JSON field that wants it.
+TEST_F(SceneFilesTest, GridMediumFileTravelsAsABlob) {
+    const std::string json =
+        R"({"camera": {"position": [0, 0, -1], "look_at": [0, 0, 0], "fov_y_deg": 40,
+                       "resolution": [4, 4]},
+            "materials": {"lamp": {"type": "lambert", "reflectance": [0, 0, 0],
+                                   "emission": [1, 1, 1]}},
+            "media": {"smoke": {"type": "grid", "file": "cache/smoke.vdb",
+                                "sigma_s": [1, 1, 1]}},
+            "shapes": [{"type": "mesh", "material": "lamp", "file": "up.obj",
+                        "exterior": "smoke"}]})";
+    const std::string vdb = testing::VdbBytes({testing::ConstantGrid("density", 0.5f, 3)});
+    fs::create_directories(dir_ / "scenes" / "cache");
+    std::ofstream(dir_ / "scenes" / "cache" / "smoke.vdb", std::ios::binary) << vdb;
+    std::ofstream(dir_ / "scenes" / "up.obj") << kTriangle;
+
+    // What submit uploads: every file the loader reads, by the name it asks for.
+    std::map<std::string, std::string> read;
+    const SceneFileReader beside = ReadBeside((dir_ / "scenes").string());
+    const absl::StatusOr<Scene> local =
+        ParseScene(json, "scene.json", [&](const std::string& name) {
+            absl::StatusOr<std::string> bytes = beside(name);
+            if (bytes.ok()) read[name] = *bytes;
+            return bytes;
+        });
+    ASSERT_TRUE(local.ok()) << local.status();
+    ASSERT_EQ(read.count("cache/smoke.vdb"), 1u);
+
+    const absl::StatusOr<Scene> farm =
+        Load(Put("scene.json", json), {Put("up.obj", kTriangle), Put("cache/smoke.vdb", vdb)});
+    ASSERT_TRUE(farm.ok()) << farm.status();
+    EXPECT_EQ(farm->content_hash, local->content_hash);
+    ASSERT_EQ(farm->media.size(), 1u);
+    EXPECT_EQ(farm->media[0].density->At(1, 1, 1), 0.5f);
+
+    const absl::StatusOr<Scene> missing = Load(Put("scene.json", json), {Put("up.obj", kTriangle)});
+    ASSERT_FALSE(missing.ok());
+    EXPECT_EQ(missing.status().code(), absl::StatusCode::kNotFound);
+    EXPECT_EQ(missing.status().message(),
+              "scene.json: media.smoke.file \"cache/smoke.vdb\": not among the files uploaded "
+              "with the scene");
 }
 
 }  // namespace

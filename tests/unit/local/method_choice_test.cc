@@ -57,6 +57,34 @@ TEST(MethodChoice, AutoPicksTheMethodTheSceneRequires) {
     EXPECT_EQ(dark.why, "the scene has no lights: the image is black whatever the method");
 }
 
+// Scattering media are the path tracer's alone: auto takes it where it would otherwise pick
+// Whitted; a homogeneous absorber (Beer's law) leaves the choice as it was.
+TEST(MethodChoice, AutoTakesThePathTracerForMediaOnlyItRenders) {
+    const std::string lit =
+        R"(, "lights": [{"type": "point", "position": [0, 2, 0], "power": [5, 5, 5]}]})";
+    const MethodChoice fog = ChooseMethod(
+        Parse(std::string(kPlane) +
+              R"(, "media": {"fog": {"type": "homogeneous", "sigma_s": [1, 1, 1]}})" + lit),
+        std::nullopt);
+    EXPECT_EQ(fog.method, Method::kPath);
+    EXPECT_EQ(fog.why,
+              "medium \"fog\" scatters light (sigma_s > 0): only the path tracer renders it");
+
+    const MethodChoice absorber = ChooseMethod(
+        Parse(std::string(kPlane) +
+              R"(, "media": {"ink": {"type": "homogeneous", "sigma_a": [1, 1, 1]}})" + lit),
+        std::nullopt);
+    EXPECT_EQ(absorber.method, Method::kWhitted);
+
+    // An interface between media passes light straight on: it neither scatters nor focuses.
+    std::string boundary = kPlane;
+    boundary.replace(boundary.find(R"("type": "lambert")"), 17, R"("type": "interface")");
+    boundary.erase(boundary.find(R"(, "reflectance": [0.5, 0.5, 0.5])"), 32);
+    const SceneTransport t = AnalyzeTransport(Parse(boundary + "}"));
+    EXPECT_FALSE(t.diffuse);
+    EXPECT_TRUE(t.specular.empty());
+}
+
 TEST(MethodChoice, RequestedMethodIsTaken) {
     const MethodChoice c = ChooseMethod(Load("cornell_box.json"), Method::kPpm);
     EXPECT_EQ(c.method, Method::kPpm);

@@ -24,6 +24,9 @@ struct Affine {
     // front face.
     Affine NormalMatrix() const;
     bool IsFinite() const;
+    // The map back, x -> M^-1 (x - t); M must be invertible (a singular M gives non-finite
+    // entries).
+    Affine Inverse() const;
 
     // translation * rotation * scale, glTF's node transform; `rotation` a unit quaternion
     // (x, y, z, w).

@@ -122,6 +122,13 @@ struct Material {
     bool double_sided = true;
 
     bool IsEmissive() const { return !emission.IsBlack(); }
+    // A closed solid whose inside light travels through: a dielectric, or a principled
+    // transmitter with a thickness (KHR_materials_volume). Its attenuation is its interior
+    // medium's absorption (Scene::media).
+    bool HasInterior() const {
+        return type == Type::kDielectric ||
+               (type == Type::kPrincipled && transmission > 0 && thickness > 0);
+    }
     // Whether rays can hit the back face: double-sided, or a transmitter whose back faces are
     // where light leaves it. Only then can two_sided_emission emit from the back.
     bool VisibleFromBehind() const {

@@ -1,0 +1,145 @@
+#include "lf/core/volume_grid.h"
+
+#include <openvdb/io/Stream.h>
+#include <openvdb/math/Maps.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <sstream>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+
+namespace lf {
+namespace {
+
+// Why the box [lo, hi] (inclusive) holds too many lattice points for a dense copy, or "".
+// Each side is below 2^33, so the product in double is exact near the bound.
+std::string TooLarge(const openvdb::Coord& lo, const openvdb::Coord& hi) {
+    double points = 1;
+    for (int a = 0; a < 3; ++a) points *= std::max(0.0, double(hi[a]) - lo[a] + 1);
+    if (points <= double(kMaxVolumeGridPoints)) return "";
+    return absl::StrCat(int64_t(hi[0]) - lo[0] + 1, " x ", int64_t(hi[1]) - lo[1] + 1, " x ",
+                        int64_t(hi[2]) - lo[2] + 1, " voxels, above the limit of ",
+                        kMaxVolumeGridPoints, " (2^28)");
+}
+
+// The bounding box the writer recorded (Grid::addStatsMetadata), when it did: TooLarge's
+// verdict on it.
+std::string RecordedTooLarge(const openvdb::GridBase& grid) {
+    const auto lo = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+    const auto hi = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+    if (!lo || !hi) return "";
+    return TooLarge(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
+}
+
+// OpenVDB's maps act on row vectors (world = index * M): M's transpose is our M.
+Affine FromVdb(const openvdb::Mat4d& m) {
+    Affine a;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) a.m[r][c] = m(c, r);
+    }
+    return a;
+}
+
+}  // namespace
+
+absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::string& bytes,
+                                                                 const std::string& file_name,
+                                                                 const std::string& grid_name,
+                                                                 const Affine& medium_transform) {
+    // Thread-safe once: a static's initialisation.
+    [[maybe_unused]] static const bool initialized = (openvdb::initialize(), true);
+    const std::string where = absl::StrCat(file_name, " grid \"", grid_name, "\"");
+    auto invalid = [&](const std::string& why) {
+        return absl::InvalidArgumentError(absl::StrCat(where, ": ", why));
+    };
+    // Checked here: OpenVDB's delayed loading leaves its temporary copy behind when the header
+    // is not a .vdb's.
+    int32_t magic = 0;
+    if (bytes.size() >= sizeof(magic)) std::memcpy(&magic, bytes.data(), sizeof(magic));
+    if (magic != openvdb::OPENVDB_MAGIC) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(file_name, ": not a readable OpenVDB file (no .vdb header)"));
+    }
+    openvdb::GridBase::Ptr base;
+    try {
+        std::istringstream in(bytes);
+        // Delayed loading reads the tree's topology here and its voxel values only when the
+        // dense copy below asks for them, after the size checks.
+        openvdb::io::Stream stream(in, /*delayLoad=*/true);
+        const openvdb::GridPtrVecPtr grids = stream.getGrids();
+        std::vector<std::string> names;
+        for (const openvdb::GridBase::Ptr& g : *grids) {
+            if (g->getName() == grid_name && !base) base = g;
+            names.push_back(absl::StrCat("\"", g->getName(), "\" (", g->valueType(), ")"));
+        }
+        if (!base) {
+            return invalid(absl::StrCat("no such grid; the file has ",
+                                        names.empty() ? "none" : absl::StrJoin(names, ", ")));
+        }
+    } catch (const std::exception& e) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(file_name, ": not a readable OpenVDB file (", e.what(), ")"));
+    }
+    const openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+    if (!grid) {
+        return invalid(absl::StrCat("a ", base->valueType(), " grid; media read float grids only"));
+    }
+    if (const std::string why = RecordedTooLarge(*grid); !why.empty()) {
+        return invalid("its metadata gives a bounding box of " + why);
+    }
+    if (!grid->transform().isLinear()) {
+        return invalid(absl::StrCat("a ", grid->transform().mapType(),
+                                    " transform; media read grids with affine transforms only"));
+    }
+
+    auto out = std::make_shared<VolumeGrid>();
+    out->name = absl::StrCat(file_name, "#", grid_name);
+    out->background = grid->background();
+    if (!(std::isfinite(out->background) && out->background >= 0)) {
+        return invalid(
+            absl::StrCat("background ", out->background, ": expected a finite value >= 0"));
+    }
+    const openvdb::math::AffineMap::ConstPtr map = grid->transform().baseMap()->getAffineMap();
+    out->index_to_world = FromVdb(map->getMat4()).Then(medium_transform);
+    out->world_to_index = out->index_to_world.Inverse();
+    if (!out->world_to_index.IsFinite()) return invalid("its transform is singular");
+
+    try {
+        const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+        if (const std::string why = TooLarge(box.min(), box.max()); !why.empty()) {
+            return invalid("its active voxels span a bounding box of " + why);
+        }
+        // No active voxel: everything reads the background.
+        if (box.empty()) return std::shared_ptr<const VolumeGrid>(std::move(out));
+        for (int a = 0; a < 3; ++a) {
+            out->min[a] = box.min()[a];
+            out->size[a] = box.max()[a] - box.min()[a] + 1;
+        }
+        out->values.resize(size_t(out->size[0]) * size_t(out->size[1]) * size_t(out->size[2]));
+        openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, out->values.data());
+        openvdb::tools::copyToDense(*grid, dense);
+    } catch (const std::exception& e) {
+        return invalid(absl::StrCat("its voxels cannot be read (", e.what(), ")"));
+    }
+    for (size_t i = 0; i < out->values.size(); ++i) {
+        const float v = out->values[i];
+        if (std::isfinite(v) && v >= 0) continue;
+        const int64_t x = int64_t(i % size_t(out->size[0])),
+                      y = int64_t(i / size_t(out->size[0]) % size_t(out->size[1])),
+                      z = int64_t(i / (size_t(out->size[0]) * size_t(out->size[1])));
+        return invalid(absl::StrCat("value ", v, " at voxel (", out->min[0] + x, ", ",
+                                    out->min[1] + y, ", ", out->min[2] + z,
+                                    "): expected a finite value >= 0 (negative density, emission "
+                                    "or temperature is unphysical)"));
+    }
+    return std::shared_ptr<const VolumeGrid>(std::move(out));
+}
+
+}  // namespace lf
