@@ -132,7 +132,11 @@ MediumInterface SceneParser::ParseMediumInterface(const Node& shape) const {
     return media;
 }
 
-void SceneParser::AddAttenuationMedia(Scene& scene) {
+}  // namespace lf::scene_internal
+
+namespace lf {
+
+void AddAttenuationMedia(Scene& scene) {
     std::map<int, int> medium_of;  // by material
     auto interior = [&](int material) {
         const Material& m = scene.materials[size_t(material)];
@@ -156,4 +160,4 @@ void SceneParser::AddAttenuationMedia(Scene& scene) {
     for (Sphere& sphere : scene.spheres) attach(sphere.material, sphere.media);
 }
 
-}  // namespace lf::scene_internal
+}  // namespace lf

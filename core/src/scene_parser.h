@@ -183,10 +183,6 @@ class SceneParser {
     MediumInterface ParseMediumInterface(const Node& shape) const;
     // The index in Scene::media of the medium named at `n`.
     int MediumIndex(const Node& n) const;
-    // Beer's law as a medium: each solid transmitter (Material::HasInterior) with a finite
-    // attenuation_distance and no interface of its own gets a homogeneous absorber inside,
-    // sigma_a = -ln(attenuation_color) / attenuation_distance, one per material.
-    static void AddAttenuationMedia(Scene& scene);
 
     const SceneFileReader& read_file_;
     const SceneOptions& options_;

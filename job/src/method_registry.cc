@@ -94,6 +94,11 @@ std::string MediaLimitation(const Scene& scene) {
         return absl::StrCat("the camera is in medium \"",
                             scene.media[size_t(scene.camera_medium)].name, "\"");
     }
+    for (const Material& m : scene.materials) {
+        if (m.type == Material::Type::kInterface) {
+            return absl::StrCat("material \"", m.name, "\" is an interface between media");
+        }
+    }
     for (const Medium& m : scene.media) {
         const std::string what = absl::StrCat("medium \"", m.name, "\"");
         if (m.type == Medium::Type::kGrid) return what + " is a grid (heterogeneous)";

@@ -194,7 +194,7 @@ Rgb BdptRenderer::FCos(const BdptVertex& v, const Vec3& dir, bool importance) co
     // (eta = IOR on wi's side over wo's), importance is not.
     float scale = 1;
     const Material& material = scene_.scene().materials[size_t(v.material)];
-    if (!reflect && HasInterior(material)) {
+    if (!reflect && material.HasInterior()) {
         const float eta = wo.z > 0 ? material.ior : 1 / material.ior;
         scale = eta * eta;
     }

@@ -195,7 +195,7 @@ bool SceneMedia::IsEmissive(int medium) const { return impl_->media[size_t(mediu
 
 bool SceneMedia::IsHomogeneousAbsorber(int medium) const {
     const RenderMedium& m = impl_->media[size_t(medium)];
-    return m.type == Medium::Type::kHomogeneous && m.sigma_s.IsBlack();
+    return m.type == Medium::Type::kHomogeneous && m.sigma_s.IsBlack() && !m.emissive;
 }
 
 Rgb SceneMedia::HomogeneousTransmittance(int medium, float distance) const {

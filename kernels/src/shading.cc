@@ -194,11 +194,6 @@ bool EmitsFromBack(const Material& material) {
     return material.two_sided_emission && material.VisibleFromBehind();
 }
 
-bool HasInterior(const Material& material) {
-    return material.type == Material::Type::kDielectric ||
-           (material.type == Material::Type::kPrincipled && material.transmission > 0 &&
-            material.thickness > 0);
-}
 
 
 namespace {

@@ -77,7 +77,11 @@ Rgb VolPathTracer::SampleLight(const SurfacePoint& from, const Vec3& n, MediumOf
                        Material::Type::kInterface) {
             return Rgb();
         }
-        if (medium >= 0) {
+        if (medium >= 0 && media_.IsHomogeneousAbsorber(medium)) {
+            // Beer's law exactly: a solid's attenuation costs no noise.
+            t_ray *= media_.HomogeneousTransmittance(medium, (hit ? hit->t : ray.t_max) *
+                                                                 Length(ray.d));
+        } else if (medium >= 0) {
             const float t_end = hit ? hit->t : ray.t_max;
             const Rgb t_maj = media_.SampleTMaj(
                 medium, ray, t_end, hero, rng,
@@ -146,7 +150,12 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
 
-        if (medium >= 0) {
+        if (medium >= 0 && media_.IsHomogeneousAbsorber(medium)) {
+            // Beer's law exactly (all channels alike: the hero's choice does not enter).
+            state.beta *= media_.HomogeneousTransmittance(
+                medium, hit ? hit->t * Length(ray.d) : std::numeric_limits<float>::infinity());
+            if (state.beta.IsBlack()) break;
+        } else if (medium >= 0) {
             bool scattered = false, terminated = false;
             const float t_end = hit ? hit->t : std::numeric_limits<float>::infinity();
             const Rgb t_maj = media_.SampleTMaj(

@@ -1,4 +1,5 @@
-// Path tracing a scene built in a test through local mode's executor.
+// Path tracing a scene built in a test through local mode's executor, with the estimator
+// `--method path` takes for it (VolPathTracer for scenes with media).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/local/local_executor.h"
+#include "lf/local/method_factory.h"
 
 namespace lf::testing {
 
@@ -23,13 +25,14 @@ inline PathRender RenderPath(const Scene& scene, uint64_t spp, int max_depth = -
     auto es = EmbreeScene::Build(scene);
     EXPECT_TRUE(es.ok()) << es.status();
     const Camera camera(scene.camera, (*es)->origin());
-    const PathTracer tracer(**es, max_depth, strategy);
+    const std::unique_ptr<RadianceEstimator> tracer =
+        MakeRayTracer(Method::kPath, **es, max_depth, strategy).value();
     RenderSettings settings;
     settings.spp = spp;
     settings.seed = seed;
     settings.tile = 8;
     settings.sampler = sampler;
-    return {RenderImage(camera, tracer, settings).value(), std::move(*es)};
+    return {RenderImage(camera, *tracer, settings).value(), std::move(*es)};
 }
 
 }  // namespace lf::testing

@@ -422,6 +422,7 @@ TEST(Bdpt, MatchesThePathTracerThroughAThinLensAndAbsorbingGlass) {
             m.attenuation_distance = 0.1f;
         }
     }
+    AddAttenuationMedia(scene);
     CompareWithPathTracer("thin lens, absorbing glass", scene, 256, 512, 8);
 }
 
@@ -442,6 +443,7 @@ TEST(Bdpt, MatchesThePathTracerThroughTintedPrincipledGlass) {
         m.attenuation_color = Rgb(0.9f, 0.7f, 0.5f);
         m.attenuation_distance = 0.5f;
     }
+    AddAttenuationMedia(scene);
     CompareWithPathTracer("tinted principled glass", scene, 256, 512, 8);
 }
 

@@ -11,8 +11,7 @@
 #include <cmath>
 
 #include "lf/kernels/embree_scene.h"
-#include "lf/kernels/path_tracer.h"
-#include "lf/kernels/shading.h"
+#include "lf/local/method_factory.h"
 #include "point_estimate.h"
 
 namespace lf {
@@ -32,12 +31,19 @@ Scene TintedSphere(const Rgb& base, float thickness, float attenuation_distance)
     scene.materials.push_back(glass);
     scene.spheres.push_back({"glass", 0, Vec3d(), 0.5});
     scene.environment = EnvironmentLight{};
+    AddAttenuationMedia(scene);
     return scene;
 }
 
 Rgb ClosedForm(const Material& m, double chord) {
     const double f = std::pow((m.ior - 1) / (m.ior + 1), 2);
-    const Rgb t = HasInterior(m) ? Transmittance(m, float(chord)) : Rgb(1);
+    // Beer's law along the chord: attenuation_color after every attenuation_distance.
+    Rgb t(1);
+    if (m.HasInterior() && std::isfinite(m.attenuation_distance)) {
+        for (int c = 0; c < 3; ++c) {
+            t[c] = float(std::pow(m.attenuation_color[c], chord / m.attenuation_distance));
+        }
+    }
     Rgb l;
     for (int c = 0; c < 3; ++c) {
         const double b = m.reflectance[c];
@@ -55,9 +61,10 @@ TEST(TransmissionTint, SphereCentreMatchesTheClosedForm) {
         const Scene scene = TintedSphere(Rgb(1, 0.5f, 0), thickness, distance);
         auto es = EmbreeScene::Build(scene);
         ASSERT_TRUE(es.ok()) << es.status();
-        const PathTracer tracer(**es, -1);
+        const std::unique_ptr<RadianceEstimator> tracer =
+            MakeRayTracer(Method::kPath, **es, -1, LightStrategy::kBvh).value();
         const Ray ray = testing::RayBetween({0, 0, 3}, {0, 0, 0}, (*es)->origin());
-        const testing::PointEstimate e = testing::EstimateRadiance(tracer, ray, 40000, 5);
+        const testing::PointEstimate e = testing::EstimateRadiance(*tracer, ray, 40000, 5);
         const Rgb expected = ClosedForm(scene.materials[0], 1.0);
         // Red glass stays red: base colour 0 passes nothing but the front reflection.
         EXPECT_LT(e.mean[2], 0.05);

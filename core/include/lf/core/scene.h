@@ -310,6 +310,12 @@ struct Scene {
     bool HasMedia() const;
 };
 
+// Beer's law as a medium: each solid transmitter (Material::HasInterior) with a finite
+// attenuation_distance and no interface of its own gets a homogeneous absorber inside (exterior
+// vacuum), sigma_a = -ln(attenuation_color) / attenuation_distance, one per material. Every
+// loader calls it; scenes built in code call it themselves.
+void AddAttenuationMedia(Scene& scene);
+
 // InvalidArgument naming the first position (vertex, sphere, light, camera) beyond
 // ±kMaxCoordinate or not finite, or direction not finite. Every loader ends with it, so whoever
 // loads a scene (a worker included) never hands such numbers to the kernels, whoever checked it

@@ -50,8 +50,8 @@ class SceneMedia {
     bool empty() const;
     float g(int medium) const;
     bool IsEmissive(int medium) const;
-    // sigma_s = 0 and sigma_a constant: transmittance is Beer's law, exp(-sigma_a t), which
-    // every method can evaluate without sampling.
+    // Homogeneous, sigma_s = 0 and no emission: nothing happens inside but Beer's law,
+    // exp(-sigma_a t), which every method evaluates without sampling (no noise).
     bool IsHomogeneousAbsorber(int medium) const;
     // Beer's law through `distance` of a homogeneous medium (IsHomogeneousAbsorber or not).
     Rgb HomogeneousTransmittance(int medium, float distance) const;

@@ -97,8 +97,4 @@ bool Transmits(const Material& material);
 // single-sided mesh's back is invisible, so neither hits nor light samples see it glow).
 bool EmitsFromBack(const Material& material);
 
-// Solid transmitters (principled with thickness > 0, dielectric): a path that crosses their
-// surface against the geometric normal is inside until it crosses back.
-bool HasInterior(const Material& material);
-
 }  // namespace lf
