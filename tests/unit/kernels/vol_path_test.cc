@@ -9,9 +9,11 @@
 
 #include "lf/core/blackbody.h"
 #include "lf/core/camera.h"
+#include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/vol_path_tracer.h"
 #include "lf/local/local_executor.h"
+#include "render_path.h"
 #include "test_scenes.h"
 
 namespace lf {
@@ -316,6 +318,44 @@ TEST(VolPath, OpticallyThickBlackBodyGridShowsPlancksLaw) {
         EXPECT_NEAR(x / (x + y + z), planck.x / sum, 0.002);
         EXPECT_NEAR(y / (x + y + z), planck.y / sum, 0.002);
     }
+}
+
+// The scene files of tests/scenes/media (written by tools/media_scenes.py), through the loader
+// and the method factory as `lightfarm render` takes them.
+Scene LoadMediaScene(const std::string& name) {
+    absl::StatusOr<Scene> scene = LoadScene(std::string(LF_TEST_SCENES) + "/media/" + name);
+    EXPECT_TRUE(scene.ok()) << scene.status();
+    return *std::move(scene);
+}
+
+TEST(VolPathScenes, SlabFileShowsBeersLaw) {
+    const RenderOutput out = testing::RenderPath(LoadMediaScene("slab.json"), 16).out;
+    const double expected[3] = {0.77880, 0.60653, 0.36788};  // exp(-(0.5, 1, 2) * 0.5)
+    for (int c = 0; c < 3; ++c) {
+        const char* names[3] = {"R", "G", "B"};
+        EXPECT_NEAR(testing::ChannelMean(out.image, names[c]).mean, expected[c],
+                    0.005 * expected[c])
+            << names[c];
+    }
+}
+
+TEST(VolPathScenes, HalfAlbedoFurnaceFileMatchesItsRandomWalkReference) {
+    // tools/media_reference.py's analog random walk (numpy, 4 million walks): image mean
+    // 0.67630 +- 0.00021.
+    const RenderOutput out = testing::RenderPath(LoadMediaScene("furnace_albedo.json"), 512).out;
+    for (const char* c : {"R", "G", "B"}) {
+        const testing::MeanAndError m = testing::ChannelMean(out.image, c);
+        EXPECT_NEAR(m.mean, 0.67630, kSigmas * std::hypot(m.standard_error, 0.00021)) << c;
+    }
+}
+
+TEST(VolPathScenes, BlenderFireCacheRendersFiniteAndGlows) {
+    Scene scene = LoadMediaScene("blender_fire.json");
+    scene.camera.width = scene.camera.height = 16;
+    const RenderOutput out = testing::RenderPath(scene, 16).out;
+    EXPECT_EQ(out.stats.invalid_samples, 0u);
+    // The flames' black body (up to ~2900 K) outshines the sky many times over.
+    EXPECT_GT(testing::ChannelMean(out.image, "R").mean, 10 * 0.02);  // the sky: 0.02
 }
 
 }  // namespace
