@@ -16,7 +16,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 fuzz_seconds=${FUZZ_SECONDS:-15}
-fuzzers=(scene_json_fuzz gltf_fuzz mesh_fuzz texture_fuzz codec_fuzz job_record_fuzz)
+fuzzers=(scene_json_fuzz gltf_fuzz mesh_fuzz texture_fuzz codec_fuzz job_record_fuzz vdb_fuzz)
 mapfile -t unit_tests < <(ls tests/unit/core/*_test.cc tests/unit/job/*_test.cc | xargs -n1 basename | sed 's/\.cc$//')
 parallel=${JOBS:-2}
 # in_parallel CMD ARG...: CMD ARG for each ARG, `parallel` at a time (each test program and fuzzer

@@ -173,6 +173,36 @@ TEST(VolPath, NonAbsorbingSphereInAFurnaceIsInvisible) {
     }
 }
 
+TEST(VolPath, MurkyGlassOfIorOneInAFurnaceIsInvisible) {
+    // A dielectric (IOR 1: no Fresnel reflection, no bending) holding a non-absorbing medium:
+    // the medium inside a refracting surface, reached by transmission instead of an interface.
+    Scene scene = SphereInSky(Homogeneous(Rgb(0), Rgb(2, 1, 4), 0.3f), false, 16);
+    scene.materials[0].type = Material::Type::kDielectric;
+    scene.materials[0].ior = 1;
+    const RenderOutput out = RenderVol(scene, 256);
+    for (const char* c : {"R", "G", "B"}) {
+        const testing::MeanAndError m = testing::ChannelMean(out.image, c);
+        EXPECT_NEAR(m.mean, 1, kSigmas * m.standard_error + 1e-4) << c;
+    }
+}
+
+TEST(VolPath, CameraInsideAnAbsorbingMediumSeesTheSkyAttenuated) {
+    // The camera at the centre of a sphere of radius 1 filled with an absorber: every ray
+    // crosses 1 m of it to the sky of radiance 1, exactly (Beer's law needs no sampling).
+    const Rgb sigma_a(0.3f, 1.0f, 2.5f);
+    Scene scene = SphereInSky(Homogeneous(sigma_a, Rgb(0)), false, 8);
+    scene.camera.position = {0, 0, 0};
+    scene.camera.look_at = {0, 0, -1};
+    scene.camera.fov_y_deg = 90;
+    scene.camera_medium = 0;
+    const RenderOutput out = RenderVol(scene, 4);
+    for (int c = 0; c < 3; ++c) {
+        const char* names[3] = {"R", "G", "B"};
+        const std::vector<float>& v = *out.image.FindChannel(names[c]);
+        for (float x : v) EXPECT_NEAR(x, std::exp(-sigma_a[c]), 1e-4) << names[c];
+    }
+}
+
 // The test's own analog random walk: the probability that light entering a sphere of radius
 // 1 along a diameter leaves it again, with extinction sigma_t, single-scattering albedo
 // `albedo` and Henyey-Greenstein's g (cos theta by the textbook inversion). By reciprocity
