@@ -411,7 +411,10 @@ absl::Status RunPlan(const PlanOptions& options) {
     std::printf("method (--method %s): %s, because %s\n", options.method.c_str(),
                 std::string(MethodName(method)).c_str(), choice.why.c_str());
     // What Whitted would give (lf/kernels/whitted.h), whether or not it is the method.
-    if (const std::vector<std::string> missing = WhittedMissingTerms(*scene); missing.empty()) {
+    if (absl::Status s = CheckMethodTakesScene(Method::kWhitted, *scene); !s.ok()) {
+        std::printf("whitted: refuses this scene (%s)\n", std::string(s.message()).c_str());
+    } else if (const std::vector<std::string> missing = WhittedMissingTerms(*scene);
+               missing.empty()) {
         std::printf(
             "whitted: exact for this scene (direct light and specular chains are all its light "
             "transport): --method whitted converges to the path tracer's image at less cost\n");
@@ -431,8 +434,8 @@ absl::Status RunPlan(const PlanOptions& options) {
     // A closed room of albedo rho keeps a path alive for 1/(1 - rho) bounces on average under
     // the roulette; an open scene ends paths sooner.
     std::printf(
-        "path depth: %s; Russian roulette from the second bounce (survival min(1, max "
-        "throughput channel)); largest reflectance %.3g, so paths average at most about "
+        "path depth: %s; Russian roulette from the second bounce (survival min(1, sqrt(max "
+        "throughput channel))); largest reflectance %.3g, so paths average at most about "
         "%.1f bounces in a closed room of it\n",
         options.max_depth < 0 ? "unlimited"
                               : absl::StrFormat("at most %d bounces", options.max_depth).c_str(),

@@ -4,7 +4,8 @@ The farm loads a scene only from the files uploaded with it, each looked up by t
 uses for it (docs/scene-format.md, docs/farm.md). The C++ client records the names its scene
 loader asks for; this module walks the same references without loading the geometry:
 
-* a JSON scene: every ``"file"`` (mesh and glTF shapes, texture objects, sky maps) and every
+* a JSON scene: every ``"file"`` (mesh and glTF shapes, texture objects, sky maps, grid media's
+  .vdb files) and every
   ``*_texture`` given as a plain string, by the name as written;
 * an OBJ mesh: its ``mtllib`` files, and the textures those MTL files name (``map_Kd``,
   ``map_Ke``, ``norm``, ``map_Bump``, ``map_d``), relative to the file naming them;

@@ -70,6 +70,16 @@ class SceneFilesTest(unittest.TestCase):
         self.assertEqual(names["models/m data.bin"], b"bin")
         self.assertEqual(names[sky], b"sky")
 
+    def test_media_grid_files(self):
+        write(self.p("cache", "smoke.vdb"), b"vdb")
+        write(self.p("scene.json"), json.dumps({
+            "camera": {"position": [0, 0, 0], "look_at": [0, 0, 1], "medium": "fog"},
+            "media": {"fog": {"type": "homogeneous", "sigma_s": [1, 1, 1]},
+                      "smoke": {"type": "grid", "file": "cache/smoke.vdb"}},
+            "shapes": []}))
+        _, files = lightfarm.scene_files(self.p("scene.json"))
+        self.assertEqual(dict(files), {"cache/smoke.vdb": b"vdb"})
+
     def test_gltf_and_glb_scenes(self):
         write(self.p("buf.bin"), b"b")
         write(self.p("img", "i.png"), b"i")
