@@ -59,8 +59,6 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
     auto invalid = [&](const std::string& why) {
         return absl::InvalidArgumentError(absl::StrCat(where, ": ", why));
     };
-    // Checked here: OpenVDB's delayed loading leaves its temporary copy behind when the header
-    // is not a .vdb's.
     int32_t magic = 0;
     if (bytes.size() >= sizeof(magic)) std::memcpy(&magic, bytes.data(), sizeof(magic));
     if (magic != openvdb::OPENVDB_MAGIC) {
@@ -70,9 +68,15 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
     openvdb::GridBase::Ptr base;
     try {
         std::istringstream in(bytes);
-        // Delayed loading reads the tree's topology here and its voxel values only when the
-        // dense copy below asks for them, after the size checks.
-        openvdb::io::Stream stream(in, /*delayLoad=*/true);
+        // OpenVDB does not check every read: past the end of a truncated or forged file it goes
+        // on with sizes it never read (a blosc block of ~10^14 bytes, say). A stream that
+        // throws at the first short read stops it there. Everything is read now, not delayed:
+        // delayed loading reads the values later from a temporary copy of the file, through a
+        // stream of its own that does not throw. The tree costs at most a few dozen times the
+        // file's bytes (a leaf of 512 values takes at least its 64-byte mask and origin in the
+        // file), which the blob limits bound; the dense copy is checked before it is made.
+        in.exceptions(std::ios::failbit | std::ios::badbit);
+        openvdb::io::Stream stream(in, /*delayLoad=*/false);
         const openvdb::GridPtrVecPtr grids = stream.getGrids();
         std::vector<std::string> names;
         for (const openvdb::GridBase::Ptr& g : *grids) {
