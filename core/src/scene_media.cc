@@ -154,7 +154,11 @@ void AddAttenuationMedia(Scene& scene) {
     };
     auto attach = [&](int material, MediumInterface& media) {
         if (media.has_interface) return;
-        if (const int medium = interior(material); medium >= 0) media = {true, medium, -1};
+        // Outside: the medium the camera is in (the scene's air, vacuum or fog), so a glass in
+        // fog leaves a ray in the fog; a shape's own "exterior" says otherwise.
+        if (const int medium = interior(material); medium >= 0) {
+            media = {true, medium, scene.camera_medium};
+        }
     };
     for (TriangleMesh& mesh : scene.meshes) attach(mesh.material, mesh.media);
     for (Sphere& sphere : scene.spheres) attach(sphere.material, sphere.media);

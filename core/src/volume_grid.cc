@@ -20,10 +20,25 @@ namespace {
 
 // Why the box [lo, hi] (inclusive) holds too many lattice points for a dense copy, or "".
 // Each side is below 2^33, so the product in double is exact near the bound.
+// Lattice coordinates beyond this would overflow the int arithmetic of lookups (VolumeGrid::At
+// subtracts the box's corner, the majorant grid rounds up past it).
+constexpr int kMaxLatticeCoordinate = 1 << 30;
+
 std::string TooLarge(const openvdb::Coord& lo, const openvdb::Coord& hi) {
     double points = 1;
     for (int a = 0; a < 3; ++a) points *= std::max(0.0, double(hi[a]) - lo[a] + 1);
-    if (points <= double(kMaxVolumeGridPoints)) return "";
+    if (points == 0) return "";  // an empty box (OpenVDB's is inverted): nothing to copy
+    if (points <= double(kMaxVolumeGridPoints)) {
+        for (int a = 0; a < 3; ++a) {
+            if (std::abs(int64_t(lo[a])) > kMaxLatticeCoordinate ||
+                std::abs(int64_t(hi[a])) > kMaxLatticeCoordinate) {
+                return absl::StrCat("[", lo[0], ", ", lo[1], ", ", lo[2], "] .. [", hi[0], ", ",
+                                    hi[1], ", ", hi[2],
+                                    "], beyond the lattice coordinates of +-2^30");
+            }
+        }
+        return "";
+    }
     return absl::StrCat(int64_t(hi[0]) - lo[0] + 1, " x ", int64_t(hi[1]) - lo[1] + 1, " x ",
                         int64_t(hi[2]) - lo[2] + 1, " voxels, above the limit of ",
                         kMaxVolumeGridPoints, " (2^28)");
@@ -36,6 +51,14 @@ std::string RecordedTooLarge(const openvdb::GridBase& grid) {
     const auto hi = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
     if (!lo || !hi) return "";
     return TooLarge(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
+}
+
+// An exception's text for a message: OpenVDB may quote whatever a forged file holds.
+std::string Brief(const char* what) {
+    std::string text(what);
+    constexpr size_t kMaxChars = 200;
+    if (text.size() > kMaxChars) text = text.substr(0, kMaxChars) + "...";
+    return text;
 }
 
 // OpenVDB's maps act on row vectors (world = index * M): M's transpose is our M.
@@ -89,7 +112,7 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
         }
     } catch (const std::exception& e) {
         return absl::InvalidArgumentError(
-            absl::StrCat(file_name, ": not a readable OpenVDB file (", e.what(), ")"));
+            absl::StrCat(file_name, ": not a readable OpenVDB file (", Brief(e.what()), ")"));
     }
     const openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
     if (!grid) {
@@ -130,7 +153,7 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
         openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, out->values.data());
         openvdb::tools::copyToDense(*grid, dense);
     } catch (const std::exception& e) {
-        return invalid(absl::StrCat("its voxels cannot be read (", e.what(), ")"));
+        return invalid(absl::StrCat("its voxels cannot be read (", Brief(e.what()), ")"));
     }
     for (size_t i = 0; i < out->values.size(); ++i) {
         const float v = out->values[i];

@@ -313,6 +313,7 @@ std::optional<LightSample> LightSampler::Sample(const Vec3& ref, const Vec3& n, 
         if (!(ls.pdf > 0) || ls.radiance.IsBlack()) return std::nullopt;
         ls.point.p = InfinitePoint(ref, ls.wi);
         ls.point.n = -ls.wi;
+        ls.at_infinity = true;
         return ls;
     }
     std::optional<LightSample> ls = SampleArea(light, ref, n, u, time);
@@ -480,6 +481,7 @@ std::optional<LightSample> LightSampler::SampleDelta(const Light& light, const V
         ls.wi = -Vec3(Normalize(dl.direction));
         ls.point.p = InfinitePoint(ref, ls.wi);
         ls.point.n = -ls.wi;
+        ls.at_infinity = true;
         ls.radiance = dl.irradiance;
         return ls;
     }

@@ -49,15 +49,26 @@ struct VolPathTracer::PathState {
     int hero = 0;
 };
 
+// PathTracer's roulette on the MIS-weighted throughput, after a surface bounce or a scattering
+// in a medium (thick media of albedo near 1 would otherwise scatter up to kMaxPathDepth times):
+// true when the path ends, else its throughput carries the survivors' weight.
+bool VolPathTracer::Roulette(PathState& state, float eta_scale, float u) {
+    const Rgb rr = state.beta * eta_scale / state.r_u.Average();
+    const float q = std::max(0.0f, 1 - std::sqrt(rr.MaxComponent()));
+    if (u < q) return true;
+    state.beta /= 1 - q;
+    return false;
+}
+
 VolPathTracer::VolPathTracer(const EmbreeScene& scene, int max_depth, LightStrategy strategy)
     : scene_(scene), media_(scene.media()), lights_(scene, strategy), max_depth_(max_depth) {}
 
-template <typename MediumOf, typename F, typename Pdf>
-Rgb VolPathTracer::SampleLight(const SurfacePoint& from, const Vec3& n, MediumOf&& medium_of,
-                               const PathState& state, float u_pick, const Vec2& u_light,
-                               MediumRng& rng, F&& f_of, Pdf&& pdf_of,
+template <typename FromOf, typename MediumOf, typename F, typename Pdf>
+Rgb VolPathTracer::SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& from_of,
+                               MediumOf&& medium_of, const PathState& state, float u_pick,
+                               const Vec2& u_light, MediumRng& rng, F&& f_of, Pdf&& pdf_of,
                                RenderStats& stats) const {
-    const std::optional<LightSample> ls = lights_.Sample(from.p, n, u_pick, u_light, from.time);
+    const std::optional<LightSample> ls = lights_.Sample(at.p, n, u_pick, u_light, at.time);
     if (!ls || !(ls->pdf > 0)) return Rgb();
     int medium = medium_of(ls->wi);
     const Rgb f = f_of(ls->wi);
@@ -69,7 +80,7 @@ Rgb VolPathTracer::SampleLight(const SurfacePoint& from, const Vec3& n, MediumOf
     // crossed, any other surface blocks.
     const int hero = state.hero;
     Rgb t_ray(1.0f), r_u(1.0f), r_l(1.0f);
-    Ray ray = SpawnRayTo(from, ls->point);
+    Ray ray = SpawnRayTo(from_of(ls->wi), ls->point);
     for (;;) {
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
@@ -77,12 +88,15 @@ Rgb VolPathTracer::SampleLight(const SurfacePoint& from, const Vec3& n, MediumOf
                        Material::Type::kInterface) {
             return Rgb();
         }
+        // Past the last surface towards a light at infinity the medium goes on for ever, as it
+        // does for a ray that escapes: both strategies must see the same attenuation.
+        const float t_end = hit                ? hit->t
+                            : ls->at_infinity ? std::numeric_limits<float>::infinity()
+                                              : ray.t_max;
         if (medium >= 0 && media_.IsHomogeneousAbsorber(medium)) {
             // Beer's law exactly: a solid's attenuation costs no noise.
-            t_ray *= media_.HomogeneousTransmittance(medium, (hit ? hit->t : ray.t_max) *
-                                                                 Length(ray.d));
+            t_ray *= media_.HomogeneousTransmittance(medium, t_end * Length(ray.d));
         } else if (medium >= 0) {
-            const float t_end = hit ? hit->t : ray.t_max;
             const Rgb t_maj = media_.SampleTMaj(
                 medium, ray, t_end, hero, rng,
                 [&](const Vec3&, const MediumPoint& mp, const Rgb& sigma_maj, const Rgb& tm) {
@@ -194,12 +208,18 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
                         const Vec3 d = Normalize(ray.d);
                         const SurfacePoint here = PointInMedium(p, ray.time);
                         L += SampleLight(
-                            here, Vec3(), [&](const Vec3&) { return medium; }, state, u_choice.x, u_light, rng,
+                            here, Vec3(), [&](const Vec3&) { return here; },
+                            [&](const Vec3&) { return medium; }, state, u_choice.x, u_light, rng,
                             [&](const Vec3& wi) { return Rgb(HenyeyGreenstein(Dot(d, wi), g)); },
                             [&](const Vec3& wi) { return HenyeyGreenstein(Dot(d, wi), g); },
                             stats);
                         const PhaseSample ps = SampleHenyeyGreenstein(d, g, u_bsdf);
                         if (!(ps.pdf > 0)) {
+                            terminated = true;
+                            return false;
+                        }
+                        if (depth > kRouletteStartDepth &&
+                            Roulette(state, eta_scale, u_roulette)) {
                             terminated = true;
                             return false;
                         }
@@ -281,12 +301,14 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
         if (!bsdf.IsDelta()) {
             // The light may lie on either side: a shadow ray through the surface starts in the
             // medium beyond it.
+            // As the BSDF decides it: a light direction the BSDF calls a transmission leaves
+            // through the surface, from where a ray in that direction starts.
             L += SampleLight(
-                sh.point, sh.ns,
+                sh.point, sh.ns, [&](const Vec3& wi_world) { return sh.Leaving(wi_world); },
                 [&](const Vec3& wi_world) {
-                    return (Dot(wi_world, ng) > 0) == (cos_o_ng > 0)
-                               ? medium
-                               : MediumAfter(scene, medium, *hit, wi_world);
+                    return frame.ToLocal(wi_world).z * wo.z < 0
+                               ? MediumAfter(scene, medium, *hit, wi_world)
+                               : medium;
                 },
                 state, u_choice.x, u_light, rng,
                 [&](const Vec3& wi_world) {
@@ -312,13 +334,7 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
         prev_n = sh.ns;
         ray = SpawnRay(sh.Leaving(wi), wi);
 
-        if (depth > kRouletteStartDepth) {
-            // PathTracer's roulette on the MIS-weighted throughput.
-            const Rgb rr = state.beta * eta_scale / state.r_u.Average();
-            const float q = std::max(0.0f, 1 - std::sqrt(rr.MaxComponent()));
-            if (u_roulette < q) break;
-            state.beta /= 1 - q;
-        }
+        if (depth > kRouletteStartDepth && Roulette(state, eta_scale, u_roulette)) break;
     }
     return L;
 }

@@ -165,6 +165,13 @@ TEST_F(VolumeGridTest, AbsurdBoundingBoxIsRefusedBeforeTheCopy) {
     vast->tree().setValue(openvdb::Coord(2000000000, 2000000000, 2000000000), 1);
     ExpectError(Load(testing::VdbBytes({vast}, false)),
                 "span a bounding box of 4000000001 x 4000000001 x 4000000001 voxels");
+    // A small box far out: its coordinates would overflow the lookups' int arithmetic.
+    openvdb::FloatGrid::Ptr far = openvdb::FloatGrid::create(0);
+    far->setName("density");
+    far->tree().setValue(openvdb::Coord(2147483000, 0, 0), 1);
+    far->tree().setValue(openvdb::Coord(2147483010, 5, 5), 1);
+    ExpectError(Load(testing::VdbBytes({far}, false)),
+                "beyond the lattice coordinates of +-2^30");
     openvdb::FloatGrid::Ptr edge = openvdb::FloatGrid::create(0);
     edge->setName("density");
     edge->tree().setValue(openvdb::Coord(0, 0, 0), 1);

@@ -502,10 +502,21 @@ TEST(SmoothShading, SphereMeshMatchesAnalyticSphere) {
 // where the facets already face away from the light (there Hanika's lifted origin lets shadow
 // rays out past their own triangle) and at the lit silhouette (where the view is below the
 // interpolated normal and the normal bends). Checked to fail with either mechanism disabled.
-TEST(SmoothShading, NoBlackTerminator) {
+// The volumetric path tracer too (a scene with any medium takes it, here one nothing uses):
+// its shadow rays leave from the same lifted origin.
+class NoBlackTerminator : public ::testing::TestWithParam<bool> {};
+
+TEST_P(NoBlackTerminator, ShadesUpToTheShadingTerminator) {
     Scene scene = LitSphereScene();
     scene.point_lights[0] = {{6, 0.5, 0.5}, Rgb(50)};  // from the right: the terminator in view
     scene.meshes.push_back(SphereMesh(8, 4, 1.0, true));
+    if (GetParam()) {
+        Medium unused;
+        unused.name = "unused";
+        unused.sigma_s = Rgb(1);
+        scene.media.push_back(unused);
+        ASSERT_TRUE(scene.HasMedia());
+    }
     const uint64_t spp = 16;
     const testing::PathRender render = testing::RenderPath(scene, spp);
     const EmbreeScene& es = *render.embree;
@@ -521,6 +532,11 @@ TEST(SmoothShading, NoBlackTerminator) {
         return Rgb(rho_i * std::max(0.0f, Dot(sh.ns, l)) / dist2 / float(kPi));
     });
 }
+
+INSTANTIATE_TEST_SUITE_P(SmoothShading, NoBlackTerminator, ::testing::Bool(),
+                         [](const auto& info) {
+                             return std::string(info.param ? "VolPathTracer" : "PathTracer");
+                         });
 
 // No light leaks: a flat quad (normal +y) whose vertex normals lean 45 degrees towards its
 // centre line x = 0 (a bowl, so Hanika's point is the hit itself), under a point light below

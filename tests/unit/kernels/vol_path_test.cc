@@ -203,6 +203,28 @@ TEST(VolPath, CameraInsideAnAbsorbingMediumSeesTheSkyAttenuated) {
     }
 }
 
+TEST(VolPath, CameraInAnUnboundedAbsorberSeesNothing) {
+    // The medium fills all space: a ray to the sky, escaping or a shadow ray, crosses an
+    // infinite stretch of it. Exactly 0, whatever geometry happens to be near.
+    Scene scene;
+    Material floor;
+    floor.reflectance = Rgb(0.8f);
+    scene.materials.push_back(floor);
+    testing::AddQuad(scene, 0, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2});
+    scene.media.push_back(Homogeneous(Rgb(0.2f), Rgb(0)));
+    scene.camera_medium = 0;
+    scene.environment = EnvironmentLight{};
+    DirectionalLight sun;
+    sun.direction = Normalize(Vec3d(0.2, -1, 0.1));
+    sun.irradiance = Rgb(3);
+    scene.directional_lights.push_back(sun);
+    scene.camera = testing::SquareCamera({0, 1, 3}, {0, 0, 0}, {0, 1, 0}, 60, 8);
+    const RenderOutput out = RenderVol(scene, 16);
+    for (const char* c : {"R", "G", "B"}) {
+        for (float x : *out.image.FindChannel(c)) EXPECT_EQ(x, 0) << c;
+    }
+}
+
 // The test's own analog random walk: the probability that light entering a sphere of radius
 // 1 along a diameter leaves it again, with extinction sigma_t, single-scattering albedo
 // `albedo` and Henyey-Greenstein's g (cos theta by the textbook inversion). By reciprocity

@@ -311,8 +311,8 @@ struct Scene {
 };
 
 // Beer's law as a medium: each solid transmitter (Material::HasInterior) with a finite
-// attenuation_distance and no interface of its own gets a homogeneous absorber inside (exterior
-// vacuum), sigma_a = -ln(attenuation_color) / attenuation_distance, one per material. Every
+// attenuation_distance and no interface of its own gets a homogeneous absorber inside (its
+// exterior the camera's medium, vacuum or fog), sigma_a = -ln(attenuation_color) / attenuation_distance, one per material. Every
 // loader calls it; scenes built in code call it themselves.
 void AddAttenuationMedia(Scene& scene);
 

@@ -39,6 +39,9 @@ struct LightSample {
                          // times the cosine is the irradiance: intensity / r^2 (point, spot),
                          // the irradiance itself (directional)
     SurfacePoint point;  // on the light; for lights at infinity a point beyond the scene
+    // A light at infinity (sky, sun disk, directional light): `point` only stands for it, so a
+    // medium that extends past the scene attenuates the shadow ray beyond it too.
+    bool at_infinity = false;
     Vec3 wi;             // unit, from the reference point to the light
     float pdf = 0;       // solid angle density times the pick probability; for a delta light
                          // just the pick probability

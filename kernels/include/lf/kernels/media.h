@@ -100,7 +100,8 @@ class SceneMedia {
     static Rgb Attenuation(const Rgb& sigma, float s) {
         Rgb a(1.0f);
         for (int c = 0; c < 3; ++c) {
-            if (sigma[c] != 0) a[c] = std::exp(-sigma[c] * s);
+            // Nothing over no distance, even for an infinite sigma (no 0 * inf).
+            if (sigma[c] != 0 && s > 0) a[c] = std::exp(-sigma[c] * s);
         }
         return a;
     }

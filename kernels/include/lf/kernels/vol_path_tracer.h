@@ -32,14 +32,15 @@ class VolPathTracer : public RadianceEstimator {
 
   private:
     struct PathState;
-    // Light sampled from a vertex at `from` (surface: `n` its shading normal; medium: n zero)
+    // Light sampled for a vertex at `at` (surface: `n` its shading normal; medium: n zero)
     // whose scattering for the light direction wi is `f_of(wi)` (BSDF times |cos|, or the phase
-    // function) with density `pdf_of(wi)`, the shadow ray starting in medium `medium_of(wi)`;
-    // the path's throughput and r_u there in `state`.
-    template <typename MediumOf, typename F, typename Pdf>
-    Rgb SampleLight(const SurfacePoint& from, const Vec3& n, MediumOf&& medium_of,
+    // function) with density `pdf_of(wi)`, the shadow ray leaving from `from_of(wi)` in medium
+    // `medium_of(wi)`; the path's throughput and r_u there in `state`.
+    template <typename FromOf, typename MediumOf, typename F, typename Pdf>
+    Rgb SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& from_of, MediumOf&& medium_of,
                     const PathState& state, float u_pick, const Vec2& u_light, MediumRng& rng,
                     F&& f_of, Pdf&& pdf_of, RenderStats& stats) const;
+    static bool Roulette(PathState& state, float eta_scale, float u);
 
     const EmbreeScene& scene_;
     const SceneMedia& media_;
