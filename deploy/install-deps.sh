@@ -5,6 +5,7 @@ packages=(
   build-essential cmake pkg-config
   libembree-dev libopenexr-dev libtbb-dev libspdlog-dev nlohmann-json3-dev libcli11-dev
   libpng-dev libtinyobjloader-dev libtinygltf-dev libdraco-dev libstb-dev libopenvdb-dev
+  libboost-dev  # OpenVDB's io headers include Boost's, which libopenvdb-dev does not depend on
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   libssl-dev libsqlite3-dev libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox
