@@ -110,24 +110,17 @@ SurfacePoint Leaving(const BdptVertex& v, const Vec3& dir) {
 
 // The point of a surface hit that a ray crossing it goes on from.
 SurfacePoint Crossing(const SurfaceHit& hit) {
-    SurfacePoint crossed;
-    crossed.p = hit.p;
-    crossed.p_error = hit.p_error;
-    crossed.n = hit.n;
-    crossed.time = hit.time;
-    return crossed;
+    return {.p = hit.p, .p_error = hit.p_error, .n = hit.n, .time = hit.time};
 }
 
 // The emitter surface a light or emitter vertex lies on, for LightSampler::Pdf and InterfaceAt.
 SurfaceHit HitOf(const BdptVertex& v) {
-    SurfaceHit hit;
-    hit.p = v.p;
-    hit.n = v.ng;
-    hit.mesh = v.mesh;
-    hit.primitive = v.primitive;
-    hit.sphere = v.sphere;
-    hit.time = v.point.time;
-    return hit;
+    return {.p = v.p,
+            .n = v.ng,
+            .mesh = v.mesh,
+            .sphere = v.sphere,
+            .primitive = v.primitive,
+            .time = v.point.time};
 }
 
 }  // namespace

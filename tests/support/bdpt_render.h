@@ -88,6 +88,32 @@ inline Mean SplatMean(const BdptFrame& f) {
     return {sum / n, std::sqrt(var) / n};
 }
 
+// The channel-average means of BDPT and the path tracer over the `block` x `block` pixels from
+// (x0, y0), and the standard error of their difference from both methods' A/B halves.
+struct BlockMeans {
+    double bdpt = 0, path = 0, se = 0;
+};
+inline BlockMeans CompareBlock(const BdptFrame& bd, const Image& pt, int x0, int y0, int block) {
+    BlockMeans m;
+    double v1 = 0, v2 = 0;
+    for (int y = y0; y < y0 + block; ++y) {
+        for (int x = x0; x < x0 + block; ++x) {
+            const size_t i = size_t(y * bd.width + x);
+            const double a = bd.half[0][i].Average(), b = bd.half[1][i].Average();
+            m.bdpt += (a + b) / 2;
+            v1 += (a - b) * (a - b) / 4;
+            const double pa = pt.Pixel(x, y, "A.").Average(), pb = pt.Pixel(x, y, "B.").Average();
+            m.path += (pa + pb) / 2;
+            v2 += (pa - pb) * (pa - pb) / 4;
+        }
+    }
+    const double n = double(block) * block;
+    m.bdpt /= n;
+    m.path /= n;
+    m.se = std::sqrt(v1 + v2) / n;
+    return m;
+}
+
 // Compares BDPT with the path tracer block by block (blocks of side `block`, channel
 // average): z from the A/B half variances of both; every |z| below the Bonferroni threshold.
 // Returns the largest |z|.
@@ -100,27 +126,11 @@ inline double CompareWithPathTracer(const std::string& name, const Scene& scene,
     double worst = 0;
     for (int by = 0; by < bh; ++by) {
         for (int bx = 0; bx < bw; ++bx) {
-            double m1 = 0, v1 = 0, m2 = 0, v2 = 0;
-            for (int y = by * block; y < (by + 1) * block; ++y) {
-                for (int x = bx * block; x < (bx + 1) * block; ++x) {
-                    const size_t i = size_t(y * bd.width + x);
-                    const double a = bd.half[0][i].Average(), b = bd.half[1][i].Average();
-                    m1 += (a + b) / 2;
-                    v1 += (a - b) * (a - b) / 4;
-                    const double pa = pt.image.Pixel(x, y, "A.").Average();
-                    const double pb = pt.image.Pixel(x, y, "B.").Average();
-                    m2 += (pa + pb) / 2;
-                    v2 += (pa - pb) * (pa - pb) / 4;
-                }
-            }
-            const double n = double(block) * block;
-            m1 /= n;
-            m2 /= n;
-            const double se = std::sqrt(v1 + v2) / n;
-            const double z = se > 0 ? (m1 - m2) / se : (m1 == m2 ? 0 : 1e9);
+            const BlockMeans m = CompareBlock(bd, pt.image, bx * block, by * block, block);
+            const double z = m.se > 0 ? (m.bdpt - m.path) / m.se : (m.bdpt == m.path ? 0 : 1e9);
             worst = std::max(worst, std::abs(z));
             EXPECT_LT(std::abs(z), threshold) << name << ": block " << bx << ", " << by << ": bdpt "
-                                              << m1 << ", path " << m2 << " +- " << se;
+                                              << m.bdpt << ", path " << m.path << " +- " << m.se;
         }
     }
     std::printf("[bdpt] %s: %d blocks, largest |z| %.2f (threshold %.2f)\n", name.c_str(), bw * bh,

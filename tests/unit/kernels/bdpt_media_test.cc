@@ -24,20 +24,10 @@ using testing::CompareWithPathTracer;
 using testing::LoadSmall;
 using testing::RenderBdpt;
 
-Material InterfaceMaterial() {
-    Material boundary;
-    boundary.name = "boundary";
-    boundary.type = Material::Type::kInterface;
-    return boundary;
-}
+Material InterfaceMaterial() { return {.name = "boundary", .type = Material::Type::kInterface}; }
 
 Medium Fog(const Rgb& sigma_a, const Rgb& sigma_s, float g) {
-    Medium m;
-    m.name = "fog";
-    m.sigma_a = sigma_a;
-    m.sigma_s = sigma_s;
-    m.g = g;
-    return m;
+    return {.name = "fog", .sigma_a = sigma_a, .sigma_s = sigma_s, .g = g};
 }
 
 // A ball of medium 0 (interface boundary, material `boundary`).
@@ -96,11 +86,11 @@ TEST(BdptMedia, NonAbsorbingChromaticSphereInAFurnaceIsInvisible) {
 }
 
 TEST(BdptMedia, MatchesThePathTracerInAFogFilledCornellBox) {
-    CompareWithPathTracer("cornell fog", LoadSmall("media/cornell_fog.json", 32), 128, 256, 5);
+    CompareWithPathTracer("cornell fog", LoadSmall("media/cornell_fog.json", 32), 256, 512, 5);
 }
 
 TEST(BdptMedia, MatchesThePathTracerOnAScatteringSphereUnderASpotLight) {
-    CompareWithPathTracer("spot sphere", LoadSmall("media/spot_sphere.json", 32), 128, 256, 6);
+    CompareWithPathTracer("spot sphere", LoadSmall("media/spot_sphere.json", 32), 256, 512, 6);
 }
 
 // A lattice over [lo, lo + n voxel]^3 whose density varies from 0 to 2 voxel by voxel in a
@@ -128,15 +118,8 @@ std::shared_ptr<VolumeGrid> PatternGrid(const Vec3d& lo, double voxel, int n) {
 // `medium` (radius 0.6) in the middle; the camera inside the room, outside the ball.
 Scene RoomWithBall(const Medium& medium, int size) {
     Scene scene;
-    Material wall;
-    wall.name = "wall";
-    wall.reflectance = Rgb(0.5f);
-    scene.materials.push_back(wall);
-    Material lamp;
-    lamp.name = "lamp";
-    lamp.reflectance = Rgb(0);
-    lamp.emission = Rgb(8, 6, 4);
-    scene.materials.push_back(lamp);
+    scene.materials.push_back({.name = "wall", .reflectance = Rgb(0.5f)});
+    scene.materials.push_back({.name = "lamp", .reflectance = Rgb(0), .emission = Rgb(8, 6, 4)});
     scene.materials.push_back(InterfaceMaterial());
     testing::AddInwardBox(scene, {0, 0, 0}, 1, 0);
     testing::AddQuad(scene, 1, {-0.3, 0.99, -0.3}, {0.3, 0.99, -0.3}, {0.3, 0.99, 0.3},
@@ -151,7 +134,7 @@ TEST(BdptMedia, MatchesThePathTracerOnAHeterogeneousGridLitByAnAreaLight) {
     Medium smoke = Fog(Rgb(0.3f, 0.2f, 0.1f), Rgb(1.5f, 2.5f, 4), -0.3f);
     smoke.type = Medium::Type::kGrid;
     smoke.density = PatternGrid({-0.6, -0.8, -0.6}, 0.1, 12);
-    CompareWithPathTracer("grid", RoomWithBall(smoke, 32), 128, 256, 5);
+    CompareWithPathTracer("grid", RoomWithBall(smoke, 32), 256, 512, 5);
 }
 
 TEST(BdptMedia, FindsTheMediumOfALampInsideAFogBall) {
@@ -160,18 +143,14 @@ TEST(BdptMedia, FindsTheMediumOfALampInsideAFogBall) {
     // estimates from medium vertices near it have infinite variance, which no z-test takes.)
     Scene scene = RoomWithBall(Fog(Rgb(0.2f), Rgb(1.5f, 1, 0.5f), 0.4f), 32);
     scene.materials[1].emission = Rgb(0);
-    Material glow;
-    glow.name = "glow";
-    glow.reflectance = Rgb(0);
-    glow.emission = Rgb(20);
-    scene.materials.push_back(glow);
+    scene.materials.push_back({.name = "glow", .reflectance = Rgb(0), .emission = Rgb(20)});
     Sphere bulb;
     bulb.name = "bulb";
     bulb.material = int(scene.materials.size()) - 1;
     bulb.center = {0, -0.2, 0};
     bulb.radius = 0.1;
     scene.spheres.push_back(bulb);
-    CompareWithPathTracer("lamp in fog", scene, 128, 256, 5);
+    CompareWithPathTracer("lamp in fog", scene, 256, 512, 5);
 }
 
 }  // namespace

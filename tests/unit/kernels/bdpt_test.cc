@@ -123,20 +123,8 @@ TEST(Bdpt, RendersThePointLightCausticThePathTracerMisses) {
     const RenderOutput pt = testing::RenderPath(scene, 512, 8, 3).out;
     // Block (2, 3) of the 32 x 32 frame: x 16..23, y 24..31, the floor around the point
     // where the light's caustic lands, in front of the sphere.
-    double m1 = 0, v1 = 0, m2 = 0, v2 = 0;
-    for (int y = 24; y < 32; ++y) {
-        for (int x = 16; x < 24; ++x) {
-            const size_t i = size_t(y * bd.width + x);
-            const double a = bd.half[0][i].Average(), b = bd.half[1][i].Average();
-            m1 += (a + b) / 128;
-            v1 += (a - b) * (a - b) / 4;
-            const double pa = pt.image.Pixel(x, y, "A.").Average();
-            const double pb = pt.image.Pixel(x, y, "B.").Average();
-            m2 += (pa + pb) / 128;
-            v2 += (pa - pb) * (pa - pb) / 4;
-        }
-    }
-    const double se = std::sqrt(v1 + v2) / 64;
+    const testing::BlockMeans block = testing::CompareBlock(bd, pt.image, 16, 24, 8);
+    const double m1 = block.bdpt, m2 = block.path, se = block.se;
     std::printf("[bdpt] point-light caustic block: bdpt %.5f, path %.5f +- %.5f\n", m1, m2, se);
     EXPECT_GT(m1 - m2, 5 * se);
 }
@@ -336,49 +324,54 @@ TEST(Bdpt, MatchesThePathTracerThroughTintedPrincipledGlass) {
     CompareWithPathTracer("tinted principled glass", scene, 256, 512, 8);
 }
 
+// Also through media, whose delta and ratio tracking draw from each sample's own stream.
 TEST(Bdpt, AnySplitOfTheWorkGivesTheSameBits) {
-    const Scene scene = LoadSmall("materials.json", 16);
-    auto es = EmbreeScene::Build(scene);
-    ASSERT_TRUE(es.ok());
-    const Camera camera(scene.camera, (*es)->origin());
-    SplatRenderSettings settings;
-    settings.max_depth = 6;
-    settings.seed = 11;
-    const BdptRenderer renderer(**es, camera, settings);
-    const PixelRect rect{0, 0, 16, 16};
-    TileSums whole(rect);
-    SplatList whole_splats(16, 16);
-    renderer.Render(SplatWork{rect, 0, 6, 0, 0}, whole, whole_splats);
+    for (const char* file : {"materials.json", "media/cornell_fog.json"}) {
+        SCOPED_TRACE(file);
+        const Scene scene = LoadSmall(file, 16);
+        auto es = EmbreeScene::Build(scene);
+        ASSERT_TRUE(es.ok());
+        const Camera camera(scene.camera, (*es)->origin());
+        SplatRenderSettings settings;
+        settings.max_depth = 6;
+        settings.seed = 11;
+        const BdptRenderer renderer(**es, camera, settings);
+        const PixelRect rect{0, 0, 16, 16};
+        TileSums whole(rect);
+        SplatList whole_splats(16, 16);
+        renderer.Render(SplatWork{rect, 0, 6, 0, 0}, whole, whole_splats);
 
-    // The same samples as two sample ranges over two halves of the rect, merged.
-    TileSums merged(rect);
-    SplatList merged_splats(16, 16);
-    for (const PixelRect part : {PixelRect{0, 0, 16, 7}, PixelRect{0, 7, 16, 9}}) {
-        for (const auto& [begin, end] : {std::pair<uint64_t, uint64_t>{0, 4}, {4, 6}}) {
-            TileSums sums(part);
-            SplatList splats(16, 16);
-            renderer.Render(SplatWork{part, begin, end, 0, 0}, sums, splats);
-            for (int y = part.y0; y < part.y0 + part.height; ++y) {
-                for (int x = 0; x < 16; ++x) merged.at(x, y) += sums.at(x, y);
-            }
-            merged.stats += sums.stats;
-            merged_splats += splats;
-        }
-    }
-    for (int y = 0; y < 16; ++y) {
-        for (int x = 0; x < 16; ++x) {
-            const PixelSums& a = whole.at(x, y);
-            const PixelSums& b = merged.at(x, y);
-            for (int h = 0; h < 2; ++h) {
-                EXPECT_EQ(a.count[h], b.count[h]);
-                for (int c = 0; c < 3; ++c) EXPECT_EQ(a.sum[h][c], b.sum[h][c]) << x << ", " << y;
+        // The same samples as two sample ranges over two halves of the rect, merged.
+        TileSums merged(rect);
+        SplatList merged_splats(16, 16);
+        for (const PixelRect part : {PixelRect{0, 0, 16, 7}, PixelRect{0, 7, 16, 9}}) {
+            for (const auto& [begin, end] : {std::pair<uint64_t, uint64_t>{0, 4}, {4, 6}}) {
+                TileSums sums(part);
+                SplatList splats(16, 16);
+                renderer.Render(SplatWork{part, begin, end, 0, 0}, sums, splats);
+                for (int y = part.y0; y < part.y0 + part.height; ++y) {
+                    for (int x = 0; x < 16; ++x) merged.at(x, y) += sums.at(x, y);
+                }
+                merged.stats += sums.stats;
+                merged_splats += splats;
             }
         }
+        for (int y = 0; y < 16; ++y) {
+            for (int x = 0; x < 16; ++x) {
+                const PixelSums& a = whole.at(x, y);
+                const PixelSums& b = merged.at(x, y);
+                for (int h = 0; h < 2; ++h) {
+                    EXPECT_EQ(a.count[h], b.count[h]);
+                    for (int c = 0; c < 3; ++c)
+                        EXPECT_EQ(a.sum[h][c], b.sum[h][c]) << x << ", " << y;
+                }
+            }
+        }
+        EXPECT_EQ(whole.stats.rays, merged.stats.rays);
+        EXPECT_EQ(whole.stats.samples, merged.stats.samples);
+        EXPECT_FALSE(whole_splats.entries().empty());
+        EXPECT_EQ(whole_splats.entries(), merged_splats.entries());
     }
-    EXPECT_EQ(whole.stats.rays, merged.stats.rays);
-    EXPECT_EQ(whole.stats.samples, merged.stats.samples);
-    EXPECT_FALSE(whole_splats.entries().empty());
-    EXPECT_EQ(whole_splats.entries(), merged_splats.entries());
 }
 
 TEST(Bdpt, RefusesPixelFiltersOtherThanTheBox) {
