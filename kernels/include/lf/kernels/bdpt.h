@@ -69,8 +69,8 @@
 // 2D next-event point; 2D BSDF direction; 1D roulette), then four per light vertex (2D lobe;
 // 2D lens point of its t = 1 connection; 2D direction; 1D roulette). The hero channel and the
 // tracking through media draw from a MediumRng seeded by (seed, pixel, sample), not from the
-// sampler. The result is a pure function of (seed, pixel, sample): any split of the samples over tasks and threads gives the
-// same sums.
+// sampler. The result is a pure function of (seed, pixel, sample): any split of the samples
+// over tasks and threads gives the same sums.
 //
 // Where results go. The t >= 2 strategies of a sample add up to one camera sample of its pixel
 // (PixelSums::Add with the sample's index); each t = 1 contribution is splatted into the
@@ -120,7 +120,6 @@ class BdptRenderer : public SplatRenderer {
     struct Scratch;
     using Path = std::vector<BdptVertex>;
 
-    // Extends `path` (whose last vertex is where `ray` starts) by up to `max_vertices` vertices.
     struct Spectral;
 
     // Extends `path` (whose last vertex is where `ray` starts, in `medium`) by up to
