@@ -253,7 +253,7 @@ absl::Status PrintMethodCosts(const Scene& scene, const EmbreeScene& embree, con
     std::vector<Method> methods = {Method::kPath, Method::kBdpt, Method::kPpm};
     if (transport.specular.empty() && !scene.environment) methods.push_back(Method::kLight);
     if (transport.whitted_missing.empty()) methods.push_back(Method::kWhitted);
-    // Media only the path tracer renders, say: the others would be costed for another image.
+    // Media a method does not render, say: it would be costed for another image.
     std::erase_if(methods, [&](Method m) { return !CheckMethodTakesScene(m, scene).ok(); });
     const uint64_t stages[2] = {options.pilot_spp, 4 * options.pilot_spp};
     std::printf(

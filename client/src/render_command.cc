@@ -171,7 +171,7 @@ Command AddRenderCommand(CLI::App& app) {
                     "and a light subpath, weighted by MIS), ppm (progressive photon mapping: --spp "
                     "passes of --photons photons each, a shrinking gather radius; consistent, "
                     "biased at any finite pass count) or auto (path for scattering, emitting or "
-                    "grid media, which only path renders; whitted where it is exact: no "
+                    "grid media, which only path and bdpt render; whitted where it is exact: no "
                     "interreflection nor caustics; else radiosity where it is exact: Lambertian "
                     "quads and triangles; else bdpt for caustics of small emitters through "
                     "specular surfaces; else path; the log says why). light, bdpt and ppm take no "

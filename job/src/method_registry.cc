@@ -13,9 +13,8 @@ namespace lf {
 
 namespace {
 
-// Every method but the path tracer renders homogeneous absorbers only.
-absl::Status MediaRefusal(Method method, const Scene& scene) {
-    const std::string why = MediaLimitation(scene);
+// FailedPrecondition for `method` and a scene's media limitation `why`; Ok when `why` is empty.
+absl::Status MediaRefusal(Method method, const std::string& why) {
     if (why.empty()) return absl::OkStatus();
     const bool lacks_model = method == Method::kWhitted || method == Method::kRadiosity;
     return absl::FailedPreconditionError(
@@ -25,13 +24,18 @@ absl::Status MediaRefusal(Method method, const Scene& scene) {
                      "; use --method path"));
 }
 
+// Every method but the path tracer and bdpt renders homogeneous absorbers only.
 template <Method kMethod>
 absl::Status MediaOnlyRefusal(const Scene& scene) {
-    return MediaRefusal(kMethod, scene);
+    return MediaRefusal(kMethod, MediaLimitation(scene));
+}
+
+absl::Status BdptMediaRefusal(const Scene& scene) {
+    return MediaRefusal(Method::kBdpt, BdptMediaLimitation(scene));
 }
 
 absl::Status RadiosityAndMediaRefusal(const Scene& scene) {
-    if (absl::Status s = MediaRefusal(Method::kRadiosity, scene); !s.ok()) return s;
+    if (absl::Status s = MediaOnlyRefusal<Method::kRadiosity>(scene); !s.ok()) return s;
     return RadiosityRefusal(scene);
 }
 
@@ -45,7 +49,7 @@ constexpr std::array<MethodInfo, 6> kMethods = {{
     {Method::kLight, "light", WorkKind::kSplatPasses, SplatPlanKind::kLightPaths, true, false,
      false, false, true, MediaOnlyRefusal<Method::kLight>},
     {Method::kBdpt, "bdpt", WorkKind::kSplatPasses, SplatPlanKind::kCameraAndLight, true, true,
-     false, false, true, MediaOnlyRefusal<Method::kBdpt>},
+     false, false, true, BdptMediaRefusal},
     {Method::kPpm, "ppm", WorkKind::kSplatPasses, SplatPlanKind::kPhotonPasses, false, true, false,
      false, true, MediaOnlyRefusal<Method::kPpm>},
 }};
@@ -104,6 +108,13 @@ std::string MediaLimitation(const Scene& scene) {
         if (m.type == Medium::Type::kGrid) return what + " is a grid (heterogeneous)";
         if (!m.sigma_s.IsBlack()) return what + " scatters light (sigma_s > 0)";
         if (m.IsEmissive()) return what + " emits light";
+    }
+    return "";
+}
+
+std::string BdptMediaLimitation(const Scene& scene) {
+    for (const Medium& m : scene.media) {
+        if (m.IsEmissive()) return absl::StrCat("medium \"", m.name, "\" emits light");
     }
     return "";
 }

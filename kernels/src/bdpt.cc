@@ -13,15 +13,17 @@
 #include "lf/kernels/bsdf.h"
 #include "lf/kernels/next_event.h"
 #include "lf/kernels/path_tracer.h"
+#include "lf/kernels/phase_function.h"
 #include "lf/kernels/shading.h"
 
 namespace lf {
 
 // A vertex of a camera or light subpath (pbrt-v4's Vertex). Densities are per area at the
 // vertex (per solid angle for a vertex at infinity): pdf_fwd that of the subpath's own sampling
-// of it, pdf_rev that of sampling it from the other side, which the MIS weight needs.
+// of it, pdf_rev that of sampling it from the other side, which the MIS weight needs. A medium
+// vertex (a real scattering event inside a medium) has no normal: its densities carry no cosine.
 struct BdptVertex {
-    enum class Type : uint8_t { kCamera, kLight, kSurface };
+    enum class Type : uint8_t { kCamera, kLight, kSurface, kMedium };
     Type type = Type::kSurface;
     Vec3 p;
     SurfacePoint point;  // p with its error bound and geometric normal: where rays start or end
@@ -41,12 +43,14 @@ struct BdptVertex {
     float nee_ratio = 1;
     // Surfaces: a delta lobe was sampled here (the vertex cannot be connected).
     bool delta = false;
-    Rgb beta;
+    // beta: the throughput over the hero channel's density (see the header); r: the subpath's
+    // density with each channel as the hero, over the hero's own (1 outside scattering media).
+    Rgb beta, r{1.0f};
     float pdf_fwd = 0, pdf_rev = 0;
-    // Surfaces: the interaction, the BSDF and its frame, the direction back along the subpath,
-    // the material, the medium the subpath arrived through and the media on either side of
-    // the surface, the emission seen from wo (camera subpaths), and the connection numbers
-    // drawn at this vertex.
+    // Surfaces: the interaction, the BSDF and its frame, the direction back along the subpath
+    // (media too), the material, the medium the subpath arrived through (media: the one it
+    // scatters in) and the media on either side of the surface, the emission seen from wo
+    // (camera subpaths), and the connection numbers drawn at this vertex (media too).
     Shading sh;
     std::optional<Bsdf> bsdf;
     Frame frame;
@@ -57,6 +61,7 @@ struct BdptVertex {
     float u_pick = 0;
     Vec2 u_conn;
 
+    bool IsScattering() const { return type == Type::kSurface || type == Type::kMedium; }
     bool IsConnectible() const {
         if (type == Type::kSurface) return !bsdf->IsDelta();
         if (type == Type::kLight) return !(infinite && delta_light);
@@ -86,10 +91,50 @@ Rgb ClampToMax(Rgb v, double clamp) {
 
 constexpr int kRouletteStartBounce = 2;  // the path tracer's depth 1: its second bounce
 
+// Connections whose transmittance estimate has fallen this low play roulette (as the path
+// tracer's shadow rays): most of them end, the survivors carry 4x.
+constexpr float kShadowRouletteBelow = 0.05f;
+constexpr float kShadowRouletteStop = 0.75f;
+
+// The most surfaces a ray from the camera crosses to find the medium a light lies in.
+constexpr int kMaxCrossings = 1024;
+
+Rgb ClampZero(const Rgb& c) {
+    return {std::max(0.0f, c.r), std::max(0.0f, c.g), std::max(0.0f, c.b)};
+}
+
+// Where a ray from scattering vertex v towards dir starts.
+SurfacePoint Leaving(const BdptVertex& v, const Vec3& dir) {
+    return v.type == BdptVertex::Type::kSurface ? v.sh.Leaving(dir) : v.point;
+}
+
+// The point of a surface hit that a ray crossing it goes on from.
+SurfacePoint Crossing(const SurfaceHit& hit) {
+    return {.p = hit.p, .p_error = hit.p_error, .n = hit.n, .time = hit.time};
+}
+
+// The emitter surface a light or emitter vertex lies on, for LightSampler::Pdf and InterfaceAt.
+SurfaceHit HitOf(const BdptVertex& v) {
+    return {.p = v.p,
+            .n = v.ng,
+            .mesh = v.mesh,
+            .sphere = v.sphere,
+            .primitive = v.primitive,
+            .time = v.point.time};
+}
+
 }  // namespace
 
 struct BdptRenderer::Scratch {
     Path camera, light;
+};
+
+// A camera sample's channel choice and the random numbers of its walks through media beyond
+// the sampler's fixed dimensions (delta and ratio tracking take as many as they meet
+// collisions).
+struct BdptRenderer::Spectral {
+    int hero = 0;
+    MediumRng rng{0};
 };
 
 BdptRenderer::BdptRenderer(const EmbreeScene& scene, const Camera& camera,
@@ -98,13 +143,18 @@ BdptRenderer::BdptRenderer(const EmbreeScene& scene, const Camera& camera,
       camera_(camera),
       settings_(settings),
       lights_(scene, settings.light_strategy),
-      emission_(scene) {
+      emission_(scene),
+      media_(scene.media()) {
     const float r = emission_.scene_radius();
     infinite_pdf_pos_ = 1 / (std::numbers::pi_v<float> * r * r);
     has_infinite_ = scene.scene().environment.has_value();
     for (const DirectionalLight& dl : scene.scene().directional_lights) {
         if (dl.angular_diameter > 0) has_infinite_ = true;
     }
+    const Scene& s = scene.scene();
+    volumetric_ = s.camera_medium >= 0;
+    for (const Material& m : s.materials) volumetric_ |= m.type == Material::Type::kInterface;
+    for (int m = 0; m < int(s.media.size()); ++m) volumetric_ |= !media_.IsHomogeneousAbsorber(m);
 }
 
 BdptRenderer::~BdptRenderer() = default;
@@ -154,13 +204,7 @@ float BdptRenderer::NeeRatio(const BdptVertex& v, const BdptVertex& ref) const {
     const float emit = PdfLightOrigin(v, ref);
     if (!(emit > 0)) return 1;
     if (v.infinite) return lights_.EscapedPdf(DirectionTo(ref, v)) / emit;
-    SurfaceHit hit;
-    hit.p = v.p;
-    hit.n = v.ng;
-    hit.mesh = v.mesh;
-    hit.primitive = v.primitive;
-    hit.sphere = v.sphere;
-    hit.time = v.point.time;
+    const SurfaceHit hit = HitOf(v);
     if (hit.mesh < 0 && hit.sphere < 0) return 1;
     const Vec3 d = v.p - ref.p;
     const float dist2 = LengthSquared(d);
@@ -176,6 +220,9 @@ float BdptRenderer::PdfTo(const BdptVertex& v, const BdptVertex* prev,
     float pdf = 0;
     if (v.type == BdptVertex::Type::kCamera) {
         pdf = camera_.PdfWe(Ray{v.p, wn, kInfinity, v.point.time}).dir;
+    } else if (v.type == BdptVertex::Type::kMedium) {
+        if (prev == nullptr) return 0;
+        pdf = HenyeyGreenstein(-Dot(DirectionTo(v, *prev), wn), media_.g(v.medium));
     } else {
         if (prev == nullptr) return 0;
         const Vec3 wp = DirectionTo(v, *prev);
@@ -185,6 +232,10 @@ float BdptRenderer::PdfTo(const BdptVertex& v, const BdptVertex* prev,
 }
 
 Rgb BdptRenderer::FCos(const BdptVertex& v, const Vec3& dir, bool importance) const {
+    // The phase function is symmetric and has no cosine: radiance and importance alike.
+    if (v.type == BdptVertex::Type::kMedium) {
+        return Rgb(HenyeyGreenstein(-Dot(v.wo, dir), media_.g(v.medium)));
+    }
     const Vec3 wo = v.frame.ToLocal(v.wo), wi = v.frame.ToLocal(dir);
     const bool reflect = wi.z * wo.z > 0;
     if (!v.sh.SidesAgree(v.wo, dir, reflect)) return Rgb(0);
@@ -204,26 +255,99 @@ Rgb BdptRenderer::FCos(const BdptVertex& v, const Vec3& dir, bool importance) co
 }
 
 int BdptRenderer::MediumToward(const BdptVertex& v, const Vec3& dir) const {
+    if (v.type == BdptVertex::Type::kMedium) return v.medium;
     if (v.type != BdptVertex::Type::kSurface) return -1;
     const bool transmitted = v.frame.ToLocal(dir).z * v.frame.ToLocal(v.wo).z < 0;
     return transmitted ? MediumAfter(v.media, v.medium, v.ng, dir) : v.medium;
 }
 
-Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to,
+Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to, Spectral& spectral,
                                RenderStats& stats) const {
     const Vec3 dir = DirectionTo(from, to);
-    ++stats.rays;
-    if (scene_.Occluded(SpawnRayTo(from.sh.Leaving(dir), to.point))) return Rgb(0);
-    return Attenuation(scene_, MediumToward(from, dir), Length(to.p - from.p));
+    int medium = MediumToward(from, dir);
+    Ray ray = SpawnRayTo(Leaving(from, dir), to.point);
+    if (!volumetric_) {
+        ++stats.rays;
+        if (scene_.Occluded(ray)) return Rgb(0);
+        return Attenuation(scene_, medium, Length(to.p - from.p));
+    }
+    // Interface surfaces are crossed, any other surface blocks; every medium on the way
+    // attenuates.
+    Rgb tr(1.0f);
+    for (;;) {
+        ++stats.rays;
+        const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
+        if (hit &&
+            scene_.scene().materials[size_t(hit->material)].type != Material::Type::kInterface) {
+            return Rgb(0);
+        }
+        if (medium >= 0) {
+            tr *= SegmentTransmittance(medium, ray, hit ? hit->t : ray.t_max, spectral);
+            if (tr.IsBlack()) return tr;
+        }
+        if (!hit) return tr;
+        medium = MediumAfter(scene_.scene(), medium, *hit, ray.d);
+        ray = SpawnRayTo(Crossing(*hit), to.point);
+    }
+}
+
+Rgb BdptRenderer::SegmentTransmittance(int medium, const Ray& ray, float t_end,
+                                       Spectral& spectral) const {
+    // Beer's law exactly where nothing but absorption happens.
+    if (media_.IsHomogeneousAbsorber(medium)) {
+        return media_.HomogeneousTransmittance(medium, t_end * Length(ray.d));
+    }
+    // Ratio tracking against the hero's majorant: unbiased in every channel for any hero.
+    const int hero = spectral.hero;
+    Rgb tr(1.0f);
+    const Rgb t_maj = media_.SampleTMaj(
+        medium, ray, t_end, hero, spectral.rng,
+        [&](const Vec3&, const MediumPoint& mp, const Rgb& sigma_maj, const Rgb& tm) {
+            const Rgb sigma_n = ClampZero(sigma_maj - mp.sigma_a - mp.sigma_s);
+            tr *= tm * sigma_n / (tm[hero] * sigma_maj[hero]);
+            if (tr.MaxComponent() < kShadowRouletteBelow) {
+                if (spectral.rng.Uniform() < kShadowRouletteStop) {
+                    tr = Rgb(0);
+                } else {
+                    tr /= 1 - kShadowRouletteStop;
+                }
+            }
+            return !tr.IsBlack();
+        });
+    if (tr.IsBlack() || !(t_maj[hero] > 0)) return Rgb(0);
+    return tr * t_maj / t_maj[hero];
+}
+
+int BdptRenderer::MediumAtLight(const BdptVertex& eye, const BdptVertex& light,
+                                RenderStats& stats) const {
+    const Scene& scene = scene_.scene();
+    if (!volumetric_) return -1;
+    // The media the segment from the camera to the light crosses, as a path would.
+    int medium = scene.camera_medium;
+    Ray ray = SpawnRayTo(eye.point, light.point);
+    for (int i = 0; i < kMaxCrossings; ++i) {
+        ++stats.rays;
+        const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
+        if (!hit) break;
+        medium = MediumAfter(scene, medium, *hit, ray.d);
+        ray = SpawnRayTo(Crossing(*hit), light.point);
+    }
+    // An area light's own surface separates the side the segment arrives on from the side
+    // it emits into.
+    if (light.on_surface)
+        medium = MediumAfter(InterfaceAt(scene, HitOf(light)), medium, light.ng, light.w);
+    return medium;
 }
 
 void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool importance,
-                        Sampler& sampler, Path& path, RenderStats& stats) const {
+                        int medium, Spectral& spectral, Sampler& sampler, Path& path,
+                        RenderStats& stats) const {
     if (max_vertices <= 0) return;
     const std::vector<Material>& materials = scene_.scene().materials;
     const float beta0 = beta.MaxComponent();
+    const int hero = spectral.hero;
+    Rgb r(1.0f);
     float eta_scale = 1;
-    int medium = -1;
     for (int bounces = 0;;) {
         // The vertex's numbers, drawn before the ray is traced and in the same order whatever
         // happens (see the header): lobe and light pick, connection, direction, roulette.
@@ -232,7 +356,48 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
         ray.d = Normalize(ray.d);
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
-        if (!hit) {
+
+        // Delta tracking through a scattering medium (as VolPathTracer::Li): a real collision
+        // is absorbed (the subpath ends) or scatters (a medium vertex), a null one reweighs.
+        std::optional<Vec3> scattered_at;
+        if (medium >= 0 && !media_.IsHomogeneousAbsorber(medium)) {
+            bool terminated = false;
+            const Rgb t_maj = media_.SampleTMaj(
+                medium, ray, hit ? hit->t : kInfinity, hero, spectral.rng,
+                [&](const Vec3& p, const MediumPoint& mp, const Rgb& sigma_maj, const Rgb& tm) {
+                    const float u = spectral.rng.Uniform(), maj = sigma_maj[hero];
+                    const float p_absorb = mp.sigma_a[hero] / maj;
+                    if (u < p_absorb) {
+                        terminated = true;
+                        return false;
+                    }
+                    const bool real = u < p_absorb + mp.sigma_s[hero] / maj;
+                    const Rgb sigma =
+                        real ? mp.sigma_s : ClampZero(sigma_maj - mp.sigma_a - mp.sigma_s);
+                    const float pdf = tm[hero] * sigma[hero];
+                    if (!(pdf > 0)) {
+                        terminated = true;
+                        return false;
+                    }
+                    beta *= tm * sigma / pdf;
+                    r *= tm * sigma / pdf;
+                    if (beta.IsBlack() || r.IsBlack()) {
+                        terminated = true;
+                        return false;
+                    }
+                    if (real) scattered_at = p;
+                    return !real;
+                });
+            if (terminated) return;
+            if (!scattered_at) {
+                const float th = t_maj[hero];
+                if (!(th > 0)) return;
+                beta *= t_maj / th;
+                r *= t_maj / th;
+                if (beta.IsBlack()) return;
+            }
+        }
+        if (!scattered_at && !hit) {
             if (!importance && has_infinite_) {
                 BdptVertex v;
                 v.type = BdptVertex::Type::kLight;
@@ -240,37 +405,51 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
                 v.w = -ray.d;
                 v.p = ray.o + ray.d;
                 v.beta = beta;
+                v.r = r;
                 v.pdf_fwd = pdf_fwd;
                 v.le = lights_.EscapedRadiance(ray.d);
                 path.push_back(v);
             }
             return;
         }
-        if (medium >= 0) {
+        if (!scattered_at && medium >= 0 && media_.IsHomogeneousAbsorber(medium)) {
             beta *= Attenuation(scene_, medium, hit->t * Length(ray.d));
             if (beta.IsBlack()) return;
         }
+        if (!scattered_at && materials[size_t(hit->material)].type == Material::Type::kInterface) {
+            // Not a vertex: the ray goes on into the medium beyond (its density is unchanged).
+            medium = MediumAfter(scene_.scene(), medium, *hit, ray.d);
+            ray = SpawnRay(Crossing(*hit), ray.d);
+            continue;
+        }
         BdptVertex v;
-        v.type = BdptVertex::Type::kSurface;
-        v.sh = Shade(scene_, *hit, -ray.d);
-        v.point = v.sh.point;
-        v.p = hit->p;
-        v.ng = hit->n;
-        v.ns = v.sh.ns;
-        v.on_surface = true;
-        v.material = hit->material;
+        if (scattered_at) {
+            v.type = BdptVertex::Type::kMedium;
+            v.p = *scattered_at;
+            v.point.p = v.p;
+            v.point.time = ray.time;
+        } else {
+            v.type = BdptVertex::Type::kSurface;
+            v.sh = Shade(scene_, *hit, -ray.d);
+            v.point = v.sh.point;
+            v.p = hit->p;
+            v.ng = hit->n;
+            v.ns = v.sh.ns;
+            v.on_surface = true;
+            v.material = hit->material;
+            v.media = InterfaceAt(scene_.scene(), *hit);
+            v.frame = Frame::FromNormal(v.sh.ns);
+            v.bsdf.emplace(materials[size_t(hit->material)], v.sh.params);
+        }
         v.medium = medium;
-        v.media = InterfaceAt(scene_.scene(), *hit);
         v.wo = -ray.d;
-        v.frame = Frame::FromNormal(v.sh.ns);
-        const Material& material = materials[size_t(hit->material)];
-        v.bsdf.emplace(material, v.sh.params);
         v.beta = beta;
+        v.r = r;
         v.pdf_fwd = ConvertDensity(path.back(), pdf_fwd, v);
         v.u_pick = u_choice.x;
         v.u_conn = u_conn;
-        if (!importance && !v.sh.emission.IsBlack() &&
-            (Dot(ray.d, hit->n) < 0 || EmitsFromBack(material))) {
+        if (!scattered_at && !importance && !v.sh.emission.IsBlack() &&
+            (Dot(ray.d, hit->n) < 0 || EmitsFromBack(materials[size_t(hit->material)]))) {
             v.light = emission_.LightOf(*hit);
             if (v.light >= 0) v.le = v.sh.emission;
             v.mesh = hit->mesh;
@@ -285,49 +464,62 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
         }
         BdptVertex& cur = path.back();
         BdptVertex& prev = path[path.size() - 2];
-        const Vec3 wo = cur.frame.ToLocal(cur.wo);
-        const std::optional<BsdfSample> bs = cur.bsdf->Sample(wo, u_choice.y, u_bsdf);
-        if (!bs || !(bs->pdf > 0)) return;
-        const Vec3 wi = cur.frame.FromLocal(bs->wi);
-        if (!cur.sh.SidesAgree(cur.wo, wi, bs->wi.z * wo.z > 0)) return;
-        const bool transmitted = bs->wi.z * wo.z < 0;
-        if (importance) {
-            // Adjoint: no 1/eta^2 across refraction; shading-normal correction (Veach 5.3).
-            const float wo_ng = std::abs(Dot(cur.wo, cur.ng));
-            if (!(wo_ng > 0)) return;
-            beta *= bs->f * (bs->eta * bs->eta * std::abs(wo.z) * std::abs(Dot(wi, cur.ng)) /
-                             (wo_ng * bs->pdf));
+        Vec3 wi;
+        float pdf_rev = 0;
+        if (scattered_at) {
+            // The phase function is sampled exactly and is symmetric: beta keeps its value,
+            // and the reverse density is the forward one.
+            const PhaseSample ps = SampleHenyeyGreenstein(ray.d, media_.g(medium), u_bsdf);
+            if (!(ps.pdf > 0)) return;
+            wi = ps.wi;
+            pdf_fwd = pdf_rev = ps.pdf;
         } else {
-            beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
-            eta_scale *= bs->eta * bs->eta;
-        }
-        if (beta.IsBlack()) return;
-        pdf_fwd = bs->pdf;
-        float pdf_rev = cur.bsdf->Pdf(bs->wi, wo);
-        if (bs->delta) {
-            // A delta lobe has no density. For the MIS ratios it counts as density 1 in the
-            // measure that reflection and refraction preserve, n^2 times projected solid angle,
-            // as in Veach's thesis (10.3.5), where the geometry terms stay: n_wi^2 |cos wi| per
-            // solid angle towards wi and n_wo^2 |cos wo| back towards wo (both divided by
-            // n_wo^2 here; a factor common to the two directions cancels in every ratio). Then
-            // two strategies that traverse a specular chain from opposite ends compare as they
-            // truly do: a camera path E D S S L through glass to a small lamp against the light
-            // path L S S D joined to the camera by p_emission(L) p(L -> S) / (p_camera(D)
-            // p(D -> S)) in projected solid angle. pbrt-v4 remaps the area density to 1
-            // instead, which drops the geometry term of every segment that leaves a delta
-            // vertex and so misjudges that ratio by G(D, S) / G(S, L): in a caustic where the
-            // floor D almost touches the glass it is thousands, and the camera path took the
-            // weight that belongs to light tracing (BdptTest's caustic test measures it).
-            cur.delta = true;
-            pdf_fwd = bs->eta * bs->eta * std::abs(Dot(wi, cur.ng));
-            pdf_rev = std::abs(Dot(cur.wo, cur.ng));
+            const Vec3 wo = cur.frame.ToLocal(cur.wo);
+            const std::optional<BsdfSample> bs = cur.bsdf->Sample(wo, u_choice.y, u_bsdf);
+            if (!bs || !(bs->pdf > 0)) return;
+            wi = cur.frame.FromLocal(bs->wi);
+            if (!cur.sh.SidesAgree(cur.wo, wi, bs->wi.z * wo.z > 0)) return;
+            const bool transmitted = bs->wi.z * wo.z < 0;
+            if (importance) {
+                // Adjoint: no 1/eta^2 across refraction; shading-normal correction (Veach 5.3).
+                const float wo_ng = std::abs(Dot(cur.wo, cur.ng));
+                if (!(wo_ng > 0)) return;
+                beta *= bs->f * (bs->eta * bs->eta * std::abs(wo.z) * std::abs(Dot(wi, cur.ng)) /
+                                 (wo_ng * bs->pdf));
+            } else {
+                beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
+                eta_scale *= bs->eta * bs->eta;
+            }
+            if (beta.IsBlack()) return;
+            pdf_fwd = bs->pdf;
+            pdf_rev = cur.bsdf->Pdf(bs->wi, wo);
+            if (bs->delta) {
+                // A delta lobe has no density. For the MIS ratios it counts as density 1 in the
+                // measure that reflection and refraction preserve, n^2 times projected solid
+                // angle, as in Veach's thesis (10.3.5), where the geometry terms stay: n_wi^2
+                // |cos wi| per solid angle towards wi and n_wo^2 |cos wo| back towards wo (both
+                // divided by n_wo^2 here; a factor common to the two directions cancels in every
+                // ratio). Then two strategies that traverse a specular chain from opposite ends
+                // compare as they truly do: a camera path E D S S L through glass to a small
+                // lamp against the light path L S S D joined to the camera by p_emission(L)
+                // p(L -> S) / (p_camera(D) p(D -> S)) in projected solid angle. pbrt-v4 remaps
+                // the area density to 1 instead, which drops the geometry term of every segment
+                // that leaves a delta vertex and so misjudges that ratio by G(D, S) / G(S, L): in
+                // a caustic where the floor D almost touches the glass it is thousands, and the
+                // camera path took the weight that belongs to light tracing (BdptTest's caustic
+                // test measures it).
+                cur.delta = true;
+                pdf_fwd = bs->eta * bs->eta * std::abs(Dot(wi, cur.ng));
+                pdf_rev = std::abs(Dot(cur.wo, cur.ng));
+            }
+            if (transmitted) medium = MediumAfter(cur.media, medium, cur.ng, wi);
         }
         prev.pdf_rev = ConvertDensity(cur, pdf_rev, prev);
-        if (transmitted) medium = MediumAfter(cur.media, medium, cur.ng, wi);
-        ray = SpawnRay(cur.sh.Leaving(wi), wi);
+        ray = SpawnRay(Leaving(cur, wi), wi);
         if (bounces >= kRouletteStartBounce) {
-            const float relative =
-                importance ? beta.MaxComponent() / beta0 : beta.MaxComponent() * eta_scale;
+            // On the throughput as the estimate weighs it (over the channels' mean density).
+            const float carried = beta.MaxComponent() / r.Average();
+            const float relative = importance ? carried / beta0 : carried * eta_scale;
             const float q = std::max(0.0f, 1 - relative);
             if (u_roulette < q) return;
             beta /= 1 - q;
@@ -336,7 +528,8 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
 }
 
 void BdptRenderer::LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_dir, float time,
-                                Sampler& sampler, Path& path, RenderStats& stats) const {
+                                const BdptVertex& eye, Spectral& spectral, Sampler& sampler,
+                                Path& path, RenderStats& stats) const {
     const std::optional<EmissionSample> es = emission_.Sample(u_pick, u_pos, u_dir, time);
     if (!es) return;
     BdptVertex v;
@@ -364,7 +557,8 @@ void BdptRenderer::LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_d
     v.beta = es->le * (cos / (es->pick * es->pdf_pos * es->pdf_dir));
     path.push_back(v);
     const int max_vertices = settings_.max_depth < 0 ? kBdptUnlimitedDepth : settings_.max_depth;
-    Walk(es->ray(), path[0].beta, es->pdf_dir, max_vertices, true, sampler, path, stats);
+    Walk(es->ray(), path[0].beta, es->pdf_dir, max_vertices, true, MediumAtLight(eye, v, stats),
+         spectral, sampler, path, stats);
 }
 
 float BdptRenderer::MisWeight(Path& light, Path& camera, int s, int t) const {
@@ -437,7 +631,7 @@ float BdptRenderer::MisWeight(Path& light, Path& camera, int s, int t) const {
     return float(1 / (1 + sum));
 }
 
-Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
+Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster, Spectral& spectral,
                           RenderStats& stats) const {
     using Type = BdptVertex::Type;
     BdptVertex& pt = camera[size_t(t - 1)];
@@ -446,13 +640,13 @@ Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
     Rgb L(0);
     if (s == 0) {
         if (pt.le.IsBlack()) return Rgb(0);
-        L = pt.beta * pt.le;
+        L = pt.beta * pt.le / pt.r.Average();
         if (L.IsBlack()) return L;
         return L * MisWeight(light, camera, s, t);
     }
     if (t == 1) {
         BdptVertex& qs = light[size_t(s - 1)];
-        if (qs.type != Type::kSurface || !qs.IsConnectible()) return Rgb(0);
+        if (!qs.IsScattering() || !qs.IsConnectible()) return Rgb(0);
         const std::optional<Camera::ImportanceSample> cs =
             camera_.SampleWi(qs.p, camera_.HasLens() ? qs.u_conn : Vec2{}, qs.point.time);
         if (!cs || !(cs->pdf > 0)) return Rgb(0);
@@ -462,9 +656,9 @@ Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
         sampled.point.p = cs->lens_point;
         sampled.point.time = qs.point.time;
         sampled.beta = Rgb(cs->we / cs->pdf);
-        L = qs.beta * FCos(qs, cs->wi, true) * sampled.beta;
+        L = qs.beta * FCos(qs, cs->wi, true) * sampled.beta / qs.r.Average();
         if (L.IsBlack()) return L;
-        L *= Transmission(qs, sampled, stats);
+        L *= Transmission(qs, sampled, spectral, stats);
         if (L.IsBlack()) return L;
         *raster = cs->raster;
         std::swap(camera[0], sampled);
@@ -473,7 +667,7 @@ Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
         return L * w;
     }
     if (s == 1) {
-        if (pt.type != Type::kSurface || !pt.IsConnectible()) return Rgb(0);
+        if (!pt.IsScattering() || !pt.IsConnectible()) return Rgb(0);
         const std::optional<LightSample> ls =
             lights_.Sample(pt.p, pt.ns, pt.u_pick, pt.u_conn, pt.point.time);
         if (!ls || !(ls->pdf > 0)) return Rgb(0);
@@ -493,9 +687,9 @@ Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
         const Rgb radiance =
             sampled.on_surface ? EmissionAt(scene_, ls->point, ls->radiance) : ls->radiance;
         sampled.beta = radiance / ls->pdf;
-        L = pt.beta * FCos(pt, ls->wi, false) * sampled.beta;
+        L = pt.beta * FCos(pt, ls->wi, false) * sampled.beta / pt.r.Average();
         if (L.IsBlack()) return L;
-        L *= Transmission(pt, sampled, stats);
+        L *= Transmission(pt, sampled, spectral, stats);
         if (L.IsBlack()) return L;
         sampled.pdf_fwd = PdfLightOrigin(sampled, pt);
         std::swap(light[0], sampled);
@@ -504,17 +698,17 @@ Rgb BdptRenderer::Connect(Path& light, Path& camera, int s, int t, Vec2* raster,
         return L * w;
     }
     BdptVertex& qs = light[size_t(s - 1)];
-    if (qs.type != Type::kSurface || pt.type != Type::kSurface || !qs.IsConnectible() ||
-        !pt.IsConnectible()) {
+    if (!qs.IsScattering() || !pt.IsScattering() || !qs.IsConnectible() || !pt.IsConnectible()) {
         return Rgb(0);
     }
     const Vec3 d = qs.p - pt.p;
     const float dist2 = LengthSquared(d);
     if (!(dist2 > 0)) return Rgb(0);
     const Vec3 w = d / std::sqrt(dist2);  // from the camera vertex to the light vertex
-    L = qs.beta * FCos(qs, -w, true) * FCos(pt, w, false) * pt.beta / dist2;
+    L = qs.beta * FCos(qs, -w, true) * FCos(pt, w, false) * pt.beta /
+        (dist2 * (qs.r * pt.r).Average());
     if (L.IsBlack()) return L;
-    L *= Transmission(pt, qs, stats);
+    L *= Transmission(pt, qs, spectral, stats);
     if (L.IsBlack()) return L;
     return L * MisWeight(light, camera, s, t);
 }
@@ -545,8 +739,16 @@ Rgb BdptRenderer::Sample(int x, int y, uint64_t sample_index, SplatList& splats,
     camera.push_back(cv);
     const Camera::ImportancePdf pdf = camera_.PdfWe(Ray{ray.o, Normalize(ray.d), kInfinity, time});
     const int max_depth = settings_.max_depth < 0 ? kBdptUnlimitedDepth : settings_.max_depth;
-    Walk(ray, Rgb(1), pdf.dir, max_depth + 1, false, sampler, camera, stats);
-    LightSubpath(u_pick, u_pos, u_dir, time, sampler, light, stats);
+    // The hero channel and the media's random numbers come from their own stream (a pure
+    // function of the sample), so the sampler's dimensions stay those of the header.
+    Spectral spectral;
+    spectral.rng = MediumRng(MixBits(MixBits(settings_.seed ^ 0x5bd1e995a3c7f2b1ULL) ^
+                                     (uint64_t(uint32_t(x)) << 32 | uint32_t(y))) ^
+                             MixBits(sample_index));
+    spectral.hero = std::min(2, int(spectral.rng.Uniform() * 3));
+    Walk(ray, Rgb(1), pdf.dir, max_depth + 1, false, scene_.scene().camera_medium, spectral,
+         sampler, camera, stats);
+    LightSubpath(u_pick, u_pos, u_dir, time, camera[0], spectral, sampler, light, stats);
 
     const int nc = int(camera.size()), nl = int(light.size());
     if (nl >= 2) light[0].nee_ratio = NeeRatio(light[0], light[1]);
@@ -560,7 +762,7 @@ Rgb BdptRenderer::Sample(int x, int y, uint64_t sample_index, SplatList& splats,
             if (s > 1 && s > nl) continue;
             if (t == 1) {
                 Vec2 raster;
-                Rgb c = Connect(light, camera, s, t, &raster, stats);
+                Rgb c = Connect(light, camera, s, t, &raster, spectral, stats);
                 if (c.IsBlack()) continue;
                 if (!c.IsFinite()) {
                     ++stats.invalid_samples;
@@ -570,7 +772,7 @@ Rgb BdptRenderer::Sample(int x, int y, uint64_t sample_index, SplatList& splats,
                 const int py = std::clamp(int(raster.y), 0, camera_.height() - 1);
                 splats.Add(px, py, int(sample_index & 1), ClampToMax(c, settings_.clamp));
             } else {
-                L += Connect(light, camera, s, t, nullptr, stats);
+                L += Connect(light, camera, s, t, nullptr, spectral, stats);
             }
         }
     }

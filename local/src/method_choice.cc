@@ -120,9 +120,12 @@ MethodChoice ChooseAutomatically(const Scene& scene) {
     if (!scene.HasLights()) {
         return {Method::kPath, "the scene has no lights: the image is black whatever the method"};
     }
-    // Scattering, emitting or grid media: every other method refuses them (MediaLimitation).
+    // Scattering, emitting or grid media: every method but the path tracer and bdpt (which
+    // refuses emissive media) refuses them (MediaLimitation); the path tracer is the reference.
     if (const std::string media = MediaLimitation(scene); !media.empty()) {
-        return {Method::kPath, absl::StrCat(media, ": only the path tracer renders it")};
+        return {Method::kPath, absl::StrCat(media, BdptMediaLimitation(scene).empty()
+                                                       ? ": only the path tracer and bdpt render it"
+                                                       : ": only the path tracer renders it")};
     }
     // Whitted before radiosity: where it is exact it has no meshing error either.
     if (t.whitted_missing.empty() && scene.HasLights()) {

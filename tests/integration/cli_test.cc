@@ -598,18 +598,18 @@ TEST_F(Cli, PlanListsMediaAndMethodsRefuseWhatTheyDoNotRender) {
          {"media:\n  fog: homogeneous, sigma_a (0, 0, 0), sigma_s (0.5, 0.5, 0.5) m^-1, g 0.3\n",
           "  smoke: grid (at density 1), sigma_a (1, 1, 1), sigma_s (0, 0, 0) m^-1, g 0, density "
           "smoke.vdb#density 4x4x4 (0.000244 MiB)\n",
-          "method (--method auto): path, because medium \"fog\" scatters light (sigma_s > 0): "
-          "only the path tracer renders it"}) {
+          "method (--method auto): path, because material \"boundary\" is an interface between "
+          "media: only the path tracer and bdpt render it"}) {
         EXPECT_NE(r.output.find(text), std::string::npos) << text << "\n" << r.output;
     }
-    EXPECT_EQ(r.output.find("  bdpt "), std::string::npos) << "bdpt costed:\n" << r.output;
+    EXPECT_EQ(r.output.find("  light "), std::string::npos) << "light costed:\n" << r.output;
     for (const std::string& command :
-         {"plan " + scene + " --method bdpt --pilot-spp 2",
-          "render " + scene + " -o " + (dir_ / "x.exr").string() + " --method bdpt --spp 1"}) {
+         {"plan " + scene + " --method light --pilot-spp 2",
+          "render " + scene + " -o " + (dir_ / "x.exr").string() + " --method light --spp 1"}) {
         const RunResult refused = Lightfarm(command);
         EXPECT_NE(refused.status, 0) << command;
-        EXPECT_NE(refused.output.find("method bdpt: medium \"fog\" scatters light (sigma_s > 0): "
-                                      "not yet supported by bdpt; use --method path"),
+        EXPECT_NE(refused.output.find("method light: material \"boundary\" is an interface between "
+                                      "media: not yet supported by light; use --method path"),
                   std::string::npos)
             << command << "\n"
             << refused.output;

@@ -1341,12 +1341,12 @@ TEST_F(Farm, GridMediumFileIsUploadedAndGivesTheLocalBits) {
     std::ofstream(smoky) << scene.dump();
     const std::string job = Submit(smoky, "--spp 4 --seed 2 --tile 16");
     ExpectSameAsLocal(job, smoky, 4, 2);
-    const CliRun bdpt = Farmctl("submit " + smoky + " --method bdpt --spp 4");
-    EXPECT_NE(bdpt.status, 0);
-    EXPECT_NE(bdpt.err.find("method bdpt: the camera is in medium \"smoke\": not yet supported "
-                            "by bdpt; use --method path"),
+    const CliRun ppm = Farmctl("submit " + smoky + " --method ppm --spp 4");
+    EXPECT_NE(ppm.status, 0);
+    EXPECT_NE(ppm.err.find("method ppm: the camera is in medium \"smoke\": not yet supported "
+                           "by ppm; use --method path"),
               std::string::npos)
-        << bdpt.err;
+        << ppm.err;
 }
 
 // Files named inside files (an OBJ's MTL, the MTL's texture) are uploaded with the scene: the

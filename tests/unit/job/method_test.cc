@@ -70,10 +70,10 @@ TEST(Method, OnlyMethodsThatTraceFromTheCameraTakeAnOrthographicCamera) {
     }
 }
 
-// Only the path tracer renders scattering, emitting and grid media and a camera in a medium;
-// the others refuse them naming themselves and the medium. A homogeneous absorber (Beer's
-// law) every method takes.
-TEST(Method, OnlyThePathTracerTakesMediaBeyondAbsorbers) {
+// Only the path tracer and bdpt render scattering and grid media and a camera in a medium, and
+// only the path tracer emitting media; the others refuse them naming themselves and the medium.
+// A homogeneous absorber (Beer's law) every method takes.
+TEST(Method, OnlyThePathTracerAndBdptTakeMediaBeyondAbsorbers) {
     Medium absorber;
     absorber.name = "ink";
     absorber.sigma_a = Rgb(1, 2, 3);
@@ -99,9 +99,15 @@ TEST(Method, OnlyThePathTracerTakesMediaBeyondAbsorbers) {
     for (const auto& [scene, why] : refused) {
         EXPECT_EQ(MediaLimitation(scene), why);
         EXPECT_TRUE(CheckMethodTakesScene(Method::kPath, scene).ok());
+        const bool emits = why.find("emits light") != std::string::npos;
+        EXPECT_EQ(BdptMediaLimitation(scene), emits ? why : "");
         for (const MethodInfo& info : AllMethods()) {
             if (info.method == Method::kPath) continue;
             const absl::Status s = CheckMethodTakesScene(info.method, scene);
+            if (info.method == Method::kBdpt && !emits) {
+                EXPECT_TRUE(s.ok()) << s;
+                continue;
+            }
             EXPECT_EQ(s.code(), absl::StatusCode::kFailedPrecondition) << info.name << ": " << s;
             const std::string name = info.name;
             const std::string expected =

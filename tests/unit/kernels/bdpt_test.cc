@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bdpt_render.h"
 #include "bonferroni.h"
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
@@ -25,116 +26,12 @@
 namespace lf {
 namespace {
 
-using testing::BonferroniZ;
-
-// A frame of BDPT estimates: per pixel the two half estimates (A: even camera samples and their
-// light subpaths, B: odd ones), each its camera mean plus its splat sum x W H / N_h, N_h the
-// camera samples of that half over the frame (lf/job/splat_merge.h's normalisation).
-struct BdptFrame {
-    int width = 0, height = 0;
-    std::vector<Rgb> half[2];
-    RenderStats stats;
-    Rgb Mean(int x, int y) const {
-        const size_t i = size_t(y * width + x);
-        return (half[0][i] + half[1][i]) * 0.5f;
-    }
-};
-
-BdptFrame RenderBdpt(const Scene& scene, uint64_t spp, int max_depth, uint64_t seed = 7) {
-    auto es = EmbreeScene::Build(scene);
-    EXPECT_TRUE(es.ok()) << es.status();
-    const Camera camera(scene.camera, (*es)->origin());
-    SplatRenderSettings settings;
-    settings.max_depth = max_depth;
-    settings.seed = seed;
-    auto renderer = MakeSplatRenderer(Method::kBdpt, **es, camera, settings);
-    EXPECT_TRUE(renderer.ok()) << renderer.status();
-    const int w = camera.width(), h = camera.height();
-    const PixelRect rect{0, 0, w, h};
-    TileSums sums(rect);
-    SplatList splats(w, h);
-    (*renderer)->Render(SplatWork{rect, 0, spp, 0, 0}, sums, splats);
-    TileSums splat_tile(rect);
-    splats.AddTo(splat_tile);
-    BdptFrame frame;
-    frame.width = w;
-    frame.height = h;
-    frame.stats = sums.stats;
-    for (int half = 0; half < 2; ++half) {
-        // Half h holds the camera samples of parity h: spp / 2 of each pixel.
-        const double per_pixel = double(spp / 2);
-        frame.half[half].resize(size_t(w * h));
-        for (int y = 0; y < h; ++y) {
-            for (int x = 0; x < w; ++x) {
-                const PixelSums& s = splat_tile.at(x, y);
-                const Rgb splat(float(s.sum[half][0].Value() / per_pixel),
-                                float(s.sum[half][1].Value() / per_pixel),
-                                float(s.sum[half][2].Value() / per_pixel));
-                frame.half[half][size_t(y * w + x)] = sums.at(x, y).HalfMean(half) + splat;
-            }
-        }
-    }
-    return frame;
-}
-
-// The mean of the channel average over the frame and its standard error from the per-pixel
-// A/B differences (Var of a pixel's mean = E[(A - B)^2] / 4).
-struct Mean {
-    double value = 0, error = 0;
-};
-Mean SplatMean(const BdptFrame& f) {
-    double sum = 0, var = 0;
-    const double n = double(f.width) * f.height;
-    for (int y = 0; y < f.height; ++y) {
-        for (int x = 0; x < f.width; ++x) {
-            const size_t i = size_t(y * f.width + x);
-            const double a = f.half[0][i].Average(), b = f.half[1][i].Average();
-            sum += (a + b) / 2;
-            var += (a - b) * (a - b) / 4;
-        }
-    }
-    return {sum / n, std::sqrt(var) / n};
-}
-
-// Compares BDPT with the path tracer block by block (blocks of side `block`, channel
-// average): z from the A/B half variances of both; every |z| below the Bonferroni threshold.
-// Returns the largest |z|.
-double CompareWithPathTracer(const std::string& name, const Scene& scene, uint64_t bdpt_spp,
-                             uint64_t path_spp, int max_depth, int block = 8) {
-    const BdptFrame bd = RenderBdpt(scene, bdpt_spp, max_depth);
-    const RenderOutput pt = testing::RenderPath(scene, path_spp, max_depth, 3).out;
-    const int bw = bd.width / block, bh = bd.height / block;
-    const double threshold = BonferroniZ(bw * bh);
-    double worst = 0;
-    for (int by = 0; by < bh; ++by) {
-        for (int bx = 0; bx < bw; ++bx) {
-            double m1 = 0, v1 = 0, m2 = 0, v2 = 0;
-            for (int y = by * block; y < (by + 1) * block; ++y) {
-                for (int x = bx * block; x < (bx + 1) * block; ++x) {
-                    const size_t i = size_t(y * bd.width + x);
-                    const double a = bd.half[0][i].Average(), b = bd.half[1][i].Average();
-                    m1 += (a + b) / 2;
-                    v1 += (a - b) * (a - b) / 4;
-                    const double pa = pt.image.Pixel(x, y, "A.").Average();
-                    const double pb = pt.image.Pixel(x, y, "B.").Average();
-                    m2 += (pa + pb) / 2;
-                    v2 += (pa - pb) * (pa - pb) / 4;
-                }
-            }
-            const double n = double(block) * block;
-            m1 /= n;
-            m2 /= n;
-            const double se = std::sqrt(v1 + v2) / n;
-            const double z = se > 0 ? (m1 - m2) / se : (m1 == m2 ? 0 : 1e9);
-            worst = std::max(worst, std::abs(z));
-            EXPECT_LT(std::abs(z), threshold) << name << ": block " << bx << ", " << by << ": bdpt "
-                                              << m1 << ", path " << m2 << " +- " << se;
-        }
-    }
-    std::printf("[bdpt] %s: %d blocks, largest |z| %.2f (threshold %.2f)\n", name.c_str(), bw * bh,
-                worst, threshold);
-    return worst;
-}
+using testing::BdptFrame;
+using testing::CompareWithPathTracer;
+using testing::LoadSmall;
+using testing::Mean;
+using testing::RenderBdpt;
+using testing::SplatMean;
 
 // A unit sphere about the origin, albedo 0.5 on both faces, seen from inside.
 Scene FurnaceSphere(float le) {
@@ -198,14 +95,6 @@ TEST(Bdpt, WhiteFurnaceWithUnlimitedDepthStopsAtTheCap) {
     EXPECT_LE(m.value, 0.5 * (1 + 2 * kBdptUnlimitedDepth));
 }
 
-Scene LoadSmall(const std::string& file, int size) {
-    SceneOptions options;
-    options.width = options.height = size;
-    absl::StatusOr<Scene> scene = LoadScene(std::string(LF_TEST_SCENES) + "/" + file, options);
-    EXPECT_TRUE(scene.ok()) << scene.status();
-    return *scene;
-}
-
 TEST(Bdpt, MatchesThePathTracerOnTheCornellBox) {
     CompareWithPathTracer("cornell_box", LoadSmall("cornell_box.json", 32), 256, 256, 5);
 }
@@ -234,20 +123,8 @@ TEST(Bdpt, RendersThePointLightCausticThePathTracerMisses) {
     const RenderOutput pt = testing::RenderPath(scene, 512, 8, 3).out;
     // Block (2, 3) of the 32 x 32 frame: x 16..23, y 24..31, the floor around the point
     // where the light's caustic lands, in front of the sphere.
-    double m1 = 0, v1 = 0, m2 = 0, v2 = 0;
-    for (int y = 24; y < 32; ++y) {
-        for (int x = 16; x < 24; ++x) {
-            const size_t i = size_t(y * bd.width + x);
-            const double a = bd.half[0][i].Average(), b = bd.half[1][i].Average();
-            m1 += (a + b) / 128;
-            v1 += (a - b) * (a - b) / 4;
-            const double pa = pt.image.Pixel(x, y, "A.").Average();
-            const double pb = pt.image.Pixel(x, y, "B.").Average();
-            m2 += (pa + pb) / 128;
-            v2 += (pa - pb) * (pa - pb) / 4;
-        }
-    }
-    const double se = std::sqrt(v1 + v2) / 64;
+    const testing::BlockMeans block = testing::CompareBlock(bd, pt.image, 16, 24, 8);
+    const double m1 = block.bdpt, m2 = block.path, se = block.se;
     std::printf("[bdpt] point-light caustic block: bdpt %.5f, path %.5f +- %.5f\n", m1, m2, se);
     EXPECT_GT(m1 - m2, 5 * se);
 }
@@ -447,49 +324,54 @@ TEST(Bdpt, MatchesThePathTracerThroughTintedPrincipledGlass) {
     CompareWithPathTracer("tinted principled glass", scene, 256, 512, 8);
 }
 
+// Also through media, whose delta and ratio tracking draw from each sample's own stream.
 TEST(Bdpt, AnySplitOfTheWorkGivesTheSameBits) {
-    const Scene scene = LoadSmall("materials.json", 16);
-    auto es = EmbreeScene::Build(scene);
-    ASSERT_TRUE(es.ok());
-    const Camera camera(scene.camera, (*es)->origin());
-    SplatRenderSettings settings;
-    settings.max_depth = 6;
-    settings.seed = 11;
-    const BdptRenderer renderer(**es, camera, settings);
-    const PixelRect rect{0, 0, 16, 16};
-    TileSums whole(rect);
-    SplatList whole_splats(16, 16);
-    renderer.Render(SplatWork{rect, 0, 6, 0, 0}, whole, whole_splats);
+    for (const char* file : {"materials.json", "media/cornell_fog.json"}) {
+        SCOPED_TRACE(file);
+        const Scene scene = LoadSmall(file, 16);
+        auto es = EmbreeScene::Build(scene);
+        ASSERT_TRUE(es.ok());
+        const Camera camera(scene.camera, (*es)->origin());
+        SplatRenderSettings settings;
+        settings.max_depth = 6;
+        settings.seed = 11;
+        const BdptRenderer renderer(**es, camera, settings);
+        const PixelRect rect{0, 0, 16, 16};
+        TileSums whole(rect);
+        SplatList whole_splats(16, 16);
+        renderer.Render(SplatWork{rect, 0, 6, 0, 0}, whole, whole_splats);
 
-    // The same samples as two sample ranges over two halves of the rect, merged.
-    TileSums merged(rect);
-    SplatList merged_splats(16, 16);
-    for (const PixelRect part : {PixelRect{0, 0, 16, 7}, PixelRect{0, 7, 16, 9}}) {
-        for (const auto& [begin, end] : {std::pair<uint64_t, uint64_t>{0, 4}, {4, 6}}) {
-            TileSums sums(part);
-            SplatList splats(16, 16);
-            renderer.Render(SplatWork{part, begin, end, 0, 0}, sums, splats);
-            for (int y = part.y0; y < part.y0 + part.height; ++y) {
-                for (int x = 0; x < 16; ++x) merged.at(x, y) += sums.at(x, y);
-            }
-            merged.stats += sums.stats;
-            merged_splats += splats;
-        }
-    }
-    for (int y = 0; y < 16; ++y) {
-        for (int x = 0; x < 16; ++x) {
-            const PixelSums& a = whole.at(x, y);
-            const PixelSums& b = merged.at(x, y);
-            for (int h = 0; h < 2; ++h) {
-                EXPECT_EQ(a.count[h], b.count[h]);
-                for (int c = 0; c < 3; ++c) EXPECT_EQ(a.sum[h][c], b.sum[h][c]) << x << ", " << y;
+        // The same samples as two sample ranges over two halves of the rect, merged.
+        TileSums merged(rect);
+        SplatList merged_splats(16, 16);
+        for (const PixelRect part : {PixelRect{0, 0, 16, 7}, PixelRect{0, 7, 16, 9}}) {
+            for (const auto& [begin, end] : {std::pair<uint64_t, uint64_t>{0, 4}, {4, 6}}) {
+                TileSums sums(part);
+                SplatList splats(16, 16);
+                renderer.Render(SplatWork{part, begin, end, 0, 0}, sums, splats);
+                for (int y = part.y0; y < part.y0 + part.height; ++y) {
+                    for (int x = 0; x < 16; ++x) merged.at(x, y) += sums.at(x, y);
+                }
+                merged.stats += sums.stats;
+                merged_splats += splats;
             }
         }
+        for (int y = 0; y < 16; ++y) {
+            for (int x = 0; x < 16; ++x) {
+                const PixelSums& a = whole.at(x, y);
+                const PixelSums& b = merged.at(x, y);
+                for (int h = 0; h < 2; ++h) {
+                    EXPECT_EQ(a.count[h], b.count[h]);
+                    for (int c = 0; c < 3; ++c)
+                        EXPECT_EQ(a.sum[h][c], b.sum[h][c]) << x << ", " << y;
+                }
+            }
+        }
+        EXPECT_EQ(whole.stats.rays, merged.stats.rays);
+        EXPECT_EQ(whole.stats.samples, merged.stats.samples);
+        EXPECT_FALSE(whole_splats.entries().empty());
+        EXPECT_EQ(whole_splats.entries(), merged_splats.entries());
     }
-    EXPECT_EQ(whole.stats.rays, merged.stats.rays);
-    EXPECT_EQ(whole.stats.samples, merged.stats.samples);
-    EXPECT_FALSE(whole_splats.entries().empty());
-    EXPECT_EQ(whole_splats.entries(), merged_splats.entries());
 }
 
 TEST(Bdpt, RefusesPixelFiltersOtherThanTheBox) {

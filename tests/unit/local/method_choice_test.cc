@@ -57,8 +57,8 @@ TEST(MethodChoice, AutoPicksTheMethodTheSceneRequires) {
     EXPECT_EQ(dark.why, "the scene has no lights: the image is black whatever the method");
 }
 
-// Scattering media are the path tracer's alone: auto takes it where it would otherwise pick
-// Whitted; a homogeneous absorber (Beer's law) leaves the choice as it was.
+// Scattering media are the path tracer's and bdpt's alone: auto takes the path tracer where it
+// would otherwise pick Whitted; a homogeneous absorber (Beer's law) leaves the choice as it was.
 TEST(MethodChoice, AutoTakesThePathTracerForMediaOnlyItRenders) {
     const std::string lit =
         R"(, "lights": [{"type": "point", "position": [0, 2, 0], "power": [5, 5, 5]}]})";
@@ -68,7 +68,8 @@ TEST(MethodChoice, AutoTakesThePathTracerForMediaOnlyItRenders) {
         std::nullopt);
     EXPECT_EQ(fog.method, Method::kPath);
     EXPECT_EQ(fog.why,
-              "medium \"fog\" scatters light (sigma_s > 0): only the path tracer renders it");
+              "medium \"fog\" scatters light (sigma_s > 0): only the path tracer and bdpt render "
+              "it");
 
     const MethodChoice absorber = ChooseMethod(
         Parse(std::string(kPlane) +

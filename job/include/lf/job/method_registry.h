@@ -65,11 +65,14 @@ Method MethodOf(const JobSpec& spec);
 // method and the pixel filter for a splatting method and a filter other than the box, or for a
 // splatting method and an orthographic camera; the method's scene_refusal otherwise.
 absl::Status CheckMethodTakesScene(Method method, const Scene& scene);
-// What only the path tracer renders of the scene's participating media: "" when every medium is
-// a homogeneous absorber (Beer's law: no scattering, no emission) and the camera is in vacuum,
-// else why not ("medium \"fog\" scatters light (sigma_s > 0)"). Every other method's
-// scene_refusal refuses such scenes.
+// What only the path tracer and bdpt render of the scene's participating media: "" when every
+// medium is a homogeneous absorber (Beer's law: no scattering, no emission), no surface is an
+// interface and the camera is in vacuum, else why not ("medium \"fog\" scatters light
+// (sigma_s > 0)"). The scene_refusal of whitted, radiosity, light and ppm refuses such scenes.
 std::string MediaLimitation(const Scene& scene);
+// What of the media bdpt does not render: "" unless a medium emits ("medium \"fire\" emits
+// light"; bdpt's subpaths neither hit nor sample emissive media). Its scene_refusal.
+std::string BdptMediaLimitation(const Scene& scene);
 // The pixel filter part of CheckMethodTakesScene, for a camera already built.
 absl::Status CheckMethodTakesFilter(Method method, const PixelFilter& filter);
 

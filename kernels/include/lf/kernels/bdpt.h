@@ -21,9 +21,31 @@
 // lights: the emission pick stands for both).
 //
 // Light subpaths carry importance: the adjoint BSDF (no 1/eta^2 across refraction) and the
-// shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) of Veach's thesis 5.3. Paths in
-// the interiors of solid transmitters are attenuated by Beer's law as in the path tracer, on
-// both subpaths and on connection segments; both subpaths start outside every interior.
+// shading-normal correction |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|) of Veach's thesis 5.3.
+//
+// Participating media (pbrt-v4's BDPT with medium vertices; VolPathTracer is the reference).
+// Both subpaths track the medium they travel in by the shapes' MediumInterfaces: the camera
+// subpath starts in Scene::camera_medium; the light subpath in the medium at its light, found
+// by following the segment from the camera to the light's point through every surface on the
+// way (then, for an area light whose shape has an interface, the side it emits into), which
+// needs no model change and is right wherever the interfaces enclose their media consistently.
+// Inside a scattering medium a subpath samples distances by delta tracking
+// (SceneMedia::SampleTMaj): a real collision is absorbed (the subpath ends) or scatters into a
+// medium vertex, sampled by the Henyey-Greenstein phase function and connectible like a
+// surface; its densities carry no cosine. Homogeneous absorbers (solids' interiors) take Beer's
+// law exactly. Interface surfaces are no vertices: walks and connections pass through them.
+// A connection segment's transmittance is estimated by ratio tracking through every medium on
+// the way (Beer's law through absorbers); any other surface blocks it.
+// Chromatic media: a hero channel per camera sample (uniform over the three), shared by both
+// subpaths, drives the distance sampling; each vertex keeps beta, its throughput over the
+// hero's density, and r, the density with each channel as the hero over the hero's own. A
+// strategy's estimate is divided by the mean of the two subpaths' r multiplied channel by
+// channel: one-sample MIS (balance heuristic) over the choice of the hero, unbiased for every
+// channel whichever hero was drawn. Ratio tracking is unbiased in every channel for any hero,
+// so the connection's transmittance needs no such weight. The MIS weights over strategies
+// ignore transmittance and distance densities (as pbrt-v4's): they are the same fictitious
+// densities in every strategy's weight, so they still sum to 1 over the strategies that can
+// make a path. Emissive media are not emitters here: lf/job/method_registry.h refuses them.
 //
 // Depth and roulette: max_depth counts bounces as the path tracer does: a path of s + t
 // vertices has s + t - 2 bounces, and strategies with more than max_depth are not made, so the
@@ -45,9 +67,10 @@
 // only when the camera has a lens), the light subpath's emission (1D light pick, 2D position,
 // 2D direction), then four draws per camera vertex (2D: next-event light pick and BSDF lobe;
 // 2D next-event point; 2D BSDF direction; 1D roulette), then four per light vertex (2D lobe;
-// 2D lens point of its t = 1 connection; 2D direction; 1D roulette). The result is a pure
-// function of (seed, pixel, sample): any split of the samples over tasks and threads gives the
-// same sums.
+// 2D lens point of its t = 1 connection; 2D direction; 1D roulette). The hero channel and the
+// tracking through media draw from a MediumRng seeded by (seed, pixel, sample), not from the
+// sampler. The result is a pure function of (seed, pixel, sample): any split of the samples
+// over tasks and threads gives the same sums.
 //
 // Where results go. The t >= 2 strategies of a sample add up to one camera sample of its pixel
 // (PixelSums::Add with the sample's index); each t = 1 contribution is splatted into the
@@ -64,6 +87,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/light_emission.h"
 #include "lf/kernels/lights.h"
+#include "lf/kernels/media.h"
 #include "lf/kernels/splat_renderer.h"
 
 namespace lf {
@@ -96,16 +120,21 @@ class BdptRenderer : public SplatRenderer {
     struct Scratch;
     using Path = std::vector<BdptVertex>;
 
-    // Extends `path` (whose last vertex is where `ray` starts) by up to `max_vertices` vertices.
-    void Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool importance, Sampler& sampler,
-              Path& path, RenderStats& stats) const;
-    // The light subpath of the emission numbers at `time` in the shutter; empty when the sample
-    // carries no light.
+    struct Spectral;
+
+    // Extends `path` (whose last vertex is where `ray` starts, in `medium`) by up to
+    // `max_vertices` vertices.
+    void Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool importance, int medium,
+              Spectral& spectral, Sampler& sampler, Path& path, RenderStats& stats) const;
+    // The light subpath of the emission numbers at `time` in the shutter (`eye`: the camera
+    // vertex, whose medium is known); empty when the sample carries no light.
     void LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_dir, float time,
-                      Sampler& sampler, Path& path, RenderStats& stats) const;
+                      const BdptVertex& eye, Spectral& spectral, Sampler& sampler, Path& path,
+                      RenderStats& stats) const;
     // Strategy (s, t) for t >= 2 (camera sum) or t = 1 (then *raster is set when it
     // contributes); 0 when it does not apply or is occluded. Weighted.
-    Rgb Connect(Path& light, Path& camera, int s, int t, Vec2* raster, RenderStats& stats) const;
+    Rgb Connect(Path& light, Path& camera, int s, int t, Vec2* raster, Spectral& spectral,
+                RenderStats& stats) const;
     float MisWeight(Path& light, Path& camera, int s, int t) const;
 
     // Densities (area measure at `next`, or solid angle when next is at infinity).
@@ -120,18 +149,28 @@ class BdptRenderer : public SplatRenderer {
     // f times the cosine at v towards unit direction `dir` (importance: the adjoint BSDF and the
     // shading-normal correction).
     Rgb FCos(const BdptVertex& v, const Vec3& dir, bool importance) const;
-    // Beer's law along the segment from surface vertex `from` towards `to`, 0 when occluded.
-    Rgb Transmission(const BdptVertex& from, const BdptVertex& to, RenderStats& stats) const;
-    // The interior a ray leaving surface vertex v in direction dir travels through, or -1.
+    // The transmittance along the segment from scattering vertex `from` towards `to` through
+    // interface surfaces, 0 when another surface blocks it.
+    Rgb Transmission(const BdptVertex& from, const BdptVertex& to, Spectral& spectral,
+                     RenderStats& stats) const;
+    // Along `ray` over [0, t_end) in `medium`: Beer's law or a ratio-tracking estimate.
+    Rgb SegmentTransmittance(int medium, const Ray& ray, float t_end, Spectral& spectral) const;
+    // The medium a ray leaving scattering vertex v in direction dir travels through, or -1.
     int MediumToward(const BdptVertex& v, const Vec3& dir) const;
+    // The medium the light subpath starting at `light` leaves into (see the file comment).
+    int MediumAtLight(const BdptVertex& eye, const BdptVertex& light, RenderStats& stats) const;
 
     const EmbreeScene& scene_;
     const Camera& camera_;
     SplatRenderSettings settings_;
     LightSampler lights_;
     EmissionSampler emission_;
+    const SceneMedia& media_;
     float infinite_pdf_pos_;  // 1 / (pi R^2): the density of the disk lights at infinity use
     bool has_infinite_;       // the scene has a sky or a sun disk that escaping rays see
+    // The scene has media beyond homogeneous absorbers, interface surfaces or a camera in a
+    // medium: connections cross interfaces and the light subpath looks up its medium.
+    bool volumetric_ = false;
 };
 
 }  // namespace lf

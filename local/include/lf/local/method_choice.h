@@ -53,7 +53,7 @@ struct MethodChoice {
     std::string why;
 };
 
-// `--method auto`: the path tracer for media only it renders (lf::MediaLimitation); whitted
+// `--method auto`: the path tracer for media only it and bdpt render (lf::MediaLimitation); whitted
 // where it is exact (no interreflection, no caustics: it then equals the path tracer, faster,
 // and has no meshing error); radiosity where it is exact (view-independent, noiseless); bdpt
 // for caustics from small emitters; otherwise the path tracer.
