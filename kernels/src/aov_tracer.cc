@@ -35,9 +35,7 @@ std::optional<FirstHit> TraceFirstHit(const EmbreeScene& scene, const Ray& camer
         const Material& material = scene.scene().materials[size_t(hit->material)];
         if (material.type == Material::Type::kInterface) {
             // A boundary between media is not a surface: the first hit lies beyond it.
-            SurfacePoint crossed{hit->p, hit->p_error, hit->n};
-            crossed.time = hit->time;
-            ray = SpawnRay(crossed, ray.d);
+            ray = SpawnRay(HitPoint(*hit), ray.d);
             continue;
         }
         const Shading sh = Shade(scene, *hit, -ray.d);

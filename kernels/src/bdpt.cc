@@ -108,11 +108,6 @@ SurfacePoint Leaving(const BdptVertex& v, const Vec3& dir) {
     return v.type == BdptVertex::Type::kSurface ? v.sh.Leaving(dir) : v.point;
 }
 
-// The point of a surface hit that a ray crossing it goes on from.
-SurfacePoint Crossing(const SurfaceHit& hit) {
-    return {.p = hit.p, .p_error = hit.p_error, .n = hit.n, .time = hit.time};
-}
-
 // The emitter surface a light or emitter vertex lies on, for LightSampler::Pdf and InterfaceAt.
 SurfaceHit HitOf(const BdptVertex& v) {
     return {.p = v.p,
@@ -287,7 +282,7 @@ Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to, Spe
         }
         if (!hit) return tr;
         medium = MediumAfter(scene_.scene(), medium, *hit, ray.d);
-        ray = SpawnRayTo(Crossing(*hit), to.point);
+        ray = SpawnRayTo(HitPoint(*hit), to.point);
     }
 }
 
@@ -330,7 +325,7 @@ int BdptRenderer::MediumAtLight(const BdptVertex& eye, const BdptVertex& light,
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
         if (!hit) break;
         medium = MediumAfter(scene, medium, *hit, ray.d);
-        ray = SpawnRayTo(Crossing(*hit), light.point);
+        ray = SpawnRayTo(HitPoint(*hit), light.point);
     }
     // An area light's own surface separates the side the segment arrives on from the side
     // it emits into.
@@ -419,7 +414,7 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
         if (!scattered_at && materials[size_t(hit->material)].type == Material::Type::kInterface) {
             // Not a vertex: the ray goes on into the medium beyond (its density is unchanged).
             medium = MediumAfter(scene_.scene(), medium, *hit, ray.d);
-            ray = SpawnRay(Crossing(*hit), ray.d);
+            ray = SpawnRay(HitPoint(*hit), ray.d);
             continue;
         }
         BdptVertex v;

@@ -127,12 +127,7 @@ Rgb VolPathTracer::SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& f
         if (t_ray.IsBlack()) return Rgb();
         if (!hit) break;
         medium = MediumAfter(scene_.scene(), medium, *hit, ray.d);
-        SurfacePoint crossed;
-        crossed.p = hit->p;
-        crossed.p_error = hit->p_error;
-        crossed.n = hit->n;
-        crossed.time = hit->time;
-        ray = SpawnRayTo(crossed, ls->point);
+        ray = SpawnRayTo(HitPoint(*hit), ls->point);
     }
     r_l *= state.r_u * ls->pdf;
     r_u *= state.r_u * pdf_of(ls->wi);
@@ -271,12 +266,7 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
         if (material.type == Material::Type::kInterface) {
             // Neither a bounce nor a scattering event: the ray goes on into the other medium.
             medium = MediumAfter(scene, medium, *hit, ray.d);
-            SurfacePoint crossed;
-            crossed.p = hit->p;
-            crossed.p_error = hit->p_error;
-            crossed.n = hit->n;
-            crossed.time = hit->time;
-            ray = SpawnRay(crossed, ray.d);
+            ray = SpawnRay(HitPoint(*hit), ray.d);
             continue;
         }
         const Vec3& ng = hit->n;

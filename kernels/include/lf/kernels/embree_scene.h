@@ -46,6 +46,12 @@ struct SurfacePoint {
     float time = 0;  // in the shutter (Ray::time): rays spawned from it leave then
 };
 
+// A hit as a point rays leave from, with its geometric normal and no shading: where a ray
+// crossing an interface surface goes on from.
+inline SurfacePoint HitPoint(const SurfaceHit& hit) {
+    return {.p = hit.p, .p_error = hit.p_error, .n = hit.n, .time = hit.time};
+}
+
 // A ray origin just outside p's error box on the side of w.
 // The area of the triangle p0 p1 p2: the one formula of the light lists and their densities.
 inline float TriangleAreaOf(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
