@@ -1159,7 +1159,7 @@ TEST_F(Cli, WhittedRendersAndUnknownMethodsAreRefused) {
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.method")), "whitted");
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.lightSampling")), "bvh");
 
-    for (const std::string command :
+    for (const std::string& command :
          {"render " + scene + " -o " + exr, "submit " + scene, "plan " + scene}) {
         const RunResult unknown = Lightfarm(command + " --method photon");
         EXPECT_NE(unknown.status, 0);

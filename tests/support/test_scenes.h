@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cmath>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "lf/core/image.h"
@@ -85,6 +87,32 @@ inline MeanAndError ChannelMean(const Image& image, const std::string& channel) 
     const double mean = sum / n;
     const double var = std::max(0.0, (sum2 - n * mean * mean) / (n - 1));
     return {mean, std::sqrt(var / n)};
+}
+
+// Per block of block x block pixels (the image's sides multiples of it): the mean of `channel`
+// and the variance of that mean, from the half-sample buffers A.channel and B.channel
+// (E[(A - B)^2] / 4 is the variance of the pixel mean (A + B) / 2).
+inline std::vector<std::pair<double, double>> BlockMeans(const Image& image,
+                                                         const std::string& channel, int block) {
+    const std::vector<float>& m = *image.FindChannel(channel);
+    const std::vector<float>& a = *image.FindChannel("A." + channel);
+    const std::vector<float>& b = *image.FindChannel("B." + channel);
+    const double n = double(block) * block;
+    std::vector<std::pair<double, double>> blocks;
+    for (int by = 0; by < image.height(); by += block) {
+        for (int bx = 0; bx < image.width(); bx += block) {
+            double sum = 0, var = 0;
+            for (int y = by; y < by + block; ++y) {
+                for (int x = bx; x < bx + block; ++x) {
+                    const size_t i = size_t(y) * image.width() + x;
+                    sum += m[i];
+                    var += (double(a[i]) - b[i]) * (double(a[i]) - b[i]) / 4;
+                }
+            }
+            blocks.push_back({sum / n, var / (n * n)});
+        }
+    }
+    return blocks;
 }
 
 }  // namespace lf::testing

@@ -124,30 +124,6 @@ TEST(PointLight, LambertianPlaneMatchesInverseSquareLaw) {
 namespace lf {
 namespace {
 
-// Per 8x8 block: mean radiance and the variance of that mean, from the half-sample buffers
-// (E[(A - B)^2] / 4 is the variance of the pixel mean (A + B) / 2).
-std::vector<std::pair<double, double>> BlockMeans(const Image& image, int channel) {
-    const char* names[3] = {"R", "G", "B"};
-    const std::vector<float>& m = *image.FindChannel(names[channel]);
-    const std::vector<float>& a = *image.FindChannel(std::string("A.") + names[channel]);
-    const std::vector<float>& b = *image.FindChannel(std::string("B.") + names[channel]);
-    std::vector<std::pair<double, double>> blocks;
-    for (int by = 0; by < image.height(); by += 8) {
-        for (int bx = 0; bx < image.width(); bx += 8) {
-            double sum = 0, var = 0;
-            for (int y = by; y < by + 8; ++y) {
-                for (int x = bx; x < bx + 8; ++x) {
-                    const size_t i = size_t(y) * image.width() + x;
-                    sum += m[i];
-                    var += (double(a[i]) - b[i]) * (double(a[i]) - b[i]) / 4;
-                }
-            }
-            blocks.push_back({sum / 64, var / (64.0 * 64.0)});
-        }
-    }
-    return blocks;
-}
-
 // The Cornell box moved 10^5 units from the origin renders the same image up to noise.
 TEST(FarFromOrigin, TranslatedCornellBoxMatches) {
     absl::StatusOr<Scene> near = LoadScene(std::string(LF_TEST_SCENES) + "/cornell_box.json");
@@ -163,7 +139,9 @@ TEST(FarFromOrigin, TranslatedCornellBoxMatches) {
     const RenderOutput a = Render(*near, 64), b = Render(far, 64);
     EXPECT_EQ(b.stats.invalid_samples, 0u);
     for (int c = 0; c < 3; ++c) {
-        const auto blocks_a = BlockMeans(a.image, c), blocks_b = BlockMeans(b.image, c);
+        const char* names[3] = {"R", "G", "B"};
+        const auto blocks_a = testing::BlockMeans(a.image, names[c], 8),
+                   blocks_b = testing::BlockMeans(b.image, names[c], 8);
         for (size_t i = 0; i < blocks_a.size(); ++i) {
             const double sigma = std::sqrt(blocks_a[i].second + blocks_b[i].second);
             EXPECT_NEAR(blocks_a[i].first, blocks_b[i].first, kSigmas * sigma + 1e-6)

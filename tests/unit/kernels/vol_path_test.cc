@@ -273,32 +273,9 @@ TEST(VolPath, HalfAlbedoSphereMatchesAnIndependentRandomWalk) {
     }
 }
 
-// Per 4x4 block of a 16x16 image: the mean and the variance of that mean, from the
-// half-sample buffers.
-std::vector<std::pair<double, double>> BlockMeans(const Image& image, const std::string& c) {
-    const std::vector<float>& m = *image.FindChannel(c);
-    const std::vector<float>& a = *image.FindChannel("A." + c);
-    const std::vector<float>& b = *image.FindChannel("B." + c);
-    std::vector<std::pair<double, double>> blocks;
-    for (int by = 0; by < image.height(); by += 4) {
-        for (int bx = 0; bx < image.width(); bx += 4) {
-            double sum = 0, var = 0;
-            for (int y = by; y < by + 4; ++y) {
-                for (int x = bx; x < bx + 4; ++x) {
-                    const size_t i = size_t(y) * image.width() + x;
-                    sum += m[i];
-                    var += (double(a[i]) - b[i]) * (double(a[i]) - b[i]) / 4;
-                }
-            }
-            blocks.push_back({sum / 16, var / (16.0 * 16.0)});
-        }
-    }
-    return blocks;
-}
-
 void ExpectSameImage(const Image& a, const Image& b) {
     for (const char* c : {"R", "G", "B"}) {
-        const auto blocks_a = BlockMeans(a, c), blocks_b = BlockMeans(b, c);
+        const auto blocks_a = testing::BlockMeans(a, c, 4), blocks_b = testing::BlockMeans(b, c, 4);
         for (size_t i = 0; i < blocks_a.size(); ++i) {
             const double sigma = std::sqrt(blocks_a[i].second + blocks_b[i].second);
             EXPECT_NEAR(blocks_a[i].first, blocks_b[i].first, kSigmas * sigma + 1e-5)
