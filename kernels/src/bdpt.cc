@@ -277,7 +277,10 @@ Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to, Spe
             return Rgb(0);
         }
         if (medium >= 0) {
-            tr *= SegmentTransmittance(medium, ray, hit ? hit->t : ray.t_max, spectral);
+            // Towards a light at infinity the medium goes on past the scene, as for a camera
+            // path that escapes (VolPathTracer does the same).
+            const float t_end = hit ? hit->t : to.infinite ? kInfinity : ray.t_max;
+            tr *= SegmentTransmittance(medium, ray, t_end, spectral);
             if (tr.IsBlack()) return tr;
         }
         if (!hit) return tr;
@@ -393,6 +396,11 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
             }
         }
         if (!scattered_at && !hit) {
+            // An escape through a Beer's-law absorber crosses an infinite stretch of it.
+            if (medium >= 0 && media_.IsHomogeneousAbsorber(medium)) {
+                beta *= Attenuation(scene_, medium, kInfinity);
+                if (beta.IsBlack()) return;
+            }
             if (!importance && has_infinite_) {
                 BdptVertex v;
                 v.type = BdptVertex::Type::kLight;
@@ -552,8 +560,17 @@ void BdptRenderer::LightSubpath(float u_pick, const Vec2& u_pos, const Vec2& u_d
     v.beta = es->le * (cos / (es->pick * es->pdf_pos * es->pdf_dir));
     path.push_back(v);
     const int max_vertices = settings_.max_depth < 0 ? kBdptUnlimitedDepth : settings_.max_depth;
-    Walk(es->ray(), path[0].beta, es->pdf_dir, max_vertices, true, MediumAtLight(eye, v, stats),
-         spectral, sampler, path, stats);
+    const int medium = MediumAtLight(eye, v, stats);
+    if (v.infinite && medium >= 0) {
+        // Light from infinity has crossed the medium all the way from there to the disk it
+        // starts on: its transmittance (0 for a medium that fills all space), estimated by
+        // ratio tracking outwards, as escaping camera paths and shadow rays see it.
+        const Ray outward{es->point.p, -es->w, kInfinity, es->point.time};
+        path[0].beta *= SegmentTransmittance(medium, outward, kInfinity, spectral);
+        if (path[0].beta.IsBlack()) return;
+    }
+    Walk(es->ray(), path[0].beta, es->pdf_dir, max_vertices, true, medium, spectral, sampler, path,
+         stats);
 }
 
 float BdptRenderer::MisWeight(Path& light, Path& camera, int s, int t) const {

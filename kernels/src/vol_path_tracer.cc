@@ -84,13 +84,13 @@ Rgb VolPathTracer::SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& f
     for (;;) {
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
-        if (hit && scene_.scene().materials[size_t(hit->material)].type !=
-                       Material::Type::kInterface) {
+        if (hit &&
+            scene_.scene().materials[size_t(hit->material)].type != Material::Type::kInterface) {
             return Rgb();
         }
         // Past the last surface towards a light at infinity the medium goes on for ever, as it
         // does for a ray that escapes: both strategies must see the same attenuation.
-        const float t_end = hit                ? hit->t
+        const float t_end = hit               ? hit->t
                             : ls->at_infinity ? std::numeric_limits<float>::infinity()
                                               : ray.t_max;
         if (medium >= 0 && media_.IsHomogeneousAbsorber(medium)) {
@@ -206,15 +206,13 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
                             here, Vec3(), [&](const Vec3&) { return here; },
                             [&](const Vec3&) { return medium; }, state, u_choice.x, u_light, rng,
                             [&](const Vec3& wi) { return Rgb(HenyeyGreenstein(Dot(d, wi), g)); },
-                            [&](const Vec3& wi) { return HenyeyGreenstein(Dot(d, wi), g); },
-                            stats);
+                            [&](const Vec3& wi) { return HenyeyGreenstein(Dot(d, wi), g); }, stats);
                         const PhaseSample ps = SampleHenyeyGreenstein(d, g, u_bsdf);
                         if (!(ps.pdf > 0)) {
                             terminated = true;
                             return false;
                         }
-                        if (depth > kRouletteStartDepth &&
-                            Roulette(state, eta_scale, u_roulette)) {
+                        if (depth > kRouletteStartDepth && Roulette(state, eta_scale, u_roulette)) {
                             terminated = true;
                             return false;
                         }
@@ -306,8 +304,7 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
                     if (!sh.SidesAgree(-ray.d, wi_world, wi.z * wo.z > 0)) return Rgb();
                     return bsdf.Eval(wo, wi) * std::abs(wi.z);
                 },
-                [&](const Vec3& wi_world) { return bsdf.Pdf(wo, frame.ToLocal(wi_world)); },
-                stats);
+                [&](const Vec3& wi_world) { return bsdf.Pdf(wo, frame.ToLocal(wi_world)); }, stats);
         }
         const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
         if (!bs || !(bs->pdf > 0)) break;

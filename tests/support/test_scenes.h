@@ -92,8 +92,9 @@ inline MeanAndError ChannelMean(const Image& image, const std::string& channel) 
 // Per block of block x block pixels (the image's sides multiples of it): the mean of `channel`
 // and the variance of that mean, from the half-sample buffers A.channel and B.channel
 // (E[(A - B)^2] / 4 is the variance of the pixel mean (A + B) / 2).
-inline std::vector<std::pair<double, double>> BlockMeans(const Image& image,
-                                                         const std::string& channel, int block) {
+inline std::vector<std::pair<double, double>> BlockStatistics(const Image& image,
+                                                              const std::string& channel,
+                                                              int block) {
     const std::vector<float>& m = *image.FindChannel(channel);
     const std::vector<float>& a = *image.FindChannel("A." + channel);
     const std::vector<float>& b = *image.FindChannel("B." + channel);

@@ -153,5 +153,22 @@ TEST(BdptMedia, FindsTheMediumOfALampInsideAFogBall) {
     CompareWithPathTracer("lamp in fog", scene, 256, 512, 5);
 }
 
+TEST(BdptMedia, MatchesThePathTracerInFogThatFillsAllSpace) {
+    // The camera's fog has no boundary: light from the sky and the sun crosses an infinite
+    // stretch of it and never arrives, whichever strategy carries it; the lamp's light does.
+    Scene scene;
+    scene.materials.push_back({.name = "floor", .reflectance = Rgb(0.6f)});
+    scene.materials.push_back({.name = "lamp", .reflectance = Rgb(0), .emission = Rgb(6, 5, 4)});
+    testing::AddQuad(scene, 0, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2});
+    testing::AddQuad(scene, 1, {-0.3, 1, -0.3}, {0.3, 1, -0.3}, {0.3, 1, 0.3},
+                     {-0.3, 1, 0.3});  // facing down
+    scene.media.push_back(Fog(Rgb(0.05f), Rgb(0.4f, 0.3f, 0.2f), 0.3f));
+    scene.camera_medium = 0;
+    scene.environment = EnvironmentLight{Rgb(1)};
+    scene.directional_lights.push_back({Normalize(Vec3d(0.3, -1, 0.2)), Rgb(3), 0});
+    scene.camera = testing::SquareCamera({0, 1.2, 2.5}, {0, 0.3, 0}, {0, 1, 0}, 60, 32);
+    CompareWithPathTracer("fog everywhere", scene, 256, 512, 5);
+}
+
 }  // namespace
 }  // namespace lf

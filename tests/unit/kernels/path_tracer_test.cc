@@ -6,7 +6,6 @@
 
 #include <numbers>
 
-#include "splat_scenes.h"
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/embree_scene.h"
@@ -14,6 +13,7 @@
 #include "lf/local/local_executor.h"
 #include "plane_render.h"
 #include "render_path.h"
+#include "splat_scenes.h"
 #include "test_scenes.h"
 
 namespace lf {
@@ -140,8 +140,8 @@ TEST(FarFromOrigin, TranslatedCornellBoxMatches) {
     EXPECT_EQ(b.stats.invalid_samples, 0u);
     for (int c = 0; c < 3; ++c) {
         const char* names[3] = {"R", "G", "B"};
-        const auto blocks_a = testing::BlockMeans(a.image, names[c], 8),
-                   blocks_b = testing::BlockMeans(b.image, names[c], 8);
+        const auto blocks_a = testing::BlockStatistics(a.image, names[c], 8),
+                   blocks_b = testing::BlockStatistics(b.image, names[c], 8);
         for (size_t i = 0; i < blocks_a.size(); ++i) {
             const double sigma = std::sqrt(blocks_a[i].second + blocks_b[i].second);
             EXPECT_NEAR(blocks_a[i].first, blocks_b[i].first, kSigmas * sigma + 1e-6)

@@ -133,8 +133,7 @@ TEST(VolPath, AbsorbingSlabFollowsBeersLawPerChannel) {
             const testing::MeanAndError m = testing::ChannelMean(out.image, names[c]);
             const double expected = std::exp(-sigma_a[c] * d);
             EXPECT_NEAR(m.mean, expected, 0.005 * expected) << names[c];
-            EXPECT_NEAR(m.mean, expected, kSigmas * m.standard_error + 1e-4 * expected)
-                << names[c];
+            EXPECT_NEAR(m.mean, expected, kSigmas * m.standard_error + 1e-4 * expected) << names[c];
         }
     }
 }
@@ -244,8 +243,7 @@ double EscapeProbability(double sigma_t, double albedo, double g, int walks) {
             if (uni(rng) >= albedo) break;
             const double u = uni(rng);
             const double s = (1 - g * g) / (1 - g + 2 * g * u);
-            const double cos_t =
-                std::abs(g) < 1e-6 ? 1 - 2 * u : (1 + g * g - s * s) / (2 * g);
+            const double cos_t = std::abs(g) < 1e-6 ? 1 - 2 * u : (1 + g * g - s * s) / (2 * g);
             const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
             const double phi = 2 * std::numbers::pi * uni(rng);
             // A frame around d.
@@ -262,8 +260,8 @@ TEST(VolPath, HalfAlbedoSphereMatchesAnIndependentRandomWalk) {
     const int walks = 1000000;
     const double reference = EscapeProbability(sigma_t, albedo, g, walks);
     const double reference_se = std::sqrt(reference * (1 - reference) / walks);
-    const Medium medium = Homogeneous(Rgb(float(sigma_t * (1 - albedo))),
-                                      Rgb(float(sigma_t * albedo)), float(g));
+    const Medium medium =
+        Homogeneous(Rgb(float(sigma_t * (1 - albedo))), Rgb(float(sigma_t * albedo)), float(g));
     const RenderOutput out = RenderVol(SphereInSky(medium, true, 16), 2048);
     for (const char* c : {"R", "G", "B"}) {
         const testing::MeanAndError m = testing::ChannelMean(out.image, c);
@@ -275,7 +273,8 @@ TEST(VolPath, HalfAlbedoSphereMatchesAnIndependentRandomWalk) {
 
 void ExpectSameImage(const Image& a, const Image& b) {
     for (const char* c : {"R", "G", "B"}) {
-        const auto blocks_a = testing::BlockMeans(a, c, 4), blocks_b = testing::BlockMeans(b, c, 4);
+        const auto blocks_a = testing::BlockStatistics(a, c, 4),
+                   blocks_b = testing::BlockStatistics(b, c, 4);
         for (size_t i = 0; i < blocks_a.size(); ++i) {
             const double sigma = std::sqrt(blocks_a[i].second + blocks_b[i].second);
             EXPECT_NEAR(blocks_a[i].first, blocks_b[i].first, kSigmas * sigma + 1e-5)
