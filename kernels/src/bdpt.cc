@@ -96,9 +96,6 @@ constexpr int kRouletteStartBounce = 2;  // the path tracer's depth 1: its secon
 constexpr float kShadowRouletteBelow = 0.05f;
 constexpr float kShadowRouletteStop = 0.75f;
 
-// The most surfaces a ray from the camera crosses to find the medium a light lies in.
-constexpr int kMaxCrossings = 1024;
-
 Rgb ClampZero(const Rgb& c) {
     return {std::max(0.0f, c.r), std::max(0.0f, c.g), std::max(0.0f, c.b)};
 }
@@ -269,7 +266,7 @@ Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to, Spe
     // Interface surfaces are crossed, any other surface blocks; every medium on the way
     // attenuates.
     Rgb tr(1.0f);
-    for (;;) {
+    for (int crossed = 0; crossed <= kMaxInterfaceCrossings; ++crossed) {
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
         if (hit &&
@@ -287,6 +284,7 @@ Rgb BdptRenderer::Transmission(const BdptVertex& from, const BdptVertex& to, Spe
         medium = MediumAfter(scene_.scene(), medium, *hit, ray.d);
         ray = SpawnRayTo(HitPoint(*hit), to.point);
     }
+    return Rgb(0);  // degenerate interfaces: blocked
 }
 
 Rgb BdptRenderer::SegmentTransmittance(int medium, const Ray& ray, float t_end,
@@ -323,7 +321,7 @@ int BdptRenderer::MediumAtLight(const BdptVertex& eye, const BdptVertex& light,
     // The media the segment from the camera to the light crosses, as a path would.
     int medium = scene.camera_medium;
     Ray ray = SpawnRayTo(eye.point, light.point);
-    for (int i = 0; i < kMaxCrossings; ++i) {
+    for (int i = 0; i < kMaxInterfaceCrossings; ++i) {
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
         if (!hit) break;
@@ -346,6 +344,7 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
     const int hero = spectral.hero;
     Rgb r(1.0f);
     float eta_scale = 1;
+    int crossings = 0;  // interface surfaces this path has passed (kMaxInterfaceCrossings)
     for (int bounces = 0;;) {
         // The vertex's numbers, drawn before the ray is traced and in the same order whatever
         // happens (see the header): lobe and light pick, connection, direction, roulette.
@@ -421,6 +420,7 @@ void BdptRenderer::Walk(Ray ray, Rgb beta, float pdf_fwd, int max_vertices, bool
         }
         if (!scattered_at && materials[size_t(hit->material)].type == Material::Type::kInterface) {
             // Not a vertex: the ray goes on into the medium beyond (its density is unchanged).
+            if (++crossings > kMaxInterfaceCrossings) return;
             medium = MediumAfter(scene_.scene(), medium, *hit, ray.d);
             ray = SpawnRay(HitPoint(*hit), ray.d);
             continue;

@@ -81,7 +81,8 @@ Rgb VolPathTracer::SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& f
     const int hero = state.hero;
     Rgb t_ray(1.0f), r_u(1.0f), r_l(1.0f);
     Ray ray = SpawnRayTo(from_of(ls->wi), ls->point);
-    for (;;) {
+    for (int crossed = 0;; ++crossed) {
+        if (crossed > kMaxInterfaceCrossings) return Rgb();  // degenerate interfaces: blocked
         ++stats.rays;
         const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
         if (hit &&
@@ -148,6 +149,7 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
     bool specular_bounce = true;  // the camera ray sees emission with full weight
     Vec3 prev_p, prev_n;          // the last scattering vertex: n zero in a medium
     float eta_scale = 1;
+    int crossings = 0;  // interface surfaces this path has passed (kMaxInterfaceCrossings)
     const int max_depth = max_depth_ < 0 ? kMaxPathDepth : max_depth_;
 
     for (int depth = 0;;) {
@@ -263,6 +265,7 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
         const Material& material = scene.materials[size_t(hit->material)];
         if (material.type == Material::Type::kInterface) {
             // Neither a bounce nor a scattering event: the ray goes on into the other medium.
+            if (++crossings > kMaxInterfaceCrossings) break;
             medium = MediumAfter(scene, medium, *hit, ray.d);
             ray = SpawnRay(HitPoint(*hit), ray.d);
             continue;

@@ -35,6 +35,11 @@ inline int MediumAfter(const Scene& scene, int medium, const SurfaceHit& hit, co
     return MediumAfter(InterfaceAt(scene, hit), medium, hit.n, w);
 }
 
+// The most interface surfaces one ray (a path's segment between two vertices, a shadow ray)
+// crosses: beyond it the geometry is degenerate (coincident interfaces hit again and again) and
+// the ray counts as blocked, so no ray loops for ever.
+inline constexpr int kMaxInterfaceCrossings = 1024;
+
 // Beer's law over `distance` (render space) of `medium`, 1 in vacuum (-1): the homogeneous
 // absorbers (a solid's KHR_materials_volume attenuation) that the methods other than the path
 // tracer take (lf/job/method_registry.h refuses them any other medium).
