@@ -1878,6 +1878,22 @@ TEST_P(FarmSplat, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
     // of those merged (2 or 3 of 16 tasks by now) would be 5 to 8 times darker.
     EXPECT_GT(sum / double(r.size()), 0.1) << "the preview is not normalised by merged paths";
     ASSERT_TRUE(WaitForStatus(job, "1 running", milliseconds(20000)));
+    // The cancel goes right after the worker leases a fresh task: light's tasks are capped at
+    // 2^18 paths, about 0.6 s or two heartbeats on an idle machine, so a cancel sent at a random
+    // moment often landed after the task's last heartbeat and found nothing to stop.
+    const auto leases = [&] {
+        const std::string text = ReadText(dir_ / "w1.log");
+        size_t n = 0;
+        for (size_t at = text.find(" leased: "); at != std::string::npos;
+             at = text.find(" leased: ", at + 1)) {
+            ++n;
+        }
+        return n;
+    };
+    const size_t leased = leases();
+    const auto deadline = Clock::now() + milliseconds(20000);
+    while (leases() == leased && Clock::now() < deadline) std::this_thread::sleep_for(milliseconds(1));
+    ASSERT_GT(leases(), leased) << "the worker leased no further task";
     ASSERT_EQ(Farmctl("cancel " + job).status, 0);
     EXPECT_TRUE(WaitForText(dir_ / "w1.log", "dropped", kStopWithin))
         << "the worker still renders after the cancel";
