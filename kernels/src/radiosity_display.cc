@@ -76,7 +76,25 @@ std::vector<std::array<Rgb, 3>> SmoothCorners(const PatchMesh& mesh,
 RadiosityDisplay::RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& mesh,
                                    std::vector<Rgb> radiosity, RadiosityShading shading)
     : scene_(scene), mesh_(mesh), radiosity_(std::move(radiosity)) {
-    if (shading == RadiosityShading::kSmooth) corners_ = SmoothCorners(mesh_, radiosity_);
+    const Scene& s = scene_.scene();
+    irradiance_.resize(radiosity_.size());
+    for (size_t i = 0; i < radiosity_.size(); ++i) {
+        const PatchMesh::Side& side = mesh_.sides()[i];
+        const Material& m = s.materials[size_t(
+            s.meshes[size_t(mesh_.patches()[size_t(side.patch)].mesh)].material)];
+        Rgb reflected = radiosity_[i];
+        if (!side.back || m.two_sided_emission) {
+            reflected = reflected - m.emission * float(std::numbers::pi);
+        }
+        for (int c = 0; c < 3; ++c) {
+            irradiance_[i][c] =
+                m.reflectance[c] > 0 ? std::max(0.f, reflected[c]) / m.reflectance[c] : 0.f;
+        }
+    }
+    if (shading == RadiosityShading::kSmooth) {
+        corners_ = SmoothCorners(mesh_, radiosity_);
+        irradiance_corners_ = SmoothCorners(mesh_, irradiance_);
+    }
 }
 
 Rgb RadiosityDisplay::Li(const Ray& ray, Sampler&, RenderStats& stats) const {
@@ -86,14 +104,23 @@ Rgb RadiosityDisplay::Li(const Ray& ray, Sampler&, RenderStats& stats) const {
     return Radiance(hit->mesh, hit->primitive, hit->b1, hit->b2, Dot(ray.d, hit->n) > 0);
 }
 
-Rgb RadiosityDisplay::Radiance(int mesh, int primitive, double b1, double b2, bool back) const {
+Rgb RadiosityDisplay::Shade(std::span<const Rgb> per_side,
+                            const std::vector<std::array<Rgb, 3>>& corners, int mesh, int primitive,
+                            double b1, double b2, bool back) const {
     const PatchPoint point = mesh_.Locate(mesh, primitive, b1, b2);
     const int32_t side = mesh_.patches()[size_t(point.patch)].sides[back ? 1 : 0];
     if (side < 0) return Rgb(0);
-    if (corners_.empty()) return radiosity_[size_t(side)] * kInvPi;
-    const auto& c = corners_[size_t(side)];
-    return (c[0] * float(point.w[0]) + c[1] * float(point.w[1]) + c[2] * float(point.w[2])) *
-           kInvPi;
+    if (corners.empty()) return per_side[size_t(side)];
+    const auto& c = corners[size_t(side)];
+    return c[0] * float(point.w[0]) + c[1] * float(point.w[1]) + c[2] * float(point.w[2]);
+}
+
+Rgb RadiosityDisplay::Radiance(int mesh, int primitive, double b1, double b2, bool back) const {
+    return Shade(radiosity_, corners_, mesh, primitive, b1, b2, back) * kInvPi;
+}
+
+Rgb RadiosityDisplay::Irradiance(int mesh, int primitive, double b1, double b2, bool back) const {
+    return Shade(irradiance_, irradiance_corners_, mesh, primitive, b1, b2, back);
 }
 
 absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,

@@ -35,6 +35,11 @@ struct RadiosityOptions {
     double patch_size = 0;   // longest patch edge in scene units; 0: from `patches`
     int64_t patches = 4000;  // target patch count
     RadiositySolver solver = RadiositySolver::kGaussSeidel;
+    // Hierarchical radiosity with clustering (radiosity_hierarchy.h): links between clusters of
+    // patches, refined until each carries at most `link_error` of the scene's power, solved by
+    // Jacobi sweeps; false: the flat n^2 form factors and `solver`.
+    bool hierarchical = false;
+    double link_error = 1e-3;
     double tolerance = 1e-4;  // relative residual
     int max_iterations = 10000;
     RadiosityShading display = RadiosityShading::kSmooth;
@@ -96,6 +101,7 @@ class RadiosityRenderer : public RadianceEstimator {
         return display_->Li(ray, sampler, stats);
     }
     const EmbreeScene& geometry() const override { return display_->geometry(); }
+    const RadiosityDisplay& display() const { return *display_; }
 
     const RadiosityReport& report() const { return report_; }
     const PatchMesh& mesh() const { return *mesh_; }

@@ -42,12 +42,21 @@ class RadiosityDisplay : public RadianceEstimator {
     // Radiance leaving one side of the point (b1, b2) of a scene triangle. Sides without an
     // unknown have radiosity 0.
     Rgb Radiance(int mesh, int primitive, double b1, double b2, bool back) const;
+    // Irradiance (W m^-2) arriving on that side, shaded as the radiance is: (B - emitted
+    // exitance) / reflectance per side and channel; 0 where the reflectance is 0, whose
+    // irradiance the solution does not hold.
+    Rgb Irradiance(int mesh, int primitive, double b1, double b2, bool back) const;
 
   private:
     const EmbreeScene& scene_;
     const PatchMesh& mesh_;
-    std::vector<Rgb> radiosity_;
-    std::vector<std::array<Rgb, 3>> corners_;  // smooth shading only
+    // The value of a side at the point: flat, or interpolated between its corners.
+    Rgb Shade(std::span<const Rgb> per_side, const std::vector<std::array<Rgb, 3>>& corners,
+              int mesh, int primitive, double b1, double b2, bool back) const;
+
+    std::vector<Rgb> radiosity_, irradiance_;
+    // Smooth shading only.
+    std::vector<std::array<Rgb, 3>> corners_, irradiance_corners_;
 };
 
 // ASCII PLY of every side with an unknown (back sides wound the other way), world positions,
