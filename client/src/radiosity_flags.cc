@@ -34,7 +34,22 @@ void AddRadiosityFlags(CLI::App* cmd, RadiositySettings& settings) {
         ->group(group)
         ->capture_default_str()
         ->check(CLI::Range(int64_t(0), kMaxRefinedPatches));
-    cmd->add_option("--solver", settings.solver, "jacobi, gauss-seidel or shooting")
+    cmd->add_option("--radiosity", settings.form,
+                    "flat: form factors between every pair of patches (n^2 time and memory, the "
+                    "reference); hierarchical: links between clusters of patches, refined until "
+                    "each carries at most --link-error of the scene's power (about linear in the "
+                    "patches; solved by Jacobi sweeps)")
+        ->group(group)
+        ->capture_default_str()
+        ->check(OneOf(kRadiosityForms));
+    cmd->add_option("--link-error", settings.link_error,
+                    "hierarchical: most power one link may carry, as a fraction of the power "
+                    "the scene emits; smaller is closer to the flat solution and slower")
+        ->group(group)
+        ->capture_default_str()
+        ->check(CLI::Range(kMinLinkError, kMaxLinkError));
+    cmd->add_option("--solver", settings.solver,
+                    "jacobi, gauss-seidel or shooting (--radiosity flat; hierarchical is jacobi)")
         ->group(group)
         ->capture_default_str()
         ->check(OneOf(kRadiositySolvers));

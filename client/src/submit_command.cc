@@ -179,15 +179,17 @@ Command AddSubmitCommand(CLI::App& app) {
         cmd->add_option("--chunk", o->spec.shot.chunk,
                         "a shot's whole frames a task, each task rendering every tile of its "
                         "frames on one worker (fixed plans only: not with adaptive sampling "
-                        "or --solver jacobi); 1: each frame's tiles spread over the workers")
+                        "or sweeps: --solver jacobi, --radiosity hierarchical); 1: each frame's "
+                        "tiles spread over the workers")
             ->capture_default_str()
             ->check(CLI::Range(1, kMaxChunk))
             ->group("Animation");
     AddPhotonFlags(cmd, o->spec.ppm);
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
-                    "--solver jacobi: patch-group tasks per sweep; each worker computes the "
-                    "form-factor rows of its groups once and keeps them. Gauss-Seidel and "
+                    "--solver jacobi or --radiosity hierarchical: patch-group tasks per sweep; "
+                    "each worker computes the form-factor rows (or links) of its groups once "
+                    "and keeps them. Gauss-Seidel and "
                     "shooting update one group after another, so with them every worker "
                     "solves the whole system before rendering display tiles")
         ->group("Radiosity")

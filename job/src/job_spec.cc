@@ -64,6 +64,14 @@ absl::Status CheckMethodSettings(const JobSpec& spec) {
 
 }  // namespace
 
+absl::Status CheckHierarchicalSolver(const RadiositySettings& r) {
+    if (r.form != "hierarchical" || r.solver == "jacobi") return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat("radiosity.solver ", r.solver,
+                     ": hierarchical radiosity solves by Jacobi sweeps (the solvers gauss-seidel "
+                     "and shooting take --radiosity flat)"));
+}
+
 absl::Status CheckNoiseThresholdMethod(Method method, double noise_threshold) {
     // Radiosity's target error refines its mesh; its display samples are no noise to stop on.
     if (noise_threshold > 0 && Info(method).work != WorkKind::kTiles) {
@@ -104,6 +112,9 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
         OneOf("radiosity.display", r.display, kRadiosityDisplays),
         InRange("radiosity.sweep_tasks", r.sweep_tasks, 1, kMaxSweepTasks),
         InRange("radiosity.max_patches", r.max_patches, int64_t(0), kMaxRefinedPatches),
+        OneOf("radiosity.form", r.form, kRadiosityForms),
+        InRange("radiosity.link_error", r.link_error, kMinLinkError, kMaxLinkError),
+        CheckHierarchicalSolver(r),
         CheckPhotonSettings(spec.ppm),
         CheckShotSettings(spec.shot),
         CheckMethodSettings(spec),

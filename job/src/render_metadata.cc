@@ -100,6 +100,10 @@ void AddAdaptiveAttributes(const AdaptiveSettings& settings, const AdaptiveRepor
 void AddRadiosityAttributes(const RenderMetadata& m, ExrAttributes& attributes) {
     const RadiositySettings& s = m.radiosity_settings;
     attributes["lightfarm.radiosity.solver"] = s.solver;
+    attributes["lightfarm.radiosity.form"] = s.form;
+    if (s.form == "hierarchical") {
+        attributes["lightfarm.radiosity.linkError"] = s.link_error;
+    }
     attributes["lightfarm.radiosity.tolerance"] = s.tolerance;
     attributes["lightfarm.radiosity.display"] = s.display;
     if (!m.radiosity) return;

@@ -1,6 +1,7 @@
 #include "lf/local/method_factory.h"
 
 #include "absl/strings/str_cat.h"
+#include "lf/job/job_spec.h"
 #include "lf/kernels/bdpt.h"
 #include "lf/kernels/light_tracer.h"
 #include "lf/kernels/path_tracer.h"
@@ -57,12 +58,15 @@ SplatRenderSettings SplatRenderSettingsOf(const JobSpec& spec) {
 
 absl::StatusOr<RadiosityOptions> RadiosityOptionsOf(const RadiositySettings& settings,
                                                     double target_error) {
+    if (absl::Status s = CheckHierarchicalSolver(settings); !s.ok()) return s;
     absl::StatusOr<RadiosityOptions> options =
         MakeRadiosityOptions(settings.patches, settings.patch_size, settings.solver,
                              settings.tolerance, settings.max_iterations, settings.display);
     if (!options.ok()) return options.status();
     options->target_error = target_error;
     options->max_patches = settings.max_patches;
+    options->hierarchical = settings.form == "hierarchical";
+    options->link_error = settings.link_error;
     return options;
 }
 

@@ -77,6 +77,8 @@ void ToProto(const RadiositySettings& s, pb::RadiosityParams* out) {
     out->set_display(s.display);
     out->set_sweep_tasks(s.sweep_tasks);
     out->set_max_patches(s.max_patches);
+    out->set_form(s.form);
+    out->set_link_error(s.link_error);
 }
 
 RadiositySettings FromProto(const pb::RadiosityParams& p) {
@@ -84,6 +86,9 @@ RadiositySettings FromProto(const pb::RadiosityParams& p) {
                         p.tolerance(), p.max_iterations(), p.display()};
     if (p.sweep_tasks() != 0) s.sweep_tasks = p.sweep_tasks();
     s.max_patches = p.max_patches();
+    // Unset by clients from before hierarchical radiosity: the flat method they knew.
+    if (!p.form().empty()) s.form = p.form();
+    if (p.link_error() != 0) s.link_error = p.link_error();
     return s;
 }
 

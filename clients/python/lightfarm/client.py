@@ -662,7 +662,8 @@ class Client:
                time_limit: float = 0.0, max_spp: int = 1 << 16, noise_threshold: float = 0.0,
                patches: int = 4000, patch_size: float = 0.0, solver: str = "jacobi",
                tolerance: float = 1e-4, max_iterations: int = 10000, display: str = "smooth",
-               sweep_tasks: int = 8, max_patches: int = 0,
+               sweep_tasks: int = 8, max_patches: int = 0, radiosity: str = "flat",
+               link_error: float = 1e-3,
                photons_per_pass: int = 1 << 18, initial_radius: float = 0.0,
                alpha: float = 2.0 / 3.0, frames: Optional[str] = None,
                frame: Optional[int] = None, fps: Optional[float] = None, shutter: float = 0.0,
@@ -684,7 +685,8 @@ class Client:
         ``noise_threshold`` (Cycles' Noise Threshold; ``spp`` is then each pixel's minimum,
         by default Cycles' automatic one, ceil(16 / threshold^0.3), as the CLI's); radiosity's ``patches``,
         ``patch_size``, ``solver``, ``tolerance``, ``max_iterations``, ``display``,
-        ``sweep_tasks``, ``max_patches``; photon mapping's ``photons_per_pass``,
+        ``sweep_tasks``, ``max_patches``, ``radiosity`` ("flat" or "hierarchical") and
+        ``link_error``; photon mapping's ``photons_per_pass``,
         ``initial_radius``, ``alpha``. A shot of an animated scene: ``frames`` ("A-B",
         "A-B:STEP") or ``frame`` (N alone), frame f showing the scene at f / ``fps`` seconds
         (default 24), ``shutter`` (motion blur: frames the shutter stays open, centred on each
@@ -734,7 +736,7 @@ class Client:
             params.radiosity.CopyFrom(common_pb2.RadiosityParams(
                 patches=patches, patch_size=patch_size, solver=solver, tolerance=tolerance,
                 max_iterations=max_iterations, display=display, sweep_tasks=sweep_tasks,
-                max_patches=max_patches))
+                max_patches=max_patches, form=radiosity, link_error=link_error))
         shot = _shot_params(frames, frame, fps, shutter, chunk)
         if shot is not None:
             params.shot.CopyFrom(shot)

@@ -89,6 +89,15 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
         {"radiosity.max_patches", [](JobSpec& s) { s.radiosity.max_patches = -1; }},
         {"radiosity.max_patches",
          [](JobSpec& s) { s.radiosity.max_patches = kMaxRefinedPatches + 1; }},
+        {"radiosity.form", [](JobSpec& s) { s.radiosity.form = "progressive"; }},
+        {"radiosity.link_error", [](JobSpec& s) { s.radiosity.link_error = 0; }},
+        {"radiosity.link_error", [](JobSpec& s) { s.radiosity.link_error = NAN; }},
+        {"radiosity.link_error", [](JobSpec& s) { s.radiosity.link_error = 2; }},
+        {"radiosity.solver",
+         [](JobSpec& s) {
+             s.radiosity.form = "hierarchical";
+             s.radiosity.solver = "gauss-seidel";
+         }},
     };
     for (const BadSetting& b : bad) {
         JobSpec spec;
@@ -107,6 +116,8 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     edge.radiosity.patches = kMaxPatchTarget;
     edge.radiosity.sweep_tasks = kMaxSweepTasks;
     edge.radiosity.max_patches = kMaxRefinedPatches;
+    edge.radiosity.form = "hierarchical";
+    edge.radiosity.link_error = kMinLinkError;
     edge.clamp = 1e300;
     JobSpec aov_edge = edge;
     aov_edge.aovs = kAllAovs;

@@ -74,6 +74,8 @@ TEST_F(SqliteJobStoreTest, RecordsRoundTripThroughAReopen) {
     job.spec.scene_hash = "hash";
     job.spec.adaptive = {0.03, 120, 512};
     job.spec.radiosity.max_patches = 999;
+    job.spec.radiosity.form = "hierarchical";
+    job.spec.radiosity.link_error = 2.5e-4;
     job.state = JobState::kFailed;
     job.error = "why";
     job.submitted = absl::FromUnixMicros(1'000'001);
@@ -98,6 +100,8 @@ TEST_F(SqliteJobStoreTest, RecordsRoundTripThroughAReopen) {
     EXPECT_EQ(back->spec.adaptive.time_limit, 120);
     EXPECT_EQ(back->spec.adaptive.max_spp, 512u);
     EXPECT_EQ(back->spec.radiosity.max_patches, 999);
+    EXPECT_EQ(back->spec.radiosity.form, "hierarchical");
+    EXPECT_EQ(back->spec.radiosity.link_error, 2.5e-4);
     EXPECT_EQ(back->state, JobState::kFailed);
     EXPECT_EQ(back->error, "why");
     EXPECT_EQ(back->started, job.started);

@@ -80,11 +80,18 @@ inline constexpr double kMinTimeLimit = 1e-3, kMaxTimeLimit = 1e7;      // secon
 inline constexpr std::array<std::string_view, 3> kRadiositySolvers = {"jacobi", "gauss-seidel",
                                                                       "shooting"};
 inline constexpr std::array<std::string_view, 2> kRadiosityDisplays = {"flat", "smooth"};
+inline constexpr std::array<std::string_view, 2> kRadiosityForms = {"flat", "hierarchical"};
+inline constexpr double kMinLinkError = 1e-9, kMaxLinkError = 1.0;
 
 // Ok if every setting of `spec` is within the limits above (the scene and its files are checked
 // where they are loaded); otherwise InvalidArgument naming the field and its allowed range, e.g.
 // "radiosity.patches 1099511627776: expected 1 to 16777216".
 absl::Status CheckJobSettings(const JobSpec& spec);
+
+// Ok unless `r` names hierarchical radiosity with a solver other than jacobi: its gather is one
+// pure step over the link hierarchy, so another solver named with it is a mistake, not a
+// preference to ignore. Part of CheckJobSettings; local mode checks it on its own.
+absl::Status CheckHierarchicalSolver(const RadiositySettings& r);
 
 // Ok unless `noise_threshold` is set (> 0) for a method without per-pixel samples (only the
 // tile methods have them): then InvalidArgument naming the method. `render`, `submit` and `plan`
@@ -103,7 +110,8 @@ JobSpec FrameSpec(const JobSpec& spec, int frame);
 // Radiosity jobs the farm solves in patch-group tasks per sweep, rather than on every worker.
 // Not adaptive ones: their passes are appended to the tasks where the sweeps would go.
 inline bool SolvedInSweeps(const JobSpec& spec) {
-    return FindMethod(spec.method) == Method::kRadiosity && spec.radiosity.solver == "jacobi" &&
+    return FindMethod(spec.method) == Method::kRadiosity &&
+           (spec.radiosity.solver == "jacobi" || spec.radiosity.form == "hierarchical") &&
            !IsAdaptive(spec.adaptive);
 }
 

@@ -41,6 +41,10 @@ struct RadiositySettings {
     // Most patches mesh refinement may reach (RadiosityOptions::max_patches); 0: 16 times the
     // coarse mesh's.
     int64_t max_patches = 0;
+    // "flat" or "hierarchical" (RadiosityOptions::hierarchical); hierarchical solves by Jacobi
+    // sweeps, refining links until each carries at most link_error of the scene's power.
+    std::string form = defaults::kRadiosityForm;
+    double link_error = defaults::kRadiosityLinkError;
 };
 inline constexpr int kMaxSweepTasks = 1024;
 
