@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_io.h"
+#include "lf/kernels/lights.h"
 #include "lf/kernels/radiosity_surfaces.h"
 
 namespace lf {
@@ -80,6 +81,11 @@ RadiosityDisplay::RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& me
       mesh_(mesh),
       surfaces_(std::make_unique<RadiositySurfaces>(scene)),
       radiosity_(std::move(radiosity)) {
+    const Scene& s = scene.scene();
+    if (s.environment || std::any_of(s.directional_lights.begin(), s.directional_lights.end(),
+                                     [](const DirectionalLight& l) { return l.angular_diameter > 0; })) {
+        sky_ = std::make_unique<LightSampler>(scene, LightStrategy::kPower);
+    }
     // The solve's own per-side reflectance and exitance (patch averages of textured ones).
     const RadiositySides sides = surfaces_->Sides(mesh_);
     irradiance_.resize(radiosity_.size());
@@ -101,7 +107,9 @@ RadiosityDisplay::~RadiosityDisplay() = default;
 Rgb RadiosityDisplay::Li(const Ray& ray, Sampler&, RenderStats& stats) const {
     ++stats.rays;
     const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
-    if (!hit || hit->mesh < 0) return Rgb(0);
+    // The sky and sun disks, as the path tracer shows them.
+    if (!hit) return sky_ ? sky_->EscapedRadiance(ray.d) : Rgb(0);
+    if (hit->mesh < 0) return Rgb(0);
     return Radiance(hit->mesh, hit->primitive, hit->b1, hit->b2, Dot(ray.d, hit->n) > 0);
 }
 

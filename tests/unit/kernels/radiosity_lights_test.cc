@@ -7,6 +7,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "lf/core/film.h"
+#include "lf/core/sampler.h"
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/radiosity.h"
 
@@ -181,6 +183,11 @@ TEST(RadiosityLights, UniformSkyLightsAnOpenPlaneByPiL) {
     for (const auto& [x, z] : {std::pair{0.0, 0.0}, {1.5, -1.2}}) {
         ExpectNear(s.At(x, z).first, sky.radiance * float(kPi), 0.01, "sky");
     }
+    // Rays that leave the scene see the sky, as the path tracer shows it.
+    Sampler sampler(1, 0, 0, 0);
+    RenderStats stats;
+    const Ray up{Vec3(0, 1, 0), Vec3(0, 1, 0)};
+    ExpectNear(s.renderer->display().Li(up, sampler, stats), sky.radiance, 1e-6, "background");
 }
 
 // The form factor from a point to a parallel rectangle with a corner right above it, sides a and

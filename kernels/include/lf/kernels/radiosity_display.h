@@ -2,7 +2,7 @@
 // same kind of EXR the path tracer writes, and a PLY export of the coloured patch mesh.
 //
 // A camera ray returns B/π of the patch side it hits (Lambertian radiance; B includes the
-// emission, so emitters need nothing extra). Flat shading uses the patch's value; smooth
+// emission, so emitters need nothing extra), or the sky and sun disks where it leaves the scene. Flat shading uses the patch's value; smooth
 // shading interpolates corner values, each the area-weighted mean B of the sides that share
 // the vertex, face the same way and lie within 30° of each other (creases stay sharp).
 #pragma once
@@ -21,6 +21,7 @@
 
 namespace lf {
 
+class LightSampler;
 class RadiositySurfaces;
 
 enum class RadiosityShading { kFlat, kSmooth };
@@ -61,6 +62,7 @@ class RadiosityDisplay : public RadianceEstimator {
               int mesh, int primitive, double b1, double b2, bool back) const;
 
     std::unique_ptr<const RadiositySurfaces> surfaces_;
+    std::unique_ptr<const LightSampler> sky_;  // what rays that leave the scene see, if any
     std::vector<Rgb> radiosity_, irradiance_;
     // Smooth shading only.
     std::vector<std::array<Rgb, 3>> corners_, irradiance_corners_;
