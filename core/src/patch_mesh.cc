@@ -235,7 +235,10 @@ std::string RadiosityDrops(const Scene& scene) {
         const std::string name = absl::StrCat("\"", m.name, "\"");
         const bool principled = m.type == Material::Type::kPrincipled;
         const bool diffuse = m.type == Material::Type::kLambert || principled;
-        if (!diffuse) dropped[0].names.push_back(absl::StrCat(name, " (", MaterialTypeName(m.type), ")"));
+        // A black lambert is black on purpose; a full metal or full transmission is not.
+        if (!diffuse || (principled && !MayReflectDiffusely(m) && !m.reflectance.IsBlack())) {
+            dropped[0].names.push_back(absl::StrCat(name, " (", MaterialTypeName(m.type), ")"));
+        }
         if (principled && (m.specular > 0 || m.metallic > 0)) dropped[1].names.push_back(name);
         if (principled && m.transmission > 0) dropped[2].names.push_back(name);
         if (principled && m.clearcoat > 0) dropped[3].names.push_back(name);

@@ -1283,15 +1283,16 @@ TEST_F(Farm, RadiosityTargetErrorRefinesOnEveryWorkerAndGivesTheLocalPixels) {
     EXPECT_EQ(ReadText(dir_ / "server-1.log").find("radiosity sweep"), std::string::npos);
 }
 
-TEST_F(Farm, RadiosityJobForAGlossySceneIsRefusedAtSubmission) {
+TEST_F(Farm, RadiosityJobForAMaskedSceneIsRefusedAtSubmission) {
     StartServer();
-    const std::string glossy = (dir_ / "glossy.json").string();
+    const std::string masked = (dir_ / "masked.json").string();
     nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
-    scene["materials"]["white"] = {{"type", "mirror"}, {"reflectance", {0.9, 0.9, 0.9}}};
-    std::ofstream(glossy) << scene.dump();
-    const CliRun r = Farmctl("submit " + glossy + " --method radiosity");
+    scene["materials"]["white"]["alpha_mode"] = "mask";
+    std::ofstream(masked) << scene.dump();
+    const CliRun r = Farmctl("submit " + masked + " --method radiosity");
     EXPECT_NE(r.status, 0);
-    EXPECT_NE(r.err.find("radiosity models lambert only"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("has an alpha mask, which radiosity does not model"), std::string::npos)
+        << r.err;
 }
 
 // A --sky map outside the scene's folder travels with the scene's files (by its name relative to

@@ -433,6 +433,11 @@ TEST(PatchMesh, RadiosityDropsNamesWhatItLeavesOut) {
     EXPECT_TRUE(MayReflectDiffusely(scene.materials[0]));
     scene.materials[0].metallic = 1;
     EXPECT_FALSE(MayReflectDiffusely(scene.materials[0]));
+    EXPECT_EQ(RadiosityDrops(scene).rfind(
+                  "no diffuse part (rendered black): \"plastic\" (principled), \"glass\" "
+                  "(dielectric)",
+                  0),
+              0u);
 }
 
 // A lone reflecting triangle gets unknowns only on the sides a light can reach: the side a
