@@ -10,8 +10,8 @@
 #include <numbers>
 
 #include "lf/core/cancel.h"
-#include "lf/core/log.h"
 #include "lf/core/light_strategy.h"
+#include "lf/core/log.h"
 #include "lf/core/sobol.h"
 #include "lf/kernels/bsdf_sampling.h"
 #include "lf/kernels/environment_emitter.h"
@@ -710,13 +710,16 @@ std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mes
             const int level = centre && !centre->at_infinity
                                   ? QuadratureLevel(Length(Vec3d(centre->point.p) - g.c) / g.radius)
                                   : 1;
-            e += SideAverage(scene, mesh, g, level, [&](const Vec3d& x, const SurfacePoint& from, int) {
-                const std::optional<LightSample> ls = lights.SampleDeltaLight(light, Vec3(x), 0);
-                if (!ls) return Rgb();
-                const float cosine = Dot(n, ls->wi);
-                if (cosine <= 0 || scene.Occluded(SpawnRayTo(from, ls->point))) return Rgb();
-                return ls->radiance * cosine;
-            });
+            e += SideAverage(scene, mesh, g, level,
+                             [&](const Vec3d& x, const SurfacePoint& from, int) {
+                                 const std::optional<LightSample> ls =
+                                     lights.SampleDeltaLight(light, Vec3(x), 0);
+                                 if (!ls) return Rgb();
+                                 const float cosine = Dot(n, ls->wi);
+                                 if (cosine <= 0 || scene.Occluded(SpawnRayTo(from, ls->point)))
+                                     return Rgb();
+                                 return ls->radiance * cosine;
+                             });
         }
         for (const SunDisk& sun : suns) {
             const Frame frame = Frame::FromNormal(sun.axis);
@@ -726,10 +729,11 @@ std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mes
                 for (int d = 0; d < kSunDirections; ++d) {
                     const Vec2 u = DirectionSample(k, d, kSunDirections);
                     const float one_minus_cos = u.x * sun.one_minus_cos;
-                    const float sin = std::sqrt(std::max(0.0f, one_minus_cos * (2 - one_minus_cos)));
+                    const float sin =
+                        std::sqrt(std::max(0.0f, one_minus_cos * (2 - one_minus_cos)));
                     const float phi = 2 * std::numbers::pi_v<float> * u.y;
-                    const Vec3 w = frame.FromLocal({sin * std::cos(phi), sin * std::sin(phi),
-                                                    1 - one_minus_cos});
+                    const Vec3 w = frame.FromLocal(
+                        {sin * std::cos(phi), sin * std::sin(phi), 1 - one_minus_cos});
                     const float cosine = Dot(n, w);
                     if (cosine > 0 && !scene.Occluded(SpawnRay(from, w))) sum += cosine;
                 }

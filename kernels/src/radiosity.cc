@@ -15,8 +15,8 @@
 #include "lf/core/patch_mesh.h"
 #include "lf/kernels/form_factors.h"
 #include "lf/kernels/radiosity_refinement.h"
-#include "lf/kernels/radiosity_surfaces.h"
 #include "lf/kernels/radiosity_solution.h"
+#include "lf/kernels/radiosity_surfaces.h"
 
 namespace lf {
 

@@ -82,8 +82,9 @@ RadiosityDisplay::RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& me
       surfaces_(std::make_unique<RadiositySurfaces>(scene)),
       radiosity_(std::move(radiosity)) {
     const Scene& s = scene.scene();
-    if (s.environment || std::any_of(s.directional_lights.begin(), s.directional_lights.end(),
-                                     [](const DirectionalLight& l) { return l.angular_diameter > 0; })) {
+    if (s.environment ||
+        std::any_of(s.directional_lights.begin(), s.directional_lights.end(),
+                    [](const DirectionalLight& l) { return l.angular_diameter > 0; })) {
         sky_ = std::make_unique<LightSampler>(scene, LightStrategy::kPower);
     }
     // The solve's own per-side reflectance and exitance (patch averages of textured ones).

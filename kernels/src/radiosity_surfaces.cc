@@ -21,8 +21,8 @@ constexpr int kMaxSamplesPerEdge = 16;
 bool ParamsVary(const Material& m) {
     return m.metallic_roughness_texture.valid() || m.specular_texture.valid() ||
            m.specular_color_texture.valid() || m.transmission_texture.valid() ||
-           (m.clearcoat > 0 && (m.clearcoat_texture.valid() ||
-                                m.clearcoat_roughness_texture.valid())) ||
+           (m.clearcoat > 0 &&
+            (m.clearcoat_texture.valid() || m.clearcoat_roughness_texture.valid())) ||
            m.sheen_color_texture.valid() || m.sheen_roughness_texture.valid();
 }
 
@@ -89,7 +89,8 @@ Rgb RadiositySurfaces::Reflectance(int mesh, const SurfaceParams& params) const 
     const int material = s.meshes[size_t(mesh)].material;
     // The diffuse albedo is linear in the base colour: one integral per material serves every
     // texel unless other parameters vary too.
-    if (params_vary_[size_t(mesh)]) return DiffuseReflectance(s.materials[size_t(material)], params);
+    if (params_vary_[size_t(mesh)])
+        return DiffuseReflectance(s.materials[size_t(material)], params);
     Rgb base;
     for (int c = 0; c < 3; ++c) base[c] = std::clamp(params.base_color[c], 0.0f, 1.0f);
     return base * white_albedo_[size_t(material)];
@@ -97,7 +98,8 @@ Rgb RadiositySurfaces::Reflectance(int mesh, const SurfaceParams& params) const 
 
 Rgb RadiositySurfaces::UntexturedReflectance(int mesh) const {
     const Scene& s = scene_.scene();
-    return Reflectance(mesh, SurfaceParams::Of(s.materials[size_t(s.meshes[size_t(mesh)].material)]));
+    return Reflectance(mesh,
+                       SurfaceParams::Of(s.materials[size_t(s.meshes[size_t(mesh)].material)]));
 }
 
 RadiositySurfaces::Point RadiositySurfaces::At(int mesh, int primitive, float b1, float b2) const {

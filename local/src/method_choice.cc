@@ -50,7 +50,8 @@ SceneTransport AnalyzeTransport(const Scene& scene) {
     out.radiosity_limitation = RadiosityLimitation(scene);
     if (const std::string drops = RadiosityDrops(scene);
         out.radiosity_limitation.empty() && !drops.empty()) {
-        out.radiosity_limitation = "radiosity would keep only the diffuse parts (dropping " + drops + ")";
+        out.radiosity_limitation =
+            "radiosity would keep only the diffuse parts (dropping " + drops + ")";
     }
     out.whitted_missing = WhittedMissingTerms(scene);
 

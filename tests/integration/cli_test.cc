@@ -283,8 +283,8 @@ TEST_F(Cli, AutoSaysWhatRadiosityWouldDrop) {
                                "\"wood\" (principled); specular reflection: \"wood\")"),
               std::string::npos)
         << plan.output;
-    const RunResult radiosity = Lightfarm("plan " + principled +
-                                          " --method radiosity --pilot-spp 2 --threads 2");
+    const RunResult radiosity =
+        Lightfarm("plan " + principled + " --method radiosity --pilot-spp 2 --threads 2");
     EXPECT_NE(radiosity.output.find("radiosity keeps the diffuse parts only; it drops no diffuse "
                                     "part (rendered black): \"wood\" (principled)"),
               std::string::npos)

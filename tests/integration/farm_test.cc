@@ -1893,7 +1893,8 @@ TEST_P(FarmSplat, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
     };
     const size_t leased = leases();
     const auto deadline = Clock::now() + milliseconds(20000);
-    while (leases() == leased && Clock::now() < deadline) std::this_thread::sleep_for(milliseconds(1));
+    while (leases() == leased && Clock::now() < deadline)
+        std::this_thread::sleep_for(milliseconds(1));
     ASSERT_GT(leases(), leased) << "the worker leased no further task";
     ASSERT_EQ(Farmctl("cancel " + job).status, 0);
     EXPECT_TRUE(WaitForText(dir_ / "w1.log", "dropped", kStopWithin))

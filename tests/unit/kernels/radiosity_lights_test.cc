@@ -33,8 +33,7 @@ TriangleMesh Box(const Vec3d& lo, const Vec3d& hi, int material) {
     box.name = "box";
     box.material = material;
     for (int i = 0; i < 8; ++i) {
-        box.positions.push_back(
-            {i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+        box.positions.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
     }
     box.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                      {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
@@ -216,8 +215,9 @@ TEST(RadiosityLights, SkyIsShadowedByARoof) {
     ASSERT_TRUE(s.renderer);
     for (const auto& [x, z] : {std::pair{0.0, 0.0}, {0.5, 1.0}, {-0.3, -2.0}}) {
         const auto [got, c] = s.At(x, z);
-        const double f = CornerFormFactor(1 - c.x, 3 - c.z, 1) + CornerFormFactor(1 + c.x, 3 - c.z, 1) +
-                         CornerFormFactor(1 - c.x, 3 + c.z, 1) + CornerFormFactor(1 + c.x, 3 + c.z, 1);
+        const double f =
+            CornerFormFactor(1 - c.x, 3 - c.z, 1) + CornerFormFactor(1 + c.x, 3 - c.z, 1) +
+            CornerFormFactor(1 - c.x, 3 + c.z, 1) + CornerFormFactor(1 + c.x, 3 + c.z, 1);
         const double expected = kPi * (1 - f);
         EXPECT_NEAR(got.r, expected, 0.01 * expected) << x << ", " << z;
     }

@@ -130,9 +130,10 @@ TEST(RadiosityMaterials, PrincipledAndMirrorFurnacesSolveWithTheirDiffuseAlbedo)
     }
 }
 
-// A 2 x 2 checker (white and 20 % grey texels, linear values, nearest filtering) repeated 4 x 4 times over a
-// floor under a point light: the solve averages the albedo over each patch, the display shows
-// each texel's albedo times the patch's irradiance, so the checker keeps its contrast.
+// A 2 x 2 checker (white and 20 % grey texels, linear values, nearest filtering) repeated 4 x 4
+// times over a floor under a point light: the solve averages the albedo over each patch, the
+// display shows each texel's albedo times the patch's irradiance, so the checker keeps its
+// contrast.
 TEST(RadiosityMaterials, TexturedFloorKeepsItsCheckerUnderTheIrradiance) {
     Scene scene;
     auto checker = std::make_shared<TextureImage>();
@@ -191,7 +192,8 @@ TEST(RadiosityMaterials, TexturedFloorKeepsItsCheckerUnderTheIrradiance) {
     const RadiositySides sides = surfaces.Sides((*renderer)->mesh());
     double area = 0, weighted = 0;
     for (size_t s = 0; s < sides.reflectance.size(); ++s) {
-        const double a = (*renderer)->mesh().patches()[size_t((*renderer)->mesh().sides()[s].patch)].area;
+        const double a =
+            (*renderer)->mesh().patches()[size_t((*renderer)->mesh().sides()[s].patch)].area;
         area += a;
         weighted += a * sides.reflectance[s].g;
     }

@@ -2,9 +2,10 @@
 // same kind of EXR the path tracer writes, and a PLY export of the coloured patch mesh.
 //
 // A camera ray returns B/π of the patch side it hits (Lambertian radiance; B includes the
-// emission, so emitters need nothing extra), or the sky and sun disks where it leaves the scene. Flat shading uses the patch's value; smooth
-// shading interpolates corner values, each the area-weighted mean B of the sides that share
-// the vertex, face the same way and lie within 30° of each other (creases stay sharp).
+// emission, so emitters need nothing extra), or the sky and sun disks where it leaves the scene.
+// Flat shading uses the patch's value; smooth shading interpolates corner values, each the
+// area-weighted mean B of the sides that share the vertex, face the same way and lie within 30° of
+// each other (creases stay sharp).
 #pragma once
 
 #include <array>

@@ -52,9 +52,9 @@ class RadiositySurfaces {
     Rgb Reflectance(int mesh, const SurfaceParams& params) const;
 
     const EmbreeScene& scene_;
-    std::vector<bool> varies_;        // per mesh
-    std::vector<bool> params_vary_;   // per mesh: textures beyond base colour and emission
-    std::vector<Rgb> white_albedo_;   // per material: the reflectance of a white base
+    std::vector<bool> varies_;       // per mesh
+    std::vector<bool> params_vary_;  // per mesh: textures beyond base colour and emission
+    std::vector<Rgb> white_albedo_;  // per material: the reflectance of a white base
 };
 
 }  // namespace lf
