@@ -11,38 +11,14 @@ Run from this folder: python3 make_room.py
 import base64
 import json
 import math
-import struct
-import zlib
+import os
+import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_writer import GltfBuffer, png  # noqa: E402
 
-def png(width, height, rows):
-    """An 8-bit RGB PNG from rows of bytes."""
-    def chunk(kind, data):
-        body = kind + data
-        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
-    raw = b"".join(b"\0" + bytes(row) for row in rows)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
-            + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
-
-
-data = bytearray()
-accessors, views = [], []
-
-
-def add(values, kind, component=5126, fmt="f"):
-    flat = [c for v in values for c in (v if isinstance(v, (tuple, list)) else (v,))]
-    offset = len(data)
-    data.extend(struct.pack("<%d%s" % (len(flat), fmt), *flat))
-    while len(data) % 4:
-        data.append(0)
-    views.append({"buffer": 0, "byteOffset": offset, "byteLength": len(flat) * struct.calcsize(fmt)})
-    accessor = {"bufferView": len(views) - 1, "componentType": component, "count": len(values),
-                "type": kind}
-    if kind == "VEC3":
-        accessor["min"] = [min(v[i] for v in values) for i in range(3)]
-        accessor["max"] = [max(v[i] for v in values) for i in range(3)]
-    accessors.append(accessor)
-    return len(accessors) - 1
+buffer = GltfBuffer()
+add = buffer.add
 
 
 def quad(corner, edge_u, edge_v, uv_scale=1.0):
@@ -155,10 +131,11 @@ gltf = {
     "samplers": [{"magFilter": 9728, "minFilter": 9728}],
     "images": [{"uri": "checker.png"}],
     "meshes": meshes,
-    "accessors": accessors,
-    "bufferViews": views,
-    "buffers": [{"byteLength": len(data),
-                 "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+    "accessors": buffer.accessors,
+    "bufferViews": buffer.views,
+    "buffers": [{"byteLength": len(buffer.data),
+                 "uri": "data:application/octet-stream;base64,"
+                        + base64.b64encode(buffer.data).decode()}],
 }
 with open("room.gltf", "w") as f:
     json.dump(gltf, f, indent=1)
