@@ -200,5 +200,56 @@ TEST(RadiosityMaterials, TexturedFloorKeepsItsCheckerUnderTheIrradiance) {
     EXPECT_NEAR(weighted / area, 0.9 * (1 + 0.2) / 2, 0.005);
 }
 
+// An emission texture (red and green texels, nearest) on a black quad: the solve's exitance is
+// the patch mean of pi Le, and the display shows each texel's own emission.
+TEST(RadiosityMaterials, EmissionTextureIsAveragedForTheSolveAndShownPerTexel) {
+    Scene scene;
+    auto image = std::make_shared<TextureImage>();
+    image->name = "sign.png";
+    image->width = 2;
+    image->height = 1;
+    image->channels = 3;
+    image->texels8 = {255, 0, 0, 0, 255, 0};
+    scene.textures.push_back(image);
+    Material sign;
+    sign.name = "sign";
+    sign.reflectance = Rgb(0.0f);
+    sign.emission = Rgb(2.0f);
+    sign.emission_texture.image = 0;
+    sign.emission_texture.nearest = true;
+    scene.materials.push_back(sign);
+    TriangleMesh quad;
+    quad.name = "sign";
+    quad.is_quad = true;
+    quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.meshes.push_back(quad);
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    RadiosityOptions options;
+    options.patches = 64;
+    const auto renderer = PrepareRadiosity(**es, options);
+    ASSERT_TRUE(renderer.ok()) << renderer.status();
+    // Over the whole sign, half red and half green.
+    const PatchMesh& mesh = (*renderer)->mesh();
+    Rgb total;
+    double area = 0;
+    for (size_t s = 0; s < mesh.sides().size(); ++s) {
+        const double a = mesh.patches()[size_t(mesh.sides()[s].patch)].area;
+        total += (*renderer)->radiosity()[s] * float(a);
+        area += a;
+    }
+    EXPECT_NEAR(total.r / area, kPi, 0.02 * kPi);
+    EXPECT_NEAR(total.g / area, kPi, 0.02 * kPi);
+    EXPECT_EQ(total.b, 0);
+    // Triangle 0 spans (0,0), (1,0), (1,1): b1 weighs corner (1,0), b2 corner (1,1).
+    const RadiosityDisplay& display = (*renderer)->display();
+    const Rgb left = display.Radiance(0, 0, 0.1, 0.05, false);  // x = 0.15: the red texel
+    const Rgb right = display.Radiance(0, 0, 0.5, 0.4, false);  // x = 0.9: the green texel
+    EXPECT_EQ(left, Rgb(2, 0, 0));
+    EXPECT_EQ(right, Rgb(0, 2, 0));
+}
+
 }  // namespace
 }  // namespace lf
