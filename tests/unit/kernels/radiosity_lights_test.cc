@@ -155,7 +155,7 @@ TEST(RadiosityLights, SunLightsTheGroundByTheSineOfItsElevationAndABoxShadowsIt)
         black.name = "black";
         black.reflectance = Rgb(0.0f);
         scene.materials.push_back(black);
-        // Light travels towards -x and down: the box's shadow falls on +x... no, on -x.
+        // Light travels towards -x and down: the box casts its shadow towards -x.
         scene.meshes.push_back(Box({1.0, 0.0, -0.5}, {2.0, 1.0, 0.5}, 1));
         scene.directional_lights.push_back(
             {Vec3d(-std::cos(elevation), -std::sin(elevation), 0), e, diameter});
@@ -221,6 +221,32 @@ TEST(RadiosityLights, SkyIsShadowedByARoof) {
         const double expected = kPi * (1 - f);
         EXPECT_NEAR(got.r, expected, 0.01 * expected) << x << ", " << z;
     }
+}
+
+// The lights' sample directions are fixed sequences, not per-thread random numbers: one thread
+// and two give the same bits.
+TEST(RadiosityLights, SameSolutionForAnyThreadCount) {
+    Scene scene = PlaneScene(3);
+    Material grey;
+    grey.reflectance = Rgb(0.3f);
+    scene.materials.push_back(grey);
+    scene.meshes.push_back(Box({-1.0, 1.0, -1.0}, {1.0, 1.2, 1.0}, 1));
+    scene.environment = EnvironmentLight{};
+    scene.directional_lights.push_back({Vec3d(-0.3, -1, 0.2), Rgb(2.0f), 0.05});
+    scene.spot_lights.push_back(
+        {.position = {0.5, 0.8, 0}, .direction = {0, -1, 0}, .intensity = Rgb(3.0f)});
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    std::vector<std::vector<Rgb>> solutions;
+    for (const int threads : {1, 2}) {
+        RadiosityOptions options;
+        options.patches = 512;
+        options.threads = threads;
+        auto renderer = PrepareRadiosity(**es, options);
+        ASSERT_TRUE(renderer.ok()) << renderer.status();
+        solutions.emplace_back((*renderer)->radiosity().begin(), (*renderer)->radiosity().end());
+    }
+    EXPECT_EQ(solutions[0], solutions[1]);
 }
 
 }  // namespace
