@@ -189,6 +189,32 @@ TEST(RadiosityLights, UniformSkyLightsAnOpenPlaneByPiL) {
     ExpectNear(s.renderer->display().Li(up, sampler, stats), sky.radiance, 1e-6, "background");
 }
 
+// A latitude-longitude map (2 x 4 texels): the upper hemisphere 1 towards -z and 3 towards +z,
+// the lower 0.5. An open plane's upper side gets pi times the cosine-weighted mean, 2 pi (each
+// half of the azimuths carries half the cosine weight), its lower side pi / 2.
+TEST(RadiosityLights, SkyMapLightsEachSideByItsHemisphere) {
+    Scene scene = PlaneScene(2);
+    auto map = std::make_shared<TextureImage>();
+    map->name = "sky.hdr";
+    map->width = 4;
+    map->height = 2;
+    map->channels = 3;
+    map->hdr = true;
+    for (const float v : {1.f, 1.f, 3.f, 3.f, 0.5f, 0.5f, 0.5f, 0.5f}) {
+        map->texels32.insert(map->texels32.end(), {v, v, v});
+    }
+    EnvironmentLight sky;
+    sky.map = map;
+    scene.environment = sky;
+    const Solved s = Solve(scene, 256);
+    ASSERT_TRUE(s.renderer);
+    const PatchMesh& mesh = s.renderer->mesh();
+    const RadiosityDisplay& display = s.renderer->display();
+    const auto [b1, b2] = mesh.TriangleBarycentrics(0, {1.0 / 3, 1.0 / 3, 1.0 / 3});
+    EXPECT_NEAR(display.Irradiance(0, 0, b1, b2, false).g, 2 * kPi, 0.01 * 2 * kPi);
+    EXPECT_NEAR(display.Irradiance(0, 0, b1, b2, true).g, 0.5 * kPi, 0.01 * 0.5 * kPi);
+}
+
 // The form factor from a point to a parallel rectangle with a corner right above it, sides a and
 // b, at height h (the classic corner formula).
 double CornerFormFactor(double a, double b, double h) {
