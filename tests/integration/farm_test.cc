@@ -1287,7 +1287,7 @@ TEST_F(Farm, RadiosityJobForAMaskedSceneIsRefusedAtSubmission) {
     StartServer();
     const std::string masked = (dir_ / "masked.json").string();
     nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
-    scene["materials"]["white"]["alpha_mode"] = "mask";
+    scene["materials"]["white"] = {{"type", "principled"}, {"alpha_mode", "mask"}};
     std::ofstream(masked) << scene.dump();
     const CliRun r = Farmctl("submit " + masked + " --method radiosity");
     EXPECT_NE(r.status, 0);
