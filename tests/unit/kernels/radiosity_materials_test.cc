@@ -130,6 +130,18 @@ TEST(RadiosityMaterials, PrincipledAndMirrorFurnacesSolveWithTheirDiffuseAlbedo)
     }
 }
 
+// A quad of corners 0 1 2 3 (triangles 0 1 2 and 0 2 3) with uvs.
+TriangleMesh TexturedQuad(const std::string& name, std::vector<Vec3d> positions,
+                          std::vector<Vec2> uvs) {
+    TriangleMesh quad;
+    quad.name = name;
+    quad.is_quad = true;
+    quad.positions = std::move(positions);
+    quad.uvs = std::move(uvs);
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    return quad;
+}
+
 // A 2 x 2 checker (white and 20 % grey texels, linear values, nearest filtering) repeated 4 x 4
 // times over a floor under a point light: the solve averages the albedo over each patch, the
 // display shows each texel's albedo times the patch's irradiance, so the checker keeps its
@@ -150,13 +162,9 @@ TEST(RadiosityMaterials, TexturedFloorKeepsItsCheckerUnderTheIrradiance) {
     floor.base_color_texture.image = 0;
     floor.base_color_texture.nearest = true;
     scene.materials.push_back(floor);
-    TriangleMesh quad;
-    quad.name = "floor";
-    quad.is_quad = true;
-    quad.positions = {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}};
-    quad.uvs = {{0, 0}, {0, 4}, {4, 4}, {4, 0}};  // 4 x 4 checkers of 1 x 1
-    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
-    scene.meshes.push_back(quad);
+    // 4 x 4 checkers of 1 x 1.
+    scene.meshes.push_back(TexturedQuad("floor", {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}},
+                                        {{0, 0}, {0, 4}, {4, 4}, {4, 0}}));
     const Rgb intensity(4.0f);
     scene.point_lights.push_back({Vec3d(0, 1.5, 0), intensity});
     auto es = EmbreeScene::Build(scene);
@@ -218,13 +226,8 @@ TEST(RadiosityMaterials, EmissionTextureIsAveragedForTheSolveAndShownPerTexel) {
     sign.emission_texture.image = 0;
     sign.emission_texture.nearest = true;
     scene.materials.push_back(sign);
-    TriangleMesh quad;
-    quad.name = "sign";
-    quad.is_quad = true;
-    quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
-    quad.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
-    scene.meshes.push_back(quad);
+    scene.meshes.push_back(TexturedQuad("sign", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}},
+                                        {{0, 0}, {1, 0}, {1, 1}, {0, 1}}));
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok()) << es.status();
     RadiosityOptions options;
