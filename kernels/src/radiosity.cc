@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <numbers>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
