@@ -192,6 +192,9 @@ absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& op
         "factors grow as patches^2 (%.3g pairs at most, docs/radiosity.md)\n",
         (long long)options.patches, mesh->patches().size(), mesh->patch_size(),
         mesh->sides().size(), n * n);
+    if (const std::string drops = RadiosityDrops(embree.scene()); !drops.empty()) {
+        std::printf("radiosity keeps the diffuse parts only; it drops %s\n", drops.c_str());
+    }
 
     const int64_t small_patches =
         std::max(options.patches / kRadiosityPilotDivisor, kMinRadiosityPilotPatches);

@@ -1,6 +1,7 @@
 #include "lf/core/patch_mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <compare>
@@ -8,6 +9,7 @@
 #include <map>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "lf/core/cancel.h"
 
 namespace lf {
@@ -79,11 +81,20 @@ class SideRule {
         }
     }
 
-    // True if a point light or a vertex of the scene lies strictly in front of the plane
-    // through p with normal n: only then can light arrive there.
+    // True if a light can shine on the plane through p with normal n from its front (a point
+    // or spot light in front of it, a directional light or sun disk towards it, any sky) or a
+    // vertex of the scene lies strictly in front of it: only then can light arrive there.
     bool SomethingInFront(const Vec3d& p, const Vec3d& n) const {
+        if (scene_.environment) return true;
         for (const PointLight& light : scene_.point_lights) {
             if (Dot(light.position - p, n) > epsilon_) return true;
+        }
+        for (const SpotLight& light : scene_.spot_lights) {
+            if (Dot(light.position - p, n) > epsilon_) return true;
+        }
+        for (const DirectionalLight& light : scene_.directional_lights) {
+            // Towards the light lies -direction; a sun disk reaches sin(radius) below it.
+            if (-Dot(light.direction, n) > -std::sin(light.angular_diameter / 2)) return true;
         }
         for (size_t m = 0; m < scene_.meshes.size(); ++m) {
             const auto& [lo, hi] = mesh_bounds_[m];
@@ -167,27 +178,27 @@ std::vector<GridTriangle> SubdivisionCells(int k) {
     return cells;
 }
 
+bool MayReflectDiffusely(const Material& m) {
+    switch (m.type) {
+        case Material::Type::kLambert:
+            return !m.reflectance.IsBlack();
+        case Material::Type::kPrincipled:
+            return !m.reflectance.IsBlack() && m.metallic < 1 && m.transmission < 1;
+        default:
+            return false;
+    }
+}
+
 std::string RadiosityLimitation(const Scene& scene) {
     for (const TriangleMesh& mesh : scene.meshes) {
         const Material& m = scene.materials[size_t(mesh.material)];
         const std::string what =
             absl::StrCat("material \"", m.name, "\" (mesh \"", mesh.name, "\") ");
-        if (m.type != Material::Type::kLambert) {
-            return absl::StrCat(what, "is ", MaterialTypeName(m.type),
-                                "; radiosity models lambert only");
+        // An interface bounds a medium: light passes it unchanged, which a patch cannot.
+        if (m.type == Material::Type::kInterface) {
+            return what + "is a medium interface, which radiosity does not model";
         }
-        // A patch has one albedo: a texture would be averaged away.
-        for (const auto& [ref, key] :
-             {std::pair{&m.base_color_texture, "base_color_texture"},
-              {&m.emission_texture, "emission_texture"},
-              {&m.normal_texture, "normal_texture"},
-              {&m.transmission_texture, "transmission_texture"},
-              {&m.metallic_roughness_texture, "metallic_roughness_texture"}}) {
-            if (!ref->valid()) continue;
-            return absl::StrCat(what, "has a texture (", key, " \"",
-                                scene.textures[size_t(ref->image)]->name,
-                                "\"), which radiosity does not model");
-        }
+        // Cut-outs change what the patches see, not what they reflect.
         if (m.alpha_mode == Material::AlphaMode::kMask) {
             return what + "has an alpha mask, which radiosity does not model";
         }
@@ -201,20 +212,45 @@ std::string RadiosityLimitation(const Scene& scene) {
                             "\" cannot be meshed; radiosity supports triangle meshes and quads "
                             "only");
     }
-    for (const DirectionalLight& light : scene.directional_lights) {
-        if (light.angular_diameter > 0) {
-            return "the scene has a sun disk (a directional light with an angular diameter), "
-                   "which radiosity does not model";
-        }
-    }
-    if (!scene.spot_lights.empty() || !scene.directional_lights.empty()) {
-        return "the scene has spot or directional lights, which radiosity does not model";
-    }
-    if (scene.environment) {
-        return "the scene has an environment light, which radiosity does not model (its patches "
-               "see only each other)";
-    }
     return "";
+}
+
+std::string RadiosityDrops(const Scene& scene) {
+    // Per category, the used materials it applies to, each named once.
+    struct Dropped {
+        const char* what;
+        std::vector<std::string> names;
+    };
+    std::array<Dropped, 6> dropped = {{{"no diffuse part (rendered black)", {}},
+                                       {"specular reflection", {}},
+                                       {"transmission", {}},
+                                       {"clear coat", {}},
+                                       {"sheen", {}},
+                                       {"normal map", {}}}};
+    std::vector<bool> seen(scene.materials.size(), false);
+    for (const TriangleMesh& mesh : scene.meshes) {
+        if (seen[size_t(mesh.material)]) continue;
+        seen[size_t(mesh.material)] = true;
+        const Material& m = scene.materials[size_t(mesh.material)];
+        const std::string name = absl::StrCat("\"", m.name, "\"");
+        const bool principled = m.type == Material::Type::kPrincipled;
+        const bool diffuse = m.type == Material::Type::kLambert || principled;
+        // A black lambert is black on purpose; a full metal or full transmission is not.
+        if (!diffuse || (principled && !MayReflectDiffusely(m) && !m.reflectance.IsBlack())) {
+            dropped[0].names.push_back(absl::StrCat(name, " (", MaterialTypeName(m.type), ")"));
+        }
+        if (principled && (m.specular > 0 || m.metallic > 0)) dropped[1].names.push_back(name);
+        if (principled && m.transmission > 0) dropped[2].names.push_back(name);
+        if (principled && m.clearcoat > 0) dropped[3].names.push_back(name);
+        if (principled && !m.sheen_color.IsBlack()) dropped[4].names.push_back(name);
+        if (diffuse && m.normal_texture.valid()) dropped[5].names.push_back(name);
+    }
+    std::string out;
+    for (const Dropped& d : dropped) {
+        if (d.names.empty()) continue;
+        absl::StrAppend(&out, out.empty() ? "" : "; ", d.what, ": ", absl::StrJoin(d.names, ", "));
+    }
+    return out;
 }
 
 absl::Status RadiosityRefusal(const Scene& scene) {
@@ -422,7 +458,7 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
                 const Vec3d n = back ? -info.normal : info.normal;
                 const bool needed =
                     ((!back || material.two_sided_emission) && material.IsEmissive()) ||
-                    (!material.reflectance.IsBlack() &&
+                    (MayReflectDiffusely(material) &&
                      rule.SomethingInFront(mesh.positions[mesh.triangles[t][0]], n));
                 if (!needed) continue;
                 for (int64_t p = info.first_patch; p < info.end_patch; ++p) {

@@ -10,7 +10,13 @@
 #include <numbers>
 
 #include "lf/core/cancel.h"
+#include "lf/core/light_strategy.h"
 #include "lf/core/log.h"
+#include "lf/core/sobol.h"
+#include "lf/kernels/bsdf_sampling.h"
+#include "lf/kernels/environment_emitter.h"
+#include "lf/kernels/light_list.h"
+#include "lf/kernels/lights.h"
 
 namespace lf {
 
@@ -649,30 +655,102 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
                        std::move(evaluated), work);
 }
 
-std::vector<Rgb> PointLightIrradiance(const EmbreeScene& scene, const PatchMesh& mesh) {
+namespace {
+
+// Directions per quadrature point for a sky (cosine-weighted) and a sun disk (uniform in its
+// cone): with 12 points a side, 768 and 192.
+constexpr int kSkyDirections = 64;
+constexpr int kSunDirections = 16;
+
+// Direction sample d of quadrature point k: point k takes the Sobol points [k n, (k + 1) n), each
+// such run a stratified net, and the side's points together a longer prefix of the sequence.
+Vec2 DirectionSample(int k, int d, int n) {
+    const uint32_t index = uint32_t(k * n + d);
+    return {float(SobolDimension0(index)) * 0x1p-32f, float(SobolDimension1(index)) * 0x1p-32f};
+}
+
+// The irradiance one light puts on a side: the quadrature's weighted sum of `at(x, from)` over
+// the side's points, at least 12 so that a shadow edge across the patch is resolved.
+template <typename At>
+Rgb SideAverage(const EmbreeScene& scene, const PatchMesh& mesh, const SideGeometry& g, int level,
+                const At& at) {
+    Rgb e;
+    const auto& nodes = GetRules().quadrature[size_t(std::max(1, level))];
+    for (size_t k = 0; k < nodes.size(); ++k) {
+        const Vec3d x = PointOf(g, nodes[k].w);
+        e += at(x, RayPointOf(scene, mesh, g, nodes[k].w), int(k)) * float(nodes[k].weight);
+    }
+    return e;
+}
+
+}  // namespace
+
+std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mesh) {
+    const Scene& s = scene.scene();
     const std::vector<SideGeometry> sides = SideGeometries(scene, mesh);
     std::vector<Rgb> irradiance(sides.size());
-    const auto& lights = scene.scene().point_lights;
-    if (lights.empty()) return irradiance;
-    tbb::parallel_for(size_t(0), sides.size(), [&](size_t s) {
-        const SideGeometry& g = sides[s];
-        for (const PointLight& light : lights) {
-            const Vec3d l = light.position - scene.origin();
-            // At least 12 points: a shadow edge across the patch is resolved, not a coin flip.
-            const int level = std::max(1, QuadratureLevel(Length(l - g.c) / g.radius));
-            const SurfacePoint target{Vec3(l), Vec3(0, 0, 0), Vec3(Normalize(g.c - l))};
-            double e = 0;
-            for (const Node& node : GetRules().quadrature[size_t(level)]) {
-                const Vec3d x = PointOf(g, node.w);
-                const Vec3d d = l - x;
-                const double cosine = Dot(g.n, d);
-                if (cosine <= 0) continue;
-                const SurfacePoint from = RayPointOf(scene, mesh, g, node.w);
-                if (scene.Occluded(SpawnRayTo(from, target))) continue;
-                const double r2 = LengthSquared(d);
-                e += node.weight * cosine / (r2 * std::sqrt(r2));
-            }
-            irradiance[s] += light.intensity * float(e);
+    const LightSampler lights(scene, LightStrategy::kPower);
+    std::vector<size_t> delta;
+    for (size_t i = 0; i < lights.size(); ++i) {
+        if (lights.IsDeltaLight(i)) delta.push_back(i);
+    }
+    std::vector<SunDisk> suns;
+    for (const DirectionalLight& light : s.directional_lights) {
+        if (const std::optional<SunDisk> sun = SunDiskOf(light)) suns.push_back(*sun);
+    }
+    std::optional<EnvironmentEmitter> sky;
+    if (s.environment) sky.emplace(*s.environment);
+    if (delta.empty() && suns.empty() && !sky) return irradiance;
+    tbb::parallel_for(size_t(0), sides.size(), [&](size_t i) {
+        const SideGeometry& g = sides[i];
+        const Vec3 n(g.n);
+        Rgb& e = irradiance[i];
+        for (const size_t light : delta) {
+            const std::optional<LightSample> centre = lights.SampleDeltaLight(light, Vec3(g.c), 0);
+            const int level = centre && !centre->at_infinity
+                                  ? QuadratureLevel(Length(Vec3d(centre->point.p) - g.c) / g.radius)
+                                  : 1;
+            e += SideAverage(scene, mesh, g, level,
+                             [&](const Vec3d& x, const SurfacePoint& from, int) {
+                                 const std::optional<LightSample> ls =
+                                     lights.SampleDeltaLight(light, Vec3(x), 0);
+                                 if (!ls) return Rgb();
+                                 const float cosine = Dot(n, ls->wi);
+                                 if (cosine <= 0 || scene.Occluded(SpawnRayTo(from, ls->point)))
+                                     return Rgb();
+                                 return ls->radiance * cosine;
+                             });
+        }
+        for (const SunDisk& sun : suns) {
+            const Frame frame = Frame::FromNormal(sun.axis);
+            const float solid_angle = 2 * std::numbers::pi_v<float> * sun.one_minus_cos;
+            e += SideAverage(scene, mesh, g, 1, [&](const Vec3d&, const SurfacePoint& from, int k) {
+                float sum = 0;
+                for (int d = 0; d < kSunDirections; ++d) {
+                    const Vec2 u = DirectionSample(k, d, kSunDirections);
+                    const float one_minus_cos = u.x * sun.one_minus_cos;
+                    const float sin =
+                        std::sqrt(std::max(0.0f, one_minus_cos * (2 - one_minus_cos)));
+                    const float phi = 2 * std::numbers::pi_v<float> * u.y;
+                    const Vec3 w = frame.FromLocal(
+                        {sin * std::cos(phi), sin * std::sin(phi), 1 - one_minus_cos});
+                    const float cosine = Dot(n, w);
+                    if (cosine > 0 && !scene.Occluded(SpawnRay(from, w))) sum += cosine;
+                }
+                return sun.radiance * (sum * solid_angle / kSunDirections);
+            });
+        }
+        if (sky) {
+            const Frame frame = Frame::FromNormal(n);
+            e += SideAverage(scene, mesh, g, 1, [&](const Vec3d&, const SurfacePoint& from, int k) {
+                Rgb sum;
+                for (int d = 0; d < kSkyDirections; ++d) {
+                    const Vec3 w = frame.FromLocal(
+                        SampleCosineHemisphere(DirectionSample(k, d, kSkyDirections)));
+                    if (!scene.Occluded(SpawnRay(from, w))) sum += sky->Le(w);
+                }
+                return sum * (std::numbers::pi_v<float> / kSkyDirections);
+            });
         }
     });
     return irradiance;

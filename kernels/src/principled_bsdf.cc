@@ -13,6 +13,7 @@ namespace lf {
 namespace {
 
 constexpr float kInvPi = std::numbers::inv_pi_v<float>;
+constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kMinCos = kBsdfMinCos;
 
 // Lobe picking estimates each lobe's share from wo alone; where the estimate vanishes but the lobe
@@ -143,6 +144,29 @@ Rgb PrincipledBsdf::DiffuseEval(const Vec3& wo, const Vec3& wi) const {
     const float cos_oh = Dot(wo, Normalize(wo + wi));
     return base_ *
            (diffuse_scale_ * (1 - LayerFresnel(cos_oh, true)) * BaseKeep(wo.z) * BaseKeep(wi.z));
+}
+
+Rgb PrincipledBsdf::DiffuseAlbedo() const {
+    if (diffuse_scale_ == 0) return {};
+    if (specular_ == 0 && !layered()) return base_ * (diffuse_scale_ * kPi);
+    // Directions uniform in cos^2 and azimuth are cosine-distributed, so the integral is pi times
+    // the mean of f over the grid; the lobes are isotropic, so wo's azimuth is fixed and wi's
+    // spans half the circle.
+    constexpr int kN = 16;
+    Rgb sum;
+    for (int i = 0; i < kN; ++i) {
+        const float cos_o = std::sqrt((i + 0.5f) / kN);
+        const Vec3 wo(std::sqrt(1 - cos_o * cos_o), 0, cos_o);
+        for (int j = 0; j < kN; ++j) {
+            const float cos_i = std::sqrt((j + 0.5f) / kN), sin_i = std::sqrt(1 - cos_i * cos_i);
+            for (int k = 0; k < kN; ++k) {
+                const float phi = kPi * (k + 0.5f) / kN;
+                const Vec3 wi(sin_i * std::cos(phi), sin_i * std::sin(phi), cos_i);
+                sum += DiffuseEval(wo, wi) * LayerKeep(wo, wi);
+            }
+        }
+    }
+    return sum * (kPi / (kN * kN * kN));
 }
 
 Rgb PrincipledBsdf::ThinTransmissionEval(const Vec3& wo, const Vec3& wi) const {

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <numbers>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -16,6 +15,7 @@
 #include "lf/kernels/form_factors.h"
 #include "lf/kernels/radiosity_refinement.h"
 #include "lf/kernels/radiosity_solution.h"
+#include "lf/kernels/radiosity_surfaces.h"
 
 namespace lf {
 
@@ -26,22 +26,26 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 }
 
 // The solver refuses this too, by side index; here the user learns which material it is. What
-// radiosity cannot model at all is said first: a textured albedo's factor of 1 is no albedo.
-absl::Status CheckReflectance(const Scene& scene) {
+// radiosity cannot model at all is said first, and what it drops is logged.
+absl::Status CheckReflectance(const EmbreeScene& embree) {
+    const Scene& scene = embree.scene();
     if (absl::Status refused = RadiosityRefusal(scene); !refused.ok()) return refused;
-    bool emits = false;
-    for (const PointLight& light : scene.point_lights) emits |= !light.intensity.IsBlack();
-    for (const TriangleMesh& mesh : scene.meshes) {
-        emits |= scene.materials[size_t(mesh.material)].IsEmissive();
+    if (const std::string drops = RadiosityDrops(scene); !drops.empty()) {
+        NamedLogger("radiosity")->info("diffuse parts only; dropped: {}", drops);
     }
-    if (!emits) return absl::OkStatus();
-    for (const TriangleMesh& mesh : scene.meshes) {
-        const Material& m = scene.materials[size_t(mesh.material)];
-        if (m.reflectance.MaxComponent() >= 1) {
+    if (!scene.HasLights()) return absl::OkStatus();
+    // Textured meshes (whose factor is often 1, scaled down by the texels) are left to the
+    // solver's check of every side's average.
+    const RadiositySurfaces surfaces(embree);
+    for (int mesh = 0; mesh < int(scene.meshes.size()); ++mesh) {
+        if (surfaces.Varies(mesh)) continue;
+        const Material& m = scene.materials[size_t(scene.meshes[size_t(mesh)].material)];
+        const Rgb rho = surfaces.UntexturedReflectance(mesh);
+        if (rho.MaxComponent() >= 1) {
             return absl::InvalidArgumentError(absl::StrFormat(
                 "radiosity: material '%s' has reflectance (%g, %g, %g); with emission in the "
                 "scene a reflectance of 1 or more has no finite solution",
-                m.name, m.reflectance.r, m.reflectance.g, m.reflectance.b));
+                m.name, rho.r, rho.g, rho.b));
         }
     }
     return absl::OkStatus();
@@ -160,7 +164,7 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& scene,
                                                            const RadiosityOptions& options) {
     const Scene& s = scene.scene();
-    if (absl::Status status = CheckReflectance(s); !status.ok()) return status;
+    if (absl::Status status = CheckReflectance(scene); !status.ok()) return status;
     RadiosityReport report;
     PatchMeshOptions mesh_options{options.patch_size, options.patches};
     RadiositySolution loaded;
@@ -251,20 +255,15 @@ absl::Status CheckNoRefinement(const RadiosityOptions& options) {
 
 RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& mesh,
                                     const FormFactors& form_factors) {
-    const std::vector<Rgb> irradiance = PointLightIrradiance(scene, mesh);
+    const std::vector<Rgb> irradiance = DirectIrradiance(scene, mesh);
+    RadiositySides sides = RadiositySurfaces(scene).Sides(mesh);
     RadiositySystem system;
     system.form_factors = &form_factors;
     for (size_t s = 0; s < mesh.sides().size(); ++s) {
-        const PatchMesh::Side& side = mesh.sides()[s];
-        const PatchMesh::Patch& patch = mesh.patches()[size_t(side.patch)];
-        const Material& m =
-            scene.scene().materials[size_t(scene.scene().meshes[size_t(patch.mesh)].material)];
-        Rgb e = m.reflectance * irradiance[s];
-        if (!side.back || m.two_sided_emission) e += m.emission * float(std::numbers::pi);
-        system.emission.push_back(e);
-        system.reflectance.push_back(m.reflectance);
-        system.area.push_back(patch.area);
+        system.emission.push_back(sides.reflectance[s] * irradiance[s] + sides.exitance[s]);
+        system.area.push_back(mesh.patches()[size_t(mesh.sides()[s].patch)].area);
     }
+    system.reflectance = std::move(sides.reflectance);
     return system;
 }
 
@@ -276,7 +275,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
             absl::StrFormat("radiosity: chunk %d of %d does not exist", chunk, chunks));
     }
     if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
-    if (absl::Status status = CheckReflectance(scene.scene()); !status.ok()) return status;
+    if (absl::Status status = CheckReflectance(scene); !status.ok()) return status;
     PatchMeshOptions mesh_options{options.patch_size, options.patches};
     mesh_options.cancel = cancel;
     absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(scene.scene(), mesh_options);

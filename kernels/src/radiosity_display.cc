@@ -9,6 +9,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_io.h"
+#include "lf/kernels/lights.h"
+#include "lf/kernels/radiosity_surfaces.h"
 
 namespace lf {
 
@@ -75,20 +77,24 @@ std::vector<std::array<Rgb, 3>> SmoothCorners(const PatchMesh& mesh,
 
 RadiosityDisplay::RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& mesh,
                                    std::vector<Rgb> radiosity, RadiosityShading shading)
-    : scene_(scene), mesh_(mesh), radiosity_(std::move(radiosity)) {
-    const Scene& s = scene_.scene();
+    : scene_(scene),
+      mesh_(mesh),
+      surfaces_(std::make_unique<RadiositySurfaces>(scene)),
+      radiosity_(std::move(radiosity)) {
+    const Scene& s = scene.scene();
+    if (s.environment ||
+        std::any_of(s.directional_lights.begin(), s.directional_lights.end(),
+                    [](const DirectionalLight& l) { return l.angular_diameter > 0; })) {
+        sky_ = std::make_unique<LightSampler>(scene, LightStrategy::kPower);
+    }
+    // The solve's own per-side reflectance and exitance (patch averages of textured ones).
+    const RadiositySides sides = surfaces_->Sides(mesh_);
     irradiance_.resize(radiosity_.size());
     for (size_t i = 0; i < radiosity_.size(); ++i) {
-        const PatchMesh::Side& side = mesh_.sides()[i];
-        const Material& m = s.materials[size_t(
-            s.meshes[size_t(mesh_.patches()[size_t(side.patch)].mesh)].material)];
-        Rgb reflected = radiosity_[i];
-        if (!side.back || m.two_sided_emission) {
-            reflected = reflected - m.emission * float(std::numbers::pi);
-        }
+        const Rgb reflected = radiosity_[i] - sides.exitance[i];
+        const Rgb& rho = sides.reflectance[i];
         for (int c = 0; c < 3; ++c) {
-            irradiance_[i][c] =
-                m.reflectance[c] > 0 ? std::max(0.f, reflected[c]) / m.reflectance[c] : 0.f;
+            irradiance_[i][c] = rho[c] > 0 ? std::max(0.f, reflected[c]) / rho[c] : 0.f;
         }
     }
     if (shading == RadiosityShading::kSmooth) {
@@ -97,10 +103,14 @@ RadiosityDisplay::RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& me
     }
 }
 
+RadiosityDisplay::~RadiosityDisplay() = default;
+
 Rgb RadiosityDisplay::Li(const Ray& ray, Sampler&, RenderStats& stats) const {
     ++stats.rays;
     const std::optional<SurfaceHit> hit = scene_.Intersect(ray);
-    if (!hit || hit->mesh < 0) return Rgb(0);
+    // The sky and sun disks, as the path tracer shows them.
+    if (!hit) return sky_ ? sky_->EscapedRadiance(ray.d) : Rgb(0);
+    if (hit->mesh < 0) return Rgb(0);
     return Radiance(hit->mesh, hit->primitive, hit->b1, hit->b2, Dot(ray.d, hit->n) > 0);
 }
 
@@ -116,7 +126,17 @@ Rgb RadiosityDisplay::Shade(std::span<const Rgb> per_side,
 }
 
 Rgb RadiosityDisplay::Radiance(int mesh, int primitive, double b1, double b2, bool back) const {
-    return Shade(radiosity_, corners_, mesh, primitive, b1, b2, back) * kInvPi;
+    if (!surfaces_->Varies(mesh)) {
+        return Shade(radiosity_, corners_, mesh, primitive, b1, b2, back) * kInvPi;
+    }
+    // Textured: the albedo and emission at the point, under the patch's irradiance.
+    const PatchPoint point = mesh_.Locate(mesh, primitive, b1, b2);
+    if (mesh_.patches()[size_t(point.patch)].sides[back ? 1 : 0] < 0) return Rgb(0);
+    const RadiositySurfaces::Point at = surfaces_->At(mesh, primitive, float(b1), float(b2));
+    const Material& m =
+        scene_.scene().materials[size_t(scene_.scene().meshes[size_t(mesh)].material)];
+    const Rgb emitted = !back || m.two_sided_emission ? at.emission : Rgb();
+    return at.reflectance * Irradiance(mesh, primitive, b1, b2, back) * kInvPi + emitted;
 }
 
 Rgb RadiosityDisplay::Irradiance(int mesh, int primitive, double b1, double b2, bool back) const {

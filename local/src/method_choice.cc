@@ -48,6 +48,11 @@ double TriangleArea(const TriangleMesh& mesh, const std::array<uint32_t, 3>& t) 
 SceneTransport AnalyzeTransport(const Scene& scene) {
     SceneTransport out;
     out.radiosity_limitation = RadiosityLimitation(scene);
+    if (const std::string drops = RadiosityDrops(scene);
+        out.radiosity_limitation.empty() && !drops.empty()) {
+        out.radiosity_limitation =
+            "radiosity would keep only the diffuse parts (dropping " + drops + ")";
+    }
     out.whitted_missing = WhittedMissingTerms(scene);
 
     std::vector<bool> used(scene.materials.size(), false);

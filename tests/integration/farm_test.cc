@@ -1283,15 +1283,16 @@ TEST_F(Farm, RadiosityTargetErrorRefinesOnEveryWorkerAndGivesTheLocalPixels) {
     EXPECT_EQ(ReadText(dir_ / "server-1.log").find("radiosity sweep"), std::string::npos);
 }
 
-TEST_F(Farm, RadiosityJobForAGlossySceneIsRefusedAtSubmission) {
+TEST_F(Farm, RadiosityJobForAMaskedSceneIsRefusedAtSubmission) {
     StartServer();
-    const std::string glossy = (dir_ / "glossy.json").string();
+    const std::string masked = (dir_ / "masked.json").string();
     nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
-    scene["materials"]["white"] = {{"type", "mirror"}, {"reflectance", {0.9, 0.9, 0.9}}};
-    std::ofstream(glossy) << scene.dump();
-    const CliRun r = Farmctl("submit " + glossy + " --method radiosity");
+    scene["materials"]["white"] = {{"type", "principled"}, {"alpha_mode", "mask"}};
+    std::ofstream(masked) << scene.dump();
+    const CliRun r = Farmctl("submit " + masked + " --method radiosity");
     EXPECT_NE(r.status, 0);
-    EXPECT_NE(r.err.find("radiosity models lambert only"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("has an alpha mask, which radiosity does not model"), std::string::npos)
+        << r.err;
 }
 
 // A --sky map outside the scene's folder travels with the scene's files (by its name relative to
@@ -1892,7 +1893,8 @@ TEST_P(FarmSplat, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
     };
     const size_t leased = leases();
     const auto deadline = Clock::now() + milliseconds(20000);
-    while (leases() == leased && Clock::now() < deadline) std::this_thread::sleep_for(milliseconds(1));
+    while (leases() == leased && Clock::now() < deadline)
+        std::this_thread::sleep_for(milliseconds(1));
     ASSERT_GT(leases(), leased) << "the worker leased no further task";
     ASSERT_EQ(Farmctl("cancel " + job).status, 0);
     EXPECT_TRUE(WaitForText(dir_ / "w1.log", "dropped", kStopWithin))

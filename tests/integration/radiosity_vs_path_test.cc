@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "lf/core/camera.h"
+#include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
@@ -241,6 +242,110 @@ TEST_F(RadiosityVsPath, RefinementBeatsAUniformMeshOfTheSameSize) {
 TEST_F(RadiosityVsPath, RefinementBeatsAUniformMeshOfTheSameSizeUnderALocalLight) {
     ASSERT_NO_FATAL_FAILURE(Load("cornell_box_wide.json"));
     ExpectRefinementBeatsAUniformMeshOfTheSameSize(*embree_, *camera_, settings_, path_);
+}
+
+// Block regions, the floor's pixels split further by the checker texel they see (light or dark,
+// from the hit's position on tests/scenes/radiosity/room.gltf's 0.5 m texels): region 2 b + 1
+// holds block b's dark floor pixels, 2 b its other pixels. Pixels whose centre and corners do not
+// all see one texel of the floor (or one other mesh) belong to no region.
+std::vector<int> BlocksByTexel(const EmbreeScene& scene, const Camera& camera, int floor) {
+    const std::vector<int> blocks = Blocks();
+    std::vector<int> region(blocks.size(), -1);
+    for (int y = 0; y < kResolution; ++y) {
+        for (int x = 0; x < kResolution; ++x) {
+            int kind = -2;  // -1: mixed; 2: a light floor texel, 3: a dark one; 10 + other meshes
+            for (float u : {0.0f, 0.5f, 0.999f}) {
+                for (float v : {0.0f, 0.5f, 0.999f}) {
+                    const auto hit = scene.Intersect(camera.GenerateRay(x, y, u, v));
+                    int k = -1;
+                    if (hit && hit->mesh == floor) {
+                        const Vec3d p = Vec3d(hit->p) + scene.origin();
+                        const int ix = int(std::floor((p.x + 2) / 0.5));
+                        const int iz = int(std::floor((2 - p.z) / 0.5));
+                        k = (ix + iz) % 2 == 0 ? 2 : 3;
+                    } else if (hit) {
+                        k = 10 + hit->mesh;
+                    }
+                    kind = kind == -2 || kind == k ? k : -1;
+                }
+            }
+            const size_t i = size_t(y) * kResolution + size_t(x);
+            if (kind >= 0) region[i] = 2 * blocks[i] + (kind == 3 ? 1 : 0);
+        }
+    }
+    return region;
+}
+
+// A textured glTF room as a modelling tool exports it (tests/scenes/radiosity): principled
+// materials, a checker-textured floor, a meshed block, a point and a spot light. Radiosity keeps
+// the diffuse parts and the texture detail: block by block, the floor's light and dark texels
+// apart, within 3 % of the path tracer plus its noise (5 sigma).
+TEST_F(RadiosityVsPath, TexturedGltfRoomAgreesBlockByBlock) {
+    ASSERT_NO_FATAL_FAILURE(Load("radiosity/room.gltf"));
+    EXPECT_EQ(RadiosityLimitation(scene_), "");
+    EXPECT_EQ(RadiosityDrops(scene_), "specular reflection: \"white plaster\"");
+    int floor = -1;
+    for (size_t m = 0; m < scene_.meshes.size(); ++m) {
+        if (scene_.meshes[m].name == "floor[0]") floor = int(m);
+    }
+    ASSERT_GE(floor, 0);
+    RadiosityOptions options;
+    options.patches = 4000;
+    auto renderer = PrepareRadiosity(*embree_, options);
+    ASSERT_TRUE(renderer.ok()) << renderer.status();
+    const Image image = RenderImage(*camera_, **renderer, settings_).value().image;
+
+    const std::vector<int> region = BlocksByTexel(*embree_, *camera_, floor);
+    const int regions = 2 * (kResolution / kBlock) * (kResolution / kBlock);
+    std::vector<int> pixels(size_t(regions), 0);
+    for (int r : region) {
+        if (r >= 0) ++pixels[size_t(r)];
+    }
+    const RegionMeans path = Means(path_, region, regions);
+    const RegionMeans radiosity = Means(image, region, regions);
+    double light_floor = 0, dark_floor = 0, worst = 0;
+    int compared = 0, light_n = 0, dark_n = 0;
+    for (int r = 0; r < regions; ++r) {
+        if (pixels[size_t(r)] < 8) continue;  // too few pixels to say much
+        ++compared;
+        for (int c = 0; c < 3; ++c) {
+            const size_t k = size_t(r) * 3 + size_t(c);
+            const double p = path.mean[k], e = path.error[k];
+            worst = std::max(worst, (std::abs(radiosity.mean[k] - p) - kSigmas * e) / p);
+            EXPECT_NEAR(radiosity.mean[k], p, 0.03 * p + kSigmas * e)
+                << "block " << r / 2 << (r % 2 ? " dark texels" : "") << " channel " << c;
+        }
+    }
+    // Radiosity over the path tracer in G per block: other pixels, then the dark floor texels.
+    for (int by = 0; by < 8; ++by) {
+        for (int bx = 0; bx < 8; ++bx) {
+            const size_t k = size_t(2 * (by * 8 + bx)) * 3 + 1;
+            std::printf("%6.3f", pixels[k / 3] >= 8 ? radiosity.mean[k] / path.mean[k] : 0.0);
+        }
+        std::printf("   ");
+        for (int bx = 0; bx < 8; ++bx) {
+            const size_t k = size_t(2 * (by * 8 + bx) + 1) * 3 + 1;
+            std::printf("%6.3f", pixels[k / 3] >= 8 ? radiosity.mean[k] / path.mean[k] : 0.0);
+        }
+        std::printf("\n");
+    }
+    // The floor's texels, from the pixels of blocks that see only floor.
+    for (int y = 0; y < kResolution; ++y) {
+        for (int x = 0; x < kResolution; ++x) {
+            const size_t i = size_t(y) * kResolution + size_t(x);
+            const auto hit = embree_->Intersect(camera_->GenerateRay(x, y, 0.5f, 0.5f));
+            if (region[i] < 0 || !hit || hit->mesh != floor) continue;
+            const double g = (*image.FindChannel("G"))[i];
+            (region[i] % 2 ? dark_floor : light_floor) += g;
+            ++(region[i] % 2 ? dark_n : light_n);
+        }
+    }
+    ASSERT_GT(light_n, 0);
+    ASSERT_GT(dark_n, 0);
+    std::printf("%d regions compared; worst excess over 5 sigma %.4f; floor light %.4f dark %.4f\n",
+                compared, worst, light_floor / light_n, dark_floor / dark_n);
+    // sRGB 200 and 60 are 0.578 and 0.0452 linear: the checker keeps its contrast of ~13.
+    EXPECT_GT(light_floor / light_n, 6 * dark_floor / dark_n);
 }
 
 }  // namespace

@@ -9,18 +9,12 @@ Run from this folder: python3 make_multi_uv.py
 """
 import base64
 import json
+import os
 import struct
-import zlib
+import sys
 
-
-def png(width, height, rows):
-    """An 8-bit RGB PNG from rows of bytes."""
-    def chunk(kind, data):
-        body = kind + data
-        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
-    raw = b"".join(b"\0" + bytes(row) for row in rows)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
-            + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from gltf_writer import png  # noqa: E402
 
 
 def quad(x0, x1):

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <set>
 #include <tuple>
@@ -338,17 +339,18 @@ TEST(PatchMesh, RefusesWhatRadiosityCannotModel) {
     scene.spheres.push_back({"ball", 0, Vec3d(), 1});
     EXPECT_EQ(PatchMesh::Build(scene, {}).status().code(), absl::StatusCode::kInvalidArgument);
     scene = OneTriangle();
-    scene.materials[0].type = Material::Type::kMirror;
-    auto mirror = PatchMesh::Build(scene, {});
-    EXPECT_EQ(mirror.status().code(), absl::StatusCode::kInvalidArgument);
-    EXPECT_NE(mirror.status().message().find("mirror"), std::string::npos);
+    scene.materials[0].type = Material::Type::kInterface;
+    auto interface = PatchMesh::Build(scene, {});
+    EXPECT_EQ(interface.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(interface.status().message().find("medium interface"), std::string::npos);
     PatchMeshOptions none;
     none.patches = 0;
     EXPECT_EQ(PatchMesh::Build(OneTriangle(), none).status().code(),
               absl::StatusCode::kInvalidArgument);
 }
 
-// What radiosity cannot model, with the reason `--method auto` logs and radiosity refuses with.
+// What radiosity cannot model, with the reason `--method auto` logs and radiosity refuses with;
+// what it takes from modelling tools (principled materials, textures, every light) is accepted.
 TEST(PatchMesh, RadiosityLimitationSaysWhy) {
     auto why = [](void (*change)(Scene&)) {
         Scene scene = OneTriangle();
@@ -358,16 +360,24 @@ TEST(PatchMesh, RadiosityLimitationSaysWhy) {
         return RadiosityLimitation(scene);
     };
     EXPECT_EQ(why([](Scene&) {}), "");
-    EXPECT_EQ(why([](Scene& s) { s.materials[0].type = Material::Type::kPrincipled; }),
-              "material \"wood\" (mesh \"floor\") is principled; radiosity models lambert only");
+    EXPECT_EQ(why([](Scene& s) { s.materials[0].type = Material::Type::kPrincipled; }), "");
+    EXPECT_EQ(why([](Scene& s) { s.materials[0].type = Material::Type::kMirror; }), "");
     EXPECT_EQ(why([](Scene& s) {
                   auto image = std::make_shared<TextureImage>();
                   image->name = "wood.png";
                   s.textures.push_back(image);
                   s.materials[0].base_color_texture.image = 0;
               }),
-              "material \"wood\" (mesh \"floor\") has a texture (base_color_texture "
-              "\"wood.png\"), which radiosity does not model");
+              "");
+    EXPECT_EQ(why([](Scene& s) { s.spot_lights.emplace_back(); }), "");
+    EXPECT_EQ(why([](Scene& s) {
+                  s.directional_lights.push_back({Vec3d(0, -1, 0), Rgb(1.0f), 0.01});
+              }),
+              "");
+    EXPECT_EQ(why([](Scene& s) { s.environment.emplace(); }), "");
+    EXPECT_EQ(why([](Scene& s) { s.materials[0].type = Material::Type::kInterface; }),
+              "material \"wood\" (mesh \"floor\") is a medium interface, which radiosity does "
+              "not model");
     EXPECT_EQ(why([](Scene& s) { s.materials[0].alpha_mode = Material::AlphaMode::kMask; }),
               "material \"wood\" (mesh \"floor\") has an alpha mask, which radiosity does not "
               "model");
@@ -379,28 +389,90 @@ TEST(PatchMesh, RadiosityLimitationSaysWhy) {
               }),
               "sphere \"ball\" cannot be meshed; radiosity supports triangle meshes and quads "
               "only");
-    EXPECT_EQ(why([](Scene& s) { s.spot_lights.emplace_back(); }),
-              "the scene has spot or directional lights, which radiosity does not model");
-    EXPECT_EQ(why([](Scene& s) { s.directional_lights.emplace_back(); }),
-              "the scene has spot or directional lights, which radiosity does not model");
-    EXPECT_EQ(why([](Scene& s) {
-                  s.directional_lights.push_back({Vec3d(0, -1, 0), Rgb(1.0f), 0.01});
-              }),
-              "the scene has a sun disk (a directional light with an angular diameter), which "
-              "radiosity does not model");
-    EXPECT_EQ(why([](Scene& s) { s.environment.emplace(); }),
-              "the scene has an environment light, which radiosity does not model (its patches "
-              "see only each other)");
     // Two-sided emission is modelled: both sides of an emitter's patches get unknowns.
     EXPECT_EQ(why([](Scene& s) { s.materials[0].two_sided_emission = true; }), "");
     // A material no shape uses does not matter.
-    EXPECT_EQ(why([](Scene& s) { s.materials.emplace_back().type = Material::Type::kDielectric; }),
+    EXPECT_EQ(why([](Scene& s) { s.materials.emplace_back().type = Material::Type::kInterface; }),
               "");
-    Scene spot = OneTriangle();
-    spot.spot_lights.emplace_back();
-    EXPECT_EQ(PatchMesh::Build(spot, {}).status().message(),
-              "radiosity: the scene has spot or directional lights, which radiosity does not "
+    Scene masked = OneTriangle();
+    masked.materials[0].alpha_mode = Material::AlphaMode::kBlend;
+    EXPECT_EQ(PatchMesh::Build(masked, {}).status().message(),
+              "radiosity: material \"\" (mesh \"\") is alpha-blended, which radiosity does not "
               "model; render it with --method path");
+}
+
+// What radiosity leaves out, by kind, each used material named once.
+TEST(PatchMesh, RadiosityDropsNamesWhatItLeavesOut) {
+    Scene scene = OneTriangle();
+    EXPECT_EQ(RadiosityDrops(scene), "");
+    scene.materials[0].name = "plastic";
+    scene.materials[0].type = Material::Type::kPrincipled;
+    scene.materials[0].clearcoat = 0.5f;
+    for (const auto& [name, type] : {std::pair{"glass", Material::Type::kDielectric},
+                                     {"chrome", Material::Type::kMirror},
+                                     {"unused", Material::Type::kGlossy}}) {
+        Material& m = scene.materials.emplace_back();
+        m.name = name;
+        m.type = type;
+    }
+    Material& velvet = scene.materials.emplace_back();
+    velvet.name = "velvet";
+    velvet.type = Material::Type::kPrincipled;
+    velvet.specular = 0;
+    velvet.sheen_color = Rgb(0.5f);
+    velvet.normal_texture.image = 0;
+    for (int m : {1, 2, 0, 4, 1}) {
+        scene.meshes.push_back(scene.meshes[0]);
+        scene.meshes.back().material = m;
+    }
+    EXPECT_EQ(RadiosityDrops(scene),
+              "no diffuse part (rendered black): \"glass\" (dielectric), \"chrome\" (mirror); "
+              "specular reflection: \"plastic\"; clear coat: \"plastic\"; sheen: \"velvet\"; "
+              "normal map: \"velvet\"");
+    EXPECT_FALSE(MayReflectDiffusely(scene.materials[1]));
+    EXPECT_TRUE(MayReflectDiffusely(scene.materials[0]));
+    scene.materials[0].metallic = 1;
+    EXPECT_FALSE(MayReflectDiffusely(scene.materials[0]));
+    EXPECT_EQ(RadiosityDrops(scene).rfind(
+                  "no diffuse part (rendered black): \"plastic\" (principled), \"glass\" "
+                  "(dielectric)",
+                  0),
+              0u);
+}
+
+// A lone reflecting triangle gets unknowns only on the sides a light can reach: the side a
+// spot, directional light or sun disk faces, both sides under a sky.
+TEST(PatchMesh, LightsDecideWhichSidesGetUnknowns) {
+    auto sides = [](void (*light)(Scene&)) {
+        Scene scene = OneTriangle();  // in the plane z = 0, front normal +z
+        scene.materials[0].emission = Rgb(0.0f);
+        light(scene);
+        auto mesh = PatchMesh::Build(scene, {.patches = 4});
+        EXPECT_TRUE(mesh.ok()) << mesh.status();
+        int front = 0, back = 0;
+        for (const PatchMesh::Side& side : mesh->sides()) ++(side.back ? back : front);
+        return std::pair{front, back};
+    };
+    EXPECT_EQ(sides([](Scene&) {}), std::pair(0, 0));
+    const int n = sides([](Scene& s) { s.environment.emplace(); }).first;
+    EXPECT_GT(n, 0);
+    EXPECT_EQ(sides([](Scene& s) { s.environment.emplace(); }), std::pair(n, n));
+    EXPECT_EQ(sides([](Scene& s) {
+                  s.spot_lights.push_back({.position = {0, 0, 1}, .direction = {0, 0, -1}});
+              }),
+              std::pair(n, 0));
+    EXPECT_EQ(sides([](Scene& s) {
+                  s.directional_lights.push_back({Vec3d(0, 0, 1), Rgb(1.0f)});
+              }),
+              std::pair(0, n));
+    // A sun disk 10° across, grazing at 2° below the plane from the back: its upper rim still
+    // reaches the front.
+    EXPECT_EQ(sides([](Scene& s) {
+                  const double a = 2 * std::numbers::pi / 180;
+                  s.directional_lights.push_back(
+                      {Vec3d(std::cos(a), 0, std::sin(a)), Rgb(1.0f), 10 * std::numbers::pi / 180});
+              }),
+              std::pair(n, n));
 }
 
 }  // namespace

@@ -287,9 +287,9 @@ TEST(Radiosity, RefusesWhatItCannotRepresent) {
     spheres.spheres.push_back({"ball", 0, Vec3d(), 0.2});
     EXPECT_EQ(Prepare(spheres, {}).renderer.status().code(), absl::StatusCode::kInvalidArgument);
 
-    Scene glossy = testing::MakeFurnace(1.0, Vec3d(), 0.5f, 1.0f, 8);
-    glossy.materials[0].type = Material::Type::kGlossy;
-    EXPECT_EQ(Prepare(glossy, {}).renderer.status().code(), absl::StatusCode::kInvalidArgument);
+    Scene masked = testing::MakeFurnace(1.0, Vec3d(), 0.5f, 1.0f, 8);
+    masked.materials[0].alpha_mode = Material::AlphaMode::kMask;
+    EXPECT_EQ(Prepare(masked, {}).renderer.status().code(), absl::StatusCode::kInvalidArgument);
 
     Scene white = testing::MakeFurnace(1.0, Vec3d(), 1.0f, 1.0f, 8);
     const auto refused = Prepare(white, {}).renderer.status();

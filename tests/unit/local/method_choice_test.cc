@@ -92,5 +92,18 @@ TEST(MethodChoice, RequestedMethodIsTaken) {
     EXPECT_EQ(c.why, "requested");
 }
 
+// A modelling tool's room (principled materials, a textured floor, point and spot lights) is
+// radiosity's to render, but it would drop the plaster's specular layer: auto takes the path
+// tracer and says what radiosity would drop; asked for, radiosity takes the scene.
+TEST(MethodChoice, RadiosityTakesAModellingToolsRoomAndSaysWhatItDrops) {
+    const Scene room = Load("radiosity/room.gltf");
+    const MethodChoice automatic = ChooseMethod(room, std::nullopt);
+    EXPECT_EQ(automatic.method, Method::kPath);
+    EXPECT_EQ(automatic.why,
+              "radiosity would keep only the diffuse parts (dropping specular reflection: "
+              "\"white plaster\")");
+    EXPECT_TRUE(CheckMethodTakesScene(Method::kRadiosity, room).ok());
+}
+
 }  // namespace
 }  // namespace lf

@@ -11,8 +11,8 @@
 //
 // A patch has two sides. A side gets an unknown (a radiosity value to solve for) only if its
 // radiosity can be non-zero: it is the front of an emitter (either side of a two-sided one), or
-// its reflectance is not black and something (a vertex of another triangle or a point light)
-// lies strictly in front of it.
+// its diffuse reflectance is not black and something (a vertex of another triangle, a light
+// that can shine on it) lies strictly in front of it.
 // Every other side has radiosity exactly zero: in a closed box only the inward sides remain.
 #pragma once
 
@@ -28,12 +28,23 @@
 
 namespace lf {
 
-// Why radiosity cannot model `scene` ("material \"wood\" (mesh \"floor\") has a texture
-// (base_color_texture \"wood.png\"), which radiosity does not model"), or empty when it can:
-// radiosity solves for one radiosity per patch side, so it takes triangle meshes whose materials
-// are untextured, opaque, double-sided lambert, lit by emission and point lights. Only materials
-// some mesh uses count. `--method auto` logs it when it picks the path tracer.
+// Why radiosity cannot model `scene` ("material \"leaf\" (mesh \"tree\") has an alpha mask,
+// which radiosity does not model"), or empty when it can: radiosity solves for one radiosity per
+// patch side, so it takes double-sided, opaque triangle meshes (no medium interfaces). What it
+// approximates instead of refusing, RadiosityDrops says. Only materials some mesh uses count.
+// `--method auto` logs it when it picks the path tracer.
 std::string RadiosityLimitation(const Scene& scene);
+
+// What radiosity leaves out of a scene it takes, by kind, naming the materials ("specular
+// reflection: \"plastic\", \"floor\"; clear coat: \"car\""), or empty when nothing: it keeps
+// every material's diffuse part (docs/radiosity.md, Scenes from modelling tools), so mirrors,
+// glass and glossy metal render black, and speculars, transmission, coats, sheen and normal
+// maps are dropped.
+std::string RadiosityDrops(const Scene& scene);
+
+// Whether a material's diffuse part can reflect anything whatever its textures: a side of it
+// gets an unknown only then.
+bool MayReflectDiffusely(const Material& material);
 
 // RadiosityLimitation as the error radiosity refuses a scene with (meshing, the solver, the
 // farm's submission), or OK.
@@ -100,7 +111,7 @@ class PatchMesh {
         bool back = false;
     };
 
-    // Fails for spheres and non-lambert materials, which radiosity does not model, and for a
+    // Fails for what RadiosityLimitation names, which radiosity does not model, and for a
     // split cell that is not in the mesh.
     static absl::StatusOr<PatchMesh> Build(const Scene& scene, const PatchMeshOptions& options);
 

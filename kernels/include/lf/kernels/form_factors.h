@@ -138,8 +138,12 @@ FormFactors ComputeFormFactors(const EmbreeScene& scene, const PatchMesh& mesh,
 // γ_k the angle between consecutive ones.
 double PointToPolygonFormFactor(const Vec3d& x, const Vec3d& n, std::span<const Vec3d> polygon);
 
-// Irradiance (W m^-2) from the scene's point lights on every side, averaged over the side with
-// one shadow ray per quadrature point.
-std::vector<Rgb> PointLightIrradiance(const EmbreeScene& scene, const PatchMesh& mesh);
+// Direct irradiance (W m^-2) from the scene's lights on every side, averaged over the side's
+// quadrature points (at least 12; finer near point and spot lights), with Embree shadow rays:
+// point and spot lights (both falloffs) and directional lights one ray per point, a sun disk 16
+// directions uniform in its cone per point, an environment (uniform or a map) 64
+// cosine-weighted directions per point. The directions are deterministic (consecutive runs of
+// the Sobol sequence), so the result does not depend on the thread count.
+std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mesh);
 
 }  // namespace lf

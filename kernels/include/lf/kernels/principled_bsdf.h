@@ -68,6 +68,12 @@ class PrincipledBsdf {
     }
     // Some lobe is a Dirac delta: the smooth base's reflection or transmission, or a smooth coat.
     bool HasDeltaLobe() const { return smooth_ || (coat_.active() && coat_.smooth()); }
+    // The diffuse base's albedo averaged over both directions, cosine-weighted: (1/pi) times the
+    // double integral of f_diffuse cos_o cos_i over the outside hemisphere, under the layers'
+    // keep, by a 16^3 midpoint rule. What radiosity takes as the surface's Lambertian
+    // reflectance: the energy the path tracer's diffuse lobe carries, without its speculars,
+    // transmission, coat and sheen.
+    Rgb DiffuseAlbedo() const;
     // Bsdf::RefractionEta: RelativeEta(wo) for a pair across a solid's interface, else 1.
     float RefractionEta(const Vec3& wo, const Vec3& wi) const {
         return refracts_ && wo.z * wi.z < 0 ? RelativeEta(wo) : 1.0f;

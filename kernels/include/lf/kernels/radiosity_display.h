@@ -2,12 +2,14 @@
 // same kind of EXR the path tracer writes, and a PLY export of the coloured patch mesh.
 //
 // A camera ray returns B/π of the patch side it hits (Lambertian radiance; B includes the
-// emission, so emitters need nothing extra). Flat shading uses the patch's value; smooth
-// shading interpolates corner values, each the area-weighted mean B of the sides that share
-// the vertex, face the same way and lie within 30° of each other (creases stay sharp).
+// emission, so emitters need nothing extra), or the sky and sun disks where it leaves the scene.
+// Flat shading uses the patch's value; smooth shading interpolates corner values, each the
+// area-weighted mean B of the sides that share the vertex, face the same way and lie within 30° of
+// each other (creases stay sharp).
 #pragma once
 
 #include <array>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -19,6 +21,9 @@
 #include "lf/kernels/radiance.h"
 
 namespace lf {
+
+class LightSampler;
+class RadiositySurfaces;
 
 enum class RadiosityShading { kFlat, kSmooth };
 
@@ -35,16 +40,19 @@ class RadiosityDisplay : public RadianceEstimator {
     // `mesh` must outlive the display; `radiosity` has one value per side.
     RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& mesh, std::vector<Rgb> radiosity,
                      RadiosityShading shading);
+    ~RadiosityDisplay() override;
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
     const EmbreeScene& geometry() const override { return scene_; }
 
-    // Radiance leaving one side of the point (b1, b2) of a scene triangle. Sides without an
-    // unknown have radiosity 0.
+    // Radiance leaving one side of the point (b1, b2) of a scene triangle: B / pi, or where the
+    // material is textured (or has vertex colours) albedo(uv) H / pi + Le(uv), H the side's
+    // irradiance, so a texture keeps its detail. Sides without an unknown have radiosity 0.
     Rgb Radiance(int mesh, int primitive, double b1, double b2, bool back) const;
     // Irradiance (W m^-2) arriving on that side, shaded as the radiance is: (B - emitted
-    // exitance) / reflectance per side and channel; 0 where the reflectance is 0, whose
-    // irradiance the solution does not hold.
+    // exitance) / reflectance per side and channel, both as the solve had them (patch averages
+    // of textured materials); 0 where the reflectance is 0, whose irradiance the solution does
+    // not hold.
     Rgb Irradiance(int mesh, int primitive, double b1, double b2, bool back) const;
 
   private:
@@ -54,6 +62,8 @@ class RadiosityDisplay : public RadianceEstimator {
     Rgb Shade(std::span<const Rgb> per_side, const std::vector<std::array<Rgb, 3>>& corners,
               int mesh, int primitive, double b1, double b2, bool back) const;
 
+    std::unique_ptr<const RadiositySurfaces> surfaces_;
+    std::unique_ptr<const LightSampler> sky_;  // what rays that leave the scene see, if any
     std::vector<Rgb> radiosity_, irradiance_;
     // Smooth shading only.
     std::vector<std::array<Rgb, 3>> corners_, irradiance_corners_;

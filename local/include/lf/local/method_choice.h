@@ -13,8 +13,8 @@
 namespace lf {
 
 struct SceneTransport {
-    // Empty when radiosity models the scene exactly (all Lambertian, triangle meshes, area
-    // lights): else why not (lf/core/patch_mesh.h).
+    // Empty when radiosity models the scene exactly (diffuse materials, textured or not,
+    // triangle meshes, any lights): else why not (lf/core/patch_mesh.h), or what it would drop.
     std::string radiosity_limitation;
     // Materials (by name) whose reflection or refraction is a delta or nearly so: mirrors,
     // dielectrics, transmissive principled materials, and glossy ones sharper than
