@@ -15,13 +15,9 @@ namespace lf {
 
 namespace {
 
-double Power(double area, const Rgb& c) {
-    return area * (double(std::abs(c.r)) + std::abs(c.g) + std::abs(c.b));
-}
-
 double SystemPower(const RadiositySystem& system, std::span<const Rgb> b) {
     double power = 0;
-    for (size_t i = 0; i < b.size(); ++i) power += Power(system.area[i], b[i]);
+    for (size_t i = 0; i < b.size(); ++i) power += RadiosityPower(system.area[i], b[i]);
     return power;
 }
 
@@ -141,7 +137,7 @@ absl::StatusOr<SolveResult> SolveGaussSeidel(const RadiositySystem& system,
             for (int32_t i = group.begin; i < group.end; ++i) {
                 Rgb& bi = b[size_t(i)];
                 const Rgb& ui = updated[size_t(i - group.begin)];
-                change += Power(system.area[size_t(i)], ui - bi);
+                change += RadiosityPower(system.area[size_t(i)], ui - bi);
                 bi = ui;
             }
         }
@@ -189,6 +185,10 @@ absl::StatusOr<SolveResult> SolveShooting(const RadiositySystem& system,
 }
 
 }  // namespace
+
+double RadiosityPower(double area, const Rgb& c) {
+    return area * (double(std::abs(c.r)) + std::abs(c.g) + std::abs(c.b));
+}
 
 absl::StatusOr<RadiositySolver> ParseRadiositySolver(std::string_view name) {
     for (RadiositySolver s :
@@ -248,8 +248,8 @@ GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<c
     GroupSweep sums;
     for (int32_t i = g.begin; i < g.end; ++i) {
         const double area = system.area[size_t(i)];
-        sums.change += Power(area, out[size_t(i - g.begin)] - b[size_t(i)]);
-        sums.power += Power(area, b[size_t(i)]);
+        sums.change += RadiosityPower(area, out[size_t(i - g.begin)] - b[size_t(i)]);
+        sums.power += RadiosityPower(area, b[size_t(i)]);
     }
     return sums;
 }

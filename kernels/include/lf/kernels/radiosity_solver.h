@@ -74,6 +74,9 @@ struct GroupSweep {
 GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
                        std::span<Rgb> out);
 
+// The power of radiosity c over `area` in that norm: area (|r| + |g| + |b|).
+double RadiosityPower(double area, const Rgb& c);
+
 // ||E + ρ F b - b|| / ||b|| in the power norm above (0 when b and E are 0).
 double RelativeResidual(const RadiositySystem& system, std::span<const Rgb> b);
 
