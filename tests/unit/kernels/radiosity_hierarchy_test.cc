@@ -13,6 +13,7 @@
 
 #include "lf/core/scene_loader.h"
 #include "lf/job/radiosity_solve.h"
+#include "lf/job/render_metadata.h"
 #include "lf/kernels/radiosity.h"
 #include "test_scenes.h"
 
@@ -81,8 +82,9 @@ double LargestSurfaceDifference(const RadiosityRenderer& a, const RadiosityRende
     return worst;
 }
 
-// The Cornell box at ~1000 patches: per surface within 1 % of flat Jacobi at a fine link error,
-// and the difference falls as the link error does.
+// The Cornell box at ~1000 patches: per surface within 1 % of flat Jacobi from the default link
+// error (1e-3: 0.4 %) down, and the difference falls as the link error does (at 1e-5 nearly all
+// links are between sides, the flat method's form factors).
 TEST(RadiosityHierarchy, ConvergesToTheFlatSolution) {
     RadiosityOptions flat;
     flat.patches = 1000;
@@ -106,10 +108,11 @@ TEST(RadiosityHierarchy, ConvergesToTheFlatSolution) {
             "%.4f\n",
             link_error, (long long)report.cluster_links, (long long)report.side_links,
             report.links_per_side, report.form_factor_seconds + report.solve_seconds, difference);
-        EXPECT_LE(difference, previous * 1.1 + 1e-3) << link_error;
+        EXPECT_LT(difference, previous) << link_error;
+        if (link_error <= 1e-3) EXPECT_LT(difference, 0.01) << link_error;
         previous = difference;
     }
-    EXPECT_LT(previous, 0.01);
+    EXPECT_LT(previous, 1e-3);
 }
 
 // A closed box of uniform emission and reflectance: B = E / (1 - ρ) on every side.
@@ -266,6 +269,26 @@ TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
                                [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
             << chunks << " chunks";
     }
+}
+
+// With a target error every refinement pass solves hierarchically; the figures the EXR header
+// and the farm carry count the links.
+TEST(RadiosityHierarchy, RefinementPassesSolveHierarchically) {
+    RadiosityOptions options = Hierarchical(1e-3);
+    options.patches = 150;
+    options.target_error = 0.2;
+    const auto h = Solve(CornellBox(), options);
+    ASSERT_TRUE(h->renderer);
+    const RadiosityReport& report = h->renderer->report();
+    ASSERT_GE(report.refinement.size(), 2u);
+    EXPECT_GT(report.patches, report.refinement.front().patches);
+    EXPECT_EQ(report.form_factor_bytes, 0u);
+    EXPECT_EQ(report.refinement.back().pairs, 0);  // no flat form factors in any pass
+    EXPECT_GT(report.refinement.back().visibility_rays, 0);
+    const RadiosityFigures figures = RadiosityFiguresOf(report);
+    EXPECT_EQ(figures.links, report.cluster_links + report.side_links);
+    EXPECT_GT(figures.solver_bytes, figures.link_bytes);
+    EXPECT_GT(figures.link_bytes, 0);
 }
 
 TEST(RadiosityHierarchy, CancelStopsTheBuild) {
