@@ -109,7 +109,9 @@ TEST(RadiosityHierarchy, ConvergesToTheFlatSolution) {
             link_error, (long long)report.cluster_links, (long long)report.side_links,
             report.links_per_side, report.form_factor_seconds + report.solve_seconds, difference);
         EXPECT_LT(difference, previous) << link_error;
-        if (link_error <= 1e-3) EXPECT_LT(difference, 0.01) << link_error;
+        if (link_error <= 1e-3) {
+            EXPECT_LT(difference, 0.01) << link_error;
+        }
         previous = difference;
     }
     EXPECT_LT(previous, 1e-3);
