@@ -78,6 +78,13 @@ absl::StatusOr<FormFactors> FormFactorsOf(const EmbreeScene& scene, const PatchM
     return form_factors;
 }
 
+void ReportSolve(const SolveResult& solved, double seconds, RadiosityReport& report) {
+    report.solve_seconds += seconds;
+    report.iterations = solved.iterations;
+    report.sweeps = solved.sweeps;
+    report.residual = solved.residual;
+}
+
 // The solve on one mesh; times and counts add up in `report`.
 absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh& mesh,
                                        const FormFactors& form_factors,
@@ -89,10 +96,7 @@ absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh
         SolveRadiosity(system, {options.solver, tolerance, options.max_iterations, options.cancel});
     if (!solved.ok()) return solved.status();
     const double solve_seconds = SecondsSince(start);
-    report.solve_seconds += solve_seconds;
-    report.iterations = solved->iterations;
-    report.sweeps = solved->sweeps;
-    report.residual = solved->residual;
+    ReportSolve(*solved, solve_seconds, report);
     NamedLogger("radiosity")
         ->info("{}: {} iterations ({:.1f} sweeps), relative residual {:.2g}, {:.2f} s",
                RadiositySolverName(options.solver), solved->iterations, solved->sweeps,
@@ -143,10 +147,7 @@ absl::StatusOr<std::vector<Rgb>> SolveHierarchically(const EmbreeScene& scene,
         h, {RadiositySolver::kJacobi, tolerance, options.max_iterations, options.cancel});
     if (!solved.ok()) return solved.status();
     const double solve_seconds = SecondsSince(solve_start);
-    report.solve_seconds += solve_seconds;
-    report.iterations = solved->iterations;
-    report.sweeps = solved->sweeps;
-    report.residual = solved->residual;
+    ReportSolve(*solved, solve_seconds, report);
     NamedLogger("radiosity")
         ->info("hierarchical jacobi: {} sweeps, relative residual {:.2g}, {:.2f} s",
                solved->iterations, solved->residual, solve_seconds);

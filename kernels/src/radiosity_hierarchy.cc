@@ -157,8 +157,7 @@ class RadiosityHierarchy::Linker {
                     const double v = Visibility(p, q, rays);
                     if (v == 1 || v == 0 || power * kPartialVisibility <= threshold_) {
                         if (v > 0) {
-                            links.node.push_back(
-                                {p, q, Vec3(d), float(v / (kPi * distance * distance))});
+                            links.node.push_back({p, q, float(v)});
                         }
                         continue;
                     }
@@ -309,11 +308,16 @@ GroupSweep RadiosityHierarchy::SweepGroup(int32_t group, std::span<const NodeExi
     // Gather: vector irradiance per node of the group's subtree, scalar per side from leaves.
     std::vector<NodeExitance> irradiance(size_t(top.nodes()));
     for (const NodeLink& link : links.node) {
-        const Vec3d d(link.d);
+        // Recomputed every sweep rather than stored: links are most of the memory.
+        const Vec3d between =
+            nodes[size_t(link.source)].centroid - nodes[size_t(link.receiver)].centroid;
+        const double r2 = LengthSquared(between);
+        const Vec3d d = between / std::sqrt(r2);
+        const double scale = double(link.visibility) / (kPi * r2);
         NodeExitance& e = irradiance[size_t(link.receiver - root)];
         for (size_t c = 0; c < 3; ++c) {
             const double toward = -Dot(d, pulled[size_t(link.source)][c]);
-            if (toward > 0) e[c] += d * (double(link.scale) * toward);
+            if (toward > 0) e[c] += d * (scale * toward);
         }
     }
     std::vector<std::array<double, 3>> h(size_t(top.size()), {0, 0, 0});
@@ -387,36 +391,20 @@ size_t RadiosityHierarchy::bytes() const {
 absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,
                                               const SolveOptions& options) {
     const RadiositySystem& system = hierarchy.system();
-    SolveResult result;
-    std::vector<Rgb> b = system.emission, next(b.size());
+    std::vector<Rgb> b = system.emission;
     double emitted = 0;
     for (size_t t = 0; t < b.size(); ++t) emitted += RadiosityPower(system.area[t], b[t]);
     if (emitted == 0) {
-        result.radiosity.assign(b.size(), Rgb(0));
-        return result;
+        SolveResult dark;
+        dark.radiosity.assign(b.size(), Rgb(0));
+        return dark;
     }
-    for (;;) {
-        const GroupSweep sweep = hierarchy.Sweep(b, next, options.cancel);
-        if (CancelRequested(options.cancel)) {
-            return absl::CancelledError("radiosity: solve cancelled");
-        }
-        const double residual = sweep.change / sweep.power;
-        ++result.iterations;
-        if (residual <= options.tolerance) {
-            result.residual = residual;
-            break;
-        }
-        if (result.iterations >= options.max_iterations) {
-            return absl::ResourceExhaustedError(absl::StrFormat(
-                "radiosity: hierarchical solve not converged after %d sweeps (relative residual "
-                "%.3g > tolerance %.3g): raise the iteration limit or the tolerance",
-                result.iterations, residual, options.tolerance));
-        }
-        b.swap(next);
-    }
-    result.sweeps = result.iterations;
-    result.radiosity = std::move(b);
-    return result;
+    return IterateJacobi(
+        std::move(b),
+        [&](std::span<const Rgb> from, std::span<Rgb> to, const std::atomic<bool>* cancel) {
+            return hierarchy.Sweep(from, to, cancel);
+        },
+        options);
 }
 
 }  // namespace lf

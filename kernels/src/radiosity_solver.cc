@@ -94,13 +94,15 @@ GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, st
     return total;
 }
 
-absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
-                                        const SolveOptions& options) {
+}  // namespace
+
+absl::StatusOr<SolveResult> IterateJacobi(std::vector<Rgb> emission, const JacobiStep& step,
+                                          const SolveOptions& options) {
     SolveResult result;
-    std::vector<Rgb> b = system.emission, next(b.size());
+    std::vector<Rgb> b = std::move(emission), next(b.size());
     SolveLog log;
     for (;;) {
-        const GroupSweep sweep = JacobiSweep(system, b, next, options.cancel);
+        const GroupSweep sweep = step(b, next, options.cancel);
         if (CancelRequested(options.cancel)) return SolveCancelled();
         const double residual = sweep.change / sweep.power;
         ++result.iterations;
@@ -117,6 +119,18 @@ absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
     result.sweeps = result.iterations;
     result.radiosity = std::move(b);
     return result;
+}
+
+namespace {
+
+absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
+                                        const SolveOptions& options) {
+    return IterateJacobi(
+        system.emission,
+        [&](std::span<const Rgb> b, std::span<Rgb> next, const std::atomic<bool>* cancel) {
+            return JacobiSweep(system, b, next, cancel);
+        },
+        options);
 }
 
 // Gauss-Seidel converges monotonically from below (E, ρ, F >= 0), so a sweep's change bounds

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <numbers>
 
@@ -312,7 +313,8 @@ namespace lf {
 namespace {
 // Not a test: the numbers of the report (docs/radiosity.md "Hierarchical"), until the CLI has
 // --radiosity hierarchical. LF_BENCH_PATCH_SIZE (0.02: ~16k patches), LF_BENCH_LINK_ERROR,
-// LF_BENCH_FLAT=1 to compare with the flat Jacobi solve. Run with
+// LF_BENCH_FLAT=1 to compare with the flat Jacobi solve (LF_BENCH_FLAT_FILE: a solution file the
+// flat solve is saved to once and loaded from after). Run with
 // --gtest_also_run_disabled_tests --gtest_filter='*Bench*'.
 TEST(RadiosityHierarchy, DISABLED_BenchCornellBox) {
     auto env = [](const char* name, double fallback) {
@@ -337,6 +339,9 @@ TEST(RadiosityHierarchy, DISABLED_BenchCornellBox) {
     RadiosityOptions flat = options;
     flat.hierarchical = false;
     flat.solver = RadiositySolver::kJacobi;
+    if (const char* file = std::getenv("LF_BENCH_FLAT_FILE")) {
+        (std::filesystem::exists(file) ? flat.load_solution : flat.save_solution) = file;
+    }
     const auto f = Solve(CornellBox(), flat);
     ASSERT_TRUE(f->renderer);
     const RadiosityReport& fr = f->renderer->report();

@@ -80,9 +80,8 @@ class RadiosityHierarchy {
 
   private:
     struct NodeLink {
-        int32_t receiver, source;  // nodes
-        Vec3 d;                    // unit, receiver to source
-        float scale;               // V / (π r^2)
+        int32_t receiver, source;  // nodes (the direction is that of their centroids)
+        float visibility;
     };
     struct LeafLink {
         int32_t receiver, source;  // tree positions
