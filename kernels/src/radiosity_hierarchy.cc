@@ -258,8 +258,11 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
     std::vector<int64_t> rays(h->groups_.size(), 0);
     tbb::parallel_for(g0, g1, [&](int32_t g) {
         if (CancelRequested(options.cancel)) return;
-        h->links_[size_t(g)] =
-            linker.Link(h->group_roots_[size_t(g)], options.cancel, rays[size_t(g)]);
+        GroupLinks& links = h->links_[size_t(g)];
+        links = linker.Link(h->group_roots_[size_t(g)], options.cancel, rays[size_t(g)]);
+        // Links are most of the solver's memory: no growth slack.
+        links.node.shrink_to_fit();
+        links.leaf.shrink_to_fit();
     });
     if (CancelRequested(options.cancel)) {
         return absl::CancelledError("radiosity: linking cancelled");
