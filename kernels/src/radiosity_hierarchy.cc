@@ -39,7 +39,7 @@ double Support(const ClusterNode& node, const Vec3d& a) {
 }
 
 // Whether some side of `from` may face some point of `to`: the largest n·(x - y) over normals
-// n in from's cone, x in to's box and y in from's box is above epsilon. Conservative.
+// n in from's cone, x in to and y in from, bounded by Support, is above epsilon. Conservative.
 bool MayFace(const ClusterNode& from, const ClusterNode& to, double epsilon) {
     if (from.half_angle >= kPi / 2) return true;
     const double s = Support(to, from.axis) + Support(from, -from.axis);
@@ -71,9 +71,9 @@ double Sum(const Rgb& c) { return double(c.r) + c.g + c.b; }
 // The links of one group at a time; everything it reads is fixed before linking starts.
 class RadiosityHierarchy::Linker {
   public:
-    Linker(const EmbreeScene& scene, const PatchMesh& mesh, const RadiosityHierarchy& h,
+    Linker(const EmbreeScene& scene, const PairEvaluator& evaluator, const RadiosityHierarchy& h,
            double link_error)
-        : scene_(scene), evaluator_(scene, mesh), h_(h) {
+        : scene_(scene), evaluator_(evaluator), h_(h) {
         const auto& nodes = h.tree_.nodes();
         const RadiositySystem& system = h.system_;
         // Brightness estimates: the emission pulled up the tree (area-weighted), plus the
@@ -135,7 +135,7 @@ class RadiosityHierarchy::Linker {
                 // As the flat method evaluates the pair: from the lower mesh side, rays and all.
                 const int32_t a = order[size_t(rp.begin)], b = order[size_t(sq.begin)];
                 const PairFormFactors f =
-                    evaluator_.Evaluate(std::min(a, b), std::max(a, b), a<b, a> b);
+                    evaluator_.Evaluate(std::min(a, b), std::max(a, b), (a < b), (a > b));
                 rays += f.rays;
                 const float value = float(a < b ? f.ab : f.ba);
                 if (value > 0) links.leaf.push_back({rp.begin, sq.begin, value});
@@ -210,7 +210,7 @@ class RadiosityHierarchy::Linker {
     }
 
     const EmbreeScene& scene_;
-    PairEvaluator evaluator_;
+    const PairEvaluator& evaluator_;
     const RadiosityHierarchy& h_;
     std::vector<double> brightness_;  // per node: estimated radiosity, channels summed
     std::vector<float> rho_;          // per node: the largest reflectance channel
@@ -233,13 +233,12 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
             absl::StrFormat("radiosity: link error %g must be > 0", options.link_error));
     }
     std::unique_ptr<RadiosityHierarchy> h(new RadiosityHierarchy());
-    {
-        const std::vector<SideGeometry> geometry = SideGeometries(scene, mesh);
-        absl::StatusOr<ClusterTree> tree = ClusterTree::Build(geometry, options.cancel);
-        if (!tree.ok()) return tree.status();
-        h->tree_ = std::move(*tree);
-        for (int32_t side : h->tree_.order()) h->normals_.push_back(geometry[size_t(side)].n);
-    }
+    // The sides' geometry serves the tree and the linking, then goes.
+    const PairEvaluator evaluator(scene, mesh);
+    absl::StatusOr<ClusterTree> tree = ClusterTree::Build(evaluator.sides(), options.cancel);
+    if (!tree.ok()) return tree.status();
+    h->tree_ = std::move(*tree);
+    for (int32_t side : h->tree_.order()) h->normals_.push_back(evaluator.sides()[size_t(side)].n);
     for (int32_t side : h->tree_.order()) {
         h->system_.emission.push_back(system.emission[size_t(side)]);
         h->system_.reflectance.push_back(system.reflectance[size_t(side)]);
@@ -253,7 +252,7 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
     h->linked_ = ChunkGroups(int32_t(h->groups_.size()), options.chunk, options.chunks);
     h->links_.resize(h->groups_.size());
 
-    const Linker linker(scene, mesh, *h, options.link_error);
+    const Linker linker(scene, evaluator, *h, options.link_error);
     const auto [g0, g1] = h->linked_;
     std::vector<int64_t> rays(h->groups_.size(), 0);
     tbb::parallel_for(g0, g1, [&](int32_t g) {
