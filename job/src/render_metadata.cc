@@ -126,6 +126,12 @@ void AddRadiosityAttributes(const RenderMetadata& m, ExrAttributes& attributes) 
         attributes["lightfarm.radiosity.budgetReached"] = YesNo(r.budget_reached);
         attributes["lightfarm.radiosity.finestAboveTarget"] = std::to_string(r.finest_above_target);
     }
+    if (r.links > 0) {
+        attributes["lightfarm.radiosity.links"] = std::to_string(r.links);
+        attributes["lightfarm.radiosity.linksPerSide"] = r.links_per_side;
+        attributes["lightfarm.radiosity.linkBytes"] = std::to_string(r.link_bytes);
+        attributes["lightfarm.radiosity.solverBytes"] = std::to_string(r.solver_bytes);
+    }
 }
 
 // Light tracing traces spp light paths per pixel-equivalent; BDPT one light subpath per camera

@@ -146,14 +146,6 @@ int QuadratureLevel(double separation) {
 
 // Geometry of a side in render space ---------------------------------------------------------
 
-struct SideGeometry {
-    std::array<Vec3d, 3> p;
-    Vec3d n, c;  // side normal, centroid
-    double radius = 0;
-    SurfacePoint centre;  // where the single ray of a far pair starts or ends
-    int32_t patch = 0;
-};
-
 Vec3d PointOf(const SideGeometry& g, const std::array<double, 3>& w) {
     return g.p[0] * w[0] + g.p[1] * w[1] + g.p[2] * w[2];
 }
@@ -163,21 +155,6 @@ SurfacePoint RayPointOf(const EmbreeScene& scene, const PatchMesh& mesh, const S
     const PatchMesh::Patch& patch = mesh.patches()[size_t(g.patch)];
     const auto [b1, b2] = mesh.TriangleBarycentrics(g.patch, w);
     return scene.TrianglePoint(patch.mesh, patch.primitive, float(b1), float(b2), 0);
-}
-
-std::vector<SideGeometry> SideGeometries(const EmbreeScene& scene, const PatchMesh& mesh) {
-    std::vector<SideGeometry> sides(mesh.sides().size());
-    for (size_t s = 0; s < sides.size(); ++s) {
-        SideGeometry& g = sides[s];
-        g.patch = mesh.sides()[s].patch;
-        const PatchMesh::Patch& patch = mesh.patches()[size_t(g.patch)];
-        for (size_t c = 0; c < 3; ++c) g.p[c] = mesh.vertices()[patch.vertices[c]] - scene.origin();
-        g.n = mesh.SideNormal(int32_t(s));
-        g.c = (g.p[0] + g.p[1] + g.p[2]) / 3.0;
-        for (const Vec3d& q : g.p) g.radius = std::max(g.radius, Length(q - g.c));
-        g.centre = RayPointOf(scene, mesh, g, {1.0 / 3, 1.0 / 3, 1.0 / 3});
-    }
-    return sides;
 }
 
 // Form factors of one pair -------------------------------------------------------------------
@@ -225,61 +202,6 @@ bool Facing(const SideGeometry& a, const SideGeometry& b, double epsilon) {
     };
     return in_front(b, a) && in_front(a, b);
 }
-
-struct PairFormFactors {
-    double ab = 0, ba = 0;
-    int rays = 0;
-};
-
-class PairEvaluator {
-  public:
-    PairEvaluator(const EmbreeScene& scene, const PatchMesh& mesh)
-        : scene_(scene), mesh_(mesh), sides_(SideGeometries(scene, mesh)) {
-        const auto [lo, hi] = scene.scene().Bounds();
-        epsilon_ = 1e-6 * Length(hi - lo);
-    }
-
-    const std::vector<SideGeometry>& sides() const { return sides_; }
-    double epsilon() const { return epsilon_; }
-
-    // F_ab and F_ba share the visibility rays; `ab` or `ba` false skips that one's quadrature
-    // (a chunk of rows needs only its own), leaving it 0.
-    PairFormFactors Evaluate(int32_t ia, int32_t ib, bool ab = true, bool ba = true) const {
-        const SideGeometry &a = sides_[size_t(ia)], &b = sides_[size_t(ib)];
-        if (!Facing(a, b, epsilon_)) return {};
-        const double distance = Length(a.c - b.c);
-        const int level_a = QuadratureLevel((distance - b.radius) / a.radius);
-        const int level_b = QuadratureLevel((distance - a.radius) / b.radius);
-        const int ray_level = std::clamp(std::max(level_a, level_b) - 1, 0, kMaxRayLevel);
-        const auto& points = GetRules().rays[size_t(ray_level)];
-        const int n = int(points.size());
-        int visible = 0;
-        for (int i = 0; i < n; ++i) {
-            if (n == 1) {
-                visible += !scene_.Occluded(SpawnRayTo(a.centre, b.centre));
-                continue;
-            }
-            // A fixed scramble pairs each point on a with a different region of b.
-            const int j = (i * (n / 2 + 1) + n / 4) % n;
-            const SurfacePoint pa = RayPointOf(scene_, mesh_, a, points[size_t(i)]);
-            const SurfacePoint pb = RayPointOf(scene_, mesh_, b, points[size_t(j)]);
-            visible += !scene_.Occluded(SpawnRayTo(pa, pb));
-        }
-        PairFormFactors f;
-        f.rays = n;
-        if (visible == 0) return f;
-        const double v = double(visible) / n;
-        if (ab) f.ab = v * UnoccludedFormFactor(a, b, level_a);
-        if (ba) f.ba = v * UnoccludedFormFactor(b, a, level_b);
-        return f;
-    }
-
-  private:
-    const EmbreeScene& scene_;
-    const PatchMesh& mesh_;
-    std::vector<SideGeometry> sides_;
-    double epsilon_ = 0;
-};
 
 // Groups and blocks ---------------------------------------------------------------------------
 
@@ -471,6 +393,57 @@ class PreviousPairs {
 };
 
 }  // namespace
+
+std::vector<SideGeometry> SideGeometries(const EmbreeScene& scene, const PatchMesh& mesh) {
+    std::vector<SideGeometry> sides(mesh.sides().size());
+    for (size_t s = 0; s < sides.size(); ++s) {
+        SideGeometry& g = sides[s];
+        g.patch = mesh.sides()[s].patch;
+        const PatchMesh::Patch& patch = mesh.patches()[size_t(g.patch)];
+        for (size_t c = 0; c < 3; ++c) g.p[c] = mesh.vertices()[patch.vertices[c]] - scene.origin();
+        g.n = mesh.SideNormal(int32_t(s));
+        g.c = (g.p[0] + g.p[1] + g.p[2]) / 3.0;
+        for (const Vec3d& q : g.p) g.radius = std::max(g.radius, Length(q - g.c));
+        g.centre = RayPointOf(scene, mesh, g, {1.0 / 3, 1.0 / 3, 1.0 / 3});
+    }
+    return sides;
+}
+
+PairEvaluator::PairEvaluator(const EmbreeScene& scene, const PatchMesh& mesh)
+    : scene_(scene), mesh_(mesh), sides_(SideGeometries(scene, mesh)) {
+    const auto [lo, hi] = scene.scene().Bounds();
+    epsilon_ = 1e-6 * Length(hi - lo);
+}
+
+PairFormFactors PairEvaluator::Evaluate(int32_t ia, int32_t ib, bool ab, bool ba) const {
+    const SideGeometry &a = sides_[size_t(ia)], &b = sides_[size_t(ib)];
+    if (!Facing(a, b, epsilon_)) return {};
+    const double distance = Length(a.c - b.c);
+    const int level_a = QuadratureLevel((distance - b.radius) / a.radius);
+    const int level_b = QuadratureLevel((distance - a.radius) / b.radius);
+    const int ray_level = std::clamp(std::max(level_a, level_b) - 1, 0, kMaxRayLevel);
+    const auto& points = GetRules().rays[size_t(ray_level)];
+    const int n = int(points.size());
+    int visible = 0;
+    for (int i = 0; i < n; ++i) {
+        if (n == 1) {
+            visible += !scene_.Occluded(SpawnRayTo(a.centre, b.centre));
+            continue;
+        }
+        // A fixed scramble pairs each point on a with a different region of b.
+        const int j = (i * (n / 2 + 1) + n / 4) % n;
+        const SurfacePoint pa = RayPointOf(scene_, mesh_, a, points[size_t(i)]);
+        const SurfacePoint pb = RayPointOf(scene_, mesh_, b, points[size_t(j)]);
+        visible += !scene_.Occluded(SpawnRayTo(pa, pb));
+    }
+    PairFormFactors f;
+    f.rays = n;
+    if (visible == 0) return f;
+    const double v = double(visible) / n;
+    if (ab) f.ab = v * UnoccludedFormFactor(a, b, level_a);
+    if (ba) f.ba = v * UnoccludedFormFactor(b, a, level_b);
+    return f;
+}
 
 double PointToPolygonFormFactor(const Vec3d& x, const Vec3d& n, std::span<const Vec3d> polygon) {
     if (polygon.size() < 3) return 0;

@@ -82,6 +82,13 @@ absl::StatusOr<FormFactors> FormFactorsOf(const EmbreeScene& scene, const PatchM
     return form_factors;
 }
 
+void ReportSolve(const SolveResult& solved, double seconds, RadiosityReport& report) {
+    report.solve_seconds += seconds;
+    report.iterations = solved.iterations;
+    report.sweeps = solved.sweeps;
+    report.residual = solved.residual;
+}
+
 // The solve on one mesh; times and counts add up in `report`.
 absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh& mesh,
                                        const FormFactors& form_factors,
@@ -93,15 +100,62 @@ absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh
         SolveRadiosity(system, {options.solver, tolerance, options.max_iterations, options.cancel});
     if (!solved.ok()) return solved.status();
     const double solve_seconds = SecondsSince(start);
-    report.solve_seconds += solve_seconds;
-    report.iterations = solved->iterations;
-    report.sweeps = solved->sweeps;
-    report.residual = solved->residual;
+    ReportSolve(*solved, solve_seconds, report);
     NamedLogger("radiosity")
         ->info("{}: {} iterations ({:.1f} sweeps), relative residual {:.2g}, {:.2f} s",
                RadiositySolverName(options.solver), solved->iterations, solved->sweeps,
                solved->residual, solve_seconds);
     return std::move(solved->radiosity);
+}
+
+HierarchyOptions HierarchyOptionsOf(const RadiosityOptions& options, int chunk, int chunks,
+                                    const std::atomic<bool>* cancel) {
+    return {options.link_error, kHierarchyGroupSize, chunk, chunks, cancel};
+}
+
+// The links of a chunk of the groups (all of them for a whole solve).
+absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> LinkHierarchy(const EmbreeScene& scene,
+                                                                  const PatchMesh& mesh,
+                                                                  const HierarchyOptions& options) {
+    const FormFactors none;  // the system's E, ρ and A are all the hierarchy reads
+    return RadiosityHierarchy::Build(scene, mesh, MakeRadiositySystem(scene, mesh, none), options);
+}
+
+// The hierarchical solve on one mesh; times and counts add up in `report`.
+absl::StatusOr<std::vector<Rgb>> SolveHierarchically(const EmbreeScene& scene,
+                                                     const PatchMesh& mesh,
+                                                     const RadiosityOptions& options,
+                                                     double tolerance, RadiosityReport& report) {
+    const auto start = std::chrono::steady_clock::now();
+    absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> linked =
+        LinkHierarchy(scene, mesh, HierarchyOptionsOf(options, 0, 1, options.cancel));
+    if (!linked.ok()) return linked.status();
+    const RadiosityHierarchy& h = **linked;
+    const double link_seconds = SecondsSince(start);
+    report.form_factor_seconds += link_seconds;
+    report.visibility_rays += h.rays();
+    report.cluster_links = h.node_links();
+    report.side_links = h.leaf_links();
+    report.links_per_side =
+        double(h.node_links() + h.leaf_links()) / std::max<double>(1, h.sides());
+    report.link_bytes = h.link_bytes();
+    report.solver_bytes = h.bytes();
+    NamedLogger("radiosity")
+        ->info(
+            "links in {:.2f} s: {} between clusters, {} between sides ({:.1f} per side), "
+            "{:.1f} MiB of {:.1f} MiB, {} rays",
+            link_seconds, h.node_links(), h.leaf_links(), report.links_per_side,
+            double(h.link_bytes()) / (1 << 20), double(h.bytes()) / (1 << 20), h.rays());
+    const auto solve_start = std::chrono::steady_clock::now();
+    absl::StatusOr<SolveResult> solved = SolveHierarchical(
+        h, {RadiositySolver::kJacobi, tolerance, options.max_iterations, options.cancel});
+    if (!solved.ok()) return solved.status();
+    const double solve_seconds = SecondsSince(solve_start);
+    ReportSolve(*solved, solve_seconds, report);
+    NamedLogger("radiosity")
+        ->info("hierarchical jacobi: {} sweeps, relative residual {:.2g}, {:.2f} s",
+               solved->iterations, solved->residual, solve_seconds);
+    return h.tree().ToMeshOrder(solved->radiosity);
 }
 
 // Solve, split the patches above the target, mesh again, solve again ... until no patch needs
@@ -124,22 +178,28 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
     FormFactors previous;
     for (bool first = true;; first = false) {
         const double form_factor_seconds = report.form_factor_seconds;
-        absl::StatusOr<FormFactors> computed = FormFactorsOf(
-            scene, mesh, first ? MeshFormFactors{} : MeshFormFactors{&previous_mesh, &previous},
-            options.cancel, report);
-        if (!computed.ok()) return computed.status();
-        FormFactors form_factors = std::move(*computed);
-        previous = FormFactors();  // freed before the solve
-        absl::StatusOr<std::vector<Rgb>> radiosity =
-            Solve(scene, mesh, form_factors, options, tolerance, report);
+        const int64_t rays = report.visibility_rays;
+        FormFactors form_factors;  // none for the hierarchical solve, which needs no reuse
+        absl::StatusOr<std::vector<Rgb>> radiosity;
+        if (options.hierarchical) {
+            radiosity = SolveHierarchically(scene, mesh, options, tolerance, report);
+        } else {
+            absl::StatusOr<FormFactors> computed = FormFactorsOf(
+                scene, mesh, first ? MeshFormFactors{} : MeshFormFactors{&previous_mesh, &previous},
+                options.cancel, report);
+            if (!computed.ok()) return computed.status();
+            form_factors = std::move(*computed);
+            previous = FormFactors();  // freed before the solve
+            radiosity = Solve(scene, mesh, form_factors, options, tolerance, report);
+        }
         if (!radiosity.ok()) return radiosity.status();
         const DiscretisationError error = EstimateDiscretisationError(mesh, *radiosity);
         const RefinementStep step = ChooseRefinement(mesh, error, options.target_error, budget);
         const FormFactorWork& work = form_factors.work();
         report.refinement.push_back({int64_t(mesh.patches().size()), int64_t(mesh.sides().size()),
                                      error.max, error.mean, int64_t(step.split.size()),
-                                     report.form_factor_seconds - form_factor_seconds, work.rays,
-                                     work.pairs, work.reused_pairs});
+                                     report.form_factor_seconds - form_factor_seconds,
+                                     report.visibility_rays - rays, work.pairs, work.reused_pairs});
         report.budget_reached = step.budget_reached;
         report.finest_above_target = step.at_finest;
         NamedLogger("radiosity")
@@ -206,6 +266,8 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         absl::StatusOr<std::vector<Rgb>> solved;
         if (options.target_error > 0) {
             solved = SolveRefining(scene, options, *mesh, report);
+        } else if (options.hierarchical) {
+            solved = SolveHierarchically(scene, *mesh, options, options.tolerance, report);
         } else {
             absl::StatusOr<FormFactors> form_factors =
                 FormFactorsOf(scene, *mesh, {}, options.cancel, report);
@@ -282,6 +344,14 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     if (!mesh.ok()) return mesh.status();
     std::unique_ptr<RadiositySweepChunk> out(new RadiositySweepChunk());
     out->chunk_ = chunk;
+    if (options.hierarchical) {
+        absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> linked =
+            LinkHierarchy(scene, *mesh, HierarchyOptionsOf(options, chunk, chunks, cancel));
+        if (!linked.ok()) return linked.status();
+        out->hierarchy_ = std::move(*linked);
+        out->groups_ = out->hierarchy_->linked_groups();
+        return out;
+    }
     FormFactorOptions ff_options;
     ff_options.chunk = chunk;
     ff_options.chunks = chunks;
@@ -299,7 +369,9 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
         return absl::InvalidArgumentError(absl::StrFormat(
             "radiosity sweep %d: %d values for %d unknowns", sweep, b.size(), sides()));
     }
-    const auto& groups = form_factors_.groups();
+    const auto& groups = hierarchy_ ? hierarchy_->groups() : form_factors_.groups();
+    const std::vector<NodeExitance> pulled =
+        hierarchy_ ? hierarchy_->Pull(b) : std::vector<NodeExitance>();
     const auto [g0, g1] = groups_;
     SweepChunkResult r;
     r.sweep = sweep;
@@ -315,7 +387,8 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
         const PatchGroup& group = groups[size_t(g)];
         const std::span<Rgb> out = std::span<Rgb>(r.output).subspan(
             size_t(group.begin - r.side_begin), size_t(group.size()));
-        const GroupSweep sums = JacobiGroup(system_, g, b, out);
+        const GroupSweep sums = hierarchy_ ? hierarchy_->SweepGroup(g, pulled, b, out)
+                                           : JacobiGroup(system_, g, b, out);
         r.change[size_t(g - g0)] = sums.change;
         r.power[size_t(g - g0)] = sums.power;
     });
@@ -333,6 +406,12 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
         return absl::InvalidArgumentError(
             absl::StrFormat("radiosity: a solution of %d values for a mesh of %d unknowns",
                             radiosity.size(), mesh->sides().size()));
+    }
+    if (options.hierarchical) {
+        absl::StatusOr<ClusterTree> tree =
+            ClusterTree::Build(SideGeometries(scene, *mesh), options.cancel);
+        if (!tree.ok()) return tree.status();
+        radiosity = tree->ToMeshOrder(radiosity);
     }
     RadiosityReport report;
     report.patches = int64_t(mesh->patches().size());

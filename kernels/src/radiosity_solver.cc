@@ -15,13 +15,9 @@ namespace lf {
 
 namespace {
 
-double Power(double area, const Rgb& c) {
-    return area * (double(std::abs(c.r)) + std::abs(c.g) + std::abs(c.b));
-}
-
 double SystemPower(const RadiositySystem& system, std::span<const Rgb> b) {
     double power = 0;
-    for (size_t i = 0; i < b.size(); ++i) power += Power(system.area[i], b[i]);
+    for (size_t i = 0; i < b.size(); ++i) power += RadiosityPower(system.area[i], b[i]);
     return power;
 }
 
@@ -98,13 +94,15 @@ GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, st
     return total;
 }
 
-absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
-                                        const SolveOptions& options) {
+}  // namespace
+
+absl::StatusOr<SolveResult> IterateJacobi(std::vector<Rgb> emission, const JacobiStep& step,
+                                          const SolveOptions& options) {
     SolveResult result;
-    std::vector<Rgb> b = system.emission, next(b.size());
+    std::vector<Rgb> b = std::move(emission), next(b.size());
     SolveLog log;
     for (;;) {
-        const GroupSweep sweep = JacobiSweep(system, b, next, options.cancel);
+        const GroupSweep sweep = step(b, next, options.cancel);
         if (CancelRequested(options.cancel)) return SolveCancelled();
         const double residual = sweep.change / sweep.power;
         ++result.iterations;
@@ -121,6 +119,18 @@ absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
     result.sweeps = result.iterations;
     result.radiosity = std::move(b);
     return result;
+}
+
+namespace {
+
+absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
+                                        const SolveOptions& options) {
+    return IterateJacobi(
+        system.emission,
+        [&](std::span<const Rgb> b, std::span<Rgb> next, const std::atomic<bool>* cancel) {
+            return JacobiSweep(system, b, next, cancel);
+        },
+        options);
 }
 
 // Gauss-Seidel converges monotonically from below (E, ρ, F >= 0), so a sweep's change bounds
@@ -141,7 +151,7 @@ absl::StatusOr<SolveResult> SolveGaussSeidel(const RadiositySystem& system,
             for (int32_t i = group.begin; i < group.end; ++i) {
                 Rgb& bi = b[size_t(i)];
                 const Rgb& ui = updated[size_t(i - group.begin)];
-                change += Power(system.area[size_t(i)], ui - bi);
+                change += RadiosityPower(system.area[size_t(i)], ui - bi);
                 bi = ui;
             }
         }
@@ -189,6 +199,10 @@ absl::StatusOr<SolveResult> SolveShooting(const RadiositySystem& system,
 }
 
 }  // namespace
+
+double RadiosityPower(double area, const Rgb& c) {
+    return area * (double(std::abs(c.r)) + std::abs(c.g) + std::abs(c.b));
+}
 
 absl::StatusOr<RadiositySolver> ParseRadiositySolver(std::string_view name) {
     for (RadiositySolver s :
@@ -248,8 +262,8 @@ GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<c
     GroupSweep sums;
     for (int32_t i = g.begin; i < g.end; ++i) {
         const double area = system.area[size_t(i)];
-        sums.change += Power(area, out[size_t(i - g.begin)] - b[size_t(i)]);
-        sums.power += Power(area, b[size_t(i)]);
+        sums.change += RadiosityPower(area, out[size_t(i - g.begin)] - b[size_t(i)]);
+        sums.power += RadiosityPower(area, b[size_t(i)]);
     }
     return sums;
 }

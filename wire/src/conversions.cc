@@ -520,6 +520,10 @@ void ToProto(const RadiosityFigures& f, pb::RadiosityReport* out) {
     out->set_coarse_patches(f.coarse_patches);
     out->set_budget_reached(f.budget_reached);
     out->set_finest_above_target(f.finest_above_target);
+    out->set_links(f.links);
+    out->set_links_per_side(f.links_per_side);
+    out->set_link_bytes(f.link_bytes);
+    out->set_solver_bytes(f.solver_bytes);
 }
 
 RadiosityFigures FromProto(const pb::RadiosityReport& r) {
@@ -538,6 +542,10 @@ RadiosityFigures FromProto(const pb::RadiosityReport& r) {
     f.coarse_patches = r.coarse_patches();
     f.budget_reached = r.budget_reached();
     f.finest_above_target = r.finest_above_target();
+    f.links = r.links();
+    f.links_per_side = r.links_per_side();
+    f.link_bytes = r.link_bytes();
+    f.solver_bytes = r.solver_bytes();
     return f;
 }
 

@@ -38,6 +38,11 @@ struct RadiosityFigures {
     int64_t coarse_patches = 0;
     bool budget_reached = false;
     int64_t finest_above_target = 0;
+    // Hierarchical radiosity: links (between clusters and between sides), per side, their bytes
+    // and all of the solver's; 0 for the flat method.
+    int64_t links = 0;
+    double links_per_side = 0;
+    int64_t link_bytes = 0, solver_bytes = 0;
 };
 
 // The figures of a kernel's lf::RadiosityReport. A template so that the job model need not
@@ -59,6 +64,10 @@ RadiosityFigures RadiosityFiguresOf(const Report& r) {
     f.coarse_patches = r.refinement.empty() ? r.patches : r.refinement.front().patches;
     f.budget_reached = r.budget_reached;
     f.finest_above_target = r.finest_above_target;
+    f.links = r.cluster_links + r.side_links;
+    f.links_per_side = r.links_per_side;
+    f.link_bytes = int64_t(r.link_bytes);
+    f.solver_bytes = int64_t(r.solver_bytes);
     return f;
 }
 

@@ -21,6 +21,7 @@
 // as evaluating them all.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <span>
@@ -122,6 +123,42 @@ struct FormFactorOptions {
     // were evaluated, instead of being evaluated again. The result is bit for bit that of
     // evaluating every pair (docs/radiosity.md). Both pointers or neither.
     MeshFormFactors previous;
+};
+
+// A side in render space (the scene's origin subtracted), as the form factors see it.
+struct SideGeometry {
+    std::array<Vec3d, 3> p;
+    Vec3d n, c;  // side normal, centroid
+    double radius = 0;
+    SurfacePoint centre;  // where the single ray of a far pair starts or ends
+    int32_t patch = 0;
+};
+
+std::vector<SideGeometry> SideGeometries(const EmbreeScene& scene, const PatchMesh& mesh);
+
+struct PairFormFactors {
+    double ab = 0, ba = 0;
+    int rays = 0;
+};
+
+// One pair of sides, as ComputeFormFactors evaluates it: the hierarchical solver's leaf-to-leaf
+// links (radiosity_hierarchy.h) use it, so their values are the flat method's bits.
+class PairEvaluator {
+  public:
+    PairEvaluator(const EmbreeScene& scene, const PatchMesh& mesh);
+
+    const std::vector<SideGeometry>& sides() const { return sides_; }
+    double epsilon() const { return epsilon_; }  // 1e-6 of the scene's diagonal
+
+    // F_ab and F_ba share the visibility rays, which run from a to b; `ab` or `ba` false skips
+    // that one's quadrature (a chunk of rows needs only its own), leaving it 0.
+    PairFormFactors Evaluate(int32_t ia, int32_t ib, bool ab = true, bool ba = true) const;
+
+  private:
+    const EmbreeScene& scene_;
+    const PatchMesh& mesh_;
+    std::vector<SideGeometry> sides_;
+    double epsilon_ = 0;
 };
 
 // Chunk `chunk` of `chunks` of `groups` patch groups: [groups * chunk / chunks,

@@ -27,6 +27,7 @@
 #include "lf/kernels/form_factors.h"
 #include "lf/kernels/radiance.h"
 #include "lf/kernels/radiosity_display.h"
+#include "lf/kernels/radiosity_hierarchy.h"
 #include "lf/kernels/radiosity_solver.h"
 
 namespace lf {
@@ -83,6 +84,12 @@ struct RadiosityReport {
     size_t form_factor_bytes = 0;
     int64_t nonzero_form_factors = 0;
     int64_t visibility_rays = 0;
+    // Hierarchical (options.hierarchical): links between clusters and between single sides
+    // (form_factor_seconds is the linking time), their bytes and all of the solver's (cluster
+    // tree, per-side data, links); form_factor_bytes and nonzero_form_factors stay 0.
+    int64_t cluster_links = 0, side_links = 0;
+    double links_per_side = 0;
+    size_t link_bytes = 0, solver_bytes = 0;
     // Estimated discretisation error of the returned solution (also without refinement).
     double estimated_error = 0, mean_estimated_error = 0;
     // With a target error: every solve (the times above are their sums), and why it stopped
@@ -115,9 +122,9 @@ class RadiosityRenderer : public RadianceEstimator {
 };
 
 // One patch-group task of the farm's Jacobi solve (lf/job/radiosity_solve.h): the form-factor
-// rows of chunk `chunk` of `chunks` of the patch groups, computed once, then swept against the
-// radiosity of each sweep in turn. The sweep's sums are those SolveRadiosity's Jacobi solver
-// makes, so the farm's solution has its bits.
+// rows of chunk `chunk` of `chunks` of the patch groups (hierarchical: the links of its groups
+// of the cluster tree), computed once, then swept against the radiosity of each sweep in turn. The
+// sweep's sums are those SolveRadiosity's Jacobi solver makes, so the farm's solution has its bits.
 class RadiositySweepChunk {
   public:
     // The same checks as PrepareRadiosity; InvalidArgument for a chunk outside 0..chunks-1 and
@@ -126,9 +133,12 @@ class RadiositySweepChunk {
         const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks,
         const std::atomic<bool>* cancel = nullptr);
 
-    int32_t sides() const { return int32_t(system_.emission.size()); }
-    // E: the radiosity sweep 0 starts from.
-    const std::vector<Rgb>& emission() const { return system_.emission; }
+    int32_t sides() const { return int32_t(emission().size()); }
+    // E: the radiosity sweep 0 starts from. Hierarchical: the unknowns in the cluster tree's
+    // order (RadiosityRendererFor maps them back to the mesh's sides).
+    const std::vector<Rgb>& emission() const {
+        return hierarchy_ ? hierarchy_->system().emission : system_.emission;
+    }
     // The chunk's part of one sweep from `b` (all sides); InvalidArgument when b is not one
     // value per side. Runs in the caller's TBB arena.
     absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> b) const;
@@ -139,11 +149,13 @@ class RadiositySweepChunk {
     std::pair<int32_t, int32_t> groups_;
     FormFactors form_factors_;  // the chunk's rows only
     RadiositySystem system_;
+    std::unique_ptr<RadiosityHierarchy> hierarchy_;  // instead, hierarchical: the chunk's links
 };
 
 // The renderer of a solution solved elsewhere (by the farm's sweeps): the scene meshed as
-// `options` say, displaying `radiosity`; InvalidArgument unless it holds one value per side,
-// and for a target error (the sweeps solve an unrefined mesh).
+// `options` say, displaying `radiosity` (hierarchical: in the cluster tree's order);
+// InvalidArgument unless it holds one value per side, and for a target error (the sweeps solve an
+// unrefined mesh).
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity);
 

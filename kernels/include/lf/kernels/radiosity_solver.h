@@ -16,6 +16,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -73,6 +74,19 @@ struct GroupSweep {
 };
 GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
                        std::span<Rgb> out);
+
+// The power of radiosity c over `area` in that norm: area (|r| + |g| + |b|).
+double RadiosityPower(double area, const Rgb& c);
+
+// One Jacobi sweep: `next` from `b`, and the sweep's sums (stopping early, with meaningless sums,
+// once `cancel` is set).
+using JacobiStep = std::function<GroupSweep(std::span<const Rgb> b, std::span<Rgb> next,
+                                            const std::atomic<bool>* cancel)>;
+// The Jacobi solver's loop over any sweep (the flat one, the hierarchical one): sweeps from
+// `emission` until a sweep's change / power is at most the tolerance; ResourceExhausted at the
+// iteration limit, Cancelled soon after options.cancel is set.
+absl::StatusOr<SolveResult> IterateJacobi(std::vector<Rgb> emission, const JacobiStep& step,
+                                          const SolveOptions& options);
 
 // ||E + ρ F b - b|| / ||b|| in the power norm above (0 when b and E are 0).
 double RelativeResidual(const RadiositySystem& system, std::span<const Rgb> b);

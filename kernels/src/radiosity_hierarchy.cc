@@ -1,0 +1,412 @@
+#include "lf/kernels/radiosity_hierarchy.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "absl/strings/str_format.h"
+#include "lf/core/cancel.h"
+
+namespace lf {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+// Visibility rays of a link between clusters.
+constexpr int kClusterRays = 4;
+// A link between two clusters joins nodes this many times the sum of their radii apart, at
+// least: closer, the irradiance at the receiver's centroid is not its mean (a cluster under the
+// light would get the brightest value everywhere). A side is small enough to be linked as soon
+// as the bounding spheres are apart.
+constexpr double kSeparation = 1.5;
+// A partly visible link carries this many times less power than a fully visible one may.
+constexpr double kPartialVisibility = 16;
+
+// An upper bound of a·x over the node's corners: the smaller of its box's and that of its slab
+// along its axis within its bounding sphere (exact along the axis: coplanar sides of a face that
+// is not axis-aligned are culled as coplanar).
+double Support(const ClusterNode& node, const Vec3d& a) {
+    double box = 0;
+    for (int k = 0; k < 3; ++k) box += a[k] * (a[k] > 0 ? node.hi[k] : node.lo[k]);
+    const double along = Dot(a, node.axis);
+    const Vec3d across = a - node.axis * along;
+    const double slab = std::max(along * node.axis_lo, along * node.axis_hi) +
+                        Dot(across, node.centroid) + Length(across) * node.radius;
+    return std::min(box, slab);
+}
+
+// Whether some side of `from` may face some point of `to`: the largest n·(x - y) over normals
+// n in from's cone, x in to and y in from, bounded by Support, is above epsilon. Conservative.
+bool MayFace(const ClusterNode& from, const ClusterNode& to, double epsilon) {
+    if (from.half_angle >= kPi / 2) return true;
+    const double s = Support(to, from.axis) + Support(from, -from.axis);
+    if (s > epsilon) return true;
+    const double reach = Length(to.centroid - from.centroid) + from.radius + to.radius;
+    return s * from.cos_half_angle + reach * from.sin_half_angle > epsilon;
+}
+
+// Whether every normal of the node's cone is within 90 degrees of the unit direction `w`: then
+// all its sides face that way, the vector sum of their light is the light sent along w (a side
+// facing away would subtract from it), and each side's irradiance from w is n·E.
+bool ConeFaces(const ClusterNode& node, const Vec3d& w) {
+    // The angle to w plus the half-angle below π/2: cos(angle) > cos(π/2 - half-angle).
+    return node.half_angle < kPi / 2 && Dot(node.axis, w) > node.sin_half_angle;
+}
+
+uint64_t Hash(uint64_t x) {
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ULL;
+    return x ^ (x >> 33);
+}
+
+double Sum(const Rgb& c) { return double(c.r) + c.g + c.b; }
+
+}  // namespace
+
+// The links of one group at a time; everything it reads is fixed before linking starts.
+class RadiosityHierarchy::Linker {
+  public:
+    Linker(const EmbreeScene& scene, const PairEvaluator& evaluator, const RadiosityHierarchy& h,
+           double link_error)
+        : scene_(scene), evaluator_(evaluator), h_(h) {
+        const auto& nodes = h.tree_.nodes();
+        const RadiositySystem& system = h.system_;
+        // Brightness estimates: the emission pulled up the tree (area-weighted), plus the
+        // ambient term of the whole scene, the light interreflection would add on average.
+        std::vector<Rgb> emitted(nodes.size());
+        rho_.resize(nodes.size());
+        for (int32_t i = int32_t(nodes.size()) - 1; i >= 0; --i) {
+            const ClusterNode& node = nodes[size_t(i)];
+            if (node.leaf()) {
+                const size_t t = size_t(node.begin);
+                emitted[size_t(i)] = system.emission[t] * float(system.area[t]);
+                rho_[size_t(i)] = system.reflectance[t].MaxComponent();
+            } else {
+                emitted[size_t(i)] = emitted[size_t(i) + 1] + emitted[size_t(node.right)];
+                rho_[size_t(i)] = std::max(rho_[size_t(i) + 1], rho_[size_t(node.right)]);
+            }
+        }
+        double area = 0;
+        Rgb reflected;
+        for (size_t t = 0; t < system.area.size(); ++t) {
+            area += system.area[t];
+            reflected += system.reflectance[t] * float(system.area[t]);
+        }
+        Rgb ambient;
+        double power = 0;
+        if (!nodes.empty() && area > 0) {
+            const Rgb& total = emitted[0];
+            power = Sum(total);
+            for (int c = 0; c < 3; ++c) {
+                const double mean_rho = std::min(double(reflected[c]) / area, 0.999);
+                ambient[c] = float(total[c] / area * mean_rho / (1 - mean_rho));
+            }
+        }
+        brightness_.resize(nodes.size());
+        for (size_t i = 0; i < nodes.size(); ++i) {
+            const double a = std::max(nodes[i].area, 1e-300);
+            brightness_[i] = Sum(emitted[i]) / a + Sum(ambient);
+        }
+        threshold_ = link_error * power;
+    }
+
+    // Refines the link (group root <- tree root) into the group's links.
+    GroupLinks Link(int32_t root, const std::atomic<bool>* cancel, int64_t& rays) const {
+        const auto& nodes = h_.tree_.nodes();
+        const std::vector<int32_t>& order = h_.tree_.order();
+        GroupLinks links;
+        std::vector<std::pair<int32_t, int32_t>> stack = {{root, 0}};
+        int64_t steps = 0;
+        while (!stack.empty()) {
+            if (++steps % 4096 == 0 && CancelRequested(cancel)) return {};
+            const auto [p, q] = stack.back();
+            stack.pop_back();
+            const ClusterNode &rp = nodes[size_t(p)], &sq = nodes[size_t(q)];
+            if (p == q && rp.leaf()) continue;
+            if (!MayFace(rp, sq, evaluator_.epsilon()) || !MayFace(sq, rp, evaluator_.epsilon())) {
+                continue;
+            }
+            if (rp.leaf() && sq.leaf()) {
+                // As the flat method evaluates the pair: from the lower mesh side, rays and all.
+                const int32_t a = order[size_t(rp.begin)], b = order[size_t(sq.begin)];
+                const PairFormFactors f =
+                    evaluator_.Evaluate(std::min(a, b), std::max(a, b), (a < b), (a > b));
+                rays += f.rays;
+                const float value = float(a < b ? f.ab : f.ba);
+                if (value > 0) links.leaf.push_back({rp.begin, sq.begin, value});
+                continue;
+            }
+            const double distance = Length(sq.centroid - rp.centroid);
+            const Vec3d d = (sq.centroid - rp.centroid) / std::max(distance, 1e-300);
+            const bool source_faces = ConeFaces(sq, -d), receiver_faces = ConeFaces(rp, d);
+            const double separation = rp.leaf() || sq.leaf() ? 1.0 : kSeparation;
+            if (source_faces && receiver_faces && distance > separation * (rp.radius + sq.radius)) {
+                const double near = distance - rp.radius;
+                const double bound = std::min(1.0, sq.radius * sq.radius / (near * near));
+                const double power = rho_[size_t(p)] * brightness_[size_t(q)] * rp.area * bound;
+                if (power <= threshold_) {
+                    // Partly visible: the visible fraction scales the mean exitance of the whole
+                    // source, though the hidden part's is not the mean (a floor under a box is
+                    // dark), and the receiver's hidden sides get the same irradiance as its
+                    // visible ones; such links must carry kPartialVisibility times less.
+                    const double v = Visibility(p, q, rays);
+                    if (v == 1 || v == 0 || power * kPartialVisibility <= threshold_) {
+                        if (v > 0) {
+                            links.node.push_back({p, q, float(v)});
+                        }
+                        continue;
+                    }
+                }
+            }
+            // A node whose sides do not all face the other is split first.
+            const bool split_source =
+                rp.leaf() || (!sq.leaf() && (source_faces == receiver_faces ? sq.radius >= rp.radius
+                                                                            : !source_faces));
+            if (split_source) {
+                stack.push_back({p, sq.right});
+                stack.push_back({p, q + 1});
+            } else {
+                stack.push_back({rp.right, q});
+                stack.push_back({p + 1, q});
+            }
+        }
+        return links;
+    }
+
+  private:
+    // A side of `node` facing `target`, chosen by hashing `key` (any side if none faces it).
+    int32_t SampleSide(const ClusterNode& node, const Vec3d& target, uint64_t key) const {
+        const auto& sides = evaluator_.sides();
+        const std::vector<int32_t>& order = h_.tree_.order();
+        int32_t side = 0;
+        for (uint64_t attempt = 0; attempt < 4; ++attempt) {
+            side = order[size_t(node.begin + int32_t(Hash(key + attempt) % uint64_t(node.size())))];
+            const SideGeometry& g = sides[size_t(side)];
+            if (Dot(g.n, target - g.c) > 0) break;
+        }
+        return side;
+    }
+
+    // The fraction of kClusterRays rays between points of p and q that arrive.
+    double Visibility(int32_t p, int32_t q, int64_t& rays) const {
+        const auto& nodes = h_.tree_.nodes();
+        const ClusterNode &rp = nodes[size_t(p)], &sq = nodes[size_t(q)];
+        const auto& sides = evaluator_.sides();
+        int visible = 0;
+        for (int k = 0; k < kClusterRays; ++k) {
+            const uint64_t key = Hash((uint64_t(uint32_t(p)) << 32 | uint32_t(q)) * 4 + k);
+            const int32_t a = SampleSide(rp, sq.centroid, key);
+            const int32_t b = SampleSide(sq, rp.centroid, Hash(key));
+            visible +=
+                !scene_.Occluded(SpawnRayTo(sides[size_t(a)].centre, sides[size_t(b)].centre));
+        }
+        rays += kClusterRays;
+        return double(visible) / kClusterRays;
+    }
+
+    const EmbreeScene& scene_;
+    const PairEvaluator& evaluator_;
+    const RadiosityHierarchy& h_;
+    std::vector<double> brightness_;  // per node: estimated radiosity, channels summed
+    std::vector<float> rho_;          // per node: the largest reflectance channel
+    double threshold_ = 0;            // the most power a link may carry
+};
+
+absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
+    const EmbreeScene& scene, const PatchMesh& mesh, const RadiositySystem& system,
+    const HierarchyOptions& options) {
+    const size_t n = mesh.sides().size();
+    if (system.emission.size() != n || system.reflectance.size() != n || system.area.size() != n) {
+        return absl::InvalidArgumentError("radiosity: system and mesh sizes differ");
+    }
+    if (options.chunks < 1 || options.chunk < 0 || options.chunk >= options.chunks) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "radiosity: chunk %d of %d does not exist", options.chunk, options.chunks));
+    }
+    if (!(options.link_error > 0)) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("radiosity: link error %g must be > 0", options.link_error));
+    }
+    std::unique_ptr<RadiosityHierarchy> h(new RadiosityHierarchy());
+    // The sides' geometry serves the tree and the linking, then goes.
+    const PairEvaluator evaluator(scene, mesh);
+    absl::StatusOr<ClusterTree> tree = ClusterTree::Build(evaluator.sides(), options.cancel);
+    if (!tree.ok()) return tree.status();
+    h->tree_ = std::move(*tree);
+    for (int32_t side : h->tree_.order()) h->normals_.push_back(evaluator.sides()[size_t(side)].n);
+    for (int32_t side : h->tree_.order()) {
+        h->system_.emission.push_back(system.emission[size_t(side)]);
+        h->system_.reflectance.push_back(system.reflectance[size_t(side)]);
+        h->system_.area.push_back(system.area[size_t(side)]);
+    }
+    h->group_roots_ = h->tree_.Cut(std::max(1, options.group_size));
+    for (int32_t root : h->group_roots_) {
+        const ClusterNode& node = h->tree_.nodes()[size_t(root)];
+        h->groups_.push_back({node.begin, node.end});
+    }
+    h->linked_ = ChunkGroups(int32_t(h->groups_.size()), options.chunk, options.chunks);
+    h->links_.resize(h->groups_.size());
+
+    const Linker linker(scene, evaluator, *h, options.link_error);
+    const auto [g0, g1] = h->linked_;
+    std::vector<int64_t> rays(h->groups_.size(), 0);
+    tbb::parallel_for(g0, g1, [&](int32_t g) {
+        if (CancelRequested(options.cancel)) return;
+        GroupLinks& links = h->links_[size_t(g)];
+        links = linker.Link(h->group_roots_[size_t(g)], options.cancel, rays[size_t(g)]);
+        // Links are most of the solver's memory: no growth slack.
+        links.node.shrink_to_fit();
+        links.leaf.shrink_to_fit();
+    });
+    if (CancelRequested(options.cancel)) {
+        return absl::CancelledError("radiosity: linking cancelled");
+    }
+    for (int32_t g = g0; g < g1; ++g) {
+        h->node_links_ += int64_t(h->links_[size_t(g)].node.size());
+        h->leaf_links_ += int64_t(h->links_[size_t(g)].leaf.size());
+        h->rays_ += rays[size_t(g)];
+    }
+    return h;
+}
+
+std::vector<NodeExitance> RadiosityHierarchy::Pull(std::span<const Rgb> b) const {
+    const auto& nodes = tree_.nodes();
+    std::vector<NodeExitance> pulled(nodes.size());
+    // Each node sums its two children, whichever thread does it: the same bits.
+    auto pull = [&](auto& self, int32_t i) -> void {
+        const ClusterNode& node = nodes[size_t(i)];
+        NodeExitance& out = pulled[size_t(i)];
+        if (node.leaf()) {
+            const size_t t = size_t(node.begin);
+            const Vec3d an = normals_[t] * system_.area[t];
+            for (int c = 0; c < 3; ++c) out[size_t(c)] = an * double(b[t][c]);
+            return;
+        }
+        if (node.size() < 4096) {
+            self(self, i + 1);
+            self(self, node.right);
+        } else {
+            tbb::parallel_invoke([&] { self(self, i + 1); }, [&] { self(self, node.right); });
+        }
+        for (size_t c = 0; c < 3; ++c) {
+            out[c] = pulled[size_t(i) + 1][c] + pulled[size_t(node.right)][c];
+        }
+    };
+    if (!nodes.empty()) pull(pull, 0);
+    return pulled;
+}
+
+GroupSweep RadiosityHierarchy::SweepGroup(int32_t group, std::span<const NodeExitance> pulled,
+                                          std::span<const Rgb> b, std::span<Rgb> out) const {
+    const int32_t root = group_roots_[size_t(group)];
+    const auto& nodes = tree_.nodes();
+    const ClusterNode& top = nodes[size_t(root)];
+    const GroupLinks& links = links_[size_t(group)];
+    // Gather: vector irradiance per node of the group's subtree, scalar per side from leaves.
+    std::vector<NodeExitance> irradiance(size_t(top.nodes()));
+    for (const NodeLink& link : links.node) {
+        // Recomputed every sweep rather than stored: links are most of the memory.
+        const Vec3d between =
+            nodes[size_t(link.source)].centroid - nodes[size_t(link.receiver)].centroid;
+        const double r2 = LengthSquared(between);
+        const Vec3d d = between / std::sqrt(r2);
+        const double scale = double(link.visibility) / (kPi * r2);
+        NodeExitance& e = irradiance[size_t(link.receiver - root)];
+        for (size_t c = 0; c < 3; ++c) {
+            const double toward = -Dot(d, pulled[size_t(link.source)][c]);
+            if (toward > 0) e[c] += d * (scale * toward);
+        }
+    }
+    std::vector<std::array<double, 3>> h(size_t(top.size()), {0, 0, 0});
+    for (const LeafLink& link : links.leaf) {
+        std::array<double, 3>& acc = h[size_t(link.receiver - top.begin)];
+        const Rgb& source = b[size_t(link.source)];
+        for (size_t c = 0; c < 3; ++c) acc[c] += double(link.f) * source[int(c)];
+    }
+    // Push: a side receives what every ancestor up to the group root received.
+    auto push = [&](auto& self, int32_t i, NodeExitance above) -> void {
+        const ClusterNode& node = nodes[size_t(i)];
+        for (size_t c = 0; c < 3; ++c) above[c] += irradiance[size_t(i - root)][c];
+        if (!node.leaf()) {
+            self(self, i + 1, above);
+            self(self, node.right, above);
+            return;
+        }
+        const Vec3d& n = normals_[size_t(node.begin)];
+        std::array<double, 3>& acc = h[size_t(node.begin - top.begin)];
+        for (size_t c = 0; c < 3; ++c) acc[c] += std::max(0.0, Dot(n, above[c]));
+    };
+    push(push, root, NodeExitance{});
+    GroupSweep sums;
+    for (int32_t t = top.begin; t < top.end; ++t) {
+        const std::array<double, 3>& acc = h[size_t(t - top.begin)];
+        const Rgb &e = system_.emission[size_t(t)], &rho = system_.reflectance[size_t(t)];
+        Rgb& o = out[size_t(t - top.begin)];
+        o = Rgb(float(e.r + rho.r * acc[0]), float(e.g + rho.g * acc[1]),
+                float(e.b + rho.b * acc[2]));
+        const double area = system_.area[size_t(t)];
+        sums.change += RadiosityPower(area, o - b[size_t(t)]);
+        sums.power += RadiosityPower(area, b[size_t(t)]);
+    }
+    return sums;
+}
+
+GroupSweep RadiosityHierarchy::Sweep(std::span<const Rgb> b, std::span<Rgb> next,
+                                     const std::atomic<bool>* cancel) const {
+    const std::vector<NodeExitance> pulled = Pull(b);
+    const auto [g0, g1] = linked_;
+    std::vector<GroupSweep> parts(size_t(g1 - g0));
+    tbb::parallel_for(g0, g1, [&](int32_t g) {
+        if (CancelRequested(cancel)) return;
+        const PatchGroup& group = groups_[size_t(g)];
+        parts[size_t(g - g0)] =
+            SweepGroup(g, pulled, b, next.subspan(size_t(group.begin), size_t(group.size())));
+    });
+    GroupSweep total;
+    for (const GroupSweep& p : parts) {
+        total.change += p.change;
+        total.power += p.power;
+    }
+    return total;
+}
+
+size_t RadiosityHierarchy::link_bytes() const {
+    size_t bytes = 0;
+    for (const GroupLinks& l : links_) {
+        bytes += l.node.capacity() * sizeof(NodeLink) + l.leaf.capacity() * sizeof(LeafLink);
+    }
+    return bytes + links_.size() * sizeof(GroupLinks);
+}
+
+size_t RadiosityHierarchy::bytes() const {
+    const size_t n = size_t(sides());
+    const size_t per_side = sizeof(int32_t) + 2 * sizeof(Rgb) + sizeof(double) + sizeof(Vec3d);
+    return link_bytes() + tree_.nodes().size() * (sizeof(ClusterNode) + sizeof(NodeExitance)) +
+           n * per_side + groups_.size() * (sizeof(PatchGroup) + sizeof(int32_t));
+}
+
+absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,
+                                              const SolveOptions& options) {
+    const RadiositySystem& system = hierarchy.system();
+    std::vector<Rgb> b = system.emission;
+    double emitted = 0;
+    for (size_t t = 0; t < b.size(); ++t) emitted += RadiosityPower(system.area[t], b[t]);
+    if (emitted == 0) {
+        SolveResult dark;
+        dark.radiosity.assign(b.size(), Rgb(0));
+        return dark;
+    }
+    return IterateJacobi(
+        std::move(b),
+        [&](std::span<const Rgb> from, std::span<Rgb> to, const std::atomic<bool>* cancel) {
+            return hierarchy.Sweep(from, to, cancel);
+        },
+        options);
+}
+
+}  // namespace lf
