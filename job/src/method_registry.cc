@@ -6,6 +6,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/aov.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/job/job_spec.h"
 
@@ -41,17 +42,18 @@ absl::Status RadiosityAndMediaRefusal(const Scene& scene) {
 
 // Indexed by Method.
 constexpr std::array<MethodInfo, 6> kMethods = {{
-    {Method::kPath, "path", WorkKind::kTiles, std::nullopt, false, true, true, true, true, nullptr},
+    {Method::kPath, "path", WorkKind::kTiles, std::nullopt, false, true, true, true, true, true,
+     nullptr},
     {Method::kRadiosity, "radiosity", WorkKind::kRadiosity, std::nullopt, false, false, true, true,
-     false, RadiosityAndMediaRefusal},
-    {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, true, true,
-     MediaOnlyRefusal<Method::kWhitted>},
+     true, false, RadiosityAndMediaRefusal},
+    {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, false, true,
+     true, MediaOnlyRefusal<Method::kWhitted>},
     {Method::kLight, "light", WorkKind::kSplatPasses, SplatPlanKind::kLightPaths, true, false,
-     false, false, true, MediaOnlyRefusal<Method::kLight>},
+     false, false, false, true, MediaOnlyRefusal<Method::kLight>},
     {Method::kBdpt, "bdpt", WorkKind::kSplatPasses, SplatPlanKind::kCameraAndLight, true, true,
-     false, false, true, BdptMediaRefusal},
+     false, false, false, true, BdptMediaRefusal},
     {Method::kPpm, "ppm", WorkKind::kSplatPasses, SplatPlanKind::kPhotonPasses, false, true, false,
-     false, true, MediaOnlyRefusal<Method::kPpm>},
+     false, false, true, MediaOnlyRefusal<Method::kPpm>},
 }};
 
 constexpr bool IndexedByMethod() {
@@ -129,8 +131,14 @@ absl::Status CheckMethodTakesFilter(Method method, const PixelFilter& filter) {
         " is not supported; light tracing and bdpt splat with the box filter only"));
 }
 
-absl::Status CheckMethodTakesScene(Method method, const Scene& scene) {
+absl::Status CheckMethodTakesScene(Method method, const Scene& scene, uint32_t aovs) {
     if (absl::Status s = CheckMethodTakesFilter(method, scene.camera.filter); !s.ok()) return s;
+    if ((aovs & kAovIlluminance) && method == Method::kPath && scene.HasMedia()) {
+        return absl::FailedPreconditionError(
+            "method path, AOV illuminance: scenes with participating media are rendered by the "
+            "volumetric path tracer, which has no illuminance estimate; remove the media or the "
+            "AOV");
+    }
     if (Info(method).splats_light_paths &&
         scene.camera.projection == CameraSpec::Projection::kOrthographic) {
         return absl::FailedPreconditionError(absl::StrCat(

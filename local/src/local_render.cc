@@ -8,6 +8,7 @@
 #include "absl/time/time.h"
 #include "lf/core/aov.h"
 #include "lf/core/camera.h"
+#include "lf/core/false_color.h"
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
@@ -218,7 +219,8 @@ void LogRenderSettings(const LocalRenderOptions& options, const Scene& scene, Me
 absl::Status RenderAndWrite(const PosedKernels& k, const LocalRenderOptions& options,
                             const JobSpec& job, const std::optional<SplatPlanSettings>& splat_plan,
                             const std::string& exr_path, const std::string& png_path,
-                            absl::Time start, LocalRenderSummary& summary) {
+                            const std::string& false_color_path, absl::Time start,
+                            LocalRenderSummary& summary) {
     auto log = NamedLogger("render");
     const std::string& job_id = summary.job_id;
     const bool adaptive = IsAdaptive(options);
@@ -306,6 +308,13 @@ absl::Status RenderAndWrite(const PosedKernels& k, const LocalRenderOptions& opt
     if (!png_path.empty()) {
         if (absl::Status s = WritePng(png_path, out->image, options.preview); !s.ok()) return s;
     }
+    if (options.false_color) {
+        if (absl::Status s =
+                WriteFalseColorPng(false_color_path, out->image, *options.false_color);
+            !s.ok()) {
+            return s;
+        }
+    }
     return absl::OkStatus();
 }
 
@@ -320,6 +329,12 @@ struct LoadedRender {
 
 absl::StatusOr<LoadedRender> LoadRender(const LocalRenderOptions& options) {
     auto log = NamedLogger("render");
+    if (options.false_color) {
+        if (absl::Status s = CheckFalseColorSource(*options.false_color, options.render.aovs);
+            !s.ok()) {
+            return s;
+        }
+    }
     absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
     LoadedRender r{.scene = std::move(*scene)};
@@ -327,7 +342,10 @@ absl::StatusOr<LoadedRender> LoadRender(const LocalRenderOptions& options) {
     const MethodChoice choice = ChooseMethod(r.scene, options.method);
     r.method = choice.method;
     // What the farm refuses at submission (media a method does not render, say) is refused here.
-    if (absl::Status s = CheckMethodTakesScene(r.method, r.scene); !s.ok()) return s;
+    if (absl::Status s = CheckMethodTakesScene(r.method, r.scene, options.render.aovs);
+        !s.ok()) {
+        return s;
+    }
     const MethodInfo& info = Info(r.method);
     log->info("job={} method {} ({})", r.job_id, info.name, choice.why);
     r.job = LocalJobOf(options, r.scene, info);
@@ -391,7 +409,8 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     TakeKernelFigures(**k, summary);
     LogRenderSettings(options, r->scene, r->method, r->splat_plan, r->job_id);
     if (absl::Status s = RenderAndWrite(**k, options, r->job, r->splat_plan, options.exr_path,
-                                        options.png_path, start, summary);
+                                        options.png_path, options.false_color_path, start,
+                                        summary);
         !s.ok()) {
         return s;
     }
@@ -447,7 +466,10 @@ absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
         if (options.progress) options.progress->StartFrame(i, frames.count(), frame);
         if (absl::Status s =
                 RenderAndWrite(*kernels, options, FrameSpec(r->job, frame), r->splat_plan,
-                               f.exr_path, f.png_path, frame_start, summary);
+                               f.exr_path, f.png_path,
+                               options.false_color ? FramePath(options.false_color_path, frame)
+                                                   : std::string(),
+                               frame_start, summary);
             !s.ok()) {
             return s;
         }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "lf/core/false_color.h"
 #include "lf/core/image_io.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/method_registry.h"
@@ -49,6 +50,9 @@ struct LocalRenderOptions {
     SceneOptions scene;    // --camera, --resolution, --filter
     std::string exr_path;  // empty: no EXR (-o out.png)
     std::string png_path;  // empty: no preview
+    // --false-color: a false-colour PNG at false_color_path (a pattern for a shot, as exr_path).
+    std::optional<FalseColorSpec> false_color;
+    std::string false_color_path;
     PngOptions preview;    // --exposure, --tonemap
     std::optional<Method> method = FindMethod(defaults::kMethod);  // nullopt: auto (ChooseMethod)
     RenderSettings render;                                         // with --clamp and --aov
