@@ -23,14 +23,14 @@ namespace {
 
 // Viridis (matplotlib's, sRGB) at t = 0, 1/8, ..., 1; linear between them.
 constexpr std::array<std::array<uint8_t, 3>, 9> kViridis = {{{68, 1, 84},
-                                                              {71, 44, 122},
-                                                              {59, 81, 139},
-                                                              {44, 113, 142},
-                                                              {33, 144, 141},
-                                                              {39, 173, 129},
-                                                              {92, 200, 99},
-                                                              {170, 220, 50},
-                                                              {253, 231, 37}}};
+                                                             {71, 44, 122},
+                                                             {59, 81, 139},
+                                                             {44, 113, 142},
+                                                             {33, 144, 141},
+                                                             {39, 173, 129},
+                                                             {92, 200, 99},
+                                                             {170, 220, 50},
+                                                             {253, 231, 37}}};
 
 constexpr std::array<uint8_t, 3> kInk = {255, 255, 255};
 
@@ -121,9 +121,9 @@ absl::StatusOr<FalseColorSpec> ParseFalseColor(std::string_view text) {
     double min = 0, max = 0;
     if (parts.size() != 3 || !absl::SimpleAtod(parts[1], &min) ||
         !absl::SimpleAtod(parts[2], &max)) {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "--false-color ", std::string(text), ": expected ", parts[0], " or ", parts[0],
-            ":MIN:MAX with numbers MIN and MAX"));
+        return absl::InvalidArgumentError(absl::StrCat("--false-color ", std::string(text),
+                                                       ": expected ", parts[0], " or ", parts[0],
+                                                       ":MIN:MAX with numbers MIN and MAX"));
     }
     if (absl::Status s = CheckRange(min, max); !s.ok()) {
         return absl::InvalidArgumentError(
@@ -187,9 +187,8 @@ absl::StatusOr<std::vector<float>> FalseColorValues(const Image& image, FalseCol
 absl::StatusOr<Rgb8Picture> DrawFalseColor(std::span<const float> values, int width, int height,
                                            FalseColorUnit unit, double min, double max) {
     if (width <= 0 || height <= 0 || values.size() != size_t(width) * size_t(height)) {
-        return absl::InvalidArgumentError(absl::StrCat("false colour: ", values.size(),
-                                                       " values for a ", width, "x", height,
-                                                       " image"));
+        return absl::InvalidArgumentError(absl::StrCat(
+            "false colour: ", values.size(), " values for a ", width, "x", height, " image"));
     }
     if (absl::Status s = CheckRange(min, max); !s.ok()) return s;
     Rgb8Picture picture{width, height + kFalseColorLegendRows, {}};
@@ -213,8 +212,8 @@ absl::StatusOr<Rgb8Picture> DrawFalseColor(std::span<const float> values, int wi
     canvas.Text(bar_x1 + 4, top + 6, unit_label);
     int free_from = 0;  // numbers left of this would overlap the last one
     const double log_ratio = std::log10(max / min);
-    for (int e = int(std::ceil(std::log10(min) - 1e-9)); e <= int(std::floor(std::log10(max) + 1e-9));
-         ++e) {
+    for (int e = int(std::ceil(std::log10(min) - 1e-9));
+         e <= int(std::floor(std::log10(max) + 1e-9)); ++e) {
         const double t = (double(e) - std::log10(min)) / log_ratio;
         const int x = bar_x0 + int(std::lround(t * double(bar_x1 - 1 - bar_x0)));
         canvas.Fill(x, top + 14, x + 1, top + 18, kInk);
@@ -231,8 +230,8 @@ absl::StatusOr<Rgb8Picture> DrawFalseColor(std::span<const float> values, int wi
 std::string FalseColorPath(const std::string& exr_path) {
     const size_t slash = exr_path.find_last_of('/');
     const size_t dot = exr_path.find_last_of('.');
-    const bool has_extension = dot != std::string::npos && dot > 0 &&
-                               (slash == std::string::npos || dot > slash + 1);
+    const bool has_extension =
+        dot != std::string::npos && dot > 0 && (slash == std::string::npos || dot > slash + 1);
     return (has_extension ? exr_path.substr(0, dot) : exr_path) + ".falsecolor.png";
 }
 

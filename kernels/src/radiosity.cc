@@ -227,8 +227,8 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
             return status;
         }
     }
-    auto renderer = std::make_unique<RadiosityRenderer>(scene, std::move(*mesh),
-                                                        std::move(radiosity), options.display, report);
+    auto renderer = std::make_unique<RadiosityRenderer>(
+        scene, std::move(*mesh), std::move(radiosity), options.display, report);
     if (!options.export_ply.empty()) {
         // The display gives the PLY its illuminance.
         if (absl::Status status = WriteRadiosityPly(options.export_ply, renderer->mesh(),

@@ -136,9 +136,8 @@ std::string CornerLux(const PatchMesh& mesh, const RadiosityDisplay& display, si
     w[c] = 1 - 2e-6;
     const auto [b1, b2] = mesh.TriangleBarycentrics(side.patch, w);
     char text[32];
-    std::snprintf(
-        text, sizeof text, "%.4g",
-        Photometric(display.Irradiance(patch.mesh, patch.primitive, b1, b2, side.back)));
+    std::snprintf(text, sizeof text, "%.4g",
+                  Photometric(display.Irradiance(patch.mesh, patch.primitive, b1, b2, side.back)));
     return text;
 }
 
@@ -186,8 +185,8 @@ absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,
                  vertices.size(), faces.size());
     for (const Vertex& v : vertices) {
         const Vec3d& p = mesh.vertices()[v.position];
-        std::fprintf(file, "%.9g %.9g %.9g %d %d %d %s\n", p.x, p.y, p.z, v.colour[0],
-                     v.colour[1], v.colour[2], v.lux.c_str());
+        std::fprintf(file, "%.9g %.9g %.9g %d %d %d %s\n", p.x, p.y, p.z, v.colour[0], v.colour[1],
+                     v.colour[2], v.lux.c_str());
     }
     for (const auto& f : faces) std::fprintf(file, "3 %u %u %u\n", f[0], f[1], f[2]);
     const bool failed = std::ferror(file) != 0;

@@ -309,8 +309,7 @@ absl::Status RenderAndWrite(const PosedKernels& k, const LocalRenderOptions& opt
         if (absl::Status s = WritePng(png_path, out->image, options.preview); !s.ok()) return s;
     }
     if (options.false_color) {
-        if (absl::Status s =
-                WriteFalseColorPng(false_color_path, out->image, *options.false_color);
+        if (absl::Status s = WriteFalseColorPng(false_color_path, out->image, *options.false_color);
             !s.ok()) {
             return s;
         }
@@ -342,8 +341,7 @@ absl::StatusOr<LoadedRender> LoadRender(const LocalRenderOptions& options) {
     const MethodChoice choice = ChooseMethod(r.scene, options.method);
     r.method = choice.method;
     // What the farm refuses at submission (media a method does not render, say) is refused here.
-    if (absl::Status s = CheckMethodTakesScene(r.method, r.scene, options.render.aovs);
-        !s.ok()) {
+    if (absl::Status s = CheckMethodTakesScene(r.method, r.scene, options.render.aovs); !s.ok()) {
         return s;
     }
     const MethodInfo& info = Info(r.method);
@@ -409,8 +407,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     TakeKernelFigures(**k, summary);
     LogRenderSettings(options, r->scene, r->method, r->splat_plan, r->job_id);
     if (absl::Status s = RenderAndWrite(**k, options, r->job, r->splat_plan, options.exr_path,
-                                        options.png_path, options.false_color_path, start,
-                                        summary);
+                                        options.png_path, options.false_color_path, start, summary);
         !s.ok()) {
         return s;
     }
@@ -464,12 +461,10 @@ absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
         summary.load_seconds = f.pose_seconds + f.bvh_seconds;
         TakeKernelFigures(*kernels, summary);
         if (options.progress) options.progress->StartFrame(i, frames.count(), frame);
-        if (absl::Status s =
-                RenderAndWrite(*kernels, options, FrameSpec(r->job, frame), r->splat_plan,
-                               f.exr_path, f.png_path,
-                               options.false_color ? FramePath(options.false_color_path, frame)
-                                                   : std::string(),
-                               frame_start, summary);
+        if (absl::Status s = RenderAndWrite(
+                *kernels, options, FrameSpec(r->job, frame), r->splat_plan, f.exr_path, f.png_path,
+                options.false_color ? FramePath(options.false_color_path, frame) : std::string(),
+                frame_start, summary);
             !s.ok()) {
             return s;
         }

@@ -1091,7 +1091,7 @@ TEST_F(Farm, ClampAovsFilterSamplerAndLightSamplingGiveTheSameImageAndHeaderLoca
     StartWorker("w1");
     StartWorker("w2");
     const std::string flags =
-        "--spp 4 --seed 2 --tile 16 --clamp 2 --aov all "
+        "--spp 4 --seed 2 --tile 16 --clamp 2 --aov all,illuminance "
         "--filter blackman-harris:2 --sampler independent --light-sampling power";
     const std::string job = Submit(scene_, flags);
     ASSERT_EQ(Farmctl("watch " + job).status, 0);
@@ -1099,17 +1099,24 @@ TEST_F(Farm, ClampAovsFilterSamplerAndLightSamplingGiveTheSameImageAndHeaderLoca
     EXPECT_NE(status.out.find("independent sampler, power light sampling"), std::string::npos)
         << status.out;
     const std::string farm = (dir_ / "farm.exr").string(), local = (dir_ / "local.exr").string();
-    ASSERT_EQ(Farmctl("fetch " + job + " -o " + farm).status, 0);
-    const CliRun r =
-        Lightfarm("render " + scene_ + " -o " + local + " " + flags + " --no-progress");
+    ASSERT_EQ(Farmctl("fetch " + job + " -o " + farm + " --false-color lux").status, 0);
+    const CliRun r = Lightfarm("render " + scene_ + " -o " + local + " " + flags +
+                               " --false-color lux --no-progress");
     ASSERT_EQ(r.status, 0) << r.out << r.err;
     ExpectSameImageAndHeader(farm, local);
+    // The false-colour PNGs of the same lux are the same bytes.
+    EXPECT_EQ(ReadText((dir_ / "farm.falsecolor.png").string()),
+              ReadText((dir_ / "local.falsecolor.png").string()));
     absl::StatusOr<ExrFile> file = ReadExr(farm);
     ASSERT_TRUE(file.ok()) << file.status();
     ASSERT_TRUE(file->attributes.count("lightfarm.clamp") &&
                 file->attributes.count("lightfarm.aovs"));
     EXPECT_EQ(std::get<double>(file->attributes.at("lightfarm.clamp")), 2.0);
-    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.aovs")), "albedo,normal,depth");
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.aovs")),
+              "albedo,normal,depth,illuminance");
+    EXPECT_NE(std::get<std::string>(file->attributes.at("lightfarm.units")).find("lux"),
+              std::string::npos);
+    EXPECT_NE(file->image.FindChannel("illuminance"), nullptr);
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.filter")),
               "blackman-harris 2 px");
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.sampler")), "independent");
@@ -1892,7 +1899,8 @@ TEST_P(FarmSplat, PreviewShowsTheMergedPathsAndCancelStopsTheTask) {
     };
     const size_t leased = leases();
     const auto deadline = Clock::now() + milliseconds(20000);
-    while (leases() == leased && Clock::now() < deadline) std::this_thread::sleep_for(milliseconds(1));
+    while (leases() == leased && Clock::now() < deadline)
+        std::this_thread::sleep_for(milliseconds(1));
     ASSERT_GT(leases(), leased) << "the worker leased no further task";
     ASSERT_EQ(Farmctl("cancel " + job).status, 0);
     EXPECT_TRUE(WaitForText(dir_ / "w1.log", "dropped", kStopWithin))

@@ -30,7 +30,7 @@ TEST(FalseColor, RampBrightensMonotonicallyFromDarkBlueToYellow) {
             << "t = " << i / 32.0;
     }
     const auto low = FalseColorRamp(0), high = FalseColorRamp(1);
-    EXPECT_GT(low[2], low[0]);   // blue-violet at the bottom
+    EXPECT_GT(low[2], low[0]);    // blue-violet at the bottom
     EXPECT_GT(high[0], high[2]);  // yellow at the top
     EXPECT_EQ(FalseColorRamp(-3), low);
     EXPECT_EQ(FalseColorRamp(7), high);
@@ -50,7 +50,7 @@ TEST(FalseColor, PlacesValuesOnALogarithmicScale) {
 TEST(FalseColor, RobustRangeRoundsPercentilesOutToDecades) {
     std::vector<float> values;
     for (int i = 0; i < 1000; ++i) values.push_back(2 + 0.5f * float(i));  // 2 .. 501.5
-    values[0] = 1e-9f;  // outliers: ignored
+    values[0] = 1e-9f;                                                     // outliers: ignored
     values[1] = 1e9f;
     values.push_back(0);
     values.push_back(-5);
@@ -74,16 +74,17 @@ TEST(FalseColor, DrawsThePictureAndALegendUnderIt) {
         const uint8_t* p = &picture.rgb[(size_t(y) * kWidth + x) * 3];
         return std::array<uint8_t, 3>{p[0], p[1], p[2]};
     };
-    EXPECT_EQ(at(0, 0), FalseColorRamp(0));                              // 1 lux
-    EXPECT_EQ(at(9, 5), FalseColorRamp(0.5));                            // 10 lux
-    EXPECT_EQ(at(kWidth - 1, kHeight - 1), FalseColorRamp(1));           // 160: clamped
+    EXPECT_EQ(at(0, 0), FalseColorRamp(0));                     // 1 lux
+    EXPECT_EQ(at(9, 5), FalseColorRamp(0.5));                   // 10 lux
+    EXPECT_EQ(at(kWidth - 1, kHeight - 1), FalseColorRamp(1));  // 160: clamped
     // The legend's bar runs through the ramp from its left end.
     EXPECT_EQ(at(4, kHeight + 8), FalseColorRamp(0));
     EXPECT_GT(Lightness(at(100, kHeight + 8)), Lightness(at(20, kHeight + 8)));
     // Ink (white) in the tick and number rows and beside the bar (the unit).
     int ink_numbers = 0, ink_unit = 0;
     for (int y = kHeight + 14; y < kHeight + kFalseColorLegendRows; ++y) {
-        for (int x = 0; x < kWidth; ++x) ink_numbers += at(x, y) == std::array<uint8_t, 3>{255, 255, 255};
+        for (int x = 0; x < kWidth; ++x)
+            ink_numbers += at(x, y) == std::array<uint8_t, 3>{255, 255, 255};
     }
     for (int y = kHeight; y < kHeight + 14; ++y) {
         for (int x = kWidth - 30; x < kWidth; ++x) {

@@ -13,6 +13,7 @@
 #include "lf/core/patch_mesh.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/job/job_spec.h"
+#include "lf/job/method_registry.h"
 #include "lf/server/farm.h"
 
 namespace lf {
@@ -46,7 +47,7 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
         {"clamp", [](JobSpec& s) { s.clamp = -1; }},
         {"clamp", [](JobSpec& s) { s.clamp = NAN; }},
         {"clamp", [](JobSpec& s) { s.clamp = INFINITY; }},
-        {"aovs", [](JobSpec& s) { s.aovs = kAllAovs + 1; }},
+        {"aovs", [](JobSpec& s) { s.aovs = kKnownAovs + 1; }},
         {"filter",
          [](JobSpec& s) {
              s.scene_options.filter = PixelFilter{PixelFilter::Type::kBox, 2};
@@ -109,7 +110,7 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     edge.radiosity.max_patches = kMaxRefinedPatches;
     edge.clamp = 1e300;
     JobSpec aov_edge = edge;
-    aov_edge.aovs = kAllAovs;
+    aov_edge.aovs = kKnownAovs;
     aov_edge.plan.tile = kMaxFarmAovTile;
     aov_edge.scene_options.filter = PixelFilter{PixelFilter::Type::kGaussian, kMaxFilterWidth};
     EXPECT_TRUE(CheckJobSettings(aov_edge).ok()) << CheckJobSettings(aov_edge);
@@ -120,6 +121,42 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     edge.light_strategy = LightStrategy::kPower;
     EXPECT_TRUE(CheckJobSettings(edge).ok()) << CheckJobSettings(edge);
     fs::remove_all(dir);
+}
+
+// The illuminance AOV: path and radiosity estimate it; the other methods are refused naming the
+// method and the AOV, and so is path on a scene with media (its volumetric tracer has none).
+TEST(JobSettingsTest, IlluminanceIsRefusedForMethodsWithoutAnEstimate) {
+    for (const char* method : {"path", "radiosity"}) {
+        JobSpec spec;
+        spec.method = method;
+        spec.aovs = kAovIlluminance;
+        EXPECT_TRUE(CheckJobSettings(spec).ok()) << method << ": " << CheckJobSettings(spec);
+    }
+    for (const char* method : {"whitted", "light", "bdpt", "ppm"}) {
+        JobSpec spec;
+        spec.method = method;
+        spec.aovs = kAovIlluminance;
+        const absl::Status s = CheckJobSettings(spec);
+        EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << method;
+        EXPECT_NE(s.message().find(method), absl::string_view::npos) << s;
+        EXPECT_NE(s.message().find("AOV"), absl::string_view::npos) << s;
+    }
+    JobSpec whitted;
+    whitted.method = "whitted";
+    whitted.aovs = kAovIlluminance;
+    EXPECT_NE(CheckJobSettings(whitted).message().find("illuminance"), absl::string_view::npos);
+
+    Scene fog;
+    Medium medium;
+    medium.sigma_s = Rgb(0.5f);
+    fog.media.push_back(medium);
+    fog.camera_medium = 0;
+    ASSERT_TRUE(fog.HasMedia());
+    EXPECT_TRUE(CheckMethodTakesScene(Method::kPath, fog, kAllAovs).ok());
+    const absl::Status refused = CheckMethodTakesScene(Method::kPath, fog, kAovIlluminance);
+    EXPECT_EQ(refused.code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_NE(refused.message().find("method path, AOV illuminance"), absl::string_view::npos)
+        << refused;
 }
 
 }  // namespace

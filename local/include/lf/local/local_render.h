@@ -50,10 +50,10 @@ struct LocalRenderOptions {
     SceneOptions scene;    // --camera, --resolution, --filter
     std::string exr_path;  // empty: no EXR (-o out.png)
     std::string png_path;  // empty: no preview
+    PngOptions preview;    // --exposure, --tonemap
     // --false-color: a false-colour PNG at false_color_path (a pattern for a shot, as exr_path).
     std::optional<FalseColorSpec> false_color;
     std::string false_color_path;
-    PngOptions preview;    // --exposure, --tonemap
     std::optional<Method> method = FindMethod(defaults::kMethod);  // nullopt: auto (ChooseMethod)
     RenderSettings render;                                         // with --clamp and --aov
     AdaptiveSettings adaptive;  // used when a target error or a time limit is set

@@ -22,8 +22,8 @@ struct ChannelView {
 };
 
 // The R,G,B image of view `channel`: normals remapped from [-1, 1] to [0, 1], depth and
-// illuminance as grey scaled by the image's largest finite value (near and dim are dark). InvalidArgument naming the channel
-// and the ones the image has for one it lacks.
+// illuminance as grey scaled by the image's largest finite value (near and dim are dark).
+// InvalidArgument naming the channel and the ones the image has for one it lacks.
 absl::StatusOr<ChannelView> ViewChannel(const Image& image, const std::string& channel);
 
 }  // namespace lf
