@@ -753,7 +753,7 @@ TEST_F(Farm, SameBitsAsLocalRenderForAnyWorkersAndTiles) {
 
 // AOVs, a wide filter and a clamp on two workers, in tiles and passes unlike the local render's:
 // every channel has the local bits, also after the server was killed mid-render and rebuilt its
-// tiles (AOV sums included) from the results its job store kept.
+// tiles (AOV sums included, illuminance's too) from the results its job store kept.
 TEST_F(Farm, AovsFilterAndClampGiveTheLocalBitsForAnyTilesAndAcrossARestart) {
     StartServer();
     StartWorker("w1");
@@ -765,7 +765,8 @@ TEST_F(Farm, AovsFilterAndClampGiveTheLocalBitsForAnyTilesAndAcrossARestart) {
             scene_, std::string("--spp 8 --seed 5 --passes 2 --tile ") + tile + " " + extras);
         ExpectSameAsLocal(job, scene_, 8, 5, "--method path " + extras);
     }
-    const std::string extras = "--aov albedo,depth" + filter_and_clamp;
+    // Illuminance too: its sums survive the restart in the job store and the tile store.
+    const std::string extras = "--aov albedo,depth,illuminance" + filter_and_clamp;
     const std::string job = Submit(scene_, "--spp 256 --seed 6 --tile 16 --passes 2 " + extras);
     ASSERT_TRUE(WaitForTasksDone(job, 8, milliseconds(30000)));
     CrashAndRestartServer();
