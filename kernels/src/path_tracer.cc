@@ -35,12 +35,13 @@ std::optional<Rgb> PathTracer::Irradiance(const Ray& camera_ray, Sampler& sample
     const std::optional<SurfaceHit> hit = scene_.Intersect(camera_ray);
     if (!hit) return Rgb(0);
     const Shading sh = Shade(scene_, *hit, -camera_ray.d);
+    // The hit's own material does not enter: irradiance is the light arriving, whatever the
+    // surface does with it. A white Lambertian reflects it with f = 1/pi, so its reflected
+    // radiance's estimate, times pi, is the irradiance's.
     Material white;
     white.type = Material::Type::kLambert;
     white.reflectance = Rgb(1);
-    SurfaceParams params = SurfaceParams::Of(white);
-    const Bsdf lambert(white, params);
-    // f = 1/pi: the reflected radiance's estimate, times pi, is the irradiance's.
+    const Bsdf lambert(white, SurfaceParams::Of(white));
     Rgb reflected = NextEventEstimate(scene_, lights_, *hit, sh, -camera_ray.d, lambert, kVacuum,
                                       Rgb(1), u_choice.x, u_light, stats);
     const Frame frame = Frame::FromNormal(sh.ns);
