@@ -6,7 +6,6 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
-#include "lf/core/aov.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/job/job_spec.h"
 
@@ -131,14 +130,8 @@ absl::Status CheckMethodTakesFilter(Method method, const PixelFilter& filter) {
         " is not supported; light tracing and bdpt splat with the box filter only"));
 }
 
-absl::Status CheckMethodTakesScene(Method method, const Scene& scene, uint32_t aovs) {
+absl::Status CheckMethodTakesScene(Method method, const Scene& scene) {
     if (absl::Status s = CheckMethodTakesFilter(method, scene.camera.filter); !s.ok()) return s;
-    if ((aovs & kAovIlluminance) && method == Method::kPath && scene.HasMedia()) {
-        return absl::FailedPreconditionError(
-            "method path, AOV illuminance: scenes with participating media are rendered by the "
-            "volumetric path tracer, which has no illuminance estimate; remove the media or the "
-            "AOV");
-    }
     if (Info(method).splats_light_paths &&
         scene.camera.projection == CameraSpec::Projection::kOrthographic) {
         return absl::FailedPreconditionError(absl::StrCat(

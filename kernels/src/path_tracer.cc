@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "lf/kernels/aov_tracer.h"
 #include "lf/kernels/bsdf.h"
 #include "lf/kernels/next_event.h"
 #include "lf/kernels/shading.h"
@@ -35,13 +36,7 @@ std::optional<Rgb> PathTracer::Irradiance(const Ray& camera_ray, Sampler& sample
     const std::optional<SurfaceHit> hit = scene_.Intersect(camera_ray);
     if (!hit) return Rgb(0);
     const Shading sh = Shade(scene_, *hit, -camera_ray.d);
-    // The hit's own material does not enter: irradiance is the light arriving, whatever the
-    // surface does with it. A white Lambertian reflects it with f = 1/pi, so its reflected
-    // radiance's estimate, times pi, is the irradiance's.
-    Material white;
-    white.type = Material::Type::kLambert;
-    white.reflectance = Rgb(1);
-    const Bsdf lambert(white, SurfaceParams::Of(white));
+    const Bsdf lambert = IrradianceBsdf();
     Rgb reflected = NextEventEstimate(scene_, lights_, *hit, sh, -camera_ray.d, lambert, kVacuum,
                                       Rgb(1), u_choice.x, u_light, stats);
     const Frame frame = Frame::FromNormal(sh.ns);

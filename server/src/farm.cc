@@ -176,9 +176,7 @@ absl::StatusOr<std::string> Farm::Submit(JobSpec spec) {
     // The service logs the refusal with its caller.
     if (!scene.ok()) return absl::InvalidArgumentError(scene.status().message());
     // Refused here, once, rather than failing on every worker.
-    if (absl::Status s = CheckMethodTakesScene(MethodOf(spec), *scene, spec.aovs); !s.ok()) {
-        return s;
-    }
+    if (absl::Status s = CheckMethodTakesScene(MethodOf(spec), *scene); !s.ok()) return s;
     // A shot's scene must pose: malformed animation is refused as `render --frames` refuses it.
     if (spec.shot.frames) {
         if (absl::Status s = PoseSceneAtFrame(spec.shot.frames->first, spec.shot, *scene);

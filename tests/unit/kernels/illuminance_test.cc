@@ -1,7 +1,7 @@
 // The illuminance AOV (lux on the side of the first hit the camera sees): a plane of albedo 0.5
 // under a point light of I candela at height h reads I cos^3(theta) / h^2 (I / h^2 below the
-// light) with the radiosity solution and with the path tracer; asking for it changes no bit of
-// the image.
+// light) with the radiosity solution and with the path tracer, and that times Beer's law with
+// the volumetric path tracer in an absorbing medium; asking for it changes no bit of the image.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +14,7 @@
 #include "lf/kernels/embree_scene.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
+#include "lf/kernels/vol_path_tracer.h"
 #include "lf/local/local_executor.h"
 #include "plane_render.h"
 #include "test_scenes.h"
@@ -38,11 +39,13 @@ Scene LitPlane() {
     return scene;
 }
 
-// I cos^3(theta) / h^2 at plane point p.
-double ExpectedLux(const Vec3d& p) {
+// I cos^3(theta) / h^2 at plane point p, times exp(-sigma_a d) over the distance d to the
+// light in a medium absorbing sigma_a.
+double ExpectedLux(const Vec3d& p, double sigma_a) {
     const double d = std::sqrt(p.x * p.x + p.z * p.z + kHeight * kHeight);
     const double cos_theta = kHeight / d;
-    return kCandela * cos_theta * cos_theta * cos_theta / (kHeight * kHeight);
+    return kCandela * cos_theta * cos_theta * cos_theta / (kHeight * kHeight) *
+           std::exp(-sigma_a * d);
 }
 
 // The lux of pixel (x, y) averaged over its footprint (box filter), and the spread over it: the
@@ -50,14 +53,14 @@ double ExpectedLux(const Vec3d& p) {
 struct PixelLux {
     double mean = 0, sd = 0;
 };
-PixelLux ExpectedPixel(const Camera& camera, int x, int y) {
+PixelLux ExpectedPixel(const Camera& camera, int x, int y, double sigma_a = 0) {
     constexpr int kGrid = 16;
     double sum = 0, sum2 = 0;
     for (int j = 0; j < kGrid; ++j) {
         for (int i = 0; i < kGrid; ++i) {
             const Ray ray = camera.GenerateRay(x, y, (i + 0.5f) / kGrid, (j + 0.5f) / kGrid);
             const Vec3d o(ray.o), d(ray.d);
-            const double e = ExpectedLux(o - d * (o.y / d.y));
+            const double e = ExpectedLux(o - d * (o.y / d.y), sigma_a);
             sum += e;
             sum2 += e * e;
         }
@@ -66,12 +69,28 @@ PixelLux ExpectedPixel(const Camera& camera, int x, int y) {
     return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean))};
 }
 
-struct Prepared {
+// LitPlane with the camera, the plane and the light in a medium absorbing sigma_a (no
+// scattering: Beer's law exactly), which the volumetric path tracer renders.
+Scene LitPlaneInAbsorber(float sigma_a) {
     Scene scene = LitPlane();
+    Medium absorber;
+    absorber.sigma_a = Rgb(sigma_a);
+    scene.media.push_back(absorber);
+    scene.camera_medium = 0;
+    return scene;
+}
+
+struct Prepared {
+    explicit Prepared(Scene s = LitPlane()) : scene(std::move(s)) {}
+    Scene scene;
     std::unique_ptr<EmbreeScene> embree = EmbreeScene::Build(scene).value();
     Camera camera{scene.camera, embree->origin()};
     Camera world{scene.camera, Vec3d()};  // rays in scene coordinates, for the expected values
 };
+
+bool SameBits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
 
 Image Render(const Prepared& p, const RadianceEstimator& estimator, uint64_t spp, uint32_t aovs) {
     RenderSettings settings;
@@ -85,13 +104,13 @@ Image Render(const Prepared& p, const RadianceEstimator& estimator, uint64_t spp
 // a mean of `spp` samples; the pixel under the light (the image's middle) reads I / h^2 and the
 // corners (50 degrees off the axis) I cos^3(theta) / h^2, about 0.28 of it.
 void ExpectInverseSquareCosineCubed(const Prepared& p, const Image& image, uint64_t spp,
-                                    double standard_errors) {
+                                    double standard_errors, double sigma_a = 0) {
     const int n = kSize;
     const std::vector<float>& lux = *image.FindChannel(kAovIlluminanceChannel);
     double worst = 0;
     for (int y = 0; y < n; ++y) {
         for (int x = 0; x < n; ++x) {
-            const PixelLux e = ExpectedPixel(p.world, x, y);
+            const PixelLux e = ExpectedPixel(p.world, x, y, sigma_a);
             const double got = lux[size_t(y) * n + x];
             const double tolerance = 0.01 * e.mean + standard_errors * e.sd / std::sqrt(spp);
             ASSERT_NEAR(got, e.mean, tolerance) << "pixel " << x << "," << y;
@@ -99,9 +118,9 @@ void ExpectInverseSquareCosineCubed(const Prepared& p, const Image& image, uint6
         }
     }
     // The middle pixel's footprint (0.2 wide) averages 0.3 % below the value under the light.
-    const double below = kCandela / (kHeight * kHeight);
+    const double below = kCandela / (kHeight * kHeight) * std::exp(-sigma_a * kHeight);
     EXPECT_NEAR(lux[size_t(n / 2) * n + n / 2], below, 0.01 * below);
-    EXPECT_LT(ExpectedPixel(p.world, 0, 0).mean, 0.5 * below);
+    EXPECT_LT(ExpectedPixel(p.world, 0, 0, sigma_a).mean, 0.5 * below);
     std::printf("worst relative error %.5f, middle pixel %.3f lux, corner %.3f lux\n", worst,
                 lux[size_t(n / 2) * n + n / 2], lux[0]);
 }
@@ -127,6 +146,21 @@ TEST(Illuminance, PathTracedPlaneUnderAPointLightIsInverseSquareCosineCubed) {
     ExpectInverseSquareCosineCubed(p, Render(p, tracer, kSpp, kAovIlluminance), kSpp, 4);
 }
 
+// In a medium absorbing 0.2 per unit, the light reaching the plane is dimmed over its way from
+// the light (exp(-0.2 d), d from 2 to 3.3), not over the camera ray's.
+TEST(Illuminance, VolumetricPathTracerDimsItByTheMediumBetweenLightAndSurface) {
+    constexpr float kSigmaA = 0.2f;
+    const Prepared p(LitPlaneInAbsorber(kSigmaA));
+    const VolPathTracer tracer(*p.embree, -1);
+    constexpr uint64_t kSpp = 64;
+    const Image with = Render(p, tracer, kSpp, kAovIlluminance);
+    ExpectInverseSquareCosineCubed(p, with, kSpp, 4, kSigmaA);
+    const Image plain = Render(p, tracer, kSpp, 0);
+    for (const auto& [name, data] : plain.channels()) {
+        EXPECT_TRUE(SameBits(data, *with.FindChannel(name))) << name;
+    }
+}
+
 // Indirect light counts: in a closed furnace of albedo a lit by emission Le from every wall the
 // irradiance everywhere is pi Le / (1 - a), which the path tracer's estimate must reach within
 // its standard error; the image keeps its bits with the AOV.
@@ -143,10 +177,7 @@ TEST(Illuminance, PathTracerCountsIndirectLightAndLeavesTheImageAlone) {
     settings.aovs = kAllAovs | kAovIlluminance;
     const Image with = RenderImage(camera, tracer, settings).value().image;
     for (const auto& [name, data] : plain.channels()) {
-        const std::vector<float>& other = *with.FindChannel(name);
-        EXPECT_TRUE(data.size() == other.size() &&
-                    std::memcmp(data.data(), other.data(), data.size() * sizeof(float)) == 0)
-            << name;
+        EXPECT_TRUE(SameBits(data, *with.FindChannel(name))) << name;
     }
     const testing::MeanAndError lux = testing::ChannelMean(with, kAovIlluminanceChannel);
     const double expected = kLumensPerWatt * std::numbers::pi * kLe / (1 - kAlbedo);

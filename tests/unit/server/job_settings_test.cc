@@ -13,7 +13,6 @@
 #include "lf/core/patch_mesh.h"
 #include "lf/core/pixel_filter.h"
 #include "lf/job/job_spec.h"
-#include "lf/job/method_registry.h"
 #include "lf/server/farm.h"
 
 namespace lf {
@@ -123,8 +122,8 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     fs::remove_all(dir);
 }
 
-// The illuminance AOV: path and radiosity estimate it; the other methods are refused naming the
-// method and the AOV, and so is path on a scene with media (its volumetric tracer has none).
+// The illuminance AOV: path (with or without media) and radiosity estimate it; the other
+// methods are refused naming the method and the AOV.
 TEST(JobSettingsTest, IlluminanceIsRefusedForMethodsWithoutAnEstimate) {
     for (const char* method : {"path", "radiosity"}) {
         JobSpec spec;
@@ -145,18 +144,6 @@ TEST(JobSettingsTest, IlluminanceIsRefusedForMethodsWithoutAnEstimate) {
     whitted.method = "whitted";
     whitted.aovs = kAovIlluminance;
     EXPECT_NE(CheckJobSettings(whitted).message().find("illuminance"), absl::string_view::npos);
-
-    Scene fog;
-    Medium medium;
-    medium.sigma_s = Rgb(0.5f);
-    fog.media.push_back(medium);
-    fog.camera_medium = 0;
-    ASSERT_TRUE(fog.HasMedia());
-    EXPECT_TRUE(CheckMethodTakesScene(Method::kPath, fog, kAllAovs).ok());
-    const absl::Status refused = CheckMethodTakesScene(Method::kPath, fog, kAovIlluminance);
-    EXPECT_EQ(refused.code(), absl::StatusCode::kFailedPrecondition);
-    EXPECT_NE(refused.message().find("method path, AOV illuminance"), absl::string_view::npos)
-        << refused;
 }
 
 }  // namespace

@@ -66,10 +66,8 @@ Method MethodOf(const JobSpec& spec);
 
 // Ok when `method` can render `scene` as its camera sees it: FailedPrecondition naming the
 // method and the pixel filter for a splatting method and a filter other than the box, or for a
-// splatting method and an orthographic camera; the method's scene_refusal otherwise. With the
-// illuminance AOV in `aovs`, FailedPrecondition for path on a scene with participating media
-// (VolPathTracer has no estimate of it).
-absl::Status CheckMethodTakesScene(Method method, const Scene& scene, uint32_t aovs = 0);
+// splatting method and an orthographic camera; the method's scene_refusal otherwise.
+absl::Status CheckMethodTakesScene(Method method, const Scene& scene);
 // What only the path tracer and bdpt render of the scene's participating media: "" when every
 // medium is a homogeneous absorber (Beer's law: no scattering, no emission), no surface is an
 // interface and the camera is in vacuum, else why not ("medium \"fog\" scatters light

@@ -29,9 +29,24 @@ class VolPathTracer : public RadianceEstimator {
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
     const EmbreeScene& geometry() const override { return scene_; }
+    // As PathTracer's: a white Lambertian bounce at the first surface (through interfaces),
+    // lit through the media on the side the camera sees; what the media between the camera and
+    // the surface do to the camera ray is no part of the light arriving there.
+    std::optional<Rgb> Irradiance(const Ray& ray, Sampler& sampler,
+                                  RenderStats& stats) const override;
 
   private:
     struct PathState;
+    // Where a path's radiance is gathered from (as PathTracer's): the camera, or a ray sampled
+    // at a surface vertex at depth - 1, starting in `medium`.
+    struct PathStart {
+        int depth = 0;
+        int medium = -1;
+        bool specular_bounce = true;
+        Vec3 prev_p, prev_n;
+    };
+    Rgb Trace(const Ray& ray, const PathStart& start, PathState& state, Sampler& sampler,
+              RenderStats& stats) const;
     // Light sampled for a vertex at `at` (surface: `n` its shading normal; medium: n zero)
     // whose scattering for the light direction wi is `f_of(wi)` (BSDF times |cos|, or the phase
     // function) with density `pdf_of(wi)`, the shadow ray leaving from `from_of(wi)` in medium
