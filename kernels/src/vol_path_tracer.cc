@@ -138,6 +138,28 @@ Rgb VolPathTracer::SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& f
     return ls->delta ? carried / r_l.Average() : carried / (r_l + r_u).Average();
 }
 
+Rgb VolPathTracer::SampleSurfaceLight(const SurfaceHit& hit, const Shading& sh, const Vec3& d,
+                                      const Bsdf& bsdf, int medium, const PathState& state,
+                                      float u_pick, const Vec2& u_light, MediumRng& rng,
+                                      RenderStats& stats) const {
+    const Frame frame = Frame::FromNormal(sh.ns);
+    const Vec3 wo = frame.ToLocal(-d);
+    return SampleLight(
+        sh.point, sh.ns, [&](const Vec3& wi_world) { return sh.Leaving(wi_world); },
+        [&](const Vec3& wi_world) {
+            return frame.ToLocal(wi_world).z * wo.z < 0
+                       ? MediumAfter(scene_.scene(), medium, hit, wi_world)
+                       : medium;
+        },
+        state, u_pick, u_light, rng,
+        [&](const Vec3& wi_world) {
+            const Vec3 wi = frame.ToLocal(wi_world);
+            if (!sh.SidesAgree(-d, wi_world, wi.z * wo.z > 0)) return Rgb();
+            return bsdf.Eval(wo, wi) * std::abs(wi.z);
+        },
+        [&](const Vec3& wi_world) { return bsdf.Pdf(wo, frame.ToLocal(wi_world)); }, stats);
+}
+
 Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) const {
     PathState state;
     // The hero channel: each of the three with probability 1/3, the one-sample MIS the
@@ -169,15 +191,8 @@ std::optional<Rgb> VolPathTracer::Irradiance(const Ray& camera_ray, Sampler& sam
     const Bsdf lambert = IrradianceBsdf();
     const Frame frame = Frame::FromNormal(sh.ns);
     const Vec3 wo = frame.ToLocal(-ray.d);
-    Rgb reflected = SampleLight(
-        sh.point, sh.ns, [&](const Vec3& wi_world) { return sh.Leaving(wi_world); },
-        [&](const Vec3&) { return medium; }, state, u_choice.x, u_light, rng,
-        [&](const Vec3& wi_world) {
-            const Vec3 wi = frame.ToLocal(wi_world);
-            if (!sh.SidesAgree(-ray.d, wi_world, wi.z * wo.z > 0)) return Rgb();
-            return lambert.Eval(wo, wi) * std::abs(wi.z);
-        },
-        [&](const Vec3& wi_world) { return lambert.Pdf(wo, frame.ToLocal(wi_world)); }, stats);
+    Rgb reflected = SampleSurfaceLight(*hit, sh, ray.d, lambert, medium, state, u_choice.x, u_light,
+                                       rng, stats);
     const std::optional<BsdfSample> bs = lambert.Sample(wo, u_choice.y, u_bsdf);
     if (max_depth_ != 0 && bs && bs->pdf > 0) {
         const Vec3 wi = frame.FromLocal(bs->wi);
@@ -343,24 +358,8 @@ Rgb VolPathTracer::Trace(const Ray& first_ray, const PathStart& start, PathState
         const Vec3 wo = frame.ToLocal(-ray.d);
         const Bsdf bsdf(material, sh.params);
         if (!bsdf.IsDelta()) {
-            // The light may lie on either side: a shadow ray through the surface starts in the
-            // medium beyond it.
-            // As the BSDF decides it: a light direction the BSDF calls a transmission leaves
-            // through the surface, from where a ray in that direction starts.
-            L += SampleLight(
-                sh.point, sh.ns, [&](const Vec3& wi_world) { return sh.Leaving(wi_world); },
-                [&](const Vec3& wi_world) {
-                    return frame.ToLocal(wi_world).z * wo.z < 0
-                               ? MediumAfter(scene, medium, *hit, wi_world)
-                               : medium;
-                },
-                state, u_choice.x, u_light, rng,
-                [&](const Vec3& wi_world) {
-                    const Vec3 wi = frame.ToLocal(wi_world);
-                    if (!sh.SidesAgree(-ray.d, wi_world, wi.z * wo.z > 0)) return Rgb();
-                    return bsdf.Eval(wo, wi) * std::abs(wi.z);
-                },
-                [&](const Vec3& wi_world) { return bsdf.Pdf(wo, frame.ToLocal(wi_world)); }, stats);
+            L += SampleSurfaceLight(*hit, sh, ray.d, bsdf, medium, state, u_choice.x, u_light, rng,
+                                    stats);
         }
         const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
         if (!bs || !(bs->pdf > 0)) break;

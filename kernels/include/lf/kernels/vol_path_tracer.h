@@ -21,6 +21,9 @@
 
 namespace lf {
 
+class Bsdf;
+struct Shading;
+
 class VolPathTracer : public RadianceEstimator {
   public:
     // As PathTracer's: max_depth negative is unlimited (kMaxPathDepth).
@@ -55,6 +58,12 @@ class VolPathTracer : public RadianceEstimator {
     Rgb SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& from_of, MediumOf&& medium_of,
                     const PathState& state, float u_pick, const Vec2& u_light, MediumRng& rng,
                     F&& f_of, Pdf&& pdf_of, RenderStats& stats) const;
+    // SampleLight for a surface vertex seen from direction -d with `bsdf` in sh.ns's shading
+    // frame, the path in `medium` on that side: the light may lie on either side, and a shadow
+    // ray the BSDF calls a transmission leaves through the surface into the medium beyond.
+    Rgb SampleSurfaceLight(const SurfaceHit& hit, const Shading& sh, const Vec3& d,
+                           const Bsdf& bsdf, int medium, const PathState& state, float u_pick,
+                           const Vec2& u_light, MediumRng& rng, RenderStats& stats) const;
     static bool Roulette(PathState& state, float eta_scale, float u);
 
     const EmbreeScene& scene_;
