@@ -204,18 +204,25 @@ void PrintJob(const pb::Job& job) {
     }
 }
 
-// The job's EXR at paths.exr, and its preview at paths.png, made here from the EXR (fetched into
-// a temporary file when -o names only the PNG). A shot's `frame` is that frame's.
+// The job's EXR at paths.exr, and its preview at paths.png and false-colour PNG at
+// paths.false_color, made here from the EXR (fetched into a temporary file when -o names only
+// the PNG). A shot's `frame` is that frame's.
 absl::Status FetchOutputs(const FarmFlags& flags, const std::string& id, const OutputPaths& paths,
-                          const PngOptions& preview_options, bool preview,
+                          const OutputFlags& output, bool preview,
                           std::optional<int> frame = std::nullopt) {
     if (absl::Status s = CheckWritable(paths.png); !s.ok()) return s;
+    if (absl::Status s = CheckWritable(paths.false_color); !s.ok()) return s;
     const std::string exr = paths.exr.empty() ? paths.png + ".exr.part" : paths.exr;
     if (absl::Status s = FarmClient(flags).FetchResult(id, exr, preview, frame); !s.ok()) return s;
-    if (paths.png.empty()) return absl::OkStatus();
+    if (paths.png.empty() && !output.false_color) return absl::OkStatus();
     absl::StatusOr<ExrFile> file = ReadExr(exr);
-    absl::Status written =
-        file.ok() ? WritePng(paths.png, file->image, preview_options) : file.status();
+    absl::Status written = file.status();
+    if (written.ok() && !paths.png.empty()) {
+        written = WritePng(paths.png, file->image, output.preview);
+    }
+    if (written.ok() && output.false_color) {
+        written = WriteFalseColorPng(paths.false_color, file->image, *output.false_color);
+    }
     std::error_code ignored;  // a temporary file left behind is harmless
     if (paths.exr.empty()) fs::remove(exr, ignored);
     return written;
@@ -401,7 +408,7 @@ Command AddFetchCommand(CLI::App& app) {
                     return ReportError(absl::InvalidArgumentError(absl::StrCat(
                         "--frames: job ", *id, " is a still, not a shot; fetch it without")));
                 }
-                if (absl::Status s = FetchOutputs(*flags, *id, *paths, output->preview, *preview);
+                if (absl::Status s = FetchOutputs(*flags, *id, *paths, *output, *preview);
                     !s.ok()) {
                     return ReportError(s);
                 }
@@ -412,10 +419,13 @@ Command AddFetchCommand(CLI::App& app) {
                 FramesToFetch(*job, *frames, *paths, *preview);
             if (!wanted.ok()) return ReportError(wanted.status());
             for (int f : *wanted) {
-                const OutputPaths frame_paths{paths->exr.empty() ? "" : FramePath(paths->exr, f),
-                                              paths->png.empty() ? "" : FramePath(paths->png, f)};
-                if (absl::Status s =
-                        FetchOutputs(*flags, *id, frame_paths, output->preview, *preview, f);
+                OutputPaths frame_paths;
+                for (auto [from, to] : {std::pair{&paths->exr, &frame_paths.exr},
+                                        std::pair{&paths->png, &frame_paths.png},
+                                        std::pair{&paths->false_color, &frame_paths.false_color}}) {
+                    if (!from->empty()) *to = FramePath(*from, f);
+                }
+                if (absl::Status s = FetchOutputs(*flags, *id, frame_paths, *output, *preview, f);
                     !s.ok()) {
                     return ReportError(s);
                 }

@@ -55,6 +55,19 @@ void AddOutputFlags(CLI::App* cmd, OutputFlags& flags) {
            "ACES filmic curve fitted by Narkowicz 2015: highlights roll off, reaching white at "
            "7.24; 1 maps to 0.80)")
         ->type_name("clamp|filmic");
+    cmd->add_option_function<std::string>(
+           "--false-color",
+           [&flags](const std::string& text) {
+               absl::StatusOr<FalseColorSpec> spec = ParseFalseColor(text);
+               if (!spec.ok()) throw CLI::ValidationError(std::string(spec.status().message()));
+               flags.false_color = *spec;
+           },
+           "also write a false-colour PNG next to -o (out.exr -> out.falsecolor.png): lux (the "
+           "illuminance channel: needs --aov illuminance) or nits (luminance, cd/m^2 = 683 x "
+           "Y of the radiance) on a logarithmic viridis scale from MIN to MAX (default: the "
+           "1st to 99th percentile, rounded out to powers of ten), with a legend bar, its "
+           "decades and the unit under the image")
+        ->type_name("lux|nits[:MIN:MAX]");
 }
 
 absl::StatusOr<OutputPaths> ResolveOutputPaths(const OutputFlags& flags) {
@@ -77,12 +90,16 @@ absl::StatusOr<OutputPaths> ResolveOutputPaths(const OutputFlags& flags) {
         }
         paths.png = flags.png;
     }
+    if (flags.false_color) paths.false_color = FalseColorPath(flags.output);
     return paths;
 }
 
 std::string OutputNames(const OutputPaths& paths) {
-    if (paths.exr.empty()) return paths.png;
-    return paths.png.empty() ? paths.exr : absl::StrCat(paths.exr, " and ", paths.png);
+    std::string names;
+    for (const std::string* path : {&paths.exr, &paths.png, &paths.false_color}) {
+        if (!path->empty()) absl::StrAppend(&names, names.empty() ? "" : " and ", *path);
+    }
+    return names;
 }
 
 absl::Status CheckWritable(const std::string& path) {

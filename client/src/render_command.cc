@@ -207,6 +207,8 @@ Command AddRenderCommand(CLI::App& app) {
             options->exr_path = paths->exr;
             options->png_path = paths->png;
             options->preview = output->preview;
+            options->false_color = output->false_color;
+            options->false_color_path = paths->false_color;
             if (absl::Status s = CheckRadiosityFlagsApply(*cmd, *method); !s.ok()) {
                 return ReportError(s);
             }
@@ -218,7 +220,8 @@ Command AddRenderCommand(CLI::App& app) {
                     return ReportError(s);
                 }
             }
-            for (const std::string* path : {&options->exr_path, &options->png_path}) {
+            for (const std::string* path :
+                 {&options->exr_path, &options->png_path, &options->false_color_path}) {
                 const std::string first =
                     shot->frames ? FramePath(*path, shot->frames->first) : *path;
                 if (absl::Status s = CheckWritable(first); !s.ok()) return ReportError(s);

@@ -91,7 +91,9 @@ void AddSampleFlags(CLI::App* cmd, SamplerType& sampler, LightStrategy& light_st
            },
            "auxiliary EXR channels of each pixel's first hits, averaged over its samples: "
            "albedo (albedo.R,G,B), normal (normal.X,Y,Z: world-space shading normal), depth "
-           "(depth.Z: distance along the ray, scene units); a comma-separated list or all")
+           "(depth.Z: distance along the ray, scene units), illuminance (illuminance: lux on "
+           "the side the camera sees, estimated with one extra light path a sample; path and "
+           "radiosity only); a comma-separated list, or all (albedo, normal and depth)")
         ->type_name("LIST");
 }
 

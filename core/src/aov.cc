@@ -11,8 +11,11 @@
 namespace lf {
 
 namespace {
-constexpr std::array<std::pair<const char*, uint32_t>, 3> kAovNames = {
-    {{"albedo", kAovAlbedo}, {"normal", kAovNormal}, {"depth", kAovDepth}}};
+constexpr std::array<std::pair<const char*, uint32_t>, 4> kAovNames = {
+    {{"albedo", kAovAlbedo},
+     {"normal", kAovNormal},
+     {"depth", kAovDepth},
+     {"illuminance", kAovIlluminance}}};
 }  // namespace
 
 absl::StatusOr<uint32_t> ParseAovList(std::string_view list) {
@@ -31,8 +34,8 @@ absl::StatusOr<uint32_t> ParseAovList(std::string_view list) {
             known = true;
         }
         if (!known) {
-            return absl::InvalidArgumentError(
-                absl::StrCat("unknown AOV \"", name, "\"; expected albedo, normal, depth or all"));
+            return absl::InvalidArgumentError(absl::StrCat(
+                "unknown AOV \"", name, "\"; expected albedo, normal, depth, illuminance or all"));
         }
     }
     return aovs;

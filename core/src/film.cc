@@ -73,6 +73,7 @@ void AovSums::Add(uint32_t aovs, const FirstHit& hit) {
         depth.Add(hit.depth);
         ++depth_hits;
     }
+    if (aovs & kAovIlluminance) illuminance.Add(hit.illuminance);
 }
 
 AovSums& AovSums::operator+=(const AovSums& o) {
@@ -81,6 +82,7 @@ AovSums& AovSums::operator+=(const AovSums& o) {
         normal[c] += o.normal[c];
     }
     depth += o.depth;
+    illuminance += o.illuminance;
     depth_hits += o.depth_hits;
     return *this;
 }
@@ -101,6 +103,10 @@ Vec3 AovSums::Normal(uint32_t samples) const {
 float AovSums::Depth() const {
     if (depth_hits == 0) return std::numeric_limits<float>::infinity();
     return float(depth.Value() / depth_hits);
+}
+
+float AovSums::Illuminance(uint32_t samples) const {
+    return samples == 0 ? 0.0f : float(illuminance.Value() / samples);
 }
 
 TileSums& TileSums::operator+=(const TileSums& o) {

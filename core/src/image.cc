@@ -46,11 +46,13 @@ void Image::SetAovs(const TileSums& tile) {
     std::vector<float>* albedo[3] = {};
     std::vector<float>* normal[3] = {};
     std::vector<float>* depth = nullptr;
+    std::vector<float>* illuminance = nullptr;
     for (int c = 0; c < 3; ++c) {
         if (tile.aovs & kAovAlbedo) albedo[c] = &Channel(kAovAlbedoChannels[c]);
         if (tile.aovs & kAovNormal) normal[c] = &Channel(kAovNormalChannels[c]);
     }
     if (tile.aovs & kAovDepth) depth = &Channel(kAovDepthChannel);
+    if (tile.aovs & kAovIlluminance) illuminance = &Channel(kAovIlluminanceChannel);
     const PixelRect& r = tile.rect;
     for (int y = r.y0; y < r.y0 + r.height; ++y) {
         for (int x = r.x0; x < r.x0 + r.width; ++x) {
@@ -64,6 +66,7 @@ void Image::SetAovs(const TileSums& tile) {
                 if (normal[c]) (*normal[c])[i] = ns[c];
             }
             if (depth) (*depth)[i] = a.Depth();
+            if (illuminance) (*illuminance)[i] = a.Illuminance(n);
         }
     }
 }

@@ -13,7 +13,8 @@ namespace {
 constexpr char kMagic[4] = {'L', 'F', 'T', 'S'};
 // Version 2 added truncated_paths after invalid_samples; version 1 tiles (from workers of an
 // older build) still decode, with no truncated paths. Version 3 adds AOVs; tiles without them
-// stay version 2, so their bytes are those of builds before AOVs.
+// stay version 2, so their bytes are those of builds before AOVs. Illuminance (flag 8) adds one
+// sum a pixel after the others in version 3: older decoders refuse its flag.
 constexpr uint32_t kVersion = 2;
 constexpr uint32_t kAovVersion = 3;
 constexpr uint32_t kOldestVersion = 1;
@@ -23,7 +24,7 @@ constexpr size_t HeaderBytes(uint32_t version) {
 constexpr size_t kPixelBytes = 6 * 16 + 2 * 4;
 constexpr size_t AovPixelBytes(uint32_t aovs) {
     return (aovs & kAovAlbedo ? 3 * 16 : 0) + (aovs & kAovNormal ? 3 * 16 : 0) +
-           (aovs & kAovDepth ? 16 + 4 : 0);
+           (aovs & kAovDepth ? 16 + 4 : 0) + (aovs & kAovIlluminance ? 16 : 0);
 }
 // 2^28 pixels is a 16k x 16k tile: far beyond any plan, small enough that size arithmetic
 // cannot overflow and a corrupt header cannot make us allocate terabytes.
@@ -70,6 +71,7 @@ std::string EncodeTileSums(const TileSums& tile) {
             PutSum(out, a.depth);
             PutU32(out, a.depth_hits);
         }
+        if (tile.aovs & kAovIlluminance) PutSum(out, a.illuminance);
     }
     return out;
 }
@@ -109,10 +111,11 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
     stats.invalid_samples = in.U64();
     if (version >= 2) stats.truncated_paths = in.U64();
     const uint32_t aovs = version >= kAovVersion ? in.U32() : 0;
-    if (version >= kAovVersion && (aovs == 0 || (aovs & ~kAllAovs) != 0)) {
+    if (version >= kAovVersion && (aovs == 0 || (aovs & ~kKnownAovs) != 0)) {
         return absl::InvalidArgumentError(
             absl::StrCat("tile sums: AOV flags ", aovs,
-                         ": expected a non-empty sum of 1 (albedo), 2 (normal) and 4 (depth)"));
+                         ": expected a non-empty sum of 1 (albedo), 2 (normal), 4 (depth) and 8 "
+                         "(illuminance)"));
     }
     if (bytes.size() != EncodedSize(rect.Area(), version, aovs)) {
         return absl::InvalidArgumentError(
@@ -139,6 +142,7 @@ absl::StatusOr<TileSums> DecodeTileSums(std::string_view bytes) {
             a.depth = in.Sum();
             a.depth_hits = in.U32();
         }
+        if (aovs & kAovIlluminance) a.illuminance = in.Sum();
     }
     return tile;
 }

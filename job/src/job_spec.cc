@@ -49,6 +49,11 @@ absl::Status CheckMethodSettings(const JobSpec& spec) {
         return absl::InvalidArgumentError(absl::StrCat(
             "aovs: method \"", spec.method, "\" makes no AOV channels; use method path"));
     }
+    if ((spec.aovs & kAovIlluminance) && !Info(*method).illuminance) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("aovs: method \"", spec.method,
+                         "\" has no estimate of AOV illuminance; use method path or radiosity"));
+    }
     if (IsAdaptive(spec.adaptive) && !Info(*method).adaptive) {
         return absl::InvalidArgumentError(absl::StrCat(
             "adaptive: method \"", spec.method,
@@ -86,14 +91,14 @@ absl::Status CheckJobSettings(const JobSpec& spec) {
     const RadiositySettings& r = spec.radiosity;
     const absl::Status checks[] = {
         InRange("spp", spec.plan.spp, uint64_t(1), kMaxSpp),
-        // With AOVs a result takes up to 220 bytes a pixel, so tiles are smaller.
+        // With AOVs a result takes up to 236 bytes a pixel, so tiles are smaller.
         InRange(spec.aovs == 0 ? "tile" : "tile (with AOVs)", spec.plan.tile, 1,
                 spec.aovs == 0 ? kMaxFarmTile : kMaxFarmAovTile),
         InRange("passes", spec.plan.passes, 1, kMaxPasses),
         InRange("max_depth", spec.max_depth, -1, kMaxDepthLimit),
         // Finite: an infinite cap is no cap, and the CLI's 0 says that.
         InRange("clamp", spec.clamp, 0.0, std::numeric_limits<double>::max()),
-        InRange("aovs", spec.aovs, 0u, uint32_t(kAllAovs)),
+        InRange("aovs", spec.aovs, 0u, uint32_t(kKnownAovs)),
         ParseMethod(spec.method).status(),
         NoneOrInRange("adaptive.target_error", spec.adaptive.target_error, kMinTargetError,
                       kMaxTargetError),

@@ -59,6 +59,7 @@ Image EmptyRenderImage(int width, int height, uint32_t aovs) {
         if (aovs & kAovNormal) image.Channel(kAovNormalChannels[c]);
     }
     if (aovs & kAovDepth) image.Channel(kAovDepthChannel);
+    if (aovs & kAovIlluminance) image.Channel(kAovIlluminanceChannel);
     return image;
 }
 

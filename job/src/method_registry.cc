@@ -41,17 +41,18 @@ absl::Status RadiosityAndMediaRefusal(const Scene& scene) {
 
 // Indexed by Method.
 constexpr std::array<MethodInfo, 6> kMethods = {{
-    {Method::kPath, "path", WorkKind::kTiles, std::nullopt, false, true, true, true, true, nullptr},
+    {Method::kPath, "path", WorkKind::kTiles, std::nullopt, false, true, true, true, true, true,
+     nullptr},
     {Method::kRadiosity, "radiosity", WorkKind::kRadiosity, std::nullopt, false, false, true, true,
-     false, RadiosityAndMediaRefusal},
-    {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, true, true,
-     MediaOnlyRefusal<Method::kWhitted>},
+     true, false, RadiosityAndMediaRefusal},
+    {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, false, true,
+     true, MediaOnlyRefusal<Method::kWhitted>},
     {Method::kLight, "light", WorkKind::kSplatPasses, SplatPlanKind::kLightPaths, true, false,
-     false, false, true, MediaOnlyRefusal<Method::kLight>},
+     false, false, false, true, MediaOnlyRefusal<Method::kLight>},
     {Method::kBdpt, "bdpt", WorkKind::kSplatPasses, SplatPlanKind::kCameraAndLight, true, true,
-     false, false, true, BdptMediaRefusal},
+     false, false, false, true, BdptMediaRefusal},
     {Method::kPpm, "ppm", WorkKind::kSplatPasses, SplatPlanKind::kPhotonPasses, false, true, false,
-     false, true, MediaOnlyRefusal<Method::kPpm>},
+     false, false, true, MediaOnlyRefusal<Method::kPpm>},
 }};
 
 constexpr bool IndexedByMethod() {

@@ -28,7 +28,18 @@ std::string DescribeChannels(const RenderMetadata& m) {
     if (m.aovs & kAovDepth) {
         absl::StrAppend(&text, "; depth.Z: first-hit distance from the camera along the ray");
     }
+    if (m.aovs & kAovIlluminance) {
+        absl::StrAppend(&text,
+                        "; illuminance: illuminance on the first hit's side the camera sees, 683 "
+                        "lm/W x Rec.709 luminance of the irradiance (0 for a miss)");
+    }
     return text;
+}
+
+std::string DescribeUnits(const RenderMetadata& m) {
+    return absl::StrCat("R,G,B: radiance W m^-2 sr^-1, linear Rec.709 RGB",
+                        m.aovs & kAovDepth ? "; depth.Z: scene units" : "",
+                        m.aovs & kAovIlluminance ? "; illuminance: lux (lm/m^2)" : "");
 }
 
 ExrAttributes DescribeMethod(const RenderMetadata& m) {
@@ -46,8 +57,7 @@ ExrAttributes DescribeMethod(const RenderMetadata& m) {
         {"lightfarm.rays", std::to_string(m.stats.rays)},
         {"lightfarm.channels", DescribeChannels(m)},
         {"lightfarm.filter", DescribePixelFilter(m.filter)},
-        {"lightfarm.units", absl::StrCat("R,G,B: radiance W m^-2 sr^-1, linear Rec.709 RGB",
-                                         m.aovs & kAovDepth ? "; depth.Z: scene units" : "")},
+        {"lightfarm.units", DescribeUnits(m)},
         // What a viewer needs to show the radiance in absolute terms: the primaries, and the
         // luminance in cd/m^2 of RGB (1, 1, 1), whose Y is 1 W m^-2 sr^-1, i.e. 683 cd/m^2.
         {"chromaticities", kRec709Chromaticities},

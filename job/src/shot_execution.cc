@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "absl/strings/str_cat.h"
+#include "lf/core/tile_codec.h"
 
 namespace lf {
 
@@ -91,10 +92,12 @@ absl::Status CheckShotChunk(const JobSpec& spec) {
     }
     if (SolvedInSweeps(spec)) return refuse("radiosity solved in sweeps adds a sweep at a time");
     // A chunk's result is one message and one record: every frame's sums (tile_codec.h: 104
-    // bytes a pixel, 220 with AOVs) and, for splatting methods, up to 2 splats of 53 bytes a pixel
-    // (the worker sums a frame's tasks' splats into one list). Each pass of a tile is a part with
-    // the tile's sums.
-    const uint64_t pixel_bytes = (spec.aovs ? 220 : 104) * uint64_t(std::max(spec.plan.passes, 1)) +
+    // bytes a pixel, up to 236 with AOVs) and, for splatting methods, up to 2 splats of 53 bytes a
+    // pixel (the worker sums a frame's tasks' splats into one list). Each pass of a tile is a part
+    // with the tile's sums.
+    const uint64_t sums_bytes =
+        EncodedTileSumsSize(1, spec.aovs) - EncodedTileSumsSize(0, spec.aovs);
+    const uint64_t pixel_bytes = sums_bytes * uint64_t(std::max(spec.plan.passes, 1)) +
                                  (UsesSplatPlan(spec.method) ? 106 : 0);
     const uint64_t bytes = uint64_t(spec.shot.chunk) * uint64_t(spec.plan.width) *
                            uint64_t(spec.plan.height) * pixel_bytes;

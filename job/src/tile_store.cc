@@ -45,9 +45,15 @@ class MemoryTileStore : public TileStore {
 };
 
 // A pixel's sums on disk: six 128-bit fixed-point sums, then the two half counts, then the
-// store's AOVs (all seven sums of AovSums and the depth hits when it has any); no padding.
+// store's AOVs (the seven sums of albedo, normal and depth and the depth hits when it has any,
+// then the illuminance sum when it has that: stores of builds before it keep their layout); no
+// padding.
 constexpr size_t kPixelBytes = 6 * sizeof(__int128) + 2 * sizeof(uint32_t);
-constexpr size_t kAovPixelBytes = 7 * sizeof(__int128) + sizeof(uint32_t);
+constexpr size_t AovPixelBytes(uint32_t aovs) {
+    if (aovs == 0) return 0;
+    return 7 * sizeof(__int128) + sizeof(uint32_t) +
+           (aovs & kAovIlluminance ? sizeof(__int128) : 0);
+}
 
 char* PutSum(const ExactSum& sum, char* out) {
     const __int128 fixed = sum.fixed();
@@ -78,25 +84,27 @@ const char* DecodePixel(const char* in, PixelSums* p) {
     return in + sizeof(p->count);
 }
 
-void EncodeAovs(const AovSums& a, char* out) {
+void EncodeAovs(uint32_t aovs, const AovSums& a, char* out) {
     for (const ExactSum& s : a.albedo) out = PutSum(s, out);
     for (const ExactSum& s : a.normal) out = PutSum(s, out);
     out = PutSum(a.depth, out);
     std::memcpy(out, &a.depth_hits, sizeof(a.depth_hits));
+    if (aovs & kAovIlluminance) PutSum(a.illuminance, out + sizeof(a.depth_hits));
 }
 
-void DecodeAovs(const char* in, AovSums* a) {
+void DecodeAovs(uint32_t aovs, const char* in, AovSums* a) {
     for (ExactSum& s : a->albedo) in = GetSum(in, &s);
     for (ExactSum& s : a->normal) in = GetSum(in, &s);
     in = GetSum(in, &a->depth);
     std::memcpy(&a->depth_hits, in, sizeof(a->depth_hits));
+    if (aovs & kAovIlluminance) GetSum(in + sizeof(a->depth_hits), &a->illuminance);
 }
 
 class FileTileStore : public TileStore {
   public:
     FileTileStore(std::vector<PixelRect> tiles, uint32_t aovs, int fd, std::string name)
         : TileStore(std::move(tiles), aovs),
-          pixel_bytes_(kPixelBytes + (aovs != 0 ? kAovPixelBytes : 0)),
+          pixel_bytes_(kPixelBytes + AovPixelBytes(aovs)),
           fd_(fd),
           name_(std::move(name)) {
         uint64_t offset = 0;
@@ -122,7 +130,7 @@ class FileTileStore : public TileStore {
         }
         for (size_t i = 0; i < sums.pixels.size(); ++i) {
             const char* aov = DecodePixel(&bytes[i * pixel_bytes_], &sums.pixels[i]);
-            if (aovs() != 0) DecodeAovs(aov, &sums.aov_pixels[i]);
+            if (aovs() != 0) DecodeAovs(aovs(), aov, &sums.aov_pixels[i]);
         }
         return sums;
     }
@@ -132,7 +140,7 @@ class FileTileStore : public TileStore {
         std::vector<char> bytes(sums.pixels.size() * pixel_bytes_);
         for (size_t i = 0; i < sums.pixels.size(); ++i) {
             char* aov = EncodePixel(sums.pixels[i], &bytes[i * pixel_bytes_]);
-            if (aovs() != 0) EncodeAovs(sums.aov_pixels[i], aov);
+            if (aovs() != 0) EncodeAovs(aovs(), sums.aov_pixels[i], aov);
         }
         std::lock_guard<std::mutex> lock(mutex_);
         return Transfer(tile, bytes.data(), bytes.size(), true);

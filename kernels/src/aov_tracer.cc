@@ -25,6 +25,13 @@ Rgb Albedo(const Material& material, const SurfaceParams& params) {
 
 }  // namespace
 
+Bsdf IrradianceBsdf() {
+    Material white;
+    white.type = Material::Type::kLambert;
+    white.reflectance = Rgb(1);
+    return Bsdf(white, SurfaceParams::Of(white));
+}
+
 std::optional<FirstHit> TraceFirstHit(const EmbreeScene& scene, const Ray& camera_ray) {
     Ray ray = camera_ray;
     float distance = 0;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
+#include "lf/kernels/aov_tracer.h"
 #include "lf/kernels/bsdf.h"
 #include "lf/kernels/next_event.h"
 #include "lf/kernels/shading.h"
@@ -14,26 +16,56 @@ namespace {
 // Roulette spares the first bounce: direct and one-bounce light are never cut.
 constexpr int kRouletteStartDepth = 1;
 
+// Scenes with media take VolPathTracer (lf/kernels/vol_path_tracer.h): every ray here travels
+// through vacuum.
+constexpr int kVacuum = -1;
+
 }  // namespace
 
 PathTracer::PathTracer(const EmbreeScene& scene, int max_depth, LightStrategy strategy)
     : scene_(scene), lights_(scene, strategy), max_depth_(max_depth) {}
 
 Rgb PathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) const {
+    return Trace(camera_ray, PathStart{}, sampler, stats);
+}
+
+std::optional<Rgb> PathTracer::Irradiance(const Ray& camera_ray, Sampler& sampler,
+                                          RenderStats& stats) const {
+    const Vec2 u_choice = sampler.Get2D(), u_light = sampler.Get2D(), u_bsdf = sampler.Get2D();
+    ++stats.rays;
+    const std::optional<SurfaceHit> hit = scene_.Intersect(camera_ray);
+    if (!hit) return Rgb(0);
+    const Shading sh = Shade(scene_, *hit, -camera_ray.d);
+    const Bsdf lambert = IrradianceBsdf();
+    Rgb reflected = NextEventEstimate(scene_, lights_, *hit, sh, -camera_ray.d, lambert, kVacuum,
+                                      Rgb(1), u_choice.x, u_light, stats);
+    const Frame frame = Frame::FromNormal(sh.ns);
+    const Vec3 wo = frame.ToLocal(-camera_ray.d);
+    const std::optional<BsdfSample> bs = lambert.Sample(wo, u_choice.y, u_bsdf);
+    if (max_depth_ != 0 && bs && bs->pdf > 0) {
+        const Vec3 wi = frame.FromLocal(bs->wi);
+        if (sh.SidesAgree(-camera_ray.d, wi, bs->wi.z * wo.z > 0)) {
+            const PathStart start{1, false, bs->pdf, hit->p, sh.ns};
+            reflected += bs->f * (std::abs(bs->wi.z) / bs->pdf) *
+                         Trace(SpawnRay(sh.Leaving(wi), wi), start, sampler, stats);
+        }
+    }
+    return reflected * std::numbers::pi_v<float>;
+}
+
+Rgb PathTracer::Trace(const Ray& first_ray, const PathStart& start, Sampler& sampler,
+                      RenderStats& stats) const {
     const std::vector<Material>& materials = scene_.scene().materials;
-    // Scenes with media take VolPathTracer (lf/kernels/vol_path_tracer.h): every ray here
-    // travels through vacuum.
-    constexpr int kVacuum = -1;
     Rgb L(0), beta(1);
-    Ray ray = camera_ray;
-    bool delta_bounce = true;  // the camera ray sees emission with full weight
-    float prev_pdf = 0;
+    Ray ray = first_ray;
+    bool delta_bounce = start.delta_bounce;
+    float prev_pdf = start.prev_pdf;
     // The previous vertex and its shading normal: the light sampler's Pdf for an emitter a
     // BSDF-sampled ray hits must see what its Sample saw there.
-    Vec3 prev_p, prev_n;
+    Vec3 prev_p = start.prev_p, prev_n = start.prev_n;
     float eta_scale = 1;
 
-    for (int depth = 0;; ++depth) {
+    for (int depth = start.depth;; ++depth) {
         // The bounce's random numbers, drawn before the ray is traced: a Sobol draw is a chain
         // of dependent hashes, which the processor computes while Embree traverses instead of
         // stalling on it where the value is used. Every bounce takes the same dimensions in the

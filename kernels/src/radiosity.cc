@@ -293,14 +293,17 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
             return status;
         }
     }
+    auto renderer = std::make_unique<RadiosityRenderer>(
+        scene, std::move(*mesh), std::move(radiosity), options.display, report);
     if (!options.export_ply.empty()) {
-        if (absl::Status status = WriteRadiosityPly(options.export_ply, *mesh, radiosity);
+        // The display gives the PLY its illuminance.
+        if (absl::Status status = WriteRadiosityPly(options.export_ply, renderer->mesh(),
+                                                    renderer->radiosity(), renderer->display());
             !status.ok()) {
             return status;
         }
     }
-    return std::make_unique<RadiosityRenderer>(scene, std::move(*mesh), std::move(radiosity),
-                                               options.display, report);
+    return renderer;
 }
 
 // The farm's sweeps solve one fixed mesh; refinement re-meshes between solves.

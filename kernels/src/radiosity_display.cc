@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/image_io.h"
+#include "lf/core/photometry.h"
 #include "lf/kernels/lights.h"
 #include "lf/kernels/radiosity_surfaces.h"
 
@@ -143,12 +144,36 @@ Rgb RadiosityDisplay::Irradiance(int mesh, int primitive, double b1, double b2, 
     return Shade(irradiance_, irradiance_corners_, mesh, primitive, b1, b2, back);
 }
 
+namespace {
+
+// The lux at corner c of side s as `display` shades it, a hair inside the patch so that the point
+// is the patch's own; printed to 4 significant digits, the PLY's text and a vertex's key.
+std::string CornerLux(const PatchMesh& mesh, const RadiosityDisplay& display, size_t s, size_t c) {
+    const PatchMesh::Side& side = mesh.sides()[s];
+    const PatchMesh::Patch& patch = mesh.patches()[size_t(side.patch)];
+    std::array<double, 3> w;
+    w.fill(1e-6);
+    w[c] = 1 - 2e-6;
+    const auto [b1, b2] = mesh.TriangleBarycentrics(side.patch, w);
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g",
+                  Photometric(display.Irradiance(patch.mesh, patch.primitive, b1, b2, side.back)));
+    return text;
+}
+
+}  // namespace
+
 absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,
-                               std::span<const Rgb> radiosity) {
+                               std::span<const Rgb> radiosity, const RadiosityDisplay& display) {
     const std::vector<std::array<Rgb, 3>> corners = SmoothCorners(mesh, radiosity);
     using Colour = std::array<uint8_t, 3>;
-    std::map<std::tuple<uint32_t, bool, Colour>, uint32_t> index;
-    std::vector<std::pair<uint32_t, Colour>> vertices;
+    struct Vertex {
+        uint32_t position;
+        Colour colour;
+        std::string lux;
+    };
+    std::map<std::tuple<uint32_t, bool, Colour, std::string>, uint32_t> index;
+    std::vector<Vertex> vertices;
     std::vector<std::array<uint32_t, 3>> faces;
     for (size_t s = 0; s < mesh.sides().size(); ++s) {
         const PatchMesh::Side& side = mesh.sides()[s];
@@ -158,9 +183,10 @@ absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,
             const Rgb radiance = corners[s][c] * kInvPi;
             const Colour colour{EncodeSrgb8(radiance.r), EncodeSrgb8(radiance.g),
                                 EncodeSrgb8(radiance.b)};
-            const auto key = std::tuple(patch_vertices[c], side.back, colour);
+            std::string lux = CornerLux(mesh, display, s, c);
+            const auto key = std::tuple(patch_vertices[c], side.back, colour, lux);
             const auto [it, inserted] = index.try_emplace(key, uint32_t(vertices.size()));
-            if (inserted) vertices.push_back({patch_vertices[c], colour});
+            if (inserted) vertices.push_back({patch_vertices[c], colour, std::move(lux)});
             face[c] = it->second;
         }
         if (side.back) std::swap(face[1], face[2]);
@@ -171,14 +197,16 @@ absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,
     if (!file) return absl::NotFoundError(absl::StrCat(path, ": cannot write PLY"));
     std::fprintf(file,
                  "ply\nformat ascii 1.0\ncomment lightfarm radiosity: vertex colours are B/pi, "
-                 "sRGB\nelement vertex %zu\nproperty float x\nproperty float y\nproperty float "
-                 "z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face "
-                 "%zu\nproperty list uchar int vertex_indices\nend_header\n",
+                 "sRGB\ncomment illuminance: lux arriving on the side, as the display shades "
+                 "it\nelement vertex %zu\nproperty float x\nproperty float y\nproperty float "
+                 "z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nproperty "
+                 "float illuminance\nelement face %zu\nproperty list uchar int "
+                 "vertex_indices\nend_header\n",
                  vertices.size(), faces.size());
-    for (const auto& [v, colour] : vertices) {
-        const Vec3d& p = mesh.vertices()[v];
-        std::fprintf(file, "%.9g %.9g %.9g %d %d %d\n", p.x, p.y, p.z, colour[0], colour[1],
-                     colour[2]);
+    for (const Vertex& v : vertices) {
+        const Vec3d& p = mesh.vertices()[v.position];
+        std::fprintf(file, "%.9g %.9g %.9g %d %d %d %s\n", p.x, p.y, p.z, v.colour[0], v.colour[1],
+                     v.colour[2], v.lux.c_str());
     }
     for (const auto& f : faces) std::fprintf(file, "3 %u %u %u\n", f[0], f[1], f[2]);
     const bool failed = std::ferror(file) != 0;

@@ -1,8 +1,25 @@
 #include "lf/kernels/tile_renderer.h"
 
+#include "lf/core/aov.h"
+#include "lf/core/photometry.h"
 #include "lf/kernels/aov_tracer.h"
 
 namespace lf {
+
+namespace {
+
+// The illuminance AOV's random numbers: the image's seed mixed with this, a stream apart from
+// the radiance's.
+constexpr uint64_t kIlluminanceStream = 0x2545f4914f6cdd1dULL;
+
+// Lux at the first hit of `ray`: 0 where the estimate is not finite, as invalid samples add 0.
+float FirstHitLux(const RadianceEstimator& estimator, const Ray& ray, Sampler& sampler,
+                  RenderStats& stats) {
+    const Rgb e = estimator.Irradiance(ray, sampler, stats).value_or(Rgb(0));
+    return e.IsFinite() ? Photometric(e) : 0.0f;
+}
+
+}  // namespace
 
 TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, const PixelRect& rect,
                     uint64_t seed, uint64_t sample_begin, uint64_t sample_end,
@@ -32,8 +49,12 @@ TileSums RenderTile(const Camera& camera, const RadianceEstimator& estimator, co
                 pixel.Add(s, L);
                 if (options.aovs != 0) {
                     ++tile.stats.rays;
-                    if (const std::optional<FirstHit> hit =
-                            TraceFirstHit(estimator.geometry(), ray)) {
+                    if (std::optional<FirstHit> hit = TraceFirstHit(estimator.geometry(), ray)) {
+                        if (options.aovs & kAovIlluminance) {
+                            Sampler aov_sampler(seed ^ kIlluminanceStream, x, y, s,
+                                                options.sampler);
+                            hit->illuminance = FirstHitLux(estimator, ray, aov_sampler, tile.stats);
+                        }
                         tile.aov_pixels[tile.Index(x, y)].Add(options.aovs, *hit);
                     }
                 }

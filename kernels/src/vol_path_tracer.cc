@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
+#include "lf/kernels/aov_tracer.h"
 #include "lf/kernels/bsdf.h"
 #include "lf/kernels/next_event.h"
 #include "lf/kernels/path_tracer.h"
@@ -136,23 +138,89 @@ Rgb VolPathTracer::SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& f
     return ls->delta ? carried / r_l.Average() : carried / (r_l + r_u).Average();
 }
 
+Rgb VolPathTracer::SampleSurfaceLight(const SurfaceHit& hit, const Shading& sh, const Vec3& d,
+                                      const Bsdf& bsdf, int medium, const PathState& state,
+                                      float u_pick, const Vec2& u_light, MediumRng& rng,
+                                      RenderStats& stats) const {
+    const Frame frame = Frame::FromNormal(sh.ns);
+    const Vec3 wo = frame.ToLocal(-d);
+    return SampleLight(
+        sh.point, sh.ns, [&](const Vec3& wi_world) { return sh.Leaving(wi_world); },
+        [&](const Vec3& wi_world) {
+            return frame.ToLocal(wi_world).z * wo.z < 0
+                       ? MediumAfter(scene_.scene(), medium, hit, wi_world)
+                       : medium;
+        },
+        state, u_pick, u_light, rng,
+        [&](const Vec3& wi_world) {
+            const Vec3 wi = frame.ToLocal(wi_world);
+            if (!sh.SidesAgree(-d, wi_world, wi.z * wo.z > 0)) return Rgb();
+            return bsdf.Eval(wo, wi) * std::abs(wi.z);
+        },
+        [&](const Vec3& wi_world) { return bsdf.Pdf(wo, frame.ToLocal(wi_world)); }, stats);
+}
+
 Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stats) const {
-    const Scene& scene = scene_.scene();
-    Rgb L(0);
     PathState state;
     // The hero channel: each of the three with probability 1/3, the one-sample MIS the
     // estimate's division by the rescaled densities' average completes.
     state.hero = std::min(2, int(sampler.Get1D() * 3));
-    const int hero = state.hero;
+    return Trace(camera_ray, PathStart{0, scene_.scene().camera_medium}, state, sampler, stats);
+}
+
+std::optional<Rgb> VolPathTracer::Irradiance(const Ray& camera_ray, Sampler& sampler,
+                                             RenderStats& stats) const {
+    const Scene& scene = scene_.scene();
+    PathState state;
+    state.hero = std::min(2, int(sampler.Get1D() * 3));
+    const Vec2 u_choice = sampler.Get2D(), u_light = sampler.Get2D(), u_bsdf = sampler.Get2D();
+    MediumRng rng(WalkSeed(sampler.Get2D(), 0));
     Ray ray = camera_ray;
     int medium = scene.camera_medium;
-    bool specular_bounce = true;  // the camera ray sees emission with full weight
-    Vec3 prev_p, prev_n;          // the last scattering vertex: n zero in a medium
+    std::optional<SurfaceHit> hit;
+    for (int crossed = 0;; ++crossed) {
+        if (crossed > kMaxInterfaceCrossings) return Rgb(0);
+        ++stats.rays;
+        hit = scene_.Intersect(ray);
+        if (!hit) return Rgb(0);
+        if (scene.materials[size_t(hit->material)].type != Material::Type::kInterface) break;
+        medium = MediumAfter(scene, medium, *hit, ray.d);
+        ray = SpawnRay(HitPoint(*hit), ray.d);
+    }
+    const Shading sh = Shade(scene_, *hit, -ray.d);
+    const Bsdf lambert = IrradianceBsdf();
+    const Frame frame = Frame::FromNormal(sh.ns);
+    const Vec3 wo = frame.ToLocal(-ray.d);
+    Rgb reflected = SampleSurfaceLight(*hit, sh, ray.d, lambert, medium, state, u_choice.x, u_light,
+                                       rng, stats);
+    const std::optional<BsdfSample> bs = lambert.Sample(wo, u_choice.y, u_bsdf);
+    if (max_depth_ != 0 && bs && bs->pdf > 0) {
+        const Vec3 wi = frame.FromLocal(bs->wi);
+        if (sh.SidesAgree(-ray.d, wi, bs->wi.z * wo.z > 0)) {
+            state.beta *= bs->f * (std::abs(bs->wi.z) / bs->pdf);
+            state.r_l = state.r_u / bs->pdf;
+            reflected += Trace(SpawnRay(sh.Leaving(wi), wi),
+                               PathStart{1, medium, false, hit->p, sh.ns}, state, sampler, stats);
+        }
+    }
+    return reflected * std::numbers::pi_v<float>;
+}
+
+Rgb VolPathTracer::Trace(const Ray& first_ray, const PathStart& start, PathState& state,
+                         Sampler& sampler, RenderStats& stats) const {
+    const Scene& scene = scene_.scene();
+    Rgb L(0);
+    const int hero = state.hero;
+    Ray ray = first_ray;
+    int medium = start.medium;
+    bool specular_bounce = start.specular_bounce;  // a camera ray sees emission with full weight
+    // The last scattering vertex: n zero in a medium.
+    Vec3 prev_p = start.prev_p, prev_n = start.prev_n;
     float eta_scale = 1;
     int crossings = 0;  // interface surfaces this path has passed (kMaxInterfaceCrossings)
     const int max_depth = max_depth_ < 0 ? kMaxPathDepth : max_depth_;
 
-    for (int depth = 0;;) {
+    for (int depth = start.depth;;) {
         // As PathTracer's bounce: the same draws in the same order whatever happens, and one
         // more pair seeding the walk through a medium.
         const Vec2 u_choice = sampler.Get2D(), u_light = sampler.Get2D(), u_bsdf = sampler.Get2D();
@@ -290,24 +358,8 @@ Rgb VolPathTracer::Li(const Ray& camera_ray, Sampler& sampler, RenderStats& stat
         const Vec3 wo = frame.ToLocal(-ray.d);
         const Bsdf bsdf(material, sh.params);
         if (!bsdf.IsDelta()) {
-            // The light may lie on either side: a shadow ray through the surface starts in the
-            // medium beyond it.
-            // As the BSDF decides it: a light direction the BSDF calls a transmission leaves
-            // through the surface, from where a ray in that direction starts.
-            L += SampleLight(
-                sh.point, sh.ns, [&](const Vec3& wi_world) { return sh.Leaving(wi_world); },
-                [&](const Vec3& wi_world) {
-                    return frame.ToLocal(wi_world).z * wo.z < 0
-                               ? MediumAfter(scene, medium, *hit, wi_world)
-                               : medium;
-                },
-                state, u_choice.x, u_light, rng,
-                [&](const Vec3& wi_world) {
-                    const Vec3 wi = frame.ToLocal(wi_world);
-                    if (!sh.SidesAgree(-ray.d, wi_world, wi.z * wo.z > 0)) return Rgb();
-                    return bsdf.Eval(wo, wi) * std::abs(wi.z);
-                },
-                [&](const Vec3& wi_world) { return bsdf.Pdf(wo, frame.ToLocal(wi_world)); }, stats);
+            L += SampleSurfaceLight(*hit, sh, ray.d, bsdf, medium, state, u_choice.x, u_light, rng,
+                                    stats);
         }
         const std::optional<BsdfSample> bs = bsdf.Sample(wo, u_choice.y, u_bsdf);
         if (!bs || !(bs->pdf > 0)) break;

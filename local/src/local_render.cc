@@ -8,6 +8,7 @@
 #include "absl/time/time.h"
 #include "lf/core/aov.h"
 #include "lf/core/camera.h"
+#include "lf/core/false_color.h"
 #include "lf/core/image_error.h"
 #include "lf/core/image_io.h"
 #include "lf/core/log.h"
@@ -218,7 +219,8 @@ void LogRenderSettings(const LocalRenderOptions& options, const Scene& scene, Me
 absl::Status RenderAndWrite(const PosedKernels& k, const LocalRenderOptions& options,
                             const JobSpec& job, const std::optional<SplatPlanSettings>& splat_plan,
                             const std::string& exr_path, const std::string& png_path,
-                            absl::Time start, LocalRenderSummary& summary) {
+                            const std::string& false_color_path, absl::Time start,
+                            LocalRenderSummary& summary) {
     auto log = NamedLogger("render");
     const std::string& job_id = summary.job_id;
     const bool adaptive = IsAdaptive(options);
@@ -306,6 +308,12 @@ absl::Status RenderAndWrite(const PosedKernels& k, const LocalRenderOptions& opt
     if (!png_path.empty()) {
         if (absl::Status s = WritePng(png_path, out->image, options.preview); !s.ok()) return s;
     }
+    if (options.false_color) {
+        if (absl::Status s = WriteFalseColorPng(false_color_path, out->image, *options.false_color);
+            !s.ok()) {
+            return s;
+        }
+    }
     return absl::OkStatus();
 }
 
@@ -320,6 +328,12 @@ struct LoadedRender {
 
 absl::StatusOr<LoadedRender> LoadRender(const LocalRenderOptions& options) {
     auto log = NamedLogger("render");
+    if (options.false_color) {
+        if (absl::Status s = CheckFalseColorSource(*options.false_color, options.render.aovs);
+            !s.ok()) {
+            return s;
+        }
+    }
     absl::StatusOr<Scene> scene = LoadScene(options.scene_path, options.scene);
     if (!scene.ok()) return scene.status();
     LoadedRender r{.scene = std::move(*scene)};
@@ -391,7 +405,7 @@ absl::StatusOr<LocalRenderSummary> RunLocalRender(const LocalRenderOptions& opti
     TakeKernelFigures(**k, summary);
     LogRenderSettings(options, r->scene, r->method, r->splat_plan, r->job_id);
     if (absl::Status s = RenderAndWrite(**k, options, r->job, r->splat_plan, options.exr_path,
-                                        options.png_path, start, summary);
+                                        options.png_path, options.false_color_path, start, summary);
         !s.ok()) {
         return s;
     }
@@ -445,9 +459,10 @@ absl::StatusOr<LocalShotSummary> RunLocalShot(const LocalRenderOptions& options,
         summary.load_seconds = f.pose_seconds + f.bvh_seconds;
         TakeKernelFigures(*kernels, summary);
         if (options.progress) options.progress->StartFrame(i, frames.count(), frame);
-        if (absl::Status s =
-                RenderAndWrite(*kernels, options, FrameSpec(r->job, frame), r->splat_plan,
-                               f.exr_path, f.png_path, frame_start, summary);
+        if (absl::Status s = RenderAndWrite(
+                *kernels, options, FrameSpec(r->job, frame), r->splat_plan, f.exr_path, f.png_path,
+                options.false_color ? FramePath(options.false_color_path, frame) : std::string(),
+                frame_start, summary);
             !s.ok()) {
             return s;
         }

@@ -23,6 +23,7 @@ constexpr ViewSource kViews[] = {
     {"albedo", {kAovAlbedoChannels[0], kAovAlbedoChannels[1], kAovAlbedoChannels[2]}},
     {"normal", {kAovNormalChannels[0], kAovNormalChannels[1], kAovNormalChannels[2]}},
     {"depth", {kAovDepthChannel, kAovDepthChannel, kAovDepthChannel}},
+    {"illuminance", {kAovIlluminanceChannel, kAovIlluminanceChannel, kAovIlluminanceChannel}},
 };
 
 bool Has(const Image& image, const ViewSource& view) {
@@ -55,9 +56,9 @@ absl::StatusOr<ChannelView> ViewChannel(const Image& image, const std::string& c
     float scale = 1, offset = 0;
     if (name == "normal") {
         scale = offset = 0.5f;
-    } else if (name == "depth") {
+    } else if (name == "depth" || name == "illuminance") {
         float far = 0;
-        for (float z : *image.FindChannel(kAovDepthChannel)) {
+        for (float z : *image.FindChannel(view->channels[0])) {
             if (std::isfinite(z)) far = std::max(far, z);
         }
         scale = far > 0 ? 1 / far : 1;

@@ -20,6 +20,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "image_files.h"
+#include "lf/core/false_color.h"
 #include "lf/core/image_io.h"
 #include "vdb_files.h"
 
@@ -870,6 +871,46 @@ TEST_F(Cli, FilterAndAovChannelsReachTheImage) {
          {"albedo.R", "albedo.G", "albedo.B", "normal.X", "normal.Y", "normal.Z", "depth.Z"}) {
         EXPECT_NE(file->image.FindChannel(ch), nullptr) << ch;
     }
+}
+
+// --aov illuminance adds the illuminance channel in lux (the header says so), and --false-color
+// lux writes out.falsecolor.png beside out.exr: the image's size plus the legend's rows. Without
+// the AOV, --false-color lux is refused before anything renders, saying what to add.
+TEST_F(Cli, FalseColorLuxWritesAPngWithALegendAndNeedsTheIlluminanceAov) {
+    const std::string scene = std::string(LF_TEST_SCENES) + "/cornell_box.json";
+    const std::string exr = (dir_ / "lux.exr").string();
+    const std::string png = (dir_ / "lux.falsecolor.png").string();
+    const RunResult r = Lightfarm("render " + scene + " -o " + exr +
+                                  " --spp 2 --resolution 24x16 --aov illuminance --false-color "
+                                  "lux --no-progress");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find(png), std::string::npos) << r.output;
+    absl::StatusOr<ExrFile> file = ReadExr(exr);
+    ASSERT_TRUE(file.ok()) << file.status();
+    ASSERT_NE(file->image.FindChannel("illuminance"), nullptr);
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.aovs")), "illuminance");
+    EXPECT_NE(
+        std::get<std::string>(file->attributes.at("lightfarm.units")).find("illuminance: lux"),
+        std::string::npos);
+    int width = 0, height = 0, channels = 0;
+    ASSERT_TRUE(stbi_info(png.c_str(), &width, &height, &channels)) << png;
+    EXPECT_EQ(width, 24);
+    EXPECT_EQ(height, 16 + kFalseColorLegendRows);
+
+    const std::string refused_exr = (dir_ / "nolux.exr").string();
+    const RunResult refused = Lightfarm("render " + scene + " -o " + refused_exr +
+                                        " --spp 2 --resolution 24x16 --false-color lux "
+                                        "--no-progress");
+    EXPECT_NE(refused.status, 0);
+    EXPECT_NE(refused.output.find("add --aov illuminance"), std::string::npos) << refused.output;
+    EXPECT_EQ(refused.output.find("samples/s"), std::string::npos) << refused.output;
+    EXPECT_FALSE(fs::exists(refused_exr));
+    EXPECT_FALSE(fs::exists(dir_ / "nolux.falsecolor.png"));
+    // A bad scale is refused by the flag itself.
+    const RunResult bad = Lightfarm("render " + scene + " -o " + refused_exr +
+                                    " --aov illuminance --false-color lux:100:1");
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.output.find("MIN < MAX"), std::string::npos) << bad.output;
 }
 
 TEST_F(Cli, BenchRefusesFewerThanOneThread) {

@@ -753,7 +753,7 @@ TEST_F(Farm, SameBitsAsLocalRenderForAnyWorkersAndTiles) {
 
 // AOVs, a wide filter and a clamp on two workers, in tiles and passes unlike the local render's:
 // every channel has the local bits, also after the server was killed mid-render and rebuilt its
-// tiles (AOV sums included) from the results its job store kept.
+// tiles (AOV sums included, illuminance's too) from the results its job store kept.
 TEST_F(Farm, AovsFilterAndClampGiveTheLocalBitsForAnyTilesAndAcrossARestart) {
     StartServer();
     StartWorker("w1");
@@ -765,7 +765,8 @@ TEST_F(Farm, AovsFilterAndClampGiveTheLocalBitsForAnyTilesAndAcrossARestart) {
             scene_, std::string("--spp 8 --seed 5 --passes 2 --tile ") + tile + " " + extras);
         ExpectSameAsLocal(job, scene_, 8, 5, "--method path " + extras);
     }
-    const std::string extras = "--aov albedo,depth" + filter_and_clamp;
+    // Illuminance too: its sums survive the restart in the job store and the tile store.
+    const std::string extras = "--aov albedo,depth,illuminance" + filter_and_clamp;
     const std::string job = Submit(scene_, "--spp 256 --seed 6 --tile 16 --passes 2 " + extras);
     ASSERT_TRUE(WaitForTasksDone(job, 8, milliseconds(30000)));
     CrashAndRestartServer();
@@ -1091,7 +1092,7 @@ TEST_F(Farm, ClampAovsFilterSamplerAndLightSamplingGiveTheSameImageAndHeaderLoca
     StartWorker("w1");
     StartWorker("w2");
     const std::string flags =
-        "--spp 4 --seed 2 --tile 16 --clamp 2 --aov all "
+        "--spp 4 --seed 2 --tile 16 --clamp 2 --aov all,illuminance "
         "--filter blackman-harris:2 --sampler independent --light-sampling power";
     const std::string job = Submit(scene_, flags);
     ASSERT_EQ(Farmctl("watch " + job).status, 0);
@@ -1099,17 +1100,24 @@ TEST_F(Farm, ClampAovsFilterSamplerAndLightSamplingGiveTheSameImageAndHeaderLoca
     EXPECT_NE(status.out.find("independent sampler, power light sampling"), std::string::npos)
         << status.out;
     const std::string farm = (dir_ / "farm.exr").string(), local = (dir_ / "local.exr").string();
-    ASSERT_EQ(Farmctl("fetch " + job + " -o " + farm).status, 0);
-    const CliRun r =
-        Lightfarm("render " + scene_ + " -o " + local + " " + flags + " --no-progress");
+    ASSERT_EQ(Farmctl("fetch " + job + " -o " + farm + " --false-color lux").status, 0);
+    const CliRun r = Lightfarm("render " + scene_ + " -o " + local + " " + flags +
+                               " --false-color lux --no-progress");
     ASSERT_EQ(r.status, 0) << r.out << r.err;
     ExpectSameImageAndHeader(farm, local);
+    // The false-colour PNGs of the same lux are the same bytes.
+    EXPECT_EQ(ReadText((dir_ / "farm.falsecolor.png").string()),
+              ReadText((dir_ / "local.falsecolor.png").string()));
     absl::StatusOr<ExrFile> file = ReadExr(farm);
     ASSERT_TRUE(file.ok()) << file.status();
     ASSERT_TRUE(file->attributes.count("lightfarm.clamp") &&
                 file->attributes.count("lightfarm.aovs"));
     EXPECT_EQ(std::get<double>(file->attributes.at("lightfarm.clamp")), 2.0);
-    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.aovs")), "albedo,normal,depth");
+    EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.aovs")),
+              "albedo,normal,depth,illuminance");
+    EXPECT_NE(std::get<std::string>(file->attributes.at("lightfarm.units")).find("lux"),
+              std::string::npos);
+    EXPECT_NE(file->image.FindChannel("illuminance"), nullptr);
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.filter")),
               "blackman-harris 2 px");
     EXPECT_EQ(std::get<std::string>(file->attributes.at("lightfarm.sampler")), "independent");

@@ -42,7 +42,7 @@ _CHANNEL_OPTIONS = [
     ("grpc.http2.max_pings_without_data", 0),
 ]
 
-_AOVS = {"albedo": 1, "normal": 2, "depth": 4}
+_AOVS = {"albedo": 1, "normal": 2, "depth": 4, "illuminance": 8}
 _FILTERS = {"box": common_pb2.FILTER_BOX, "gaussian": common_pb2.FILTER_GAUSSIAN,
             "blackman-harris": common_pb2.FILTER_BLACKMAN_HARRIS}
 _SAMPLERS = {"independent": common_pb2.SAMPLER_INDEPENDENT, "sobol": common_pb2.SAMPLER_SOBOL}
@@ -678,7 +678,7 @@ class Client:
         ``max_depth`` (-1 unlimited), ``tile``, ``passes``, ``method`` (path, radiosity,
         whitted, light, bdpt, ppm), ``priority`` (higher runs first), ``name`` (default the
         scene file's name), ``camera`` (a glTF camera's name), ``resolution`` (width, height),
-        ``clamp``, ``aovs`` (flags or names: "albedo", "normal", "depth"), ``filter`` ("box",
+        ``clamp``, ``aovs`` (flags or names: "albedo", "normal", "depth", "illuminance"), ``filter`` ("box",
         "gaussian", "blackman-harris") and ``filter_width``, ``sampler`` ("sobol",
         "independent"), ``light_sampling`` ("bvh", "power"); adaptive sampling with
         ``target_error``, ``time_limit`` (seconds) and ``max_spp``, or per pixel with

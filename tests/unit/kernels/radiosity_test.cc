@@ -11,6 +11,7 @@
 #include <fstream>
 #include <numbers>
 #include <set>
+#include <sstream>
 
 #include "lf/core/camera.h"
 #include "lf/core/scene_loader.h"
@@ -200,7 +201,8 @@ TEST(Radiosity, SavedSolutionRendersAnotherCameraWithoutSolving) {
 }
 
 // A closed box with k x k subdivided faces: each face shares its (k+1)^2 grid vertices between
-// its 2 k^2 patches, and only the inward sides exist.
+// its 2 k^2 patches, and only the inward sides exist. Every vertex carries the furnace's
+// illuminance, pi Le / (1 - rho) W m^-2 at 683 lm/W.
 TEST(Radiosity, PlyExportWritesTheSharedVertices) {
     const Scene scene = testing::MakeFurnace(1.0, Vec3d(), 0.5f, 1.0f, 8);
     const std::string path = TempPath("radiosity.ply");
@@ -212,10 +214,20 @@ TEST(Radiosity, PlyExportWritesTheSharedVertices) {
     std::ifstream in(path);
     std::string line;
     int64_t vertices = -1, faces = -1, body_lines = 0;
-    bool in_body = false;
+    bool in_body = false, has_illuminance = false;
+    const double lux = 683 * std::numbers::pi * 1.0 / (1 - 0.5);
     while (std::getline(in, line)) {
         if (in_body) {
             ++body_lines;
+            if (body_lines <= vertices) {
+                std::istringstream fields(line);
+                double x, y, z, illuminance = 0;
+                int r, g, b;
+                fields >> x >> y >> z >> r >> g >> b >> illuminance;
+                EXPECT_NEAR(illuminance, lux, 0.01 * lux) << line;
+            }
+        } else if (line == "property float illuminance") {
+            has_illuminance = true;
         } else if (line.rfind("element vertex ", 0) == 0) {
             vertices = std::stoll(line.substr(15));
         } else if (line.rfind("element face ", 0) == 0) {
@@ -224,6 +236,7 @@ TEST(Radiosity, PlyExportWritesTheSharedVertices) {
             in_body = true;
         }
     }
+    EXPECT_TRUE(has_illuminance);
     EXPECT_EQ(vertices, 6 * 4 * 4);
     EXPECT_EQ(faces, 6 * 2 * 3 * 3);
     EXPECT_EQ(body_lines, vertices + faces);

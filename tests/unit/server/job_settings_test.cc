@@ -46,7 +46,7 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
         {"clamp", [](JobSpec& s) { s.clamp = -1; }},
         {"clamp", [](JobSpec& s) { s.clamp = NAN; }},
         {"clamp", [](JobSpec& s) { s.clamp = INFINITY; }},
-        {"aovs", [](JobSpec& s) { s.aovs = kAllAovs + 1; }},
+        {"aovs", [](JobSpec& s) { s.aovs = kKnownAovs + 1; }},
         {"filter",
          [](JobSpec& s) {
              s.scene_options.filter = PixelFilter{PixelFilter::Type::kBox, 2};
@@ -120,7 +120,7 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     edge.radiosity.link_error = kMinLinkError;
     edge.clamp = 1e300;
     JobSpec aov_edge = edge;
-    aov_edge.aovs = kAllAovs;
+    aov_edge.aovs = kKnownAovs;
     aov_edge.plan.tile = kMaxFarmAovTile;
     aov_edge.scene_options.filter = PixelFilter{PixelFilter::Type::kGaussian, kMaxFilterWidth};
     EXPECT_TRUE(CheckJobSettings(aov_edge).ok()) << CheckJobSettings(aov_edge);
@@ -131,6 +131,30 @@ TEST(JobSettingsTest, EveryFieldOutOfRangeIsRefusedNamingIt) {
     edge.light_strategy = LightStrategy::kPower;
     EXPECT_TRUE(CheckJobSettings(edge).ok()) << CheckJobSettings(edge);
     fs::remove_all(dir);
+}
+
+// The illuminance AOV: path (with or without media) and radiosity estimate it; the other
+// methods are refused naming the method and the AOV.
+TEST(JobSettingsTest, IlluminanceIsRefusedForMethodsWithoutAnEstimate) {
+    for (const char* method : {"path", "radiosity"}) {
+        JobSpec spec;
+        spec.method = method;
+        spec.aovs = kAovIlluminance;
+        EXPECT_TRUE(CheckJobSettings(spec).ok()) << method << ": " << CheckJobSettings(spec);
+    }
+    for (const char* method : {"whitted", "light", "bdpt", "ppm"}) {
+        JobSpec spec;
+        spec.method = method;
+        spec.aovs = kAovIlluminance;
+        const absl::Status s = CheckJobSettings(spec);
+        EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << method;
+        EXPECT_NE(s.message().find(method), absl::string_view::npos) << s;
+        EXPECT_NE(s.message().find("AOV"), absl::string_view::npos) << s;
+    }
+    JobSpec whitted;
+    whitted.method = "whitted";
+    whitted.aovs = kAovIlluminance;
+    EXPECT_NE(CheckJobSettings(whitted).message().find("illuminance"), absl::string_view::npos);
 }
 
 }  // namespace

@@ -54,6 +54,20 @@ TEST(PreviewChannels, EachViewIsAnRgbImageWithItsToneCurve) {
     EXPECT_EQ(depth->rgb.channels().size(), 3u);
 }
 
+// Illuminance (lux) is the last view, grey scaled by the brightest pixel without the filmic curve.
+TEST(PreviewChannels, IlluminanceIsGreyScaledByItsBrightest) {
+    Image image = TwoPixels();
+    image.Channel("illuminance") = {250, 1000};
+    EXPECT_EQ(PreviewChannels(image),
+              (std::vector<std::string>{"beauty", "albedo", "normal", "depth", "illuminance"}));
+    absl::StatusOr<ChannelView> lux = ViewChannel(image, "illuminance");
+    ASSERT_TRUE(lux.ok()) << lux.status();
+    EXPECT_EQ(lux->tone, ToneCurve::kClamp);
+    for (const char* c : {"R", "G", "B"}) {
+        EXPECT_EQ(*lux->rgb.FindChannel(c), (std::vector<float>{0.25f, 1})) << c;
+    }
+}
+
 TEST(PreviewChannels, AViewTheImageLacksIsNamedWithTheOnesItHas) {
     absl::StatusOr<ChannelView> view = ViewChannel(TwoPixels(), "A");
     ASSERT_FALSE(view.ok());

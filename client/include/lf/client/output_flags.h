@@ -1,12 +1,15 @@
-// -o, --png, --exposure and --tonemap: which image files `render` and `fetch` write (an OpenEXR
-// of the radiance, an sRGB PNG preview, or both) and how the preview is made from the radiance.
+// -o, --png, --exposure, --tonemap and --false-color: which image files `render` and `fetch`
+// write (an OpenEXR of the radiance, an sRGB PNG preview, or both, and a false-colour PNG of lux
+// or nits) and how the preview is made from the radiance.
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "lf/core/false_color.h"
 #include "lf/core/image_io.h"
 
 namespace lf {
@@ -15,14 +18,16 @@ struct OutputFlags {
     std::string output;  // -o: .exr (the radiance) or .png (the preview alone)
     std::string png;     // --png: a preview beside an EXR
     PngOptions preview;  // --exposure, --tonemap
+    std::optional<FalseColorSpec> false_color;  // --false-color
 };
 
 // The files to write; "" for none.
 struct OutputPaths {
     std::string exr, png;
+    std::string false_color;  // FalseColorPath of -o with --false-color
 };
 
-// -o (required), --png, --exposure and --tonemap into `flags`.
+// -o (required), --png, --exposure, --tonemap and --false-color into `flags`.
 void AddOutputFlags(CLI::App* cmd, OutputFlags& flags);
 
 // What -o and --png ask for. InvalidArgument, naming the flag, for -o ending in neither .exr

@@ -51,15 +51,18 @@ struct FirstHit {
     Rgb albedo;       // the surface's reflectance there (lf/kernels/aov_tracer.h says which)
     Vec3 normal;      // world-space unit shading normal
     float depth = 0;  // distance from the ray's origin
+    // Lux arriving on the side the ray sees (RadianceEstimator::Irradiance), when asked for.
+    float illuminance = 0;
 };
 
 // The AOVs of one pixel's samples, summed exactly like the radiance. Albedo and normal are summed
 // over the samples that hit (a miss adds 0) and averaged over all samples (PixelSums::Count);
-// depth is summed and averaged over the `depth_hits` samples that hit only, +inf when none did.
+// depth is summed and averaged over the `depth_hits` samples that hit only, +inf when none did;
+// illuminance is summed and averaged like albedo (a miss reads 0 lux).
 // Each value goes through ExactSum's clamp to +-2^50, so a depth (scene units reach 1e15) times
 // kMaxSpp = 2^24 samples stays inside the 127 bits: 2^(50 + 50 + 24) = 2^124.
 struct AovSums {
-    ExactSum albedo[3], normal[3], depth;
+    ExactSum albedo[3], normal[3], depth, illuminance;
     uint32_t depth_hits = 0;
 
     // Adds only the AOVs `aovs` (flags) asks for, so unrequested sums stay zero.
@@ -70,6 +73,7 @@ struct AovSums {
     Rgb Albedo(uint32_t samples) const;
     Vec3 Normal(uint32_t samples) const;
     float Depth() const;  // +inf when no sample hit
+    float Illuminance(uint32_t samples) const;
 };
 
 struct PixelRect {

@@ -24,7 +24,8 @@ class Image {
 
     // Writes a tile's means: R,G,B and the two half-sample estimates A.R.. and B.R..,
     // plus the per-pixel sample count in `spp`, and the AOV channels of tile.aovs
-    // (lf/core/aov.h: albedo.R/G/B, normal.X/Y/Z, depth.Z), each a mean as AovSums defines.
+    // (lf/core/aov.h: albedo.R/G/B, normal.X/Y/Z, depth.Z, illuminance), each a mean as AovSums
+    // defines.
     void SetTile(const TileSums& tile);
 
     Rgb Pixel(int x, int y, const std::string& prefix = "") const;

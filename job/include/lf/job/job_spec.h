@@ -68,8 +68,9 @@ struct JobSpec {
 // tile limits are kMaxSpp and kMaxFarmTile (plan.h); the patch budget kMaxRefinedPatches.
 inline constexpr int kMaxDepthLimit = 1 << 20;  // max_depth in -1 (unlimited)..this
 inline constexpr int kMaxPasses = 1 << 20;
-// The tile limit of jobs with AOVs: a result then takes up to 220 bytes a pixel (tile_codec.h),
-// and 128x128 of them stay under gRPC's 4 MiB message limit as kMaxFarmTile's 104 bytes do.
+// The tile limit of jobs with AOVs: a result then takes up to 236 bytes a pixel (tile_codec.h),
+// and 128x128 of them (3.9 MB) stay under gRPC's 4 MiB message limit as kMaxFarmTile's 104
+// bytes do.
 inline constexpr int kMaxFarmAovTile = 128;
 // Far beyond what an O(n^2) radiosity solve can handle; below the mesher's own hard limit.
 inline constexpr int64_t kMaxPatchTarget = int64_t(1) << 24;

@@ -40,6 +40,9 @@ struct MethodInfo {
     // Splat passes have no per-pixel first hits to make AOVs of, and no tile whose error alone
     // decides its next pass.
     bool aovs;
+    // Estimates the illuminance AOV (RadianceEstimator::Irradiance): the path tracer and
+    // radiosity; whitted has no diffuse indirect light to estimate it with.
+    bool illuminance;
     bool adaptive;  // --target-error, --time-limit
     // Renders a shutter interval (--shutter): radiosity solves one instant per frame.
     bool motion_blur;

@@ -9,6 +9,7 @@
 
 #include "lf/core/film.h"
 #include "lf/core/ray.h"
+#include "lf/kernels/bsdf.h"
 #include "lf/kernels/embree_scene.h"
 
 namespace lf {
@@ -21,5 +22,10 @@ namespace lf {
 // is the world-space shading normal (vertex normals, normal maps) on the front face's side;
 // depth is the distance from the ray's origin (on the lens with depth of field).
 std::optional<FirstHit> TraceFirstHit(const EmbreeScene& scene, const Ray& ray);
+
+// What the illuminance estimates (RadianceEstimator::Irradiance) reflect the light arriving at a
+// first hit with, in place of its material: a Lambertian of albedo 1, whose f = 1/pi makes pi
+// times its reflected radiance the irradiance, whatever the surface does with the light.
+Bsdf IrradianceBsdf();
 
 }  // namespace lf

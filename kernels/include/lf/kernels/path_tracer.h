@@ -28,8 +28,24 @@ class PathTracer : public RadianceEstimator {
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
     const EmbreeScene& geometry() const override { return scene_; }
+    // At the first hit, one sample of a Lambertian of albedo 1 times pi: next-event estimation
+    // and a cosine-weighted direction whose radiance is this path tracer's own (MIS-weighted
+    // where it meets an area light, up to max_depth bounces from the hit), so indirect light
+    // counts. Unbiased; at least direct light with max_depth 0.
+    std::optional<Rgb> Irradiance(const Ray& ray, Sampler& sampler,
+                                  RenderStats& stats) const override;
 
   private:
+    // Where a path's radiance is gathered from: a camera ray (sees emission with full weight),
+    // or a ray BSDF-sampled at a vertex at depth - 1 with pdf prev_pdf.
+    struct PathStart {
+        int depth = 0;
+        bool delta_bounce = true;
+        float prev_pdf = 0;
+        Vec3 prev_p, prev_n;
+    };
+    Rgb Trace(const Ray& ray, const PathStart& start, Sampler& sampler, RenderStats& stats) const;
+
     const EmbreeScene& scene_;
     LightSampler lights_;
     int max_depth_;

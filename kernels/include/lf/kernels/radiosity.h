@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -108,6 +109,15 @@ class RadiosityRenderer : public RadianceEstimator {
         return display_->Li(ray, sampler, stats);
     }
     const EmbreeScene& geometry() const override { return display_->geometry(); }
+    // The solution's irradiance on the side the ray sees (RadiosityDisplay::Irradiance), shaded
+    // as the image is; exact for the solution, so it draws no random numbers.
+    std::optional<Rgb> Irradiance(const Ray& ray, Sampler&, RenderStats& stats) const override {
+        ++stats.rays;
+        const std::optional<SurfaceHit> hit = geometry().Intersect(ray);
+        if (!hit || hit->mesh < 0) return Rgb(0);
+        return display_->Irradiance(hit->mesh, hit->primitive, hit->b1, hit->b2,
+                                    Dot(ray.d, hit->n) > 0);
+    }
     const RadiosityDisplay& display() const { return *display_; }
 
     const RadiosityReport& report() const { return report_; }

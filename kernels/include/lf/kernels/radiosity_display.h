@@ -70,9 +70,12 @@ class RadiosityDisplay : public RadianceEstimator {
 };
 
 // ASCII PLY of every side with an unknown (back sides wound the other way), world positions,
-// vertex colours the smooth radiance B/π sRGB-encoded and clamped to [0, 1]. A vertex is
-// written once per distinct colour, so a side of a flat surface shares all its vertices.
+// vertex colours the smooth radiance B/π sRGB-encoded and clamped to [0, 1], and `property float
+// illuminance`: lux arriving on the side at the vertex as `display` (of this solution) shades it
+// (smooth: the same area-weighted corner means as the colours), 4 significant digits. A vertex
+// is written once per distinct colour and illuminance, so a side of a flat surface shares all
+// its vertices.
 absl::Status WriteRadiosityPly(const std::string& path, const PatchMesh& mesh,
-                               std::span<const Rgb> radiosity);
+                               std::span<const Rgb> radiosity, const RadiosityDisplay& display);
 
 }  // namespace lf

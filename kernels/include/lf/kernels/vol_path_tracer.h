@@ -21,6 +21,9 @@
 
 namespace lf {
 
+class Bsdf;
+struct Shading;
+
 class VolPathTracer : public RadianceEstimator {
   public:
     // As PathTracer's: max_depth negative is unlimited (kMaxPathDepth).
@@ -29,9 +32,24 @@ class VolPathTracer : public RadianceEstimator {
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
     const EmbreeScene& geometry() const override { return scene_; }
+    // As PathTracer's: a white Lambertian bounce at the first surface (through interfaces),
+    // lit through the media on the side the camera sees; what the media between the camera and
+    // the surface do to the camera ray is no part of the light arriving there.
+    std::optional<Rgb> Irradiance(const Ray& ray, Sampler& sampler,
+                                  RenderStats& stats) const override;
 
   private:
     struct PathState;
+    // Where a path's radiance is gathered from (as PathTracer's): the camera, or a ray sampled
+    // at a surface vertex at depth - 1, starting in `medium`.
+    struct PathStart {
+        int depth = 0;
+        int medium = -1;
+        bool specular_bounce = true;
+        Vec3 prev_p, prev_n;
+    };
+    Rgb Trace(const Ray& ray, const PathStart& start, PathState& state, Sampler& sampler,
+              RenderStats& stats) const;
     // Light sampled for a vertex at `at` (surface: `n` its shading normal; medium: n zero)
     // whose scattering for the light direction wi is `f_of(wi)` (BSDF times |cos|, or the phase
     // function) with density `pdf_of(wi)`, the shadow ray leaving from `from_of(wi)` in medium
@@ -40,6 +58,12 @@ class VolPathTracer : public RadianceEstimator {
     Rgb SampleLight(const SurfacePoint& at, const Vec3& n, FromOf&& from_of, MediumOf&& medium_of,
                     const PathState& state, float u_pick, const Vec2& u_light, MediumRng& rng,
                     F&& f_of, Pdf&& pdf_of, RenderStats& stats) const;
+    // SampleLight for a surface vertex seen from direction -d with `bsdf` in sh.ns's shading
+    // frame, the path in `medium` on that side: the light may lie on either side, and a shadow
+    // ray the BSDF calls a transmission leaves through the surface into the medium beyond.
+    Rgb SampleSurfaceLight(const SurfaceHit& hit, const Shading& sh, const Vec3& d,
+                           const Bsdf& bsdf, int medium, const PathState& state, float u_pick,
+                           const Vec2& u_light, MediumRng& rng, RenderStats& stats) const;
     static bool Roulette(PathState& state, float eta_scale, float u);
 
     const EmbreeScene& scene_;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "lf/core/false_color.h"
 #include "lf/core/image_io.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/method_registry.h"
@@ -50,6 +51,9 @@ struct LocalRenderOptions {
     std::string exr_path;  // empty: no EXR (-o out.png)
     std::string png_path;  // empty: no preview
     PngOptions preview;    // --exposure, --tonemap
+    // --false-color: a false-colour PNG at false_color_path (a pattern for a shot, as exr_path).
+    std::optional<FalseColorSpec> false_color;
+    std::string false_color_path;
     std::optional<Method> method = FindMethod(defaults::kMethod);  // nullopt: auto (ChooseMethod)
     RenderSettings render;                                         // with --clamp and --aov
     AdaptiveSettings adaptive;  // used when a target error or a time limit is set

@@ -1,6 +1,6 @@
 // What the dashboard's preview can show of a result image: its beauty (R,G,B), the two
-// half-sample estimates (A, B) and the AOVs it holds (albedo, normal, depth), each turned into an
-// R,G,B image that EncodePng can tone-map, with the tone curve that suits it.
+// half-sample estimates (A, B) and the AOVs it holds (albedo, normal, depth, illuminance), each
+// turned into an R,G,B image that EncodePng can tone-map, with the tone curve that suits it.
 #pragma once
 
 #include <string>
@@ -12,7 +12,7 @@
 
 namespace lf {
 
-// The views `image` has, in a fixed order: beauty, A, B, albedo, normal, depth.
+// The views `image` has, in a fixed order: beauty, A, B, albedo, normal, depth, illuminance.
 std::vector<std::string> PreviewChannels(const Image& image);
 
 struct ChannelView {
@@ -21,9 +21,9 @@ struct ChannelView {
     ToneCurve tone = ToneCurve::kFilmic;
 };
 
-// The R,G,B image of view `channel`: normals remapped from [-1, 1] to [0, 1], depth as grey
-// scaled by the image's largest finite depth (near is dark). InvalidArgument naming the channel
-// and the ones the image has for one it lacks.
+// The R,G,B image of view `channel`: normals remapped from [-1, 1] to [0, 1], depth and
+// illuminance as grey scaled by the image's largest finite value (near and dim are dark).
+// InvalidArgument naming the channel and the ones the image has for one it lacks.
 absl::StatusOr<ChannelView> ViewChannel(const Image& image, const std::string& channel);
 
 }  // namespace lf
