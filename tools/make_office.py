@@ -159,24 +159,24 @@ class Office:
         for cz in (0.3, 0.7):
             x, z = x0 + 0.5 * ROOM_W, z0 + cz * ROOM_D
             # Counter-clockwise seen from below: the front (emitting) face looks down.
-            self.lamps.append([[x - LAMP_HALF, y, z - LAMP_HALF], [x + LAMP_HALF, y, z - LAMP_HALF],
-                               [x + LAMP_HALF, y, z + LAMP_HALF], [x - LAMP_HALF, y, z + LAMP_HALF]])
+            h = LAMP_HALF
+            self.lamps.append([[x - h, y, z - h], [x + h, y, z - h], [x + h, y, z + h],
+                               [x - h, y, z + h]])
 
     def walls(self):
-        window = ((ROOM_W - WINDOW_WIDTH) / 2, (ROOM_W + WINDOW_WIDTH) / 2) + WINDOW_V
-        window_z = ((ROOM_D - WINDOW_WIDTH) / 2, (ROOM_D + WINDOW_WIDTH) / 2) + WINDOW_V
-        for i in range(self.nx + 1):  # walls of constant x, along +z
-            outer = i in (0, self.nx)
-            for j in range(self.nz):
-                self.surfaces["wall"].append(Surface(
-                    (i * ROOM_W, 0, j * ROOM_D), (0, 0, 1), (0, 1, 0), ROOM_D, HEIGHT,
-                    [window_z if outer else DOOR]))
-        for j in range(self.nz + 1):  # walls of constant z, along +x
-            outer = j in (0, self.nz)
-            for i in range(self.nx):
-                self.surfaces["wall"].append(Surface(
-                    (i * ROOM_W, 0, j * ROOM_D), (1, 0, 0), (0, 1, 0), ROOM_W, HEIGHT,
-                    [window if outer else DOOR]))
+        """Walls of constant x (along +z), then of constant z (along +x): a window in the outer
+        ones, a door in those between two rooms."""
+        size, count = (ROOM_W, ROOM_D), (self.nx, self.nz)
+        for a, along in ((0, (0, 0, 1)), (1, (1, 0, 0))):  # a: the axis (x, z) walls cut
+            length = size[1 - a]
+            window = ((length - WINDOW_WIDTH) / 2, (length + WINDOW_WIDTH) / 2) + WINDOW_V
+            for k in range(count[a] + 1):
+                for m in range(count[1 - a]):
+                    xz = [0.0, 0.0]
+                    xz[a], xz[1 - a] = k * size[a], m * size[1 - a]
+                    self.surfaces["wall"].append(Surface(
+                        (xz[0], 0, xz[1]), along, (0, 1, 0), length, HEIGHT,
+                        [window if k in (0, count[a]) else DOOR]))
 
     def box_triangles(self):
         return sum(10 if f else 12 for boxes in self.boxes.values() for _, _, f in boxes)
