@@ -6,10 +6,10 @@
 # /usr/bin/time -v and prints the time to solution (the render's "radiosity" phase: meshing, form
 # factors or links, solve), the render's CPU seconds, the peak RSS, the solve's statistics from
 # the EXR header (lightfarm.radiosity.*: patches, links per element where the solver writes
-# them) and the agreement with a path-traced render of the same camera, compared in 16x16-pixel blocks against
-# the path tracer's own standard error (exr_compare --blocks). With --farm-rounds N, also times
-# the Cornell box job (256^2, --patch-size 0.02) on a local farm of two 1-thread workers against
-# `lightfarm render --threads 2`, N rounds, for each solver.
+# them) and the agreement with a path-traced render of the same camera, compared in 16x16-pixel
+# blocks against the path tracer's own standard error (exr_compare --blocks). With
+# --farm-rounds N, also times the Cornell box job (256^2, --patch-size 0.02) on a local farm of
+# two 1-thread workers against `lightfarm render --threads 2`, N rounds, for each solver.
 #
 #   tools/radiosity_bench.sh [--scenes cornell,10k,100k,1M] [--solvers flat,hierarchical]
 #       [--link-error 0.01] [--spp 16] [--ref-spp 256] [--threads 2] [--timeout 900]
@@ -28,21 +28,11 @@ scenes=cornell,10k,100k,1M solvers=flat,hierarchical link_error=0.01 spp=16 ref_
 threads=2 timeout=900 farm_rounds=0 out=""
 usage="usage: $0 [--scenes LIST] [--solvers LIST] [--link-error E] [--spp N] [--ref-spp N]"
 usage+=" [--threads N] [--timeout S] [--farm-rounds N] [--out DIR]"
-while [ $# -ge 2 ]; do
-  case "$1" in
-    # --link-error E sets link_error, and so on.
-    --scenes | --solvers | --link-error | --spp | --ref-spp | --threads | --timeout | \
-      --farm-rounds | --out)
-      name="${1#--}"
-      printf -v "${name//-/_}" '%s' "$2"
-      ;;
-    *) break ;;
-  esac
-  shift 2
-done
-[ $# -eq 0 ] || { echo "$usage" >&2; exit 2; }
+source tools/bench_options.sh
+parse_options "scenes solvers link-error spp ref-spp threads timeout farm-rounds out" "$@"
 for tool in lightfarm exr_compare; do
-  [ -x "$bin/$tool" ] || { echo "$0: no $bin/$tool: cmake --build build --target $tool" >&2; exit 1; }
+  [ -x "$bin/$tool" ] ||
+    { echo "$0: no $bin/$tool: cmake --build build --target $tool" >&2; exit 1; }
 done
 "$bin/exr_compare" --help | grep -q -- --blocks ||
   { echo "$0: $bin/exr_compare has no --blocks: build it from this tree" >&2; exit 1; }
@@ -111,7 +101,8 @@ for scene in "${scene_list[@]}"; do
       -o "$out/$name.exr" --png "$out/$name.png" --method radiosity --spp "$spp" \
       --threads "$threads" --no-progress $(radiosity_args "$scene" "$solver") \
       >"$out/$name.log" 2>&1; then
-      row "failed: $(grep -m1 -i -E 'error|timeout|killed' "$out/$name.log" || tail -1 "$out/$name.log")"
+      why=$(grep -m1 -i -E 'error|timeout|killed' "$out/$name.log" || tail -1 "$out/$name.log")
+      row "failed: $why"
       continue
     fi
     # "time: load 0.02 s, radiosity 26.25 s (mesh ..., form factors ..., solve ...), ..."
