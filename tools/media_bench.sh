@@ -19,18 +19,8 @@ cd "$(dirname "$0")/.."
 bin="${LF_BIN_DIR:-build/bin}"
 grid_size=256 resolution=512 spp=8 threads=2 out=""
 usage="usage: $0 [--grid-size N] [--resolution N] [--spp N] [--threads N] [--out DIR]"
-while [ $# -ge 2 ]; do
-  case "$1" in
-    # --grid-size N sets grid_size, and so on.
-    --grid-size | --resolution | --spp | --threads | --out)
-      name="${1#--}"
-      printf -v "${name//-/_}" '%s' "$2"
-      ;;
-    *) break ;;
-  esac
-  shift 2
-done
-[ $# -eq 0 ] || { echo "$usage" >&2; exit 2; }
+source tools/bench_options.sh
+parse_options "grid-size resolution spp threads out" "$@"
 [ -n "$out" ] || out="$(mktemp -d /tmp/media_bench.XXXXXX)"
 mkdir -p "$out"
 [ -x "$bin/lightfarm" ] || { echo "media_bench: no $bin/lightfarm; build it first" >&2; exit 1; }
