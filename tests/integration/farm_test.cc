@@ -1195,6 +1195,28 @@ TEST_F(Farm, ServerKilledMidSolveStillGivesTheLocalPixels) {
     EXPECT_NE(ReadText(dir_ / "server-2.log").find("radiosity sweep 1:"), std::string::npos);
 }
 
+// Hierarchical radiosity solves in the same sweeps, each patch-group task linking and gathering
+// its receiver clusters: a worker killed mid-sweep and a server killed mid-solve change nothing,
+// so the image has the bits of `lightfarm render --radiosity hierarchical`.
+TEST_F(Farm, HierarchicalSweepsSurviveAWorkerKillAndAServerRestartWithTheLocalPixels) {
+    StartServer(/*lease_seconds=*/1);
+    Child* doomed = StartWorker("doomed");
+    StartWorker("survivor");
+    const std::string flags =
+        "--method radiosity --patches 1500 --radiosity hierarchical --link-error 1e-4";
+    const std::string job = Submit(scene_, "--spp 2 --seed 8 --tile 16 --sweep-tasks 3 " + flags);
+    ASSERT_TRUE(KillMidTask(doomed, "doomed.log"));
+    const auto deadline = Clock::now() + milliseconds(60000);
+    while (ReadText(dir_ / "server-1.log").find("radiosity sweep 3:") == std::string::npos &&
+           Clock::now() < deadline) {
+        std::this_thread::sleep_for(milliseconds(2));
+    }
+    CrashAndRestartServer();
+    ExpectSameAsLocal(job, scene_, 2, 8, flags);
+    EXPECT_NE(ReadText(dir_ / "server-2.log").find("radiosity sweep 1:"), std::string::npos);
+    EXPECT_NE(ReadText(dir_ / "survivor.log").find("radiosity sweep"), std::string::npos);
+}
+
 // Adaptive sampling on the farm: passes only for the tiles whose estimated error is above the
 // target, each tile's passes decided by its own samples, so the same pixels as local mode.
 TEST_F(Farm, TargetErrorPlansPassesOnlyWhereNeededAndGivesTheLocalPixels) {

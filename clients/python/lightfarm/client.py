@@ -663,7 +663,7 @@ class Client:
                patches: int = 4000, patch_size: float = 0.0, solver: str = "jacobi",
                tolerance: float = 1e-4, max_iterations: int = 10000, display: str = "smooth",
                sweep_tasks: int = 8, max_patches: int = 0, radiosity: str = "flat",
-               link_error: float = 1e-3,
+               link_error: float = 1e-4,
                photons_per_pass: int = 1 << 18, initial_radius: float = 0.0,
                alpha: float = 2.0 / 3.0, frames: Optional[str] = None,
                frame: Optional[int] = None, fps: Optional[float] = None, shutter: float = 0.0,

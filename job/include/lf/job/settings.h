@@ -34,7 +34,7 @@ inline constexpr int kRadiosityMaxIterations = 10000;
 inline constexpr const char* kRadiosityDisplay = "smooth";
 // Flat form factors (n^2, the reference) or hierarchical radiosity with clustering.
 inline constexpr const char* kRadiosityForm = "flat";
-inline constexpr double kRadiosityLinkError = 1e-3;
+inline constexpr double kRadiosityLinkError = 1e-4;
 inline constexpr int kRadiositySweepTasks = 8;
 
 // Progressive photon mapping (`ppm`, lf/job/splat_settings.h): photons traced per pass, the

@@ -41,7 +41,7 @@ struct RadiosityOptions {
     // patches, refined until each carries at most `link_error` of the scene's power, solved by
     // Jacobi sweeps; false: the flat n^2 form factors and `solver`.
     bool hierarchical = false;
-    double link_error = 1e-3;
+    double link_error = 1e-4;
     double tolerance = 1e-4;  // relative residual
     int max_iterations = 10000;
     RadiosityShading display = RadiosityShading::kSmooth;
