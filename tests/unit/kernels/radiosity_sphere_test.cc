@@ -65,7 +65,7 @@ TEST(RadiositySphere, UnderAUniformSkyItsRadiosityIsAlbedoTimesPiL) {
 // nearest the light is I / (d - r)^2 (the patch's mean, within 1 % at the mesh's resolution).
 TEST(RadiositySphere, PointLightGivesTheInverseSquareBelowIt) {
     const double r = 0.5, d = 3;
-    const Vec3d center(0, 0, 0), light(0.6, 2.4, 1.8);  // |light - center| = 3
+    const Vec3d center(0, 0, 0), light = Normalize(Vec3d(0.2, 0.8, 0.5)) * d;
     Scene scene = SphereScene(0.5f, center, r);
     const Rgb intensity(4, 5, 6);
     scene.point_lights.push_back({light, intensity});

@@ -8,7 +8,7 @@
 namespace lf {
 
 // Default largest gap between a flat triangle and the sphere, relative to the radius: the
-// tessellation's area is then within 0.3 % of 4 pi r^2 (frequency 9, 1620 triangles).
+// tessellation's area is then 0.31 % below 4 pi r^2 (frequency 10, 2000 triangles).
 inline constexpr double kSphereMeshTolerance = 3e-3;
 // The finest frequency: 20 * 64^2 = 81920 triangles a sphere.
 inline constexpr int kMaxSphereMeshFrequency = 64;
