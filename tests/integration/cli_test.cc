@@ -196,7 +196,7 @@ TEST_F(Cli, AutoPicksRadiosityForLambertianScenesAndSaysWhy) {
 TEST_F(Cli, RadiosityRefusesWhatItCannotModel) {
     const RunResult r =
         Lightfarm("render " + std::string(LF_TEST_SCENES) +
-                  "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf -o " +
+                  "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --camera auto -o " +
                   (dir_ / "a.exr").string() + " --method radiosity --spp 1 --no-progress");
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.output.find("which radiosity does not model"), std::string::npos) << r.output;
@@ -340,8 +340,8 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     // rendering.
     const RunResult refused =
         Lightfarm("converge " + std::string(LF_TEST_SCENES) +
-                  "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --out " + out.string() +
-                  " --method both");
+                  "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --camera auto --out " +
+                  out.string() + " --method both");
     EXPECT_NE(refused.status, 0);
     EXPECT_NE(refused.output.find("radiosity cannot model this scene: material"), std::string::npos)
         << refused.output;
@@ -651,10 +651,10 @@ TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
         EXPECT_NE(radiosity.output.find(text), std::string::npos) << text << "\n"
                                                                   << radiosity.output;
     }
-    const RunResult refused =
-        Lightfarm("plan " + std::string(LF_TEST_SCENES) +
-                  "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --method radiosity "
-                  "--threads 2");
+    const RunResult refused = Lightfarm(
+        "plan " + std::string(LF_TEST_SCENES) +
+        "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --camera auto --method radiosity "
+        "--threads 2");
     EXPECT_NE(refused.status, 0);
     EXPECT_NE(refused.output.find("which radiosity does not model"), std::string::npos)
         << refused.output;
