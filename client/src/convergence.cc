@@ -20,6 +20,7 @@
 #include "lf/core/log.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/method_registry.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/splat_settings.h"
 #include "lf/kernels/embree_scene.h"
@@ -490,6 +491,9 @@ absl::StatusOr<ConvergenceResult> RunConvergence(const ConvergenceOptions& optio
             return absl::InvalidArgumentError(absl::StrCat(
                 "--method ", options.method, ": radiosity cannot model this scene: ", why));
         }
+        // With `both`, the path ladder renders radiosity's tessellation too: the comparison is
+        // of the methods on one geometry.
+        PrepareSceneFor(Method::kRadiosity, *scene);
     }
     auto log = NamedLogger("converge");
     const std::string job_id = "converge-" + scene->content_hash.substr(0, 8);

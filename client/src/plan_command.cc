@@ -24,6 +24,7 @@
 #include "lf/core/plural.h"
 #include "lf/core/scene_loader.h"
 #include "lf/job/job_spec.h"
+#include "lf/job/method_registry.h"
 #include "lf/job/plan.h"
 #include "lf/job/settings.h"
 #include "lf/job/splat_settings.h"
@@ -449,6 +450,7 @@ absl::Status RunPlan(const PlanOptions& options) {
             "they leave it\n");
     }
 
+    PrepareSceneFor(method, *scene);
     absl::StatusOr<std::unique_ptr<EmbreeScene>> embree = EmbreeScene::Build(*scene);
     if (!embree.ok()) return embree.status();
     if (Info(method).work == WorkKind::kRadiosity) {

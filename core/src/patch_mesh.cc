@@ -189,30 +189,38 @@ bool MayReflectDiffusely(const Material& m) {
     }
 }
 
+namespace {
+
+// The material of every shape radiosity meshes, with the shape's name: meshes, then spheres
+// (TessellateSpheres makes them meshes of the same material).
+template <typename F>
+void ForEachShapeMaterial(const Scene& scene, F&& f) {
+    for (const TriangleMesh& mesh : scene.meshes) f(mesh.material, "mesh", mesh.name);
+    for (const Sphere& sphere : scene.spheres) f(sphere.material, "sphere", sphere.name);
+}
+
+}  // namespace
+
 std::string RadiosityLimitation(const Scene& scene) {
-    for (const TriangleMesh& mesh : scene.meshes) {
-        const Material& m = scene.materials[size_t(mesh.material)];
+    std::string why;
+    ForEachShapeMaterial(scene, [&](int material, const char* kind, const std::string& name) {
+        if (!why.empty()) return;
+        const Material& m = scene.materials[size_t(material)];
         const std::string what =
-            absl::StrCat("material \"", m.name, "\" (mesh \"", mesh.name, "\") ");
+            absl::StrCat("material \"", m.name, "\" (", kind, " \"", name, "\") ");
         // An interface bounds a medium: light passes it unchanged, which a patch cannot.
         if (m.type == Material::Type::kInterface) {
-            return what + "is a medium interface, which radiosity does not model";
+            why = what + "is a medium interface, which radiosity does not model";
+        } else if (m.alpha_mode == Material::AlphaMode::kMask) {
+            // Cut-outs change what the patches see, not what they reflect.
+            why = what + "has an alpha mask, which radiosity does not model";
+        } else if (m.alpha_mode == Material::AlphaMode::kBlend) {
+            why = what + "is alpha-blended, which radiosity does not model";
+        } else if (!m.double_sided) {
+            why = what + "is single-sided, which radiosity does not model";
         }
-        // Cut-outs change what the patches see, not what they reflect.
-        if (m.alpha_mode == Material::AlphaMode::kMask) {
-            return what + "has an alpha mask, which radiosity does not model";
-        }
-        if (m.alpha_mode == Material::AlphaMode::kBlend) {
-            return what + "is alpha-blended, which radiosity does not model";
-        }
-        if (!m.double_sided) return what + "is single-sided, which radiosity does not model";
-    }
-    if (!scene.spheres.empty()) {
-        return absl::StrCat("sphere \"", scene.spheres.front().name,
-                            "\" cannot be meshed; radiosity supports triangle meshes and quads "
-                            "only");
-    }
-    return "";
+    });
+    return why;
 }
 
 std::string RadiosityDrops(const Scene& scene) {
@@ -228,10 +236,10 @@ std::string RadiosityDrops(const Scene& scene) {
                                        {"sheen", {}},
                                        {"normal map", {}}}};
     std::vector<bool> seen(scene.materials.size(), false);
-    for (const TriangleMesh& mesh : scene.meshes) {
-        if (seen[size_t(mesh.material)]) continue;
-        seen[size_t(mesh.material)] = true;
-        const Material& m = scene.materials[size_t(mesh.material)];
+    ForEachShapeMaterial(scene, [&](int material, const char*, const std::string&) {
+        if (seen[size_t(material)]) return;
+        seen[size_t(material)] = true;
+        const Material& m = scene.materials[size_t(material)];
         const std::string name = absl::StrCat("\"", m.name, "\"");
         const bool principled = m.type == Material::Type::kPrincipled;
         const bool diffuse = m.type == Material::Type::kLambert || principled;
@@ -244,7 +252,7 @@ std::string RadiosityDrops(const Scene& scene) {
         if (principled && m.clearcoat > 0) dropped[3].names.push_back(name);
         if (principled && !m.sheen_color.IsBlack()) dropped[4].names.push_back(name);
         if (diffuse && m.normal_texture.valid()) dropped[5].names.push_back(name);
-    }
+    });
     std::string out;
     for (const Dropped& d : dropped) {
         if (d.names.empty()) continue;
@@ -263,6 +271,12 @@ absl::Status RadiosityRefusal(const Scene& scene) {
 absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOptions& options) {
     auto cancelled = [&] { return CancelRequested(options.cancel); };
     if (absl::Status refused = RadiosityRefusal(scene); !refused.ok()) return refused;
+    if (!scene.spheres.empty()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("radiosity: sphere \"", scene.spheres.front().name,
+                         "\" was not meshed (lf/core/sphere_mesh.h TessellateSpheres meshes "
+                         "spheres before the patch mesh is built)"));
+    }
     if (!(options.patch_size >= 0) || (options.patch_size == 0 && options.patches <= 0)) {
         return absl::InvalidArgumentError(
             "radiosity: give a positive patch size or a positive patch count");

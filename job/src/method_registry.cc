@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/patch_mesh.h"
+#include "lf/core/sphere_mesh.h"
 #include "lf/job/job_spec.h"
 
 namespace lf {
@@ -42,17 +43,17 @@ absl::Status RadiosityAndMediaRefusal(const Scene& scene) {
 // Indexed by Method.
 constexpr std::array<MethodInfo, 6> kMethods = {{
     {Method::kPath, "path", WorkKind::kTiles, std::nullopt, false, true, true, true, true, true,
-     nullptr},
+     false, nullptr},
     {Method::kRadiosity, "radiosity", WorkKind::kRadiosity, std::nullopt, false, false, true, true,
-     true, false, RadiosityAndMediaRefusal},
+     true, false, true, RadiosityAndMediaRefusal},
     {Method::kWhitted, "whitted", WorkKind::kTiles, std::nullopt, false, true, true, false, true,
-     true, MediaOnlyRefusal<Method::kWhitted>},
+     true, false, MediaOnlyRefusal<Method::kWhitted>},
     {Method::kLight, "light", WorkKind::kSplatPasses, SplatPlanKind::kLightPaths, true, false,
-     false, false, false, true, MediaOnlyRefusal<Method::kLight>},
+     false, false, false, true, false, MediaOnlyRefusal<Method::kLight>},
     {Method::kBdpt, "bdpt", WorkKind::kSplatPasses, SplatPlanKind::kCameraAndLight, true, true,
-     false, false, false, true, BdptMediaRefusal},
+     false, false, false, true, false, BdptMediaRefusal},
     {Method::kPpm, "ppm", WorkKind::kSplatPasses, SplatPlanKind::kPhotonPasses, false, true, false,
-     false, false, true, MediaOnlyRefusal<Method::kPpm>},
+     false, false, true, false, MediaOnlyRefusal<Method::kPpm>},
 }};
 
 constexpr bool IndexedByMethod() {
@@ -92,6 +93,10 @@ Method MethodOf(const JobSpec& spec) {
     if (std::optional<Method> method = FindMethod(spec.method)) return *method;
     std::fprintf(stderr, "MethodOf: unchecked job spec with method \"%s\"\n", spec.method.c_str());
     std::abort();
+}
+
+void PrepareSceneFor(Method method, Scene& scene) {
+    if (Info(method).meshes_spheres) TessellateSpheres(scene);
 }
 
 std::string MediaLimitation(const Scene& scene) {

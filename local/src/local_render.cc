@@ -342,6 +342,7 @@ absl::StatusOr<LoadedRender> LoadRender(const LocalRenderOptions& options) {
     r.method = choice.method;
     // What the farm refuses at submission (media a method does not render, say) is refused here.
     if (absl::Status s = CheckMethodTakesScene(r.method, r.scene); !s.ok()) return s;
+    PrepareSceneFor(r.method, r.scene);
     const MethodInfo& info = Info(r.method);
     log->info("job={} method {} ({})", r.job_id, info.name, choice.why);
     r.job = LocalJobOf(options, r.scene, info);

@@ -195,11 +195,21 @@ TEST_F(Cli, AutoPicksRadiosityForLambertianScenesAndSaysWhy) {
 }
 
 TEST_F(Cli, RadiosityRefusesWhatItCannotModel) {
-    const std::string scene = std::string(LF_TEST_SCENES) + "/materials.json";
-    const RunResult r = Lightfarm("render " + scene + " -o " + (dir_ / "m.exr").string() +
-                                  " --method radiosity --spp 1 --no-progress");
+    const RunResult r =
+        Lightfarm("render " + std::string(LF_TEST_SCENES) +
+                  "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --camera auto -o " +
+                  (dir_ / "a.exr").string() + " --method radiosity --spp 1 --no-progress");
     EXPECT_NE(r.status, 0);
-    EXPECT_NE(r.output.find("radiosity"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("which radiosity does not model"), std::string::npos) << r.output;
+    // materials.json's spheres are meshed; its glass, mirror and glossy balls have no diffuse
+    // part, which the render names.
+    const std::string scene = std::string(LF_TEST_SCENES) + "/materials.json";
+    const RunResult spheres =
+        Lightfarm("render " + scene + " -o " + (dir_ / "m.exr").string() +
+                  " --method radiosity --patches 300 --resolution 16x16 --spp 1 --no-progress");
+    EXPECT_EQ(spheres.status, 0) << spheres.output;
+    EXPECT_NE(spheres.output.find("\"glass\" (dielectric), \"mirror\" (mirror)"), std::string::npos)
+        << spheres.output;
     const RunResult automatic = Lightfarm("render " + scene + " -o " + (dir_ / "m.exr").string() +
                                           " --method auto --spp 1 --no-progress");
     EXPECT_EQ(automatic.status, 0) << automatic.output;
@@ -327,11 +337,14 @@ TEST_F(Cli, ConvergeWritesTheCsvAndThePlot) {
     EXPECT_EQ(rows[3].back(), ',') << rows[3];
     EXPECT_GT(fs::file_size(out / "convergence.png"), 1000u);
 
-    // Radiosity's refusal comes before any rendering.
-    const RunResult refused = Lightfarm("converge " + std::string(LF_TEST_SCENES) +
-                                        "/materials.json --out " + out.string() + " --method both");
+    // Radiosity's refusal (of alpha-blended materials; spheres it meshes) comes before any
+    // rendering.
+    const RunResult refused =
+        Lightfarm("converge " + std::string(LF_TEST_SCENES) +
+                  "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --camera auto --out " +
+                  out.string() + " --method both");
     EXPECT_NE(refused.status, 0);
-    EXPECT_NE(refused.output.find("radiosity cannot model this scene: sphere"), std::string::npos)
+    EXPECT_NE(refused.output.find("radiosity cannot model this scene: material"), std::string::npos)
         << refused.output;
 }
 
@@ -639,10 +652,13 @@ TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
         EXPECT_NE(radiosity.output.find(text), std::string::npos) << text << "\n"
                                                                   << radiosity.output;
     }
-    const RunResult refused = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
-                                        "/materials.json --method radiosity --threads 2");
+    const RunResult refused = Lightfarm(
+        "plan " + std::string(LF_TEST_SCENES) +
+        "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --camera auto --method radiosity "
+        "--threads 2");
     EXPECT_NE(refused.status, 0);
-    EXPECT_NE(refused.output.find("radiosity"), std::string::npos) << refused.output;
+    EXPECT_NE(refused.output.find("which radiosity does not model"), std::string::npos)
+        << refused.output;
     // Every complete method costed from its own pilot, the path tracer named incomplete where a
     // point light's caustics are beyond it, and the fastest complete one named.
     const RunResult glossy = Lightfarm("plan " + std::string(LF_TEST_SCENES) +

@@ -1019,6 +1019,25 @@ TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
     EXPECT_NE(server_log.find("radiosity sweep 2: relative residual"), std::string::npos);
 }
 
+// A sphere is meshed for radiosity (PrepareSceneFor) on every worker as `lightfarm render`
+// meshes it: the submission takes it, and the swept solve and the tiles give the local bits.
+TEST_F(Farm, RadiosityOfASceneWithASphereGivesTheLocalPixels) {
+    StartServer();
+    StartWorker("w1");
+    StartWorker("w2");
+    const std::string sphere = (dir_ / "sphere.json").string();
+    nlohmann::json scene = nlohmann::json::parse(ReadText(scene_));
+    scene["shapes"].push_back({{"type", "sphere"},
+                               {"name", "ball"},
+                               {"material", "white"},
+                               {"center", {0.4, 0.07, 0.13}},
+                               {"radius", 0.07}});
+    std::ofstream(sphere) << scene.dump();
+    const std::string flags = "--method radiosity --patches 300 --solver jacobi";
+    const std::string job = Submit(sphere, "--spp 2 --seed 6 --tile 16 --sweep-tasks 3 " + flags);
+    ExpectSameAsLocal(job, sphere, 2, 6, flags);
+}
+
 // One command line, two ways: `lightfarm render FLAGS` and `lightfarm submit FLAGS` then
 // `fetch` give the same pixels and the same header but for timings, whatever the method: path,
 // radiosity with its default solver (jacobi, which the farm solves in sweeps), adaptive, whitted.

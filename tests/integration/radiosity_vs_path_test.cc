@@ -13,6 +13,7 @@
 #include "lf/core/camera.h"
 #include "lf/core/patch_mesh.h"
 #include "lf/core/scene_loader.h"
+#include "lf/job/method_registry.h"
 #include "lf/kernels/path_tracer.h"
 #include "lf/kernels/radiosity.h"
 #include "lf/kernels/tile_renderer.h"
@@ -111,11 +112,13 @@ std::vector<int> Surfaces(const EmbreeScene& scene, const Camera& camera) {
 // A scene of tests/scenes at 64 x 64 and its path-traced reference.
 class RadiosityVsPath : public ::testing::Test {
   protected:
-    void Load(const std::string& file) {
+    // `edit` changes the scene before both methods render it.
+    void Load(const std::string& file, void (*edit)(Scene&) = nullptr) {
         auto loaded = LoadScene(std::string(LF_TEST_SCENES) + "/" + file);
         ASSERT_TRUE(loaded.ok()) << loaded.status();
         scene_ = std::move(*loaded);
         scene_.camera.width = scene_.camera.height = kResolution;
+        if (edit) edit(scene_);
         auto es = EmbreeScene::Build(scene_);
         ASSERT_TRUE(es.ok()) << es.status();
         embree_ = std::move(*es);
@@ -180,6 +183,40 @@ TEST_F(RadiosityVsPath, CornellBoxAgreesAndConvergesWithTheMesh) {
         EXPECT_NEAR(r.mean[k], path_surfaces.mean[k],
                     kSigmas * path_surfaces.error[k] + discretisation)
             << scene->meshes[k / 3].name << " channel " << k % 3;
+    }
+}
+
+// A white sphere on the Cornell box's floor, meshed as radiosity meshes it (PrepareSceneFor), so
+// both methods see one geometry: surface by surface (the sphere's pixels one of them), radiosity
+// is within 3 % of the path tracer plus its noise (5 sigma).
+TEST_F(RadiosityVsPath, CornellBoxWithASphereAgreesSurfaceBySurface) {
+    ASSERT_NO_FATAL_FAILURE(Load("cornell_box.json", [](Scene& scene) {
+        int white = 0;
+        while (scene.materials[size_t(white)].name != "white") ++white;
+        scene.spheres.push_back({"ball", white, Vec3d(0.4, 0.07, 0.13), 0.07});
+        PrepareSceneFor(Method::kRadiosity, scene);
+    }));
+    ASSERT_TRUE(scene_.spheres.empty());
+    const int ball = int(scene_.meshes.size()) - 1;
+    ASSERT_EQ(scene_.meshes[size_t(ball)].name, "ball");
+    RadiosityOptions options;
+    options.patches = 4000;
+    auto renderer = PrepareRadiosity(*embree_, options);
+    ASSERT_TRUE(renderer.ok()) << renderer.status();
+    const Image image = RenderImage(*camera_, **renderer, settings_).value().image;
+
+    const std::vector<int> surfaces = Surfaces(*embree_, *camera_);
+    const int count = int(scene_.meshes.size());
+    EXPECT_GT(std::count(surfaces.begin(), surfaces.end(), ball), 50);
+    const RegionMeans path = Means(path_, surfaces, count);
+    const RegionMeans radiosity = Means(image, surfaces, count);
+    for (size_t k = 0; k < path.mean.size(); ++k) {
+        const double p = path.mean[k];
+        if (p == 0) continue;  // a surface the camera does not see
+        std::printf("%-12s %d radiosity / path %.4f\n", scene_.meshes[k / 3].name.c_str(),
+                    int(k % 3), radiosity.mean[k] / p);
+        EXPECT_NEAR(radiosity.mean[k], p, 0.03 * p + kSigmas * path.error[k])
+            << scene_.meshes[k / 3].name << " channel " << k % 3;
     }
 }
 

@@ -18,6 +18,7 @@
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
 #include "lf/job/adaptive_plan.h"
+#include "lf/job/method_registry.h"
 #include "lf/job/shot.h"
 #include "lf/job/splat_settings.h"
 #include "lf/kernels/radiosity.h"
@@ -373,6 +374,7 @@ absl::Status Worker::PrepareScene(const TaskAssignment& task, const std::atomic<
     cache_.Trim();
     if (!scene.ok()) return scene.status();
     if (cancel) return cancelled();
+    PrepareSceneFor(MethodOf(task.spec), *scene);
     LoadedScene loaded;
     loaded.scene = std::make_unique<Scene>(std::move(*scene));
     // A shot's BVH is built for its first frame's pose (PoseFrame), a still's for the rest pose.

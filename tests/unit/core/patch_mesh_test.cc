@@ -335,9 +335,12 @@ TEST(PatchMesh, RefusesSplitsOutsideTheMesh) {
 }
 
 TEST(PatchMesh, RefusesWhatRadiosityCannotModel) {
+    // A sphere is meshed before (TessellateSpheres); one left over is refused, by name.
     Scene scene = OneTriangle();
     scene.spheres.push_back({"ball", 0, Vec3d(), 1});
-    EXPECT_EQ(PatchMesh::Build(scene, {}).status().code(), absl::StatusCode::kInvalidArgument);
+    auto sphere = PatchMesh::Build(scene, {});
+    EXPECT_EQ(sphere.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(sphere.status().message().find("sphere \"ball\" was not meshed"), std::string::npos);
     scene = OneTriangle();
     scene.materials[0].type = Material::Type::kInterface;
     auto interface = PatchMesh::Build(scene, {});
@@ -384,11 +387,15 @@ TEST(PatchMesh, RadiosityLimitationSaysWhy) {
     EXPECT_EQ(why([](Scene& s) { s.materials[0].double_sided = false; }),
               "material \"wood\" (mesh \"floor\") is single-sided, which radiosity does not "
               "model");
+    // Spheres are meshed (TessellateSpheres); their materials count like a mesh's.
+    EXPECT_EQ(why([](Scene& s) { s.spheres.push_back({"ball", 0, Vec3d(), 1}); }), "");
     EXPECT_EQ(why([](Scene& s) {
-                  s.spheres.push_back({"ball", 0, Vec3d(), 1});
+                  s.spheres.push_back({"ball", 1, Vec3d(), 1});
+                  s.materials.emplace_back().name = "glass";
+                  s.materials.back().double_sided = false;
               }),
-              "sphere \"ball\" cannot be meshed; radiosity supports triangle meshes and quads "
-              "only");
+              "material \"glass\" (sphere \"ball\") is single-sided, which radiosity does not "
+              "model");
     // Two-sided emission is modelled: both sides of an emitter's patches get unknowns.
     EXPECT_EQ(why([](Scene& s) { s.materials[0].two_sided_emission = true; }), "");
     // A material no shape uses does not matter.
@@ -402,6 +409,15 @@ TEST(PatchMesh, RadiosityLimitationSaysWhy) {
 }
 
 // What radiosity leaves out, by kind, each used material named once.
+TEST(PatchMesh, RadiosityDropsNamesASpheresMaterial) {
+    Scene scene = OneTriangle();
+    Material& chrome = scene.materials.emplace_back();
+    chrome.name = "chrome";
+    chrome.type = Material::Type::kMirror;
+    scene.spheres.push_back({"ball", 1, Vec3d(), 1});
+    EXPECT_EQ(RadiosityDrops(scene), "no diffuse part (rendered black): \"chrome\" (mirror)");
+}
+
 TEST(PatchMesh, RadiosityDropsNamesWhatItLeavesOut) {
     Scene scene = OneTriangle();
     EXPECT_EQ(RadiosityDrops(scene), "");

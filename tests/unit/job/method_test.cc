@@ -127,5 +127,26 @@ TEST(Method, OnlyThePathTracerAndBdptTakeMediaBeyondAbsorbers) {
     }
 }
 
+// Radiosity takes triangles only: its scene preparation meshes the spheres, and the scene hash
+// (the input's name) stays; every other method keeps the analytic spheres.
+TEST(Method, OnlyRadiosityMeshesSpheres) {
+    for (const MethodInfo& info : AllMethods()) {
+        Scene scene;
+        scene.materials.emplace_back();
+        scene.spheres.push_back({"ball", 0, Vec3d(), 1});
+        scene.content_hash = "input";
+        PrepareSceneFor(info.method, scene);
+        EXPECT_EQ(scene.content_hash, "input");
+        if (info.method == Method::kRadiosity) {
+            EXPECT_TRUE(scene.spheres.empty());
+            ASSERT_EQ(scene.meshes.size(), 1u);
+            EXPECT_EQ(scene.meshes[0].name, "ball");
+        } else {
+            EXPECT_EQ(scene.spheres.size(), 1u) << info.name;
+            EXPECT_TRUE(scene.meshes.empty()) << info.name;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lf

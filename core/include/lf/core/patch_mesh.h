@@ -30,8 +30,9 @@ namespace lf {
 
 // Why radiosity cannot model `scene` ("material \"leaf\" (mesh \"tree\") has an alpha mask,
 // which radiosity does not model"), or empty when it can: radiosity solves for one radiosity per
-// patch side, so it takes double-sided, opaque triangle meshes (no medium interfaces). What it
-// approximates instead of refusing, RadiosityDrops says. Only materials some mesh uses count.
+// patch side, so it takes double-sided, opaque triangle meshes (no medium interfaces), and
+// spheres as meshes (lf/core/sphere_mesh.h). What it approximates instead of refusing,
+// RadiosityDrops says. Only materials some mesh or sphere uses count.
 // `--method auto` logs it when it picks the path tracer.
 std::string RadiosityLimitation(const Scene& scene);
 
@@ -111,8 +112,8 @@ class PatchMesh {
         bool back = false;
     };
 
-    // Fails for what RadiosityLimitation names, which radiosity does not model, and for a
-    // split cell that is not in the mesh.
+    // Fails for what RadiosityLimitation names, which radiosity does not model, for a sphere
+    // (TessellateSpheres meshes them first) and for a split cell that is not in the mesh.
     static absl::StatusOr<PatchMesh> Build(const Scene& scene, const PatchMeshOptions& options);
 
     // The patch size used (derived from the target count if the options gave none).

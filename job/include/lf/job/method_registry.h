@@ -46,6 +46,8 @@ struct MethodInfo {
     bool adaptive;  // --target-error, --time-limit
     // Renders a shutter interval (--shutter): radiosity solves one instant per frame.
     bool motion_blur;
+    // Takes triangles only: PrepareSceneFor tessellates the spheres (radiosity's patches).
+    bool meshes_spheres;
     // The scenes the method cannot represent: why, as a status; nullptr when it takes any.
     // Whitted's omissions (lf::WhittedMissingTerms) are logged, not refused.
     absl::Status (*scene_refusal)(const Scene& scene);
@@ -68,6 +70,11 @@ Method MethodOf(const JobSpec& spec);
 // method and the pixel filter for a splatting method and a filter other than the box, or for a
 // splatting method and an orthographic camera; the method's scene_refusal otherwise.
 absl::Status CheckMethodTakesScene(Method method, const Scene& scene);
+// The scene as `method`'s kernels see it, made once after loading and before the BVH is built:
+// every render of it (local, the farm's workers, plan, converge) calls this, so all build the
+// same geometry and give the same bits. Radiosity: spheres become meshes (TessellateSpheres).
+// The scene's content hash, which names the input, is kept.
+void PrepareSceneFor(Method method, Scene& scene);
 // What only the path tracer and bdpt render of the scene's participating media: "" when every
 // medium is a homogeneous absorber (Beer's law: no scattering, no emission), no surface is an
 // interface and the camera is in vacuum, else why not ("medium \"fog\" scatters light
