@@ -366,6 +366,16 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     return out;
 }
 
+RadiosityReport RadiositySweepChunk::LinkReport() const {
+    RadiosityReport report;
+    if (!hierarchy_) return report;
+    report.cluster_links = hierarchy_->node_links();
+    report.side_links = hierarchy_->leaf_links();
+    report.link_bytes = hierarchy_->link_bytes();
+    report.solver_bytes = hierarchy_->bytes();
+    return report;
+}
+
 absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
                                                             std::span<const Rgb> b) const {
     if (int64_t(b.size()) != sides()) {

@@ -296,12 +296,17 @@ void Farm::WriteFrame(const std::string& job_id, int frame) {
 }
 
 absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
-                                 std::string_view sweep_result, const TaskTimes& times) {
+                                 std::string_view sweep_result, const TaskTimes& times,
+                                 const std::optional<RadiosityFigures>& links) {
     absl::StatusOr<SweepChunkResult> result = DecodeSweepResult(sweep_result);
     if (!result.ok()) return RefuseUndecodable(lease_id, worker, result.status());
     absl::StatusOr<Scheduler::Completion> done =
         scheduler_.Complete(lease_id, worker, TaskResult{.sweep = &*result, .times = times});
     if (!done.ok()) return done.status();
+    if (links && links->links > 0) {
+        std::lock_guard<std::mutex> lock(radiosity_mutex_);
+        sweep_links_[done->job_id][result->chunk] = *links;
+    }
     if (done->sweep && done->sweep->converged) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         sweep_solves_[done->job_id] = {done->sweep->iterations, done->sweep->residual};
@@ -342,6 +347,7 @@ void Farm::FinishJob(const std::string& job_id) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         radiosity_.erase(job_id);
         sweep_solves_.erase(job_id);
+        sweep_links_.erase(job_id);
     }
     if (absl::IsFailedPrecondition(written)) return;  // cancelled meanwhile
     scheduler_.Finish(job_id, written.ok() ? absl::StatusOr<std::string>(path)
@@ -370,6 +376,15 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
             if (auto solve = sweep_solves_.find(job.id); solve != sweep_solves_.end()) {
                 outcome.radiosity->iterations = solve->second.iterations;
                 outcome.radiosity->residual = solve->second.residual;
+            }
+            if (auto links = sweep_links_.find(job.id); links != sweep_links_.end()) {
+                RadiosityFigures& r = *outcome.radiosity;
+                for (const auto& [chunk, f] : links->second) {
+                    r.links += f.links;
+                    r.link_bytes += f.link_bytes;
+                    r.solver_bytes += f.solver_bytes;
+                }
+                r.links_per_side = double(r.links) / std::max<double>(1, double(r.unknowns));
             }
         }
     }

@@ -701,7 +701,10 @@ grpc::Status WorkerServiceImpl::CompleteTask(grpc::ServerContext* context, const
                   req.splats().empty() ? std::nullopt
                                        : std::optional<std::string_view>(req.splats()),
                   req.has_frame() ? std::optional<int>(req.frame()) : std::nullopt, parts, times)
-            : farm_.CompleteSweep(req.lease_id(), worker, req.radiosity_sweep(), times);
+            : farm_.CompleteSweep(req.lease_id(), worker, req.radiosity_sweep(), times,
+                                  req.has_radiosity()
+                                      ? std::optional<RadiosityFigures>(FromProto(req.radiosity()))
+                                      : std::nullopt);
     if (!s.ok()) {
         Log()->warn("{}", RefusedResultLine(req.lease_id(), worker, context->peer(),
                                             std::string(s.message())));

@@ -376,9 +376,12 @@ class Farm : public ::testing::Test {
             EXPECT_EQ(0, std::memcmp(x.data(), y->data(), x.size() * sizeof(float)))
                 << "channel " << ch << " differs from the local render";
         }
-        const std::set<std::string> timings = {"lightfarm.seconds",
-                                               "lightfarm.radiosity.formFactorSeconds",
-                                               "lightfarm.radiosity.solveSeconds"};
+        // Costs of the process that rendered: times, and hierarchical radiosity's memory (the
+        // farm's is the sum over its chunks, each holding the cluster tree).
+        const std::set<std::string> timings = {
+            "lightfarm.seconds", "lightfarm.radiosity.formFactorSeconds",
+            "lightfarm.radiosity.solveSeconds", "lightfarm.radiosity.linkBytes",
+            "lightfarm.radiosity.solverBytes"};
         std::set<std::string> farm_names, local_names;
         for (const auto& [name, value] : a->attributes) {
             if (name.rfind("lightfarm.", 0) == 0) farm_names.insert(name);

@@ -232,9 +232,10 @@ absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>
         result.frame = task.frame;
     }
     if (task.sweep >= 0) {
-        absl::StatusOr<std::string> swept = Sweep(task, cancel);
+        RadiosityFigures figures;
+        absl::StatusOr<std::string> swept = Sweep(task, cancel, figures);
         if (!swept.ok()) return swept.status();
-        result = {std::move(*swept), true, std::nullopt};
+        result = {std::move(*swept), true, figures};
         return absl::OkStatus();
     }
     if (UsesSplatPlan(task.spec.method)) {
@@ -438,7 +439,8 @@ absl::StatusOr<std::vector<Rgb>> Worker::ReadRadiosity(const std::string& hash) 
 }
 
 absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
-                                          const std::atomic<bool>& cancel) {
+                                          const std::atomic<bool>& cancel,
+                                          RadiosityFigures& figures) {
     const RadiositySettings& r = task.spec.radiosity;
     std::unique_ptr<RadiositySweepChunk>& chunk = loaded_.chunks[task.chunk];
     if (!chunk) {
@@ -473,6 +475,7 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
     absl::StatusOr<SweepChunkResult> result;
     arena_.execute([&] { result = chunk->Sweep(task.sweep, input); });
     if (!result.ok()) return result.status();
+    figures = RadiosityFiguresOf(chunk->LinkReport());
     return EncodeSweepResult(*result);
 }
 

@@ -152,6 +152,10 @@ class RadiositySweepChunk {
     // The chunk's part of one sweep from `b` (all sides); InvalidArgument when b is not one
     // value per side. Runs in the caller's TBB arena.
     absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> b) const;
+    // Hierarchical: the links of the chunk's receivers, their bytes and the chunk's solver bytes
+    // (the farm's header sums them over the chunks; the links add up to local mode's); zeros for
+    // the flat method.
+    RadiosityReport LinkReport() const;
 
   private:
     RadiositySweepChunk() = default;

@@ -101,8 +101,10 @@ class Farm {
                           const std::vector<ResultPart>& parts = {}, const TaskTimes& times = {});
     // A radiosity patch-group task's result (lf::EncodeSweepResult); when it ends a sweep,
     // stores the next sweep's input or the solution as a blob for the workers.
+    // `links`: the chunk's link figures (hierarchical radiosity), which the header sums.
     absl::Status CompleteSweep(const std::string& lease_id, const std::string& worker,
-                               std::string_view sweep_result, const TaskTimes& times = {});
+                               std::string_view sweep_result, const TaskTimes& times = {},
+                               const std::optional<RadiosityFigures>& links = std::nullopt);
 
     // The EXR of a succeeded job; with `preview`, also of a running one (what is merged so far).
     // A preview is written again only when a task was merged since the last one. A shot's
@@ -192,6 +194,9 @@ class Farm {
         int iterations = 0;
         double residual = 0;
     };
+    // Hierarchical sweeps: each chunk's link figures, by job id and chunk (soft state, as the
+    // solve: a restart solves again and reports them again).
+    std::map<std::string, std::map<int, RadiosityFigures>> sweep_links_;
     std::map<std::string, RadiosityFigures> radiosity_;      // by job id
     std::map<std::string, SweepSolveFigures> sweep_solves_;  // by job id
     std::unique_ptr<BlobStore> blobs_;

@@ -95,7 +95,9 @@ class Worker {
     absl::Status RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
                              ServerConnection::TaskResult& result, RenderStats& stats,
                              SplatList* frame_splats);
-    absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel);
+    // The chunk's sweep result, and in `figures` its link figures (RadiositySweepChunk::LinkReport).
+    absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel,
+                                      RadiosityFigures& figures);
     // A radiosity vector the server stored as a blob.
     absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
     // Hands the result to the sender thread, after the previous one was sent: the upload of a
