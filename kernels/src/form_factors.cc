@@ -658,7 +658,8 @@ Rgb SideAverage(const EmbreeScene& scene, const PatchMesh& mesh, const SideGeome
 
 }  // namespace
 
-std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mesh) {
+std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mesh,
+                                  const std::atomic<bool>* cancel) {
     const Scene& s = scene.scene();
     const std::vector<SideGeometry> sides = SideGeometries(scene, mesh);
     std::vector<Rgb> irradiance(sides.size());
@@ -675,6 +676,8 @@ std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mes
     if (s.environment) sky.emplace(*s.environment);
     if (delta.empty() && suns.empty() && !sky) return irradiance;
     tbb::parallel_for(size_t(0), sides.size(), [&](size_t i) {
+        // A sky costs hundreds of rays a side: a cancel must not wait for millions of sides.
+        if (cancel && cancel->load(std::memory_order_relaxed)) return;
         const SideGeometry& g = sides[i];
         const Vec3 n(g.n);
         Rgb& e = irradiance[i];

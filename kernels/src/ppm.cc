@@ -302,8 +302,8 @@ Rgb PpmRenderer::DirectLight(const SurfaceHit& hit, const Shading& sh, const Vec
                               u_light, stats);
     // Beer's law when the BSDF sample reaches an emitter through a solid's interior.
     auto transmittance = [&](const Vec3& w, bool transmitted, float distance) {
-        return Attenuation(scene_, transmitted ? MediumAfter(scene_.scene(), medium, hit, w) : medium,
-                           distance);
+        return Attenuation(
+            scene_, transmitted ? MediumAfter(scene_.scene(), medium, hit, w) : medium, distance);
     };
     // A delta lobe's sample is the path's next segment (Li), which counts what it hits.
     if (!bs || bs->delta || !(bs->pdf > 0)) return L;

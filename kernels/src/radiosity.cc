@@ -95,7 +95,8 @@ absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh
                                        const RadiosityOptions& options, double tolerance,
                                        RadiosityReport& report) {
     const auto start = std::chrono::steady_clock::now();
-    const RadiositySystem system = MakeRadiositySystem(scene, mesh, form_factors);
+    const RadiositySystem system = MakeRadiositySystem(scene, mesh, form_factors, options.cancel);
+    if (CancelRequested(options.cancel)) return FormFactorsCancelled();
     absl::StatusOr<SolveResult> solved =
         SolveRadiosity(system, {options.solver, tolerance, options.max_iterations, options.cancel});
     if (!solved.ok()) return solved.status();
@@ -118,7 +119,9 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> LinkHierarchy(const EmbreeSc
                                                                   const PatchMesh& mesh,
                                                                   const HierarchyOptions& options) {
     const FormFactors none;  // the system's E, ρ and A are all the hierarchy reads
-    return RadiosityHierarchy::Build(scene, mesh, MakeRadiositySystem(scene, mesh, none), options);
+    const RadiositySystem system = MakeRadiositySystem(scene, mesh, none, options.cancel);
+    if (CancelRequested(options.cancel)) return FormFactorsCancelled();
+    return RadiosityHierarchy::Build(scene, mesh, system, options);
 }
 
 // The hierarchical solve on one mesh; times and counts add up in `report`.
@@ -319,8 +322,9 @@ absl::Status CheckNoRefinement(const RadiosityOptions& options) {
 }  // namespace
 
 RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& mesh,
-                                    const FormFactors& form_factors) {
-    const std::vector<Rgb> irradiance = DirectIrradiance(scene, mesh);
+                                    const FormFactors& form_factors,
+                                    const std::atomic<bool>* cancel) {
+    const std::vector<Rgb> irradiance = DirectIrradiance(scene, mesh, cancel);
     RadiositySides sides = RadiositySurfaces(scene).Sides(mesh);
     RadiositySystem system;
     system.form_factors = &form_factors;
@@ -362,7 +366,8 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     out->form_factors_ = ComputeFormFactors(scene, *mesh, ff_options);
     if (CancelRequested(cancel)) return FormFactorsCancelled();
     out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
-    out->system_ = MakeRadiositySystem(scene, *mesh, out->form_factors_);
+    out->system_ = MakeRadiositySystem(scene, *mesh, out->form_factors_, cancel);
+    if (CancelRequested(cancel)) return FormFactorsCancelled();
     return out;
 }
 

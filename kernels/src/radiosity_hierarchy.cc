@@ -232,6 +232,7 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
         return absl::InvalidArgumentError(
             absl::StrFormat("radiosity: link error %g must be > 0", options.link_error));
     }
+    if (absl::Status status = CheckRadiosityValues(system); !status.ok()) return status;
     std::unique_ptr<RadiosityHierarchy> h(new RadiosityHierarchy());
     // The sides' geometry serves the tree and the linking, then goes.
     const PairEvaluator evaluator(scene, mesh);

@@ -27,6 +27,13 @@ absl::Status Validate(const RadiositySystem& system) {
         system.reflectance.size() != n || system.area.size() != n) {
         return absl::InvalidArgumentError("radiosity: inconsistent system sizes");
     }
+    return CheckRadiosityValues(system);
+}
+
+}  // namespace
+
+absl::Status CheckRadiosityValues(const RadiositySystem& system) {
+    const size_t n = system.emission.size();
     bool emission = false;
     int32_t bright = -1;
     for (size_t i = 0; i < n; ++i) {
@@ -48,6 +55,8 @@ absl::Status Validate(const RadiositySystem& system) {
     }
     return absl::OkStatus();
 }
+
+namespace {
 
 absl::Status NotConverged(int sweeps, double residual, double tolerance) {
     return absl::ResourceExhaustedError(absl::StrFormat(

@@ -232,6 +232,27 @@ TEST(RadiosityHierarchy, LinksPerSideStayBounded) {
     EXPECT_LT(per_side[1], 1.5 * per_side[0]);
 }
 
+// The solver's checks of E and rho hold on this path too: a side reflecting everything in an
+// emitting scene has no finite solution, and a NaN would spread through every sweep.
+TEST(RadiosityHierarchy, RefusesReflectanceOfOneAndNonFiniteValuesNamingTheSide) {
+    const Scene scene = CornellBox();
+    auto es = EmbreeScene::Build(scene);
+    ASSERT_TRUE(es.ok()) << es.status();
+    auto mesh = PatchMesh::Build(scene, {0, 200});
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    const FormFactors none;
+    RadiositySystem bright = MakeRadiositySystem(**es, *mesh, none);
+    bright.reflectance[3] = Rgb(1, 0.5f, 0.5f);
+    auto h = RadiosityHierarchy::Build(**es, *mesh, bright, {});
+    EXPECT_EQ(h.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(h.status().message().find("at side 3"), std::string::npos) << h.status();
+    RadiositySystem nan = MakeRadiositySystem(**es, *mesh, none);
+    nan.emission[5] = Rgb(NAN, 0, 0);
+    h = RadiosityHierarchy::Build(**es, *mesh, nan, {});
+    EXPECT_EQ(h.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(h.status().message().find("side 5"), std::string::npos) << h.status();
+}
+
 // The farm's way: chunks of the groups swept against each sweep's radiosity, the sums added by
 // RadiositySolve, give PrepareRadiosity's bits for any chunk count.
 TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {

@@ -181,6 +181,9 @@ double PointToPolygonFormFactor(const Vec3d& x, const Vec3d& n, std::span<const 
 // directions uniform in its cone per point, an environment (uniform or a map) 64
 // cosine-weighted directions per point. The directions are deterministic (consecutive runs of
 // the Sobol sequence), so the result does not depend on the thread count.
-std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mesh);
+// Set `cancel` from another thread: the remaining sides are skipped (the result is then
+// unusable; the caller checks the flag).
+std::vector<Rgb> DirectIrradiance(const EmbreeScene& scene, const PatchMesh& mesh,
+                                  const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace lf

@@ -174,9 +174,10 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity);
 
 // The system B = E + ρ F B of `mesh`: E the exitance π L_e of emitters' front sides plus the
-// point lights' direct light reflected.
+// lights' direct light reflected. After `cancel` is set the system is unusable: callers check it.
 RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& mesh,
-                                    const FormFactors& form_factors);
+                                    const FormFactors& form_factors,
+                                    const std::atomic<bool>* cancel = nullptr);
 
 // Options from plain values, as `render`, `submit` and the farm's workers receive them;
 // InvalidArgument naming a bad solver or display name.

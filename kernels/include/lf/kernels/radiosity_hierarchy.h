@@ -35,7 +35,7 @@ namespace lf {
 inline constexpr int32_t kHierarchyGroupSize = 256;
 
 struct HierarchyOptions {
-    double link_error = 1e-3;  // of the scene's emitted power, per link
+    double link_error = 1e-4;  // of the scene's emitted power, per link
     int32_t group_size = kHierarchyGroupSize;
     // Link only the groups of chunk `chunk` of `chunks` (ChunkGroups).
     int chunk = 0, chunks = 1;

@@ -57,6 +57,11 @@ struct SolveResult {
     double residual = 0;  // relative residual of `radiosity`, computed exactly
 };
 
+// InvalidArgument for negative or non-finite emission or reflectance, and for a reflectance of 1
+// or more while the scene emits (no finite solution), naming the side. SolveRadiosity and the
+// hierarchical solver check it before any work.
+absl::Status CheckRadiosityValues(const RadiositySystem& system);
+
 // Fails without iterating if a reflectance is 1 or more while there is emission (no finite
 // solution), and if the iteration cap is reached first.
 absl::StatusOr<SolveResult> SolveRadiosity(const RadiositySystem& system,
