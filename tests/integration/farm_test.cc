@@ -1403,9 +1403,11 @@ TEST_F(Farm, GridMediumFileIsUploadedAndGivesTheLocalBits) {
 }
 
 // Files named inside files (an OBJ's MTL, the MTL's texture) are uploaded with the scene: the
-// server finds them and refuses radiosity for the texture, not for a missing file.
+// server finds them, and a worker renders the textured radiosity (which averages the texture
+// per patch) with local mode's bits, which it could not without the texture.
 TEST_F(Farm, FilesAnObjNamesAreUploadedWithTheScene) {
     StartServer();
+    StartWorker("w1");
     fs::create_directories(dir_ / "models");
     std::ofstream(dir_ / "models" / "box.obj")
         << "mtllib box.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl wood\nf 1/1 2/1 3/1\n";
@@ -1416,13 +1418,9 @@ TEST_F(Farm, FilesAnObjNamesAreUploadedWithTheScene) {
     scene["shapes"].push_back({{"type", "mesh"}, {"file", "models/box.obj"}});
     const std::string textured = (dir_ / "textured.json").string();
     std::ofstream(textured) << scene.dump();
-    const CliRun r = Farmctl("submit " + textured + " --method radiosity");
-    EXPECT_NE(r.status, 0);
-    EXPECT_NE(r.err.find("radiosity: material \"models/box.mtl#wood\" (mesh "), std::string::npos)
-        << r.err;
-    EXPECT_NE(r.err.find("has a texture (base_color_texture \"models/wood.png\")"),
-              std::string::npos)
-        << r.err;
+    const std::string flags = "--method radiosity --patches 300";
+    const std::string job = Submit(textured, "--spp 2 --seed 3 --tile 16 " + flags);
+    ExpectSameAsLocal(job, textured, 2, 3, flags);
 }
 
 TEST_F(Farm, JobsAboveTheLimitsAreRefusedWithTheLimitNamed) {
