@@ -12,7 +12,7 @@
 # two 1-thread workers against `lightfarm render --threads 2`, N rounds, for each solver.
 #
 #   tools/radiosity_bench.sh [--scenes cornell,10k,100k,1M] [--solvers flat,hierarchical]
-#       [--link-error 0.01] [--spp 16] [--ref-spp 256] [--threads 2] [--timeout 900]
+#       [--link-error 1e-4] [--spp 16] [--ref-spp 256] [--threads 2] [--timeout 900]
 #       [--farm-rounds 0] [--out DIR]
 #
 # Flat is skipped above 20k triangles (its form factors are n^2: ~240 MiB at 10k patches, 24 GB
@@ -24,7 +24,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin="${LF_BIN_DIR:-build/bin}"
-scenes=cornell,10k,100k,1M solvers=flat,hierarchical link_error=0.01 spp=16 ref_spp=256
+scenes=cornell,10k,100k,1M solvers=flat,hierarchical link_error=1e-4 spp=16 ref_spp=256
 threads=2 timeout=900 farm_rounds=0 out=""
 usage="usage: $0 [--scenes LIST] [--solvers LIST] [--link-error E] [--spp N] [--ref-spp N]"
 usage+=" [--threads N] [--timeout S] [--farm-rounds N] [--out DIR]"

@@ -126,11 +126,14 @@ absl::StatusOr<std::unique_ptr<PosedKernels>> BuildKernels(const Scene& scene,
         k->radiosity_seconds = absl::ToDoubleSeconds(absl::Now() - solve_start);
         k->radiosity = RadiosityFiguresOf(rep);
         k->mesh_seconds = rep.mesh_seconds;
+        // Hierarchical: links instead of form factors, and the solver's whole memory.
+        const bool links = rep.cluster_links + rep.side_links > 0;
         log->info(
-            "job={} radiosity: {} patches, {} unknowns, {}, residual {:.2e}, form "
-            "factors {:.2f} s ({} MiB), solve {:.2f} s",
+            "job={} radiosity: {} patches, {} unknowns, {}, residual {:.2e}, {} {:.2f} s ({} "
+            "MiB), solve {:.2f} s",
             job_id, rep.patches, rep.sides, Plural(rep.iterations, "iteration"), rep.residual,
-            rep.form_factor_seconds, rep.form_factor_bytes >> 20, rep.solve_seconds);
+            links ? "links" : "form factors", rep.form_factor_seconds,
+            (links ? rep.solver_bytes : rep.form_factor_bytes) >> 20, rep.solve_seconds);
         for (size_t pass = 0; pass < rep.refinement.size(); ++pass) {
             const RadiosityRefinementPass& p = rep.refinement[pass];
             log->info(
