@@ -1207,11 +1207,7 @@ TEST_F(Farm, ServerKilledMidSolveStillGivesTheLocalPixels) {
     StartWorker("w2");
     const std::string flags = "--method radiosity --patches 300 --solver jacobi";
     const std::string job = Submit(scene_, "--spp 2 --seed 8 --tile 16 " + flags);
-    const auto deadline = Clock::now() + milliseconds(30000);
-    while (ReadText(dir_ / "server-1.log").find("radiosity sweep 3:") == std::string::npos &&
-           Clock::now() < deadline) {
-        std::this_thread::sleep_for(milliseconds(2));
-    }
+    ASSERT_TRUE(WaitForText(dir_ / "server-1.log", "radiosity sweep 3:", milliseconds(60000)));
     CrashAndRestartServer();
     ExpectSameAsLocal(job, scene_, 2, 8, flags);
     EXPECT_NE(ReadText(dir_ / "server-2.log").find("radiosity sweep 1:"), std::string::npos);
@@ -1228,11 +1224,7 @@ TEST_F(Farm, HierarchicalSweepsSurviveAWorkerKillAndAServerRestartWithTheLocalPi
         "--method radiosity --patches 1500 --radiosity hierarchical --link-error 1e-4";
     const std::string job = Submit(scene_, "--spp 2 --seed 8 --tile 16 --sweep-tasks 3 " + flags);
     ASSERT_TRUE(KillMidTask(doomed, "doomed.log"));
-    const auto deadline = Clock::now() + milliseconds(60000);
-    while (ReadText(dir_ / "server-1.log").find("radiosity sweep 3:") == std::string::npos &&
-           Clock::now() < deadline) {
-        std::this_thread::sleep_for(milliseconds(2));
-    }
+    ASSERT_TRUE(WaitForText(dir_ / "server-1.log", "radiosity sweep 3:", milliseconds(60000)));
     CrashAndRestartServer();
     ExpectSameAsLocal(job, scene_, 2, 8, flags);
     EXPECT_NE(ReadText(dir_ / "server-2.log").find("radiosity sweep 1:"), std::string::npos);
