@@ -1,13 +1,27 @@
 #include "lf/job/sweep_execution.h"
 
+#include <algorithm>
+
 #include "absl/strings/str_cat.h"
+#include "lf/job/job_spec.h"
 
 namespace lf {
+
+RenderPlanSettings SweepExecution::DisplayPlan(RenderPlanSettings plan, uint32_t aovs) {
+    const int limit = aovs == 0 ? kMaxFarmTile : kMaxFarmAovTile;
+    const uint64_t pass_spp = std::max<uint64_t>(1, plan.spp / uint64_t(std::max(1, plan.passes)));
+    while (plan.tile < limit && uint64_t(plan.tile) * uint64_t(plan.tile) * pass_spp <
+                                    kMinDisplayTaskSamples) {
+        plan.tile = std::min(2 * plan.tile, limit);
+    }
+    return plan;
+}
 
 absl::StatusOr<std::unique_ptr<SweepExecution>> SweepExecution::Make(
     const RenderPlanSettings& plan, const RadiositySettings& radiosity,
     const TileStoreFactory& tile_stores, uint32_t aovs) {
-    absl::StatusOr<std::unique_ptr<TileMerger>> merger = PlanTiles(plan, tile_stores, aovs);
+    absl::StatusOr<std::unique_ptr<TileMerger>> merger =
+        PlanTiles(DisplayPlan(plan, aovs), tile_stores, aovs);
     if (!merger.ok()) return merger.status();
     return std::unique_ptr<SweepExecution>(
         new SweepExecution(std::move(*merger), plan.spp, radiosity));

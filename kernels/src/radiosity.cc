@@ -381,15 +381,28 @@ RadiosityReport RadiositySweepChunk::LinkReport() const {
     return report;
 }
 
+std::vector<NodeExitance> RadiositySweepChunk::Pull(std::span<const Rgb> b) const {
+    if (!hierarchy_ || int64_t(b.size()) != sides()) return {};
+    return hierarchy_->Pull(b);
+}
+
 absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
                                                             std::span<const Rgb> b) const {
+    return Sweep(sweep, b, Pull(b));
+}
+
+absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
+    int32_t sweep, std::span<const Rgb> b, std::span<const NodeExitance> pulled) const {
     if (int64_t(b.size()) != sides()) {
         return absl::InvalidArgumentError(absl::StrFormat(
             "radiosity sweep %d: %d values for %d unknowns", sweep, b.size(), sides()));
     }
+    if (hierarchy_ && pulled.size() != hierarchy_->tree().nodes().size()) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("radiosity sweep %d: a pull of %d nodes for a tree of %d", sweep,
+                            pulled.size(), hierarchy_->tree().nodes().size()));
+    }
     const auto& groups = hierarchy_ ? hierarchy_->groups() : form_factors_.groups();
-    const std::vector<NodeExitance> pulled =
-        hierarchy_ ? hierarchy_->Pull(b) : std::vector<NodeExitance>();
     const auto [g0, g1] = groups_;
     SweepChunkResult r;
     r.sweep = sweep;

@@ -198,6 +198,11 @@ std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(
     return ended_.FindRequest(request_id);
 }
 
+bool Scheduler::IsActive(const std::string& job_id) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return active_.count(job_id) > 0;
+}
+
 absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
     {
         std::lock_guard<std::mutex> lock(mutex_);

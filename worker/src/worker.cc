@@ -426,6 +426,8 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic
     loaded_.chunks.clear();
     loaded_.input.clear();
     loaded_.input_hash.clear();
+    loaded_.pulled.clear();
+    loaded_.pulled_hash.reset();
     return absl::OkStatus();
 }
 
@@ -473,7 +475,13 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
         input = loaded_.input;
     }
     absl::StatusOr<SweepChunkResult> result;
-    arena_.execute([&] { result = chunk->Sweep(task.sweep, input); });
+    arena_.execute([&] {
+        if (loaded_.pulled_hash != task.radiosity_hash) {
+            loaded_.pulled = chunk->Pull(input);
+            loaded_.pulled_hash = task.radiosity_hash;
+        }
+        result = chunk->Sweep(task.sweep, input, loaded_.pulled);
+    });
     if (!result.ok()) return result.status();
     figures = RadiosityFiguresOf(chunk->LinkReport());
     return EncodeSweepResult(*result);

@@ -185,7 +185,8 @@ SweepChunkResult DarkChunk(int sweep) {
 TEST(SweepExecution, SolvesBeforeTheTilesAndHandsTheSolutionOn) {
     RadiositySettings radiosity;
     radiosity.sweep_tasks = 1;
-    auto made = SweepExecution::Make({16, 8, 4, 8, 1}, radiosity, MakeMemoryTileStore);
+    // 8x8 tiles of 4096 samples a pixel: enough work a task to be kept as asked.
+    auto made = SweepExecution::Make({16, 8, 4096, 8, 1}, radiosity, MakeMemoryTileStore);
     ASSERT_TRUE(made.ok()) << made.status();
     SweepExecution& e = **made;
     EXPECT_EQ(e.Start(), std::vector<int>{2});  // sweep 0's chunk, after the two tiles
@@ -215,6 +216,25 @@ TEST(SweepExecution, SolvesBeforeTheTilesAndHandsTheSolutionOn) {
     std::set<std::string> blobs;
     e.AddBlobsInUse(blobs);
     EXPECT_EQ(blobs, std::set<std::string>{"solution-hash"});
+}
+
+// Display tiles of few samples are widened until a task holds 2^18 samples a pass, up to the
+// farm's tile limit (lower with AOVs); tiles of enough samples stay as asked.
+TEST(SweepExecution, WidensTheDisplayTilesOfCheapTasks) {
+    auto tile = [](RenderPlanSettings plan, uint32_t aovs) {
+        return SweepExecution::DisplayPlan(plan, aovs).tile;
+    };
+    EXPECT_EQ(tile({256, 256, 16, 32, 1}, 0), 128);  // 128^2 x 16 = 2^18
+    EXPECT_EQ(tile({256, 256, 16, 32, 4}, 0), kMaxFarmTile);
+    EXPECT_EQ(tile({256, 256, 16, 32, 4}, 1), kMaxFarmAovTile);
+    EXPECT_EQ(tile({256, 256, 256, 32, 1}, 0), 32);
+    EXPECT_EQ(tile({256, 256, 64, 24, 1}, 0), 96);
+    EXPECT_EQ(tile({256, 256, 1, 150, 1}, 0), kMaxFarmTile);
+    const RenderPlanSettings plan{64, 48, 16, 32, 1};
+    absl::StatusOr<std::unique_ptr<SweepExecution>> made =
+        SweepExecution::Make(plan, RadiositySettings(), MakeMemoryTileStore);
+    ASSERT_TRUE(made.ok()) << made.status();
+    EXPECT_EQ((*made)->tasks_total(), 1) << "one 64x48 display task";
 }
 
 TEST(MakeJobExecution, ChoosesTheKindFromTheSpec) {

@@ -18,6 +18,12 @@ namespace lf {
 
 class SweepExecution : public TileExecution {
   public:
+    // A display tile's sample costs about one ray: tiles of fewer samples a pass than this are
+    // widened (up to the farm's tile limit), so a task's lease and result round trip stay small
+    // beside its work. The pixels do not depend on the tiles.
+    static constexpr uint64_t kMinDisplayTaskSamples = uint64_t(1) << 18;
+    static RenderPlanSettings DisplayPlan(RenderPlanSettings plan, uint32_t aovs);
+
     static absl::StatusOr<std::unique_ptr<SweepExecution>> Make(const RenderPlanSettings& plan,
                                                                 const RadiositySettings& radiosity,
                                                                 const TileStoreFactory& tile_stores,

@@ -152,6 +152,12 @@ class RadiositySweepChunk {
     // The chunk's part of one sweep from `b` (all sides); InvalidArgument when b is not one
     // value per side. Runs in the caller's TBB arena.
     absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> b) const;
+    // Hierarchical: the pull of `b` over the whole tree, the same for every chunk of a system
+    // (a worker holding several chunks pulls once a sweep); empty for the flat method.
+    std::vector<NodeExitance> Pull(std::span<const Rgb> b) const;
+    // Sweep with `pulled` = Pull(b) of this chunk or of another of the same system.
+    absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> b,
+                                           std::span<const NodeExitance> pulled) const;
     // Hierarchical: the links of the chunk's receivers, their bytes and the chunk's solver bytes
     // (the farm's header sums them over the chunks; the links add up to local mode's); zeros for
     // the flat method.

@@ -62,10 +62,13 @@ class Worker {
         std::unique_ptr<RadianceEstimator> tracer;  // path or Whitted tracer, radiosity display
         std::unique_ptr<SplatRenderer> frame;       // a splatting method's (light, bdpt, ppm)
         // Radiosity solved in sweeps: the form-factor rows of the chunks this worker swept
-        // (the server gives a chunk back to the worker that has its rows), and the last input.
+        // (the server gives a chunk back to the worker that has its rows), and the last input
+        // and its pull (hierarchical; the same for all the chunks, so pulled once a sweep).
         std::map<int, std::unique_ptr<RadiositySweepChunk>> chunks;
         std::string input_hash;
         std::vector<Rgb> input;
+        std::optional<std::string> pulled_hash;  // the input pulled; "": the emission
+        std::vector<NodeExitance> pulled;
         // A shot's: the frame the scene is posed at (the BVH, camera and kernels are of it).
         std::optional<int> posed_frame;
     };
