@@ -10,8 +10,8 @@ namespace lf {
 RenderPlanSettings SweepExecution::DisplayPlan(RenderPlanSettings plan, uint32_t aovs) {
     const int limit = aovs == 0 ? kMaxFarmTile : kMaxFarmAovTile;
     const uint64_t pass_spp = std::max<uint64_t>(1, plan.spp / uint64_t(std::max(1, plan.passes)));
-    while (plan.tile < limit && uint64_t(plan.tile) * uint64_t(plan.tile) * pass_spp <
-                                    kMinDisplayTaskSamples) {
+    while (plan.tile < limit &&
+           uint64_t(plan.tile) * uint64_t(plan.tile) * pass_spp < kMinDisplayTaskSamples) {
         plan.tile = std::min(2 * plan.tile, limit);
     }
     return plan;

@@ -319,6 +319,29 @@ absl::Status CheckNoRefinement(const RadiosityOptions& options) {
     return absl::OkStatus();
 }
 
+absl::Status CheckSolutionSize(const std::vector<Rgb>& radiosity, const PatchMesh& mesh) {
+    if (radiosity.size() == mesh.sides().size()) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrFormat("radiosity: a solution of %d values for a mesh of %d unknowns",
+                        radiosity.size(), mesh.sides().size()));
+}
+
+// The display of a solution solved elsewhere, in mesh order.
+std::unique_ptr<RadiosityRenderer> RendererOfSolution(const EmbreeScene& scene,
+                                                      const RadiosityOptions& options,
+                                                      PatchMesh mesh, std::vector<Rgb> radiosity) {
+    RadiosityReport report;
+    report.patches = int64_t(mesh.patches().size());
+    report.sides = int64_t(mesh.sides().size());
+    report.patch_size = mesh.patch_size();
+    // As PrepareRadiosity reports it, so the farm's EXR header says what local mode's does.
+    const DiscretisationError error = EstimateDiscretisationError(mesh, radiosity);
+    report.estimated_error = error.max;
+    report.mean_estimated_error = error.mean;
+    return std::make_unique<RadiosityRenderer>(scene, std::move(mesh), std::move(radiosity),
+                                               options.display, report);
+}
+
 }  // namespace
 
 RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& mesh,
@@ -357,6 +380,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
         if (!linked.ok()) return linked.status();
         out->hierarchy_ = std::move(*linked);
         out->groups_ = out->hierarchy_->linked_groups();
+        out->mesh_ = std::move(*mesh);
         return out;
     }
     FormFactorOptions ff_options;
@@ -368,6 +392,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
     out->system_ = MakeRadiositySystem(scene, *mesh, out->form_factors_, cancel);
     if (CancelRequested(cancel)) return FormFactorsCancelled();
+    out->mesh_ = std::move(*mesh);
     return out;
 }
 
@@ -426,6 +451,13 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
     return r;
 }
 
+absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiositySweepChunk::Renderer(
+    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity) const {
+    if (absl::Status status = CheckSolutionSize(radiosity, mesh_); !status.ok()) return status;
+    if (hierarchy_) radiosity = hierarchy_->tree().ToMeshOrder(radiosity);
+    return RendererOfSolution(scene, options, mesh_, std::move(radiosity));
+}
+
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity) {
     if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
@@ -433,27 +465,14 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
     mesh_options.cancel = options.cancel;
     absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(scene.scene(), mesh_options);
     if (!mesh.ok()) return mesh.status();
-    if (radiosity.size() != mesh->sides().size()) {
-        return absl::InvalidArgumentError(
-            absl::StrFormat("radiosity: a solution of %d values for a mesh of %d unknowns",
-                            radiosity.size(), mesh->sides().size()));
-    }
+    if (absl::Status status = CheckSolutionSize(radiosity, *mesh); !status.ok()) return status;
     if (options.hierarchical) {
         absl::StatusOr<ClusterTree> tree =
             ClusterTree::Build(SideGeometries(scene, *mesh), options.cancel);
         if (!tree.ok()) return tree.status();
         radiosity = tree->ToMeshOrder(radiosity);
     }
-    RadiosityReport report;
-    report.patches = int64_t(mesh->patches().size());
-    report.sides = int64_t(mesh->sides().size());
-    report.patch_size = mesh->patch_size();
-    // As PrepareRadiosity reports it, so the farm's EXR header says what local mode's does.
-    const DiscretisationError error = EstimateDiscretisationError(*mesh, radiosity);
-    report.estimated_error = error.max;
-    report.mean_estimated_error = error.mean;
-    return std::make_unique<RadiosityRenderer>(scene, std::move(*mesh), std::move(radiosity),
-                                               options.display, report);
+    return RendererOfSolution(scene, options, std::move(*mesh), std::move(radiosity));
 }
 
 RadiosityRenderer::RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh,

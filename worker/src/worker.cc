@@ -414,7 +414,11 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic
     if (!task.radiosity_hash.empty()) {  // solved by the farm's sweeps
         absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task.radiosity_hash);
         if (!solution.ok()) return solution.status();
-        renderer = RadiosityRendererFor(*loaded_.embree, *options, std::move(*solution));
+        // A chunk this worker swept has the mesh (and cluster tree) the display needs.
+        renderer = loaded_.chunks.empty()
+                       ? RadiosityRendererFor(*loaded_.embree, *options, std::move(*solution))
+                       : loaded_.chunks.begin()->second->Renderer(*loaded_.embree, *options,
+                                                                  std::move(*solution));
     } else {
         // Every worker of the job solves the same system to the same bits (the solver is
         // deterministic for any thread count), so its tiles match `lightfarm render`.

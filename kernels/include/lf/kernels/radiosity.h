@@ -162,10 +162,16 @@ class RadiositySweepChunk {
     // (the farm's header sums them over the chunks; the links add up to local mode's); zeros for
     // the flat method.
     RadiosityReport LinkReport() const;
+    // RadiosityRendererFor with this chunk's mesh (and cluster tree), which are those of every
+    // chunk of the system: not built again for the display. `options` as the chunk was built.
+    absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Renderer(const EmbreeScene& scene,
+                                                                const RadiosityOptions& options,
+                                                                std::vector<Rgb> radiosity) const;
 
   private:
     RadiositySweepChunk() = default;
     int chunk_ = 0;
+    PatchMesh mesh_;
     std::pair<int32_t, int32_t> groups_;
     FormFactors form_factors_;  // the chunk's rows only
     RadiositySystem system_;

@@ -98,7 +98,8 @@ class Worker {
     absl::Status RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
                              ServerConnection::TaskResult& result, RenderStats& stats,
                              SplatList* frame_splats);
-    // The chunk's sweep result, and in `figures` its link figures (RadiositySweepChunk::LinkReport).
+    // The chunk's sweep result, and in `figures` its link figures
+    // (RadiositySweepChunk::LinkReport).
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel,
                                       RadiosityFigures& figures);
     // A radiosity vector the server stored as a blob.
