@@ -128,7 +128,9 @@ Command AddSubmitCommand(CLI::App& app) {
                     "most bounces per path; -1 = unlimited (Russian roulette ends paths)")
         ->capture_default_str()
         ->check(CLI::Range(-1, kMaxDepthLimit));
-    cmd->add_option("--tile", o->spec.plan.tile, "tile side in pixels")
+    cmd->add_option("--tile", o->spec.plan.tile,
+                    "tile side in pixels (a swept radiosity job's display tiles are widened to "
+                    "2^18 samples a pass)")
         ->capture_default_str()
         ->check(CLI::Range(1, kMaxFarmTile));
     cmd->add_option("--passes", o->spec.plan.passes,
