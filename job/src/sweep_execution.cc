@@ -61,7 +61,11 @@ void SweepExecution::Lease(int task, const std::string& worker, TaskAssignment& 
         lease.radiosity_hash = solution_;
         return;
     }
-    chunk_owner_[at->chunk] = worker;
+    // The worker of a task's first lease owns the chunk: a second lease of the same task (a
+    // straggler's copy, or a retry) must not move the chunk, and with it every later sweep of
+    // it, to a worker that then holds more chunks than the others.
+    ChunkOwner& owner = chunk_owner_[at->chunk];
+    if (owner.task != task) owner = {task, worker};
     lease.task.index = task;
     lease.sweep = at->sweep;
     lease.chunk = at->chunk;
@@ -72,7 +76,7 @@ std::string SweepExecution::PreferredWorker(int task) const {
     const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(task);
     if (!at) return "";
     auto owner = chunk_owner_.find(at->chunk);
-    return owner == chunk_owner_.end() ? "" : owner->second;
+    return owner == chunk_owner_.end() ? "" : owner->second.worker;
 }
 
 void SweepExecution::Describe(int task, TaskStatus& status) const {

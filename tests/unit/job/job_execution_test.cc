@@ -218,6 +218,43 @@ TEST(SweepExecution, SolvesBeforeTheTilesAndHandsTheSolutionOn) {
     EXPECT_EQ(blobs, std::set<std::string>{"solution-hash"});
 }
 
+// A chunk belongs to the worker of its task's first lease: a straggler's second lease of the
+// same task leaves it there (else that worker would take every later sweep of the chunk); the
+// next sweep's task of a chunk whose owner is gone goes to whoever leases it.
+TEST(SweepExecution, ASecondLeaseOfATaskLeavesTheChunkWithItsOwner) {
+    RadiositySettings radiosity;
+    radiosity.sweep_tasks = 2;
+    auto made = SweepExecution::Make({16, 8, 4096, 8, 1}, radiosity, MakeMemoryTileStore);
+    ASSERT_TRUE(made.ok()) << made.status();
+    SweepExecution& e = **made;
+    const std::vector<int> sweep0 = e.Start();
+    ASSERT_EQ(sweep0.size(), 2u);
+    TaskAssignment lease;
+    e.Lease(sweep0[0], "a", lease);
+    e.Lease(sweep0[1], "b", lease);
+    e.Lease(sweep0[1], "a", lease);  // the straggler's copy
+    EXPECT_EQ(e.PreferredWorker(sweep0[0]), "a");
+    EXPECT_EQ(e.PreferredWorker(sweep0[1]), "b");
+    // Two unknowns, one a chunk, lit: sweep 0 does not converge.
+    for (int chunk : {0, 1}) {
+        SweepChunkResult r = DarkChunk(0);
+        r.chunk = chunk;
+        r.sides = 2;
+        r.side_begin = chunk;
+        r.output = {Rgb(1)};
+        r.change = {1};
+        absl::StatusOr<JobExecution::Merged> merged = e.Merge(sweep0[size_t(chunk)], {.sweep = &r});
+        ASSERT_TRUE(merged.ok()) << merged.status();
+    }
+    absl::StatusOr<std::vector<int>> sweep1 = e.Publish(false, "b1-hash");
+    ASSERT_TRUE(sweep1.ok()) << sweep1.status();
+    ASSERT_EQ(sweep1->size(), 2u);
+    EXPECT_EQ(e.PreferredWorker((*sweep1)[0]), "a");
+    EXPECT_EQ(e.PreferredWorker((*sweep1)[1]), "b");
+    e.Lease((*sweep1)[0], "b", lease);  // "a" is gone: the scheduler let "b" take it
+    EXPECT_EQ(e.PreferredWorker((*sweep1)[0]), "b");
+}
+
 // Display tiles of few samples are widened until a task holds 2^18 samples a pass, up to the
 // farm's tile limit (lower with AOVs); tiles of enough samples stay as asked.
 TEST(SweepExecution, WidensTheDisplayTilesOfCheapTasks) {

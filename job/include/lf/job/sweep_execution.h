@@ -2,7 +2,8 @@
 // SweepTaskNumbering after the tiles) come first, a sweep at a time, each sweep's result stored
 // by the caller as a blob (Publish); once solved, the display tiles, which read the solution.
 // A chunk goes back to the worker that did it before, which keeps its form-factor rows; that is
-// soft state, so any worker may take a chunk whose owner is gone.
+// soft state, so any worker may take a chunk whose owner is gone (the next sweep's task then
+// goes to whoever leases it first).
 #pragma once
 
 #include <map>
@@ -56,7 +57,11 @@ class SweepExecution : public TileExecution {
     std::optional<SweepTaskNumbering> sweeps_;
     std::string sweep_input_;  // blob of the current sweep's input; "" in sweep 0
     std::string solution_;     // blob of the solution, once solved
-    std::map<int, std::string> chunk_owner_;
+    struct ChunkOwner {
+        int task = -1;  // the chunk's last task leased
+        std::string worker;
+    };
+    std::map<int, ChunkOwner> chunk_owner_;
 };
 
 }  // namespace lf
