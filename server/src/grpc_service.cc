@@ -410,7 +410,9 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const Caller
         // below returns at once for what changed during the gap.
         const absl::Time paced = absl::Now() + kMinGap;
         for (uint64_t seen = version; absl::Now() < paced && scheduler.IsActive(req.job_id());) {
-            seen = scheduler.WaitForChange(seen, paced);
+            const uint64_t changed = scheduler.WaitForChange(seen, paced);
+            if (changed == seen) break;  // the gap is over, or the server is shutting down
+            seen = changed;
         }
         version = scheduler.WaitForChange(version, absl::Now() + absl::Seconds(1));
     }
