@@ -79,17 +79,18 @@ class RadiosityHierarchy {
     size_t bytes() const;  // tree, per-side data and links
 
   private:
-    struct NodeLink {
-        int32_t receiver, source;  // nodes (the direction is that of their centroids)
-        float visibility;
-    };
-    struct LeafLink {
-        int32_t receiver, source;  // tree positions
-        float f;                   // F_receiver,source
+    // A group's links by receiver, in compressed rows: links are most of the solver's memory.
+    // Node i of the group's subtree (root + i) gathers from node_source[node_start[i] ..
+    // node_start[i + 1]), each entry a source node << 2 | (visible rays - 1) of kClusterRays (4)
+    // (the direction is that of the centroids); side begin + i from leaf[leaf_start[i] ..
+    // leaf_start[i + 1]).
+    struct LeafSource {
+        int32_t source;  // tree position
+        float f;         // F_receiver,source
     };
     struct GroupLinks {
-        std::vector<NodeLink> node;
-        std::vector<LeafLink> leaf;
+        std::vector<uint32_t> node_start, node_source, leaf_start;
+        std::vector<LeafSource> leaf;
     };
     class Linker;
 
