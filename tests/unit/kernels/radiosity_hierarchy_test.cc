@@ -272,26 +272,30 @@ TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
             tasks.push_back(std::move(*task));
         }
         RadiositySolve solve(chunks, options.tolerance, options.max_iterations);
-        std::vector<Rgb> b = tasks[0]->emission();
+        std::vector<Rgb> h = tasks[0]->start();  // the gathered irradiance
         for (;;) {
             for (int c = chunks - 1; c >= 0; --c) {
-                auto result = tasks[size_t(c)]->Sweep(solve.sweep(), b);
+                auto result = tasks[size_t(c)]->Sweep(solve.sweep(), h);
                 ASSERT_TRUE(result.ok()) << result.status();
                 ASSERT_TRUE(solve.Add(*result).ok());
             }
             ASSERT_TRUE(solve.SweepComplete());
             auto outcome = solve.FinishSweep();
             ASSERT_TRUE(outcome.ok()) << outcome.status();
-            b = std::move(outcome->radiosity);
+            h = std::move(outcome->radiosity);
             if (outcome->converged) break;
         }
-        auto farm = RadiosityRendererFor(**es, options, b);
+        auto farm = RadiosityRendererFor(**es, options, h);
         ASSERT_TRUE(farm.ok()) << farm.status();
-        const auto mine = (*farm)->radiosity(), theirs = (*local)->radiosity();
-        ASSERT_EQ(mine.size(), theirs.size());
-        EXPECT_TRUE(std::equal(mine.begin(), mine.end(), theirs.begin(),
-                               [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
-            << chunks << " chunks";
+        for (const auto& [mine, theirs] :
+             {std::pair((*farm)->radiosity(), (*local)->radiosity()),
+              std::pair((*farm)->display().irradiance(), (*local)->display().irradiance())}) {
+            ASSERT_EQ(mine.size(), theirs.size());
+            EXPECT_TRUE(std::equal(
+                mine.begin(), mine.end(), theirs.begin(),
+                [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
+                << chunks << " chunks";
+        }
     }
 }
 
