@@ -113,13 +113,15 @@ absl::StatusOr<SolveResult> IterateJacobi(const RadiositySystem& system, const J
                                           const SolveOptions& options) {
     SolveResult result;
     const size_t n = system.emission.size();
-    std::vector<Rgb> h(n), next(n), b = system.emission;
+    std::vector<Rgb> h(n), next(n), b = system.emission;  // nothing gathered yet
     SolveLog log;
     for (;;) {
         const GroupSweep sweep = step(b, next, options.cancel);
         if (CancelRequested(options.cancel)) return SolveCancelled();
         const double residual = sweep.change / sweep.power;
         ++result.iterations;
+        h.swap(next);
+        b = RadiosityFromIrradiance(system, h);
         if (residual <= options.tolerance) {
             result.residual = residual;
             break;
@@ -128,8 +130,6 @@ absl::StatusOr<SolveResult> IterateJacobi(const RadiositySystem& system, const J
             return NotConverged(result.iterations, residual, options.tolerance);
         }
         log.Maybe("jacobi sweep", result.iterations, residual);
-        h.swap(next);
-        b = RadiosityFromIrradiance(system, h);
     }
     result.sweeps = result.iterations;
     result.radiosity = std::move(b);

@@ -62,7 +62,7 @@ struct SolveResult {
     std::vector<Rgb> radiosity;
     // Per side, F B gathered from the other sides (W m^-2; the lights' direct irradiance is not
     // in it). Jacobi and Gauss-Seidel: radiosity = E + ρ irradiance exactly; shooting: F of its
-    // radiosity.
+    // radiosity. Jacobi's `residual` is that of the radiosity its last sweep gathered from.
     std::vector<Rgb> irradiance;
     int iterations = 0;   // sweeps (Jacobi, Gauss-Seidel) or group shots (shooting)
     double sweeps = 0;    // form-factor work in units of one pass over the whole matrix
@@ -117,8 +117,10 @@ using JacobiStep = std::function<GroupSweep(std::span<const Rgb> b, std::span<Rg
                                             const std::atomic<bool>* cancel)>;
 // The Jacobi solver's loop over any sweep (the flat one, the hierarchical one) of `system` (its
 // E and ρ): from no gathered irradiance (B = E), each sweep gathers H from B = E + ρ H of the
-// last, until a sweep's change / power is at most the tolerance; that sweep's input is the
-// result. ResourceExhausted at the iteration limit, Cancelled soon after options.cancel is set.
+// last, until a sweep's change / power is at most the tolerance. The result is that sweep's H
+// and its B = E + ρ H, so H is all a black side receives from the radiosity the residual was
+// measured on; that B, one sweep on, is closer still (from E, Jacobi rises monotonically to the
+// solution). ResourceExhausted at the iteration limit, Cancelled soon after options.cancel is set.
 absl::StatusOr<SolveResult> IterateJacobi(const RadiositySystem& system, const JacobiStep& step,
                                           const SolveOptions& options);
 
