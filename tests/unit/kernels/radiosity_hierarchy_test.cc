@@ -253,10 +253,12 @@ TEST(RadiosityHierarchy, RefusesReflectanceOfOneAndNonFiniteValuesNamingTheSide)
     EXPECT_NE(h.status().message().find("side 5"), std::string::npos) << h.status();
 }
 
-// The farm's way: chunks of the groups swept against each sweep's radiosity, the sums added by
-// RadiositySolve, give PrepareRadiosity's bits for any chunk count.
+// The farm's way: chunks of the groups swept against each sweep's gathered irradiance, the sums
+// added by RadiositySolve, give PrepareRadiosity's bits for any chunk count: the radiosity, and
+// the irradiance with the point light's direct part, which RadiosityRendererFor computes again.
 TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
-    const Scene scene = CornellBox();
+    Scene scene = CornellBox();
+    scene.point_lights.push_back({{0.278, 0.45, 0.28}, Rgb(0.4f, 0.3f, 0.2f)});
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok()) << es.status();
     RadiosityOptions options = Hierarchical(1e-3);
