@@ -301,9 +301,8 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
     report.mean_estimated_error = error.mean;
 
     if (!options.save_solution.empty()) {
-        const RadiositySolution saved{s.content_hash,     mesh->patch_size(),
-                                      report.patches,     report.iterations,
-                                      report.residual,    solution.radiosity,
+        const RadiositySolution saved{s.content_hash,      mesh->patch_size(), report.patches,
+                                      report.iterations,   report.residual,    solution.radiosity,
                                       solution.irradiance, mesh->split()};
         if (absl::Status status = SaveRadiositySolution(options.save_solution, saved);
             !status.ok()) {
@@ -474,8 +473,8 @@ RadiosityRenderer::RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh,
                                      RadiosityShading shading, const RadiosityReport& report)
     : mesh_(std::make_unique<const PatchMesh>(std::move(mesh))),
       radiosity_(std::move(radiosity)),
-      display_(std::make_unique<RadiosityDisplay>(scene, *mesh_, radiosity_,
-                                                  std::move(irradiance), shading)),
+      display_(std::make_unique<RadiosityDisplay>(scene, *mesh_, radiosity_, std::move(irradiance),
+                                                  shading)),
       report_(report) {}
 
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> PrepareRadiosity(

@@ -343,7 +343,9 @@ GroupSweep RadiosityHierarchy::SweepGroup(int32_t group, std::span<const NodeExi
         for (size_t c = 0; c < 3; ++c) acc[c] += std::max(0.0, Dot(n, above[c]));
     };
     push(push, root, NodeExitance{});
-    for (size_t k = 0; k < h.size(); ++k) out[k] = Rgb(float(h[k][0]), float(h[k][1]), float(h[k][2]));
+    for (size_t k = 0; k < h.size(); ++k) {
+        out[k] = Rgb(float(h[k][0]), float(h[k][1]), float(h[k][2]));
+    }
     return SweepSums(system_, top.begin, b, out);
 }
 
@@ -383,19 +385,8 @@ size_t RadiosityHierarchy::bytes() const {
 
 absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,
                                               const SolveOptions& options) {
-    const RadiositySystem& system = hierarchy.system();
-    double emitted = 0;
-    for (size_t t = 0; t < system.area.size(); ++t) {
-        emitted += RadiosityPower(system.area[t], system.emission[t]);
-    }
-    if (emitted == 0) {
-        SolveResult dark;
-        dark.radiosity.assign(system.area.size(), Rgb(0));
-        dark.irradiance = dark.radiosity;
-        return dark;
-    }
     return IterateJacobi(
-        system,
+        hierarchy.system(),
         [&](std::span<const Rgb> b, std::span<Rgb> gathered, const std::atomic<bool>* cancel) {
             return hierarchy.Sweep(b, gathered, cancel);
         },

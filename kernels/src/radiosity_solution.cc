@@ -107,8 +107,8 @@ absl::StatusOr<RadiositySolution> LoadRadiositySolution(const std::string& path)
     const std::streamoff payload = in.tellg() - header_end;
     const std::streamoff per_vector = std::streamoff(sides) * std::streamoff(sizeof(Rgb));
     if (payload != 2 * per_vector) {
-        return corrupt(absl::StrCat(payload, " bytes of radiosity and irradiance for ", sides,
-                                    " sides"));
+        return corrupt(
+            absl::StrCat(payload, " bytes of radiosity and irradiance for ", sides, " sides"));
     }
     in.seekg(header_end);
     for (std::vector<Rgb>* values : {&solution.radiosity, &solution.irradiance}) {

@@ -21,6 +21,14 @@ double SystemPower(const RadiositySystem& system, std::span<const Rgb> b) {
     return power;
 }
 
+// Nothing emits: no light anywhere, and no sweeps (whose relative residual would be 0 / 0).
+SolveResult Dark(const RadiositySystem& system) {
+    SolveResult dark;
+    dark.radiosity.assign(system.emission.size(), Rgb(0));
+    dark.irradiance = dark.radiosity;
+    return dark;
+}
+
 double Relative(const GroupSweep& sweep) {
     return sweep.power > 0 ? sweep.change / sweep.power : sweep.change;
 }
@@ -111,6 +119,7 @@ GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b,
 
 absl::StatusOr<SolveResult> IterateJacobi(const RadiositySystem& system, const JacobiStep& step,
                                           const SolveOptions& options) {
+    if (SystemPower(system, system.emission) == 0) return Dark(system);
     SolveResult result;
     const size_t n = system.emission.size();
     std::vector<Rgb> h(n), next(n), b = system.emission;  // nothing gathered yet
@@ -312,12 +321,7 @@ absl::StatusOr<SolveResult> SolveRadiosity(const RadiositySystem& system,
     if (!(options.tolerance > 0) || options.max_iterations < 1) {
         return absl::InvalidArgumentError("radiosity: tolerance and iteration limit must be > 0");
     }
-    if (SystemPower(system, system.emission) == 0) {
-        SolveResult dark;
-        dark.radiosity.assign(system.emission.size(), Rgb(0));
-        dark.irradiance = dark.radiosity;
-        return dark;
-    }
+    if (SystemPower(system, system.emission) == 0) return Dark(system);
     switch (options.solver) {
         case RadiositySolver::kJacobi:
             return SolveJacobi(system, options);

@@ -248,8 +248,8 @@ TEST(Illuminance, LampPanelReadsTheLightTheFloorSendsBack) {
     scene.meshes = {square(5, 0, 0, true), square(kSide / 2, kHeight, 1, false)};
     const auto embree = EmbreeScene::Build(scene).value();
     const double expected = kAlbedo * kLe * kSide * kSide / (3 * kHeight * kHeight);
-    for (const RadiositySolver solver : {RadiositySolver::kJacobi, RadiositySolver::kGaussSeidel,
-                                         RadiositySolver::kShooting}) {
+    for (const RadiositySolver solver :
+         {RadiositySolver::kJacobi, RadiositySolver::kGaussSeidel, RadiositySolver::kShooting}) {
         SCOPED_TRACE(RadiositySolverName(solver));
         RadiosityOptions options;
         options.patch_size = 0.1;

@@ -293,9 +293,9 @@ TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
              {std::pair((*farm)->radiosity(), (*local)->radiosity()),
               std::pair((*farm)->display().irradiance(), (*local)->display().irradiance())}) {
             ASSERT_EQ(mine.size(), theirs.size());
-            EXPECT_TRUE(std::equal(
-                mine.begin(), mine.end(), theirs.begin(),
-                [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
+            EXPECT_TRUE(
+                std::equal(mine.begin(), mine.end(), theirs.begin(),
+                           [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
                 << chunks << " chunks";
         }
     }

@@ -238,8 +238,9 @@ TEST(RadiositySolver, SweepsAreSequencesOfThePureGroupStep) {
                 if (jacobi) continue;
                 for (int32_t i = group.begin; i < group.end; ++i) {
                     h[size_t(i)] = next[size_t(i)];
-                    b[size_t(i)] = RadiosityFromIrradiance(
-                        p->system.emission[size_t(i)], p->system.reflectance[size_t(i)], h[size_t(i)]);
+                    b[size_t(i)] =
+                        RadiosityFromIrradiance(p->system.emission[size_t(i)],
+                                                p->system.reflectance[size_t(i)], h[size_t(i)]);
                 }
             }
             if (jacobi) {

@@ -106,8 +106,8 @@ class RadiosityHierarchy {
 };
 
 // Jacobi sweeps over every group until the relative residual is below the tolerance, as
-// SolveRadiosity's Jacobi solver stops; the radiosity and gathered irradiance in tree order. ResourceExhausted at the
-// iteration limit, Cancelled soon after options.cancel is set.
+// SolveRadiosity's Jacobi solver stops; the radiosity and gathered irradiance in tree order.
+// ResourceExhausted at the iteration limit, Cancelled soon after options.cancel is set.
 absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,
                                               const SolveOptions& options);
 

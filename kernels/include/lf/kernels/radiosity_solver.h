@@ -120,7 +120,8 @@ using JacobiStep = std::function<GroupSweep(std::span<const Rgb> b, std::span<Rg
 // last, until a sweep's change / power is at most the tolerance. The result is that sweep's H
 // and its B = E + ρ H, so H is all a black side receives from the radiosity the residual was
 // measured on; that B, one sweep on, is closer still (from E, Jacobi rises monotonically to the
-// solution). ResourceExhausted at the iteration limit, Cancelled soon after options.cancel is set.
+// solution). Zero at once when nothing emits; ResourceExhausted at the iteration limit,
+// Cancelled soon after options.cancel is set.
 absl::StatusOr<SolveResult> IterateJacobi(const RadiositySystem& system, const JacobiStep& step,
                                           const SolveOptions& options);
 
