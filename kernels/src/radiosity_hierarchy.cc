@@ -376,18 +376,10 @@ GroupSweep RadiosityHierarchy::SweepGroup(int32_t group, std::span<const NodeExi
         for (size_t c = 0; c < 3; ++c) acc[c] += std::max(0.0, Dot(n, above[c]));
     };
     push(push, root, NodeExitance{});
-    GroupSweep sums;
-    for (int32_t t = top.begin; t < top.end; ++t) {
-        const std::array<double, 3>& acc = h[size_t(t - top.begin)];
-        const Rgb &e = system_.emission[size_t(t)], &rho = system_.reflectance[size_t(t)];
-        Rgb& o = out[size_t(t - top.begin)];
-        o = Rgb(float(e.r + rho.r * acc[0]), float(e.g + rho.g * acc[1]),
-                float(e.b + rho.b * acc[2]));
-        const double area = system_.area[size_t(t)];
-        sums.change += RadiosityPower(area, o - b[size_t(t)]);
-        sums.power += RadiosityPower(area, b[size_t(t)]);
+    for (size_t k = 0; k < h.size(); ++k) {
+        out[k] = Rgb(float(h[k][0]), float(h[k][1]), float(h[k][2]));
     }
-    return sums;
+    return SweepSums(system_, top.begin, b, out);
 }
 
 GroupSweep RadiosityHierarchy::Sweep(std::span<const Rgb> b, std::span<Rgb> next,
@@ -428,19 +420,10 @@ size_t RadiosityHierarchy::bytes() const {
 
 absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,
                                               const SolveOptions& options) {
-    const RadiositySystem& system = hierarchy.system();
-    std::vector<Rgb> b = system.emission;
-    double emitted = 0;
-    for (size_t t = 0; t < b.size(); ++t) emitted += RadiosityPower(system.area[t], b[t]);
-    if (emitted == 0) {
-        SolveResult dark;
-        dark.radiosity.assign(b.size(), Rgb(0));
-        return dark;
-    }
     return IterateJacobi(
-        std::move(b),
-        [&](std::span<const Rgb> from, std::span<Rgb> to, const std::atomic<bool>* cancel) {
-            return hierarchy.Sweep(from, to, cancel);
+        hierarchy.system(),
+        [&](std::span<const Rgb> b, std::span<Rgb> gathered, const std::atomic<bool>* cancel) {
+            return hierarchy.Sweep(b, gathered, cancel);
         },
         options);
 }

@@ -252,10 +252,12 @@ TEST(RadiosityHierarchy, RefusesReflectanceOfOneAndNonFiniteValuesNamingTheSide)
     EXPECT_NE(h.status().message().find("side 5"), std::string::npos) << h.status();
 }
 
-// The farm's way: chunks of the groups swept against each sweep's radiosity, the sums added by
-// RadiositySolve, give PrepareRadiosity's bits for any chunk count.
+// The farm's way: chunks of the groups swept against each sweep's gathered irradiance, the sums
+// added by RadiositySolve, give PrepareRadiosity's bits for any chunk count: the radiosity, and
+// the irradiance with the point light's direct part, which RadiosityRendererFor computes again.
 TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
-    const Scene scene = CornellBox();
+    Scene scene = CornellBox();
+    scene.point_lights.push_back({{0.278, 0.45, 0.28}, Rgb(0.4f, 0.3f, 0.2f)});
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok()) << es.status();
     RadiosityOptions options = Hierarchical(1e-3);
@@ -271,26 +273,30 @@ TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
             tasks.push_back(std::move(*task));
         }
         RadiositySolve solve(chunks, options.tolerance, options.max_iterations);
-        std::vector<Rgb> b = tasks[0]->emission();
+        std::vector<Rgb> h = tasks[0]->start();  // the gathered irradiance
         for (;;) {
             for (int c = chunks - 1; c >= 0; --c) {
-                auto result = tasks[size_t(c)]->Sweep(solve.sweep(), b);
+                auto result = tasks[size_t(c)]->Sweep(solve.sweep(), h);
                 ASSERT_TRUE(result.ok()) << result.status();
                 ASSERT_TRUE(solve.Add(*result).ok());
             }
             ASSERT_TRUE(solve.SweepComplete());
             auto outcome = solve.FinishSweep();
             ASSERT_TRUE(outcome.ok()) << outcome.status();
-            b = std::move(outcome->radiosity);
+            h = std::move(outcome->radiosity);
             if (outcome->converged) break;
         }
-        auto farm = RadiosityRendererFor(**es, options, b);
+        auto farm = RadiosityRendererFor(**es, options, h);
         ASSERT_TRUE(farm.ok()) << farm.status();
-        const auto mine = (*farm)->radiosity(), theirs = (*local)->radiosity();
-        ASSERT_EQ(mine.size(), theirs.size());
-        EXPECT_TRUE(std::equal(mine.begin(), mine.end(), theirs.begin(),
-                               [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
-            << chunks << " chunks";
+        for (const auto& [mine, theirs] :
+             {std::pair((*farm)->radiosity(), (*local)->radiosity()),
+              std::pair((*farm)->display().irradiance(), (*local)->display().irradiance())}) {
+            ASSERT_EQ(mine.size(), theirs.size());
+            EXPECT_TRUE(
+                std::equal(mine.begin(), mine.end(), theirs.begin(),
+                           [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
+                << chunks << " chunks";
+        }
     }
 }
 

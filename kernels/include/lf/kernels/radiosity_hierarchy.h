@@ -63,13 +63,13 @@ class RadiosityHierarchy {
 
     // Every node's exitance from b (tree order): the pull, O(n).
     std::vector<NodeExitance> Pull(std::span<const Rgb> b) const;
-    // One group's Jacobi step: out = E + ρ H(b) over the group's sides (gather over its links,
-    // push down to its sides), and JacobiGroup's sums. `pulled` is Pull(b).
+    // One group's Jacobi step: out = H(b), the irradiance its sides gather (over its links,
+    // pushed down to its sides), and JacobiGroup's sums (SweepSums). `pulled` is Pull(b).
     GroupSweep SweepGroup(int32_t group, std::span<const NodeExitance> pulled,
                           std::span<const Rgb> b, std::span<Rgb> out) const;
     // SweepGroup over every linked group; the sums in group order. Stops early once `cancel`
     // is set (the result is then meaningless).
-    GroupSweep Sweep(std::span<const Rgb> b, std::span<Rgb> next,
+    GroupSweep Sweep(std::span<const Rgb> b, std::span<Rgb> gathered,
                      const std::atomic<bool>* cancel = nullptr) const;
 
     int64_t node_links() const { return node_links_; }
@@ -107,8 +107,8 @@ class RadiosityHierarchy {
 };
 
 // Jacobi sweeps over every group until the relative residual is below the tolerance, as
-// SolveRadiosity's Jacobi solver stops; the radiosity in tree order. ResourceExhausted at the
-// iteration limit, Cancelled soon after options.cancel is set.
+// SolveRadiosity's Jacobi solver stops; the radiosity and gathered irradiance in tree order.
+// ResourceExhausted at the iteration limit, Cancelled soon after options.cancel is set.
 absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,
                                               const SolveOptions& options);
 
