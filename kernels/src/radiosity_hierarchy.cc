@@ -95,16 +95,13 @@ class RadiosityHierarchy::Linker {
         // Brightness estimates: the emission pulled up the tree (area-weighted), plus the
         // ambient term of the whole scene, the light interreflection would add on average.
         std::vector<Rgb> emitted(nodes.size());
-        rho_.resize(nodes.size());
         for (int32_t i = int32_t(nodes.size()) - 1; i >= 0; --i) {
             const ClusterNode& node = nodes[size_t(i)];
             if (node.leaf()) {
                 const size_t t = size_t(node.begin);
                 emitted[size_t(i)] = system.emission[t] * float(system.area[t]);
-                rho_[size_t(i)] = system.reflectance[t].MaxComponent();
             } else {
                 emitted[size_t(i)] = emitted[size_t(i) + 1] + emitted[size_t(node.right)];
-                rho_[size_t(i)] = std::max(rho_[size_t(i) + 1], rho_[size_t(node.right)]);
             }
         }
         double area = 0;
@@ -167,7 +164,7 @@ class RadiosityHierarchy::Linker {
             if (distance > separation * (rp.radius + sq.radius)) {
                 const double near = distance - rp.radius;
                 const double bound = std::min(1.0, sq.radius * sq.radius / (near * near));
-                const double power = rho_[size_t(p)] * brightness_[size_t(q)] * rp.area * bound;
+                const double power = brightness_[size_t(q)] * rp.area * bound;
                 // Partly visible: the visible fraction scales the mean exitance of the whole
                 // source, though the hidden part's is not the mean (a floor under a box is dark),
                 // and the receiver's hidden sides get the same irradiance as its visible ones;
@@ -239,7 +236,6 @@ class RadiosityHierarchy::Linker {
     const PairEvaluator& evaluator_;
     const RadiosityHierarchy& h_;
     std::vector<double> brightness_;  // per node: estimated radiosity, channels summed
-    std::vector<float> rho_;          // per node: the largest reflectance channel
     double threshold_ = 0;            // the most power a link may carry
 };
 
