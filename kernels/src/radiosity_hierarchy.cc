@@ -135,11 +135,17 @@ class RadiosityHierarchy::Linker {
         const ClusterNode& top = nodes[size_t(root)];
         std::vector<std::pair<int32_t, uint32_t>> node_links;  // receiver, source entry
         std::vector<std::pair<int32_t, LeafSource>> leaf_links;
-        std::vector<std::pair<int32_t, int32_t>> stack = {{root, 0}};
+        // A pair, and whether rays already reached its source from its receiver before their
+        // cones faced: then they are not tried again until the cones face.
+        struct Pair {
+            int32_t p, q;
+            bool seen;
+        };
+        std::vector<Pair> stack = {{root, 0, false}};
         int64_t steps = 0;
         while (!stack.empty()) {
             if (++steps % 4096 == 0 && CancelRequested(cancel)) return {};
-            const auto [p, q] = stack.back();
+            const auto [p, q, seen] = stack.back();
             stack.pop_back();
             const ClusterNode &rp = nodes[size_t(p)], &sq = nodes[size_t(q)];
             if (p == q && rp.leaf()) continue;
@@ -161,6 +167,7 @@ class RadiosityHierarchy::Linker {
             const Vec3d d = between / std::max(distance, 1e-300);
             const bool source_faces = ConeFaces(sq, -d), receiver_faces = ConeFaces(rp, d);
             const double separation = rp.leaf() || sq.leaf() ? 1.0 : kSeparation;
+            bool split_seen = false;
             if (distance > separation * (rp.radius + sq.radius)) {
                 const double near = distance - rp.radius;
                 const double bound = std::min(1.0, sq.radius * sq.radius / (near * near));
@@ -174,9 +181,10 @@ class RadiosityHierarchy::Linker {
                 // bound, since its rays may have missed a door.
                 const bool faces = source_faces && receiver_faces;
                 const bool strict = power * kPartialVisibility <= threshold_;
-                if (power <= threshold_ && (faces || strict)) {
+                if (power <= threshold_ && (faces || (strict && !seen))) {
                     const int visible = VisibleRays(p, q, rays);
                     if (visible == 0) continue;
+                    split_seen = true;
                     if (faces && (visible == kClusterRays || strict)) {
                         node_links.push_back({p - root, uint32_t(q) << 2 | uint32_t(visible - 1)});
                         continue;
@@ -184,15 +192,16 @@ class RadiosityHierarchy::Linker {
                 }
             }
             // A node whose sides do not all face the other is split first.
+            const bool child_seen = seen || split_seen;
             const bool split_source =
                 rp.leaf() || (!sq.leaf() && (source_faces == receiver_faces ? sq.radius >= rp.radius
                                                                             : !source_faces));
             if (split_source) {
-                stack.push_back({p, sq.right});
-                stack.push_back({p, q + 1});
+                stack.push_back({p, sq.right, child_seen});
+                stack.push_back({p, q + 1, child_seen});
             } else {
-                stack.push_back({rp.right, q});
-                stack.push_back({p + 1, q});
+                stack.push_back({rp.right, q, child_seen});
+                stack.push_back({p + 1, q, child_seen});
             }
         }
         GroupLinks links;
