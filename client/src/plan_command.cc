@@ -55,7 +55,7 @@ struct PlanOptions {
     int tile = defaults::kTile;
     uint64_t seed = defaults::kSeed;
     uint64_t max_spp = defaults::kAdaptiveMaxSpp;
-    int64_t patches = defaults::kRadiosityPatches;
+    RadiositySettings radiosity;  // the render's radiosity flags: mesh, form, solver
     int max_depth = defaults::kMaxDepth;
     int threads = 0;
     // --sampler, --light-sampling and --clamp: the pilot's noise, and so the samples, are
@@ -181,28 +181,61 @@ double PredictFormFactorSeconds(const RadiosityReport& small, const RadiosityRep
     return b * n + a * n * n;
 }
 
-// The solve's sweeps each read every stored form factor, and their number depends on the
+// A plan pilots radiosity on meshes of at most this many unknowns: a flat pilot's form factors
+// are up to unknowns^2 floats (8000: 244 MiB), and a hierarchical one takes about a second per
+// 10^4 unknowns.
+constexpr int64_t kMaxFlatPilotSides = 8000, kMaxHierarchicalPilotSides = 50000;
+
+// The solver's memory per unknown the hierarchical solve took on docs/radiosity.md's generated
+// offices of 10^5 and 10^6 triangles (0.67 and 0.65 kB): what plan quotes for a scene too
+// large to pilot.
+constexpr double kHierarchicalBytesPerUnknown = 650;
+
+// Flat: the solve's sweeps each read every stored form factor, and their number depends on the
 // reflectances, not on the mesh, so the solve's time grows as n^2, like the form factors'
-// memory.
+// memory. Hierarchical: links, tree and time grow about as n (links per unknown slowly, docs/
+// radiosity.md), so the larger pilot is scaled linearly and its figures are a lower estimate.
 absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& options) {
-    absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(embree.scene(), {0, options.patches});
+    const RadiositySettings& target = options.radiosity;
+    const bool hierarchical = target.form == "hierarchical";
+    absl::StatusOr<PatchMesh> mesh =
+        PatchMesh::Build(embree.scene(), {target.patch_size, target.patches});
     if (!mesh.ok()) return mesh.status();
     const double n = double(mesh->patches().size()), unknowns = double(mesh->sides().size());
+    const std::string what = target.patch_size > 0
+                                 ? absl::StrFormat("--patch-size %g", target.patch_size)
+                                 : absl::StrFormat("--patches %lld", (long long)target.patches);
     std::printf(
-        "radiosity: target %lld patches -> %zu patches of size %.3g, %zu unknowns; form "
-        "factors grow as patches^2 (%.3g pairs at most, docs/radiosity.md)\n",
-        (long long)options.patches, mesh->patches().size(), mesh->patch_size(),
-        mesh->sides().size(), n * n);
+        "radiosity (%s): %s -> %zu patches of size %.3g, %zu unknowns; %s\n", target.form.c_str(),
+        what.c_str(), mesh->patches().size(), mesh->patch_size(), mesh->sides().size(),
+        hierarchical ? absl::StrFormat("links grow about as the unknowns (link error %g, "
+                                       "docs/radiosity.md)",
+                                       target.link_error)
+                           .c_str()
+                     : absl::StrFormat("form factors grow as patches^2 (%.3g pairs at most, "
+                                       "docs/radiosity.md)",
+                                       n * n)
+                           .c_str());
     if (const std::string drops = RadiosityDrops(embree.scene()); !drops.empty()) {
         std::printf("radiosity keeps the diffuse parts only; it drops %s\n", drops.c_str());
     }
 
+    const int64_t patches = int64_t(mesh->patches().size());
     const int64_t small_patches =
-        std::max(options.patches / kRadiosityPilotDivisor, kMinRadiosityPilotPatches);
+        std::max(patches / kRadiosityPilotDivisor, kMinRadiosityPilotPatches);
+    const int64_t max_pilot_sides = hierarchical ? kMaxHierarchicalPilotSides : kMaxFlatPilotSides;
     std::vector<RadiosityReport> pilots;
-    for (int64_t patches : {small_patches, 2 * small_patches}) {
-        RadiositySettings settings;
-        settings.patches = std::min(patches, options.patches);
+    for (int64_t pilot_patches : {small_patches, 2 * small_patches}) {
+        RadiositySettings settings = target;
+        settings.patch_size = 0;
+        settings.patches = std::min(pilot_patches, patches);
+        settings.max_patches = 0;
+        // A scene of many triangles meshes no coarser than one patch each: the pilot can be
+        // the target itself, and too large to run.
+        absl::StatusOr<PatchMesh> pilot_mesh =
+            PatchMesh::Build(embree.scene(), {0, settings.patches});
+        if (!pilot_mesh.ok()) return pilot_mesh.status();
+        if (int64_t(pilot_mesh->sides().size()) > max_pilot_sides) break;
         absl::StatusOr<RadiosityOptions> pilot_options = RadiosityOptionsOf(settings, 0);
         if (!pilot_options.ok()) return pilot_options.status();
         pilot_options->threads = options.threads;
@@ -212,26 +245,47 @@ absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& op
         pilots.push_back((*pilot)->report());
         const RadiosityReport& r = pilots.back();
         std::printf(
-            "radiosity pilot: %lld patches, %lld unknowns: form factors %.3f s (%.2f MiB), "
-            "solve %.3f s (%s), estimated discretisation error %.3g (worst patch "
-            "share %.3g)\n",
-            (long long)r.patches, (long long)r.sides, r.form_factor_seconds,
-            double(r.form_factor_bytes) / (1 << 20), r.solve_seconds,
-            Plural(r.iterations, "iteration").c_str(), r.mean_estimated_error, r.estimated_error);
-        if (settings.patches == options.patches) break;  // the target itself
+            "radiosity pilot: %lld patches, %lld unknowns: %s %.3f s (%.2f MiB), solve %.3f s "
+            "(%s), estimated discretisation error %.3g (worst patch share %.3g)\n",
+            (long long)r.patches, (long long)r.sides, hierarchical ? "links" : "form factors",
+            r.form_factor_seconds,
+            double(hierarchical ? r.solver_bytes : r.form_factor_bytes) / (1 << 20),
+            r.solve_seconds, Plural(r.iterations, "iteration").c_str(), r.mean_estimated_error,
+            r.estimated_error);
+        if (r.sides >= int64_t(unknowns)) break;  // the target itself
+    }
+    const std::string render =
+        absl::StrCat("render --method radiosity --radiosity ", target.form, " ", what);
+    if (pilots.empty()) {
+        const double bytes =
+            hierarchical ? kHierarchicalBytesPerUnknown * unknowns : 4 * unknowns * unknowns;
+        std::printf(
+            "no radiosity pilot: the scene's triangles mesh to more than %lld unknowns even "
+            "at the pilot's patch count; %s needs about %.0f MiB of %s%s\n",
+            (long long)max_pilot_sides, render.c_str(), bytes / (1 << 20),
+            hierarchical ? "links and cluster tree (docs/radiosity.md's offices)"
+                         : "form factors (unknowns^2 floats at most)",
+            hierarchical ? "" : "; --radiosity hierarchical grows about linearly instead");
+        return absl::OkStatus();
     }
     const RadiosityReport& large = pilots.back();
-    const double form_factor_seconds = pilots.size() == 1
-                                           ? large.form_factor_seconds
-                                           : PredictFormFactorSeconds(pilots[0], large, unknowns);
-    const double squared = std::pow(unknowns / double(large.sides), 2);
-    const double solve_seconds = large.solve_seconds * squared;
+    const double scale = unknowns / double(large.sides);
+    double link_seconds, solve_seconds, bytes;
+    if (hierarchical) {
+        link_seconds = large.form_factor_seconds * scale;
+        solve_seconds = large.solve_seconds * scale;
+        bytes = double(large.solver_bytes) * scale;
+    } else {
+        link_seconds = pilots.size() == 1 ? large.form_factor_seconds
+                                          : PredictFormFactorSeconds(pilots[0], large, unknowns);
+        solve_seconds = large.solve_seconds * scale * scale;
+        bytes = double(large.form_factor_bytes) * scale * scale;
+    }
     std::printf(
-        "cost of render --method radiosity --patches %lld: about %.1f s of form factors "
-        "(%.0f MiB) and %.1f s of solve at this speed, %.1f s before the display pass\n",
-        (long long)options.patches, form_factor_seconds,
-        double(large.form_factor_bytes) * squared / (1 << 20), solve_seconds,
-        form_factor_seconds + solve_seconds);
+        "cost of %s: about %.1f s of %s (%.0f MiB) and %.1f s of solve at this speed, %.1f s "
+        "before the display pass\n",
+        render.c_str(), link_seconds, hierarchical ? "links" : "form factors", bytes / (1 << 20),
+        solve_seconds, link_seconds + solve_seconds);
     // No prediction of the refined patch count: the worst share sits at discontinuities (a box
     // on the floor), which a finer uniform mesh does not improve and only refinement splits.
     std::printf(
@@ -523,7 +577,8 @@ Command AddPlanCommand(CLI::App& app) {
         "Say what a render of the scene will model and why: materials, lights and participating\n"
         "media (with their grids' sizes and memory) in use, the method --method picks, the path\n"
         "depth policy, for radiosity the patch count and the time and memory of the form\n"
-        "factors and the solve (from a pilot solve of fewer patches), and the samples and time\n"
+        "factors or hierarchical links and the solve (from pilot solves of fewer patches; a\n"
+        "mesh too large to pilot gets a memory bound instead), and the samples and time\n"
         "a target error needs (from a two-stage pilot render's own error estimates, how fast\n"
         "they fall, and its speed; give the render's --spp, --tile, --seed and --max-spp for\n"
         "its passes), then the same target's cost for\n"
@@ -564,9 +619,6 @@ Command AddPlanCommand(CLI::App& app) {
     cmd->add_option("--max-spp", options->max_spp, "the render's --max-spp")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t(2), kMaxSpp));
-    cmd->add_option("--patches", options->patches, "radiosity patch target")
-        ->capture_default_str()
-        ->check(CLI::Range(int64_t(1), kMaxPatchTarget));
     cmd->add_option("--max-depth", options->max_depth, "most bounces; -1 = unlimited")
         ->capture_default_str()
         ->check(CLI::Range(-1, kMaxDepthLimit));
@@ -577,6 +629,7 @@ Command AddPlanCommand(CLI::App& app) {
     AddLightSamplingFlag(cmd, options->light_strategy);
     AddClampFlag(cmd, options->clamp);
     AddPhotonFlags(cmd, options->ppm);
+    AddRadiosityFlags(cmd, options->radiosity);
     return {cmd, [cmd, options] {
                 if (options->noise_threshold > 0 && cmd->count("--target-error") > 0) {
                     return ReportError(absl::InvalidArgumentError(

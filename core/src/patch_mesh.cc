@@ -470,10 +470,10 @@ absl::StatusOr<PatchMesh> PatchMesh::Build(const Scene& scene, const PatchMeshOp
                 if (cancelled()) return MeshingCancelled();
                 const Triangle& info = pm.triangles_[size_t(pm.mesh_first_triangle_[m]) + t];
                 const Vec3d n = back ? -info.normal : info.normal;
+                // A black side's radiosity is its emission, but its irradiance is shown.
                 const bool needed =
                     ((!back || material.two_sided_emission) && material.IsEmissive()) ||
-                    (MayReflectDiffusely(material) &&
-                     rule.SomethingInFront(mesh.positions[mesh.triangles[t][0]], n));
+                    rule.SomethingInFront(mesh.positions[mesh.triangles[t][0]], n);
                 if (!needed) continue;
                 for (int64_t p = info.first_patch; p < info.end_patch; ++p) {
                     pm.patches_[size_t(p)].sides[size_t(back)] = int32_t(pm.sides_.size());

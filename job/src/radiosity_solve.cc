@@ -31,7 +31,7 @@ absl::Status RadiositySolve::Add(const SweepChunkResult& r) {
         if (int64_t(input_.size()) != r.sides) {
             return absl::InvalidArgumentError("sweep result: the system changed size");
         }
-        // The input is the server's own b: a worker that swept something else is wrong.
+        // The input is the server's own state: a worker that swept something else is wrong.
         for (size_t i = 0; i < r.input.size(); ++i) {
             if (!(r.input[i] == input_[size_t(r.side_begin) + i])) {
                 return absl::InvalidArgumentError(absl::StrFormat(
@@ -54,7 +54,7 @@ bool RadiositySolve::SweepComplete() const {
 absl::StatusOr<RadiositySolve::Outcome> RadiositySolve::FinishSweep() {
     // The chunks must tile [0, sides) in order: then group order is chunk order.
     const int32_t sides = results_[0]->sides;
-    std::vector<Rgb> input(static_cast<size_t>(sides)), output(static_cast<size_t>(sides));
+    std::vector<Rgb> output(static_cast<size_t>(sides));
     int32_t next_side = 0;
     double change = 0, power = 0;
     for (const auto& r : results_) {
@@ -64,7 +64,6 @@ absl::StatusOr<RadiositySolve::Outcome> RadiositySolve::FinishSweep() {
                 absl::StrFormat("sweep %d: chunk %d starts at side %d, expected %d", sweep_,
                                 r->chunk, r->side_begin, next_side));
         }
-        std::copy(r->input.begin(), r->input.end(), input.begin() + r->side_begin);
         std::copy(r->output.begin(), r->output.end(), output.begin() + r->side_begin);
         next_side += int32_t(r->input.size());
         for (size_t g = 0; g < r->change.size(); ++g) {
@@ -87,7 +86,8 @@ absl::StatusOr<RadiositySolve::Outcome> RadiositySolve::FinishSweep() {
             "raise the iteration limit or the tolerance",
             out.iterations, out.residual, tolerance_));
     }
-    out.radiosity = out.converged ? std::move(input) : output;
+    // Converged or not, the gathered irradiance of this sweep is the next state (IterateJacobi).
+    out.radiosity = output;
     input_ = std::move(output);
     ++sweep_;
     results_.assign(size_t(chunks_), std::nullopt);

@@ -44,45 +44,63 @@ class Builder {
     void Bound(ClusterNode& node, int32_t begin, int32_t end) const {
         node.begin = begin;
         node.end = end;
-        node.lo = Vec3d(1e300, 1e300, 1e300);
-        node.hi = -node.lo;
-        Vec3d weighted, normals;
+        Vec3d lo(1e300, 1e300, 1e300), hi = -lo, weighted, normals;
+        double area = 0;
         for (int32_t t = begin; t < end; ++t) {
             const SideGeometry& s = sides_[size_t(order_[size_t(t)])];
-            const double area = Length(Cross(s.p[1] - s.p[0], s.p[2] - s.p[0])) / 2;
+            const double a = Length(Cross(s.p[1] - s.p[0], s.p[2] - s.p[0])) / 2;
             for (const Vec3d& q : s.p) {
-                node.lo = Min(node.lo, q);
-                node.hi = Max(node.hi, q);
+                lo = Min(lo, q);
+                hi = Max(hi, q);
             }
-            node.area += area;
-            weighted += s.c * area;
-            normals += s.n * area;
+            area += a;
+            weighted += s.c * a;
+            normals += s.n * a;
         }
-        node.centroid = node.area > 0 ? weighted / node.area : (node.lo + node.hi) * 0.5;
+        const Vec3d centroid = area > 0 ? weighted / area : (lo + hi) * 0.5;
         const double length = Length(normals);
-        node.axis = length > 1e-9 * node.area ? normals / length : Vec3d(0, 0, 1);
-        double cosine = length > 1e-9 * node.area ? 1.0 : -1.0;
-        node.axis_lo = 1e300;
-        node.axis_hi = -1e300;
+        const bool has_axis = length > 1e-9 * area;
+        node.axis = has_axis ? normals / length : Vec3d(0, 0, 1);
+        node.centroid = Vec3(centroid);
+        // The radius is measured from the stored (rounded) centroid.
+        const Vec3d c(node.centroid), n = node.axis;
+        double cosine = has_axis ? 1.0 : -1.0, radius = 0;
+        double axis_lo = 1e300, axis_hi = -1e300;
         for (int32_t t = begin; t < end; ++t) {
             const SideGeometry& s = sides_[size_t(order_[size_t(t)])];
-            cosine = std::min(cosine, Dot(node.axis, s.n));
+            cosine = std::min(cosine, Dot(n, s.n));
             for (const Vec3d& q : s.p) {
-                node.radius = std::max(node.radius, Length(q - node.centroid));
-                node.axis_lo = std::min(node.axis_lo, Dot(node.axis, q));
-                node.axis_hi = std::max(node.axis_hi, Dot(node.axis, q));
+                radius = std::max(radius, Length(q - c));
+                axis_lo = std::min(axis_lo, Dot(n, q));
+                axis_hi = std::max(axis_hi, Dot(n, q));
             }
         }
-        node.half_angle = std::acos(std::clamp(cosine, -1.0, 1.0));
-        node.cos_half_angle = std::cos(node.half_angle);
-        node.sin_half_angle = std::sin(node.half_angle);
+        for (int k = 0; k < 3; ++k) {
+            node.lo[k] = Down(lo[k]);
+            node.hi[k] = Up(hi[k]);
+        }
+        node.area = float(area);
+        node.radius = Up(radius);
+        node.cos_half_angle = std::clamp(cosine, -1.0, 1.0);
+        node.axis_lo = axis_lo;
+        node.axis_hi = axis_hi;
+    }
+
+    // The float nearest x on the side away from the node, so bounds stay bounds.
+    static float Up(double x) {
+        const float f = float(x);
+        return double(f) >= x ? f : std::nextafter(f, INFINITY);
+    }
+    static float Down(double x) {
+        const float f = float(x);
+        return double(f) <= x ? f : std::nextafter(f, -INFINITY);
     }
 
     // The median split along the longest of six axes: the centroid's coordinates in units of
     // the node's longest box edge, and the normal's (extent up to 2), so a node whose normals
     // spread more than about 60 degrees splits by orientation first.
     void Split(const ClusterNode& node, int32_t begin, int32_t mid, int32_t end) const {
-        const Vec3d extent = node.hi - node.lo;
+        const Vec3d extent = Vec3d(node.hi) - Vec3d(node.lo);
         const double longest = std::max({extent.x, extent.y, extent.z, 1e-300});
         Vec3d n_lo(2, 2, 2), n_hi(-2, -2, -2);
         for (int32_t t = begin; t < end; ++t) {

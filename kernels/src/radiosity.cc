@@ -82,6 +82,17 @@ absl::StatusOr<FormFactors> FormFactorsOf(const EmbreeScene& scene, const PatchM
     return form_factors;
 }
 
+// What the display shows: per side the radiosity and all the irradiance arriving.
+struct Solution {
+    std::vector<Rgb> radiosity, irradiance;
+};
+
+// The lights' direct irradiance plus the gathered one, per side.
+std::vector<Rgb> AddDirect(std::span<const Rgb> direct, std::vector<Rgb> gathered) {
+    for (size_t i = 0; i < gathered.size(); ++i) gathered[i] += direct[i];
+    return gathered;
+}
+
 void ReportSolve(const SolveResult& solved, double seconds, RadiosityReport& report) {
     report.solve_seconds += seconds;
     report.iterations = solved.iterations;
@@ -90,10 +101,9 @@ void ReportSolve(const SolveResult& solved, double seconds, RadiosityReport& rep
 }
 
 // The solve on one mesh; times and counts add up in `report`.
-absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh& mesh,
-                                       const FormFactors& form_factors,
-                                       const RadiosityOptions& options, double tolerance,
-                                       RadiosityReport& report) {
+absl::StatusOr<Solution> Solve(const EmbreeScene& scene, const PatchMesh& mesh,
+                               const FormFactors& form_factors, const RadiosityOptions& options,
+                               double tolerance, RadiosityReport& report) {
     const auto start = std::chrono::steady_clock::now();
     const RadiositySystem system = MakeRadiositySystem(scene, mesh, form_factors, options.cancel);
     if (CancelRequested(options.cancel)) return FormFactorsCancelled();
@@ -106,7 +116,8 @@ absl::StatusOr<std::vector<Rgb>> Solve(const EmbreeScene& scene, const PatchMesh
         ->info("{}: {} iterations ({:.1f} sweeps), relative residual {:.2g}, {:.2f} s",
                RadiositySolverName(options.solver), solved->iterations, solved->sweeps,
                solved->residual, solve_seconds);
-    return std::move(solved->radiosity);
+    return Solution{std::move(solved->radiosity),
+                    AddDirect(system.direct, std::move(solved->irradiance))};
 }
 
 HierarchyOptions HierarchyOptionsOf(const RadiosityOptions& options, int chunk, int chunks,
@@ -114,24 +125,26 @@ HierarchyOptions HierarchyOptionsOf(const RadiosityOptions& options, int chunk, 
     return {options.link_error, kHierarchyGroupSize, chunk, chunks, cancel};
 }
 
-// The links of a chunk of the groups (all of them for a whole solve).
-absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> LinkHierarchy(const EmbreeScene& scene,
-                                                                  const PatchMesh& mesh,
-                                                                  const HierarchyOptions& options) {
+// The links of a chunk of the groups (all of them for a whole solve); with `direct`, the lights'
+// direct irradiance per side there too.
+absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> LinkHierarchy(
+    const EmbreeScene& scene, const PatchMesh& mesh, const HierarchyOptions& options,
+    std::vector<Rgb>* direct = nullptr) {
     const FormFactors none;  // the system's E, ρ and A are all the hierarchy reads
-    const RadiositySystem system = MakeRadiositySystem(scene, mesh, none, options.cancel);
+    RadiositySystem system = MakeRadiositySystem(scene, mesh, none, options.cancel);
     if (CancelRequested(options.cancel)) return FormFactorsCancelled();
+    if (direct) *direct = std::move(system.direct);
     return RadiosityHierarchy::Build(scene, mesh, system, options);
 }
 
 // The hierarchical solve on one mesh; times and counts add up in `report`.
-absl::StatusOr<std::vector<Rgb>> SolveHierarchically(const EmbreeScene& scene,
-                                                     const PatchMesh& mesh,
-                                                     const RadiosityOptions& options,
-                                                     double tolerance, RadiosityReport& report) {
+absl::StatusOr<Solution> SolveHierarchically(const EmbreeScene& scene, const PatchMesh& mesh,
+                                             const RadiosityOptions& options, double tolerance,
+                                             RadiosityReport& report) {
     const auto start = std::chrono::steady_clock::now();
+    std::vector<Rgb> direct;
     absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> linked =
-        LinkHierarchy(scene, mesh, HierarchyOptionsOf(options, 0, 1, options.cancel));
+        LinkHierarchy(scene, mesh, HierarchyOptionsOf(options, 0, 1, options.cancel), &direct);
     if (!linked.ok()) return linked.status();
     const RadiosityHierarchy& h = **linked;
     const double link_seconds = SecondsSince(start);
@@ -158,14 +171,14 @@ absl::StatusOr<std::vector<Rgb>> SolveHierarchically(const EmbreeScene& scene,
     NamedLogger("radiosity")
         ->info("hierarchical jacobi: {} sweeps, relative residual {:.2g}, {:.2f} s",
                solved->iterations, solved->residual, solve_seconds);
-    return h.tree().ToMeshOrder(solved->radiosity);
+    return Solution{h.tree().ToMeshOrder(solved->radiosity),
+                    AddDirect(direct, h.tree().ToMeshOrder(solved->irradiance))};
 }
 
 // Solve, split the patches above the target, mesh again, solve again ... until no patch needs
 // splitting or the budget is spent. `mesh` is the coarse mesh on entry, the final one on return.
-absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
-                                               const RadiosityOptions& options, PatchMesh& mesh,
-                                               RadiosityReport& report) {
+absl::StatusOr<Solution> SolveRefining(const EmbreeScene& scene, const RadiosityOptions& options,
+                                       PatchMesh& mesh, RadiosityReport& report) {
     // The solve's error in B is up to its residual / (1 - ρ) (docs/radiosity.md, Solvers): a
     // tenth of the target keeps it below the discretisation error asked for wherever ρ < 0.9,
     // so the indicator measures the mesh, not an unfinished solve.
@@ -183,9 +196,9 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
         const double form_factor_seconds = report.form_factor_seconds;
         const int64_t rays = report.visibility_rays;
         FormFactors form_factors;  // none for the hierarchical solve, which needs no reuse
-        absl::StatusOr<std::vector<Rgb>> radiosity;
+        absl::StatusOr<Solution> solution;
         if (options.hierarchical) {
-            radiosity = SolveHierarchically(scene, mesh, options, tolerance, report);
+            solution = SolveHierarchically(scene, mesh, options, tolerance, report);
         } else {
             absl::StatusOr<FormFactors> computed = FormFactorsOf(
                 scene, mesh, first ? MeshFormFactors{} : MeshFormFactors{&previous_mesh, &previous},
@@ -193,10 +206,10 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
             if (!computed.ok()) return computed.status();
             form_factors = std::move(*computed);
             previous = FormFactors();  // freed before the solve
-            radiosity = Solve(scene, mesh, form_factors, options, tolerance, report);
+            solution = Solve(scene, mesh, form_factors, options, tolerance, report);
         }
-        if (!radiosity.ok()) return radiosity.status();
-        const DiscretisationError error = EstimateDiscretisationError(mesh, *radiosity);
+        if (!solution.ok()) return solution.status();
+        const DiscretisationError error = EstimateDiscretisationError(mesh, solution->radiosity);
         const RefinementStep step = ChooseRefinement(mesh, error, options.target_error, budget);
         const FormFactorWork& work = form_factors.work();
         report.refinement.push_back({int64_t(mesh.patches().size()), int64_t(mesh.sides().size()),
@@ -212,7 +225,7 @@ absl::StatusOr<std::vector<Rgb>> SolveRefining(const EmbreeScene& scene,
                 report.refinement.size(), mesh.patches().size(), error.max, error.mean,
                 options.target_error, step.above_target, step.split.size(),
                 step.budget_reached ? " (patch budget reached)" : "");
-        if (step.split.empty()) return radiosity;
+        if (step.split.empty()) return solution;
         mesh_options.split = mesh.split();
         mesh_options.split.insert(mesh_options.split.end(), step.split.begin(), step.split.end());
         const auto start = std::chrono::steady_clock::now();
@@ -253,7 +266,7 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         ->info("{} patches of size {:.3g}, {} unknowns", mesh->patches().size(), mesh->patch_size(),
                mesh->sides().size());
 
-    std::vector<Rgb> radiosity;
+    Solution solution;
     if (!options.load_solution.empty()) {
         if (absl::Status status =
                 CheckRadiositySolution(loaded, options.load_solution, s.content_hash, *mesh);
@@ -263,10 +276,10 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
         report.loaded = true;
         report.iterations = loaded.iterations;
         report.residual = loaded.residual;
-        radiosity = std::move(loaded.radiosity);
+        solution = {std::move(loaded.radiosity), std::move(loaded.irradiance)};
         NamedLogger("radiosity")->info("loaded the solution from {}", options.load_solution);
     } else {
-        absl::StatusOr<std::vector<Rgb>> solved;
+        absl::StatusOr<Solution> solved;
         if (options.target_error > 0) {
             solved = SolveRefining(scene, options, *mesh, report);
         } else if (options.hierarchical) {
@@ -278,26 +291,27 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Prepare(const EmbreeScene& sc
             solved = Solve(scene, *mesh, *form_factors, options, options.tolerance, report);
         }
         if (!solved.ok()) return solved.status();
-        radiosity = std::move(*solved);
+        solution = std::move(*solved);
     }
     report.patches = int64_t(mesh->patches().size());
     report.sides = int64_t(mesh->sides().size());
     report.patch_size = mesh->patch_size();
-    const DiscretisationError error = EstimateDiscretisationError(*mesh, radiosity);
+    const DiscretisationError error = EstimateDiscretisationError(*mesh, solution.radiosity);
     report.estimated_error = error.max;
     report.mean_estimated_error = error.mean;
 
     if (!options.save_solution.empty()) {
-        const RadiositySolution solution{s.content_hash,    mesh->patch_size(), report.patches,
-                                         report.iterations, report.residual,    radiosity,
-                                         mesh->split()};
-        if (absl::Status status = SaveRadiositySolution(options.save_solution, solution);
+        const RadiositySolution saved{s.content_hash,      mesh->patch_size(), report.patches,
+                                      report.iterations,   report.residual,    solution.radiosity,
+                                      solution.irradiance, mesh->split()};
+        if (absl::Status status = SaveRadiositySolution(options.save_solution, saved);
             !status.ok()) {
             return status;
         }
     }
     auto renderer = std::make_unique<RadiosityRenderer>(
-        scene, std::move(*mesh), std::move(radiosity), options.display, report);
+        scene, std::move(*mesh), std::move(solution.radiosity), std::move(solution.irradiance),
+        options.display, report);
     if (!options.export_ply.empty()) {
         // The display gives the PLY its illuminance.
         if (absl::Status status = WriteRadiosityPly(options.export_ply, renderer->mesh(),
@@ -319,17 +333,22 @@ absl::Status CheckNoRefinement(const RadiosityOptions& options) {
     return absl::OkStatus();
 }
 
-absl::Status CheckSolutionSize(const std::vector<Rgb>& radiosity, const PatchMesh& mesh) {
-    if (radiosity.size() == mesh.sides().size()) return absl::OkStatus();
+absl::Status CheckSolutionSize(const std::vector<Rgb>& gathered, const PatchMesh& mesh) {
+    if (gathered.size() == mesh.sides().size()) return absl::OkStatus();
     return absl::InvalidArgumentError(
         absl::StrFormat("radiosity: a solution of %d values for a mesh of %d unknowns",
-                        radiosity.size(), mesh.sides().size()));
+                        gathered.size(), mesh.sides().size()));
 }
 
-// The display of a solution solved elsewhere, in mesh order.
-std::unique_ptr<RadiosityRenderer> RendererOfSolution(const EmbreeScene& scene,
-                                                      const RadiosityOptions& options,
-                                                      PatchMesh mesh, std::vector<Rgb> radiosity) {
+// The display of a sweep state solved elsewhere, `gathered` in mesh order.
+absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RendererOfSolution(
+    const EmbreeScene& scene, const RadiosityOptions& options, PatchMesh mesh,
+    std::vector<Rgb> gathered) {
+    // B = E + ρ H side by side as the sweeps had it, and the lights' direct irradiance again.
+    const FormFactors none;
+    const RadiositySystem system = MakeRadiositySystem(scene, mesh, none, options.cancel);
+    if (CancelRequested(options.cancel)) return FormFactorsCancelled();
+    std::vector<Rgb> radiosity = RadiosityFromIrradiance(system, gathered);
     RadiosityReport report;
     report.patches = int64_t(mesh.patches().size());
     report.sides = int64_t(mesh.sides().size());
@@ -339,6 +358,7 @@ std::unique_ptr<RadiosityRenderer> RendererOfSolution(const EmbreeScene& scene,
     report.estimated_error = error.max;
     report.mean_estimated_error = error.mean;
     return std::make_unique<RadiosityRenderer>(scene, std::move(mesh), std::move(radiosity),
+                                               AddDirect(system.direct, std::move(gathered)),
                                                options.display, report);
 }
 
@@ -356,6 +376,7 @@ RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& m
         system.area.push_back(mesh.patches()[size_t(mesh.sides()[s].patch)].area);
     }
     system.reflectance = std::move(sides.reflectance);
+    system.direct = std::move(irradiance);
     return system;
 }
 
@@ -381,6 +402,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
         out->hierarchy_ = std::move(*linked);
         out->groups_ = out->hierarchy_->linked_groups();
         out->mesh_ = std::move(*mesh);
+        out->start_.resize(size_t(out->sides()));
         return out;
     }
     FormFactorOptions ff_options;
@@ -392,6 +414,8 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
     out->system_ = MakeRadiositySystem(scene, *mesh, out->form_factors_, cancel);
     if (CancelRequested(cancel)) return FormFactorsCancelled();
+    out->system_.direct = {};  // the display's, not the sweeps'
+    out->start_.resize(size_t(out->sides()));
     out->mesh_ = std::move(*mesh);
     return out;
 }
@@ -406,21 +430,21 @@ RadiosityReport RadiositySweepChunk::LinkReport() const {
     return report;
 }
 
-std::vector<NodeExitance> RadiositySweepChunk::Pull(std::span<const Rgb> b) const {
-    if (!hierarchy_ || int64_t(b.size()) != sides()) return {};
-    return hierarchy_->Pull(b);
+std::vector<NodeExitance> RadiositySweepChunk::Pull(std::span<const Rgb> h) const {
+    if (!hierarchy_ || int64_t(h.size()) != sides()) return {};
+    return hierarchy_->Pull(RadiosityFromIrradiance(system(), h));
 }
 
 absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
-                                                            std::span<const Rgb> b) const {
-    return Sweep(sweep, b, Pull(b));
+                                                            std::span<const Rgb> h) const {
+    return Sweep(sweep, h, Pull(h));
 }
 
 absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
-    int32_t sweep, std::span<const Rgb> b, std::span<const NodeExitance> pulled) const {
-    if (int64_t(b.size()) != sides()) {
+    int32_t sweep, std::span<const Rgb> h, std::span<const NodeExitance> pulled) const {
+    if (int64_t(h.size()) != sides()) {
         return absl::InvalidArgumentError(absl::StrFormat(
-            "radiosity sweep %d: %d values for %d unknowns", sweep, b.size(), sides()));
+            "radiosity sweep %d: %d values for %d unknowns", sweep, h.size(), sides()));
     }
     if (hierarchy_ && pulled.size() != hierarchy_->tree().nodes().size()) {
         return absl::InvalidArgumentError(
@@ -428,6 +452,7 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
                             pulled.size(), hierarchy_->tree().nodes().size()));
     }
     const auto& groups = hierarchy_ ? hierarchy_->groups() : form_factors_.groups();
+    const std::vector<Rgb> b = RadiosityFromIrradiance(system(), h);
     const auto [g0, g1] = groups_;
     SweepChunkResult r;
     r.sweep = sweep;
@@ -435,7 +460,7 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
     r.sides = sides();
     r.side_begin = g0 < g1 ? groups[size_t(g0)].begin : 0;
     const int32_t side_end = g0 < g1 ? groups[size_t(g1 - 1)].end : 0;
-    r.input.assign(b.begin() + r.side_begin, b.begin() + side_end);
+    r.input.assign(h.begin() + r.side_begin, h.begin() + side_end);
     r.output.resize(r.input.size());
     r.change.resize(size_t(g1 - g0));
     r.power.resize(size_t(g1 - g0));
@@ -452,35 +477,36 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
 }
 
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiositySweepChunk::Renderer(
-    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity) const {
-    if (absl::Status status = CheckSolutionSize(radiosity, mesh_); !status.ok()) return status;
-    if (hierarchy_) radiosity = hierarchy_->tree().ToMeshOrder(radiosity);
-    return RendererOfSolution(scene, options, mesh_, std::move(radiosity));
+    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> gathered) const {
+    if (absl::Status status = CheckSolutionSize(gathered, mesh_); !status.ok()) return status;
+    if (hierarchy_) gathered = hierarchy_->tree().ToMeshOrder(gathered);
+    return RendererOfSolution(scene, options, mesh_, std::move(gathered));
 }
 
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
-    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity) {
+    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> gathered) {
     if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
     PatchMeshOptions mesh_options{options.patch_size, options.patches};
     mesh_options.cancel = options.cancel;
     absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(scene.scene(), mesh_options);
     if (!mesh.ok()) return mesh.status();
-    if (absl::Status status = CheckSolutionSize(radiosity, *mesh); !status.ok()) return status;
+    if (absl::Status status = CheckSolutionSize(gathered, *mesh); !status.ok()) return status;
     if (options.hierarchical) {
         absl::StatusOr<ClusterTree> tree =
             ClusterTree::Build(SideGeometries(scene, *mesh), options.cancel);
         if (!tree.ok()) return tree.status();
-        radiosity = tree->ToMeshOrder(radiosity);
+        gathered = tree->ToMeshOrder(gathered);
     }
-    return RendererOfSolution(scene, options, std::move(*mesh), std::move(radiosity));
+    return RendererOfSolution(scene, options, std::move(*mesh), std::move(gathered));
 }
 
 RadiosityRenderer::RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh,
-                                     std::vector<Rgb> radiosity, RadiosityShading shading,
-                                     const RadiosityReport& report)
+                                     std::vector<Rgb> radiosity, std::vector<Rgb> irradiance,
+                                     RadiosityShading shading, const RadiosityReport& report)
     : mesh_(std::make_unique<const PatchMesh>(std::move(mesh))),
       radiosity_(std::move(radiosity)),
-      display_(std::make_unique<RadiosityDisplay>(scene, *mesh_, radiosity_, shading)),
+      display_(std::make_unique<RadiosityDisplay>(scene, *mesh_, radiosity_, std::move(irradiance),
+                                                  shading)),
       report_(report) {}
 
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> PrepareRadiosity(

@@ -77,26 +77,18 @@ std::vector<std::array<Rgb, 3>> SmoothCorners(const PatchMesh& mesh,
 }
 
 RadiosityDisplay::RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& mesh,
-                                   std::vector<Rgb> radiosity, RadiosityShading shading)
+                                   std::vector<Rgb> radiosity, std::vector<Rgb> irradiance,
+                                   RadiosityShading shading)
     : scene_(scene),
       mesh_(mesh),
       surfaces_(std::make_unique<RadiositySurfaces>(scene)),
-      radiosity_(std::move(radiosity)) {
+      radiosity_(std::move(radiosity)),
+      irradiance_(std::move(irradiance)) {
     const Scene& s = scene.scene();
     if (s.environment ||
         std::any_of(s.directional_lights.begin(), s.directional_lights.end(),
                     [](const DirectionalLight& l) { return l.angular_diameter > 0; })) {
         sky_ = std::make_unique<LightSampler>(scene, LightStrategy::kPower);
-    }
-    // The solve's own per-side reflectance and exitance (patch averages of textured ones).
-    const RadiositySides sides = surfaces_->Sides(mesh_);
-    irradiance_.resize(radiosity_.size());
-    for (size_t i = 0; i < radiosity_.size(); ++i) {
-        const Rgb reflected = radiosity_[i] - sides.exitance[i];
-        const Rgb& rho = sides.reflectance[i];
-        for (int c = 0; c < 3; ++c) {
-            irradiance_[i][c] = rho[c] > 0 ? std::max(0.f, reflected[c]) / rho[c] : 0.f;
-        }
     }
     if (shading == RadiosityShading::kSmooth) {
         corners_ = SmoothCorners(mesh_, radiosity_);

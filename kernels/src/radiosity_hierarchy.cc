@@ -30,22 +30,25 @@ constexpr double kPartialVisibility = 16;
 // is not axis-aligned are culled as coplanar).
 double Support(const ClusterNode& node, const Vec3d& a) {
     double box = 0;
-    for (int k = 0; k < 3; ++k) box += a[k] * (a[k] > 0 ? node.hi[k] : node.lo[k]);
-    const double along = Dot(a, node.axis);
-    const Vec3d across = a - node.axis * along;
+    for (int k = 0; k < 3; ++k) box += a[k] * double(a[k] > 0 ? node.hi[k] : node.lo[k]);
+    const Vec3d& axis = node.axis;
+    const double along = Dot(a, axis);
+    const Vec3d across = a - axis * along;
     const double slab = std::max(along * node.axis_lo, along * node.axis_hi) +
-                        Dot(across, node.centroid) + Length(across) * node.radius;
+                        Dot(across, Vec3d(node.centroid)) + Length(across) * node.radius;
     return std::min(box, slab);
 }
 
 // Whether some side of `from` may face some point of `to`: the largest n·(x - y) over normals
 // n in from's cone, x in to and y in from, bounded by Support, is above epsilon. Conservative.
 bool MayFace(const ClusterNode& from, const ClusterNode& to, double epsilon) {
-    if (from.half_angle >= kPi / 2) return true;
-    const double s = Support(to, from.axis) + Support(from, -from.axis);
+    if (!from.narrow()) return true;
+    const Vec3d& axis = from.axis;
+    const double s = Support(to, axis) + Support(from, -axis);
     if (s > epsilon) return true;
-    const double reach = Length(to.centroid - from.centroid) + from.radius + to.radius;
-    return s * from.cos_half_angle + reach * from.sin_half_angle > epsilon;
+    const double reach =
+        Length(Vec3d(to.centroid) - Vec3d(from.centroid)) + double(from.radius) + to.radius;
+    return s * from.cos_half_angle + reach * from.sin_half_angle() > epsilon;
 }
 
 // Whether every normal of the node's cone is within 90 degrees of the unit direction `w`: then
@@ -53,7 +56,7 @@ bool MayFace(const ClusterNode& from, const ClusterNode& to, double epsilon) {
 // facing away would subtract from it), and each side's irradiance from w is n·E.
 bool ConeFaces(const ClusterNode& node, const Vec3d& w) {
     // The angle to w plus the half-angle below π/2: cos(angle) > cos(π/2 - half-angle).
-    return node.half_angle < kPi / 2 && Dot(node.axis, w) > node.sin_half_angle;
+    return node.narrow() && Dot(node.axis, w) > node.sin_half_angle();
 }
 
 uint64_t Hash(uint64_t x) {
@@ -65,6 +68,19 @@ uint64_t Hash(uint64_t x) {
 }
 
 double Sum(const Rgb& c) { return double(c.r) + c.g + c.b; }
+
+// (row, value) pairs to compressed rows over `rows` rows: a stable counting sort, so each row
+// keeps the order its links were made in.
+template <typename T>
+void Compress(const std::vector<std::pair<int32_t, T>>& links, int32_t rows,
+              std::vector<uint32_t>& start, std::vector<T>& values) {
+    start.assign(size_t(rows) + 1, 0);
+    for (const auto& link : links) ++start[size_t(link.first) + 1];
+    for (size_t r = 0; r < size_t(rows); ++r) start[r + 1] += start[r];
+    std::vector<uint32_t> next(start.begin(), start.end() - 1);
+    values.resize(links.size());
+    for (const auto& link : links) values[next[size_t(link.first)]++] = link.second;
+}
 
 }  // namespace
 
@@ -79,16 +95,13 @@ class RadiosityHierarchy::Linker {
         // Brightness estimates: the emission pulled up the tree (area-weighted), plus the
         // ambient term of the whole scene, the light interreflection would add on average.
         std::vector<Rgb> emitted(nodes.size());
-        rho_.resize(nodes.size());
         for (int32_t i = int32_t(nodes.size()) - 1; i >= 0; --i) {
             const ClusterNode& node = nodes[size_t(i)];
             if (node.leaf()) {
                 const size_t t = size_t(node.begin);
                 emitted[size_t(i)] = system.emission[t] * float(system.area[t]);
-                rho_[size_t(i)] = system.reflectance[t].MaxComponent();
             } else {
                 emitted[size_t(i)] = emitted[size_t(i) + 1] + emitted[size_t(node.right)];
-                rho_[size_t(i)] = std::max(rho_[size_t(i) + 1], rho_[size_t(node.right)]);
             }
         }
         double area = 0;
@@ -109,7 +122,7 @@ class RadiosityHierarchy::Linker {
         }
         brightness_.resize(nodes.size());
         for (size_t i = 0; i < nodes.size(); ++i) {
-            const double a = std::max(nodes[i].area, 1e-300);
+            const double a = std::max(double(nodes[i].area), 1e-300);
             brightness_[i] = Sum(emitted[i]) / a + Sum(ambient);
         }
         threshold_ = link_error * power;
@@ -119,12 +132,20 @@ class RadiosityHierarchy::Linker {
     GroupLinks Link(int32_t root, const std::atomic<bool>* cancel, int64_t& rays) const {
         const auto& nodes = h_.tree_.nodes();
         const std::vector<int32_t>& order = h_.tree_.order();
-        GroupLinks links;
-        std::vector<std::pair<int32_t, int32_t>> stack = {{root, 0}};
+        const ClusterNode& top = nodes[size_t(root)];
+        std::vector<std::pair<int32_t, uint32_t>> node_links;  // receiver, source entry
+        std::vector<std::pair<int32_t, LeafSource>> leaf_links;
+        // A pair, and whether rays already reached its source from its receiver before their
+        // cones faced: then they are not tried again until the cones face.
+        struct Pair {
+            int32_t p, q;
+            bool seen;
+        };
+        std::vector<Pair> stack = {{root, 0, false}};
         int64_t steps = 0;
         while (!stack.empty()) {
             if (++steps % 4096 == 0 && CancelRequested(cancel)) return {};
-            const auto [p, q] = stack.back();
+            const auto [p, q, seen] = stack.back();
             stack.pop_back();
             const ClusterNode &rp = nodes[size_t(p)], &sq = nodes[size_t(q)];
             if (p == q && rp.leaf()) continue;
@@ -138,43 +159,54 @@ class RadiosityHierarchy::Linker {
                     evaluator_.Evaluate(std::min(a, b), std::max(a, b), (a < b), (a > b));
                 rays += f.rays;
                 const float value = float(a < b ? f.ab : f.ba);
-                if (value > 0) links.leaf.push_back({rp.begin, sq.begin, value});
+                if (value > 0) leaf_links.push_back({rp.begin - top.begin, {sq.begin, value}});
                 continue;
             }
-            const double distance = Length(sq.centroid - rp.centroid);
-            const Vec3d d = (sq.centroid - rp.centroid) / std::max(distance, 1e-300);
+            const Vec3d between = Vec3d(sq.centroid) - Vec3d(rp.centroid);
+            const double distance = Length(between);
+            const Vec3d d = between / std::max(distance, 1e-300);
             const bool source_faces = ConeFaces(sq, -d), receiver_faces = ConeFaces(rp, d);
             const double separation = rp.leaf() || sq.leaf() ? 1.0 : kSeparation;
-            if (source_faces && receiver_faces && distance > separation * (rp.radius + sq.radius)) {
+            bool split_seen = false;
+            if (distance > separation * (rp.radius + sq.radius)) {
                 const double near = distance - rp.radius;
                 const double bound = std::min(1.0, sq.radius * sq.radius / (near * near));
-                const double power = rho_[size_t(p)] * brightness_[size_t(q)] * rp.area * bound;
-                if (power <= threshold_) {
-                    // Partly visible: the visible fraction scales the mean exitance of the whole
-                    // source, though the hidden part's is not the mean (a floor under a box is
-                    // dark), and the receiver's hidden sides get the same irradiance as its
-                    // visible ones; such links must carry kPartialVisibility times less.
-                    const double v = Visibility(p, q, rays);
-                    if (v == 1 || v == 0 || power * kPartialVisibility <= threshold_) {
-                        if (v > 0) {
-                            links.node.push_back({p, q, float(v)});
-                        }
+                const double power = brightness_[size_t(q)] * rp.area * bound;
+                // Partly visible: the visible fraction scales the mean exitance of the whole
+                // source, though the hidden part's is not the mean (a floor under a box is dark),
+                // and the receiver's hidden sides get the same irradiance as its visible ones;
+                // such links must carry kPartialVisibility times less. Rays that all miss end
+                // the pair, and are tried before the cones face: another room is dropped whole
+                // instead of split down to its walls. Such a pair is held to the same stricter
+                // bound, since its rays may have missed a door.
+                const bool faces = source_faces && receiver_faces;
+                const bool strict = power * kPartialVisibility <= threshold_;
+                if (power <= threshold_ && (faces || (strict && !seen))) {
+                    const int visible = VisibleRays(p, q, rays);
+                    if (visible == 0) continue;
+                    split_seen = true;
+                    if (faces && (visible == kClusterRays || strict)) {
+                        node_links.push_back({p - root, uint32_t(q) << 2 | uint32_t(visible - 1)});
                         continue;
                     }
                 }
             }
             // A node whose sides do not all face the other is split first.
+            const bool child_seen = seen || split_seen;
             const bool split_source =
                 rp.leaf() || (!sq.leaf() && (source_faces == receiver_faces ? sq.radius >= rp.radius
                                                                             : !source_faces));
             if (split_source) {
-                stack.push_back({p, sq.right});
-                stack.push_back({p, q + 1});
+                stack.push_back({p, sq.right, child_seen});
+                stack.push_back({p, q + 1, child_seen});
             } else {
-                stack.push_back({rp.right, q});
-                stack.push_back({p + 1, q});
+                stack.push_back({rp.right, q, child_seen});
+                stack.push_back({p + 1, q, child_seen});
             }
         }
+        GroupLinks links;
+        Compress(node_links, top.nodes(), links.node_start, links.node_source);
+        Compress(leaf_links, top.size(), links.leaf_start, links.leaf);
         return links;
     }
 
@@ -192,28 +224,27 @@ class RadiosityHierarchy::Linker {
         return side;
     }
 
-    // The fraction of kClusterRays rays between points of p and q that arrive.
-    double Visibility(int32_t p, int32_t q, int64_t& rays) const {
+    // How many of kClusterRays rays between points of p and q arrive.
+    int VisibleRays(int32_t p, int32_t q, int64_t& rays) const {
         const auto& nodes = h_.tree_.nodes();
         const ClusterNode &rp = nodes[size_t(p)], &sq = nodes[size_t(q)];
         const auto& sides = evaluator_.sides();
         int visible = 0;
         for (int k = 0; k < kClusterRays; ++k) {
             const uint64_t key = Hash((uint64_t(uint32_t(p)) << 32 | uint32_t(q)) * 4 + k);
-            const int32_t a = SampleSide(rp, sq.centroid, key);
-            const int32_t b = SampleSide(sq, rp.centroid, Hash(key));
+            const int32_t a = SampleSide(rp, Vec3d(sq.centroid), key);
+            const int32_t b = SampleSide(sq, Vec3d(rp.centroid), Hash(key));
             visible +=
                 !scene_.Occluded(SpawnRayTo(sides[size_t(a)].centre, sides[size_t(b)].centre));
         }
         rays += kClusterRays;
-        return double(visible) / kClusterRays;
+        return visible;
     }
 
     const EmbreeScene& scene_;
     const PairEvaluator& evaluator_;
     const RadiosityHierarchy& h_;
     std::vector<double> brightness_;  // per node: estimated radiosity, channels summed
-    std::vector<float> rho_;          // per node: the largest reflectance channel
     double threshold_ = 0;            // the most power a link may carry
 };
 
@@ -239,6 +270,10 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
     absl::StatusOr<ClusterTree> tree = ClusterTree::Build(evaluator.sides(), options.cancel);
     if (!tree.ok()) return tree.status();
     h->tree_ = std::move(*tree);
+    if (h->tree_.nodes().size() >= (size_t(1) << 30)) {  // a link keeps a node in 30 bits
+        return absl::ResourceExhaustedError(
+            absl::StrFormat("radiosity: %d sides are too many for the hierarchy", n));
+    }
     for (int32_t side : h->tree_.order()) h->normals_.push_back(evaluator.sides()[size_t(side)].n);
     for (int32_t side : h->tree_.order()) {
         h->system_.emission.push_back(system.emission[size_t(side)]);
@@ -260,15 +295,12 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
         if (CancelRequested(options.cancel)) return;
         GroupLinks& links = h->links_[size_t(g)];
         links = linker.Link(h->group_roots_[size_t(g)], options.cancel, rays[size_t(g)]);
-        // Links are most of the solver's memory: no growth slack.
-        links.node.shrink_to_fit();
-        links.leaf.shrink_to_fit();
     });
     if (CancelRequested(options.cancel)) {
         return absl::CancelledError("radiosity: linking cancelled");
     }
     for (int32_t g = g0; g < g1; ++g) {
-        h->node_links_ += int64_t(h->links_[size_t(g)].node.size());
+        h->node_links_ += int64_t(h->links_[size_t(g)].node_source.size());
         h->leaf_links_ += int64_t(h->links_[size_t(g)].leaf.size());
         h->rays_ += rays[size_t(g)];
     }
@@ -310,24 +342,30 @@ GroupSweep RadiosityHierarchy::SweepGroup(int32_t group, std::span<const NodeExi
     const GroupLinks& links = links_[size_t(group)];
     // Gather: vector irradiance per node of the group's subtree, scalar per side from leaves.
     std::vector<NodeExitance> irradiance(size_t(top.nodes()));
-    for (const NodeLink& link : links.node) {
-        // Recomputed every sweep rather than stored: links are most of the memory.
-        const Vec3d between =
-            nodes[size_t(link.source)].centroid - nodes[size_t(link.receiver)].centroid;
-        const double r2 = LengthSquared(between);
-        const Vec3d d = between / std::sqrt(r2);
-        const double scale = double(link.visibility) / (kPi * r2);
-        NodeExitance& e = irradiance[size_t(link.receiver - root)];
-        for (size_t c = 0; c < 3; ++c) {
-            const double toward = -Dot(d, pulled[size_t(link.source)][c]);
-            if (toward > 0) e[c] += d * (scale * toward);
+    for (int32_t i = 0; i < top.nodes(); ++i) {
+        const Vec3d receiver(nodes[size_t(root + i)].centroid);
+        NodeExitance& e = irradiance[size_t(i)];
+        for (uint32_t k = links.node_start[size_t(i)]; k < links.node_start[size_t(i) + 1]; ++k) {
+            const uint32_t entry = links.node_source[k];
+            const int32_t source = int32_t(entry >> 2);
+            // Recomputed every sweep rather than stored: links are most of the memory.
+            const Vec3d between = Vec3d(nodes[size_t(source)].centroid) - receiver;
+            const double r2 = LengthSquared(between);
+            const Vec3d d = between / std::sqrt(r2);
+            const double scale = double((entry & 3) + 1) / kClusterRays / (kPi * r2);
+            for (size_t c = 0; c < 3; ++c) {
+                const double toward = -Dot(d, pulled[size_t(source)][c]);
+                if (toward > 0) e[c] += d * (scale * toward);
+            }
         }
     }
     std::vector<std::array<double, 3>> h(size_t(top.size()), {0, 0, 0});
-    for (const LeafLink& link : links.leaf) {
-        std::array<double, 3>& acc = h[size_t(link.receiver - top.begin)];
-        const Rgb& source = b[size_t(link.source)];
-        for (size_t c = 0; c < 3; ++c) acc[c] += double(link.f) * source[int(c)];
+    for (int32_t i = 0; i < top.size(); ++i) {
+        std::array<double, 3>& acc = h[size_t(i)];
+        for (uint32_t k = links.leaf_start[size_t(i)]; k < links.leaf_start[size_t(i) + 1]; ++k) {
+            const Rgb& source = b[size_t(links.leaf[k].source)];
+            for (size_t c = 0; c < 3; ++c) acc[c] += double(links.leaf[k].f) * source[int(c)];
+        }
     }
     // Push: a side receives what every ancestor up to the group root received.
     auto push = [&](auto& self, int32_t i, NodeExitance above) -> void {
@@ -343,18 +381,10 @@ GroupSweep RadiosityHierarchy::SweepGroup(int32_t group, std::span<const NodeExi
         for (size_t c = 0; c < 3; ++c) acc[c] += std::max(0.0, Dot(n, above[c]));
     };
     push(push, root, NodeExitance{});
-    GroupSweep sums;
-    for (int32_t t = top.begin; t < top.end; ++t) {
-        const std::array<double, 3>& acc = h[size_t(t - top.begin)];
-        const Rgb &e = system_.emission[size_t(t)], &rho = system_.reflectance[size_t(t)];
-        Rgb& o = out[size_t(t - top.begin)];
-        o = Rgb(float(e.r + rho.r * acc[0]), float(e.g + rho.g * acc[1]),
-                float(e.b + rho.b * acc[2]));
-        const double area = system_.area[size_t(t)];
-        sums.change += RadiosityPower(area, o - b[size_t(t)]);
-        sums.power += RadiosityPower(area, b[size_t(t)]);
+    for (size_t k = 0; k < h.size(); ++k) {
+        out[k] = Rgb(float(h[k][0]), float(h[k][1]), float(h[k][2]));
     }
-    return sums;
+    return SweepSums(system_, top.begin, b, out);
 }
 
 GroupSweep RadiosityHierarchy::Sweep(std::span<const Rgb> b, std::span<Rgb> next,
@@ -379,7 +409,9 @@ GroupSweep RadiosityHierarchy::Sweep(std::span<const Rgb> b, std::span<Rgb> next
 size_t RadiosityHierarchy::link_bytes() const {
     size_t bytes = 0;
     for (const GroupLinks& l : links_) {
-        bytes += l.node.capacity() * sizeof(NodeLink) + l.leaf.capacity() * sizeof(LeafLink);
+        bytes += (l.node_start.capacity() + l.node_source.capacity() + l.leaf_start.capacity()) *
+                     sizeof(uint32_t) +
+                 l.leaf.capacity() * sizeof(LeafSource);
     }
     return bytes + links_.size() * sizeof(GroupLinks);
 }
@@ -393,19 +425,10 @@ size_t RadiosityHierarchy::bytes() const {
 
 absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,
                                               const SolveOptions& options) {
-    const RadiositySystem& system = hierarchy.system();
-    std::vector<Rgb> b = system.emission;
-    double emitted = 0;
-    for (size_t t = 0; t < b.size(); ++t) emitted += RadiosityPower(system.area[t], b[t]);
-    if (emitted == 0) {
-        SolveResult dark;
-        dark.radiosity.assign(b.size(), Rgb(0));
-        return dark;
-    }
     return IterateJacobi(
-        std::move(b),
-        [&](std::span<const Rgb> from, std::span<Rgb> to, const std::atomic<bool>* cancel) {
-            return hierarchy.Sweep(from, to, cancel);
+        hierarchy.system(),
+        [&](std::span<const Rgb> b, std::span<Rgb> gathered, const std::atomic<bool>* cancel) {
+            return hierarchy.Sweep(b, gathered, cancel);
         },
         options);
 }

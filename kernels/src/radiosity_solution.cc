@@ -15,7 +15,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "the solution file is little-endian");
 
 constexpr char kMagic[8] = {'L', 'F', 'R', 'A', 'D', 'S', 'O', 'L'};
-constexpr uint32_t kVersion = 2;  // 1: no split cells
+constexpr uint32_t kVersion = 3;  // 1: no split cells; 1 and 2: no irradiance
 // A scene hash is a hex digest; anything longer is a corrupt length field.
 constexpr uint32_t kMaxHashLength = 1024;
 
@@ -32,6 +32,10 @@ bool Get(std::ifstream& in, T& value) {
 }  // namespace
 
 absl::Status SaveRadiositySolution(const std::string& path, const RadiositySolution& solution) {
+    if (solution.irradiance.size() != solution.radiosity.size()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(path, ": a radiosity solution needs one irradiance per side"));
+    }
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     if (!out) return absl::NotFoundError(absl::StrCat(path, ": cannot write radiosity solution"));
     out.write(kMagic, sizeof kMagic);
@@ -48,8 +52,10 @@ absl::Status SaveRadiositySolution(const std::string& path, const RadiositySolut
         for (int32_t v : {c.mesh, c.primitive, c.level, c.i, c.j, int32_t(c.up)}) Put(out, v);
     }
     static_assert(sizeof(Rgb) == 3 * sizeof(float));
-    out.write(reinterpret_cast<const char*>(solution.radiosity.data()),
-              std::streamsize(solution.radiosity.size() * sizeof(Rgb)));
+    for (const std::vector<Rgb>* values : {&solution.radiosity, &solution.irradiance}) {
+        out.write(reinterpret_cast<const char*>(values->data()),
+                  std::streamsize(values->size() * sizeof(Rgb)));
+    }
     out.close();
     if (!out) return absl::DataLossError(absl::StrCat(path, ": error writing radiosity solution"));
     return absl::OkStatus();
@@ -68,7 +74,12 @@ absl::StatusOr<RadiositySolution> LoadRadiositySolution(const std::string& path)
         return corrupt("bad magic");
     }
     if (!Get(in, version) || version < 1 || version > kVersion) {
-        return corrupt(absl::StrCat("version ", version, ", expected 1 to ", kVersion));
+        return corrupt(absl::StrCat("version ", version, ", expected ", kVersion));
+    }
+    if (version < kVersion) {
+        return absl::FailedPreconditionError(absl::StrCat(
+            path, ": a version ", version,
+            " radiosity solution holds no irradiance, which the illuminance needs; solve again"));
     }
     if (!Get(in, hash_length) || hash_length > kMaxHashLength) return corrupt("bad scene hash");
     RadiositySolution solution;
@@ -82,7 +93,7 @@ absl::StatusOr<RadiositySolution> LoadRadiositySolution(const std::string& path)
     }
     solution.iterations = iterations;
     int64_t split = 0;
-    if (version >= 2 && (!Get(in, split) || split < 0)) return corrupt("truncated header");
+    if (!Get(in, split) || split < 0) return corrupt("truncated header");
     for (int64_t n = 0; n < split; ++n) {
         std::array<int32_t, 6> v;
         for (int32_t& x : v) {
@@ -94,13 +105,17 @@ absl::StatusOr<RadiositySolution> LoadRadiositySolution(const std::string& path)
     const std::streamoff header_end = in.tellg();
     in.seekg(0, std::ios::end);
     const std::streamoff payload = in.tellg() - header_end;
-    if (payload != std::streamoff(sides) * std::streamoff(sizeof(Rgb))) {
-        return corrupt(absl::StrCat(payload, " bytes of radiosity for ", sides, " sides"));
+    const std::streamoff per_vector = std::streamoff(sides) * std::streamoff(sizeof(Rgb));
+    if (payload != 2 * per_vector) {
+        return corrupt(
+            absl::StrCat(payload, " bytes of radiosity and irradiance for ", sides, " sides"));
     }
     in.seekg(header_end);
-    solution.radiosity.resize(size_t(sides));
-    if (!in.read(reinterpret_cast<char*>(solution.radiosity.data()), payload)) {
-        return corrupt("truncated radiosity");
+    for (std::vector<Rgb>* values : {&solution.radiosity, &solution.irradiance}) {
+        values->resize(size_t(sides));
+        if (!in.read(reinterpret_cast<char*>(values->data()), per_vector)) {
+            return corrupt("truncated radiosity");
+        }
     }
     return solution;
 }

@@ -21,6 +21,18 @@ double SystemPower(const RadiositySystem& system, std::span<const Rgb> b) {
     return power;
 }
 
+// Nothing emits: no light anywhere, and no sweeps (whose relative residual would be 0 / 0).
+SolveResult Dark(const RadiositySystem& system) {
+    SolveResult dark;
+    dark.radiosity.assign(system.emission.size(), Rgb(0));
+    dark.irradiance = dark.radiosity;
+    return dark;
+}
+
+double Relative(const GroupSweep& sweep) {
+    return sweep.power > 0 ? sweep.change / sweep.power : sweep.change;
+}
+
 absl::Status Validate(const RadiositySystem& system) {
     const size_t n = system.emission.size();
     if (!system.form_factors || system.form_factors->size() != int32_t(n) ||
@@ -83,17 +95,17 @@ class SolveLog {
 
 absl::Status SolveCancelled() { return absl::CancelledError("radiosity: solve cancelled"); }
 
-// b_next = E + ρ F b for every group at once, and the sweep's residual sums. Once `cancel` is
-// set the remaining groups are skipped (the sums are then meaningless).
-GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, std::span<Rgb> next,
-                       const std::atomic<bool>* cancel = nullptr) {
+// The irradiance F b every group gathers, at once, and the sweep's residual sums. Once `cancel`
+// is set the remaining groups are skipped (the sums are then meaningless).
+GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b,
+                       std::span<Rgb> gathered, const std::atomic<bool>* cancel = nullptr) {
     const auto& groups = system.form_factors->groups();
     std::vector<GroupSweep> parts(groups.size());
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
         if (CancelRequested(cancel)) return;
         const PatchGroup& group = groups[g];
         parts[g] = JacobiGroup(system, int32_t(g), b,
-                               next.subspan(size_t(group.begin), size_t(group.size())));
+                               gathered.subspan(size_t(group.begin), size_t(group.size())));
     });
     GroupSweep total;
     for (const GroupSweep& p : parts) {
@@ -105,16 +117,20 @@ GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b, st
 
 }  // namespace
 
-absl::StatusOr<SolveResult> IterateJacobi(std::vector<Rgb> emission, const JacobiStep& step,
+absl::StatusOr<SolveResult> IterateJacobi(const RadiositySystem& system, const JacobiStep& step,
                                           const SolveOptions& options) {
+    if (SystemPower(system, system.emission) == 0) return Dark(system);
     SolveResult result;
-    std::vector<Rgb> b = std::move(emission), next(b.size());
+    const size_t n = system.emission.size();
+    std::vector<Rgb> h(n), next(n), b = system.emission;  // nothing gathered yet
     SolveLog log;
     for (;;) {
         const GroupSweep sweep = step(b, next, options.cancel);
         if (CancelRequested(options.cancel)) return SolveCancelled();
         const double residual = sweep.change / sweep.power;
         ++result.iterations;
+        h.swap(next);
+        b = RadiosityFromIrradiance(system, h);
         if (residual <= options.tolerance) {
             result.residual = residual;
             break;
@@ -123,10 +139,10 @@ absl::StatusOr<SolveResult> IterateJacobi(std::vector<Rgb> emission, const Jacob
             return NotConverged(result.iterations, residual, options.tolerance);
         }
         log.Maybe("jacobi sweep", result.iterations, residual);
-        b.swap(next);
     }
     result.sweeps = result.iterations;
     result.radiosity = std::move(b);
+    result.irradiance = std::move(h);
     return result;
 }
 
@@ -135,19 +151,20 @@ namespace {
 absl::StatusOr<SolveResult> SolveJacobi(const RadiositySystem& system,
                                         const SolveOptions& options) {
     return IterateJacobi(
-        system.emission,
-        [&](std::span<const Rgb> b, std::span<Rgb> next, const std::atomic<bool>* cancel) {
-            return JacobiSweep(system, b, next, cancel);
+        system,
+        [&](std::span<const Rgb> b, std::span<Rgb> gathered, const std::atomic<bool>* cancel) {
+            return JacobiSweep(system, b, gathered, cancel);
         },
         options);
 }
 
 // Gauss-Seidel converges monotonically from below (E, ρ, F >= 0), so a sweep's change bounds
-// the residual of the solution it started from; the exact residual confirms the stop.
+// the residual of the solution it started from; the exact residual confirms the stop. Each
+// side keeps the irradiance its last update gathered, so B = E + ρ H holds side by side.
 absl::StatusOr<SolveResult> SolveGaussSeidel(const RadiositySystem& system,
                                              const SolveOptions& options) {
     SolveResult result;
-    std::vector<Rgb> b = system.emission, updated;
+    std::vector<Rgb> b = system.emission, h(b.size());
     const auto& groups = system.form_factors->groups();
     SolveLog log;
     for (;;) {
@@ -155,11 +172,12 @@ absl::StatusOr<SolveResult> SolveGaussSeidel(const RadiositySystem& system,
         for (size_t g = 0; g < groups.size(); ++g) {
             if (CancelRequested(options.cancel)) return SolveCancelled();
             const PatchGroup& group = groups[g];
-            updated.resize(size_t(group.size()));
-            GatherGroup(system, int32_t(g), b, updated);
+            const std::span<Rgb> gathered(&h[size_t(group.begin)], size_t(group.size()));
+            GatherGroup(system, int32_t(g), b, gathered);
             for (int32_t i = group.begin; i < group.end; ++i) {
                 Rgb& bi = b[size_t(i)];
-                const Rgb& ui = updated[size_t(i - group.begin)];
+                const Rgb ui = RadiosityFromIrradiance(system.emission[size_t(i)],
+                                                       system.reflectance[size_t(i)], h[size_t(i)]);
                 change += RadiosityPower(system.area[size_t(i)], ui - bi);
                 bi = ui;
             }
@@ -178,10 +196,12 @@ absl::StatusOr<SolveResult> SolveGaussSeidel(const RadiositySystem& system,
         log.Maybe("gauss-seidel sweep", result.iterations, estimate);
     }
     result.radiosity = std::move(b);
+    result.irradiance = std::move(h);
     return result;
 }
 
-// The tracked residual drifts from the exact one by rounding, so a stop is confirmed exactly.
+// The tracked residual drifts from the exact one by rounding, so a stop is confirmed exactly, by
+// the sweep that also gathers the irradiance of the result.
 absl::StatusOr<SolveResult> SolveShooting(const RadiositySystem& system,
                                           const SolveOptions& options) {
     ShootingSolver shooter(system);
@@ -192,7 +212,8 @@ absl::StatusOr<SolveResult> SolveShooting(const RadiositySystem& system,
         if (CancelRequested(options.cancel)) return SolveCancelled();
         if (shooter.residual() <= options.tolerance) {
             result.radiosity = shooter.Radiosity();
-            result.residual = RelativeResidual(system, result.radiosity);
+            result.irradiance.resize(result.radiosity.size());
+            result.residual = Relative(JacobiSweep(system, result.radiosity, result.irradiance));
             ++exact_checks;
             if (result.residual <= options.tolerance) break;
         }
@@ -256,31 +277,42 @@ void GatherGroup(const RadiositySystem& system, int32_t group, std::span<const R
             acc[2] += s2;
         }
     }
-    for (int32_t i = g.begin; i < g.end; ++i) {
-        const double* acc = &sum[size_t(i - g.begin) * 3];
-        const Rgb &e = system.emission[size_t(i)], &rho = system.reflectance[size_t(i)];
-        out[size_t(i - g.begin)] = Rgb(float(e.r + rho.r * acc[0]), float(e.g + rho.g * acc[1]),
-                                       float(e.b + rho.b * acc[2]));
+    for (size_t i = 0; i < size_t(g.size()); ++i) {
+        out[i] = Rgb(float(sum[i * 3]), float(sum[i * 3 + 1]), float(sum[i * 3 + 2]));
     }
+}
+
+std::vector<Rgb> RadiosityFromIrradiance(const RadiositySystem& system,
+                                         std::span<const Rgb> irradiance) {
+    std::vector<Rgb> b(irradiance.size());
+    for (size_t i = 0; i < b.size(); ++i) {
+        b[i] = RadiosityFromIrradiance(system.emission[i], system.reflectance[i], irradiance[i]);
+    }
+    return b;
+}
+
+GroupSweep SweepSums(const RadiositySystem& system, int32_t begin, std::span<const Rgb> b,
+                     std::span<const Rgb> gathered) {
+    GroupSweep sums;
+    for (size_t k = 0; k < gathered.size(); ++k) {
+        const size_t i = size_t(begin) + k;
+        const Rgb next =
+            RadiosityFromIrradiance(system.emission[i], system.reflectance[i], gathered[k]);
+        sums.change += RadiosityPower(system.area[i], next - b[i]);
+        sums.power += RadiosityPower(system.area[i], b[i]);
+    }
+    return sums;
 }
 
 GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
                        std::span<Rgb> out) {
     GatherGroup(system, group, b, out);
-    const PatchGroup& g = system.form_factors->groups()[size_t(group)];
-    GroupSweep sums;
-    for (int32_t i = g.begin; i < g.end; ++i) {
-        const double area = system.area[size_t(i)];
-        sums.change += RadiosityPower(area, out[size_t(i - g.begin)] - b[size_t(i)]);
-        sums.power += RadiosityPower(area, b[size_t(i)]);
-    }
-    return sums;
+    return SweepSums(system, system.form_factors->groups()[size_t(group)].begin, b, out);
 }
 
 double RelativeResidual(const RadiositySystem& system, std::span<const Rgb> b) {
-    std::vector<Rgb> next(b.size());
-    const GroupSweep sweep = JacobiSweep(system, b, next);
-    return sweep.power > 0 ? sweep.change / sweep.power : sweep.change;
+    std::vector<Rgb> gathered(b.size());
+    return Relative(JacobiSweep(system, b, gathered));
 }
 
 absl::StatusOr<SolveResult> SolveRadiosity(const RadiositySystem& system,
@@ -289,11 +321,7 @@ absl::StatusOr<SolveResult> SolveRadiosity(const RadiositySystem& system,
     if (!(options.tolerance > 0) || options.max_iterations < 1) {
         return absl::InvalidArgumentError("radiosity: tolerance and iteration limit must be > 0");
     }
-    if (SystemPower(system, system.emission) == 0) {
-        SolveResult dark;
-        dark.radiosity.assign(system.emission.size(), Rgb(0));
-        return dark;
-    }
+    if (SystemPower(system, system.emission) == 0) return Dark(system);
     switch (options.solver) {
         case RadiositySolver::kJacobi:
             return SolveJacobi(system, options);

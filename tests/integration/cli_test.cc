@@ -648,10 +648,36 @@ TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
     for (const char* text :
          {"method (--method radiosity): radiosity, because requested",
           "radiosity pilot: 242 patches", "radiosity pilot: 488 patches",
-          "cost of render --method radiosity --patches 1000: about", "s of form factors ("}) {
+          "cost of render --method radiosity --radiosity flat --patches 1000: about",
+          "s of form factors ("}) {
         EXPECT_NE(radiosity.output.find(text), std::string::npos) << text << "\n"
                                                                   << radiosity.output;
     }
+    // Hierarchical pilots cost links; a flat target whose pilots alone would need gigabytes of
+    // form factors is not piloted but bounded, and hierarchical is named.
+    const RunResult links = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
+                                      "/cornell_box.json --method radiosity --radiosity "
+                                      "hierarchical --patches 1000 --pilot-spp 2 --threads 2 "
+                                      "--resolution 16x16");
+    ASSERT_EQ(links.status, 0) << links.output;
+    for (const char* text : {"radiosity (hierarchical): --patches 1000 ->",
+                             "radiosity pilot: 242 patches", "unknowns: links ",
+                             "cost of render --method radiosity --radiosity hierarchical "
+                             "--patches 1000: about"}) {
+        EXPECT_NE(links.output.find(text), std::string::npos) << text << "\n" << links.output;
+    }
+    const RunResult huge = Lightfarm("plan " + std::string(LF_TEST_SCENES) +
+                                     "/cornell_box.json --method radiosity --patches 200000 "
+                                     "--pilot-spp 2 --threads 2 --resolution 16x16");
+    ASSERT_EQ(huge.status, 0) << huge.output;
+    EXPECT_NE(huge.output.find("no radiosity pilot: the scene's triangles mesh to more than 8000 "
+                               "unknowns"),
+              std::string::npos)
+        << huge.output;
+    EXPECT_NE(huge.output.find("MiB of form factors (unknowns^2 floats at most); --radiosity "
+                               "hierarchical grows about linearly instead"),
+              std::string::npos)
+        << huge.output;
     const RunResult refused = Lightfarm(
         "plan " + std::string(LF_TEST_SCENES) +
         "/khronos/AlphaBlendModeTest/AlphaBlendModeTest.gltf --camera auto --method radiosity "

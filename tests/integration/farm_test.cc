@@ -1004,7 +1004,9 @@ TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
     StartServer();
     StartWorker("w1");
     StartWorker("w2");
-    const std::string flags = "--method radiosity --patches 300 --solver jacobi";
+    // The illuminance comes from the swept irradiance (and the lights' direct part each worker
+    // computes again): the same bits too.
+    const std::string flags = "--method radiosity --patches 300 --solver jacobi --aov illuminance";
     int chunks = 0;
     for (int sweep_tasks : {3, 5}) {
         const std::string job = Submit(scene_, "--spp 2 --seed 6 --tile 16 --sweep-tasks " +
@@ -1221,7 +1223,8 @@ TEST_F(Farm, HierarchicalSweepsSurviveAWorkerKillAndAServerRestartWithTheLocalPi
     Child* doomed = StartWorker("doomed");
     StartWorker("survivor");
     const std::string flags =
-        "--method radiosity --patches 1500 --radiosity hierarchical --link-error 1e-4";
+        "--method radiosity --patches 1500 --radiosity hierarchical --link-error 1e-4 "
+        "--aov illuminance";
     const std::string job = Submit(scene_, "--spp 2 --seed 8 --tile 16 --sweep-tasks 3 " + flags);
     ASSERT_TRUE(KillMidTask(doomed, "doomed.log"));
     ASSERT_TRUE(WaitForText(dir_ / "server-1.log", "radiosity sweep 3:", milliseconds(60000)));

@@ -468,7 +468,7 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
                     task.task.index, task.chunk, r.sweep_tasks,
                     absl::ToDoubleSeconds(absl::Now() - start));
     }
-    std::span<const Rgb> input = chunk->emission();
+    std::span<const Rgb> input = chunk->start();
     if (!task.radiosity_hash.empty()) {
         if (loaded_.input_hash != task.radiosity_hash) {
             absl::StatusOr<std::vector<Rgb>> read = ReadRadiosity(task.radiosity_hash);

@@ -8,7 +8,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <map>
 #include <numbers>
 
@@ -253,10 +252,12 @@ TEST(RadiosityHierarchy, RefusesReflectanceOfOneAndNonFiniteValuesNamingTheSide)
     EXPECT_NE(h.status().message().find("side 5"), std::string::npos) << h.status();
 }
 
-// The farm's way: chunks of the groups swept against each sweep's radiosity, the sums added by
-// RadiositySolve, give PrepareRadiosity's bits for any chunk count.
+// The farm's way: chunks of the groups swept against each sweep's gathered irradiance, the sums
+// added by RadiositySolve, give PrepareRadiosity's bits for any chunk count: the radiosity, and
+// the irradiance with the point light's direct part, which RadiosityRendererFor computes again.
 TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
-    const Scene scene = CornellBox();
+    Scene scene = CornellBox();
+    scene.point_lights.push_back({{0.278, 0.45, 0.28}, Rgb(0.4f, 0.3f, 0.2f)});
     auto es = EmbreeScene::Build(scene);
     ASSERT_TRUE(es.ok()) << es.status();
     RadiosityOptions options = Hierarchical(1e-3);
@@ -272,26 +273,30 @@ TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
             tasks.push_back(std::move(*task));
         }
         RadiositySolve solve(chunks, options.tolerance, options.max_iterations);
-        std::vector<Rgb> b = tasks[0]->emission();
+        std::vector<Rgb> h = tasks[0]->start();  // the gathered irradiance
         for (;;) {
             for (int c = chunks - 1; c >= 0; --c) {
-                auto result = tasks[size_t(c)]->Sweep(solve.sweep(), b);
+                auto result = tasks[size_t(c)]->Sweep(solve.sweep(), h);
                 ASSERT_TRUE(result.ok()) << result.status();
                 ASSERT_TRUE(solve.Add(*result).ok());
             }
             ASSERT_TRUE(solve.SweepComplete());
             auto outcome = solve.FinishSweep();
             ASSERT_TRUE(outcome.ok()) << outcome.status();
-            b = std::move(outcome->radiosity);
+            h = std::move(outcome->radiosity);
             if (outcome->converged) break;
         }
-        auto farm = RadiosityRendererFor(**es, options, b);
+        auto farm = RadiosityRendererFor(**es, options, h);
         ASSERT_TRUE(farm.ok()) << farm.status();
-        const auto mine = (*farm)->radiosity(), theirs = (*local)->radiosity();
-        ASSERT_EQ(mine.size(), theirs.size());
-        EXPECT_TRUE(std::equal(mine.begin(), mine.end(), theirs.begin(),
-                               [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
-            << chunks << " chunks";
+        for (const auto& [mine, theirs] :
+             {std::pair((*farm)->radiosity(), (*local)->radiosity()),
+              std::pair((*farm)->display().irradiance(), (*local)->display().irradiance())}) {
+            ASSERT_EQ(mine.size(), theirs.size());
+            EXPECT_TRUE(
+                std::equal(mine.begin(), mine.end(), theirs.begin(),
+                           [](Rgb x, Rgb y) { return x.r == y.r && x.g == y.g && x.b == y.b; }))
+                << chunks << " chunks";
+        }
     }
 }
 
@@ -327,66 +332,5 @@ TEST(RadiosityHierarchy, CancelStopsTheBuild) {
               absl::StatusCode::kCancelled);
 }
 
-}  // namespace
-}  // namespace lf
-
-namespace lf {
-namespace {
-// Not a test: the numbers of the report (docs/radiosity.md "Hierarchical"), until the CLI has
-// --radiosity hierarchical. LF_BENCH_PATCH_SIZE (0.02: ~16k patches), LF_BENCH_LINK_ERROR,
-// LF_BENCH_FLAT=1 to compare with the flat Jacobi solve (LF_BENCH_FLAT_FILE: a solution file the
-// flat solve is saved to once and loaded from after). Run with
-// --gtest_also_run_disabled_tests --gtest_filter='*Bench*'.
-TEST(RadiosityHierarchy, DISABLED_BenchCornellBox) {
-    auto env = [](const char* name, double fallback) {
-        const char* v = std::getenv(name);
-        return v ? std::atof(v) : fallback;
-    };
-    RadiosityOptions options = Hierarchical(env("LF_BENCH_LINK_ERROR", 1e-3));
-    options.patch_size = env("LF_BENCH_PATCH_SIZE", 0.02);
-    options.tolerance = 1e-4;
-    options.threads = int(env("LF_BENCH_THREADS", 2));
-    const auto h = Solve(CornellBox(), options);
-    ASSERT_TRUE(h->renderer);
-    const RadiosityReport& r = h->renderer->report();
-    std::printf(
-        "hierarchical: %lld patches %lld sides, link %.2f s solve %.2f s (%d sweeps), "
-        "%lld + %lld links (%.1f per side), links %.1f MiB of %.1f MiB, %lld rays\n",
-        (long long)r.patches, (long long)r.sides, r.form_factor_seconds, r.solve_seconds,
-        r.iterations, (long long)r.cluster_links, (long long)r.side_links, r.links_per_side,
-        double(r.link_bytes) / (1 << 20), double(r.solver_bytes) / (1 << 20),
-        (long long)r.visibility_rays);
-    if (env("LF_BENCH_FLAT", 0) == 0) return;
-    RadiosityOptions flat = options;
-    flat.hierarchical = false;
-    flat.solver = RadiositySolver::kJacobi;
-    if (const char* file = std::getenv("LF_BENCH_FLAT_FILE")) {
-        (std::filesystem::exists(file) ? flat.load_solution : flat.save_solution) = file;
-    }
-    const auto f = Solve(CornellBox(), flat);
-    ASSERT_TRUE(f->renderer);
-    const RadiosityReport& fr = f->renderer->report();
-    std::printf("flat: form factors %.2f s solve %.2f s, %.1f MiB\n", fr.form_factor_seconds,
-                fr.solve_seconds, double(fr.form_factor_bytes) / (1 << 20));
-    const auto means = SurfaceMeans(*h->renderer), reference = SurfaceMeans(*f->renderer);
-    for (const auto& [key, m] : reference) {
-        std::printf("  mesh %d %s: flat %.4f hierarchical %.4f (%+.2f%%)\n", key.first,
-                    key.second ? "back" : "front", m, means.at(key),
-                    m > 0 ? 100 * (means.at(key) / m - 1) : 0.0);
-    }
-    double max_diff = 0, sum_diff = 0, sum = 0;
-    const auto hb = h->renderer->radiosity(), fb = f->renderer->radiosity();
-    for (size_t s = 0; s < hb.size(); ++s) {
-        for (int c = 0; c < 3; ++c) {
-            max_diff = std::max(max_diff, double(std::abs(hb[s][c] - fb[s][c])));
-            sum_diff += std::abs(hb[s][c] - fb[s][c]);
-            sum += fb[s][c];
-        }
-    }
-    std::printf(
-        "per side: max |difference| %.4f W/m^2, mean %.4f relative to the mean radiosity "
-        "%.4f\n",
-        max_diff, sum_diff / sum, sum / double(3 * hb.size()));
-}
 }  // namespace
 }  // namespace lf

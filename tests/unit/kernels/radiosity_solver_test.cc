@@ -226,21 +226,32 @@ TEST(RadiositySolver, SweepsAreSequencesOfThePureGroupStep) {
         options.solver = solver;
         auto result = SolveRadiosity(p->system, options);
         ASSERT_TRUE(result.ok()) << result.status();
-        std::vector<Rgb> b = p->system.emission, next(b.size());
+        // b = E + ρ h side by side, h the irradiance each side gathered last.
+        std::vector<Rgb> b = p->system.emission, h(b.size()), next(b.size()), measured;
         const bool jacobi = solver == RadiositySolver::kJacobi;
-        // Jacobi's last sweep only measures the residual of the solution it returns.
-        const int sweeps = jacobi ? result->iterations - 1 : result->iterations;
-        for (int k = 0; k < sweeps; ++k) {
+        for (int k = 0; k < result->iterations; ++k) {
+            measured = b;
             for (int32_t g = 0; g < int32_t(groups.size()); ++g) {
                 const PatchGroup& group = groups[size_t(g)];
                 std::span<Rgb> out(&next[size_t(group.begin)], size_t(group.size()));
                 GatherGroup(p->system, g, b, out);
-                if (!jacobi) std::copy(out.begin(), out.end(), b.begin() + group.begin);
+                if (jacobi) continue;
+                for (int32_t i = group.begin; i < group.end; ++i) {
+                    h[size_t(i)] = next[size_t(i)];
+                    b[size_t(i)] =
+                        RadiosityFromIrradiance(p->system.emission[size_t(i)],
+                                                p->system.reflectance[size_t(i)], h[size_t(i)]);
+                }
             }
-            if (jacobi) b.swap(next);
+            if (jacobi) {
+                h.swap(next);
+                b = RadiosityFromIrradiance(p->system, h);
+            }
         }
         EXPECT_EQ(b, result->radiosity) << RadiositySolverName(solver);
-        EXPECT_NEAR(RelativeResidual(p->system, b), result->residual, 1e-12);
+        EXPECT_EQ(h, result->irradiance) << RadiositySolverName(solver);
+        // Jacobi measured the radiosity its last sweep gathered from, Gauss-Seidel its result.
+        EXPECT_NEAR(RelativeResidual(p->system, jacobi ? measured : b), result->residual, 1e-12);
     }
 }
 

@@ -48,13 +48,13 @@ class RadiositySweepChunkTest : public ::testing::TestWithParam<bool> {
 // the solution's display from a chunk is RadiosityRendererFor's, report included.
 TEST_P(RadiositySweepChunkTest, SharedPullAndChunkMeshGiveTheBitsOfTheirOwn) {
     RadiositySolve solve(kChunks, options_.tolerance, options_.max_iterations);
-    std::vector<Rgb> b = chunks_[0]->emission();
+    std::vector<Rgb> h = chunks_[0]->start();  // the gathered irradiance
     for (;;) {
-        const std::vector<NodeExitance> pulled = chunks_[0]->Pull(b);
+        const std::vector<NodeExitance> pulled = chunks_[0]->Pull(h);
         EXPECT_EQ(pulled.empty(), !GetParam()) << "the flat method pulls nothing";
         for (int c = 0; c < kChunks; ++c) {
-            auto own = chunks_[size_t(c)]->Sweep(solve.sweep(), b);
-            auto shared = chunks_[size_t(c)]->Sweep(solve.sweep(), b, pulled);
+            auto own = chunks_[size_t(c)]->Sweep(solve.sweep(), h);
+            auto shared = chunks_[size_t(c)]->Sweep(solve.sweep(), h, pulled);
             ASSERT_TRUE(own.ok()) << own.status();
             ASSERT_TRUE(shared.ok()) << shared.status();
             EXPECT_TRUE(SameBits(own->output, shared->output)) << "chunk " << c;
@@ -63,11 +63,11 @@ TEST_P(RadiositySweepChunkTest, SharedPullAndChunkMeshGiveTheBitsOfTheirOwn) {
         }
         auto outcome = solve.FinishSweep();
         ASSERT_TRUE(outcome.ok()) << outcome.status();
-        b = std::move(outcome->radiosity);
+        h = std::move(outcome->radiosity);
         if (outcome->converged) break;
     }
-    auto built = RadiosityRendererFor(*embree_, options_, b);
-    auto reused = chunks_[1]->Renderer(*embree_, options_, b);
+    auto built = RadiosityRendererFor(*embree_, options_, h);
+    auto reused = chunks_[1]->Renderer(*embree_, options_, h);
     ASSERT_TRUE(built.ok()) << built.status();
     ASSERT_TRUE(reused.ok()) << reused.status();
     EXPECT_TRUE(SameBits((*built)->radiosity(), (*reused)->radiosity()));
@@ -78,15 +78,15 @@ TEST_P(RadiositySweepChunkTest, SharedPullAndChunkMeshGiveTheBitsOfTheirOwn) {
 
 // A solution or a pull of another size is refused with the sizes named, not read past its end.
 TEST_P(RadiositySweepChunkTest, RefusesASolutionOrPullOfAnotherSize) {
-    const std::vector<Rgb> b = chunks_[0]->emission();
-    const std::vector<Rgb> shorter(b.begin(), b.end() - 1);
+    const std::vector<Rgb> h = chunks_[0]->start();
+    const std::vector<Rgb> shorter(h.begin(), h.end() - 1);
     auto renderer = chunks_[0]->Renderer(*embree_, options_, shorter);
     EXPECT_EQ(renderer.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(renderer.status().message().find("unknowns"), std::string::npos) << renderer.status();
     if (!GetParam()) return;
-    std::vector<NodeExitance> pulled = chunks_[0]->Pull(b);
+    std::vector<NodeExitance> pulled = chunks_[0]->Pull(h);
     pulled.pop_back();
-    auto swept = chunks_[0]->Sweep(0, b, pulled);
+    auto swept = chunks_[0]->Sweep(0, h, pulled);
     EXPECT_EQ(swept.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(swept.status().message().find("a pull of"), std::string::npos) << swept.status();
 }

@@ -9,11 +9,11 @@
 // Where a split cell meets an unsplit one, the midpoint is a vertex of the finer side only (a
 // T-junction: the patches still tile the triangle, as Embree intersects the scene triangles).
 //
-// A patch has two sides. A side gets an unknown (a radiosity value to solve for) only if its
-// radiosity can be non-zero: it is the front of an emitter (either side of a two-sided one), or
-// its diffuse reflectance is not black and something (a vertex of another triangle, a light
-// that can shine on it) lies strictly in front of it.
-// Every other side has radiosity exactly zero: in a closed box only the inward sides remain.
+// A patch has two sides. A side gets an unknown (a radiosity and an irradiance to solve for)
+// only if either can be non-zero: it is the front of an emitter (either side of a two-sided one),
+// or something (a vertex of another triangle, a light that can shine on it) lies strictly in
+// front of it, whatever its reflectance (a black floor's illuminance is shown too).
+// Every other side receives and sends nothing: in a closed box only the inward sides remain.
 #pragma once
 
 #include <array>
@@ -43,8 +43,7 @@ std::string RadiosityLimitation(const Scene& scene);
 // maps are dropped.
 std::string RadiosityDrops(const Scene& scene);
 
-// Whether a material's diffuse part can reflect anything whatever its textures: a side of it
-// gets an unknown only then.
+// Whether a material's diffuse part can reflect anything whatever its textures.
 bool MayReflectDiffusely(const Material& material);
 
 // RadiosityLimitation as the error radiosity refuses a scene with (meshing, the solver, the

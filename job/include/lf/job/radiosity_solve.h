@@ -1,8 +1,9 @@
 // The farm's radiosity solve, without I/O: Jacobi sweeps, each split into patch-group tasks
 // (chunks of the patch groups, see lf::RadiositySweepChunk), until the relative residual is
-// below the tolerance. Sweep k's tasks all read the radiosity b_k (sweep 0: the emission E,
-// which the workers compute) and each returns its chunk's b_{k+1} and residual sums. The sums
-// are added in group order and the stop follows SolveRadiosity's Jacobi solver exactly, so the
+// below the tolerance. The state is the irradiance each side gathered, H_k (B_k = E + ρ H_k):
+// sweep k's tasks all read H_k (sweep 0: zero, which the workers start from) and each returns
+// its chunk's H_{k+1} and residual sums (of B, ||B_{k+1} - B_k|| and ||B_k||). The sums are
+// added in group order and the stop follows SolveRadiosity's Jacobi solver exactly, so the
 // solution has the bits of `lightfarm render --method radiosity --solver jacobi`.
 //
 // Jacobi, because its sweep splits into independent tasks; Gauss-Seidel and shooting update
@@ -34,6 +35,8 @@ class RadiositySolve {
 
     struct Outcome {
         bool converged = false;  // radiosity is the solution; else the next sweep's input
+        // The gathered irradiance H_{k+1} (RadiosityRendererFor turns a solution into B and the
+        // irradiance), named for the blob it travels in.
         std::vector<Rgb> radiosity;
         double residual = 0;  // of the sweep's input
         int iterations = 0;
@@ -48,7 +51,7 @@ class RadiositySolve {
     int max_iterations_;
     int sweep_ = 0;
     std::vector<std::optional<SweepChunkResult>> results_;  // by chunk, this sweep
-    std::vector<Rgb> input_;                                // b of this sweep, once known
+    std::vector<Rgb> input_;                                // H of this sweep, once known
 };
 
 }  // namespace lf

@@ -5,7 +5,9 @@
 // the sides alone, not on the thread count.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -17,18 +19,26 @@
 
 namespace lf {
 
+// The box, centroid, radius and area in single precision, rounded outward: a node is most of the
+// tree's memory, and the tree has two nodes per side. The normal cone and slab stay double: a
+// flat cluster's cone must be exactly flat, or coplanar sides would no longer be culled.
 struct ClusterNode {
     int32_t begin = 0, end = 0;  // sides in tree order
     int32_t right = -1;          // second child (the first is the next node); -1: a leaf
-    Vec3d lo, hi;                // bounding box of the sides' corners
-    Vec3d centroid;              // area-weighted
-    double radius = 0;           // bounding sphere about the centroid
-    double area = 0;
-    Vec3d axis;  // normal cone: every side's normal is within half_angle of axis
-    double half_angle = 0;
-    double cos_half_angle = 1, sin_half_angle = 0;
+    Vec3 lo, hi;                 // bounding box of the sides' corners
+    Vec3 centroid;               // area-weighted
+    float radius = 0;            // bounding sphere about the centroid
+    float area = 0;
+    Vec3d axis;  // normal cone: every side's normal is within the half-angle of axis
+    double cos_half_angle = 1;
     double axis_lo = 0, axis_hi = 0;  // the corners' extent along axis (a slab)
 
+    // Whether the cone is narrower than a half-space (the half-angle below 90 degrees).
+    bool narrow() const { return cos_half_angle > 0; }
+    double sin_half_angle() const {
+        const double c = cos_half_angle;
+        return std::sqrt(std::max(0.0, 1 - c * c));
+    }
     bool leaf() const { return right < 0; }
     int32_t size() const { return end - begin; }
     // The subtree's nodes are [this node, this node + nodes()) in preorder.

@@ -102,8 +102,10 @@ struct RadiosityReport {
 
 class RadiosityRenderer : public RadianceEstimator {
   public:
+    // Per side: the radiosity and all the irradiance arriving (RadiosityDisplay).
     RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh, std::vector<Rgb> radiosity,
-                      RadiosityShading shading, const RadiosityReport& report);
+                      std::vector<Rgb> irradiance, RadiosityShading shading,
+                      const RadiosityReport& report);
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override {
         return display_->Li(ray, sampler, stats);
@@ -133,8 +135,10 @@ class RadiosityRenderer : public RadianceEstimator {
 
 // One patch-group task of the farm's Jacobi solve (lf/job/radiosity_solve.h): the form-factor
 // rows of chunk `chunk` of `chunks` of the patch groups (hierarchical: the links of its groups
-// of the cluster tree), computed once, then swept against the radiosity of each sweep in turn. The
-// sweep's sums are those SolveRadiosity's Jacobi solver makes, so the farm's solution has its bits.
+// of the cluster tree), computed once, then swept in turn against each sweep's state: the
+// irradiance every side gathered in the sweep before (F B, the Jacobi iterate IterateJacobi
+// keeps; B = E + ρ H). The sweep's sums are those SolveRadiosity's Jacobi solver makes, so the
+// farm's solution has its bits.
 class RadiositySweepChunk {
   public:
     // The same checks as PrepareRadiosity; InvalidArgument for a chunk outside 0..chunks-1 and
@@ -143,20 +147,21 @@ class RadiositySweepChunk {
         const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks,
         const std::atomic<bool>* cancel = nullptr);
 
-    int32_t sides() const { return int32_t(emission().size()); }
-    // E: the radiosity sweep 0 starts from. Hierarchical: the unknowns in the cluster tree's
-    // order (RadiosityRendererFor maps them back to the mesh's sides).
-    const std::vector<Rgb>& emission() const {
-        return hierarchy_ ? hierarchy_->system().emission : system_.emission;
-    }
-    // The chunk's part of one sweep from `b` (all sides); InvalidArgument when b is not one
-    // value per side. Runs in the caller's TBB arena.
-    absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> b) const;
-    // Hierarchical: the pull of `b` over the whole tree, the same for every chunk of a system
-    // (a worker holding several chunks pulls once a sweep); empty for the flat method.
-    std::vector<NodeExitance> Pull(std::span<const Rgb> b) const;
-    // Sweep with `pulled` = Pull(b) of this chunk or of another of the same system.
-    absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> b,
+    int32_t sides() const { return int32_t(system().emission.size()); }
+    // E, ρ and A per unknown. Hierarchical: the unknowns in the cluster tree's order
+    // (RadiosityRendererFor maps them back to the mesh's sides).
+    const RadiositySystem& system() const { return hierarchy_ ? hierarchy_->system() : system_; }
+    // The state sweep 0 starts from: nothing gathered yet (B = E).
+    const std::vector<Rgb>& start() const { return start_; }
+    // The chunk's part of one sweep from the gathered irradiance `h` (all sides): its sides' new
+    // irradiance from B = E + ρ h; InvalidArgument when h is not one value per side. Runs in the
+    // caller's TBB arena.
+    absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> h) const;
+    // Hierarchical: the pull up the whole tree of B = E + ρ h, the same for every chunk of a
+    // system (a worker holding several chunks pulls once a sweep); empty for the flat method.
+    std::vector<NodeExitance> Pull(std::span<const Rgb> h) const;
+    // Sweep with `pulled` = Pull(h) of this chunk or of another of the same system.
+    absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> h,
                                            std::span<const NodeExitance> pulled) const;
     // Hierarchical: the links of the chunk's receivers, their bytes and the chunk's solver bytes
     // (the farm's header sums them over the chunks; the links add up to local mode's); zeros for
@@ -166,7 +171,7 @@ class RadiositySweepChunk {
     // chunk of the system: not built again for the display. `options` as the chunk was built.
     absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Renderer(const EmbreeScene& scene,
                                                                 const RadiosityOptions& options,
-                                                                std::vector<Rgb> radiosity) const;
+                                                                std::vector<Rgb> gathered) const;
 
   private:
     RadiositySweepChunk() = default;
@@ -176,17 +181,20 @@ class RadiositySweepChunk {
     FormFactors form_factors_;  // the chunk's rows only
     RadiositySystem system_;
     std::unique_ptr<RadiosityHierarchy> hierarchy_;  // instead, hierarchical: the chunk's links
+    std::vector<Rgb> start_;
 };
 
 // The renderer of a solution solved elsewhere (by the farm's sweeps): the scene meshed as
-// `options` say, displaying `radiosity` (hierarchical: in the cluster tree's order);
+// `options` say, the final sweep state `gathered` (hierarchical: in the cluster tree's order)
+// giving B = E + ρ H and, with the lights' direct irradiance computed again, the irradiance;
 // InvalidArgument unless it holds one value per side, and for a target error (the sweeps solve an
 // unrefined mesh).
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
-    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> radiosity);
+    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> gathered);
 
 // The system B = E + ρ F B of `mesh`: E the exitance π L_e of emitters' front sides plus the
-// lights' direct light reflected. After `cancel` is set the system is unusable: callers check it.
+// lights' direct light reflected, and that direct irradiance. After `cancel` is set the system is
+// unusable: callers check it.
 RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& mesh,
                                     const FormFactors& form_factors,
                                     const std::atomic<bool>* cancel = nullptr);

@@ -37,9 +37,10 @@ std::vector<std::array<Rgb, 3>> SmoothCorners(const PatchMesh& mesh,
 
 class RadiosityDisplay : public RadianceEstimator {
   public:
-    // `mesh` must outlive the display; `radiosity` has one value per side.
+    // `mesh` must outlive the display; `radiosity` and `irradiance` (all the light arriving,
+    // the lights' direct irradiance included) have one value per side.
     RadiosityDisplay(const EmbreeScene& scene, const PatchMesh& mesh, std::vector<Rgb> radiosity,
-                     RadiosityShading shading);
+                     std::vector<Rgb> irradiance, RadiosityShading shading);
     ~RadiosityDisplay() override;
 
     Rgb Li(const Ray& ray, Sampler& sampler, RenderStats& stats) const override;
@@ -49,11 +50,11 @@ class RadiosityDisplay : public RadianceEstimator {
     // material is textured (or has vertex colours) albedo(uv) H / pi + Le(uv), H the side's
     // irradiance, so a texture keeps its detail. Sides without an unknown have radiosity 0.
     Rgb Radiance(int mesh, int primitive, double b1, double b2, bool back) const;
-    // Irradiance (W m^-2) arriving on that side, shaded as the radiance is: (B - emitted
-    // exitance) / reflectance per side and channel, both as the solve had them (patch averages
-    // of textured materials); 0 where the reflectance is 0, whose irradiance the solution does
-    // not hold.
+    // Irradiance (W m^-2) arriving on that side, shaded as the radiance is: the solve's per side
+    // (the lights' direct irradiance plus F B), whatever the reflectance there; 0 on a side
+    // without an unknown, which nothing lies in front of.
     Rgb Irradiance(int mesh, int primitive, double b1, double b2, bool back) const;
+    std::span<const Rgb> irradiance() const { return irradiance_; }  // per side
 
   private:
     const EmbreeScene& scene_;
@@ -62,7 +63,7 @@ class RadiosityDisplay : public RadianceEstimator {
     Rgb Shade(std::span<const Rgb> per_side, const std::vector<std::array<Rgb, 3>>& corners,
               int mesh, int primitive, double b1, double b2, bool back) const;
 
-    std::unique_ptr<const RadiositySurfaces> surfaces_;
+    std::unique_ptr<const RadiositySurfaces> surfaces_;  // textured albedo and emission
     std::unique_ptr<const LightSampler> sky_;  // what rays that leave the scene see, if any
     std::vector<Rgb> radiosity_, irradiance_;
     // Smooth shading only.

@@ -63,13 +63,13 @@ class RadiosityHierarchy {
 
     // Every node's exitance from b (tree order): the pull, O(n).
     std::vector<NodeExitance> Pull(std::span<const Rgb> b) const;
-    // One group's Jacobi step: out = E + ρ H(b) over the group's sides (gather over its links,
-    // push down to its sides), and JacobiGroup's sums. `pulled` is Pull(b).
+    // One group's Jacobi step: out = H(b), the irradiance its sides gather (over its links,
+    // pushed down to its sides), and JacobiGroup's sums (SweepSums). `pulled` is Pull(b).
     GroupSweep SweepGroup(int32_t group, std::span<const NodeExitance> pulled,
                           std::span<const Rgb> b, std::span<Rgb> out) const;
     // SweepGroup over every linked group; the sums in group order. Stops early once `cancel`
     // is set (the result is then meaningless).
-    GroupSweep Sweep(std::span<const Rgb> b, std::span<Rgb> next,
+    GroupSweep Sweep(std::span<const Rgb> b, std::span<Rgb> gathered,
                      const std::atomic<bool>* cancel = nullptr) const;
 
     int64_t node_links() const { return node_links_; }
@@ -79,17 +79,18 @@ class RadiosityHierarchy {
     size_t bytes() const;  // tree, per-side data and links
 
   private:
-    struct NodeLink {
-        int32_t receiver, source;  // nodes (the direction is that of their centroids)
-        float visibility;
-    };
-    struct LeafLink {
-        int32_t receiver, source;  // tree positions
-        float f;                   // F_receiver,source
+    // A group's links by receiver, in compressed rows: links are most of the solver's memory.
+    // Node i of the group's subtree (root + i) gathers from node_source[node_start[i] ..
+    // node_start[i + 1]), each entry a source node << 2 | (visible rays - 1) of kClusterRays (4)
+    // (the direction is that of the centroids); side begin + i from leaf[leaf_start[i] ..
+    // leaf_start[i + 1]).
+    struct LeafSource {
+        int32_t source;  // tree position
+        float f;         // F_receiver,source
     };
     struct GroupLinks {
-        std::vector<NodeLink> node;
-        std::vector<LeafLink> leaf;
+        std::vector<uint32_t> node_start, node_source, leaf_start;
+        std::vector<LeafSource> leaf;
     };
     class Linker;
 
@@ -106,8 +107,8 @@ class RadiosityHierarchy {
 };
 
 // Jacobi sweeps over every group until the relative residual is below the tolerance, as
-// SolveRadiosity's Jacobi solver stops; the radiosity in tree order. ResourceExhausted at the
-// iteration limit, Cancelled soon after options.cancel is set.
+// SolveRadiosity's Jacobi solver stops; the radiosity and gathered irradiance in tree order.
+// ResourceExhausted at the iteration limit, Cancelled soon after options.cancel is set.
 absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,
                                               const SolveOptions& options);
 

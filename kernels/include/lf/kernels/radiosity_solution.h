@@ -2,11 +2,12 @@
 // names the scene by content hash and the meshing by its patch size and split cells, so a
 // solution is never applied to a scene or mesh it was not computed for.
 //
-// Binary, little-endian: "LFRADSOL", u32 version (2), u32 length + bytes of the scene hash,
+// Binary, little-endian: "LFRADSOL", u32 version (3), u32 length + bytes of the scene hash,
 // f64 patch size, i64 patch count, i64 side count, i32 iterations, f64 residual, i64 count of
 // split cells and six i32 per cell (mesh, triangle, level, i, j, 1 if upward), then three f32
-// (R, G, B radiosity, W m^-2) per side in PatchMesh::sides() order. Version 1, from before
-// refinement, has no split cells and still loads.
+// (R, G, B radiosity, W m^-2) per side in PatchMesh::sides() order, then three f32 (irradiance,
+// W m^-2) per side. Versions 1 and 2 held no irradiance, which the radiosity cannot give where
+// a reflectance channel is 0: they are refused (FailedPrecondition, solve again).
 #pragma once
 
 #include <cstdint>
@@ -26,6 +27,7 @@ struct RadiositySolution {
     int iterations = 0;
     double residual = 0;
     std::vector<Rgb> radiosity;    // per side
+    std::vector<Rgb> irradiance;   // per side: all arriving, the lights' direct included
     std::vector<PatchCell> split;  // PatchMeshOptions::split of the mesh
 };
 

@@ -7,11 +7,15 @@
 // row sum, 1 in a closed scene), so a solve takes about ln(tolerance / (1 - ρ)) / ln(ρ) sweeps,
 // and B is within about tolerance / (1 - ρ) of the solution.
 //
-// Jacobi and Gauss-Seidel are sequences of one pure step, GatherGroup: the new B of one group
-// of sides from a solution so far. A Jacobi sweep applies it to every group against the same
-// previous solution (in parallel); Gauss-Seidel applies the groups in order, each seeing the
-// updates of those before it. Shooting (progressive refinement) sends the unshot radiosity of
-// the group holding the most unshot power into the scene, one group at a time.
+// Jacobi and Gauss-Seidel are sequences of one pure step, GatherGroup: the irradiance H = F B
+// one group of sides gathers from a solution so far, whose new radiosity is E + ρ H
+// (RadiosityFromIrradiance). A Jacobi sweep applies it to every group against the same previous
+// solution (in parallel); Gauss-Seidel applies the groups in order, each seeing the updates of
+// those before it. Shooting (progressive refinement) sends the unshot radiosity of the group
+// holding the most unshot power into the scene, one group at a time.
+//
+// Every solver returns the gathered irradiance with B: it is what the illuminance shows, and
+// (B - E) / ρ cannot give it where a channel of ρ is 0.
 #pragma once
 
 #include <atomic>
@@ -39,6 +43,10 @@ struct RadiositySystem {
     std::vector<Rgb> emission;
     std::vector<Rgb> reflectance;
     std::vector<double> area;
+    // Per side: the lights' direct irradiance (W m^-2), which `emission` holds reflected. The
+    // solvers do not read it; the display adds it to the gathered irradiance. Empty where no one
+    // needs it (hand-made systems, the hierarchy's copy in tree order).
+    std::vector<Rgb> direct;
 };
 
 struct SolveOptions {
@@ -52,6 +60,10 @@ struct SolveOptions {
 
 struct SolveResult {
     std::vector<Rgb> radiosity;
+    // Per side, F B gathered from the other sides (W m^-2; the lights' direct irradiance is not
+    // in it). Jacobi and Gauss-Seidel: radiosity = E + ρ irradiance exactly; shooting: F of its
+    // radiosity. Jacobi's `residual` is that of the radiosity its last sweep gathered from.
+    std::vector<Rgb> irradiance;
     int iterations = 0;   // sweeps (Jacobi, Gauss-Seidel) or group shots (shooting)
     double sweeps = 0;    // form-factor work in units of one pass over the whole matrix
     double residual = 0;  // relative residual of `radiosity`, computed exactly
@@ -67,30 +79,50 @@ absl::Status CheckRadiosityValues(const RadiositySystem& system);
 absl::StatusOr<SolveResult> SolveRadiosity(const RadiositySystem& system,
                                            const SolveOptions& options);
 
-// The pure step: out[i - group.begin] = E_i + ρ_i Σ_j F_ij b_j for the sides i of `group`.
+// A side's radiosity E + ρ H from the irradiance H it gathered, in double and rounded once: the
+// one formula of the solvers, the farm's sweeps and the display, so all have the same bits.
+inline Rgb RadiosityFromIrradiance(const Rgb& emission, const Rgb& reflectance, const Rgb& h) {
+    return Rgb(float(double(emission.r) + double(reflectance.r) * h.r),
+               float(double(emission.g) + double(reflectance.g) * h.g),
+               float(double(emission.b) + double(reflectance.b) * h.b));
+}
+// That for every side of `system`.
+std::vector<Rgb> RadiosityFromIrradiance(const RadiositySystem& system,
+                                         std::span<const Rgb> irradiance);
+
+// The pure step: out[i - group.begin] = Σ_j F_ij b_j, the irradiance the sides i of `group`
+// gather from radiosity b.
 void GatherGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
                  std::span<Rgb> out);
 
-// GatherGroup, and the group's share of a Jacobi sweep's residual: change = ||out - b|| and
-// power = ||b|| over the group's sides. A sweep sums these in group order, locally and on the
-// farm alike (lf/job/radiosity_solve.h), so both stop after the same sweep with the same bits.
+// A group's share of a Jacobi sweep's residual, with `gathered` the new irradiance of its sides
+// from `begin` on: change = ||B_new - b|| (B_new = E + ρ gathered) and power = ||b|| over them. A
+// sweep sums these in group order, locally and on the farm alike (lf/job/radiosity_solve.h), so
+// both stop after the same sweep with the same bits.
 struct GroupSweep {
     double change = 0, power = 0;
 };
+GroupSweep SweepSums(const RadiositySystem& system, int32_t begin, std::span<const Rgb> b,
+                     std::span<const Rgb> gathered);
+// GatherGroup, and its SweepSums.
 GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
                        std::span<Rgb> out);
 
 // The power of radiosity c over `area` in that norm: area (|r| + |g| + |b|).
 double RadiosityPower(double area, const Rgb& c);
 
-// One Jacobi sweep: `next` from `b`, and the sweep's sums (stopping early, with meaningless sums,
-// once `cancel` is set).
-using JacobiStep = std::function<GroupSweep(std::span<const Rgb> b, std::span<Rgb> next,
+// One Jacobi sweep: the irradiance `gathered` from radiosity `b`, and the sweep's sums (stopping
+// early, with meaningless sums, once `cancel` is set).
+using JacobiStep = std::function<GroupSweep(std::span<const Rgb> b, std::span<Rgb> gathered,
                                             const std::atomic<bool>* cancel)>;
-// The Jacobi solver's loop over any sweep (the flat one, the hierarchical one): sweeps from
-// `emission` until a sweep's change / power is at most the tolerance; ResourceExhausted at the
-// iteration limit, Cancelled soon after options.cancel is set.
-absl::StatusOr<SolveResult> IterateJacobi(std::vector<Rgb> emission, const JacobiStep& step,
+// The Jacobi solver's loop over any sweep (the flat one, the hierarchical one) of `system` (its
+// E and ρ): from no gathered irradiance (B = E), each sweep gathers H from B = E + ρ H of the
+// last, until a sweep's change / power is at most the tolerance. The result is that sweep's H
+// and its B = E + ρ H, so H is all a black side receives from the radiosity the residual was
+// measured on; that B, one sweep on, is closer still (from E, Jacobi rises monotonically to the
+// solution). Zero at once when nothing emits; ResourceExhausted at the iteration limit,
+// Cancelled soon after options.cancel is set.
+absl::StatusOr<SolveResult> IterateJacobi(const RadiositySystem& system, const JacobiStep& step,
                                           const SolveOptions& options);
 
 // ||E + ρ F b - b|| / ||b|| in the power norm above (0 when b and E are 0).

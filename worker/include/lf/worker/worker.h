@@ -67,7 +67,7 @@ class Worker {
         std::map<int, std::unique_ptr<RadiositySweepChunk>> chunks;
         std::string input_hash;
         std::vector<Rgb> input;
-        std::optional<std::string> pulled_hash;  // the input pulled; "": the emission
+        std::optional<std::string> pulled_hash;  // the input pulled; "": sweep 0's start
         std::vector<NodeExitance> pulled;
         // A shot's: the frame the scene is posed at (the BVH, camera and kernels are of it).
         std::optional<int> posed_frame;
