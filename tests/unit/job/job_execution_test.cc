@@ -182,13 +182,20 @@ SweepChunkResult DarkChunk(int sweep) {
     return r;
 }
 
-TEST(SweepExecution, SolvesBeforeTheTilesAndHandsTheSolutionOn) {
+// 16x8 pixels in two 8x8 tiles of 4096 samples a pixel: enough work a task to be kept as asked.
+std::unique_ptr<SweepExecution> TwoTileSweeps(int sweep_tasks) {
     RadiositySettings radiosity;
-    radiosity.sweep_tasks = 1;
-    // 8x8 tiles of 4096 samples a pixel: enough work a task to be kept as asked.
-    auto made = SweepExecution::Make({16, 8, 4096, 8, 1}, radiosity, MakeMemoryTileStore);
-    ASSERT_TRUE(made.ok()) << made.status();
-    SweepExecution& e = **made;
+    radiosity.sweep_tasks = sweep_tasks;
+    absl::StatusOr<std::unique_ptr<SweepExecution>> made =
+        SweepExecution::Make({16, 8, 4096, 8, 1}, radiosity, MakeMemoryTileStore);
+    EXPECT_TRUE(made.ok()) << made.status();
+    return made.ok() ? std::move(*made) : nullptr;
+}
+
+TEST(SweepExecution, SolvesBeforeTheTilesAndHandsTheSolutionOn) {
+    const std::unique_ptr<SweepExecution> made = TwoTileSweeps(1);
+    ASSERT_TRUE(made);
+    SweepExecution& e = *made;
     EXPECT_EQ(e.Start(), std::vector<int>{2});  // sweep 0's chunk, after the two tiles
     EXPECT_EQ(e.task_count(), 3u);
     EXPECT_EQ(e.tasks_total(), 2);
@@ -222,11 +229,9 @@ TEST(SweepExecution, SolvesBeforeTheTilesAndHandsTheSolutionOn) {
 // same task leaves it there (else that worker would take every later sweep of the chunk); the
 // next sweep's task of a chunk whose owner is gone goes to whoever leases it.
 TEST(SweepExecution, ASecondLeaseOfATaskLeavesTheChunkWithItsOwner) {
-    RadiositySettings radiosity;
-    radiosity.sweep_tasks = 2;
-    auto made = SweepExecution::Make({16, 8, 4096, 8, 1}, radiosity, MakeMemoryTileStore);
-    ASSERT_TRUE(made.ok()) << made.status();
-    SweepExecution& e = **made;
+    const std::unique_ptr<SweepExecution> made = TwoTileSweeps(2);
+    ASSERT_TRUE(made);
+    SweepExecution& e = *made;
     const std::vector<int> sweep0 = e.Start();
     ASSERT_EQ(sweep0.size(), 2u);
     TaskAssignment lease;
