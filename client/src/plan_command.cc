@@ -276,7 +276,8 @@ absl::Status PrintRadiosityCost(const EmbreeScene& embree, const PlanOptions& op
         solve_seconds = large.solve_seconds * scale;
         bytes = double(large.solver_bytes) * scale;
     } else {
-        link_seconds = pilots.size() == 1 ? large.form_factor_seconds
+        // One pilot: the target itself (scale 1), or the second was too large to run.
+        link_seconds = pilots.size() == 1 ? large.form_factor_seconds * scale * scale
                                           : PredictFormFactorSeconds(pilots[0], large, unknowns);
         solve_seconds = large.solve_seconds * scale * scale;
         bytes = double(large.form_factor_bytes) * scale * scale;

@@ -144,7 +144,7 @@ absl::StatusOr<ClusterTree> ClusterTree::Build(std::span<const SideGeometry> sid
     if (n == 0) return tree;
     tree.order_.resize(size_t(n));
     for (int32_t s = 0; s < n; ++s) tree.order_[size_t(s)] = s;
-    tree.nodes_.resize(size_t(2 * n - 1));
+    tree.nodes_.resize(2 * size_t(n) - 1);
     Builder(sides, tree.nodes_, tree.order_, cancel).Build(0, 0, n);
     if (CancelRequested(cancel)) return absl::CancelledError("radiosity: cluster tree cancelled");
     return tree;

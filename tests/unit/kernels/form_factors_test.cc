@@ -304,6 +304,9 @@ TEST(FormFactors, ReciprocityHoldsWithinTheQuadratureError) {
         "grazing ones %.1e\n",
         pairs, worst, straddling_mismatch / straddling_transfer,
         grazing_mismatch / grazing_transfer);
+    // No derived bound there (both cosines near 0 on both receivers); 2.6 % is measured, and a
+    // tenth catches an integration that breaks on them.
+    if (grazing_transfer > 0) EXPECT_LT(grazing_mismatch / grazing_transfer, 0.1);
 }
 
 // The hemisphere of every receiver point is partitioned by the box, so rows differ from 1 only

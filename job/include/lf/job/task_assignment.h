@@ -18,8 +18,8 @@ struct TaskAssignment {
     RenderTask task;  // a tile's rectangle and samples; for a sweep task only its index
     JobSpec spec;
     // Radiosity jobs solved in sweeps (SolvedInSweeps): a patch-group task of sweep `sweep`
-    // (>= 0) reads the blob `radiosity_hash` ("" in sweep 0: the emission, which workers
-    // compute); a display tile (sweep -1) reads the solution from it.
+    // (>= 0) reads the gathered irradiance of the sweep before from the blob `radiosity_hash`
+    // ("" in sweep 0: zero, B = E); a display tile (sweep -1) reads the solution from it.
     int sweep = -1, chunk = 0;
     std::string radiosity_hash;
     // Splatting methods (UsesSplatPlan(spec.method)): the task's light paths or photon passes

@@ -1,7 +1,8 @@
 // Solving the radiosity system B = E + ρ ∘ (F B) for one RGB radiosity (W m^-2) per side.
 //
 // All solvers start from B = 0 or B = E and converge to the same B. They stop when the relative
-// residual ||E + ρ F B - B|| / ||B|| of the returned B is below the tolerance, in the norm
+// residual ||E + ρ F B - B|| / ||B|| is below the tolerance (Jacobi: of the B its last sweep
+// gathered from, one sweep before the B it returns), in the norm
 // ||x|| = Σ_i A_i (|x_r| + |x_g| + |x_b|): power, so the residual is the fraction of the radiant
 // power not yet accounted for. Each sweep shrinks the error by about max ρ (times the largest
 // row sum, 1 in a closed scene), so a solve takes about ln(tolerance / (1 - ρ)) / ln(ρ) sweeps,
@@ -64,9 +65,10 @@ struct SolveResult {
     // in it). Jacobi and Gauss-Seidel: radiosity = E + ρ irradiance exactly; shooting: F of its
     // radiosity. Jacobi's `residual` is that of the radiosity its last sweep gathered from.
     std::vector<Rgb> irradiance;
-    int iterations = 0;   // sweeps (Jacobi, Gauss-Seidel) or group shots (shooting)
-    double sweeps = 0;    // form-factor work in units of one pass over the whole matrix
-    double residual = 0;  // relative residual of `radiosity`, computed exactly
+    int iterations = 0;  // sweeps (Jacobi, Gauss-Seidel) or group shots (shooting)
+    double sweeps = 0;   // form-factor work in units of one pass over the whole matrix
+    // Relative residual, computed exactly: of `radiosity`, except Jacobi's (above).
+    double residual = 0;
 };
 
 // InvalidArgument for negative or non-finite emission or reflectance, and for a reflectance of 1
