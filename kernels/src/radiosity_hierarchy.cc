@@ -184,11 +184,14 @@ class RadiosityHierarchy::Linker {
                 const bool faces = source_faces && receiver_faces;
                 const bool strict = power * kPartialVisibility <= threshold_;
                 if (power <= threshold_ && (faces || (strict && !seen))) {
-                    int facing = 0, facing_visible = 0;
-                    const int visible = VisibleRays(p, q, rays, facing, facing_visible);
-                    // Without facing cones, only rays between sides that face each other tell.
-                    if (faces ? visible == 0 : facing > 0 && facing_visible == 0) continue;
-                    split_seen = facing_visible > 0;
+                    // Without facing cones a sampled side may face away from the other node, and
+                    // its ray start into what is behind it; yet counting only rays between sides
+                    // that face each other took 2.8 times the CPU on the 10^6-triangle office
+                    // and left the 10^5 one's agreement with the path tracer as it was
+                    // (docs/radiosity.md).
+                    const int visible = VisibleRays(p, q, rays);
+                    if (visible == 0) continue;
+                    split_seen = true;
                     if (faces && (visible == kClusterRays || strict)) {
                         node_links.push_back({p - root, uint32_t(q) << 2 | uint32_t(visible - 1)});
                         continue;
@@ -228,25 +231,18 @@ class RadiosityHierarchy::Linker {
         return side;
     }
 
-    // How many of kClusterRays rays between points of p and q arrive. In `facing`, how many join
-    // two sides that face each other, and in `facing_visible` how many of those arrive: a ray
-    // from a side facing away starts into whatever is behind it, so its miss says nothing.
-    int VisibleRays(int32_t p, int32_t q, int64_t& rays, int& facing, int& facing_visible) const {
+    // How many of kClusterRays rays between points of p and q arrive.
+    int VisibleRays(int32_t p, int32_t q, int64_t& rays) const {
         const auto& nodes = h_.tree_.nodes();
         const ClusterNode &rp = nodes[size_t(p)], &sq = nodes[size_t(q)];
         const auto& sides = evaluator_.sides();
         int visible = 0;
-        facing = facing_visible = 0;
         for (int k = 0; k < kClusterRays; ++k) {
             const uint64_t key = Hash((uint64_t(uint32_t(p)) << 32 | uint32_t(q)) * 4 + k);
-            const SideGeometry& a = sides[size_t(SampleSide(rp, Vec3d(sq.centroid), key))];
-            const SideGeometry& b = sides[size_t(SampleSide(sq, Vec3d(rp.centroid), Hash(key)))];
-            const bool arrives = !scene_.Occluded(SpawnRayTo(a.centre, b.centre));
-            visible += arrives;
-            if (Dot(a.n, b.c - a.c) > 0 && Dot(b.n, a.c - b.c) > 0) {
-                ++facing;
-                facing_visible += arrives;
-            }
+            const int32_t a = SampleSide(rp, Vec3d(sq.centroid), key);
+            const int32_t b = SampleSide(sq, Vec3d(rp.centroid), Hash(key));
+            visible +=
+                !scene_.Occluded(SpawnRayTo(sides[size_t(a)].centre, sides[size_t(b)].centre));
         }
         rays += kClusterRays;
         return visible;
