@@ -405,15 +405,7 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const Caller
             last_time = absl::Now();
         }
         if (IsFinal(job->state)) break;
-        // The gap is waited out unless the job ends meanwhile: its end goes out at once, so
-        // `watch` returns when the job does. `version` stays the one read above, so the wait
-        // below returns at once for what changed during the gap.
-        const absl::Time paced = absl::Now() + kMinGap;
-        for (uint64_t seen = version; absl::Now() < paced && scheduler.IsActive(req.job_id());) {
-            const uint64_t changed = scheduler.WaitForChange(seen, paced);
-            if (changed == seen) break;  // the gap is over, or the server is shutting down
-            seen = changed;
-        }
+        absl::SleepFor(kMinGap);
         version = scheduler.WaitForChange(version, absl::Now() + absl::Seconds(1));
     }
     return grpc::Status::OK;

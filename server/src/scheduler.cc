@@ -198,11 +198,6 @@ std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(
     return ended_.FindRequest(request_id);
 }
 
-bool Scheduler::IsActive(const std::string& job_id) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return active_.count(job_id) > 0;
-}
-
 absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
     {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -658,9 +653,14 @@ std::vector<std::string> Scheduler::EnforceTimeLimits() {
 }
 
 bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::Time now) const {
-    const std::string preferred = job.execution->PreferredWorker(t);
-    if (!preferred.empty() && preferred != worker && workers_.IsLive(preferred, now)) return false;
     const ScheduledJob::Task& task = job.tasks[size_t(t)];
+    // A task keeps to its preferred worker (the one holding its chunk) while that one lives,
+    // unless it failed there: else it would wait for as long as that worker lives.
+    const std::string preferred = job.execution->PreferredWorker(t);
+    if (!preferred.empty() && preferred != worker && !task.failed_on.count(preferred) &&
+        workers_.IsLive(preferred, now)) {
+        return false;
+    }
     if (!task.failed_on.count(worker)) return true;
     // It failed here: it waits for a live worker it has not failed on that may take the job
     // (enabled, not blocklisted from it, with its tags: a worker that may not would hold it

@@ -82,21 +82,6 @@ TEST_F(SchedulerTest, PriorityOfAnEndedOrUnknownJobIsRefused) {
     EXPECT_TRUE(absl::IsNotFound(scheduler_.SetPriority("nope", 1).status()));
 }
 
-// What a watch asks at every change while it paces its messages: queued, paused and running
-// jobs are active; an ended or unknown one is not.
-TEST_F(SchedulerTest, IsActiveUntilTheJobEnds) {
-    const std::string id = Submit(0);
-    EXPECT_TRUE(scheduler_.IsActive(id));
-    ASSERT_TRUE(scheduler_.SetPaused(id, true).ok());
-    EXPECT_TRUE(scheduler_.IsActive(id));
-    ASSERT_TRUE(scheduler_.SetPaused(id, false).ok());
-    ASSERT_TRUE(scheduler_.LeaseTask("w").has_value());
-    EXPECT_TRUE(scheduler_.IsActive(id));
-    ASSERT_TRUE(scheduler_.Cancel(id).ok());
-    EXPECT_FALSE(scheduler_.IsActive(id));
-    EXPECT_FALSE(scheduler_.IsActive("nope"));
-}
-
 TEST_F(SchedulerTest, AllResultsInAnyOrderSucceedTheJob) {
     const std::string id = Submit(0);
     std::vector<TaskAssignment> leases;

@@ -245,8 +245,6 @@ class Scheduler {
 
     // Running jobs as they are now, ended ones from the store.
     absl::StatusOr<JobRecord> Get(const std::string& job_id) const;
-    // Queued or running (paused included): a lookup, cheap enough to ask at every change.
-    bool IsActive(const std::string& job_id) const;
     // The jobs the query selects from the store, running ones as they are now.
     absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const;
 
