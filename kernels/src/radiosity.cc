@@ -120,21 +120,17 @@ absl::StatusOr<Solution> Solve(const EmbreeScene& scene, const PatchMesh& mesh,
                     AddDirect(system.direct, std::move(solved->irradiance))};
 }
 
-HierarchyOptions HierarchyOptionsOf(const RadiosityOptions& options, int chunk, int chunks,
-                                    const std::atomic<bool>* cancel) {
-    return {options.link_error, kHierarchyGroupSize, chunk, chunks, cancel};
-}
-
-// The links of a chunk of the groups (all of them for a whole solve); with `direct`, the lights'
-// direct irradiance per side there too.
-absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> LinkHierarchy(
-    const EmbreeScene& scene, const PatchMesh& mesh, const HierarchyOptions& options,
-    std::vector<Rgb>* direct = nullptr) {
+// The cluster tree of `mesh`, nothing linked; with `direct`, the lights' direct irradiance per
+// side there too.
+absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> BuildHierarchy(
+    const EmbreeScene& scene, const PatchMesh& mesh, const RadiosityOptions& options,
+    const std::atomic<bool>* cancel, std::vector<Rgb>* direct = nullptr) {
     const FormFactors none;  // the system's E, ρ and A are all the hierarchy reads
-    RadiositySystem system = MakeRadiositySystem(scene, mesh, none, options.cancel);
-    if (CancelRequested(options.cancel)) return FormFactorsCancelled();
+    RadiositySystem system = MakeRadiositySystem(scene, mesh, none, cancel);
+    if (CancelRequested(cancel)) return FormFactorsCancelled();
     if (direct) *direct = std::move(system.direct);
-    return RadiosityHierarchy::Build(scene, mesh, system, options);
+    return RadiosityHierarchy::Build(scene, mesh, system,
+                                     {options.link_error, kHierarchyGroupSize, cancel});
 }
 
 // The hierarchical solve on one mesh; times and counts add up in `report`.
@@ -144,8 +140,9 @@ absl::StatusOr<Solution> SolveHierarchically(const EmbreeScene& scene, const Pat
     const auto start = std::chrono::steady_clock::now();
     std::vector<Rgb> direct;
     absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> linked =
-        LinkHierarchy(scene, mesh, HierarchyOptionsOf(options, 0, 1, options.cancel), &direct);
+        BuildHierarchy(scene, mesh, options, options.cancel, &direct);
     if (!linked.ok()) return linked.status();
+    if (absl::Status s = (*linked)->Link(scene, mesh, 0, 1, options.cancel); !s.ok()) return s;
     const RadiosityHierarchy& h = **linked;
     const double link_seconds = SecondsSince(start);
     report.form_factor_seconds += link_seconds;
@@ -380,12 +377,12 @@ RadiositySystem MakeRadiositySystem(const EmbreeScene& scene, const PatchMesh& m
     return system;
 }
 
-absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
-    const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks,
+absl::StatusOr<std::unique_ptr<RadiositySweepChunks>> RadiositySweepChunks::Make(
+    const EmbreeScene& scene, const RadiosityOptions& options, int chunks,
     const std::atomic<bool>* cancel) {
-    if (chunks < 1 || chunk < 0 || chunk >= chunks) {
+    if (chunks < 1) {
         return absl::InvalidArgumentError(
-            absl::StrFormat("radiosity: chunk %d of %d does not exist", chunk, chunks));
+            absl::StrFormat("radiosity: %d chunks; at least 1", chunks));
     }
     if (absl::Status status = CheckNoRefinement(options); !status.ok()) return status;
     if (absl::Status status = CheckReflectance(scene); !status.ok()) return status;
@@ -393,55 +390,81 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> RadiositySweepChunk::Build(
     mesh_options.cancel = cancel;
     absl::StatusOr<PatchMesh> mesh = PatchMesh::Build(scene.scene(), mesh_options);
     if (!mesh.ok()) return mesh.status();
-    std::unique_ptr<RadiositySweepChunk> out(new RadiositySweepChunk());
-    out->chunk_ = chunk;
+    std::unique_ptr<RadiositySweepChunks> out(new RadiositySweepChunks());
+    out->chunks_ = chunks;
     if (options.hierarchical) {
-        absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> linked =
-            LinkHierarchy(scene, *mesh, HierarchyOptionsOf(options, chunk, chunks, cancel));
-        if (!linked.ok()) return linked.status();
-        out->hierarchy_ = std::move(*linked);
-        out->groups_ = out->hierarchy_->linked_groups();
-        out->mesh_ = std::move(*mesh);
-        out->start_.resize(size_t(out->sides()));
-        return out;
+        absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> built =
+            BuildHierarchy(scene, *mesh, options, cancel);
+        if (!built.ok()) return built.status();
+        out->hierarchy_ = std::move(*built);
+    } else {
+        const FormFactors none;  // each chunk's rows come with Link
+        out->system_ = MakeRadiositySystem(scene, *mesh, none, cancel);
+        if (CancelRequested(cancel)) return FormFactorsCancelled();
+        out->system_.form_factors = nullptr;
+        out->system_.direct = {};  // the display's, not the sweeps'
     }
-    FormFactorOptions ff_options;
-    ff_options.chunk = chunk;
-    ff_options.chunks = chunks;
-    ff_options.cancel = cancel;
-    out->form_factors_ = ComputeFormFactors(scene, *mesh, ff_options);
-    if (CancelRequested(cancel)) return FormFactorsCancelled();
-    out->groups_ = ChunkGroups(int32_t(out->form_factors_.groups().size()), chunk, chunks);
-    out->system_ = MakeRadiositySystem(scene, *mesh, out->form_factors_, cancel);
-    if (CancelRequested(cancel)) return FormFactorsCancelled();
-    out->system_.direct = {};  // the display's, not the sweeps'
-    out->start_.resize(size_t(out->sides()));
     out->mesh_ = std::move(*mesh);
+    out->start_.resize(size_t(out->sides()));
     return out;
 }
 
-RadiosityReport RadiositySweepChunk::LinkReport() const {
+absl::Status RadiositySweepChunks::Link(const EmbreeScene& scene, int chunk,
+                                        const std::atomic<bool>* cancel) {
+    if (chunk < 0 || chunk >= chunks_) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("radiosity: chunk %d of %d does not exist", chunk, chunks_));
+    }
+    if (hierarchy_) return hierarchy_->Link(scene, mesh_, chunk, chunks_, cancel);
+    if (form_factors_.contains(chunk)) return absl::OkStatus();
+    FormFactorOptions ff_options;
+    ff_options.chunk = chunk;
+    ff_options.chunks = chunks_;
+    ff_options.cancel = cancel;
+    FormFactors rows = ComputeFormFactors(scene, mesh_, ff_options);
+    if (CancelRequested(cancel)) return FormFactorsCancelled();
+    form_factors_.emplace(chunk, std::move(rows));
+    return absl::OkStatus();
+}
+
+std::pair<int32_t, int32_t> RadiositySweepChunks::Groups(int chunk) const {
+    const size_t groups =
+        hierarchy_ ? hierarchy_->groups().size() : form_factors_.at(chunk).groups().size();
+    return ChunkGroups(int32_t(groups), chunk, chunks_);
+}
+
+bool RadiositySweepChunks::Linked(int chunk) const {
+    if (chunk < 0 || chunk >= chunks_) return false;
+    if (!hierarchy_) return form_factors_.contains(chunk);
+    const auto [g0, g1] = Groups(chunk);
+    for (int32_t g = g0; g < g1; ++g) {
+        if (!hierarchy_->Linked(g)) return false;
+    }
+    return true;
+}
+
+RadiosityReport RadiositySweepChunks::LinkReport(int chunk) const {
     RadiosityReport report;
-    if (!hierarchy_) return report;
-    report.cluster_links = hierarchy_->node_links();
-    report.side_links = hierarchy_->leaf_links();
-    report.link_bytes = hierarchy_->link_bytes();
-    report.solver_bytes = hierarchy_->bytes();
+    if (!hierarchy_ || !Linked(chunk)) return report;
+    const auto [g0, g1] = Groups(chunk);
+    const LinkFigures f = hierarchy_->Figures(g0, g1);
+    const size_t shared = hierarchy_->shared_bytes();
+    report.cluster_links = f.node_links;
+    report.side_links = f.leaf_links;
+    report.link_bytes = f.bytes;
+    // Shares that add up to `shared` exactly over the chunks.
+    report.solver_bytes = f.bytes + shared * size_t(chunk + 1) / size_t(chunks_) -
+                          shared * size_t(chunk) / size_t(chunks_);
     return report;
 }
 
-std::vector<NodeExitance> RadiositySweepChunk::Pull(std::span<const Rgb> h) const {
+std::vector<NodeExitance> RadiositySweepChunks::Pull(std::span<const Rgb> h) const {
     if (!hierarchy_ || int64_t(h.size()) != sides()) return {};
     return hierarchy_->Pull(RadiosityFromIrradiance(system(), h));
 }
 
-absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(int32_t sweep,
-                                                            std::span<const Rgb> h) const {
-    return Sweep(sweep, h, Pull(h));
-}
-
-absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
-    int32_t sweep, std::span<const Rgb> h, std::span<const NodeExitance> pulled) const {
+absl::StatusOr<SweepChunkResult> RadiositySweepChunks::Sweep(
+    int chunk, int32_t sweep, std::span<const Rgb> h, std::span<const NodeExitance> pulled) const {
     if (int64_t(h.size()) != sides()) {
         return absl::InvalidArgumentError(absl::StrFormat(
             "radiosity sweep %d: %d values for %d unknowns", sweep, h.size(), sides()));
@@ -451,12 +474,17 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
             absl::StrFormat("radiosity sweep %d: a pull of %d nodes for a tree of %d", sweep,
                             pulled.size(), hierarchy_->tree().nodes().size()));
     }
-    const auto& groups = hierarchy_ ? hierarchy_->groups() : form_factors_.groups();
+    if (!Linked(chunk)) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "radiosity sweep %d: chunk %d of %d is not linked here", sweep, chunk, chunks_));
+    }
+    const FormFactors* rows = hierarchy_ ? nullptr : &form_factors_.at(chunk);
+    const auto& groups = hierarchy_ ? hierarchy_->groups() : rows->groups();
     const std::vector<Rgb> b = RadiosityFromIrradiance(system(), h);
-    const auto [g0, g1] = groups_;
+    const auto [g0, g1] = Groups(chunk);
     SweepChunkResult r;
     r.sweep = sweep;
-    r.chunk = chunk_;
+    r.chunk = chunk;
     r.sides = sides();
     r.side_begin = g0 < g1 ? groups[size_t(g0)].begin : 0;
     const int32_t side_end = g0 < g1 ? groups[size_t(g1 - 1)].end : 0;
@@ -469,14 +497,14 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunk::Sweep(
         const std::span<Rgb> out = std::span<Rgb>(r.output).subspan(
             size_t(group.begin - r.side_begin), size_t(group.size()));
         const GroupSweep sums = hierarchy_ ? hierarchy_->SweepGroup(g, pulled, b, out)
-                                           : JacobiGroup(system_, g, b, out);
+                                           : JacobiGroup(system_, *rows, g, b, out);
         r.change[size_t(g - g0)] = sums.change;
         r.power[size_t(g - g0)] = sums.power;
     });
     return r;
 }
 
-absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiositySweepChunk::Renderer(
+absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiositySweepChunks::Renderer(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> gathered) const {
     if (absl::Status status = CheckSolutionSize(gathered, mesh_); !status.ok()) return status;
     if (hierarchy_) gathered = hierarchy_->tree().ToMeshOrder(gathered);

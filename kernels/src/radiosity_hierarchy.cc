@@ -262,10 +262,6 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
     if (system.emission.size() != n || system.reflectance.size() != n || system.area.size() != n) {
         return absl::InvalidArgumentError("radiosity: system and mesh sizes differ");
     }
-    if (options.chunks < 1 || options.chunk < 0 || options.chunk >= options.chunks) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "radiosity: chunk %d of %d does not exist", options.chunk, options.chunks));
-    }
     if (!(options.link_error > 0)) {
         return absl::InvalidArgumentError(
             absl::StrFormat("radiosity: link error %g must be > 0", options.link_error));
@@ -276,12 +272,12 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
     }
     if (absl::Status status = CheckRadiosityValues(system); !status.ok()) return status;
     std::unique_ptr<RadiosityHierarchy> h(new RadiosityHierarchy());
-    // The sides' geometry serves the tree and the linking, then goes.
-    const PairEvaluator evaluator(scene, mesh);
-    absl::StatusOr<ClusterTree> tree = ClusterTree::Build(evaluator.sides(), options.cancel);
+    // The sides' geometry serves the tree, then goes (each Link makes it again).
+    const std::vector<SideGeometry> sides = SideGeometries(scene, mesh);
+    absl::StatusOr<ClusterTree> tree = ClusterTree::Build(sides, options.cancel);
     if (!tree.ok()) return tree.status();
     h->tree_ = std::move(*tree);
-    for (int32_t side : h->tree_.order()) h->normals_.push_back(evaluator.sides()[size_t(side)].n);
+    for (int32_t side : h->tree_.order()) h->normals_.push_back(sides[size_t(side)].n);
     for (int32_t side : h->tree_.order()) {
         h->system_.emission.push_back(system.emission[size_t(side)]);
         h->system_.reflectance.push_back(system.reflectance[size_t(side)]);
@@ -292,26 +288,42 @@ absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> RadiosityHierarchy::Build(
         const ClusterNode& node = h->tree_.nodes()[size_t(root)];
         h->groups_.push_back({node.begin, node.end});
     }
-    h->linked_ = ChunkGroups(int32_t(h->groups_.size()), options.chunk, options.chunks);
+    h->link_error_ = options.link_error;
+    h->linked_.assign(h->groups_.size(), false);
     h->links_.resize(h->groups_.size());
-
-    const Linker linker(scene, evaluator, *h, options.link_error);
-    const auto [g0, g1] = h->linked_;
-    std::vector<int64_t> rays(h->groups_.size(), 0);
-    tbb::parallel_for(g0, g1, [&](int32_t g) {
-        if (CancelRequested(options.cancel)) return;
-        GroupLinks& links = h->links_[size_t(g)];
-        links = linker.Link(h->group_roots_[size_t(g)], options.cancel, rays[size_t(g)]);
-    });
-    if (CancelRequested(options.cancel)) {
-        return absl::CancelledError("radiosity: linking cancelled");
-    }
-    for (int32_t g = g0; g < g1; ++g) {
-        h->node_links_ += int64_t(h->links_[size_t(g)].node_source.size());
-        h->leaf_links_ += int64_t(h->links_[size_t(g)].leaf.size());
-        h->rays_ += rays[size_t(g)];
-    }
     return h;
+}
+
+absl::Status RadiosityHierarchy::Link(const EmbreeScene& scene, const PatchMesh& mesh, int chunk,
+                                      int chunks, const std::atomic<bool>* cancel) {
+    if (chunks < 1 || chunk < 0 || chunk >= chunks) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("radiosity: chunk %d of %d does not exist", chunk, chunks));
+    }
+    if (mesh.sides().size() != size_t(sides())) {
+        return absl::InvalidArgumentError("radiosity: linking another mesh than the tree's");
+    }
+    const auto [g0, g1] = ChunkGroups(int32_t(groups_.size()), chunk, chunks);
+    const PairEvaluator evaluator(scene, mesh);
+    const Linker linker(scene, evaluator, *this, link_error_);
+    std::vector<GroupLinks> made(size_t(g1 - g0));
+    std::vector<int64_t> rays(size_t(g1 - g0), 0);
+    tbb::parallel_for(g0, g1, [&](int32_t g) {
+        if (linked_[size_t(g)] || CancelRequested(cancel)) return;
+        made[size_t(g - g0)] = linker.Link(group_roots_[size_t(g)], cancel, rays[size_t(g - g0)]);
+    });
+    // Nothing of a cancelled chunk is kept: it is linked whole or not at all.
+    if (CancelRequested(cancel)) return absl::CancelledError("radiosity: linking cancelled");
+    for (int32_t g = g0; g < g1; ++g) {
+        if (linked_[size_t(g)]) continue;
+        GroupLinks& links = links_[size_t(g)];
+        links = std::move(made[size_t(g - g0)]);
+        linked_[size_t(g)] = true;
+        node_links_ += int64_t(links.node_source.size());
+        leaf_links_ += int64_t(links.leaf.size());
+        rays_ += rays[size_t(g - g0)];
+    }
+    return absl::OkStatus();
 }
 
 std::vector<NodeExitance> RadiosityHierarchy::Pull(std::span<const Rgb> b) const {
@@ -397,12 +409,11 @@ GroupSweep RadiosityHierarchy::SweepGroup(int32_t group, std::span<const NodeExi
 GroupSweep RadiosityHierarchy::Sweep(std::span<const Rgb> b, std::span<Rgb> next,
                                      const std::atomic<bool>* cancel) const {
     const std::vector<NodeExitance> pulled = Pull(b);
-    const auto [g0, g1] = linked_;
-    std::vector<GroupSweep> parts(size_t(g1 - g0));
-    tbb::parallel_for(g0, g1, [&](int32_t g) {
-        if (CancelRequested(cancel)) return;
+    std::vector<GroupSweep> parts(groups_.size());
+    tbb::parallel_for(int32_t(0), int32_t(groups_.size()), [&](int32_t g) {
+        if (!linked_[size_t(g)] || CancelRequested(cancel)) return;
         const PatchGroup& group = groups_[size_t(g)];
-        parts[size_t(g - g0)] =
+        parts[size_t(g)] =
             SweepGroup(g, pulled, b, next.subspan(size_t(group.begin), size_t(group.size())));
     });
     GroupSweep total;
@@ -413,21 +424,24 @@ GroupSweep RadiosityHierarchy::Sweep(std::span<const Rgb> b, std::span<Rgb> next
     return total;
 }
 
-size_t RadiosityHierarchy::link_bytes() const {
-    size_t bytes = 0;
-    for (const GroupLinks& l : links_) {
-        bytes += (l.node_start.capacity() + l.node_source.capacity() + l.leaf_start.capacity()) *
-                     sizeof(uint32_t) +
-                 l.leaf.capacity() * sizeof(LeafSource);
+LinkFigures RadiosityHierarchy::Figures(int32_t g0, int32_t g1) const {
+    LinkFigures f;
+    for (int32_t g = g0; g < g1; ++g) {
+        const GroupLinks& l = links_[size_t(g)];
+        f.node_links += int64_t(l.node_source.size());
+        f.leaf_links += int64_t(l.leaf.size());
+        f.bytes += (l.node_start.capacity() + l.node_source.capacity() + l.leaf_start.capacity()) *
+                       sizeof(uint32_t) +
+                   l.leaf.capacity() * sizeof(LeafSource) + sizeof(GroupLinks);
     }
-    return bytes + links_.size() * sizeof(GroupLinks);
+    return f;
 }
 
-size_t RadiosityHierarchy::bytes() const {
+size_t RadiosityHierarchy::shared_bytes() const {
     const size_t n = size_t(sides());
     const size_t per_side = sizeof(int32_t) + 2 * sizeof(Rgb) + sizeof(double) + sizeof(Vec3d);
-    return link_bytes() + tree_.nodes().size() * (sizeof(ClusterNode) + sizeof(NodeExitance)) +
-           n * per_side + groups_.size() * (sizeof(PatchGroup) + sizeof(int32_t));
+    return tree_.nodes().size() * (sizeof(ClusterNode) + sizeof(NodeExitance)) + n * per_side +
+           groups_.size() * (sizeof(PatchGroup) + sizeof(int32_t) + 1);
 }
 
 absl::StatusOr<SolveResult> SolveHierarchical(const RadiosityHierarchy& hierarchy,

@@ -104,7 +104,7 @@ GroupSweep JacobiSweep(const RadiositySystem& system, std::span<const Rgb> b,
     tbb::parallel_for(size_t(0), groups.size(), [&](size_t g) {
         if (CancelRequested(cancel)) return;
         const PatchGroup& group = groups[g];
-        parts[g] = JacobiGroup(system, int32_t(g), b,
+        parts[g] = JacobiGroup(system, *system.form_factors, int32_t(g), b,
                                gathered.subspan(size_t(group.begin), size_t(group.size())));
     });
     GroupSweep total;
@@ -173,7 +173,7 @@ absl::StatusOr<SolveResult> SolveGaussSeidel(const RadiositySystem& system,
             if (CancelRequested(options.cancel)) return SolveCancelled();
             const PatchGroup& group = groups[g];
             const std::span<Rgb> gathered(&h[size_t(group.begin)], size_t(group.size()));
-            GatherGroup(system, int32_t(g), b, gathered);
+            GatherGroup(*system.form_factors, int32_t(g), b, gathered);
             for (int32_t i = group.begin; i < group.end; ++i) {
                 Rgb& bi = b[size_t(i)];
                 const Rgb ui = RadiosityFromIrradiance(system.emission[size_t(i)],
@@ -256,11 +256,11 @@ const char* RadiositySolverName(RadiositySolver solver) {
     return "unknown";
 }
 
-void GatherGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
+void GatherGroup(const FormFactors& form_factors, int32_t group, std::span<const Rgb> b,
                  std::span<Rgb> out) {
-    const PatchGroup& g = system.form_factors->groups()[size_t(group)];
+    const PatchGroup& g = form_factors.groups()[size_t(group)];
     std::vector<double> sum(size_t(g.size()) * 3, 0.0);
-    for (const FormFactorBlock& block : system.form_factors->RowBlocks(group)) {
+    for (const FormFactorBlock& block : form_factors.RowBlocks(group)) {
         const int32_t cols = block.cols();
         const Rgb* source = &b[size_t(block.col_begin)];
         for (int32_t r = block.row_begin; r < block.row_end; ++r) {
@@ -304,10 +304,10 @@ GroupSweep SweepSums(const RadiositySystem& system, int32_t begin, std::span<con
     return sums;
 }
 
-GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
-                       std::span<Rgb> out) {
-    GatherGroup(system, group, b, out);
-    return SweepSums(system, system.form_factors->groups()[size_t(group)].begin, b, out);
+GroupSweep JacobiGroup(const RadiositySystem& system, const FormFactors& form_factors,
+                       int32_t group, std::span<const Rgb> b, std::span<Rgb> out) {
+    GatherGroup(form_factors, group, b, out);
+    return SweepSums(system, form_factors.groups()[size_t(group)].begin, b, out);
 }
 
 double RelativeResidual(const RadiositySystem& system, std::span<const Rgb> b) {

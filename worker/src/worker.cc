@@ -414,11 +414,10 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic
     if (!task.radiosity_hash.empty()) {  // solved by the farm's sweeps
         absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task.radiosity_hash);
         if (!solution.ok()) return solution.status();
-        // A chunk this worker swept has the mesh (and cluster tree) the display needs.
-        renderer = loaded_.chunks.empty()
-                       ? RadiosityRendererFor(*loaded_.embree, *options, std::move(*solution))
-                       : loaded_.chunks.begin()->second->Renderer(*loaded_.embree, *options,
-                                                                  std::move(*solution));
+        // The sweeps' mesh (and cluster tree) are those the display needs.
+        renderer = loaded_.sweeps
+                       ? loaded_.sweeps->Renderer(*loaded_.embree, *options, std::move(*solution))
+                       : RadiosityRendererFor(*loaded_.embree, *options, std::move(*solution));
     } else {
         // Every worker of the job solves the same system to the same bits (the solver is
         // deterministic for any thread count), so its tiles match `lightfarm render`.
@@ -427,7 +426,7 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic
     if (!renderer.ok()) return renderer.status();
     loaded_.tracer = std::move(*renderer);
     // The sweeps are over: their form-factor rows are not needed again.
-    loaded_.chunks.clear();
+    loaded_.sweeps.reset();
     loaded_.input.clear();
     loaded_.input_hash.clear();
     loaded_.pulled.clear();
@@ -448,27 +447,32 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
                                           const std::atomic<bool>& cancel,
                                           RadiosityFigures& figures) {
     const RadiositySettings& r = task.spec.radiosity;
-    std::unique_ptr<RadiositySweepChunk>& chunk = loaded_.chunks[task.chunk];
-    if (!chunk) {
+    if (!loaded_.sweeps || !loaded_.sweeps->Linked(task.chunk)) {
         absl::StatusOr<RadiosityOptions> options =
             RadiosityOptionsOf(task.spec.radiosity, task.spec.adaptive.target_error);
         if (!options.ok()) return options.status();
         const absl::Time start = absl::Now();
-        absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> built;
+        absl::Status linked;
         arena_.execute([&] {
-            built = RadiositySweepChunk::Build(*loaded_.embree, *options, task.chunk, r.sweep_tasks,
-                                               &cancel);
+            // The mesh and system (or cluster tree) once, for every chunk this worker gets.
+            if (!loaded_.sweeps) {
+                absl::StatusOr<std::unique_ptr<RadiositySweepChunks>> made =
+                    RadiositySweepChunks::Make(*loaded_.embree, *options, r.sweep_tasks, &cancel);
+                if (!made.ok()) {
+                    linked = made.status();
+                    return;
+                }
+                loaded_.sweeps = std::move(*made);
+            }
+            linked = loaded_.sweeps->Link(*loaded_.embree, task.chunk, &cancel);
         });
-        if (!built.ok()) {
-            loaded_.chunks.erase(task.chunk);
-            return built.status();
-        }
-        chunk = std::move(*built);
+        if (!linked.ok()) return linked;
         Log()->info("job={} task={} form factors of chunk {}/{} in {:.2f} s", task.job_id,
                     task.task.index, task.chunk, r.sweep_tasks,
                     absl::ToDoubleSeconds(absl::Now() - start));
     }
-    std::span<const Rgb> input = chunk->start();
+    const RadiositySweepChunks& chunks = *loaded_.sweeps;
+    std::span<const Rgb> input = chunks.start();
     if (!task.radiosity_hash.empty()) {
         if (loaded_.input_hash != task.radiosity_hash) {
             absl::StatusOr<std::vector<Rgb>> read = ReadRadiosity(task.radiosity_hash);
@@ -481,13 +485,13 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
     absl::StatusOr<SweepChunkResult> result;
     arena_.execute([&] {
         if (loaded_.pulled_hash != task.radiosity_hash) {
-            loaded_.pulled = chunk->Pull(input);
+            loaded_.pulled = chunks.Pull(input);
             loaded_.pulled_hash = task.radiosity_hash;
         }
-        result = chunk->Sweep(task.sweep, input, loaded_.pulled);
+        result = chunks.Sweep(task.chunk, task.sweep, input, loaded_.pulled);
     });
     if (!result.ok()) return result.status();
-    figures = RadiosityFiguresOf(chunk->LinkReport());
+    figures = RadiosityFiguresOf(chunks.LinkReport(task.chunk));
     return EncodeSweepResult(*result);
 }
 

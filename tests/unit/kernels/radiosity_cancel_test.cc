@@ -161,8 +161,10 @@ TEST_F(RadiosityCancelTest, SweepChunkReturnsCancelledDuringTheFormFactors) {
     RadiosityOptions options;
     options.patches = 12000;
     const CancelAtPoll cancel_at(cancel, 20000);
-    const absl::Status status = OnOneThread(
-        [&] { return RadiositySweepChunk::Build(*embree_, options, 0, 1, &cancel).status(); });
+    const absl::Status status = OnOneThread([&] {
+        auto chunks = RadiositySweepChunks::Make(*embree_, options, 1, &cancel);
+        return chunks.ok() ? (*chunks)->Link(*embree_, 0, &cancel) : chunks.status();
+    });
     EXPECT_TRUE(absl::IsCancelled(status)) << status;
     EXPECT_NE(status.message().find("form factors"), std::string_view::npos) << status;
     EXPECT_TRUE(cancel_at.reached());

@@ -224,6 +224,7 @@ TEST(RadiosityHierarchy, LinksPerSideStayBounded) {
         auto h = RadiosityHierarchy::Build(**es, *mesh, MakeRadiositySystem(**es, *mesh, none),
                                            {.link_error = 1e-3});
         ASSERT_TRUE(h.ok()) << h.status();
+        ASSERT_TRUE((*h)->Link(**es, *mesh, 0, 1).ok());
         per_side[k] = double((*h)->node_links() + (*h)->leaf_links()) / (*h)->sides();
         std::printf("%lld patches: %d sides, %lld + %lld links, %.1f per side, %.1f MiB\n",
                     (long long)patches[k], (*h)->sides(), (long long)(*h)->node_links(),
@@ -254,7 +255,8 @@ TEST(RadiosityHierarchy, RefusesReflectanceOfOneAndNonFiniteValuesNamingTheSide)
 }
 
 // The farm's way: chunks of the groups swept against each sweep's gathered irradiance, the sums
-// added by RadiositySolve, give PrepareRadiosity's bits for any chunk count: the radiosity, and
+// added by RadiositySolve, give PrepareRadiosity's bits for any chunk count and any split of the
+// chunks over workers (here two, one holding the even chunks, one the odd): the radiosity, and
 // the irradiance with the point light's direct part, which RadiosityRendererFor computes again.
 TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
     Scene scene = CornellBox();
@@ -267,17 +269,18 @@ TEST(RadiosityHierarchy, SweepChunksGivePrepareRadiositysBits) {
     auto local = PrepareRadiosity(**es, options);
     ASSERT_TRUE(local.ok()) << local.status();
     for (int chunks : {1, 2, 3, 7}) {
-        std::vector<std::unique_ptr<RadiositySweepChunk>> tasks;
-        for (int c = 0; c < chunks; ++c) {
-            auto task = RadiositySweepChunk::Build(**es, options, c, chunks);
-            ASSERT_TRUE(task.ok()) << task.status();
-            tasks.push_back(std::move(*task));
+        std::vector<std::unique_ptr<RadiositySweepChunks>> workers;
+        for (int w = 0; w < 2; ++w) {
+            auto worker = RadiositySweepChunks::Make(**es, options, chunks);
+            ASSERT_TRUE(worker.ok()) << worker.status();
+            workers.push_back(std::move(*worker));
         }
+        for (int c = 0; c < chunks; ++c) ASSERT_TRUE(workers[size_t(c % 2)]->Link(**es, c).ok());
         RadiositySolve solve(chunks, options.tolerance, options.max_iterations);
-        std::vector<Rgb> h = tasks[0]->start();  // the gathered irradiance
+        std::vector<Rgb> h = workers[0]->start();  // the gathered irradiance
         for (;;) {
             for (int c = chunks - 1; c >= 0; --c) {
-                auto result = tasks[size_t(c)]->Sweep(solve.sweep(), h);
+                auto result = workers[size_t(c % 2)]->Sweep(c, solve.sweep(), h);
                 ASSERT_TRUE(result.ok()) << result.status();
                 ASSERT_TRUE(solve.Add(*result).ok());
             }
@@ -329,8 +332,20 @@ TEST(RadiosityHierarchy, CancelStopsTheBuild) {
     RadiosityOptions options = Hierarchical(1e-3);
     options.cancel = &cancel;
     EXPECT_EQ(PrepareRadiosity(**es, options).status().code(), absl::StatusCode::kCancelled);
-    EXPECT_EQ(RadiositySweepChunk::Build(**es, options, 0, 2, &cancel).status().code(),
+    EXPECT_EQ(RadiositySweepChunks::Make(**es, options, 2, &cancel).status().code(),
               absl::StatusCode::kCancelled);
+    // A chunk whose linking is cancelled is not linked, and links whole when asked again.
+    cancel = false;
+    auto chunks = RadiositySweepChunks::Make(**es, options, 2, &cancel);
+    ASSERT_TRUE(chunks.ok()) << chunks.status();
+    cancel = true;
+    EXPECT_EQ((*chunks)->Link(**es, 1, &cancel).code(), absl::StatusCode::kCancelled);
+    EXPECT_FALSE((*chunks)->Linked(1));
+    cancel = false;
+    EXPECT_TRUE((*chunks)->Link(**es, 1, &cancel).ok());
+    EXPECT_TRUE((*chunks)->Linked(1));
+    EXPECT_FALSE((*chunks)->Linked(0));
+    EXPECT_GT((*chunks)->LinkReport(1).side_links, 0);
 }
 
 }  // namespace

@@ -234,7 +234,7 @@ TEST(RadiositySolver, SweepsAreSequencesOfThePureGroupStep) {
             for (int32_t g = 0; g < int32_t(groups.size()); ++g) {
                 const PatchGroup& group = groups[size_t(g)];
                 std::span<Rgb> out(&next[size_t(group.begin)], size_t(group.size()));
-                GatherGroup(p->system, g, b, out);
+                GatherGroup(*p->system.form_factors, g, b, out);
                 if (jacobi) continue;
                 for (int32_t i = group.begin; i < group.end; ++i) {
                     h[size_t(i)] = next[size_t(i)];

@@ -574,7 +574,7 @@ TEST(Radiosity, SweepsRefuseATargetError) {
     RadiosityOptions options;
     options.patches = 50;
     options.target_error = 0.1;
-    EXPECT_EQ(RadiositySweepChunk::Build(**embree, options, 0, 1).status().code(),
+    EXPECT_EQ(RadiositySweepChunks::Make(**embree, options, 1).status().code(),
               absl::StatusCode::kInvalidArgument);
     EXPECT_EQ(RadiosityRendererFor(**embree, options, {}).status().code(),
               absl::StatusCode::kInvalidArgument);

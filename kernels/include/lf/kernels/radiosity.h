@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -133,54 +134,65 @@ class RadiosityRenderer : public RadianceEstimator {
     RadiosityReport report_;
 };
 
-// One patch-group task of the farm's Jacobi solve (lf/job/radiosity_solve.h): the form-factor
-// rows of chunk `chunk` of `chunks` of the patch groups (hierarchical: the links of its groups
-// of the cluster tree), computed once, then swept in turn against each sweep's state: the
-// irradiance every side gathered in the sweep before (F B, the Jacobi iterate IterateJacobi
-// keeps; B = E + ρ H). The sweep's sums are those SolveRadiosity's Jacobi solver makes, so the
-// farm's solution has its bits.
-class RadiositySweepChunk {
+// What a farm worker holds of a radiosity job solved in sweeps (lf/job/radiosity_solve.h): the
+// mesh and system (hierarchical: the cluster tree), built once, and the form-factor rows
+// (hierarchical: the links) of each patch-group chunk it is given, computed once, then swept in
+// turn against each sweep's state: the irradiance every side gathered in the sweep before (F B,
+// the Jacobi iterate IterateJacobi keeps; B = E + ρ H). A chunk's sums are those SolveRadiosity's
+// Jacobi solver makes for its groups, so the farm's solution has its bits, whichever worker
+// holds which chunks.
+class RadiositySweepChunks {
   public:
-    // The same checks as PrepareRadiosity; InvalidArgument for a chunk outside 0..chunks-1 and
-    // for a target error (refinement needs whole solves); Cancelled soon after `cancel` is set.
-    static absl::StatusOr<std::unique_ptr<RadiositySweepChunk>> Build(
-        const EmbreeScene& scene, const RadiosityOptions& options, int chunk, int chunks,
+    // The same checks as PrepareRadiosity; InvalidArgument for chunks < 1 and for a target error
+    // (refinement needs whole solves); Cancelled soon after `cancel` is set. No chunk linked.
+    static absl::StatusOr<std::unique_ptr<RadiositySweepChunks>> Make(
+        const EmbreeScene& scene, const RadiosityOptions& options, int chunks,
         const std::atomic<bool>* cancel = nullptr);
 
+    // Computes chunk `chunk`'s rows or links, once; InvalidArgument outside 0..chunks-1,
+    // Cancelled soon after `cancel` is set (the chunk is then not linked). `scene` as made.
+    absl::Status Link(const EmbreeScene& scene, int chunk,
+                      const std::atomic<bool>* cancel = nullptr);
+    bool Linked(int chunk) const;
+
+    int chunks() const { return chunks_; }
     int32_t sides() const { return int32_t(system().emission.size()); }
     // E, ρ and A per unknown. Hierarchical: the unknowns in the cluster tree's order
     // (RadiosityRendererFor maps them back to the mesh's sides).
     const RadiositySystem& system() const { return hierarchy_ ? hierarchy_->system() : system_; }
     // The state sweep 0 starts from: nothing gathered yet (B = E).
     const std::vector<Rgb>& start() const { return start_; }
-    // The chunk's part of one sweep from the gathered irradiance `h` (all sides): its sides' new
-    // irradiance from B = E + ρ h; InvalidArgument when h is not one value per side. Runs in the
-    // caller's TBB arena.
-    absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> h) const;
-    // Hierarchical: the pull up the whole tree of B = E + ρ h, the same for every chunk of a
-    // system (a worker holding several chunks pulls once a sweep); empty for the flat method.
+    // Hierarchical: the pull up the whole tree of B = E + ρ h, which every chunk's sweep reads
+    // (pulled once a sweep for all of them); empty for the flat method.
     std::vector<NodeExitance> Pull(std::span<const Rgb> h) const;
-    // Sweep with `pulled` = Pull(h) of this chunk or of another of the same system.
-    absl::StatusOr<SweepChunkResult> Sweep(int32_t sweep, std::span<const Rgb> h,
+    // A linked chunk's part of one sweep from the gathered irradiance `h` (all sides): its
+    // sides' new irradiance from B = E + ρ h, with `pulled` = Pull(h). InvalidArgument when h is
+    // not one value per side, the pull is of another size, or the chunk is not linked. Runs in
+    // the caller's TBB arena.
+    absl::StatusOr<SweepChunkResult> Sweep(int chunk, int32_t sweep, std::span<const Rgb> h,
                                            std::span<const NodeExitance> pulled) const;
-    // Hierarchical: the links of the chunk's receivers, their bytes and the chunk's solver bytes
-    // (the farm's header sums them over the chunks; the links add up to local mode's); zeros for
-    // the flat method.
-    RadiosityReport LinkReport() const;
-    // RadiosityRendererFor with this chunk's mesh (and cluster tree), which are those of every
-    // chunk of the system: not built again for the display. `options` as the chunk was built.
+    absl::StatusOr<SweepChunkResult> Sweep(int chunk, int32_t sweep, std::span<const Rgb> h) const {
+        return Sweep(chunk, sweep, h, Pull(h));
+    }
+    // Hierarchical: a linked chunk's links, their bytes, and its share of the solver's bytes (the
+    // tree and per-side data split evenly over the chunks): summed over the chunks, the farm's
+    // EXR header says what local mode's does. Zeros for the flat method.
+    RadiosityReport LinkReport(int chunk) const;
+    // RadiosityRendererFor with this mesh (and cluster tree), not built again for the display.
+    // `options` as made.
     absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Renderer(const EmbreeScene& scene,
                                                                 const RadiosityOptions& options,
                                                                 std::vector<Rgb> gathered) const;
 
   private:
-    RadiositySweepChunk() = default;
-    int chunk_ = 0;
+    RadiositySweepChunks() = default;
+    std::pair<int32_t, int32_t> Groups(int chunk) const;
+
+    int chunks_ = 1;
     PatchMesh mesh_;
-    std::pair<int32_t, int32_t> groups_;
-    FormFactors form_factors_;  // the chunk's rows only
-    RadiositySystem system_;
-    std::unique_ptr<RadiosityHierarchy> hierarchy_;  // instead, hierarchical: the chunk's links
+    RadiositySystem system_;                         // flat: E, ρ and A in mesh order
+    std::map<int, FormFactors> form_factors_;        // flat: each linked chunk's rows only
+    std::unique_ptr<RadiosityHierarchy> hierarchy_;  // instead, hierarchical: every chunk's links
     std::vector<Rgb> start_;
 };
 

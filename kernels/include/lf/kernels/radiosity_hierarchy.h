@@ -37,10 +37,14 @@ inline constexpr int32_t kHierarchyGroupSize = 256;
 struct HierarchyOptions {
     double link_error = 1e-4;  // of the scene's emitted power, per link
     int32_t group_size = kHierarchyGroupSize;
-    // Link only the groups of chunk `chunk` of `chunks` (ChunkGroups).
-    int chunk = 0, chunks = 1;
-    // Set from another thread: Build returns Cancelled soon after.
+    // Set from another thread: Build and Link return Cancelled soon after.
     const std::atomic<bool>* cancel = nullptr;
+};
+
+// The links of some of a hierarchy's groups: their counts and bytes.
+struct LinkFigures {
+    int64_t node_links = 0, leaf_links = 0;
+    size_t bytes = 0;
 };
 
 // Per node and channel, Σ B A n over its sides.
@@ -48,18 +52,23 @@ using NodeExitance = std::array<Vec3d, 3>;
 
 class RadiosityHierarchy {
   public:
-    // `system`: E, ρ and A per side in mesh order (MakeRadiositySystem's). Runs in the caller's
-    // TBB arena; the links do not depend on the thread count.
+    // The cluster tree and groups of `mesh`, nothing linked yet. `system`: E, ρ and A per side in
+    // mesh order (MakeRadiositySystem's). Runs in the caller's TBB arena.
     static absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> Build(
         const EmbreeScene& scene, const PatchMesh& mesh, const RadiositySystem& system,
         const HierarchyOptions& options);
+    // Links the groups of chunk `chunk` of `chunks` (ChunkGroups; 0 of 1: all of them) that are
+    // not linked yet: a farm worker links each chunk it is given into one hierarchy, whose tree
+    // it builds once. `scene` and `mesh` as built. The links do not depend on the thread count.
+    absl::Status Link(const EmbreeScene& scene, const PatchMesh& mesh, int chunk, int chunks,
+                      const std::atomic<bool>* cancel = nullptr);
 
     int32_t sides() const { return int32_t(system_.emission.size()); }
     const ClusterTree& tree() const { return tree_; }
     // E, ρ and A in tree order (form_factors is null).
     const RadiositySystem& system() const { return system_; }
     const std::vector<PatchGroup>& groups() const { return groups_; }  // in tree order
-    std::pair<int32_t, int32_t> linked_groups() const { return linked_; }
+    bool Linked(int32_t group) const { return linked_[size_t(group)]; }
 
     // Every node's exitance from b (tree order): the pull, O(n).
     std::vector<NodeExitance> Pull(std::span<const Rgb> b) const;
@@ -74,9 +83,12 @@ class RadiosityHierarchy {
 
     int64_t node_links() const { return node_links_; }
     int64_t leaf_links() const { return leaf_links_; }
-    int64_t rays() const { return rays_; }
-    size_t link_bytes() const;
-    size_t bytes() const;  // tree, per-side data and links
+    int64_t rays() const { return rays_; }  // of every Link so far
+    size_t link_bytes() const { return Figures(0, int32_t(groups_.size())).bytes; }
+    // The links of groups [g0, g1).
+    LinkFigures Figures(int32_t g0, int32_t g1) const;
+    size_t shared_bytes() const;  // tree and per-side data: all but the links
+    size_t bytes() const { return shared_bytes() + link_bytes(); }
 
   private:
     // A group's links by receiver, in compressed rows: links are most of the solver's memory.
@@ -101,8 +113,9 @@ class RadiosityHierarchy {
     std::vector<Vec3d> normals_;  // per side, tree order
     std::vector<PatchGroup> groups_;
     std::vector<int32_t> group_roots_;
-    std::pair<int32_t, int32_t> linked_;
-    std::vector<GroupLinks> links_;  // per group; empty outside linked_
+    double link_error_ = 0;
+    std::vector<bool> linked_;       // per group
+    std::vector<GroupLinks> links_;  // per group; empty where not linked
     int64_t node_links_ = 0, leaf_links_ = 0, rays_ = 0;
 };
 

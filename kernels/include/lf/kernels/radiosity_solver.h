@@ -94,7 +94,7 @@ std::vector<Rgb> RadiosityFromIrradiance(const RadiositySystem& system,
 
 // The pure step: out[i - group.begin] = Σ_j F_ij b_j, the irradiance the sides i of `group`
 // gather from radiosity b.
-void GatherGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
+void GatherGroup(const FormFactors& form_factors, int32_t group, std::span<const Rgb> b,
                  std::span<Rgb> out);
 
 // A group's share of a Jacobi sweep's residual, with `gathered` the new irradiance of its sides
@@ -106,9 +106,9 @@ struct GroupSweep {
 };
 GroupSweep SweepSums(const RadiositySystem& system, int32_t begin, std::span<const Rgb> b,
                      std::span<const Rgb> gathered);
-// GatherGroup, and its SweepSums.
-GroupSweep JacobiGroup(const RadiositySystem& system, int32_t group, std::span<const Rgb> b,
-                       std::span<Rgb> out);
+// GatherGroup with `form_factors` (the system's, or a farm chunk's rows), and its SweepSums.
+GroupSweep JacobiGroup(const RadiositySystem& system, const FormFactors& form_factors,
+                       int32_t group, std::span<const Rgb> b, std::span<Rgb> out);
 
 // The power of radiosity c over `area` in that norm: area (|r| + |g| + |b|).
 double RadiosityPower(double area, const Rgb& c);

@@ -61,10 +61,11 @@ class Worker {
         std::unique_ptr<Camera> camera;
         std::unique_ptr<RadianceEstimator> tracer;  // path or Whitted tracer, radiosity display
         std::unique_ptr<SplatRenderer> frame;       // a splatting method's (light, bdpt, ppm)
-        // Radiosity solved in sweeps: the form-factor rows of the chunks this worker swept
-        // (the server gives a chunk back to the worker that has its rows), and the last input
-        // and its pull (hierarchical; the same for all the chunks, so pulled once a sweep).
-        std::map<int, std::unique_ptr<RadiositySweepChunk>> chunks;
+        // Radiosity solved in sweeps: the mesh and system (or cluster tree), and the form-factor
+        // rows (or links) of the chunks this worker swept (the server gives a chunk back to the
+        // worker that has its rows), and the last input and its pull (hierarchical; the same for
+        // all the chunks, so pulled once a sweep).
+        std::unique_ptr<RadiositySweepChunks> sweeps;
         std::string input_hash;
         std::vector<Rgb> input;
         std::optional<std::string> pulled_hash;  // the input pulled; "": sweep 0's start
@@ -99,7 +100,7 @@ class Worker {
                              ServerConnection::TaskResult& result, RenderStats& stats,
                              SplatList* frame_splats);
     // The chunk's sweep result, and in `figures` its link figures
-    // (RadiositySweepChunk::LinkReport).
+    // (RadiositySweepChunks::LinkReport).
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel,
                                       RadiosityFigures& figures);
     // A radiosity vector the server stored as a blob.
