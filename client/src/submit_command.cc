@@ -189,9 +189,10 @@ Command AddSubmitCommand(CLI::App& app) {
     AddPhotonFlags(cmd, o->spec.ppm);
     AddRadiosityFlags(cmd, o->spec.radiosity);
     cmd->add_option("--sweep-tasks", o->spec.radiosity.sweep_tasks,
-                    "--solver jacobi or --radiosity hierarchical: patch-group tasks per sweep; "
-                    "each worker computes the form-factor rows (or links) of its groups once "
-                    "and keeps them. Gauss-Seidel and "
+                    "--solver jacobi or --radiosity hierarchical: chunks of the patch groups; "
+                    "the first sweep is a task a chunk, and each worker computes the form-factor "
+                    "rows (or links) of its chunks once and keeps them, so later sweeps are one "
+                    "task a worker of all its chunks. Gauss-Seidel and "
                     "shooting update one group after another, so with them every worker "
                     "solves the whole system before rendering display tiles")
         ->group("Radiosity")

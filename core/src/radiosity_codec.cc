@@ -66,6 +66,8 @@ class Reader {
         for (Rgb& c : values) Get(c.r), Get(c.g), Get(c.b);
         return values;
     }
+    bool empty() const { return bytes_.empty(); }
+    bool ok() const { return ok_; }
     absl::Status Done() const {
         if (!ok_) return absl::InvalidArgumentError(absl::StrCat(what_, ": truncated"));
         if (!bytes_.empty()) {
@@ -117,8 +119,10 @@ std::string EncodeSweepResult(const SweepChunkResult& r) {
     return out;
 }
 
-absl::StatusOr<SweepChunkResult> DecodeSweepResult(std::string_view bytes) {
-    Reader in(bytes, "sweep result");
+namespace {
+
+// One result from where `in` stands.
+absl::StatusOr<SweepChunkResult> ReadSweepResult(Reader& in) {
     if (absl::Status s = in.Magic("LFSW"); !s.ok()) return s;
     SweepChunkResult r;
     int64_t side_count = 0, groups = 0;
@@ -131,7 +135,6 @@ absl::StatusOr<SweepChunkResult> DecodeSweepResult(std::string_view bytes) {
         r.input = in.Rgbs(side_count);
         r.output = in.Rgbs(side_count);
     }
-    if (absl::Status s = in.Done(); !s.ok()) return s;
     if (r.sweep < 0 || r.chunk < 0 || r.side_begin < 0 || r.sides < 0 ||
         int64_t(r.side_begin) + side_count > r.sides) {
         return absl::InvalidArgumentError(absl::StrCat(
@@ -139,6 +142,30 @@ absl::StatusOr<SweepChunkResult> DecodeSweepResult(std::string_view bytes) {
             ") outside the system's ", r.sides, " (sweep ", r.sweep, ", chunk ", r.chunk, ")"));
     }
     return r;
+}
+
+}  // namespace
+
+std::string EncodeSweepResults(std::span<const SweepChunkResult> results) {
+    std::string out;
+    for (const SweepChunkResult& r : results) out += EncodeSweepResult(r);
+    return out;
+}
+
+absl::StatusOr<std::vector<SweepChunkResult>> DecodeSweepResults(std::string_view bytes) {
+    Reader in(bytes, "sweep result");
+    std::vector<SweepChunkResult> results;
+    do {
+        absl::StatusOr<SweepChunkResult> r = ReadSweepResult(in);
+        if (!in.ok()) return in.Done();  // truncated
+        if (!r.ok() && !results.empty()) {
+            return absl::InvalidArgumentError(
+                absl::StrCat("after ", results.size(), " chunk results: ", r.status().message()));
+        }
+        if (!r.ok()) return r.status();
+        results.push_back(std::move(*r));
+    } while (!in.empty());
+    return results;
 }
 
 }  // namespace lf

@@ -7,7 +7,27 @@ namespace lf {
 RadiositySolve::RadiositySolve(int chunks, double tolerance, int max_iterations)
     : chunks_(chunks), tolerance_(tolerance), max_iterations_(max_iterations), results_(chunks) {}
 
-absl::Status RadiositySolve::Add(const SweepChunkResult& r) {
+absl::Status RadiositySolve::Add(std::span<const SweepChunkResult> results) {
+    for (size_t k = 0; k < results.size(); ++k) {
+        const SweepChunkResult& r = results[k];
+        if (absl::Status s = Check(r); !s.ok()) return s;
+        for (size_t j = 0; j < k; ++j) {
+            if (results[j].chunk == r.chunk) {
+                return absl::AlreadyExistsError(
+                    absl::StrFormat("sweep %d chunk %d twice in one result", r.sweep, r.chunk));
+            }
+            if (results[j].sides != r.sides) {
+                return absl::InvalidArgumentError(
+                    absl::StrFormat("sweep result of chunk %d has %d unknowns, chunk %d had %d",
+                                    r.chunk, r.sides, results[j].chunk, results[j].sides));
+            }
+        }
+    }
+    for (const SweepChunkResult& r : results) results_[size_t(r.chunk)] = r;
+    return absl::OkStatus();
+}
+
+absl::Status RadiositySolve::Check(const SweepChunkResult& r) const {
     if (r.sweep != sweep_ || r.chunk < 0 || r.chunk >= chunks_) {
         return absl::InvalidArgumentError(
             absl::StrFormat("sweep result of sweep %d chunk %d, expected sweep %d chunk 0..%d",
@@ -40,7 +60,6 @@ absl::Status RadiositySolve::Add(const SweepChunkResult& r) {
             }
         }
     }
-    results_[size_t(r.chunk)] = r;
     return absl::OkStatus();
 }
 

@@ -52,7 +52,7 @@ uint64_t SplatExecution::TaskSamples(int index) const {
 }
 
 absl::StatusOr<JobExecution::Merged> SplatExecution::Merge(int index, const TaskResult& result) {
-    if (result.sweep) return absl::InvalidArgumentError("a sweep result for a tile");
+    if (!result.sweeps.empty()) return absl::InvalidArgumentError("a sweep result for a tile");
     if (!result.splats || !result.sums) {
         return absl::InvalidArgumentError("a splat task's result without its splats");
     }

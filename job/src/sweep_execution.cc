@@ -37,50 +37,64 @@ std::vector<int> SweepExecution::Start() {
     if (!solution_.empty() || merger().Complete()) return TileExecution::Start();
     solve_ = std::make_unique<RadiositySolve>(radiosity_.sweep_tasks, radiosity_.tolerance,
                                               radiosity_.max_iterations);
-    sweeps_ = SweepTaskNumbering{int(TileExecution::task_count()), solve_->chunks()};
+    sweeps_.emplace(int(TileExecution::task_count()));
     sweep_input_.clear();
     return QueueSweep();
 }
 
 std::vector<int> SweepExecution::QueueSweep() {
-    const int sweep = solve_->sweep();
-    tasks_ = std::max(tasks_, size_t(sweeps_->ToIndex({sweep + 1, 0})));
-    std::vector<int> queued;
-    for (int c = 0; c < sweeps_->chunks; ++c) queued.push_back(sweeps_->ToIndex({sweep, c}));
+    std::vector<std::vector<int>> tasks;
+    std::map<std::string, size_t> task_of_worker;
+    for (int c = 0; c < solve_->chunks(); ++c) {
+        auto owner = chunk_owner_.find(c);
+        // Sweep 0 (no owners yet): a task a chunk. Later, a worker's chunks in one task, in
+        // chunk order; a chunk never leased (none: sweep 0 leased them all) goes alone.
+        if (solve_->sweep() == 0 || owner == chunk_owner_.end()) {
+            tasks.push_back({c});
+            continue;
+        }
+        auto [it, added] = task_of_worker.try_emplace(owner->second.worker, tasks.size());
+        if (added) tasks.emplace_back();
+        tasks[it->second].push_back(c);
+    }
+    const std::vector<int> queued = sweeps_->Append(std::move(tasks));
+    tasks_ = std::max(tasks_, size_t(sweeps_->end()));
     return queued;
 }
 
-std::optional<SweepTaskNumbering::SweepChunk> SweepExecution::SweepChunkOf(int task) const {
+std::optional<SweepTaskNumbering::SweepTask> SweepExecution::SweepTaskOf(int task) const {
     return sweeps_ ? sweeps_->FromIndex(task) : std::nullopt;
 }
 
 void SweepExecution::Lease(int task, const std::string& worker, TaskAssignment& lease) {
-    const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(task);
+    const std::optional<SweepTaskNumbering::SweepTask> at = SweepTaskOf(task);
     if (!at) {
         TileExecution::Lease(task, worker, lease);
         lease.radiosity_hash = solution_;
         return;
     }
-    // The worker of a task's first lease owns the chunk: a second lease of the same task (a
-    // straggler's copy, or a retry) must not move the chunk, and with it every later sweep of
-    // it, to a worker that then holds more chunks than the others.
-    ChunkOwner& owner = chunk_owner_[at->chunk];
-    if (owner.task != task) owner = {task, worker};
+    // The worker of a task's first lease owns its chunks: a second lease of the same task (a
+    // straggler's copy, or a retry) must not move them, and with them every later sweep, to a
+    // worker that then holds more chunks than the others.
+    for (int chunk : at->chunks) {
+        ChunkOwner& owner = chunk_owner_[chunk];
+        if (owner.task != task) owner = {task, worker};
+    }
     lease.task.index = task;
     lease.sweep = at->sweep;
-    lease.chunk = at->chunk;
+    lease.chunks.assign(at->chunks.begin(), at->chunks.end());
     lease.radiosity_hash = sweep_input_;
 }
 
 std::string SweepExecution::PreferredWorker(int task) const {
-    const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(task);
-    if (!at) return "";
-    auto owner = chunk_owner_.find(at->chunk);
+    const std::optional<SweepTaskNumbering::SweepTask> at = SweepTaskOf(task);
+    if (!at || at->chunks.empty()) return "";
+    auto owner = chunk_owner_.find(at->chunks.front());
     return owner == chunk_owner_.end() ? "" : owner->second.worker;
 }
 
 void SweepExecution::Describe(int task, TaskStatus& status) const {
-    if (SweepChunkOf(task)) {
+    if (SweepTaskOf(task)) {
         status.kind = TaskKind::kRadiositySweep;
         return;
     }
@@ -88,22 +102,30 @@ void SweepExecution::Describe(int task, TaskStatus& status) const {
 }
 
 uint64_t SweepExecution::TaskSamples(int task) const {
-    return SweepChunkOf(task) ? 0 : TileExecution::TaskSamples(task);
+    return SweepTaskOf(task) ? 0 : TileExecution::TaskSamples(task);
 }
 
 absl::StatusOr<JobExecution::Merged> SweepExecution::Merge(int task, const TaskResult& result) {
-    const std::optional<SweepTaskNumbering::SweepChunk> at = SweepChunkOf(task);
-    if (!result.sweep) {
+    const std::optional<SweepTaskNumbering::SweepTask> at = SweepTaskOf(task);
+    if (result.sweeps.empty()) {
         if (at) return absl::InvalidArgumentError("a tile result for a sweep task");
         return TileExecution::Merge(task, result);
     }
-    const SweepChunkResult& sweep = *result.sweep;
     if (!at) return absl::InvalidArgumentError("a sweep result for a tile");
-    if (*at != SweepTaskNumbering::SweepChunk{sweep.sweep, sweep.chunk} || !solve_) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("a result of sweep ", sweep.sweep, " chunk ", sweep.chunk));
+    // Exactly the task's chunks, in its order, of its sweep: checked whole before any is added.
+    bool fits = solve_ && at->sweep == solve_->sweep() && result.sweeps.size() == at->chunks.size();
+    for (size_t k = 0; fits && k < result.sweeps.size(); ++k) {
+        fits = result.sweeps[k].sweep == at->sweep && result.sweeps[k].chunk == at->chunks[k];
     }
-    if (absl::Status added = solve_->Add(sweep); !added.ok()) return added;
+    if (!fits) {
+        std::string chunks;
+        for (const SweepChunkResult& r : result.sweeps) {
+            absl::StrAppend(&chunks, chunks.empty() ? "" : ", ", r.chunk, " of sweep ", r.sweep);
+        }
+        return absl::InvalidArgumentError(
+            absl::StrCat("a result of chunks ", chunks, " for task ", task));
+    }
+    if (absl::Status added = solve_->Add(result.sweeps); !added.ok()) return added;
     Merged merged;
     if (solve_->SweepComplete()) {
         absl::StatusOr<RadiositySolve::Outcome> outcome = solve_->FinishSweep();
@@ -117,7 +139,7 @@ absl::StatusOr<JobExecution::Merged> SweepExecution::Merge(int task, const TaskR
 }
 
 std::optional<std::string> SweepExecution::RecordOf(const TaskResult& result) const {
-    if (result.sweep) return std::nullopt;
+    if (!result.sweeps.empty()) return std::nullopt;
     return TileExecution::RecordOf(result);
 }
 

@@ -63,7 +63,7 @@ absl::StatusOr<std::vector<int>> TileExecution::MergeSums(int task, const TileSu
 }
 
 absl::StatusOr<JobExecution::Merged> TileExecution::Merge(int task, const TaskResult& result) {
-    if (result.sweep) return absl::InvalidArgumentError("a sweep result for a tile");
+    if (!result.sweeps.empty()) return absl::InvalidArgumentError("a sweep result for a tile");
     if (result.splats) return absl::InvalidArgumentError("splats in the result of a tile task");
     if (!result.sums) return absl::InvalidArgumentError("a tile task's result without its sums");
     absl::StatusOr<std::vector<int>> appended = MergeSums(task, *result.sums);

@@ -298,14 +298,15 @@ void Farm::WriteFrame(const std::string& job_id, int frame) {
 absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
                                  std::string_view sweep_result, const TaskTimes& times,
                                  const std::optional<RadiosityFigures>& links) {
-    absl::StatusOr<SweepChunkResult> result = DecodeSweepResult(sweep_result);
-    if (!result.ok()) return RefuseUndecodable(lease_id, worker, result.status());
+    absl::StatusOr<std::vector<SweepChunkResult>> results = DecodeSweepResults(sweep_result);
+    if (!results.ok()) return RefuseUndecodable(lease_id, worker, results.status());
     absl::StatusOr<Scheduler::Completion> done =
-        scheduler_.Complete(lease_id, worker, TaskResult{.sweep = &*result, .times = times});
+        scheduler_.Complete(lease_id, worker, TaskResult{.sweeps = *results, .times = times});
     if (!done.ok()) return done.status();
-    if (links && links->links > 0) {
+    // A chunk's links come with its sweep-0 task, which is of that chunk alone.
+    if (links && links->links > 0 && results->size() == 1) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
-        sweep_links_[done->job_id][result->chunk] = *links;
+        sweep_links_[done->job_id][results->front().chunk] = *links;
     }
     if (done->sweep && done->sweep->converged) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);

@@ -997,9 +997,10 @@ TEST_F(Farm, RadiosityJobGivesTheLocalPixels) {
     ExpectSameAsLocal(job, scene_, 2, 6, flags);
 }
 
-// With --solver jacobi the farm solves: every sweep is --sweep-tasks patch-group tasks, and
-// each chunk of form-factor rows is computed once, by the worker that keeps sweeping it. The
-// solution, and so the image, has the bits of a local Jacobi solve for any split.
+// With --solver jacobi the farm solves: sweep 0 is --sweep-tasks patch-group tasks, each chunk
+// of form-factor rows is computed once, by the worker that keeps sweeping it, and every later
+// sweep is one task a worker, of all its chunks. The solution, and so the image, has the bits of
+// a local Jacobi solve for any split.
 TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
     StartServer();
     StartWorker("w1");
@@ -1022,6 +1023,16 @@ TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
     EXPECT_EQ(built, chunks) << "a chunk's form factors were computed twice:\n" << logs;
     const std::string server_log = ReadText(dir_ / "server-1.log");
     EXPECT_NE(server_log.find("radiosity sweep 2: relative residual"), std::string::npos);
+    // Sweep 2 of each job: a task a worker (two at most), one of them of several chunks (five
+    // chunks over two workers).
+    int sweep2 = 0;
+    for (size_t at = 0;
+         (at = logs.find("leased: radiosity sweep 2 patch group", at)) != std::string::npos; ++at) {
+        ++sweep2;
+    }
+    EXPECT_GE(sweep2, 2) << logs;
+    EXPECT_LE(sweep2, 4) << logs;
+    EXPECT_NE(logs.find("leased: radiosity sweep 2 patch groups "), std::string::npos) << logs;
 }
 
 // A sphere is meshed for radiosity (PrepareSceneFor) on every worker as `lightfarm render`

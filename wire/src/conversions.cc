@@ -306,7 +306,8 @@ void ToProto(const TaskAssignment& task, pb::Task* out) {
     if (task.sweep >= 0) {
         out->set_kind(pb::Task::RADIOSITY_SWEEP);
         out->set_sweep(task.sweep);
-        out->set_chunk(task.chunk);
+        if (!task.chunks.empty()) out->set_chunk(task.chunks.front());
+        for (size_t k = 1; k < task.chunks.size(); ++k) out->add_more_chunks(task.chunks[k]);
     } else if (UsesSplatPlan(task.spec.method)) {
         out->set_kind(pb::Task::FRAME);
         out->set_path_begin(task.path_begin);
@@ -340,7 +341,8 @@ TaskAssignment FromProto(const pb::Task& t) {
     FromProto(t.params(), &task.spec);
     if (t.kind() == pb::Task::RADIOSITY_SWEEP) {
         task.sweep = t.sweep();
-        task.chunk = t.chunk();
+        task.chunks.push_back(t.chunk());
+        task.chunks.insert(task.chunks.end(), t.more_chunks().begin(), t.more_chunks().end());
     }
     if (t.kind() == pb::Task::FRAME) {
         task.path_begin = t.path_begin();

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "lf/core/file_util.h"
 #include "lf/core/log.h"
 #include "lf/core/plural.h"
@@ -56,8 +57,9 @@ class TaskClock {
 // What a lease asks for, for its first log line.
 std::string DescribeTask(const TaskAssignment& task) {
     if (task.sweep >= 0) {
-        return absl::StrCat("radiosity sweep ", task.sweep, " patch group ", task.chunk, " of ",
-                            task.spec.radiosity.sweep_tasks);
+        return absl::StrCat("radiosity sweep ", task.sweep, " patch group",
+                            task.chunks.size() == 1 ? " " : "s ", absl::StrJoin(task.chunks, ", "),
+                            " of ", task.spec.radiosity.sweep_tasks);
     }
     const PixelRect& r = task.task.rect;
     std::string what =
@@ -232,7 +234,7 @@ absl::Status Worker::RunTask(const TaskAssignment& task, const std::atomic<bool>
         result.frame = task.frame;
     }
     if (task.sweep >= 0) {
-        RadiosityFigures figures;
+        std::optional<RadiosityFigures> figures;
         absl::StatusOr<std::string> swept = Sweep(task, cancel, figures);
         if (!swept.ok()) return swept.status();
         result = {std::move(*swept), true, figures};
@@ -445,9 +447,11 @@ absl::StatusOr<std::vector<Rgb>> Worker::ReadRadiosity(const std::string& hash) 
 
 absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
                                           const std::atomic<bool>& cancel,
-                                          RadiosityFigures& figures) {
+                                          std::optional<RadiosityFigures>& figures) {
     const RadiositySettings& r = task.spec.radiosity;
-    if (!loaded_.sweeps || !loaded_.sweeps->Linked(task.chunk)) {
+    if (task.chunks.empty()) return absl::InvalidArgumentError("a sweep task of no chunks");
+    for (int chunk : task.chunks) {
+        if (loaded_.sweeps && loaded_.sweeps->Linked(chunk)) continue;
         absl::StatusOr<RadiosityOptions> options =
             RadiosityOptionsOf(task.spec.radiosity, task.spec.adaptive.target_error);
         if (!options.ok()) return options.status();
@@ -464,11 +468,11 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
                 }
                 loaded_.sweeps = std::move(*made);
             }
-            linked = loaded_.sweeps->Link(*loaded_.embree, task.chunk, &cancel);
+            linked = loaded_.sweeps->Link(*loaded_.embree, chunk, &cancel);
         });
         if (!linked.ok()) return linked;
         Log()->info("job={} task={} form factors of chunk {}/{} in {:.2f} s", task.job_id,
-                    task.task.index, task.chunk, r.sweep_tasks,
+                    task.task.index, chunk, r.sweep_tasks,
                     absl::ToDoubleSeconds(absl::Now() - start));
     }
     const RadiositySweepChunks& chunks = *loaded_.sweeps;
@@ -482,17 +486,33 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
         }
         input = loaded_.input;
     }
-    absl::StatusOr<SweepChunkResult> result;
+    std::vector<SweepChunkResult> results;
+    absl::Status swept;
     arena_.execute([&] {
         if (loaded_.pulled_hash != task.radiosity_hash) {
             loaded_.pulled = chunks.Pull(input);
             loaded_.pulled_hash = task.radiosity_hash;
         }
-        result = chunks.Sweep(task.chunk, task.sweep, input, loaded_.pulled);
+        for (int chunk : task.chunks) {
+            if (cancel) {
+                swept = absl::CancelledError("radiosity sweep cancelled");
+                return;
+            }
+            absl::StatusOr<SweepChunkResult> result =
+                chunks.Sweep(chunk, task.sweep, input, loaded_.pulled);
+            if (!result.ok()) {
+                swept = result.status();
+                return;
+            }
+            results.push_back(std::move(*result));
+        }
     });
-    if (!result.ok()) return result.status();
-    figures = RadiosityFiguresOf(chunks.LinkReport(task.chunk));
-    return EncodeSweepResult(*result);
+    if (!swept.ok()) return swept;
+    // A chunk's links, for the EXR header, go with its sweep-0 task, which is of it alone.
+    if (task.sweep == 0 && task.chunks.size() == 1) {
+        figures = RadiosityFiguresOf(chunks.LinkReport(task.chunks.front()));
+    }
+    return EncodeSweepResults(results);
 }
 
 TileSums Worker::Render(const TaskAssignment& task, const std::atomic<bool>& cancel) {

@@ -34,33 +34,49 @@ TEST(RadiosityCodec, RadiosityRoundTripKeepsEveryBit) {
     }
 }
 
-TEST(RadiosityCodec, SweepResultRoundTripKeepsEveryBit) {
-    const SweepChunkResult r = Example();
-    absl::StatusOr<SweepChunkResult> back = DecodeSweepResult(EncodeSweepResult(r));
+// A task's results, one a chunk, back to back: each comes back with every bit, in order.
+TEST(RadiosityCodec, SweepResultsRoundTripKeepEveryBit) {
+    SweepChunkResult second = Example();
+    second.chunk = 5;
+    second.side_begin = 0;
+    second.change = {2.5};
+    second.power = {0.5};
+    const std::vector<SweepChunkResult> results = {Example(), second};
+    absl::StatusOr<std::vector<SweepChunkResult>> back =
+        DecodeSweepResults(EncodeSweepResults(results));
     ASSERT_TRUE(back.ok()) << back.status();
-    EXPECT_EQ(back->sweep, r.sweep);
-    EXPECT_EQ(back->chunk, r.chunk);
-    EXPECT_EQ(back->sides, r.sides);
-    EXPECT_EQ(back->side_begin, r.side_begin);
-    EXPECT_EQ(back->change, r.change);
-    EXPECT_EQ(back->power, r.power);
-    EXPECT_EQ(back->input, r.input);
-    EXPECT_EQ(back->output, r.output);
+    ASSERT_EQ(back->size(), results.size());
+    for (size_t k = 0; k < results.size(); ++k) {
+        const SweepChunkResult &r = results[k], &b = (*back)[k];
+        EXPECT_EQ(b.sweep, r.sweep);
+        EXPECT_EQ(b.chunk, r.chunk);
+        EXPECT_EQ(b.sides, r.sides);
+        EXPECT_EQ(b.side_begin, r.side_begin);
+        EXPECT_EQ(b.change, r.change);
+        EXPECT_EQ(b.power, r.power);
+        EXPECT_EQ(b.input, r.input);
+        EXPECT_EQ(b.output, r.output);
+    }
 }
 
 TEST(RadiosityCodec, GarbageIsRefusedWithAReason) {
     const std::string good = EncodeSweepResult(Example());
-    EXPECT_FALSE(DecodeSweepResult("").ok());
-    EXPECT_FALSE(DecodeSweepResult(EncodeRadiosity({})).ok());  // the other kind
-    for (size_t cut : {size_t(5), size_t(20), good.size() - 1}) {
-        absl::StatusOr<SweepChunkResult> r = DecodeSweepResult(good.substr(0, cut));
-        EXPECT_FALSE(r.ok()) << cut;
+    EXPECT_FALSE(DecodeSweepResults("").ok());
+    EXPECT_FALSE(DecodeSweepResults(EncodeRadiosity({})).ok());  // the other kind
+    for (const std::string& whole : {good, good + good}) {
+        for (size_t cut : {size_t(5), size_t(20), good.size() + 20, whole.size() - 1}) {
+            if (cut >= whole.size()) continue;
+            absl::StatusOr<std::vector<SweepChunkResult>> r =
+                DecodeSweepResults(whole.substr(0, cut));
+            EXPECT_FALSE(r.ok()) << cut;
+        }
     }
-    EXPECT_NE(DecodeSweepResult(good + "x").status().message().find("after the end"),
-              std::string::npos);
+    const absl::Status trailing = DecodeSweepResults(good + "x").status();
+    EXPECT_NE(trailing.message().find("after 1 chunk results"), std::string::npos) << trailing;
     SweepChunkResult outside = Example();
     outside.side_begin = 8;  // 3 sides from 8 overrun the system's 10
-    absl::StatusOr<SweepChunkResult> r = DecodeSweepResult(EncodeSweepResult(outside));
+    absl::StatusOr<std::vector<SweepChunkResult>> r =
+        DecodeSweepResults(EncodeSweepResult(outside));
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.status().message().find("outside"), std::string::npos) << r.status();
     // A count far beyond the bytes present is refused before anything is allocated.

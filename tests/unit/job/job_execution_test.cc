@@ -45,7 +45,8 @@ TEST(TileExecution, StartsWithEveryTileAndRefusesOtherKindsOfResult) {
     const SweepChunkResult sweep;
     EXPECT_EQ(e.Merge(0, {.sums = &sums, .splats = &splats}).status().code(),
               absl::StatusCode::kInvalidArgument);
-    EXPECT_EQ(e.Merge(0, {.sweep = &sweep}).status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(e.Merge(0, {.sweeps = {&sweep, 1}}).status().code(),
+              absl::StatusCode::kInvalidArgument);
     EXPECT_EQ(e.Merge(1, {.sums = &sums}).status().code(), absl::StatusCode::kInvalidArgument)
         << "another task's rectangle";
     absl::StatusOr<JobExecution::Merged> merged = e.Merge(0, {.sums = &sums});
@@ -207,11 +208,13 @@ TEST(SweepExecution, SolvesBeforeTheTilesAndHandsTheSolutionOn) {
     const TileSums sums = Flat(TaskOf(e, 0), 0.5f, 0.5f);
     EXPECT_EQ(e.Merge(2, {.sums = &sums}).status().code(), absl::StatusCode::kInvalidArgument);
     const SweepChunkResult wrong = DarkChunk(1);
-    EXPECT_EQ(e.Merge(2, {.sweep = &wrong}).status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_EQ(e.Merge(2, {.sweeps = {&wrong, 1}}).status().code(),
+              absl::StatusCode::kInvalidArgument);
     const SweepChunkResult chunk = DarkChunk(0);
-    EXPECT_EQ(e.Merge(0, {.sweep = &chunk}).status().code(), absl::StatusCode::kInvalidArgument);
-    EXPECT_FALSE(e.RecordOf({.sweep = &chunk}).has_value()) << "soft state";
-    absl::StatusOr<JobExecution::Merged> merged = e.Merge(2, {.sweep = &chunk});
+    EXPECT_EQ(e.Merge(0, {.sweeps = {&chunk, 1}}).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    EXPECT_FALSE(e.RecordOf({.sweeps = {&chunk, 1}}).has_value()) << "soft state";
+    absl::StatusOr<JobExecution::Merged> merged = e.Merge(2, {.sweeps = {&chunk, 1}});
     ASSERT_TRUE(merged.ok()) << merged.status();
     ASSERT_TRUE(merged->sweep.has_value());
     EXPECT_TRUE(merged->sweep->converged);
@@ -248,7 +251,8 @@ TEST(SweepExecution, ASecondLeaseOfATaskLeavesTheChunkWithItsOwner) {
         r.side_begin = chunk;
         r.output = {Rgb(1)};
         r.change = {1};
-        absl::StatusOr<JobExecution::Merged> merged = e.Merge(sweep0[size_t(chunk)], {.sweep = &r});
+        absl::StatusOr<JobExecution::Merged> merged =
+            e.Merge(sweep0[size_t(chunk)], {.sweeps = {&r, 1}});
         ASSERT_TRUE(merged.ok()) << merged.status();
     }
     absl::StatusOr<std::vector<int>> sweep1 = e.Publish(false, "b1-hash");
@@ -258,6 +262,91 @@ TEST(SweepExecution, ASecondLeaseOfATaskLeavesTheChunkWithItsOwner) {
     EXPECT_EQ(e.PreferredWorker((*sweep1)[1]), "b");
     e.Lease((*sweep1)[0], "b", lease);  // "a" is gone: the scheduler let "b" take it
     EXPECT_EQ(e.PreferredWorker((*sweep1)[0]), "b");
+    EXPECT_EQ(lease.chunks, std::vector<int>{0});
+}
+
+// The results of `chunks` in `sweep` of a system of `of` unknowns, one a chunk, lit: each
+// gathers 1 from sweep 0 on (so a later sweep's input is 1), never converging.
+std::vector<SweepChunkResult> LitChunks(int sweep, const std::vector<int>& chunks, int of) {
+    std::vector<SweepChunkResult> results;
+    for (int chunk : chunks) {
+        SweepChunkResult r = DarkChunk(sweep);
+        r.chunk = chunk;
+        r.sides = of;
+        r.side_begin = chunk;
+        r.input = {Rgb(sweep == 0 ? 0 : 1)};
+        r.output = {Rgb(1)};
+        r.change = {1};
+        r.power = {1};
+        results.push_back(r);
+    }
+    return results;
+}
+
+// After sweep 0 (a task a chunk), each sweep has one task a worker, of every chunk it holds in
+// chunk order: one lease and result a worker and sweep. A result must be of exactly its task's
+// chunks, and is added whole or not at all. A worker gone gives its whole task to the next.
+TEST(SweepExecution, LaterSweepsHaveOneTaskAWorkerOfAllItsChunks) {
+    const std::unique_ptr<SweepExecution> made = TwoTileSweeps(5);
+    ASSERT_TRUE(made);
+    SweepExecution& e = *made;
+    const std::vector<int> sweep0 = e.Start();
+    ASSERT_EQ(sweep0, (std::vector<int>{2, 3, 4, 5, 6}));
+    TaskAssignment lease;
+    const std::vector<std::string> owner = {"a", "b", "a", "a", "b"};
+    for (int c = 0; c < 5; ++c) {
+        e.Lease(sweep0[size_t(c)], owner[size_t(c)], lease);
+        EXPECT_EQ(lease.chunks, std::vector<int>{c});
+        EXPECT_EQ(lease.sweep, 0);
+        const std::vector<SweepChunkResult> r = LitChunks(0, {c}, 5);
+        ASSERT_TRUE(e.Merge(sweep0[size_t(c)], {.sweeps = r}).ok());
+    }
+    absl::StatusOr<std::vector<int>> sweep1 = e.Publish(false, "h1");
+    ASSERT_TRUE(sweep1.ok()) << sweep1.status();
+    ASSERT_EQ(*sweep1, (std::vector<int>{7, 8}));  // numbered after sweep 0's
+    EXPECT_EQ(e.task_count(), 9u);
+    EXPECT_EQ(e.PreferredWorker(7), "a");
+    EXPECT_EQ(e.PreferredWorker(8), "b");
+    e.Lease(7, "a", lease);
+    EXPECT_EQ(lease.sweep, 1);
+    EXPECT_EQ(lease.chunks, (std::vector<int>{0, 2, 3}));
+    EXPECT_EQ(lease.radiosity_hash, "h1");
+    TaskStatus status;
+    e.Describe(8, status);
+    EXPECT_EQ(status.kind, TaskKind::kRadiositySweep);
+    EXPECT_EQ(e.TaskSamples(8), 0u);
+    // Another task's chunks, a chunk short, out of order, or of another sweep: refused, and
+    // nothing of them is added (the right result is taken afterwards).
+    for (const std::vector<SweepChunkResult>& wrong :
+         {LitChunks(1, {1, 4}, 5), LitChunks(1, {0, 2}, 5), LitChunks(1, {2, 0, 3}, 5),
+          LitChunks(0, {0, 2, 3}, 5)}) {
+        EXPECT_EQ(e.Merge(7, {.sweeps = wrong}).status().code(),
+                  absl::StatusCode::kInvalidArgument);
+    }
+    std::vector<SweepChunkResult> bad_input = LitChunks(1, {0, 2, 3}, 5);
+    bad_input[2].sides = 6;  // its last chunk does not fit: the first two are not added either
+    EXPECT_FALSE(e.Merge(7, {.sweeps = bad_input}).ok());
+    absl::StatusOr<JobExecution::Merged> merged =
+        e.Merge(7, {.sweeps = LitChunks(1, {0, 2, 3}, 5)});
+    ASSERT_TRUE(merged.ok()) << merged.status();
+    EXPECT_FALSE(merged->sweep.has_value()) << "b's chunks are still out";
+    merged = e.Merge(8, {.sweeps = LitChunks(1, {1, 4}, 5)});
+    ASSERT_TRUE(merged.ok()) << merged.status();
+    ASSERT_TRUE(merged->sweep.has_value());
+    // "b" is gone in sweep 2: "a" takes b's task, and with it chunks 1 and 4.
+    absl::StatusOr<std::vector<int>> sweep2 = e.Publish(false, "h2");
+    ASSERT_TRUE(sweep2.ok()) << sweep2.status();
+    ASSERT_EQ(*sweep2, (std::vector<int>{9, 10}));
+    e.Lease(10, "a", lease);
+    EXPECT_EQ(lease.chunks, (std::vector<int>{1, 4}));
+    EXPECT_EQ(e.PreferredWorker(10), "a");
+    ASSERT_TRUE(e.Merge(9, {.sweeps = LitChunks(2, {0, 2, 3}, 5)}).ok());
+    ASSERT_TRUE(e.Merge(10, {.sweeps = LitChunks(2, {1, 4}, 5)}).ok());
+    absl::StatusOr<std::vector<int>> sweep3 = e.Publish(false, "h3");
+    ASSERT_TRUE(sweep3.ok()) << sweep3.status();
+    ASSERT_EQ(sweep3->size(), 1u) << "one worker holds every chunk";
+    e.Lease(sweep3->front(), "a", lease);
+    EXPECT_EQ(lease.chunks, (std::vector<int>{0, 1, 2, 3, 4}));
 }
 
 // Display tiles of few samples are widened until a task holds 2^18 samples a pass, up to the

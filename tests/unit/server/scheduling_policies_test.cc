@@ -2,9 +2,9 @@
 // when an adaptive job's time limit is reached; and where sweep tasks are numbered.
 #include <gtest/gtest.h>
 
-#include "lf/server/speculation.h"
 #include "lf/job/sweep_task_numbering.h"
 #include "lf/job/time_limit.h"
+#include "lf/server/speculation.h"
 
 namespace lf {
 namespace {
@@ -37,18 +37,30 @@ TEST(TimeLimit, ReachedOnlyOnceStartedAndPastTheLimit) {
     EXPECT_FALSE(TimeLimitReached(AdaptiveSettings{.target_error = 0.1}, t0, t0 + absl::Hours(9)));
 }
 
-TEST(SweepTaskNumbering, SweepChunksFollowTheTilesInOrder) {
-    const SweepTaskNumbering n{.tiles = 10, .chunks = 3};
+// Sweeps' tasks follow the tiles and each other in order, each with the chunks it covers; an
+// index of a tile or beyond the last sweep is no sweep task.
+TEST(SweepTaskNumbering, SweepTasksFollowTheTilesInOrder) {
+    SweepTaskNumbering n(10);
     EXPECT_FALSE(n.FromIndex(9).has_value());
-    EXPECT_EQ(n.ToIndex({0, 0}), 10);
-    EXPECT_EQ(n.ToIndex({2, 1}), 17);
-    for (int index = 10; index < 40; ++index) {
-        const std::optional<SweepTaskNumbering::SweepChunk> at = n.FromIndex(index);
-        ASSERT_TRUE(at.has_value());
-        EXPECT_LT(at->chunk, 3);
-        EXPECT_EQ(n.ToIndex(*at), index);
+    EXPECT_FALSE(n.FromIndex(10).has_value());
+    EXPECT_EQ(n.Append({{0}, {1}, {2}}), (std::vector<int>{10, 11, 12}));
+    EXPECT_EQ(n.Append({{0, 2}, {1}}), (std::vector<int>{13, 14}));
+    EXPECT_EQ(n.Append({{0, 1, 2}}), std::vector<int>{15});
+    EXPECT_EQ(n.end(), 16);
+    EXPECT_EQ(n.sweeps(), 3);
+    EXPECT_FALSE(n.FromIndex(9).has_value());
+    EXPECT_FALSE(n.FromIndex(16).has_value());
+    EXPECT_FALSE(n.FromIndex(-1).has_value());
+    const std::vector<std::pair<int, std::vector<int>>> want = {
+        {0, {0}}, {0, {1}}, {0, {2}}, {1, {0, 2}}, {1, {1}}, {2, {0, 1, 2}}};
+    for (int index = 10; index < 16; ++index) {
+        const std::optional<SweepTaskNumbering::SweepTask> at = n.FromIndex(index);
+        ASSERT_TRUE(at.has_value()) << index;
+        EXPECT_EQ(at->sweep, want[size_t(index - 10)].first) << index;
+        EXPECT_EQ(std::vector<int>(at->chunks.begin(), at->chunks.end()),
+                  want[size_t(index - 10)].second)
+            << index;
     }
-    EXPECT_EQ(*n.FromIndex(17), (SweepTaskNumbering::SweepChunk{2, 1}));
 }
 
 }  // namespace

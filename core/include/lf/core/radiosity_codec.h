@@ -36,7 +36,10 @@ struct SweepChunkResult {
 };
 
 std::string EncodeSweepResult(const SweepChunkResult& result);
-// InvalidArgument for anything malformed, including a run outside [0, sides).
-absl::StatusOr<SweepChunkResult> DecodeSweepResult(std::string_view bytes);
+// A task's results, one a chunk, back to back.
+std::string EncodeSweepResults(std::span<const SweepChunkResult> results);
+// At least one result; InvalidArgument for anything malformed, including a run outside
+// [0, sides).
+absl::StatusOr<std::vector<SweepChunkResult>> DecodeSweepResults(std::string_view bytes);
 
 }  // namespace lf

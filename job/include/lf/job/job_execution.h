@@ -16,6 +16,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -41,7 +42,8 @@ namespace lf {
 struct TaskResult {
     const TileSums* sums = nullptr;
     SplatList* splats = nullptr;  // coalesced by the merge
-    const SweepChunkResult* sweep = nullptr;
+    // A radiosity sweep task's: one result a chunk of its lease, in that order.
+    std::span<const SweepChunkResult> sweeps;
     // A shot's: the frame the worker rendered (its lease's); a chunk's: one result a part of its
     // lease, in that order.
     std::optional<int> frame;

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,10 +28,11 @@ class RadiositySolve {
     int chunks() const { return chunks_; }
     int sweep() const { return sweep_; }  // the sweep whose tasks are out
 
-    // A chunk's result of the current sweep. InvalidArgument when it is of another sweep or
-    // chunk count, or does not fit the results before it (system size, sides covered, input);
-    // AlreadyExists for a chunk added before.
-    absl::Status Add(const SweepChunkResult& result);
+    // Chunks' results of the current sweep (one task's), all or none. InvalidArgument when one
+    // is of another sweep or chunk count, or does not fit the results before it or beside it
+    // (system size, sides covered, input); AlreadyExists for a chunk added before or twice.
+    absl::Status Add(std::span<const SweepChunkResult> results);
+    absl::Status Add(const SweepChunkResult& result) { return Add({&result, 1}); }
     bool SweepComplete() const;
 
     struct Outcome {
@@ -46,6 +48,9 @@ class RadiositySolve {
     absl::StatusOr<Outcome> FinishSweep();
 
   private:
+    // Whether `result` fits the results added before.
+    absl::Status Check(const SweepChunkResult& result) const;
+
     int chunks_;
     double tolerance_;
     int max_iterations_;

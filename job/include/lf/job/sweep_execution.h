@@ -1,9 +1,11 @@
 // Radiosity solved in sweeps: the solve's patch-group tasks (lf::RadiositySolve, numbered by
 // SweepTaskNumbering after the tiles) come first, a sweep at a time, each sweep's result stored
 // by the caller as a blob (Publish); once solved, the display tiles, which read the solution.
-// A chunk goes back to the worker that did it before, which keeps its form-factor rows; that is
-// soft state, so any worker may take a chunk whose owner is gone (the next sweep's task then
-// goes to whoever leases it first).
+// Sweep 0 has a task a chunk, leased one at a time, so the workers share the linking, whose
+// cost per chunk is not known before; the worker of a chunk's first lease keeps its rows, and
+// each later sweep has one task a worker holding chunks, covering all of them: one lease,
+// heartbeat and result a worker and sweep instead of one a chunk. That is soft state: any
+// worker may take a task whose worker is gone (its chunks are then that worker's).
 #pragma once
 
 #include <map>
@@ -46,8 +48,8 @@ class SweepExecution : public TileExecution {
   private:
     SweepExecution(std::unique_ptr<TileMerger> merger, uint64_t spp,
                    const RadiositySettings& radiosity);
-    // The sweep and chunk of a patch-group task; nullopt for a tile's.
-    std::optional<SweepTaskNumbering::SweepChunk> SweepChunkOf(int task) const;
+    // The sweep and chunks of a patch-group task; nullopt for a tile's.
+    std::optional<SweepTaskNumbering::SweepTask> SweepTaskOf(int task) const;
     // Grows the tasks by the current sweep's, and returns them.
     std::vector<int> QueueSweep();
 

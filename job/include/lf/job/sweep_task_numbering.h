@@ -1,28 +1,51 @@
-// Where a radiosity job's patch-group tasks sit among its tasks: after the job's `tiles` tile
-// tasks, sweep k's chunk c is task tiles + k * chunks + c, so a sweep's tasks are appended in
-// order once the sweep before it is solved.
+// Where a radiosity job's sweep tasks sit among its tasks: after the job's `tiles` tile tasks,
+// each sweep's tasks in turn, appended once the sweep before it is solved. A task covers one or
+// more patch-group chunks: sweep 0 one a chunk, a later sweep one a worker holding chunks
+// (lf::SweepExecution), so a sweep's task count is known only when it starts.
 #pragma once
 
+#include <algorithm>
 #include <optional>
+#include <span>
+#include <vector>
 
 namespace lf {
 
-struct SweepTaskNumbering {
-    int tiles = 0;   // tile tasks, numbered first
-    int chunks = 1;  // patch-group tasks per sweep
+class SweepTaskNumbering {
+  public:
+    explicit SweepTaskNumbering(int tiles) : end_(tiles) {}
 
-    struct SweepChunk {
-        int sweep = 0;
-        int chunk = 0;
-        bool operator==(const SweepChunk&) const = default;
-    };
-
-    int ToIndex(SweepChunk at) const { return tiles + at.sweep * chunks + at.chunk; }
-    // The sweep and chunk of task `index`; nullopt for a tile's task.
-    std::optional<SweepChunk> FromIndex(int index) const {
-        if (index < tiles) return std::nullopt;
-        return SweepChunk{(index - tiles) / chunks, (index - tiles) % chunks};
+    // Numbers the next sweep's tasks, each the chunks it covers; returns their indices.
+    std::vector<int> Append(std::vector<std::vector<int>> task_chunks) {
+        std::vector<int> indices;
+        for (size_t k = 0; k < task_chunks.size(); ++k) indices.push_back(end_ + int(k));
+        sweeps_.push_back({end_, std::move(task_chunks)});
+        end_ += int(sweeps_.back().tasks.size());
+        return indices;
     }
+
+    struct SweepTask {
+        int sweep = 0;
+        std::span<const int> chunks;
+    };
+    // The sweep and chunks of task `index`; nullopt for a tile's task or one not numbered.
+    std::optional<SweepTask> FromIndex(int index) const {
+        auto after = std::upper_bound(sweeps_.begin(), sweeps_.end(), index,
+                                      [](int i, const Sweep& s) { return i < s.first; });
+        if (after == sweeps_.begin() || index >= end_) return std::nullopt;
+        const Sweep& s = *(after - 1);
+        return SweepTask{int(after - 1 - sweeps_.begin()), s.tasks[size_t(index - s.first)]};
+    }
+    int sweeps() const { return int(sweeps_.size()); }
+    int end() const { return end_; }  // one past the last task numbered
+
+  private:
+    struct Sweep {
+        int first;  // the index of its first task
+        std::vector<std::vector<int>> tasks;
+    };
+    std::vector<Sweep> sweeps_;
+    int end_;
 };
 
 }  // namespace lf

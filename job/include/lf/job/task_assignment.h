@@ -18,9 +18,11 @@ struct TaskAssignment {
     RenderTask task;  // a tile's rectangle and samples; for a sweep task only its index
     JobSpec spec;
     // Radiosity jobs solved in sweeps (SolvedInSweeps): a patch-group task of sweep `sweep`
-    // (>= 0) reads the gathered irradiance of the sweep before from the blob `radiosity_hash`
-    // ("" in sweep 0: zero, B = E); a display tile (sweep -1) reads the solution from it.
-    int sweep = -1, chunk = 0;
+    // (>= 0) sweeps `chunks` (one in sweep 0; later, every chunk the worker holds) and reads the
+    // gathered irradiance of the sweep before from the blob `radiosity_hash` ("" in sweep 0:
+    // zero, B = E); a display tile (sweep -1) reads the solution from it.
+    int sweep = -1;
+    std::vector<int> chunks;
     std::string radiosity_hash;
     // Splatting methods (UsesSplatPlan(spec.method)): the task's light paths or photon passes
     // [path_begin, path_end) over the whole frame (lf::SplatTask); `task` holds its camera part.

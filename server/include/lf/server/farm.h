@@ -99,9 +99,10 @@ class Farm {
                           std::optional<std::string_view> splats = std::nullopt,
                           std::optional<int> frame = std::nullopt,
                           const std::vector<ResultPart>& parts = {}, const TaskTimes& times = {});
-    // A radiosity patch-group task's result (lf::EncodeSweepResult); when it ends a sweep,
-    // stores the next sweep's input or the solution as a blob for the workers.
-    // `links`: the chunk's link figures (hierarchical radiosity), which the header sums.
+    // A radiosity patch-group task's result (lf::EncodeSweepResults: one a chunk of the task);
+    // when it ends a sweep, stores the next sweep's input or the solution as a blob for the
+    // workers. `links`: a sweep-0 task's chunk's link figures (hierarchical radiosity), which
+    // the header sums.
     absl::Status CompleteSweep(const std::string& lease_id, const std::string& worker,
                                std::string_view sweep_result, const TaskTimes& times = {},
                                const std::optional<RadiosityFigures>& links = std::nullopt);

@@ -154,7 +154,7 @@ class Scheduler {
     }
     absl::StatusOr<Completion> CompleteSweep(const std::string& lease_id, const std::string& worker,
                                              const SweepChunkResult& result) {
-        return Complete(lease_id, worker, TaskResult{.sweep = &result});
+        return Complete(lease_id, worker, TaskResult{.sweeps = {&result, 1}});
     }
     // Queues the sweep that reads blob `hash`, or the display tiles when `converged`; fails the
     // job when the blob could not be stored.

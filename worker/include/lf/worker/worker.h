@@ -99,10 +99,10 @@ class Worker {
     absl::Status RenderSplat(const TaskAssignment& task, const std::atomic<bool>& cancel,
                              ServerConnection::TaskResult& result, RenderStats& stats,
                              SplatList* frame_splats);
-    // The chunk's sweep result, and in `figures` its link figures
-    // (RadiositySweepChunks::LinkReport).
+    // The sweep results of the task's chunks (linking those this worker does not hold yet),
+    // and in sweep 0 in `figures` its chunk's link figures (RadiositySweepChunks::LinkReport).
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel,
-                                      RadiosityFigures& figures);
+                                      std::optional<RadiosityFigures>& figures);
     // A radiosity vector the server stored as a blob.
     absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
     // Hands the result to the sender thread, after the previous one was sent: the upload of a
