@@ -505,10 +505,10 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunks::Sweep(
 }
 
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiositySweepChunks::Renderer(
-    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> gathered) const {
+    const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> gathered) && {
     if (absl::Status status = CheckSolutionSize(gathered, mesh_); !status.ok()) return status;
     if (hierarchy_) gathered = hierarchy_->tree().ToMeshOrder(gathered);
-    return RendererOfSolution(scene, options, mesh_, std::move(gathered));
+    return RendererOfSolution(scene, options, std::move(mesh_), std::move(gathered));
 }
 
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(

@@ -416,23 +416,25 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic
     if (!task.radiosity_hash.empty()) {  // solved by the farm's sweeps
         absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task.radiosity_hash);
         if (!solution.ok()) return solution.status();
-        // The sweeps' mesh (and cluster tree) are those the display needs.
+        // The sweeps' mesh (and cluster tree) are those the display needs: the mesh moves over.
         renderer = loaded_.sweeps
-                       ? loaded_.sweeps->Renderer(*loaded_.embree, *options, std::move(*solution))
+                       ? std::move(*loaded_.sweeps)
+                             .Renderer(*loaded_.embree, *options, std::move(*solution))
                        : RadiosityRendererFor(*loaded_.embree, *options, std::move(*solution));
     } else {
         // Every worker of the job solves the same system to the same bits (the solver is
         // deterministic for any thread count), so its tiles match `lightfarm render`.
         renderer = PrepareRadiosity(*loaded_.embree, *options);
     }
-    if (!renderer.ok()) return renderer.status();
-    loaded_.tracer = std::move(*renderer);
-    // The sweeps are over: their form-factor rows are not needed again.
+    // The sweeps are over: their form-factor rows are not needed again (and a holder whose
+    // Renderer failed may have given its mesh away: a retry builds from the scene).
     loaded_.sweeps.reset();
     loaded_.input.clear();
     loaded_.input_hash.clear();
     loaded_.pulled.clear();
     loaded_.pulled_hash.reset();
+    if (!renderer.ok()) return renderer.status();
+    loaded_.tracer = std::move(*renderer);
     return absl::OkStatus();
 }
 

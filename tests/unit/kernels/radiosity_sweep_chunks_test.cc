@@ -89,7 +89,7 @@ TEST_P(RadiositySweepChunksTest, SharedMeshTreeAndPullGiveTheBitsOfAChunkAlone) 
     EXPECT_EQ(shares, alone_shares);
     EXPECT_EQ(shares > 0, GetParam());
     auto built = RadiosityRendererFor(*embree_, options_, h);
-    auto reused = all_->Renderer(*embree_, options_, h);
+    auto reused = std::move(*all_).Renderer(*embree_, options_, h);
     ASSERT_TRUE(built.ok()) << built.status();
     ASSERT_TRUE(reused.ok()) << reused.status();
     EXPECT_TRUE(SameBits((*built)->radiosity(), (*reused)->radiosity()));
@@ -103,7 +103,7 @@ TEST_P(RadiositySweepChunksTest, SharedMeshTreeAndPullGiveTheBitsOfAChunkAlone) 
 TEST_P(RadiositySweepChunksTest, RefusesASolutionPullOrChunkItDoesNotHave) {
     const std::vector<Rgb> h = all_->start();
     const std::vector<Rgb> shorter(h.begin(), h.end() - 1);
-    auto renderer = all_->Renderer(*embree_, options_, shorter);
+    auto renderer = std::move(*all_).Renderer(*embree_, options_, shorter);  // refused: kept
     EXPECT_EQ(renderer.status().code(), absl::StatusCode::kInvalidArgument);
     EXPECT_NE(renderer.status().message().find("unknowns"), std::string::npos) << renderer.status();
     auto other = alone_[0]->Sweep(1, 0, h);

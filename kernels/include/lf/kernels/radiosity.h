@@ -179,10 +179,11 @@ class RadiositySweepChunks {
     // EXR header says what local mode's does. Zeros for the flat method.
     RadiosityReport LinkReport(int chunk) const;
     // RadiosityRendererFor with this mesh (and cluster tree), not built again for the display.
-    // `options` as made.
+    // `options` as made. Spends the holder, whose mesh moves into the renderer (held once, not
+    // copied), unless the solution is refused.
     absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Renderer(const EmbreeScene& scene,
                                                                 const RadiosityOptions& options,
-                                                                std::vector<Rgb> gathered) const;
+                                                                std::vector<Rgb> gathered) &&;
 
   private:
     RadiositySweepChunks() = default;
