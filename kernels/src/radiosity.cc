@@ -337,15 +337,11 @@ absl::Status CheckSolutionSize(const std::vector<Rgb>& gathered, const PatchMesh
                         gathered.size(), mesh.sides().size()));
 }
 
-// The display of a sweep state solved elsewhere, `gathered` in mesh order.
+// The display of a sweep state solved elsewhere: the radiosity B = E + ρ H, the gathered
+// irradiance H and the lights' direct irradiance, all in mesh order.
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RendererOfSolution(
     const EmbreeScene& scene, const RadiosityOptions& options, PatchMesh mesh,
-    std::vector<Rgb> gathered) {
-    // B = E + ρ H side by side as the sweeps had it, and the lights' direct irradiance again.
-    const FormFactors none;
-    const RadiositySystem system = MakeRadiositySystem(scene, mesh, none, options.cancel);
-    if (CancelRequested(options.cancel)) return FormFactorsCancelled();
-    std::vector<Rgb> radiosity = RadiosityFromIrradiance(system, gathered);
+    std::vector<Rgb> radiosity, std::vector<Rgb> gathered, std::span<const Rgb> direct) {
     RadiosityReport report;
     report.patches = int64_t(mesh.patches().size());
     report.sides = int64_t(mesh.sides().size());
@@ -355,7 +351,7 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RendererOfSolution(
     report.estimated_error = error.max;
     report.mean_estimated_error = error.mean;
     return std::make_unique<RadiosityRenderer>(scene, std::move(mesh), std::move(radiosity),
-                                               AddDirect(system.direct, std::move(gathered)),
+                                               AddDirect(direct, std::move(gathered)),
                                                options.display, report);
 }
 
@@ -394,7 +390,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunks>> RadiositySweepChunks::Make
     out->chunks_ = chunks;
     if (options.hierarchical) {
         absl::StatusOr<std::unique_ptr<RadiosityHierarchy>> built =
-            BuildHierarchy(scene, *mesh, options, cancel);
+            BuildHierarchy(scene, *mesh, options, cancel, &out->direct_);
         if (!built.ok()) return built.status();
         out->hierarchy_ = std::move(*built);
     } else {
@@ -402,7 +398,7 @@ absl::StatusOr<std::unique_ptr<RadiositySweepChunks>> RadiositySweepChunks::Make
         out->system_ = MakeRadiositySystem(scene, *mesh, none, cancel);
         if (CancelRequested(cancel)) return FormFactorsCancelled();
         out->system_.form_factors = nullptr;
-        out->system_.direct = {};  // the display's, not the sweeps'
+        out->direct_ = std::move(out->system_.direct);  // the display's, not the sweeps'
     }
     out->mesh_ = std::move(*mesh);
     out->start_.resize(size_t(out->sides()));
@@ -507,8 +503,14 @@ absl::StatusOr<SweepChunkResult> RadiositySweepChunks::Sweep(
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiositySweepChunks::Renderer(
     const EmbreeScene& scene, const RadiosityOptions& options, std::vector<Rgb> gathered) && {
     if (absl::Status status = CheckSolutionSize(gathered, mesh_); !status.ok()) return status;
-    if (hierarchy_) gathered = hierarchy_->tree().ToMeshOrder(gathered);
-    return RendererOfSolution(scene, options, std::move(mesh_), std::move(gathered));
+    // B = E + ρ H side by side as the sweeps had it; the lights' direct light as Make found it.
+    std::vector<Rgb> radiosity = RadiosityFromIrradiance(system(), gathered);
+    if (hierarchy_) {
+        radiosity = hierarchy_->tree().ToMeshOrder(radiosity);
+        gathered = hierarchy_->tree().ToMeshOrder(gathered);
+    }
+    return RendererOfSolution(scene, options, std::move(mesh_), std::move(radiosity),
+                              std::move(gathered), direct_);
 }
 
 absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
@@ -525,7 +527,13 @@ absl::StatusOr<std::unique_ptr<RadiosityRenderer>> RadiosityRendererFor(
         if (!tree.ok()) return tree.status();
         gathered = tree->ToMeshOrder(gathered);
     }
-    return RendererOfSolution(scene, options, std::move(*mesh), std::move(gathered));
+    // B = E + ρ H side by side as the sweeps had it, and the lights' direct irradiance again.
+    const FormFactors none;
+    const RadiositySystem system = MakeRadiositySystem(scene, *mesh, none, options.cancel);
+    if (CancelRequested(options.cancel)) return FormFactorsCancelled();
+    std::vector<Rgb> radiosity = RadiosityFromIrradiance(system, gathered);
+    return RendererOfSolution(scene, options, std::move(*mesh), std::move(radiosity),
+                              std::move(gathered), system.direct);
 }
 
 RadiosityRenderer::RadiosityRenderer(const EmbreeScene& scene, PatchMesh mesh,

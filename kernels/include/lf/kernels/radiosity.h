@@ -178,9 +178,9 @@ class RadiositySweepChunks {
     // tree and per-side data split evenly over the chunks): summed over the chunks, the farm's
     // EXR header says what local mode's does. Zeros for the flat method.
     RadiosityReport LinkReport(int chunk) const;
-    // RadiosityRendererFor with this mesh (and cluster tree), not built again for the display.
-    // `options` as made. Spends the holder, whose mesh moves into the renderer (held once, not
-    // copied), unless the solution is refused.
+    // RadiosityRendererFor with this mesh, cluster tree and direct light, not computed again for
+    // the display (the same bits). `options` as made. Spends the holder, whose mesh moves into
+    // the renderer (held once, not copied), unless the solution is refused.
     absl::StatusOr<std::unique_ptr<RadiosityRenderer>> Renderer(const EmbreeScene& scene,
                                                                 const RadiosityOptions& options,
                                                                 std::vector<Rgb> gathered) &&;
@@ -194,6 +194,7 @@ class RadiositySweepChunks {
     RadiositySystem system_;                         // flat: E, ρ and A in mesh order
     std::map<int, FormFactors> form_factors_;        // flat: each linked chunk's rows only
     std::unique_ptr<RadiosityHierarchy> hierarchy_;  // instead, hierarchical: every chunk's links
+    std::vector<Rgb> direct_;                        // the lights' direct irradiance, mesh order
     std::vector<Rgb> start_;
 };
 
