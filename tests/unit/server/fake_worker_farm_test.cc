@@ -572,6 +572,64 @@ TEST_F(FakeWorkerFarm, DeleteRemovesAnEndedJobAndRefusesARunningOne) {
     EXPECT_EQ(remove(job).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
+// A watch's last message goes out once the job's end is in the store: a client acting on it at
+// once finds the job ended there, and may requeue it (not "has just ended": UNAVAILABLE).
+TEST_F(FakeWorkerFarm, WatchEndsOnceTheJobsEndIsInTheStore) {
+    const std::string job = Submit();
+    ASSERT_TRUE(Lease("honest").has_value());
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+    pb::WatchJobRequest request;
+    request.set_job_id(job);
+    auto reader = job_stub_->WatchJob(&context, request);
+    pb::Job seen;
+    ASSERT_TRUE(reader->Read(&seen));
+    EXPECT_EQ(seen.state(), pb::Job::RUNNING);
+    std::thread cancel([&] {
+        pb::CancelJobRequest cancel_request;
+        cancel_request.set_job_id(job);
+        pb::Job cancelled;
+        grpc::ClientContext cancel_context;
+        EXPECT_TRUE(job_stub_->CancelJob(&cancel_context, cancel_request, &cancelled).ok());
+    });
+    while (reader->Read(&seen)) {
+    }
+    const grpc::Status watched = reader->Finish();
+    absl::StatusOr<JobRecord> stored = farm_->store().Get(job);
+    pb::RequeueJobRequest requeue_request;
+    requeue_request.set_job_id(job);
+    pb::Job requeued;
+    grpc::ClientContext requeue_context;
+    const grpc::Status requeue =
+        job_stub_->RequeueJob(&requeue_context, requeue_request, &requeued);
+    cancel.join();
+    ASSERT_TRUE(watched.ok()) << watched.error_message();
+    EXPECT_EQ(seen.state(), pb::Job::CANCELLED);
+    ASSERT_TRUE(stored.ok()) << stored.status();
+    EXPECT_EQ(stored->state, JobState::kCancelled);
+    ASSERT_TRUE(requeue.ok()) << requeue.error_message();
+    EXPECT_EQ(requeued.state(), pb::Job::QUEUED);
+}
+
+// A server shutting down ends the watches of running jobs at once (UNAVAILABLE: the client
+// watches on after the restart), rather than when their clients' deadlines pass.
+TEST_F(FakeWorkerFarm, ShutdownEndsAWatchAsUnavailable) {
+    const std::string job = Submit();
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+    pb::WatchJobRequest request;
+    request.set_job_id(job);
+    auto reader = job_stub_->WatchJob(&context, request);
+    pb::Job seen;
+    ASSERT_TRUE(reader->Read(&seen));
+    farm_->scheduler().Shutdown();
+    while (reader->Read(&seen)) {
+    }
+    const grpc::Status watched = reader->Finish();
+    EXPECT_EQ(watched.error_code(), grpc::StatusCode::UNAVAILABLE) << watched.error_message();
+    EXPECT_EQ(seen.state(), pb::Job::QUEUED);
+}
+
 class WatcherCapTest : public FakeWorkerFarm {
   protected:
     WatcherCapTest() { service_options_.max_watchers = 2; }
