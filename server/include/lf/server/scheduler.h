@@ -271,7 +271,7 @@ class Scheduler {
     // Blocks until the job has ended and its end is settled, or `deadline`, or Shutdown. WatchJob
     // paces its messages with it, so that a job's end goes out as soon as it settled.
     EndWait WaitForEnd(const std::string& job_id, absl::Time deadline);
-    void Shutdown();  // wakes every WaitForChange for good
+    void Shutdown();  // wakes every WaitForChange and WaitForEnd for good
 
     // A queued or running job's tasks as they are now (TaskStatus::log_lines left 0: the logs
     // are not the scheduler's); nullopt for a job that is not queued or running.
