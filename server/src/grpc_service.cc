@@ -381,32 +381,44 @@ grpc::Status JobServiceImpl::WatchJob(grpc::ServerContext* context, const Caller
                     std::string(slot.status().message()));
         return ToGrpcStatus(slot.status());
     }
-    // At most five messages a second, and one at least every few seconds so a dead client is
-    // noticed.
+    // At most five messages a second but for the job's end, and one at least every few seconds
+    // so a dead client is noticed.
     constexpr absl::Duration kMinGap = absl::Milliseconds(200), kMaxGap = absl::Seconds(5);
+    using EndWait = Scheduler::EndWait;
     Scheduler& scheduler = farm_.scheduler();
     std::string last_sent;
     absl::Time last_time = absl::InfinitePast();
     // Taken before each read, so a change during the read or the pause is never missed.
     uint64_t version = scheduler.WaitForChange(0, absl::InfinitePast());
     while (!context->IsCancelled()) {
-        absl::StatusOr<JobRecord> job = scheduler.Get(req.job_id());
+        // A job's end is read once it settled: a client acting on it at once (a `requeue`, a
+        // `list`) finds the job's record in the store.
+        absl::StatusOr<std::optional<JobRecord>> job = scheduler.GetSettled(req.job_id());
         if (!job.ok()) return ToGrpcStatus(job.status());
-        pb::Job message;
-        ToProto(*job, &message);
-        std::string bytes = message.SerializeAsString();
-        if (bytes != last_sent || absl::Now() - last_time > kMaxGap) {
-            // A token revoked meanwhile ends the stream (within the Authenticator's cache time).
-            if (auto c = guard_.Check(context, "WatchJob", Action::kReadJobs); !c.ok()) {
-                return ToGrpcStatus(c.status());
+        if (*job) {
+            pb::Job message;
+            ToProto(**job, &message);
+            std::string bytes = message.SerializeAsString();
+            if (bytes != last_sent || absl::Now() - last_time > kMaxGap) {
+                // A token revoked meanwhile ends the stream (within the Authenticator's cache
+                // time).
+                if (auto c = guard_.Check(context, "WatchJob", Action::kReadJobs); !c.ok()) {
+                    return ToGrpcStatus(c.status());
+                }
+                if (!write(message)) break;
+                last_sent = std::move(bytes);
+                last_time = absl::Now();
             }
-            if (!write(message)) break;
-            last_sent = std::move(bytes);
-            last_time = absl::Now();
+            if (IsFinal((*job)->state)) break;
         }
-        if (IsFinal(job->state)) break;
-        absl::SleepFor(kMinGap);
-        version = scheduler.WaitForChange(version, absl::Now() + absl::Seconds(1));
+        // The gap ends early when the job's end settles: that goes out at once.
+        const EndWait paced = scheduler.WaitForEnd(req.job_id(), absl::Now() + kMinGap);
+        if (paced == EndWait::kShutdown) {
+            return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+        }
+        if (paced == EndWait::kRunning) {
+            version = scheduler.WaitForChange(version, absl::Now() + absl::Seconds(1));
+        }
     }
     return grpc::Status::OK;
 }

@@ -102,6 +102,7 @@ void Scheduler::Locked::SettleEnded() {
     lock.lock();
     for (size_t i = 0; i < ended.size(); ++i) scheduler_.ended_.Settle(ended[i].first, durable[i]);
     scheduler_.left_memory_ += ended.size();
+    scheduler_.changed_.notify_all();  // for WaitForEnd
 }
 
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
@@ -199,14 +200,28 @@ std::optional<std::pair<std::string, uint64_t>> Scheduler::FindRequestInMemory(
 }
 
 absl::StatusOr<JobRecord> Scheduler::Get(const std::string& job_id) const {
+    absl::StatusOr<std::optional<JobRecord>> job = Read(job_id, false);
+    if (!job.ok()) return job.status();
+    return std::move(**job);
+}
+
+absl::StatusOr<std::optional<JobRecord>> Scheduler::GetSettled(const std::string& job_id) const {
+    return Read(job_id, true);
+}
+
+absl::StatusOr<std::optional<JobRecord>> Scheduler::Read(const std::string& job_id,
+                                                         bool settled_only) const {
     {
         std::lock_guard<std::mutex> lock(mutex_);
         if (auto it = active_.find(job_id); it != active_.end()) {
             return ReadRecord(*it->second, clock_());
         }
+        if (settled_only && ended_.IsSettling(job_id)) return std::nullopt;
         if (const JobRecord* ended = ended_.Find(job_id)) return *ended;
     }
-    return store_.Get(job_id);
+    absl::StatusOr<JobRecord> stored = store_.Get(job_id);
+    if (!stored.ok()) return stored.status();
+    return std::move(*stored);
 }
 
 absl::StatusOr<std::vector<JobRecord>> Scheduler::List(const JobQuery& query) const {
@@ -1322,6 +1337,14 @@ uint64_t Scheduler::WaitForChange(uint64_t version, absl::Time deadline) {
     changed_.wait_until(lock, absl::ToChronoTime(deadline),
                         [&] { return version_ != version || shutdown_; });
     return version_;
+}
+
+Scheduler::EndWait Scheduler::WaitForEnd(const std::string& job_id, absl::Time deadline) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const auto ended = [&] { return !active_.count(job_id) && !ended_.IsSettling(job_id); };
+    changed_.wait_until(lock, absl::ToChronoTime(deadline), [&] { return shutdown_ || ended(); });
+    if (ended()) return EndWait::kEnded;
+    return shutdown_ ? EndWait::kShutdown : EndWait::kRunning;
 }
 
 void Scheduler::Shutdown() {

@@ -215,6 +215,26 @@ class FakeWorkerFarm : public ::testing::Test {
         }
     }
 
+    // A client's watch of a job: its last message read, and its status once it ended.
+    struct Watching {
+        grpc::ClientContext context;
+        std::unique_ptr<grpc::ClientReader<pb::Job>> reader;
+        pb::Job last;
+        bool open = false;  // its first message came
+        grpc::Status ReadToEnd() {
+            while (reader->Read(&last)) {
+            }
+            return reader->Finish();
+        }
+    };
+    void OpenWatch(const std::string& job_id, Watching& w) {
+        w.context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
+        pb::WatchJobRequest request;
+        request.set_job_id(job_id);
+        w.reader = job_stub_->WatchJob(&w.context, request);
+        w.open = w.reader->Read(&w.last);
+    }
+
     absl::Duration speculate_after_ = absl::Seconds(30);  // no speculation but in StragglerTest
     JobServiceOptions service_options_;
     fs::path dir_;
@@ -572,30 +592,64 @@ TEST_F(FakeWorkerFarm, DeleteRemovesAnEndedJobAndRefusesARunningOne) {
     EXPECT_EQ(remove(job).error_code(), grpc::StatusCode::NOT_FOUND);
 }
 
+// A watch's last message goes out once the job's end is in the store: a client acting on it at
+// once finds the job ended there, and may requeue it (not "has just ended": UNAVAILABLE).
+TEST_F(FakeWorkerFarm, WatchEndsOnceTheJobsEndIsInTheStore) {
+    const std::string job = Submit();
+    ASSERT_TRUE(Lease("honest").has_value());
+    Watching watch;
+    OpenWatch(job, watch);
+    ASSERT_TRUE(watch.open);
+    EXPECT_EQ(watch.last.state(), pb::Job::RUNNING);
+    std::thread cancel([&] {
+        pb::CancelJobRequest cancel_request;
+        cancel_request.set_job_id(job);
+        pb::Job cancelled;
+        grpc::ClientContext cancel_context;
+        EXPECT_TRUE(job_stub_->CancelJob(&cancel_context, cancel_request, &cancelled).ok());
+    });
+    const grpc::Status watched = watch.ReadToEnd();
+    absl::StatusOr<JobRecord> stored = farm_->store().Get(job);
+    pb::RequeueJobRequest requeue_request;
+    requeue_request.set_job_id(job);
+    pb::Job requeued;
+    grpc::ClientContext requeue_context;
+    const grpc::Status requeue =
+        job_stub_->RequeueJob(&requeue_context, requeue_request, &requeued);
+    cancel.join();
+    ASSERT_TRUE(watched.ok()) << watched.error_message();
+    EXPECT_EQ(watch.last.state(), pb::Job::CANCELLED);
+    ASSERT_TRUE(stored.ok()) << stored.status();
+    EXPECT_EQ(stored->state, JobState::kCancelled);
+    ASSERT_TRUE(requeue.ok()) << requeue.error_message();
+    EXPECT_EQ(requeued.state(), pb::Job::QUEUED);
+}
+
+// A server shutting down ends the watches of running jobs at once (UNAVAILABLE: the client
+// watches on after the restart), rather than when their clients' deadlines pass.
+TEST_F(FakeWorkerFarm, ShutdownEndsAWatchAsUnavailable) {
+    Watching watch;
+    OpenWatch(Submit(), watch);
+    ASSERT_TRUE(watch.open);
+    farm_->scheduler().Shutdown();
+    const grpc::Status watched = watch.ReadToEnd();
+    EXPECT_EQ(watched.error_code(), grpc::StatusCode::UNAVAILABLE) << watched.error_message();
+    EXPECT_EQ(watch.last.state(), pb::Job::QUEUED);
+}
+
 class WatcherCapTest : public FakeWorkerFarm {
   protected:
     WatcherCapTest() { service_options_.max_watchers = 2; }
 };
 
 TEST_F(WatcherCapTest, WatchBeyondTheCapIsRefusedAndOneEndingFreesItsSlot) {
-    struct Watch {
-        grpc::ClientContext context;
-        std::unique_ptr<grpc::ClientReader<pb::Job>> reader;
-        pb::Job first;
-        bool open = false;
-    };
-    auto watch = [&](const std::string& id, Watch& w) {
-        pb::WatchJobRequest request;
-        request.set_job_id(id);
-        w.reader = job_stub_->WatchJob(&w.context, request);
-        w.open = w.reader->Read(&w.first);  // the first message comes once the slot is taken
-    };
+    // The first message of a watch comes once its slot is taken.
     const std::string a = Submit(), b = Submit();
-    Watch first, second, third;
-    watch(a, first);
-    watch(b, second);
+    Watching first, second, third;
+    OpenWatch(a, first);
+    OpenWatch(b, second);
     ASSERT_TRUE(first.open && second.open);
-    watch(b, third);
+    OpenWatch(b, third);
     EXPECT_FALSE(third.open);
     const grpc::Status refused = third.reader->Finish();
     EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
@@ -603,12 +657,9 @@ TEST_F(WatcherCapTest, WatchBeyondTheCapIsRefusedAndOneEndingFreesItsSlot) {
         << refused.error_message();
 
     RenderHonestly(a);  // the first watch ends with its job
-    pb::Job job;
-    while (first.reader->Read(&job)) {
-    }
-    ASSERT_TRUE(first.reader->Finish().ok());
-    Watch fourth;
-    watch(b, fourth);
+    ASSERT_TRUE(first.ReadToEnd().ok());
+    Watching fourth;
+    OpenWatch(b, fourth);
     EXPECT_TRUE(fourth.open) << "the ended watch's slot is free again";
     second.context.TryCancel();
     fourth.context.TryCancel();

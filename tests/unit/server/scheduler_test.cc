@@ -942,6 +942,54 @@ TEST(SchedulerLockTest, EndingAJobWaitsForTheStoreWithoutTheLock) {
     EXPECT_EQ(store.Get(id)->state, JobState::kCancelled);
 }
 
+// What WatchJob reads and waits for before it sends a job's end: the end settled, its record
+// durable. Until then GetSettled reads nothing, and a wait that began while the job ran (its
+// deadline beyond any test) goes on: at the end in memory, a requeue would still be refused.
+TEST(SchedulerLockTest, GetSettledAndWaitForEndSeeTheEndOnceItIsDurable) {
+    using EndWait = Scheduler::EndWait;
+    HeldStore store;
+    Scheduler scheduler({}, store);
+    const std::string id = *scheduler.Submit(SmallSpec(""));
+    EXPECT_EQ(scheduler.WaitForEnd(id, absl::InfinitePast()), EndWait::kRunning);
+    EXPECT_EQ((*scheduler.GetSettled(id))->state, JobState::kQueued);
+    std::future<EndWait> waited = std::async(std::launch::async, [&] {
+        const EndWait end = scheduler.WaitForEnd(id, absl::Now() + absl::Hours(1));
+        // Asked before the test releases anything more: the job is requeued at once.
+        EXPECT_TRUE(scheduler.RequeueJob(id).ok());
+        return end;
+    });
+    store.Hold();
+    std::thread cancel([&] { EXPECT_TRUE(scheduler.Cancel(id).ok()); });
+    store.AwaitBlocked();
+    EXPECT_EQ(scheduler.Get(id)->state, JobState::kCancelled);
+    EXPECT_FALSE(scheduler.GetSettled(id)->has_value());
+    EXPECT_EQ(scheduler.WaitForEnd(id, absl::InfinitePast()), EndWait::kRunning);
+    EXPECT_TRUE(absl::IsUnavailable(scheduler.RequeueJob(id).status()));
+    EXPECT_EQ(waited.wait_for(std::chrono::seconds(0)), std::future_status::timeout);
+    store.Release();
+    cancel.join();
+    EXPECT_EQ(waited.get(), EndWait::kEnded);
+    EXPECT_EQ((*scheduler.GetSettled(id))->state, JobState::kQueued);
+    EXPECT_EQ(scheduler.WaitForEnd("job-unknown", absl::InfinitePast()), EndWait::kEnded);
+    EXPECT_TRUE(absl::IsNotFound(scheduler.GetSettled("job-unknown").status()));
+}
+
+// Shutdown ends a wait for a job that has not ended; one that ended is still reported so.
+TEST(SchedulerLockTest, ShutdownEndsAWaitForAJobsEnd) {
+    using EndWait = Scheduler::EndWait;
+    InMemoryJobStore store;
+    Scheduler scheduler({}, store);
+    const std::string running = *scheduler.Submit(SmallSpec("")),
+                      ended = *scheduler.Submit(SmallSpec(""));
+    ASSERT_TRUE(scheduler.Cancel(ended).ok());
+    std::future<EndWait> waited = std::async(std::launch::async, [&] {
+        return scheduler.WaitForEnd(running, absl::Now() + absl::Hours(1));
+    });
+    scheduler.Shutdown();
+    EXPECT_EQ(waited.get(), EndWait::kShutdown);
+    EXPECT_EQ(scheduler.WaitForEnd(ended, absl::InfinitePast()), EndWait::kEnded);
+}
+
 TEST(SchedulerLockTest, SubmitLooksUpItsRequestWithoutTheLock) {
     HeldStore store;
     Scheduler scheduler({}, store);

@@ -20,6 +20,8 @@ class EndedJobs {
     // A job that ended, its final record queued in the store as `ticket`. Returns the record.
     const JobRecord& Add(JobRecord record, uint64_t ticket);
     const JobRecord* Find(const std::string& job_id) const;
+    // Whether the job's final record is queued but not yet settled (see Settle).
+    bool IsSettling(const std::string& job_id) const { return ending_.count(job_id) > 0; }
     // The job of a submission with this request id, and the store ticket to wait for.
     std::optional<std::pair<std::string, uint64_t>> FindRequest(
         const std::string& request_id) const;

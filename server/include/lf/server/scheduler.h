@@ -245,6 +245,10 @@ class Scheduler {
 
     // Running jobs as they are now, ended ones from the store.
     absl::StatusOr<JobRecord> Get(const std::string& job_id) const;
+    // Get for a reader that a client may act on at once (WatchJob): nullopt while the job has
+    // ended but its end has not settled (see WaitForEnd), rather than an end that a `requeue`
+    // would still refuse.
+    absl::StatusOr<std::optional<JobRecord>> GetSettled(const std::string& job_id) const;
     // The jobs the query selects from the store, running ones as they are now.
     absl::StatusOr<std::vector<JobRecord>> List(const JobQuery& query = {}) const;
 
@@ -255,7 +259,19 @@ class Scheduler {
     // Blocks until some job changed after `version` was current, or `deadline`, or Shutdown.
     // Returns the version now.
     uint64_t WaitForChange(uint64_t version, absl::Time deadline);
-    void Shutdown();  // wakes every WaitForChange for good
+    // What WaitForEnd saw when it returned.
+    enum class EndWait {
+        // The job is not queued or running and its end is settled: its final record is durable
+        // in the store (or logged as not recorded), so a client told of the end finds the job
+        // there, for a `requeue` or a `list` at once. An unknown job counts as ended.
+        kEnded,
+        kRunning,   // `deadline` came first: the job is queued, running, or its end not settled
+        kShutdown,  // Shutdown was called, and the job has not ended
+    };
+    // Blocks until the job has ended and its end is settled, or `deadline`, or Shutdown. WatchJob
+    // paces its messages with it, so that a job's end goes out as soon as it settled.
+    EndWait WaitForEnd(const std::string& job_id, absl::Time deadline);
+    void Shutdown();  // wakes every WaitForChange and WaitForEnd for good
 
     // A queued or running job's tasks as they are now (TaskStatus::log_lines left 0: the logs
     // are not the scheduler's); nullopt for a job that is not queued or running.
@@ -373,6 +389,9 @@ class Scheduler {
     // succeeding by `known`; nullopt when none did.
     std::optional<std::string> EndedDependencyFailure(
         const JobRecord& job, const std::map<std::string, DependencyState>& known) const;
+    // Get, and GetSettled when `settled_only`.
+    absl::StatusOr<std::optional<JobRecord>> Read(const std::string& job_id,
+                                                  bool settled_only) const;
     // The job's record as a reader sees it: with its waiting_reason.
     JobRecord ReadRecord(const Job& job, absl::Time now) const;
     // The lease a result names, when `worker` holds it (FailedPrecondition otherwise).
