@@ -152,10 +152,16 @@ std::string EncodeSweepResults(std::span<const SweepChunkResult> results) {
     return out;
 }
 
-absl::StatusOr<std::vector<SweepChunkResult>> DecodeSweepResults(std::string_view bytes) {
+absl::StatusOr<std::vector<SweepChunkResult>> DecodeSweepResults(std::string_view bytes,
+                                                                 size_t max_results) {
     Reader in(bytes, "sweep result");
     std::vector<SweepChunkResult> results;
     do {
+        // A record can be 32 bytes and decode to several times that: bounded before decoding.
+        if (results.size() == max_results) {
+            return absl::InvalidArgumentError(absl::StrCat("sweep result: more than ", max_results,
+                                                           " chunk results in one task's"));
+        }
         absl::StatusOr<SweepChunkResult> r = ReadSweepResult(in);
         if (!in.ok()) return in.Done();  // truncated
         if (!r.ok() && !results.empty()) {

@@ -15,6 +15,7 @@
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
 #include "lf/job/method_registry.h"
+#include "lf/job/plan.h"
 #include "lf/job/render_metadata.h"
 
 namespace lf {
@@ -298,13 +299,15 @@ void Farm::WriteFrame(const std::string& job_id, int frame) {
 absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
                                  std::string_view sweep_result, const TaskTimes& times,
                                  const std::optional<RadiosityFigures>& links) {
-    absl::StatusOr<std::vector<SweepChunkResult>> results = DecodeSweepResults(sweep_result);
+    absl::StatusOr<std::vector<SweepChunkResult>> results =
+        DecodeSweepResults(sweep_result, size_t(kMaxSweepTasks));
     if (!results.ok()) return RefuseUndecodable(lease_id, worker, results.status());
     absl::StatusOr<Scheduler::Completion> done =
         scheduler_.Complete(lease_id, worker, TaskResult{.sweeps = *results, .times = times});
     if (!done.ok()) return done.status();
-    // A chunk's links come with its sweep-0 task, which is of that chunk alone.
-    if (links && links->links > 0 && results->size() == 1) {
+    // A chunk's links come with its sweep-0 task, which is of that chunk alone (a chunk may
+    // have no links: its share of the solver's bytes still counts).
+    if (links && results->size() == 1 && results->front().sweep == 0) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         sweep_links_[done->job_id][results->front().chunk] = *links;
     }

@@ -667,14 +667,22 @@ std::vector<std::string> Scheduler::EnforceTimeLimits() {
     return rendered;
 }
 
+bool Scheduler::MayWorkOn(const Job& job, const std::string& id,
+                          const WorkerDescription& about) const {
+    return ControlOf(id, about) == WorkerControl::kEnabled && !IsBlocklisted(job.record, id) &&
+           HasAllTags(about.tags, job.record.spec.tags);
+}
+
 bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::Time now) const {
     const ScheduledJob::Task& task = job.tasks[size_t(t)];
-    // A task keeps to its preferred worker (the one holding its chunk) while that one lives,
-    // unless it failed there: else it would wait for as long as that worker lives.
+    // A task keeps to its preferred worker (the one holding its chunk) while that one lives and
+    // may work on the job, unless it failed there: else it would wait for as long as that worker
+    // lives (a worker blocklisted from the job, disabled, or without its tags never takes it).
     const std::string preferred = job.execution->PreferredWorker(t);
     if (!preferred.empty() && preferred != worker && !task.failed_on.count(preferred) &&
         workers_.IsLive(preferred, now)) {
-        return false;
+        const WorkerDescription* about = workers_.AboutOf(preferred);
+        if (about && MayWorkOn(job, preferred, *about)) return false;
     }
     if (!task.failed_on.count(worker)) return true;
     // It failed here: it waits for a live worker it has not failed on that may take the job
@@ -683,11 +691,7 @@ bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::
     // failures end the job. The workers kept are the live ones.
     size_t eligible = 0, eligible_failed = 0;
     for (const WorkerRegistry::Entry& entry : workers_.List()) {
-        if (ControlOf(entry.id, entry.about) != WorkerControl::kEnabled ||
-            IsBlocklisted(job.record, entry.id) ||
-            !HasAllTags(entry.about.tags, job.record.spec.tags)) {
-            continue;
-        }
+        if (!MayWorkOn(job, entry.id, entry.about)) continue;
         ++eligible;
         eligible_failed += task.failed_on.count(entry.id);
     }
@@ -787,7 +791,9 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     Completion completion{job.id(), false, std::nullopt};
     const TaskState state = job.states.state(t);
     if (state == TaskState::kDone || state == TaskState::kDropped) return completion;
-    absl::StatusOr<JobExecution::Merged> merged = job.execution->Merge(t, result);
+    TaskResult made = result;
+    made.worker = worker;
+    absl::StatusOr<JobExecution::Merged> merged = job.execution->Merge(t, made);
     if (!merged.ok()) return Refuse(*ref, worker, merged.status());
     workers_.Worked(worker);
     workers_.Worked(TokenStrikes(worker));

@@ -19,7 +19,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             (void)lf::DecodeRadiosity(in.bytes);
             break;
         default:
-            (void)lf::DecodeSweepResults(in.bytes);
+            (void)lf::DecodeSweepResults(in.bytes, 1024);
     }
     return 0;
 }

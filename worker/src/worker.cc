@@ -510,9 +510,11 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
         }
     });
     if (!swept.ok()) return swept;
-    // A chunk's links, for the EXR header, go with its sweep-0 task, which is of it alone.
+    // A chunk's links (hierarchical), for the EXR header, go with its sweep-0 task, which is of
+    // it alone.
     if (task.sweep == 0 && task.chunks.size() == 1) {
-        figures = RadiosityFiguresOf(chunks.LinkReport(task.chunks.front()));
+        const RadiosityReport links = chunks.LinkReport(task.chunks.front());
+        if (links.solver_bytes > 0) figures = RadiosityFiguresOf(links);
     }
     return EncodeSweepResults(results);
 }

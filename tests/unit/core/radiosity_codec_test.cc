@@ -43,7 +43,7 @@ TEST(RadiosityCodec, SweepResultsRoundTripKeepEveryBit) {
     second.power = {0.5};
     const std::vector<SweepChunkResult> results = {Example(), second};
     absl::StatusOr<std::vector<SweepChunkResult>> back =
-        DecodeSweepResults(EncodeSweepResults(results));
+        DecodeSweepResults(EncodeSweepResults(results), 2);
     ASSERT_TRUE(back.ok()) << back.status();
     ASSERT_EQ(back->size(), results.size());
     for (size_t k = 0; k < results.size(); ++k) {
@@ -61,22 +61,28 @@ TEST(RadiosityCodec, SweepResultsRoundTripKeepEveryBit) {
 
 TEST(RadiosityCodec, GarbageIsRefusedWithAReason) {
     const std::string good = EncodeSweepResult(Example());
-    EXPECT_FALSE(DecodeSweepResults("").ok());
-    EXPECT_FALSE(DecodeSweepResults(EncodeRadiosity({})).ok());  // the other kind
+    EXPECT_FALSE(DecodeSweepResults("", 8).ok());
+    EXPECT_FALSE(DecodeSweepResults(EncodeRadiosity({}), 8).ok());  // the other kind
     for (const std::string& whole : {good, good + good}) {
         for (size_t cut : {size_t(5), size_t(20), good.size() + 20, whole.size() - 1}) {
             if (cut >= whole.size()) continue;
             absl::StatusOr<std::vector<SweepChunkResult>> r =
-                DecodeSweepResults(whole.substr(0, cut));
+                DecodeSweepResults(whole.substr(0, cut), 8);
             EXPECT_FALSE(r.ok()) << cut;
         }
     }
-    const absl::Status trailing = DecodeSweepResults(good + "x").status();
+    const absl::Status trailing = DecodeSweepResults(good + "x", 8).status();
     EXPECT_NE(trailing.message().find("after 1 chunk results"), std::string::npos) << trailing;
+    // More records than a task has chunks: refused before they are decoded.
+    std::string many;
+    for (int k = 0; k < 9; ++k) many += good;
+    const absl::Status too_many = DecodeSweepResults(many, 8).status();
+    EXPECT_NE(too_many.message().find("more than 8 chunk results"), std::string::npos) << too_many;
+    EXPECT_TRUE(DecodeSweepResults(many, 9).ok());
     SweepChunkResult outside = Example();
     outside.side_begin = 8;  // 3 sides from 8 overrun the system's 10
     absl::StatusOr<std::vector<SweepChunkResult>> r =
-        DecodeSweepResults(EncodeSweepResult(outside));
+        DecodeSweepResults(EncodeSweepResult(outside), 8);
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.status().message().find("outside"), std::string::npos) << r.status();
     // A count far beyond the bytes present is refused before anything is allocated.

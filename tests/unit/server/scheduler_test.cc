@@ -48,6 +48,43 @@ class SchedulerTest : public ::testing::Test {
     Scheduler scheduler_;
 };
 
+// A radiosity sweep task waits for the worker holding its chunks while that worker lives and
+// may work on the job; one disabled (or blocklisted, or without the job's tags) never takes it,
+// so another worker does instead of the job waiting forever.
+TEST_F(SchedulerTest, ASweepTaskOfADisabledOwnerGoesToAnotherWorker) {
+    JobSpec spec;
+    spec.name = "sweeps";
+    spec.plan = {16, 16, 4, 8, 1};
+    spec.method = "radiosity";
+    spec.radiosity.solver = "jacobi";
+    spec.radiosity.sweep_tasks = 2;
+    absl::StatusOr<std::string> id = scheduler_.Submit(spec);
+    ASSERT_TRUE(id.ok()) << id.status();
+    // Sweep 0: chunk 0 to "a", chunk 1 to "b"; one unknown a chunk, lit.
+    for (const std::string worker : {"a", "b"}) {
+        std::optional<TaskAssignment> lease = scheduler_.LeaseTask(worker);
+        ASSERT_TRUE(lease && lease->sweep == 0) << worker;
+        SweepChunkResult r;
+        r.chunk = lease->chunks.at(0);
+        r.sides = 2;
+        r.side_begin = r.chunk;
+        r.change = {1};
+        r.power = {1};
+        r.input = {Rgb(0)};
+        r.output = {Rgb(1)};
+        ASSERT_TRUE(scheduler_.CompleteSweep(lease->lease_id, worker, r).ok()) << worker;
+    }
+    scheduler_.Publish(*id, false, "h1");
+    std::optional<TaskAssignment> mine = scheduler_.LeaseTask("a");
+    ASSERT_TRUE(mine && mine->sweep == 1);
+    EXPECT_EQ(mine->chunks, std::vector<int>{0});
+    EXPECT_FALSE(scheduler_.LeaseTask("a")) << "b's task waits for b, which lives";
+    scheduler_.SetWorkerControl("b", WorkerControl::kDisabled);
+    std::optional<TaskAssignment> theirs = scheduler_.LeaseTask("a");
+    ASSERT_TRUE(theirs && theirs->sweep == 1) << "b is disabled: a takes its task";
+    EXPECT_EQ(theirs->chunks, std::vector<int>{1});
+}
+
 TEST_F(SchedulerTest, HigherPriorityFirstThenOlderFirst) {
     const std::string low = Submit(0), high_old = Submit(5), high_new = Submit(5);
     EXPECT_EQ(scheduler_.LeaseTask("w")->job_id, high_old);

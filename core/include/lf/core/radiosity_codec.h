@@ -38,8 +38,10 @@ struct SweepChunkResult {
 std::string EncodeSweepResult(const SweepChunkResult& result);
 // A task's results, one a chunk, back to back.
 std::string EncodeSweepResults(std::span<const SweepChunkResult> results);
-// At least one result; InvalidArgument for anything malformed, including a run outside
+// At least one result and at most `max_results` (a task holds at most that many chunks: memory
+// stays a few times the bytes); InvalidArgument for anything malformed, including a run outside
 // [0, sides).
-absl::StatusOr<std::vector<SweepChunkResult>> DecodeSweepResults(std::string_view bytes);
+absl::StatusOr<std::vector<SweepChunkResult>> DecodeSweepResults(std::string_view bytes,
+                                                                 size_t max_results);
 
 }  // namespace lf

@@ -50,6 +50,8 @@ struct TaskResult {
     std::vector<TaskResult> parts;
     // What it cost on the worker: a chunk's whole lease, and each part its own.
     TaskTimes times;
+    // Who made it: the farm's worker (set by the scheduler); empty in local mode.
+    std::string worker;
 };
 
 class JobExecution {

@@ -28,7 +28,9 @@ class SweepTaskNumbering {
         int sweep = 0;
         std::span<const int> chunks;
     };
-    // The sweep and chunks of task `index`; nullopt for a tile's task or one not numbered.
+    // The sweep and chunks of task `index`; nullopt for a tile's task or one not numbered. The
+    // chunks stay valid while the numbering lives (Append moves a task's chunk list, not its
+    // buffer).
     std::optional<SweepTask> FromIndex(int index) const {
         auto after = std::upper_bound(sweeps_.begin(), sweeps_.end(), index,
                                       [](int i, const Sweep& s) { return i < s.first; });

@@ -371,6 +371,9 @@ class Scheduler {
     // live worker waits for it, and a task that failed on `worker` waits for a live worker it has
     // not failed on, while there is one.
     bool MayTake(const Job& job, int task, const std::string& worker, absl::Time now) const;
+    // Whether worker `id` may lease the job's tasks: enabled, not blocklisted from it, with its
+    // tags.
+    bool MayWorkOn(const Job& job, const std::string& id, const WorkerDescription& about) const;
     // Whether the job goes to `worker`, which has `tags`: the worker has every tag of the job,
     // and the job's max_workers cap leaves it room (or the worker already holds a lease of it).
     bool Admits(const Job& job, const std::string& worker,
