@@ -126,13 +126,14 @@ absl::StatusOr<JobExecution::Merged> SweepExecution::Merge(int task, const TaskR
             absl::StrCat("a result of chunks ", chunks, " for task ", task));
     }
     if (absl::Status added = solve_->Add(result.sweeps); !added.ok()) return added;
-    // The worker that did them holds their rows now (a retry after the owner was lost, or a
-    // straggler's copy that won): later sweeps go there, not to a third worker that would
-    // compute them again. That worker may then hold more chunks than the others; computing a
-    // chunk's rows costs far more than sweeping it (the Cornell box at 0.02: 2.2 s of links
-    // against 14 ms a sweep), so that is cheaper than spreading them again.
-    if (!result.worker.empty()) {
-        for (int chunk : at->chunks) chunk_owner_[chunk].worker = result.worker;
+    // Done by another worker while their owner is gone (a retry after it was lost): that worker
+    // holds their rows now, and later sweeps go there, not to a third worker that would compute
+    // them again. It may then hold more chunks than the others; computing a chunk's rows costs
+    // far more than sweeping it (the Cornell box at 0.02: 2.2 s of links against 14 ms a sweep),
+    // so that is cheaper than spreading them again. A straggler's copy that won while the owner
+    // lives leaves them there: both hold the rows.
+    if (!result.takes_over.empty()) {
+        for (int chunk : at->chunks) chunk_owner_[chunk].worker = result.takes_over;
     }
     Merged merged;
     if (solve_->SweepComplete()) {

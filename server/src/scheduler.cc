@@ -84,25 +84,29 @@ Scheduler::Locked::Locked(Scheduler& scheduler) : lock(scheduler.mutex_), schedu
 Scheduler::Locked::~Locked() {
     if (!lock.owns_lock()) lock.lock();
     if (!scheduler_.ended_.has_unsettled()) return;
-    // Taken with the jobs SettleEnded waits for: their tasks are handed on once they are durable
-    // (or logged as not recorded), with the lock released for the callback to write.
-    std::vector<std::pair<JobRecord, std::vector<TaskStatus>>> tasks;
-    tasks.swap(scheduler_.ended_tasks_);
     SettleEnded();
-    lock.unlock();
-    if (!scheduler_.tasks_ended_) return;
-    for (auto& [record, statuses] : tasks) scheduler_.tasks_ended_(record, std::move(statuses));
 }
 
 void Scheduler::Locked::SettleEnded() {
+    // Taken with the jobs whose ends settle here: their tasks are handed on once their records
+    // are durable (or logged as not recorded), with the lock released for the callback to write,
+    // and before the ends settle, so a client told of an end lists the job's tasks at once.
+    std::vector<std::pair<JobRecord, std::vector<TaskStatus>>> tasks;
+    tasks.swap(scheduler_.ended_tasks_);
     const std::vector<std::pair<std::string, uint64_t>> ended = scheduler_.ended_.TakeUnsettled();
     lock.unlock();
     std::vector<absl::Status> durable;
     for (const auto& [id, ticket] : ended) durable.push_back(scheduler_.store_.WaitDurable(ticket));
+    if (scheduler_.tasks_ended_) {
+        for (auto& [record, statuses] : tasks) scheduler_.tasks_ended_(record, std::move(statuses));
+    }
     lock.lock();
     for (size_t i = 0; i < ended.size(); ++i) scheduler_.ended_.Settle(ended[i].first, durable[i]);
     scheduler_.left_memory_ += ended.size();
-    scheduler_.changed_.notify_all();  // for WaitForEnd
+    // A change: a WaitForChange begun after the end's Save returns for its settling too.
+    ++scheduler_.version_;
+    scheduler_.changed_.notify_all();
+    scheduler_.settled_.notify_all();
 }
 
 absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
@@ -673,17 +677,24 @@ bool Scheduler::MayWorkOn(const Job& job, const std::string& id,
            HasAllTags(about.tags, job.record.spec.tags);
 }
 
+bool Scheduler::PreferredMayTake(const Job& job, int t, absl::Time now) const {
+    const std::string preferred = job.execution->PreferredWorker(t);
+    if (preferred.empty() || job.tasks[size_t(t)].failed_on.count(preferred) ||
+        !workers_.IsLive(preferred, now) || workers_.IsQuarantined(preferred, now) ||
+        workers_.IsQuarantined(TokenStrikes(preferred), now)) {
+        return false;
+    }
+    const WorkerDescription* about = workers_.AboutOf(preferred);
+    return about && MayWorkOn(job, preferred, *about);
+}
+
 bool Scheduler::MayTake(const Job& job, int t, const std::string& worker, absl::Time now) const {
     const ScheduledJob::Task& task = job.tasks[size_t(t)];
     // A task keeps to its preferred worker (the one holding its chunk) while that one lives and
-    // may work on the job, unless it failed there: else it would wait for as long as that worker
-    // lives (a worker blocklisted from the job, disabled, or without its tags never takes it).
-    const std::string preferred = job.execution->PreferredWorker(t);
-    if (!preferred.empty() && preferred != worker && !task.failed_on.count(preferred) &&
-        workers_.IsLive(preferred, now)) {
-        const WorkerDescription* about = workers_.AboutOf(preferred);
-        if (about && MayWorkOn(job, preferred, *about)) return false;
-    }
+    // may take it, unless it failed there: else it would wait for as long as that worker lives
+    // (a worker blocklisted from the job, disabled, without its tags or quarantined does not
+    // take it).
+    if (job.execution->PreferredWorker(t) != worker && PreferredMayTake(job, t, now)) return false;
     if (!task.failed_on.count(worker)) return true;
     // It failed here: it waits for a live worker it has not failed on that may take the job
     // (enabled, not blocklisted from it, with its tags: a worker that may not would hold it
@@ -792,7 +803,12 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     const TaskState state = job.states.state(t);
     if (state == TaskState::kDone || state == TaskState::kDropped) return completion;
     TaskResult made = result;
-    made.worker = worker;
+    // Done by another worker than the one the task waited for, which is gone or may not take it
+    // now: the execution prefers this one from now on (it holds what the task built).
+    const std::string preferred = job.execution->PreferredWorker(t);
+    if (!preferred.empty() && preferred != worker && !PreferredMayTake(job, t, now)) {
+        made.takes_over = worker;
+    }
     absl::StatusOr<JobExecution::Merged> merged = job.execution->Merge(t, made);
     if (!merged.ok()) return Refuse(*ref, worker, merged.status());
     workers_.Worked(worker);
@@ -1348,15 +1364,20 @@ uint64_t Scheduler::WaitForChange(uint64_t version, absl::Time deadline) {
 Scheduler::EndWait Scheduler::WaitForEnd(const std::string& job_id, absl::Time deadline) {
     std::unique_lock<std::mutex> lock(mutex_);
     const auto ended = [&] { return !active_.count(job_id) && !ended_.IsSettling(job_id); };
-    changed_.wait_until(lock, absl::ToChronoTime(deadline), [&] { return shutdown_ || ended(); });
+    // A shutdown ends the wait for a job still queued or running; one whose end is settling
+    // settles within moments (the store outlives the service), and its end is what the client
+    // must hear.
+    const auto stopped = [&] { return shutdown_ && active_.count(job_id); };
+    settled_.wait_until(lock, absl::ToChronoTime(deadline), [&] { return ended() || stopped(); });
     if (ended()) return EndWait::kEnded;
-    return shutdown_ ? EndWait::kShutdown : EndWait::kRunning;
+    return stopped() ? EndWait::kShutdown : EndWait::kRunning;
 }
 
 void Scheduler::Shutdown() {
     std::lock_guard<std::mutex> lock(mutex_);
     shutdown_ = true;
     changed_.notify_all();
+    settled_.notify_all();
 }
 
 }  // namespace lf

@@ -299,7 +299,7 @@ TEST(SweepExecution, LaterSweepsHaveOneTaskAWorkerOfAllItsChunks) {
         EXPECT_EQ(lease.chunks, std::vector<int>{c});
         EXPECT_EQ(lease.sweep, 0);
         const std::vector<SweepChunkResult> r = LitChunks(0, {c}, 5);
-        ASSERT_TRUE(e.Merge(sweep0[size_t(c)], {.sweeps = r, .worker = owner[size_t(c)]}).ok());
+        ASSERT_TRUE(e.Merge(sweep0[size_t(c)], {.sweeps = r}).ok());
     }
     absl::StatusOr<std::vector<int>> sweep1 = e.Publish(false, "h1");
     ASSERT_TRUE(sweep1.ok()) << sweep1.status();
@@ -327,10 +327,10 @@ TEST(SweepExecution, LaterSweepsHaveOneTaskAWorkerOfAllItsChunks) {
     bad_input[2].sides = 6;  // its last chunk does not fit: the first two are not added either
     EXPECT_FALSE(e.Merge(7, {.sweeps = bad_input}).ok());
     absl::StatusOr<JobExecution::Merged> merged =
-        e.Merge(7, {.sweeps = LitChunks(1, {0, 2, 3}, 5), .worker = "a"});
+        e.Merge(7, {.sweeps = LitChunks(1, {0, 2, 3}, 5)});
     ASSERT_TRUE(merged.ok()) << merged.status();
     EXPECT_FALSE(merged->sweep.has_value()) << "b's chunks are still out";
-    merged = e.Merge(8, {.sweeps = LitChunks(1, {1, 4}, 5), .worker = "b"});
+    merged = e.Merge(8, {.sweeps = LitChunks(1, {1, 4}, 5)});
     ASSERT_TRUE(merged.ok()) << merged.status();
     ASSERT_TRUE(merged->sweep.has_value());
     // "b" is gone in sweep 2: "a" takes b's task, and with it chunks 1 and 4.
@@ -340,8 +340,8 @@ TEST(SweepExecution, LaterSweepsHaveOneTaskAWorkerOfAllItsChunks) {
     e.Lease(10, "a", lease);
     EXPECT_EQ(lease.chunks, (std::vector<int>{1, 4}));
     EXPECT_EQ(e.PreferredWorker(10), "a");
-    ASSERT_TRUE(e.Merge(9, {.sweeps = LitChunks(2, {0, 2, 3}, 5), .worker = "a"}).ok());
-    ASSERT_TRUE(e.Merge(10, {.sweeps = LitChunks(2, {1, 4}, 5), .worker = "a"}).ok());
+    ASSERT_TRUE(e.Merge(9, {.sweeps = LitChunks(2, {0, 2, 3}, 5)}).ok());
+    ASSERT_TRUE(e.Merge(10, {.sweeps = LitChunks(2, {1, 4}, 5)}).ok());
     absl::StatusOr<std::vector<int>> sweep3 = e.Publish(false, "h3");
     ASSERT_TRUE(sweep3.ok()) << sweep3.status();
     ASSERT_EQ(sweep3->size(), 1u) << "one worker holds every chunk";
@@ -349,11 +349,12 @@ TEST(SweepExecution, LaterSweepsHaveOneTaskAWorkerOfAllItsChunks) {
     EXPECT_EQ(lease.chunks, (std::vector<int>{0, 1, 2, 3, 4}));
 }
 
-// A chunk belongs to the worker whose result of it was merged, which holds its rows: a task
-// taken again by "b" after its owner "a" was lost mid-task (the same task: its second lease
-// does not move the chunks) gives them to "b", and the next sweep's task of them goes to "b",
-// not to a third worker that would compute the rows again.
-TEST(SweepExecution, ChunksGoToTheWorkerWhoseResultWasMerged) {
+// A task taken again by "b" after its owner "a" was lost mid-task (the same task: its second
+// lease does not move the chunks) gives them to "b" with its result (takes_over, which the
+// scheduler sets when the owner is gone), and the next sweep's task of them goes to "b", not
+// to a third worker that would compute the rows again. A straggler's copy that wins while the
+// owner lives (no takes_over) leaves the chunks with their owner.
+TEST(SweepExecution, ChunksGoToTheWorkerThatTookOverTheirTask) {
     const std::unique_ptr<SweepExecution> made = TwoTileSweeps(3);
     ASSERT_TRUE(made);
     SweepExecution& e = *made;
@@ -365,9 +366,11 @@ TEST(SweepExecution, ChunksGoToTheWorkerWhoseResultWasMerged) {
         e.Lease(sweep0[size_t(c)], owner[size_t(c)], lease);
         if (c == 0) e.Lease(sweep0[0], "b", lease);  // "a" lost: the retry goes to "b"
         EXPECT_EQ(e.PreferredWorker(sweep0[size_t(c)]), owner[size_t(c)]);
-        const std::string by = c == 0 ? "b" : owner[size_t(c)];
+        if (c == 2) e.Lease(sweep0[2], "b", lease);  // a straggler's copy; "c" lives
+        const std::string takes_over = c == 0 ? "b" : "";
         ASSERT_TRUE(
-            e.Merge(sweep0[size_t(c)], {.sweeps = LitChunks(0, {c}, 3), .worker = by}).ok());
+            e.Merge(sweep0[size_t(c)], {.sweeps = LitChunks(0, {c}, 3), .takes_over = takes_over})
+                .ok());
     }
     absl::StatusOr<std::vector<int>> sweep1 = e.Publish(false, "h1");
     ASSERT_TRUE(sweep1.ok()) << sweep1.status();

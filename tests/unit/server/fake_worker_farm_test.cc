@@ -610,6 +610,8 @@ TEST_F(FakeWorkerFarm, WatchEndsOnceTheJobsEndIsInTheStore) {
     });
     const grpc::Status watched = watch.ReadToEnd();
     absl::StatusOr<JobRecord> stored = farm_->store().Get(job);
+    // Its tasks are recorded before the end goes out: `lightfarm tasks` lists them at once.
+    absl::StatusOr<std::vector<TaskStatus>> tasks = farm_->Tasks(job);
     pb::RequeueJobRequest requeue_request;
     requeue_request.set_job_id(job);
     pb::Job requeued;
@@ -621,6 +623,9 @@ TEST_F(FakeWorkerFarm, WatchEndsOnceTheJobsEndIsInTheStore) {
     EXPECT_EQ(watch.last.state(), pb::Job::CANCELLED);
     ASSERT_TRUE(stored.ok()) << stored.status();
     EXPECT_EQ(stored->state, JobState::kCancelled);
+    ASSERT_TRUE(tasks.ok()) << tasks.status();
+    EXPECT_EQ(int(tasks->size()), stored->tasks_total);
+    EXPECT_FALSE(tasks->empty());
     ASSERT_TRUE(requeue.ok()) << requeue.error_message();
     EXPECT_EQ(requeued.state(), pb::Job::QUEUED);
 }

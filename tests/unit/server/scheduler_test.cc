@@ -83,6 +83,24 @@ TEST_F(SchedulerTest, ASweepTaskOfADisabledOwnerGoesToAnotherWorker) {
     std::optional<TaskAssignment> theirs = scheduler_.LeaseTask("a");
     ASSERT_TRUE(theirs && theirs->sweep == 1) << "b is disabled: a takes its task";
     EXPECT_EQ(theirs->chunks, std::vector<int>{1});
+    // a's result of b's task makes a the chunk's owner (it holds its rows now): sweep 2 is one
+    // task, of both chunks, for a.
+    for (const TaskAssignment* lease : {&*mine, &*theirs}) {
+        SweepChunkResult r;
+        r.sweep = 1;
+        r.chunk = lease->chunks.at(0);
+        r.sides = 2;
+        r.side_begin = r.chunk;
+        r.change = {1};
+        r.power = {1};
+        r.input = {Rgb(1)};
+        r.output = {Rgb(1)};
+        ASSERT_TRUE(scheduler_.CompleteSweep(lease->lease_id, "a", r).ok());
+    }
+    scheduler_.Publish(*id, false, "h2");
+    std::optional<TaskAssignment> both = scheduler_.LeaseTask("a");
+    ASSERT_TRUE(both && both->sweep == 2);
+    EXPECT_EQ(both->chunks, (std::vector<int>{0, 1}));
 }
 
 TEST_F(SchedulerTest, HigherPriorityFirstThenOlderFirst) {
@@ -977,6 +995,29 @@ TEST(SchedulerLockTest, EndingAJobWaitsForTheStoreWithoutTheLock) {
     }));
     cancel.join();
     EXPECT_EQ(store.Get(id)->state, JobState::kCancelled);
+}
+
+// A job's tasks are handed on (the farm records them for `lightfarm tasks`) before its end
+// settles: a client told of the end lists them at once. While the callback runs, a wait for
+// the end goes on.
+TEST(SchedulerLockTest, TasksAreHandedOnBeforeTheEndSettles) {
+    using EndWait = Scheduler::EndWait;
+    InMemoryJobStore store;
+    Scheduler scheduler({}, store);
+    std::promise<void> entered, release;
+    std::shared_future<void> released = release.get_future().share();
+    scheduler.OnTasksEnded([&](const JobRecord&, std::vector<TaskStatus> tasks) {
+        EXPECT_FALSE(tasks.empty());
+        entered.set_value();
+        released.wait();
+    });
+    const std::string id = *scheduler.Submit(SmallSpec(""));
+    std::thread cancel([&] { EXPECT_TRUE(scheduler.Cancel(id).ok()); });
+    entered.get_future().wait();
+    EXPECT_EQ(scheduler.WaitForEnd(id, absl::Now() + absl::Milliseconds(50)), EndWait::kRunning);
+    release.set_value();
+    EXPECT_EQ(scheduler.WaitForEnd(id, absl::Now() + absl::Hours(1)), EndWait::kEnded);
+    cancel.join();
 }
 
 // What WatchJob reads and waits for before it sends a job's end: the end settled, its record

@@ -50,8 +50,11 @@ struct TaskResult {
     std::vector<TaskResult> parts;
     // What it cost on the worker: a chunk's whole lease, and each part its own.
     TaskTimes times;
-    // Who made it: the farm's worker (set by the scheduler); empty in local mode.
-    std::string worker;
+    // The farm's worker that made it, when the task's preferred worker (PreferredWorker) is
+    // gone or may not take it now: the execution may prefer this one from now on. Empty when
+    // the preferred worker made it or may still take it (a straggler's copy that won), and in
+    // local mode.
+    std::string takes_over;
 };
 
 class JobExecution {

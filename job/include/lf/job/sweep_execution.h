@@ -5,8 +5,8 @@
 // cost per chunk is not known before; the worker of a chunk's first lease keeps its rows, and
 // each later sweep has one task a worker holding chunks, covering all of them: one lease,
 // heartbeat and result a worker and sweep instead of one a chunk. That is soft state: any
-// worker may take a task whose worker is gone, and a task's chunks belong to the worker whose
-// result was merged, which holds their rows.
+// worker may take a task whose worker is gone, and its result makes it the chunks' owner
+// (TaskResult::takes_over): it holds their rows.
 #pragma once
 
 #include <map>

@@ -262,11 +262,12 @@ class Scheduler {
     // What WaitForEnd saw when it returned.
     enum class EndWait {
         // The job is not queued or running and its end is settled: its final record is durable
-        // in the store (or logged as not recorded), so a client told of the end finds the job
-        // there, for a `requeue` or a `list` at once. An unknown job counts as ended.
+        // in the store, so a client told of the end finds the job there, for a `requeue` or a
+        // `list` at once (or the write failed and was logged: then neither finds it). An
+        // unknown job counts as ended.
         kEnded,
         kRunning,   // `deadline` came first: the job is queued, running, or its end not settled
-        kShutdown,  // Shutdown was called, and the job has not ended
+        kShutdown,  // Shutdown was called, and the job is queued or running
     };
     // Blocks until the job has ended and its end is settled, or `deadline`, or Shutdown. WatchJob
     // paces its messages with it, so that a job's end goes out as soon as it settled.
@@ -374,6 +375,10 @@ class Scheduler {
     // Whether worker `id` may lease the job's tasks: enabled, not blocklisted from it, with its
     // tags.
     bool MayWorkOn(const Job& job, const std::string& id, const WorkerDescription& about) const;
+    // Whether the execution's preferred worker for task `t` (lf::JobExecution::PreferredWorker)
+    // lives and may lease it now (MayWorkOn, and not quarantined): the task waits for it, and
+    // another worker's result of it takes its place (TaskResult::takes_over).
+    bool PreferredMayTake(const Job& job, int t, absl::Time now) const;
     // Whether the job goes to `worker`, which has `tags`: the worker has every tag of the job,
     // and the job's max_workers cap leaves it room (or the worker already holds a lease of it).
     bool Admits(const Job& job, const std::string& worker,
@@ -437,6 +442,9 @@ class Scheduler {
 
     mutable std::mutex mutex_;
     std::condition_variable changed_;
+    // Notified when ended jobs settle, and at Shutdown: WaitForEnd's, apart from changed_, which
+    // every lease and result notifies.
+    std::condition_variable settled_;
     uint64_t version_ = 0;
     bool shutdown_ = false;
     uint64_t next_seq_ = 1;
