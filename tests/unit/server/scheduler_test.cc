@@ -48,6 +48,21 @@ class SchedulerTest : public ::testing::Test {
     Scheduler scheduler_;
 };
 
+// The result of a sweep task of one chunk of a system of two unknowns, one a chunk, each
+// gathering 1 from sweep 0 on.
+SweepChunkResult LitChunk(const TaskAssignment& lease) {
+    SweepChunkResult r;
+    r.sweep = lease.sweep;
+    r.chunk = lease.chunks.at(0);
+    r.sides = 2;
+    r.side_begin = r.chunk;
+    r.change = {1};
+    r.power = {1};
+    r.input = {Rgb(lease.sweep == 0 ? 0 : 1)};
+    r.output = {Rgb(1)};
+    return r;
+}
+
 // A radiosity sweep task waits for the worker holding its chunks while that worker lives and
 // may work on the job; one disabled (or blocklisted, or without the job's tags) never takes it,
 // so another worker does instead of the job waiting forever.
@@ -64,15 +79,8 @@ TEST_F(SchedulerTest, ASweepTaskOfADisabledOwnerGoesToAnotherWorker) {
     for (const std::string worker : {"a", "b"}) {
         std::optional<TaskAssignment> lease = scheduler_.LeaseTask(worker);
         ASSERT_TRUE(lease && lease->sweep == 0) << worker;
-        SweepChunkResult r;
-        r.chunk = lease->chunks.at(0);
-        r.sides = 2;
-        r.side_begin = r.chunk;
-        r.change = {1};
-        r.power = {1};
-        r.input = {Rgb(0)};
-        r.output = {Rgb(1)};
-        ASSERT_TRUE(scheduler_.CompleteSweep(lease->lease_id, worker, r).ok()) << worker;
+        ASSERT_TRUE(scheduler_.CompleteSweep(lease->lease_id, worker, LitChunk(*lease)).ok())
+            << worker;
     }
     scheduler_.Publish(*id, false, "h1");
     std::optional<TaskAssignment> mine = scheduler_.LeaseTask("a");
@@ -86,16 +94,7 @@ TEST_F(SchedulerTest, ASweepTaskOfADisabledOwnerGoesToAnotherWorker) {
     // a's result of b's task makes a the chunk's owner (it holds its rows now): sweep 2 is one
     // task, of both chunks, for a.
     for (const TaskAssignment* lease : {&*mine, &*theirs}) {
-        SweepChunkResult r;
-        r.sweep = 1;
-        r.chunk = lease->chunks.at(0);
-        r.sides = 2;
-        r.side_begin = r.chunk;
-        r.change = {1};
-        r.power = {1};
-        r.input = {Rgb(1)};
-        r.output = {Rgb(1)};
-        ASSERT_TRUE(scheduler_.CompleteSweep(lease->lease_id, "a", r).ok());
+        ASSERT_TRUE(scheduler_.CompleteSweep(lease->lease_id, "a", LitChunk(*lease)).ok());
     }
     scheduler_.Publish(*id, false, "h2");
     std::optional<TaskAssignment> both = scheduler_.LeaseTask("a");
