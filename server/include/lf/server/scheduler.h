@@ -294,9 +294,10 @@ class Scheduler {
 
     // Called with an ended job's final record and its tasks as they were when it ended, after
     // the scheduler's lock is released and that record is durable (or logged as not recorded),
-    // so that they can be kept once the job leaves memory. The record is the one the job ended
-    // with, even when the job was requeued meanwhile. Set before the first job is submitted or
-    // recovered.
+    // so that they can be kept once the job leaves memory; before the end settles (WaitForEnd),
+    // so a client told of the end finds them kept. Until it returns the job cannot be requeued
+    // (UNAVAILABLE: "again in a moment"); the record stays the one the job ended with when it
+    // is requeued afterwards. Set before the first job is submitted or recovered.
     using TasksEnded = std::function<void(const JobRecord& ended, std::vector<TaskStatus>)>;
     void OnTasksEnded(TasksEnded callback) { tasks_ended_ = std::move(callback); }
 
