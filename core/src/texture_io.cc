@@ -161,17 +161,34 @@ const StbFormat* FindStbFormat(const std::string& bytes) {
 
 // A PNG's size from its IHDR chunk. stb_image refuses very large images itself, with a message
 // about the format rather than the size; this keeps the size the reason given.
+int64_t BigEndian32(const std::string& bytes, size_t at) {
+    int64_t v = 0;
+    for (size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(bytes[at + i]);
+    return v;
+}
+
 std::optional<std::pair<int64_t, int64_t>> PngSize(const std::string& bytes) {
     if (bytes.size() < 24 || bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0 ||
         bytes.compare(12, 4, "IHDR") != 0) {
         return std::nullopt;
     }
-    auto be32 = [&](size_t at) {
-        int64_t v = 0;
-        for (size_t i = 0; i < 4; ++i) v = v << 8 | static_cast<unsigned char>(bytes[at + i]);
-        return v;
-    };
-    return std::pair(be32(16), be32(20));
+    return std::pair(BigEndian32(bytes, 16), BigEndian32(bytes, 20));
+}
+
+// A PNG's chunks up to IEND, each within the file: stb_image (the copy Debian's libdraco
+// exports too) allocates what a chunk claims before reading it, up to 2 GB for 247 bytes.
+absl::Status CheckPngChunks(const std::string& bytes, const std::string& name) {
+    for (size_t at = 8; at + 12 <= bytes.size();) {
+        const int64_t length = BigEndian32(bytes, at);
+        if (length > int64_t(bytes.size() - at - 12)) {
+            return absl::InvalidArgumentError(absl::StrCat(
+                name, ": PNG chunk at byte ", at, " claims ", length, " bytes, beyond the file's ",
+                bytes.size(), " (truncated or corrupt)"));
+        }
+        if (bytes.compare(at + 4, 4, "IEND") == 0) break;
+        at += 12 + size_t(length);
+    }
+    return absl::OkStatus();
 }
 
 absl::StatusOr<TextureImage> DecodeStb(const std::string& bytes, const std::string& name) {
@@ -182,6 +199,7 @@ absl::StatusOr<TextureImage> DecodeStb(const std::string& bytes, const std::stri
     }
     if (const auto size = PngSize(bytes)) {
         if (absl::Status s = CheckSize(name, size->first, size->second); !s.ok()) return s;
+        if (absl::Status s = CheckPngChunks(bytes, name); !s.ok()) return s;
     }
     const int length = int(bytes.size());
     int width = 0, height = 0, channels = 0;

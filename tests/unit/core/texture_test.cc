@@ -235,6 +235,24 @@ TEST(TextureIo, FormatsBeyondPngJpegHdrAndExrAreRefusedThoughStbKnowsThem) {
 
 // A JPEG cut after its headers decodes in full with stb_image (it reads zeros past the end): one
 // claiming 16384 x 16384 texels in a few hundred bytes is refused before a texel is allocated.
+// A PNG chunk claiming more bytes than the file holds is refused before stb_image sees it (a
+// fuzzer's 247-byte PNG made it allocate 2 GB); a valid PNG's chunks all fit.
+TEST(TextureIo, APngChunkClaimingMoreThanTheFileIsRefusedBeforeDecoding) {
+    const TextureImage source = Gradient(4);
+    std::string png = testing::PngBytes(4, 2, 4, source.texels8);
+    ASSERT_TRUE(DecodeTexture(png, "whole.png").ok());
+    const size_t idat = png.find("IDAT");
+    ASSERT_NE(idat, std::string::npos);
+    png.replace(idat - 4, 4, "\x7f\xff\xff\xff", 4);  // the IDAT chunk's length: 2 GB
+    const auto decoded = DecodeTexture(png, "claims.png");
+    ASSERT_FALSE(decoded.ok());
+    EXPECT_EQ(decoded.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(decoded.status().message().find("claims.png: PNG chunk at byte " +
+                                              std::to_string(idat - 4) + " claims 2147483647"),
+              std::string::npos)
+        << decoded.status();
+}
+
 TEST(TextureIo, ATruncatedJpegClaimingFarMoreTexelsThanItsBytesIsRefused) {
     std::string jpeg;
     const std::vector<uint8_t> texels(8 * 8 * 3, 128);
