@@ -9,7 +9,8 @@
 
 namespace lf {
 
-absl::StatusOr<std::vector<int>> JobExecution::Publish(bool converged, const std::string& hash) {
+absl::StatusOr<std::vector<int>> JobExecution::Publish(bool converged, const std::string& hash,
+                                                       std::shared_ptr<const std::string> bytes) {
     return absl::FailedPreconditionError("not a job solved in sweeps");
 }
 

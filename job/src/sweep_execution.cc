@@ -39,6 +39,7 @@ std::vector<int> SweepExecution::Start() {
                                               radiosity_.max_iterations);
     sweeps_.emplace(int(TileExecution::task_count()));
     sweep_input_.clear();
+    bytes_.reset();
     return QueueSweep();
 }
 
@@ -71,6 +72,7 @@ void SweepExecution::Lease(int task, const std::string& worker, TaskAssignment& 
     if (!at) {
         TileExecution::Lease(task, worker, lease);
         lease.radiosity_hash = solution_;
+        lease.radiosity_input = bytes_;
         return;
     }
     // The worker of a task's first lease owns its chunks: a second lease of the same task (a
@@ -84,6 +86,7 @@ void SweepExecution::Lease(int task, const std::string& worker, TaskAssignment& 
     lease.sweep = at->sweep;
     lease.chunks.assign(at->chunks.begin(), at->chunks.end());
     lease.radiosity_hash = sweep_input_;
+    lease.radiosity_input = bytes_;
 }
 
 std::string SweepExecution::PreferredWorker(int task) const {
@@ -152,8 +155,10 @@ std::optional<std::string> SweepExecution::RecordOf(const TaskResult& result) co
     return TileExecution::RecordOf(result);
 }
 
-absl::StatusOr<std::vector<int>> SweepExecution::Publish(bool converged, const std::string& hash) {
+absl::StatusOr<std::vector<int>> SweepExecution::Publish(bool converged, const std::string& hash,
+                                                         std::shared_ptr<const std::string> bytes) {
     if (!solve_) return absl::FailedPreconditionError("radiosity: no solve under way");
+    bytes_ = std::move(bytes);
     if (!converged) {
         sweep_input_ = hash;
         return QueueSweep();
@@ -164,9 +169,10 @@ absl::StatusOr<std::vector<int>> SweepExecution::Publish(bool converged, const s
 }
 
 void SweepExecution::AddBlobsInUse(std::set<std::string>& hashes) const {
-    for (const std::string* hash : {&sweep_input_, &solution_}) {
-        if (!hash->empty()) hashes.insert(*hash);
-    }
+    // The last one published is the one in use; one whose bytes go with the leases was never
+    // stored.
+    const std::string& hash = solution_.empty() ? sweep_input_ : solution_;
+    if (!hash.empty() && !bytes_) hashes.insert(hash);
 }
 
 }  // namespace lf

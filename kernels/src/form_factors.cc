@@ -539,7 +539,11 @@ double FormFactors::RowSum(int32_t i) const {
 }
 
 std::pair<int32_t, int32_t> ChunkGroups(int32_t groups, int chunk, int chunks) {
-    const auto at = [&](int k) { return int32_t(int64_t(groups) * k / std::max(chunks, 1)); };
+    // Chunks 0..k-1 hold sum_{j<k} (n - j) = k (2n - k + 1) / 2 of the n (n + 1) / 2 parts.
+    const int64_t n = std::max(chunks, 1);
+    const auto at = [&](int64_t k) {
+        return int32_t(int64_t(groups) * k * (2 * n - k + 1) / (n * (n + 1)));
+    };
     return {at(chunk), at(chunk + 1)};
 }
 

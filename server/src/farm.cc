@@ -14,6 +14,7 @@
 #include "lf/core/radiosity_codec.h"
 #include "lf/core/splat_codec.h"
 #include "lf/core/tile_codec.h"
+#include "lf/job/digest.h"
 #include "lf/job/method_registry.h"
 #include "lf/job/plan.h"
 #include "lf/job/render_metadata.h"
@@ -316,8 +317,15 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
         sweep_solves_[done->job_id] = {done->sweep->iterations, done->sweep->residual};
     }
     if (done->sweep) {
-        scheduler_.Publish(done->job_id, done->sweep->converged,
-                           blobs_->Put(EncodeRadiosity(done->sweep->radiosity)));
+        std::string encoded = EncodeRadiosity(done->sweep->radiosity);
+        if (encoded.size() <= kMaxInlineRadiosityBytes) {
+            // Soft state, like the sweep's results (a restart solves again): it goes with the
+            // leases of the next sweep, or of the display tiles.
+            auto bytes = std::make_shared<const std::string>(std::move(encoded));
+            scheduler_.Publish(done->job_id, done->sweep->converged, Sha256Hex(*bytes), bytes);
+        } else {
+            scheduler_.Publish(done->job_id, done->sweep->converged, blobs_->Put(encoded));
+        }
     }
     return absl::OkStatus();
 }

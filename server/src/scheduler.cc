@@ -633,8 +633,14 @@ TaskAssignment Scheduler::Grant(Job& job, int t, const std::string& worker, absl
     metrics_.leases.Add();
     TaskAssignment lease;
     lease.lease_id = leases_.Grant(job.id(), t, task.attempts, worker, now + options_.lease);
-    if (job.record.state == JobState::kQueued) job.MoveTo(clock_(), JobState::kRunning);
-    Save(job);
+    // A lease is not durable (a restart queues its task again): the record is written when the
+    // job starts (its time limit counts from then), else with its next recorded change.
+    if (job.record.state == JobState::kQueued) {
+        job.MoveTo(clock_(), JobState::kRunning);
+        Save(job);
+    } else {
+        Announce(job);
+    }
     Log()->debug("job={} task={} leased to {} (attempt {})", job.id(), t, LogSafe(worker),
                  task.attempts);
     lease.job_id = job.id();
@@ -830,7 +836,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     EnforceTimeLimit(job, now);
     const std::optional<std::string> record = job.execution->RecordOf(result);
     if (!record) {  // soft state, not recorded
-        Save(job);
+        Announce(job);
         return completion;
     }
     job.Sync();
@@ -894,7 +900,8 @@ void Scheduler::MarkDone(Job& job, int t, absl::Time now) {
 }
 
 void Scheduler::Publish(const std::string& job_id, bool converged,
-                        const absl::StatusOr<std::string>& hash) {
+                        const absl::StatusOr<std::string>& hash,
+                        std::shared_ptr<const std::string> bytes) {
     Locked locked(*this);
     auto it = active_.find(job_id);
     if (it == active_.end()) return;  // cancelled meanwhile
@@ -903,13 +910,18 @@ void Scheduler::Publish(const std::string& job_id, bool converged,
         FailJob(job, absl::StrCat("storing the radiosity: ", hash.status().message()));
         return;
     }
-    absl::StatusOr<std::vector<int>> ready = job.execution->Publish(converged, *hash);
+    absl::StatusOr<std::vector<int>> ready =
+        job.execution->Publish(converged, *hash, std::move(bytes));
     if (!ready.ok()) {
         FailJob(job, std::string(ready.status().message()));
         return;
     }
     job.Queue(*ready);
-    Save(job);
+    if (converged) {
+        Save(job);  // the display tiles, whose results are recorded, start
+    } else {
+        Announce(job);
+    }
 }
 
 absl::Status Scheduler::Fail(const std::string& lease_id, const std::string& worker,
@@ -1352,6 +1364,12 @@ uint64_t Scheduler::Save(Job& job, const std::vector<int>& drop_results) {
     ++version_;
     changed_.notify_all();
     return ticket;
+}
+
+void Scheduler::Announce(Job& job) {
+    job.Sync();
+    ++version_;
+    changed_.notify_all();
 }
 
 uint64_t Scheduler::WaitForChange(uint64_t version, absl::Time deadline) {

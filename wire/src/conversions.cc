@@ -1,5 +1,6 @@
 #include "lf/wire/conversions.h"
 
+#include <memory>
 #include <optional>
 
 #include "lf/job/method_registry.h"
@@ -314,6 +315,7 @@ void ToProto(const TaskAssignment& task, pb::Task* out) {
         out->set_path_end(task.path_end);
     }
     out->set_radiosity_hash(task.radiosity_hash);
+    if (task.radiosity_input) out->set_radiosity_input(*task.radiosity_input);
     if (task.frame) out->set_frame(*task.frame);
     for (const TaskAssignment::Part& part : task.parts) {
         pb::TaskPart* p = out->add_parts();
@@ -349,6 +351,9 @@ TaskAssignment FromProto(const pb::Task& t) {
         task.path_end = t.path_end();
     }
     task.radiosity_hash = t.radiosity_hash();
+    if (!t.radiosity_input().empty()) {
+        task.radiosity_input = std::make_shared<const std::string>(t.radiosity_input());
+    }
     task.task.rect = {t.x0(), t.y0(), t.width(), t.height()};
     task.task.sample_begin = t.sample_begin();
     task.task.sample_end = t.sample_end();

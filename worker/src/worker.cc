@@ -414,7 +414,7 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic
     options->cancel = &cancel;  // meshing, form factors and the solve stop on a cancel
     absl::StatusOr<std::unique_ptr<RadiosityRenderer>> renderer;
     if (!task.radiosity_hash.empty()) {  // solved by the farm's sweeps
-        absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task.radiosity_hash);
+        absl::StatusOr<std::vector<Rgb>> solution = ReadRadiosity(task);
         if (!solution.ok()) return solution.status();
         // The sweeps' mesh (and cluster tree) are those the display needs: the mesh moves over.
         renderer = loaded_.sweeps
@@ -438,9 +438,12 @@ absl::Status Worker::PrepareTracer(const TaskAssignment& task, const std::atomic
     return absl::OkStatus();
 }
 
-absl::StatusOr<std::vector<Rgb>> Worker::ReadRadiosity(const std::string& hash) {
-    absl::StatusOr<std::string> path = cache_.Get(
-        hash, [&](const std::string& h, const std::string& p) { return server_.FetchBlob(h, p); });
+absl::StatusOr<std::vector<Rgb>> Worker::ReadRadiosity(const TaskAssignment& task) {
+    if (task.radiosity_input) return DecodeRadiosity(*task.radiosity_input);
+    absl::StatusOr<std::string> path =
+        cache_.Get(task.radiosity_hash, [&](const std::string& h, const std::string& p) {
+            return server_.FetchBlob(h, p);
+        });
     if (!path.ok()) return path.status();
     absl::StatusOr<std::string> bytes = ReadFile(*path);
     if (!bytes.ok()) return bytes.status();
@@ -481,7 +484,7 @@ absl::StatusOr<std::string> Worker::Sweep(const TaskAssignment& task,
     std::span<const Rgb> input = chunks.start();
     if (!task.radiosity_hash.empty()) {
         if (loaded_.input_hash != task.radiosity_hash) {
-            absl::StatusOr<std::vector<Rgb>> read = ReadRadiosity(task.radiosity_hash);
+            absl::StatusOr<std::vector<Rgb>> read = ReadRadiosity(task);
             if (!read.ok()) return read.status();
             loaded_.input = std::move(*read);
             loaded_.input_hash = task.radiosity_hash;

@@ -283,6 +283,55 @@ std::vector<SweepChunkResult> LitChunks(int sweep, const std::vector<int>& chunk
     return results;
 }
 
+// A sweep's input or solution published with its bytes is soft state: the bytes go with each
+// lease of the sweep or display tile, and the blob is not kept from collection (it was never
+// stored).
+TEST(SweepExecution, ASweepInputPublishedWithItsBytesGoesWithTheLeases) {
+    const std::unique_ptr<SweepExecution> made = TwoTileSweeps(1);
+    ASSERT_TRUE(made);
+    SweepExecution& e = *made;
+    const std::vector<int> sweep0 = e.Start();
+    ASSERT_EQ(sweep0.size(), 1u);
+    TaskAssignment lease;
+    e.Lease(sweep0[0], "w", lease);
+    EXPECT_EQ(lease.radiosity_input, nullptr) << "sweep 0 reads no input";
+    const std::vector<SweepChunkResult> lit = LitChunks(0, {0}, 1);
+    ASSERT_TRUE(e.Merge(sweep0[0], {.sweeps = lit}).ok());
+    const auto bytes = std::make_shared<const std::string>("b1 bytes");
+    absl::StatusOr<std::vector<int>> sweep1 = e.Publish(false, "b1-hash", bytes);
+    ASSERT_TRUE(sweep1.ok()) << sweep1.status();
+    ASSERT_EQ(sweep1->size(), 1u);
+    e.Lease(sweep1->front(), "w", lease);
+    EXPECT_EQ(lease.radiosity_hash, "b1-hash");
+    ASSERT_NE(lease.radiosity_input, nullptr);
+    EXPECT_EQ(*lease.radiosity_input, "b1 bytes");
+    std::set<std::string> blobs;
+    e.AddBlobsInUse(blobs);
+    EXPECT_TRUE(blobs.empty()) << "b1-hash is not in the store";
+    // Sweep 2's input is a stored blob (too large to travel, say): no bytes go with its leases.
+    ASSERT_TRUE(e.Merge(sweep1->front(), {.sweeps = LitChunks(1, {0}, 1)}).ok());
+    absl::StatusOr<std::vector<int>> sweep2 = e.Publish(false, "b2-hash");
+    ASSERT_TRUE(sweep2.ok()) << sweep2.status();
+    e.Lease(sweep2->front(), "w", lease);
+    EXPECT_EQ(lease.radiosity_hash, "b2-hash");
+    EXPECT_EQ(lease.radiosity_input, nullptr);
+    e.AddBlobsInUse(blobs);
+    EXPECT_EQ(blobs, std::set<std::string>{"b2-hash"});
+    // The solution goes with the display tiles' leases the same way.
+    ASSERT_TRUE(e.Merge(sweep2->front(), {.sweeps = LitChunks(2, {0}, 1)}).ok());
+    const auto solution = std::make_shared<const std::string>("solution bytes");
+    absl::StatusOr<std::vector<int>> tiles = e.Publish(true, "solution-hash", solution);
+    ASSERT_TRUE(tiles.ok()) << tiles.status();
+    EXPECT_EQ(*tiles, (std::vector<int>{0, 1}));
+    e.Lease(tiles->front(), "w", lease);
+    EXPECT_EQ(lease.radiosity_hash, "solution-hash");
+    ASSERT_NE(lease.radiosity_input, nullptr);
+    EXPECT_EQ(*lease.radiosity_input, "solution bytes");
+    blobs.clear();
+    e.AddBlobsInUse(blobs);
+    EXPECT_TRUE(blobs.empty());
+}
+
 // After sweep 0 (a task a chunk), each sweep has one task a worker, of every chunk it holds in
 // chunk order: one lease and result a worker and sweep. A result must be of exactly its task's
 // chunks, and is added whole or not at all. A worker gone gives its whole task to the next.

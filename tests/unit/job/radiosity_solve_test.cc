@@ -10,7 +10,7 @@ namespace lf {
 namespace {
 
 // Three unknowns in two groups ({0, 1}, {2}); unit areas. The chunks sweep exactly as
-// lf::RadiositySweepChunk does: per group ||out - in|| and ||in|| in the power norm.
+// lf::RadiositySweepChunks does: per group ||out - in|| and ||in|| in the power norm.
 struct System {
     float rho = 0.5f;
     float f[3][3] = {{0, 0.5f, 0.5f}, {0.5f, 0, 0.5f}, {0.5f, 0.5f, 0}};
@@ -21,8 +21,10 @@ struct System {
 
     SweepChunkResult Chunk(int sweep, int chunk, int chunks, const std::vector<Rgb>& b) const {
         // Groups split over chunks as lf::ChunkGroups does.
-        const int g0 = int(groups.size()) * chunk / chunks;
-        const int g1 = int(groups.size()) * (chunk + 1) / chunks;
+        const auto at = [&](int k) {
+            return int(groups.size()) * k * (2 * chunks - k + 1) / (chunks * (chunks + 1));
+        };
+        const int g0 = at(chunk), g1 = at(chunk + 1);
         SweepChunkResult r;
         r.sweep = sweep;
         r.chunk = chunk;

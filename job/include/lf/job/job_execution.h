@@ -116,9 +116,12 @@ class JobExecution {
     // The kinds whose tasks the time limit may drop say when it passes.
     virtual std::optional<absl::Duration> time_limit() const { return std::nullopt; }
 
-    // A radiosity solve's sweep stored as blob `hash`: the next sweep's tasks, or (converged)
-    // the display tiles, to queue. FailedPrecondition for a job that is not solved in sweeps.
-    virtual absl::StatusOr<std::vector<int>> Publish(bool converged, const std::string& hash);
+    // A radiosity solve's sweep stored as blob `hash` (or, a sweep's input, not stored: its
+    // `bytes` go with the leases): the next sweep's tasks, or (converged) the display tiles, to
+    // queue. FailedPrecondition for a job that is not solved in sweeps.
+    virtual absl::StatusOr<std::vector<int>> Publish(
+        bool converged, const std::string& hash,
+        std::shared_ptr<const std::string> bytes = nullptr);
     // The blobs the job reads beyond its spec's (a sweep's input, the solution).
     virtual void AddBlobsInUse(std::set<std::string>& hashes) const {}
 

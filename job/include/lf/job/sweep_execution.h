@@ -43,7 +43,9 @@ class SweepExecution : public TileExecution {
     uint64_t TaskSamples(int task) const override;
     absl::StatusOr<Merged> Merge(int task, const TaskResult& result) override;
     std::optional<std::string> RecordOf(const TaskResult& result) const override;
-    absl::StatusOr<std::vector<int>> Publish(bool converged, const std::string& hash) override;
+    absl::StatusOr<std::vector<int>> Publish(
+        bool converged, const std::string& hash,
+        std::shared_ptr<const std::string> bytes = nullptr) override;
     void AddBlobsInUse(std::set<std::string>& hashes) const override;
 
   private:
@@ -60,6 +62,9 @@ class SweepExecution : public TileExecution {
     std::optional<SweepTaskNumbering> sweeps_;
     std::string sweep_input_;  // blob of the current sweep's input; "" in sweep 0
     std::string solution_;     // blob of the solution, once solved
+    // The bytes of the current sweep's input, or of the solution, when they go with the leases
+    // (not stored).
+    std::shared_ptr<const std::string> bytes_;
     struct ChunkOwner {
         int task = -1;  // the chunk's last task leased
         std::string worker;

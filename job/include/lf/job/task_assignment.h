@@ -2,6 +2,7 @@
 // pixels and samples (or which patch-group chunk of a radiosity sweep), and the job's settings.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,6 +25,10 @@ struct TaskAssignment {
     int sweep = -1;
     std::vector<int> chunks;
     std::string radiosity_hash;
+    // The sweep's input, or the solution, itself when it travels with the lease
+    // (kMaxInlineRadiosityBytes at most): then the blob `radiosity_hash` is not stored. Null:
+    // the worker fetches the blob.
+    std::shared_ptr<const std::string> radiosity_input;
     // Splatting methods (UsesSplatPlan(spec.method)): the task's light paths or photon passes
     // [path_begin, path_end) over the whole frame (lf::SplatTask); `task` holds its camera part.
     uint64_t path_begin = 0, path_end = 0;

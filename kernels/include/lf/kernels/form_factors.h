@@ -161,8 +161,12 @@ class PairEvaluator {
     double epsilon_ = 0;
 };
 
-// Chunk `chunk` of `chunks` of `groups` patch groups: [groups * chunk / chunks,
-// groups * (chunk + 1) / chunks), so the chunks cover every group once, in order.
+// Chunk `chunk` of `chunks` of `groups` patch groups, a range; the chunks cover every group
+// once, in order. Chunk k holds about (chunks - k) parts of chunks (chunks + 1) / 2: the farm
+// leases sweep 0's chunks in order and a chunk's cost is not known before its links are made,
+// so ending on the smallest ones evens out the workers' finishing times (greedy list scheduling
+// ends within the last chunk's time of the even split; equal chunks left one worker idle for
+// half a chunk on average).
 std::pair<int32_t, int32_t> ChunkGroups(int32_t groups, int chunk, int chunks);
 
 // Runs in the caller's TBB arena; the result does not depend on the thread count.

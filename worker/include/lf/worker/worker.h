@@ -103,8 +103,9 @@ class Worker {
     // and in sweep 0 in `figures` its chunk's link figures (RadiositySweepChunks::LinkReport).
     absl::StatusOr<std::string> Sweep(const TaskAssignment& task, const std::atomic<bool>& cancel,
                                       std::optional<RadiosityFigures>& figures);
-    // A radiosity vector the server stored as a blob.
-    absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const std::string& hash);
+    // The radiosity vector a task reads: the bytes that came with its lease, else the blob
+    // `radiosity_hash` the server stored.
+    absl::StatusOr<std::vector<Rgb>> ReadRadiosity(const TaskAssignment& task);
     // Hands the result to the sender thread, after the previous one was sent: the upload of a
     // result overlaps the lease and render of the next task (over a slow link, a 64x64 tile's
     // 400 kB take a few hundred milliseconds), and at most one result waits in memory.
