@@ -318,7 +318,7 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
     }
     if (done->sweep) {
         std::string encoded = EncodeRadiosity(done->sweep->radiosity);
-        if (encoded.size() <= kMaxInlineRadiosityBytes) {
+        if (encoded.size() <= std::min(options_.inline_radiosity_bytes, kMaxInlineRadiosityBytes)) {
             // Soft state, like the sweep's results (a restart solves again): it goes with the
             // leases of the next sweep, or of the display tiles.
             auto bytes = std::make_shared<const std::string>(std::move(encoded));

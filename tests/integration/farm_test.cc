@@ -1002,7 +1002,9 @@ TEST_F(Farm, RadiosityJobGivesTheLocalPixels) {
 // sweep is one task a worker, of all its chunks. The solution, and so the image, has the bits of
 // a local Jacobi solve for any split.
 TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
-    StartServer();
+    // Each sweep's input and the solution through the blob store, as a large scene's are (the
+    // other radiosity tests send them with the leases).
+    StartServer(10, "127.0.0.1:0", {"--inline-radiosity-bytes", "0"});
     StartWorker("w1");
     StartWorker("w2");
     // The illuminance comes from the swept irradiance (and the lights' direct part each worker
@@ -1033,6 +1035,12 @@ TEST_F(Farm, RadiosityJacobiSweepsInPatchGroupTasksGiveTheLocalPixels) {
     EXPECT_GE(sweep2, 2) << logs;
     EXPECT_LE(sweep2, 4) << logs;
     EXPECT_NE(logs.find("leased: radiosity sweep 2 patch groups "), std::string::npos) << logs;
+    // The scene's blob and the radiosity's: a sweep's input and the solution of each job.
+    int blobs = 0;
+    for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_ / "data" / "blobs")) {
+        blobs += entry.is_regular_file();
+    }
+    EXPECT_GE(blobs, 1 + 2 * 2);
 }
 
 // A sphere is meshed for radiosity (PrepareSceneFor) on every worker as `lightfarm render`

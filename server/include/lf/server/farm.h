@@ -14,6 +14,7 @@
 
 #include "absl/status/statusor.h"
 #include "lf/core/dir_lock.h"
+#include "lf/job/plan.h"
 #include "lf/job/render_metadata.h"
 #include "lf/job/task_status.h"
 #include "lf/server/blob_store.h"
@@ -57,6 +58,10 @@ struct FarmOptions {
     // "" for nowhere.
     std::string notify_url;
     JobNotifierOptions notify;
+    // lightfarm-server --inline-radiosity-bytes: a radiosity sweep's input or solution up to
+    // this size goes with the leases; larger (or with 0, always) it is stored as a blob that
+    // workers fetch. At most kMaxInlineRadiosityBytes.
+    size_t inline_radiosity_bytes = kMaxInlineRadiosityBytes;
 };
 
 class Farm {
