@@ -39,7 +39,7 @@ std::vector<int> SweepExecution::Start() {
                                               radiosity_.max_iterations);
     sweeps_.emplace(int(TileExecution::task_count()));
     sweep_input_.clear();
-    bytes_.reset();
+    sweep_input_bytes_.reset();
     return QueueSweep();
 }
 
@@ -72,7 +72,6 @@ void SweepExecution::Lease(int task, const std::string& worker, TaskAssignment& 
     if (!at) {
         TileExecution::Lease(task, worker, lease);
         lease.radiosity_hash = solution_;
-        lease.radiosity_input = bytes_;
         return;
     }
     // The worker of a task's first lease owns its chunks: a second lease of the same task (a
@@ -86,7 +85,7 @@ void SweepExecution::Lease(int task, const std::string& worker, TaskAssignment& 
     lease.sweep = at->sweep;
     lease.chunks.assign(at->chunks.begin(), at->chunks.end());
     lease.radiosity_hash = sweep_input_;
-    lease.radiosity_input = bytes_;
+    lease.radiosity_input = sweep_input_bytes_;
 }
 
 std::string SweepExecution::PreferredWorker(int task) const {
@@ -158,21 +157,24 @@ std::optional<std::string> SweepExecution::RecordOf(const TaskResult& result) co
 absl::StatusOr<std::vector<int>> SweepExecution::Publish(bool converged, const std::string& hash,
                                                          std::shared_ptr<const std::string> bytes) {
     if (!solve_) return absl::FailedPreconditionError("radiosity: no solve under way");
-    bytes_ = std::move(bytes);
     if (!converged) {
         sweep_input_ = hash;
+        sweep_input_bytes_ = std::move(bytes);
         return QueueSweep();
     }
+    // Every display tile's lease would carry it: the tiles read a stored blob.
+    if (bytes) return absl::InvalidArgumentError("radiosity: a solution that is not stored");
     solution_ = hash;
+    sweep_input_.clear();  // no sweep reads it again
+    sweep_input_bytes_.reset();
     solve_.reset();
     return Start();
 }
 
 void SweepExecution::AddBlobsInUse(std::set<std::string>& hashes) const {
-    // The last one published is the one in use; one whose bytes go with the leases was never
-    // stored.
-    const std::string& hash = solution_.empty() ? sweep_input_ : solution_;
-    if (!hash.empty() && !bytes_) hashes.insert(hash);
+    // One whose bytes go with the leases was never stored.
+    if (!sweep_input_.empty() && !sweep_input_bytes_) hashes.insert(sweep_input_);
+    if (!solution_.empty()) hashes.insert(solution_);
 }
 
 }  // namespace lf

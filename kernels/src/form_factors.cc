@@ -539,10 +539,12 @@ double FormFactors::RowSum(int32_t i) const {
 }
 
 std::pair<int32_t, int32_t> ChunkGroups(int32_t groups, int chunk, int chunks) {
-    // Chunks 0..k-1 hold sum_{j<k} (n - j) = k (2n - k + 1) / 2 of the n (n + 1) / 2 parts.
+    // Chunk j has weight 3n - 2j: chunks k..n-1 hold (n - k)(2n - k + 1) of the n (2n + 1)
+    // parts. Counting from the end rounds the remainder into the first chunks, so a few groups
+    // go first, not last.
     const int64_t n = std::max(chunks, 1);
     const auto at = [&](int64_t k) {
-        return int32_t(int64_t(groups) * k * (2 * n - k + 1) / (n * (n + 1)));
+        return int32_t(groups - int64_t(groups) * (n - k) * (2 * n - k + 1) / (n * (2 * n + 1)));
     };
     return {at(chunk), at(chunk + 1)};
 }

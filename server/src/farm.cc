@@ -318,11 +318,14 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
     }
     if (done->sweep) {
         std::string encoded = EncodeRadiosity(done->sweep->radiosity);
-        if (encoded.size() <= std::min(options_.inline_radiosity_bytes, kMaxInlineRadiosityBytes)) {
-            // Soft state, like the sweep's results (a restart solves again): it goes with the
-            // leases of the next sweep, or of the display tiles.
+        // A sweep's input is soft state, like the sweep's results (a restart solves again): it
+        // goes with the leases of the next sweep, one a worker. The solution goes to every
+        // display tile's lease, of which a worker reads one: it is a blob each worker fetches
+        // once.
+        if (!done->sweep->converged &&
+            encoded.size() <= std::min(options_.inline_radiosity_bytes, kMaxInlineRadiosityBytes)) {
             auto bytes = std::make_shared<const std::string>(std::move(encoded));
-            scheduler_.Publish(done->job_id, done->sweep->converged, Sha256Hex(*bytes), bytes);
+            scheduler_.Publish(done->job_id, false, Sha256Hex(*bytes), bytes);
         } else {
             scheduler_.Publish(done->job_id, done->sweep->converged, blobs_->Put(encoded));
         }

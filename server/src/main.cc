@@ -76,8 +76,8 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     app.add_option("--inline-radiosity-bytes", options.inline_radiosity_bytes,
-                   "a radiosity sweep's input or solution up to this size goes with the leases; "
-                   "larger (or with 0, always) it is stored as a blob the workers fetch")
+                   "a radiosity sweep's input up to this size goes with the leases; larger (or "
+                   "with 0, always) it is stored as a blob the workers fetch")
         ->capture_default_str()
         ->check(CLI::Range(size_t(0), lf::kMaxInlineRadiosityBytes));
     // A duration flag's check: 7d, 12h, 30m, 1d12h or 0 (lf::ParseRetention).

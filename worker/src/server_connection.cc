@@ -4,6 +4,7 @@
 
 #include <fstream>
 
+#include "lf/job/plan.h"
 #include "lf/job/splat_settings.h"
 #include "lf/proto/connection_status.h"
 #include "lf/proto/grpc_status.h"
@@ -34,6 +35,8 @@ absl::StatusOr<std::unique_ptr<ServerConnection>> ServerConnection::Open(
     args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
     // The coordinator takes results up to this (splat tasks' splats: docs/farm.md).
     args.SetMaxSendMessageSize(kMaxTaskResultBytes);
+    // A lease carries the job's spec and may carry a radiosity sweep's input.
+    args.SetMaxReceiveMessageSize(int(kMaxLeaseBytes));
     absl::StatusOr<std::shared_ptr<grpc::Channel>> channel = OpenChannel(options, args);
     if (!channel.ok()) return channel.status();
     std::unique_ptr<ServerConnection> connection(

@@ -283,9 +283,9 @@ std::vector<SweepChunkResult> LitChunks(int sweep, const std::vector<int>& chunk
     return results;
 }
 
-// A sweep's input or solution published with its bytes is soft state: the bytes go with each
-// lease of the sweep or display tile, and the blob is not kept from collection (it was never
-// stored).
+// A sweep's input published with its bytes is soft state: the bytes go with each lease of the
+// sweep, and the blob is not kept from collection (it was never stored). The solution, which
+// every display tile's lease would carry, is a stored blob.
 TEST(SweepExecution, ASweepInputPublishedWithItsBytesGoesWithTheLeases) {
     const std::unique_ptr<SweepExecution> made = TwoTileSweeps(1);
     ASSERT_TRUE(made);
@@ -317,19 +317,19 @@ TEST(SweepExecution, ASweepInputPublishedWithItsBytesGoesWithTheLeases) {
     EXPECT_EQ(lease.radiosity_input, nullptr);
     e.AddBlobsInUse(blobs);
     EXPECT_EQ(blobs, std::set<std::string>{"b2-hash"});
-    // The solution goes with the display tiles' leases the same way.
+    // The solution goes to every display tile's lease: it must be a stored blob.
     ASSERT_TRUE(e.Merge(sweep2->front(), {.sweeps = LitChunks(2, {0}, 1)}).ok());
-    const auto solution = std::make_shared<const std::string>("solution bytes");
-    absl::StatusOr<std::vector<int>> tiles = e.Publish(true, "solution-hash", solution);
+    EXPECT_EQ(e.Publish(true, "solution-hash", bytes).status().code(),
+              absl::StatusCode::kInvalidArgument);
+    absl::StatusOr<std::vector<int>> tiles = e.Publish(true, "solution-hash");
     ASSERT_TRUE(tiles.ok()) << tiles.status();
     EXPECT_EQ(*tiles, (std::vector<int>{0, 1}));
     e.Lease(tiles->front(), "w", lease);
     EXPECT_EQ(lease.radiosity_hash, "solution-hash");
-    ASSERT_NE(lease.radiosity_input, nullptr);
-    EXPECT_EQ(*lease.radiosity_input, "solution bytes");
+    EXPECT_EQ(lease.radiosity_input, nullptr);
     blobs.clear();
     e.AddBlobsInUse(blobs);
-    EXPECT_TRUE(blobs.empty());
+    EXPECT_EQ(blobs, std::set<std::string>{"solution-hash"});
 }
 
 // After sweep 0 (a task a chunk), each sweep has one task a worker, of every chunk it holds in

@@ -20,11 +20,10 @@ struct System {
     static double Power(const Rgb& c) { return std::abs(c.r) + std::abs(c.g) + std::abs(c.b); }
 
     SweepChunkResult Chunk(int sweep, int chunk, int chunks, const std::vector<Rgb>& b) const {
-        // Groups split over chunks as lf::ChunkGroups does.
-        const auto at = [&](int k) {
-            return int(groups.size()) * k * (2 * chunks - k + 1) / (chunks * (chunks + 1));
-        };
-        const int g0 = at(chunk), g1 = at(chunk + 1);
+        // Groups split over chunks in order, evenly (lf::ChunkGroups tapers them; the sums do
+        // not depend on where the chunks end).
+        const int g0 = int(groups.size()) * chunk / chunks;
+        const int g1 = int(groups.size()) * (chunk + 1) / chunks;
         SweepChunkResult r;
         r.sweep = sweep;
         r.chunk = chunk;

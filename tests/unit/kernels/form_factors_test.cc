@@ -364,15 +364,17 @@ TEST(FormFactors, ChunkRowsAreTheWholeMatrixRows) {
 }
 
 // The farm leases sweep 0's chunks in order: they shrink, so the last ones, which decide when
-// the slowest worker ends, are small, and they still cover every group once, in order.
+// the slowest worker ends, are smaller, and they still cover every group once, in order, the
+// first ones taking the remainder.
 TEST(FormFactors, ChunkGroupsShrinkInOrder) {
     for (const auto& [groups, chunks] : {std::pair{128, 8}, {81, 8}, {4000, 32}, {5, 8}}) {
         int32_t next = 0, previous = groups + 1;
         for (int c = 0; c < chunks; ++c) {
             const auto [g0, g1] = ChunkGroups(groups, c, chunks);
             EXPECT_EQ(g0, next) << groups << " groups, chunk " << c << " of " << chunks;
-            // Chunk c's share is (chunks - c) / (chunks (chunks + 1) / 2), rounded.
-            const double share = double(groups) * (chunks - c) * 2 / (chunks * (chunks + 1));
+            // Chunk c's share is (3 chunks - 2c) / (chunks (2 chunks + 1)), rounded.
+            const double share =
+                double(groups) * (3 * chunks - 2 * c) / (chunks * (2 * chunks + 1));
             EXPECT_NEAR(g1 - g0, share, 1.0) << groups << " groups, chunk " << c;
             if (groups >= 2 * chunks) {
                 EXPECT_LE(g1 - g0, previous) << groups << " groups";
@@ -382,9 +384,12 @@ TEST(FormFactors, ChunkGroupsShrinkInOrder) {
         }
         EXPECT_EQ(next, groups);
     }
-    // 128 groups in 8 chunks: the first holds 28, the last 3 or 4 (an even split: 16 each).
-    EXPECT_EQ(ChunkGroups(128, 0, 8), std::make_pair(0, 28));
-    EXPECT_LE(ChunkGroups(128, 7, 8).second - ChunkGroups(128, 7, 8).first, 4);
+    // 128 groups in 8 chunks: the first holds 23, the last 9 (an even split: 16 each).
+    EXPECT_EQ(ChunkGroups(128, 0, 8), std::make_pair(0, 23));
+    EXPECT_EQ(ChunkGroups(128, 7, 8), std::make_pair(119, 128));
+    // Fewer groups than chunks: they go to the first chunks, leased first.
+    EXPECT_EQ(ChunkGroups(1, 0, 8), std::make_pair(0, 1));
+    EXPECT_EQ(ChunkGroups(3, 1, 8), std::make_pair(1, 2));
 }
 
 // Every block with the same rows, columns and value bits.

@@ -117,8 +117,9 @@ class JobExecution {
     virtual std::optional<absl::Duration> time_limit() const { return std::nullopt; }
 
     // A radiosity solve's sweep stored as blob `hash` (or, a sweep's input, not stored: its
-    // `bytes` go with the leases): the next sweep's tasks, or (converged) the display tiles, to
-    // queue. FailedPrecondition for a job that is not solved in sweeps.
+    // `bytes` go with the leases; a solution must be stored): the next sweep's tasks, or
+    // (converged) the display tiles, to queue. FailedPrecondition for a job that is not solved
+    // in sweeps.
     virtual absl::StatusOr<std::vector<int>> Publish(
         bool converged, const std::string& hash,
         std::shared_ptr<const std::string> bytes = nullptr);

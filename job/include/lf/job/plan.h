@@ -51,6 +51,10 @@ inline constexpr int kMaxSweepTasks = 1024;
 // through the blob store: no write, fsync and fetch a sweep (about 4 ms of the Cornell box's
 // 18 ms sweeps on two workers); larger (above ~87k sides) it is a blob, fetched once a worker.
 inline constexpr size_t kMaxInlineRadiosityBytes = size_t(1) << 20;
+// The largest lease a worker takes (its gRPC receive limit): the job's spec, which came in a
+// request of at most 4 MiB (the coordinator's kMaxRequestBytes), a sweep's input and the task's
+// own fields, with room to spare.
+inline constexpr size_t kMaxLeaseBytes = (size_t(6) << 20) + kMaxInlineRadiosityBytes;
 
 struct RenderTask {
     int index = 0;  // position in the plan

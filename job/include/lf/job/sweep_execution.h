@@ -61,10 +61,8 @@ class SweepExecution : public TileExecution {
     std::unique_ptr<RadiositySolve> solve_;  // while solving
     std::optional<SweepTaskNumbering> sweeps_;
     std::string sweep_input_;  // blob of the current sweep's input; "" in sweep 0
-    std::string solution_;     // blob of the solution, once solved
-    // The bytes of the current sweep's input, or of the solution, when they go with the leases
-    // (not stored).
-    std::shared_ptr<const std::string> bytes_;
+    std::shared_ptr<const std::string> sweep_input_bytes_;  // its bytes, when not stored
+    std::string solution_;                                  // blob of the solution, once solved
     struct ChunkOwner {
         int task = -1;  // the chunk's last task leased
         std::string worker;

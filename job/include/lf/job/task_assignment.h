@@ -25,9 +25,8 @@ struct TaskAssignment {
     int sweep = -1;
     std::vector<int> chunks;
     std::string radiosity_hash;
-    // The sweep's input, or the solution, itself when it travels with the lease
-    // (kMaxInlineRadiosityBytes at most): then the blob `radiosity_hash` is not stored. Null:
-    // the worker fetches the blob.
+    // A sweep's input itself when it travels with the lease (kMaxInlineRadiosityBytes at most):
+    // then the blob `radiosity_hash` is not stored. Null: the worker fetches the blob.
     std::shared_ptr<const std::string> radiosity_input;
     // Splatting methods (UsesSplatPlan(spec.method)): the task's light paths or photon passes
     // [path_begin, path_end) over the whole frame (lf::SplatTask); `task` holds its camera part.

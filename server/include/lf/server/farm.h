@@ -58,9 +58,9 @@ struct FarmOptions {
     // "" for nowhere.
     std::string notify_url;
     JobNotifierOptions notify;
-    // lightfarm-server --inline-radiosity-bytes: a radiosity sweep's input or solution up to
-    // this size goes with the leases; larger (or with 0, always) it is stored as a blob that
-    // workers fetch. At most kMaxInlineRadiosityBytes.
+    // lightfarm-server --inline-radiosity-bytes: a radiosity sweep's input up to this size
+    // goes with the leases; larger (or with 0, always) it is stored as a blob that workers
+    // fetch, as the solution always is. At most kMaxInlineRadiosityBytes.
     size_t inline_radiosity_bytes = kMaxInlineRadiosityBytes;
 };
 

@@ -20,6 +20,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "lf/job/plan.h"
 #include "lf/proto/grpc_status.h"
 #include "lf/server/auth.h"
 
@@ -28,6 +29,8 @@ namespace lf {
 // The largest request of any call but a worker's task result (CompleteTask): job specs, lists and
 // heartbeats are a few kB; scenes travel as blobs in chunks of 1 MiB.
 inline constexpr size_t kMaxRequestBytes = size_t(4) << 20;
+// A lease holds what such a request submitted, and a sweep's input: the workers take that much.
+static_assert(kMaxRequestBytes + kMaxInlineRadiosityBytes + (size_t(1) << 20) <= kMaxLeaseBytes);
 
 struct CallGuard {
     Authenticator& auth;
