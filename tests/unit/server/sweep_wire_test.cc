@@ -5,6 +5,8 @@
 
 #include <memory>
 
+#include "lf/job/plan.h"
+#include "lf/server/read_after_auth.h"
 #include "lf/wire/conversions.h"
 
 namespace lf {
@@ -44,6 +46,38 @@ TEST(SweepWire, ASweepTasksInputTravelsInlineOrByItsBlob) {
     back = FromProto(by_blob);
     EXPECT_EQ(back.radiosity_hash, std::string(64, 'a'));
     EXPECT_EQ(back.radiosity_input, nullptr);
+}
+
+// The largest lease a worker may be sent: the spec of the largest submission the coordinator
+// takes (kMaxRequestBytes, here tens of thousands of mesh files) and a sweep's input inline.
+// The worker's channel takes kMaxLeaseBytes; above it the lease would be lost in transit and
+// the job would hang.
+TEST(SweepWire, TheLargestLeaseFitsTheWorkersReceiveLimit) {
+    pb::SubmitJobRequest request;
+    request.mutable_scene()->set_path("scene.json");
+    request.mutable_scene()->set_hash(std::string(64, 'b'));
+    request.mutable_params()->set_method("radiosity");
+    // Each file costs its own bytes and at most 3 of tag and length.
+    for (size_t i = 0, size = request.ByteSizeLong(); size < kMaxRequestBytes - 256; ++i) {
+        pb::SceneFile* file = request.add_files();
+        file->set_path("meshes/a_rather_long_directory_name/part_" + std::to_string(i) + ".ply");
+        file->set_hash(std::string(64, 'c'));
+        file->set_size(uint64_t(1) << 40);
+        size += file->ByteSizeLong() + 3;
+    }
+    ASSERT_LE(request.ByteSizeLong(), kMaxRequestBytes);
+    ASSERT_GT(request.ByteSizeLong(), kMaxRequestBytes - 256 - 3 * size_t(request.files_size()));
+    TaskAssignment lease = SweepTask();
+    lease.spec = FromProto(request);
+    lease.lease_id = std::string(64, 'l');
+    lease.job_id = "job-0123456789";
+    lease.chunks.assign(size_t(kMaxSweepTasks), 0);  // every chunk of the largest split
+    lease.radiosity_input =
+        std::make_shared<const std::string>(std::string(kMaxInlineRadiosityBytes, '\x7f'));
+    pb::Task task;
+    ToProto(lease, &task);
+    EXPECT_GT(task.ByteSizeLong(), kMaxRequestBytes);
+    EXPECT_LE(task.ByteSizeLong(), kMaxLeaseBytes);
 }
 
 }  // namespace
