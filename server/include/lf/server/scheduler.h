@@ -440,8 +440,8 @@ class Scheduler {
     uint64_t Save(Job& job, const std::vector<int>& drop_results = {});
     // Wakes watchers to a change that is not written: a lease, a radiosity sweep's progress (a
     // restart queues the task again, and solves again from sweep 0). Writing the record for
-    // each of them cost the coordinator a third of its CPU on the Cornell box's radiosity job
-    // (about 40 tasks, each leased and completed).
+    // each of them cost the coordinator about a fifth of its CPU on the Cornell box's
+    // radiosity job (about 40 tasks, each leased and completed).
     void Announce(Job& job);
 
     const SchedulerOptions options_;
