@@ -10,7 +10,7 @@ absl::StatusOr<HealthPort> StartHealthPort(const std::string& listen) {
     builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
     HealthPort health;
     health.health = std::make_unique<HealthService>();
-    builder.RegisterCallbackGenericService(health.health.get());
+    builder.RegisterService(health.health.get());
     builder.AddListeningPort(listen, grpc::InsecureServerCredentials(), &health.port);
     health.server = builder.BuildAndStart();
     if (!health.server || health.port == 0) {

@@ -1,42 +1,40 @@
 #include "lf/server/health_service.h"
 
+#include <grpcpp/impl/rpc_service_method.h>
 #include <grpcpp/support/byte_buffer.h>
-
-#include <optional>
-#include <string>
+#include <grpcpp/support/method_handler.h>
+#include <grpcpp/support/sync_stream.h>
 
 namespace lf {
 
 namespace {
 
-// Answers one status (HealthCheckResponse{status}: field 1 as a varint, SERVING 1 and
-// NOT_SERVING 2) and ends the call; or ends it UNIMPLEMENTED. The request is never read.
-class OneAnswer final : public grpc::ServerGenericBidiReactor {
-  public:
-    explicit OneAnswer(std::optional<bool> serving) {
-        if (!serving) {
-            Finish(grpc::Status(grpc::StatusCode::UNIMPLEMENTED, ""));
-            return;
-        }
-        const char bytes[2] = {0x08, char(*serving ? 1 : 2)};
-        grpc::Slice slice(bytes, sizeof bytes);
-        answer_ = grpc::ByteBuffer(&slice, 1);
-        StartWriteAndFinish(&answer_, grpc::WriteOptions(), grpc::Status::OK);
-    }
-    void OnDone() override { delete this; }
-
-  private:
-    grpc::ByteBuffer answer_;
-};
+// HealthCheckResponse{status}: field 1 as a varint, SERVING 1 and NOT_SERVING 2.
+grpc::ByteBuffer Answer(bool serving) {
+    const char bytes[2] = {0x08, char(serving ? 1 : 2)};
+    grpc::Slice slice(bytes, sizeof bytes);
+    return grpc::ByteBuffer(&slice, 1);
+}
 
 }  // namespace
 
-grpc::ServerGenericBidiReactor* HealthService::CreateReactor(
-    grpc::GenericCallbackServerContext* context) {
-    const std::string& method = context->method();
-    const bool health =
-        method == "/grpc.health.v1.Health/Check" || method == "/grpc.health.v1.Health/Watch";
-    return new OneAnswer(health ? std::optional<bool>(serving_) : std::nullopt);
+HealthService::HealthService() {
+    using grpc::ByteBuffer;
+    using grpc::internal::RpcMethod;
+    // As bidi streams whose handler writes the answer and ends: the request is never read (a
+    // unary or split streamer would not write before it read), and a unary client takes the one
+    // message as its answer.
+    for (const char* method : {"/grpc.health.v1.Health/Check", "/grpc.health.v1.Health/Watch"}) {
+        AddMethod(new grpc::internal::RpcServiceMethod(
+            method, RpcMethod::BIDI_STREAMING,
+            new grpc::internal::BidiStreamingHandler<HealthService, ByteBuffer, ByteBuffer>(
+                [](HealthService* self, grpc::ServerContext*,
+                   grpc::ServerReaderWriter<ByteBuffer, ByteBuffer>* call) {
+                    call->Write(Answer(self->serving()));
+                    return grpc::Status::OK;
+                },
+                this)));
+    }
 }
 
 }  // namespace lf

@@ -217,7 +217,7 @@ int main(int argc, char** argv) {
     builder.AddListeningPort(listen, *credentials, &port);
     builder.RegisterService(&job_service);
     builder.RegisterService(&worker_service);
-    builder.RegisterCallbackGenericService(&health_service);
+    builder.RegisterService(&health_service);
     std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
     if (!server || port == 0) {
         std::fprintf(stderr,

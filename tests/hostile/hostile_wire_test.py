@@ -122,6 +122,19 @@ class HostileWire(unittest.TestCase):
             self.assertEqual(answer, b"\x08\x01", "SERVING")
         self.assert_memory_bounded(before, "3 health checks of 200 MB")
 
+    def test_health_watch_and_unknown_methods_answer_without_reading(self):
+        # Watch answers the state once and ends; a method the server does not serve is
+        # UNIMPLEMENTED. Neither reads what is sent.
+        before = vm_hwm_kb(self.server.pid)
+        body = string_field(200 * MB)
+        code, details, answer = self.call("/grpc.health.v1.Health/Watch", body)
+        self.assertEqual(code, grpc.StatusCode.OK, details)
+        self.assertEqual(answer, b"\x08\x01", "SERVING")
+        for method in ("/grpc.health.v1.Health/List", "/lightfarm.v1.NoSuchService/Call"):
+            code, details, _ = self.call(method, body)
+            self.assertEqual(code, grpc.StatusCode.UNIMPLEMENTED, f"{method}: {details}")
+        self.assert_memory_bounded(before, "a health watch and 2 unknown calls of 200 MB")
+
     def test_a_submitter_may_not_send_a_task_result(self):
         before = vm_hwm_kb(self.server.pid)
         code, details, _ = self.call("/lightfarm.v1.WorkerService/CompleteTask",

@@ -6,17 +6,22 @@
 // token, so one probe announcing 200 MB made the server hold them (gRPC 1.51 buffers a message
 // before its size limit applies, grpc/grpc#43012). This one never reads: the service name a
 // request may carry is not looked at, and every name answers the server's state, as "" does.
+//
+// It is a sync service, as the coordinator's others are. A callback service (gRPC's default
+// health service is one) starts gRPC's callback threads beside the sync server's, and then the
+// coordinator took a worker's call up to 90 ms late, in about half the Cornell box jobs on two
+// cores (tools/radiosity_bench.md, "A health service without callbacks").
 #pragma once
 
-#include <grpcpp/generic/async_generic_service.h>
+#include <grpcpp/impl/service_type.h>
 
 #include <atomic>
 
 namespace lf {
 
-class HealthService final : public grpc::CallbackGenericService {
+class HealthService final : public grpc::Service {
   public:
-    grpc::ServerGenericBidiReactor* CreateReactor(grpc::GenericCallbackServerContext*) override;
+    HealthService();
 
     void SetServing(bool serving) { serving_ = serving; }
     bool serving() const { return serving_; }
