@@ -75,6 +75,8 @@ class Worker {
     };
 
     void Execute(const TaskAssignment& task);
+    // A sweep (after the first) of chunks whose links this worker made for the task's job.
+    bool SweepsHeldLinks(const TaskAssignment& task) const;
     // The job's scene, built once for consecutive tasks of the same job.
     // Each returns Cancelled soon after `cancel` is set.
     absl::Status PrepareScene(const TaskAssignment& task, const std::atomic<bool>& cancel);
