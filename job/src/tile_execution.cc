@@ -73,6 +73,7 @@ absl::StatusOr<JobExecution::Merged> TileExecution::Merge(int task, const TaskRe
 
 std::optional<std::string> TileExecution::RecordOf(const TaskResult& result) const {
     if (!result.sums) return std::nullopt;  // not a tile's result: nothing to record
+    if (!result.encoded_sums.empty()) return std::string(result.encoded_sums);
     return EncodeTileSums(*result.sums);
 }
 

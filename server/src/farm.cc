@@ -253,6 +253,7 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     std::vector<TaskResult> results;
     for (size_t i = 0; i < wire.size(); ++i) {
         results.push_back({.sums = &sums[i],
+                           .encoded_sums = wire[i].tile_sums,
                            .splats = lists[i] ? &*lists[i] : nullptr,
                            .frame = parts.empty() ? frame : std::optional<int>(wire[i].frame),
                            .times = wire[i].times});

@@ -7,6 +7,7 @@
 
 #include <typeindex>
 
+#include "lf/core/tile_codec.h"
 #include "lf/job/adaptive_tile_execution.h"
 #include "lf/job/splat_execution.h"
 #include "lf/job/sweep_execution.h"
@@ -73,6 +74,36 @@ TEST(TileExecution, RecordedResultsMergeToTheSameImage) {
     }
     EXPECT_TRUE((*live)->Complete());
     EXPECT_TRUE((*restarted)->Complete());
+    const absl::StatusOr<Image> a = (*live)->SnapshotReader()();
+    const absl::StatusOr<Image> b = (*restarted)->SnapshotReader()();
+    ASSERT_TRUE(a.ok() && b.ok());
+    for (const char* c : {"R", "A.G", "B.B", "spp"}) {
+        EXPECT_EQ(*a->FindChannel(c), *b->FindChannel(c)) << c;
+    }
+}
+
+// The farm records a tile as the bytes it came in (TaskResult::encoded_sums), not encoded
+// again; a restart merges those to the same image as the sums it decoded from them.
+TEST(TileExecution, ARecordIsTheBytesTheSumsCameIn) {
+    auto live = TileExecution::Make({16, 8, 4, 8, 1}, MakeMemoryTileStore);
+    auto restarted = TileExecution::Make({16, 8, 4, 8, 1}, MakeMemoryTileStore);
+    ASSERT_TRUE(live.ok() && restarted.ok());
+    const std::string wire = EncodeTileSums(Flat(TaskOf(**live, 0), 0.25f, 0.75f));
+    const absl::StatusOr<TileSums> sums = DecodeTileSums(wire);
+    ASSERT_TRUE(sums.ok()) << sums.status();
+    ASSERT_TRUE((*live)->Merge(0, {.sums = &*sums, .encoded_sums = wire}).ok());
+    // Not the encoding of `sums` made again: given other bytes, the record is those.
+    TileSums other = *sums;
+    other.stats.samples += 1;
+    const std::string given = EncodeTileSums(other);
+    ASSERT_NE(given, wire);
+    const std::optional<std::string> record =
+        (*live)->RecordOf({.sums = &*sums, .encoded_sums = given});
+    EXPECT_EQ(record, given) << "the record is the bytes given";
+    const std::optional<std::string> own =
+        (*live)->RecordOf({.sums = &*sums, .encoded_sums = wire});
+    ASSERT_EQ(own, wire);
+    ASSERT_TRUE((*restarted)->MergeRecorded(0, *own).ok());
     const absl::StatusOr<Image> a = (*live)->SnapshotReader()();
     const absl::StatusOr<Image> b = (*restarted)->SnapshotReader()();
     ASSERT_TRUE(a.ok() && b.ok());
