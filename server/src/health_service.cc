@@ -30,6 +30,14 @@ HealthService::HealthService() {
             new grpc::internal::BidiStreamingHandler<HealthService, ByteBuffer, ByteBuffer>(
                 [](HealthService* self, grpc::ServerContext*,
                    grpc::ServerReaderWriter<ByteBuffer, ByteBuffer>* call) {
+                    struct InFlight {
+                        std::atomic<int>& n;
+                        ~InFlight() { --n; }
+                    } counted{self->in_flight_};
+                    if (++self->in_flight_ > kMaxCallsInFlight) {
+                        return grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                                            "too many health checks at once");
+                    }
                     call->Write(Answer(self->serving()));
                     return grpc::Status::OK;
                 },

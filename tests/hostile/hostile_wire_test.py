@@ -10,9 +10,12 @@ Environment (set by ctest): LF_BIN_DIR, the build's bin folder.
 
 import os
 import shutil
+import socket
+import struct
 import subprocess
 import tempfile
 import threading
+import time
 import unittest
 
 import grpc
@@ -39,6 +42,30 @@ def string_field(size):
         if not v:
             break
     return bytes(out) + b"x" * size
+
+
+def threads(pid):
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("Threads:"):
+                return int(line.split()[1])
+    raise AssertionError("no Threads")
+
+
+def h2_frame(kind, flags, stream, payload):
+    return struct.pack(">I", len(payload))[1:] + bytes([kind, flags]) + struct.pack(">I", stream) + payload
+
+
+def h2_unary_call(stream, authority, path):
+    """HEADERS (HPACK literals, no Huffman) and an empty gRPC message ending the stream."""
+    def literal(index, value):  # a literal value for the static table's name `index`
+        return bytes([index, len(value)]) + value.encode()
+
+    def new_name(name, value):
+        return bytes([0, len(name)]) + name.encode() + bytes([len(value)]) + value.encode()
+    headers = (b"\x83\x86" + literal(4, path) + literal(1, authority) +  # POST, http
+               new_name("content-type", "application/grpc") + new_name("te", "trailers"))
+    return h2_frame(1, 4, stream, headers) + h2_frame(0, 1, stream, b"\x00" * 5)
 
 
 def vm_hwm_kb(pid):
@@ -134,6 +161,27 @@ class HostileWire(unittest.TestCase):
             code, details, _ = self.call(method, body)
             self.assertEqual(code, grpc.StatusCode.UNIMPLEMENTED, f"{method}: {details}")
         self.assert_memory_bounded(before, "a health watch and 2 unknown calls of 200 MB")
+
+    def test_health_calls_that_cannot_be_answered_hold_a_bounded_number_of_threads(self):
+        # Raw HTTP/2: 300 health checks on a connection whose streams have a window of 0, so no
+        # answer can be sent. A sync handler waits for its answer to go out: past
+        # HealthService::kMaxCallsInFlight (32) at once, they are refused at once instead.
+        before = threads(self.server.pid)
+        host, port = self.address.rsplit(":", 1)
+        with socket.create_connection((host, int(port))) as s:
+            s.sendall(b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" +
+                      h2_frame(4, 0, 0, struct.pack(">HI", 4, 0)))  # INITIAL_WINDOW_SIZE 0
+            for i in range(300):
+                s.sendall(h2_unary_call(2 * i + 1, self.address, "/grpc.health.v1.Health/Check"))
+            s.sendall(h2_frame(4, 1, 0, b""))  # the server's settings, acknowledged
+            time.sleep(2)
+            held = threads(self.server.pid) - before
+            print(f"300 health checks that cannot be answered: {held} more threads")
+            self.assertLess(held, 32 + 16, "a thread per unanswerable health check")
+        # Once that client is gone, checks answer again.
+        code, details, answer = self.call("/grpc.health.v1.Health/Check", b"")
+        self.assertEqual(code, grpc.StatusCode.OK, details)
+        self.assertEqual(answer, b"\x08\x01", "SERVING")
 
     def test_a_submitter_may_not_send_a_task_result(self):
         before = vm_hwm_kb(self.server.pid)

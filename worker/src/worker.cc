@@ -161,7 +161,7 @@ void Worker::Execute(const TaskAssignment& task) {
     // The first goes at once: it tells the coordinator the task was taken (a lease that expires
     // before any heartbeat is held against the worker, not the task). But a sweep of links this
     // worker holds is a few milliseconds of arithmetic on what it computed already: its result
-    // says the same, so its first heartbeat waits an interval (two RPCs a sweep fewer).
+    // says the same, so its first heartbeat waits an interval (one RPC a worker and sweep fewer).
     std::mutex hb_mutex;
     std::condition_variable hb_wake;
     bool task_over = false;

@@ -41,9 +41,10 @@ namespace lf {
 // task: a tile's sums, a splat task's camera sums and splats, a patch-group task's sweep chunk.
 struct TaskResult {
     const TileSums* sums = nullptr;
-    // The bytes `sums` was decoded from (lf::DecodeTileSums), when the caller has them: a tile's
-    // record is then those bytes, not an encoding of `sums` made again (1.7 MB a 128x128 tile,
-    // under the scheduler's lock).
+    // The bytes `sums` was decoded from (lf::DecodeTileSums), valid for the call, when the
+    // caller has them: a tile's record is then those bytes, not an encoding of `sums` made
+    // again (1.7 MB a 128x128 tile, under the scheduler's lock). They decode to `sums`, in
+    // whichever version of the encoding the worker sent.
     std::string_view encoded_sums;
     SplatList* splats = nullptr;  // coalesced by the merge
     // A radiosity sweep task's: one result a chunk of its lease, in that order.

@@ -21,6 +21,11 @@ namespace lf {
 
 class HealthService final : public grpc::Service {
   public:
+    // A sync handler holds a server thread until its answer is sent, and a client that opens no
+    // HTTP/2 window holds it until the client goes: 300 such calls held 300 threads. Beyond this
+    // many at once, a call answers UNAVAILABLE at once (a status, which no window holds back).
+    static constexpr int kMaxCallsInFlight = 32;
+
     HealthService();
 
     void SetServing(bool serving) { serving_ = serving; }
@@ -28,6 +33,7 @@ class HealthService final : public grpc::Service {
 
   private:
     std::atomic<bool> serving_{true};
+    std::atomic<int> in_flight_{0};
 };
 
 }  // namespace lf
