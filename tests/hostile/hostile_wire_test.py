@@ -44,14 +44,6 @@ def string_field(size):
     return bytes(out) + b"x" * size
 
 
-def threads(pid):
-    with open(f"/proc/{pid}/status") as f:
-        for line in f:
-            if line.startswith("Threads:"):
-                return int(line.split()[1])
-    raise AssertionError("no Threads")
-
-
 def h2_frame(kind, flags, stream, payload):
     return struct.pack(">I", len(payload))[1:] + bytes([kind, flags]) + struct.pack(">I", stream) + payload
 
@@ -68,12 +60,20 @@ def h2_unary_call(stream, authority, path):
     return h2_frame(1, 4, stream, headers) + h2_frame(0, 1, stream, b"\x00" * 5)
 
 
-def vm_hwm_kb(pid):
+def proc_status(pid, field):
     with open(f"/proc/{pid}/status") as f:
         for line in f:
-            if line.startswith("VmHWM:"):
+            if line.startswith(field + ":"):
                 return int(line.split()[1])
-    raise AssertionError("no VmHWM")
+    raise AssertionError(f"no {field}")
+
+
+def vm_hwm_kb(pid):
+    return proc_status(pid, "VmHWM")
+
+
+def threads(pid):
+    return proc_status(pid, "Threads")
 
 
 class HostileWire(unittest.TestCase):
