@@ -71,7 +71,7 @@ absl::StatusOr<std::unique_ptr<SqliteJobStore>> SqliteJobStore::Open(const std::
     // SQLite to overwrite every deleted byte, which wrote a job's task results (1.7 MB a
     // 128x128 tile) again when it succeeded, in the commit that ends it (19.5 ms of the Cornell
     // box's 1.6 s); FAST still clears deleted records on the tree's pages, not the overflow
-    // pages of large results.
+    // pages of large ones (task results, large job specs) until SQLite reuses them.
     absl::Status s = Exec(db,
                           "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"
                           "PRAGMA busy_timeout=5000; PRAGMA secure_delete=FAST;");
