@@ -276,8 +276,10 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
         radiosity_[done->job_id] = *radiosity;
     }
     for (int f : done->frames_completed) WriteFrame(done->job_id, f);
+    // The job's image is written while the last result's record is made durable: a restart
+    // before both finds the task not done and renders it again.
     if (done->job_rendered) FinishJob(done->job_id);
-    return absl::OkStatus();
+    return scheduler_.AwaitRecorded(*done);
 }
 
 std::string Farm::FramePathOf(const std::string& dir, const std::string& job_id, int frame) const {

@@ -847,19 +847,29 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     Log()->debug("job={} task={} done by {} ({}/{})", job.id(), t, LogSafe(worker),
                  job.record.tasks_done, job.record.tasks_total);
     completion.job_rendered = job.execution->Complete();
+    completion.unrecorded = Completion::Unrecorded{t, ticket};
     locked.lock.unlock();
-    // The worker hears "done" only once the result is durable.
-    if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) {
-        // The merge cannot be taken back, and a job whose results are not all recorded would not
-        // survive a restart: it fails here, and the worker hears why.
-        locked.lock.lock();
-        if (auto it = active_.find(completion.job_id); it != active_.end()) {
-            FailJob(*it->second,
-                    absl::StrCat("recording the result of task ", t, ": ", s.message()));
-        }
-        return absl::Status(s.code(), absl::StrCat("job=", completion.job_id, ": ", s.message()));
-    }
+    if (completion.job_rendered) return completion;  // recorded while the image is written
+    if (absl::Status s = AwaitRecorded(completion); !s.ok()) return s;
+    completion.unrecorded.reset();
     return completion;
+}
+
+absl::Status Scheduler::AwaitRecorded(const Completion& completion) {
+    if (!completion.unrecorded) return absl::OkStatus();
+    // The worker hears "done" only once the result is durable.
+    const absl::Status s = store_.WaitDurable(completion.unrecorded->ticket);
+    if (s.ok()) return s;
+    // The merge cannot be taken back, and a job whose results are not all recorded would not
+    // survive a restart: it fails here, and the worker hears why.
+    {
+        Locked locked(*this);
+        if (auto it = active_.find(completion.job_id); it != active_.end()) {
+            FailJob(*it->second, absl::StrCat("recording the result of task ",
+                                              completion.unrecorded->task, ": ", s.message()));
+        }
+    }
+    return absl::Status(s.code(), absl::StrCat("job=", completion.job_id, ": ", s.message()));
 }
 
 absl::StatusOr<Scheduler::LeaseRef> Scheduler::ResultLease(const std::string& lease_id,

@@ -1019,6 +1019,45 @@ TEST(SchedulerLockTest, TasksAreHandedOnBeforeTheEndSettles) {
     cancel.join();
 }
 
+// A result is answered once its record is durable; the one that renders the job is not waited
+// for by Complete (the farm writes the image meanwhile) but by AwaitRecorded.
+TEST(SchedulerLockTest, TheLastResultIsRecordedWhileTheImageIsWritten) {
+    HeldStore store;
+    Scheduler scheduler({}, store);
+    const std::string id = *scheduler.Submit(SmallSpec(""));
+    std::vector<TaskAssignment> leases;
+    while (std::optional<TaskAssignment> l = scheduler.LeaseTask("w")) leases.push_back(*l);
+    ASSERT_GE(leases.size(), 2u);
+    const auto complete = [&](const TaskAssignment& lease) {
+        return scheduler.Complete(lease.lease_id, "w", testing::UniformResult(lease, Rgb(0.5f)));
+    };
+    store.Hold();
+    std::future<absl::StatusOr<Scheduler::Completion>> first =
+        std::async(std::launch::async, [&] { return complete(leases[0]); });
+    store.AwaitBlocked();  // an earlier result waits for its record
+    store.Release();
+    ASSERT_TRUE(first.get().ok());
+    for (size_t i = 1; i + 1 < leases.size(); ++i) ASSERT_TRUE(complete(leases[i]).ok());
+
+    store.Hold();
+    absl::StatusOr<Scheduler::Completion> last;
+    std::thread writer([&] { last = complete(leases.back()); });
+    writer.join();  // returned with the store held
+    ASSERT_TRUE(last.ok()) << last.status();
+    EXPECT_TRUE(last->job_rendered);
+    ASSERT_TRUE(last->unrecorded.has_value());
+    EXPECT_EQ(last->unrecorded->task, leases.back().task.index);
+    EXPECT_TRUE(scheduler.Snapshot(id).ok());  // the image can be written meanwhile
+    std::future<absl::Status> recorded =
+        std::async(std::launch::async, [&] { return scheduler.AwaitRecorded(*last); });
+    store.AwaitBlocked();
+    EXPECT_EQ(recorded.wait_for(std::chrono::milliseconds(50)), std::future_status::timeout);
+    store.Release();
+    EXPECT_TRUE(recorded.get().ok());
+    scheduler.Finish(id, std::string("/results/x.exr"));
+    EXPECT_EQ(store.Get(id)->state, JobState::kSucceeded);
+}
+
 // What WatchJob reads and waits for before it sends a job's end: the end settled, its record
 // durable. Until then GetSettled reads nothing, and a wait that began while the job ran (its
 // deadline beyond any test) goes on: at the end in memory, a requeue would still be refused.

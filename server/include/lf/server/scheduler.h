@@ -138,14 +138,26 @@ class Scheduler {
     // iterations fails the job.
     // `frames_completed`: a shot's frames the result completed, whose EXR the caller writes
     // (WriteFrame) before it learns the job is rendered.
+    // The result of the task that renders the job (`job_rendered`) is not waited for: its record
+    // becomes durable while the caller writes the job's image, and the caller calls
+    // AwaitRecorded before the worker hears "done".
     struct Completion {
         std::string job_id;
         bool job_rendered = false;
         std::optional<RadiositySolve::Outcome> sweep;
         std::vector<int> frames_completed;
+        struct Unrecorded {
+            int task = 0;
+            uint64_t ticket = 0;
+        };
+        std::optional<Unrecorded> unrecorded;
     };
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
                                         const TaskResult& result);
+    // Waits for a completion's record (Completion::unrecorded; none: at once). A record that
+    // could not be stored fails the job if it is still running (a restart would lack the
+    // result) and is the worker's answer.
+    absl::Status AwaitRecorded(const Completion& completion);
     // A tile's result, or a splat task's (`sums` its camera part, a 0x0 tile with the stats when
     // it has none, and `splats` its splat list).
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
