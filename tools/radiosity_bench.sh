@@ -143,7 +143,8 @@ echo "machine after: load average $(cut -d' ' -f1-3 /proc/loadavg)"
 [ "$farm_rounds" -gt 0 ] || exit 0
 
 # The farm: the Cornell box job, 256^2, --patch-size 0.02, from submit to the end of watch, on
-# two 1-thread workers, against the same render locally with 2 threads, round by round.
+# two 1-thread workers, against the same render locally with 2 threads, round by round. Also as
+# one command (`submit --watch`): the same job without the second client process.
 for tool in lightfarm-server lightfarm-worker; do
   [ -x "$bin/$tool" ] || { echo "$0: no $bin/$tool" >&2; exit 1; }
 done
@@ -160,6 +161,7 @@ for solver in "${solver_list[@]}"; do
   # shellcheck disable=SC2207  # radiosity_args prints separate words
   args=(--method radiosity --spp "$spp" $(radiosity_args cornell "$solver"))
   ratios=()
+  ratios_one=()
   for round in $(seq "$farm_rounds"); do
     t0="$(now)"
     "$bin/lightfarm" render "$scene" -o "$work/local.exr" --threads 2 --no-progress "${args[@]}" \
@@ -168,17 +170,26 @@ for solver in "${solver_list[@]}"; do
     job="$("$bin/lightfarm" submit "$scene" --server "$address" "${args[@]}" | tail -n 1)"
     "$bin/lightfarm" watch "$job" --server "$address" >/dev/null
     t2="$(now)"
+    "$bin/lightfarm" submit "$scene" --server "$address" "${args[@]}" --watch >/dev/null
+    t3="$(now)"
     # The farm promises local mode's bits: an RMSE of 0 between the two images.
     "$bin/lightfarm" fetch "$job" --server "$address" -o "$work/farm.exr" >/dev/null
     rmse=$("$bin/exr_compare" "$work/farm.exr" "$work/local.exr" --rmse |
       awk '{ for (i = 1; i < NF; i++) if ($i == "rmse") print $(i + 1) }')
     local_s=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", b - a }')
     farm_s=$(awk -v a="$t1" -v b="$t2" 'BEGIN { printf "%.2f", b - a }')
+    one_s=$(awk -v a="$t2" -v b="$t3" 'BEGIN { printf "%.2f", b - a }')
     ratios+=("$(awk -v l="$local_s" -v f="$farm_s" 'BEGIN { printf "%.3f", l / f }')")
+    ratios_one+=("$(awk -v l="$local_s" -v f="$one_s" 'BEGIN { printf "%.3f", l / f }')")
     echo "farm $solver round $round: local (2 threads) ${local_s} s, farm (2 x 1 thread)" \
-      "${farm_s} s submit..watch, throughput farm/local ${ratios[-1]}, rmse farm-local $rmse"
+      "${farm_s} s submit..watch (${one_s} s submit --watch), throughput farm/local" \
+      "${ratios[-1]} (${ratios_one[-1]}), rmse farm-local $rmse"
   done
-  echo "farm $solver: median throughput farm/local $(printf '%s\n' "${ratios[@]}" | sort -n |
-    awk '{r[NR] = $1} END {print (NR % 2) ? r[(NR + 1) / 2] : (r[NR / 2] + r[NR / 2 + 1]) / 2}')" \
-    "(target >= 0.90); load average $(cut -d' ' -f1-3 /proc/loadavg)"
+  median() {
+    printf '%s\n' "$@" | sort -n |
+      awk '{r[NR] = $1} END {print (NR % 2) ? r[(NR + 1) / 2] : (r[NR / 2] + r[NR / 2 + 1]) / 2}'
+  }
+  echo "farm $solver: median throughput farm/local $(median "${ratios[@]}") (target >= 0.90)" \
+    "($(median "${ratios_one[@]}") with submit --watch); load average" \
+    "$(cut -d' ' -f1-3 /proc/loadavg)"
 done

@@ -364,17 +364,19 @@ Command AddWatchCommand(CLI::App& app) {
     cmd->add_option("job", *id, "job id")->required();
     AddServerOption(cmd, *flags);
     AddRetryOption(cmd, *flags);
-    return {cmd, [flags, id] {
-                ProgressBar bar(*id);
-                absl::StatusOr<pb::Job> job = FarmClient(*flags).Watch(*id, bar);
-                bar.Finish();
-                if (!job.ok()) return ReportError(job.status());
-                std::printf("job %s %s (%d/%d tasks%s, %d retried)%s%s\n", job->id().c_str(),
-                            StateName(job->state()).c_str(), job->tasks_done(), job->tasks_total(),
-                            FramesDone(*job).c_str(), job->retries(),
-                            job->error().empty() ? "" : ": ", job->error().c_str());
-                return job->state() == pb::Job::SUCCEEDED ? 0 : 1;
-            }};
+    return {cmd, [flags, id] { return WatchJob(*flags, *id); }};
+}
+
+int WatchJob(const FarmFlags& flags, const std::string& job_id) {
+    ProgressBar bar(job_id);
+    absl::StatusOr<pb::Job> job = FarmClient(flags).Watch(job_id, bar);
+    bar.Finish();
+    if (!job.ok()) return ReportError(job.status());
+    std::printf("job %s %s (%d/%d tasks%s, %d retried)%s%s\n", job->id().c_str(),
+                StateName(job->state()).c_str(), job->tasks_done(), job->tasks_total(),
+                FramesDone(*job).c_str(), job->retries(), job->error().empty() ? "" : ": ",
+                job->error().c_str());
+    return job->state() == pb::Job::SUCCEEDED ? 0 : 1;
 }
 
 Command AddFetchCommand(CLI::App& app) {

@@ -57,6 +57,7 @@ absl::StatusOr<std::map<std::string, std::string>> ReadSceneFiles(const fs::path
 
 struct SubmitOptions {
     FarmFlags farm;
+    bool watch = false;  // --watch: follow the job to its end, as `lightfarm watch`
     std::string scene_path;
     JobSpec spec;      // the scene and files are filled in by Submit
     std::string tags;  // --tags, into spec.tags
@@ -118,6 +119,10 @@ Command AddSubmitCommand(CLI::App& app) {
     AddSkyFlag(cmd, o->spec.scene_options);
     AddServerOption(cmd, o->farm);
     AddRetryOption(cmd, o->farm);
+    cmd->add_flag("--watch", o->watch,
+                  "after printing the job's id, follow it to its end as `lightfarm watch` does "
+                  "(progress bar on a terminal, how it ended), with watch's exit status: 0 only "
+                  "when it succeeded");
     auto frame_flags = std::make_shared<FrameFlags>();
     AddFrameFlags(cmd, *frame_flags);
     cmd->add_option("--spp", o->spec.plan.spp, "samples per pixel")
@@ -223,7 +228,9 @@ Command AddSubmitCommand(CLI::App& app) {
                 absl::StatusOr<std::string> id = Submit(*o);
                 if (!id.ok()) return ReportError(id.status());
                 std::printf("%s\n", id->c_str());
-                return 0;
+                if (!o->watch) return 0;
+                std::fflush(stdout);  // the id first, for a script reading it as the job runs
+                return WatchJob(o->farm, *id);
             }};
 }
 

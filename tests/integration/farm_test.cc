@@ -497,6 +497,30 @@ std::vector<std::string> FirstColumn(const std::string& table) {
     return column;
 }
 
+// `submit --watch` prints the job's id first (a script reads it while the job runs), then
+// follows the job to its end as `watch` does, with watch's exit status.
+TEST_F(Farm, SubmitWithWatchPrintsTheIdThenFollowsTheJobToItsEnd) {
+    StartServer();
+    StartWorker("w1");
+    const CliRun done = Farmctl("submit " + scene_ + " --spp 2 --tile 16 --watch");
+    ASSERT_EQ(done.status, 0) << done.out << done.err;
+    const std::string id = done.out.substr(0, done.out.find('\n'));
+    ASSERT_EQ(id.rfind("job-", 0), 0u) << done.out;
+    EXPECT_EQ(done.LastLine().rfind("job " + id + " succeeded (", 0), 0u) << done.out;
+
+    // Without a free worker the job waits: cancelled meanwhile, it ends the command with 1.
+    Child* waiting = Spawn({std::string(LF_BIN_DIR) + "/lightfarm", "submit", scene_, "--spp", "2",
+                            "--tags", "gpu", "--watch", "--server", address_},
+                           "submit-watch.log");
+    const std::string queued = waiting->ReadLine(milliseconds(20000));
+    ASSERT_EQ(queued.rfind("job-", 0), 0u) << queued;
+    ASSERT_EQ(Farmctl("cancel " + queued).status, 0);
+    EXPECT_EQ(waiting->Wait(milliseconds(20000)), std::optional<int>(1))
+        << ReadText(dir_ / "submit-watch.log");
+    const std::string ended = waiting->ReadLine(milliseconds(5000));
+    EXPECT_EQ(ended.rfind("job " + queued + " cancelled", 0), 0u) << ended;
+}
+
 // Issue 27: two workers on one host both showed as the host name in `workers`, while `tasks`
 // named them by id. Both tables name a worker by the one identity the server knows it by.
 TEST_F(Farm, WorkersAndTasksNameTwoWorkersOfOneHostAlike) {
