@@ -1,73 +1,52 @@
 #include "lf/core/volume_grid.h"
 
-#include <openvdb/io/Stream.h>
-#include <openvdb/math/Maps.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/Dense.h>
+#include <dlfcn.h>
+#include <unistd.h>
 
-#include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <exception>
-#include <sstream>
+#include <filesystem>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_join.h"
+#include "lf/core/vdb_reader.h"
 
 namespace lf {
 namespace {
 
-// Why the box [lo, hi] (inclusive) holds too many lattice points for a dense copy, or "".
-// Each side is below 2^33, so the product in double is exact near the bound.
-// Lattice coordinates beyond this would overflow the int arithmetic of lookups (VolumeGrid::At
-// subtracts the box's corner, the majorant grid rounds up past it).
-constexpr int kMaxLatticeCoordinate = 1 << 30;
-
-std::string TooLarge(const openvdb::Coord& lo, const openvdb::Coord& hi) {
-    double points = 1;
-    for (int a = 0; a < 3; ++a) points *= std::max(0.0, double(hi[a]) - lo[a] + 1);
-    if (points == 0) return "";  // an empty box (OpenVDB's is inverted): nothing to copy
-    if (points <= double(kMaxVolumeGridPoints)) {
-        for (int a = 0; a < 3; ++a) {
-            if (std::abs(int64_t(lo[a])) > kMaxLatticeCoordinate ||
-                std::abs(int64_t(hi[a])) > kMaxLatticeCoordinate) {
-                return absl::StrCat("[", lo[0], ", ", lo[1], ", ", lo[2], "] .. [", hi[0], ", ",
-                                    hi[1], ", ", hi[2],
-                                    "], beyond the lattice coordinates of +-2^30");
-            }
-        }
-        return "";
-    }
-    return absl::StrCat(int64_t(hi[0]) - lo[0] + 1, " x ", int64_t(hi[1]) - lo[1] + 1, " x ",
-                        int64_t(hi[2]) - lo[2] + 1, " voxels, above the limit of ",
-                        kMaxVolumeGridPoints, " (2^28)");
-}
-
-// The bounding box the writer recorded (Grid::addStatsMetadata), when it did: TooLarge's
-// verdict on it.
-std::string RecordedTooLarge(const openvdb::GridBase& grid) {
-    const auto lo = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
-    const auto hi = grid.getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
-    if (!lo || !hi) return "";
-    return TooLarge(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
-}
-
-// An exception's text for a message: OpenVDB may quote whatever a forged file holds.
-std::string Brief(const char* what) {
-    std::string text(what);
-    constexpr size_t kMaxChars = 200;
-    if (text.size() > kMaxChars) text = text.substr(0, kMaxChars) + "...";
-    return text;
-}
-
 // OpenVDB's maps act on row vectors (world = index * M): M's transpose is our M.
-Affine FromVdb(const openvdb::Mat4d& m) {
+Affine FromVdb(const std::array<std::array<double, 4>, 4>& m) {
     Affine a;
     for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 4; ++c) a.m[r][c] = m(c, r);
+        for (int c = 0; c < 4; ++c) a.m[size_t(r)][size_t(c)] = m[size_t(c)][size_t(r)];
     }
     return a;
+}
+
+// liblf_vdb.so's entry point, loaded once (and never unloaded: the grids it made free their
+// memory through it).
+absl::StatusOr<ReadVdbGridFunction> LoadVdbModule() {
+    std::error_code error;
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+    if (error) {
+        return absl::FailedPreconditionError(
+            absl::StrCat("reading OpenVDB grids: cannot tell where this program is (",
+                         error.message(), ") to find ", kVdbModuleFile));
+    }
+    std::string tried;
+    for (const std::filesystem::path& dir :
+         {exe.parent_path(), exe.parent_path() / kVdbModuleInstallDir}) {
+        const std::string path = (dir / kVdbModuleFile).lexically_normal().string();
+        if (void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) {
+            if (void* read = dlsym(module, kReadVdbGridSymbol)) {
+                return reinterpret_cast<ReadVdbGridFunction>(read);
+            }
+        }
+        const char* why = dlerror();
+        absl::StrAppend(&tried, tried.empty() ? "" : "; ", why ? why : path);
+    }
+    return absl::FailedPreconditionError(absl::StrCat(
+        "reading OpenVDB grids needs ", kVdbModuleFile, " beside the lightfarm binaries or in ",
+        kVdbModuleInstallDir, " from them (docs/deploy.md): ", tried));
 }
 
 }  // namespace
@@ -77,84 +56,19 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
                                                                  const std::string& grid_name,
                                                                  const Affine& medium_transform) {
     // Thread-safe once: a static's initialisation.
-    [[maybe_unused]] static const bool initialized = (openvdb::initialize(), true);
-    const std::string where = absl::StrCat(file_name, " grid \"", grid_name, "\"");
-    auto invalid = [&](const std::string& why) {
-        return absl::InvalidArgumentError(absl::StrCat(where, ": ", why));
+    static const absl::StatusOr<ReadVdbGridFunction> read = LoadVdbModule();
+    if (!read.ok()) return read.status();
+    VdbGridRead got;
+    (*read)(bytes, file_name, grid_name, got);
+    if (!got.status.ok()) return got.status;
+    auto out = std::make_shared<VolumeGrid>(std::move(got.grid));
+    const auto invalid = [&](const std::string& why) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(file_name, " grid \"", grid_name, "\": ", why));
     };
-    int32_t magic = 0;
-    if (bytes.size() >= sizeof(magic)) std::memcpy(&magic, bytes.data(), sizeof(magic));
-    if (magic != openvdb::OPENVDB_MAGIC) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(file_name, ": not a readable OpenVDB file (no .vdb header)"));
-    }
-    openvdb::GridBase::Ptr base;
-    try {
-        std::istringstream in(bytes);
-        // OpenVDB does not check every read: past the end of a truncated or forged file it goes
-        // on with sizes it never read (a blosc block of ~10^14 bytes, say). A stream that
-        // throws at the first short read stops it there. Everything is read now, not delayed:
-        // delayed loading reads the values later from a temporary copy of the file, through a
-        // stream of its own that does not throw. The tree costs at most a few dozen times the
-        // file's bytes (a leaf of 512 values takes at least its 64-byte mask and origin in the
-        // file), which the blob limits bound; the dense copy is checked before it is made.
-        in.exceptions(std::ios::failbit | std::ios::badbit);
-        openvdb::io::Stream stream(in, /*delayLoad=*/false);
-        const openvdb::GridPtrVecPtr grids = stream.getGrids();
-        std::vector<std::string> names;
-        for (const openvdb::GridBase::Ptr& g : *grids) {
-            if (g->getName() == grid_name && !base) base = g;
-            names.push_back(absl::StrCat("\"", g->getName(), "\" (", g->valueType(), ")"));
-        }
-        if (!base) {
-            return invalid(absl::StrCat("no such grid; the file has ",
-                                        names.empty() ? "none" : absl::StrJoin(names, ", ")));
-        }
-    } catch (const std::exception& e) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(file_name, ": not a readable OpenVDB file (", Brief(e.what()), ")"));
-    }
-    const openvdb::FloatGrid::Ptr grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
-    if (!grid) {
-        return invalid(absl::StrCat("a ", base->valueType(), " grid; media read float grids only"));
-    }
-    if (const std::string why = RecordedTooLarge(*grid); !why.empty()) {
-        return invalid("its metadata gives a bounding box of " + why);
-    }
-    if (!grid->transform().isLinear()) {
-        return invalid(absl::StrCat("a ", grid->transform().mapType(),
-                                    " transform; media read grids with affine transforms only"));
-    }
-
-    auto out = std::make_shared<VolumeGrid>();
-    out->name = absl::StrCat(file_name, "#", grid_name);
-    out->background = grid->background();
-    if (!(std::isfinite(out->background) && out->background >= 0)) {
-        return invalid(
-            absl::StrCat("background ", out->background, ": expected a finite value >= 0"));
-    }
-    const openvdb::math::AffineMap::ConstPtr map = grid->transform().baseMap()->getAffineMap();
-    out->index_to_world = FromVdb(map->getMat4()).Then(medium_transform);
+    out->index_to_world = FromVdb(got.index_to_world).Then(medium_transform);
     out->world_to_index = out->index_to_world.Inverse();
     if (!out->world_to_index.IsFinite()) return invalid("its transform is singular");
-
-    try {
-        const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
-        if (const std::string why = TooLarge(box.min(), box.max()); !why.empty()) {
-            return invalid("its active voxels span a bounding box of " + why);
-        }
-        // No active voxel: everything reads the background.
-        if (box.empty()) return std::shared_ptr<const VolumeGrid>(std::move(out));
-        for (int a = 0; a < 3; ++a) {
-            out->min[a] = box.min()[a];
-            out->size[a] = box.max()[a] - box.min()[a] + 1;
-        }
-        out->values.resize(size_t(out->size[0]) * size_t(out->size[1]) * size_t(out->size[2]));
-        openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, out->values.data());
-        openvdb::tools::copyToDense(*grid, dense);
-    } catch (const std::exception& e) {
-        return invalid(absl::StrCat("its voxels cannot be read (", Brief(e.what()), ")"));
-    }
     for (size_t i = 0; i < out->values.size(); ++i) {
         const float v = out->values[i];
         if (std::isfinite(v) && v >= 0) continue;

@@ -59,6 +59,11 @@ def fail(path, message):
     errors.append(f"{rel(path) if os.path.isabs(path) else path}: {message}")
 
 
+# The module the binaries load to read OpenVDB grids, and where from (lf/core/vdb_reader.h).
+VDB_MODULE = "liblf_vdb.so"
+VDB_MODULE_DIR = "../lib/lightfarm"
+
+
 def binary(name):
     return os.path.join(BIN_DIR, name)
 
@@ -307,14 +312,26 @@ def check_dockerfile(stages, pki):
             fail(DOCKERFILE, f"target {target}: no COPY --from=... {exe} {entry[0]}")
         if (s["user"] or "").split(":")[0] not in (UID, "lightfarm"):
             fail(DOCKERFILE, f"target {target}: USER {s['user']}, not {UID} (lightfarm)")
-        other = [c for c in s["copy"] if "--from" in c and f"/{exe}" not in c]
+        # The OpenVDB module goes where the binary looks for it (lf/core/vdb_reader.h):
+        # ../lib/lightfarm from the binary's directory.
+        module_path = os.path.normpath(os.path.join(os.path.dirname(entry[0]), VDB_MODULE_DIR,
+                                                    VDB_MODULE))
+        if not any(re.search(rf"--from=\S+\s+\S*/{VDB_MODULE}\s+{re.escape(module_path)}$", c)
+                   for c in s["copy"]):
+            fail(DOCKERFILE, f"target {target}: no COPY --from=... {VDB_MODULE} {module_path} "
+                             f"(reading OpenVDB grids needs it)")
+        other = [c for c in s["copy"]
+                 if "--from" in c and f"/{exe}" not in c and f"/{VDB_MODULE}" not in c]
         if other:
-            fail(DOCKERFILE, f"target {target}: copies more than its binary: {other}")
-        linked = linked_packages(exe)
-        if linked is not None:
+            fail(DOCKERFILE, f"target {target}: copies more than its binary and "
+                             f"{VDB_MODULE}: {other}")
+        for program in (exe, VDB_MODULE):
+            linked = linked_packages(program)
+            if linked is None:
+                continue
             missing = linked - BASE_PACKAGES - installed_packages(s, stages)
             if missing:
-                fail(DOCKERFILE, f"target {target}: {exe} links libraries of "
+                fail(DOCKERFILE, f"target {target}: {program} links libraries of "
                                  f"{', '.join(sorted(missing))}, which it does not install")
         images[target] = {"exe": exe, "entry": entry, "cmd": s["cmd"] or [],
                           "expose": s["expose"], "volume": s["volume"]}

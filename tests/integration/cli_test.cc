@@ -34,14 +34,19 @@ struct RunResult {
     std::string output;  // stdout and stderr
 };
 
-RunResult Lightfarm(const std::string& args) {
-    const std::string cmd = std::string(LF_BIN_DIR) + "/lightfarm " + args + " 2>&1";
+// `command` (a shell command line), its stderr with its stdout.
+RunResult RunCommand(const std::string& command) {
+    const std::string cmd = command + " 2>&1";
     FILE* pipe = popen(cmd.c_str(), "r");
     std::string out;
     char buf[4096];
     while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
     const int status = pclose(pipe);
     return {WEXITSTATUS(status), out};
+}
+
+RunResult Lightfarm(const std::string& args) {
+    return RunCommand(std::string(LF_BIN_DIR) + "/lightfarm " + args);
 }
 
 class Cli : public ::testing::Test {
@@ -626,6 +631,41 @@ TEST_F(Cli, PlanListsMediaAndMethodsRefuseWhatTheyDoNotRender) {
             << command << "\n"
             << refused.output;
     }
+}
+
+// OpenVDB is loaded with liblf_vdb.so when a grid is read, not at every start: the programs do
+// not link it, and one without the module beside it renders everything else and says what a
+// grid needs.
+TEST_F(Cli, OpenVdbIsLoadedOnlyToReadAGrid) {
+    for (const char* program : {"lightfarm", "lightfarm-server", "lightfarm-worker"}) {
+        const RunResult linked = RunCommand("ldd " + std::string(LF_BIN_DIR) + "/" + program);
+        ASSERT_EQ(linked.status, 0) << linked.output;
+        EXPECT_EQ(linked.output.find("libopenvdb"), std::string::npos) << program;
+    }
+    fs::create_directories(dir_ / "alone");
+    fs::copy_file(fs::path(LF_BIN_DIR) / "lightfarm", dir_ / "alone" / "lightfarm");
+    const std::string alone = (dir_ / "alone" / "lightfarm").string();
+    const RunResult cornell =
+        RunCommand(alone + " plan " + std::string(LF_TEST_SCENES) +
+                   "/cornell_box.json --pilot-spp 2 " + "--resolution 16x16 --threads 1");
+    EXPECT_EQ(cornell.status, 0) << cornell.output;
+    std::ofstream(dir_ / "smoke.vdb", std::ios::binary)
+        << testing::VdbBytes({testing::ConstantGrid("density", 0.5f, 4, 0.25)});
+    const std::string scene = Write("smoke.json", R"({
+      "camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 40,
+                 "resolution": [8, 8]},
+      "materials": {"boundary": {"type": "interface"}},
+      "media": {"smoke": {"type": "grid", "file": "smoke.vdb", "sigma_a": [1, 1, 1]}},
+      "shapes": [{"type": "sphere", "material": "boundary", "center": [0, 0, 0],
+                  "radius": 0.5, "interior": "smoke"}],
+      "lights": [{"type": "environment", "radiance": [1, 1, 1]}]})");
+    const RunResult refused = RunCommand(alone + " plan " + scene + " --pilot-spp 2 --threads 1");
+    EXPECT_NE(refused.status, 0) << refused.output;
+    EXPECT_NE(refused.output.find("reading OpenVDB grids needs liblf_vdb.so"), std::string::npos)
+        << refused.output;
+    const RunResult read = Lightfarm("plan " + scene + " --pilot-spp 2 --threads 1");
+    EXPECT_EQ(read.status, 0) << read.output;
+    EXPECT_NE(read.output.find("smoke.vdb#density 4x4x4"), std::string::npos) << read.output;
 }
 
 TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {
