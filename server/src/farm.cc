@@ -86,7 +86,7 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
             farm->WriteFrame(job_id, frame);
         }
     }
-    for (const std::string& job_id : *rendered) farm->FinishJob(job_id);
+    for (const std::string& job_id : *rendered) (void)farm->FinishJob(job_id);
     if (absl::StatusOr<int> expired = farm->DeleteExpired(absl::Now()); !expired.ok()) {
         return expired.status();
     }
@@ -278,7 +278,7 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     for (int f : done->frames_completed) WriteFrame(done->job_id, f);
     // The job's image is written while the last result's record is made durable: a restart
     // before both finds the task not done and renders it again.
-    if (done->job_rendered) FinishJob(done->job_id);
+    if (done->job_rendered) return FinishJob(done->job_id, &*done);
     return scheduler_.AwaitRecorded(*done);
 }
 
@@ -344,7 +344,9 @@ absl::Status Farm::WriteSnapshot(const std::string& job_id, bool complete,
     return WriteImage(*snapshot, complete, path);
 }
 
-void Farm::FinishJob(const std::string& job_id) {
+absl::Status Farm::FinishJob(const std::string& job_id, const Scheduler::Completion* last) {
+    // The job ends only once every result is recorded: one that is not fails it (AwaitRecorded).
+    const auto recorded = [&] { return last ? scheduler_.AwaitRecorded(*last) : absl::OkStatus(); };
     absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
     if (job.ok() && job->spec.shot.frames) {
         // Its frames are its result, each written as it completed; those a restart or a time
@@ -353,11 +355,12 @@ void Farm::FinishJob(const std::string& job_id) {
             if (id == job_id) WriteFrame(job_id, frame);
         }
         job = scheduler_.Get(job_id);
-        if (job.ok() && IsFinal(job->state)) return;  // a frame's write failed it
+        if (job.ok() && IsFinal(job->state)) return recorded();  // a frame's write failed it
+        if (absl::Status s = recorded(); !s.ok()) return s;
         scheduler_.Finish(job_id, job.ok() && !job->frames.empty()
                                       ? absl::StatusOr<std::string>(job->frames.back().result_path)
                                       : absl::StatusOr<std::string>(job.status()));
-        return;
+        return absl::OkStatus();
     }
     const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
     const absl::Status written = WriteSnapshot(job_id, true, path);
@@ -367,14 +370,20 @@ void Farm::FinishJob(const std::string& job_id) {
         sweep_solves_.erase(job_id);
         sweep_links_.erase(job_id);
     }
-    if (absl::IsFailedPrecondition(written)) return;  // cancelled meanwhile
+    if (absl::IsFailedPrecondition(written)) return recorded();  // cancelled meanwhile
+    if (absl::Status s = recorded(); !s.ok()) {
+        std::error_code ignored;  // nothing may serve the image of a failed job
+        if (written.ok()) fs::remove(path, ignored);
+        return s;
+    }
     scheduler_.Finish(job_id, written.ok() ? absl::StatusOr<std::string>(path)
                                            : absl::StatusOr<std::string>(written));
+    return absl::OkStatus();
 }
 
 void Farm::CheckTimers() {
     scheduler_.ExpireLeases();
-    for (const std::string& job_id : scheduler_.EnforceTimeLimits()) FinishJob(job_id);
+    for (const std::string& job_id : scheduler_.EnforceTimeLimits()) (void)FinishJob(job_id);
 }
 
 absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete,
@@ -684,7 +693,7 @@ absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id,
         frames ? scheduler_.RequeueFrames(job_id, *frames, remove_files)
                : scheduler_.RequeueJob(job_id);
     if (!requeued.ok()) return requeued.status();
-    if (requeued->rendered) FinishJob(job_id);
+    if (requeued->rendered) (void)FinishJob(job_id);
     return requeued->record;
 }
 

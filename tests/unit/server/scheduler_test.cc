@@ -1040,9 +1040,12 @@ TEST(SchedulerLockTest, TheLastResultIsRecordedWhileTheImageIsWritten) {
     for (size_t i = 1; i + 1 < leases.size(); ++i) ASSERT_TRUE(complete(leases[i]).ok());
 
     store.Hold();
-    absl::StatusOr<Scheduler::Completion> last;
-    std::thread writer([&] { last = complete(leases.back()); });
-    writer.join();  // returned with the store held
+    std::future<absl::StatusOr<Scheduler::Completion>> answered =
+        std::async(std::launch::async, [&] { return complete(leases.back()); });
+    const bool returned = answered.wait_for(std::chrono::seconds(30)) == std::future_status::ready;
+    if (!returned) store.Release();  // a Complete that waited again: fail, not hang
+    ASSERT_TRUE(returned) << "Complete waited for the last result's record";
+    const absl::StatusOr<Scheduler::Completion> last = answered.get();
     ASSERT_TRUE(last.ok()) << last.status();
     EXPECT_TRUE(last->job_rendered);
     ASSERT_TRUE(last->unrecorded.has_value());

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "absl/strings/str_cat.h"
 #include "lease_results.h"
 #include "lf/job/shot.h"
 #include "lf/server/farm.h"
@@ -393,6 +394,33 @@ TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs)
     store.fail = false;
     EXPECT_EQ(scheduler.Get(done)->state, JobState::kSucceeded);
     EXPECT_EQ(store.Get(running)->state, JobState::kRunning) << "so it runs after a restart";
+}
+
+// The result that renders the job is answered by AwaitRecorded (the farm writes the image
+// meanwhile): a record that fails there fails the job, which has not ended yet.
+TEST_F(SqliteJobStoreTest, LastResultThatCannotBeRecordedFailsTheJobBeforeItEnds) {
+    FailingStore store;
+    Scheduler scheduler({}, store);
+    const std::string id = *scheduler.Submit(Spec());
+    std::vector<TaskAssignment> leases;
+    while (std::optional<TaskAssignment> l = scheduler.LeaseTask("w")) leases.push_back(*l);
+    ASSERT_GE(leases.size(), 2u);
+    for (size_t i = 0; i + 1 < leases.size(); ++i) {
+        ASSERT_TRUE(scheduler.Complete(leases[i].lease_id, "w", Result(leases[i])).ok());
+    }
+    store.fail = true;
+    const absl::StatusOr<Scheduler::Completion> last =
+        scheduler.Complete(leases.back().lease_id, "w", Result(leases.back()));
+    ASSERT_TRUE(last.ok()) << last.status();
+    ASSERT_TRUE(last->job_rendered);
+    EXPECT_EQ(scheduler.Get(id)->state, JobState::kRunning) << "not failed before the wait";
+    const absl::Status recorded = scheduler.AwaitRecorded(*last);
+    EXPECT_EQ(recorded.code(), absl::StatusCode::kResourceExhausted);
+    EXPECT_EQ(scheduler.Get(id)->state, JobState::kFailed);
+    EXPECT_NE(scheduler.Get(id)->error.find(
+                  absl::StrCat("recording the result of task ", leases.back().task.index, ": ")),
+              std::string::npos)
+        << scheduler.Get(id)->error;
 }
 
 TEST_F(SqliteJobStoreTest, UnusableDataDirIsAClearError) {

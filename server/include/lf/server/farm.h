@@ -177,7 +177,10 @@ class Farm {
     // error estimates only when `complete` (a preview has pixels without samples).
     absl::Status WriteImage(const Scheduler::JobImage& snapshot, bool complete,
                             const std::string& path);
-    void FinishJob(const std::string& job_id);
+    // Writes the job's result and ends it. `last`: the completion that rendered it, whose record
+    // is awaited after the image is written and before the job ends (a record that failed fails
+    // the job instead, and its image is removed); its status is the worker's answer.
+    absl::Status FinishJob(const std::string& job_id, const Scheduler::Completion* last = nullptr);
     // Writes a shot's complete frame `frame` as results/JOB.frame<N>.exr, its header the frame's
     // (MetadataOf(FrameSpec)), and records it; a failed write fails the job.
     void WriteFrame(const std::string& job_id, int frame);

@@ -155,8 +155,8 @@ class Scheduler {
     absl::StatusOr<Completion> Complete(const std::string& lease_id, const std::string& worker,
                                         const TaskResult& result);
     // Waits for a completion's record (Completion::unrecorded; none: at once). A record that
-    // could not be stored fails the job if it is still running (a restart would lack the
-    // result) and is the worker's answer.
+    // could not be stored fails the job while it still runs (a restart would lack the result),
+    // so the caller awaits it before Finish; the error is the worker's answer.
     absl::Status AwaitRecorded(const Completion& completion);
     // A tile's result, or a splat task's (`sums` its camera part, a 0x0 tile with the stats when
     // it has none, and `splats` its splat list).
