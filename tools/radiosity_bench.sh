@@ -152,6 +152,10 @@ done
 source tools/farm_common.sh
 start_farm radiosity_bench
 now() { date +%s.%N; }
+median() {
+  printf '%s\n' "$@" | sort -n |
+    awk '{r[NR] = $1} END {print (NR % 2) ? r[(NR + 1) / 2] : (r[NR / 2] + r[NR / 2 + 1]) / 2}'
+}
 scene="$PWD/tests/scenes/cornell_box.json"
 for solver in "${solver_list[@]}"; do
   if [ "$solver" != flat ] && [ "$hierarchical_built" = 0 ]; then
@@ -162,33 +166,44 @@ for solver in "${solver_list[@]}"; do
   args=(--method radiosity --spp "$spp" $(radiosity_args cornell "$solver"))
   ratios=()
   ratios_one=()
+  # submit + watch (the job's id kept for the comparison with local mode's image) and
+  # submit --watch, in turn first and second from round to round.
+  two_commands() {
+    job="$("$bin/lightfarm" submit "$scene" --server "$address" "${args[@]}" | tail -n 1)"
+    "$bin/lightfarm" watch "$job" --server "$address" >/dev/null
+  }
+  one_command() {
+    "$bin/lightfarm" submit "$scene" --server "$address" "${args[@]}" --watch >/dev/null
+  }
+  # timed VAR FUNCTION: FUNCTION's seconds into VAR (not in a subshell: two_commands sets job).
+  timed() {
+    local start
+    start="$(now)"
+    "$2"
+    printf -v "$1" '%s' "$(awk -v a="$start" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }')"
+  }
   for round in $(seq "$farm_rounds"); do
     t0="$(now)"
     "$bin/lightfarm" render "$scene" -o "$work/local.exr" --threads 2 --no-progress "${args[@]}" \
       >/dev/null 2>&1
-    t1="$(now)"
-    job="$("$bin/lightfarm" submit "$scene" --server "$address" "${args[@]}" | tail -n 1)"
-    "$bin/lightfarm" watch "$job" --server "$address" >/dev/null
-    t2="$(now)"
-    "$bin/lightfarm" submit "$scene" --server "$address" "${args[@]}" --watch >/dev/null
-    t3="$(now)"
+    local_s=$(awk -v a="$t0" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }')
+    if [ $((round % 2)) = 1 ]; then
+      timed farm_s two_commands
+      timed one_s one_command
+    else
+      timed one_s one_command
+      timed farm_s two_commands
+    fi
     # The farm promises local mode's bits: an RMSE of 0 between the two images.
     "$bin/lightfarm" fetch "$job" --server "$address" -o "$work/farm.exr" >/dev/null
     rmse=$("$bin/exr_compare" "$work/farm.exr" "$work/local.exr" --rmse |
       awk '{ for (i = 1; i < NF; i++) if ($i == "rmse") print $(i + 1) }')
-    local_s=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", b - a }')
-    farm_s=$(awk -v a="$t1" -v b="$t2" 'BEGIN { printf "%.2f", b - a }')
-    one_s=$(awk -v a="$t2" -v b="$t3" 'BEGIN { printf "%.2f", b - a }')
     ratios+=("$(awk -v l="$local_s" -v f="$farm_s" 'BEGIN { printf "%.3f", l / f }')")
     ratios_one+=("$(awk -v l="$local_s" -v f="$one_s" 'BEGIN { printf "%.3f", l / f }')")
     echo "farm $solver round $round: local (2 threads) ${local_s} s, farm (2 x 1 thread)" \
       "${farm_s} s submit..watch (${one_s} s submit --watch), throughput farm/local" \
       "${ratios[-1]} (${ratios_one[-1]}), rmse farm-local $rmse"
   done
-  median() {
-    printf '%s\n' "$@" | sort -n |
-      awk '{r[NR] = $1} END {print (NR % 2) ? r[(NR + 1) / 2] : (r[NR / 2] + r[NR / 2 + 1]) / 2}'
-  }
   echo "farm $solver: median throughput farm/local $(median "${ratios[@]}") (target >= 0.90)" \
     "($(median "${ratios_one[@]}") with submit --watch); load average" \
     "$(cut -d' ' -f1-3 /proc/loadavg)"

@@ -1,14 +1,15 @@
 #include "lf/core/volume_grid.h"
 
 #include <dlfcn.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
+#include <mutex>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "lf/core/vdb_reader.h"
+#include "lf/version.h"
 
 namespace lf {
 namespace {
@@ -22,8 +23,7 @@ Affine FromVdb(const std::array<std::array<double, 4>, 4>& m) {
     return a;
 }
 
-// liblf_vdb.so's entry point, loaded once (and never unloaded: the grids it made free their
-// memory through it).
+// liblf_vdb.so's entry point, from the first place that has a module of this build.
 absl::StatusOr<ReadVdbGridFunction> LoadVdbModule() {
     std::error_code error;
     const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
@@ -33,20 +33,45 @@ absl::StatusOr<ReadVdbGridFunction> LoadVdbModule() {
                          error.message(), ") to find ", kVdbModuleFile));
     }
     std::string tried;
+    const auto refuse = [&](void* module, const std::string& why) {
+        if (module) dlclose(module);
+        absl::StrAppend(&tried, tried.empty() ? "" : "; ", why);
+    };
     for (const std::filesystem::path& dir :
          {exe.parent_path(), exe.parent_path() / kVdbModuleInstallDir}) {
         const std::string path = (dir / kVdbModuleFile).lexically_normal().string();
-        if (void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) {
-            if (void* read = dlsym(module, kReadVdbGridSymbol)) {
-                return reinterpret_cast<ReadVdbGridFunction>(read);
-            }
+        void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+        if (!module) {
+            const char* why = dlerror();  // no such file, or a library it needs is missing
+            refuse(nullptr, why ? why : path);
+            continue;
         }
-        const char* why = dlerror();
-        absl::StrAppend(&tried, tried.empty() ? "" : "; ", why ? why : path);
+        const auto build = reinterpret_cast<VdbBuildFunction>(dlsym(module, kVdbBuildSymbol));
+        const auto read = reinterpret_cast<ReadVdbGridFunction>(dlsym(module, kReadVdbGridSymbol));
+        if (!build || !read) {
+            refuse(module, absl::StrCat(path, ": not lightfarm's OpenVDB module"));
+        } else if (const std::string its = build(); its != kBuildVersion) {
+            // It passes C++ objects: another build's layout would be read as this one's.
+            refuse(module, absl::StrCat(path, ": of build ", its));
+        } else {
+            return read;  // never unloaded: OpenVDB registers its types globally
+        }
     }
-    return absl::FailedPreconditionError(absl::StrCat(
-        "reading OpenVDB grids needs ", kVdbModuleFile, " beside the lightfarm binaries or in ",
-        kVdbModuleInstallDir, " from them (docs/deploy.md): ", tried));
+    return absl::FailedPreconditionError(
+        absl::StrCat("reading OpenVDB grids: no ", kVdbModuleFile, " of this build (",
+                     kBuildVersion, ") beside this program or in ", kVdbModuleInstallDir,
+                     " from it (docs/deploy.md): ", tried));
+}
+
+// Found once; a failure is tried again at the next grid (a module installed meanwhile).
+absl::StatusOr<ReadVdbGridFunction> VdbModule() {
+    static std::mutex mutex;
+    static ReadVdbGridFunction found = nullptr;
+    std::lock_guard<std::mutex> lock(mutex);
+    if (found) return found;
+    absl::StatusOr<ReadVdbGridFunction> loaded = LoadVdbModule();
+    if (loaded.ok()) found = *loaded;
+    return loaded;
 }
 
 }  // namespace
@@ -55,8 +80,7 @@ absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::stri
                                                                  const std::string& file_name,
                                                                  const std::string& grid_name,
                                                                  const Affine& medium_transform) {
-    // Thread-safe once: a static's initialisation.
-    static const absl::StatusOr<ReadVdbGridFunction> read = LoadVdbModule();
+    const absl::StatusOr<ReadVdbGridFunction> read = VdbModule();
     if (!read.ok()) return read.status();
     VdbGridRead got;
     (*read)(bytes, file_name, grid_name, got);

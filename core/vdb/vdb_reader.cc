@@ -17,6 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "lf/core/volume_grid.h"
+#include "lf/version.h"
 
 namespace lf {
 namespace {
@@ -127,6 +128,11 @@ absl::Status Read(const std::string& bytes, const std::string& file_name,
     for (int r = 0; r < 4; ++r) {
         for (int c = 0; c < 4; ++c) out.index_to_world[size_t(r)][size_t(c)] = m(r, c);
     }
+    // Before the copy, which may be large: LoadVolumeGrid checks the inverse with the medium's
+    // transform too.
+    if (const double det = m.getMat3().det(); !(std::isfinite(det) && det != 0)) {
+        return invalid("its transform is singular");
+    }
 
     try {
         const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
@@ -151,14 +157,22 @@ absl::Status Read(const std::string& bytes, const std::string& file_name,
 }  // namespace
 }  // namespace lf
 
-// Nothing escapes: every exception OpenVDB throws is caught above, or the call below says so.
-extern "C" void lf_read_vdb_grid(const std::string& bytes, const std::string& file_name,
-                                 const std::string& grid_name, lf::VdbGridRead& out) {
+// No exception leaves the module: those OpenVDB throws are caught above, any other here.
+extern "C" __attribute__((visibility("default"))) void lf_read_vdb_grid(
+    const std::string& bytes, const std::string& file_name, const std::string& grid_name,
+    lf::VdbGridRead& out) {
     static_assert(std::is_same_v<decltype(&lf_read_vdb_grid), lf::ReadVdbGridFunction>);
+    const std::string failed = absl::StrCat(file_name, ": reading grid \"", grid_name, "\" failed");
     try {
         out.status = lf::Read(bytes, file_name, grid_name, out);
     } catch (const std::exception& e) {
-        out.status = absl::InternalError(absl::StrCat(file_name, ": reading grid \"", grid_name,
-                                                      "\" failed: ", lf::Brief(e.what())));
+        out.status = absl::InternalError(absl::StrCat(failed, ": ", lf::Brief(e.what())));
+    } catch (...) {
+        out.status = absl::InternalError(failed);
     }
+}
+
+extern "C" __attribute__((visibility("default"))) const char* lf_vdb_build() {
+    static_assert(std::is_same_v<decltype(&lf_vdb_build), lf::VdbBuildFunction>);
+    return lf::kBuildVersion;
 }

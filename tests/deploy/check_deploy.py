@@ -316,7 +316,8 @@ def check_dockerfile(stages, pki):
         # ../lib/lightfarm from the binary's directory.
         module_path = os.path.normpath(os.path.join(os.path.dirname(entry[0]), VDB_MODULE_DIR,
                                                     VDB_MODULE))
-        if not any(re.search(rf"--from=\S+\s+\S*/{VDB_MODULE}\s+{re.escape(module_path)}$", c)
+        if not any(re.search(rf"--from=\S+\s+\S*/{re.escape(VDB_MODULE)}\s+"
+                             rf"{re.escape(module_path)}$", c)
                    for c in s["copy"]):
             fail(DOCKERFILE, f"target {target}: no COPY --from=... {VDB_MODULE} {module_path} "
                              f"(reading OpenVDB grids needs it)")

@@ -1,7 +1,7 @@
 // The OpenVDB side of LoadVolumeGrid (lf/core/volume_grid.h), built as its own module,
-// liblf_vdb.so, that LoadVolumeGrid loads (dlopen) on first use. Loading OpenVDB's library binds
-// about 57,000 symbols, 22 of the 35 ms every lightfarm process took to start; now only a process
-// that reads a .vdb file pays it.
+// liblf_vdb.so, that LoadVolumeGrid loads (dlopen) on first use: loading OpenVDB's library binds
+// tens of thousands of symbols, most of a lightfarm program's start, so only a process that
+// reads a .vdb file pays it (docs/architecture.md).
 #pragma once
 
 #include <array>
@@ -12,8 +12,8 @@
 
 namespace lf {
 
-// The module's file name, and where LoadVolumeGrid looks for it: beside the executable, then in
-// ../lib/lightfarm from it (an install with the binaries in bin/).
+// The module's file name, and where LoadVolumeGrid looks for it: beside the executable (its
+// real path, symlinks resolved), then in ../lib/lightfarm from there (binaries in bin/).
 inline constexpr char kVdbModuleFile[] = "liblf_vdb.so";
 inline constexpr char kVdbModuleInstallDir[] = "../lib/lightfarm";
 
@@ -27,10 +27,12 @@ struct VdbGridRead {
     std::array<std::array<double, 4>, 4> index_to_world{};
 };
 
-// The module's one entry point, by name (kReadVdbGridSymbol), compiled with the same compiler
-// and libraries as the executables that load it.
+// The module's entry points, by name. It passes C++ objects, so a module is used only by a
+// program of its own build: kVdbBuildSymbol returns the module's lf::kBuildVersion.
 using ReadVdbGridFunction = void (*)(const std::string& bytes, const std::string& file_name,
                                      const std::string& grid_name, VdbGridRead& out);
 inline constexpr char kReadVdbGridSymbol[] = "lf_read_vdb_grid";
+using VdbBuildFunction = const char* (*)();
+inline constexpr char kVdbBuildSymbol[] = "lf_vdb_build";
 
 }  // namespace lf
