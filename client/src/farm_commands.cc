@@ -364,12 +364,15 @@ Command AddWatchCommand(CLI::App& app) {
     cmd->add_option("job", *id, "job id")->required();
     AddServerOption(cmd, *flags);
     AddRetryOption(cmd, *flags);
-    return {cmd, [flags, id] { return WatchJob(*flags, *id); }};
+    return {cmd, [flags, id] {
+                FarmClient client(*flags);
+                return WatchJob(client, *id);
+            }};
 }
 
-int WatchJob(const FarmFlags& flags, const std::string& job_id) {
+int WatchJob(FarmClient& client, const std::string& job_id) {
     ProgressBar bar(job_id);
-    absl::StatusOr<pb::Job> job = FarmClient(flags).Watch(job_id, bar);
+    absl::StatusOr<pb::Job> job = client.Watch(job_id, bar);
     bar.Finish();
     if (!job.ok()) return ReportError(job.status());
     std::printf("job %s %s (%d/%d tasks%s, %d retried)%s%s\n", job->id().c_str(),

@@ -63,7 +63,7 @@ struct SubmitOptions {
     std::string tags;  // --tags, into spec.tags
 };
 
-absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
+absl::StatusOr<std::string> Submit(const SubmitOptions& o, FarmClient& client) {
     const fs::path scene_path(o.scene_path);
     absl::StatusOr<std::string> scene_text = ReadFile(o.scene_path);
     // It exists (CLI::ExistingFile): say only that it cannot be read, as submit always has.
@@ -98,7 +98,7 @@ absl::StatusOr<std::string> Submit(const SubmitOptions& o) {
     // gets the job of the first attempt.
     spec.request_id = Sha256Hex(
         absl::StrCat(absl::ToUnixNanos(absl::Now()), "/", ::getpid(), "/", scene_path.string()));
-    return FarmClient(o.farm).Submit(spec, blobs);
+    return client.Submit(spec, blobs);
 }
 
 }  // namespace
@@ -225,12 +225,13 @@ Command AddSubmitCommand(CLI::App& app) {
                     return ReportError(s);
                 }
                 o->spec.tags = *ParseTags(o->tags, "--tags");  // checked by the flag
-                absl::StatusOr<std::string> id = Submit(*o);
+                FarmClient client(o->farm);
+                absl::StatusOr<std::string> id = Submit(*o, client);
                 if (!id.ok()) return ReportError(id.status());
                 std::printf("%s\n", id->c_str());
                 if (!o->watch) return 0;
                 std::fflush(stdout);  // the id first, for a script reading it as the job runs
-                return WatchJob(o->farm, *id);
+                return WatchJob(client, *id);  // on the same connection
             }};
 }
 

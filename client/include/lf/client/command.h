@@ -18,11 +18,6 @@ struct Command {
 // Prints "lightfarm: error: <message>" and returns 1.
 int ReportError(const absl::Status& status);
 
-struct FarmFlags;
-// `lightfarm watch JOB` (and `submit --watch`): follows the job to its end, with a progress bar
-// on a terminal, and prints how it ended; 0 only when it succeeded.
-int WatchJob(const FarmFlags& flags, const std::string& job_id);
-
 Command AddRenderCommand(CLI::App& app);
 Command AddBenchCommand(CLI::App& app);
 Command AddConvergeCommand(CLI::App& app);

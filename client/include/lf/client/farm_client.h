@@ -79,4 +79,9 @@ class FarmClient {
     std::unique_ptr<lightfarm::v1::JobService::Stub> stub_;
 };
 
+// `lightfarm watch JOB` (and `submit --watch`, on the connection it submitted on): follows the
+// job to its end, with a progress bar on a terminal, and prints how it ended; returns the exit
+// status, 0 only when it succeeded.
+int WatchJob(FarmClient& client, const std::string& job_id);
+
 }  // namespace lf
