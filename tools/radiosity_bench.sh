@@ -166,6 +166,8 @@ for solver in "${solver_list[@]}"; do
   args=(--method radiosity --spp "$spp" $(radiosity_args cornell "$solver"))
   ratios=()
   ratios_one=()
+  farm_s=
+  one_s=
   # submit + watch (the job's id kept for the comparison with local mode's image) and
   # submit --watch, in turn first and second from round to round.
   two_commands() {

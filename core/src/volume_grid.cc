@@ -32,9 +32,11 @@ absl::StatusOr<ReadVdbGridFunction> LoadVdbModule() {
             absl::StrCat("reading OpenVDB grids: cannot tell where this program is (",
                          error.message(), ") to find ", kVdbModuleFile));
     }
+    // A module opened is never closed, not even one refused: closing would run the destructors
+    // of OpenVDB's and its libraries' globals. Opened again it is the same one (refused again
+    // until the program restarts); a missing one is looked for again at the next grid.
     std::string tried;
-    const auto refuse = [&](void* module, const std::string& why) {
-        if (module) dlclose(module);
+    const auto refuse = [&](const std::string& why) {
         absl::StrAppend(&tried, tried.empty() ? "" : "; ", why);
     };
     for (const std::filesystem::path& dir :
@@ -43,23 +45,23 @@ absl::StatusOr<ReadVdbGridFunction> LoadVdbModule() {
         void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
         if (!module) {
             const char* why = dlerror();  // no such file, or a library it needs is missing
-            refuse(nullptr, why ? why : path);
+            refuse(why ? why : path);
             continue;
         }
         const auto build = reinterpret_cast<VdbBuildFunction>(dlsym(module, kVdbBuildSymbol));
         const auto read = reinterpret_cast<ReadVdbGridFunction>(dlsym(module, kReadVdbGridSymbol));
         if (!build || !read) {
-            refuse(module, absl::StrCat(path, ": not lightfarm's OpenVDB module"));
-        } else if (const std::string its = build(); its != kBuildVersion) {
+            refuse(absl::StrCat(path, ": not lightfarm's OpenVDB module"));
+        } else if (const std::string its = build(); its != VdbModuleBuild()) {
             // It passes C++ objects: another build's layout would be read as this one's.
-            refuse(module, absl::StrCat(path, ": of build ", its));
+            refuse(absl::StrCat(path, ": of build ", its));
         } else {
-            return read;  // never unloaded: OpenVDB registers its types globally
+            return read;
         }
     }
     return absl::FailedPreconditionError(
         absl::StrCat("reading OpenVDB grids: no ", kVdbModuleFile, " of this build (",
-                     kBuildVersion, ") beside this program or in ", kVdbModuleInstallDir,
+                     VdbModuleBuild(), ") beside this program or in ", kVdbModuleInstallDir,
                      " from it (docs/deploy.md): ", tried));
 }
 

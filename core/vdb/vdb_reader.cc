@@ -123,8 +123,13 @@ absl::Status Read(const std::string& bytes, const std::string& file_name,
     if (!(std::isfinite(g.background) && g.background >= 0)) {
         return invalid(absl::StrCat("background ", g.background, ": expected a finite value >= 0"));
     }
-    const openvdb::math::AffineMap::ConstPtr map = grid->transform().baseMap()->getAffineMap();
-    const openvdb::Mat4d m = map->getMat4();
+    openvdb::Mat4d m;
+    try {
+        // Made from a scale map's matrix, which OpenVDB refuses when it is nearly singular.
+        m = grid->transform().baseMap()->getAffineMap()->getMat4();
+    } catch (const std::exception&) {
+        return invalid("its transform is singular");
+    }
     for (int r = 0; r < 4; ++r) {
         for (int c = 0; c < 4; ++c) out.index_to_world[size_t(r)][size_t(c)] = m(r, c);
     }
@@ -174,5 +179,6 @@ extern "C" __attribute__((visibility("default"))) void lf_read_vdb_grid(
 
 extern "C" __attribute__((visibility("default"))) const char* lf_vdb_build() {
     static_assert(std::is_same_v<decltype(&lf_vdb_build), lf::VdbBuildFunction>);
-    return lf::kBuildVersion;
+    static const std::string build = lf::VdbModuleBuild();
+    return build.c_str();
 }

@@ -861,14 +861,15 @@ absl::Status Scheduler::AwaitRecorded(const Completion& completion) {
     const absl::Status s = store_.WaitDurable(completion.unrecorded->ticket);
     if (s.ok()) return s;
     // The merge cannot be taken back, and a job whose results are not all recorded would not
-    // survive a restart: it fails here, and the worker hears why. Only the job that merged the
-    // result holds its task as done: one requeued since the job ended does not (it reads the
-    // recorded results), and is left alone.
+    // survive a restart: it fails here, and the worker hears why. The job that merged the result
+    // holds its task as done; one requeued since it ended (cancelled during this wait) reads the
+    // recorded results, so it does not, unless it rendered the task again meanwhile.
     {
         Locked locked(*this);
         const int t = completion.unrecorded->task;
         if (auto it = active_.find(completion.job_id);
-            it != active_.end() && it->second->states.state(t) == TaskState::kDone) {
+            it != active_.end() && size_t(t) < it->second->states.size() &&
+            it->second->states.state(t) == TaskState::kDone) {
             FailJob(*it->second,
                     absl::StrCat("recording the result of task ", t, ": ", s.message()));
         }

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/cleanup/cleanup.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "image_files.h"
@@ -646,6 +647,7 @@ TEST_F(Cli, OpenVdbIsLoadedOnlyToReadAGrid) {
     const fs::path root =
         fs::path(LF_BIN_DIR).parent_path() / ("cli_vdb_" + std::to_string(::getpid()));
     fs::remove_all(root);
+    const absl::Cleanup remove_copies = [&root] { fs::remove_all(root); };
     fs::create_directories(root / "alone");
     fs::create_directories(root / "install" / "bin");
     fs::create_directories(root / "install" / "lib" / "lightfarm");
@@ -682,7 +684,6 @@ TEST_F(Cli, OpenVdbIsLoadedOnlyToReadAGrid) {
         EXPECT_NE(read.output.find("smoke.vdb#density 4x4x4"), std::string::npos) << program << "\n"
                                                                                   << read.output;
     }
-    fs::remove_all(root);
 }
 
 TEST_F(Cli, PlanSaysWhatItWillModelAndWhatItCosts) {

@@ -9,6 +9,7 @@
 
 #include "absl/status/status.h"
 #include "lf/core/medium.h"
+#include "lf/version.h"
 
 namespace lf {
 
@@ -28,11 +29,13 @@ struct VdbGridRead {
 };
 
 // The module's entry points, by name. It passes C++ objects, so a module is used only by a
-// program of its own build: kVdbBuildSymbol returns the module's lf::kBuildVersion.
+// program of its own build: kVdbBuildSymbol returns the module's VdbModuleBuild().
 using ReadVdbGridFunction = void (*)(const std::string& bytes, const std::string& file_name,
                                      const std::string& grid_name, VdbGridRead& out);
 inline constexpr char kReadVdbGridSymbol[] = "lf_read_vdb_grid";
 using VdbBuildFunction = const char* (*)();
 inline constexpr char kVdbBuildSymbol[] = "lf_vdb_build";
+// The commit and the configuration (compiler, flags) a program or module was built at.
+inline std::string VdbModuleBuild() { return std::string(kBuildVersion) + ", " + kBuildConfig; }
 
 }  // namespace lf

@@ -19,8 +19,8 @@ inline constexpr int64_t kMaxVolumeGridPoints = int64_t(1) << 28;
 // VolumeGrid::name): its active voxel bounding box copied densely, its background, and
 // index_to_world its own (affine) transform followed by `medium_transform`. InvalidArgument for
 // bytes that are not a .vdb file, a missing grid (the message lists the file's grids), a grid of
-// another value type, a frustum transform, more than kMaxVolumeGridPoints lattice points, and
-// negative or non-finite values (density, emission and temperature are all >= 0).
+// another value type, a frustum or singular transform, more than kMaxVolumeGridPoints lattice
+// points, and negative or non-finite values (density, emission and temperature are all >= 0).
 // FailedPrecondition when OpenVDB's module, liblf_vdb.so of this build, is not where
 // lf/core/vdb_reader.h says; Internal for an error OpenVDB raised outside its reads.
 absl::StatusOr<std::shared_ptr<const VolumeGrid>> LoadVolumeGrid(const std::string& bytes,
