@@ -78,15 +78,16 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
     if (!controls.ok()) return controls.status();
     for (const auto& [name, control] : *controls) farm->scheduler_.SetWorkerControl(name, control);
     farm->SweepTemporaryFiles();
-    absl::StatusOr<std::vector<std::string>> rendered = farm->scheduler_.Recover();
+    absl::StatusOr<std::vector<Scheduler::JobRun>> rendered = farm->scheduler_.Recover();
     if (!rendered.ok()) return rendered.status();
     // Frames complete before the restart whose EXR was not recorded, of shots still running.
     for (const auto& [job_id, frame] : farm->scheduler_.UnwrittenFrames()) {
-        if (std::find(rendered->begin(), rendered->end(), job_id) == rendered->end()) {
+        if (std::none_of(rendered->begin(), rendered->end(),
+                         [&](const Scheduler::JobRun& r) { return r.job_id == job_id; })) {
             farm->WriteFrame(job_id, frame);
         }
     }
-    for (const std::string& job_id : *rendered) (void)farm->FinishJob(job_id);
+    for (const Scheduler::JobRun& run : *rendered) (void)farm->FinishJob(run);
     if (absl::StatusOr<int> expired = farm->DeleteExpired(absl::Now()); !expired.ok()) {
         return expired.status();
     }
@@ -278,7 +279,7 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
     for (int f : done->frames_completed) WriteFrame(done->job_id, f);
     // The job's image is written while the last result's record is made durable: a restart
     // before both finds the task not done and renders it again.
-    if (done->job_rendered) return FinishJob(done->job_id, &*done);
+    if (done->job_rendered) return FinishJob({done->job_id, done->run}, &*done);
     return scheduler_.AwaitRecorded(*done);
 }
 
@@ -336,15 +337,19 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
     return absl::OkStatus();
 }
 
-absl::Status Farm::WriteSnapshot(const std::string& job_id, bool complete,
-                                 const std::string& path) {
+absl::Status Farm::WriteSnapshot(const std::string& job_id, bool complete, const std::string& path,
+                                 std::optional<uint64_t> run) {
     std::lock_guard<std::mutex> lock(image_mutex_);
     absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.Snapshot(job_id);
     if (!snapshot.ok()) return snapshot.status();
+    if (run && snapshot->run != *run) {
+        return absl::AbortedError(absl::StrCat("job ", job_id, " was cancelled and queued again"));
+    }
     return WriteImage(*snapshot, complete, path);
 }
 
-absl::Status Farm::FinishJob(const std::string& job_id, const Scheduler::Completion* last) {
+absl::Status Farm::FinishJob(const Scheduler::JobRun& rendered, const Scheduler::Completion* last) {
+    const std::string& job_id = rendered.job_id;
     // The job ends only once every result is recorded: one that is not fails it (AwaitRecorded).
     const auto recorded = [&] { return last ? scheduler_.AwaitRecorded(*last) : absl::OkStatus(); };
     absl::StatusOr<JobRecord> job = scheduler_.Get(job_id);
@@ -357,13 +362,16 @@ absl::Status Farm::FinishJob(const std::string& job_id, const Scheduler::Complet
         job = scheduler_.Get(job_id);
         if (job.ok() && IsFinal(job->state)) return recorded();  // a frame's write failed it
         if (absl::Status s = recorded(); !s.ok()) return s;
-        scheduler_.Finish(job_id, job.ok() && !job->frames.empty()
-                                      ? absl::StatusOr<std::string>(job->frames.back().result_path)
-                                      : absl::StatusOr<std::string>(job.status()));
+        scheduler_.Finish(rendered,
+                          job.ok() && !job->frames.empty()
+                              ? absl::StatusOr<std::string>(job->frames.back().result_path)
+                              : absl::StatusOr<std::string>(job.status()));
         return absl::OkStatus();
     }
     const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
-    const absl::Status written = WriteSnapshot(job_id, true, path);
+    const absl::Status written = WriteSnapshot(job_id, true, path, rendered.run);
+    // Cancelled and queued again meanwhile: that run writes its own image, with its figures.
+    if (absl::IsAborted(written)) return recorded();
     {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
         radiosity_.erase(job_id);
@@ -376,14 +384,14 @@ absl::Status Farm::FinishJob(const std::string& job_id, const Scheduler::Complet
         if (written.ok()) fs::remove(path, ignored);
         return s;
     }
-    scheduler_.Finish(job_id, written.ok() ? absl::StatusOr<std::string>(path)
-                                           : absl::StatusOr<std::string>(written));
+    scheduler_.Finish(rendered, written.ok() ? absl::StatusOr<std::string>(path)
+                                             : absl::StatusOr<std::string>(written));
     return absl::OkStatus();
 }
 
 void Farm::CheckTimers() {
     scheduler_.ExpireLeases();
-    for (const std::string& job_id : scheduler_.EnforceTimeLimits()) (void)FinishJob(job_id);
+    for (const Scheduler::JobRun& run : scheduler_.EnforceTimeLimits()) (void)FinishJob(run);
 }
 
 absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete,
@@ -693,7 +701,7 @@ absl::StatusOr<JobRecord> Farm::Requeue(const std::string& job_id,
         frames ? scheduler_.RequeueFrames(job_id, *frames, remove_files)
                : scheduler_.RequeueJob(job_id);
     if (!requeued.ok()) return requeued.status();
-    if (requeued->rendered) (void)FinishJob(job_id);
+    if (requeued->rendered) (void)FinishJob({job_id, requeued->run});
     return requeued->record;
 }
 

@@ -152,6 +152,7 @@ absl::StatusOr<std::string> Scheduler::Submit(const JobSpec& spec) {
     job->record.seq = next_seq_++;
     const uint64_t ticket = Save(*job);
     job->submit_ticket = ticket;
+    job->run = next_run_++;
     const std::string summary = job->execution->Summary();
     active_[id] = std::move(job);
     locked.lock.unlock();
@@ -319,7 +320,7 @@ SchedulerLoad Scheduler::Load() {
     return load;
 }
 
-absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
+absl::StatusOr<std::vector<Scheduler::JobRun>> Scheduler::Recover() {
     // The store is read before the lock is taken.
     struct Stored {
         JobRecord record;
@@ -342,7 +343,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
     }
     Locked locked(*this);
     next_seq_ = std::max(next_seq_, last_seq + 1);
-    std::vector<std::string> rendered;
+    std::vector<JobRun> rendered;
     for (Stored& s : stored) {
         if (active_.count(s.record.id)) continue;
         // One job that cannot be taken up (its task results unreadable, or a spec this build
@@ -354,7 +355,7 @@ absl::StatusOr<std::vector<std::string>> Scheduler::Recover() {
             FailUnrecoverable(std::move(s.record), done.status());
             continue;
         }
-        if (*done) rendered.push_back(id);
+        if (*done) rendered.push_back({id, active_.at(id)->run});
     }
     // A dependency whose failure was recorded before the restart, its dependents' not yet.
     std::vector<std::string> ids;
@@ -408,6 +409,7 @@ absl::StatusOr<bool> Scheduler::TakeUp(std::unique_ptr<Job> job,
                 job->record.tasks_done, job->record.tasks_total, job->record.tasks_leased);
     const bool rendered = EnforceTimeLimit(*job, clock_()) || job->execution->Complete();
     Save(*job);
+    job->run = next_run_++;
     active_[job->id()] = std::move(job);
     return rendered;
 }
@@ -427,7 +429,7 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::RequeueJob(const std::string& job
             job.record.last_error.clear();
             Log()->info("job={} requeued: {} failed tasks reset, blocklist cleared", job_id, reset);
             const uint64_t ticket = Save(job);
-            Requeued requeued{job.record, false};
+            Requeued requeued{job.record, job.run};
             locked.lock.unlock();
             if (absl::Status s = store_.WaitDurable(ticket); !s.ok()) return s;
             return requeued;
@@ -529,6 +531,7 @@ absl::StatusOr<Scheduler::Requeued> Scheduler::Reopen(const std::string& job_id,
                 frames ? absl::StrCat(" (frames ", FrameRangeText(*frames), " again)") : "");
     const uint64_t ticket = Save(job, dropped);
     requeued.record = job.record;
+    requeued.run = job.run;
     requeued.rendered = *rendered;
     // Leases and merges wait for the lock: no frame of this run is written yet.
     if (remove_files && !requeued.frames.empty()) remove_files(requeued.frames);
@@ -667,12 +670,12 @@ bool Scheduler::EnforceTimeLimit(Job& job, absl::Time now) {
     return !dropped->empty() && job.execution->Complete();
 }
 
-std::vector<std::string> Scheduler::EnforceTimeLimits() {
+std::vector<Scheduler::JobRun> Scheduler::EnforceTimeLimits() {
     Locked locked(*this);
-    std::vector<std::string> rendered;
+    std::vector<JobRun> rendered;
     const absl::Time now = clock_();
     for (auto& [id, job] : active_) {
-        if (EnforceTimeLimit(*job, now)) rendered.push_back(id);
+        if (EnforceTimeLimit(*job, now)) rendered.push_back({id, job->run});
     }
     return rendered;
 }
@@ -805,7 +808,7 @@ absl::StatusOr<Scheduler::Completion> Scheduler::Complete(const std::string& lea
     if (!ref.ok()) return ref.status();
     Job& job = *ref->job;
     const int t = ref->lease->task;
-    Completion completion{job.id(), false, std::nullopt};
+    Completion completion{job.id(), job.run};
     const TaskState state = job.states.state(t);
     if (state == TaskState::kDone || state == TaskState::kDropped) return completion;
     TaskResult made = result;
@@ -861,17 +864,15 @@ absl::Status Scheduler::AwaitRecorded(const Completion& completion) {
     const absl::Status s = store_.WaitDurable(completion.unrecorded->ticket);
     if (s.ok()) return s;
     // The merge cannot be taken back, and a job whose results are not all recorded would not
-    // survive a restart: it fails here, and the worker hears why. The job that merged the result
-    // holds its task as done; one requeued since it ended (cancelled during this wait) reads the
-    // recorded results, so it does not, unless it rendered the task again meanwhile.
+    // survive a restart: the run that merged it fails here, and the worker hears why. A run
+    // requeued since that one ended (cancelled during this wait) read the recorded results, and
+    // renders the task again.
     {
         Locked locked(*this);
-        const int t = completion.unrecorded->task;
         if (auto it = active_.find(completion.job_id);
-            it != active_.end() && size_t(t) < it->second->states.size() &&
-            it->second->states.state(t) == TaskState::kDone) {
-            FailJob(*it->second,
-                    absl::StrCat("recording the result of task ", t, ": ", s.message()));
+            it != active_.end() && it->second->run == completion.run) {
+            FailJob(*it->second, absl::StrCat("recording the result of task ",
+                                              completion.unrecorded->task, ": ", s.message()));
         }
     }
     return absl::Status(s.code(), absl::StrCat("job=", completion.job_id, ": ", s.message()));
@@ -1286,6 +1287,7 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::Snapshot(const std::string& job_i
         }
         const Job& job = *it->second;
         snapshot.record = job.record;
+        snapshot.run = job.run;
         read = job.execution->SnapshotReader();
         snapshot.adaptive = job.execution->TileReport();
     }
@@ -1308,6 +1310,7 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::FrameSnapshot(const std::string& 
             return absl::NotFoundError(absl::StrCat("job ", job_id, " renders no frame ", frame));
         }
         snapshot.record = job.record;
+        snapshot.run = job.run;
         snapshot.record.spec = FrameSpec(job.record.spec, frame);
         snapshot.record.stats = execution->stats();
         read = execution->SnapshotReader();
@@ -1354,10 +1357,11 @@ std::vector<std::pair<std::string, int>> Scheduler::UnwrittenFrames() const {
     return frames;
 }
 
-void Scheduler::Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path) {
+void Scheduler::Finish(const JobRun& rendered, const absl::StatusOr<std::string>& result_path) {
     Locked locked(*this);
+    const std::string& job_id = rendered.job_id;
     auto it = active_.find(job_id);
-    if (it == active_.end()) return;  // cancelled meanwhile
+    if (it == active_.end() || it->second->run != rendered.run) return;  // cancelled meanwhile
     Job& job = *it->second;
     if (!result_path.ok()) {
         FailJob(job, absl::StrCat("writing the result: ", result_path.status().message()));

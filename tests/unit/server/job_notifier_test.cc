@@ -92,14 +92,18 @@ class JobNotifierTest : public ::testing::Test {
         EXPECT_TRUE(id.ok()) << id.status();
         return *id;
     }
-    // Merges every task of the job, as workers' results would.
-    void RenderAll(const std::string& id) {
+    // Merges every task of the job, as workers' results would; the run they rendered.
+    Scheduler::JobRun RenderAll(const std::string& id) {
         Scheduler& s = farm_->scheduler();
+        Scheduler::JobRun rendered{id};
         while (std::optional<TaskAssignment> lease = s.LeaseTask("w")) {
-            ASSERT_EQ(lease->job_id, id);
-            ASSERT_TRUE(
-                s.Complete(lease->lease_id, "w", testing::UniformResult(*lease, Rgb(1))).ok());
+            EXPECT_EQ(lease->job_id, id);
+            absl::StatusOr<Scheduler::Completion> done =
+                s.Complete(lease->lease_id, "w", testing::UniformResult(*lease, Rgb(1)));
+            EXPECT_TRUE(done.ok()) << done.status();
+            if (done.ok()) rendered.run = done->run;
         }
+        return rendered;
     }
 
     Endpoint endpoint_;
@@ -109,11 +113,9 @@ class JobNotifierTest : public ::testing::Test {
 
 TEST_F(JobNotifierTest, SucceededAndFailedJobsArePosted) {
     const std::string good = Queue("good");
-    RenderAll(good);
-    farm_->scheduler().Finish(good, std::string("/results/good.exr"));
+    farm_->scheduler().Finish(RenderAll(good), std::string("/results/good.exr"));
     const std::string bad = Queue("bad");
-    RenderAll(bad);
-    farm_->scheduler().Finish(bad, absl::InternalError("disk full"));
+    farm_->scheduler().Finish(RenderAll(bad), absl::InternalError("disk full"));
     const std::vector<nlohmann::json> posted = endpoint_.Await(2);
     ASSERT_EQ(posted.size(), 2u);
     EXPECT_EQ(posted[0]["job_id"], good);
@@ -137,8 +139,7 @@ TEST_F(JobNotifierTest, HangingEndpointDoesNotHoldUpTheJobsEnds) {
     ASSERT_TRUE(farm_->scheduler().Cancel(first).ok());
     endpoint_.Await(1);  // the notifier thread is now stuck in its POST
     const std::string second = Queue("second");
-    RenderAll(second);
-    farm_->scheduler().Finish(second, std::string("/results/second.exr"));
+    farm_->scheduler().Finish(RenderAll(second), std::string("/results/second.exr"));
     EXPECT_EQ(farm_->scheduler().Get(second)->state, JobState::kSucceeded);
     const std::string third = Queue("third");
     ASSERT_TRUE(farm_->scheduler().Cancel(third).ok());

@@ -349,7 +349,7 @@ TEST(SqliteJobStoreUpgrade, Version1DatabaseListsAndRecoversItsJobs) {
         // The jobs that had not ended are running again, with the settings they were submitted
         // with.
         Scheduler scheduler({}, **store);
-        const absl::StatusOr<std::vector<std::string>> rendered = scheduler.Recover();
+        const absl::StatusOr<std::vector<Scheduler::JobRun>> rendered = scheduler.Recover();
         ASSERT_TRUE(rendered.ok()) << rendered.status();
         for (const JobRecord& job : jobs) {
             if (IsFinal(job.state)) continue;

@@ -48,7 +48,7 @@ class SchedulerDependencies : public ::testing::Test {
             scheduler_.Complete(lease->lease_id, "w-1", testing::UniformResult(*lease, Rgb(0.5f)));
         ASSERT_TRUE(done.ok()) << done.status();
         ASSERT_TRUE(done->job_rendered);
-        scheduler_.Finish(id, "/results/" + id + ".exr");
+        scheduler_.Finish({id, done->run}, "/results/" + id + ".exr");
     }
 
     JobRecord Get(const std::string& id) {
@@ -76,12 +76,12 @@ TEST_F(SchedulerDependencies, ChainRunsInOrderAndSaysWhatItWaitsFor) {
     EXPECT_FALSE(Lease().has_value()) << "B and C wait while A runs";
     EXPECT_EQ(Get(b).waiting_reason, "waiting for " + a + " (running)");
     EXPECT_EQ(Get(b).state, JobState::kQueued);
-    ASSERT_TRUE(
-        scheduler_.Complete(first->lease_id, "w-1", testing::UniformResult(*first, Rgb(0.5f)))
-            .ok());
+    absl::StatusOr<Scheduler::Completion> rendered =
+        scheduler_.Complete(first->lease_id, "w-1", testing::UniformResult(*first, Rgb(0.5f)));
+    ASSERT_TRUE(rendered.ok()) << rendered.status();
     EXPECT_FALSE(Lease().has_value()) << "A rendered is not A succeeded";
     now_ += absl::Seconds(1);
-    scheduler_.Finish(a, "/results/a.exr");
+    scheduler_.Finish({a, rendered->run}, "/results/a.exr");
     EXPECT_TRUE(Get(b).waiting_reason.empty());
     EXPECT_TRUE(Get(b).waiting_for.empty());
     now_ += absl::Seconds(1);
@@ -236,9 +236,10 @@ TEST_F(SchedulerDependencies, RecoverStillWaitsAndSeesWhatEndedMeanwhile) {
     ASSERT_TRUE(lease.has_value());
     EXPECT_EQ(lease->job_id, a);
     EXPECT_FALSE(restarted.LeaseTask("w-1", absl::InfinitePast()).has_value());
-    ASSERT_TRUE(
-        restarted.Complete(lease->lease_id, "w-1", testing::UniformResult(*lease, Rgb(0.5f))).ok());
-    restarted.Finish(a, "/results/a.exr");
+    absl::StatusOr<Scheduler::Completion> rendered =
+        restarted.Complete(lease->lease_id, "w-1", testing::UniformResult(*lease, Rgb(0.5f)));
+    ASSERT_TRUE(rendered.ok()) << rendered.status();
+    restarted.Finish({a, rendered->run}, "/results/a.exr");
     lease = restarted.LeaseTask("w-1", absl::InfinitePast());
     ASSERT_TRUE(lease.has_value());
     EXPECT_EQ(lease->job_id, b) << "released once its dependency succeeded";

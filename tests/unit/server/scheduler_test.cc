@@ -141,19 +141,22 @@ TEST_F(SchedulerTest, AllResultsInAnyOrderSucceedTheJob) {
     std::vector<TaskAssignment> leases;
     while (std::optional<TaskAssignment> l = scheduler_.LeaseTask("w")) leases.push_back(*l);
     ASSERT_EQ(leases.size(), 8u);
+    uint64_t run = 0;
     for (size_t i = leases.size(); i-- > 0;) {
         absl::StatusOr<Scheduler::Completion> done =
             scheduler_.Complete(leases[i].lease_id, "w", Result(leases[i]));
         ASSERT_TRUE(done.ok()) << done.status();
         EXPECT_EQ(done->job_id, id);
         EXPECT_EQ(done->job_rendered, i == 0);
+        run = done->run;
     }
     EXPECT_EQ(Job(id).tasks_done, 8);
     EXPECT_EQ(Job(id).stats.samples, 0u);  // the fake results carry no stats
     auto snapshot = scheduler_.Snapshot(id);
     ASSERT_TRUE(snapshot.ok());
     EXPECT_EQ((*snapshot->image.FindChannel("spp"))[0], 4.0f);
-    scheduler_.Finish(id, std::string("/results/x.exr"));
+    EXPECT_EQ(snapshot->run, run);
+    scheduler_.Finish({id, run}, std::string("/results/x.exr"));
     EXPECT_EQ(Job(id).state, JobState::kSucceeded);
     EXPECT_EQ(Job(id).result_path, "/results/x.exr");
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
@@ -393,10 +396,11 @@ TEST_F(JobManagementTest, RequeuedFailedJobIsQueuedAgainAndRenders) {
         absl::StatusOr<Scheduler::Completion> done =
             scheduler_.Complete(lease->lease_id, "w", Result(*lease));
         ASSERT_TRUE(done.ok()) << done.status();
+        EXPECT_EQ(done->run, requeued->run);
         rendered = done->job_rendered;
     }
     EXPECT_TRUE(rendered);
-    scheduler_.Finish(id, std::string("/results/x.exr"));
+    scheduler_.Finish({id, requeued->run}, std::string("/results/x.exr"));
     EXPECT_EQ(Job(id).state, JobState::kSucceeded);
 }
 
@@ -828,6 +832,13 @@ TEST_F(SchedulerTest, AdaptiveJobQueuesPassesOnlyForTheTileAboveTheTarget) {
     EXPECT_EQ((*snapshot->image.FindChannel("spp"))[15 * 16 + 15], 64.0f);
 }
 
+// The jobs of runs, as EnforceTimeLimits and Recover report them.
+std::vector<std::string> JobsOf(const std::vector<Scheduler::JobRun>& runs) {
+    std::vector<std::string> ids;
+    for (const Scheduler::JobRun& run : runs) ids.push_back(run.job_id);
+    return ids;
+}
+
 // An adaptive job's four first passes (SubmitAdaptive) leased and merged with HalvesResult.
 void CompleteFirstPasses(Scheduler& scheduler) {
     for (int i = 0; i < 4; ++i) {
@@ -846,7 +857,7 @@ TEST_F(SchedulerTest, TimeLimitDropsPassesStopsTheirLeasesAndEndsTheJob) {
     EXPECT_EQ(running->task.sample_end, 8u);
     EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
     now_ += absl::Seconds(5);
-    EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
+    EXPECT_EQ(JobsOf(scheduler_.EnforceTimeLimits()), std::vector<std::string>{id});
     EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());         // reported once
     EXPECT_FALSE(scheduler_.Heartbeat(running->lease_id, "w"));  // the worker stops
     EXPECT_FALSE(scheduler_.LeaseTask("w").has_value());
@@ -877,7 +888,7 @@ TEST_F(SchedulerTest, TimeLimitClockStopsWhileTheJobIsPaused) {
     now_ += absl::Seconds(2);  // 4 s of the 5 run
     EXPECT_TRUE(scheduler_.EnforceTimeLimits().empty());
     now_ += absl::Seconds(1);
-    EXPECT_EQ(scheduler_.EnforceTimeLimits(), std::vector<std::string>{id});
+    EXPECT_EQ(JobsOf(scheduler_.EnforceTimeLimits()), std::vector<std::string>{id});
 }
 
 // The time paused is in the job's record: a coordinator restarted during a pause keeps the
@@ -899,7 +910,7 @@ TEST_F(SchedulerTest, TimeLimitClockStaysStoppedForAPauseAcrossARestart) {
     now_ += absl::Seconds(2);                           // 4 s of the 5 run
     EXPECT_TRUE(restarted.EnforceTimeLimits().empty());
     now_ += absl::Seconds(1);
-    EXPECT_EQ(restarted.EnforceTimeLimits(), std::vector<std::string>{id});
+    EXPECT_EQ(JobsOf(restarted.EnforceTimeLimits()), std::vector<std::string>{id});
 }
 
 // A job its last result completed is reported by Complete, and not again by the time limit.
@@ -1057,7 +1068,7 @@ TEST(SchedulerLockTest, TheLastResultIsRecordedWhileTheImageIsWritten) {
     EXPECT_EQ(recorded.wait_for(std::chrono::milliseconds(50)), std::future_status::timeout);
     store.Release();
     EXPECT_TRUE(recorded.get().ok());
-    scheduler.Finish(id, std::string("/results/x.exr"));
+    scheduler.Finish({id, last->run}, std::string("/results/x.exr"));
     EXPECT_EQ(store.Get(id)->state, JobState::kSucceeded);
 }
 

@@ -136,7 +136,7 @@ TEST_F(SqliteJobStoreTest, RestartKeepsDoneTasksAndQueuesTheRest) {
 
     std::unique_ptr<SqliteJobStore> store = OpenStore();
     Scheduler after({}, *store);
-    absl::StatusOr<std::vector<std::string>> rendered = after.Recover();
+    absl::StatusOr<std::vector<Scheduler::JobRun>> rendered = after.Recover();
     ASSERT_TRUE(rendered.ok()) << rendered.status();
     EXPECT_TRUE(rendered->empty());
     EXPECT_EQ(after.Get(id)->tasks_done, 3);
@@ -231,11 +231,12 @@ TEST_F(SqliteJobStoreTest, JobRenderedButNotWrittenIsHandedBackAfterARestart) {
     }
     std::unique_ptr<SqliteJobStore> store = OpenStore();
     Scheduler after({}, *store);
-    absl::StatusOr<std::vector<std::string>> rendered = after.Recover();
+    absl::StatusOr<std::vector<Scheduler::JobRun>> rendered = after.Recover();
     ASSERT_TRUE(rendered.ok()) << rendered.status();
-    EXPECT_EQ(*rendered, std::vector<std::string>{id});
+    ASSERT_EQ(rendered->size(), 1u);
+    EXPECT_EQ(rendered->front().job_id, id);
     EXPECT_FALSE(after.LeaseTask("w"));
-    after.Finish(id, std::string("/results/x.exr"));
+    after.Finish(rendered->front(), std::string("/results/x.exr"));
     EXPECT_EQ(after.Get(id)->state, JobState::kSucceeded);
     EXPECT_TRUE(store->TaskResults(id)->empty()) << "an ended job keeps no task results";
 }
@@ -282,7 +283,7 @@ TEST_F(SqliteJobStoreTest, RequeuedFailedJobRendersOnFromItsRecordedResultsAfter
     }
     EXPECT_EQ(leased, 5);
     EXPECT_EQ(Pixels(after, id), expected);
-    after.Finish(id, std::string("/results/x.exr"));
+    after.Finish({id, requeued->run}, std::string("/results/x.exr"));
     EXPECT_EQ(after.Get(id)->state, JobState::kSucceeded);
     EXPECT_TRUE(store->TaskResults(id)->empty()) << "a succeeded job keeps no task results";
     EXPECT_EQ(after.RequeueJob(id).status().code(), absl::StatusCode::kFailedPrecondition);
@@ -337,7 +338,7 @@ TEST_F(SqliteJobStoreTest, StoreThatCannotListFailsRecoveryInsteadOfStartingEmpt
     }
     store.fail_reads = true;
     Scheduler after({}, store);
-    const absl::StatusOr<std::vector<std::string>> rendered = after.Recover();
+    const absl::StatusOr<std::vector<Scheduler::JobRun>> rendered = after.Recover();
     EXPECT_EQ(rendered.status().code(), absl::StatusCode::kDataLoss);
     EXPECT_NE(rendered.status().message().find("malformed"), std::string_view::npos);
     EXPECT_EQ(after.List().status().code(), absl::StatusCode::kDataLoss) << "nor lists nothing";
@@ -358,7 +359,7 @@ TEST_F(SqliteJobStoreTest, StoredJobThatCannotBeTakenUpFailsAloneAndTheRestRecov
     }
     std::unique_ptr<SqliteJobStore> store = OpenStore();
     Scheduler after({}, *store);
-    const absl::StatusOr<std::vector<std::string>> rendered = after.Recover();
+    const absl::StatusOr<std::vector<Scheduler::JobRun>> rendered = after.Recover();
     ASSERT_TRUE(rendered.ok()) << rendered.status();
     const JobRecord failed = *after.Get(bad);
     EXPECT_EQ(failed.state, JobState::kFailed);
@@ -376,7 +377,7 @@ TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs)
     Scheduler scheduler({}, store);
     const std::string done = *scheduler.Submit(Spec());
     CompleteAll(scheduler, "w");
-    scheduler.Finish(done, std::string("/results/x.exr"));
+    scheduler.Finish({done, scheduler.Snapshot(done)->run}, std::string("/results/x.exr"));
     const std::string running = *scheduler.Submit(Spec());
     std::optional<TaskAssignment> lease = scheduler.LeaseTask("w");
 
@@ -421,6 +422,47 @@ TEST_F(SqliteJobStoreTest, LastResultThatCannotBeRecordedFailsTheJobBeforeItEnds
                   absl::StrCat("recording the result of task ", leases.back().task.index, ": ")),
               std::string::npos)
         << scheduler.Get(id)->error;
+}
+
+// The job cancelled and requeued while the last result's record was awaited is another run: that
+// record failing does not fail it, although it has rendered the task again meanwhile, and the
+// earlier run's Finish (its image written meanwhile) does not end it.
+TEST_F(SqliteJobStoreTest, WhatIsDecidedForAnEndedRunLeavesTheJobQueuedAgainAlone) {
+    FailingStore store;
+    Scheduler scheduler({}, store);
+    const std::string id = *scheduler.Submit(Spec());
+    std::vector<TaskAssignment> leases;
+    while (std::optional<TaskAssignment> l = scheduler.LeaseTask("w")) leases.push_back(*l);
+    for (size_t i = 0; i + 1 < leases.size(); ++i) {
+        ASSERT_TRUE(scheduler.Complete(leases[i].lease_id, "w", Result(leases[i])).ok());
+    }
+    store.fail = true;
+    const absl::StatusOr<Scheduler::Completion> last =
+        scheduler.Complete(leases.back().lease_id, "w", Result(leases.back()));
+    ASSERT_TRUE(last.ok()) << last.status();
+    ASSERT_TRUE(last->job_rendered);
+    store.fail = false;
+    ASSERT_TRUE(scheduler.Cancel(id).ok());
+    const absl::StatusOr<Scheduler::Requeued> requeued = scheduler.RequeueJob(id);
+    ASSERT_TRUE(requeued.ok()) << requeued.status();
+    EXPECT_NE(requeued->run, last->run);
+    EXPECT_EQ(scheduler.Snapshot(id)->run, requeued->run);
+    std::optional<Scheduler::Completion> again;
+    while (std::optional<TaskAssignment> l = scheduler.LeaseTask("w")) {
+        absl::StatusOr<Scheduler::Completion> done =
+            scheduler.Complete(l->lease_id, "w", Result(*l));
+        ASSERT_TRUE(done.ok()) << done.status();
+        if (done->job_rendered) again = *done;
+    }
+    ASSERT_TRUE(again.has_value()) << "the requeued run renders every task again";
+    EXPECT_EQ(scheduler.AwaitRecorded(*last).code(), absl::StatusCode::kResourceExhausted);
+    EXPECT_EQ(scheduler.Get(id)->state, JobState::kRunning) << scheduler.Get(id)->error;
+    scheduler.Finish({id, last->run}, std::string("/results/old.exr"));
+    EXPECT_EQ(scheduler.Get(id)->state, JobState::kRunning);
+    ASSERT_TRUE(scheduler.AwaitRecorded(*again).ok());
+    scheduler.Finish({id, again->run}, std::string("/results/x.exr"));
+    EXPECT_EQ(scheduler.Get(id)->state, JobState::kSucceeded);
+    EXPECT_EQ(scheduler.Get(id)->result_path, "/results/x.exr");
 }
 
 TEST_F(SqliteJobStoreTest, UnusableDataDirIsAClearError) {

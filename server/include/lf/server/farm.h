@@ -180,7 +180,9 @@ class Farm {
     // Writes the job's result and ends it. `last`: the completion that rendered it, whose record
     // is awaited after the image is written and before the job ends (a record that failed fails
     // the job instead, and its image is removed); its status is the worker's answer.
-    absl::Status FinishJob(const std::string& job_id, const Scheduler::Completion* last = nullptr);
+    // Nothing is written for a run that has ended (Scheduler::JobRun).
+    absl::Status FinishJob(const Scheduler::JobRun& rendered,
+                           const Scheduler::Completion* last = nullptr);
     // Writes a shot's complete frame `frame` as results/JOB.frame<N>.exr, its header the frame's
     // (MetadataOf(FrameSpec)), and records it; a failed write fails the job.
     void WriteFrame(const std::string& job_id, int frame);
@@ -191,7 +193,9 @@ class Farm {
     void SweepTemporaryFiles();
     // Snapshot and WriteImage, one job at a time: the image being written is the only one in
     // the server's memory (the merged tiles are in files, lf/job/tile_store.h).
-    absl::Status WriteSnapshot(const std::string& job_id, bool complete, const std::string& path);
+    // `run`: only that run's image (Aborted for another's; FailedPrecondition for an ended job).
+    absl::Status WriteSnapshot(const std::string& job_id, bool complete, const std::string& path,
+                               std::optional<uint64_t> run = std::nullopt);
 
     const FarmOptions options_;
     std::unique_ptr<DirLock> lock_;

@@ -65,6 +65,7 @@ struct ScheduledJob {
     TaskStateMachine states;
     std::vector<Task> tasks;     // by index, as many as `states`
     uint64_t submit_ticket = 0;  // the store's, for a retry that comes before the commit
+    uint64_t run = 0;            // Scheduler::JobRun::run, set when it is queued
     SpeculationPolicy speculation{absl::ZeroDuration()};
 
   private:

@@ -100,6 +100,15 @@ class Scheduler {
     Scheduler(
         SchedulerOptions options, JobStore& store, Clock clock = [] { return absl::Now(); });
 
+    // One run of a job: a job requeued after it ended runs again under a new number, so that
+    // what the caller does for an earlier run (writing its image, awaiting its last record)
+    // cannot end the new one. Numbers are this process's, never stored.
+    struct JobRun {
+        std::string job_id;
+        uint64_t run = 0;
+        bool operator==(const JobRun&) const = default;
+    };
+
     // Plans and queues the job; `spec` must be validated, but for its dependencies (spec.after:
     // their ids as CheckDependencyIds checks them, each known and not failed nor cancelled, see
     // AddDependencies). Returns the job id once the job is in
@@ -112,7 +121,7 @@ class Scheduler {
     // recorded task results are merged again and every other task is queued (leases do not
     // outlive the server; their workers' late results are still taken). Returns the jobs that
     // are fully rendered, whose result the caller writes and Finishes.
-    absl::StatusOr<std::vector<std::string>> Recover();
+    absl::StatusOr<std::vector<JobRun>> Recover();
 
     // The first queued task of the highest-priority, oldest job that this worker may take (a
     // task that failed here goes to a live worker it has not failed on, while there is one); when
@@ -143,6 +152,7 @@ class Scheduler {
     // AwaitRecorded before the worker hears "done".
     struct Completion {
         std::string job_id;
+        uint64_t run = 0;  // JobRun::run of the job that merged the result
         bool job_rendered = false;
         std::optional<RadiositySolve::Outcome> sweep;
         std::vector<int> frames_completed;
@@ -171,8 +181,7 @@ class Scheduler {
     // Queues the sweep that reads blob `hash` (not stored when its `bytes` go with the leases,
     // JobExecution::Publish), or the display tiles when `converged`; fails the job when the
     // blob could not be stored.
-    void Publish(const std::string& job_id, bool converged,
-                 const absl::StatusOr<std::string>& hash,
+    void Publish(const std::string& job_id, bool converged, const absl::StatusOr<std::string>& hash,
                  std::shared_ptr<const std::string> bytes = nullptr);
 
     // Gives a leased task back. Ignored when the lease is no longer current.
@@ -196,6 +205,7 @@ class Scheduler {
     // ending right now (its final record not yet durable).
     struct Requeued {
         JobRecord record;
+        uint64_t run = 0;  // JobRun::run of the job queued again
         bool rendered = false;
         std::vector<int> frames;  // RequeueFrames: the frames whose EXRs are dropped
     };
@@ -231,7 +241,7 @@ class Scheduler {
     // Ends the sampling of adaptive jobs whose time limit has passed since they started: passes
     // not yet merged are dropped (leases of them hear "stop"), tiles keep their first pass.
     // Returns the jobs that are now fully rendered, whose result the caller writes and Finishes.
-    std::vector<std::string> EnforceTimeLimits();
+    std::vector<JobRun> EnforceTimeLimits();
 
     // A rendered job's record and image, to write as its result, and for an adaptive job how its
     // sampling ended. The image is read from the job's tile store one tile at a time after the
@@ -239,6 +249,7 @@ class Scheduler {
     // another's older one, never half a tile.
     struct JobImage {
         JobRecord record;
+        uint64_t run = 0;  // JobRun::run of the job read
         Image image;
         std::optional<AdaptiveReport> adaptive;
     };
@@ -255,7 +266,8 @@ class Scheduler {
     std::vector<std::pair<std::string, int>> UnwrittenFrames() const;
 
     // Ends a fully rendered job: succeeded with the result file, or failed with the error.
-    void Finish(const std::string& job_id, const absl::StatusOr<std::string>& result_path);
+    // Nothing when that run has ended (a job cancelled meanwhile, or cancelled and requeued).
+    void Finish(const JobRun& rendered, const absl::StatusOr<std::string>& result_path);
 
     // Running jobs as they are now, ended ones from the store.
     absl::StatusOr<JobRecord> Get(const std::string& job_id) const;
@@ -468,6 +480,7 @@ class Scheduler {
     uint64_t version_ = 0;
     bool shutdown_ = false;
     uint64_t next_seq_ = 1;
+    uint64_t next_run_ = 1;  // JobRun::run
     std::map<std::string, std::unique_ptr<Job>> active_;
     EndedJobs ended_;
     uint64_t left_memory_ = 0;  // ended jobs settled out of `ended_`, for FindRequest
