@@ -81,10 +81,9 @@ absl::StatusOr<std::unique_ptr<Farm>> Farm::Open(const FarmOptions& options) {
     absl::StatusOr<std::vector<Scheduler::JobRun>> rendered = farm->scheduler_.Recover();
     if (!rendered.ok()) return rendered.status();
     // Frames complete before the restart whose EXR was not recorded, of shots still running.
-    for (const auto& [job_id, frame] : farm->scheduler_.UnwrittenFrames()) {
-        if (std::none_of(rendered->begin(), rendered->end(),
-                         [&](const Scheduler::JobRun& r) { return r.job_id == job_id; })) {
-            farm->WriteFrame(job_id, frame);
+    for (const auto& [run, frame] : farm->scheduler_.UnwrittenFrames()) {
+        if (std::find(rendered->begin(), rendered->end(), run) == rendered->end()) {
+            farm->WriteFrame(run, frame);
         }
     }
     for (const Scheduler::JobRun& run : *rendered) (void)farm->FinishJob(run);
@@ -266,20 +265,21 @@ absl::Status Farm::Complete(const std::string& lease_id, const std::string& work
         // A chunk refused half way keeps the parts merged before the refusal: the frames they
         // completed are written now, so that a shot cancelled before the retry still has them.
         if (!parts.empty()) {
-            for (const auto& [id, f] : scheduler_.UnwrittenFrames()) {
-                if (id == holder->job_id) WriteFrame(id, f);
+            for (const auto& [run, f] : scheduler_.UnwrittenFrames()) {
+                if (run.job_id == holder->job_id) WriteFrame(run, f);
             }
         }
         return done.status();
     }
+    const Scheduler::JobRun run{done->job_id, done->run};
     if (radiosity) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
-        radiosity_[done->job_id] = *radiosity;
+        radiosity_[run] = *radiosity;
     }
-    for (int f : done->frames_completed) WriteFrame(done->job_id, f);
+    for (int f : done->frames_completed) WriteFrame(run, f);
     // The job's image is written while the last result's record is made durable: a restart
     // before both finds the task not done and renders it again.
-    if (done->job_rendered) return FinishJob({done->job_id, done->run}, &*done);
+    if (done->job_rendered) return FinishJob(run, &*done);
     return scheduler_.AwaitRecorded(*done);
 }
 
@@ -287,18 +287,24 @@ std::string Farm::FramePathOf(const std::string& dir, const std::string& job_id,
     return absl::StrCat(options_.data_dir, "/", dir, "/", job_id, ".frame", frame, ".exr");
 }
 
-void Farm::WriteFrame(const std::string& job_id, int frame) {
-    const std::string path = FramePathOf("results", job_id, frame);
-    absl::Status written;
-    {
-        std::lock_guard<std::mutex> lock(image_mutex_);
-        absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.FrameSnapshot(job_id, frame);
-        written = snapshot.ok() ? WriteImage(*snapshot, true, path) : snapshot.status();
-    }
-    if (absl::IsFailedPrecondition(written)) return;  // cancelled meanwhile
-    scheduler_.FrameWritten(
-        job_id, frame,
+void Farm::WriteFrame(const Scheduler::JobRun& run, int frame) {
+    const std::string path = FramePathOf("results", run.job_id, frame);
+    // Held until the frame is recorded: a run queued meanwhile writes this path only after.
+    std::lock_guard<std::mutex> lock(image_mutex_);
+    absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.FrameSnapshot(run.job_id, frame);
+    if (absl::IsFailedPrecondition(snapshot.status())) return;  // cancelled meanwhile
+    if (snapshot.ok() && snapshot->run != run.run) return;      // and queued again
+    const absl::Status written =
+        snapshot.ok() ? WriteImage(*snapshot, true, path) : snapshot.status();
+    const bool recorded = scheduler_.FrameWritten(
+        run, frame,
         written.ok() ? absl::StatusOr<std::string>(path) : absl::StatusOr<std::string>(written));
+    // Ended during the write: the frame is not this job's any more (a run queued again renders
+    // and writes it itself, and `requeue --frames` removed it before the write put it back).
+    if (!recorded && written.ok()) {
+        std::error_code ignored;
+        fs::remove(path, ignored);
+    }
 }
 
 absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string& worker,
@@ -314,11 +320,11 @@ absl::Status Farm::CompleteSweep(const std::string& lease_id, const std::string&
     // have no links: its share of the solver's bytes still counts).
     if (links && results->size() == 1 && results->front().sweep == 0) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
-        sweep_links_[done->job_id][results->front().chunk] = *links;
+        sweep_links_[{done->job_id, done->run}][results->front().chunk] = *links;
     }
     if (done->sweep && done->sweep->converged) {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
-        sweep_solves_[done->job_id] = {done->sweep->iterations, done->sweep->residual};
+        sweep_solves_[{done->job_id, done->run}] = {done->sweep->iterations, done->sweep->residual};
     }
     if (done->sweep) {
         std::string encoded = EncodeRadiosity(done->sweep->radiosity);
@@ -343,7 +349,8 @@ absl::Status Farm::WriteSnapshot(const std::string& job_id, bool complete, const
     absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.Snapshot(job_id);
     if (!snapshot.ok()) return snapshot.status();
     if (run && snapshot->run != *run) {
-        return absl::AbortedError(absl::StrCat("job ", job_id, " was cancelled and queued again"));
+        return absl::FailedPreconditionError(
+            absl::StrCat("job ", job_id, " was cancelled and queued again"));
     }
     return WriteImage(*snapshot, complete, path);
 }
@@ -356,8 +363,8 @@ absl::Status Farm::FinishJob(const Scheduler::JobRun& rendered, const Scheduler:
     if (job.ok() && job->spec.shot.frames) {
         // Its frames are its result, each written as it completed; those a restart or a time
         // limit completed since are written now.
-        for (const auto& [id, frame] : scheduler_.UnwrittenFrames()) {
-            if (id == job_id) WriteFrame(job_id, frame);
+        for (const auto& [run, frame] : scheduler_.UnwrittenFrames()) {
+            if (run == rendered) WriteFrame(run, frame);
         }
         job = scheduler_.Get(job_id);
         if (job.ok() && IsFinal(job->state)) return recorded();  // a frame's write failed it
@@ -370,18 +377,26 @@ absl::Status Farm::FinishJob(const Scheduler::JobRun& rendered, const Scheduler:
     }
     const std::string path = options_.data_dir + "/results/" + job_id + ".exr";
     const absl::Status written = WriteSnapshot(job_id, true, path, rendered.run);
-    // Cancelled and queued again meanwhile: that run writes its own image, with its figures.
-    if (absl::IsAborted(written)) return recorded();
     {
+        // This run's figures, and those of runs cancelled before it; a later run keeps its own.
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
-        radiosity_.erase(job_id);
-        sweep_solves_.erase(job_id);
-        sweep_links_.erase(job_id);
+        const auto up_to_this_run = [&](auto& figures) {
+            figures.erase(figures.lower_bound({job_id, 0}),
+                          figures.upper_bound({job_id, rendered.run}));
+        };
+        up_to_this_run(radiosity_);
+        up_to_this_run(sweep_solves_);
+        up_to_this_run(sweep_links_);
     }
-    if (absl::IsFailedPrecondition(written)) return recorded();  // cancelled meanwhile
+    // Cancelled meanwhile (and perhaps queued again: that run writes its own image).
+    if (absl::IsFailedPrecondition(written)) return recorded();
     if (absl::Status s = recorded(); !s.ok()) {
-        std::error_code ignored;  // nothing may serve the image of a failed job
-        if (written.ok()) fs::remove(path, ignored);
+        // Nothing may serve the image of a failed job; a run queued again since the write may
+        // have written its own there (under image_mutex_).
+        std::lock_guard<std::mutex> lock(image_mutex_);
+        const std::optional<uint64_t> now = scheduler_.RunOf(job_id);
+        std::error_code ignored;
+        if (written.ok() && (!now || *now == rendered.run)) fs::remove(path, ignored);
         return s;
     }
     scheduler_.Finish(rendered, written.ok() ? absl::StatusOr<std::string>(path)
@@ -405,14 +420,15 @@ absl::Status Farm::WriteImage(const Scheduler::JobImage& snapshot, bool complete
     outcome.adaptive = snapshot.adaptive;
     {
         std::lock_guard<std::mutex> lock(radiosity_mutex_);
-        if (auto it = radiosity_.find(job.id); it != radiosity_.end()) {
+        const Scheduler::JobRun run{job.id, snapshot.run};
+        if (auto it = radiosity_.find(run); it != radiosity_.end()) {
             outcome.radiosity = it->second;
             // The display tiles' workers read the farm's solution: the solve's figures are ours.
-            if (auto solve = sweep_solves_.find(job.id); solve != sweep_solves_.end()) {
+            if (auto solve = sweep_solves_.find(run); solve != sweep_solves_.end()) {
                 outcome.radiosity->iterations = solve->second.iterations;
                 outcome.radiosity->residual = solve->second.residual;
             }
-            if (auto links = sweep_links_.find(job.id); links != sweep_links_.end()) {
+            if (auto links = sweep_links_.find(run); links != sweep_links_.end()) {
                 RadiosityFigures& r = *outcome.radiosity;
                 for (const auto& [chunk, f] : links->second) {
                     r.links += f.links;

@@ -1319,15 +1319,17 @@ absl::StatusOr<Scheduler::JobImage> Scheduler::FrameSnapshot(const std::string& 
     return ReadSnapshot(std::move(snapshot), read);
 }
 
-void Scheduler::FrameWritten(const std::string& job_id, int frame,
+bool Scheduler::FrameWritten(const JobRun& run, int frame,
                              const absl::StatusOr<std::string>& path) {
     Locked locked(*this);
+    const std::string& job_id = run.job_id;
     auto it = active_.find(job_id);
-    if (it == active_.end()) return;  // cancelled meanwhile: it keeps the frames recorded before
+    // Cancelled meanwhile: it keeps the frames recorded before.
+    if (it == active_.end() || it->second->run != run.run) return false;
     Job& job = *it->second;
     if (!path.ok()) {
         FailJob(job, absl::StrCat("writing frame ", frame, ": ", path.status().message()));
-        return;
+        return true;
     }
     job.Sync();
     for (FrameProgress& f : job.record.frames) {
@@ -1341,17 +1343,25 @@ void Scheduler::FrameWritten(const std::string& job_id, int frame,
         Log()->error("job={} frame {}: its path is not recorded: {}", job_id, frame,
                      std::string(s.message()));
     }
+    return true;
 }
 
-std::vector<std::pair<std::string, int>> Scheduler::UnwrittenFrames() const {
+std::optional<uint64_t> Scheduler::RunOf(const std::string& job_id) const {
     std::lock_guard<std::mutex> lock(mutex_);
-    std::vector<std::pair<std::string, int>> frames;
+    auto it = active_.find(job_id);
+    if (it == active_.end()) return std::nullopt;
+    return it->second->run;
+}
+
+std::vector<std::pair<Scheduler::JobRun, int>> Scheduler::UnwrittenFrames() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::pair<JobRun, int>> frames;
     for (const auto& [id, job] : active_) {
         const std::vector<FrameProgress>& recorded = job->record.frames;  // in frame order
         const std::vector<FrameProgress> now = job->execution->Frames();
         for (size_t i = 0; i < now.size(); ++i) {
             const bool written = i < recorded.size() && !recorded[i].result_path.empty();
-            if (now[i].done && !written) frames.emplace_back(id, now[i].frame);
+            if (now[i].done && !written) frames.emplace_back(JobRun{id, job->run}, now[i].frame);
         }
     }
     return frames;

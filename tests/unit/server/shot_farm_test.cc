@@ -357,6 +357,30 @@ TEST_F(ShotFarmTest, RequeuedFramesOfASucceededShotAreRenderedAgainAcrossARestar
     for (int f : {1, 2, 3}) ExpectFrame(*job, f);
 }
 
+// A frame an earlier run wrote as the shot was requeued (the farm's write of frame 2 finishing
+// after `requeue --frames 2`) is not recorded in the run queued again, which renders it itself.
+TEST_F(ShotFarmTest, AFrameWrittenForAnEndedRunIsNotRecordedInTheRunQueuedAgain) {
+    absl::StatusOr<std::string> job = farm_->Submit(Shot());
+    ASSERT_TRUE(job.ok()) << job.status();
+    for (int t = 0; t < 11; ++t) RenderOne();
+    const std::optional<uint64_t> earlier = farm_->scheduler().RunOf(*job);
+    ASSERT_TRUE(earlier.has_value());
+    RenderOne();
+    ASSERT_EQ(farm_->scheduler().Get(*job)->state, JobState::kSucceeded);
+    EXPECT_FALSE(farm_->scheduler().RunOf(*job).has_value()) << "an ended job has no run";
+    const std::string frame_2 = *farm_->ResultFile(*job, false, 2);
+    ASSERT_TRUE(farm_->Requeue(*job, FrameRange{2, 2, 1}).ok());
+    const std::optional<uint64_t> again = farm_->scheduler().RunOf(*job);
+    ASSERT_TRUE(again.has_value());
+    EXPECT_NE(*again, *earlier);
+    EXPECT_FALSE(farm_->scheduler().FrameWritten({*job, *earlier}, 2, frame_2));
+    EXPECT_TRUE(farm_->scheduler().Get(*job)->frames[1].result_path.empty());
+    EXPECT_EQ(farm_->ResultFile(*job, false, 2).status().code(),
+              absl::StatusCode::kFailedPrecondition);
+    EXPECT_FALSE(farm_->scheduler().FrameWritten({*job, *earlier}, 2, absl::InternalError("disk")));
+    EXPECT_EQ(farm_->scheduler().Get(*job)->state, JobState::kQueued) << "nor fails it";
+}
+
 // A chunk holds several frames: requeuing one renders its chunk again, and says which frames.
 // A job released by the shot's success would wait for it again mid-render (and a cycle could
 // close through it): the shot's frames are refused a requeue while such a job is queued or

@@ -180,12 +180,13 @@ class Farm {
     // Writes the job's result and ends it. `last`: the completion that rendered it, whose record
     // is awaited after the image is written and before the job ends (a record that failed fails
     // the job instead, and its image is removed); its status is the worker's answer.
-    // Nothing is written for a run that has ended (Scheduler::JobRun).
+    // A run that has ended before its image is read (Scheduler::JobRun) is not ended again.
     absl::Status FinishJob(const Scheduler::JobRun& rendered,
                            const Scheduler::Completion* last = nullptr);
     // Writes a shot's complete frame `frame` as results/JOB.frame<N>.exr, its header the frame's
     // (MetadataOf(FrameSpec)), and records it; a failed write fails the job.
-    void WriteFrame(const std::string& job_id, int frame);
+    // Nothing is written for a run that has ended, and a frame written as it ended is removed.
+    void WriteFrame(const Scheduler::JobRun& run, int frame);
     std::string FramePathOf(const std::string& dir, const std::string& job_id, int frame) const;
     void RemoveJobFiles(const std::string& job_id);
     void RemoveJobLogs(const std::vector<std::string>& job_ids);
@@ -193,7 +194,7 @@ class Farm {
     void SweepTemporaryFiles();
     // Snapshot and WriteImage, one job at a time: the image being written is the only one in
     // the server's memory (the merged tiles are in files, lf/job/tile_store.h).
-    // `run`: only that run's image (Aborted for another's; FailedPrecondition for an ended job).
+    // `run`: only that run's image (FailedPrecondition for another's, as for an ended job).
     absl::Status WriteSnapshot(const std::string& job_id, bool complete, const std::string& path,
                                std::optional<uint64_t> run = std::nullopt);
 
@@ -207,11 +208,12 @@ class Farm {
         int iterations = 0;
         double residual = 0;
     };
-    // Hierarchical sweeps: each chunk's link figures, by job id and chunk (soft state, as the
-    // solve: a restart solves again and reports them again).
-    std::map<std::string, std::map<int, RadiosityFigures>> sweep_links_;
-    std::map<std::string, RadiosityFigures> radiosity_;      // by job id
-    std::map<std::string, SweepSolveFigures> sweep_solves_;  // by job id
+    // Hierarchical sweeps: each chunk's link figures, by run and chunk (soft state, as the
+    // solve: a restart solves again and reports them again). By run: a job requeued while an
+    // earlier run's image was written keeps its own.
+    std::map<Scheduler::JobRun, std::map<int, RadiosityFigures>> sweep_links_;
+    std::map<Scheduler::JobRun, RadiosityFigures> radiosity_;
+    std::map<Scheduler::JobRun, SweepSolveFigures> sweep_solves_;
     std::unique_ptr<BlobStore> blobs_;
     // Shared by a submission from its blob checks until its job is held by the scheduler, and
     // taken alone by RemoveUnusedBlobs, so that no blob goes between the two.

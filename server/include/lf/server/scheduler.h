@@ -106,7 +106,7 @@ class Scheduler {
     struct JobRun {
         std::string job_id;
         uint64_t run = 0;
-        bool operator==(const JobRun&) const = default;
+        auto operator<=>(const JobRun&) const = default;
     };
 
     // Plans and queues the job; `spec` must be validated, but for its dependencies (spec.after:
@@ -258,12 +258,13 @@ class Scheduler {
     // (FrameSpec), its stats the frame's. NotFound for a frame the job does not render.
     absl::StatusOr<JobImage> FrameSnapshot(const std::string& job_id, int frame) const;
     // Records frame `frame`'s EXR as written (fetchable from now on, whatever the job ends as), or
-    // fails the job with the error.
-    void FrameWritten(const std::string& job_id, int frame,
-                      const absl::StatusOr<std::string>& path);
+    // fails the job with the error. False, and nothing done, when that run has ended.
+    bool FrameWritten(const JobRun& run, int frame, const absl::StatusOr<std::string>& path);
     // The frames of running shots that are complete but whose EXR is not recorded (the
-    // coordinator stopped between the merge and the write): (job id, frame).
-    std::vector<std::pair<std::string, int>> UnwrittenFrames() const;
+    // coordinator stopped between the merge and the write).
+    std::vector<std::pair<JobRun, int>> UnwrittenFrames() const;
+    // The run of queued or running job `job_id`; nullopt for any other.
+    std::optional<uint64_t> RunOf(const std::string& job_id) const;
 
     // Ends a fully rendered job: succeeded with the result file, or failed with the error.
     // Nothing when that run has ended (a job cancelled meanwhile, or cancelled and requeued).
