@@ -293,7 +293,14 @@ void Farm::WriteFrame(const Scheduler::JobRun& run, int frame) {
     std::lock_guard<std::mutex> lock(image_mutex_);
     absl::StatusOr<Scheduler::JobImage> snapshot = scheduler_.FrameSnapshot(run.job_id, frame);
     if (absl::IsFailedPrecondition(snapshot.status())) return;  // cancelled meanwhile
-    if (snapshot.ok() && snapshot->run != run.run) return;      // and queued again
+    if (snapshot.ok()) {
+        if (snapshot->run != run.run) return;  // and queued again
+        // Written by another result's thread since this one read UnwrittenFrames: its file is
+        // recorded, and must not be rewritten (nor removed, were the job to end meanwhile).
+        for (const FrameProgress& f : snapshot->record.frames) {
+            if (f.frame == frame && !f.result_path.empty()) return;
+        }
+    }
     const absl::Status written =
         snapshot.ok() ? WriteImage(*snapshot, true, path) : snapshot.status();
     const bool recorded = scheduler_.FrameWritten(
@@ -392,11 +399,15 @@ absl::Status Farm::FinishJob(const Scheduler::JobRun& rendered, const Scheduler:
     if (absl::IsFailedPrecondition(written)) return recorded();
     if (absl::Status s = recorded(); !s.ok()) {
         // Nothing may serve the image of a failed job; a run queued again since the write may
-        // have written its own there (under image_mutex_).
+        // have written its own there (under image_mutex_), and may have succeeded with it.
         std::lock_guard<std::mutex> lock(image_mutex_);
         const std::optional<uint64_t> now = scheduler_.RunOf(job_id);
+        const absl::StatusOr<JobRecord> ended = scheduler_.Get(job_id);
+        const bool later_succeeded = ended.ok() && ended->state == JobState::kSucceeded;
         std::error_code ignored;
-        if (written.ok() && (!now || *now == rendered.run)) fs::remove(path, ignored);
+        if (written.ok() && (now ? *now == rendered.run : !later_succeeded)) {
+            fs::remove(path, ignored);
+        }
         return s;
     }
     scheduler_.Finish(rendered, written.ok() ? absl::StatusOr<std::string>(path)

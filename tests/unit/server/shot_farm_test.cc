@@ -357,8 +357,8 @@ TEST_F(ShotFarmTest, RequeuedFramesOfASucceededShotAreRenderedAgainAcrossARestar
     for (int f : {1, 2, 3}) ExpectFrame(*job, f);
 }
 
-// A frame an earlier run wrote as the shot was requeued (the farm's write of frame 2 finishing
-// after `requeue --frames 2`) is not recorded in the run queued again, which renders it itself.
+// A frame's record from an earlier run (as the farm's write of frame 2 would make it, finishing
+// after `requeue --frames 2`) is not taken by the run queued again, which renders it itself.
 TEST_F(ShotFarmTest, AFrameWrittenForAnEndedRunIsNotRecordedInTheRunQueuedAgain) {
     absl::StatusOr<std::string> job = farm_->Submit(Shot());
     ASSERT_TRUE(job.ok()) << job.status();

@@ -454,7 +454,7 @@ TEST_F(SqliteJobStoreTest, WhatIsDecidedForAnEndedRunLeavesTheJobQueuedAgainAlon
         ASSERT_TRUE(done.ok()) << done.status();
         if (done->job_rendered) again = *done;
     }
-    ASSERT_TRUE(again.has_value()) << "the requeued run renders every task again";
+    ASSERT_TRUE(again.has_value()) << "the requeued run renders the unrecorded task again";
     EXPECT_EQ(scheduler.AwaitRecorded(*last).code(), absl::StatusCode::kResourceExhausted);
     EXPECT_EQ(scheduler.Get(id)->state, JobState::kRunning) << scheduler.Get(id)->error;
     scheduler.Finish({id, last->run}, std::string("/results/old.exr"));
