@@ -53,6 +53,28 @@ class SqliteJobStoreTest : public ::testing::Test {
         }
     }
 
+    // Submits a job and merges every task, the last (its completion `last`: the job rendered)
+    // while the store fails its writes (FailingStore::fail, true only for that one).
+    static void RenderWithTheLastRecordFailing(Scheduler& scheduler, bool& fail,
+                                               std::optional<Scheduler::Completion>& last) {
+        ASSERT_TRUE(scheduler.Submit(Spec()).ok());
+        std::vector<TaskAssignment> leases;
+        while (std::optional<TaskAssignment> l = scheduler.LeaseTask("w")) leases.push_back(*l);
+        ASSERT_GE(leases.size(), 2u);
+        for (size_t i = 0; i + 1 < leases.size(); ++i) {
+            ASSERT_TRUE(scheduler.Complete(leases[i].lease_id, "w", Result(leases[i])).ok());
+        }
+        fail = true;
+        absl::StatusOr<Scheduler::Completion> done =
+            scheduler.Complete(leases.back().lease_id, "w", Result(leases.back()));
+        ASSERT_TRUE(done.ok()) << done.status();
+        ASSERT_TRUE(done->job_rendered);
+        ASSERT_TRUE(done->unrecorded.has_value());
+        ASSERT_EQ(done->unrecorded->task, leases.back().task.index);
+        fail = false;
+        last = *done;
+    }
+
     static std::vector<float> Pixels(const Scheduler& scheduler, const std::string& id) {
         absl::StatusOr<Scheduler::JobImage> snapshot = scheduler.Snapshot(id);
         EXPECT_TRUE(snapshot.ok()) << snapshot.status();
@@ -402,24 +424,15 @@ TEST_F(SqliteJobStoreTest, StoreThatCannotWriteRefusesWithoutHarmingEarlierJobs)
 TEST_F(SqliteJobStoreTest, LastResultThatCannotBeRecordedFailsTheJobBeforeItEnds) {
     FailingStore store;
     Scheduler scheduler({}, store);
-    const std::string id = *scheduler.Submit(Spec());
-    std::vector<TaskAssignment> leases;
-    while (std::optional<TaskAssignment> l = scheduler.LeaseTask("w")) leases.push_back(*l);
-    ASSERT_GE(leases.size(), 2u);
-    for (size_t i = 0; i + 1 < leases.size(); ++i) {
-        ASSERT_TRUE(scheduler.Complete(leases[i].lease_id, "w", Result(leases[i])).ok());
-    }
-    store.fail = true;
-    const absl::StatusOr<Scheduler::Completion> last =
-        scheduler.Complete(leases.back().lease_id, "w", Result(leases.back()));
-    ASSERT_TRUE(last.ok()) << last.status();
-    ASSERT_TRUE(last->job_rendered);
+    std::optional<Scheduler::Completion> last;
+    ASSERT_NO_FATAL_FAILURE(RenderWithTheLastRecordFailing(scheduler, store.fail, last));
+    const std::string id = last->job_id;
     EXPECT_EQ(scheduler.Get(id)->state, JobState::kRunning) << "not failed before the wait";
     const absl::Status recorded = scheduler.AwaitRecorded(*last);
     EXPECT_EQ(recorded.code(), absl::StatusCode::kResourceExhausted);
     EXPECT_EQ(scheduler.Get(id)->state, JobState::kFailed);
     EXPECT_NE(scheduler.Get(id)->error.find(
-                  absl::StrCat("recording the result of task ", leases.back().task.index, ": ")),
+                  absl::StrCat("recording the result of task ", last->unrecorded->task, ": ")),
               std::string::npos)
         << scheduler.Get(id)->error;
 }
@@ -430,19 +443,10 @@ TEST_F(SqliteJobStoreTest, LastResultThatCannotBeRecordedFailsTheJobBeforeItEnds
 TEST_F(SqliteJobStoreTest, WhatIsDecidedForAnEndedRunLeavesTheJobQueuedAgainAlone) {
     FailingStore store;
     Scheduler scheduler({}, store);
-    const std::string id = *scheduler.Submit(Spec());
-    std::vector<TaskAssignment> leases;
-    while (std::optional<TaskAssignment> l = scheduler.LeaseTask("w")) leases.push_back(*l);
-    for (size_t i = 0; i + 1 < leases.size(); ++i) {
-        ASSERT_TRUE(scheduler.Complete(leases[i].lease_id, "w", Result(leases[i])).ok());
-    }
-    store.fail = true;
-    const absl::StatusOr<Scheduler::Completion> last =
-        scheduler.Complete(leases.back().lease_id, "w", Result(leases.back()));
-    ASSERT_TRUE(last.ok()) << last.status();
-    ASSERT_TRUE(last->job_rendered);
-    store.fail = false;
-    ASSERT_TRUE(scheduler.Cancel(id).ok());
+    std::optional<Scheduler::Completion> last;
+    ASSERT_NO_FATAL_FAILURE(RenderWithTheLastRecordFailing(scheduler, store.fail, last));
+    ASSERT_TRUE(scheduler.Cancel(last->job_id).ok());
+    const std::string id = last->job_id;
     const absl::StatusOr<Scheduler::Requeued> requeued = scheduler.RequeueJob(id);
     ASSERT_TRUE(requeued.ok()) << requeued.status();
     EXPECT_NE(requeued->run, last->run);
